@@ -1,0 +1,215 @@
+// Headless explore run: image → scene → simulated pantograph + model hand → servo ticks → files.
+#include "explore.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "config/load.hpp"
+#include "haptics/hand_path.hpp"
+#include "haptics/servo.hpp"
+#include "haptics/sim_pantograph.hpp"
+#include "image_scene.hpp"
+
+namespace hk::app {
+namespace {
+
+using json = nlohmann::json;
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void write_text(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream f(p, std::ios::binary | std::ios::trunc);
+  f << text;
+  f.close();
+  if (!f) throw ExploreError("output '" + p.string() + "': cannot write the file");
+}
+
+json scene_json(const ImageScene& is, const config::Settings& s) {
+  json j;
+  j["image"] = {{"path", is.image_path}, {"width_px", is.width_px}, {"height_px", is.height_px}};
+  j["px_to_m"] = {{"scale", is.px_to_m.scale_m_per_px}, {"offset_x_m", is.px_to_m.offset_x_m}, {"offset_y_m", is.px_to_m.offset_y_m}};
+  j["stiffness_n_per_m"] = s.haptics.stiffness_n_per_m;
+  j["max_force_n"] = s.haptics.max_force_n;
+  j["level_in_use"] = s.haptics.level;
+  json curves = json::array();
+  const Scene& sc = *is.scene;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    json levels = json::array();
+    for (int l = 0; l < ci.levels; ++l) {
+      json pts = json::array();
+      const Vec2* p = sc.points(c, l);
+      for (std::uint32_t i = 0; i < ci.point_count[l]; ++i) pts.push_back({p[i].x, p[i].y});
+      levels.push_back({{"level", l}, {"points_m", std::move(pts)}, {"max_error_m", ci.max_error_m[l]},
+                        {"max_box_half_width_m", ci.max_box_half_width_m[l]}});
+    }
+    curves.push_back({{"id", c}, {"closed", ci.closed}, {"levels", std::move(levels)}});
+  }
+  j["curves"] = std::move(curves);
+  return j;
+}
+
+cv::Point2d to_px(const vision::PxToM& m, Vec2 q) { return {m.u_px(q.x), m.v_px(q.y)}; }
+
+void write_overlay(const std::filesystem::path& out, const ImageScene& is, int level, const std::vector<Vec2>& proxy_path) {
+  cv::Mat img = cv::imread(is.image_path, cv::IMREAD_COLOR);
+  if (img.empty()) throw ExploreError("image '" + is.image_path + "': could not be read again for the overlay");
+  // Dim the picture so the drawn curves stand out; draw at 4x sub-pixel precision.
+  img = img * 0.55;
+  const int thick = std::max(1, static_cast<int>(std::lround(std::max(img.cols, img.rows) / 400.0)));
+  constexpr int kShift = 2;
+  auto fixed = [&](cv::Point2d p) { return cv::Point(static_cast<int>(std::lround(p.x * 4)), static_cast<int>(std::lround(p.y * 4))); };
+  const Scene& sc = *is.scene;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const int l = sc.clamp_level(c, level);
+    std::vector<cv::Point> pts;
+    const Vec2* p = sc.points(c, l);
+    for (std::uint32_t i = 0; i < sc.curve(c).point_count[l]; ++i) pts.push_back(fixed(to_px(is.px_to_m, p[i])));
+    cv::polylines(img, pts, sc.curve(c).closed, cv::Scalar(0, 220, 255), thick, cv::LINE_AA, kShift);
+  }
+  std::vector<cv::Point> path;
+  const std::size_t stride = std::max<std::size_t>(1, proxy_path.size() / 20000);
+  for (std::size_t i = 0; i < proxy_path.size(); i += stride) path.push_back(fixed(to_px(is.px_to_m, proxy_path[i])));
+  if (path.size() > 1) cv::polylines(img, path, false, cv::Scalar(255, 120, 40), std::max(1, thick / 2), cv::LINE_AA, kShift);
+  if (!cv::imwrite(out.string(), img)) throw ExploreError("output '" + out.string() + "': cannot write the PNG");
+}
+
+double percentile(std::vector<std::int64_t>& v, double q) {
+  if (v.empty()) return 0.0;
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return static_cast<double>(v[k]);
+}
+
+}  // namespace
+
+ExploreSummary run_explore(const ExploreOptions& o) {
+  const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
+  if (!std::isfinite(o.duration_s) || o.duration_s > 24 * 3600.0) {
+    throw ExploreError("--duration " + std::to_string(o.duration_s) + " s is outside (0, 86400] s");
+  }
+  // Read the hand before the (slower) image so a bad hand file fails fast.
+  const HandPath path = o.hand == "raster" ? raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m,
+                                                         s.hand.raster_speed_m_per_s)
+                                           : load_hand_csv(o.hand);
+  std::error_code ec;
+  std::filesystem::create_directories(o.out_dir, ec);
+  if (ec || !std::filesystem::is_directory(o.out_dir)) {
+    throw ExploreError("output folder '" + o.out_dir + "': cannot create it (" + ec.message() + ")");
+  }
+  const std::filesystem::path out(o.out_dir);
+
+  ImageScene is = build_image_scene(o.image_path, s);
+  const Scene& scene = *is.scene;
+
+  SimPantographParams dp;
+  dp.handle_mass_kg = s.device.handle_mass_kg;
+  dp.handle_damping_n_s_per_m = s.device.handle_damping_n_s_per_m;
+  dp.encoder_counts_per_rev = s.device.encoder_counts_per_rev;
+  dp.max_torque_n_m = s.device.max_torque_n_m;
+  dp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
+  SimulatedPantograph device(dp, path.at(0.0));
+  device.open();
+  ModelHandParams hp;
+  hp.stiffness_n_per_m = s.hand.stiffness_n_per_m;
+  hp.damping_n_s_per_m = s.hand.damping_n_s_per_m;
+  hp.max_force_n = s.hand.max_force_n;
+
+  ServoParams sp;
+  sp.period_s = 1.0 / s.haptics.servo_rate_hz;
+  sp.level = s.haptics.level;
+  sp.query_deadline_s = s.haptics.query_deadline_us * 1e-6;
+  sp.contact.stiffness_n_per_m = s.haptics.stiffness_n_per_m;
+  sp.contact.damping_n_s_per_m = s.haptics.damping_n_s_per_m;
+  sp.contact.max_force_n = s.haptics.max_force_n;
+  sp.guard.max_force_n = s.haptics.max_force_n;
+  sp.guard.ramp_s = s.haptics.force_ramp_s;
+  ServoLoop servo(scene, sp);
+  servo.start(device.read().handle_m);
+
+  const double duration = o.duration_s > 0.0 ? o.duration_s : path.duration_s() + 0.5;
+  const long n_ticks = static_cast<long>(std::ceil(duration / sp.period_s));
+
+  const std::filesystem::path trace_path = out / "trace.csv";
+  std::unique_ptr<FILE, int (*)(FILE*)> trace(std::fopen(trace_path.c_str(), "w"), &std::fclose);
+  if (!trace) throw ExploreError("output '" + trace_path.string() + "': cannot open for writing");
+  static char buffer[1 << 16];
+  std::setvbuf(trace.get(), buffer, _IOFBF, sizeof buffer);
+  std::fputs("t_s,handle_x_m,handle_y_m,proxy_x_m,proxy_y_m,force_x_n,force_y_n,contact,curve,level,tick_ns\n", trace.get());
+
+  ExploreSummary sum;
+  sum.curves = scene.curve_count();
+  std::vector<std::int64_t> tick_ns;
+  tick_ns.reserve(static_cast<std::size_t>(n_ticks));
+  std::vector<Vec2> proxy_path;
+  proxy_path.reserve(static_cast<std::size_t>(n_ticks));
+  long budget_exhausted = 0;
+  ServoOutput so;
+  for (long k = 0; k < n_ticks; ++k) {
+    const double t = static_cast<double>(k) * sp.period_s;
+    ServoInput in;
+    in.sample = device.read();
+    const std::int64_t t0 = steady_ns();
+    in.now_ns = t0;
+    servo.update(in, so);
+    const std::int64_t t1 = steady_ns();
+    device.write_force(so.force_n);
+    device.step(sp.period_s, model_hand_force(hp, path.at(t), device.true_position_m(), device.velocity_m_per_s()));
+
+    const ContactOutput& c = so.contact;
+    const int state = static_cast<int>(c.state);
+    const int curve = c.state == ContactState::Free ? -1 : c.constraint[0].curve;
+    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld\n", t, in.sample.handle_m.x, in.sample.handle_m.y,
+                 c.proxy_m.x, c.proxy_m.y, so.force_n.x, so.force_n.y, state, curve, c.level, static_cast<long long>(t1 - t0));
+    tick_ns.push_back(t1 - t0);
+    proxy_path.push_back(c.proxy_m);
+    ++sum.ticks;
+    sum.free_ticks += state == 0;
+    sum.edge_ticks += state == 1;
+    sum.vertex_ticks += state == 2;
+    sum.max_force_n = std::max(sum.max_force_n, length(so.force_n));
+    budget_exhausted += c.query.budget_exhausted;
+  }
+  if (std::fflush(trace.get()) != 0 || std::ferror(trace.get())) throw ExploreError("output '" + trace_path.string() + "': write failed");
+  trace.reset();
+  device.close();
+
+  write_text(out / "scene.json", scene_json(is, s).dump() + "\n");
+  json sj;
+  sj["ticks"] = sum.ticks;
+  sj["servo_rate_hz"] = s.haptics.servo_rate_hz;
+  sj["tick_ns"] = {{"p50", percentile(tick_ns, 0.5)}, {"p99", percentile(tick_ns, 0.99)}, {"p999", percentile(tick_ns, 0.999)},
+                   {"max", tick_ns.empty() ? 0.0 : static_cast<double>(*std::max_element(tick_ns.begin(), tick_ns.end()))}};
+  sj["contact_ticks"] = {{"free", sum.free_ticks}, {"edge", sum.edge_ticks}, {"vertex", sum.vertex_ticks}};
+  sj["max_force_n"] = sum.max_force_n;
+  sj["query_budget_exhausted_ticks"] = budget_exhausted;
+  sj["curves"] = scene.curve_count();
+  sj["chains"] = {{"found", is.chains_found}, {"too_short", is.chains_too_short}, {"unbuildable", scene.skipped_curves()}};
+  json segs = json::array();
+  for (int l = 0; l < Scene::kMaxLevels; ++l) {
+    bool any = false;
+    for (std::size_t c = 0; c < scene.curve_count(); ++c) any = any || scene.curve(c).levels > l;
+    if (!any) break;
+    segs.push_back({{"level", l}, {"segments", scene.total_segments(l)}});
+  }
+  sj["segments_per_level"] = std::move(segs);
+  sj["segments_in_use"] = scene.total_segments(s.haptics.level);
+  sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};
+  sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms},
+                    {"multires", is.times.multires_ms}, {"tree", is.times.tree_ms}};
+  write_text(out / "summary.json", sj.dump(2) + "\n");
+  write_overlay(out / "overlay.png", is, s.haptics.level, proxy_path);
+  return sum;
+}
+
+}  // namespace hk::app

@@ -1,0 +1,39 @@
+#pragma once
+/// @file explore.hpp
+/// The headless `explore` run (DESIGN.md "Headless runs"): the whole pipeline on the simulated
+/// pantograph driven by a model hand, tick by tick as fast as it can, writing scene.json, trace.csv,
+/// summary.json and overlay.png into the output folder.
+
+#include <stdexcept>
+#include <string>
+
+namespace hk::app {
+
+/// What `haptic-kiosk explore` was asked to do.
+struct ExploreOptions {
+  std::string image_path;      ///< picture to explore
+  std::string out_dir;         ///< folder for the four output files (created if missing)
+  std::string hand = "raster"; ///< "raster" or a CSV file with header t_s,x_m,y_m
+  double duration_s = 0.0;     ///< run length [s]; ≤ 0: the hand path's duration + 0.5 s
+  std::string config_path;     ///< TOML settings; empty: defaults
+};
+
+/// A problem with the run's own arguments or output folder (bad inputs raise their own typed errors:
+/// vision::InputError, config::ConfigError, HandFileError).
+class ExploreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Numbers of a finished run (also written to summary.json).
+struct ExploreSummary {
+  long ticks = 0;
+  long free_ticks = 0, edge_ticks = 0, vertex_ticks = 0;
+  double max_force_n = 0.0;
+  std::size_t curves = 0;
+};
+
+/// Runs explore. Throws on bad input with a one-line message naming the input and the limit.
+ExploreSummary run_explore(const ExploreOptions& options);
+
+}  // namespace hk::app

@@ -1,0 +1,53 @@
+#include "image_scene.hpp"
+
+namespace hk::app {
+
+ImageScene build_image_scene(const std::string& path, const config::Settings& s) {
+  ImageScene out;
+  out.image_path = path;
+  vision::ExtractParams p;
+  p.limits.max_file_bytes = s.vision.max_file_bytes;
+  p.limits.max_width_px = s.vision.max_width_px;
+  p.limits.max_height_px = s.vision.max_height_px;
+  p.limits.max_pixels = s.vision.max_pixels;
+  p.edges.blur_sigma_px = s.vision.blur_sigma_px;
+  p.edges.canny_low = s.vision.canny_low;
+  p.edges.canny_high = s.vision.canny_high;
+  p.max_image_side_px = s.vision.max_image_side_px;
+  // Length is judged in metres below, where the workspace scale is known; keep every real chain here.
+  p.min_chain_length_px = 2.0;
+  const vision::Extraction ex = vision::extract_chains(path, p);
+  out.width_px = ex.width_px;
+  out.height_px = ex.height_px;
+  out.canny_low = ex.edge_map.low;
+  out.canny_high = ex.edge_map.high;
+  out.times.load_ms = ex.times.load_ms;
+  out.times.edges_ms = ex.times.edges_ms;
+  out.times.linking_ms = ex.times.linking_ms;
+  out.px_to_m = vision::fit_to_workspace(ex.width_px, ex.height_px, s.workspace.width_m, s.workspace.height_m);
+  out.chains_found = ex.chains.size();
+
+  for (const vision::Chain& c : ex.chains) {
+    Polyline pl;
+    pl.closed = c.closed;
+    pl.points_m.reserve(c.points_px.size());
+    double length_m = 0.0;
+    for (const auto& q : c.points_px) {
+      const Vec2 m{out.px_to_m.x_m(q.x), out.px_to_m.y_m(q.y)};
+      if (!pl.points_m.empty()) length_m += distance(pl.points_m.back(), m);
+      pl.points_m.push_back(m);
+    }
+    if (pl.closed && pl.points_m.size() > 1) length_m += distance(pl.points_m.back(), pl.points_m.front());
+    if (length_m < s.vision.min_chain_length_m) {  // a fingertip cannot resolve it
+      ++out.chains_too_short;
+      continue;
+    }
+    out.polylines.push_back(std::move(pl));
+  }
+  out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
+  out.times.multires_ms = out.scene->build_times().multires_ms;
+  out.times.tree_ms = out.scene->build_times().tree_ms;
+  return out;
+}
+
+}  // namespace hk::app

@@ -1,0 +1,48 @@
+// haptic-kiosk: command line entry. Subcommands so far: explore (headless run, DESIGN.md contract).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "explore.hpp"
+
+namespace {
+
+// Errors reach the visitor's operator as exactly one line: fold any line breaks a library put in.
+void print_error(const std::string& what) {
+  std::string line = what;
+  for (char& ch : line) {
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  }
+  std::fprintf(stderr, "haptic-kiosk: %s\n", line.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"haptic-kiosk: feel the shapes in a picture through a force-feedback pantograph"};
+  cli.require_subcommand(1);
+  hk::app::ExploreOptions eo;
+  CLI::App* explore = cli.add_subcommand("explore", "Run the whole pipeline headless on the simulated pantograph");
+  explore->add_option("image", eo.image_path, "Picture to explore (PNG, JPEG, BMP, TIFF, WebP)")->required();
+  explore->add_option("--out", eo.out_dir, "Folder for scene.json, trace.csv, summary.json, overlay.png")->required();
+  explore->add_option("--hand", eo.hand, "Model hand: 'raster' or a CSV file with header t_s,x_m,y_m")->default_val("raster");
+  explore->add_option("--duration", eo.duration_s, "Run length [s]; default: the hand path's length")->check(CLI::PositiveNumber);
+  explore->add_option("--config", eo.config_path, "Settings file (TOML)");
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return cli.exit(e);
+  }
+  try {
+    if (*explore) {
+      const auto sum = hk::app::run_explore(eo);
+      std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n", sum.ticks,
+                  sum.curves, sum.edge_ticks, sum.vertex_ticks, sum.max_force_n, eo.out_dir.c_str());
+    }
+  } catch (const std::exception& e) {
+    print_error(e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,99 @@
+#pragma once
+/// @file collision_query.hpp
+/// Anytime hierarchical collision detection of a swept point against the scene's collision trees
+/// (seed paper §3; DESIGN.md "Collision query").
+///
+/// The handle moves from a to b in one tick. The boundary section — the frontier of tree nodes near the
+/// handle — is kept from tick to tick and changes by splits (a box hit by the sweep is refined to its
+/// children) and merges (two siblings whose parent is clear by a margin are replaced by the parent).
+/// Each tick the sweep is clipped (Liang–Barsky) against the boxes of the boundary section; hit boxes
+/// are sorted by entry parameter and refined depth-first, nearest first, down to the target level,
+/// where the sweep is intersected with that level's polyline. Boxes whose entry lies past the best hit
+/// so far are pruned. A budget (deadline and/or box-test count) makes it anytime: past it, a box not yet
+/// refined is answered with its own level's segment, so the answer is the one at the finest level reached.
+///
+/// Real-time: all storage is sized in the constructor; `first_hit` allocates nothing, takes no lock,
+/// throws nothing.
+
+#include <cstdint>
+#include <vector>
+
+#include "haptics/scene.hpp"
+
+namespace hk {
+
+/// Liang–Barsky clipping of the segment a→b against a box (grown by margin_m on every side).
+/// Returns true on overlap and writes the entry and exit parameters in [0, 1].
+bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit);
+
+/// Proper or touching intersection of the sweep a→b with segment p→q. Returns true with `t` the sweep
+/// parameter in [0, 1] of the first common point; parallel (including collinear) pairs never hit,
+/// because a sweep sliding along a wall does not cross it.
+bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t);
+
+/// Limits that make the query anytime. Zero means "no limit".
+struct QueryBudget {
+  std::int64_t deadline_ns = 0;   ///< absolute steady-clock time [ns] after which refinement stops
+  std::int32_t max_box_tests = 0; ///< box clips after which refinement stops (deterministic deadline for tests)
+};
+
+/// Result of a sweep query.
+struct SweepHit {
+  bool hit = false;
+  double t = 1.0;        ///< sweep parameter of the first hit, in [0, 1]
+  Vec2 point_m;          ///< a + t (b − a) [m]
+  SegmentRef segment;    ///< the segment hit (its level is the level actually reached)
+};
+
+/// Work done by one query (for timing analysis and the anytime chart).
+struct QueryStats {
+  std::int32_t box_tests = 0;
+  std::int32_t segment_tests = 0;
+  std::int32_t splits = 0;
+  std::int32_t merges = 0;
+  std::int32_t section_size = 0;       ///< boundary-section nodes after the query
+  std::int32_t coarsest_answer_level = 0;  ///< coarsest level at which a segment was tested (> target when the budget ran out)
+  bool budget_exhausted = false;
+};
+
+/// The boundary section of one scene plus the scratch space of the query. One per servo thread.
+class BoundarySection {
+ public:
+  static constexpr int kMaxExcluded = 2;
+
+  /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots.
+  explicit BoundarySection(const Scene& scene, double merge_margin_m = 1e-3);
+
+  /// Forgets the frontier: back to one root per curve. Real-time safe.
+  void reset();
+
+  /// First hit of the sweep a→b against the polylines at `level` (clamped per curve to its coarsest),
+  /// ignoring up to kMaxExcluded segments (the contact solver's active constraints). Updates the
+  /// boundary section. Real-time safe.
+  SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
+                     const QueryBudget& budget, QueryStats* stats = nullptr);
+
+  /// Closest point on the polylines at `level` to p within max_distance_m, by a box-distance-pruned
+  /// walk from the roots (does not use or change the frontier). Returns false when nothing is that close.
+  bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out);
+
+  /// Node ids of the current boundary section (for the operator overlay and tests).
+  const std::vector<std::uint32_t>& section() const { return section_; }
+
+ private:
+  void split(std::uint32_t node);
+  const Scene* scene_;
+  double merge_margin_m_;
+  std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
+  std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
+  std::vector<std::uint8_t> removed_;      // per node: 1 when split/merged away this tick (compacted at the end)
+  struct Candidate { double t_enter; std::uint32_t node; };
+  std::vector<Candidate> candidates_;      // section nodes hit this tick
+  std::vector<std::uint32_t> merge_scratch_;
+  std::vector<Candidate> stack_;           // DFS stack, sized for the widest root fan-out plus 2 per level
+  std::vector<std::uint32_t> hit_stamp_;   // per node: tick at which its margin-grown box was last hit
+  std::uint32_t tick_ = 0;
+  int last_level_ = -1;
+};
+
+}  // namespace hk

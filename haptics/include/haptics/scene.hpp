@@ -1,0 +1,130 @@
+#pragma once
+/// @file scene.hpp
+/// The scene index: every curve's multiresolution polylines and its collision tree of error boxes
+/// (seed paper §3, DESIGN.md "Collision tree"), stored scene-wide in flat arrays addressed by node ids,
+/// so the servo tick walks them with indices and a fixed-size stack and never chases pointers.
+///
+/// Node numbering. Segment k of level l of curve c is node `curves[c].box_offset[l] + k`. After all
+/// segment nodes come one root node per curve (`root_node(c)`) whose box is the curve's axis-aligned
+/// bounding box; its children are the segments of the coarsest level. Children of segment k at level l
+/// (l ≥ 1) are segments 2k and 2k+1 at level l−1.
+
+#include <cstdint>
+#include <vector>
+
+#include "haptics/multires.hpp"
+#include "haptics/vec2.hpp"
+
+namespace hk {
+
+/// A box aligned with a segment (seed §3 "error bounding box"). 64 bytes.
+/// Points q inside satisfy u_min ≤ dot(q − origin, axis) ≤ u_max and n_min ≤ cross(axis, q − origin) ≤ n_max.
+struct ErrorBox {
+  Vec2 origin_m;        ///< frame origin: the segment's first point [m]
+  Vec2 axis;            ///< unit vector along the segment (x axis for a zero-length segment)
+  double u_min = 0.0;   ///< extent along axis [m]
+  double u_max = 0.0;
+  double n_min = 0.0;   ///< extent along the left normal [m]
+  double n_max = 0.0;
+};
+
+/// True when p lies in the box, grown by `margin_m` on every side.
+bool box_contains(const ErrorBox& box, Vec2 p, double margin_m = 0.0);
+/// The four corners of the box [m], counter-clockwise.
+void box_corners(const ErrorBox& box, Vec2 out[4]);
+/// Largest distance of a box point from the line through its segment [m]: max(|n_min|, |n_max|).
+double box_half_width(const ErrorBox& box);
+
+/// Where one curve's data sits in the scene arrays. Levels 0 .. levels−1.
+struct CurveInfo {
+  bool closed = false;
+  int levels = 0;
+  std::uint32_t point_offset[16] = {};   ///< index of level l's first point in Scene::points_m
+  std::uint32_t point_count[16] = {};    ///< points of level l
+  std::uint32_t box_offset[16] = {};     ///< node id of level l's first segment
+  std::uint32_t segment_count[16] = {};  ///< segments of level l (closed: points; open: points − 1)
+  double max_error_m[16] = {};           ///< largest distance of an original point from the level-l segment standing for it [m]
+  double max_box_half_width_m[16] = {};  ///< largest error box half-width at level l [m]
+};
+
+/// Identifies one segment of one level of one curve.
+struct SegmentRef {
+  std::int32_t curve = -1;
+  std::int32_t level = 0;
+  std::int32_t segment = -1;
+};
+constexpr bool operator==(SegmentRef a, SegmentRef b) { return a.curve == b.curve && a.level == b.level && a.segment == b.segment; }
+
+/// Per-node bookkeeping the tree walks need. 12 bytes.
+struct NodeInfo {
+  std::uint32_t curve = 0;
+  std::int32_t level = 0;     ///< segment level, or `levels` of its curve for a root node
+  std::uint32_t index = 0;    ///< segment index within its level (0 for a root)
+};
+
+/// Build timings of a scene [ms].
+struct SceneBuildTimes {
+  double multires_ms = 0.0;
+  double tree_ms = 0.0;
+};
+
+/// All curves of a picture, ready for the servo loop. Immutable once built; shared read-only.
+class Scene {
+ public:
+  static constexpr int kMaxLevels = 16;
+
+  /// Builds multiresolution models and collision trees for `curves` (workspace metres), with at most
+  /// `max_levels` levels above level 0 (clamped to kMaxLevels − 1). Curves with fewer than 2 distinct
+  /// points or zero length are skipped (counted in skipped_curves()). Throws std::bad_alloc only.
+  static Scene build(const std::vector<Polyline>& curves, int max_levels);
+
+  std::size_t curve_count() const { return curves_.size(); }
+  const CurveInfo& curve(std::size_t c) const { return curves_[c]; }
+  /// The multiresolution model of curve c (scaling and wavelet coefficients; not used by the servo path).
+  const CurveMultires& model(std::size_t c) const { return models_[c]; }
+  /// Index of curve c in the `curves` handed to build().
+  std::size_t source_index(std::size_t c) const { return source_index_[c]; }
+  std::size_t skipped_curves() const { return skipped_; }
+
+  /// Total nodes: all segment nodes of all levels of all curves, then one root per curve.
+  std::size_t node_count() const { return boxes_.size(); }
+  std::uint32_t root_node(std::size_t c) const { return static_cast<std::uint32_t>(segment_nodes_ + c); }
+  bool is_root(std::uint32_t node) const { return node >= segment_nodes_; }
+  const ErrorBox& box(std::uint32_t node) const { return boxes_[node]; }
+  const NodeInfo& info(std::uint32_t node) const { return info_[node]; }
+  std::uint32_t node_of(SegmentRef s) const { return curves_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
+  /// Parent of a node (a root's parent is itself).
+  std::uint32_t parent(std::uint32_t node) const;
+  /// First child and child count of a node (0 children for a level-0 segment).
+  void children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const;
+
+  /// Level-l points of curve c (the scaling coefficients) [m].
+  const Vec2* points(std::size_t c, int level) const { return points_m_.data() + curves_[c].point_offset[level]; }
+  /// End points of a segment [m].
+  void segment(SegmentRef s, Vec2* a, Vec2* b) const;
+  /// Segment count over all curves at `level` (curves with fewer levels use their coarsest).
+  std::size_t total_segments(int level) const;
+  /// Coarsest level available in every curve clamped: min(level, levels−1 of curve c).
+  int clamp_level(std::size_t c, int level) const {
+    const int top = curves_[c].levels - 1;
+    return level < 0 ? 0 : (level > top ? top : level);
+  }
+  /// Bounding rectangle of every curve's level-0 points [m].
+  Vec2 bounds_min() const { return bounds_min_; }
+  Vec2 bounds_max() const { return bounds_max_; }
+  const SceneBuildTimes& build_times() const { return times_; }
+
+ private:
+  std::vector<CurveInfo> curves_;
+  std::vector<CurveMultires> models_;
+  std::vector<std::size_t> source_index_;
+  std::vector<Vec2> points_m_;
+  std::vector<ErrorBox> boxes_;
+  std::vector<NodeInfo> info_;
+  std::size_t segment_nodes_ = 0;
+  std::size_t skipped_ = 0;
+  Vec2 bounds_min_{0, 0}, bounds_max_{0, 0};
+  SceneBuildTimes times_;
+};
+
+}  // namespace hk

@@ -1,0 +1,289 @@
+// Anytime swept-point query over the collision trees (seed paper §3).
+#include "haptics/collision_query.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace hk {
+namespace {
+
+inline std::int64_t steady_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Distance from p to a box (0 inside) [m].
+inline double box_distance(const ErrorBox& box, Vec2 p) {
+  const Vec2 r = p - box.origin_m;
+  const double u = dot(r, box.axis);
+  const double n = cross(box.axis, r);
+  const double du = std::max({box.u_min - u, 0.0, u - box.u_max});
+  const double dn = std::max({box.n_min - n, 0.0, n - box.n_max});
+  return std::hypot(du, dn);
+}
+
+}  // namespace
+
+bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit) {
+  // Work in the box frame: u along the axis, n along the left normal.
+  const Vec2 ra = a - box.origin_m;
+  const Vec2 d = b - a;
+  const double p0[2] = {dot(ra, box.axis), cross(box.axis, ra)};
+  const double dp[2] = {dot(d, box.axis), cross(box.axis, d)};
+  const double lo[2] = {box.u_min - margin_m, box.n_min - margin_m};
+  const double hi[2] = {box.u_max + margin_m, box.n_max + margin_m};
+  double t0 = 0.0, t1 = 1.0;
+  for (int i = 0; i < 2; ++i) {
+    if (dp[i] == 0.0) {
+      if (p0[i] < lo[i] || p0[i] > hi[i]) return false;  // parallel to this slab and outside it
+      continue;
+    }
+    const double inv = 1.0 / dp[i];
+    double ta = (lo[i] - p0[i]) * inv;
+    double tb = (hi[i] - p0[i]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  *t_enter = t0;
+  *t_exit = t1;
+  return true;
+}
+
+bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) {
+  const Vec2 r = b - a;
+  const Vec2 s = q - p;
+  const double denom = cross(r, s);
+  if (denom == 0.0) return false;  // parallel or collinear: sliding along a wall is not crossing it
+  const Vec2 ap = p - a;
+  const double tt = cross(ap, s) / denom;
+  const double uu = cross(ap, r) / denom;
+  if (tt < 0.0 || tt > 1.0 || uu < 0.0 || uu > 1.0) return false;
+  *t = tt;
+  return true;
+}
+
+BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : scene_(&scene), merge_margin_m_(merge_margin_m) {
+  const std::size_t n = scene.node_count();
+  std::size_t widest_root = 0;
+  for (std::size_t c = 0; c < scene.curve_count(); ++c) {
+    const CurveInfo& ci = scene.curve(c);
+    widest_root = std::max<std::size_t>(widest_root, ci.segment_count[ci.levels - 1]);
+  }
+  // Room for every node twice: entries removed this tick stay until the compaction at its end.
+  section_.reserve(2 * n + widest_root + 8);
+  in_section_.assign(n, 0);
+  removed_.assign(n, 0);
+  candidates_.reserve(2 * n + widest_root + 8);
+  merge_scratch_.reserve(2 * n + widest_root + 8);
+  stack_.resize(widest_root + 4 * Scene::kMaxLevels + 8);
+  hit_stamp_.assign(n, 0);
+  reset();
+}
+
+void BoundarySection::reset() {
+  for (std::uint32_t node : section_) in_section_[node] = 0;
+  section_.clear();
+  for (std::size_t c = 0; c < scene_->curve_count(); ++c) {
+    const std::uint32_t r = scene_->root_node(c);
+    section_.push_back(r);
+    in_section_[r] = 1;
+  }
+}
+
+void BoundarySection::split(std::uint32_t node) {
+  std::uint32_t first = 0, count = 0;
+  scene_->children(node, &first, &count);
+  if (count == 0 || !in_section_[node]) return;
+  in_section_[node] = 0;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    section_.push_back(first + i);
+    in_section_[first + i] = 1;
+  }
+}
+
+SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
+                                    const QueryBudget& budget, QueryStats* stats_out) {
+  QueryStats st;
+  SweepHit best;
+  best.t = std::numeric_limits<double>::infinity();
+  best.point_m = b;
+  const Scene& sc = *scene_;
+  if (level != last_level_) {  // the frontier was cut for another level: start again from the roots
+    reset();
+    last_level_ = level;
+  }
+  ++tick_;
+  if (tick_ == 0) {  // stamp wrap-around: clear so old stamps cannot match
+    std::fill(hit_stamp_.begin(), hit_stamp_.end(), 0u);
+    tick_ = 1;
+  }
+  bool exhausted = false;
+  auto charge_box = [&]() {
+    ++st.box_tests;
+    if (exhausted) return;
+    if (budget.max_box_tests > 0 && st.box_tests >= budget.max_box_tests) exhausted = true;
+    // Read the clock every 8 box tests: cheap enough, fine enough for µs deadlines.
+    if (budget.deadline_ns > 0 && (st.box_tests & 7) == 0 && steady_now_ns() > budget.deadline_ns) exhausted = true;
+  };
+  auto is_excluded = [&](SegmentRef s) {
+    for (int i = 0; i < excluded_count; ++i) {
+      if (excluded[i] == s) return true;
+    }
+    return false;
+  };
+  auto test_segment = [&](std::uint32_t node) {
+    const NodeInfo& in = sc.info(node);
+    const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+    if (is_excluded(ref)) return;
+    ++st.segment_tests;
+    st.coarsest_answer_level = std::max(st.coarsest_answer_level, in.level);
+    Vec2 p, q;
+    sc.segment(ref, &p, &q);
+    double t = 0.0;
+    if (intersect_sweep_segment(a, b, p, q, &t) && t < best.t) {
+      best.hit = true;
+      best.t = t;
+      best.segment = ref;
+    }
+  };
+
+  // 1. Clip the sweep against the boundary section (boxes grown by the merge margin, so one clip
+  //    answers both "hit?" and "still near?").
+  candidates_.clear();
+  merge_scratch_.clear();
+  const std::size_t n_section = section_.size();
+  for (std::size_t i = 0; i < n_section; ++i) {
+    const std::uint32_t node = section_[i];
+    double te = 0.0, tx = 0.0;
+    charge_box();
+    if (clip_segment_box(sc.box(node), a, b, merge_margin_m_, &te, &tx)) {
+      hit_stamp_[node] = tick_;
+      if (clip_segment_box(sc.box(node), a, b, 0.0, &te, &tx)) candidates_.push_back({te, node});
+    } else {
+      merge_scratch_.push_back(node);
+    }
+  }
+  // 2. Nearest first: sort hit boxes by entry parameter, refine depth-first, prune past the best hit.
+  std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& x, const Candidate& y) { return x.t_enter < y.t_enter; });
+  for (const Candidate& cand : candidates_) {
+    if (cand.t_enter > best.t) break;
+    int top = 0;
+    stack_[top++] = cand;
+    while (top > 0) {
+      const Candidate cur = stack_[--top];
+      if (cur.t_enter > best.t) continue;
+      const std::uint32_t node = cur.node;
+      const bool root = sc.is_root(node);
+      const NodeInfo& in = sc.info(node);
+      const int target = sc.clamp_level(in.curve, level);
+      if (!root && (in.level <= target || exhausted)) {
+        test_segment(node);
+        continue;
+      }
+      std::uint32_t first = 0, count = 0;
+      sc.children(node, &first, &count);
+      // Push hit children far-to-near so the nearest is popped first.
+      const int base = top;
+      for (std::uint32_t i = 0; i < count; ++i) {
+        double te = 0.0, tx = 0.0;
+        charge_box();
+        if (clip_segment_box(sc.box(first + i), a, b, 0.0, &te, &tx) && te <= best.t) stack_[top++] = {te, first + i};
+      }
+      std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
+    }
+  }
+  // 3. The boundary section follows the handle: split what was hit (one level per tick) ...
+  for (const Candidate& cand : candidates_) {
+    const NodeInfo& in = sc.info(cand.node);
+    if (sc.is_root(cand.node) || in.level > sc.clamp_level(in.curve, level)) {
+      split(cand.node);
+      ++st.splits;
+    }
+  }
+  // ... and merge siblings whose parent is clear of the sweep by the margin (bounded work per tick).
+  constexpr int kMaxMergesPerTick = 16;
+  for (std::uint32_t node : merge_scratch_) {
+    if (st.merges >= kMaxMergesPerTick) break;
+    if (!in_section_[node] || sc.is_root(node)) continue;
+    const std::uint32_t parent = sc.parent(node);
+    if (in_section_[parent]) continue;
+    std::uint32_t first = 0, count = 0;
+    sc.children(parent, &first, &count);
+    bool all_idle = true;
+    for (std::uint32_t i = 0; i < count && all_idle; ++i) all_idle = in_section_[first + i] && hit_stamp_[first + i] != tick_;
+    if (!all_idle) continue;
+    double te = 0.0, tx = 0.0;
+    charge_box();
+    if (clip_segment_box(sc.box(parent), a, b, merge_margin_m_, &te, &tx)) continue;
+    for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
+    in_section_[parent] = 1;
+    section_.push_back(parent);
+    ++st.merges;
+  }
+  // Compact: drop entries that were split or merged away.
+  std::size_t w = 0;
+  for (std::size_t i = 0; i < section_.size(); ++i) {
+    const std::uint32_t node = section_[i];
+    if (in_section_[node] && removed_[node] == 0) {
+      removed_[node] = 1;  // de-duplicate within this pass
+      section_[w++] = node;
+    }
+  }
+  section_.resize(w);
+  for (std::uint32_t node : section_) removed_[node] = 0;
+
+  if (best.hit) {
+    best.point_m = lerp(a, b, best.t);
+  } else {
+    best.t = 1.0;
+  }
+  st.budget_exhausted = exhausted;
+  st.section_size = static_cast<std::int32_t>(section_.size());
+  if (stats_out) *stats_out = st;
+  return best;
+}
+
+bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out) {
+  const Scene& sc = *scene_;
+  double best = max_distance_m;
+  bool found = false;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const std::uint32_t root = sc.root_node(c);
+    const double dr = box_distance(sc.box(root), p);
+    if (dr > best) continue;
+    const int target = sc.clamp_level(c, level);
+    int top = 0;
+    stack_[top++] = {dr, root};
+    while (top > 0) {
+      const Candidate cur = stack_[--top];
+      if (cur.t_enter > best) continue;
+      const NodeInfo& in = sc.info(cur.node);
+      if (!sc.is_root(cur.node) && in.level <= target) {
+        const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+        Vec2 a, b;
+        sc.segment(ref, &a, &b);
+        const Vec2 q = closest_point_on_segment(p, a, b);
+        const double d = distance(p, q);
+        if (d <= best) {
+          best = d;
+          found = true;
+          if (point_out) *point_out = q;
+          if (segment_out) *segment_out = ref;
+        }
+        continue;
+      }
+      std::uint32_t first = 0, count = 0;
+      sc.children(cur.node, &first, &count);
+      for (std::uint32_t i = 0; i < count; ++i) {
+        const double d = box_distance(sc.box(first + i), p);
+        if (d <= best) stack_[top++] = {d, first + i};
+      }
+    }
+  }
+  return found;
+}
+
+}  // namespace hk

@@ -1,0 +1,152 @@
+// Pseudocoiflet multiresolution of plane curves (seed paper §2, DESIGN.md "Wavelets").
+// The lifting form is used because it is exactly invertible in floating point (each step is undone by
+// subtracting the same rounded value) and needs no boundary-extended filter banks.
+#include "haptics/multires.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace hk {
+namespace {
+
+// Periodic index into a sequence of length n (k may be negative).
+inline std::size_t wrap(long k, std::size_t n) {
+  const long m = static_cast<long>(n);
+  long r = k % m;
+  return static_cast<std::size_t>(r < 0 ? r + m : r);
+}
+
+// Prediction of odd sample k from the even samples e (size ne), cubic interpolation (DESIGN.md).
+inline double predict(const double* e, std::size_t ne, std::size_t k, bool closed) {
+  if (closed) {
+    const long kk = static_cast<long>(k);
+    return (-e[wrap(kk - 1, ne)] + 9.0 * e[k] + 9.0 * e[wrap(kk + 1, ne)] - e[wrap(kk + 2, ne)]) / 16.0;
+  }
+  const std::size_t no = ne - 1;
+  if (k == 0) return (5.0 * e[0] + 15.0 * e[1] - 5.0 * e[2] + e[3]) / 16.0;
+  if (k == no - 1) return (5.0 * e[ne - 1] + 15.0 * e[ne - 2] - 5.0 * e[ne - 3] + e[ne - 4]) / 16.0;
+  return (-e[k - 1] + 9.0 * e[k] + 9.0 * e[k + 1] - e[k + 2]) / 16.0;
+}
+
+// Update of even sample k from the wavelet coefficients d (size nd). Open curves: outside d are zero
+// and the two end samples are not updated, so the curve keeps its ends at every level.
+inline double update(const double* d, std::size_t nd, std::size_t ne, std::size_t k, bool closed) {
+  const long kk = static_cast<long>(k);
+  if (closed) {
+    return (-d[wrap(kk - 2, nd)] + 9.0 * d[wrap(kk - 1, nd)] + 9.0 * d[k] - d[wrap(kk + 1, nd)]) / 32.0;
+  }
+  if (k == 0 || k == ne - 1) return 0.0;
+  auto at = [&](long i) { return (i >= 0 && i < static_cast<long>(nd)) ? d[i] : 0.0; };
+  return (-at(kk - 2) + 9.0 * at(kk - 1) + 9.0 * at(kk) - at(kk + 1)) / 32.0;
+}
+
+void check_forward_size(std::size_t n, bool closed) {
+  if (closed ? (n < 8 || n % 2 != 0) : (n < 7 || n % 2 == 0)) {
+    throw CurveError("pseudocoiflet transform: " + std::to_string(n) + " samples is not a valid " +
+                     (closed ? "closed length (even, >= 8)" : "open length (odd, >= 7)"));
+  }
+}
+
+}  // namespace
+
+void pseudocoiflet_forward(const std::vector<double>& x, bool closed, std::vector<double>& s, std::vector<double>& d) {
+  const std::size_t n = x.size();
+  check_forward_size(n, closed);
+  const std::size_t ne = closed ? n / 2 : (n + 1) / 2;
+  const std::size_t no = n / 2;
+  std::vector<double> e(ne);
+  for (std::size_t k = 0; k < ne; ++k) e[k] = x[2 * k];
+  d.assign(no, 0.0);
+  for (std::size_t k = 0; k < no; ++k) d[k] = x[2 * k + 1] - predict(e.data(), ne, k, closed);
+  s.assign(ne, 0.0);
+  for (std::size_t k = 0; k < ne; ++k) s[k] = e[k] + update(d.data(), no, ne, k, closed);
+}
+
+void pseudocoiflet_inverse(const std::vector<double>& s, const std::vector<double>& d, bool closed, std::vector<double>& x) {
+  const std::size_t ne = s.size();
+  const std::size_t no = d.size();
+  if (closed ? (no != ne || ne < 4) : (no + 1 != ne || ne < 4)) {
+    throw CurveError("pseudocoiflet inverse: " + std::to_string(ne) + " scaling and " + std::to_string(no) +
+                     " wavelet coefficients do not fit a " + (closed ? "closed" : "open") + " curve");
+  }
+  std::vector<double> e(ne);
+  for (std::size_t k = 0; k < ne; ++k) e[k] = s[k] - update(d.data(), no, ne, k, closed);
+  x.assign(ne + no, 0.0);
+  for (std::size_t k = 0; k < ne; ++k) x[2 * k] = e[k];
+  for (std::size_t k = 0; k < no; ++k) x[2 * k + 1] = d[k] + predict(e.data(), ne, k, closed);
+}
+
+std::vector<Vec2> resample_arc_length(const Polyline& curve, std::size_t count, std::vector<double>* arc_out) {
+  const auto& p = curve.points_m;
+  if (p.size() < 2) throw CurveError("curve has " + std::to_string(p.size()) + " points; at least 2 are needed");
+  for (const Vec2& q : p) {
+    if (!is_finite(q)) throw CurveError("curve has a non-finite coordinate");
+  }
+  if (count < (curve.closed ? 3u : 2u)) throw CurveError("resampling count " + std::to_string(count) + " is too small");
+  // Cumulative arc length of the input vertices; a closed curve adds its closing segment.
+  const std::size_t nseg = curve.closed ? p.size() : p.size() - 1;
+  std::vector<double> cum(nseg + 1, 0.0);
+  for (std::size_t i = 0; i < nseg; ++i) cum[i + 1] = cum[i] + distance(p[i], p[(i + 1) % p.size()]);
+  const double total = cum[nseg];
+  if (!(total > 0.0)) throw CurveError("curve has zero length");
+
+  std::vector<Vec2> out(count);
+  if (arc_out) arc_out->assign(count, 0.0);
+  const double step = curve.closed ? total / static_cast<double>(count) : total / static_cast<double>(count - 1);
+  std::size_t seg = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    double s = step * static_cast<double>(i);
+    if (!curve.closed && i + 1 == count) s = total;  // land exactly on the last point
+    while (seg + 1 < nseg && cum[seg + 1] < s) ++seg;
+    const double len = cum[seg + 1] - cum[seg];
+    const double t = len > 0.0 ? std::clamp((s - cum[seg]) / len, 0.0, 1.0) : 0.0;
+    out[i] = lerp(p[seg], p[(seg + 1) % p.size()], t);
+    if (arc_out) (*arc_out)[i] = s;
+  }
+  return out;
+}
+
+LevelPlan plan_levels(std::size_t point_count, bool closed, int max_levels) {
+  // Coarsest level keeps at least 4 segments (closed) or 3 (open): the cubic predictor needs 4 even samples.
+  const std::size_t min_k = closed ? 4 : 3;
+  const std::size_t segments = closed ? point_count : (point_count > 0 ? point_count - 1 : 0);
+  int levels = std::max(0, max_levels);
+  while (levels > 0 && (segments >> levels) < min_k) --levels;
+  const std::size_t unit = std::size_t{1} << levels;
+  const std::size_t k = std::max(min_k, (segments + unit - 1) / unit);
+  LevelPlan plan;
+  plan.k = k;
+  plan.levels_above_0 = levels;
+  plan.level0_points = k * unit + (closed ? 0 : 1);
+  return plan;
+}
+
+CurveMultires build_multires(const Polyline& curve, int max_levels) {
+  const LevelPlan plan = plan_levels(curve.points_m.size(), curve.closed, max_levels);
+  CurveMultires m;
+  m.closed = curve.closed;
+  m.levels = plan.levels_above_0 + 1;
+  m.scaling.resize(static_cast<std::size_t>(m.levels));
+  m.wavelet.resize(static_cast<std::size_t>(m.levels));
+  m.scaling[0] = resample_arc_length(curve, plan.level0_points, &m.arc_m);
+
+  std::vector<double> x, y, sx, sy, dx, dy;
+  for (int l = 1; l < m.levels; ++l) {
+    const auto& fine = m.scaling[static_cast<std::size_t>(l - 1)];
+    x.resize(fine.size());
+    y.resize(fine.size());
+    for (std::size_t i = 0; i < fine.size(); ++i) { x[i] = fine[i].x; y[i] = fine[i].y; }
+    pseudocoiflet_forward(x, curve.closed, sx, dx);
+    pseudocoiflet_forward(y, curve.closed, sy, dy);
+    auto& coarse = m.scaling[static_cast<std::size_t>(l)];
+    auto& w = m.wavelet[static_cast<std::size_t>(l)];
+    coarse.resize(sx.size());
+    for (std::size_t i = 0; i < sx.size(); ++i) coarse[i] = {sx[i], sy[i]};
+    w.resize(dx.size());
+    for (std::size_t i = 0; i < dx.size(); ++i) w[i] = {dx[i], dy[i]};
+  }
+  return m;
+}
+
+}  // namespace hk

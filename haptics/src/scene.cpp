@@ -1,0 +1,244 @@
+// Scene index and collision tree construction (seed paper §3; DESIGN.md "Collision tree").
+// Boxes are built bottom-up: a level-0 box holds its segment and the original input vertices it
+// stands for; a level-l box holds its segment and the corners of its two children's boxes, so a miss
+// on a box proves a miss on everything under it, down to the original curve.
+#include "haptics/scene.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace hk {
+namespace {
+
+// Boxes grow by this much on every side so that corners computed in another frame, which carry
+// rounding of a few ulps, still test inside their parents.
+constexpr double kBoxPad_m = 1e-9;
+
+struct Extent {
+  double u_min = std::numeric_limits<double>::infinity();
+  double u_max = -std::numeric_limits<double>::infinity();
+  double n_min = std::numeric_limits<double>::infinity();
+  double n_max = -std::numeric_limits<double>::infinity();
+};
+
+inline void grow(Extent& e, Vec2 origin, Vec2 axis, Vec2 q) {
+  const Vec2 r = q - origin;
+  const double u = dot(r, axis);
+  const double n = cross(axis, r);
+  e.u_min = std::min(e.u_min, u);
+  e.u_max = std::max(e.u_max, u);
+  e.n_min = std::min(e.n_min, n);
+  e.n_max = std::max(e.n_max, n);
+}
+
+inline ErrorBox make_box(Vec2 origin, Vec2 axis, const Extent& e) {
+  return ErrorBox{origin, axis, e.u_min - kBoxPad_m, e.u_max + kBoxPad_m, e.n_min - kBoxPad_m, e.n_max + kBoxPad_m};
+}
+
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+bool box_contains(const ErrorBox& box, Vec2 p, double margin_m) {
+  const Vec2 r = p - box.origin_m;
+  const double u = dot(r, box.axis);
+  const double n = cross(box.axis, r);
+  return u >= box.u_min - margin_m && u <= box.u_max + margin_m && n >= box.n_min - margin_m && n <= box.n_max + margin_m;
+}
+
+void box_corners(const ErrorBox& box, Vec2 out[4]) {
+  const Vec2 nrm = left_perp(box.axis);
+  out[0] = box.origin_m + box.u_min * box.axis + box.n_min * nrm;
+  out[1] = box.origin_m + box.u_max * box.axis + box.n_min * nrm;
+  out[2] = box.origin_m + box.u_max * box.axis + box.n_max * nrm;
+  out[3] = box.origin_m + box.u_min * box.axis + box.n_max * nrm;
+}
+
+double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min), std::abs(box.n_max)); }
+
+std::uint32_t Scene::parent(std::uint32_t node) const {
+  if (is_root(node)) return node;
+  const NodeInfo& in = info_[node];
+  const CurveInfo& c = curves_[in.curve];
+  if (in.level + 1 >= c.levels) return root_node(in.curve);
+  return c.box_offset[in.level + 1] + in.index / 2;
+}
+
+void Scene::children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const {
+  const NodeInfo& in = info_[node];
+  const CurveInfo& c = curves_[in.curve];
+  if (is_root(node)) {
+    *first = c.box_offset[c.levels - 1];
+    *count = c.segment_count[c.levels - 1];
+  } else if (in.level == 0) {
+    *first = 0;
+    *count = 0;
+  } else {
+    *first = c.box_offset[in.level - 1] + 2 * in.index;
+    *count = 2;
+  }
+}
+
+void Scene::segment(SegmentRef s, Vec2* a, Vec2* b) const {
+  const CurveInfo& c = curves_[static_cast<std::size_t>(s.curve)];
+  const Vec2* p = points_m_.data() + c.point_offset[s.level];
+  const std::uint32_t n = c.point_count[s.level];
+  const std::uint32_t k = static_cast<std::uint32_t>(s.segment);
+  *a = p[k];
+  *b = p[k + 1 == n ? 0 : k + 1];
+}
+
+std::size_t Scene::total_segments(int level) const {
+  std::size_t total = 0;
+  for (std::size_t c = 0; c < curves_.size(); ++c) total += curves_[c].segment_count[clamp_level(c, level)];
+  return total;
+}
+
+Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
+  Scene scene;
+  max_levels = std::clamp(max_levels, 0, kMaxLevels - 1);
+  const double t0 = now_ms();
+
+  // Multiresolution models first (they fix every array size).
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    try {
+      scene.models_.push_back(build_multires(input[i], max_levels));
+      scene.source_index_.push_back(i);
+    } catch (const CurveError&) {
+      ++scene.skipped_;  // fewer than 2 points or zero length: nothing to feel
+    }
+  }
+  const double t1 = now_ms();
+
+  // Lay out points and segment nodes, level by level within each curve.
+  std::size_t npoints = 0, nnodes = 0;
+  scene.curves_.resize(scene.models_.size());
+  for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+    const CurveMultires& m = scene.models_[c];
+    CurveInfo& ci = scene.curves_[c];
+    ci.closed = m.closed;
+    ci.levels = m.levels;
+    for (int l = 0; l < m.levels; ++l) {
+      ci.point_offset[l] = static_cast<std::uint32_t>(npoints);
+      ci.point_count[l] = static_cast<std::uint32_t>(m.scaling[l].size());
+      ci.box_offset[l] = static_cast<std::uint32_t>(nnodes);
+      ci.segment_count[l] = static_cast<std::uint32_t>(m.segment_count(l));
+      npoints += m.scaling[l].size();
+      nnodes += m.segment_count(l);
+    }
+  }
+  scene.segment_nodes_ = nnodes;
+  scene.points_m_.resize(npoints);
+  scene.boxes_.resize(nnodes + scene.curves_.size());
+  scene.info_.resize(nnodes + scene.curves_.size());
+
+  Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  Vec2 hi{-lo.x, -lo.y};
+  std::vector<double> orig_arc;
+  std::vector<std::uint32_t> orig_first;  // per level-0 segment: first original vertex strictly inside it
+  for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+    const CurveMultires& m = scene.models_[c];
+    const CurveInfo& ci = scene.curves_[c];
+    const Polyline& src = input[scene.source_index_[c]];
+    for (int l = 0; l < m.levels; ++l) {
+      std::copy(m.scaling[l].begin(), m.scaling[l].end(), scene.points_m_.begin() + ci.point_offset[l]);
+    }
+
+    // Arc length of every original vertex, to know which level-0 segment each one belongs to.
+    const auto& p = src.points_m;
+    orig_arc.assign(p.size() + 1, 0.0);
+    for (std::size_t i = 1; i < p.size(); ++i) orig_arc[i] = orig_arc[i - 1] + distance(p[i - 1], p[i]);
+    const double total = src.closed ? orig_arc[p.size() - 1] + distance(p.back(), p.front()) : orig_arc[p.size() - 1];
+    const std::size_t n0 = m.scaling[0].size();
+    const std::size_t s0 = ci.segment_count[0];
+    // Original vertex range [orig_first[k], orig_first[k+1]) lies within level-0 segment k.
+    orig_first.assign(s0 + 1, 0);
+    {
+      std::size_t j = 0;
+      for (std::size_t k = 0; k <= s0; ++k) {
+        const double start = k < n0 ? m.arc_m[k] : total;
+        while (j < p.size() && orig_arc[j] < start) ++j;
+        orig_first[k] = static_cast<std::uint32_t>(j);
+      }
+      orig_first[s0] = static_cast<std::uint32_t>(p.size());
+    }
+    auto level0_end = [&](std::size_t k) { return m.scaling[0][k + 1 == n0 ? 0 : k + 1]; };
+
+    // Level 0: segment + original vertices it stands for.
+    for (std::size_t k = 0; k < s0; ++k) {
+      const Vec2 a = m.scaling[0][k], b = level0_end(k);
+      const Vec2 axis = normalized_or(b - a, Vec2{1.0, 0.0});
+      Extent e;
+      grow(e, a, axis, a);
+      grow(e, a, axis, b);
+      for (std::uint32_t j = orig_first[k]; j < orig_first[k + 1]; ++j) grow(e, a, axis, p[j]);
+      const std::uint32_t node = ci.box_offset[0] + static_cast<std::uint32_t>(k);
+      scene.boxes_[node] = make_box(a, axis, e);
+      scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), 0, static_cast<std::uint32_t>(k)};
+    }
+    // Coarser levels: segment + children's box corners.
+    for (int l = 1; l < m.levels; ++l) {
+      const auto& pts = m.scaling[l];
+      for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
+        const Vec2 a = pts[k], b = pts[k + 1 == pts.size() ? 0 : k + 1];
+        const Vec2 axis = normalized_or(b - a, Vec2{1.0, 0.0});
+        Extent e;
+        grow(e, a, axis, a);
+        grow(e, a, axis, b);
+        for (std::uint32_t ch = 0; ch < 2; ++ch) {
+          Vec2 corners[4];
+          box_corners(scene.boxes_[ci.box_offset[l - 1] + 2 * k + ch], corners);
+          for (const Vec2& q : corners) grow(e, a, axis, q);
+        }
+        const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k);
+        scene.boxes_[node] = make_box(a, axis, e);
+        scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), l, static_cast<std::uint32_t>(k)};
+      }
+    }
+    // Root: axis-aligned box around the coarsest boxes (origin (0,0), axis x, so u = x and n = y).
+    Extent root;
+    const int top = m.levels - 1;
+    for (std::size_t k = 0; k < ci.segment_count[top]; ++k) {
+      Vec2 corners[4];
+      box_corners(scene.boxes_[ci.box_offset[top] + k], corners);
+      for (const Vec2& q : corners) grow(root, Vec2{0, 0}, Vec2{1, 0}, q);
+    }
+    const std::uint32_t rnode = scene.root_node(c);
+    scene.boxes_[rnode] = make_box(Vec2{0, 0}, Vec2{1, 0}, root);
+    scene.info_[rnode] = NodeInfo{static_cast<std::uint32_t>(c), m.levels, 0};
+
+    // Error of each level: distance of every original vertex and level-0 point to the segment that stands for it.
+    CurveInfo& cw = scene.curves_[c];
+    for (int l = 0; l < m.levels; ++l) {
+      const auto& pts = m.scaling[l];
+      double worst = 0.0, widest = 0.0;
+      for (std::size_t k = 0; k < s0; ++k) {
+        const std::size_t seg = k >> l;
+        const Vec2 a = pts[seg], b = pts[seg + 1 == pts.size() ? 0 : seg + 1];
+        worst = std::max(worst, distance_to_segment(m.scaling[0][k], a, b));
+        for (std::uint32_t j = orig_first[k]; j < orig_first[k + 1]; ++j) worst = std::max(worst, distance_to_segment(p[j], a, b));
+      }
+      for (std::size_t k = 0; k < cw.segment_count[l]; ++k) widest = std::max(widest, box_half_width(scene.boxes_[cw.box_offset[l] + k]));
+      cw.max_error_m[l] = worst;
+      cw.max_box_half_width_m[l] = widest;
+    }
+    for (const Vec2& q : m.scaling[0]) {
+      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    }
+  }
+  if (!scene.curves_.empty()) {
+    scene.bounds_min_ = lo;
+    scene.bounds_max_ = hi;
+  }
+  const double t2 = now_ms();
+  scene.times_.multires_ms = t1 - t0;
+  scene.times_.tree_ms = t2 - t1;
+  return scene;
+}
+
+}  // namespace hk

@@ -1,0 +1,221 @@
+// Collision tree and swept query: containment of every error box, and first hits equal to brute force
+// on ≥100,000 seeded swept segments, both coherent (servo-like) and random.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "curves.hpp"
+#include "haptics/collision_query.hpp"
+#include "haptics/scene.hpp"
+
+using namespace hk;
+
+namespace {
+
+std::vector<Polyline> random_scene(std::mt19937& rng, int blobs, int strokes) {
+  std::uniform_real_distribution<double> ux(-0.06, 0.06), uy(-0.035, 0.035), ur(0.004, 0.02);
+  std::uniform_int_distribution<int> un(20, 400);
+  std::vector<Polyline> curves;
+  for (int i = 0; i < blobs; ++i) curves.push_back(test::random_blob(rng, {ux(rng), uy(rng)}, ur(rng), un(rng)));
+  for (int i = 0; i < strokes; ++i) curves.push_back(test::random_stroke(rng, {ux(rng), uy(rng)}, 0.0003, un(rng)));
+  curves.push_back(test::staircase_circle({0.0, 0.0}, 0.03, 0.0002));
+  return curves;
+}
+
+// Every original vertex lies in the box of the level-l segment that stands for it, at every level;
+// every child's box lies in its parent's. Arc positions computed here, independently of the tree.
+void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
+  constexpr double tol = 1e-12;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    const CurveMultires& m = sc.model(c);
+    const Polyline& src = input[sc.source_index(c)];
+    double arc = 0.0;
+    std::size_t k = 0;
+    const std::size_t s0 = ci.segment_count[0];
+    for (std::size_t j = 0; j < src.points_m.size(); ++j) {
+      if (j > 0) arc += distance(src.points_m[j - 1], src.points_m[j]);
+      while (k + 1 < s0 && m.arc_m[k + 1] <= arc) ++k;
+      for (int l = 0; l < ci.levels; ++l) {
+        const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k >> l);
+        ASSERT_TRUE(box_contains(sc.box(node), src.points_m[j], tol)) << "curve " << c << " vertex " << j << " level " << l;
+      }
+    }
+    for (int l = 0; l < ci.levels; ++l) {
+      for (std::uint32_t s = 0; s < ci.segment_count[l]; ++s) {
+        const std::uint32_t node = ci.box_offset[l] + s;
+        Vec2 a, b;
+        sc.segment({static_cast<int>(c), l, static_cast<int>(s)}, &a, &b);
+        ASSERT_TRUE(box_contains(sc.box(node), a, tol) && box_contains(sc.box(node), b, tol));
+        std::uint32_t first = 0, count = 0;
+        sc.children(node, &first, &count);
+        for (std::uint32_t i = 0; i < count; ++i) {
+          Vec2 corners[4];
+          box_corners(sc.box(first + i), corners);
+          for (const Vec2& q : corners) ASSERT_TRUE(box_contains(sc.box(node), q, tol)) << "child of " << node;
+        }
+      }
+    }
+    // The root holds the coarsest boxes.
+    const std::uint32_t root = sc.root_node(c);
+    std::uint32_t first = 0, count = 0;
+    sc.children(root, &first, &count);
+    ASSERT_EQ(count, ci.segment_count[ci.levels - 1]);
+    for (std::uint32_t i = 0; i < count; ++i) {
+      Vec2 corners[4];
+      box_corners(sc.box(first + i), corners);
+      for (const Vec2& q : corners) ASSERT_TRUE(box_contains(sc.box(root), q, tol));
+    }
+  }
+}
+
+}  // namespace
+
+TEST(CollisionTree, BoxesContainOriginalsAndChildren) {
+  std::mt19937 rng(10);
+  for (int trial = 0; trial < 5; ++trial) {
+    const auto curves = random_scene(rng, 6, 6);
+    const Scene sc = Scene::build(curves, 6);
+    ASSERT_EQ(sc.curve_count(), curves.size());
+    check_containment(sc, curves);
+  }
+}
+
+TEST(CollisionTree, ErrorGrowsWithLevelAndBoxesBoundIt) {
+  std::mt19937 rng(11);
+  const auto curves = random_scene(rng, 4, 4);
+  const Scene sc = Scene::build(curves, 6);
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    for (int l = 0; l < ci.levels; ++l) {
+      // The box half-width bounds the measured deviation (plus the box padding).
+      EXPECT_LE(ci.max_error_m[l], ci.max_box_half_width_m[l] + 1e-8) << "curve " << c << " level " << l;
+    }
+    EXPECT_GE(ci.max_error_m[ci.levels - 1] + 1e-12, ci.max_error_m[0]);
+  }
+}
+
+TEST(CollisionTree, SkipsDegenerateCurves) {
+  std::vector<Polyline> curves(3);
+  curves[0].points_m = {{0.01, 0.01}};                  // one point
+  curves[1].points_m = {{0.02, 0.02}, {0.02, 0.02}};    // zero length
+  curves[2].points_m = {{0.0, 0.0}, {0.01, 0.0}};       // two points: a single short wall
+  const Scene sc = Scene::build(curves, 6);
+  EXPECT_EQ(sc.curve_count(), 1u);
+  EXPECT_EQ(sc.skipped_curves(), 2u);
+  EXPECT_EQ(sc.source_index(0), 2u);
+}
+
+class QueryVsBruteForce : public ::testing::TestWithParam<int> {};
+
+TEST_P(QueryVsBruteForce, FirstHitEqualsBruteForce) {
+  const int level = GetParam();
+  std::mt19937 rng(20 + level);
+  const auto curves = random_scene(rng, 8, 8);
+  const Scene sc = Scene::build(curves, 6);
+  BoundarySection section(sc);
+  std::uniform_real_distribution<double> ux(-0.075, 0.075), uy(-0.05, 0.05), step(-0.0004, 0.0004);
+  int hits = 0, checked = 0;
+  auto check = [&](Vec2 a, Vec2 b) {
+    QueryStats st;
+    const SweepHit h = section.first_hit(a, b, level, nullptr, 0, QueryBudget{}, &st);
+    double t_ref = 0.0;
+    SegmentRef ref;
+    const bool hit_ref = test::brute_first_hit(sc, a, b, level, &t_ref, &ref);
+    ++checked;
+    ASSERT_EQ(h.hit, hit_ref) << "a=(" << a.x << "," << a.y << ") b=(" << b.x << "," << b.y << ")";
+    if (hit_ref) {
+      ++hits;
+      ASSERT_NEAR(h.t, t_ref, 1e-9);
+      ASSERT_FALSE(st.budget_exhausted);
+    }
+  };
+  // Coherent: a wandering handle, as the servo loop sees it (exercises splits and merges).
+  Vec2 p{0.0, 0.0};
+  for (int i = 0; i < 60000; ++i) {
+    Vec2 q{std::clamp(p.x + step(rng), -0.075, 0.075), std::clamp(p.y + step(rng), -0.05, 0.05)};
+    check(p, q);
+    p = q;
+  }
+  // Random long sweeps across the scene.
+  for (int i = 0; i < 45000; ++i) check({ux(rng), uy(rng)}, {ux(rng), uy(rng)});
+  EXPECT_GE(checked, 100000);
+  EXPECT_GT(hits, 5000);  // the stream really tests hits, not only misses
+}
+
+INSTANTIATE_TEST_SUITE_P(Levels, QueryVsBruteForce, ::testing::Values(0, 2));
+
+TEST(CollisionQuery, BoundarySectionFollowsTheHandle) {
+  std::vector<Polyline> curves{test::random_blob(*std::make_unique<std::mt19937>(5), {0, 0}, 0.02, 400)};
+  const Scene sc = Scene::build(curves, 6);
+  BoundarySection section(sc);
+  ASSERT_EQ(section.section().size(), 1u);  // starts at the root
+  // Sweeps that keep hitting the curve refine the section down to the target level near the hit...
+  Vec2 a{-0.05, 0.0}, b{0.0, 0.0};
+  for (int i = 0; i < 10; ++i) section.first_hit(a, b, 0, nullptr, 0, QueryBudget{});
+  const std::size_t refined = section.section().size();
+  EXPECT_GT(refined, 8u);
+  // ... and far-away motion merges it back up.
+  for (int i = 0; i < 200; ++i) section.first_hit({0.07, 0.045}, {0.069, 0.045}, 0, nullptr, 0, QueryBudget{});
+  EXPECT_LT(section.section().size(), refined);
+}
+
+TEST(CollisionQuery, ExcludedSegmentIsIgnored) {
+  Polyline wall;
+  wall.points_m = {{-0.02, 0.0}, {0.02, 0.0}};
+  const Scene sc = Scene::build({wall}, 6);
+  BoundarySection section(sc);
+  const SweepHit h = section.first_hit({0.001, 0.01}, {0.001, -0.01}, 0, nullptr, 0, QueryBudget{});
+  ASSERT_TRUE(h.hit);
+  EXPECT_NEAR(h.t, 0.5, 1e-12);
+  const SweepHit h2 = section.first_hit({0.001, 0.01}, {0.001, -0.01}, 0, &h.segment, 1, QueryBudget{});
+  EXPECT_FALSE(h2.hit);
+}
+
+TEST(CollisionQuery, AnytimeAnswersAtACoarserLevelOnItsOwnPolyline) {
+  std::mt19937 rng(6);
+  std::vector<Polyline> curves{test::random_blob(rng, {0, 0}, 0.02, 800)};
+  const Scene sc = Scene::build(curves, 6);
+  int coarse_answers = 0;
+  for (int i = 0; i < 200; ++i) {
+    BoundarySection section(sc);
+    const double th = 2 * M_PI * i / 200.0;
+    const Vec2 a{0.06 * std::cos(th), 0.04 * std::sin(th)};
+    QueryStats st;
+    QueryBudget budget;
+    budget.max_box_tests = 6;
+    const SweepHit h = section.first_hit(a, {0, 0}, 0, nullptr, 0, budget, &st);
+    ASSERT_TRUE(h.hit);  // a sweep into a closed curve's interior always finds some level's polyline
+    // The answer lies on the segment it names, at the level reached.
+    Vec2 p, q;
+    sc.segment(h.segment, &p, &q);
+    EXPECT_LT(distance_to_segment(h.point_m, p, q), 1e-12);
+    if (h.segment.level > 0) ++coarse_answers;
+    EXPECT_TRUE(st.budget_exhausted);
+  }
+  EXPECT_GT(coarse_answers, 100);
+}
+
+TEST(CollisionQuery, ClosestPointEqualsBruteForce) {
+  std::mt19937 rng(7);
+  const auto curves = random_scene(rng, 5, 5);
+  const Scene sc = Scene::build(curves, 6);
+  BoundarySection section(sc);
+  std::uniform_real_distribution<double> ux(-0.07, 0.07), uy(-0.045, 0.045);
+  for (int i = 0; i < 2000; ++i) {
+    const Vec2 p{ux(rng), uy(rng)};
+    double best = 1e9;
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      const int l = sc.clamp_level(c, 1);
+      for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
+        Vec2 a, b;
+        sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
+        best = std::min(best, distance_to_segment(p, a, b));
+      }
+    }
+    Vec2 q;
+    SegmentRef s;
+    ASSERT_TRUE(section.closest_point(p, 1, 1.0, &q, &s));
+    EXPECT_NEAR(distance(p, q), best, 1e-12);
+  }
+}

@@ -1,0 +1,113 @@
+#include <algorithm>
+#pragma once
+// Seeded random curves and independent geometry checks shared by the test suites.
+// The checks here are written separately from the library (orientation predicates, brute force), so a
+// bug in the library's own geometry cannot hide itself.
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "haptics/multires.hpp"
+#include "haptics/scene.hpp"
+
+namespace hk::test {
+
+/// A smooth random closed blob: r(θ) = r0 (1 + Σ a_i cos(iθ + φ_i)), n points, centred at c.
+inline Polyline random_blob(std::mt19937& rng, Vec2 c, double r0, int n) {
+  std::uniform_real_distribution<double> amp(-0.12, 0.12), ph(0.0, 2 * M_PI);
+  double a[6], phi[6];
+  for (int i = 0; i < 6; ++i) { a[i] = amp(rng) / (1 + i); phi[i] = ph(rng); }
+  Polyline p;
+  p.closed = true;
+  for (int k = 0; k < n; ++k) {
+    const double th = 2 * M_PI * k / n;
+    double r = 1.0;
+    for (int i = 0; i < 6; ++i) r += a[i] * std::cos((i + 2) * th + phi[i]);
+    p.points_m.push_back({c.x + r0 * r * std::cos(th), c.y + r0 * r * std::sin(th)});
+  }
+  return p;
+}
+
+/// A random open wiggly stroke of n points starting at s, step length step_m, smoothly turning.
+inline Polyline random_stroke(std::mt19937& rng, Vec2 s, double step_m, int n) {
+  std::normal_distribution<double> turn(0.0, 0.15);
+  Polyline p;
+  double heading = std::uniform_real_distribution<double>(0, 2 * M_PI)(rng), rate = 0.0;
+  Vec2 q = s;
+  for (int k = 0; k < n; ++k) {
+    p.points_m.push_back(q);
+    rate = 0.8 * rate + turn(rng);
+    heading += rate;
+    q = q + step_m * Vec2{std::cos(heading), std::sin(heading)};
+  }
+  return p;
+}
+
+/// A pixel-like staircase curve: a circle rounded to a grid of `cell_m` (as edge chains are).
+inline Polyline staircase_circle(Vec2 c, double r, double cell_m) {
+  Polyline p;
+  p.closed = true;
+  const int n = static_cast<int>(2 * M_PI * r / cell_m);
+  for (int k = 0; k < n; ++k) {
+    const double th = 2 * M_PI * k / n;
+    Vec2 q{std::round((c.x + r * std::cos(th)) / cell_m) * cell_m, std::round((c.y + r * std::sin(th)) / cell_m) * cell_m};
+    if (p.points_m.empty() || !(p.points_m.back() == q)) p.points_m.push_back(q);
+  }
+  if (p.points_m.size() > 1 && p.points_m.back() == p.points_m.front()) p.points_m.pop_back();
+  return p;
+}
+
+/// Orientation of (a, b, c): > 0 counter-clockwise.
+inline double orient(Vec2 a, Vec2 b, Vec2 c) { return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x); }
+
+/// True when the open segments p1p2 and q1q2 cross strictly (each separates the other's end points).
+inline bool crosses_strictly(Vec2 p1, Vec2 p2, Vec2 q1, Vec2 q2) {
+  const double o1 = orient(p1, p2, q1), o2 = orient(p1, p2, q2);
+  const double o3 = orient(q1, q2, p1), o4 = orient(q1, q2, p2);
+  return ((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0));
+}
+
+/// Brute-force first hit of a→b over every segment of `level`: smallest sweep parameter, computed by
+/// solving the 2x2 system with Cramer's rule in a different arrangement from the library's.
+inline bool brute_first_hit(const Scene& sc, Vec2 a, Vec2 b, int level, double* t_out, SegmentRef* seg_out) {
+  double best = 2.0;
+  bool found = false;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const int l = sc.clamp_level(c, level);
+    for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
+      Vec2 p, q;
+      const SegmentRef ref{static_cast<int>(c), l, static_cast<int>(k)};
+      sc.segment(ref, &p, &q);
+      // a + t (b − a) = p + s (q − p)  →  [b−a, p−q] [t s]^T = p − a
+      const double m11 = b.x - a.x, m12 = p.x - q.x, m21 = b.y - a.y, m22 = p.y - q.y;
+      const double det = m11 * m22 - m12 * m21;
+      if (det == 0.0) continue;
+      const double rx = p.x - a.x, ry = p.y - a.y;
+      const double t = (rx * m22 - m12 * ry) / det;
+      const double s = (m11 * ry - rx * m21) / det;
+      if (t >= 0 && t <= 1 && s >= 0 && s <= 1 && t < best) {
+        best = t;
+        found = true;
+        if (seg_out) *seg_out = ref;
+      }
+    }
+  }
+  if (t_out) *t_out = best;
+  return found;
+}
+
+/// Number of level-`level` segments that the move p→q crosses strictly.
+inline int count_crossings(const Scene& sc, Vec2 p, Vec2 q, int level) {
+  int n = 0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const int l = sc.clamp_level(c, level);
+    for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
+      Vec2 a, b;
+      sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
+      if (crosses_strictly(p, q, a, b)) ++n;
+    }
+  }
+  return n;
+}
+
+}  // namespace hk::test
