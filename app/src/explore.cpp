@@ -15,17 +15,13 @@
 #include "config/load.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
-#include "haptics/sim_pantograph.hpp"
 #include "image_scene.hpp"
+#include "simulation.hpp"
 
 namespace hk::app {
 namespace {
 
 using json = nlohmann::json;
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 void write_text(const std::filesystem::path& p, const std::string& text) {
   std::ofstream f(p, std::ios::binary | std::ios::trunc);
@@ -112,34 +108,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   ImageScene is = build_image_scene(o.image_path, s);
   const Scene& scene = *is.scene;
 
-  SimPantographParams dp;
-  dp.handle_mass_kg = s.device.handle_mass_kg;
-  dp.handle_damping_n_s_per_m = s.device.handle_damping_n_s_per_m;
-  dp.encoder_counts_per_rev = s.device.encoder_counts_per_rev;
-  dp.max_torque_n_m = s.device.max_torque_n_m;
-  dp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
-  SimulatedPantograph device(dp, path.at(0.0));
-  device.open();
-  ModelHandParams hp;
-  hp.stiffness_n_per_m = s.hand.stiffness_n_per_m;
-  hp.damping_n_s_per_m = s.hand.damping_n_s_per_m;
-  hp.max_force_n = s.hand.max_force_n;
-
-  ServoParams sp;
-  sp.period_s = 1.0 / s.haptics.servo_rate_hz;
-  sp.level = s.haptics.level;
-  sp.query_deadline_s = s.haptics.query_deadline_us * 1e-6;
-  sp.contact.stiffness_n_per_m = s.haptics.stiffness_n_per_m;
-  sp.contact.damping_n_s_per_m = s.haptics.damping_n_s_per_m;
-  sp.contact.max_force_n = s.haptics.max_force_n;
-  sp.guard.max_force_n = s.haptics.max_force_n;
-  sp.guard.ramp_s = s.haptics.force_ramp_s;
-  ServoLoop servo(scene, sp);
-  servo.start(device.read().handle_m);
-
   const double duration = o.duration_s > 0.0 ? o.duration_s : path.duration_s() + 0.5;
-  const long n_ticks = static_cast<long>(std::ceil(duration / sp.period_s));
-
   const std::filesystem::path trace_path = out / "trace.csv";
   std::unique_ptr<FILE, int (*)(FILE*)> trace(std::fopen(trace_path.c_str(), "w"), &std::fclose);
   if (!trace) throw ExploreError("output '" + trace_path.string() + "': cannot open for writing");
@@ -150,28 +119,15 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   ExploreSummary sum;
   sum.curves = scene.curve_count();
   std::vector<std::int64_t> tick_ns;
-  tick_ns.reserve(static_cast<std::size_t>(n_ticks));
   std::vector<Vec2> proxy_path;
-  proxy_path.reserve(static_cast<std::size_t>(n_ticks));
   long budget_exhausted = 0;
-  ServoOutput so;
-  for (long k = 0; k < n_ticks; ++k) {
-    const double t = static_cast<double>(k) * sp.period_s;
-    ServoInput in;
-    in.sample = device.read();
-    const std::int64_t t0 = steady_ns();
-    in.now_ns = t0;
-    servo.update(in, so);
-    const std::int64_t t1 = steady_ns();
-    device.write_force(so.force_n);
-    device.step(sp.period_s, model_hand_force(hp, path.at(t), device.true_position_m(), device.velocity_m_per_s()));
-
+  run_simulation(scene, s, path, duration, [&](const TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     const int state = static_cast<int>(c.state);
     const int curve = c.state == ContactState::Free ? -1 : c.constraint[0].curve;
-    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld\n", t, in.sample.handle_m.x, in.sample.handle_m.y,
-                 c.proxy_m.x, c.proxy_m.y, so.force_n.x, so.force_n.y, state, curve, c.level, static_cast<long long>(t1 - t0));
-    tick_ns.push_back(t1 - t0);
+    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld\n", r.t_s, r.handle_m.x, r.handle_m.y, c.proxy_m.x,
+                 c.proxy_m.y, so.force_n.x, so.force_n.y, state, curve, c.level, static_cast<long long>(r.tick_ns));
+    tick_ns.push_back(r.tick_ns);
     proxy_path.push_back(c.proxy_m);
     ++sum.ticks;
     sum.free_ticks += state == 0;
@@ -179,10 +135,9 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     sum.vertex_ticks += state == 2;
     sum.max_force_n = std::max(sum.max_force_n, length(so.force_n));
     budget_exhausted += c.query.budget_exhausted;
-  }
+  });
   if (std::fflush(trace.get()) != 0 || std::ferror(trace.get())) throw ExploreError("output '" + trace_path.string() + "': write failed");
   trace.reset();
-  device.close();
 
   write_text(out / "scene.json", scene_json(is, s).dump() + "\n");
   json sj;

@@ -1,0 +1,69 @@
+#include "simulation.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "haptics/sim_pantograph.hpp"
+
+namespace hk::app {
+namespace {
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+ServoParams servo_params_from(const config::Settings& s) {
+  ServoParams sp;
+  sp.period_s = 1.0 / s.haptics.servo_rate_hz;
+  sp.level = s.haptics.level;
+  sp.query_deadline_s = s.haptics.query_deadline_us * 1e-6;
+  sp.contact.stiffness_n_per_m = s.haptics.stiffness_n_per_m;
+  sp.contact.damping_n_s_per_m = s.haptics.damping_n_s_per_m;
+  sp.contact.max_force_n = s.haptics.max_force_n;
+  sp.guard.max_force_n = s.haptics.max_force_n;
+  sp.guard.ramp_s = s.haptics.force_ramp_s;
+  return sp;
+}
+
+long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+                    const TickObserver& observe) {
+  SimPantographParams dp;
+  dp.handle_mass_kg = s.device.handle_mass_kg;
+  dp.handle_damping_n_s_per_m = s.device.handle_damping_n_s_per_m;
+  dp.encoder_counts_per_rev = s.device.encoder_counts_per_rev;
+  dp.max_torque_n_m = s.device.max_torque_n_m;
+  dp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
+  SimulatedPantograph device(dp, hand.at(0.0));
+  device.open();
+  ModelHandParams hp;
+  hp.stiffness_n_per_m = s.hand.stiffness_n_per_m;
+  hp.damping_n_s_per_m = s.hand.damping_n_s_per_m;
+  hp.max_force_n = s.hand.max_force_n;
+
+  const ServoParams sp = servo_params_from(s);
+  ServoLoop servo(scene, sp);
+  servo.start(device.read().handle_m);
+  const long n_ticks = static_cast<long>(std::ceil(duration_s / sp.period_s - 1e-9));
+  ServoOutput so;
+  TickRecord rec;
+  for (long k = 0; k < n_ticks; ++k) {
+    rec.index = k;
+    rec.t_s = static_cast<double>(k) * sp.period_s;
+    ServoInput in;
+    in.sample = device.read();
+    const std::int64_t t0 = steady_ns();
+    in.now_ns = t0;
+    servo.update(in, so);
+    rec.tick_ns = steady_ns() - t0;
+    rec.handle_m = in.sample.handle_m;
+    device.write_force(so.force_n);
+    device.step(sp.period_s, model_hand_force(hp, hand.at(rec.t_s), device.true_position_m(), device.velocity_m_per_s()));
+    if (observe) observe(rec, so);
+  }
+  device.close();
+  return n_ticks;
+}
+
+}  // namespace hk::app

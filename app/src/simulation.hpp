@@ -1,0 +1,35 @@
+#pragma once
+/// @file simulation.hpp
+/// The headless servo run: simulated pantograph + model hand + servo loop, tick by tick as fast as the
+/// machine goes (DESIGN.md "Headless runs"). Shared by `explore` and the integration tests.
+
+#include <cstdint>
+#include <functional>
+
+#include "config/settings.hpp"
+#include "haptics/hand_path.hpp"
+#include "haptics/scene.hpp"
+#include "haptics/servo.hpp"
+
+namespace hk::app {
+
+/// One tick as the trace records it.
+struct TickRecord {
+  long index = 0;
+  double t_s = 0.0;             ///< tick k at t = k · period [s]
+  Vec2 handle_m;                ///< handle position the servo saw (encoder-quantised) [m]
+  std::int64_t tick_ns = 0;     ///< measured time of collision + contact + force [ns]
+};
+
+/// Called after every tick with its record and the servo's full output (proxy path, events, stats).
+using TickObserver = std::function<void(const TickRecord&, const ServoOutput&)>;
+
+/// Servo parameters from the settings.
+ServoParams servo_params_from(const config::Settings& s);
+
+/// Runs the simulated pantograph driven by `hand` over `scene` for `duration_s` seconds.
+/// Returns the number of ticks run.
+long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+                    const TickObserver& observe);
+
+}  // namespace hk::app

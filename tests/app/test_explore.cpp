@@ -1,0 +1,216 @@
+// End to end on real images: the explore contract files for every picture, raster sweeps in which the
+// proxy never crosses the level's polylines (independent grid + orientation check), and bad inputs that
+// end in one clear line on stderr.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "crossing_grid.hpp"
+#include "haptics/hand_path.hpp"
+#include "image_scene.hpp"
+#include "simulation.hpp"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace hk;
+
+namespace {
+
+const fs::path kData = HK_TEST_DATA_DIR;
+
+std::vector<fs::path> test_images() {
+  std::vector<fs::path> v;
+  for (const auto& e : fs::directory_iterator(kData / "images")) {
+    const auto ext = e.path().extension().string();
+    if (ext == ".png" || ext == ".jpg") v.push_back(e.path());
+  }
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+struct ExeResult {
+  int status = -1;
+  std::string err;
+};
+
+// Runs haptic-kiosk with `args`, capturing stderr.
+ExeResult run_kiosk(const std::string& args, const fs::path& tmp) {
+  const fs::path err = tmp / "stderr.txt";
+  const std::string cmd = std::string(HK_KIOSK_EXE) + " " + args + " >/dev/null 2>" + err.string();
+  ExeResult r;
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+  std::ifstream f(err);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("hk_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+}  // namespace
+
+class ExploreContract : public ::testing::TestWithParam<fs::path> {};
+
+TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
+  const fs::path img = GetParam();
+  const fs::path out = fresh_dir("contract_" + img.stem().string());
+  const ExeResult r = run_kiosk("explore " + quoted(img) + " --out " + quoted(out) + " --duration 2", out);
+  ASSERT_EQ(r.status, 0) << r.err;
+
+  // scene.json
+  std::ifstream sf(out / "scene.json");
+  const json scene = json::parse(sf);
+  ASSERT_GT(scene["image"]["width_px"].get<int>(), 0);
+  const double scale = scene["px_to_m"]["scale"], ox = scene["px_to_m"]["offset_x_m"], oy = scene["px_to_m"]["offset_y_m"];
+  const int w = scene["image"]["width_px"], h = scene["image"]["height_px"];
+  // The image fits the default usable rectangle 0.14 m x 0.09 m, centred.
+  EXPECT_GE(ox, -0.07 - 1e-9);
+  EXPECT_LE(ox + scale * (w - 1), 0.07 + 1e-9);
+  EXPECT_LE(oy, 0.045 + 1e-9);
+  EXPECT_GE(oy - scale * (h - 1), -0.045 - 1e-9);
+  EXPECT_NEAR(ox + scale * (w - 1) / 2.0, 0.0, 1e-9);
+  ASSERT_GT(scene["stiffness_n_per_m"].get<double>(), 0.0);
+  ASSERT_FALSE(scene["curves"].empty()) << img;
+  for (const auto& c : scene["curves"]) {
+    ASSERT_TRUE(c.contains("id") && c.contains("closed"));
+    double prev_err = -1.0;
+    for (const auto& lv : c["levels"]) {
+      ASSERT_GE(lv["points_m"].size(), 2u);
+      const double err = lv["max_error_m"];
+      EXPECT_GE(err, 0.0);
+      EXPECT_LT(err, 0.02);  // no level strays 2 cm from its curve
+      prev_err = err;
+    }
+    (void)prev_err;
+  }
+
+  // trace.csv: header, one row per tick (2 s at 1 kHz), consistent columns.
+  std::ifstream tf(out / "trace.csv");
+  std::string line;
+  std::getline(tf, line);
+  EXPECT_EQ(line, "t_s,handle_x_m,handle_y_m,proxy_x_m,proxy_y_m,force_x_n,force_y_n,contact,curve,level,tick_ns");
+  long rows = 0;
+  double max_force = 0.0;
+  while (std::getline(tf, line)) {
+    double t, hx, hy, px, py, fx, fy;
+    int contact, curve, level;
+    long long ns;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d,%lld", &t, &hx, &hy, &px, &py, &fx, &fy, &contact, &curve,
+                          &level, &ns), 11) << line;
+    EXPECT_NEAR(t, rows * 0.001, 1e-9);
+    ASSERT_GE(contact, 0);
+    ASSERT_LE(contact, 2);
+    EXPECT_EQ(curve == -1, contact == 0) << line;
+    if (curve >= 0) {
+      // In contact the proxy lies on the scene.json polyline of that curve and level: the file holds
+      // exactly what the solver used.
+      ASSERT_LT(curve, static_cast<int>(scene["curves"].size()));
+      const auto& pts = scene["curves"][curve]["levels"][level]["points_m"];
+      const bool closed = scene["curves"][curve]["closed"];
+      double best = 1e9;
+      for (std::size_t i = 0; i + (closed ? 0 : 1) < pts.size(); ++i) {
+        const auto& a = pts[i];
+        const auto& b = pts[(i + 1) % pts.size()];
+        best = std::min(best, distance_to_segment({px, py}, {a[0], a[1]}, {b[0], b[1]}));
+      }
+      EXPECT_LT(best, 1e-5) << line;
+    }
+    ASSERT_GE(ns, 0);
+    max_force = std::max(max_force, std::hypot(fx, fy));
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2000);
+  EXPECT_LE(max_force, scene["max_force_n"].get<double>() + 1e-9);
+
+  std::ifstream mf(out / "summary.json");
+  const json sum = json::parse(mf);
+  EXPECT_EQ(sum["ticks"].get<long>(), rows);
+  for (const char* k : {"p50", "p99", "p999", "max"}) EXPECT_TRUE(sum["tick_ns"].contains(k));
+  for (const char* k : {"load", "edges", "linking", "multires", "tree"}) EXPECT_GE(sum["build_ms"][k].get<double>(), 0.0);
+  EXPECT_EQ(sum["curves"].get<std::size_t>(), scene["curves"].size());
+  EXPECT_GT(fs::file_size(out / "overlay.png"), 1000u);
+  fs::remove_all(out);
+}
+
+INSTANTIATE_TEST_SUITE_P(RealImages, ExploreContract, ::testing::ValuesIn(test_images()),
+                         [](const auto& info) { return info.param.stem().string(); });
+
+class RasterNeverCrosses : public ::testing::TestWithParam<fs::path> {};
+
+TEST_P(RasterNeverCrosses, ProxyStaysOnItsSideOfEveryWall) {
+  // A visitor who pushes harder than the device can hold (6 N against 4 N): the handle goes through
+  // walls, so the proxy is dragged along the outlines and round corners — the hard case for the solver.
+  config::Settings s;
+  s.hand.max_force_n = 6.0;
+  s.hand.raster_spacing_m = 0.008;
+  s.hand.raster_speed_m_per_s = 0.12;
+  const app::ImageScene is = app::build_image_scene(GetParam().string(), s);
+  const Scene& sc = *is.scene;
+  ASSERT_GT(sc.curve_count(), 0u);
+  const HandPath path = raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
+  test::CrossingGrid grid(sc, s.haptics.level);
+  long crossings = 0, contact_ticks = 0, vertex_ticks = 0, bad_force = 0;
+  app::run_simulation(sc, s, path, path.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
+    const ContactOutput& c = so.contact;
+    for (int m = 1; m < c.path_count; ++m) crossings += grid.crossings(c.path_m[m - 1], c.path_m[m]);
+    contact_ticks += c.state != ContactState::Free;
+    vertex_ticks += c.state == ContactState::Vertex;
+    // Force = stiffness · separation, up to the clamp (and the start-up ramp).
+    const double expect = std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
+    if (r.t_s > s.haptics.force_ramp_s && std::abs(length(so.force_n) - expect) > 1e-6) ++bad_force;
+  });
+  EXPECT_EQ(crossings, 0);
+  EXPECT_EQ(bad_force, 0);
+  EXPECT_GT(contact_ticks, 100) << "the sweep should touch the picture's curves";
+}
+
+INSTANTIATE_TEST_SUITE_P(RealImages, RasterNeverCrosses, ::testing::ValuesIn(test_images()),
+                         [](const auto& info) { return info.param.stem().string(); });
+
+struct BadCase {
+  std::string name;
+  std::string args;       // after "explore"; {bad} is replaced by tests/data/bad
+  std::string must_name;  // the stderr line must contain this
+};
+
+class BadInput : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadInput, OneLineErrorNonZeroExitNoCrash) {
+  const fs::path out = fresh_dir("bad_" + GetParam().name);
+  std::string args = GetParam().args;
+  for (std::size_t at; (at = args.find("{bad}")) != std::string::npos;) args.replace(at, 5, (kData / "bad").string());
+  for (std::size_t at; (at = args.find("{img}")) != std::string::npos;) args.replace(at, 5, (kData / "images").string());
+  const ExeResult r = run_kiosk("explore " + args + " --out " + quoted(out / "o"), out);
+  EXPECT_EQ(r.status, 1) << r.err;  // 1 = refused input; a crash or sanitizer abort would be another code
+  ASSERT_FALSE(r.err.empty());
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(GetParam().must_name), std::string::npos) << r.err;
+  fs::remove_all(out);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Files, BadInput,
+    ::testing::Values(BadCase{"missing", "{bad}/no_such_file.png", "no_such_file.png"},
+                      BadCase{"text_as_png", "{bad}/not_an_image.png", "not_an_image.png"},
+                      BadCase{"truncated_jpeg", "{bad}/truncated.jpg", "truncated.jpg"},
+                      BadCase{"empty", "{bad}/empty.png", "empty.png"},
+                      BadCase{"huge_header", "{bad}/huge_declared.png", "huge_declared.png"},
+                      BadCase{"config_out_of_range", "{img}/horse.png --config {bad}/config_out_of_range.toml", "stiffness_n_per_m"},
+                      BadCase{"config_syntax", "{img}/horse.png --config {bad}/config_syntax.toml", "config_syntax.toml"},
+                      BadCase{"hand_nan", "{img}/horse.png --hand {bad}/hand_nan.csv", "hand_nan.csv"},
+                      BadCase{"hand_decreasing", "{img}/horse.png --hand {bad}/hand_time_decreasing.csv", "hand_time_decreasing.csv"}),
+    [](const auto& info) { return info.param.name; });
