@@ -13,21 +13,27 @@ namespace hk::config {
 struct HapticsSettings {
   double stiffness_n_per_m = 800.0;       ///< key stiffness_n_per_m, wall stiffness, [10, 5000] N/m
   double damping_n_s_per_m = 0.0;         ///< key damping_n_s_per_m, rendered damping in contact, [0, 20] N·s/m
-  double max_force_n = 4.0;               ///< key max_force_n, force clamp, [0.1, 20] N
+  double max_force_n = 3.5;               ///< key max_force_n, force clamp, [0.1, 20] N (the simulated pantograph gives ≥ 3.78 N in every direction)
   double servo_rate_hz = 1000.0;          ///< key servo_rate_hz, [100, 10000] Hz
-  int level = 1;                          ///< key level, resolution level rendered, [0, 12]; 0 = finest
+  int level = 1;                          ///< key level, resolution level rendered, [0, 12] and <= max_levels; 0 = finest
   int max_levels = 6;                     ///< key max_levels, levels built above level 0, [1, 12]
   double query_deadline_us = 200.0;       ///< key query_deadline_us, anytime collision deadline, [1, 100000] µs
   double force_ramp_s = 0.5;              ///< key force_ramp_s, start-up force ramp, [0, 10] s
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const HapticsSettings&) const = default;
 };
 
 /// [device] — which device and the simulated pantograph's physical parameters.
 struct DeviceSettings {
-  std::string type = "simulated";         ///< key type, one of "simulated"
+  std::string type = "simulated";         ///< key type, one of "simulated" (the list grows as devices are added)
   double handle_mass_kg = 0.08;           ///< key handle_mass_kg, effective handle mass, [0.001, 5] kg
   double handle_damping_n_s_per_m = 2.0;  ///< key handle_damping_n_s_per_m, device viscous damping, [0, 100] N·s/m
   int encoder_counts_per_rev = 16384;     ///< key encoder_counts_per_rev, [64, 1048576] counts/rev
   double max_torque_n_m = 0.5;            ///< key max_torque_n_m, per-motor torque limit, [0.001, 10] N·m
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const DeviceSettings&) const = default;
 };
 
 /// [hand] — the model hand that drives the simulated pantograph in headless runs.
@@ -37,6 +43,9 @@ struct HandSettings {
   double max_force_n = 2.0;               ///< key max_force_n, the most a visitor pushes with, [0.01, 50] N
   double raster_speed_m_per_s = 0.08;     ///< key raster_speed_m_per_s, target speed of the raster, [0.001, 5] m/s
   double raster_spacing_m = 0.006;        ///< key raster_spacing_m, line spacing of the raster, [0.0005, 0.05] m
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const HandSettings&) const = default;
 };
 
 /// [vision] — image intake limits, edge detection and linking.
@@ -47,15 +56,21 @@ struct VisionSettings {
   std::int64_t max_pixels = 40'000'000;       ///< key max_pixels, width·height limit, [256, 2^31] px
   double blur_sigma_px = 1.5;                 ///< key blur_sigma_px, Gaussian pre-blur, [0, 20] px
   double canny_low = 0.0;                     ///< key canny_low, hysteresis low threshold, [0, 2000]; 0 = from the image
-  double canny_high = 0.0;                    ///< key canny_high, hysteresis high threshold, [0, 2000]; 0 = from the image
+  double canny_high = 0.0;                    ///< key canny_high, hysteresis high threshold, [0, 2000]; 0 = from the image; canny_low <= canny_high when both nonzero
   double min_chain_length_m = 0.004;          ///< key min_chain_length_m, drop shorter chains (can't be felt), [0, 0.1] m
   int max_image_side_px = 800;                ///< key max_image_side_px, images are downscaled to this, [64, 10000] px
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const VisionSettings&) const = default;
 };
 
 /// [workspace] — the device's usable rectangle, centred on the workspace origin.
 struct WorkspaceSettings {
   double width_m = 0.14;                  ///< key width_m, [0.01, 1] m
   double height_m = 0.09;                 ///< key height_m, [0.01, 1] m
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const WorkspaceSettings&) const = default;
 };
 
 /// All settings. Default-constructed = the shipped defaults.
@@ -65,6 +80,9 @@ struct Settings {
   HandSettings hand;
   VisionSettings vision;
   WorkspaceSettings workspace;
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const Settings&) const = default;
 };
 
 }  // namespace hk::config

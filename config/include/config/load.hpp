@@ -1,0 +1,120 @@
+#pragma once
+/// @file load.hpp
+/// Reading, checking and writing the kiosk settings (`settings.hpp`) as TOML.
+///
+/// The file layout is one TOML table per settings struct ([haptics], [device], [hand], [vision],
+/// [workspace]) with one key per field, named exactly as the field. Every key is optional: a key
+/// that is absent keeps its default. Everything else is refused with a ConfigError whose message is
+/// one line naming the file, the key (as `table.key`), the bad value and what is allowed, e.g.
+///   config 'k.toml': haptics.stiffness_n_per_m = -5 is out of range [10, 5000] N/m (line 3)
+///
+/// All field knowledge (table, key, range, unit, help) lives in one descriptor table,
+/// field_descriptors(), which load, validate and to_toml share.
+
+#include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "config/settings.hpp"
+
+namespace hk::config {
+
+/// Bad settings or a settings file that can't be read or written.
+/// what() is a single line (no newline characters; control characters in values are escaped)
+/// naming the source (the file path, or "settings" for an in-memory Settings), the key as
+/// `table.key` when one key is at fault, the bad value, and the allowed range or type.
+class ConfigError : public std::runtime_error {
+ public:
+  /// @param source  the file path or "settings"; @param key  `table.key` or empty;
+  /// @param message the full one-line message returned by what().
+  ConfigError(std::string source, std::string key, const std::string& message);
+
+  /// The file path (as given by the caller) or "settings".
+  [[nodiscard]] const std::string& source() const noexcept { return source_; }
+  /// The offending key as `table.key` (or `[table]` for a bad table), empty when the error is not
+  /// about one key (missing file, syntax error, I/O failure).
+  [[nodiscard]] const std::string& key() const noexcept { return key_; }
+
+ private:
+  std::string source_;
+  std::string key_;
+};
+
+/// How a field is stored and written in TOML.
+enum class FieldKind {
+  real,     ///< double; TOML float or integer accepted; must be finite and within [min, max]
+  integer,  ///< int or std::int64_t; TOML integer only; within [min, max]
+  text,     ///< std::string; TOML string; must be one of `choices`
+};
+
+/// Mutable view of one field inside a Settings.
+using FieldRef = std::variant<double*, int*, std::int64_t*, std::string*>;
+/// Read-only view of one field inside a Settings.
+using ConstFieldRef =
+    std::variant<const double*, const int*, const std::int64_t*, const std::string*>;
+
+/// Describes one settings field: where it lives in TOML, its allowed values and its unit.
+/// Bounds are inclusive; for integer fields they are whole numbers (exact in a double).
+struct FieldDescriptor {
+  std::string_view table;  ///< TOML table, e.g. "haptics"
+  std::string_view key;    ///< key in that table, e.g. "stiffness_n_per_m" (= the field name)
+  FieldKind kind;          ///< storage kind
+  double min;              ///< inclusive lower bound (real, integer); unused for text
+  double max;              ///< inclusive upper bound (real, integer); unused for text
+  std::string_view unit;   ///< unit shown to the operator, e.g. "N/m"; empty when dimensionless
+  std::string_view help;   ///< one-line description for the operator
+  std::span<const std::string_view> choices;  ///< allowed values of a text field
+  FieldRef (*ref)(Settings&);                 ///< the field inside a Settings
+  ConstFieldRef (*cref)(const Settings&);     ///< the field inside a const Settings
+};
+
+/// Every settings field, grouped by table in file order (haptics, device, hand, vision,
+/// workspace). The span refers to static storage.
+[[nodiscard]] std::span<const FieldDescriptor> field_descriptors() noexcept;
+
+/// The descriptor of `table.key`, or nullptr when there is no such field.
+[[nodiscard]] const FieldDescriptor* find_field(std::string_view table, std::string_view key) noexcept;
+
+/// Largest settings file load_settings() reads, in bytes (1 MiB).
+inline constexpr std::uintmax_t kMaxConfigFileBytes = 1u << 20;
+
+/// Reads settings from the TOML file at `path`: starts from the defaults (Settings{}) and
+/// overrides every key present, then validate()s the result.
+/// @throws ConfigError if the file is missing, not a regular file, larger than
+///   kMaxConfigFileBytes or unreadable; on a TOML syntax error (message gives line and column);
+///   on an unknown table or key (named, with a suggestion for a likely typo); on a wrong type
+///   (an integer is accepted where a real is expected, nothing else is converted); on a
+///   non-finite or out-of-range value; on a failed cross-field check (see validate()).
+[[nodiscard]] Settings load_settings(const std::string& path);
+
+/// As load_settings(), but from TOML text in memory. `source_name` names the input in messages
+/// (use the file path or e.g. "operator panel").
+/// @throws ConfigError as load_settings() (except the file errors).
+[[nodiscard]] Settings parse_settings(std::string_view toml_text, const std::string& source_name);
+
+/// Checks every field against its range (reals must be finite) and the cross-field rules:
+/// - haptics.level <= haptics.max_levels (only levels 0..max_levels are built);
+/// - vision.canny_low <= vision.canny_high when both are nonzero (0 = derive from the image);
+/// - device.type is one of the known device types (FieldDescriptor::choices).
+/// @throws ConfigError (source "settings") naming the first bad key.
+void validate(const Settings& settings);
+
+/// Writes every key of every table as TOML, each preceded by a comment giving its meaning, unit,
+/// allowed range and default, so an operator can edit the file by hand. Reals are written with
+/// the shortest representation that reads back to the same double, so
+/// parse_settings(to_toml(s)) == s for every valid s. Does not validate.
+[[nodiscard]] std::string to_toml(const Settings& settings);
+
+/// validate()s `settings`, then writes to_toml(settings) to `path` atomically: the text goes to a
+/// new temporary file in the same directory, which is fsync'ed and renamed over `path`; the
+/// directory is then fsync'ed (best effort). A new file gets mode 0644, an existing file keeps its
+/// mode. Not safe against concurrent writers of the same path.
+/// @throws ConfigError if validation fails or any step before the rename fails (missing or
+///   read-only directory, disk full, ...); the existing file at `path` is then untouched and the
+///   temporary file removed.
+void save_settings_atomic(const Settings& settings, const std::string& path);
+
+}  // namespace hk::config

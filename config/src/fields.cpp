@@ -1,0 +1,300 @@
+/// @file fields.cpp
+/// The one table of settings fields (table, key, range, unit, help, accessors) and the checks
+/// built on it: range checks, cross-field checks, message formatting.
+
+#include <array>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+#include "config/load.hpp"
+#include "detail.hpp"
+
+namespace hk::config {
+
+ConfigError::ConfigError(std::string source, std::string key, const std::string& message)
+    : std::runtime_error(message), source_(std::move(source)), key_(std::move(key)) {}
+
+namespace {
+
+template <auto Sub, auto Member>
+FieldRef ref_of(Settings& s) {
+  return &(s.*Sub.*Member);
+}
+
+template <auto Sub, auto Member>
+ConstFieldRef cref_of(const Settings& s) {
+  return &(s.*Sub.*Member);
+}
+
+/// Builds a descriptor; evaluated at compile time, so a bad row (min > max, fractional integer
+/// bound, int bound beyond int) is a compile error.
+template <auto Sub, auto Member>
+constexpr FieldDescriptor make_field(std::string_view table, std::string_view key, double min,
+                                     double max, std::string_view unit, std::string_view help,
+                                     std::span<const std::string_view> choices = {}) {
+  using T = std::remove_cvref_t<decltype(std::declval<Settings&>().*Sub.*Member)>;
+  static_assert(std::is_same_v<T, double> || std::is_same_v<T, int> ||
+                    std::is_same_v<T, std::int64_t> || std::is_same_v<T, std::string>,
+                "unsupported settings field type");
+  FieldKind kind = FieldKind::real;
+  if constexpr (std::is_same_v<T, std::string>) {
+    kind = FieldKind::text;
+    if (choices.empty()) throw "a text field needs its list of choices";
+  } else if constexpr (!std::is_same_v<T, double>) {
+    kind = FieldKind::integer;
+    if (min != static_cast<double>(static_cast<long long>(min)) ||
+        max != static_cast<double>(static_cast<long long>(max)))
+      throw "integer bounds must be whole numbers";
+    if (std::is_same_v<T, int> && (min < INT_MIN || max > INT_MAX))
+      throw "bounds of an int field must fit in int";
+  }
+  if (kind != FieldKind::text && !(min <= max)) throw "min must be <= max";
+  return FieldDescriptor{table, key, kind, min, max, unit, help, choices,
+                         &ref_of<Sub, Member>, &cref_of<Sub, Member>};
+}
+
+// HK_FIELD(table, field, ...): the key is the field name, spelled once.
+#define HK_FIELD(table, field, ...)                                                        \
+  make_field<&Settings::table, &decltype(Settings::table)::field>(#table, #field, __VA_ARGS__)
+
+constexpr std::array<std::string_view, 1> kDeviceTypes{"simulated"};
+constexpr double kTwoPow31 = 2147483648.0;
+
+constexpr std::array<detail::TableInfo, 5> kTables{{
+    {"haptics", "Force rendering and the servo loop."},
+    {"device", "Which device drives the handle, and the simulated pantograph's physics."},
+    {"hand", "The model hand that drives the simulated pantograph in headless runs."},
+    {"vision", "Image intake limits, edge detection and linking."},
+    {"workspace", "The device's usable rectangle, centred on the workspace origin."},
+}};
+
+constexpr auto kFields = std::to_array<FieldDescriptor>({
+    // [haptics]
+    HK_FIELD(haptics, stiffness_n_per_m, 10, 5000, "N/m", "Wall stiffness."),
+    HK_FIELD(haptics, damping_n_s_per_m, 0, 20, "N·s/m", "Damping rendered while in contact."),
+    HK_FIELD(haptics, max_force_n, 0.1, 20, "N", "Force clamp: no force above this leaves the device."),
+    HK_FIELD(haptics, servo_rate_hz, 100, 10000, "Hz", "Servo loop rate."),
+    HK_FIELD(haptics, level, 0, 12, "",
+             "Resolution level rendered; 0 = finest; must be <= max_levels."),
+    HK_FIELD(haptics, max_levels, 1, 12, "", "Number of levels built above level 0."),
+    HK_FIELD(haptics, query_deadline_us, 1, 100000, "µs", "Deadline of the anytime collision query."),
+    HK_FIELD(haptics, force_ramp_s, 0, 10, "s", "Start-up force ramp duration."),
+    // [device]
+    HK_FIELD(device, type, 0, 0, "", "Device driving the handle.", kDeviceTypes),
+    HK_FIELD(device, handle_mass_kg, 0.001, 5, "kg", "Effective handle mass (simulated pantograph)."),
+    HK_FIELD(device, handle_damping_n_s_per_m, 0, 100, "N·s/m", "Device viscous damping."),
+    HK_FIELD(device, encoder_counts_per_rev, 64, 1048576, "counts/rev", "Encoder resolution."),
+    HK_FIELD(device, max_torque_n_m, 0.001, 10, "N·m", "Per-motor torque limit."),
+    // [hand]
+    HK_FIELD(hand, stiffness_n_per_m, 1, 5000, "N/m", "Spring pulling the hand to its target."),
+    HK_FIELD(hand, damping_n_s_per_m, 0, 200, "N·s/m", "Damping of the hand spring."),
+    HK_FIELD(hand, max_force_n, 0.01, 50, "N", "The most a visitor pushes with."),
+    HK_FIELD(hand, raster_speed_m_per_s, 0.001, 5, "m/s", "Target speed along the raster."),
+    HK_FIELD(hand, raster_spacing_m, 0.0005, 0.05, "m", "Line spacing of the raster."),
+    // [vision]
+    HK_FIELD(vision, max_file_bytes, 1024, kTwoPow31, "bytes", "Largest image file accepted."),
+    HK_FIELD(vision, max_width_px, 16, 100000, "px", "Widest image accepted."),
+    HK_FIELD(vision, max_height_px, 16, 100000, "px", "Tallest image accepted."),
+    HK_FIELD(vision, max_pixels, 256, kTwoPow31, "px", "Largest width x height accepted."),
+    HK_FIELD(vision, blur_sigma_px, 0, 20, "px", "Gaussian pre-blur sigma."),
+    HK_FIELD(vision, canny_low, 0, 2000, "",
+             "Canny hysteresis low threshold; 0 = from the image; <= canny_high when both nonzero."),
+    HK_FIELD(vision, canny_high, 0, 2000, "", "Canny hysteresis high threshold; 0 = from the image."),
+    HK_FIELD(vision, min_chain_length_m, 0, 0.1, "m", "Edge chains shorter than this are dropped."),
+    HK_FIELD(vision, max_image_side_px, 64, 10000, "px", "Images are downscaled to this longest side."),
+    // [workspace]
+    HK_FIELD(workspace, width_m, 0.01, 1, "m", "Width of the usable rectangle."),
+    HK_FIELD(workspace, height_m, 0.01, 1, "m", "Height of the usable rectangle."),
+});
+
+#undef HK_FIELD
+
+std::string with_unit(std::string text, std::string_view unit) {
+  if (!unit.empty()) {
+    text += ' ';
+    text += unit;
+  }
+  return text;
+}
+
+std::string format_bound(const FieldDescriptor& d, double b) {
+  if (d.kind == FieldKind::integer) return std::to_string(static_cast<long long>(b));
+  return detail::format_real(b);
+}
+
+}  // namespace
+
+std::span<const FieldDescriptor> field_descriptors() noexcept { return kFields; }
+
+const FieldDescriptor* find_field(std::string_view table, std::string_view key) noexcept {
+  for (const auto& d : kFields)
+    if (d.table == table && d.key == key) return &d;
+  return nullptr;
+}
+
+namespace detail {
+
+std::span<const TableInfo> tables() noexcept { return kTables; }
+
+std::string one_line(std::string_view s, std::size_t max_chars) {
+  std::string out;
+  bool cut = false;
+  for (char c : s) {
+    if (out.size() >= max_chars) {
+      cut = true;
+      break;
+    }
+    const auto u = static_cast<unsigned char>(c);
+    switch (c) {
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (u < 0x20 || u == 0x7f) {
+          static constexpr char kHex[] = "0123456789abcdef";
+          out += "\\x";
+          out += kHex[u >> 4];
+          out += kHex[u & 15];
+        } else {
+          out += c;
+        }
+    }
+  }
+  if (cut) out += "...";
+  return out;
+}
+
+std::string format_real(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  // Plain decimals read best ("100000", "0.0005"); very large or small magnitudes would make them
+  // long, so those fall back to the shortest form, which may use an exponent ("5e-324").
+  std::array<char, 32> fixed{};
+  if (auto [end, ec] = std::to_chars(fixed.data(), fixed.data() + fixed.size(), v, std::chars_format::fixed);
+      ec == std::errc{})
+    return std::string(fixed.data(), end);
+  std::array<char, 64> buf{};
+  auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  if (ec != std::errc{}) return "?";  // cannot happen with 64 chars
+  return std::string(buf.data(), end);
+}
+
+std::string format_toml_real(double v) {
+  std::string s = format_real(v);
+  if (std::isfinite(v) && s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string toml_string(std::string_view s) {
+  std::string out = "\"";
+  for (char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (u < 0x20 || u == 0x7f) {
+          static constexpr char kHex[] = "0123456789ABCDEF";
+          out += "\\u00";
+          out += kHex[u >> 4];
+          out += kHex[u & 15];
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+  return out;
+}
+
+std::string qualified(const FieldDescriptor& d) {
+  std::string s(d.table);
+  s += '.';
+  s += d.key;
+  return s;
+}
+
+std::string allowed_text(const FieldDescriptor& d) {
+  if (d.kind == FieldKind::text) {
+    std::string s = "one of ";
+    for (std::size_t i = 0; i < d.choices.size(); ++i) {
+      if (i) s += ", ";
+      s += toml_string(d.choices[i]);
+    }
+    return s;
+  }
+  return with_unit("[" + format_bound(d, d.min) + ", " + format_bound(d, d.max) + "]", d.unit);
+}
+
+std::optional<std::string> real_problem(const FieldDescriptor& d, double v) {
+  if (!std::isfinite(v)) return "is not a finite number; allowed range " + allowed_text(d);
+  if (v < d.min || v > d.max) return "is out of range " + allowed_text(d);
+  return std::nullopt;
+}
+
+std::optional<std::string> integer_problem(const FieldDescriptor& d, long long v) {
+  // Bounds are whole and |bound| <= 2^31, so comparing in long long is exact.
+  if (v < static_cast<long long>(d.min) || v > static_cast<long long>(d.max))
+    return "is out of range " + allowed_text(d);
+  return std::nullopt;
+}
+
+std::optional<std::string> text_problem(const FieldDescriptor& d, std::string_view v) {
+  for (auto c : d.choices)
+    if (c == v) return std::nullopt;
+  return "is not a known value; allowed: " + allowed_text(d);
+}
+
+void fail(const Source& src, const std::string& key, const std::string& body, std::size_t line) {
+  std::string msg = src.is_file ? "config '" + one_line(src.name) + "': " : one_line(src.name) + ": ";
+  msg += body;
+  if (line > 0) msg += " (line " + std::to_string(line) + ")";
+  // Belt and braces: callers escape what they insert, but the message must stay one line.
+  for (char& c : msg)
+    if (c == '\n' || c == '\r') c = ' ';
+  throw ConfigError(src.name, key, msg);
+}
+
+void validate_as(const Settings& s, const Source& src) {
+  for (const auto& d : kFields) {
+    const std::string key = qualified(d);
+    std::visit(
+        [&](auto* p) {
+          using T = std::remove_cvref_t<decltype(*p)>;
+          if constexpr (std::is_same_v<T, double>) {
+            if (auto why = real_problem(d, *p)) fail(src, key, key + " = " + format_real(*p) + " " + *why);
+          } else if constexpr (std::is_same_v<T, std::string>) {
+            if (auto why = text_problem(d, *p))
+              fail(src, key, key + " = \"" + one_line(*p, 80) + "\" " + *why);
+          } else {
+            if (auto why = integer_problem(d, static_cast<long long>(*p)))
+              fail(src, key, key + " = " + std::to_string(*p) + " " + *why);
+          }
+        },
+        d.cref(s));
+  }
+  // Cross-field rules.
+  if (s.haptics.level > s.haptics.max_levels)
+    fail(src, "haptics.level",
+         "haptics.level = " + std::to_string(s.haptics.level) + " must be <= haptics.max_levels = " +
+             std::to_string(s.haptics.max_levels) + " (only levels 0..max_levels are built)");
+  if (s.vision.canny_low != 0.0 && s.vision.canny_high != 0.0 &&
+      s.vision.canny_low > s.vision.canny_high)
+    fail(src, "vision.canny_low",
+         "vision.canny_low = " + format_real(s.vision.canny_low) +
+             " must be <= vision.canny_high = " + format_real(s.vision.canny_high) +
+             " when both are nonzero");
+}
+
+}  // namespace detail
+
+void validate(const Settings& settings) { detail::validate_as(settings, {"settings", false}); }
+
+}  // namespace hk::config

@@ -1,0 +1,155 @@
+/// @file save.cpp
+/// Settings -> commented TOML text, and the atomic save (temp file, fsync, rename).
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+#include "config/load.hpp"
+#include "detail.hpp"
+
+namespace hk::config {
+
+namespace {
+
+using detail::fail;
+using detail::one_line;
+using detail::Source;
+
+/// The value of a field as TOML text.
+std::string toml_value(const FieldDescriptor& d, const Settings& s) {
+  return std::visit(
+      [](auto* p) -> std::string {
+        using T = std::remove_cvref_t<decltype(*p)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return detail::format_toml_real(*p);
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return detail::toml_string(*p);
+        } else {
+          return std::to_string(*p);
+        }
+      },
+      d.cref(s));
+}
+
+[[noreturn]] void io_fail(const Source& src, const std::string& what, int err) {
+  fail(src, "", "not saved: " + what + ": " + one_line(std::strerror(err)) + " (nothing was changed)");
+}
+
+/// Writes all of `text` to `fd`; returns 0 or an errno value.
+int write_all(int fd, const std::string& text) {
+  const char* p = text.data();
+  std::size_t left = text.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::string to_toml(const Settings& settings) {
+  static const Settings kDefaults{};
+  std::string out;
+  out += "# haptic-kiosk settings (TOML), written by hk::config::to_toml.\n";
+  out += "# Every key is optional: a key left out keeps its default. Unknown tables or keys, wrong\n";
+  out += "# types and values outside the range given above each key are refused with an error.\n";
+  for (const auto& table : detail::tables()) {
+    out += "\n[";
+    out += table.name;
+    out += "]\n# ";
+    out += table.help;
+    out += '\n';
+    for (const auto& d : field_descriptors()) {
+      if (d.table != table.name) continue;
+      out += "\n# ";
+      out += d.help;
+      if (d.kind == FieldKind::text) {
+        out += " Allowed: " + detail::allowed_text(d) + ".";
+      } else {
+        out += " Range ";
+        out += detail::allowed_text(d);
+        out += d.kind == FieldKind::integer ? ", an integer." : ".";
+      }
+      out += " Default " + toml_value(d, kDefaults) + ".\n";
+      out += d.key;
+      out += " = ";
+      out += toml_value(d, settings);
+      out += '\n';
+    }
+  }
+  return out;
+}
+
+void save_settings_atomic(const Settings& settings, const std::string& path) {
+  const Source src{path, true};
+  try {
+    detail::validate_as(settings, src);
+  } catch (const ConfigError& e) {
+    throw ConfigError(e.source(), e.key(), std::string(e.what()) + "; not saved");
+  }
+  const std::string text = to_toml(settings);
+
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  if (target.filename().empty()) fail(src, "", "not saved: the path names no file");
+  fs::path dir = target.parent_path();
+  if (dir.empty()) dir = ".";
+
+  // Keep the mode of an existing file; a new file gets 0644.
+  mode_t mode = 0644;
+  struct stat st{};
+  if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) mode = st.st_mode & 07777;
+
+  std::string tmp = (dir / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+  std::vector<char> tmpl(tmp.begin(), tmp.end());
+  tmpl.push_back('\0');
+  const int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);
+  if (fd < 0) io_fail(src, "cannot create a temporary file in '" + one_line(dir.string()) + "'", errno);
+  tmp.assign(tmpl.data());
+
+  const auto abandon = [&](const std::string& what, int err) {
+    ::unlink(tmp.c_str());
+    io_fail(src, what, err);
+  };
+  if (int err = write_all(fd, text)) {
+    ::close(fd);
+    abandon("cannot write '" + one_line(tmp) + "'", err);
+  }
+  if (::fchmod(fd, mode) != 0) {
+    const int err = errno;
+    ::close(fd);
+    abandon("cannot set the mode of '" + one_line(tmp) + "'", err);
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    abandon("cannot flush '" + one_line(tmp) + "' to disk", err);
+  }
+  if (::close(fd) != 0) abandon("cannot close '" + one_line(tmp) + "'", errno);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) abandon("cannot rename the temporary file over it", errno);
+
+  // The rename is the commit point. Flushing the directory makes it durable; some file systems
+  // refuse fsync on a directory, so this is best effort and never reported as a failure.
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    (void)::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+}  // namespace hk::config

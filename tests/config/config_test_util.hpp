@@ -1,0 +1,145 @@
+#pragma once
+/// @file config_test_util.hpp
+/// Helpers shared by the config tests: the expected field list (written from the comments in
+/// settings.hpp, independently of the implementation's descriptor table), temp directories and
+/// error capture.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "config/load.hpp"
+
+namespace hk::config::test {
+
+/// One numeric field as documented in settings.hpp.
+struct NumericSpec {
+  const char* table;
+  const char* key;
+  double min;
+  double max;
+  bool integer;
+  std::string name() const { return std::string(table) + "." + key; }
+};
+
+inline constexpr double kTwo31 = 2147483648.0;
+
+/// Every numeric field with its documented range (settings.hpp). device.type is the one text field.
+inline const std::vector<NumericSpec>& numeric_specs() {
+  static const std::vector<NumericSpec> specs{
+      {"haptics", "stiffness_n_per_m", 10, 5000, false},
+      {"haptics", "damping_n_s_per_m", 0, 20, false},
+      {"haptics", "max_force_n", 0.1, 20, false},
+      {"haptics", "servo_rate_hz", 100, 10000, false},
+      {"haptics", "level", 0, 12, true},
+      {"haptics", "max_levels", 1, 12, true},
+      {"haptics", "query_deadline_us", 1, 100000, false},
+      {"haptics", "force_ramp_s", 0, 10, false},
+      {"device", "handle_mass_kg", 0.001, 5, false},
+      {"device", "handle_damping_n_s_per_m", 0, 100, false},
+      {"device", "encoder_counts_per_rev", 64, 1048576, true},
+      {"device", "max_torque_n_m", 0.001, 10, false},
+      {"hand", "stiffness_n_per_m", 1, 5000, false},
+      {"hand", "damping_n_s_per_m", 0, 200, false},
+      {"hand", "max_force_n", 0.01, 50, false},
+      {"hand", "raster_speed_m_per_s", 0.001, 5, false},
+      {"hand", "raster_spacing_m", 0.0005, 0.05, false},
+      {"vision", "max_file_bytes", 1024, kTwo31, true},
+      {"vision", "max_width_px", 16, 100000, true},
+      {"vision", "max_height_px", 16, 100000, true},
+      {"vision", "max_pixels", 256, kTwo31, true},
+      {"vision", "blur_sigma_px", 0, 20, false},
+      {"vision", "canny_low", 0, 2000, false},
+      {"vision", "canny_high", 0, 2000, false},
+      {"vision", "min_chain_length_m", 0, 0.1, false},
+      {"vision", "max_image_side_px", 64, 10000, true},
+      {"workspace", "width_m", 0.01, 1, false},
+      {"workspace", "height_m", 0.01, 1, false},
+  };
+  return specs;
+}
+
+/// Directory of the test data (tests/data).
+inline std::filesystem::path data_dir() { return HK_TEST_DATA_DIR; }
+
+/// Shortest round-trip text of a double as a TOML float ("1.0", "0.006", "1e-05").
+inline std::string toml_float(double v) {
+  char buf[64];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  std::string s(buf, end);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+/// Runs `f`; returns the ConfigError it threw, or nullopt (and records a failure) if it threw
+/// nothing or something else.
+inline std::optional<ConfigError> capture_error(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "threw a non-ConfigError: " << e.what();
+    return std::nullopt;
+  }
+  ADD_FAILURE() << "did not throw";
+  return std::nullopt;
+}
+
+/// True when `s` is a single line.
+inline bool is_one_line(const std::string& s) { return s.find_first_of("\r\n") == std::string::npos; }
+
+/// A fresh directory under the system temp dir, removed (with its contents) at scope exit.
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (std::filesystem::temp_directory_path() / "hk_config_test_XXXXXX").string();
+    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = tmpl;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::permissions(path_, std::filesystem::perms::owner_all,
+                                 std::filesystem::perm_options::add, ec);
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline std::string read_file(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+inline void write_file(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + p.string());
+}
+
+/// Names of the entries of a directory, sorted.
+inline std::vector<std::string> list_dir(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace hk::config::test

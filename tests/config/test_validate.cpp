@@ -1,0 +1,176 @@
+// Field table and validate(): defaults, every documented range, cross-field rules.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <set>
+#include <string>
+#include <variant>
+
+#include "config/load.hpp"
+#include "config_test_util.hpp"
+
+namespace hk::config {
+namespace {
+
+using test::capture_error;
+using test::is_one_line;
+using test::numeric_specs;
+
+/// Sets the field `table.key` of `s` to `v` (numeric fields only).
+void set_numeric(Settings& s, const test::NumericSpec& spec, double v) {
+  const FieldDescriptor* d = find_field(spec.table, spec.key);
+  ASSERT_NE(d, nullptr) << spec.name();
+  std::visit(
+      [&](auto* p) {
+        using T = std::remove_pointer_t<decltype(p)>;
+        if constexpr (std::is_same_v<T, std::string>) {
+          FAIL() << spec.name() << " is not numeric";
+        } else {
+          *p = static_cast<T>(v);
+        }
+      },
+      d->ref(s));
+}
+
+TEST(ConfigValidate, DefaultsAreValid) { EXPECT_NO_THROW(validate(Settings{})); }
+
+TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
+  // Every documented numeric field is in the table with its documented range and kind...
+  std::set<std::string> seen;
+  for (const auto& spec : numeric_specs()) {
+    const FieldDescriptor* d = find_field(spec.table, spec.key);
+    ASSERT_NE(d, nullptr) << spec.name() << " missing from field_descriptors()";
+    EXPECT_EQ(d->min, spec.min) << spec.name();
+    EXPECT_EQ(d->max, spec.max) << spec.name();
+    EXPECT_EQ(d->kind, spec.integer ? FieldKind::integer : FieldKind::real) << spec.name();
+    seen.insert(spec.name());
+  }
+  // ...and the table holds nothing else but device.type.
+  for (const auto& d : field_descriptors()) {
+    const std::string name = std::string(d.table) + "." + std::string(d.key);
+    if (name == "device.type") {
+      EXPECT_EQ(d.kind, FieldKind::text);
+      ASSERT_EQ(d.choices.size(), 1u);
+      EXPECT_EQ(d.choices[0], "simulated");
+      continue;
+    }
+    EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
+    EXPECT_FALSE(d.help.empty()) << name;
+  }
+  EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + 1);
+}
+
+TEST(ConfigValidate, EveryDefaultIsInsideItsRange) {
+  const Settings s{};
+  for (const auto& spec : numeric_specs()) {
+    const FieldDescriptor* d = find_field(spec.table, spec.key);
+    ASSERT_NE(d, nullptr);
+    double v = std::visit(
+        [](auto* p) -> double {
+          if constexpr (std::is_same_v<std::remove_cvref_t<decltype(*p)>, std::string>) {
+            return std::numeric_limits<double>::quiet_NaN();
+          } else {
+            return static_cast<double>(*p);
+          }
+        },
+        d->cref(s));
+    EXPECT_GE(v, spec.min) << spec.name();
+    EXPECT_LE(v, spec.max) << spec.name();
+  }
+}
+
+TEST(ConfigValidate, EveryFieldBelowMinOrAboveMaxIsRefusedNamingIt) {
+  for (const auto& spec : numeric_specs()) {
+    const double below = spec.integer ? spec.min - 1 : std::nextafter(spec.min, -INFINITY);
+    const double above = spec.integer ? spec.max + 1 : std::nextafter(spec.max, INFINITY);
+    for (double bad : {below, above}) {
+      Settings s;
+      set_numeric(s, spec, bad);
+      auto e = capture_error([&] { validate(s); });
+      ASSERT_TRUE(e) << spec.name() << " = " << bad;
+      const std::string msg = e->what();
+      EXPECT_NE(msg.find(spec.name() + " = "), std::string::npos) << msg;
+      EXPECT_NE(msg.find("out of range"), std::string::npos) << msg;
+      EXPECT_EQ(e->key(), spec.name());
+      EXPECT_EQ(msg.rfind("settings: ", 0), 0u) << msg;
+      EXPECT_TRUE(is_one_line(msg)) << msg;
+    }
+  }
+}
+
+TEST(ConfigValidate, BoundsThemselvesAreAccepted) {
+  for (const auto& spec : numeric_specs()) {
+    for (double ok : {spec.min, spec.max}) {
+      Settings s;
+      s.haptics.max_levels = 12;  // so that haptics.level = 12 passes the cross-field rule
+      set_numeric(s, spec, ok);
+      EXPECT_NO_THROW(validate(s)) << spec.name() << " = " << ok;
+    }
+  }
+}
+
+TEST(ConfigValidate, NonFiniteRealsAreRefused) {
+  for (const auto& spec : numeric_specs()) {
+    if (spec.integer) continue;
+    for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                       -std::numeric_limits<double>::infinity()}) {
+      Settings s;
+      set_numeric(s, spec, bad);
+      auto e = capture_error([&] { validate(s); });
+      ASSERT_TRUE(e) << spec.name();
+      EXPECT_EQ(e->key(), spec.name());
+      EXPECT_NE(std::string(e->what()).find("not a finite number"), std::string::npos) << e->what();
+    }
+  }
+}
+
+TEST(ConfigValidate, LevelMustNotExceedMaxLevels) {
+  Settings s;
+  s.haptics.max_levels = 4;
+  s.haptics.level = 4;
+  EXPECT_NO_THROW(validate(s));
+  s.haptics.level = 5;
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "haptics.level");
+  EXPECT_NE(std::string(e->what()).find("haptics.max_levels = 4"), std::string::npos) << e->what();
+}
+
+TEST(ConfigValidate, CannyLowMustNotExceedHighWhenBothSet) {
+  Settings s;
+  s.vision.canny_low = 300;
+  s.vision.canny_high = 0;  // high from the image: any low is fine
+  EXPECT_NO_THROW(validate(s));
+  s.vision.canny_high = 300;
+  EXPECT_NO_THROW(validate(s));
+  s.vision.canny_high = 200;
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "vision.canny_low");
+  EXPECT_EQ(std::string(e->what()),
+            "settings: vision.canny_low = 300 must be <= vision.canny_high = 200 when both are nonzero");
+}
+
+TEST(ConfigValidate, UnknownDeviceTypeIsRefused) {
+  Settings s;
+  s.device.type = "mouse";
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "device.type");
+  EXPECT_EQ(std::string(e->what()),
+            "settings: device.type = \"mouse\" is not a known value; allowed: one of \"simulated\"");
+}
+
+TEST(ConfigValidate, ControlCharactersInValuesDoNotBreakTheLine) {
+  Settings s;
+  s.device.type = "sim\nulated\r\x01";
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_TRUE(is_one_line(e->what())) << e->what();
+  EXPECT_NE(std::string(e->what()).find("sim\\nulated\\r\\x01"), std::string::npos) << e->what();
+}
+
+}  // namespace
+}  // namespace hk::config
