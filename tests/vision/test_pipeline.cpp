@@ -1,0 +1,113 @@
+// The whole vision pipeline on every real test image, and the scale-back of chains found on a
+// shrunk image, which must land on the original image's boundaries.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "chain_checks.hpp"
+#include "vision/pipeline.hpp"
+
+namespace hk::vision {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(ExtractChains, SucceedsOnEveryTestImage) {
+  int images = 0;
+  for (const auto& entry : fs::directory_iterator(std::string(HK_TEST_DATA_DIR) + "/images")) {
+    SCOPED_TRACE(entry.path().filename().string());
+    const ExtractParams p;
+    const Extraction ex = extract_chains(entry.path().string(), p);
+    ++images;
+    const cv::Mat decoded = cv::imread(entry.path().string(), cv::IMREAD_COLOR);
+    EXPECT_EQ(ex.width_px, decoded.cols);
+    EXPECT_EQ(ex.height_px, decoded.rows);
+    EXPECT_GE(ex.px_scale, 1.0);
+    EXPECT_LE(std::max(ex.edge_map.edges.cols, ex.edge_map.edges.rows), p.max_image_side_px);
+    ASSERT_GE(ex.chains.size(), 1u);
+    test::expect_chains_sane(ex.chains, ex.width_px, ex.height_px);
+    for (const Chain& c : ex.chains) EXPECT_GE(chain_length_px(c) / ex.px_scale, p.min_chain_length_px - 1e-9);
+    EXPECT_GE(ex.times.load_ms, 0.0);
+    EXPECT_GE(ex.times.edges_ms, 0.0);
+    EXPECT_GE(ex.times.linking_ms, 0.0);
+  }
+  EXPECT_GE(images, 20);
+}
+
+TEST(ExtractChains, SilhouetteOutlinesHaveNoDanglingEnds) {
+  // In a binary image every boundary is a closed curve or runs into the image border. Canny can
+  // leave a gap of a pixel or two at a sharp notch, but an open chain must not end anywhere else:
+  // each end lies at the border or next to another chain end.
+  for (int i = 1; i <= 10; ++i) {
+    const std::string name = "silhouette_" + std::to_string(i) + ".png";
+    SCOPED_TRACE(name);
+    const Extraction ex = extract_chains(std::string(HK_TEST_DATA_DIR) + "/images/" + name, {});
+    std::vector<cv::Point2d> ends;
+    for (const Chain& c : ex.chains) {
+      if (c.closed) continue;
+      ends.push_back(c.points_px.front());
+      ends.push_back(c.points_px.back());
+    }
+    for (std::size_t k = 0; k < ends.size(); ++k) {
+      const cv::Point2d e = ends[k];
+      const double to_border = std::min({e.x, e.y, ex.width_px - 1 - e.x, ex.height_px - 1 - e.y});
+      double to_end = INFINITY;
+      for (std::size_t m = 0; m < ends.size(); ++m) {
+        if (m != k) to_end = std::min(to_end, cv::norm(ends[m] - e));
+      }
+      EXPECT_TRUE(to_border <= 2.0 || to_end <= 5.0) << "dangling end " << e;
+    }
+  }
+}
+
+TEST(ExtractChains, ChainsOfAShrunkImageAreInOriginalPixels) {
+  // A 1600 x 1200 picture of a disc, processed at 800 x 600: the loop must come back around the
+  // disc's true outline in original pixels.
+  const fs::path path = fs::temp_directory_path() /
+                        ("hk_vision_disc_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
+  const cv::Point2d centre(830.0, 570.0);
+  const double r = 400.0;
+  cv::Mat img(1200, 1600, CV_8UC3, cv::Scalar(255, 255, 255));
+  cv::circle(img, cv::Point(830, 570), 400, cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
+  ASSERT_TRUE(cv::imwrite(path.string(), img));
+  const Extraction ex = extract_chains(path.string(), {});
+  fs::remove(path);
+
+  EXPECT_EQ(ex.width_px, 1600);
+  EXPECT_EQ(ex.height_px, 1200);
+  EXPECT_DOUBLE_EQ(ex.px_scale, 2.0);
+  EXPECT_EQ(ex.edge_map.edges.size(), cv::Size(800, 600));
+  ASSERT_EQ(ex.chains.size(), 1u);
+  const Chain& c = ex.chains[0];
+  EXPECT_TRUE(c.closed);
+  test::expect_chains_sane(ex.chains, ex.width_px, ex.height_px);
+  for (const cv::Point2d& q : c.points_px) EXPECT_NEAR(cv::norm(q - centre), r, 2.0 * ex.px_scale);
+  EXPECT_NEAR(chain_length_px(c) / (2 * std::numbers::pi * r), 1.0, 0.08);
+}
+
+TEST(ExtractChains, RefusesBadFilesWithInputError) {
+  const std::string bad = std::string(HK_TEST_DATA_DIR) + "/bad/";
+  for (const char* name : {"not_an_image.png", "empty.png", "truncated.jpg", "huge_declared.png", "missing.png"}) {
+    EXPECT_THROW(extract_chains(bad + name, {}), InputError) << name;
+  }
+}
+
+TEST(ExtractChains, RejectsBadParameters) {
+  const std::string img = std::string(HK_TEST_DATA_DIR) + "/images/horse.png";
+  ExtractParams p;
+  p.max_image_side_px = 0;
+  EXPECT_THROW(extract_chains(img, p), std::invalid_argument);
+  p = {};
+  p.min_chain_length_px = -1;
+  EXPECT_THROW(extract_chains(img, p), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hk::vision

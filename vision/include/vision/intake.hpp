@@ -1,0 +1,96 @@
+#pragma once
+/// @file intake.hpp
+/// Image intake: the only door through which outside image files enter the kiosk.
+///
+/// Files come from USB sticks handed in by strangers, so every check that can be made without
+/// decoding is made before decoding (DESIGN.md "Bad input"): file size, then the dimensions the
+/// header declares (a 100 kB PNG can declare 100000 x 100000 px and make a decoder allocate 30 GB),
+/// then, for JPEG, that the stream is complete. Only then is OpenCV allowed to decode, from the
+/// bytes already checked (not by reopening the path, which could have changed in between).
+/// Every refusal is an InputError whose message is one line naming the file and the problem.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace hk::vision {
+
+/// Limits applied to an image file before it is decoded. All must be positive.
+struct ImageLimits {
+  std::int64_t max_file_bytes = 64LL << 20;  ///< largest accepted file [bytes] (64 MiB)
+  int max_width_px = 10000;                  ///< largest declared width [px]
+  int max_height_px = 10000;                 ///< largest declared height [px]
+  std::int64_t max_pixels = 40'000'000;      ///< largest declared width x height [px]
+};
+
+/// A refused input file. what() is a single line (control characters in the path are escaped)
+/// of the form "image '<path>': <problem>", e.g.
+/// "image 'x.png': declared size 100000 x 100000 px exceeds the limit of 10000 x 10000 px".
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// What an image file's header declares, read without decoding any pixel data.
+struct ImageHeader {
+  int width_px = 0;    ///< declared width [px], > 0
+  int height_px = 0;   ///< declared height [px], > 0
+  std::string format;  ///< container format: "png", "jpeg", "bmp", "tiff" or "webp"
+};
+
+/// Reads the declared size of an image from its header bytes only; the format is recognised by
+/// its signature, not by the file name's extension.
+///
+/// Parsed structures (sources: the format specifications):
+/// - PNG: signature + IHDR chunk, CRC checked (W3C PNG 2nd ed. §5.3, §11.2.2);
+/// - JPEG: marker segments walked up to the first SOFn frame header (ITU-T T.81 §B.2);
+/// - BMP: BITMAPCOREHEADER / BITMAPINFOHEADER and later (Microsoft "Bitmap Header Types");
+/// - TIFF and BigTIFF: first IFD, tags ImageWidth (256) and ImageLength (257) (TIFF 6.0 §2);
+/// - WebP: RIFF chunk VP8 (RFC 6386 §9.1), VP8L (RFC 9649 §3.4 / WebP lossless spec) or VP8X.
+/// Reads a few hundred bytes for most files; a JPEG's walk skips over (does not read) segments.
+///
+/// @throws InputError if the file is missing or unreadable, empty (0 bytes), of an unknown format
+///         (e.g. a text file named .png), or its header is truncated, corrupt, or declares a zero
+///         or out-of-range size.
+ImageHeader read_image_header(const std::string& path);
+
+/// Loads an image file as 8-bit BGR after checking it against the limits.
+///
+/// Order of checks: file exists and is a regular file; size in (0, max_file_bytes]; header
+/// (read_image_header rules) declares width <= max_width_px, height <= max_height_px and
+/// width*height <= max_pixels; then the container structure: a JPEG must reach its end-of-image
+/// marker 0xFFD9 (libjpeg only warns on a truncated stream and returns a half-grey image, which
+/// would show as a false edge), a PNG must have intact chunks (CRC) up to IEND.
+/// Decoding is cv::imdecode(IMREAD_COLOR) of the bytes that were checked, equivalent to
+/// cv::imread(path, IMREAD_COLOR) (EXIF orientation is applied; same pixels) but without
+/// reopening the path. For PNG, ancillary chunks OpenCV ignores (colour profiles, text) are left
+/// out of the decoded copy so libpng does not print warnings about them.
+/// Images with an alpha channel (PNG colour types 4/6 or tRNS, WebP alpha, TIFF extra samples)
+/// are composited over white, as a viewer would show them, so transparent areas do not turn black.
+/// OpenCV's own log output is silenced while decoding (libjpeg may still print a warning for
+/// corrupt data inside a complete JPEG: it writes to stderr directly).
+///
+/// @return CV_8UC3 BGR image, rows = height, cols = width (as decoded; an EXIF rotation may swap
+///         the declared width and height).
+/// @throws InputError for every refusal above and when decoding fails.
+/// @throws std::invalid_argument if a limit is not positive.
+cv::Mat load_image(const std::string& path, const ImageLimits& limits);
+
+/// Converts to one grey channel and shrinks so that max(width, height) <= max_side_px.
+///
+/// Shrinking uses cv::INTER_AREA (pixel-area averaging, the alias-free choice for decimation).
+/// The long side becomes exactly max_side_px; the short side is rounded, so its scale differs
+/// from the long side's by less than half a processed pixel. Images already small enough are
+/// not resized (never enlarged).
+///
+/// @param bgr          CV_8UC3 (BGR), CV_8UC4 (BGRA, alpha ignored) or CV_8UC1 (copied).
+/// @param max_side_px  largest allowed side of the result [px], >= 1.
+/// @param px_scale_out if not null, receives original px per processed px along the long side
+///                     (>= 1; exactly 1 when not resized).
+/// @return CV_8UC1 grey image.
+/// @throws std::invalid_argument if bgr is empty or of another type, or max_side_px < 1.
+cv::Mat to_grey(const cv::Mat& bgr, int max_side_px, double* px_scale_out);
+
+}  // namespace hk::vision

@@ -1,0 +1,55 @@
+#pragma once
+/// @file pipeline.hpp
+/// The vision pipeline in one call, for the app: file -> grey -> edges -> chains.
+///
+/// Edge detection runs on a downscaled image because a fingertip cannot resolve more than a few
+/// hundred features across the workspace and Canny on a 40 MP photo would take seconds; the
+/// chains are scaled back to the original pixel grid so that the caller maps one image size.
+
+#include <string>
+#include <vector>
+
+#include "vision/edges.hpp"
+#include "vision/intake.hpp"
+#include "vision/linking.hpp"
+
+namespace hk::vision {
+
+/// Parameters of extract_chains.
+struct ExtractParams {
+  ImageLimits limits;                ///< refusal limits for the file (see load_image)
+  EdgeParams edges;                  ///< edge detection, at the processed resolution
+  int max_image_side_px = 800;       ///< longest side the image is shrunk to before edges [px], >= 1
+  double min_chain_length_px = 20;   ///< shortest chain kept [processed px], >= 0 (see link_edges)
+};
+
+/// Wall-clock time of each stage [ms].
+struct StageTimes {
+  double load_ms;     ///< load_image + to_grey (file checks, decoding, grey, downscale)
+  double edges_ms;    ///< detect_edges
+  double linking_ms;  ///< link_edges + scaling the chains back
+};
+
+/// Result of extract_chains.
+struct Extraction {
+  int width_px;   ///< decoded image width [original px]
+  int height_px;  ///< decoded image height [original px]
+  /// Linked chains in ORIGINAL image pixel coordinates (u right, v down, origin at the centre of
+  /// the top-left pixel) [px]. When the image was shrunk, a processed pixel centre (u', v') maps
+  /// to ((u' + 0.5) * sx - 0.5, (v' + 0.5) * sy - 0.5) with sx = width_px / processed width and
+  /// sy likewise, so points are not integers and consecutive points are about px_scale apart.
+  std::vector<Chain> chains;
+  EdgeMap edge_map;  ///< edges at the processed resolution
+  double px_scale;   ///< original px per processed px (>= 1; 1 = not shrunk), see to_grey
+  StageTimes times;  ///< per-stage wall time
+};
+
+/// load_image -> to_grey (shrink to max_image_side_px) -> detect_edges -> link_edges
+/// (min_chain_length_px, measured at the processed resolution like the blur) -> chains scaled
+/// back to original pixels.
+///
+/// @throws InputError when the file is refused (see load_image).
+/// @throws std::invalid_argument on invalid parameters.
+Extraction extract_chains(const std::string& path, const ExtractParams& p);
+
+}  // namespace hk::vision

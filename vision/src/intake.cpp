@@ -1,0 +1,156 @@
+// load_image: the checked path from a file name to BGR pixels.
+//
+// The file is read into memory once and everything (header, limits, JPEG completeness,
+// decoding) works on those bytes, so a file swapped on the USB stick between the check and the
+// decode cannot slip past the limits. OpenCV's logger is silenced while decoding because the
+// kiosk reports refusals itself, in one line, and its log must not fill with decoder chatter.
+
+#include <climits>
+#include <fstream>
+#include <mutex>
+#include <span>
+#include <vector>
+
+#include <opencv2/core/utils/logger.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "image_header_detail.hpp"
+#include "input_error.hpp"
+
+namespace hk::vision {
+namespace {
+
+/// Silences OpenCV's logger for its lifetime. Nested and concurrent guards share one count so
+/// the level saved by the first is restored by the last.
+class QuietOpenCvLog {
+ public:
+  QuietOpenCvLog() {
+    const std::lock_guard<std::mutex> lock(mutex());
+    if (count()++ == 0) saved() = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  }
+  ~QuietOpenCvLog() {
+    const std::lock_guard<std::mutex> lock(mutex());
+    if (--count() == 0) cv::utils::logging::setLogLevel(saved());
+  }
+  QuietOpenCvLog(const QuietOpenCvLog&) = delete;
+  QuietOpenCvLog& operator=(const QuietOpenCvLog&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& count() {
+    static int c = 0;
+    return c;
+  }
+  static cv::utils::logging::LogLevel& saved() {
+    static cv::utils::logging::LogLevel level = cv::utils::logging::LOG_LEVEL_WARNING;
+    return level;
+  }
+};
+
+/// The whole file, which was measured at `expected` bytes (already checked against the limit).
+std::vector<std::uint8_t> read_all(const std::string& path, std::uint64_t expected) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) detail::throw_input_error(path, "cannot open the file for reading");
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(expected));
+  f.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  const bool short_read = static_cast<std::uint64_t>(f.gcount()) != expected;
+  if (short_read || f.peek() != std::ifstream::traits_type::eof()) {
+    detail::throw_input_error(path, "the file changed size while being read");
+  }
+  return bytes;
+}
+
+/// out = alpha * colour + (1 - alpha) * white, for 8- or 16-bit BGRA.
+cv::Mat composite_over_white(const cv::Mat& bgra) {
+  cv::Mat f;
+  bgra.convertTo(f, CV_32F, bgra.depth() == CV_16U ? 1.0 / 65535.0 : 1.0 / 255.0);
+  cv::Mat out(bgra.size(), CV_8UC3);
+  for (int y = 0; y < f.rows; ++y) {
+    const auto* src = f.ptr<cv::Vec4f>(y);
+    auto* dst = out.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < f.cols; ++x) {
+      const float a = src[x][3];
+      for (int c = 0; c < 3; ++c) dst[x][c] = cv::saturate_cast<std::uint8_t>(255.0f * (a * src[x][c] + 1.0f - a));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+cv::Mat load_image(const std::string& path, const ImageLimits& limits) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
+      limits.max_pixels <= 0) {
+    throw std::invalid_argument("load_image: every ImageLimits field must be positive");
+  }
+  const std::uint64_t size = detail::checked_file_size(path);
+  if (size > static_cast<std::uint64_t>(limits.max_file_bytes)) {
+    detail::throw_input_error(path, "file size " + std::to_string(size) + " bytes exceeds the limit of " +
+                                        std::to_string(limits.max_file_bytes) + " bytes");
+  }
+  const std::vector<std::uint8_t> bytes = read_all(path, size);
+  detail::MemorySource src(bytes);
+  const detail::HeaderDetails hd = detail::parse_image_header(src, path);
+  const ImageHeader& h = hd.header;
+  const std::string declared = "declared size " + std::to_string(h.width_px) + " x " + std::to_string(h.height_px) + " px";
+  if (h.width_px > limits.max_width_px || h.height_px > limits.max_height_px) {
+    detail::throw_input_error(path, declared + " exceeds the limit of " + std::to_string(limits.max_width_px) +
+                                        " x " + std::to_string(limits.max_height_px) + " px");
+  }
+  const std::int64_t pixels = std::int64_t{h.width_px} * h.height_px;
+  if (pixels > limits.max_pixels) {
+    detail::throw_input_error(path, declared + " (" + std::to_string(pixels) + " pixels) exceeds the limit of " +
+                                        std::to_string(limits.max_pixels) + " pixels");
+  }
+  if (h.format == "jpeg" && !detail::jpeg_is_complete(bytes)) {
+    detail::throw_input_error(path, "truncated or corrupt JPEG: the stream does not reach its end-of-image marker (0xFFD9)");
+  }
+
+  std::vector<std::uint8_t> png_copy;
+  std::span<const std::uint8_t> to_decode = bytes;
+  if (h.format == "png") {
+    png_copy = detail::png_decodable_copy(bytes, path);
+    to_decode = png_copy;
+  }
+
+  if (to_decode.size() > static_cast<std::size_t>(INT_MAX)) {  // cv::Mat's column count is an int
+    detail::throw_input_error(path, "file too large for the decoder (over 2 GiB)");
+  }
+  const QuietOpenCvLog quiet;
+  const cv::Mat buffer(1, static_cast<int>(to_decode.size()), CV_8UC1, const_cast<std::uint8_t*>(to_decode.data()));
+  cv::Mat bgr;
+  try {
+    bgr = cv::imdecode(buffer, cv::IMREAD_COLOR);
+  } catch (const cv::Exception&) {
+    bgr.release();  // reported below as a decoding failure
+  }
+  if (bgr.empty()) {
+    detail::throw_input_error(path, "the " + h.format + " data could not be decoded (corrupt or unsupported)");
+  }
+  const bool as_declared = bgr.cols == h.width_px && bgr.rows == h.height_px;
+  const bool transposed = bgr.cols == h.height_px && bgr.rows == h.width_px;  // EXIF rotation
+  if (!as_declared && !transposed) {
+    detail::throw_input_error(path, "decoded size " + std::to_string(bgr.cols) + " x " + std::to_string(bgr.rows) +
+                                        " px differs from the " + declared);
+  }
+  if (hd.may_have_alpha) {
+    cv::Mat with_alpha;
+    try {
+      with_alpha = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception&) {
+      with_alpha.release();  // keep the colour decode
+    }
+    const bool usable = with_alpha.channels() == 4 && with_alpha.size() == bgr.size() &&
+                        (with_alpha.depth() == CV_8U || with_alpha.depth() == CV_16U);
+    if (usable) bgr = composite_over_white(with_alpha);
+  }
+  if (bgr.type() != CV_8UC3) {
+    detail::throw_input_error(path, "decoder returned an unexpected pixel type");
+  }
+  return bgr;
+}
+
+}  // namespace hk::vision

@@ -1,0 +1,67 @@
+// PNG chunk check and clean-up before decoding.
+//
+// libpng reports problems by printing to stderr ("libpng error: Read Error" for a truncated
+// file, "libpng warning: iCCP: ..." for a colour profile it dislikes, as in tests/data/images/
+// page.png) and OpenCV cannot silence it. Checking the chunk structure here turns a truncated or
+// damaged file into one clear InputError, and handing libpng only the chunks that matter to
+// OpenCV's pixels keeps the kiosk's log free of warnings about data it would ignore anyway.
+
+#include <cstring>
+
+#include "image_header_detail.hpp"
+#include "input_error.hpp"
+
+namespace hk::vision::detail {
+namespace {
+
+bool kept_chunk(const std::uint8_t* type) {
+  for (const char* keep : {"IHDR", "PLTE", "IDAT", "IEND", "tRNS", "eXIf"}) {
+    if (std::memcmp(type, keep, 4) == 0) return true;
+  }
+  return false;
+}
+
+bool is_critical(const std::uint8_t* type) { return (type[0] & 0x20U) == 0; }  // upper-case first letter
+
+std::uint32_t be32(const std::uint8_t* p) {
+  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) | p[3];
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> png_decodable_copy(std::span<const std::uint8_t> bytes, const std::string& path) {
+  const std::size_t n = bytes.size();
+  std::vector<std::uint8_t> out(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(n, 8)));
+  std::size_t pos = 8;
+  bool idat = false;
+  // W3C PNG 2nd ed. §5.3: length (4, <= 2^31 - 1), type (4), data, CRC over type + data (4).
+  for (;;) {
+    if (pos > n || n - pos < 12) {
+      throw_input_error(path, "truncated PNG: the file ends before its IEND chunk");
+    }
+    const std::uint8_t* chunk = bytes.data() + pos;
+    const std::uint32_t len = be32(chunk);
+    const std::uint8_t* type = chunk + 4;
+    const std::string name(reinterpret_cast<const char*>(type), 4);
+    if (len > 0x7FFFFFFFU || len > n - pos - 12) {
+      throw_input_error(path, "truncated PNG: chunk '" + name + "' at byte " + std::to_string(pos) +
+                                  " runs past the end of the file");
+    }
+    const bool crc_ok = crc32_png(type, 4 + std::size_t{len}) == be32(type + 4 + len);
+    if (kept_chunk(type) || is_critical(type)) {
+      // Unknown critical chunks are passed on: libpng refuses them, as the standard requires.
+      if (!crc_ok) {
+        throw_input_error(path, "corrupt PNG: checksum (CRC) mismatch in chunk '" + name + "' at byte " +
+                                    std::to_string(pos));
+      }
+      out.insert(out.end(), chunk, chunk + 12 + std::size_t{len});
+      idat = idat || std::memcmp(type, "IDAT", 4) == 0;
+      if (std::memcmp(type, "IEND", 4) == 0) break;
+    }
+    pos += 12 + std::size_t{len};
+  }
+  if (!idat) throw_input_error(path, "corrupt PNG: no image data (IDAT chunk)");
+  return out;
+}
+
+}  // namespace hk::vision::detail
