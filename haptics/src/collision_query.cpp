@@ -168,19 +168,29 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   }
   // 2. Nearest first: sort hit boxes by entry parameter, refine depth-first, prune past the best hit.
   std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& x, const Candidate& y) { return x.t_enter < y.t_enter; });
+  // Past the budget, boxes are not refined: the nearest such box bounds what is proven clear.
+  double unresolved_t = std::numeric_limits<double>::infinity();
+  std::uint32_t unresolved_node = 0;
   for (const Candidate& cand : candidates_) {
-    if (cand.t_enter > best.t) break;
+    if (cand.t_enter > std::min(best.t, unresolved_t)) break;
     int top = 0;
     stack_[top++] = cand;
     while (top > 0) {
       const Candidate cur = stack_[--top];
-      if (cur.t_enter > best.t) continue;
+      if (cur.t_enter > std::min(best.t, unresolved_t)) continue;
       const std::uint32_t node = cur.node;
       const bool root = sc.is_root(node);
       const NodeInfo& in = sc.info(node);
       const int target = sc.clamp_level(in.curve, level);
-      if (!root && (in.level <= target || exhausted)) {
+      if (!root && in.level <= target) {
         test_segment(node);
+        continue;
+      }
+      if (exhausted) {
+        if (cur.t_enter < unresolved_t) {
+          unresolved_t = cur.t_enter;
+          unresolved_node = node;
+        }
         continue;
       }
       std::uint32_t first = 0, count = 0;
@@ -235,7 +245,21 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   section_.resize(w);
   for (std::uint32_t node : section_) removed_[node] = 0;
 
-  if (best.hit) {
+  if (unresolved_t < best.t) {
+    // Not resolved in time: report the finest level reached, and how far the sweep is proven clear.
+    best.hit = false;
+    best.blocked = true;
+    best.t = unresolved_t;
+    const NodeInfo& in = sc.info(unresolved_node);
+    if (sc.is_root(unresolved_node)) {
+      const CurveInfo& ci = sc.curve(in.curve);
+      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), ci.levels - 1, 0};
+    } else {
+      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+    }
+    st.coarsest_answer_level = std::max(st.coarsest_answer_level, best.segment.level);
+  }
+  if (best.hit || best.blocked) {
     best.point_m = lerp(a, b, best.t);
   } else {
     best.t = 1.0;

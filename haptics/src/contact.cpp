@@ -61,7 +61,7 @@ void ContactSolver::reset(Vec2 p_m, int level) {
   }
 }
 
-bool ContactSolver::move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count,
+ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count,
                             const QueryBudget& budget, ContactOutput& out, Constraint* hit_out) {
   QueryStats st;
   const SweepHit hit = section_.first_hit(proxy_, target, level, excluded, excluded_count, budget, &st);
@@ -73,10 +73,19 @@ bool ContactSolver::move_to(Vec2 target, int level, const SegmentRef* excluded, 
   out.query.coarsest_answer_level = std::max(out.query.coarsest_answer_level, st.coarsest_answer_level);
   out.query.budget_exhausted = out.query.budget_exhausted || st.budget_exhausted;
   ++out.queries;
+  if (hit.blocked) {
+    // Unresolved in time: go only as far as the sweep is proven clear, less the skin. Never guess.
+    const double len = distance(proxy_, target);
+    const double t = len > 0.0 ? std::max(0.0, hit.t - params_.skin_m / len) : 0.0;
+    proxy_ = proxy_ + t * (target - proxy_);
+    if (out.path_count < ContactOutput::kMaxPath) out.path_m[out.path_count++] = proxy_;
+    out.events |= kEventQueryBudget;
+    return Move::Blocked;
+  }
   if (!hit.hit) {
     proxy_ = target;
     if (out.path_count < ContactOutput::kMaxPath) out.path_m[out.path_count++] = proxy_;
-    return false;
+    return Move::Clear;
   }
   // Stop where the proxy is a skin away from the wall's line, along the path already proven clear.
   const SegGeom g = geom(*scene_, hit.segment);
@@ -90,7 +99,7 @@ bool ContactSolver::move_to(Vec2 target, int level, const SegmentRef* excluded, 
   if (out.path_count < ContactOutput::kMaxPath) out.path_m[out.path_count++] = proxy_;
   hit_out->seg = hit.segment;
   hit_out->side = side;
-  return true;
+  return Move::Hit;
 }
 
 void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
@@ -113,7 +122,8 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
     switch (state_) {
       case ContactState::Free: {
         Constraint hit;
-        if (move_to(h, level_, nullptr, 0, in.budget, out, &hit)) {
+        const Move m = move_to(h, level_, nullptr, 0, in.budget, out, &hit);
+        if (m == Move::Hit) {
           state_ = ContactState::Edge;
           c_[0] = hit;
         } else {
@@ -133,7 +143,12 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
         const int clamped = tau < 0.0 ? -1 : (tau > g.len ? 1 : 0);
         const double tau_c = std::clamp(tau, 0.0, g.len);
         Constraint hit;
-        if (move_to(g.a + tau_c * g.u + (side * skin) * g.n, level_, &seg, 1, in.budget, out, &hit)) {
+        const Move m = move_to(g.a + tau_c * g.u + (side * skin) * g.n, level_, &seg, 1, in.budget, out, &hit);
+        if (m == Move::Blocked) {
+          rest = true;
+          break;
+        }
+        if (m == Move::Hit) {
           state_ = ContactState::Vertex;  // a second wall while sliding
           c_[1] = hit;
           out.events |= kEventVertexBegin;
@@ -169,7 +184,12 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
         // along the next edge if the handle is behind it, or leave it.
         if (turn < 0.0) out.events |= kEventConvexCorner;
         const Vec2 bis = normalized_or(g.n + gn.n, clamped > 0 ? g.u : -g.u);
-        if (move_to(v + (side * skin) * bis, level_, nullptr, 0, in.budget, out, &hit)) {
+        const Move mc = move_to(v + (side * skin) * bis, level_, nullptr, 0, in.budget, out, &hit);
+        if (mc == Move::Blocked) {
+          rest = true;
+          break;
+        }
+        if (mc == Move::Hit) {
           state_ = ContactState::Edge;
           c_[0] = hit;
           break;

@@ -166,7 +166,15 @@ TEST_P(RasterNeverCrosses, ProxyStaysOnItsSideOfEveryWall) {
   long crossings = 0, contact_ticks = 0, vertex_ticks = 0, bad_force = 0;
   app::run_simulation(sc, s, path, path.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
-    for (int m = 1; m < c.path_count; ++m) crossings += grid.crossings(c.path_m[m - 1], c.path_m[m]);
+    for (int m = 1; m < c.path_count; ++m) {
+      const int n = grid.crossings(c.path_m[m - 1], c.path_m[m]);
+      if (n && getenv("HK_DEBUG")) {
+        fprintf(stderr, "tick %ld move %d/%d crossings %d state %d ev %x h(%.9g,%.9g) c0 %d/%d/%d c1 %d/%d/%d\n", r.index, m, c.path_count, n, (int)c.state, c.events, r.handle_m.x, r.handle_m.y,
+          c.constraint[0].curve, c.constraint[0].level, c.constraint[0].segment, c.constraint[1].curve, c.constraint[1].level, c.constraint[1].segment);
+        for (int q = 0; q < c.path_count; ++q) fprintf(stderr, "   p%d (%.12g, %.12g)\n", q, c.path_m[q].x, c.path_m[q].y);
+      }
+      crossings += n;
+    }
     contact_ticks += c.state != ContactState::Free;
     vertex_ticks += c.state == ContactState::Vertex;
     // Force = stiffness · separation, up to the clamp (and the start-up ramp).
@@ -186,6 +194,9 @@ struct BadCase {
   std::string args;       // after "explore"; {bad} is replaced by tests/data/bad
   std::string must_name;  // the stderr line must contain this
 };
+
+// Short names in test listings instead of a byte dump of the struct.
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
 
 class BadInput : public ::testing::TestWithParam<BadCase> {};
 

@@ -9,8 +9,11 @@
 /// Each tick the sweep is clipped (Liang–Barsky) against the boxes of the boundary section; hit boxes
 /// are sorted by entry parameter and refined depth-first, nearest first, down to the target level,
 /// where the sweep is intersected with that level's polyline. Boxes whose entry lies past the best hit
-/// so far are pruned. A budget (deadline and/or box-test count) makes it anytime: past it, a box not yet
-/// refined is answered with its own level's segment, so the answer is the one at the finest level reached.
+/// so far are pruned. A budget (deadline and/or box-test count) makes it anytime: past it, boxes are no
+/// longer refined, and the answer is the one at the finest level reached — reported conservatively: the
+/// sweep is clear up to the entry of the nearest box not refined in time (a box holds everything finer,
+/// so no wall of the target level lies before it). The caller can then stop short instead of crossing a
+/// wall it has not resolved; the boundary section keeps the refinement for the next tick.
 ///
 /// Real-time: all storage is sized in the constructor; `first_hit` allocates nothing, takes no lock,
 /// throws nothing.
@@ -39,10 +42,13 @@ struct QueryBudget {
 
 /// Result of a sweep query.
 struct SweepHit {
-  bool hit = false;
-  double t = 1.0;        ///< sweep parameter of the first hit, in [0, 1]
+  bool hit = false;      ///< the exact first hit at the target level was found
+  bool blocked = false;  ///< the budget ran out first: the sweep is proven clear only up to `t`
+  double t = 1.0;        ///< hit: sweep parameter of the first hit; blocked: where the first box not
+                         ///< refined in time begins (no wall of the target level lies before it); else 1
   Vec2 point_m;          ///< a + t (b − a) [m]
-  SegmentRef segment;    ///< the segment hit (its level is the level actually reached)
+  SegmentRef segment;    ///< hit: the segment hit; blocked: the coarse segment of that box, i.e. the
+                         ///< answer at the finest level reached (level > target)
 };
 
 /// Work done by one query (for timing analysis and the anytime chart).
@@ -52,7 +58,7 @@ struct QueryStats {
   std::int32_t splits = 0;
   std::int32_t merges = 0;
   std::int32_t section_size = 0;       ///< boundary-section nodes after the query
-  std::int32_t coarsest_answer_level = 0;  ///< coarsest level at which a segment was tested (> target when the budget ran out)
+  std::int32_t coarsest_answer_level = 0;  ///< coarsest level reached by an answer (> target when the budget ran out)
   bool budget_exhausted = false;
 };
 

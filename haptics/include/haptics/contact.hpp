@@ -35,6 +35,7 @@ enum HapticEvent : std::uint32_t {
   kEventVertexBegin = 1u << 2,    ///< entered vertex contact (concave corner)
   kEventConvexCorner = 1u << 3,   ///< slid over a convex corner onto the next edge
   kEventIterationLimit = 1u << 4, ///< the tick's move budget ran out before the proxy came to rest
+  kEventQueryBudget = 1u << 5,    ///< a collision query ran out of time: the proxy stopped where the sweep was proven clear
 };
 
 /// Solver parameters. Units in names.
@@ -97,8 +98,10 @@ class ContactSolver {
     SegmentRef seg;
     double side = 1.0;  // +1: proxy on the segment's left, −1: right
   };
-  // Moves the proxy towards `target`, stopping a skin short of the first wall; returns the wall hit.
-  bool move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count, const QueryBudget& budget,
+  enum class Move : std::uint8_t { Clear, Hit, Blocked };
+  // Moves the proxy towards `target`, stopping a skin short of the first wall (Hit, wall in hit_out),
+  // or short of the first box the query could not resolve in its budget (Blocked).
+  Move move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count, const QueryBudget& budget,
                ContactOutput& out, Constraint* hit_out);
   double side_of(SegmentRef s, Vec2 p) const;
 
