@@ -116,17 +116,28 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   std::setvbuf(trace.get(), buffer, _IOFBF, sizeof buffer);
   std::fputs("t_s,handle_x_m,handle_y_m,proxy_x_m,proxy_y_m,force_x_n,force_y_n,contact,curve,level,tick_ns\n", trace.get());
 
+  struct Row {
+    double t_s;
+    Vec2 handle_m, proxy_m, force_n;
+    int contact, curve, level;
+    std::int64_t tick_ns;
+  };
+  std::vector<Row> rows;
+  rows.reserve(static_cast<std::size_t>(std::ceil(duration * s.haptics.servo_rate_hz)) + 1);
   ExploreSummary sum;
   sum.curves = scene.curve_count();
   std::vector<std::int64_t> tick_ns;
   std::vector<Vec2> proxy_path;
   long budget_exhausted = 0;
+  double queries = 0, box_tests = 0, section_sum = 0;
+  long section_max = 0, iteration_limited = 0;
   run_simulation(scene, s, path, duration, [&](const TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     const int state = static_cast<int>(c.state);
     const int curve = c.state == ContactState::Free ? -1 : c.constraint[0].curve;
-    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld\n", r.t_s, r.handle_m.x, r.handle_m.y, c.proxy_m.x,
-                 c.proxy_m.y, so.force_n.x, so.force_n.y, state, curve, c.level, static_cast<long long>(r.tick_ns));
+    // Rows are kept in memory and formatted after the run: printf between ticks would evict the
+    // servo's data from the caches and inflate the tick times we measure.
+    rows.push_back({r.t_s, r.handle_m, c.proxy_m, so.force_n, state, curve, c.level, r.tick_ns});
     tick_ns.push_back(r.tick_ns);
     proxy_path.push_back(c.proxy_m);
     ++sum.ticks;
@@ -135,7 +146,16 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     sum.vertex_ticks += state == 2;
     sum.max_force_n = std::max(sum.max_force_n, length(so.force_n));
     budget_exhausted += c.query.budget_exhausted;
+    queries += c.queries;
+    box_tests += c.query.box_tests;
+    section_sum += c.query.section_size;
+    section_max = std::max<long>(section_max, c.query.section_size);
+    iteration_limited += (c.events & kEventIterationLimit) != 0;
   });
+  for (const Row& w : rows) {
+    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld\n", w.t_s, w.handle_m.x, w.handle_m.y, w.proxy_m.x,
+                 w.proxy_m.y, w.force_n.x, w.force_n.y, w.contact, w.curve, w.level, static_cast<long long>(w.tick_ns));
+  }
   if (std::fflush(trace.get()) != 0 || std::ferror(trace.get())) throw ExploreError("output '" + trace_path.string() + "': write failed");
   trace.reset();
 
@@ -148,6 +168,9 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["contact_ticks"] = {{"free", sum.free_ticks}, {"edge", sum.edge_ticks}, {"vertex", sum.vertex_ticks}};
   sj["max_force_n"] = sum.max_force_n;
   sj["query_budget_exhausted_ticks"] = budget_exhausted;
+  const double n = std::max<long>(1, sum.ticks);
+  sj["per_tick"] = {{"queries_mean", queries / n}, {"box_tests_mean", box_tests / n}, {"boundary_section_mean", section_sum / n},
+                    {"boundary_section_max", section_max}, {"iteration_limited_ticks", iteration_limited}};
   sj["curves"] = scene.curve_count();
   sj["chains"] = {{"found", is.chains_found}, {"too_short", is.chains_too_short}, {"unbuildable", scene.skipped_curves()}};
   json segs = json::array();
