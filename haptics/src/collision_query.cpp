@@ -78,7 +78,8 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   removed_.assign(n, 0);
   candidates_.reserve(2 * n + widest_root + 8);
   merge_scratch_.reserve(2 * n + widest_root + 8);
-  stack_.resize(widest_root + 4 * Scene::kMaxLevels + 8);
+  // Widest fan-out (a curve root), plus two per level of curve and hierarchy (≤ 64 levels deep).
+  stack_.resize(widest_root + 4 * Scene::kMaxLevels + 2 * 64 + 8);
   hit_stamp_.assign(n, 0);
   reset();
 }
@@ -86,11 +87,10 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
 void BoundarySection::reset() {
   for (std::uint32_t node : section_) in_section_[node] = 0;
   section_.clear();
-  for (std::size_t c = 0; c < scene_->curve_count(); ++c) {
-    const std::uint32_t r = scene_->root_node(c);
-    section_.push_back(r);
-    in_section_[r] = 1;
-  }
+  if (scene_->curve_count() == 0) return;
+  const std::uint32_t r = scene_->scene_root();
+  section_.push_back(r);
+  in_section_[r] = 1;
 }
 
 void BoundarySection::split(std::uint32_t node) {
@@ -179,10 +179,8 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
       const Candidate cur = stack_[--top];
       if (cur.t_enter > std::min(best.t, unresolved_t)) continue;
       const std::uint32_t node = cur.node;
-      const bool root = sc.is_root(node);
       const NodeInfo& in = sc.info(node);
-      const int target = sc.clamp_level(in.curve, level);
-      if (!root && in.level <= target) {
+      if (sc.is_segment(node) && in.level <= sc.clamp_level(in.curve, level)) {
         test_segment(node);
         continue;
       }
@@ -208,7 +206,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   // 3. The boundary section follows the handle: split what was hit (one level per tick) ...
   for (const Candidate& cand : candidates_) {
     const NodeInfo& in = sc.info(cand.node);
-    if (sc.is_root(cand.node) || in.level > sc.clamp_level(in.curve, level)) {
+    if (!sc.is_segment(cand.node) || in.level > sc.clamp_level(in.curve, level)) {
       split(cand.node);
       ++st.splits;
     }
@@ -217,7 +215,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   constexpr int kMaxMergesPerTick = 16;
   for (std::uint32_t node : merge_scratch_) {
     if (st.merges >= kMaxMergesPerTick) break;
-    if (!in_section_[node] || sc.is_root(node)) continue;
+    if (!in_section_[node] || node == sc.scene_root()) continue;
     const std::uint32_t parent = sc.parent(node);
     if (in_section_[parent]) continue;
     std::uint32_t first = 0, count = 0;
@@ -251,9 +249,11 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     best.blocked = true;
     best.t = unresolved_t;
     const NodeInfo& in = sc.info(unresolved_node);
-    if (sc.is_root(unresolved_node)) {
+    if (sc.is_curve_root(unresolved_node)) {
       const CurveInfo& ci = sc.curve(in.curve);
       best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), ci.levels - 1, 0};
+    } else if (!sc.is_segment(unresolved_node)) {  // above the curves: no segment to name yet
+      best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
     } else {
       best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
     }
@@ -274,37 +274,35 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   const Scene& sc = *scene_;
   double best = max_distance_m;
   bool found = false;
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
-    const std::uint32_t root = sc.root_node(c);
-    const double dr = box_distance(sc.box(root), p);
-    if (dr > best) continue;
-    const int target = sc.clamp_level(c, level);
-    int top = 0;
-    stack_[top++] = {dr, root};
-    while (top > 0) {
-      const Candidate cur = stack_[--top];
-      if (cur.t_enter > best) continue;
-      const NodeInfo& in = sc.info(cur.node);
-      if (!sc.is_root(cur.node) && in.level <= target) {
-        const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
-        Vec2 a, b;
-        sc.segment(ref, &a, &b);
-        const Vec2 q = closest_point_on_segment(p, a, b);
-        const double d = distance(p, q);
-        if (d <= best) {
-          best = d;
-          found = true;
-          if (point_out) *point_out = q;
-          if (segment_out) *segment_out = ref;
-        }
-        continue;
+  if (sc.curve_count() == 0) return false;
+  const std::uint32_t root = sc.scene_root();
+  const double dr = box_distance(sc.box(root), p);
+  if (dr > best) return false;
+  int top = 0;
+  stack_[top++] = {dr, root};
+  while (top > 0) {
+    const Candidate cur = stack_[--top];
+    if (cur.t_enter > best) continue;
+    const NodeInfo& in = sc.info(cur.node);
+    if (sc.is_segment(cur.node) && in.level <= sc.clamp_level(in.curve, level)) {
+      const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+      Vec2 a, b;
+      sc.segment(ref, &a, &b);
+      const Vec2 q = closest_point_on_segment(p, a, b);
+      const double d = distance(p, q);
+      if (d <= best) {
+        best = d;
+        found = true;
+        if (point_out) *point_out = q;
+        if (segment_out) *segment_out = ref;
       }
-      std::uint32_t first = 0, count = 0;
-      sc.children(cur.node, &first, &count);
-      for (std::uint32_t i = 0; i < count; ++i) {
-        const double d = box_distance(sc.box(first + i), p);
-        if (d <= best) stack_[top++] = {d, first + i};
-      }
+      continue;
+    }
+    std::uint32_t first = 0, count = 0;
+    sc.children(cur.node, &first, &count);
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const double d = box_distance(sc.box(first + i), p);
+      if (d <= best) stack_[top++] = {d, first + i};
     }
   }
   return found;

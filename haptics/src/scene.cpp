@@ -37,6 +37,41 @@ inline ErrorBox make_box(Vec2 origin, Vec2 axis, const Extent& e) {
   return ErrorBox{origin, axis, e.u_min - kBoxPad_m, e.u_max + kBoxPad_m, e.n_min - kBoxPad_m, e.n_max + kBoxPad_m};
 }
 
+// One node of the curve hierarchy while it is built: the curve range it covers in leaf order and,
+// for an inner node, the id of its first child (the second is first + 1).
+struct HierarchyNode {
+  std::size_t begin = 0, end = 0;
+  std::size_t first_child = 0;
+  bool leaf = true;
+};
+
+constexpr std::size_t kCurvesPerLeaf = 4;
+
+// Median split on the longer axis of the curve centres. `order` is permuted in place into leaf order.
+// Children of a node are allocated as a consecutive pair, so they have consecutive ids.
+void build_hierarchy(std::vector<std::size_t>& order, const std::vector<Vec2>& centre, std::vector<HierarchyNode>& nodes) {
+  nodes.clear();
+  nodes.push_back({0, order.size(), 0, true});
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const std::size_t begin = nodes[i].begin, end = nodes[i].end;
+    if (end - begin <= kCurvesPerLeaf) continue;
+    Vec2 lo = centre[order[begin]], hi = lo;
+    for (std::size_t k = begin; k < end; ++k) {
+      const Vec2 c = centre[order[k]];
+      lo = {std::min(lo.x, c.x), std::min(lo.y, c.y)};
+      hi = {std::max(hi.x, c.x), std::max(hi.y, c.y)};
+    }
+    const bool split_x = hi.x - lo.x >= hi.y - lo.y;
+    const std::size_t mid = begin + (end - begin) / 2;
+    std::nth_element(order.begin() + static_cast<long>(begin), order.begin() + static_cast<long>(mid), order.begin() + static_cast<long>(end),
+                     [&](std::size_t a, std::size_t b) { return split_x ? centre[a].x < centre[b].x : centre[a].y < centre[b].y; });
+    nodes[i].leaf = false;
+    nodes[i].first_child = nodes.size();
+    nodes.push_back({begin, mid, 0, true});
+    nodes.push_back({mid, end, 0, true});
+  }
+}
+
 double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -60,27 +95,9 @@ void box_corners(const ErrorBox& box, Vec2 out[4]) {
 
 double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min), std::abs(box.n_max)); }
 
-std::uint32_t Scene::parent(std::uint32_t node) const {
-  if (is_root(node)) return node;
-  const NodeInfo& in = info_[node];
-  const CurveInfo& c = curves_[in.curve];
-  if (in.level + 1 >= c.levels) return root_node(in.curve);
-  return c.box_offset[in.level + 1] + in.index / 2;
-}
-
-void Scene::children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const {
-  const NodeInfo& in = info_[node];
-  const CurveInfo& c = curves_[in.curve];
-  if (is_root(node)) {
-    *first = c.box_offset[c.levels - 1];
-    *count = c.segment_count[c.levels - 1];
-  } else if (in.level == 0) {
-    *first = 0;
-    *count = 0;
-  } else {
-    *first = c.box_offset[in.level - 1] + 2 * in.index;
-    *count = 2;
-  }
+std::size_t Scene::hot_bytes() const {
+  return boxes_.size() * sizeof(ErrorBox) + info_.size() * sizeof(NodeInfo) +
+         (parent_.size() + child_first_.size() + child_count_.size()) * sizeof(std::uint32_t) + points_m_.size() * sizeof(Vec2);
 }
 
 void Scene::segment(SegmentRef s, Vec2* a, Vec2* b) const {
@@ -114,6 +131,31 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   }
   const double t1 = now_ms();
 
+  // Curve hierarchy: order the curves so every hierarchy leaf covers consecutive curve roots.
+  std::vector<HierarchyNode> hierarchy;
+  {
+    std::vector<Vec2> centre(scene.models_.size());
+    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+      Vec2 lo = scene.models_[c].scaling[0][0], hi = lo;
+      for (const Vec2& q : scene.models_[c].scaling[0]) {
+        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+      }
+      centre[c] = 0.5 * (lo + hi);
+    }
+    std::vector<std::size_t> order(scene.models_.size());
+    for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
+    build_hierarchy(order, centre, hierarchy);
+    std::vector<CurveMultires> models(order.size());
+    std::vector<std::size_t> source(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      models[k] = std::move(scene.models_[order[k]]);
+      source[k] = scene.source_index_[order[k]];
+    }
+    scene.models_ = std::move(models);
+    scene.source_index_ = std::move(source);
+  }
+
   // Lay out points and segment nodes, level by level within each curve.
   std::size_t npoints = 0, nnodes = 0;
   scene.curves_.resize(scene.models_.size());
@@ -133,8 +175,13 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   }
   scene.segment_nodes_ = nnodes;
   scene.points_m_.resize(npoints);
-  scene.boxes_.resize(nnodes + scene.curves_.size());
-  scene.info_.resize(nnodes + scene.curves_.size());
+  const std::size_t hierarchy_base = nnodes + scene.curves_.size();
+  const std::size_t total_nodes = hierarchy_base + (scene.curves_.empty() ? 0 : hierarchy.size());
+  scene.boxes_.resize(total_nodes);
+  scene.info_.resize(total_nodes);
+  scene.parent_.assign(total_nodes, 0);
+  scene.child_first_.assign(total_nodes, 0);
+  scene.child_count_.assign(total_nodes, 0);
 
   Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
   Vec2 hi{-lo.x, -lo.y};
@@ -179,6 +226,7 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
       const std::uint32_t node = ci.box_offset[0] + static_cast<std::uint32_t>(k);
       scene.boxes_[node] = make_box(a, axis, e);
       scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), 0, static_cast<std::uint32_t>(k)};
+      scene.parent_[node] = m.levels > 1 ? ci.box_offset[1] + static_cast<std::uint32_t>(k / 2) : scene.root_node(c);
     }
     // Coarser levels: segment + children's box corners.
     for (int l = 1; l < m.levels; ++l) {
@@ -197,6 +245,9 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
         const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k);
         scene.boxes_[node] = make_box(a, axis, e);
         scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), l, static_cast<std::uint32_t>(k)};
+        scene.parent_[node] = l + 1 < m.levels ? ci.box_offset[l + 1] + static_cast<std::uint32_t>(k / 2) : scene.root_node(c);
+        scene.child_first_[node] = ci.box_offset[l - 1] + 2 * static_cast<std::uint32_t>(k);
+        scene.child_count_[node] = 2;
       }
     }
     // Root: axis-aligned box around the coarsest boxes (origin (0,0), axis x, so u = x and n = y).
@@ -210,6 +261,8 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
     const std::uint32_t rnode = scene.root_node(c);
     scene.boxes_[rnode] = make_box(Vec2{0, 0}, Vec2{1, 0}, root);
     scene.info_[rnode] = NodeInfo{static_cast<std::uint32_t>(c), m.levels, 0};
+    scene.child_first_[rnode] = ci.box_offset[top];
+    scene.child_count_[rnode] = ci.segment_count[top];
 
     // Error of each level: distance of every original vertex and level-0 point to the segment that stands for it.
     CurveInfo& cw = scene.curves_[c];
@@ -234,6 +287,26 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   if (!scene.curves_.empty()) {
     scene.bounds_min_ = lo;
     scene.bounds_max_ = hi;
+    // Hierarchy boxes bottom-up (children always have larger indices than their parent).
+    for (std::size_t i = hierarchy.size(); i-- > 0;) {
+      const HierarchyNode& h = hierarchy[i];
+      const std::uint32_t node = static_cast<std::uint32_t>(hierarchy_base + i);
+      const std::uint32_t first = h.leaf ? scene.root_node(h.begin) : static_cast<std::uint32_t>(hierarchy_base + h.first_child);
+      const std::uint32_t count = h.leaf ? static_cast<std::uint32_t>(h.end - h.begin) : 2u;
+      Extent e;
+      for (std::uint32_t k = 0; k < count; ++k) {
+        Vec2 corners[4];
+        box_corners(scene.boxes_[first + k], corners);
+        for (const Vec2& q : corners) grow(e, Vec2{0, 0}, Vec2{1, 0}, q);
+        scene.parent_[first + k] = node;
+      }
+      scene.boxes_[node] = make_box(Vec2{0, 0}, Vec2{1, 0}, e);
+      scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(h.begin), kHierarchyLevel, 0};
+      scene.child_first_[node] = first;
+      scene.child_count_[node] = count;
+    }
+    scene.scene_root_ = static_cast<std::uint32_t>(hierarchy_base);
+    scene.parent_[scene.scene_root_] = scene.scene_root_;
   }
   const double t2 = now_ms();
   scene.times_.multires_ms = t1 - t0;

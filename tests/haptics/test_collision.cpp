@@ -81,6 +81,35 @@ TEST(CollisionTree, BoxesContainOriginalsAndChildren) {
   }
 }
 
+TEST(CollisionTree, CurveHierarchyHoldsEveryCurveOnce) {
+  std::mt19937 rng(12);
+  const auto curves = random_scene(rng, 40, 40);
+  const Scene sc = Scene::build(curves, 6);
+  // Walk down from the scene root: every curve root is reached exactly once, and every child box
+  // lies inside its parent's box.
+  std::vector<int> reached(sc.curve_count(), 0);
+  std::vector<std::uint32_t> stack{sc.scene_root()};
+  while (!stack.empty()) {
+    const std::uint32_t node = stack.back();
+    stack.pop_back();
+    if (sc.is_curve_root(node)) {
+      ++reached[sc.info(node).curve];
+      continue;
+    }
+    std::uint32_t first = 0, count = 0;
+    sc.children(node, &first, &count);
+    ASSERT_GE(count, 1u);
+    for (std::uint32_t i = 0; i < count; ++i) {
+      ASSERT_EQ(sc.parent(first + i), node);
+      Vec2 corners[4];
+      box_corners(sc.box(first + i), corners);
+      for (const Vec2& q : corners) ASSERT_TRUE(box_contains(sc.box(node), q, 1e-12));
+      stack.push_back(first + i);
+    }
+  }
+  for (int r : reached) EXPECT_EQ(r, 1);
+}
+
 TEST(CollisionTree, ErrorGrowsWithLevelAndBoxesBoundIt) {
   std::mt19937 rng(11);
   const auto curves = random_scene(rng, 4, 4);

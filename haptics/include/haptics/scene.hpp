@@ -7,7 +7,10 @@
 /// Node numbering. Segment k of level l of curve c is node `curves[c].box_offset[l] + k`. After all
 /// segment nodes come one root node per curve (`root_node(c)`) whose box is the curve's axis-aligned
 /// bounding box; its children are the segments of the coarsest level. Children of segment k at level l
-/// (l ≥ 1) are segments 2k and 2k+1 at level l−1.
+/// (l ≥ 1) are segments 2k and 2k+1 at level l−1. Above the curve roots sits a bounding-volume
+/// hierarchy over the curves (axis-aligned boxes, median split on the longer axis, at most 4 curves per
+/// leaf), so a scene of thousands of curves is entered through one node, `scene_root()`: curves are
+/// stored in the hierarchy's leaf order, so every node's children are consecutive ids.
 
 #include <cstdint>
 #include <vector>
@@ -57,9 +60,9 @@ constexpr bool operator==(SegmentRef a, SegmentRef b) { return a.curve == b.curv
 
 /// Per-node bookkeeping the tree walks need. 12 bytes.
 struct NodeInfo {
-  std::uint32_t curve = 0;
-  std::int32_t level = 0;     ///< segment level, or `levels` of its curve for a root node
-  std::uint32_t index = 0;    ///< segment index within its level (0 for a root)
+  std::uint32_t curve = 0;    ///< curve of a segment or curve root; first curve under a hierarchy node
+  std::int32_t level = 0;     ///< segment level; `levels` of its curve for a curve root; kHierarchyLevel above
+  std::uint32_t index = 0;    ///< segment index within its level (0 otherwise)
 };
 
 /// Build timings of a scene [ms].
@@ -72,6 +75,7 @@ struct SceneBuildTimes {
 class Scene {
  public:
   static constexpr int kMaxLevels = 16;
+  static constexpr std::int32_t kHierarchyLevel = 1000;  ///< NodeInfo::level of the nodes above the curve roots
 
   /// Builds multiresolution models and collision trees for `curves` (workspace metres), with at most
   /// `max_levels` levels above level 0 (clamped to kMaxLevels − 1). Curves with fewer than 2 distinct
@@ -86,17 +90,27 @@ class Scene {
   std::size_t source_index(std::size_t c) const { return source_index_[c]; }
   std::size_t skipped_curves() const { return skipped_; }
 
-  /// Total nodes: all segment nodes of all levels of all curves, then one root per curve.
+  /// Total nodes: segment nodes of all levels of all curves, one root per curve, the hierarchy above.
   std::size_t node_count() const { return boxes_.size(); }
   std::uint32_t root_node(std::size_t c) const { return static_cast<std::uint32_t>(segment_nodes_ + c); }
-  bool is_root(std::uint32_t node) const { return node >= segment_nodes_; }
+  /// The one node every walk starts from (a hierarchy node; valid only when curve_count() > 0).
+  std::uint32_t scene_root() const { return scene_root_; }
+  /// True for segment nodes (they carry a segment of some level); false for curve roots and above.
+  bool is_segment(std::uint32_t node) const { return node < segment_nodes_; }
+  /// True for a curve's root node.
+  bool is_curve_root(std::uint32_t node) const { return node >= segment_nodes_ && node < segment_nodes_ + curves_.size(); }
   const ErrorBox& box(std::uint32_t node) const { return boxes_[node]; }
   const NodeInfo& info(std::uint32_t node) const { return info_[node]; }
   std::uint32_t node_of(SegmentRef s) const { return curves_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
-  /// Parent of a node (a root's parent is itself).
-  std::uint32_t parent(std::uint32_t node) const;
-  /// First child and child count of a node (0 children for a level-0 segment).
-  void children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const;
+  /// Parent of a node (the scene root's parent is itself).
+  std::uint32_t parent(std::uint32_t node) const { return parent_[node]; }
+  /// First child and child count of a node; children are consecutive ids (0 for a level-0 segment).
+  void children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const {
+    *first = child_first_[node];
+    *count = child_count_[node];
+  }
+  /// Bytes of the arrays the servo path reads (boxes, node links, points), for bytes-per-segment figures.
+  std::size_t hot_bytes() const;
 
   /// Level-l points of curve c (the scaling coefficients) [m].
   const Vec2* points(std::size_t c, int level) const { return points_m_.data() + curves_[c].point_offset[level]; }
@@ -121,7 +135,9 @@ class Scene {
   std::vector<Vec2> points_m_;
   std::vector<ErrorBox> boxes_;
   std::vector<NodeInfo> info_;
+  std::vector<std::uint32_t> parent_, child_first_, child_count_;
   std::size_t segment_nodes_ = 0;
+  std::uint32_t scene_root_ = 0;
   std::size_t skipped_ = 0;
   Vec2 bounds_min_{0, 0}, bounds_max_{0, 0};
   SceneBuildTimes times_;
