@@ -81,6 +81,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   // Widest fan-out (a curve root), plus two per level of curve and hierarchy (≤ 64 levels deep).
   stack_.resize(widest_root + 4 * Scene::kMaxLevels + 2 * 64 + 8);
   hit_stamp_.assign(n, 0);
+  merge_stamp_.assign(n, 0);
   reset();
 }
 
@@ -118,6 +119,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   ++tick_;
   if (tick_ == 0) {  // stamp wrap-around: clear so old stamps cannot match
     std::fill(hit_stamp_.begin(), hit_stamp_.end(), 0u);
+    std::fill(merge_stamp_.begin(), merge_stamp_.end(), 0u);
     tick_ = 1;
   }
   bool exhausted = false;
@@ -154,12 +156,14 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   //    answers both "hit?" and "still near?").
   candidates_.clear();
   merge_scratch_.clear();
+  // Rectangle around the sweep: most boxes are rejected by four comparisons before the exact clip.
+  const Aabb sweep{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
   const std::size_t n_section = section_.size();
   for (std::size_t i = 0; i < n_section; ++i) {
     const std::uint32_t node = section_[i];
     double te = 0.0, tx = 0.0;
     charge_box();
-    if (clip_segment_box(sc.box(node), a, b, merge_margin_m_, &te, &tx)) {
+    if (overlaps(sc.aabb(node), sweep, merge_margin_m_) && clip_segment_box(sc.box(node), a, b, merge_margin_m_, &te, &tx)) {
       hit_stamp_[node] = tick_;
       if (clip_segment_box(sc.box(node), a, b, 0.0, &te, &tx)) candidates_.push_back({te, node});
     } else {
@@ -198,7 +202,9 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
       for (std::uint32_t i = 0; i < count; ++i) {
         double te = 0.0, tx = 0.0;
         charge_box();
-        if (clip_segment_box(sc.box(first + i), a, b, 0.0, &te, &tx) && te <= best.t) stack_[top++] = {te, first + i};
+        if (overlaps(sc.aabb(first + i), sweep, 0.0) && clip_segment_box(sc.box(first + i), a, b, 0.0, &te, &tx) && te <= best.t) {
+          stack_[top++] = {te, first + i};
+        }
       }
       std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
     }
@@ -217,7 +223,9 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     if (st.merges >= kMaxMergesPerTick) break;
     if (!in_section_[node] || node == sc.scene_root()) continue;
     const std::uint32_t parent = sc.parent(node);
-    if (in_section_[parent]) continue;
+    // One check per parent per tick: a curve root has many children, and each would ask again.
+    if (in_section_[parent] || merge_stamp_[parent] == tick_) continue;
+    merge_stamp_[parent] = tick_;
     std::uint32_t first = 0, count = 0;
     sc.children(parent, &first, &count);
     bool all_idle = true;
@@ -225,7 +233,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     if (!all_idle) continue;
     double te = 0.0, tx = 0.0;
     charge_box();
-    if (clip_segment_box(sc.box(parent), a, b, merge_margin_m_, &te, &tx)) continue;
+    if (overlaps(sc.aabb(parent), sweep, merge_margin_m_) && clip_segment_box(sc.box(parent), a, b, merge_margin_m_, &te, &tx)) continue;
     for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
     in_section_[parent] = 1;
     section_.push_back(parent);
@@ -300,10 +308,13 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
     }
     std::uint32_t first = 0, count = 0;
     sc.children(cur.node, &first, &count);
+    const int base = top;
     for (std::uint32_t i = 0; i < count; ++i) {
       const double d = box_distance(sc.box(first + i), p);
       if (d <= best) stack_[top++] = {d, first + i};
     }
+    // Nearest child on top of the stack: the first leaf reached is close, so the bound prunes early.
+    std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
   }
   return found;
 }

@@ -96,7 +96,7 @@ void box_corners(const ErrorBox& box, Vec2 out[4]) {
 double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min), std::abs(box.n_max)); }
 
 std::size_t Scene::hot_bytes() const {
-  return boxes_.size() * sizeof(ErrorBox) + info_.size() * sizeof(NodeInfo) +
+  return boxes_.size() * sizeof(ErrorBox) + aabbs_.size() * sizeof(Aabb) + info_.size() * sizeof(NodeInfo) +
          (parent_.size() + child_first_.size() + child_count_.size()) * sizeof(std::uint32_t) + points_m_.size() * sizeof(Vec2);
 }
 
@@ -307,6 +307,18 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
     }
     scene.scene_root_ = static_cast<std::uint32_t>(hierarchy_base);
     scene.parent_[scene.scene_root_] = scene.scene_root_;
+  }
+  // Rectangles around every box, for the cheap reject in the queries.
+  scene.aabbs_.resize(scene.boxes_.size());
+  for (std::size_t i = 0; i < scene.boxes_.size(); ++i) {
+    Vec2 corners[4];
+    box_corners(scene.boxes_[i], corners);
+    Aabb r{corners[0], corners[0]};
+    for (const Vec2& q : corners) {
+      r.lo = {std::min(r.lo.x, q.x), std::min(r.lo.y, q.y)};
+      r.hi = {std::max(r.hi.x, q.x), std::max(r.hi.y, q.y)};
+    }
+    scene.aabbs_[i] = r;
   }
   const double t2 = now_ms();
   scene.times_.multires_ms = t1 - t0;

@@ -68,7 +68,7 @@ class BoundarySection {
   static constexpr int kMaxExcluded = 2;
 
   /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots.
-  explicit BoundarySection(const Scene& scene, double merge_margin_m = 1e-3);
+  explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4);
 
   /// Forgets the frontier: back to one root per curve. Real-time safe.
   void reset();
@@ -98,6 +98,7 @@ class BoundarySection {
   std::vector<std::uint32_t> merge_scratch_;
   std::vector<Candidate> stack_;           // DFS stack, sized for the widest root fan-out plus 2 per level
   std::vector<std::uint32_t> hit_stamp_;   // per node: tick at which its margin-grown box was last hit
+  std::vector<std::uint32_t> merge_stamp_; // per node: tick at which it was last considered for a merge
   std::uint32_t tick_ = 0;
   int last_level_ = -1;
 };

@@ -31,6 +31,16 @@ struct ErrorBox {
   double n_max = 0.0;
 };
 
+/// An axis-aligned rectangle [m]: the cheap first test before a box's exact clip. 32 bytes.
+struct Aabb {
+  Vec2 lo, hi;
+};
+
+/// True when two rectangles overlap after growing `a` by margin_m on every side.
+inline bool overlaps(const Aabb& a, const Aabb& b, double margin_m) {
+  return a.lo.x - margin_m <= b.hi.x && b.lo.x <= a.hi.x + margin_m && a.lo.y - margin_m <= b.hi.y && b.lo.y <= a.hi.y + margin_m;
+}
+
 /// True when p lies in the box, grown by `margin_m` on every side.
 bool box_contains(const ErrorBox& box, Vec2 p, double margin_m = 0.0);
 /// The four corners of the box [m], counter-clockwise.
@@ -100,6 +110,8 @@ class Scene {
   /// True for a curve's root node.
   bool is_curve_root(std::uint32_t node) const { return node >= segment_nodes_ && node < segment_nodes_ + curves_.size(); }
   const ErrorBox& box(std::uint32_t node) const { return boxes_[node]; }
+  /// Axis-aligned rectangle around a node's box (its four corners) [m].
+  const Aabb& aabb(std::uint32_t node) const { return aabbs_[node]; }
   const NodeInfo& info(std::uint32_t node) const { return info_[node]; }
   std::uint32_t node_of(SegmentRef s) const { return curves_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
   /// Parent of a node (the scene root's parent is itself).
@@ -134,6 +146,7 @@ class Scene {
   std::vector<std::size_t> source_index_;
   std::vector<Vec2> points_m_;
   std::vector<ErrorBox> boxes_;
+  std::vector<Aabb> aabbs_;
   std::vector<NodeInfo> info_;
   std::vector<std::uint32_t> parent_, child_first_, child_count_;
   std::size_t segment_nodes_ = 0;

@@ -1,0 +1,240 @@
+// Servo query against peers (issue 3 items 2 and 4): the same query streams answered by our collision
+// tree with its boundary section, by brute force, and by a Boost.Geometry R-tree; results checked equal
+// before anything is timed. One benchmark iteration is one query, timed on its own (manual time), so
+// the mean and the percentiles describe the same measurements; each includes ~30 ns of clock reads.
+//
+// Names: BM_FirstHit/<method>/<segments>  — synthetic scenes tiled from real pictures, random-walk hand
+//        BM_Closest/<method>/<segments>   — closest point on the same scenes
+//        BM_Picture/<method>/<picture>    — the handle sweeps of an explore raster run on that picture
+//        BM_Level/<method>/<level>        — speed against accuracy: 4 pictures, queries at each level
+// Counters: p50_ns, p99_ns, max_ns per query; build_ms; bytes_per_segment; segments; max_error_mm.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "bench_scenes.hpp"
+#include "peers.hpp"
+
+using namespace hk;
+using namespace hk::bench;
+
+namespace {
+
+double now_ms() { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+// One scene with its three indexes and a query stream, built once.
+struct Case {
+  std::string name;
+  std::unique_ptr<Scene> scene;
+  int level = 0;
+  std::vector<std::pair<Vec2, Vec2>> segs;
+  std::unique_ptr<BruteForce> brute;
+  std::unique_ptr<RtreeIndex> rtree;
+  std::unique_ptr<BoundarySection> ours;
+  std::vector<Sweep> stream;
+  double build_ms_ours = 0, build_ms_rtree = 0, build_ms_brute = 0;
+  double max_error_mm = 0;
+};
+
+std::unique_ptr<Case> make_case(std::string name, std::vector<Polyline> curves, int level, std::vector<Sweep> stream) {
+  auto c = std::make_unique<Case>();
+  c->name = std::move(name);
+  c->level = level;
+  double t0 = now_ms();
+  c->scene = std::make_unique<Scene>(Scene::build(curves, config::Settings{}.haptics.max_levels));
+  c->ours = std::make_unique<BoundarySection>(*c->scene);
+  c->build_ms_ours = now_ms() - t0;
+  t0 = now_ms();
+  c->segs = flat_segments(*c->scene, level);
+  c->brute = std::make_unique<BruteForce>(c->segs);
+  c->build_ms_brute = now_ms() - t0;
+  t0 = now_ms();
+  c->rtree = std::make_unique<RtreeIndex>(c->segs);
+  c->build_ms_rtree = now_ms() - t0;
+  c->stream = std::move(stream);
+  for (std::size_t k = 0; k < c->scene->curve_count(); ++k) {
+    const CurveInfo& ci = c->scene->curve(k);
+    c->max_error_mm = std::max(c->max_error_mm, 1e3 * ci.max_error_m[c->scene->clamp_level(k, level)]);
+  }
+  return c;
+}
+
+// Equal results on the first `n` queries of the stream, or the program stops: a fast wrong answer is worthless.
+void check_equal(Case& c, std::size_t n) {
+  BoundarySection fresh(*c.scene);
+  std::size_t hits = 0;
+  for (std::size_t i = 0; i < std::min(n, c.stream.size()); ++i) {
+    const Sweep& s = c.stream[i];
+    const SweepHit h = fresh.first_hit(s.a, s.b, c.level, nullptr, 0, QueryBudget{});
+    const PeerHit b = c.brute->first_hit(s.a, s.b);
+    const PeerHit r = c.rtree->first_hit(s.a, s.b);
+    if (h.hit != b.hit || r.hit != b.hit || (b.hit && (h.t != b.t || r.t != b.t))) {
+      std::fprintf(stderr, "first_hit: methods disagree on %s query %zu (ours %d %.17g, brute %d %.17g, rtree %d %.17g)\n", c.name.c_str(), i,
+                   h.hit, h.t, b.hit, b.t, r.hit, r.t);
+      std::exit(2);
+    }
+    hits += b.hit;
+  }
+  std::fprintf(stderr, "first_hit: %s: %zu segments, %zu queries checked equal (%zu hits)\n", c.name.c_str(), c.segs.size(),
+               std::min(n, c.stream.size()), hits);
+}
+
+enum class Method { Ours, Brute, Rtree };
+const char* method_name(Method m) { return m == Method::Ours ? "ours" : (m == Method::Brute ? "brute" : "rtree"); }
+
+void set_percentiles(benchmark::State& state, std::vector<double>& ns) {
+  if (ns.empty()) return;
+  std::sort(ns.begin(), ns.end());
+  auto at = [&](double q) { return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * static_cast<double>(ns.size() - 1) + 0.5))]; };
+  state.counters["p50_ns"] = at(0.5);
+  state.counters["p99_ns"] = at(0.99);
+  state.counters["max_ns"] = ns.back();
+}
+
+void run_first_hit(benchmark::State& state, Case* c, Method m) {
+  std::vector<double> ns;
+  ns.reserve(1 << 20);
+  std::size_t i = 0, hits = 0;
+  for (auto _ : state) {
+    const Sweep& s = c->stream[i];
+    i = i + 1 == c->stream.size() ? 0 : i + 1;
+    const auto t0 = std::chrono::steady_clock::now();
+    bool hit = false;
+    if (m == Method::Ours) {
+      hit = c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}).hit;
+    } else if (m == Method::Brute) {
+      hit = c->brute->first_hit(s.a, s.b).hit;
+    } else {
+      hit = c->rtree->first_hit(s.a, s.b).hit;
+    }
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(dt);
+    if (ns.size() < ns.capacity()) ns.push_back(dt * 1e9);
+    hits += hit;
+    benchmark::DoNotOptimize(hit);
+  }
+  set_percentiles(state, ns);
+  const double segs = static_cast<double>(c->segs.size());
+  state.counters["segments"] = segs;
+  state.counters["hit_fraction"] = static_cast<double>(hits) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+  state.counters["max_error_mm"] = c->max_error_mm;
+  if (m == Method::Ours) {
+    state.counters["build_ms"] = c->build_ms_ours;
+    state.counters["bytes_per_segment"] = static_cast<double>(c->scene->hot_bytes()) / segs;
+  } else if (m == Method::Brute) {
+    state.counters["build_ms"] = c->build_ms_brute;
+    state.counters["bytes_per_segment"] = static_cast<double>(c->brute->bytes()) / segs;
+  } else {
+    state.counters["build_ms"] = c->build_ms_rtree;
+    state.counters["bytes_per_segment"] = static_cast<double>(c->rtree->bytes()) / segs;
+  }
+}
+
+void run_closest(benchmark::State& state, Case* c, Method m) {
+  std::vector<double> ns;
+  ns.reserve(1 << 20);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Vec2 p = c->stream[i].b;
+    i = i + 1 == c->stream.size() ? 0 : i + 1;
+    const auto t0 = std::chrono::steady_clock::now();
+    double d = 0.0;
+    if (m == Method::Ours) {
+      Vec2 q;
+      SegmentRef s;
+      d = c->ours->closest_point(p, c->level, 1.0, &q, &s) ? distance(p, q) : 1.0;
+    } else if (m == Method::Brute) {
+      d = c->brute->closest_distance(p);
+    } else {
+      d = c->rtree->closest_distance(p);
+    }
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(dt);
+    if (ns.size() < ns.capacity()) ns.push_back(dt * 1e9);
+    benchmark::DoNotOptimize(d);
+  }
+  set_percentiles(state, ns);
+  state.counters["segments"] = static_cast<double>(c->segs.size());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool quick = false;
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quick") == 0) {
+      quick = true;
+    } else {
+      args.push_back(argv[i]);
+    }
+  }
+  int bargc = static_cast<int>(args.size());
+  benchmark::Initialize(&bargc, args.data());
+
+  const config::Settings settings;
+  std::fprintf(stderr, "first_hit: building picture scenes and explore streams...\n");
+  const auto pictures = picture_curves(settings);
+  std::vector<std::unique_ptr<Case>> cases;
+
+  // 1. Synthetic scenes, 10^3 .. 10^6 segments, random-walk hand.
+  std::vector<std::size_t> sizes = {1000, 10000, 100000, 1000000};
+  if (quick) sizes.pop_back();
+  for (std::size_t n : sizes) {
+    Vec2 plane;
+    auto curves = tiled_scene(pictures, n, settings.haptics.max_levels, &plane);
+    auto c = make_case(std::to_string(n), std::move(curves), 0, random_walk_stream(plane, 100000));
+    check_equal(*c, n >= 1000000 ? 300 : 3000);
+    Case* cp = c.get();
+    for (Method m : {Method::Ours, Method::Rtree, Method::Brute}) {
+      benchmark::RegisterBenchmark(("BM_FirstHit/" + std::string(method_name(m)) + "/" + std::to_string(n)).c_str(),
+                                   [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+      benchmark::RegisterBenchmark(("BM_Closest/" + std::string(method_name(m)) + "/" + std::to_string(n)).c_str(),
+                                   [cp, m](benchmark::State& s) { run_closest(s, cp, m); })->UseManualTime();
+    }
+    cases.push_back(std::move(c));
+  }
+
+  // 2. Every picture with the handle sweeps of its explore run, level 0.
+  const auto paths = picture_paths();
+  std::vector<std::vector<Sweep>> streams(paths.size());
+  auto stream_of = [&](std::size_t i) -> const std::vector<Sweep>& {
+    if (streams[i].empty()) streams[i] = explore_stream(Scene::build(pictures[i], settings.haptics.max_levels), settings);
+    return streams[i];
+  };
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    if (quick && i % 4 != 0) continue;
+    auto c = make_case(paths[i].stem().string(), pictures[i], 0, stream_of(i));
+    check_equal(*c, c->stream.size());
+    Case* cp = c.get();
+    for (Method m : {Method::Ours, Method::Rtree, Method::Brute}) {
+      benchmark::RegisterBenchmark(("BM_Picture/" + std::string(method_name(m)) + "/" + cp->name).c_str(),
+                                   [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+    }
+    cases.push_back(std::move(c));
+  }
+
+  // 3. Speed against accuracy: the same sweeps at every level on four pictures of different kinds.
+  for (int level = 0; level <= settings.haptics.max_levels; ++level) {
+    for (const char* name : {"horse", "camera", "fruits", "sudoku"}) {
+      std::size_t i = 0;
+      while (i < paths.size() && paths[i].stem() != name) ++i;
+      if (i == paths.size()) continue;
+      auto c = make_case(std::string(name) + "@L" + std::to_string(level), pictures[i], level, stream_of(i));
+      check_equal(*c, 2000);
+      Case* cp = c.get();
+      for (Method m : {Method::Ours, Method::Rtree, Method::Brute}) {
+        benchmark::RegisterBenchmark(("BM_Level/" + std::string(method_name(m)) + "/" + std::to_string(level) + "/" + name).c_str(),
+                                     [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+      }
+      cases.push_back(std::move(c));
+    }
+  }
+
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

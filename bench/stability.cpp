@@ -1,0 +1,1036 @@
+// Stability where methods fail (issue 3 item 6): how stiff a wall the servo loop can render at each
+// servo rate before the sampled-data loop goes unstable, and how fast a hand can move before the
+// god-object proxy tunnels through a wall or misses a contact. An analysis, not a timing benchmark:
+// plain main(), one JSON file with every raw number, charts by bench/plot_stability.py.
+//
+// Usage: bench_stability [--out docs/bench/stability.json] [--quick]
+//
+// ── Part 1: largest stable wall stiffness per servo rate ─────────────────────────────────────────────
+// One long straight open polyline (y = 0, x in [−0.06, 0.06] m) is the wall. The simulated pantograph
+// (default geometry, mass 0.08 kg, device damping b = 2 N·s/m, 16384-count encoders) is driven by the
+// model hand, wired as app/src/simulation.cpp does it (read → ServoLoop::update → write_force → step),
+// with three changes, each so that the loop under test, not a limiter, decides the outcome:
+//   * the force clamps (contact max_force_n, guard max_force_n) are 1e6 N and the per-motor torque
+//     limit 1e4 N·m: a clamp bounds the energy a wall can inject and would hide instability;
+//   * the guard's start-up ramp is 0 (the ramp is a clamp too) and the query deadline is off, so a run
+//     is deterministic;
+//   * the plant is integrated finely at every servo rate: the servo period is split into chunks of at
+//     most 25 µs (the model hand's force is recomputed per chunk, so the hand acts as a continuous
+//     spring-damper, not a second sampled-data loop) and each chunk into device substeps of ≤ 1 µs.
+//     The motor force is held over the whole servo period (zero-order hold): with the torque limit out
+//     of the way, recomputing τ = Jᵀ·F at each chunk and mapping it back returns the same F.
+// Contact damping is 0 (the default), so the servo's velocity filter plays no part.
+// Two hand behaviours, each run for 2 s of simulated time per (rate, stiffness):
+//   push    — the hand's target sits 5 mm behind the wall (default hand: 200 N/m, 4 N·s/m, 2 N max):
+//             the handle comes to rest on the wall, as a visitor leaning on an edge.
+//             Unstable when either (a) sustained oscillation: peak-to-peak of the true handle
+//             position normal to the wall over the last 0.5 s exceeds 2 encoder steps (normal to the
+//             wall at the contact point) and is not at least halved from the 0.5 s before; or
+//             (b) energy growth: E = ½·m·|v|² + ½·K·depth², taken about its final mean, has a larger
+//             peak in the last of six 0.25 s windows after a 0.5 s transient than in the first one and
+//             that peak exceeds the energy of a 2-step oscillation. A stable loop's transient decays as
+//             exp(−(b + b_hand)/(2m)·t) = exp(−37.5 t): gone by 0.5 s, so anything left is the loop's.
+//   let-go  — the same push until the first tick in contact, then the hand lets go (zero force): the
+//             classic wall bounce. A free handle bouncing off a one-sided wall can only leave it, so
+//             instability shows as energy created by the wall: unstable when the largest E after the
+//             let-go exceeds E at the let-go by more than 1 % (a passive wall with damping can only
+//             return less than it received). This is the device alone, the case Colgate & Schenkel's
+//             bound is about.
+// Each rate's largest stable stiffness is found on a log grid and then refined by bisection between
+// the last stable and first unstable grid values. It is compared with
+//   * the passivity bound K < 2b/T (Colgate & Schenkel 1997, "Passivity of a class of sampled-data
+//     systems: application to haptic interfaces", J. Robotic Systems 14(1); b the device damping, T the
+//     servo period; it is sufficient for passivity, hence for stability against any passive hand);
+//   * the exact stability limit of the linearised loop (mass m, continuous damping, continuous hand
+//     spring, wall spring sampled and held), from the Jury test on the 2×2 discrete-time closed loop;
+//     for small b·T/m it tends to 2·b_total/T (Gil, Avello, Rubio & Flórez 2004, "Stability analysis of
+//     a 1-DOF haptic interface using the Routh–Hurwitz criterion", IEEE TCST 12(4)). Encoder
+//     quantisation is not in this model; it adds small limit cycles (Diolaiti, Niemeyer, Barbagli &
+//     Salisbury 2006, "Stability of haptic rendering: discretization, quantization, time delay, and
+//     Coulomb effects", IEEE T-RO 22(2)), which is why the oscillation rule ignores 2 encoder steps.
+//
+// ── Part 2: tunnelling and missed contacts against hand speed ───────────────────────────────────────
+// Strokes straight across a thin closed curve (an ellipse 0.2 mm thick), an open straight wall, and
+// into acute corners (10° and 30° wedges, polylines with the apex kept at level 0), at hand speeds on a
+// log grid from 0.05 to 5 m/s, rendered at level 0 (the sharpest geometry) with the shipped servo
+// settings (800 N/m, 3.5 N, 1 kHz, 200 µs query deadline):
+//   kinematic — the ServoLoop alone, the handle put exactly on the stroke every 1 ms tick (no device),
+//               so 5 m/s is a 5 mm jump per tick;
+//   device    — the simulated pantograph (default parameters, substeps ≤ 1 µs) pulled by a firm hand
+//               (400 N/m, 4 N·s/m relative to the target's motion, 5 N max) whose target moves along the
+//               stroke; speeds up to 1 m/s (a 0.08 kg handle under 5 N does not get much faster inside
+//               the 0.14 m workspace); the measured impact speed is recorded.
+// Failures, checked every tick against the level-0 polyline with an orientation predicate written here
+// (independent of the library's parametric intersection):
+//   tunnelling — any proxy sub-move within the tick (ContactOutput::path_m[0..path_count)) crosses a
+//                polyline segment, or the proxy ends the stroke on the far side (the straight line from
+//                the stroke's start to the final proxy crosses the polyline an odd number of times);
+//   missed contact — the handle is clearly past the wall (the line from the stroke's start to the handle
+//                crosses the polyline and the handle is > 0.25 mm from it) and yet the state is Free.
+// The god-object never lets its proxy cross a polyline (Zilles & Salisbury 1995); the point of part 2
+// is to measure that at speeds where a penalty method (force from the nearest wall) pops through.
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "config/settings.hpp"
+#include "haptics/pantograph.hpp"
+#include "haptics/scene.hpp"
+#include "haptics/servo.hpp"
+#include "haptics/sim_pantograph.hpp"
+#include "simulation.hpp"
+
+using namespace hk;
+using json = nlohmann::ordered_json;
+
+namespace {
+
+// ───────────────────────────── shared: driving the simulated device finely ─────────────────────────────
+
+constexpr double kMaxChunkS = 25e-6;    // hand force recomputed at least this often [s]
+constexpr double kMaxSubstepS = 1e-6;   // device integration step at most this long [s]
+
+/// Splits one servo period into hand chunks and device substeps no longer than the limits above.
+struct Chunking {
+  int chunks = 1;          // hand-force updates per servo period
+  int substeps = 1;        // device substeps per chunk
+  double chunk_s = 0.0;
+};
+Chunking chunking_for(double period_s) {
+  Chunking c;
+  c.chunks = static_cast<int>(std::ceil(period_s / kMaxChunkS - 1e-9));
+  c.chunk_s = period_s / c.chunks;
+  c.substeps = static_cast<int>(std::ceil(c.chunk_s / kMaxSubstepS - 1e-9));
+  return c;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// Log-spaced grid of n values from lo to hi inclusive.
+std::vector<double> log_grid(double lo, double hi, int n) {
+  std::vector<double> v;
+  for (int i = 0; i < n; ++i) v.push_back(lo * std::pow(hi / lo, n == 1 ? 0.0 : static_cast<double>(i) / (n - 1)));
+  return v;
+}
+
+/// Rounds to 4 significant digits for the JSON (raw numbers stay readable; nothing here is that exact).
+double sig4(double v) {
+  if (v == 0.0 || !std::isfinite(v)) return v;
+  const double s = std::pow(10.0, 3 - static_cast<int>(std::floor(std::log10(std::abs(v)))));
+  return std::round(v * s) / s;
+}
+
+// ──────────────────────────────────────── Part 1: stiffness ────────────────────────────────────────
+
+enum class HandMode { Push, LetGo };
+const char* mode_name(HandMode m) { return m == HandMode::Push ? "push" : "let_go"; }
+
+constexpr double kRunS = 2.0;            // simulated time per case [s]
+constexpr double kTransientS = 0.5;      // ignored by the push rules [s]
+constexpr double kWindowS = 0.25;        // energy windows after the transient [s]
+constexpr double kTailS = 0.5;           // oscillation window at the end [s]
+constexpr double kLetGoHeightM = 0.001;  // let-go: the hand lets go this far in front of the wall [m]
+constexpr double kMinOscillationM = 1e-6;  // oscillation floor when the encoder is finer than this [m]
+constexpr int kIdealEncoderCounts = 1 << 24;  // "ideal" encoder: 0.06 µm steps, quantisation out of the way
+const Vec2 kWallStart{0.0, 0.003};       // handle starts 3 mm in front of the wall [m]
+const Vec2 kHandTarget{0.0, -0.005};     // hand target 5 mm behind the wall [m]
+
+/// What one (rate, stiffness, mode, encoder) run measured and how it was classified.
+struct WallRun {
+  double rate_hz = 0, stiffness_n_per_m = 0;
+  HandMode mode = HandMode::Push;
+  int encoder_counts = 0;
+  bool stable = true;
+  std::string cls = "stable";  // push: stable / limit_cycle / unstable; let-go: stable / unstable
+  std::string reason;          // which rule fired ("" when stable)
+  double p2p_tail_m = 0;       // peak-to-peak normal displacement over the last 0.5 s [m]
+  double p2p_before_m = 0;     // the same over the 0.5 s before [m]
+  std::vector<double> window_energy_j;  // push: peak |E − E_rest| per 0.25 s window after the transient [J]
+  double energy_in_j = 0;      // let-go: kinetic energy arriving at the wall [J]
+  double energy_out_j = 0;     // let-go: kinetic energy when the wall force ended [J]
+  int bounce_ticks = 0;        // let-go: servo ticks from the wall crossing to the end of the wall force
+  double max_depth_m = 0;      // deepest penetration behind the wall over the run [m]
+  double max_force_n = 0;      // largest commanded force [N]
+  double free_fraction_tail = 0;  // push: fraction of ticks in the last 0.5 s with the proxy free (bouncing)
+  double final_depth_m = 0;    // penetration at the end [m] (negative: in front of the wall)
+};
+
+/// Encoder resolution normal to the wall at a point: the larger y-step of one count of either motor [m].
+double normal_encoder_step_m(const SimPantographParams& dp, Vec2 at_m) {
+  JointAngles q;
+  if (!inverse_kinematics(dp.geometry, at_m, &q)) return 0.0;
+  const Mat2 J = jacobian(dp.geometry, q);
+  const double step_rad = 2.0 * std::numbers::pi / dp.encoder_counts_per_rev;
+  return std::max(std::abs(J.a21), std::abs(J.a22)) * step_rad;
+}
+
+/// The straight-wall scene, shared read-only by every run (and thread).
+class WallBench {
+ public:
+  WallBench() {
+    Polyline wall;
+    for (int i = 0; i <= 240; ++i) wall.points_m.push_back({-0.06 + 0.12 * i / 240.0, 0.0});  // 0.5 mm spacing
+    scene_ = Scene::build({wall}, config::Settings{}.haptics.max_levels);
+  }
+
+  /// The device of every run: shipped parameters, torque limit out of the way.
+  static SimPantographParams device_params(int encoder_counts) {
+    SimPantographParams dp;
+    dp.max_torque_n_m = 1e4;  // far above what any stable wall asks for: the clamp must not hide instability
+    dp.encoder_counts_per_rev = encoder_counts;
+    return dp;
+  }
+
+  WallRun run(double rate_hz, double k_n_per_m, HandMode mode, int encoder_counts) const {
+    WallRun r;
+    r.rate_hz = rate_hz;
+    r.stiffness_n_per_m = k_n_per_m;
+    r.mode = mode;
+    r.encoder_counts = encoder_counts;
+    const double period_s = 1.0 / rate_hz;
+    const Chunking ch = chunking_for(period_s);
+    SimPantographParams dp = device_params(encoder_counts);
+    dp.substeps = ch.substeps;
+    const double step_normal_m = normal_encoder_step_m(dp, {0.0, 0.0});
+    SimulatedPantograph dev(dp, kWallStart);
+    dev.open();
+    const ModelHandParams hand;  // defaults: 200 N/m, 4 N·s/m, 2 N
+    ServoParams sp;
+    sp.period_s = period_s;
+    sp.level = config::Settings{}.haptics.level;
+    sp.query_deadline_s = 0.0;  // deterministic: no wall-clock budget
+    sp.contact.stiffness_n_per_m = k_n_per_m;
+    sp.contact.damping_n_s_per_m = 0.0;
+    sp.contact.max_force_n = 1e6;
+    sp.guard.max_force_n = 1e6;
+    sp.guard.ramp_s = 0.0;
+    ServoLoop servo(scene_, sp);
+    servo.start(dev.read().handle_m);
+
+    const long n_ticks = std::lround(kRunS / period_s);
+    // Samples at every chunk end: time, normal position, energy.
+    std::vector<double> t_s, y_m, e_j;
+    t_s.reserve(static_cast<std::size_t>(n_ticks * ch.chunks));
+    y_m.reserve(t_s.capacity());
+    e_j.reserve(t_s.capacity());
+    const double mass_kg = dp.handle_mass_kg;
+    auto kinetic = [&]() { return 0.5 * mass_kg * length_sq(dev.velocity_m_per_s()); };
+    auto energy = [&]() {
+      const double depth = std::max(0.0, -dev.true_position_m().y);
+      return kinetic() + 0.5 * k_n_per_m * depth * depth;
+    };
+    bool let_go = false, entered = false, bounce_done = false, touched = false;
+    long entry_tick = 0;
+    long tail_ticks = 0, tail_free = 0;
+    const long tail_start_tick = n_ticks - std::lround(kTailS / period_s);
+    ServoOutput so;
+    for (long k = 0; k < n_ticks; ++k) {
+      ServoInput in;
+      in.sample = dev.read();
+      servo.update(in, so);
+      dev.write_force(so.force_n);
+      r.max_force_n = std::max(r.max_force_n, length(so.force_n));
+      const bool in_contact = so.contact.state != ContactState::Free;
+      if (k >= tail_start_tick) {
+        ++tail_ticks;
+        tail_free += !in_contact;
+      }
+      if (mode == HandMode::LetGo && entered && !bounce_done) {
+        touched = touched || in_contact;
+        // The bounce is over when the servo has seen the contact and now commands no force: from here
+        // on only the device's damping acts, so this kinetic energy is all the wall gave back.
+        if (touched && !in_contact && so.force_n == Vec2{} && dev.true_position_m().y > 0.0) {
+          bounce_done = true;
+          r.energy_out_j = kinetic();
+          r.bounce_ticks = static_cast<int>(k - entry_tick);
+        }
+      }
+      for (int c = 0; c < ch.chunks; ++c) {
+        if (mode == HandMode::LetGo && !let_go && dev.true_position_m().y < kLetGoHeightM) let_go = true;
+        const Vec2 f_hand = let_go ? Vec2{} : model_hand_force(hand, kHandTarget, dev.true_position_m(), dev.velocity_m_per_s());
+        const double ke_before = kinetic();
+        const bool outside_before = dev.true_position_m().y > 0.0;
+        dev.step(ch.chunk_s, f_hand);
+        if (mode == HandMode::LetGo && !entered && outside_before && dev.true_position_m().y <= 0.0) {
+          entered = true;  // free flight up to here: the energy brought to the wall is kinetic
+          entry_tick = k;
+          r.energy_in_j = ke_before;
+        }
+        t_s.push_back(static_cast<double>(k) * period_s + (c + 1) * ch.chunk_s);
+        y_m.push_back(dev.true_position_m().y);
+        e_j.push_back(energy());
+        r.max_depth_m = std::max(r.max_depth_m, -y_m.back());
+      }
+    }
+    r.final_depth_m = -dev.true_position_m().y;
+    r.free_fraction_tail = tail_ticks ? static_cast<double>(tail_free) / tail_ticks : 0.0;
+
+    // Peak-to-peak of the normal position in [a, b].
+    auto p2p = [&](double a, double b) {
+      double lo = 1e300, hi = -1e300;
+      for (std::size_t i = 0; i < t_s.size(); ++i) {
+        if (t_s[i] >= a && t_s[i] <= b + 1e-12) {
+          lo = std::min(lo, y_m[i]);
+          hi = std::max(hi, y_m[i]);
+        }
+      }
+      return hi >= lo ? hi - lo : 0.0;
+    };
+    r.p2p_tail_m = p2p(kRunS - kTailS, kRunS);
+    r.p2p_before_m = p2p(kRunS - 2 * kTailS, kRunS - kTailS);
+
+    if (mode == HandMode::Push) {
+      // Oscillation energy: E about its mean over the last window (the resting handle stores ½·K·depth²
+      // in the wall; that is not oscillation). Peak per window.
+      double mean_tail = 0;
+      int n_tail = 0;
+      for (std::size_t i = 0; i < t_s.size(); ++i) {
+        if (t_s[i] >= kRunS - kWindowS) {
+          mean_tail += e_j[i];
+          ++n_tail;
+        }
+      }
+      mean_tail = n_tail ? mean_tail / n_tail : 0.0;
+      const int windows = static_cast<int>(std::lround((kRunS - kTransientS) / kWindowS));
+      r.window_energy_j.assign(static_cast<std::size_t>(windows), 0.0);
+      for (std::size_t i = 0; i < t_s.size(); ++i) {
+        if (t_s[i] < kTransientS) continue;
+        const auto w = static_cast<std::size_t>(std::min(windows - 1, static_cast<int>((t_s[i] - kTransientS) / kWindowS)));
+        r.window_energy_j[w] = std::max(r.window_energy_j[w], std::abs(e_j[i] - mean_tail));
+      }
+      const double threshold_m = std::max(2.0 * step_normal_m, kMinOscillationM);
+      // The energy of an oscillation of that peak-to-peak on the wall and hand springs.
+      const double amp_m = 0.5 * threshold_m;
+      const double threshold_j = 0.5 * (k_n_per_m + hand.stiffness_n_per_m) * amp_m * amp_m;
+      const bool oscillating = r.p2p_tail_m > threshold_m && r.p2p_tail_m > 0.5 * r.p2p_before_m;
+      const bool growing = r.window_energy_j.back() > 2.0 * r.window_energy_j.front() && r.window_energy_j.back() > threshold_j;
+      if (growing) {
+        r.cls = "unstable";
+        r.reason = "energy growth";
+      } else if (oscillating && r.free_fraction_tail > 0.0) {
+        r.cls = "unstable";
+        r.reason = "sustained oscillation, bouncing off the wall";
+      } else if (oscillating) {
+        r.cls = "limit_cycle";
+        r.reason = "sustained oscillation in contact";
+      }
+    } else {
+      if (!entered || !bounce_done) {
+        r.cls = "unstable";
+        r.reason = entered ? "did not leave the wall" : "never reached the wall";
+      } else if (r.energy_out_j > r.energy_in_j) {
+        r.cls = "unstable";
+        r.reason = "energy created by the wall";
+      }
+    }
+    r.stable = r.cls == "stable";
+    return r;
+  }
+
+ private:
+  Scene scene_;
+};
+
+// ── Linearised sampled-data loop: exact stability limit by the Jury test ──
+// Plant: m·ẍ = −b·ẋ − k_h·x + u, u held over each period at −K·x(t_k) (x = position normal to the wall,
+// about the resting point). Discretised exactly (here by RK4 with 4000 steps per period, exact to
+// rounding for this linear plant): [x; v]_{k+1} = Φ·[x; v]_k + Γ·u_k. The closed loop M = Φ − Γ·K·[1 0]
+// is stable iff |det M| < 1 and |tr M| < 1 + det M (Jury's conditions for a second-order polynomial).
+struct Discrete2 {
+  double phi[2][2];
+  double gam[2];
+};
+Discrete2 discretise(double m_kg, double b_n_s_per_m, double kh_n_per_m, double period_s) {
+  auto deriv = [&](const std::array<double, 2>& s, double u) {
+    return std::array<double, 2>{s[1], (-b_n_s_per_m * s[1] - kh_n_per_m * s[0] + u) / m_kg};
+  };
+  auto integrate = [&](std::array<double, 2> s, double u) {
+    const int n = 4000;
+    const double h = period_s / n;
+    for (int i = 0; i < n; ++i) {
+      const auto k1 = deriv(s, u);
+      const auto k2 = deriv({s[0] + 0.5 * h * k1[0], s[1] + 0.5 * h * k1[1]}, u);
+      const auto k3 = deriv({s[0] + 0.5 * h * k2[0], s[1] + 0.5 * h * k2[1]}, u);
+      const auto k4 = deriv({s[0] + h * k3[0], s[1] + h * k3[1]}, u);
+      s[0] += h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]);
+      s[1] += h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]);
+    }
+    return s;
+  };
+  Discrete2 d;
+  const auto c0 = integrate({1, 0}, 0), c1 = integrate({0, 1}, 0), g = integrate({0, 0}, 1);
+  d.phi[0][0] = c0[0];
+  d.phi[1][0] = c0[1];
+  d.phi[0][1] = c1[0];
+  d.phi[1][1] = c1[1];
+  d.gam[0] = g[0];
+  d.gam[1] = g[1];
+  return d;
+}
+bool jury_stable(const Discrete2& d, double k_n_per_m) {
+  const double m00 = d.phi[0][0] - d.gam[0] * k_n_per_m, m01 = d.phi[0][1];
+  const double m10 = d.phi[1][0] - d.gam[1] * k_n_per_m, m11 = d.phi[1][1];
+  const double tr = m00 + m11, det = m00 * m11 - m01 * m10;
+  return std::abs(det) < 1.0 && std::abs(tr) < 1.0 + det;
+}
+/// Largest K [N/m] for which the linearised loop is stable (bisection in log K between 1 and 1e8).
+double linear_limit_n_per_m(double m_kg, double b_n_s_per_m, double kh_n_per_m, double period_s) {
+  const Discrete2 d = discretise(m_kg, b_n_s_per_m, kh_n_per_m, period_s);
+  double lo = 1.0, hi = 1e8;
+  if (!jury_stable(d, lo)) return 0.0;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (jury_stable(d, mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+json wall_run_json(const WallRun& r) {
+  json j;
+  j["stiffness_n_per_m"] = sig4(r.stiffness_n_per_m);
+  j["stable"] = r.stable;
+  j["class"] = r.cls;
+  j["reason"] = r.reason;
+  j["p2p_tail_m"] = sig4(r.p2p_tail_m);
+  j["p2p_before_m"] = sig4(r.p2p_before_m);
+  j["max_depth_m"] = sig4(r.max_depth_m);
+  j["final_depth_m"] = sig4(r.final_depth_m);
+  j["max_force_n"] = sig4(r.max_force_n);
+  if (r.mode == HandMode::Push) {
+    j["free_fraction_tail"] = sig4(r.free_fraction_tail);
+    json w = json::array();
+    for (double e : r.window_energy_j) w.push_back(sig4(e));
+    j["window_energy_j"] = w;
+  } else {
+    j["energy_in_j"] = sig4(r.energy_in_j);
+    j["energy_out_j"] = sig4(r.energy_out_j);
+    j["energy_ratio"] = r.energy_in_j > 0 ? sig4(r.energy_out_j / r.energy_in_j) : 0.0;
+    j["bounce_ticks"] = r.bounce_ticks;
+  }
+  return j;
+}
+
+/// Runs f(i) for i in [0, n) on all hardware threads. The runs are independent and deterministic.
+void parallel_for(std::size_t n, const std::function<void(std::size_t)>& f) {
+  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), static_cast<unsigned>(n)));
+  std::atomic<std::size_t> next{0};
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t) {
+    pool.emplace_back([&] {
+      for (std::size_t i = next++; i < n; i = next++) f(i);
+    });
+  }
+  for (auto& th : pool) th.join();
+}
+
+/// One stiffness sweep: a (rate, hand mode, encoder) on the grid, then bisection at the boundary.
+struct Series {
+  double rate_hz = 0;
+  HandMode mode = HandMode::Push;
+  int encoder_counts = 0;
+  json result;
+};
+
+void run_series(const WallBench& bench, const std::vector<double>& grid, int refine_steps, Series& s) {
+  json cases = json::array();
+  double largest_stable = 0.0, first_unstable = 0.0, largest_not_unstable = 0.0;
+  bool islands = false;  // an unstable grid value below a stable one: the boundary is not one crossing
+  bool seen_unstable = false;
+  for (double k : grid) {
+    const WallRun r = bench.run(s.rate_hz, k, s.mode, s.encoder_counts);
+    cases.push_back(wall_run_json(r));
+    if (r.cls != "unstable") largest_not_unstable = k;
+    if (r.stable) {
+      if (seen_unstable) islands = true;
+      largest_stable = k;
+    } else if (!seen_unstable) {
+      seen_unstable = true;
+      first_unstable = k;
+    }
+  }
+  // Bisection (in log K) between the largest stable grid value and the grid value above it.
+  double lo = largest_stable, hi = 0.0;
+  for (double k : grid) {
+    if (k > largest_stable) {
+      hi = k;
+      break;
+    }
+  }
+  json refine = json::array();
+  if (lo > 0.0 && hi > 0.0) {
+    for (int i = 0; i < refine_steps; ++i) {
+      const double mid = std::sqrt(lo * hi);
+      const WallRun r = bench.run(s.rate_hz, mid, s.mode, s.encoder_counts);
+      refine.push_back(wall_run_json(r));
+      (r.stable ? lo : hi) = mid;
+    }
+  }
+  const double bound = 2.0 * WallBench::device_params(s.encoder_counts).handle_damping_n_s_per_m * s.rate_hz;
+  json& j = s.result;
+  j["rate_hz"] = s.rate_hz;
+  j["mode"] = mode_name(s.mode);
+  j["encoder_counts_per_rev"] = s.encoder_counts;
+  j["largest_stable_grid_n_per_m"] = sig4(largest_stable);
+  j["first_unstable_grid_n_per_m"] = sig4(first_unstable);
+  j["largest_stable_n_per_m"] = sig4(lo);                  // after bisection
+  j["smallest_unstable_n_per_m"] = hi > 0 ? json(sig4(hi)) : json(nullptr);
+  j["largest_without_divergence_grid_n_per_m"] = sig4(largest_not_unstable);  // push: limit cycles allowed
+  j["non_monotonic"] = islands;
+  j["ratio_to_passivity_bound"] = sig4(lo / bound);
+  j["grid"] = cases;
+  j["refinement"] = refine;
+}
+
+json run_part1(bool quick) {
+  const std::vector<double> rates_hz = quick ? std::vector<double>{250, 1000, 4000} : std::vector<double>{250, 500, 1000, 2000, 4000};
+  const std::vector<double> grid = log_grid(100.0, 50000.0, quick ? 10 : 25);
+  const int refine_steps = quick ? 3 : 7;
+  const int default_counts = SimPantographParams{}.encoder_counts_per_rev;
+  const WallBench bench;
+  const SimPantographParams dp = WallBench::device_params(default_counts);
+  const ModelHandParams hand;
+  json out;
+  out["wall"] = "open straight polyline y = 0, x in [-0.06, 0.06] m, 241 points, rendered at level " +
+                std::to_string(config::Settings{}.haptics.level);
+  out["device"] = {{"handle_mass_kg", dp.handle_mass_kg},
+                   {"handle_damping_n_s_per_m", dp.handle_damping_n_s_per_m},
+                   {"encoder_counts_per_rev", default_counts},
+                   {"ideal_encoder_counts_per_rev", kIdealEncoderCounts},
+                   {"encoder_step_normal_m", sig4(normal_encoder_step_m(dp, {0.0, 0.0}))},
+                   {"max_torque_n_m", dp.max_torque_n_m},
+                   {"max_chunk_s", kMaxChunkS},
+                   {"max_substep_s", kMaxSubstepS}};
+  out["hand"] = {{"stiffness_n_per_m", hand.stiffness_n_per_m},
+                 {"damping_n_s_per_m", hand.damping_n_s_per_m},
+                 {"max_force_n", hand.max_force_n},
+                 {"start_m", {kWallStart.x, kWallStart.y}},
+                 {"target_m", {kHandTarget.x, kHandTarget.y}},
+                 {"let_go_height_m", kLetGoHeightM}};
+  out["servo"] = {{"contact_damping_n_s_per_m", 0.0}, {"max_force_n", 1e6}, {"force_ramp_s", 0.0}, {"query_deadline_s", 0.0}};
+  out["run_s"] = kRunS;
+  out["transient_s"] = kTransientS;
+  out["rules"] = {
+      {"push",
+       "oscillating: p2p normal displacement over the last 0.5 s > max(2 encoder steps, 1 um) and > half the p2p of the 0.5 s "
+       "before; growing: peak |E - E_rest| in the last 0.25 s window > 2x that of the first window after 0.5 s and > the "
+       "energy of the oscillation threshold; E = 0.5 m |v|^2 + 0.5 K depth^2. unstable = growing, or oscillating with the "
+       "proxy free at some tick of the last 0.5 s (bouncing); limit_cycle = oscillating in permanent contact; stable = "
+       "neither. Only stable counts as stable."},
+      {"let_go",
+       "the hand lets go 1 mm in front of the wall; unstable if the kinetic energy when the wall force has ended exceeds the "
+       "kinetic energy at the wall crossing (the wall created energy)"}};
+  out["stiffness_grid_n_per_m"] = json::array();
+  for (double k : grid) out["stiffness_grid_n_per_m"].push_back(sig4(k));
+
+  json rates = json::array();
+  for (double rate : rates_hz) {
+    const double period_s = 1.0 / rate;
+    json jr;
+    jr["rate_hz"] = rate;
+    jr["period_s"] = period_s;
+    jr["passivity_bound_n_per_m"] = sig4(2.0 * dp.handle_damping_n_s_per_m / period_s);
+    // Linear predictions: push = device + hand (continuous damping b + b_hand, hand spring);
+    // let-go = the device alone.
+    jr["linear_limit_push_n_per_m"] =
+        sig4(linear_limit_n_per_m(dp.handle_mass_kg, dp.handle_damping_n_s_per_m + hand.damping_n_s_per_m, hand.stiffness_n_per_m, period_s));
+    jr["linear_limit_let_go_n_per_m"] = sig4(linear_limit_n_per_m(dp.handle_mass_kg, dp.handle_damping_n_s_per_m, 0.0, period_s));
+    rates.push_back(jr);
+  }
+  out["rates"] = rates;
+
+  std::vector<Series> series;
+  for (int counts : {default_counts, kIdealEncoderCounts}) {
+    for (double rate : rates_hz) {
+      for (HandMode mode : {HandMode::Push, HandMode::LetGo}) series.push_back(Series{rate, mode, counts, json()});
+    }
+  }
+  parallel_for(series.size(), [&](std::size_t i) { run_series(bench, grid, refine_steps, series[i]); });
+  json js = json::array();
+  for (const Series& s : series) {
+    js.push_back(s.result);
+    std::fprintf(stderr, "  %5.0f Hz %-6s encoder %8d: largest stable %7.0f N/m (2b/T %6.0f)%s\n", s.rate_hz, mode_name(s.mode), s.encoder_counts,
+                 s.result["largest_stable_n_per_m"].get<double>(), 2.0 * dp.handle_damping_n_s_per_m * s.rate_hz,
+                 s.result["non_monotonic"].get<bool>() ? "  [non-monotonic]" : "");
+  }
+  out["series"] = js;
+  return out;
+}
+
+// ──────────────────────────────────────── Part 2: tunnelling ────────────────────────────────────────
+
+/// Sign of the turn a → b → c: +1 left, −1 right, 0 collinear (exact in doubles for these magnitudes
+/// only up to rounding; a touch within rounding counts as not crossing, which is the safe side for a
+/// predicate that looks for crossings the solver should have prevented only when they are real).
+int orient(Vec2 a, Vec2 b, Vec2 c) {
+  const double v = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0);
+}
+
+/// True when the move p → q crosses segment a–b: p and q strictly on opposite sides of the segment's
+/// line, and the crossing point within the closed segment (a move through a vertex crosses). A move that
+/// ends on the line, or slides along it, does not cross.
+bool crosses(Vec2 p, Vec2 q, Vec2 a, Vec2 b) {
+  const int sp = orient(a, b, p), sq = orient(a, b, q);
+  if (sp == 0 || sq == 0 || sp == sq) return false;
+  const int sa = orient(p, q, a), sb = orient(p, q, b);
+  return sa * sb <= 0;
+}
+
+/// The level-0 segments of a scene, flat, for the brute-force predicate.
+struct Segments {
+  std::vector<std::pair<Vec2, Vec2>> segs;
+  int crossings(Vec2 p, Vec2 q) const {
+    int n = 0;
+    // Quick reject on the move's bounding box; the scenes are small, brute force is fine.
+    const double x0 = std::min(p.x, q.x), x1 = std::max(p.x, q.x), y0 = std::min(p.y, q.y), y1 = std::max(p.y, q.y);
+    for (const auto& [a, b] : segs) {
+      if (std::max(a.x, b.x) < x0 || std::min(a.x, b.x) > x1 || std::max(a.y, b.y) < y0 || std::min(a.y, b.y) > y1) continue;
+      n += crosses(p, q, a, b);
+    }
+    return n;
+  }
+  double distance(Vec2 p) const {
+    double d = 1e300;
+    for (const auto& [a, b] : segs) d = std::min(d, distance_to_segment(p, a, b));
+    return d;
+  }
+};
+
+Segments level_segments(const Scene& sc, int level) {
+  Segments s;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    const int l = sc.clamp_level(c, level);
+    for (std::uint32_t k = 0; k < ci.segment_count[l]; ++k) {
+      Vec2 a, b;
+      sc.segment(SegmentRef{static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)}, &a, &b);
+      s.segs.push_back({a, b});
+    }
+  }
+  return s;
+}
+
+struct Stroke {
+  Vec2 start_m, end_m;
+};
+
+/// One test shape with the strokes across or into it.
+struct StrokeScene {
+  std::string name;
+  std::string description;
+  double feature_m = 0.0;              // the thickness or wedge angle that makes it hard, for the chart
+  Scene scene;
+  Segments segs;
+  std::vector<Stroke> strokes;         // kinematic strokes
+  std::vector<Stroke> device_strokes;  // device strokes (a longer run-up where the shape allows it)
+};
+
+constexpr int kTunnelLevel = 0;
+constexpr double kClearlyPastM = 0.25e-3;  // "clearly past the wall": farther than this from it [m]
+
+/// A stroke along direction angle alpha through aim point c: `before_m` before it, `after_m` after it.
+Stroke stroke_through(Vec2 c, double alpha_rad, double before_m, double after_m) {
+  const Vec2 d{std::cos(alpha_rad), std::sin(alpha_rad)};
+  return {c - before_m * d, c + after_m * d};
+}
+
+std::vector<StrokeScene> make_stroke_scenes() {
+  const int max_levels = config::Settings{}.haptics.max_levels;
+  std::vector<StrokeScene> out;
+  // `behind` says where a handle is unambiguously behind the shape: there the proxy has no way round
+  // it (the missed-contact rule needs that), so every stroke must end inside it.
+  auto finish = [&](StrokeScene s, const std::vector<Polyline>& curves, const std::function<bool(Vec2)>& behind) {
+    s.scene = Scene::build(curves, max_levels);
+    s.segs = level_segments(s.scene, kTunnelLevel);
+    for (const auto* v : {&s.strokes, &s.device_strokes}) {
+      for (const Stroke& st : *v) {
+        if (!behind(st.end_m) || s.segs.crossings(st.start_m, st.end_m) == 0) {
+          std::fprintf(stderr, "bench_stability: stroke of %s does not end behind the shape\n", s.name.c_str());
+          std::exit(3);
+        }
+      }
+    }
+    out.push_back(std::move(s));
+  };
+  const double deg = std::numbers::pi / 180.0;
+  // Aim points and angles avoid exact symmetry (a stroke through a vertex exactly is a tie, not a test).
+  // Wall and thin curve: 30 mm run-up (45 mm with the device, which must accelerate), 12 mm past the
+  // wall, so that the handle's foot on the wall stays well inside the wall's span.
+  {
+    StrokeScene s;
+    s.name = "straight_wall";
+    s.description = "open straight polyline x = 0, y in [-0.04, 0.04] m, 161 points";
+    Polyline p;
+    for (int i = 0; i <= 160; ++i) p.points_m.push_back({0.0, -0.04 + 0.08 * i / 160.0});
+    for (double y0 : {-0.0051, 0.00023, 0.0063}) {
+      for (double a : {0.0, 25.0, -40.0}) {
+        s.strokes.push_back(stroke_through({0.0, y0}, a * deg, 0.03, 0.012));
+        s.device_strokes.push_back(stroke_through({0.0, y0}, a * deg, 0.045, 0.012));
+      }
+    }
+    finish(std::move(s), {p}, [](Vec2 q) { return q.x > 0.0 && std::abs(q.y) < 0.035; });
+  }
+  {
+    StrokeScene s;
+    s.name = "thin_closed";
+    s.description = "closed ellipse centred at the origin, 0.2 mm wide (x) by 30 mm tall (y), 256 points";
+    s.feature_m = 0.0002;
+    Polyline p;
+    p.closed = true;
+    for (int i = 0; i < 256; ++i) {
+      const double t = 2.0 * std::numbers::pi * i / 256.0;
+      p.points_m.push_back({0.0001 * std::cos(t), 0.015 * std::sin(t)});
+    }
+    for (double y0 : {-0.0051, 0.00023, 0.0063}) {
+      for (double a : {0.0, 25.0, -40.0}) {
+        s.strokes.push_back(stroke_through({0.0, y0}, a * deg, 0.03, 0.012));
+        s.device_strokes.push_back(stroke_through({0.0, y0}, a * deg, 0.045, 0.012));
+      }
+    }
+    finish(std::move(s), {p}, [](Vec2 q) { return q.x > 0.0001 && std::abs(q.y) < 0.013; });
+  }
+  for (double wedge_deg : {30.0, 10.0}) {
+    StrokeScene s;
+    s.name = "wedge_" + std::to_string(static_cast<int>(wedge_deg));
+    s.description = std::to_string(static_cast<int>(wedge_deg)) +
+                    "-degree wedge: apex (0.01, 0) m, two 50 mm arms opening towards -x, 201 points; strokes from inside into the apex";
+    s.feature_m = wedge_deg;
+    const Vec2 apex{0.01, 0.0};
+    const double half = 0.5 * wedge_deg * deg;
+    const Vec2 arm_a{-std::cos(half), std::sin(half)}, arm_b{-std::cos(half), -std::sin(half)};
+    Polyline p;
+    for (int i = 100; i >= 1; --i) p.points_m.push_back(apex + (0.05 * i / 100.0) * arm_a);
+    p.points_m.push_back(apex);
+    for (int i = 1; i <= 100; ++i) p.points_m.push_back(apex + (0.05 * i / 100.0) * arm_b);
+    // Aim 1 mm short of the apex, slightly off the bisector; tilts of ±40 % of the half-angle keep the
+    // start inside the wedge, so every stroke is driven into the corner from its concave side and ends
+    // 29 mm beyond the apex, outside the wedge, where the arms (50 mm) leave the proxy no way round.
+    const Vec2 aim = apex + Vec2{-0.001, 0.000037};
+    for (double frac : {0.0, 0.4, -0.4}) {
+      s.strokes.push_back(stroke_through(aim, frac * half, 0.03, 0.03));
+      s.device_strokes.push_back(stroke_through(aim, frac * half, 0.03, 0.03));  // the arms bound the run-up
+    }
+    finish(std::move(s), {p}, [apex](Vec2 q) { return q.x > apex.x; });
+  }
+  return out;
+}
+
+/// Failure counts of a set of strokes at one speed.
+struct StrokeTally {
+  int strokes = 0;
+  int ticks = 0;
+  int tunnel_ticks = 0;          // ticks with a proxy sub-move crossing the polyline
+  int strokes_tunnelled = 0;     // strokes with any tunnel tick or ending on the far side
+  int strokes_far_side = 0;      // strokes whose final proxy is on the far side
+  int missed_ticks = 0;          // ticks with the handle clearly past the wall and the state Free
+  int strokes_missed = 0;
+  int contact_ticks = 0;         // ticks in Edge or Vertex
+  int vertex_ticks = 0;
+  int iteration_limit_ticks = 0; // ticks whose move budget ran out (the proxy stays valid, but it is a sign)
+  int query_budget_ticks = 0;    // ticks whose collision query hit the deadline
+  double max_handle_step_m = 0;  // the largest handle jump in one tick [m]
+  double impact_speed_sum = 0;   // device: sum of handle speeds at first contact [m/s]
+  int impacts = 0;
+  double max_depth_m = 0;        // largest handle distance past the wall while in contact [m]
+  void add(const StrokeTally& o) {
+    strokes += o.strokes; ticks += o.ticks; tunnel_ticks += o.tunnel_ticks; strokes_tunnelled += o.strokes_tunnelled;
+    strokes_far_side += o.strokes_far_side; missed_ticks += o.missed_ticks; strokes_missed += o.strokes_missed;
+    contact_ticks += o.contact_ticks; vertex_ticks += o.vertex_ticks; iteration_limit_ticks += o.iteration_limit_ticks;
+    query_budget_ticks += o.query_budget_ticks; max_handle_step_m = std::max(max_handle_step_m, o.max_handle_step_m);
+    impact_speed_sum += o.impact_speed_sum; impacts += o.impacts; max_depth_m = std::max(max_depth_m, o.max_depth_m);
+  }
+  bool failed() const { return strokes_tunnelled > 0 || strokes_missed > 0; }
+};
+
+/// Checks one tick's servo output against the polyline. `start` is the stroke's start (free side).
+struct TickChecker {
+  TickChecker(const Segments* s, Vec2 start_m) : segs(s), start(start_m) {}
+  const Segments* segs;
+  Vec2 start;
+  bool any_tunnel = false, any_missed = false, had_contact = false;
+  Vec2 prev_handle;
+  bool first = true;
+  void check(Vec2 handle, const ServoOutput& so, StrokeTally& t) {
+    ++t.ticks;
+    bool tunnel = false;
+    for (int i = 0; i + 1 < so.contact.path_count; ++i) {
+      if (segs->crossings(so.contact.path_m[i], so.contact.path_m[i + 1]) > 0) tunnel = true;
+    }
+    if (tunnel) {
+      ++t.tunnel_ticks;
+      any_tunnel = true;
+    }
+    const bool in_contact = so.contact.state != ContactState::Free;
+    t.contact_ticks += in_contact;
+    t.vertex_ticks += so.contact.state == ContactState::Vertex;
+    t.iteration_limit_ticks += (so.contact.events & kEventIterationLimit) != 0;
+    t.query_budget_ticks += (so.contact.events & kEventQueryBudget) != 0;
+    const bool past = segs->crossings(start, handle) > 0;
+    const double dist = past ? segs->distance(handle) : 0.0;
+    if (past && in_contact) t.max_depth_m = std::max(t.max_depth_m, dist);
+    if (past && dist > kClearlyPastM && !in_contact) {
+      ++t.missed_ticks;
+      any_missed = true;
+    }
+    if (!first) t.max_handle_step_m = std::max(t.max_handle_step_m, distance(prev_handle, handle));
+    prev_handle = handle;
+    first = false;
+    had_contact = had_contact || in_contact;
+  }
+  void finish(Vec2 final_proxy, StrokeTally& t) {
+    ++t.strokes;
+    const bool far = (segs->crossings(start, final_proxy) % 2) == 1;
+    t.strokes_far_side += far;
+    t.strokes_tunnelled += (any_tunnel || far);
+    t.strokes_missed += any_missed;
+  }
+};
+
+ServoParams shipped_servo_params() {
+  return app::servo_params_from(config::Settings{});
+}
+
+/// A stroke with the ServoLoop alone: the handle is exactly on the stroke every tick.
+StrokeTally kinematic_stroke(const StrokeScene& sc, const Stroke& st, double speed_m_per_s) {
+  ServoParams sp = shipped_servo_params();
+  sp.level = kTunnelLevel;
+  ServoLoop servo(sc.scene, sp);
+  servo.start(st.start_m);
+  const double len = distance(st.start_m, st.end_m);
+  const Vec2 dir = (1.0 / len) * (st.end_m - st.start_m);
+  const long move_ticks = static_cast<long>(std::ceil(len / (speed_m_per_s * sp.period_s)));
+  const long dwell_ticks = 30;  // the proxy must stay put with the handle parked past the wall
+  StrokeTally t;
+  TickChecker chk{&sc.segs, st.start_m};
+  ServoOutput so;
+  for (long k = 1; k <= move_ticks + dwell_ticks; ++k) {
+    const double s = std::min(len, static_cast<double>(k) * speed_m_per_s * sp.period_s);
+    ServoInput in;
+    in.sample.handle_m = st.start_m + s * dir;
+    in.sample.status = DeviceStatus::Ok;
+    in.sample.time_ns = static_cast<std::int64_t>(k * 1000000);
+    in.now_ns = steady_ns();
+    servo.update(in, so);
+    chk.check(in.sample.handle_m, so, t);
+  }
+  chk.finish(so.contact.proxy_m, t);
+  return t;
+}
+
+// The device strokes' hand: firm (so that it follows the stroke), damped relative to the target's motion
+// (a hand moving with the stroke does not brake it), and no stronger than the wall's 3.5 N clamp, so the
+// handle gets past a wall only by its momentum, as a fast visitor's would.
+constexpr double kDeviceHandStiffnessNPerM = 400.0;
+constexpr double kDeviceHandDampingNSPerM = 4.0;
+constexpr double kDeviceHandMaxForceN = 3.0;
+
+/// A stroke through the simulated pantograph: a firm hand pulls the handle after a target moving along
+/// the stroke at `speed_m_per_s`. The servo runs 0.6 s with the handle parked first, so that the
+/// guard's 0.5 s start-up ramp is over when the stroke begins.
+StrokeTally device_stroke(const StrokeScene& sc, const Stroke& st, double speed_m_per_s) {
+  ServoParams sp = shipped_servo_params();
+  sp.level = kTunnelLevel;
+  const Chunking ch = chunking_for(sp.period_s);
+  SimPantographParams dp;  // shipped device
+  dp.substeps = ch.substeps;
+  SimulatedPantograph dev(dp, st.start_m);
+  dev.open();
+  ModelHandParams hand;
+  hand.stiffness_n_per_m = kDeviceHandStiffnessNPerM;
+  hand.damping_n_s_per_m = kDeviceHandDampingNSPerM;
+  hand.max_force_n = kDeviceHandMaxForceN;
+  ServoLoop servo(sc.scene, sp);
+  servo.start(dev.read().handle_m);
+  const double len = distance(st.start_m, st.end_m);
+  const Vec2 dir = (1.0 / len) * (st.end_m - st.start_m);
+  const double park_s = 0.6, move_s = len / speed_m_per_s, dwell_s = 0.2;
+  const long n_ticks = std::lround((park_s + move_s + dwell_s) / sp.period_s);
+  StrokeTally t;
+  TickChecker chk{&sc.segs, st.start_m};
+  ServoOutput so;
+  for (long k = 0; k < n_ticks; ++k) {
+    ServoInput in;
+    in.sample = dev.read();
+    in.now_ns = steady_ns();
+    servo.update(in, so);
+    dev.write_force(so.force_n);
+    const double t_s = static_cast<double>(k) * sp.period_s;
+    if (t_s >= park_s) {
+      const bool was_contact = chk.had_contact;
+      chk.check(in.sample.handle_m, so, t);
+      if (!was_contact && chk.had_contact) {
+        t.impact_speed_sum += length(dev.velocity_m_per_s());
+        ++t.impacts;
+      }
+    }
+    for (int c = 0; c < ch.chunks; ++c) {
+      const double tc = t_s + c * ch.chunk_s;
+      const double s = std::clamp((tc - park_s) * speed_m_per_s, 0.0, len);
+      const Vec2 target = st.start_m + s * dir;
+      const Vec2 target_v = (tc >= park_s && s < len) ? speed_m_per_s * dir : Vec2{};
+      // Damping relative to the target's motion: a hand that moves with the stroke does not brake it.
+      dev.step(ch.chunk_s, model_hand_force(hand, target, dev.true_position_m(), dev.velocity_m_per_s() - target_v));
+    }
+  }
+  chk.finish(so.contact.proxy_m, t);
+  return t;
+}
+
+json tally_json(double speed, const StrokeTally& t) {
+  json j;
+  j["speed_m_per_s"] = sig4(speed);
+  j["strokes"] = t.strokes;
+  j["ticks"] = t.ticks;
+  j["tunnel_ticks"] = t.tunnel_ticks;
+  j["strokes_tunnelled"] = t.strokes_tunnelled;
+  j["strokes_far_side"] = t.strokes_far_side;
+  j["missed_contact_ticks"] = t.missed_ticks;
+  j["strokes_missed_contact"] = t.strokes_missed;
+  j["contact_ticks"] = t.contact_ticks;
+  j["vertex_ticks"] = t.vertex_ticks;
+  j["iteration_limit_ticks"] = t.iteration_limit_ticks;
+  j["query_budget_ticks"] = t.query_budget_ticks;
+  j["max_handle_step_m"] = sig4(t.max_handle_step_m);
+  j["max_depth_in_contact_m"] = sig4(t.max_depth_m);
+  if (t.impacts > 0) j["mean_impact_speed_m_per_s"] = sig4(t.impact_speed_sum / t.impacts);
+  return j;
+}
+
+json run_part2(bool quick) {
+  const std::vector<double> speeds = log_grid(0.05, 5.0, quick ? 5 : 13);
+  std::vector<double> device_speeds;
+  for (double v : log_grid(0.05, 1.0, quick ? 3 : 7)) device_speeds.push_back(v);
+  const std::vector<StrokeScene> scenes = make_stroke_scenes();
+  const ServoParams sp = shipped_servo_params();
+  json out;
+  out["level"] = kTunnelLevel;
+  out["servo"] = {{"rate_hz", 1.0 / sp.period_s},
+                  {"stiffness_n_per_m", sp.contact.stiffness_n_per_m},
+                  {"max_force_n", sp.contact.max_force_n},
+                  {"query_deadline_s", sp.query_deadline_s}};
+  out["device_hand"] = {{"stiffness_n_per_m", kDeviceHandStiffnessNPerM},
+                        {"damping_n_s_per_m_relative_to_target", kDeviceHandDampingNSPerM},
+                        {"max_force_n", kDeviceHandMaxForceN}};
+  out["clearly_past_m"] = kClearlyPastM;
+  out["rules"] = {{"tunnelling", "a proxy sub-move path_m[i] -> path_m[i+1] crosses a level-0 segment, or the final proxy is on the far side"},
+                  {"missed_contact", "handle past the wall (start -> handle crosses the polyline) by > clearly_past_m and contact state Free"}};
+  // One job per (scene, drive, speed), run in parallel; tallies land in fixed slots, so the output does
+  // not depend on the scheduling.
+  struct Job {
+    std::size_t scene;
+    bool device;
+    double speed_m_per_s;
+    StrokeTally tally;
+  };
+  std::vector<Job> jobs;
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    for (double v : speeds) jobs.push_back(Job{i, false, v, {}});
+    for (double v : device_speeds) jobs.push_back(Job{i, true, v, {}});
+  }
+  parallel_for(jobs.size(), [&](std::size_t j) {
+    Job& job = jobs[j];
+    const StrokeScene& sc = scenes[job.scene];
+    for (const Stroke& st : job.device ? sc.device_strokes : sc.strokes) {
+      job.tally.add(job.device ? device_stroke(sc, st, job.speed_m_per_s) : kinematic_stroke(sc, st, job.speed_m_per_s));
+    }
+  });
+  json jscenes = json::array();
+  double first_fail_kin = 0.0, first_fail_dev = 0.0;
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const StrokeScene& sc = scenes[i];
+    json js;
+    js["name"] = sc.name;
+    js["description"] = sc.description;
+    js["feature"] = sc.feature_m;
+    js["segments"] = sc.segs.segs.size();
+    js["strokes_per_speed"] = sc.strokes.size();
+    js["device_strokes_per_speed"] = sc.device_strokes.size();
+    json kin = json::array(), dev = json::array();
+    int kin_fail = 0, dev_fail = 0;
+    for (const Job& job : jobs) {
+      if (job.scene != i) continue;
+      (job.device ? dev : kin).push_back(tally_json(job.speed_m_per_s, job.tally));
+      if (job.tally.failed()) {
+        double& first = job.device ? first_fail_dev : first_fail_kin;
+        if (first == 0.0 || job.speed_m_per_s < first) first = job.speed_m_per_s;
+        (job.device ? dev_fail : kin_fail) += job.tally.strokes_tunnelled + job.tally.strokes_missed;
+      }
+    }
+    js["kinematic"] = kin;
+    js["device"] = dev;
+    std::fprintf(stderr, "  %-14s failing strokes: kinematic %d, device %d\n", sc.name.c_str(), kin_fail, dev_fail);
+    jscenes.push_back(js);
+  }
+  out["speeds_m_per_s"] = json::array();
+  for (double v : speeds) out["speeds_m_per_s"].push_back(sig4(v));
+  out["device_speeds_m_per_s"] = json::array();
+  for (double v : device_speeds) out["device_speeds_m_per_s"].push_back(sig4(v));
+  out["scenes"] = jscenes;
+  out["first_failure_speed_kinematic_m_per_s"] = first_fail_kin > 0.0 ? json(sig4(first_fail_kin)) : json(nullptr);
+  out["first_failure_speed_device_m_per_s"] = first_fail_dev > 0.0 ? json(sig4(first_fail_dev)) : json(nullptr);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string out_path = "docs/bench/stability.json";
+  bool quick = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
+      out_path = argv[++i];
+    } else if (std::strcmp(argv[i], "--quick") == 0) {
+      quick = true;
+    } else {
+      std::fprintf(stderr, "usage: %s [--out FILE.json] [--quick]\n", argv[0]);
+      return 2;
+    }
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  json root;
+  root["generator"] = "bench_stability";
+  root["quick"] = quick;
+  std::fprintf(stderr, "part 1: largest stable wall stiffness per servo rate\n");
+  const auto t1 = std::chrono::steady_clock::now();
+  root["stiffness"] = run_part1(quick);
+  root["stiffness"]["elapsed_s"] = sig4(seconds_since(t1));
+  std::fprintf(stderr, "part 2: tunnelling and missed contacts against hand speed\n");
+  const auto t2 = std::chrono::steady_clock::now();
+  root["tunnelling"] = run_part2(quick);
+  root["tunnelling"]["elapsed_s"] = sig4(seconds_since(t2));
+  root["elapsed_s"] = sig4(seconds_since(t0));
+
+  try {
+    const std::filesystem::path p(out_path);
+    if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+    std::ofstream f(p);
+    if (!f) throw std::runtime_error("cannot open for writing");
+    f << root.dump(1) << '\n';
+    if (!f) throw std::runtime_error("write failed");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_stability: '%s': %s\n", out_path.c_str(), e.what());
+    return 1;
+  }
+  std::fprintf(stderr, "wrote %s in %.1f s\n", out_path.c_str(), seconds_since(t0));
+  return 0;
+}
