@@ -436,7 +436,7 @@ int main(int argc, char** argv) {
   // Aggregates per method and level.
   int max_level = 0;
   for (const auto& r : results) max_level = std::max(max_level, static_cast<int>(r.levels.size()) - 1);
-  nlohmann::json aggregate = nlohmann::json::array(), boxes = nlohmann::json::array();
+  nlohmann::ordered_json aggregate = nlohmann::ordered_json::array(), boxes = nlohmann::ordered_json::array();
   // Level 0 in pixels too: resampling a pixel staircase cuts its corners, which is a fraction of a pixel.
   std::map<std::string, double> mm_per_px;
   for (const auto& is : scenes) mm_per_px[fs::path(is.image_path).stem().string()] = 1e3 * is.px_to_m.scale_m_per_px;
@@ -512,15 +512,15 @@ int main(int argc, char** argv) {
                 hi_of(err_ratio));
   }
 
-  nlohmann::json curves = nlohmann::json::array();
+  nlohmann::ordered_json curves = nlohmann::ordered_json::array();
   for (std::size_t j : order) {
     const CurveResult& r = results[j];
-    nlohmann::json lv = nlohmann::json::array();
+    nlohmann::ordered_json lv = nlohmann::ordered_json::array();
     for (const LevelResult& lr : r.levels) {
-      nlohmann::json ms = nlohmann::json::object();
+      nlohmann::ordered_json ms = nlohmann::ordered_json::object();
       for (int mth = 0; mth < kMethods; ++mth) {
         const Errors& e = lr.m[mth];
-        nlohmann::json x = {{"n", e.n},
+        nlohmann::ordered_json x = {{"n", e.n},
                             {"vertex_fraction", r6(static_cast<double>(e.n) / static_cast<double>(r.n_orig))},
                             {"max_dev_mm", mm(e.max_dev_m)},
                             {"rms_mm", mm(e.rms_m)},
@@ -541,7 +541,7 @@ int main(int argc, char** argv) {
                       {"levels", lv}});
   }
 
-  nlohmann::json images = nlohmann::json::array();
+  nlohmann::ordered_json images = nlohmann::ordered_json::array();
   for (const auto& is : scenes) {
     images.push_back({{"image", fs::path(is.image_path).filename().string()},
                       {"width_px", is.width_px},
@@ -550,17 +550,17 @@ int main(int argc, char** argv) {
                       {"curves", is.scene->curve_count()},
                       {"skipped_curves", is.scene->skipped_curves()}});
   }
-  nlohmann::json methods = nlohmann::json::array();
+  nlohmann::ordered_json methods = nlohmann::ordered_json::array();
   for (int mth = 0; mth < kMethods; ++mth) methods.push_back({{"key", kMethodKey[mth]}, {"label", kMethodLabel[mth]}});
 
   const double t_end = now_s();
-  nlohmann::json timing = {{"total_s", r6(t_end - t_start)},
+  nlohmann::ordered_json timing = {{"total_s", r6(t_end - t_start)},
                            {"build_scenes_s", r6(t_scenes - t_start)},
                            {"analysis_wall_s", r6(t_done - t_scenes)},
                            {"threads", threads}};
-  for (int mth = 0; mth < kMethods; ++mth) timing["cpu_s_" + std::string(kMethodKey[mth])] = r6(1e-9 * static_cast<double>(method_ns[mth].load()));
+  for (int mth = 0; mth < kMethods; ++mth) timing["thread_s_" + std::string(kMethodKey[mth])] = r6(1e-9 * static_cast<double>(method_ns[mth].load()));
 
-  const nlohmann::json doc = {
+  const nlohmann::ordered_json doc = {
       {"what", "accuracy against size: each level of the pseudocoiflet model vs Douglas-Peucker, uniform arc-length "
                "resampling and the linear (2,2) wavelet at equal vertex counts; errors against the original pixel chain"},
       {"settings",
@@ -581,11 +581,26 @@ int main(int argc, char** argv) {
   if (opt.out.has_parent_path()) fs::create_directories(opt.out.parent_path());
   std::ofstream f(opt.out);
   if (!f) die("cannot write " + opt.out.string());
-  f << doc.dump(1) << "\n";
+  // One line per top-level key and per array element: small enough to keep in git (~3 MB), and a
+  // changed curve shows up as one changed line in a diff.
+  f << "{\n";
+  bool first_key = true;
+  for (auto it = doc.begin(); it != doc.end(); ++it) {
+    f << (first_key ? "" : ",\n") << nlohmann::ordered_json(it.key()).dump() << ": ";
+    first_key = false;
+    if (it->is_array() && !it->empty()) {
+      f << "[\n";
+      for (std::size_t i = 0; i < it->size(); ++i) f << "  " << (*it)[i].dump() << (i + 1 < it->size() ? ",\n" : "\n");
+      f << "]";
+    } else {
+      f << it->dump();
+    }
+  }
+  f << "\n}\n";
   if (!f) die("write failed: " + opt.out.string());
   std::printf("\n%zu curves from %zu pictures; level 0 of ours within %.4f mm (%.3f px) of the original everywhere\n", results.size(),
               scenes.size(), level0_worst_mm, level0_worst_px);
-  std::printf("time: %.1f s total (scenes %.1f s, analysis %.1f s on %u threads; cpu s ours %.1f dp %.1f uniform %.1f linear22 %.1f) -> %s\n",
+  std::printf("time: %.1f s total (scenes %.1f s, analysis %.1f s on %u threads; thread-seconds in ours %.1f dp %.1f uniform %.1f linear22 %.1f) -> %s\n",
               t_end - t_start, t_scenes - t_start, t_done - t_scenes, threads, 1e-9 * method_ns[0].load(), 1e-9 * method_ns[1].load(),
               1e-9 * method_ns[2].load(), 1e-9 * method_ns[3].load(), opt.out.string().c_str());
   return 0;

@@ -2,6 +2,32 @@
 
 namespace hk::app {
 
+std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chains, const vision::PxToM& map, double min_length_m,
+                                          std::size_t* too_short) {
+  std::vector<Polyline> out;
+  out.reserve(chains.size());
+  std::size_t dropped = 0;
+  for (const vision::Chain& c : chains) {
+    Polyline pl;
+    pl.closed = c.closed;
+    pl.points_m.reserve(c.points_px.size());
+    double length_m = 0.0;
+    for (const auto& q : c.points_px) {
+      const Vec2 m{map.x_m(q.x), map.y_m(q.y)};
+      if (!pl.points_m.empty()) length_m += distance(pl.points_m.back(), m);
+      pl.points_m.push_back(m);
+    }
+    if (pl.closed && pl.points_m.size() > 1) length_m += distance(pl.points_m.back(), pl.points_m.front());
+    if (length_m < min_length_m) {
+      ++dropped;
+      continue;
+    }
+    out.push_back(std::move(pl));
+  }
+  if (too_short) *too_short = dropped;
+  return out;
+}
+
 ImageScene build_image_scene(const std::string& path, const config::Settings& s) {
   ImageScene out;
   out.image_path = path;
@@ -27,23 +53,7 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s)
   out.px_to_m = vision::fit_to_workspace(ex.width_px, ex.height_px, s.workspace.width_m, s.workspace.height_m);
   out.chains_found = ex.chains.size();
 
-  for (const vision::Chain& c : ex.chains) {
-    Polyline pl;
-    pl.closed = c.closed;
-    pl.points_m.reserve(c.points_px.size());
-    double length_m = 0.0;
-    for (const auto& q : c.points_px) {
-      const Vec2 m{out.px_to_m.x_m(q.x), out.px_to_m.y_m(q.y)};
-      if (!pl.points_m.empty()) length_m += distance(pl.points_m.back(), m);
-      pl.points_m.push_back(m);
-    }
-    if (pl.closed && pl.points_m.size() > 1) length_m += distance(pl.points_m.back(), pl.points_m.front());
-    if (length_m < s.vision.min_chain_length_m) {  // a fingertip cannot resolve it
-      ++out.chains_too_short;
-      continue;
-    }
-    out.polylines.push_back(std::move(pl));
-  }
+  out.polylines = chains_to_polylines(ex.chains, out.px_to_m, s.vision.min_chain_length_m, &out.chains_too_short);
   out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
   out.times.multires_ms = out.scene->build_times().multires_ms;
   out.times.tree_ms = out.scene->build_times().tree_ms;

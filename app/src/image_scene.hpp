@@ -33,6 +33,11 @@ struct ImageScene {
   BuildTimes times;
 };
 
+/// Chains (pixels) → polylines in workspace metres, dropping chains shorter than min_length_m (a
+/// fingertip cannot resolve them). `too_short` (optional) receives the number dropped.
+std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chains, const vision::PxToM& map, double min_length_m,
+                                          std::size_t* too_short = nullptr);
+
 /// Loads the image at `path` and builds its scene with `settings`. Throws vision::InputError for bad
 /// image files (one line naming the file and the limit).
 ImageScene build_image_scene(const std::string& path, const config::Settings& settings);

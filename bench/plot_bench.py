@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""Charts and tables from the benchmark outputs in docs/bench (issue 3).
+
+Reads first_hit.json and scene_build.json (Google Benchmark JSON) and anytime.json, writes
+first_hit_vs_size.png, speed_accuracy.png, anytime.png, scene_build.png, and the Markdown tables
+between the BEGIN/END markers of docs/PERFORMANCE.md.
+"""
+import json
+import os
+import re
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+BENCH = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
+PERF = sys.argv[2] if len(sys.argv) > 2 else "docs/PERFORMANCE.md"
+COLORS = {"ours": "tab:blue", "rtree": "tab:orange", "brute": "tab:gray", "opencv": "tab:green"}
+
+
+def load_gbench(name):
+    path = os.path.join(BENCH, name)
+    if not os.path.exists(path):
+        return []
+    rows = json.load(open(path))["benchmarks"]
+    return [r for r in rows if r.get("run_type", "iteration") == "iteration"]
+
+
+def ns(r):
+    """Mean per-iteration time in ns whatever the benchmark's unit."""
+    scale = {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[r.get("time_unit", "ns")]
+    return r["real_time"] * scale
+
+
+def replace_block(text, key, block):
+    pattern = re.compile(r"(<!-- BEGIN %s -->\n).*?(<!-- END %s -->)" % (key, key), re.S)
+    if not pattern.search(text):
+        return text + "\n<!-- BEGIN %s -->\n%s\n<!-- END %s -->\n" % (key, block, key)
+    return pattern.sub(lambda m: m.group(1) + block + "\n" + m.group(2), text)
+
+
+tables = {}
+fh = load_gbench("first_hit.json")
+
+# 1. First hit and closest point against scene size.
+size_rows = defaultdict(dict)
+for r in fh:
+    m = re.match(r"BM_(FirstHit|Closest)/(\w+)/(\d+)/manual_time", r["name"])
+    if m:
+        size_rows[(m.group(1), int(m.group(3)))][m.group(2)] = r
+if size_rows:
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    for ax, kind in zip(axes, ["FirstHit", "Closest"]):
+        for method in ["ours", "rtree", "brute"]:
+            pts = sorted((n, rows[method]) for (k, n), rows in size_rows.items() if k == kind and method in rows)
+            if not pts:
+                continue
+            xs = [p[0] for p in pts]
+            ax.plot(xs, [ns(p[1]) for p in pts], "o-", color=COLORS[method], label=f"{method} mean")
+            ax.plot(xs, [p[1]["p99_ns"] for p in pts], "s--", color=COLORS[method], alpha=0.6, label=f"{method} p99")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("segments in the scene (level 0)")
+        ax.set_ylabel("time per query [ns]")
+        ax.set_title({"FirstHit": "First hit of the handle's sweep", "Closest": "Closest point"}[kind])
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Servo queries against peers, tiled scenes from real pictures, random-walk hand at 1 kHz")
+    fig.tight_layout()
+    fig.savefig(os.path.join(BENCH, "first_hit_vs_size.png"), dpi=110)
+    lines = ["| query | segments | method | mean ns | p50 ns | p99 ns | max ns | build ms | bytes/segment | ours vs rtree (mean) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for (kind, n) in sorted(size_rows):
+        rows = size_rows[(kind, n)]
+        for method in ["ours", "rtree", "brute"]:
+            if method not in rows:
+                continue
+            r = rows[method]
+            speed = ""
+            if method == "ours" and "rtree" in rows:
+                speed = "%.2fx faster" % (ns(rows["rtree"]) / ns(r)) if ns(r) < ns(rows["rtree"]) else "%.2fx slower" % (ns(r) / ns(rows["rtree"]))
+            lines.append("| %s | %d | %s | %.0f | %.0f | %.0f | %.0f | %s | %s | %s |" % (
+                kind, n, method, ns(r), r["p50_ns"], r["p99_ns"], r["max_ns"],
+                "%.1f" % r["build_ms"] if "build_ms" in r else "", "%.0f" % r["bytes_per_segment"] if "bytes_per_segment" in r else "", speed))
+    tables["first_hit"] = "\n".join(lines)
+
+# 2. Pictures: the explore sweeps.
+pic = defaultdict(dict)
+for r in fh:
+    m = re.match(r"BM_Picture/(\w+)/(.+)/manual_time", r["name"])
+    if m:
+        pic[m.group(2)][m.group(1)] = r
+if pic:
+    lines = ["| picture | segments | ours mean / p99 ns | rtree mean / p99 ns | brute mean / p99 ns |", "|---|---|---|---|---|"]
+    for name in sorted(pic):
+        rows = pic[name]
+        cell = lambda m: "%.0f / %.0f" % (ns(rows[m]), rows[m]["p99_ns"]) if m in rows else ""
+        lines.append("| %s | %d | %s | %s | %s |" % (name, rows["ours"]["segments"], cell("ours"), cell("rtree"), cell("brute")))
+    tables["pictures"] = "\n".join(lines)
+
+# 3. Speed against accuracy: per method and level, p99 over four pictures against max deviation.
+lvl = defaultdict(lambda: defaultdict(list))
+for r in fh:
+    m = re.match(r"BM_Level/(\w+)/(\d+)/(\w+)/manual_time", r["name"])
+    if m:
+        lvl[m.group(1)][int(m.group(2))].append(r)
+if lvl:
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    lines = ["| method | level | p99 ns (mean of 4 pictures) | max deviation mm (max of 4) | segments (sum) |", "|---|---|---|---|---|"]
+    for method in ["ours", "rtree", "brute"]:
+        pts = []
+        for level in sorted(lvl[method]):
+            rows = lvl[method][level]
+            p99 = sum(r["p99_ns"] for r in rows) / len(rows)
+            err = max(r["max_error_mm"] for r in rows)
+            pts.append((p99, err, level))
+            lines.append("| %s | %d | %.0f | %.3f | %d |" % (method, level, p99, err, sum(r["segments"] for r in rows)))
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=COLORS[method], label=method)
+        for p in pts:
+            ax.annotate("L%d" % p[2], (p[0], p[1]), textcoords="offset points", xytext=(4, 3), fontsize=7, color=COLORS[method])
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("query time per tick, p99 [ns]")
+    ax.set_ylabel("max deviation of the level from the original curve [mm]")
+    ax.set_title("Speed against accuracy (horse, camera, fruits, sudoku; explore sweeps)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(BENCH, "speed_accuracy.png"), dpi=110)
+    tables["speed_accuracy"] = "\n".join(lines)
+
+# 4. Anytime.
+any_path = os.path.join(BENCH, "anytime.json")
+if os.path.exists(any_path):
+    data = json.load(open(any_path))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    lines = ["| scene | deadline µs | answered exactly | mean level reached | mean error mm | p99 ns |", "|---|---|---|---|---|---|"]
+    for sc in data:
+        rows = [r for r in sc["rows"] if r["deadline_us"] > 0]
+        xs = [r["deadline_us"] for r in rows]
+        axes[0].plot(xs, [r["exact_fraction"] for r in rows], "o-", label="%s (%d segments)" % (sc["scene"], sc["segments"]))
+        axes[1].plot(xs, [max(r["mean_error_mm"], 1e-4) for r in rows], "o-", label=sc["scene"])
+        for r in sc["rows"]:
+            lines.append("| %s | %s | %.3f | %.2f | %.3f | %.0f |" % (sc["scene"], "none" if r["deadline_us"] == 0 else "%g" % r["deadline_us"],
+                                                                      r["exact_fraction"], r["mean_level"], r["mean_error_mm"], r["p99_ns"]))
+    axes[0].set_ylabel("fraction answered exactly at level 0")
+    axes[1].set_ylabel("mean error of the level reached [mm]")
+    axes[1].set_yscale("log")
+    for ax in axes:
+        ax.set_xscale("log")
+        ax.set_xlabel("deadline [µs]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Anytime collision query from a cold boundary section")
+    fig.tight_layout()
+    fig.savefig(os.path.join(BENCH, "anytime.png"), dpi=110)
+    tables["anytime"] = "\n".join(lines)
+
+# 5. Scene build against OpenCV.
+sb = defaultdict(dict)
+for r in load_gbench("scene_build.json"):
+    m = re.match(r"BM_SceneBuild/(\w+)/(.+)", r["name"])
+    if m:
+        sb[m.group(2)][m.group(1)] = r
+if sb:
+    names = sorted(sb)
+    ratios = [ns(sb[n]["ours"]) / ns(sb[n]["opencv"]) for n in names]
+    fig, ax = plt.subplots(figsize=(11, 4.5))
+    ax.bar(range(len(names)), ratios, color=["tab:blue" if q <= 2 else "tab:red" for q in ratios])
+    ax.axhline(2.0, color="k", ls="--", label="target: at most 2x")
+    ax.set_xticks(range(len(names)))
+    ax.set_xticklabels(names, rotation=60, ha="right", fontsize=8)
+    ax.set_ylabel("our build time / OpenCV blur+Canny+findContours")
+    ax.set_title("Picture → collision trees, against OpenCV's own contour extraction (same grey image)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(BENCH, "scene_build.png"), dpi=110)
+    lines = ["| picture | ours ms | OpenCV ms | ratio |", "|---|---|---|---|"]
+    for n, q in zip(names, ratios):
+        lines.append("| %s | %.2f | %.2f | %.2f |" % (n, ns(sb[n]["ours"]) / 1e6, ns(sb[n]["opencv"]) / 1e6, q))
+    tables["scene_build"] = "\n".join(lines)
+
+if os.path.exists(PERF):
+    text = open(PERF).read()
+    for key, block in tables.items():
+        text = replace_block(text, key, block)
+    open(PERF, "w").write(text)
+print("plot_bench: wrote", ", ".join(sorted(tables)))

@@ -1,0 +1,84 @@
+// Scene build against OpenCV (issue 3 item 7): picture → collision trees with our pipeline, next to
+// OpenCV's own GaussianBlur + Canny + findContours on the same grey image, in the same run.
+// Both start from the decoded, downscaled grey image (decoding is common to both and left out).
+// Ours: blur + Canny (thresholds from the image) + edge linking + px→m (dropping chains too short to
+// feel, as explore does) + multiresolution + trees — exactly the pipeline of app::build_image_scene.
+#include <benchmark/benchmark.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "bench_scenes.hpp"
+#include "vision/edges.hpp"
+#include "vision/intake.hpp"
+#include "vision/linking.hpp"
+#include "vision/mapping.hpp"
+
+using namespace hk;
+
+namespace {
+
+struct Picture {
+  std::string name;
+  cv::Mat grey;
+  double px_scale = 1.0;
+};
+
+std::vector<Picture>& pictures() {
+  static std::vector<Picture> v;
+  return v;
+}
+
+void build_ours(benchmark::State& state, const Picture* p) {
+  const config::Settings s;
+  vision::EdgeParams ep;
+  ep.blur_sigma_px = s.vision.blur_sigma_px;
+  std::size_t segments = 0;
+  for (auto _ : state) {
+    const vision::EdgeMap em = vision::detect_edges(p->grey, ep);
+    const auto chains = vision::link_edges(em.edges, 2.0);
+    const vision::PxToM map = vision::fit_to_workspace(p->grey.cols, p->grey.rows, s.workspace.width_m, s.workspace.height_m);
+    const std::vector<Polyline> curves = app::chains_to_polylines(chains, map, s.vision.min_chain_length_m);
+    const Scene scene = Scene::build(curves, s.haptics.max_levels);
+    segments = scene.total_segments(0);
+    benchmark::DoNotOptimize(scene.node_count());
+  }
+  state.counters["segments"] = static_cast<double>(segments);
+}
+
+void build_opencv(benchmark::State& state, const Picture* p) {
+  const double sigma = config::Settings{}.vision.blur_sigma_px;
+  std::size_t contours_out = 0;
+  for (auto _ : state) {
+    cv::Mat blurred, edges;
+    cv::GaussianBlur(p->grey, blurred, cv::Size(0, 0), sigma);
+    cv::Canny(blurred, edges, 50, 150, 3, true);
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(edges, contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
+    contours_out = contours.size();
+    benchmark::DoNotOptimize(contours.data());
+  }
+  state.counters["contours"] = static_cast<double>(contours_out);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  const config::Settings s;
+  vision::ImageLimits limits;
+  for (const auto& path : bench::picture_paths()) {
+    Picture p;
+    p.name = path.stem().string();
+    p.grey = vision::to_grey(vision::load_image(path.string(), limits), s.vision.max_image_side_px, &p.px_scale);
+    pictures().push_back(std::move(p));
+  }
+  for (const Picture& p : pictures()) {
+    benchmark::RegisterBenchmark(("BM_SceneBuild/ours/" + p.name).c_str(), [&p](benchmark::State& st) { build_ours(st, &p); })
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_SceneBuild/opencv/" + p.name).c_str(), [&p](benchmark::State& st) { build_opencv(st, &p); })
+        ->Unit(benchmark::kMillisecond);
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

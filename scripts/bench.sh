@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Runs every benchmark and regenerates every chart and table of docs/PERFORMANCE.md (issue 3):
+# Google Benchmark JSON and analysis JSON in docs/bench/, PNG charts beside them, tables in
+# docs/PERFORMANCE.md between its BEGIN/END markers. Takes ~10 minutes on 2 cores.
+# Usage: scripts/bench.sh [--quick]
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+quick=""
+[ "${1:-}" = "--quick" ] && quick="--quick"
+bash "$root/scripts/install-deps.sh"
+if ! /usr/bin/python3 -c "import matplotlib" 2>/dev/null; then
+  sudo_cmd=""; [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get install -y -qq --no-install-recommends python3-matplotlib >/dev/null
+fi
+bash "$root/scripts/build.sh" "$root/build" >/dev/null
+out="$root/docs/bench"
+mkdir -p "$out"
+b="$root/build/bench"
+min_time=0.5
+[ -n "$quick" ] && min_time=0.05
+"$b/bench_first_hit" $quick --benchmark_min_time=$min_time --benchmark_out="$out/first_hit.json" --benchmark_out_format=json >/dev/null
+"$b/bench_scene_build" --benchmark_min_time=$min_time --benchmark_out="$out/scene_build.json" --benchmark_out_format=json >/dev/null
+"$b/bench_anytime" --out "$out/anytime.json" 2>/dev/null
+[ -x "$b/bench_accuracy" ] && "$b/bench_accuracy" --images "$root/tests/data/images" --out "$out/accuracy.json"
+[ -x "$b/bench_stability" ] && "$b/bench_stability" $quick --out "$out/stability.json"
+/usr/bin/python3 "$root/bench/plot_bench.py" "$out" "$root/docs/PERFORMANCE.md"
+for p in "$root"/bench/plot_accuracy.py "$root"/bench/plot_stability.py; do
+  [ -f "$p" ] && (cd "$root" && /usr/bin/python3 "$p")
+done
+echo "bench: charts in $out, tables in docs/PERFORMANCE.md"
