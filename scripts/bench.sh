@@ -24,7 +24,8 @@ min_time=0.5
 [ -x "$b/bench_accuracy" ] && "$b/bench_accuracy" --images "$root/tests/data/images" --out "$out/accuracy.json"
 [ -x "$b/bench_stability" ] && "$b/bench_stability" $quick --out "$out/stability.json"
 /usr/bin/python3 "$root/bench/plot_bench.py" "$out" "$root/docs/PERFORMANCE.md"
-for p in "$root"/bench/plot_accuracy.py "$root"/bench/plot_stability.py; do
-  [ -f "$p" ] && (cd "$root" && /usr/bin/python3 "$p")
-done
+/usr/bin/python3 "$root/bench/plot_accuracy.py" "$out/accuracy.json" --outdir "$out"
+if [ -f "$out/stability.json" ]; then
+  /usr/bin/python3 "$root/bench/plot_stability.py" "$out/stability.json" --outdir "$out"
+fi
 echo "bench: charts in $out, tables in docs/PERFORMANCE.md"
