@@ -67,19 +67,21 @@ bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) {
 
 BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : scene_(&scene), merge_margin_m_(merge_margin_m) {
   const std::size_t n = scene.node_count();
-  std::size_t widest_root = 0;
-  for (std::size_t c = 0; c < scene.curve_count(); ++c) {
-    const CurveInfo& ci = scene.curve(c);
-    widest_root = std::max<std::size_t>(widest_root, ci.segment_count[ci.levels - 1]);
+  std::size_t widest_root = 0;  // widest fan-out of any node (chunks and hierarchy leaves: 4)
+  for (std::uint32_t node = 0; node < n; ++node) {
+    std::uint32_t first = 0, count = 0;
+    scene.children(node, &first, &count);
+    widest_root = std::max<std::size_t>(widest_root, count);
   }
   // Room for every node twice: entries removed this tick stay until the compaction at its end.
   section_.reserve(2 * n + widest_root + 8);
+  section_box_.reserve(2 * n + widest_root + 8);
   in_section_.assign(n, 0);
   removed_.assign(n, 0);
   candidates_.reserve(2 * n + widest_root + 8);
   merge_scratch_.reserve(2 * n + widest_root + 8);
-  // Widest fan-out (a curve root), plus two per level of curve and hierarchy (≤ 64 levels deep).
-  stack_.resize(widest_root + 4 * Scene::kMaxLevels + 2 * 64 + 8);
+  // Widest fan-out, plus that many per level of curve and hierarchy (≤ 64 levels deep).
+  stack_.resize(widest_root * (Scene::kMaxLevels + 64) + 8);
   hit_stamp_.assign(n, 0);
   merge_stamp_.assign(n, 0);
   reset();
@@ -88,9 +90,12 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
 void BoundarySection::reset() {
   for (std::uint32_t node : section_) in_section_[node] = 0;
   section_.clear();
+  section_box_.clear();
+  ball_radius_m_ = 0.0;
   if (scene_->curve_count() == 0) return;
   const std::uint32_t r = scene_->scene_root();
   section_.push_back(r);
+  section_box_.push_back(scene_->aabb(r));
   in_section_[r] = 1;
 }
 
@@ -101,6 +106,7 @@ void BoundarySection::split(std::uint32_t node) {
   in_section_[node] = 0;
   for (std::uint32_t i = 0; i < count; ++i) {
     section_.push_back(first + i);
+    section_box_.push_back(scene_->aabb(first + i));
     in_section_[first + i] = 1;
   }
 }
@@ -115,6 +121,15 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   if (level != last_level_) {  // the frontier was cut for another level: start again from the roots
     reset();
     last_level_ = level;
+  }
+  // Free-space ball (seed §3: "distances to the boxes ... can be used to schedule box updates"): the
+  // last full query proved that no box of the section comes within ball_radius_m_ of ball_center_m_,
+  // and the section covers every wall. A sweep inside that ball cannot hit anything: answer at once.
+  if (ball_radius_m_ > 0.0 && distance(a, ball_center_m_) < ball_radius_m_ && distance(b, ball_center_m_) < ball_radius_m_) {
+    st.section_size = static_cast<std::int32_t>(section_.size());
+    if (stats_out) *stats_out = st;
+    best.t = 1.0;
+    return best;
   }
   ++tick_;
   if (tick_ == 0) {  // stamp wrap-around: clear so old stamps cannot match
@@ -163,7 +178,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     const std::uint32_t node = section_[i];
     double te = 0.0, tx = 0.0;
     charge_box();
-    if (overlaps(sc.aabb(node), sweep, merge_margin_m_) && clip_segment_box(sc.box(node), a, b, merge_margin_m_, &te, &tx)) {
+    if (overlaps(section_box_[i], sweep, merge_margin_m_) && clip_segment_box(sc.box(node), a, b, merge_margin_m_, &te, &tx)) {
       hit_stamp_[node] = tick_;
       if (clip_segment_box(sc.box(node), a, b, 0.0, &te, &tx)) candidates_.push_back({te, node});
     } else {
@@ -217,15 +232,19 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
       ++st.splits;
     }
   }
-  // ... and merge siblings whose parent is clear of the sweep by the margin (bounded work per tick).
-  constexpr int kMaxMergesPerTick = 16;
-  for (std::uint32_t node : merge_scratch_) {
-    if (st.merges >= kMaxMergesPerTick) break;
+  // ... and merge siblings whose parent is clear of the sweep by the margin. Merging only shrinks the
+  // section, so it can be lazy: a few parents per tick, taken round-robin, bound the work.
+  constexpr int kMergeChecksPerTick = 4;
+  const std::size_t n_idle = merge_scratch_.size();
+  int checks = 0;
+  for (std::size_t j = 0; j < n_idle && checks < kMergeChecksPerTick; ++j) {
+    const std::uint32_t node = merge_scratch_[(j + tick_) % n_idle];
     if (!in_section_[node] || node == sc.scene_root()) continue;
     const std::uint32_t parent = sc.parent(node);
     // One check per parent per tick: a curve root has many children, and each would ask again.
     if (in_section_[parent] || merge_stamp_[parent] == tick_) continue;
     merge_stamp_[parent] = tick_;
+    ++checks;
     std::uint32_t first = 0, count = 0;
     sc.children(parent, &first, &count);
     bool all_idle = true;
@@ -237,18 +256,30 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
     in_section_[parent] = 1;
     section_.push_back(parent);
+    section_box_.push_back(sc.aabb(parent));
     ++st.merges;
   }
   // Compact: drop entries that were split or merged away.
+  // Compact: drop entries that were split or merged away; on the way, measure how far the end of
+  // the sweep is from the nearest box of the section (the next free-space ball).
   std::size_t w = 0;
+  double nearest_sq = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < section_.size(); ++i) {
     const std::uint32_t node = section_[i];
     if (in_section_[node] && removed_[node] == 0) {
       removed_[node] = 1;  // de-duplicate within this pass
+      const Aabb& r = section_box_[i];
+      const double dx = std::max({r.lo.x - b.x, 0.0, b.x - r.hi.x});
+      const double dy = std::max({r.lo.y - b.y, 0.0, b.y - r.hi.y});
+      nearest_sq = std::min(nearest_sq, dx * dx + dy * dy);
+      section_box_[w] = r;
       section_[w++] = node;
     }
   }
+  ball_center_m_ = b;
+  ball_radius_m_ = std::sqrt(nearest_sq);
   section_.resize(w);
+  section_box_.resize(w);
   for (std::uint32_t node : section_) removed_[node] = 0;
 
   if (unresolved_t < best.t) {
@@ -257,9 +288,9 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     best.blocked = true;
     best.t = unresolved_t;
     const NodeInfo& in = sc.info(unresolved_node);
-    if (sc.is_curve_root(unresolved_node)) {
+    if (sc.is_chunk(unresolved_node)) {
       const CurveInfo& ci = sc.curve(in.curve);
-      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), ci.levels - 1, 0};
+      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), ci.levels - 1, static_cast<std::int32_t>(in.index)};
     } else if (!sc.is_segment(unresolved_node)) {  // above the curves: no segment to name yet
       best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
     } else {

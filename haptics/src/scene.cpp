@@ -37,7 +37,7 @@ inline ErrorBox make_box(Vec2 origin, Vec2 axis, const Extent& e) {
   return ErrorBox{origin, axis, e.u_min - kBoxPad_m, e.u_max + kBoxPad_m, e.n_min - kBoxPad_m, e.n_max + kBoxPad_m};
 }
 
-// One node of the curve hierarchy while it is built: the curve range it covers in leaf order and,
+// One node of the scene hierarchy while it is built: the chunk range it covers in leaf order and,
 // for an inner node, the id of its first child (the second is first + 1).
 struct HierarchyNode {
   std::size_t begin = 0, end = 0;
@@ -45,16 +45,16 @@ struct HierarchyNode {
   bool leaf = true;
 };
 
-constexpr std::size_t kCurvesPerLeaf = 4;
+constexpr std::size_t kChunksPerLeaf = 4;
 
-// Median split on the longer axis of the curve centres. `order` is permuted in place into leaf order.
+// Median split on the longer axis of the chunk centres. `order` is permuted in place into leaf order.
 // Children of a node are allocated as a consecutive pair, so they have consecutive ids.
 void build_hierarchy(std::vector<std::size_t>& order, const std::vector<Vec2>& centre, std::vector<HierarchyNode>& nodes) {
   nodes.clear();
   nodes.push_back({0, order.size(), 0, true});
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const std::size_t begin = nodes[i].begin, end = nodes[i].end;
-    if (end - begin <= kCurvesPerLeaf) continue;
+    if (end - begin <= kChunksPerLeaf) continue;
     Vec2 lo = centre[order[begin]], hi = lo;
     for (std::size_t k = begin; k < end; ++k) {
       const Vec2 c = centre[order[k]];
@@ -131,31 +131,6 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   }
   const double t1 = now_ms();
 
-  // Curve hierarchy: order the curves so every hierarchy leaf covers consecutive curve roots.
-  std::vector<HierarchyNode> hierarchy;
-  {
-    std::vector<Vec2> centre(scene.models_.size());
-    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
-      Vec2 lo = scene.models_[c].scaling[0][0], hi = lo;
-      for (const Vec2& q : scene.models_[c].scaling[0]) {
-        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
-        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
-      }
-      centre[c] = 0.5 * (lo + hi);
-    }
-    std::vector<std::size_t> order(scene.models_.size());
-    for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
-    build_hierarchy(order, centre, hierarchy);
-    std::vector<CurveMultires> models(order.size());
-    std::vector<std::size_t> source(order.size());
-    for (std::size_t k = 0; k < order.size(); ++k) {
-      models[k] = std::move(scene.models_[order[k]]);
-      source[k] = scene.source_index_[order[k]];
-    }
-    scene.models_ = std::move(models);
-    scene.source_index_ = std::move(source);
-  }
-
   // Lay out points and segment nodes, level by level within each curve.
   std::size_t npoints = 0, nnodes = 0;
   scene.curves_.resize(scene.models_.size());
@@ -175,8 +150,38 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   }
   scene.segment_nodes_ = nnodes;
   scene.points_m_.resize(npoints);
-  const std::size_t hierarchy_base = nnodes + scene.curves_.size();
-  const std::size_t total_nodes = hierarchy_base + (scene.curves_.empty() ? 0 : hierarchy.size());
+
+  // Chunks: runs of at most kSegmentsPerChunk consecutive coarsest segments of one curve. They are the
+  // leaves of the scene hierarchy, so no node has more than a handful of children (a long curve would
+  // otherwise fan out to hundreds of coarsest segments, and the boundary section with it).
+  struct Chunk {
+    std::uint32_t curve, first_segment, count;
+  };
+  std::vector<Chunk> chunks;
+  std::vector<Vec2> chunk_centre;
+  for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+    const int top = scene.models_[c].levels - 1;
+    const auto& pts = scene.models_[c].scaling[static_cast<std::size_t>(top)];
+    const std::uint32_t k_top = scene.curves_[c].segment_count[top];
+    for (std::uint32_t k = 0; k < k_top; k += kSegmentsPerChunk) {
+      const std::uint32_t n = std::min<std::uint32_t>(kSegmentsPerChunk, k_top - k);
+      Vec2 lo = pts[k], hi = pts[k];
+      for (std::uint32_t i = k; i <= k + n; ++i) {
+        const Vec2 q = pts[i % pts.size()];
+        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+      }
+      chunks.push_back({static_cast<std::uint32_t>(c), k, n});
+      chunk_centre.push_back(0.5 * (lo + hi));
+    }
+  }
+  std::vector<HierarchyNode> hierarchy;
+  std::vector<std::size_t> chunk_order(chunks.size());
+  for (std::size_t i = 0; i < chunk_order.size(); ++i) chunk_order[i] = i;
+  build_hierarchy(chunk_order, chunk_centre, hierarchy);  // chunk_order becomes leaf order
+  scene.chunk_count_ = chunks.size();
+  const std::size_t hierarchy_base = nnodes + chunks.size();
+  const std::size_t total_nodes = hierarchy_base + (chunks.empty() ? 0 : hierarchy.size());
   scene.boxes_.resize(total_nodes);
   scene.info_.resize(total_nodes);
   scene.parent_.assign(total_nodes, 0);
@@ -226,7 +231,7 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
       const std::uint32_t node = ci.box_offset[0] + static_cast<std::uint32_t>(k);
       scene.boxes_[node] = make_box(a, axis, e);
       scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), 0, static_cast<std::uint32_t>(k)};
-      scene.parent_[node] = m.levels > 1 ? ci.box_offset[1] + static_cast<std::uint32_t>(k / 2) : scene.root_node(c);
+      scene.parent_[node] = m.levels > 1 ? ci.box_offset[1] + static_cast<std::uint32_t>(k / 2) : 0;  // coarsest: set with its chunk
     }
     // Coarser levels: segment + children's box corners.
     for (int l = 1; l < m.levels; ++l) {
@@ -245,25 +250,11 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
         const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k);
         scene.boxes_[node] = make_box(a, axis, e);
         scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), l, static_cast<std::uint32_t>(k)};
-        scene.parent_[node] = l + 1 < m.levels ? ci.box_offset[l + 1] + static_cast<std::uint32_t>(k / 2) : scene.root_node(c);
+        scene.parent_[node] = l + 1 < m.levels ? ci.box_offset[l + 1] + static_cast<std::uint32_t>(k / 2) : 0;  // coarsest: set with its chunk
         scene.child_first_[node] = ci.box_offset[l - 1] + 2 * static_cast<std::uint32_t>(k);
         scene.child_count_[node] = 2;
       }
     }
-    // Root: axis-aligned box around the coarsest boxes (origin (0,0), axis x, so u = x and n = y).
-    Extent root;
-    const int top = m.levels - 1;
-    for (std::size_t k = 0; k < ci.segment_count[top]; ++k) {
-      Vec2 corners[4];
-      box_corners(scene.boxes_[ci.box_offset[top] + k], corners);
-      for (const Vec2& q : corners) grow(root, Vec2{0, 0}, Vec2{1, 0}, q);
-    }
-    const std::uint32_t rnode = scene.root_node(c);
-    scene.boxes_[rnode] = make_box(Vec2{0, 0}, Vec2{1, 0}, root);
-    scene.info_[rnode] = NodeInfo{static_cast<std::uint32_t>(c), m.levels, 0};
-    scene.child_first_[rnode] = ci.box_offset[top];
-    scene.child_count_[rnode] = ci.segment_count[top];
-
     // Error of each level: distance of every original vertex and level-0 point to the segment that stands for it.
     CurveInfo& cw = scene.curves_[c];
     for (int l = 0; l < m.levels; ++l) {
@@ -287,11 +278,30 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   if (!scene.curves_.empty()) {
     scene.bounds_min_ = lo;
     scene.bounds_max_ = hi;
+    // Chunk nodes, in the hierarchy's leaf order so that every leaf's chunks have consecutive ids.
+    for (std::size_t k = 0; k < chunks.size(); ++k) {
+      const Chunk& ch = chunks[chunk_order[k]];
+      const CurveInfo& ci = scene.curves_[ch.curve];
+      const int top = ci.levels - 1;
+      const std::uint32_t node = static_cast<std::uint32_t>(scene.segment_nodes_ + k);
+      const std::uint32_t first = ci.box_offset[top] + ch.first_segment;
+      Extent e;
+      for (std::uint32_t i = 0; i < ch.count; ++i) {
+        Vec2 corners[4];
+        box_corners(scene.boxes_[first + i], corners);
+        for (const Vec2& q : corners) grow(e, Vec2{0, 0}, Vec2{1, 0}, q);
+        scene.parent_[first + i] = node;
+      }
+      scene.boxes_[node] = make_box(Vec2{0, 0}, Vec2{1, 0}, e);
+      scene.info_[node] = NodeInfo{ch.curve, ci.levels, ch.first_segment};
+      scene.child_first_[node] = first;
+      scene.child_count_[node] = ch.count;
+    }
     // Hierarchy boxes bottom-up (children always have larger indices than their parent).
     for (std::size_t i = hierarchy.size(); i-- > 0;) {
       const HierarchyNode& h = hierarchy[i];
       const std::uint32_t node = static_cast<std::uint32_t>(hierarchy_base + i);
-      const std::uint32_t first = h.leaf ? scene.root_node(h.begin) : static_cast<std::uint32_t>(hierarchy_base + h.first_child);
+      const std::uint32_t first = h.leaf ? static_cast<std::uint32_t>(scene.segment_nodes_ + h.begin) : static_cast<std::uint32_t>(hierarchy_base + h.first_child);
       const std::uint32_t count = h.leaf ? static_cast<std::uint32_t>(h.end - h.begin) : 2u;
       Extent e;
       for (std::uint32_t k = 0; k < count; ++k) {
@@ -301,7 +311,7 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
         scene.parent_[first + k] = node;
       }
       scene.boxes_[node] = make_box(Vec2{0, 0}, Vec2{1, 0}, e);
-      scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(h.begin), kHierarchyLevel, 0};
+      scene.info_[node] = NodeInfo{chunks[chunk_order[h.begin]].curve, kHierarchyLevel, 0};
       scene.child_first_[node] = first;
       scene.child_count_[node] = count;
     }

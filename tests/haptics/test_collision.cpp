@@ -56,16 +56,6 @@ void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
         }
       }
     }
-    // The root holds the coarsest boxes.
-    const std::uint32_t root = sc.root_node(c);
-    std::uint32_t first = 0, count = 0;
-    sc.children(root, &first, &count);
-    ASSERT_EQ(count, ci.segment_count[ci.levels - 1]);
-    for (std::uint32_t i = 0; i < count; ++i) {
-      Vec2 corners[4];
-      box_corners(sc.box(first + i), corners);
-      for (const Vec2& q : corners) ASSERT_TRUE(box_contains(sc.box(root), q, tol));
-    }
   }
 }
 
@@ -81,24 +71,28 @@ TEST(CollisionTree, BoxesContainOriginalsAndChildren) {
   }
 }
 
-TEST(CollisionTree, CurveHierarchyHoldsEveryCurveOnce) {
+TEST(CollisionTree, SceneHierarchyHoldsEveryCoarsestSegmentOnce) {
   std::mt19937 rng(12);
   const auto curves = random_scene(rng, 40, 40);
   const Scene sc = Scene::build(curves, 6);
-  // Walk down from the scene root: every curve root is reached exactly once, and every child box
-  // lies inside its parent's box.
-  std::vector<int> reached(sc.curve_count(), 0);
+  // Walk down from the scene root to the coarsest segments: each is reached exactly once, every
+  // child box lies inside its parent's box, and no node fans out to more than a handful of children.
+  std::vector<std::vector<int>> reached(sc.curve_count());
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) reached[c].assign(sc.curve(c).segment_count[sc.curve(c).levels - 1], 0);
   std::vector<std::uint32_t> stack{sc.scene_root()};
   while (!stack.empty()) {
     const std::uint32_t node = stack.back();
     stack.pop_back();
-    if (sc.is_curve_root(node)) {
-      ++reached[sc.info(node).curve];
+    if (sc.is_segment(node)) {
+      const NodeInfo& in = sc.info(node);
+      ASSERT_EQ(in.level, sc.curve(in.curve).levels - 1);
+      ++reached[in.curve][in.index];
       continue;
     }
     std::uint32_t first = 0, count = 0;
     sc.children(node, &first, &count);
     ASSERT_GE(count, 1u);
+    ASSERT_LE(count, 4u);
     for (std::uint32_t i = 0; i < count; ++i) {
       ASSERT_EQ(sc.parent(first + i), node);
       Vec2 corners[4];
@@ -107,7 +101,9 @@ TEST(CollisionTree, CurveHierarchyHoldsEveryCurveOnce) {
       stack.push_back(first + i);
     }
   }
-  for (int r : reached) EXPECT_EQ(r, 1);
+  for (const auto& v : reached) {
+    for (int r : v) EXPECT_EQ(r, 1);
+  }
 }
 
 TEST(CollisionTree, ErrorGrowsWithLevelAndBoxesBoundIt) {

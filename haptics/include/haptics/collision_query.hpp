@@ -14,6 +14,9 @@
 /// sweep is clear up to the entry of the nearest box not refined in time (a box holds everything finer,
 /// so no wall of the target level lies before it). The caller can then stop short instead of crossing a
 /// wall it has not resolved; the boundary section keeps the refinement for the next tick.
+/// Between full queries a free-space ball answers at once: a full query measures how far the end of
+/// its sweep is from the nearest box of the section, and a later sweep wholly inside that distance
+/// cannot hit anything (seed §3 suggests scheduling box updates from box distances).
 ///
 /// Real-time: all storage is sized in the constructor; `first_hit` allocates nothing, takes no lock,
 /// throws nothing.
@@ -91,6 +94,7 @@ class BoundarySection {
   const Scene* scene_;
   double merge_margin_m_;
   std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
+  std::vector<Aabb> section_box_;          // their rectangles, inline so the per-tick scan streams through memory
   std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
   std::vector<std::uint8_t> removed_;      // per node: 1 when split/merged away this tick (compacted at the end)
   struct Candidate { double t_enter; std::uint32_t node; };
@@ -101,6 +105,8 @@ class BoundarySection {
   std::vector<std::uint32_t> merge_stamp_; // per node: tick at which it was last considered for a merge
   std::uint32_t tick_ = 0;
   int last_level_ = -1;
+  Vec2 ball_center_m_;          // free-space ball: no section box comes closer to its centre than its radius
+  double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
 };
 
 }  // namespace hk

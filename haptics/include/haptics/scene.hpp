@@ -4,13 +4,14 @@
 /// (seed paper §3, DESIGN.md "Collision tree"), stored scene-wide in flat arrays addressed by node ids,
 /// so the servo tick walks them with indices and a fixed-size stack and never chases pointers.
 ///
-/// Node numbering. Segment k of level l of curve c is node `curves[c].box_offset[l] + k`. After all
-/// segment nodes come one root node per curve (`root_node(c)`) whose box is the curve's axis-aligned
-/// bounding box; its children are the segments of the coarsest level. Children of segment k at level l
-/// (l ≥ 1) are segments 2k and 2k+1 at level l−1. Above the curve roots sits a bounding-volume
-/// hierarchy over the curves (axis-aligned boxes, median split on the longer axis, at most 4 curves per
-/// leaf), so a scene of thousands of curves is entered through one node, `scene_root()`: curves are
-/// stored in the hierarchy's leaf order, so every node's children are consecutive ids.
+/// Node numbering. Segment k of level l of curve c is node `curves[c].box_offset[l] + k`; children of
+/// segment k at level l (l ≥ 1) are segments 2k and 2k+1 at level l−1. After all segment nodes come the
+/// chunks: runs of at most 4 consecutive coarsest-level segments of one curve, each with an axis-aligned
+/// box around its segments' boxes. Above the chunks sits a bounding-volume hierarchy (axis-aligned
+/// boxes, median split on the longer axis, at most 4 chunks per leaf), entered through one node,
+/// `scene_root()`. Chunks are numbered in the hierarchy's leaf order, so every node's children are
+/// consecutive ids, and no node has more than 4 children: the boundary section stays small however
+/// long or many the curves are.
 
 #include <cstdint>
 #include <vector>
@@ -70,9 +71,9 @@ constexpr bool operator==(SegmentRef a, SegmentRef b) { return a.curve == b.curv
 
 /// Per-node bookkeeping the tree walks need. 12 bytes.
 struct NodeInfo {
-  std::uint32_t curve = 0;    ///< curve of a segment or curve root; first curve under a hierarchy node
-  std::int32_t level = 0;     ///< segment level; `levels` of its curve for a curve root; kHierarchyLevel above
-  std::uint32_t index = 0;    ///< segment index within its level (0 otherwise)
+  std::uint32_t curve = 0;    ///< curve of a segment or chunk; curve of the first chunk under a hierarchy node
+  std::int32_t level = 0;     ///< segment level; `levels` of its curve for a chunk; kHierarchyLevel above
+  std::uint32_t index = 0;    ///< segment index within its level; a chunk's first coarsest segment; 0 above
 };
 
 /// Build timings of a scene [ms].
@@ -85,7 +86,7 @@ struct SceneBuildTimes {
 class Scene {
  public:
   static constexpr int kMaxLevels = 16;
-  static constexpr std::int32_t kHierarchyLevel = 1000;  ///< NodeInfo::level of the nodes above the curve roots
+  static constexpr std::int32_t kHierarchyLevel = 1000;  ///< NodeInfo::level of the nodes above the chunks
 
   /// Builds multiresolution models and collision trees for `curves` (workspace metres), with at most
   /// `max_levels` levels above level 0 (clamped to kMaxLevels − 1). Curves with fewer than 2 distinct
@@ -100,15 +101,16 @@ class Scene {
   std::size_t source_index(std::size_t c) const { return source_index_[c]; }
   std::size_t skipped_curves() const { return skipped_; }
 
-  /// Total nodes: segment nodes of all levels of all curves, one root per curve, the hierarchy above.
+  /// Total nodes: segment nodes of all levels of all curves, the chunks, the hierarchy above.
   std::size_t node_count() const { return boxes_.size(); }
-  std::uint32_t root_node(std::size_t c) const { return static_cast<std::uint32_t>(segment_nodes_ + c); }
   /// The one node every walk starts from (a hierarchy node; valid only when curve_count() > 0).
   std::uint32_t scene_root() const { return scene_root_; }
   /// True for segment nodes (they carry a segment of some level); false for curve roots and above.
   bool is_segment(std::uint32_t node) const { return node < segment_nodes_; }
-  /// True for a curve's root node.
-  bool is_curve_root(std::uint32_t node) const { return node >= segment_nodes_ && node < segment_nodes_ + curves_.size(); }
+  /// True for a chunk (a run of coarsest segments of one curve).
+  bool is_chunk(std::uint32_t node) const { return node >= segment_nodes_ && node < segment_nodes_ + chunk_count_; }
+  /// Coarsest segments per chunk, at most.
+  static constexpr std::uint32_t kSegmentsPerChunk = 4;
   const ErrorBox& box(std::uint32_t node) const { return boxes_[node]; }
   /// Axis-aligned rectangle around a node's box (its four corners) [m].
   const Aabb& aabb(std::uint32_t node) const { return aabbs_[node]; }
@@ -150,6 +152,7 @@ class Scene {
   std::vector<NodeInfo> info_;
   std::vector<std::uint32_t> parent_, child_first_, child_count_;
   std::size_t segment_nodes_ = 0;
+  std::size_t chunk_count_ = 0;
   std::uint32_t scene_root_ = 0;
   std::size_t skipped_ = 0;
   Vec2 bounds_min_{0, 0}, bounds_max_{0, 0};
