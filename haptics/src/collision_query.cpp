@@ -74,12 +74,15 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
     widest_root = std::max<std::size_t>(widest_root, count);
   }
   // Room for every node twice: entries removed this tick stay until the compaction at its end.
-  section_.reserve(2 * n + widest_root + 8);
-  section_box_.reserve(2 * n + widest_root + 8);
+  // The section's storage is bounded so that a scene of millions of segments does not cost tens of
+  // megabytes of scratch: when it is full, boxes are simply not split (the query still descends).
+  capacity_ = std::min<std::size_t>(2 * n, kMaxSectionEntries) + widest_root + 8;
+  section_.reserve(capacity_);
+  section_box_.reserve(capacity_);
   in_section_.assign(n, 0);
   removed_.assign(n, 0);
-  candidates_.reserve(2 * n + widest_root + 8);
-  merge_scratch_.reserve(2 * n + widest_root + 8);
+  candidates_.reserve(capacity_);
+  merge_scratch_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (≤ 64 levels deep).
   stack_.resize(widest_root * (Scene::kMaxLevels + 64) + 8);
   hit_stamp_.assign(n, 0);
@@ -103,6 +106,7 @@ void BoundarySection::split(std::uint32_t node) {
   std::uint32_t first = 0, count = 0;
   scene_->children(node, &first, &count);
   if (count == 0 || !in_section_[node]) return;
+  if (section_.size() + count + 8 > capacity_) return;  // full: keep the node (room kept for this tick's merges)
   in_section_[node] = 0;
   for (std::uint32_t i = 0; i < count; ++i) {
     section_.push_back(first + i);

@@ -69,6 +69,7 @@ struct QueryStats {
 class BoundarySection {
  public:
   static constexpr int kMaxExcluded = 2;
+  static constexpr std::size_t kMaxSectionEntries = 1u << 16;  ///< bound on the section's storage (entries)
 
   /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots.
   explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4);
@@ -105,6 +106,7 @@ class BoundarySection {
   std::vector<std::uint32_t> merge_stamp_; // per node: tick at which it was last considered for a merge
   std::uint32_t tick_ = 0;
   int last_level_ = -1;
+  std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
   Vec2 ball_center_m_;          // free-space ball: no section box comes closer to its centre than its radius
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
 };
