@@ -263,9 +263,10 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
       for (std::size_t k = 0; k < s0; ++k) {
         const std::size_t seg = k >> l;
         const Vec2 a = pts[seg], b = pts[seg + 1 == pts.size() ? 0 : seg + 1];
-        worst = std::max(worst, distance_to_segment(m.scaling[0][k], a, b));
-        for (std::uint32_t j = orig_first[k]; j < orig_first[k + 1]; ++j) worst = std::max(worst, distance_to_segment(p[j], a, b));
+        worst = std::max(worst, distance_sq_to_segment(m.scaling[0][k], a, b));
+        for (std::uint32_t j = orig_first[k]; j < orig_first[k + 1]; ++j) worst = std::max(worst, distance_sq_to_segment(p[j], a, b));
       }
+      worst = std::sqrt(worst);  // squared above: one root per level
       for (std::size_t k = 0; k < cw.segment_count[l]; ++k) widest = std::max(widest, box_half_width(scene.boxes_[cw.box_offset[l] + k]));
       cw.max_error_m[l] = worst;
       cw.max_box_half_width_m[l] = widest;
