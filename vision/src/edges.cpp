@@ -7,9 +7,10 @@
 //
 // Everything after the blur is our own code, but it computes exactly what
 // cv::Sobel(..., BORDER_REPLICATE) and cv::Canny(dx, dy, ..., L2gradient = true) compute (all
-// integer arithmetic; tests/vision/test_edges.cpp checks the edge maps against OpenCV's): only
-// faster, because it runs in one pass per stage, vectorised, without a branch per pixel, and
-// without sorting or any per-pixel allocation.
+// integer arithmetic; tests/vision/test_reference.cpp checks the edge maps against OpenCV's),
+// only faster: one pass per stage, vectorised, the suppression without per-pixel branches, no
+// sorting, in row stripes on OpenCV's threads (as cv::Canny), and with the image-sized buffers
+// kept between calls (Scratch).
 
 #include "vision/edges.hpp"
 

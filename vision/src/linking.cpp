@@ -13,10 +13,15 @@
 // tracing and the junction clean-up after it.
 //
 // Layout: the edge map is copied into a byte grid with a one-pixel empty border so neighbour
-// lookups need no bounds checks; per pixel we keep the 8-bit mask of its graph links and the
-// mask of links already walked. Directions are numbered clockwise on screen from east. Tracing
-// yields segments (junction to junction/end, or junction-free cycles); joining segments through
-// junctions yields the chains.
+// lookups need no bounds checks, and the edge pixels are listed once in raster order; every
+// later pass visits only that list (a few percent of the pixels), never the whole grid. The
+// thinning and link rules depend only on the 8-neighbour mask of a pixel and are tabulated. Per
+// pixel we keep the 8-bit mask of its graph links and the mask of links already walked.
+// Directions are numbered clockwise on screen from east. Tracing yields segments (junction to
+// junction/end, or junction-free cycles), stored concatenated in one array; joining segments
+// through junctions yields the chains. Loops over pixels avoid data-dependent branches where
+// the branch would be unpredictable (they cost more than the work on this data), and the
+// buffers are kept between calls (see Linker).
 
 #include "vision/linking.hpp"
 
@@ -99,8 +104,9 @@ const std::array<double, 2> kStepHypot = {std::hypot(1.0, 0.0), std::hypot(1.0, 
 constexpr std::size_t kKeepPixels = std::size_t{1} << 22;
 
 /// One linker per thread (see link_edges): its buffers, the largest of which are as large as the
-/// edge map, are kept between calls, because allocating them anew each call costs more than the
-/// linking (large freed blocks go back to the OS and come back as page faults).
+/// edge map (3 bytes per pixel), are kept between calls, because allocating them anew each call
+/// costs more than the linking (large freed blocks go back to the OS and come back as page
+/// faults).
 class Linker {
  public:
   /// Links `edges` (CV_8UC1, non-empty); everything of a previous call is reset first.
@@ -125,7 +131,6 @@ class Linker {
     if (capacity_ < size_) {  // grids: every cell read is written first, so no clearing
       set_ = std::make_unique_for_overwrite<std::uint8_t[]>(size_);
       node_ = std::make_unique_for_overwrite<Node[]>(size_);
-      end_index_ = std::make_unique_for_overwrite<std::uint32_t[]>(size_);
       capacity_ = size_;
     }
     pix_.clear();
@@ -171,6 +176,7 @@ class Linker {
   struct Segment {
     std::size_t begin = 0;
     std::size_t end = 0;
+    std::size_t front_end = 0;  // index in ends_ of the first pixel (segments from pass 1)
     bool cycle = false;   // a cycle without junctions
     bool minor = false;   // a corner artefact, kept as its own chain (see kSpurPx)
     double length = 0.0;  // polyline length [px] (of an open walk; cycles: unused)
@@ -289,7 +295,6 @@ class Linker {
     for (const std::size_t p : pix_) {  // without a branch per pixel
       const std::uint8_t links = kLinks[neighbours(p)];
       node_[p] = Node{links, 0};
-      end_index_[p] = static_cast<std::uint32_t>(n);  // kept for degree != 2 only
       ends_[n] = p;
       n += kPopcount[links] != 2 ? 1U : 0U;
     }
@@ -328,17 +333,19 @@ class Linker {
   void trace_all() {
     seg_pix_.reserve(pix_.size() + pix_.size() / 4 + 16);
     // Pass 1: branches from ends, junctions and isolated pixels (degree != 2).
-    for (const std::size_t p : ends_) {
+    for (std::size_t k = 0; k < ends_.size(); ++k) {
+      const std::size_t p = ends_[k];
       if (node_[p].links == 0) {
         Segment s;
         s.begin = seg_pix_.size();
         seg_pix_.push_back(p);
         s.end = seg_pix_.size();
+        s.front_end = k;
         segs_.push_back(s);
         continue;
       }
       for (unsigned free = node_[p].links & ~node_[p].used; free != 0; free = node_[p].links & ~node_[p].used) {
-        trace(p, std::countr_zero(free));
+        trace(p, std::countr_zero(free)).front_end = k;
       }
     }
     // Pass 2: what is left are cycles of degree-2 pixels; start each at its raster-first pixel.
@@ -399,13 +406,14 @@ class Linker {
       std::array<std::int64_t, 2> end{};  // the first two of them
     };
     std::vector<Junction> at(ends_.size());  // by index in ends_ (junctions are among them)
+    // Segments not from pass 1 (cycles) have no junction ends, minor ones are skipped.
     for (std::size_t i = 0; i < segs_.size(); ++i) {
       const Segment& s = segs_[i];
       if (s.cycle || s.minor || s.size() < 2) continue;
       for (std::size_t e = 0; e < 2; ++e) {
         const std::size_t p = e == 0 ? seg_pix_[s.begin] : seg_pix_[s.end - 1];
         if (!is_junction(p)) continue;
-        Junction& j = at[end_index_[p]];
+        Junction& j = at[e == 0 || p == seg_pix_[s.begin] ? s.front_end : index_in_ends(p)];
         if (j.count < 2) j.end[static_cast<std::size_t>(j.count)] = static_cast<std::int64_t>(2 * i + e);
         ++j.count;
       }
@@ -417,8 +425,22 @@ class Linker {
     }
   }
 
-  /// Appends pix_begin[0 .. n) (reversed when !forward; without its first pixel when `skip_first`)
-  /// to the chain being built.
+  /// Index in ends_ (raster order) of one of its pixels: a binary search whose steps compile to
+  /// conditional moves (a full-size pixel -> index grid would cost more in page faults on the
+  /// first call than this costs on the few junction ends).
+  std::size_t index_in_ends(std::size_t p) const {
+    const std::size_t* base = ends_.data();
+    std::size_t len = ends_.size();
+    while (len > 1) {
+      const std::size_t half = len / 2;
+      base = base[half - 1] < p ? base + half : base;
+      len -= half;
+    }
+    return static_cast<std::size_t>(base - ends_.data());
+  }
+
+  /// Appends the pixels of segment `seg` (reversed when !forward; without its first pixel when
+  /// `skip_first`) to the chain being built at the end of out_pix_.
   void append(std::size_t seg, bool forward, bool skip_first) {
     const Segment& s = segs_[seg];
     const std::size_t skip = skip_first ? 1 : 0;
@@ -522,8 +544,6 @@ class Linker {
   std::array<std::ptrdiff_t, 8> off_{};
   std::unique_ptr<std::uint8_t[]> set_;  // 1 = edge pixel (padded grid; border 0)
   std::unique_ptr<Node[]> node_;         // graph state, written for the pixels in pix_
-  std::unique_ptr<std::uint32_t[]> end_index_;  // index in ends_, valid for the pixels in ends_
-                                                // (< 2^31: cv::countNonZero counts in an int)
   std::vector<std::size_t> pix_;         // edge pixels (left by thinning), raster order
   std::vector<std::size_t> ends_;        // those of degree != 2, raster order
   std::vector<std::size_t> seg_pix_;     // pixels of all segments, concatenated

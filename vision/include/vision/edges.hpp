@@ -27,9 +27,14 @@ struct EdgeMap {
 /// Canny edge detection (J. Canny, "A Computational Approach to Edge Detection", IEEE PAMI 8(6),
 /// 1986) with automatic thresholds.
 ///
-/// Steps: cv::GaussianBlur (sigma = blur_sigma_px, replicated border); 3x3 Sobel derivatives;
-/// cv::Canny on those derivatives with the L2 gradient norm sqrt(gx^2 + gy^2). The magnitude of
-/// a blurred step of height D grey levels is about 8 * D / (sigma * sqrt(2 pi)) in these units.
+/// Steps: cv::GaussianBlur (sigma = blur_sigma_px, replicated border); 3x3 Sobel derivatives
+/// (replicated border); Canny's non-maximum suppression and hysteresis on those derivatives
+/// with the L2 gradient norm sqrt(gx^2 + gy^2). The magnitude of a blurred step of height D grey
+/// levels is about 8 * D / (sigma * sqrt(2 pi)) in these units. The Sobel and Canny steps are
+/// our own vectorised code, but the edge map is bit for bit that of cv::Sobel(..., CV_16S, ...,
+/// BORDER_REPLICATE) followed by cv::Canny(dx, dy, edges, low, high, L2gradient = true) (all
+/// integer arithmetic; like cv::Sobel, a submatrix input sees its parent's pixels beyond its
+/// edges).
 ///
 /// Automatic high threshold (when canny_high == 0), after the rule of MATLAB's
 /// edge(I, 'canny') (a fixed fraction of pixels are non-edges, "ThresholdRatio" low = 0.4 high;
@@ -44,6 +49,11 @@ struct EdgeMap {
 /// probability exp(-12.5) ~ 4e-6 per pixel. kMinAutoHigh (= 20, a blurred step of about 10 grey
 /// levels at sigma 1.5) keeps faint shading and JPEG blocking of nearly uniform images out.
 /// Given thresholds are used as they are (low = 0.4 * high when only high is given).
+///
+/// Cost: O(pixels), no sorting. Like cv::Canny, the passes run in row stripes on OpenCV's
+/// threads (cv::setNumThreads(1) makes them serial); the result does not depend on the number of
+/// threads. Each calling thread keeps its scratch images (about 6 bytes per pixel) between
+/// calls, for images of up to 2^22 pixels; concurrent calls from different threads are safe.
 ///
 /// @param grey CV_8UC1 image, non-empty.
 /// @throws std::invalid_argument if grey is empty or not CV_8UC1, or a parameter is negative or

@@ -53,7 +53,10 @@ struct Chain {
 /// chain contains a pixel twice; consecutive points, and the last and first points of a closed
 /// chain, are 8-adjacent; 8-connected components of the edge map are never split or merged.
 /// Output order: by raster index (v, then u) of the first point, ties in discovery order;
-/// deterministic. Time and memory O(width * height) (plus sorting the few short segments).
+/// deterministic. Time and memory O(width * height) (plus sorting the chains and the few short
+/// segments); the passes after one scan of the map visit only the edge pixels. Each calling
+/// thread keeps its scratch buffers (about 3 bytes per pixel) between calls, for edge maps of up
+/// to 2^22 pixels; concurrent calls from different threads are safe.
 ///
 /// @param edges         CV_8UC1; non-zero = edge pixel. May be empty (no chains).
 /// @param min_length_px smallest polyline length kept [px], >= 0.
