@@ -6,6 +6,7 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libboost-dev
+  libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev sox
 )
 missing=()
 for p in "${packages[@]}"; do

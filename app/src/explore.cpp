@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,7 +13,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "audio/mixer.hpp"
+#include "audio/wav.hpp"
 #include "config/load.hpp"
+#include "cue_tracker.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
 #include "image_scene.hpp"
@@ -109,6 +113,19 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   const Scene& scene = *is.scene;
 
   const double duration = o.duration_s > 0.0 ? o.duration_s : path.duration_s() + 0.5;
+  if (!o.audio_out.empty()) {
+    const std::filesystem::path a(o.audio_out);
+    std::string ext = a.extension().string();
+    for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (ext != ".wav") throw ExploreError("--audio-out '" + o.audio_out + "': must name a .wav file");
+    const std::filesystem::path parent = a.has_parent_path() ? a.parent_path() : std::filesystem::path(".");
+    if (!std::filesystem::is_directory(parent)) {
+      throw ExploreError("--audio-out '" + o.audio_out + "': folder '" + parent.string() + "' does not exist");
+    }
+    if (duration > 3600.0) {
+      throw ExploreError("--audio-out '" + o.audio_out + "': a run of " + std::to_string(duration) + " s is over the audio limit of 3600 s");
+    }
+  }
   const std::filesystem::path trace_path = out / "trace.csv";
   std::unique_ptr<FILE, int (*)(FILE*)> trace(std::fopen(trace_path.c_str(), "w"), &std::fclose);
   if (!trace) throw ExploreError("output '" + trace_path.string() + "': cannot open for writing");
@@ -131,8 +148,16 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   long budget_exhausted = 0;
   double queries = 0, box_tests = 0, section_sum = 0;
   long section_max = 0, iteration_limited = 0;
+  CueTrackerParams ctp;
+  ctp.period_s = 1.0 / s.haptics.servo_rate_hz;
+  ctp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
+  CueTracker tracker(ctp);
+  std::vector<audio::CueEvent> cues;
   run_simulation(scene, s, path, duration, [&](const TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
+    audio::CueEvent tick_cues[CueTracker::kMaxCuesPerTick];
+    const int nc = tracker.update(r.index, so, r.handle_m, s.haptics.level, tick_cues);
+    cues.insert(cues.end(), tick_cues, tick_cues + nc);
     const int state = static_cast<int>(c.state);
     const int curve = c.state == ContactState::Free ? -1 : c.constraint[0].curve;
     // Rows are kept in memory and formatted after the run: printf between ticks would evict the
@@ -187,6 +212,24 @@ ExploreSummary run_explore(const ExploreOptions& o) {
                     {"multires", is.times.multires_ms}, {"tree", is.times.tree_ms}};
   write_text(out / "summary.json", sj.dump(2) + "\n");
   write_overlay(out / "overlay.png", is, s.haptics.level, proxy_path);
+  sum.cues = cues.size();
+  if (!o.audio_out.empty()) {
+    // The earcons on the trace's timeline: tick k sounds at t = k · period (issue 4, item 5).
+    std::string csv = "tick,t_s,kind,curve,speed_m_per_s,level\n";
+    char line[160];
+    for (const audio::CueEvent& e : cues) {
+      std::snprintf(line, sizeof line, "%lld,%.6f,%s,%d,%.6g,%d\n", static_cast<long long>(e.tick),
+                    static_cast<double>(e.tick) * ctp.period_s, audio::cue_kind_name(e.kind), e.curve,
+                    static_cast<double>(e.speed_m_per_s), e.level);
+      csv += line;
+    }
+    write_text(out / "cues.csv", csv);
+    audio::MixerParams mp;
+    mp.earcons.gain = s.audio.earcon_gain;
+    mp.duck_db = s.audio.duck_db;
+    const std::vector<float> wav = audio::render_cue_timeline(cues, ctp.period_s, static_cast<double>(sum.ticks) * ctp.period_s, mp);
+    audio::write_wav(o.audio_out, wav, audio::kSampleRateHz);
+  }
   return sum;
 }
 

@@ -16,6 +16,7 @@ struct ExploreOptions {
   std::string hand = "raster"; ///< "raster" or a CSV file with header t_s,x_m,y_m
   double duration_s = 0.0;     ///< run length [s]; ≤ 0: the hand path's duration + 0.5 s
   std::string config_path;     ///< TOML settings; empty: defaults
+  std::string audio_out;       ///< WAV file for the run's earcons (and cues.csv beside the outputs); empty: none
 };
 
 /// A problem with the run's own arguments or output folder (bad inputs raise their own typed errors:
@@ -31,6 +32,7 @@ struct ExploreSummary {
   long free_ticks = 0, edge_ticks = 0, vertex_ticks = 0;
   double max_force_n = 0.0;
   std::size_t curves = 0;
+  std::size_t cues = 0;        ///< audio cues emitted (counted with or without --audio-out)
 };
 
 /// Runs explore. Throws on bad input with a one-line message naming the input and the limit.

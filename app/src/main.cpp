@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   explore->add_option("--hand", eo.hand, "Model hand: 'raster' or a CSV file with header t_s,x_m,y_m")->default_val("raster");
   explore->add_option("--duration", eo.duration_s, "Run length [s]; default: the hand path's length")->check(CLI::PositiveNumber);
   explore->add_option("--config", eo.config_path, "Settings file (TOML)");
+  explore->add_option("--audio-out", eo.audio_out, "Also render the run's earcons to this WAV file (tick k at t = k / servo rate)");
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -64,12 +64,13 @@ constexpr FieldDescriptor make_field(std::string_view table, std::string_view ke
 constexpr std::array<std::string_view, 1> kDeviceTypes{"simulated"};
 constexpr double kTwoPow31 = 2147483648.0;
 
-constexpr std::array<detail::TableInfo, 5> kTables{{
+constexpr std::array<detail::TableInfo, 6> kTables{{
     {"haptics", "Force rendering and the servo loop."},
     {"device", "Which device drives the handle, and the simulated pantograph's physics."},
     {"hand", "The model hand that drives the simulated pantograph in headless runs."},
     {"vision", "Image intake limits, edge detection and linking."},
     {"workspace", "The device's usable rectangle, centred on the workspace origin."},
+    {"audio", "Earcons, speech and volume."},
 }};
 
 constexpr auto kFields = std::to_array<FieldDescriptor>({
@@ -109,6 +110,13 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     // [workspace]
     HK_FIELD(workspace, width_m, 0.01, 1, "m", "Width of the usable rectangle."),
     HK_FIELD(workspace, height_m, 0.01, 1, "m", "Height of the usable rectangle."),
+    // [audio]
+    HK_FIELD(audio, volume_default_step, 1, 10, "", "Volume step at the start of every session (10 = loudest)."),
+    HK_FIELD(audio, volume_step_db, 1, 6, "dB", "Loudness change per volume step."),
+    HK_FIELD(audio, earcon_gain, 0, 1, "", "Level of the earcons before the volume."),
+    HK_FIELD(audio, duck_db, -40, 0, "dB", "Earcons are this much quieter while speech plays."),
+    HK_FIELD(audio, speech_rate_wpm, 80, 450, "words/min", "Speaking rate."),
+    HK_FIELD(audio, buffer_frames, 32, 4096, "frames", "Audio output buffer at 48 kHz (256 = 5.3 ms)."),
 });
 
 #undef HK_FIELD

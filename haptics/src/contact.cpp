@@ -106,6 +106,7 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
   const Scene& sc = *scene_;
   const ContactState before = state_;
   out.events = kEventNone;
+  out.corner_turn_rad = 0.0;
   out.query = QueryStats{};
   out.queries = 0;
   out.path_count = 0;
@@ -152,6 +153,8 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
           state_ = ContactState::Vertex;  // a second wall while sliding
           c_[1] = hit;
           out.events |= kEventVertexBegin;
+          const SegGeom gh = geom(sc, hit.seg);  // the angle between the two walls' lines, in [0, π/2]
+          out.corner_turn_rad = std::max(out.corner_turn_rad, std::atan2(std::fabs(cross(g.u, gh.u)), std::fabs(dot(g.u, gh.u))));
           break;
         }
         if (clamped == 0) {
@@ -170,11 +173,13 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
         const Vec2 u_out = clamped > 0 ? gn.u : g.u;
         const double turn = side * cross(u_in, u_out);
         const bool pen_nb = side * dot(gn.n, h - gn.a) < 0.0;
+        const double turn_rad = std::atan2(std::fabs(turn), dot(u_in, u_out));  // how sharply the curve turns at V
         if (turn > 0.0) {  // concave on the proxy's side: the two walls hold it
           if (pen_nb) {
             state_ = ContactState::Vertex;
             c_[1] = Constraint{nb, side};
             out.events |= kEventVertexBegin;
+            out.corner_turn_rad = std::max(out.corner_turn_rad, turn_rad);
           } else {
             rest = true;
           }
@@ -182,7 +187,10 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
         }
         // Convex (or straight): step round the corner to the bisector of the two normals, then go on
         // along the next edge if the handle is behind it, or leave it.
-        if (turn < 0.0) out.events |= kEventConvexCorner;
+        if (turn < 0.0) {
+          out.events |= kEventConvexCorner;
+          out.corner_turn_rad = std::max(out.corner_turn_rad, turn_rad);
+        }
         const Vec2 bis = normalized_or(g.n + gn.n, clamped > 0 ? g.u : -g.u);
         const Move mc = move_to(v + (side * skin) * bis, level_, nullptr, 0, in.budget, out, &hit);
         if (mc == Move::Blocked) {

@@ -65,6 +65,12 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"vision", "max_image_side_px", 64, 10000, true},
       {"workspace", "width_m", 0.01, 1, false},
       {"workspace", "height_m", 0.01, 1, false},
+      {"audio", "volume_default_step", 1, 10, true},
+      {"audio", "volume_step_db", 1, 6, false},
+      {"audio", "earcon_gain", 0, 1, false},
+      {"audio", "duck_db", -40, 0, false},
+      {"audio", "speech_rate_wpm", 80, 450, true},
+      {"audio", "buffer_frames", 32, 4096, true},
   };
   return specs;
 }

@@ -73,6 +73,19 @@ struct WorkspaceSettings {
   bool operator==(const WorkspaceSettings&) const = default;
 };
 
+/// [audio] — earcons, speech and volume (audio-cues).
+struct AudioSettings {
+  int volume_default_step = 7;            ///< key volume_default_step, volume at the start of every session, [1, 10] (10 = loudest)
+  double volume_step_db = 3.0;            ///< key volume_step_db, loudness change per volume step, [1, 6] dB
+  double earcon_gain = 0.5;               ///< key earcon_gain, level of the earcons before the volume, [0, 1]
+  double duck_db = -14.0;                 ///< key duck_db, earcons are this much quieter while speech plays, [-40, 0] dB
+  int speech_rate_wpm = 165;              ///< key speech_rate_wpm, speaking rate, [80, 450] words/min
+  int buffer_frames = 256;                ///< key buffer_frames, audio output buffer, [32, 4096] frames (at 48 kHz: 256 = 5.3 ms)
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const AudioSettings&) const = default;
+};
+
 /// All settings. Default-constructed = the shipped defaults.
 struct Settings {
   HapticsSettings haptics;
@@ -80,6 +93,7 @@ struct Settings {
   HandSettings hand;
   VisionSettings vision;
   WorkspaceSettings workspace;
+  AudioSettings audio;
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const Settings&) const = default;

@@ -63,6 +63,10 @@ struct ContactOutput {
   SegmentRef constraint[2];          ///< active constraints (edge: [0]; vertex: [0] and [1])
   std::int32_t level = -1;           ///< level whose polyline constrained the proxy (−1 when free)
   std::uint32_t events = kEventNone; ///< HapticEvent flags
+  /// Sharpest turn of the corners met this tick (convex corners passed, the corner of a vertex contact
+  /// entered) [rad], 0 when none: the direction change of the polyline there, in [0, π]. Lets sound and
+  /// display mark only the corners a hand would call corners, not every vertex of a smooth curve.
+  double corner_turn_rad = 0.0;
   QueryStats query;                  ///< summed over this step's queries
   std::int32_t queries = 0;
   /// The proxy's path within the tick: path_m[0] is where it started, then the end of every move

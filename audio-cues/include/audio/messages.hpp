@@ -1,0 +1,68 @@
+#pragma once
+/// @file messages.hpp
+/// Everything the kiosk says, in one catalogue (issue 4, item 6). The English text lives in
+/// audio-cues/messages/en.toml and is compiled in; a translation is a copy of that file with the
+/// right-hand sides translated, loaded with MessageCatalog::load().
+
+#include <array>
+#include <initializer_list>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+
+namespace hk::audio {
+
+/// The messages. Their keys in the TOML file are kMessageKeys[id].
+enum class MessageId : int {
+  welcome, attract, help, picture_loaded, picture_loaded_one, picture_empty, describe,
+  level_finer, level_coarser, level_finest, level_coarsest, volume_up, volume_down, volume_limit,
+  tutorial_start, tutorial_circle, tutorial_triangle, tutorial_done, timeout_warning, goodbye,
+  no_audio_device,
+};
+inline constexpr int kMessageCount = 21;
+
+/// TOML key of every MessageId, in enum order.
+inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
+    "welcome", "attract", "help", "picture_loaded", "picture_loaded_one", "picture_empty", "describe",
+    "level_finer", "level_coarser", "level_finest", "level_coarsest", "volume_up", "volume_down", "volume_limit",
+    "tutorial_start", "tutorial_circle", "tutorial_triangle", "tutorial_done", "timeout_warning", "goodbye",
+    "no_audio_device"};
+
+/// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
+/// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".
+class MessageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A named value for a {placeholder}.
+using MessageArg = std::pair<std::string_view, std::string>;
+
+/// The texts of one language.
+class MessageCatalog {
+ public:
+  /// The compiled-in English catalogue (never throws: it is checked by the tests).
+  static const MessageCatalog& english();
+  /// Loads a translation. Every key of the English file must be there, no other key may be, every value is
+  /// a non-empty string of at most 1000 bytes, and it may use only the placeholders its English text uses.
+  /// @throws MessageError (one line: the file and the key at fault).
+  static MessageCatalog load(const std::string& path);
+  /// Parses catalogue text (`source` names it in errors). @throws MessageError.
+  static MessageCatalog parse(std::string_view toml_text, const std::string& source);
+
+  /// The text of `id` with each {name} replaced by its argument; unknown names are left as they are.
+  std::string text(MessageId id, std::initializer_list<MessageArg> args = {}) const;
+  /// The raw text (placeholders unexpanded).
+  const std::string& raw(MessageId id) const { return texts_[static_cast<std::size_t>(id)]; }
+  /// espeak-ng voice for this language (e.g. "en", "de").
+  const std::string& voice() const { return voice_; }
+  /// Language name as the file gives it.
+  const std::string& language() const { return language_; }
+
+ private:
+  std::array<std::string, kMessageCount> texts_;
+  std::string voice_, language_;
+};
+
+}  // namespace hk::audio
