@@ -23,6 +23,16 @@ min_time=0.5
 "$b/bench_anytime" --out "$out/anytime.json" 2>/dev/null
 [ -x "$b/bench_accuracy" ] && "$b/bench_accuracy" --images "$root/tests/data/images" --out "$out/accuracy.json"
 [ -x "$b/bench_stability" ] && "$b/bench_stability" $quick --out "$out/stability.json"
+"$b/bench_earcon_latency" --out "$out/earcon_latency.json" > "$out/earcon_latency.md"
+"$b/bench_audio_latency" > "$out/audio_latency.json" 2>/dev/null || true
+# The latency table (the first table of earcon_latency.md) goes between its markers in PERFORMANCE.md.
+/usr/bin/python3 - "$out/earcon_latency.md" "$root/docs/PERFORMANCE.md" <<'PY'
+import re, sys
+table = open(sys.argv[1]).read().strip().split("\n\n")[0]
+doc = open(sys.argv[2]).read()
+doc = re.sub(r"(<!-- BEGIN earcon_latency -->\n).*?(\n<!-- END earcon_latency -->)", lambda m: m.group(1) + table + m.group(2), doc, flags=re.S)
+open(sys.argv[2], "w").write(doc)
+PY
 /usr/bin/python3 "$root/bench/plot_bench.py" "$out" "$root/docs/PERFORMANCE.md"
 /usr/bin/python3 "$root/bench/plot_accuracy.py" "$out/accuracy.json" --outdir "$out"
 if [ -f "$out/stability.json" ]; then

@@ -91,7 +91,10 @@ std::size_t SpeechStream::read(float* out, std::size_t frames) noexcept {
     speaking_.store(true, std::memory_order_relaxed);
   }
   if (n < frames) std::memset(out + n, 0, (frames - n) * sizeof(float));
-  if (!have_current_ && spoken == 0) speaking_.store(false, std::memory_order_relaxed);
+  // Still speaking while a block of the current utterance plays or waits in the ring (the producer may be
+  // behind the consumer for a moment without the utterance being over).
+  const bool more = (have_current_ && current_.generation == gen && offset_ < current_.count) || ring_.size() > 0;
+  speaking_.store(more || (spoken > 0 && !(have_current_ && current_.last)), std::memory_order_relaxed);
   return spoken;
 }
 

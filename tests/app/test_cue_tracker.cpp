@@ -69,7 +69,9 @@ TEST(CueTracker, SlideCuesEveryFiveTicksWithTheProxySpeed) {
   for (int k = 1; k <= 20; ++k) r.step(ContactState::Edge, 0, {0.00005 * k, 0});  // 0.05 m/s
   ASSERT_EQ(r.count(CueKind::Slide), 4);
   for (const CueEvent& e : r.cues) {
-    if (e.kind == CueKind::Slide) EXPECT_NEAR(e.speed_m_per_s, 0.05, 1e-6);
+    if (e.kind == CueKind::Slide) {
+      EXPECT_NEAR(e.speed_m_per_s, 0.05, 1e-6);
+    }
   }
   // Vertex contact is not sliding.
   const int before = r.count(CueKind::Slide);
