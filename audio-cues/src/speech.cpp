@@ -1,0 +1,309 @@
+#include "audio/speech.hpp"
+
+#include <espeak-ng/speak_lib.h>
+#include <samplerate.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <optional>
+
+namespace hk::audio {
+namespace {
+
+/// Receives resampled speech; returns false to stop the synthesis (the utterance was cancelled).
+using Sink = std::function<bool(const float*, std::size_t)>;
+
+/// The one lock around every espeak-ng call (and the globals below).
+std::mutex& espeak_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+/// The synthesis in progress, reached from espeak-ng's callback (guarded by espeak_mutex()).
+struct Synthesis {
+  SRC_STATE* src = nullptr;
+  double ratio = 1.0;  // kSampleRateHz / espeak-ng's rate
+  Sink sink;
+  std::vector<float> in, out;
+  bool stopped = false;            // the sink asked to stop, or an error: abort espeak-ng
+  std::string error;               // a resampler error
+  std::exception_ptr exception;    // thrown by the sink inside the C callback; rethrown after it
+};
+Synthesis* g_current = nullptr;
+std::optional<SpeechParams> g_configured;  // what espeak-ng is set to now (nullopt: unknown)
+
+/// Converts `n` int16 samples to float, resamples them and hands them to the sink. `last` flushes the
+/// resampler's tail. Returns false to stop (sink said so, or a resampler error in s.error).
+bool feed(Synthesis& s, const short* pcm, std::size_t n, bool last) {
+  s.in.resize(std::max<std::size_t>(n, 1));  // never a null data_in
+  for (std::size_t i = 0; i < n; ++i) s.in[i] = static_cast<float>(pcm[i]) / 32768.0f;
+  s.out.resize(static_cast<std::size_t>(static_cast<double>(n) * s.ratio) + 256);
+  SRC_DATA d{};
+  d.src_ratio = s.ratio;
+  d.end_of_input = last ? 1 : 0;
+  std::size_t used = 0;
+  for (;;) {
+    d.data_in = s.in.data() + used;
+    d.input_frames = static_cast<long>(n - used);
+    d.data_out = s.out.data();
+    d.output_frames = static_cast<long>(s.out.size());
+    if (const int err = src_process(s.src, &d); err != 0) {
+      s.error = std::string("speech: resampling failed (libsamplerate: ") + src_strerror(err) + ")";
+      return false;
+    }
+    used += static_cast<std::size_t>(d.input_frames_used);
+    const auto got = static_cast<std::size_t>(d.output_frames_gen);
+    // A sinc resampler overshoots a full-scale step a little: keep the promise of [-1, 1].
+    for (std::size_t i = 0; i < got; ++i) s.out[i] = std::clamp(s.out[i], -1.0f, 1.0f);
+    if (got > 0 && !s.sink(s.out.data(), got)) return false;
+    if (used >= n && (!last || got == 0)) return true;
+    if (d.input_frames_used == 0 && got == 0) return true;  // no progress possible (guard)
+  }
+}
+
+/// espeak-ng's synth callback (AUDIO_OUTPUT_SYNCHRONOUS: called on the synthesising thread, inside
+/// espeak_Synth). pcm == nullptr marks the end. Returns 1 to abort the synthesis.
+int on_samples(short* pcm, int n, espeak_EVENT* /*events*/) {
+  Synthesis* s = g_current;
+  if (s == nullptr || s->stopped) return 1;
+  if (pcm == nullptr || n <= 0) return 0;
+  try {
+    if (!feed(*s, pcm, static_cast<std::size_t>(n), false)) s->stopped = true;
+  } catch (...) {  // never let an exception cross espeak-ng's C frames
+    s->exception = std::current_exception();
+    s->stopped = true;
+  }
+  return s->stopped ? 1 : 0;
+}
+
+/// Initialises espeak-ng once per process; returns its sample rate [Hz]. Caller holds espeak_mutex().
+int native_rate_locked() {
+  static const int rate = [] {
+    // 100 ms buffers: ~2200 samples per callback, the granularity of streaming and of stopping.
+    // nullptr path: espeak-ng's default data directory (Debian: /usr/lib/x86_64-linux-gnu/espeak-ng-data).
+    const int r = espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 100, nullptr, espeakINITIALIZE_DONT_EXIT);
+    if (r > 0) espeak_SetSynthCallback(&on_samples);
+    return r;
+  }();
+  if (rate <= 0) throw SpeechError("speech: espeak-ng could not start (is the espeak-ng-data package installed?)");
+  return rate;
+}
+
+void check_text(std::string_view text) {
+  if (text.size() > kMaxSpeechTextBytes) {
+    throw SpeechError("speech: text of " + std::to_string(text.size()) + " bytes is over the limit of " +
+                      std::to_string(kMaxSpeechTextBytes) + " bytes");
+  }
+}
+
+void check_params(const SpeechParams& p) {
+  if (p.rate_wpm < espeakRATE_MINIMUM || p.rate_wpm > espeakRATE_MAXIMUM) {
+    throw SpeechError("speech: rate_wpm " + std::to_string(p.rate_wpm) + " words/min is outside [" +
+                      std::to_string(espeakRATE_MINIMUM) + ", " + std::to_string(espeakRATE_MAXIMUM) + "]");
+  }
+  if (p.pitch < 0 || p.pitch > 100) throw SpeechError("speech: pitch " + std::to_string(p.pitch) + " is outside [0, 100]");
+  if (p.voice.empty() || p.voice.size() > 64 || p.voice.find_first_of(std::string_view("\0\n\r", 3)) != std::string::npos) {
+    throw SpeechError("speech: voice name '" + p.voice.substr(0, 64) + "' must be 1 to 64 characters on one line");
+  }
+}
+
+/// Sets voice, rate and pitch (skipped when espeak-ng is already set so). Caller holds espeak_mutex().
+void configure_locked(const SpeechParams& p) {
+  check_params(p);
+  native_rate_locked();
+  if (g_configured == p) return;
+  g_configured.reset();  // a refusal below leaves espeak-ng half set
+  if (espeak_SetVoiceByName(p.voice.c_str()) != EE_OK) throw SpeechError("speech: espeak-ng has no voice '" + p.voice + "'");
+  if (espeak_SetParameter(espeakRATE, p.rate_wpm, 0) != EE_OK) {
+    throw SpeechError("speech: espeak-ng refused rate_wpm " + std::to_string(p.rate_wpm));
+  }
+  if (espeak_SetParameter(espeakPITCH, p.pitch, 0) != EE_OK) {
+    throw SpeechError("speech: espeak-ng refused pitch " + std::to_string(p.pitch));
+  }
+  g_configured = p;
+}
+
+/// Synthesises `text` (non-empty) into `sink` at kSampleRateHz. Caller holds espeak_mutex() and has
+/// configured. Returns normally also when the sink stopped it.
+void synthesize_locked(const std::string& text, Sink sink) {
+  int err = 0;
+  std::unique_ptr<SRC_STATE, SRC_STATE* (*)(SRC_STATE*)> src(src_new(SRC_SINC_FASTEST, 1, &err), &src_delete);
+  if (!src) throw SpeechError(std::string("speech: resampler could not start (libsamplerate: ") + src_strerror(err) + ")");
+  Synthesis s;
+  s.src = src.get();
+  s.ratio = static_cast<double>(kSampleRateHz) / native_rate_locked();
+  s.sink = std::move(sink);
+  g_current = &s;
+  const espeak_ERROR r =
+      espeak_Synth(text.c_str(), text.size() + 1, 0, POS_CHARACTER, 0, espeakCHARS_UTF8, nullptr, nullptr);
+  g_current = nullptr;
+  if (s.exception) std::rethrow_exception(s.exception);
+  if (!s.error.empty()) throw SpeechError(s.error);
+  if (s.stopped) return;  // cancelled
+  if (r != EE_OK) throw SpeechError("speech: espeak-ng could not synthesise the text (espeak_Synth error " + std::to_string(r) + ")");
+  const short none = 0;
+  feed(s, &none, 0, true);  // the resampler's tail
+  if (!s.error.empty()) throw SpeechError(s.error);
+}
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+std::vector<float> synthesize_speech(std::string_view text, const SpeechParams& params) {
+  check_text(text);
+  std::lock_guard<std::mutex> lock(espeak_mutex());
+  configure_locked(params);
+  std::vector<float> out;
+  if (text.empty()) return out;
+  synthesize_locked(std::string(text), [&](const float* x, std::size_t n) {
+    out.insert(out.end(), x, x + n);
+    return true;
+  });
+  return out;
+}
+
+Speaker::Speaker(SpeechStream& stream, const SpeechParams& params) : stream_(stream), params_(params) {
+  {
+    std::lock_guard<std::mutex> lock(espeak_mutex());
+    configure_locked(params_);  // refuse a bad voice now, not later in the worker
+  }
+  worker_ = std::thread([this] { run(); });
+}
+
+Speaker::~Speaker() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    stop_ = true;
+    has_job_ = false;
+    stream_.cancel();  // the worker's sink sees it and aborts espeak-ng
+  }
+  cv_.notify_all();
+  worker_.join();
+}
+
+void Speaker::submit(std::string text) {
+  // Under m_, so two concurrent say() calls queue in the order of their generations.
+  job_generation_ = stream_.cancel();
+  has_job_ = !text.empty();
+  log_.emplace_back(steady_ns(), text);
+  while (log_.size() > kLogEntries) log_.pop_front();
+  if (!text.empty()) {
+    last_ = text;
+    job_text_ = std::move(text);
+  }
+}
+
+void Speaker::say(std::string text) {
+  check_text(text);
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    submit(std::move(text));
+  }
+  cv_.notify_all();
+}
+
+void Speaker::repeat() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    if (last_.empty()) return;
+    submit(last_);
+  }
+  cv_.notify_all();
+}
+
+void Speaker::cancel() {
+  std::lock_guard<std::mutex> lock(m_);
+  has_job_ = false;
+  stream_.cancel();
+}
+
+bool Speaker::busy() const {
+  std::lock_guard<std::mutex> lock(m_);
+  if (working_ || has_job_ || stream_.speaking()) return true;
+  return handed_ && handed_generation_ == stream_.generation() &&
+         steady_ns() - handed_at_ns_ < static_cast<std::int64_t>(kHandOverGrace * 1e9);
+}
+
+bool Speaker::wait_idle(double timeout_s) {
+  std::unique_lock<std::mutex> lock(m_);
+  return cv_.wait_for(lock, std::chrono::duration<double>(std::max(timeout_s, 0.0)),
+                      [this] { return !working_ && !has_job_; });
+}
+
+std::string Speaker::last_text() const {
+  std::lock_guard<std::mutex> lock(m_);
+  return last_;
+}
+
+std::vector<std::pair<std::int64_t, std::string>> Speaker::log() const {
+  std::lock_guard<std::mutex> lock(m_);
+  return {log_.begin(), log_.end()};
+}
+
+void Speaker::run() {
+  const auto retry = std::chrono::duration<double>(kFullRingRetry);
+  for (;;) {
+    std::string text;
+    std::uint32_t gen = 0;
+    {
+      std::unique_lock<std::mutex> lock(m_);
+      cv_.wait(lock, [this] { return stop_ || has_job_; });
+      if (stop_) return;
+      text = std::move(job_text_);
+      gen = job_generation_;
+      has_job_ = false;
+      working_ = true;
+    }
+    bool finished = false;
+    if (gen == stream_.generation()) {
+      try {
+        {
+          std::lock_guard<std::mutex> lock(espeak_mutex());
+          configure_locked(params_);
+          synthesize_locked(text, [&](const float* x, std::size_t n) {
+            // Hand the samples to the mixer; when its ring is full, wait for the callback to make room.
+            while (n > 0) {
+              std::size_t taken = 0;
+              const bool ok = stream_.push(gen, x, n, &taken);
+              x += taken;
+              n -= taken;
+              if (ok) break;
+              if (stream_.generation() != gen) return false;  // cancelled: abort espeak-ng now
+              std::this_thread::sleep_for(retry);
+            }
+            return stream_.generation() == gen;
+          });
+        }
+        while (stream_.generation() == gen) {
+          if (stream_.finish(gen)) {
+            finished = true;
+            break;
+          }
+          std::this_thread::sleep_for(retry);
+        }
+      } catch (const std::exception& e) {
+        // Voice and parameters were checked at construction; this is rare (out of memory, espeak-ng error).
+        spdlog::warn("speech: could not say '{}': {}", text.substr(0, 60), e.what());
+      }
+    }
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      working_ = false;
+      if (finished) {
+        handed_ = true;
+        handed_generation_ = gen;
+        handed_at_ns_ = steady_ns();
+      }
+    }
+    cv_.notify_all();
+  }
+}
+
+}  // namespace hk::audio
