@@ -1,9 +1,11 @@
-// haptic-kiosk: command line entry. Subcommands so far: explore (headless run, DESIGN.md contract).
+// haptic-kiosk: command line entry. Subcommands so far: explore (headless run, DESIGN.md contract) and speak
+// (a message or text rendered to WAV).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <string>
 
+#include "audio_settings.hpp"
 #include "explore.hpp"
 
 namespace {
@@ -30,6 +32,12 @@ int main(int argc, char** argv) {
   explore->add_option("--duration", eo.duration_s, "Run length [s]; default: the hand path's length")->check(CLI::PositiveNumber);
   explore->add_option("--config", eo.config_path, "Settings file (TOML)");
   explore->add_option("--audio-out", eo.audio_out, "Also render the run's earcons to this WAV file (tick k at t = k / servo rate)");
+  hk::app::SpeakOptions so;
+  CLI::App* speak = cli.add_subcommand("speak", "Render a message of the catalogue, or any text, as speech into a WAV file");
+  speak->add_option("what", so.what, "A message key (welcome, help, picture_loaded, ...) or text to say")->required();
+  speak->add_option("--wav", so.wav_path, "WAV file to write")->required();
+  speak->add_option("--config", so.config_path, "Settings file (TOML): [audio] speech_rate_wpm");
+  speak->add_option("--messages", so.messages_path, "A translated message catalogue (see audio-cues/messages/en.toml)");
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -40,6 +48,9 @@ int main(int argc, char** argv) {
       const auto sum = hk::app::run_explore(eo);
       std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n", sum.ticks,
                   sum.curves, sum.edge_ticks, sum.vertex_ticks, sum.max_force_n, eo.out_dir.c_str());
+    } else if (*speak) {
+      const std::string text = hk::app::run_speak(so);
+      std::printf("speak: \"%s\" -> %s\n", text.c_str(), so.wav_path.c_str());
     }
   } catch (const std::exception& e) {
     print_error(e.what());

@@ -1,0 +1,40 @@
+#include "audio_settings.hpp"
+
+#include "audio/wav.hpp"
+#include "config/load.hpp"
+
+namespace hk::app {
+
+audio::AudioSystemParams audio_params_from(const config::Settings& s) {
+  audio::AudioSystemParams p;
+  p.mixer.earcons.gain = s.audio.earcon_gain;
+  p.mixer.duck_db = s.audio.duck_db;
+  p.speech.voice.clear();  // the catalogue's voice
+  p.speech.rate_wpm = s.audio.speech_rate_wpm;
+  p.output.frames_per_buffer = s.audio.buffer_frames;
+  p.volume_default_step = s.audio.volume_default_step;
+  p.volume_step_db = s.audio.volume_step_db;
+  return p;
+}
+
+std::string run_speak(const SpeakOptions& o) {
+  const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
+  const audio::MessageCatalog catalog =
+      o.messages_path.empty() ? audio::MessageCatalog::english() : audio::MessageCatalog::load(o.messages_path);
+  std::string text = o.what;
+  for (int i = 0; i < audio::kMessageCount; ++i) {
+    if (audio::kMessageKeys[static_cast<std::size_t>(i)] == o.what) {
+      // Sample values for the placeholders, so a translator hears a whole sentence.
+      text = catalog.text(static_cast<audio::MessageId>(i), {{"picture", "2"}, {"pictures", "5"}, {"shapes", "7"}, {"level", "3"},
+                                                             {"seconds", "20"}, {"description", "A large closed shape in the middle."}});
+    }
+  }
+  audio::SpeechParams sp;
+  sp.voice = catalog.voice();
+  sp.rate_wpm = s.audio.speech_rate_wpm;
+  const std::vector<float> samples = audio::synthesize_speech(text, sp);
+  audio::write_wav(o.wav_path, samples, audio::kSampleRateHz);
+  return text;
+}
+
+}  // namespace hk::app

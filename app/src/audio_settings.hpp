@@ -1,0 +1,30 @@
+#pragma once
+/// @file audio_settings.hpp
+/// [audio] settings → the audio side's parameters, and the headless `speak` command that renders a
+/// message or a text to a WAV file (to hear a translation or a voice without a sound card).
+
+#include <stdexcept>
+#include <string>
+
+#include "audio/system.hpp"
+#include "config/settings.hpp"
+
+namespace hk::app {
+
+/// The audio side's parameters from the settings (volume, earcon level, ducking, speech rate, buffer).
+audio::AudioSystemParams audio_params_from(const config::Settings& s);
+
+/// What `haptic-kiosk speak` was asked to do.
+struct SpeakOptions {
+  std::string what;           ///< a message key of the catalogue (e.g. "welcome") or free text
+  std::string wav_path;       ///< output WAV
+  std::string config_path;    ///< TOML settings; empty: defaults
+  std::string messages_path;  ///< a translated catalogue; empty: English
+};
+
+/// Renders the speech of `options.what` to `options.wav_path` (a message's placeholders get sample values:
+/// picture 2 of 5, 7 shapes, 20 seconds, ...). Returns the spoken text.
+/// @throws config::ConfigError, audio::MessageError, audio::SpeechError, audio::WavError (one line each).
+std::string run_speak(const SpeakOptions& options);
+
+}  // namespace hk::app

@@ -1,0 +1,91 @@
+#pragma once
+/// @file system.hpp
+/// The kiosk's whole audio side in one object (issue 4): the cue ring the servo thread fills, the mixer
+/// (earcons + speech, ducking, volume), the espeak-ng speaker, the message catalogue and the PortAudio
+/// output. Any part that cannot start (no sound card, no espeak-ng data) is logged once and the rest goes
+/// on: a kiosk without a speaker still renders forces, and tests run it headless and pull render().
+
+#include <cstdint>
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "audio/cue_event.hpp"
+#include "audio/messages.hpp"
+#include "audio/mixer.hpp"
+#include "audio/output.hpp"
+#include "audio/speech.hpp"
+#include "audio/speech_stream.hpp"
+#include "audio/spsc_ring.hpp"
+#include "audio/volume.hpp"
+
+namespace hk::audio {
+
+/// Everything the audio side is configured with. Units in names.
+struct AudioSystemParams {
+  MixerParams mixer;
+  SpeechParams speech;              ///< voice: empty = the catalogue's voice
+  OutputParams output;
+  int volume_default_step = 7;      ///< [1, 10]
+  double volume_step_db = 3.0;      ///< [dB]
+  std::size_t cue_capacity = 4096;  ///< cue ring entries (4 s of cues at 1 kHz)
+  bool open_output = true;          ///< false: no PortAudio; the caller pulls render() (headless runs, tests)
+  std::string messages_file;        ///< a translated catalogue; empty: English, built in
+};
+
+/// The audio side. Construct and destroy on the kiosk's main thread.
+class AudioSystem {
+ public:
+  /// @throws MessageError if `messages_file` is given and cannot be used (the operator's mistake: say so).
+  ///         Never throws for a missing sound card or speech engine (logged; running without).
+  explicit AudioSystem(const AudioSystemParams& params);
+  ~AudioSystem();
+  AudioSystem(const AudioSystem&) = delete;
+  AudioSystem& operator=(const AudioSystem&) = delete;
+
+  /// The ring the servo thread pushes cues into (its only producer). Real-time safe to push.
+  SpscRing<CueEvent>& cues() noexcept { return cues_; }
+
+  /// Speaks message `id` (placeholders filled from `args`), cutting off whatever is being said. Returns at once.
+  void say(MessageId id, std::initializer_list<MessageArg> args = {});
+  /// Speaks free text (e.g. a picture description), cutting off whatever is being said.
+  void say_text(std::string text);
+  /// Says the last text again.
+  void repeat();
+  /// Stops speech now.
+  void stop_speech();
+  /// Volume one step up / down; false at the limit (the kiosk then says volume_limit).
+  bool volume_up() noexcept { return volume_.up(); }
+  bool volume_down() noexcept { return volume_.down(); }
+  /// A new visitor: volume back to the operator's default, speech stopped.
+  void new_session();
+
+  /// Headless: pulls `frames` samples of the mix (only when open_output was false; otherwise PortAudio pulls).
+  void render(float* out, std::size_t frames) noexcept { mixer_.render(out, frames); }
+
+  const Volume& volume() const noexcept { return volume_; }
+  const MessageCatalog& messages() const noexcept { return catalog_; }
+  /// True if sound reaches a device.
+  bool sound_output() const { return output_ && output_->running(); }
+  /// The output's state (why_not when there is none); null if open_output was false.
+  const OutputInfo* output_info() const { return output_ ? &output_->info() : nullptr; }
+  /// True if espeak-ng started.
+  bool speech_available() const noexcept { return speaker_ != nullptr; }
+  /// Every text spoken, with its steady-clock time [ns] (empty without speech).
+  std::vector<std::pair<std::int64_t, std::string>> speech_log() const;
+  /// Cues dropped because the ring was full.
+  std::uint64_t cues_dropped() const noexcept { return cues_.overflows(); }
+
+ private:
+  MessageCatalog catalog_;
+  SpscRing<CueEvent> cues_;
+  SpeechStream speech_stream_;
+  Volume volume_;
+  Mixer mixer_;
+  std::unique_ptr<Speaker> speaker_;
+  std::unique_ptr<AudioOutput> output_;
+};
+
+}  // namespace hk::audio

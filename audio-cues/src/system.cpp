@@ -1,0 +1,56 @@
+#include "audio/system.hpp"
+
+#include <spdlog/spdlog.h>
+
+namespace hk::audio {
+
+namespace {
+
+MessageCatalog load_catalog(const std::string& file) { return file.empty() ? MessageCatalog::english() : MessageCatalog::load(file); }
+
+}  // namespace
+
+AudioSystem::AudioSystem(const AudioSystemParams& p)
+    : catalog_(load_catalog(p.messages_file)),
+      cues_(p.cue_capacity),
+      volume_(p.volume_default_step, 10, p.volume_step_db),
+      mixer_(p.mixer, &cues_, &speech_stream_, &volume_) {
+  SpeechParams sp = p.speech;
+  if (sp.voice.empty()) sp.voice = catalog_.voice();
+  try {
+    speaker_ = std::make_unique<Speaker>(speech_stream_, sp);
+  } catch (const SpeechError& e) {
+    spdlog::warn("audio: no speech ({}); the kiosk continues with earcons only", e.what());
+  }
+  if (p.open_output) output_ = std::make_unique<AudioOutput>(mixer_, p.output);  // logs its own state
+}
+
+AudioSystem::~AudioSystem() {
+  output_.reset();  // stop the callback before the mixer and the stream go
+  speaker_.reset();
+}
+
+void AudioSystem::say(MessageId id, std::initializer_list<MessageArg> args) { say_text(catalog_.text(id, args)); }
+
+void AudioSystem::say_text(std::string text) {
+  if (speaker_) speaker_->say(std::move(text));
+}
+
+void AudioSystem::repeat() {
+  if (speaker_) speaker_->repeat();
+}
+
+void AudioSystem::stop_speech() {
+  if (speaker_) speaker_->cancel();
+}
+
+void AudioSystem::new_session() {
+  volume_.reset();
+  stop_speech();
+}
+
+std::vector<std::pair<std::int64_t, std::string>> AudioSystem::speech_log() const {
+  return speaker_ ? speaker_->log() : std::vector<std::pair<std::int64_t, std::string>>{};
+}
+
+}  // namespace hk::audio

@@ -1,0 +1,94 @@
+// The audio side as the kiosk uses it: messages spoken through the mixer, cues from the ring, a new
+// session resetting the volume, no sound card tolerated, a bad translation refused.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+#include <vector>
+
+#include "audio/system.hpp"
+#include "audio_analysis.hpp"
+
+namespace hk::audio {
+namespace {
+
+AudioSystemParams headless() {
+  AudioSystemParams p;
+  p.open_output = false;
+  return p;
+}
+
+// Pulls the mix like an audio callback for `seconds` of audio (sleeping 1 ms between 5 ms buffers so the
+// speech worker keeps ahead).
+std::vector<float> pull(AudioSystem& a, double seconds) {
+  std::vector<float> x(static_cast<std::size_t>(seconds * kSampleRateHz));
+  for (std::size_t i = 0; i < x.size(); i += 240) {
+    a.render(x.data() + i, std::min<std::size_t>(240, x.size() - i));
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  return x;
+}
+
+TEST(AudioSystem, SpeaksCatalogueMessagesThroughTheMix) {
+  AudioSystem a(headless());
+  ASSERT_TRUE(a.speech_available());
+  a.say(MessageId::picture_loaded, {{"picture", "1"}, {"pictures", "4"}, {"shapes", "3"}});
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const std::vector<float> x = pull(a, 1.0);
+  EXPECT_GT(test::rms(x, 0, x.size()), 0.01) << "the message is heard";
+  const auto log = a.speech_log();
+  ASSERT_EQ(log.size(), 1u);
+  EXPECT_EQ(log[0].second, "Picture 1 of 4. It has 3 shapes.");
+}
+
+TEST(AudioSystem, CuesFromTheRingAreHeard) {
+  AudioSystem a(headless());
+  CueEvent e;
+  e.kind = CueKind::ContactBegin;
+  e.speed_m_per_s = 0.1f;
+  ASSERT_TRUE(a.cues().try_push(e));
+  std::vector<float> x(2400);
+  a.render(x.data(), x.size());
+  EXPECT_GT(test::peak(x, 0, 96), 0.05) << "the click starts in the first buffer after the push";
+  EXPECT_EQ(a.cues_dropped(), 0u);
+}
+
+TEST(AudioSystem, NewSessionResetsTheVolumeAndStopsSpeech) {
+  AudioSystemParams p = headless();
+  p.volume_default_step = 5;
+  AudioSystem a(p);
+  EXPECT_TRUE(a.volume_up());
+  EXPECT_TRUE(a.volume_up());
+  EXPECT_EQ(a.volume().step(), 7);
+  a.say(MessageId::help);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const std::vector<float> before = pull(a, 0.5);
+  ASSERT_GT(test::rms(before, 0, before.size()), 0.01) << "help was being spoken";
+  a.new_session();
+  EXPECT_EQ(a.volume().step(), 5);
+  const std::vector<float> x = pull(a, 0.2);
+  EXPECT_EQ(test::peak(x, 480, x.size()), 0.0) << "speech was cut at the new session";
+}
+
+TEST(AudioSystem, RunsWithoutASoundCard) {
+  AudioSystemParams p;  // open_output = true: on this machine there is no device, on a kiosk there is
+  AudioSystem a(p);
+  ASSERT_NE(a.output_info(), nullptr);
+  if (!a.sound_output()) EXPECT_FALSE(a.output_info()->why_not.empty());
+  a.say(MessageId::welcome);
+  EXPECT_EQ(a.speech_log().size(), 1u);
+}
+
+TEST(AudioSystem, TranslationChoosesItsVoiceAndBadOnesAreRefused) {
+  AudioSystemParams p = headless();
+  p.messages_file = std::string(HK_TEST_DATA_DIR) + "/messages/de.toml";
+  AudioSystem de(p);
+  EXPECT_EQ(de.messages().voice(), "de");
+  de.say(MessageId::volume_up);
+  EXPECT_EQ(de.speech_log().back().second, "Lauter.");
+  p.messages_file = std::string(HK_TEST_DATA_DIR) + "/messages/missing_key.toml";
+  EXPECT_THROW(AudioSystem bad(p), MessageError);
+}
+
+}  // namespace
+}  // namespace hk::audio
