@@ -1,0 +1,86 @@
+#include "servo_core.hpp"
+
+namespace hk::app {
+
+ServoCore::ServoCore(Device& device, const CueTrackerParams& cue_params, audio::SpscRing<audio::CueEvent>* cues)
+    : device_(device), tracker_(cue_params), cues_(cues) {}
+
+ServoCore::~ServoCore() {
+  delete pending_.exchange(nullptr);
+  delete current_;
+  delete to_retire_;
+  collect_retired();
+}
+
+void ServoCore::publish(std::unique_ptr<SceneBundle> bundle) {
+  delete pending_.exchange(bundle.release(), std::memory_order_acq_rel);
+}
+
+int ServoCore::collect_retired() {
+  int n = 0;
+  SceneBundle* b = nullptr;
+  while (retired_.try_pop(b)) {
+    delete b;
+    ++n;
+  }
+  return n;
+}
+
+TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
+  ServoInput in;
+  in.sample = device_.read();
+  in.now_ns = now_ns;
+  in.deadline_missed = deadline_missed;
+
+  // Hand back a bundle that found no room in the ring last time.
+  if (to_retire_ && retired_.try_push(to_retire_)) to_retire_ = nullptr;
+  // A new picture waits while the old one's force fades out over the force ramp time (a wall must not
+  // vanish under a pressing hand in one tick); then it is taken and started at the handle (proxy there,
+  // force ramped in from zero by the guard), and the old one is retired.
+  if (!fading_ && current_ && pending_.load(std::memory_order_acquire) != nullptr) {
+    const ServoParams& p = current_->loop.params();
+    fade_total_ = p.guard.ramp_s > 0.0 ? static_cast<long>(p.guard.ramp_s / p.period_s + 0.5) : 0;
+    fade_left_ = fade_total_;
+    fading_ = fade_total_ > 0;
+  }
+  if (fading_ && fade_left_ > 0) --fade_left_;
+  if (!to_retire_ && (!fading_ || fade_left_ == 0)) {
+    if (SceneBundle* next = pending_.exchange(nullptr, std::memory_order_acq_rel)) {
+      fading_ = false;
+      if (current_ && !retired_.try_push(current_)) to_retire_ = current_;
+      current_ = next;
+      current_->loop.start(in.sample.handle_m);
+      tracker_.reset();
+    }
+  }
+
+  TickResult r = TickResult::Ok;
+  if (current_) {
+    r = current_->loop.update(in, out_);
+  } else {
+    out_ = ServoOutput{};
+    out_.contact.proxy_m = in.sample.handle_m;
+  }
+  if (fading_ && fade_total_ > 0) out_.force_n = (static_cast<double>(fade_left_) / static_cast<double>(fade_total_)) * out_.force_n;
+  device_.write_force(out_.force_n);
+
+  if (current_) {
+    audio::CueEvent c[CueTracker::kMaxCuesPerTick];
+    const int n = tracker_.update(tick_, out_, in.sample.handle_m, current_->loop.params().level, c);
+    for (int i = 0; cues_ && i < n; ++i) cues_->try_push(c[i]);  // a full ring drops and counts
+  }
+
+  ServoDisplayState& d = display_.back();
+  d.tick = tick_;
+  d.handle_m = in.sample.handle_m;
+  d.proxy_m = out_.contact.proxy_m;
+  d.force_n = out_.force_n;
+  d.state = out_.contact.state;
+  d.curve = out_.contact.state == ContactState::Free ? -1 : out_.contact.constraint[0].curve;
+  d.level = current_ ? current_->loop.params().level : 0;
+  d.scene_id = current_ ? current_->id : -1;
+  ++tick_;
+  return r;
+}
+
+}  // namespace hk::app

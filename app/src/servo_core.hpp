@@ -1,0 +1,95 @@
+#pragma once
+/// @file servo_core.hpp
+/// What the kiosk's servo thread does each tick (issue 5, item 2; DESIGN.md "Data flow", "Real-time
+/// rules"): read the device, swap in a newly published picture, run the servo loop, write the force, push
+/// audio cues, publish the display state. Deterministic and clock-free, so tests drive it tick by tick;
+/// ServoThread (servo_thread.hpp) calls it on time.
+///
+/// A picture crosses threads as a SceneBundle built on another thread (the scene and a ServoLoop sized for
+/// it: all allocation happens there). publish() hands it over with one atomic exchange. The servo thread
+/// first fades the old picture's force to zero over the force ramp time (guard.ramp_s), so a wall never
+/// vanishes under a pressing hand in one tick; then it takes the new bundle, places the proxy where the
+/// handle is (ServoLoop::start: outside every curve, forces ramped in from zero by the force guard), and
+/// passes the previous bundle back through a small ring, so it is freed outside the servo thread
+/// (collect_retired()). Every force step of a swap is thus at most max_force_n · period / ramp_s.
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+#include "audio/cue_event.hpp"
+#include "audio/spsc_ring.hpp"
+#include "cue_tracker.hpp"
+#include "haptics/device.hpp"
+#include "haptics/scene.hpp"
+#include "haptics/servo.hpp"
+#include "haptics/triple_buffer.hpp"
+
+namespace hk::app {
+
+/// A picture ready for the servo thread: its scene and a servo loop sized for it. Build on any thread
+/// but the servo's (allocates).
+struct SceneBundle {
+  SceneBundle(std::unique_ptr<Scene> s, const ServoParams& params) : scene(std::move(s)), loop(*scene, params) {}
+  std::unique_ptr<Scene> scene;
+  ServoLoop loop;
+  int id = 0;  ///< caller's picture number (shown in the display state)
+};
+
+/// The servo thread's state of one tick, for the display (latest value wins). 112 bytes.
+struct ServoDisplayState {
+  std::int64_t tick = 0;
+  Vec2 handle_m, proxy_m, force_n;
+  ContactState state = ContactState::Free;
+  int curve = -1;
+  int level = 0;
+  int scene_id = -1;               ///< SceneBundle::id in use, −1 before the first
+  std::int64_t tick_compute_ns = 0;///< time of this tick's work [ns] (set by ServoThread)
+  std::int64_t period_error_ns = 0;///< wake-up minus deadline of this tick [ns] (set by ServoThread)
+  std::int64_t missed_deadlines = 0;
+};
+
+/// Per-tick work of the servo thread. Methods marked real-time are called by the servo thread only.
+class ServoCore {
+ public:
+  /// `device` must be open and outlive the core; `cues` may be null (no sound).
+  ServoCore(Device& device, const CueTrackerParams& cue_params, audio::SpscRing<audio::CueEvent>* cues);
+  /// Frees every bundle. Call only when the servo thread has stopped.
+  ~ServoCore();
+
+  /// One thread but the servo's (the owner): hands `bundle` to the servo thread (taken at its next tick).
+  /// A bundle published before and not yet taken is freed here (the servo thread never saw it).
+  void publish(std::unique_ptr<SceneBundle> bundle);
+  /// Any thread but the servo's (one caller): frees bundles the servo thread has let go of. Returns how many.
+  int collect_retired();
+
+  /// Real-time: one tick. `now_ns` = steady time at its start (for the query deadline; 0 = none),
+  /// `deadline_missed` zeroes the force (the force guard). Returns the tick's result.
+  TickResult tick(std::int64_t now_ns, bool deadline_missed) noexcept;
+
+  /// Real-time (servo thread): the display slot's back buffer, for ServoThread to add timing before publishing.
+  ServoDisplayState& display_back() noexcept { return display_.back(); }
+  void publish_display() noexcept { display_.publish(); }
+  /// Display thread: the newest state.
+  const ServoDisplayState& display() noexcept { return display_.read(); }
+
+  /// Servo thread (or when stopped): the last tick's output.
+  const ServoOutput& last_output() const noexcept { return out_; }
+  std::int64_t ticks() const noexcept { return tick_; }
+
+ private:
+  Device& device_;
+  CueTracker tracker_;
+  audio::SpscRing<audio::CueEvent>* cues_;
+  std::atomic<SceneBundle*> pending_{nullptr};
+  audio::SpscRing<SceneBundle*> retired_{16};          // servo → owner
+  SceneBundle* current_ = nullptr;                     // owned by the servo thread while running
+  SceneBundle* to_retire_ = nullptr;                   // waiting for room in retired_
+  bool fading_ = false;                                // the old picture's force fades before a swap
+  long fade_total_ = 0, fade_left_ = 0;                // [ticks]
+  TripleBuffer<ServoDisplayState> display_;
+  ServoOutput out_;
+  std::int64_t tick_ = 0;
+};
+
+}  // namespace hk::app

@@ -1,0 +1,130 @@
+// The servo thread's per-tick work: swapping pictures under a pressing hand without a force step, the
+// hand-over of scenes between threads, cues and the display slot.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "haptics/hand_path.hpp"
+#include "haptics/sim_pantograph.hpp"
+#include "servo_core.hpp"
+#include "simulation.hpp"
+
+namespace hk::app {
+namespace {
+
+Polyline square(double half) {
+  Polyline p;
+  p.closed = true;
+  p.points_m = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
+  return p;
+}
+
+std::unique_ptr<SceneBundle> bundle(const ServoParams& sp, int id, double half = 0.02) {
+  auto b = std::make_unique<SceneBundle>(std::make_unique<Scene>(Scene::build({square(half)}, 2)), sp);
+  b->id = id;
+  return b;
+}
+
+struct Rig {
+  config::Settings s;
+  ServoParams sp;
+  SimulatedPantograph device;
+  ModelHandParams hand;
+  audio::SpscRing<audio::CueEvent> cues{1024};
+  ServoCore core;
+  Vec2 target{0.0, 0.0};  // the hand pulls towards the square's centre: it presses on the left wall
+  std::vector<Vec2> forces, handles;
+
+  Rig() : sp(servo_params_from(s)), device(sim_params(s), {-0.03, 0.0}), core(device, CueTrackerParams{}, &cues) {
+    device.open();
+    hand.stiffness_n_per_m = s.hand.stiffness_n_per_m;
+    hand.damping_n_s_per_m = s.hand.damping_n_s_per_m;
+    hand.max_force_n = s.hand.max_force_n;
+  }
+  static SimPantographParams sim_params(const config::Settings& s) {
+    SimPantographParams p;
+    p.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
+    return p;
+  }
+  void run(double seconds) {
+    const long n = static_cast<long>(seconds / sp.period_s + 0.5);
+    for (long k = 0; k < n; ++k) {
+      core.tick(0, false);
+      core.publish_display();
+      forces.push_back(core.last_output().force_n);
+      handles.push_back(core.display().handle_m);
+      device.step(sp.period_s, model_hand_force(hand, target, device.true_position_m(), device.velocity_m_per_s()));
+    }
+  }
+};
+
+double max_step(const std::vector<Vec2>& f, std::size_t from, std::size_t to) {
+  double m = 0;
+  for (std::size_t i = from + 1; i < to && i < f.size(); ++i) m = std::max(m, length(f[i] - f[i - 1]));
+  return m;
+}
+
+TEST(ServoCore, SwappingPicturesUnderAPressingHandHasNoForceStep) {
+  Rig r;
+  r.core.publish(bundle(r.sp, 1));
+  r.run(1.5);  // ramp in (0.5 s), then press steadily on the left wall
+  const std::size_t swap_at = r.forces.size();
+  r.core.publish(bundle(r.sp, 2));
+  r.run(1.5);  // fade out (0.5 s), swap, ramp in (0.5 s), settle
+  // Per tick, the force may change by the ramp's step plus what the hand's own motion does to a spring
+  // wall (stiffness × handle displacement): nothing of the swap itself may show as a jump.
+  const double ramp_step = r.sp.guard.max_force_n * r.sp.period_s / r.sp.guard.ramp_s;  // 3.5 N / 500 ticks
+  const double k = r.sp.contact.stiffness_n_per_m;
+  for (std::size_t i = swap_at; i < r.forces.size(); ++i) {
+    const double allowed = ramp_step + k * length(r.handles[i] - r.handles[i - 1]) + 1e-9;
+    ASSERT_LE(length(r.forces[i] - r.forces[i - 1]), allowed) << "tick " << i - swap_at << " after the publish";
+  }
+  EXPECT_EQ(r.core.display().scene_id, 2);
+  EXPECT_EQ(r.core.collect_retired(), 1) << "the old picture came back to be freed here";
+  // Without the fade the wall would vanish in one tick: the step would be the whole pressing force.
+  EXPECT_GT(length(r.forces[swap_at - 1]), 100 * ramp_step);
+}
+
+TEST(ServoCore, NewPictureStartsWithTheProxyAtTheHandle) {
+  Rig r;
+  r.target = {-0.05, 0.0};  // stay outside the square, no contact
+  r.core.publish(bundle(r.sp, 1));
+  r.run(0.2);
+  r.core.publish(bundle(r.sp, 2, 0.01));
+  r.run(0.6);
+  const ServoDisplayState& d = r.core.display();
+  EXPECT_EQ(d.scene_id, 2);
+  EXPECT_EQ(d.state, ContactState::Free);
+  EXPECT_LT(length(d.proxy_m - d.handle_m), 1e-9);
+}
+
+TEST(ServoCore, APictureReplacedBeforeItWasTakenIsFreedAndTheLastOneWins) {
+  Rig r;
+  r.core.publish(bundle(r.sp, 1));
+  r.core.publish(bundle(r.sp, 2));  // 1 never reaches the servo thread (ASan: no leak)
+  r.core.publish(bundle(r.sp, 3));
+  r.run(0.01);
+  EXPECT_EQ(r.core.display().scene_id, 3);
+  EXPECT_EQ(r.core.collect_retired(), 0);
+}
+
+TEST(ServoCore, ContactCuesReachTheRing) {
+  Rig r;
+  r.core.publish(bundle(r.sp, 1));
+  r.run(1.0);
+  audio::CueEvent e;
+  bool contact = false;
+  while (r.cues.try_pop(e)) contact = contact || e.kind == audio::CueKind::ContactBegin;
+  EXPECT_TRUE(contact);
+}
+
+TEST(ServoCore, NoPictureMeansNoForce) {
+  Rig r;
+  r.run(0.1);
+  EXPECT_EQ(length(r.forces.back()), 0.0);
+  EXPECT_EQ(r.core.display().scene_id, -1);
+}
+
+}  // namespace
+}  // namespace hk::app
