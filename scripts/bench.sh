@@ -25,12 +25,14 @@ min_time=0.5
 [ -x "$b/bench_stability" ] && "$b/bench_stability" $quick --out "$out/stability.json"
 "$b/bench_earcon_latency" --out "$out/earcon_latency.json" > "$out/earcon_latency.md"
 "$b/bench_audio_latency" > "$out/audio_latency.json" 2>/dev/null || true
-# The latency table (the first table of earcon_latency.md) goes between its markers in PERFORMANCE.md.
-/usr/bin/python3 - "$out/earcon_latency.md" "$root/docs/PERFORMANCE.md" <<'PY'
+"$b/bench_servo_rate" --seconds 5 --out "$out/servo_rate.json" 2>/dev/null > "$out/servo_rate.md"
+# Tables printed by the audio and servo benches go between their markers in PERFORMANCE.md.
+/usr/bin/python3 - "$out" "$root/docs/PERFORMANCE.md" <<'PY'
 import re, sys
-table = open(sys.argv[1]).read().strip().split("\n\n")[0]
 doc = open(sys.argv[2]).read()
-doc = re.sub(r"(<!-- BEGIN earcon_latency -->\n).*?(\n<!-- END earcon_latency -->)", lambda m: m.group(1) + table + m.group(2), doc, flags=re.S)
+for name in ("earcon_latency", "servo_rate"):
+    lines = [l for l in open(f"{sys.argv[1]}/{name}.md").read().strip().split("\n\n")[0].splitlines() if l.startswith("|")]
+    doc = re.sub(rf"(<!-- BEGIN {name} -->\n).*?(\n<!-- END {name} -->)", lambda m: m.group(1) + "\n".join(lines) + m.group(2), doc, flags=re.S)
 open(sys.argv[2], "w").write(doc)
 PY
 /usr/bin/python3 "$root/bench/plot_bench.py" "$out" "$root/docs/PERFORMANCE.md"

@@ -1,0 +1,120 @@
+#include "servo_thread.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <spdlog/spdlog.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace hk::app {
+namespace {
+
+constexpr std::int64_t kNsPerS = 1'000'000'000;
+
+std::int64_t mono_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerS + ts.tv_nsec;
+}
+
+timespec to_timespec(std::int64_t ns) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(ns / kNsPerS);
+  ts.tv_nsec = static_cast<long>(ns % kNsPerS);
+  return ts;
+}
+
+double percentile_us(const std::array<std::atomic<std::uint32_t>, 2048>& h, double q) {
+  std::uint64_t total = 0;
+  for (const auto& b : h) total += b.load(std::memory_order_relaxed);
+  if (total == 0) return 0;
+  const auto want = static_cast<std::uint64_t>(q * static_cast<double>(total - 1)) + 1;
+  std::uint64_t seen = 0;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    seen += h[i].load(std::memory_order_relaxed);
+    if (seen >= want) return static_cast<double>(i);
+  }
+  return static_cast<double>(h.size() - 1);
+}
+
+}  // namespace
+
+ServoThread::ServoThread(ServoCore& core, const ServoThreadParams& params, AfterTick after_tick)
+    : core_(core), params_(params), after_tick_(std::move(after_tick)) {
+  if (!(params.rate_hz >= 100 && params.rate_hz <= 10000)) {
+    throw std::invalid_argument("servo rate " + std::to_string(params.rate_hz) + " Hz is outside [100, 10000] Hz");
+  }
+  thread_ = std::thread([this] { run(); });
+}
+
+ServoThread::~ServoThread() { stop(); }
+
+void ServoThread::stop() {
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+}
+
+void ServoThread::run() {
+  if (params_.realtime) {
+    sched_param sp{};
+    sp.sched_priority = params_.fifo_priority;
+    const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+    if (err == 0) {
+      realtime_.store(true);
+      spdlog::info("servo: SCHED_FIFO priority {} at {} Hz", params_.fifo_priority, params_.rate_hz);
+    } else {
+      spdlog::warn("servo: SCHED_FIFO refused ({}); running at normal priority at {} Hz (grant CAP_SYS_NICE or an rtprio limit)",
+                   std::strerror(err), params_.rate_hz);
+    }
+  }
+  const auto period_ns = static_cast<std::int64_t>(static_cast<double>(kNsPerS) / params_.rate_hz + 0.5);
+  const double period_s = static_cast<double>(period_ns) / static_cast<double>(kNsPerS);
+  std::int64_t deadline = mono_ns() + period_ns;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    const timespec ts = to_timespec(deadline);
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    }
+    const std::int64_t woke = mono_ns();
+    const std::int64_t late = woke - deadline;
+    const bool missed = late >= period_ns;
+    core_.tick(woke, missed);
+    if (after_tick_) after_tick_(period_s);
+    const std::int64_t done = mono_ns();
+
+    ServoDisplayState& d = core_.display_back();
+    d.tick_compute_ns = done - woke;
+    d.period_error_ns = late;
+    d.missed_deadlines = missed_.load(std::memory_order_relaxed) + (missed ? 1 : 0);
+    core_.publish_display();
+
+    late_[static_cast<std::size_t>(std::clamp<std::int64_t>(late / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
+    compute_[static_cast<std::size_t>(std::clamp<std::int64_t>((done - woke) / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
+    if (late > max_late_ns_.load(std::memory_order_relaxed)) max_late_ns_.store(late, std::memory_order_relaxed);
+    ticks_.fetch_add(1, std::memory_order_relaxed);
+    if (missed) {
+      missed_.fetch_add(1, std::memory_order_relaxed);
+      // Skip ahead to the next deadline in the future rather than bursting ticks to catch up.
+      deadline += ((done - deadline) / period_ns) * period_ns;
+    }
+    deadline += period_ns;
+  }
+}
+
+ServoTimingStats ServoThread::stats() const {
+  ServoTimingStats s;
+  s.ticks = ticks_.load();
+  s.missed_deadlines = missed_.load();
+  s.lateness_p50_us = percentile_us(late_, 0.5);
+  s.lateness_p99_us = percentile_us(late_, 0.99);
+  s.lateness_max_us = static_cast<double>(max_late_ns_.load()) / 1000.0;
+  s.compute_p50_us = percentile_us(compute_, 0.5);
+  s.compute_p99_us = percentile_us(compute_, 0.99);
+  return s;
+}
+
+}  // namespace hk::app

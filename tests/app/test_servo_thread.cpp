@@ -1,0 +1,61 @@
+// The servo thread: it ticks the core, counts a deadline it missed (and the guard zeroes that tick's
+// force), refuses a bad rate, and stops cleanly. Its timing is measured in bench/servo_rate.cpp.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "haptics/sim_pantograph.hpp"
+#include "servo_thread.hpp"
+#include "simulation.hpp"
+
+namespace hk::app {
+namespace {
+
+Polyline square(double half) {
+  Polyline p;
+  p.closed = true;
+  p.points_m = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
+  return p;
+}
+
+TEST(ServoThread, TicksCountsAMissedDeadlineAndStops) {
+  const config::Settings s;
+  const ServoParams sp = servo_params_from(s);
+  SimPantographParams dp;
+  SimulatedPantograph device(dp, {-0.03, 0.0});
+  device.open();
+  ServoCore core(device, CueTrackerParams{}, nullptr);
+  auto b = std::make_unique<SceneBundle>(std::make_unique<Scene>(Scene::build({square(0.02)}, 2)), sp);
+  b->id = 7;
+  core.publish(std::move(b));
+  std::atomic<int> after{0};
+  {
+    ServoThread t(core, {}, [&](double period_s) {
+      EXPECT_DOUBLE_EQ(period_s, 0.001);
+      if (++after == 50) std::this_thread::sleep_for(std::chrono::milliseconds(3));  // a stall: the next tick is late
+    });
+    while (t.stats().ticks < 100) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    const ServoTimingStats st = t.stats();
+    EXPECT_GE(st.missed_deadlines, 1) << "the 3 ms stall must count as a missed deadline";
+    EXPECT_GE(st.lateness_max_us, 1000.0);
+    t.stop();
+    const std::int64_t ticks = t.stats().ticks;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_EQ(t.stats().ticks, ticks) << "stopped means stopped";
+  }
+  EXPECT_EQ(core.display().scene_id, 7);
+  EXPECT_GE(core.display().missed_deadlines, 1);
+}
+
+TEST(ServoThread, RefusesARateOutsideItsRange) {
+  SimPantographParams dp;
+  SimulatedPantograph device(dp, {0.0, 0.0});
+  ServoCore core(device, CueTrackerParams{}, nullptr);
+  ServoThreadParams p;
+  p.rate_hz = 50;
+  EXPECT_THROW(ServoThread(core, p), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hk::app
