@@ -1,0 +1,59 @@
+#include "describe.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hk::app {
+namespace {
+
+struct Shape {
+  double diag_m;
+  Vec2 centre_m;
+  bool closed;
+};
+
+const char* place(Vec2 c, Vec2 half) {
+  // Thirds of the workspace; y is away from the visitor = up on the screen = "top".
+  const int col = c.x < -half.x / 3 ? 0 : (c.x > half.x / 3 ? 2 : 1);
+  const int row = c.y > half.y / 3 ? 0 : (c.y < -half.y / 3 ? 2 : 1);
+  static const char* const names[3][3] = {{"at the top left", "at the top", "at the top right"},
+                                          {"on the left", "in the middle", "on the right"},
+                                          {"at the bottom left", "at the bottom", "at the bottom right"}};
+  return names[row][col];
+}
+
+}  // namespace
+
+std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half, int max_named) {
+  std::vector<Shape> shapes;
+  for (const Polyline& p : curves) {
+    if (p.points_m.empty()) continue;
+    Vec2 lo = p.points_m[0], hi = p.points_m[0];
+    for (const Vec2& q : p.points_m) {
+      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    }
+    shapes.push_back({length(hi - lo), 0.5 * (lo + hi), p.closed});
+  }
+  if (shapes.empty()) return "There are no shapes in this picture.";
+  std::sort(shapes.begin(), shapes.end(), [](const Shape& a, const Shape& b) { return a.diag_m > b.diag_m; });
+  const double ws = 2.0 * length(half);
+  auto size = [&](const Shape& s) { return s.diag_m > 0.4 * ws ? "large" : (s.diag_m > 0.15 * ws ? "medium" : "small"); };
+  std::string out = shapes.size() == 1 ? "One shape. " : std::to_string(shapes.size()) + " shapes. ";
+  const std::size_t named = std::min<std::size_t>(shapes.size(), static_cast<std::size_t>(std::max(1, max_named)));
+  for (std::size_t i = 0; i < named; ++i) {
+    const Shape& s = shapes[i];
+    std::string part = std::string(i == 0 ? "A " : "a ") + size(s) + (s.closed ? " closed shape " : " line ") + place(s.centre_m, half);
+    if (i > 0) out += (i + 1 == named && shapes.size() == named) ? ", and " : ", ";
+    out += part;
+  }
+  if (shapes.size() > named) {
+    const std::size_t rest = shapes.size() - named;
+    out += ", and " + std::to_string(rest) + (rest == 1 ? " more, smaller." : " more, smaller ones.");
+  } else {
+    out += ".";
+  }
+  return out;
+}
+
+}  // namespace hk::app

@@ -1,0 +1,21 @@
+#pragma once
+/// @file describe.hpp
+/// The Describe key (issue 5, item 4): a spoken summary of a picture's shapes and where they are, e.g.
+/// "3 shapes. A large closed shape in the middle, a small line at the top left, and a small closed shape
+/// at the bottom right." English only for now (the catalogue's `describe` message carries it whole).
+
+#include <string>
+#include <vector>
+
+#include "haptics/multires.hpp"
+#include "haptics/vec2.hpp"
+
+namespace hk::app {
+
+/// Describes `curves` (workspace metres) in a workspace of half extents `half_extent_m` [m]. The largest
+/// `max_named` shapes are named with their size (large / medium / small by bounding-box diagonal against
+/// the workspace diagonal: > 40 %, > 15 %, else small), kind (closed shape or line) and place (the cell of a
+/// 3 x 3 grid holding their bounding-box centre); the rest are counted.
+std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half_extent_m, int max_named = 3);
+
+}  // namespace hk::app
