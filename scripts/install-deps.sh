@@ -7,6 +7,7 @@ packages=(
   libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libboost-dev
   libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev sox
+  libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri xvfb xauth
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -7,6 +7,7 @@
 
 #include "audio_settings.hpp"
 #include "explore.hpp"
+#include "kiosk_app.hpp"
 
 namespace {
 
@@ -23,7 +24,17 @@ void print_error(const std::string& what) {
 
 int main(int argc, char** argv) {
   CLI::App cli{"haptic-kiosk: feel the shapes in a picture through a force-feedback pantograph"};
-  cli.require_subcommand(1);
+  cli.require_subcommand(0, 1);
+  hk::app::KioskOptions ko;
+  cli.add_flag("--windowed", ko.windowed, "A 1280 x 720 window instead of full screen (development)");
+  cli.add_option("--config", ko.config_path, "Settings file (TOML)");
+  cli.add_option("--library", ko.library, "Picture folder (default: the shipped data/pictures)");
+  cli.add_option("--show", ko.show, "Start on this picture, past the welcome and tutorial (documentation, tests)");
+  cli.add_flag("--high-contrast", ko.high_contrast, "Start in high contrast: dimmed picture, thick bright curves (key C)");
+  cli.add_flag("--overlay", ko.overlay, "Start with the operator overlay (key O)");
+  cli.add_option("--screenshot", ko.screenshot, "Run --frames frames (scripted input from --script), write the last as PNG, quit");
+  cli.add_option("--frames", ko.frames, "Frames to run before the screenshot (60 per second)");
+  cli.add_option("--script", ko.script, "Scripted input: lines 'FRAME key NAME', 'FRAME cursor X_M Y_M', 'FRAME move'");
   hk::app::ExploreOptions eo;
   CLI::App* explore = cli.add_subcommand("explore", "Run the whole pipeline headless on the simulated pantograph");
   explore->add_option("image", eo.image_path, "Picture to explore (PNG, JPEG, BMP, TIFF, WebP)")->required();
@@ -48,6 +59,8 @@ int main(int argc, char** argv) {
       const auto sum = hk::app::run_explore(eo);
       std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n", sum.ticks,
                   sum.curves, sum.edge_ticks, sum.vertex_ticks, sum.max_force_n, eo.out_dir.c_str());
+    } else if (!*explore && !*speak) {
+      return hk::app::run_kiosk(ko);
     } else if (*speak) {
       const std::string text = hk::app::run_speak(so);
       std::printf("speak: \"%s\" -> %s\n", text.c_str(), so.wav_path.c_str());

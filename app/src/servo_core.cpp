@@ -54,6 +54,9 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
     }
   }
 
+  const int want_level = requested_level_.load(std::memory_order_relaxed);
+  if (current_ && want_level >= 0 && want_level != current_->loop.params().level) current_->loop.set_level(want_level);
+
   TickResult r = TickResult::Ok;
   if (current_) {
     r = current_->loop.update(in, out_);

@@ -63,6 +63,9 @@ class ServoCore {
   /// Any thread but the servo's (one caller): frees bundles the servo thread has let go of. Returns how many.
   int collect_retired();
 
+  /// Any thread: the level to render from the next tick on (clamped per curve by the scene). −1: keep.
+  void request_level(int level) noexcept { requested_level_.store(level, std::memory_order_relaxed); }
+
   /// Real-time: one tick. `now_ns` = steady time at its start (for the query deadline; 0 = none),
   /// `deadline_missed` zeroes the force (the force guard). Returns the tick's result.
   TickResult tick(std::int64_t now_ns, bool deadline_missed) noexcept;
@@ -85,6 +88,7 @@ class ServoCore {
   audio::SpscRing<SceneBundle*> retired_{16};          // servo → owner
   SceneBundle* current_ = nullptr;                     // owned by the servo thread while running
   SceneBundle* to_retire_ = nullptr;                   // waiting for room in retired_
+  std::atomic<int> requested_level_{-1};
   bool fading_ = false;                                // the old picture's force fades before a swap
   long fade_total_ = 0, fade_left_ = 0;                // [ticks]
   TripleBuffer<ServoDisplayState> display_;

@@ -1,0 +1,33 @@
+#pragma once
+/// @file kiosk_app.hpp
+/// The kiosk a visitor walks up to (issue 5): `haptic-kiosk` with no subcommand. One window (full screen
+/// on the primary monitor, or `--windowed`), the servo thread driving the simulated pantograph from the
+/// mouse (the model hand pulls the handle towards the cursor), the audio side, and the visitor's flow
+/// (kiosk_flow.hpp) on the keyboard.
+///
+/// View mapping (tests rely on it): workspace metres → window pixels with one uniform scale
+/// s = 0.9 · min(W / width_m, H / height_m) [px/m] about the window centre, y up:
+///   px = W/2 + s·x,  py = H/2 − s·y   (py counted from the top row).
+
+#include <string>
+
+namespace hk::app {
+
+/// What `haptic-kiosk` (no subcommand) was asked to do.
+struct KioskOptions {
+  bool windowed = false;        ///< a 1280 x 720 window instead of full screen
+  std::string config_path;      ///< TOML settings; empty: defaults
+  std::string library;          ///< picture folder; empty: the shipped data/pictures
+  std::string show;             ///< start on this picture (skips attract and tutorial): for documentation and tests
+  bool high_contrast = false;   ///< start in high contrast (dimmed picture, thick bright curves)
+  bool overlay = false;         ///< start with the operator overlay
+  std::string screenshot;       ///< write the last frame here as PNG and quit
+  int frames = 0;               ///< frames to run before the screenshot (at 60 Hz)
+  std::string script;           ///< scripted input: lines "FRAME key NAME", "FRAME cursor X_M Y_M", "FRAME move"
+};
+
+/// Runs the kiosk until the window closes (or, with a screenshot, for `frames` frames). Returns the exit
+/// status. @throws on bad input (one line naming it): settings, library, script, screenshot path, no display.
+int run_kiosk(const KioskOptions& options);
+
+}  // namespace hk::app

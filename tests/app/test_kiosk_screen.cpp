@@ -1,0 +1,77 @@
+// The kiosk under Xvfb (issue 5, "Tests it must have"): it starts full screen, shows a picture with its
+// curves, and writes a screenshot in which the curves are where scene.json says they are, through the
+// documented view mapping (kiosk_app.hpp), checked from the pixels.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kData = HK_TEST_DATA_DIR;
+
+int sh(const std::string& cmd) {
+  const int raw = std::system(cmd.c_str());
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+}
+
+bool yellow_near(const cv::Mat& img, int x, int y, int r) {
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      const int u = x + dx, v = y + dy;
+      if (u < 0 || v < 0 || u >= img.cols || v >= img.rows) continue;
+      const cv::Vec3b p = img.at<cv::Vec3b>(v, u);  // BGR
+      if (p[2] > 200 && p[1] > 160 && p[0] < 90) return true;
+    }
+  }
+  return false;
+}
+
+TEST(KioskScreen, CurvesAreDrawnWhereSceneJsonSaysFullScreenUnderXvfb) {
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  const fs::path dir = fs::temp_directory_path() / ("hk_screen_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "library");
+  fs::copy_file(kData / "images" / "horse.png", dir / "library" / "horse.png");
+  const std::string exe = HK_KIOSK_EXE;
+  ASSERT_EQ(sh(exe + " explore '" + (dir / "library" / "horse.png").string() + "' --out '" + (dir / "explore").string() +
+               "' --duration 0.01 >/dev/null 2>&1"),
+            0);
+  const fs::path png = dir / "screen.png";
+  ASSERT_EQ(sh("timeout 120 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --library '" + (dir / "library").string() + "' --show '" +
+               (dir / "library" / "horse.png").string() + "' --screenshot '" + png.string() + "' --frames 20 >'" +
+               (dir / "log.txt").string() + "' 2>&1"),
+            0)
+      << std::ifstream(dir / "log.txt").rdbuf();
+  const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(img.empty());
+  EXPECT_EQ(img.cols, 1280) << "full screen on the 1280 x 720 Xvfb screen";
+  EXPECT_EQ(img.rows, 720);
+
+  std::ifstream sf(dir / "explore" / "scene.json");
+  const nlohmann::json scene = nlohmann::json::parse(sf);
+  const int level = scene["level_in_use"];
+  const double s = 0.9 * std::min(1280 / 0.14, 720 / 0.09);  // the documented view mapping, default workspace
+  long points = 0, hits = 0, shifted_hits = 0;
+  for (const auto& c : scene["curves"]) {
+    const auto& lv = c["levels"][std::min<std::size_t>(static_cast<std::size_t>(level), c["levels"].size() - 1)];
+    for (const auto& p : lv["points_m"]) {
+      const double x = 640 + s * p[0].get<double>(), y = 360 - s * p[1].get<double>();
+      ++points;
+      hits += yellow_near(img, static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)), 2);
+      shifted_hits += yellow_near(img, static_cast<int>(std::lround(x + 25)), static_cast<int>(std::lround(y + 25)), 2);
+    }
+  }
+  ASSERT_GT(points, 100);
+  EXPECT_GT(static_cast<double>(hits) / points, 0.95) << hits << " of " << points << " curve points have a curve pixel within 2 px";
+  EXPECT_LT(static_cast<double>(shifted_hits) / points, 0.2) << "control: 25 px off the curves there should be little yellow";
+  fs::remove_all(dir);
+}
+
+}  // namespace
