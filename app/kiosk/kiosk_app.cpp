@@ -384,6 +384,8 @@ int run_kiosk(const KioskOptions& o) {
   }
   App app(o, s);
   KioskFlowParams fp;
+  fp.timeout_s = s.kiosk.timeout_s;
+  fp.warning_s = s.kiosk.warning_s;
   KioskFlow flow(app, app.audio().messages(), fp);
 
   glfwSetErrorCallback([](int code, const char* what) { spdlog::error("glfw {}: {}", code, what ? what : ""); });

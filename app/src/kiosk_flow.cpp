@@ -1,5 +1,6 @@
 #include "kiosk_flow.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hk::app {
@@ -7,7 +8,9 @@ namespace hk::app {
 using audio::MessageId;
 
 KioskFlow::KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params)
-    : fx_(effects), msg_(messages), p_(params) {}
+    : fx_(effects), msg_(messages), p_(params) {
+  p_.warning_s = std::min(p_.warning_s, 0.5 * p_.timeout_s);  // a warning must leave time to answer it
+}
 
 void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say(msg_.text(id, args)); }
 

@@ -50,7 +50,7 @@ class KioskEffects {
 /// Timing of the flow. Units in names.
 struct KioskFlowParams {
   double timeout_s = 120.0;  ///< no key and no motion for this long ends the session
-  double warning_s = 20.0;   ///< the spoken warning comes this long before the end
+  double warning_s = 20.0;   ///< the spoken warning comes this long before the end (at most timeout_s / 2)
 };
 
 /// The state machine. Not thread-safe: call from the window thread.

@@ -64,13 +64,14 @@ constexpr FieldDescriptor make_field(std::string_view table, std::string_view ke
 constexpr std::array<std::string_view, 1> kDeviceTypes{"simulated"};
 constexpr double kTwoPow31 = 2147483648.0;
 
-constexpr std::array<detail::TableInfo, 6> kTables{{
+constexpr std::array<detail::TableInfo, 7> kTables{{
     {"haptics", "Force rendering and the servo loop."},
     {"device", "Which device drives the handle, and the simulated pantograph's physics."},
     {"hand", "The model hand that drives the simulated pantograph in headless runs."},
     {"vision", "Image intake limits, edge detection and linking."},
     {"workspace", "The device's usable rectangle, centred on the workspace origin."},
     {"audio", "Earcons, speech and volume."},
+    {"kiosk", "The visitor's session."},
 }};
 
 constexpr auto kFields = std::to_array<FieldDescriptor>({
@@ -117,6 +118,9 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(audio, duck_db, -40, 0, "dB", "Earcons are this much quieter while speech plays."),
     HK_FIELD(audio, speech_rate_wpm, 80, 450, "words/min", "Speaking rate."),
     HK_FIELD(audio, buffer_frames, 32, 4096, "frames", "Audio output buffer at 48 kHz (256 = 5.3 ms)."),
+    // [kiosk]
+    HK_FIELD(kiosk, timeout_s, 10, 3600, "s", "No key and no handle motion for this long ends the session."),
+    HK_FIELD(kiosk, warning_s, 1, 600, "s", "The spoken warning comes this long before the end (at most half the timeout)."),
 });
 
 #undef HK_FIELD

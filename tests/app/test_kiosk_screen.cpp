@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -71,6 +72,41 @@ TEST(KioskScreen, CurvesAreDrawnWhereSceneJsonSaysFullScreenUnderXvfb) {
   ASSERT_GT(points, 100);
   EXPECT_GT(static_cast<double>(hits) / points, 0.95) << hits << " of " << points << " curve points have a curve pixel within 2 px";
   EXPECT_LT(static_cast<double>(shifted_hits) / points, 0.2) << "control: 25 px off the curves there should be little yellow";
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+// Scripted keys walk attract → tutorial → picture → next picture → time-out → attract; what the kiosk
+// said (its speech log, one "say:" line per message) must follow the flow.
+TEST(KioskScreen, ScriptedVisitWalksTheFlowAndSaysEachStep) {
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  const fs::path dir = fs::temp_directory_path() / ("hk_flow_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "library");
+  fs::copy_file(kData / "images" / "horse.png", dir / "library" / "a_horse.png");
+  fs::copy_file(kData / "images" / "silhouette_3.png", dir / "library" / "b_silhouette.png");
+  std::ofstream(dir / "kiosk.toml") << "[kiosk]\ntimeout_s = 10\nwarning_s = 1\n";
+  std::ofstream(dir / "script.txt") << "# frame action\n1 move\n30 key next\n60 key next\n90 key next\n120 key next\n";
+  const std::string exe = HK_KIOSK_EXE;
+  ASSERT_EQ(sh("timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --config '" + (dir / "kiosk.toml").string() + "' --library '" +
+               (dir / "library").string() + "' --script '" + (dir / "script.txt").string() + "' --screenshot '" + (dir / "end.png").string() +
+               "' --frames 760 >'" + (dir / "log.txt").string() + "' 2>&1"),
+            0)
+      << std::ifstream(dir / "log.txt").rdbuf();
+  std::ifstream log(dir / "log.txt");
+  std::vector<std::string> said;
+  for (std::string line; std::getline(log, line);) {
+    const auto at = line.find("say: ");
+    if (at != std::string::npos) said.push_back(line.substr(at + 5));
+  }
+  const std::vector<std::string> want_prefix{"Welcome.", "Now a circle.", "Now a triangle.", "Well done. Here is the first picture. Picture 1 of 2.",
+                                             "Picture 2 of 2.", "Are you still there? The kiosk will start again in 1 seconds.",
+                                             "Thank you for visiting. Goodbye."};
+  ASSERT_EQ(said.size(), want_prefix.size()) << std::ifstream(dir / "log.txt").rdbuf();
+  for (std::size_t i = 0; i < said.size(); ++i) EXPECT_EQ(said[i].rfind(want_prefix[i], 0), 0u) << said[i];
   fs::remove_all(dir);
 }
 

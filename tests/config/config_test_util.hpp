@@ -71,6 +71,8 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"audio", "duck_db", -40, 0, false},
       {"audio", "speech_rate_wpm", 80, 450, true},
       {"audio", "buffer_frames", 32, 4096, true},
+      {"kiosk", "timeout_s", 10, 3600, false},
+      {"kiosk", "warning_s", 1, 600, false},
   };
   return specs;
 }

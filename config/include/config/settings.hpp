@@ -86,6 +86,15 @@ struct AudioSettings {
   bool operator==(const AudioSettings&) const = default;
 };
 
+/// [kiosk] — the visitor's session.
+struct KioskSettings {
+  double timeout_s = 120.0;               ///< key timeout_s, no key and no handle motion for this long ends the session, [10, 3600] s
+  double warning_s = 20.0;                ///< key warning_s, the spoken warning comes this long before the end, [1, 600] s (at most half of timeout_s)
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const KioskSettings&) const = default;
+};
+
 /// All settings. Default-constructed = the shipped defaults.
 struct Settings {
   HapticsSettings haptics;
@@ -94,6 +103,7 @@ struct Settings {
   VisionSettings vision;
   WorkspaceSettings workspace;
   AudioSettings audio;
+  KioskSettings kiosk;
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const Settings&) const = default;
