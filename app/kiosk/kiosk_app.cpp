@@ -124,8 +124,10 @@ class App final : public KioskEffects {
   // ---- KioskEffects ----
   void say(const std::string& text) override {
     spdlog::info("say: {}", text);
+    last_said_ = text;
     audio_.say_text(text);
   }
+  const std::string& last_said() const { return last_said_; }
   void show_tutorial(TutorialShape shape) override {
     Shown sh;
     sh.polylines = {tutorial_polyline(shape, half_)};
@@ -230,18 +232,20 @@ class App final : public KioskEffects {
   Shown shown_;
   int level_ = 1;
   bool high_contrast_ = false, overlay_ = false;
+  std::string last_said_;
 };
 
 // ---- drawing (OpenGL 2, legacy pipeline: one draw per frame of a few thousand vertices) ---------------
+// The documented view mapping (kiosk_app.hpp): the bottom 14 % of the screen is left to the captions.
 struct View {
   int w = 0, h = 0;
   double s = 1;  // [px/m]
   double px(double x) const { return w / 2.0 + s * x; }
-  double py(double y) const { return h / 2.0 - s * y; }
-  Vec2 to_m(double x_px, double y_px) const { return {(x_px - w / 2.0) / s, (h / 2.0 - y_px) / s}; }
+  double py(double y) const { return 0.43 * h - s * y; }
+  Vec2 to_m(double x_px, double y_px) const { return {(x_px - w / 2.0) / s, (0.43 * h - y_px) / s}; }
 };
 
-View make_view(int w, int h, Vec2 half) { return {w, h, 0.9 * std::min(w / (2 * half.x), h / (2 * half.y))}; }
+View make_view(int w, int h, Vec2 half) { return {w, h, 0.9 * std::min(w / (2 * half.x), 0.8 * h / (2 * half.y))}; }
 
 void disc(const View& v, Vec2 c, double r_px, bool filled) {
   glBegin(filled ? GL_TRIANGLE_FAN : GL_LINE_LOOP);
@@ -451,7 +455,8 @@ int run_kiosk(const KioskOptions& o) {
   bool have_tex = false;
   int tex_w = 0, tex_h = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  Vec2 last_moved_at = app.core().display().handle_m;
+  Vec2 last_moved_at;
+  bool have_baseline = false;
   int frame = 0;
   std::size_t next_script = 0;
   while (!glfwWindowShouldClose(win)) {
@@ -477,7 +482,11 @@ int run_kiosk(const KioskOptions& o) {
       app.set_cursor({std::clamp(m.x, -app.half().x, app.half().x), std::clamp(m.y, -app.half().y, app.half().y)});
     }
     const ServoDisplayState& d = app.core().display();
-    if (length(d.handle_m - last_moved_at) > 0.005) {
+    if (!have_baseline && d.tick > 0) {  // the first sample from the servo thread: where the handle rests
+      have_baseline = true;
+      last_moved_at = d.handle_m;
+    }
+    if (have_baseline && length(d.handle_m - last_moved_at) > 0.005) {
       last_moved_at = d.handle_m;
       flow.handle_moved(ws.now_s);
     }
@@ -500,10 +509,21 @@ int run_kiosk(const KioskOptions& o) {
       }
     }
     draw_frame(app, view, tex, have_tex, tex_w, tex_h);
+    ImGui_ImplOpenGL2_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    {
+      // Captions: what the kiosk says, large, for a companion who sees and for visitors with some sight.
+      const std::string caption = flow.state() == KioskState::Attract ? app.audio().messages().raw(audio::MessageId::attract) : app.last_said();
+      ImGui::SetNextWindowPos(ImVec2(0.05f * fw, 0.86f * fh));
+      ImGui::SetNextWindowSize(ImVec2(0.9f * fw, 0.13f * fh));
+      ImGui::SetNextWindowBgAlpha(0.75f);
+      ImGui::Begin("caption", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoSavedSettings);
+      ImGui::SetWindowFontScale(std::max(1.5f, fh / 400.0f));
+      ImGui::TextWrapped("%s", caption.c_str());
+      ImGui::End();
+    }
     if (app.overlay()) {
-      ImGui_ImplOpenGL2_NewFrame();
-      ImGui_ImplGlfw_NewFrame();
-      ImGui::NewFrame();
       ImGui::SetNextWindowPos(ImVec2(10, 10));
       ImGui::Begin("operator", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
       ImGui::Text("state %s   picture %d   level %d", state_name(flow.state()), flow.picture() + 1, app.level());
@@ -517,9 +537,9 @@ int run_kiosk(const KioskOptions& o) {
       ImGui::Text("volume %d/10   sound %s   cues dropped %llu", app.audio().volume().step(), app.audio().sound_output() ? "on" : "no device",
                   static_cast<unsigned long long>(app.audio().cues_dropped()));
       ImGui::End();
-      ImGui::Render();
-      ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
     }
+    ImGui::Render();
+    ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
     ++frame;
     if (scripted && frame >= o.frames) {
       glFinish();

@@ -6,8 +6,8 @@
 /// (kiosk_flow.hpp) on the keyboard.
 ///
 /// View mapping (tests rely on it): workspace metres → window pixels with one uniform scale
-/// s = 0.9 · min(W / width_m, H / height_m) [px/m] about the window centre, y up:
-///   px = W/2 + s·x,  py = H/2 − s·y   (py counted from the top row).
+/// s = 0.9 · min(W / width_m, 0.8 · H / height_m) [px/m], y up, the bottom 14 % left to the captions:
+///   px = W/2 + s·x,  py = 0.43·H − s·y   (py counted from the top row).
 
 #include <string>
 
