@@ -58,12 +58,12 @@ TEST(KioskScreen, CurvesAreDrawnWhereSceneJsonSaysFullScreenUnderXvfb) {
   std::ifstream sf(dir / "explore" / "scene.json");
   const nlohmann::json scene = nlohmann::json::parse(sf);
   const int level = scene["level_in_use"];
-  const double s = 0.9 * std::min(1280 / 0.14, 720 / 0.09);  // the documented view mapping, default workspace
+  const double s = 0.9 * std::min(1280 / 0.14, 0.8 * 720 / 0.09);  // the documented view mapping, default workspace
   long points = 0, hits = 0, shifted_hits = 0;
   for (const auto& c : scene["curves"]) {
     const auto& lv = c["levels"][std::min<std::size_t>(static_cast<std::size_t>(level), c["levels"].size() - 1)];
     for (const auto& p : lv["points_m"]) {
-      const double x = 640 + s * p[0].get<double>(), y = 360 - s * p[1].get<double>();
+      const double x = 640 + s * p[0].get<double>(), y = 0.43 * 720 - s * p[1].get<double>();
       ++points;
       hits += yellow_near(img, static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)), 2);
       shifted_hits += yellow_near(img, static_cast<int>(std::lround(x + 25)), static_cast<int>(std::lround(y + 25)), 2);
