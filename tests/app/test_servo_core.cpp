@@ -59,12 +59,6 @@ struct Rig {
   }
 };
 
-double max_step(const std::vector<Vec2>& f, std::size_t from, std::size_t to) {
-  double m = 0;
-  for (std::size_t i = from + 1; i < to && i < f.size(); ++i) m = std::max(m, length(f[i] - f[i - 1]));
-  return m;
-}
-
 TEST(ServoCore, SwappingPicturesUnderAPressingHandHasNoForceStep) {
   Rig r;
   r.core.publish(bundle(r.sp, 1));
