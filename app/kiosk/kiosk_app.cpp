@@ -154,6 +154,11 @@ class App final : public KioskEffects {
   }
   bool change_volume(int delta) override { return delta > 0 ? audio_.volume_up() : audio_.volume_down(); }
   void new_session() override {
+    if (servo_) {  // the servo thread's timing, once per visitor's session
+      const ServoTimingStats t = servo_->take_stats();
+      spdlog::info("session: servo {} ticks, {} missed deadlines, lateness p50 {:.0f} p99 {:.0f} max {:.0f} us, tick work p99 {:.0f} us",
+                   t.ticks, t.missed_deadlines, t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us, t.compute_p99_us);
+    }
     audio_.new_session();
     level_ = s_.haptics.level;
     core_.request_level(level_);
@@ -168,6 +173,7 @@ class App final : public KioskEffects {
   ServoCore& core() { return core_; }
   audio::AudioSystem& audio() { return audio_; }
   const Shown& shown() const { return shown_; }
+  int shown_id() const { return shown_id_; }
   int level() const { return level_; }
   Vec2 half() const { return half_; }
   bool& high_contrast() { return high_contrast_; }
@@ -215,6 +221,7 @@ class App final : public KioskEffects {
     bundle->id = id;
     sh.scene = bundle->scene.get();
     shown_ = std::move(sh);
+    shown_id_ = id;
     core_.publish(std::move(bundle));
   }
 
@@ -233,6 +240,7 @@ class App final : public KioskEffects {
   int level_ = 1;
   bool high_contrast_ = false, overlay_ = false;
   std::string last_said_;
+  int shown_id_ = -100;
 };
 
 // ---- drawing (OpenGL 2, legacy pipeline: one draw per frame of a few thousand vertices) ---------------
@@ -323,8 +331,35 @@ void draw_frame(App& app, const View& v, GLuint tex, bool have_tex, int tex_w, i
       }
     }
   }
-  // Handle (red ring), proxy (white disc, on the curve in contact: seed §4), force arrow from the handle.
   const ServoDisplayState& d = app.core().display();
+  // The boundary section the servo thread keeps (operator overlay): magenta, segment boxes or node rectangles.
+  if (app.overlay() && sh.scene && d.scene_id == app.shown_id()) {
+    const Scene& sc = *sh.scene;
+    glColor4f(1.0f, 0.3f, 1.0f, 0.8f);
+    glLineWidth(1.5f);
+    const int n = std::min(d.section_count, ServoDisplayState::kMaxSection);
+    for (int i = 0; i < n; ++i) {
+      const std::uint32_t node = d.section[i];
+      if (node >= sc.node_count()) continue;
+      glBegin(GL_LINE_LOOP);
+      if (sc.is_segment(node)) {
+        const ErrorBox& b = sc.box(node);
+        const Vec2 nrm = left_perp(b.axis);
+        for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
+          const Vec2 q = b.origin_m + u * b.axis + w * nrm;
+          glVertex2d(v.px(q.x), v.py(q.y));
+        }
+      } else {
+        const Aabb& a = sc.aabb(node);
+        glVertex2d(v.px(a.lo.x), v.py(a.lo.y));
+        glVertex2d(v.px(a.hi.x), v.py(a.lo.y));
+        glVertex2d(v.px(a.hi.x), v.py(a.hi.y));
+        glVertex2d(v.px(a.lo.x), v.py(a.hi.y));
+      }
+      glEnd();
+    }
+  }
+  // Handle (red ring), proxy (white disc, on the curve in contact: seed §4), force arrow from the handle.
   glLineWidth(2.0f);
   glColor4f(1.0f, 0.3f, 0.3f, 1.0f);
   disc(v, d.handle_m, 9, false);

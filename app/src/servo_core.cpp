@@ -1,5 +1,7 @@
 #include "servo_core.hpp"
 
+#include <algorithm>
+
 namespace hk::app {
 
 ServoCore::ServoCore(Device& device, const CueTrackerParams& cue_params, audio::SpscRing<audio::CueEvent>* cues)
@@ -82,6 +84,13 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
   d.curve = out_.contact.state == ContactState::Free ? -1 : out_.contact.constraint[0].curve;
   d.level = current_ ? current_->loop.params().level : 0;
   d.scene_id = current_ ? current_->id : -1;
+  d.section_count = 0;
+  if (current_) {
+    const auto& sec = current_->loop.solver().section().section();
+    d.section_count = static_cast<std::int32_t>(sec.size());
+    const std::size_t n = std::min<std::size_t>(sec.size(), ServoDisplayState::kMaxSection);
+    std::copy_n(sec.data(), n, d.section);
+  }
   ++tick_;
   return r;
 }

@@ -36,7 +36,8 @@ struct SceneBundle {
   int id = 0;  ///< caller's picture number (shown in the display state)
 };
 
-/// The servo thread's state of one tick, for the display (latest value wins). 112 bytes.
+/// The servo thread's state of one tick, for the display (latest value wins). ~1.1 KiB, of which the tick
+/// copies only the section entries in use.
 struct ServoDisplayState {
   std::int64_t tick = 0;
   Vec2 handle_m, proxy_m, force_n;
@@ -47,6 +48,10 @@ struct ServoDisplayState {
   std::int64_t tick_compute_ns = 0;///< time of this tick's work [ns] (set by ServoThread)
   std::int64_t period_error_ns = 0;///< wake-up minus deadline of this tick [ns] (set by ServoThread)
   std::int64_t missed_deadlines = 0;
+  /// The boundary section (seed §3): the first kMaxSection node ids of the collision tree's frontier.
+  static constexpr int kMaxSection = 256;
+  std::int32_t section_count = 0;  ///< entries in the section (may exceed kMaxSection; only those are copied)
+  std::uint32_t section[kMaxSection];
 };
 
 /// Per-tick work of the servo thread. Methods marked real-time are called by the servo thread only.

@@ -117,4 +117,14 @@ ServoTimingStats ServoThread::stats() const {
   return s;
 }
 
+ServoTimingStats ServoThread::take_stats() {
+  const ServoTimingStats s = stats();
+  for (auto& b : late_) b.store(0, std::memory_order_relaxed);
+  for (auto& b : compute_) b.store(0, std::memory_order_relaxed);
+  ticks_.store(0);
+  missed_.store(0);
+  max_late_ns_.store(0);
+  return s;
+}
+
 }  // namespace hk::app

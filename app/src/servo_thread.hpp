@@ -51,6 +51,9 @@ class ServoThread {
   bool realtime() const { return realtime_.load(); }
   /// Timing so far (reads the servo thread's histograms; any thread).
   ServoTimingStats stats() const;
+  /// Timing since the last call (or the start), then starts counting afresh: one report per visitor's
+  /// session. Counts racing with the servo thread's increments may be off by a tick.
+  ServoTimingStats take_stats();
 
  private:
   void run();

@@ -69,6 +69,8 @@ class ServoLoop {
   /// Changes the rendered level (takes effect next tick).
   void set_level(int level) { params_.level = level; }
   std::int64_t ticks() const { return ticks_; }
+  /// The contact solver (its proxy and boundary section), for display snapshots taken in the servo thread.
+  const ContactSolver& solver() const { return solver_; }
 
  private:
   const Scene* scene_;
