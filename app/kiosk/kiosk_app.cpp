@@ -7,6 +7,7 @@
 #include <imgui_impl_opengl2.h>
 #include <spdlog/spdlog.h>
 
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -386,20 +387,32 @@ const char* state_name(KioskState s) {
   return "?";
 }
 
-KioskKey map_key(int key, bool* known) {
-  *known = true;
-  switch (key) {
-    case GLFW_KEY_F1: case GLFW_KEY_H: return KioskKey::Help;
-    case GLFW_KEY_RIGHT: case GLFW_KEY_N: case GLFW_KEY_SPACE: return KioskKey::Next;
-    case GLFW_KEY_LEFT: case GLFW_KEY_P: return KioskKey::Previous;
-    case GLFW_KEY_D: case GLFW_KEY_ENTER: return KioskKey::Describe;
-    case GLFW_KEY_UP: case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: return KioskKey::Finer;
-    case GLFW_KEY_DOWN: case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: return KioskKey::Coarser;
-    case GLFW_KEY_PAGE_UP: return KioskKey::VolumeUp;
-    case GLFW_KEY_PAGE_DOWN: return KioskKey::VolumeDown;
-    case GLFW_KEY_T: return KioskKey::Tutorial;
-    default: *known = false; return KioskKey::Other;
-  }
+// GLFW key code of a [keys] name (config/settings.hpp lists the names; the config refuses others).
+int glfw_key(const std::string& name) {
+  if (name.size() == 1 && name[0] >= 'A' && name[0] <= 'Z') return GLFW_KEY_A + (name[0] - 'A');
+  if (name.size() == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
+  if (name.size() >= 2 && name[0] == 'F' && std::isdigit(static_cast<unsigned char>(name[1]))) return GLFW_KEY_F1 + std::stoi(name.substr(1)) - 1;
+  if (name.size() == 4 && name.rfind("KP_", 0) == 0 && std::isdigit(static_cast<unsigned char>(name[3]))) return GLFW_KEY_KP_0 + (name[3] - '0');
+  static const std::map<std::string, int> named{{"SPACE", GLFW_KEY_SPACE},         {"ENTER", GLFW_KEY_ENTER},
+                                                {"TAB", GLFW_KEY_TAB},             {"BACKSPACE", GLFW_KEY_BACKSPACE},
+                                                {"LEFT", GLFW_KEY_LEFT},           {"RIGHT", GLFW_KEY_RIGHT},
+                                                {"UP", GLFW_KEY_UP},               {"DOWN", GLFW_KEY_DOWN},
+                                                {"PAGE_UP", GLFW_KEY_PAGE_UP},     {"PAGE_DOWN", GLFW_KEY_PAGE_DOWN},
+                                                {"HOME", GLFW_KEY_HOME},           {"END", GLFW_KEY_END},
+                                                {"INSERT", GLFW_KEY_INSERT},       {"DELETE", GLFW_KEY_DELETE},
+                                                {"MINUS", GLFW_KEY_MINUS},         {"EQUAL", GLFW_KEY_EQUAL},
+                                                {"KP_ADD", GLFW_KEY_KP_ADD},       {"KP_SUBTRACT", GLFW_KEY_KP_SUBTRACT},
+                                                {"KP_ENTER", GLFW_KEY_KP_ENTER}};
+  const auto it = named.find(name);
+  return it == named.end() ? GLFW_KEY_UNKNOWN : it->second;
+}
+
+std::map<int, KioskKey> key_map(const config::KeysSettings& k) {
+  return {{glfw_key(k.help), KioskKey::Help},         {glfw_key(k.next), KioskKey::Next},
+          {glfw_key(k.previous), KioskKey::Previous}, {glfw_key(k.describe), KioskKey::Describe},
+          {glfw_key(k.finer), KioskKey::Finer},       {glfw_key(k.coarser), KioskKey::Coarser},
+          {glfw_key(k.volume_up), KioskKey::VolumeUp}, {glfw_key(k.volume_down), KioskKey::VolumeDown},
+          {glfw_key(k.tutorial), KioskKey::Tutorial}};
 }
 
 struct WindowState {
@@ -407,6 +420,7 @@ struct WindowState {
   KioskFlow* flow = nullptr;
   double now_s = 0;
   bool windowed = false;
+  std::map<int, KioskKey> keys;  // GLFW key → action, from [keys]
 };
 
 }  // namespace
@@ -450,7 +464,7 @@ int run_kiosk(const KioskOptions& o) {
   ImGui_ImplGlfw_InitForOpenGL(win, true);
   ImGui_ImplOpenGL2_Init();
 
-  WindowState ws{&app, &flow, 0.0, o.windowed};
+  WindowState ws{&app, &flow, 0.0, o.windowed, key_map(s.keys)};
   glfwSetWindowUserPointer(win, &ws);
   glfwSetKeyCallback(win, [](GLFWwindow* wnd, int key, int, int action, int) {
     if (action != GLFW_PRESS) return;
@@ -467,9 +481,8 @@ int run_kiosk(const KioskOptions& o) {
       glfwSetWindowShouldClose(wnd, 1);
       return;
     }
-    bool known = false;
-    const KioskKey k = map_key(key, &known);
-    st->flow->key(k, st->now_s);
+    const auto it = st->keys.find(key);
+    st->flow->key(it == st->keys.end() ? KioskKey::Other : it->second, st->now_s);
   });
 
   app.start_servo();

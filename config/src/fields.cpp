@@ -63,8 +63,15 @@ constexpr FieldDescriptor make_field(std::string_view table, std::string_view ke
 
 constexpr std::array<std::string_view, 1> kDeviceTypes{"simulated"};
 constexpr double kTwoPow31 = 2147483648.0;
+// Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
+constexpr auto kKeyNames = std::to_array<std::string_view>({
+    "F1", "F2", "F3", "F4", "F5", "F6", "F7", "F8", "F9", "F10", "F11", "F12",
+    "A", "B", "D", "E", "F", "G", "H", "I", "J", "K", "L", "M", "N", "P", "Q", "R", "S", "T", "U", "V", "W", "X", "Y", "Z",
+    "0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "SPACE", "ENTER", "TAB", "BACKSPACE", "LEFT", "RIGHT", "UP", "DOWN",
+    "PAGE_UP", "PAGE_DOWN", "HOME", "END", "INSERT", "DELETE", "MINUS", "EQUAL",
+    "KP_0", "KP_1", "KP_2", "KP_3", "KP_4", "KP_5", "KP_6", "KP_7", "KP_8", "KP_9", "KP_ADD", "KP_SUBTRACT", "KP_ENTER"});
 
-constexpr std::array<detail::TableInfo, 7> kTables{{
+constexpr std::array<detail::TableInfo, 8> kTables{{
     {"haptics", "Force rendering and the servo loop."},
     {"device", "Which device drives the handle, and the simulated pantograph's physics."},
     {"hand", "The model hand that drives the simulated pantograph in headless runs."},
@@ -72,6 +79,7 @@ constexpr std::array<detail::TableInfo, 7> kTables{{
     {"workspace", "The device's usable rectangle, centred on the workspace origin."},
     {"audio", "Earcons, speech and volume."},
     {"kiosk", "The visitor's session."},
+    {"keys", "The key for each of the visitor's actions (O, C and ESCAPE are the operator's)."},
 }};
 
 constexpr auto kFields = std::to_array<FieldDescriptor>({
@@ -121,6 +129,16 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     // [kiosk]
     HK_FIELD(kiosk, timeout_s, 10, 3600, "s", "No key and no handle motion for this long ends the session."),
     HK_FIELD(kiosk, warning_s, 1, 600, "s", "The spoken warning comes this long before the end (at most half the timeout)."),
+    // [keys]
+    HK_FIELD(keys, help, 0, 0, "", "Help.", kKeyNames),
+    HK_FIELD(keys, next, 0, 0, "", "Next picture (next tutorial shape).", kKeyNames),
+    HK_FIELD(keys, previous, 0, 0, "", "Previous picture.", kKeyNames),
+    HK_FIELD(keys, describe, 0, 0, "", "Describe the picture.", kKeyNames),
+    HK_FIELD(keys, finer, 0, 0, "", "More detail (finer level).", kKeyNames),
+    HK_FIELD(keys, coarser, 0, 0, "", "Less detail (coarser level).", kKeyNames),
+    HK_FIELD(keys, volume_up, 0, 0, "", "Louder.", kKeyNames),
+    HK_FIELD(keys, volume_down, 0, 0, "", "Quieter.", kKeyNames),
+    HK_FIELD(keys, tutorial, 0, 0, "", "Start the tutorial again.", kKeyNames),
 });
 
 #undef HK_FIELD

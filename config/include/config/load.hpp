@@ -3,7 +3,7 @@
 /// Reading, checking and writing the kiosk settings (`settings.hpp`) as TOML.
 ///
 /// The file layout is one TOML table per settings struct ([haptics], [device], [hand], [vision],
-/// [workspace], [audio], [kiosk]) with one key per field, named exactly as the field. Every key is optional: a key
+/// [workspace], [audio], [kiosk], [keys]) with one key per field, named exactly as the field. Every key is optional: a key
 /// that is absent keeps its default. Everything else is refused with a ConfigError whose message is
 /// one line naming the file, the key (as `table.key`), the bad value and what is allowed, e.g.
 ///   config 'k.toml': haptics.stiffness_n_per_m = -5 is out of range [10, 5000] N/m (line 3)
@@ -72,7 +72,7 @@ struct FieldDescriptor {
 };
 
 /// Every settings field, grouped by table in file order (haptics, device, hand, vision,
-/// workspace, audio, kiosk). The span refers to static storage.
+/// workspace, audio, kiosk, keys). The span refers to static storage.
 [[nodiscard]] std::span<const FieldDescriptor> field_descriptors() noexcept;
 
 /// The descriptor of `table.key`, or nullptr when there is no such field.

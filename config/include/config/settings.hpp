@@ -95,6 +95,25 @@ struct KioskSettings {
   bool operator==(const KioskSettings&) const = default;
 };
 
+/// [keys] — the key for each of the visitor's actions (issue 5: keys a blind visitor can find). Each value
+/// is one key name: F1..F12, A..Z, 0..9, SPACE, ENTER, TAB, BACKSPACE, LEFT, RIGHT, UP, DOWN, PAGE_UP,
+/// PAGE_DOWN, HOME, END, INSERT, DELETE, MINUS, EQUAL, KP_0..KP_9, KP_ADD, KP_SUBTRACT, KP_ENTER.
+/// O, C and ESCAPE are the operator's (overlay, contrast, quit in windowed mode).
+struct KeysSettings {
+  std::string help = "F1";                ///< key help
+  std::string next = "RIGHT";             ///< key next, next picture (next tutorial shape)
+  std::string previous = "LEFT";          ///< key previous
+  std::string describe = "D";             ///< key describe, speak what the picture holds and where
+  std::string finer = "UP";               ///< key finer, more detail (finer level)
+  std::string coarser = "DOWN";           ///< key coarser, less detail
+  std::string volume_up = "PAGE_UP";      ///< key volume_up
+  std::string volume_down = "PAGE_DOWN";  ///< key volume_down
+  std::string tutorial = "T";             ///< key tutorial, start the tutorial again
+
+  /// Field-by-field equality; used by round-trip checks.
+  bool operator==(const KeysSettings&) const = default;
+};
+
 /// All settings. Default-constructed = the shipped defaults.
 struct Settings {
   HapticsSettings haptics;
@@ -104,6 +123,7 @@ struct Settings {
   WorkspaceSettings workspace;
   AudioSettings audio;
   KioskSettings kiosk;
+  KeysSettings keys;
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const Settings&) const = default;
