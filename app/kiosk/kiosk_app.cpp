@@ -505,6 +505,8 @@ int run_kiosk(const KioskOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   Vec2 last_moved_at;
   bool have_baseline = false;
+  bool mouse_seen = false, mouse_moved = false;
+  Vec2 mouse_rest;  // [px]
   int frame = 0;
   std::size_t next_script = 0;
   while (!glfwWindowShouldClose(win)) {
@@ -521,6 +523,17 @@ int run_kiosk(const KioskOptions& o) {
     glfwGetFramebufferSize(win, &fw, &fh);
     const View view = make_view(fw, fh, app.half());
     if (!scripted) {
+      // The mouse stands in for the visitor's hand, but only once it has moved: where the pointer happens
+      // to rest when the kiosk starts must not drag the handle (and wake the kiosk).
+      double cx = 0, cy = 0;
+      glfwGetCursorPos(win, &cx, &cy);
+      if (!mouse_seen) {
+        mouse_seen = true;
+        mouse_rest = {cx, cy};
+      }
+      mouse_moved = mouse_moved || std::hypot(cx - mouse_rest.x, cy - mouse_rest.y) > 2.0;
+    }
+    if (!scripted && mouse_moved) {
       double cx = 0, cy = 0;
       glfwGetCursorPos(win, &cx, &cy);
       int ww = 0, wh = 0;
