@@ -74,7 +74,9 @@ TEST(AudioSystem, RunsWithoutASoundCard) {
   AudioSystemParams p;  // open_output = true: on this machine there is no device, on a kiosk there is
   AudioSystem a(p);
   ASSERT_NE(a.output_info(), nullptr);
-  if (!a.sound_output()) EXPECT_FALSE(a.output_info()->why_not.empty());
+  if (!a.sound_output()) {
+    EXPECT_FALSE(a.output_info()->why_not.empty());
+  }
   a.say(MessageId::welcome);
   EXPECT_EQ(a.speech_log().size(), 1u);
 }
