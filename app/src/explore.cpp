@@ -197,7 +197,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["per_tick"] = {{"queries_mean", queries / n}, {"box_tests_mean", box_tests / n}, {"boundary_section_mean", section_sum / n},
                     {"boundary_section_max", section_max}, {"iteration_limited_ticks", iteration_limited}};
   sj["curves"] = scene.curve_count();
-  sj["chains"] = {{"found", is.chains_found}, {"too_short", is.chains_too_short}, {"unbuildable", scene.skipped_curves()}};
+  sj["chains"] = {{"found", is.chains_found}, {"too_short", is.chains_too_short}, {"over_budget", is.chains_over_budget},
+                  {"unbuildable", scene.skipped_curves()}};
   json segs = json::array();
   for (int l = 0; l < Scene::kMaxLevels; ++l) {
     bool any = false;

@@ -1,5 +1,7 @@
 #include "image_scene.hpp"
 
+#include <algorithm>
+
 namespace hk::app {
 
 std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chains, const vision::PxToM& map, double min_length_m,
@@ -55,6 +57,30 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s)
 
   out.polylines = chains_to_polylines(ex.chains, out.px_to_m, s.vision.min_chain_length_m, &out.chains_too_short);
   out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
+  // Scene budget (issue 6, item 4): keep the servo's data within max_segments level-0 segments, keeping
+  // the longest curves (a first measure of salience: long boundaries are the shapes a visitor explores).
+  const auto budget = static_cast<std::size_t>(s.vision.max_segments);
+  if (out.scene->total_segments(0) > budget) {
+    std::vector<std::size_t> order(out.scene->curve_count());
+    std::vector<double> len(order.size(), 0.0);
+    for (std::size_t c = 0; c < order.size(); ++c) {
+      order[c] = c;
+      const Polyline& p = out.polylines[out.scene->source_index(c)];
+      for (std::size_t i = 1; i < p.points_m.size(); ++i) len[c] += distance(p.points_m[i - 1], p.points_m[i]);
+    }
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return len[a] > len[b]; });
+    std::vector<Polyline> kept;
+    std::size_t used = 0;
+    for (std::size_t c : order) {
+      const std::size_t n = out.scene->curve(c).segment_count[0];
+      if (used + n > budget) continue;  // a shorter one further down may still fit
+      used += n;
+      kept.push_back(out.polylines[out.scene->source_index(c)]);
+    }
+    out.chains_over_budget = out.scene->curve_count() - kept.size();
+    out.polylines = std::move(kept);
+    out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
+  }
   out.times.multires_ms = out.scene->build_times().multires_ms;
   out.times.tree_ms = out.scene->build_times().tree_ms;
   return out;

@@ -27,6 +27,7 @@ struct ImageScene {
   vision::PxToM px_to_m{};
   std::size_t chains_found = 0;        ///< chains out of edge linking
   std::size_t chains_too_short = 0;    ///< dropped: shorter than vision.min_chain_length_m
+  std::size_t chains_over_budget = 0;  ///< dropped: the scene would hold more than vision.max_segments level-0 segments (shortest dropped first)
   double canny_low = 0, canny_high = 0;
   std::vector<Polyline> polylines;     ///< kept chains in workspace metres
   std::unique_ptr<Scene> scene;        ///< collision trees (heap: the servo loop holds a pointer)

@@ -116,6 +116,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(vision, canny_high, 0, 2000, "", "Canny hysteresis high threshold; 0 = from the image."),
     HK_FIELD(vision, min_chain_length_m, 0, 0.1, "m", "Edge chains shorter than this are dropped."),
     HK_FIELD(vision, max_image_side_px, 64, 10000, "px", "Images are downscaled to this longest side."),
+    HK_FIELD(vision, max_segments, 100, 1000000, "", "Scene budget: level-0 segments kept, the longest curves first."),
     // [workspace]
     HK_FIELD(workspace, width_m, 0.01, 1, "m", "Width of the usable rectangle."),
     HK_FIELD(workspace, height_m, 0.01, 1, "m", "Height of the usable rectangle."),

@@ -63,6 +63,7 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"vision", "canny_high", 0, 2000, false},
       {"vision", "min_chain_length_m", 0, 0.1, false},
       {"vision", "max_image_side_px", 64, 10000, true},
+      {"vision", "max_segments", 100, 1000000, true},
       {"workspace", "width_m", 0.01, 1, false},
       {"workspace", "height_m", 0.01, 1, false},
       {"audio", "volume_default_step", 1, 10, true},

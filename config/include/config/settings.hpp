@@ -59,6 +59,7 @@ struct VisionSettings {
   double canny_high = 0.0;                    ///< key canny_high, hysteresis high threshold, [0, 2000]; 0 = from the image; canny_low <= canny_high when both nonzero
   double min_chain_length_m = 0.004;          ///< key min_chain_length_m, drop shorter chains (can't be felt), [0, 0.1] m
   int max_image_side_px = 800;                ///< key max_image_side_px, images are downscaled to this, [64, 10000] px
+  int max_segments = 30000;                   ///< key max_segments, scene budget: level-0 segments kept, longest curves first, [100, 1000000]
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const VisionSettings&) const = default;
