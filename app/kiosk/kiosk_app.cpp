@@ -95,13 +95,11 @@ class App final : public KioskEffects {
  public:
   App(const KioskOptions& o, const config::Settings& s)
       : opt_(o), s_(s), audio_(audio_params_from(s)), half_{s.workspace.width_m / 2, s.workspace.height_m / 2},
-        sp_(servo_params_from(s)), device_(sim_params(s), {0.0, -0.9 * s.workspace.height_m / 2}),
+        sp_(servo_params_from(s)), device_(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2}),
         core_(device_, cue_params(), &audio_.cues()) {
     pictures_ = list_pictures(o.library.empty() ? std::string(HK_DATA_DIR) + "/pictures" : o.library);
     device_.open();
-    hand_.stiffness_n_per_m = s.hand.stiffness_n_per_m;
-    hand_.damping_n_s_per_m = s.hand.damping_n_s_per_m;
-    hand_.max_force_n = s.hand.max_force_n;
+    hand_ = hand_params_from(s);
     cursor_.back() = device_.true_position_m();
     cursor_.publish();
     level_ = s.haptics.level;
@@ -190,15 +188,6 @@ class App final : public KioskEffects {
   void collect() { core_.collect_retired(); }
 
  private:
-  static SimPantographParams sim_params(const config::Settings& s) {
-    SimPantographParams p;
-    p.handle_mass_kg = s.device.handle_mass_kg;
-    p.handle_damping_n_s_per_m = s.device.handle_damping_n_s_per_m;
-    p.encoder_counts_per_rev = s.device.encoder_counts_per_rev;
-    p.max_torque_n_m = s.device.max_torque_n_m;
-    p.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
-    return p;
-  }
   CueTrackerParams cue_params() const {
     CueTrackerParams p;
     p.period_s = 1.0 / s_.haptics.servo_rate_hz;

@@ -27,20 +27,29 @@ ServoParams servo_params_from(const config::Settings& s) {
   return sp;
 }
 
-long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
-                    const TickObserver& observe) {
+SimPantographParams sim_params_from(const config::Settings& s) {
   SimPantographParams dp;
   dp.handle_mass_kg = s.device.handle_mass_kg;
   dp.handle_damping_n_s_per_m = s.device.handle_damping_n_s_per_m;
   dp.encoder_counts_per_rev = s.device.encoder_counts_per_rev;
   dp.max_torque_n_m = s.device.max_torque_n_m;
   dp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
-  SimulatedPantograph device(dp, hand.at(0.0));
-  device.open();
+  return dp;
+}
+
+ModelHandParams hand_params_from(const config::Settings& s) {
   ModelHandParams hp;
   hp.stiffness_n_per_m = s.hand.stiffness_n_per_m;
   hp.damping_n_s_per_m = s.hand.damping_n_s_per_m;
   hp.max_force_n = s.hand.max_force_n;
+  return hp;
+}
+
+long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+                    const TickObserver& observe) {
+  SimulatedPantograph device(sim_params_from(s), hand.at(0.0));
+  device.open();
+  const ModelHandParams hp = hand_params_from(s);
 
   const ServoParams sp = servo_params_from(s);
   ServoLoop servo(scene, sp);

@@ -10,6 +10,7 @@
 #include "haptics/hand_path.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
+#include "haptics/sim_pantograph.hpp"
 
 namespace hk::app {
 
@@ -26,6 +27,12 @@ using TickObserver = std::function<void(const TickRecord&, const ServoOutput&)>;
 
 /// Servo parameters from the settings.
 ServoParams servo_params_from(const config::Settings& s);
+
+/// Simulated pantograph parameters from the settings ([device] and the [workspace] rectangle).
+SimPantographParams sim_params_from(const config::Settings& s);
+
+/// Model hand parameters from the settings ([hand]).
+ModelHandParams hand_params_from(const config::Settings& s);
 
 /// Runs the simulated pantograph driven by `hand` over `scene` for `duration_s` seconds.
 /// Returns the number of ticks run.

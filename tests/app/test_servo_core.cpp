@@ -2,6 +2,8 @@
 // hand-over of scenes between threads, cues and the display slot.
 #include <gtest/gtest.h>
 
+#include "curves.hpp"
+
 #include <memory>
 #include <vector>
 
@@ -13,12 +15,7 @@
 namespace hk::app {
 namespace {
 
-Polyline square(double half) {
-  Polyline p;
-  p.closed = true;
-  p.points_m = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
-  return p;
-}
+using test::square;
 
 std::unique_ptr<SceneBundle> bundle(const ServoParams& sp, int id, double half = 0.02) {
   auto b = std::make_unique<SceneBundle>(std::make_unique<Scene>(Scene::build({square(half)}, 2)), sp);

@@ -2,6 +2,8 @@
 // force), refuses a bad rate, and stops cleanly. Its timing is measured in bench/servo_rate.cpp.
 #include <gtest/gtest.h>
 
+#include "curves.hpp"
+
 #include <chrono>
 #include <thread>
 
@@ -12,12 +14,7 @@
 namespace hk::app {
 namespace {
 
-Polyline square(double half) {
-  Polyline p;
-  p.closed = true;
-  p.points_m = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
-  return p;
-}
+using test::square;
 
 TEST(ServoThread, TicksCountsAMissedDeadlineAndStops) {
   const config::Settings s;

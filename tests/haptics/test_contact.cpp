@@ -11,12 +11,7 @@ using namespace hk;
 
 namespace {
 
-Polyline square(double half) {
-  Polyline p;
-  p.closed = true;
-  p.points_m = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};  // counter-clockwise
-  return p;
-}
+using test::square;
 
 struct Trajectory {
   std::vector<Vec2> proxies;

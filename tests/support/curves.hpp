@@ -12,6 +12,14 @@
 
 namespace hk::test {
 
+/// A closed axis-aligned square of half side `half` [m] centred at the origin, counter-clockwise.
+inline Polyline square(double half) {
+  Polyline p;
+  p.closed = true;
+  p.points_m = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
+  return p;
+}
+
 /// A smooth random closed blob: r(θ) = r0 (1 + Σ a_i cos(iθ + φ_i)), n points, centred at c.
 inline Polyline random_blob(std::mt19937& rng, Vec2 c, double r0, int n) {
   std::uniform_real_distribution<double> amp(-0.12, 0.12), ph(0.0, 2 * M_PI);
