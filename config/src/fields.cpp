@@ -62,6 +62,7 @@ constexpr FieldDescriptor make_field(std::string_view table, std::string_view ke
   make_field<&Settings::table, &decltype(Settings::table)::field>(#table, #field, __VA_ARGS__)
 
 constexpr std::array<std::string_view, 1> kDeviceTypes{"simulated"};
+constexpr std::array<std::string_view, 2> kLevelModes{"auto", "fixed"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>({
@@ -89,7 +90,15 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(haptics, max_force_n, 0.1, 20, "N", "Force clamp: no force above this leaves the device."),
     HK_FIELD(haptics, servo_rate_hz, 100, 10000, "Hz", "Servo loop rate."),
     HK_FIELD(haptics, level, 0, 12, "",
-             "Resolution level rendered; 0 = finest; must be <= max_levels."),
+             "Resolution level at the start, and always when level_mode = \"fixed\"; 0 = finest; must be <= max_levels."),
+    HK_FIELD(haptics, level_mode, 0, 0, "", "\"auto\": the level follows the hand's speed; \"fixed\": always `level`.", kLevelModes),
+    HK_FIELD(haptics, level_error_at_rest_m, 0, 0.01, "m", "Deviation from the true curve a slowly moving fingertip cannot feel."),
+    HK_FIELD(haptics, level_blur_time_s, 0, 0.1, "s", "The tolerable deviation grows by the hand's speed times this."),
+    HK_FIELD(haptics, level_hysteresis, 0, 0.9, "", "Go coarser only when that level's error is this fraction below the tolerance."),
+    HK_FIELD(haptics, level_min_dwell_s, 0, 5, "s", "Least time between two level changes."),
+    HK_FIELD(haptics, level_max_force_step_n, 0.001, 5, "N", "Largest force change per tick that a level change may cause."),
+    HK_FIELD(haptics, static_friction, 0, 2, "", "Coulomb static friction of the walls; >= dynamic_friction."),
+    HK_FIELD(haptics, dynamic_friction, 0, 2, "", "Coulomb dynamic friction of the walls; both 0 = frictionless."),
     HK_FIELD(haptics, max_levels, 1, 12, "", "Number of levels built above level 0."),
     HK_FIELD(haptics, query_deadline_us, 1, 100000, "µs", "Deadline of the anytime collision query."),
     HK_FIELD(haptics, force_ramp_s, 0, 10, "s", "Start-up force ramp duration."),
@@ -116,7 +125,8 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(vision, canny_high, 0, 2000, "", "Canny hysteresis high threshold; 0 = from the image."),
     HK_FIELD(vision, min_chain_length_m, 0, 0.1, "m", "Edge chains shorter than this are dropped."),
     HK_FIELD(vision, max_image_side_px, 64, 10000, "px", "Images are downscaled to this longest side."),
-    HK_FIELD(vision, max_segments, 100, 1000000, "", "Scene budget: level-0 segments kept, the longest curves first."),
+    HK_FIELD(vision, max_segments, 100, 1000000, "", "Scene budget: level-0 segments kept, the most salient curves first."),
+    HK_FIELD(vision, thin_line_max_width_m, 0, 0.01, "m", "The two edges of a line thinner than this become one curve; 0 = off."),
     // [workspace]
     HK_FIELD(workspace, width_m, 0.01, 1, "m", "Width of the usable rectangle."),
     HK_FIELD(workspace, height_m, 0.01, 1, "m", "Height of the usable rectangle."),
@@ -322,6 +332,11 @@ void validate_as(const Settings& s, const Source& src) {
          "vision.canny_low = " + format_real(s.vision.canny_low) +
              " must be <= vision.canny_high = " + format_real(s.vision.canny_high) +
              " when both are nonzero");
+  if (s.haptics.dynamic_friction > s.haptics.static_friction)
+    fail(src, "haptics.dynamic_friction",
+         "haptics.dynamic_friction = " + format_real(s.haptics.dynamic_friction) +
+             " must be <= haptics.static_friction = " + format_real(s.haptics.static_friction) +
+             " (a wall that holds less at rest than while sliding would chatter)");
 }
 
 }  // namespace detail

@@ -252,6 +252,8 @@ TEST(ConfigLoad, EveryKeyAtItsBoundsIsAccepted) {
     for (double ok : {spec.min, spec.max}) {
       std::string text = doc(spec, number_text(spec, ok));
       if (spec.name() == "haptics.level") text += "max_levels = 12\n";
+      if (spec.name() == "haptics.dynamic_friction") text += "static_friction = 2.0\n";
+      if (spec.name() == "haptics.static_friction") text += "dynamic_friction = 0.0\n";
       EXPECT_NO_THROW((void)parse_settings(text, "bounds.toml")) << text;
     }
   }

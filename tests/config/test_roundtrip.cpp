@@ -96,6 +96,7 @@ Settings random_settings(std::mt19937_64& rng) {
   if (s.haptics.max_levels < 1) s.haptics.max_levels = 1;
   if (s.haptics.level > s.haptics.max_levels) s.haptics.level = s.haptics.max_levels;
   if (s.vision.canny_low > s.vision.canny_high) std::swap(s.vision.canny_low, s.vision.canny_high);
+  if (s.haptics.dynamic_friction > s.haptics.static_friction) std::swap(s.haptics.dynamic_friction, s.haptics.static_friction);
   return s;
 }
 

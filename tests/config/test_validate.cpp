@@ -58,6 +58,13 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
+    if (name == "haptics.level_mode") {
+      EXPECT_EQ(d.kind, FieldKind::text);
+      ASSERT_EQ(d.choices.size(), 2u);
+      EXPECT_EQ(d.choices[0], "auto");
+      ++texts;
+      continue;
+    }
     if (d.table == "keys") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_GT(d.choices.size(), 50u) << name;
@@ -67,7 +74,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 10u);
+  EXPECT_EQ(texts, 11u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -114,6 +121,8 @@ TEST(ConfigValidate, BoundsThemselvesAreAccepted) {
     for (double ok : {spec.min, spec.max}) {
       Settings s;
       s.haptics.max_levels = 12;  // so that haptics.level = 12 passes the cross-field rule
+      s.haptics.static_friction = 2.0;  // and any dynamic friction passes dynamic <= static...
+      if (spec.name() == "haptics.static_friction") s.haptics.dynamic_friction = 0.0;  // ...and any static
       set_numeric(s, spec, ok);
       EXPECT_NO_THROW(validate(s)) << spec.name() << " = " << ok;
     }
@@ -160,6 +169,29 @@ TEST(ConfigValidate, CannyLowMustNotExceedHighWhenBothSet) {
   EXPECT_EQ(e->key(), "vision.canny_low");
   EXPECT_EQ(std::string(e->what()),
             "settings: vision.canny_low = 300 must be <= vision.canny_high = 200 when both are nonzero");
+}
+
+TEST(ConfigValidate, DynamicFrictionMustNotExceedStatic) {
+  Settings s;
+  s.haptics.static_friction = 0.0;
+  s.haptics.dynamic_friction = 0.0;  // frictionless walls
+  EXPECT_NO_THROW(validate(s));
+  s.haptics.static_friction = 0.5;
+  s.haptics.dynamic_friction = 0.5;
+  EXPECT_NO_THROW(validate(s));
+  s.haptics.dynamic_friction = 0.6;
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "haptics.dynamic_friction");
+  EXPECT_NE(std::string(e->what()).find("must be <= haptics.static_friction = 0.5"), std::string::npos) << e->what();
+}
+
+TEST(ConfigValidate, UnknownLevelModeIsRefused) {
+  Settings s;
+  s.haptics.level_mode = "adaptive";
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "haptics.level_mode");
 }
 
 TEST(ConfigValidate, UnknownDeviceTypeIsRefused) {

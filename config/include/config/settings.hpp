@@ -15,7 +15,15 @@ struct HapticsSettings {
   double damping_n_s_per_m = 0.0;         ///< key damping_n_s_per_m, rendered damping in contact, [0, 20] N·s/m
   double max_force_n = 3.5;               ///< key max_force_n, force clamp, [0.1, 20] N (the simulated pantograph gives ≥ 3.78 N in every direction)
   double servo_rate_hz = 1000.0;          ///< key servo_rate_hz, [100, 10000] Hz
-  int level = 1;                          ///< key level, resolution level rendered, [0, 12] and <= max_levels; 0 = finest
+  int level = 1;                          ///< key level, resolution level at the start (and always, when level_mode = "fixed"), [0, 12] and <= max_levels; 0 = finest
+  std::string level_mode = "auto";        ///< key level_mode, "auto" (from hand speed, issue 6) or "fixed" (always `level`)
+  double level_error_at_rest_m = 1e-4;    ///< key level_error_at_rest_m, deviation a slow fingertip cannot feel, [0, 0.01] m; 0 = the finest level whenever the hand rests
+  double level_blur_time_s = 0.010;       ///< key level_blur_time_s, tolerable deviation grows by hand speed x this, [0, 0.1] s
+  double level_hysteresis = 0.3;          ///< key level_hysteresis, go coarser only when the bound is this fraction under the tolerance, [0, 0.9]
+  double level_min_dwell_s = 0.15;        ///< key level_min_dwell_s, least time between two level changes, [0, 5] s
+  double level_max_force_step_n = 0.05;   ///< key level_max_force_step_n, largest force change per tick a level change may cause, [0.001, 5] N
+  double static_friction = 0.4;           ///< key static_friction, Coulomb static coefficient of the walls, [0, 2]; >= dynamic_friction
+  double dynamic_friction = 0.3;          ///< key dynamic_friction, Coulomb dynamic coefficient, [0, 2]; 0 and 0 = frictionless
   int max_levels = 6;                     ///< key max_levels, levels built above level 0, [1, 12]
   double query_deadline_us = 200.0;       ///< key query_deadline_us, anytime collision deadline, [1, 100000] µs
   double force_ramp_s = 0.5;              ///< key force_ramp_s, start-up force ramp, [0, 10] s
@@ -59,7 +67,8 @@ struct VisionSettings {
   double canny_high = 0.0;                    ///< key canny_high, hysteresis high threshold, [0, 2000]; 0 = from the image; canny_low <= canny_high when both nonzero
   double min_chain_length_m = 0.004;          ///< key min_chain_length_m, drop shorter chains (can't be felt), [0, 0.1] m
   int max_image_side_px = 800;                ///< key max_image_side_px, images are downscaled to this, [64, 10000] px
-  int max_segments = 30000;                   ///< key max_segments, scene budget: level-0 segments kept, longest curves first, [100, 1000000]
+  int max_segments = 30000;                   ///< key max_segments, scene budget: level-0 segments kept, most salient curves first, [100, 1000000]
+  double thin_line_max_width_m = 0.001;       ///< key thin_line_max_width_m, the two edges of a line thinner than this become one curve, [0, 0.01] m; 0 = off
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const VisionSettings&) const = default;
