@@ -1,6 +1,7 @@
 // Headless explore run: image → scene → simulated pantograph + model hand → servo ticks → files.
 #include "explore.hpp"
 
+#include <array>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -148,6 +149,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   long budget_exhausted = 0;
   double queries = 0, box_tests = 0, section_sum = 0;
   long section_max = 0, iteration_limited = 0;
+  long level_changes = 0, level_waiting = 0, sticking = 0;
+  std::array<long, Scene::kMaxLevels> level_ticks{};
   CueTrackerParams ctp;
   ctp.period_s = 1.0 / s.haptics.servo_rate_hz;
   ctp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
@@ -156,7 +159,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   run_simulation(scene, s, path, duration, [&](const TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     audio::CueEvent tick_cues[CueTracker::kMaxCuesPerTick];
-    const int nc = tracker.update(r.index, so, r.handle_m, s.haptics.level, tick_cues);
+    const int nc = tracker.update(r.index, so, r.handle_m, so.level, tick_cues);
     cues.insert(cues.end(), tick_cues, tick_cues + nc);
     const int state = static_cast<int>(c.state);
     const int curve = c.state == ContactState::Free ? -1 : c.constraint[0].curve;
@@ -176,6 +179,10 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     section_sum += c.query.section_size;
     section_max = std::max<long>(section_max, c.query.section_size);
     iteration_limited += (c.events & kEventIterationLimit) != 0;
+    level_changes += so.level_changed;
+    level_waiting += so.level != so.level_wanted;
+    sticking += c.sticking;
+    if (so.level >= 0 && so.level < Scene::kMaxLevels) ++level_ticks[static_cast<std::size_t>(so.level)];
   });
   for (const Row& w : rows) {
     std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld\n", w.t_s, w.handle_m.x, w.handle_m.y, w.proxy_m.x,
@@ -207,6 +214,13 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     segs.push_back({{"level", l}, {"segments", scene.total_segments(l)}});
   }
   sj["segments_per_level"] = std::move(segs);
+  json lt = json::array();
+  for (int l = 0; l < Scene::kMaxLevels; ++l) {
+    if (level_ticks[static_cast<std::size_t>(l)] > 0) lt.push_back({{"level", l}, {"ticks", level_ticks[static_cast<std::size_t>(l)]}});
+  }
+  sj["levels"] = {{"mode", s.haptics.level_mode}, {"changes", level_changes}, {"ticks_waiting_for_a_safe_change", level_waiting},
+                  {"ticks_per_level", std::move(lt)}};
+  sj["sticking_ticks"] = sticking;
   sj["segments_in_use"] = scene.total_segments(s.haptics.level);
   sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};
   sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms},

@@ -18,6 +18,14 @@ ServoParams servo_params_from(const config::Settings& s) {
   ServoParams sp;
   sp.period_s = 1.0 / s.haptics.servo_rate_hz;
   sp.level = s.haptics.level;
+  sp.auto_level = s.haptics.level_mode == "auto";
+  sp.policy.error_at_rest_m = s.haptics.level_error_at_rest_m;
+  sp.policy.blur_time_s = s.haptics.level_blur_time_s;
+  sp.policy.hysteresis = s.haptics.level_hysteresis;
+  sp.policy.min_dwell_s = s.haptics.level_min_dwell_s;
+  sp.max_force_step_n = s.haptics.level_max_force_step_n;
+  sp.contact.static_friction = s.haptics.static_friction;
+  sp.contact.dynamic_friction = s.haptics.dynamic_friction;
   sp.query_deadline_s = s.haptics.query_deadline_us * 1e-6;
   sp.contact.stiffness_n_per_m = s.haptics.stiffness_n_per_m;
   sp.contact.damping_n_s_per_m = s.haptics.damping_n_s_per_m;

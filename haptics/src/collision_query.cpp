@@ -313,7 +313,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   return best;
 }
 
-bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out) {
+bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve) {
   const Scene& sc = *scene_;
   double best = max_distance_m;
   bool found = false;
@@ -327,6 +327,7 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
     const Candidate cur = stack_[--top];
     if (cur.t_enter > best) continue;
     const NodeInfo& in = sc.info(cur.node);
+    if (curve >= 0 && (sc.is_segment(cur.node) || sc.is_chunk(cur.node)) && static_cast<int>(in.curve) != curve) continue;
     if (sc.is_segment(cur.node) && in.level <= sc.clamp_level(in.curve, level)) {
       const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
       Vec2 a, b;

@@ -39,7 +39,13 @@ inline bool neighbour(const Scene& sc, SegmentRef s, int dir, SegmentRef* out) {
 }  // namespace
 
 ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
-    : scene_(&scene), params_(params), section_(scene) {}
+    : scene_(&scene), params_(params), section_(scene) {
+  for (int l = 0; l < 16; ++l) {
+    for (std::size_t c = 0; c < scene.curve_count(); ++c) {
+      max_half_width_m_[l] = std::max(max_half_width_m_[l], scene.curve(c).max_box_half_width_m[scene.clamp_level(c, l)]);
+    }
+  }
+}
 
 double ContactSolver::side_of(SegmentRef s, Vec2 p) const {
   const SegGeom g = geom(*scene_, s);
@@ -49,6 +55,8 @@ double ContactSolver::side_of(SegmentRef s, Vec2 p) const {
 void ContactSolver::reset(Vec2 p_m, int level) {
   proxy_ = p_m;
   state_ = ContactState::Free;
+  sticking_ = false;
+  transition_level_ = -1;
   level_ = level;
   section_.reset();
   // A proxy started on a wall would have no side: push it off along the wall's normal.
@@ -61,10 +69,75 @@ void ContactSolver::reset(Vec2 p_m, int level) {
   }
 }
 
+int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m) {
+  const Scene& sc = *scene_;
+  Vec2 q;
+  SegmentRef s;
+  if (!section_.closest_point(p, level, radius_m, &q, &s, curve)) return 0;
+  const SegGeom g = geom(sc, s);
+  // The sign of (p − q) against the normal at q decides the side; where q is a vertex that normal is the
+  // angle-weighted pseudo-normal (in 2D the bisector of the two edges' normals), which makes the sign
+  // exact (Bærentzen & Aanæs 2005, "Signed distance computation using the angle weighted pseudonormal",
+  // IEEE TVCG 11(3)).
+  Vec2 n = g.n;
+  const double t = dot(q - g.a, g.u);
+  SegmentRef nb;
+  for (int dir : {-1, +1}) {
+    if (dir < 0 ? t > 1e-12 : t < g.len - 1e-12) continue;
+    // Nearest to an open end: p is beyond the curve, not between its levels (the levels share their ends).
+    if (!neighbour(sc, s, dir, &nb)) return 0;
+    n = normalized_or(g.n + geom(sc, nb).n, g.n);
+  }
+  const double d = dot(p - q, n);
+  return d > 0.0 ? 1 : (d < 0.0 ? -1 : 2);  // 2: on the polyline, no side
+}
+
+bool ContactSolver::level_change_is_safe(int new_level) {
+  if (new_level == level_) return true;
+  if (transition_level_ >= 0) return false;  // one change at a time
+  // A curve's polylines at two levels lie within E = (largest error-box half-width at one level + at the
+  // other) of each other, so a point between them lies within E of both; search twice as far.
+  const double e = max_half_width_m_[std::clamp(level_, 0, 15)] + max_half_width_m_[std::clamp(new_level, 0, 15)];
+  const double radius = 2.0 * e + 4.0 * params_.skin_m;
+  // The curves that could have the proxy between their two levels: those it touches, and the nearest one
+  // at either level.
+  int curves[4];
+  int n = 0;
+  if (state_ != ContactState::Free) curves[n++] = c_[0].seg.curve;
+  if (state_ == ContactState::Vertex) curves[n++] = c_[1].seg.curve;
+  for (int l : {level_, new_level}) {
+    Vec2 q;
+    SegmentRef s;
+    if (section_.closest_point(proxy_, l, radius, &q, &s)) curves[n++] = s.curve;
+  }
+  for (int i = 0; i < n; ++i) {
+    bool seen = false;
+    for (int j = 0; j < i; ++j) seen = seen || curves[j] == curves[i];
+    if (seen) continue;
+    const int before = side_of_curve(proxy_, curves[i], level_, radius);
+    const int after = side_of_curve(proxy_, curves[i], new_level, radius);
+    if (before == 2 || after == 2) return false;
+    if (before != 0 && after != 0 && before != after) return false;  // the proxy would be behind the new wall
+  }
+  return true;
+}
+
 ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count,
                             const QueryBudget& budget, ContactOutput& out, Constraint* hit_out) {
   QueryStats st;
-  const SweepHit hit = section_.first_hit(proxy_, target, level, excluded, excluded_count, budget, &st);
+  SweepHit hit = section_.first_hit(proxy_, target, level, excluded, excluded_count, budget, &st);
+  if (transition_level_ >= 0) {
+    // Just after a level change both levels are walls (see level_change_is_safe): the nearer one stops the move.
+    QueryStats st2;
+    const SweepHit old_hit = section_.first_hit(proxy_, target, transition_level_, excluded, excluded_count, budget, &st2);
+    st.box_tests += st2.box_tests;
+    st.segment_tests += st2.segment_tests;
+    st.splits += st2.splits;
+    st.merges += st2.merges;
+    st.budget_exhausted = st.budget_exhausted || st2.budget_exhausted;
+    const bool old_first = (old_hit.hit || old_hit.blocked) && (!(hit.hit || hit.blocked) || old_hit.t < hit.t);
+    if (old_first) hit = old_hit;
+  }
   out.query.box_tests += st.box_tests;
   out.query.segment_tests += st.segment_tests;
   out.query.splits += st.splits;
@@ -111,8 +184,10 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
   out.queries = 0;
   out.path_count = 0;
   out.path_m[out.path_count++] = proxy_;
-  if (in.level != level_) {  // constraints refer to the old level's segments: start free (proxy kept)
-    state_ = ContactState::Free;
+  if (in.level != level_) {
+    // A level change (the caller checked level_change_is_safe): the old level stays a wall, with its
+    // constraints, until the proxy no longer touches it, so the move onto the new level crosses neither.
+    transition_level_ = level_;
     level_ = in.level;
   }
   const Vec2 h = in.handle_m;
@@ -127,6 +202,7 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
         if (m == Move::Hit) {
           state_ = ContactState::Edge;
           c_[0] = hit;
+          sticking_ = false;  // the proxy arrives moving: judged against the dynamic cone first
         } else {
           rest = true;
         }
@@ -140,7 +216,21 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
           state_ = ContactState::Free;
           break;
         }
-        const double tau = dot(g.u, h - g.a);
+        // Friction cone (see contact.hpp): inside it the proxy stays; outside, it slides to trail the
+        // handle's foot point by μ_d · penetration.
+        const double depth = -side * dot(g.n, h - g.a);  // > 0: the handle is behind the wall's line
+        const double t_off = dot(g.u, h - proxy_);        // the handle's lead along the edge [m]
+        const double mu = sticking_ ? params_.static_friction : params_.dynamic_friction;
+        if (std::fabs(t_off) <= mu * depth) {
+          // Inside the cone: the proxy stays. A sliding proxy sticks again only once the hand has all but
+          // stopped along the edge (Karnopp's stick band): otherwise a press that deepens while sliding
+          // would re-stick it every few ticks and each break-away would be a μ_s − μ_d force step, a buzz.
+          if (!sticking_) sticking_ = mu > 0.0 && std::fabs(dot(g.u, in.handle_velocity_m_per_s)) <= params_.stick_speed_m_per_s;
+          rest = true;
+          break;
+        }
+        sticking_ = false;
+        const double tau = dot(g.u, h - g.a) - std::copysign(params_.dynamic_friction * depth, t_off);
         const int clamped = tau < 0.0 ? -1 : (tau > g.len ? 1 : 0);
         const double tau_c = std::clamp(tau, 0.0, g.len);
         Constraint hit;
@@ -256,6 +346,7 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
   out.proxy_m = proxy_;
   out.force_n = f;
   out.state = state_;
+  out.sticking = state_ == ContactState::Edge && sticking_;
   out.level = -1;
   out.constraint[0] = SegmentRef{};
   out.constraint[1] = SegmentRef{};
@@ -264,6 +355,12 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
     out.level = c_[0].seg.level;
     if (state_ == ContactState::Vertex) out.constraint[1] = c_[1].seg;
   }
+  if (transition_level_ >= 0) {  // the old level's walls go once the proxy rests on none of them
+    const bool on_old = state_ != ContactState::Free &&
+                        (c_[0].seg.level == transition_level_ || (state_ == ContactState::Vertex && c_[1].seg.level == transition_level_));
+    if (!on_old) transition_level_ = -1;
+  }
+  out.transition_level = transition_level_;
   if (before == ContactState::Free && state_ != ContactState::Free) out.events |= kEventContactBegin;
   if (before != ContactState::Free && state_ == ContactState::Free) out.events |= kEventContactEnd;
 }

@@ -28,14 +28,48 @@ Vec2 ForceGuard::apply(Vec2 f, double since_start_s, DeviceStatus status, bool d
   return f;
 }
 
+namespace {
+
+// The scene's error bound per level for the policy: the largest error-box half-width of any curve (curves
+// with fewer levels count with their coarsest), so the level chosen keeps every curve within tolerance.
+LevelPolicy make_policy(const Scene& scene, const ServoParams& p) {
+  double err[LevelPolicy::kMaxLevels] = {};
+  int levels = 1;
+  for (std::size_t c = 0; c < scene.curve_count(); ++c) levels = std::max(levels, scene.curve(c).levels);
+  levels = std::min(levels, LevelPolicy::kMaxLevels);
+  for (int l = 0; l < levels; ++l) {
+    for (std::size_t c = 0; c < scene.curve_count(); ++c) {
+      err[l] = std::max(err[l], scene.curve(c).max_box_half_width_m[scene.clamp_level(c, l)]);
+    }
+  }
+  LevelPolicyParams pp = p.policy;
+  pp.fixed_level = -1;
+  return LevelPolicy(pp, err, levels, p.level);
+}
+
+}  // namespace
+
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
-    : scene_(&scene), params_(params), solver_(scene, params.contact) {}
+    : scene_(&scene), params_(params), solver_(scene, params.contact), policy_(make_policy(scene, params)), level_(params.level) {}
 
 void ServoLoop::start(Vec2 handle_m) {
-  solver_.reset(handle_m, params_.level);
+  level_ = params_.auto_level ? policy_.level() : params_.level;
+  solver_.reset(handle_m, level_);
   last_handle_ = handle_m;
   velocity_ = {0.0, 0.0};
+  force_residual_ = {0.0, 0.0};
+  last_force_ = {0.0, 0.0};
   ticks_ = 0;
+}
+
+void ServoLoop::set_auto_level(bool on) noexcept {
+  if (on && !params_.auto_level) {
+    ServoParams p = params_;
+    p.level = level_;  // the policy starts from the level in use, its speed filter from rest
+    policy_ = make_policy(*scene_, p);
+  }
+  params_.auto_level = on;
+  if (!on) params_.level = level_;
 }
 
 TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
@@ -52,20 +86,48 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   velocity_ = velocity_ + alpha * (raw - velocity_);
   last_handle_ = h;
 
+  // Level: from the hand's speed or fixed; changed only when the proxy can move to it without crossing.
+  const int wanted = params_.auto_level ? policy_.update(velocity_, dt) : params_.level;
+  out.level_changed = false;
+  if (wanted != level_) {
+    if (solver_.level_change_is_safe(wanted)) {
+      // The new level's force fades in: keep this tick's force continuous with the last one.
+      out.level_changed = true;
+      level_ = wanted;
+      ++level_changes_;
+    } else {
+      ++deferred_ticks_;
+    }
+  }
+  out.level = level_;
+  out.level_wanted = wanted;
+
   ContactInput ci;
   ci.handle_m = h;
   ci.handle_velocity_m_per_s = velocity_;
-  ci.level = params_.level;
+  ci.level = level_;
   if (params_.query_deadline_s > 0.0 && in.now_ns > 0) {
     ci.budget.deadline_ns = in.now_ns + static_cast<std::int64_t>(params_.query_deadline_s * 1e9);
   }
   solver_.update(ci, out.contact);
-  if (out.contact.state == ContactState::Free) out.contact.level = params_.level;
+  if (out.contact.state == ContactState::Free) out.contact.level = level_;
+
+  // Force-step limit at level changes: the difference between the old level's force and the new one's
+  // fades out at max_force_step_n per tick instead of arriving at once.
+  Vec2 f = out.contact.force_n;
+  if (out.level_changed && ticks_ > 0) force_residual_ = last_force_ - f;  // this tick: the force of the last
+  const double r = length(force_residual_);
+  if (r > 0.0) {
+    f = f + force_residual_;
+    force_residual_ = r > params_.max_force_step_n ? ((r - params_.max_force_step_n) / r) * force_residual_ : Vec2{0.0, 0.0};
+  }
+  if (!is_finite(f)) f = Vec2{0.0, 0.0};
+  last_force_ = f;
 
   const double since_start = static_cast<double>(ticks_) * dt;
   ++ticks_;
   TickResult why = TickResult::Ok;
-  out.force_n = params_.guard.apply(out.contact.force_n, since_start, in.sample.status, in.deadline_missed, &why);
+  out.force_n = params_.guard.apply(f, since_start, in.sample.status, in.deadline_missed, &why);
   out.handle_velocity_m_per_s = velocity_;
   out.result = why;
   return why;

@@ -158,6 +158,7 @@ TEST_P(RasterNeverCrosses, ProxyStaysOnItsSideOfEveryWall) {
   s.hand.max_force_n = 6.0;
   s.hand.raster_spacing_m = 0.008;
   s.hand.raster_speed_m_per_s = 0.12;
+  s.haptics.level_mode = "fixed";  // one level's walls; level changes have their own test (test_level_changes)
   const app::ImageScene is = app::build_image_scene(GetParam().string(), s);
   const Scene& sc = *is.scene;
   ASSERT_GT(sc.curve_count(), 0u);

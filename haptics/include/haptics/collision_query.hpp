@@ -85,7 +85,8 @@ class BoundarySection {
 
   /// Closest point on the polylines at `level` to p within max_distance_m, by a box-distance-pruned
   /// walk from the roots (does not use or change the frontier). Returns false when nothing is that close.
-  bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out);
+  /// `curve` ≥ 0 restricts the search to that curve. Allocates nothing.
+  bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1);
 
   /// Node ids of the current boundary section (for the operator overlay and tests).
   const std::vector<std::uint32_t>& section() const { return section_; }

@@ -16,6 +16,17 @@
 /// Curves are walls from both sides: the proxy keeps the side it came from.
 /// Force on the handle = stiffness · (proxy − handle) − damping · (handle velocity along the contact
 /// normal), clamped to max_force_n.
+///
+/// Friction (issue 6, item 3; the friction cone of the god-object, Salisbury, Brock, Massie, Swarup &
+/// Zilles 1995, "Haptic rendering: programming touch interaction with virtual objects", §"friction", and
+/// CHAI3D's finger-proxy algorithm): in edge contact the handle's offset from the proxy has a normal part
+/// d (the penetration) and a tangential part t. The proxy sticks while |t| ≤ μ_s·d (inside the static
+/// cone); once outside, it slides and trails the handle at |t| = μ_d·d (on the dynamic cone), so the
+/// tangential force is μ_d times the normal force: Coulomb's law. It sticks again when the handle comes
+/// back inside the dynamic cone and has all but stopped along the edge (stick_speed_m_per_s). μ_s ≥ μ_d
+/// gives the hysteresis between sticking and sliding. Both 0:
+/// frictionless, the seed paper's model. Friction only ever holds the proxy back, so it takes energy out
+/// (the work the hand does round a closed loop is ≥ 0).
 
 #include <cstdint>
 
@@ -45,6 +56,12 @@ struct ContactParams {
   double max_force_n = 4.0;
   double skin_m = 1e-6;       ///< the proxy rests this far on its side of a wall, so rounding never puts it across
   int max_iterations = 8;     ///< proxy moves per tick before giving up for this tick (it stays valid)
+  double static_friction = 0.0;   ///< μ_s: the proxy sticks while |tangential offset| ≤ μ_s · penetration
+  double dynamic_friction = 0.0;  ///< μ_d ≤ μ_s: a sliding proxy trails the handle by μ_d · penetration
+  /// A sliding proxy sticks again only when the handle moves along the edge slower than this [m/s]
+  /// (Karnopp 1985, "Computer simulation of stick-slip friction in mechanical dynamic systems": a band of
+  /// relative speed counted as zero), so a hand that keeps moving feels steady μ_d, not stick-slip.
+  double stick_speed_m_per_s = 0.002;
 };
 
 /// Input of one solver step.
@@ -67,6 +84,8 @@ struct ContactOutput {
   /// entered) [rad], 0 when none: the direction change of the polyline there, in [0, π]. Lets sound and
   /// display mark only the corners a hand would call corners, not every vertex of a smooth curve.
   double corner_turn_rad = 0.0;
+  bool sticking = false;             ///< edge contact held by static friction this tick
+  std::int32_t transition_level = -1; ///< ≥ 0: the previous level, still a wall after a level change (see level_change_is_safe)
   QueryStats query;                  ///< summed over this step's queries
   std::int32_t queries = 0;
   /// The proxy's path within the tick: path_m[0] is where it started, then the end of every move
@@ -90,6 +109,20 @@ class ContactSolver {
   /// One tick: move the proxy towards the handle under the constraints, then compute the force.
   /// Real-time safe: no allocation, lock, throw or I/O.
   void update(const ContactInput& in, ContactOutput& out);
+
+  /// Whether the level in use may change to `new_level` now without the proxy ending up on the other side
+  /// of the new level's polyline than it is of the old one (issue 6, item 2). For each curve the proxy
+  /// touches, and the nearest curve at either level, the proxy's side of the curve is found at both levels
+  /// (closest point and pseudo-normal, see side_of_curve); a curve on which the sides differ has the proxy
+  /// between its two polylines, and the change must wait (the caller tries again next tick; as the hand
+  /// moves on, the two levels' polylines cross each other and the sides agree again). Points between two
+  /// levels lie within E = (largest error-box half-width of the old level + of the new) of both polylines,
+  /// so only curves within 2E are searched. When the change is made (the next update() with the new level),
+  /// the old level stays a wall, with the proxy's constraints on it, until the proxy rests on none of its
+  /// segments: the proxy, on the same side of both polylines, then reaches the new one without crossing
+  /// either. No second change is made while the old level is still a wall. Allocates nothing (at most six
+  /// closest-point walks).
+  bool level_change_is_safe(int new_level);
 
   Vec2 proxy() const { return proxy_; }
   ContactState state() const { return state_; }
@@ -116,6 +149,12 @@ class ContactSolver {
   ContactState state_ = ContactState::Free;
   Constraint c_[2];
   int level_ = 0;
+  bool sticking_ = false;   // edge contact inside the static friction cone
+  int transition_level_ = -1;  // the previous level, still a wall just after a change; −1 = none
+  double max_half_width_m_[16] = {};  // per level: the largest error-box half-width of any curve [m]
+  // Side of p relative to curve `curve`'s polyline at `level`: +1 left, −1 right, 0 when the polyline is not
+  // within radius_m or its nearest point is an open end, 2 when p lies on it.
+  int side_of_curve(Vec2 p, int curve, int level, double radius_m);
 };
 
 }  // namespace hk

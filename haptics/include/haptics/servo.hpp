@@ -9,6 +9,7 @@
 
 #include "haptics/contact.hpp"
 #include "haptics/device.hpp"
+#include "haptics/level_policy.hpp"
 #include "haptics/scene.hpp"
 
 namespace hk {
@@ -34,7 +35,12 @@ struct ForceGuard {
 /// Parameters of the servo loop.
 struct ServoParams {
   double period_s = 0.001;          ///< servo period = 1 / servo rate [s]
-  int level = 1;                    ///< resolution level rendered
+  int level = 1;                    ///< resolution level at start, and always when !auto_level
+  bool auto_level = false;          ///< the level follows the hand's speed (LevelPolicy; issue 6)
+  LevelPolicyParams policy;         ///< used when auto_level (its fixed_level is ignored: see `auto_level`)
+  /// At a level change the force passes from the old level's to the new level's by at most this much per
+  /// tick [N] (on top of what the hand's own motion changes), so a coarser or finer wall never kicks.
+  double max_force_step_n = 0.05;
   double query_deadline_s = 200e-6; ///< anytime budget of one tick's collision work [s]; 0 = none
   double velocity_cutoff_hz = 100;  ///< low-pass on the finite-difference handle velocity [Hz]
   ContactParams contact;
@@ -53,6 +59,9 @@ struct ServoOutput {
   Vec2 force_n;                ///< force to write to the device [N] (after the guard)
   Vec2 handle_velocity_m_per_s;
   ContactOutput contact;       ///< proxy, state, constraints, events, query stats
+  std::int32_t level = 0;      ///< level in use this tick (walls the proxy met)
+  std::int32_t level_wanted = 0;  ///< level asked for (policy or fixed); differs from `level` while a change waits
+  bool level_changed = false;  ///< the level in use changed at the start of this tick
   TickResult result = TickResult::Ok;
 };
 
@@ -66,8 +75,20 @@ class ServoLoop {
   /// One servo tick. Real-time safe.
   TickResult update(const ServoInput& in, ServoOutput& out);
   const ServoParams& params() const { return params_; }
-  /// Changes the rendered level (takes effect next tick).
-  void set_level(int level) { params_.level = level; }
+  /// Fixes the level (automatic selection off). Takes effect at the next tick at which the proxy can move to
+  /// it without crossing (see ContactSolver::level_change_is_safe). Real-time safe.
+  void set_level(int level) noexcept {
+    params_.level = level;
+    params_.auto_level = false;
+  }
+  /// Turns automatic level selection from hand speed on or off (off: stays at the level in use). Real-time safe.
+  void set_auto_level(bool on) noexcept;
+  /// Level in use (walls rendered) [0 = finest].
+  int level() const noexcept { return level_; }
+  /// Ticks a wanted level change has waited for a safe moment, summed over the run.
+  std::int64_t deferred_ticks() const noexcept { return deferred_ticks_; }
+  /// Level changes made.
+  std::int64_t level_changes() const noexcept { return level_changes_; }
   std::int64_t ticks() const { return ticks_; }
   /// The contact solver (its proxy and boundary section), for display snapshots taken in the servo thread.
   const ContactSolver& solver() const { return solver_; }
@@ -76,6 +97,12 @@ class ServoLoop {
   const Scene* scene_;
   ServoParams params_;
   ContactSolver solver_;
+  LevelPolicy policy_;
+  int level_ = 0;              // level in use
+  Vec2 force_residual_;        // old level's force minus new level's, fading out at max_force_step_n per tick [N]
+  Vec2 last_force_;            // force of the previous tick before the guard [N]
+  std::int64_t deferred_ticks_ = 0;
+  std::int64_t level_changes_ = 0;
   Vec2 last_handle_;
   Vec2 velocity_;
   std::int64_t ticks_ = 0;

@@ -1,0 +1,148 @@
+// Levels from hand speed on real pictures (issue 6, items 1 and 2): a raster whose rows alternate slow
+// and fast makes the level change many times; no move of the proxy crosses the polyline of the level in
+// force, no level change leaves the proxy on the other side of the new polyline than it was of the old
+// one (an independent between-region test), and the force never jumps at a change by more than the limit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "crossing_grid.hpp"
+#include "haptics/hand_path.hpp"
+#include "image_scene.hpp"
+#include "simulation.hpp"
+
+namespace hk {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The raster of `raster_path`, re-timed so that its rows alternate between `slow` and `fast` [m/s]
+/// (the steps between rows go at the slow speed).
+HandPath fast_and_slow_raster(double w, double h, double spacing, double slow, double fast) {
+  const HandPath r = raster_path(w, h, spacing, 1.0);
+  std::vector<HandSample> out;
+  double t = 0.0;
+  int row = 0;
+  const auto& s = r.samples();
+  out.push_back({0.0, s[0].target_m});
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    const Vec2 a = s[i - 1].target_m, b = s[i].target_m;
+    const bool horizontal = std::fabs(a.y - b.y) < 1e-12;
+    const double v = horizontal ? ((row++ % 2) ? fast : slow) : slow;
+    t += distance(a, b) / v;
+    out.push_back({t, b});
+  }
+  return HandPath(std::move(out));
+}
+
+/// True when p lies strictly between curve c's polylines at levels `lo` and `ln` (an odd number of
+/// crossings of the ray p → +x with the loop old polyline → new polyline reversed; for an open curve the
+/// loop is closed by the two short joins between the levels' end points). Brute force over all segments,
+/// independent of the solver's trees.
+bool between_levels(const Scene& sc, std::size_t c, int lo, int ln, Vec2 p) {
+  const CurveInfo& ci = sc.curve(c);
+  lo = sc.clamp_level(c, lo);
+  ln = sc.clamp_level(c, ln);
+  if (lo == ln) return false;
+  int crossings = 0;
+  auto edge = [&](Vec2 a, Vec2 b) {
+    if ((a.y > p.y) == (b.y > p.y)) return;
+    const double x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
+    if (x > p.x) ++crossings;
+  };
+  for (int l : {lo, ln}) {
+    const Vec2* pts = sc.points(c, l);
+    const std::uint32_t n = ci.point_count[l];
+    for (std::uint32_t i = 0; i + 1 < n; ++i) edge(pts[i], pts[i + 1]);
+    if (ci.closed && n > 1) edge(pts[n - 1], pts[0]);
+  }
+  if (!ci.closed) {
+    const Vec2* po = sc.points(c, lo);
+    const Vec2* pn = sc.points(c, ln);
+    edge(po[0], pn[0]);
+    edge(po[ci.point_count[lo] - 1], pn[ci.point_count[ln] - 1]);
+  }
+  return crossings % 2 == 1;
+}
+
+class LevelChanges : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) {
+  config::Settings s;
+  s.haptics.level_mode = "auto";
+  s.hand.max_force_n = 2.0;  // a visitor's push, under the device's clamp, so force steps are visible
+  const std::string path = std::string(HK_TEST_DATA_DIR) + "/images/" + GetParam();
+  const app::ImageScene is = app::build_image_scene(path, s);
+  const Scene& sc = *is.scene;
+  ASSERT_GT(sc.curve_count(), 0u);
+  const HandPath hand = fast_and_slow_raster(s.workspace.width_m, s.workspace.height_m, 0.008, 0.03, 0.3);
+
+  std::vector<std::unique_ptr<test::CrossingGrid>> grids;
+  for (int l = 0; l <= s.haptics.max_levels; ++l) grids.push_back(std::make_unique<test::CrossingGrid>(sc, l));
+  const double k = s.haptics.stiffness_n_per_m;
+  const double step = s.haptics.level_max_force_step_n;
+
+  int prev_transition = -1;
+  long transition_ticks = 0, waiting = 0, changes = 0, finer = 0, coarser = 0, crossings = 0, wrong_side = 0, force_steps = 0, contact_changes = 0;
+  int prev_level = -1;
+  Vec2 prev_force, prev_handle, prev_gap;
+  bool prev_unclamped = false;
+  app::run_simulation(sc, s, hand, hand.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
+    const ContactOutput& c = so.contact;
+    // Every move of the proxy this tick, against the polyline of the level in force this tick.
+    // Just after a change the old level is a wall too, until the proxy has left it: nor may it be crossed.
+    const int old_wall = so.level_changed ? prev_level : prev_transition;
+    for (int m = 1; m < c.path_count; ++m) {
+      crossings += grids[static_cast<std::size_t>(so.level)]->crossings(c.path_m[m - 1], c.path_m[m]);
+      if (old_wall >= 0) crossings += grids[static_cast<std::size_t>(old_wall)]->crossings(c.path_m[m - 1], c.path_m[m]);
+    }
+    transition_ticks += old_wall >= 0;
+    prev_transition = c.transition_level;
+    waiting += so.level != so.level_wanted;
+    if (so.level_changed) {
+      ++changes;
+      (so.level < prev_level ? finer : coarser) += 1;
+      contact_changes += c.state != ContactState::Free;
+      // Where the proxy was when the change was made: on the same side of the new polyline as of the old.
+      for (std::size_t cv = 0; cv < sc.curve_count(); ++cv) wrong_side += between_levels(sc, cv, prev_level, so.level, c.path_m[0]);
+    }
+    // The force may jump at a change by no more than the configured step (plus what the hand's own motion
+    // does: stiffness × its displacement) ...
+    if (so.level_changed && r.index > 0) {
+      if (distance(so.force_n, prev_force) > step + k * distance(r.handle_m, prev_handle) + 1e-9) ++force_steps;
+    }
+    // ... and the force leaves the spring law of the new level (stiffness × (proxy − handle)) only by a
+    // difference made at the change tick that then shrinks by at most the step per tick (unclamped ticks
+    // after the start-up ramp).
+    const Vec2 spring = k * (c.proxy_m - r.handle_m);
+    const Vec2 gap = so.force_n - spring;
+    const bool unclamped = length(spring) < s.haptics.max_force_n - 1e-6 && length(so.force_n) < s.haptics.max_force_n - 1e-6;
+    if (!so.level_changed && unclamped && prev_unclamped && r.t_s > s.haptics.force_ramp_s && distance(gap, prev_gap) > step + 1e-9) ++force_steps;
+    prev_gap = gap;
+    prev_unclamped = unclamped;
+    prev_level = so.level;
+    prev_force = so.force_n;
+    prev_handle = r.handle_m;
+  });
+  RecordProperty("level_changes", std::to_string(changes));
+  RecordProperty("ticks_waiting", std::to_string(waiting));
+  RecordProperty("ticks_with_two_levels", std::to_string(transition_ticks));
+  EXPECT_GE(changes, 10) << "the fast rows must coarsen and the slow rows refine the level";
+  EXPECT_GT(finer, 3);
+  EXPECT_GT(coarser, 3);
+  EXPECT_GT(contact_changes, 0) << "some changes must happen while the proxy is on a wall";
+  EXPECT_EQ(crossings, 0);
+  EXPECT_EQ(wrong_side, 0);
+  EXPECT_EQ(force_steps, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(RealImages, LevelChanges,
+                         ::testing::Values("horse.png", "butterfly.jpg", "coins.png", "silhouette_3.png", "fruits.jpg", "sudoku.png"),
+                         [](const auto& info) { return fs::path(info.param).stem().string(); });
+
+}  // namespace
+}  // namespace hk
