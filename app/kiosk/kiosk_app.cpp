@@ -103,6 +103,7 @@ class App final : public KioskEffects {
     cursor_.back() = device_.true_position_m();
     cursor_.publish();
     level_ = s.haptics.level;
+    auto_level_ = s.haptics.level_mode == "auto";
     high_contrast_ = o.high_contrast;
     overlay_ = o.overlay;
   }
@@ -145,9 +146,12 @@ class App final : public KioskEffects {
   int picture_count() const override { return static_cast<int>(pictures_.size()); }
   std::string describe() override { return describe_scene(shown_.polylines, half_); }
   bool change_level(int delta) override {
-    const int next = level_ + delta;
+    // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until
+    // the session ends.
+    const int next = level() + delta;
     if (next < 0 || next > s_.haptics.max_levels) return false;
     level_ = next;
+    auto_level_ = false;
     core_.request_level(level_);
     return true;
   }
@@ -160,7 +164,8 @@ class App final : public KioskEffects {
     }
     audio_.new_session();
     level_ = s_.haptics.level;
-    core_.request_level(level_);
+    auto_level_ = s_.haptics.level_mode == "auto";
+    core_.request_level(auto_level_ ? ServoCore::kAutoLevel : level_);
     high_contrast_ = opt_.high_contrast;
   }
 
@@ -173,7 +178,8 @@ class App final : public KioskEffects {
   audio::AudioSystem& audio() { return audio_; }
   const Shown& shown() const { return shown_; }
   int shown_id() const { return shown_id_; }
-  int level() const { return level_; }
+  /// Level in use (the servo thread's, which follows the hand's speed in auto mode).
+  int level() { return core_.display().level; }
   Vec2 half() const { return half_; }
   bool& high_contrast() { return high_contrast_; }
   bool& overlay() { return overlay_; }
@@ -206,7 +212,8 @@ class App final : public KioskEffects {
       }
     }
     ServoParams sp = sp_;
-    sp.level = level_;
+    sp.level = auto_level_ ? s_.haptics.level : level_;  // auto: where the policy starts
+    sp.auto_level = auto_level_;
     auto bundle = std::make_unique<SceneBundle>(std::move(scene), sp);
     bundle->id = id;
     sh.scene = bundle->scene.get();
@@ -227,7 +234,8 @@ class App final : public KioskEffects {
   std::unique_ptr<ServoThread> servo_;
   std::vector<std::string> pictures_;
   Shown shown_;
-  int level_ = 1;
+  int level_ = 1;           // the fixed level (auto_level_ false)
+  bool auto_level_ = true;  // levels from hand speed
   bool high_contrast_ = false, overlay_ = false;
   std::string last_said_;
   int shown_id_ = -100;
@@ -576,7 +584,7 @@ int run_kiosk(const KioskOptions& o) {
     if (app.overlay()) {
       ImGui::SetNextWindowPos(ImVec2(10, 10));
       ImGui::Begin("operator", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
-      ImGui::Text("state %s   picture %d   level %d", state_name(flow.state()), flow.picture() + 1, app.level());
+      ImGui::Text("state %s   picture %d   level %d%s", state_name(flow.state()), flow.picture() + 1, app.level(), d.auto_level ? " (auto)" : "");
       ImGui::Text("contact %d   curve %d   force %.2f N", static_cast<int>(d.state), d.curve, length(d.force_n));
       if (ServoThread* st = app.servo()) {
         const ServoTimingStats t = st->stats();

@@ -56,8 +56,9 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
     }
   }
 
-  const int want_level = requested_level_.load(std::memory_order_relaxed);
-  if (current_ && want_level >= 0 && want_level != current_->loop.params().level) current_->loop.set_level(want_level);
+  const int want_level = requested_level_.exchange(-1, std::memory_order_relaxed);
+  if (current_ && want_level == kAutoLevel) current_->loop.set_auto_level(true);
+  if (current_ && want_level >= 0) current_->loop.set_level(want_level);
 
   TickResult r = TickResult::Ok;
   if (current_) {
@@ -71,7 +72,7 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
 
   if (current_) {
     audio::CueEvent c[CueTracker::kMaxCuesPerTick];
-    const int n = tracker_.update(tick_, out_, in.sample.handle_m, current_->loop.params().level, c);
+    const int n = tracker_.update(tick_, out_, in.sample.handle_m, out_.level, c);
     for (int i = 0; cues_ && i < n; ++i) cues_->try_push(c[i]);  // a full ring drops and counts
   }
 
@@ -82,7 +83,8 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
   d.force_n = out_.force_n;
   d.state = out_.contact.state;
   d.curve = out_.contact.state == ContactState::Free ? -1 : out_.contact.constraint[0].curve;
-  d.level = current_ ? current_->loop.params().level : 0;
+  d.level = current_ ? current_->loop.level() : 0;
+  d.auto_level = current_ && current_->loop.params().auto_level;
   d.scene_id = current_ ? current_->id : -1;
   d.section_count = 0;
   if (current_) {

@@ -43,7 +43,8 @@ struct ServoDisplayState {
   Vec2 handle_m, proxy_m, force_n;
   ContactState state = ContactState::Free;
   int curve = -1;
-  int level = 0;
+  int level = 0;                   ///< level in use
+  bool auto_level = false;         ///< the level follows the hand's speed
   int scene_id = -1;               ///< SceneBundle::id in use, −1 before the first
   std::int64_t tick_compute_ns = 0;///< time of this tick's work [ns] (set by ServoThread)
   std::int64_t period_error_ns = 0;///< wake-up minus deadline of this tick [ns] (set by ServoThread)
@@ -68,7 +69,10 @@ class ServoCore {
   /// Any thread but the servo's (one caller): frees bundles the servo thread has let go of. Returns how many.
   int collect_retired();
 
-  /// Any thread: the level to render from the next tick on (clamped per curve by the scene). −1: keep.
+  /// request_level(kAutoLevel): the level follows the hand's speed (ServoLoop::set_auto_level).
+  static constexpr int kAutoLevel = -2;
+  /// Any thread: fix the level rendered from the next tick on (clamped per curve by the scene), or
+  /// kAutoLevel. Applied once, to the picture in use; a picture published later brings its own ServoParams.
   void request_level(int level) noexcept { requested_level_.store(level, std::memory_order_relaxed); }
 
   /// Real-time: one tick. `now_ns` = steady time at its start (for the query deadline; 0 = none),

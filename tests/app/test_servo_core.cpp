@@ -117,5 +117,20 @@ TEST(ServoCore, NoPictureMeansNoForce) {
   EXPECT_EQ(r.core.display().scene_id, -1);
 }
 
+TEST(ServoCore, LevelRequestsFixTheLevelOrHandItBackToTheHandsSpeed) {
+  Rig r;
+  ASSERT_EQ(r.s.haptics.level_mode, "auto");
+  r.core.publish(bundle(r.sp, 1));
+  r.run(0.2);
+  EXPECT_TRUE(r.core.display().auto_level);
+  r.core.request_level(0);  // the visitor asked for the finest level
+  r.run(0.5);
+  EXPECT_FALSE(r.core.display().auto_level);
+  EXPECT_EQ(r.core.display().level, 0);
+  r.core.request_level(ServoCore::kAutoLevel);  // a new session: back to the hand's speed
+  r.run(0.2);
+  EXPECT_TRUE(r.core.display().auto_level);
+}
+
 }  // namespace
 }  // namespace hk::app
