@@ -204,8 +204,11 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["per_tick"] = {{"queries_mean", queries / n}, {"box_tests_mean", box_tests / n}, {"boundary_section_mean", section_sum / n},
                     {"boundary_section_max", section_max}, {"iteration_limited_ticks", iteration_limited}};
   sj["curves"] = scene.curve_count();
-  sj["chains"] = {{"found", is.chains_found}, {"too_short", is.chains_too_short}, {"over_budget", is.chains_over_budget},
-                  {"unbuildable", scene.skipped_curves()}};
+  // What the scene left out and why (issue 6, item 4), in pipeline order.
+  sj["chains"] = {{"found", is.chains_found}, {"thin_line_pairs_merged", is.thin_line_pairs_merged},
+                  {"after_thin_lines", is.chains_after_thin_lines}, {"too_short", is.chains_too_short},
+                  {"over_budget", is.chains_over_budget}, {"unbuildable", scene.skipped_curves()}};
+  sj["segments_budget"] = {{"max_segments", s.vision.max_segments}, {"before", is.segments_before_budget}, {"after", is.segments_after_budget}};
   json segs = json::array();
   for (int l = 0; l < Scene::kMaxLevels; ++l) {
     bool any = false;
@@ -223,7 +226,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["sticking_ticks"] = sticking;
   sj["segments_in_use"] = scene.total_segments(s.haptics.level);
   sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};
-  sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms},
+  sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms}, {"thin_lines", is.times.thin_lines_ms},
                     {"multires", is.times.multires_ms}, {"tree", is.times.tree_ms}};
   write_text(out / "summary.json", sj.dump(2) + "\n");
   write_overlay(out / "overlay.png", is, s.haptics.level, proxy_path);

@@ -1,15 +1,27 @@
 #include "image_scene.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "vision/thin_lines.hpp"
 
 namespace hk::app {
 
+double curve_salience(double length_m, double strength, double canny_high) {
+  if (!std::isfinite(length_m) || !std::isfinite(strength) || !std::isfinite(canny_high) || canny_high <= 0.0) return 0.0;
+  return length_m * std::clamp(strength / canny_high, 0.0, 1.0);
+}
+
 std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chains, const vision::PxToM& map, double min_length_m,
-                                          std::size_t* too_short) {
+                                          std::size_t* too_short, std::vector<std::size_t>* kept) {
   std::vector<Polyline> out;
   out.reserve(chains.size());
+  if (kept) kept->clear();
   std::size_t dropped = 0;
-  for (const vision::Chain& c : chains) {
+  for (std::size_t k = 0; k < chains.size(); ++k) {
+    const vision::Chain& c = chains[k];
     Polyline pl;
     pl.closed = c.closed;
     pl.points_m.reserve(c.points_px.size());
@@ -25,10 +37,27 @@ std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chai
       continue;
     }
     out.push_back(std::move(pl));
+    if (kept) kept->push_back(k);
   }
   if (too_short) *too_short = dropped;
   return out;
 }
+
+namespace {
+
+double mean(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+/// Polyline length [m], with the closing segment of a closed curve (what a hand can follow).
+double length_m(const Polyline& p) {
+  double l = 0.0;
+  for (std::size_t i = 1; i < p.points_m.size(); ++i) l += distance(p.points_m[i - 1], p.points_m[i]);
+  if (p.closed && p.points_m.size() > 1) l += distance(p.points_m.back(), p.points_m.front());
+  return l;
+}
+
+}  // namespace
 
 ImageScene build_image_scene(const std::string& path, const config::Settings& s) {
   ImageScene out;
@@ -44,7 +73,7 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s)
   p.max_image_side_px = s.vision.max_image_side_px;
   // Length is judged in metres below, where the workspace scale is known; keep every real chain here.
   p.min_chain_length_px = 2.0;
-  const vision::Extraction ex = vision::extract_chains(path, p);
+  vision::Extraction ex = vision::extract_chains(path, p);
   out.width_px = ex.width_px;
   out.height_px = ex.height_px;
   out.canny_low = ex.edge_map.low;
@@ -55,32 +84,72 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s)
   out.px_to_m = vision::fit_to_workspace(ex.width_px, ex.height_px, s.workspace.width_m, s.workspace.height_m);
   out.chains_found = ex.chains.size();
 
-  out.polylines = chains_to_polylines(ex.chains, out.px_to_m, s.vision.min_chain_length_m, &out.chains_too_short);
+  // Thin lines (issue 6, item 4): the two edges of a stroke thinner than a fingertip can resolve become
+  // its centre line. Merged at the resolution the edges were found at (extract_chains returns original
+  // pixels; the inverse of its scale-back is exact), where the chains are 8-connected pixel walks.
+  std::vector<vision::Chain> chains = std::move(ex.chains);
+  vision::PointValues point_strength = std::move(ex.point_strength);
+  if (s.vision.thin_line_max_width_m > 0.0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double sx = static_cast<double>(ex.width_px) / ex.edge_map.edges.cols;
+    const double sy = static_cast<double>(ex.height_px) / ex.edge_map.edges.rows;
+    for (vision::Chain& c : chains) {
+      for (cv::Point2d& q : c.points_px) q = {(q.x + 0.5) / sx - 0.5, (q.y + 0.5) / sy - 0.5};
+    }
+    // Metres → original px → processed px (sx and sy differ from each other only by rounding).
+    const double width_px = s.vision.thin_line_max_width_m / out.px_to_m.scale_m_per_px / (0.5 * (sx + sy));
+    vision::ThinLineStats st;
+    vision::PointValues merged_strength;
+    chains = vision::merge_thin_lines(chains, width_px, &st, point_strength, &merged_strength);
+    point_strength = std::move(merged_strength);
+    out.thin_line_pairs_merged = st.pairs_merged;
+    for (vision::Chain& c : chains) {
+      for (cv::Point2d& q : c.points_px) q = {(q.x + 0.5) * sx - 0.5, (q.y + 0.5) * sy - 0.5};
+    }
+    out.times.thin_lines_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  out.chains_after_thin_lines = chains.size();
+
+  std::vector<std::size_t> kept_chain;
+  out.polylines = chains_to_polylines(chains, out.px_to_m, s.vision.min_chain_length_m, &out.chains_too_short, &kept_chain);
+  out.strength.reserve(kept_chain.size());
+  for (const std::size_t k : kept_chain) out.strength.push_back(mean(point_strength[k]));
   out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
-  // Scene budget (issue 6, item 4): keep the servo's data within max_segments level-0 segments, keeping
-  // the longest curves (a first measure of salience: long boundaries are the shapes a visitor explores).
+  out.segments_before_budget = out.scene->total_segments(0);
+  // Scene budget (issue 6, item 4): keep the servo's data within max_segments level-0 segments, filled
+  // with the most salient curves first (curve_salience: long, sure boundaries).
   const auto budget = static_cast<std::size_t>(s.vision.max_segments);
-  if (out.scene->total_segments(0) > budget) {
+  if (out.segments_before_budget > budget) {
     std::vector<std::size_t> order(out.scene->curve_count());
-    std::vector<double> len(order.size(), 0.0);
+    std::vector<double> salience(order.size(), 0.0);
     for (std::size_t c = 0; c < order.size(); ++c) {
       order[c] = c;
-      const Polyline& p = out.polylines[out.scene->source_index(c)];
-      for (std::size_t i = 1; i < p.points_m.size(); ++i) len[c] += distance(p.points_m[i - 1], p.points_m[i]);
+      const std::size_t i = out.scene->source_index(c);
+      salience[c] = curve_salience(length_m(out.polylines[i]), out.strength[i], out.canny_high);
     }
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return len[a] > len[b]; });
-    std::vector<Polyline> kept;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return salience[a] > salience[b]; });
+    std::vector<char> keep(order.size(), 0);
     std::size_t used = 0;
     for (std::size_t c : order) {
       const std::size_t n = out.scene->curve(c).segment_count[0];
-      if (used + n > budget) continue;  // a shorter one further down may still fit
+      if (used + n > budget) continue;  // a less salient one further down may still fit
       used += n;
+      keep[c] = 1;
+    }
+    // Kept curves in pipeline order, so the scene's curve ids follow the picture, not the ranking.
+    std::vector<Polyline> kept;
+    std::vector<double> kept_strength;
+    for (std::size_t c = 0; c < order.size(); ++c) {
+      if (!keep[c]) continue;
       kept.push_back(out.polylines[out.scene->source_index(c)]);
+      kept_strength.push_back(out.strength[out.scene->source_index(c)]);
     }
     out.chains_over_budget = out.scene->curve_count() - kept.size();
     out.polylines = std::move(kept);
+    out.strength = std::move(kept_strength);
     out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
   }
+  out.segments_after_budget = out.scene->total_segments(0);
   out.times.multires_ms = out.scene->build_times().multires_ms;
   out.times.tree_ms = out.scene->build_times().tree_ms;
   return out;

@@ -1,7 +1,9 @@
 #pragma once
 /// @file image_scene.hpp
-/// Image file → haptic scene: the vision pipeline, the pixel → workspace mapping, the dropping of
-/// chains too short to feel, and the multiresolution collision trees (DESIGN.md "Data flow").
+/// Image file → haptic scene: the vision pipeline, the pixel → workspace mapping, a scene that models
+/// no more than it needs (thin lines felt as one curve, chains too short to feel dropped, a segment
+/// budget filled with the most salient curves), and the multiresolution collision trees (DESIGN.md
+/// "Data flow").
 
 #include <memory>
 #include <string>
@@ -16,31 +18,67 @@ namespace hk::app {
 
 /// Build time of each stage [ms].
 struct BuildTimes {
-  double load_ms = 0, edges_ms = 0, linking_ms = 0, multires_ms = 0, tree_ms = 0;
+  double load_ms = 0, edges_ms = 0, linking_ms = 0, thin_lines_ms = 0, multires_ms = 0, tree_ms = 0;
 };
 
 /// A picture turned into a scene. `polylines[i]` is the curve built into `scene` as the curve whose
 /// `source_index` is i.
+///
+/// What was dropped and why, in pipeline order (each count is of the stage before it):
+///   chains_found --thin-line merging--> chains_after_thin_lines
+///   = chains_too_short + chains_over_budget + polylines.size().
 struct ImageScene {
   std::string image_path;
   int width_px = 0, height_px = 0;
   vision::PxToM px_to_m{};
-  std::size_t chains_found = 0;        ///< chains out of edge linking
-  std::size_t chains_too_short = 0;    ///< dropped: shorter than vision.min_chain_length_m
-  std::size_t chains_over_budget = 0;  ///< dropped: the scene would hold more than vision.max_segments level-0 segments (shortest dropped first)
+  std::size_t chains_found = 0;             ///< chains out of edge linking
+  std::size_t thin_line_pairs_merged = 0;   ///< pairs of facing edges (two sides of a stroke thinner than vision.thin_line_max_width_m) felt as one centre line
+  std::size_t chains_after_thin_lines = 0;  ///< chains after thin-line merging (centre lines, left-over pieces, untouched chains)
+  std::size_t chains_too_short = 0;         ///< dropped: shorter than vision.min_chain_length_m
+  std::size_t chains_over_budget = 0;       ///< dropped: the scene would hold more than vision.max_segments level-0 segments (least salient dropped first)
+  std::size_t segments_before_budget = 0;   ///< level-0 segments of the scene of every curve long enough to feel
+  std::size_t segments_after_budget = 0;    ///< level-0 segments of the scene built (<= vision.max_segments)
   double canny_low = 0, canny_high = 0;
-  std::vector<Polyline> polylines;     ///< kept chains in workspace metres
-  std::unique_ptr<Scene> scene;        ///< collision trees (heap: the servo loop holds a pointer)
+  std::vector<Polyline> polylines;          ///< kept chains in workspace metres
+  /// strength[i]: mean edge strength along polylines[i], in Canny threshold units (the Sobel-3x3 L2
+  /// gradient magnitude Canny thresholded, vision::Extraction::point_strength; a centre line takes
+  /// the mean of its two sides).
+  std::vector<double> strength;
+  std::unique_ptr<Scene> scene;             ///< collision trees (heap: the servo loop holds a pointer)
   BuildTimes times;
 };
 
-/// Chains (pixels) → polylines in workspace metres, dropping chains shorter than min_length_m (a
-/// fingertip cannot resolve them). `too_short` (optional) receives the number dropped.
-std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chains, const vision::PxToM& map, double min_length_m,
-                                          std::size_t* too_short = nullptr);
+/// Salience of a curve for the segment budget: what a visitor most needs to feel first.
+///
+///   salience = length_m · clamp(strength / canny_high, 0, 1)
+///
+/// Long boundaries are the shapes a visitor explores (a fingertip finds a long wall and can follow
+/// it; a short one is a bump), so length counts linearly. Strength says how sure the boundary is:
+/// Canny accepts an edge pixel above canny_high outright and one between canny_low and canny_high
+/// only when it is linked to a sure one, so a curve whose mean magnitude is below canny_high is
+/// mostly hysteresis-linked shading or texture and is discounted in proportion; above canny_high
+/// every curve is equally sure (a wall is felt the same whatever its grey-level contrast), hence the
+/// clip at 1. Returns 0 for a non-positive canny_high or a non-finite input.
+double curve_salience(double length_m, double strength, double canny_high);
 
-/// Loads the image at `path` and builds its scene with `settings`. Throws vision::InputError for bad
-/// image files (one line naming the file and the limit).
+/// Chains (pixels) → polylines in workspace metres, dropping chains shorter than min_length_m (a
+/// fingertip cannot resolve them). `too_short` (optional) receives the number dropped, `kept`
+/// (optional) the index in `chains` of each polyline returned.
+std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chains, const vision::PxToM& map, double min_length_m,
+                                          std::size_t* too_short = nullptr, std::vector<std::size_t>* kept = nullptr);
+
+/// Loads the image at `path` and builds its scene with `settings`:
+/// 1. vision::extract_chains (load, grey, shrink to vision.max_image_side_px, Canny, linking, edge
+///    strength per chain point);
+/// 2. thin-line merging (vision::merge_thin_lines) at the processed resolution, with
+///    vision.thin_line_max_width_m converted to processed pixels through the workspace scale (skipped
+///    when 0), the chains then scaled back to original pixels;
+/// 3. pixels → metres, chains shorter than vision.min_chain_length_m dropped;
+/// 4. the segment budget: when the curves' level-0 segments exceed vision.max_segments, curves are
+///    taken in decreasing curve_salience (ties: pipeline order) and each is kept if it still fits
+///    (a less salient one further down may still fit);
+/// 5. Scene::build (haptics.max_levels).
+/// Throws vision::InputError for bad image files (one line naming the file and the limit).
 ImageScene build_image_scene(const std::string& path, const config::Settings& settings);
 
 }  // namespace hk::app

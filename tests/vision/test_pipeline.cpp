@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <numbers>
 
@@ -90,6 +91,48 @@ TEST(ExtractChains, ChainsOfAShrunkImageAreInOriginalPixels) {
   test::expect_chains_sane(ex.chains, ex.width_px, ex.height_px);
   for (const cv::Point2d& q : c.points_px) EXPECT_NEAR(cv::norm(q - centre), r, 2.0 * ex.px_scale);
   EXPECT_NEAR(chain_length_px(c) / (2 * std::numbers::pi * r), 1.0, 0.08);
+}
+
+TEST(ExtractChains, PointStrengthIsTheGradientMagnitudeCannyThresholded) {
+  // Recomputed independently with OpenCV's own blur and Sobel on the processed grey image, at each
+  // chain point mapped back to processed pixels; every edge pixel passed Canny's low threshold.
+  // And a picture bigger than max_image_side_px, so the chains are scaled back from a shrunk image.
+  const fs::path shrunk = fs::temp_directory_path() /
+                          ("hk_vision_strength_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
+  cv::Mat big(1000, 1700, CV_8UC3, cv::Scalar(230, 230, 230));
+  cv::circle(big, cv::Point(600, 500), 300, cv::Scalar(20, 20, 20), cv::FILLED, cv::LINE_AA);
+  cv::rectangle(big, cv::Rect(1100, 200, 400, 500), cv::Scalar(150, 150, 150), cv::FILLED);
+  ASSERT_TRUE(cv::imwrite(shrunk.string(), big));
+  const std::string images = std::string(HK_TEST_DATA_DIR) + "/images/";
+  for (const std::string& path : {images + "fruits.jpg", images + "horse.png", images + "sudoku.png", images + "butterfly.jpg", shrunk.string()}) {
+    SCOPED_TRACE(path);
+    const ExtractParams p;
+    const Extraction ex = extract_chains(path, p);
+    const cv::Mat grey = to_grey(load_image(path, p.limits), p.max_image_side_px, nullptr);
+    cv::Mat blurred, dx, dy;
+    cv::GaussianBlur(grey, blurred, cv::Size(0, 0), p.edges.blur_sigma_px, p.edges.blur_sigma_px, cv::BORDER_REPLICATE);
+    cv::Sobel(blurred, dx, CV_16S, 1, 0, 3, 1.0, 0.0, cv::BORDER_REPLICATE);
+    cv::Sobel(blurred, dy, CV_16S, 0, 1, 3, 1.0, 0.0, cv::BORDER_REPLICATE);
+    const double sx = static_cast<double>(ex.width_px) / grey.cols;
+    const double sy = static_cast<double>(ex.height_px) / grey.rows;
+    ASSERT_EQ(ex.point_strength.size(), ex.chains.size());
+    std::size_t checked = 0;
+    for (std::size_t k = 0; k < ex.chains.size(); ++k) {
+      ASSERT_EQ(ex.point_strength[k].size(), ex.chains[k].points_px.size());
+      for (std::size_t i = 0; i < ex.chains[k].points_px.size(); ++i) {
+        const cv::Point2d q = ex.chains[k].points_px[i];
+        const int u = static_cast<int>(std::lround((q.x + 0.5) / sx - 0.5));
+        const int v = static_cast<int>(std::lround((q.y + 0.5) / sy - 0.5));
+        const double gx = dx.at<std::int16_t>(v, u);
+        const double gy = dy.at<std::int16_t>(v, u);
+        ASSERT_NEAR(ex.point_strength[k][i], std::hypot(gx, gy), 1e-9) << "chain " << k << " point " << i;
+        ASSERT_GT(ex.point_strength[k][i], ex.edge_map.low) << "chain " << k << " point " << i;
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 500u);
+  }
+  fs::remove(shrunk);
 }
 
 TEST(ExtractChains, RefusesBadFilesWithInputError) {

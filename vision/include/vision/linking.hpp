@@ -22,6 +22,10 @@ struct Chain {
   bool closed = false;  ///< true when the chain is a loop
 };
 
+/// One value per chain point, e.g. edge strength: values[k][i] belongs to chains[k].points_px[i]
+/// (same outer size as the chains, same inner size as each chain's points).
+using PointValues = std::vector<std::vector<double>>;
+
 /// Links 8-connected edge pixels into ordered chains.
 ///
 /// Algorithm (pixel-graph tracing, as in classic edge linkers, e.g. P. Kovesi's edgelink.m and

@@ -27,7 +27,7 @@ struct ExtractParams {
 struct StageTimes {
   double load_ms;     ///< load_image + to_grey (file checks, decoding, grey, downscale)
   double edges_ms;    ///< detect_edges
-  double linking_ms;  ///< link_edges + scaling the chains back
+  double linking_ms;  ///< link_edges + edge strength at the chain points + scaling the chains back
 };
 
 /// Result of extract_chains.
@@ -39,14 +39,22 @@ struct Extraction {
   /// to ((u' + 0.5) * sx - 0.5, (v' + 0.5) * sy - 0.5) with sx = width_px / processed width and
   /// sy likewise, so points are not integers and consecutive points are about px_scale apart.
   std::vector<Chain> chains;
+  /// Edge strength at every chain point (point_strength[k][i] at chains[k].points_px[i]): the L2
+  /// gradient magnitude sqrt(gx^2 + gy^2) of the 3x3 Sobel derivatives of the blurred processed
+  /// image at the point's processed pixel, i.e. exactly the magnitude Canny thresholded there, in
+  /// the units of edge_map.low and edge_map.high (a blurred step of D grey levels gives about
+  /// 8 D / (sigma sqrt(2 pi))). Used to rank curves by salience: a faint shading edge matters less
+  /// than a strong outline of the same length.
+  PointValues point_strength;
   EdgeMap edge_map;  ///< edges at the processed resolution
   double px_scale;   ///< original px per processed px (>= 1; 1 = not shrunk), see to_grey
   StageTimes times;  ///< per-stage wall time
 };
 
 /// load_image -> to_grey (shrink to max_image_side_px) -> detect_edges -> link_edges
-/// (min_chain_length_px, measured at the processed resolution like the blur) -> chains scaled
-/// back to original pixels.
+/// (min_chain_length_px, measured at the processed resolution like the blur) -> edge strength at
+/// each chain point (see Extraction::point_strength; the blur and Sobel of detect_edges, sampled
+/// at the chain points only) -> chains scaled back to original pixels.
 ///
 /// @throws InputError when the file is refused (see load_image).
 /// @throws std::invalid_argument on invalid parameters.
