@@ -26,17 +26,20 @@ min_time=0.5
 "$b/bench_earcon_latency" --out "$out/earcon_latency.json" > "$out/earcon_latency.md"
 "$b/bench_audio_latency" > "$out/audio_latency.json" 2>/dev/null || true
 "$b/bench_servo_rate" --seconds 5 --out "$out/servo_rate.json" 2>/dev/null > "$out/servo_rate.md"
+"$b/bench_levels" --out "$out/levels.json" > "$out/levels.md"
 # Tables printed by the audio and servo benches go between their markers in PERFORMANCE.md.
 /usr/bin/python3 - "$out" "$root/docs/PERFORMANCE.md" <<'PY'
 import re, sys
 doc = open(sys.argv[2]).read()
-for name in ("earcon_latency", "servo_rate"):
-    lines = [l for l in open(f"{sys.argv[1]}/{name}.md").read().strip().split("\n\n")[0].splitlines() if l.startswith("|")]
+for name, part in (("earcon_latency", 0), ("servo_rate", 0), ("levels", 0), ("levels_speed", 1)):
+    md = "levels" if name.startswith("levels") else name
+    lines = [l for l in open(f"{sys.argv[1]}/{md}.md").read().strip().split("\n\n")[part].splitlines() if l.startswith("|")]
     doc = re.sub(rf"(<!-- BEGIN {name} -->\n).*?(\n<!-- END {name} -->)", lambda m: m.group(1) + "\n".join(lines) + m.group(2), doc, flags=re.S)
 open(sys.argv[2], "w").write(doc)
 PY
 /usr/bin/python3 "$root/bench/plot_bench.py" "$out" "$root/docs/PERFORMANCE.md"
 /usr/bin/python3 "$root/bench/plot_accuracy.py" "$out/accuracy.json" --outdir "$out"
+/usr/bin/python3 "$root/bench/plot_levels.py" "$out/levels.json" --outdir "$out"
 if [ -f "$out/stability.json" ]; then
   /usr/bin/python3 "$root/bench/plot_stability.py" "$out/stability.json" --outdir "$out"
 fi
