@@ -192,3 +192,31 @@ TEST(Friction, ClosedLoopRoundACurveCreatesNoEnergy) {
   // Frictionless, the loop costs next to nothing.
   EXPECT_LT(std::fabs(w_free), 0.05 * expected);
 }
+
+TEST(Friction, DefaultsKeepAHandPushingSlightlyAskewOnTheCurve) {
+  // Seed §5: frictionless walls "cause the handle to easily slip off the curve being explored". A hand
+  // pressing on a circle 15° off its normal: without friction the proxy slides round the curve; with the
+  // coefficients the settings ship ([haptics] static_friction 0.4, dynamic_friction 0.3: μ_s = 0.4 holds
+  // pushes up to atan 0.4 ≈ 22° off the normal) it stays put.
+  Polyline circle;
+  circle.closed = true;
+  const double R = 0.02;
+  for (int k = 0; k < 256; ++k) circle.points_m.push_back({R * std::cos(2 * M_PI * k / 256), R * std::sin(2 * M_PI * k / 256)});
+  const Scene sc = Scene::build({circle}, 3);
+  const double tilt = 15.0 * M_PI / 180.0;
+  double slide[2] = {0.0, 0.0};
+  int i = 0;
+  for (const auto& [mu_s, mu_d] : {std::pair{0.0, 0.0}, std::pair{0.4, 0.3}}) {
+    ContactSolver s(sc, friction(mu_s, mu_d));
+    const Vec2 top{0.0, R + 0.005};
+    s.reset(top, 0);
+    // Come straight down onto the top of the circle, then push 1.5 mm in along a line 15° off the normal.
+    for (int k = 0; k <= 100; ++k) tick(s, lerp(top, {0.0, R - 0.0001}, k / 100.0), {0.0, -0.05});
+    const Vec2 touch = s.proxy();
+    const Vec2 push{std::sin(tilt), -std::cos(tilt)};
+    for (int k = 1; k <= 300; ++k) tick(s, Vec2{0.0, R - 0.0001} + (0.0015 * k / 300.0) * push, 0.005 * push);
+    slide[i++] = distance(s.proxy(), touch);
+  }
+  EXPECT_GT(slide[0], 0.0003) << "frictionless: the proxy slides away from where the hand pushes";
+  EXPECT_LT(slide[1], 1e-5) << "with the shipped friction it holds";
+}
