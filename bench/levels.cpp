@@ -22,22 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// A raster (6 mm rows) whose horizontal rows cycle through `speeds` [m/s]; the steps between rows at 2 cm/s.
-HandPath speed_cycle_raster(double w, double h, const std::vector<double>& speeds) {
-  const HandPath r = raster_path(w, h, 0.006, 1.0);
-  std::vector<HandSample> out{{0.0, r.samples()[0].target_m}};
-  double t = 0.0;
-  std::size_t row = 0;
-  for (std::size_t i = 1; i < r.samples().size(); ++i) {
-    const Vec2 a = r.samples()[i - 1].target_m, b = r.samples()[i].target_m;
-    const bool horizontal = std::fabs(a.y - b.y) < 1e-12;
-    const double v = horizontal ? speeds[row++ % speeds.size()] : 0.02;
-    t += distance(a, b) / v;
-    out.push_back({t, b});
-  }
-  return HandPath(std::move(out));
-}
-
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -80,7 +64,7 @@ int main(int argc, char** argv) {
     const std::size_t raw_segments = app::build_image_scene(f.string(), raw).scene->total_segments(0);
     const app::ImageScene tight_is = app::build_image_scene(f.string(), tight);
     const Scene& sc = *is.scene;
-    const HandPath hand = speed_cycle_raster(s.workspace.width_m, s.workspace.height_m, speeds);
+    const HandPath hand = raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.006, speeds, 0.02);
     const int levels = s.haptics.max_levels + 1;
     std::vector<std::vector<long>> hist(bin_edges.size() - 1, std::vector<long>(static_cast<std::size_t>(levels), 0));
     std::vector<double> tick_us;

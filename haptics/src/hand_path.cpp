@@ -226,4 +226,27 @@ class Reader {
 
 HandPath load_hand_csv(const std::string& path, const HandFileLimits& limits) { return Reader(path).read(limits); }
 
+HandPath raster_path_with_line_speeds(double width_m, double height_m, double spacing_m,
+                                      const std::vector<double>& line_speeds_m_per_s, double step_speed_m_per_s) {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  bool ok = !line_speeds_m_per_s.empty() && positive(step_speed_m_per_s);
+  for (double v : line_speeds_m_per_s) ok = ok && positive(v);
+  if (!ok) throw std::invalid_argument("raster path: line speeds (at least one) and step speed must be finite and > 0");
+  const HandPath unit = raster_path(width_m, height_m, spacing_m, 1.0);
+  const std::vector<HandSample>& in = unit.samples();
+  std::vector<HandSample> out;
+  out.reserve(in.size());
+  out.push_back({0.0, in[0].target_m});
+  double t = 0.0;
+  std::size_t line = 0;
+  for (std::size_t i = 1; i < in.size(); ++i) {
+    const Vec2 a = in[i - 1].target_m, b = in[i].target_m;
+    const bool along_line = a.y == b.y;  // raster lines are horizontal; the steps between them vertical
+    const double v = along_line ? line_speeds_m_per_s[line++ % line_speeds_m_per_s.size()] : step_speed_m_per_s;
+    t += distance(a, b) / v;
+    out.push_back({t, b});
+  }
+  return HandPath(std::move(out));
+}
+
 }  // namespace hk

@@ -20,25 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The raster of `raster_path`, re-timed so that its rows alternate between `slow` and `fast` [m/s]
-/// (the steps between rows go at the slow speed).
-HandPath fast_and_slow_raster(double w, double h, double spacing, double slow, double fast) {
-  const HandPath r = raster_path(w, h, spacing, 1.0);
-  std::vector<HandSample> out;
-  double t = 0.0;
-  int row = 0;
-  const auto& s = r.samples();
-  out.push_back({0.0, s[0].target_m});
-  for (std::size_t i = 1; i < s.size(); ++i) {
-    const Vec2 a = s[i - 1].target_m, b = s[i].target_m;
-    const bool horizontal = std::fabs(a.y - b.y) < 1e-12;
-    const double v = horizontal ? ((row++ % 2) ? fast : slow) : slow;
-    t += distance(a, b) / v;
-    out.push_back({t, b});
-  }
-  return HandPath(std::move(out));
-}
-
 /// True when p lies strictly between curve c's polylines at levels `lo` and `ln` (an odd number of
 /// crossings of the ray p → +x with the loop old polyline → new polyline reversed; for an open curve the
 /// loop is closed by the two short joins between the levels' end points). Brute force over all segments,
@@ -79,7 +60,7 @@ TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) 
   const app::ImageScene is = app::build_image_scene(path, s);
   const Scene& sc = *is.scene;
   ASSERT_GT(sc.curve_count(), 0u);
-  const HandPath hand = fast_and_slow_raster(s.workspace.width_m, s.workspace.height_m, 0.008, 0.03, 0.3);
+  const HandPath hand = raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
 
   std::vector<std::unique_ptr<test::CrossingGrid>> grids;
   for (int l = 0; l <= s.haptics.max_levels; ++l) grids.push_back(std::make_unique<test::CrossingGrid>(sc, l));

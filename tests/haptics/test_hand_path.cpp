@@ -175,6 +175,21 @@ TEST(HandPath, RasterRejectsBadArguments) {
   EXPECT_THROW(raster_path(0.14, 0.09, 1e-12, 0.08), std::invalid_argument) << "too many lines";
 }
 
+TEST(HandPath, RasterWithLineSpeedsTimesEachLineAtItsSpeed) {
+  // 0.14 × 0.09 m at 0.03 m spacing: 4 lines (0.14 m each) and 3 steps (0.03 m each).
+  const HandPath p = raster_path_with_line_speeds(0.14, 0.09, 0.03, {0.02, 0.2}, 0.05);
+  const HandPath same_path = raster_path(0.14, 0.09, 0.03, 1.0);
+  ASSERT_EQ(p.samples().size(), same_path.samples().size());
+  for (std::size_t i = 0; i < p.samples().size(); ++i) EXPECT_EQ(p.samples()[i].target_m, same_path.samples()[i].target_m);
+  // Lines alternate 7 s and 0.7 s, steps take 0.6 s: 2·7 + 2·0.7 + 3·0.6 = 17.2 s.
+  EXPECT_NEAR(p.duration_s(), 17.2, 1e-9);
+  EXPECT_NEAR(p.samples()[1].t_s, 7.0, 1e-9);
+  EXPECT_NEAR(p.samples()[3].t_s - p.samples()[2].t_s, 0.7, 1e-9);
+  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {}, 0.05), std::invalid_argument);
+  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {0.1, 0.0}, 0.05), std::invalid_argument);
+  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {0.1}, NAN), std::invalid_argument);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Hand files
 

@@ -50,6 +50,13 @@ class HandPath {
 /// than 1,000,000 lines.
 HandPath raster_path(double width_m, double height_m, double spacing_m, double speed_m_per_s);
 
+/// The raster of `raster_path`, re-timed so that its lines run at `line_speeds_m_per_s` in turn (line k at
+/// speed k mod size) and the steps between lines at `step_speed_m_per_s` [m/s]: a hand that keeps changing
+/// pace, for the level policy (issue 6). Throws std::invalid_argument (one line) when a speed is not finite
+/// and > 0, `line_speeds_m_per_s` is empty, or raster_path refuses its arguments.
+HandPath raster_path_with_line_speeds(double width_m, double height_m, double spacing_m,
+                                      const std::vector<double>& line_speeds_m_per_s, double step_speed_m_per_s);
+
 /// A bad hand file. what() is one line: `hand file '<path>' line <n>: <problem>` (no line number
 /// when the file cannot be opened), naming the limit for limit violations.
 class HandFileError : public std::runtime_error {
