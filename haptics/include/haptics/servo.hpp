@@ -1,7 +1,14 @@
 #pragma once
 /// @file servo.hpp
-/// The servo tick (DESIGN.md "Data flow", "Real-time rules"): device sample → collision query and
-/// contact solver at the level in use → force guard → force command, plus haptic events.
+/// The servo tick (DESIGN.md "Data flow", "Real-time rules"): device sample → level policy (hand speed,
+/// issue 6) → collision query and contact solver at the level in use → force-step limit at level changes →
+/// force guard → force command, plus haptic events.
+///
+/// Level changes (issue 6, item 2): the level wanted (LevelPolicy in auto mode, else the fixed level) is
+/// taken only at a tick where ContactSolver::level_change_is_safe says the proxy is on the same side of the
+/// new level's polyline as of the old one; until then the old level stays (ServoOutput::level_wanted shows
+/// the wait). After the change the old level remains a wall until the proxy leaves it, and any difference
+/// between the force of the last tick and the new level's force fades out at max_force_step_n per tick.
 /// The tick is `update(input, output) -> TickResult`: a function of (state, sample, scene), with no
 /// allocation, lock, throw, I/O or logging. Status enums here; exceptions only at setup.
 
