@@ -28,7 +28,7 @@ ServoParams auto_params() {
 /// Drives `loop` along handle positions `path` (one per tick) and counts proxy moves that cross a wall in
 /// force (the level in use, and the previous level while it is still a wall).
 struct RunStats {
-  long crossings = 0, contact_changes = 0, level_changes = 0, ticks = 0;
+  long crossings = 0, contact_changes = 0, level_changes = 0, wanted_changes = 0, ticks = 0;
   long min_gap_ticks = 1 << 30;  ///< fewest ticks between two contact begin/end events
   std::vector<ContactState> states;
 };
@@ -36,7 +36,7 @@ struct RunStats {
 RunStats drive(const Scene& sc, ServoLoop& loop, const std::vector<Vec2>& path, long settle_ticks = 0) {
   RunStats r;
   ServoOutput out;
-  int prev_level = loop.level(), prev_transition = -1;
+  int prev_level = loop.level(), prev_transition = -1, prev_wanted = -1;
   long last_event = -(1 << 20);
   for (std::size_t i = 0; i < path.size(); ++i) {
     ServoInput in;
@@ -58,6 +58,8 @@ RunStats drive(const Scene& sc, ServoLoop& loop, const std::vector<Vec2>& path, 
       last_event = static_cast<long>(i);
     }
     r.level_changes += out.level_changed;
+    r.wanted_changes += prev_wanted >= 0 && out.level_wanted != prev_wanted;
+    prev_wanted = out.level_wanted;
     r.states.push_back(c.state);
     ++r.ticks;
   }
@@ -85,10 +87,14 @@ TEST(HardCases, TremorAtAWallNeitherFlapsLevelsNorChatters) {
   // wall once per cycle, so two contact events per cycle are honest. The bound we hold (and document in
   // docs/PERFORMANCE.md): at most 2 contact events per tremor cycle and never two within 10 ms of each
   // other (no chatter on top of the tremor); after the first second, at most one level change.
-  std::mt19937 rng(8);
-  const Scene sc = Scene::build({test::random_blob(rng, {0, 0}, 0.02, 512)}, 6);
+  // A pixel-staircase circle: its error bounds (0.13, 0.22, 0.29, 0.43, 0.70 mm at levels 0–4) straddle
+  // what the policy tolerates at the tremor's speed (0.1 mm + ~22 mm/s · 10 ms ≈ 0.3 mm), the case where
+  // a level choice without hysteresis and speed filtering flaps.
+  const Scene sc = Scene::build({test::staircase_circle({0, 0}, 0.02, 0.0004)}, 6);
+  ASSERT_GT(sc.curve(0).max_box_half_width_m[3], 0.3e-3);
+  ASSERT_LT(sc.curve(0).max_box_half_width_m[1], 0.3e-3);
   const Vec2* pts = sc.points(0, 0);
-  // The wall point: curve point 0 (θ = 0), outward normal roughly +x for a blob round the origin.
+  // The wall point: curve point 0, outward normal roughly along it for a circle round the origin.
   const Vec2 w = pts[0];
   const Vec2 n = normalized_or(w, Vec2{1, 0});
   for (const Vec2 dir : {n, left_perp(n)}) {  // tremor across the wall, and along it
@@ -107,6 +113,16 @@ TEST(HardCases, TremorAtAWallNeitherFlapsLevelsNorChatters) {
       EXPECT_GE(r.min_gap_ticks, 10);
     }
     EXPECT_LE(r.level_changes, 1);
+    EXPECT_LE(r.wanted_changes, 1);
+    // The same hand with the speed unfiltered and no hysteresis or dwell: the level asked for flaps with the
+    // tremor (the level in use may flap less: a change also waits for the proxy to be on the right side).
+    ServoParams naive = auto_params();
+    naive.policy.speed_cutoff_hz = 200.0;
+    naive.policy.hysteresis = 0.0;
+    naive.policy.min_dwell_s = 0.0;
+    ServoLoop flappy(sc, naive);
+    flappy.start(path[0]);
+    EXPECT_GT(drive(sc, flappy, path, 1300).wanted_changes, 20) << "the case must be one where a naive policy flaps";
   }
 }
 
