@@ -2,7 +2,9 @@
 // OpenCV's own GaussianBlur + Canny + findContours on the same grey image, in the same run.
 // Both start from the decoded, downscaled grey image (decoding is common to both and left out).
 // Ours: blur + Canny (thresholds from the image) + edge linking + px→m (dropping chains too short to
-// feel, as explore does) + multiresolution + trees — exactly the pipeline of app::build_image_scene.
+// feel, as explore does) + multiresolution + trees — the pipeline of app::build_image_scene without the
+// issue-6 simplification (thin-line merging and the salience budget: OpenCV's side has no counterpart;
+// their time is in explore's summary.json, build_ms.thin_lines).
 #include <benchmark/benchmark.h>
 
 #include <opencv2/imgproc.hpp>
