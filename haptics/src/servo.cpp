@@ -32,25 +32,35 @@ namespace {
 
 // The scene's error bound per level for the policy: the largest error-box half-width of any curve (curves
 // with fewer levels count with their coarsest), so the level chosen keeps every curve within tolerance.
-LevelPolicy make_policy(const Scene& scene, const ServoParams& p) {
-  double err[LevelPolicy::kMaxLevels] = {};
+// Returns the number of levels.
+int level_error_ladder(const Scene& scene, double* err) {
   int levels = 1;
   for (std::size_t c = 0; c < scene.curve_count(); ++c) levels = std::max(levels, scene.curve(c).levels);
   levels = std::min(levels, LevelPolicy::kMaxLevels);
   for (int l = 0; l < levels; ++l) {
+    err[l] = 0.0;
     for (std::size_t c = 0; c < scene.curve_count(); ++c) {
       err[l] = std::max(err[l], scene.curve(c).max_box_half_width_m[scene.clamp_level(c, l)]);
     }
   }
+  return levels;
+}
+
+LevelPolicyParams policy_params(const ServoParams& p) {
   LevelPolicyParams pp = p.policy;
-  pp.fixed_level = -1;
-  return LevelPolicy(pp, err, levels, p.level);
+  pp.fixed_level = -1;  // fixing the level is the loop's business (auto_level off)
+  return pp;
 }
 
 }  // namespace
 
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
-    : scene_(&scene), params_(params), solver_(scene, params.contact), policy_(make_policy(scene, params)), level_(params.level) {}
+    : scene_(&scene),
+      params_(params),
+      solver_(scene, params.contact),
+      levels_(level_error_ladder(scene, level_error_m_)),
+      policy_(policy_params(params), level_error_m_, levels_, params.level),
+      level_(params.level) {}
 
 void ServoLoop::start(Vec2 handle_m) {
   level_ = params_.auto_level ? policy_.level() : params_.level;
@@ -63,11 +73,9 @@ void ServoLoop::start(Vec2 handle_m) {
 }
 
 void ServoLoop::set_auto_level(bool on) noexcept {
-  if (on && !params_.auto_level) {
-    ServoParams p = params_;
-    p.level = level_;  // the policy starts from the level in use, its speed filter from rest
-    policy_ = make_policy(*scene_, p);
-  }
+  // The policy starts again from the level in use, its speed filter from rest (the ladder is kept: no
+  // walk over the scene in the servo thread).
+  if (on && !params_.auto_level) policy_ = LevelPolicy(policy_params(params_), level_error_m_, levels_, level_);
   params_.auto_level = on;
   if (!on) params_.level = level_;
 }

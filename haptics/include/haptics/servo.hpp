@@ -104,6 +104,8 @@ class ServoLoop {
   const Scene* scene_;
   ServoParams params_;
   ContactSolver solver_;
+  double level_error_m_[LevelPolicy::kMaxLevels] = {};  // the scene's error bound per level [m] (policy input)
+  int levels_ = 1;
   LevelPolicy policy_;
   int level_ = 0;              // level in use
   Vec2 force_residual_;        // old level's force minus new level's, fading out at max_force_step_n per tick [N]
