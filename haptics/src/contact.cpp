@@ -40,11 +40,7 @@ inline bool neighbour(const Scene& sc, SegmentRef s, int dir, SegmentRef* out) {
 
 ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
     : scene_(&scene), params_(params), section_(scene) {
-  for (int l = 0; l < 16; ++l) {
-    for (std::size_t c = 0; c < scene.curve_count(); ++c) {
-      max_half_width_m_[l] = std::max(max_half_width_m_[l], scene.curve(c).max_box_half_width_m[scene.clamp_level(c, l)]);
-    }
-  }
+  for (int l = 0; l < 16; ++l) max_half_width_m_[l] = scene.max_box_half_width_m(l);
 }
 
 double ContactSolver::side_of(SegmentRef s, Vec2 p) const {

@@ -115,6 +115,18 @@ std::size_t Scene::total_segments(int level) const {
   return total;
 }
 
+double Scene::max_box_half_width_m(int level) const {
+  double widest = 0.0;
+  for (std::size_t c = 0; c < curves_.size(); ++c) widest = std::max(widest, curves_[c].max_box_half_width_m[clamp_level(c, level)]);
+  return widest;
+}
+
+int Scene::max_curve_levels() const {
+  int levels = 1;
+  for (const CurveInfo& ci : curves_) levels = std::max(levels, ci.levels);
+  return levels;
+}
+
 Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   Scene scene;
   max_levels = std::clamp(max_levels, 0, kMaxLevels - 1);

@@ -30,19 +30,11 @@ Vec2 ForceGuard::apply(Vec2 f, double since_start_s, DeviceStatus status, bool d
 
 namespace {
 
-// The scene's error bound per level for the policy: the largest error-box half-width of any curve (curves
-// with fewer levels count with their coarsest), so the level chosen keeps every curve within tolerance.
-// Returns the number of levels.
+// The scene's error bound per level for the policy (the worst curve's, so the level chosen keeps every
+// curve within tolerance). Returns the number of levels.
 int level_error_ladder(const Scene& scene, double* err) {
-  int levels = 1;
-  for (std::size_t c = 0; c < scene.curve_count(); ++c) levels = std::max(levels, scene.curve(c).levels);
-  levels = std::min(levels, LevelPolicy::kMaxLevels);
-  for (int l = 0; l < levels; ++l) {
-    err[l] = 0.0;
-    for (std::size_t c = 0; c < scene.curve_count(); ++c) {
-      err[l] = std::max(err[l], scene.curve(c).max_box_half_width_m[scene.clamp_level(c, l)]);
-    }
-  }
+  const int levels = std::min(scene.max_curve_levels(), LevelPolicy::kMaxLevels);
+  for (int l = 0; l < levels; ++l) err[l] = scene.max_box_half_width_m(l);
   return levels;
 }
 

@@ -120,6 +120,25 @@ TEST(CollisionTree, ErrorGrowsWithLevelAndBoxesBoundIt) {
   }
 }
 
+TEST(CollisionTree, SceneErrorBoundIsTheWidestBoxOfAnyCurveAtThatLevel) {
+  // A short curve (few levels) and a long one: past the short curve's coarsest level, its coarsest boxes
+  // still count.
+  std::mt19937 rng(12);
+  std::vector<Polyline> curves{test::random_blob(rng, {-0.03, 0}, 0.01, 16), test::random_blob(rng, {0.03, 0}, 0.02, 400)};
+  const Scene sc = Scene::build(curves, 6);
+  ASSERT_LT(sc.curve(0).levels, sc.curve(1).levels);
+  EXPECT_EQ(sc.max_curve_levels(), std::max(sc.curve(0).levels, sc.curve(1).levels));
+  for (int l = 0; l < 8; ++l) {
+    double widest = 0.0;
+    for (std::size_t c = 0; c < 2; ++c) {
+      const int top = std::min(l, sc.curve(c).levels - 1);
+      widest = std::max(widest, sc.curve(c).max_box_half_width_m[top]);
+    }
+    EXPECT_EQ(sc.max_box_half_width_m(l), widest) << "level " << l;
+  }
+  EXPECT_EQ(Scene::build({}, 3).max_box_half_width_m(2), 0.0);
+}
+
 TEST(CollisionTree, SkipsDegenerateCurves) {
   std::vector<Polyline> curves(3);
   curves[0].points_m = {{0.01, 0.01}};                  // one point

@@ -132,6 +132,11 @@ class Scene {
   void segment(SegmentRef s, Vec2* a, Vec2* b) const;
   /// Segment count over all curves at `level` (curves with fewer levels use their coarsest).
   std::size_t total_segments(int level) const;
+  /// The scene's error bound at `level`: the largest error-box half-width of any curve there (curves with
+  /// fewer levels count with their coarsest) [m]; 0 for an empty scene. O(curves): for setup code.
+  double max_box_half_width_m(int level) const;
+  /// Levels of the curve with the most levels (1 for an empty scene).
+  int max_curve_levels() const;
   /// Coarsest level available in every curve clamped: min(level, levels−1 of curve c).
   int clamp_level(std::size_t c, int level) const {
     const int top = curves_[c].levels - 1;
