@@ -47,8 +47,7 @@ LevelPolicyParams policy_params(const ServoParams& p) {
 }  // namespace
 
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
-    : scene_(&scene),
-      params_(params),
+    : params_(params),
       solver_(scene, params.contact),
       levels_(level_error_ladder(scene, level_error_m_)),
       policy_(policy_params(params), level_error_m_, levels_, params.level),
@@ -90,13 +89,9 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   const int wanted = params_.auto_level ? policy_.update(velocity_, dt) : params_.level;
   out.level_changed = false;
   if (wanted != level_) {
-    if (solver_.level_change_is_safe(wanted)) {
-      // The new level's force fades in: keep this tick's force continuous with the last one.
+    if (solver_.level_change_is_safe(wanted)) {  // else it waits (out.level_wanted shows it)
       out.level_changed = true;
       level_ = wanted;
-      ++level_changes_;
-    } else {
-      ++deferred_ticks_;
     }
   }
   out.level = level_;

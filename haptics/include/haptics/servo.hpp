@@ -92,16 +92,11 @@ class ServoLoop {
   void set_auto_level(bool on) noexcept;
   /// Level in use (walls rendered) [0 = finest].
   int level() const noexcept { return level_; }
-  /// Ticks a wanted level change has waited for a safe moment, summed over the run.
-  std::int64_t deferred_ticks() const noexcept { return deferred_ticks_; }
-  /// Level changes made.
-  std::int64_t level_changes() const noexcept { return level_changes_; }
   std::int64_t ticks() const { return ticks_; }
   /// The contact solver (its proxy and boundary section), for display snapshots taken in the servo thread.
   const ContactSolver& solver() const { return solver_; }
 
  private:
-  const Scene* scene_;
   ServoParams params_;
   ContactSolver solver_;
   double level_error_m_[LevelPolicy::kMaxLevels] = {};  // the scene's error bound per level [m] (policy input)
@@ -110,8 +105,6 @@ class ServoLoop {
   int level_ = 0;              // level in use
   Vec2 force_residual_;        // old level's force minus new level's, fading out at max_force_step_n per tick [N]
   Vec2 last_force_;            // force of the previous tick before the guard [N]
-  std::int64_t deferred_ticks_ = 0;
-  std::int64_t level_changes_ = 0;
   Vec2 last_handle_;
   Vec2 velocity_;
   std::int64_t ticks_ = 0;
