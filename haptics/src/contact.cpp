@@ -40,7 +40,7 @@ inline bool neighbour(const Scene& sc, SegmentRef s, int dir, SegmentRef* out) {
 
 ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
     : scene_(&scene), params_(params), section_(scene) {
-  for (int l = 0; l < 16; ++l) max_half_width_m_[l] = scene.max_box_half_width_m(l);
+  for (int l = 0; l < Scene::kMaxLevels; ++l) max_half_width_m_[l] = scene.max_box_half_width_m(l);
 }
 
 double ContactSolver::side_of(SegmentRef s, Vec2 p) const {
@@ -93,7 +93,7 @@ bool ContactSolver::level_change_is_safe(int new_level) {
   if (transition_level_ >= 0) return false;  // one change at a time
   // A curve's polylines at two levels lie within E = (largest error-box half-width at one level + at the
   // other) of each other, so a point between them lies within E of both; search twice as far.
-  const double e = max_half_width_m_[std::clamp(level_, 0, 15)] + max_half_width_m_[std::clamp(new_level, 0, 15)];
+  const double e = max_half_width_m_[std::clamp(level_, 0, Scene::kMaxLevels - 1)] + max_half_width_m_[std::clamp(new_level, 0, Scene::kMaxLevels - 1)];
   const double radius = 2.0 * e + 4.0 * params_.skin_m;
   // The curves that could have the proxy between their two levels: those it touches, and the nearest one
   // at either level.

@@ -151,7 +151,7 @@ class ContactSolver {
   int level_ = 0;
   bool sticking_ = false;   // edge contact inside the static friction cone
   int transition_level_ = -1;  // the previous level, still a wall just after a change; −1 = none
-  double max_half_width_m_[16] = {};  // per level: the largest error-box half-width of any curve [m]
+  double max_half_width_m_[Scene::kMaxLevels] = {};  // per level: the largest error-box half-width of any curve [m]
   // Side of p relative to curve `curve`'s polyline at `level`: +1 left, −1 right, 0 when the polyline is not
   // within radius_m or its nearest point is an open end, 2 when p lies on it.
   int side_of_curve(Vec2 p, int curve, int level, double radius_m);
