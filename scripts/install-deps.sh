@@ -8,6 +8,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libboost-dev
   libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev sox
   libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri xvfb xauth
+  libpoppler-cpp-dev libudev-dev libblkid-dev
+  poppler-utils e2fsprogs util-linux mount qpdf
 )
 missing=()
 for p in "${packages[@]}"; do

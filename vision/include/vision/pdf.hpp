@@ -1,0 +1,107 @@
+#pragma once
+/// @file pdf.hpp
+/// PDF pages as pictures, with their text (issue 11, items 3 and 4).
+///
+/// A PDF from a stick is hostile input, and poppler is a large parser: every poppler call runs in a
+/// forked worker process (fork(2), no exec) with RLIMIT_CPU and a wall-clock kill, so a PDF that crashes or
+/// hangs poppler takes down only its worker. The kiosk process itself never calls poppler. The worker
+/// sends its answer back through a pipe; the parent reads it with poll(2) against the deadline, then
+/// SIGKILLs and reaps the worker in every case (wait4, for the worker's peak memory).
+///
+/// Order inside the worker: poppler::document::load_from_raw_data, then is_locked() before anything
+/// else (a locked document crashes pages() in Debian 12's poppler 22.12), then the page count (capped),
+/// then the page: rendered in grey (poppler::page_renderer, antialiasing on) at the DPI that keeps the
+/// page within the pixel budget, and its words (page::text_list) in the same pixel frame.
+
+#include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace hk::vision {
+
+/// Limits of PDF work. Defaults are the config's (`[stick]`). All must be positive.
+struct PdfLimits {
+  std::int64_t max_file_bytes = 200LL << 20;  ///< largest PDF [bytes]
+  int max_pages = 1000;                       ///< pages offered; a longer document offers its first max_pages
+  double max_page_pixels = 4e6;               ///< render budget [px]: DPI chosen so width x height <= this
+  double max_dpi = 300.0;                     ///< never rendered finer than this [dots per inch]
+  double worker_cpu_s = 5.0;                  ///< RLIMIT_CPU of the worker [s]
+  double worker_wall_s = 5.0;                 ///< the worker is killed after this wall-clock time [s]
+};
+
+/// What a PDF is, without rendering any page.
+struct PdfInfo {
+  int pages = 0;               ///< pages offered (min(real pages, max_pages)), >= 1
+  int pages_in_file = 0;       ///< pages the document has
+  bool capped = false;         ///< pages_in_file > max_pages
+  double worker_ms = 0.0;      ///< wall time of the worker [ms]
+  long worker_max_rss_kb = 0;  ///< the worker's peak resident memory [KiB]
+};
+
+/// One word (poppler text box) on a rendered page, in the page image's pixels (u right, v down, origin at
+/// the top-left pixel's corner).
+struct PdfWord {
+  std::string text;           ///< UTF-8
+  cv::Rect2d box_px;          ///< bounding box [px]
+};
+
+/// A block of text (a paragraph or a heading): words grouped into lines, lines into blocks
+/// (group_text_blocks).
+struct TextBlock {
+  cv::Rect2d box_px;  ///< union of its words' boxes [px]
+  std::string text;   ///< its lines in reading order, joined with single spaces
+  int lines = 0;      ///< number of lines
+};
+
+/// A rendered page.
+struct PdfPage {
+  cv::Mat grey;                   ///< CV_8UC1, the page on white
+  double dpi = 0.0;               ///< the DPI it was rendered at
+  double width_pt = 0, height_pt = 0;  ///< page size [pt] (1/72 inch), after its rotation
+  std::vector<PdfWord> words;     ///< every word on the page, in poppler's reading order
+  std::vector<TextBlock> blocks;  ///< words grouped (group_text_blocks)
+  int pages = 0;                  ///< pages offered by the document (as PdfInfo::pages)
+  double worker_ms = 0.0;         ///< wall time of the worker [ms]
+  long worker_max_rss_kb = 0;     ///< the worker's peak resident memory [KiB]
+};
+
+/// A refused or unreadable PDF or page. what() is one line: "pdf '<name>': <problem>", e.g.
+/// "pdf 'report.pdf': protected by a password", "pdf 'x.pdf': page 3 took longer than 5 s to draw".
+class PdfError : public std::runtime_error {
+ public:
+  enum class Kind { NotPdf, Damaged, Locked, NoSuchPage, TooLarge, Timeout, WorkerCrashed };
+  PdfError(Kind kind, const std::string& what) : std::runtime_error(what), kind_(kind) {}
+  Kind kind() const { return kind_; }
+
+ private:
+  Kind kind_;
+};
+
+/// Opens the document in a worker and counts its pages.
+/// @param name   how to name it in errors (made printable on one line)
+/// @throws PdfError (NotPdf: no "%PDF-" header; Damaged: poppler cannot load it or it has no page;
+///         Locked: needs a password; TooLarge: over max_file_bytes; Timeout / WorkerCrashed).
+PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits);
+
+/// Renders page `page` (from 1) in a worker: grey, at dpi = min(max_dpi, 72 · sqrt(max_page_pixels /
+/// (width_pt · height_pt))), with its words and text blocks.
+/// @throws PdfError as probe_pdf, plus NoSuchPage (page outside [1, pages offered]) and TooLarge (a page so
+///         large that even 1 DPI would exceed the budget).
+PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& name, int page, const PdfLimits& limits);
+
+/// Groups words into lines and lines into blocks, the way a reader sees paragraphs:
+/// - a word joins a line when its vertical extent overlaps the line's by at least half of the smaller
+///   height and the horizontal gap to the line's last word is under 1.5 x the line's height;
+/// - a line joins a block when the vertical gap to the block's last line is under 1.0 x the line height,
+///   the heights differ by less than a factor 1.5, and the lines overlap horizontally.
+/// Blocks come out in reading order (top to bottom, then left to right).
+std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words);
+
+/// True when `bytes` start with "%PDF-" (after up to 1024 bytes of leading junk, as readers allow).
+bool looks_like_pdf(std::span<const std::uint8_t> bytes);
+
+}  // namespace hk::vision

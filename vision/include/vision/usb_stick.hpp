@@ -1,0 +1,117 @@
+#pragma once
+/// @file usb_stick.hpp
+/// USB sticks coming and going (issue 11, item 1): block-device events, filesystem identification, and a
+/// read-only mount that nothing can write through.
+///
+/// Events come through the small BlockEventSource interface: UdevBlockEventSource watches the kernel's
+/// uevents with a libudev monitor (subsystem "block", ID_BUS=usb, partitions and whole disks that carry a
+/// filesystem); tests feed events for loop devices through FakeBlockEventSource.
+///
+/// Mounting follows one order, each step refusing with a one-line StickMountError:
+/// 1. identify the filesystem with libblkid on the device node (probe of superblocks, TYPE tag);
+///    only vfat, exfat, ntfs3 (blkid says "ntfs"), ext4 and iso9660 are accepted;
+/// 2. make the block device read-only with ioctl(BLKROSET, 1), so not even the filesystem driver's
+///    journal replay or a "dirty" flag can write to the stick;
+/// 3. mount(2) under `<mount_root>/<N>` with MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC |
+///    MS_NOSYMFOLLOW | MS_NOATIME (plus, for ext4, "noload" so no journal is replayed);
+/// 4. on removal or destruction, umount2(MNT_DETACH) and remove the mount point.
+/// The kiosk needs CAP_SYS_ADMIN for steps 2 and 3; have_mount_capability() tells beforehand.
+
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace hk::vision {
+
+/// A block device appearing or disappearing.
+struct BlockEvent {
+  enum class Action { Add, Remove };
+  Action action = Action::Add;
+  std::string devnode;  ///< e.g. "/dev/sdb1" or "/dev/loop3"
+  std::string label;    ///< filesystem label if the event carries one (ID_FS_LABEL), else ""
+};
+
+/// Where block events come from. Not thread-safe: one consumer thread polls it.
+class BlockEventSource {
+ public:
+  virtual ~BlockEventSource() = default;
+  /// The next event, waiting at most timeout_ms [ms] (0: do not wait). nullopt when none came.
+  virtual std::optional<BlockEvent> next(int timeout_ms) = 0;
+};
+
+/// libudev monitor on the "udev" netlink group, filtered to subsystem "block", ID_BUS=usb, with a
+/// filesystem (ID_FS_USAGE=filesystem) or a partition. Also reports the sticks already present at
+/// construction as Add events (enumeration), so a stick inserted before the kiosk started is seen.
+class UdevBlockEventSource final : public BlockEventSource {
+ public:
+  /// @throws StickMountError when libudev cannot create the monitor (no /run/udev, no netlink).
+  UdevBlockEventSource();
+  ~UdevBlockEventSource() override;
+  std::optional<BlockEvent> next(int timeout_ms) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Events pushed by hand (tests, and the `stick --device` command's single mount). Thread-safe: push
+/// from any thread, next() from the consumer.
+class FakeBlockEventSource final : public BlockEventSource {
+ public:
+  void push(BlockEvent e);
+  std::optional<BlockEvent> next(int timeout_ms) override;
+
+ private:
+  struct Queue;
+  std::shared_ptr<Queue> q_ = make_queue();
+  static std::shared_ptr<Queue> make_queue();
+};
+
+/// A refused stick or failed mount. what() is one line naming the device: "stick '/dev/sdb1': ...".
+class StickMountError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The filesystem type libblkid finds on `devnode` ("vfat", "exfat", "ntfs", "ext4", "iso9660", ...),
+/// probing superblocks only (no writes; the device is opened O_RDONLY).
+/// @throws StickMountError if the device cannot be opened or carries no recognisable filesystem.
+std::string identify_filesystem(const std::string& devnode);
+
+/// Whether the filesystem type (as identify_filesystem returns it) is one the kiosk mounts.
+bool filesystem_supported(const std::string& type);
+
+/// Whether this process holds CAP_SYS_ADMIN in its effective set (needed to mount and for BLKROSET).
+bool have_mount_capability();
+
+/// One line for the log on how to grant the capability (setcap on the executable, or the systemd unit's
+/// AmbientCapabilities=CAP_SYS_ADMIN).
+std::string mount_capability_hint();
+
+/// A stick mounted read-only. Unmounts (MNT_DETACH) and removes its mount point when destroyed.
+class MountedStick {
+ public:
+  /// Identifies, sets the device read-only, and mounts it under `<mount_root>/<slot>` (the folder is
+  /// created with mode 0700; mount_root is created if missing).
+  /// @throws StickMountError (unsupported filesystem, no capability, mount refused by the kernel).
+  MountedStick(const std::string& devnode, const std::string& mount_root, int slot);
+  ~MountedStick();
+  MountedStick(const MountedStick&) = delete;
+  MountedStick& operator=(const MountedStick&) = delete;
+
+  const std::string& devnode() const { return devnode_; }
+  const std::string& mount_point() const { return mount_point_; }
+  const std::string& filesystem() const { return fs_; }
+  /// Unmounts now (idempotent). Never throws; a failure is logged by the caller through the return value.
+  bool unmount();
+
+ private:
+  std::string devnode_, mount_point_, fs_;
+  bool mounted_ = false;
+};
+
+/// The default mount root, "/run/haptic-kiosk/usb".
+inline constexpr const char* kDefaultStickMountRoot = "/run/haptic-kiosk/usb";
+
+}  // namespace hk::vision
