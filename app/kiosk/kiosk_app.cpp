@@ -34,6 +34,7 @@
 #include "servo_core.hpp"
 #include "servo_thread.hpp"
 #include "simulation.hpp"
+#include "stick_service.hpp"
 
 #ifndef HK_DATA_DIR
 #define HK_DATA_DIR "data"
@@ -45,8 +46,8 @@ namespace {
 // ---- scripted input ---------------------------------------------------------------------------------
 struct ScriptLine {
   int frame = 0;
-  std::string what;  // "key", "cursor", "move"
-  std::string key;
+  std::string what;  // "key", "cursor", "move", "stick", "unstick", "wait_loaded"
+  std::string key;   // key name, or the stick's folder
   Vec2 cursor_m;
 };
 
@@ -74,8 +75,12 @@ std::vector<ScriptLine> load_script(const std::string& path) {
     bool ok = static_cast<bool>(ss) && s.frame >= 0;
     if (ok && s.what == "key") ok = static_cast<bool>(ss >> s.key) && key_names().count(s.key);
     else if (ok && s.what == "cursor") ok = static_cast<bool>(ss >> s.cursor_m.x >> s.cursor_m.y);
-    else if (ok && s.what != "move") ok = false;
-    if (!ok) throw std::runtime_error("script '" + path + "': line " + std::to_string(n) + " is not 'FRAME key NAME', 'FRAME cursor X_M Y_M' or 'FRAME move'");
+    else if (ok && s.what == "stick") ok = static_cast<bool>(ss >> s.key);
+    else if (ok && s.what != "move" && s.what != "unstick" && s.what != "wait_loaded") ok = false;
+    if (!ok) {
+      throw std::runtime_error("script '" + path + "': line " + std::to_string(n) +
+                               " is not 'FRAME key NAME', 'FRAME cursor X_M Y_M', 'FRAME move', 'FRAME stick DIR', 'FRAME unstick' or 'FRAME wait_loaded'");
+    }
     out.push_back(s);
   }
   return out;
@@ -89,14 +94,26 @@ struct Shown {
   cv::Mat picture;                                     // BGR, empty for tutorial shapes
   vision::PxToM px_to_m{1, 0, 0};
   const Scene* scene = nullptr;                        // the published scene (read-only here; for the overlay)
+  std::vector<TextBlockM> text_blocks;                 // a document page's text (Describe reads the one under the hand)
 };
+
+std::unique_ptr<vision::BlockEventSource> block_events(bool hotplug) {
+  if (!hotplug) return nullptr;
+  try {
+    return std::make_unique<vision::UdevBlockEventSource>();
+  } catch (const std::exception& e) {
+    spdlog::warn("usb sticks: no hot-plug ({}); the kiosk runs on without sticks", e.what());
+    return nullptr;
+  }
+}
 
 class App final : public KioskEffects {
  public:
   App(const KioskOptions& o, const config::Settings& s)
       : opt_(o), s_(s), audio_(audio_params_from(s)), half_{s.workspace.width_m / 2, s.workspace.height_m / 2},
         sp_(servo_params_from(s)), device_(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2}),
-        core_(device_, cue_params(), &audio_.cues()) {
+        core_(device_, cue_params(), &audio_.cues()),
+        sticks_(s, block_events(o.hotplug), o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
     pictures_ = list_pictures(o.library.empty() ? std::string(HK_DATA_DIR) + "/pictures" : o.library);
     device_.open();
     hand_ = hand_params_from(s);
@@ -135,16 +152,86 @@ class App final : public KioskEffects {
   }
   int show_picture(int index) override {
     ImageScene is = build_image_scene(pictures_[static_cast<std::size_t>(index)], s_);
-    Shown sh;
-    sh.polylines = is.polylines;
-    sh.picture = cv::imread(is.image_path, cv::IMREAD_COLOR);
-    sh.px_to_m = is.px_to_m;
     const int shapes = static_cast<int>(is.scene->curve_count());
-    publish(std::move(sh), std::move(is.scene), index);
+    show_built(is, index);
+    shown_page_ = 0;
     return shapes;
   }
+  /// Puts a built scene on the device and the screen (the old one's force fades out first: ServoCore).
+  void show_built(ImageScene& is, int id) {
+    Shown sh;
+    sh.polylines = is.polylines;
+    sh.picture = is.picture.empty() ? cv::imread(is.image_path, cv::IMREAD_COLOR) : is.picture;
+    sh.px_to_m = is.px_to_m;
+    sh.text_blocks = is.text_blocks;
+    std::vector<Aabb> boxes;
+    for (const TextBlockM& b : is.text_blocks) boxes.push_back({b.lo_m, b.hi_m});
+    publish(std::move(sh), std::move(is.scene), id, std::move(boxes));
+  }
   int picture_count() const override { return static_cast<int>(pictures_.size()); }
-  std::string describe() override { return describe_scene(shown_.polylines, half_); }
+  std::string describe() override {
+    if (shown_page_ > 0) {
+      // A document page: the block of text under the hand is read; elsewhere, what the page holds.
+      const Vec2 p = core_.display().proxy_m;
+      for (const TextBlockM& b : shown_.text_blocks) {
+        if (b.contains(p)) return audio_.messages().text(audio::MessageId::text_block, {{"text", b.text}});
+      }
+      return describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines)) + " " +
+             describe_scene(shown_.polylines, half_);
+    }
+    return describe_scene(shown_.polylines, half_);
+  }
+  void show_document(int document, int page) override { sticks_.load(stick_id_, document, page); }
+  void forget_stick() override {
+    sticks_.forget();
+    stick_id_ = 0;
+  }
+
+  /// Window thread, every frame: news of sticks and finished loads, handed to the flow.
+  void poll_sticks(KioskFlow& flow, double now_s) {
+    for (StickNews& n : sticks_.poll_news()) {
+      if (n.kind == StickNews::Kind::Inserted) {
+        stick_id_ = n.stick;
+        std::vector<StickEntry> entries;
+        for (const ListedDocument& d : n.documents) entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages});
+        stick_busy_ = !entries.empty();
+        flow.stick_inserted(entries, now_s);
+      } else if (n.kind == StickNews::Kind::Refused) {
+        stick_busy_ = false;
+        flow.stick_refused(n.reason, now_s);
+      } else {
+        stick_id_ = 0;
+        stick_busy_ = false;
+        flow.stick_removed(now_s);
+      }
+    }
+    for (LoadedDocument& d : sticks_.poll_loaded()) {
+      if (d.stick != stick_id_) continue;  // a stick taken out or forgotten meanwhile
+      DocumentResult r;
+      r.document = d.document;
+      r.page = d.page;
+      if (d.scene) {
+        ImageScene& is = *d.scene;
+        r.ok = true;
+        r.description = is.page > 0 ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
+                                    : describe_shapes(static_cast<int>(is.scene->curve_count()));
+        show_built(is, 1000 + d.document * 100000 + d.page);
+        shown_page_ = is.page;
+      } else {
+        r.reason = d.reason;
+      }
+      stick_busy_ = false;
+      flow.document_ready(r, now_s);
+    }
+    if (flow.loading()) stick_busy_ = true;
+  }
+  /// Whether stick work (scan or load) may still bring news (scripted runs wait for it).
+  bool stick_busy() const { return stick_busy_; }
+  void insert_stick_folder(const std::string& dir) {
+    stick_busy_ = true;
+    sticks_.insert_folder(dir);
+  }
+  void remove_stick_folder() { sticks_.remove_folder(); }
   bool change_level(int delta) override {
     // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until
     // the session ends.
@@ -200,7 +287,7 @@ class App final : public KioskEffects {
     p.workspace_half_extent_m = half_;
     return p;
   }
-  void publish(Shown sh, std::unique_ptr<Scene> scene, int id) {
+  void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {}) {
     const Scene& sc = *scene;
     sh.levels.resize(sc.curve_count());
     sh.closed.resize(sc.curve_count());
@@ -216,6 +303,7 @@ class App final : public KioskEffects {
     sp.auto_level = auto_level_;
     auto bundle = std::make_unique<SceneBundle>(std::move(scene), sp);
     bundle->id = id;
+    bundle->text_blocks_m = std::move(text_boxes);
     sh.scene = bundle->scene.get();
     shown_ = std::move(sh);
     shown_id_ = id;
@@ -239,6 +327,10 @@ class App final : public KioskEffects {
   bool high_contrast_ = false, overlay_ = false;
   std::string last_said_;
   int shown_id_ = -100;
+  int shown_page_ = 0;      // a document page shown (from 1), 0 for a picture
+  int stick_id_ = 0;        // the stick the flow browses (StickNews::stick), 0 for none
+  bool stick_busy_ = false;
+  StickService sticks_;     // last: its threads stop first
 };
 
 // ---- drawing (OpenGL 2, legacy pipeline: one draw per frame of a few thousand vertices) ---------------
@@ -483,6 +575,7 @@ int run_kiosk(const KioskOptions& o) {
   });
 
   app.start_servo();
+  if (!o.stick.empty()) app.insert_stick_folder(o.stick);
   if (!o.show.empty()) {
     int idx = app.find_picture(o.show);
     if (idx < 0) {
@@ -506,15 +599,27 @@ int run_kiosk(const KioskOptions& o) {
   Vec2 mouse_rest;  // [px]
   int frame = 0;
   std::size_t next_script = 0;
+  int held_frames = 0;
+  constexpr int kMaxHeldFrames = 3600;  // 60 s of scripted frames
   while (!glfwWindowShouldClose(win)) {
     glfwPollEvents();
     const bool scripted = !o.screenshot.empty();
     ws.now_s = scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    app.poll_sticks(flow, ws.now_s);
+    bool holding = false;  // a scripted run waits (frames do not count) while stick work is under way
     while (next_script < script.size() && script[next_script].frame <= frame) {
-      const ScriptLine& l = script[next_script++];
+      const ScriptLine& l = script[next_script];
+      if (l.what == "wait_loaded" && app.stick_busy()) {
+        if (++held_frames > kMaxHeldFrames) throw std::runtime_error("script '" + o.script + "': stick work did not finish within 60 s");
+        holding = true;
+        break;
+      }
+      ++next_script;
       if (l.what == "key") flow.key(key_names().at(l.key), ws.now_s);
       if (l.what == "cursor") app.set_cursor(l.cursor_m);
       if (l.what == "move") flow.handle_moved(ws.now_s);
+      if (l.what == "stick") app.insert_stick_folder(l.key);
+      if (l.what == "unstick") app.remove_stick_folder();
     }
     int fw = 0, fh = 0;
     glfwGetFramebufferSize(win, &fw, &fh);
@@ -598,7 +703,7 @@ int run_kiosk(const KioskOptions& o) {
     }
     ImGui::Render();
     ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
-    ++frame;
+    if (!holding) ++frame;
     if (scripted && frame >= o.frames) {
       glFinish();
       std::vector<unsigned char> px(static_cast<std::size_t>(fw) * static_cast<std::size_t>(fh) * 3);

@@ -3,7 +3,8 @@
 /// The kiosk a visitor walks up to (issue 5): `haptic-kiosk` with no subcommand. One window (full screen
 /// on the primary monitor, or `--windowed`), the servo thread driving the simulated pantograph from the
 /// mouse (the model hand pulls the handle towards the cursor), the audio side, and the visitor's flow
-/// (kiosk_flow.hpp) on the keyboard.
+/// (kiosk_flow.hpp) on the keyboard. USB sticks are watched, mounted read-only and scanned, and their
+/// documents built, on worker threads (stick_service.hpp).
 ///
 /// View mapping (tests rely on it): workspace metres → window pixels with one uniform scale
 /// s = 0.9 · min(W / width_m, 0.8 · H / height_m) [px/m], y up, the bottom 14 % left to the captions:
@@ -23,7 +24,12 @@ struct KioskOptions {
   bool overlay = false;         ///< start with the operator overlay
   std::string screenshot;       ///< write the last frame here as PNG and quit
   int frames = 0;               ///< frames to run before the screenshot (at 60 Hz)
-  std::string script;           ///< scripted input: lines "FRAME key NAME", "FRAME cursor X_M Y_M", "FRAME move"
+  std::string script;           ///< scripted input: lines "FRAME key NAME", "FRAME cursor X_M Y_M", "FRAME move",
+                                ///< "FRAME stick DIR" (a folder inserted as a USB stick), "FRAME unstick" (taken out),
+                                ///< "FRAME wait_loaded" (hold the frame count until stick work is done)
+  std::string stick;            ///< a folder treated as a USB stick inserted at start (documentation, tests)
+  bool hotplug = true;          ///< watch for USB sticks (libudev); off: only --stick and scripted sticks
+  std::string mount_root;       ///< where sticks are mounted; empty: /run/haptic-kiosk/usb
 };
 
 /// Runs the kiosk until the window closes (or, with a screenshot, for `frames` frames). Returns the exit

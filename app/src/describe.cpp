@@ -56,4 +56,51 @@ std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half, int m
   return out;
 }
 
+int count_figures(const std::vector<Polyline>& curves, double margin_m) {
+  std::vector<std::pair<Vec2, Vec2>> boxes;
+  for (const Polyline& p : curves) {
+    if (p.points_m.empty()) continue;
+    Vec2 lo = p.points_m[0], hi = p.points_m[0];
+    for (const Vec2& q : p.points_m) {
+      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    }
+    boxes.emplace_back(lo, hi);
+  }
+  std::vector<std::size_t> parent(boxes.size());
+  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  auto find = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  int groups = static_cast<int>(boxes.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    for (std::size_t j = i + 1; j < boxes.size(); ++j) {
+      const auto& [a0, a1] = boxes[i];
+      const auto& [b0, b1] = boxes[j];
+      const bool touch = a0.x - margin_m <= b1.x && b0.x <= a1.x + margin_m && a0.y - margin_m <= b1.y && b0.y <= a1.y + margin_m;
+      if (!touch) continue;
+      const std::size_t ri = find(i), rj = find(j);
+      if (ri != rj) {
+        parent[ri] = rj;
+        --groups;
+      }
+    }
+  }
+  return groups;
+}
+
+std::string describe_shapes(int shapes) {
+  if (shapes == 0) return "I found no shapes in it.";
+  return shapes == 1 ? "It has one shape." : "It has " + std::to_string(shapes) + " shapes.";
+}
+
+std::string describe_page(int text_blocks, int figures) {
+  auto count = [](int n, const char* one, const char* many, const char* none) {
+    return n == 0 ? std::string(none) : n == 1 ? std::string(one) : std::to_string(n) + " " + many;
+  };
+  return "It has " + count(text_blocks, "one block of text", "blocks of text", "no text") + " and " +
+         count(figures, "one figure", "figures", "no figures") + ".";
+}
+
 }  // namespace hk::app

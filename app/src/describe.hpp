@@ -18,4 +18,16 @@ namespace hk::app {
 /// 3 x 3 grid holding their bounding-box centre); the rest are counted.
 std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half_extent_m, int max_named = 3);
 
+/// Figures on a document page: groups of curves whose bounding boxes, grown by margin_m on every side,
+/// overlap (transitively: union-find over the pairs). A drawing of many strokes counts once; two drawings
+/// apart count twice. Returns 0 for no curves.
+int count_figures(const std::vector<Polyline>& curves, double margin_m = 0.002);
+
+/// How many shapes a picture has, for speech: "It has 4 shapes.", "It has one shape.", "I found no shapes in it."
+std::string describe_shapes(int shapes);
+
+/// What a document page holds, for speech (issue 11, item 4): "It has 2 blocks of text and one figure.",
+/// "It has one block of text and no figures.", "It has no text and no figures."
+std::string describe_page(int text_blocks, int figures);
+
 }  // namespace hk::app

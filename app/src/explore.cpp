@@ -18,6 +18,7 @@
 #include "audio/wav.hpp"
 #include "config/load.hpp"
 #include "cue_tracker.hpp"
+#include "documents.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
 #include "image_scene.hpp"
@@ -57,13 +58,22 @@ json scene_json(const ImageScene& is, const config::Settings& s) {
     curves.push_back({{"id", c}, {"closed", ci.closed}, {"levels", std::move(levels)}});
   }
   j["curves"] = std::move(curves);
+  if (is.page > 0) {  // a document page: its text is spoken, not felt
+    j["page"] = is.page;
+    j["pages"] = is.pages;
+    json blocks = json::array();
+    for (const TextBlockM& b : is.text_blocks) {
+      blocks.push_back({{"id", b.id}, {"bbox_m", {b.lo_m.x, b.lo_m.y, b.hi_m.x, b.hi_m.y}}, {"text", b.text}});
+    }
+    j["text_blocks"] = std::move(blocks);
+  }
   return j;
 }
 
 cv::Point2d to_px(const vision::PxToM& m, Vec2 q) { return {m.u_px(q.x), m.v_px(q.y)}; }
 
 void write_overlay(const std::filesystem::path& out, const ImageScene& is, int level, const std::vector<Vec2>& proxy_path) {
-  cv::Mat img = cv::imread(is.image_path, cv::IMREAD_COLOR);
+  cv::Mat img = is.picture.empty() ? cv::imread(is.image_path, cv::IMREAD_COLOR) : is.picture.clone();
   if (img.empty()) throw ExploreError("image '" + is.image_path + "': could not be read again for the overlay");
   // Dim the picture so the drawn curves stand out; draw at 4x sub-pixel precision.
   img = img * 0.55;
@@ -94,6 +104,15 @@ double percentile(std::vector<std::int64_t>& v, double q) {
 
 }  // namespace
 
+ImageScene build_input_scene(const std::string& path, int page, const config::Settings& s) {
+  if (page < 0) throw ExploreError("--page " + std::to_string(page) + " is outside [1, pages of the document]");
+  if (!is_pdf_file(path)) {
+    if (page > 0) throw ExploreError("--page " + std::to_string(page) + ": '" + path + "' is not a PDF (pages are for PDF documents)");
+    return build_image_scene(path, s);
+  }
+  return build_pdf_page_scene(read_file_limited(path, s.stick.max_file_bytes), path, page > 0 ? page : 1, s);
+}
+
 ExploreSummary run_explore(const ExploreOptions& o) {
   const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
   if (!std::isfinite(o.duration_s) || o.duration_s > 24 * 3600.0) {
@@ -110,7 +129,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   }
   const std::filesystem::path out(o.out_dir);
 
-  ImageScene is = build_image_scene(o.image_path, s);
+  ImageScene is = build_input_scene(o.image_path, o.page, s);
   const Scene& scene = *is.scene;
 
   const double duration = o.duration_s > 0.0 ? o.duration_s : path.duration_s() + 0.5;
@@ -155,6 +174,9 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   ctp.period_s = 1.0 / s.haptics.servo_rate_hz;
   ctp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
   CueTracker tracker(ctp);
+  std::vector<Aabb> text_boxes;
+  for (const TextBlockM& b : is.text_blocks) text_boxes.push_back({b.lo_m, b.hi_m});
+  tracker.set_text_blocks(text_boxes.data(), static_cast<int>(text_boxes.size()));
   std::vector<audio::CueEvent> cues;
   run_simulation(scene, s, path, duration, [&](const TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
@@ -224,6 +246,10 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["levels"] = {{"mode", s.haptics.level_mode}, {"changes", level_changes}, {"ticks_waiting_for_a_safe_change", level_waiting},
                   {"ticks_per_level", std::move(lt)}};
   sj["sticking_ticks"] = sticking;
+  if (is.page > 0) {
+    sj["document"] = {{"page", is.page}, {"pages", is.pages}, {"text_blocks", is.text_blocks.size()}, {"words_masked", is.text_words_masked},
+                      {"dpi", is.render_dpi}, {"worker_ms", is.worker_ms}, {"worker_max_rss_kb", is.worker_max_rss_kb}};
+  }
   sj["segments_in_use"] = scene.total_segments(s.haptics.level);
   sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};
   sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms}, {"thin_lines", is.times.thin_lines_ms},

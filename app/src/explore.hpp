@@ -7,11 +7,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "config/settings.hpp"
+#include "image_scene.hpp"
+
 namespace hk::app {
 
 /// What `haptic-kiosk explore` was asked to do.
 struct ExploreOptions {
-  std::string image_path;      ///< picture to explore
+  std::string image_path;      ///< picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore
+  int page = 0;                ///< PDF page (from 1); 0 = not given (a PDF's first page; refused for a picture)
   std::string out_dir;         ///< folder for the four output files (created if missing)
   std::string hand = "raster"; ///< "raster" or a CSV file with header t_s,x_m,y_m
   double duration_s = 0.0;     ///< run length [s]; ≤ 0: the hand path's duration + 0.5 s
@@ -34,6 +38,11 @@ struct ExploreSummary {
   std::size_t curves = 0;
   std::size_t cues = 0;        ///< audio cues emitted (counted with or without --audio-out)
 };
+
+/// The scene of the run's input: a picture file, or page `page` of a PDF (drawn in the worker, text
+/// masked and kept as text blocks). Throws ExploreError for --page with a picture or a page < 1 given,
+/// vision::InputError / vision::PdfError for bad files.
+ImageScene build_input_scene(const std::string& path, int page, const config::Settings& s);
 
 /// Runs explore. Throws on bad input with a one-line message naming the input and the limit.
 ExploreSummary run_explore(const ExploreOptions& options);

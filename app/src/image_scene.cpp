@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numeric>
 
+#include <opencv2/imgproc.hpp>
+
 #include "vision/thin_lines.hpp"
 
 namespace hk::app {
@@ -59,9 +61,9 @@ double length_m(const Polyline& p) {
 
 }  // namespace
 
-ImageScene build_image_scene(const std::string& path, const config::Settings& s) {
-  ImageScene out;
-  out.image_path = path;
+namespace {
+
+vision::ExtractParams extract_params(const config::Settings& s) {
   vision::ExtractParams p;
   p.limits.max_file_bytes = s.vision.max_file_bytes;
   p.limits.max_width_px = s.vision.max_width_px;
@@ -73,7 +75,11 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s)
   p.max_image_side_px = s.vision.max_image_side_px;
   // Length is judged in metres below, where the workspace scale is known; keep every real chain here.
   p.min_chain_length_px = 2.0;
-  vision::Extraction ex = vision::extract_chains(path, p);
+  return p;
+}
+
+/// Steps 2-5 of build_image_scene on an extraction: thin lines, metres, budget, trees.
+void build_from_extraction(ImageScene& out, vision::Extraction ex, const config::Settings& s) {
   out.width_px = ex.width_px;
   out.height_px = ex.height_px;
   out.canny_low = ex.edge_map.low;
@@ -152,6 +158,61 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s)
   out.segments_after_budget = out.scene->total_segments(0);
   out.times.multires_ms = out.scene->build_times().multires_ms;
   out.times.tree_ms = out.scene->build_times().tree_ms;
+}
+
+}  // namespace
+
+ImageScene build_image_scene(const std::string& path, const config::Settings& s) {
+  ImageScene out;
+  out.image_path = path;
+  build_from_extraction(out, vision::extract_chains(path, extract_params(s)), s);
+  return out;
+}
+
+ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& s) {
+  ImageScene out;
+  out.image_path = name;
+  const vision::ExtractParams p = extract_params(s);
+  const auto t0 = std::chrono::steady_clock::now();
+  out.picture = vision::decode_image(bytes, name, p.limits);
+  const double decode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  build_from_extraction(out, vision::extract_chains_from_image(out.picture, p), s);
+  out.times.load_ms += decode_ms;
+  return out;
+}
+
+cv::Mat text_mask(cv::Size size, const std::vector<vision::PdfWord>& words, double grow) {
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(0));
+  const cv::Rect2d frame(0, 0, size.width, size.height);
+  for (const vision::PdfWord& w : words) {
+    const double g = grow * w.box_px.height;
+    const cv::Rect2d r = cv::Rect2d(w.box_px.x - g, w.box_px.y - g, w.box_px.width + 2 * g, w.box_px.height + 2 * g) & frame;
+    if (r.width <= 0 || r.height <= 0) continue;
+    const cv::Point p0(static_cast<int>(std::floor(r.x)), static_cast<int>(std::floor(r.y)));
+    const cv::Point p1(static_cast<int>(std::ceil(r.x + r.width)) - 1, static_cast<int>(std::ceil(r.y + r.height)) - 1);
+    cv::rectangle(mask, p0, p1, cv::Scalar(255), cv::FILLED);
+  }
+  return mask;
+}
+
+ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& s) {
+  ImageScene out;
+  out.image_path = name;
+  out.page = page_number;
+  out.pages = page.pages;
+  cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
+  out.text_words_masked = page.words.size();
+  const cv::Mat mask = page.words.empty() ? cv::Mat() : text_mask(page.grey.size(), page.words);
+  build_from_extraction(out, vision::extract_chains_from_image(page.grey, extract_params(s), mask), s);
+  // Word boxes have their origin at the top-left pixel's corner; PxToM maps pixel centres.
+  for (const vision::TextBlock& b : page.blocks) {
+    TextBlockM t;
+    t.id = static_cast<int>(out.text_blocks.size());
+    t.lo_m = {out.px_to_m.x_m(b.box_px.x - 0.5), out.px_to_m.y_m(b.box_px.y + b.box_px.height - 0.5)};
+    t.hi_m = {out.px_to_m.x_m(b.box_px.x + b.box_px.width - 0.5), out.px_to_m.y_m(b.box_px.y - 0.5)};
+    t.text = b.text;
+    out.text_blocks.push_back(std::move(t));
+  }
   return out;
 }
 

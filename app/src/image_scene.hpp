@@ -12,6 +12,7 @@
 #include "config/settings.hpp"
 #include "haptics/scene.hpp"
 #include "vision/mapping.hpp"
+#include "vision/pdf.hpp"
 #include "vision/pipeline.hpp"
 
 namespace hk::app {
@@ -21,6 +22,15 @@ struct BuildTimes {
   double load_ms = 0, edges_ms = 0, linking_ms = 0, thin_lines_ms = 0, multires_ms = 0, tree_ms = 0;
 };
 
+/// A block of text of a document page in workspace metres (issue 11, item 4): spoken, not felt.
+struct TextBlockM {
+  int id = 0;             ///< index in ImageScene::text_blocks
+  Vec2 lo_m, hi_m;        ///< bounding box [m]: lo = (x0, y0) lower left, hi = (x1, y1) upper right
+  std::string text;       ///< its words in reading order (UTF-8)
+  /// Whether the point p [m] lies in the box (edges included).
+  bool contains(Vec2 p) const { return p.x >= lo_m.x && p.x <= hi_m.x && p.y >= lo_m.y && p.y <= hi_m.y; }
+};
+
 /// A picture turned into a scene. `polylines[i]` is the curve built into `scene` as the curve whose
 /// `source_index` is i.
 ///
@@ -28,7 +38,15 @@ struct BuildTimes {
 ///   chains_found --thin-line merging--> chains_after_thin_lines
 ///   = chains_too_short + chains_over_budget + polylines.size().
 struct ImageScene {
-  std::string image_path;
+  std::string image_path;                   ///< the file (for a document page: the PDF)
+  int page = 0;                             ///< document page shown (from 1); 0 for a picture file
+  int pages = 0;                            ///< pages the document offers; 0 for a picture file
+  cv::Mat picture;                          ///< BGR pixels of a page built from memory; empty for a picture file (read it from image_path)
+  std::vector<TextBlockM> text_blocks;      ///< a page's text blocks (masked from the edges), in reading order
+  std::size_t text_words_masked = 0;        ///< words whose outlines were kept out of the edges
+  double render_dpi = 0;                    ///< a PDF page: the DPI it was drawn at
+  double worker_ms = 0;                     ///< a PDF page: wall time of the drawing worker [ms]
+  long worker_max_rss_kb = 0;               ///< a PDF page: the worker's peak memory [KiB]
   int width_px = 0, height_px = 0;
   vision::PxToM px_to_m{};
   std::size_t chains_found = 0;             ///< chains out of edge linking
@@ -80,5 +98,23 @@ std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chai
 /// 5. Scene::build (haptics.max_levels).
 /// Throws vision::InputError for bad image files (one line naming the file and the limit).
 ImageScene build_image_scene(const std::string& path, const config::Settings& settings);
+
+/// build_image_scene on a picture's bytes already read (a document from a USB stick, read once through
+/// vision::read_stick_file): vision::decode_image with the [vision] limits, then the same steps. `name`
+/// names it in errors and scene.json; ImageScene::picture holds the decoded pixels.
+/// @throws vision::InputError (one line naming `name` and the limit).
+ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& settings);
+
+/// Builds the scene of a rendered document page (issue 11, items 3-4) the way build_image_scene builds a
+/// picture's, except that text is spoken, not felt: every word's box, grown by a quarter of its height on
+/// each side (the blurred glyphs' edges reach past the box), is masked from edge detection
+/// (vision::extract_chains_from_image), and the page's text blocks are kept in metres for the earcon and
+/// the Describe key. Figures, rules and drawings stay curves.
+/// @param name  the document's name for scene.json and messages (image_path).
+ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& settings);
+
+/// The mask of a page's text for vision::extract_chains_from_image: CV_8UC1 of `size`, 255 inside each
+/// word box grown by `grow` x its height on every side, 0 elsewhere.
+cv::Mat text_mask(cv::Size size, const std::vector<vision::PdfWord>& words, double grow = 0.25);
 
 }  // namespace hk::app

@@ -77,6 +77,18 @@ void KioskFlow::key(KioskKey k, double now_s) {
     default:
       break;
   }
+  if (source_ == KioskSource::Stick) {
+    switch (k) {
+      case KioskKey::Next:
+        step_document(+1, now_s);
+        return;
+      case KioskKey::Previous:
+        step_document(-1, now_s);
+        return;
+      default:
+        break;
+    }
+  }
   if (state_ == KioskState::Tutorial) {
     switch (k) {
       case KioskKey::Next:
@@ -129,9 +141,17 @@ void KioskFlow::key(KioskKey k, double now_s) {
 
 void KioskFlow::tick(double now_s) {
   if (state_ == KioskState::Attract) return;
+  if (pending_doc_ >= 0 && !loading_said_ && now_s - pending_since_s_ > p_.loading_cue_s) {
+    loading_said_ = true;
+    say(MessageId::loading);
+  }
   const double idle = now_s - last_activity_s_;
   if (idle >= p_.timeout_s) {
     fx_.new_session();  // first: it stops speech, and the goodbye must be heard
+    if (source_ == KioskSource::Stick || !stick_.empty()) fx_.forget_stick();
+    source_ = KioskSource::Library;
+    stick_.clear();
+    doc_ = at_doc_ = pending_doc_ = -1;
     say(MessageId::goodbye);
     state_ = KioskState::Attract;
     warned_ = false;
@@ -141,6 +161,123 @@ void KioskFlow::tick(double now_s) {
     warned_ = true;
     say(MessageId::timeout_warning, {{"seconds", std::to_string(static_cast<int>(std::lround(p_.timeout_s - idle)))}});
   }
+}
+
+std::string KioskFlow::stick_summary() const {
+  // English phrase for {summary}; the sentence around it comes from the catalogue.
+  int pictures = 0, pdfs = 0, pages = 0;
+  for (const StickEntry& e : stick_) {
+    pictures += !e.pdf;
+    pdfs += e.pdf;
+    pages += e.pdf ? e.pages : 0;
+  }
+  auto count = [](int n, const char* one, const char* many) { return n == 1 ? std::string(one) : std::to_string(n) + " " + many; };
+  const int n = static_cast<int>(stick_.size());
+  std::string s = count(n, "one document", "documents") + ": ";
+  std::string pdf_part;
+  if (pdfs == 1) {
+    pdf_part = "a PDF of " + count(pages, "one page", "pages");
+  } else if (pdfs > 1) {
+    pdf_part = std::to_string(pdfs) + " PDFs of " + count(pages, "one page", "pages") + " in all";
+  }
+  if (pictures > 0 && pdfs > 0) return s + count(pictures, "a picture", "pictures") + " and " + pdf_part;
+  if (pictures > 0) return s + count(pictures, "a picture", "pictures");
+  return s + pdf_part;
+}
+
+void KioskFlow::request(int document, int page, double now_s) {
+  pending_doc_ = at_doc_ = document;
+  pending_page_ = at_page_ = page;
+  pending_since_s_ = now_s;
+  loading_said_ = false;
+  fx_.show_document(document, page);
+}
+
+void KioskFlow::step_document(int delta, double now_s) {
+  // From the last page asked for: the one awaited (a key pressed while loading moves on from there), or
+  // the last one shown or found unreadable (so a visitor can step past a page that cannot be read).
+  int d = at_doc_;
+  int p = at_page_;
+  const int n = static_cast<int>(stick_.size());
+  if (d < 0) {
+    d = delta > 0 ? 0 : n - 1;
+    p = delta > 0 ? 1 : stick_[static_cast<std::size_t>(d)].pages;
+  } else if (delta > 0) {
+    if (++p > stick_[static_cast<std::size_t>(d)].pages) {
+      d = (d + 1) % n;
+      p = 1;
+    }
+  } else if (--p < 1) {
+    d = (d - 1 + n) % n;
+    p = stick_[static_cast<std::size_t>(d)].pages;
+  }
+  request(d, p, now_s);
+}
+
+void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double now_s) {
+  last_activity_s_ = now_s;
+  warned_ = false;
+  if (state_ == KioskState::Attract) state_ = KioskState::Picture;  // a stick is someone at the kiosk
+  if (state_ == KioskState::Tutorial) state_ = KioskState::Picture;
+  stick_ = documents;
+  doc_ = at_doc_ = pending_doc_ = -1;
+  if (stick_.empty()) {
+    source_ = KioskSource::Library;
+    say(MessageId::stick_empty);
+    return;
+  }
+  source_ = KioskSource::Stick;
+  announce_prefix_ = msg_.text(MessageId::stick_inserted, {{"summary", stick_summary()}});
+  request(0, 1, now_s);
+}
+
+void KioskFlow::stick_refused(const std::string& reason, double now_s) {
+  last_activity_s_ = now_s;
+  warned_ = false;
+  if (state_ == KioskState::Attract) state_ = KioskState::Picture;
+  say(MessageId::stick_unreadable, {{"reason", reason}});
+}
+
+void KioskFlow::stick_removed(double now_s) {
+  const bool browsing = source_ == KioskSource::Stick;
+  stick_.clear();
+  source_ = KioskSource::Library;
+  doc_ = at_doc_ = pending_doc_ = -1;
+  announce_prefix_.clear();
+  if (!browsing || state_ == KioskState::Attract) return;  // nothing of the stick was in use
+  last_activity_s_ = now_s;
+  warned_ = false;
+  if (state_ == KioskState::Tutorial) {
+    say(MessageId::stick_removed);
+    return;
+  }
+  show(picture_, msg_.raw(MessageId::stick_removed));
+}
+
+void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
+  (void)now_s;
+  if (source_ != KioskSource::Stick || r.document != pending_doc_ || r.page != pending_page_) return;  // superseded
+  pending_doc_ = -1;
+  const StickEntry& e = stick_[static_cast<std::size_t>(r.document)];
+  std::string text;
+  if (r.ok) {
+    doc_ = r.document;
+    page_ = r.page;
+    state_ = KioskState::Picture;
+    text = e.pdf ? msg_.text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(e.pages)},
+                                                          {"name", e.name}, {"description", r.description}})
+                 : msg_.text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
+                                                             {"documents", std::to_string(stick_.size())},
+                                                             {"name", e.name}, {"description", r.description}});
+  } else {
+    const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + e.name : e.name;
+    text = msg_.text(MessageId::document_unreadable, {{"name", what}, {"reason", r.reason}});
+  }
+  if (!announce_prefix_.empty()) {
+    text = announce_prefix_ + " " + text;
+    announce_prefix_.clear();
+  }
+  fx_.say(text);
 }
 
 }  // namespace hk::app

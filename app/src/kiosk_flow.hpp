@@ -8,8 +8,17 @@
 /// Every key press is answered in speech at once (the speech cuts off what was being said). With no key
 /// and no handle motion for `timeout_s`, the kiosk warns `warning_s` ahead, then says goodbye, restores the
 /// operator's defaults and returns to Attract. Any key or motion extends the time.
+///
+/// USB sticks (issue 11, item 5): a stick inserted (stick_inserted) makes Next / Previous walk its documents
+/// and their pages instead of the picture library. Its first page is loaded at once and announced after a
+/// summary of the stick ("A USB stick with 3 documents: 2 pictures and a PDF of 12 pages. Press Next ...").
+/// Documents load asynchronously (KioskEffects::show_document; the window layer reports back with
+/// document_ready), so slow work never blocks; "Loading." is said when a load takes longer than
+/// loading_cue_s. A page that cannot be read is reported and the picture felt before stays. Removing the
+/// stick goes back to the library picture; a new session forgets the stick.
 
 #include <string>
+#include <vector>
 
 #include "audio/messages.hpp"
 
@@ -23,6 +32,25 @@ enum class KioskState { Attract, Tutorial, Picture };
 
 /// Tutorial shapes, in order.
 enum class TutorialShape { Square = 0, Circle = 1, Triangle = 2 };
+
+/// A document of a USB stick as the flow sees it.
+struct StickEntry {
+  std::string name;  ///< file name made safe for speech
+  bool pdf = false;  ///< a PDF (pages) or a picture
+  int pages = 1;     ///< pages offered (1 for a picture)
+};
+
+/// Where Next and Previous go.
+enum class KioskSource { Library, Stick };
+
+/// The outcome of an asynchronous document load (KioskEffects::show_document), reported by the window layer.
+struct DocumentResult {
+  int document = 0;          ///< as requested
+  int page = 1;              ///< as requested (from 1)
+  bool ok = false;           ///< the scene is on the device
+  std::string description;   ///< ok: what the page holds, one sentence ("It has 3 shapes and 2 blocks of text.")
+  std::string reason;        ///< !ok: why it cannot be shown, one line for speech
+};
 
 /// What the flow asks of the rest of the kiosk. The window layer implements it with the AudioSystem, the
 /// servo core and the picture library; tests record the calls.
@@ -45,12 +73,18 @@ class KioskEffects {
   virtual bool change_volume(int delta) = 0;
   /// A new visitor: the operator's default settings (volume, level), speech stopped.
   virtual void new_session() = 0;
+  /// Start loading page `page` (from 1) of stick document `document` (0-based) off the window thread; when
+  /// done, the window layer calls KioskFlow::document_ready. A newer request supersedes an older one.
+  virtual void show_document(int document, int page) = 0;
+  /// Drop the stick's listing (a new visitor must not browse the last one's stick).
+  virtual void forget_stick() = 0;
 };
 
 /// Timing of the flow. Units in names.
 struct KioskFlowParams {
   double timeout_s = 120.0;  ///< no key and no motion for this long ends the session
   double warning_s = 20.0;   ///< the spoken warning comes this long before the end (at most timeout_s / 2)
+  double loading_cue_s = 0.5; ///< "Loading." is said when a document takes longer than this to load
 };
 
 /// The state machine. Not thread-safe: call from the window thread.
@@ -62,8 +96,21 @@ class KioskFlow {
   void key(KioskKey k, double now_s);
   /// The handle moved noticeably (the caller decides, e.g. > 5 mm since the last call) at `now_s`.
   void handle_moved(double now_s);
-  /// Time passes (call every frame): warnings and the time-out.
+  /// Time passes (call every frame): warnings, the time-out and the loading cue.
   void tick(double now_s);
+  /// A USB stick was inserted and scanned: its documents (may be empty), at `now_s`. Wakes the kiosk.
+  void stick_inserted(const std::vector<StickEntry>& documents, double now_s);
+  /// A stick was refused (unsupported filesystem, unreadable): `reason` is spoken.
+  void stick_refused(const std::string& reason, double now_s);
+  /// The stick was taken out: back to the library.
+  void stick_removed(double now_s);
+  /// A load asked for with show_document finished (ignored unless it is the one awaited).
+  void document_ready(const DocumentResult& result, double now_s);
+
+  KioskSource source() const { return source_; }
+  int document() const { return doc_; }        ///< stick document shown (0-based), −1 before the first
+  int page() const { return page_; }           ///< its page (from 1)
+  bool loading() const { return pending_doc_ >= 0; }  ///< a document load is awaited
 
   KioskState state() const { return state_; }
   TutorialShape tutorial_shape() const { return shape_; }
@@ -75,6 +122,9 @@ class KioskFlow {
   void start_tutorial();
   void show(int index, const std::string& before = {});
   void say(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
+  void request(int document, int page, double now_s);
+  void step_document(int delta, double now_s);
+  std::string stick_summary() const;
 
   KioskEffects& fx_;
   const audio::MessageCatalog& msg_;
@@ -84,6 +134,14 @@ class KioskFlow {
   int picture_ = 0;
   double last_activity_s_ = 0;
   bool warned_ = false;
+  KioskSource source_ = KioskSource::Library;
+  std::vector<StickEntry> stick_;
+  int doc_ = -1, page_ = 1;                 // shown
+  int at_doc_ = -1, at_page_ = 1;           // where browsing stands: the last page asked for, shown or not
+  int pending_doc_ = -1, pending_page_ = 1; // awaited
+  double pending_since_s_ = 0;
+  bool loading_said_ = false;
+  std::string announce_prefix_;             // said before the first page's announcement (the stick's summary)
 };
 
 }  // namespace hk::app

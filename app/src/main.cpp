@@ -1,4 +1,4 @@
-// haptic-kiosk: command line entry. Subcommands so far: explore (headless run, DESIGN.md contract) and speak
+// haptic-kiosk: command line entry. Subcommands: explore (headless run, DESIGN.md contract), stick (what a USB stick offers) and speak
 // (a message or text rendered to WAV).
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -8,6 +8,7 @@
 #include "audio_settings.hpp"
 #include "explore.hpp"
 #include "kiosk_app.hpp"
+#include "stick_command.hpp"
 
 namespace {
 
@@ -34,10 +35,14 @@ int main(int argc, char** argv) {
   cli.add_flag("--overlay", ko.overlay, "Start with the operator overlay (key O)");
   cli.add_option("--screenshot", ko.screenshot, "Run --frames frames (scripted input from --script), write the last as PNG, quit");
   cli.add_option("--frames", ko.frames, "Frames to run before the screenshot (60 per second)");
-  cli.add_option("--script", ko.script, "Scripted input: lines 'FRAME key NAME', 'FRAME cursor X_M Y_M', 'FRAME move'");
+  cli.add_option("--script", ko.script, "Scripted input: lines 'FRAME key NAME', 'FRAME cursor X_M Y_M', 'FRAME move', 'FRAME stick DIR', 'FRAME unstick', 'FRAME wait_loaded'");
+  cli.add_option("--stick", ko.stick, "A folder treated as a USB stick inserted at start");
+  cli.add_flag("!--no-hotplug", ko.hotplug, "Do not watch for USB sticks");
+  cli.add_option("--mount-root", ko.mount_root, "Where USB sticks are mounted (default /run/haptic-kiosk/usb)");
   hk::app::ExploreOptions eo;
   CLI::App* explore = cli.add_subcommand("explore", "Run the whole pipeline headless on the simulated pantograph");
-  explore->add_option("image", eo.image_path, "Picture to explore (PNG, JPEG, BMP, TIFF, WebP)")->required();
+  explore->add_option("input", eo.image_path, "Picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore")->required();
+  explore->add_option("--page", eo.page, "Page of a PDF, from 1 (default 1)")->check(CLI::PositiveNumber);
   explore->add_option("--out", eo.out_dir, "Folder for scene.json, trace.csv, summary.json, overlay.png")->required();
   explore->add_option("--hand", eo.hand, "Model hand: 'raster' or a CSV file with header t_s,x_m,y_m")->default_val("raster");
   explore->add_option("--duration", eo.duration_s, "Run length [s]; default: the hand path's length")->check(CLI::PositiveNumber);
@@ -49,6 +54,13 @@ int main(int argc, char** argv) {
   speak->add_option("--wav", so.wav_path, "WAV file to write")->required();
   speak->add_option("--config", so.config_path, "Settings file (TOML): [audio] speech_rate_wpm");
   speak->add_option("--messages", so.messages_path, "A translated message catalogue (see audio-cues/messages/en.toml)");
+  hk::app::StickOptions sto;
+  CLI::App* stick = cli.add_subcommand("stick", "What a USB stick (a folder, or a device mounted read-only) offers, and what was refused and why");
+  stick->add_option("folder", sto.folder, "A mounted stick or any folder");
+  stick->add_option("--device", sto.device, "A block device (e.g. /dev/sdb1): mounted read-only, scanned, unmounted (needs CAP_SYS_ADMIN)");
+  stick->add_option("--json", sto.json_path, "Write the listing to this file (default: standard output)");
+  stick->add_option("--config", sto.config_path, "Settings file (TOML): [stick] limits");
+  stick->add_option("--mount-root", sto.mount_root, "Where --device is mounted (default /run/haptic-kiosk/usb)");
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -59,6 +71,8 @@ int main(int argc, char** argv) {
       const auto sum = hk::app::run_explore(eo);
       std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n", sum.ticks,
                   sum.curves, sum.edge_ticks, sum.vertex_ticks, sum.max_force_n, eo.out_dir.c_str());
+    } else if (*stick) {
+      return hk::app::run_stick(sto);
     } else if (!*explore && !*speak) {
       return hk::app::run_kiosk(ko);
     } else if (*speak) {

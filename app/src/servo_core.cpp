@@ -53,6 +53,7 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
       current_ = next;
       current_->loop.start(in.sample.handle_m);
       tracker_.reset();
+      tracker_.set_text_blocks(current_->text_blocks_m.data(), static_cast<int>(current_->text_blocks_m.size()));
     }
   }
 

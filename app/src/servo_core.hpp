@@ -16,6 +16,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "audio/cue_event.hpp"
 #include "audio/spsc_ring.hpp"
@@ -34,6 +35,8 @@ struct SceneBundle {
   std::unique_ptr<Scene> scene;
   ServoLoop loop;
   int id = 0;  ///< caller's picture number (shown in the display state)
+  /// Text blocks of a document page [m] (TextBlock cues, CueTracker::set_text_blocks); empty for a picture.
+  std::vector<Aabb> text_blocks_m;
 };
 
 /// The servo thread's state of one tick, for the display (latest value wins). ~1.1 KiB, of which the tick

@@ -24,6 +24,7 @@ const char* cue_kind_name(CueKind kind) {
     case CueKind::LevelFiner: return "level_finer";
     case CueKind::LevelCoarser: return "level_coarser";
     case CueKind::WorkspaceEdge: return "workspace_edge";
+    case CueKind::TextBlock: return "text_block";
   }
   return "unknown";
 }
@@ -157,6 +158,12 @@ void EarconSynth::trigger(const CueEvent& e) noexcept {
       start({180, 150, 0.15, 0.002, 0.06, 0.02, g * 0.6, 0.3, 400, 1.0, d});
       start({180, 180, 0.003, 0.00005, 0.0007, 0.0005, g * 0.5, 1.0, 1500, 0.8, d});
     }
+      break;
+    case CueKind::TextBlock:
+      // Text here (press Describe to hear it): two soft rising sine notes, a fifth apart (G5 then D6),
+      // unlike every contact sound (no strike, no noise) and unlike the level chirps (two steps, not a glide).
+      start({784, 784, 0.09, 0.004, 0.0, 0.04, g * 0.3, 0.0, 0, 1, 0});
+      start({1175, 1175, 0.12, 0.004, 0.0, 0.05, g * 0.3, 0.0, 0, 1, 0.08});
       break;
   }
 }

@@ -72,7 +72,7 @@ constexpr auto kKeyNames = std::to_array<std::string_view>({
     "PAGE_UP", "PAGE_DOWN", "HOME", "END", "INSERT", "DELETE", "MINUS", "EQUAL",
     "KP_0", "KP_1", "KP_2", "KP_3", "KP_4", "KP_5", "KP_6", "KP_7", "KP_8", "KP_9", "KP_ADD", "KP_SUBTRACT", "KP_ENTER"});
 
-constexpr std::array<detail::TableInfo, 8> kTables{{
+constexpr std::array<detail::TableInfo, 9> kTables{{
     {"haptics", "Force rendering and the servo loop."},
     {"device", "Which device drives the handle, and the simulated pantograph's physics."},
     {"hand", "The model hand that drives the simulated pantograph in headless runs."},
@@ -80,6 +80,7 @@ constexpr std::array<detail::TableInfo, 8> kTables{{
     {"workspace", "The device's usable rectangle, centred on the workspace origin."},
     {"audio", "Earcons, speech and volume."},
     {"kiosk", "The visitor's session."},
+    {"stick", "Documents from USB sticks: how far a scan goes and how PDF pages are drawn."},
     {"keys", "The key for each of the visitor's actions (O, C and ESCAPE are the operator's)."},
 }};
 
@@ -140,6 +141,16 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     // [kiosk]
     HK_FIELD(kiosk, timeout_s, 10, 3600, "s", "No key and no handle motion for this long ends the session."),
     HK_FIELD(kiosk, warning_s, 1, 600, "s", "The spoken warning comes this long before the end (at most half the timeout)."),
+    // [stick]
+    HK_FIELD(stick, max_depth, 1, 64, "", "Deepest folder of a stick that is entered (its root is 0)."),
+    HK_FIELD(stick, max_entries, 10, 1000000, "", "Directory entries looked at per scan of a stick."),
+    HK_FIELD(stick, max_documents, 1, 100000, "", "Documents offered per stick."),
+    HK_FIELD(stick, max_file_bytes, 1024, kTwoPow31, "bytes", "Largest document read from a stick."),
+    HK_FIELD(stick, scan_timeout_s, 0.1, 60, "s", "Wall-clock limit of one scan of a stick."),
+    HK_FIELD(stick, max_pdf_pages, 1, 100000, "", "Pages offered per PDF (the first ones)."),
+    HK_FIELD(stick, page_max_pixels, 1e5, 4e7, "px", "A PDF page is drawn at the DPI that keeps it within this many pixels."),
+    HK_FIELD(stick, page_max_dpi, 10, 1200, "dpi", "A PDF page is never drawn finer than this."),
+    HK_FIELD(stick, page_timeout_s, 0.5, 120, "s", "The worker drawing a PDF page is stopped after this (wall clock and CPU)."),
     // [keys]
     HK_FIELD(keys, help, 0, 0, "", "Help.", kKeyNames),
     HK_FIELD(keys, next, 0, 0, "", "Next picture (next tutorial shape).", kKeyNames),

@@ -39,7 +39,23 @@ struct Recorder final : KioskEffects {
     level = 1;
     volume = 7;
   }
+  std::vector<std::pair<int, int>> requested;  // show_document calls (document, page)
+  int forgotten = 0;
+  void show_document(int d, int p) override {
+    requested.emplace_back(d, p);
+    shown.push_back("document " + std::to_string(d) + " page " + std::to_string(p));
+  }
+  void forget_stick() override { ++forgotten; }
 };
+
+DocumentResult ready(int d, int p, std::string description = "It has 2 blocks of text and one figure.") {
+  DocumentResult r;
+  r.document = d;
+  r.page = p;
+  r.ok = true;
+  r.description = std::move(description);
+  return r;
+}
 
 TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   Recorder fx;
@@ -123,6 +139,117 @@ TEST(KioskFlow, EveryKeyIsAnsweredInSpeech) {
   }
 }
 
+// Issue 11, item 5: a stick inserted, browsed, a page that cannot be read, a load superseded, the stick
+// taken out mid-load and inserted again, and a new visitor who does not inherit it.
+TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
+  Recorder fx;
+  const auto& en = audio::MessageCatalog::english();
+  KioskFlow flow(fx, en, {120.0, 20.0});
+  const std::vector<StickEntry> stick{{"cat.png", false, 1}, {"report.pdf", true, 3}, {"dog.jpg", false, 1}};
+
+  flow.stick_inserted(stick, 1.0);
+  EXPECT_EQ(flow.state(), KioskState::Picture) << "a stick wakes the kiosk";
+  EXPECT_EQ(flow.source(), KioskSource::Stick);
+  ASSERT_EQ(fx.requested.size(), 1u);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1)) << "the first page is loaded at once";
+  EXPECT_TRUE(fx.said.empty()) << "the summary waits for the first page, so one announcement says both";
+  flow.tick(1.4);
+  EXPECT_TRUE(fx.said.empty()) << "no loading cue within 0.5 s";
+  flow.tick(1.6);
+  ASSERT_EQ(fx.said.size(), 1u);
+  EXPECT_EQ(fx.said.back(), "Loading.");
+  flow.tick(1.7);
+  EXPECT_EQ(fx.said.size(), 1u) << "said once per load";
+  flow.document_ready(ready(0, 1, "It has 4 shapes."), 2.0);
+  EXPECT_EQ(fx.said.back(),
+            "A USB stick with 3 documents: 2 pictures and a PDF of 3 pages. Press Next to go through them. "
+            "Document 1 of 3, cat.png. It has 4 shapes.");
+  EXPECT_EQ(flow.document(), 0);
+
+  flow.key(KioskKey::Next, 3.0);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(1, 1));
+  flow.document_ready(ready(1, 1), 3.1);
+  EXPECT_EQ(fx.said.back(), "Page 1 of 3 of report.pdf. It has 2 blocks of text and one figure.");
+  flow.key(KioskKey::Next, 4.0);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(1, 2)) << "Next walks the pages of a PDF";
+  // A page the worker cannot draw: reported, the page felt before stays.
+  DocumentResult bad;
+  bad.document = 1;
+  bad.page = 2;
+  bad.reason = "the reader stopped on page 2 (signal 11)";
+  flow.document_ready(bad, 4.2);
+  EXPECT_EQ(fx.said.back(), "Page 2 of report.pdf cannot be shown: the reader stopped on page 2 (signal 11). You still feel the picture before.");
+  EXPECT_EQ(flow.document(), 1);
+  EXPECT_EQ(flow.page(), 1) << "the page shown is still page 1";
+  // Next moves on from the unreadable page; a second press while loading moves on from the first; the
+  // first's late result is ignored.
+  flow.key(KioskKey::Next, 5.0);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(1, 3)) << "past the unreadable page";
+  flow.key(KioskKey::Next, 5.1);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(2, 1)) << "page 3 is the last: on to the next document";
+  const std::size_t said = fx.said.size();
+  flow.document_ready(ready(1, 3), 5.2);
+  EXPECT_EQ(fx.said.size(), said) << "a superseded load says nothing";
+  flow.document_ready(ready(2, 1, "It has one shape."), 5.3);
+  EXPECT_EQ(fx.said.back(), "Document 3 of 3, dog.jpg. It has one shape.");
+  flow.key(KioskKey::Next, 6.0);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1)) << "wraps round to the first document";
+  flow.key(KioskKey::Previous, 6.1);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(2, 1)) << "previous from the one awaited";
+  flow.key(KioskKey::Previous, 6.2);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(1, 3)) << "previous goes to the last page of a PDF";
+
+  // Taken out mid-load: back to the library picture, and the late result is ignored.
+  flow.stick_removed(7.0);
+  EXPECT_EQ(flow.source(), KioskSource::Library);
+  EXPECT_EQ(fx.said.back(), "The USB stick was taken out. Back to the picture library. Picture 1 of 3. It has 4 shapes.");
+  EXPECT_EQ(fx.shown.back(), "picture 0");
+  flow.document_ready(ready(1, 3), 7.5);
+  EXPECT_EQ(fx.shown.back(), "picture 0");
+  flow.key(KioskKey::Next, 8.0);
+  EXPECT_EQ(fx.shown.back(), "picture 1") << "Next walks the library again";
+
+  // Inserted again: a fresh listing from its first page.
+  flow.stick_inserted({{"only.pdf", true, 1}}, 9.0);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
+  flow.document_ready(ready(0, 1, "It has no text and one figure."), 9.1);
+  EXPECT_EQ(fx.said.back(),
+            "A USB stick with one document: a PDF of one page. Press Next to go through them. Page 1 of 1 of only.pdf. It has no text and one figure.");
+
+  // The visitor leaves; the next one does not get the stick.
+  flow.tick(9.1 + 120.0);
+  EXPECT_EQ(flow.state(), KioskState::Attract);
+  EXPECT_EQ(fx.forgotten, 1);
+  EXPECT_EQ(flow.source(), KioskSource::Library);
+  flow.key(KioskKey::Other, 300.0);
+  EXPECT_EQ(flow.state(), KioskState::Tutorial);
+}
+
+TEST(KioskFlow, EmptyAndRefusedSticksAreSaidAndChangeNothing) {
+  Recorder fx;
+  KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
+  flow.key(KioskKey::Other, 0.0);
+  for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 1.0);
+  ASSERT_EQ(flow.state(), KioskState::Picture);
+  flow.stick_inserted({}, 2.0);
+  EXPECT_EQ(fx.said.back(), "I found no pictures and no PDF documents on this USB stick.");
+  EXPECT_EQ(flow.source(), KioskSource::Library);
+  EXPECT_TRUE(fx.requested.empty());
+  flow.stick_refused("its filesystem (btrfs) is not one the kiosk reads", 3.0);
+  EXPECT_EQ(fx.said.back(), "I cannot read this USB stick. its filesystem (btrfs) is not one the kiosk reads");
+  flow.key(KioskKey::Next, 4.0);
+  EXPECT_EQ(fx.shown.back(), "picture 1") << "the library is still what Next walks";
+}
+
+TEST(Describe, PagesCountTextBlocksAndFigures) {
+  EXPECT_EQ(describe_page(2, 1), "It has 2 blocks of text and one figure.");
+  EXPECT_EQ(describe_page(1, 0), "It has one block of text and no figures.");
+  EXPECT_EQ(describe_page(0, 3), "It has no text and 3 figures.");
+  EXPECT_EQ(describe_shapes(0), "I found no shapes in it.");
+  EXPECT_EQ(describe_shapes(1), "It has one shape.");
+  EXPECT_EQ(describe_shapes(5), "It has 5 shapes.");
+}
+
 Polyline rect(Vec2 c, Vec2 half, bool closed = true) {
   Polyline p;
   p.closed = closed;
@@ -141,6 +268,16 @@ TEST(Describe, SizesKindsAndPlaces) {
   std::vector<Polyline> many(6, rect({0.05, 0.03}, {0.002, 0.002}));
   many.push_back(rect({-0.04, 0}, {0.015, 0.01}));
   EXPECT_EQ(describe_scene(many, half, 2), "7 shapes. A medium closed shape on the left, a small closed shape at the top right, and 5 more, smaller ones.");
+}
+
+TEST(Describe, FiguresAreGroupsOfTouchingCurves) {
+  // A drawing of three strokes that touch (one figure), a separate box (a second), a stroke 1 mm from the
+  // box (within the 2 mm margin: the same figure), a dot far away (a third).
+  const std::vector<Polyline> curves{rect({-0.03, 0}, {0.01, 0.01}), rect({-0.02, 0}, {0.01, 0.002}, false), rect({-0.01, 0.005}, {0.002, 0.01}, false),
+                                     rect({0.03, 0}, {0.005, 0.005}), rect({0.0365, 0}, {0.0005, 0.004}, false), rect({0.06, -0.04}, {0.001, 0.001})};
+  EXPECT_EQ(count_figures(curves), 3);
+  EXPECT_EQ(count_figures(curves, 0.0), 4) << "without the margin the stroke beside the box stands alone";
+  EXPECT_EQ(count_figures({}), 0);
 }
 
 }  // namespace

@@ -92,6 +92,19 @@ cv::Mat load_image(const std::string& path, const ImageLimits& limits) {
                                         std::to_string(limits.max_file_bytes) + " bytes");
   }
   const std::vector<std::uint8_t> bytes = read_all(path, size);
+  return decode_image(bytes, path, limits);
+}
+
+cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
+      limits.max_pixels <= 0) {
+    throw std::invalid_argument("decode_image: every ImageLimits field must be positive");
+  }
+  if (bytes.empty()) detail::throw_input_error(path, "empty file (0 bytes)");
+  if (bytes.size() > static_cast<std::uint64_t>(limits.max_file_bytes)) {
+    detail::throw_input_error(path, "file size " + std::to_string(bytes.size()) + " bytes exceeds the limit of " +
+                                        std::to_string(limits.max_file_bytes) + " bytes");
+  }
   detail::MemorySource src(bytes);
   const detail::HeaderDetails hd = detail::parse_image_header(src, path);
   const ImageHeader& h = hd.header;

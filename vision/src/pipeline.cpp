@@ -50,37 +50,70 @@ PointValues chain_strength(const cv::Mat& grey, double blur_sigma_px, const std:
 
 }  // namespace
 
-Extraction extract_chains(const std::string& path, const ExtractParams& p) {
+namespace {
+
+void check_params(const ExtractParams& p) {
   if (p.max_image_side_px < 1) throw std::invalid_argument("extract_chains: max_image_side_px must be >= 1");
   if (std::isnan(p.min_chain_length_px) || p.min_chain_length_px < 0.0) {
     throw std::invalid_argument("extract_chains: min_chain_length_px must be >= 0");
   }
-  Extraction out{};
+}
 
+/// The stages after the grey image is ready: edges, ignored regions cleared, linking, strength, scale back
+/// to the `full` size. `t0` is when grey conversion began (load_ms ends here).
+void extract_from_grey(const cv::Mat& grey, cv::Size full, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
   auto t0 = std::chrono::steady_clock::now();
-  const cv::Mat bgr = load_image(path, p.limits);
-  const cv::Mat grey = to_grey(bgr, p.max_image_side_px, &out.px_scale);
-  out.width_px = bgr.cols;
-  out.height_px = bgr.rows;
-  out.times.load_ms = ms_since(t0);
-
-  t0 = std::chrono::steady_clock::now();
   out.edge_map = detect_edges(grey, p.edges);
+  if (!ignore_mask.empty()) {
+    cv::Mat small = ignore_mask;
+    if (ignore_mask.size() != grey.size()) cv::resize(ignore_mask, small, grey.size(), 0, 0, cv::INTER_AREA);
+    out.edge_map.edges.setTo(0, small > 0);
+  }
   out.times.edges_ms = ms_since(t0);
 
   t0 = std::chrono::steady_clock::now();
   out.chains = link_edges(out.edge_map.edges, p.min_chain_length_px);
   out.point_strength = chain_strength(grey, p.edges.blur_sigma_px, out.chains);
-  if (grey.size() != bgr.size()) {
+  if (grey.size() != full) {
     // Pixel-centre correspondence of area resampling: processed pixel i covers original
     // [i * s, (i + 1) * s), whose centre is (i + 0.5) * s - 0.5.
-    const double sx = static_cast<double>(bgr.cols) / grey.cols;
-    const double sy = static_cast<double>(bgr.rows) / grey.rows;
+    const double sx = static_cast<double>(full.width) / grey.cols;
+    const double sy = static_cast<double>(full.height) / grey.rows;
     for (Chain& c : out.chains) {
       for (cv::Point2d& q : c.points_px) q = {(q.x + 0.5) * sx - 0.5, (q.y + 0.5) * sy - 0.5};
     }
   }
   out.times.linking_ms = ms_since(t0);
+}
+
+}  // namespace
+
+Extraction extract_chains(const std::string& path, const ExtractParams& p) {
+  check_params(p);
+  Extraction out{};
+  const auto t0 = std::chrono::steady_clock::now();
+  const cv::Mat bgr = load_image(path, p.limits);
+  const cv::Mat grey = to_grey(bgr, p.max_image_side_px, &out.px_scale);
+  out.width_px = bgr.cols;
+  out.height_px = bgr.rows;
+  out.times.load_ms = ms_since(t0);
+  extract_from_grey(grey, bgr.size(), p, cv::Mat(), out);
+  return out;
+}
+
+Extraction extract_chains_from_image(const cv::Mat& image, const ExtractParams& p, const cv::Mat& ignore_mask) {
+  check_params(p);
+  if (image.empty()) throw std::invalid_argument("extract_chains_from_image: the image is empty");
+  if (!ignore_mask.empty() && (ignore_mask.type() != CV_8UC1 || ignore_mask.size() != image.size())) {
+    throw std::invalid_argument("extract_chains_from_image: ignore_mask must be CV_8UC1 of the image's size");
+  }
+  Extraction out{};
+  const auto t0 = std::chrono::steady_clock::now();
+  const cv::Mat grey = to_grey(image, p.max_image_side_px, &out.px_scale);  // checks the type
+  out.width_px = image.cols;
+  out.height_px = image.rows;
+  out.times.load_ms = ms_since(t0);
+  extract_from_grey(grey, image.size(), p, ignore_mask, out);
   return out;
 }
 

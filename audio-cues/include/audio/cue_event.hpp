@@ -18,10 +18,11 @@ enum class CueKind : std::uint8_t {
   LevelFiner,     ///< the rendered resolution level became finer (level = the new level)
   LevelCoarser,   ///< the rendered resolution level became coarser (level = the new level)
   WorkspaceEdge,  ///< the handle reached the edge of the usable workspace
+  TextBlock,      ///< the proxy entered a block of text on a document page (curve = the block's id)
 };
 
 /// Number of CueKind values.
-inline constexpr int kCueKindCount = 8;
+inline constexpr int kCueKindCount = 9;
 
 /// One cue. 24 bytes (checked below): small enough that a 4096-entry queue is 96 KiB.
 struct CueEvent {

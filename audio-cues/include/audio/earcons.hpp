@@ -10,7 +10,8 @@
 ///   ConvexCorner  a short bright tick (high spectral centroid, 1 ms decay);
 ///   VertexContact a double tick (the proxy is held in a concave corner);
 ///   LevelFiner / LevelCoarser  a rising / falling chirp (an octave in 160 ms);
-///   WorkspaceEdge a low thud.
+///   WorkspaceEdge a low thud;
+///   TextBlock     two soft rising sine notes, G5 then D6 (text here: Describe reads it).
 /// Each curve has its own pitch (curve_pitch_hz) so two touching shapes sound different. Clicks and ticks
 /// start at least 3 ms apart (a later one waits, at most 6 ms), so each stays audible on its own.
 /// Earcons as a design idea: Blattner, Sumikawa & Greenberg 1989; Brewster 1994.

@@ -18,16 +18,18 @@ enum class MessageId : int {
   welcome, attract, help, picture_loaded, picture_loaded_one, picture_empty, describe,
   level_finer, level_coarser, level_finest, level_coarsest, volume_up, volume_down, volume_limit,
   tutorial_start, tutorial_circle, tutorial_triangle, tutorial_done, timeout_warning, goodbye,
-  no_audio_device,
+  no_audio_device, stick_inserted, stick_empty, stick_removed, stick_unreadable, document_page, document_picture,
+  document_unreadable, loading, text_block,
 };
-inline constexpr int kMessageCount = 21;
+inline constexpr int kMessageCount = 30;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "welcome", "attract", "help", "picture_loaded", "picture_loaded_one", "picture_empty", "describe",
     "level_finer", "level_coarser", "level_finest", "level_coarsest", "volume_up", "volume_down", "volume_limit",
     "tutorial_start", "tutorial_circle", "tutorial_triangle", "tutorial_done", "timeout_warning", "goodbye",
-    "no_audio_device"};
+    "no_audio_device", "stick_inserted", "stick_empty", "stick_removed", "stick_unreadable", "document_page",
+    "document_picture", "document_unreadable", "loading", "text_block"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".

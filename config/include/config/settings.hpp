@@ -105,6 +105,23 @@ struct KioskSettings {
   bool operator==(const KioskSettings&) const = default;
 };
 
+/// [stick] — documents from USB sticks (issue 11): how far a scan goes and how PDF pages are drawn. A stick
+/// is a stranger's: every limit here bounds what one can make the kiosk do.
+struct StickSettings {
+  int max_depth = 8;                          ///< key max_depth, deepest folder entered (the stick's root is 0), [1, 64]
+  int max_entries = 10000;                    ///< key max_entries, directory entries looked at per scan, [10, 1000000]
+  int max_documents = 500;                    ///< key max_documents, documents offered per stick, [1, 100000]
+  std::int64_t max_file_bytes = 200LL << 20;  ///< key max_file_bytes, largest document, [1024, 2^31] bytes
+  double scan_timeout_s = 2.0;                ///< key scan_timeout_s, wall-clock limit of one scan, [0.1, 60] s
+  int max_pdf_pages = 1000;                   ///< key max_pdf_pages, pages offered per PDF (the first ones), [1, 100000]
+  double page_max_pixels = 4e6;               ///< key page_max_pixels, a PDF page is drawn at the DPI that keeps it within this, [1e5, 4e7] px
+  double page_max_dpi = 300.0;                ///< key page_max_dpi, never drawn finer than this, [10, 1200] dpi
+  double page_timeout_s = 5.0;                ///< key page_timeout_s, the worker drawing a page is stopped after this (wall clock and CPU), [0.5, 120] s
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const StickSettings&) const = default;
+};
+
 /// [keys] — the key for each of the visitor's actions (issue 5: keys a blind visitor can find). Each value
 /// is one key name: F1..F12, A..Z, 0..9, SPACE, ENTER, TAB, BACKSPACE, LEFT, RIGHT, UP, DOWN, PAGE_UP,
 /// PAGE_DOWN, HOME, END, INSERT, DELETE, MINUS, EQUAL, KP_0..KP_9, KP_ADD, KP_SUBTRACT, KP_ENTER.
@@ -133,6 +150,7 @@ struct Settings {
   WorkspaceSettings workspace;
   AudioSettings audio;
   KioskSettings kiosk;
+  StickSettings stick;
   KeysSettings keys;
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.

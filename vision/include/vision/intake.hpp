@@ -10,6 +10,7 @@
 /// Every refusal is an InputError whose message is one line naming the file and the problem.
 
 #include <cstdint>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -77,6 +78,12 @@ ImageHeader read_image_header(const std::string& path);
 /// @throws InputError for every refusal above and when decoding fails.
 /// @throws std::invalid_argument if a limit is not positive.
 cv::Mat load_image(const std::string& path, const ImageLimits& limits);
+
+/// load_image on bytes already read (a document from a USB stick, read through stick_scan's
+/// read_stick_file so that no path is opened twice). `name` names the input in errors. Same checks and
+/// decoding as load_image after the file has been read.
+/// @throws InputError as load_image; std::invalid_argument if a limit is not positive.
+cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& name, const ImageLimits& limits);
 
 /// Converts to one grey channel and shrinks so that max(width, height) <= max_side_px.
 ///

@@ -60,4 +60,18 @@ struct Extraction {
 /// @throws std::invalid_argument on invalid parameters.
 Extraction extract_chains(const std::string& path, const ExtractParams& p);
 
+/// extract_chains on pixels already in memory (a rendered PDF page, a camera frame), with regions where
+/// edges are ignored: to_grey (shrink) -> detect_edges -> edge pixels under `ignore_mask` cleared ->
+/// link_edges -> edge strength -> chains scaled back to `image`'s pixels. Used for document pages, whose
+/// text is spoken, not felt (issue 11, item 4): the letters' outlines never become curves.
+///
+/// @param image        CV_8UC1 (grey), CV_8UC3 (BGR) or CV_8UC4 (BGRA); not empty.
+/// @param ignore_mask  empty (nothing ignored) or CV_8UC1 of image's size; nonzero = ignore edges there. It
+///                     is shrunk with the image by area averaging and any coverage counts, so an ignored
+///                     region never shrinks away.
+/// Extraction::times.load_ms covers the grey conversion and shrinking only.
+/// @throws std::invalid_argument on invalid parameters, an empty or unsupported image, or a mask of
+///         another size or type.
+Extraction extract_chains_from_image(const cv::Mat& image, const ExtractParams& p, const cv::Mat& ignore_mask = {});
+
 }  // namespace hk::vision

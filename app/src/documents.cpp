@@ -1,0 +1,161 @@
+#include "documents.hpp"
+
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "vision/intake.hpp"
+
+namespace hk::app {
+
+vision::ScanLimits scan_limits_from(const config::Settings& s) {
+  vision::ScanLimits l;
+  l.max_depth = s.stick.max_depth;
+  l.max_entries = s.stick.max_entries;
+  l.max_documents = s.stick.max_documents;
+  l.max_file_bytes = s.stick.max_file_bytes;
+  l.max_seconds = s.stick.scan_timeout_s;
+  return l;
+}
+
+vision::PdfLimits pdf_limits_from(const config::Settings& s) {
+  vision::PdfLimits l;
+  l.max_file_bytes = s.stick.max_file_bytes;
+  l.max_pages = s.stick.max_pdf_pages;
+  l.max_page_pixels = s.stick.page_max_pixels;
+  l.max_dpi = s.stick.page_max_dpi;
+  l.worker_cpu_s = s.stick.page_timeout_s;
+  l.worker_wall_s = s.stick.page_timeout_s;
+  return l;
+}
+
+namespace {
+
+[[noreturn]] void refuse(const std::string& path, const std::string& problem) {
+  std::string p;
+  for (const char ch : path) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (u < 0x20 || u == 0x7F) {
+      char buf[5];
+      std::snprintf(buf, sizeof buf, "\\x%02X", u);
+      p += buf;
+    } else {
+      p += ch;
+    }
+  }
+  throw vision::InputError("image '" + p + "': " + problem);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> read_file_limited(const std::string& path, std::int64_t max_bytes) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) refuse(path, "cannot open the file (" + std::string(std::strerror(errno)) + ")");
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) refuse(path, "not a regular file");
+  if (st.st_size == 0) refuse(path, "empty file (0 bytes)");
+  if (st.st_size > max_bytes) {
+    refuse(path, "file size " + std::to_string(st.st_size) + " bytes exceeds the limit of " + std::to_string(max_bytes) + " bytes");
+  }
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(st.st_size));
+  std::size_t got = 0;
+  while (got < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) refuse(path, "the file changed size while being read");
+    got += static_cast<std::size_t>(n);
+  }
+  return bytes;
+}
+
+bool is_pdf_file(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) return false;
+  struct stat st {};
+  bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+  std::vector<std::uint8_t> head(1024 + 8);
+  const ssize_t n = regular ? ::read(fd, head.data(), head.size()) : 0;
+  ::close(fd);
+  if (n <= 0) return false;
+  head.resize(static_cast<std::size_t>(n));
+  return vision::looks_like_pdf(head);
+}
+
+int StickListing::pictures() const {
+  int n = 0;
+  for (const ListedDocument& d : documents) n += d.doc.kind == vision::DocumentKind::Image;
+  return n;
+}
+
+int StickListing::pdfs() const { return static_cast<int>(documents.size()) - pictures(); }
+
+StickListing list_stick(const std::string& root, const config::Settings& s) {
+  StickListing out;
+  out.scan = vision::scan_stick(root, scan_limits_from(s));
+  out.refused = std::move(out.scan.refused);
+  const vision::PdfLimits pl = pdf_limits_from(s);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (vision::StickDocument& d : out.scan.documents) {
+    ListedDocument ld;
+    if (d.kind == vision::DocumentKind::Pdf) {
+      try {
+        const std::vector<std::uint8_t> bytes = vision::read_stick_file(root, d.path, s.stick.max_file_bytes);
+        const vision::PdfInfo info = vision::probe_pdf(bytes, d.display_name, pl);
+        ld.pages = info.pages;
+        ld.pages_in_file = info.pages_in_file;
+      } catch (const std::exception& e) {  // PdfError, StickError: this document only
+        out.refused.push_back({d.display_name, e.what()});
+        continue;
+      }
+    }
+    ld.doc = std::move(d);
+    out.documents.push_back(std::move(ld));
+  }
+  out.scan.documents.clear();
+  out.probe_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+nlohmann::json stick_listing_json(const StickListing& l) {
+  nlohmann::json docs = nlohmann::json::array();
+  for (const ListedDocument& d : l.documents) {
+    nlohmann::json j{{"path", d.doc.display_name},
+                     {"kind", d.doc.kind == vision::DocumentKind::Pdf ? "pdf" : "image"},
+                     {"format", d.doc.format},
+                     {"bytes", d.doc.bytes},
+                     {"pages", d.pages}};
+    if (d.pages_in_file != d.pages) j["pages_in_file"] = d.pages_in_file;
+    docs.push_back(std::move(j));
+  }
+  nlohmann::json refused = nlohmann::json::array();
+  for (const vision::RefusedEntry& r : l.refused) refused.push_back({{"path", r.path}, {"reason", r.reason}});
+  return {{"documents", std::move(docs)},
+          {"refused", std::move(refused)},
+          {"complete", l.scan.complete},
+          {"entries_scanned", l.scan.entries_scanned},
+          {"scan_ms", 1000.0 * l.scan.seconds},
+          {"probe_ms", l.probe_ms}};
+}
+
+ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const vision::PdfPage pg = vision::render_pdf_page(bytes, name, page, pdf_limits_from(s));
+  const double render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  ImageScene is = build_page_scene(pg, name, page, s);
+  is.times.load_ms += render_ms;
+  is.render_dpi = pg.dpi;
+  is.worker_ms = pg.worker_ms;
+  is.worker_max_rss_kb = pg.worker_max_rss_kb;
+  return is;
+}
+
+}  // namespace hk::app

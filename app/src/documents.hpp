@@ -1,0 +1,65 @@
+#pragma once
+/// @file documents.hpp
+/// Documents (pictures and PDF pages) as the app sees them (issue 11): the settings turned into the vision
+/// module's limits, a document's bytes read with a size limit, one page of it built into a scene, and the
+/// listing of a stick that the `stick` command prints and the kiosk speaks.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "config/settings.hpp"
+#include "image_scene.hpp"
+#include "vision/pdf.hpp"
+#include "vision/stick_scan.hpp"
+
+namespace hk::app {
+
+/// [stick] settings as the scan's limits.
+vision::ScanLimits scan_limits_from(const config::Settings& s);
+/// [stick] settings as the PDF worker's limits (page_timeout_s is both the wall-clock and the CPU limit).
+vision::PdfLimits pdf_limits_from(const config::Settings& s);
+
+/// The whole file at `path` (outside a stick: the command line's input), at most max_bytes.
+/// @throws vision::InputError "image '<path>': ..." one line (missing, not a regular file, too large,
+///         unreadable).
+std::vector<std::uint8_t> read_file_limited(const std::string& path, std::int64_t max_bytes);
+
+/// Whether the file at `path` starts with "%PDF-" (reads its first kilobyte; false when unreadable).
+bool is_pdf_file(const std::string& path);
+
+/// One document of a stick, with its page count (1 for a picture).
+struct ListedDocument {
+  vision::StickDocument doc;
+  int pages = 1;             ///< pages offered (a PDF's are capped at [stick] max_pdf_pages)
+  int pages_in_file = 1;     ///< pages the document has
+};
+
+/// What a stick offers: the scan, with every PDF probed in the worker (its pages counted). A PDF the
+/// worker refuses (locked, damaged, hostile) moves from the documents to `refused`, with its reason.
+struct StickListing {
+  std::vector<ListedDocument> documents;
+  std::vector<vision::RefusedEntry> refused;
+  vision::StickScan scan;    ///< the walk's own figures (entries, complete, seconds); its lists are moved out
+  double probe_ms = 0.0;     ///< time spent counting PDF pages [ms]
+  int pictures() const;      ///< documents that are pictures
+  int pdfs() const;          ///< documents that are PDFs
+};
+
+/// Scans the folder `root` (a mounted stick, or any folder) and probes its PDFs, with the [stick] limits.
+/// @throws vision::StickError when root is not a readable folder.
+StickListing list_stick(const std::string& root, const config::Settings& s);
+
+/// The `stick` command's JSON: {"documents": [{"path", "kind": "image"|"pdf", "pages"}], "refused":
+/// [{"path", "reason"}], "complete", "entries_scanned", "scan_ms"} (paths relative to the root, made safe).
+nlohmann::json stick_listing_json(const StickListing& listing);
+
+/// Builds the scene of page `page` (from 1) of the PDF held in `bytes`, named `name`: drawn in the worker
+/// (vision::render_pdf_page with the [stick] limits), then build_page_scene (text masked, kept as blocks).
+/// The drawing time is added to times.load_ms.
+/// @throws vision::PdfError (one line: not a PDF, locked, damaged, no such page, worker stopped).
+ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s);
+
+}  // namespace hk::app

@@ -1,0 +1,111 @@
+#pragma once
+/// @file stick_service.hpp
+/// The kiosk's USB-stick work off the window and servo threads (issue 11, items 1 and 5).
+///
+/// Two worker threads:
+/// - the watcher takes block events (vision::BlockEventSource), mounts an inserted stick read-only
+///   (vision::MountedStick), scans it and counts its PDFs' pages (list_stick), and unmounts it when it is
+///   taken out; without CAP_SYS_ADMIN it says once in the log how to grant it and ignores sticks;
+/// - the loader builds the scene of a document page on request (the PDF drawn in its forked worker,
+///   edges, multiresolution, trees), so a slow or hostile page never blocks the window.
+/// The window thread polls both with poll_news() and poll_loaded() each frame (mutex-guarded queues: neither
+/// thread is real-time). A folder can stand in for a stick (insert_folder), for tests and `--stick DIR`.
+
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "config/settings.hpp"
+#include "documents.hpp"
+#include "image_scene.hpp"
+#include "vision/usb_stick.hpp"
+
+namespace hk::app {
+
+/// Something that happened to the stick.
+struct StickNews {
+  enum class Kind { Inserted, Refused, Removed };
+  Kind kind = Kind::Inserted;
+  int stick = 0;                        ///< the stick's number (every insertion gets a new one)
+  std::vector<ListedDocument> documents;///< Inserted: what it offers
+  std::size_t refused_entries = 0;      ///< Inserted: entries left out (reasons in the log)
+  std::string reason;                   ///< Refused: why, one line for speech
+  double scan_ms = 0;                   ///< Inserted: mount + scan + page counting [ms]
+};
+
+/// A finished load.
+struct LoadedDocument {
+  int stick = 0, document = 0, page = 1;
+  std::optional<ImageScene> scene;      ///< set when it could be built
+  std::string reason;                   ///< why not, one line for speech (the problem without the file name)
+  double load_ms = 0;                   ///< request to result [ms]
+};
+
+/// Watcher and loader threads. Construct and use from the window thread.
+class StickService {
+ public:
+  /// `events` may be null (no hot-plug: only insert_folder). `mount_root` is where sticks are mounted.
+  StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events, std::string mount_root);
+  /// Stops both threads (a load in progress finishes first: at most the page time limit) and unmounts.
+  ~StickService();
+  StickService(const StickService&) = delete;
+  StickService& operator=(const StickService&) = delete;
+
+  /// Treat a folder as an inserted stick (scanned on the watcher thread; news as for a stick).
+  void insert_folder(const std::string& folder);
+  /// Treat the folder stick as taken out.
+  void remove_folder();
+  /// News since the last call, oldest first.
+  std::vector<StickNews> poll_news();
+  /// Ask for page `page` of document `document` of stick `stick`; supersedes a request not yet started.
+  void load(int stick, int document, int page);
+  /// Finished loads since the last call.
+  std::vector<LoadedDocument> poll_loaded();
+  /// Forget the stick's listing (a new session): later loads of it are refused. The mount stays until removal.
+  void forget();
+  /// Whether sticks can be mounted (CAP_SYS_ADMIN); folders work regardless.
+  bool can_mount() const { return can_mount_; }
+
+ private:
+  struct Request {
+    int stick = 0, document = 0, page = 1;
+  };
+  void watch();
+  void serve();
+  void handle_add(const std::string& devnode);
+  void handle_remove(const std::string& devnode);
+  void scan_root(const std::string& root, double started_ms_offset);
+  void post(StickNews n);
+  LoadedDocument build(const Request& r);
+
+  config::Settings s_;
+  std::unique_ptr<vision::BlockEventSource> events_;
+  std::string mount_root_;
+  bool can_mount_ = false;
+
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool stop_ = false;
+  std::deque<std::string> folder_inserts_;  // guarded by m_
+  bool folder_remove_ = false;              // guarded by m_
+  std::vector<StickNews> news_;             // guarded by m_
+  std::optional<Request> request_;          // guarded by m_
+  std::vector<LoadedDocument> loaded_;      // guarded by m_
+  int stick_id_ = 0;                        // guarded by m_: the stick whose listing is current (0: none)
+  std::string stick_root_;                  // guarded by m_
+  std::vector<ListedDocument> stick_docs_;  // guarded by m_
+
+  // watcher thread only
+  std::unique_ptr<vision::MountedStick> mounted_;
+  int next_stick_ = 1;
+  int next_slot_ = 0;
+
+  std::thread watcher_, loader_;
+};
+
+}  // namespace hk::app
