@@ -36,16 +36,19 @@ struct BlockEvent {
 class BlockEventSource {
  public:
   virtual ~BlockEventSource() = default;
-  /// The next event, waiting at most timeout_ms [ms] (0: do not wait). nullopt when none came.
+  /// The next event, waiting at most timeout_ms [ms] (0: do not wait; negative: wait without limit).
+  /// nullopt when none came.
   virtual std::optional<BlockEvent> next(int timeout_ms) = 0;
 };
 
 /// libudev monitor on the "udev" netlink group, filtered to subsystem "block", ID_BUS=usb, with a
 /// filesystem (ID_FS_USAGE=filesystem) or a partition. Also reports the sticks already present at
-/// construction as Add events (enumeration), so a stick inserted before the kiosk started is seen.
+/// construction as Add events (enumeration), so a stick inserted before the kiosk started is seen (one
+/// inserted during construction may be reported twice). Only "add" and "remove" actions are reported.
 class UdevBlockEventSource final : public BlockEventSource {
  public:
-  /// @throws StickMountError when libudev cannot create the monitor (no /run/udev, no netlink).
+  /// @throws StickMountError when libudev cannot create the monitor (no /run/udev/control, i.e. udevd is
+  /// not running; no netlink). what() is one line starting "stick monitor: ".
   UdevBlockEventSource();
   ~UdevBlockEventSource() override;
   std::optional<BlockEvent> next(int timeout_ms) override;
@@ -74,15 +77,18 @@ class StickMountError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The filesystem type libblkid finds on `devnode` ("vfat", "exfat", "ntfs", "ext4", "iso9660", ...),
-/// probing superblocks only (no writes; the device is opened O_RDONLY).
-/// @throws StickMountError if the device cannot be opened or carries no recognisable filesystem.
+/// The filesystem type libblkid finds on `devnode` ("vfat", "exfat", "ntfs", "ext4", "iso9660", "swap",
+/// ...), probing superblocks only (no writes; the device is opened O_RDONLY). `devnode` is a block device
+/// node, or an image file.
+/// @throws StickMountError if the device cannot be opened, is neither a block device nor a regular file,
+/// carries no recognisable filesystem, or carries signatures of several (ambiguous).
 std::string identify_filesystem(const std::string& devnode);
 
 /// Whether the filesystem type (as identify_filesystem returns it) is one the kiosk mounts.
 bool filesystem_supported(const std::string& type);
 
-/// Whether this process holds CAP_SYS_ADMIN in its effective set (needed to mount and for BLKROSET).
+/// Whether this thread holds CAP_SYS_ADMIN in its effective set (needed to mount and for BLKROSET), as
+/// capget(2) reports it. False if capget fails.
 bool have_mount_capability();
 
 /// One line for the log on how to grant the capability (setcap on the executable, or the systemd unit's
@@ -93,8 +99,17 @@ std::string mount_capability_hint();
 class MountedStick {
  public:
   /// Identifies, sets the device read-only, and mounts it under `<mount_root>/<slot>` (the folder is
-  /// created with mode 0700; mount_root is created if missing).
-  /// @throws StickMountError (unsupported filesystem, no capability, mount refused by the kernel).
+  /// created with mode 0700; mount_root and its missing parents are created with mode 0700; a folder left
+  /// at `<mount_root>/<slot>` by an earlier run is detached and replaced). `devnode` must be a block
+  /// device; the filesystem is checked before the capability, so an unsupported stick is named as such.
+  /// On vfat/exfat/ntfs3 every file belongs to the kiosk's uid/gid and is readable by it only; on ext4
+  /// and iso9660 the stick's own owners and modes apply. After mounting, the mounted filesystem's device is
+  /// checked to be the one probed (a device node swapped meanwhile is unmounted and refused).
+  /// The read-only flag stays set on the device after unmounting (a removed stick takes it along; a loop
+  /// device keeps it until `blockdev --setrw`).
+  /// @throws StickMountError (not a block device, unsupported filesystem, no capability, BLKROSET
+  /// refused, mount refused by the kernel, e.g. no driver for the filesystem), one line naming devnode.
+  /// Nothing stays mounted and no mount point is left when it throws.
   MountedStick(const std::string& devnode, const std::string& mount_root, int slot);
   ~MountedStick();
   MountedStick(const MountedStick&) = delete;
@@ -103,7 +118,9 @@ class MountedStick {
   const std::string& devnode() const { return devnode_; }
   const std::string& mount_point() const { return mount_point_; }
   const std::string& filesystem() const { return fs_; }
-  /// Unmounts now (idempotent). Never throws; a failure is logged by the caller through the return value.
+  /// Unmounts now (umount2 with MNT_DETACH, then removes the mount point; idempotent). Never throws; a
+  /// failure is logged by the caller through the return value (false: the detach or the rmdir failed).
+  /// Files still open on the stick stay readable until closed (lazy detach).
   bool unmount();
 
  private:

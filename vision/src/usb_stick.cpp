@@ -1,0 +1,403 @@
+// USB sticks coming and going: libudev block events, libblkid identification, and a read-only mount
+// (see usb_stick.hpp for the order of the steps and why each one is there).
+
+#include "vision/usb_stick.hpp"
+
+#include <blkid/blkid.h>
+#include <fcntl.h>
+#include <libudev.h>
+#include <linux/capability.h>
+#include <poll.h>
+#include <sys/ioctl.h>
+#include <sys/mount.h>
+#include <sys/stat.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <condition_variable>
+#include <cstring>
+#include <deque>
+#include <mutex>
+#include <string_view>
+#include <utility>
+
+#ifndef MS_NOSYMFOLLOW
+#define MS_NOSYMFOLLOW 256  // Linux 5.10
+#endif
+
+namespace hk::vision {
+namespace {
+
+/// "stick '<devnode>': <what>", kept on one line (a device name from udev cannot hold a newline, but a
+/// devnode given on the command line could).
+std::string stick_message(const std::string& devnode, const std::string& what) {
+  std::string line = "stick '" + devnode + "': " + what;
+  for (char& c : line) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return line;
+}
+
+[[noreturn]] void refuse(const std::string& devnode, const std::string& what) {
+  throw StickMountError(stick_message(devnode, what));
+}
+
+std::string errno_text(int err) { return std::strerror(err); }
+
+/// A file descriptor closed on scope exit.
+class Fd {
+ public:
+  explicit Fd(int fd = -1) : fd_(fd) {}
+  ~Fd() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  int get() const { return fd_; }
+
+ private:
+  int fd_;
+};
+
+/// Opens `devnode` read-only for probing; refuses anything that is neither a block device nor a regular
+/// file (an image). Never creates, never writes.
+int open_for_probe(const std::string& devnode, struct stat* st) {
+  const int fd = ::open(devnode.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
+  if (fd < 0) refuse(devnode, "cannot open the device: " + errno_text(errno));
+  if (::fstat(fd, st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    refuse(devnode, "cannot examine the device: " + errno_text(err));
+  }
+  if (!S_ISBLK(st->st_mode) && !S_ISREG(st->st_mode)) {
+    ::close(fd);
+    refuse(devnode, "not a block device");
+  }
+  return fd;
+}
+
+/// The TYPE libblkid finds through the open descriptor `fd`; refuses when there is none.
+std::string probe_type(const std::string& devnode, int fd) {
+  blkid_probe pr = blkid_new_probe();
+  if (pr == nullptr) refuse(devnode, "cannot probe the device (libblkid out of memory)");
+  struct ProbeGuard {
+    blkid_probe p;
+    ~ProbeGuard() { blkid_free_probe(p); }
+  } guard{pr};
+  if (blkid_probe_set_device(pr, fd, 0, 0) != 0) refuse(devnode, "cannot probe the device (libblkid refused it)");
+  blkid_probe_enable_superblocks(pr, 1);
+  blkid_probe_set_superblocks_flags(pr, BLKID_SUBLKS_TYPE);
+  const int rc = blkid_do_safeprobe(pr);
+  if (rc == 1) refuse(devnode, "it carries no filesystem the kiosk recognises");
+  if (rc == -2) refuse(devnode, "it carries signatures of more than one filesystem, so it is not mounted");
+  if (rc != 0) refuse(devnode, "cannot read the device to find its filesystem");
+  const char* type = nullptr;
+  size_t len = 0;
+  if (blkid_probe_lookup_value(pr, "TYPE", &type, &len) != 0 || type == nullptr || *type == '\0') {
+    refuse(devnode, "it carries no filesystem the kiosk recognises");
+  }
+  return std::string(type);
+}
+
+/// mount(2)'s filesystem type for a libblkid TYPE (only differs for NTFS, read by the ntfs3 driver).
+std::string kernel_fs_type(const std::string& type) { return type == "ntfs" ? "ntfs3" : type; }
+
+/// Filesystem-specific mount data: ext4 never replays its journal; on the filesystems without Unix
+/// owners, every file belongs to the kiosk and is readable by it alone; names are read as UTF-8.
+std::string mount_data(const std::string& type) {
+  const std::string ids = "uid=" + std::to_string(::getuid()) + ",gid=" + std::to_string(::getgid());
+  if (type == "ext4") return "noload";
+  if (type == "vfat") return ids + ",fmask=0177,dmask=0077,utf8";
+  if (type == "exfat") return ids + ",fmask=0177,dmask=0077,iocharset=utf8";
+  if (type == "ntfs") return ids + ",fmask=0177,dmask=0077,iocharset=utf8";
+  if (type == "iso9660") return ids + ",utf8";
+  return "";
+}
+
+/// Why mount(2) refused, for a visitor or an attendant.
+std::string mount_failure(int err, const std::string& type) {
+  switch (err) {
+    case ENODEV:
+      return "this computer's kernel cannot read " + type + " (no " + kernel_fs_type(type) + " driver)";
+    case EPERM:
+    case EACCES:
+      return "mounting was not permitted (" + errno_text(err) + "); " + mount_capability_hint();
+    case EINVAL:
+      return "the kernel refused to mount its " + type + " filesystem (damaged, or an option it does not know)";
+    default:
+      return "the kernel refused to mount its " + type + " filesystem: " + errno_text(err);
+  }
+}
+
+/// Makes `dir` an empty folder with mode 0700 that is not a mount point. A folder left by a kiosk that
+/// crashed while a stick was mounted is detached and removed first.
+void fresh_mount_point(const std::string& devnode, const std::string& dir) {
+  struct stat st {};
+  if (::lstat(dir.c_str(), &st) == 0) {
+    if (!S_ISDIR(st.st_mode)) refuse(devnode, "the mount point " + dir + " exists and is not a folder");
+    (void)::umount2(dir.c_str(), MNT_DETACH | UMOUNT_NOFOLLOW);  // EINVAL when nothing is mounted there
+    if (::rmdir(dir.c_str()) != 0) {
+      refuse(devnode, "cannot clear the old mount point " + dir + ": " + errno_text(errno));
+    }
+  } else if (errno != ENOENT) {
+    refuse(devnode, "cannot examine the mount point " + dir + ": " + errno_text(errno));
+  }
+  if (::mkdir(dir.c_str(), 0700) != 0) refuse(devnode, "cannot create the mount point " + dir + ": " + errno_text(errno));
+  (void)::chmod(dir.c_str(), 0700);  // exactly 0700, whatever the umask
+}
+
+/// Creates `root` and its missing parents, each new one with mode 0700.
+void make_root(const std::string& devnode, const std::string& root) {
+  if (root.empty()) refuse(devnode, "no mount root given");
+  std::string path;
+  std::size_t pos = 0;
+  while (pos != std::string::npos) {
+    pos = root.find('/', pos + 1);
+    path = root.substr(0, pos);
+    if (path.empty() || path == "/") continue;
+    if (::mkdir(path.c_str(), 0700) != 0 && errno != EEXIST) {
+      refuse(devnode, "cannot create the mount root " + path + ": " + errno_text(errno));
+    }
+  }
+  struct stat st {};
+  if (::stat(root.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) refuse(devnode, "the mount root " + root + " is not a folder");
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// Identification and capability
+
+std::string identify_filesystem(const std::string& devnode) {
+  struct stat st {};
+  Fd fd(open_for_probe(devnode, &st));
+  return probe_type(devnode, fd.get());
+}
+
+bool filesystem_supported(const std::string& type) {
+  return type == "vfat" || type == "exfat" || type == "ntfs" || type == "ext4" || type == "iso9660";
+}
+
+bool have_mount_capability() {
+  __user_cap_header_struct header{};
+  header.version = _LINUX_CAPABILITY_VERSION_3;
+  header.pid = 0;  // this thread
+  __user_cap_data_struct data[_LINUX_CAPABILITY_U32S_3]{};
+  if (::syscall(SYS_capget, &header, data) != 0) return false;
+  constexpr int kBit = CAP_SYS_ADMIN;  // 21: in the first 32-bit word
+  return (data[kBit / 32].effective & (1u << (kBit % 32))) != 0;
+}
+
+std::string mount_capability_hint() {
+  return "the kiosk needs CAP_SYS_ADMIN to mount sticks: sudo setcap cap_sys_admin+ep /usr/bin/haptic-kiosk, "
+         "or AmbientCapabilities=CAP_SYS_ADMIN in its systemd unit";
+}
+
+// ---------------------------------------------------------------------------------------------------
+// MountedStick
+
+MountedStick::MountedStick(const std::string& devnode, const std::string& mount_root, int slot) : devnode_(devnode) {
+  if (slot < 0) refuse(devnode, "invalid mount slot " + std::to_string(slot));
+  struct stat st {};
+  Fd fd(open_for_probe(devnode, &st));
+  if (!S_ISBLK(st.st_mode)) refuse(devnode, "not a block device");
+
+  // 1. Identify.
+  fs_ = probe_type(devnode, fd.get());
+  if (!filesystem_supported(fs_)) {
+    refuse(devnode, "its filesystem (" + fs_ + ") is not one the kiosk reads (FAT, exFAT, NTFS, ext4, ISO 9660)");
+  }
+  if (!have_mount_capability()) refuse(devnode, "cannot mount it: " + mount_capability_hint());
+
+  // 2. Read-only at the block layer, before any filesystem driver sees the device.
+  const int one = 1;
+  if (::ioctl(fd.get(), BLKROSET, &one) != 0) {
+    refuse(devnode, "cannot make the device read-only (BLKROSET: " + errno_text(errno) + "), so it is not mounted");
+  }
+  int ro = 0;
+  if (::ioctl(fd.get(), BLKROGET, &ro) != 0 || ro != 1) {
+    refuse(devnode, "the device did not become read-only, so it is not mounted");
+  }
+
+  // 3. Mount.
+  make_root(devnode, mount_root);
+  std::string root = mount_root;
+  while (root.size() > 1 && root.back() == '/') root.pop_back();
+  mount_point_ = (root == "/" ? "" : root) + "/" + std::to_string(slot);
+  fresh_mount_point(devnode, mount_point_);
+  const unsigned long flags = MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC | MS_NOSYMFOLLOW | MS_NOATIME;
+  const std::string data = mount_data(fs_);
+  if (::mount(devnode.c_str(), mount_point_.c_str(), kernel_fs_type(fs_).c_str(), flags,
+              data.empty() ? nullptr : data.c_str()) != 0) {
+    const int err = errno;
+    (void)::rmdir(mount_point_.c_str());
+    refuse(devnode, mount_failure(err, fs_));
+  }
+  mounted_ = true;
+
+  // The device node is looked up again by mount(2): make sure it is still the device probed above.
+  struct stat mounted {};
+  if (::stat(mount_point_.c_str(), &mounted) != 0 || mounted.st_dev != st.st_rdev) {
+    unmount();
+    refuse(devnode, "the device changed while it was being mounted, so it was unmounted again");
+  }
+}
+
+MountedStick::~MountedStick() { (void)unmount(); }
+
+bool MountedStick::unmount() {
+  if (!mounted_) return true;
+  mounted_ = false;
+  bool ok = ::umount2(mount_point_.c_str(), MNT_DETACH | UMOUNT_NOFOLLOW) == 0;
+  ok = (::rmdir(mount_point_.c_str()) == 0) && ok;
+  return ok;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// FakeBlockEventSource
+
+struct FakeBlockEventSource::Queue {
+  std::mutex mutex;
+  std::condition_variable ready;
+  std::deque<BlockEvent> events;
+};
+
+std::shared_ptr<FakeBlockEventSource::Queue> FakeBlockEventSource::make_queue() { return std::make_shared<Queue>(); }
+
+void FakeBlockEventSource::push(BlockEvent e) {
+  {
+    std::lock_guard lock(q_->mutex);
+    q_->events.push_back(std::move(e));
+  }
+  q_->ready.notify_one();
+}
+
+std::optional<BlockEvent> FakeBlockEventSource::next(int timeout_ms) {
+  std::unique_lock lock(q_->mutex);
+  const auto has_event = [this] { return !q_->events.empty(); };
+  if (timeout_ms < 0) {
+    q_->ready.wait(lock, has_event);
+  } else if (!q_->ready.wait_for(lock, std::chrono::milliseconds(timeout_ms), has_event)) {
+    return std::nullopt;
+  }
+  BlockEvent e = std::move(q_->events.front());
+  q_->events.pop_front();
+  return e;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// UdevBlockEventSource
+
+namespace {
+
+std::string property(udev_device* dev, const char* key) {
+  const char* v = udev_device_get_property_value(dev, key);
+  return v != nullptr ? std::string(v) : std::string();
+}
+
+/// A USB block device that carries a filesystem, or a USB partition.
+bool is_usb_stick(udev_device* dev) {
+  if (property(dev, "ID_BUS") != "usb") return false;
+  const char* devtype = udev_device_get_devtype(dev);
+  const bool partition = devtype != nullptr && std::string_view(devtype) == "partition";
+  return property(dev, "ID_FS_USAGE") == "filesystem" || partition;
+}
+
+std::optional<BlockEvent> to_event(udev_device* dev, BlockEvent::Action action) {
+  const char* node = udev_device_get_devnode(dev);
+  if (node == nullptr || !is_usb_stick(dev)) return std::nullopt;
+  BlockEvent e;
+  e.action = action;
+  e.devnode = node;
+  e.label = property(dev, "ID_FS_LABEL");
+  return e;
+}
+
+}  // namespace
+
+struct UdevBlockEventSource::Impl {
+  udev* ctx = nullptr;
+  udev_monitor* monitor = nullptr;
+  int fd = -1;
+  std::deque<BlockEvent> pending;  ///< sticks found by the enumeration at construction
+
+  ~Impl() {
+    if (monitor != nullptr) udev_monitor_unref(monitor);
+    if (ctx != nullptr) udev_unref(ctx);
+  }
+
+  void enumerate() {
+    udev_enumerate* en = udev_enumerate_new(ctx);
+    if (en == nullptr) return;
+    udev_enumerate_add_match_subsystem(en, "block");
+    udev_enumerate_add_match_property(en, "ID_BUS", "usb");
+    if (udev_enumerate_scan_devices(en) >= 0) {
+      udev_list_entry* entry = nullptr;
+      udev_list_entry_foreach(entry, udev_enumerate_get_list_entry(en)) {
+        udev_device* dev = udev_device_new_from_syspath(ctx, udev_list_entry_get_name(entry));
+        if (dev == nullptr) continue;
+        if (auto e = to_event(dev, BlockEvent::Action::Add)) pending.push_back(std::move(*e));
+        udev_device_unref(dev);
+      }
+    }
+    udev_enumerate_unref(en);
+  }
+};
+
+UdevBlockEventSource::UdevBlockEventSource() : impl_(std::make_unique<Impl>()) {
+  const std::string who = "stick monitor";
+  // Without udevd, libudev quietly opens a monitor that never receives anything (events carry ID_BUS
+  // only once udevd has processed them): say so instead of waiting forever.
+  if (::access("/run/udev/control", F_OK) != 0) {
+    throw StickMountError(who + ": udev is not running (no /run/udev/control), so USB sticks would never be seen");
+  }
+  impl_->ctx = udev_new();
+  if (impl_->ctx == nullptr) throw StickMountError(who + ": cannot start libudev: " + errno_text(errno));
+  impl_->monitor = udev_monitor_new_from_netlink(impl_->ctx, "udev");
+  if (impl_->monitor == nullptr) throw StickMountError(who + ": cannot open the udev netlink socket: " + errno_text(errno));
+  if (udev_monitor_filter_add_match_subsystem_devtype(impl_->monitor, "block", nullptr) < 0 ||
+      udev_monitor_enable_receiving(impl_->monitor) < 0) {
+    throw StickMountError(who + ": cannot listen to udev block events: " + errno_text(errno));
+  }
+  impl_->fd = udev_monitor_get_fd(impl_->monitor);
+  if (impl_->fd < 0) throw StickMountError(who + ": the udev monitor has no socket");
+  // Enumerate after the monitor listens, so a stick inserted in between is not lost (it may be reported
+  // twice; consumers treat a second Add of a mounted devnode as nothing new).
+  impl_->enumerate();
+}
+
+UdevBlockEventSource::~UdevBlockEventSource() = default;
+
+std::optional<BlockEvent> UdevBlockEventSource::next(int timeout_ms) {
+  if (!impl_->pending.empty()) {
+    BlockEvent e = std::move(impl_->pending.front());
+    impl_->pending.pop_front();
+    return e;
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto deadline = Clock::now() + std::chrono::milliseconds(timeout_ms < 0 ? 0 : timeout_ms);
+  for (;;) {
+    int wait_ms = -1;
+    if (timeout_ms >= 0) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      wait_ms = left > 0 ? static_cast<int>(left) : 0;
+    }
+    pollfd p{impl_->fd, POLLIN, 0};
+    const int n = ::poll(&p, 1, wait_ms);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return std::nullopt;
+    udev_device* dev = udev_monitor_receive_device(impl_->monitor);
+    if (dev != nullptr) {
+      std::optional<BlockEvent> e;
+      const char* action = udev_device_get_action(dev);
+      if (action != nullptr && std::string_view(action) == "add") e = to_event(dev, BlockEvent::Action::Add);
+      if (action != nullptr && std::string_view(action) == "remove") e = to_event(dev, BlockEvent::Action::Remove);
+      udev_device_unref(dev);
+      if (e) return e;
+    }
+  }
+}
+
+}  // namespace hk::vision
