@@ -50,7 +50,7 @@ struct RefusedEntry {
 struct StickScan {
   std::vector<StickDocument> documents;
   std::vector<RefusedEntry> refused;
-  long entries_scanned = 0;  ///< directory entries looked at
+  long entries_scanned = 0;  ///< directory entries looked at ("." and ".." not counted); never above max_entries
   bool complete = true;      ///< false when a limit (entries, documents, time) stopped the walk early
   std::string stopped_by;    ///< when !complete: which limit, one line (also added to `refused` as path "")
   double seconds = 0.0;      ///< wall-clock time of the walk [s]
@@ -65,24 +65,54 @@ class StickError : public std::runtime_error {
 /// Walks the folder `root` (a mounted stick, or any folder for tests and `haptic-kiosk stick DIR`).
 /// Never follows a symbolic link, never leaves the tree or its filesystem, reads at most 16 bytes of each
 /// regular file (its magic bytes), writes nothing.
+///
+/// Each folder's entries are sorted by name (byte order) before they are visited, so the walk, and what a
+/// limit cuts off, is the same on every scan of an unchanged stick. FIFOs, sockets, device nodes and
+/// symbolic links are refused from their directory entry type without being opened. Hidden entries (name
+/// starting with '.', e.g. .Trash-1000, .fseventsd, macOS "._*" AppleDouble files) and the Windows system
+/// folders "System Volume Information" and "$RECYCLE.BIN" are refused with a reason, never opened or
+/// entered. A regular file is refused when empty, when its first bytes are not a document's, or when it
+/// is larger than max_file_bytes, in that order. Limits while walking:
+///  - a folder deeper than max_depth is refused ("folder deeper than 8 levels is not entered"), the walk goes on;
+///  - entries: once max_entries entries have been counted and another one is met, the walk stops reading
+///    folders; entries already read are still classified, folders among them are refused unentered;
+///  - documents: the document after the max_documents-th is refused and the walk stops;
+///  - time: the clock is read at every entry; past max_seconds the walk stops at once.
+/// A stopping limit sets complete=false and stopped_by, which also ends `refused` (path "").
+/// Failures on single entries (unreadable folder, open errors, entries vanishing) are refusals, not errors.
 /// @throws StickError if root cannot be opened as a folder.
 /// @throws std::invalid_argument if a limit is not positive.
 StickScan scan_stick(const std::string& root, const ScanLimits& limits);
 
 /// The kind a file's first bytes announce: "png", "jpeg", "bmp", "tiff", "webp", "pdf", or "" (not a
 /// document). `head` is the file's first bytes (16 are enough; fewer are fine for a short file).
+/// PNG \x89PNG\r\n\x1a\n; JPEG FF D8 FF; TIFF "II*\0", "MM\0*" and BigTIFF "II+\0", "MM\0+";
+/// WebP "RIFF" ???? "WEBP"; PDF "%PDF-" at offset 0; BMP "BM", and when 16 bytes are given, the low 16 bits
+/// of the DIB header size at offset 14 must be a known size (12, 16, 40, 52, 56, 64, 108 or 124), since
+/// "BM" alone also starts ordinary text.
 std::string sniff_document_format(std::string_view head);
 
 /// A file name or path (raw bytes) made safe to speak and show, on one line: invalid UTF-8 sequences
 /// become U+FFFD; C0/C1 control characters, DEL, and the bidirectional controls (U+200E, U+200F,
 /// U+202A..U+202E, U+2066..U+2069, U+061C) are removed; other invisible format characters (U+200B..U+200D,
 /// U+FEFF) are removed; the result is cut at 255 bytes on a character boundary with "…".
+/// Details: ill-formed UTF-8 (overlong forms, surrogates, values above U+10FFFF, truncated or stray bytes)
+/// gives one U+FFFD per maximal subpart, as Unicode recommends; the line and paragraph separators U+2028,
+/// U+2029 and the word joiner U+2060 are removed too; the result is always valid UTF-8 of at most 255
+/// bytes, "…" included (a longer one keeps its longest prefix of at most 252 bytes that ends on a
+/// character boundary, then "…"); a non-empty input that leaves nothing gives "\uFFFD", never "".
 std::string safe_display_name(std::string_view raw);
 
 /// Reads a whole document found by scan_stick, opening it again with the same openat2 rules relative to
 /// `root` (so a link swapped in after the scan is refused), and checks it is still a regular file of at
 /// most max_bytes.
-/// @throws StickError (one line naming the document and the problem).
+/// `relative_path` is a StickDocument::path: relative, '/'-separated, raw bytes; an absolute path, or one
+/// with an empty, "." or ".." component, is refused before anything is opened. The path is first looked
+/// at with O_PATH (a device node, FIFO, socket or trailing link is refused without being opened), then
+/// opened O_NONBLOCK and must still be the same regular file; one that shrinks or grows while read is refused.
+/// @returns the file's bytes (its whole size, at most max_bytes).
+/// @throws StickError (one line "stick file '<safe path>': <problem>"), also when max_bytes is not positive
+///         or the root cannot be opened.
 std::vector<std::uint8_t> read_stick_file(const std::string& root, const std::string& relative_path, std::int64_t max_bytes);
 
 }  // namespace hk::vision
