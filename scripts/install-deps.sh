@@ -9,7 +9,7 @@ packages=(
   libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev sox
   libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri xvfb xauth
   libpoppler-cpp-dev libudev-dev libblkid-dev
-  poppler-utils e2fsprogs util-linux mount qpdf
+  poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -164,20 +164,17 @@ class App final : public KioskEffects {
     sh.picture = is.picture.empty() ? cv::imread(is.image_path, cv::IMREAD_COLOR) : is.picture;
     sh.px_to_m = is.px_to_m;
     sh.text_blocks = is.text_blocks;
-    std::vector<Aabb> boxes;
-    for (const TextBlockM& b : is.text_blocks) boxes.push_back({b.lo_m, b.hi_m});
-    publish(std::move(sh), std::move(is.scene), id, std::move(boxes));
+    publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
   }
   int picture_count() const override { return static_cast<int>(pictures_.size()); }
   std::string describe() override {
     if (shown_page_ > 0) {
       // A document page: the block of text under the hand is read; elsewhere, what the page holds.
-      const Vec2 p = core_.display().proxy_m;
-      for (const TextBlockM& b : shown_.text_blocks) {
-        if (b.contains(p)) return audio_.messages().text(audio::MessageId::text_block, {{"text", b.text}});
+      if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m)) {
+        return audio_.messages().text(audio::MessageId::text_block, {{"text", b->text}});
       }
-      return describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines)) + " " +
-             describe_scene(shown_.polylines, half_);
+      const std::string page = describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
+      return shown_.polylines.empty() ? page : page + " " + describe_scene(shown_.polylines, half_);
     }
     return describe_scene(shown_.polylines, half_);
   }
@@ -231,7 +228,10 @@ class App final : public KioskEffects {
     stick_busy_ = true;
     sticks_.insert_folder(dir);
   }
-  void remove_stick_folder() { sticks_.remove_folder(); }
+  void remove_stick_folder() {
+    stick_busy_ = true;  // until the news of the removal arrives
+    sticks_.remove_folder();
+  }
   bool change_level(int delta) override {
     // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until
     // the session ends.
@@ -392,6 +392,17 @@ void draw_frame(App& app, const View& v, GLuint tex, bool have_tex, int tex_w, i
   glVertex2d(v.px(app.half().x), v.py(app.half().y));
   glVertex2d(v.px(-app.half().x), v.py(app.half().y));
   glEnd();
+  // Text blocks of a document page (spoken, not felt): pale blue frames, for a companion who sees.
+  glColor4f(0.45f, 0.7f, 1.0f, hc ? 1.0f : 0.8f);
+  glLineWidth(hc ? 3.0f : 1.5f);
+  for (const TextBlockM& b : sh.text_blocks) {
+    glBegin(GL_LINE_LOOP);
+    glVertex2d(v.px(b.lo_m.x), v.py(b.lo_m.y));
+    glVertex2d(v.px(b.hi_m.x), v.py(b.lo_m.y));
+    glVertex2d(v.px(b.hi_m.x), v.py(b.hi_m.y));
+    glVertex2d(v.px(b.lo_m.x), v.py(b.hi_m.y));
+    glEnd();
+  }
   // The curves at the level in use: bright yellow (RGB 255, 220, 0), thicker in high contrast.
   glColor4f(1.0f, 220.0f / 255.0f, 0.0f, 1.0f);
   glLineWidth(hc ? 6.0f : 3.0f);

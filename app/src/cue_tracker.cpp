@@ -19,7 +19,7 @@ void CueTracker::reset() noexcept {
 
 namespace {
 
-bool inside(const Aabb& b, Vec2 p, double margin_m) {
+bool in_box(const Aabb& b, Vec2 p, double margin_m) {
   return p.x >= b.lo.x - margin_m && p.x <= b.hi.x + margin_m && p.y >= b.lo.y - margin_m && p.y <= b.hi.y + margin_m;
 }
 
@@ -77,9 +77,9 @@ int CueTracker::update(std::int64_t tick, const ServoOutput& out, Vec2 handle_m,
     at_edge_ = false;
   }
 
-  if (in_text_block_ >= 0 && !inside(text_blocks_[in_text_block_], c.proxy_m, p_.text_block_margin_m)) in_text_block_ = -1;
+  if (in_text_block_ >= 0 && !in_box(text_blocks_[in_text_block_], c.proxy_m, p_.text_block_margin_m)) in_text_block_ = -1;
   for (int b = 0; b < text_block_count_; ++b) {
-    if (b != in_text_block_ && inside(text_blocks_[b], c.proxy_m, 0.0)) {
+    if (b != in_text_block_ && in_box(text_blocks_[b], c.proxy_m, 0.0)) {
       in_text_block_ = b;
       emit(CueKind::TextBlock, b, 0.0, level_in_use);
       break;

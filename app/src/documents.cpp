@@ -146,9 +146,12 @@ nlohmann::json stick_listing_json(const StickListing& l) {
           {"probe_ms", l.probe_ms}};
 }
 
-ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s) {
+ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
+                                vision::PdfFault fault) {
   const auto t0 = std::chrono::steady_clock::now();
-  const vision::PdfPage pg = vision::render_pdf_page(bytes, name, page, pdf_limits_from(s));
+  vision::PdfLimits limits = pdf_limits_from(s);
+  limits.fault = fault;
+  const vision::PdfPage pg = vision::render_pdf_page(bytes, name, page, limits);
   const double render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ImageScene is = build_page_scene(pg, name, page, s);
   is.times.load_ms += render_ms;

@@ -60,6 +60,8 @@ nlohmann::json stick_listing_json(const StickListing& listing);
 /// (vision::render_pdf_page with the [stick] limits), then build_page_scene (text masked, kept as blocks).
 /// The drawing time is added to times.load_ms.
 /// @throws vision::PdfError (one line: not a PDF, locked, damaged, no such page, worker stopped).
-ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s);
+/// `fault` is the worker's test hook (vision::PdfFault): None outside tests.
+ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
+                                vision::PdfFault fault = vision::PdfFault::None);
 
 }  // namespace hk::app

@@ -174,8 +174,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   ctp.period_s = 1.0 / s.haptics.servo_rate_hz;
   ctp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
   CueTracker tracker(ctp);
-  std::vector<Aabb> text_boxes;
-  for (const TextBlockM& b : is.text_blocks) text_boxes.push_back({b.lo_m, b.hi_m});
+  const std::vector<Aabb> text_boxes = text_block_regions(is.text_blocks);
   tracker.set_text_blocks(text_boxes.data(), static_cast<int>(text_boxes.size()));
   std::vector<audio::CueEvent> cues;
   run_simulation(scene, s, path, duration, [&](const TickRecord& r, const ServoOutput& so) {

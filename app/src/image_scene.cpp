@@ -181,6 +181,28 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
   return out;
 }
 
+std::vector<Aabb> text_block_regions(const std::vector<TextBlockM>& blocks) {
+  std::vector<Aabb> out;
+  out.reserve(blocks.size());
+  const Vec2 grow{kTextBlockReachM, kTextBlockReachM};
+  for (const TextBlockM& b : blocks) out.push_back({b.lo_m - grow, b.hi_m + grow});
+  return out;
+}
+
+const TextBlockM* text_block_at(const std::vector<TextBlockM>& blocks, Vec2 p) {
+  const TextBlockM* best = nullptr;
+  double best_d = 3.0 * kTextBlockReachM;
+  for (const TextBlockM& b : blocks) {
+    const double d = b.distance_m(p);
+    if (d <= best_d) {
+      best_d = d;
+      best = &b;
+      if (d == 0.0) break;
+    }
+  }
+  return best;
+}
+
 cv::Mat text_mask(cv::Size size, const std::vector<vision::PdfWord>& words, double grow) {
   cv::Mat mask(size, CV_8UC1, cv::Scalar(0));
   const cv::Rect2d frame(0, 0, size.width, size.height);

@@ -5,6 +5,8 @@
 /// budget filled with the most salient curves), and the multiresolution collision trees (DESIGN.md
 /// "Data flow").
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,7 +31,24 @@ struct TextBlockM {
   std::string text;       ///< its words in reading order (UTF-8)
   /// Whether the point p [m] lies in the box (edges included).
   bool contains(Vec2 p) const { return p.x >= lo_m.x && p.x <= hi_m.x && p.y >= lo_m.y && p.y <= hi_m.y; }
+  /// Distance from p to the box [m] (0 inside).
+  double distance_m(Vec2 p) const {
+    const double dx = std::max({lo_m.x - p.x, 0.0, p.x - hi_m.x}), dy = std::max({lo_m.y - p.y, 0.0, p.y - hi_m.y});
+    return std::hypot(dx, dy);
+  }
 };
+
+/// How far around a text block a hand still finds it [m]: a line of a printed page is about 1 mm high in
+/// the workspace, and lines are about as far apart, so the TextBlock cue's regions are the blocks grown by
+/// this much (neighbouring lines' regions meet) and Describe reads the nearest block within 3 times it.
+inline constexpr double kTextBlockReachM = 0.001;
+
+/// The regions of the TextBlock cue (CueTracker::set_text_blocks): each block grown by kTextBlockReachM.
+std::vector<Aabb> text_block_regions(const std::vector<TextBlockM>& blocks);
+
+/// The block a hand at p is reading: the one containing p, else the nearest within 3 · kTextBlockReachM;
+/// null when none.
+const TextBlockM* text_block_at(const std::vector<TextBlockM>& blocks, Vec2 p);
 
 /// A picture turned into a scene. `polylines[i]` is the curve built into `scene` as the curve whose
 /// `source_index` is i.

@@ -11,6 +11,7 @@
 /// The window thread polls both with poll_news() and poll_loaded() each frame (mutex-guarded queues: neither
 /// thread is real-time). A folder can stand in for a stick (insert_folder), for tests and `--stick DIR`.
 
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <memory>
@@ -70,6 +71,8 @@ class StickService {
   void forget();
   /// Whether sticks can be mounted (CAP_SYS_ADMIN); folders work regardless.
   bool can_mount() const { return can_mount_; }
+  /// Test hook: the PDF worker of every later load fails on purpose (vision::PdfFault). None in the kiosk.
+  void set_pdf_fault(vision::PdfFault fault) { pdf_fault_.store(fault); }
 
  private:
   struct Request {
@@ -87,6 +90,7 @@ class StickService {
   std::unique_ptr<vision::BlockEventSource> events_;
   std::string mount_root_;
   bool can_mount_ = false;
+  std::atomic<vision::PdfFault> pdf_fault_{vision::PdfFault::None};
 
   std::mutex m_;
   std::condition_variable cv_;

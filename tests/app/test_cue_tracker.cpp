@@ -118,5 +118,30 @@ TEST(CueTracker, WorkspaceEdgeOnceUntilTheHandComesBack) {
   EXPECT_EQ(r.count(CueKind::WorkspaceEdge), 2) << "still latched";
 }
 
+// Issue 11, item 4: a chime when the proxy enters a block of text, once per entry, not on its border.
+TEST(CueTracker, TextBlockOnEnteringEachBlockOnce) {
+  CueRun r;
+  const Aabb blocks[2] = {{{0.0, 0.0}, {0.02, 0.01}}, {{0.03, 0.0}, {0.05, 0.01}}};
+  r.tracker.set_text_blocks(blocks, 2);
+  r.step(ContactState::Free, -1, {-0.01, 0.005});
+  EXPECT_EQ(r.count(CueKind::TextBlock), 0);
+  r.step(ContactState::Free, -1, {0.001, 0.005});
+  ASSERT_EQ(r.count(CueKind::TextBlock), 1);
+  EXPECT_EQ(r.cues.back().curve, 0) << "curve carries the block's id";
+  r.step(ContactState::Free, -1, {0.010, 0.005});
+  r.step(ContactState::Free, -1, {0.0205, 0.005});  // 0.5 mm outside: within the 1 mm margin, still in
+  r.step(ContactState::Free, -1, {0.019, 0.005});
+  EXPECT_EQ(r.count(CueKind::TextBlock), 1) << "moving inside or along the border does not repeat it";
+  r.step(ContactState::Free, -1, {0.025, 0.005});  // 5 mm outside: left
+  r.step(ContactState::Free, -1, {0.019, 0.005});
+  EXPECT_EQ(r.count(CueKind::TextBlock), 2) << "entering again is a new cue";
+  r.step(ContactState::Free, -1, {0.031, 0.005});
+  ASSERT_EQ(r.count(CueKind::TextBlock), 3);
+  EXPECT_EQ(r.cues.back().curve, 1) << "another block";
+  r.tracker.set_text_blocks(nullptr, 0);
+  r.step(ContactState::Free, -1, {0.001, 0.005});
+  EXPECT_EQ(r.count(CueKind::TextBlock), 3) << "a picture has no text blocks";
+}
+
 }  // namespace
 }  // namespace hk::app

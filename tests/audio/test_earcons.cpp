@@ -95,6 +95,19 @@ TEST(Earcons, TwoCurvesDifferInPitch) {
   EXPECT_NEAR(fb, 293.66, 293.66 * 0.02);
 }
 
+// The text-block chime (issue 11): two soft notes, G5 (784 Hz) then D6 (1175 Hz) 80 ms later, and no strike:
+// unlike a contact click it has no noise burst at its start (low spectral centroid over its first 5 ms).
+TEST(Earcons, TextBlockIsTwoRisingNotesWithoutAStrike) {
+  const std::vector<float> x = render_cue_timeline(std::vector{cue(10, CueKind::TextBlock, 0)}, kPeriod, 0.4);
+  const std::size_t t = at(10);
+  EXPECT_NEAR(test::dominant_frequency(x, t + 960, 2400), 784.0, 784.0 * 0.03) << "first note";
+  EXPECT_NEAR(test::dominant_frequency(x, t + 4800, 2400), 1175.0, 1175.0 * 0.03) << "second note, 80 ms on";
+  const std::vector<float> click = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.1f)}, kPeriod, 0.4);
+  EXPECT_LT(test::spectral_centroid(x, t, 240), test::spectral_centroid(click, t, 240)) << "no bright strike at the start";
+  EXPECT_GT(test::rms(x, t, t + at(200)), 0.0);
+  EXPECT_LT(test::peak(x, t + at(350), x.size()), 1e-4) << "over within 350 ms";
+}
+
 TEST(Earcons, ContactLoudnessGrowsWithApproachSpeed) {
   const std::vector<float> soft = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.01f)}, kPeriod, 0.2);
   const std::vector<float> hard = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.15f)}, kPeriod, 0.2);
