@@ -82,6 +82,15 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"audio", "buffer_frames", 32, 4096, true},
       {"kiosk", "timeout_s", 10, 3600, false},
       {"kiosk", "warning_s", 1, 600, false},
+      {"stick", "max_depth", 1, 64, true},
+      {"stick", "max_entries", 10, 1000000, true},
+      {"stick", "max_documents", 1, 100000, true},
+      {"stick", "max_file_bytes", 1024, 2147483648.0, true},
+      {"stick", "scan_timeout_s", 0.1, 60, false},
+      {"stick", "max_pdf_pages", 1, 100000, true},
+      {"stick", "page_max_pixels", 1e5, 4e7, false},
+      {"stick", "page_max_dpi", 10, 1200, false},
+      {"stick", "page_timeout_s", 0.5, 120, false},
   };
   return specs;
 }
