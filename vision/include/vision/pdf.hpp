@@ -23,7 +23,16 @@
 
 namespace hk::vision {
 
-/// Limits of PDF work. Defaults are the config's (`[stick]`). All must be positive.
+/// Test hook: makes the worker fail on purpose right after fork(2), before it touches poppler, so tests of
+/// "a worker that crashes or hangs" need no special PDF. Never set outside tests.
+enum class PdfFault {
+  None,   ///< normal work
+  Crash,  ///< the worker raises SIGSEGV (with the default action, so it dies of signal 11 even under ASan)
+  Hang,   ///< the worker spins on the CPU forever (until RLIMIT_CPU or the wall-clock kill)
+};
+
+/// Limits of PDF work. Defaults are the config's (`[stick]`). All must be positive (worker_max_memory_mb
+/// may be 0).
 struct PdfLimits {
   std::int64_t max_file_bytes = 200LL << 20;  ///< largest PDF [bytes]
   int max_pages = 1000;                       ///< pages offered; a longer document offers its first max_pages
@@ -31,6 +40,11 @@ struct PdfLimits {
   double max_dpi = 300.0;                     ///< never rendered finer than this [dots per inch]
   double worker_cpu_s = 5.0;                  ///< RLIMIT_CPU of the worker [s]
   double worker_wall_s = 5.0;                 ///< the worker is killed after this wall-clock time [s]
+  /// Address space the worker may add to what it inherited from fork(2) [MiB] (RLIMIT_AS, set in the worker
+  /// to its size at fork plus this). Applied only in builds without AddressSanitizer (ASan reserves terabytes
+  /// of shadow memory); there memory is only reported (worker_max_rss_kb). 0 = no limit.
+  double worker_max_memory_mb = 2048.0;
+  PdfFault fault = PdfFault::None;            ///< test hook only (PdfFault); None in the kiosk
 };
 
 /// What a PDF is, without rendering any page.
@@ -39,21 +53,28 @@ struct PdfInfo {
   int pages_in_file = 0;       ///< pages the document has
   bool capped = false;         ///< pages_in_file > max_pages
   double worker_ms = 0.0;      ///< wall time of the worker [ms]
-  long worker_max_rss_kb = 0;  ///< the worker's peak resident memory [KiB]
+  long worker_max_rss_kb = 0;  ///< the worker's peak resident memory [KiB] (wait4's ru_maxrss; includes the
+                               ///< pages it shared with the kiosk process at fork)
 };
 
 /// One word (poppler text box) on a rendered page, in the page image's pixels (u right, v down, origin at
-/// the top-left pixel's corner).
+/// the top-left pixel's corner). Boxes are clipped to the page; words wholly outside it are dropped. The boxes
+/// come from the font's metrics: with a substituted (not embedded) font, glyphs may spill a little over them.
 struct PdfWord {
   std::string text;           ///< UTF-8
   cv::Rect2d box_px;          ///< bounding box [px]
+  /// poppler's has_space_after(): false when the next word follows with no space on the same line (as
+  /// "globs2" then "," in "globs2,"); group_text_blocks then joins the two without a space, as pdftotext
+  /// does, when their boxes are less than 0.3 line heights apart.
+  bool space_after = true;
 };
 
 /// A block of text (a paragraph or a heading): words grouped into lines, lines into blocks
 /// (group_text_blocks).
 struct TextBlock {
   cv::Rect2d box_px;  ///< union of its words' boxes [px]
-  std::string text;   ///< its lines in reading order, joined with single spaces
+  std::string text;   ///< its lines in reading order, words joined with single spaces (none after a word
+                      ///< whose space_after is false and that the next word on its line touches)
   int lines = 0;      ///< number of lines
 };
 
@@ -66,13 +87,15 @@ struct PdfPage {
   std::vector<TextBlock> blocks;  ///< words grouped (group_text_blocks)
   int pages = 0;                  ///< pages offered by the document (as PdfInfo::pages)
   double worker_ms = 0.0;         ///< wall time of the worker [ms]
-  long worker_max_rss_kb = 0;     ///< the worker's peak resident memory [KiB]
+  long worker_max_rss_kb = 0;     ///< the worker's peak resident memory [KiB] (as PdfInfo's)
 };
 
 /// A refused or unreadable PDF or page. what() is one line: "pdf '<name>': <problem>", e.g.
 /// "pdf 'report.pdf': protected by a password", "pdf 'x.pdf': page 3 took longer than 5 s to draw".
 class PdfError : public std::runtime_error {
  public:
+  /// NotPdf: no "%PDF-" header; Damaged: poppler cannot read it; Locked: needs a password; NoSuchPage;
+  /// TooLarge: a file, page or memory limit; Timeout: wall-clock or CPU limit; WorkerCrashed: the worker died.
   enum class Kind { NotPdf, Damaged, Locked, NoSuchPage, TooLarge, Timeout, WorkerCrashed };
   PdfError(Kind kind, const std::string& what) : std::runtime_error(what), kind_(kind) {}
   Kind kind() const { return kind_; }
@@ -84,13 +107,16 @@ class PdfError : public std::runtime_error {
 /// Opens the document in a worker and counts its pages.
 /// @param name   how to name it in errors (made printable on one line)
 /// @throws PdfError (NotPdf: no "%PDF-" header; Damaged: poppler cannot load it or it has no page;
-///         Locked: needs a password; TooLarge: over max_file_bytes; Timeout / WorkerCrashed).
+///         Locked: needs a password; TooLarge: over max_file_bytes; Timeout / WorkerCrashed);
+///         std::invalid_argument when a limit is not positive.
 PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits);
 
 /// Renders page `page` (from 1) in a worker: grey, at dpi = min(max_dpi, 72 · sqrt(max_page_pixels /
-/// (width_pt · height_pt))), with its words and text blocks.
+/// (width_pt · height_pt))) (lowered by a fraction of a percent when rounding up to whole pixels would
+/// overshoot the budget), with its words and text blocks.
 /// @throws PdfError as probe_pdf, plus NoSuchPage (page outside [1, pages offered]) and TooLarge (a page so
-///         large that even 1 DPI would exceed the budget).
+///         large that even 1 DPI would exceed the budget). Timeout: the worker outlived worker_wall_s or
+///         used up worker_cpu_s; WorkerCrashed: it died (a signal, or an exit without an answer).
 PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& name, int page, const PdfLimits& limits);
 
 /// Groups words into lines and lines into blocks, the way a reader sees paragraphs:
