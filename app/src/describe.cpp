@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace hk::app {
 namespace {
@@ -22,17 +23,23 @@ const char* place(Vec2 c, Vec2 half) {
   return names[row][col];
 }
 
+/// Bounding box (lower left, upper right) of a non-empty polyline [m].
+std::pair<Vec2, Vec2> bounds_of(const Polyline& p) {
+  Vec2 lo = p.points_m[0], hi = p.points_m[0];
+  for (const Vec2& q : p.points_m) {
+    lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+    hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+  }
+  return {lo, hi};
+}
+
 }  // namespace
 
 std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half, int max_named) {
   std::vector<Shape> shapes;
   for (const Polyline& p : curves) {
     if (p.points_m.empty()) continue;
-    Vec2 lo = p.points_m[0], hi = p.points_m[0];
-    for (const Vec2& q : p.points_m) {
-      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
-      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
-    }
+    const auto [lo, hi] = bounds_of(p);
     shapes.push_back({length(hi - lo), 0.5 * (lo + hi), p.closed});
   }
   if (shapes.empty()) return "There are no shapes in this picture.";
@@ -59,13 +66,7 @@ std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half, int m
 int count_figures(const std::vector<Polyline>& curves, double margin_m) {
   std::vector<std::pair<Vec2, Vec2>> boxes;
   for (const Polyline& p : curves) {
-    if (p.points_m.empty()) continue;
-    Vec2 lo = p.points_m[0], hi = p.points_m[0];
-    for (const Vec2& q : p.points_m) {
-      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
-      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
-    }
-    boxes.emplace_back(lo, hi);
+    if (!p.points_m.empty()) boxes.push_back(bounds_of(p));
   }
   std::vector<std::size_t> parent(boxes.size());
   for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;

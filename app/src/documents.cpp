@@ -1,10 +1,8 @@
 #include "documents.hpp"
 
 #include <chrono>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -32,49 +30,6 @@ vision::PdfLimits pdf_limits_from(const config::Settings& s) {
   l.worker_cpu_s = s.stick.page_timeout_s;
   l.worker_wall_s = s.stick.page_timeout_s;
   return l;
-}
-
-namespace {
-
-[[noreturn]] void refuse(const std::string& path, const std::string& problem) {
-  std::string p;
-  for (const char ch : path) {
-    const auto u = static_cast<unsigned char>(ch);
-    if (u < 0x20 || u == 0x7F) {
-      char buf[5];
-      std::snprintf(buf, sizeof buf, "\\x%02X", u);
-      p += buf;
-    } else {
-      p += ch;
-    }
-  }
-  throw vision::InputError("image '" + p + "': " + problem);
-}
-
-}  // namespace
-
-std::vector<std::uint8_t> read_file_limited(const std::string& path, std::int64_t max_bytes) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) refuse(path, "cannot open the file (" + std::string(std::strerror(errno)) + ")");
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) refuse(path, "not a regular file");
-  if (st.st_size == 0) refuse(path, "empty file (0 bytes)");
-  if (st.st_size > max_bytes) {
-    refuse(path, "file size " + std::to_string(st.st_size) + " bytes exceeds the limit of " + std::to_string(max_bytes) + " bytes");
-  }
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(st.st_size));
-  std::size_t got = 0;
-  while (got < bytes.size()) {
-    const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) refuse(path, "the file changed size while being read");
-    got += static_cast<std::size_t>(n);
-  }
-  return bytes;
 }
 
 bool is_pdf_file(const std::string& path) {

@@ -22,11 +22,6 @@ vision::ScanLimits scan_limits_from(const config::Settings& s);
 /// [stick] settings as the PDF worker's limits (page_timeout_s is both the wall-clock and the CPU limit).
 vision::PdfLimits pdf_limits_from(const config::Settings& s);
 
-/// The whole file at `path` (outside a stick: the command line's input), at most max_bytes.
-/// @throws vision::InputError "image '<path>': ..." one line (missing, not a regular file, too large,
-///         unreadable).
-std::vector<std::uint8_t> read_file_limited(const std::string& path, std::int64_t max_bytes);
-
 /// Whether the file at `path` starts with "%PDF-" (reads its first kilobyte; false when unreadable).
 bool is_pdf_file(const std::string& path);
 

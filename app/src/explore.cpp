@@ -110,7 +110,7 @@ ImageScene build_input_scene(const std::string& path, int page, const config::Se
     if (page > 0) throw ExploreError("--page " + std::to_string(page) + ": '" + path + "' is not a PDF (pages are for PDF documents)");
     return build_image_scene(path, s);
   }
-  return build_pdf_page_scene(read_file_limited(path, s.stick.max_file_bytes), path, page > 0 ? page : 1, s);
+  return build_pdf_page_scene(vision::read_input_file(path, s.stick.max_file_bytes), path, page > 0 ? page : 1, s);
 }
 
 ExploreSummary run_explore(const ExploreOptions& o) {

@@ -80,7 +80,7 @@ double fraction_within(const ImageScene& a, const ImageScene& b, double tol_px) 
   return n == 0 ? 0.0 : static_cast<double>(near) / static_cast<double>(n);
 }
 
-std::vector<std::uint8_t> bytes_of(const fs::path& p) { return read_file_limited(p.string(), 1 << 30); }
+std::vector<std::uint8_t> bytes_of(const fs::path& p) { return vision::read_input_file(p.string(), 1 << 30); }
 
 }  // namespace
 

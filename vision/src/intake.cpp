@@ -86,13 +86,16 @@ cv::Mat load_image(const std::string& path, const ImageLimits& limits) {
       limits.max_pixels <= 0) {
     throw std::invalid_argument("load_image: every ImageLimits field must be positive");
   }
+  return decode_image(read_input_file(path, limits.max_file_bytes), path, limits);
+}
+
+std::vector<std::uint8_t> read_input_file(const std::string& path, std::int64_t max_bytes) {
+  if (max_bytes <= 0) throw std::invalid_argument("read_input_file: max_bytes must be positive");
   const std::uint64_t size = detail::checked_file_size(path);
-  if (size > static_cast<std::uint64_t>(limits.max_file_bytes)) {
-    detail::throw_input_error(path, "file size " + std::to_string(size) + " bytes exceeds the limit of " +
-                                        std::to_string(limits.max_file_bytes) + " bytes");
+  if (size > static_cast<std::uint64_t>(max_bytes)) {
+    detail::throw_input_error(path, "file size " + std::to_string(size) + " bytes exceeds the limit of " + std::to_string(max_bytes) + " bytes");
   }
-  const std::vector<std::uint8_t> bytes = read_all(path, size);
-  return decode_image(bytes, path, limits);
+  return read_all(path, size);
 }
 
 cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits) {

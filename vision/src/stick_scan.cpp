@@ -17,6 +17,8 @@
 
 #include "vision/stick_scan.hpp"
 
+#include "unique_fd.hpp"
+
 #include <dirent.h>
 #include <fcntl.h>
 #include <linux/openat2.h>
@@ -39,21 +41,7 @@ namespace {
 constexpr std::uint64_t kResolve = RESOLVE_BENEATH | RESOLVE_NO_SYMLINKS | RESOLVE_NO_XDEV | RESOLVE_NO_MAGICLINKS;
 constexpr std::size_t kMagicBytes = 16;
 
-/// One fd, closed at the end of its scope.
-class Fd {
- public:
-  explicit Fd(int fd = -1) : fd_(fd) {}
-  ~Fd() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  int get() const { return fd_; }
-  bool ok() const { return fd_ >= 0; }
-
- private:
-  int fd_;
-};
+using Fd = detail::UniqueFd;
 
 std::string errno_text(int e) { return std::generic_category().message(e); }
 

@@ -3,6 +3,8 @@
 
 #include "vision/usb_stick.hpp"
 
+#include "unique_fd.hpp"
+
 #include <blkid/blkid.h>
 #include <fcntl.h>
 #include <libudev.h>
@@ -46,20 +48,7 @@ std::string stick_message(const std::string& devnode, const std::string& what) {
 
 std::string errno_text(int err) { return std::strerror(err); }
 
-/// A file descriptor closed on scope exit.
-class Fd {
- public:
-  explicit Fd(int fd = -1) : fd_(fd) {}
-  ~Fd() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  int get() const { return fd_; }
-
- private:
-  int fd_;
-};
+using Fd = detail::UniqueFd;
 
 /// Opens `devnode` read-only for probing; refuses anything that is neither a block device nor a regular
 /// file (an image). Never creates, never writes.

@@ -13,6 +13,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -78,6 +79,13 @@ ImageHeader read_image_header(const std::string& path);
 /// @throws InputError for every refusal above and when decoding fails.
 /// @throws std::invalid_argument if a limit is not positive.
 cv::Mat load_image(const std::string& path, const ImageLimits& limits);
+
+/// The whole file at `path` (an input named on the command line), read once, after checking it is a
+/// regular file of 1 to max_bytes bytes.
+/// @throws InputError "image '<path>': <problem>" (not found, not a regular file, empty, over max_bytes with
+///         both sizes named, changed size while read).
+/// @throws std::invalid_argument if max_bytes is not positive.
+std::vector<std::uint8_t> read_input_file(const std::string& path, std::int64_t max_bytes);
 
 /// load_image on bytes already read (a document from a USB stick, read through stick_scan's
 /// read_stick_file so that no path is opened twice). `name` names the input in errors. Same checks and
