@@ -71,6 +71,9 @@ class StickService {
   void forget();
   /// Whether sticks can be mounted (CAP_SYS_ADMIN); folders work regardless.
   bool can_mount() const { return can_mount_; }
+  /// Loads that have read their document and begun drawing and building it (for the operator's status and
+  /// for tests that need a load to be under way).
+  int loads_started() const { return loads_started_.load(); }
   /// Test hook: the PDF worker of every later load fails on purpose (vision::PdfFault). None in the kiosk.
   void set_pdf_fault(vision::PdfFault fault) { pdf_fault_.store(fault); }
 
@@ -91,6 +94,7 @@ class StickService {
   std::string mount_root_;
   bool can_mount_ = false;
   std::atomic<vision::PdfFault> pdf_fault_{vision::PdfFault::None};
+  std::atomic<int> loads_started_{0};
 
   std::mutex m_;
   std::condition_variable cv_;
