@@ -222,6 +222,7 @@ LoadedDocument StickService::build(const Request& r) {
     out.reason = problem_of(e.what());
   }
   out.load_ms = ms_since(t0);
+  if (out.scene) spdlog::info("stick {}: '{}' page {} built in {:.0f} ms", r.stick, doc.doc.display_name, r.page, out.load_ms);
   return out;
 }
 

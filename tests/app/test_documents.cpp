@@ -85,6 +85,21 @@ double fraction_within(const ImageScene& a, const ImageScene& b, double tol_px) 
   return n == 0 ? 0.0 : static_cast<double>(near) / static_cast<double>(n);
 }
 
+/// Default settings with a minute for the PDF worker instead of 5 s: these tests are about what a page
+/// gives, not about time, and ctest runs them beside other suites (and the kiosk beside its software GL)
+/// on a loaded 2-core machine under ASan.
+config::Settings test_settings() {
+  config::Settings s;
+  s.stick.page_timeout_s = 60.0;
+  return s;
+}
+
+/// The same for the command line: a settings file in `dir`, returned as " --config 'FILE'".
+std::string generous_config(const fs::path& dir) {
+  std::ofstream(dir / "generous.toml") << "[stick]\npage_timeout_s = 60.0\n";
+  return " --config '" + (dir / "generous.toml").string() + "'";
+}
+
 std::vector<std::uint8_t> bytes_of(const fs::path& p) { return vision::read_input_file(p.string(), 1 << 30); }
 
 }  // namespace
@@ -95,7 +110,7 @@ std::vector<std::uint8_t> bytes_of(const fs::path& p) { return vision::read_inpu
 TEST(PdfPages, PicturePagesGiveThePngsCurvesWithinAPixel) {
   const std::vector<std::uint8_t> pdf = bytes_of(kHorsePdf);
   for (const auto& [page, png, side] : {std::tuple{1, "horse.png", 400}, std::tuple{2, "page.png", 384}}) {
-    config::Settings s;
+    config::Settings s = test_settings();
     s.vision.max_image_side_px = side;
     s.stick.page_max_dpi = 72.0;  // the DPI img2pdf embedded the pictures at: one page pixel per picture pixel
     const ImageScene from_png = build_image_scene((kData / "images" / png).string(), s);
@@ -124,7 +139,7 @@ TEST(PdfPages, PicturePagesGiveThePngsCurvesWithinAPixel) {
 // A page of text: its words are masked from the edges (far fewer curves than the same page unmasked), the
 // curves that remain do not run through the text, and the text is kept as blocks in the workspace.
 TEST(PdfPages, TextIsSpokenNotFelt) {
-  config::Settings s;
+  config::Settings s = test_settings();
   const vision::PdfPage page = vision::render_pdf_page(bytes_of(kSpecPdf), "shared-mime-info-spec.pdf", 2, pdf_limits_from(s));
   ASSERT_GT(page.words.size(), 50u) << "page 2 of the specification is a page of text";
   const ImageScene masked = build_page_scene(page, "spec.pdf", 2, s);
@@ -184,7 +199,7 @@ TEST(PdfPages, TextMaskCoversEachWordGrownByAQuarterOfItsHeight) {
 TEST(ExploreDocument, PdfPageWritesTextBlocksAndRefusesBadPagesInOneLine) {
   const fs::path out = fresh_dir("explore");
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(exe + " explore " + q(kSpecPdf) + " --page 2 --out " + q(out) + " --duration 1 >/dev/null 2>" + q(out / "err.txt")), 0)
+  ASSERT_EQ(sh(exe + " explore " + q(kSpecPdf) + " --page 2 --out " + q(out) + generous_config(out) + " --duration 1 >/dev/null 2>" + q(out / "err.txt")), 0)
       << slurp(out / "err.txt");
   const json scene = json::parse(slurp(out / "scene.json"));
   EXPECT_EQ(scene["page"], 2);
@@ -203,7 +218,7 @@ TEST(ExploreDocument, PdfPageWritesTextBlocksAndRefusesBadPagesInOneLine) {
   EXPECT_EQ(sum["document"]["text_blocks"], scene["text_blocks"].size());
   EXPECT_GT(sum["document"]["words_masked"].get<int>(), 50);
   EXPECT_TRUE(fs::exists(out / "overlay.png"));
-  EXPECT_EQ(sh(exe + " explore " + q(kHorsePdf) + " --out " + q(out / "p1") + " --duration 0.2 >/dev/null 2>&1"), 0) << "a PDF without --page: page 1";
+  EXPECT_EQ(sh(exe + " explore " + q(kHorsePdf) + " --out " + q(out / "p1") + generous_config(out) + " --duration 0.2 >/dev/null 2>&1"), 0) << "a PDF without --page: page 1";
   EXPECT_EQ(json::parse(slurp(out / "p1" / "scene.json"))["page"], 1);
 
   // Bad pages and files: a non-zero exit and one line naming the input and the limit.
@@ -232,7 +247,7 @@ TEST(StickCommand, ListsDocumentsWithPagesAndRefusalsWithReasons) {
   std::ofstream(stick / "notes.pdf") << "not a PDF at all\n";
   fs::create_symlink("/etc/passwd", stick / "passwords.png");
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(exe + " stick " + q(stick) + " --json " + q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt")), 0) << slurp(dir / "err.txt");
+  ASSERT_EQ(sh(exe + " stick " + q(stick) + generous_config(dir) + " --json " + q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt")), 0) << slurp(dir / "err.txt");
   const json j = json::parse(slurp(dir / "stick.json"));
   ASSERT_EQ(j["documents"].size(), 3u) << j.dump(2);
   EXPECT_EQ(j["documents"][0]["path"], "holiday/butterfly.jpg");
@@ -285,7 +300,7 @@ TEST(StickCommand, DeviceIsMountedReadOnlyScannedAndUnmounted) {
     ~Detach() { sh("losetup -d " + dev + " 2>/dev/null"); }
   } detach{loop};
   const std::string exe = HK_KIOSK_EXE;
-  const int status = sh("unshare -m --propagation private " + exe + " stick --device " + loop + " --mount-root " + q(dir / "mnt") + " --json " +
+  const int status = sh("unshare -m --propagation private " + exe + " stick --device " + loop + generous_config(dir) + " --mount-root " + q(dir / "mnt") + " --json " +
                         q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt"));
   if (status != 0 && slurp(dir / "err.txt").find("unshare") != std::string::npos) GTEST_SKIP() << "no mount namespace here";
   ASSERT_EQ(status, 0) << slurp(dir / "err.txt");
@@ -326,7 +341,7 @@ TEST(StickService, InsertBrowseCrashRemoveInsertAgain) {
   const fs::path dir = fresh_dir("service");
   fs::copy_file(kData / "images" / "silhouette_3.png", dir / "a_shape.png");
   fs::copy_file(kHorsePdf, dir / "b_pages.pdf");
-  config::Settings s;
+  config::Settings s = test_settings();
   StickService svc(s, nullptr, (dir / "mnt").string());
   svc.insert_folder(dir.string());
   std::vector<StickNews> news = wait_for([&] { return svc.poll_news(); });
@@ -393,7 +408,7 @@ TEST(KioskScreen, StickIsBrowsedPageByPageAndTakenOut) {
   std::ofstream(dir / "script.txt") << "1 stick " << (dir / "stick").string() << "\n2 wait_loaded\n3 key next\n4 wait_loaded\n"
                                     << "5 key next\n6 wait_loaded\n7 key describe\n8 unstick\n9 wait_loaded\n";
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh("ASAN_OPTIONS=detect_leaks=0 timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug --library " +
+  ASSERT_EQ(sh("ASAN_OPTIONS=detect_leaks=0 timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug" + generous_config(dir) + " --library " +
                q(dir / "library") + " --script " + q(dir / "script.txt") + " --screenshot " + q(dir / "end.png") + " --frames 40 >" +
                q(dir / "log.txt") + " 2>&1"),
             0)
@@ -423,7 +438,7 @@ TEST(StickCommand, HostilePdfsAreRefusedOrCappedWithReasons) {
     fs::copy_file(kData / "bad" / f, stick / f);
   }
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(exe + " stick " + q(stick) + " --json " + q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt")), 0) << slurp(dir / "err.txt");
+  ASSERT_EQ(sh(exe + " stick " + q(stick) + generous_config(dir) + " --json " + q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt")), 0) << slurp(dir / "err.txt");
   const json j = json::parse(slurp(dir / "stick.json"));
   std::map<std::string, std::string> refused;
   for (const auto& r : j["refused"]) refused[r["path"]] = r["reason"];
@@ -517,8 +532,8 @@ TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
   const std::string result = in_mount_namespace([&]() -> std::string {
     auto events = std::make_unique<vision::FakeBlockEventSource>();
     vision::FakeBlockEventSource* fake = events.get();
-    config::Settings s;
-    s.stick.page_timeout_s = 2.0;
+    config::Settings s = test_settings();
+    s.stick.page_timeout_s = 10.0;  // the page drawn first must be done within it, and the hanging worker lasts it
     StickService svc(s, std::move(events), (dir / "mnt").string());
     if (!svc.can_mount()) return "SKIP: no CAP_SYS_ADMIN";
     fake->push({vision::BlockEvent::Action::Add, loop, ""});
@@ -531,7 +546,7 @@ TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
     if (d.size() != 1 || !d[0].scene || d[0].scene->page != 2) return "browse: page 2 not built: " + (d.empty() ? "" : d[0].reason);
 
     svc.set_pdf_fault(vision::PdfFault::Hang);
-    svc.load(first, 0, 1);  // drawn by a worker that hangs until the 2 s page limit
+    svc.load(first, 0, 1);  // drawn by a worker that hangs until the 10 s page limit
     const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     while (svc.loads_started() < 2 && std::chrono::steady_clock::now() < until) std::this_thread::yield();
     if (svc.loads_started() < 2) return "remove: the second load never started";

@@ -1,6 +1,10 @@
-// PDF pages in a forked poppler worker (see vision/pdf.hpp for the contract).
+// PDF pages in a poppler worker process (see vision/pdf.hpp for the contract).
 //
-// The parent (the kiosk) never calls poppler. Each probe or render forks a worker which
+// The parent (the kiosk) never calls poppler. Each probe or render starts the worker executable
+// hk-pdf-worker with posix_spawn(3) (no fork of the kiosk: a fork of a process whose other threads hold locks
+// - the allocator's, a sanitizer's - can deadlock in the child; observed under AddressSanitizer), with the
+// document in a sealed memfd as descriptor 3, the answer pipe as descriptor 4 and the request (page and
+// limits) in its arguments. The worker
 //   1. limits itself (RLIMIT_CPU; RLIMIT_AS only in builds without AddressSanitizer, see PdfLimits),
 //      closes every inherited descriptor but its pipe, sends its stdout/stderr to /dev/null, silences
 //      poppler's error callback and asks to be killed if the kiosk dies (PR_SET_PDEATHSIG);
@@ -13,7 +17,7 @@
 //   refusal: u8 PdfError::Kind, str problem
 //   answer:  i32 pages_in_file; for a render also f64 width_pt, height_pt, dpi, i32 width, height,
 //            width*height grey bytes, u32 word count, per word: str text, f64 x, y, w, h [px], u8 space_after
-//   str = u32 length + bytes; numbers in the machine's byte order (the worker is a fork of the reader).
+//   str = u32 length + bytes; numbers in the machine's byte order (the worker runs on the same machine).
 // Coordinates: poppler's text_list() boxes are in points, y down, in the frame of the page's crop box
 // after the page's /Rotate (the same frame page_renderer draws in); pixels = points x dpi / 72. The tests
 // check this on a rotated page with an offset crop box (tests/data/documents/rotated_text.pdf).
@@ -23,6 +27,9 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <spawn.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -38,6 +45,8 @@
 #include <cstring>
 #include <memory>
 #include <new>
+#include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 #include <poppler/cpp/poppler-document.h>
@@ -55,6 +64,8 @@
 #define HK_PDF_ASAN 1
 #endif
 #endif
+
+extern char** environ;  // the kiosk's environment, passed on to the worker (sanitizer options)
 
 namespace hk::vision {
 namespace {
@@ -239,10 +250,9 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   out.raw(words.bytes().data(), words.bytes().size());
 }
 
-/// Everything the forked worker does; never returns.
+/// Everything the worker does once its document is mapped; never returns.
 [[noreturn]] void worker_main(int fd, std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits) {
-  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  // Only the pipe stays open: a PDF that takes over poppler finds no kiosk file, socket or device.
+  // Only the answer pipe stays open: a PDF that takes over poppler finds no kiosk file, socket or device.
   if (fd > 3) ::syscall(SYS_close_range, 3u, static_cast<unsigned>(fd - 1), 0u);
   ::syscall(SYS_close_range, static_cast<unsigned>(fd + 1), ~0u, 0u);
   const int devnull = ::open("/dev/null", O_RDWR | O_CLOEXEC);
@@ -318,23 +328,94 @@ struct WorkerRun {
   long max_rss_kb = 0;
 };
 
+/// The worker executable: $HK_PDF_WORKER if set; else hk-pdf-worker beside this executable (an installed
+/// kiosk); else the one this build made (tests and bench binaries live elsewhere in the build tree).
+const std::string& worker_path() {
+  static const std::string path = [] {
+    if (const char* env = std::getenv("HK_PDF_WORKER"); env && *env) return std::string(env);
+    char self[4096];
+    const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n > 0) {
+      std::string beside(self, static_cast<std::size_t>(n));
+      beside = beside.substr(0, beside.rfind('/') + 1) + "hk-pdf-worker";
+      if (::access(beside.c_str(), X_OK) == 0) return beside;
+    }
+#ifdef HK_PDF_WORKER_PATH
+    return std::string(HK_PDF_WORKER_PATH);
+#else
+    return std::string("hk-pdf-worker");
+#endif
+  }();
+  return path;
+}
+
+std::string arg(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+/// A descriptor moved to 10 or above (so dup2 onto 3 and 4 in the child never meets it), close-on-exec.
+int high_fd(int fd) {
+  const int h = ::fcntl(fd, F_DUPFD_CLOEXEC, 10);
+  ::close(fd);
+  return h;
+}
+
 WorkerRun run_worker(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits, const std::string& name, std::size_t max_answer) {
+  auto cannot_start = [&](const char* what, int e) {
+    fail(PdfError::Kind::WorkerCrashed, name, std::string("cannot start the reader (") + what + ": " + std::strerror(e) + ")");
+  };
+  // The document, in memory the worker maps read-only (sealed: it cannot be changed after it is written).
+  const int doc = high_fd(::memfd_create("hk-pdf", MFD_CLOEXEC | MFD_ALLOW_SEALING));
+  if (doc < 0) cannot_start("memfd", errno);
+  std::size_t off = 0;
+  while (off < bytes.size()) {
+    const ssize_t n = ::write(doc, bytes.data() + off, bytes.size() - off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int e = errno;
+      ::close(doc);
+      cannot_start("memfd write", e);
+    }
+    off += static_cast<std::size_t>(n);
+  }
+  ::fcntl(doc, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_WRITE | F_SEAL_SEAL);
   int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) fail(PdfError::Kind::WorkerCrashed, name, std::string("cannot start the reader (pipe: ") + std::strerror(errno) + ")");
-  const auto t0 = std::chrono::steady_clock::now();
-  std::fflush(nullptr);  // nothing buffered in stdio is written twice
-  const pid_t pid = ::fork();
-  if (pid < 0) {
+  if (::pipe2(fds, O_CLOEXEC) != 0) {
     const int e = errno;
-    ::close(fds[0]);
-    ::close(fds[1]);
-    fail(PdfError::Kind::WorkerCrashed, name, std::string("cannot start the reader (fork: ") + std::strerror(e) + ")");
+    ::close(doc);
+    cannot_start("pipe", e);
   }
-  if (pid == 0) {
-    ::close(fds[0]);
-    worker_main(fds[1], bytes, page, limits);
-  }
+  fds[0] = high_fd(fds[0]);
+  fds[1] = high_fd(fds[1]);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_adddup2(&fa, doc, 3);
+  posix_spawn_file_actions_adddup2(&fa, fds[1], 4);
+  const std::string path = worker_path();
+  std::vector<std::string> args{path,
+                                std::to_string(page),
+                                std::to_string(limits.max_pages),
+                                arg(limits.max_page_pixels),
+                                arg(limits.max_dpi),
+                                arg(limits.worker_cpu_s),
+                                arg(limits.worker_max_memory_mb),
+                                std::to_string(static_cast<int>(limits.fault)),
+                                std::to_string(bytes.size())};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const auto t0 = std::chrono::steady_clock::now();
+  pid_t pid = -1;
+  const int rc = ::posix_spawn(&pid, path.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  ::close(doc);
   ::close(fds[1]);
+  if (rc != 0) {
+    ::close(fds[0]);
+    cannot_start(path.c_str(), rc);
+  }
 
   WorkerRun run;
   const auto deadline = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(limits.worker_wall_s));
@@ -424,7 +505,7 @@ std::string doing(int page) { return page == 0 ? "opening the document" : "page 
   fail(PdfError::Kind::WorkerCrashed, name, "the reader gave no usable answer " + where);
 }
 
-/// Checks what every caller checks before forking.
+/// Checks what every caller checks before starting a worker.
 void check_input(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits) {
   if (!(limits.max_file_bytes > 0 && limits.max_pages > 0 && limits.max_page_pixels > 0 && limits.max_dpi > 0 && limits.worker_cpu_s > 0 &&
         limits.worker_wall_s > 0 && limits.worker_max_memory_mb >= 0)) {
@@ -467,6 +548,26 @@ bool looks_like_pdf(std::span<const std::uint8_t> bytes) {
     if (std::memcmp(bytes.data() + i, kHeader, n) == 0) return true;
   }
   return false;
+}
+
+int pdf_worker_entry(int argc, char** argv) {
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (argc != 9) return 64;
+  PdfLimits limits;
+  const int page = std::atoi(argv[1]);
+  limits.max_pages = std::atoi(argv[2]);
+  limits.max_page_pixels = std::strtod(argv[3], nullptr);
+  limits.max_dpi = std::strtod(argv[4], nullptr);
+  limits.worker_cpu_s = std::strtod(argv[5], nullptr);
+  limits.worker_max_memory_mb = std::strtod(argv[6], nullptr);
+  const int fault = std::atoi(argv[7]);
+  limits.fault = fault == 1 ? PdfFault::Crash : fault == 2 ? PdfFault::Hang : PdfFault::None;
+  const auto size = static_cast<std::size_t>(std::strtoull(argv[8], nullptr, 10));
+  struct stat st {};
+  if (::fstat(3, &st) != 0 || static_cast<std::size_t>(st.st_size) != size || size == 0) return 65;
+  void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, 3, 0);
+  if (map == MAP_FAILED) return 66;
+  worker_main(4, std::span<const std::uint8_t>(static_cast<const std::uint8_t*>(map), size), page, limits);
 }
 
 PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits) {

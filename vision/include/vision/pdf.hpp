@@ -3,8 +3,10 @@
 /// PDF pages as pictures, with their text (issue 11, items 3 and 4).
 ///
 /// A PDF from a stick is hostile input, and poppler is a large parser: every poppler call runs in a
-/// forked worker process (fork(2), no exec) with RLIMIT_CPU and a wall-clock kill, so a PDF that crashes or
-/// hangs poppler takes down only its worker. The kiosk process itself never calls poppler. The worker
+/// worker process, the executable hk-pdf-worker started with posix_spawn (not a fork of the kiosk, whose
+/// other threads may hold locks a forked child would wait on forever), with RLIMIT_CPU and a wall-clock
+/// kill, so a PDF that crashes or hangs poppler takes down only its worker. The worker is found as
+/// $HK_PDF_WORKER, else beside the running executable, else where the build put it. The kiosk process itself never calls poppler. The worker
 /// sends its answer back through a pipe; the parent reads it with poll(2) against the deadline, then
 /// SIGKILLs and reaps the worker in every case (wait4, for the worker's peak memory).
 ///
@@ -23,7 +25,7 @@
 
 namespace hk::vision {
 
-/// Test hook: makes the worker fail on purpose right after fork(2), before it touches poppler, so tests of
+/// Test hook: makes the worker fail on purpose as soon as it has started, before it touches poppler, so tests of
 /// "a worker that crashes or hangs" need no special PDF. Never set outside tests.
 enum class PdfFault {
   None,   ///< normal work
@@ -40,8 +42,8 @@ struct PdfLimits {
   double max_dpi = 300.0;                     ///< never rendered finer than this [dots per inch]
   double worker_cpu_s = 5.0;                  ///< RLIMIT_CPU of the worker [s]
   double worker_wall_s = 5.0;                 ///< the worker is killed after this wall-clock time [s]
-  /// Address space the worker may add to what it inherited from fork(2) [MiB] (RLIMIT_AS, set in the worker
-  /// to its size at fork plus this). Applied only in builds without AddressSanitizer (ASan reserves terabytes
+  /// Address space the worker may add to its size at start [MiB] (RLIMIT_AS, set in the worker to its size
+  /// with the document mapped, plus this). Applied only in builds without AddressSanitizer (ASan reserves terabytes
   /// of shadow memory); there memory is only reported (worker_max_rss_kb). 0 = no limit.
   double worker_max_memory_mb = 2048.0;
   PdfFault fault = PdfFault::None;            ///< test hook only (PdfFault); None in the kiosk
@@ -53,8 +55,7 @@ struct PdfInfo {
   int pages_in_file = 0;       ///< pages the document has
   bool capped = false;         ///< pages_in_file > max_pages
   double worker_ms = 0.0;      ///< wall time of the worker [ms]
-  long worker_max_rss_kb = 0;  ///< the worker's peak resident memory [KiB] (wait4's ru_maxrss; includes the
-                               ///< pages it shared with the kiosk process at fork)
+  long worker_max_rss_kb = 0;  ///< the worker's peak resident memory [KiB] (wait4's ru_maxrss)
 };
 
 /// One word (poppler text box) on a rendered page, in the page image's pixels (u right, v down, origin at
@@ -129,5 +130,11 @@ std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words);
 
 /// True when `bytes` start with "%PDF-" (after up to 1024 bytes of leading junk, as readers allow).
 bool looks_like_pdf(std::span<const std::uint8_t> bytes);
+
+/// Entry point of the worker executable (vision/worker/pdf_worker_main.cpp), not for other callers: maps the
+/// document from descriptor 3, limits itself, runs poppler for the request in argv (page, max_pages,
+/// max_page_pixels, max_dpi, worker_cpu_s, worker_max_memory_mb, fault, document size), writes the answer
+/// to descriptor 4 and exits. Returns 64-66 (never reaching poppler) for a malformed request.
+int pdf_worker_entry(int argc, char** argv);
 
 }  // namespace hk::vision
