@@ -16,6 +16,8 @@
 #include <unistd.h>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 #include "stick_service.hpp"
 
 using namespace hk;
@@ -46,6 +48,7 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--out") out_path = argv[i + 1];
     if (std::string(argv[i]) == "--repeats") repeats = std::max(1, std::atoi(argv[i + 1]));
   }
+  spdlog::set_level(spdlog::level::warn);  // the service's info lines would land in the table
   const fs::path data = HK_TEST_DATA_DIR;
   const std::vector<fs::path> docs{data / "documents" / "horse_and_page.pdf", data / "documents" / "shared-mime-info-spec.pdf",
                                    data / "images" / "fruits.jpg"};
