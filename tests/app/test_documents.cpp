@@ -100,6 +100,26 @@ std::string generous_config(const fs::path& dir) {
   return " --config '" + (dir / "generous.toml").string() + "'";
 }
 
+/// The image attached read-only to a free loop device (losetup -r), made writable again and detached when
+/// destroyed; dev is empty when the kernel refused.
+struct LoopDevice {
+  std::string dev;
+  explicit LoopDevice(const fs::path& img) {
+    FILE* p = ::popen(("losetup -r -f --show " + q(img) + " 2>/dev/null").c_str(), "r");
+    char buf[128] = {};
+    if (p && std::fgets(buf, sizeof buf, p)) dev = buf;
+    if (p) ::pclose(p);
+    while (!dev.empty() && (dev.back() == '\n' || dev.back() == ' ')) dev.pop_back();
+  }
+  ~LoopDevice() {
+    // The kiosk set the device read-only (BLKROSET), and the flag outlives the attachment: clear it, so the
+    // next user of this loop device finds it as the kernel hands it out.
+    if (!dev.empty()) sh("blockdev --setrw " + dev + " 2>/dev/null; losetup -d " + dev + " 2>/dev/null");
+  }
+  LoopDevice(const LoopDevice&) = delete;
+  LoopDevice& operator=(const LoopDevice&) = delete;
+};
+
 std::vector<std::uint8_t> bytes_of(const fs::path& p) { return vision::read_input_file(p.string(), 1 << 30); }
 
 }  // namespace
@@ -288,17 +308,9 @@ TEST(StickCommand, DeviceIsMountedReadOnlyScannedAndUnmounted) {
   const fs::path img = dir / "stick.img";
   ASSERT_EQ(sh("mkfs.ext4 -q -F -d " + q(dir / "src") + " " + q(img) + " 8M >/dev/null 2>&1"), 0);
   const std::string before = slurp(img);
-  FILE* p = ::popen(("losetup -r -f --show " + q(img) + " 2>/dev/null").c_str(), "r");
-  char buf[128] = {};
-  const bool got = p && std::fgets(buf, sizeof buf, p);
-  if (p) ::pclose(p);
-  std::string loop = got ? std::string(buf) : "";
-  while (!loop.empty() && (loop.back() == '\n' || loop.back() == ' ')) loop.pop_back();
-  if (loop.empty()) GTEST_SKIP() << "the kernel refused a loop device";
-  struct Detach {
-    std::string dev;
-    ~Detach() { sh("losetup -d " + dev + " 2>/dev/null"); }
-  } detach{loop};
+  const LoopDevice attached(img);
+  if (attached.dev.empty()) GTEST_SKIP() << "the kernel refused a loop device";
+  const std::string& loop = attached.dev;
   const std::string exe = HK_KIOSK_EXE;
   const int status = sh("unshare -m --propagation private " + exe + " stick --device " + loop + generous_config(dir) + " --mount-root " + q(dir / "mnt") + " --json " +
                         q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt"));
@@ -517,17 +529,9 @@ TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
   const fs::path img = dir / "stick.img";
   ASSERT_EQ(sh("mkfs.ext4 -q -F -d " + q(dir / "src") + " " + q(img) + " 8M >/dev/null 2>&1"), 0);
   const std::string before = slurp(img);
-  FILE* p = ::popen(("losetup -r -f --show " + q(img) + " 2>/dev/null").c_str(), "r");
-  char buf[128] = {};
-  const bool got = p && std::fgets(buf, sizeof buf, p);
-  if (p) ::pclose(p);
-  std::string loop = got ? std::string(buf) : "";
-  while (!loop.empty() && (loop.back() == '\n' || loop.back() == ' ')) loop.pop_back();
-  if (loop.empty()) GTEST_SKIP() << "the kernel refused a loop device";
-  struct Detach {
-    std::string dev;
-    ~Detach() { sh("losetup -d " + dev + " 2>/dev/null"); }
-  } detach{loop};
+  const LoopDevice attached(img);
+  if (attached.dev.empty()) GTEST_SKIP() << "the kernel refused a loop device";
+  const std::string& loop = attached.dev;
 
   const std::string result = in_mount_namespace([&]() -> std::string {
     auto events = std::make_unique<vision::FakeBlockEventSource>();
