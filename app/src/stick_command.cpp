@@ -35,7 +35,7 @@ void write_atomically(const std::string& path, const std::string& text) {
 }  // namespace
 
 int run_stick(const StickOptions& o) {
-  if (o.folder.empty() == o.device.empty()) throw std::runtime_error("stick: give a folder or --device DEV, not both");
+  if (o.folder.empty() == o.device.empty()) throw std::runtime_error("stick: give exactly one of a folder or --device DEV");
   const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
   if (!o.json_path.empty()) {  // refuse a bad output before mounting anything
     const std::filesystem::path p(o.json_path);
