@@ -16,6 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -118,6 +119,21 @@ struct LoopDevice {
   }
   LoopDevice(const LoopDevice&) = delete;
   LoopDevice& operator=(const LoopDevice&) = delete;
+};
+
+/// An 8 MB ext4 image of the folder `src` (mkfs.ext4 -d), its bytes when made, and a read-only loop device
+/// over it (LoopDevice).
+struct Ext4Stick {
+  fs::path img;
+  bool made = false;
+  std::string before;
+  std::unique_ptr<LoopDevice> loop;
+  Ext4Stick(const fs::path& src, fs::path image) : img(std::move(image)) {
+    made = sh("mkfs.ext4 -q -F -d " + q(src) + " " + q(img) + " 8M >/dev/null 2>&1") == 0;
+    if (!made) return;
+    before = slurp(img);
+    loop = std::make_unique<LoopDevice>(img);
+  }
 };
 
 std::vector<std::uint8_t> bytes_of(const fs::path& p) { return vision::read_input_file(p.string(), 1 << 30); }
@@ -305,12 +321,12 @@ TEST(StickCommand, DeviceIsMountedReadOnlyScannedAndUnmounted) {
   fs::copy_file(kData / "images" / "horse.png", dir / "src" / "horse.png");
   fs::copy_file(kHorsePdf, dir / "src" / "docs" / "horse_and_page.pdf");
   fs::create_symlink("/etc/shadow", dir / "src" / "shadow.png");
-  const fs::path img = dir / "stick.img";
-  ASSERT_EQ(sh("mkfs.ext4 -q -F -d " + q(dir / "src") + " " + q(img) + " 8M >/dev/null 2>&1"), 0);
-  const std::string before = slurp(img);
-  const LoopDevice attached(img);
-  if (attached.dev.empty()) GTEST_SKIP() << "the kernel refused a loop device";
-  const std::string& loop = attached.dev;
+  const Ext4Stick stick(dir / "src", dir / "stick.img");
+  ASSERT_TRUE(stick.made) << "mkfs.ext4 -d failed";
+  if (stick.loop->dev.empty()) GTEST_SKIP() << "the kernel refused a loop device";
+  const fs::path& img = stick.img;
+  const std::string& before = stick.before;
+  const std::string& loop = stick.loop->dev;
   const std::string exe = HK_KIOSK_EXE;
   const int status = sh("unshare -m --propagation private " + exe + " stick --device " + loop + generous_config(dir) + " --mount-root " + q(dir / "mnt") + " --json " +
                         q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt"));
@@ -526,12 +542,12 @@ TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
   fs::create_directories(dir / "src");
   fs::copy_file(kHorsePdf, dir / "src" / "pages.pdf");
   fs::copy_file(kData / "images" / "silhouette_3.png", dir / "src" / "shape.png");
-  const fs::path img = dir / "stick.img";
-  ASSERT_EQ(sh("mkfs.ext4 -q -F -d " + q(dir / "src") + " " + q(img) + " 8M >/dev/null 2>&1"), 0);
-  const std::string before = slurp(img);
-  const LoopDevice attached(img);
-  if (attached.dev.empty()) GTEST_SKIP() << "the kernel refused a loop device";
-  const std::string& loop = attached.dev;
+  const Ext4Stick stick(dir / "src", dir / "stick.img");
+  ASSERT_TRUE(stick.made) << "mkfs.ext4 -d failed";
+  if (stick.loop->dev.empty()) GTEST_SKIP() << "the kernel refused a loop device";
+  const fs::path& img = stick.img;
+  const std::string& before = stick.before;
+  const std::string& loop = stick.loop->dev;
 
   const std::string result = in_mount_namespace([&]() -> std::string {
     auto events = std::make_unique<vision::FakeBlockEventSource>();

@@ -554,6 +554,12 @@ class UsbStickImage : public ::testing::Test {
     return rc == 0;
   }
   void remember_image() { original_ = read_bytes(image_); }
+  /// Makes image_ an 8 MB ext4 filesystem holding src_ and remembers its bytes.
+  bool make_ext4_image() {
+    if (!make("mkfs.ext4 -q -d '" + src_.string() + "' '" + image_.string() + "' 8M")) return false;
+    remember_image();
+    return true;
+  }
   void expect_image_unchanged() {
     ASSERT_FALSE(original_.empty());
     EXPECT_TRUE(read_bytes(image_) == original_) << "the image changed";
@@ -565,8 +571,7 @@ TEST_F(UsbStickImage, Ext4MountedReadOnlyAndReadBack) {
   SKIP_UNLESS_TOOL("mkfs.ext4");
   SKIP_UNLESS_TOOL("losetup");
   make_ext4_tree(src_);
-  ASSERT_TRUE(make("mkfs.ext4 -q -d '" + src_.string() + "' '" + image_.string() + "' 8M"));
-  remember_image();
+  ASSERT_TRUE(make_ext4_image());
   {
     LoopDevice loop(image_, /*read_only=*/true);
     if (loop.dev().empty()) GTEST_SKIP() << loop.error();
@@ -620,8 +625,7 @@ TEST_F(UsbStickImage, WritableDeviceIsMadeReadOnlyBeforeMounting) {
   SKIP_UNLESS_TOOL("mkfs.ext4");
   SKIP_UNLESS_TOOL("losetup");
   copy_documents(src_);
-  ASSERT_TRUE(make("mkfs.ext4 -q -d '" + src_.string() + "' '" + image_.string() + "' 8M"));
-  remember_image();
+  ASSERT_TRUE(make_ext4_image());
   {
     LoopDevice loop(image_, /*read_only=*/false);
     if (loop.dev().empty()) GTEST_SKIP() << loop.error();
@@ -781,8 +785,7 @@ TEST_F(UsbStickImage, WithoutCapabilityNothingIsMounted) {
   SKIP_UNLESS_TOOL("mkfs.ext4");
   SKIP_UNLESS_TOOL("losetup");
   copy_documents(src_);
-  ASSERT_TRUE(make("mkfs.ext4 -q -d '" + src_.string() + "' '" + image_.string() + "' 8M"));
-  remember_image();
+  ASSERT_TRUE(make_ext4_image());
   {
     LoopDevice loop(image_, /*read_only=*/false);
     if (loop.dev().empty()) GTEST_SKIP() << loop.error();
