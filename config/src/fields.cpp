@@ -10,6 +10,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "config/keys.hpp"
 #include "config/load.hpp"
 #include "detail.hpp"
 
@@ -31,11 +32,12 @@ ConstFieldRef cref_of(const Settings& s) {
 }
 
 /// Builds a descriptor; evaluated at compile time, so a bad row (min > max, fractional integer
-/// bound, int bound beyond int) is a compile error.
+/// bound, int bound beyond int, a text field with neither choices nor a check) is a compile error.
 template <auto Sub, auto Member>
-constexpr FieldDescriptor make_field(std::string_view table, std::string_view key, double min,
-                                     double max, std::string_view unit, std::string_view help,
-                                     std::span<const std::string_view> choices = {}) {
+constexpr FieldDescriptor make_field(std::string_view table, std::string_view key, FieldGroup group, ApplyWhen apply,
+                                     double min, double max, std::string_view unit, std::string_view help,
+                                     std::span<const std::string_view> choices = {},
+                                     std::string (*check)(std::string_view) = nullptr) {
   using T = std::remove_cvref_t<decltype(std::declval<Settings&>().*Sub.*Member)>;
   static_assert(std::is_same_v<T, double> || std::is_same_v<T, int> ||
                     std::is_same_v<T, std::int64_t> || std::is_same_v<T, std::string>,
@@ -43,7 +45,7 @@ constexpr FieldDescriptor make_field(std::string_view table, std::string_view ke
   FieldKind kind = FieldKind::real;
   if constexpr (std::is_same_v<T, std::string>) {
     kind = FieldKind::text;
-    if (choices.empty()) throw "a text field needs its list of choices";
+    if (choices.empty() == (check == nullptr)) throw "a text field needs either its list of choices or a check";
   } else if constexpr (!std::is_same_v<T, double>) {
     kind = FieldKind::integer;
     if (min != static_cast<double>(static_cast<long long>(min)) ||
@@ -52,14 +54,43 @@ constexpr FieldDescriptor make_field(std::string_view table, std::string_view ke
     if (std::is_same_v<T, int> && (min < INT_MIN || max > INT_MAX))
       throw "bounds of an int field must fit in int";
   }
+  if (kind != FieldKind::text && check != nullptr) throw "only a text field has a check";
   if (kind != FieldKind::text && !(min <= max)) throw "min must be <= max";
-  return FieldDescriptor{table, key, kind, min, max, unit, help, choices,
+  return FieldDescriptor{table, key, kind, min, max, unit, help, choices, check, group, apply,
                          &ref_of<Sub, Member>, &cref_of<Sub, Member>};
 }
 
-// HK_FIELD(table, field, ...): the key is the field name, spelled once.
+// HK_FIELD(table, field, group, apply, min, max, unit, help[, choices]): the key is the field name,
+// spelled once. HK_FIELD_IN(member, "toml table", ...) for a table whose name is a C++ keyword.
 #define HK_FIELD(table, field, ...)                                                        \
   make_field<&Settings::table, &decltype(Settings::table)::field>(#table, #field, __VA_ARGS__)
+#define HK_FIELD_IN(member, table_name, field, ...)                                         \
+  make_field<&Settings::member, &decltype(Settings::member)::field>(table_name, #field, __VA_ARGS__)
+
+/// The check of a path field: at most 4096 bytes, no control characters.
+std::string path_problem(std::string_view v) {
+  if (v.size() > 4096) return "is longer than 4096 bytes";
+  for (char c : v)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "holds a control character";
+  return {};
+}
+
+/// The check of [operator] pin_hash: empty, or what libsodium's crypto_pwhash_str writes for argon2id
+/// (printable ASCII starting "$argon2id$", at most 127 bytes: crypto_pwhash_STRBYTES − 1).
+std::string pin_hash_problem(std::string_view v) {
+  if (v.empty()) return {};
+  if (v.size() > 127) return "is longer than an argon2id hash (127 bytes); set the PIN with 'haptic-kiosk pin set'";
+  if (v.rfind("$argon2id$", 0) != 0) return "is not an argon2id hash; set the PIN with 'haptic-kiosk pin set'";
+  for (char c : v)
+    if (c <= 0x20 || c >= 0x7f) return "holds a character no argon2id hash has; set the PIN with 'haptic-kiosk pin set'";
+  return {};
+}
+
+/// The check of [operator] open_chord (parse_chord).
+std::string chord_problem(std::string_view v) {
+  std::string why;
+  return parse_chord(v, &why) ? std::string{} : why;
+}
 
 constexpr std::array<std::string_view, 1> kDeviceTypes{"simulated"};
 constexpr std::array<std::string_view, 2> kLevelModes{"auto", "fixed"};
@@ -72,7 +103,7 @@ constexpr auto kKeyNames = std::to_array<std::string_view>({
     "PAGE_UP", "PAGE_DOWN", "HOME", "END", "INSERT", "DELETE", "MINUS", "EQUAL",
     "KP_0", "KP_1", "KP_2", "KP_3", "KP_4", "KP_5", "KP_6", "KP_7", "KP_8", "KP_9", "KP_ADD", "KP_SUBTRACT", "KP_ENTER"});
 
-constexpr std::array<detail::TableInfo, 9> kTables{{
+constexpr std::array<detail::TableInfo, 10> kTables{{
     {"haptics", "Force rendering and the servo loop."},
     {"device", "Which device drives the handle, and the simulated pantograph's physics."},
     {"hand", "The model hand that drives the simulated pantograph in headless runs."},
@@ -82,88 +113,101 @@ constexpr std::array<detail::TableInfo, 9> kTables{{
     {"kiosk", "The visitor's session."},
     {"stick", "Documents from USB sticks: how far a scan goes and how PDF pages are drawn."},
     {"keys", "The key for each of the visitor's actions (O, C and ESCAPE are the operator's)."},
+    {"operator", "The operator's panel: how it opens, its PIN (set with 'haptic-kiosk pin set') and its records."},
 }};
 
 constexpr auto kFields = std::to_array<FieldDescriptor>({
     // [haptics]
-    HK_FIELD(haptics, stiffness_n_per_m, 10, 5000, "N/m", "Wall stiffness."),
-    HK_FIELD(haptics, damping_n_s_per_m, 0, 20, "N·s/m", "Damping rendered while in contact."),
-    HK_FIELD(haptics, max_force_n, 0.1, 20, "N", "Force clamp: no force above this leaves the device."),
-    HK_FIELD(haptics, servo_rate_hz, 100, 10000, "Hz", "Servo loop rate."),
-    HK_FIELD(haptics, level, 0, 12, "",
+    HK_FIELD(haptics, stiffness_n_per_m, FieldGroup::haptics, ApplyWhen::live, 10, 5000, "N/m", "Wall stiffness."),
+    HK_FIELD(haptics, damping_n_s_per_m, FieldGroup::haptics, ApplyWhen::live, 0, 20, "N·s/m", "Damping rendered while in contact."),
+    HK_FIELD(haptics, max_force_n, FieldGroup::haptics, ApplyWhen::live, 0.1, 20, "N", "Force clamp: no force above this leaves the device."),
+    HK_FIELD(haptics, servo_rate_hz, FieldGroup::haptics, ApplyWhen::restart, 100, 10000, "Hz", "Servo loop rate."),
+    HK_FIELD(haptics, level, FieldGroup::levels, ApplyWhen::scene, 0, 12, "",
              "Resolution level at the start, and always when level_mode = \"fixed\"; 0 = finest; must be <= max_levels."),
-    HK_FIELD(haptics, level_mode, 0, 0, "", "\"auto\": the level follows the hand's speed; \"fixed\": always `level`.", kLevelModes),
-    HK_FIELD(haptics, level_error_at_rest_m, 0, 0.01, "m", "Deviation from the true curve a slowly moving fingertip cannot feel."),
-    HK_FIELD(haptics, level_blur_time_s, 0, 0.1, "s", "The tolerable deviation grows by the hand's speed times this."),
-    HK_FIELD(haptics, level_hysteresis, 0, 0.9, "", "Go coarser only when that level's error is this fraction below the tolerance."),
-    HK_FIELD(haptics, level_min_dwell_s, 0, 5, "s", "Least time between two level changes."),
-    HK_FIELD(haptics, level_max_force_step_n, 0.001, 5, "N", "Largest force change per tick that a level change may cause."),
-    HK_FIELD(haptics, static_friction, 0, 2, "", "Coulomb static friction of the walls; >= dynamic_friction."),
-    HK_FIELD(haptics, dynamic_friction, 0, 2, "", "Coulomb dynamic friction of the walls; both 0 = frictionless."),
-    HK_FIELD(haptics, max_levels, 1, 12, "", "Number of levels built above level 0."),
-    HK_FIELD(haptics, query_deadline_us, 1, 100000, "µs", "Deadline of the anytime collision query."),
-    HK_FIELD(haptics, force_ramp_s, 0, 10, "s", "Start-up force ramp duration."),
+    HK_FIELD(haptics, level_mode, FieldGroup::levels, ApplyWhen::scene, 0, 0, "", "\"auto\": the level follows the hand's speed; \"fixed\": always `level`.", kLevelModes),
+    HK_FIELD(haptics, level_error_at_rest_m, FieldGroup::levels, ApplyWhen::scene, 0, 0.01, "m", "Deviation from the true curve a slowly moving fingertip cannot feel."),
+    HK_FIELD(haptics, level_blur_time_s, FieldGroup::levels, ApplyWhen::scene, 0, 0.1, "s", "The tolerable deviation grows by the hand's speed times this."),
+    HK_FIELD(haptics, level_hysteresis, FieldGroup::levels, ApplyWhen::scene, 0, 0.9, "", "Go coarser only when that level's error is this fraction below the tolerance."),
+    HK_FIELD(haptics, level_min_dwell_s, FieldGroup::levels, ApplyWhen::scene, 0, 5, "s", "Least time between two level changes."),
+    HK_FIELD(haptics, level_max_force_step_n, FieldGroup::haptics, ApplyWhen::live, 0.001, 5, "N", "Largest force change per tick that a level change may cause."),
+    HK_FIELD(haptics, static_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "", "Coulomb static friction of the walls; >= dynamic_friction."),
+    HK_FIELD(haptics, dynamic_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "", "Coulomb dynamic friction of the walls; both 0 = frictionless."),
+    HK_FIELD(haptics, max_levels, FieldGroup::levels, ApplyWhen::scene, 1, 12, "", "Number of levels built above level 0."),
+    HK_FIELD(haptics, query_deadline_us, FieldGroup::haptics, ApplyWhen::live, 1, 100000, "µs", "Deadline of the anytime collision query."),
+    HK_FIELD(haptics, force_ramp_s, FieldGroup::haptics, ApplyWhen::scene, 0, 10, "s", "Start-up force ramp duration."),
     // [device]
-    HK_FIELD(device, type, 0, 0, "", "Device driving the handle.", kDeviceTypes),
-    HK_FIELD(device, handle_mass_kg, 0.001, 5, "kg", "Effective handle mass (simulated pantograph)."),
-    HK_FIELD(device, handle_damping_n_s_per_m, 0, 100, "N·s/m", "Device viscous damping."),
-    HK_FIELD(device, encoder_counts_per_rev, 64, 1048576, "counts/rev", "Encoder resolution."),
-    HK_FIELD(device, max_torque_n_m, 0.001, 10, "N·m", "Per-motor torque limit."),
+    HK_FIELD(device, type, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Device driving the handle.", kDeviceTypes),
+    HK_FIELD(device, handle_mass_kg, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "kg", "Effective handle mass (simulated pantograph)."),
+    HK_FIELD(device, handle_damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 100, "N·s/m", "Device viscous damping."),
+    HK_FIELD(device, encoder_counts_per_rev, FieldGroup::devices, ApplyWhen::restart, 64, 1048576, "counts/rev", "Encoder resolution."),
+    HK_FIELD(device, max_torque_n_m, FieldGroup::devices, ApplyWhen::restart, 0.001, 10, "N·m", "Per-motor torque limit."),
     // [hand]
-    HK_FIELD(hand, stiffness_n_per_m, 1, 5000, "N/m", "Spring pulling the hand to its target."),
-    HK_FIELD(hand, damping_n_s_per_m, 0, 200, "N·s/m", "Damping of the hand spring."),
-    HK_FIELD(hand, max_force_n, 0.01, 50, "N", "The most a visitor pushes with."),
-    HK_FIELD(hand, raster_speed_m_per_s, 0.001, 5, "m/s", "Target speed along the raster."),
-    HK_FIELD(hand, raster_spacing_m, 0.0005, 0.05, "m", "Line spacing of the raster."),
+    HK_FIELD(hand, stiffness_n_per_m, FieldGroup::devices, ApplyWhen::restart, 1, 5000, "N/m", "Spring pulling the hand to its target."),
+    HK_FIELD(hand, damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 200, "N·s/m", "Damping of the hand spring."),
+    HK_FIELD(hand, max_force_n, FieldGroup::devices, ApplyWhen::restart, 0.01, 50, "N", "The most a visitor pushes with."),
+    HK_FIELD(hand, raster_speed_m_per_s, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "m/s", "Target speed along the raster."),
+    HK_FIELD(hand, raster_spacing_m, FieldGroup::devices, ApplyWhen::restart, 0.0005, 0.05, "m", "Line spacing of the raster."),
     // [vision]
-    HK_FIELD(vision, max_file_bytes, 1024, kTwoPow31, "bytes", "Largest image file accepted."),
-    HK_FIELD(vision, max_width_px, 16, 100000, "px", "Widest image accepted."),
-    HK_FIELD(vision, max_height_px, 16, 100000, "px", "Tallest image accepted."),
-    HK_FIELD(vision, max_pixels, 256, kTwoPow31, "px", "Largest width x height accepted."),
-    HK_FIELD(vision, blur_sigma_px, 0, 20, "px", "Gaussian pre-blur sigma."),
-    HK_FIELD(vision, canny_low, 0, 2000, "",
+    HK_FIELD(vision, max_file_bytes, FieldGroup::scene, ApplyWhen::scene, 1024, kTwoPow31, "bytes", "Largest image file accepted."),
+    HK_FIELD(vision, max_width_px, FieldGroup::scene, ApplyWhen::scene, 16, 100000, "px", "Widest image accepted."),
+    HK_FIELD(vision, max_height_px, FieldGroup::scene, ApplyWhen::scene, 16, 100000, "px", "Tallest image accepted."),
+    HK_FIELD(vision, max_pixels, FieldGroup::scene, ApplyWhen::scene, 256, kTwoPow31, "px", "Largest width x height accepted."),
+    HK_FIELD(vision, blur_sigma_px, FieldGroup::scene, ApplyWhen::scene, 0, 20, "px", "Gaussian pre-blur sigma."),
+    HK_FIELD(vision, canny_low, FieldGroup::scene, ApplyWhen::scene, 0, 2000, "",
              "Canny hysteresis low threshold; 0 = from the image; <= canny_high when both nonzero."),
-    HK_FIELD(vision, canny_high, 0, 2000, "", "Canny hysteresis high threshold; 0 = from the image."),
-    HK_FIELD(vision, min_chain_length_m, 0, 0.1, "m", "Edge chains shorter than this are dropped."),
-    HK_FIELD(vision, max_image_side_px, 64, 10000, "px", "Images are downscaled to this longest side."),
-    HK_FIELD(vision, max_segments, 100, 1000000, "", "Scene budget: level-0 segments kept, the most salient curves first."),
-    HK_FIELD(vision, thin_line_max_width_m, 0, 0.01, "m", "The two edges of a line thinner than this become one curve; 0 = off."),
+    HK_FIELD(vision, canny_high, FieldGroup::scene, ApplyWhen::scene, 0, 2000, "", "Canny hysteresis high threshold; 0 = from the image."),
+    HK_FIELD(vision, min_chain_length_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.1, "m", "Edge chains shorter than this are dropped."),
+    HK_FIELD(vision, max_image_side_px, FieldGroup::scene, ApplyWhen::scene, 64, 10000, "px", "Images are downscaled to this longest side."),
+    HK_FIELD(vision, max_segments, FieldGroup::scene, ApplyWhen::scene, 100, 1000000, "", "Scene budget: level-0 segments kept, the most salient curves first."),
+    HK_FIELD(vision, thin_line_max_width_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.01, "m", "The two edges of a line thinner than this become one curve; 0 = off."),
     // [workspace]
-    HK_FIELD(workspace, width_m, 0.01, 1, "m", "Width of the usable rectangle."),
-    HK_FIELD(workspace, height_m, 0.01, 1, "m", "Height of the usable rectangle."),
+    HK_FIELD(workspace, width_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Width of the usable rectangle."),
+    HK_FIELD(workspace, height_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Height of the usable rectangle."),
     // [audio]
-    HK_FIELD(audio, volume_default_step, 1, 10, "", "Volume step at the start of every session (10 = loudest)."),
-    HK_FIELD(audio, volume_step_db, 1, 6, "dB", "Loudness change per volume step."),
-    HK_FIELD(audio, earcon_gain, 0, 1, "", "Level of the earcons before the volume."),
-    HK_FIELD(audio, duck_db, -40, 0, "dB", "Earcons are this much quieter while speech plays."),
-    HK_FIELD(audio, speech_rate_wpm, 80, 450, "words/min", "Speaking rate."),
-    HK_FIELD(audio, buffer_frames, 32, 4096, "frames", "Audio output buffer at 48 kHz (256 = 5.3 ms)."),
+    HK_FIELD(audio, volume_default_step, FieldGroup::audio, ApplyWhen::session, 1, 10, "", "Volume step at the start of every session (10 = loudest)."),
+    HK_FIELD(audio, volume_step_db, FieldGroup::audio, ApplyWhen::restart, 1, 6, "dB", "Loudness change per volume step."),
+    HK_FIELD(audio, earcon_gain, FieldGroup::audio, ApplyWhen::restart, 0, 1, "", "Level of the earcons before the volume."),
+    HK_FIELD(audio, duck_db, FieldGroup::audio, ApplyWhen::restart, -40, 0, "dB", "Earcons are this much quieter while speech plays."),
+    HK_FIELD(audio, speech_rate_wpm, FieldGroup::audio, ApplyWhen::restart, 80, 450, "words/min", "Speaking rate."),
+    HK_FIELD(audio, buffer_frames, FieldGroup::audio, ApplyWhen::restart, 32, 4096, "frames", "Audio output buffer at 48 kHz (256 = 5.3 ms)."),
     // [kiosk]
-    HK_FIELD(kiosk, timeout_s, 10, 3600, "s", "No key and no handle motion for this long ends the session."),
-    HK_FIELD(kiosk, warning_s, 1, 600, "s", "The spoken warning comes this long before the end (at most half the timeout)."),
+    HK_FIELD(kiosk, timeout_s, FieldGroup::kiosk, ApplyWhen::live, 10, 3600, "s", "No key and no handle motion for this long ends the session."),
+    HK_FIELD(kiosk, warning_s, FieldGroup::kiosk, ApplyWhen::live, 1, 600, "s", "The spoken warning comes this long before the end (at most half the timeout)."),
     // [stick]
-    HK_FIELD(stick, max_depth, 1, 64, "", "Deepest folder of a stick that is entered (its root is 0)."),
-    HK_FIELD(stick, max_entries, 10, 1000000, "", "Directory entries looked at per scan of a stick."),
-    HK_FIELD(stick, max_documents, 1, 100000, "", "Documents offered per stick."),
-    HK_FIELD(stick, max_file_bytes, 1024, kTwoPow31, "bytes", "Largest document read from a stick."),
-    HK_FIELD(stick, scan_timeout_s, 0.1, 60, "s", "Wall-clock limit of one scan of a stick."),
-    HK_FIELD(stick, max_pdf_pages, 1, 100000, "", "Pages offered per PDF (the first ones)."),
-    HK_FIELD(stick, page_max_pixels, 1e5, 4e7, "px", "A PDF page is drawn at the DPI that keeps it within this many pixels."),
-    HK_FIELD(stick, page_max_dpi, 10, 1200, "dpi", "A PDF page is never drawn finer than this."),
-    HK_FIELD(stick, page_timeout_s, 0.5, 120, "s", "The worker drawing a PDF page is stopped after this (wall clock and CPU)."),
+    HK_FIELD(stick, max_depth, FieldGroup::devices, ApplyWhen::restart, 1, 64, "", "Deepest folder of a stick that is entered (its root is 0)."),
+    HK_FIELD(stick, max_entries, FieldGroup::devices, ApplyWhen::restart, 10, 1000000, "", "Directory entries looked at per scan of a stick."),
+    HK_FIELD(stick, max_documents, FieldGroup::devices, ApplyWhen::restart, 1, 100000, "", "Documents offered per stick."),
+    HK_FIELD(stick, max_file_bytes, FieldGroup::devices, ApplyWhen::restart, 1024, kTwoPow31, "bytes", "Largest document read from a stick."),
+    HK_FIELD(stick, scan_timeout_s, FieldGroup::devices, ApplyWhen::restart, 0.1, 60, "s", "Wall-clock limit of one scan of a stick."),
+    HK_FIELD(stick, max_pdf_pages, FieldGroup::devices, ApplyWhen::restart, 1, 100000, "", "Pages offered per PDF (the first ones)."),
+    HK_FIELD(stick, page_max_pixels, FieldGroup::devices, ApplyWhen::restart, 1e5, 4e7, "px", "A PDF page is drawn at the DPI that keeps it within this many pixels."),
+    HK_FIELD(stick, page_max_dpi, FieldGroup::devices, ApplyWhen::restart, 10, 1200, "dpi", "A PDF page is never drawn finer than this."),
+    HK_FIELD(stick, page_timeout_s, FieldGroup::devices, ApplyWhen::restart, 0.5, 120, "s", "The worker drawing a PDF page is stopped after this (wall clock and CPU)."),
     // [keys]
-    HK_FIELD(keys, help, 0, 0, "", "Help.", kKeyNames),
-    HK_FIELD(keys, next, 0, 0, "", "Next picture (next tutorial shape).", kKeyNames),
-    HK_FIELD(keys, previous, 0, 0, "", "Previous picture.", kKeyNames),
-    HK_FIELD(keys, describe, 0, 0, "", "Describe the picture.", kKeyNames),
-    HK_FIELD(keys, finer, 0, 0, "", "More detail (finer level).", kKeyNames),
-    HK_FIELD(keys, coarser, 0, 0, "", "Less detail (coarser level).", kKeyNames),
-    HK_FIELD(keys, volume_up, 0, 0, "", "Louder.", kKeyNames),
-    HK_FIELD(keys, volume_down, 0, 0, "", "Quieter.", kKeyNames),
-    HK_FIELD(keys, tutorial, 0, 0, "", "Start the tutorial again.", kKeyNames),
+    HK_FIELD(keys, help, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Help.", kKeyNames),
+    HK_FIELD(keys, next, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Next picture (next tutorial shape).", kKeyNames),
+    HK_FIELD(keys, previous, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Previous picture.", kKeyNames),
+    HK_FIELD(keys, describe, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Describe the picture.", kKeyNames),
+    HK_FIELD(keys, finer, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "More detail (finer level).", kKeyNames),
+    HK_FIELD(keys, coarser, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Less detail (coarser level).", kKeyNames),
+    HK_FIELD(keys, volume_up, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Louder.", kKeyNames),
+    HK_FIELD(keys, volume_down, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Quieter.", kKeyNames),
+    HK_FIELD(keys, tutorial, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Start the tutorial again.", kKeyNames),
+    // [operator]
+    HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
+                "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),
+    HK_FIELD_IN(operator_, "operator", idle_close_s, FieldGroup::kiosk, ApplyWhen::live, 10, 3600, "s",
+                "The operator's panel closes itself after this long without input."),
+    HK_FIELD_IN(operator_, "operator", pin_hash, FieldGroup::hidden, ApplyWhen::live, 0, 0, "",
+                "Hash of the operator's PIN (argon2id); written by 'haptic-kiosk pin set', never by hand.", {}, &pin_hash_problem),
+    HK_FIELD_IN(operator_, "operator", state_file, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+                "Failed PIN attempts and the time of the last (the lockout); empty = beside the settings file (.state).", {}, &path_problem),
+    HK_FIELD_IN(operator_, "operator", audit_log, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+                "One line per change made in the panel; empty = beside the settings file (.audit.log).", {}, &path_problem),
 });
 
 #undef HK_FIELD
+#undef HK_FIELD_IN
 
 std::string with_unit(std::string text, std::string_view unit) {
   if (!unit.empty()) {
@@ -181,6 +225,60 @@ std::string format_bound(const FieldDescriptor& d, double b) {
 }  // namespace
 
 std::span<const FieldDescriptor> field_descriptors() noexcept { return kFields; }
+
+std::string_view group_name(FieldGroup g) noexcept {
+  switch (g) {
+    case FieldGroup::haptics: return "Haptics";
+    case FieldGroup::levels: return "Levels";
+    case FieldGroup::scene: return "Scene";
+    case FieldGroup::audio: return "Audio";
+    case FieldGroup::kiosk: return "Kiosk";
+    case FieldGroup::keys: return "Keys";
+    case FieldGroup::devices: return "Devices";
+    case FieldGroup::hidden: return "";
+  }
+  return "";
+}
+
+std::span<const std::string_view> visitor_key_names() noexcept { return kKeyNames; }
+
+std::optional<KeyChord> parse_chord(std::string_view text, std::string* why) {
+  const auto refuse = [&](std::string reason) -> std::optional<KeyChord> {
+    if (why) *why = std::move(reason);
+    return std::nullopt;
+  };
+  if (text.empty()) return refuse("is empty; write e.g. \"CTRL+ALT+O\"");
+  KeyChord c;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t plus = text.find('+', start);
+    const std::string_view part = text.substr(start, plus == std::string_view::npos ? std::string_view::npos : plus - start);
+    if (part.empty()) return refuse("has an empty part between '+' signs");
+    if (plus == std::string_view::npos) {  // the key
+      bool known = part == "O" || part == "C" || part == "ESCAPE";
+      for (auto k : kKeyNames) known = known || k == part;
+      if (!known) return refuse("ends in '" + detail::one_line(part, 40) + "', which is not a key name (e.g. O, F12, HOME)");
+      c.key = std::string(part);
+      break;
+    }
+    bool* flag = part == "CTRL" ? &c.ctrl : part == "ALT" ? &c.alt : part == "SHIFT" ? &c.shift : part == "SUPER" ? &c.super : nullptr;
+    if (!flag) return refuse("has '" + detail::one_line(part, 40) + "' where a modifier (CTRL, ALT, SHIFT, SUPER) belongs");
+    if (*flag) return refuse("names " + std::string(part) + " twice");
+    *flag = true;
+    start = plus + 1;
+  }
+  if (!c.ctrl && !c.alt && !c.super) return refuse("needs CTRL, ALT or SUPER, so no visitor opens the PIN prompt with one key");
+  return c;
+}
+
+std::string chord_text(const KeyChord& c) {
+  std::string s;
+  if (c.ctrl) s += "CTRL+";
+  if (c.alt) s += "ALT+";
+  if (c.shift) s += "SHIFT+";
+  if (c.super) s += "SUPER+";
+  return s + c.key;
+}
 
 const FieldDescriptor* find_field(std::string_view table, std::string_view key) noexcept {
   for (const auto& d : kFields)
@@ -274,6 +372,7 @@ std::string qualified(const FieldDescriptor& d) {
 }
 
 std::string allowed_text(const FieldDescriptor& d) {
+  if (d.kind == FieldKind::text && d.check) return "text";
   if (d.kind == FieldKind::text) {
     std::string s = "one of ";
     for (std::size_t i = 0; i < d.choices.size(); ++i) {
@@ -299,6 +398,11 @@ std::optional<std::string> integer_problem(const FieldDescriptor& d, long long v
 }
 
 std::optional<std::string> text_problem(const FieldDescriptor& d, std::string_view v) {
+  if (d.check) {
+    std::string why = d.check(v);
+    if (why.empty()) return std::nullopt;
+    return why;
+  }
   for (auto c : d.choices)
     if (c == v) return std::nullopt;
   return "is not a known value; allowed: " + allowed_text(d);

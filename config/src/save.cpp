@@ -78,7 +78,9 @@ std::string to_toml(const Settings& settings) {
       if (d.table != table.name) continue;
       out += "\n# ";
       out += d.help;
-      if (d.kind == FieldKind::text) {
+      if (d.kind == FieldKind::text && d.check) {
+        // Free text: its help says what it holds.
+      } else if (d.kind == FieldKind::text) {
         out += " Allowed: " + detail::allowed_text(d) + ".";
       } else {
         out += " Range ";
@@ -110,10 +112,11 @@ void save_settings_atomic(const Settings& settings, const std::string& path) {
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
 
-  // Keep the mode of an existing file; a new file gets 0644.
+  // Keep the mode of an existing file; a new file gets 0644. A file holding the PIN's hash is 0600.
   mode_t mode = 0644;
   struct stat st{};
   if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) mode = st.st_mode & 07777;
+  if (!settings.operator_.pin_hash.empty()) mode = 0600;
 
   std::string tmp = (dir / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
   std::vector<char> tmpl(tmp.begin(), tmp.end());

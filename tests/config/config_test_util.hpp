@@ -91,6 +91,7 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"stick", "page_max_pixels", 1e5, 4e7, false},
       {"stick", "page_max_dpi", 10, 1200, false},
       {"stick", "page_timeout_s", 0.5, 120, false},
+      {"operator", "idle_close_s", 10, 3600, false},
   };
   return specs;
 }

@@ -8,6 +8,7 @@
 #include <string>
 #include <variant>
 
+#include "config/keys.hpp"
 #include "config/load.hpp"
 #include "config_test_util.hpp"
 
@@ -71,10 +72,17 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
+    if (name == "operator.open_chord" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log") {
+      EXPECT_EQ(d.kind, FieldKind::text) << name;
+      EXPECT_TRUE(d.choices.empty()) << name;
+      EXPECT_NE(d.check, nullptr) << name;  // free text, checked
+      ++texts;
+      continue;
+    }
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 11u);
+  EXPECT_EQ(texts, 15u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -211,6 +219,49 @@ TEST(ConfigValidate, ControlCharactersInValuesDoNotBreakTheLine) {
   ASSERT_TRUE(e);
   EXPECT_TRUE(is_one_line(e->what())) << e->what();
   EXPECT_NE(std::string(e->what()).find("sim\\nulated\\r\\x01"), std::string::npos) << e->what();
+}
+
+
+// [operator] open_chord: what parse_chord reads, and what it refuses with a phrase saying why.
+TEST(OperatorChord, ParsesModifiersInAnyOrderAndRefusesWhatAVisitorCouldPressAlone) {
+  std::string why;
+  const auto c = parse_chord("ALT+CTRL+O", &why);
+  ASSERT_TRUE(c) << why;
+  EXPECT_TRUE(c->ctrl && c->alt && !c->shift && !c->super);
+  EXPECT_EQ(c->key, "O");
+  EXPECT_EQ(chord_text(*c), "CTRL+ALT+O");
+  EXPECT_EQ(parse_chord(chord_text(*c)), c);
+  EXPECT_TRUE(parse_chord("SUPER+F12"));
+  for (const char* bad : {"", "O", "SHIFT+O", "CTRL+", "+O", "CTRL+CTRL+O", "CTRL+ALT+Ö", "ctrl+alt+o", "CTRL+META+O"}) {
+    why.clear();
+    EXPECT_FALSE(parse_chord(bad, &why)) << bad;
+    EXPECT_FALSE(why.empty()) << bad;
+  }
+  EXPECT_NE((parse_chord("SHIFT+O", &why), why).find("CTRL, ALT or SUPER"), std::string::npos);
+  // The loader gives the same phrase, naming the key.
+  try {
+    (void)parse_settings("[operator]\nopen_chord = \"O\"\n", "k.toml");
+    FAIL() << "a chord of one key was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "operator.open_chord");
+    EXPECT_NE(std::string(e.what()).find("needs CTRL, ALT or SUPER"), std::string::npos) << e.what();
+  }
+}
+
+// [operator] pin_hash is empty or an argon2id hash: anything else typed by hand is refused at load.
+TEST(OperatorPinHash, OnlyAnArgon2idHashOrNothingIsAccepted) {
+  EXPECT_NO_THROW((void)parse_settings("[operator]\npin_hash = \"\"\n", "k.toml"));
+  EXPECT_NO_THROW((void)parse_settings(
+      "[operator]\npin_hash = \"$argon2id$v=19$m=65536,t=2,p=1$c29tZXNhbHQ$aGFzaGhhc2hoYXNoaGFzaA\"\n", "k.toml"));
+  for (const char* bad : {"1234", "$argon2i$v=19$m=4096,t=3,p=1$abc$def", "$argon2id$ with space"}) {
+    try {
+      (void)parse_settings(std::string("[operator]\npin_hash = \"") + bad + "\"\n", "k.toml");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), "operator.pin_hash");
+      EXPECT_NE(std::string(e.what()).find("pin set"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

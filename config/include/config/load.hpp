@@ -3,7 +3,7 @@
 /// Reading, checking and writing the kiosk settings (`settings.hpp`) as TOML.
 ///
 /// The file layout is one TOML table per settings struct ([haptics], [device], [hand], [vision],
-/// [workspace], [audio], [kiosk], [keys]) with one key per field, named exactly as the field. Every key is optional: a key
+/// [workspace], [audio], [kiosk], [stick], [keys], [operator]) with one key per field, named exactly as the field. Every key is optional: a key
 /// that is absent keeps its default. Everything else is refused with a ConfigError whose message is
 /// one line naming the file, the key (as `table.key`), the bad value and what is allowed, e.g.
 ///   config 'k.toml': haptics.stiffness_n_per_m = -5 is out of range [10, 5000] N/m (line 3)
@@ -47,7 +47,22 @@ class ConfigError : public std::runtime_error {
 enum class FieldKind {
   real,     ///< double; TOML float or integer accepted; must be finite and within [min, max]
   integer,  ///< int or std::int64_t; TOML integer only; within [min, max]
-  text,     ///< std::string; TOML string; must be one of `choices`
+  text,     ///< std::string; TOML string; one of `choices`, or (no choices) accepted by `check`
+};
+
+/// Where a field sits in the operator's panel (issue 12, item 3). `hidden` fields are never shown
+/// (the PIN's hash).
+enum class FieldGroup { haptics, levels, scene, audio, kiosk, keys, devices, hidden };
+
+/// Display name of a group: "Haptics", "Levels", "Scene", "Audio", "Kiosk", "Keys", "Devices", "".
+[[nodiscard]] std::string_view group_name(FieldGroup g) noexcept;
+
+/// When a change made in the running kiosk takes effect (issue 12, item 4).
+enum class ApplyWhen {
+  live,     ///< at once: servo gains through the lock-free hand-over, keys, session timing
+  scene,    ///< the scene is rebuilt off the servo thread and swapped in with the fade
+  session,  ///< at the next visitor's session
+  restart,  ///< at the next start of the kiosk
 };
 
 /// Mutable view of one field inside a Settings.
@@ -66,13 +81,18 @@ struct FieldDescriptor {
   double max;              ///< inclusive upper bound (real, integer); unused for text
   std::string_view unit;   ///< unit shown to the operator, e.g. "N/m"; empty when dimensionless
   std::string_view help;   ///< one-line description for the operator
-  std::span<const std::string_view> choices;  ///< allowed values of a text field
+  std::span<const std::string_view> choices;  ///< allowed values of a text field (empty: `check` decides)
+  /// For a text field without choices: why `value` is not allowed (one phrase, e.g. "is longer than 4096
+  /// bytes"), or empty when it is. Null for every other field.
+  std::string (*check)(std::string_view value);
+  FieldGroup group;                           ///< where the operator's panel shows it
+  ApplyWhen apply;                            ///< when a change in the running kiosk takes effect
   FieldRef (*ref)(Settings&);                 ///< the field inside a Settings
   ConstFieldRef (*cref)(const Settings&);     ///< the field inside a const Settings
 };
 
 /// Every settings field, grouped by table in file order (haptics, device, hand, vision,
-/// workspace, audio, kiosk, keys). The span refers to static storage.
+/// workspace, audio, kiosk, stick, keys, operator). The span refers to static storage.
 [[nodiscard]] std::span<const FieldDescriptor> field_descriptors() noexcept;
 
 /// The descriptor of `table.key`, or nullptr when there is no such field.
@@ -111,7 +131,7 @@ void validate(const Settings& settings);
 /// validate()s `settings`, then writes to_toml(settings) to `path` atomically: the text goes to a
 /// new temporary file in the same directory, which is fsync'ed and renamed over `path`; the
 /// directory is then fsync'ed (best effort). A new file gets mode 0644, an existing file keeps its
-/// mode. Not safe against concurrent writers of the same path.
+/// mode, and a file with a PIN hash ([operator] pin_hash) is always 0600. Not safe against concurrent writers of the same path.
 /// @throws ConfigError if validation fails or any step before the rename fails (missing or
 ///   read-only directory, disk full, ...); the existing file at `path` is then untouched and the
 ///   temporary file removed.

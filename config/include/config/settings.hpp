@@ -141,6 +141,19 @@ struct KeysSettings {
   bool operator==(const KeysSettings&) const = default;
 };
 
+/// [operator] — the operator's panel (issue 12): how it is opened, its PIN and where its records go.
+/// Paths left empty are beside the settings file: `<settings>.state` and `<settings>.audit.log`.
+struct OperatorSettings {
+  std::string open_chord = "CTRL+ALT+O";  ///< key open_chord, the key chord that asks for the PIN: modifiers (CTRL, ALT, SHIFT, SUPER; at least one of CTRL, ALT, SUPER) and one key, joined by '+'
+  double idle_close_s = 60.0;             ///< key idle_close_s, the panel closes itself after this long without input, [10, 3600] s
+  std::string pin_hash;                   ///< key pin_hash, argon2id hash of the PIN (libsodium crypto_pwhash_str), written by `haptic-kiosk pin set`; empty = no PIN, the panel stays shut
+  std::string state_file;                 ///< key state_file, failed PIN attempts and the time of the last (the lockout), survives restarts; empty = `<settings>.state`
+  std::string audit_log;                  ///< key audit_log, one line per change made in the panel; empty = `<settings>.audit.log`
+
+  /// Field-by-field equality; used by round-trip checks.
+  bool operator==(const OperatorSettings&) const = default;
+};
+
 /// All settings. Default-constructed = the shipped defaults.
 struct Settings {
   HapticsSettings haptics;
@@ -152,6 +165,7 @@ struct Settings {
   KioskSettings kiosk;
   StickSettings stick;
   KeysSettings keys;
+  OperatorSettings operator_;  ///< TOML table [operator] (`operator` is a C++ keyword)
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const Settings&) const = default;
