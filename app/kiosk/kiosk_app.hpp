@@ -4,7 +4,13 @@
 /// on the primary monitor, or `--windowed`), the servo thread driving the simulated pantograph from the
 /// mouse (the model hand pulls the handle towards the cursor), the audio side, and the visitor's flow
 /// (kiosk_flow.hpp) on the keyboard. USB sticks are watched, mounted read-only and scanned, and their
-/// documents built, on worker threads (stick_service.hpp).
+/// documents built, on worker threads (stick_service.hpp). The operator's panel (operator_panel.hpp) opens
+/// with the [operator] open_chord and the PIN.
+///
+/// The pieces, each in a file of its own (issue 12, item 7): window.hpp (GLFW, GL context, Dear ImGui, the
+/// input queue), view.hpp (the scene drawn), hud.hpp (captions, overlay status), operator_panel.hpp and
+/// app/src/operator_session.hpp (the panel and its logic), script.hpp (scripted input), keymap.hpp (key
+/// names), app/src/kiosk_runtime.hpp (everything but the window); this file's run_kiosk puts them together.
 ///
 /// View mapping (tests rely on it): workspace metres → window pixels with one uniform scale
 /// s = 0.9 · min(W / width_m, 0.8 · H / height_m) [px/m], y up, the bottom 14 % left to the captions:
@@ -24,16 +30,16 @@ struct KioskOptions {
   bool overlay = false;         ///< start with the operator overlay
   std::string screenshot;       ///< write the last frame here as PNG and quit
   int frames = 0;               ///< frames to run before the screenshot (at 60 Hz)
-  std::string script;           ///< scripted input: lines "FRAME key NAME", "FRAME cursor X_M Y_M", "FRAME move",
-                                ///< "FRAME stick DIR" (a folder inserted as a USB stick), "FRAME unstick" (taken out),
-                                ///< "FRAME wait_loaded" (hold the frame count until stick work is done)
+  std::string script;           ///< scripted input (script.hpp): key, press, type, click, cursor, move, stick, unstick, wait
   std::string stick;            ///< a folder treated as a USB stick inserted at start (documentation, tests)
   bool hotplug = true;          ///< watch for USB sticks (libudev); off: only --stick and scripted sticks
   std::string mount_root;       ///< where sticks are mounted; empty: /run/haptic-kiosk/usb
 };
 
 /// Runs the kiosk until the window closes (or, with a screenshot, for `frames` frames). Returns the exit
-/// status. @throws on bad input (one line naming it): settings, library, script, screenshot path, no display.
+/// status. A settings file that does not load is kept aside and the kiosk runs on its .bak or the defaults
+/// (config/store.hpp). @throws on bad input (one line naming it): a missing settings file, library, script,
+/// screenshot path, no display.
 int run_kiosk(const KioskOptions& options);
 
 }  // namespace hk::app

@@ -226,6 +226,8 @@ std::string format_bound(const FieldDescriptor& d, double b) {
 
 std::span<const FieldDescriptor> field_descriptors() noexcept { return kFields; }
 
+std::string allowed_text(const FieldDescriptor& d) { return detail::allowed_text(d); }
+
 std::string_view group_name(FieldGroup g) noexcept {
   switch (g) {
     case FieldGroup::haptics: return "Haptics";

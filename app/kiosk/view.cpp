@@ -1,0 +1,168 @@
+#include "view.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+namespace hk::app {
+
+View make_view(int w, int h, Vec2 half) { return {w, h, 0.9 * std::min(w / (2 * half.x), 0.8 * h / (2 * half.y))}; }
+
+PictureTexture::PictureTexture() { glGenTextures(1, &tex_); }
+PictureTexture::~PictureTexture() { glDeleteTextures(1, &tex_); }
+
+void PictureTexture::update(const Shown& shown) {
+  if (shown.scene == for_) return;
+  for_ = shown.scene;
+  valid_ = !shown.picture.empty();
+  if (!valid_) return;
+  cv::Mat rgb;
+  cv::cvtColor(shown.picture, rgb, cv::COLOR_BGR2RGB);
+  w_ = rgb.cols;
+  h_ = rgb.rows;
+  glBindTexture(GL_TEXTURE_2D, tex_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE, rgb.data);
+}
+
+namespace {
+
+void disc(const View& v, Vec2 c, double r_px, bool filled) {
+  glBegin(filled ? GL_TRIANGLE_FAN : GL_LINE_LOOP);
+  for (int k = 0; k < 24; ++k) {
+    const double a = 2 * M_PI * k / 24;
+    glVertex2d(v.px(c.x) + r_px * std::cos(a), v.py(c.y) + r_px * std::sin(a));
+  }
+  glEnd();
+}
+
+}  // namespace
+
+void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
+  glViewport(0, 0, v.w, v.h);
+  glClearColor(0.05f, 0.05f, 0.08f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  glMatrixMode(GL_PROJECTION);
+  glLoadIdentity();
+  glOrtho(0, v.w, v.h, 0, -1, 1);  // pixels, y down
+  glMatrixMode(GL_MODELVIEW);
+  glLoadIdentity();
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  const Shown& sh = app.shown();
+  const bool hc = app.high_contrast();
+  // The picture, in the workspace where its pixels map.
+  if (tex.valid()) {
+    const vision::PxToM& m = sh.px_to_m;
+    const double x0 = m.x_m(-0.5), x1 = m.x_m(tex.width() - 0.5), y0 = m.y_m(-0.5), y1 = m.y_m(tex.height() - 0.5);
+    glEnable(GL_TEXTURE_2D);
+    glBindTexture(GL_TEXTURE_2D, tex.id());
+    const float dim = hc ? 0.25f : 0.8f;
+    glColor4f(dim, dim, dim, 1.0f);
+    glBegin(GL_QUADS);
+    glTexCoord2f(0, 0); glVertex2d(v.px(x0), v.py(y0));
+    glTexCoord2f(1, 0); glVertex2d(v.px(x1), v.py(y0));
+    glTexCoord2f(1, 1); glVertex2d(v.px(x1), v.py(y1));
+    glTexCoord2f(0, 1); glVertex2d(v.px(x0), v.py(y1));
+    glEnd();
+    glDisable(GL_TEXTURE_2D);
+  }
+  // The usable rectangle's frame.
+  glColor4f(0.4f, 0.4f, 0.45f, 1.0f);
+  glLineWidth(1.0f);
+  glBegin(GL_LINE_LOOP);
+  glVertex2d(v.px(-app.half().x), v.py(-app.half().y));
+  glVertex2d(v.px(app.half().x), v.py(-app.half().y));
+  glVertex2d(v.px(app.half().x), v.py(app.half().y));
+  glVertex2d(v.px(-app.half().x), v.py(app.half().y));
+  glEnd();
+  // Text blocks of a document page (spoken, not felt): pale blue frames, for a companion who sees.
+  glColor4f(0.45f, 0.7f, 1.0f, hc ? 1.0f : 0.8f);
+  glLineWidth(hc ? 3.0f : 1.5f);
+  for (const TextBlockM& b : sh.text_blocks) {
+    glBegin(GL_LINE_LOOP);
+    glVertex2d(v.px(b.lo_m.x), v.py(b.lo_m.y));
+    glVertex2d(v.px(b.hi_m.x), v.py(b.lo_m.y));
+    glVertex2d(v.px(b.hi_m.x), v.py(b.hi_m.y));
+    glVertex2d(v.px(b.lo_m.x), v.py(b.hi_m.y));
+    glEnd();
+  }
+  // The curves at the level in use: bright yellow (RGB 255, 220, 0), thicker in high contrast.
+  glColor4f(1.0f, 220.0f / 255.0f, 0.0f, 1.0f);
+  glLineWidth(hc ? 6.0f : 3.0f);
+  for (std::size_t c = 0; c < sh.levels.size(); ++c) {
+    const int l = std::min<int>(app.level(), static_cast<int>(sh.levels[c].size()) - 1);
+    glBegin(sh.closed[c] ? GL_LINE_LOOP : GL_LINE_STRIP);
+    for (const Vec2& p : sh.levels[c][static_cast<std::size_t>(l)]) glVertex2d(v.px(p.x), v.py(p.y));
+    glEnd();
+  }
+  // Error boxes of the level in use (operator overlay).
+  if (app.overlay() && sh.scene) {
+    const Scene& sc = *sh.scene;
+    glColor4f(0.2f, 0.9f, 1.0f, 0.5f);
+    glLineWidth(1.0f);
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      const int l = sc.clamp_level(c, app.level());
+      const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
+      for (std::uint32_t k = 0; k < segs; ++k) {
+        const ErrorBox& b = sc.box(sc.node_of({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)}));
+        const Vec2 n = left_perp(b.axis);
+        glBegin(GL_LINE_LOOP);
+        for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
+          const Vec2 q = b.origin_m + u * b.axis + w * n;
+          glVertex2d(v.px(q.x), v.py(q.y));
+        }
+        glEnd();
+      }
+    }
+  }
+  const ServoDisplayState& d = app.core().display();
+  // The boundary section the servo thread keeps (operator overlay): magenta, segment boxes or node rectangles.
+  if (app.overlay() && sh.scene && d.scene_id == app.shown_id()) {
+    const Scene& sc = *sh.scene;
+    glColor4f(1.0f, 0.3f, 1.0f, 0.8f);
+    glLineWidth(1.5f);
+    const int n = std::min(d.section_count, ServoDisplayState::kMaxSection);
+    for (int i = 0; i < n; ++i) {
+      const std::uint32_t node = d.section[i];
+      if (node >= sc.node_count()) continue;
+      glBegin(GL_LINE_LOOP);
+      if (sc.is_segment(node)) {
+        const ErrorBox& b = sc.box(node);
+        const Vec2 nrm = left_perp(b.axis);
+        for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
+          const Vec2 q = b.origin_m + u * b.axis + w * nrm;
+          glVertex2d(v.px(q.x), v.py(q.y));
+        }
+      } else {
+        const Aabb& a = sc.aabb(node);
+        glVertex2d(v.px(a.lo.x), v.py(a.lo.y));
+        glVertex2d(v.px(a.hi.x), v.py(a.lo.y));
+        glVertex2d(v.px(a.hi.x), v.py(a.hi.y));
+        glVertex2d(v.px(a.lo.x), v.py(a.hi.y));
+      }
+      glEnd();
+    }
+  }
+  // Handle (red ring), proxy (white disc, on the curve in contact: seed §4), force arrow from the handle.
+  glLineWidth(2.0f);
+  glColor4f(1.0f, 0.3f, 0.3f, 1.0f);
+  disc(v, d.handle_m, 9, false);
+  glColor4f(1.0f, 1.0f, 1.0f, 1.0f);
+  disc(v, d.proxy_m, 6, true);
+  const double f = length(d.force_n);
+  if (f > 0.05) {
+    const Vec2 tip = d.handle_m + 0.006 * d.force_n;  // 6 mm per newton
+    glColor4f(0.3f, 1.0f, 0.4f, 1.0f);
+    glBegin(GL_LINES);
+    glVertex2d(v.px(d.handle_m.x), v.py(d.handle_m.y));
+    glVertex2d(v.px(tip.x), v.py(tip.y));
+    glEnd();
+    disc(v, tip, 3, true);
+  }
+}
+
+
+}  // namespace hk::app

@@ -1,0 +1,309 @@
+#include "kiosk_runtime.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+#include "audio_settings.hpp"
+#include "config/load.hpp"
+#include "describe.hpp"
+#include "picture_library.hpp"
+#include "simulation.hpp"
+
+namespace hk::app {
+namespace {
+
+std::unique_ptr<vision::BlockEventSource> block_events(bool hotplug) {
+  if (!hotplug) return nullptr;
+  try {
+    return std::make_unique<vision::UdevBlockEventSource>();
+  } catch (const std::exception& e) {
+    spdlog::warn("usb sticks: no hot-plug ({}); the kiosk runs on without sticks", e.what());
+    return nullptr;
+  }
+}
+
+audio::AudioSystemParams audio_params(const config::Settings& s, bool open_output) {
+  audio::AudioSystemParams p = audio_params_from(s);
+  p.open_output = open_output;
+  return p;
+}
+
+}  // namespace
+
+KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
+    : opt_(o), s_(s), audio_(audio_params(s, o.open_audio_output)), half_{s.workspace.width_m / 2, s.workspace.height_m / 2},
+      sp_(servo_params_from(s)), device_(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2}),
+      core_(device_, cue_params(), &audio_.cues()),
+      sticks_(s, block_events(o.hotplug), o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
+  pictures_ = list_pictures(o.library);
+  device_.open();
+  hand_ = hand_params_from(s);
+  cursor_.back() = device_.true_position_m();
+  cursor_.publish();
+  level_ = s.haptics.level;
+  auto_level_ = s.haptics.level_mode == "auto";
+  high_contrast_ = o.high_contrast;
+  overlay_ = o.overlay;
+}
+
+KioskRuntime::~KioskRuntime() { stop_servo(); }
+
+void KioskRuntime::start_servo() {
+  ServoThreadParams tp;
+  tp.rate_hz = s_.haptics.servo_rate_hz;
+  servo_ = std::make_unique<ServoThread>(core_, tp, [this](double dt) {
+    // The simulated pantograph: the model hand pulls the handle towards the cursor.
+    const Vec2 target = cursor_.read();
+    device_.step(dt, model_hand_force(hand_, target, device_.true_position_m(), device_.velocity_m_per_s()));
+  });
+}
+
+void KioskRuntime::stop_servo() {
+  if (servo_) servo_->stop();
+}
+
+void KioskRuntime::say(const std::string& text) {
+  spdlog::info("say: {}", text);
+  last_said_ = text;
+  audio_.say_text(text);
+}
+
+void KioskRuntime::show_tutorial(TutorialShape shape) {
+  Shown sh;
+  sh.polylines = {tutorial_polyline(shape, half_)};
+  publish(std::move(sh), std::make_unique<Scene>(Scene::build({tutorial_polyline(shape, half_)}, s_.haptics.max_levels)),
+          -1 - static_cast<int>(shape));
+  shown_picture_ = -1;
+  shown_document_ = -1;
+  shown_page_ = 0;
+}
+
+int KioskRuntime::show_picture(int index) {
+  ImageScene is = build_image_scene(pictures_[static_cast<std::size_t>(index)], s_);
+  const int shapes = static_cast<int>(is.scene->curve_count());
+  show_built(is, index);
+  shown_picture_ = index;
+  shown_document_ = -1;
+  shown_page_ = 0;
+  return shapes;
+}
+
+void KioskRuntime::show_built(ImageScene& is, int id) {
+  Shown sh;
+  sh.polylines = is.polylines;
+  sh.picture = is.picture.empty() ? cv::imread(is.image_path, cv::IMREAD_COLOR) : is.picture;
+  sh.px_to_m = is.px_to_m;
+  sh.text_blocks = is.text_blocks;
+  publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
+}
+
+std::string KioskRuntime::describe() {
+  if (shown_page_ > 0) {
+    // A document page: the block of text under the hand is read; elsewhere, what the page holds.
+    if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m)) {
+      return audio_.messages().text(audio::MessageId::text_block, {{"text", b->text}});
+    }
+    const std::string page = describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
+    return shown_.polylines.empty() ? page : page + " " + describe_scene(shown_.polylines, half_);
+  }
+  return describe_scene(shown_.polylines, half_);
+}
+
+void KioskRuntime::show_document(int document, int page) { sticks_.load(stick_id_, document, page); }
+
+void KioskRuntime::forget_stick() {
+  sticks_.forget();
+  stick_id_ = 0;
+}
+
+void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
+  for (StickNews& n : sticks_.poll_news()) {
+    if (n.kind == StickNews::Kind::Inserted) {
+      stick_id_ = n.stick;
+      std::vector<StickEntry> entries;
+      for (const ListedDocument& d : n.documents) entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages});
+      stick_busy_ = !entries.empty();
+      flow.stick_inserted(entries, now_s);
+    } else if (n.kind == StickNews::Kind::Refused) {
+      stick_busy_ = false;
+      flow.stick_refused(n.reason, now_s);
+    } else {
+      stick_id_ = 0;
+      stick_busy_ = false;
+      rebuild_page_id_ = 0;
+      flow.stick_removed(now_s);
+    }
+  }
+  for (LoadedDocument& d : sticks_.poll_loaded()) {
+    if (d.stick != stick_id_) continue;  // a stick taken out or forgotten meanwhile
+    const int id = 1000 + d.document * 100000 + d.page;
+    if (rebuild_page_id_ == id && !flow.loading()) {
+      // The page shown, rebuilt with new settings (apply_settings): swapped in without a new announcement.
+      rebuild_page_id_ = 0;
+      if (d.scene) show_built(*d.scene, id);
+      stick_busy_ = false;
+      continue;
+    }
+    DocumentResult r;
+    r.document = d.document;
+    r.page = d.page;
+    if (d.scene) {
+      ImageScene& is = *d.scene;
+      r.ok = true;
+      r.description = is.page > 0 ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
+                                  : describe_shapes(static_cast<int>(is.scene->curve_count()));
+      show_built(is, id);
+      shown_page_ = is.page;
+      shown_document_ = d.document;
+      shown_picture_ = -1;
+    } else {
+      r.reason = d.reason;
+    }
+    stick_busy_ = false;
+    flow.document_ready(r, now_s);
+  }
+  if (flow.loading()) stick_busy_ = true;
+}
+
+void KioskRuntime::insert_stick_folder(const std::string& dir) {
+  stick_busy_ = true;
+  sticks_.insert_folder(dir);
+}
+
+void KioskRuntime::remove_stick_folder() {
+  stick_busy_ = true;  // until the news of the removal arrives
+  sticks_.remove_folder();
+}
+
+bool KioskRuntime::change_level(int delta) {
+  // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until the
+  // session ends.
+  const int next = level() + delta;
+  if (next < 0 || next > s_.haptics.max_levels) return false;
+  level_ = next;
+  auto_level_ = false;
+  core_.request_level(level_);
+  return true;
+}
+
+bool KioskRuntime::change_volume(int delta) { return delta > 0 ? audio_.volume_up() : audio_.volume_down(); }
+
+void KioskRuntime::new_session() {
+  if (servo_) {  // the servo thread's timing, once per visitor's session
+    const ServoTimingStats t = servo_->take_stats();
+    spdlog::info("session: servo {} ticks, {} missed deadlines, lateness p50 {:.0f} p99 {:.0f} max {:.0f} us, tick work p99 {:.0f} us",
+                 t.ticks, t.missed_deadlines, t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us, t.compute_p99_us);
+  }
+  audio_.new_session();
+  level_ = s_.haptics.level;
+  auto_level_ = s_.haptics.level_mode == "auto";
+  core_.request_level(auto_level_ ? ServoCore::kAutoLevel : level_);
+  high_contrast_ = opt_.high_contrast;
+}
+
+void KioskRuntime::set_cursor(Vec2 m) {
+  cursor_.back() = m;
+  cursor_.publish();
+}
+
+int KioskRuntime::find_picture(const std::string& path) const {
+  for (std::size_t i = 0; i < pictures_.size(); ++i) {
+    std::error_code ec;
+    if (std::filesystem::equivalent(pictures_[i], path, ec)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+CueTrackerParams KioskRuntime::cue_params() const {
+  CueTrackerParams p;
+  p.period_s = 1.0 / s_.haptics.servo_rate_hz;
+  p.workspace_half_extent_m = half_;
+  return p;
+}
+
+void KioskRuntime::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes) {
+  const Scene& sc = *scene;
+  sh.levels.resize(sc.curve_count());
+  sh.closed.resize(sc.curve_count());
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    sh.closed[c] = sc.curve(c).closed;
+    for (int l = 0; l < sc.curve(c).levels; ++l) {
+      const Vec2* p = sc.points(c, l);
+      sh.levels[c].emplace_back(p, p + sc.curve(c).point_count[l]);
+    }
+  }
+  ServoParams sp = sp_;
+  sp.level = auto_level_ ? s_.haptics.level : level_;  // auto: where the policy starts
+  sp.auto_level = auto_level_;
+  auto bundle = std::make_unique<SceneBundle>(std::move(scene), sp);
+  bundle->id = id;
+  bundle->text_blocks_m = std::move(text_boxes);
+  sh.scene = bundle->scene.get();
+  shown_ = std::move(sh);
+  shown_id_ = id;
+  core_.publish(std::move(bundle));
+}
+
+void KioskRuntime::rebuild_shown() {
+  if (shown_id_ <= -1 && shown_id_ >= -3) {
+    const int shape = -1 - shown_id_;
+    show_tutorial(static_cast<TutorialShape>(shape));
+  } else if (shown_picture_ >= 0) {
+    show_picture(shown_picture_);
+  } else if (shown_document_ >= 0 && stick_id_ != 0) {
+    rebuild_page_id_ = 1000 + shown_document_ * 100000 + shown_page_;
+    stick_busy_ = true;
+    sticks_.load(stick_id_, shown_document_, shown_page_);
+  }
+}
+
+ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow& flow) {
+  ApplyReport r;
+  const config::Settings before = s_;
+  bool rebuild = false;
+  for (const config::FieldDescriptor& d : config::field_descriptors()) {
+    const bool same = std::visit([&](const auto* a) {
+      using P = decltype(a);
+      return *a == *std::get<P>(d.cref(next));
+    }, d.cref(before));
+    if (same) continue;
+    const std::string key = std::string(d.table) + "." + std::string(d.key);
+    switch (d.apply) {
+      case config::ApplyWhen::live:
+        if (d.table == "haptics") r.gains = true;
+        if (d.table == "keys") r.keys = true;
+        if (d.table == "kiosk") r.timing = true;
+        break;
+      case config::ApplyWhen::scene: rebuild = true; break;
+      case config::ApplyWhen::session: r.next_session.push_back(key); break;
+      case config::ApplyWhen::restart: r.restart.push_back(key); break;
+    }
+  }
+  // What the next start needs stays as it was in the running kiosk (its threads, device and view were made
+  // with it); everything else is taken.
+  config::Settings in_use = next;
+  for (const config::FieldDescriptor& d : config::field_descriptors()) {
+    if (d.apply != config::ApplyWhen::restart) continue;
+    std::visit([&](auto* dst) {
+      using P = decltype(dst);
+      *dst = *std::get<std::add_pointer_t<std::add_const_t<std::remove_pointer_t<P>>>>(d.cref(before));
+    }, d.ref(in_use));
+  }
+  s_ = in_use;
+  sp_ = servo_params_from(s_);
+  if (r.gains) core_.set_gains(servo_gains_from(s_));
+  if (r.keys) flow.set_keys(s_.keys);
+  if (r.timing) flow.set_timing(s_.kiosk.timeout_s, s_.kiosk.warning_s);
+  if (rebuild) {
+    level_ = s_.haptics.level;
+    auto_level_ = s_.haptics.level_mode == "auto";
+    rebuild_shown();
+    r.scene_rebuilt = true;
+  }
+  return r;
+}
+
+}  // namespace hk::app

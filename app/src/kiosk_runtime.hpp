@@ -1,0 +1,165 @@
+#pragma once
+/// @file kiosk_runtime.hpp
+/// Everything the kiosk runs apart from its window (issue 5; split out of run_kiosk in issue 12, item 7):
+/// the simulated pantograph driven by the cursor through the model hand, the servo thread, the audio side,
+/// the USB stick service and what is shown (scene on the device, curves for the screen). It implements the
+/// visitor's flow's KioskEffects, and applies settings changed by the operator while it runs
+/// (apply_settings). No OpenGL here: the window layer (app/kiosk) draws what `shown()` holds, and tests
+/// drive the runtime headless.
+///
+/// Threads: construct, call and destroy on one thread (the window thread); the servo thread and the stick
+/// service's threads are owned here.
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "audio/system.hpp"
+#include "config/settings.hpp"
+#include "haptics/hand_path.hpp"
+#include "haptics/sim_pantograph.hpp"
+#include "haptics/triple_buffer.hpp"
+#include "image_scene.hpp"
+#include "kiosk_flow.hpp"
+#include "servo_core.hpp"
+#include "servo_thread.hpp"
+#include "stick_service.hpp"
+
+namespace hk::app {
+
+/// What the runtime is started with besides the settings.
+struct RuntimeOptions {
+  std::string library;           ///< picture folder (already resolved; must hold at least one picture)
+  bool hotplug = true;           ///< watch for USB sticks (libudev)
+  std::string mount_root;        ///< where sticks are mounted; empty: vision::kDefaultStickMountRoot
+  bool high_contrast = false;    ///< start (and every session) in high contrast
+  bool overlay = false;          ///< start with the operator overlay
+  bool open_audio_output = true; ///< false: no PortAudio (tests)
+};
+
+/// What is on the device and on the screen.
+struct Shown {
+  std::vector<Polyline> polylines;                     ///< level-0 source curves [m] (for Describe)
+  std::vector<std::vector<std::vector<Vec2>>> levels;  ///< [curve][level] → points [m]
+  std::vector<bool> closed;                            ///< [curve]
+  cv::Mat picture;                                     ///< BGR, empty for tutorial shapes
+  vision::PxToM px_to_m{1, 0, 0};                      ///< picture pixels → workspace metres
+  const Scene* scene = nullptr;                        ///< the published scene (read-only here; for the overlay)
+  std::vector<TextBlockM> text_blocks;                 ///< a document page's text (Describe reads the one under the hand)
+};
+
+/// What apply_settings did with a change, for the operator panel and the audit.
+struct ApplyReport {
+  bool gains = false;          ///< stiffness, damping, force, friction or deadline went to the servo thread
+  bool scene_rebuilt = false;  ///< the scene was rebuilt and swapped in with the fade
+  bool keys = false;           ///< the visitor's keys (and what the kiosk says of them) changed
+  bool timing = false;         ///< the session's time-out changed
+  std::vector<std::string> next_session;  ///< keys (table.key) that take effect with the next visitor
+  std::vector<std::string> restart;       ///< keys that take effect at the next start
+};
+
+/// The kiosk without its window. Not thread-safe: one thread.
+class KioskRuntime final : public KioskEffects {
+ public:
+  /// Opens the simulated pantograph, the audio side and the stick service. Call start_servo() next.
+  /// @throws std::runtime_error (one line) for an empty library; audio::MessageError for a bad catalogue.
+  KioskRuntime(const RuntimeOptions& options, const config::Settings& settings);
+  ~KioskRuntime() override;
+  KioskRuntime(const KioskRuntime&) = delete;
+  KioskRuntime& operator=(const KioskRuntime&) = delete;
+
+  /// Starts the servo thread at [haptics] servo_rate_hz. @throws std::invalid_argument for a bad rate.
+  void start_servo();
+  /// Stops it (idempotent).
+  void stop_servo();
+
+  // ---- KioskEffects (kiosk_flow.hpp) ----
+  void say(const std::string& text) override;
+  void show_tutorial(TutorialShape shape) override;
+  int show_picture(int index) override;
+  int picture_count() const override { return static_cast<int>(pictures_.size()); }
+  std::string describe() override;
+  void show_document(int document, int page) override;
+  void forget_stick() override;
+  bool change_level(int delta) override;
+  bool change_volume(int delta) override;
+  void new_session() override;
+
+  /// Window thread, every frame: news of sticks and finished loads, handed to the flow.
+  void poll_sticks(KioskFlow& flow, double now_s);
+  /// Whether stick work (scan or load) may still bring news (scripted runs wait for it).
+  bool stick_busy() const { return stick_busy_; }
+  /// A folder treated as an inserted USB stick / taken out again (documentation, tests).
+  void insert_stick_folder(const std::string& dir);
+  void remove_stick_folder();
+
+  /// The operator changed settings (issue 12, item 4). Compared with the settings in use, field by field
+  /// (config::FieldDescriptor::apply): servo gains go to the servo thread at once (no force step beyond
+  /// level_max_force_step_n per tick: ServoCore::set_gains); level and scene settings rebuild what is shown
+  /// here, off the servo thread, and it is swapped in with the fade; keys and the session's timing change
+  /// in `flow` at once; the rest is kept for the next visitor or the next start (listed in the report).
+  /// `settings` must be valid (config::validate). Returns what was done.
+  ApplyReport apply_settings(const config::Settings& settings, KioskFlow& flow);
+  /// The settings in use (the last applied).
+  const config::Settings& settings() const { return s_; }
+
+  /// The model hand's target [m] (the mouse or a script stands in for the visitor's hand).
+  void set_cursor(Vec2 m);
+  ServoCore& core() { return core_; }
+  audio::AudioSystem& audio() { return audio_; }
+  const Shown& shown() const { return shown_; }
+  /// SceneBundle id of what is shown (tutorial −1..−3, picture index, 1000 + stick page).
+  int shown_id() const { return shown_id_; }
+  /// Level in use (the servo thread's, which follows the hand's speed in auto mode).
+  int level() { return core_.display().level; }
+  /// Half the workspace's extent [m].
+  Vec2 half() const { return half_; }
+  bool& high_contrast() { return high_contrast_; }
+  bool& overlay() { return overlay_; }
+  /// Null before start_servo().
+  ServoThread* servo() { return servo_.get(); }
+  /// Index of `path` in the library, −1 when it is not there.
+  int find_picture(const std::string& path) const;
+  /// Puts `path` first in the library (documentation runs: --show of a picture from elsewhere).
+  void add_picture_first(const std::string& path) { pictures_.insert(pictures_.begin(), path); }
+  /// Frees scene bundles the servo thread has let go of (every frame).
+  void collect() { core_.collect_retired(); }
+  /// The last text said (the caption).
+  const std::string& last_said() const { return last_said_; }
+  /// The stick service, for the operator's status.
+  const StickService& sticks() const { return sticks_; }
+
+ private:
+  CueTrackerParams cue_params() const;
+  void show_built(ImageScene& is, int id);
+  void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
+  void rebuild_shown();
+
+  RuntimeOptions opt_;
+  config::Settings s_;
+  audio::AudioSystem audio_;
+  Vec2 half_;
+  ServoParams sp_;
+  SimulatedPantograph device_;
+  ModelHandParams hand_;
+  ServoCore core_;
+  TripleBuffer<Vec2> cursor_;
+  std::unique_ptr<ServoThread> servo_;
+  std::vector<std::string> pictures_;
+  Shown shown_;
+  int level_ = 1;           // the fixed level (auto_level_ false)
+  bool auto_level_ = true;  // levels from hand speed
+  bool high_contrast_ = false, overlay_ = false;
+  std::string last_said_;
+  int shown_id_ = -100;
+  int shown_picture_ = -1;  // library index shown, −1 for none
+  int shown_page_ = 0;      // a document page shown (from 1), 0 for a picture
+  int shown_document_ = -1; // stick document shown, −1 for none
+  int rebuild_page_id_ = 0; // a stick page re-requested by apply_settings (shown without a new announcement)
+  int stick_id_ = 0;        // the stick the flow browses (StickNews::stick), 0 for none
+  bool stick_busy_ = false;
+  StickService sticks_;     // last: its threads stop first
+};
+
+}  // namespace hk::app

@@ -1,0 +1,68 @@
+// The keys the settings name are the keys that work (issue 12, item 6): every name [keys] allows maps to
+// one GLFW key, different names to different keys, each action to its configured key, and the operator's
+// chord only with exactly its modifiers.
+#include <GLFW/glfw3.h>
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+
+#include "config/keys.hpp"
+#include "config/settings.hpp"
+#include "keymap.hpp"
+
+namespace hk::app {
+namespace {
+
+TEST(Keymap, EveryAllowedKeyNameIsAKeyAndNoTwoNamesShareOne) {
+  std::set<int> codes;
+  for (std::string_view name : config::visitor_key_names()) {
+    const int code = glfw_key(std::string(name));
+    EXPECT_NE(code, GLFW_KEY_UNKNOWN) << name;
+    EXPECT_TRUE(codes.insert(code).second) << name << " shares its key with another name";
+  }
+  // Independent spot checks against GLFW's own codes.
+  EXPECT_EQ(glfw_key("F1"), GLFW_KEY_F1);
+  EXPECT_EQ(glfw_key("F12"), GLFW_KEY_F12);
+  EXPECT_EQ(glfw_key("PAGE_UP"), GLFW_KEY_PAGE_UP);
+  EXPECT_EQ(glfw_key("KP_5"), GLFW_KEY_KP_5);
+  EXPECT_EQ(glfw_key("Z"), GLFW_KEY_Z);
+  EXPECT_EQ(glfw_key("O"), GLFW_KEY_O);
+  EXPECT_EQ(glfw_key("ESCAPE"), GLFW_KEY_ESCAPE);
+  EXPECT_EQ(glfw_key("F13"), GLFW_KEY_UNKNOWN);
+  EXPECT_EQ(glfw_key("up"), GLFW_KEY_UNKNOWN);
+}
+
+TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
+  // Every name on every action (the other actions moved off it), as the operator could set them.
+  const KioskKey actions[] = {KioskKey::Help,     KioskKey::Next,        KioskKey::Previous,
+                              KioskKey::Describe, KioskKey::Finer,       KioskKey::Coarser,
+                              KioskKey::VolumeUp, KioskKey::VolumeDown,  KioskKey::Tutorial};
+  for (int a = 0; a < 9; ++a) {
+    for (std::string_view name : config::visitor_key_names()) {
+      config::KeysSettings k;
+      std::string* slot[] = {&k.help, &k.next, &k.previous, &k.describe, &k.finer, &k.coarser, &k.volume_up, &k.volume_down, &k.tutorial};
+      for (int b = 0; b < 9; ++b)
+        if (b != a && *slot[b] == name) *slot[b] = *slot[a];  // swap: the set stays one key per action
+      *slot[a] = std::string(name);
+      const auto map = visitor_key_map(k);
+      ASSERT_EQ(map.size(), 9u) << name;
+      const auto it = map.find(glfw_key(std::string(name)));
+      ASSERT_NE(it, map.end()) << name;
+      EXPECT_EQ(it->second, actions[a]) << name;
+    }
+  }
+}
+
+TEST(Keymap, TheChordNeedsExactlyItsModifiers) {
+  const config::KeyChord c = *config::parse_chord("CTRL+ALT+O");
+  EXPECT_TRUE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT));
+  EXPECT_TRUE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_NUM_LOCK)) << "Num Lock is not a modifier";
+  EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, 0)) << "O alone is the overlay's key";
+  EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL));
+  EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SHIFT));
+  EXPECT_FALSE(chord_pressed(c, GLFW_KEY_P, GLFW_MOD_CONTROL | GLFW_MOD_ALT));
+}
+
+}  // namespace
+}  // namespace hk::app
