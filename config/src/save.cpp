@@ -1,5 +1,5 @@
 /// @file save.cpp
-/// Settings -> commented TOML text, and the atomic save (temp file, fsync, rename).
+/// Settings -> commented TOML text, and the atomic save (temp file, fsync, .bak, rename).
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <variant>
 #include <vector>
@@ -60,6 +61,68 @@ int write_all(int fd, const std::string& text) {
   return 0;
 }
 
+/// Creates `<prefix>XXXXXX` (a new, unique name) holding `text` with `mode`, fsync'ed and closed, and
+/// returns its path. On failure removes it and throws ConfigError ("not saved: ...").
+std::string write_temp(const Source& src, const std::string& prefix, const std::string& text, mode_t mode) {
+  std::vector<char> tmpl(prefix.begin(), prefix.end());
+  for (char c : std::string_view("XXXXXX")) tmpl.push_back(c);
+  tmpl.push_back('\0');
+  const int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);
+  if (fd < 0) {
+    const std::string dir = std::filesystem::path(prefix).parent_path().string();
+    io_fail(src, "cannot create a temporary file in '" + one_line(dir) + "'", errno);
+  }
+  const std::string tmp(tmpl.data());
+  const auto abandon = [&](const std::string& what, int err) {
+    ::unlink(tmp.c_str());
+    io_fail(src, what, err);
+  };
+  if (int err = write_all(fd, text)) {
+    ::close(fd);
+    abandon("cannot write '" + one_line(tmp) + "'", err);
+  }
+  if (::fchmod(fd, mode) != 0) {
+    const int err = errno;
+    ::close(fd);
+    abandon("cannot set the mode of '" + one_line(tmp) + "'", err);
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    abandon("cannot flush '" + one_line(tmp) + "' to disk", err);
+  }
+  if (::close(fd) != 0) abandon("cannot close '" + one_line(tmp) + "'", errno);
+  return tmp;
+}
+
+/// Reads the whole file at `path` into `text` and its permission bits into `mode`; returns 0 or an errno value.
+int read_whole(const std::string& path, std::string& text, mode_t& mode) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return errno;
+  struct stat st{};
+  if (::fstat(fd, &st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return err;
+  }
+  mode = st.st_mode & 07777;
+  text.clear();
+  char buf[8192];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      return err;
+    }
+    if (n == 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  return 0;
+}
+
 }  // namespace
 
 std::string to_toml(const Settings& settings) {
@@ -97,7 +160,7 @@ std::string to_toml(const Settings& settings) {
   return out;
 }
 
-void save_settings_atomic(const Settings& settings, const std::string& path) {
+void save_settings_atomic(const Settings& settings, const std::string& path, const SaveOptions& options) {
   const Source src{path, true};
   try {
     detail::validate_as(settings, src);
@@ -115,36 +178,69 @@ void save_settings_atomic(const Settings& settings, const std::string& path) {
   // Keep the mode of an existing file; a new file gets 0644. A file holding the PIN's hash is 0600.
   mode_t mode = 0644;
   struct stat st{};
-  if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) mode = st.st_mode & 07777;
+  const bool replaces_a_file = ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+  if (replaces_a_file) mode = st.st_mode & 07777;
   if (!settings.operator_.pin_hash.empty()) mode = 0600;
 
-  std::string tmp = (dir / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
-  std::vector<char> tmpl(tmp.begin(), tmp.end());
-  tmpl.push_back('\0');
-  const int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);
-  if (fd < 0) io_fail(src, "cannot create a temporary file in '" + one_line(dir.string()) + "'", errno);
-  tmp.assign(tmpl.data());
-
-  const auto abandon = [&](const std::string& what, int err) {
-    ::unlink(tmp.c_str());
-    io_fail(src, what, err);
+  // Every temporary name is ".<name>.tmp.*" beside the target, so one pattern finds what a crash left.
+  const std::string temp_prefix = (dir / ("." + target.filename().string() + ".tmp.")).string();
+  const std::string tmp = write_temp(src, temp_prefix, text, mode);
+  bool tmp_renamed = false;  // after the commit point `tmp` no longer names our file
+  const auto reached = [&](SaveStage stage) {
+    if (!options.hook) return;
+    try {
+      options.hook(stage);
+    } catch (...) {
+      if (!tmp_renamed) ::unlink(tmp.c_str());
+      throw;
+    }
   };
-  if (int err = write_all(fd, text)) {
-    ::close(fd);
-    abandon("cannot write '" + one_line(tmp) + "'", err);
+  reached(SaveStage::temp_written);
+
+  if (replaces_a_file && options.keep_backup) {
+    const std::string bak = path + ".bak";
+    const std::string what = "cannot keep the old file as '" + one_line(bak) + "'";
+    // A second name for the old file, then renamed over .bak: .bak is always a complete file.
+    std::string bak_tmp = tmp + ".bak";
+    if (::linkat(AT_FDCWD, path.c_str(), AT_FDCWD, bak_tmp.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+      const int err = errno;
+      bak_tmp.clear();
+      // No hard links here (vfat: EPERM), or the target is a symbolic link to another file system:
+      // a copy does the same job.
+      if (err == EPERM || err == EOPNOTSUPP || err == EXDEV || err == EMLINK) {
+        std::string old_text;
+        mode_t old_mode = 0600;
+        if (int rerr = read_whole(path, old_text, old_mode)) {
+          ::unlink(tmp.c_str());
+          io_fail(src, what + " (copying it)", rerr);
+        }
+        try {
+          bak_tmp = write_temp(src, temp_prefix, old_text, old_mode);
+        } catch (...) {
+          ::unlink(tmp.c_str());
+          throw;
+        }
+      } else {
+        ::unlink(tmp.c_str());
+        io_fail(src, what, err);
+      }
+    }
+    if (::rename(bak_tmp.c_str(), bak.c_str()) != 0) {
+      const int err = errno;
+      ::unlink(bak_tmp.c_str());
+      ::unlink(tmp.c_str());
+      io_fail(src, what, err);
+    }
   }
-  if (::fchmod(fd, mode) != 0) {
+  reached(SaveStage::backup_kept);
+
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
     const int err = errno;
-    ::close(fd);
-    abandon("cannot set the mode of '" + one_line(tmp) + "'", err);
+    ::unlink(tmp.c_str());
+    io_fail(src, "cannot rename the temporary file over it", err);
   }
-  if (::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    abandon("cannot flush '" + one_line(tmp) + "' to disk", err);
-  }
-  if (::close(fd) != 0) abandon("cannot close '" + one_line(tmp) + "'", errno);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) abandon("cannot rename the temporary file over it", errno);
+  tmp_renamed = true;
+  reached(SaveStage::renamed);
 
   // The rename is the commit point. Flushing the directory makes it durable; some file systems
   // refuse fsync on a directory, so this is best effort and never reported as a failure.

@@ -54,7 +54,8 @@ TEST(ConfigSave, OverwritesAnExistingFileAndKeepsItsMode) {
   save_settings_atomic(s, path.string());
   EXPECT_EQ(load_settings(path.string()), s);
   EXPECT_EQ(fs::status(path).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write);
-  EXPECT_EQ(list_dir(dir.path()), std::vector<std::string>{"settings.toml"});
+  // The replaced file is kept as .bak (test_store.cpp); no temporary file is left.
+  EXPECT_EQ(list_dir(dir.path()), (std::vector<std::string>{"settings.toml", "settings.toml.bak"}));
 }
 
 TEST(ConfigSave, RelativePathInTheCurrentDirectory) {

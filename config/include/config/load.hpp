@@ -12,6 +12,7 @@
 /// field_descriptors(), which load, validate and to_toml share.
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -131,13 +132,41 @@ void validate(const Settings& settings);
 /// parse_settings(to_toml(s)) == s for every valid s. Does not validate.
 [[nodiscard]] std::string to_toml(const Settings& settings);
 
-/// validate()s `settings`, then writes to_toml(settings) to `path` atomically: the text goes to a
-/// new temporary file in the same directory, which is fsync'ed and renamed over `path`; the
-/// directory is then fsync'ed (best effort). A new file gets mode 0644, an existing file keeps its
-/// mode, and a file with a PIN hash ([operator] pin_hash) is always 0600. Not safe against concurrent writers of the same path.
-/// @throws ConfigError if validation fails or any step before the rename fails (missing or
-///   read-only directory, disk full, ...); the existing file at `path` is then untouched and the
-///   temporary file removed.
-void save_settings_atomic(const Settings& settings, const std::string& path);
+/// Points of save_settings_atomic() at which a test may inject a fault through SaveOptions::hook
+/// (the hook may throw, or _exit to simulate a crash). Every save passes all three, in this order.
+enum class SaveStage {
+  temp_written,  ///< the new text is in a temporary file beside `path`, fsync'ed; nothing renamed yet
+  backup_kept,   ///< the file being replaced is now also `<path>.bak` (when there was one and
+                 ///< SaveOptions::keep_backup); `path` itself is still the old file
+  renamed,       ///< the temporary file has been renamed over `path`; the directory is not yet fsync'ed
+};
+
+/// Options of save_settings_atomic().
+struct SaveOptions {
+  bool keep_backup = true;              ///< keep the file being replaced as `<path>.bak`
+  std::function<void(SaveStage)> hook;  ///< fault injection for tests; empty in production
+};
+
+/// validate()s `settings`, then writes to_toml(settings) to `path` atomically, keeping the file it
+/// replaces as `<path>.bak`:
+///  1. the text goes to a new temporary file in the same directory (`.<name>.tmp.XXXXXX`), which is
+///     fsync'ed; hook(temp_written);
+///  2. when `path` is an existing regular file and options.keep_backup: it is hard-linked to a temporary
+///     name, which is renamed over `<path>.bak` (so `.bak` is at every instant a complete file: the
+///     previous backup or the file being replaced); where the file system has no hard links it is
+///     copied (written, fsync'ed, renamed) instead; hook(backup_kept);
+///  3. the temporary file is renamed over `path` (the commit point); hook(renamed);
+///  4. the directory is fsync'ed (best effort).
+/// A crash at any point leaves `path` either the old or the new complete file, and `<path>.bak`
+/// either the previous backup or the old file (a crash may leave a `.<name>.tmp.*` file behind).
+/// A new file gets mode 0644, an existing file keeps its mode, and a file with a PIN hash
+/// ([operator] pin_hash) is always 0600; `.bak` is the old file itself, with its mode. Not safe against
+/// concurrent writers of the same path. A two-argument call keeps a backup.
+/// @throws ConfigError if validation fails or any step before the rename over `path` fails (missing or
+///   read-only directory, disk full, `<path>.bak` can't be replaced, ...); `path` is then untouched
+///   (`.bak` may already hold the old file) and the temporary files are removed.
+/// If the hook throws, the temporary files are removed where they still exist and the exception
+/// propagates unchanged.
+void save_settings_atomic(const Settings& settings, const std::string& path, const SaveOptions& options = {});
 
 }  // namespace hk::config
