@@ -177,7 +177,7 @@ void OperatorPanel::draw_fields(config::FieldGroup group, std::int64_t now_unix_
     } else if (d.kind == config::FieldKind::text && d.check) {
       ImGui::TextWrapped("text");
     } else {
-      ImGui::TextWrapped("%s", config::allowed_text(d).c_str());
+      ImGui::TextWrapped("%s", config::field_allowed_text(d).c_str());
     }
     ImGui::TableNextColumn();
     ImGui::TextUnformatted(apply_text(d.apply));

@@ -129,7 +129,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(haptics, level_blur_time_s, FieldGroup::levels, ApplyWhen::scene, 0, 0.1, "s", "The tolerable deviation grows by the hand's speed times this."),
     HK_FIELD(haptics, level_hysteresis, FieldGroup::levels, ApplyWhen::scene, 0, 0.9, "", "Go coarser only when that level's error is this fraction below the tolerance."),
     HK_FIELD(haptics, level_min_dwell_s, FieldGroup::levels, ApplyWhen::scene, 0, 5, "s", "Least time between two level changes."),
-    HK_FIELD(haptics, level_max_force_step_n, FieldGroup::haptics, ApplyWhen::live, 0.001, 5, "N", "Largest force change per tick that a level change may cause."),
+    HK_FIELD(haptics, level_max_force_step_n, FieldGroup::haptics, ApplyWhen::live, 0.001, 5, "N", "Largest force change per tick that a level change or a live change of stiffness, damping, force or friction may cause."),
     HK_FIELD(haptics, static_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "", "Coulomb static friction of the walls; >= dynamic_friction."),
     HK_FIELD(haptics, dynamic_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "", "Coulomb dynamic friction of the walls; both 0 = frictionless."),
     HK_FIELD(haptics, max_levels, FieldGroup::levels, ApplyWhen::scene, 1, 12, "", "Number of levels built above level 0."),
@@ -226,7 +226,7 @@ std::string format_bound(const FieldDescriptor& d, double b) {
 
 std::span<const FieldDescriptor> field_descriptors() noexcept { return kFields; }
 
-std::string allowed_text(const FieldDescriptor& d) { return detail::allowed_text(d); }
+std::string field_allowed_text(const FieldDescriptor& d) { return detail::allowed_text(d); }
 
 std::string_view group_name(FieldGroup g) noexcept {
   switch (g) {

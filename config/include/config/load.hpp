@@ -100,7 +100,7 @@ struct FieldDescriptor {
 [[nodiscard]] const FieldDescriptor* find_field(std::string_view table, std::string_view key) noexcept;
 
 /// What `d` allows, as the loader's messages say it: "[10, 5000] N/m", "one of \"auto\", \"fixed\"", "text".
-[[nodiscard]] std::string allowed_text(const FieldDescriptor& d);
+[[nodiscard]] std::string field_allowed_text(const FieldDescriptor& d);
 
 /// Largest settings file load_settings() reads, in bytes (1 MiB).
 inline constexpr std::uintmax_t kMaxConfigFileBytes = 1u << 20;

@@ -21,7 +21,7 @@ struct HapticsSettings {
   double level_blur_time_s = 0.010;       ///< key level_blur_time_s, tolerable deviation grows by hand speed x this, [0, 0.1] s
   double level_hysteresis = 0.3;          ///< key level_hysteresis, go coarser only when the bound is this fraction under the tolerance, [0, 0.9]
   double level_min_dwell_s = 0.15;        ///< key level_min_dwell_s, least time between two level changes, [0, 5] s
-  double level_max_force_step_n = 0.05;   ///< key level_max_force_step_n, largest force change per tick a level change may cause, [0.001, 5] N
+  double level_max_force_step_n = 0.05;   ///< key level_max_force_step_n, largest force change per tick a level change or a live gains change (operator panel) may cause, [0.001, 5] N
   double static_friction = 0.4;           ///< key static_friction, Coulomb static coefficient of the walls, [0, 2]; >= dynamic_friction
   double dynamic_friction = 0.3;          ///< key dynamic_friction, Coulomb dynamic coefficient, [0, 2]; 0 and 0 = frictionless
   int max_levels = 6;                     ///< key max_levels, levels built above level 0, [1, 12]
