@@ -28,11 +28,22 @@ int ServoCore::collect_retired() {
   return n;
 }
 
+void ServoCore::set_gains(const ServoGains& g) noexcept {
+  GainsSlot& slot = gains_in_.back();
+  slot.gains = g;
+  slot.seq = ++gains_written_;
+  gains_in_.publish();
+}
+
 TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
   ServoInput in;
   in.sample = device_.read();
   in.now_ns = now_ns;
   in.deadline_missed = deadline_missed;
+
+  // New gains (set_gains): kept for every picture taken from now on, applied below to the one in use.
+  const GainsSlot& g = gains_in_.read();
+  if (g.seq != gains_.seq) gains_ = g;
 
   // Hand back a bundle that found no room in the ring last time.
   if (to_retire_ && retired_.try_push(to_retire_)) to_retire_ = nullptr;
@@ -51,6 +62,7 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
       fading_ = false;
       if (current_ && !retired_.try_push(current_)) to_retire_ = current_;
       current_ = next;
+      if (gains_.seq != 0) current_->loop.set_gains(gains_.gains);  // before start: no fade, the ramp brings it in
       current_->loop.start(in.sample.handle_m);
       tracker_.reset();
       tracker_.set_text_blocks(current_->text_blocks_m.data(), static_cast<int>(current_->text_blocks_m.size()));
@@ -60,6 +72,7 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
   const int want_level = requested_level_.exchange(-1, std::memory_order_relaxed);
   if (current_ && want_level == kAutoLevel) current_->loop.set_auto_level(true);
   if (current_ && want_level >= 0) current_->loop.set_level(want_level);
+  if (current_ && gains_.seq != 0) current_->loop.set_gains(gains_.gains);  // no-op unless they changed
 
   TickResult r = TickResult::Ok;
   if (current_) {
@@ -87,6 +100,9 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
   d.level = current_ ? current_->loop.level() : 0;
   d.auto_level = current_ && current_->loop.params().auto_level;
   d.scene_id = current_ ? current_->id : -1;
+  d.penetration_m = out_.contact.state == ContactState::Free ? 0.0 : length(in.sample.handle_m - out_.contact.proxy_m);
+  d.stiffness_n_per_m = current_ ? current_->loop.gains().stiffness_n_per_m : 0.0;
+  d.gains_transition = current_ && current_->loop.transition_active();
   d.section_count = 0;
   if (current_) {
     const auto& sec = current_->loop.solver().section().section();

@@ -12,6 +12,12 @@
 /// handle is (ServoLoop::start: outside every curve, forces ramped in from zero by the force guard), and
 /// passes the previous bundle back through a small ring, so it is freed outside the servo thread
 /// (collect_retired()). Every force step of a swap is thus at most max_force_n · period / ramp_s.
+///
+/// Live gains (issue 12, item 4): set_gains() hands stiffness, damping, max force and friction to the servo
+/// thread through a triple buffer (latest value wins, no lock, no allocation). The servo thread takes them
+/// at its next tick for the picture in use (ServoLoop::set_gains: the force moves to the new law at no more
+/// than max_force_step_n per tick) and gives them to every picture it takes afterwards, before starting it,
+/// so a bundle built with older ServoParams cannot bring the old gains back.
 
 #include <atomic>
 #include <cstdint>
@@ -52,6 +58,13 @@ struct ServoDisplayState {
   std::int64_t tick_compute_ns = 0;///< time of this tick's work [ns] (set by ServoThread)
   std::int64_t period_error_ns = 0;///< wake-up minus deadline of this tick [ns] (set by ServoThread)
   std::int64_t missed_deadlines = 0;
+  /// |handle − proxy| while in contact, else 0 [m] (the operator panel's live plot: force against it).
+  double penetration_m = 0.0;
+  /// Wall stiffness the picture in use renders with [N/m] (0 before the first picture); the new value
+  /// after a set_gains, from the tick that takes it. Fully in force once gains_transition is false.
+  double stiffness_n_per_m = 0.0;
+  /// A gains (or level) change is still fading in (ServoLoop::transition_active).
+  bool gains_transition = false;
   /// The boundary section (seed §3): the first kMaxSection node ids of the collision tree's frontier.
   static constexpr int kMaxSection = 256;
   std::int32_t section_count = 0;  ///< entries in the section (may exceed kMaxSection; only those are copied)
@@ -78,6 +91,12 @@ class ServoCore {
   /// kAutoLevel. Applied once, to the picture in use; a picture published later brings its own ServoParams.
   void request_level(int level) noexcept { requested_level_.store(level, std::memory_order_relaxed); }
 
+  /// Any thread but the servo's (one writer): new gains for the picture in use (from the next tick, faded
+  /// in as ServoLoop::set_gains describes) and for every picture taken afterwards (a bundle built before
+  /// the change does not bring the old gains back). Lock-free: a triple buffer; nothing is allocated on
+  /// either side.
+  void set_gains(const ServoGains& g) noexcept;
+
   /// Real-time: one tick. `now_ns` = steady time at its start (for the query deadline; 0 = none),
   /// `deadline_missed` zeroes the force (the force guard). Returns the tick's result.
   TickResult tick(std::int64_t now_ns, bool deadline_missed) noexcept;
@@ -101,6 +120,13 @@ class ServoCore {
   SceneBundle* current_ = nullptr;                     // owned by the servo thread while running
   SceneBundle* to_retire_ = nullptr;                   // waiting for room in retired_
   std::atomic<int> requested_level_{-1};
+  struct GainsSlot {
+    ServoGains gains;
+    std::uint64_t seq = 0;  // 0: set_gains never called (pictures keep their own ServoParams)
+  };
+  TripleBuffer<GainsSlot> gains_in_;                   // set_gains' thread → servo
+  std::uint64_t gains_written_ = 0;                    // writer's count of set_gains
+  GainsSlot gains_;                                    // servo thread: the gains last taken
   bool fading_ = false;                                // the old picture's force fades before a swap
   long fade_total_ = 0, fade_left_ = 0;                // [ticks]
   TripleBuffer<ServoDisplayState> display_;

@@ -14,6 +14,18 @@ std::int64_t steady_ns() {
 
 }  // namespace
 
+ServoGains servo_gains_from(const config::Settings& s) {
+  ServoGains g;
+  g.stiffness_n_per_m = s.haptics.stiffness_n_per_m;
+  g.damping_n_s_per_m = s.haptics.damping_n_s_per_m;
+  g.max_force_n = s.haptics.max_force_n;
+  g.static_friction = s.haptics.static_friction;
+  g.dynamic_friction = s.haptics.dynamic_friction;
+  g.max_force_step_n = s.haptics.level_max_force_step_n;
+  g.query_deadline_s = s.haptics.query_deadline_us * 1e-6;
+  return g;
+}
+
 ServoParams servo_params_from(const config::Settings& s) {
   ServoParams sp;
   sp.period_s = 1.0 / s.haptics.servo_rate_hz;
@@ -23,14 +35,7 @@ ServoParams servo_params_from(const config::Settings& s) {
   sp.policy.blur_time_s = s.haptics.level_blur_time_s;
   sp.policy.hysteresis = s.haptics.level_hysteresis;
   sp.policy.min_dwell_s = s.haptics.level_min_dwell_s;
-  sp.max_force_step_n = s.haptics.level_max_force_step_n;
-  sp.contact.static_friction = s.haptics.static_friction;
-  sp.contact.dynamic_friction = s.haptics.dynamic_friction;
-  sp.query_deadline_s = s.haptics.query_deadline_us * 1e-6;
-  sp.contact.stiffness_n_per_m = s.haptics.stiffness_n_per_m;
-  sp.contact.damping_n_s_per_m = s.haptics.damping_n_s_per_m;
-  sp.contact.max_force_n = s.haptics.max_force_n;
-  sp.guard.max_force_n = s.haptics.max_force_n;
+  apply_gains(sp, servo_gains_from(s));
   sp.guard.ramp_s = s.haptics.force_ramp_s;
   return sp;
 }

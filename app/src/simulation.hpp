@@ -25,7 +25,12 @@ struct TickRecord {
 /// Called after every tick with its record and the servo's full output (proxy path, events, stats).
 using TickObserver = std::function<void(const TickRecord&, const ServoOutput&)>;
 
-/// Servo parameters from the settings.
+/// The live-changeable servo gains from the settings ([haptics]: stiffness, damping, max force, friction,
+/// level_max_force_step_n, query deadline), as ServoCore::set_gains takes them at Apply.
+ServoGains servo_gains_from(const config::Settings& s);
+
+/// Servo parameters from the settings. Its gains part is servo_gains_from(s) (gains_of(servo_params_from(s))
+/// == servo_gains_from(s)).
 ServoParams servo_params_from(const config::Settings& s);
 
 /// Simulated pantograph parameters from the settings ([device] and the [workspace] rectangle).

@@ -44,14 +44,44 @@ LevelPolicyParams policy_params(const ServoParams& p) {
   return pp;
 }
 
+// `v` one fade step shorter: its length less `step` [N], or zero when that is (within rounding) all of it.
+Vec2 fade(Vec2 v, double step) {
+  const double r = length(v);
+  return r - step > 1e-12 ? ((r - step) / r) * v : Vec2{0.0, 0.0};
+}
+
 }  // namespace
+
+ServoGains gains_of(const ServoParams& p) noexcept {
+  ServoGains g;
+  g.stiffness_n_per_m = p.contact.stiffness_n_per_m;
+  g.damping_n_s_per_m = p.contact.damping_n_s_per_m;
+  g.max_force_n = p.contact.max_force_n;
+  g.static_friction = p.contact.static_friction;
+  g.dynamic_friction = p.contact.dynamic_friction;
+  g.max_force_step_n = p.max_force_step_n;
+  g.query_deadline_s = p.query_deadline_s;
+  return g;
+}
+
+void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
+  p.contact.stiffness_n_per_m = g.stiffness_n_per_m;
+  p.contact.damping_n_s_per_m = g.damping_n_s_per_m;
+  p.contact.max_force_n = g.max_force_n;
+  p.contact.static_friction = g.static_friction;
+  p.contact.dynamic_friction = g.dynamic_friction;
+  p.guard.max_force_n = g.max_force_n;
+  p.max_force_step_n = g.max_force_step_n;
+  p.query_deadline_s = g.query_deadline_s;
+}
 
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
       solver_(scene, params.contact),
       levels_(level_error_ladder(scene, level_error_m_)),
       policy_(policy_params(params), level_error_m_, levels_, params.level),
-      level_(params.level) {}
+      level_(params.level),
+      guard_max_force_n_(params.guard.max_force_n) {}
 
 void ServoLoop::start(Vec2 handle_m) {
   level_ = params_.auto_level ? policy_.level() : params_.level;
@@ -59,8 +89,21 @@ void ServoLoop::start(Vec2 handle_m) {
   last_handle_ = handle_m;
   velocity_ = {0.0, 0.0};
   force_residual_ = {0.0, 0.0};
+  guard_max_force_n_ = params_.guard.max_force_n;  // the start-up ramp brings the force in from zero
+  gains_changed_ = false;
   last_force_ = {0.0, 0.0};
   ticks_ = 0;
+}
+
+void ServoLoop::set_gains(const ServoGains& g) noexcept {
+  if (g == gains()) return;
+  apply_gains(params_, g);
+  solver_.set_params(params_.contact);
+  gains_changed_ = true;
+}
+
+bool ServoLoop::transition_active() const noexcept {
+  return force_residual_.x != 0.0 || force_residual_.y != 0.0 || guard_max_force_n_ != params_.guard.max_force_n;
 }
 
 void ServoLoop::set_auto_level(bool on) noexcept {
@@ -107,22 +150,29 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   solver_.update(ci, out.contact);
   if (out.contact.state == ContactState::Free) out.contact.level = level_;
 
-  // Force-step limit at level changes: the difference between the old level's force and the new one's
-  // fades out at max_force_step_n per tick instead of arriving at once.
+  // Force-step limit at level and gains changes: the difference between the last tick's force and the new
+  // level's (or gains') force fades out at max_force_step_n per tick instead of arriving at once. The tick
+  // of the change already takes the first step.
+  const double step = params_.max_force_step_n;
   Vec2 f = out.contact.force_n;
-  if (out.level_changed && ticks_ > 0) force_residual_ = last_force_ - f;  // this tick: the force of the last
-  const double r = length(force_residual_);
-  if (r > 0.0) {
+  if ((out.level_changed || gains_changed_) && ticks_ > 0) force_residual_ = last_force_ - f;
+  gains_changed_ = false;
+  if (force_residual_.x != 0.0 || force_residual_.y != 0.0) {
+    force_residual_ = fade(force_residual_, step);
     f = f + force_residual_;
-    force_residual_ = r > params_.max_force_step_n ? ((r - params_.max_force_step_n) / r) * force_residual_ : Vec2{0.0, 0.0};
   }
   if (!is_finite(f)) f = Vec2{0.0, 0.0};
   last_force_ = f;
+  // The guard's clamp walks to a new max force at the same rate.
+  const double clamp_gap = params_.guard.max_force_n - guard_max_force_n_;
+  guard_max_force_n_ = std::fabs(clamp_gap) - step > 1e-12 ? guard_max_force_n_ + std::copysign(step, clamp_gap) : params_.guard.max_force_n;
+  ForceGuard guard = params_.guard;
+  guard.max_force_n = guard_max_force_n_;
 
   const double since_start = static_cast<double>(ticks_) * dt;
   ++ticks_;
   TickResult why = TickResult::Ok;
-  out.force_n = params_.guard.apply(f, since_start, in.sample.status, in.deadline_missed, &why);
+  out.force_n = guard.apply(f, since_start, in.sample.status, in.deadline_missed, &why);
   out.handle_velocity_m_per_s = velocity_;
   out.result = why;
   return why;

@@ -9,6 +9,14 @@
 /// new level's polyline as of the old one; until then the old level stays (ServoOutput::level_wanted shows
 /// the wait). After the change the old level remains a wall until the proxy leaves it, and any difference
 /// between the force of the last tick and the new level's force fades out at max_force_step_n per tick.
+///
+/// Live gains (issue 12, item 4): stiffness, damping, maximum force and friction may change while a hand
+/// presses on a wall (ServoLoop::set_gains). The solver uses the new gains at once; the difference between
+/// the last tick's force and the new gains' force goes into the same fading residual as a level change, and
+/// the guard's clamp walks to the new maximum force at max_force_step_n per tick, so no change of gains
+/// (or of level, or both in one tick) moves the force by more than max_force_step_n per tick beyond what
+/// the hand's own motion does. A difference of D [N] is gone after ceil(D / max_force_step_n) ticks,
+/// counting the tick that takes the change.
 /// The tick is `update(input, output) -> TickResult`: a function of (state, sample, scene), with no
 /// allocation, lock, throw, I/O or logging. Status enums here; exceptions only at setup.
 
@@ -39,6 +47,19 @@ struct ForceGuard {
   Vec2 apply(Vec2 force_n, double since_start_s, DeviceStatus status, bool deadline_missed, TickResult* why) const;
 };
 
+/// The servo settings an operator may change while a visitor touches a wall (issue 12, item 4). Units in
+/// names. Values are assumed checked (config ranges): finite, max_force_step_n > 0, the rest ≥ 0.
+struct ServoGains {
+  double stiffness_n_per_m = 800.0;   ///< wall stiffness [N/m] (ContactParams::stiffness_n_per_m)
+  double damping_n_s_per_m = 0.0;     ///< damping along the contact normal [N·s/m]
+  double max_force_n = 4.0;           ///< force clamp of the solver and of the guard [N]
+  double static_friction = 0.0;       ///< μ_s (ContactParams::static_friction)
+  double dynamic_friction = 0.0;      ///< μ_d ≤ μ_s
+  double max_force_step_n = 0.05;     ///< the limit on force change per tick a gains change (or level change) may cause [N]
+  double query_deadline_s = 200e-6;   ///< anytime budget of one tick's collision work [s]; 0 = none
+  bool operator==(const ServoGains&) const = default;
+};
+
 /// Parameters of the servo loop.
 struct ServoParams {
   double period_s = 0.001;          ///< servo period = 1 / servo rate [s]
@@ -53,6 +74,11 @@ struct ServoParams {
   ContactParams contact;
   ForceGuard guard;
 };
+
+/// The gains part of `p` (max_force_n from the solver's clamp, p.contact.max_force_n).
+ServoGains gains_of(const ServoParams& p) noexcept;
+/// Writes `g` into `p` (max_force_n into both the solver's and the guard's clamp). Real-time safe.
+void apply_gains(ServoParams& p, const ServoGains& g) noexcept;
 
 /// Input of one tick.
 struct ServoInput {
@@ -90,6 +116,21 @@ class ServoLoop {
   }
   /// Turns automatic level selection from hand speed on or off (off: stays at the level in use). Real-time safe.
   void set_auto_level(bool on) noexcept;
+  /// Real-time safe. New gains from the next update on. The solver uses them at once; the difference
+  /// between the force the old gains gave at the last tick and what the new gains give fades at
+  /// max_force_step_n per tick (the residual mechanism shared with level changes: the tick that takes the
+  /// change already moves one step, so a difference of D [N] is gone after ceil(D / max_force_step_n)
+  /// ticks); the guard's clamp (max force) moves towards the new value by at most max_force_step_n per
+  /// tick, so lowering max force does not cut the force in one tick either. Gains equal to gains() change
+  /// nothing. Before the first update after start() there is no force to keep: the gains simply apply.
+  void set_gains(const ServoGains& g) noexcept;
+  /// The gains in use (the targets: the force may still be fading towards them, see transition_active).
+  /// Real-time safe.
+  ServoGains gains() const noexcept { return gains_of(params_); }
+  /// True while a gains or level change is still fading in (residual non-zero or the guard's clamp not
+  /// yet at the new max force). False again from the tick on which the new gains' force law holds exactly.
+  /// Real-time safe.
+  bool transition_active() const noexcept;
   /// Level in use (walls rendered) [0 = finest].
   int level() const noexcept { return level_; }
   std::int64_t ticks() const { return ticks_; }
@@ -103,7 +144,9 @@ class ServoLoop {
   int levels_ = 1;
   LevelPolicy policy_;
   int level_ = 0;              // level in use
-  Vec2 force_residual_;        // old level's force minus new level's, fading out at max_force_step_n per tick [N]
+  Vec2 force_residual_;        // old level's (or gains') force minus the new one's, fading out at max_force_step_n per tick [N]
+  double guard_max_force_n_ = 0.0;  // the guard's clamp in use, walking to params_.guard.max_force_n [N]
+  bool gains_changed_ = false; // set_gains since the last update: this tick's force difference goes to the residual
   Vec2 last_force_;            // force of the previous tick before the guard [N]
   Vec2 last_handle_;
   Vec2 velocity_;
