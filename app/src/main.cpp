@@ -1,5 +1,5 @@
-// haptic-kiosk: command line entry. Subcommands: explore (headless run, DESIGN.md contract), stick (what a USB stick offers) and speak
-// (a message or text rendered to WAV).
+// haptic-kiosk: command line entry. Subcommands: explore (headless run, DESIGN.md contract), stick (what a USB stick offers), pin
+// (set or check the operator's PIN) and speak (a message or text rendered to WAV).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -8,6 +8,7 @@
 #include "audio_settings.hpp"
 #include "explore.hpp"
 #include "kiosk_app.hpp"
+#include "pin_command.hpp"
 #include "stick_command.hpp"
 
 namespace {
@@ -61,6 +62,12 @@ int main(int argc, char** argv) {
   stick->add_option("--json", sto.json_path, "Write the listing to this file (default: standard output)");
   stick->add_option("--config", sto.config_path, "Settings file (TOML): [stick] limits");
   stick->add_option("--mount-root", sto.mount_root, "Where --device is mounted (default /run/haptic-kiosk/usb)");
+  hk::app::PinOptions po;
+  CLI::App* pin = cli.add_subcommand("pin", "Set or check the operator's PIN (read from standard input)");
+  pin->add_option("action", po.action, "set: a new PIN (4 to 12 digits); check: exit 0 right, 1 wrong, 2 locked, 3 no PIN or unusable settings")
+      ->required()
+      ->check(CLI::IsMember({"set", "check"}));
+  pin->add_option("--config", po.config_path, "Settings file (TOML) holding [operator] pin_hash")->required();
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -73,6 +80,8 @@ int main(int argc, char** argv) {
                   sum.curves, sum.edge_ticks, sum.vertex_ticks, sum.max_force_n, eo.out_dir.c_str());
     } else if (*stick) {
       return hk::app::run_stick(sto);
+    } else if (*pin) {
+      return hk::app::run_pin(po);
     } else if (!*explore && !*speak) {
       return hk::app::run_kiosk(ko);
     } else if (*speak) {
