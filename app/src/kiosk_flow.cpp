@@ -1,6 +1,7 @@
 #include "kiosk_flow.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace hk::app {
@@ -12,7 +13,20 @@ KioskFlow::KioskFlow(KioskEffects& effects, const audio::MessageCatalog& message
   p_.warning_s = std::min(p_.warning_s, 0.5 * p_.timeout_s);  // a warning must leave time to answer it
 }
 
-void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say(msg_.text(id, args)); }
+std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings& k) {
+  // In the order of kKeyPlaceholders: help, next, previous, describe, finer, coarser, volume_up, volume_down, tutorial.
+  return {{{audio::kKeyPlaceholders[0], k.help},      {audio::kKeyPlaceholders[1], k.next},
+           {audio::kKeyPlaceholders[2], k.previous},  {audio::kKeyPlaceholders[3], k.describe},
+           {audio::kKeyPlaceholders[4], k.finer},     {audio::kKeyPlaceholders[5], k.coarser},
+           {audio::kKeyPlaceholders[6], k.volume_up}, {audio::kKeyPlaceholders[7], k.volume_down},
+           {audio::kKeyPlaceholders[8], k.tutorial}}};
+}
+
+std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageArg> args) const {
+  return msg_.text(id, args, key_args(p_.keys));
+}
+
+void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say(text(id, args)); }
 
 void KioskFlow::start_tutorial() {
   state_ = KioskState::Tutorial;
@@ -26,22 +40,22 @@ void KioskFlow::show(int index, const std::string& before) {
   state_ = KioskState::Picture;
   const int shapes = fx_.show_picture(picture_);
   const std::string num = std::to_string(picture_ + 1), total = std::to_string(n);
-  std::string text;
+  std::string line;
   if (shapes == 0) {
-    text = msg_.text(MessageId::picture_empty, {{"picture", num}, {"pictures", total}});
+    line = text(MessageId::picture_empty, {{"picture", num}, {"pictures", total}});
   } else if (shapes == 1) {
-    text = msg_.text(MessageId::picture_loaded_one, {{"picture", num}, {"pictures", total}});
+    line = text(MessageId::picture_loaded_one, {{"picture", num}, {"pictures", total}});
   } else {
-    text = msg_.text(MessageId::picture_loaded, {{"picture", num}, {"pictures", total}, {"shapes", std::to_string(shapes)}});
+    line = text(MessageId::picture_loaded, {{"picture", num}, {"pictures", total}, {"shapes", std::to_string(shapes)}});
   }
-  fx_.say(before.empty() ? text : before + " " + text);
+  fx_.say(before.empty() ? line : before + " " + line);
 }
 
 void KioskFlow::wake(double now_s) {
   last_activity_s_ = now_s;
   warned_ = false;
   start_tutorial();
-  fx_.say(msg_.raw(MessageId::welcome) + " " + msg_.raw(MessageId::tutorial_start));
+  fx_.say(text(MessageId::welcome) + " " + text(MessageId::tutorial_start));
 }
 
 void KioskFlow::handle_moved(double now_s) {
@@ -101,7 +115,7 @@ void KioskFlow::key(KioskKey k, double now_s) {
           fx_.show_tutorial(shape_);
           say(MessageId::tutorial_triangle);
         } else {
-          show(0, msg_.raw(MessageId::tutorial_done));
+          show(0, text(MessageId::tutorial_done));
         }
         return;
       case KioskKey::Previous:
@@ -125,7 +139,7 @@ void KioskFlow::key(KioskKey k, double now_s) {
       show(picture_ - 1);
       return;
     case KioskKey::Describe:
-      fx_.say(msg_.text(MessageId::describe, {{"description", fx_.describe()}}));
+      fx_.say(text(MessageId::describe, {{"description", fx_.describe()}}));
       return;
     case KioskKey::Finer:
       say(fx_.change_level(-1) ? MessageId::level_finer : MessageId::level_finest);
@@ -227,7 +241,7 @@ void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double 
     return;
   }
   source_ = KioskSource::Stick;
-  announce_prefix_ = msg_.text(MessageId::stick_inserted, {{"summary", stick_summary()}});
+  announce_summary_ = stick_summary();
   request(0, 1, now_s);
 }
 
@@ -243,7 +257,7 @@ void KioskFlow::stick_removed(double now_s) {
   stick_.clear();
   source_ = KioskSource::Library;
   doc_ = at_doc_ = pending_doc_ = -1;
-  announce_prefix_.clear();
+  announce_summary_.clear();
   if (!browsing || state_ == KioskState::Attract) return;  // nothing of the stick was in use
   last_activity_s_ = now_s;
   warned_ = false;
@@ -251,7 +265,7 @@ void KioskFlow::stick_removed(double now_s) {
     say(MessageId::stick_removed);
     return;
   }
-  show(picture_, msg_.raw(MessageId::stick_removed));
+  show(picture_, text(MessageId::stick_removed));
 }
 
 void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
@@ -259,25 +273,25 @@ void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
   if (source_ != KioskSource::Stick || r.document != pending_doc_ || r.page != pending_page_) return;  // superseded
   pending_doc_ = -1;
   const StickEntry& e = stick_[static_cast<std::size_t>(r.document)];
-  std::string text;
+  std::string line;
   if (r.ok) {
     doc_ = r.document;
     page_ = r.page;
     state_ = KioskState::Picture;
-    text = e.pdf ? msg_.text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(e.pages)},
+    line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(e.pages)},
                                                           {"name", e.name}, {"description", r.description}})
-                 : msg_.text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
+                 : text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
                                                              {"documents", std::to_string(stick_.size())},
                                                              {"name", e.name}, {"description", r.description}});
   } else {
     const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + e.name : e.name;
-    text = msg_.text(MessageId::document_unreadable, {{"name", what}, {"reason", r.reason}});
+    line = text(MessageId::document_unreadable, {{"name", what}, {"reason", r.reason}});
   }
-  if (!announce_prefix_.empty()) {
-    text = announce_prefix_ + " " + text;
-    announce_prefix_.clear();
+  if (!announce_summary_.empty()) {  // said now, so it names the keys of now
+    line = text(MessageId::stick_inserted, {{"summary", announce_summary_}}) + " " + line;
+    announce_summary_.clear();
   }
-  fx_.say(text);
+  fx_.say(line);
 }
 
 }  // namespace hk::app

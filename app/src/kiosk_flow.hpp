@@ -11,16 +11,22 @@
 ///
 /// USB sticks (issue 11, item 5): a stick inserted (stick_inserted) makes Next / Previous walk its documents
 /// and their pages instead of the picture library. Its first page is loaded at once and announced after a
-/// summary of the stick ("A USB stick with 3 documents: 2 pictures and a PDF of 12 pages. Press Next ...").
+/// summary of the stick ("A USB stick with 3 documents: 2 pictures and a PDF of 12 pages. Press the Right arrow ...").
 /// Documents load asynchronously (KioskEffects::show_document; the window layer reports back with
 /// document_ready), so slow work never blocks; "Loading." is said when a load takes longer than
 /// loading_cue_s. A page that cannot be read is reported and the picture felt before stays. Removing the
 /// stick goes back to the library picture; a new session forgets the stick.
+///
+/// Keys (issue 12, item 6): what the kiosk says names the keys that work. Every message is said with its
+/// key placeholders ({help_key}, {next_key}, …) filled from the [keys] settings (KioskFlowParams::keys, changed
+/// live with set_keys()), as the catalogue's spoken form of each key ("Press the Up arrow for more detail.").
 
+#include <array>
 #include <string>
 #include <vector>
 
 #include "audio/messages.hpp"
+#include "config/settings.hpp"
 
 namespace hk::app {
 
@@ -80,11 +86,17 @@ class KioskEffects {
   virtual void forget_stick() = 0;
 };
 
+/// The key placeholders of the catalogue ({help_key} … {tutorial_key}, audio::kKeyPlaceholders) paired with the
+/// keys of `keys`, for audio::MessageCatalog::text(). The pairs view the strings of `keys`: keep it alive while
+/// they are used. For anything outside the flow that says a message naming keys (e.g. `haptic-kiosk speak`).
+std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings& keys);
+
 /// Timing of the flow. Units in names.
 struct KioskFlowParams {
   double timeout_s = 120.0;  ///< no key and no motion for this long ends the session
   double warning_s = 20.0;   ///< the spoken warning comes this long before the end (at most timeout_s / 2)
   double loading_cue_s = 0.5; ///< "Loading." is said when a document takes longer than this to load
+  config::KeysSettings keys{};  ///< the key of each action ([keys]), named in what is said; default: the shipped keys
 };
 
 /// The state machine. Not thread-safe: call from the window thread.
@@ -106,6 +118,13 @@ class KioskFlow {
   void stick_removed(double now_s);
   /// A load asked for with show_document finished (ignored unless it is the one awaited).
   void document_ready(const DocumentResult& result, double now_s);
+  /// The operator changed the keys ([keys]): from now on every message names these (the next thing said
+  /// already does). Does not speak and does not touch the session.
+  void set_keys(const config::KeysSettings& keys) { p_.keys = keys; }
+  /// The keys named in what is said.
+  const config::KeysSettings& keys() const { return p_.keys; }
+  /// The text of `id` as the flow says it: `args` filled in, and every key placeholder naming the current key.
+  std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) const;
 
   KioskSource source() const { return source_; }
   int document() const { return doc_; }        ///< stick document shown (0-based), −1 before the first
@@ -141,7 +160,7 @@ class KioskFlow {
   int pending_doc_ = -1, pending_page_ = 1; // awaited
   double pending_since_s_ = 0;
   bool loading_said_ = false;
-  std::string announce_prefix_;             // said before the first page's announcement (the stick's summary)
+  std::string announce_summary_;            // the stick's summary, said before the first page's announcement
 };
 
 }  // namespace hk::app

@@ -12,6 +12,7 @@ namespace {
 #include "messages_en.inc"
 
 constexpr std::size_t kMaxTextBytes = 1000;
+constexpr std::size_t kMaxKeyNameBytes = 100;
 constexpr std::uintmax_t kMaxFileBytes = 256 * 1024;
 
 std::set<std::string> placeholders(std::string_view s) {
@@ -22,6 +23,16 @@ std::set<std::string> placeholders(std::string_view s) {
     out.emplace(s.substr(i + 1, j - i - 1));
   }
   return out;
+}
+
+/// True when text put at the end of `out` starts a sentence: `out` is empty or blank, or its last
+/// character before the spaces ends one ('.', '!', '?').
+bool starts_sentence(const std::string& out) {
+  const std::size_t last = out.find_last_not_of(" \t\n");
+  if (last == std::string::npos) return true;
+  if (last + 1 == out.size()) return false;  // no space: in the middle of a word
+  const char c = out[last];
+  return c == '.' || c == '!' || c == '?';
 }
 
 }  // namespace
@@ -67,6 +78,28 @@ MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& s
     }
     c.texts_[static_cast<std::size_t>(i)] = *v;
   }
+  // [key_names]: English names every key a visitor may be given; a translation names exactly the same ones.
+  const toml::table* kn = t["key_names"].as_table();
+  if (!kn) throw MessageError(where + "has no [key_names] table");
+  for (const auto& [key, node] : *kn) {
+    const std::string name(key.str());
+    if (en && !en->key_names_.count(name)) {
+      throw MessageError(where + "key_names." + name + " is not a key name the English catalogue has");
+    }
+    const auto v = node.value<std::string>();
+    if (!v) throw MessageError(where + "key_names." + name + " is not a string");
+    if (v->empty() || v->size() > kMaxKeyNameBytes) {
+      throw MessageError(where + "key_names." + name + " must be 1 to " + std::to_string(kMaxKeyNameBytes) + " bytes");
+    }
+    c.key_names_.emplace(name, *v);
+  }
+  if (en) {
+    for (const auto& [name, form] : en->key_names_) {
+      if (!c.key_names_.count(name)) throw MessageError(where + "key_names." + name + " is missing (or not a string)");
+    }
+  } else if (c.key_names_.empty()) {
+    throw MessageError(where + "[key_names] is empty");
+  }
   return c;
 }
 
@@ -90,15 +123,46 @@ MessageCatalog MessageCatalog::load(const std::string& path) {
   return parse(ss.str(), path);
 }
 
-std::string MessageCatalog::text(MessageId id, std::initializer_list<MessageArg> args) const {
-  std::string s = raw(id);
-  for (const MessageArg& a : args) {
-    const std::string token = "{" + std::string(a.first) + "}";
-    for (std::size_t i = s.find(token); i != std::string::npos; i = s.find(token, i + a.second.size())) {
-      s.replace(i, token.size(), a.second);
+std::string MessageCatalog::key_name(std::string_view name) const {
+  const auto it = key_names_.find(name);
+  return it == key_names_.end() ? std::string(name) : it->second;
+}
+
+std::string MessageCatalog::text(MessageId id, std::initializer_list<MessageArg> args, std::span<const KeyArg> keys) const {
+  const std::string& s = raw(id);
+  std::string out;
+  out.reserve(s.size());
+  std::size_t i = 0;
+  while (i < s.size()) {
+    std::size_t open = s.find('{', i);
+    if (open == std::string::npos) break;
+    const std::size_t close = s.find('}', open + 1);
+    if (close == std::string::npos) break;
+    open = s.rfind('{', close);  // the innermost: "{{seconds}}" keeps its outer braces
+    const std::string_view name = std::string_view(s).substr(open + 1, close - open - 1);
+    out.append(s, i, open - i);
+    const MessageArg* arg = nullptr;
+    for (const MessageArg& a : args) {
+      if (!arg && a.first == name) arg = &a;
     }
+    const KeyArg* key = nullptr;
+    for (const KeyArg& k : keys) {
+      if (!key && k.first == name) key = &k;
+    }
+    if (arg) {
+      out += arg->second;
+    } else if (key) {
+      std::string form = key_name(key->second);
+      // Forms are written as they read after "Press"; a sentence starts with a capital (ASCII letters only).
+      if (!form.empty() && starts_sentence(out) && form[0] >= 'a' && form[0] <= 'z') form[0] = static_cast<char>(form[0] - 'a' + 'A');
+      out += form;
+    } else {
+      out.append(s, open, close - open + 1);  // unknown: left as it is
+    }
+    i = close + 1;
   }
-  return s;
+  out.append(s, i, std::string::npos);
+  return out;
 }
 
 }  // namespace hk::audio

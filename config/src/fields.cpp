@@ -454,6 +454,22 @@ void validate_as(const Settings& s, const Source& src) {
          "haptics.dynamic_friction = " + format_real(s.haptics.dynamic_friction) +
              " must be <= haptics.static_friction = " + format_real(s.haptics.static_friction) +
              " (a wall that holds less at rest than while sliding would chatter)");
+  // Each visitor action on its own key: one key cannot do two things, and the help names each action's key.
+  // The first pair in table order is reported, attributed to the earlier key and naming the later.
+  {
+    const std::array<std::pair<std::string_view, const std::string*>, 9> keys{{
+        {"help", &s.keys.help}, {"next", &s.keys.next}, {"previous", &s.keys.previous},
+        {"describe", &s.keys.describe}, {"finer", &s.keys.finer}, {"coarser", &s.keys.coarser},
+        {"volume_up", &s.keys.volume_up}, {"volume_down", &s.keys.volume_down}, {"tutorial", &s.keys.tutorial}}};
+    for (std::size_t i = 0; i < keys.size(); ++i)
+      for (std::size_t j = i + 1; j < keys.size(); ++j)
+        if (*keys[i].second == *keys[j].second) {
+          const std::string earlier = "keys." + std::string(keys[i].first);
+          fail(src, earlier,
+               earlier + " = \"" + one_line(*keys[i].second, 80) + "\" is also keys." + std::string(keys[j].first) +
+                   "; each action needs its own key");
+        }
+  }
 }
 
 }  // namespace detail

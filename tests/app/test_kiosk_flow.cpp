@@ -70,13 +70,16 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   ASSERT_EQ(fx.said.size(), 1u);
   EXPECT_EQ(fx.said.back().rfind("Welcome.", 0), 0u);
   EXPECT_NE(fx.said.back().find("First, a square."), std::string::npos);
+  EXPECT_NE(fx.said.back().find("Press F1 at any time for help."), std::string::npos) << "the shipped help key";
+  EXPECT_NE(fx.said.back().find("Press the Right arrow for the next shape."), std::string::npos) << "the shipped next key";
   EXPECT_EQ(fx.shown.back(), "tutorial 0");
 
   flow.key(KioskKey::Next, 20.0);
-  EXPECT_EQ(fx.said.back(), en.raw(audio::MessageId::tutorial_circle));
+  EXPECT_EQ(fx.said.back(), "Now a circle. Follow it all the way round. Press the Right arrow for the next shape, or the Left arrow to go back.");
+  EXPECT_EQ(fx.said.back(), flow.text(audio::MessageId::tutorial_circle));
   EXPECT_EQ(fx.shown.back(), "tutorial 1");
   flow.key(KioskKey::Next, 30.0);
-  EXPECT_EQ(fx.said.back(), en.raw(audio::MessageId::tutorial_triangle));
+  EXPECT_EQ(fx.said.back(), "Now a triangle. Feel its three corners. Press the Right arrow for the first picture.");
   flow.key(KioskKey::Next, 40.0);
   EXPECT_EQ(flow.state(), KioskState::Picture);
   EXPECT_EQ(fx.said.back(), "Well done. Here is the first picture. Picture 1 of 3. It has 4 shapes.");
@@ -89,6 +92,13 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   EXPECT_EQ(fx.said.back(), "Picture 3 of 3. It has 4 shapes.") << "previous wraps round";
   flow.key(KioskKey::Describe, 53.0);
   EXPECT_EQ(fx.said.back(), "4 shapes. A large closed shape in the middle.");
+  flow.key(KioskKey::Help, 53.5);
+  EXPECT_EQ(fx.said.back(),
+            "Move the handle slowly to feel the outlines. Press the Right arrow for the next picture and the Left arrow for the one "
+            "before. Press the Up arrow for more detail and the Down arrow for less. Press the D key to hear what the picture "
+            "holds. Press Page Up for louder and Page Down for quieter. Press the T key to practise with the shapes again, and F1 "
+            "to hear this again.")
+      << "the help names the shipped keys";
   flow.key(KioskKey::Finer, 54.0);
   EXPECT_EQ(fx.said.back(), "More detail.");
   flow.key(KioskKey::Finer, 55.0);
@@ -162,7 +172,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   EXPECT_EQ(fx.said.size(), 1u) << "said once per load";
   flow.document_ready(ready(0, 1, "It has 4 shapes."), 2.0);
   EXPECT_EQ(fx.said.back(),
-            "A USB stick with 3 documents: 2 pictures and a PDF of 3 pages. Press Next to go through them. "
+            "A USB stick with 3 documents: 2 pictures and a PDF of 3 pages. Press the Right arrow to go through them. "
             "Document 1 of 3, cat.png. It has 4 shapes.");
   EXPECT_EQ(flow.document(), 0);
 
@@ -214,7 +224,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
   flow.document_ready(ready(0, 1, "It has no text and one figure."), 9.1);
   EXPECT_EQ(fx.said.back(),
-            "A USB stick with one document: a PDF of one page. Press Next to go through them. Page 1 of 1 of only.pdf. It has no text and one figure.");
+            "A USB stick with one document: a PDF of one page. Press the Right arrow to go through them. Page 1 of 1 of only.pdf. It has no text and one figure.");
 
   // The visitor leaves; the next one does not get the stick.
   flow.tick(9.1 + 120.0);

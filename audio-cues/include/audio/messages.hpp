@@ -3,9 +3,17 @@
 /// Everything the kiosk says, in one catalogue (issue 4, item 6). The English text lives in
 /// audio-cues/messages/en.toml and is compiled in; a translation is a copy of that file with the
 /// right-hand sides translated, loaded with MessageCatalog::load().
+///
+/// Keys (issue 12, item 6): a message names the visitor's keys with placeholders ({help_key}, {next_key},
+/// …: kKeyPlaceholders), filled with the spoken form of the key the operator configured; the [key_names]
+/// table of the catalogue gives that spoken form for every key name ("UP" → "the Up arrow"). The
+/// catalogue knows nothing of the settings: the caller passes the key names (KeyArg).
 
 #include <array>
+#include <functional>
 #include <initializer_list>
+#include <map>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -41,6 +49,16 @@ class MessageError : public std::runtime_error {
 /// A named value for a {placeholder}.
 using MessageArg = std::pair<std::string_view, std::string>;
 
+/// The placeholders that name one of the visitor's keys, one per action of the [keys] settings (help, next,
+/// previous, describe, finer, coarser, volume_up, volume_down, tutorial), in that order.
+inline constexpr std::array<std::string_view, 9> kKeyPlaceholders{
+    "help_key", "next_key", "previous_key", "describe_key", "finer_key", "coarser_key",
+    "volume_up_key", "volume_down_key", "tutorial_key"};
+
+/// A key placeholder and the key it stands for, by its settings name: {"help_key", "F1"}. MessageCatalog::text()
+/// puts the spoken form of the key (MessageCatalog::key_name()) in its place.
+using KeyArg = std::pair<std::string_view, std::string_view>;
+
 /// The texts of one language.
 class MessageCatalog {
  public:
@@ -48,13 +66,22 @@ class MessageCatalog {
   static const MessageCatalog& english();
   /// Loads a translation. Every key of the English file must be there, no other key may be, every value is
   /// a non-empty string of at most 1000 bytes, and it may use only the placeholders its English text uses.
-  /// @throws MessageError (one line: the file and the key at fault).
+  /// The same holds for [key_names]: exactly the English key names, each a spoken form of 1 to 100 bytes.
+  /// @throws MessageError (one line: the file and the key at fault, e.g. "key_names.UP is missing").
   static MessageCatalog load(const std::string& path);
   /// Parses catalogue text (`source` names it in errors). @throws MessageError.
   static MessageCatalog parse(std::string_view toml_text, const std::string& source);
 
-  /// The text of `id` with each {name} replaced by its argument; unknown names are left as they are.
-  std::string text(MessageId id, std::initializer_list<MessageArg> args = {}) const;
+  /// The text of `id` with each {name} replaced by its argument in `args`, or, for a key placeholder listed
+  /// in `keys`, by the spoken form of that key (key_name()), its first letter made upper case where it starts
+  /// the text or a sentence ("the Up arrow" → "The Up arrow gives more detail."). Unknown names are left as
+  /// they are. One pass: the text put in is never searched for placeholders again.
+  std::string text(MessageId id, std::initializer_list<MessageArg> args = {}, std::span<const KeyArg> keys = {}) const;
+  /// The spoken form of the key that the settings call `name` ("UP" → "the Up arrow", "F1" → "F1"), lower
+  /// case as it reads after "Press"; for a name the catalogue does not know, `name` itself.
+  std::string key_name(std::string_view name) const;
+  /// Every entry of [key_names]: settings name → spoken form.
+  const std::map<std::string, std::string, std::less<>>& key_names() const { return key_names_; }
   /// The raw text (placeholders unexpanded).
   const std::string& raw(MessageId id) const { return texts_[static_cast<std::size_t>(id)]; }
   /// espeak-ng voice for this language (e.g. "en", "de").
@@ -64,6 +91,7 @@ class MessageCatalog {
 
  private:
   std::array<std::string, kMessageCount> texts_;
+  std::map<std::string, std::string, std::less<>> key_names_;
   std::string voice_, language_;
 };
 
