@@ -11,10 +11,10 @@
 namespace hk::app {
 namespace {
 
-constexpr ImVec4 kRed{1.0f, 0.45f, 0.4f, 1.0f};
-constexpr ImVec4 kOrange{1.0f, 0.75f, 0.3f, 1.0f};
-constexpr ImVec4 kGrey{0.7f, 0.7f, 0.72f, 1.0f};
-constexpr ImVec4 kGreen{0.5f, 0.95f, 0.55f, 1.0f};
+const ImVec4 kRed{1.0f, 0.45f, 0.4f, 1.0f};
+const ImVec4 kOrange{1.0f, 0.75f, 0.3f, 1.0f};
+const ImVec4 kGrey{0.7f, 0.7f, 0.72f, 1.0f};
+const ImVec4 kGreen{0.5f, 0.95f, 0.55f, 1.0f};
 
 const char* apply_text(config::ApplyWhen a) {
   switch (a) {

@@ -121,6 +121,12 @@ class KioskFlow {
   /// The operator changed the keys ([keys]): from now on every message names these (the next thing said
   /// already does). Does not speak and does not touch the session.
   void set_keys(const config::KeysSettings& keys) { p_.keys = keys; }
+  /// The operator changed the session's time-out ([kiosk] timeout_s, warning_s [s]): counted from the last
+  /// activity, as before. A warning already given stays given.
+  void set_timing(double timeout_s, double warning_s) {
+    p_.timeout_s = timeout_s;
+    p_.warning_s = warning_s;
+  }
   /// The keys named in what is said.
   const config::KeysSettings& keys() const { return p_.keys; }
   /// The text of `id` as the flow says it: `args` filled in, and every key placeholder naming the current key.
