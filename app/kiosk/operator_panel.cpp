@@ -112,6 +112,7 @@ void OperatorPanel::draw_pin_prompt(int fw, int fh, double now_s, std::int64_t n
 void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double, std::int64_t now_unix_s) {
   ImGui::SetNextWindowPos(ImVec2(0.04f * fw, 0.04f * fh));
   ImGui::SetNextWindowSize(ImVec2(0.92f * fw, 0.8f * fh));
+  ImGui::SetNextWindowBgAlpha(0.96f);  // the picture must not show through the settings
   ImGui::Begin("Operator panel", nullptr, ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
   if (!s_.load_notice().empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
