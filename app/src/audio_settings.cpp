@@ -1,5 +1,7 @@
 #include "audio_settings.hpp"
 
+#include "kiosk_flow.hpp"
+
 #include "audio/wav.hpp"
 #include "config/load.hpp"
 
@@ -22,11 +24,13 @@ std::string run_speak(const SpeakOptions& o) {
   const audio::MessageCatalog catalog =
       o.messages_path.empty() ? audio::MessageCatalog::english() : audio::MessageCatalog::load(o.messages_path);
   std::string text = o.what;
+  const auto keys = key_args(s.keys);  // the keys of the settings, named as the kiosk names them
   for (int i = 0; i < audio::kMessageCount; ++i) {
     if (audio::kMessageKeys[static_cast<std::size_t>(i)] == o.what) {
       // Sample values for the placeholders, so a translator hears a whole sentence.
       text = catalog.text(static_cast<audio::MessageId>(i), {{"picture", "2"}, {"pictures", "5"}, {"shapes", "7"}, {"level", "3"},
-                                                             {"seconds", "20"}, {"description", "A large closed shape in the middle."}});
+                                                             {"seconds", "20"}, {"description", "A large closed shape in the middle."}},
+                          keys);
     }
   }
   audio::SpeechParams sp;

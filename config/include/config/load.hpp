@@ -122,6 +122,8 @@ inline constexpr std::uintmax_t kMaxConfigFileBytes = 1u << 20;
 /// Checks every field against its range (reals must be finite) and the cross-field rules:
 /// - haptics.level <= haptics.max_levels (only levels 0..max_levels are built);
 /// - vision.canny_low <= vision.canny_high when both are nonzero (0 = derive from the image);
+/// - haptics.dynamic_friction <= haptics.static_friction;
+/// - each [keys] action on its own key;
 /// - device.type is one of the known device types (FieldDescriptor::choices).
 /// @throws ConfigError (source "settings") naming the first bad key.
 void validate(const Settings& settings);
