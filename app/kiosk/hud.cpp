@@ -5,19 +5,6 @@
 #include <algorithm>
 
 namespace hk::app {
-namespace {
-
-const char* state_name(KioskState s) {
-  switch (s) {
-    case KioskState::Attract: return "attract";
-    case KioskState::Tutorial: return "tutorial";
-    case KioskState::Picture: return "picture";
-  }
-  return "?";
-}
-
-}  // namespace
-
 void draw_captions(KioskRuntime& app, const KioskFlow& flow, int fw, int fh) {
   const std::string caption = flow.state() == KioskState::Attract ? app.audio().messages().raw(audio::MessageId::attract) : app.last_said();
   ImGui::SetNextWindowPos(ImVec2(0.05f * fw, 0.86f * fh));

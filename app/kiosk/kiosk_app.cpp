@@ -227,8 +227,7 @@ int run_kiosk(const KioskOptions& o) {
   Kiosk* kiosk_ptr = nullptr;
   OperatorSession session(o.config_path, start.settings, start.notice, [&](const config::Settings& s) {
     const ApplyReport r = rt.apply_settings(s, flow);
-    if (r.keys && kiosk_ptr) kiosk_ptr->keys_changed();
-    if (kiosk_ptr) kiosk_ptr->keys_changed();  // the operator's chord may have changed too
+    if (kiosk_ptr) kiosk_ptr->keys_changed();  // the visitor's keys, and the operator's chord
     return describe_apply(r);
   });
   OperatorPanel panel(session);

@@ -26,14 +26,6 @@ const char* apply_text(config::ApplyWhen a) {
   return "";
 }
 
-const char* state_name(KioskState s) {
-  switch (s) {
-    case KioskState::Attract: return "attract";
-    case KioskState::Tutorial: return "tutorial";
-    case KioskState::Picture: return "picture";
-  }
-  return "?";
-}
 
 constexpr config::FieldGroup kTabs[] = {config::FieldGroup::haptics, config::FieldGroup::levels, config::FieldGroup::scene,
                                         config::FieldGroup::audio,   config::FieldGroup::kiosk,  config::FieldGroup::keys,

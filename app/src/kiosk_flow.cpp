@@ -6,6 +6,16 @@
 
 namespace hk::app {
 
+const char* state_name(KioskState s) {
+  switch (s) {
+    case KioskState::Attract: return "attract";
+    case KioskState::Tutorial: return "tutorial";
+    case KioskState::Picture: return "picture";
+  }
+  return "?";
+}
+
+
 using audio::MessageId;
 
 KioskFlow::KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params)

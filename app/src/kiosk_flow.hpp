@@ -36,6 +36,9 @@ enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, 
 /// States of the flow.
 enum class KioskState { Attract, Tutorial, Picture };
 
+/// The state's name for the operator's screens: "attract", "tutorial", "picture".
+const char* state_name(KioskState s);
+
 /// Tutorial shapes, in order.
 enum class TutorialShape { Square = 0, Circle = 1, Triangle = 2 };
 

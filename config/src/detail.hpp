@@ -41,6 +41,12 @@ std::string format_toml_real(double v);
 /// A TOML basic string literal for `s` (quoted, escaped).
 std::string toml_string(std::string_view s);
 
+/// The value of field `d` in `s` as TOML text, as to_toml writes it (800.0, "UP", 16384).
+std::string toml_value(const FieldDescriptor& d, const Settings& s);
+
+/// Writes all of `text` to `fd` (retrying short writes and EINTR); returns 0 or an errno value.
+int write_all(int fd, std::string_view text);
+
 /// "table.key" of a descriptor.
 std::string qualified(const FieldDescriptor& d);
 

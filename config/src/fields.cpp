@@ -2,7 +2,10 @@
 /// The one table of settings fields (table, key, range, unit, help, accessors) and the checks
 /// built on it: range checks, cross-field checks, message formatting.
 
+#include <unistd.h>
+
 #include <array>
+#include <cerrno>
 #include <charconv>
 #include <climits>
 #include <cmath>
@@ -364,6 +367,36 @@ std::string toml_string(std::string_view s) {
   }
   out += '"';
   return out;
+}
+
+std::string toml_value(const FieldDescriptor& d, const Settings& s) {
+  return std::visit(
+      [](auto* p) -> std::string {
+        using T = std::remove_cvref_t<decltype(*p)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return format_toml_real(*p);
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return toml_string(*p);
+        } else {
+          return std::to_string(*p);
+        }
+      },
+      d.cref(s));
+}
+
+int write_all(int fd, std::string_view text) {
+  const char* p = text.data();
+  std::size_t left = text.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  return 0;
 }
 
 std::string qualified(const FieldDescriptor& d) {

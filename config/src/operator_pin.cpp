@@ -57,21 +57,6 @@ bool to_hash_buffer(std::string_view hash, std::array<char, crypto_pwhash_STRBYT
   throw ConfigError(path, "", msg);
 }
 
-/// Writes all of `text` to `fd`; returns 0 or an errno value.
-int write_all(int fd, const std::string& text) {
-  const char* p = text.data();
-  std::size_t left = text.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return errno;
-    }
-    p += n;
-    left -= static_cast<std::size_t>(n);
-  }
-  return 0;
-}
 
 /// An exclusive flock on "<state file>.lock", held for the object's life. The lock file is created
 /// (mode 0600) and never removed: removing it would let two processes lock two different files.
@@ -280,7 +265,7 @@ void write_lockout_state(const std::string& path, const LockoutState& s) {
     ::unlink(tmp.c_str());
     state_fail(path, "not saved: " + what + ": " + one_line(std::strerror(err)) + " (the old state is kept)");
   };
-  if (int err = write_all(fd, text)) abandon("cannot write '" + one_line(tmp) + "'", err);
+  if (int err = detail::write_all(fd, text)) abandon("cannot write '" + one_line(tmp) + "'", err);
   if (::fchmod(fd, 0600) != 0) abandon("cannot set the mode of '" + one_line(tmp) + "'", errno);
   if (::fsync(fd) != 0) abandon("cannot flush '" + one_line(tmp) + "' to disk", errno);
   if (::close(fd) != 0) {

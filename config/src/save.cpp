@@ -25,41 +25,11 @@ using detail::fail;
 using detail::one_line;
 using detail::Source;
 
-/// The value of a field as TOML text.
-std::string toml_value(const FieldDescriptor& d, const Settings& s) {
-  return std::visit(
-      [](auto* p) -> std::string {
-        using T = std::remove_cvref_t<decltype(*p)>;
-        if constexpr (std::is_same_v<T, double>) {
-          return detail::format_toml_real(*p);
-        } else if constexpr (std::is_same_v<T, std::string>) {
-          return detail::toml_string(*p);
-        } else {
-          return std::to_string(*p);
-        }
-      },
-      d.cref(s));
-}
 
 [[noreturn]] void io_fail(const Source& src, const std::string& what, int err) {
   fail(src, "", "not saved: " + what + ": " + one_line(std::strerror(err)) + " (nothing was changed)");
 }
 
-/// Writes all of `text` to `fd`; returns 0 or an errno value.
-int write_all(int fd, const std::string& text) {
-  const char* p = text.data();
-  std::size_t left = text.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd, p, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return errno;
-    }
-    p += n;
-    left -= static_cast<std::size_t>(n);
-  }
-  return 0;
-}
 
 /// Creates `<prefix>XXXXXX` (a new, unique name) holding `text` with `mode`, fsync'ed and closed, and
 /// returns its path. On failure removes it and throws ConfigError ("not saved: ...").
@@ -77,7 +47,7 @@ std::string write_temp(const Source& src, const std::string& prefix, const std::
     ::unlink(tmp.c_str());
     io_fail(src, what, err);
   };
-  if (int err = write_all(fd, text)) {
+  if (int err = detail::write_all(fd, text)) {
     ::close(fd);
     abandon("cannot write '" + one_line(tmp) + "'", err);
   }
@@ -150,10 +120,10 @@ std::string to_toml(const Settings& settings) {
         out += detail::allowed_text(d);
         out += d.kind == FieldKind::integer ? ", an integer." : ".";
       }
-      out += " Default " + toml_value(d, kDefaults) + ".\n";
+      out += " Default " + detail::toml_value(d, kDefaults) + ".\n";
       out += d.key;
       out += " = ";
-      out += toml_value(d, settings);
+      out += detail::toml_value(d, settings);
       out += '\n';
     }
   }

@@ -56,21 +56,6 @@ std::string iso_utc(std::int64_t unix_s) { return format_utc(unix_s, "%Y-%m-%dT%
 /// "20261122T030405Z" (for file names).
 std::string compact_utc(std::int64_t unix_s) { return format_utc(unix_s, "%Y%m%dT%H%M%SZ"); }
 
-/// The value of a field as TOML text (as to_toml writes it).
-std::string toml_value(const FieldDescriptor& d, const Settings& s) {
-  return std::visit(
-      [](auto* p) -> std::string {
-        using T = std::remove_cvref_t<decltype(*p)>;
-        if constexpr (std::is_same_v<T, double>) {
-          return detail::format_toml_real(*p);
-        } else if constexpr (std::is_same_v<T, std::string>) {
-          return detail::toml_string(*p);
-        } else {
-          return std::to_string(*p);
-        }
-      },
-      d.cref(s));
-}
 
 /// True when field `d` holds the same value in `a` and `b` (exact for doubles, as Settings::operator==).
 bool same_value(const FieldDescriptor& d, const Settings& a, const Settings& b) {
@@ -327,7 +312,7 @@ std::vector<SettingChange> diff_settings(const Settings& before, const Settings&
   std::vector<SettingChange> changes;
   for (const auto& d : field_descriptors()) {
     if (same_value(d, before, after)) continue;
-    SettingChange c{detail::qualified(d), toml_value(d, before), toml_value(d, after)};
+    SettingChange c{detail::qualified(d), detail::toml_value(d, before), detail::toml_value(d, after)};
     if (d.group == FieldGroup::hidden) {  // a secret (the PIN's hash) never goes into a log
       const bool had = !std::get<const std::string*>(d.cref(before))->empty();
       const bool has = !std::get<const std::string*>(d.cref(after))->empty();

@@ -21,34 +21,17 @@
 #include "config/operator_pin.hpp"
 #include "pin_verifier.hpp"
 
+#include "letter_dir.hpp"
+
 namespace fs = std::filesystem;
 using namespace hk;
 
 namespace {
 
-/// A fresh folder whose name holds no digit (so stderr naming a file in it can be searched for a PIN),
-/// removed at scope exit.
-class LetterDir {
+/// A fresh folder named without digits (letter_dir.hpp).
+class LetterDir : public hk::test::LetterDir {
  public:
-  LetterDir() {
-    static int counter = 0;
-    std::string tag;
-    for (unsigned long v = static_cast<unsigned long>(::getpid()) * 1000 + static_cast<unsigned long>(counter++); v > 0; v /= 10)
-      tag += static_cast<char>('a' + v % 10);
-    path_ = fs::temp_directory_path() / ("hk_pin_command_" + tag);
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~LetterDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  LetterDir(const LetterDir&) = delete;
-  LetterDir& operator=(const LetterDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
+  LetterDir() : hk::test::LetterDir("hk_pin_command_") {}
 };
 
 std::string read_text(const fs::path& p) {

@@ -14,6 +14,8 @@
 #include "config/operator_pin.hpp"
 #include "config_test_util.hpp"
 
+#include "letter_dir.hpp"
+
 namespace fs = std::filesystem;
 using namespace hk::config;
 using hk::config::test::capture_error;
@@ -23,29 +25,10 @@ using hk::config::test::write_file;
 
 namespace {
 
-/// A fresh folder whose name holds no digit (so a message naming a file in it can be searched for a
-/// PIN), removed at scope exit.
-class LetterDir {
+/// A fresh folder named without digits (letter_dir.hpp).
+class LetterDir : public hk::test::LetterDir {
  public:
-  LetterDir() {
-    static int counter = 0;
-    std::string tag;
-    for (unsigned long v = static_cast<unsigned long>(::getpid()) * 1000 + static_cast<unsigned long>(counter++); v > 0; v /= 10)
-      tag += static_cast<char>('a' + v % 10);
-    path_ = fs::temp_directory_path() / ("hk_operator_pin_" + tag);
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~LetterDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  LetterDir(const LetterDir&) = delete;
-  LetterDir& operator=(const LetterDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
+  LetterDir() : hk::test::LetterDir("hk_operator_pin_") {}
 };
 
 /// Settings with a value other than the default in every table (and all of [operator] but the hash).
