@@ -95,7 +95,9 @@ std::string chord_problem(std::string_view v) {
   return parse_chord(v, &why) ? std::string{} : why;
 }
 
-constexpr std::array<std::string_view, 1> kDeviceTypes{"simulated"};
+constexpr std::array<std::string_view, 3> kDeviceTypes{"auto", "simulated", "haply"};
+constexpr std::array<std::string_view, 3> kTransports{"auto", "usb", "tty"};
+constexpr std::array<std::string_view, 2> kRotations{"cw", "ccw"};
 constexpr std::array<std::string_view, 2> kLevelModes{"auto", "fixed"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
@@ -108,7 +110,7 @@ constexpr auto kKeyNames = std::to_array<std::string_view>({
 
 constexpr std::array<detail::TableInfo, 10> kTables{{
     {"haptics", "Force rendering and the servo loop."},
-    {"device", "Which device drives the handle, and the simulated pantograph's physics."},
+    {"device", "Which device drives the handle: the simulated pantograph's physics, and the USB pantograph's board, links and calibration."},
     {"hand", "The model hand that drives the simulated pantograph in headless runs."},
     {"vision", "Image intake limits, edge detection and linking."},
     {"workspace", "The device's usable rectangle, centred on the workspace origin."},
@@ -143,7 +145,34 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(device, handle_mass_kg, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "kg", "Effective handle mass (simulated pantograph)."),
     HK_FIELD(device, handle_damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 100, "N·s/m", "Device viscous damping."),
     HK_FIELD(device, encoder_counts_per_rev, FieldGroup::devices, ApplyWhen::restart, 64, 1048576, "counts/rev", "Encoder resolution."),
-    HK_FIELD(device, max_torque_n_m, FieldGroup::devices, ApplyWhen::restart, 0.001, 10, "N·m", "Per-motor torque limit."),
+    HK_FIELD(device, max_torque_n_m, FieldGroup::devices, ApplyWhen::restart, 0.001, 10, "N·m", "Per-motor torque limit (simulated pantograph)."),
+    HK_FIELD(device, transport, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "How to reach the USB pantograph: \"auto\" (libusb, then the kernel's tty), \"usb\" or \"tty\".", kTransports),
+    HK_FIELD(device, usb_vid, FieldGroup::devices, ApplyWhen::restart, 0, 65535, "", "USB vendor id of the pantograph's board ('haptic-kiosk devices' lists what is plugged in)."),
+    HK_FIELD(device, usb_pid, FieldGroup::devices, ApplyWhen::restart, 0, 65535, "", "USB product id of the pantograph's board."),
+    HK_FIELD(device, serial_path, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "The board's tty for the tty transport; empty: the first /dev/serial/by-id entry.", {}, &path_problem),
+    HK_FIELD(device, device_id, FieldGroup::devices, ApplyWhen::restart, 1, 255, "", "hAPI device id the board is set up with."),
+    HK_FIELD(device, lost_after_ticks, FieldGroup::devices, ApplyWhen::restart, 1, 1000, "ticks", "Servo ticks without a valid reply before the device counts as lost (force off, spoken)."),
+    HK_FIELD(device, actuator1_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "", "Board port of actuator 1 (Haply joint 1)."),
+    HK_FIELD(device, actuator1_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Positive direction of actuator 1.", kRotations),
+    HK_FIELD(device, actuator2_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "", "Board port of actuator 2 (Haply joint 2)."),
+    HK_FIELD(device, actuator2_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Positive direction of actuator 2.", kRotations),
+    HK_FIELD(device, encoder1_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "", "Board port of encoder 1."),
+    HK_FIELD(device, encoder1_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Positive direction of encoder 1.", kRotations),
+    HK_FIELD(device, encoder1_offset_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg", "Angle encoder 1 reports at the pose the board starts in ('haptic-kiosk calibrate' sets it)."),
+    HK_FIELD(device, encoder1_resolution, FieldGroup::devices, ApplyWhen::restart, 1, 1000000, "counts/rev", "Encoder 1 resolution as the board's firmware takes it."),
+    HK_FIELD(device, encoder2_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "", "Board port of encoder 2."),
+    HK_FIELD(device, encoder2_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Positive direction of encoder 2.", kRotations),
+    HK_FIELD(device, encoder2_offset_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg", "Angle encoder 2 reports at the pose the board starts in ('haptic-kiosk calibrate' sets it)."),
+    HK_FIELD(device, encoder2_resolution, FieldGroup::devices, ApplyWhen::restart, 1, 1000000, "counts/rev", "Encoder 2 resolution as the board's firmware takes it."),
+    HK_FIELD(device, link_proximal_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 0.5, "m", "USB pantograph: motor-to-elbow link length."),
+    HK_FIELD(device, link_distal_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 0.5, "m", "USB pantograph: elbow-to-handle link length."),
+    HK_FIELD(device, motor_spacing_m, FieldGroup::devices, ApplyWhen::restart, 0, 0.5, "m", "USB pantograph: distance between the two motor axes."),
+    HK_FIELD(device, torque_limit_n_m, FieldGroup::devices, ApplyWhen::restart, 0.001, 10, "N·m", "USB pantograph: torque limit per motor (the board's own limit)."),
+    HK_FIELD(device, rect_width_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 1, "m", "USB pantograph: width of its usable rectangle, mapped onto [workspace]."),
+    HK_FIELD(device, rect_height_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 1, "m", "USB pantograph: height of its usable rectangle."),
+    HK_FIELD(device, rect_center_y_m, FieldGroup::devices, ApplyWhen::restart, -1, 1, "m", "USB pantograph: the rectangle's centre relative to the motor axes (negative: towards the visitor)."),
+    HK_FIELD(device, park_theta1_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg", "Joint 1 angle at the calibration (park) pose."),
+    HK_FIELD(device, park_theta2_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg", "Joint 2 angle at the calibration (park) pose."),
     // [hand]
     HK_FIELD(hand, stiffness_n_per_m, FieldGroup::devices, ApplyWhen::restart, 1, 5000, "N/m", "Spring pulling the hand to its target."),
     HK_FIELD(hand, damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 200, "N·s/m", "Damping of the hand spring."),
@@ -487,6 +516,20 @@ void validate_as(const Settings& s, const Source& src) {
          "haptics.dynamic_friction = " + format_real(s.haptics.dynamic_friction) +
              " must be <= haptics.static_friction = " + format_real(s.haptics.static_friction) +
              " (a wall that holds less at rest than while sliding would chatter)");
+  // The USB pantograph's board: two actuators on two ports, two encoders on two ports (hAPI masks one bit
+  // per port), and links that can close the five-bar (2·L must span the motor spacing).
+  if (s.device.actuator1_port == s.device.actuator2_port)
+    fail(src, "device.actuator1_port",
+         "device.actuator1_port = " + std::to_string(s.device.actuator1_port) +
+             " is also device.actuator2_port; each actuator needs its own board port");
+  if (s.device.encoder1_port == s.device.encoder2_port)
+    fail(src, "device.encoder1_port",
+         "device.encoder1_port = " + std::to_string(s.device.encoder1_port) +
+             " is also device.encoder2_port; each encoder needs its own board port");
+  if (s.device.motor_spacing_m >= 2.0 * (s.device.link_proximal_m + s.device.link_distal_m))
+    fail(src, "device.motor_spacing_m",
+         "device.motor_spacing_m = " + format_real(s.device.motor_spacing_m) +
+             " must be < 2 * (device.link_proximal_m + device.link_distal_m) or the links cannot meet");
   // Each visitor action on its own key: one key cannot do two things, and the help names each action's key.
   // The first pair in table order is reported, attributed to the earlier key and naming the later.
   {

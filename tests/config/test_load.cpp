@@ -254,6 +254,12 @@ TEST(ConfigLoad, EveryKeyAtItsBoundsIsAccepted) {
       if (spec.name() == "haptics.level") text += "max_levels = 12\n";
       if (spec.name() == "haptics.dynamic_friction") text += "static_friction = 2.0\n";
       if (spec.name() == "haptics.static_friction") text += "dynamic_friction = 0.0\n";
+      // The other actuator/encoder moves off a port this bound takes (each needs its own board port).
+      if (spec.name() == "device.actuator1_port") text += ok == 1 ? "actuator2_port = 2\n" : "actuator2_port = 1\n";
+      if (spec.name() == "device.actuator2_port") text += ok == 2 ? "actuator1_port = 1\n" : "actuator1_port = 2\n";
+      if (spec.name() == "device.encoder1_port") text += ok == 1 ? "encoder2_port = 2\n" : "encoder2_port = 1\n";
+      if (spec.name() == "device.encoder2_port") text += ok == 2 ? "encoder1_port = 1\n" : "encoder1_port = 2\n";
+      if (spec.name() == "device.motor_spacing_m") text += "link_distal_m = 0.5\n";
       EXPECT_NO_THROW((void)parse_settings(text, "bounds.toml")) << text;
     }
   }
@@ -309,7 +315,7 @@ TEST(ConfigLoad, DeviceTypeMustBeAKnownStringValue) {
   auto e = capture_error([&] { (void)parse_settings("[device]\ntype = \"usb\"\n", "t.toml"); });
   ASSERT_TRUE(e);
   EXPECT_EQ(std::string(e->what()),
-            "config 't.toml': device.type = \"usb\" is not a known value; allowed: one of \"simulated\" (line 2)");
+            "config 't.toml': device.type = \"usb\" is not a known value; allowed: one of \"auto\", \"simulated\", \"haply\" (line 2)");
   e = capture_error([&] { (void)parse_settings("[device]\ntype = 3\n", "t.toml"); });
   ASSERT_TRUE(e);
   EXPECT_TRUE(contains(e->what(), "device.type = 3 has the wrong type (integer)")) << e->what();

@@ -1,5 +1,6 @@
 // to_toml -> parse_settings gives back exactly the same Settings, and the text is operator-readable.
 
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -31,11 +32,38 @@ Settings every_field_changed() {
   s.haptics.max_levels = 9;
   s.haptics.query_deadline_us = 150;
   s.haptics.force_ramp_s = 1.5;
-  s.device.type = "simulated";  // the only known type
+  s.device.type = "haply";
   s.device.handle_mass_kg = 0.1;
   s.device.handle_damping_n_s_per_m = 3;
   s.device.encoder_counts_per_rev = 4096;
   s.device.max_torque_n_m = 0.25;
+  s.device.transport = "tty";
+  s.device.usb_vid = 0x239A;
+  s.device.usb_pid = 0x8013;
+  s.device.serial_path = "/dev/serial/by-id/usb-Haply_board-if00";
+  s.device.device_id = 7;
+  s.device.lost_after_ticks = 5;
+  s.device.actuator1_port = 1;
+  s.device.actuator1_dir = "ccw";
+  s.device.actuator2_port = 2;
+  s.device.actuator2_dir = "ccw";
+  s.device.encoder1_port = 1;
+  s.device.encoder1_dir = "cw";
+  s.device.encoder1_offset_deg = 181.5;
+  s.device.encoder1_resolution = 2048;
+  s.device.encoder2_port = 2;
+  s.device.encoder2_dir = "cw";
+  s.device.encoder2_offset_deg = -1.25;
+  s.device.encoder2_resolution = 8192;
+  s.device.link_proximal_m = 0.05;
+  s.device.link_distal_m = 0.07;
+  s.device.motor_spacing_m = 0.02;
+  s.device.torque_limit_n_m = 0.2;
+  s.device.rect_width_m = 0.08;
+  s.device.rect_height_m = 0.05;
+  s.device.rect_center_y_m = -0.08;
+  s.device.park_theta1_deg = 170;
+  s.device.park_theta2_deg = 10;
   s.hand.stiffness_n_per_m = 300;
   s.hand.damping_n_s_per_m = 6;
   s.hand.max_force_n = 2.5;
@@ -97,6 +125,9 @@ Settings random_settings(std::mt19937_64& rng) {
   if (s.haptics.level > s.haptics.max_levels) s.haptics.level = s.haptics.max_levels;
   if (s.vision.canny_low > s.vision.canny_high) std::swap(s.vision.canny_low, s.vision.canny_high);
   if (s.haptics.dynamic_friction > s.haptics.static_friction) std::swap(s.haptics.dynamic_friction, s.haptics.static_friction);
+  if (s.device.actuator1_port == s.device.actuator2_port) s.device.actuator2_port = s.device.actuator1_port % 4 + 1;
+  if (s.device.encoder1_port == s.device.encoder2_port) s.device.encoder2_port = s.device.encoder1_port % 4 + 1;
+  s.device.motor_spacing_m = std::min(s.device.motor_spacing_m, 1.9 * (s.device.link_proximal_m + s.device.link_distal_m));
   return s;
 }
 

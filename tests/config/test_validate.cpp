@@ -54,8 +54,10 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     const std::string name = std::string(d.table) + "." + std::string(d.key);
     if (name == "device.type") {
       EXPECT_EQ(d.kind, FieldKind::text);
-      ASSERT_EQ(d.choices.size(), 1u);
-      EXPECT_EQ(d.choices[0], "simulated");
+      ASSERT_EQ(d.choices.size(), 3u);
+      EXPECT_EQ(d.choices[0], "auto");
+      EXPECT_EQ(d.choices[1], "simulated");
+      EXPECT_EQ(d.choices[2], "haply");
       ++texts;
       continue;
     }
@@ -72,7 +74,14 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
-    if (name == "operator.open_chord" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log") {
+    if (name == "device.transport" || name == "device.actuator1_dir" || name == "device.actuator2_dir" ||
+        name == "device.encoder1_dir" || name == "device.encoder2_dir") {
+      EXPECT_EQ(d.kind, FieldKind::text) << name;
+      EXPECT_GE(d.choices.size(), 2u) << name;
+      ++texts;
+      continue;
+    }
+    if (name == "operator.open_chord" || name == "device.serial_path" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -82,7 +91,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 15u);
+  EXPECT_EQ(texts, 21u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -131,7 +140,13 @@ TEST(ConfigValidate, BoundsThemselvesAreAccepted) {
       s.haptics.max_levels = 12;  // so that haptics.level = 12 passes the cross-field rule
       s.haptics.static_friction = 2.0;  // and any dynamic friction passes dynamic <= static...
       if (spec.name() == "haptics.static_friction") s.haptics.dynamic_friction = 0.0;  // ...and any static
+      s.device.link_distal_m = 0.5;  // so that any motor spacing lets the links meet
       set_numeric(s, spec, ok);
+      // The other actuator/encoder moves off a port this bound takes (each needs its own board port).
+      if (spec.name() == "device.actuator1_port" && ok == s.device.actuator2_port) s.device.actuator2_port = 3;
+      if (spec.name() == "device.actuator2_port" && ok == s.device.actuator1_port) s.device.actuator1_port = 3;
+      if (spec.name() == "device.encoder1_port" && ok == s.device.encoder2_port) s.device.encoder2_port = 3;
+      if (spec.name() == "device.encoder2_port" && ok == s.device.encoder1_port) s.device.encoder1_port = 3;
       EXPECT_NO_THROW(validate(s)) << spec.name() << " = " << ok;
     }
   }
@@ -209,7 +224,7 @@ TEST(ConfigValidate, UnknownDeviceTypeIsRefused) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "device.type");
   EXPECT_EQ(std::string(e->what()),
-            "settings: device.type = \"mouse\" is not a known value; allowed: one of \"simulated\"");
+            "settings: device.type = \"mouse\" is not a known value; allowed: one of \"auto\", \"simulated\", \"haply\"");
 }
 
 TEST(ConfigValidate, ControlCharactersInValuesDoNotBreakTheLine) {

@@ -32,13 +32,44 @@ struct HapticsSettings {
   bool operator==(const HapticsSettings&) const = default;
 };
 
-/// [device] — which device and the simulated pantograph's physical parameters.
+/// [device] — which device drives the handle: the simulated pantograph's physics, and the USB pantograph
+/// (Haply 2DIY gen3 speaking hAPI over CDC serial, issue 13): where to find it, its board layout (which
+/// actuator and encoder sit on which port, their directions, offsets and resolutions), its links, its
+/// torque limit, its usable rectangle and its calibration pose. The defaults are the gen3 2DIY's (Haply's
+/// hAPI examples and firmware Haply_M0_Firmware_V0_3; ports cross-wired: actuator/encoder 1 on port 2).
 struct DeviceSettings {
-  std::string type = "simulated";         ///< key type, one of "simulated" (the list grows as devices are added)
+  std::string type = "auto";              ///< key type, "auto" (the USB pantograph when one answers, else simulated), "simulated" or "haply"
   double handle_mass_kg = 0.08;           ///< key handle_mass_kg, effective handle mass, [0.001, 5] kg
   double handle_damping_n_s_per_m = 2.0;  ///< key handle_damping_n_s_per_m, device viscous damping, [0, 100] N·s/m
   int encoder_counts_per_rev = 16384;     ///< key encoder_counts_per_rev, [64, 1048576] counts/rev
   double max_torque_n_m = 0.5;            ///< key max_torque_n_m, per-motor torque limit, [0.001, 10] N·m
+  std::string transport = "auto";         ///< key transport, "auto" (libusb, then the kernel's tty), "usb" or "tty"
+  int usb_vid = 0x2341;                   ///< key usb_vid, USB vendor id of the pantograph's board, [0, 65535]
+  int usb_pid = 0x804D;                   ///< key usb_pid, USB product id, [0, 65535]
+  std::string serial_path;                ///< key serial_path, tty of the board for the tty transport; empty = the first /dev/serial/by-id entry
+  int device_id = 5;                      ///< key device_id, hAPI device id, [1, 255]
+  int lost_after_ticks = 3;               ///< key lost_after_ticks, ticks without a valid reply before the device counts as lost, [1, 1000]
+  int actuator1_port = 2;                 ///< key actuator1_port, board port of actuator 1 (Haply joint 1), [1, 4]
+  std::string actuator1_dir = "cw";       ///< key actuator1_dir, "cw" or "ccw"
+  int actuator2_port = 1;                 ///< key actuator2_port, [1, 4]
+  std::string actuator2_dir = "cw";       ///< key actuator2_dir, "cw" or "ccw"
+  int encoder1_port = 2;                  ///< key encoder1_port, [1, 4]
+  std::string encoder1_dir = "ccw";       ///< key encoder1_dir, "cw" or "ccw"
+  double encoder1_offset_deg = 180.0;     ///< key encoder1_offset_deg, joint 1 angle at the calibration pose, [-360, 360] deg
+  double encoder1_resolution = 4880.0;    ///< key encoder1_resolution, counts per revolution as the firmware takes it, [1, 1000000]
+  int encoder2_port = 1;                  ///< key encoder2_port, [1, 4]
+  std::string encoder2_dir = "ccw";       ///< key encoder2_dir, "cw" or "ccw"
+  double encoder2_offset_deg = 0.0;       ///< key encoder2_offset_deg, [-360, 360] deg
+  double encoder2_resolution = 4880.0;    ///< key encoder2_resolution, [1, 1000000]
+  double link_proximal_m = 0.07;          ///< key link_proximal_m, motor-to-elbow link l, [0.01, 0.5] m
+  double link_distal_m = 0.09;            ///< key link_distal_m, elbow-to-handle link L, [0.01, 0.5] m
+  double motor_spacing_m = 0.038;         ///< key motor_spacing_m, distance between the motor axes d, [0, 0.5] m
+  double torque_limit_n_m = 0.123;        ///< key torque_limit_n_m, the board's torque limit per motor, [0.001, 10] N·m
+  double rect_width_m = 0.1;              ///< key rect_width_m, the USB pantograph's usable rectangle, mapped onto [workspace], [0.01, 1] m
+  double rect_height_m = 0.064;           ///< key rect_height_m, [0.01, 1] m
+  double rect_center_y_m = -0.09;         ///< key rect_center_y_m, its centre's distance from the motor axis line (negative: towards the user), [-1, 1] m
+  double park_theta1_deg = 180.0;         ///< key park_theta1_deg, Haply joint 1 angle at the calibration (park) pose, [-360, 360] deg
+  double park_theta2_deg = 0.0;           ///< key park_theta2_deg, Haply joint 2 angle at the park pose, [-360, 360] deg
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const DeviceSettings&) const = default;
