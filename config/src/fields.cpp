@@ -171,8 +171,8 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(device, rect_width_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 1, "m", "USB pantograph: width of its usable rectangle, mapped onto [workspace]."),
     HK_FIELD(device, rect_height_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 1, "m", "USB pantograph: height of its usable rectangle."),
     HK_FIELD(device, rect_center_y_m, FieldGroup::devices, ApplyWhen::restart, -1, 1, "m", "USB pantograph: the rectangle's centre relative to the motor axes (negative: towards the visitor)."),
-    HK_FIELD(device, park_theta1_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg", "Joint 1 angle at the calibration (park) pose."),
-    HK_FIELD(device, park_theta2_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg", "Joint 2 angle at the calibration (park) pose."),
+    HK_FIELD(device, park_x_m, FieldGroup::devices, ApplyWhen::restart, -0.5, 0.5, "m", "Where the handle rests for 'haptic-kiosk calibrate' (workspace x)."),
+    HK_FIELD(device, park_y_m, FieldGroup::devices, ApplyWhen::restart, -0.5, 0.5, "m", "Where the handle rests for calibration (workspace y)."),
     // [hand]
     HK_FIELD(hand, stiffness_n_per_m, FieldGroup::devices, ApplyWhen::restart, 1, 5000, "N/m", "Spring pulling the hand to its target."),
     HK_FIELD(hand, damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 200, "N·s/m", "Damping of the hand spring."),

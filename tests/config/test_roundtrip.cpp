@@ -62,8 +62,8 @@ Settings every_field_changed() {
   s.device.rect_width_m = 0.08;
   s.device.rect_height_m = 0.05;
   s.device.rect_center_y_m = -0.08;
-  s.device.park_theta1_deg = 170;
-  s.device.park_theta2_deg = 10;
+  s.device.park_x_m = 0.01;
+  s.device.park_y_m = -0.02;
   s.hand.stiffness_n_per_m = 300;
   s.hand.damping_n_s_per_m = 6;
   s.hand.max_force_n = 2.5;

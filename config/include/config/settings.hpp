@@ -68,8 +68,8 @@ struct DeviceSettings {
   double rect_width_m = 0.1;              ///< key rect_width_m, the USB pantograph's usable rectangle, mapped onto [workspace], [0.01, 1] m
   double rect_height_m = 0.064;           ///< key rect_height_m, [0.01, 1] m
   double rect_center_y_m = -0.09;         ///< key rect_center_y_m, its centre's distance from the motor axis line (negative: towards the user), [-1, 1] m
-  double park_theta1_deg = 180.0;         ///< key park_theta1_deg, Haply joint 1 angle at the calibration (park) pose, [-360, 360] deg
-  double park_theta2_deg = 0.0;           ///< key park_theta2_deg, Haply joint 2 angle at the park pose, [-360, 360] deg
+  double park_x_m = 0.0;                 ///< key park_x_m, where the handle rests for calibration (a dimple in the kiosk's surface), workspace frame, [-0.5, 0.5] m
+  double park_y_m = 0.0;                  ///< key park_y_m, [-0.5, 0.5] m
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const DeviceSettings&) const = default;
