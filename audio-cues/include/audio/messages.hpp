@@ -27,9 +27,9 @@ enum class MessageId : int {
   level_finer, level_coarser, level_finest, level_coarsest, volume_up, volume_down, volume_limit,
   tutorial_start, tutorial_circle, tutorial_triangle, tutorial_done, timeout_warning, goodbye,
   no_audio_device, stick_inserted, stick_empty, stick_removed, stick_unreadable, document_page, document_picture,
-  document_unreadable, loading, text_block,
+  document_unreadable, loading, text_block, device_ready, device_simulated, device_lost, device_back,
 };
-inline constexpr int kMessageCount = 30;
+inline constexpr int kMessageCount = 34;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -37,7 +37,8 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "level_finer", "level_coarser", "level_finest", "level_coarsest", "volume_up", "volume_down", "volume_limit",
     "tutorial_start", "tutorial_circle", "tutorial_triangle", "tutorial_done", "timeout_warning", "goodbye",
     "no_audio_device", "stick_inserted", "stick_empty", "stick_removed", "stick_unreadable", "document_page",
-    "document_picture", "document_unreadable", "loading", "text_block"};
+    "document_picture", "document_unreadable", "loading", "text_block", "device_ready", "device_simulated",
+    "device_lost", "device_back"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".
