@@ -118,6 +118,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   if (!std::isfinite(o.duration_s) || o.duration_s > 24 * 3600.0) {
     throw ExploreError("--duration " + std::to_string(o.duration_s) + " s is outside (0, 86400] s");
   }
+  const DeviceChoice device = parse_device_choice(o.device);
   // Read the hand before the (slower) image so a bad hand file fails fast.
   const HandPath path = o.hand == "raster" ? raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m,
                                                          s.hand.raster_speed_m_per_s)
@@ -204,7 +205,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     level_waiting += so.level != so.level_wanted;
     sticking += c.sticking;
     if (so.level >= 0 && so.level < Scene::kMaxLevels) ++level_ticks[static_cast<std::size_t>(so.level)];
-  });
+  }, device, &sum.device);
   for (const Row& w : rows) {
     std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld\n", w.t_s, w.handle_m.x, w.handle_m.y, w.proxy_m.x,
                  w.proxy_m.y, w.force_n.x, w.force_n.y, w.contact, w.curve, w.level, static_cast<long long>(w.tick_ns));
@@ -245,6 +246,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["levels"] = {{"mode", s.haptics.level_mode}, {"changes", level_changes}, {"ticks_waiting_for_a_safe_change", level_waiting},
                   {"ticks_per_level", std::move(lt)}};
   sj["sticking_ticks"] = sticking;
+  sj["device"] = {{"name", sum.device.name}, {"status", sum.device.status}, {"replies_missing", sum.device.replies_missing},
+                  {"reconnects", sum.device.reconnects}, {"malformed_replies", sum.device.malformed}};
   if (is.page > 0) {
     sj["document"] = {{"page", is.page}, {"pages", is.pages}, {"text_blocks", is.text_blocks.size()}, {"words_masked", is.text_words_masked},
                       {"dpi", is.render_dpi}, {"worker_ms", is.worker_ms}, {"worker_max_rss_kb", is.worker_max_rss_kb}};

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "config/settings.hpp"
+#include "device_setup.hpp"
 #include "image_scene.hpp"
 
 namespace hk::app {
@@ -21,6 +22,7 @@ struct ExploreOptions {
   double duration_s = 0.0;     ///< run length [s]; ≤ 0: the hand path's duration + 0.5 s
   std::string config_path;     ///< TOML settings; empty: defaults
   std::string audio_out;       ///< WAV file for the run's earcons (and cues.csv beside the outputs); empty: none
+  std::string device = "sim";  ///< "sim" or "haply-emulator[:FAULT=VALUE,...]" (parse_device_choice)
 };
 
 /// A problem with the run's own arguments or output folder (bad inputs raise their own typed errors:
@@ -37,6 +39,7 @@ struct ExploreSummary {
   double max_force_n = 0.0;
   std::size_t curves = 0;
   std::size_t cues = 0;        ///< audio cues emitted (counted with or without --audio-out)
+  DeviceReport device;         ///< the device's name, final status and counters (summary.json "device")
 };
 
 /// The scene of the run's input: a picture file, or page `page` of a PDF (drawn in the worker, text

@@ -1,11 +1,13 @@
 // haptic-kiosk: command line entry. Subcommands: explore (headless run, DESIGN.md contract), stick (what a USB stick offers), pin
-// (set or check the operator's PIN) and speak (a message or text rendered to WAV).
+// (set or check the operator's PIN), speak (a message or text rendered to WAV), devices (USB and serial devices
+// found) and calibrate (the USB pantograph's encoder offsets).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <string>
 
 #include "audio_settings.hpp"
+#include "device_command.hpp"
 #include "explore.hpp"
 #include "kiosk_app.hpp"
 #include "pin_command.hpp"
@@ -49,6 +51,17 @@ int main(int argc, char** argv) {
   explore->add_option("--duration", eo.duration_s, "Run length [s]; default: the hand path's length")->check(CLI::PositiveNumber);
   explore->add_option("--config", eo.config_path, "Settings file (TOML)");
   explore->add_option("--audio-out", eo.audio_out, "Also render the run's earcons to this WAV file (tick k at t = k / servo rate)");
+  explore->add_option("--device", eo.device,
+                      "sim, or haply-emulator[:FAULT=VALUE,...] (the firmware emulator behind a pty; faults disconnect_at_s, "
+                      "drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed, calib_error1_deg, calib_error2_deg)")
+      ->default_val("sim");
+  hk::app::DevicesOptions dvo;
+  CLI::App* devices = cli.add_subcommand("devices", "List the USB and serial devices found, and which are supported");
+  devices->add_option("--config", dvo.config_path, "Settings file (TOML): [device] usb_vid, usb_pid");
+  hk::app::CalibrateOptions co;
+  CLI::App* calibrate = cli.add_subcommand("calibrate", "With the handle resting at the park place, set the encoder offsets");
+  calibrate->add_option("--config", co.config_path, "Settings file (TOML) to read and to write the offsets into")->required();
+  calibrate->add_option("--device", co.device, "haply (the board) or haply-emulator[:calib_error1_deg=V,...]")->default_val("haply");
   hk::app::SpeakOptions so;
   CLI::App* speak = cli.add_subcommand("speak", "Render a message of the catalogue, or any text, as speech into a WAV file");
   speak->add_option("what", so.what, "A message key (welcome, help, picture_loaded, ...) or text to say")->required();
@@ -78,11 +91,15 @@ int main(int argc, char** argv) {
       const auto sum = hk::app::run_explore(eo);
       std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n", sum.ticks,
                   sum.curves, sum.edge_ticks, sum.vertex_ticks, sum.max_force_n, eo.out_dir.c_str());
+    } else if (*devices) {
+      return hk::app::run_devices(dvo);
+    } else if (*calibrate) {
+      return hk::app::run_calibrate(co);
     } else if (*stick) {
       return hk::app::run_stick(sto);
     } else if (*pin) {
       return hk::app::run_pin(po);
-    } else if (!*explore && !*speak) {
+    } else if (!*speak) {
       return hk::app::run_kiosk(ko);
     } else if (*speak) {
       const std::string text = hk::app::run_speak(so);

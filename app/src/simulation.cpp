@@ -3,6 +3,10 @@
 #include <chrono>
 #include <cmath>
 
+#include "haptics/hapi_emulator.hpp"
+#include "haptics/io/haply_device.hpp"
+#include "haptics/io/tty_transport.hpp"
+#include "haptics/pty_emulator.hpp"
 #include "haptics/sim_pantograph.hpp"
 
 namespace hk::app {
@@ -58,8 +62,10 @@ ModelHandParams hand_params_from(const config::Settings& s) {
   return hp;
 }
 
-long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
-                    const TickObserver& observe) {
+namespace {
+
+long run_simulated(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+                   const TickObserver& observe, DeviceReport* report) {
   SimulatedPantograph device(sim_params_from(s), hand.at(0.0));
   device.open();
   const ModelHandParams hp = hand_params_from(s);
@@ -80,12 +86,83 @@ long run_simulation(const Scene& scene, const config::Settings& s, const HandPat
     servo.update(in, so);
     rec.tick_ns = steady_ns() - t0;
     rec.handle_m = in.sample.handle_m;
+    rec.device_status = in.sample.status;
     device.write_force(so.force_n);
     device.step(sp.period_s, model_hand_force(hp, hand.at(rec.t_s), device.true_position_m(), device.velocity_m_per_s()));
+    const Torques tau = device.applied_torques_n_m();
+    rec.motor_torque_n_m[0] = tau.tau1_n_m;
+    rec.motor_torque_n_m[1] = tau.tau2_n_m;
     if (observe) observe(rec, so);
+  }
+  if (report) {
+    *report = DeviceReport{};
+    report->name = device.name();
+    report->status = device_status_name(device.status());
   }
   device.close();
   return n_ticks;
+}
+
+long run_emulated(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+                  const TickObserver& observe, const DeviceChoice& choice, DeviceReport* report) {
+  io::HaplyDeviceParams dp = haply_params_from(s);
+  dp.reply_wait_us = 10000;  // headless: wait for the reply instead of depending on the machine's speed
+  const double scale = io::workspace_scale(dp);
+  const Vec2 centre = dp.rect_center_device_m;
+  const ModelHandParams hp = hand_params_from(s);
+  // The model hand lives in the workspace frame; the emulator's handle in the device frame.
+  hapi::HandForce hand_force = [&hand, hp, scale, centre](double t_s, Vec2 handle_device_m, Vec2 velocity_device_m_per_s) {
+    return model_hand_force(hp, hand.at(t_s), scale * (handle_device_m - centre), scale * velocity_device_m_per_s);
+  };
+  hapi::FirmwareEmulator emulator(emulator_params_from(s, choice), (1.0 / scale) * hand.at(0.0) + centre, hand_force);
+  hapi::PtyEmulator pty(emulator);
+  const std::string tty_path = pty.device_path();
+  io::HaplyDevice device(dp, [tty_path] { return std::make_unique<io::TtyTransport>(tty_path); });
+  device.open();
+
+  const ServoParams sp = servo_params_from(s);
+  ServoLoop servo(scene, sp);
+  servo.start(device.read().handle_m);
+  const long n_ticks = static_cast<long>(std::ceil(duration_s / sp.period_s - 1e-9));
+  ServoOutput so;
+  TickRecord rec;
+  DeviceStatus last_status = DeviceStatus::Ok;
+  for (long k = 0; k < n_ticks; ++k) {
+    rec.index = k;
+    rec.t_s = static_cast<double>(k) * sp.period_s;
+    ServoInput in;
+    in.sample = device.read();
+    if (in.sample.status == DeviceStatus::Ok && last_status != DeviceStatus::Ok) servo.start(in.sample.handle_m);  // back: ramp in again
+    last_status = in.sample.status;
+    const std::int64_t t0 = steady_ns();
+    in.now_ns = t0;
+    servo.update(in, so);
+    rec.tick_ns = steady_ns() - t0;
+    rec.handle_m = in.sample.handle_m;
+    rec.device_status = in.sample.status;
+    device.write_force(so.force_n);
+    device.last_torques_n_m(&rec.motor_torque_n_m[0], &rec.motor_torque_n_m[1]);
+    if (observe) observe(rec, so);
+  }
+  if (report) {
+    const io::HaplyCounters c = device.counters();
+    report->name = "haply-emulator (" + device.name() + ")";
+    report->status = device_status_name(device.status());
+    report->replies_missing = c.replies_missing;
+    report->reconnects = c.reconnects;
+    report->malformed = c.malformed;
+  }
+  device.close();
+  pty.stop();
+  return n_ticks;
+}
+
+}  // namespace
+
+long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+                    const TickObserver& observe, const DeviceChoice& device, DeviceReport* report) {
+  if (device.kind == DeviceChoice::Kind::HaplyEmulator) return run_emulated(scene, s, hand, duration_s, observe, device, report);
+  return run_simulated(scene, s, hand, duration_s, observe, report);
 }
 
 }  // namespace hk::app

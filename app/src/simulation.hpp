@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "config/settings.hpp"
+#include "device_setup.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
@@ -20,6 +21,10 @@ struct TickRecord {
   double t_s = 0.0;             ///< tick k at t = k · period [s]
   Vec2 handle_m;                ///< handle position the servo saw (encoder-quantised) [m]
   std::int64_t tick_ns = 0;     ///< measured time of collision + contact + force [ns]
+  /// Motor torques the device was commanded this tick [N·m]: the simulated pantograph's (left, right motor),
+  /// or the USB pantograph's (actuator 1, actuator 2) as sent in the torque packet.
+  double motor_torque_n_m[2] = {0.0, 0.0};
+  DeviceStatus device_status = DeviceStatus::Ok;  ///< the sample's status this tick
 };
 
 /// Called after every tick with its record and the servo's full output (proxy path, events, stats).
@@ -39,9 +44,14 @@ SimPantographParams sim_params_from(const config::Settings& s);
 /// Model hand parameters from the settings ([hand]).
 ModelHandParams hand_params_from(const config::Settings& s);
 
-/// Runs the simulated pantograph driven by `hand` over `scene` for `duration_s` seconds.
-/// Returns the number of ticks run.
+/// Runs the device `device` chose (the simulated pantograph, or the Haply firmware emulator behind a pty
+/// reached through the tty transport and the hAPI driver, bytes and all) driven by `hand` over `scene` for
+/// `duration_s` seconds, tick by tick as fast as the machine goes. With the emulator a tick waits up to
+/// 10 ms for the reply to the previous tick's packet while the device is Ok (so the run does not depend on
+/// the machine's speed), not at all while it is Lost; a device that comes back restarts the servo at the
+/// handle (force ramped in again). `report` (may be null) receives the device's name, final status and
+/// counters. Returns the number of ticks run. Throws DeviceError when the emulator cannot be reached.
 long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
-                    const TickObserver& observe);
+                    const TickObserver& observe, const DeviceChoice& device = {}, DeviceReport* report = nullptr);
 
 }  // namespace hk::app

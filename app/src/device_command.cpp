@@ -1,0 +1,91 @@
+#include "device_command.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "config/load.hpp"
+#include "device_setup.hpp"
+#include "haptics/hapi_emulator.hpp"
+#include "haptics/io/haply_device.hpp"
+#include "haptics/io/tty_transport.hpp"
+#include "haptics/io/usb_devices.hpp"
+#include "haptics/pty_emulator.hpp"
+
+namespace hk::app {
+
+int run_devices(const DevicesOptions& o) {
+  const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
+  std::string reason;
+  const std::vector<io::UsbDeviceInfo> usb = io::list_usb_devices(&reason);
+  std::printf("USB devices:\n");
+  if (usb.empty()) std::printf("  no USB device found%s%s\n", reason.empty() ? "" : ": ", reason.c_str());
+  for (const io::UsbDeviceInfo& d : usb) {
+    const bool supported = d.vid == s.device.usb_vid && d.pid == s.device.usb_pid;
+    std::string label = d.manufacturer;
+    if (!d.product.empty()) label += (label.empty() ? "" : " ") + d.product;
+    if (label.empty()) label = "(no name readable)";
+    std::printf("  %04x:%04x bus %d address %d  %s  %s\n", d.vid, d.pid, d.bus, d.address, label.c_str(),
+                supported ? "supported: USB pantograph (hAPI, [device] usb_vid:usb_pid)" : "not supported");
+  }
+  std::printf("Serial devices (/dev/serial/by-id):\n");
+  const std::vector<std::string> ttys = io::list_serial_by_id();
+  if (ttys.empty()) std::printf("  none\n");
+  for (const std::string& t : ttys) std::printf("  %s  %s\n", t.c_str(), "usable with [device] transport = \"tty\"");
+  return 0;
+}
+
+int run_calibrate(const CalibrateOptions& o) {
+  config::Settings s = config::load_settings(o.config_path);
+  io::HaplyDeviceParams dp = haply_params_from(s);
+  dp.reply_wait_us = 20000;
+  const Vec2 park{s.device.park_x_m, s.device.park_y_m};
+  std::unique_ptr<hapi::FirmwareEmulator> emulator;
+  std::unique_ptr<hapi::PtyEmulator> pty;
+  io::TransportFactory factory;
+  if (o.device == "haply") {
+    factory = board_transport_factory(s);
+  } else {
+    const DeviceChoice choice = parse_device_choice(o.device);
+    if (choice.kind != DeviceChoice::Kind::HaplyEmulator)
+      throw DeviceChoiceError("--device '" + o.device + "': calibrate needs 'haply' or 'haply-emulator[:...]'");
+    const double scale = io::workspace_scale(dp);
+    // The emulated handle rests at the park place, untouched.
+    emulator = std::make_unique<hapi::FirmwareEmulator>(emulator_params_from(s, choice), (1.0 / scale) * park + dp.rect_center_device_m,
+                                                        [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+    pty = std::make_unique<hapi::PtyEmulator>(*emulator);
+    const std::string path = pty->device_path();
+    factory = [path] { return std::make_unique<io::TtyTransport>(path); };
+  }
+  io::HaplyDevice device(dp, factory);
+  device.open();
+  double sum1 = 0, sum2 = 0;
+  constexpr int kTicks = 50;
+  for (int k = 0; k < kTicks; ++k) {
+    device.write_force({0.0, 0.0});
+    const DeviceSample smp = device.read();
+    if (smp.status != DeviceStatus::Ok) throw DeviceError(device.name() + ": stopped answering during calibration");
+    double a1 = 0, a2 = 0;
+    device.joint_angles_deg(&a1, &a2);
+    sum1 += a1;
+    sum2 += a2;
+  }
+  device.close();
+  if (pty) pty->stop();
+  double o1 = 0, o2 = 0;
+  if (!io::calibrated_offsets(dp, park, sum1 / kTicks, sum2 / kTicks, &o1, &o2))
+    throw std::runtime_error("calibrate: the park place (" + std::to_string(park.x) + ", " + std::to_string(park.y) +
+                             ") m is out of the links' reach; check [device] park_x_m, park_y_m and the rectangle");
+  const double old1 = s.device.encoder1_offset_deg, old2 = s.device.encoder2_offset_deg;
+  s.device.encoder1_offset_deg = std::round(o1 * 1000.0) / 1000.0;
+  s.device.encoder2_offset_deg = std::round(o2 * 1000.0) / 1000.0;
+  config::save_settings_atomic(s, o.config_path);
+  std::printf("calibrate: encoder 1 offset %.3f -> %.3f deg, encoder 2 offset %.3f -> %.3f deg; written to %s\n", old1,
+              s.device.encoder1_offset_deg, old2, s.device.encoder2_offset_deg, o.config_path.c_str());
+  return 0;
+}
+
+}  // namespace hk::app

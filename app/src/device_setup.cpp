@@ -1,0 +1,170 @@
+#include "device_setup.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "haptics/io/tty_transport.hpp"
+#include "haptics/io/usb_transport.hpp"
+
+namespace hk::app {
+namespace {
+
+hapi::Rotation rotation_of(const std::string& dir) { return dir == "ccw" ? hapi::Rotation::CCW : hapi::Rotation::CW; }
+
+double number_of(const std::string& key, const std::string& value, double lo, double hi, bool integer) {
+  double v = 0.0;
+  const char* first = value.data();
+  const char* last = value.data() + value.size();
+  auto [p, ec] = std::from_chars(first, last, v);
+  const bool ok = ec == std::errc{} && p == last && std::isfinite(v) && v >= lo && v <= hi && (!integer || v == std::floor(v));
+  if (!ok) {
+    char range[96];
+    std::snprintf(range, sizeof range, "%s in [%g, %g]", integer ? "an integer" : "a number", lo, hi);
+    throw DeviceChoiceError("--device haply-emulator: " + key + "=" + value + " must be " + range);
+  }
+  return v;
+}
+
+}  // namespace
+
+DeviceChoice parse_device_choice(const std::string& text) {
+  DeviceChoice c;
+  if (text == "sim" || text == "simulated") return c;
+  const std::string kEmu = "haply-emulator";
+  if (text.rfind(kEmu, 0) != 0 || (text.size() > kEmu.size() && text[kEmu.size()] != ':'))
+    throw DeviceChoiceError("--device '" + text + "': must be 'sim' or 'haply-emulator[:FAULT=VALUE,...]'");
+  c.kind = DeviceChoice::Kind::HaplyEmulator;
+  std::string rest = text.size() > kEmu.size() ? text.substr(kEmu.size() + 1) : std::string{};
+  std::size_t at = 0;
+  while (at < rest.size()) {
+    std::size_t comma = rest.find(',', at);
+    if (comma == std::string::npos) comma = rest.size();
+    const std::string item = rest.substr(at, comma - at);
+    at = comma + 1;
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw DeviceChoiceError("--device haply-emulator: '" + item + "' must be KEY=VALUE");
+    const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+    constexpr double kDay = 86400.0, kMaxEvery = 1e6;
+    if (key == "disconnect_at_s") c.faults.disconnect_at_s = number_of(key, value, 0, kDay, false);
+    else if (key == "stall_at_s") c.faults.stall_at_s = number_of(key, value, 0, kDay, false);
+    else if (key == "stall_s") c.faults.stall_s = number_of(key, value, 0, 60, false);
+    else if (key == "drop_every") c.faults.drop_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
+    else if (key == "garbage_every") c.faults.garbage_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
+    else if (key == "wrong_id_every") c.faults.wrong_id_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
+    else if (key == "seed") c.faults.seed = static_cast<std::uint64_t>(number_of(key, value, 0, 9007199254740992.0, true));
+    else if (key == "calib_error1_deg") c.calibration_error_deg[0] = number_of(key, value, -90, 90, false);
+    else if (key == "calib_error2_deg") c.calibration_error_deg[1] = number_of(key, value, -90, 90, false);
+    else
+      throw DeviceChoiceError("--device haply-emulator: unknown fault '" + key +
+                              "'; known: disconnect_at_s, drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed, "
+                              "calib_error1_deg, calib_error2_deg");
+  }
+  return c;
+}
+
+hapi::BoardLayout board_layout_from(const config::Settings& s) {
+  const config::DeviceSettings& d = s.device;
+  hapi::BoardLayout b;
+  b.device_id = static_cast<std::uint8_t>(d.device_id);
+  b.actuator_count = 2;
+  b.actuators[0] = {1, rotation_of(d.actuator1_dir), d.actuator1_port};
+  b.actuators[1] = {2, rotation_of(d.actuator2_dir), d.actuator2_port};
+  b.encoder_count = 2;
+  b.encoders[0] = {1, rotation_of(d.encoder1_dir), d.encoder1_offset_deg, d.encoder1_resolution, d.encoder1_port};
+  b.encoders[1] = {2, rotation_of(d.encoder2_dir), d.encoder2_offset_deg, d.encoder2_resolution, d.encoder2_port};
+  return b;
+}
+
+io::HaplyDeviceParams haply_params_from(const config::Settings& s) {
+  const config::DeviceSettings& d = s.device;
+  io::HaplyDeviceParams p;
+  p.layout = board_layout_from(s);
+  p.mechanism.proximal_m = d.link_proximal_m;
+  p.mechanism.distal_m = d.link_distal_m;
+  p.mechanism.motor_spacing_m = d.motor_spacing_m;
+  p.torque_limit_n_m = d.torque_limit_n_m;
+  p.rect_center_device_m = {0.0, d.rect_center_y_m};
+  p.rect_size_device_m = {d.rect_width_m, d.rect_height_m};
+  p.workspace_size_m = {s.workspace.width_m, s.workspace.height_m};
+  p.lost_after_ticks = d.lost_after_ticks;
+  p.reply_wait_us = 0;
+  return p;
+}
+
+hapi::EmulatorParams emulator_params_from(const config::Settings& s, const DeviceChoice& choice) {
+  const config::DeviceSettings& d = s.device;
+  hapi::EmulatorParams e;
+  e.mechanism.proximal_m = d.link_proximal_m;
+  e.mechanism.distal_m = d.link_distal_m;
+  e.mechanism.motor_spacing_m = d.motor_spacing_m;
+  e.handle_mass_kg = d.handle_mass_kg;
+  e.handle_damping_n_s_per_m = d.handle_damping_n_s_per_m;
+  e.torque_limit_n_m = d.torque_limit_n_m;
+  e.period_s = 1.0 / s.haptics.servo_rate_hz;
+  // The board wired as configured: port → joint and the true directions per port.
+  for (int port = 1; port <= 2; ++port) {
+    if (d.actuator1_port == port) e.wired_motor_dir[port - 1] = rotation_of(d.actuator1_dir);
+    if (d.actuator2_port == port) e.wired_motor_dir[port - 1] = rotation_of(d.actuator2_dir);
+    if (d.encoder1_port == port) {
+      e.wired_encoder_dir[port - 1] = rotation_of(d.encoder1_dir);
+      e.port_joint[port - 1] = 1;
+    }
+    if (d.encoder2_port == port) {
+      e.wired_encoder_dir[port - 1] = rotation_of(d.encoder2_dir);
+      e.port_joint[port - 1] = 2;
+    }
+  }
+  e.reference_deg[0] = d.encoder1_offset_deg;
+  e.reference_deg[1] = d.encoder2_offset_deg;
+  e.calibration_error_deg[0] = choice.calibration_error_deg[0];
+  e.calibration_error_deg[1] = choice.calibration_error_deg[1];
+  e.workspace_half_extent_m = {d.rect_width_m / 2, d.rect_height_m / 2};
+  e.workspace_center_m = {0.0, d.rect_center_y_m};
+  e.stop_margin_m = 0.005;
+  e.faults = choice.faults;
+  return e;
+}
+
+io::TransportFactory board_transport_factory(const config::Settings& s) {
+  const config::DeviceSettings d = s.device;
+  return [d]() -> std::unique_ptr<io::ByteTransport> {
+    auto tty = [&d]() -> std::unique_ptr<io::ByteTransport> {
+      std::string path = d.serial_path;
+      if (path.empty()) {
+        const std::vector<std::string> ids = io::list_serial_by_id();
+        if (ids.empty()) throw DeviceError("no serial device in /dev/serial/by-id (set [device] serial_path)");
+        path = ids.front();
+      }
+      return std::make_unique<io::TtyTransport>(path);
+    };
+    auto usb = [&d]() -> std::unique_ptr<io::ByteTransport> {
+      return std::make_unique<io::UsbCdcTransport>(static_cast<std::uint16_t>(d.usb_vid), static_cast<std::uint16_t>(d.usb_pid));
+    };
+    if (d.transport == "tty") return tty();
+    if (d.transport == "usb") return usb();
+    // auto: libusb when the board is on the bus (probe by opening), else the kernel's tty.
+    try {
+      auto t = usb();
+      t->open();
+      t->close();
+      return usb();
+    } catch (const std::exception&) {
+      return tty();
+    }
+  };
+}
+
+const char* device_status_name(DeviceStatus status) noexcept {
+  switch (status) {
+    case DeviceStatus::Closed: return "closed";
+    case DeviceStatus::Ok: return "ok";
+    case DeviceStatus::Lost: return "lost";
+    case DeviceStatus::Fault: return "fault";
+  }
+  return "unknown";
+}
+
+}  // namespace hk::app

@@ -1,0 +1,68 @@
+#pragma once
+/// @file device_setup.hpp
+/// Which device a run or the kiosk uses, built from the settings (issue 13, items 3, 4 and 6): the
+/// `--device` choice of headless runs (`sim`, or `haply-emulator[:FAULT=VALUE,...]`: the firmware emulator
+/// behind a pty, reached through the same tty transport and driver as a real board), the USB pantograph's
+/// driver parameters from [device] and [workspace], and the transport to a real board ([device] transport:
+/// libusb CDC-ACM by VID:PID, or the kernel's tty).
+
+#include <stdexcept>
+#include <string>
+
+#include "config/settings.hpp"
+#include "haptics/device.hpp"
+#include "haptics/hapi_emulator.hpp"
+#include "haptics/hapi_protocol.hpp"
+#include "haptics/io/haply_device.hpp"
+
+namespace hk::app {
+
+/// A `--device` value that cannot be used; the message names the value and the limit.
+class DeviceChoiceError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// What `--device` asked for.
+struct DeviceChoice {
+  enum class Kind { Simulated, HaplyEmulator };
+  Kind kind = Kind::Simulated;
+  hapi::EmulatorFaults faults;             ///< haply-emulator faults (disconnect_at_s, drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed)
+  double calibration_error_deg[2] = {0, 0};///< haply-emulator: encoder zero errors of joints 1 and 2 (calib_error1_deg, calib_error2_deg) [deg]
+};
+
+/// Parses `sim` (or `simulated`) and `haply-emulator[:KEY=VALUE,...]` with keys disconnect_at_s, stall_at_s,
+/// stall_s (seconds ≥ 0), drop_every, garbage_every, wrong_id_every (integers in [0, 1000000]; 0 = never),
+/// seed (integer ≥ 0), calib_error1_deg, calib_error2_deg ([-90, 90]). Throws DeviceChoiceError naming the
+/// key or value and its limit.
+DeviceChoice parse_device_choice(const std::string& text);
+
+/// The hAPI board layout of [device] (ports, directions, encoder offsets and resolutions, device id).
+hapi::BoardLayout board_layout_from(const config::Settings& s);
+
+/// The USB pantograph driver's parameters from [device] and [workspace]; reply_wait_us 0 (kiosk timing).
+io::HaplyDeviceParams haply_params_from(const config::Settings& s);
+
+/// The firmware emulator's parameters: the board wired as [device] describes it (so a right configuration
+/// reads right), the mechanism and handle physics of [device], the stop box = the usable rectangle plus
+/// 5 mm, and the choice's faults and calibration errors.
+hapi::EmulatorParams emulator_params_from(const config::Settings& s, const DeviceChoice& choice);
+
+/// Opens transports to a real board as [device] transport says: "usb" → libusb CDC-ACM at usb_vid:usb_pid;
+/// "tty" → serial_path, or the first /dev/serial/by-id entry; "auto" → usb, and the tty when libusb finds
+/// no such device. The factory throws DeviceError (one line) when there is nothing to open.
+io::TransportFactory board_transport_factory(const config::Settings& s);
+
+/// Lower-case name of a device status for summary.json and logs: "closed", "ok", "lost", "fault".
+const char* device_status_name(DeviceStatus status) noexcept;
+
+/// The device part of summary.json: {name, status, replies_missing, reconnects}.
+struct DeviceReport {
+  std::string name = "simulated pantograph";
+  std::string status = "ok";        ///< status at the end of the run (before closing)
+  long long replies_missing = 0;    ///< ticks whose reply did not come or came malformed (0 for the simulation)
+  long long reconnects = 0;         ///< times the device came back after being lost
+  long long malformed = 0;          ///< replies refused (wrong id, bad angles, bytes out of step)
+};
+
+}  // namespace hk::app

@@ -1,0 +1,253 @@
+// The hAPI pantograph driver (haptics/io/haply_device.hpp) against the firmware emulator, in process: a
+// loopback transport hands the driver's bytes to FirmwareEmulator::receive and its replies back, so every
+// tick is deterministic. Positions, torques through the cross-wired ports, the torque clamp, lost and
+// stalled boards, garbage and dropped replies, and calibration.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "haptics/hapi_emulator.hpp"
+#include "haptics/io/haply_device.hpp"
+
+using namespace hk;
+
+namespace {
+
+/// A transport straight into the emulator (no pty, no thread): write feeds it, read takes its output.
+class LoopbackTransport final : public io::ByteTransport {
+ public:
+  explicit LoopbackTransport(hapi::FirmwareEmulator& e) : emu_(e) {}
+  void open() override { open_ = true; }
+  void close() noexcept override { open_ = false; }
+  int write(const std::uint8_t* data, int n, int) noexcept override {
+    emu_.receive(data, n);
+    return n;
+  }
+  int read(std::uint8_t* buf, int capacity, int) noexcept override { return emu_.take_output(buf, capacity); }
+  void flush_input() noexcept override {
+    std::uint8_t sink[256];
+    while (emu_.take_output(sink, sizeof sink) > 0) {
+    }
+  }
+  bool is_open() const noexcept override { return open_; }
+  std::string name() const override { return "loopback"; }
+
+ private:
+  hapi::FirmwareEmulator& emu_;
+  bool open_ = false;
+};
+
+hapi::EmulatorParams emulator_params(const io::HaplyDeviceParams& dp) {
+  hapi::EmulatorParams e;
+  e.mechanism = dp.mechanism;
+  e.torque_limit_n_m = dp.torque_limit_n_m;
+  e.workspace_half_extent_m = 0.5 * dp.rect_size_device_m;
+  e.workspace_center_m = dp.rect_center_device_m;
+  return e;
+}
+
+struct Rig {
+  explicit Rig(hapi::EmulatorParams ep = {}, Vec2 start_ws = {0.01, -0.005}, io::HaplyDeviceParams p = {})
+      : dp(p),
+        emu(fill(ep, dp), device_of(dp, start_ws), [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; }),
+        dev(dp, [this] { return std::make_unique<LoopbackTransport>(emu); }) {}
+  static hapi::EmulatorParams fill(hapi::EmulatorParams ep, const io::HaplyDeviceParams& dp) {
+    ep.mechanism = dp.mechanism;
+    ep.torque_limit_n_m = dp.torque_limit_n_m;
+    ep.workspace_half_extent_m = 0.5 * dp.rect_size_device_m;
+    ep.workspace_center_m = dp.rect_center_device_m;
+    return ep;
+  }
+  static Vec2 device_of(const io::HaplyDeviceParams& dp, Vec2 ws) { return (1.0 / io::workspace_scale(dp)) * ws + dp.rect_center_device_m; }
+  io::HaplyDeviceParams dp;
+  hapi::FirmwareEmulator emu;
+  io::HaplyDevice dev;
+};
+
+// One encoder count of the gen3 board is 360 / (4880 / 2) degrees; through links of 0.07 m and 0.09 m and
+// the workspace scale (1.4) that moves the handle well under a millimetre.
+constexpr double kPositionTolerance_m = 1e-3;
+
+}  // namespace
+
+TEST(HaplyDevice, ReadsTheHandleWhereTheEmulatedLinkageHoldsIt) {
+  Rig r;
+  r.dev.open();
+  EXPECT_EQ(r.dev.status(), DeviceStatus::Ok);
+  for (int k = 0; k < 20; ++k) {
+    r.dev.write_force({0.0, 0.0});
+    const DeviceSample s = r.dev.read();
+    ASSERT_EQ(s.status, DeviceStatus::Ok);
+    const Vec2 truth = r.dev.to_workspace(r.emu.handle_device_m());
+    EXPECT_NEAR(s.handle_m.x, truth.x, kPositionTolerance_m) << k;
+    EXPECT_NEAR(s.handle_m.y, truth.y, kPositionTolerance_m) << k;
+  }
+  EXPECT_NEAR(r.dev.read().handle_m.x, 0.01, kPositionTolerance_m);
+  EXPECT_NEAR(r.dev.read().handle_m.y, -0.005, kPositionTolerance_m);
+}
+
+TEST(HaplyDevice, AForceComesOutAsThatForceThroughTheCrossWiredPorts) {
+  // Jᵀ·F per joint, sent in port order (port 1 = actuator 2), turned back into a handle force by the
+  // emulator's own Jacobian: the same vector comes out only if every index and port is mapped right.
+  for (Vec2 f : {Vec2{0.4, 0.0}, Vec2{0.0, 0.4}, Vec2{-0.3, 0.2}, Vec2{0.1, -0.35}}) {
+    Rig r;
+    r.dev.open();
+    r.dev.read();
+    r.dev.write_force(f);
+    r.dev.read();  // the emulator has executed the packet
+    const Vec2 out = r.emu.applied_force_device_n();
+    EXPECT_NEAR(out.x, f.x, 0.03 * length(f)) << f.x << "," << f.y;
+    EXPECT_NEAR(out.y, f.y, 0.03 * length(f)) << f.x << "," << f.y;
+  }
+}
+
+TEST(HaplyDevice, TorquesAreClampedAndANonFiniteForceSendsZero) {
+  Rig r;
+  r.dev.open();
+  r.dev.read();
+  double t1 = 0, t2 = 0;
+  r.dev.write_force({500.0, -300.0});
+  r.dev.last_torques_n_m(&t1, &t2);
+  EXPECT_LE(std::fabs(t1), r.dp.torque_limit_n_m);
+  EXPECT_LE(std::fabs(t2), r.dp.torque_limit_n_m);
+  EXPECT_TRUE(std::fabs(t1) == r.dp.torque_limit_n_m || std::fabs(t2) == r.dp.torque_limit_n_m);
+  r.dev.read();
+  r.dev.write_force({NAN, 1.0});
+  r.dev.last_torques_n_m(&t1, &t2);
+  EXPECT_EQ(t1, 0.0);
+  EXPECT_EQ(t2, 0.0);
+}
+
+TEST(HaplyDevice, ADisconnectedBoardIsLostAfterLostAfterTicksAndGetsZeroTorque) {
+  hapi::EmulatorParams ep;
+  ep.faults.disconnect_at_s = 0.2;
+  Rig r(ep);
+  r.dev.open();
+  const double lim = r.dp.torque_limit_n_m;
+  long first_lost = -1, answered_ticks = 0;
+  for (long k = 0; k < 600; ++k) {
+    const DeviceSample s = r.dev.read();
+    if (s.status == DeviceStatus::Lost && first_lost < 0) first_lost = k;
+    if (s.status == DeviceStatus::Ok) ++answered_ticks;
+    r.dev.write_force({0.5, 0.5});  // a force the servo would send if the guard let it
+    double t1 = 0, t2 = 0;
+    r.dev.last_torques_n_m(&t1, &t2);
+    if (first_lost >= 0) {
+      EXPECT_EQ(t1, 0.0) << k;
+      EXPECT_EQ(t2, 0.0) << k;
+    } else {
+      EXPECT_LE(std::fabs(t1), lim);
+    }
+  }
+  ASSERT_GE(first_lost, 0) << "the board never counted as lost";
+  // The emulator stops at 0.2 s of its time (200 torque packets, one of them sent by open()); the driver
+  // notices lost_after_ticks = 3 ticks later.
+  EXPECT_LE(first_lost, 200 + r.dp.lost_after_ticks + 1);
+  EXPECT_GE(first_lost, 200 - 1);
+  EXPECT_EQ(r.dev.status(), DeviceStatus::Lost);
+  EXPECT_GE(r.dev.counters().replies_missing, 600 - first_lost);
+}
+
+TEST(HaplyDevice, AStalledBoardIsLostThenBackWithOneReconnect) {
+  hapi::EmulatorParams ep;
+  ep.faults.stall_at_s = 0.1;
+  ep.faults.stall_s = 0.05;
+  Rig r(ep);
+  r.dev.open();
+  bool was_lost = false;
+  for (long k = 0; k < 400; ++k) {
+    const DeviceSample s = r.dev.read();
+    was_lost = was_lost || s.status == DeviceStatus::Lost;
+    r.dev.write_force({0.1, 0.0});
+  }
+  EXPECT_TRUE(was_lost);
+  EXPECT_EQ(r.dev.status(), DeviceStatus::Ok);
+  EXPECT_EQ(r.dev.counters().reconnects, 1);
+}
+
+TEST(HaplyDevice, GarbageDropsAndWrongIdsNeverGiveABadTorqueOrAJump) {
+  hapi::EmulatorParams ep;
+  ep.faults.garbage_every = 7;
+  ep.faults.drop_every = 11;
+  ep.faults.wrong_id_every = 13;
+  ep.faults.seed = 42;
+  Rig r(ep);
+  r.dev.open();
+  Vec2 last = r.dev.read().handle_m;
+  long ok_ticks = 0;
+  for (long k = 0; k < 3000; ++k) {
+    const DeviceSample s = r.dev.read();
+    ASSERT_TRUE(is_finite(s.handle_m)) << k;
+    ok_ticks += s.status == DeviceStatus::Ok;
+    // The handle barely moves (no hand, small forces): a misread reply would show as a jump.
+    EXPECT_LT(distance(s.handle_m, last), 0.005) << k;
+    last = s.handle_m;
+    r.dev.write_force({0.2 * std::sin(k * 0.01), 0.2 * std::cos(k * 0.01)});
+    double t1 = 0, t2 = 0;
+    r.dev.last_torques_n_m(&t1, &t2);
+    ASSERT_TRUE(std::isfinite(t1) && std::isfinite(t2)) << k;
+    ASSERT_LE(std::fabs(t1), r.dp.torque_limit_n_m);
+    ASSERT_LE(std::fabs(t2), r.dp.torque_limit_n_m);
+  }
+  EXPECT_GT(r.dev.counters().malformed, 100);
+  EXPECT_GT(ok_ticks, 2500) << "faults one tick in seven must not lose the board";
+}
+
+TEST(HaplyDevice, CalibrationRemovesAnEncoderZeroError) {
+  hapi::EmulatorParams ep;
+  ep.calibration_error_deg[0] = 3.0;
+  ep.calibration_error_deg[1] = -2.0;
+  const Vec2 park{0.0, 0.0};
+  Rig r(ep, park);
+  r.dev.open();
+  r.dev.write_force({0, 0});
+  const DeviceSample before = r.dev.read();
+  EXPECT_GT(distance(before.handle_m, park), 2e-3) << "3 degrees of error must show";
+  double a1 = 0, a2 = 0;
+  r.dev.joint_angles_deg(&a1, &a2);
+  double o1 = 0, o2 = 0;
+  ASSERT_TRUE(io::calibrated_offsets(r.dp, park, a1, a2, &o1, &o2));
+  EXPECT_NEAR(o1, 180.0 - 3.0, 0.3);
+  EXPECT_NEAR(o2, 0.0 + 2.0, 0.3);
+
+  // A board set up with the new offsets reads the park place.
+  io::HaplyDeviceParams fixed = r.dp;
+  for (int i = 0; i < fixed.layout.encoder_count; ++i)
+    fixed.layout.encoders[i].offset_deg = fixed.layout.encoders[i].index == 1 ? o1 : o2;
+  Rig again(ep, park, fixed);
+  again.dev.open();
+  again.dev.write_force({0, 0});
+  const DeviceSample after = again.dev.read();
+  EXPECT_NEAR(after.handle_m.x, park.x, kPositionTolerance_m);
+  EXPECT_NEAR(after.handle_m.y, park.y, kPositionTolerance_m);
+}
+
+TEST(HaplyDevice, BadParametersAreRefusedInOneLine) {
+  io::HaplyDeviceParams p;
+  p.layout.actuators[1].port = p.layout.actuators[0].port;
+  EXPECT_THROW(io::HaplyDevice(p, [] { return std::unique_ptr<io::ByteTransport>(); }), DeviceError);
+  io::HaplyDeviceParams q;
+  q.rect_size_device_m = {0.0, 0.05};
+  try {
+    io::HaplyDevice d(q, [] { return std::unique_ptr<io::ByteTransport>(); });
+    FAIL() << "a zero-width rectangle was accepted";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("rectangle"), std::string::npos) << e.what();
+  }
+}
+
+TEST(HaplyDevice, ABoardThatNeverAnswersFailsToOpenNamingTheTransport) {
+  hapi::EmulatorParams ep;
+  ep.faults.disconnect_at_s = 0.0;
+  io::HaplyDeviceParams p;
+  p.open_timeout_ms = 50;
+  Rig r(ep, {0.0, 0.0}, p);
+  try {
+    r.dev.open();
+    FAIL() << "open succeeded without a reply";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("loopback"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(r.dev.status(), DeviceStatus::Closed);
+}
