@@ -137,6 +137,28 @@ TEST(HapiEmulator, RoundTripGivesTheFirmwareReply) {
   EXPECT_NEAR(a[1], th2, kCountDeg);
 }
 
+TEST(HapiEmulator, ExactReplyBytesAtAKnownPose) {
+  // Pose chosen half-way between counter edges so the count is unambiguous: θ_h1 = 180° − 203.5 counts,
+  // θ_h2 = 0° + 250.5 counts (one count = 360/2440°). Firmware, gen3 setup (offsets 180° and 0°):
+  //   setup writes Enc->write(offset·(4880/2)/360): port 2 (encoder 1) 180·2440/360 = 1220, port 1 0;
+  //   since then the counters moved by ⌊−203.5⌋ = −204 and ⌊250.5⌋ = 250 edges;
+  //   read_encoder_value = 360.0·count/EncResolution → port 2: 360·1016/2440, port 1: 360·250/2440;
+  //   read_states sends [id, port 1 float, port 2 float].
+  const double th1 = 180.0 - 203.5 * kCountDeg;
+  const double th2 = 0.0 + 250.5 * kCountDeg;
+  Vec2 start;
+  ASSERT_TRUE(forward_kinematics(geometry_of(HaplyMechanism{}), joints_from_haply_deg(th1, th2), &start));
+  FirmwareEmulator e = make({}, start);
+  ASSERT_EQ(e.handle_device_m(), start);  // inside the stop box, not clamped
+  start_gen3(e);
+  send(e, torque_pkt(0, 0));
+  Bytes expected(9);
+  expected[0] = 5;
+  put_f32_le(static_cast<float>(360.0 * 250 / 2440.0f), &expected[1]);
+  put_f32_le(static_cast<float>(360.0 * 1016 / 2440.0f), &expected[5]);
+  EXPECT_EQ(drain(e), expected);
+}
+
 TEST(HapiEmulator, ReportedAnglesEqualTrueHaplyAnglesAcrossTheWorkspace) {
   const Vec2 starts[] = {kCenter, {0.05, -0.06}, {-0.05, -0.115}, {0.02, -0.12}, {-0.055, -0.055}};
   for (const Vec2 s : starts) {
