@@ -65,10 +65,10 @@ struct DeviceSettings {
   double link_distal_m = 0.09;            ///< key link_distal_m, elbow-to-handle link L, [0.01, 0.5] m
   double motor_spacing_m = 0.038;         ///< key motor_spacing_m, distance between the motor axes d, [0, 0.5] m
   double torque_limit_n_m = 0.123;        ///< key torque_limit_n_m, the board's torque limit per motor, [0.001, 10] N·m
-  double rect_width_m = 0.1;              ///< key rect_width_m, the USB pantograph's usable rectangle, mapped onto [workspace], [0.01, 1] m
-  double rect_height_m = 0.064;           ///< key rect_height_m, [0.01, 1] m
-  double rect_center_y_m = -0.09;         ///< key rect_center_y_m, its centre's distance from the motor axis line (negative: towards the user), [-1, 1] m
-  double park_x_m = 0.0;                 ///< key park_x_m, where the handle rests for calibration (a dimple in the kiosk's surface), workspace frame, [-0.5, 0.5] m
+  double rect_width_m = 0.112;            ///< key rect_width_m, the USB pantograph's usable rectangle, mapped onto [workspace], [0.01, 1] m
+  double rect_height_m = 0.072;           ///< key rect_height_m, [0.01, 1] m
+  double rect_center_y_m = -0.088;        ///< key rect_center_y_m, its centre's distance from the motor axis line (negative: towards the user), [-1, 1] m
+  double park_x_m = 0.0;                  ///< key park_x_m, where the handle rests for calibration (a dimple in the kiosk's surface), workspace frame, [-0.5, 0.5] m
   double park_y_m = 0.0;                  ///< key park_y_m, [-0.5, 0.5] m
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.

@@ -51,8 +51,8 @@ struct HaplyDeviceParams {
   hapi::BoardLayout layout = hapi::BoardLayout::haply_gen3();  ///< ports, directions, offsets, device id
   hapi::HaplyMechanism mechanism;          ///< link lengths and motor spacing [m]
   double torque_limit_n_m = 0.123;         ///< |τ| clamp per motor [N·m] (the firmware's MAX_TORQUE)
-  Vec2 rect_center_device_m{0.0, -0.09};   ///< centre of the device's usable rectangle, device frame [m]
-  Vec2 rect_size_device_m{0.1, 0.064};     ///< its width and height [m]
+  Vec2 rect_center_device_m{0.0, -0.088};  ///< centre of the device's usable rectangle, device frame [m]
+  Vec2 rect_size_device_m{0.112, 0.072};   ///< its width and height [m]
   Vec2 workspace_size_m{0.14, 0.09};       ///< the kiosk's usable rectangle ([workspace]) it maps onto [m]
   int lost_after_ticks = 3;                ///< ticks without a valid reply before Lost, ≥ 1
   int reply_wait_us = 0;                   ///< read() waits this long for the reply [µs]; 0 = take what is there
