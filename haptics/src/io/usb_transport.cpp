@@ -14,10 +14,11 @@
 #include <thread>
 #include <vector>
 
-#include "haptics/io/spsc_byte_ring.hpp"
+#include "haptics/io/byte_channel.hpp"
 #include "haptics/io/usb_cdc.hpp"
 
 namespace hk::io {
+static_assert(ByteTransport::kGone == -1, "ByteChannel returns -1 for a closed channel");
 namespace {
 
 constexpr unsigned kControlTimeoutMs = 1000;
@@ -35,28 +36,14 @@ std::string usb_error(const char* call, int code) {
   return std::string(call) + ": " + libusb_error_name(code) + " (" + libusb_strerror(code) + ")";
 }
 
-std::int64_t now_us() noexcept {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
 void signal_fd(int fd) noexcept {
   const std::uint64_t one = 1;
-  [[maybe_unused]] const ssize_t r = ::write(fd, &one, sizeof one);  // EAGAIN only at counter overflow
+  [[maybe_unused]] const ssize_t r = ::write(fd, &one, sizeof one);
 }
 
 void drain_fd(int fd) noexcept {
   std::uint64_t v;
   [[maybe_unused]] const ssize_t r = ::read(fd, &v, sizeof v);
-}
-
-// ppoll for POLLIN on fd until deadline_us. Blocks at most until the deadline.
-void wait_readable(int fd, std::int64_t deadline_us) noexcept {
-  const std::int64_t left = std::max<std::int64_t>(0, deadline_us - now_us());
-  pollfd p{fd, POLLIN, 0};
-  timespec ts{static_cast<time_t>(left / 1000000), static_cast<long>((left % 1000000) * 1000)};
-  ::ppoll(&p, 1, &ts, nullptr);  // EINTR: the caller's loop re-checks the deadline
 }
 
 }  // namespace
@@ -73,8 +60,10 @@ struct UsbCdcTransport::Impl {
   CdcEndpoints ep;
   int bus = 0, address = 0;
   bool claimed_control = false, claimed_data = false;
-  SpscByteRing in_ring{kRingBytes}, out_ring{kRingBytes};
-  int wake_fd = -1, data_fd = -1, space_fd = -1;
+  ByteChannel in{kRingBytes};   // event thread → caller
+  ByteChannel out{kRingBytes};  // caller → event thread (its data_fd() wakes the event thread)
+  int wake_fd = -1;             // stop and pollfd changes
+  int in_transfer_bytes = kInTransferBytes;
   std::unique_ptr<std::uint8_t[]> in_bufs, out_buf;
   Slot in_slots[kInTransfers];
   Slot out_slot;
@@ -89,8 +78,8 @@ struct UsbCdcTransport::Impl {
 
   void mark_gone() noexcept {
     gone.store(true, std::memory_order_release);
-    signal_fd(data_fd);
-    signal_fd(space_fd);
+    in.close();
+    out.close();
   }
 
   bool submit(Slot& s) noexcept {
@@ -107,9 +96,8 @@ struct UsbCdcTransport::Impl {
   // Event thread: moves bytes from the out ring into the OUT transfer when it is idle.
   void kick_out() noexcept {
     if (out_slot.active || stop.load(std::memory_order_relaxed) || gone.load(std::memory_order_relaxed)) return;
-    const std::size_t n = out_ring.pop(out_buf.get(), kOutTransferBytes);
+    const std::size_t n = out.pop(out_buf.get(), kOutTransferBytes);  // wakes a writer waiting for room
     if (n == 0) return;
-    signal_fd(space_fd);
     out_slot.t->length = static_cast<int>(n);
     submit(out_slot);
   }
@@ -122,9 +110,8 @@ struct UsbCdcTransport::Impl {
     switch (t->status) {
       case LIBUSB_TRANSFER_COMPLETED: {
         const auto n = static_cast<std::size_t>(t->actual_length);
-        const std::size_t pushed = m.in_ring.push(t->buffer, n);
+        const std::size_t pushed = m.in.push(t->buffer, n);  // wakes a waiting reader
         if (pushed < n) m.dropped.fetch_add(n - pushed, std::memory_order_relaxed);
-        if (n > 0) signal_fd(m.data_fd);
         m.consecutive_errors = 0;
         break;
       }
@@ -173,7 +160,7 @@ struct UsbCdcTransport::Impl {
     auto cancel_deadline = std::chrono::steady_clock::now();
     for (;;) {
       if (fds_changed.exchange(false, std::memory_order_acq_rel)) {
-        fds.assign(1, pollfd{wake_fd, POLLIN, 0});
+        fds.assign({pollfd{wake_fd, POLLIN, 0}, pollfd{out.data_fd(), POLLIN, 0}});
         const libusb_pollfd** list = libusb_get_pollfds(ctx);
         own_poll = list != nullptr;
         for (int i = 0; list != nullptr && list[i] != nullptr; ++i) fds.push_back({list[i]->fd, list[i]->events, 0});
@@ -200,9 +187,11 @@ struct UsbCdcTransport::Impl {
         for (auto& p : fds) p.revents = 0;
         ::poll(fds.data(), fds.size(), timeout_ms);
         if (fds[0].revents & POLLIN) drain_fd(wake_fd);
+        if (fds[1].revents & POLLIN) out.drain_data_signal();  // kick_out() below re-checks the ring
         timeval zero{0, 0};
         libusb_handle_events_timeout_completed(ctx, &zero, nullptr);
       } else {  // platforms without pollfds: let libusb wait, bounded to 1 ms so writes are picked up
+        out.drain_data_signal();
         timeval tv{0, 1000};
         libusb_handle_events_timeout_completed(ctx, &tv, nullptr);
       }
@@ -235,10 +224,8 @@ struct UsbCdcTransport::Impl {
     }
     if (h != nullptr) libusb_close(h);
     h = nullptr;
-    for (int* fd : {&wake_fd, &data_fd, &space_fd}) {
-      if (*fd >= 0) ::close(*fd);
-      *fd = -1;
-    }
+    if (wake_fd >= 0) ::close(wake_fd);
+    wake_fd = -1;
     if (ctx != nullptr && !leaked) {
       libusb_set_pollfd_notifiers(ctx, nullptr, nullptr, nullptr);
       libusb_exit(ctx);
@@ -358,19 +345,18 @@ void UsbCdcTransport::open() {
   }
   // Everything the real-time path needs, allocated now.
   m->wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  m->data_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  m->space_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  if (m->wake_fd < 0 || m->data_fd < 0 || m->space_fd < 0) {
-    throw DeviceError(here + ": eventfd: " + std::strerror(errno));
-  }
-  m->in_bufs = std::make_unique<std::uint8_t[]>(static_cast<std::size_t>(kInTransfers) * kInTransferBytes);
+  if (m->wake_fd < 0) throw DeviceError(here + ": eventfd: " + std::strerror(errno));
+  // IN transfers: a whole number of packets, at least one (a short buffer would overflow on a full packet).
+  const int mps_in = m->ep.max_packet_in;
+  m->in_transfer_bytes = std::max(mps_in, kInTransferBytes / mps_in * mps_in);
+  m->in_bufs = std::make_unique<std::uint8_t[]>(static_cast<std::size_t>(kInTransfers) * m->in_transfer_bytes);
   m->out_buf = std::make_unique<std::uint8_t[]>(kOutTransferBytes);
   for (int i = 0; i < kInTransfers; ++i) {
     Impl::Slot& s = m->in_slots[i];
     s.impl = m.get();
     s.t = libusb_alloc_transfer(0);
     if (s.t == nullptr) throw DeviceError(here + ": libusb_alloc_transfer failed");
-    libusb_fill_bulk_transfer(s.t, m->h, m->ep.bulk_in, m->in_bufs.get() + i * kInTransferBytes, kInTransferBytes,
+    libusb_fill_bulk_transfer(s.t, m->h, m->ep.bulk_in, m->in_bufs.get() + i * m->in_transfer_bytes, m->in_transfer_bytes,
                               &Impl::on_in, &s, 0);
   }
   m->out_slot.impl = m.get();
@@ -398,46 +384,18 @@ bool UsbCdcTransport::is_open() const noexcept { return impl_ != nullptr; }
 
 int UsbCdcTransport::write(const std::uint8_t* data, int n, int timeout_us) noexcept {
   Impl* m = impl_.get();
-  if (m == nullptr || m->gone.load(std::memory_order_acquire)) return kGone;
-  if (n <= 0) return 0;
-  const std::int64_t deadline = now_us() + std::max(0, timeout_us);
-  auto total = m->out_ring.push(data, static_cast<std::size_t>(n));
-  if (total > 0) signal_fd(m->wake_fd);
-  while (total < static_cast<std::size_t>(n) && now_us() < deadline) {
-    drain_fd(m->space_fd);  // drain, then retry, then wait: a signal after the drain keeps the fd readable
-    const auto more = m->out_ring.push(data + total, static_cast<std::size_t>(n) - total);
-    if (more > 0) {
-      total += more;
-      signal_fd(m->wake_fd);
-      continue;
-    }
-    if (m->gone.load(std::memory_order_acquire)) break;
-    wait_readable(m->space_fd, deadline);
-  }
-  return total == 0 && m->gone.load(std::memory_order_acquire) ? kGone : static_cast<int>(total);
+  if (m == nullptr) return kGone;
+  return m->out.push_wait(data, n, timeout_us);  // -1 == kGone once the device is gone
 }
 
 int UsbCdcTransport::read(std::uint8_t* buf, int capacity, int timeout_us) noexcept {
   Impl* m = impl_.get();
   if (m == nullptr) return kGone;
-  if (capacity <= 0) return 0;
-  const std::int64_t deadline = now_us() + std::max(0, timeout_us);
-  for (;;) {
-    drain_fd(m->data_fd);
-    const auto n = m->in_ring.pop(buf, static_cast<std::size_t>(capacity));
-    if (n > 0) return static_cast<int>(n);
-    if (m->gone.load(std::memory_order_acquire)) {
-      // bytes pushed just before the device went are still returned first
-      const auto last = m->in_ring.pop(buf, static_cast<std::size_t>(capacity));
-      return last > 0 ? static_cast<int>(last) : kGone;
-    }
-    if (now_us() >= deadline) return 0;
-    wait_readable(m->data_fd, deadline);
-  }
+  return m->in.pop_wait(buf, capacity, timeout_us);  // received bytes first, then -1 == kGone
 }
 
 void UsbCdcTransport::flush_input() noexcept {
-  if (impl_) impl_->in_ring.clear();
+  if (impl_) impl_->in.clear();
 }
 
 std::string UsbCdcTransport::name() const {

@@ -33,10 +33,12 @@ struct UsbDeviceInfo {
 /// on success. Setup-time: allocates and does I/O.
 std::vector<UsbDeviceInfo> list_usb_devices(std::string* reason = nullptr);
 
-/// Calls `on_change(true)` when a device with `vid`:`pid` arrives (also once per such device already
-/// attached when the monitor starts: LIBUSB_HOTPLUG_ENUMERATE) and `on_change(false)` when one leaves.
-/// Runs its own libusb context and event thread; `on_change` is called on that thread and must not
-/// block long or call back into the monitor. When libusb cannot start or lacks hotplug support
+/// Calls `on_change(true)` when a device with `vid`:`pid` arrives and `on_change(false)` when one leaves.
+/// Devices already attached are reported as arrivals too (LIBUSB_HOTPLUG_ENUMERATE), from inside the
+/// constructor on the constructing thread; the libusb docs warn that with ENUMERATE one arrival may be
+/// reported twice and a departure may come without its arrival, so treat calls as "state may have
+/// changed" and re-check with list_usb_devices() if exact counts matter. Runs its own libusb context and
+/// event thread; later calls come on that thread and must not block long or call back into the monitor. When libusb cannot start or lacks hotplug support
 /// (libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG) == 0), supported() is false, nothing is ever called,
 /// and callers poll list_usb_devices() instead. Never throws from the constructor for lack of USB.
 class UsbHotplugMonitor {

@@ -8,21 +8,27 @@
 ///    SET_CONTROL_LINE_STATE(DTR|RTS) (synchronous libusb_control_transfer, 1 s timeout each), allocates
 ///    the two byte rings, the asynchronous transfers and their buffers, submits the IN transfers and
 ///    starts the event thread. Everything that allocates happens here.
+///  - Bytes cross between the caller and the event thread in two ByteChannels (byte_channel.hpp: a
+///    lock-free SPSC ring plus eventfds), capacity kRingBytes each: "out" (caller → event thread) and
+///    "in" (event thread → caller).
 ///  - The event thread polls libusb's file descriptors (libusb_get_pollfds, refreshed when libusb's
-///    pollfd notifiers say they changed) together with a "wake" eventfd, then runs
+///    pollfd notifiers say they changed) together with the out channel's data eventfd and its own "wake"
+///    eventfd (stop, pollfd changes), then runs
 ///    libusb_handle_events_timeout_completed with a zero timeout. Transfer callbacks run on it: IN data is
-///    pushed into the in ring (bytes that do not fit are dropped and counted: dropped_in_bytes()) and the
-///    transfer resubmitted; OUT transfers are filled from the out ring and submitted when the wake eventfd
-///    fires or an OUT transfer completes.
-///  - write() (caller) pushes into the out ring (SPSC, lock-free) and writes 1 to the wake eventfd
-///    (eventfd(2) write: a syscall that never blocks with EFD_NONBLOCK and takes no user-space lock). If
-///    the ring is full it waits for room with ppoll() on the "space" eventfd, bounded by timeout_us.
-///  - read() (caller) pops from the in ring; if empty it waits with ppoll() on the "data" eventfd, bounded
-///    by timeout_us. Nothing else blocks on the caller's side; libusb is never called from read/write.
+///    pushed into the in channel (bytes that do not fit are dropped and counted: dropped_in_bytes()) and
+///    the transfer resubmitted; the one OUT transfer (up to 4096 bytes, LIBUSB_TRANSFER_ADD_ZERO_PACKET,
+///    Linux) is filled from the out channel and submitted when its data eventfd fires or the previous OUT
+///    transfer completes.
+///  - write() (caller) = out.push_wait(): pushes into the ring and writes 1 to the data eventfd
+///    (eventfd(2) on an EFD_NONBLOCK eventfd: one syscall, never blocks, no user-space lock). If the ring
+///    is full it waits for room with ppoll() on the channel's space eventfd, bounded by timeout_us.
+///  - read() (caller) = in.pop_wait(): pops; if empty it waits with ppoll() on the data eventfd, bounded by
+///    timeout_us. Nothing else blocks on the caller's side; libusb is never called from read/write.
 ///  - LIBUSB_TRANSFER_NO_DEVICE in a callback or LIBUSB_ERROR_NO_DEVICE on submit marks the device gone:
 ///    read() returns the bytes already received, then kGone; write() returns kGone.
 ///  - close() drops DTR/RTS (best effort), stops the thread (which cancels the transfers and waits for
-///    their callbacks), releases the interfaces, closes the handle and exits the context.
+///    their callbacks, at most 2 s; if some never complete they are leaked rather than freed while
+///    pending), releases the interfaces, closes the handle and exits the context.
 ///
 /// Sources (libusb 1.0 API, https://libusb.sourceforge.io/api-1.0/): "Asynchronous device I/O"
 /// (libusb_alloc_transfer, libusb_fill_bulk_transfer, libusb_submit_transfer, libusb_cancel_transfer,
@@ -55,6 +61,7 @@ class UsbCdcTransport final : public ByteTransport {
   /// "usb 2341:804d: libusb_open: LIBUSB_ERROR_ACCESS ...", "usb 2341:804d: no CDC-ACM function ...", or
   /// "libusb_init: ..." when there is no USB at all.
   void open() override;
+  /// See the file comment; blocks up to ~2 s when the device does not complete cancelled transfers.
   void close() noexcept override;
   int write(const std::uint8_t* data, int n, int timeout_us) noexcept override;
   int read(std::uint8_t* buf, int capacity, int timeout_us) noexcept override;
@@ -67,7 +74,8 @@ class UsbCdcTransport final : public ByteTransport {
 
   /// Capacity of each byte ring [bytes].
   static constexpr std::size_t kRingBytes = 16384;
-  /// IN transfers kept submitted, and the size of each [bytes] (a multiple of wMaxPacketSize).
+  /// IN transfers kept submitted, and the size of each [bytes], rounded down to a multiple of the bulk
+  /// IN wMaxPacketSize, and at least one packet.
   static constexpr int kInTransfers = 4, kInTransferBytes = 512;
 
   struct Impl;  ///< libusb state (usb_transport.cpp)
