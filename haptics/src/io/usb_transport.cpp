@@ -78,8 +78,8 @@ struct UsbCdcTransport::Impl {
 
   void mark_gone() noexcept {
     gone.store(true, std::memory_order_release);
+    out.close();  // first: a reader that sees kGone from `in` then also gets kGone from write()
     in.close();
-    out.close();
   }
 
   bool submit(Slot& s) noexcept {
