@@ -27,8 +27,11 @@ class TtyTransport final : public ByteTransport {
 
   /// Opens and configures the tty. Throws hk::DeviceError "tty <path>: <strerror> (<step>)" on failure.
   void open() override;
+  /// Releases TIOCEXCL (TIOCNXCL) and closes. Idempotent.
   void close() noexcept override;
+  /// ByteTransport::write: non-blocking write(2), then ppoll(POLLOUT) up to timeout_us. Real-time.
   int write(const std::uint8_t* data, int n, int timeout_us) noexcept override;
+  /// ByteTransport::read: ppoll(POLLIN) up to timeout_us, then read(2). Real-time.
   int read(std::uint8_t* buf, int capacity, int timeout_us) noexcept override;
   /// tcflush(TCIFLUSH): drops the driver's input queue.
   void flush_input() noexcept override;

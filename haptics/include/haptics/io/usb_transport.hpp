@@ -63,9 +63,13 @@ class UsbCdcTransport final : public ByteTransport {
   void open() override;
   /// See the file comment; blocks up to ~2 s when the device does not complete cancelled transfers.
   void close() noexcept override;
+  /// ByteTransport::write through the out channel (see the file comment for what blocks). Real-time.
   int write(const std::uint8_t* data, int n, int timeout_us) noexcept override;
+  /// ByteTransport::read from the in channel (see the file comment for what blocks). Real-time.
   int read(std::uint8_t* buf, int capacity, int timeout_us) noexcept override;
+  /// Drops the bytes in the in channel (not those still in flight in IN transfers). Real-time.
   void flush_input() noexcept override;
+  /// True between open() and close(), even after the device went.
   bool is_open() const noexcept override;
   /// "usb 2341:804d bus 1 addr 5" when open, "usb 2341:804d" before.
   std::string name() const override;
