@@ -38,15 +38,6 @@ class LoopbackTransport final : public io::ByteTransport {
   bool open_ = false;
 };
 
-hapi::EmulatorParams emulator_params(const io::HaplyDeviceParams& dp) {
-  hapi::EmulatorParams e;
-  e.mechanism = dp.mechanism;
-  e.torque_limit_n_m = dp.torque_limit_n_m;
-  e.workspace_half_extent_m = 0.5 * dp.rect_size_device_m;
-  e.workspace_center_m = dp.rect_center_device_m;
-  return e;
-}
-
 struct Rig {
   explicit Rig(hapi::EmulatorParams ep = {}, Vec2 start_ws = {0.01, -0.005}, io::HaplyDeviceParams p = {})
       : dp(p),
