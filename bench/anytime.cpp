@@ -1,10 +1,13 @@
-// Anytime chart (issue 3 item 5): with deadlines from 0.5 µs to 50 µs, which level does a cold query
-// reach, and what does that level cost in accuracy? "Cold" = the boundary section starts at the scene
+// Anytime chart (issue 3 item 5; box budgets since issue 13 item 5): with box-test budgets from 8 to 4096
+// (QueryBudget: the servo's work limit, no clock), which level does a cold query reach, what does that
+// level cost in accuracy, and how long does it take? "Cold" = the boundary section starts at the scene
 // root, as after a new picture or a level change; a warm section (every other tick) rarely needs
-// refining and no deadline bites. Queries sweep 2–20 mm from a random point towards a point of the
+// refining and no budget bites. Queries sweep 2–20 mm from a random point towards a point of the
 // curves, so almost all of them end in a wall.
-// Output JSON: per scene and deadline — fraction answered exactly at level 0, mean level reached,
-// mean and max of the reached level's max error [mm], p50/p99 query time [ns].
+// Output JSON: per scene and budget — fraction answered exactly at level 0, mean level reached,
+// mean and max of the reached level's max error [mm], p50/p99 query time [ns], mean box tests per query,
+// and ns per box test (total time / total box tests): the figure ServoParams::query_box_budget's default
+// is chosen from (kDefaultQueryBoxBudget, haptics/servo.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -43,18 +46,20 @@ std::vector<Sweep> cold_sweeps(const Scene& sc, std::size_t n, std::uint32_t see
 nlohmann::json run(const std::string& name, const Scene& sc, const std::vector<Sweep>& sweeps) {
   nlohmann::json rows = nlohmann::json::array();
   BoundarySection section(sc);
-  for (double deadline_us : {0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 0.0}) {
+  for (std::int32_t box_budget : {8, 16, 32, 64, 128, 256, 512, 1024, 4096, 0}) {
     std::vector<double> ns;
-    double level_sum = 0, err_sum = 0, err_max = 0;
+    double level_sum = 0, err_sum = 0, err_max = 0, ns_total = 0, boxes_total = 0;
     std::size_t exact = 0;
     for (const Sweep& s : sweeps) {
       section.reset();
       QueryBudget budget;
-      const std::int64_t t0 = now_ns();
-      if (deadline_us > 0) budget.deadline_ns = t0 + static_cast<std::int64_t>(deadline_us * 1000);
+      budget.max_box_tests = box_budget;
       QueryStats st;
+      const std::int64_t t0 = now_ns();
       const SweepHit h = section.first_hit(s.a, s.b, 0, nullptr, 0, budget, &st);
       ns.push_back(static_cast<double>(now_ns() - t0));
+      ns_total += ns.back();
+      boxes_total += st.box_tests;
       // Level reached: 0 when exact; otherwise the level of the box the answer stopped at (a box above
       // every curve counts as one level above the curve's coarsest).
       int level = 0;
@@ -77,11 +82,13 @@ nlohmann::json run(const std::string& name, const Scene& sc, const std::vector<S
     }
     std::sort(ns.begin(), ns.end());
     const double n = static_cast<double>(sweeps.size());
-    rows.push_back({{"deadline_us", deadline_us}, {"exact_fraction", exact / n}, {"mean_level", level_sum / n},
+    const double ns_per_box = boxes_total > 0 ? ns_total / boxes_total : 0.0;
+    rows.push_back({{"box_budget", box_budget}, {"exact_fraction", exact / n}, {"mean_level", level_sum / n},
                     {"mean_error_mm", err_sum / n}, {"max_error_mm", err_max}, {"p50_ns", ns[ns.size() / 2]},
-                    {"p99_ns", ns[static_cast<std::size_t>(0.99 * (n - 1))]}});
-    std::fprintf(stderr, "anytime %s deadline %.1f us: exact %.3f, mean level %.2f, mean error %.3f mm\n", name.c_str(), deadline_us,
-                 exact / n, level_sum / n, err_sum / n);
+                    {"p99_ns", ns[static_cast<std::size_t>(0.99 * (n - 1))]}, {"mean_box_tests", boxes_total / n},
+                    {"ns_per_box_test", ns_per_box}});
+    std::fprintf(stderr, "anytime %s budget %d box tests: exact %.3f, mean level %.2f, mean error %.3f mm, %.0f box tests, %.1f ns per box test\n",
+                 name.c_str(), box_budget, exact / n, level_sum / n, err_sum / n, boxes_total / n, ns_per_box);
   }
   return {{"scene", name}, {"segments", sc.total_segments(0)}, {"rows", rows}};
 }

@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     device.open();
     ModelHandParams hp;
     hp.max_force_n = s.hand.max_force_n;
-    app::ServoCore core(device, app::CueTrackerParams{}, nullptr);
+    app::ServoCore core(app::CueTrackerParams{}, nullptr);
     const ServoParams sp = app::servo_params_from(s);
     core.publish(std::make_unique<app::SceneBundle>(std::move(is.scene), sp));
     std::atomic<bool> spin{loaded};
@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
     });
     double t_s = 0.0;
     {
-      app::ServoThread thread(core, {}, [&](double dt) {
+      app::ServoThread thread(core, device, {}, [&](double dt) {
         device.step(dt, model_hand_force(hp, hand.at(t_s), device.true_position_m(), device.velocity_m_per_s()));
         t_s += dt;
       });

@@ -14,8 +14,8 @@
 // not a limiter decides the outcome:
 //   * the force clamps (contact and guard max_force_n) are 1e6 N and the per-motor torque limit
 //     1e4 N·m: a clamp bounds the energy a wall can inject and would hide instability;
-//   * the guard's start-up ramp is 0 (the ramp is a clamp too) and the query deadline is off (a run is
-//     deterministic);
+//   * the guard's start-up ramp is 0 (the ramp is a clamp too) and the query's box-test budget is off
+//     (every query exact);
 //   * the plant is integrated finely at every servo rate: the servo period is split into chunks of at
 //     most 25 µs (the model hand's force is recomputed per chunk, so the hand is a continuous
 //     spring-damper, not a second sampled-data loop) and each chunk into device substeps of ≤ 1 µs.
@@ -69,7 +69,7 @@
 // Strokes straight across a thin closed curve (an ellipse 0.2 mm wide, 60 mm long), an open straight
 // wall, and into acute corners (10° and 30° wedges, polylines whose apex is a level-0 vertex), at hand
 // speeds on a log grid from 0.05 to 5 m/s, rendered at level 0 (the sharpest geometry) with the
-// shipped servo settings (800 N/m, 3.5 N, 1 kHz, 200 µs query deadline):
+// shipped servo settings (800 N/m, 3.5 N, 1 kHz, the default box-test budget per tick):
 //   kinematic — the ServoLoop alone, the handle put exactly on the stroke every 1 ms tick (no device),
 //               so 5 m/s is a 5 mm jump per tick, 25 times the thin curve's width;
 //   device    — the simulated pantograph (shipped parameters, substeps ≤ 1 µs), the servo run 0.6 s
@@ -141,10 +141,6 @@ Chunking chunking_for(double period_s) {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 /// Log-spaced grid of n values from lo to hi inclusive.
@@ -272,7 +268,7 @@ class WallBench {
     ServoParams sp;
     sp.period_s = period_s;
     sp.level = config::Settings{}.haptics.level;
-    sp.query_deadline_s = 0.0;  // deterministic: no wall-clock budget
+    sp.query_box_budget = 0;  // no box-test limit: every query exact
     sp.contact.stiffness_n_per_m = k_n_per_m;
     sp.contact.damping_n_s_per_m = 0.0;
     sp.contact.max_force_n = 1e6;
@@ -588,7 +584,7 @@ json run_part1(bool quick) {
                  {"start_m", {kWallStart.x, kWallStart.y}},
                  {"target_m", {kHandTarget.x, kHandTarget.y}},
                  {"let_go_height_m", kLetGoHeightM}};
-  out["servo"] = {{"contact_damping_n_s_per_m", 0.0}, {"max_force_n", 1e6}, {"force_ramp_s", 0.0}, {"query_deadline_s", 0.0}};
+  out["servo"] = {{"contact_damping_n_s_per_m", 0.0}, {"max_force_n", 1e6}, {"force_ramp_s", 0.0}, {"query_box_budget", 0}};
   out["run_s"] = kRunS;
   out["transient_s"] = kTransientS;
   out["rules"] = {
@@ -828,7 +824,7 @@ struct StrokeTally {
   int contact_ticks = 0;         // ticks in Edge or Vertex
   int vertex_ticks = 0;
   int iteration_limit_ticks = 0; // ticks whose move budget ran out (the proxy stays valid, but it is a sign)
-  int query_budget_ticks = 0;    // ticks whose collision query hit the deadline
+  int query_budget_ticks = 0;    // ticks whose collision queries ran out of the box-test budget
   double max_handle_step_m = 0;  // the largest handle jump in one tick [m]
   double impact_speed_sum = 0;   // device: sum of handle speeds at first contact [m/s]
   int impacts = 0;
@@ -915,7 +911,6 @@ StrokeTally kinematic_stroke(const StrokeScene& sc, const Stroke& st, double spe
     in.sample.handle_m = st.start_m + s * dir;
     in.sample.status = DeviceStatus::Ok;
     in.sample.time_ns = static_cast<std::int64_t>(k * 1000000);
-    in.now_ns = steady_ns();
     if (control) {
       so.contact.path_m[0] = so.contact.path_count > 0 ? so.contact.proxy_m : st.start_m;
       so.contact.path_m[1] = in.sample.handle_m;
@@ -966,7 +961,6 @@ StrokeTally device_stroke(const StrokeScene& sc, const Stroke& st, double speed_
   for (long k = 0; k < n_ticks; ++k) {
     ServoInput in;
     in.sample = dev.read();
-    in.now_ns = steady_ns();
     servo.update(in, so);
     dev.write_force(so.force_n);
     const double t_s = static_cast<double>(k) * sp.period_s;
@@ -1023,7 +1017,7 @@ json run_part2(bool quick) {
   out["servo"] = {{"rate_hz", 1.0 / sp.period_s},
                   {"stiffness_n_per_m", sp.contact.stiffness_n_per_m},
                   {"max_force_n", sp.contact.max_force_n},
-                  {"query_deadline_s", sp.query_deadline_s}};
+                  {"query_box_budget", sp.query_box_budget}};
   out["device_hand"] = {{"stiffness_n_per_m", kDeviceHandStiffnessNPerM},
                         {"damping_n_s_per_m_relative_to_target", kDeviceHandDampingNSPerM},
                         {"max_force_n", kDeviceHandMaxForceN}};

@@ -36,7 +36,7 @@ audio::AudioSystemParams audio_params(const config::Settings& s, bool open_outpu
 KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
     : opt_(o), s_(s), audio_(audio_params(s, o.open_audio_output)), half_{s.workspace.width_m / 2, s.workspace.height_m / 2},
       sp_(servo_params_from(s)), device_(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2}),
-      core_(device_, cue_params(), &audio_.cues()),
+      core_(cue_params(), &audio_.cues()),
       sticks_(s, block_events(o.hotplug), o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
   pictures_ = list_pictures(o.library);
   device_.open();
@@ -54,7 +54,7 @@ KioskRuntime::~KioskRuntime() { stop_servo(); }
 void KioskRuntime::start_servo() {
   ServoThreadParams tp;
   tp.rate_hz = s_.haptics.servo_rate_hz;
-  servo_ = std::make_unique<ServoThread>(core_, tp, [this](double dt) {
+  servo_ = std::make_unique<ServoThread>(core_, device_, tp, [this](double dt) {
     // The simulated pantograph: the model hand pulls the handle towards the cursor.
     const Vec2 target = cursor_.read();
     device_.step(dt, model_hand_force(hand_, target, device_.true_position_m(), device_.velocity_m_per_s()));

@@ -107,6 +107,9 @@ class KioskRuntime final : public KioskEffects {
   /// The model hand's target [m] (the mouse or a script stands in for the visitor's hand).
   void set_cursor(Vec2 m);
   ServoCore& core() { return core_; }
+  /// The simulated pantograph the servo thread reads and drives (tests step the core by hand against it
+  /// when no servo thread runs).
+  Device& device() { return device_; }
   audio::AudioSystem& audio() { return audio_; }
   const Shown& shown() const { return shown_; }
   /// SceneBundle id of what is shown (tutorial −1..−3, picture index, 1000 + stick page).

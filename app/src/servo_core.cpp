@@ -4,8 +4,8 @@
 
 namespace hk::app {
 
-ServoCore::ServoCore(Device& device, const CueTrackerParams& cue_params, audio::SpscRing<audio::CueEvent>* cues)
-    : device_(device), tracker_(cue_params), cues_(cues) {}
+ServoCore::ServoCore(const CueTrackerParams& cue_params, audio::SpscRing<audio::CueEvent>* cues)
+    : tracker_(cue_params), cues_(cues) {}
 
 ServoCore::~ServoCore() {
   delete pending_.exchange(nullptr);
@@ -35,11 +35,13 @@ void ServoCore::set_gains(const ServoGains& g) noexcept {
   gains_in_.publish();
 }
 
-TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
+TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, ServoCommand& cmd) noexcept {
   ServoInput in;
-  in.sample = device_.read();
-  in.now_ns = now_ns;
+  in.sample = sample;
   in.deadline_missed = deadline_missed;
+  // A device back after Lost/Fault/Closed: the picture in use starts again at the handle, force ramped in.
+  const bool device_returned = sample.status == DeviceStatus::Ok && last_status_ != DeviceStatus::Ok;
+  last_status_ = sample.status;
 
   // New gains (set_gains): kept for every picture taken from now on, applied below to the one in use.
   const GainsSlot& g = gains_in_.read();
@@ -73,6 +75,7 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
   if (current_ && want_level == kAutoLevel) current_->loop.set_auto_level(true);
   if (current_ && want_level >= 0) current_->loop.set_level(want_level);
   if (current_ && gains_.seq != 0) current_->loop.set_gains(gains_.gains);  // no-op unless they changed
+  if (current_ && device_returned && is_finite(sample.handle_m)) current_->loop.start(sample.handle_m);
 
   TickResult r = TickResult::Ok;
   if (current_) {
@@ -82,7 +85,7 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
     out_.contact.proxy_m = in.sample.handle_m;
   }
   if (fading_ && fade_total_ > 0) out_.force_n = (static_cast<double>(fade_left_) / static_cast<double>(fade_total_)) * out_.force_n;
-  device_.write_force(out_.force_n);
+  cmd.force_n = out_.force_n;
 
   if (current_) {
     audio::CueEvent c[CueTracker::kMaxCuesPerTick];
@@ -100,6 +103,7 @@ TickResult ServoCore::tick(std::int64_t now_ns, bool deadline_missed) noexcept {
   d.level = current_ ? current_->loop.level() : 0;
   d.auto_level = current_ && current_->loop.params().auto_level;
   d.scene_id = current_ ? current_->id : -1;
+  d.device_status = sample.status;
   d.penetration_m = out_.contact.state == ContactState::Free ? 0.0 : length(in.sample.handle_m - out_.contact.proxy_m);
   d.stiffness_n_per_m = current_ ? current_->loop.gains().stiffness_n_per_m : 0.0;
   d.gains_transition = current_ && current_->loop.transition_active();

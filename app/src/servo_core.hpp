@@ -1,9 +1,15 @@
 #pragma once
 /// @file servo_core.hpp
-/// What the kiosk's servo thread does each tick (issue 5, item 2; DESIGN.md "Data flow", "Real-time
-/// rules"): read the device, swap in a newly published picture, run the servo loop, write the force, push
-/// audio cues, publish the display state. Deterministic and clock-free, so tests drive it tick by tick;
-/// ServoThread (servo_thread.hpp) calls it on time.
+/// What the kiosk's servo thread does each tick (issue 5, item 2; issue 13, item 5; DESIGN.md "Data flow",
+/// "Real-time rules"): a pure step from the device sample to the force command. The caller reads the
+/// device, calls step(), writes the command's force: `sample = device.read(); core.step(sample, late, cmd);
+/// device.write_force(cmd.force_n);`. The step swaps in a newly published picture, runs the servo loop,
+/// pushes audio cues and fills the display state. It holds no device, reads no clock and is deterministic,
+/// so tests drive it tick by tick; ServoThread (servo_thread.hpp) calls it on time.
+///
+/// A device that comes back (the sample's status Ok again after Lost, Fault or Closed) gets its force back
+/// gently: the picture in use restarts at the handle (ServoLoop::start: proxy there, force ramped in from
+/// zero over guard.ramp_s), so a hand that moved while the device was away is not kicked out of a wall.
 ///
 /// A picture crosses threads as a SceneBundle built on another thread (the scene and a ServoLoop sized for
 /// it: all allocation happens there). publish() hands it over with one atomic exchange. The servo thread
@@ -55,6 +61,8 @@ struct ServoDisplayState {
   int level = 0;                   ///< level in use
   bool auto_level = false;         ///< the level follows the hand's speed
   int scene_id = -1;               ///< SceneBundle::id in use, −1 before the first
+  /// The device sample's status of this tick, so the display thread can announce a lost or returned device.
+  DeviceStatus device_status = DeviceStatus::Closed;
   std::int64_t tick_compute_ns = 0;///< time of this tick's work [ns] (set by ServoThread)
   std::int64_t period_error_ns = 0;///< wake-up minus deadline of this tick [ns] (set by ServoThread)
   std::int64_t missed_deadlines = 0;
@@ -71,11 +79,16 @@ struct ServoDisplayState {
   std::uint32_t section[kMaxSection];
 };
 
+/// What one step asks the caller to send to the device.
+struct ServoCommand {
+  Vec2 force_n;  ///< force to write to the device this tick [N], workspace frame (after the force guard)
+};
+
 /// Per-tick work of the servo thread. Methods marked real-time are called by the servo thread only.
 class ServoCore {
  public:
-  /// `device` must be open and outlive the core; `cues` may be null (no sound).
-  ServoCore(Device& device, const CueTrackerParams& cue_params, audio::SpscRing<audio::CueEvent>* cues);
+  /// `cues` may be null (no sound). Holds no device: the caller reads it and writes the force (step()).
+  ServoCore(const CueTrackerParams& cue_params, audio::SpscRing<audio::CueEvent>* cues);
   /// Frees every bundle. Call only when the servo thread has stopped.
   ~ServoCore();
 
@@ -97,9 +110,10 @@ class ServoCore {
   /// either side.
   void set_gains(const ServoGains& g) noexcept;
 
-  /// Real-time: one tick. `now_ns` = steady time at its start (for the query deadline; 0 = none),
-  /// `deadline_missed` zeroes the force (the force guard). Returns the tick's result.
-  TickResult tick(std::int64_t now_ns, bool deadline_missed) noexcept;
+  /// Real-time: one tick from the device sample `sample` (handle [m], status) to the command `out` (force
+  /// [N] to write to the device). `deadline_missed` zeroes the force (the force guard). Returns the tick's
+  /// result (TickResult::Ok before the first picture). No clock, no device, no allocation, lock, throw, I/O.
+  TickResult step(const DeviceSample& sample, bool deadline_missed, ServoCommand& out) noexcept;
 
   /// Real-time (servo thread): the display slot's back buffer, for ServoThread to add timing before publishing.
   ServoDisplayState& display_back() noexcept { return display_.back(); }
@@ -112,7 +126,6 @@ class ServoCore {
   std::int64_t ticks() const noexcept { return tick_; }
 
  private:
-  Device& device_;
   CueTracker tracker_;
   audio::SpscRing<audio::CueEvent>* cues_;
   std::atomic<SceneBundle*> pending_{nullptr};
@@ -131,6 +144,7 @@ class ServoCore {
   long fade_total_ = 0, fade_left_ = 0;                // [ticks]
   TripleBuffer<ServoDisplayState> display_;
   ServoOutput out_;
+  DeviceStatus last_status_ = DeviceStatus::Ok;        // the previous tick's sample status (a return restarts the picture)
   std::int64_t tick_ = 0;
 };
 

@@ -44,8 +44,8 @@ double percentile_us(const std::array<std::atomic<std::uint32_t>, 2048>& h, doub
 
 }  // namespace
 
-ServoThread::ServoThread(ServoCore& core, const ServoThreadParams& params, AfterTick after_tick)
-    : core_(core), params_(params), after_tick_(std::move(after_tick)) {
+ServoThread::ServoThread(ServoCore& core, Device& device, const ServoThreadParams& params, AfterTick after_tick)
+    : core_(core), device_(device), params_(params), after_tick_(std::move(after_tick)) {
   if (!(params.rate_hz >= 100 && params.rate_hz <= 10000)) {
     throw std::invalid_argument("servo rate " + std::to_string(params.rate_hz) + " Hz is outside [100, 10000] Hz");
   }
@@ -75,6 +75,7 @@ void ServoThread::run() {
   const auto period_ns = static_cast<std::int64_t>(static_cast<double>(kNsPerS) / params_.rate_hz + 0.5);
   const double period_s = static_cast<double>(period_ns) / static_cast<double>(kNsPerS);
   std::int64_t deadline = mono_ns() + period_ns;
+  ServoCommand cmd;
   while (!stop_.load(std::memory_order_relaxed)) {
     const timespec ts = to_timespec(deadline);
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
@@ -82,7 +83,9 @@ void ServoThread::run() {
     const std::int64_t woke = mono_ns();
     const std::int64_t late = woke - deadline;
     const bool missed = late >= period_ns;
-    core_.tick(woke, missed);
+    const DeviceSample sample = device_.read();
+    core_.step(sample, missed, cmd);
+    device_.write_force(cmd.force_n);
     if (after_tick_) after_tick_(period_s);
     const std::int64_t done = mono_ns();
 

@@ -1,6 +1,7 @@
 #pragma once
 /// @file servo_thread.hpp
-/// The kiosk's servo thread (issue 5, item 2): ServoCore::tick at the configured rate on its own thread,
+/// The kiosk's servo thread (issue 5, item 2): at the configured rate on its own thread, read the device,
+/// ServoCore::step, write the force (the step itself holds no device and reads no clock; this thread times it),
 /// SCHED_FIFO where the system permits it (a logged warning where not), absolute-deadline sleeps
 /// (clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC, so lateness does not accumulate), and measured
 /// wake-up lateness and missed deadlines. A tick that starts a whole period late is a missed deadline: it
@@ -39,8 +40,9 @@ class ServoThread {
   /// physics step. Must be real-time safe.
   using AfterTick = std::function<void(double period_s)>;
 
-  /// Starts the thread. @throws std::invalid_argument for a rate outside [100, 10000] Hz.
-  ServoThread(ServoCore& core, const ServoThreadParams& params, AfterTick after_tick = {});
+  /// Starts the thread, which reads `device` and writes its force each tick. `core` and `device` (open)
+  /// must outlive the thread. @throws std::invalid_argument for a rate outside [100, 10000] Hz.
+  ServoThread(ServoCore& core, Device& device, const ServoThreadParams& params, AfterTick after_tick = {});
   /// Stops and joins.
   ~ServoThread();
   ServoThread(const ServoThread&) = delete;
@@ -59,6 +61,7 @@ class ServoThread {
   void run();
   static constexpr int kBins = 2048;  // 1 µs bins up to 2 ms; the last bin holds everything later
   ServoCore& core_;
+  Device& device_;
   ServoThreadParams params_;
   AfterTick after_tick_;
   std::atomic<bool> stop_{false};

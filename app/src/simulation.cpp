@@ -26,7 +26,7 @@ ServoGains servo_gains_from(const config::Settings& s) {
   g.static_friction = s.haptics.static_friction;
   g.dynamic_friction = s.haptics.dynamic_friction;
   g.max_force_step_n = s.haptics.level_max_force_step_n;
-  g.query_deadline_s = s.haptics.query_deadline_us * 1e-6;
+  g.query_box_budget = s.haptics.query_box_budget;
   return g;
 }
 
@@ -81,8 +81,7 @@ long run_simulated(const Scene& scene, const config::Settings& s, const HandPath
     rec.t_s = static_cast<double>(k) * sp.period_s;
     ServoInput in;
     in.sample = device.read();
-    const std::int64_t t0 = steady_ns();
-    in.now_ns = t0;
+    const std::int64_t t0 = steady_ns();  // timing only: the step reads no clock
     servo.update(in, so);
     rec.tick_ns = steady_ns() - t0;
     rec.handle_m = in.sample.handle_m;

@@ -31,7 +31,7 @@ struct TickRecord {
 using TickObserver = std::function<void(const TickRecord&, const ServoOutput&)>;
 
 /// The live-changeable servo gains from the settings ([haptics]: stiffness, damping, max force, friction,
-/// level_max_force_step_n, query deadline), as ServoCore::set_gains takes them at Apply.
+/// level_max_force_step_n, query box budget), as ServoCore::set_gains takes them at Apply.
 ServoGains servo_gains_from(const config::Settings& s);
 
 /// Servo parameters from the settings. Its gains part is servo_gains_from(s) (gains_of(servo_params_from(s))

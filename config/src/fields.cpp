@@ -138,7 +138,8 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(haptics, static_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "", "Coulomb static friction of the walls; >= dynamic_friction."),
     HK_FIELD(haptics, dynamic_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "", "Coulomb dynamic friction of the walls; both 0 = frictionless."),
     HK_FIELD(haptics, max_levels, FieldGroup::levels, ApplyWhen::scene, 1, 12, "", "Number of levels built above level 0."),
-    HK_FIELD(haptics, query_deadline_us, FieldGroup::haptics, ApplyWhen::live, 1, 100000, "µs", "Deadline of the anytime collision query."),
+    HK_FIELD(haptics, query_box_budget, FieldGroup::haptics, ApplyWhen::live, 0, 10000000, "box tests",
+             "Box tests the collision queries and level-change checks of one servo tick may do; past it the proxy waits where the sweep is proven clear (anytime). 0 = no limit."),
     HK_FIELD(haptics, force_ramp_s, FieldGroup::haptics, ApplyWhen::scene, 0, 10, "s", "Start-up force ramp duration."),
     // [device]
     HK_FIELD(device, type, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Device driving the handle.", kDeviceTypes),

@@ -2,16 +2,11 @@
 #include "haptics/collision_query.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 namespace hk {
 namespace {
-
-inline std::int64_t steady_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 // Distance from p to a box (0 inside) [m].
 inline double box_distance(const ErrorBox& box, Vec2 p) {
@@ -116,7 +111,7 @@ void BoundarySection::split(std::uint32_t node) {
 }
 
 SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                                    const QueryBudget& budget, QueryStats* stats_out) {
+                                    QueryBudget& budget, QueryStats* stats_out) {
   QueryStats st;
   SweepHit best;
   best.t = std::numeric_limits<double>::infinity();
@@ -141,13 +136,16 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     std::fill(merge_stamp_.begin(), merge_stamp_.end(), 0u);
     tick_ = 1;
   }
-  bool exhausted = false;
-  auto charge_box = [&]() {
+  // A section entry's clip is always done and charged; every other box test only while the budget lasts.
+  auto charge_section_box = [&]() {
     ++st.box_tests;
-    if (exhausted) return;
-    if (budget.max_box_tests > 0 && st.box_tests >= budget.max_box_tests) exhausted = true;
-    // Read the clock every 8 box tests: cheap enough, fine enough for µs deadlines.
-    if (budget.deadline_ns > 0 && (st.box_tests & 7) == 0 && steady_now_ns() > budget.deadline_ns) exhausted = true;
+    ++st.section_box_tests;
+    budget.charge();
+  };
+  auto spend_box = [&]() {
+    if (!budget.spend()) return false;
+    ++st.box_tests;
+    return true;
   };
   auto is_excluded = [&](SegmentRef s) {
     for (int i = 0; i < excluded_count; ++i) {
@@ -181,7 +179,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   for (std::size_t i = 0; i < n_section; ++i) {
     const std::uint32_t node = section_[i];
     double te = 0.0, tx = 0.0;
-    charge_box();
+    charge_section_box();
     if (overlaps(section_box_[i], sweep, merge_margin_m_) && clip_segment_box(sc.box(node), a, b, merge_margin_m_, &te, &tx)) {
       hit_stamp_[node] = tick_;
       if (clip_segment_box(sc.box(node), a, b, 0.0, &te, &tx)) candidates_.push_back({te, node});
@@ -207,23 +205,28 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
         test_segment(node);
         continue;
       }
-      if (exhausted) {
+      std::uint32_t first = 0, count = 0;
+      sc.children(node, &first, &count);
+      // Push hit children far-to-near so the nearest is popped first.
+      const int base = top;
+      bool refined = true;
+      for (std::uint32_t i = 0; i < count && refined; ++i) {
+        double te = 0.0, tx = 0.0;
+        if (!spend_box()) {
+          refined = false;
+          break;
+        }
+        if (overlaps(sc.aabb(first + i), sweep, 0.0) && clip_segment_box(sc.box(first + i), a, b, 0.0, &te, &tx) && te <= best.t) {
+          stack_[top++] = {te, first + i};
+        }
+      }
+      if (!refined) {  // past the budget (before or amid its children): the box bounds what is proven clear
+        top = base;
         if (cur.t_enter < unresolved_t) {
           unresolved_t = cur.t_enter;
           unresolved_node = node;
         }
         continue;
-      }
-      std::uint32_t first = 0, count = 0;
-      sc.children(node, &first, &count);
-      // Push hit children far-to-near so the nearest is popped first.
-      const int base = top;
-      for (std::uint32_t i = 0; i < count; ++i) {
-        double te = 0.0, tx = 0.0;
-        charge_box();
-        if (overlaps(sc.aabb(first + i), sweep, 0.0) && clip_segment_box(sc.box(first + i), a, b, 0.0, &te, &tx) && te <= best.t) {
-          stack_[top++] = {te, first + i};
-        }
       }
       std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
     }
@@ -255,7 +258,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     for (std::uint32_t i = 0; i < count && all_idle; ++i) all_idle = in_section_[first + i] && hit_stamp_[first + i] != tick_;
     if (!all_idle) continue;
     double te = 0.0, tx = 0.0;
-    charge_box();
+    if (!spend_box()) break;  // merging can wait for a tick with budget left
     if (overlaps(sc.aabb(parent), sweep, merge_margin_m_) && clip_segment_box(sc.box(parent), a, b, merge_margin_m_, &te, &tx)) continue;
     for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
     in_section_[parent] = 1;
@@ -287,7 +290,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   for (std::uint32_t node : section_) removed_[node] = 0;
 
   if (unresolved_t < best.t) {
-    // Not resolved in time: report the finest level reached, and how far the sweep is proven clear.
+    // Not resolved within the budget: report the finest level reached, and how far the sweep is proven clear.
     best.hit = false;
     best.blocked = true;
     best.t = unresolved_t;
@@ -307,18 +310,20 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   } else {
     best.t = 1.0;
   }
-  st.budget_exhausted = exhausted;
+  st.budget_exhausted = budget.exhausted();
   st.section_size = static_cast<std::int32_t>(section_.size());
   if (stats_out) *stats_out = st;
   return best;
 }
 
-bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve) {
+bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
+                                    QueryBudget* budget) {
   const Scene& sc = *scene_;
   double best = max_distance_m;
   bool found = false;
   if (sc.curve_count() == 0) return false;
   const std::uint32_t root = sc.scene_root();
+  if (budget && !budget->spend()) return false;
   const double dr = box_distance(sc.box(root), p);
   if (dr > best) return false;
   int top = 0;
@@ -346,6 +351,7 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
     sc.children(cur.node, &first, &count);
     const int base = top;
     for (std::uint32_t i = 0; i < count; ++i) {
+      if (budget && !budget->spend()) return false;  // unknown: the caller sees budget->ran_out
       const double d = box_distance(sc.box(first + i), p);
       if (d <= best) stack_[top++] = {d, first + i};
     }

@@ -65,11 +65,11 @@ void ContactSolver::reset(Vec2 p_m, int level) {
   }
 }
 
-int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m) {
+int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget) {
   const Scene& sc = *scene_;
   Vec2 q;
   SegmentRef s;
-  if (!section_.closest_point(p, level, radius_m, &q, &s, curve)) return 0;
+  if (!section_.closest_point(p, level, radius_m, &q, &s, curve, budget)) return budget && budget->ran_out ? 3 : 0;
   const SegGeom g = geom(sc, s);
   // The sign of (p − q) against the normal at q decides the side; where q is a vertex that normal is the
   // angle-weighted pseudo-normal (in 2D the bisector of the two edges' normals), which makes the sign
@@ -88,7 +88,7 @@ int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m) 
   return d > 0.0 ? 1 : (d < 0.0 ? -1 : 2);  // 2: on the polyline, no side
 }
 
-bool ContactSolver::level_change_is_safe(int new_level) {
+bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) {
   if (new_level == level_) return true;
   if (transition_level_ >= 0) return false;  // one change at a time
   // A curve's polylines at two levels lie within E = (largest error-box half-width at one level + at the
@@ -104,14 +104,16 @@ bool ContactSolver::level_change_is_safe(int new_level) {
   for (int l : {level_, new_level}) {
     Vec2 q;
     SegmentRef s;
-    if (section_.closest_point(proxy_, l, radius, &q, &s)) curves[n++] = s.curve;
+    if (section_.closest_point(proxy_, l, radius, &q, &s, -1, budget)) curves[n++] = s.curve;
+    if (budget && budget->ran_out) return false;  // not known within this tick's budget: wait
   }
   for (int i = 0; i < n; ++i) {
     bool seen = false;
     for (int j = 0; j < i; ++j) seen = seen || curves[j] == curves[i];
     if (seen) continue;
-    const int before = side_of_curve(proxy_, curves[i], level_, radius);
-    const int after = side_of_curve(proxy_, curves[i], new_level, radius);
+    const int before = side_of_curve(proxy_, curves[i], level_, radius, budget);
+    const int after = side_of_curve(proxy_, curves[i], new_level, radius, budget);
+    if (before == 3 || after == 3) return false;  // not known within this tick's budget: wait
     if (before == 2 || after == 2) return false;
     if (before != 0 && after != 0 && before != after) return false;  // the proxy would be behind the new wall
   }
@@ -119,7 +121,7 @@ bool ContactSolver::level_change_is_safe(int new_level) {
 }
 
 ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count,
-                            const QueryBudget& budget, ContactOutput& out, Constraint* hit_out) {
+                            QueryBudget& budget, ContactOutput& out, Constraint* hit_out) {
   QueryStats st;
   SweepHit hit = section_.first_hit(proxy_, target, level, excluded, excluded_count, budget, &st);
   if (transition_level_ >= 0) {
@@ -127,6 +129,7 @@ ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Segment
     QueryStats st2;
     const SweepHit old_hit = section_.first_hit(proxy_, target, transition_level_, excluded, excluded_count, budget, &st2);
     st.box_tests += st2.box_tests;
+    st.section_box_tests += st2.section_box_tests;
     st.segment_tests += st2.segment_tests;
     st.splits += st2.splits;
     st.merges += st2.merges;
@@ -135,6 +138,7 @@ ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Segment
     if (old_first) hit = old_hit;
   }
   out.query.box_tests += st.box_tests;
+  out.query.section_box_tests += st.section_box_tests;
   out.query.segment_tests += st.segment_tests;
   out.query.splits += st.splits;
   out.query.merges += st.merges;
@@ -143,7 +147,7 @@ ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Segment
   out.query.budget_exhausted = out.query.budget_exhausted || st.budget_exhausted;
   ++out.queries;
   if (hit.blocked) {
-    // Unresolved in time: go only as far as the sweep is proven clear, less the skin. Never guess.
+    // Unresolved within the budget: go only as far as the sweep is proven clear, less the skin. Never guess.
     const double len = distance(proxy_, target);
     const double t = len > 0.0 ? std::max(0.0, hit.t - params_.skin_m / len) : 0.0;
     proxy_ = proxy_ + t * (target - proxy_);
@@ -172,8 +176,23 @@ ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Segment
 }
 
 void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
-  const Scene& sc = *scene_;
   const ContactState before = state_;
+  begin_step(in, out);
+  Step s{in, out, in.budget};
+  bool rest = false;
+  for (int iter = 0; iter < params_.max_iterations && !rest; ++iter) {
+    switch (state_) {
+      case ContactState::Free: rest = step_free(s); break;
+      case ContactState::Edge: rest = step_edge(s); break;
+      case ContactState::Vertex: rest = step_vertex(s); break;
+    }
+  }
+  if (!rest) out.events |= kEventIterationLimit;
+  out.budget_used = s.budget.box_tests_used;
+  finish_step(before, contact_force(in), out);
+}
+
+void ContactSolver::begin_step(const ContactInput& in, ContactOutput& out) {
   out.events = kEventNone;
   out.corner_turn_rad = 0.0;
   out.query = QueryStats{};
@@ -186,161 +205,163 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
     transition_level_ = level_;
     level_ = in.level;
   }
-  const Vec2 h = in.handle_m;
-  const double skin = params_.skin_m;
-  bool rest = false;
-  int iter = 0;
-  for (; iter < params_.max_iterations && !rest; ++iter) {
-    switch (state_) {
-      case ContactState::Free: {
-        Constraint hit;
-        const Move m = move_to(h, level_, nullptr, 0, in.budget, out, &hit);
-        if (m == Move::Hit) {
-          state_ = ContactState::Edge;
-          c_[0] = hit;
-          sticking_ = false;  // the proxy arrives moving: judged against the dynamic cone first
-        } else {
-          rest = true;
-        }
-        break;
-      }
-      case ContactState::Edge: {
-        const SegmentRef seg = c_[0].seg;
-        const double side = c_[0].side;
-        const SegGeom g = geom(sc, seg);
-        if (side * dot(g.n, h - g.a) >= 0.0) {  // handle back on the proxy's side: contact released
-          state_ = ContactState::Free;
-          break;
-        }
-        // Friction cone (see contact.hpp): inside it the proxy stays; outside, it slides to trail the
-        // handle's foot point by μ_d · penetration.
-        const double depth = -side * dot(g.n, h - g.a);  // > 0: the handle is behind the wall's line
-        const double t_off = dot(g.u, h - proxy_);        // the handle's lead along the edge [m]
-        const double mu = sticking_ ? params_.static_friction : params_.dynamic_friction;
-        if (std::fabs(t_off) <= mu * depth) {
-          // Inside the cone: the proxy stays. A sliding proxy sticks again only once the hand has all but
-          // stopped along the edge (Karnopp's stick band): otherwise a press that deepens while sliding
-          // would re-stick it every few ticks and each break-away would be a μ_s − μ_d force step, a buzz.
-          if (!sticking_) sticking_ = mu > 0.0 && std::fabs(dot(g.u, in.handle_velocity_m_per_s)) <= params_.stick_speed_m_per_s;
-          rest = true;
-          break;
-        }
-        sticking_ = false;
-        const double tau = dot(g.u, h - g.a) - std::copysign(params_.dynamic_friction * depth, t_off);
-        const int clamped = tau < 0.0 ? -1 : (tau > g.len ? 1 : 0);
-        const double tau_c = std::clamp(tau, 0.0, g.len);
-        Constraint hit;
-        const Move m = move_to(g.a + tau_c * g.u + (side * skin) * g.n, level_, &seg, 1, in.budget, out, &hit);
-        if (m == Move::Blocked) {
-          rest = true;
-          break;
-        }
-        if (m == Move::Hit) {
-          state_ = ContactState::Vertex;  // a second wall while sliding
-          c_[1] = hit;
-          out.events |= kEventVertexBegin;
-          const SegGeom gh = geom(sc, hit.seg);  // the angle between the two walls' lines, in [0, π/2]
-          out.corner_turn_rad = std::max(out.corner_turn_rad, std::atan2(std::fabs(cross(g.u, gh.u)), std::fabs(dot(g.u, gh.u))));
-          break;
-        }
-        if (clamped == 0) {
-          rest = true;
-          break;
-        }
-        // The slide reached a vertex V of the segment.
-        SegmentRef nb;
-        if (!neighbour(sc, seg, clamped, &nb)) {  // the open end of a curve: go round it
-          state_ = ContactState::Free;
-          break;
-        }
-        const SegGeom gn = geom(sc, nb);
-        const Vec2 v = clamped > 0 ? g.b : g.a;
-        const Vec2 u_in = clamped > 0 ? g.u : gn.u;
-        const Vec2 u_out = clamped > 0 ? gn.u : g.u;
-        const double turn = side * cross(u_in, u_out);
-        const bool pen_nb = side * dot(gn.n, h - gn.a) < 0.0;
-        const double turn_rad = std::atan2(std::fabs(turn), dot(u_in, u_out));  // how sharply the curve turns at V
-        if (turn > 0.0) {  // concave on the proxy's side: the two walls hold it
-          if (pen_nb) {
-            state_ = ContactState::Vertex;
-            c_[1] = Constraint{nb, side};
-            out.events |= kEventVertexBegin;
-            out.corner_turn_rad = std::max(out.corner_turn_rad, turn_rad);
-          } else {
-            rest = true;
-          }
-          break;
-        }
-        // Convex (or straight): step round the corner to the bisector of the two normals, then go on
-        // along the next edge if the handle is behind it, or leave it.
-        if (turn < 0.0) {
-          out.events |= kEventConvexCorner;
-          out.corner_turn_rad = std::max(out.corner_turn_rad, turn_rad);
-        }
-        const Vec2 bis = normalized_or(g.n + gn.n, clamped > 0 ? g.u : -g.u);
-        const Move mc = move_to(v + (side * skin) * bis, level_, nullptr, 0, in.budget, out, &hit);
-        if (mc == Move::Blocked) {
-          rest = true;
-          break;
-        }
-        if (mc == Move::Hit) {
-          state_ = ContactState::Edge;
-          c_[0] = hit;
-          break;
-        }
-        if (pen_nb) {
-          c_[0] = Constraint{nb, side};
-        } else {
-          state_ = ContactState::Free;
-        }
-        break;
-      }
-      case ContactState::Vertex: {
-        const SegGeom ga = geom(sc, c_[0].seg);
-        const SegGeom gb = geom(sc, c_[1].seg);
-        const double sa = c_[0].side, sb = c_[1].side;
-        const bool pen_a = sa * dot(ga.n, h - ga.a) < 0.0;
-        const bool pen_b = sb * dot(gb.n, h - gb.a) < 0.0;
-        if (!pen_a && !pen_b) {
-          state_ = ContactState::Free;
-        } else if (!pen_a) {
-          state_ = ContactState::Edge;
-          c_[0] = c_[1];
-        } else if (!pen_b) {
-          state_ = ContactState::Edge;
-        } else {
-          // Stable-contact rule (seed §4): sliding along an edge must not lead away from the other wall.
-          const Vec2 pull = h - proxy_;
-          const double along_a = dot(ga.u, pull), along_b = dot(gb.u, pull);
-          const bool a_leaves_b = sb * dot(gb.n, along_a * ga.u) > 0.0;
-          const bool b_leaves_a = sa * dot(ga.n, along_b * gb.u) > 0.0;
-          if (a_leaves_b && (!b_leaves_a || std::abs(along_a) >= std::abs(along_b))) {
-            state_ = ContactState::Edge;
-          } else if (b_leaves_a) {
-            state_ = ContactState::Edge;
-            c_[0] = c_[1];
-          } else {
-            rest = true;
-          }
-        }
-        break;
-      }
-    }
-  }
-  if (!rest) out.events |= kEventIterationLimit;
+}
 
-  // Force: spring from handle to proxy, damping along the contact normal, one clamp.
+bool ContactSolver::step_free(Step& s) {
+  Constraint hit;
+  const Move m = move_to(s.in.handle_m, level_, nullptr, 0, s.budget, s.out, &hit);
+  if (m != Move::Hit) return true;
+  state_ = ContactState::Edge;
+  c_[0] = hit;
+  sticking_ = false;  // the proxy arrives moving: judged against the dynamic cone first
+  return false;
+}
+
+bool ContactSolver::step_edge(Step& s) {
+  const Scene& sc = *scene_;
+  const Vec2 h = s.in.handle_m;
+  const SegmentRef seg = c_[0].seg;
+  const double side = c_[0].side;
+  const SegGeom g = geom(sc, seg);
+  if (side * dot(g.n, h - g.a) >= 0.0) {  // handle back on the proxy's side: contact released
+    state_ = ContactState::Free;
+    return false;
+  }
+  // Friction cone (see contact.hpp): inside it the proxy stays; outside, it slides to trail the
+  // handle's foot point by μ_d · penetration.
+  const double depth = -side * dot(g.n, h - g.a);  // > 0: the handle is behind the wall's line
+  const double t_off = dot(g.u, h - proxy_);        // the handle's lead along the edge [m]
+  const double mu = sticking_ ? params_.static_friction : params_.dynamic_friction;
+  if (std::fabs(t_off) <= mu * depth) {
+    // Inside the cone: the proxy stays. A sliding proxy sticks again only once the hand has all but
+    // stopped along the edge (Karnopp's stick band): otherwise a press that deepens while sliding
+    // would re-stick it every few ticks and each break-away would be a μ_s − μ_d force step, a buzz.
+    if (!sticking_) sticking_ = mu > 0.0 && std::fabs(dot(g.u, s.in.handle_velocity_m_per_s)) <= params_.stick_speed_m_per_s;
+    return true;
+  }
+  sticking_ = false;
+  const double tau = dot(g.u, h - g.a) - std::copysign(params_.dynamic_friction * depth, t_off);
+  const int clamped = tau < 0.0 ? -1 : (tau > g.len ? 1 : 0);
+  const double tau_c = std::clamp(tau, 0.0, g.len);
+  Constraint hit;
+  const Move m = move_to(g.a + tau_c * g.u + (side * params_.skin_m) * g.n, level_, &seg, 1, s.budget, s.out, &hit);
+  if (m == Move::Blocked) return true;
+  if (m == Move::Hit) {
+    state_ = ContactState::Vertex;  // a second wall while sliding
+    c_[1] = hit;
+    s.out.events |= kEventVertexBegin;
+    const SegGeom gh = geom(sc, hit.seg);  // the angle between the two walls' lines, in [0, π/2]
+    s.out.corner_turn_rad = std::max(s.out.corner_turn_rad, std::atan2(std::fabs(cross(g.u, gh.u)), std::fabs(dot(g.u, gh.u))));
+    return false;
+  }
+  if (clamped == 0) return true;
+  return at_edge_vertex(s, clamped);
+}
+
+bool ContactSolver::at_edge_vertex(Step& s, int clamped) {
+  const Scene& sc = *scene_;
+  const Vec2 h = s.in.handle_m;
+  const SegmentRef seg = c_[0].seg;
+  const double side = c_[0].side;
+  const SegGeom g = geom(sc, seg);
+  SegmentRef nb;
+  if (!neighbour(sc, seg, clamped, &nb)) {  // the open end of a curve: go round it
+    state_ = ContactState::Free;
+    return false;
+  }
+  const SegGeom gn = geom(sc, nb);
+  const Vec2 v = clamped > 0 ? g.b : g.a;
+  const Vec2 u_in = clamped > 0 ? g.u : gn.u;
+  const Vec2 u_out = clamped > 0 ? gn.u : g.u;
+  const double turn = side * cross(u_in, u_out);
+  const bool pen_nb = side * dot(gn.n, h - gn.a) < 0.0;
+  const double turn_rad = std::atan2(std::fabs(turn), dot(u_in, u_out));  // how sharply the curve turns at V
+  if (turn > 0.0) {  // concave on the proxy's side: the two walls hold it
+    if (!pen_nb) return true;
+    state_ = ContactState::Vertex;
+    c_[1] = Constraint{nb, side};
+    s.out.events |= kEventVertexBegin;
+    s.out.corner_turn_rad = std::max(s.out.corner_turn_rad, turn_rad);
+    return false;
+  }
+  // Convex (or straight): step round the corner to the bisector of the two normals, then go on
+  // along the next edge if the handle is behind it, or leave it.
+  if (turn < 0.0) {
+    s.out.events |= kEventConvexCorner;
+    s.out.corner_turn_rad = std::max(s.out.corner_turn_rad, turn_rad);
+  }
+  const Vec2 bis = normalized_or(g.n + gn.n, clamped > 0 ? g.u : -g.u);
+  Constraint hit;
+  const Move mc = move_to(v + (side * params_.skin_m) * bis, level_, nullptr, 0, s.budget, s.out, &hit);
+  if (mc == Move::Blocked) return true;
+  if (mc == Move::Hit) {
+    state_ = ContactState::Edge;
+    c_[0] = hit;
+    return false;
+  }
+  if (pen_nb) {
+    c_[0] = Constraint{nb, side};
+  } else {
+    state_ = ContactState::Free;
+  }
+  return false;
+}
+
+bool ContactSolver::step_vertex(Step& s) {
+  const Scene& sc = *scene_;
+  const Vec2 h = s.in.handle_m;
+  const SegGeom ga = geom(sc, c_[0].seg);
+  const SegGeom gb = geom(sc, c_[1].seg);
+  const double sa = c_[0].side, sb = c_[1].side;
+  const bool pen_a = sa * dot(ga.n, h - ga.a) < 0.0;
+  const bool pen_b = sb * dot(gb.n, h - gb.a) < 0.0;
+  if (!pen_a && !pen_b) {
+    state_ = ContactState::Free;
+    return false;
+  }
+  if (!pen_a) {
+    state_ = ContactState::Edge;
+    c_[0] = c_[1];
+    return false;
+  }
+  if (!pen_b) {
+    state_ = ContactState::Edge;
+    return false;
+  }
+  // Stable-contact rule (seed §4): sliding along an edge must not lead away from the other wall.
+  const Vec2 pull = h - proxy_;
+  const double along_a = dot(ga.u, pull), along_b = dot(gb.u, pull);
+  const bool a_leaves_b = sb * dot(gb.n, along_a * ga.u) > 0.0;
+  const bool b_leaves_a = sa * dot(ga.n, along_b * gb.u) > 0.0;
+  if (a_leaves_b && (!b_leaves_a || std::abs(along_a) >= std::abs(along_b))) {
+    state_ = ContactState::Edge;
+    return false;
+  }
+  if (b_leaves_a) {
+    state_ = ContactState::Edge;
+    c_[0] = c_[1];
+    return false;
+  }
+  return true;
+}
+
+Vec2 ContactSolver::contact_force(const ContactInput& in) const {
+  // Spring from handle to proxy, damping along the contact normal, one clamp.
+  const Vec2 h = in.handle_m;
   Vec2 f = params_.stiffness_n_per_m * (proxy_ - h);
   if (state_ != ContactState::Free && params_.damping_n_s_per_m > 0.0) {
-    const SegGeom g = geom(sc, c_[0].seg);
+    const SegGeom g = geom(*scene_, c_[0].seg);
     f -= (params_.damping_n_s_per_m * dot(in.handle_velocity_m_per_s, g.n)) * g.n;
   }
   const double mag = length(f);
   if (mag > params_.max_force_n) f = (params_.max_force_n / mag) * f;
   if (!is_finite(f)) f = Vec2{0.0, 0.0};
+  return f;
+}
 
+void ContactSolver::finish_step(ContactState before, Vec2 force_n, ContactOutput& out) {
   out.proxy_m = proxy_;
-  out.force_n = f;
+  out.force_n = force_n;
   out.state = state_;
   out.sticking = state_ == ContactState::Edge && sticking_;
   out.level = -1;

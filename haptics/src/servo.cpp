@@ -60,7 +60,7 @@ ServoGains gains_of(const ServoParams& p) noexcept {
   g.static_friction = p.contact.static_friction;
   g.dynamic_friction = p.contact.dynamic_friction;
   g.max_force_step_n = p.max_force_step_n;
-  g.query_deadline_s = p.query_deadline_s;
+  g.query_box_budget = p.query_box_budget;
   return g;
 }
 
@@ -72,7 +72,7 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
   p.contact.dynamic_friction = g.dynamic_friction;
   p.guard.max_force_n = g.max_force_n;
   p.max_force_step_n = g.max_force_step_n;
-  p.query_deadline_s = g.query_deadline_s;
+  p.query_box_budget = g.query_box_budget;
 }
 
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
@@ -130,9 +130,12 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
 
   // Level: from the hand's speed or fixed; changed only when the proxy can move to it without crossing.
   const int wanted = params_.auto_level ? policy_.update(velocity_, dt) : params_.level;
+  // One box-test budget for the whole tick: the level-change check first, then every query of the solver.
+  QueryBudget budget;
+  budget.max_box_tests = params_.query_box_budget;
   out.level_changed = false;
   if (wanted != level_) {
-    if (solver_.level_change_is_safe(wanted)) {  // else it waits (out.level_wanted shows it)
+    if (solver_.level_change_is_safe(wanted, &budget)) {  // else it waits (out.level_wanted shows it)
       out.level_changed = true;
       level_ = wanted;
     }
@@ -144,9 +147,7 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   ci.handle_m = h;
   ci.handle_velocity_m_per_s = velocity_;
   ci.level = level_;
-  if (params_.query_deadline_s > 0.0 && in.now_ns > 0) {
-    ci.budget.deadline_ns = in.now_ns + static_cast<std::int64_t>(params_.query_deadline_s * 1e9);
-  }
+  ci.budget = budget;
   solver_.update(ci, out.contact);
   if (out.contact.state == ContactState::Free) out.contact.level = level_;
 

@@ -34,7 +34,9 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   KioskFlow flow(rt, rt.audio().messages(), fp);
   flow.key(KioskKey::Other, 0.0);  // wake: the tutorial's square is shown
   const auto tick = [&] {          // the servo thread's part (no servo thread in this test)
-    rt.core().tick(0, false);
+    ServoCommand cmd;
+    rt.core().step(rt.device().read(), false, cmd);
+    rt.device().write_force(cmd.force_n);
     rt.core().publish_display();
   };
   tick();                          // the servo's core takes the square

@@ -40,11 +40,13 @@ struct Rig {
   std::vector<ServoDisplayState> shown;
   Vec2 target{0.0, 0.0};  // where the hand pulls to
 
-  Rig() : sp(servo_params_from(s)), device(sim_params_from(s), {-0.03, 0.0}), hand(hand_params_from(s)), core(device, CueTrackerParams{}, nullptr) {
+  Rig() : sp(servo_params_from(s)), device(sim_params_from(s), {-0.03, 0.0}), hand(hand_params_from(s)), core(CueTrackerParams{}, nullptr) {
     device.open();
   }
   void tick() {
-    core.tick(0, false);
+    ServoCommand cmd;
+    core.step(device.read(), false, cmd);
+    device.write_force(cmd.force_n);
     core.publish_display();
     forces.push_back(core.last_output().force_n);
     const ServoDisplayState& d = core.display();

@@ -33,7 +33,7 @@ struct Rig {
   Vec2 target{0.0, 0.0};  // the hand pulls towards the square's centre: it presses on the left wall
   std::vector<Vec2> forces, handles;
 
-  Rig() : sp(servo_params_from(s)), device(sim_params(s), {-0.03, 0.0}), core(device, CueTrackerParams{}, &cues) {
+  Rig() : sp(servo_params_from(s)), device(sim_params(s), {-0.03, 0.0}), core(CueTrackerParams{}, &cues) {
     device.open();
     hand.stiffness_n_per_m = s.hand.stiffness_n_per_m;
     hand.damping_n_s_per_m = s.hand.damping_n_s_per_m;
@@ -47,7 +47,9 @@ struct Rig {
   void run(double seconds) {
     const long n = static_cast<long>(seconds / sp.period_s + 0.5);
     for (long k = 0; k < n; ++k) {
-      core.tick(0, false);
+      ServoCommand cmd;
+      core.step(device.read(), false, cmd);
+      device.write_force(cmd.force_n);
       core.publish_display();
       forces.push_back(core.last_output().force_n);
       handles.push_back(core.display().handle_m);

@@ -22,13 +22,13 @@ TEST(ServoThread, TicksCountsAMissedDeadlineAndStops) {
   SimPantographParams dp;
   SimulatedPantograph device(dp, {-0.03, 0.0});
   device.open();
-  ServoCore core(device, CueTrackerParams{}, nullptr);
+  ServoCore core(CueTrackerParams{}, nullptr);
   auto b = std::make_unique<SceneBundle>(std::make_unique<Scene>(Scene::build({square(0.02)}, 2)), sp);
   b->id = 7;
   core.publish(std::move(b));
   std::atomic<int> after{0};
   {
-    ServoThread t(core, {}, [&](double period_s) {
+    ServoThread t(core, device, {}, [&](double period_s) {
       EXPECT_DOUBLE_EQ(period_s, 0.001);
       if (++after == 50) std::this_thread::sleep_for(std::chrono::milliseconds(3));  // a stall: the next tick is late
     });
@@ -51,10 +51,10 @@ TEST(ServoThread, TicksCountsAMissedDeadlineAndStops) {
 TEST(ServoThread, RefusesARateOutsideItsRange) {
   SimPantographParams dp;
   SimulatedPantograph device(dp, {0.0, 0.0});
-  ServoCore core(device, CueTrackerParams{}, nullptr);
+  ServoCore core(CueTrackerParams{}, nullptr);
   ServoThreadParams p;
   p.rate_hz = 50;
-  EXPECT_THROW(ServoThread(core, p), std::invalid_argument);
+  EXPECT_THROW(ServoThread(core, device, p), std::invalid_argument);
 }
 
 }  // namespace

@@ -43,7 +43,7 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"haptics", "servo_rate_hz", 100, 10000, false},
       {"haptics", "level", 0, 12, true},
       {"haptics", "max_levels", 1, 12, true},
-      {"haptics", "query_deadline_us", 1, 100000, false},
+      {"haptics", "query_box_budget", 0, 10000000, true},
       {"haptics", "force_ramp_s", 0, 10, false},
       {"haptics", "level_error_at_rest_m", 0, 0.01, false},
       {"haptics", "level_blur_time_s", 0, 0.1, false},

@@ -21,7 +21,7 @@ ServoParams auto_params() {
   p.level = 2;
   p.contact.static_friction = 0.4;
   p.contact.dynamic_friction = 0.3;
-  p.query_deadline_s = 0.0;  // deterministic: no wall-clock deadline
+  p.query_box_budget = 0;  // no box-test limit: every query exact
   return p;
 }
 

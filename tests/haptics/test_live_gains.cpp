@@ -24,7 +24,7 @@ ServoParams params(double k = 800.0) {
   p.level = 0;
   p.auto_level = false;
   p.max_force_step_n = kStep;
-  p.query_deadline_s = 0.0;
+  p.query_box_budget = 0;
   p.contact.stiffness_n_per_m = k;
   p.contact.max_force_n = 3.5;
   p.guard.max_force_n = 3.5;
@@ -312,7 +312,7 @@ TEST(LiveGains, GainsOfServoParamsRoundTrip) {
   g.static_friction = 0.4;
   g.dynamic_friction = 0.3;
   g.max_force_step_n = 0.02;
-  g.query_deadline_s = 150e-6;
+  g.query_box_budget = 1500;
   apply_gains(p, g);
   EXPECT_EQ(gains_of(p), g);
   EXPECT_EQ(p.guard.max_force_n, 2.0) << "the guard's clamp is the solver's";

@@ -25,7 +25,7 @@ struct HapticsSettings {
   double static_friction = 0.4;           ///< key static_friction, Coulomb static coefficient of the walls, [0, 2]; >= dynamic_friction
   double dynamic_friction = 0.3;          ///< key dynamic_friction, Coulomb dynamic coefficient, [0, 2]; 0 and 0 = frictionless
   int max_levels = 6;                     ///< key max_levels, levels built above level 0, [1, 12]
-  double query_deadline_us = 200.0;       ///< key query_deadline_us, anytime collision deadline, [1, 100000] µs
+  int query_box_budget = 4000;            ///< key query_box_budget, box tests the collision queries and level-change checks of one servo tick may do, [0, 10000000] box tests; 0 = no limit (default measured: see hk::kDefaultQueryBoxBudget in haptics/servo.hpp)
   double force_ramp_s = 0.5;              ///< key force_ramp_s, start-up force ramp, [0, 10] s
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.

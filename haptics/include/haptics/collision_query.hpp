@@ -9,9 +9,9 @@
 /// Each tick the sweep is clipped (Liang–Barsky) against the boxes of the boundary section; hit boxes
 /// are sorted by entry parameter and refined depth-first, nearest first, down to the target level,
 /// where the sweep is intersected with that level's polyline. Boxes whose entry lies past the best hit
-/// so far are pruned. A budget (deadline and/or box-test count) makes it anytime: past it, boxes are no
-/// longer refined, and the answer is the one at the finest level reached — reported conservatively: the
-/// sweep is clear up to the entry of the nearest box not refined in time (a box holds everything finer,
+/// so far are pruned. A budget of box tests (QueryBudget, shared by every query of a servo tick) makes it
+/// anytime: past it, boxes are no longer refined, and the answer is the one at the finest level reached — reported conservatively: the
+/// sweep is clear up to the entry of the nearest box not refined within the budget (a box holds everything finer,
 /// so no wall of the target level lies before it). The caller can then stop short instead of crossing a
 /// wall it has not resolved; the boundary section keeps the refinement for the next tick.
 /// Between full queries a free-space ball answers at once: a full query measures how far the end of
@@ -37,10 +37,33 @@ bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, doub
 /// because a sweep sliding along a wall does not cross it.
 bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t);
 
-/// Limits that make the query anytime. Zero means "no limit".
+/// The work limit that makes queries anytime: a count of box tests, shared by every query (and
+/// closest-point walk) it is passed to, so one number bounds a servo tick's collision work. No clock.
+///
+/// Two kinds of box test draw on it. Optional work (refining a hit box into its children, merge checks,
+/// closest-point walks) is done only while the budget lasts: `spend()` refuses once `box_tests_used`
+/// has reached `max_box_tests`, so that work never takes the count past the limit. The clip of the
+/// sweep against the boundary section itself is always done in full (it is what proves the sweep clear
+/// at all) and is charged even past the limit: that is the only overrun, so after any number of queries
+/// box_tests_used ≤ max_box_tests + the section entries they scanned (QueryStats::section_box_tests).
 struct QueryBudget {
-  std::int64_t deadline_ns = 0;   ///< absolute steady-clock time [ns] after which refinement stops
-  std::int32_t max_box_tests = 0; ///< box clips after which refinement stops (deterministic deadline for tests)
+  std::int32_t max_box_tests = 0;   ///< box tests allowed [count]; 0 = no limit
+  std::int32_t box_tests_used = 0;  ///< box tests charged so far by everything sharing this budget [count]
+  bool ran_out = false;             ///< some optional work was refused for want of budget
+
+  /// True when no optional box test may be done any more.
+  bool exhausted() const noexcept { return max_box_tests > 0 && box_tests_used >= max_box_tests; }
+  /// Charges one optional box test. Returns false (and sets ran_out) when the budget is spent.
+  bool spend() noexcept {
+    if (exhausted()) {
+      ran_out = true;
+      return false;
+    }
+    ++box_tests_used;
+    return true;
+  }
+  /// Charges one box test that is done regardless (a section entry's clip).
+  void charge() noexcept { ++box_tests_used; }
 };
 
 /// Result of a sweep query.
@@ -48,7 +71,7 @@ struct SweepHit {
   bool hit = false;      ///< the exact first hit at the target level was found
   bool blocked = false;  ///< the budget ran out first: the sweep is proven clear only up to `t`
   double t = 1.0;        ///< hit: sweep parameter of the first hit; blocked: where the first box not
-                         ///< refined in time begins (no wall of the target level lies before it); else 1
+                         ///< refined within the budget begins (no wall of the target level lies before it); else 1
   Vec2 point_m;          ///< a + t (b − a) [m]
   SegmentRef segment;    ///< hit: the segment hit; blocked: the coarse segment of that box, i.e. the
                          ///< answer at the finest level reached (level > target)
@@ -56,13 +79,14 @@ struct SweepHit {
 
 /// Work done by one query (for timing analysis and the anytime chart).
 struct QueryStats {
-  std::int32_t box_tests = 0;
+  std::int32_t box_tests = 0;          ///< every box test of the query (section clips, refinement, merges)
+  std::int32_t section_box_tests = 0;  ///< of which clips of the boundary section, done even past the budget
   std::int32_t segment_tests = 0;
   std::int32_t splits = 0;
   std::int32_t merges = 0;
   std::int32_t section_size = 0;       ///< boundary-section nodes after the query
   std::int32_t coarsest_answer_level = 0;  ///< coarsest level reached by an answer (> target when the budget ran out)
-  bool budget_exhausted = false;
+  bool budget_exhausted = false;       ///< the budget was spent when (or before) this query ended
 };
 
 /// The boundary section of one scene plus the scratch space of the query. One per servo thread.
@@ -79,14 +103,23 @@ class BoundarySection {
 
   /// First hit of the sweep a→b against the polylines at `level` (clamped per curve to its coarsest),
   /// ignoring up to kMaxExcluded segments (the contact solver's active constraints). Updates the
-  /// boundary section. Real-time safe.
+  /// boundary section. Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                     const QueryBudget& budget, QueryStats* stats = nullptr);
+                     QueryBudget& budget, QueryStats* stats = nullptr);
+  /// The same for a one-off query: spends a copy of `budget` (tests, benches). Real-time safe.
+  SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
+                     const QueryBudget& budget, QueryStats* stats = nullptr) {
+    QueryBudget copy = budget;
+    return first_hit(a, b, level, excluded, excluded_count, copy, stats);
+  }
 
   /// Closest point on the polylines at `level` to p within max_distance_m, by a box-distance-pruned
   /// walk from the roots (does not use or change the frontier). Returns false when nothing is that close.
-  /// `curve` ≥ 0 restricts the search to that curve. Allocates nothing.
-  bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1);
+  /// `curve` ≥ 0 restricts the search to that curve. With a `budget`, each box-distance test is an
+  /// optional box test charged to it; when it runs out the walk stops and returns false with
+  /// budget->ran_out set (the answer is then unknown, not "nothing close"). Allocates nothing.
+  bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
+                     QueryBudget* budget = nullptr);
 
   /// Node ids of the current boundary section (for the operator overlay and tests).
   const std::vector<std::uint32_t>& section() const { return section_; }

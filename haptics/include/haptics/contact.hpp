@@ -46,7 +46,7 @@ enum HapticEvent : std::uint32_t {
   kEventVertexBegin = 1u << 2,    ///< entered vertex contact (concave corner)
   kEventConvexCorner = 1u << 3,   ///< slid over a convex corner onto the next edge
   kEventIterationLimit = 1u << 4, ///< the tick's move budget ran out before the proxy came to rest
-  kEventQueryBudget = 1u << 5,    ///< a collision query ran out of time: the proxy stopped where the sweep was proven clear
+  kEventQueryBudget = 1u << 5,    ///< a collision query ran out of its box-test budget: the proxy stopped where the sweep was proven clear
 };
 
 /// Solver parameters. Units in names.
@@ -69,7 +69,9 @@ struct ContactInput {
   Vec2 handle_m;                     ///< handle position [m]
   Vec2 handle_velocity_m_per_s;      ///< for rendered damping [m/s]
   int level = 0;                     ///< level whose polylines are walls
-  QueryBudget budget;                ///< anytime limits of the collision queries
+  /// The tick's box-test budget (QueryBudget): its limit, and what was already spent this tick before the
+  /// step (e.g. by level_change_is_safe). Every query of the step draws on it.
+  QueryBudget budget;
 };
 
 /// Output of one solver step.
@@ -88,6 +90,9 @@ struct ContactOutput {
   std::int32_t transition_level = -1; ///< ≥ 0: the previous level, still a wall after a level change (see level_change_is_safe)
   QueryStats query;                  ///< summed over this step's queries
   std::int32_t queries = 0;
+  /// Box tests charged to the tick's budget by the end of the step: ContactInput::budget.box_tests_used
+  /// plus this step's (query.box_tests). At most budget.max_box_tests + query.section_box_tests.
+  std::int32_t budget_used = 0;
   /// The proxy's path within the tick: path_m[0] is where it started, then the end of every move
   /// (a wrap round a convex corner is several moves; the straight chord between ticks may cut it).
   static constexpr int kMaxPath = 40;
@@ -121,8 +126,9 @@ class ContactSolver {
   /// the old level stays a wall, with the proxy's constraints on it, until the proxy rests on none of its
   /// segments: the proxy, on the same side of both polylines, then reaches the new one without crossing
   /// either. No second change is made while the old level is still a wall. Allocates nothing (at most six
-  /// closest-point walks).
-  bool level_change_is_safe(int new_level);
+  /// closest-point walks). With a `budget`, the walks' box tests are charged to it and never take it past
+  /// its limit: when it runs out before the answer is known, the answer is false (the change waits).
+  bool level_change_is_safe(int new_level, QueryBudget* budget = nullptr);
 
   Vec2 proxy() const { return proxy_; }
   ContactState state() const { return state_; }
@@ -138,8 +144,24 @@ class ContactSolver {
   enum class Move : std::uint8_t { Clear, Hit, Blocked };
   // Moves the proxy towards `target`, stopping a skin short of the first wall (Hit, wall in hit_out),
   // or short of the first box the query could not resolve in its budget (Blocked).
-  Move move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count, const QueryBudget& budget,
+  Move move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
                ContactOutput& out, Constraint* hit_out);
+  // What one update() works on: the handle, the tick's budget, the output. Passed to the state steps.
+  struct Step {
+    const ContactInput& in;
+    ContactOutput& out;
+    QueryBudget budget;
+  };
+  // The phases of update(), in order: begin_step, then per iteration the step of the current state
+  // (each returns true when the proxy is at rest for this tick), then contact_force and finish_step.
+  void begin_step(const ContactInput& in, ContactOutput& out);
+  bool step_free(Step& s);
+  bool step_edge(Step& s);
+  bool step_vertex(Step& s);
+  // Edge state: the slide along c_[0] reached its vertex at the end `clamped` (−1 start, +1 end).
+  bool at_edge_vertex(Step& s, int clamped);
+  Vec2 contact_force(const ContactInput& in) const;
+  void finish_step(ContactState before, Vec2 force_n, ContactOutput& out);
   double side_of(SegmentRef s, Vec2 p) const;
 
   const Scene* scene_;
@@ -153,8 +175,8 @@ class ContactSolver {
   int transition_level_ = -1;  // the previous level, still a wall just after a change; −1 = none
   double max_half_width_m_[Scene::kMaxLevels] = {};  // per level: the largest error-box half-width of any curve [m]
   // Side of p relative to curve `curve`'s polyline at `level`: +1 left, −1 right, 0 when the polyline is not
-  // within radius_m or its nearest point is an open end, 2 when p lies on it.
-  int side_of_curve(Vec2 p, int curve, int level, double radius_m);
+  // within radius_m or its nearest point is an open end, 2 when p lies on it, 3 when `budget` ran out first.
+  int side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget);
 };
 
 }  // namespace hk

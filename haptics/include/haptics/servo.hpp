@@ -18,7 +18,11 @@
 /// the hand's own motion does. A difference of D [N] is gone after ceil(D / max_force_step_n) ticks,
 /// counting the tick that takes the change.
 /// The tick is `update(input, output) -> TickResult`: a function of (state, sample, scene), with no
-/// allocation, lock, throw, I/O or logging. Status enums here; exceptions only at setup.
+/// allocation, lock, throw, I/O, logging or clock read. Its collision work is bounded by one number, the
+/// box-test budget ServoParams::query_box_budget: one counter per tick (QueryBudget) shared by the
+/// level-change check (ContactSolver::level_change_is_safe) and every collision query of the contact
+/// solver; past it the proxy waits where the sweep is proven clear and a level change waits for a later
+/// tick. Timing the tick is the caller's business. Status enums here; exceptions only at setup.
 
 #include <cstdint>
 
@@ -43,9 +47,23 @@ struct ForceGuard {
   double max_force_n = 4.0;  ///< clamp on |F| [N]
   double ramp_s = 0.5;       ///< time for the clamp to grow linearly from 0 to max_force_n after start [s]
 
-  /// Returns the force to send. `since_start_s` is the time since the loop (or a new scene) started.
+  /// Returns the force to send [N]. `since_start_s` is the time since the loop (or a new scene) started [s].
+  /// Zero force when `status` is not Ok (why = DeviceNotOk), when `deadline_missed` (DeadlineMissed) or
+  /// when `force_n` is NaN/inf (NonFinite), checked in that order; otherwise the force clamped in length
+  /// to max_force_n · min(1, since_start_s / ramp_s), direction kept (why = Ok). `why` must not be null.
   Vec2 apply(Vec2 force_n, double since_start_s, DeviceStatus status, bool deadline_missed, TickResult* why) const;
 };
+
+/// Default box-test budget of a servo tick (ServoParams::query_box_budget; config key
+/// [haptics] query_box_budget), sized so a tick's collision work stays near 200 µs, a fifth of the 1 ms
+/// period. Measured 2026-11-22 on the 2-core development machine with a build running on the other core:
+///   cmake --build build --target bench_anytime && build/bench/bench_anytime --out /tmp/anytime.json
+/// which reports whole cold-query time divided by its box tests (sorting, segment tests and section
+/// upkeep included): 42 ns per box test on horse, 46 ns on sudoku, 70 ns on a tiled 100k-segment scene
+/// and ~100 ns on a tiled 1M-segment one. 200 µs / ~46 ns ≈ 4300 on the test pictures, hence 4000
+/// (≈ 185 µs there; ≈ 400 µs in the worst case measured, the 1M-segment scene, still within the period).
+/// A cold query needs 30–60 box tests to answer exactly at level 0, so the budget binds only in pathologies.
+inline constexpr std::int32_t kDefaultQueryBoxBudget = 4000;
 
 /// The servo settings an operator may change while a visitor touches a wall (issue 12, item 4). Units in
 /// names. Values are assumed checked (config ranges): finite, max_force_step_n > 0, the rest ≥ 0.
@@ -56,7 +74,7 @@ struct ServoGains {
   double static_friction = 0.0;       ///< μ_s (ContactParams::static_friction)
   double dynamic_friction = 0.0;      ///< μ_d ≤ μ_s
   double max_force_step_n = 0.05;     ///< the limit on force change per tick a gains change (or level change) may cause [N]
-  double query_deadline_s = 200e-6;   ///< anytime budget of one tick's collision work [s]; 0 = none
+  std::int32_t query_box_budget = kDefaultQueryBoxBudget;  ///< box tests per tick (ServoParams::query_box_budget); 0 = no limit
   bool operator==(const ServoGains&) const = default;
 };
 
@@ -69,7 +87,11 @@ struct ServoParams {
   /// At a level change the force passes from the old level's to the new level's by at most this much per
   /// tick [N] (on top of what the hand's own motion changes), so a coarser or finer wall never kicks.
   double max_force_step_n = 0.05;
-  double query_deadline_s = 200e-6; ///< anytime budget of one tick's collision work [s]; 0 = none
+  /// Box tests one tick's level-change check and collision queries may do together [count]; 0 = no limit.
+  /// Past it the proxy waits where the sweep is proven clear (anytime) and a level change waits. The
+  /// scan of the boundary section is done even past it (QueryBudget), so a tick's box tests are at most
+  /// this plus ContactOutput::query.section_box_tests.
+  std::int32_t query_box_budget = kDefaultQueryBoxBudget;
   double velocity_cutoff_hz = 100;  ///< low-pass on the finite-difference handle velocity [Hz]
   ContactParams contact;
   ForceGuard guard;
@@ -83,15 +105,14 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept;
 /// Input of one tick.
 struct ServoInput {
   DeviceSample sample;         ///< handle position [m] and status
-  std::int64_t now_ns = 0;     ///< steady-clock time at the start of the tick [ns] (for the deadline)
-  bool deadline_missed = false;
+  bool deadline_missed = false;  ///< the caller says this tick is late: the guard sends zero force
 };
 
 /// Output of one tick.
 struct ServoOutput {
   Vec2 force_n;                ///< force to write to the device [N] (after the guard)
   Vec2 handle_velocity_m_per_s;
-  ContactOutput contact;       ///< proxy, state, constraints, events, query stats
+  ContactOutput contact;       ///< proxy, state, constraints, events, query stats (budget_used: the whole tick's box tests)
   std::int32_t level = 0;      ///< level in use this tick (walls the proxy met)
   std::int32_t level_wanted = 0;  ///< level asked for (policy or fixed); differs from `level` while a change waits
   bool level_changed = false;  ///< the level in use changed at the start of this tick
@@ -105,7 +126,8 @@ class ServoLoop {
   ServoLoop(const Scene& scene, const ServoParams& params);
   /// Starts (or restarts) at the handle position: proxy placed there, force ramp from zero.
   void start(Vec2 handle_m);
-  /// One servo tick. Real-time safe.
+  /// One servo tick: a function of (state, in, scene); no clock is read. A non-finite handle position
+  /// gives zero force and NonFinite with the state kept. Real-time safe.
   TickResult update(const ServoInput& in, ServoOutput& out);
   const ServoParams& params() const { return params_; }
   /// Fixes the level (automatic selection off). Takes effect at the next tick at which the proxy can move to

@@ -1,0 +1,240 @@
+// ServoCore::step as a pure step (issue 13, item 5): no device inside it, the same samples give the same
+// commands bit for bit, nothing is allocated or freed in it (counted by a replaced global operator new in
+// this translation unit), and a device that comes back gets its force back through the start-up ramp.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <memory>
+#include <new>
+#include <vector>
+
+#include "curves.hpp"
+#include "haptics/sim_pantograph.hpp"
+#include "servo_core.hpp"
+#include "simulation.hpp"
+
+// ── Counting allocation ───────────────────────────────────────────────────────────────────────────
+// Replaces the global allocation functions of the whole test_app executable (allowed, also under ASan,
+// which intercepts the malloc/free these forward to). They count only on a thread whose flag is set,
+// around the calls under test, so the rest of the executable is unaffected.
+namespace {
+thread_local bool g_counting = false;
+std::atomic<long> g_allocations{0};
+std::atomic<long> g_frees{0};
+
+[[gnu::noinline]] void* counted_alloc(std::size_t n) {
+  if (g_counting) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(n == 0 ? 1 : n);
+}
+[[gnu::noinline]] void* counted_aligned_alloc(std::size_t n, std::align_val_t al) {
+  if (g_counting) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  const auto a = static_cast<std::size_t>(al);
+  return std::aligned_alloc(a, (n + a - 1) / a * a + (n == 0 ? a : 0));
+}
+// Out of line: inlined into a delete-expression, free() would look mismatched to GCC's
+// -Wmismatched-new-delete.
+[[gnu::noinline]] void counted_free(void* p) noexcept {
+  if (g_counting && p != nullptr) g_frees.fetch_add(1, std::memory_order_relaxed);
+  std::free(p);
+}
+
+/// Counts the allocations and frees of this thread while alive.
+struct CountAllocations {
+  CountAllocations() { g_counting = true; }
+  ~CountAllocations() { g_counting = false; }
+};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  if (void* p = counted_alloc(n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+  if (void* p = counted_alloc(n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return counted_alloc(n); }
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return counted_alloc(n); }
+void* operator new(std::size_t n, std::align_val_t al) {
+  if (void* p = counted_aligned_alloc(n, al)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n, std::align_val_t al) {
+  if (void* p = counted_aligned_alloc(n, al)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { counted_free(p); }
+void operator delete[](void* p) noexcept { counted_free(p); }
+void operator delete(void* p, std::size_t) noexcept { counted_free(p); }
+void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { counted_free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { counted_free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { counted_free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { counted_free(p); }
+
+namespace hk::app {
+namespace {
+
+std::unique_ptr<SceneBundle> bundle(const ServoParams& sp, int id, double half = 0.02) {
+  auto b = std::make_unique<SceneBundle>(std::make_unique<Scene>(Scene::build({test::square(half)}, 3)), sp);
+  b->id = id;
+  return b;
+}
+
+/// The kiosk's defaults; the model hand starts left of a 4 cm square and pulls towards `target` (its
+/// centre at first), so it presses on the left wall. The caller does what ServoThread does each tick.
+struct Rig {
+  config::Settings s;
+  ServoParams sp;
+  SimulatedPantograph device;
+  ModelHandParams hand;
+  audio::SpscRing<audio::CueEvent> cues{1024};
+  ServoCore core;
+  Vec2 target{0.0, 0.0};
+  std::vector<DeviceSample> samples;   // what step() was given
+  std::vector<Vec2> commands;          // what it asked for
+
+  Rig() : sp(servo_params_from(s)), device(sim_params_from(s), {-0.03, 0.0}), hand(hand_params_from(s)), core(CueTrackerParams{}, &cues) {
+    device.open();
+  }
+  /// One tick: read, step (allocations counted when `count`), write, then the plant and the drain.
+  void tick(bool count = false) {
+    const DeviceSample sample = device.read();
+    ServoCommand cmd;
+    if (count) {
+      CountAllocations c;
+      core.step(sample, false, cmd);
+      core.publish_display();
+    } else {
+      core.step(sample, false, cmd);
+      core.publish_display();
+    }
+    device.write_force(cmd.force_n);
+    samples.push_back(sample);
+    commands.push_back(cmd.force_n);
+    device.step(sp.period_s, model_hand_force(hand, target, device.true_position_m(), device.velocity_m_per_s()));
+    audio::CueEvent e;
+    while (cues.try_pop(e)) {
+    }
+  }
+  void run(double seconds, bool count = false) {
+    for (long k = 0, n = static_cast<long>(seconds / sp.period_s + 0.5); k < n; ++k) tick(count);
+  }
+};
+
+TEST(ServoStep, NothingIsAllocatedOrFreedInTheStep) {
+  Rig r;
+  r.samples.reserve(10000);
+  r.commands.reserve(10000);
+  r.core.publish(bundle(r.sp, 1));
+  r.tick();  // the first picture is taken (outside the count: the loop was sized on this thread anyway)
+  g_allocations = 0;
+  g_frees = 0;
+  r.run(1.0, true);  // ramp in, press on the left wall
+  ASSERT_NE(r.core.display().state, ContactState::Free) << "the hand must be in contact for this to test anything";
+  r.core.request_level(0);
+  r.run(0.3, true);
+  EXPECT_EQ(r.core.display().level, 0) << "a level change happened in the counted steps";
+  r.core.request_level(ServoCore::kAutoLevel);
+  ServoGains g = servo_gains_from(r.s);
+  g.stiffness_n_per_m *= 2.0;
+  g.static_friction = 0.1;
+  g.dynamic_friction = 0.05;
+  r.core.set_gains(g);  // the caller's side
+  r.target = {0.0, 0.01};  // slide along the wall
+  r.run(0.5, true);
+  EXPECT_EQ(r.core.display().stiffness_n_per_m, 2.0 * r.s.haptics.stiffness_n_per_m);
+  r.core.publish(bundle(r.sp, 2, 0.015));  // built and handed over outside the count
+  r.run(1.5, true);                        // fade, swap (the old bundle goes to the retired ring), ramp in
+  EXPECT_EQ(r.core.display().scene_id, 2);
+  EXPECT_EQ(g_allocations.load(), 0) << "operator new called in ServoCore::step";
+  EXPECT_EQ(g_frees.load(), 0) << "operator delete called in ServoCore::step";
+  EXPECT_EQ(r.core.collect_retired(), 1);
+  // The counter counts: an allocation in a counted region shows.
+  {
+    CountAllocations c;
+    auto p = std::make_unique<int>(3);
+    EXPECT_EQ(*p, 3);
+  }
+  EXPECT_EQ(g_allocations.load(), 1);
+  EXPECT_EQ(g_frees.load(), 1);
+}
+
+TEST(ServoStep, SameSamplesGiveBitIdenticalCommands) {
+  // A closed-loop run through the simulated pantograph, recorded; then a second core, given the same
+  // pictures, requests and gains at the same ticks, replays the recorded samples with no device at all.
+  Rig a;
+  const auto script = [](ServoCore& core, const ServoParams& sp, long k) {
+    if (k == 0) core.publish(bundle(sp, 1));
+    if (k == 900) core.request_level(0);
+    if (k == 1400) {
+      ServoGains g = gains_of(sp);
+      g.stiffness_n_per_m = 1300.0;
+      core.set_gains(g);
+    }
+    if (k == 1800) core.publish(bundle(sp, 2, 0.015));
+  };
+  const long n = 3000;
+  for (long k = 0; k < n; ++k) {
+    script(a.core, a.sp, k);
+    if (k == 1000) a.target = {0.0, 0.012};
+    a.tick();
+  }
+  ServoCore b(CueTrackerParams{}, nullptr);
+  long contact_ticks = 0;
+  for (long k = 0; k < n; ++k) {
+    script(b, a.sp, k);
+    ServoCommand cmd;
+    b.step(a.samples[static_cast<std::size_t>(k)], false, cmd);
+    ASSERT_EQ(cmd.force_n.x, a.commands[static_cast<std::size_t>(k)].x) << "tick " << k;
+    ASSERT_EQ(cmd.force_n.y, a.commands[static_cast<std::size_t>(k)].y) << "tick " << k;
+    contact_ticks += b.last_output().contact.state != ContactState::Free;
+  }
+  EXPECT_GT(contact_ticks, 1000) << "the run must press on walls";
+  EXPECT_EQ(b.display_back().scene_id, 2);
+}
+
+TEST(ServoStep, AReturningDeviceGetsItsForceBackThroughTheRamp) {
+  // Scripted samples, no device: the hand presses 1 mm into the left wall, the device is lost while the
+  // hand goes 5 mm deeper, then it comes back.
+  const config::Settings s;
+  const ServoParams sp = servo_params_from(s);
+  ServoCore core(CueTrackerParams{}, nullptr);
+  core.publish(bundle(sp, 1));
+  ServoCommand cmd;
+  const auto step = [&](Vec2 h, DeviceStatus st) {
+    DeviceSample smp;
+    smp.handle_m = h;
+    smp.status = st;
+    core.step(smp, false, cmd);
+    core.publish_display();
+    return cmd.force_n;
+  };
+  for (int i = 0; i <= 100; ++i) step({-0.03 + 0.011 * i / 100.0, 0.0}, DeviceStatus::Ok);  // to 1 mm inside
+  for (int i = 0; i < 600; ++i) step({-0.019, 0.0}, DeviceStatus::Ok);                       // past the ramp
+  const Vec2 pressing = step({-0.019, 0.0}, DeviceStatus::Ok);
+  ASSERT_GT(length(pressing), 0.7) << "800 N/m × 1 mm";
+  ASSERT_EQ(core.display().device_status, DeviceStatus::Ok);
+  for (int i = 0; i <= 100; ++i) {
+    const Vec2 f = step({-0.019 + 0.005 * i / 100.0, 0.0}, DeviceStatus::Lost);
+    ASSERT_EQ(length(f), 0.0);
+  }
+  EXPECT_EQ(core.display().device_status, DeviceStatus::Lost) << "the display can announce it";
+  // Back: without the restart the proxy would still be at the wall, 6 mm from the handle, and the whole
+  // clamped force would come back in one tick.
+  const double ramp_step_n = sp.guard.max_force_n * sp.period_s / sp.guard.ramp_s;
+  Vec2 prev = step({-0.014, 0.0}, DeviceStatus::Ok);
+  EXPECT_EQ(core.display().device_status, DeviceStatus::Ok);
+  EXPECT_LE(length(prev), ramp_step_n + 1e-12) << "the first tick back";
+  EXPECT_LT(length(core.display().proxy_m - core.display().handle_m), 1e-9) << "the picture restarted at the handle";
+  for (int i = 1; i <= 700; ++i) {
+    const Vec2 h{-0.014 - 0.006 * std::min(1.0, i / 300.0), 0.0};  // the hand backs out through the wall
+    const Vec2 f = step(h, DeviceStatus::Ok);
+    ASSERT_LE(length(f - prev), ramp_step_n + 800.0 * 0.006 / 300.0 + 1e-9) << "tick " << i << " after the return";
+    prev = f;
+  }
+}
+
+}  // namespace
+}  // namespace hk::app
