@@ -134,7 +134,6 @@ long run_emulated(const Scene& scene, const config::Settings& s, const HandPath&
     if (in.sample.status == DeviceStatus::Ok && last_status != DeviceStatus::Ok) servo.start(in.sample.handle_m);  // back: ramp in again
     last_status = in.sample.status;
     const std::int64_t t0 = steady_ns();
-    in.now_ns = t0;
     servo.update(in, so);
     rec.tick_ns = steady_ns() - t0;
     rec.handle_m = in.sample.handle_m;
