@@ -216,6 +216,7 @@ int run_kiosk(const KioskOptions& o) {
   ro.mount_root = o.mount_root;
   ro.high_contrast = o.high_contrast;
   ro.overlay = o.overlay;
+  ro.probe_usb_device = o.screenshot.empty();  // scripted runs (documentation, tests) never depend on hardware
   KioskRuntime rt(ro, start.settings);
   KioskFlowParams fp;
   fp.timeout_s = start.settings.kiosk.timeout_s;
@@ -236,6 +237,7 @@ int run_kiosk(const KioskOptions& o) {
   ScriptPlayer script(script_lines, o.script);
 
   rt.start_servo();
+  rt.announce_device();
   if (!o.stick.empty()) rt.insert_stick_folder(o.stick);
   if (!o.show.empty()) show_first(o.show, rt, flow);
 
@@ -247,6 +249,7 @@ int run_kiosk(const KioskOptions& o) {
     kiosk.now_s_ = scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const InputEvent& e : window.poll()) kiosk.input(e);
     rt.poll_sticks(flow, kiosk.now_s_);
+    rt.poll_device(kiosk.now_s_);
     const bool holding = scripted && script.step(frame, kiosk);
     if (!scripted) kiosk.follow_mouse();
     kiosk.watch_handle();

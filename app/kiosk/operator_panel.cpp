@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "config/load.hpp"
+#include "device_setup.hpp"
 
 namespace hk::app {
 namespace {
@@ -116,7 +117,7 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
   ImGui::BeginChild("tabs", ImVec2(0, -actions_h));
   if (ImGui::BeginTabBar("groups")) {
     if (ImGui::BeginTabItem("Status")) {
-      draw_status(runtime, flow);
+      draw_status(runtime, flow, now_unix_s);
       ImGui::EndTabItem();
     }
     record("tab:Status");
@@ -223,7 +224,45 @@ void OperatorPanel::sample_plot(KioskRuntime& runtime) {
   plot_at_ = (plot_at_ + 1) % kPlotSamples;
 }
 
-void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow) {
+void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) {
+  const ServoDisplayState& d = runtime.core().display();
+  io::HaplyDevice* usb = runtime.usb_device();
+  if (!usb) {
+    ImGui::Text("Device: simulated pantograph%s%s", runtime.device_note().empty() ? "" : " (no USB pantograph: ",
+                runtime.device_note().empty() ? "" : (runtime.device_note() + ")").c_str());
+    return;
+  }
+  const io::HaplyCounters c = usb->counters();
+  ImGui::Text("Device: %s, %s; replies missing %lld, refused %lld, reconnects %lld", usb->name().c_str(), device_status_name(d.device_status),
+              static_cast<long long>(c.replies_missing), static_cast<long long>(c.malformed), static_cast<long long>(c.reconnects));
+  if (d.device_status != DeviceStatus::Ok) {
+    ImGui::SameLine();
+    ImGui::TextColored(kOrange, "(no force while it does not answer)");
+  }
+  if (ImGui::Button("Calibrate: the handle rests at the park place")) {
+    double o1 = 0, o2 = 0;
+    std::string why;
+    if (runtime.calibrate_usb(&o1, &o2, &why)) {
+      char text[32];
+      for (const auto& [key, value] : {std::pair{"encoder1_offset_deg", o1}, std::pair{"encoder2_offset_deg", o2}}) {
+        if (const config::FieldDescriptor* f = config::find_field("device", key)) {
+          std::snprintf(text, sizeof text, "%.3f", value);
+          s_.edit_text(*f) = text;
+          s_.commit_field(*f, now_unix_s);
+        }
+      }
+      char note[160];
+      std::snprintf(note, sizeof note, "Calibrated: encoder offsets %.3f and %.3f deg, in force now; Save keeps them.", o1, o2);
+      calibrate_note_ = note;
+    } else {
+      calibrate_note_ = "Not calibrated: " + why + ".";
+    }
+  }
+  record("button:Calibrate");
+  if (!calibrate_note_.empty()) ImGui::TextWrapped("%s", calibrate_note_.c_str());
+}
+
+void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, std::int64_t now_unix_s) {
   const config::Settings& s = runtime.settings();
   const ServoDisplayState& d = runtime.core().display();
   ImGui::Text("Visitor: %s, picture %d, level %d%s", state_name(flow.state()), flow.picture() + 1, d.level, d.auto_level ? " (from hand speed)" : " (fixed)");
@@ -237,7 +276,8 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow) {
       ImGui::TextColored(kOrange, "(each one zeroed the force for a tick)");
     }
   }
-  ImGui::Text("Device: %s pantograph, stiffness %.0f N/m, max force %.2f N", s.device.type.c_str(), s.haptics.stiffness_n_per_m, s.haptics.max_force_n);
+  draw_device(runtime, now_unix_s);
+  ImGui::Text("Walls: stiffness %.0f N/m, max force %.2f N", s.haptics.stiffness_n_per_m, s.haptics.max_force_n);
   audio::AudioSystem& a = runtime.audio();
   ImGui::Text("Sound: %s; speech %s; volume %d/10; cues dropped %llu", a.sound_output() ? "playing" : "no sound device",
               a.speech_available() ? "on" : "unavailable", a.volume().step(), static_cast<unsigned long long>(a.cues_dropped()));

@@ -44,7 +44,8 @@ class OperatorPanel {
   void draw_notice(int fw, int fh);
   void draw_pin_prompt(int fw, int fh, double now_s, std::int64_t now_unix_s);
   void draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double now_s, std::int64_t now_unix_s);
-  void draw_status(KioskRuntime& runtime, const KioskFlow& flow);
+  void draw_status(KioskRuntime& runtime, const KioskFlow& flow, std::int64_t now_unix_s);
+  void draw_device(KioskRuntime& runtime, std::int64_t now_unix_s);
   void draw_fields(config::FieldGroup group, std::int64_t now_unix_s);
   void draw_actions(std::int64_t now_unix_s);
   void sample_plot(KioskRuntime& runtime);
@@ -52,6 +53,7 @@ class OperatorPanel {
 
   OperatorSession& s_;
   std::string pin_;                       // the PIN being typed (wiped at submit and close)
+  std::string calibrate_note_;            // what the last Calibrate did
   bool focus_pin_ = false;
   std::map<std::string, WidgetRect> widgets_, drawing_;
   static constexpr int kPlotSamples = 300;  // 5 s of frames at 60 Hz

@@ -9,6 +9,7 @@
 #include "audio_settings.hpp"
 #include "config/load.hpp"
 #include "describe.hpp"
+#include "device_setup.hpp"
 #include "picture_library.hpp"
 #include "simulation.hpp"
 
@@ -35,13 +36,22 @@ audio::AudioSystemParams audio_params(const config::Settings& s, bool open_outpu
 
 KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
     : opt_(o), s_(s), audio_(audio_params(s, o.open_audio_output)), half_{s.workspace.width_m / 2, s.workspace.height_m / 2},
-      sp_(servo_params_from(s)), device_(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2}),
+      sp_(servo_params_from(s)), sim_(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2}),
       core_(cue_params(), &audio_.cues()),
       sticks_(s, block_events(o.hotplug), o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
   pictures_ = list_pictures(o.library);
-  device_.open();
+  sim_.open();
+  if (s.device.type != "simulated" && o.probe_usb_device) {
+    try_open_usb();
+    try {
+      usb_watch_ = std::make_unique<io::UsbHotplugMonitor>(static_cast<std::uint16_t>(s.device.usb_vid), static_cast<std::uint16_t>(s.device.usb_pid),
+                                                           [this](bool arrived) { if (arrived) usb_arrived_.store(true); });
+    } catch (const std::exception& e) {
+      spdlog::warn("device: no USB hot-plug ({}); the kiosk probes for the handle every 10 s", e.what());
+    }
+  }
   hand_ = hand_params_from(s);
-  cursor_.back() = device_.true_position_m();
+  cursor_.back() = sim_.true_position_m();
   cursor_.publish();
   level_ = s.haptics.level;
   auto_level_ = s.haptics.level_mode == "auto";
@@ -49,16 +59,87 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
   overlay_ = o.overlay;
 }
 
-KioskRuntime::~KioskRuntime() { stop_servo(); }
+KioskRuntime::~KioskRuntime() {
+  stop_servo();
+  usb_watch_.reset();
+  if (usb_) usb_->close();  // zero torque, then the transport closes
+}
 
 void KioskRuntime::start_servo() {
   ServoThreadParams tp;
   tp.rate_hz = s_.haptics.servo_rate_hz;
-  servo_ = std::make_unique<ServoThread>(core_, device_, tp, [this](double dt) {
+  if (usb_) {
+    servo_ = std::make_unique<ServoThread>(core_, *usb_, tp);
+    return;
+  }
+  servo_ = std::make_unique<ServoThread>(core_, sim_, tp, [this](double dt) {
     // The simulated pantograph: the model hand pulls the handle towards the cursor.
     const Vec2 target = cursor_.read();
-    device_.step(dt, model_hand_force(hand_, target, device_.true_position_m(), device_.velocity_m_per_s()));
+    sim_.step(dt, model_hand_force(hand_, target, sim_.true_position_m(), sim_.velocity_m_per_s()));
   });
+}
+
+bool KioskRuntime::try_open_usb() {
+  try {
+    auto dev = std::make_unique<io::HaplyDevice>(haply_params_from(s_), board_transport_factory(s_));
+    dev->open();
+    spdlog::info("device: {}", dev->name());
+    usb_ = std::move(dev);
+    device_note_.clear();
+    return true;
+  } catch (const std::exception& e) {
+    device_note_ = e.what();
+    spdlog::warn("device: no USB pantograph ({}); the simulated pantograph stands in", e.what());
+    return false;
+  }
+}
+
+bool KioskRuntime::calibrate_usb(double* offset1_deg, double* offset2_deg, std::string* why) {
+  if (!usb_) {
+    *why = "no USB pantograph is in use" + (device_note_.empty() ? std::string{} : " (" + device_note_ + ")");
+    return false;
+  }
+  if (usb_->status() != DeviceStatus::Ok) {
+    *why = "the handle does not answer";
+    return false;
+  }
+  if (!usb_->calibrate({s_.device.park_x_m, s_.device.park_y_m}, offset1_deg, offset2_deg)) {
+    *why = "the park place is out of the links' reach";
+    return false;
+  }
+  return true;
+}
+
+void KioskRuntime::announce_device() {
+  say(audio_.messages().text(usb_ ? audio::MessageId::device_ready : audio::MessageId::device_simulated));
+}
+
+void KioskRuntime::poll_device(double now_s) {
+  const DeviceStatus st = core_.display().device_status;
+  if (usb_ && st != last_status_) {
+    if (st == DeviceStatus::Lost) {
+      spdlog::warn("device: {} lost", usb_->name());
+      say(audio_.messages().text(audio::MessageId::device_lost));
+    } else if (st == DeviceStatus::Ok && last_status_ == DeviceStatus::Lost) {
+      spdlog::info("device: {} back", usb_->name());
+      say(audio_.messages().text(audio::MessageId::device_back));
+    }
+  }
+  last_status_ = st;
+  // The simulated pantograph stands in: take a USB pantograph that arrives.
+  if (usb_ || s_.device.type == "simulated" || !opt_.probe_usb_device) return;
+  const bool arrived = usb_arrived_.exchange(false);
+  if (!arrived && now_s < next_probe_s_) return;
+  next_probe_s_ = now_s + 10.0;
+  const bool running = servo_ != nullptr;
+  if (!try_open_usb()) return;
+  if (running) {
+    servo_->stop();
+    servo_.reset();
+    start_servo();
+  }
+  last_status_ = DeviceStatus::Ok;
+  announce_device();
 }
 
 void KioskRuntime::stop_servo() {

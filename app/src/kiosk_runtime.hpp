@@ -1,7 +1,8 @@
 #pragma once
 /// @file kiosk_runtime.hpp
 /// Everything the kiosk runs apart from its window (issue 5; split out of run_kiosk in issue 12, item 7):
-/// the simulated pantograph driven by the cursor through the model hand, the servo thread, the audio side,
+/// the device (issue 13: the USB pantograph when one answers — [device] type "auto" or "haply" — else the
+/// simulated pantograph driven by the cursor through the model hand), the servo thread, the audio side,
 /// the USB stick service and what is shown (scene on the device, curves for the screen). It implements the
 /// visitor's flow's KioskEffects, and applies settings changed by the operator while it runs
 /// (apply_settings). No OpenGL here: the window layer (app/kiosk) draws what `shown()` holds, and tests
@@ -10,6 +11,7 @@
 /// Threads: construct, call and destroy on one thread (the window thread); the servo thread and the stick
 /// service's threads are owned here.
 
+#include <atomic>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
@@ -18,6 +20,8 @@
 #include "audio/system.hpp"
 #include "config/settings.hpp"
 #include "haptics/hand_path.hpp"
+#include "haptics/io/haply_device.hpp"
+#include "haptics/io/usb_devices.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "haptics/triple_buffer.hpp"
 #include "image_scene.hpp"
@@ -36,6 +40,9 @@ struct RuntimeOptions {
   bool high_contrast = false;    ///< start (and every session) in high contrast
   bool overlay = false;          ///< start with the operator overlay
   bool open_audio_output = true; ///< false: no PortAudio (tests)
+  /// Look for the USB pantograph ([device] type "auto" or "haply"); false: always the simulated one (tests,
+  /// documentation runs).
+  bool probe_usb_device = true;
 };
 
 /// What is on the device and on the screen.
@@ -62,7 +69,8 @@ struct ApplyReport {
 /// The kiosk without its window. Not thread-safe: one thread.
 class KioskRuntime final : public KioskEffects {
  public:
-  /// Opens the simulated pantograph, the audio side and the stick service. Call start_servo() next.
+  /// Opens the device (the USB pantograph when [device] type is "auto" or "haply" and one answers, else the
+  /// simulated pantograph), the audio side and the stick service. Call start_servo() next.
   /// @throws std::runtime_error (one line) for an empty library; audio::MessageError for a bad catalogue.
   KioskRuntime(const RuntimeOptions& options, const config::Settings& settings);
   ~KioskRuntime() override;
@@ -73,6 +81,23 @@ class KioskRuntime final : public KioskEffects {
   void start_servo();
   /// Stops it (idempotent).
   void stop_servo();
+  /// Says which device is in use: "The handle is ready." or that the kiosk runs on its simulated handle.
+  void announce_device();
+  /// Window thread, every frame: says when the handle is lost and when it works again (the servo thread's
+  /// display state carries the device status), and, while the simulated pantograph stands in for a USB
+  /// pantograph that was not found, switches to one that arrives (USB hot-plug, or a probe every 10 s).
+  void poll_device(double now_s);
+  /// The device the servo thread drives.
+  Device& device() { return usb_ ? static_cast<Device&>(*usb_) : static_cast<Device&>(sim_); }
+  /// The operator's Calibrate (issue 13, item 3): with the handle resting at the park place, the encoder
+  /// offsets that make it read right (io::calibrated_offsets from the angles read now), applied to the
+  /// running board at once (io::HaplyDevice::apply_offsets). Returns false with `why` when no USB pantograph
+  /// is in use or the park place is out of reach. The caller stores the offsets in the settings.
+  bool calibrate_usb(double* offset1_deg, double* offset2_deg, std::string* why);
+  /// The USB pantograph in use, or null when the simulated one is.
+  io::HaplyDevice* usb_device() { return usb_.get(); }
+  /// Why the simulated pantograph is in use (empty when the USB pantograph is, or [device] type is "simulated").
+  const std::string& device_note() const { return device_note_; }
 
   // ---- KioskEffects (kiosk_flow.hpp) ----
   void say(const std::string& text) override;
@@ -107,9 +132,6 @@ class KioskRuntime final : public KioskEffects {
   /// The model hand's target [m] (the mouse or a script stands in for the visitor's hand).
   void set_cursor(Vec2 m);
   ServoCore& core() { return core_; }
-  /// The simulated pantograph the servo thread reads and drives (tests step the core by hand against it
-  /// when no servo thread runs).
-  Device& device() { return device_; }
   audio::AudioSystem& audio() { return audio_; }
   const Shown& shown() const { return shown_; }
   /// SceneBundle id of what is shown (tutorial −1..−3, picture index, 1000 + stick page).
@@ -138,13 +160,20 @@ class KioskRuntime final : public KioskEffects {
   void show_built(ImageScene& is, int id);
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
   void rebuild_shown();
+  bool try_open_usb();  // the USB pantograph per [device]; false (device_note_ says why) when none answers
 
   RuntimeOptions opt_;
   config::Settings s_;
   audio::AudioSystem audio_;
   Vec2 half_;
   ServoParams sp_;
-  SimulatedPantograph device_;
+  SimulatedPantograph sim_;                // stands in when there is no USB pantograph
+  std::unique_ptr<io::HaplyDevice> usb_;  // the USB pantograph, when one answered
+  std::string device_note_;
+  DeviceStatus last_status_ = DeviceStatus::Ok;
+  std::unique_ptr<io::UsbHotplugMonitor> usb_watch_;
+  std::atomic<bool> usb_arrived_{false};
+  double next_probe_s_ = 10.0;
   ModelHandParams hand_;
   ServoCore core_;
   TripleBuffer<Vec2> cursor_;

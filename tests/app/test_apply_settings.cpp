@@ -28,6 +28,7 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   ro.library = lib.string();
   ro.hotplug = false;
   ro.open_audio_output = false;
+  ro.probe_usb_device = false;
   config::Settings s;
   KioskRuntime rt(ro, s);
   KioskFlowParams fp;

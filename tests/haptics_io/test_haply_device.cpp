@@ -202,7 +202,22 @@ TEST(HaplyDevice, CalibrationRemovesAnEncoderZeroError) {
   EXPECT_NEAR(o1, 180.0 - 3.0, 0.3);
   EXPECT_NEAR(o2, 0.0 + 2.0, 0.3);
 
-  // A board set up with the new offsets reads the park place.
+  // The running board, calibrated in place, reads the park place at once...
+  double c1 = 0, c2 = 0;
+  ASSERT_TRUE(r.dev.calibrate(park, &c1, &c2));
+  EXPECT_DOUBLE_EQ(c1, o1);
+  EXPECT_DOUBLE_EQ(c2, o2);
+  r.dev.write_force({0, 0});
+  const DeviceSample corrected = r.dev.read();
+  EXPECT_NEAR(corrected.handle_m.x, park.x, kPositionTolerance_m);
+  EXPECT_NEAR(corrected.handle_m.y, park.y, kPositionTolerance_m);
+  EXPECT_EQ(corrected.status, DeviceStatus::Ok);
+  // Calibrating again where it already reads right changes nothing.
+  ASSERT_TRUE(r.dev.calibrate(park, &c1, &c2));
+  EXPECT_NEAR(c1, o1, 0.2);
+  EXPECT_NEAR(c2, o2, 0.2);
+
+  // ...and so does a board set up with the new offsets.
   io::HaplyDeviceParams fixed = r.dp;
   for (int i = 0; i < fixed.layout.encoder_count; ++i)
     fixed.layout.encoders[i].offset_deg = fixed.layout.encoders[i].index == 1 ? o1 : o2;

@@ -142,6 +142,8 @@ bool HaplyDevice::take_replies(int wait_us) noexcept {
     while (rx_len_ - at >= len) {
       double angle[4] = {0, 0, 0, 0};
       bool ok = hapi::decode_reply(params_.layout, rx_ + at, len, angle) == hapi::ReplyStatus::Ok;
+      angle[0] += correction1_deg_.load(std::memory_order_relaxed);
+      angle[1] += correction2_deg_.load(std::memory_order_relaxed);
       if (ok && have_angles_) {
         const double allowed = params_.max_step_deg * (1.0 + missing_in_row_);
         ok = std::fabs(angle[0] - th1_deg_.load(std::memory_order_relaxed)) <= allowed &&
@@ -294,6 +296,30 @@ HaplyCounters HaplyDevice::counters() const noexcept {
   c.reconnects = reconnects_.load(std::memory_order_relaxed);
   c.reopens = reopens_.load(std::memory_order_relaxed);
   return c;
+}
+
+void HaplyDevice::apply_offsets(double offset1_deg, double offset2_deg) noexcept {
+  double o1 = 0, o2 = 0;
+  for (int i = 0; i < params_.layout.encoder_count; ++i) {
+    if (params_.layout.encoders[i].index == 1) o1 = params_.layout.encoders[i].offset_deg;
+    if (params_.layout.encoders[i].index == 2) o2 = params_.layout.encoders[i].offset_deg;
+  }
+  if (std::isfinite(offset1_deg) && std::isfinite(offset2_deg)) {
+    correction1_deg_.store(offset1_deg - o1, std::memory_order_relaxed);
+    correction2_deg_.store(offset2_deg - o2, std::memory_order_relaxed);
+  }
+}
+
+bool HaplyDevice::calibrate(Vec2 park_workspace_m, double* offset1_deg, double* offset2_deg) noexcept {
+  if (replies_.load(std::memory_order_relaxed) == 0) return false;
+  const double raw1 = th1_deg_.load(std::memory_order_relaxed) - correction1_deg_.load(std::memory_order_relaxed);
+  const double raw2 = th2_deg_.load(std::memory_order_relaxed) - correction2_deg_.load(std::memory_order_relaxed);
+  double o1 = 0, o2 = 0;
+  if (!calibrated_offsets(params_, park_workspace_m, raw1, raw2, &o1, &o2)) return false;
+  apply_offsets(o1, o2);
+  *offset1_deg = o1;
+  *offset2_deg = o2;
+  return true;
 }
 
 void HaplyDevice::joint_angles_deg(double* th1_deg, double* th2_deg) const noexcept {

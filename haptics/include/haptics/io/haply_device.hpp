@@ -115,7 +115,17 @@ class HaplyDevice final : public Device {
 
   /// Counters so far. Any thread.
   HaplyCounters counters() const noexcept;
-  /// Haply joint angles of the newest valid reply [deg] (joint 1, joint 2). Any thread (relaxed reads).
+  /// New encoder offsets [deg] for the running board (the operator panel's Calibrate): the difference to the
+  /// offsets the board was set up with is added to every angle read from now on (the board keeps counting
+  /// from its setup; a board set up again later gets the same correction). Any thread; a correction of
+  /// more than max_step_deg may cost a few refused replies.
+  void apply_offsets(double offset1_deg, double offset2_deg) noexcept;
+  /// Calibrates the running board with the handle resting at `park_workspace_m`: calibrated_offsets from the
+  /// angles last read (as the board reports them, before any correction) and the offsets it was set up
+  /// with, then apply_offsets. False (nothing changed) when no reply was read yet or the park place is out
+  /// of reach. Any thread.
+  bool calibrate(Vec2 park_workspace_m, double* offset1_deg, double* offset2_deg) noexcept;
+  /// Haply joint angles of the newest valid reply [deg] (joint 1, joint 2), corrected. Any thread (relaxed reads).
   void joint_angles_deg(double* th1_deg, double* th2_deg) const noexcept;
   /// The torques of the last packet, per actuator index (1, 2) [N·m]. Any thread.
   void last_torques_n_m(double* tau1, double* tau2) const noexcept;
@@ -148,6 +158,7 @@ class HaplyDevice final : public Device {
   bool have_angles_ = false;
   std::atomic<double> th1_deg_{0.0}, th2_deg_{0.0};
   std::atomic<double> tau1_{0.0}, tau2_{0.0};
+  std::atomic<double> correction1_deg_{0.0}, correction2_deg_{0.0};  // apply_offsets − the layout's offsets
   JointAngles q_;                             // our joint angles of the newest valid reply
   Vec2 handle_ws_m_;                          // its handle, workspace frame
   std::int64_t t0_ns_ = 0;
