@@ -111,6 +111,7 @@ bool KioskRuntime::calibrate_usb(double* offset1_deg, double* offset2_deg, std::
 }
 
 void KioskRuntime::announce_device() {
+  if (s_.device.type == "simulated" || !opt_.probe_usb_device) return;  // chosen, not found: nothing to tell
   say(audio_.messages().text(usb_ ? audio::MessageId::device_ready : audio::MessageId::device_simulated));
 }
 

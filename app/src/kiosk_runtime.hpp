@@ -81,7 +81,8 @@ class KioskRuntime final : public KioskEffects {
   void start_servo();
   /// Stops it (idempotent).
   void stop_servo();
-  /// Says which device is in use: "The handle is ready." or that the kiosk runs on its simulated handle.
+  /// Says which device is in use: "The handle is ready." or that the kiosk runs on its simulated handle
+  /// (nothing when the simulated pantograph was chosen: [device] type "simulated", or probe_usb_device off).
   void announce_device();
   /// Window thread, every frame: says when the handle is lost and when it works again (the servo thread's
   /// display state carries the device status), and, while the simulated pantograph stands in for a USB
