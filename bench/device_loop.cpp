@@ -9,6 +9,7 @@
 //     the same run on the simulated pantograph. The emulator's own thread is the "board" and is not counted.
 // Usage: bench_device_loop [--seconds S] [--out FILE.json]
 #include <pthread.h>
+#include <spdlog/spdlog.h>
 #include <time.h>
 
 #include <algorithm>
@@ -153,6 +154,7 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--seconds") seconds = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--out") out_path = argv[i + 1];
   }
+  spdlog::set_level(spdlog::level::warn);  // the tables alone on stdout
   const config::Settings s;
   nlohmann::json j;
   std::printf("| measurement | ticks | p50 µs | p99 µs | max µs | missing |\n|---|---|---|---|---|---|\n");
