@@ -64,35 +64,49 @@ ModelHandParams hand_params_from(const config::Settings& s) {
 
 namespace {
 
-long run_simulated(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
-                   const TickObserver& observe, DeviceReport* report) {
-  SimulatedPantograph device(sim_params_from(s), hand.at(0.0));
-  device.open();
-  const ModelHandParams hp = hand_params_from(s);
-
-  const ServoParams sp = servo_params_from(s);
+// The headless servo loop over any device: read, step (timed; the step reads no clock), write, then
+// `after_write(rec)` (the simulated pantograph's physics and torques, or the driver's torques), observe.
+// A device that comes back after being lost restarts the servo at the handle: the force ramps in again.
+template <class AfterWrite>
+long run_ticks(const Scene& scene, const ServoParams& sp, Device& device, double duration_s, const TickObserver& observe,
+               AfterWrite after_write) {
   ServoLoop servo(scene, sp);
   servo.start(device.read().handle_m);
   const long n_ticks = static_cast<long>(std::ceil(duration_s / sp.period_s - 1e-9));
   ServoOutput so;
   TickRecord rec;
+  DeviceStatus last_status = DeviceStatus::Ok;
   for (long k = 0; k < n_ticks; ++k) {
     rec.index = k;
     rec.t_s = static_cast<double>(k) * sp.period_s;
     ServoInput in;
     in.sample = device.read();
-    const std::int64_t t0 = steady_ns();  // timing only: the step reads no clock
+    if (in.sample.status == DeviceStatus::Ok && last_status != DeviceStatus::Ok) servo.start(in.sample.handle_m);
+    last_status = in.sample.status;
+    const std::int64_t t0 = steady_ns();
     servo.update(in, so);
     rec.tick_ns = steady_ns() - t0;
     rec.handle_m = in.sample.handle_m;
     rec.device_status = in.sample.status;
     device.write_force(so.force_n);
+    after_write(rec);
+    if (observe) observe(rec, so);
+  }
+  return n_ticks;
+}
+
+long run_simulated(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+                   const TickObserver& observe, DeviceReport* report) {
+  SimulatedPantograph device(sim_params_from(s), hand.at(0.0));
+  device.open();
+  const ModelHandParams hp = hand_params_from(s);
+  const ServoParams sp = servo_params_from(s);
+  const long n_ticks = run_ticks(scene, sp, device, duration_s, observe, [&](TickRecord& rec) {
     device.step(sp.period_s, model_hand_force(hp, hand.at(rec.t_s), device.true_position_m(), device.velocity_m_per_s()));
     const Torques tau = device.applied_torques_n_m();
     rec.motor_torque_n_m[0] = tau.tau1_n_m;
     rec.motor_torque_n_m[1] = tau.tau2_n_m;
-    if (observe) observe(rec, so);
-  }
+  });
   if (report) {
     *report = DeviceReport{};
     report->name = device.name();
@@ -118,30 +132,9 @@ long run_emulated(const Scene& scene, const config::Settings& s, const HandPath&
   const std::string tty_path = pty.device_path();
   io::HaplyDevice device(dp, [tty_path] { return std::make_unique<io::TtyTransport>(tty_path); });
   device.open();
-
-  const ServoParams sp = servo_params_from(s);
-  ServoLoop servo(scene, sp);
-  servo.start(device.read().handle_m);
-  const long n_ticks = static_cast<long>(std::ceil(duration_s / sp.period_s - 1e-9));
-  ServoOutput so;
-  TickRecord rec;
-  DeviceStatus last_status = DeviceStatus::Ok;
-  for (long k = 0; k < n_ticks; ++k) {
-    rec.index = k;
-    rec.t_s = static_cast<double>(k) * sp.period_s;
-    ServoInput in;
-    in.sample = device.read();
-    if (in.sample.status == DeviceStatus::Ok && last_status != DeviceStatus::Ok) servo.start(in.sample.handle_m);  // back: ramp in again
-    last_status = in.sample.status;
-    const std::int64_t t0 = steady_ns();
-    servo.update(in, so);
-    rec.tick_ns = steady_ns() - t0;
-    rec.handle_m = in.sample.handle_m;
-    rec.device_status = in.sample.status;
-    device.write_force(so.force_n);
+  const long n_ticks = run_ticks(scene, servo_params_from(s), device, duration_s, observe, [&](TickRecord& rec) {
     device.last_torques_n_m(&rec.motor_torque_n_m[0], &rec.motor_torque_n_m[1]);
-    if (observe) observe(rec, so);
-  }
+  });
   if (report) {
     const io::HaplyCounters c = device.counters();
     report->name = "haply-emulator (" + device.name() + ")";

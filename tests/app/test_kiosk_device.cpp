@@ -1,0 +1,121 @@
+// The kiosk's runtime and the USB pantograph (issue 13, items 3 and 6), without its window: a board on a
+// tty (the firmware emulator behind a pty, named in [device] serial_path) is opened, used by the servo
+// thread and announced; when it stops answering the kiosk says so; with no board the simulated pantograph
+// stands in and the kiosk says that, and why is kept for the operator.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "audio/messages.hpp"
+#include "device_setup.hpp"
+#include "haptics/hapi_emulator.hpp"
+#include "haptics/pty_emulator.hpp"
+#include "kiosk_runtime.hpp"
+
+namespace fs = std::filesystem;
+
+namespace hk::app {
+namespace {
+
+const fs::path kData = HK_TEST_DATA_DIR;
+
+struct Library {
+  Library() : dir(fs::temp_directory_path() / ("hk_kiosk_device_" + std::to_string(::getpid()))) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::copy_file(kData / "images" / "horse.png", dir / "horse.png");
+  }
+  ~Library() { fs::remove_all(dir); }
+  fs::path dir;
+};
+
+RuntimeOptions options(const Library& lib) {
+  RuntimeOptions ro;
+  ro.library = lib.dir.string();
+  ro.hotplug = false;
+  ro.open_audio_output = false;
+  ro.probe_usb_device = true;
+  return ro;
+}
+
+const std::string& said(audio::MessageId id) {
+  static std::string texts[audio::kMessageCount];
+  std::string& t = texts[static_cast<int>(id)];
+  if (t.empty()) t = audio::MessageCatalog::english().text(id);
+  return t;
+}
+
+}  // namespace
+
+TEST(KioskDevice, ABoardOnItsTtyIsUsedAnnouncedAndItsLossSpoken) {
+  config::Settings s;
+  s.device.type = "haply";
+  s.device.transport = "tty";
+  DeviceChoice unplug;
+  unplug.kind = DeviceChoice::Kind::HaplyEmulator;
+  unplug.faults.disconnect_at_s = 0.5;  // of the board's own time: 500 torque packets
+  const io::HaplyDeviceParams dp = haply_params_from(s);
+  hapi::FirmwareEmulator board(emulator_params_from(s, unplug), dp.rect_center_device_m, [](double, Vec2, Vec2) { return Vec2{}; });
+  hapi::PtyEmulator pty(board);
+  s.device.serial_path = pty.device_path();
+
+  const Library lib;
+  KioskRuntime rt(options(lib), s);
+  ASSERT_NE(rt.usb_device(), nullptr) << rt.device_note();
+  EXPECT_EQ(&rt.device(), rt.usb_device());
+  EXPECT_TRUE(rt.device_note().empty());
+  rt.start_servo();
+  rt.announce_device();
+  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
+
+  // The servo thread sends a packet every millisecond; the board stops answering after 500 of them.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  double t = 0.0;
+  while (rt.last_said() != said(audio::MessageId::device_lost) && std::chrono::steady_clock::now() < give_up) {
+    rt.poll_device(t += 0.01);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));  // a frame; the outcome is the message, not the time
+  }
+  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_lost));
+  EXPECT_EQ(rt.usb_device()->status(), DeviceStatus::Lost);
+  EXPECT_GE(board.torque_commands(), 500);
+  rt.stop_servo();
+  double tau1 = 1, tau2 = 1;
+  rt.usb_device()->last_torques_n_m(&tau1, &tau2);
+  EXPECT_EQ(tau1, 0.0);
+  EXPECT_EQ(tau2, 0.0);
+}
+
+TEST(KioskDevice, WithNoBoardTheSimulatedPantographStandsInAndSaysSo) {
+  config::Settings s;
+  s.device.type = "auto";
+  s.device.transport = "tty";
+  s.device.serial_path = "/dev/hk-no-such-board";
+  const Library lib;
+  KioskRuntime rt(options(lib), s);
+  EXPECT_EQ(rt.usb_device(), nullptr);
+  EXPECT_NE(rt.device_note().find("/dev/hk-no-such-board"), std::string::npos) << rt.device_note();
+  rt.start_servo();
+  rt.announce_device();
+  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_simulated));
+  double o1 = 0, o2 = 0;
+  std::string why;
+  EXPECT_FALSE(rt.calibrate_usb(&o1, &o2, &why));
+  EXPECT_NE(why.find("no USB pantograph"), std::string::npos) << why;
+  rt.stop_servo();
+}
+
+TEST(KioskDevice, ChosenSimulatedIsNotAnnounced) {
+  config::Settings s;
+  s.device.type = "simulated";
+  const Library lib;
+  KioskRuntime rt(options(lib), s);
+  EXPECT_EQ(rt.usb_device(), nullptr);
+  EXPECT_TRUE(rt.device_note().empty());
+  rt.announce_device();
+  EXPECT_TRUE(rt.last_said().empty()) << rt.last_said();
+}
+
+}  // namespace hk::app
