@@ -217,6 +217,7 @@ int run_kiosk(const KioskOptions& o) {
   ro.high_contrast = o.high_contrast;
   ro.overlay = o.overlay;
   ro.probe_usb_device = o.screenshot.empty();  // scripted runs (documentation, tests) never depend on hardware
+  ro.device = o.device;
   KioskRuntime rt(ro, start.settings);
   KioskFlowParams fp;
   fp.timeout_s = start.settings.kiosk.timeout_s;
@@ -237,7 +238,7 @@ int run_kiosk(const KioskOptions& o) {
   ScriptPlayer script(script_lines, o.script);
 
   rt.start_servo();
-  rt.announce_device();
+  if (ro.probe_usb_device || !ro.device.empty()) rt.announce_device();
   if (!o.stick.empty()) rt.insert_stick_folder(o.stick);
   if (!o.show.empty()) show_first(o.show, rt, flow);
 

@@ -34,6 +34,9 @@ struct KioskOptions {
   std::string stick;            ///< a folder treated as a USB stick inserted at start (documentation, tests)
   bool hotplug = true;          ///< watch for USB sticks (libudev); off: only --stick and scripted sticks
   std::string mount_root;       ///< where sticks are mounted; empty: /run/haptic-kiosk/usb
+  /// Empty: the device [device] names. "haply-emulator[:FAULT=V,...]": the USB pantograph's driver on the
+  /// firmware emulator behind a pty, its handle pulled by the mouse (demonstrations, documentation).
+  std::string device;
 };
 
 /// Runs the kiosk until the window closes (or, with a screenshot, for `frames` frames). Returns the exit

@@ -10,6 +10,7 @@
 #include "config/load.hpp"
 #include "describe.hpp"
 #include "device_setup.hpp"
+#include "haptics/io/tty_transport.hpp"
 #include "picture_library.hpp"
 #include "simulation.hpp"
 
@@ -41,7 +42,10 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
       sticks_(s, block_events(o.hotplug), o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
   pictures_ = list_pictures(o.library);
   sim_.open();
-  if (s.device.type != "simulated" && o.probe_usb_device) {
+  hand_ = hand_params_from(s);
+  if (!o.device.empty()) {
+    open_emulated_board(o.device);
+  } else if (s.device.type != "simulated" && o.probe_usb_device) {
     try_open_usb();
     try {
       usb_watch_ = std::make_unique<io::UsbHotplugMonitor>(static_cast<std::uint16_t>(s.device.usb_vid), static_cast<std::uint16_t>(s.device.usb_pid),
@@ -50,7 +54,6 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
       spdlog::warn("device: no USB hot-plug ({}); the kiosk probes for the handle every 10 s", e.what());
     }
   }
-  hand_ = hand_params_from(s);
   cursor_.back() = sim_.true_position_m();
   cursor_.publish();
   level_ = s.haptics.level;
@@ -63,6 +66,7 @@ KioskRuntime::~KioskRuntime() {
   stop_servo();
   usb_watch_.reset();
   if (usb_) usb_->close();  // zero torque, then the transport closes
+  if (board_pty_) board_pty_->stop();
 }
 
 void KioskRuntime::start_servo() {
@@ -110,8 +114,29 @@ bool KioskRuntime::calibrate_usb(double* offset1_deg, double* offset2_deg, std::
   return true;
 }
 
+void KioskRuntime::open_emulated_board(const std::string& text) {
+  const DeviceChoice choice = parse_device_choice(text);
+  if (choice.kind != DeviceChoice::Kind::HaplyEmulator)
+    throw DeviceChoiceError("--device '" + text + "': the kiosk takes 'haply-emulator[:FAULT=VALUE,...]' (or nothing: [device])");
+  const io::HaplyDeviceParams dp = haply_params_from(s_);
+  const double scale = io::workspace_scale(dp);
+  const Vec2 centre = dp.rect_center_device_m;
+  // The board's handle follows the cursor through the model hand (workspace frame ↔ device frame).
+  board_ = std::make_unique<hapi::FirmwareEmulator>(
+      emulator_params_from(s_, choice), (1.0 / scale) * cursor_.read() + centre,
+      [this, scale, centre](double, Vec2 handle_device_m, Vec2 velocity_device_m_per_s) {
+        return model_hand_force(hand_, cursor_.read(), scale * (handle_device_m - centre), scale * velocity_device_m_per_s);
+      });
+  board_pty_ = std::make_unique<hapi::PtyEmulator>(*board_);
+  const std::string path = board_pty_->device_path();
+  usb_ = std::make_unique<io::HaplyDevice>(dp, [path] { return std::make_unique<io::TtyTransport>(path); });
+  usb_->open();
+  spdlog::info("device: {} on the firmware emulator", usb_->name());
+}
+
 void KioskRuntime::announce_device() {
-  if (s_.device.type == "simulated" || !opt_.probe_usb_device) return;  // chosen, not found: nothing to tell
+  if (s_.device.type == "simulated" && opt_.device.empty()) return;  // chosen: nothing to tell
+  if (!opt_.probe_usb_device && opt_.device.empty()) return;
   say(audio_.messages().text(usb_ ? audio::MessageId::device_ready : audio::MessageId::device_simulated));
 }
 

@@ -20,6 +20,8 @@
 #include "audio/system.hpp"
 #include "config/settings.hpp"
 #include "haptics/hand_path.hpp"
+#include "haptics/hapi_emulator.hpp"
+#include "haptics/pty_emulator.hpp"
 #include "haptics/io/haply_device.hpp"
 #include "haptics/io/usb_devices.hpp"
 #include "haptics/sim_pantograph.hpp"
@@ -43,6 +45,10 @@ struct RuntimeOptions {
   /// Look for the USB pantograph ([device] type "auto" or "haply"); false: always the simulated one (tests,
   /// documentation runs).
   bool probe_usb_device = true;
+  /// Empty: the device of [device]. "haply-emulator[:FAULT=V,...]" (parse_device_choice): the USB
+  /// pantograph's driver on the firmware emulator behind a pty, its handle pulled by the cursor through the
+  /// model hand (demonstrations, documentation, tests). @throws DeviceChoiceError for anything else.
+  std::string device;
 };
 
 /// What is on the device and on the screen.
@@ -162,6 +168,7 @@ class KioskRuntime final : public KioskEffects {
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
   void rebuild_shown();
   bool try_open_usb();  // the USB pantograph per [device]; false (device_note_ says why) when none answers
+  void open_emulated_board(const std::string& choice);  // RuntimeOptions::device
 
   RuntimeOptions opt_;
   config::Settings s_;
@@ -169,6 +176,8 @@ class KioskRuntime final : public KioskEffects {
   Vec2 half_;
   ServoParams sp_;
   SimulatedPantograph sim_;                // stands in when there is no USB pantograph
+  std::unique_ptr<hapi::FirmwareEmulator> board_;  // RuntimeOptions::device "haply-emulator": the emulated board...
+  std::unique_ptr<hapi::PtyEmulator> board_pty_;    // ...behind its pty
   std::unique_ptr<io::HaplyDevice> usb_;  // the USB pantograph, when one answered
   std::string device_note_;
   DeviceStatus last_status_ = DeviceStatus::Ok;

@@ -42,6 +42,9 @@ int main(int argc, char** argv) {
   cli.add_option("--stick", ko.stick, "A folder treated as a USB stick inserted at start");
   cli.add_flag("!--no-hotplug", ko.hotplug, "Do not watch for USB sticks");
   cli.add_option("--mount-root", ko.mount_root, "Where USB sticks are mounted (default /run/haptic-kiosk/usb)");
+  cli.add_option("--device", ko.device,
+                 "haply-emulator[:FAULT=V,...]: the USB pantograph's driver on the firmware emulator behind a pty, pulled by the mouse "
+                 "(default: the device of [device])");
   hk::app::ExploreOptions eo;
   CLI::App* explore = cli.add_subcommand("explore", "Run the whole pipeline headless on the simulated pantograph");
   explore->add_option("input", eo.image_path, "Picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore")->required();
