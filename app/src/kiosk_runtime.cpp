@@ -141,14 +141,22 @@ void KioskRuntime::announce_device() {
 }
 
 void KioskRuntime::poll_device(double now_s) {
+  // A loss is spoken once it has lasted kLostSpeech_s (a board that misses a few replies and comes back
+  // within it is not worth interrupting the visitor for: the force was off for those ticks and ramped
+  // back in), and the return only after a loss that was spoken.
+  constexpr double kLostSpeech_s = 0.5;
   const DeviceStatus st = core_.display().device_status;
-  if (usb_ && st != last_status_) {
-    if (st == DeviceStatus::Lost) {
+  if (usb_) {
+    if (st != DeviceStatus::Ok && last_status_ == DeviceStatus::Ok) lost_since_s_ = now_s;
+    if (st != DeviceStatus::Ok && !lost_spoken_ && now_s - lost_since_s_ >= kLostSpeech_s) {
       spdlog::warn("device: {} lost", usb_->name());
       say(audio_.messages().text(audio::MessageId::device_lost));
-    } else if (st == DeviceStatus::Ok && last_status_ == DeviceStatus::Lost) {
+      lost_spoken_ = true;
+    }
+    if (st == DeviceStatus::Ok && lost_spoken_) {
       spdlog::info("device: {} back", usb_->name());
       say(audio_.messages().text(audio::MessageId::device_back));
+      lost_spoken_ = false;
     }
   }
   last_status_ = st;

@@ -90,8 +90,9 @@ class KioskRuntime final : public KioskEffects {
   /// Says which device is in use: "The handle is ready." or that the kiosk runs on its simulated handle
   /// (nothing when the simulated pantograph was chosen: [device] type "simulated", or probe_usb_device off).
   void announce_device();
-  /// Window thread, every frame: says when the handle is lost and when it works again (the servo thread's
-  /// display state carries the device status), and, while the simulated pantograph stands in for a USB
+  /// Window thread, every frame (`now_s` the frame clock [s]): says when the handle has been lost for
+  /// 0.5 s and, after that, when it works again (the servo thread's display state carries the device
+  /// status; shorter losses are not spoken), and, while the simulated pantograph stands in for a USB
   /// pantograph that was not found, switches to one that arrives (USB hot-plug, or a probe every 10 s).
   void poll_device(double now_s);
   /// The device the servo thread drives.
@@ -181,6 +182,8 @@ class KioskRuntime final : public KioskEffects {
   std::unique_ptr<io::HaplyDevice> usb_;  // the USB pantograph, when one answered
   std::string device_note_;
   DeviceStatus last_status_ = DeviceStatus::Ok;
+  double lost_since_s_ = 0.0;   // when the device stopped answering [s, poll_device's clock]
+  bool lost_spoken_ = false;    // the loss was said (the return will be)
   std::unique_ptr<io::UsbHotplugMonitor> usb_watch_;
   std::atomic<bool> usb_arrived_{false};
   double next_probe_s_ = 10.0;

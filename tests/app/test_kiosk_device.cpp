@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <functional>
+#include <vector>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -116,6 +118,84 @@ TEST(KioskDevice, ChosenSimulatedIsNotAnnounced) {
   EXPECT_TRUE(rt.device_note().empty());
   rt.announce_device();
   EXPECT_TRUE(rt.last_said().empty()) << rt.last_said();
+}
+
+}  // namespace hk::app
+
+namespace hk::app {
+
+TEST(KioskDevice, TheEmulatedBoardOptionDrivesTheDriverThroughAPty) {
+  const Library lib;
+  RuntimeOptions ro = options(lib);
+  ro.probe_usb_device = false;  // a scripted run: no hardware looked for...
+  ro.device = "haply-emulator";  // ...but the emulated board asked for
+  config::Settings s;
+  KioskRuntime rt(ro, s);
+  ASSERT_NE(rt.usb_device(), nullptr);
+  EXPECT_NE(rt.usb_device()->name().find("tty /dev/"), std::string::npos) << rt.usb_device()->name();
+  rt.announce_device();
+  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
+  rt.start_servo();
+  // The handle follows the cursor through the board's model hand: the servo sees it arrive.
+  rt.set_cursor({0.03, 0.01});
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (distance(rt.core().display().handle_m, Vec2{0.03, 0.01}) > 0.004 && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_LT(distance(rt.core().display().handle_m, Vec2{0.03, 0.01}), 0.004);
+  rt.stop_servo();
+
+  RuntimeOptions bad = options(lib);
+  bad.device = "sim";
+  EXPECT_THROW(KioskRuntime(bad, s), DeviceChoiceError);
+}
+
+}  // namespace hk::app
+
+namespace hk::app {
+namespace {
+
+// A kiosk on an emulated board that stalls at 0.3 s of its time for `stall_s`; polls the device on the
+// real clock until `done` or 20 s. Returns everything said, in order.
+std::vector<std::string> run_stall(double stall_s, const std::function<bool(KioskRuntime&)>& done) {
+  config::Settings s;
+  DeviceChoice stall;
+  stall.kind = DeviceChoice::Kind::HaplyEmulator;
+  stall.faults.stall_at_s = 0.3;
+  stall.faults.stall_s = stall_s;
+  hapi::FirmwareEmulator board(emulator_params_from(s, stall), haply_params_from(s).rect_center_device_m,
+                               [](double, Vec2, Vec2) { return Vec2{}; });
+  hapi::PtyEmulator pty(board);
+  s.device.type = "haply";
+  s.device.transport = "tty";
+  s.device.serial_path = pty.device_path();
+  const Library lib;
+  KioskRuntime rt(options(lib), s);
+  std::vector<std::string> said_all;
+  if (!rt.usb_device()) return said_all;
+  rt.start_servo();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string last;
+  while (!done(rt) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20)) {
+    rt.poll_device(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    if (rt.last_said() != last) said_all.push_back(last = rt.last_said());
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  rt.stop_servo();
+  return said_all;
+}
+
+}  // namespace
+
+TEST(KioskDevice, ALongLossIsSpokenAndSoIsTheReturn) {
+  const std::vector<std::string> s = run_stall(1.5, [](KioskRuntime& rt) { return rt.usb_device()->counters().reconnects >= 1 && !rt.last_said().empty() && rt.last_said() == said(audio::MessageId::device_back); });
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0], said(audio::MessageId::device_lost));
+  EXPECT_EQ(s[1], said(audio::MessageId::device_back));
+}
+
+TEST(KioskDevice, AShortLossIsNotSpoken) {
+  const std::vector<std::string> s = run_stall(0.02, [](KioskRuntime& rt) { return rt.usb_device()->counters().reconnects >= 1; });
+  EXPECT_TRUE(s.empty()) << s.front();
 }
 
 }  // namespace hk::app
