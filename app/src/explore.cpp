@@ -17,6 +17,7 @@
 #include "audio/mixer.hpp"
 #include "audio/wav.hpp"
 #include "config/load.hpp"
+#include "coverage.hpp"
 #include "cue_tracker.hpp"
 #include "documents.hpp"
 #include "haptics/hand_path.hpp"
@@ -178,6 +179,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   const std::vector<Aabb> text_boxes = text_block_regions(is.text_blocks);
   tracker.set_text_blocks(text_boxes.data(), static_cast<int>(text_boxes.size()));
   std::vector<audio::CueEvent> cues;
+  CoverageMeter coverage(0.001);
   run_simulation(scene, s, path, duration, [&](const TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     audio::CueEvent tick_cues[CueTracker::kMaxCuesPerTick];
@@ -190,6 +192,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     rows.push_back({r.t_s, r.handle_m, c.proxy_m, so.force_n, state, curve, c.level, r.tick_ns});
     tick_ns.push_back(r.tick_ns);
     proxy_path.push_back(c.proxy_m);
+    coverage.add(c.proxy_m, curve, c.state == ContactState::Vertex ? c.constraint[1].curve : -1);
     ++sum.ticks;
     sum.free_ticks += state == 0;
     sum.edge_ticks += state == 1;
@@ -246,6 +249,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["levels"] = {{"mode", s.haptics.level_mode}, {"changes", level_changes}, {"ticks_waiting_for_a_safe_change", level_waiting},
                   {"ticks_per_level", std::move(lt)}};
   sj["sticking_ticks"] = sticking;
+  const Coverage cov = coverage.measure(scene);
+  sj["coverage"] = {{"length_fraction", cov.length_fraction}, {"curves_touched", cov.curves_touched}, {"curves", cov.curves}};
   sj["device"] = {{"name", sum.device.name}, {"status", sum.device.status}, {"replies_missing", sum.device.replies_missing},
                   {"reconnects", sum.device.reconnects}, {"malformed_replies", sum.device.malformed}};
   if (is.page > 0) {

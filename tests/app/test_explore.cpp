@@ -142,6 +142,13 @@ TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
   for (const char* k : {"p50", "p99", "p999", "max"}) EXPECT_TRUE(sum["tick_ns"].contains(k));
   for (const char* k : {"load", "edges", "linking", "multires", "tree"}) EXPECT_GE(sum["build_ms"][k].get<double>(), 0.0);
   EXPECT_EQ(sum["curves"].get<std::size_t>(), scene["curves"].size());
+  // Coverage (issue 14, item 5): a fraction, and no more curves touched than there are.
+  const double covered = sum["coverage"]["length_fraction"].get<double>();
+  EXPECT_TRUE(covered >= 0.0 && covered <= 1.0) << covered;
+  EXPECT_EQ(sum["coverage"]["curves"].get<std::size_t>(), scene["curves"].size());
+  EXPECT_LE(sum["coverage"]["curves_touched"].get<std::size_t>(), scene["curves"].size());
+  EXPECT_EQ(sum["device"]["name"], "simulated pantograph");
+  EXPECT_EQ(sum["device"]["status"], "ok");
   EXPECT_GT(fs::file_size(out / "overlay.png"), 1000u);
   fs::remove_all(out);
 }
