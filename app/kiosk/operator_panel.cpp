@@ -239,6 +239,12 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
     ImGui::SameLine();
     ImGui::TextColored(kOrange, "(no force while it does not answer)");
   }
+  const double can_n = io::min_force_capability_n(usb->params());
+  ImGui::Text("It gives at least %.2f N in every direction everywhere in its rectangle.", can_n);
+  if (runtime.settings().haptics.max_force_n > can_n) {
+    ImGui::SameLine();
+    ImGui::TextColored(kOrange, "Max force %.2f N is more: walls saturate above it.", runtime.settings().haptics.max_force_n);
+  }
   if (ImGui::Button("Calibrate: the handle rests at the park place")) {
     double o1 = 0, o2 = 0;
     std::string why;

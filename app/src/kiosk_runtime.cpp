@@ -88,6 +88,10 @@ bool KioskRuntime::try_open_usb() {
     auto dev = std::make_unique<io::HaplyDevice>(haply_params_from(s_), board_transport_factory(s_));
     dev->open();
     spdlog::info("device: {}", dev->name());
+    const double can_n = io::min_force_capability_n(dev->params());
+    if (s_.haptics.max_force_n > can_n)
+      spdlog::warn("device: [haptics] max_force_n = {} N is more than this handle can give everywhere ({:.2f} N); walls saturate above it",
+                   s_.haptics.max_force_n, can_n);
     usb_ = std::move(dev);
     device_note_.clear();
     return true;

@@ -257,3 +257,20 @@ TEST(HaplyDevice, ABoardThatNeverAnswersFailsToOpenNamingTheTransport) {
   }
   EXPECT_EQ(r.dev.status(), DeviceStatus::Closed);
 }
+
+TEST(HaplyDevice, TheGen3CanGiveAboutOneAndAHalfNewtonsEverywhere) {
+  // The reachability scan that chose the rectangle found σ(J) ≤ 0.094 m/rad over its stop box, so at
+  // least 0.123 / 0.094 = 1.3 N in every direction (per motor the bound is looser still); the default
+  // max_force_n (4 N) is more than the gen3 can give everywhere.
+  const io::HaplyDeviceParams p;
+  const double f = io::min_force_capability_n(p);
+  EXPECT_GE(f, 1.3);
+  EXPECT_LT(f, 4.0);
+  // Twice the torque limit, twice the force; a rectangle out of reach, none.
+  io::HaplyDeviceParams strong = p;
+  strong.torque_limit_n_m *= 2;
+  EXPECT_NEAR(io::min_force_capability_n(strong), 2 * f, 1e-9);
+  io::HaplyDeviceParams far = p;
+  far.rect_center_device_m = {0.0, -0.5};
+  EXPECT_EQ(io::min_force_capability_n(far), 0.0);
+}

@@ -87,6 +87,12 @@ double workspace_scale(const HaplyDeviceParams& p) noexcept;
 bool calibrated_offsets(const HaplyDeviceParams& p, Vec2 park_workspace_m, double reported_th1_deg, double reported_th2_deg,
                         double* offset1_deg, double* offset2_deg) noexcept;
 
+/// The force the pantograph can give in every direction everywhere in its usable rectangle [N]: at each
+/// point of a 21 × 21 grid over the rectangle and each of 72 directions u, the largest f with
+/// |(Jᵀ·f·u)_i| ≤ torque_limit for both motors; the minimum over all. 0 when some grid point is out of reach.
+/// Above it, walls saturate somewhere: an operator's max_force_n over this cannot be felt everywhere.
+double min_force_capability_n(const HaplyDeviceParams& p) noexcept;
+
 /// The hAPI pantograph as a `Device`.
 class HaplyDevice final : public Device {
  public:
