@@ -24,12 +24,12 @@ KioskFlow::KioskFlow(KioskEffects& effects, const audio::MessageCatalog& message
 }
 
 std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings& k) {
-  // In the order of kKeyPlaceholders: help, next, previous, describe, finer, coarser, volume_up, volume_down, tutorial.
+  // In the order of kKeyPlaceholders: help, next, previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide.
   return {{{audio::kKeyPlaceholders[0], k.help},      {audio::kKeyPlaceholders[1], k.next},
            {audio::kKeyPlaceholders[2], k.previous},  {audio::kKeyPlaceholders[3], k.describe},
            {audio::kKeyPlaceholders[4], k.finer},     {audio::kKeyPlaceholders[5], k.coarser},
            {audio::kKeyPlaceholders[6], k.volume_up}, {audio::kKeyPlaceholders[7], k.volume_down},
-           {audio::kKeyPlaceholders[8], k.tutorial}}};
+           {audio::kKeyPlaceholders[8], k.tutorial},  {audio::kKeyPlaceholders[9], k.guide}}};
 }
 
 std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageArg> args) const {

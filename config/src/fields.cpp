@@ -99,6 +99,7 @@ constexpr std::array<std::string_view, 3> kDeviceTypes{"auto", "simulated", "hap
 constexpr std::array<std::string_view, 3> kTransports{"auto", "usb", "tty"};
 constexpr std::array<std::string_view, 2> kRotations{"cw", "ccw"};
 constexpr std::array<std::string_view, 2> kLevelModes{"auto", "fixed"};
+constexpr std::array<std::string_view, 2> kRenderModes{"walls", "grooves"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>({
@@ -141,6 +142,17 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(haptics, query_box_budget, FieldGroup::haptics, ApplyWhen::live, 0, 10000000, "box tests",
              "Box tests the collision queries and level-change checks of one servo tick may do; past it the proxy waits where the sweep is proven clear (anytime). 0 = no limit."),
     HK_FIELD(haptics, force_ramp_s, FieldGroup::haptics, ApplyWhen::scene, 0, 10, "s", "Start-up force ramp duration."),
+    HK_FIELD(haptics, pop_force_n, FieldGroup::haptics, ApplyWhen::live, 0, 20, "N",
+             "Pressing a wall harder than this for pop_hold_s lets the hand through it; 0 = walls never give way."),
+    HK_FIELD(haptics, pop_hold_s, FieldGroup::haptics, ApplyWhen::live, 0.01, 5, "s", "How long a press must last to push through a wall."),
+    HK_FIELD(haptics, pop_release_s, FieldGroup::haptics, ApplyWhen::live, 0.001, 1, "s", "After a push-through the force falls to zero over this."),
+    HK_FIELD(haptics, render, FieldGroup::haptics, ApplyWhen::scene, 0, 0, "",
+             "\"walls\": curves are walls the hand slides along; \"grooves\": curves are engraved lines that pull the hand in.", kRenderModes),
+    HK_FIELD(haptics, groove_capture_radius_m, FieldGroup::haptics, ApplyWhen::scene, 0.0005, 0.02, "m", "A groove pulls the hand within this distance of its curve."),
+    HK_FIELD(haptics, groove_depth_n, FieldGroup::haptics, ApplyWhen::scene, 0.05, 10, "N",
+             "Depth of a groove as felt: its strongest pull (never more than stiffness x capture radius / 2)."),
+    HK_FIELD(haptics, tour_max_force_n, FieldGroup::haptics, ApplyWhen::live, 0.1, 5, "N", "The guided tour never pulls the handle harder than this; below pop_force_n."),
+    HK_FIELD(haptics, tour_speed_m_per_s, FieldGroup::haptics, ApplyWhen::live, 0.005, 0.2, "m/s", "Speed of the guided tour along an outline."),
     // [device]
     HK_FIELD(device, type, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Device driving the handle.", kDeviceTypes),
     HK_FIELD(device, handle_mass_kg, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "kg", "Effective handle mass (simulated pantograph)."),
@@ -226,6 +238,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(keys, volume_up, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Louder.", kKeyNames),
     HK_FIELD(keys, volume_down, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Quieter.", kKeyNames),
     HK_FIELD(keys, tutorial, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Start the tutorial again.", kKeyNames),
+    HK_FIELD(keys, guide, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Guided tour: lead the handle to the next shape not yet touched and round it.", kKeyNames),
     // [operator]
     HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
                 "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),
@@ -517,6 +530,11 @@ void validate_as(const Settings& s, const Source& src) {
          "haptics.dynamic_friction = " + format_real(s.haptics.dynamic_friction) +
              " must be <= haptics.static_friction = " + format_real(s.haptics.static_friction) +
              " (a wall that holds less at rest than while sliding would chatter)");
+  if (s.haptics.pop_force_n > 0.0 && s.haptics.tour_max_force_n >= s.haptics.pop_force_n)
+    fail(src, "haptics.tour_max_force_n",
+         "haptics.tour_max_force_n = " + format_real(s.haptics.tour_max_force_n) +
+             " must be < haptics.pop_force_n = " + format_real(s.haptics.pop_force_n) +
+             " (the guided tour must not push the hand through a wall)");
   // The USB pantograph's board: two actuators on two ports, two encoders on two ports (hAPI masks one bit
   // per port), and links that can close the five-bar (2·L must span the motor spacing).
   if (s.device.actuator1_port == s.device.actuator2_port)
@@ -534,10 +552,11 @@ void validate_as(const Settings& s, const Source& src) {
   // Each visitor action on its own key: one key cannot do two things, and the help names each action's key.
   // The first pair in table order is reported, attributed to the earlier key and naming the later.
   {
-    const std::array<std::pair<std::string_view, const std::string*>, 9> keys{{
+    const std::array<std::pair<std::string_view, const std::string*>, 10> keys{{
         {"help", &s.keys.help}, {"next", &s.keys.next}, {"previous", &s.keys.previous},
         {"describe", &s.keys.describe}, {"finer", &s.keys.finer}, {"coarser", &s.keys.coarser},
-        {"volume_up", &s.keys.volume_up}, {"volume_down", &s.keys.volume_down}, {"tutorial", &s.keys.tutorial}}};
+        {"volume_up", &s.keys.volume_up}, {"volume_down", &s.keys.volume_down}, {"tutorial", &s.keys.tutorial},
+        {"guide", &s.keys.guide}}};
     for (std::size_t i = 0; i < keys.size(); ++i)
       for (std::size_t j = i + 1; j < keys.size(); ++j)
         if (*keys[i].second == *keys[j].second) {

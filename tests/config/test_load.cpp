@@ -254,6 +254,8 @@ TEST(ConfigLoad, EveryKeyAtItsBoundsIsAccepted) {
       if (spec.name() == "haptics.level") text += "max_levels = 12\n";
       if (spec.name() == "haptics.dynamic_friction") text += "static_friction = 2.0\n";
       if (spec.name() == "haptics.static_friction") text += "dynamic_friction = 0.0\n";
+      if (spec.name() == "haptics.tour_max_force_n") text += "pop_force_n = 20.0\n";  // the tour stays below the push-through force
+      if (spec.name() == "haptics.pop_force_n") text += "tour_max_force_n = 0.1\n";
       // The other actuator/encoder moves off a port this bound takes (each needs its own board port).
       if (spec.name() == "device.actuator1_port") text += ok == 1 ? "actuator2_port = 2\n" : "actuator2_port = 1\n";
       if (spec.name() == "device.actuator2_port") text += ok == 2 ? "actuator1_port = 1\n" : "actuator1_port = 2\n";

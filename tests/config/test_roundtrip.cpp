@@ -125,6 +125,9 @@ Settings random_settings(std::mt19937_64& rng) {
   if (s.haptics.level > s.haptics.max_levels) s.haptics.level = s.haptics.max_levels;
   if (s.vision.canny_low > s.vision.canny_high) std::swap(s.vision.canny_low, s.vision.canny_high);
   if (s.haptics.dynamic_friction > s.haptics.static_friction) std::swap(s.haptics.dynamic_friction, s.haptics.static_friction);
+  if (s.haptics.pop_force_n > 0.0 && s.haptics.tour_max_force_n >= s.haptics.pop_force_n) {
+    if (s.haptics.pop_force_n > 0.2) s.haptics.tour_max_force_n = s.haptics.pop_force_n / 2; else s.haptics.pop_force_n = 0.0;
+  }
   if (s.device.actuator1_port == s.device.actuator2_port) s.device.actuator2_port = s.device.actuator1_port % 4 + 1;
   if (s.device.encoder1_port == s.device.encoder2_port) s.device.encoder2_port = s.device.encoder1_port % 4 + 1;
   s.device.motor_spacing_m = std::min(s.device.motor_spacing_m, 1.9 * (s.device.link_proximal_m + s.device.link_distal_m));

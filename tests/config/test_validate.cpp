@@ -68,6 +68,14 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
+    if (name == "haptics.render") {
+      EXPECT_EQ(d.kind, FieldKind::text);
+      ASSERT_EQ(d.choices.size(), 2u);
+      EXPECT_EQ(d.choices[0], "walls");
+      EXPECT_EQ(d.choices[1], "grooves");
+      ++texts;
+      continue;
+    }
     if (d.table == "keys") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_GT(d.choices.size(), 50u) << name;
@@ -91,7 +99,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 21u);
+  EXPECT_EQ(texts, 23u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -141,6 +149,8 @@ TEST(ConfigValidate, BoundsThemselvesAreAccepted) {
       s.haptics.static_friction = 2.0;  // and any dynamic friction passes dynamic <= static...
       if (spec.name() == "haptics.static_friction") s.haptics.dynamic_friction = 0.0;  // ...and any static
       s.device.link_distal_m = 0.5;  // so that any motor spacing lets the links meet
+      s.haptics.pop_force_n = 20.0;  // so that any tour force stays below the push-through force...
+      s.haptics.tour_max_force_n = 0.1;  // ...and any push-through force above the tour's
       set_numeric(s, spec, ok);
       // The other actuator/encoder moves off a port this bound takes (each needs its own board port).
       if (spec.name() == "device.actuator1_port" && ok == s.device.actuator2_port) s.device.actuator2_port = 3;
@@ -207,6 +217,29 @@ TEST(ConfigValidate, DynamicFrictionMustNotExceedStatic) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "haptics.dynamic_friction");
   EXPECT_NE(std::string(e->what()).find("must be <= haptics.static_friction = 0.5"), std::string::npos) << e->what();
+}
+
+TEST(ConfigValidate, TheTourMustPullLessThanAPushThrough) {
+  Settings s;
+  s.haptics.pop_force_n = 2.0;
+  s.haptics.tour_max_force_n = 1.9;
+  EXPECT_NO_THROW(validate(s));
+  s.haptics.tour_max_force_n = 2.0;  // the tour could push the hand through a wall
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "haptics.tour_max_force_n");
+  EXPECT_EQ(std::string(e->what()), "settings: haptics.tour_max_force_n = 2 must be < haptics.pop_force_n = 2 (the guided tour must not push the hand through a wall)");
+  s.haptics.pop_force_n = 0.0;  // walls never give way: any tour force is fine
+  EXPECT_NO_THROW(validate(s));
+}
+
+TEST(ConfigValidate, UnknownRenderModeIsRefused) {
+  Settings s;
+  s.haptics.render = "ridges";
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "haptics.render");
+  EXPECT_NE(std::string(e->what()).find("grooves"), std::string::npos) << e->what();
 }
 
 TEST(ConfigValidate, UnknownLevelModeIsRefused) {

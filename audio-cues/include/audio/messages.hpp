@@ -52,9 +52,9 @@ using MessageArg = std::pair<std::string_view, std::string>;
 
 /// The placeholders that name one of the visitor's keys, one per action of the [keys] settings (help, next,
 /// previous, describe, finer, coarser, volume_up, volume_down, tutorial), in that order.
-inline constexpr std::array<std::string_view, 9> kKeyPlaceholders{
+inline constexpr std::array<std::string_view, 10> kKeyPlaceholders{
     "help_key", "next_key", "previous_key", "describe_key", "finer_key", "coarser_key",
-    "volume_up_key", "volume_down_key", "tutorial_key"};
+    "volume_up_key", "volume_down_key", "tutorial_key", "guide_key"};
 
 /// A key placeholder and the key it stands for, by its settings name: {"help_key", "F1"}. MessageCatalog::text()
 /// puts the spoken form of the key (MessageCatalog::key_name()) in its place.

@@ -27,6 +27,14 @@ struct HapticsSettings {
   int max_levels = 6;                     ///< key max_levels, levels built above level 0, [1, 12]
   int query_box_budget = 4000;            ///< key query_box_budget, box tests the collision queries and level-change checks of one servo tick may do, [0, 10000000] box tests; 0 = no limit (default measured: see hk::kDefaultQueryBoxBudget in haptics/servo.hpp)
   double force_ramp_s = 0.5;              ///< key force_ramp_s, start-up force ramp, [0, 10] s
+  double pop_force_n = 3.0;               ///< key pop_force_n, pressing a wall harder than this for pop_hold_s lets the proxy through (issue 14), [0, 20] N; 0 = walls never give way
+  double pop_hold_s = 0.3;                ///< key pop_hold_s, how long the press must last, [0.01, 5] s
+  double pop_release_s = 0.02;            ///< key pop_release_s, the force falls to zero over this after a push-through, [0.001, 1] s
+  std::string render = "walls";           ///< key render, "walls" (the seed paper's god-object walls) or "grooves" (each curve an engraved line that pulls the hand in, never blocks)
+  double groove_capture_radius_m = 0.003; ///< key groove_capture_radius_m, a groove pulls within this distance of its curve, [0.0005, 0.02] m
+  double groove_depth_n = 1.0;            ///< key groove_depth_n, the groove's depth as felt: its strongest pull, [0.05, 10] N (at most stiffness x radius / 2)
+  double tour_max_force_n = 1.2;          ///< key tour_max_force_n, the guided tour never pulls harder than this, [0.1, 5] N; below pop_force_n
+  double tour_speed_m_per_s = 0.03;       ///< key tour_speed_m_per_s, speed of the guided tour along an outline, [0.005, 0.2] m/s
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const HapticsSettings&) const = default;
@@ -167,6 +175,7 @@ struct KeysSettings {
   std::string volume_up = "PAGE_UP";      ///< key volume_up
   std::string volume_down = "PAGE_DOWN";  ///< key volume_down
   std::string tutorial = "T";             ///< key tutorial, start the tutorial again
+  std::string guide = "G";                ///< key guide, the guided tour: the handle is led to the next shape not yet touched and round it
 
   /// Field-by-field equality; used by round-trip checks.
   bool operator==(const KeysSettings&) const = default;
