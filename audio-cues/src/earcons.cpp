@@ -25,6 +25,8 @@ const char* cue_kind_name(CueKind kind) {
     case CueKind::LevelCoarser: return "level_coarser";
     case CueKind::WorkspaceEdge: return "workspace_edge";
     case CueKind::TextBlock: return "text_block";
+    case CueKind::PopThrough: return "pop_through";
+    case CueKind::TourStart: return "tour_start";
   }
   return "unknown";
 }
@@ -164,6 +166,22 @@ void EarconSynth::trigger(const CueEvent& e) noexcept {
       // unlike every contact sound (no strike, no noise) and unlike the level chirps (two steps, not a glide).
       start({784, 784, 0.09, 0.004, 0.0, 0.04, g * 0.3, 0.0, 0, 1, 0});
       start({1175, 1175, 0.12, 0.004, 0.0, 0.05, g * 0.3, 0.0, 0, 1, 0.08});
+      break;
+    case CueKind::PopThrough:
+    {
+      // A membrane giving way: a noisy burst sweeping down two octaves over a low plop. Nothing else
+      // glides down this fast (the coarser chirp falls one octave in 160 ms, as a pure tone).
+      const double d = transient_delay_s(true);
+      start({1600, 400, 0.05, 0.0005, 0.0, 0.015, g * 0.7, 0.8, 1000, 1.5, d});
+      start({220, 110, 0.09, 0.001, 0.04, 0.02, g * 0.6, 0.0, 0, 1, d});
+      slide_active_ = false;
+    }
+      break;
+    case CueKind::TourStart:
+      // "Follow me": a rising C-major arpeggio, soft sine notes with no strike.
+      start({523.25, 523.25, 0.08, 0.004, 0.0, 0.03, g * 0.3, 0.0, 0, 1, 0.0});
+      start({659.25, 659.25, 0.08, 0.004, 0.0, 0.03, g * 0.3, 0.0, 0, 1, 0.07});
+      start({783.99, 783.99, 0.12, 0.004, 0.0, 0.05, g * 0.3, 0.0, 0, 1, 0.14});
       break;
   }
 }

@@ -108,6 +108,29 @@ TEST(Earcons, TextBlockIsTwoRisingNotesWithoutAStrike) {
   EXPECT_LT(test::peak(x, t + at(350), x.size()), 1e-4) << "over within 350 ms";
 }
 
+// The push-through earcon (issue 14): a bright noisy burst at once, then a low plop falling from 220 Hz,
+// all over within 150 ms; unlike the coarser chirp, which starts as a pure tone near 1 kHz.
+TEST(Earcons, PopThroughIsABurstOverALowFallingPlop) {
+  const std::vector<float> x = render_cue_timeline(std::vector{cue(10, CueKind::PopThrough, 0)}, kPeriod, 0.4);
+  const std::size_t t = at(10);
+  const double plop = test::dominant_frequency(x, t + at(55), 1440);  // 55–85 ms: the burst is over
+  EXPECT_GT(plop, 100.0);
+  EXPECT_LT(plop, 200.0) << "the plop has fallen below its 220 Hz start";
+  const std::vector<float> coarser = render_cue_timeline(std::vector{cue(10, CueKind::LevelCoarser, -1, 0, 2)}, kPeriod, 0.4);
+  EXPECT_GT(test::spectral_centroid(x, t, 480), 1.5 * test::spectral_centroid(coarser, t, 480)) << "a noisy start";
+  EXPECT_GT(test::rms(x, t, t + at(50)), 0.0);
+  EXPECT_LT(test::peak(x, t + at(150), x.size()), 1e-4) << "over within 150 ms";
+}
+
+// The guided tour's start (issue 14): three rising notes, C5, E5, G5, 70 ms apart.
+TEST(Earcons, TourStartIsARisingArpeggio) {
+  const std::vector<float> x = render_cue_timeline(std::vector{cue(10, CueKind::TourStart, 0)}, kPeriod, 0.5);
+  const std::size_t t = at(10);
+  EXPECT_NEAR(test::dominant_frequency(x, t + at(10), 2400), 523.25, 523.25 * 0.03);
+  EXPECT_NEAR(test::dominant_frequency(x, t + at(150), 4800), 783.99, 783.99 * 0.03);
+  EXPECT_LT(test::peak(x, t + at(400), x.size()), 1e-4);
+}
+
 TEST(Earcons, ContactLoudnessGrowsWithApproachSpeed) {
   const std::vector<float> soft = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.01f)}, kPeriod, 0.2);
   const std::vector<float> hard = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.15f)}, kPeriod, 0.2);

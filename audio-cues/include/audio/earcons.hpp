@@ -12,6 +12,9 @@
 ///   LevelFiner / LevelCoarser  a rising / falling chirp (an octave in 160 ms);
 ///   WorkspaceEdge a low thud;
 ///   TextBlock     two soft rising sine notes, G5 then D6 (text here: Describe reads it).
+///   PopThrough    a membrane giving way: a 50 ms burst of band-passed noise around 1 kHz with a tone
+///                 sweeping down two octaves (1600 → 400 Hz), over a low plop (220 → 110 Hz in 90 ms);
+///   TourStart     "follow me": three soft rising sine notes, C5, E5, G5, 70 ms apart.
 /// Each curve has its own pitch (curve_pitch_hz) so two touching shapes sound different. Clicks and ticks
 /// start at least 3 ms apart (a later one waits, at most 6 ms), so each stays audible on its own.
 /// Earcons as a design idea: Blattner, Sumikawa & Greenberg 1989; Brewster 1994.
