@@ -51,6 +51,16 @@ TEST(CueTracker, ContactBeginAndEndCarryCurveTickAndSpeed) {
   EXPECT_EQ(r.cues[1].curve, 3) << "the end sounds at the pitch of the curve that was left";
 }
 
+TEST(CueTracker, APushThroughSoundsItsOwnCueInsteadOfTheRelease) {
+  CueRun r;
+  r.step(ContactState::Edge, 4, {0, 0}, kEventContactBegin);
+  r.step(ContactState::Free, -1, {0, 0}, kEventContactEnd | kEventPopThrough);
+  ASSERT_EQ(r.cues.size(), 2u);
+  EXPECT_EQ(r.cues[1].kind, CueKind::PopThrough);
+  EXPECT_EQ(r.cues[1].curve, 4) << "at the pitch of the wall pushed through";
+  EXPECT_EQ(r.count(CueKind::ContactEnd), 0);
+}
+
 TEST(CueTracker, MovingOntoAnotherCurveSoundsItsPitch) {
   CueRun r;
   r.step(ContactState::Edge, 1, {0, 0}, kEventContactBegin);
