@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <thread>
 
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/io/haply_device.hpp"
@@ -137,6 +138,21 @@ long run_emulated(const Scene& scene, const config::Settings& s, const HandPath&
   device.open();
   const long n_ticks = run_ticks(scene, servo_params_from(s), device, duration_s, observe, [&](TickRecord& rec) {
     device.last_torques_n_m(&rec.motor_torque_n_m[0], &rec.motor_torque_n_m[1]);
+    // Keep the emulated board in step with the run, Lost or not: wait (up to 20 ms) until it has executed
+    // every torque packet sent, so the emulated time, and what a fault does, never depends on how busy the
+    // machine is (a loaded machine once let the run end while a stalled board still had a backlog).
+    const std::int64_t sent = device.counters().ticks;
+    const std::int64_t give_up = steady_ns() + 20'000'000;
+    for (;;) {
+      long done = 0;
+      bool unplugged = false;
+      pty.with_emulator([&](hapi::FirmwareEmulator& e) {
+        done = e.torque_commands();
+        unplugged = e.disconnected();  // a disconnected board executes nothing more
+      });
+      if (unplugged || done >= sent || steady_ns() >= give_up) break;
+      std::this_thread::sleep_for(std::chrono::microseconds(20));
+    }
   });
   if (report) {
     const io::HaplyCounters c = device.counters();

@@ -47,8 +47,9 @@ ModelHandParams hand_params_from(const config::Settings& s);
 /// Runs the device `device` chose (the simulated pantograph, or the Haply firmware emulator behind a pty
 /// reached through the tty transport and the hAPI driver, bytes and all) driven by `hand` over `scene` for
 /// `duration_s` seconds, tick by tick as fast as the machine goes. With the emulator a tick waits up to
-/// 10 ms for the reply to the previous tick's packet while the device is Ok (so the run does not depend on
-/// the machine's speed), not at all while it is Lost; a device that comes back restarts the servo at the
+/// 10 ms for the reply to the previous tick's packet while the device is Ok (not while it is Lost), and up
+/// to 20 ms after each write for the emulator to have executed every packet sent, Lost or not, until it is
+/// disconnected (so the run does not depend on the machine's speed); a device that comes back restarts the servo at the
 /// handle (force ramped in again). `report` (may be null) receives the device's name, final status and
 /// counters. Returns the number of ticks run. Throws DeviceError when the emulator cannot be reached.
 long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
