@@ -109,8 +109,11 @@ TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
     double t, hx, hy, px, py, fx, fy;
     int contact, curve, level;
     long long ns;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d,%lld", &t, &hx, &hy, &px, &py, &fx, &fy, &contact, &curve,
-                          &level, &ns), 11) << line;
+    int pop = -1;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d,%lld,%d", &t, &hx, &hy, &px, &py, &fx, &fy, &contact, &curve,
+                          &level, &ns, &pop), 12) << line;
+    ASSERT_TRUE(pop == 0 || pop == 1) << line;
+    if (pop == 1) EXPECT_EQ(contact, 0) << "a pop leaves the proxy free: " << line;
     EXPECT_NEAR(t, rows * 0.001, 1e-9);
     ASSERT_GE(contact, 0);
     ASSERT_LE(contact, 2);
