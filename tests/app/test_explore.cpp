@@ -113,7 +113,9 @@ TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
     ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d,%lld,%d", &t, &hx, &hy, &px, &py, &fx, &fy, &contact, &curve,
                           &level, &ns, &pop), 12) << line;
     ASSERT_TRUE(pop == 0 || pop == 1) << line;
-    if (pop == 1) EXPECT_EQ(contact, 0) << "a pop leaves the proxy free: " << line;
+    if (pop == 1) {
+      EXPECT_EQ(contact, 0) << "a pop leaves the proxy free: " << line;
+    }
     EXPECT_NEAR(t, rows * 0.001, 1e-9);
     ASSERT_GE(contact, 0);
     ASSERT_LE(contact, 2);
@@ -234,8 +236,11 @@ TEST_P(RasterPushThrough, AGentleHandNeverPopsAHardOneOnlyOnPopTicks) {
     EXPECT_EQ(crossings_without_pop, 0);
     EXPECT_EQ(pops_that_cross, pops) << "a pop that crossed nothing";
     EXPECT_EQ(bad_force, 0);
-    if (push_n < s.haptics.pop_force_n) EXPECT_EQ(pops, 0);
-    else EXPECT_GT(pops, 0) << "a 6 N raster pushes through somewhere";
+    if (push_n < s.haptics.pop_force_n) {
+      EXPECT_EQ(pops, 0);
+    } else {
+      EXPECT_GT(pops, 0) << "a 6 N raster pushes through somewhere";
+    }
   }
 }
 
