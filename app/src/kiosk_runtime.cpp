@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
@@ -43,6 +44,9 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
   pictures_ = list_pictures(o.library);
   sim_.open();
   hand_ = hand_params_from(s);
+  // The cursor's hand may press harder than a model visitor: a cursor held well past a wall (about 2 cm at
+  // the hand's 200 N/m) pushes through it, as a visitor at the real handle would (issue 14, push-through).
+  hand_.max_force_n = std::max(hand_.max_force_n, 1.5 * s.haptics.pop_force_n);
   if (!o.device.empty()) {
     open_emulated_board(o.device);
   } else if (s.device.type != "simulated" && o.probe_usb_device) {
