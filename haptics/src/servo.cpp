@@ -73,11 +73,15 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
   p.guard.max_force_n = g.max_force_n;
   p.max_force_step_n = g.max_force_step_n;
   p.query_box_budget = g.query_box_budget;
+  p.groove.stiffness_n_per_m = g.stiffness_n_per_m;
+  p.groove.max_force_n = g.max_force_n;
+  p.groove.jump_step_n = g.max_force_step_n;
 }
 
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
       solver_(scene, params.contact),
+      groove_(scene, params.groove),
       levels_(level_error_ladder(scene, level_error_m_)),
       policy_(policy_params(params), level_error_m_, levels_, params.level),
       level_(params.level),
@@ -85,7 +89,11 @@ ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
 
 void ServoLoop::start(Vec2 handle_m) {
   level_ = params_.auto_level ? policy_.level() : params_.level;
-  solver_.reset(handle_m, level_);
+  if (params_.render == RenderMode::Grooves) {
+    groove_.reset(handle_m, level_);
+  } else {
+    solver_.reset(handle_m, level_);
+  }
   last_handle_ = handle_m;
   velocity_ = {0.0, 0.0};
   force_residual_ = {0.0, 0.0};
@@ -99,6 +107,7 @@ void ServoLoop::set_gains(const ServoGains& g) noexcept {
   if (g == gains()) return;
   apply_gains(params_, g);
   solver_.set_params(params_.contact);
+  groove_.set_params(params_.groove);
   gains_changed_ = true;
 }
 
@@ -134,8 +143,9 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   QueryBudget budget;
   budget.max_box_tests = params_.query_box_budget;
   out.level_changed = false;
+  const bool grooves = params_.render == RenderMode::Grooves;
   if (wanted != level_) {
-    if (solver_.level_change_is_safe(wanted, &budget)) {  // else it waits (out.level_wanted shows it)
+    if (grooves || solver_.level_change_is_safe(wanted, &budget)) {  // grooves: no wall to cross  // else it waits (out.level_wanted shows it)
       out.level_changed = true;
       level_ = wanted;
     }
@@ -148,7 +158,11 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   ci.handle_velocity_m_per_s = velocity_;
   ci.level = level_;
   ci.budget = budget;
-  solver_.update(ci, out.contact);
+  if (grooves) {
+    groove_.update(ci, out.contact);
+  } else {
+    solver_.update(ci, out.contact);
+  }
   if (out.contact.state == ContactState::Free) out.contact.level = level_;
 
   // Force-step limit at level and gains changes: the difference between the last tick's force and the new
@@ -156,7 +170,8 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   // of the change already takes the first step.
   const double step = params_.max_force_step_n;
   Vec2 f = out.contact.force_n;
-  if ((out.level_changed || gains_changed_) && ticks_ > 0) force_residual_ = last_force_ - f;
+  // Grooves: the groove solver already limits every change per tick (GrooveParams::jump_step_n).
+  if ((out.level_changed || gains_changed_) && ticks_ > 0 && !grooves) force_residual_ = last_force_ - f;
   gains_changed_ = false;
   if (force_residual_.x != 0.0 || force_residual_.y != 0.0) {
     force_residual_ = fade(force_residual_, step);
