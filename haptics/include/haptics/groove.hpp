@@ -28,7 +28,10 @@
 /// (and at a change of level or gains, where the polyline or the law changes under the hand), the change
 /// of the groove force per tick is limited to k·|handle motion since the last tick| + jump_step_n. Along a
 /// lone straight or convex stretch the limit never binds (the field is k-Lipschitz), so the force the
-/// hand feels there is exactly F(r) towards q.
+/// hand feels there is exactly F(r) towards q. The limit catches up at jump_step_n per tick at least, so a
+/// jump of J [N] is absorbed within ceil(J / jump_step_n) ticks (2·depth_n / jump_step_n at worst, 40 ticks at
+/// the defaults); a hand that leaves the radius within those ticks of a jump feels the rest of it fade
+/// outside the rim, the one case where the force is not zero with the state Free.
 
 #include <cstdint>
 
