@@ -23,6 +23,12 @@
 /// level-change check (ContactSolver::level_change_is_safe) and every collision query of the contact
 /// solver; past it the proxy waits where the sweep is proven clear and a level change waits for a later
 /// tick. Timing the tick is the caller's business. Status enums here; exceptions only at setup.
+///
+/// Grooves (issue 14, item 2; ServoParams::render): the loop holds both solvers, sized at construction, and
+/// steps the one in use: GrooveSolver (groove.hpp) in grooves mode, whose output fills the same
+/// ContactOutput (proxy = closest point within the capture radius, state Edge inside it). Level changes are
+/// then taken at once (no wall to cross), and the force-step limit at level and gains changes is the groove
+/// solver's per-tick limit (k·|Δhandle| + jump_step_n, jump_step_n = max_force_step_n), not the residual.
 
 #include <cstdint>
 
@@ -140,7 +146,8 @@ class ServoLoop {
  public:
   /// `scene` must outlive the loop. Allocates (setup only).
   ServoLoop(const Scene& scene, const ServoParams& params);
-  /// Starts (or restarts) at the handle position: proxy placed there, force ramp from zero.
+  /// Starts (or restarts) at the handle position: proxy placed there, force ramp from zero. Resets the
+  /// solver in use (walls: ContactSolver, grooves: GrooveSolver).
   void start(Vec2 handle_m);
   /// One servo tick: a function of (state, in, scene); no clock is read. A non-finite handle position
   /// gives zero force and NonFinite with the state kept. Real-time safe.
