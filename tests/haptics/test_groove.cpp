@@ -210,6 +210,34 @@ TEST(GrooveSolver, EventsOnEnteringAndLeavingTheRadius) {
   EXPECT_EQ(out.state, ContactState::Free);
 }
 
+TEST(GrooveSolver, OutOfBudgetKeepsTheLastClosestPointWhileWithinTheRadius) {
+  const Scene sc = line_scene();
+  GrooveParams gp;
+  GrooveSolver solver(sc, gp);
+  solver.reset({0.001, -0.001}, 0);
+  ContactInput in;
+  in.level = 0;
+  in.handle_m = {0.001, -0.001};
+  ContactOutput out;
+  solver.update(in, out);  // no limit: the exact answer
+  ASSERT_EQ(out.state, ContactState::Edge);
+  const Vec2 q = out.proxy_m;
+  in.budget.max_box_tests = 1;  // too little for any walk below the root
+  in.handle_m = {0.0012, -0.0011};
+  solver.update(in, out);
+  EXPECT_NE(out.events & kEventQueryBudget, 0u);
+  EXPECT_TRUE(out.query.budget_exhausted);
+  EXPECT_EQ(out.state, ContactState::Edge) << "the groove is followed from where it was";
+  EXPECT_EQ(out.proxy_m, q);
+  EXPECT_LE(out.budget_used, 1);
+  EXPECT_GT(out.force_n.y, 0.0);
+  in.handle_m = {0.0012, -0.0045};  // out of the last closest point's radius: free, no guess
+  solver.update(in, out);
+  EXPECT_EQ(out.state, ContactState::Free);
+  EXPECT_NE(out.events & kEventContactEnd, 0u);
+  EXPECT_EQ(out.proxy_m, in.handle_m);
+}
+
 // ── Continuity ────────────────────────────────────────────────────────────────────────────────────
 
 TEST(GrooveContinuity, LoneStraightLineNeverNeedsTheLimiter) {
