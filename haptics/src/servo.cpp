@@ -145,7 +145,7 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   out.level_changed = false;
   const bool grooves = params_.render == RenderMode::Grooves;
   if (wanted != level_) {
-    if (grooves || solver_.level_change_is_safe(wanted, &budget)) {  // grooves: no wall to cross  // else it waits (out.level_wanted shows it)
+    if (grooves || solver_.level_change_is_safe(wanted, &budget)) {  // grooves: no wall to cross; walls: else it waits (level_wanted)
       out.level_changed = true;
       level_ = wanted;
     }

@@ -88,11 +88,14 @@ class GrooveSolver {
   /// The boundary section (the grooves mode walks from the roots and leaves it at the roots; kept for
   /// the display, which shows the active solver's section).
   const BoundarySection& section() const { return section_; }
+  /// The parameters in use.
   const GrooveParams& params() const { return params_; }
   /// New parameters from the next update on; the force moves to the new law through the per-tick limiter.
   /// Real-time safe.
   void set_params(const GrooveParams& p) { params_ = p; }
+  /// The closest point after the last update (Edge), or the handle (Free) [m].
   Vec2 proxy() const { return proxy_; }
+  /// Edge within the capture radius after the last update, else Free.
   ContactState state() const { return state_; }
 
  private:

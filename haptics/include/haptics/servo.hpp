@@ -75,7 +75,10 @@ inline constexpr std::int32_t kDefaultQueryBoxBudget = 4000;
 /// How curves are felt (issue 14, item 2; config key [haptics] render): as walls the proxy cannot cross
 /// (ContactSolver, the seed paper's god-object) or as engraved grooves that pull the hand in within a
 /// capture radius and never block (GrooveSolver, groove.hpp).
-enum class RenderMode : std::uint8_t { Walls, Grooves };
+enum class RenderMode : std::uint8_t {
+  Walls,    ///< god-object walls (ContactSolver), the default
+  Grooves,  ///< engraved lines (GrooveSolver)
+};
 
 /// The servo settings an operator may change while a visitor touches a wall (issue 12, item 4). Units in
 /// names. Values are assumed checked (config ranges): finite, max_force_step_n > 0, the rest ≥ 0.
