@@ -45,7 +45,12 @@ int CueTracker::update(std::int64_t tick, const ServoOutput& out, Vec2 handle_m,
   }
   prev_level_ = level_in_use;
 
-  if (c.events & kEventContactEnd) emit(CueKind::ContactEnd, prev_curve_, 0.0, level_in_use);
+  // A push-through ends the contact with its own sound, in place of the soft tock of letting go.
+  if (c.events & kEventPopThrough) {
+    emit(CueKind::PopThrough, prev_curve_, 0.0, level_in_use);
+  } else if (c.events & kEventContactEnd) {
+    emit(CueKind::ContactEnd, prev_curve_, 0.0, level_in_use);
+  }
   if (c.events & kEventContactBegin) {
     emit(CueKind::ContactBegin, curve, length(out.handle_velocity_m_per_s), level_in_use);
   } else if (in_contact && prev_curve_ >= 0 && curve != prev_curve_) {

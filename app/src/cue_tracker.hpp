@@ -34,7 +34,8 @@ class CueTracker {
   explicit CueTracker(const CueTrackerParams& params) : p_(params) {}
 
   /// Cues of tick `tick` into out[0 .. return value). `level_in_use` is the level the servo renders.
-  /// Rules: ContactBegin / ContactEnd from the solver's events (approach speed = handle speed); a new
+  /// Rules: ContactBegin / ContactEnd from the solver's events (approach speed = handle speed), PopThrough in
+  /// place of ContactEnd when the contact ended by a push-through (kEventPopThrough); a new
   /// ContactBegin when contact moves to another curve (its pitch changes); VertexContact on entering a
   /// concave corner; ConvexCorner when one is passed (both only at corners of corner_min_turn_rad or more); Slide with the proxy's mean speed over the last
   /// slide_every_ticks ticks of edge contact; LevelFiner / LevelCoarser when level_in_use changes;

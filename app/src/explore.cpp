@@ -153,13 +153,14 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   if (!trace) throw ExploreError("output '" + trace_path.string() + "': cannot open for writing");
   static char buffer[1 << 16];
   std::setvbuf(trace.get(), buffer, _IOFBF, sizeof buffer);
-  std::fputs("t_s,handle_x_m,handle_y_m,proxy_x_m,proxy_y_m,force_x_n,force_y_n,contact,curve,level,tick_ns\n", trace.get());
+  std::fputs("t_s,handle_x_m,handle_y_m,proxy_x_m,proxy_y_m,force_x_n,force_y_n,contact,curve,level,tick_ns,pop\n", trace.get());
 
   struct Row {
     double t_s;
     Vec2 handle_m, proxy_m, force_n;
     int contact, curve, level;
     std::int64_t tick_ns;
+    int pop;
   };
   std::vector<Row> rows;
   rows.reserve(static_cast<std::size_t>(std::ceil(duration * s.haptics.servo_rate_hz)) + 1);
@@ -170,7 +171,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   long budget_exhausted = 0;
   double queries = 0, box_tests = 0, section_sum = 0;
   long section_max = 0, iteration_limited = 0;
-  long level_changes = 0, level_waiting = 0, sticking = 0;
+  long level_changes = 0, level_waiting = 0, sticking = 0, pops = 0;
   std::array<long, Scene::kMaxLevels> level_ticks{};
   CueTrackerParams ctp;
   ctp.period_s = 1.0 / s.haptics.servo_rate_hz;
@@ -189,7 +190,9 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     const int curve = c.state == ContactState::Free ? -1 : c.constraint[0].curve;
     // Rows are kept in memory and formatted after the run: printf between ticks would evict the
     // servo's data from the caches and inflate the tick times we measure.
-    rows.push_back({r.t_s, r.handle_m, c.proxy_m, so.force_n, state, curve, c.level, r.tick_ns});
+    const int pop = (c.events & kEventPopThrough) != 0;
+    rows.push_back({r.t_s, r.handle_m, c.proxy_m, so.force_n, state, curve, c.level, r.tick_ns, pop});
+    pops += pop;
     tick_ns.push_back(r.tick_ns);
     proxy_path.push_back(c.proxy_m);
     coverage.add(c.proxy_m, curve, c.state == ContactState::Vertex ? c.constraint[1].curve : -1);
@@ -210,8 +213,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     if (so.level >= 0 && so.level < Scene::kMaxLevels) ++level_ticks[static_cast<std::size_t>(so.level)];
   }, device, &sum.device);
   for (const Row& w : rows) {
-    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld\n", w.t_s, w.handle_m.x, w.handle_m.y, w.proxy_m.x,
-                 w.proxy_m.y, w.force_n.x, w.force_n.y, w.contact, w.curve, w.level, static_cast<long long>(w.tick_ns));
+    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld,%d\n", w.t_s, w.handle_m.x, w.handle_m.y, w.proxy_m.x,
+                 w.proxy_m.y, w.force_n.x, w.force_n.y, w.contact, w.curve, w.level, static_cast<long long>(w.tick_ns), w.pop);
   }
   if (std::fflush(trace.get()) != 0 || std::ferror(trace.get())) throw ExploreError("output '" + trace_path.string() + "': write failed");
   trace.reset();
@@ -249,6 +252,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["levels"] = {{"mode", s.haptics.level_mode}, {"changes", level_changes}, {"ticks_waiting_for_a_safe_change", level_waiting},
                   {"ticks_per_level", std::move(lt)}};
   sj["sticking_ticks"] = sticking;
+  sj["push_throughs"] = pops;
   const Coverage cov = coverage.measure(scene);
   sj["coverage"] = {{"length_fraction", cov.length_fraction}, {"curves_touched", cov.curves_touched}, {"curves", cov.curves}};
   sj["device"] = {{"name", sum.device.name}, {"status", sum.device.status}, {"replies_missing", sum.device.replies_missing},

@@ -79,6 +79,7 @@ TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, Ser
 
   TickResult r = TickResult::Ok;
   if (current_) {
+    in.press_counts = !fading_;  // a hand sinking into a fading wall is not pushing through it
     r = current_->loop.update(in, out_);
   } else {
     out_ = ServoOutput{};

@@ -27,6 +27,9 @@ ServoGains servo_gains_from(const config::Settings& s) {
   g.dynamic_friction = s.haptics.dynamic_friction;
   g.max_force_step_n = s.haptics.level_max_force_step_n;
   g.query_box_budget = s.haptics.query_box_budget;
+  g.pop_force_n = s.haptics.pop_force_n;
+  g.pop_hold_s = s.haptics.pop_hold_s;
+  g.pop_release_s = s.haptics.pop_release_s;
   return g;
 }
 

@@ -54,15 +54,68 @@ void ContactSolver::reset(Vec2 p_m, int level) {
   sticking_ = false;
   transition_level_ = -1;
   level_ = level;
+  press_ticks_ = 0;
+  release_left_ = 0;
+  last_force_n_ = Vec2{0.0, 0.0};
   section_.reset();
-  // A proxy started on a wall would have no side: push it off along the wall's normal.
+  push_off_walls(nullptr);
+}
+
+void ContactSolver::push_off_walls(QueryBudget* budget) {
+  // A proxy on a wall would have no side: push it off along the wall's normal, to the side it is on.
   Vec2 q;
   SegmentRef s;
-  if (section_.closest_point(p_m, level, 2.0 * params_.skin_m, &q, &s)) {
+  if (section_.closest_point(proxy_, level_, 2.0 * params_.skin_m, &q, &s, -1, budget)) {
     const SegGeom g = geom(*scene_, s);
-    const double side = dot(g.n, p_m - g.a) >= 0.0 ? 1.0 : -1.0;
+    const double side = dot(g.n, proxy_ - g.a) >= 0.0 ? 1.0 : -1.0;
     proxy_ = q + (2.0 * params_.skin_m * side) * g.n;
   }
+}
+
+namespace {
+// A duration in servo ticks, at least one.
+long ticks_of(double duration_s, double period_s) {
+  return std::max(1L, std::lround(duration_s / (period_s > 0.0 ? period_s : 0.001)));
+}
+}  // namespace
+
+bool ContactSolver::pop_due() const {
+  return params_.pop_force_n > 0.0 && state_ != ContactState::Free && press_ticks_ >= ticks_of(params_.pop_hold_s, params_.period_s);
+}
+
+void ContactSolver::pop_through(Step& s) {
+  // The wall gives way: the proxy goes to the handle, beyond the wall(s) it was held by, off any polyline.
+  proxy_ = s.in.handle_m;
+  push_off_walls(&s.budget);
+  if (s.out.path_count < ContactOutput::kMaxPath) s.out.path_m[s.out.path_count++] = proxy_;
+  state_ = ContactState::Free;
+  sticking_ = false;
+  transition_level_ = -1;
+  press_ticks_ = 0;
+  release_from_n_ = last_force_n_;
+  release_left_ = ticks_of(params_.pop_release_s, params_.period_s);
+  s.out.events |= kEventPopThrough;
+}
+
+Vec2 ContactSolver::release_force(Vec2 f) {
+  if (release_left_ > 0) {
+    const double share = static_cast<double>(release_left_) / static_cast<double>(ticks_of(params_.pop_release_s, params_.period_s));
+    f += std::min(share, 1.0) * release_from_n_;
+    --release_left_;
+    const double mag = length(f);
+    if (mag > params_.max_force_n) f = (params_.max_force_n / mag) * f;
+    if (!is_finite(f)) f = Vec2{0.0, 0.0};
+  }
+  last_force_n_ = f;
+  return f;
+}
+
+void ContactSolver::count_press(const ContactInput& in, ContactOutput& out) {
+  // How hard the hand presses: the spring's force, unclamped (the clamp is what the device can give).
+  const bool pressing = params_.pop_force_n > 0.0 && in.press_counts && state_ != ContactState::Free &&
+                        params_.stiffness_n_per_m * distance(proxy_, in.handle_m) >= params_.pop_force_n;
+  press_ticks_ = pressing ? press_ticks_ + 1 : 0;
+  out.press_s = static_cast<double>(press_ticks_) * params_.period_s;
 }
 
 int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget) {
@@ -179,6 +232,7 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
   const ContactState before = state_;
   begin_step(in, out);
   Step s{in, out, in.budget};
+  if (pop_due()) pop_through(s);
   bool rest = false;
   for (int iter = 0; iter < params_.max_iterations && !rest; ++iter) {
     switch (state_) {
@@ -189,7 +243,8 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
   }
   if (!rest) out.events |= kEventIterationLimit;
   out.budget_used = s.budget.box_tests_used;
-  finish_step(before, contact_force(in), out);
+  finish_step(before, release_force(contact_force(in)), out);
+  count_press(in, out);
 }
 
 void ContactSolver::begin_step(const ContactInput& in, ContactOutput& out) {

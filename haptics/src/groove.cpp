@@ -33,6 +33,7 @@ void GrooveSolver::update(const ContactInput& in, ContactOutput& out) {
   out.corner_turn_rad = 0.0;
   out.sticking = false;
   out.transition_level = -1;
+  out.press_s = 0.0;  // grooves never block, so nothing is pushed through
   out.query = QueryStats{};
   out.queries = 0;
   out.path_count = 0;

@@ -38,6 +38,13 @@ int level_error_ladder(const Scene& scene, double* err) {
   return levels;
 }
 
+// The solver's parameters, stepped at the loop's period.
+ContactParams contact_params(const ServoParams& p) {
+  ContactParams c = p.contact;
+  c.period_s = p.period_s;
+  return c;
+}
+
 LevelPolicyParams policy_params(const ServoParams& p) {
   LevelPolicyParams pp = p.policy;
   pp.fixed_level = -1;  // fixing the level is the loop's business (auto_level off)
@@ -61,6 +68,9 @@ ServoGains gains_of(const ServoParams& p) noexcept {
   g.dynamic_friction = p.contact.dynamic_friction;
   g.max_force_step_n = p.max_force_step_n;
   g.query_box_budget = p.query_box_budget;
+  g.pop_force_n = p.contact.pop_force_n;
+  g.pop_hold_s = p.contact.pop_hold_s;
+  g.pop_release_s = p.contact.pop_release_s;
   return g;
 }
 
@@ -73,6 +83,9 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
   p.guard.max_force_n = g.max_force_n;
   p.max_force_step_n = g.max_force_step_n;
   p.query_box_budget = g.query_box_budget;
+  p.contact.pop_force_n = g.pop_force_n;
+  p.contact.pop_hold_s = g.pop_hold_s;
+  p.contact.pop_release_s = g.pop_release_s;
   p.groove.stiffness_n_per_m = g.stiffness_n_per_m;
   p.groove.max_force_n = g.max_force_n;
   p.groove.jump_step_n = g.max_force_step_n;
@@ -80,7 +93,7 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
 
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
-      solver_(scene, params.contact),
+      solver_(scene, contact_params(params)),
       groove_(scene, params.groove),
       levels_(level_error_ladder(scene, level_error_m_)),
       policy_(policy_params(params), level_error_m_, levels_, params.level),
@@ -106,7 +119,7 @@ void ServoLoop::start(Vec2 handle_m) {
 void ServoLoop::set_gains(const ServoGains& g) noexcept {
   if (g == gains()) return;
   apply_gains(params_, g);
-  solver_.set_params(params_.contact);
+  solver_.set_params(contact_params(params_));
   groove_.set_params(params_.groove);
   gains_changed_ = true;
 }
@@ -158,6 +171,7 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   ci.handle_velocity_m_per_s = velocity_;
   ci.level = level_;
   ci.budget = budget;
+  ci.press_counts = in.press_counts && static_cast<double>(ticks_) * params_.period_s >= params_.guard.ramp_s;  // not while the force ramps in
   if (grooves) {
     groove_.update(ci, out.contact);
   } else {

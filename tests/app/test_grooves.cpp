@@ -150,7 +150,7 @@ TEST(GroovesExplore, TraceHoldsTheClosestPointAndContactWithinTheRadius) {
   ASSERT_GE(head.size(), 11u);
   ASSERT_EQ(head[3], "proxy_x_m");
   ASSERT_EQ(head[7], "contact");
-  long rows = 0, contact_rows = 0, wrong_contact = 0, wrong_proxy = 0, free_force = 0, checked = 0;
+  long pops = 0, rows = 0, contact_rows = 0, wrong_contact = 0, wrong_proxy = 0, free_force = 0, checked = 0;
   while (std::getline(trace, line)) {
     const std::vector<std::string> f = split(line);
     ASSERT_GE(f.size(), 11u);
@@ -160,6 +160,7 @@ TEST(GroovesExplore, TraceHoldsTheClosestPointAndContactWithinTheRadius) {
     const int contact = std::stoi(f[7]), level = std::stoi(f[9]);
     ASSERT_TRUE(level >= 0 && level < 16) << line;
     contact_rows += contact == 1;
+    if (head.size() > 11 && head[11] == "pop") pops += std::stoi(f[11]);
     ASSERT_NE(contact, 2) << line;
     if (contact == 0) {
       free_force += std::hypot(fx, fy) > 1e-9;
@@ -179,6 +180,7 @@ TEST(GroovesExplore, TraceHoldsTheClosestPointAndContactWithinTheRadius) {
   EXPECT_EQ(wrong_contact, 0) << "contact == 1 iff the handle is within the capture radius of the level's polylines";
   EXPECT_EQ(wrong_proxy, 0) << "proxy columns: the closest point in contact, the handle when free";
   EXPECT_EQ(free_force, 0) << "no force in free space";
+  EXPECT_EQ(pops, 0) << "nothing is pushed through a groove";
 
   json summary;
   std::ifstream(dir / "out" / "summary.json") >> summary;

@@ -27,6 +27,18 @@
 /// gives the hysteresis between sticking and sliding. Both 0:
 /// frictionless, the seed paper's model. Friction only ever holds the proxy back, so it takes energy out
 /// (the work the hand does round a closed loop is ≥ 0).
+///
+/// Push-through (issue 14, item 1; DESIGN.md "Contact"): a blind visitor cannot lift the handle over a wall,
+/// so a wall gives way, as a membrane, to a deliberate press. While in contact, the spring force
+/// stiffness·|proxy − handle| (unclamped: how hard the hand presses) is counted tick by tick (not while the
+/// force ramps in: ContactInput::press_counts); once it has
+/// been ≥ pop_force_n for pop_hold_s without a break, the next tick begins with a pop: the proxy jumps to
+/// the handle, on the far side of the wall(s) it was held by (pushed off any polyline within the skin, so
+/// it never rests on a wall), the state becomes Free, and the event kEventPopThrough is set. That is the
+/// one tick on which the proxy crosses a curve. The force of the tick before the pop does not vanish in one
+/// tick: it fades linearly to zero over pop_release_s (added to whatever the proxy's new contacts give, the
+/// sum clamped to max_force_n). pop_force_n = 0 turns push-through off: walls never give way. A gentle
+/// exploration (the visitor's usual 1–2 N) never reaches the default 3 N.
 
 #include <cstdint>
 
@@ -47,6 +59,7 @@ enum HapticEvent : std::uint32_t {
   kEventConvexCorner = 1u << 3,   ///< slid over a convex corner onto the next edge
   kEventIterationLimit = 1u << 4, ///< the tick's move budget ran out before the proxy came to rest
   kEventQueryBudget = 1u << 5,    ///< a collision query ran out of its box-test budget: the proxy stopped where the sweep was proven clear
+  kEventPopThrough = 1u << 6,     ///< the proxy passed through a wall on purpose this tick (pressed ≥ pop_force_n for pop_hold_s)
 };
 
 /// Solver parameters. Units in names.
@@ -62,6 +75,12 @@ struct ContactParams {
   /// (Karnopp 1985, "Computer simulation of stick-slip friction in mechanical dynamic systems": a band of
   /// relative speed counted as zero), so a hand that keeps moving feels steady μ_d, not stick-slip.
   double stick_speed_m_per_s = 0.002;
+  /// Push-through (see above): a press with spring force ≥ this for pop_hold_s lets the proxy through [N];
+  /// 0 = off (walls never give way).
+  double pop_force_n = 0.0;
+  double pop_hold_s = 0.3;      ///< how long the press must last [s]
+  double pop_release_s = 0.02;  ///< the force of the tick before a pop fades to zero over this [s]
+  double period_s = 0.001;      ///< the servo period the solver is stepped at [s] (counts pop_hold_s and pop_release_s in ticks)
 };
 
 /// Input of one solver step.
@@ -72,6 +91,9 @@ struct ContactInput {
   /// The tick's box-test budget (QueryBudget): its limit, and what was already spent this tick before the
   /// step (e.g. by level_change_is_safe). Every query of the step draws on it.
   QueryBudget budget;
+  /// False while the force is still ramping in (start-up, a device back, a new picture): a hand sinks into
+  /// a wall the ramp holds weakly, and that must not count as a deliberate press (push-through).
+  bool press_counts = true;
 };
 
 /// Output of one solver step.
@@ -88,6 +110,9 @@ struct ContactOutput {
   double corner_turn_rad = 0.0;
   bool sticking = false;             ///< edge contact held by static friction this tick
   std::int32_t transition_level = -1; ///< ≥ 0: the previous level, still a wall after a level change (see level_change_is_safe)
+  /// How long the hand has pressed with ≥ pop_force_n without a break, by the end of this tick [s]; 0 when
+  /// push-through is off, the proxy is free or the press is lighter. The wall gives way once it reaches pop_hold_s.
+  double press_s = 0.0;
   QueryStats query;                  ///< summed over this step's queries
   std::int32_t queries = 0;
   /// Box tests charged to the tick's budget by the end of the step: ContactInput::budget.box_tests_used
@@ -152,9 +177,18 @@ class ContactSolver {
     ContactOutput& out;
     QueryBudget budget;
   };
-  // The phases of update(), in order: begin_step, then per iteration the step of the current state
-  // (each returns true when the proxy is at rest for this tick), then contact_force and finish_step.
+  // The phases of update(), in order: begin_step, pop_through (when a press has lasted pop_hold_s), then per
+  // iteration the step of the current state (each returns true when the proxy is at rest for this tick),
+  // then contact_force, release_force and finish_step (which also counts the press for the next tick).
   void begin_step(const ContactInput& in, ContactOutput& out);
+  // Push-through, its own transition Edge/Vertex → Free: true when the press counted so far is due.
+  bool pop_due() const;
+  void pop_through(Step& s);
+  // The contact force plus what remains of the force before a pop (fading over pop_release_s), clamped.
+  Vec2 release_force(Vec2 contact_force_n);
+  void count_press(const ContactInput& in, ContactOutput& out);
+  // Pushes the proxy off any polyline of the level in use within the skin, to the side it is on.
+  void push_off_walls(QueryBudget* budget);
   bool step_free(Step& s);
   bool step_edge(Step& s);
   bool step_vertex(Step& s);
@@ -173,6 +207,10 @@ class ContactSolver {
   int level_ = 0;
   bool sticking_ = false;   // edge contact inside the static friction cone
   int transition_level_ = -1;  // the previous level, still a wall just after a change; −1 = none
+  long press_ticks_ = 0;       // consecutive ticks in contact pressed with ≥ pop_force_n
+  Vec2 release_from_n_;        // the force of the tick before the last pop [N]
+  long release_left_ = 0;      // ticks of its fade still to go
+  Vec2 last_force_n_;          // the force of the last tick [N]
   double max_half_width_m_[Scene::kMaxLevels] = {};  // per level: the largest error-box half-width of any curve [m]
   // Side of p relative to curve `curve`'s polyline at `level`: +1 left, −1 right, 0 when the polyline is not
   // within radius_m or its nearest point is an open end, 2 when p lies on it, 3 when `budget` ran out first.

@@ -17,6 +17,8 @@
 /// (or of level, or both in one tick) moves the force by more than max_force_step_n per tick beyond what
 /// the hand's own motion does. A difference of D [N] is gone after ceil(D / max_force_step_n) ticks,
 /// counting the tick that takes the change.
+/// Push-through (issue 14) is the contact solver's (ContactSolver::pop_through); the loop only keeps a press
+/// from counting while its force ramps in (start-up, ServoInput::press_counts false while the caller fades).
 /// The tick is `update(input, output) -> TickResult`: a function of (state, sample, scene), with no
 /// allocation, lock, throw, I/O, logging or clock read. Its collision work is bounded by one number, the
 /// box-test budget ServoParams::query_box_budget: one counter per tick (QueryBudget) shared by the
@@ -90,6 +92,9 @@ struct ServoGains {
   double dynamic_friction = 0.0;      ///< μ_d ≤ μ_s
   double max_force_step_n = 0.05;     ///< the limit on force change per tick a gains change (or level change) may cause [N]
   std::int32_t query_box_budget = kDefaultQueryBoxBudget;  ///< box tests per tick (ServoParams::query_box_budget); 0 = no limit
+  double pop_force_n = 0.0;           ///< push-through press [N], 0 = off (ContactParams::pop_force_n)
+  double pop_hold_s = 0.3;            ///< how long the press must last [s]
+  double pop_release_s = 0.02;        ///< the force fades over this after a push-through [s]
   bool operator==(const ServoGains&) const = default;
 };
 
@@ -131,6 +136,9 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept;
 struct ServoInput {
   DeviceSample sample;         ///< handle position [m] and status
   bool deadline_missed = false;  ///< the caller says this tick is late: the guard sends zero force
+  /// False while the caller fades the force out (ServoCore's picture swap): a press then is not a
+  /// deliberate push-through (ContactInput::press_counts). The loop also stops counting during its own ramp.
+  bool press_counts = true;
 };
 
 /// Output of one tick.
