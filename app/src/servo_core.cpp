@@ -110,7 +110,7 @@ TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, Ser
   d.gains_transition = current_ && current_->loop.transition_active();
   d.section_count = 0;
   if (current_) {
-    const auto& sec = current_->loop.solver().section().section();
+    const auto& sec = current_->loop.section().section();
     d.section_count = static_cast<std::int32_t>(sec.size());
     const std::size_t n = std::min<std::size_t>(sec.size(), ServoDisplayState::kMaxSection);
     std::copy_n(sec.data(), n, d.section);

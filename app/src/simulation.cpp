@@ -43,6 +43,11 @@ ServoParams servo_params_from(const config::Settings& s) {
   sp.policy.blur_time_s = s.haptics.level_blur_time_s;
   sp.policy.hysteresis = s.haptics.level_hysteresis;
   sp.policy.min_dwell_s = s.haptics.level_min_dwell_s;
+  // Walls or grooves (issue 14, item 2). The groove's stiffness, max force and per-tick jump limit come from
+  // the gains below (stiffness_n_per_m, max_force_n, level_max_force_step_n) through apply_gains.
+  sp.render = s.haptics.render == "grooves" ? RenderMode::Grooves : RenderMode::Walls;
+  sp.groove.capture_radius_m = s.haptics.groove_capture_radius_m;
+  sp.groove.depth_n = s.haptics.groove_depth_n;
   apply_gains(sp, servo_gains_from(s));
   sp.guard.ramp_s = s.haptics.force_ramp_s;
   return sp;

@@ -86,11 +86,15 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
   p.contact.pop_force_n = g.pop_force_n;
   p.contact.pop_hold_s = g.pop_hold_s;
   p.contact.pop_release_s = g.pop_release_s;
+  p.groove.stiffness_n_per_m = g.stiffness_n_per_m;
+  p.groove.max_force_n = g.max_force_n;
+  p.groove.jump_step_n = g.max_force_step_n;
 }
 
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
       solver_(scene, contact_params(params)),
+      groove_(scene, params.groove),
       levels_(level_error_ladder(scene, level_error_m_)),
       policy_(policy_params(params), level_error_m_, levels_, params.level),
       level_(params.level),
@@ -98,7 +102,11 @@ ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
 
 void ServoLoop::start(Vec2 handle_m) {
   level_ = params_.auto_level ? policy_.level() : params_.level;
-  solver_.reset(handle_m, level_);
+  if (params_.render == RenderMode::Grooves) {
+    groove_.reset(handle_m, level_);
+  } else {
+    solver_.reset(handle_m, level_);
+  }
   last_handle_ = handle_m;
   velocity_ = {0.0, 0.0};
   force_residual_ = {0.0, 0.0};
@@ -112,6 +120,7 @@ void ServoLoop::set_gains(const ServoGains& g) noexcept {
   if (g == gains()) return;
   apply_gains(params_, g);
   solver_.set_params(contact_params(params_));
+  groove_.set_params(params_.groove);
   gains_changed_ = true;
 }
 
@@ -147,8 +156,9 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   QueryBudget budget;
   budget.max_box_tests = params_.query_box_budget;
   out.level_changed = false;
+  const bool grooves = params_.render == RenderMode::Grooves;
   if (wanted != level_) {
-    if (solver_.level_change_is_safe(wanted, &budget)) {  // else it waits (out.level_wanted shows it)
+    if (grooves || solver_.level_change_is_safe(wanted, &budget)) {  // grooves: no wall to cross; walls: else it waits (level_wanted)
       out.level_changed = true;
       level_ = wanted;
     }
@@ -162,7 +172,11 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   ci.level = level_;
   ci.budget = budget;
   ci.press_counts = in.press_counts && static_cast<double>(ticks_) * params_.period_s >= params_.guard.ramp_s;  // not while the force ramps in
-  solver_.update(ci, out.contact);
+  if (grooves) {
+    groove_.update(ci, out.contact);
+  } else {
+    solver_.update(ci, out.contact);
+  }
   if (out.contact.state == ContactState::Free) out.contact.level = level_;
 
   // Force-step limit at level and gains changes: the difference between the last tick's force and the new
@@ -170,7 +184,8 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   // of the change already takes the first step.
   const double step = params_.max_force_step_n;
   Vec2 f = out.contact.force_n;
-  if ((out.level_changed || gains_changed_) && ticks_ > 0) force_residual_ = last_force_ - f;
+  // Grooves: the groove solver already limits every change per tick (GrooveParams::jump_step_n).
+  if ((out.level_changed || gains_changed_) && ticks_ > 0 && !grooves) force_residual_ = last_force_ - f;
   gains_changed_ = false;
   if (force_residual_.x != 0.0 || force_residual_.y != 0.0) {
     force_residual_ = fade(force_residual_, step);

@@ -25,11 +25,18 @@
 /// level-change check (ContactSolver::level_change_is_safe) and every collision query of the contact
 /// solver; past it the proxy waits where the sweep is proven clear and a level change waits for a later
 /// tick. Timing the tick is the caller's business. Status enums here; exceptions only at setup.
+///
+/// Grooves (issue 14, item 2; ServoParams::render): the loop holds both solvers, sized at construction, and
+/// steps the one in use: GrooveSolver (groove.hpp) in grooves mode, whose output fills the same
+/// ContactOutput (proxy = closest point within the capture radius, state Edge inside it). Level changes are
+/// then taken at once (no wall to cross), and the force-step limit at level and gains changes is the groove
+/// solver's per-tick limit (k·|Δhandle| + jump_step_n, jump_step_n = max_force_step_n), not the residual.
 
 #include <cstdint>
 
 #include "haptics/contact.hpp"
 #include "haptics/device.hpp"
+#include "haptics/groove.hpp"
 #include "haptics/level_policy.hpp"
 #include "haptics/scene.hpp"
 
@@ -67,6 +74,14 @@ struct ForceGuard {
 /// A cold query needs 30–60 box tests to answer exactly at level 0, so the budget binds only in pathologies.
 inline constexpr std::int32_t kDefaultQueryBoxBudget = 4000;
 
+/// How curves are felt (issue 14, item 2; config key [haptics] render): as walls the proxy cannot cross
+/// (ContactSolver, the seed paper's god-object) or as engraved grooves that pull the hand in within a
+/// capture radius and never block (GrooveSolver, groove.hpp).
+enum class RenderMode : std::uint8_t {
+  Walls,    ///< god-object walls (ContactSolver), the default
+  Grooves,  ///< engraved lines (GrooveSolver)
+};
+
 /// The servo settings an operator may change while a visitor touches a wall (issue 12, item 4). Units in
 /// names. Values are assumed checked (config ranges): finite, max_force_step_n > 0, the rest ≥ 0.
 struct ServoGains {
@@ -100,11 +115,21 @@ struct ServoParams {
   double velocity_cutoff_hz = 100;  ///< low-pass on the finite-difference handle velocity [Hz]
   ContactParams contact;
   ForceGuard guard;
+  /// Walls (ContactSolver) or grooves (GrooveSolver). Fixed for the loop's life (a change of [haptics]
+  /// render builds a new loop with the scene). In grooves mode a level change is always safe (no wall to
+  /// cross), and the force-step limit at level and gains changes is the groove solver's own per-tick
+  /// limit (groove.jump_step_n = max_force_step_n beyond what the hand's motion does), so the residual
+  /// fade below is not added on top of it.
+  RenderMode render = RenderMode::Walls;
+  /// The groove field (grooves mode). apply_gains writes stiffness, max force and jump_step_n
+  /// (= max_force_step_n) into it as into `contact`.
+  GrooveParams groove;
 };
 
 /// The gains part of `p` (max_force_n from the solver's clamp, p.contact.max_force_n).
 ServoGains gains_of(const ServoParams& p) noexcept;
-/// Writes `g` into `p` (max_force_n into both the solver's and the guard's clamp). Real-time safe.
+/// Writes `g` into `p` (max_force_n into both the solver's and the guard's clamp; stiffness, max force and
+/// max_force_step_n also into the groove params). Real-time safe.
 void apply_gains(ServoParams& p, const ServoGains& g) noexcept;
 
 /// Input of one tick.
@@ -132,7 +157,8 @@ class ServoLoop {
  public:
   /// `scene` must outlive the loop. Allocates (setup only).
   ServoLoop(const Scene& scene, const ServoParams& params);
-  /// Starts (or restarts) at the handle position: proxy placed there, force ramp from zero.
+  /// Starts (or restarts) at the handle position: proxy placed there, force ramp from zero. Resets the
+  /// solver in use (walls: ContactSolver, grooves: GrooveSolver).
   void start(Vec2 handle_m);
   /// One servo tick: a function of (state, in, scene); no clock is read. A non-finite handle position
   /// gives zero force and NonFinite with the state kept. Real-time safe.
@@ -165,11 +191,19 @@ class ServoLoop {
   int level() const noexcept { return level_; }
   std::int64_t ticks() const { return ticks_; }
   /// The contact solver (its proxy and boundary section), for display snapshots taken in the servo thread.
+  /// In grooves mode it is not stepped: use section() for what the display shows.
   const ContactSolver& solver() const { return solver_; }
+  /// The groove solver (stepped in grooves mode only).
+  const GrooveSolver& groove() const { return groove_; }
+  /// The boundary section of the solver in use (walls: the contact solver's; grooves: the groove solver's).
+  const BoundarySection& section() const {
+    return params_.render == RenderMode::Grooves ? groove_.section() : solver_.section();
+  }
 
  private:
   ServoParams params_;
   ContactSolver solver_;
+  GrooveSolver groove_;
   double level_error_m_[LevelPolicy::kMaxLevels] = {};  // the scene's error bound per level [m] (policy input)
   int levels_ = 1;
   LevelPolicy policy_;

@@ -1,0 +1,103 @@
+// The grooves rendering mode (issue 14, item 2). See groove.hpp for the model and the profile.
+#include "haptics/groove.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hk {
+
+double groove_profile_n(const GrooveParams& p, double r_m) noexcept {
+  const double R = p.capture_radius_m;
+  if (!(r_m >= 0.0) || !(r_m < R) || !std::isfinite(r_m)) return 0.0;
+  const double k = p.stiffness_n_per_m;
+  const double f = std::min({k * r_m, p.depth_n, k * (R - r_m)});
+  return std::clamp(f, 0.0, std::max(0.0, p.max_force_n));
+}
+
+GrooveSolver::GrooveSolver(const Scene& scene, const GrooveParams& params) : scene_(&scene), params_(params), section_(scene) {}
+
+void GrooveSolver::reset(Vec2 p_m, int level) {
+  proxy_ = p_m;
+  state_ = ContactState::Free;
+  seg_ = SegmentRef{};
+  level_ = level;
+  last_force_ = {0.0, 0.0};
+  last_handle_ = p_m;
+  section_.reset();
+}
+
+void GrooveSolver::update(const ContactInput& in, ContactOutput& out) {
+  const Vec2 h = in.handle_m;
+  const ContactState before = state_;
+  out.events = kEventNone;
+  out.corner_turn_rad = 0.0;
+  out.sticking = false;
+  out.transition_level = -1;
+  out.press_s = 0.0;  // grooves never block, so nothing is pushed through
+  out.query = QueryStats{};
+  out.queries = 0;
+  out.path_count = 0;
+  out.path_m[out.path_count++] = proxy_;
+  level_ = in.level;
+
+  // The closest point of the polylines at the level in use, within the capture radius.
+  QueryBudget budget = in.budget;
+  const std::int32_t used_before = budget.box_tests_used;
+  const double R = params_.capture_radius_m;
+  Vec2 q;
+  SegmentRef s;
+  const bool found = section_.closest_point(h, level_, R, &q, &s, -1, &budget);
+  out.queries = 1;
+  out.query.box_tests = budget.box_tests_used - used_before;
+  out.query.section_size = static_cast<std::int32_t>(section_.section().size());
+  out.query.coarsest_answer_level = level_;
+  out.query.budget_exhausted = budget.exhausted();
+  if (found && distance(h, q) < R) {
+    state_ = ContactState::Edge;
+    proxy_ = q;
+    seg_ = s;
+  } else if (!found && budget.ran_out) {
+    // Unknown within this tick's budget: follow the groove from where it was if the handle is still within
+    // the radius of last tick's closest point (a point of the curve, so the pull is towards the curve).
+    out.events |= kEventQueryBudget;
+    out.query.budget_exhausted = true;
+    if (!(state_ == ContactState::Edge && distance(h, proxy_) < R)) {
+      state_ = ContactState::Free;
+      proxy_ = h;
+    }
+  } else {
+    state_ = ContactState::Free;
+    proxy_ = h;
+  }
+
+  // The pull of the profile towards the closest point.
+  Vec2 target{0.0, 0.0};
+  if (state_ == ContactState::Edge) {
+    const double r = distance(h, proxy_);
+    if (r > 0.0) target = (groove_profile_n(params_, r) / r) * (proxy_ - h);
+  }
+  // The per-tick limit (groove.hpp): binds only where the closest point jumps (the medial axis) or the
+  // law changes (level, gains); along a lone curve the target moves by at most k·|Δh| and passes as is.
+  const double allowed = params_.stiffness_n_per_m * distance(h, last_handle_) + params_.jump_step_n;
+  const Vec2 delta = target - last_force_;
+  const double dn = length(delta);
+  Vec2 f = dn > allowed && dn > 0.0 ? last_force_ + (allowed / dn) * delta : target;
+  const double mag = length(f);
+  if (mag > params_.max_force_n) f = mag > 0.0 ? (params_.max_force_n / mag) * f : Vec2{0.0, 0.0};
+  if (!is_finite(f)) f = Vec2{0.0, 0.0};
+  last_force_ = f;
+  last_handle_ = h;
+
+  out.path_m[out.path_count++] = proxy_;
+  out.proxy_m = proxy_;
+  out.force_n = f;
+  out.state = state_;
+  out.constraint[0] = state_ == ContactState::Edge ? seg_ : SegmentRef{};
+  out.constraint[1] = SegmentRef{};
+  out.level = level_;
+  out.budget_used = budget.box_tests_used;
+  if (before == ContactState::Free && state_ != ContactState::Free) out.events |= kEventContactBegin;
+  if (before != ContactState::Free && state_ == ContactState::Free) out.events |= kEventContactEnd;
+}
+
+}  // namespace hk
