@@ -11,6 +11,9 @@ ServoCore::~ServoCore() {
   delete pending_.exchange(nullptr);
   delete current_;
   delete to_retire_;
+  delete tour_pending_.exchange(nullptr);
+  delete tour_;
+  delete tour_to_retire_;
   collect_retired();
 }
 
@@ -25,7 +28,111 @@ int ServoCore::collect_retired() {
     delete b;
     ++n;
   }
+  TourPath* t = nullptr;
+  while (tour_retired_.try_pop(t)) delete t;
   return n;
+}
+
+void ServoCore::publish_tour(std::unique_ptr<TourPath> path) {
+  delete tour_pending_.exchange(path.release(), std::memory_order_acq_rel);
+}
+
+void ServoCore::end_tour(TourPhase how) noexcept {
+  tour_phase_ = how;
+  tour_ending_ = TourPhase::None;
+  if (tour_ && !tour_retired_.try_push(tour_)) tour_to_retire_ = tour_;  // step() takes no tour while this is set
+  tour_ = nullptr;
+}
+
+void ServoCore::tour_before_update(const DeviceSample& sample) noexcept {
+  if (tour_to_retire_ && tour_retired_.try_push(tour_to_retire_)) tour_to_retire_ = nullptr;
+  const bool cancel = tour_cancel_.exchange(false, std::memory_order_acq_rel);
+  const bool picture_changing = fading_ || !current_ || (tour_ && current_->id != tour_->scene_id);
+  if (tour_ && tour_ending_ == TourPhase::None && (cancel || picture_changing)) {
+    tour_ending_ = TourPhase::Stopped;
+    tour_fade_left_ = tour_fade_ticks_;
+  }
+  // A new tour waits while a picture is being swapped in (it may be for the new one), then is taken for
+  // the picture in use or dropped.
+  if (!tour_ && !tour_to_retire_ && current_ && !fading_) {
+    if (TourPath* next = tour_pending_.exchange(nullptr, std::memory_order_acq_rel)) {
+      tour_id_ = next->id;
+      tour_curve_ = next->curve;
+      tour_ = next;
+      if (current_->id != next->scene_id || next->points.empty()) {
+        end_tour(TourPhase::Stopped);  // for another picture: dropped
+      } else {
+        const double period = current_->loop.params().period_s;
+        tour_phase_ = TourPhase::Transit;
+        tour_ending_ = TourPhase::None;
+        tour_t_s_ = 0.0;
+        tour_cursor_ = 0;
+        tour_ticks_ = 0;
+        tour_hold_ticks_ = 0;
+        tour_fade_ticks_ = std::max(1L, static_cast<long>(next->params.fade_s / period + 0.5));
+        tour_fade_left_ = 0;
+      }
+    }
+  }
+  // Walls suspended in the transit once they have faded out: the proxy goes with the handle.
+  if (tour_ && tour_phase_ == TourPhase::Transit && tour_ticks_ >= tour_fade_ticks_ && is_finite(sample.handle_m))
+    current_->loop.relocate(sample.handle_m);
+}
+
+void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
+  guide_force_ = {0.0, 0.0};
+  if (!tour_) return;
+  if (out_.result == TickResult::DeviceNotOk || out_.result == TickResult::NonFinite) {
+    end_tour(TourPhase::Stopped);  // no force goes out anyway; the tour does not resume on its own
+    return;
+  }
+  const TourParams& p = tour_->params;
+  const double period = current_->loop.params().period_s;
+  const Vec2 h = sample.handle_m;
+  const Vec2 v = out_.handle_velocity_m_per_s;
+  const Vec2 target = tour_->target_at(tour_t_s_, tour_cursor_);
+  const Vec2 e = target - h;
+  Vec2 f = p.stiffness_n_per_m * e - p.damping_n_s_per_m * v;
+  const double f_len = length(f);
+  if (f_len > p.max_force_n) f = (p.max_force_n / f_len) * f;
+  double gain = std::min(1.0, static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_));  // fade in
+  // The walls: faded out over the first fade_s of the transit, then off (relocate); on from the outline.
+  if (tour_phase_ == TourPhase::Transit)
+    out_.force_n = std::max(0.0, 1.0 - static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_)) * out_.force_n;
+  if (tour_ending_ == TourPhase::None && out_.result == TickResult::Ok) {
+    // Held still against it: the force at its limit and the handle (nearly) not moving, for hold_s.
+    const bool held = f_len >= 0.95 * p.max_force_n && length(v) < p.hold_speed_m_per_s;
+    tour_hold_ticks_ = held ? tour_hold_ticks_ + 1 : 0;
+    if (static_cast<double>(tour_hold_ticks_) * period >= p.hold_s) {
+      tour_ending_ = TourPhase::Stopped;
+      tour_fade_left_ = tour_fade_ticks_;
+    }
+    // The path's clock runs while the handle keeps up (within the spring's saturation distance).
+    if (tour_ending_ == TourPhase::None && length(e) * p.stiffness_n_per_m < p.max_force_n) tour_t_s_ += period;
+    if (tour_phase_ == TourPhase::Transit && tour_t_s_ >= tour_->outline_start_s) {
+      tour_phase_ = TourPhase::Outline;
+      if (cues_) {
+        audio::CueEvent c;
+        c.tick = tick_;
+        c.kind = audio::CueKind::TourStart;
+        c.curve = tour_->curve;
+        c.speed_m_per_s = static_cast<float>(p.speed_m_per_s);
+        c.level = static_cast<std::int16_t>(out_.level);
+        cues_->try_push(c);  // a full ring drops and counts
+      }
+    }
+    if (tour_ending_ == TourPhase::None && tour_t_s_ >= tour_->duration_s()) {
+      tour_ending_ = TourPhase::Done;
+      tour_fade_left_ = tour_fade_ticks_;
+    }
+  }
+  if (tour_ending_ != TourPhase::None) {
+    --tour_fade_left_;
+    gain *= std::max(0.0, static_cast<double>(tour_fade_left_) / static_cast<double>(tour_fade_ticks_));
+  }
+  if (out_.result == TickResult::Ok) guide_force_ = gain * f;  // a late tick (DeadlineMissed) sends nothing
+  ++tour_ticks_;
+  if (tour_ending_ != TourPhase::None && tour_fade_left_ <= 0) end_tour(tour_ending_);
 }
 
 void ServoCore::set_gains(const ServoGains& g) noexcept {
@@ -77,6 +184,8 @@ TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, Ser
   if (current_ && gains_.seq != 0) current_->loop.set_gains(gains_.gains);  // no-op unless they changed
   if (current_ && device_returned && is_finite(sample.handle_m)) current_->loop.start(sample.handle_m);
 
+  tour_before_update(sample);
+
   TickResult r = TickResult::Ok;
   if (current_) {
     r = current_->loop.update(in, out_);
@@ -85,6 +194,15 @@ TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, Ser
     out_.contact.proxy_m = in.sample.handle_m;
   }
   if (fading_ && fade_total_ > 0) out_.force_n = (static_cast<double>(fade_left_) / static_cast<double>(fade_total_)) * out_.force_n;
+  tour_after_update(sample);
+  if (guide_force_.x != 0.0 || guide_force_.y != 0.0) {
+    // Walls plus guide, never above the guard's clamp.
+    const double max_n = current_->loop.params().guard.max_force_n;
+    Vec2 total = out_.force_n + guide_force_;
+    const double len = length(total);
+    if (len > max_n) total = (max_n / len) * total;
+    out_.force_n = total;
+  }
   cmd.force_n = out_.force_n;
 
   if (current_) {
@@ -107,6 +225,10 @@ TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, Ser
   d.penetration_m = out_.contact.state == ContactState::Free ? 0.0 : length(in.sample.handle_m - out_.contact.proxy_m);
   d.stiffness_n_per_m = current_ ? current_->loop.gains().stiffness_n_per_m : 0.0;
   d.gains_transition = current_ && current_->loop.transition_active();
+  d.tour_phase = tour_phase_;
+  d.tour_id = tour_id_;
+  d.tour_curve = tour_curve_;
+  d.guide_force_n = guide_force_;
   d.section_count = 0;
   if (current_) {
     const auto& sec = current_->loop.solver().section().section();
