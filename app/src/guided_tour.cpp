@@ -13,19 +13,20 @@ TourParams tour_params_from(const config::Settings& s) {
   return p;
 }
 
-Vec2 TourPath::target_at(double t_s, std::size_t& cursor) const noexcept {
+TourPoint TourPath::at(double t_s, std::size_t& cursor) const noexcept {
   const std::size_t n = points.size();
-  if (n == 1 || t_s <= points.front().t_s) return points.front().target_m;
+  if (n == 1 || t_s <= points.front().t_s) return points.front();
   if (t_s >= points.back().t_s) {
     cursor = n - 1;
-    return points.back().target_m;
+    return points.back();
   }
   if (cursor >= n - 1) cursor = 0;
   while (cursor + 1 < n - 1 && points[cursor + 1].t_s <= t_s) ++cursor;
   const TourPoint& a = points[cursor];
   const TourPoint& b = points[cursor + 1];
   const double span = b.t_s - a.t_s;
-  return span > 0.0 ? lerp(a.target_m, b.target_m, (t_s - a.t_s) / span) : b.target_m;
+  const double f = span > 0.0 ? (t_s - a.t_s) / span : 1.0;
+  return {t_s, lerp(a.target_m, b.target_m, f), lerp(a.press_n, b.press_n, f)};
 }
 
 void VisitTouches::reset(int scene_id, int curve_count) {
@@ -108,20 +109,30 @@ Closest closest_on(const std::vector<Vec2>& pts, bool closed, Vec2 p) {
 /// Left unit normal of the segment a → b (the left normal of `fallback_dir` for a zero-length segment).
 Vec2 seg_normal(Vec2 a, Vec2 b, Vec2 fallback_dir) { return left_perp(normalized_or(b - a, fallback_dir)); }
 
-/// Unit normal at a vertex between the segments with normals n0 and n1: their bisector (n0 for a cusp).
-Vec2 vertex_normal(Vec2 n0, Vec2 n1) { return normalized_or(n0 + n1, n0); }
+/// Offset direction at a vertex between the segments with unit normals n0 and n1: their bisector, scaled
+/// by the miter factor 1 / cos(half the turn) (at most 2), so an offset along it lies the offset's distance
+/// from both segments' lines (n0 for a cusp).
+Vec2 vertex_normal(Vec2 n0, Vec2 n1) {
+  const Vec2 b = normalized_or(n0 + n1, n0);
+  return (1.0 / std::max(0.5, dot(b, n0))) * b;
+}
 
-/// Appends the polyline `pts` to `out` at `speed` [m/s]: its vertices and points in between no more than
-/// `step` [m] apart, each timed by its arc length from the last point of `out` (which is pts' start).
-void append_polyline(std::vector<TourPoint>& out, const std::vector<Vec2>& pts, double speed, double step) {
-  for (const Vec2& b : pts) {
+/// Appends the polyline `pts` (with its press force at each point) to `out` at `speed` [m/s]: its vertices
+/// and points in between no more than `step` [m] apart, each timed by its arc length from the last point
+/// of `out`, the press interpolated along each piece.
+void append_polyline(std::vector<TourPoint>& out, const std::vector<Vec2>& pts, const std::vector<Vec2>& press, double speed, double step) {
+  for (std::size_t k = 0; k < pts.size(); ++k) {
     const TourPoint last = out.back();
+    const Vec2 b = pts[k];
     const double len = distance(last.target_m, b);
-    if (len <= 1e-9) continue;
+    if (len <= 1e-9) {
+      out.back().press_n = press[k];
+      continue;
+    }
     const int pieces = std::max(1, static_cast<int>(std::ceil(len / step)));
     for (int i = 1; i <= pieces; ++i) {
       const double f = static_cast<double>(i) / pieces;
-      out.push_back({last.t_s + f * len / speed, lerp(last.target_m, b, f)});
+      out.push_back({last.t_s + f * len / speed, lerp(last.target_m, b, f), lerp(last.press_n, press[k], f)});
     }
   }
 }
@@ -191,7 +202,7 @@ std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_
   path.params = p;
   const double v = p.speed_m_per_s;
   // 1. Transit: minimum-jerk from the handle to the start point off the curve, mean speed v.
-  const Vec2 start = base.front() + (side * p.offset_m) * normal.front();
+  const Vec2 start = base.front() + (side * p.offset_m) * normalized_or(normal.front(), {0.0, 1.0});
   const double transit_len = distance(handle_m, start);
   const double T = std::max(transit_len / v, p.min_transit_s);
   const int steps = std::max(1, static_cast<int>(std::ceil(T / p.transit_sample_s)));
@@ -199,15 +210,44 @@ std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_
   for (int i = 0; i <= steps; ++i) {
     const double tau = static_cast<double>(i) / steps;
     const double s = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
-    path.points.push_back({tau * T, lerp(handle_m, start, s)});
+    path.points.push_back({tau * T, lerp(handle_m, start, s), {}});
   }
   path.outline_start_s = T;
-  // 2.–4. Approach across the wall, the outline press_m past the curve, the release to the handle's side.
-  std::vector<Vec2> rest;
-  rest.reserve(base.size() + 1);
-  for (std::size_t i = 0; i < base.size(); ++i) rest.push_back(base[i] - (side * p.press_m) * normal[i]);
-  rest.push_back(base.back() + (side * p.offset_m) * normal.back());
-  append_polyline(path.points, rest, v, p.sample_m);
+  // 2.–4. Onto the outline's track, round it with the press towards the wall (ramped in and out), the
+  // release to the start's offset.
+  // The track: the offset outline, densified to sample_m so the press ramps over press_ramp_m; inside a
+  // segment the press is along its normal, at a vertex along the bisector.
+  std::vector<Vec2> rest, press, press_dir;
+  std::vector<double> arc;
+  const double k_off = side * p.track_offset_m;
+  for (std::size_t i = 0; i < base.size(); ++i) {
+    if (i == 0) {
+      rest.push_back(base[0] + k_off * normal[0]);
+      press_dir.push_back(normalized_or(normal[0], {0.0, 1.0}));
+      arc.push_back(0.0);
+      continue;
+    }
+    const Vec2 a = rest.back(), b = base[i] + k_off * normal[i];
+    const double len = distance(a, b);
+    const int pieces = std::max(1, static_cast<int>(std::ceil(len / p.sample_m)));
+    const Vec2 seg_dir = left_perp(normalized_or(base[i] - base[i - 1], {1.0, 0.0}));
+    const Vec2 seg_n = dot(seg_dir, normal[i]) < 0.0 ? -seg_dir : seg_dir;  // the normals' orientation
+    for (int j = 1; j <= pieces; ++j) {
+      const double f = static_cast<double>(j) / pieces;
+      rest.push_back(lerp(a, b, f));
+      press_dir.push_back(j == pieces ? normalized_or(normal[i], seg_n) : seg_n);
+      arc.push_back(arc.back() + len / pieces);
+    }
+  }
+  const double total = arc.back();
+  press.reserve(rest.size() + 1);
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    const double ramp = p.press_ramp_m > 0.0 ? std::clamp(std::min(arc[i], total - arc[i]) / p.press_ramp_m, 0.0, 1.0) : 1.0;
+    press.push_back((-side * p.press_force_n * ramp) * press_dir[i]);
+  }
+  rest.push_back(base.back() + (side * p.offset_m) * normalized_or(normal.back(), {0.0, 1.0}));
+  press.push_back({});
+  append_polyline(path.points, rest, press, v, p.sample_m);
   return path;
 }
 

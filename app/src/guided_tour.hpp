@@ -13,15 +13,22 @@
 ///      mean; the mean is tour_speed, so it never goes faster than 2 × tour_speed. Walls are suspended
 ///      (the visitor is led through the air, over walls in the way).
 ///   2. approach: across the wall to the outline's first point, at tour_speed. Walls are on from here.
-///   3. outline: the shape's polyline offset press_m PAST the curve (on the side away from the handle),
-///      at tour_speed: the spring presses the handle lightly against the wall (at 300 N/m against an
-///      800 N/m wall, 1.5 mm gives ~0.4 mm of penetration and ~0.33 N), so the visitor feels the wall and
-///      hears its slide cues while being led round it. A closed shape is traced all the way round back to
-///      the start; an open one from its end nearer the handle to the far end.
-///   4. release: back off the wall to kTourOffsetM on the handle's side, at tour_speed; then the servo
-///      lets go (the guide force fades out over fade_s).
-/// (The issue's sketch put the outline 1.5 mm off the wall on the handle's side; the handle would then be
-/// led round in the air and never touch the shape. Pressing lightly past the wall keeps the contact.)
+///   3. outline: the target runs along the shape's outline track_offset_m (1 mm) off the curve on the
+///      handle's side, at tour_speed, and a force, press_force_n (0.6 N), pushes the handle onto the wall:
+///      along the wall's inward normal while the handle touches the shape (ServoCore takes it from the
+///      contact), else along the path's normal. Against the 300 N/m spring and the 800 N/m wall this rests
+///      the handle ~0.3 mm into the wall, so the visitor feels the wall and hears its slide cues while
+///      being led round it. The press grows in over the first press_ramp_m of the outline and fades over
+///      its last. A closed shape is traced all the way round back to the start; an open one from its end
+///      nearer the handle to the far end.
+///   4. release: back to offset_m on the handle's side, at tour_speed; then the servo lets go (the guide
+///      force fades out over fade_s).
+/// (The issue's sketch put the outline 1.5 mm off the wall on the handle's side with no press; the handle
+/// would then be led round in the air and never touch the shape. A target 1.5 mm past the wall was tried
+/// next and fails: with the walls' friction (μ_s 0.4) the handle sticks on the wall wherever the pull
+/// points mostly into it — round every convex corner — while the target runs on. A target outside pulls
+/// the handle round convex corners; the press, a force along the wall's normal where the handle is,
+/// keeps it on the wall without pulling it into a corner.)
 ///
 /// "Sensible order": always the nearest untouched shape from where the handle is (distance to its
 /// polyline), so repeated Guide presses walk the picture without long jumps. Specks are not toured: a
@@ -38,10 +45,12 @@
 
 namespace hk::app {
 
-/// One timed target of a tour: where the spring pulls the handle at time t_s after the tour was taken.
+/// One timed target of a tour: where the spring pulls the handle at time t_s after the tour was taken,
+/// and the force that presses it against the wall there.
 struct TourPoint {
   double t_s = 0.0;  ///< time since the tour started [s], increasing along the path
   Vec2 target_m;     ///< target of the guide spring [m], workspace frame
+  Vec2 press_n;      ///< force towards the wall [N] where the handle touches no wall (zero in the transit)
 };
 
 /// Tuning of the guided tour. Units in names. Defaults: the shipped settings ([haptics] tour_max_force_n,
@@ -53,9 +62,11 @@ struct TourParams {
   /// follower with ω ≈ 61 rad/s and ζ ≈ 0.7 (no overshoot worth feeling); it lags ~0.7 mm at 3 cm/s and
   /// saturates at max_force_n after 4 mm of error.
   double stiffness_n_per_m = 300.0;
-  double damping_n_s_per_m = 5.0;    ///< guide damping on the handle's velocity [N·s/m]
+  double damping_n_s_per_m = 5.0;    ///< guide damping on the handle's velocity relative to the target's [N·s/m]
   double offset_m = 0.0015;          ///< start and end points lie this far off the curve on the handle's side [m]
-  double press_m = 0.0015;           ///< the outline runs this far past the curve (into the wall) [m]
+  double track_offset_m = 0.001;     ///< the outline's targets lie this far off the curve on the handle's side [m]
+  double press_force_n = 0.6;        ///< force pressing the handle onto the wall along the outline [N]
+  double press_ramp_m = 0.002;       ///< the press grows in over this much of the outline's start and fades over its end [m]
   double sample_m = 0.0005;          ///< spacing of the outline's targets [m]
   double transit_sample_s = 0.005;   ///< spacing of the transit's targets [s]
   double min_transit_s = 0.2;        ///< the shortest transit [s] (a start right by the shape still eases in)
@@ -89,10 +100,10 @@ struct TourPath {
   std::vector<TourPoint> points; ///< timed targets; points.front() is the handle at planning time, t = 0
   /// Time of the last point [s] (0 for an empty path).
   double duration_s() const noexcept { return points.empty() ? 0.0 : points.back().t_s; }
-  /// The target at time t [s], linear between points, clamped to the ends. `cursor` is the index of the
-  /// segment used last (start at 0); t must not decrease between calls with the same cursor. Real-time
-  /// safe; amortised O(1). Requires a non-empty path.
-  Vec2 target_at(double t_s, std::size_t& cursor) const noexcept;
+  /// The target and press at time t [s], linear between points, clamped to the ends. `cursor` is the
+  /// index of the segment used last (start at 0); t must not decrease between calls with the same cursor.
+  /// Real-time safe; amortised O(1). Requires a non-empty path.
+  TourPoint at(double t_s, std::size_t& cursor) const noexcept;
 };
 
 /// The shapes touched in this visit of this picture (issue 14: "the kiosk keeps what was touched per

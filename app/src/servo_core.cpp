@@ -1,6 +1,7 @@
 #include "servo_core.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace hk::app {
 
@@ -71,6 +72,9 @@ void ServoCore::tour_before_update(const DeviceSample& sample) noexcept {
         tour_hold_ticks_ = 0;
         tour_fade_ticks_ = std::max(1L, static_cast<long>(next->params.fade_s / period + 0.5));
         tour_fade_left_ = 0;
+        tour_prev_handle_ = sample.handle_m;
+        tour_prev_target_ = next->points.front().target_m;
+        tour_velocity_ = tour_hold_velocity_ = tour_press_ = {0.0, 0.0};
       }
     }
   }
@@ -89,10 +93,38 @@ void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
   const TourParams& p = tour_->params;
   const double period = current_->loop.params().period_s;
   const Vec2 h = sample.handle_m;
-  const Vec2 v = out_.handle_velocity_m_per_s;
-  const Vec2 target = tour_->target_at(tour_t_s_, tour_cursor_);
+  // The handle's velocity through two low-passes of its own (the servo loop's 100 Hz one passes the
+  // encoder's steps: ~38 µm in one tick is 38 mm/s raw): kTourVelocityHz for the damping, kHoldVelocityHz
+  // to tell a handle held still.
+  const Vec2 raw_v = (1.0 / period) * (h - tour_prev_handle_);
+  tour_prev_handle_ = h;
+  const double a_v = 1.0 - std::exp(-2.0 * M_PI * kTourVelocityHz * period);
+  const double a_h = 1.0 - std::exp(-2.0 * M_PI * kHoldVelocityHz * period);
+  tour_velocity_ = tour_velocity_ + a_v * (raw_v - tour_velocity_);
+  tour_hold_velocity_ = tour_hold_velocity_ + a_h * (raw_v - tour_hold_velocity_);
+  const Vec2 v = tour_velocity_;
+  TourPoint here = tour_->at(tour_t_s_, tour_cursor_);
+  // The press goes along the wall's inward normal where the handle touches the shape (so it never pushes
+  // along the wall the handle is on, into a corner), else along the path's.
+  const double press_len = length(here.press_n);
+  if (press_len > 0.0 && out_.contact.state != ContactState::Free && out_.contact.constraint[0].curve == tour_->curve) {
+    Vec2 a, b;
+    current_->scene->segment(out_.contact.constraint[0], &a, &b);
+    Vec2 n = left_perp(normalized_or(b - a, {1.0, 0.0}));
+    if (dot(out_.contact.proxy_m - a, n) < 0.0) n = -n;  // outward: the proxy's side
+    here.press_n = -press_len * n;
+  }
+  // Low-passed, so contact beginning or ending and the polyline's vertices turn it smoothly.
+  const double a_p = 1.0 - std::exp(-2.0 * M_PI * kPressHz * period);
+  tour_press_ = tour_press_ + a_p * (here.press_n - tour_press_);
+  here.press_n = tour_press_;
+  const Vec2 target = here.target_m;
+  const Vec2 target_v = (1.0 / period) * (target - tour_prev_target_);
+  tour_prev_target_ = target;
   const Vec2 e = target - h;
-  Vec2 f = p.stiffness_n_per_m * e - p.damping_n_s_per_m * v;
+  // A spring to the target, damping of the velocity relative to the target's (PD tracking) and the press
+  // towards the wall.
+  Vec2 f = p.stiffness_n_per_m * e + p.damping_n_s_per_m * (target_v - v) + here.press_n;
   const double f_len = length(f);
   if (f_len > p.max_force_n) f = (p.max_force_n / f_len) * f;
   double gain = std::min(1.0, static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_));  // fade in
@@ -101,14 +133,17 @@ void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
     out_.force_n = std::max(0.0, 1.0 - static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_)) * out_.force_n;
   if (tour_ending_ == TourPhase::None && out_.result == TickResult::Ok) {
     // Held still against it: the force at its limit and the handle (nearly) not moving, for hold_s.
-    const bool held = f_len >= 0.95 * p.max_force_n && length(v) < p.hold_speed_m_per_s;
+    // (or the path's clock stopped: the handle does not keep up) while the handle barely moves.
+    const Vec2 pull = p.stiffness_n_per_m * e + here.press_n;
+    const bool keeping_up = length(pull) < p.max_force_n;
+    const bool held = (f_len >= 0.95 * p.max_force_n || !keeping_up) && length(tour_hold_velocity_) < p.hold_speed_m_per_s;
     tour_hold_ticks_ = held ? tour_hold_ticks_ + 1 : 0;
     if (static_cast<double>(tour_hold_ticks_) * period >= p.hold_s) {
       tour_ending_ = TourPhase::Stopped;
       tour_fade_left_ = tour_fade_ticks_;
     }
     // The path's clock runs while the handle keeps up (within the spring's saturation distance).
-    if (tour_ending_ == TourPhase::None && length(e) * p.stiffness_n_per_m < p.max_force_n) tour_t_s_ += period;
+    if (tour_ending_ == TourPhase::None && keeping_up) tour_t_s_ += period;
     if (tour_phase_ == TourPhase::Transit && tour_t_s_ >= tour_->outline_start_s) {
       tour_phase_ = TourPhase::Outline;
       if (cues_) {

@@ -28,14 +28,16 @@
 /// The guided tour (issue 14, item 3; guided_tour.hpp): publish_tour() hands a planned TourPath to the
 /// servo thread as publish() hands a picture (one atomic exchange; the path the servo let go of goes back
 /// through a ring and is freed by collect_retired()). Each tick of a tour the target is read off the path
-/// and the guide force is F_g = k_g·(target − handle) − b_g·(handle velocity), clamped in length to
-/// TourParams::max_force_n; it fades in and out over fade_s. The command is the walls' force (after the
+/// and the guide force is F_g = k_g·(target − handle) + b_g·(target velocity − handle velocity) + press
+/// (the handle's velocity low-passed at 30 Hz: encoder steps are noise to a damper; press: the path's force
+/// onto the wall along the outline, turned along the inward normal of the wall segment the handle touches
+/// when it touches the shape, low-passed at 10 Hz so it turns smoothly), clamped in length to TourParams::max_force_n; it fades in and out over fade_s. The command is the walls' force (after the
 /// guard) plus F_g, clamped to the guard's max_force_n. During the transit the walls are suspended: they
 /// fade out over fade_s, then the proxy is put at the handle every tick (ServoLoop::relocate); from the
-/// outline on they are on. The path's clock runs only while the handle is within max_force_n / k_g of the
-/// target, so a held handle is not left behind by a target running away; the tour stops (force faded out)
-/// at cancel_tour(), when the hand holds still against it (guide force at ≥ 95 % of its limit while the
-/// handle moves slower than hold_speed_m_per_s, for hold_s), when the device is not Ok or the sample not
+/// outline on they are on. The path's clock runs only while |spring + press| stays below max_force_n, so a held handle is not left behind by a target running away; the tour stops (force faded out)
+/// at cancel_tour(), when the hand holds still against it (guide force at ≥ 95 % of its limit, or the
+/// clock stopped, while the handle, its velocity low-passed at 5 Hz, moves slower than
+/// hold_speed_m_per_s, for hold_s), when the device is not Ok or the sample not
 /// finite (at once), or when the picture changes. A TourStart cue marks the outline's start.
 
 #include <atomic>
@@ -197,6 +199,12 @@ class ServoCore {
   long tour_fade_left_ = 0;                            // while ending: ticks of fade left
   long tour_hold_ticks_ = 0;                           // consecutive ticks "held still against it"
   Vec2 guide_force_;                                   // this tick's guide force [N]
+  Vec2 tour_prev_handle_, tour_prev_target_;           // last tick's handle and target [m]
+  Vec2 tour_velocity_, tour_hold_velocity_;            // the handle's velocity, low-passed [m/s]
+  static constexpr double kTourVelocityHz = 30.0;      // low-pass of the guide's damping velocity [Hz]
+  static constexpr double kHoldVelocityHz = 5.0;       // low-pass of the "held still" velocity [Hz]
+  static constexpr double kPressHz = 10.0;             // low-pass of the press force's direction changes [Hz]
+  Vec2 tour_press_;                                    // the press force, low-passed [N]
   std::int64_t tick_ = 0;
 };
 

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -70,27 +71,41 @@ TEST(TourPlanner, StartsOffTheCurveOnTheHandlesSideAndPressesPastItRoundAClosedS
     EXPECT_EQ(plan->curve, 0);
     EXPECT_EQ(plan->scene_id, 1);
     std::size_t cur = 0;
-    EXPECT_LT(distance(plan->target_at(0.0, cur), handle), 1e-12) << "the path starts at the handle";
+    EXPECT_LT(distance(plan->at(0.0, cur).target_m, handle), 1e-12) << "the path starts at the handle";
     cur = 0;
-    const Vec2 start = plan->target_at(plan->outline_start_s, cur);
+    const Vec2 start = plan->at(plan->outline_start_s, cur).target_m;
     EXPECT_NEAR(dist_to_level0(sc, 0, start), p.offset_m, 1e-4);
     EXPECT_EQ(inside(sq, start), handle_inside) << "the start point is on the handle's side";
-    // The outline: every target past the wall (the other side), ~press_m from it; back to where it began.
+    // The outline: every target track_offset_m off the curve on the handle's side, pressed towards the
+    // other side; back to where it began.
     int outline = 0;
     Vec2 first{}, last{};
     for (const TourPoint& tp : plan->points) {
-      if (tp.t_s <= plan->outline_start_s + p.offset_m / p.speed_m_per_s + 0.02 || tp.t_s >= plan->duration_s() - 0.1) continue;
-      EXPECT_NE(inside(sq, tp.target_m), handle_inside) << "t " << tp.t_s;
-      EXPECT_LT(dist_to_level0(sc, 0, tp.target_m), p.press_m + 1e-4);
-      EXPECT_GT(dist_to_level0(sc, 0, tp.target_m), 0.5 * p.press_m);  // corners shrink the offset by cos(45°)
-      if (outline++ == 0) first = tp.target_m;
-      last = tp.target_m;
+      if (tp.t_s <= plan->outline_start_s + 1e-9 || tp.t_s >= plan->duration_s() - 1e-9) continue;
+      const double d = dist_to_level0(sc, 0, tp.target_m);
+      EXPECT_LT(d, p.offset_m + 1e-6) << "t " << tp.t_s;  // the track, or the 0.5 mm steps onto it and off it
+      EXPECT_GT(d, p.track_offset_m - 1e-6) << "t " << tp.t_s;
+      EXPECT_EQ(inside(sq, tp.target_m), handle_inside) << "t " << tp.t_s;
+      EXPECT_LE(length(tp.press_n), p.press_force_n + 1e-9);
+      if (length(tp.press_n) > 0.5 * p.press_force_n) {
+        ++outline;
+        const Vec2 pushed = tp.target_m + (0.003 / length(tp.press_n)) * tp.press_n;
+        double to_corner = 1.0;
+        for (const Vec2& c : sq) to_corner = std::min(to_corner, distance(c, tp.target_m));
+        if (to_corner > 0.003) {  // (by a corner, pushing 3 mm along an edge's normal can miss the square)
+          EXPECT_NE(inside(sq, pushed), handle_inside) << "t " << tp.t_s << ": the press points away from the handle's side";
+        }
+        if (first == Vec2{}) first = tp.target_m;
+        last = tp.target_m;
+      }
     }
     EXPECT_GT(outline, 100);
-    EXPECT_LT(distance(first, last), 0.002) << "a closed shape is traced all the way round";
+    EXPECT_LT(distance(first, last), 0.003) << "a closed shape is traced all the way round (the press ramps over 2 mm at each end)";
     // Let go off the wall on the handle's side.
     EXPECT_EQ(inside(sq, plan->points.back().target_m), handle_inside);
     EXPECT_NEAR(dist_to_level0(sc, 0, plan->points.back().target_m), p.offset_m, 1e-4);
+    EXPECT_EQ(length(plan->points.back().press_n), 0.0) << "no press when it lets go";
+    EXPECT_EQ(length(plan->points.front().press_n), 0.0) << "no press in the transit";
   }
 }
 
@@ -103,7 +118,7 @@ TEST(TourPlanner, AnOpenCurveGoesFromItsNearerEndToTheFarEnd) {
   const auto plan = plan_tour(sc, 1, {0.03, 0.004}, none, TourParams{});
   ASSERT_TRUE(plan.has_value());
   std::size_t cur = 0;
-  const Vec2 start = plan->target_at(plan->outline_start_s, cur);
+  const Vec2 start = plan->at(plan->outline_start_s, cur).target_m;
   EXPECT_NEAR(start.x, 0.02, 0.001) << "starts at the right end, the one nearer the handle";
   EXPECT_GT(start.y, 0.0) << "on the handle's side";
   const Vec2 end = plan->points.back().target_m;
@@ -187,6 +202,7 @@ struct TourRig {
   // Per tick checks and records.
   double max_guide_n = 0.0, max_total_n = 0.0, max_guide_step_n = 0.0;
   Vec2 last_guide;
+  std::vector<Vec2> guides;  // every tick's guide force [N]
   int tour_starts = 0;
   std::vector<int> tour_start_curves;
 
@@ -210,6 +226,7 @@ struct TourRig {
     max_total_n = std::max(max_total_n, length(cmd.force_n));
     max_guide_step_n = std::max(max_guide_step_n, length(g - last_guide));
     last_guide = g;
+    guides.push_back(g);
     const Vec2 hand = hand_stiff ? model_hand_force(stiff_hand, hand_target, device.true_position_m(), device.velocity_m_per_s()) : Vec2{};
     device.step(sp.period_s, hand);
     audio::CueEvent e;
@@ -224,6 +241,12 @@ struct TourRig {
     for (long k = 0, n = static_cast<long>(seconds / sp.period_s + 0.5); k < n; ++k) tick();
   }
   Vec2 handle() { return device.read().handle_m; }
+  /// Largest change of the guide force from one tick to the next over the last `n` ticks [N].
+  double max_step_last(long n) const {
+    double m = 0.0;
+    for (std::size_t i = guides.size() - static_cast<std::size_t>(n); i < guides.size(); ++i) m = std::max(m, length(guides[i] - guides[i - 1]));
+    return m;
+  }
 };
 
 /// The five-shape picture's scene (built through the image pipeline from a PNG written here).
@@ -279,8 +302,13 @@ TEST(GuidedTour, RepeatedGuideReachesEachOfFiveShapesOnceNearestFirstWithinItsFo
         touched_now.insert(d.curve);
         if (d.tour_phase == TourPhase::Outline && d.curve == curve) ++outline_contact;
       }
+      if (std::getenv("HK_TOUR_DEBUG") && ticks % 50 == 0)
+        std::printf("press %d t %ld phase %d handle %.4f %.4f guide %.3f %.3f curve %d level %d state %d\n", press, ticks, static_cast<int>(d.tour_phase),
+                    d.handle_m.x, d.handle_m.y, d.guide_force_n.x, d.guide_force_n.y, d.curve, d.level, static_cast<int>(d.state));
       if (d.tour_id == press && (d.tour_phase == TourPhase::Done || d.tour_phase == TourPhase::Stopped)) break;
-      ASSERT_LT(ticks, 60000) << "press " << press << ": the tour did not end within 60 s";
+      ASSERT_LT(ticks, 60000) << "press " << press << ": the tour did not end within 60 s; phase " << static_cast<int>(d.tour_phase)
+                              << " handle " << d.handle_m.x << ", " << d.handle_m.y << " guide " << d.guide_force_n.x << ", "
+                              << d.guide_force_n.y << " contact " << d.curve << " level " << d.level;
     }
     EXPECT_EQ(r.core.display().tour_phase, TourPhase::Done) << "press " << press;
     total_s += static_cast<double>(ticks) * r.sp.period_s;
@@ -323,9 +351,12 @@ TEST(GuidedTour, AHandHoldingStillAgainstItStopsItWithinASecondAndTheForceFades)
   EXPECT_GT(r.max_guide_n, 0.95 * r.tp.max_force_n) << "it pulled at its limit against the hand";
   EXPECT_LE(r.max_guide_n, r.tp.max_force_n + 1e-9);
   EXPECT_EQ(length(r.core.last_guide_force()), 0.0);
-  // Faded, not cut: no tick changed the guide force by more than the limit over the fade's ticks (+ the
-  // spring's own change as the handle gives a little).
-  EXPECT_LE(r.max_guide_step_n, r.tp.max_force_n * r.sp.period_s / r.tp.fade_s + 0.01);
+  // Faded from its limit, not cut (a cut would change it by > 1 N in one tick): over the fade no tick
+  // changed it by more than 0.1 N (the fade's own 1.2 N / 50 ticks plus the spring's and damper's change
+  // as the handle gives a little and the encoder steps).
+  const long fade = static_cast<long>(r.tp.fade_s / r.sp.period_s + 0.5);
+  EXPECT_GT(length(r.guides[r.guides.size() - static_cast<std::size_t>(fade) - 2]), 0.9 * r.tp.max_force_n);
+  EXPECT_LE(r.max_step_last(fade + 2), 0.1);
   EXPECT_LT(distance(r.handle(), r.hand_target), 0.002) << "the hand kept the handle";
 }
 
@@ -339,9 +370,11 @@ TEST(GuidedTour, AKeyStopsItAndTheForceFadesOut) {
   ASSERT_TRUE(plan.has_value());
   plan->id = 3;
   r.core.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
-  r.run(0.4);
-  EXPECT_EQ(r.core.display().tour_phase, TourPhase::Transit);
-  EXPECT_GT(length(r.core.last_guide_force()), 0.01) << "pulling when the key comes";
+  for (long k = 0; k < 20000 && r.core.display().tour_phase != TourPhase::Outline; ++k) r.tick();
+  r.run(0.5);
+  ASSERT_EQ(r.core.display().tour_phase, TourPhase::Outline);
+  const double at_key = length(r.core.last_guide_force());
+  EXPECT_GT(at_key, 0.15) << "pressing on the wall when the key comes";
   r.core.cancel_tour();
   const long fade = static_cast<long>(r.tp.fade_s / r.sp.period_s + 0.5);
   long ticks = 0;
@@ -350,8 +383,8 @@ TEST(GuidedTour, AKeyStopsItAndTheForceFadesOut) {
   EXPECT_EQ(r.core.display().tour_id, 3);
   EXPECT_LE(ticks, fade + 1);
   EXPECT_EQ(length(r.core.last_guide_force()), 0.0);
-  EXPECT_LE(r.max_guide_step_n, r.tp.max_force_n * r.sp.period_s / r.tp.fade_s + 0.01);
-  EXPECT_EQ(r.tour_starts, 0) << "stopped in the transit: no outline";
+  EXPECT_LE(r.max_step_last(ticks), 0.5 * at_key) << "faded, not cut";
+  EXPECT_EQ(r.tour_starts, 1);
 }
 
 TEST(GuidedTour, ATourForAnotherPictureIsDropped) {
