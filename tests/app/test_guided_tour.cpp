@@ -19,6 +19,7 @@
 #include "guided_tour.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "image_scene.hpp"
+#include "kiosk_runtime.hpp"
 #include "kiosk_flow.hpp"
 #include "servo_core.hpp"
 #include "simulation.hpp"
@@ -435,6 +436,98 @@ TEST(GuidedTour, TheFlowSendsGuideAndTellsOfEveryKey) {
   flow.key(KioskKey::Describe, 4.0);
   EXPECT_EQ(fx.guides, 2);
   EXPECT_EQ(fx.keys, 6) << "every key after the wake is reported (a running tour stops)";
+}
+
+}  // namespace
+}  // namespace hk::app
+
+// ── The kiosk runtime, its servo core stepped by hand (no servo thread, no sleeps) ─────────────────────
+namespace hk::app {
+namespace {
+
+struct RuntimeRig {
+  fs::path dir = fs::temp_directory_path() / ("hk_tour_rt_" + std::to_string(::getpid()));
+  config::Settings s;
+  std::unique_ptr<KioskRuntime> rt;
+  RuntimeRig() {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    EXPECT_TRUE(test::write_five_shapes_png((dir / "five.png").string()));
+    RuntimeOptions ro;
+    ro.library = dir.string();
+    ro.hotplug = false;
+    ro.open_audio_output = false;
+    ro.probe_usb_device = false;
+    rt = std::make_unique<KioskRuntime>(ro, s);
+  }
+  ~RuntimeRig() {
+    rt.reset();
+    fs::remove_all(dir);
+  }
+  /// What the servo thread does, with the limp model hand the runtime asks for during a tour (no hand
+  /// force: the cursor is not moved in these tests), then the window thread's poll.
+  void run(double seconds) {
+    auto& sim = dynamic_cast<SimulatedPantograph&>(rt->device());
+    const double dt = 1.0 / s.haptics.servo_rate_hz;
+    for (long k = 0, n = static_cast<long>(seconds / dt + 0.5); k < n; ++k) {
+      ServoCommand cmd;
+      rt->core().step(sim.read(), false, cmd);
+      rt->core().publish_display();
+      sim.write_force(cmd.force_n);
+      sim.step(dt, {});
+      rt->collect();
+      if (k % 16 == 0) rt->poll_tour();  // a frame
+    }
+    rt->poll_tour();
+  }
+  std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) { return audio::MessageCatalog::english().text(id, args); }
+};
+
+TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) {
+  RuntimeRig r;
+  ASSERT_EQ(r.rt->show_picture(0), 5);
+  r.run(0.6);
+  r.rt->key_pressed();
+  r.rt->guide();
+  ASSERT_TRUE(r.rt->tour_running()) << r.rt->last_said();
+  r.run(12.0);
+  EXPECT_FALSE(r.rt->tour_running());
+  EXPECT_EQ(r.rt->touches().count(), 1);
+  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}}));
+  // A key during the next tour stops it, quietly; the Guide key stopping it says so.
+  r.rt->key_pressed();
+  r.rt->guide();
+  r.run(0.5);
+  r.rt->key_pressed();  // e.g. Describe: its own answer is what the visitor hears
+  r.run(0.2);
+  EXPECT_FALSE(r.rt->tour_running());
+  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}})) << "nothing said of a tour a key stopped";
+  r.rt->key_pressed();
+  r.rt->guide();
+  r.run(0.5);
+  r.rt->key_pressed();
+  r.rt->guide();  // the Guide key again: stops it
+  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_stopped));
+  r.run(0.2);
+  EXPECT_FALSE(r.rt->tour_running());
+  // The rest, one Guide after another.
+  // (A shape may be touched on the way to another: then fewer tours are needed.)
+  for (int tours = 0; tours < 4 && r.rt->touches().count() < 5; ++tours) {
+    r.rt->key_pressed();
+    r.rt->guide();
+    ASSERT_TRUE(r.rt->tour_running()) << tours;
+    for (int i = 0; i < 40 && r.rt->tour_running(); ++i) r.run(0.5);
+    EXPECT_FALSE(r.rt->tour_running());
+  }
+  EXPECT_EQ(r.rt->touches().count(), 5);
+  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_all_touched));
+  r.rt->key_pressed();
+  r.rt->guide();
+  EXPECT_FALSE(r.rt->tour_running());
+  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_all_touched));
+  // A new visitor: nothing touched.
+  r.rt->new_session();
+  EXPECT_EQ(r.rt->touches().count(), 0);
 }
 
 }  // namespace

@@ -96,7 +96,8 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   EXPECT_EQ(fx.said.back(),
             "Move the handle slowly to feel the outlines. Press the Right arrow for the next picture and the Left arrow for the one "
             "before. Press the Up arrow for more detail and the Down arrow for less. Press the D key to hear what the picture "
-            "holds. Press Page Up for louder and Page Down for quieter. Press the T key to practise with the shapes again, and F1 "
+            "holds. Press Page Up for louder and Page Down for quieter. Press the G key to be led to a shape you have not touched "
+            "yet. Press the T key to practise with the shapes again, and F1 "
             "to hear this again.")
       << "the help names the shipped keys";
   flow.key(KioskKey::Finer, 54.0);
