@@ -6,8 +6,9 @@
 // with it (as the kiosk counts) or its tour is done.
 //
 //   build/bench/bench_tour_time [picture ...]     (no argument: the five-shape picture and three others)
-// Prints one row per picture: shapes, tours, total time, time per shape, the longest tour, the peak guide
-// force and the peak total force.
+// Prints one row per picture: shapes, tours, tours stopped (the hand is relaxed, so a stop means the
+// tour could not go on: the handle held by another shape's wall), total time, time per shape, the longest
+// tour, the peak guide force and the peak total force; and on stderr a line per stopped tour.
 #include <unistd.h>
 
 #include <algorithm>
@@ -69,14 +70,19 @@ Row run(const std::string& name, const std::string& path, const config::Settings
     const int curve = plan->curve;
     core.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
     long ticks = 0;
+    int last_contact = -1;
     for (;; ++ticks) {
       tick();
       const ServoDisplayState& d = core.display();
       if (d.curve >= 0) touches.touch(1, d.curve);
       if (d.tour_id == id && (d.tour_phase == TourPhase::Done || d.tour_phase == TourPhase::Stopped)) {
         row.stopped += d.tour_phase == TourPhase::Stopped;
+        if (d.tour_phase == TourPhase::Stopped)
+          std::fprintf(stderr, "%s: tour %d to shape %d (%.1f mm long) stopped after %.2f s: handle (%.1f, %.1f) mm, in contact with %d\n", name.c_str(), id,
+                       curve, 1000 * curve_length_m(sc, static_cast<std::size_t>(curve)), ticks * sp.period_s, 1000 * d.handle_m.x, 1000 * d.handle_m.y, last_contact);
         break;
       }
+      if (d.curve >= 0) last_contact = d.curve;
     }
     touches.touch(1, curve);
     core.collect_retired();
