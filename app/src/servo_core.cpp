@@ -78,8 +78,16 @@ void ServoCore::tour_before_update(const DeviceSample& sample) noexcept {
       }
     }
   }
-  // Walls suspended in the transit once they have faded out: the proxy goes with the handle.
-  if (tour_ && tour_phase_ == TourPhase::Transit && tour_ticks_ >= tour_fade_ticks_ && is_finite(sample.handle_m))
+  // Walls suspended in the transit once they have faded out: the proxy goes with the handle. In the
+  // outline only the toured shape is a wall: a contact (last tick) with other shapes only, met one tick
+  // before at one tick's depth, is let go of, so a neighbouring outline never holds the handle back.
+  bool other_walls_only = false;
+  if (tour_ && tour_phase_ == TourPhase::Outline && out_.contact.state != ContactState::Free) {
+    const int n = out_.contact.state == ContactState::Vertex ? 2 : 1;
+    other_walls_only = true;
+    for (int i = 0; i < n; ++i) other_walls_only = other_walls_only && out_.contact.constraint[i].curve != tour_->curve;
+  }
+  if (tour_ && ((tour_phase_ == TourPhase::Transit && tour_ticks_ >= tour_fade_ticks_) || other_walls_only) && is_finite(sample.handle_m))
     current_->loop.relocate(sample.handle_m);
 }
 

@@ -34,7 +34,10 @@
 /// when it touches the shape, low-passed at 10 Hz so it turns smoothly), clamped in length to TourParams::max_force_n; it fades in and out over fade_s. The command is the walls' force (after the
 /// guard) plus F_g, clamped to the guard's max_force_n. During the transit the walls are suspended: they
 /// fade out over fade_s, then the proxy is put at the handle every tick (ServoLoop::relocate); from the
-/// outline on they are on. The path's clock runs only while |spring + press| stays below max_force_n, so a held handle is not left behind by a target running away; the tour stops (force faded out)
+/// outline on the toured shape is a wall, and a contact with other shapes only is let go of at the next
+/// tick (relocate again: one tick's depth, a few hundredths of a newton), so a neighbouring outline never
+/// holds the handle back. The path's clock runs only while |spring + press| stays below max_force_n, so
+/// a held handle is not left behind by a target running away; the tour stops (force faded out)
 /// at cancel_tour(), when the hand holds still against it (guide force at ≥ 95 % of its limit, or the
 /// clock stopped, while the handle, its velocity low-passed at 5 Hz, moves slower than
 /// hold_speed_m_per_s, for hold_s), when the device is not Ok or the sample not
