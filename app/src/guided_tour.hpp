@@ -7,12 +7,13 @@
 /// force-limited spring.
 ///
 /// The path, as a flat list of timed targets (TourPath::points, built here, read by the servo thread):
-///   1. transit: from the handle to a start point kTourOffsetM off the shape on the handle's side, in a
+///   1. transit: from the handle to a start point offset_m (1.5 mm) off the shape on the handle's side, in a
 ///      straight line with a minimum-jerk time law (Flash & Hogan 1985, "The coordination of arm
 ///      movements", J. Neurosci. 5(7)): it starts and ends at rest and its peak speed is 1.875 times its
 ///      mean; the mean is tour_speed, so it never goes faster than 2 × tour_speed. Walls are suspended
 ///      (the visitor is led through the air, over walls in the way).
-///   2. approach: across the wall to the outline's first point, at tour_speed. Walls are on from here.
+///   2. onto the track: 0.5 mm from the start point to the outline's track, at tour_speed; walls are on
+///      from here (only the toured shape's: ServoCore lets go of contacts with other shapes).
 ///   3. outline: the target runs along the shape's outline track_offset_m (1 mm) off the curve on the
 ///      handle's side, at tour_speed, and a force, press_force_n (0.6 N), pushes the handle onto the wall:
 ///      along the wall's inward normal while the handle touches the shape (ServoCore takes it from the
