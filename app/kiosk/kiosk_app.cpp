@@ -254,6 +254,7 @@ int run_kiosk(const KioskOptions& o) {
     const bool holding = scripted && script.step(frame, kiosk);
     if (!scripted) kiosk.follow_mouse();
     kiosk.watch_handle();
+    rt.poll_tour();
     flow.tick(kiosk.now_s_);
     session.tick(kiosk.now_s_, unix_now_s());
     rt.collect();

@@ -18,7 +18,8 @@ const std::map<std::string, KioskKey>& action_names() {
                                                  {"previous", KioskKey::Previous}, {"describe", KioskKey::Describe},
                                                  {"finer", KioskKey::Finer},       {"coarser", KioskKey::Coarser},
                                                  {"volume_up", KioskKey::VolumeUp}, {"volume_down", KioskKey::VolumeDown},
-                                                 {"tutorial", KioskKey::Tutorial}, {"other", KioskKey::Other}};
+                                                 {"tutorial", KioskKey::Tutorial}, {"guide", KioskKey::Guide},
+                                                 {"other", KioskKey::Other}};
   return m;
 }
 

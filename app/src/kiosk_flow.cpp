@@ -84,7 +84,11 @@ void KioskFlow::key(KioskKey k, double now_s) {
   }
   last_activity_s_ = now_s;
   warned_ = false;
+  fx_.key_pressed();
   switch (k) {
+    case KioskKey::Guide:
+      fx_.guide();
+      return;
     case KioskKey::Help:
       say(MessageId::help);
       return;

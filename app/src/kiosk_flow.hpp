@@ -4,7 +4,8 @@
 /// it can be driven by scripted input in tests:
 ///   Attract   — waiting; the first key press or handle motion speaks the welcome and starts the tutorial;
 ///   Tutorial  — a square, a circle, a triangle (Next moves on); after the triangle, the first picture;
-///   Picture   — Next / Previous picture, Describe, Finer / Coarser level, Volume, Help, Tutorial again.
+///   Picture   — Next / Previous picture, Describe, Finer / Coarser level, Volume, Help, Tutorial again,
+///               Guide (the guided tour, also on the tutorial's shapes; any key stops a running tour).
 /// Every key press is answered in speech at once (the speech cuts off what was being said). With no key
 /// and no handle motion for `timeout_s`, the kiosk warns `warning_s` ahead, then says goodbye, restores the
 /// operator's defaults and returns to Attract. Any key or motion extends the time.
@@ -31,7 +32,7 @@
 namespace hk::app {
 
 /// Keys a blind visitor can find (mapped to physical keys in the config by the window layer).
-enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Other };
+enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Guide, Other };
 
 /// States of the flow.
 enum class KioskState { Attract, Tutorial, Picture };
@@ -87,6 +88,13 @@ class KioskEffects {
   virtual void show_document(int document, int page) = 0;
   /// Drop the stick's listing (a new visitor must not browse the last one's stick).
   virtual void forget_stick() = 0;
+  /// Any key was pressed (before the flow acts on it): a guided tour that runs stops (issue 14, item 3).
+  /// Default: nothing.
+  virtual void key_pressed() {}
+  /// The Guide key (issue 14, item 3): lead the handle to the nearest shape not yet touched and round it,
+  /// or, when the press stopped a running tour (key_pressed), say so. What is said is up to the
+  /// implementation (the tour's end is reported later). Default: nothing.
+  virtual void guide() {}
 };
 
 /// The key placeholders of the catalogue ({help_key} … {tutorial_key}, audio::kKeyPlaceholders) paired with the

@@ -60,6 +60,7 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
   }
   cursor_.back() = sim_.true_position_m();
   cursor_.publish();
+  cursor_in_ = sim_.true_position_m();
   level_ = s.haptics.level;
   auto_level_ = s.haptics.level_mode == "auto";
   high_contrast_ = o.high_contrast;
@@ -81,8 +82,9 @@ void KioskRuntime::start_servo() {
     return;
   }
   servo_ = std::make_unique<ServoThread>(core_, sim_, tp, [this](double dt) {
-    // The simulated pantograph: the model hand pulls the handle towards the cursor.
-    const Vec2 target = cursor_.read();
+    // The simulated pantograph: the model hand pulls the handle towards the cursor (limp during a tour:
+    // it follows the handle, giving only its damping).
+    const Vec2 target = hand_limp_.load(std::memory_order_relaxed) ? sim_.true_position_m() : cursor_.read();
     sim_.step(dt, model_hand_force(hand_, target, sim_.true_position_m(), sim_.velocity_m_per_s()));
   });
 }
@@ -133,7 +135,9 @@ void KioskRuntime::open_emulated_board(const std::string& text) {
   board_ = std::make_unique<hapi::FirmwareEmulator>(
       emulator_params_from(s_, choice), (1.0 / scale) * cursor_.read() + centre,
       [this, scale, centre](double, Vec2 handle_device_m, Vec2 velocity_device_m_per_s) {
-        return model_hand_force(hand_, cursor_.read(), scale * (handle_device_m - centre), scale * velocity_device_m_per_s);
+        const Vec2 handle = scale * (handle_device_m - centre);
+        const Vec2 target = hand_limp_.load(std::memory_order_relaxed) ? handle : cursor_.read();
+        return model_hand_force(hand_, target, handle, scale * velocity_device_m_per_s);
       });
   board_pty_ = std::make_unique<hapi::PtyEmulator>(*board_);
   const std::string path = board_pty_->device_path();
@@ -325,11 +329,79 @@ void KioskRuntime::new_session() {
   auto_level_ = s_.haptics.level_mode == "auto";
   core_.request_level(auto_level_ ? ServoCore::kAutoLevel : level_);
   high_contrast_ = opt_.high_contrast;
+  if (tour_running_) {
+    core_.cancel_tour();
+    tour_quiet_ = true;
+  }
+  touches_.reset(shown_id_, shown_.scene ? static_cast<int>(shown_.scene->curve_count()) : 0);
+  cursor_offset_ = {};
 }
 
 void KioskRuntime::set_cursor(Vec2 m) {
-  cursor_.back() = m;
+  cursor_in_ = m;
+  if (tour_running_ && !tour_quiet_ && length(m - tour_cursor_ref_) > 0.003) {
+    core_.cancel_tour();  // the visitor's hand takes over
+    tour_quiet_ = true;
+    spdlog::info("tour: stopped by the hand");
+  }
+  const Vec2 c = m + cursor_offset_;
+  const bool offset = cursor_offset_.x != 0.0 || cursor_offset_.y != 0.0;
+  cursor_.back() = offset ? Vec2{std::clamp(c.x, -half_.x, half_.x), std::clamp(c.y, -half_.y, half_.y)} : m;
   cursor_.publish();
+}
+
+void KioskRuntime::key_pressed() {
+  guide_stops_ = tour_running_ != 0;
+  if (tour_running_) {
+    core_.cancel_tour();
+    tour_quiet_ = true;
+  }
+}
+
+void KioskRuntime::guide() {
+  if (guide_stops_) {
+    guide_stops_ = false;
+    say(audio_.messages().text(audio::MessageId::tour_stopped));
+    return;
+  }
+  if (!shown_.scene) return;
+  const TourParams tp = tour_params_from(s_);
+  std::optional<TourPath> plan = plan_tour(*shown_.scene, shown_id_, core_.display().handle_m, touches_, tp);
+  if (!plan) {
+    bool any_shape = false;
+    for (std::size_t c = 0; c < shown_.scene->curve_count(); ++c) any_shape = any_shape || is_tour_shape(*shown_.scene, c, tp);
+    say(audio_.messages().text(any_shape ? audio::MessageId::tour_all_touched : audio::MessageId::tour_nothing));
+    return;
+  }
+  plan->id = ++tour_seq_;
+  tour_running_ = plan->id;
+  tour_scene_ = shown_id_;
+  tour_quiet_ = false;
+  tour_cursor_ref_ = cursor_in_;
+  spdlog::info("tour {}: to shape {} ({:.1f} s)", plan->id, plan->curve, plan->duration_s());
+  hand_limp_.store(true, std::memory_order_relaxed);
+  core_.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
+}
+
+void KioskRuntime::poll_tour() {
+  const ServoDisplayState& d = core_.display();
+  if (d.scene_id == touches_.scene_id() && d.curve >= 0) touches_.touch(d.scene_id, d.curve);
+  if (!tour_running_ || d.tour_id != tour_running_ || (d.tour_phase != TourPhase::Done && d.tour_phase != TourPhase::Stopped)) return;
+  if (d.tour_phase == TourPhase::Done) touches_.touch(tour_scene_, d.tour_curve);
+  tour_running_ = 0;
+  // The hand lets go where the tour left the handle (unless the visitor's own hand took over).
+  if (hand_limp_.load(std::memory_order_relaxed)) {
+    if (!tour_quiet_ || length(cursor_in_ - tour_cursor_ref_) <= 0.003) cursor_offset_ = d.handle_m - cursor_in_;
+    set_cursor(cursor_in_);
+    hand_limp_.store(false, std::memory_order_relaxed);
+  }
+  if (tour_quiet_ || !shown_.scene || tour_scene_ != shown_id_) return;
+  const int left = shapes_remaining(*shown_.scene, touches_, tour_params_from(s_));
+  std::string text = d.tour_phase == TourPhase::Stopped ? audio_.messages().text(audio::MessageId::tour_stopped) + " " : std::string{};
+  if (left == 0) text += audio_.messages().text(audio::MessageId::tour_all_touched);
+  else if (left == 1) text += audio_.messages().text(audio::MessageId::tour_one_remaining);
+  else text += audio_.messages().text(audio::MessageId::tour_remaining, {{"count", std::to_string(left)}});
+  say(text);
 }
 
 int KioskRuntime::find_picture(const std::string& path) const {
@@ -367,6 +439,11 @@ void KioskRuntime::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::
   sh.scene = bundle->scene.get();
   shown_ = std::move(sh);
   shown_id_ = id;
+  touches_.reset(id, static_cast<int>(sc.curve_count()));  // touches are kept per picture
+  if (tour_running_) {
+    core_.cancel_tour();  // the servo stops it at the swap anyway; nothing to say of it
+    tour_quiet_ = true;
+  }
   core_.publish(std::move(bundle));
 }
 

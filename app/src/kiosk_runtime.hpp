@@ -26,6 +26,7 @@
 #include "haptics/io/usb_devices.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "haptics/triple_buffer.hpp"
+#include "guided_tour.hpp"
 #include "image_scene.hpp"
 #include "kiosk_flow.hpp"
 #include "servo_core.hpp"
@@ -118,6 +119,22 @@ class KioskRuntime final : public KioskEffects {
   bool change_level(int delta) override;
   bool change_volume(int delta) override;
   void new_session() override;
+  void key_pressed() override;
+  /// The Guide key: plans the tour from the handle to the nearest shape of the picture shown not yet
+  /// touched in this visit (plan_tour) and hands it to the servo thread; nothing left: says so
+  /// (tour_all_touched, or tour_nothing for a picture without shapes). A press that stopped a running tour
+  /// says tour_stopped instead. With the simulated pantograph the model hand goes limp while the tour runs
+  /// (it follows the handle), so the tour leads the handle.
+  void guide() override;
+  /// Window thread, every frame: keeps what the handle touches (the servo's contact curve) in this visit's
+  /// touches, and when the tour handed over has ended, says what remains ("3 shapes not yet touched.";
+  /// "Tour stopped. …" first when the hand held it back or the device was lost; nothing when a key or the
+  /// mouse stopped it, or a new picture or visitor came) and gives the handle back to the cursor where it is.
+  void poll_tour();
+  /// Whether a tour handed to the servo thread has not yet been reported ended (poll_tour).
+  bool tour_running() const { return tour_running_ != 0; }
+  /// The shapes touched in this visit of the picture shown.
+  const VisitTouches& touches() const { return touches_; }
 
   /// Window thread, every frame: news of sticks and finished loads, handed to the flow.
   void poll_sticks(KioskFlow& flow, double now_s);
@@ -137,7 +154,10 @@ class KioskRuntime final : public KioskEffects {
   /// The settings in use (the last applied).
   const config::Settings& settings() const { return s_; }
 
-  /// The model hand's target [m] (the mouse or a script stands in for the visitor's hand).
+  /// The model hand's target [m] (the mouse or a script stands in for the visitor's hand). After a guided
+  /// tour the hand keeps the place the tour led the handle to: later cursors are offset by it (until the
+  /// next visitor). While a tour runs, a cursor more than 3 mm from where it was at its start stops the
+  /// tour (the visitor's hand takes over).
   void set_cursor(Vec2 m);
   ServoCore& core() { return core_; }
   audio::AudioSystem& audio() { return audio_; }
@@ -204,6 +224,17 @@ class KioskRuntime final : public KioskEffects {
   int rebuild_page_id_ = 0; // a stick page re-requested by apply_settings (shown without a new announcement)
   int stick_id_ = 0;        // the stick the flow browses (StickNews::stick), 0 for none
   bool stick_busy_ = false;
+  // The guided tour (window thread but hand_limp_).
+  VisitTouches touches_;
+  int tour_seq_ = 0;           // TourPath::id of the last tour handed over
+  int tour_running_ = 0;       // its id until poll_tour sees it ended, else 0
+  int tour_scene_ = 0;         // the picture it was planned for
+  bool tour_quiet_ = false;    // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
+  bool guide_stops_ = false;   // this key press stopped a running tour
+  std::atomic<bool> hand_limp_{false};  // the model hand follows the handle (a tour leads it)
+  Vec2 cursor_in_;             // the last cursor given to set_cursor [m]
+  Vec2 cursor_offset_;         // added to it: where tours left the hand [m]
+  Vec2 tour_cursor_ref_;       // cursor_in_ when the tour was handed over [m]
   StickService sticks_;     // last: its threads stop first
 };
 

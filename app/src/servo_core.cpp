@@ -1,6 +1,7 @@
 #include "servo_core.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace hk::app {
 
@@ -11,6 +12,9 @@ ServoCore::~ServoCore() {
   delete pending_.exchange(nullptr);
   delete current_;
   delete to_retire_;
+  delete tour_pending_.exchange(nullptr);
+  delete tour_;
+  delete tour_to_retire_;
   collect_retired();
 }
 
@@ -25,7 +29,153 @@ int ServoCore::collect_retired() {
     delete b;
     ++n;
   }
+  TourPath* t = nullptr;
+  while (tour_retired_.try_pop(t)) delete t;
   return n;
+}
+
+void ServoCore::publish_tour(std::unique_ptr<TourPath> path) {
+  delete tour_pending_.exchange(path.release(), std::memory_order_acq_rel);
+}
+
+void ServoCore::end_tour(TourPhase how) noexcept {
+  tour_phase_ = how;
+  tour_ending_ = TourPhase::None;
+  if (tour_ && !tour_retired_.try_push(tour_)) tour_to_retire_ = tour_;  // step() takes no tour while this is set
+  tour_ = nullptr;
+}
+
+void ServoCore::tour_before_update(const DeviceSample& sample) noexcept {
+  if (tour_to_retire_ && tour_retired_.try_push(tour_to_retire_)) tour_to_retire_ = nullptr;
+  const bool cancel = tour_cancel_.exchange(false, std::memory_order_acq_rel);
+  const bool picture_changing = fading_ || !current_ || (tour_ && current_->id != tour_->scene_id);
+  if (tour_ && tour_ending_ == TourPhase::None && (cancel || picture_changing)) {
+    tour_ending_ = TourPhase::Stopped;
+    tour_fade_left_ = tour_fade_ticks_;
+  }
+  // A new tour waits while a picture is being swapped in (it may be for the new one), then is taken for
+  // the picture in use or dropped.
+  if (!tour_ && !tour_to_retire_ && current_ && !fading_) {
+    if (TourPath* next = tour_pending_.exchange(nullptr, std::memory_order_acq_rel)) {
+      tour_id_ = next->id;
+      tour_curve_ = next->curve;
+      tour_ = next;
+      if (current_->id != next->scene_id || next->points.empty()) {
+        end_tour(TourPhase::Stopped);  // for another picture: dropped
+      } else {
+        const double period = current_->loop.params().period_s;
+        tour_phase_ = TourPhase::Transit;
+        tour_ending_ = TourPhase::None;
+        tour_t_s_ = 0.0;
+        tour_cursor_ = 0;
+        tour_ticks_ = 0;
+        tour_hold_ticks_ = 0;
+        tour_fade_ticks_ = std::max(1L, static_cast<long>(next->params.fade_s / period + 0.5));
+        tour_fade_left_ = 0;
+        tour_prev_handle_ = sample.handle_m;
+        tour_prev_target_ = next->points.front().target_m;
+        tour_velocity_ = tour_hold_velocity_ = tour_press_ = {0.0, 0.0};
+      }
+    }
+  }
+  // Walls suspended in the transit once they have faded out: the proxy goes with the handle. In the
+  // outline only the toured shape is a wall: a contact (last tick) with other shapes only, met one tick
+  // before at one tick's depth, is let go of, so a neighbouring outline never holds the handle back.
+  bool other_walls_only = false;
+  if (tour_ && tour_phase_ == TourPhase::Outline && out_.contact.state != ContactState::Free) {
+    const int n = out_.contact.state == ContactState::Vertex ? 2 : 1;
+    other_walls_only = true;
+    for (int i = 0; i < n; ++i) other_walls_only = other_walls_only && out_.contact.constraint[i].curve != tour_->curve;
+  }
+  if (tour_ && ((tour_phase_ == TourPhase::Transit && tour_ticks_ >= tour_fade_ticks_) || other_walls_only) && is_finite(sample.handle_m))
+    current_->loop.relocate(sample.handle_m);
+}
+
+void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
+  guide_force_ = {0.0, 0.0};
+  if (!tour_) return;
+  if (out_.result == TickResult::DeviceNotOk || out_.result == TickResult::NonFinite) {
+    end_tour(TourPhase::Stopped);  // no force goes out anyway; the tour does not resume on its own
+    return;
+  }
+  const TourParams& p = tour_->params;
+  const double period = current_->loop.params().period_s;
+  const Vec2 h = sample.handle_m;
+  // The handle's velocity through two low-passes of its own (the servo loop's 100 Hz one passes the
+  // encoder's steps: ~38 µm in one tick is 38 mm/s raw): kTourVelocityHz for the damping, kHoldVelocityHz
+  // to tell a handle held still.
+  const Vec2 raw_v = (1.0 / period) * (h - tour_prev_handle_);
+  tour_prev_handle_ = h;
+  const double a_v = 1.0 - std::exp(-2.0 * M_PI * kTourVelocityHz * period);
+  const double a_h = 1.0 - std::exp(-2.0 * M_PI * kHoldVelocityHz * period);
+  tour_velocity_ = tour_velocity_ + a_v * (raw_v - tour_velocity_);
+  tour_hold_velocity_ = tour_hold_velocity_ + a_h * (raw_v - tour_hold_velocity_);
+  const Vec2 v = tour_velocity_;
+  TourPoint here = tour_->at(tour_t_s_, tour_cursor_);
+  // The press goes along the wall's inward normal where the handle touches the shape (so it never pushes
+  // along the wall the handle is on, into a corner), else along the path's.
+  const double press_len = length(here.press_n);
+  if (press_len > 0.0 && out_.contact.state != ContactState::Free && out_.contact.constraint[0].curve == tour_->curve) {
+    Vec2 a, b;
+    current_->scene->segment(out_.contact.constraint[0], &a, &b);
+    Vec2 n = left_perp(normalized_or(b - a, {1.0, 0.0}));
+    if (dot(out_.contact.proxy_m - a, n) < 0.0) n = -n;  // outward: the proxy's side
+    here.press_n = -press_len * n;
+  }
+  // Low-passed, so contact beginning or ending and the polyline's vertices turn it smoothly.
+  const double a_p = 1.0 - std::exp(-2.0 * M_PI * kPressHz * period);
+  tour_press_ = tour_press_ + a_p * (here.press_n - tour_press_);
+  here.press_n = tour_press_;
+  const Vec2 target = here.target_m;
+  const Vec2 target_v = (1.0 / period) * (target - tour_prev_target_);
+  tour_prev_target_ = target;
+  const Vec2 e = target - h;
+  // A spring to the target, damping of the velocity relative to the target's (PD tracking) and the press
+  // towards the wall.
+  Vec2 f = p.stiffness_n_per_m * e + p.damping_n_s_per_m * (target_v - v) + here.press_n;
+  const double f_len = length(f);
+  if (f_len > p.max_force_n) f = (p.max_force_n / f_len) * f;
+  double gain = std::min(1.0, static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_));  // fade in
+  // The walls: faded out over the first fade_s of the transit, then off (relocate); on from the outline.
+  if (tour_phase_ == TourPhase::Transit)
+    out_.force_n = std::max(0.0, 1.0 - static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_)) * out_.force_n;
+  if (tour_ending_ == TourPhase::None && out_.result == TickResult::Ok) {
+    // Held still against it: the force at its limit and the handle (nearly) not moving, for hold_s.
+    // (or the path's clock stopped: the handle does not keep up) while the handle barely moves.
+    const Vec2 pull = p.stiffness_n_per_m * e + here.press_n;
+    const bool keeping_up = length(pull) < p.max_force_n;
+    const bool held = (f_len >= 0.95 * p.max_force_n || !keeping_up) && length(tour_hold_velocity_) < p.hold_speed_m_per_s;
+    tour_hold_ticks_ = held ? tour_hold_ticks_ + 1 : 0;
+    if (static_cast<double>(tour_hold_ticks_) * period >= p.hold_s) {
+      tour_ending_ = TourPhase::Stopped;
+      tour_fade_left_ = tour_fade_ticks_;
+    }
+    // The path's clock runs while the handle keeps up (within the spring's saturation distance).
+    if (tour_ending_ == TourPhase::None && keeping_up) tour_t_s_ += period;
+    if (tour_phase_ == TourPhase::Transit && tour_t_s_ >= tour_->outline_start_s) {
+      tour_phase_ = TourPhase::Outline;
+      if (cues_) {
+        audio::CueEvent c;
+        c.tick = tick_;
+        c.kind = audio::CueKind::TourStart;
+        c.curve = tour_->curve;
+        c.speed_m_per_s = static_cast<float>(p.speed_m_per_s);
+        c.level = static_cast<std::int16_t>(out_.level);
+        cues_->try_push(c);  // a full ring drops and counts
+      }
+    }
+    if (tour_ending_ == TourPhase::None && tour_t_s_ >= tour_->duration_s()) {
+      tour_ending_ = TourPhase::Done;
+      tour_fade_left_ = tour_fade_ticks_;
+    }
+  }
+  if (tour_ending_ != TourPhase::None) {
+    --tour_fade_left_;
+    gain *= std::max(0.0, static_cast<double>(tour_fade_left_) / static_cast<double>(tour_fade_ticks_));
+  }
+  if (out_.result == TickResult::Ok) guide_force_ = gain * f;  // a late tick (DeadlineMissed) sends nothing
+  ++tour_ticks_;
+  if (tour_ending_ != TourPhase::None && tour_fade_left_ <= 0) end_tour(tour_ending_);
 }
 
 void ServoCore::set_gains(const ServoGains& g) noexcept {
@@ -77,6 +227,8 @@ TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, Ser
   if (current_ && gains_.seq != 0) current_->loop.set_gains(gains_.gains);  // no-op unless they changed
   if (current_ && device_returned && is_finite(sample.handle_m)) current_->loop.start(sample.handle_m);
 
+  tour_before_update(sample);
+
   TickResult r = TickResult::Ok;
   if (current_) {
     in.press_counts = !fading_;  // a hand sinking into a fading wall is not pushing through it
@@ -86,6 +238,15 @@ TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, Ser
     out_.contact.proxy_m = in.sample.handle_m;
   }
   if (fading_ && fade_total_ > 0) out_.force_n = (static_cast<double>(fade_left_) / static_cast<double>(fade_total_)) * out_.force_n;
+  tour_after_update(sample);
+  if (guide_force_.x != 0.0 || guide_force_.y != 0.0) {
+    // Walls plus guide, never above the guard's clamp.
+    const double max_n = current_->loop.params().guard.max_force_n;
+    Vec2 total = out_.force_n + guide_force_;
+    const double len = length(total);
+    if (len > max_n) total = (max_n / len) * total;
+    out_.force_n = total;
+  }
   cmd.force_n = out_.force_n;
 
   if (current_) {
@@ -108,6 +269,10 @@ TickResult ServoCore::step(const DeviceSample& sample, bool deadline_missed, Ser
   d.penetration_m = out_.contact.state == ContactState::Free ? 0.0 : length(in.sample.handle_m - out_.contact.proxy_m);
   d.stiffness_n_per_m = current_ ? current_->loop.gains().stiffness_n_per_m : 0.0;
   d.gains_transition = current_ && current_->loop.transition_active();
+  d.tour_phase = tour_phase_;
+  d.tour_id = tour_id_;
+  d.tour_curve = tour_curve_;
+  d.guide_force_n = guide_force_;
   d.section_count = 0;
   if (current_) {
     const auto& sec = current_->loop.section().section();

@@ -24,6 +24,24 @@
 /// at its next tick for the picture in use (ServoLoop::set_gains: the force moves to the new law at no more
 /// than max_force_step_n per tick) and gives them to every picture it takes afterwards, before starting it,
 /// so a bundle built with older ServoParams cannot bring the old gains back.
+///
+/// The guided tour (issue 14, item 3; guided_tour.hpp): publish_tour() hands a planned TourPath to the
+/// servo thread as publish() hands a picture (one atomic exchange; the path the servo let go of goes back
+/// through a ring and is freed by collect_retired()). Each tick of a tour the target is read off the path
+/// and the guide force is F_g = k_g·(target − handle) + b_g·(target velocity − handle velocity) + press
+/// (the handle's velocity low-passed at 30 Hz: encoder steps are noise to a damper; press: the path's force
+/// onto the wall along the outline, turned along the inward normal of the wall segment the handle touches
+/// when it touches the shape, low-passed at 10 Hz so it turns smoothly), clamped in length to TourParams::max_force_n; it fades in and out over fade_s. The command is the walls' force (after the
+/// guard) plus F_g, clamped to the guard's max_force_n. During the transit the walls are suspended: they
+/// fade out over fade_s, then the proxy is put at the handle every tick (ServoLoop::relocate); from the
+/// outline on the toured shape is a wall, and a contact with other shapes only is let go of at the next
+/// tick (relocate again: one tick's depth, a few hundredths of a newton), so a neighbouring outline never
+/// holds the handle back. The path's clock runs only while |spring + press| stays below max_force_n, so
+/// a held handle is not left behind by a target running away; the tour stops (force faded out)
+/// at cancel_tour(), when the hand holds still against it (guide force at ≥ 95 % of its limit, or the
+/// clock stopped, while the handle, its velocity low-passed at 5 Hz, moves slower than
+/// hold_speed_m_per_s, for hold_s), when the device is not Ok or the sample not
+/// finite (at once), or when the picture changes. A TourStart cue marks the outline's start.
 
 #include <atomic>
 #include <cstdint>
@@ -33,6 +51,7 @@
 #include "audio/cue_event.hpp"
 #include "audio/spsc_ring.hpp"
 #include "cue_tracker.hpp"
+#include "guided_tour.hpp"
 #include "haptics/device.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
@@ -73,6 +92,12 @@ struct ServoDisplayState {
   double stiffness_n_per_m = 0.0;
   /// A gains (or level) change is still fading in (ServoLoop::transition_active).
   bool gains_transition = false;
+  /// The guided tour: phase, its path's id and shape (TourPath::id, curve; −1 / 0 before the first), and
+  /// the guide force of this tick [N] (included in force_n; zero without a tour).
+  TourPhase tour_phase = TourPhase::None;
+  int tour_id = 0;
+  int tour_curve = -1;
+  Vec2 guide_force_n;
   /// The boundary section (seed §3): the first kMaxSection node ids of the collision tree's frontier.
   static constexpr int kMaxSection = 256;
   std::int32_t section_count = 0;  ///< entries in the section (may exceed kMaxSection; only those are copied)
@@ -95,8 +120,21 @@ class ServoCore {
   /// One thread but the servo's (the owner): hands `bundle` to the servo thread (taken at its next tick).
   /// A bundle published before and not yet taken is freed here (the servo thread never saw it).
   void publish(std::unique_ptr<SceneBundle> bundle);
-  /// Any thread but the servo's (one caller): frees bundles the servo thread has let go of. Returns how many.
+  /// Any thread but the servo's (one caller): frees bundles and tour paths the servo thread has let go of.
+  /// Returns how many bundles.
   int collect_retired();
+
+  /// The owner's thread: hands a planned tour to the servo thread. It is taken at the first tick with no
+  /// tour running (a running one is let go of first: cancel_tour()) and no picture being swapped in, and
+  /// only for the picture in use (TourPath::scene_id == SceneBundle::id; else it is dropped, reported
+  /// Stopped). A path published before
+  /// and not yet taken is freed here. `path` must be non-empty.
+  void publish_tour(std::unique_ptr<TourPath> path);
+  /// Any thread: stops the running tour at the next tick (its force fades out over fade_s; then reported
+  /// Stopped). Nothing happens without one.
+  void cancel_tour() noexcept { tour_cancel_.store(true, std::memory_order_release); }
+  /// Servo thread (or when stopped): the guide force of the last tick [N] (zero without a tour).
+  Vec2 last_guide_force() const noexcept { return guide_force_; }
 
   /// request_level(kAutoLevel): the level follows the hand's speed (ServoLoop::set_auto_level).
   static constexpr int kAutoLevel = -2;
@@ -145,6 +183,31 @@ class ServoCore {
   TripleBuffer<ServoDisplayState> display_;
   ServoOutput out_;
   DeviceStatus last_status_ = DeviceStatus::Ok;        // the previous tick's sample status (a return restarts the picture)
+  // The guided tour (servo thread but the atomics and the ring).
+  void tour_before_update(const DeviceSample& sample) noexcept;
+  void tour_after_update(const DeviceSample& sample) noexcept;
+  void end_tour(TourPhase how) noexcept;
+  std::atomic<TourPath*> tour_pending_{nullptr};
+  std::atomic<bool> tour_cancel_{false};
+  audio::SpscRing<TourPath*> tour_retired_{8};         // servo → owner
+  TourPath* tour_ = nullptr;                           // running (or fading out)
+  TourPath* tour_to_retire_ = nullptr;                 // waiting for room in tour_retired_
+  TourPhase tour_phase_ = TourPhase::None;             // reported
+  TourPhase tour_ending_ = TourPhase::None;            // Done / Stopped while the force fades out
+  int tour_id_ = 0, tour_curve_ = -1;
+  double tour_t_s_ = 0.0;                              // the path's clock [s]
+  std::size_t tour_cursor_ = 0;
+  long tour_ticks_ = 0;                                // ticks since the tour was taken
+  long tour_fade_ticks_ = 1;                           // fade_s in ticks
+  long tour_fade_left_ = 0;                            // while ending: ticks of fade left
+  long tour_hold_ticks_ = 0;                           // consecutive ticks "held still against it"
+  Vec2 guide_force_;                                   // this tick's guide force [N]
+  Vec2 tour_prev_handle_, tour_prev_target_;           // last tick's handle and target [m]
+  Vec2 tour_velocity_, tour_hold_velocity_;            // the handle's velocity, low-passed [m/s]
+  static constexpr double kTourVelocityHz = 30.0;      // low-pass of the guide's damping velocity [Hz]
+  static constexpr double kHoldVelocityHz = 5.0;       // low-pass of the "held still" velocity [Hz]
+  static constexpr double kPressHz = 10.0;             // low-pass of the press force's direction changes [Hz]
+  Vec2 tour_press_;                                    // the press force, low-passed [N]
   std::int64_t tick_ = 0;
 };
 

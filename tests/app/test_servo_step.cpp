@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "curves.hpp"
+#include "guided_tour.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "servo_core.hpp"
 #include "simulation.hpp"
@@ -159,6 +160,42 @@ TEST(ServoStep, NothingIsAllocatedOrFreedInTheStep) {
   }
   EXPECT_EQ(g_allocations.load(), 1);
   EXPECT_EQ(g_frees.load(), 1);
+}
+
+TEST(ServoStep, NothingIsAllocatedOrFreedInAGuidedTour) {
+  // The guided tour (issue 14, item 3) in the servo path: taken, led through the transit (walls
+  // suspended), round the outline, let go, and a second one cancelled by a key; the paths are planned and
+  // freed outside the count.
+  Rig r;
+  r.hand = ModelHandParams{0.0, 0.0, 0.0};  // relaxed: the tour leads the handle
+  r.samples.reserve(40000);
+  r.commands.reserve(40000);
+  r.core.publish(bundle(r.sp, 1));
+  r.tick();
+  r.run(0.6);
+  const Scene square = Scene::build({test::square(0.02)}, 3);  // the bundle's picture
+  const TourParams tp = tour_params_from(r.s);
+  VisitTouches none;
+  none.reset(1, 1);
+  auto plan = plan_tour(square, 1, r.device.read().handle_m, none, tp);
+  ASSERT_TRUE(plan.has_value());
+  plan->id = 1;
+  r.core.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
+  g_allocations = 0;
+  g_frees = 0;
+  for (int k = 0; k < 30000 && r.core.display().tour_phase != TourPhase::Done; ++k) r.tick(true);
+  EXPECT_EQ(r.core.display().tour_phase, TourPhase::Done);
+  plan = plan_tour(square, 1, r.device.read().handle_m, none, tp);
+  ASSERT_TRUE(plan.has_value());
+  plan->id = 2;
+  r.core.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
+  r.run(0.3, true);
+  r.core.cancel_tour();
+  r.run(0.2, true);
+  EXPECT_EQ(r.core.display().tour_phase, TourPhase::Stopped);
+  EXPECT_EQ(g_allocations.load(), 0) << "operator new called in ServoCore::step during a tour";
+  EXPECT_EQ(g_frees.load(), 0) << "operator delete called in ServoCore::step during a tour";
+  r.core.collect_retired();
 }
 
 TEST(ServoStep, SameSamplesGiveBitIdenticalCommands) {

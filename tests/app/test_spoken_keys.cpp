@@ -54,7 +54,7 @@ constexpr std::array<Action, 10> kActions{{
     {"volume_up", &config::KeysSettings::volume_up, "Press ", " for louder"},
     {"volume_down", &config::KeysSettings::volume_down, "and ", " for quieter."},
     {"tutorial", &config::KeysSettings::tutorial, "Press ", " to practise with the shapes again"},
-    {"guide", &config::KeysSettings::guide, "Press ", " to be led to a shape you have not touched yet"},
+    {"guide", &config::KeysSettings::guide, "Press ", " to be led to a shape you have not touched yet."},
 }};
 
 /// The shipped keys with `action` on `name`; an action that had `name` moves to a key no action uses, so the
@@ -102,7 +102,7 @@ TEST(SpokenKeys, EnglishAndGermanHaveASpokenFormForEveryKeyName) {
   }
 }
 
-// The test of the issue: 9 actions x every key name (75), each a kiosk configured so, woken, asked for help.
+// The test of the issue: 10 actions (the guided tour's Guide since issue 14) x every key name (75), each a kiosk configured so, woken, asked for help.
 TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
   const audio::MessageCatalog& en = audio::MessageCatalog::english();
   const audio::MessageCatalog de = audio::MessageCatalog::load(kMessagesDir + "de.toml");

@@ -28,8 +28,9 @@ enum class MessageId : int {
   tutorial_start, tutorial_circle, tutorial_triangle, tutorial_done, timeout_warning, goodbye,
   no_audio_device, stick_inserted, stick_empty, stick_removed, stick_unreadable, document_page, document_picture,
   document_unreadable, loading, text_block, device_ready, device_simulated, device_lost, device_back,
+  tour_remaining, tour_one_remaining, tour_all_touched, tour_stopped, tour_nothing,
 };
-inline constexpr int kMessageCount = 34;
+inline constexpr int kMessageCount = 39;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -38,7 +39,8 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "tutorial_start", "tutorial_circle", "tutorial_triangle", "tutorial_done", "timeout_warning", "goodbye",
     "no_audio_device", "stick_inserted", "stick_empty", "stick_removed", "stick_unreadable", "document_page",
     "document_picture", "document_unreadable", "loading", "text_block", "device_ready", "device_simulated",
-    "device_lost", "device_back"};
+    "device_lost", "device_back", "tour_remaining", "tour_one_remaining", "tour_all_touched", "tour_stopped",
+    "tour_nothing"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".

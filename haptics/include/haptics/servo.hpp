@@ -160,6 +160,12 @@ class ServoLoop {
   /// Starts (or restarts) at the handle position: proxy placed there, force ramp from zero. Resets the
   /// solver in use (walls: ContactSolver, grooves: GrooveSolver).
   void start(Vec2 handle_m);
+  /// Puts the proxy at the handle, free, its contact state forgotten (ContactSolver::reset at the level in
+  /// use), without restarting the force ramp, the velocity filter or the level: called before update() on
+  /// every tick the guided tour leads the handle through the air (app guided_tour.hpp), so the walls give
+  /// no force then and are on again, on the handle's side, when it stops. Allocates nothing; walks the
+  /// tree only within two skins of the handle.
+  void relocate(Vec2 handle_m) noexcept { solver_.reset(handle_m, level_); }
   /// One servo tick: a function of (state, in, scene); no clock is read. A non-finite handle position
   /// gives zero force and NonFinite with the state kept. Real-time safe.
   TickResult update(const ServoInput& in, ServoOutput& out);

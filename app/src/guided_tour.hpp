@@ -1,0 +1,149 @@
+#pragma once
+/// @file guided_tour.hpp
+/// The guided tour (issue 14, item 3): the Guide key leads the handle to the nearest shape not yet touched
+/// in this visit, traces its outline once and lets go. This file is the planning half, GL-free and off the
+/// servo thread: which shapes were touched (VisitTouches), which shape comes next and the timed path of
+/// the handle's target (plan_tour). The servo half (ServoCore::publish_tour) follows the path with a
+/// force-limited spring.
+///
+/// The path, as a flat list of timed targets (TourPath::points, built here, read by the servo thread):
+///   1. transit: from the handle to a start point offset_m (1.5 mm) off the shape on the handle's side, in a
+///      straight line with a minimum-jerk time law (Flash & Hogan 1985, "The coordination of arm
+///      movements", J. Neurosci. 5(7)): it starts and ends at rest and its peak speed is 1.875 times its
+///      mean; the mean is tour_speed, so it never goes faster than 2 × tour_speed. Walls are suspended
+///      (the visitor is led through the air, over walls in the way).
+///   2. onto the track: 0.5 mm from the start point to the outline's track, at tour_speed; walls are on
+///      from here (only the toured shape's: ServoCore lets go of contacts with other shapes).
+///   3. outline: the target runs along the shape's outline track_offset_m (1 mm) off the curve on the
+///      handle's side, at tour_speed, and a force, press_force_n (0.6 N), pushes the handle onto the wall:
+///      along the wall's inward normal while the handle touches the shape (ServoCore takes it from the
+///      contact), else along the path's normal. Against the 300 N/m spring and the 800 N/m wall this rests
+///      the handle ~0.3 mm into the wall, so the visitor feels the wall and hears its slide cues while
+///      being led round it. The press grows in over the first press_ramp_m of the outline and fades over
+///      its last. A closed shape is traced all the way round back to the start; an open one from its end
+///      nearer the handle to the far end.
+///   4. release: back to offset_m on the handle's side, at tour_speed; then the servo lets go (the guide
+///      force fades out over fade_s).
+/// (The issue's sketch put the outline 1.5 mm off the wall on the handle's side with no press; the handle
+/// would then be led round in the air and never touch the shape. A target 1.5 mm past the wall was tried
+/// next and fails: with the walls' friction (μ_s 0.4) the handle sticks on the wall wherever the pull
+/// points mostly into it — round every convex corner — while the target runs on. A target outside pulls
+/// the handle round convex corners; the press, a force along the wall's normal where the handle is,
+/// keeps it on the wall without pulling it into a corner.)
+///
+/// "Sensible order": always the nearest untouched shape from where the handle is (distance to its
+/// polyline), so repeated Guide presses walk the picture without long jumps. Specks are not toured: a
+/// curve whose level-0 length is below min_shape_length_m (6 mm, about a fingertip's width) is neither
+/// chosen nor counted as remaining.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "config/settings.hpp"
+#include "haptics/scene.hpp"
+#include "haptics/vec2.hpp"
+
+namespace hk::app {
+
+/// One timed target of a tour: where the spring pulls the handle at time t_s after the tour was taken,
+/// and the force that presses it against the wall there.
+struct TourPoint {
+  double t_s = 0.0;  ///< time since the tour started [s], increasing along the path
+  Vec2 target_m;     ///< target of the guide spring [m], workspace frame
+  Vec2 press_n;      ///< force towards the wall [N] where the handle touches no wall (zero in the transit)
+};
+
+/// Tuning of the guided tour. Units in names. Defaults: the shipped settings ([haptics] tour_max_force_n,
+/// tour_speed_m_per_s) and the constants chosen here.
+struct TourParams {
+  double max_force_n = 1.2;          ///< |guide force| never exceeds this [N] ([haptics] tour_max_force_n)
+  double speed_m_per_s = 0.03;       ///< speed along the outline [m/s] ([haptics] tour_speed_m_per_s)
+  /// Guide spring [N/m]. 300 N/m with the 0.08 kg handle and 2 + 5 N·s/m of damping is a second-order
+  /// follower with ω ≈ 61 rad/s and ζ ≈ 0.7 (no overshoot worth feeling); it lags ~0.7 mm at 3 cm/s and
+  /// saturates at max_force_n after 4 mm of error.
+  double stiffness_n_per_m = 300.0;
+  double damping_n_s_per_m = 5.0;    ///< guide damping on the handle's velocity relative to the target's [N·s/m]
+  double offset_m = 0.0015;          ///< start and end points lie this far off the curve on the handle's side [m]
+  double track_offset_m = 0.001;     ///< the outline's targets lie this far off the curve on the handle's side [m]
+  double press_force_n = 0.6;        ///< force pressing the handle onto the wall along the outline [N]
+  double press_ramp_m = 0.002;       ///< the press grows in over this much of the outline's start and fades over its end [m]
+  double sample_m = 0.0005;          ///< spacing of the outline's targets [m]
+  double transit_sample_s = 0.005;   ///< spacing of the transit's targets [s]
+  double min_transit_s = 0.2;        ///< the shortest transit [s] (a start right by the shape still eases in)
+  double fade_s = 0.05;              ///< the guide force fades in and out over this [s]; walls fade out over it at the start
+  double hold_speed_m_per_s = 0.005; ///< "holding still": the handle slower than this...
+  double hold_s = 0.5;               ///< ...with the guide force at its limit for this long stops the tour [s]
+  double min_shape_length_m = 0.006; ///< curves shorter than this (level 0) are specks, not toured [m]
+  double plan_error_m = 0.0005;      ///< plan on the coarsest level whose error is below this [m]
+};
+
+/// TourParams from the settings: [haptics] tour_max_force_n and tour_speed_m_per_s; the rest the defaults.
+TourParams tour_params_from(const config::Settings& s);
+
+/// The tour's phase as the servo thread reports it (ServoDisplayState::tour_phase).
+enum class TourPhase : std::uint8_t {
+  None,     ///< no tour taken yet
+  Transit,  ///< leading the handle to the shape (walls suspended)
+  Outline,  ///< tracing the outline (walls on)
+  Done,     ///< traced to the end and let go (the force has faded out)
+  Stopped,  ///< stopped before the end: a key, the hand holding still, the device lost or a new picture
+};
+
+/// A planned tour, handed to the servo thread (ServoCore::publish_tour). Built off the servo thread;
+/// the servo thread only reads it.
+struct TourPath {
+  int id = 0;             ///< caller's tour number (ServoDisplayState::tour_id)
+  int scene_id = 0;       ///< SceneBundle::id the tour is for; the servo drops it for another picture
+  int curve = -1;         ///< the shape: scene curve index
+  TourParams params;
+  double outline_start_s = 0.0;  ///< end of the transit: walls are on from here [s]
+  std::vector<TourPoint> points; ///< timed targets; points.front() is the handle at planning time, t = 0
+  /// Time of the last point [s] (0 for an empty path).
+  double duration_s() const noexcept { return points.empty() ? 0.0 : points.back().t_s; }
+  /// The target and press at time t [s], linear between points, clamped to the ends. `cursor` is the
+  /// index of the segment used last (start at 0); t must not decrease between calls with the same cursor.
+  /// Real-time safe; amortised O(1). Requires a non-empty path.
+  TourPoint at(double t_s, std::size_t& cursor) const noexcept;
+};
+
+/// The shapes touched in this visit of this picture (issue 14: "the kiosk keeps what was touched per
+/// visit"). Fed with the servo display state's contact curve and with completed tours. Forgotten with a
+/// new picture (reset) and a new visitor.
+class VisitTouches {
+ public:
+  /// Forgets everything; from now on touches of picture `scene_id` with `curve_count` curves are kept.
+  void reset(int scene_id, int curve_count);
+  /// Curve `curve` of picture `scene_id` was touched. Ignored for another picture or a curve out of range.
+  void touch(int scene_id, int curve);
+  /// Whether curve `curve` was touched (false out of range).
+  bool touched(int curve) const;
+  /// Curves touched.
+  int count() const { return count_; }
+  /// The picture the touches are of (−1 before the first reset).
+  int scene_id() const { return scene_id_; }
+
+ private:
+  int scene_id_ = -1;
+  int count_ = 0;
+  std::vector<unsigned char> touched_;
+};
+
+/// Length of curve c's level-0 polyline [m] (closed: round the loop).
+double curve_length_m(const Scene& scene, std::size_t c);
+/// Whether curve c is a shape worth a tour (level-0 length ≥ p.min_shape_length_m).
+bool is_tour_shape(const Scene& scene, std::size_t c, const TourParams& p);
+/// Shapes (is_tour_shape) of the scene not yet touched.
+int shapes_remaining(const Scene& scene, const VisitTouches& touched, const TourParams& p);
+/// Distance from p to curve c's polyline at `level` (clamped to the curve's levels) [m].
+double distance_to_curve_m(const Scene& scene, std::size_t c, int level, Vec2 p);
+/// The level tours of curve c are planned on: the coarsest whose max_error_m is below p.plan_error_m (0 if none).
+int tour_plan_level(const Scene& scene, std::size_t c, const TourParams& p);
+
+/// Plans the tour to the nearest shape not yet touched from `handle_m` [m] (distance to its polyline at
+/// tour_plan_level), as described in the file comment. `scene_id` is stored in the path (the servo drops a
+/// path for another picture). Returns nullopt when every shape is touched (or there is none). Allocates:
+/// not for the servo thread. Never throws for a valid scene (std::bad_alloc aside).
+std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_m, const VisitTouches& touched, const TourParams& p);
+
+}  // namespace hk::app
