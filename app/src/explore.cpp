@@ -293,6 +293,13 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["sticking_ticks"] = sticking;
   const Coverage cov = coverage.measure(scene);
   sj["hand"] = {{"kind", o.hand == "raster" || explorer ? o.hand : std::string("file")}, {"seed", o.seed}};
+  if (const auto* ex = dynamic_cast<const ExplorerHand*>(hand.get())) {
+    const ExplorerStats& st = ex->stats();
+    sj["hand"]["explorer"] = {{"traces", st.traces}, {"traces_closed", st.traces_closed}, {"traces_lost", st.traces_lost},
+                              {"traces_stalled", st.traces_stalled}, {"traces_timed_out", st.traces_timed_out},
+                              {"traces_retraced", st.traces_retraced}, {"pops", st.pops}, {"pops_through", st.pops_through},
+                              {"passes", st.passes}, {"traced_m", st.traced_m}};
+  }
   sj["coverage"] = {{"length_fraction", cov.length_fraction}, {"curves_touched", cov.curves_touched}, {"curves", cov.curves}};
   sj["device"] = {{"name", sum.device.name}, {"status", sum.device.status}, {"replies_missing", sum.device.replies_missing},
                   {"reconnects", sum.device.reconnects}, {"malformed_replies", sum.device.malformed}};

@@ -18,6 +18,7 @@ constexpr double kMarginM = 0.003;        // raster lines stay this far inside t
 constexpr double kWaypointReachM = 0.0015; // a waypoint is reached within this [m]
 constexpr double kPopFactor = 1.4;         // push with this times pop_force_n
 constexpr double kPopExtraS = 0.15;        // push for pop_hold_s plus this
+constexpr double kTurnRadiusM = 0.002;    // a trace that lost its wall turns towards it on this radius [m]
 constexpr double kReleaseIgnoreS = 0.06;   // after a push-through, forces are not walls for this long [s]
 
 }  // namespace
@@ -57,6 +58,7 @@ ExplorerHand::ExplorerHand(const ExplorerParams& p) : p_(p), rng_(p.seed) {
   nx_ = static_cast<int>(std::ceil(p_.workspace_width_m / p_.cell_m)) + 2;
   ny_ = static_cast<int>(std::ceil(p_.workspace_height_m / p_.cell_m)) + 2;
   traced_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_), 0);
+  traced_at_m_.assign(traced_.size(), 0.0);
   plan_pass();
   start_ = waypoints_.front();
   wi_ = 1;
@@ -76,7 +78,10 @@ int ExplorerHand::cell_index(Vec2 p) const noexcept {
 
 void ExplorerHand::mark_traced(Vec2 p) {
   const int i = cell_index(p);
-  if (i >= 0) traced_[static_cast<std::size_t>(i)] = trace_id_;
+  if (i < 0) return;
+  const auto k = static_cast<std::size_t>(i);
+  if (traced_[k] != trace_id_) traced_at_m_[k] = travelled_;
+  traced_[k] = trace_id_;
 }
 
 int ExplorerHand::trace_id_at(Vec2 p) const noexcept {
@@ -145,6 +150,8 @@ void ExplorerHand::enter_trace(const HandFeel& f, Vec2 n) {
   trace_t0_ = f.t_s;
   travelled_ = 0.0;
   retraced_ = 0.0;
+  start_settled_ = false;
+  travelled_at_start_ = 0.0;
   n_ = n;
   lost_since_ = -1.0;
   lookahead_m_ = p_.trace_speed_m_per_s * 6.0 / p_.hand_stiffness_n_per_m;
@@ -227,33 +234,55 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
   if (touching) {
     n_ = normalized_or(0.5 * n_ + 0.5 * ((1.0 / felt) * f.device_force_n), n_);
     lost_since_ = -1.0;
-  } else if (lost_since_ < 0) {
-    lost_since_ = f.t_s;
+  } else {
+    if (lost_since_ < 0) lost_since_ = f.t_s;
+    // The wall fell away (a convex corner, an open end): turn towards it, round a circle of kTurnRadiusM.
+    const double turn = static_cast<double>(sense_) * std::max(p_.trace_speed_m_per_s, length(f.handle_velocity_m_per_s)) / kTurnRadiusM * dt;
+    n_ = Vec2{n_.x * std::cos(turn) - n_.y * std::sin(turn), n_.x * std::sin(turn) + n_.y * std::cos(turn)};
   }
   const double moved = distance(f.handle_m, last_handle_);
   travelled_ += moved;
   stats_.traced_m += moved;
-  const int old_id = trace_id_at(f.handle_m);
-  if (old_id != 0 && old_id != trace_id_) {
-    retraced_ += moved;  // running over a wall an earlier trace felt
-  } else {
-    retraced_ = 0.0;
-  }
+  // Running over walls felt before: an earlier trace's, or this trace's own from more than loop_min_m of travel
+  // ago (round an open end and back along its other side, or round a loop again).
+  const int i = cell_index(f.handle_m);
+  const bool own_old = i >= 0 && traced_[static_cast<std::size_t>(i)] == trace_id_ &&
+                       travelled_ - traced_at_m_[static_cast<std::size_t>(i)] > p_.loop_min_m;
+  const bool other = i >= 0 && traced_[static_cast<std::size_t>(i)] != 0 && traced_[static_cast<std::size_t>(i)] != trace_id_;
+  retraced_ = (own_old || other) ? retraced_ + moved : 0.0;
   if (touching) {
     mark_traced(f.handle_m);
     if (!p_.grooves) mark_traced(f.handle_m + 0.0015 * n_);
   }
+  // The loop is judged from where the trace had settled (the first contact presses harder than a trace).
+  if (!start_settled_ && travelled_ > 0.003) {
+    start_settled_ = true;
+    trace_start_ = f.handle_m;
+    travelled_at_start_ = travelled_;
+  }
   // When the trace ends.
   bool done = false;
-  if (travelled_ > p_.loop_min_m && distance(f.handle_m, trace_start_) < p_.loop_close_m) {
+  if (start_settled_ && travelled_ - travelled_at_start_ > p_.loop_min_m && distance(f.handle_m, trace_start_) < p_.loop_close_m) {
     done = true;
     ++stats_.traces_closed;
   }
-  if (f.t_s - trace_t0_ > p_.trace_max_s) done = true;
-  if (lost_since_ >= 0 && f.t_s - lost_since_ > p_.lost_s) done = true;
-  if (retraced_ > p_.retrace_max_m) done = true;
-  if (f.t_s - stall_t_ > p_.stall_s) {
-    if (distance(f.handle_m, stall_pos_) < 0.001) done = true;
+  if (!done && f.t_s - trace_t0_ > p_.trace_max_s) {
+    done = true;
+    ++stats_.traces_timed_out;
+  }
+  if (!done && lost_since_ >= 0 && f.t_s - lost_since_ > p_.lost_s) {
+    done = true;
+    ++stats_.traces_lost;
+  }
+  if (!done && retraced_ > p_.retrace_max_m) {
+    done = true;
+    ++stats_.traces_retraced;
+  }
+  if (!done && f.t_s - stall_t_ > p_.stall_s) {
+    if (distance(f.handle_m, stall_pos_) < 0.001) {
+      done = true;
+      ++stats_.traces_stalled;
+    }
     stall_t_ = f.t_s;
     stall_pos_ = f.handle_m;
   }
@@ -273,7 +302,7 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
   const Vec2 t = static_cast<double>(sense_) * left_perp(n_);
   const double v_along = dot(f.handle_velocity_m_per_s, t);
   lookahead_m_ = std::clamp(lookahead_m_ + 0.3 * (p_.trace_speed_m_per_s - v_along) * dt, 0.0005, 0.008);
-  const double lead = touching ? lookahead_m_ : 0.5 * lookahead_m_;  // off the wall: turn round the corner towards it
+  const double lead = lookahead_m_;
   return HandCommand{f.handle_m - (p_.press_force_n / k) * n_ + lead * t, p_.max_force_n};
 }
 

@@ -13,7 +13,8 @@
 ///           carries on along the other side. Ends back within `loop_close_m` of where it started after at
 ///           least `loop_min_m` travelled, after trace_max_s, when the wall is lost for lost_s, when it has
 ///           made no progress for stall_s (e.g. at the mechanical stops), or after `retrace_max_m` run
-///           over walls traced before. Every place traced is remembered in a grid of cell_m cells.
+///           over walls traced before (by an earlier trace, or by this one more than loop_min_m of travel ago:
+///           round an open end and back along its other side, which coverage does not need). Every place traced is remembered in a grid of cell_m cells.
 ///   Pop   — presses straight into the wall (along −n̂) with 1.4 · pop_force_n (HandCommand::max_force_n
 ///           above the usual max_force_n) for at most pop_hold_s + 0.15 s; the wall gave way when the
 ///           force pushing back falls under contact_force_n. A wall that does not give way (push-through
@@ -56,12 +57,12 @@ struct ExplorerParams {
   double duration_s = 120.0;            ///< natural_duration_s [s], > 0
   double cell_m = 0.002;                ///< memory grid cell [m], > 0
   double carrot_lead_m = 0.008;         ///< the sweep's target runs at most this far ahead of the handle [m], > 0
-  double loop_close_m = 0.002;          ///< a trace is round when back this close to its start [m], > 0
+  double loop_close_m = 0.003;          ///< a trace is round when back this close to its start [m], > 0
   double loop_min_m = 0.010;            ///< ... after travelling at least this [m], > loop_close_m
-  double trace_max_s = 25.0;            ///< longest trace [s], > 0
-  double lost_s = 0.25;                 ///< a trace that feels no wall this long ends [s], > 0
+  double trace_max_s = 40.0;            ///< longest trace [s], > 0
+  double lost_s = 0.4;                  ///< a trace that feels no wall this long ends [s], > 0
   double stall_s = 1.0;                 ///< a trace or move making less than 1 mm of progress in this ends [s], > 0
-  double retrace_max_m = 0.015;         ///< a trace running this far over walls traced before ends [m], > 0
+  double retrace_max_m = 0.02;          ///< a trace running this far over walls traced before ends [m], > 0
   double pop_travel_max_m = 0.008;      ///< a push that carried the handle this far without the wall giving way failed [m], > 0
 
   /// Throws std::invalid_argument (one line naming the field and its limit) when a value is out of range.
@@ -75,6 +76,10 @@ enum class ExplorerPhase : std::uint8_t { Move, Trace, Pop };
 struct ExplorerStats {
   long traces = 0;          ///< traces begun
   long traces_closed = 0;   ///< traces that came round to their start
+  long traces_lost = 0;     ///< traces ended because no wall was felt for lost_s
+  long traces_stalled = 0;  ///< traces ended for lack of progress (stall_s)
+  long traces_timed_out = 0;///< traces ended after trace_max_s
+  long traces_retraced = 0; ///< traces ended running over walls traced before (retrace_max_m)
   long pops = 0;            ///< push-throughs tried
   long pops_through = 0;    ///< push-throughs in which the wall gave way
   long passes = 0;          ///< raster passes begun
@@ -149,6 +154,8 @@ class ExplorerHand final : public HandController {
   double trace_t0_ = 0.0;
   double travelled_ = 0.0;
   double retraced_ = 0.0;
+  bool start_settled_ = false;
+  double travelled_at_start_ = 0.0;
   Vec2 n_;                  // felt force direction (unit)
   double lost_since_ = -1.0;
   double lookahead_m_ = 0.001;
@@ -164,6 +171,7 @@ class ExplorerHand final : public HandController {
   // Memory: per cell the id of the trace that marked it (0 = never traced).
   int nx_ = 0, ny_ = 0;
   std::vector<int> traced_;
+  std::vector<double> traced_at_m_;  // the trace's travel when the cell was first marked by it [m]
 };
 
 }  // namespace hk
