@@ -19,6 +19,9 @@ constexpr double kWaypointReachM = 0.0015; // a waypoint is reached within this 
 constexpr double kPopFactor = 1.4;         // push with this times pop_force_n
 constexpr double kPopExtraS = 0.15;        // push for pop_hold_s plus this
 constexpr double kTurnRadiusM = 0.002;    // a trace that lost its wall turns towards it on this radius [m]
+constexpr long kPopTriesBeforeGivingUp = 3;  // pushes that all failed before the hand stops pushing
+constexpr double kBypassLineM = 0.0015;   // a bypass ends back within this of the sweep line [m]
+constexpr double kBypassGainM = 0.003;    // ... at least this much closer to the waypoint than where it began [m]
 constexpr double kReleaseIgnoreS = 0.06;   // after a push-through, forces are not walls for this long [s]
 
 }  // namespace
@@ -61,6 +64,7 @@ ExplorerHand::ExplorerHand(const ExplorerParams& p) : p_(p), rng_(p.seed) {
   traced_at_m_.assign(traced_.size(), 0.0);
   plan_pass();
   start_ = waypoints_.front();
+  line_from_ = start_;
   wi_ = 1;
   carrot_ = start_;
   last_handle_ = start_;
@@ -126,7 +130,13 @@ void ExplorerHand::plan_pass() {
   wi_ = 0;
 }
 
+bool ExplorerHand::walls_give_way() const noexcept {
+  // Like a visitor, give up pushing after kPopTriesBeforeGivingUp pushes of which none went through.
+  return p_.pop_force_n > 0 && !(stats_.pops >= kPopTriesBeforeGivingUp && stats_.pops_through == 0);
+}
+
 void ExplorerHand::next_waypoint() {
+  line_from_ = wi_ < waypoints_.size() ? waypoints_[wi_] : last_handle_;
   ++wi_;
   if (wi_ >= waypoints_.size()) plan_pass();
   move_check_t_ = last_t_;
@@ -142,9 +152,16 @@ void ExplorerHand::enter_move(Vec2 handle) {
   move_check_dist_ = distance(handle, waypoints_[wi_]);
 }
 
-void ExplorerHand::enter_trace(const HandFeel& f, Vec2 n) {
+void ExplorerHand::enter_trace(const HandFeel& f, Vec2 n, bool bypass) {
   phase_ = ExplorerPhase::Trace;
-  ++stats_.traces;
+  bypass_ = bypass;
+  if (bypass) {
+    ++stats_.bypasses;
+    bypass_goal_dist_ = distance(f.handle_m, waypoints_[wi_]);
+    bypass_from_ = f.handle_m;
+  } else {
+    ++stats_.traces;
+  }
   ++trace_id_;
   trace_start_ = f.handle_m;
   trace_t0_ = f.t_s;
@@ -191,15 +208,19 @@ HandCommand ExplorerHand::step_move(const HandFeel& f, double dt) {
   if (felt > p_.contact_force_n && f.t_s >= ignore_until_t_) {
     const Vec2 n = (1.0 / felt) * f.device_force_n;
     if (!traced_near(f.handle_m)) {
-      enter_trace(f, n);
+      enter_trace(f, n, false);
       return step_trace(f, 0.0);
     }
     if (!p_.grooves) {
-      if (p_.pop_force_n > 0) {
+      if (walls_give_way()) {
         enter_pop(f, n);
         return step_pop(f);
       }
-      next_waypoint();  // a traced wall that never gives way: this sweep line ends here
+      if (p_.bypass_walls) {
+        enter_trace(f, n, true);  // walls that never give way: go round this one to the sweep line's far side
+        return step_trace(f, 0.0);
+      }
+      next_waypoint();  // walls that never give way: this sweep line ends here
       carrot_ = f.handle_m;
     }
   }
@@ -262,6 +283,7 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
   }
   // When the trace ends.
   bool done = false;
+  const long closed_before = stats_.traces_closed;
   if (start_settled_ && travelled_ - travelled_at_start_ > p_.loop_min_m && distance(f.handle_m, trace_start_) < p_.loop_close_m) {
     done = true;
     ++stats_.traces_closed;
@@ -274,7 +296,22 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
     done = true;
     ++stats_.traces_lost;
   }
-  if (!done && retraced_ > p_.retrace_max_m) {
+  if (bypass_) {
+    // Back on the sweep line, past the obstacle: carry on sweeping. Round to the start again: the waypoint is
+    // out of reach (inside a closed shape), skip it.
+    const Vec2 a = bypass_from_, b = waypoints_[wi_];
+    const double off = std::abs(cross(normalized_or(b - a, Vec2{1, 0}), f.handle_m - a));
+    if (!done && off < kBypassLineM && distance(f.handle_m, b) < bypass_goal_dist_ - kBypassGainM) {
+      enter_move(f.handle_m);
+      return HandCommand{f.handle_m, p_.max_force_n};
+    }
+    if (stats_.traces_closed > closed_before) {
+      next_waypoint();
+      enter_move(f.handle_m);
+      return HandCommand{f.handle_m, p_.max_force_n};
+    }
+  }
+  if (!done && !bypass_ && retraced_ > p_.retrace_max_m) {
     done = true;
     ++stats_.traces_retraced;
   }
@@ -317,7 +354,11 @@ HandCommand ExplorerHand::step_pop(const HandFeel& f) {
     return HandCommand{f.handle_m, p_.max_force_n};
   }
   if (since > p_.pop_hold_s + kPopExtraS || dot(pop_start_ - f.handle_m, pop_n_) > p_.pop_travel_max_m) {
-    // The wall did not give way: this sweep line ends here.
+    // The wall did not give way: go round it to the far side of the sweep line, or end the sweep line here.
+    if (p_.bypass_walls) {
+      enter_trace(f, pop_n_, true);
+      return step_trace(f, 0.0);
+    }
     enter_move(f.handle_m);
     next_waypoint();
     return HandCommand{f.handle_m, p_.max_force_n};

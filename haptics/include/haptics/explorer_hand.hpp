@@ -52,6 +52,9 @@ struct ExplorerParams {
   double hand_stiffness_n_per_m = 200;  ///< the hand's own spring ([hand] stiffness_n_per_m) [N/m], > 0
   double pop_force_n = 3.0;             ///< [haptics] pop_force_n: a wall gives way above this [N]; 0 = never (no Pop)
   double pop_hold_s = 0.3;              ///< [haptics] pop_hold_s [s], > 0
+  /// A traced wall that does not give way (push-through off, or three pushes failed): true = go round it back
+  /// to the sweep line's far side (Bug2); false = end the sweep line there and take the next.
+  bool bypass_walls = false;
   bool grooves = false;                 ///< [haptics] render = "grooves": the force points towards the curve
   std::uint64_t seed = 1;               ///< start corner, first pass orientation, turning sense
   double duration_s = 120.0;            ///< natural_duration_s [s], > 0
@@ -82,6 +85,7 @@ struct ExplorerStats {
   long traces_retraced = 0; ///< traces ended running over walls traced before (retrace_max_m)
   long pops = 0;            ///< push-throughs tried
   long pops_through = 0;    ///< push-throughs in which the wall gave way
+  long bypasses = 0;        ///< walls gone round because they did not give way (traces of the Bug2 kind)
   long passes = 0;          ///< raster passes begun
   double traced_m = 0.0;    ///< handle travel while tracing [m]
 };
@@ -117,7 +121,8 @@ class ExplorerHand final : public HandController {
   HandCommand step_pop(const HandFeel& f);
   // Phase entries.
   void enter_move(Vec2 handle);
-  void enter_trace(const HandFeel& f, Vec2 n);
+  void enter_trace(const HandFeel& f, Vec2 n, bool bypass);
+  bool walls_give_way() const noexcept;
   void enter_pop(const HandFeel& f, Vec2 n);
   // Raster planning: the waypoints of pass `stats_.passes`.
   void plan_pass();
@@ -150,6 +155,10 @@ class ExplorerHand final : public HandController {
 
   // Trace.
   int trace_id_ = 0;
+  bool bypass_ = false;        // going round a wall that did not give way, back to the sweep line
+  double bypass_goal_dist_ = 0.0;
+  Vec2 bypass_from_;           // where the bypass met the wall: it ends back on the line from here to the waypoint
+  Vec2 line_from_;             // where the current sweep line began
   Vec2 trace_start_;
   double trace_t0_ = 0.0;
   double travelled_ = 0.0;
