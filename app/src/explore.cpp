@@ -20,6 +20,7 @@
 #include "coverage.hpp"
 #include "cue_tracker.hpp"
 #include "documents.hpp"
+#include "haptics/explorer_hand.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
 #include "image_scene.hpp"
@@ -103,7 +104,38 @@ double percentile(std::vector<std::int64_t>& v, double q) {
   return static_cast<double>(v[k]);
 }
 
+// The explorer's parameters from the settings: the workspace, the hand's spring and force, the raster's
+// spacing and speed for its sweeps, the walls' push-through and the rendering mode.
+ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t seed) {
+  ExplorerParams ep;
+  ep.workspace_width_m = s.workspace.width_m;
+  ep.workspace_height_m = s.workspace.height_m;
+  ep.sweep_spacing_m = s.hand.raster_spacing_m;
+  ep.sweep_speed_m_per_s = s.hand.raster_speed_m_per_s;
+  ep.max_force_n = s.hand.max_force_n;
+  ep.press_force_n = std::min(ep.press_force_n, 0.5 * s.hand.max_force_n);
+  ep.contact_force_n = std::min(ep.contact_force_n, 0.25 * s.hand.max_force_n);
+  ep.hand_stiffness_n_per_m = s.hand.stiffness_n_per_m;
+  ep.pop_force_n = s.haptics.pop_force_n;
+  ep.pop_hold_s = s.haptics.pop_hold_s;
+  ep.grooves = s.haptics.render == "grooves";
+  ep.seed = seed;
+  return ep;
+}
+
 }  // namespace
+
+std::uint64_t parse_seed(const std::string& text) {
+  const std::string limit = "' is not a whole number in [0, 9223372036854775807]";
+  if (text.empty() || text.size() > 19) throw ExploreError("--seed '" + text + limit);
+  std::uint64_t v = 0;
+  for (char ch : text) {
+    if (ch < '0' || ch > '9') throw ExploreError("--seed '" + text + limit);
+    v = v * 10 + static_cast<std::uint64_t>(ch - '0');
+  }
+  if (v > 9223372036854775807ULL) throw ExploreError("--seed '" + text + limit);
+  return v;
+}
 
 ImageScene build_input_scene(const std::string& path, int page, const config::Settings& s) {
   if (page < 0) throw ExploreError("--page " + std::to_string(page) + " is outside [1, pages of the document]");
@@ -120,10 +152,20 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     throw ExploreError("--duration " + std::to_string(o.duration_s) + " s is outside (0, 86400] s");
   }
   const DeviceChoice device = parse_device_choice(o.device);
+  const bool explorer = o.hand == "explorer";
+  if (explorer && device.kind == DeviceChoice::Kind::HaplyEmulator) {
+    throw ExploreError("--hand explorer: the explorer needs the device's force each tick, which only --device sim gives");
+  }
   // Read the hand before the (slower) image so a bad hand file fails fast.
-  const HandPath path = o.hand == "raster" ? raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m,
-                                                         s.hand.raster_speed_m_per_s)
-                                           : load_hand_csv(o.hand);
+  const HandPath path = o.hand == "raster" || explorer
+                            ? raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s)
+                            : load_hand_csv(o.hand);
+  std::unique_ptr<HandController> hand;
+  if (explorer) {
+    hand = std::make_unique<ExplorerHand>(explorer_params_from(s, o.seed));
+  } else {
+    hand = std::make_unique<PathHand>(path, s.hand.max_force_n);
+  }
   std::error_code ec;
   std::filesystem::create_directories(o.out_dir, ec);
   if (ec || !std::filesystem::is_directory(o.out_dir)) {
@@ -134,7 +176,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   ImageScene is = build_input_scene(o.image_path, o.page, s);
   const Scene& scene = *is.scene;
 
-  const double duration = o.duration_s > 0.0 ? o.duration_s : path.duration_s() + 0.5;
+  const double duration = o.duration_s > 0.0 ? o.duration_s : explorer ? hand->natural_duration_s() : path.duration_s() + 0.5;
   if (!o.audio_out.empty()) {
     const std::filesystem::path a(o.audio_out);
     std::string ext = a.extension().string();
@@ -181,7 +223,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   tracker.set_text_blocks(text_boxes.data(), static_cast<int>(text_boxes.size()));
   std::vector<audio::CueEvent> cues;
   CoverageMeter coverage(0.001);
-  run_simulation(scene, s, path, duration, [&](const TickRecord& r, const ServoOutput& so) {
+  run_simulation(scene, s, *hand, duration, [&](const TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     audio::CueEvent tick_cues[CueTracker::kMaxCuesPerTick];
     const int nc = tracker.update(r.index, so, r.handle_m, so.level, tick_cues);
@@ -254,6 +296,14 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["sticking_ticks"] = sticking;
   sj["push_throughs"] = pops;
   const Coverage cov = coverage.measure(scene);
+  sj["hand"] = {{"kind", o.hand == "raster" || explorer ? o.hand : std::string("file")}, {"seed", o.seed}};
+  if (const auto* ex = dynamic_cast<const ExplorerHand*>(hand.get())) {
+    const ExplorerStats& st = ex->stats();
+    sj["hand"]["explorer"] = {{"traces", st.traces}, {"traces_closed", st.traces_closed}, {"traces_lost", st.traces_lost},
+                              {"traces_stalled", st.traces_stalled}, {"traces_timed_out", st.traces_timed_out},
+                              {"traces_retraced", st.traces_retraced}, {"pops", st.pops}, {"pops_through", st.pops_through},
+                              {"passes", st.passes}, {"traced_m", st.traced_m}};
+  }
   sj["coverage"] = {{"length_fraction", cov.length_fraction}, {"curves_touched", cov.curves_touched}, {"curves", cov.curves}};
   sj["device"] = {{"name", sum.device.name}, {"status", sum.device.status}, {"replies_missing", sum.device.replies_missing},
                   {"reconnects", sum.device.reconnects}, {"malformed_replies", sum.device.malformed}};

@@ -4,6 +4,7 @@
 /// pantograph driven by a model hand, tick by tick as fast as it can, writing scene.json, trace.csv,
 /// summary.json and overlay.png into the output folder.
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -18,8 +19,9 @@ struct ExploreOptions {
   std::string image_path;      ///< picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore
   int page = 0;                ///< PDF page (from 1); 0 = not given (a PDF's first page; refused for a picture)
   std::string out_dir;         ///< folder for the four output files (created if missing)
-  std::string hand = "raster"; ///< "raster" or a CSV file with header t_s,x_m,y_m
-  double duration_s = 0.0;     ///< run length [s]; ≤ 0: the hand path's duration + 0.5 s
+  std::string hand = "raster"; ///< "raster", "explorer" (the visitor-like closed-loop hand) or a CSV file with header t_s,x_m,y_m
+  std::uint64_t seed = 1;      ///< the explorer's seed (start corner, pass orientation, turning sense); see parse_seed
+  double duration_s = 0.0;     ///< run length [s]; ≤ 0: the hand path's duration + 0.5 s, or 120 s for the explorer
   std::string config_path;     ///< TOML settings; empty: defaults
   std::string audio_out;       ///< WAV file for the run's earcons (and cues.csv beside the outputs); empty: none
   std::string device = "sim";  ///< "sim" or "haply-emulator[:FAULT=VALUE,...]" (parse_device_choice)
@@ -31,6 +33,10 @@ class ExploreError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// The `--seed` argument: a whole number in [0, 2^63 − 1], decimal digits only. Throws ExploreError
+/// ("--seed 'TEXT': ...", one line naming the limit) for anything else (empty, a sign, a fraction, too big).
+std::uint64_t parse_seed(const std::string& text);
 
 /// Numbers of a finished run (also written to summary.json).
 struct ExploreSummary {

@@ -50,8 +50,14 @@ int main(int argc, char** argv) {
   explore->add_option("input", eo.image_path, "Picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore")->required();
   explore->add_option("--page", eo.page, "Page of a PDF, from 1 (default 1)")->check(CLI::PositiveNumber);
   explore->add_option("--out", eo.out_dir, "Folder for scene.json, trace.csv, summary.json, overlay.png")->required();
-  explore->add_option("--hand", eo.hand, "Model hand: 'raster' or a CSV file with header t_s,x_m,y_m")->default_val("raster");
-  explore->add_option("--duration", eo.duration_s, "Run length [s]; default: the hand path's length")->check(CLI::PositiveNumber);
+  explore->add_option("--hand", eo.hand,
+                      "Model hand: 'raster', 'explorer' (sweeps, traces outlines, pushes through walls it knows) or a CSV file "
+                      "with header t_s,x_m,y_m")
+      ->default_val("raster");
+  std::string seed_text = "1";
+  explore->add_option("--seed", seed_text, "The explorer's seed, a whole number >= 0 (default 1): same seed, same run");
+  explore->add_option("--duration", eo.duration_s, "Run length [s]; default: the hand path's length, 120 s for the explorer")
+      ->check(CLI::PositiveNumber);
   explore->add_option("--config", eo.config_path, "Settings file (TOML)");
   explore->add_option("--audio-out", eo.audio_out, "Also render the run's earcons to this WAV file (tick k at t = k / servo rate)");
   explore->add_option("--device", eo.device,
@@ -91,6 +97,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*explore) {
+      eo.seed = hk::app::parse_seed(seed_text);
       const auto sum = hk::app::run_explore(eo);
       std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n", sum.ticks,
                   sum.curves, sum.edge_ticks, sum.vertex_ticks, sum.max_force_n, eo.out_dir.c_str());

@@ -104,14 +104,19 @@ long run_ticks(const Scene& scene, const ServoParams& sp, Device& device, double
   return n_ticks;
 }
 
-long run_simulated(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+long run_simulated(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
                    const TickObserver& observe, DeviceReport* report) {
-  SimulatedPantograph device(sim_params_from(s), hand.at(0.0));
+  SimulatedPantograph device(sim_params_from(s), hand.start_m());
   device.open();
   const ModelHandParams hp = hand_params_from(s);
   const ServoParams sp = servo_params_from(s);
   const long n_ticks = run_ticks(scene, sp, device, duration_s, observe, [&](TickRecord& rec) {
-    device.step(sp.period_s, model_hand_force(hp, hand.at(rec.t_s), device.true_position_m(), device.velocity_m_per_s()));
+    // What the hand feels: where the handle is and the force the device was told to put on it (last write).
+    const HandFeel feel{rec.t_s, device.true_position_m(), device.velocity_m_per_s(), device.commanded_force_n()};
+    const HandCommand cmd = hand.command(feel);
+    ModelHandParams tick_hp = hp;
+    tick_hp.max_force_n = cmd.max_force_n;
+    device.step(sp.period_s, model_hand_force(tick_hp, cmd.target_m, device.true_position_m(), device.velocity_m_per_s()));
     const Torques tau = device.applied_torques_n_m();
     rec.motor_torque_n_m[0] = tau.tau1_n_m;
     rec.motor_torque_n_m[1] = tau.tau2_n_m;
@@ -125,7 +130,7 @@ long run_simulated(const Scene& scene, const config::Settings& s, const HandPath
   return n_ticks;
 }
 
-long run_emulated(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+long run_emulated(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
                   const TickObserver& observe, const DeviceChoice& choice, DeviceReport* report) {
   io::HaplyDeviceParams dp = haply_params_from(s);
   dp.reply_wait_us = 10000;  // headless: wait for the reply instead of depending on the machine's speed
@@ -133,10 +138,16 @@ long run_emulated(const Scene& scene, const config::Settings& s, const HandPath&
   const Vec2 centre = dp.rect_center_device_m;
   const ModelHandParams hp = hand_params_from(s);
   // The model hand lives in the workspace frame; the emulator's handle in the device frame.
+  // Called on the emulator's thread only (the controller is not touched by this thread during the run); no
+  // device force is fed back (see run_simulation).
   hapi::HandForce hand_force = [&hand, hp, scale, centre](double t_s, Vec2 handle_device_m, Vec2 velocity_device_m_per_s) {
-    return model_hand_force(hp, hand.at(t_s), scale * (handle_device_m - centre), scale * velocity_device_m_per_s);
+    const Vec2 handle = scale * (handle_device_m - centre), velocity = scale * velocity_device_m_per_s;
+    const HandCommand cmd = hand.command(HandFeel{t_s, handle, velocity, Vec2{}});
+    ModelHandParams tick_hp = hp;
+    tick_hp.max_force_n = cmd.max_force_n;
+    return model_hand_force(tick_hp, cmd.target_m, handle, velocity);
   };
-  hapi::FirmwareEmulator emulator(emulator_params_from(s, choice), (1.0 / scale) * hand.at(0.0) + centre, hand_force);
+  hapi::FirmwareEmulator emulator(emulator_params_from(s, choice), (1.0 / scale) * hand.start_m() + centre, hand_force);
   hapi::PtyEmulator pty(emulator);
   const std::string tty_path = pty.device_path();
   io::HaplyDevice device(dp, [tty_path] { return std::make_unique<io::TtyTransport>(tty_path); });
@@ -174,10 +185,16 @@ long run_emulated(const Scene& scene, const config::Settings& s, const HandPath&
 
 }  // namespace
 
-long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+long run_simulation(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
                     const TickObserver& observe, const DeviceChoice& device, DeviceReport* report) {
   if (device.kind == DeviceChoice::Kind::HaplyEmulator) return run_emulated(scene, s, hand, duration_s, observe, device, report);
   return run_simulated(scene, s, hand, duration_s, observe, report);
+}
+
+long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
+                    const TickObserver& observe, const DeviceChoice& device, DeviceReport* report) {
+  PathHand path_hand(hand, s.hand.max_force_n);
+  return run_simulation(scene, s, path_hand, duration_s, observe, device, report);
 }
 
 }  // namespace hk::app

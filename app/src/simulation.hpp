@@ -8,6 +8,7 @@
 
 #include "config/settings.hpp"
 #include "device_setup.hpp"
+#include "haptics/hand_controller.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
@@ -45,13 +46,23 @@ SimPantographParams sim_params_from(const config::Settings& s);
 ModelHandParams hand_params_from(const config::Settings& s);
 
 /// Runs the device `device` chose (the simulated pantograph, or the Haply firmware emulator behind a pty
-/// reached through the tty transport and the hAPI driver, bytes and all) driven by `hand` over `scene` for
-/// `duration_s` seconds, tick by tick as fast as the machine goes. With the emulator a tick waits up to
-/// 10 ms for the reply to the previous tick's packet while the device is Ok (not while it is Lost), and up
-/// to 20 ms after each write for the emulator to have executed every packet sent, Lost or not, until it is
-/// disconnected (so the run does not depend on the machine's speed); a device that comes back restarts the servo at the
-/// handle (force ramped in again). `report` (may be null) receives the device's name, final status and
-/// counters. Returns the number of ticks run. Throws DeviceError when the emulator cannot be reached.
+/// reached through the tty transport and the hAPI driver, bytes and all) driven by the model hand `hand` over
+/// `scene` for `duration_s` seconds, tick by tick as fast as the machine goes. Each tick the simulated
+/// pantograph is pushed by model_hand_force(hand_params_from(s) with max_force_n = the command's max_force_n,
+/// command.target_m, ...), the command being hand.command(feel) with feel = {t, true handle position, its
+/// velocity, the force the servo wrote to the device at the previous tick (after the guard)}.
+/// With the emulator the hand force is computed on the emulator's own thread and the feel carries no device
+/// force (zero): only open-loop hands (PathHand) are meaningful there, and `hand` must not be used
+/// elsewhere during the run. A tick waits up to 10 ms for the reply to the previous tick's packet while the
+/// device is Ok (not while it is Lost), and up to 20 ms after each write for the emulator to have executed
+/// every packet sent, Lost or not, until it is disconnected (so the run does not depend on the machine's
+/// speed); a device that comes back restarts the servo at the handle (force ramped in again). `report` (may
+/// be null) receives the device's name, final status and counters. Returns the number of ticks run. Throws
+/// DeviceError when the emulator cannot be reached.
+long run_simulation(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
+                    const TickObserver& observe, const DeviceChoice& device = {}, DeviceReport* report = nullptr);
+
+/// The same for an open-loop hand path: a PathHand pushing with at most [hand] max_force_n.
 long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,
                     const TickObserver& observe, const DeviceChoice& device = {}, DeviceReport* report = nullptr);
 

@@ -1,0 +1,163 @@
+// The visitor-like explorer hand (issue 14, item 4) on its own: parameter checks, determinism from the seed,
+// and in a closed loop with the simulated pantograph and the servo (walls at the default 800 N/m, friction
+// 0.4/0.3 as the kiosk's defaults) that it traces a shape round, remembers it, and then pushes at it with
+// 1.4 x pop_force_n.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "haptics/explorer_hand.hpp"
+#include "haptics/multires.hpp"
+#include "haptics/scene.hpp"
+#include "haptics/servo.hpp"
+#include "haptics/sim_pantograph.hpp"
+
+namespace hk {
+namespace {
+
+Polyline square(Vec2 c, double half, double step) {
+  Polyline p;
+  p.closed = true;
+  const int n = static_cast<int>(std::lround(2 * half / step));
+  for (int i = 0; i < n; ++i) p.points_m.push_back(c + Vec2{-half + i * step, -half});
+  for (int i = 0; i < n; ++i) p.points_m.push_back(c + Vec2{half, -half + i * step});
+  for (int i = 0; i < n; ++i) p.points_m.push_back(c + Vec2{half - i * step, half});
+  for (int i = 0; i < n; ++i) p.points_m.push_back(c + Vec2{-half, half - i * step});
+  return p;
+}
+
+struct LoopResult {
+  double max_command_force_n = 0.0;
+  std::vector<HandCommand> commands;
+};
+
+// The headless loop of app/src/simulation.cpp, reduced: read, servo, write, hand, step.
+LoopResult run_loop(const Scene& sc, ExplorerHand& hand, double seconds, bool keep_commands = false) {
+  ServoParams sp;
+  sp.level = 0;
+  sp.contact.static_friction = 0.4;
+  sp.contact.dynamic_friction = 0.3;
+  sp.contact.max_force_n = 3.5;
+  sp.guard.max_force_n = 3.5;
+  ServoLoop servo(sc, sp);
+  SimulatedPantograph dev(SimPantographParams{}, hand.start_m());
+  dev.open();
+  servo.start(dev.read().handle_m);
+  ModelHandParams hp;
+  LoopResult r;
+  ServoOutput so;
+  const long n = static_cast<long>(seconds / sp.period_s);
+  for (long k = 0; k < n; ++k) {
+    ServoInput in;
+    in.sample = dev.read();
+    servo.update(in, so);
+    dev.write_force(so.force_n);
+    const HandCommand c = hand.command(HandFeel{k * sp.period_s, dev.true_position_m(), dev.velocity_m_per_s(), dev.commanded_force_n()});
+    r.max_command_force_n = std::max(r.max_command_force_n, c.max_force_n);
+    if (keep_commands) r.commands.push_back(c);
+    hp.max_force_n = c.max_force_n;
+    dev.step(sp.period_s, model_hand_force(hp, c.target_m, dev.true_position_m(), dev.velocity_m_per_s()));
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(ExplorerHand, RefusesBadParametersNamingTheField) {
+  auto message = [](ExplorerParams p) {
+    try {
+      ExplorerHand h(p);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  ExplorerParams p;
+  p.sweep_spacing_m = 0.0;
+  EXPECT_NE(message(p).find("sweep_spacing_m"), std::string::npos);
+  p = {};
+  p.press_force_n = 2.5;  // above max_force_n = 2
+  EXPECT_NE(message(p).find("press_force_n"), std::string::npos);
+  p = {};
+  p.pop_force_n = 0.5;  // below the press: a trace would push through
+  EXPECT_NE(message(p).find("pop_force_n"), std::string::npos);
+  p = {};
+  p.trace_speed_m_per_s = std::nan("");
+  EXPECT_NE(message(p).find("trace_speed_m_per_s"), std::string::npos);
+  p = {};
+  EXPECT_EQ(message(p), "") << "the defaults are valid";
+  EXPECT_EQ(message(p).find('\n'), std::string::npos);
+}
+
+TEST(ExplorerHand, StartsInsideTheWorkspaceAndTheSeedChoosesTheStart) {
+  int differing = 0;
+  ExplorerParams p;
+  const Vec2 first = ExplorerHand(p).start_m();
+  for (std::uint64_t seed = 1; seed <= 16; ++seed) {
+    p.seed = seed;
+    const ExplorerHand a(p), b(p);
+    EXPECT_EQ(a.start_m(), b.start_m());
+    EXPECT_EQ(a.turning_sense(), b.turning_sense());
+    EXPECT_LE(std::abs(a.start_m().x), p.workspace_width_m / 2);
+    EXPECT_LE(std::abs(a.start_m().y), p.workspace_height_m / 2);
+    differing += !(a.start_m() == first);
+  }
+  EXPECT_GE(differing, 4) << "16 seeds give more than one start corner";
+}
+
+TEST(ExplorerHand, SameFeelsGiveTheSameCommands) {
+  ExplorerParams p;
+  p.seed = 7;
+  ExplorerHand a(p), b(p);
+  for (int k = 0; k < 3000; ++k) {
+    // A made-up feel: a wall pushing back along +x for a while, then nothing.
+    const double t = k * 0.001;
+    const HandFeel f{t, {0.01 * std::sin(t), 0.005 * std::cos(2 * t)}, {0.01, 0.0}, k > 500 && k < 1500 ? Vec2{1.2, 0.1} : Vec2{}};
+    const HandCommand ca = a.command(f), cb = b.command(f);
+    ASSERT_EQ(ca.target_m, cb.target_m) << "tick " << k;
+    ASSERT_EQ(ca.max_force_n, cb.max_force_n) << "tick " << k;
+  }
+}
+
+TEST(ExplorerHand, FeelingAWallStartsATraceThatPressesIntoItGently) {
+  ExplorerParams p;
+  ExplorerHand h(p);
+  const Vec2 at = h.start_m();
+  h.command(HandFeel{0.0, at, {}, {}});
+  EXPECT_EQ(h.phase(), ExplorerPhase::Move);
+  const HandCommand c = h.command(HandFeel{0.001, at, {}, {0.0, 1.5}});  // a wall below pushes up
+  EXPECT_EQ(h.phase(), ExplorerPhase::Trace);
+  EXPECT_LE(c.max_force_n, p.max_force_n);
+  // Pressing down into the wall with press_force_n (the hand's spring), sliding sideways.
+  EXPECT_NEAR((c.target_m - at).y, -p.press_force_n / p.hand_stiffness_n_per_m, 1e-9);
+  EXPECT_GT(std::abs((c.target_m - at).x), 0.0);
+  EXPECT_TRUE(h.traced_at(at));
+}
+
+TEST(ExplorerHand, TracesASquareRoundThenPushesIntoItWithMoreThanThePopForce) {
+  const Scene sc = Scene::build({square({0.0, 0.0}, 0.015, 0.001)}, 4);
+  ExplorerParams p;
+  p.seed = 3;
+  ExplorerHand h(p);
+  const LoopResult r = run_loop(sc, h, 25.0);
+  EXPECT_GE(h.stats().traces_closed, 1) << "the square is traced round to where the trace began";
+  // The memory holds the outline: points along the four sides (1.5 mm outside the square, where the handle
+  // pressing on the outside runs) are traced.
+  int traced = 0, points = 0;
+  for (int side = 0; side < 4; ++side)
+    for (double u = -0.013; u <= 0.013; u += 0.002) {
+      const double o = 0.0155;
+      const Vec2 q = side == 0 ? Vec2{u, -o} : side == 1 ? Vec2{o, u} : side == 2 ? Vec2{u, o} : Vec2{-o, u};
+      ++points;
+      traced += h.traced_at(q) || h.traced_at(q + Vec2{0.002, 0}) || h.traced_at(q - Vec2{0.002, 0}) || h.traced_at(q + Vec2{0, 0.002}) ||
+                h.traced_at(q - Vec2{0, 0.002});
+    }
+  EXPECT_GE(traced, points * 9 / 10) << traced << " of " << points;
+  EXPECT_GE(h.stats().pops, 1) << "the sweep met the traced square again and pushed at it";
+  EXPECT_NEAR(r.max_command_force_n, 1.4 * p.pop_force_n, 1e-9);
+}
+
+}  // namespace hk
