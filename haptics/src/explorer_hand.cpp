@@ -16,7 +16,9 @@ void require(bool ok, const char* field, const std::string& limit, double value)
 
 constexpr double kMarginM = 0.003;        // raster lines stay this far inside the workspace edge [m]
 constexpr double kWaypointReachM = 0.0015; // a waypoint is reached within this [m]
-constexpr double kPopFactor = 1.4;         // push with this times pop_force_n
+// Push with this times pop_force_n: over the wall's give-way force, but under the force a wall is clamped at
+// (3.5 N against the 3 N default), so the handle stops a few mm in and the press is held, not lost.
+constexpr double kPopFactor = 1.1;
 constexpr double kPopExtraS = 0.15;        // push for pop_hold_s plus this
 constexpr double kTurnRadiusM = 0.002;    // a trace that lost its wall turns towards it on this radius [m]
 constexpr long kPopTriesBeforeGivingUp = 3;  // pushes that all failed before the hand stops pushing

@@ -157,7 +157,7 @@ TEST(ExplorerHand, TracesASquareRoundThenPushesIntoItWithMoreThanThePopForce) {
     }
   EXPECT_GE(traced, points * 9 / 10) << traced << " of " << points;
   EXPECT_GE(h.stats().pops, 1) << "the sweep met the traced square again and pushed at it";
-  EXPECT_NEAR(r.max_command_force_n, 1.4 * p.pop_force_n, 1e-9);
+  EXPECT_NEAR(r.max_command_force_n, 1.1 * p.pop_force_n, 1e-9) << "over the give-way force, under the wall's 3.5 N clamp";
 }
 
 }  // namespace hk

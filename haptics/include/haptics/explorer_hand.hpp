@@ -15,7 +15,7 @@
 ///           made no progress for stall_s (e.g. at the mechanical stops), or after `retrace_max_m` run
 ///           over walls traced before (by an earlier trace, or by this one more than loop_min_m of travel ago:
 ///           round an open end and back along its other side, which coverage does not need). Every place traced is remembered in a grid of cell_m cells.
-///   Pop   — presses straight into the wall (along −n̂) with 1.4 · pop_force_n (HandCommand::max_force_n
+///   Pop   — presses straight into the wall (along −n̂) with 1.1 · pop_force_n (HandCommand::max_force_n
 ///           above the usual max_force_n) for at most pop_hold_s + 0.15 s; the wall gave way when the
 ///           force pushing back falls under contact_force_n. A wall that does not give way (push-through
 ///           off, or pressing would carry the handle more than pop_travel_max_m) ends the sweep line.
@@ -97,7 +97,7 @@ class ExplorerHand final : public HandController {
   explicit ExplorerHand(const ExplorerParams& p);
 
   /// One tick: updates the memory and the phase from what is felt, returns the target and the force limit
-  /// (max_force_n, or 1.4 · pop_force_n while pushing through). Non-finite feels are treated as no force
+  /// (max_force_n, or 1.1 · pop_force_n while pushing through). Non-finite feels are treated as no force
   /// and the last handle position.
   HandCommand command(const HandFeel& feel) override;
   /// The first pass's start corner, 3 mm inside the workspace [m].
