@@ -3,8 +3,7 @@
 # level-0 length within 1 mm of the proxy's path) three model hands reach on every picture of tests/data/images:
 #   raster            --hand raster (its natural duration: one boustrophedon, ~27 s)
 #   explorer          --hand explorer --duration 120 (seed 1)
-#   explorer_grooves  the same with [haptics] render = "grooves" (only when the build has grooves: haptics/src
-#                     mentions them outside the explorer; otherwise the column is empty)
+#   explorer_grooves  the same with [haptics] render = "grooves"
 # Writes OUT/coverage.csv (picture,raster,explorer,explorer_grooves,explorer_wall_s), then OUT/coverage.png and
 # the table of docs/PERFORMANCE.md between its coverage markers (bench/plot_coverage.py).
 # Usage: bench/coverage.sh [BUILD_DIR] [OUT_DIR]    (two runs at a time)
@@ -17,8 +16,6 @@ exe="$build/app/haptic-kiosk"
 mkdir -p "$out"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-grooves=0
-if grep -rqil groove --exclude=explorer_hand.cpp "$root/haptics/src"; then grooves=1; fi
 printf '[haptics]\nrender = "grooves"\n' > "$work/grooves.toml"
 
 run_one() {  # picture kind -> prints "kind picture fraction wall_seconds"
@@ -40,8 +37,7 @@ run_one() {  # picture kind -> prints "kind picture fraction wall_seconds"
 export -f run_one
 export exe work
 
-kinds="raster explorer"
-[ "$grooves" = 1 ] && kinds="$kinds explorer_grooves"
+kinds="raster explorer explorer_grooves"
 for img in "$root"/tests/data/images/*.png "$root"/tests/data/images/*.jpg; do
   for k in $kinds; do echo "$img $k"; done
 done | xargs -P 2 -L 1 bash -c 'run_one "$0" "$1"' > "$work/results.txt"

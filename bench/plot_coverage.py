@@ -38,7 +38,7 @@ def main():
     ax.set_ylabel("curve length within 1 mm of the proxy [%]")
     ax.set_ylim(0, 105)
     ax.set_title("Coverage per picture (summary.json coverage.length_fraction)")
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.42), ncol=4)
     fig.tight_layout()
     fig.savefig(os.path.join(a.outdir, "coverage.png"), dpi=110)
     if a.doc:
@@ -47,7 +47,8 @@ def main():
             g = f"{100 * float(r['explorer_grooves']):.1f} %" if r["explorer_grooves"] else "to be measured"
             lines.append(f"| {r['picture']} | {100 * float(r['raster']):.1f} % | {100 * float(r['explorer']):.1f} % | {g} |")
         n = sum(1 for r in rows if float(r["explorer"]) >= 0.8)
-        lines.append(f"| **≥ 80 %** | {sum(1 for r in rows if float(r['raster']) >= 0.8)} of {len(rows)} | {n} of {len(rows)} | |")
+        g80 = sum(1 for r in rows if r["explorer_grooves"] and float(r["explorer_grooves"]) >= 0.8)
+        lines.append(f"| **≥ 80 %** | {sum(1 for r in rows if float(r['raster']) >= 0.8)} of {len(rows)} | {n} of {len(rows)} | {g80} of {len(rows)} |")
         doc = open(a.doc).read()
         doc = re.sub(r"(<!-- BEGIN coverage -->\n).*?(\n<!-- END coverage -->)", lambda m: m.group(1) + "\n".join(lines) + m.group(2),
                      doc, flags=re.S)

@@ -31,6 +31,8 @@ min_time=0.5
 "$b/bench_pdf_pages" --out "$out/pdf_pages.json" > "$out/pdf_pages.md"
 "$b/bench_stick_first_page" --out "$out/stick_first_page.json" > "$out/stick_first_page.md"
 "$b/bench_device_loop" --seconds 5 --out "$out/device_loop.json" 2>/dev/null > "$out/device_loop.md"
+"$b/bench_tour_time" > "$out/tour_time.md"
+bash "$root/bench/coverage.sh" "$root/build" "$out" >/dev/null  # coverage per picture: CSV, chart and its table
 # Tables printed by the audio and servo benches go between their markers in PERFORMANCE.md.
 /usr/bin/python3 - "$out" "$root/docs/PERFORMANCE.md" <<'PY'
 import re, sys
