@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "coverage.hpp"
+#include "curves.hpp"
 #include "haptics/multires.hpp"
 
 namespace hk::app {
@@ -13,17 +14,6 @@ namespace {
 Polyline line_x(double x0, double x1, double y, double step) {
   Polyline p;
   for (double x = x0; x <= x1 + 1e-12; x += step) p.points_m.push_back({x, y});
-  return p;
-}
-
-Polyline square(double half, double step) {
-  Polyline p;
-  p.closed = true;
-  const int n = static_cast<int>(std::lround(2 * half / step));
-  for (int i = 0; i < n; ++i) p.points_m.push_back({-half + i * step, -half});
-  for (int i = 0; i < n; ++i) p.points_m.push_back({half, -half + i * step});
-  for (int i = 0; i < n; ++i) p.points_m.push_back({half - i * step, half});
-  for (int i = 0; i < n; ++i) p.points_m.push_back({-half, half - i * step});
   return p;
 }
 
@@ -50,7 +40,7 @@ TEST(Coverage, APathTwoMillimetresAwayCoversNothing) {
 }
 
 TEST(Coverage, TracingAClosedSquareInsideCoversAllOfItAndTouchesIt) {
-  const Scene sc = Scene::build({square(0.01, 0.001), line_x(-0.02, 0.02, 0.03, 0.001)}, 4);
+  const Scene sc = Scene::build({test::sampled_square(0.01, 0.001), line_x(-0.02, 0.02, 0.03, 0.001)}, 4);
   CoverageMeter m(0.001);
   const double h = 0.0095;  // half a millimetre inside each side
   for (int side = 0; side < 4; ++side)

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "crossing_grid.hpp"
+#include "kiosk_exe.hpp"
 #include "haptics/hand_path.hpp"
 #include "image_scene.hpp"
 #include "simulation.hpp"
@@ -22,44 +23,12 @@ using namespace hk;
 namespace {
 
 const fs::path kData = HK_TEST_DATA_DIR;
+using test::ExeResult;
+using test::fresh_dir;
+using test::quoted;
+using test::run_kiosk;
+using test::test_images;
 
-std::vector<fs::path> test_images() {
-  std::vector<fs::path> v;
-  for (const auto& e : fs::directory_iterator(kData / "images")) {
-    const auto ext = e.path().extension().string();
-    if (ext == ".png" || ext == ".jpg") v.push_back(e.path());
-  }
-  std::sort(v.begin(), v.end());
-  return v;
-}
-
-struct ExeResult {
-  int status = -1;
-  std::string err;
-};
-
-// Runs haptic-kiosk with `args`, capturing stderr.
-ExeResult run_kiosk(const std::string& args, const fs::path& tmp) {
-  const fs::path err = tmp / "stderr.txt";
-  const std::string cmd = std::string(HK_KIOSK_EXE) + " " + args + " >/dev/null 2>" + err.string();
-  ExeResult r;
-  const int raw = std::system(cmd.c_str());
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-  std::ifstream f(err);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  r.err = ss.str();
-  return r;
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("hk_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
 }  // namespace
 

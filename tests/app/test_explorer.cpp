@@ -17,6 +17,8 @@
 #include <vector>
 
 #include "coverage.hpp"
+#include "curves.hpp"
+#include "kiosk_exe.hpp"
 #include "explore.hpp"
 #include "haptics/explorer_hand.hpp"
 #include "haptics/multires.hpp"
@@ -29,43 +31,12 @@ using namespace hk;
 namespace {
 
 const fs::path kData = HK_TEST_DATA_DIR;
-
-std::vector<fs::path> test_images() {
-  std::vector<fs::path> v;
-  for (const auto& e : fs::directory_iterator(kData / "images")) {
-    const auto ext = e.path().extension().string();
-    if (ext == ".png" || ext == ".jpg") v.push_back(e.path());
-  }
-  std::sort(v.begin(), v.end());
-  return v;
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("hk_test_explorer_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
-
-struct ExeResult {
-  int status = -1;
-  std::string err;
-};
-
-ExeResult run_kiosk(const std::string& args, const fs::path& tmp) {
-  const fs::path err = tmp / "stderr.txt";
-  const std::string cmd = std::string(HK_KIOSK_EXE) + " " + args + " >/dev/null 2>" + err.string();
-  ExeResult r;
-  const int raw = std::system(cmd.c_str());
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-  std::ifstream f(err);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  r.err = ss.str();
-  return r;
-}
+using test::ExeResult;
+using test::fresh_dir;
+using test::quoted;
+using test::run_kiosk;
+using test::test_images;
+using test::sampled_square;
 
 // trace.csv without its last column, tick_ns (the measured compute time of each tick, never the same twice).
 std::string trace_without_tick_times(const fs::path& p) {
@@ -81,22 +52,11 @@ std::string trace_without_tick_times(const fs::path& p) {
   return out;
 }
 
-Polyline square(double half, double step) {
-  Polyline p;
-  p.closed = true;
-  const int n = static_cast<int>(std::lround(2 * half / step));
-  for (int i = 0; i < n; ++i) p.points_m.push_back({-half + i * step, -half});
-  for (int i = 0; i < n; ++i) p.points_m.push_back({half, -half + i * step});
-  for (int i = 0; i < n; ++i) p.points_m.push_back({half - i * step, half});
-  for (int i = 0; i < n; ++i) p.points_m.push_back({-half, half - i * step});
-  return p;
-}
-
 }  // namespace
 
 TEST(Explorer, TheSameSeedGivesTheSameTraceAndAnotherSeedAnotherOne) {
   const fs::path img = kData / "images" / "apple.jpg";
-  const fs::path tmp = fresh_dir("determinism");
+  const fs::path tmp = fresh_dir("explorer_determinism");
   for (const char* run : {"a", "b"}) {
     const ExeResult r = run_kiosk("explore " + quoted(img) + " --out " + quoted(tmp / run) + " --hand explorer --seed 5 --duration 4", tmp);
     ASSERT_EQ(r.status, 0) << r.err;
@@ -122,7 +82,7 @@ TEST(Explorer, WithoutADurationTheExplorerRuns120Seconds) {
 }
 
 TEST(Explorer, ABadSeedIsOneLineNamingSeed) {
-  const fs::path tmp = fresh_dir("badseed");
+  const fs::path tmp = fresh_dir("explorer_badseed");
   const fs::path img = kData / "images" / "apple.jpg";
   for (const char* seed : {"-1", "1.5", "abc", "99999999999999999999"}) {
     const ExeResult r =
@@ -139,7 +99,7 @@ TEST(Explorer, ABadSeedIsOneLineNamingSeed) {
 }
 
 TEST(Explorer, TheEmulatedBoardIsRefusedInOneLine) {
-  const fs::path tmp = fresh_dir("emulator");
+  const fs::path tmp = fresh_dir("explorer_emulator");
   const ExeResult r = run_kiosk("explore " + quoted(kData / "images" / "apple.jpg") + " --out " + quoted(tmp / "o") +
                                     " --hand explorer --duration 1 --device haply-emulator",
                                 tmp);
@@ -152,7 +112,7 @@ TEST(Explorer, TheEmulatedBoardIsRefusedInOneLine) {
 // A closed square inside a closed square: the explorer traces the outer one from outside, pushes through it,
 // sweeps inside, meets the inner one and traces it. Needs the walls' push-through ([haptics] pop_force_n).
 TEST(Explorer, TracesASquareInsideASquare) {
-  const Scene sc = Scene::build({square(0.03, 0.001), square(0.012, 0.001)}, 4);
+  const Scene sc = Scene::build({sampled_square(0.03, 0.001), sampled_square(0.012, 0.001)}, 4);
   config::Settings s;
   ExplorerParams ep;
   ep.seed = 1;
@@ -164,7 +124,7 @@ TEST(Explorer, TracesASquareInsideASquare) {
     outer.add(so.contact.proxy_m);
     inner.add(so.contact.proxy_m);
   });
-  const Scene only_outer = Scene::build({square(0.03, 0.001)}, 4), only_inner = Scene::build({square(0.012, 0.001)}, 4);
+  const Scene only_outer = Scene::build({sampled_square(0.03, 0.001)}, 4), only_inner = Scene::build({sampled_square(0.012, 0.001)}, 4);
   const double co = outer.measure(only_outer).length_fraction, ci = inner.measure(only_inner).length_fraction;
   RecordProperty("outer_coverage", std::to_string(co));
   RecordProperty("inner_coverage", std::to_string(ci));
@@ -182,7 +142,7 @@ TEST(Explorer, TracesASquareInsideASquare) {
 TEST(Explorer, CoversFourFifthsOfTheCurvesOnMostPictures) {
   const std::vector<fs::path> images = test_images();
   ASSERT_GE(images.size(), 10u);
-  const fs::path tmp = fresh_dir("coverage");
+  const fs::path tmp = fresh_dir("explorer_coverage");
   std::vector<double> coverage(images.size(), -1.0);
   std::vector<std::string> errors(images.size());
   std::atomic<std::size_t> next{0};

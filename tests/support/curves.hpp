@@ -20,6 +20,19 @@ inline Polyline square(double half) {
   return p;
 }
 
+/// The same square sampled every `step` [m] along its sides (4·round(2·half/step) points, counter-clockwise from
+/// (−half, −half)), for tests that need a curve with many points.
+inline Polyline sampled_square(double half, double step) {
+  Polyline p;
+  p.closed = true;
+  const int n = static_cast<int>(std::lround(2 * half / step));
+  for (int i = 0; i < n; ++i) p.points_m.push_back({-half + i * step, -half});
+  for (int i = 0; i < n; ++i) p.points_m.push_back({half, -half + i * step});
+  for (int i = 0; i < n; ++i) p.points_m.push_back({half - i * step, half});
+  for (int i = 0; i < n; ++i) p.points_m.push_back({-half, half - i * step});
+  return p;
+}
+
 /// A smooth random closed blob: r(θ) = r0 (1 + Σ a_i cos(iθ + φ_i)), n points, centred at c.
 inline Polyline random_blob(std::mt19937& rng, Vec2 c, double r0, int n) {
   std::uniform_real_distribution<double> amp(-0.12, 0.12), ph(0.0, 2 * M_PI);
