@@ -111,7 +111,9 @@ ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t see
   ep.workspace_width_m = s.workspace.width_m;
   ep.workspace_height_m = s.workspace.height_m;
   ep.sweep_spacing_m = s.hand.raster_spacing_m;
-  ep.sweep_speed_m_per_s = s.hand.raster_speed_m_per_s;
+  // 1.5 x the raster's speed: the raster runs into walls blind, the explorer's plans keep it off the walls it
+  // remembers and it slows to the trace speed at every wall it meets.
+  ep.sweep_speed_m_per_s = std::min(5.0, 1.5 * s.hand.raster_speed_m_per_s);
   ep.max_force_n = s.hand.max_force_n;
   ep.press_force_n = std::min(ep.press_force_n, 0.5 * s.hand.max_force_n);
   ep.contact_force_n = std::min(ep.contact_force_n, 0.25 * s.hand.max_force_n);
@@ -302,7 +304,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     sj["hand"]["explorer"] = {{"traces", st.traces}, {"traces_closed", st.traces_closed}, {"traces_lost", st.traces_lost},
                               {"traces_stalled", st.traces_stalled}, {"traces_timed_out", st.traces_timed_out},
                               {"traces_retraced", st.traces_retraced}, {"pops", st.pops}, {"pops_through", st.pops_through},
-                              {"passes", st.passes}, {"traced_m", st.traced_m}};
+                              {"passes", st.passes}, {"plans", st.plans}, {"traced_m", st.traced_m},
+                              {"move_s", st.move_s}, {"trace_s", st.trace_s}, {"pop_s", st.pop_s}};
   }
   sj["coverage"] = {{"length_fraction", cov.length_fraction}, {"curves_touched", cov.curves_touched}, {"curves", cov.curves}};
   sj["device"] = {{"name", sum.device.name}, {"status", sum.device.status}, {"replies_missing", sum.device.replies_missing},

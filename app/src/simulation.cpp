@@ -74,7 +74,7 @@ ModelHandParams hand_params_from(const config::Settings& s) {
 namespace {
 
 // The headless servo loop over any device: read, step (timed; the step reads no clock), write, then
-// `after_write(rec)` (the simulated pantograph's physics and torques, or the driver's torques), observe.
+// `after_write(rec, servo output)` (the simulated pantograph's physics and torques, or the driver's torques), observe.
 // A device that comes back after being lost restarts the servo at the handle: the force ramps in again.
 template <class AfterWrite>
 long run_ticks(const Scene& scene, const ServoParams& sp, Device& device, double duration_s, const TickObserver& observe,
@@ -98,7 +98,7 @@ long run_ticks(const Scene& scene, const ServoParams& sp, Device& device, double
     rec.handle_m = in.sample.handle_m;
     rec.device_status = in.sample.status;
     device.write_force(so.force_n);
-    after_write(rec);
+    after_write(rec, so);
     if (observe) observe(rec, so);
   }
   return n_ticks;
@@ -110,9 +110,11 @@ long run_simulated(const Scene& scene, const config::Settings& s, HandController
   device.open();
   const ModelHandParams hp = hand_params_from(s);
   const ServoParams sp = servo_params_from(s);
-  const long n_ticks = run_ticks(scene, sp, device, duration_s, observe, [&](TickRecord& rec) {
-    // What the hand feels: where the handle is and the force the device was told to put on it (last write).
-    const HandFeel feel{rec.t_s, device.true_position_m(), device.velocity_m_per_s(), device.commanded_force_n()};
+  const long n_ticks = run_ticks(scene, sp, device, duration_s, observe, [&](TickRecord& rec, const ServoOutput& so) {
+    // What the hand feels: where the handle is and the force the device was told to put on it (last write);
+    // what it hears: the push-through earcon of this tick.
+    const bool heard_pop = (so.contact.events & kEventPopThrough) != 0;
+    const HandFeel feel{rec.t_s, device.true_position_m(), device.velocity_m_per_s(), device.commanded_force_n(), heard_pop};
     const HandCommand cmd = hand.command(feel);
     ModelHandParams tick_hp = hp;
     tick_hp.max_force_n = cmd.max_force_n;
@@ -152,7 +154,7 @@ long run_emulated(const Scene& scene, const config::Settings& s, HandController&
   const std::string tty_path = pty.device_path();
   io::HaplyDevice device(dp, [tty_path] { return std::make_unique<io::TtyTransport>(tty_path); });
   device.open();
-  const long n_ticks = run_ticks(scene, servo_params_from(s), device, duration_s, observe, [&](TickRecord& rec) {
+  const long n_ticks = run_ticks(scene, servo_params_from(s), device, duration_s, observe, [&](TickRecord& rec, const ServoOutput&) {
     device.last_torques_n_m(&rec.motor_torque_n_m[0], &rec.motor_torque_n_m[1]);
     // Keep the emulated board in step with the run, Lost or not: wait (up to 20 ms) until it has executed
     // every torque packet sent, so the emulated time, and what a fault does, never depends on how busy the

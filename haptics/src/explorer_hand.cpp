@@ -3,7 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
 #include <stdexcept>
+#include <utility>
 
 namespace hk {
 namespace {
@@ -14,17 +18,21 @@ void require(bool ok, const char* field, const std::string& limit, double value)
   }
 }
 
-constexpr double kMarginM = 0.003;        // raster lines stay this far inside the workspace edge [m]
-constexpr double kWaypointReachM = 0.0015; // a waypoint is reached within this [m]
+constexpr double kMarginM = 0.003;        // the sweep keeps this far inside the workspace edge [m]
+constexpr double kWaypointReachM = 0.0015; // a plan's end is reached within this [m]
 // Push with this times pop_force_n: over the wall's give-way force, but under the force a wall is clamped at
 // (3.5 N against the 3 N default), so the handle stops a few mm in and the press is held, not lost.
 constexpr double kPopFactor = 1.1;
 constexpr double kPopExtraS = 0.15;        // push for pop_hold_s plus this
 constexpr double kTurnRadiusM = 0.002;    // a trace that lost its wall turns towards it on this radius [m]
 constexpr long kPopTriesBeforeGivingUp = 3;  // pushes that all failed before the hand stops pushing
-constexpr double kBypassLineM = 0.0015;   // a bypass ends back within this of the sweep line [m]
-constexpr double kBypassGainM = 0.003;    // ... at least this much closer to the waypoint than where it began [m]
 constexpr double kReleaseIgnoreS = 0.06;   // after a push-through, forces are not walls for this long [s]
+constexpr double kWallCostM = 0.03;               // planning: entering a remembered wall costs this much travel (~ a push) [m]
+constexpr double kCrossAheadM = 0.006;     // a remembered wall felt is pushed through if the plan crosses it this near [m]
+constexpr int kRunMaxCells = 10;           // a plan runs on along its line at most this many cells (1.5 cm at the default cell)
+constexpr double kGrooveReachM = 0.003;    // a groove is felt this far from its curve ([haptics] groove_capture_radius_m) [m]
+constexpr double kSmallLoopM2 = 1e-4;      // a loop felt round enclosing less than this (1 cm²): its inside is not planned to [m²]
+constexpr double kBlockingCos = 0.7;       // a wall whose force turns the way back by more than ~135° stands across it           // a plan runs on along its line at most this many cells
 
 }  // namespace
 
@@ -64,10 +72,15 @@ ExplorerHand::ExplorerHand(const ExplorerParams& p) : p_(p), rng_(p.seed) {
   ny_ = static_cast<int>(std::ceil(p_.workspace_height_m / p_.cell_m)) + 2;
   traced_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_), 0);
   traced_at_m_.assign(traced_.size(), 0.0);
-  plan_pass();
-  start_ = waypoints_.front();
-  line_from_ = start_;
-  wi_ = 1;
+  seen_.assign(traced_.size(), 0);
+  skip_.assign(traced_.size(), 0);
+  // The footprint of a sweep line: sweep_spacing_m across, so the next line lies one spacing over.
+  half_strip_ = std::max(0, static_cast<int>(std::lround(p_.sweep_spacing_m / p_.cell_m)) - 1);
+  // The start: the seed's corner, kMarginM inside the workspace; the first run heads away from it.
+  const bool left = corner_ == 0 || corner_ == 3, top = corner_ == 0 || corner_ == 1;
+  start_ = {(left ? -1 : 1) * (p_.workspace_width_m / 2 - kMarginM), (top ? 1 : -1) * (p_.workspace_height_m / 2 - kMarginM)};
+  run_dir_ = orient0_ == 0 ? (left ? 1 : -1) : (top ? 1 : -1);
+  start_pass();
   carrot_ = start_;
   last_handle_ = start_;
 }
@@ -98,73 +111,214 @@ int ExplorerHand::trace_id_at(Vec2 p) const noexcept {
 bool ExplorerHand::traced_at(Vec2 p_m) const noexcept { return trace_id_at(p_m) != 0; }
 
 bool ExplorerHand::traced_near(Vec2 p) const noexcept {
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx)
+  // Walls are felt only on contact: the 8 neighbours. A groove pulls from its capture radius (3 mm by default).
+  const int r = p_.grooves ? std::max(1, static_cast<int>(std::ceil(kGrooveReachM / p_.cell_m))) : 1;
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx)
       if (traced_at(p + Vec2{dx * p_.cell_m, dy * p_.cell_m})) return true;
   return false;
 }
 
-// ---- raster planning ----
+// ---- coverage planning ----
+//
+// The hand's memory is a grid of cell_m cells over the workspace. A cell is *seen* in this pass once the handle
+// has run across it: the footprint of the handle is a strip one cell long along the pass's lines and
+// sweep_spacing_m across them, so the nearest unseen cells lie along the current line first, then on the next line
+// one spacing over: a boustrophedon (lawn-mower) sweep that plans itself (Choset 2000, "Coverage of known spaces:
+// the boustrophedon cellular decomposition", Autonomous Robots 9(3)). Remembered walls (traced cells) cost
+// kWallCostM of travel to enter (a push-through) or are impassable where walls do not give way, so the sweep
+// covers the region it is in before it pushes into the next one.
 
-void ExplorerHand::plan_pass() {
-  const long k = stats_.passes++;
-  const bool vertical = ((orient0_ + k) % 2) == 1;
-  const double offset = ((k / 2) % 2) == 1 ? p_.sweep_spacing_m / 2 : 0.0;
-  const double hw = p_.workspace_width_m / 2 - kMarginM, hh = p_.workspace_height_m / 2 - kMarginM;
-  // Along: the lines' direction; across: where the lines lie. In a pass's own frame (u along, v across).
-  const double half_along = vertical ? hh : hw, half_across = vertical ? hw : hh;
-  std::vector<double> across;
-  for (double v = -half_across + offset; v <= half_across + 1e-12; v += p_.sweep_spacing_m) across.push_back(v);
-  // The corner decides where the first line lies and which way it runs.
-  const bool left = corner_ == 0 || corner_ == 3, top = corner_ == 0 || corner_ == 1;
-  const bool across_from_high = vertical ? !left : top;
-  bool along_positive = vertical ? !top : left;
-  if (across_from_high) std::reverse(across.begin(), across.end());
-  waypoints_.clear();
-  for (double v : across) {
-    const double u0 = along_positive ? -half_along : half_along;
-    const Vec2 a = vertical ? Vec2{v, u0} : Vec2{u0, v};
-    const Vec2 b = vertical ? Vec2{v, -u0} : Vec2{-u0, v};
-    waypoints_.push_back(a);
-    waypoints_.push_back(b);
-    along_positive = !along_positive;
-  }
-  wi_ = 0;
+Vec2 ExplorerHand::cell_centre(int i) const noexcept {
+  const int ix = i % nx_, iy = i / nx_;
+  return {(ix - 1 + 0.5) * p_.cell_m - p_.workspace_width_m / 2, (iy - 1 + 0.5) * p_.cell_m - p_.workspace_height_m / 2};
 }
+
+bool ExplorerHand::targetable(int i) const noexcept {
+  const Vec2 c = cell_centre(i);
+  return std::abs(c.x) <= p_.workspace_width_m / 2 - kMarginM && std::abs(c.y) <= p_.workspace_height_m / 2 - kMarginM;
+}
+
+void ExplorerHand::start_pass() {
+  const long k = stats_.passes++;
+  orient_ = static_cast<int>((orient0_ + k) % 2);
+  for (std::size_t i = 0; i < seen_.size(); ++i) seen_[i] = targetable(static_cast<int>(i)) && skip_[i] == 0 ? 0 : 1;
+}
+
+void ExplorerHand::mark_seen(Vec2 p) {
+  const int i = cell_index(p);
+  if (i < 0) return;
+  const int ix = i % nx_, iy = i / nx_;
+  for (int d = -half_strip_; d <= half_strip_; ++d) {
+    const int jx = orient_ == 0 ? ix : ix + d, jy = orient_ == 0 ? iy + d : iy;
+    if (jx >= 0 && jy >= 0 && jx < nx_ && jy < ny_) seen_[static_cast<std::size_t>(jy * nx_ + jx)] = 1;
+  }
+}
+
+void ExplorerHand::skip_small_loop() {
+  // A loop felt round that encloses less than kSmallLoopM2: what is inside it is known well enough from its outline;
+  // its inside is never planned to (shoelace area; cells by the crossing-number test on their centres).
+  const std::size_t n = trace_path_.size();
+  if (n < 3) return;
+  double area = 0.0;
+  Vec2 lo = trace_path_[0], hi = trace_path_[0];
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2 a = trace_path_[k], b = trace_path_[(k + 1) % n];
+    area += 0.5 * cross(a, b);
+    lo = {std::min(lo.x, a.x), std::min(lo.y, a.y)};
+    hi = {std::max(hi.x, a.x), std::max(hi.y, a.y)};
+  }
+  if (std::abs(area) >= kSmallLoopM2) return;
+  for (double y = lo.y; y <= hi.y + p_.cell_m; y += p_.cell_m)
+    for (double x = lo.x; x <= hi.x + p_.cell_m; x += p_.cell_m) {
+      const int i = cell_index({x, y});
+      if (i < 0) continue;
+      const Vec2 c = cell_centre(i);
+      bool inside = false;
+      for (std::size_t k = 0, j = n - 1; k < n; j = k++) {
+        const Vec2 a = trace_path_[k], b = trace_path_[j];
+        if ((a.y > c.y) != (b.y > c.y) && c.x < (b.x - a.x) * (c.y - a.y) / (b.y - a.y) + a.x) inside = !inside;
+      }
+      if (inside) skip_[static_cast<std::size_t>(i)] = seen_[static_cast<std::size_t>(i)] = 1;
+    }
+}
+
+bool ExplorerHand::passable(int from, int to) const noexcept {
+  // Walls that never give way cannot be planned through (grooves never block).
+  if (p_.grooves || walls_give_way()) return true;
+  return traced_[static_cast<std::size_t>(to)] == 0 || traced_[static_cast<std::size_t>(from)] != 0;
+}
+
+double ExplorerHand::step_cost(int from, int to, bool diagonal) const noexcept {
+  double c = (diagonal ? std::sqrt(2.0) : 1.0) * p_.cell_m;
+  if (!p_.grooves && traced_[static_cast<std::size_t>(to)] != 0 && traced_[static_cast<std::size_t>(from)] == 0) c += kWallCostM;
+  return c;
+}
+
+bool ExplorerHand::plan(Vec2 handle) {
+  // Dijkstra from the handle's cell to the cheapest unseen cell (ties to the lower index: deterministic).
+  waypoints_.clear();
+  wi_ = 0;
+  if (!is_finite(handle)) return false;
+  // From the grid's cell nearest the handle (a handle pushed past the workspace's edge plans from its border).
+  const double hx = p_.workspace_width_m / 2 + p_.cell_m / 2, hy = p_.workspace_height_m / 2 + p_.cell_m / 2;
+  const int src = cell_index({std::clamp(handle.x, -hx, hx), std::clamp(handle.y, -hy, hy)});
+  if (src < 0) return false;
+  const std::size_t n = seen_.size();
+  cost_.assign(n, std::numeric_limits<double>::infinity());
+  prev_.assign(n, -1);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
+  cost_[static_cast<std::size_t>(src)] = 0.0;
+  open.push({0.0, src});
+  int target = -1;
+  while (!open.empty()) {
+    const auto [c, i] = open.top();
+    open.pop();
+    if (c > cost_[static_cast<std::size_t>(i)]) continue;
+    if (seen_[static_cast<std::size_t>(i)] == 0) {
+      target = i;
+      break;
+    }
+    const int ix = i % nx_, iy = i / nx_;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0) continue;
+        const int jx = ix + dx, jy = iy + dy;
+        if (jx < 0 || jy < 0 || jx >= nx_ || jy >= ny_) continue;
+        const int j = jy * nx_ + jx;
+        const bool diagonal = dx != 0 && dy != 0;
+        // No cutting a corner between two cells of a remembered wall.
+        if (diagonal && !p_.grooves && (traced_[static_cast<std::size_t>(iy * nx_ + jx)] != 0 || traced_[static_cast<std::size_t>(jy * nx_ + ix)] != 0))
+          continue;
+        if (!passable(i, j)) continue;
+        const double cj = c + step_cost(i, j, diagonal);
+        if (cj < cost_[static_cast<std::size_t>(j)]) {
+          cost_[static_cast<std::size_t>(j)] = cj;
+          prev_[static_cast<std::size_t>(j)] = i;
+          open.push({cj, j});
+        }
+      }
+  }
+  if (target < 0) return false;
+  for (int i = target; i >= 0 && i != src; i = prev_[static_cast<std::size_t>(i)]) waypoints_.push_back(cell_centre(i));
+  std::reverse(waypoints_.begin(), waypoints_.end());
+  // Then run on along the line through the target while the cells ahead are unseen and free, the way the last
+  // run went if it can (a lawn-mower turns back at the end of a line).
+  const int tx = target % nx_, ty = target / nx_;
+  auto run_length = [&](int dir) {
+    int len = 0;
+    for (int s = 1; s <= kRunMaxCells; ++s) {
+      const int jx = orient_ == 0 ? tx + dir * s : tx, jy = orient_ == 0 ? ty : ty + dir * s;
+      if (jx < 0 || jy < 0 || jx >= nx_ || jy >= ny_) break;
+      const auto j = static_cast<std::size_t>(jy * nx_ + jx);
+      if (seen_[j] != 0 || (traced_[j] != 0 && !p_.grooves)) break;
+      len = s;
+    }
+    return len;
+  };
+  const int ahead = run_length(run_dir_), back = run_length(-run_dir_);
+  if (back > ahead) run_dir_ = -run_dir_;
+  const int len = std::max(ahead, back);
+  if (len > 0) {
+    const int jx = orient_ == 0 ? tx + run_dir_ * len : tx, jy = orient_ == 0 ? ty : ty + run_dir_ * len;
+    waypoints_.push_back(cell_centre(jy * nx_ + jx));
+  }
+  ++stats_.plans;
+  return true;
+}
+
+bool ExplorerHand::replan(Vec2 handle) {
+  if (plan(handle)) return true;
+  start_pass();  // everything reachable seen: the next pass, along the other lines
+  return plan(handle);
+}
+
+bool ExplorerHand::plan_crosses_wall(Vec2 handle) const noexcept {
+  // Whether the planned way, within kCrossAheadM of the handle, runs over a remembered wall.
+  Vec2 a = handle;
+  double left = kCrossAheadM;
+  for (std::size_t k = wi_; k < waypoints_.size() && left > 0; ++k) {
+    const Vec2 b = waypoints_[k];
+    const double len = distance(a, b);
+    for (double u = 0.0; u < std::min(len, left); u += 0.5 * p_.cell_m)
+      if (trace_id_at(a + (u / len) * (b - a)) != 0) return true;
+    left -= len;
+    a = b;
+  }
+  return false;
+}
+
+// ---- phases ----
 
 bool ExplorerHand::walls_give_way() const noexcept {
   // Like a visitor, give up pushing after kPopTriesBeforeGivingUp pushes of which none went through.
   return p_.pop_force_n > 0 && !(stats_.pops >= kPopTriesBeforeGivingUp && stats_.pops_through == 0);
 }
 
-void ExplorerHand::next_waypoint() {
-  line_from_ = wi_ < waypoints_.size() ? waypoints_[wi_] : last_handle_;
-  ++wi_;
-  if (wi_ >= waypoints_.size()) plan_pass();
-  move_check_t_ = last_t_;
-  move_check_dist_ = distance(last_handle_, waypoints_[wi_]);
+void ExplorerHand::remember_wall(Vec2 handle, Vec2 n) {
+  // Under the nearest remembered wall's id: the handle's cell and the cell at the wall's face (n̂ points off it).
+  int id = 0;
+  for (int dy = -1; dy <= 1 && id == 0; ++dy)
+    for (int dx = -1; dx <= 1 && id == 0; ++dx) id = trace_id_at(handle + Vec2{dx * p_.cell_m, dy * p_.cell_m});
+  for (const Vec2 q : {handle, handle + 0.001 * n}) {
+    const int i = cell_index(q);
+    if (i >= 0 && traced_[static_cast<std::size_t>(i)] == 0) traced_[static_cast<std::size_t>(i)] = id;
+  }
 }
-
-// ---- phases ----
 
 void ExplorerHand::enter_move(Vec2 handle) {
   phase_ = ExplorerPhase::Move;
   carrot_ = handle;
-  move_check_t_ = last_t_;
-  move_check_dist_ = distance(handle, waypoints_[wi_]);
+  waypoints_.clear();  // plan afresh from here: what was felt changed the memory
+  wi_ = 0;
 }
 
-void ExplorerHand::enter_trace(const HandFeel& f, Vec2 n, bool bypass) {
+void ExplorerHand::enter_trace(const HandFeel& f, Vec2 n) {
   phase_ = ExplorerPhase::Trace;
-  bypass_ = bypass;
-  if (bypass) {
-    ++stats_.bypasses;
-    bypass_goal_dist_ = distance(f.handle_m, waypoints_[wi_]);
-    bypass_from_ = f.handle_m;
-  } else {
-    ++stats_.traces;
-  }
+  ++stats_.traces;
   ++trace_id_;
+  trace_path_.clear();
   trace_start_ = f.handle_m;
   trace_t0_ = f.t_s;
   travelled_ = 0.0;
@@ -195,6 +349,8 @@ HandCommand ExplorerHand::command(const HandFeel& feel_in) {
   const double dt = started_ ? std::clamp(f.t_s - last_t_, 0.0, 0.1) : 0.0;
   started_ = true;
   last_t_ = f.t_s;
+  (phase_ == ExplorerPhase::Move ? stats_.move_s : phase_ == ExplorerPhase::Trace ? stats_.trace_s : stats_.pop_s) += dt;
+  mark_seen(f.handle_m);
   HandCommand c;
   switch (phase_) {
     case ExplorerPhase::Move: c = step_move(f, dt); break;
@@ -205,50 +361,99 @@ HandCommand ExplorerHand::command(const HandFeel& feel_in) {
   return c;
 }
 
+// Move, phase by phase: a wall met (trace it, push through it, or patch the memory), the plan (made afresh
+// when done), the carrot along it, the goal reached or given up.
 HandCommand ExplorerHand::step_move(const HandFeel& f, double dt) {
+  if (const MoveOutcome o = meet_wall(f); o != MoveOutcome::Carry) {
+    if (o == MoveOutcome::Traced) return step_trace(f, 0.0);
+    if (o == MoveOutcome::Pushed) return step_pop(f);
+    return HandCommand{f.handle_m, p_.max_force_n};  // Replanned: stand still this tick
+  }
+  if (!have_plan(f)) {
+    carrot_ = f.handle_m;
+    return HandCommand{f.handle_m, p_.max_force_n};
+  }
+  advance_carrot(f.handle_m, dt);
+  check_goal(f);
+  return HandCommand{carrot_, p_.max_force_n};
+}
+
+ExplorerHand::MoveOutcome ExplorerHand::meet_wall(const HandFeel& f) {
   const double felt = length(f.device_force_n);
-  if (felt > p_.contact_force_n && f.t_s >= ignore_until_t_) {
-    const Vec2 n = (1.0 / felt) * f.device_force_n;
-    if (!traced_near(f.handle_m)) {
-      enter_trace(f, n, false);
-      return step_trace(f, 0.0);
-    }
-    if (!p_.grooves) {
-      if (walls_give_way()) {
-        enter_pop(f, n);
-        return step_pop(f);
-      }
-      if (p_.bypass_walls) {
-        enter_trace(f, n, true);  // walls that never give way: go round this one to the sweep line's far side
-        return step_trace(f, 0.0);
-      }
-      next_waypoint();  // walls that never give way: this sweep line ends here
-      carrot_ = f.handle_m;
-    }
+  if (felt <= p_.contact_force_n || f.t_s < ignore_until_t_) return MoveOutcome::Carry;
+  const Vec2 n = (1.0 / felt) * f.device_force_n;
+  if (!traced_near(f.handle_m)) {
+    enter_trace(f, n);
+    return MoveOutcome::Traced;
   }
-  // The carrot runs to the waypoint at the sweep speed, never far ahead of the handle.
-  Vec2 goal = waypoints_[wi_];
-  if (distance(f.handle_m, goal) < kWaypointReachM) {
-    next_waypoint();
-    goal = waypoints_[wi_];
+  if (p_.grooves) return MoveOutcome::Carry;  // remembered grooves are crossed
+  // A wall felt round before: push through it where the plan crosses it or where it stands square across the
+  // way; where the plan only runs beside it, brush along it.
+  const Vec2 way = carrot_ - f.handle_m;
+  const bool across = length(way) > 1e-4 && dot(n, (1.0 / length(way)) * way) < -kBlockingCos;
+  const bool crosses = plan_crosses_wall(f.handle_m);
+  if (across && !crosses && !patched_) {
+    // The memory held this wall short of where it stands: remember it here, and plan again (round it, or
+    // through it if going round costs more).
+    remember_wall(f.handle_m, n);
+    patched_ = true;
+    enter_move(f.handle_m);
+    return MoveOutcome::Replanned;
   }
-  const Vec2 to_goal = goal - carrot_;
-  const double d = length(to_goal);
-  const double step = p_.sweep_speed_m_per_s * dt;
-  carrot_ = d <= step ? goal : carrot_ + (step / d) * to_goal;
-  const Vec2 lead = carrot_ - f.handle_m;
-  if (length(lead) > p_.carrot_lead_m) carrot_ = f.handle_m + (p_.carrot_lead_m / length(lead)) * lead;
-  // No progress towards the waypoint for stall_s (the stops, a wall too soft to feel): skip it.
-  if (f.t_s - move_check_t_ > p_.stall_s) {
+  if (walls_give_way() && (across || crosses)) {
+    enter_pop(f, n);
+    return MoveOutcome::Pushed;
+  }
+  return MoveOutcome::Carry;
+}
+
+bool ExplorerHand::have_plan(const HandFeel& f) {
+  if (wi_ < waypoints_.size()) return true;
+  if (f.t_s < idle_until_t_) return false;
+  if (!replan(f.handle_m)) {
+    idle_until_t_ = f.t_s + 0.5;  // nothing left to reach: hold still, look again later
+    return false;
+  }
+  move_check_t_ = f.t_s;
+  move_check_dist_ = distance(f.handle_m, waypoints_.back());
+  patched_ = false;
+  return true;
+}
+
+void ExplorerHand::advance_carrot(Vec2 handle, double dt) {
+  // The carrot runs through the waypoints at the sweep speed, never far ahead of the handle.
+  double step = p_.sweep_speed_m_per_s * dt;
+  while (wi_ < waypoints_.size()) {
+    const Vec2 to = waypoints_[wi_] - carrot_;
+    const double d = length(to);
+    if (d > step) {
+      carrot_ = carrot_ + (step / d) * to;
+      break;
+    }
+    carrot_ = waypoints_[wi_];
+    step -= d;
+    if (wi_ + 1 == waypoints_.size()) break;  // the last one is left when the handle reaches it
+    ++wi_;
+  }
+  const Vec2 lead = carrot_ - handle;
+  if (length(lead) > p_.carrot_lead_m) carrot_ = handle + (p_.carrot_lead_m / length(lead)) * lead;
+}
+
+void ExplorerHand::check_goal(const HandFeel& f) {
+  const Vec2 goal = waypoints_.back();
+  if (wi_ + 1 >= waypoints_.size() && distance(f.handle_m, goal) < kWaypointReachM) {
+    if (const int g = cell_index(goal); g >= 0) seen_[static_cast<std::size_t>(g)] = 1;
+    wi_ = waypoints_.size();  // done: plan again next tick
+  } else if (f.t_s - move_check_t_ > p_.stall_s) {
+    // No progress towards the goal for stall_s (a wall too soft to feel, a stop): give it up as seen.
     const double now = distance(f.handle_m, goal);
     if (now > move_check_dist_ - 0.001) {
-      next_waypoint();
-    } else {
-      move_check_t_ = f.t_s;
-      move_check_dist_ = now;
+      if (const int g = cell_index(goal); g >= 0) seen_[static_cast<std::size_t>(g)] = 1;
+      wi_ = waypoints_.size();
     }
+    move_check_t_ = f.t_s;
+    move_check_dist_ = now;
   }
-  return HandCommand{carrot_, p_.max_force_n};
 }
 
 HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
@@ -272,7 +477,10 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
   const bool own_old = i >= 0 && traced_[static_cast<std::size_t>(i)] == trace_id_ &&
                        travelled_ - traced_at_m_[static_cast<std::size_t>(i)] > p_.loop_min_m;
   const bool other = i >= 0 && traced_[static_cast<std::size_t>(i)] != 0 && traced_[static_cast<std::size_t>(i)] != trace_id_;
-  retraced_ = (own_old || other) ? retraced_ + moved : 0.0;
+  // Travel since a new wall was last felt: over old walls, or off any wall (circling at an end that keeps
+  // brushing the wall it left), it grows.
+  retraced_ = (touching && !own_old && !other) ? 0.0 : retraced_ + moved;
+  if (trace_path_.empty() || distance(trace_path_.back(), f.handle_m) > 0.5 * p_.cell_m) trace_path_.push_back(f.handle_m);
   if (touching) {
     mark_traced(f.handle_m);
     if (!p_.grooves) mark_traced(f.handle_m + 0.0015 * n_);
@@ -281,14 +489,17 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
   if (!start_settled_ && travelled_ > 0.003) {
     start_settled_ = true;
     trace_start_ = f.handle_m;
+    start_heading_ = static_cast<double>(sense_) * left_perp(n_);
     travelled_at_start_ = travelled_;
   }
   // When the trace ends.
   bool done = false;
-  const long closed_before = stats_.traces_closed;
-  if (start_settled_ && travelled_ - travelled_at_start_ > p_.loop_min_m && distance(f.handle_m, trace_start_) < p_.loop_close_m) {
+  // Round when back at the start going the same way (not passing it on the far side of a thin stroke).
+  if (start_settled_ && travelled_ - travelled_at_start_ > p_.loop_min_m && distance(f.handle_m, trace_start_) < p_.loop_close_m &&
+      dot(static_cast<double>(sense_) * left_perp(n_), start_heading_) > 0.5) {
     done = true;
     ++stats_.traces_closed;
+    skip_small_loop();
   }
   if (!done && f.t_s - trace_t0_ > p_.trace_max_s) {
     done = true;
@@ -298,22 +509,7 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
     done = true;
     ++stats_.traces_lost;
   }
-  if (bypass_) {
-    // Back on the sweep line, past the obstacle: carry on sweeping. Round to the start again: the waypoint is
-    // out of reach (inside a closed shape), skip it.
-    const Vec2 a = bypass_from_, b = waypoints_[wi_];
-    const double off = std::abs(cross(normalized_or(b - a, Vec2{1, 0}), f.handle_m - a));
-    if (!done && off < kBypassLineM && distance(f.handle_m, b) < bypass_goal_dist_ - kBypassGainM) {
-      enter_move(f.handle_m);
-      return HandCommand{f.handle_m, p_.max_force_n};
-    }
-    if (stats_.traces_closed > closed_before) {
-      next_waypoint();
-      enter_move(f.handle_m);
-      return HandCommand{f.handle_m, p_.max_force_n};
-    }
-  }
-  if (!done && !bypass_ && retraced_ > p_.retrace_max_m) {
+  if (!done && retraced_ > p_.retrace_max_m) {
     done = true;
     ++stats_.traces_retraced;
   }
@@ -349,20 +545,20 @@ HandCommand ExplorerHand::step_pop(const HandFeel& f) {
   const double push = kPopFactor * p_.pop_force_n;
   const double back = dot(f.device_force_n, pop_n_);
   const double since = f.t_s - pop_t0_;
-  if (since > 0.0 && back < p_.contact_force_n) {  // the wall gave way
+  // Press along the wall's normal as felt now: pressed off it, the proxy slides and the press never holds.
+  const double felt = length(f.device_force_n);
+  if (felt > p_.contact_force_n) pop_n_ = normalized_or(0.8 * pop_n_ + 0.2 * ((1.0 / felt) * f.device_force_n), pop_n_);
+  if (since > 0.0 && (f.heard_pop || back < p_.contact_force_n)) {  // the wall gave way (heard, or felt)
     ++stats_.pops_through;
     ignore_until_t_ = f.t_s + kReleaseIgnoreS;
     enter_move(f.handle_m);
     return HandCommand{f.handle_m, p_.max_force_n};
   }
   if (since > p_.pop_hold_s + kPopExtraS || dot(pop_start_ - f.handle_m, pop_n_) > p_.pop_travel_max_m) {
-    // The wall did not give way: go round it to the far side of the sweep line, or end the sweep line here.
-    if (p_.bypass_walls) {
-      enter_trace(f, pop_n_, true);
-      return step_trace(f, 0.0);
-    }
+    // The wall did not give way: what lay beyond it is given up for this pass; plan afresh.
+    if (!waypoints_.empty())
+      if (const int g = cell_index(waypoints_.back()); g >= 0) seen_[static_cast<std::size_t>(g)] = 1;
     enter_move(f.handle_m);
-    next_waypoint();
     return HandCommand{f.handle_m, p_.max_force_n};
   }
   return HandCommand{f.handle_m - (1.05 * push / p_.hand_stiffness_n_per_m) * pop_n_, push};

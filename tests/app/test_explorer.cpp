@@ -135,10 +135,9 @@ TEST(Explorer, TracesASquareInsideASquare) {
 }
 
 // Issue 14's target: with --hand explorer --duration 120, coverage >= 80 % of the curves' length on at least
-// 90 % of the pictures (20 of the 22). NOT MET YET: 17 of 22 on 2026-11-22 (the five busiest pictures, with
-// 40-120 curves, stay at 0.61-0.67; figures in docs/PERFORMANCE.md, "Every shape within reach"). This test
-// guards what is reached, 80 % on at least 16 of the 22 pictures, and prints every figure; raise it to the
-// issue's 90 % when the explorer gets there. Two runs at a time (the machine's two cores).
+// 90 % of the pictures (20 of the 22). 21 of 22 on 2026-11-22 with seed 1 (and with seeds 2 and 3; sudoku stays
+// just under, 0.70-0.79); figures in docs/PERFORMANCE.md, "Every shape within reach". Two runs at a time (the
+// machine's two cores).
 TEST(Explorer, CoversFourFifthsOfTheCurvesOnMostPictures) {
   const std::vector<fs::path> images = test_images();
   ASSERT_GE(images.size(), 10u);
@@ -171,6 +170,6 @@ TEST(Explorer, CoversFourFifthsOfTheCurvesOnMostPictures) {
     reached += coverage[i] >= 0.80;
   }
   std::printf("explorer coverage >= 0.80 on %zu of %zu pictures\n", reached, images.size());
-  EXPECT_GE(reached, 16u) << reached << " of " << images.size() << " pictures at >= 80 % (issue 14 asks for 90 %: 20 of 22)";
+  EXPECT_GE(10 * reached, 9 * images.size()) << reached << " of " << images.size() << " pictures at >= 80 % (issue 14: 90 %)";
   fs::remove_all(tmp);
 }

@@ -31,6 +31,7 @@ Polyline square(Vec2 c, double half, double step) {
 
 struct LoopResult {
   double max_command_force_n = 0.0;
+  std::vector<Vec2> handle_m;  // per tick
   std::vector<HandCommand> commands;
 };
 
@@ -55,13 +56,47 @@ LoopResult run_loop(const Scene& sc, ExplorerHand& hand, double seconds, bool ke
     in.sample = dev.read();
     servo.update(in, so);
     dev.write_force(so.force_n);
-    const HandCommand c = hand.command(HandFeel{k * sp.period_s, dev.true_position_m(), dev.velocity_m_per_s(), dev.commanded_force_n()});
+    const bool heard_pop = (so.contact.events & kEventPopThrough) != 0;
+    const HandCommand c =
+        hand.command(HandFeel{k * sp.period_s, dev.true_position_m(), dev.velocity_m_per_s(), dev.commanded_force_n(), heard_pop});
+    r.handle_m.push_back(dev.true_position_m());
     r.max_command_force_n = std::max(r.max_command_force_n, c.max_force_n);
     if (keep_commands) r.commands.push_back(c);
     hp.max_force_n = c.max_force_n;
     dev.step(sp.period_s, model_hand_force(hp, c.target_m, dev.true_position_m(), dev.velocity_m_per_s()));
   }
   return r;
+}
+
+// Runs the hand open-loop against nothing: the handle goes where the hand pulls it (an ideal, massless hand).
+std::vector<Vec2> run_free(ExplorerHand& hand, double seconds) {
+  std::vector<Vec2> path;
+  Vec2 handle = hand.start_m();
+  for (long k = 0; k < static_cast<long>(seconds / 0.001); ++k) {
+    handle = hand.command(HandFeel{k * 0.001, handle, {}, {}}).target_m;
+    path.push_back(handle);
+  }
+  return path;
+}
+
+// The largest and the mean distance from the points of a 1 mm grid over |x| <= hx, |y| <= hy to the path [m].
+struct Gap {
+  double largest_m = 0.0;
+  double mean_m = 0.0;
+};
+Gap gap_to(const std::vector<Vec2>& path, double hx, double hy) {
+  Gap g;
+  long n = 0;
+  for (double y = -hy; y <= hy + 1e-12; y += 0.001)
+    for (double x = -hx; x <= hx + 1e-12; x += 0.001) {
+      double best = 1e9;
+      for (std::size_t k = 0; k < path.size(); k += 5) best = std::min(best, distance(path[k], {x, y}));
+      g.largest_m = std::max(g.largest_m, best);
+      g.mean_m += best;
+      ++n;
+    }
+  g.mean_m /= static_cast<double>(std::max(n, 1L));
+  return g;
 }
 
 }  // namespace
@@ -158,6 +193,78 @@ TEST(ExplorerHand, TracesASquareRoundThenPushesIntoItWithMoreThanThePopForce) {
   EXPECT_GE(traced, points * 9 / 10) << traced << " of " << points;
   EXPECT_GE(h.stats().pops, 1) << "the sweep met the traced square again and pushed at it";
   EXPECT_NEAR(r.max_command_force_n, 1.1 * p.pop_force_n, 1e-9) << "over the give-way force, under the wall's 3.5 N clamp";
+}
+
+TEST(ExplorerHand, OnAnEmptyWorkspaceItsPlansSweepEveryPlaceAboutASpacingApart) {
+  // Nothing to feel: the plans alone must reach every cell of the memory grid, so no place of the workspace (less
+  // the 3 mm margin) lies farther from the path than the footprint reaches (sweep_spacing_m across from the far side
+  // of the handle's cell, half a cell along), and the first pass must end. The lines lie about a spacing apart: on average a place is within a third of a
+  // spacing of the path (a perfect raster: a quarter), and the first pass takes no longer than 1.5 x its lines'
+  // length at the sweep speed.
+  ExplorerParams p;
+  for (std::uint64_t seed : {1u, 2u}) {
+    p.seed = seed;
+    ExplorerHand h(p);
+    const double hx = p.workspace_width_m / 2 - 0.003, hy = p.workspace_height_m / 2 - 0.003;
+    const double lines_s = (2 * hx) * (2 * hy) / p.sweep_spacing_m / p.sweep_speed_m_per_s;
+    const std::vector<Vec2> path = run_free(h, 1.5 * lines_s);
+    EXPECT_GE(h.stats().passes, 2) << "seed " << seed << ": the first pass ended";
+    EXPECT_EQ(h.stats().traces, 0);
+    EXPECT_EQ(h.stats().pops, 0);
+    const Gap g = gap_to(path, hx, hy);
+    EXPECT_LE(g.largest_m, p.sweep_spacing_m + p.cell_m / 2) << "seed " << seed;
+    EXPECT_LE(g.mean_m, p.sweep_spacing_m / 3) << "seed " << seed;
+    for (const Vec2& q : path) {
+      ASSERT_LE(std::abs(q.x), p.workspace_width_m / 2) << "seed " << seed;
+      ASSERT_LE(std::abs(q.y), p.workspace_height_m / 2) << "seed " << seed;
+    }
+  }
+}
+
+TEST(ExplorerHand, AWallGivesWayWhenThePushThroughEarconIsHeardEvenIfItPressesBackAgainAtOnce) {
+  // Pressing through one wall onto another just behind it, the force never falls: the earcon tells the hand.
+  ExplorerParams p;
+  ExplorerHand h(p);
+  const Vec2 at = h.start_m();
+  h.command(HandFeel{0.0, at, {}, {}});
+  h.command(HandFeel{0.001, at, {}, {0.0, 1.5}});  // a wall: a trace begins and marks it
+  ASSERT_EQ(h.phase(), ExplorerPhase::Trace);
+  ASSERT_TRUE(h.traced_at(at));
+  // Hold it until the trace gives up (no progress for stall_s), back in Move beside a remembered wall.
+  double t = 0.002;
+  for (; t < 3.0 && h.phase() != ExplorerPhase::Move; t += 0.001) h.command(HandFeel{t, at, {}, {0.0, 1.5}});
+  ASSERT_EQ(h.phase(), ExplorerPhase::Move);
+  // Planned towards the wall (y decreasing from a top corner, or across it) it pushes where it stands across the way;
+  // feel the remembered wall square against the way until a push begins.
+  for (int k = 0; k < 2000 && h.phase() != ExplorerPhase::Pop; ++k, t += 0.001) {
+    const HandCommand c = h.command(HandFeel{t, at, {}, {}});
+    const Vec2 way = c.target_m - at;
+    if (length(way) > 1e-4) h.command(HandFeel{t += 0.001, at, {}, -(1.5 / length(way)) * way});
+  }
+  ASSERT_EQ(h.phase(), ExplorerPhase::Pop);
+  const long through = h.stats().pops_through;
+  h.command(HandFeel{t + 0.001, at, {}, {0.0, 3.2}, false});
+  EXPECT_EQ(h.phase(), ExplorerPhase::Pop) << "still pressed back, nothing heard: still pushing";
+  h.command(HandFeel{t + 0.002, at, {}, {0.0, 3.2}, true});
+  EXPECT_EQ(h.phase(), ExplorerPhase::Move) << "the earcon: the wall gave way";
+  EXPECT_EQ(h.stats().pops_through, through + 1);
+}
+
+TEST(ExplorerHand, WithPushThroughOffItNeverPushesHardAndSweepsRoundAClosedShape) {
+  // pop_force_n = 0: remembered walls are impassable to the plans; the hand never presses harder than its usual
+  // max_force_n, the square is traced, and the sweep carries on outside it (plans keep being made).
+  const Scene sc = Scene::build({square({0.0, 0.0}, 0.015, 0.001)}, 4);
+  ExplorerParams p;
+  p.pop_force_n = 0.0;
+  ExplorerHand h(p);
+  const LoopResult r = run_loop(sc, h, 40.0);
+  EXPECT_LE(r.max_command_force_n, p.max_force_n);
+  EXPECT_EQ(h.stats().pops, 0);
+  EXPECT_GE(h.stats().traces_closed, 1);
+  EXPECT_GE(h.stats().plans, 50);
+  long inside = 0;
+  for (const Vec2& q : r.handle_m) inside += std::abs(q.x) < 0.012 && std::abs(q.y) < 0.012;
+  EXPECT_EQ(inside, 0) << "the handle came well inside the square without pushing through";
 }
 
 }  // namespace hk

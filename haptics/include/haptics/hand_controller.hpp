@@ -20,6 +20,8 @@ struct HandFeel {
   Vec2 handle_m;                     ///< where the handle is [m] (the device's true position)
   Vec2 handle_velocity_m_per_s;      ///< its velocity [m/s]
   Vec2 device_force_n;               ///< the force the device put on the handle at the last tick [N] (what a fingertip feels)
+  bool heard_pop = false;            ///< the push-through earcon sounded at the last tick (what an ear hears); false where no
+                                     ///< servo output reaches the hand (the emulated device's thread)
 };
 
 /// What the model hand does at one tick.
