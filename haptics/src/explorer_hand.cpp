@@ -20,6 +20,7 @@ void require(bool ok, const char* field, const std::string& limit, double value)
 
 constexpr double kMarginM = 0.003;        // the sweep keeps this far inside the workspace edge [m]
 constexpr double kWaypointReachM = 0.0015; // a plan's end is reached within this [m]
+constexpr double kPlanAheadM = 0.004;      // the next plan is made from the goal when the handle is this near it [m]
 // Push with this times pop_force_n: over the wall's give-way force, but under the force a wall is clamped at
 // (3.5 N against the 3 N default), so the handle stops a few mm in and the press is held, not lost.
 constexpr double kPopFactor = 1.1;
@@ -441,6 +442,23 @@ void ExplorerHand::advance_carrot(Vec2 handle, double dt) {
 
 void ExplorerHand::check_goal(const HandFeel& f) {
   const Vec2 goal = waypoints_.back();
+  if (wi_ + 1 >= waypoints_.size() && distance(carrot_, goal) < 1e-9 && distance(f.handle_m, goal) < kPlanAheadM) {
+    // Nearly there: what lies between the handle and the goal will be seen; plan on from the goal, so the hand
+    // does not stop at every goal.
+    const double d = distance(f.handle_m, goal);
+    for (double u = 0.0; u <= d; u += 0.5 * p_.cell_m) mark_seen(f.handle_m + (u / std::max(d, 1e-12)) * (goal - f.handle_m));
+    mark_seen(goal);
+    if (replan(goal)) {
+      waypoints_.insert(waypoints_.begin(), goal);
+      wi_ = 0;
+      move_check_t_ = f.t_s;
+      move_check_dist_ = distance(f.handle_m, waypoints_.back());
+      patched_ = false;
+      return;
+    }
+    wi_ = waypoints_.size();
+    return;
+  }
   if (wi_ + 1 >= waypoints_.size() && distance(f.handle_m, goal) < kWaypointReachM) {
     if (const int g = cell_index(goal); g >= 0) seen_[static_cast<std::size_t>(g)] = 1;
     wi_ = waypoints_.size();  // done: plan again next tick

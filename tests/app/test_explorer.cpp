@@ -135,9 +135,9 @@ TEST(Explorer, TracesASquareInsideASquare) {
 }
 
 // Issue 14's target: with --hand explorer --duration 120, coverage >= 80 % of the curves' length on at least
-// 90 % of the pictures (20 of the 22). 21 of 22 on 2026-11-22 with seed 1 (and with seeds 2 and 3; sudoku stays
-// just under, 0.70-0.79); figures in docs/PERFORMANCE.md, "Every shape within reach". Two runs at a time (the
-// machine's two cores).
+// 90 % of the pictures (20 of the 22). 21 of 22 on 2026-11-22 with seed 1 (and with seeds 2 and 3; sudoku or
+// the butterfly just under, 0.79-0.80); figures in docs/PERFORMANCE.md, "Every shape within reach". Two runs at
+// a time (the machine's two cores).
 TEST(Explorer, CoversFourFifthsOfTheCurvesOnMostPictures) {
   const std::vector<fs::path> images = test_images();
   ASSERT_GE(images.size(), 10u);

@@ -13,7 +13,8 @@
 ///           swept before the hand pushes into the next. When every reachable cell is seen, a new pass begins with
 ///           the lines turned 90°. Feeling a wall (|device force| > contact_force_n) where the memory holds none
 ///           starts a Trace; a remembered wall the plan crosses within 6 mm is pushed through (Pop); one the plan
-///           runs beside is brushed along. No progress for stall_s: the goal is given up as seen.
+///           runs beside is brushed along. The next plan is made from the goal when the handle is 4 mm from it,
+///           so the hand does not stop at each goal. No progress for stall_s: the goal is given up as seen.
 ///   Trace — follows the outline: presses gently against the wall (press_force_n along the felt force's
 ///           opposite, n̂) while moving along t̂ = sense·left_perp(n̂) at the trace speed (the turning sense
 ///           is fixed for the whole run). At an open end the felt force swings round the end and the trace
