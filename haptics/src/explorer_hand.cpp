@@ -265,6 +265,9 @@ bool ExplorerHand::plan(Vec2 handle) {
     const int jx = orient_ == 0 ? tx + run_dir_ * len : tx, jy = orient_ == 0 ? ty : ty + run_dir_ * len;
     waypoints_.push_back(cell_centre(jy * nx_ + jx));
   }
+  // The handle's own cell unseen and nothing to run on to: the plan is that cell's centre (a plan is never
+  // empty; its last waypoint is the goal).
+  if (waypoints_.empty()) waypoints_.push_back(cell_centre(target));
   ++stats_.plans;
   return true;
 }
