@@ -33,6 +33,7 @@ min_time=0.5
 "$b/bench_device_loop" --seconds 5 --out "$out/device_loop.json" 2>/dev/null > "$out/device_loop.md"
 "$b/bench_tour_time" > "$out/tour_time.md"
 bash "$root/bench/coverage.sh" "$root/build" "$out" >/dev/null  # coverage per picture: CSV, chart and its table
+bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detectors.md"  # issue 15: each picture's scene, canny → auto
 # Tables printed by the audio and servo benches go between their markers in PERFORMANCE.md.
 /usr/bin/python3 - "$out" "$root/docs/PERFORMANCE.md" <<'PY'
 import re, sys

@@ -316,6 +316,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   }
   sj["segments_in_use"] = scene.total_segments(s.haptics.level);
   sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};
+  sj["detector"] = vision::detector_name(is.detector);
+  sj["two_tone"] = {{"two_tone", is.tones.two_tone}, {"threshold", is.tones.threshold}, {"near_share", is.tones.near_share}, {"ink_width_px", is.tones.ink_width_px}, {"line_drawing", is.line_drawing}};
   sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms}, {"thin_lines", is.times.thin_lines_ms},
                     {"multires", is.times.multires_ms}, {"tree", is.times.tree_ms}};
   write_text(out / "summary.json", sj.dump(2) + "\n");

@@ -73,6 +73,7 @@ vision::ExtractParams extract_params(const config::Settings& s) {
   p.edges.canny_low = s.vision.canny_low;
   p.edges.canny_high = s.vision.canny_high;
   p.max_image_side_px = s.vision.max_image_side_px;
+  p.detector = vision::detector_from_name(s.vision.detector);
   // Length is judged in metres below, where the workspace scale is known; keep every real chain here.
   p.min_chain_length_px = 2.0;
   return p;
@@ -84,6 +85,8 @@ void build_from_extraction(ImageScene& out, vision::Extraction ex, const config:
   out.height_px = ex.height_px;
   out.canny_low = ex.edge_map.low;
   out.canny_high = ex.edge_map.high;
+  out.detector = ex.detector_used;
+  out.tones = ex.tones;
   out.times.load_ms = ex.times.load_ms;
   out.times.edges_ms = ex.times.edges_ms;
   out.times.linking_ms = ex.times.linking_ms;
@@ -93,9 +96,14 @@ void build_from_extraction(ImageScene& out, vision::Extraction ex, const config:
   // Thin lines (issue 6, item 4): the two edges of a stroke thinner than a fingertip can resolve become
   // its centre line. Merged at the resolution the edges were found at (extract_chains returns original
   // pixels; the inverse of its scale-back is exact), where the chains are 8-connected pixel walks.
+  // Traced outlines (a two-tone picture) are merged too when the picture is a line drawing — its ink on
+  // average no wider than a thin line — and otherwise stay as they are: a silhouette keeps one closed curve
+  // per outline, exact to the pixel, its narrow parts included.
   std::vector<vision::Chain> chains = std::move(ex.chains);
   vision::PointValues point_strength = std::move(ex.point_strength);
-  if (s.vision.thin_line_max_width_m > 0.0) {
+  const double ink_width_m = ex.tones.ink_width_px * ex.px_scale * out.px_to_m.scale_m_per_px;
+  out.line_drawing = ex.detector_used == vision::Detector::Outline && ink_width_m <= s.vision.thin_line_max_width_m;
+  if (s.vision.thin_line_max_width_m > 0.0 && (ex.detector_used == vision::Detector::Canny || out.line_drawing)) {
     const auto t0 = std::chrono::steady_clock::now();
     const double sx = static_cast<double>(ex.width_px) / ex.edge_map.edges.cols;
     const double sy = static_cast<double>(ex.height_px) / ex.edge_map.edges.rows;

@@ -75,7 +75,12 @@ struct ImageScene {
   std::size_t chains_over_budget = 0;       ///< dropped: the scene would hold more than vision.max_segments level-0 segments (least salient dropped first)
   std::size_t segments_before_budget = 0;   ///< level-0 segments of the scene of every curve long enough to feel
   std::size_t segments_after_budget = 0;    ///< level-0 segments of the scene built (<= vision.max_segments)
-  double canny_low = 0, canny_high = 0;
+  double canny_low = 0, canny_high = 0;     ///< Canny's thresholds; for traced outlines low = 0, high = the sure strength (vision::Extraction::edge_map)
+  vision::Detector detector = vision::Detector::Canny;  ///< how the boundaries were found (what [vision] detector "auto" chose)
+  vision::TwoTone tones;                    ///< the picture's two tones, when it was classified
+  /// Outline detector and the foreground's mean width (tones.ink_width_px, in metres at the workspace scale) at
+  /// most vision.thin_line_max_width_m: a line drawing, whose strokes were merged to centre lines.
+  bool line_drawing = false;
   std::vector<Polyline> polylines;          ///< kept chains in workspace metres
   /// strength[i]: mean edge strength along polylines[i], in Canny threshold units (the Sobel-3x3 L2
   /// gradient magnitude Canny thresholded, vision::Extraction::point_strength; a centre line takes

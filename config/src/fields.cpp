@@ -100,6 +100,7 @@ constexpr std::array<std::string_view, 3> kTransports{"auto", "usb", "tty"};
 constexpr std::array<std::string_view, 2> kRotations{"cw", "ccw"};
 constexpr std::array<std::string_view, 2> kLevelModes{"auto", "fixed"};
 constexpr std::array<std::string_view, 2> kRenderModes{"walls", "grooves"};
+constexpr std::array<std::string_view, 3> kDetectors{"auto", "canny", "outline"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>({
@@ -205,6 +206,9 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(vision, max_image_side_px, FieldGroup::scene, ApplyWhen::scene, 64, 10000, "px", "Images are downscaled to this longest side."),
     HK_FIELD(vision, max_segments, FieldGroup::scene, ApplyWhen::scene, 100, 1000000, "", "Scene budget: level-0 segments kept, the most salient curves first."),
     HK_FIELD(vision, thin_line_max_width_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.01, "m", "The two edges of a line thinner than this become one curve; 0 = off."),
+    HK_FIELD(vision, detector, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
+             "\"auto\": two-tone pictures (silhouettes, drawings) traced from a threshold, others by Canny; \"canny\"; \"outline\": always traced from a threshold.",
+             kDetectors),
     // [workspace]
     HK_FIELD(workspace, width_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Width of the usable rectangle."),
     HK_FIELD(workspace, height_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Height of the usable rectangle."),

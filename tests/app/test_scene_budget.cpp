@@ -112,6 +112,7 @@ TEST(SceneBudget, AStrongEdgeBeatsALongerFaintOne) {
   s.vision.canny_high = 60;  // the strong edge (~250 units) is sure, the faint one (~25) is only linked
   s.vision.canny_low = 15;
   s.vision.max_segments = 1000000;
+  s.vision.detector = "canny";  // the faint step is under the two-tone spread: "auto" would trace only the strong one
   const ImageScene full = build_image_scene(path.string(), s);
   // Which curve is which: the strong one lies on v = 150 (y of pixel row 149.5).
   const auto is_strong = [&](const Polyline& p) {

@@ -68,6 +68,15 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
+    if (name == "vision.detector") {
+      EXPECT_EQ(d.kind, FieldKind::text);
+      ASSERT_EQ(d.choices.size(), 3u);
+      EXPECT_EQ(d.choices[0], "auto");
+      EXPECT_EQ(d.choices[1], "canny");
+      EXPECT_EQ(d.choices[2], "outline");
+      ++texts;
+      continue;
+    }
     if (name == "haptics.render") {
       EXPECT_EQ(d.kind, FieldKind::text);
       ASSERT_EQ(d.choices.size(), 2u);
@@ -99,7 +108,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 23u);
+  EXPECT_EQ(texts, 24u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -240,6 +249,15 @@ TEST(ConfigValidate, UnknownRenderModeIsRefused) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "haptics.render");
   EXPECT_NE(std::string(e->what()).find("grooves"), std::string::npos) << e->what();
+}
+
+TEST(ConfigValidate, UnknownDetectorIsRefused) {
+  Settings s;
+  s.vision.detector = "sobel";
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "vision.detector");
+  EXPECT_NE(std::string(e->what()).find("outline"), std::string::npos) << e->what();
 }
 
 TEST(ConfigValidate, UnknownLevelModeIsRefused) {

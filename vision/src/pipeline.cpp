@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -50,6 +51,21 @@ PointValues chain_strength(const cv::Mat& grey, double blur_sigma_px, const std:
 
 }  // namespace
 
+const char* detector_name(Detector d) {
+  switch (d) {
+    case Detector::Auto: return "auto";
+    case Detector::Canny: return "canny";
+    case Detector::Outline: return "outline";
+  }
+  return "auto";
+}
+
+Detector detector_from_name(const std::string& name) {
+  for (Detector d : {Detector::Auto, Detector::Canny, Detector::Outline})
+    if (name == detector_name(d)) return d;
+  throw std::invalid_argument("detector '" + name + "' is not one of auto, canny, outline");
+}
+
 namespace {
 
 void check_params(const ExtractParams& p) {
@@ -59,9 +75,8 @@ void check_params(const ExtractParams& p) {
   }
 }
 
-/// The stages after the grey image is ready: edges, ignored regions cleared, linking, strength, scale back
-/// to the `full` size. `t0` is when grey conversion began (load_ms ends here).
-void extract_from_grey(const cv::Mat& grey, cv::Size full, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
+/// Canny: edges, ignored regions cleared, linking.
+void canny_chains(const cv::Mat& grey, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
   auto t0 = std::chrono::steady_clock::now();
   out.edge_map = detect_edges(grey, p.edges);
   if (!ignore_mask.empty()) {
@@ -70,9 +85,69 @@ void extract_from_grey(const cv::Mat& grey, cv::Size full, const ExtractParams& 
     out.edge_map.edges.setTo(0, small > 0);
   }
   out.times.edges_ms = ms_since(t0);
-
   t0 = std::chrono::steady_clock::now();
   out.chains = link_edges(out.edge_map.edges, p.min_chain_length_px);
+  out.detector_used = Detector::Canny;
+  out.times.linking_ms = ms_since(t0);
+}
+
+/// Outline: the two tones' boundaries, closed where they do not meet the frame (nothing to link). Chains under
+/// the ignore mask are cut there, as Canny's edges are cleared.
+void outline_chains(const cv::Mat& grey, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Chain> chains = trace_outlines(grey, out.tones.threshold);
+  if (!ignore_mask.empty()) {
+    cv::Mat small = ignore_mask;
+    if (ignore_mask.size() != grey.size()) cv::resize(ignore_mask, small, grey.size(), 0, 0, cv::INTER_AREA);
+    std::vector<Chain> kept;
+    for (Chain& c : chains) {
+      Chain piece;
+      bool cut = false;
+      for (const cv::Point2d& q : c.points_px) {
+        if (small.at<std::uint8_t>(static_cast<int>(q.y), static_cast<int>(q.x)) != 0) {
+          cut = true;
+          if (!piece.points_px.empty()) kept.push_back(std::move(piece));
+          piece = Chain{};
+        } else {
+          piece.points_px.push_back(q);
+        }
+      }
+      piece.closed = c.closed && !cut;
+      if (!piece.points_px.empty()) kept.push_back(std::move(piece));
+    }
+    chains = std::move(kept);
+  }
+  out.chains.clear();
+  for (Chain& c : chains) {
+    double len = 0.0;
+    for (std::size_t i = 1; i < c.points_px.size(); ++i) len += cv::norm(c.points_px[i] - c.points_px[i - 1]);
+    if (len >= p.min_chain_length_px) out.chains.push_back(std::move(c));
+  }
+  // The strength a blurred step between the tones gives (detect_edges' units: 8·D/(σ·√(2π)), the unblurred
+  // 3x3 Sobel of a step: 4·D), halved: as sure as Canny's high threshold.
+  const double step = out.tones.light_mean - out.tones.dark_mean;
+  const double sigma = p.edges.blur_sigma_px;
+  const double magnitude = sigma > 0.0 ? 8.0 * step / (sigma * std::sqrt(2.0 * std::numbers::pi)) : 4.0 * step;
+  // The boundary pixels kept, as an edge image like Canny's (for views and the processed size).
+  cv::Mat edges = cv::Mat::zeros(grey.size(), CV_8U);
+  for (const Chain& c : out.chains)
+    for (const cv::Point2d& q : c.points_px) edges.at<std::uint8_t>(static_cast<int>(q.y), static_cast<int>(q.x)) = 255;
+  out.edge_map = EdgeMap{edges, 0.0, 0.5 * std::min(magnitude, 4.0 * step)};
+  out.detector_used = Detector::Outline;
+  out.times.edges_ms = 0.0;
+  out.times.linking_ms = ms_since(t0);
+}
+
+/// The stages after the grey image is ready: boundaries (Canny or outline), strength, scale back to the
+/// `full` size.
+void extract_from_grey(const cv::Mat& grey, cv::Size full, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
+  if (p.detector != Detector::Canny) out.tones = classify_two_tone(grey);
+  if (p.detector == Detector::Outline || (p.detector == Detector::Auto && out.tones.two_tone)) {
+    outline_chains(grey, p, ignore_mask, out);
+  } else {
+    canny_chains(grey, p, ignore_mask, out);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
   out.point_strength = chain_strength(grey, p.edges.blur_sigma_px, out.chains);
   if (grey.size() != full) {
     // Pixel-centre correspondence of area resampling: processed pixel i covers original
@@ -83,7 +158,7 @@ void extract_from_grey(const cv::Mat& grey, cv::Size full, const ExtractParams& 
       for (cv::Point2d& q : c.points_px) q = {(q.x + 0.5) * sx - 0.5, (q.y + 0.5) * sy - 0.5};
     }
   }
-  out.times.linking_ms = ms_since(t0);
+  out.times.linking_ms += ms_since(t0);
 }
 
 }  // namespace

@@ -16,7 +16,8 @@ namespace hk::vision {
 /// One linked edge: an ordered polyline through pixel centres.
 struct Chain {
   /// Points in pixel coordinates (u right, v down, origin at the centre of the top-left pixel)
-  /// [px]. From link_edges: integer-valued, consecutive points 8-adjacent, no pixel twice.
+  /// [px]. From link_edges: integer-valued, consecutive points 8-adjacent, no pixel twice (from
+  /// trace_outlines: the same, but a pixel may come twice where the region is one pixel wide).
   /// A closed chain does NOT repeat its first point at the end; its last point joins the first.
   std::vector<cv::Point2d> points_px;
   bool closed = false;  ///< true when the chain is a loop

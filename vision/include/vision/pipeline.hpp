@@ -6,17 +6,32 @@
 /// hundred features across the workspace and Canny on a 40 MP photo would take seconds; the
 /// chains are scaled back to the original pixel grid so that the caller maps one image size.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "vision/edges.hpp"
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
+#include "vision/outline.hpp"
 
 namespace hk::vision {
 
+/// How boundaries are found ([vision] detector).
+enum class Detector : std::uint8_t {
+  Auto,     ///< Outline for a two-tone picture (classify_two_tone), Canny for any other
+  Canny,    ///< detect_edges + link_edges (Gaussian blur, Canny, pixel-graph linking)
+  Outline,  ///< trace_outlines at Otsu's threshold, whatever the picture
+};
+
+/// The [vision] detector name of `d`: "auto", "canny" or "outline".
+const char* detector_name(Detector d);
+/// The Detector named `name`; throws std::invalid_argument (naming the choices) for any other name.
+Detector detector_from_name(const std::string& name);
+
 /// Parameters of extract_chains.
 struct ExtractParams {
+  Detector detector = Detector::Auto;  ///< how boundaries are found
   ImageLimits limits;                ///< refusal limits for the file (see load_image)
   EdgeParams edges;                  ///< edge detection, at the processed resolution
   int max_image_side_px = 800;       ///< longest side the image is shrunk to before edges [px], >= 1
@@ -46,15 +61,22 @@ struct Extraction {
   /// 8 D / (sigma sqrt(2 pi))). Used to rank curves by salience: a faint shading edge matters less
   /// than a strong outline of the same length.
   PointValues point_strength;
-  EdgeMap edge_map;  ///< edges at the processed resolution
+  /// Canny: the edges and the thresholds used, at the processed resolution. Outline: `edges` the traced
+  /// boundary pixels kept (255, at the processed resolution), low = 0
+  /// and high = half the Sobel magnitude a blurred step between the two tones gives (a boundary as sure as
+  /// one over Canny's high threshold), so curve strengths compare with `high` alike.
+  EdgeMap edge_map;
+  Detector detector_used = Detector::Canny;  ///< Canny or Outline (what Auto chose)
+  TwoTone tones;                             ///< classify_two_tone of the processed grey image (Auto and Outline)
   double px_scale;   ///< original px per processed px (>= 1; 1 = not shrunk), see to_grey
   StageTimes times;  ///< per-stage wall time
 };
 
-/// load_image -> to_grey (shrink to max_image_side_px) -> detect_edges -> link_edges
-/// (min_chain_length_px, measured at the processed resolution like the blur) -> edge strength at
-/// each chain point (see Extraction::point_strength; the blur and Sobel of detect_edges, sampled
-/// at the chain points only) -> chains scaled back to original pixels.
+/// load_image -> to_grey (shrink to max_image_side_px) -> boundaries: detect_edges -> link_edges
+/// (min_chain_length_px, measured at the processed resolution like the blur), or for a two-tone picture
+/// (ExtractParams::detector) trace_outlines -> edge strength at each chain point (see
+/// Extraction::point_strength; the blur and Sobel of detect_edges, sampled at the chain points only) ->
+/// chains scaled back to original pixels.
 ///
 /// @throws InputError when the file is refused (see load_image).
 /// @throws std::invalid_argument on invalid parameters.
