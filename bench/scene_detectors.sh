@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The scene of every picture of tests/data/images, before and after issue 15's detector choice (a two-tone
-# picture traced from a threshold instead of found by Canny): per picture, for [vision] detector = "canny" (the
-# old pipeline) and "auto" (the default): the detector used, shapes (curves kept), closed share, level-0
-# segments in use and build time [ms] (the sum of summary.json build_ms).
+# The scene of every picture of tests/data/images, before and after issue 15 (a two-tone picture traced from a
+# threshold instead of found by Canny; chain ends across gaps up to gap_close_m joined): per picture, for the
+# old pipeline ([vision] detector = "canny", gap_close_m = 0) and the defaults: the detector used, shapes
+# (curves kept), closed share, level-0 segments in use, gaps closed and build time [ms] (the sum of
+# summary.json build_ms).
 # Writes OUT/scene_detectors.csv and prints it as a table.
 # Usage: bench/scene_detectors.sh [BUILD_DIR] [OUT_DIR]
 set -euo pipefail
@@ -14,7 +15,7 @@ exe="$build/app/haptic-kiosk"
 mkdir -p "$out"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-printf '[vision]\ndetector = "canny"\n' > "$work/canny.toml"
+printf '[vision]\ndetector = "canny"\ngap_close_m = 0\n' > "$work/canny.toml"
 for img in "$root"/tests/data/images/*; do
   name="$(basename "$img")"
   "$exe" explore "$img" --out "$work/canny/$name" --duration 0.05 --config "$work/canny.toml" > /dev/null
@@ -33,15 +34,16 @@ for name in sorted(os.listdir(os.path.join(work, "auto"))):
         row[mode + "_shapes"] = len(curves)
         row[mode + "_closed"] = round(sum(c["closed"] for c in curves) / max(len(curves), 1), 2)
         row[mode + "_segments"] = d["segments_in_use"]
+        row[mode + "_gaps_closed"] = d["chains"]["gaps_closed"]
         row[mode + "_build_ms"] = round(sum(d["build_ms"].values()), 1)
     rows.append(row)
 with open(path, "w", newline="") as f:
     w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
     w.writeheader()
     w.writerows(rows)
-print("| picture | detector | shapes | closed | segments | build ms |")
-print("|---|---|---|---|---|---|")
+print("| picture | detector | shapes | closed | segments | gaps closed | build ms |")
+print("|---|---|---|---|---|---|---|")
 for r in rows:
     print(f"| {r['picture']} | {r['auto_detector']} | {r['canny_shapes']} → {r['auto_shapes']} | {r['canny_closed']:.2f} → {r['auto_closed']:.2f} "
-          f"| {r['canny_segments']} → {r['auto_segments']} | {r['canny_build_ms']} → {r['auto_build_ms']} |")
+          f"| {r['canny_segments']} → {r['auto_segments']} | {r['auto_gaps_closed']} | {r['canny_build_ms']} → {r['auto_build_ms']} |")
 PY

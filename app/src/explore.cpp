@@ -278,7 +278,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["curves"] = scene.curve_count();
   // What the scene left out and why (issue 6, item 4), in pipeline order.
   sj["chains"] = {{"found", is.chains_found}, {"thin_line_pairs_merged", is.thin_line_pairs_merged},
-                  {"after_thin_lines", is.chains_after_thin_lines}, {"too_short", is.chains_too_short},
+                  {"after_thin_lines", is.chains_after_thin_lines}, {"gaps_closed", is.gaps_closed},
+                  {"closed_by_gaps", is.chains_closed_by_gaps}, {"after_gaps", is.chains_after_gaps}, {"too_short", is.chains_too_short},
                   {"over_budget", is.chains_over_budget}, {"unbuildable", scene.skipped_curves()}};
   sj["segments_budget"] = {{"max_segments", s.vision.max_segments}, {"before", is.segments_before_budget}, {"after", is.segments_after_budget}};
   json segs = json::array();
@@ -318,7 +319,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};
   sj["detector"] = vision::detector_name(is.detector);
   sj["two_tone"] = {{"two_tone", is.tones.two_tone}, {"threshold", is.tones.threshold}, {"near_share", is.tones.near_share}, {"ink_width_px", is.tones.ink_width_px}, {"line_drawing", is.line_drawing}};
-  sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms}, {"thin_lines", is.times.thin_lines_ms},
+  sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms}, {"thin_lines", is.times.thin_lines_ms}, {"gaps", is.times.gaps_ms},
                     {"multires", is.times.multires_ms}, {"tree", is.times.tree_ms}};
   write_text(out / "summary.json", sj.dump(2) + "\n");
   write_overlay(out / "overlay.png", is, s.haptics.level, proxy_path);

@@ -7,6 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "vision/gaps.hpp"
 #include "vision/thin_lines.hpp"
 
 namespace hk::app {
@@ -74,6 +75,9 @@ vision::ExtractParams extract_params(const config::Settings& s) {
   p.edges.canny_high = s.vision.canny_high;
   p.max_image_side_px = s.vision.max_image_side_px;
   p.detector = vision::detector_from_name(s.vision.detector);
+  p.line_drawing_max_ink_m = s.vision.thin_line_max_width_m;
+  p.workspace_width_m = s.workspace.width_m;
+  p.workspace_height_m = s.workspace.height_m;
   // Length is judged in metres below, where the workspace scale is known; keep every real chain here.
   p.min_chain_length_px = 2.0;
   return p;
@@ -96,14 +100,12 @@ void build_from_extraction(ImageScene& out, vision::Extraction ex, const config:
   // Thin lines (issue 6, item 4): the two edges of a stroke thinner than a fingertip can resolve become
   // its centre line. Merged at the resolution the edges were found at (extract_chains returns original
   // pixels; the inverse of its scale-back is exact), where the chains are 8-connected pixel walks.
-  // Traced outlines (a two-tone picture) are merged too when the picture is a line drawing — its ink on
-  // average no wider than a thin line — and otherwise stay as they are: a silhouette keeps one closed curve
-  // per outline, exact to the pixel, its narrow parts included.
+  // Traced outlines (a two-tone picture but a line drawing, which goes to Canny) stay as they are: a
+  // silhouette keeps one closed curve per outline, exact to the pixel, its narrow parts included.
   std::vector<vision::Chain> chains = std::move(ex.chains);
   vision::PointValues point_strength = std::move(ex.point_strength);
-  const double ink_width_m = ex.tones.ink_width_px * ex.px_scale * out.px_to_m.scale_m_per_px;
-  out.line_drawing = ex.detector_used == vision::Detector::Outline && ink_width_m <= s.vision.thin_line_max_width_m;
-  if (s.vision.thin_line_max_width_m > 0.0 && (ex.detector_used == vision::Detector::Canny || out.line_drawing)) {
+  out.line_drawing = ex.line_drawing;
+  if (s.vision.thin_line_max_width_m > 0.0 && ex.detector_used == vision::Detector::Canny) {
     const auto t0 = std::chrono::steady_clock::now();
     const double sx = static_cast<double>(ex.width_px) / ex.edge_map.edges.cols;
     const double sy = static_cast<double>(ex.height_px) / ex.edge_map.edges.rows;
@@ -123,6 +125,29 @@ void build_from_extraction(ImageScene& out, vision::Extraction ex, const config:
     out.times.thin_lines_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   out.chains_after_thin_lines = chains.size();
+
+  // Gaps (issue 15, item 3): chain ends facing each other across at most gap_close_m are joined, so outlines
+  // Canny broke at a highlight or a notch are felt closed. Not for traced outlines: closed by construction,
+  // their open ends are where a shape runs into the frame.
+  if (s.vision.gap_close_m > 0.0 && ex.detector_used == vision::Detector::Canny) {
+    const auto t0 = std::chrono::steady_clock::now();
+    vision::GapParams gp;
+    // The gap is the space between the two end pixels: their centres' distance less one pixel (of the
+    // resolution the chains were found at, px_scale original px); in original px, as the chains are.
+    gp.max_gap_px = s.vision.gap_close_m / out.px_to_m.scale_m_per_px + ex.px_scale;
+    gp.direction_span_px = std::max(gp.direction_span_px, 2.0 * gp.max_gap_px);
+    // Outlines are completed, crumbs are not assembled: each piece joined is at least half as long as a
+    // curve worth keeping (min_chain_length_m).
+    gp.min_piece_px = 0.5 * s.vision.min_chain_length_m / out.px_to_m.scale_m_per_px;
+    vision::GapStats gs;
+    vision::PointValues joined_strength;
+    chains = vision::close_gaps(chains, gp, &gs, point_strength, &joined_strength);
+    point_strength = std::move(joined_strength);
+    out.gaps_closed = gs.joins;
+    out.chains_closed_by_gaps = gs.chains_closed;
+    out.times.gaps_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  out.chains_after_gaps = chains.size();
 
   std::vector<std::size_t> kept_chain;
   out.polylines = chains_to_polylines(chains, out.px_to_m, s.vision.min_chain_length_m, &out.chains_too_short, &kept_chain);

@@ -21,7 +21,7 @@ namespace hk::app {
 
 /// Build time of each stage [ms].
 struct BuildTimes {
-  double load_ms = 0, edges_ms = 0, linking_ms = 0, thin_lines_ms = 0, multires_ms = 0, tree_ms = 0;
+  double load_ms = 0, edges_ms = 0, linking_ms = 0, thin_lines_ms = 0, gaps_ms = 0, multires_ms = 0, tree_ms = 0;
 };
 
 /// A block of text of a document page in workspace metres (issue 11, item 4): spoken, not felt.
@@ -54,7 +54,7 @@ const TextBlockM* text_block_at(const std::vector<TextBlockM>& blocks, Vec2 p);
 /// `source_index` is i.
 ///
 /// What was dropped and why, in pipeline order (each count is of the stage before it):
-///   chains_found --thin-line merging--> chains_after_thin_lines
+///   chains_found --thin-line merging--> chains_after_thin_lines --gap closing--> chains_after_gaps
 ///   = chains_too_short + chains_over_budget + polylines.size().
 struct ImageScene {
   std::string image_path;                   ///< the file (for a document page: the PDF)
@@ -71,6 +71,9 @@ struct ImageScene {
   std::size_t chains_found = 0;             ///< chains out of edge linking
   std::size_t thin_line_pairs_merged = 0;   ///< pairs of facing edges (two sides of a stroke thinner than vision.thin_line_max_width_m) felt as one centre line
   std::size_t chains_after_thin_lines = 0;  ///< chains after thin-line merging (centre lines, left-over pieces, untouched chains)
+  std::size_t gaps_closed = 0;              ///< chain ends joined across a gap of at most vision.gap_close_m (vision::close_gaps)
+  std::size_t chains_closed_by_gaps = 0;    ///< chains that came out closed from those joins
+  std::size_t chains_after_gaps = 0;        ///< chains after gap closing
   std::size_t chains_too_short = 0;         ///< dropped: shorter than vision.min_chain_length_m
   std::size_t chains_over_budget = 0;       ///< dropped: the scene would hold more than vision.max_segments level-0 segments (least salient dropped first)
   std::size_t segments_before_budget = 0;   ///< level-0 segments of the scene of every curve long enough to feel
@@ -78,8 +81,8 @@ struct ImageScene {
   double canny_low = 0, canny_high = 0;     ///< Canny's thresholds; for traced outlines low = 0, high = the sure strength (vision::Extraction::edge_map)
   vision::Detector detector = vision::Detector::Canny;  ///< how the boundaries were found (what [vision] detector "auto" chose)
   vision::TwoTone tones;                    ///< the picture's two tones, when it was classified
-  /// Outline detector and the foreground's mean width (tones.ink_width_px, in metres at the workspace scale) at
-  /// most vision.thin_line_max_width_m: a line drawing, whose strokes were merged to centre lines.
+  /// A two-tone picture whose ink (tones.ink_width_px, in metres at the workspace scale) is at most
+  /// vision.thin_line_max_width_m: a line drawing, found by Canny and its strokes merged to centre lines.
   bool line_drawing = false;
   std::vector<Polyline> polylines;          ///< kept chains in workspace metres
   /// strength[i]: mean edge strength along polylines[i], in Canny threshold units (the Sobel-3x3 L2

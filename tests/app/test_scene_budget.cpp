@@ -59,7 +59,7 @@ TEST(SceneBudget, ClutteredPhotoStaysWithinBudgetKeepingTheMostSalientCurves) {
     EXPECT_EQ(small.segments_after_budget, small.scene->total_segments(0));
     EXPECT_GT(small.chains_over_budget, 0u);
     EXPECT_EQ(small.chains_over_budget + small.polylines.size(), full.polylines.size());
-    EXPECT_EQ(small.chains_after_thin_lines, small.chains_too_short + small.chains_over_budget + small.polylines.size());
+    EXPECT_EQ(small.chains_after_gaps, small.chains_too_short + small.chains_over_budget + small.polylines.size());
     // Kept curves are full's curves, with full's strengths.
     const std::vector<std::size_t> where = find_all(small.polylines, full.polylines);
     for (std::size_t i = 0; i < where.size(); ++i) {

@@ -3,6 +3,8 @@
 
 #include "vision/pipeline.hpp"
 
+#include "vision/mapping.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -73,6 +75,10 @@ void check_params(const ExtractParams& p) {
   if (std::isnan(p.min_chain_length_px) || p.min_chain_length_px < 0.0) {
     throw std::invalid_argument("extract_chains: min_chain_length_px must be >= 0");
   }
+  if (!std::isfinite(p.line_drawing_max_ink_m) || p.line_drawing_max_ink_m < 0.0)
+    throw std::invalid_argument("extract_chains: line_drawing_max_ink_m must be finite and >= 0");
+  if (!(p.workspace_width_m > 0.0) || !(p.workspace_height_m > 0.0) || !std::isfinite(p.workspace_width_m) || !std::isfinite(p.workspace_height_m))
+    throw std::invalid_argument("extract_chains: the workspace must be finite and > 0");
 }
 
 /// Canny: edges, ignored regions cleared, linking.
@@ -142,7 +148,12 @@ void outline_chains(const cv::Mat& grey, const ExtractParams& p, const cv::Mat& 
 /// `full` size.
 void extract_from_grey(const cv::Mat& grey, cv::Size full, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
   if (p.detector != Detector::Canny) out.tones = classify_two_tone(grey);
-  if (p.detector == Detector::Outline || (p.detector == Detector::Auto && out.tones.two_tone)) {
+  if (out.tones.two_tone && p.line_drawing_max_ink_m > 0.0) {
+    const double m_per_px = fit_to_workspace(full.width, full.height, p.workspace_width_m, p.workspace_height_m).scale_m_per_px;
+    const double px_scale = static_cast<double>(full.width) / grey.cols;
+    out.line_drawing = out.tones.ink_width_px * px_scale * m_per_px <= p.line_drawing_max_ink_m;
+  }
+  if (p.detector == Detector::Outline || (p.detector == Detector::Auto && out.tones.two_tone && !out.line_drawing)) {
     outline_chains(grey, p, ignore_mask, out);
   } else {
     canny_chains(grey, p, ignore_mask, out);

@@ -19,7 +19,7 @@ namespace hk::vision {
 
 /// How boundaries are found ([vision] detector).
 enum class Detector : std::uint8_t {
-  Auto,     ///< Outline for a two-tone picture (classify_two_tone), Canny for any other
+  Auto,     ///< Outline for a two-tone picture (classify_two_tone) but a line drawing, Canny for any other
   Canny,    ///< detect_edges + link_edges (Gaussian blur, Canny, pixel-graph linking)
   Outline,  ///< trace_outlines at Otsu's threshold, whatever the picture
 };
@@ -36,6 +36,12 @@ struct ExtractParams {
   EdgeParams edges;                  ///< edge detection, at the processed resolution
   int max_image_side_px = 800;       ///< longest side the image is shrunk to before edges [px], >= 1
   double min_chain_length_px = 20;   ///< shortest chain kept [processed px], >= 0 (see link_edges)
+  /// Auto: a two-tone picture whose ink (TwoTone::ink_width_px) is at most this wide at the workspace scale is
+  /// a line drawing and goes to Canny, whose two edges of each stroke the caller merges into one centre line
+  /// (thin_lines.hpp); wider ink is traced as outlines. 0 = no picture is a line drawing. [m], >= 0
+  double line_drawing_max_ink_m = 0.0;
+  double workspace_width_m = 0.14;   ///< the workspace the picture is fitted to (fit_to_workspace) [m], > 0
+  double workspace_height_m = 0.09;  ///< [m], > 0
 };
 
 /// Wall-clock time of each stage [ms].
@@ -67,6 +73,7 @@ struct Extraction {
   /// one over Canny's high threshold), so curve strengths compare with `high` alike.
   EdgeMap edge_map;
   Detector detector_used = Detector::Canny;  ///< Canny or Outline (what Auto chose)
+  bool line_drawing = false;                 ///< two-tone, but ink no wider than ExtractParams::line_drawing_max_ink_m
   TwoTone tones;                             ///< classify_two_tone of the processed grey image (Auto and Outline)
   double px_scale;   ///< original px per processed px (>= 1; 1 = not shrunk), see to_grey
   StageTimes times;  ///< per-stage wall time
