@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The scene of every picture of tests/data/images, before and after issue 15 (a two-tone picture traced from a
 # threshold instead of found by Canny; chain ends across gaps up to gap_close_m joined): per picture, for the
-# old pipeline ([vision] detector = "canny", gap_close_m = 0) and the defaults: the detector used, shapes
+# old pipeline ([vision] detector = "canny", gap_close_m = 0, max_shapes = 1000: no shape budget) and the defaults: the detector used, shapes
 # (curves kept), closed share, level-0 segments in use, gaps closed and build time [ms] (the sum of
 # summary.json build_ms).
 # Writes OUT/scene_detectors.csv and prints it as a table.
@@ -15,7 +15,7 @@ exe="$build/app/haptic-kiosk"
 mkdir -p "$out"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-printf '[vision]\ndetector = "canny"\ngap_close_m = 0\n' > "$work/canny.toml"
+printf '[vision]\ndetector = "canny"\ngap_close_m = 0\nmax_shapes = 1000\n' > "$work/canny.toml"
 for img in "$root"/tests/data/images/*; do
   name="$(basename "$img")"
   "$exe" explore "$img" --out "$work/canny/$name" --duration 0.05 --config "$work/canny.toml" > /dev/null

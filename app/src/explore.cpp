@@ -280,7 +280,9 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   sj["chains"] = {{"found", is.chains_found}, {"thin_line_pairs_merged", is.thin_line_pairs_merged},
                   {"after_thin_lines", is.chains_after_thin_lines}, {"gaps_closed", is.gaps_closed},
                   {"closed_by_gaps", is.chains_closed_by_gaps}, {"after_gaps", is.chains_after_gaps}, {"too_short", is.chains_too_short},
+                  {"along_border", is.chains_along_border}, {"over_max_shapes", is.chains_over_max_shapes},
                   {"over_budget", is.chains_over_budget}, {"unbuildable", scene.skipped_curves()}};
+  sj["shapes_budget"] = {{"max_shapes", s.vision.max_shapes}, {"kept", is.polylines.size()}};
   sj["segments_budget"] = {{"max_segments", s.vision.max_segments}, {"before", is.segments_before_budget}, {"after", is.segments_after_budget}};
   json segs = json::array();
   for (int l = 0; l < Scene::kMaxLevels; ++l) {

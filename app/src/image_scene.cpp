@@ -17,6 +17,43 @@ double curve_salience(double length_m, double strength, double canny_high) {
   return length_m * std::clamp(strength / canny_high, 0.0, 1.0);
 }
 
+double polyline_length_m(const Polyline& p) {
+  double l = 0.0;
+  for (std::size_t i = 1; i < p.points_m.size(); ++i) l += distance(p.points_m[i - 1], p.points_m[i]);
+  if (p.closed && p.points_m.size() > 1) l += distance(p.points_m.back(), p.points_m.front());
+  return l;
+}
+
+double shape_salience(const ShapeFeatures& f, double canny_high) {
+  if (!std::isfinite(f.area_m2) || f.area_m2 < 0.0) return 0.0;
+  if (!std::isfinite(f.length_m) || !std::isfinite(f.strength) || !std::isfinite(canny_high) || canny_high <= 0.0) return 0.0;
+  const double outline_m = f.length_m + (f.closed ? 2.0 * std::sqrt(f.area_m2) : 0.0);
+  return outline_m * std::max(0.0, f.strength) / canny_high;
+}
+
+double enclosed_area_m2(const Polyline& p) {
+  const std::size_t n = p.points_m.size();
+  double twice = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 a = p.points_m[i], b = p.points_m[(i + 1) % n];
+    twice += a.x * b.y - b.x * a.y;
+  }
+  return 0.5 * std::abs(twice);
+}
+
+double border_share(const Polyline& p, const vision::PxToM& map, int width_px, int height_px, double band_m) {
+  if (p.points_m.empty()) return 0.0;
+  const double band_px = band_m / map.scale_m_per_px;
+  std::size_t near = 0;
+  for (const Vec2& q : p.points_m) {
+    const double u = map.u_px(q.x), v = map.v_px(q.y);
+    // The frame is the outer edge of the outer pixels: u = -0.5 and u = width - 0.5.
+    const double to_frame = std::min({u + 0.5, width_px - 0.5 - u, v + 0.5, height_px - 0.5 - v});
+    near += to_frame <= band_px;
+  }
+  return static_cast<double>(near) / static_cast<double>(p.points_m.size());
+}
+
 std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chains, const vision::PxToM& map, double min_length_m,
                                           std::size_t* too_short, std::vector<std::size_t>* kept) {
   std::vector<Polyline> out;
@@ -52,14 +89,6 @@ double mean(const std::vector<double>& v) {
   return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
 }
 
-/// Polyline length [m], with the closing segment of a closed curve (what a hand can follow).
-double length_m(const Polyline& p) {
-  double l = 0.0;
-  for (std::size_t i = 1; i < p.points_m.size(); ++i) l += distance(p.points_m[i - 1], p.points_m[i]);
-  if (p.closed && p.points_m.size() > 1) l += distance(p.points_m.back(), p.points_m.front());
-  return l;
-}
-
 }  // namespace
 
 namespace {
@@ -81,6 +110,57 @@ vision::ExtractParams extract_params(const config::Settings& s) {
   // Length is judged in metres below, where the workspace scale is known; keep every real chain here.
   p.min_chain_length_px = 2.0;
   return p;
+}
+
+/// The budgets (issue 6, item 4; issue 15, item 2): curves along the picture's frame are dropped; the rest
+/// are taken in decreasing shape_salience (ties: pipeline order) and each is kept while fewer than
+/// vision.max_shapes are kept and its level-0 segments still fit vision.max_segments (a less salient one
+/// further down may still fit). The scene is rebuilt from the kept curves, in pipeline order, so the curve
+/// ids follow the picture, not the ranking.
+void apply_budgets(ImageScene& out, const config::Settings& s) {
+  const std::size_t n_curves = out.scene->curve_count();
+  std::vector<std::size_t> order;
+  std::vector<double> salience(n_curves, 0.0);
+  for (std::size_t c = 0; c < n_curves; ++c) {
+    const std::size_t i = out.scene->source_index(c);
+    const Polyline& p = out.polylines[i];
+    if (border_share(p, out.px_to_m, out.width_px, out.height_px, kBorderBandM) >= kBorderShare) {
+      ++out.chains_along_border;
+      continue;
+    }
+    order.push_back(c);
+    salience[c] = shape_salience({polyline_length_m(p), out.strength[i], p.closed, p.closed ? enclosed_area_m2(p) : 0.0}, out.canny_high);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return salience[a] > salience[b]; });
+  const auto max_segments = static_cast<std::size_t>(s.vision.max_segments);
+  const auto max_shapes = static_cast<std::size_t>(s.vision.max_shapes);
+  std::vector<char> keep(n_curves, 0);
+  std::size_t used = 0, kept_count = 0;
+  for (const std::size_t c : order) {
+    const std::size_t n = out.scene->curve(c).segment_count[0];
+    if (kept_count == max_shapes) {
+      ++out.chains_over_max_shapes;
+      continue;
+    }
+    if (used + n > max_segments) {
+      ++out.chains_over_budget;
+      continue;
+    }
+    used += n;
+    ++kept_count;
+    keep[c] = 1;
+  }
+  if (kept_count == n_curves) return;
+  std::vector<Polyline> kept;
+  std::vector<double> kept_strength;
+  for (std::size_t c = 0; c < n_curves; ++c) {
+    if (!keep[c]) continue;
+    kept.push_back(out.polylines[out.scene->source_index(c)]);
+    kept_strength.push_back(out.strength[out.scene->source_index(c)]);
+  }
+  out.polylines = std::move(kept);
+  out.strength = std::move(kept_strength);
+  out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
 }
 
 /// Steps 2-5 of build_image_scene on an extraction: thin lines, metres, budget, trees.
@@ -155,39 +235,7 @@ void build_from_extraction(ImageScene& out, vision::Extraction ex, const config:
   for (const std::size_t k : kept_chain) out.strength.push_back(mean(point_strength[k]));
   out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
   out.segments_before_budget = out.scene->total_segments(0);
-  // Scene budget (issue 6, item 4): keep the servo's data within max_segments level-0 segments, filled
-  // with the most salient curves first (curve_salience: long, sure boundaries).
-  const auto budget = static_cast<std::size_t>(s.vision.max_segments);
-  if (out.segments_before_budget > budget) {
-    std::vector<std::size_t> order(out.scene->curve_count());
-    std::vector<double> salience(order.size(), 0.0);
-    for (std::size_t c = 0; c < order.size(); ++c) {
-      order[c] = c;
-      const std::size_t i = out.scene->source_index(c);
-      salience[c] = curve_salience(length_m(out.polylines[i]), out.strength[i], out.canny_high);
-    }
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return salience[a] > salience[b]; });
-    std::vector<char> keep(order.size(), 0);
-    std::size_t used = 0;
-    for (std::size_t c : order) {
-      const std::size_t n = out.scene->curve(c).segment_count[0];
-      if (used + n > budget) continue;  // a less salient one further down may still fit
-      used += n;
-      keep[c] = 1;
-    }
-    // Kept curves in pipeline order, so the scene's curve ids follow the picture, not the ranking.
-    std::vector<Polyline> kept;
-    std::vector<double> kept_strength;
-    for (std::size_t c = 0; c < order.size(); ++c) {
-      if (!keep[c]) continue;
-      kept.push_back(out.polylines[out.scene->source_index(c)]);
-      kept_strength.push_back(out.strength[out.scene->source_index(c)]);
-    }
-    out.chains_over_budget = out.scene->curve_count() - kept.size();
-    out.polylines = std::move(kept);
-    out.strength = std::move(kept_strength);
-    out.scene = std::make_unique<Scene>(Scene::build(out.polylines, s.haptics.max_levels));
-  }
+  apply_budgets(out, s);
   out.segments_after_budget = out.scene->total_segments(0);
   out.times.multires_ms = out.scene->build_times().multires_ms;
   out.times.tree_ms = out.scene->build_times().tree_ms;

@@ -55,7 +55,7 @@ const TextBlockM* text_block_at(const std::vector<TextBlockM>& blocks, Vec2 p);
 ///
 /// What was dropped and why, in pipeline order (each count is of the stage before it):
 ///   chains_found --thin-line merging--> chains_after_thin_lines --gap closing--> chains_after_gaps
-///   = chains_too_short + chains_over_budget + polylines.size().
+///   = chains_too_short + chains_along_border + chains_over_max_shapes + chains_over_budget + polylines.size().
 struct ImageScene {
   std::string image_path;                   ///< the file (for a document page: the PDF)
   int page = 0;                             ///< document page shown (from 1); 0 for a picture file
@@ -75,6 +75,8 @@ struct ImageScene {
   std::size_t chains_closed_by_gaps = 0;    ///< chains that came out closed from those joins
   std::size_t chains_after_gaps = 0;        ///< chains after gap closing
   std::size_t chains_too_short = 0;         ///< dropped: shorter than vision.min_chain_length_m
+  std::size_t chains_along_border = 0;      ///< dropped: running along the picture's frame (border_share >= kBorderShare), not shapes
+  std::size_t chains_over_max_shapes = 0;   ///< dropped: vision.max_shapes more salient curves were kept
   std::size_t chains_over_budget = 0;       ///< dropped: the scene would hold more than vision.max_segments level-0 segments (least salient dropped first)
   std::size_t segments_before_budget = 0;   ///< level-0 segments of the scene of every curve long enough to feel
   std::size_t segments_after_budget = 0;    ///< level-0 segments of the scene built (<= vision.max_segments)
@@ -93,7 +95,8 @@ struct ImageScene {
   BuildTimes times;
 };
 
-/// Salience of a curve for the segment budget: what a visitor most needs to feel first.
+/// Salience of a curve as the segment budget ranked curves before issue 15 (now shape_salience; kept as
+/// the baseline the shape budget's test compares with).
 ///
 ///   salience = length_m · clamp(strength / canny_high, 0, 1)
 ///
@@ -105,6 +108,44 @@ struct ImageScene {
 /// every curve is equally sure (a wall is felt the same whatever its grey-level contrast), hence the
 /// clip at 1. Returns 0 for a non-positive canny_high or a non-finite input.
 double curve_salience(double length_m, double strength, double canny_high);
+
+/// What a curve offers a hand, for ranking it against the others (issue 15, item 2).
+struct ShapeFeatures {
+  double length_m = 0.0;  ///< polyline length [m]
+  double strength = 0.0;  ///< mean edge strength along it (ImageScene::strength) [Canny threshold units]
+  bool closed = false;    ///< a closed outline
+  double area_m2 = 0.0;   ///< area it encloses when closed [m²], else 0
+};
+
+/// Salience of a shape for the budgets (issue 15, item 2): its length plus, when closed, twice the square
+/// root of the area it encloses, weighted by its mean edge strength relative to canny_high:
+///
+///   shape_salience = (length_m + closed · 2·√area_m2) · max(strength, 0) / canny_high
+///
+/// A closed outline is an object a visitor can recognise by going round it, and a large one more than a
+/// small one: a square of side a counts 4a + 2a, a circle of radius r 2πr + 3.5 r; a thin closed loop (a
+/// hair, a crack in the texture, w × L) gains only 2·√(w/L) of its length. Strength counts in proportion,
+/// not clipped at canny_high as in curve_salience: with at most max_shapes curves kept, the strongest
+/// boundaries of a photograph are its objects' outlines, and so the kept curves carry more of the picture's
+/// edge strength × length than the old ranking's (tests/app/test_shape_budget.cpp). 0 for a non-finite
+/// input or a non-positive canny_high; area_m2 must be >= 0 (0 for an open curve).
+double shape_salience(const ShapeFeatures& f, double canny_high);
+
+/// Polyline length [m], with the closing segment of a closed curve (what a hand can follow).
+double polyline_length_m(const Polyline& p);
+
+/// Area enclosed by the polyline taken as closed (shoelace formula, absolute value) [m²]; 0 for fewer than
+/// 3 points.
+double enclosed_area_m2(const Polyline& p);
+
+/// Share of a polyline's points (in metres, mapped back to pixels through `map`) within band_m of the
+/// picture's frame, the outer edge of its outer pixels, [0, 1]; 0 for no point.
+double border_share(const Polyline& p, const vision::PxToM& map, int width_px, int height_px, double band_m);
+
+/// Curves with at least kBorderShare of their points within kBorderBandM of the picture's frame run along
+/// the border (a scanned page's edge, a photo's frame line): not shapes, dropped.
+inline constexpr double kBorderBandM = 0.001;  // [m]
+inline constexpr double kBorderShare = 0.5;
 
 /// Chains (pixels) → polylines in workspace metres, dropping chains shorter than min_length_m (a
 /// fingertip cannot resolve them). `too_short` (optional) receives the number dropped, `kept`
@@ -119,9 +160,9 @@ std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chai
 ///    vision.thin_line_max_width_m converted to processed pixels through the workspace scale (skipped
 ///    when 0), the chains then scaled back to original pixels;
 /// 3. pixels → metres, chains shorter than vision.min_chain_length_m dropped;
-/// 4. the segment budget: when the curves' level-0 segments exceed vision.max_segments, curves are
-///    taken in decreasing curve_salience (ties: pipeline order) and each is kept if it still fits
-///    (a less salient one further down may still fit);
+/// 4. the budgets: curves along the picture's frame dropped; the rest taken in decreasing shape_salience
+///    (ties: pipeline order), each kept while fewer than vision.max_shapes are and its level-0 segments
+///    still fit vision.max_segments (a less salient one further down may still fit);
 /// 5. Scene::build (haptics.max_levels).
 /// Throws vision::InputError for bad image files (one line naming the file and the limit).
 ImageScene build_image_scene(const std::string& path, const config::Settings& settings);

@@ -205,6 +205,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(vision, min_chain_length_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.1, "m", "Edge chains shorter than this are dropped."),
     HK_FIELD(vision, max_image_side_px, FieldGroup::scene, ApplyWhen::scene, 64, 10000, "px", "Images are downscaled to this longest side."),
     HK_FIELD(vision, max_segments, FieldGroup::scene, ApplyWhen::scene, 100, 1000000, "", "Scene budget: level-0 segments kept, the most salient curves first."),
+    HK_FIELD(vision, max_shapes, FieldGroup::scene, ApplyWhen::scene, 1, 1000, "", "Shape budget: curves kept, the most salient first (long, sure, closed, enclosing much); the rest are not felt."),
     HK_FIELD(vision, thin_line_max_width_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.01, "m", "The two edges of a line thinner than this become one curve; 0 = off."),
     HK_FIELD(vision, gap_close_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.005, "m", "Chain ends facing each other across a gap up to this are joined into one curve (closing outlines Canny broke); 0 = off."),
     HK_FIELD(vision, detector, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",

@@ -31,8 +31,16 @@ double length_m(const Polyline& p) {
   return l;
 }
 
-/// The rule of image_scene.hpp, written out again: length · clamp(strength / canny_high, 0, 1).
-double salience(const Polyline& p, double strength, double canny_high) { return length_m(p) * std::clamp(strength / canny_high, 0.0, 1.0); }
+/// The rule of image_scene.hpp (shape_salience), written out again: (length + closed · 2·√area) ·
+/// max(strength, 0) / canny_high, the area by the shoelace formula.
+double salience(const Polyline& p, double strength, double canny_high) {
+  double twice_area = 0;
+  for (std::size_t i = 0; p.closed && i < p.points_m.size(); ++i) {
+    const Vec2 a = p.points_m[i], b = p.points_m[(i + 1) % p.points_m.size()];
+    twice_area += a.x * b.y - b.x * a.y;
+  }
+  return (length_m(p) + 2 * std::sqrt(std::abs(twice_area) / 2)) * std::max(strength, 0.0) / canny_high;
+}
 
 /// Index in `in` of each of `of` (exact polyline equality), or npos.
 std::vector<std::size_t> find_all(const std::vector<Polyline>& of, const std::vector<Polyline>& in) {
@@ -49,17 +57,20 @@ TEST(SceneBudget, ClutteredPhotoStaysWithinBudgetKeepingTheMostSalientCurves) {
     SCOPED_TRACE(name);
     config::Settings full_s;
     full_s.vision.max_segments = 1000000;
+    full_s.vision.max_shapes = 1000;  // the segment budget alone
     const ImageScene full = build_image_scene(kImages + name, full_s);
     config::Settings small_s;
     small_s.vision.max_segments = 2000;
+    small_s.vision.max_shapes = 1000;  // the segment budget alone
     const ImageScene small = build_image_scene(kImages + name, small_s);
     ASSERT_GT(full.scene->total_segments(0), 2000u) << "the photo must be over the budget to test it";
     EXPECT_LE(small.scene->total_segments(0), 2000u);
-    EXPECT_EQ(small.segments_before_budget, full.scene->total_segments(0));
+    EXPECT_EQ(small.segments_before_budget, full.segments_before_budget);
+    EXPECT_EQ(small.chains_along_border, full.chains_along_border);
     EXPECT_EQ(small.segments_after_budget, small.scene->total_segments(0));
     EXPECT_GT(small.chains_over_budget, 0u);
     EXPECT_EQ(small.chains_over_budget + small.polylines.size(), full.polylines.size());
-    EXPECT_EQ(small.chains_after_gaps, small.chains_too_short + small.chains_over_budget + small.polylines.size());
+    EXPECT_EQ(small.chains_after_gaps, small.chains_too_short + small.chains_along_border + small.chains_over_max_shapes + small.chains_over_budget + small.polylines.size());
     // Kept curves are full's curves, with full's strengths.
     const std::vector<std::size_t> where = find_all(small.polylines, full.polylines);
     for (std::size_t i = 0; i < where.size(); ++i) {
@@ -112,6 +123,7 @@ TEST(SceneBudget, AStrongEdgeBeatsALongerFaintOne) {
   s.vision.canny_high = 60;  // the strong edge (~250 units) is sure, the faint one (~25) is only linked
   s.vision.canny_low = 15;
   s.vision.max_segments = 1000000;
+  s.vision.max_shapes = 1000;  // the segment budget alone
   s.vision.detector = "canny";  // the faint step is under the two-tone spread: "auto" would trace only the strong one
   const ImageScene full = build_image_scene(path.string(), s);
   // Which curve is which: the strong one lies on v = 150 (y of pixel row 149.5).
@@ -141,6 +153,7 @@ TEST(SceneBudget, AStrongEdgeBeatsALongerFaintOne) {
               length_m(full.polylines[strong]) * 1000, full.strength[strong], n_strong, length_m(full.polylines[faint]) * 1000,
               full.strength[faint], n_faint, full.canny_high);
   s.vision.max_segments = static_cast<int>(std::max(n_strong, n_faint));
+  s.vision.max_shapes = 1000;  // the segment budget alone
   ASSERT_LT(static_cast<std::size_t>(s.vision.max_segments), n_strong + n_faint) << "the budget must fit only one";
   const ImageScene small = build_image_scene(path.string(), s);
   fs::remove(path);
@@ -152,9 +165,11 @@ TEST(SceneBudget, AStrongEdgeBeatsALongerFaintOne) {
 TEST(SceneBudget, KeptCurvesOfARealPhotoAreStrongerAndLongerThanTheDropped) {
   config::Settings full_s;
   full_s.vision.max_segments = 1000000;
+  full_s.vision.max_shapes = 1000;  // the segment budget alone
   const ImageScene full = build_image_scene(kImages + "fruits.jpg", full_s);
   config::Settings small_s;
   small_s.vision.max_segments = 1500;
+  small_s.vision.max_shapes = 1000;  // the segment budget alone
   const ImageScene small = build_image_scene(kImages + "fruits.jpg", small_s);
   ASSERT_GT(small.chains_over_budget, 0u);
   std::vector<char> kept(full.polylines.size(), 0);

@@ -197,10 +197,11 @@ TEST(ThinLineScene, ShippedPicturesSegmentsBeforeAndAfter) {
     const ImageScene a = build_image_scene(entry.path().string(), off);
     const ImageScene b = build_image_scene(entry.path().string(), on);
     for (const ImageScene* s : {&a, &b}) {
-      EXPECT_EQ(s->chains_after_gaps, s->chains_too_short + s->chains_over_budget + s->polylines.size());
+      EXPECT_EQ(s->chains_after_gaps, s->chains_too_short + s->chains_along_border + s->chains_over_max_shapes + s->chains_over_budget + s->polylines.size());
       EXPECT_EQ(s->strength.size(), s->polylines.size());
       EXPECT_EQ(s->segments_after_budget, s->scene->total_segments(0));
       EXPECT_LE(s->segments_after_budget, static_cast<std::size_t>(on.vision.max_segments));
+      EXPECT_LE(s->polylines.size(), static_cast<std::size_t>(on.vision.max_shapes));
       EXPECT_LE(s->segments_after_budget, s->segments_before_budget);
     }
     EXPECT_EQ(a.chains_after_thin_lines, a.chains_found);

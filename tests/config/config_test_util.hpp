@@ -99,6 +99,7 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"vision", "min_chain_length_m", 0, 0.1, false},
       {"vision", "max_image_side_px", 64, 10000, true},
       {"vision", "max_segments", 100, 1000000, true},
+      {"vision", "max_shapes", 1, 1000, true},
       {"vision", "thin_line_max_width_m", 0, 0.01, false},
       {"vision", "gap_close_m", 0, 0.005, false},
       {"workspace", "width_m", 0.01, 1, false},

@@ -107,6 +107,7 @@ struct VisionSettings {
   double min_chain_length_m = 0.004;          ///< key min_chain_length_m, drop shorter chains (can't be felt), [0, 0.1] m
   int max_image_side_px = 800;                ///< key max_image_side_px, images are downscaled to this, [64, 10000] px
   int max_segments = 30000;                   ///< key max_segments, scene budget: level-0 segments kept, most salient curves first, [100, 1000000]
+  int max_shapes = 30;                        ///< key max_shapes, shape budget: curves kept, most salient first (long, sure, closed, enclosing much), [1, 1000]
   double thin_line_max_width_m = 0.001;       ///< key thin_line_max_width_m, the two edges of a line thinner than this become one curve, [0, 0.01] m; 0 = off
   double gap_close_m = 0.001;                 ///< key gap_close_m, chain ends facing each other across a gap up to this are joined, [0, 0.005] m; 0 = off
   std::string detector = "auto";              ///< key detector, how boundaries are found: "auto" (two-tone pictures traced from a threshold, others Canny), "canny" or "outline"
