@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 
 namespace hk::app {
@@ -11,6 +12,9 @@ struct Shape {
   double diag_m;
   Vec2 centre_m;
   bool closed;
+  std::size_t curve;   // index in the curves described
+  int inside = 0;      // shapes nested in it, at any depth
+  bool top = true;     // inside no other shape
 };
 
 const char* place(Vec2 c, Vec2 half) {
@@ -33,29 +37,78 @@ std::pair<Vec2, Vec2> bounds_of(const Polyline& p) {
   return {lo, hi};
 }
 
+/// Whether p lies inside the closed polygon `poly` (even-odd rule, crossing count of a ray towards +x).
+bool inside_polygon(Vec2 p, const std::vector<Vec2>& poly) {
+  bool in = false;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Vec2 a = poly[i], b = poly[j];
+    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) in = !in;
+  }
+  return in;
+}
+
+/// Whether curve `inner` lies inside the closed curve `outer`: its bounding box within outer's, and up to
+/// kNestSamples of its points, spread along it, all inside outer's polygon.
+bool nested_in(const Polyline& inner, const Polyline& outer, const std::pair<Vec2, Vec2>& inner_box, const std::pair<Vec2, Vec2>& outer_box) {
+  constexpr std::size_t kNestSamples = 16;
+  if (!outer.closed || outer.points_m.size() < 3) return false;
+  if (inner_box.first.x < outer_box.first.x || inner_box.first.y < outer_box.first.y || inner_box.second.x > outer_box.second.x ||
+      inner_box.second.y > outer_box.second.y)
+    return false;
+  const std::size_t n = inner.points_m.size();
+  const std::size_t step = std::max<std::size_t>(1, n / kNestSamples);
+  for (std::size_t i = 0; i < n; i += step)
+    if (!inside_polygon(inner.points_m[i], outer.points_m)) return false;
+  return true;
+}
+
+/// The shapes of `curves` with their nesting: `inside` counts the shapes within each closed shape (at any
+/// depth), `top` marks those within none.
+std::vector<Shape> shapes_of(const std::vector<Polyline>& curves) {
+  std::vector<Shape> shapes;
+  std::vector<std::pair<Vec2, Vec2>> boxes;
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    const Polyline& p = curves[k];
+    if (p.points_m.empty()) continue;
+    boxes.push_back(bounds_of(p));
+    shapes.push_back({length(boxes.back().second - boxes.back().first), 0.5 * (boxes.back().first + boxes.back().second), p.closed, k});
+  }
+  for (std::size_t i = 0; i < shapes.size(); ++i)
+    for (std::size_t j = 0; j < shapes.size(); ++j) {
+      if (i == j || shapes[j].diag_m <= shapes[i].diag_m) continue;
+      if (nested_in(curves[shapes[i].curve], curves[shapes[j].curve], boxes[i], boxes[j])) {
+        ++shapes[j].inside;
+        shapes[i].top = false;
+      }
+    }
+  return shapes;
+}
+
 }  // namespace
 
 std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half, int max_named) {
-  std::vector<Shape> shapes;
-  for (const Polyline& p : curves) {
-    if (p.points_m.empty()) continue;
-    const auto [lo, hi] = bounds_of(p);
-    shapes.push_back({length(hi - lo), 0.5 * (lo + hi), p.closed});
-  }
-  if (shapes.empty()) return "There are no shapes in this picture.";
-  std::sort(shapes.begin(), shapes.end(), [](const Shape& a, const Shape& b) { return a.diag_m > b.diag_m; });
+  std::vector<Shape> all = shapes_of(curves);
+  if (all.empty()) return "There are no shapes in this picture.";
+  std::vector<Shape> top;
+  for (const Shape& s : all)
+    if (s.top) top.push_back(s);
+  std::stable_sort(top.begin(), top.end(), [](const Shape& a, const Shape& b) { return a.diag_m > b.diag_m; });
   const double ws = 2.0 * length(half);
   auto size = [&](const Shape& s) { return s.diag_m > 0.4 * ws ? "large" : (s.diag_m > 0.15 * ws ? "medium" : "small"); };
-  std::string out = shapes.size() == 1 ? "One shape. " : std::to_string(shapes.size()) + " shapes. ";
-  const std::size_t named = std::min<std::size_t>(shapes.size(), static_cast<std::size_t>(std::max(1, max_named)));
+  std::string out = all.size() == 1 ? "One shape. " : std::to_string(all.size()) + " shapes. ";
+  const std::size_t named = std::min<std::size_t>(top.size(), static_cast<std::size_t>(std::max(1, max_named)));
+  std::size_t told = 0;  // shapes spoken of so far, the nested ones included
   for (std::size_t i = 0; i < named; ++i) {
-    const Shape& s = shapes[i];
-    std::string part = std::string(i == 0 ? "A " : "a ") + size(s) + (s.closed ? " closed shape " : " line ") + place(s.centre_m, half);
-    if (i > 0) out += (i + 1 == named && shapes.size() == named) ? ", and " : ", ";
+    const Shape& s = top[i];
+    std::string part = std::string(i == 0 ? "A " : "a ") + size(s) + (s.closed ? " closed shape" : " line");
+    if (s.inside > 0) part += s.inside == 1 ? " with a smaller shape inside it," : " with " + std::to_string(s.inside) + " smaller shapes inside it,";
+    part += std::string(" ") + place(s.centre_m, half);
+    told += 1 + static_cast<std::size_t>(s.inside);
+    if (i > 0) out += (i + 1 == named && told == all.size()) ? ", and " : ", ";
     out += part;
   }
-  if (shapes.size() > named) {
-    const std::size_t rest = shapes.size() - named;
+  if (told < all.size()) {
+    const std::size_t rest = all.size() - told;
     out += ", and " + std::to_string(rest) + (rest == 1 ? " more, smaller." : " more, smaller ones.");
   } else {
     out += ".";

@@ -1,8 +1,8 @@
 #pragma once
 /// @file describe.hpp
 /// The Describe key (issue 5, item 4): a spoken summary of a picture's shapes and where they are, e.g.
-/// "3 shapes. A large closed shape in the middle, a small line at the top left, and a small closed shape
-/// at the bottom right." English only for now (the catalogue's `describe` message carries it whole).
+/// "3 shapes. A large closed shape with a smaller shape inside it, in the middle, a small line at the top
+/// left, and a small closed shape at the bottom right." English only for now (the catalogue's `describe` message carries it whole).
 
 #include <string>
 #include <vector>
@@ -12,10 +12,14 @@
 
 namespace hk::app {
 
-/// Describes `curves` (workspace metres) in a workspace of half extents `half_extent_m` [m]. The largest
-/// `max_named` shapes are named with their size (large / medium / small by bounding-box diagonal against
-/// the workspace diagonal: > 40 %, > 15 %, else small), kind (closed shape or line) and place (the cell of a
-/// 3 x 3 grid holding their bounding-box centre); the rest are counted.
+/// Describes `curves` (workspace metres) in a workspace of half extents `half_extent_m` [m] (issue 5, item 4;
+/// structure, issue 15, item 4): how many shapes, then the largest `max_named` of those inside no other shape,
+/// each with its size (large / medium / small by bounding-box diagonal against the workspace diagonal:
+/// > 40 %, > 15 %, else small), kind (closed shape or line), how many shapes lie inside it (a shape is inside
+/// a larger closed one when its bounding box is within the other's and 16 of its points, spread along it,
+/// are inside the other's polygon) and place (the cell of a 3 x 3 grid holding its bounding-box centre);
+/// the rest are counted. E.g. "4 shapes. A large closed shape with 3 smaller shapes inside it, at the top
+/// left." Cost: O(shapes² · 16 · points of the larger), for the few dozen shapes of a scene.
 std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half_extent_m, int max_named = 3);
 
 /// Figures on a document page: groups of curves whose bounding boxes, grown by margin_m on every side,

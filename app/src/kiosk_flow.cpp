@@ -50,8 +50,13 @@ void KioskFlow::show(int index, const std::string& before) {
   state_ = KioskState::Picture;
   const int shapes = fx_.show_picture(picture_);
   const std::string num = std::to_string(picture_ + 1), total = std::to_string(n);
+  const std::string title = fx_.shown_notes().title;
   std::string line;
-  if (shapes == 0) {
+  if (!title.empty()) {
+    // A person's words first: "Picture 2 of 5: a horse, seen from the side. It has 2 shapes."
+    const MessageId id = shapes == 0 ? MessageId::picture_titled_empty : shapes == 1 ? MessageId::picture_titled_one : MessageId::picture_titled;
+    line = text(id, {{"picture", num}, {"pictures", total}, {"title", title}, {"shapes", std::to_string(shapes)}});
+  } else if (shapes == 0) {
     line = text(MessageId::picture_empty, {{"picture", num}, {"pictures", total}});
   } else if (shapes == 1) {
     line = text(MessageId::picture_loaded_one, {{"picture", num}, {"pictures", total}});

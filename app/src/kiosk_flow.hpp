@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "audio/messages.hpp"
+#include "picture_notes.hpp"
 #include "config/settings.hpp"
 
 namespace hk::app {
@@ -75,6 +76,8 @@ class KioskEffects {
   virtual int show_picture(int index) = 0;
   /// Pictures in the library (≥ 1).
   virtual int picture_count() const = 0;
+  /// The title and description a person wrote for the picture shown (picture_notes.hpp); empty when none.
+  virtual PictureNotes shown_notes() const { return {}; }
   /// A spoken description of what is shown (describe.hpp).
   virtual std::string describe() = 0;
   /// Level one finer (delta −1) or coarser (+1). Returns false at the limit (nothing changes).

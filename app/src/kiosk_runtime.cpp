@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
@@ -209,9 +210,17 @@ void KioskRuntime::show_tutorial(TutorialShape shape) {
 }
 
 int KioskRuntime::show_picture(int index) {
-  ImageScene is = build_image_scene(pictures_[static_cast<std::size_t>(index)], s_);
+  const std::string& path = pictures_[static_cast<std::size_t>(index)];
+  ImageScene is = build_image_scene(path, s_);
   const int shapes = static_cast<int>(is.scene->curve_count());
+  PictureNotes notes;
+  try {
+    notes = read_picture_notes(path);
+  } catch (const PictureNotesError& e) {
+    spdlog::warn("{}; the picture is shown without it", e.what());  // the picture still shows
+  }
   show_built(is, index);
+  shown_.notes = std::move(notes);
   shown_picture_ = index;
   shown_document_ = -1;
   shown_page_ = 0;
@@ -236,7 +245,17 @@ std::string KioskRuntime::describe() {
     const std::string page = describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
     return shown_.polylines.empty() ? page : page + " " + describe_scene(shown_.polylines, half_);
   }
-  return describe_scene(shown_.polylines, half_);
+  // A picture: what a person wrote of it first ("A horse, seen from the side. A horse standing, ..."), then
+  // its shapes.
+  std::string words;
+  if (!shown_.notes.title.empty()) {
+    words = shown_.notes.title;
+    words[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(words[0])));
+    if (words.back() != '.' && words.back() != '!' && words.back() != '?') words += '.';
+    words += ' ';
+  }
+  if (!shown_.notes.description.empty()) words += shown_.notes.description + ' ';
+  return words + describe_scene(shown_.polylines, half_);
 }
 
 void KioskRuntime::show_document(int document, int page) { sticks_.load(stick_id_, document, page); }

@@ -29,6 +29,7 @@
 #include "guided_tour.hpp"
 #include "image_scene.hpp"
 #include "kiosk_flow.hpp"
+#include "picture_notes.hpp"
 #include "servo_core.hpp"
 #include "servo_thread.hpp"
 #include "stick_service.hpp"
@@ -61,6 +62,7 @@ struct Shown {
   vision::PxToM px_to_m{1, 0, 0};                      ///< picture pixels → workspace metres
   const Scene* scene = nullptr;                        ///< the published scene (read-only here; for the overlay)
   std::vector<TextBlockM> text_blocks;                 ///< a document page's text (Describe reads the one under the hand)
+  PictureNotes notes;                                  ///< a library picture's title and description (its sidecar)
 };
 
 /// What apply_settings did with a change, for the operator panel and the audit.
@@ -113,6 +115,7 @@ class KioskRuntime final : public KioskEffects {
   void show_tutorial(TutorialShape shape) override;
   int show_picture(int index) override;
   int picture_count() const override { return static_cast<int>(pictures_.size()); }
+  PictureNotes shown_notes() const override { return shown_.notes; }
   std::string describe() override;
   void show_document(int document, int page) override;
   void forget_stick() override;

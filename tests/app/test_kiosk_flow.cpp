@@ -46,6 +46,8 @@ struct Recorder final : KioskEffects {
     shown.push_back("document " + std::to_string(d) + " page " + std::to_string(p));
   }
   void forget_stick() override { ++forgotten; }
+  PictureNotes notes;  // what shown_notes() gives
+  PictureNotes shown_notes() const override { return notes; }
 };
 
 DocumentResult ready(int d, int p, std::string description = "It has 2 blocks of text and one figure.") {
@@ -252,6 +254,21 @@ TEST(KioskFlow, EmptyAndRefusedSticksAreSaidAndChangeNothing) {
   EXPECT_EQ(fx.shown.back(), "picture 1") << "the library is still what Next walks";
 }
 
+TEST(KioskFlow, APictureWithATitleIsAnnouncedByIt) {
+  Recorder fx;
+  fx.notes.title = "a horse, seen from the side";
+  KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
+  flow.handle_moved(1.0);
+  for (int k = 0; k < 3; ++k) flow.key(KioskKey::Next, 2.0 + k);  // square, circle, triangle, then pictures
+  EXPECT_EQ(fx.shown.back(), "picture 0");
+  EXPECT_EQ(fx.said.back(), "Well done. Here is the first picture. Picture 1 of 3: a horse, seen from the side. It has 4 shapes.");
+  flow.key(KioskKey::Next, 10.0);
+  EXPECT_EQ(fx.said.back(), "Picture 2 of 3: a horse, seen from the side. It has one shape.");
+  fx.notes = {};
+  flow.key(KioskKey::Next, 11.0);
+  EXPECT_EQ(fx.said.back(), "Picture 3 of 3. It has 4 shapes.") << "no title: as before";
+}
+
 TEST(Describe, PagesCountTextBlocksAndFigures) {
   EXPECT_EQ(describe_page(2, 1), "It has 2 blocks of text and one figure.");
   EXPECT_EQ(describe_page(1, 0), "It has one block of text and no figures.");
@@ -279,6 +296,33 @@ TEST(Describe, SizesKindsAndPlaces) {
   std::vector<Polyline> many(6, rect({0.05, 0.03}, {0.002, 0.002}));
   many.push_back(rect({-0.04, 0}, {0.015, 0.01}));
   EXPECT_EQ(describe_scene(many, half, 2), "7 shapes. A medium closed shape on the left, a small closed shape at the top right, and 5 more, smaller ones.");
+}
+
+TEST(Describe, ShapesInsideAClosedShapeAreToldWithIt) {
+  const Vec2 half{0.07, 0.045};
+  // A plate at the top left with three holes, and a small line at the bottom right: the holes are told with
+  // the plate.
+  const Polyline plate = rect({-0.035, 0.02}, {0.03, 0.02});
+  const std::vector<Polyline> holes{rect({-0.05, 0.025}, {0.004, 0.004}), rect({-0.035, 0.015}, {0.005, 0.003}),
+                                    rect({-0.02, 0.03}, {0.003, 0.003}, false)};
+  std::vector<Polyline> scene{holes[0], plate, holes[1], rect({0.05, -0.035}, {0.003, 0.002}, false), holes[2]};
+  EXPECT_EQ(describe_scene(scene, half),
+            "5 shapes. A large closed shape with 3 smaller shapes inside it, at the top left, and a small line at the bottom right.");
+  // Nesting at any depth: a face, an eye in it, a pupil in the eye; the eye alone holds one.
+  const std::vector<Polyline> face{rect({0, 0}, {0.04, 0.03}), rect({-0.015, 0.01}, {0.008, 0.005}), rect({-0.015, 0.01}, {0.002, 0.002})};
+  EXPECT_EQ(describe_scene(face, half), "3 shapes. A large closed shape with 2 smaller shapes inside it, in the middle.");
+  EXPECT_EQ(describe_scene({face[1], face[2]}, half), "2 shapes. A small closed shape with a smaller shape inside it, in the middle.");
+  // In an L's bounding box but outside the L (its notch), and overlapping a shape without being in it: not
+  // inside.
+  Polyline ell;
+  ell.closed = true;
+  ell.points_m = {{-0.04, -0.03}, {0.04, -0.03}, {0.04, -0.01}, {-0.02, -0.01}, {-0.02, 0.03}, {-0.04, 0.03}};
+  const Polyline in_notch = rect({0.03, 0.02}, {0.005, 0.005});
+  const Polyline across = rect({-0.04, 0.0}, {0.006, 0.004});
+  EXPECT_EQ(describe_scene({ell, in_notch, across}, half),
+            "3 shapes. A large closed shape in the middle, a small closed shape on the left, and a small closed shape at the top right.");
+  // Only the largest few named: the rest counted, the nested ones as told.
+  EXPECT_EQ(describe_scene(scene, half, 1), "5 shapes. A large closed shape with 3 smaller shapes inside it, at the top left, and 1 more, smaller.");
 }
 
 TEST(Describe, FiguresAreGroupsOfTouchingCurves) {

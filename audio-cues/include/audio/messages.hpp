@@ -23,18 +23,20 @@ namespace hk::audio {
 
 /// The messages. Their keys in the TOML file are kMessageKeys[id].
 enum class MessageId : int {
-  welcome, attract, help, picture_loaded, picture_loaded_one, picture_empty, describe,
+  welcome, attract, help, picture_loaded, picture_loaded_one, picture_empty, picture_titled, picture_titled_one,
+  picture_titled_empty, describe,
   level_finer, level_coarser, level_finest, level_coarsest, volume_up, volume_down, volume_limit,
   tutorial_start, tutorial_circle, tutorial_triangle, tutorial_done, timeout_warning, goodbye,
   no_audio_device, stick_inserted, stick_empty, stick_removed, stick_unreadable, document_page, document_picture,
   document_unreadable, loading, text_block, device_ready, device_simulated, device_lost, device_back,
   tour_remaining, tour_one_remaining, tour_all_touched, tour_stopped, tour_nothing,
 };
-inline constexpr int kMessageCount = 39;
+inline constexpr int kMessageCount = 42;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
-    "welcome", "attract", "help", "picture_loaded", "picture_loaded_one", "picture_empty", "describe",
+    "welcome", "attract", "help", "picture_loaded", "picture_loaded_one", "picture_empty", "picture_titled",
+    "picture_titled_one", "picture_titled_empty", "describe",
     "level_finer", "level_coarser", "level_finest", "level_coarsest", "volume_up", "volume_down", "volume_limit",
     "tutorial_start", "tutorial_circle", "tutorial_triangle", "tutorial_done", "timeout_warning", "goodbye",
     "no_audio_device", "stick_inserted", "stick_empty", "stick_removed", "stick_unreadable", "document_page",

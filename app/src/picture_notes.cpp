@@ -1,0 +1,102 @@
+// A picture's title and description from its sidecar file (issue 15, item 4): read_picture_notes.
+#include "picture_notes.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string_view>
+
+#include <toml++/toml.h>
+
+namespace hk::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const std::string& file, const std::string& what) {
+  throw PictureNotesError("picture notes '" + fs::path(file).filename().string() + "': " + what);
+}
+
+/// Whether `s` is valid UTF-8 (no overlong forms, no surrogates, at most U+10FFFF).
+bool valid_utf8(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    int extra = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xE ? 2 : (c >> 3) == 0x1E ? 3 : -1;
+    if (extra < 0 || i + static_cast<std::size_t>(extra) >= s.size()) return false;  // a lead byte, and all its bytes there
+    unsigned cp = extra == 0 ? c : extra == 1 ? (c & 0x1Fu) : extra == 2 ? (c & 0x0Fu) : (c & 0x07u);
+    for (int k = 1; k <= extra; ++k) {
+      const auto d = static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]);
+      if ((d >> 6) != 0x2) return false;
+      cp = (cp << 6) | (d & 0x3Fu);
+    }
+    if ((extra == 1 && cp < 0x80) || (extra == 2 && cp < 0x800) || (extra == 3 && cp < 0x10000) || cp > 0x10FFFF ||
+        (cp >= 0xD800 && cp <= 0xDFFF))
+      return false;
+    i += 1 + static_cast<std::size_t>(extra);
+  }
+  return true;
+}
+
+std::string trimmed(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string_view::npos) return {};
+  const auto e = s.find_last_not_of(" \t\r\n");
+  return std::string(s.substr(b, e - b + 1));
+}
+
+/// The text of key `key`, checked: valid UTF-8, not blank, at most `max_bytes`, no control characters (but
+/// line breaks where `lines`).
+std::string checked_text(const std::string& file, const std::string& key, const toml::node& node, std::size_t max_bytes, bool lines) {
+  const auto* str = node.as_string();
+  if (!str) fail(file, key + " must be a string");
+  const std::string& raw = str->get();
+  if (!valid_utf8(raw)) fail(file, key + " is not valid UTF-8");
+  std::string text = trimmed(raw);
+  if (text.empty()) fail(file, key + " is blank");
+  if (text.size() > max_bytes) fail(file, key + " is " + std::to_string(text.size()) + " bytes, at most " + std::to_string(max_bytes));
+  for (const char ch : text) {
+    const auto u = static_cast<unsigned char>(ch);
+    if ((u < 0x20 && !(lines && (ch == '\n' || ch == '\r'))) || u == 0x7F)
+      fail(file, key + " holds a control character" + (lines ? "" : " (one line, please)"));
+  }
+  return text;
+}
+
+}  // namespace
+
+std::string notes_path(const std::string& image_path) { return fs::path(image_path).replace_extension(".toml").string(); }
+
+PictureNotes read_picture_notes(const std::string& image_path) {
+  const std::string file = notes_path(image_path);
+  std::error_code ec;
+  if (!fs::exists(file, ec)) return {};
+  if (!fs::is_regular_file(file, ec)) fail(file, "is not a regular file");
+  const auto size = fs::file_size(file, ec);
+  if (ec) fail(file, "cannot be read: " + ec.message());
+  if (size > kMaxNotesFileBytes) fail(file, "is " + std::to_string(size) + " bytes, at most " + std::to_string(kMaxNotesFileBytes));
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail(file, "cannot be opened");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  toml::table root;
+  try {
+    root = toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    fail(file, "TOML syntax error at line " + std::to_string(b.line) + ", column " + std::to_string(b.column));
+  }
+  PictureNotes notes;
+  for (auto&& [key, node] : root) {
+    const std::string name(key.str());
+    if (name == "title") {
+      notes.title = checked_text(file, name, node, kMaxTitleBytes, false);
+    } else if (name == "description") {
+      notes.description = checked_text(file, name, node, kMaxDescriptionBytes, true);
+    } else {
+      fail(file, "unknown key '" + name + "' (title and description are known)");
+    }
+  }
+  return notes;
+}
+
+}  // namespace hk::app

@@ -1,0 +1,46 @@
+#pragma once
+/// @file picture_notes.hpp
+/// What a person wrote about a picture (issue 15, item 4): a title and a description in a sidecar file
+/// beside it, `horse.toml` for `horse.png`:
+///
+///     title = "a horse, seen from the side"
+///     description = "A horse standing, its head to the left."
+///
+/// The kiosk speaks the title when the picture is shown ("Picture 2 of 5: a horse, seen from the side.") and
+/// both first when the visitor asks for a description. Written by people, so read with care: a sidecar that
+/// cannot be used is refused with one line, and the picture is shown without it.
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+namespace hk::app {
+
+/// A picture's title and description; both empty when it has none.
+struct PictureNotes {
+  std::string title;        ///< one line, 1 to kMaxTitleBytes bytes of UTF-8; empty when none
+  std::string description;  ///< 1 to kMaxDescriptionBytes bytes of UTF-8, spoken as it is; empty when none
+};
+
+inline constexpr std::size_t kMaxNotesFileBytes = 16 * 1024;
+inline constexpr std::size_t kMaxTitleBytes = 200;
+inline constexpr std::size_t kMaxDescriptionBytes = 1000;
+
+/// A sidecar that cannot be used: what() is one line naming the file and what is wrong with it, e.g.
+/// "picture notes 'horse.toml': title is 312 bytes, at most 200".
+class PictureNotesError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The sidecar of `image_path`: the file of the same name with the extension `.toml` in the same folder.
+std::string notes_path(const std::string& image_path);
+
+/// Reads the sidecar of `image_path` (notes_path). No sidecar: empty notes. The file must be at most
+/// kMaxNotesFileBytes, valid TOML, with only the string keys `title` (one line, no control characters, at
+/// most kMaxTitleBytes) and `description` (no control characters but line breaks, at most
+/// kMaxDescriptionBytes), both valid UTF-8 and not blank; surrounding white space is trimmed.
+/// @throws PictureNotesError (one line) for a sidecar that breaks any of these, or cannot be read.
+PictureNotes read_picture_notes(const std::string& image_path);
+
+}  // namespace hk::app
