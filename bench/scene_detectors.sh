@@ -4,7 +4,8 @@
 # old pipeline ([vision] detector = "canny", gap_close_m = 0, max_shapes = 1000: no shape budget) and the defaults: the detector used, shapes
 # (curves kept), closed share, level-0 segments in use, gaps closed and build time [ms] (the sum of
 # summary.json build_ms).
-# Writes OUT/scene_detectors.csv and prints it as a table.
+# Writes OUT/scene_detectors.csv and OUT/contact_sheet.png (every picture's overlay, before | after:
+# bench/contact_sheet.py), and prints the table.
 # Usage: bench/scene_detectors.sh [BUILD_DIR] [OUT_DIR]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -21,7 +22,8 @@ for img in "$root"/tests/data/images/*; do
   "$exe" explore "$img" --out "$work/canny/$name" --duration 0.05 --config "$work/canny.toml" > /dev/null
   "$exe" explore "$img" --out "$work/auto/$name" --duration 0.05 > /dev/null
 done
-python3 - "$work" "$out/scene_detectors.csv" <<'PY'
+/usr/bin/python3 "$root/bench/contact_sheet.py" "$work" "$out/contact_sheet.png" >&2
+/usr/bin/python3 - "$work" "$out/scene_detectors.csv" <<'PY'
 import csv, json, os, sys
 work, path = sys.argv[1], sys.argv[2]
 rows = []
