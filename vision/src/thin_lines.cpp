@@ -175,8 +175,19 @@ std::string number(double v) {
   return s.str();
 }
 
-std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineStats* stats, const PointValues* values_in,
-                         PointValues* values_out) {
+/// Every point of every chain in one array (global index g): position, tangent over ±h points, chain, index
+/// in its chain, arc length from the chain's start; per chain its offset, length and closedness.
+struct Flat {
+  std::size_t K = 0, N = 0;
+  std::vector<std::size_t> off;  // points of chain k: g in [off[k], off[k + 1])
+  std::vector<cv::Point2d> pos, tan;
+  std::vector<std::size_t> chain_of, idx;
+  std::vector<double> arc, length;
+  std::vector<char> closed;
+};
+
+/// Checks the input (throws std::invalid_argument) and flattens it (step 1).
+Flat flatten(const std::vector<Chain>& chains, double w, const PointValues* values_in) {
   if (!std::isfinite(w) || w < 0.0) {
     throw std::invalid_argument("merge_thin_lines: max_width_px must be finite and >= 0, got " + number(w));
   }
@@ -185,48 +196,41 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
     for (std::size_t k = 0; ok && k < chains.size(); ++k) ok = (*values_in)[k].size() == chains[k].points_px.size();
     if (!ok) throw std::invalid_argument("merge_thin_lines: values_in must have one value per chain point");
   }
-  const std::size_t K = chains.size();
-  std::vector<std::size_t> off(K + 1, 0);
-  for (std::size_t k = 0; k < K; ++k) {
+  Flat f;
+  f.K = chains.size();
+  f.off.assign(f.K + 1, 0);
+  for (std::size_t k = 0; k < f.K; ++k) {
     for (const cv::Point2d& p : chains[k].points_px) {
       if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
         throw std::invalid_argument("merge_thin_lines: chain " + std::to_string(k) + " has a non-finite point");
       }
     }
-    off[k + 1] = off[k] + chains[k].points_px.size();
+    f.off[k + 1] = f.off[k] + chains[k].points_px.size();
   }
-  const std::size_t N = off[K];
-  ThinLineStats st;
-  st.points_in = N;
-  const auto value_of = [&](std::size_t k, std::size_t i) { return values_in != nullptr ? (*values_in)[k][i] : 0.0; };
-
-  if (w == 0.0 || N == 0) {
-    st.points_out = N;
-    if (stats != nullptr) *stats = st;
-    if (values_out != nullptr) *values_out = values_in != nullptr ? *values_in : PointValues(K);
-    return chains;
-  }
-
-  // Flattened points: position, tangent, chain, index in chain, arc length from the chain's start.
-  std::vector<cv::Point2d> pos(N), tan(N);
-  std::vector<std::size_t> chain_of(N), idx(N);
-  std::vector<double> arc(N), length(K);
-  std::vector<char> closed(K);
+  f.N = f.off[f.K];
+  if (w == 0.0 || f.N == 0) return f;
+  f.pos.resize(f.N);
+  f.tan.resize(f.N);
+  f.chain_of.resize(f.N);
+  f.idx.resize(f.N);
+  f.arc.resize(f.N);
+  f.length.resize(f.K);
+  f.closed.resize(f.K);
   const long h = std::clamp(std::lround(w / 2.0), 2L, 4L);
-  for (std::size_t k = 0; k < K; ++k) {
+  for (std::size_t k = 0; k < f.K; ++k) {
     const auto& p = chains[k].points_px;
     const std::size_t n = p.size();
-    closed[k] = chains[k].closed && n >= 3;
+    f.closed[k] = chains[k].closed && n >= 3;
     for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t g = off[k] + i;
-      pos[g] = p[i];
-      chain_of[g] = k;
-      idx[g] = i;
-      arc[g] = i == 0 ? 0.0 : arc[g - 1] + cv::norm(p[i] - p[i - 1]);
+      const std::size_t g = f.off[k] + i;
+      f.pos[g] = p[i];
+      f.chain_of[g] = k;
+      f.idx[g] = i;
+      f.arc[g] = i == 0 ? 0.0 : f.arc[g - 1] + cv::norm(p[i] - p[i - 1]);
       long a = static_cast<long>(i) - h;
       long b = static_cast<long>(i) + h;
       const long nl = static_cast<long>(n);
-      if (closed[k]) {
+      if (f.closed[k]) {
         a = ((a % nl) + nl) % nl;
         b %= nl;
       } else {
@@ -235,32 +239,34 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
       }
       const cv::Point2d t = p[static_cast<std::size_t>(b)] - p[static_cast<std::size_t>(a)];
       const double tn = cv::norm(t);
-      tan[g] = tn > 1e-12 ? t / tn : cv::Point2d(0, 0);  // a zero tangent pairs with nothing
+      f.tan[g] = tn > 1e-12 ? t / tn : cv::Point2d(0, 0);  // a zero tangent pairs with nothing
     }
-    length[k] = n == 0 ? 0.0 : arc[off[k] + n - 1] + (closed[k] ? cv::norm(p.back() - p.front()) : 0.0);
+    f.length[k] = n == 0 ? 0.0 : f.arc[f.off[k] + n - 1] + (f.closed[k] ? cv::norm(p.back() - p.front()) : 0.0);
   }
+  return f;
+}
 
-  // Step 2: each point's partner, the nearest facing point across a gap of at most w.
-  std::vector<std::size_t> partner(N, kNone);
-  const PointGrid grid(pos, w);  // all input points; also used by the joins (step 5)
-  for (std::size_t g = 0; g < N; ++g) {
+/// Step 2: each point's partner, the nearest facing point across a gap of at most w (kNone: none).
+std::vector<std::size_t> find_partners(const Flat& f, const PointGrid& grid, double w) {
+  std::vector<std::size_t> partner(f.N, kNone);
+  for (std::size_t g = 0; g < f.N; ++g) {
     std::size_t best = kNone;
     double best_d2 = std::numeric_limits<double>::infinity();
-    grid.for_each_within(pos[g], w, [&](std::size_t q, double d2) {
+    grid.for_each_within(f.pos[g], w, [&](std::size_t q, double d2) {
       if (q == g || d2 < kMinGapPx * kMinGapPx) return;
       if (d2 > best_d2 || (d2 == best_d2 && q > best)) return;  // cannot beat the best
       // Most candidates are p's neighbours along its own edge: the gap-along-the-tangent test,
       // squared (no root), rejects them first.
-      const cv::Point2d r = pos[q] - pos[g];
-      const double along_g = r.dot(tan[g]);
+      const cv::Point2d r = f.pos[q] - f.pos[g];
+      const double along_g = r.dot(f.tan[g]);
       if (along_g * along_g > kSinNormal * kSinNormal * d2) return;
-      if (std::abs(tan[g].dot(tan[q])) < kCosParallel) return;
-      const double along_q = r.dot(tan[q]);
+      if (std::abs(f.tan[g].dot(f.tan[q])) < kCosParallel) return;
+      const double along_q = r.dot(f.tan[q]);
       if (along_q * along_q > kSinNormal * kSinNormal * d2) return;
-      if (chain_of[q] == chain_of[g]) {
+      if (f.chain_of[q] == f.chain_of[g]) {
         const double d = std::sqrt(d2);
-        double sep = std::abs(arc[q] - arc[g]);
-        if (closed[chain_of[g]]) sep = std::min(sep, length[chain_of[g]] - sep);
+        double sep = std::abs(f.arc[q] - f.arc[g]);
+        if (f.closed[f.chain_of[g]]) sep = std::min(sep, f.length[f.chain_of[g]] - sep);
         if (sep < std::max(1.5 * d, d + 2.0)) return;  // its own neighbourhood, not a facing side
       }
       best = q;
@@ -268,37 +274,42 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
     });
     partner[g] = best;
   }
+  return partner;
+}
 
-  // Step 3: runs of paired points along each chain.
+/// Signed index step from i to j on chain k, the short way round a closed chain.
+long index_step(const Flat& f, std::size_t k, std::size_t i, std::size_t j) {
+  long d = static_cast<long>(j) - static_cast<long>(i);
+  if (f.closed[k]) {
+    const long n = static_cast<long>(f.off[k + 1] - f.off[k]);
+    d = ((d % n) + n) % n;
+    if (d > n / 2) d -= n;
+  }
+  return d;
+}
+
+/// Step 3: runs of paired points along each chain; `kept` marks those long enough to be lines (short runs
+/// are corners and crossings).
+std::vector<Run> find_runs(const Flat& f, const std::vector<std::size_t>& partner, double w) {
   const std::size_t max_skip = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(w / 2.0)));
-  // Signed index step from i to j on chain k, the short way round a closed chain.
-  const auto index_step = [&](std::size_t k, std::size_t i, std::size_t j) {
-    long d = static_cast<long>(j) - static_cast<long>(i);
-    if (closed[k]) {
-      const long n = static_cast<long>(chains[k].points_px.size());
-      d = ((d % n) + n) % n;
-      if (d > n / 2) d -= n;
-    }
-    return d;
-  };
   // Partners of consecutive run points (walk steps apart) must stay on one chain and move on
   // slowly; a leap is another stroke.
   const auto partners_follow = [&](std::size_t g0, std::size_t g1, std::size_t steps) {
     const std::size_t q0 = partner[g0];
     const std::size_t q1 = partner[g1];
-    if (chain_of[q0] != chain_of[q1]) return false;
-    return std::labs(index_step(chain_of[q0], idx[q0], idx[q1])) <= 2 * static_cast<long>(steps) + 3;
+    if (f.chain_of[q0] != f.chain_of[q1]) return false;
+    return std::labs(index_step(f, f.chain_of[q0], f.idx[q0], f.idx[q1])) <= 2 * static_cast<long>(steps) + 3;
   };
   std::vector<Run> runs;
-  std::vector<std::size_t> run_of(N, kNone), partner_of_run(N, kNone);
-  for (std::size_t k = 0; k < K; ++k) {
-    const std::size_t n = chains[k].points_px.size();
+  std::vector<std::size_t> run_of(f.N, kNone), partner_of_run(f.N, kNone);
+  for (std::size_t k = 0; k < f.K; ++k) {
+    const std::size_t n = f.off[k + 1] - f.off[k];
     if (n == 0) continue;
     // A closed chain's walk starts at an unpaired point, so that no run is cut at index 0.
     std::size_t start = 0;
-    if (closed[k]) {
+    if (f.closed[k]) {
       for (std::size_t i = 0; i < n; ++i) {
-        if (partner[off[k] + i] == kNone) {
+        if (partner[f.off[k] + i] == kNone) {
           start = i;
           break;
         }
@@ -307,7 +318,7 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
     const std::size_t first_run = runs.size();
     std::size_t cur = kNone;
     for (std::size_t t = 0; t < n; ++t) {
-      const std::size_t g = off[k] + (start + t) % n;
+      const std::size_t g = f.off[k] + (start + t) % n;
       if (partner[g] == kNone) continue;
       bool extend = false;
       if (cur != kNone) {
@@ -328,7 +339,7 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
       run_of[g] = cur;
       partner_of_run[partner[g]] = cur;
     }
-    if (!closed[k] || runs.size() == first_run) continue;
+    if (!f.closed[k] || runs.size() == first_run) continue;
     // Closed chain: the last run may go on across the walk's start into the first.
     Run& first = runs[first_run];
     Run& last = runs.back();
@@ -351,24 +362,56 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
     first.members.clear();
     first.walk_pos.clear();
   }
-  // Short runs are corners and crossings, not lines.
   for (Run& r : runs) {
     if (r.members.size() < 2) continue;
     double len = 0.0;
     if (r.closed) {
-      len = length[r.chain];
+      len = f.length[r.chain];
     } else {
       for (std::size_t j = 1; j < r.members.size(); ++j) {
-        const double a0 = arc[r.members[j - 1]];
-        const double a1 = arc[r.members[j]];
-        len += a1 >= a0 ? a1 - a0 : a1 + length[r.chain] - a0;  // across the start of a closed chain
+        const double a0 = f.arc[r.members[j - 1]];
+        const double a1 = f.arc[r.members[j]];
+        len += a1 >= a0 ? a1 - a0 : a1 + f.length[r.chain] - a0;  // across the start of a closed chain
       }
     }
     r.kept = len >= kMinRunWidths * w;
   }
+  return runs;
+}
 
-  // Step 4: centre lines from the runs' fresh points; cover what each run stands for.
-  std::vector<char> covered(N, 0);
+/// The value of chain k's point i, 0 without values.
+double value_at(const PointValues* values_in, std::size_t k, std::size_t i) { return values_in != nullptr ? (*values_in)[k][i] : 0.0; }
+
+/// Marks what run r stands for as covered: its points, their partners, the unpaired points skipped between
+/// run points and the partner-side points between consecutive partners.
+void cover_run(const Flat& f, const std::vector<std::size_t>& partner, const Run& r, std::vector<char>& covered) {
+  const std::size_t m = r.members.size();
+  for (std::size_t j = 0; j < m; ++j) {
+    covered[r.members[j]] = 1;
+    covered[partner[r.members[j]]] = 1;
+  }
+  const std::size_t n_own = f.off[r.chain + 1] - f.off[r.chain];
+  for (std::size_t j = 1; j <= m; ++j) {
+    if (j == m && !r.closed) break;
+    const std::size_t g0 = r.members[j - 1];
+    const std::size_t g1 = r.members[j % m];
+    const std::size_t steps = j < m ? r.walk_pos[j] - r.walk_pos[j - 1] : r.walk_pos[0] + n_own - r.walk_pos[m - 1];
+    for (std::size_t s = 1; s < steps; ++s) covered[f.off[r.chain] + (f.idx[g0] + s) % n_own] = 1;
+    const std::size_t q0 = partner[g0];
+    const std::size_t c = f.chain_of[q0];
+    const long d = index_step(f, c, f.idx[q0], f.idx[partner[g1]]);
+    const long n_c = static_cast<long>(f.off[c + 1] - f.off[c]);
+    for (long s = 1; s < std::labs(d); ++s) {
+      const long i = static_cast<long>(f.idx[q0]) + (d > 0 ? s : -s);
+      covered[f.off[c] + static_cast<std::size_t>(((i % n_c) + n_c) % n_c)] = 1;
+    }
+  }
+}
+
+/// Step 4: centre lines from the kept runs' fresh points (midpoints of each point and its partner, values
+/// averaged), smoothed; what each run stands for is marked in `covered`.
+std::vector<Piece> build_centre_lines(const Flat& f, const std::vector<std::size_t>& partner, const std::vector<Run>& runs,
+                                      const PointValues* values_in, std::vector<char>& covered) {
   std::vector<Piece> centre;
   for (const Run& r : runs) {
     if (!r.kept) continue;
@@ -382,8 +425,8 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
     const auto midpoint = [&](std::size_t j, Piece& c) {
       const std::size_t g = r.members[j];
       const std::size_t q = partner[g];
-      c.pts.push_back(0.5 * (pos[g] + pos[q]));
-      c.vals.push_back(0.5 * (value_of(chain_of[g], idx[g]) + value_of(chain_of[q], idx[q])));
+      c.pts.push_back(0.5 * (f.pos[g] + f.pos[q]));
+      c.vals.push_back(0.5 * (value_at(values_in, f.chain_of[g], f.idx[g]) + value_at(values_in, f.chain_of[q], f.idx[q])));
     };
     if (r.closed && all_fresh) {
       Piece c;
@@ -406,162 +449,169 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
         c = Piece{};
       }
     }
-    // Cover the run's points, their partners, the unpaired points skipped between run points
-    // and the partner-side points between consecutive partners.
-    for (std::size_t j = 0; j < m; ++j) {
-      covered[r.members[j]] = 1;
-      covered[partner[r.members[j]]] = 1;
-    }
-    const std::size_t n_own = chains[r.chain].points_px.size();
-    for (std::size_t j = 1; j <= m; ++j) {
-      if (j == m && !r.closed) break;
-      const std::size_t g0 = r.members[j - 1];
-      const std::size_t g1 = r.members[j % m];
-      const std::size_t steps = j < m ? r.walk_pos[j] - r.walk_pos[j - 1] : r.walk_pos[0] + n_own - r.walk_pos[m - 1];
-      for (std::size_t s = 1; s < steps; ++s) covered[off[r.chain] + (idx[g0] + s) % n_own] = 1;
-      const std::size_t q0 = partner[g0];
-      const std::size_t c = chain_of[q0];
-      const long d = index_step(c, idx[q0], idx[partner[g1]]);
-      const long n_c = static_cast<long>(chains[c].points_px.size());
-      for (long s = 1; s < std::labs(d); ++s) {
-        const long i = static_cast<long>(idx[q0]) + (d > 0 ? s : -s);
-        covered[off[c] + static_cast<std::size_t>(((i % n_c) + n_c) % n_c)] = 1;
-      }
-    }
+    cover_run(f, partner, r, covered);
   }
   for (Piece& c : centre) {
     smooth(c);
     drop_close_points(c);
   }
+  return centre;
+}
 
-  // Step 5: join centre-line ends that continue each other (mutual best, smallest turn).
+/// A centre line's end, for joining.
+struct End {
+  std::size_t piece;
+  bool back;
+  cv::Point2d at;
+  cv::Point2d out;  // unit direction leaving the piece through this end
+};
+
+/// The open centre lines' ends, each with the direction it leaves by (over up to w, or half the line).
+std::vector<End> open_ends(const std::vector<Piece>& centre, double w) {
+  std::vector<End> ends;
+  for (std::size_t c = 0; c < centre.size(); ++c) {
+    const Piece& pc = centre[c];
+    if (!pc.live || pc.closed || pc.pts.size() < 2) continue;
+    const double reach = std::min(w, 0.5 * polyline_length(pc.pts, false));
+    for (const bool back : {false, true}) {
+      const std::size_t n = pc.pts.size();
+      const auto at = [&](std::size_t i) { return back ? pc.pts[n - 1 - i] : pc.pts[i]; };
+      std::size_t i = 1;
+      double walked = cv::norm(at(1) - at(0));
+      while (walked < reach && i + 1 < n) {
+        walked += cv::norm(at(i + 1) - at(i));
+        ++i;
+      }
+      const cv::Point2d d = at(0) - at(i);
+      const double dn = cv::norm(d);
+      ends.push_back({c, back, at(0), dn > 0 ? d / dn : cv::Point2d(0, 0)});
+    }
+  }
+  return ends;
+}
+
+/// The path of a join: through the point where the two ends' rays meet when the stroke turns (an L's centre
+/// line has its corner there; the chord would cut it), else the chord. Empty when neither stays clear of
+/// every edge point (`grid`: all input points).
+std::vector<cv::Point2d> join_path(const End& ea, const End& eb, const PointGrid& grid, double join_r) {
+  std::vector<std::vector<cv::Point2d>> tries;
+  const double det = ea.out.x * (-eb.out.y) - ea.out.y * (-eb.out.x);  // ea + t out_a = eb + u out_b
+  if (ea.out.dot(-eb.out) < kCosCorner && std::abs(det) > 1e-9) {
+    const cv::Point2d r = eb.at - ea.at;
+    const double t = (r.x * (-eb.out.y) - r.y * (-eb.out.x)) / det;
+    const double u = (ea.out.x * r.y - ea.out.y * r.x) / det;
+    if (t > 0.0 && u > 0.0 && t <= join_r && u <= join_r) tries.push_back({ea.at, ea.at + t * ea.out, eb.at});
+  }
+  tries.push_back({ea.at, eb.at});
+  for (const auto& path : tries) {
+    bool clear = true;
+    for (std::size_t k = 1; clear && k < path.size(); ++k) {
+      const int parts = static_cast<int>(std::ceil(cv::norm(path[k] - path[k - 1]) / 0.25));
+      for (int i = 0; clear && i <= parts; ++i) {
+        const cv::Point2d p = path[k - 1] + (path[k] - path[k - 1]) * (parts > 0 ? static_cast<double>(i) / parts : 0.0);
+        clear = !grid.any_within(p, kJoinClearPx);
+      }
+    }
+    if (clear) return path;
+  }
+  return {};
+}
+
+/// Each end's best partner end for a join (kNone: none): within join_r, the smallest turn, the joining
+/// segment not doubling back and its path clear of the edges.
+std::vector<std::size_t> best_joins(const std::vector<End>& ends, const std::vector<Piece>& centre, const PointGrid& grid, double join_r) {
+  std::vector<cv::Point2d> end_pts;
+  for (const End& e : ends) end_pts.push_back(e.at);
+  const PointGrid end_grid(end_pts, join_r);
+  std::vector<std::size_t> best(ends.size(), kNone);
+  for (std::size_t a = 0; a < ends.size(); ++a) {
+    double best_score = -std::numeric_limits<double>::infinity();
+    end_grid.for_each_within(ends[a].at, join_r, [&](std::size_t b, double d2) {
+      if (b == a) return;
+      const End& ea = ends[a];
+      const End& eb = ends[b];
+      if (ea.piece == eb.piece && polyline_length(centre[ea.piece].pts, false) < 3.0 * join_r) return;
+      const double score = ea.out.dot(-eb.out);
+      if (score < kCosJoin) return;
+      if (d2 > 0.25) {  // the joining segment must not double back either
+        const cv::Point2d s = (eb.at - ea.at) / std::sqrt(d2);
+        if (s.dot(ea.out) < kCosJoin || s.dot(-eb.out) < kCosJoin) return;
+      }
+      if (!(score > best_score || (score == best_score && b < best[a]))) return;
+      // ... nor cross an edge: a continuation runs inside the stroke (through a corner or a
+      // crossing); a path leaving it would bridge two strokes across the background.
+      if (join_path(ea, eb, grid, join_r).empty()) return;
+      best_score = score;
+      best[a] = b;
+    });
+  }
+  return best;
+}
+
+/// Joins the pieces of ends a and b (mutual best) along `path`: A ends at the join, B starts there; one piece
+/// joined to itself closes.
+void join_pieces(std::vector<Piece>& centre, const End& ea, const End& eb, const std::vector<cv::Point2d>& path) {
+  Piece& A = centre[ea.piece];
+  if (!ea.back) {  // A must end at the join ...
+    std::reverse(A.pts.begin(), A.pts.end());
+    std::reverse(A.vals.begin(), A.vals.end());
+  }
+  const double v_end = A.vals.back();
+  if (ea.piece == eb.piece) {
+    if (path.size() == 3) {
+      A.pts.push_back(path[1]);
+      A.vals.push_back(0.5 * (v_end + A.vals.front()));
+    }
+    A.closed = true;
+    drop_close_points(A);
+    return;
+  }
+  Piece& B = centre[eb.piece];
+  if (eb.back) {  // ... and B start there
+    std::reverse(B.pts.begin(), B.pts.end());
+    std::reverse(B.vals.begin(), B.vals.end());
+  }
+  if (path.size() == 3) {
+    A.pts.push_back(path[1]);
+    A.vals.push_back(0.5 * (v_end + B.vals.front()));
+  }
+  A.pts.insert(A.pts.end(), B.pts.begin(), B.pts.end());
+  A.vals.insert(A.vals.end(), B.vals.begin(), B.vals.end());
+  B = Piece{};
+  B.live = false;
+  drop_close_points(A);
+}
+
+/// Step 5: joins centre-line ends that continue each other (mutual best, smallest turn), round after round
+/// until no join is left; returns the live lines.
+std::vector<Piece> join_centre_lines(std::vector<Piece> centre, const PointGrid& grid, double w) {
   const double join_r = 2.0 * w + 2.0;
   for (bool joined = true; joined;) {
     joined = false;
-    struct End {
-      std::size_t piece;
-      bool back;
-      cv::Point2d at;
-      cv::Point2d out;  // unit direction leaving the piece through this end
-    };
-    std::vector<End> ends;
-    std::vector<cv::Point2d> end_pts;
-    for (std::size_t c = 0; c < centre.size(); ++c) {
-      const Piece& pc = centre[c];
-      if (!pc.live || pc.closed || pc.pts.size() < 2) continue;
-      const double reach = std::min(w, 0.5 * polyline_length(pc.pts, false));
-      for (const bool back : {false, true}) {
-        const std::size_t n = pc.pts.size();
-        const auto at = [&](std::size_t i) { return back ? pc.pts[n - 1 - i] : pc.pts[i]; };
-        std::size_t i = 1;
-        double walked = cv::norm(at(1) - at(0));
-        while (walked < reach && i + 1 < n) {
-          walked += cv::norm(at(i + 1) - at(i));
-          ++i;
-        }
-        const cv::Point2d d = at(0) - at(i);
-        const double dn = cv::norm(d);
-        ends.push_back({c, back, at(0), dn > 0 ? d / dn : cv::Point2d(0, 0)});
-        end_pts.push_back(at(0));
-      }
-    }
+    const std::vector<End> ends = open_ends(centre, w);
     if (ends.size() < 2) break;
-    const PointGrid end_grid(end_pts, join_r);
-    // The path of a join: through the point where the two ends' rays meet when the stroke turns
-    // (an L's centre line has its corner there; the chord would cut it), else the chord. Empty
-    // when neither stays clear of every edge point.
-    const auto join_path = [&](const End& ea, const End& eb) {
-      std::vector<std::vector<cv::Point2d>> tries;
-      const double det = ea.out.x * (-eb.out.y) - ea.out.y * (-eb.out.x);  // ea + t out_a = eb + u out_b
-      if (ea.out.dot(-eb.out) < kCosCorner && std::abs(det) > 1e-9) {
-        const cv::Point2d r = eb.at - ea.at;
-        const double t = (r.x * (-eb.out.y) - r.y * (-eb.out.x)) / det;
-        const double u = (ea.out.x * r.y - ea.out.y * r.x) / det;
-        if (t > 0.0 && u > 0.0 && t <= join_r && u <= join_r) tries.push_back({ea.at, ea.at + t * ea.out, eb.at});
-      }
-      tries.push_back({ea.at, eb.at});
-      for (const auto& path : tries) {
-        bool clear = true;
-        for (std::size_t k = 1; clear && k < path.size(); ++k) {
-          const int parts = static_cast<int>(std::ceil(cv::norm(path[k] - path[k - 1]) / 0.25));
-          for (int i = 0; clear && i <= parts; ++i) {
-            const cv::Point2d p = path[k - 1] + (path[k] - path[k - 1]) * (parts > 0 ? static_cast<double>(i) / parts : 0.0);
-            clear = !grid.any_within(p, kJoinClearPx);
-          }
-        }
-        if (clear) return path;
-      }
-      return std::vector<cv::Point2d>{};
-    };
-    std::vector<std::size_t> best(ends.size(), kNone);
-    for (std::size_t a = 0; a < ends.size(); ++a) {
-      double best_score = -std::numeric_limits<double>::infinity();
-      end_grid.for_each_within(ends[a].at, join_r, [&](std::size_t b, double d2) {
-        if (b == a) return;
-        const End& ea = ends[a];
-        const End& eb = ends[b];
-        if (ea.piece == eb.piece && polyline_length(centre[ea.piece].pts, false) < 3.0 * join_r) return;
-        const double score = ea.out.dot(-eb.out);
-        if (score < kCosJoin) return;
-        if (d2 > 0.25) {  // the joining segment must not double back either
-          const cv::Point2d s = (eb.at - ea.at) / std::sqrt(d2);
-          if (s.dot(ea.out) < kCosJoin || s.dot(-eb.out) < kCosJoin) return;
-        }
-        if (!(score > best_score || (score == best_score && b < best[a]))) return;
-        // ... nor cross an edge: a continuation runs inside the stroke (through a corner or a
-        // crossing); a path leaving it would bridge two strokes across the background.
-        if (join_path(ea, eb).empty()) return;
-        best_score = score;
-        best[a] = b;
-      });
-    }
+    const std::vector<std::size_t> best = best_joins(ends, centre, grid, join_r);
     std::vector<char> touched(centre.size(), 0);
     for (std::size_t a = 0; a < ends.size(); ++a) {
       const std::size_t b = best[a];
       if (b == kNone || b < a || best[b] != a) continue;
-      const std::size_t pa = ends[a].piece;
-      const std::size_t pb = ends[b].piece;
-      if (touched[pa] || touched[pb]) continue;  // this round's other join moved its ends
-      touched[pa] = touched[pb] = 1;
+      if (touched[ends[a].piece] || touched[ends[b].piece]) continue;  // this round's other join moved its ends
+      touched[ends[a].piece] = touched[ends[b].piece] = 1;
       joined = true;
-      const std::vector<cv::Point2d> path = join_path(ends[a], ends[b]);
-      Piece& A = centre[pa];
-      if (!ends[a].back) {  // A must end at the join ...
-        std::reverse(A.pts.begin(), A.pts.end());
-        std::reverse(A.vals.begin(), A.vals.end());
-      }
-      const double v_end = A.vals.back();
-      if (pa == pb) {
-        if (path.size() == 3) {
-          A.pts.push_back(path[1]);
-          A.vals.push_back(0.5 * (v_end + A.vals.front()));
-        }
-        A.closed = true;
-        drop_close_points(A);
-        continue;
-      }
-      Piece& B = centre[pb];
-      if (ends[b].back) {  // ... and B start there
-        std::reverse(B.pts.begin(), B.pts.end());
-        std::reverse(B.vals.begin(), B.vals.end());
-      }
-      if (path.size() == 3) {
-        A.pts.push_back(path[1]);
-        A.vals.push_back(0.5 * (v_end + B.vals.front()));
-      }
-      A.pts.insert(A.pts.end(), B.pts.begin(), B.pts.end());
-      A.vals.insert(A.vals.end(), B.vals.begin(), B.vals.end());
-      B = Piece{};
-      B.live = false;
-      drop_close_points(A);
+      join_pieces(centre, ends[a], ends[b], join_path(ends[a], ends[b], grid, join_r));
     }
   }
   std::vector<Piece> lines;
   for (Piece& c : centre) {
     if (c.live && c.pts.size() >= 2) lines.push_back(std::move(c));
   }
+  return lines;
+}
 
-  // Step 6: the points no run covered, trimmed where they run into a centre line.
+/// Step 6: the chains' points no run covered (untouched chains whole, the rest cut into pieces trimmed where
+/// they run into a centre line, crumbs dropped), then the centre lines; values alongside.
+std::vector<Chain> assemble(const std::vector<Chain>& chains, const Flat& f, const std::vector<char>& covered, std::vector<Piece> lines,
+                            double w, const PointValues* values_in, PointValues& vals_out, ThinLineStats& st) {
   std::vector<cv::Point2d> samples;  // centre lines sampled at <= 0.5 px
   for (const Piece& c : lines) {
     const std::size_t n = c.pts.size();
@@ -576,36 +626,35 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
   }
   const PointGrid near_lines(samples, w);
   std::vector<Chain> out;
-  PointValues vals_out;
-  for (std::size_t k = 0; k < K; ++k) {
+  for (std::size_t k = 0; k < f.K; ++k) {
     const std::size_t n = chains[k].points_px.size();
     bool touched = false;
-    for (std::size_t i = 0; i < n && !touched; ++i) touched = covered[off[k] + i] != 0;
+    for (std::size_t i = 0; i < n && !touched; ++i) touched = covered[f.off[k] + i] != 0;
     if (!touched) {
       out.push_back(chains[k]);
       vals_out.push_back(values_in != nullptr ? (*values_in)[k] : std::vector<double>(n, 0.0));
       continue;
     }
     std::size_t s = 0;
-    if (closed[k]) {
-      while (!covered[off[k] + s]) ++s;  // start at a covered point: pieces are never cut at 0
+    if (f.closed[k]) {
+      while (!covered[f.off[k] + s]) ++s;  // start at a covered point: pieces are never cut at 0
     }
     std::vector<std::size_t> piece;
     for (std::size_t t = 0; t <= n; ++t) {
       const std::size_t i = (s + t) % n;
-      if (t < n && !covered[off[k] + i]) {
+      if (t < n && !covered[f.off[k] + i]) {
         piece.push_back(i);
         continue;
       }
       std::size_t a = 0;
       std::size_t b = piece.size();
-      while (a < b && near_lines.any_within(pos[off[k] + piece[a]], w)) ++a;
-      while (b > a && near_lines.any_within(pos[off[k] + piece[b - 1]], w)) --b;
+      while (a < b && near_lines.any_within(f.pos[f.off[k] + piece[a]], w)) ++a;
+      while (b > a && near_lines.any_within(f.pos[f.off[k] + piece[b - 1]], w)) --b;
       Chain c;
       std::vector<double> v;
       for (std::size_t j = a; j < b; ++j) {
-        c.points_px.push_back(pos[off[k] + piece[j]]);
-        v.push_back(value_of(k, piece[j]));
+        c.points_px.push_back(f.pos[f.off[k] + piece[j]]);
+        v.push_back(value_at(values_in, k, piece[j]));
       }
       if (c.points_px.size() >= 2 && polyline_length(c.points_px, false) > kMinPiecePx) {
         out.push_back(std::move(c));
@@ -622,6 +671,28 @@ std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineSta
     vals_out.push_back(std::move(c.vals));
     ++st.pairs_merged;
   }
+  return out;
+}
+
+/// merge_thin_lines, phase by phase (thin_lines.hpp's steps).
+std::vector<Chain> merge(const std::vector<Chain>& chains, double w, ThinLineStats* stats, const PointValues* values_in,
+                         PointValues* values_out) {
+  const Flat f = flatten(chains, w, values_in);
+  ThinLineStats st;
+  st.points_in = f.N;
+  if (w == 0.0 || f.N == 0) {
+    st.points_out = f.N;
+    if (stats != nullptr) *stats = st;
+    if (values_out != nullptr) *values_out = values_in != nullptr ? *values_in : PointValues(f.K);
+    return chains;
+  }
+  const PointGrid grid(f.pos, w);  // all input points: partners (step 2) and the joins' clearance (step 5)
+  const std::vector<std::size_t> partner = find_partners(f, grid, w);
+  const std::vector<Run> runs = find_runs(f, partner, w);
+  std::vector<char> covered(f.N, 0);
+  std::vector<Piece> lines = join_centre_lines(build_centre_lines(f, partner, runs, values_in, covered), grid, w);
+  PointValues vals_out;
+  std::vector<Chain> out = assemble(chains, f, covered, std::move(lines), w, values_in, vals_out, st);
   for (const Chain& c : out) st.points_out += c.points_px.size();
   if (stats != nullptr) *stats = st;
   if (values_out != nullptr) *values_out = std::move(vals_out);
