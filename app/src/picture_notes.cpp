@@ -6,6 +6,7 @@
 #include <iterator>
 #include <string_view>
 
+#include <exiv2/exiv2.hpp>
 #include <toml++/toml.h>
 
 namespace hk::app {
@@ -45,32 +46,80 @@ std::string trimmed(std::string_view s) {
   return std::string(s.substr(b, e - b + 1));
 }
 
-/// The text of key `key`, checked: valid UTF-8, not blank, at most `max_bytes`, no control characters (but
-/// line breaks where `lines`).
-std::string checked_text(const std::string& file, const std::string& key, const toml::node& node, std::size_t max_bytes, bool lines) {
-  const auto* str = node.as_string();
-  if (!str) fail(file, key + " must be a string");
-  const std::string& raw = str->get();
-  if (!valid_utf8(raw)) fail(file, key + " is not valid UTF-8");
-  std::string text = trimmed(raw);
-  if (text.empty()) fail(file, key + " is blank");
-  if (text.size() > max_bytes) fail(file, key + " is " + std::to_string(text.size()) + " bytes, at most " + std::to_string(max_bytes));
+/// What is wrong with `raw` as a title (lines = false) or description (true), or "" when nothing is: valid
+/// UTF-8, not blank, at most `max_bytes` once trimmed, no control characters (but line breaks where `lines`).
+std::string text_problem(const std::string& key, const std::string& raw, std::size_t max_bytes, bool lines) {
+  if (!valid_utf8(raw)) return key + " is not valid UTF-8";
+  const std::string text = trimmed(raw);
+  if (text.empty()) return key + " is blank";
+  if (text.size() > max_bytes) return key + " is " + std::to_string(text.size()) + " bytes, at most " + std::to_string(max_bytes);
   for (const char ch : text) {
     const auto u = static_cast<unsigned char>(ch);
     if ((u < 0x20 && !(lines && (ch == '\n' || ch == '\r'))) || u == 0x7F)
-      fail(file, key + " holds a control character" + (lines ? "" : " (one line, please)"));
+      return key + " holds a control character" + (lines ? "" : " (one line, please)");
   }
+  return "";
+}
+
+/// The text of a sidecar's key `key`, checked (text_problem); refused with fail().
+std::string checked_text(const std::string& file, const std::string& key, const toml::node& node, std::size_t max_bytes, bool lines) {
+  const auto* str = node.as_string();
+  if (!str) fail(file, key + " must be a string");
+  if (const std::string why = text_problem(key, str->get(), max_bytes, lines); !why.empty()) fail(file, why);
+  return trimmed(str->get());
+}
+
+/// A metadata value, trimmed, when it passes text_problem and is no camera's placeholder; else "".
+std::string usable(const std::string& raw, std::size_t max_bytes, bool lines) {
+  static const char* const kPlaceholders[] = {"OLYMPUS DIGITAL CAMERA", "SONY DSC", "DCIM", "Digital Camera", "DIGITAL CAMERA",
+                                              "KODAK Digital Still Camera", "Default", "Untitled", "default"};
+  if (!text_problem("", raw, max_bytes, lines).empty()) return "";
+  std::string text = trimmed(raw);
+  for (const char* p : kPlaceholders)
+    if (text == p) return "";
   return text;
 }
 
+/// An XMP language alternative's default text ("x-default", else the first), "" when absent.
+std::string xmp_text(const Exiv2::XmpData& xmp, const char* key) {
+  const auto it = xmp.findKey(Exiv2::XmpKey(key));
+  if (it == xmp.end()) return "";
+  if (const auto* alt = dynamic_cast<const Exiv2::LangAltValue*>(&it->value())) {
+    const auto d = alt->value_.find("x-default");
+    if (d != alt->value_.end()) return d->second;
+    return alt->value_.empty() ? "" : alt->value_.begin()->second;
+  }
+  return it->toString();
+}
+
 }  // namespace
+
+PictureNotes embedded_notes(const std::string& image_path) {
+  PictureNotes notes;
+  try {
+    Exiv2::LogMsg::setLevel(Exiv2::LogMsg::mute);  // exiv2 would print to stderr about odd files
+    const Exiv2::Image::AutoPtr image = Exiv2::ImageFactory::open(image_path);
+    if (image.get() == nullptr) return notes;
+    image->readMetadata();
+    notes.title = usable(xmp_text(image->xmpData(), "Xmp.dc.title"), kMaxTitleBytes, false);
+    if (notes.title.empty()) {
+      const auto it = image->exifData().findKey(Exiv2::ExifKey("Exif.Image.ImageDescription"));
+      if (it != image->exifData().end()) notes.title = usable(it->toString(), kMaxTitleBytes, false);
+    }
+    notes.description = usable(xmp_text(image->xmpData(), "Xmp.dc.description"), kMaxDescriptionBytes, true);
+    if (notes.description.empty()) notes.description = usable(image->comment(), kMaxDescriptionBytes, true);
+  } catch (const std::exception&) {
+    return {};  // not an image exiv2 reads, or damaged metadata: nothing said of it
+  }
+  return notes;
+}
 
 std::string notes_path(const std::string& image_path) { return fs::path(image_path).replace_extension(".toml").string(); }
 
 PictureNotes read_picture_notes(const std::string& image_path) {
   const std::string file = notes_path(image_path);
   std::error_code ec;
-  if (!fs::exists(file, ec)) return {};
+  if (!fs::exists(file, ec)) return embedded_notes(image_path);
   if (!fs::is_regular_file(file, ec)) fail(file, "is not a regular file");
   const auto size = fs::file_size(file, ec);
   if (ec) fail(file, "cannot be read: " + ec.message());

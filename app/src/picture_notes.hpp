@@ -33,10 +33,19 @@ class PictureNotesError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// What the picture file itself says of it (exiv2): the title from XMP dc:title, else EXIF ImageDescription;
+/// the description from XMP dc:description, else the image comment (a PNG's `Description` text, a JPEG's
+/// COM). Values are checked as a sidecar's are (trimmed, valid UTF-8, not blank, within the byte limits, one
+/// line for the title); a value that fails, and the placeholders cameras write ("OLYMPUS DIGITAL CAMERA",
+/// "SONY DSC", ...), are skipped rather than refused: the file's author did not write them for the kiosk.
+/// Never throws; a file exiv2 cannot read gives empty notes.
+PictureNotes embedded_notes(const std::string& image_path);
+
 /// The sidecar of `image_path`: the file of the same name with the extension `.toml` in the same folder.
 std::string notes_path(const std::string& image_path);
 
-/// Reads the sidecar of `image_path` (notes_path). No sidecar: empty notes. The file must be at most
+/// Reads the sidecar of `image_path` (notes_path). No sidecar: embedded_notes, what the file itself says
+/// (a sidecar wins over the file: it is the operator's). The sidecar must be at most
 /// kMaxNotesFileBytes, valid TOML, with only the string keys `title` (one line, no control characters, at
 /// most kMaxTitleBytes) and `description` (no control characters but line breaks, at most
 /// kMaxDescriptionBytes), both valid UTF-8 and not blank; surrounding white space is trimmed.

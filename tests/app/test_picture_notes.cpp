@@ -6,6 +6,10 @@
 #include <fstream>
 #include <string>
 
+#include <exiv2/exiv2.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 #include "kiosk_exe.hpp"
 #include "picture_library.hpp"
 #include "picture_notes.hpp"
@@ -71,6 +75,55 @@ TEST(PictureNotes, BadSidecarsAreRefusedWithOneLineNamingTheFileAndTheLimit) {
   }
   fs::create_directory(dir / "dir.toml");
   EXPECT_THROW(read_picture_notes((dir / "dir.png").string()), PictureNotesError);
+  fs::remove_all(dir);
+}
+
+/// A small picture written by OpenCV as `name` in dir, its metadata then set by `set` through exiv2.
+template <typename F>
+std::string picture_with_metadata(const fs::path& dir, const std::string& name, F&& set) {
+  const std::string path = (dir / name).string();
+  EXPECT_TRUE(cv::imwrite(path, cv::Mat(40, 60, CV_8UC3, cv::Scalar(200, 200, 200))));
+  Exiv2::Image::AutoPtr image = Exiv2::ImageFactory::open(path);
+  image->readMetadata();
+  set(*image);
+  image->writeMetadata();
+  return path;
+}
+
+TEST(PictureNotes, WithoutASidecarThePicturesOwnMetadataSpeaks) {
+  const fs::path dir = fresh_dir("notes_embedded");
+  // XMP title and description (as photo managers write them), on a PNG.
+  const std::string png = picture_with_metadata(dir, "bike.png", [](Exiv2::Image& im) {
+    im.xmpData()["Xmp.dc.title"] = "lang=x-default a bicycle leaning on a wall";
+    im.xmpData()["Xmp.dc.description"] = "lang=x-default A red bicycle, its front wheel turned to the left.";
+  });
+  PictureNotes n = read_picture_notes(png);
+  EXPECT_EQ(n.title, "a bicycle leaning on a wall");
+  EXPECT_EQ(n.description, "A red bicycle, its front wheel turned to the left.");
+  // A sidecar wins: it is the operator's.
+  std::ofstream(dir / "bike.toml") << "title = \"my bike\"\n";
+  n = read_picture_notes(png);
+  EXPECT_EQ(n.title, "my bike");
+  EXPECT_TRUE(n.description.empty());
+  // EXIF ImageDescription and the comment, on a JPEG; a camera's placeholder is no title.
+  const std::string jpg = picture_with_metadata(dir, "apple.jpg", [](Exiv2::Image& im) {
+    im.exifData()["Exif.Image.ImageDescription"] = "  a red apple on a table ";
+    im.setComment("Taken in the kitchen.");
+  });
+  n = embedded_notes(jpg);
+  EXPECT_EQ(n.title, "a red apple on a table");
+  EXPECT_EQ(n.description, "Taken in the kitchen.");
+  const std::string cam = picture_with_metadata(dir, "cam.jpg", [](Exiv2::Image& im) { im.exifData()["Exif.Image.ImageDescription"] = "OLYMPUS DIGITAL CAMERA"; });
+  EXPECT_TRUE(embedded_notes(cam).title.empty());
+  // A title of two lines or over 200 bytes is skipped, not refused.
+  const std::string two = picture_with_metadata(dir, "two.png", [](Exiv2::Image& im) { im.xmpData()["Xmp.dc.title"] = "lang=x-default one\ntwo"; });
+  EXPECT_TRUE(embedded_notes(two).title.empty());
+  // No metadata, a damaged file, no file: nothing said, nothing thrown.
+  EXPECT_TRUE(embedded_notes(picture_with_metadata(dir, "plain.png", [](Exiv2::Image&) {})).title.empty());
+  const unsigned char broken[] = {0xff, 0xd8, 0xff, 0xe1, 0x00, 0x10, 'E', 'x', 'i', 'f', 0, 0, 'g', 'a', 'r', 'b', 'a', 'g', 'e'};
+  std::ofstream(dir / "broken.jpg", std::ios::binary).write(reinterpret_cast<const char*>(broken), sizeof broken);
+  EXPECT_TRUE(embedded_notes((dir / "broken.jpg").string()).title.empty());
+  EXPECT_TRUE(embedded_notes((dir / "missing.png").string()).title.empty());
   fs::remove_all(dir);
 }
 
