@@ -14,6 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "config/load.hpp"
 #include "image_scene.hpp"
 #include "kiosk_exe.hpp"
 
@@ -152,6 +153,15 @@ std::vector<std::pair<std::string, cv::Mat>> made_silhouettes() {
 }
 
 }  // namespace
+
+TEST(OutlineScene, TheSettingsOfferExactlyTheDetectorsVisionKnows) {
+  // The settings' choices (config, which does not link vision) and vision's names are two lists: kept equal.
+  const config::FieldDescriptor* d = config::find_field("vision", "detector");
+  ASSERT_NE(d, nullptr);
+  ASSERT_EQ(d->choices.size(), 3u);
+  for (const auto& name : d->choices) EXPECT_EQ(vision::detector_name(vision::detector_from_name(std::string(name))), name);
+  EXPECT_THROW(vision::detector_from_name("sobel"), std::invalid_argument);
+}
 
 TEST(OutlineScene, MadeSilhouettesGiveOneClosedCurvePerOutlineOnTheBoundary) {
   const fs::path dir = fresh_dir("outline_scene");

@@ -26,12 +26,6 @@ double end_value(const PointValues& values, int end) {
   return is_start(end) ? v.front() : v.back();
 }
 
-double polyline_length(const Chain& c) {
-  double len = 0.0;
-  for (std::size_t i = 1; i < c.points_px.size(); ++i) len += cv::norm(c.points_px[i] - c.points_px[i - 1]);
-  return len;
-}
-
 void check_input(const std::vector<Chain>& chains, const GapParams& p, const PointValues& values) {
   if (!std::isfinite(p.max_gap_px) || p.max_gap_px < 0.0)
     throw std::invalid_argument("close_gaps: max_gap_px must be finite and >= 0, got " + std::to_string(p.max_gap_px));
@@ -66,7 +60,7 @@ std::vector<Candidate> find_candidates(const std::vector<Chain>& chains, const G
   for (std::size_t k = 0; k < chains.size(); ++k) {
     const Chain& c = chains[k];
     if (c.closed || c.points_px.size() < 2) continue;
-    lengths[k] = polyline_length(c);
+    lengths[k] = chain_length_px(c);  // open: no closing segment
     if (lengths[k] < p.min_piece_px) continue;
     for (const bool start : {true, false}) {
       ends.push_back(2 * static_cast<int>(k) + (start ? 0 : 1));

@@ -81,15 +81,19 @@ void check_params(const ExtractParams& p) {
     throw std::invalid_argument("extract_chains: the workspace must be finite and > 0");
 }
 
+/// The ignore mask at the processed size: area-averaged, so any coverage of a processed pixel counts (nonzero).
+cv::Mat processed_mask(const cv::Mat& ignore_mask, cv::Size size) {
+  if (ignore_mask.empty() || ignore_mask.size() == size) return ignore_mask;
+  cv::Mat small;
+  cv::resize(ignore_mask, small, size, 0, 0, cv::INTER_AREA);
+  return small;
+}
+
 /// Canny: edges, ignored regions cleared, linking.
 void canny_chains(const cv::Mat& grey, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
   auto t0 = std::chrono::steady_clock::now();
   out.edge_map = detect_edges(grey, p.edges);
-  if (!ignore_mask.empty()) {
-    cv::Mat small = ignore_mask;
-    if (ignore_mask.size() != grey.size()) cv::resize(ignore_mask, small, grey.size(), 0, 0, cv::INTER_AREA);
-    out.edge_map.edges.setTo(0, small > 0);
-  }
+  if (!ignore_mask.empty()) out.edge_map.edges.setTo(0, processed_mask(ignore_mask, grey.size()) > 0);
   out.times.edges_ms = ms_since(t0);
   t0 = std::chrono::steady_clock::now();
   out.chains = link_edges(out.edge_map.edges, p.min_chain_length_px);
@@ -103,8 +107,7 @@ void outline_chains(const cv::Mat& grey, const ExtractParams& p, const cv::Mat& 
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<Chain> chains = trace_outlines(grey, out.tones.threshold);
   if (!ignore_mask.empty()) {
-    cv::Mat small = ignore_mask;
-    if (ignore_mask.size() != grey.size()) cv::resize(ignore_mask, small, grey.size(), 0, 0, cv::INTER_AREA);
+    const cv::Mat small = processed_mask(ignore_mask, grey.size());
     std::vector<Chain> kept;
     for (Chain& c : chains) {
       Chain piece;
@@ -124,11 +127,8 @@ void outline_chains(const cv::Mat& grey, const ExtractParams& p, const cv::Mat& 
     chains = std::move(kept);
   }
   out.chains.clear();
-  for (Chain& c : chains) {
-    double len = 0.0;
-    for (std::size_t i = 1; i < c.points_px.size(); ++i) len += cv::norm(c.points_px[i] - c.points_px[i - 1]);
-    if (len >= p.min_chain_length_px) out.chains.push_back(std::move(c));
-  }
+  for (Chain& c : chains)
+    if (chain_length_px(c) >= p.min_chain_length_px) out.chains.push_back(std::move(c));  // as link_edges measures
   // The strength a blurred step between the tones gives (detect_edges' units: 8·D/(σ·√(2π)), the unblurred
   // 3x3 Sobel of a step: 4·D), halved: as sure as Canny's high threshold.
   const double step = out.tones.light_mean - out.tones.dark_mean;
