@@ -14,6 +14,7 @@
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
 #include "vision/mapping.hpp"
+#include "vision/scene_chains.hpp"
 
 using namespace hk;
 
@@ -39,7 +40,7 @@ void build_ours(benchmark::State& state, const Picture* p) {
     const vision::EdgeMap em = vision::detect_edges(p->grey, ep);
     const auto chains = vision::link_edges(em.edges, 2.0);
     const vision::PxToM map = vision::fit_to_workspace(p->grey.cols, p->grey.rows, s.workspace.width_m, s.workspace.height_m);
-    const std::vector<Polyline> curves = app::chains_to_polylines(chains, map, s.vision.min_chain_length_m);
+    const std::vector<Polyline> curves = app::to_polylines(vision::chains_to_curves(chains, {}, map, s.vision.min_chain_length_m));
     const Scene scene = Scene::build(curves, s.haptics.max_levels);
     segments = scene.total_segments(0);
     benchmark::DoNotOptimize(scene.node_count());

@@ -20,6 +20,7 @@ min_time=0.5
 [ -n "$quick" ] && min_time=0.05
 "$b/bench_first_hit" $quick --benchmark_min_time=$min_time --benchmark_out="$out/first_hit.json" --benchmark_out_format=json >/dev/null
 "$b/bench_scene_build" --benchmark_min_time=$min_time --benchmark_out="$out/scene_build.json" --benchmark_out_format=json >/dev/null
+"$b/bench_detectors" --benchmark_min_time=$min_time --benchmark_out="$out/detectors.json" --benchmark_out_format=json >/dev/null
 "$b/bench_anytime" --out "$out/anytime.json" 2>/dev/null
 [ -x "$b/bench_accuracy" ] && "$b/bench_accuracy" --images "$root/tests/data/images" --out "$out/accuracy.json"
 [ -x "$b/bench_stability" ] && "$b/bench_stability" $quick --out "$out/stability.json"
@@ -33,7 +34,7 @@ min_time=0.5
 "$b/bench_device_loop" --seconds 5 --out "$out/device_loop.json" 2>/dev/null > "$out/device_loop.md"
 "$b/bench_tour_time" > "$out/tour_time.md"
 bash "$root/bench/coverage.sh" "$root/build" "$out" >/dev/null  # coverage per picture: CSV, chart and its table
-bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detectors.md"  # issue 15: each picture's scene, canny → auto
+bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detectors.md"  # issue 15: each picture's scene, canny → auto, and per detector
 # Tables printed by the audio and servo benches go between their markers in PERFORMANCE.md.
 /usr/bin/python3 - "$out" "$root/docs/PERFORMANCE.md" <<'PY'
 import re, sys

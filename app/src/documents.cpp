@@ -1,5 +1,8 @@
 #include "documents.hpp"
 
+#include "picture_notes.hpp"
+
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -53,6 +56,17 @@ int StickListing::pictures() const {
 
 int StickListing::pdfs() const { return static_cast<int>(documents.size()) - pictures(); }
 
+std::string pdf_title(const std::string& raw) {
+  std::string t = usable_note(raw, kMaxTitleBytes, false);
+  static const char* const kOfficePrefixes[] = {"Microsoft Word - ", "Microsoft PowerPoint - ", "Microsoft Excel - "};
+  for (const char* p : kOfficePrefixes)
+    if (t.rfind(p, 0) == 0) return "";
+  std::string lower = t;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (lower == "untitled" || lower == "untitled document" || lower == "title") return "";
+  return t;
+}
+
 StickListing list_stick(const std::string& root, const config::Settings& s) {
   StickListing out;
   out.scan = vision::scan_stick(root, scan_limits_from(s));
@@ -67,6 +81,7 @@ StickListing list_stick(const std::string& root, const config::Settings& s) {
         const vision::PdfInfo info = vision::probe_pdf(bytes, d.display_name, pl);
         ld.pages = info.pages;
         ld.pages_in_file = info.pages_in_file;
+        ld.title = pdf_title(info.title);
       } catch (const std::exception& e) {  // PdfError, StickError: this document only
         out.refused.push_back({d.display_name, e.what()});
         continue;
@@ -89,6 +104,7 @@ nlohmann::json stick_listing_json(const StickListing& l) {
                      {"bytes", d.doc.bytes},
                      {"pages", d.pages}};
     if (d.pages_in_file != d.pages) j["pages_in_file"] = d.pages_in_file;
+    if (!d.title.empty()) j["title"] = d.title;
     docs.push_back(std::move(j));
   }
   nlohmann::json refused = nlohmann::json::array();
@@ -113,6 +129,7 @@ ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const st
   is.render_dpi = pg.dpi;
   is.worker_ms = pg.worker_ms;
   is.worker_max_rss_kb = pg.worker_max_rss_kb;
+  is.document_title = pdf_title(pg.title);
   return is;
 }
 

@@ -30,7 +30,13 @@ struct ListedDocument {
   vision::StickDocument doc;
   int pages = 1;             ///< pages offered (a PDF's are capped at [stick] max_pdf_pages)
   int pages_in_file = 1;     ///< pages the document has
+  std::string title;         ///< a PDF's title (pdf_title of its Info /Title), spoken in place of its file name; "" when none
 };
+
+/// The title of a PDF to speak, from vision::PdfInfo::title as the file gives it: usable_note (one line, at
+/// most kMaxTitleBytes, valid UTF-8, not blank, no placeholder) and not what an office program writes in
+/// place of one ("Microsoft Word - report.docx", "untitled"); "" when none is usable.
+std::string pdf_title(const std::string& raw);
 
 /// What a stick offers: the scan, with every PDF probed in the worker (its pages counted). A PDF the
 /// worker refuses (locked, damaged, hostile) moves from the documents to `refused`, with its reason.

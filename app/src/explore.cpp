@@ -277,7 +277,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
                     {"boundary_section_max", section_max}, {"iteration_limited_ticks", iteration_limited}};
   sj["curves"] = scene.curve_count();
   // What the scene left out and why (issue 6, item 4), in pipeline order.
-  sj["chains"] = {{"found", is.chains_found}, {"thin_line_pairs_merged", is.thin_line_pairs_merged},
+  sj["chains"] = {{"texture", is.chains_texture}, {"found", is.chains_found}, {"thin_line_pairs_merged", is.thin_line_pairs_merged},
                   {"after_thin_lines", is.chains_after_thin_lines}, {"gaps_closed", is.gaps_closed},
                   {"closed_by_gaps", is.chains_closed_by_gaps}, {"after_gaps", is.chains_after_gaps}, {"too_short", is.chains_too_short},
                   {"along_border", is.chains_along_border}, {"over_max_shapes", is.chains_over_max_shapes},
@@ -315,7 +315,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
                   {"reconnects", sum.device.reconnects}, {"malformed_replies", sum.device.malformed}};
   if (is.page > 0) {
     sj["document"] = {{"page", is.page}, {"pages", is.pages}, {"text_blocks", is.text_blocks.size()}, {"words_masked", is.text_words_masked},
-                      {"dpi", is.render_dpi}, {"worker_ms", is.worker_ms}, {"worker_max_rss_kb", is.worker_max_rss_kb}};
+                      {"dpi", is.render_dpi}, {"worker_ms", is.worker_ms}, {"worker_max_rss_kb", is.worker_max_rss_kb},
+                      {"title", is.document_title}};
   }
   sj["segments_in_use"] = scene.total_segments(s.haptics.level);
   sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};

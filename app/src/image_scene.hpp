@@ -1,9 +1,8 @@
 #pragma once
 /// @file image_scene.hpp
-/// Image file → haptic scene: the vision pipeline, the pixel → workspace mapping, a scene that models
-/// no more than it needs (thin lines felt as one curve, chains too short to feel dropped, a segment
-/// budget filled with the most salient curves), and the multiresolution collision trees (DESIGN.md
-/// "Data flow").
+/// Image file → haptic scene: vision's scene of the picture (vision/scene_chains.hpp: the curves a hand is
+/// given, in workspace metres, and why the others were left out) and the multiresolution collision trees
+/// (DESIGN.md "Data flow").
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +15,7 @@
 #include "vision/mapping.hpp"
 #include "vision/pdf.hpp"
 #include "vision/pipeline.hpp"
+#include "vision/scene_chains.hpp"
 
 namespace hk::app {
 
@@ -60,6 +60,7 @@ struct ImageScene {
   std::string image_path;                   ///< the file (for a document page: the PDF)
   int page = 0;                             ///< document page shown (from 1); 0 for a picture file
   int pages = 0;                            ///< pages the document offers; 0 for a picture file
+  std::string document_title;               ///< a PDF's own title (documents.hpp pdf_title), "" when none or a picture file
   cv::Mat picture;                          ///< BGR pixels of a page built from memory; empty for a picture file (read it from image_path)
   std::vector<TextBlockM> text_blocks;      ///< a page's text blocks (masked from the edges), in reading order
   std::size_t text_words_masked = 0;        ///< words whose outlines were kept out of the edges
@@ -68,7 +69,8 @@ struct ImageScene {
   long worker_max_rss_kb = 0;               ///< a PDF page: the worker's peak memory [KiB]
   int width_px = 0, height_px = 0;
   vision::PxToM px_to_m{};
-  std::size_t chains_found = 0;             ///< chains out of edge linking
+  std::size_t chains_texture = 0;           ///< dropped before chains_found: edges that do not stand out from their surround (detector "surround", vision::stands_out)
+  std::size_t chains_found = 0;             ///< chains out of edge linking (after the texture test)
   std::size_t thin_line_pairs_merged = 0;   ///< pairs of facing edges (two sides of a stroke thinner than vision.thin_line_max_width_m) felt as one centre line
   std::size_t chains_after_thin_lines = 0;  ///< chains after thin-line merging (centre lines, left-over pieces, untouched chains)
   std::size_t gaps_closed = 0;              ///< chain ends joined across a gap of at most vision.gap_close_m (vision::close_gaps)
@@ -95,75 +97,15 @@ struct ImageScene {
   BuildTimes times;
 };
 
-/// Salience of a curve as the segment budget ranked curves before issue 15 (now shape_salience; kept as
-/// the baseline the shape budget's test compares with).
-///
-///   salience = length_m · clamp(strength / canny_high, 0, 1)
-///
-/// Long boundaries are the shapes a visitor explores (a fingertip finds a long wall and can follow
-/// it; a short one is a bump), so length counts linearly. Strength says how sure the boundary is:
-/// Canny accepts an edge pixel above canny_high outright and one between canny_low and canny_high
-/// only when it is linked to a sure one, so a curve whose mean magnitude is below canny_high is
-/// mostly hysteresis-linked shading or texture and is discounted in proportion; above canny_high
-/// every curve is equally sure (a wall is felt the same whatever its grey-level contrast), hence the
-/// clip at 1. Returns 0 for a non-positive canny_high or a non-finite input.
-double curve_salience(double length_m, double strength, double canny_high);
-
-/// What a curve offers a hand, for ranking it against the others (issue 15, item 2).
-struct ShapeFeatures {
-  double length_m = 0.0;  ///< polyline length [m]
-  double strength = 0.0;  ///< mean edge strength along it (ImageScene::strength) [Canny threshold units]
-  bool closed = false;    ///< a closed outline
-  double area_m2 = 0.0;   ///< area it encloses when closed [m²], else 0
-};
-
-/// Salience of a shape for the budgets (issue 15, item 2): its length plus, when closed, twice the square
-/// root of the area it encloses, weighted by its mean edge strength relative to canny_high:
-///
-///   shape_salience = (length_m + closed · 2·√area_m2) · max(strength, 0) / canny_high
-///
-/// A closed outline is an object a visitor can recognise by going round it, and a large one more than a
-/// small one: a square of side a counts 4a + 2a, a circle of radius r 2πr + 3.5 r; a thin closed loop (a
-/// hair, a crack in the texture, w × L) gains only 2·√(w/L) of its length. Strength counts in proportion,
-/// not clipped at canny_high as in curve_salience: with at most max_shapes curves kept, the strongest
-/// boundaries of a photograph are its objects' outlines, and so the kept curves carry more of the picture's
-/// edge strength × length than the old ranking's (tests/app/test_shape_budget.cpp). 0 for a non-finite
-/// input or a non-positive canny_high; area_m2 must be >= 0 (0 for an open curve).
-double shape_salience(const ShapeFeatures& f, double canny_high);
-
 /// Polyline length [m], with the closing segment of a closed curve (what a hand can follow).
 double polyline_length_m(const Polyline& p);
 
-/// Area enclosed by the polyline taken as closed (shoelace formula, absolute value) [m²]; 0 for fewer than
-/// 3 points.
-double enclosed_area_m2(const Polyline& p);
+/// vision's curves as haptics' polylines (same points, same closedness).
+std::vector<Polyline> to_polylines(const std::vector<vision::SceneCurve>& curves);
 
-/// Share of a polyline's points (in metres, mapped back to pixels through `map`) within band_m of the
-/// picture's frame, the outer edge of its outer pixels, [0, 1]; 0 for no point.
-double border_share(const Polyline& p, const vision::PxToM& map, int width_px, int height_px, double band_m);
-
-/// Curves with at least kBorderShare of their points within kBorderBandM of the picture's frame run along
-/// the border (a scanned page's edge, a photo's frame line): not shapes, dropped.
-inline constexpr double kBorderBandM = 0.001;  // [m]
-inline constexpr double kBorderShare = 0.5;
-
-/// Chains (pixels) → polylines in workspace metres, dropping chains shorter than min_length_m (a
-/// fingertip cannot resolve them). `too_short` (optional) receives the number dropped, `kept`
-/// (optional) the index in `chains` of each polyline returned.
-std::vector<Polyline> chains_to_polylines(const std::vector<vision::Chain>& chains, const vision::PxToM& map, double min_length_m,
-                                          std::size_t* too_short = nullptr, std::vector<std::size_t>* kept = nullptr);
-
-/// Loads the image at `path` and builds its scene with `settings`:
-/// 1. vision::extract_chains (load, grey, shrink to vision.max_image_side_px, Canny, linking, edge
-///    strength per chain point);
-/// 2. thin-line merging (vision::merge_thin_lines) at the processed resolution, with
-///    vision.thin_line_max_width_m converted to processed pixels through the workspace scale (skipped
-///    when 0), the chains then scaled back to original pixels;
-/// 3. pixels → metres, chains shorter than vision.min_chain_length_m dropped;
-/// 4. the budgets: curves along the picture's frame dropped; the rest taken in decreasing shape_salience
-///    (ties: pipeline order), each kept while fewer than vision.max_shapes are and its level-0 segments
-///    still fit vision.max_segments (a less salient one further down may still fit);
-/// 5. Scene::build (haptics.max_levels).
+/// Loads the image at `path` and builds its scene with `settings`: vision::scene_chains (extraction, thin
+/// lines, gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the
+/// level-0 segments plan_levels gives it), then Scene::build (haptics.max_levels) of the curves kept.
 /// Throws vision::InputError for bad image files (one line naming the file and the limit).
 ImageScene build_image_scene(const std::string& path, const config::Settings& settings);
 

@@ -292,18 +292,20 @@ void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
   if (source_ != KioskSource::Stick || r.document != pending_doc_ || r.page != pending_page_) return;  // superseded
   pending_doc_ = -1;
   const StickEntry& e = stick_[static_cast<std::size_t>(r.document)];
+  // A PDF's own title, when it has a usable one, names it: "Page 1 of 3 of Annual report 2025."
+  const std::string& name = e.title.empty() ? e.name : e.title;
   std::string line;
   if (r.ok) {
     doc_ = r.document;
     page_ = r.page;
     state_ = KioskState::Picture;
     line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(e.pages)},
-                                                          {"name", e.name}, {"description", r.description}})
+                                                          {"name", name}, {"description", r.description}})
                  : text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
                                                              {"documents", std::to_string(stick_.size())},
-                                                             {"name", e.name}, {"description", r.description}});
+                                                             {"name", name}, {"description", r.description}});
   } else {
-    const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + e.name : e.name;
+    const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + name : name;
     line = text(MessageId::document_unreadable, {{"name", what}, {"reason", r.reason}});
   }
   if (!announce_summary_.empty()) {  // said now, so it names the keys of now

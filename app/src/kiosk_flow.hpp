@@ -46,9 +46,10 @@ enum class TutorialShape { Square = 0, Circle = 1, Triangle = 2 };
 
 /// A document of a USB stick as the flow sees it.
 struct StickEntry {
-  std::string name;  ///< file name made safe for speech
-  bool pdf = false;  ///< a PDF (pages) or a picture
-  int pages = 1;     ///< pages offered (1 for a picture)
+  std::string name;   ///< file name made safe for speech
+  bool pdf = false;   ///< a PDF (pages) or a picture
+  int pages = 1;      ///< pages offered (1 for a picture)
+  std::string title;  ///< the document's own title (ListedDocument::title), spoken in place of `name`; "" when none
 };
 
 /// Where Next and Previous go.

@@ -270,7 +270,7 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
     if (n.kind == StickNews::Kind::Inserted) {
       stick_id_ = n.stick;
       std::vector<StickEntry> entries;
-      for (const ListedDocument& d : n.documents) entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages});
+      for (const ListedDocument& d : n.documents) entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages, d.title});
       stick_busy_ = !entries.empty();
       flow.stick_inserted(entries, now_s);
     } else if (n.kind == StickNews::Kind::Refused) {

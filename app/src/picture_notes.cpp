@@ -7,6 +7,8 @@
 #include <string_view>
 
 #include <exiv2/exiv2.hpp>
+
+#include "png_text.hpp"
 #include <toml++/toml.h>
 
 namespace hk::app {
@@ -69,8 +71,9 @@ std::string checked_text(const std::string& file, const std::string& key, const 
   return trimmed(str->get());
 }
 
-/// A metadata value, trimmed, when it passes text_problem and is no camera's placeholder; else "".
-std::string usable(const std::string& raw, std::size_t max_bytes, bool lines) {
+}  // namespace
+
+std::string usable_note(const std::string& raw, std::size_t max_bytes, bool lines) {
   static const char* const kPlaceholders[] = {"OLYMPUS DIGITAL CAMERA", "SONY DSC", "DCIM", "Digital Camera", "DIGITAL CAMERA",
                                               "KODAK Digital Still Camera", "Default", "Untitled", "default"};
   if (!text_problem("", raw, max_bytes, lines).empty()) return "";
@@ -79,6 +82,8 @@ std::string usable(const std::string& raw, std::size_t max_bytes, bool lines) {
     if (text == p) return "";
   return text;
 }
+
+namespace {
 
 /// An XMP language alternative's default text ("x-default", else the first), "" when absent.
 std::string xmp_text(const Exiv2::XmpData& xmp, const char* key) {
@@ -101,13 +106,16 @@ PictureNotes embedded_notes(const std::string& image_path) {
     const Exiv2::Image::AutoPtr image = Exiv2::ImageFactory::open(image_path);
     if (image.get() == nullptr) return notes;
     image->readMetadata();
-    notes.title = usable(xmp_text(image->xmpData(), "Xmp.dc.title"), kMaxTitleBytes, false);
+    const PngText png = read_png_text(image_path);  // empty for any other format
+    notes.title = usable_note(xmp_text(image->xmpData(), "Xmp.dc.title"), kMaxTitleBytes, false);
+    if (notes.title.empty()) notes.title = usable_note(png.title, kMaxTitleBytes, false);
     if (notes.title.empty()) {
       const auto it = image->exifData().findKey(Exiv2::ExifKey("Exif.Image.ImageDescription"));
-      if (it != image->exifData().end()) notes.title = usable(it->toString(), kMaxTitleBytes, false);
+      if (it != image->exifData().end()) notes.title = usable_note(it->toString(), kMaxTitleBytes, false);
     }
-    notes.description = usable(xmp_text(image->xmpData(), "Xmp.dc.description"), kMaxDescriptionBytes, true);
-    if (notes.description.empty()) notes.description = usable(image->comment(), kMaxDescriptionBytes, true);
+    notes.description = usable_note(xmp_text(image->xmpData(), "Xmp.dc.description"), kMaxDescriptionBytes, true);
+    if (notes.description.empty()) notes.description = usable_note(png.description, kMaxDescriptionBytes, true);
+    if (notes.description.empty()) notes.description = usable_note(image->comment(), kMaxDescriptionBytes, true);
   } catch (const std::exception&) {
     return {};  // not an image exiv2 reads, or damaged metadata: nothing said of it
   }

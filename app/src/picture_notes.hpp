@@ -33,13 +33,19 @@ class PictureNotesError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// What the picture file itself says of it (exiv2): the title from XMP dc:title, else EXIF ImageDescription;
-/// the description from XMP dc:description, else the image comment (a PNG's `Description` text, a JPEG's
-/// COM). Values are checked as a sidecar's are (trimmed, valid UTF-8, not blank, within the byte limits, one
+/// What the picture file itself says of it (exiv2, and libpng for a PNG's text chunks, png_text.hpp): the
+/// title from XMP dc:title, else a PNG's `Title` text, else EXIF ImageDescription; the description from XMP
+/// dc:description, else a PNG's `Description` text, else the image comment (a JPEG's COM). Values are checked as a sidecar's are (trimmed, valid UTF-8, not blank, within the byte limits, one
 /// line for the title); a value that fails, and the placeholders cameras write ("OLYMPUS DIGITAL CAMERA",
 /// "SONY DSC", ...), are skipped rather than refused: the file's author did not write them for the kiosk.
 /// Never throws; a file exiv2 cannot read gives empty notes.
 PictureNotes embedded_notes(const std::string& image_path);
+
+/// A title or description found in a file (a picture's metadata, a PDF's Info /Title): trimmed, when it is
+/// valid UTF-8, not blank, at most max_bytes, one line when `lines` is false (no control characters but line
+/// breaks when true), and no camera's placeholder ("OLYMPUS DIGITAL CAMERA", "Untitled", ...); else "".
+/// Never throws.
+std::string usable_note(const std::string& raw, std::size_t max_bytes, bool lines);
 
 /// The sidecar of `image_path`: the file of the same name with the extension `.toml` in the same folder.
 std::string notes_path(const std::string& image_path);

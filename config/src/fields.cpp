@@ -100,7 +100,7 @@ constexpr std::array<std::string_view, 3> kTransports{"auto", "usb", "tty"};
 constexpr std::array<std::string_view, 2> kRotations{"cw", "ccw"};
 constexpr std::array<std::string_view, 2> kLevelModes{"auto", "fixed"};
 constexpr std::array<std::string_view, 2> kRenderModes{"walls", "grooves"};
-constexpr std::array<std::string_view, 3> kDetectors{"auto", "canny", "outline"};
+constexpr std::array<std::string_view, 6> kDetectors{"auto", "canny", "surround", "bilateral", "edpf", "outline"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>({
@@ -208,8 +208,10 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(vision, max_shapes, FieldGroup::scene, ApplyWhen::scene, 1, 1000, "", "Shape budget: curves kept, the most salient first (long, sure, closed, enclosing much); the rest are not felt."),
     HK_FIELD(vision, thin_line_max_width_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.01, "m", "The two edges of a line thinner than this become one curve; 0 = off."),
     HK_FIELD(vision, gap_close_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.005, "m", "Chain ends facing each other across a gap up to this are joined into one curve (closing outlines Canny broke); 0 = off."),
+    HK_FIELD(vision, surround_inhibition, FieldGroup::scene, ApplyWhen::scene, 0, 4, "",
+             "Texture test of the \"surround\" detector: how much of the surrounding edge strength is taken off each edge before asking whether it still stands out; 0 = none."),
     HK_FIELD(vision, detector, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
-             "\"auto\": two-tone pictures (silhouettes, drawings) traced from a threshold, others by Canny; \"canny\"; \"outline\": always traced from a threshold.",
+             "\"auto\": two-tone pictures (silhouettes, logos) traced from a threshold, two-tone line drawings by \"canny\", others by \"surround\"; \"canny\": Canny alone; \"surround\": Canny, edges that do not stand out from the texture around them dropped; \"bilateral\": Canny after a bilateral filter; \"edpf\": Edge Drawing (parameter-free); \"outline\": always traced from a threshold.",
              kDetectors),
     // [workspace]
     HK_FIELD(workspace, width_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Width of the usable rectangle."),

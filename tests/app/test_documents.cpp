@@ -142,7 +142,8 @@ std::vector<std::uint8_t> bytes_of(const fs::path& p) { return vision::read_inpu
 
 // The picture pages of horse_and_page.pdf (horse.png and page.png wrapped at 72 dpi by img2pdf) give the
 // PNGs' own curves within a pixel, when drawn at that DPI and processed at the PNG's resolution with the
-// same Canny thresholds (so geometry is compared, not the automatic thresholds of slightly different tones).
+// same Canny thresholds and Canny alone (so geometry is compared, not the automatic thresholds or the texture
+// test's decisions on slightly different tones).
 TEST(PdfPages, PicturePagesGiveThePngsCurvesWithinAPixel) {
   const std::vector<std::uint8_t> pdf = bytes_of(kHorsePdf);
   for (const auto& [page, png, side] : {std::tuple{1, "horse.png", 400}, std::tuple{2, "page.png", 384}}) {
@@ -150,6 +151,7 @@ TEST(PdfPages, PicturePagesGiveThePngsCurvesWithinAPixel) {
     s.vision.max_image_side_px = side;
     s.stick.page_max_dpi = 72.0;  // the DPI img2pdf embedded the pictures at: one page pixel per picture pixel
     s.vision.max_shapes = 1000;   // every curve: the pages' geometry is compared, not which 30 rank first
+    s.vision.detector = "canny";  // nor which edges stand out from their surround (vision/texture.hpp)
     const ImageScene from_png = build_image_scene((kData / "images" / png).string(), s);
     s.vision.canny_low = from_png.canny_low;
     s.vision.canny_high = from_png.canny_high;
@@ -308,6 +310,42 @@ TEST(StickCommand, ListsDocumentsWithPagesAndRefusalsWithReasons) {
   const std::string err = slurp(dir / "err.txt");
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   fs::remove_all(dir);
+}
+
+TEST(StickCommand, APdfsOwnTitleIsListedWhenItIsOneAPersonWrote) {
+  const fs::path dir = fresh_dir("stick_title");
+  const fs::path stick = dir / "stick";
+  fs::create_directories(stick);
+  fs::copy_file(kData / "documents" / "titled.pdf", stick / "ring.pdf");
+  fs::copy_file(kData / "bad" / "title_2000_bytes.pdf", stick / "long.pdf");
+  fs::copy_file(kHorsePdf, stick / "plain.pdf");
+  const StickListing l = list_stick(stick.string(), test_settings());
+  ASSERT_EQ(l.documents.size(), 3u);
+  std::map<std::string, std::string> titles;
+  for (const ListedDocument& d : l.documents) titles[d.doc.display_name] = d.title;
+  EXPECT_EQ(titles["ring.pdf"], "A ring, drawn for the hand \u2014 caf\u00e9 edition");
+  EXPECT_EQ(titles["long.pdf"], "") << "2000 bytes: no title";
+  EXPECT_EQ(titles["plain.pdf"], "") << "none in the file";
+  const json j = stick_listing_json(l);
+  for (const auto& d : j["documents"]) EXPECT_EQ(d.contains("title"), d["path"] == "ring.pdf") << d.dump();
+  // Explore on the PDF itself: summary.json's document says it too.
+  const std::string exe = HK_KIOSK_EXE;
+  ASSERT_EQ(sh(exe + " explore " + q(stick / "ring.pdf") + " --out " + q(dir / "out") + " --duration 0.05 >/dev/null 2>" + q(dir / "err.txt")), 0)
+      << slurp(dir / "err.txt");
+  EXPECT_EQ(json::parse(slurp(dir / "out" / "summary.json"))["document"]["title"], "A ring, drawn for the hand \u2014 caf\u00e9 edition");
+  fs::remove_all(dir);
+}
+
+TEST(PdfTitle, WhatAnOfficeProgramWritesIsNoTitle) {
+  EXPECT_EQ(pdf_title("  Annual report 2025 "), "Annual report 2025");
+  EXPECT_EQ(pdf_title("Microsoft Word - notes.docx"), "");
+  EXPECT_EQ(pdf_title("Microsoft PowerPoint - talk.pptx"), "");
+  EXPECT_EQ(pdf_title("Untitled"), "");
+  EXPECT_EQ(pdf_title("untitled document"), "");
+  EXPECT_EQ(pdf_title("two\nlines"), "") << "a title is one line";
+  EXPECT_EQ(pdf_title(std::string(201, 'x')), "") << "at most 200 bytes";
+  EXPECT_EQ(pdf_title("bad \xff utf-8"), "");
+  EXPECT_EQ(pdf_title("   "), "");
 }
 
 // `haptic-kiosk stick --device`: a real ext4 stick image on a read-only loop device, mounted by the kiosk's

@@ -152,13 +152,30 @@ TEST(KioskFlow, EveryKeyIsAnsweredInSpeech) {
   }
 }
 
+// Issue 15, item 4: a PDF with a title of its own is named by it, in what is said and when a page fails.
+TEST(KioskFlow, APdfIsNamedByItsOwnTitle) {
+  Recorder fx;
+  KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
+  flow.stick_inserted({{"ring.pdf", true, 2, "A ring, drawn for the hand"}}, 1.0);
+  flow.document_ready(ready(0, 1, "It has one figure."), 1.1);
+  EXPECT_NE(fx.said.back().find("Page 1 of 2 of A ring, drawn for the hand. It has one figure."), std::string::npos) << fx.said.back();
+  EXPECT_EQ(fx.said.back().find("ring.pdf"), std::string::npos) << fx.said.back();
+  flow.key(KioskKey::Next, 2.0);
+  DocumentResult bad;
+  bad.document = 0;
+  bad.page = 2;
+  bad.reason = "it took longer than 5 s to draw";
+  flow.document_ready(bad, 2.1);
+  EXPECT_EQ(fx.said.back().rfind("Page 2 of A ring, drawn for the hand cannot be shown", 0), 0u) << fx.said.back();
+}
+
 // Issue 11, item 5: a stick inserted, browsed, a page that cannot be read, a load superseded, the stick
 // taken out mid-load and inserted again, and a new visitor who does not inherit it.
 TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   Recorder fx;
   const auto& en = audio::MessageCatalog::english();
   KioskFlow flow(fx, en, {120.0, 20.0});
-  const std::vector<StickEntry> stick{{"cat.png", false, 1}, {"report.pdf", true, 3}, {"dog.jpg", false, 1}};
+  const std::vector<StickEntry> stick{{"cat.png", false, 1, ""}, {"report.pdf", true, 3, ""}, {"dog.jpg", false, 1, ""}};
 
   flow.stick_inserted(stick, 1.0);
   EXPECT_EQ(flow.state(), KioskState::Picture) << "a stick wakes the kiosk";
@@ -223,7 +240,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   EXPECT_EQ(fx.shown.back(), "picture 1") << "Next walks the library again";
 
   // Inserted again: a fresh listing from its first page.
-  flow.stick_inserted({{"only.pdf", true, 1}}, 9.0);
+  flow.stick_inserted({{"only.pdf", true, 1, ""}}, 9.0);
   EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
   flow.document_ready(ready(0, 1, "It has no text and one figure."), 9.1);
   EXPECT_EQ(fx.said.back(),

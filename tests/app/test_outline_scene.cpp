@@ -158,7 +158,7 @@ TEST(OutlineScene, TheSettingsOfferExactlyTheDetectorsVisionKnows) {
   // The settings' choices (config, which does not link vision) and vision's names are two lists: kept equal.
   const config::FieldDescriptor* d = config::find_field("vision", "detector");
   ASSERT_NE(d, nullptr);
-  ASSERT_EQ(d->choices.size(), 3u);
+  ASSERT_EQ(d->choices.size(), 6u);
   for (const auto& name : d->choices) EXPECT_EQ(vision::detector_name(vision::detector_from_name(std::string(name))), name);
   EXPECT_THROW(vision::detector_from_name("sobel"), std::invalid_argument);
 }

@@ -10,9 +10,12 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <png.h>
+
 #include "kiosk_exe.hpp"
 #include "picture_library.hpp"
 #include "picture_notes.hpp"
+#include "png_text.hpp"
 
 namespace hk::app {
 namespace {
@@ -124,6 +127,86 @@ TEST(PictureNotes, WithoutASidecarThePicturesOwnMetadataSpeaks) {
   std::ofstream(dir / "broken.jpg", std::ios::binary).write(reinterpret_cast<const char*>(broken), sizeof broken);
   EXPECT_TRUE(embedded_notes((dir / "broken.jpg").string()).title.empty());
   EXPECT_TRUE(embedded_notes((dir / "missing.png").string()).title.empty());
+  fs::remove_all(dir);
+}
+
+/// A text chunk to write: keyword, value (UTF-8 for iTXt, Latin-1 bytes for tEXt and zTXt), libpng's
+/// compression code (PNG_TEXT_COMPRESSION_NONE: tEXt, _zTXt: zTXt, PNG_ITXT_COMPRESSION_NONE: iTXt).
+struct Chunk {
+  const char* key;
+  std::string value;
+  int compression;
+};
+
+/// Writes a 16 x 8 grey PNG with libpng, `before` its image data and `after` it.
+void write_png_with_text(const fs::path& file, const std::vector<Chunk>& before, const std::vector<Chunk>& after) {
+  std::FILE* f = std::fopen(file.c_str(), "wb");
+  ASSERT_NE(f, nullptr);
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png_create_info_struct(png), end = png_create_info_struct(png);
+  png_init_io(png, f);
+  png_set_IHDR(png, info, 16, 8, 8, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  const auto texts = [](const std::vector<Chunk>& chunks) {
+    std::vector<png_text> t(chunks.size());
+    for (std::size_t i = 0; i < chunks.size(); ++i) {
+      t[i] = png_text{};
+      t[i].compression = chunks[i].compression;
+      t[i].key = const_cast<char*>(chunks[i].key);
+      t[i].text = const_cast<char*>(chunks[i].value.c_str());
+      t[i].text_length = chunks[i].value.size();
+    }
+    return t;
+  };
+  std::vector<png_text> b = texts(before), a = texts(after);
+  if (!b.empty()) png_set_text(png, info, b.data(), static_cast<int>(b.size()));
+  png_write_info(png, info);
+  std::vector<png_byte> row(16, 128);
+  for (int y = 0; y < 8; ++y) png_write_row(png, row.data());
+  if (!a.empty()) png_set_text(png, end, a.data(), static_cast<int>(a.size()));
+  png_write_end(png, end);
+  png_destroy_info_struct(png, &end);
+  png_destroy_write_struct(&png, &info);
+  std::fclose(f);
+}
+
+TEST(PngText, TitleAndDescriptionFromEveryKindOfTextChunkBeforeOrAfterTheImage) {
+  const fs::path dir = fresh_dir("png_text");
+  // tEXt before the image data; the Latin-1 "é" (0xE9) comes out as UTF-8.
+  write_png_with_text(dir / "text.png", {{"Title", "A horse at the caf\xe9", PNG_TEXT_COMPRESSION_NONE}, {"Author", "me", PNG_TEXT_COMPRESSION_NONE}},
+                      {});
+  PngText t = read_png_text((dir / "text.png").string());
+  EXPECT_EQ(t.title, "A horse at the caf\u00e9");
+  EXPECT_EQ(t.description, "");
+  // zTXt after the image data, iTXt (UTF-8) before it.
+  write_png_with_text(dir / "mixed.png", {{"Title", "Ein Pferd \u2014 von der Seite", PNG_ITXT_COMPRESSION_NONE}},
+                      {{"Description", std::string(3000, 'a') + " standing", PNG_TEXT_COMPRESSION_zTXt}});
+  t = read_png_text((dir / "mixed.png").string());
+  EXPECT_EQ(t.title, "Ein Pferd \u2014 von der Seite");
+  EXPECT_EQ(t.description, std::string(3000, 'a') + " standing");
+  // Through the notes: the PNG's title is spoken; the 3000-byte description is over the limit and skipped.
+  const PictureNotes notes = read_picture_notes((dir / "mixed.png").string());
+  EXPECT_EQ(notes.title, "Ein Pferd \u2014 von der Seite");
+  EXPECT_EQ(notes.description, "");
+  // Not a PNG, no file, a PNG cut short: nothing, no throw.
+  EXPECT_EQ(read_png_text((fs::path(HK_TEST_DATA_DIR) / "images" / "apple.jpg").string()).title, "");
+  EXPECT_EQ(read_png_text((dir / "missing.png").string()).title, "");
+  std::ifstream in(dir / "mixed.png", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(dir / "cut.png", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  EXPECT_EQ(read_png_text((dir / "cut.png").string()).description, "");
+  fs::remove_all(dir);
+}
+
+TEST(PngText, ACompressedTextBombIsNotExpanded) {
+  // 4 MiB of zeros in a zTXt chunk deflate to about 4 KiB; read_png_text lets libpng inflate no chunk past
+  // 1 MiB (libpng's own default would allow 8 MB).
+  const fs::path dir = fresh_dir("png_bomb");
+  write_png_with_text(dir / "bomb.png", {{"Title", "fine", PNG_TEXT_COMPRESSION_NONE}, {"Description", std::string(4u << 20, '0'), PNG_TEXT_COMPRESSION_zTXt}},
+                      {});
+  EXPECT_LT(fs::file_size(dir / "bomb.png"), 64u << 10);
+  const PngText t = read_png_text((dir / "bomb.png").string());
+  EXPECT_EQ(t.description, "") << "refused, not expanded";
+  EXPECT_EQ(t.title, "fine") << "the rest of the file is read";
   fs::remove_all(dir);
 }
 

@@ -20,6 +20,8 @@
 namespace hk::app {
 namespace {
 
+using vision::curve_salience;
+
 namespace fs = std::filesystem;
 
 const std::string kImages = std::string(HK_TEST_DATA_DIR) + "/images/";

@@ -150,7 +150,7 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
       flow.key(KioskKey::Next, 4.0);
       ASSERT_EQ(flow.state(), KioskState::Picture);
       // A USB stick: "Press <next> to go through them."
-      flow.stick_inserted({{"cat.png", false, 1}}, 5.0);
+      flow.stick_inserted({{"cat.png", false, 1, ""}}, 5.0);
       DocumentResult r;
       r.ok = true;
       r.description = "It has 3 shapes.";
@@ -208,7 +208,7 @@ TEST(SpokenKeys, TheOperatorsChangeIsHeardAtOnce) {
   EXPECT_EQ(fx.caption().find("Up arrow"), std::string::npos) << "the old key is not named any more: " << fx.caption();
 
   // A stick inserted before the change and announced after it names the new next key.
-  flow.stick_inserted({{"a.png", false, 1}}, 7.0);
+  flow.stick_inserted({{"a.png", false, 1, ""}}, 7.0);
   k.next = "ENTER";
   flow.set_keys(k);
   DocumentResult r;

@@ -102,6 +102,7 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"vision", "max_shapes", 1, 1000, true},
       {"vision", "thin_line_max_width_m", 0, 0.01, false},
       {"vision", "gap_close_m", 0, 0.005, false},
+      {"vision", "surround_inhibition", 0, 4, false},
       {"workspace", "width_m", 0.01, 1, false},
       {"workspace", "height_m", 0.01, 1, false},
       {"audio", "volume_default_step", 1, 10, true},

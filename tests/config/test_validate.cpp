@@ -70,10 +70,13 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     }
     if (name == "vision.detector") {
       EXPECT_EQ(d.kind, FieldKind::text);
-      ASSERT_EQ(d.choices.size(), 3u);
+      ASSERT_EQ(d.choices.size(), 6u);
       EXPECT_EQ(d.choices[0], "auto");
       EXPECT_EQ(d.choices[1], "canny");
-      EXPECT_EQ(d.choices[2], "outline");
+      EXPECT_EQ(d.choices[2], "surround");
+      EXPECT_EQ(d.choices[3], "bilateral");
+      EXPECT_EQ(d.choices[4], "edpf");
+      EXPECT_EQ(d.choices[5], "outline");
       ++texts;
       continue;
     }

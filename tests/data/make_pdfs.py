@@ -4,15 +4,17 @@
     python3 make_pdfs.py
 
 Writes bad/locked.pdf and bad/pages_5000.pdf (need qpdf), bad/page_14400pt.pdf, bad/truncated.pdf,
-bad/empty.pdf, bad/text_named.pdf and documents/rotated_text.pdf. See bad/IMAGES.md and SOURCES.md.
+bad/empty.pdf, bad/text_named.pdf, bad/title_2000_bytes.pdf, documents/rotated_text.pdf and
+documents/titled.pdf. See bad/IMAGES.md and SOURCES.md.
 """
 import math
 import os
 import subprocess
 
 
-def write_pdf(path, objects):
-    """objects: list of bytes, object i+1 is objects[i]; object 1 is the catalog."""
+def write_pdf(path, objects, info=None):
+    """objects: list of bytes, object i+1 is objects[i]; object 1 is the catalog. info: the object number of
+    the document information dictionary, or None."""
     out = bytearray(b"%PDF-1.4\n%\xe2\xe3\xcf\xd3\n")
     offsets = []
     for i, body in enumerate(objects):
@@ -22,7 +24,8 @@ def write_pdf(path, objects):
     out += b"xref\n0 %d\n0000000000 65535 f \n" % (len(objects) + 1)
     for off in offsets:
         out += b"%010d 00000 n \n" % off
-    out += b"trailer\n<< /Size %d /Root 1 0 R >>\nstartxref\n%d\n%%%%EOF\n" % (len(objects) + 1, xref)
+    info_ref = b" /Info %d 0 R" % info if info else b""
+    out += b"trailer\n<< /Size %d /Root 1 0 R%s >>\nstartxref\n%d\n%%%%EOF\n" % (len(objects) + 1, info_ref, xref)
     with open(path, "wb") as f:
         f.write(out)
 
@@ -83,6 +86,19 @@ def rotated_text(path):
     ])
 
 
+def titled(path, title):
+    """One 300 x 200 pt page with a ring drawn on it, and a document information dictionary whose /Title is
+    `title` (a str), written as UTF-16BE with its byte-order mark (PDF text strings may be UTF-16)."""
+    hexed = ("FEFF" + title.encode("utf-16-be").hex().upper()).encode()
+    write_pdf(path, [
+        b"<< /Type /Catalog /Pages 2 0 R >>",
+        b"<< /Type /Pages /Count 1 /Kids [3 0 R] >>",
+        b"<< /Type /Page /Parent 2 0 R /MediaBox [0 0 300 200] /Contents 4 0 R >>",
+        stream(b"0 0 0 RG 6 w " + circle(150, 100, 60) + b"S"),
+        b"<< /Title <" + hexed + b"> /Producer (haptic-kiosk make_pdfs.py) >>",
+    ], info=5)
+
+
 def main():
     os.makedirs("bad", exist_ok=True)
     subprocess.run(["qpdf", "--encrypt", "user", "owner", "256", "--", "documents/horse_and_page.pdf", "bad/locked.pdf"], check=True)
@@ -98,6 +114,8 @@ def main():
     with open("bad/text_named.pdf", "w") as f:
         f.write("This is a plain text file with a .pdf name, not a PDF.\n")
     rotated_text("documents/rotated_text.pdf")
+    titled("documents/titled.pdf", "A ring, drawn for the hand \u2014 caf\u00e9 edition")
+    titled("bad/title_2000_bytes.pdf", "x" * 2000)
 
 
 if __name__ == "__main__":

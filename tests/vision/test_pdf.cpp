@@ -37,6 +37,7 @@ const std::string kData = HK_TEST_DATA_DIR;
 const std::string kHorse = kData + "/documents/horse_and_page.pdf";
 const std::string kSpec = kData + "/documents/shared-mime-info-spec.pdf";
 const std::string kRotated = kData + "/documents/rotated_text.pdf";
+const std::string kTitled = kData + "/documents/titled.pdf";
 
 std::vector<std::uint8_t> read_file(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
@@ -128,6 +129,22 @@ TEST(PdfDocuments, ShippedDocumentsProbeLikePdfinfoAndRenderEveryPageWithinTheBu
       EXPECT_LT(lo, 128.0);
     }
   }
+}
+
+TEST(PdfDocuments, TheTitleComesFromTheInfoDictionaryAsUtf8) {
+  // titled.pdf's /Title is UTF-16BE with a byte-order mark (tests/data/make_pdfs.py); pdfinfo reads the same.
+  const std::string want = "A ring, drawn for the hand \u2014 caf\u00e9 edition";
+  const auto bytes = read_file(kTitled);
+  EXPECT_EQ(probe_pdf(bytes, "titled.pdf", generous()).title, want);
+  EXPECT_EQ(render_pdf_page(bytes, "titled.pdf", 1, generous()).title, want);
+  if (have_tool("pdfinfo")) {
+    EXPECT_EQ(run("pdfinfo '" + kTitled + "' 2>/dev/null | sed -n 's/^Title: *//p'"), want + "\n");
+  }
+  EXPECT_EQ(probe_pdf(read_file(kHorse), "horse_and_page.pdf", generous()).title, "") << "no /Title";
+  // A /Title of 2000 bytes is dropped, the document is not.
+  const PdfInfo long_title = probe_pdf(read_file(kData + "/bad/title_2000_bytes.pdf"), "title_2000_bytes.pdf", generous());
+  EXPECT_EQ(long_title.title, "");
+  EXPECT_EQ(long_title.pages, 1);
 }
 
 TEST(PdfDocuments, HorsePageAtThePngResolutionMatchesThePng) {

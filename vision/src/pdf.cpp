@@ -15,7 +15,8 @@
 // checked against the limits before anything is allocated:
 //   u32 magic 'HKPD', u8 status (0 = answer, 1 = refusal)
 //   refusal: u8 PdfError::Kind, str problem
-//   answer:  i32 pages_in_file; for a render also f64 width_pt, height_pt, dpi, i32 width, height,
+//   answer:  i32 pages_in_file, str title (the Info dictionary's, UTF-8, at most kMaxPdfTitleBytes, else
+//            empty); for a render also f64 width_pt, height_pt, dpi, i32 width, height,
 //            width*height grey bytes, u32 word count, per word: str text, f64 x, y, w, h [px], u8 space_after
 //   str = u32 length + bytes; numbers in the machine's byte order (the worker runs on the same machine).
 // Coordinates: poppler's text_list() boxes are in points, y down, in the frame of the page's crop box
@@ -172,8 +173,15 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   const int n = doc->pages();
   if (n <= 0) throw Refusal{PdfError::Kind::Damaged, "the document has no pages"};
   const int offered = std::min(n, limits.max_pages);
+  const auto title = [&] {
+    const poppler::byte_array utf8 = doc->get_title().to_utf8();
+    std::string t(utf8.begin(), utf8.end());
+    while (!t.empty() && t.back() == '\0') t.pop_back();
+    return t.size() <= kMaxPdfTitleBytes ? t : std::string();  // a "title" that long is no title
+  };
   if (page == 0) {  // probe
     out.i32(n);
+    out.str(title());
     return;
   }
   if (page > offered) {
@@ -217,6 +225,7 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   }
 
   out.i32(n);
+  out.str(title());
   out.f64(w_pt);
   out.f64(h_pt);
   out.f64(dpi);
@@ -576,8 +585,8 @@ PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, 
   Reader in(run.answer);
   read_head(in, run, name, 0, limits);
   std::int32_t n = 0;
-  if (!in.i32(n) || n <= 0) fail_run(run, name, 0, limits);
   PdfInfo info;
+  if (!in.i32(n) || n <= 0 || !in.str(info.title, kMaxPdfTitleBytes) || in.left() != 0) fail_run(run, name, 0, limits);
   info.pages_in_file = n;
   info.pages = std::min(n, limits.max_pages);
   info.capped = n > limits.max_pages;
@@ -595,7 +604,7 @@ PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& 
   read_head(in, run, name, page, limits);
   std::int32_t n = 0, w = 0, h = 0;
   PdfPage out;
-  if (!in.i32(n) || n < page || !in.f64(out.width_pt) || !in.f64(out.height_pt) || !in.f64(out.dpi) || !in.i32(w) || !in.i32(h) || w <= 0 ||
+  if (!in.i32(n) || n < page || !in.str(out.title, kMaxPdfTitleBytes) || !in.f64(out.width_pt) || !in.f64(out.height_pt) || !in.f64(out.dpi) || !in.i32(w) || !in.i32(h) || w <= 0 ||
       h <= 0 || static_cast<double>(w) * h > limits.max_page_pixels || !(out.dpi > 0 && out.dpi <= limits.max_dpi) ||
       std::abs(w - out.width_pt * out.dpi / 72.0) > 2.0 || std::abs(h - out.height_pt * out.dpi / 72.0) > 2.0) {
     fail_run(run, name, page, limits);

@@ -110,7 +110,8 @@ struct VisionSettings {
   int max_shapes = 30;                        ///< key max_shapes, shape budget: curves kept, most salient first (long, sure, closed, enclosing much), [1, 1000]
   double thin_line_max_width_m = 0.001;       ///< key thin_line_max_width_m, the two edges of a line thinner than this become one curve, [0, 0.01] m; 0 = off
   double gap_close_m = 0.001;                 ///< key gap_close_m, chain ends facing each other across a gap up to this are joined, [0, 0.005] m; 0 = off
-  std::string detector = "auto";              ///< key detector, how boundaries are found: "auto" (two-tone pictures traced from a threshold, others Canny), "canny" or "outline"
+  double surround_inhibition = 1.5;           ///< key surround_inhibition, texture test α of the "surround" detector (vision::stands_out), [0, 4]; 0 = none
+  std::string detector = "auto";              ///< key detector, how boundaries are found: "auto" (two-tone pictures traced from a threshold, line drawings "canny", others "surround"), "canny", "surround", "bilateral", "edpf" or "outline"
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const VisionSettings&) const = default;

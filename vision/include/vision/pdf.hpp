@@ -50,8 +50,15 @@ struct PdfLimits {
 };
 
 /// What a PDF is, without rendering any page.
+/// Longest document title passed on [bytes]: a longer Info /Title is no title a person would hear, and is dropped.
+inline constexpr std::size_t kMaxPdfTitleBytes = 1024;
+
 struct PdfInfo {
   int pages = 0;               ///< pages offered (min(real pages, max_pages)), >= 1
+  /// The document's title as its Info dictionary gives it (poppler's document::get_title, UTF-8), as written:
+  /// unchecked text from a stranger's file — check it before speaking it (app::usable_note). Empty when it has
+  /// none or it is longer than kMaxPdfTitleBytes.
+  std::string title;
   int pages_in_file = 0;       ///< pages the document has
   bool capped = false;         ///< pages_in_file > max_pages
   double worker_ms = 0.0;      ///< wall time of the worker [ms]
@@ -87,6 +94,7 @@ struct PdfPage {
   std::vector<PdfWord> words;     ///< every word on the page, in poppler's reading order
   std::vector<TextBlock> blocks;  ///< words grouped (group_text_blocks)
   int pages = 0;                  ///< pages offered by the document (as PdfInfo::pages)
+  std::string title;              ///< the document's title, unchecked (as PdfInfo::title)
   double worker_ms = 0.0;         ///< wall time of the worker [ms]
   long worker_max_rss_kb = 0;     ///< the worker's peak resident memory [KiB] (as PdfInfo's)
 };

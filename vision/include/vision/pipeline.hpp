@@ -18,16 +18,31 @@
 namespace hk::vision {
 
 /// How boundaries are found ([vision] detector).
+/// The edge detectors (Canny, Surround, Bilateral, Edpf) were compared on every test picture and on generated
+/// texture (docs/PERFORMANCE.md, "Texture out before edges"; bench/scene_detectors.sh); Auto uses the best.
 enum class Detector : std::uint8_t {
-  Auto,     ///< Outline for a two-tone picture (classify_two_tone) but a line drawing, Canny for any other
-  Canny,    ///< detect_edges + link_edges (Gaussian blur, Canny, pixel-graph linking)
-  Outline,  ///< trace_outlines at Otsu's threshold, whatever the picture
+  Auto,       ///< Outline for a two-tone picture (classify_two_tone), Canny for a line drawing, kAutoEdgeDetector for any other
+  Canny,      ///< detect_edges + link_edges (Gaussian blur, Canny, pixel-graph linking), no texture suppression
+  Surround,   ///< Canny, then chains that do not stand out from their surround dropped as texture (texture.hpp)
+  Bilateral,  ///< Canny after an edge-preserving bilateral filter (cv::bilateralFilter, kBilateral* below)
+  Edpf,       ///< Edge Drawing, parameter-free (cv::ximgproc::EdgeDrawing, PFmode: a-contrario validated segments)
+  Outline,    ///< trace_outlines at Otsu's threshold, whatever the picture
 };
 
-/// The [vision] detector name of `d`: "auto", "canny" or "outline".
+/// The edge detector Auto uses for a picture that is not two-tone (chosen by the measurements, see Detector).
+inline constexpr Detector kAutoEdgeDetector = Detector::Surround;
+
+/// The [vision] detector name of `d`: "auto", "canny", "surround", "bilateral", "edpf" or "outline".
 const char* detector_name(Detector d);
 /// The Detector named `name`; throws std::invalid_argument (naming the choices) for any other name.
 Detector detector_from_name(const std::string& name);
+
+/// Bilateral filter of Detector::Bilateral, at the processed resolution: neighbourhood diameter [px], colour
+/// sigma [grey levels] (differences well above it are edges and kept), space sigma [px]. Applied before the
+/// Gaussian blur of detect_edges.
+inline constexpr int kBilateralDiameterPx = 9;
+inline constexpr double kBilateralSigmaGrey = 40.0;
+inline constexpr double kBilateralSigmaSpacePx = 4.0;
 
 /// Parameters of extract_chains.
 struct ExtractParams {
@@ -36,6 +51,8 @@ struct ExtractParams {
   EdgeParams edges;                  ///< edge detection, at the processed resolution
   int max_image_side_px = 800;       ///< longest side the image is shrunk to before edges [px], >= 1
   double min_chain_length_px = 20;   ///< shortest chain kept [processed px], >= 0 (see link_edges)
+  /// Surround inhibition α of Detector::Surround's texture test (stands_out), >= 0; 0 keeps every chain.
+  double surround_inhibition = 1.5;
   /// Auto: a two-tone picture whose ink (TwoTone::ink_width_px) is at most this wide at the workspace scale is
   /// a line drawing and goes to Canny, whose two edges of each stroke the caller merges into one centre line
   /// (thin_lines.hpp); wider ink is traced as outlines. 0 = no picture is a line drawing. [m], >= 0
@@ -72,7 +89,8 @@ struct Extraction {
   /// and high = half the Sobel magnitude a blurred step between the two tones gives (a boundary as sure as
   /// one over Canny's high threshold), so curve strengths compare with `high` alike.
   EdgeMap edge_map;
-  Detector detector_used = Detector::Canny;  ///< Canny or Outline (what Auto chose)
+  Detector detector_used = Detector::Canny;  ///< the detector that ran (never Auto: what Auto chose)
+  std::size_t texture_chains = 0;            ///< Surround: chains dropped as texture (not standing out from their surround)
   bool line_drawing = false;                 ///< two-tone, but ink no wider than ExtractParams::line_drawing_max_ink_m
   TwoTone tones;                             ///< classify_two_tone of the processed grey image (Auto and Outline)
   double px_scale;   ///< original px per processed px (>= 1; 1 = not shrunk), see to_grey

@@ -1,0 +1,22 @@
+#pragma once
+/// @file png_text.hpp
+/// A PNG's own words about itself (issue 15, item 4): the `Title` and `Description` of its text chunks
+/// (tEXt, zTXt, iTXt; W3C PNG 2nd ed. §11.3.4), read with libpng. exiv2, which reads the pictures' other
+/// metadata (picture_notes.cpp), ignores a PNG's Title.
+
+#include <string>
+
+namespace hk::app {
+
+/// The text chunks' values of the keywords "Title" and "Description", as UTF-8 (tEXt and zTXt are Latin-1 and
+/// converted; iTXt is UTF-8 already), unchecked: the caller checks them (usable_note). The first chunk with a
+/// keyword wins, wherever it is in the file (before or after the image data). Compressed chunks are inflated
+/// by libpng within a 1 MiB limit per chunk (a zTXt bomb is refused, not expanded). Empty strings for a file
+/// that is not a PNG, has no such chunk, or that libpng cannot read (never throws; nothing is printed).
+struct PngText {
+  std::string title;
+  std::string description;
+};
+PngText read_png_text(const std::string& path);
+
+}  // namespace hk::app
