@@ -33,7 +33,8 @@ std::map<int, KioskKey> visitor_key_map(const config::KeysSettings& k) {
           {glfw_key(k.previous), KioskKey::Previous}, {glfw_key(k.describe), KioskKey::Describe},
           {glfw_key(k.finer), KioskKey::Finer},       {glfw_key(k.coarser), KioskKey::Coarser},
           {glfw_key(k.volume_up), KioskKey::VolumeUp}, {glfw_key(k.volume_down), KioskKey::VolumeDown},
-          {glfw_key(k.tutorial), KioskKey::Tutorial}, {glfw_key(k.guide), KioskKey::Guide}};
+          {glfw_key(k.tutorial), KioskKey::Tutorial}, {glfw_key(k.guide), KioskKey::Guide},
+          {glfw_key(k.capture), KioskKey::Capture}};
 }
 
 int glfw_mods(const config::KeyChord& c) {

@@ -217,12 +217,14 @@ int run_kiosk(const KioskOptions& o) {
   ro.high_contrast = o.high_contrast;
   ro.overlay = o.overlay;
   ro.probe_usb_device = o.screenshot.empty();  // scripted runs (documentation, tests) never depend on hardware
+  ro.probe_camera = o.screenshot.empty();
   ro.device = o.device;
   KioskRuntime rt(ro, start.settings);
   KioskFlowParams fp;
   fp.timeout_s = start.settings.kiosk.timeout_s;
   fp.warning_s = start.settings.kiosk.warning_s;
   fp.keys = start.settings.keys;
+  fp.camera = rt.has_camera();
   KioskFlow flow(rt, rt.audio().messages(), fp);
 
   KioskWindow window(o.windowed);
@@ -239,10 +241,12 @@ int run_kiosk(const KioskOptions& o) {
 
   rt.start_servo();
   if (ro.probe_usb_device || !ro.device.empty()) rt.announce_device();
+  rt.announce_camera();
   if (!o.stick.empty()) rt.insert_stick_folder(o.stick);
   if (!o.show.empty()) show_first(o.show, rt, flow);
 
   PictureTexture texture;
+  CapturePreviewView preview;
   const bool scripted = !o.screenshot.empty();
   const auto t0 = std::chrono::steady_clock::now();
   int frame = 0;
@@ -250,6 +254,7 @@ int run_kiosk(const KioskOptions& o) {
     kiosk.now_s_ = scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const InputEvent& e : window.poll()) kiosk.input(e);
     rt.poll_sticks(flow, kiosk.now_s_);
+    rt.poll_capture(flow, kiosk.now_s_);
     rt.poll_device(kiosk.now_s_);
     const bool holding = scripted && script.step(frame, kiosk);
     if (!scripted) kiosk.follow_mouse();
@@ -262,6 +267,7 @@ int run_kiosk(const KioskOptions& o) {
     const auto [fw, fh] = window.framebuffer_size();
     texture.update(rt.shown());
     draw_scene(rt, make_view(fw, fh, rt.half()), texture);
+    if (flow.capturing()) preview.draw(rt.capture_preview(), make_view(fw, fh, rt.half()), rt.half());
     window.begin_frame(scripted ? script.mouse() : std::nullopt);
     draw_captions(rt, flow, fw, fh);
     if (rt.overlay() && session.state() != PanelState::open) draw_overlay_status(rt, flow);

@@ -19,7 +19,7 @@ const std::map<std::string, KioskKey>& action_names() {
                                                  {"finer", KioskKey::Finer},       {"coarser", KioskKey::Coarser},
                                                  {"volume_up", KioskKey::VolumeUp}, {"volume_down", KioskKey::VolumeDown},
                                                  {"tutorial", KioskKey::Tutorial}, {"guide", KioskKey::Guide},
-                                                 {"other", KioskKey::Other}};
+                                                 {"capture", KioskKey::Capture}, {"other", KioskKey::Other}};
   return m;
 }
 

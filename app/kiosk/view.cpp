@@ -27,6 +27,45 @@ void PictureTexture::update(const Shown& shown) {
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE, rgb.data);
 }
 
+CapturePreviewView::CapturePreviewView() { glGenTextures(1, &tex_); }
+CapturePreviewView::~CapturePreviewView() { glDeleteTextures(1, &tex_); }
+
+void CapturePreviewView::draw(const CapturePreview& p, const View& v, Vec2 half) {
+  if (p.frame.empty()) return;
+  cv::Mat rgb;
+  cv::cvtColor(p.frame, rgb, cv::COLOR_BGR2RGB);
+  glBindTexture(GL_TEXTURE_2D, tex_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE, rgb.data);
+  // The frame fitted into the workspace rectangle, keeping its aspect ratio: pixel (u, v) at (x0 + k·u, y0 − k·v).
+  const double k = std::min(2 * half.x / rgb.cols, 2 * half.y / rgb.rows);
+  const double x0 = -k * rgb.cols / 2, y0 = k * rgb.rows / 2;
+  const auto at = [&](double u, double w) { return std::pair<double, double>{v.px(x0 + k * u), v.py(y0 - k * w)}; };
+  glEnable(GL_TEXTURE_2D);
+  glColor4f(1, 1, 1, 1);
+  glBegin(GL_QUADS);
+  const double us[4] = {0, 1, 1, 0}, ws[4] = {0, 0, 1, 1};
+  for (int i = 0; i < 4; ++i) {
+    const auto [x, y] = at(us[i] * rgb.cols, ws[i] * rgb.rows);
+    glTexCoord2d(us[i], ws[i]);
+    glVertex2d(x, y);
+  }
+  glEnd();
+  glDisable(GL_TEXTURE_2D);
+  if (p.corners_px) {
+    glColor4f(0.2f, 1.0f, 0.3f, 1.0f);
+    glLineWidth(3.0f);
+    glBegin(GL_LINE_LOOP);
+    for (const cv::Point2d& c : *p.corners_px) {
+      const auto [x, y] = at(c.x + 0.5, c.y + 0.5);
+      glVertex2d(x, y);
+    }
+    glEnd();
+  }
+}
+
 namespace {
 
 void disc(const View& v, Vec2 c, double r_px, bool filled) {

@@ -48,6 +48,21 @@ class PictureTexture {
   int w_ = 0, h_ = 0;
 };
 
+/// The camera's preview while a capture is under way (issue 16, for sighted companions): the latest frame
+/// fitted into the workspace rectangle, over the scene, with the page the guide found outlined in green.
+class CapturePreviewView {
+ public:
+  CapturePreviewView();
+  ~CapturePreviewView();
+  CapturePreviewView(const CapturePreviewView&) = delete;
+  CapturePreviewView& operator=(const CapturePreviewView&) = delete;
+  /// Uploads and draws `p` (nothing when it has no frame yet). `half`: the workspace's half extent [m].
+  void draw(const CapturePreview& p, const View& v, Vec2 half);
+
+ private:
+  GLuint tex_ = 0;
+};
+
 /// Clears the frame and draws the scene (see the file comment).
 void draw_scene(KioskRuntime& runtime, const View& view, const PictureTexture& texture);
 

@@ -16,6 +16,7 @@
 
 #include "audio/mixer.hpp"
 #include "audio/wav.hpp"
+#include "capture.hpp"
 #include "config/load.hpp"
 #include "coverage.hpp"
 #include "cue_tracker.hpp"
@@ -125,6 +126,17 @@ ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t see
   return ep;
 }
 
+// --source: one capture (capture.hpp; a time-out keeps the last frame), written beside the outputs as capture.png
+// and capture.json, and the scene of what it captured.
+ImageScene build_capture_scene(const std::string& spec_text, int page, const config::Settings& s, const std::filesystem::path& out) {
+  if (page > 0) throw ExploreError("--page " + std::to_string(page) + ": a camera capture has no pages");
+  const vision::SourceSpec spec = vision::parse_source_spec(spec_text);
+  std::unique_ptr<vision::FrameSource> source = vision::open_frame_source(spec, frame_source_params_from(s));
+  const CaptureOutcome captured = run_capture(*source, capture_params_from(s));
+  write_capture(captured, source->name(), out.string());
+  return build_image_scene_from_picture(captured.image, spec.str(), s);
+}
+
 }  // namespace
 
 std::uint64_t parse_seed(const std::string& text) {
@@ -175,7 +187,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   }
   const std::filesystem::path out(o.out_dir);
 
-  ImageScene is = build_input_scene(o.image_path, o.page, s);
+  ImageScene is = o.source.empty() ? build_input_scene(o.image_path, o.page, s) : build_capture_scene(o.source, o.page, s, out);
   const Scene& scene = *is.scene;
 
   const double duration = o.duration_s > 0.0 ? o.duration_s : explorer ? hand->natural_duration_s() : path.duration_s() + 0.5;

@@ -16,7 +16,8 @@ namespace hk::app {
 
 /// What `haptic-kiosk explore` was asked to do.
 struct ExploreOptions {
-  std::string image_path;      ///< picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore
+  std::string image_path;      ///< picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore; empty when `source` is given
+  std::string source;          ///< a camera capture instead (capture.hpp): "file:PATH" | "libcamera:N" | "v4l2:DEV"; empty: none
   int page = 0;                ///< PDF page (from 1); 0 = not given (a PDF's first page; refused for a picture)
   std::string out_dir;         ///< folder for the four output files (created if missing)
   std::string hand = "raster"; ///< "raster", "explorer" (the visitor-like closed-loop hand) or a CSV file with header t_s,x_m,y_m

@@ -133,6 +133,15 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
   return out;
 }
 
+ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& s) {
+  if (bgr.empty() || bgr.type() != CV_8UC3) throw std::invalid_argument("picture '" + name + "': must be a non-empty 8-bit BGR image");
+  ImageScene out;
+  out.image_path = name;
+  out.picture = bgr.clone();
+  build_from_chains(out, vision::scene_chains_from_image(out.picture, extract_params(s), simplify_params(s), segment_cost(s)), s);
+  return out;
+}
+
 std::vector<Aabb> text_block_regions(const std::vector<TextBlockM>& blocks) {
   std::vector<Aabb> out;
   out.reserve(blocks.size());

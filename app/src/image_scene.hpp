@@ -115,6 +115,11 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& se
 /// @throws vision::InputError (one line naming `name` and the limit).
 ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& settings);
 
+/// build_image_scene on pixels already in memory (a camera capture, issue 16): the same steps from
+/// vision::scene_chains_from_image. `name` names it in errors and scene.json; ImageScene::picture holds a copy.
+/// @throws std::invalid_argument for an empty or non-CV_8UC3 image (and as scene_chains_from_image).
+ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& settings);
+
 /// Builds the scene of a rendered document page (issue 11, items 3-4) the way build_image_scene builds a
 /// picture's, except that text is spoken, not felt: every word's box, grown by a quarter of its height on
 /// each side (the blurred glyphs' edges reach past the box), is masked from edge detection

@@ -24,12 +24,14 @@ KioskFlow::KioskFlow(KioskEffects& effects, const audio::MessageCatalog& message
 }
 
 std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings& k) {
-  // In the order of kKeyPlaceholders: help, next, previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide.
+  // In the order of kKeyPlaceholders: help, next, previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide,
+  // capture.
   return {{{audio::kKeyPlaceholders[0], k.help},      {audio::kKeyPlaceholders[1], k.next},
            {audio::kKeyPlaceholders[2], k.previous},  {audio::kKeyPlaceholders[3], k.describe},
            {audio::kKeyPlaceholders[4], k.finer},     {audio::kKeyPlaceholders[5], k.coarser},
            {audio::kKeyPlaceholders[6], k.volume_up}, {audio::kKeyPlaceholders[7], k.volume_down},
-           {audio::kKeyPlaceholders[8], k.tutorial},  {audio::kKeyPlaceholders[9], k.guide}}};
+           {audio::kKeyPlaceholders[8], k.tutorial},  {audio::kKeyPlaceholders[9], k.guide},
+           {audio::kKeyPlaceholders[10], k.capture}}};
 }
 
 std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageArg> args) const {
@@ -90,12 +92,26 @@ void KioskFlow::key(KioskKey k, double now_s) {
   last_activity_s_ = now_s;
   warned_ = false;
   fx_.key_pressed();
+  if (capturing_) {  // any key stops a capture, and does nothing else
+    capturing_ = false;
+    fx_.cancel_capture();
+    say(MessageId::capture_cancelled);
+    return;
+  }
   switch (k) {
+    case KioskKey::Capture:
+      if (fx_.start_capture()) {
+        capturing_ = true;
+        say(MessageId::capture_start);
+      } else {
+        say(MessageId::capture_no_camera);
+      }
+      return;
     case KioskKey::Guide:
       fx_.guide();
       return;
     case KioskKey::Help:
-      say(MessageId::help);
+      say_help();
       return;
     case KioskKey::Tutorial:
       start_tutorial();
@@ -146,7 +162,7 @@ void KioskFlow::key(KioskKey k, double now_s) {
         fx_.say(fx_.describe());
         return;
       default:
-        say(MessageId::help);  // any other key still gets an answer
+        say_help();  // any other key still gets an answer
         return;
     }
   }
@@ -167,9 +183,42 @@ void KioskFlow::key(KioskKey k, double now_s) {
       say(fx_.change_level(+1) ? MessageId::level_coarser : MessageId::level_coarsest);
       return;
     default:
-      say(MessageId::help);
+      say_help();
       return;
   }
+}
+
+void KioskFlow::say_help() {
+  fx_.say(p_.camera ? text(MessageId::help) + " " + text(MessageId::help_camera) : text(MessageId::help));
+}
+
+void KioskFlow::capture_advice(MessageId advice, double now_s) {
+  if (!capturing_) return;
+  last_activity_s_ = now_s;
+  warned_ = false;
+  say(advice);
+}
+
+void KioskFlow::capture_done(int shapes, double now_s) {
+  if (!capturing_) return;
+  capturing_ = false;
+  last_activity_s_ = now_s;
+  warned_ = false;
+  state_ = KioskState::Picture;
+  if (shapes == 0) {
+    say(MessageId::captured_empty);
+  } else if (shapes == 1) {
+    say(MessageId::captured_one);
+  } else {
+    say(MessageId::captured, {{"shapes", std::to_string(shapes)}});
+  }
+}
+
+void KioskFlow::capture_failed(bool timeout, double now_s) {
+  if (!capturing_) return;
+  capturing_ = false;
+  last_activity_s_ = now_s;
+  say(timeout ? MessageId::capture_timeout : MessageId::capture_failed);
 }
 
 void KioskFlow::tick(double now_s) {
@@ -180,6 +229,8 @@ void KioskFlow::tick(double now_s) {
   }
   const double idle = now_s - last_activity_s_;
   if (idle >= p_.timeout_s) {
+    if (capturing_) fx_.cancel_capture();
+    capturing_ = false;
     fx_.new_session();  // first: it stops speech, and the goodbye must be heard
     if (source_ == KioskSource::Stick || !stick_.empty()) fx_.forget_stick();
     source_ = KioskSource::Library;

@@ -18,6 +18,12 @@
 /// loading_cue_s. A page that cannot be read is reported and the picture felt before stays. Removing the
 /// stick goes back to the library picture; a new session forgets the stick.
 ///
+/// The camera (issue 16, item 3): the Capture key starts a capture (KioskEffects::start_capture) guided by voice
+/// (capture_advice, each advice said as it comes, cutting off the one before); any key cancels it; when the
+/// picture is taken (capture_done) the Shutter earcon has sounded and the flow says "Captured. It has N shapes."
+/// and stays on it (Next and Previous go on in the library). A failure or a time-out is said. Without a camera
+/// the key says so, and the help names the key only when there is a camera (KioskFlowParams::camera).
+///
 /// Keys (issue 12, item 6): what the kiosk says names the keys that work. Every message is said with its
 /// key placeholders ({help_key}, {next_key}, …) filled from the [keys] settings (KioskFlowParams::keys, changed
 /// live with set_keys()), as the catalogue's spoken form of each key ("Press the Up arrow for more detail.").
@@ -33,7 +39,7 @@
 namespace hk::app {
 
 /// Keys a blind visitor can find (mapped to physical keys in the config by the window layer).
-enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Guide, Other };
+enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Guide, Capture, Other };
 
 /// States of the flow.
 enum class KioskState { Attract, Tutorial, Picture };
@@ -95,6 +101,12 @@ class KioskEffects {
   /// Any key was pressed (before the flow acts on it): a guided tour that runs stops (issue 14, item 3).
   /// Default: nothing.
   virtual void key_pressed() {}
+  /// The Capture key (issue 16): start a guided camera capture off the window thread; the window layer then
+  /// reports with KioskFlow::capture_advice / capture_done / capture_failed. False when there is no camera
+  /// (nothing starts). Default: no camera.
+  virtual bool start_capture() { return false; }
+  /// Stop the capture under way (a key was pressed or the session ended); no report follows. Default: nothing.
+  virtual void cancel_capture() {}
   /// The Guide key (issue 14, item 3): lead the handle to the nearest shape not yet touched and round it,
   /// or, when the press stopped a running tour (key_pressed), say so. What is said is up to the
   /// implementation (the tour's end is reported later). Default: nothing.
@@ -112,6 +124,7 @@ struct KioskFlowParams {
   double warning_s = 20.0;   ///< the spoken warning comes this long before the end (at most timeout_s / 2)
   double loading_cue_s = 0.5; ///< "Loading." is said when a document takes longer than this to load
   config::KeysSettings keys{};  ///< the key of each action ([keys]), named in what is said; default: the shipped keys
+  bool camera = false;          ///< a camera is there: the help names the Capture key
 };
 
 /// The state machine. Not thread-safe: call from the window thread.
@@ -133,6 +146,17 @@ class KioskFlow {
   void stick_removed(double now_s);
   /// A load asked for with show_document finished (ignored unless it is the one awaited).
   void document_ready(const DocumentResult& result, double now_s);
+  /// The capture under way says `advice` (one of the capture_* messages, capture.hpp advice_message). Counts as
+  /// activity (the visitor is busy placing the picture). Ignored when no capture is under way.
+  void capture_advice(audio::MessageId advice, double now_s);
+  /// The capture under way took its picture and put it on the device with `shapes` shapes: said, and the
+  /// flow is on that picture. Ignored when no capture is under way.
+  void capture_done(int shapes, double now_s);
+  /// The capture under way ended without a picture: the camera failed (timeout = false) or the picture never
+  /// lay still long enough (timeout = true). Said; the picture felt before stays.
+  void capture_failed(bool timeout, double now_s);
+  /// A capture is under way.
+  bool capturing() const { return capturing_; }
   /// The operator changed the keys ([keys]): from now on every message names these (the next thing said
   /// already does). Does not speak and does not touch the session.
   void set_keys(const config::KeysSettings& keys) { p_.keys = keys; }
@@ -162,6 +186,7 @@ class KioskFlow {
   void start_tutorial();
   void show(int index, const std::string& before = {});
   void say(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
+  void say_help();  // the help, and the Capture key's sentence when there is a camera
   void request(int document, int page, double now_s);
   void step_document(int delta, double now_s);
   std::string stick_summary() const;
@@ -182,6 +207,7 @@ class KioskFlow {
   double pending_since_s_ = 0;
   bool loading_said_ = false;
   std::string announce_summary_;            // the stick's summary, said before the first page's announcement
+  bool capturing_ = false;                  // a camera capture is under way
 };
 
 }  // namespace hk::app

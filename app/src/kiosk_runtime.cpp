@@ -41,6 +41,7 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
     : opt_(o), s_(s), audio_(audio_params(s, o.open_audio_output)), half_{s.workspace.width_m / 2, s.workspace.height_m / 2},
       sp_(servo_params_from(s)), sim_(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2}),
       core_(cue_params(), &audio_.cues()),
+      capture_(s, o.probe_camera || s.camera.source != "auto" ? choose_camera(s.camera) : CameraChoice{{}, {}, "not looked for (a scripted run)"}),
       sticks_(s, block_events(o.hotplug), o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
   pictures_ = list_pictures(o.library);
   sim_.open();
@@ -151,6 +152,49 @@ void KioskRuntime::announce_device() {
   if (s_.device.type == "simulated" && opt_.device.empty()) return;  // chosen: nothing to tell
   if (!opt_.probe_usb_device && opt_.device.empty()) return;
   say(audio_.messages().text(usb_ ? audio::MessageId::device_ready : audio::MessageId::device_simulated));
+}
+
+void KioskRuntime::announce_camera() {
+  const CameraChoice& c = capture_.camera();
+  if (c.spec) {
+    spdlog::info("camera: {}", c.name);
+    say(audio_.messages().text(audio::MessageId::camera_ready, {}, key_args(s_.keys)));
+    return;
+  }
+  spdlog::info("camera: none ({})", c.why);
+  if (s_.camera.source == "none" || (s_.camera.source == "auto" && !opt_.probe_camera)) return;
+  say(audio_.messages().text(audio::MessageId::camera_none));
+}
+
+bool KioskRuntime::start_capture() { return capture_.start(); }
+
+void KioskRuntime::cancel_capture() { capture_.cancel(); }
+
+void KioskRuntime::poll_capture(KioskFlow& flow, double now_s) {
+  for (CaptureNews& n : capture_.poll()) {
+    switch (n.kind) {
+      case CaptureNews::Kind::Advice:
+        flow.capture_advice(advice_message(n.advice), now_s);
+        break;
+      case CaptureNews::Kind::Captured: {
+        audio_.play(audio::CueKind::Shutter);
+        const int shapes = static_cast<int>(n.scene->scene->curve_count());
+        show_built(*n.scene, kFirstCaptureId - captures_++);
+        shown_.notes = {};
+        shown_picture_ = -1;
+        shown_document_ = -1;
+        shown_page_ = 0;
+        flow.capture_done(shapes, now_s);
+        break;
+      }
+      case CaptureNews::Kind::Failed:
+        flow.capture_failed(false, now_s);
+        break;
+      case CaptureNews::Kind::TimedOut:
+        flow.capture_failed(true, now_s);
+        break;
+    }
+  }
 }
 
 void KioskRuntime::poll_device(double now_s) {
@@ -343,6 +387,7 @@ void KioskRuntime::new_session() {
     spdlog::info("session: servo {} ticks, {} missed deadlines, lateness p50 {:.0f} p99 {:.0f} max {:.0f} us, tick work p99 {:.0f} us",
                  t.ticks, t.missed_deadlines, t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us, t.compute_p99_us);
   }
+  capture_.cancel();
   audio_.new_session();
   level_ = s_.haptics.level;
   auto_level_ = s_.haptics.level_mode == "auto";
@@ -472,6 +517,9 @@ void KioskRuntime::rebuild_shown() {
     show_tutorial(static_cast<TutorialShape>(shape));
   } else if (shown_picture_ >= 0) {
     show_picture(shown_picture_);
+  } else if (shown_id_ <= kFirstCaptureId && !shown_.picture.empty()) {
+    ImageScene is = build_image_scene_from_picture(shown_.picture.clone(), "camera capture", s_);
+    show_built(is, shown_id_);
   } else if (shown_document_ >= 0 && stick_id_ != 0) {
     rebuild_page_id_ = 1000 + shown_document_ * 100000 + shown_page_;
     stick_busy_ = true;
@@ -512,6 +560,7 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
     }, d.ref(in_use));
   }
   s_ = in_use;
+  capture_.set_settings(s_);
   sp_ = servo_params_from(s_);
   if (r.gains) core_.set_gains(servo_gains_from(s_));
   if (r.keys) flow.set_keys(s_.keys);

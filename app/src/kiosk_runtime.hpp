@@ -26,6 +26,7 @@
 #include "haptics/io/usb_devices.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "haptics/triple_buffer.hpp"
+#include "capture_service.hpp"
 #include "guided_tour.hpp"
 #include "image_scene.hpp"
 #include "kiosk_flow.hpp"
@@ -51,6 +52,9 @@ struct RuntimeOptions {
   /// pantograph's driver on the firmware emulator behind a pty, its handle pulled by the cursor through the
   /// model hand (demonstrations, documentation, tests). @throws DeviceChoiceError for anything else.
   std::string device;
+  /// Look for a camera when [camera] source is "auto" (list_cameras); false: "auto" means no camera (scripted
+  /// runs, tests). A source named in the settings ("file:...", "libcamera:N", "v4l2:DEV") is used either way.
+  bool probe_camera = false;
 };
 
 /// What is on the device and on the screen.
@@ -93,6 +97,11 @@ class KioskRuntime final : public KioskEffects {
   /// Says which device is in use: "The handle is ready." or that the kiosk runs on its simulated handle
   /// (nothing when the simulated pantograph was chosen: [device] type "simulated", or probe_usb_device off).
   void announce_device();
+  /// Says which camera there is (issue 16): "There is a camera: press … to feel a picture of your own." or "No
+  /// camera was found." (nothing when [camera] source is "none", or "auto" was not probed). Logged either way.
+  void announce_camera();
+  /// Whether there is a camera to capture from.
+  bool has_camera() const { return capture_.available(); }
   /// Window thread, every frame (`now_s` the frame clock [s]): says when the handle has been lost for
   /// 0.5 s and, after that, when it works again (the servo thread's display state carries the device
   /// status; shorter losses are not spoken), and, while the simulated pantograph stands in for a USB
@@ -123,6 +132,16 @@ class KioskRuntime final : public KioskEffects {
   bool change_volume(int delta) override;
   void new_session() override;
   void key_pressed() override;
+  /// The Capture key: starts a capture on the camera's worker (CaptureService::start); false without a camera.
+  bool start_capture() override;
+  /// Stops the capture under way.
+  void cancel_capture() override;
+  /// Window thread, every frame: the capture's news handed to the flow: advice to say; a picture taken (the
+  /// Shutter earcon, its scene put on the device with the fade, KioskFlow::capture_done); a failure or a
+  /// time-out (KioskFlow::capture_failed).
+  void poll_capture(KioskFlow& flow, double now_s);
+  /// The capture under way's latest frame and page (for the preview), empty when none is under way.
+  CapturePreview capture_preview() const { return capture_.busy() ? capture_.preview() : CapturePreview{}; }
   /// The Guide key: plans the tour from the handle to the nearest shape of the picture shown not yet
   /// touched in this visit (plan_tour) and hands it to the servo thread; nothing left: says so
   /// (tour_all_touched, or tour_nothing for a picture without shapes). A press that stopped a running tour
@@ -165,7 +184,8 @@ class KioskRuntime final : public KioskEffects {
   ServoCore& core() { return core_; }
   audio::AudioSystem& audio() { return audio_; }
   const Shown& shown() const { return shown_; }
-  /// SceneBundle id of what is shown (tutorial −1..−3, picture index, 1000 + stick page).
+  /// SceneBundle id of what is shown (tutorial −1..−3, picture index, 1000 + stick page, camera captures
+  /// kFirstCaptureId, kFirstCaptureId − 1, ...).
   int shown_id() const { return shown_id_; }
   /// Level in use (the servo thread's, which follows the hand's speed in auto mode).
   int level() { return core_.display().level; }
@@ -225,6 +245,8 @@ class KioskRuntime final : public KioskEffects {
   int shown_page_ = 0;      // a document page shown (from 1), 0 for a picture
   int shown_document_ = -1; // stick document shown, −1 for none
   int rebuild_page_id_ = 0; // a stick page re-requested by apply_settings (shown without a new announcement)
+  static constexpr int kFirstCaptureId = -100;  // shown_id_ of the first camera capture; later ones count down
+  int captures_ = 0;        // camera captures shown so far
   int stick_id_ = 0;        // the stick the flow browses (StickNews::stick), 0 for none
   bool stick_busy_ = false;
   // The guided tour (window thread but hand_limp_).
@@ -238,6 +260,7 @@ class KioskRuntime final : public KioskEffects {
   Vec2 cursor_in_;             // the last cursor given to set_cursor [m]
   Vec2 cursor_offset_;         // added to it: where tours left the hand [m]
   Vec2 tour_cursor_ref_;       // cursor_in_ when the tour was handed over [m]
+  CaptureService capture_;  // the camera; its worker stops before the rest goes
   StickService sticks_;     // last: its threads stop first
 };
 

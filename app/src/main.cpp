@@ -1,4 +1,5 @@
-// haptic-kiosk: command line entry. Subcommands: explore (headless run, DESIGN.md contract), stick (what a USB stick offers), pin
+// haptic-kiosk: command line entry. Subcommands: explore (headless run, DESIGN.md contract), capture (one camera capture),
+// cameras (the cameras found), stick (what a USB stick offers), pin
 // (set or check the operator's PIN), speak (a message or text rendered to WAV), devices (USB and serial devices
 // found) and calibrate (the USB pantograph's encoder offsets).
 #include <CLI/CLI.hpp>
@@ -7,6 +8,7 @@
 #include <string>
 
 #include "audio_settings.hpp"
+#include "capture.hpp"
 #include "device_command.hpp"
 #include "explore.hpp"
 #include "kiosk_app.hpp"
@@ -47,7 +49,12 @@ int main(int argc, char** argv) {
                  "(default: the device of [device])");
   hk::app::ExploreOptions eo;
   CLI::App* explore = cli.add_subcommand("explore", "Run the whole pipeline headless on the simulated pantograph");
-  explore->add_option("input", eo.image_path, "Picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore")->required();
+  CLI::Option* input = explore->add_option("input", eo.image_path, "Picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore");
+  CLI::Option* source = explore->add_option("--source", eo.source,
+                                            "A camera capture in place of the input: file:PATH (an image or a folder of frames), "
+                                            "libcamera:N or v4l2:DEV; capture.png and capture.json go beside the outputs");
+  input->excludes(source);
+  source->excludes(input);
   explore->add_option("--page", eo.page, "Page of a PDF, from 1 (default 1)")->check(CLI::PositiveNumber);
   explore->add_option("--out", eo.out_dir, "Folder for scene.json, trace.csv, summary.json, overlay.png")->required();
   explore->add_option("--hand", eo.hand,
@@ -64,6 +71,12 @@ int main(int argc, char** argv) {
                       "sim, or haply-emulator[:FAULT=VALUE,...] (the firmware emulator behind a pty; faults disconnect_at_s, "
                       "drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed, calib_error1_deg, calib_error2_deg)")
       ->default_val("sim");
+  hk::app::CaptureOptions cao;
+  CLI::App* capture = cli.add_subcommand("capture", "Capture a picture from a camera or frames once: the page found, guided, rectified");
+  capture->add_option("--source", cao.source, "file:PATH (an image or a folder of frames), libcamera:N or v4l2:DEV")->required();
+  capture->add_option("--out", cao.out_dir, "Folder for capture.png and capture.json")->required();
+  capture->add_option("--config", cao.config_path, "Settings file (TOML): [camera]");
+  CLI::App* cameras = cli.add_subcommand("cameras", "List the cameras found (libcamera, then V4L2)");
   hk::app::DevicesOptions dvo;
   CLI::App* devices = cli.add_subcommand("devices", "List the USB and serial devices found, and which are supported");
   devices->add_option("--config", dvo.config_path, "Settings file (TOML): [device] usb_vid, usb_pid");
@@ -97,10 +110,15 @@ int main(int argc, char** argv) {
   }
   try {
     if (*explore) {
+      if (eo.image_path.empty() && eo.source.empty()) throw std::runtime_error("explore: give a picture or PDF to explore, or --source");
       eo.seed = hk::app::parse_seed(seed_text);
       const auto sum = hk::app::run_explore(eo);
       std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n", sum.ticks,
                   sum.curves, sum.edge_ticks, sum.vertex_ticks, sum.max_force_n, eo.out_dir.c_str());
+    } else if (*capture) {
+      return hk::app::run_capture_command(cao);
+    } else if (*cameras) {
+      return hk::app::run_cameras_command();
     } else if (*devices) {
       return hk::app::run_devices(dvo);
     } else if (*calibrate) {

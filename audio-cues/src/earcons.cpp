@@ -27,6 +27,7 @@ const char* cue_kind_name(CueKind kind) {
     case CueKind::TextBlock: return "text_block";
     case CueKind::PopThrough: return "pop_through";
     case CueKind::TourStart: return "tour_start";
+    case CueKind::Shutter: return "shutter";
   }
   return "unknown";
 }
@@ -182,6 +183,14 @@ void EarconSynth::trigger(const CueEvent& e) noexcept {
       start({523.25, 523.25, 0.08, 0.004, 0.0, 0.03, g * 0.3, 0.0, 0, 1, 0.0});
       start({659.25, 659.25, 0.08, 0.004, 0.0, 0.03, g * 0.3, 0.0, 0, 1, 0.07});
       start({783.99, 783.99, 0.12, 0.004, 0.0, 0.05, g * 0.3, 0.0, 0, 1, 0.14});
+      break;
+    case CueKind::Shutter:
+      // A camera's shutter: two bright noise clicks 60 ms apart (the blades opening, then closing), the second
+      // softer, over a faint low thump. Nothing else in the kiosk is two clicks.
+      start({3000, 3000, 0.012, 0.0003, 0.003, 0.004, g * 0.8, 1.0, 3500, 1.2, 0.0});
+      start({2500, 2500, 0.012, 0.0003, 0.003, 0.004, g * 0.55, 1.0, 3000, 1.2, 0.060});
+      start({150, 150, 0.02, 0.001, 0.006, 0.008, g * 0.3, 0.0, 0, 1, 0.0});
+      slide_active_ = false;
       break;
   }
 }

@@ -19,8 +19,9 @@ inline float soft_limit(float x) {
 
 }  // namespace
 
-Mixer::Mixer(const MixerParams& params, SpscRing<CueEvent>* cues, SpeechStream* speech, const Volume* volume)
-    : params_(params), synth_(params.earcons, kSampleRateHz), cues_(cues), speech_(speech), volume_(volume) {
+Mixer::Mixer(const MixerParams& params, SpscRing<CueEvent>* cues, SpeechStream* speech, const Volume* volume,
+             SpscRing<CueEvent>* ui_cues)
+    : params_(params), synth_(params.earcons, kSampleRateHz), cues_(cues), ui_cues_(ui_cues), speech_(speech), volume_(volume) {
   const double fs = kSampleRateHz;
   duck_down_ = static_cast<float>(1.0 - std::exp(-1.0 / (std::max(1e-4, params.duck_attack_s) * fs)));
   duck_up_ = static_cast<float>(1.0 - std::exp(-1.0 / (std::max(1e-4, params.duck_release_s) * fs)));
@@ -28,9 +29,10 @@ Mixer::Mixer(const MixerParams& params, SpscRing<CueEvent>* cues, SpeechStream* 
 }
 
 void Mixer::render(float* out, std::size_t frames) noexcept {
-  if (cues_) {
+  for (SpscRing<CueEvent>* queue : {cues_, ui_cues_}) {
+    if (queue == nullptr) continue;
     CueEvent e;
-    while (cues_->try_pop(e)) {
+    while (queue->try_pop(e)) {
       synth_.trigger(e);
       ++cues_played_;
     }

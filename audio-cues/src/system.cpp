@@ -13,8 +13,9 @@ MessageCatalog load_catalog(const std::string& file) { return file.empty() ? Mes
 AudioSystem::AudioSystem(const AudioSystemParams& p)
     : catalog_(load_catalog(p.messages_file)),
       cues_(p.cue_capacity),
+      ui_cues_(64),
       volume_(p.volume_default_step, 10, p.volume_step_db),
-      mixer_(p.mixer, &cues_, &speech_stream_, &volume_) {
+      mixer_(p.mixer, &cues_, &speech_stream_, &volume_, &ui_cues_) {
   SpeechParams sp = p.speech;
   if (sp.voice.empty()) sp.voice = catalog_.voice();
   try {
@@ -23,6 +24,12 @@ AudioSystem::AudioSystem(const AudioSystemParams& p)
     spdlog::warn("audio: no speech ({}); the kiosk continues with earcons only", e.what());
   }
   if (p.open_output) output_ = std::make_unique<AudioOutput>(mixer_, p.output);  // logs its own state
+}
+
+bool AudioSystem::play(CueKind kind) noexcept {
+  CueEvent e;
+  e.kind = kind;
+  return ui_cues_.try_push(e);
 }
 
 AudioSystem::~AudioSystem() {

@@ -78,6 +78,18 @@ std::string path_problem(std::string_view v) {
   return {};
 }
 
+/// The check of [camera] source: "auto", "none", or "file:PATH" (a path field's rules), "libcamera:N" or
+/// "v4l2:DEV" (vision::parse_source_spec reads it when the camera is opened, and refuses a bad index there).
+std::string camera_source_problem(std::string_view v) {
+  if (v == "auto" || v == "none") return {};
+  for (std::string_view kind : {"file:", "libcamera:", "v4l2:"})
+    if (v.substr(0, kind.size()) == kind) {
+      if (v.size() == kind.size()) return "names no " + std::string(kind == "libcamera:" ? "camera number" : "path") + " after '" + std::string(kind) + "'";
+      return path_problem(v);
+    }
+  return "is not \"auto\", \"none\", \"file:PATH\", \"libcamera:N\" or \"v4l2:DEV\"";
+}
+
 /// The check of [operator] pin_hash: empty, or what libsodium's crypto_pwhash_str writes for argon2id
 /// (printable ASCII starting "$argon2id$", at most 127 bytes: crypto_pwhash_STRBYTES − 1).
 std::string pin_hash_problem(std::string_view v) {
@@ -110,7 +122,7 @@ constexpr auto kKeyNames = std::to_array<std::string_view>({
     "PAGE_UP", "PAGE_DOWN", "HOME", "END", "INSERT", "DELETE", "MINUS", "EQUAL",
     "KP_0", "KP_1", "KP_2", "KP_3", "KP_4", "KP_5", "KP_6", "KP_7", "KP_8", "KP_9", "KP_ADD", "KP_SUBTRACT", "KP_ENTER"});
 
-constexpr std::array<detail::TableInfo, 10> kTables{{
+constexpr std::array<detail::TableInfo, 11> kTables{{
     {"haptics", "Force rendering and the servo loop."},
     {"device", "Which device drives the handle: the simulated pantograph's physics, and the USB pantograph's board, links and calibration."},
     {"hand", "The model hand that drives the simulated pantograph in headless runs."},
@@ -119,6 +131,7 @@ constexpr std::array<detail::TableInfo, 10> kTables{{
     {"audio", "Earcons, speech and volume."},
     {"kiosk", "The visitor's session."},
     {"stick", "Documents from USB sticks: how far a scan goes and how PDF pages are drawn."},
+    {"camera", "The camera a visitor puts a picture under: the source, the frame size and when a capture happens."},
     {"keys", "The key for each of the visitor's actions (O, C and ESCAPE are the operator's)."},
     {"operator", "The operator's panel: how it opens, its PIN (set with 'haptic-kiosk pin set') and its records."},
 }};
@@ -236,6 +249,13 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(stick, page_max_pixels, FieldGroup::devices, ApplyWhen::restart, 1e5, 4e7, "px", "A PDF page is drawn at the DPI that keeps it within this many pixels."),
     HK_FIELD(stick, page_max_dpi, FieldGroup::devices, ApplyWhen::restart, 10, 1200, "dpi", "A PDF page is never drawn finer than this."),
     HK_FIELD(stick, page_timeout_s, FieldGroup::devices, ApplyWhen::restart, 0.5, 120, "s", "The worker drawing a PDF page is stopped after this (wall clock and CPU)."),
+    // [camera]
+    HK_FIELD(camera, source, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "\"auto\": the first camera found (libcamera, then V4L2); \"none\": no capture; or \"file:PATH\", \"libcamera:N\", \"v4l2:DEV\".", {}, &camera_source_problem),
+    HK_FIELD(camera, width_px, FieldGroup::devices, ApplyWhen::restart, 64, 8192, "px", "Frame width asked of the camera."),
+    HK_FIELD(camera, height_px, FieldGroup::devices, ApplyWhen::restart, 64, 8192, "px", "Frame height asked of the camera."),
+    HK_FIELD(camera, still_s, FieldGroup::devices, ApplyWhen::live, 0.2, 10, "s", "A picture is captured once it has been whole, centred and still this long."),
+    HK_FIELD(camera, timeout_s, FieldGroup::devices, ApplyWhen::live, 5, 600, "s", "A capture that has not happened after this long is given up."),
     // [keys]
     HK_FIELD(keys, help, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Help.", kKeyNames),
     HK_FIELD(keys, next, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Next picture (next tutorial shape).", kKeyNames),
@@ -247,6 +267,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(keys, volume_down, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Quieter.", kKeyNames),
     HK_FIELD(keys, tutorial, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Start the tutorial again.", kKeyNames),
     HK_FIELD(keys, guide, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Guided tour: lead the handle to the next shape not yet touched and round it.", kKeyNames),
+    HK_FIELD(keys, capture, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Capture a picture with the camera, guided by voice (any key cancels).", kKeyNames),
     // [operator]
     HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
                 "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),
@@ -560,11 +581,11 @@ void validate_as(const Settings& s, const Source& src) {
   // Each visitor action on its own key: one key cannot do two things, and the help names each action's key.
   // The first pair in table order is reported, attributed to the earlier key and naming the later.
   {
-    const std::array<std::pair<std::string_view, const std::string*>, 10> keys{{
+    const std::array<std::pair<std::string_view, const std::string*>, 11> keys{{
         {"help", &s.keys.help}, {"next", &s.keys.next}, {"previous", &s.keys.previous},
         {"describe", &s.keys.describe}, {"finer", &s.keys.finer}, {"coarser", &s.keys.coarser},
         {"volume_up", &s.keys.volume_up}, {"volume_down", &s.keys.volume_down}, {"tutorial", &s.keys.tutorial},
-        {"guide", &s.keys.guide}}};
+        {"guide", &s.keys.guide}, {"capture", &s.keys.capture}}};
     for (std::size_t i = 0; i < keys.size(); ++i)
       for (std::size_t j = i + 1; j < keys.size(); ++j)
         if (*keys[i].second == *keys[j].second) {

@@ -110,7 +110,7 @@ std::vector<std::string_view> table_names() {
         body += " (did you mean " + detail::qualified(d) + ", i.e. under [" + std::string(d.table) + "]?)";
         fail(src, std::string(name), body, line);
       }
-    body += "; keys belong under a table: [haptics], [device], [hand], [vision], [workspace], [audio], [kiosk], [stick], [keys] or [operator]";
+    body += "; keys belong under a table: [haptics], [device], [hand], [vision], [workspace], [audio], [kiosk], [stick], [camera], [keys] or [operator]";
     fail(src, std::string(name), body, line);
   }
   std::string body = "unknown table [" + shown + "]";

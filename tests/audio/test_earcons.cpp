@@ -131,6 +131,21 @@ TEST(Earcons, TourStartIsARisingArpeggio) {
   EXPECT_LT(test::peak(x, t + at(400), x.size()), 1e-4);
 }
 
+// The camera's shutter (issue 16): two bright clicks 60 ms apart, the second softer, silence between them and
+// after, over within 120 ms.
+TEST(Earcons, ShutterIsTwoBrightClicksSixtyMillisecondsApart) {
+  const std::vector<float> x = render_cue_timeline(std::vector{cue(10, CueKind::Shutter, -1)}, kPeriod, 0.3);
+  const std::size_t t = at(10);
+  const double first = test::peak(x, t, t + at(20)), second = test::peak(x, t + at(60), t + at(80));
+  EXPECT_GT(first, 0.05);
+  EXPECT_GT(second, 0.05);
+  EXPECT_LT(second, first) << "the second click is softer";
+  EXPECT_LT(test::peak(x, t + at(35), t + at(58)), 0.1 * second) << "silence between the clicks";
+  EXPECT_LT(test::peak(x, t + at(120), x.size()), 1e-4) << "over within 120 ms";
+  const std::vector<float> contact = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.1f)}, kPeriod, 0.3);
+  EXPECT_GT(test::spectral_centroid(x, t, 240), test::spectral_centroid(contact, t, 240)) << "brighter than a wall's click";
+}
+
 TEST(Earcons, ContactLoudnessGrowsWithApproachSpeed) {
   const std::vector<float> soft = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.01f)}, kPeriod, 0.2);
   const std::vector<float> hard = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.15f)}, kPeriod, 0.2);

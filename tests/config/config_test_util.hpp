@@ -122,6 +122,10 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"stick", "page_max_pixels", 1e5, 4e7, false},
       {"stick", "page_max_dpi", 10, 1200, false},
       {"stick", "page_timeout_s", 0.5, 120, false},
+      {"camera", "width_px", 64, 8192, true},
+      {"camera", "height_px", 64, 8192, true},
+      {"camera", "still_s", 0.2, 10, false},
+      {"camera", "timeout_s", 5, 600, false},
       {"operator", "idle_close_s", 10, 3600, false},
   };
   return specs;

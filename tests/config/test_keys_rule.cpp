@@ -19,11 +19,11 @@ using test::capture_error;
 using test::is_one_line;
 
 /// The [keys] actions in table order, with their fields.
-constexpr std::array<std::pair<std::string_view, std::string KeysSettings::*>, 10> kActions{{
+constexpr std::array<std::pair<std::string_view, std::string KeysSettings::*>, 11> kActions{{
     {"help", &KeysSettings::help}, {"next", &KeysSettings::next}, {"previous", &KeysSettings::previous},
     {"describe", &KeysSettings::describe}, {"finer", &KeysSettings::finer}, {"coarser", &KeysSettings::coarser},
     {"volume_up", &KeysSettings::volume_up}, {"volume_down", &KeysSettings::volume_down}, {"tutorial", &KeysSettings::tutorial},
-    {"guide", &KeysSettings::guide}}};
+    {"guide", &KeysSettings::guide}, {"capture", &KeysSettings::capture}}};
 
 TEST(KeysRule, ShippedKeysAreAllDifferentAndValid) { EXPECT_NO_THROW(validate(Settings{})); }
 

@@ -101,7 +101,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
-    if (name == "operator.open_chord" || name == "device.serial_path" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log") {
+    if (name == "operator.open_chord" || name == "device.serial_path" || name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -111,7 +111,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 24u);
+  EXPECT_EQ(texts, 26u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -261,6 +261,25 @@ TEST(ConfigValidate, UnknownDetectorIsRefused) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "vision.detector");
   EXPECT_NE(std::string(e->what()).find("outline"), std::string::npos) << e->what();
+}
+
+TEST(ConfigValidate, CameraSourceIsAutoNoneOrASourceSpec) {
+  Settings s;
+  for (const char* good : {"auto", "none", "file:/srv/frames", "libcamera:0", "v4l2:/dev/video0"}) {
+    s.camera.source = good;
+    EXPECT_NO_THROW(validate(s)) << good;
+  }
+  for (const char* bad : {"usb:1", "", "file:", "libcamera:", "webcam"}) {
+    s.camera.source = bad;
+    auto e = capture_error([&] { validate(s); });
+    ASSERT_TRUE(e) << bad;
+    EXPECT_EQ(e->key(), "camera.source");
+    EXPECT_TRUE(is_one_line(e->what())) << e->what();
+  }
+  s.camera.source = std::string("file:/tmp/a\nb");
+  auto e = capture_error([&] { validate(s); });
+  ASSERT_TRUE(e);
+  EXPECT_NE(std::string(e->what()).find("control character"), std::string::npos) << e->what();
 }
 
 TEST(ConfigValidate, UnknownLevelModeIsRefused) {

@@ -38,16 +38,17 @@ TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
   const KioskKey actions[] = {KioskKey::Help,     KioskKey::Next,        KioskKey::Previous,
                               KioskKey::Describe, KioskKey::Finer,       KioskKey::Coarser,
                               KioskKey::VolumeUp, KioskKey::VolumeDown,  KioskKey::Tutorial,
-                              KioskKey::Guide};
-  for (int a = 0; a < 10; ++a) {
+                              KioskKey::Guide,    KioskKey::Capture};
+  for (int a = 0; a < 11; ++a) {
     for (std::string_view name : config::visitor_key_names()) {
       config::KeysSettings k;
-      std::string* slot[] = {&k.help, &k.next, &k.previous, &k.describe, &k.finer, &k.coarser, &k.volume_up, &k.volume_down, &k.tutorial, &k.guide};
-      for (int b = 0; b < 10; ++b)
+      std::string* slot[] = {&k.help, &k.next, &k.previous, &k.describe, &k.finer, &k.coarser, &k.volume_up, &k.volume_down, &k.tutorial, &k.guide,
+                             &k.capture};
+      for (int b = 0; b < 11; ++b)
         if (b != a && *slot[b] == name) *slot[b] = *slot[a];  // swap: the set stays one key per action
       *slot[a] = std::string(name);
       const auto map = visitor_key_map(k);
-      ASSERT_EQ(map.size(), 10u) << name;
+      ASSERT_EQ(map.size(), 11u) << name;
       const auto it = map.find(glfw_key(std::string(name)));
       ASSERT_NE(it, map.end()) << name;
       EXPECT_EQ(it->second, actions[a]) << name;

@@ -21,10 +21,11 @@ enum class CueKind : std::uint8_t {
   TextBlock,      ///< the proxy entered a block of text on a document page (curve = the block's id)
   PopThrough,     ///< the visitor pushed through a wall on purpose (issue 14: pop_force_n for pop_hold_s)
   TourStart,      ///< the guided tour starts tracing a shape's outline (curve = the shape)
+  Shutter,        ///< the camera took the picture (issue 16; sent by the window thread, AudioSystem::play)
 };
 
 /// Number of CueKind values.
-inline constexpr int kCueKindCount = 11;
+inline constexpr int kCueKindCount = 12;
 
 /// One cue. 24 bytes (checked below): small enough that a 4096-entry queue is 96 KiB.
 struct CueEvent {

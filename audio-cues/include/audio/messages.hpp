@@ -30,8 +30,12 @@ enum class MessageId : int {
   no_audio_device, stick_inserted, stick_empty, stick_removed, stick_unreadable, document_page, document_picture,
   document_unreadable, loading, text_block, device_ready, device_simulated, device_lost, device_back,
   tour_remaining, tour_one_remaining, tour_all_touched, tour_stopped, tour_nothing,
+  help_camera, camera_ready, camera_none, capture_start, capture_no_camera, capture_place, capture_too_dark, capture_cut_off_top,
+  capture_cut_off_bottom, capture_cut_off_left, capture_cut_off_right, capture_move_left, capture_move_right,
+  capture_move_up, capture_move_down, capture_hold_still, captured, captured_one, captured_empty, capture_cancelled,
+  capture_failed, capture_timeout,
 };
-inline constexpr int kMessageCount = 42;
+inline constexpr int kMessageCount = 64;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -42,7 +46,10 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "no_audio_device", "stick_inserted", "stick_empty", "stick_removed", "stick_unreadable", "document_page",
     "document_picture", "document_unreadable", "loading", "text_block", "device_ready", "device_simulated",
     "device_lost", "device_back", "tour_remaining", "tour_one_remaining", "tour_all_touched", "tour_stopped",
-    "tour_nothing"};
+    "tour_nothing", "help_camera", "camera_ready", "camera_none", "capture_start", "capture_no_camera", "capture_place",
+    "capture_too_dark", "capture_cut_off_top", "capture_cut_off_bottom", "capture_cut_off_left", "capture_cut_off_right",
+    "capture_move_left", "capture_move_right", "capture_move_up", "capture_move_down", "capture_hold_still", "captured",
+    "captured_one", "captured_empty", "capture_cancelled", "capture_failed", "capture_timeout"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".
@@ -55,10 +62,10 @@ class MessageError : public std::runtime_error {
 using MessageArg = std::pair<std::string_view, std::string>;
 
 /// The placeholders that name one of the visitor's keys, one per action of the [keys] settings (help, next,
-/// previous, describe, finer, coarser, volume_up, volume_down, tutorial), in that order.
-inline constexpr std::array<std::string_view, 10> kKeyPlaceholders{
+/// previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide, capture), in that order.
+inline constexpr std::array<std::string_view, 11> kKeyPlaceholders{
     "help_key", "next_key", "previous_key", "describe_key", "finer_key", "coarser_key",
-    "volume_up_key", "volume_down_key", "tutorial_key", "guide_key"};
+    "volume_up_key", "volume_down_key", "tutorial_key", "guide_key", "capture_key"};
 
 /// A key placeholder and the key it stands for, by its settings name: {"help_key", "F1"}. MessageCatalog::text()
 /// puts the spoken form of the key (MessageCatalog::key_name()) in its place.

@@ -32,9 +32,12 @@ struct MixerParams {
 class Mixer final : public AudioSource {
  public:
   /// `cues` (may be null: no live cues), `speech` (may be null) and `volume` must outlive the mixer.
-  Mixer(const MixerParams& params, SpscRing<CueEvent>* cues, SpeechStream* speech, const Volume* volume);
+  /// `ui_cues` (may be null): a second queue, for cues of the window thread (the camera's shutter), drained
+  /// the same way; each queue has its own single producer.
+  Mixer(const MixerParams& params, SpscRing<CueEvent>* cues, SpeechStream* speech, const Volume* volume,
+        SpscRing<CueEvent>* ui_cues = nullptr);
 
-  /// Real-time: drains the cue queue (each cue starts at the beginning of this buffer), renders earcons
+  /// Real-time: drains the cue queues (each cue starts at the beginning of this buffer), renders earcons
   /// and speech, ducks, applies the volume and limits. No allocation, lock or throw.
   void render(float* out, std::size_t frames) noexcept override;
 
@@ -51,6 +54,7 @@ class Mixer final : public AudioSource {
   MixerParams params_;
   EarconSynth synth_;
   SpscRing<CueEvent>* cues_;
+  SpscRing<CueEvent>* ui_cues_;
   SpeechStream* speech_;
   const Volume* volume_;
   float duck_ = 1.0f;           ///< current earcon gain from ducking

@@ -48,6 +48,10 @@ class AudioSystem {
   /// The ring the servo thread pushes cues into (its only producer). Real-time safe to push.
   SpscRing<CueEvent>& cues() noexcept { return cues_; }
 
+  /// Plays the earcon of `kind` now, from the window thread (its queue's only producer; the servo thread has
+  /// cues()): the camera's Shutter. Returns at once; false when the queue is full (dropped).
+  bool play(CueKind kind) noexcept;
+
   /// Speaks message `id` (placeholders filled from `args`), cutting off whatever is being said. Returns at once.
   void say(MessageId id, std::initializer_list<MessageArg> args = {});
   /// Speaks free text (e.g. a picture description), cutting off whatever is being said.
@@ -81,6 +85,7 @@ class AudioSystem {
  private:
   MessageCatalog catalog_;
   SpscRing<CueEvent> cues_;
+  SpscRing<CueEvent> ui_cues_;  // the window thread's earcons (play)
   SpeechStream speech_stream_;
   Volume volume_;
   Mixer mixer_;

@@ -3,7 +3,7 @@
 /// Reading, checking and writing the kiosk settings (`settings.hpp`) as TOML.
 ///
 /// The file layout is one TOML table per settings struct ([haptics], [device], [hand], [vision],
-/// [workspace], [audio], [kiosk], [stick], [keys], [operator]) with one key per field, named exactly as the field. Every key is optional: a key
+/// [workspace], [audio], [kiosk], [stick], [camera], [keys], [operator]) with one key per field, named exactly as the field. Every key is optional: a key
 /// that is absent keeps its default. Everything else is refused with a ConfigError whose message is
 /// one line naming the file, the key (as `table.key`), the bad value and what is allowed, e.g.
 ///   config 'k.toml': haptics.stiffness_n_per_m = -5 is out of range [10, 5000] N/m (line 3)

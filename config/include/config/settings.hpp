@@ -165,6 +165,19 @@ struct StickSettings {
   bool operator==(const StickSettings&) const = default;
 };
 
+/// [camera] — the camera a visitor puts a picture under (issue 16): which source, the frame size asked
+/// for, and when the framing guide captures.
+struct CameraSettings {
+  std::string source = "auto";    ///< key source, "auto" (the first camera found: libcamera, then V4L2), "none" (no capture), or a source "file:PATH" | "libcamera:N" | "v4l2:DEV"
+  int width_px = 1280;            ///< key width_px, frame width asked of the camera, [64, 8192] px
+  int height_px = 960;            ///< key height_px, frame height asked of the camera, [64, 8192] px
+  double still_s = 1.0;           ///< key still_s, the page must be whole, centred and still this long before it is captured, [0.2, 10] s
+  double timeout_s = 60.0;        ///< key timeout_s, a capture that has not happened after this long is given up (said so), [5, 600] s
+
+  /// Field-by-field equality (exact for doubles); used by round-trip checks.
+  bool operator==(const CameraSettings&) const = default;
+};
+
 /// [keys] — the key for each of the visitor's actions (issue 5: keys a blind visitor can find). Each value
 /// is one key name: F1..F12, A..Z, 0..9, SPACE, ENTER, TAB, BACKSPACE, LEFT, RIGHT, UP, DOWN, PAGE_UP,
 /// PAGE_DOWN, HOME, END, INSERT, DELETE, MINUS, EQUAL, KP_0..KP_9, KP_ADD, KP_SUBTRACT, KP_ENTER.
@@ -180,6 +193,7 @@ struct KeysSettings {
   std::string volume_down = "PAGE_DOWN";  ///< key volume_down
   std::string tutorial = "T";             ///< key tutorial, start the tutorial again
   std::string guide = "G";                ///< key guide, the guided tour: the handle is led to the next shape not yet touched and round it
+  std::string capture = "SPACE";          ///< key capture, capture a picture with the camera, guided by voice (any key cancels)
 
   /// Field-by-field equality; used by round-trip checks.
   bool operator==(const KeysSettings&) const = default;
@@ -208,6 +222,7 @@ struct Settings {
   AudioSettings audio;
   KioskSettings kiosk;
   StickSettings stick;
+  CameraSettings camera;
   KeysSettings keys;
   OperatorSettings operator_;  ///< TOML table [operator] (`operator` is a C++ keyword)
 

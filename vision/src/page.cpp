@@ -1,0 +1,986 @@
+// Pages made flat (issue 16, item 2): find the page in a camera frame, its aspect ratio, the warp flat.
+// See vision/page.hpp for the contract; the steps are described at each function below.
+
+#include "vision/page.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+#ifdef HK_PAGE_DEBUG
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#endif
+
+#include <opencv2/imgproc.hpp>
+
+namespace hk::vision {
+namespace {
+
+using Quad = std::array<cv::Point2d, 4>;
+
+/// A line through `p` with unit direction `d`.
+struct Line {
+  cv::Point2d p;
+  cv::Point2d d;
+};
+
+double cross(cv::Point2d a, cv::Point2d b) { return a.x * b.y - a.y * b.x; }
+
+/// Shoelace area; positive when the corners run clockwise on screen (x right, y down).
+double signed_area(const Quad& q) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) s += cross(q[i], q[(i + 1) % 4]);
+  return 0.5 * s;
+}
+
+bool finite(cv::Point2d p) { return std::isfinite(p.x) && std::isfinite(p.y); }
+
+std::optional<cv::Point2d> intersect(const Line& a, const Line& b) {
+  const double den = cross(a.d, b.d);
+  if (std::abs(den) < 1e-9) return std::nullopt;
+  const double t = cross(b.p - a.p, b.d) / den;
+  return a.p + t * a.d;
+}
+
+/// The order of PageDetection: clockwise on screen, starting at the corner where the side that faces the frame's
+/// top most directly (outward normal closest to straight up) begins.
+Quad order_corners(Quad q) {
+  if (signed_area(q) < 0) std::swap(q[1], q[3]);
+  std::size_t best = 0;
+  double best_dx = -2.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const cv::Point2d d = q[(i + 1) % 4] - q[i];
+    const double n = std::hypot(d.x, d.y);
+    // Clockwise on screen, the outward normal of side d is (d.y, -d.x) / |d|: up is d pointing right.
+    if (n > 0 && d.x / n > best_dx) {
+      best_dx = d.x / n;
+      best = i;
+    }
+  }
+  std::rotate(q.begin(), q.begin() + static_cast<std::ptrdiff_t>(best), q.end());
+  return q;
+}
+
+/// The part of the segment a → b within the rectangle of pixel centres [m, W − 1 − m] x [m, H − 1 − m]
+/// (Liang–Barsky), as parameters 0 <= t0 < t1 <= 1; empty when the segment misses it.
+std::optional<std::pair<double, double>> clip_segment(cv::Point2d a, cv::Point2d b, cv::Size size, double m) {
+  double t0 = 0.0, t1 = 1.0;
+  const cv::Point2d d = b - a;
+  const std::array<std::pair<double, double>, 4> pq{{{-d.x, a.x - m}, {d.x, size.width - 1 - m - a.x}, {-d.y, a.y - m}, {d.y, size.height - 1 - m - a.y}}};
+  for (const auto& [p, q] : pq) {
+    if (p == 0.0) {
+      if (q < 0.0) return std::nullopt;
+      continue;
+    }
+    const double r = q / p;
+    if (p < 0.0) t0 = std::max(t0, r);
+    else t1 = std::min(t1, r);
+  }
+  if (t1 - t0 <= 0.0) return std::nullopt;
+  return std::make_pair(t0, t1);
+}
+
+/// Area of the part of `q` (convex) inside the frame [px²].
+double visible_area(const Quad& q, cv::Size size) {
+  std::vector<cv::Point2f> quad, rect{{-0.5f, -0.5f}, {size.width - 0.5f, -0.5f}, {size.width - 0.5f, size.height - 0.5f}, {-0.5f, size.height - 0.5f}};
+  for (const cv::Point2d& p : q) quad.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+  if (signed_area(q) < 0) std::reverse(quad.begin(), quad.end());
+  std::vector<cv::Point2f> both;
+  return static_cast<double>(cv::intersectConvexConvex(quad, rect, both, true));
+}
+
+/// Samples `grey` (CV_8UC1, or CV_8UC3 giving CV_32FC3) at the points base_i + o_k·normal + s_j·tangent for every sample position i, tangential
+/// offset j and normal offset k; returns n_pos rows of (n_tan · n_off) values, j-major, as CV_32F (bilinear,
+/// border replicated).
+cv::Mat sample_across(const cv::Mat& grey, const std::vector<cv::Point2d>& base, cv::Point2d tangent, cv::Point2d normal,
+                      const std::vector<double>& tan_offsets, const std::vector<double>& normal_offsets) {
+  const int n_pos = static_cast<int>(base.size());
+  const int n_tan = static_cast<int>(tan_offsets.size()), n_off = static_cast<int>(normal_offsets.size());
+  cv::Mat mx(n_pos, n_tan * n_off, CV_32F), my(n_pos, n_tan * n_off, CV_32F);
+  for (int i = 0; i < n_pos; ++i) {
+    float* px = mx.ptr<float>(i);
+    float* py = my.ptr<float>(i);
+    for (int j = 0; j < n_tan; ++j) {
+      const cv::Point2d b = base[static_cast<std::size_t>(i)] + tan_offsets[static_cast<std::size_t>(j)] * tangent;
+      for (int k = 0; k < n_off; ++k) {
+        const cv::Point2d p = b + normal_offsets[static_cast<std::size_t>(k)] * normal;
+        px[j * n_off + k] = static_cast<float>(p.x);
+        py[j * n_off + k] = static_cast<float>(p.y);
+      }
+    }
+  }
+  cv::Mat sampled, out;
+  cv::remap(grey, sampled, mx, my, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  sampled.convertTo(out, CV_MAKETYPE(CV_32F, grey.channels()));
+  return out;
+}
+
+/// Positions spread along a → b over [t0, t1], those at least `margin` inside the frame.
+std::vector<cv::Point2d> positions_along(cv::Point2d a, cv::Point2d b, int n, double t0, double t1, cv::Size frame, double margin) {
+  std::vector<cv::Point2d> out;
+  out.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double t = t0 + (t1 - t0) * (n == 1 ? 0.5 : static_cast<double>(i) / (n - 1));
+    const cv::Point2d p = a + t * (b - a);
+    if (p.x >= margin && p.y >= margin && p.x <= frame.width - 1 - margin && p.y <= frame.height - 1 - margin) out.push_back(p);
+  }
+  return out;
+}
+
+/// Edge points near the side a → b of `image` (grey or BGR): at each position along it, the strongest change
+/// across the side within ±window px (colour: the length of the per-channel derivatives), located to sub-pixel
+/// precision (parabola through the peak of the smoothed derivative). Profiles are averaged over 5 samples along the
+/// side first, which lowers the noise without blurring across it.
+struct EdgePoints {
+  std::vector<cv::Point2f> pts;  ///< the edge points found
+  std::vector<double> t;         ///< each point's position along a → b, [0, 1]
+  std::vector<double> tried;     ///< the positions looked at, [0, 1]
+  std::vector<float> strength;   ///< each point's derivative across the side [grey levels / px]
+};
+
+EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double window, double unit, double t0 = 0.05, double t1 = 0.95,
+                       bool nearest = false) {
+  const cv::Point2d d = b - a;
+  const double len = std::hypot(d.x, d.y);
+  const cv::Point2d t = d / len, n(t.y, -t.x);
+  const int n_pos = std::clamp(static_cast<int>((t1 - t0) * len / (2.7 * unit)), 12, 64);
+  const std::vector<cv::Point2d> base = positions_along(a, b, n_pos, t0, t1, image.size(), 2.0);
+  EdgePoints out;
+  for (const cv::Point2d& p : base) out.tried.push_back((p - a).dot(d) / (len * len));
+  if (base.size() < 8) return out;
+  constexpr double kStep = 0.5;  // px between samples across the side
+  const int half = static_cast<int>(std::ceil(window / kStep)) + 4;
+  std::vector<double> offs;
+  for (int k = -half; k <= half; ++k) offs.push_back(k * kStep);
+  const std::vector<double> tans{-2 * unit, -unit, 0.0, unit, 2 * unit};
+  const cv::Mat s = sample_across(image, base, t, n, tans, offs);
+  const int n_off = static_cast<int>(offs.size()), n_tan = static_cast<int>(tans.size()), cn = image.channels();
+  const int rows = static_cast<int>(base.size());
+  const double sigma = std::max(1.5, 1.5 * unit);  // in samples
+  const int ks = 2 * static_cast<int>(std::ceil(3 * sigma)) + 1;
+  cv::Mat mag2(rows, n_off, CV_32F, cv::Scalar(0));
+  for (int c = 0; c < cn; ++c) {
+    cv::Mat prof(rows, n_off, CV_32F, cv::Scalar(0));
+    for (int i = 0; i < rows; ++i) {
+      const float* src = s.ptr<float>(i);
+      float* dst = prof.ptr<float>(i);
+      for (int j = 0; j < n_tan; ++j)
+        for (int k = 0; k < n_off; ++k) dst[k] += src[(j * n_off + k) * cn + c] / static_cast<float>(n_tan);
+    }
+    cv::GaussianBlur(prof, prof, cv::Size(ks, 1), sigma, 0, cv::BORDER_REPLICATE);
+    cv::Mat der;
+    cv::Sobel(prof, der, CV_32F, 1, 0, 1, 1.0 / (2 * kStep), 0, cv::BORDER_REPLICATE);  // grey levels per px
+    mag2 += der.mul(der);
+  }
+  cv::Mat der;
+  cv::sqrt(mag2, der);
+  const int lo = half - static_cast<int>(std::floor(window / kStep)), hi = half + static_cast<int>(std::floor(window / kStep));
+  for (int i = 0; i < der.rows; ++i) {
+    const float* g = der.ptr<float>(i);
+    int best = -1;
+    float best_v = 0.0f;
+    for (int k = std::max(lo, 1); k <= std::min(hi, n_off - 2); ++k) {
+      if (g[k] > best_v) {
+        best_v = g[k];
+        best = k;
+      }
+    }
+    if (nearest && best >= 0) {  // the peak nearest the side among those at least 0.4 x the strongest
+      for (int k = std::max(lo, 1) + 1; k < std::min(hi, n_off - 2); ++k) {
+        if (g[k] >= 0.4f * best_v && g[k] >= g[k - 1] && g[k] > g[k + 1] && std::abs(k - half) < std::abs(best - half)) best = k;
+      }
+      best_v = g[best];
+    }
+    if (best <= std::max(lo, 1) || best >= std::min(hi, n_off - 2) || best_v < 2.0f) continue;  // no peak inside the window
+    const double y0 = g[best - 1], y1 = g[best], y2 = g[best + 1];
+    const double den = y0 - 2 * y1 + y2;
+    const double delta = den < 0 ? std::clamp(0.5 * (y0 - y2) / den, -0.5, 0.5) : 0.0;
+    const double o = offs[static_cast<std::size_t>(best)] + delta * kStep;
+    const cv::Point2d p = base[static_cast<std::size_t>(i)] + o * n;
+    out.pts.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+    out.t.push_back(out.tried[static_cast<std::size_t>(i)]);
+    out.strength.push_back(best_v);
+  }
+  return out;
+}
+
+Line fit(const std::vector<cv::Point2f>& pts, int dist) {
+  cv::Vec4f l;
+  cv::fitLine(pts, l, dist, 0, 0.01, 0.01);
+  return {{l[2], l[3]}, {l[0], l[1]}};
+}
+
+double distance(const Line& l, cv::Point2d p) { return std::abs(cross(l.d, p - l.p)); }
+
+/// The side a → b refined at full resolution: edge points within ±window of it (at each position the change nearest
+/// the side among those at least 0.4 x the strongest, so a stronger edge in the picture just inside its border
+/// does not pull the side in), a robust (Huber) line fit, edge
+/// points again within a narrow window of that line, and a least-squares fit to those within `inlier_px` of a
+/// second Huber fit. Empty when too few edge points were found.
+std::optional<Line> refine_side(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double window, double unit) {
+  EdgePoints e = edge_points(image, a, b, window, unit, 0.05, 0.95, true);
+  if (e.pts.size() < 8) return std::nullopt;
+  Line l = fit(e.pts, cv::DIST_HUBER);
+  // Narrow pass along the fitted line, between the projections of a and b.
+  const cv::Point2d a2 = l.p + (a - l.p).dot(l.d) * l.d, b2 = l.p + (b - l.p).dot(l.d) * l.d;
+  e = edge_points(image, a2, b2, 1.5 + 1.5 * unit, unit);
+  if (e.pts.size() < 8) return std::nullopt;
+  l = fit(e.pts, cv::DIST_HUBER);
+  const double inlier_px = std::max(0.75, 0.75 * unit);
+  std::vector<cv::Point2f> in;
+  for (const cv::Point2f& p : e.pts)
+    if (distance(l, p) <= inlier_px) in.push_back(p);
+  if (in.size() < 8) return std::nullopt;
+  l = fit(in, cv::DIST_L2);
+  if (l.d.dot(b - a) < 0) l.d = -l.d;
+  return l;
+}
+
+/// How well the stretch [t0, t1] of the side a → b of a found quadrilateral is backed by an edge: the share of
+/// positions along it whose strongest change across it (within a narrow window) lies within `inlier_px` of it and
+/// is at least 0.3 x `typical` (when given). `typical` returns the median strength of the changes found.
+double side_support(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double unit, double t0, double t1, float* typical) {
+  const EdgePoints e = edge_points(image, a, b, 1.5 + 1.5 * unit, unit, t0, t1);
+  if (e.tried.size() < 4 || e.pts.empty()) return 0.0;
+  float least = 0.0f;
+  if (*typical > 0.0f) {
+    least = 0.3f * *typical;
+  } else {
+    std::vector<float> v = e.strength;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    *typical = v[v.size() / 2];
+    least = 0.3f * *typical;
+  }
+  const Line l{a, (b - a) / cv::norm(b - a)};
+  const double inlier_px = std::max(1.0, 0.75 * unit);
+  int hits = 0;
+  for (std::size_t i = 0; i < e.pts.size(); ++i) hits += distance(l, e.pts[i]) <= inlier_px && e.strength[i] >= least;
+  return static_cast<double>(hits) / e.tried.size();
+}
+
+/// Contrast across the sides of a quadrilateral (corners clockwise on screen; each side a → b, or the part of it
+/// inside the frame) in `image` (grey, or BGR: the distance between mean colours): per side not on the frame's
+/// edge, in stretches of an eighth of the side, the difference between the mean of a band just inside
+/// the quad and the mean of a band just outside it; bands `depth` px deep starting `gap` px from the side.
+struct SideContrast {
+  std::array<std::vector<double>, 4> stretches;  ///< per side, the contrast of each stretch measured
+  /// Mean over all stretches measured; negative when none.
+  double mean() const {
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (const auto& v : stretches) {
+      for (double x : v) sum += x;
+      n += v.size();
+    }
+    return n > 0 ? sum / static_cast<double>(n) : -1.0;
+  }
+};
+
+using Segments = std::array<std::pair<cv::Point2d, cv::Point2d>, 4>;
+
+SideContrast border_contrast(const cv::Mat& image, const Segments& sides, const std::array<bool, 4>& on_frame, double gap, double depth) {
+  constexpr int kStretches = 8, kPerStretch = 5, kDepths = 4;
+  std::vector<double> offs;
+  for (int k = 0; k < kDepths; ++k) offs.push_back(gap + depth * k / (kDepths - 1));     // outward (positive) ...
+  for (int k = 0; k < kDepths; ++k) offs.push_back(-(gap + depth * k / (kDepths - 1)));  // ... and inward
+  const double reach = gap + depth;
+  const int cn = image.channels();
+  SideContrast out;
+  for (std::size_t s = 0; s < 4; ++s) {
+    if (on_frame[s]) continue;
+    const auto [a, b] = sides[s];
+    const cv::Point2d d = b - a;
+    const double len = std::hypot(d.x, d.y);
+    if (len < 1.0) continue;
+    const cv::Point2d t = d / len, n(t.y, -t.x);  // n: outward for corners clockwise on screen
+    const auto in_frame = [&](cv::Point2d x) { return x.x >= 0 && x.y >= 0 && x.x <= image.cols - 1 && x.y <= image.rows - 1; };
+    for (int st = 0; st < kStretches; ++st) {
+      std::vector<cv::Point2d> base;
+      for (int i = 0; i < kPerStretch; ++i) {
+        const double u = 0.08 + 0.84 * (st * kPerStretch + i + 0.5) / (kStretches * kPerStretch);
+        const cv::Point2d p = a + u * d;
+        if (in_frame(p + reach * n) && in_frame(p - reach * n)) base.push_back(p);
+      }
+      if (base.size() < 2) continue;
+      const cv::Mat v = sample_across(image, base, t, n, {0.0}, offs);
+      double dist2 = 0.0;
+      for (int c = 0; c < cn; ++c) {
+        double out_sum = 0.0, in_sum = 0.0;
+        for (int i = 0; i < v.rows; ++i) {
+          const float* r = v.ptr<float>(i);
+          for (int k = 0; k < kDepths; ++k) out_sum += r[k * cn + c], in_sum += r[(kDepths + k) * cn + c];
+        }
+        const double diff = (out_sum - in_sum) / (v.rows * kDepths);
+        dist2 += diff * diff;
+      }
+      out.stretches[s].push_back(std::sqrt(dist2));
+    }
+  }
+  return out;
+}
+
+/// A candidate quadrilateral from the downscaled frame, corners in order, and which of its sides lie on the
+/// frame's edge (top, right, bottom or left).
+struct Candidate {
+  Quad q;
+  std::array<int, 4> frame_edge{-1, -1, -1, -1};  ///< per side: the frame edge (0 top, 1 right, 2 bottom, 3 left) or -1
+  double area = 0.0;
+};
+
+/// The frame edge (0 top, 1 right, 2 bottom, 3 left) both ends of a → b lie within `tol` of, or -1.
+int frame_edge_of(cv::Point2d a, cv::Point2d b, cv::Size size, double tol) {
+  const double r = size.width - 1.0, btm = size.height - 1.0;
+  if (a.y <= tol && b.y <= tol) return 0;
+  if (a.x >= r - tol && b.x >= r - tol) return 1;
+  if (a.y >= btm - tol && b.y >= btm - tol) return 2;
+  if (a.x <= tol && b.x <= tol) return 3;
+  return -1;
+}
+
+void add_quad(const Quad& quad, double min_area, cv::Size size, std::vector<Candidate>& out) {
+  std::vector<cv::Point2f> poly;
+  for (const cv::Point2d& p : quad) {
+    const double beyond = 0.25 * std::max(size.width, size.height);
+    if (!finite(p) || p.x < -beyond || p.y < -beyond || p.x > size.width + beyond || p.y > size.height + beyond) return;
+    poly.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+  }
+  if (!cv::isContourConvex(poly)) return;
+  const double area = visible_area(quad, size);
+  if (area < min_area) return;
+  Candidate c;
+  c.q = order_corners(quad);
+  c.area = area;
+  for (std::size_t i = 0; i < 4; ++i) c.frame_edge[i] = frame_edge_of(c.q[i], c.q[(i + 1) % 4], size, 3.0);
+  out.push_back(c);
+}
+
+/// Quadrilaterals from a convex polygon of 4 to 6 corners: itself when it has 4; else its sides' lines with the
+/// shortest dropped until 4 remain, intersected in turn (a corner the outline missed, cut off by a shadow or a
+/// dark stretch of the page's edge, is restored by extending its neighbouring sides).
+void quads_from_polygon(const std::vector<cv::Point>& poly, double min_area, cv::Size size, std::vector<Candidate>& out) {
+  const std::size_t n = poly.size();
+  if (n < 4 || n > 6) return;
+  if (n == 4) {
+    add_quad({cv::Point2d(poly[0]), cv::Point2d(poly[1]), cv::Point2d(poly[2]), cv::Point2d(poly[3])}, min_area, size, out);
+    return;
+  }
+  std::vector<std::size_t> keep(n);
+  for (std::size_t i = 0; i < n; ++i) keep[i] = i;
+  const auto side_len = [&](std::size_t i) { return cv::norm(cv::Point2d(poly[(i + 1) % n]) - cv::Point2d(poly[i])); };
+  while (keep.size() > 4) {
+    const auto shortest = std::min_element(keep.begin(), keep.end(), [&](std::size_t a, std::size_t b) { return side_len(a) < side_len(b); });
+    keep.erase(shortest);
+  }
+  std::array<Line, 4> lines;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const cv::Point2d a(poly[keep[k]]), b(poly[(keep[k] + 1) % n]);
+    const double len = cv::norm(b - a);
+    if (len < 1.0) return;
+    lines[k] = {a, (b - a) / len};
+  }
+  Quad q;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const auto p = intersect(lines[(k + 3) % 4], lines[k]);
+    if (!p) return;
+    q[k] = *p;
+  }
+  add_quad(q, min_area, size, out);
+}
+
+/// Quadrilaterals from the outlines in a binary map: each outline's convex hull (which closes a page cut off by
+/// the frame's edge and ignores what the page shows inside) and the outline itself, each simplified with
+/// Douglas–Peucker (cv::approxPolyDP) at a few tolerances until four corners remain.
+void quads_from_map(const cv::Mat& map, double min_area, std::vector<Candidate>& out) {
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(map, contours, cv::RETR_LIST, cv::CHAIN_APPROX_SIMPLE);
+  for (const auto& c : contours) {
+    if (cv::boundingRect(c).area() < min_area) continue;
+    std::vector<cv::Point> hull;
+    cv::convexHull(c, hull);
+    if (cv::contourArea(hull) < min_area) continue;
+    for (const std::vector<cv::Point>* shape : {static_cast<const std::vector<cv::Point>*>(&hull), &c}) {
+      const double perimeter = cv::arcLength(*shape, true);
+      for (double f : {0.015, 0.025, 0.04, 0.06}) {
+        std::vector<cv::Point> poly;
+        cv::approxPolyDP(*shape, poly, f * perimeter, true);
+        if (poly.size() < 4) break;
+        if (shape == &hull || poly.size() == 4) quads_from_polygon(poly, min_area, map.size(), out);
+        if (poly.size() == 4) break;
+      }
+    }
+  }
+}
+
+/// A straight line gathered from collinear edge segments: unit normal n (angle in [0, π)), offset rho = n·p,
+/// and the stretches along it (parameter along (−n.y, n.x)) that the segments cover.
+struct SegmentLine {
+  cv::Point2d n;
+  double rho = 0.0;
+  std::vector<std::pair<double, double>> spans;
+  double covered = 0.0;  ///< total length of the union of spans
+  int frame_edge = -1;   ///< 0..3 for the frame's own edges (top, right, bottom, left), else -1
+};
+
+/// Length of the union of `spans` within [t0, t1].
+double covered_length(std::vector<std::pair<double, double>> spans, double t0, double t1) {
+  std::sort(spans.begin(), spans.end());
+  double total = 0.0, reach = t0;
+  for (const auto& [a, b] : spans) {
+    const double lo = std::max(a, reach), hi = std::min(b, t1);
+    if (hi > lo) total += hi - lo;
+    reach = std::max(reach, std::min(b, t1));
+  }
+  return total;
+}
+
+/// Groups segments (longest first) into lines: a segment joins a line when it is within 5° of it and both its ends
+/// are within `tol` px of it; the line is then fitted again (least squares) to points along all its segments.
+std::vector<SegmentLine> group_segments(std::vector<std::pair<cv::Point2d, cv::Point2d>> segs, double tol) {
+  std::sort(segs.begin(), segs.end(), [](const auto& x, const auto& y) { return cv::norm(x.second - x.first) > cv::norm(y.second - y.first); });
+  const double cos_tol = std::cos(5.0 * CV_PI / 180.0);
+  std::vector<SegmentLine> lines;
+  std::vector<std::vector<cv::Point2f>> members;  // per line, points along its segments
+  for (const auto& [a, b] : segs) {
+    const double len = cv::norm(b - a);
+    if (len < 1.0) continue;
+    const cv::Point2d d = (b - a) / len;
+    const auto joined = std::find_if(lines.begin(), lines.end(), [&](const SegmentLine& l) {
+      return std::abs(l.n.dot(cv::Point2d(-d.y, d.x))) >= cos_tol && std::abs(l.n.dot(a) - l.rho) <= tol && std::abs(l.n.dot(b) - l.rho) <= tol;
+    });
+    const auto k = static_cast<std::size_t>(joined - lines.begin());
+    if (joined == lines.end()) {
+      lines.emplace_back();
+      members.emplace_back();
+    }
+    SegmentLine& l = lines[k];
+    const int steps = std::max(1, static_cast<int>(len / 2.0));
+    for (int i = 0; i <= steps; ++i) {
+      const cv::Point2d p = a + (static_cast<double>(i) / steps) * (b - a);
+      members[k].emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+    }
+    l.spans.emplace_back(cv::norm(a), cv::norm(b));  // placeholder, recomputed below
+    const Line fitted = fit(members[k], cv::DIST_L2);
+    l.n = {-fitted.d.y, fitted.d.x};
+    if (l.n.y < 0 || (l.n.y == 0 && l.n.x < 0)) l.n = -l.n;
+    l.rho = l.n.dot(fitted.p);
+  }
+  // Spans along each line's final direction.
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    SegmentLine& l = lines[k];
+    const cv::Point2d t(-l.n.y, l.n.x);
+    l.spans.clear();
+    std::vector<double> proj;
+    for (const cv::Point2f& p : members[k]) proj.push_back(t.dot(cv::Point2d(p)));
+    // Consecutive points of one segment are 2 px or less apart; a larger jump starts another segment.
+    std::size_t start = 0;
+    for (std::size_t i = 1; i <= proj.size(); ++i) {
+      if (i == proj.size() || cv::norm(cv::Point2d(members[k][i]) - cv::Point2d(members[k][i - 1])) > 2.5) {
+        const auto [lo, hi] = std::minmax_element(proj.begin() + static_cast<std::ptrdiff_t>(start), proj.begin() + static_cast<std::ptrdiff_t>(i));
+        l.spans.emplace_back(*lo, *hi);
+        start = i;
+      }
+    }
+    l.covered = covered_length(l.spans, -1e18, 1e18);
+  }
+  return lines;
+}
+
+/// Quadrilaterals bounded by four of the longest straight lines (or the frame's own edges, for a page cut off by
+/// them): two roughly parallel pairs (within 35°) crossing at more than 45°, every side not on the frame's edge
+/// covered at least 40 % by edge segments. This finds a page whose outline no single edge map closes: broken by
+/// weak stretches, or tied to a textured background.
+void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& segs, cv::Size size, double min_area, std::vector<Candidate>& out) {
+  const double shorter = std::min(size.width, size.height);
+  std::vector<SegmentLine> lines = group_segments(segs, std::max(2.5, 0.006 * shorter));
+  std::sort(lines.begin(), lines.end(), [](const SegmentLine& a, const SegmentLine& b) { return a.covered > b.covered; });
+  lines.erase(std::remove_if(lines.begin(), lines.end(), [&](const SegmentLine& l) { return l.covered < 0.1 * shorter; }), lines.end());
+  if (lines.size() > 16) lines.resize(16);
+#ifdef HK_PAGE_DEBUG
+  for (const SegmentLine& l : lines) fprintf(stderr, "line n (%.3f %.3f) rho %.1f covered %.1f spans %zu\n", l.n.x, l.n.y, l.rho, l.covered, l.spans.size());
+#endif
+  const double w = size.width - 1.0, h = size.height - 1.0;
+  const std::array<std::pair<cv::Point2d, double>, 4> frame{{{{0, 1}, 0.0}, {{1, 0}, w}, {{0, 1}, h}, {{1, 0}, 0.0}}};
+  for (int e = 0; e < 4; ++e) {
+    SegmentLine l;
+    l.n = frame[static_cast<std::size_t>(e)].first;
+    l.rho = frame[static_cast<std::size_t>(e)].second;
+    l.frame_edge = e;
+    lines.push_back(l);
+  }
+  const std::size_t n = lines.size();
+  const double beyond = 0.25 * std::max(w, h);  // a page cut off at a corner has that corner outside the frame
+  const auto as_line = [](const SegmentLine& l) { return Line{l.rho * l.n, {-l.n.y, l.n.x}}; };
+  const double cos_parallel = std::cos(35.0 * CV_PI / 180.0), cos_cross = std::cos(45.0 * CV_PI / 180.0);
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      if (std::abs(lines[i].n.dot(lines[j].n)) >= cos_parallel) pairs.emplace_back(i, j);
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    for (std::size_t r = p + 1; r < pairs.size(); ++r) {
+      const auto [i, j] = pairs[p];
+      const auto [k, l] = pairs[r];
+      if (i == k || i == l || j == k || j == l) continue;
+      if (std::abs(lines[i].n.dot(lines[k].n)) > cos_cross) continue;
+      const int on_frame = (lines[i].frame_edge >= 0) + (lines[j].frame_edge >= 0) + (lines[k].frame_edge >= 0) + (lines[l].frame_edge >= 0);
+      if (on_frame > 2) continue;
+      const std::array<std::size_t, 4> side{i, k, j, l};  // around the quad: i, k, j, l; corner s joins side s-1 and s
+      Quad q;
+      bool ok = true;
+      for (std::size_t s = 0; s < 4 && ok; ++s) {
+        const auto c = intersect(as_line(lines[side[(s + 3) % 4]]), as_line(lines[side[s]]));
+        ok = c && c->x >= -beyond && c->y >= -beyond && c->x <= w + beyond && c->y <= h + beyond;
+        if (ok) q[s] = *c;
+      }
+      if (!ok || visible_area(q, size) < min_area) continue;
+      for (std::size_t s = 0; s < 4 && ok; ++s) {
+        const SegmentLine& sl = lines[side[s]];
+        if (sl.frame_edge >= 0) continue;
+        const cv::Point2d t(-sl.n.y, sl.n.x);
+        const double t0 = std::min(t.dot(q[s]), t.dot(q[(s + 1) % 4])), t1 = std::max(t.dot(q[s]), t.dot(q[(s + 1) % 4]));
+        ok = t1 - t0 > 1.0 && covered_length(sl.spans, t0, t1) >= 0.4 * (t1 - t0);
+      }
+      if (ok) add_quad(q, min_area, size, out);
+    }
+  }
+}
+
+/// Candidates from several edge maps of the downscaled frame (after OpenCV's squares.cpp sample), each map giving
+/// quadrilaterals two ways (quads_from_map on the dilated map; quads_from_lines on its long straight stretches,
+/// cv::HoughLinesP): Canny edges (of the colour image where there is one: the largest gradient of the three
+/// channels) at three thresholds and three blurs; the strong blurs (σ 3 and 5 px of the downscaled frame, taken on
+/// a half-size copy) wash out the fine texture of a table or cloth, which would otherwise tie the page's outline to
+/// the background. Also Otsu thresholds of the grey and of each colour channel, both polarities, opened to cut
+/// thin links. Sorted by area, largest first, near-duplicates dropped.
+std::vector<Candidate> candidates(const cv::Mat& small, double min_area) {
+  std::vector<Candidate> out;
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+  cv::Mat half;
+  cv::pyrDown(small, half);
+  const double to_small_x = static_cast<double>(small.cols) / half.cols, to_small_y = static_cast<double>(small.rows) / half.rows;
+  const double half_area = min_area / (to_small_x * to_small_y);
+  std::vector<std::pair<cv::Point2d, cv::Point2d>> segments;  // in downscaled-frame px
+  for (double sigma : {1.5, 2.5}) {
+    cv::Mat blurred;
+    cv::GaussianBlur(half, blurred, cv::Size(0, 0), sigma);
+    for (double hi : {30.0, 60.0, 120.0}) {
+      cv::Mat edges;
+      cv::Canny(blurred, edges, hi / 2, hi);
+      std::vector<cv::Vec4i> segs;
+      const double shorter = std::min(edges.cols, edges.rows);
+      cv::HoughLinesP(edges, segs, 1, CV_PI / 360, static_cast<int>(0.05 * shorter), 0.06 * shorter, 0.015 * shorter);
+      for (const cv::Vec4i& sg : segs)
+        segments.emplace_back(cv::Point2d((sg[0] + 0.5) * to_small_x - 0.5, (sg[1] + 0.5) * to_small_y - 0.5),
+                              cv::Point2d((sg[2] + 0.5) * to_small_x - 0.5, (sg[3] + 0.5) * to_small_y - 0.5));
+      cv::dilate(edges, edges, kernel);
+      std::vector<Candidate> found;
+      quads_from_map(edges, half_area, found);
+      for (Candidate& c : found) {
+        for (cv::Point2d& p : c.q) p = {(p.x + 0.5) * to_small_x - 0.5, (p.y + 0.5) * to_small_y - 0.5};
+        c.area *= to_small_x * to_small_y;
+        for (std::size_t i = 0; i < 4; ++i) c.frame_edge[i] = frame_edge_of(c.q[i], c.q[(i + 1) % 4], small.size(), 4.0);
+        out.push_back(c);
+      }
+    }
+  }
+  quads_from_lines(segments, small.size(), min_area, out);
+  std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) { return a.area > b.area; });
+  // Near-duplicates (every corner within 2 px) add nothing.
+  std::vector<Candidate> unique;
+  for (const Candidate& c : out) {
+    const bool dup = std::any_of(unique.begin(), unique.end(), [&](const Candidate& u) {
+      for (std::size_t i = 0; i < 4; ++i)
+        if (cv::norm(u.q[i] - c.q[i]) > 2.0) return false;
+      return true;
+    });
+    if (!dup) unique.push_back(c);
+  }
+  return unique;
+}
+
+/// The frame edge `e` (0 top, 1 right, 2 bottom, 3 left) as a line in frame pixels: the outer boundary of the
+/// outermost pixels (half a pixel beyond their centres), directed clockwise on screen.
+Line frame_line(int e, cv::Size size) {
+  const double r = size.width - 0.5, b = size.height - 0.5;
+  switch (e) {
+    case 0: return {{-0.5, -0.5}, {1, 0}};
+    case 1: return {{r, -0.5}, {0, 1}};
+    case 2: return {{r, b}, {-1, 0}};
+    default: return {{-0.5, b}, {0, -1}};
+  }
+}
+
+/// The gradient of the downscaled frame (blurred, σ 1.5 px), per pixel that of the colour channel where it is
+/// largest: CV_32FC2 (d/dx, d/dy), Sobel 3 x 3 (about 8 x grey levels per px).
+cv::Mat strongest_gradient(const cv::Mat& small) {
+  cv::Mat blurred, gx, gy;
+  cv::GaussianBlur(small, blurred, cv::Size(0, 0), 1.5);
+  cv::Sobel(blurred, gx, CV_32F, 1, 0, 3);
+  cv::Sobel(blurred, gy, CV_32F, 0, 1, 3);
+  const int cn = small.channels();
+  cv::Mat g(small.size(), CV_32FC2);
+  for (int y = 0; y < small.rows; ++y) {
+    const float* px = gx.ptr<float>(y);
+    const float* py = gy.ptr<float>(y);
+    cv::Vec2f* out = g.ptr<cv::Vec2f>(y);
+    for (int x = 0; x < small.cols; ++x) {
+      int best = 0;
+      float best_m = -1.0f;
+      for (int c = 0; c < cn; ++c) {
+        const float m = px[x * cn + c] * px[x * cn + c] + py[x * cn + c] * py[x * cn + c];
+        if (m > best_m) best_m = m, best = c;
+      }
+      out[x] = {px[x * cn + best], py[x * cn + best]};
+    }
+  }
+  return g;
+}
+
+/// A quick check of a candidate on the downscaled frame: the least, over its sides not on the frame's edge, share
+/// of points along the side with a gradient across it (within 1.5 px of the side, at least `min_grad`, pointing
+/// within ~37° of the side's normal).
+double quick_support(const cv::Mat& grad, const Candidate& c, double min_grad) {
+  double least = 1.0;
+  for (std::size_t s = 0; s < 4; ++s) {
+    if (c.frame_edge[s] >= 0) continue;
+    const cv::Point2d a = c.q[s], b = c.q[(s + 1) % 4];
+    const double len = cv::norm(b - a);
+    if (len < 4.0) return 0.0;
+    const cv::Point2d t = (b - a) / len, n(t.y, -t.x);
+    const int count = std::clamp(static_cast<int>(len / 3.0), 8, 80);
+    int hits = 0, tried = 0;
+    for (int i = 0; i < count; ++i) {
+      const cv::Point2d p = a + (0.05 + 0.9 * (i + 0.5) / count) * (b - a);
+      bool hit = false, inside = false;
+      const double reach = 1.5 + 0.01 * len;
+      for (double o = -reach; o <= reach; o += 0.75) {
+        const cv::Point2d q = p + o * n;
+        const int x = static_cast<int>(std::lround(q.x)), y = static_cast<int>(std::lround(q.y));
+        if (x < 0 || y < 0 || x >= grad.cols || y >= grad.rows) continue;
+        inside = true;
+        const cv::Vec2f g = grad.at<cv::Vec2f>(y, x);
+        const double across = std::abs(g[0] * n.x + g[1] * n.y), along = std::abs(g[0] * t.x + g[1] * t.y);
+        if (across >= min_grad && across >= 1.33 * along) hit = true;
+      }
+      tried += inside ? 1 : 0;
+      hits += hit ? 1 : 0;
+    }
+    if (tried < 4) return 0.0;
+    least = std::min(least, static_cast<double>(hits) / tried);
+  }
+  return least;
+}
+
+void check_params(const PageParams& p) {
+  if (!(p.min_area_fraction > 0.0 && p.min_area_fraction < 1.0))
+    throw std::invalid_argument("find_page: min_area_fraction must be in (0, 1)");
+  if (!(p.min_contrast >= 0.0 && p.min_contrast <= 255.0)) throw std::invalid_argument("find_page: min_contrast must be in [0, 255]");
+  if (p.max_side_px < 64) throw std::invalid_argument("find_page: max_side_px must be at least 64");
+}
+
+/// The frame being searched, and how the downscaled copy maps onto it.
+struct Frame {
+  const cv::Mat& image;  ///< CV_8UC3 or CV_8UC1
+  cv::Mat grey;
+  double sx, sy;      ///< frame px per downscaled px, along x and y
+  double unit;        ///< the larger of sx, sy
+  double touch_tol;   ///< 1 % of the frame's diagonal [px]
+  double area;        ///< [px²]
+};
+
+#ifdef HK_PAGE_DEBUG
+#define REJECT(n) do { fprintf(stderr, "  reject %d (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f)\n", n, c.q[0].x, c.q[0].y, c.q[1].x, c.q[1].y, c.q[2].x, c.q[2].y, c.q[3].x, c.q[3].y); return std::nullopt; } while (0)
+#else
+#define REJECT(n) return std::nullopt
+#endif
+
+/// A candidate that passed: the page it would be, and the colour contrast across each of its sides (in the order of
+/// det.corners_px: side s runs from corner s to corner s + 1; negative on the frame's edge).
+struct Found {
+  PageDetection det;
+  std::array<std::vector<double>, 4> side_contrast;  ///< per side, per stretch (empty on the frame's edge)
+};
+
+/// Refines a candidate at full resolution and checks it (see find_page); the page when it passes.
+std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams& params) {
+  const cv::Mat& frame = f.image;
+  const double unit = f.unit;
+  Quad full;
+  for (std::size_t i = 0; i < 4; ++i) full[i] = {(c.q[i].x + 0.5) * f.sx - 0.5, (c.q[i].y + 0.5) * f.sy - 0.5};
+  std::array<Line, 4> lines;
+  for (std::size_t s = 0; s < 4; ++s) {
+    if (c.frame_edge[s] >= 0) {
+      lines[s] = frame_line(c.frame_edge[s], frame.size());
+      continue;
+    }
+    const cv::Point2d a = full[s], b = full[(s + 1) % 4];
+    const double window = std::max(4.0 * unit + 2.0, 0.04 * cv::norm(b - a));
+    const std::optional<Line> l = refine_side(frame, a, b, window, unit);
+    if (!l) REJECT(1);
+    // Early out: the refined line, over the candidate's side, must be mostly an edge.
+    const cv::Point2d pa = l->p + (a - l->p).dot(l->d) * l->d, pb = l->p + (b - l->p).dot(l->d) * l->d;
+    float typical = 0.0f;
+#ifdef HK_PAGE_DEBUG
+    fprintf(stderr, "   side %zu refined (%.1f,%.1f)-(%.1f,%.1f) early support %.2f\n", s, pa.x, pa.y, pb.x, pb.y, side_support(frame, pa, pb, unit, 0.1, 0.9, &typical));
+    typical = 0.0f;
+#endif
+    if (side_support(frame, pa, pb, unit, 0.1, 0.9, &typical) < 0.5) REJECT(2);
+    lines[s] = *l;
+  }
+  Quad q;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto p = intersect(lines[(i + 3) % 4], lines[i]);
+    if (!p || !finite(*p)) REJECT(3);
+    q[i] = *p;
+  }
+  // Corners inside the frame or, for a page cut off at a corner, not far beyond it.
+  const double beyond = 0.25 * std::max(frame.cols, frame.rows);
+  if (!std::all_of(q.begin(), q.end(), [&](cv::Point2d p) {
+        return p.x >= -beyond && p.y >= -beyond && p.x <= frame.cols - 1 + beyond && p.y <= frame.rows - 1 + beyond;
+      }))
+    REJECT(4);
+  const double area = visible_area(q, frame.size());
+  if (signed_area(q) <= 0.0 || area / f.area < params.min_area_fraction) REJECT(5);
+  std::vector<cv::Point2f> poly;
+  for (const cv::Point2d& p : q) poly.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+  if (!cv::isContourConvex(poly)) REJECT(6);
+  std::array<bool, 4> on_frame{};
+  for (std::size_t s = 0; s < 4; ++s) on_frame[s] = c.frame_edge[s] >= 0;
+  // The visible part of each side, and whether it ends at the frame's edge (at a side on the frame's edge, or
+  // where the side leaves the frame) rather than at a corner of the page.
+  Segments visible;
+  std::array<std::pair<bool, bool>, 4> ends_at_frame{};
+  for (std::size_t s = 0; s < 4; ++s) {
+    const cv::Point2d a = q[s], b = q[(s + 1) % 4];
+    visible[s] = {a, b};
+    if (on_frame[s]) continue;
+    const auto t = clip_segment(a, b, frame.size(), 0.0);
+    if (!t || (t->second - t->first) * cv::norm(b - a) < 0.03 * std::hypot(frame.cols, frame.rows)) REJECT(14);
+    visible[s] = {a + t->first * (b - a), a + t->second * (b - a)};
+    ends_at_frame[s] = {on_frame[(s + 3) % 4] || t->first > 0.0, on_frame[(s + 1) % 4] || t->second < 1.0};
+  }
+  // Every side off the frame's edge backed by an edge along most of its length. A page cut off by the frame
+  // shows its sides right up to the frame's edge: two sides of a page and two edges of the frame make a larger,
+  // false quadrilateral whose sides run on past the page's corners, over the background, to the frame.
+  for (std::size_t s = 0; s < 4; ++s) {
+    const auto [a, b] = visible[s];
+    if (on_frame[s]) continue;
+    float typical = 0.0f;
+    if (side_support(frame, a, b, unit, 0.05, 0.95, &typical) < 0.6) REJECT(8);
+    const double len = cv::norm(b - a), stretch = std::max(0.1, 15.0 * unit / len), tip = std::min(0.02, 3.0 / len);
+    if (ends_at_frame[s].first && side_support(frame, a, b, unit, tip, stretch, &typical) < 0.5) REJECT(9);
+    if (ends_at_frame[s].second && side_support(frame, a, b, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5) REJECT(10);
+  }
+  const double contrast = border_contrast(f.grey, visible, on_frame, 1.5 + 1.5 * unit, 3.0 * unit).mean();
+  if (contrast < params.min_contrast) REJECT(11);
+  const SideContrast colour = border_contrast(frame, visible, on_frame, 1.5 + 1.5 * unit, 3.0 * unit);
+  // A side that meets the frame's edge is set off from the background there as it is elsewhere: where it runs on
+  // past the page's corner along a grain of the background, the stretch at the frame has no step across it.
+  for (std::size_t s = 0; s < 4; ++s) {
+    const std::vector<double>& v = colour.stretches[s];
+    if (on_frame[s] || v.size() < 4) continue;
+    std::vector<double> sorted = v;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    if (ends_at_frame[s].first && v.front() < 0.35 * median) REJECT(12);
+    if (ends_at_frame[s].second && v.back() < 0.35 * median) REJECT(13);
+  }
+
+  Found out;
+  PageDetection& det = out.det;
+  det.found = true;
+  det.corners_px = order_corners(q);
+  for (std::size_t s = 0; s < 4; ++s) {
+    const auto k = static_cast<std::size_t>(std::find(q.begin(), q.end(), det.corners_px[s]) - q.begin());
+    out.side_contrast[s] = colour.stretches[k];
+  }
+  det.area_fraction = area / f.area;
+  det.contrast = contrast;
+  // The page reaches (or passes) an edge of the frame where a corner lies within touch_tol of it or beyond.
+  for (const cv::Point2d& p : q) {
+    det.touches_frame[0] = det.touches_frame[0] || p.y <= -0.5 + f.touch_tol;
+    det.touches_frame[1] = det.touches_frame[1] || p.x >= frame.cols - 0.5 - f.touch_tol;
+    det.touches_frame[2] = det.touches_frame[2] || p.y >= frame.rows - 0.5 - f.touch_tol;
+    det.touches_frame[3] = det.touches_frame[3] || p.x <= -0.5 + f.touch_tol;
+  }
+  return out;
+}
+
+/// Whether side `s` of quadrilateral `b` lies on a side of `a` (both its ends within `tol` px of that side's line,
+/// directions within 3°).
+bool shares_side(const Quad& a, const Quad& b, std::size_t s, double tol) {
+  const cv::Point2d b0 = b[s], b1 = b[(s + 1) % 4];
+  const cv::Point2d bd = (b1 - b0) / cv::norm(b1 - b0);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Line l{a[i], (a[(i + 1) % 4] - a[i]) / cv::norm(a[(i + 1) % 4] - a[i])};
+    if (std::abs(l.d.dot(bd)) >= std::cos(3.0 * CV_PI / 180.0) && distance(l, b0) <= tol && distance(l, b1) <= tol) return true;
+  }
+  return false;
+}
+
+/// The page among the quadrilaterals that passed: the largest, unless a smaller one shares some of its sides while
+/// the larger's other sides are weak — their lower quartile of stretch contrasts under half that of the shared
+/// sides, and under 1 / 1.5 of the smaller's other sides: the larger then runs past the page's corners to a line in
+/// the background (a wood grain, a fold in a cloth). A smaller one sharing no side, or the larger's other sides
+/// being as strong as the shared ones, is something inside the page: a picture on it, a line in the picture. And a
+/// larger one whose other sides are all on the frame's edge loses to a smaller one whose other sides lie just inside
+/// it (within `tol`): the page's own side, not cut off, near the frame's edge.
+PageDetection choose(std::vector<Found> found, cv::Size frame, double tol) {
+  std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.det.area_fraction > b.det.area_fraction; });
+  // Lower quartile of the stretch contrasts of x's sides that are (shared = true) or are not sides of y.
+  const auto lower_quartile = [&](const Found& x, const Found& y, bool shared) {
+    std::vector<double> v;
+    for (std::size_t s = 0; s < 4; ++s)
+      if (shares_side(y.det.corners_px, x.det.corners_px, s, tol) == shared)
+        v.insert(v.end(), x.side_contrast[s].begin(), x.side_contrast[s].end());
+    if (v.empty()) return -1.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 4), v.end());
+    return v[v.size() / 4];
+  };
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    bool beaten = false;
+    for (std::size_t j = i + 1; j < found.size() && !beaten; ++j) {
+      int shared = 0;
+      for (std::size_t s = 0; s < 4; ++s) shared += shares_side(found[i].det.corners_px, found[j].det.corners_px, s, tol);
+      if (shared == 0 || shared == 4) continue;
+      const double own = lower_quartile(found[i], found[j], false), common = lower_quartile(found[i], found[j], true);
+      const double other = lower_quartile(found[j], found[i], false);
+      beaten = own >= 0 && own < 0.5 * common && other > 1.5 * own;
+      // The larger's other sides all on the frame's edge, the smaller's just inside it: the page's own side, seen.
+      bool frame_only = true, near_frame = true;
+      for (std::size_t s = 0; s < 4; ++s) {
+        if (!shares_side(found[j].det.corners_px, found[i].det.corners_px, s, tol)) frame_only = frame_only && found[i].side_contrast[s].empty();
+        if (!shares_side(found[i].det.corners_px, found[j].det.corners_px, s, tol)) {
+          const cv::Point2d a = found[j].det.corners_px[s], b = found[j].det.corners_px[(s + 1) % 4];
+          near_frame = near_frame && frame_edge_of(a + cv::Point2d(0.5, 0.5), b + cv::Point2d(0.5, 0.5), frame + cv::Size(1, 1), tol) >= 0;
+        }
+      }
+      beaten = beaten || (frame_only && near_frame);
+    }
+    if (!beaten) return found[i].det;
+  }
+  return {};
+}
+
+}  // namespace
+
+PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
+  if (frame.empty()) throw std::invalid_argument("find_page: empty frame");
+  if (frame.type() != CV_8UC3 && frame.type() != CV_8UC1)
+    throw std::invalid_argument("find_page: the frame must be CV_8UC3 (BGR) or CV_8UC1 (grey)");
+  check_params(params);
+  Frame f{frame, {}, 1.0, 1.0, 1.0, 0.01 * std::hypot(frame.cols, frame.rows), static_cast<double>(frame.cols) * frame.rows};
+  if (frame.channels() == 3) cv::cvtColor(frame, f.grey, cv::COLOR_BGR2GRAY);
+  else f.grey = frame;
+
+  const double scale = std::min(1.0, static_cast<double>(params.max_side_px) / std::max(frame.cols, frame.rows));
+  cv::Mat small = frame;
+  if (scale < 1.0) {
+    const cv::Size ss(std::max(1, static_cast<int>(std::lround(frame.cols * scale))), std::max(1, static_cast<int>(std::lround(frame.rows * scale))));
+    cv::resize(frame, small, ss, 0, 0, cv::INTER_AREA);
+  }
+  f.sx = static_cast<double>(frame.cols) / small.cols;
+  f.sy = static_cast<double>(frame.rows) / small.rows;
+  f.unit = std::max(f.sx, f.sy);
+#ifdef HK_PAGE_DEBUG
+  const auto t0 = std::chrono::steady_clock::now();
+#endif
+  const std::vector<Candidate> cands = candidates(small, 0.8 * params.min_area_fraction * small.cols * small.rows);
+#ifdef HK_PAGE_DEBUG
+  const auto t1 = std::chrono::steady_clock::now();
+#endif
+
+  // Look first at the candidates whose sides are best backed by edges; merge those that differ by less than
+  // 1 % of the frame's diagonal.
+  const cv::Mat grad = strongest_gradient(small);
+  std::vector<std::pair<double, Candidate>> ranked;
+  const double same = 0.01 * std::hypot(small.cols, small.rows);
+  for (const Candidate& c : cands) {
+    // At least two sides must be the page's own; each side on the frame's edge (which shows no edge to back it)
+    // counts against a candidate, so a cut-off page is looked at after the pages seen whole.
+    const auto on_frame = std::count_if(c.frame_edge.begin(), c.frame_edge.end(), [](int e) { return e >= 0; });
+    if (on_frame > 2) continue;
+    const double score = quick_support(grad, c, 24.0) - 0.15 * static_cast<double>(on_frame);
+#ifdef HK_PAGE_DEBUG
+    fprintf(stderr, "quick %.2f area %.0f q (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f)\n", score, c.area, c.q[0].x, c.q[0].y, c.q[1].x, c.q[1].y, c.q[2].x, c.q[2].y, c.q[3].x, c.q[3].y);
+#endif
+    if (score < 0.4 - 0.15 * static_cast<double>(on_frame)) continue;
+    auto twin = std::find_if(ranked.begin(), ranked.end(), [&](const auto& r) {
+      for (std::size_t i = 0; i < 4; ++i)
+        if (cv::norm(r.second.q[i] - c.q[i]) > same) return false;
+      return true;
+    });
+    if (twin == ranked.end()) ranked.emplace_back(score, c);
+    else if (score > twin->first) *twin = {score, c};
+  }
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  constexpr std::size_t kMaxVerified = 16;
+  std::vector<Found> found;
+  for (std::size_t i = 0; i < std::min(ranked.size(), kMaxVerified); ++i) {
+    if (std::optional<Found> d = verify(f, ranked[i].second, params)) found.push_back(*d);
+  }
+  const PageDetection best = choose(found, frame.size(), f.touch_tol + 1.0);
+#ifdef HK_PAGE_DEBUG
+  const auto t2 = std::chrono::steady_clock::now();
+  fprintf(stderr, "TIME cands %zu ranked %zu candidates %.1f ms verify %.1f ms\n", cands.size(), ranked.size(), std::chrono::duration<double, std::milli>(t1 - t0).count(), std::chrono::duration<double, std::milli>(t2 - t1).count());
+#endif
+  return best;
+}
+
+double page_aspect_ratio(const std::array<cv::Point2d, 4>& corners_px, cv::Point2d centre_px) {
+  for (const cv::Point2d& p : corners_px)
+    if (!finite(p)) throw std::invalid_argument("page_aspect_ratio: corners must be finite");
+  if (!finite(centre_px)) throw std::invalid_argument("page_aspect_ratio: the centre must be finite");
+  const cv::Point2d tl = corners_px[0], tr = corners_px[1], br = corners_px[2], bl = corners_px[3];
+  const double across = cv::norm(tr - tl) + cv::norm(br - bl), down = cv::norm(bl - tl) + cv::norm(br - tr);
+  if (!(down > 0.0) || !(across > 0.0)) throw std::invalid_argument("page_aspect_ratio: degenerate quadrilateral");
+  const double mean_sides = across / down;
+  // Zhang & He's m1..m4 are the rectangle's (0,0), (w,0), (0,h), (w,h): top-left, top-right, bottom-left,
+  // bottom-right. Coordinates relative to the principal point, so u0 = v0 = 0 below.
+  const auto h = [&](cv::Point2d p) { return cv::Vec3d(p.x - centre_px.x, p.y - centre_px.y, 1.0); };
+  const cv::Vec3d m1 = h(tl), m2 = h(tr), m3 = h(bl), m4 = h(br);
+  const double k2 = m1.cross(m4).dot(m3) / m2.cross(m4).dot(m3);
+  const double k3 = m1.cross(m4).dot(m2) / m3.cross(m4).dot(m2);
+  const cv::Vec3d n2 = k2 * m2 - m1, n3 = k3 * m3 - m1;
+  // n2[2] = k2 − 1 and n3[2] = k3 − 1 vanish when a pair of opposite sides is parallel: f is then undetermined.
+  constexpr double kParallel = 1e-6;
+  if (!std::isfinite(k2) || !std::isfinite(k3) || std::abs(n2[2]) < kParallel || std::abs(n3[2]) < kParallel) return mean_sides;
+  const double f2 = -(n2[0] * n3[0] + n2[1] * n3[1]) / (n2[2] * n3[2]);
+  if (!std::isfinite(f2) || !(f2 > 0.0)) return mean_sides;
+  // (w/h)² = n2ᵀ A⁻ᵀA⁻¹ n2 / n3ᵀ A⁻ᵀA⁻¹ n3 with A = [f 0 0; 0 f 0; 0 0 1]; both sides times f².
+  const double num = n2[0] * n2[0] + n2[1] * n2[1] + f2 * n2[2] * n2[2];
+  const double den = n3[0] * n3[0] + n3[1] * n3[1] + f2 * n3[2] * n3[2];
+  const double r = std::sqrt(num / den);
+  return std::isfinite(r) && r > 0.0 ? r : mean_sides;
+}
+
+cv::Mat rectify_page(const cv::Mat& frame, const std::array<cv::Point2d, 4>& corners_px) {
+  if (frame.empty()) throw std::invalid_argument("rectify_page: empty frame");
+  for (const cv::Point2d& p : corners_px)
+    if (!finite(p)) throw std::invalid_argument("rectify_page: corners must be finite");
+  if (std::abs(signed_area(corners_px)) < 1.0) throw std::invalid_argument("rectify_page: degenerate quadrilateral (area < 1 px²)");
+  double longest = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) longest = std::max(longest, cv::norm(corners_px[(i + 1) % 4] - corners_px[i]));
+  const double diag = std::hypot(frame.cols, frame.rows);
+  if (longest > 4.0 * diag) throw std::invalid_argument("rectify_page: a side is longer than 4 times the frame's diagonal");
+  const double ratio = page_aspect_ratio(corners_px, {(frame.cols - 1) / 2.0, (frame.rows - 1) / 2.0});
+  const double w = ratio >= 1.0 ? longest : longest * ratio, h = ratio >= 1.0 ? longest / ratio : longest;
+  const int W = std::max(1, static_cast<int>(std::lround(w))), H = std::max(1, static_cast<int>(std::lround(h)));
+  cv::Point2f src[4], dst[4];
+  for (std::size_t i = 0; i < 4; ++i) src[i] = cv::Point2f(static_cast<float>(corners_px[i].x), static_cast<float>(corners_px[i].y));
+  // The page's corners are the outer corners of the output's corner pixels.
+  dst[0] = {-0.5f, -0.5f};
+  dst[1] = {static_cast<float>(W) - 0.5f, -0.5f};
+  dst[2] = {static_cast<float>(W) - 0.5f, static_cast<float>(H) - 0.5f};
+  dst[3] = {-0.5f, static_cast<float>(H) - 0.5f};
+  const cv::Mat m = cv::getPerspectiveTransform(src, dst);
+  cv::Mat out;
+  cv::warpPerspective(frame, out, m, cv::Size(W, H), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  return out;
+}
+
+}  // namespace hk::vision
