@@ -12,7 +12,7 @@
 // the new scene's force then ramps in over [haptics] force_ramp_s, felt from its first tick.
 //
 //   build/bench/bench_capture_latency [--out FILE.json]     prints a Markdown table (one row per picture)
-//   build/bench/bench_capture_latency --write-frame DIR     writes the horse's photo as DIR/frame.png and stops
+//   build/bench/bench_capture_latency --write-frame DIR     writes the horse's photo as DIR/frame.jpg and stops
 //                                                          (tests/data/camera/still, the README's example)
 #include <unistd.h>
 
@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     const test::SyntheticPhoto photo = test::synthetic_photo(picture, cv::Size(1280, 960), c);
     if (!write_frame.empty()) {
       fs::create_directories(write_frame);
-      return cv::imwrite((fs::path(write_frame) / "frame.png").string(), photo.frame) ? 0 : 1;
+      return cv::imwrite((fs::path(write_frame) / "frame.jpg").string(), photo.frame, {cv::IMWRITE_JPEG_QUALITY, 90}) ? 0 : 1;
     }
     fs::remove_all(tmp);
     fs::create_directories(tmp);

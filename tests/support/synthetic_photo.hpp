@@ -85,7 +85,7 @@ inline cv::Mat backdrop_texture(Backdrop kind, int w, int h, std::uint64_t seed)
   return out;
 }
 
-/// A page of a document (the "page" of the tests), w x h, CV_8UC3: off-white paper, a title, five lines of
+/// A page of a document (the "page" of the tests), w x h, CV_8UC3: off-white paper, a title, four lines of
 /// word-like text in large print (cv::putText) and a figure (a disc, a square and a triangle, drawn in black), with
 /// margins of about 7 % so the paper's edge is plain. Deterministic from `seed`.
 inline cv::Mat text_page(int w = 420, int h = 594, std::uint64_t seed = 7) {
@@ -94,18 +94,18 @@ inline cv::Mat text_page(int w = 420, int h = 594, std::uint64_t seed = 7) {
   const int margin = static_cast<int>(0.07 * w);
   const double s = w / 420.0;
   const cv::Scalar ink(30, 30, 30);
-  const int thick = std::max(1, static_cast<int>(std::lround(3 * s)));
-  cv::putText(page, "Shapes", {margin, margin + static_cast<int>(40 * s)}, cv::FONT_HERSHEY_DUPLEX, 1.6 * s, ink, thick + 1, cv::LINE_AA);
-  int y = margin + static_cast<int>(100 * s);
-  const int line_step = static_cast<int>(40 * s);
-  for (int line = 0; line < 5; ++line, y += line_step) {
+  const int thick = std::max(1, static_cast<int>(std::lround(5 * s)));
+  cv::putText(page, "Shapes", {margin, margin + static_cast<int>(48 * s)}, cv::FONT_HERSHEY_DUPLEX, 2.0 * s, ink, thick + 1, cv::LINE_AA);
+  int y = margin + static_cast<int>(115 * s);
+  const int line_step = static_cast<int>(50 * s);
+  for (int line = 0; line < 4; ++line, y += line_step) {
     std::string text;
-    while (text.size() < 16) {
-      const int len = rng.uniform(2, 7);
+    while (text.size() < 12) {
+      const int len = rng.uniform(2, 6);
       for (int k = 0; k < len; ++k) text += static_cast<char>('a' + rng.uniform(0, 26));
       text += ' ';
     }
-    cv::putText(page, text, {margin, y}, cv::FONT_HERSHEY_SIMPLEX, 1.0 * s, ink, thick, cv::LINE_AA);
+    cv::putText(page, text, {margin, y}, cv::FONT_HERSHEY_SIMPLEX, 1.25 * s, ink, thick, cv::LINE_AA);
   }
   const int fy = y;
   const int fh = h - margin - fy;

@@ -144,7 +144,7 @@ struct EdgePoints {
 };
 
 EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double window, double unit, double t0 = 0.05, double t1 = 0.95,
-                       bool nearest = false) {
+                       bool nearest = false, double smooth_px = 0.75) {
   const cv::Point2d d = b - a;
   const double len = std::hypot(d.x, d.y);
   const cv::Point2d t = d / len, n(t.y, -t.x);
@@ -161,7 +161,7 @@ EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, doubl
   const cv::Mat s = sample_across(image, base, t, n, tans, offs);
   const int n_off = static_cast<int>(offs.size()), n_tan = static_cast<int>(tans.size()), cn = image.channels();
   const int rows = static_cast<int>(base.size());
-  const double sigma = std::max(1.5, 1.5 * unit);  // in samples
+  const double sigma = smooth_px * std::max(1.0, unit) / kStep;  // in samples
   const int ks = 2 * static_cast<int>(std::ceil(3 * sigma)) + 1;
   cv::Mat mag2(rows, n_off, CV_32F, cv::Scalar(0));
   for (int c = 0; c < cn; ++c) {
@@ -245,7 +245,7 @@ std::optional<Line> refine_side(const cv::Mat& image, cv::Point2d a, cv::Point2d
 /// positions along it whose strongest change across it (within a narrow window) lies within `inlier_px` of it and
 /// is at least 0.3 x `typical` (when given). `typical` returns the median strength of the changes found.
 double side_support(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double unit, double t0, double t1, float* typical) {
-  const EdgePoints e = edge_points(image, a, b, 1.5 + 1.5 * unit, unit, t0, t1);
+  const EdgePoints e = edge_points(image, a, b, 2.0 + unit, unit, t0, t1, false, 1.25);
   if (e.tried.size() < 4 || e.pts.empty()) return 0.0;
   float least = 0.0f;
   if (*typical > 0.0f) {
@@ -257,9 +257,16 @@ double side_support(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double u
     least = 0.3f * *typical;
   }
   const Line l{a, (b - a) / cv::norm(b - a)};
-  const double inlier_px = std::max(1.0, 0.75 * unit);
+  const double inlier_px = std::max(1.25, 0.75 * unit);
   int hits = 0;
   for (std::size_t i = 0; i < e.pts.size(); ++i) hits += distance(l, e.pts[i]) <= inlier_px && e.strength[i] >= least;
+#ifdef HK_PAGE_DEBUG
+  if (std::getenv("HK_PAGE_DUMP")) {
+    fprintf(stderr, "    support (%.0f,%.0f)-(%.0f,%.0f) typical %.1f tried %zu found %zu:", a.x, a.y, b.x, b.y, *typical, e.tried.size(), e.pts.size());
+    for (std::size_t i = 0; i < e.pts.size(); ++i) fprintf(stderr, " %.1f/%.0f", cross(l.d, cv::Point2d(e.pts[i]) - l.p), e.strength[i]);
+    fprintf(stderr, "\n");
+  }
+#endif
   return static_cast<double>(hits) / e.tried.size();
 }
 
@@ -542,7 +549,7 @@ void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& se
         if (sl.frame_edge >= 0) continue;
         const cv::Point2d t(-sl.n.y, sl.n.x);
         const double t0 = std::min(t.dot(q[s]), t.dot(q[(s + 1) % 4])), t1 = std::max(t.dot(q[s]), t.dot(q[(s + 1) % 4]));
-        ok = t1 - t0 > 1.0 && covered_length(sl.spans, t0, t1) >= 0.4 * (t1 - t0);
+        ok = t1 - t0 > 1.0 && covered_length(sl.spans, t0, t1) >= 0.3 * (t1 - t0);
       }
       if (ok) add_quad(q, min_area, size, out);
     }
@@ -908,7 +915,7 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
 #ifdef HK_PAGE_DEBUG
     fprintf(stderr, "quick %.2f area %.0f q (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f)\n", score, c.area, c.q[0].x, c.q[0].y, c.q[1].x, c.q[1].y, c.q[2].x, c.q[2].y, c.q[3].x, c.q[3].y);
 #endif
-    if (score < 0.4 - 0.15 * static_cast<double>(on_frame)) continue;
+    if (score < 0.3 - 0.15 * static_cast<double>(on_frame)) continue;
     auto twin = std::find_if(ranked.begin(), ranked.end(), [&](const auto& r) {
       for (std::size_t i = 0; i < 4; ++i)
         if (cv::norm(r.second.q[i] - c.q[i]) > same) return false;
