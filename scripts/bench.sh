@@ -33,6 +33,8 @@ min_time=0.5
 "$b/bench_stick_first_page" --out "$out/stick_first_page.json" > "$out/stick_first_page.md"
 "$b/bench_device_loop" --seconds 5 --out "$out/device_loop.json" 2>/dev/null > "$out/device_loop.md"
 "$b/bench_tour_time" > "$out/tour_time.md"
+"$b/bench_capture_latency" --out "$out/capture_latency.json" > "$out/capture_latency.md"
+[ -x "$b/bench_rectify" ] && "$b/bench_rectify" --benchmark_min_time=$min_time --benchmark_out="$out/rectify.json" --benchmark_out_format=json >/dev/null
 bash "$root/bench/coverage.sh" "$root/build" "$out" >/dev/null  # coverage per picture: CSV, chart and its table
 bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detectors.md"  # issue 15: each picture's scene, canny → auto, and per detector
 # Tables printed by the audio and servo benches go between their markers in PERFORMANCE.md.

@@ -43,6 +43,14 @@ void CapturePreviewView::draw(const CapturePreview& p, const View& v, Vec2 half)
   const double k = std::min(2 * half.x / rgb.cols, 2 * half.y / rgb.rows);
   const double x0 = -k * rgb.cols / 2, y0 = k * rgb.rows / 2;
   const auto at = [&](double u, double w) { return std::pair<double, double>{v.px(x0 + k * u), v.py(y0 - k * w)}; };
+  // The scene behind is covered: the preview is the only picture on the screen while it runs.
+  glColor4f(0.05f, 0.05f, 0.08f, 1.0f);
+  glBegin(GL_QUADS);
+  glVertex2d(v.px(-half.x), v.py(half.y));
+  glVertex2d(v.px(half.x), v.py(half.y));
+  glVertex2d(v.px(half.x), v.py(-half.y));
+  glVertex2d(v.px(-half.x), v.py(-half.y));
+  glEnd();
   glEnable(GL_TEXTURE_2D);
   glColor4f(1, 1, 1, 1);
   glBegin(GL_QUADS);
