@@ -150,9 +150,12 @@ inline std::array<cv::Point2d, 4> photo_corners(cv::Size picture, cv::Size frame
 
 /// Renders `picture` (CV_8UC1 or CV_8UC3) into a `frame`-sized photo under conditions `c`. The picture is first
 /// shrunk (INTER_AREA) to about its size in the frame so the perspective warp (bilinear) does not alias; the
-/// frame is then backdrop·(1 − coverage) + picture·coverage, times the light, blurred, plus noise.
-inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, const PhotoConditions& c) {
+/// frame is then backdrop·(1 − coverage) + picture·coverage (cv::blendLinear), times the light, blurred, plus
+/// noise. `backdrop`, when given (frame-sized CV_8UC3, e.g. a cached backdrop_texture), is used instead of
+/// generating one from c.backdrop and c.seed.
+inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, const PhotoConditions& c, const cv::Mat* backdrop = nullptr) {
   CV_Assert(!picture.empty() && (picture.type() == CV_8UC1 || picture.type() == CV_8UC3));
+  CV_Assert(backdrop == nullptr || (backdrop->size() == frame && backdrop->type() == CV_8UC3));
   cv::Mat pic;
   if (picture.channels() == 1) cv::cvtColor(picture, pic, cv::COLOR_GRAY2BGR);
   else pic = picture;
@@ -164,8 +167,7 @@ inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, co
   cv::Point2f dst[4];
   for (int k = 0; k < 4; ++k) dst[k] = cv::Point2f(static_cast<float>(out.corners_px[static_cast<std::size_t>(k)].x),
                                                    static_cast<float>(out.corners_px[static_cast<std::size_t>(k)].y));
-  cv::Mat hm = cv::getPerspectiveTransform(src, dst);
-  out.homography = cv::Matx33d(hm);
+  out.homography = cv::Matx33d(cv::getPerspectiveTransform(src, dst));
 
   // Shrink first when the picture is smaller in the frame than in its file.
   const double area = std::abs(cv::contourArea(std::vector<cv::Point2f>(dst, dst + 4)));
@@ -179,40 +181,34 @@ inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, co
     const cv::Matx33d to_pic(sx, 0, 0.5 * sx - 0.5, 0, sy, 0.5 * sy - 0.5, 0, 0, 1);
     render_h = out.homography * to_pic;
   }
-  cv::Mat colour, coverage;
+  cv::Mat colour, coverage, uncovered, img;
   cv::warpPerspective(render, colour, cv::Mat(render_h), frame, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   // Bilinear coverage of a ones image with a zero border: 0.5 exactly on the picture's outline (x = -0.5).
   cv::warpPerspective(cv::Mat(render.size(), CV_32F, cv::Scalar(1.0)), coverage, cv::Mat(render_h), frame, cv::INTER_LINEAR,
                       cv::BORDER_CONSTANT, cv::Scalar(0.0));
-  cv::Mat bg = backdrop_texture(c.backdrop, frame.width, frame.height, c.seed);
-  cv::Mat colour_f, bg_f, cov3;
-  colour.convertTo(colour_f, CV_32FC3);
-  bg.convertTo(bg_f, CV_32FC3);
-  cv::merge(std::vector<cv::Mat>{coverage, coverage, coverage}, cov3);
-  cv::Mat img = bg_f + cov3.mul(colour_f - bg_f);
+  cv::subtract(cv::Scalar(1.0), coverage, uncovered);
+  cv::blendLinear(colour, backdrop ? *backdrop : backdrop_texture(c.backdrop, frame.width, frame.height, c.seed), coverage, uncovered, img);
 
   cv::RNG rng(c.seed * 104729 + 3);
+  cv::Mat f;
+  img.convertTo(f, CV_32FC3);
   if (c.uneven_light) {
     const double a = rng.uniform(0.0, 2 * std::numbers::pi);
     const double dx = std::cos(a), dy = std::sin(a);
     const double lo = std::min(0.0, dx * frame.width) + std::min(0.0, dy * frame.height);
     const double hi = std::max(0.0, dx * frame.width) + std::max(0.0, dy * frame.height);
-    cv::Mat light(frame, CV_32F);
     for (int y = 0; y < frame.height; ++y) {
-      float* row = light.ptr<float>(y);
-      for (int x = 0; x < frame.width; ++x) row[x] = static_cast<float>(0.6 + 0.5 * ((dx * x + dy * y) - lo) / (hi - lo));
+      cv::Vec3f* row = f.ptr<cv::Vec3f>(y);
+      for (int x = 0; x < frame.width; ++x) row[x] *= static_cast<float>(0.6 + 0.5 * ((dx * x + dy * y) - lo) / (hi - lo));
     }
-    cv::Mat light3;
-    cv::merge(std::vector<cv::Mat>{light, light, light}, light3);
-    img = img.mul(light3);
   }
-  if (c.blur_sigma_px > 0) cv::GaussianBlur(img, img, cv::Size(0, 0), c.blur_sigma_px);
+  if (c.blur_sigma_px > 0) cv::GaussianBlur(f, f, cv::Size(0, 0), c.blur_sigma_px);
   if (c.noise_sigma > 0) {
     cv::Mat noise(frame, CV_32FC3);
     rng.fill(noise, cv::RNG::NORMAL, 0.0, c.noise_sigma);
-    img += noise;
+    f += noise;
   }
-  img.convertTo(out.frame, CV_8UC3);
+  f.convertTo(out.frame, CV_8UC3);
   return out;
 }
 

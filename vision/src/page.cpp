@@ -10,11 +10,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-#ifdef HK_PAGE_DEBUG
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
-#endif
 
 #include <opencv2/imgproc.hpp>
 
@@ -94,29 +89,33 @@ double visible_area(const Quad& q, cv::Size size) {
   return static_cast<double>(cv::intersectConvexConvex(quad, rect, both, true));
 }
 
-/// Samples `grey` (CV_8UC1, or CV_8UC3 giving CV_32FC3) at the points base_i + o_k·normal + s_j·tangent for every sample position i, tangential
-/// offset j and normal offset k; returns n_pos rows of (n_tan · n_off) values, j-major, as CV_32F (bilinear,
-/// border replicated).
-cv::Mat sample_across(const cv::Mat& grey, const std::vector<cv::Point2d>& base, cv::Point2d tangent, cv::Point2d normal,
+/// Samples `image` (CV_8UC1 or CV_8UC3) at the points base_i + o_k·normal + s_j·tangent for every sample position
+/// i, tangential offset j and normal offset k: n_pos rows of (n_tan · n_off) pixels, j-major, same type as `image`
+/// (bilinear, border replicated). The result is a view of a buffer kept per thread and reused by the next call
+/// (this runs a few hundred times per frame; reusing the buffers keeps it from allocating each time).
+cv::Mat sample_across(const cv::Mat& image, const std::vector<cv::Point2d>& base, cv::Point2d tangent, cv::Point2d normal,
                       const std::vector<double>& tan_offsets, const std::vector<double>& normal_offsets) {
   const int n_pos = static_cast<int>(base.size());
   const int n_tan = static_cast<int>(tan_offsets.size()), n_off = static_cast<int>(normal_offsets.size());
-  cv::Mat mx(n_pos, n_tan * n_off, CV_32F), my(n_pos, n_tan * n_off, CV_32F);
+  thread_local cv::Mat map_buffer, out_buffers[2];  // out: grey, colour
+  const auto view = [](cv::Mat& buffer, int rows, int cols, int type) {
+    if (buffer.type() != type || buffer.rows < rows || buffer.cols < cols)
+      buffer.create(std::max(rows, buffer.type() == type ? buffer.rows : 0), std::max(cols, buffer.type() == type ? buffer.cols : 0), type);
+    return buffer(cv::Rect(0, 0, cols, rows));
+  };
+  cv::Mat map = view(map_buffer, n_pos, n_tan * n_off, CV_32FC2);
   for (int i = 0; i < n_pos; ++i) {
-    float* px = mx.ptr<float>(i);
-    float* py = my.ptr<float>(i);
+    cv::Vec2f* m = map.ptr<cv::Vec2f>(i);
     for (int j = 0; j < n_tan; ++j) {
       const cv::Point2d b = base[static_cast<std::size_t>(i)] + tan_offsets[static_cast<std::size_t>(j)] * tangent;
       for (int k = 0; k < n_off; ++k) {
         const cv::Point2d p = b + normal_offsets[static_cast<std::size_t>(k)] * normal;
-        px[j * n_off + k] = static_cast<float>(p.x);
-        py[j * n_off + k] = static_cast<float>(p.y);
+        m[j * n_off + k] = {static_cast<float>(p.x), static_cast<float>(p.y)};
       }
     }
   }
-  cv::Mat sampled, out;
-  cv::remap(grey, sampled, mx, my, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-  sampled.convertTo(out, CV_MAKETYPE(CV_32F, grey.channels()));
+  cv::Mat out = view(out_buffers[image.channels() == 1 ? 0 : 1], n_pos, n_tan * n_off, image.type());
+  cv::remap(image, out, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   return out;
 }
 
@@ -132,10 +131,7 @@ std::vector<cv::Point2d> positions_along(cv::Point2d a, cv::Point2d b, int n, do
   return out;
 }
 
-/// Edge points near the side a → b of `image` (grey or BGR): at each position along it, the strongest change
-/// across the side within ±window px (colour: the length of the per-channel derivatives), located to sub-pixel
-/// precision (parabola through the peak of the smoothed derivative). Profiles are averaged over 5 samples along the
-/// side first, which lowers the noise without blurring across it.
+/// Edge points found across a side, and where along it they were looked for.
 struct EdgePoints {
   std::vector<cv::Point2f> pts;  ///< the edge points found
   std::vector<double> t;         ///< each point's position along a → b, [0, 1]
@@ -143,6 +139,12 @@ struct EdgePoints {
   std::vector<float> strength;   ///< each point's derivative across the side [grey levels / px]
 };
 
+/// Edge points near the side a → b of `image` (grey or BGR), at up to 64 positions spread over [t0, t1] of it: at
+/// each, the largest change across the side within ±window px (colour: the length of the vector of per-channel
+/// derivatives) or, with `nearest`, the one nearest the side among those at least 0.4 x the largest; located to
+/// sub-pixel precision (parabola through the peak). The profiles across the side are sampled every 0.5 px
+/// (cv::remap, bilinear), averaged over 5 samples along the side (less noise, no blur across it), smoothed across
+/// it (Gaussian, σ = smooth_px x unit) and differentiated ([-1 0 1]). `unit`: frame px per downscaled px.
 EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double window, double unit, double t0 = 0.05, double t1 = 0.95,
                        bool nearest = false, double smooth_px = 0.75) {
   const cv::Point2d d = b - a;
@@ -163,20 +165,21 @@ EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, doubl
   const int rows = static_cast<int>(base.size());
   const double sigma = smooth_px * std::max(1.0, unit) / kStep;  // in samples
   const int ks = 2 * static_cast<int>(std::ceil(3 * sigma)) + 1;
-  cv::Mat mag2(rows, n_off, CV_32F, cv::Scalar(0));
-  for (int c = 0; c < cn; ++c) {
-    cv::Mat prof(rows, n_off, CV_32F, cv::Scalar(0));
-    for (int i = 0; i < rows; ++i) {
-      const float* src = s.ptr<float>(i);
-      float* dst = prof.ptr<float>(i);
-      for (int j = 0; j < n_tan; ++j)
-        for (int k = 0; k < n_off; ++k) dst[k] += src[(j * n_off + k) * cn + c] / static_cast<float>(n_tan);
-    }
-    cv::GaussianBlur(prof, prof, cv::Size(ks, 1), sigma, 0, cv::BORDER_REPLICATE);
-    cv::Mat der;
-    cv::Sobel(prof, der, CV_32F, 1, 0, 1, 1.0 / (2 * kStep), 0, cv::BORDER_REPLICATE);  // grey levels per px
-    mag2 += der.mul(der);
+  // Profiles across the side, averaged along it, per channel; smoothed and differentiated across.
+  cv::Mat prof(rows, n_off, CV_MAKETYPE(CV_32F, cn), cv::Scalar::all(0));
+  for (int i = 0; i < rows; ++i) {
+    const uchar* src = s.ptr<uchar>(i);
+    float* dst = prof.ptr<float>(i);
+    for (int j = 0; j < n_tan; ++j)
+      for (int k = 0; k < n_off * cn; ++k) dst[k] += src[j * n_off * cn + k] / static_cast<float>(n_tan);
   }
+  cv::GaussianBlur(prof, prof, cv::Size(ks, 1), sigma, 0, cv::BORDER_REPLICATE);
+  cv::Mat d3;
+  cv::Sobel(prof, d3, CV_32F, 1, 0, 1, 1.0 / (2 * kStep), 0, cv::BORDER_REPLICATE);  // grey levels per px
+  const cv::Mat sq = d3.mul(d3);
+  cv::Mat mag2;
+  cv::reduce(sq.reshape(1, rows * n_off), mag2, 1, cv::REDUCE_SUM);  // sum over the channels
+  mag2 = mag2.reshape(1, rows);
   cv::Mat der;
   cv::sqrt(mag2, der);
   const int lo = half - static_cast<int>(std::floor(window / kStep)), hi = half + static_cast<int>(std::floor(window / kStep));
@@ -242,10 +245,11 @@ std::optional<Line> refine_side(const cv::Mat& image, cv::Point2d a, cv::Point2d
 }
 
 /// How well the stretch [t0, t1] of the side a → b of a found quadrilateral is backed by an edge: the share of
-/// positions along it whose strongest change across it (within a narrow window) lies within `inlier_px` of it and
-/// is at least 0.3 x `typical` (when given). `typical` returns the median strength of the changes found.
+/// positions along it where the change across it nearest the side (edge_points with `nearest`, within ±4 px)
+/// lies within 1.25 px of it and is at least 0.3 x `typical`. `typical`: when zero, set to the median strength of
+/// the changes found (so a weak page edge counts where it is as strong as elsewhere along the side).
 double side_support(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double unit, double t0, double t1, float* typical) {
-  const EdgePoints e = edge_points(image, a, b, 2.0 + unit, unit, t0, t1, false, 1.25);
+  const EdgePoints e = edge_points(image, a, b, 4.0 * std::max(1.0, unit), unit, t0, t1, true, 1.0);
   if (e.tried.size() < 4 || e.pts.empty()) return 0.0;
   float least = 0.0f;
   if (*typical > 0.0f) {
@@ -260,13 +264,6 @@ double side_support(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double u
   const double inlier_px = std::max(1.25, 0.75 * unit);
   int hits = 0;
   for (std::size_t i = 0; i < e.pts.size(); ++i) hits += distance(l, e.pts[i]) <= inlier_px && e.strength[i] >= least;
-#ifdef HK_PAGE_DEBUG
-  if (std::getenv("HK_PAGE_DUMP")) {
-    fprintf(stderr, "    support (%.0f,%.0f)-(%.0f,%.0f) typical %.1f tried %zu found %zu:", a.x, a.y, b.x, b.y, *typical, e.tried.size(), e.pts.size());
-    for (std::size_t i = 0; i < e.pts.size(); ++i) fprintf(stderr, " %.1f/%.0f", cross(l.d, cv::Point2d(e.pts[i]) - l.p), e.strength[i]);
-    fprintf(stderr, "\n");
-  }
-#endif
   return static_cast<double>(hits) / e.tried.size();
 }
 
@@ -319,7 +316,7 @@ SideContrast border_contrast(const cv::Mat& image, const Segments& sides, const 
       for (int c = 0; c < cn; ++c) {
         double out_sum = 0.0, in_sum = 0.0;
         for (int i = 0; i < v.rows; ++i) {
-          const float* r = v.ptr<float>(i);
+          const uchar* r = v.ptr<uchar>(i);
           for (int k = 0; k < kDepths; ++k) out_sum += r[k * cn + c], in_sum += r[(kDepths + k) * cn + c];
         }
         const double diff = (out_sum - in_sum) / (v.rows * kDepths);
@@ -470,7 +467,6 @@ std::vector<SegmentLine> group_segments(std::vector<std::pair<cv::Point2d, cv::P
       const cv::Point2d p = a + (static_cast<double>(i) / steps) * (b - a);
       members[k].emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
     }
-    l.spans.emplace_back(cv::norm(a), cv::norm(b));  // placeholder, recomputed below
     const Line fitted = fit(members[k], cv::DIST_L2);
     l.n = {-fitted.d.y, fitted.d.x};
     if (l.n.y < 0 || (l.n.y == 0 && l.n.x < 0)) l.n = -l.n;
@@ -497,19 +493,17 @@ std::vector<SegmentLine> group_segments(std::vector<std::pair<cv::Point2d, cv::P
   return lines;
 }
 
-/// Quadrilaterals bounded by four of the longest straight lines (or the frame's own edges, for a page cut off by
-/// them): two roughly parallel pairs (within 35°) crossing at more than 45°, every side not on the frame's edge
-/// covered at least 40 % by edge segments. This finds a page whose outline no single edge map closes: broken by
-/// weak stretches, or tied to a textured background.
+/// Quadrilaterals bounded by four of the 24 longest straight lines (or by up to two of the frame's own edges, for a
+/// page cut off by them): two roughly parallel pairs (within 35°) crossing at more than 45°, every side not on the
+/// frame's edge covered at least 20 % by edge segments, corners at most a quarter of the frame's size outside it (a
+/// page cut off at a corner). This finds a page whose outline no single edge map closes: broken by weak stretches,
+/// or tied to a textured background.
 void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& segs, cv::Size size, double min_area, std::vector<Candidate>& out) {
   const double shorter = std::min(size.width, size.height);
   std::vector<SegmentLine> lines = group_segments(segs, std::max(2.5, 0.006 * shorter));
   std::sort(lines.begin(), lines.end(), [](const SegmentLine& a, const SegmentLine& b) { return a.covered > b.covered; });
   lines.erase(std::remove_if(lines.begin(), lines.end(), [&](const SegmentLine& l) { return l.covered < 0.1 * shorter; }), lines.end());
-  if (lines.size() > 16) lines.resize(16);
-#ifdef HK_PAGE_DEBUG
-  for (const SegmentLine& l : lines) fprintf(stderr, "line n (%.3f %.3f) rho %.1f covered %.1f spans %zu\n", l.n.x, l.n.y, l.rho, l.covered, l.spans.size());
-#endif
+  if (lines.size() > 24) lines.resize(24);
   const double w = size.width - 1.0, h = size.height - 1.0;
   const std::array<std::pair<cv::Point2d, double>, 4> frame{{{{0, 1}, 0.0}, {{1, 0}, w}, {{0, 1}, h}, {{1, 0}, 0.0}}};
   for (int e = 0; e < 4; ++e) {
@@ -549,25 +543,22 @@ void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& se
         if (sl.frame_edge >= 0) continue;
         const cv::Point2d t(-sl.n.y, sl.n.x);
         const double t0 = std::min(t.dot(q[s]), t.dot(q[(s + 1) % 4])), t1 = std::max(t.dot(q[s]), t.dot(q[(s + 1) % 4]));
-        ok = t1 - t0 > 1.0 && covered_length(sl.spans, t0, t1) >= 0.3 * (t1 - t0);
+        ok = t1 - t0 > 1.0 && covered_length(sl.spans, t0, t1) >= 0.2 * (t1 - t0);
       }
       if (ok) add_quad(q, min_area, size, out);
     }
   }
 }
 
-/// Candidates from several edge maps of the downscaled frame (after OpenCV's squares.cpp sample), each map giving
-/// quadrilaterals two ways (quads_from_map on the dilated map; quads_from_lines on its long straight stretches,
-/// cv::HoughLinesP): Canny edges (of the colour image where there is one: the largest gradient of the three
-/// channels) at three thresholds and three blurs; the strong blurs (σ 3 and 5 px of the downscaled frame, taken on
-/// a half-size copy) wash out the fine texture of a table or cloth, which would otherwise tie the page's outline to
-/// the background. Also Otsu thresholds of the grey and of each colour channel, both polarities, opened to cut
-/// thin links. Sorted by area, largest first, near-duplicates dropped.
-std::vector<Candidate> candidates(const cv::Mat& small, double min_area) {
+/// Candidates (in downscaled px) from six edge maps of the half-size copy (after OpenCV's squares.cpp sample):
+/// Canny edges (of the colour image where there is one: the largest gradient of its channels) at three thresholds
+/// after two blurs (σ 1.5 and 2.5 px of the half-size copy, 3 and 5 of the downscaled frame: they wash out the fine
+/// texture of a table or cloth, which would otherwise tie the page's outline to the background). Each map gives
+/// quadrilaterals two ways: quads_from_map on the dilated map, and quads_from_lines on the long straight stretches of
+/// all the maps together (cv::HoughLinesP). Sorted by area, largest first, near-duplicates dropped.
+std::vector<Candidate> candidates(const cv::Mat& small, const cv::Mat& half, double min_area) {
   std::vector<Candidate> out;
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
-  cv::Mat half;
-  cv::pyrDown(small, half);
   const double to_small_x = static_cast<double>(small.cols) / half.cols, to_small_y = static_cast<double>(small.rows) / half.rows;
   const double half_area = min_area / (to_small_x * to_small_y);
   std::vector<std::pair<cv::Point2d, cv::Point2d>> segments;  // in downscaled-frame px
@@ -579,7 +570,7 @@ std::vector<Candidate> candidates(const cv::Mat& small, double min_area) {
       cv::Canny(blurred, edges, hi / 2, hi);
       std::vector<cv::Vec4i> segs;
       const double shorter = std::min(edges.cols, edges.rows);
-      cv::HoughLinesP(edges, segs, 1, CV_PI / 360, static_cast<int>(0.05 * shorter), 0.06 * shorter, 0.015 * shorter);
+      cv::HoughLinesP(edges, segs, 1, CV_PI / 180, static_cast<int>(0.05 * shorter), 0.06 * shorter, 0.015 * shorter);
       for (const cv::Vec4i& sg : segs)
         segments.emplace_back(cv::Point2d((sg[0] + 0.5) * to_small_x - 0.5, (sg[1] + 0.5) * to_small_y - 0.5),
                               cv::Point2d((sg[2] + 0.5) * to_small_x - 0.5, (sg[3] + 0.5) * to_small_y - 0.5));
@@ -621,36 +612,39 @@ Line frame_line(int e, cv::Size size) {
   }
 }
 
-/// The gradient of the downscaled frame (blurred, σ 1.5 px), per pixel that of the colour channel where it is
-/// largest: CV_32FC2 (d/dx, d/dy), Sobel 3 x 3 (about 8 x grey levels per px).
-cv::Mat strongest_gradient(const cv::Mat& small) {
-  cv::Mat blurred, gx, gy;
-  cv::GaussianBlur(small, blurred, cv::Size(0, 0), 1.5);
-  cv::Sobel(blurred, gx, CV_32F, 1, 0, 3);
-  cv::Sobel(blurred, gy, CV_32F, 0, 1, 3);
-  const int cn = small.channels();
-  cv::Mat g(small.size(), CV_32FC2);
-  for (int y = 0; y < small.rows; ++y) {
-    const float* px = gx.ptr<float>(y);
-    const float* py = gy.ptr<float>(y);
-    cv::Vec2f* out = g.ptr<cv::Vec2f>(y);
-    for (int x = 0; x < small.cols; ++x) {
-      int best = 0;
-      float best_m = -1.0f;
-      for (int c = 0; c < cn; ++c) {
-        const float m = px[x * cn + c] * px[x * cn + c] + py[x * cn + c] * py[x * cn + c];
-        if (m > best_m) best_m = m, best = c;
-      }
-      out[x] = {px[x * cn + best], py[x * cn + best]};
+/// The gradient of the half-size copy of the downscaled frame (blurred, σ 1 px): Sobel 3 x 3 d/dx and d/dy (about
+/// 8 x grey levels per px), CV_16S with one channel per colour channel.
+struct Gradient {
+  cv::Mat gx, gy;
+  double to_half_x = 0.5, to_half_y = 0.5;  ///< half-size px per downscaled px
+  /// At pixel (x, y) of the half-size copy, the gradient of the channel where it is largest.
+  cv::Point2d at(int x, int y) const {
+    const short* px = gx.ptr<short>(y) + static_cast<std::ptrdiff_t>(x) * gx.channels();
+    const short* py = gy.ptr<short>(y) + static_cast<std::ptrdiff_t>(x) * gy.channels();
+    int best = 0, best_m = -1;
+    for (int c = 0; c < gx.channels(); ++c) {
+      const int m = px[c] * px[c] + py[c] * py[c];
+      if (m > best_m) best_m = m, best = c;
     }
+    return {static_cast<double>(px[best]), static_cast<double>(py[best])};
   }
+};
+
+Gradient gradient_of(const cv::Mat& half, cv::Size small) {
+  cv::Mat blurred;
+  cv::GaussianBlur(half, blurred, cv::Size(0, 0), 1.0);
+  Gradient g;
+  cv::Sobel(blurred, g.gx, CV_16S, 1, 0, 3);
+  cv::Sobel(blurred, g.gy, CV_16S, 0, 1, 3);
+  g.to_half_x = static_cast<double>(half.cols) / small.width;
+  g.to_half_y = static_cast<double>(half.rows) / small.height;
   return g;
 }
 
-/// A quick check of a candidate on the downscaled frame: the least, over its sides not on the frame's edge, share
-/// of points along the side with a gradient across it (within 1.5 px of the side, at least `min_grad`, pointing
-/// within ~37° of the side's normal).
-double quick_support(const cv::Mat& grad, const Candidate& c, double min_grad) {
+/// A quick check of a candidate (in downscaled px) on the half-size copy: the least, over its sides not on the
+/// frame's edge, share of points along the side with a gradient across it (within 1.5 px + 1 % of the side's length
+/// of it, at least `min_grad`, pointing within ~37° of the side's normal).
+double quick_support(const Gradient& grad, const Candidate& c, double min_grad) {
   double least = 1.0;
   for (std::size_t s = 0; s < 4; ++s) {
     if (c.frame_edge[s] >= 0) continue;
@@ -664,13 +658,14 @@ double quick_support(const cv::Mat& grad, const Candidate& c, double min_grad) {
       const cv::Point2d p = a + (0.05 + 0.9 * (i + 0.5) / count) * (b - a);
       bool hit = false, inside = false;
       const double reach = 1.5 + 0.01 * len;
-      for (double o = -reach; o <= reach; o += 0.75) {
+      for (double o = -reach; o <= reach; o += 1.0) {
         const cv::Point2d q = p + o * n;
-        const int x = static_cast<int>(std::lround(q.x)), y = static_cast<int>(std::lround(q.y));
-        if (x < 0 || y < 0 || x >= grad.cols || y >= grad.rows) continue;
+        const int x = static_cast<int>(std::lround((q.x + 0.5) * grad.to_half_x - 0.5));
+        const int y = static_cast<int>(std::lround((q.y + 0.5) * grad.to_half_y - 0.5));
+        if (x < 0 || y < 0 || x >= grad.gx.cols || y >= grad.gx.rows) continue;
         inside = true;
-        const cv::Vec2f g = grad.at<cv::Vec2f>(y, x);
-        const double across = std::abs(g[0] * n.x + g[1] * n.y), along = std::abs(g[0] * t.x + g[1] * t.y);
+        const cv::Point2d g = grad.at(x, y);
+        const double across = std::abs(g.dot(n)), along = std::abs(g.dot(t));
         if (across >= min_grad && across >= 1.33 * along) hit = true;
       }
       tried += inside ? 1 : 0;
@@ -699,12 +694,6 @@ struct Frame {
   double area;        ///< [px²]
 };
 
-#ifdef HK_PAGE_DEBUG
-#define REJECT(n) do { fprintf(stderr, "  reject %d (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f)\n", n, c.q[0].x, c.q[0].y, c.q[1].x, c.q[1].y, c.q[2].x, c.q[2].y, c.q[3].x, c.q[3].y); return std::nullopt; } while (0)
-#else
-#define REJECT(n) return std::nullopt
-#endif
-
 /// A candidate that passed: the page it would be, and the colour contrast across each of its sides (in the order of
 /// det.corners_px: side s runs from corner s to corner s + 1; negative on the frame's edge).
 struct Found {
@@ -712,8 +701,27 @@ struct Found {
   std::array<std::vector<double>, 4> side_contrast;  ///< per side, per stretch (empty on the frame's edge)
 };
 
-/// Refines a candidate at full resolution and checks it (see find_page); the page when it passes.
-std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams& params) {
+/// Sides already refined (candidates share sides: the same page outline is found in several edge maps).
+struct RefinedSide {
+  cv::Point2d a, b;          ///< the candidate's side
+  std::optional<Line> line;  ///< the refined line, empty when it failed
+};
+
+/// Quadrilaterals already checked, after refinement.
+struct Memo {
+  std::vector<RefinedSide> sides;
+  std::vector<Quad> quads;
+};
+
+/// Refines a candidate at full resolution and checks it; the page when it passes. Each side off the frame's edge is
+/// refined (refine_side) and must be an edge over most of the candidate's side; the corners are where the refined
+/// lines meet, at most a quarter of the frame's size outside it; the part inside the frame covers at least
+/// min_area_fraction; the quadrilateral is convex; every side off the frame's edge is backed by an edge over 60 %
+/// of its visible length and, where it meets the frame's edge, over 50 % of its last 10 % (or 15 px); the mean
+/// grey contrast across the sides is at least min_contrast and each side's median colour contrast (bands 3 to 11 px
+/// deep, deeper than the grain of a table) at least 1.5 x min_contrast, including at its end on the frame's edge
+/// (at least 0.35 x its median there).
+std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams& params, Memo& memo) {
   const cv::Mat& frame = f.image;
   const double unit = f.unit;
   Quad full;
@@ -725,36 +733,51 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
       continue;
     }
     const cv::Point2d a = full[s], b = full[(s + 1) % 4];
-    const double window = std::max(4.0 * unit + 2.0, 0.04 * cv::norm(b - a));
-    const std::optional<Line> l = refine_side(frame, a, b, window, unit);
-    if (!l) REJECT(1);
-    // Early out: the refined line, over the candidate's side, must be mostly an edge.
-    const cv::Point2d pa = l->p + (a - l->p).dot(l->d) * l->d, pb = l->p + (b - l->p).dot(l->d) * l->d;
-    float typical = 0.0f;
-#ifdef HK_PAGE_DEBUG
-    fprintf(stderr, "   side %zu refined (%.1f,%.1f)-(%.1f,%.1f) early support %.2f\n", s, pa.x, pa.y, pb.x, pb.y, side_support(frame, pa, pb, unit, 0.1, 0.9, &typical));
-    typical = 0.0f;
-#endif
-    if (side_support(frame, pa, pb, unit, 0.1, 0.9, &typical) < 0.5) REJECT(2);
+    const double same = 2.0 * unit;
+    auto known = std::find_if(memo.sides.begin(), memo.sides.end(), [&](const RefinedSide& r) {
+      return (cv::norm(r.a - a) <= same && cv::norm(r.b - b) <= same) || (cv::norm(r.a - b) <= same && cv::norm(r.b - a) <= same);
+    });
+    if (known == memo.sides.end()) {
+      const double window = std::max(4.0 * unit + 2.0, 0.04 * cv::norm(b - a));
+      std::optional<Line> l = refine_side(frame, a, b, window, unit);
+      // Early out: the refined line, over the candidate's side, must be mostly an edge.
+      if (l) {
+        const cv::Point2d pa = l->p + (a - l->p).dot(l->d) * l->d, pb = l->p + (b - l->p).dot(l->d) * l->d;
+        float typical = 0.0f;
+        if (side_support(frame, pa, pb, unit, 0.1, 0.9, &typical) < 0.5) l.reset();
+      }
+      memo.sides.push_back({a, b, l});
+      known = memo.sides.end() - 1;
+    }
+    if (!known->line) return std::nullopt;
+    std::optional<Line> l = known->line;
+    if (l->d.dot(b - a) < 0) l->d = -l->d;
     lines[s] = *l;
   }
   Quad q;
   for (std::size_t i = 0; i < 4; ++i) {
     const auto p = intersect(lines[(i + 3) % 4], lines[i]);
-    if (!p || !finite(*p)) REJECT(3);
+    if (!p || !finite(*p)) return std::nullopt;
     q[i] = *p;
   }
+  if (std::any_of(memo.quads.begin(), memo.quads.end(), [&](const Quad& seen) {
+        return std::all_of(q.begin(), q.end(), [&](cv::Point2d p) {
+          return std::any_of(seen.begin(), seen.end(), [&](cv::Point2d r) { return cv::norm(p - r) <= unit; });
+        });
+      }))
+    return std::nullopt;  // checked already
+  memo.quads.push_back(q);
   // Corners inside the frame or, for a page cut off at a corner, not far beyond it.
   const double beyond = 0.25 * std::max(frame.cols, frame.rows);
   if (!std::all_of(q.begin(), q.end(), [&](cv::Point2d p) {
         return p.x >= -beyond && p.y >= -beyond && p.x <= frame.cols - 1 + beyond && p.y <= frame.rows - 1 + beyond;
       }))
-    REJECT(4);
+    return std::nullopt;
   const double area = visible_area(q, frame.size());
-  if (signed_area(q) <= 0.0 || area / f.area < params.min_area_fraction) REJECT(5);
+  if (signed_area(q) <= 0.0 || area / f.area < params.min_area_fraction) return std::nullopt;
   std::vector<cv::Point2f> poly;
   for (const cv::Point2d& p : q) poly.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
-  if (!cv::isContourConvex(poly)) REJECT(6);
+  if (!cv::isContourConvex(poly)) return std::nullopt;
   std::array<bool, 4> on_frame{};
   for (std::size_t s = 0; s < 4; ++s) on_frame[s] = c.frame_edge[s] >= 0;
   // The visible part of each side, and whether it ends at the frame's edge (at a side on the frame's edge, or
@@ -766,7 +789,7 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
     visible[s] = {a, b};
     if (on_frame[s]) continue;
     const auto t = clip_segment(a, b, frame.size(), 0.0);
-    if (!t || (t->second - t->first) * cv::norm(b - a) < 0.03 * std::hypot(frame.cols, frame.rows)) REJECT(14);
+    if (!t || (t->second - t->first) * cv::norm(b - a) < 0.03 * std::hypot(frame.cols, frame.rows)) return std::nullopt;
     visible[s] = {a + t->first * (b - a), a + t->second * (b - a)};
     ends_at_frame[s] = {on_frame[(s + 3) % 4] || t->first > 0.0, on_frame[(s + 1) % 4] || t->second < 1.0};
   }
@@ -777,24 +800,29 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
     const auto [a, b] = visible[s];
     if (on_frame[s]) continue;
     float typical = 0.0f;
-    if (side_support(frame, a, b, unit, 0.05, 0.95, &typical) < 0.6) REJECT(8);
+    if (side_support(frame, a, b, unit, 0.05, 0.95, &typical) < 0.6) return std::nullopt;
     const double len = cv::norm(b - a), stretch = std::max(0.1, 15.0 * unit / len), tip = std::min(0.02, 3.0 / len);
-    if (ends_at_frame[s].first && side_support(frame, a, b, unit, tip, stretch, &typical) < 0.5) REJECT(9);
-    if (ends_at_frame[s].second && side_support(frame, a, b, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5) REJECT(10);
+    if (ends_at_frame[s].first && side_support(frame, a, b, unit, tip, stretch, &typical) < 0.5) return std::nullopt;
+    if (ends_at_frame[s].second && side_support(frame, a, b, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5) return std::nullopt;
   }
   const double contrast = border_contrast(f.grey, visible, on_frame, 1.5 + 1.5 * unit, 3.0 * unit).mean();
-  if (contrast < params.min_contrast) REJECT(11);
-  const SideContrast colour = border_contrast(frame, visible, on_frame, 1.5 + 1.5 * unit, 3.0 * unit);
+  if (contrast < params.min_contrast) return std::nullopt;
+  const SideContrast colour = border_contrast(frame, visible, on_frame, 1.5 + 1.5 * unit, 8.0 * unit);
   // A side that meets the frame's edge is set off from the background there as it is elsewhere: where it runs on
   // past the page's corner along a grain of the background, the stretch at the frame has no step across it.
+  // And every side is set off from its surroundings along most of its length (median stretch at least 1.5 x
+  // min_contrast): a grain line of a table or a fold of a cloth has the same stuff on both sides.
   for (std::size_t s = 0; s < 4; ++s) {
     const std::vector<double>& v = colour.stretches[s];
-    if (on_frame[s] || v.size() < 4) continue;
+    if (on_frame[s]) continue;
+    if (v.size() < 2) return std::nullopt;
     std::vector<double> sorted = v;
     std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
     const double median = sorted[sorted.size() / 2];
-    if (ends_at_frame[s].first && v.front() < 0.35 * median) REJECT(12);
-    if (ends_at_frame[s].second && v.back() < 0.35 * median) REJECT(13);
+    if (median < 1.5 * params.min_contrast) return std::nullopt;
+    if (v.size() < 4) continue;
+    if (ends_at_frame[s].first && v.front() < 0.35 * median) return std::nullopt;
+    if (ends_at_frame[s].second && v.back() < 0.35 * median) return std::nullopt;
   }
 
   Found out;
@@ -829,14 +857,36 @@ bool shares_side(const Quad& a, const Quad& b, std::size_t s, double tol) {
   return false;
 }
 
-/// The page among the quadrilaterals that passed: the largest, unless a smaller one shares some of its sides while
-/// the larger's other sides are weak — their lower quartile of stretch contrasts under half that of the shared
-/// sides, and under 1 / 1.5 of the smaller's other sides: the larger then runs past the page's corners to a line in
-/// the background (a wood grain, a fold in a cloth). A smaller one sharing no side, or the larger's other sides
-/// being as strong as the shared ones, is something inside the page: a picture on it, a line in the picture. And a
-/// larger one whose other sides are all on the frame's edge loses to a smaller one whose other sides lie just inside
-/// it (within `tol`): the page's own side, not cut off, near the frame's edge.
-PageDetection choose(std::vector<Found> found, cv::Size frame, double tol) {
+/// Mean colour of a band along the side a → b (positions 10 % to 90 % along it), from `gap` to `gap` + `depth` px
+/// off it, outward (corners clockwise on screen) or inward.
+cv::Scalar band_mean(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double gap, double depth, bool outward) {
+  const double len = cv::norm(b - a);
+  const cv::Point2d t = (b - a) / len, n = (outward ? 1.0 : -1.0) * cv::Point2d(t.y, -t.x);
+  std::vector<cv::Point2d> base;
+  for (int i = 0; i < 16; ++i) {
+    const cv::Point2d p = a + (0.1 + 0.8 * i / 15.0) * (b - a);
+    const cv::Point2d far = p + (gap + depth) * n;
+    if (p.x >= 0 && p.y >= 0 && p.x <= image.cols - 1 && p.y <= image.rows - 1 && far.x >= 0 && far.y >= 0 && far.x <= image.cols - 1 &&
+        far.y <= image.rows - 1)
+      base.push_back(p);
+  }
+  if (base.empty()) return cv::Scalar::all(-1);
+  return cv::mean(sample_across(image, base, t, n, {0.0}, {gap, gap + depth / 3, gap + 2 * depth / 3, gap + depth}));
+}
+
+double colour_distance(const cv::Scalar& a, const cv::Scalar& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+/// The page among the quadrilaterals that passed: the largest, unless a smaller one shares some of its sides and
+/// the larger runs past it over the background: the larger's other sides are weak (their lower quartile of stretch
+/// contrasts under half that of the shared sides), the smaller's other sides at least twice as strong, and the
+/// strip between them looks like the background outside the smaller's shared sides more than like the inside of
+/// the smaller (a grain line of the table beyond the page's edge, not a line in the picture on it). A smaller one
+/// sharing no side lies inside the page: a picture on it. And a larger one whose other sides are all on the frame's
+/// edge loses to a smaller one whose other sides lie just inside it (within `tol`): the page's own side, not cut
+/// off, near the frame's edge. Bands for the colours: `gap` to `gap` + `depth` px off a side.
+PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap, double depth, double tol) {
   std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.det.area_fraction > b.det.area_fraction; });
   // Lower quartile of the stretch contrasts of x's sides that are (shared = true) or are not sides of y.
   const auto lower_quartile = [&](const Found& x, const Found& y, bool shared) {
@@ -848,6 +898,28 @@ PageDetection choose(std::vector<Found> found, cv::Size frame, double tol) {
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 4), v.end());
     return v[v.size() / 4];
   };
+  // Whether the strip between the smaller y's own sides and the larger looks like the background round y.
+  const auto strip_is_background = [&](const Found& y, const Found& x) {
+    cv::Scalar strip, inside, background;
+    int n_strip = 0, n_background = 0;
+    for (std::size_t s = 0; s < 4; ++s) {
+      const cv::Point2d a = y.det.corners_px[s], b = y.det.corners_px[(s + 1) % 4];
+      const cv::Scalar out = band_mean(image, a, b, gap, depth, true);
+      if (out[0] < 0) continue;
+      if (shares_side(x.det.corners_px, y.det.corners_px, s, tol)) {
+        background += out;
+        ++n_background;
+      } else {
+        const cv::Scalar in = band_mean(image, a, b, gap, depth, false);
+        if (in[0] < 0) continue;
+        strip += out;
+        inside += in;
+        ++n_strip;
+      }
+    }
+    if (n_strip == 0 || n_background == 0) return false;
+    return colour_distance(strip / n_strip, background / n_background) < colour_distance(strip / n_strip, inside / n_strip);
+  };
   for (std::size_t i = 0; i < found.size(); ++i) {
     bool beaten = false;
     for (std::size_t j = i + 1; j < found.size() && !beaten; ++j) {
@@ -856,14 +928,14 @@ PageDetection choose(std::vector<Found> found, cv::Size frame, double tol) {
       if (shared == 0 || shared == 4) continue;
       const double own = lower_quartile(found[i], found[j], false), common = lower_quartile(found[i], found[j], true);
       const double other = lower_quartile(found[j], found[i], false);
-      beaten = own >= 0 && own < 0.5 * common && other > 1.5 * own;
+      beaten = own >= 0 && own < 0.5 * common && other >= 2.0 * own && strip_is_background(found[j], found[i]);
       // The larger's other sides all on the frame's edge, the smaller's just inside it: the page's own side, seen.
       bool frame_only = true, near_frame = true;
       for (std::size_t s = 0; s < 4; ++s) {
         if (!shares_side(found[j].det.corners_px, found[i].det.corners_px, s, tol)) frame_only = frame_only && found[i].side_contrast[s].empty();
         if (!shares_side(found[i].det.corners_px, found[j].det.corners_px, s, tol)) {
           const cv::Point2d a = found[j].det.corners_px[s], b = found[j].det.corners_px[(s + 1) % 4];
-          near_frame = near_frame && frame_edge_of(a + cv::Point2d(0.5, 0.5), b + cv::Point2d(0.5, 0.5), frame + cv::Size(1, 1), tol) >= 0;
+          near_frame = near_frame && frame_edge_of(a + cv::Point2d(0.5, 0.5), b + cv::Point2d(0.5, 0.5), image.size() + cv::Size(1, 1), tol) >= 0;
         }
       }
       beaten = beaten || (frame_only && near_frame);
@@ -893,17 +965,13 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
   f.sx = static_cast<double>(frame.cols) / small.cols;
   f.sy = static_cast<double>(frame.rows) / small.rows;
   f.unit = std::max(f.sx, f.sy);
-#ifdef HK_PAGE_DEBUG
-  const auto t0 = std::chrono::steady_clock::now();
-#endif
-  const std::vector<Candidate> cands = candidates(small, 0.8 * params.min_area_fraction * small.cols * small.rows);
-#ifdef HK_PAGE_DEBUG
-  const auto t1 = std::chrono::steady_clock::now();
-#endif
+  cv::Mat half;
+  cv::pyrDown(small, half);
+  const std::vector<Candidate> cands = candidates(small, half, 0.8 * params.min_area_fraction * small.cols * small.rows);
 
-  // Look first at the candidates whose sides are best backed by edges; merge those that differ by less than
-  // 1 % of the frame's diagonal.
-  const cv::Mat grad = strongest_gradient(small);
+  // Score each candidate by how well its sides are backed by edges; merge those that differ by less than 1 % of
+  // the frame's diagonal.
+  const Gradient grad = gradient_of(half, small.size());
   std::vector<std::pair<double, Candidate>> ranked;
   const double same = 0.01 * std::hypot(small.cols, small.rows);
   for (const Candidate& c : cands) {
@@ -912,9 +980,6 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
     const auto on_frame = std::count_if(c.frame_edge.begin(), c.frame_edge.end(), [](int e) { return e >= 0; });
     if (on_frame > 2) continue;
     const double score = quick_support(grad, c, 24.0) - 0.15 * static_cast<double>(on_frame);
-#ifdef HK_PAGE_DEBUG
-    fprintf(stderr, "quick %.2f area %.0f q (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f) (%.0f,%.0f)\n", score, c.area, c.q[0].x, c.q[0].y, c.q[1].x, c.q[1].y, c.q[2].x, c.q[2].y, c.q[3].x, c.q[3].y);
-#endif
     if (score < 0.3 - 0.15 * static_cast<double>(on_frame)) continue;
     auto twin = std::find_if(ranked.begin(), ranked.end(), [&](const auto& r) {
       for (std::size_t i = 0; i < 4; ++i)
@@ -924,18 +989,24 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
     if (twin == ranked.end()) ranked.emplace_back(score, c);
     else if (score > twin->first) *twin = {score, c};
   }
+  // Verified: the best-backed candidates, then the largest of the well-backed (score >= 0.75) ones not yet looked at
+  // (the page is the largest quadrilateral; the lines of a printed grid or a window in a photograph make many
+  // smaller, equally well-backed ones inside it).
   std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  constexpr std::size_t kMaxVerified = 16;
+  constexpr std::size_t kBestBacked = 10, kLargest = 10;
+  std::vector<const Candidate*> order;
+  for (std::size_t i = 0; i < std::min(ranked.size(), kBestBacked); ++i) order.push_back(&ranked[i].second);
+  std::vector<const Candidate*> rest;
+  for (std::size_t i = kBestBacked; i < ranked.size(); ++i)
+    if (ranked[i].first >= 0.75) rest.push_back(&ranked[i].second);
+  std::stable_sort(rest.begin(), rest.end(), [](const Candidate* a, const Candidate* b) { return a->area > b->area; });
+  for (std::size_t i = 0; i < std::min(rest.size(), kLargest); ++i) order.push_back(rest[i]);
   std::vector<Found> found;
-  for (std::size_t i = 0; i < std::min(ranked.size(), kMaxVerified); ++i) {
-    if (std::optional<Found> d = verify(f, ranked[i].second, params)) found.push_back(*d);
+  Memo memo;
+  for (const Candidate* c : order) {
+    if (std::optional<Found> d = verify(f, *c, params, memo)) found.push_back(*d);
   }
-  const PageDetection best = choose(found, frame.size(), f.touch_tol + 1.0);
-#ifdef HK_PAGE_DEBUG
-  const auto t2 = std::chrono::steady_clock::now();
-  fprintf(stderr, "TIME cands %zu ranked %zu candidates %.1f ms verify %.1f ms\n", cands.size(), ranked.size(), std::chrono::duration<double, std::milli>(t1 - t0).count(), std::chrono::duration<double, std::milli>(t2 - t1).count());
-#endif
-  return best;
+  return choose(found, frame, 1.5 + 1.5 * f.unit, 8.0 * f.unit, f.touch_tol + 1.0);
 }
 
 double page_aspect_ratio(const std::array<cv::Point2d, 4>& corners_px, cv::Point2d centre_px) {
