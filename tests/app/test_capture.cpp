@@ -226,6 +226,16 @@ TEST(Capture, ExploreFromASourceBuildsTheSceneOfTheRectifiedPage) {
   EXPECT_TRUE(fs::exists(dir / "out" / "trace.csv"));
 }
 
+/// A runtime with no sound card, no USB watch and no USB pantograph, on the test pictures.
+RuntimeOptions headless_options() {
+  RuntimeOptions ro;
+  ro.library = std::string(HK_TEST_DATA_DIR) + "/images";
+  ro.hotplug = false;
+  ro.open_audio_output = false;
+  ro.probe_usb_device = false;
+  return ro;
+}
+
 /// Waits (bounded) for the runtime's capture to end, polling its news into the flow as the window does.
 void poll_until_done(KioskRuntime& rt, KioskFlow& flow) {
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
@@ -242,12 +252,7 @@ TEST(CaptureRuntime, TheKioskCapturesFromItsCameraAndPutsThePictureOnTheDevice) 
   write_frames(dir / "frames", {frame_with_card(bg, c, 520, kH / 2), frame_with_card(bg, c, kW / 2, kH / 2)});
   config::Settings s;
   s.camera.source = "file:" + (dir / "frames").string();
-  RuntimeOptions ro;
-  ro.library = std::string(HK_TEST_DATA_DIR) + "/images";
-  ro.hotplug = false;
-  ro.open_audio_output = false;
-  ro.probe_usb_device = false;
-  KioskRuntime rt(ro, s);
+  KioskRuntime rt(headless_options(), s);
   ASSERT_TRUE(rt.has_camera());
   KioskFlowParams fp;
   fp.camera = rt.has_camera();
@@ -271,12 +276,7 @@ TEST(CaptureRuntime, TheKioskCapturesFromItsCameraAndPutsThePictureOnTheDevice) 
 
 TEST(CaptureRuntime, ScriptedRunsLookForNoCameraAndSayNothingOfIt) {
   config::Settings s;  // [camera] source = "auto"
-  RuntimeOptions ro;
-  ro.library = std::string(HK_TEST_DATA_DIR) + "/images";
-  ro.hotplug = false;
-  ro.open_audio_output = false;
-  ro.probe_usb_device = false;
-  KioskRuntime rt(ro, s);
+  KioskRuntime rt(headless_options(), s);
   EXPECT_FALSE(rt.has_camera());
   rt.announce_camera();
   EXPECT_EQ(rt.last_said(), "");
