@@ -10,6 +10,8 @@ packages=(
   libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri xvfb xauth
   libpoppler-cpp-dev libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev
   poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools
+  dpkg-dev file lintian systemd cage
+  clang libclang-rt-14-dev llvm-14
 )
 missing=()
 for p in "${packages[@]}"; do

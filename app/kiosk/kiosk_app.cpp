@@ -27,6 +27,7 @@
 #include "script.hpp"
 #include "view.hpp"
 #include "window.hpp"
+#include "app_error.hpp"
 
 #ifndef HK_DATA_DIR
 #define HK_DATA_DIR "data"
@@ -67,10 +68,10 @@ StartSettings start_settings(const std::string& path) {
 void check_screenshot_options(const KioskOptions& o) {
   if (o.screenshot.empty()) return;
   const std::filesystem::path p(o.screenshot);
-  if (p.extension() != ".png") throw std::runtime_error("--screenshot '" + o.screenshot + "': must name a .png file");
+  if (p.extension() != ".png") throw AppError("--screenshot '" + o.screenshot + "': must name a .png file");
   const auto parent = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
-  if (!std::filesystem::is_directory(parent)) throw std::runtime_error("--screenshot '" + o.screenshot + "': folder '" + parent.string() + "' does not exist");
-  if (o.frames < 1 || o.frames > 100000) throw std::runtime_error("--frames " + std::to_string(o.frames) + " is outside [1, 100000]");
+  if (!std::filesystem::is_directory(parent)) throw AppError("--screenshot '" + o.screenshot + "': folder '" + parent.string() + "' does not exist");
+  if (o.frames < 1 || o.frames > 100000) throw AppError("--frames " + std::to_string(o.frames) + " is outside [1, 100000]");
 }
 
 /// Input routing and the frame loop's state: what a key does depends on who has the keyboard.
@@ -275,7 +276,7 @@ int run_kiosk(const KioskOptions& o) {
     window.end_frame();
     if (!holding) ++frame;
     if (scripted && frame >= o.frames) {
-      if (!cv::imwrite(o.screenshot, window.read_pixels())) throw std::runtime_error("--screenshot '" + o.screenshot + "': cannot write the PNG");
+      if (!cv::imwrite(o.screenshot, window.read_pixels())) throw AppError("--screenshot '" + o.screenshot + "': cannot write the PNG");
       break;
     }
     window.swap();

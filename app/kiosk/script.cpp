@@ -9,6 +9,7 @@
 
 #include "config/keys.hpp"
 #include "keymap.hpp"
+#include "app_error.hpp"
 
 namespace hk::app {
 namespace {
@@ -65,7 +66,7 @@ std::string rest_of_line(std::istringstream& ss) {
 
 std::vector<ScriptLine> load_script(const std::string& path) {
   std::ifstream f(path);
-  if (!f) throw std::runtime_error("script '" + path + "': cannot read the file");
+  if (!f) throw AppError("script '" + path + "': cannot read the file");
   std::vector<ScriptLine> out;
   std::string line;
   int n = 0;
@@ -94,7 +95,7 @@ std::vector<ScriptLine> load_script(const std::string& path) {
     } else if (ok && s.what != "move" && s.what != "unstick" && s.what != "wait") {
       ok = false;
     }
-    if (!ok) throw std::runtime_error("script '" + path + "': line " + std::to_string(n) + " is not " + kAllowed);
+    if (!ok) throw AppError("script '" + path + "': line " + std::to_string(n) + " is not " + kAllowed);
     out.push_back(s);
   }
   return out;
@@ -111,7 +112,7 @@ bool ScriptPlayer::step(int frame, ScriptTarget& t) {
   while (next_ < lines_.size() && lines_[next_].frame <= frame) {
     const ScriptLine& l = lines_[next_];
     if (l.what == "wait" && t.busy()) {
-      if (++held_ > kMaxHeldFrames) throw std::runtime_error("script '" + path_ + "': line " + std::to_string(l.number) + ": the kiosk was still busy after 60 s");
+      if (++held_ > kMaxHeldFrames) throw AppError("script '" + path_ + "': line " + std::to_string(l.number) + ": the kiosk was still busy after 60 s");
       return true;
     }
     if (l.what == "click" && !clicks_.empty()) return false;  // one click at a time: this one waits a frame
@@ -130,7 +131,7 @@ bool ScriptPlayer::step(int frame, ScriptTarget& t) {
     }
     if (l.what == "click") {
       const std::optional<WidgetRect> r = t.widget(l.arg);
-      if (!r) throw std::runtime_error("script '" + path_ + "': line " + std::to_string(l.number) + ": no widget '" + l.arg + "' on screen at frame " + std::to_string(frame));
+      if (!r) throw AppError("script '" + path_ + "': line " + std::to_string(l.number) + ": no widget '" + l.arg + "' on screen at frame " + std::to_string(frame));
       const ScriptedMouse at{0.5f * (r->x0 + r->x1), 0.5f * (r->y0 + r->y1), false};
       mouse_ = at;                               // this frame: the pointer arrives (hover)
       clicks_.push_back({at.x, at.y, true});     // next: button down

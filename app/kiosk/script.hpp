@@ -41,7 +41,7 @@ struct ScriptLine {
   int number = 0;       ///< line number in the file
 };
 
-/// Reads a script. @throws std::runtime_error (one line: the file, the line number, what is allowed).
+/// Reads a script. @throws AppError (one line: the file, the line number, what is allowed).
 std::vector<ScriptLine> load_script(const std::string& path);
 
 /// What a script acts on.
@@ -63,7 +63,7 @@ class ScriptPlayer {
  public:
   ScriptPlayer(std::vector<ScriptLine> lines, std::string path) : lines_(std::move(lines)), path_(std::move(path)) {}
   /// Runs the lines due at `frame` (and the releases and clicks under way). Returns true when a wait line
-  /// holds: the caller must not count this frame. @throws std::runtime_error when a wait lasts more than 60 s
+  /// holds: the caller must not count this frame. @throws AppError when a wait lasts more than 60 s
   /// of frames or a click names a widget not on screen.
   bool step(int frame, ScriptTarget& target);
   /// The scripted pointer for this frame, once a click has been played (it then stays where it clicked).

@@ -1,4 +1,5 @@
 #include "window.hpp"
+#include "app_error.hpp"
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -19,7 +20,7 @@ std::vector<InputEvent>& queue_of(GLFWwindow* w) { return *static_cast<std::vect
 
 KioskWindow::KioskWindow(bool windowed) {
   glfwSetErrorCallback([](int code, const char* what) { spdlog::error("glfw {}: {}", code, what ? what : ""); });
-  if (!glfwInit()) throw std::runtime_error("display: GLFW could not start (no X display? run under xvfb-run for headless use)");
+  if (!glfwInit()) throw AppError("display: GLFW could not start (no X display? run under xvfb-run for headless use)");
   GLFWmonitor* monitor = windowed ? nullptr : glfwGetPrimaryMonitor();
   int w = 1280, h = 720;
   if (monitor) {
@@ -31,7 +32,7 @@ KioskWindow::KioskWindow(bool windowed) {
   win_ = glfwCreateWindow(w, h, "haptic-kiosk", monitor, nullptr);
   if (!win_) {
     glfwTerminate();
-    throw std::runtime_error("display: cannot open a window");
+    throw AppError("display: cannot open a window");
   }
   glfwMakeContextCurrent(win_);
   glfwSwapInterval(1);

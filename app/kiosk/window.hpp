@@ -38,7 +38,7 @@ struct ScriptedMouse {
 /// The window, its GL context and Dear ImGui. One per process; the window thread only.
 class KioskWindow {
  public:
-  /// @throws std::runtime_error (one line) when GLFW cannot start (no display) or the window cannot open.
+  /// @throws AppError (one line) when GLFW cannot start (no display) or the window cannot open.
   explicit KioskWindow(bool windowed);
   ~KioskWindow();
   KioskWindow(const KioskWindow&) = delete;

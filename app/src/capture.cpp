@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "config/load.hpp"
+#include "app_error.hpp"
 
 namespace hk::app {
 namespace {
@@ -159,20 +160,20 @@ std::string capture_json(const CaptureOutcome& o, const std::string& source_name
 }
 
 void write_capture(const CaptureOutcome& o, const std::string& source_name, const std::string& out_dir) {
-  if (o.image.empty()) throw std::runtime_error("capture: nothing was captured, so nothing is written to '" + out_dir + "'");
+  if (o.image.empty()) throw AppError("capture: nothing was captured, so nothing is written to '" + out_dir + "'");
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec || !std::filesystem::is_directory(out_dir)) {
-    throw std::runtime_error("output folder '" + out_dir + "': cannot create it (" + ec.message() + ")");
+    throw AppError("output folder '" + out_dir + "': cannot create it (" + ec.message() + ")");
   }
   const std::filesystem::path dir(out_dir);
   const std::string png = (dir / "capture.png").string();
-  if (!cv::imwrite(png, o.image)) throw std::runtime_error("output '" + png + "': cannot write the PNG");
+  if (!cv::imwrite(png, o.image)) throw AppError("output '" + png + "': cannot write the PNG");
   const std::filesystem::path json = dir / "capture.json";
   std::ofstream f(json, std::ios::binary | std::ios::trunc);
   f << capture_json(o, source_name);
   f.close();
-  if (!f) throw std::runtime_error("output '" + json.string() + "': cannot write the file");
+  if (!f) throw AppError("output '" + json.string() + "': cannot write the file");
 }
 
 int run_capture_command(const CaptureOptions& opt) {

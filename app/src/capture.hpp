@@ -96,13 +96,13 @@ struct CaptureOptions {
 std::string capture_json(const CaptureOutcome& o, const std::string& source_name);
 
 /// Writes DIR/capture.png (CaptureOutcome::image) and DIR/capture.json.
-/// @throws std::runtime_error (one line) when the folder cannot be made or a file cannot be written, or there is
+/// @throws AppError (one line) when the folder cannot be made or a file cannot be written, or there is
 ///         no image (a cancelled capture).
 void write_capture(const CaptureOutcome& o, const std::string& source_name, const std::string& out_dir);
 
 /// `haptic-kiosk capture`: opens the source, runs one capture (a time-out keeps the last frame) and writes it.
 /// Prints one line: how it ended and where it went. Returns the exit status (0).
-/// @throws vision::CameraError, config::ConfigError, std::runtime_error (one line each).
+/// @throws vision::CameraError, config::ConfigError, AppError (one line each).
 int run_capture_command(const CaptureOptions& o);
 
 /// `haptic-kiosk cameras`: one line per camera ("libcamera:0  imx219  (libcamera)"), or "no camera found".

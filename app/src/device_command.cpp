@@ -14,6 +14,7 @@
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/io/usb_devices.hpp"
 #include "haptics/pty_emulator.hpp"
+#include "app_error.hpp"
 
 namespace hk::app {
 
@@ -77,7 +78,7 @@ int run_calibrate(const CalibrateOptions& o) {
   if (pty) pty->stop();
   double o1 = 0, o2 = 0;
   if (!io::calibrated_offsets(dp, park, sum1 / kTicks, sum2 / kTicks, &o1, &o2))
-    throw std::runtime_error("calibrate: the park place (" + std::to_string(park.x) + ", " + std::to_string(park.y) +
+    throw AppError("calibrate: the park place (" + std::to_string(park.x) + ", " + std::to_string(park.y) +
                              ") m is out of the links' reach; check [device] park_x_m, park_y_m and the rectangle");
   const double old1 = s.device.encoder1_offset_deg, old2 = s.device.encoder2_offset_deg;
   s.device.encoder1_offset_deg = std::round(o1 * 1000.0) / 1000.0;

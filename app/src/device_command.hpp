@@ -27,7 +27,7 @@ struct CalibrateOptions {
 /// (io::calibrated_offsets), writes encoder1_offset_deg and encoder2_offset_deg into the settings file
 /// (atomically, every other value kept) and prints old and new offsets. Returns 0; throws DeviceError when the
 /// device cannot be opened or stops answering, DeviceChoiceError for a bad --device, config::ConfigError for a
-/// bad settings file, and std::runtime_error when the park place is out of the links' reach.
+/// bad settings file, and AppError when the park place is out of the links' reach.
 int run_calibrate(const CalibrateOptions& options);
 
 }  // namespace hk::app

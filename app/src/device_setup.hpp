@@ -6,6 +6,7 @@
 /// driver parameters from [device] and [workspace], and the transport to a real board ([device] transport:
 /// libusb CDC-ACM by VID:PID, or the kernel's tty).
 
+#include "hk/error.hpp"
 #include <stdexcept>
 #include <string>
 
@@ -18,9 +19,9 @@
 namespace hk::app {
 
 /// A `--device` value that cannot be used; the message names the value and the limit.
-class DeviceChoiceError : public std::runtime_error {
+class DeviceChoiceError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// What `--device` asked for.

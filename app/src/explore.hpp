@@ -4,6 +4,7 @@
 /// pantograph driven by a model hand, tick by tick as fast as it can, writing scene.json, trace.csv,
 /// summary.json and overlay.png into the output folder.
 
+#include "hk/error.hpp"
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -30,9 +31,9 @@ struct ExploreOptions {
 
 /// A problem with the run's own arguments or output folder (bad inputs raise their own typed errors:
 /// vision::InputError, config::ConfigError, HandFileError).
-class ExploreError : public std::runtime_error {
+class ExploreError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// The `--seed` argument: a whole number in [0, 2^63 − 1], decimal digits only. Throws ExploreError

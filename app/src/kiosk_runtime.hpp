@@ -84,7 +84,7 @@ class KioskRuntime final : public KioskEffects {
  public:
   /// Opens the device (the USB pantograph when [device] type is "auto" or "haply" and one answers, else the
   /// simulated pantograph), the audio side and the stick service. Call start_servo() next.
-  /// @throws std::runtime_error (one line) for an empty library; audio::MessageError for a bad catalogue.
+  /// @throws AppError (one line) for an empty library; audio::MessageError for a bad catalogue.
   KioskRuntime(const RuntimeOptions& options, const config::Settings& settings);
   ~KioskRuntime() override;
   KioskRuntime(const KioskRuntime&) = delete;

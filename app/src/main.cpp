@@ -14,6 +14,7 @@
 #include "kiosk_app.hpp"
 #include "pin_command.hpp"
 #include "stick_command.hpp"
+#include "app_error.hpp"
 
 namespace {
 
@@ -110,7 +111,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*explore) {
-      if (eo.image_path.empty() && eo.source.empty()) throw std::runtime_error("explore: give a picture or PDF to explore, or --source");
+      if (eo.image_path.empty() && eo.source.empty()) throw hk::app::AppError("explore: give a picture or PDF to explore, or --source");
       eo.seed = hk::app::parse_seed(seed_text);
       const auto sum = hk::app::run_explore(eo);
       std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n", sum.ticks,

@@ -1,4 +1,5 @@
 #include "picture_library.hpp"
+#include "app_error.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -42,8 +43,8 @@ std::vector<std::string> list_pictures(const std::string& folder) {
       out.push_back(e.path().string());
     }
   }
-  if (ec) throw std::runtime_error("picture library '" + folder + "': cannot read the folder (" + ec.message() + ")");
-  if (out.empty()) throw std::runtime_error("picture library '" + folder + "': holds no picture (png, jpg, bmp, tif, webp)");
+  if (ec) throw AppError("picture library '" + folder + "': cannot read the folder (" + ec.message() + ")");
+  if (out.empty()) throw AppError("picture library '" + folder + "': holds no picture (png, jpg, bmp, tif, webp)");
   std::sort(out.begin(), out.end());
   return out;
 }

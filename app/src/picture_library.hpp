@@ -15,7 +15,7 @@ namespace hk::app {
 /// The tutorial shape as one closed polyline in workspace metres, centred, about half the workspace high.
 Polyline tutorial_polyline(TutorialShape shape, Vec2 half_extent_m);
 
-/// Image files of `folder`, sorted by name. @throws std::runtime_error (one line) if the folder cannot be
+/// Image files of `folder`, sorted by name. @throws AppError (one line) if the folder cannot be
 /// read or holds no image.
 std::vector<std::string> list_pictures(const std::string& folder);
 

@@ -10,6 +10,7 @@
 /// both first when the visitor asks for a description. Written by people, so read with care: a sidecar that
 /// cannot be used is refused with one line, and the picture is shown without it.
 
+#include "hk/error.hpp"
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -28,9 +29,9 @@ inline constexpr std::size_t kMaxDescriptionBytes = 1000;
 
 /// A sidecar that cannot be used: what() is one line naming the file and what is wrong with it, e.g.
 /// "picture notes 'horse.toml': title is 312 bytes, at most 200".
-class PictureNotesError : public std::runtime_error {
+class PictureNotesError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// What the picture file itself says of it (exiv2, and libpng for a PNG's text chunks, png_text.hpp): the

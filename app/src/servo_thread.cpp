@@ -98,9 +98,12 @@ void ServoThread::run() {
     late_[static_cast<std::size_t>(std::clamp<std::int64_t>(late / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
     compute_[static_cast<std::size_t>(std::clamp<std::int64_t>((done - woke) / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
     if (late > max_late_ns_.load(std::memory_order_relaxed)) max_late_ns_.store(late, std::memory_order_relaxed);
+    if (late > total_max_late_ns_.load(std::memory_order_relaxed)) total_max_late_ns_.store(late, std::memory_order_relaxed);
     ticks_.fetch_add(1, std::memory_order_relaxed);
+    total_ticks_.fetch_add(1, std::memory_order_relaxed);
     if (missed) {
       missed_.fetch_add(1, std::memory_order_relaxed);
+      total_missed_.fetch_add(1, std::memory_order_relaxed);
       // Skip ahead to the next deadline in the future rather than bursting ticks to catch up.
       deadline += ((done - deadline) / period_ns) * period_ns;
     }
@@ -118,6 +121,14 @@ ServoTimingStats ServoThread::stats() const {
   s.compute_p50_us = percentile_us(compute_, 0.5);
   s.compute_p99_us = percentile_us(compute_, 0.99);
   return s;
+}
+
+ServoThread::Totals ServoThread::totals() const {
+  Totals t;
+  t.ticks = total_ticks_.load();
+  t.missed_deadlines = total_missed_.load();
+  t.lateness_max_us = static_cast<double>(total_max_late_ns_.load()) / 1000.0;
+  return t;
 }
 
 ServoTimingStats ServoThread::take_stats() {

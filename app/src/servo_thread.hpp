@@ -56,6 +56,14 @@ class ServoThread {
   /// Timing since the last call (or the start), then starts counting afresh: one report per visitor's
   /// session. Counts racing with the servo thread's increments may be off by a tick.
   ServoTimingStats take_stats();
+  /// Since the thread started, never reset by take_stats() (a soak's accounting while the kiosk takes its
+  /// per-visitor reports): ticks, missed deadlines, and the worst lateness [µs].
+  struct Totals {
+    std::int64_t ticks = 0;
+    std::int64_t missed_deadlines = 0;
+    double lateness_max_us = 0;
+  };
+  Totals totals() const;
 
  private:
   void run();
@@ -67,6 +75,7 @@ class ServoThread {
   std::atomic<bool> stop_{false};
   std::atomic<bool> realtime_{false};
   std::atomic<std::int64_t> ticks_{0}, missed_{0}, max_late_ns_{0};
+  std::atomic<std::int64_t> total_ticks_{0}, total_missed_{0}, total_max_late_ns_{0};  // never reset
   std::array<std::atomic<std::uint32_t>, kBins> late_{}, compute_{};
   std::thread thread_;
 };

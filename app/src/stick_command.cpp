@@ -9,6 +9,7 @@
 #include "config/load.hpp"
 #include "documents.hpp"
 #include "vision/usb_stick.hpp"
+#include "app_error.hpp"
 
 namespace hk::app {
 namespace {
@@ -21,26 +22,26 @@ void write_atomically(const std::string& path, const std::string& text) {
     f.close();
     if (!f) {
       std::filesystem::remove(tmp);
-      throw std::runtime_error("--json '" + path + "': cannot write the file");
+      throw AppError("--json '" + path + "': cannot write the file");
     }
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     std::filesystem::remove(tmp);
-    throw std::runtime_error("--json '" + path + "': cannot write the file (" + ec.message() + ")");
+    throw AppError("--json '" + path + "': cannot write the file (" + ec.message() + ")");
   }
 }
 
 }  // namespace
 
 int run_stick(const StickOptions& o) {
-  if (o.folder.empty() == o.device.empty()) throw std::runtime_error("stick: give exactly one of a folder or --device DEV");
+  if (o.folder.empty() == o.device.empty()) throw AppError("stick: give exactly one of a folder or --device DEV");
   const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
   if (!o.json_path.empty()) {  // refuse a bad output before mounting anything
     const std::filesystem::path p(o.json_path);
     const auto parent = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
-    if (!std::filesystem::is_directory(parent)) throw std::runtime_error("--json '" + o.json_path + "': folder '" + parent.string() + "' does not exist");
+    if (!std::filesystem::is_directory(parent)) throw AppError("--json '" + o.json_path + "': folder '" + parent.string() + "' does not exist");
   }
   std::optional<vision::MountedStick> mounted;
   std::string root = o.folder;

@@ -19,7 +19,7 @@ struct StickOptions {
 /// Runs the command: scans (mounting first with --device), probes every PDF's pages in the worker, writes
 /// the JSON of stick_listing_json. Returns the exit status: 0 when the scan ran (things refused or a limit
 /// reached are in the JSON, not errors).
-/// @throws vision::StickError / vision::StickMountError / std::runtime_error (one line) when the folder or
+/// @throws vision::StickError / vision::StickMountError / AppError (one line) when the folder or
 ///         device cannot be read or mounted, or the JSON cannot be written.
 int run_stick(const StickOptions& options);
 

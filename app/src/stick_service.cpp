@@ -23,9 +23,13 @@ std::string problem_of(const std::string& what) {
 
 StickService::StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events, std::string mount_root)
     : s_(settings), events_(std::move(events)), mount_root_(std::move(mount_root)) {
-  can_mount_ = vision::have_mount_capability();
-  if (events_ && !can_mount_) {
-    spdlog::warn("usb sticks: not mounted: this process lacks CAP_SYS_ADMIN. {}", vision::mount_capability_hint());
+  helper_path_ = vision::stick_helper_path();
+  mounter_ = vision::choose_stick_mounter(vision::have_mount_capability(), helper_path_);
+  if (events_ && mounter_ == vision::StickMounter::None) {
+    spdlog::warn("usb sticks: not mounted: this process lacks CAP_SYS_ADMIN and there is no mount helper at {}. {}", helper_path_,
+                 vision::mount_capability_hint());
+  } else if (events_ && mounter_ == vision::StickMounter::Helper) {
+    spdlog::info("usb sticks: mounted read-only by the helper {} under {}", helper_path_, vision::kDefaultStickMountRoot);
   }
   watcher_ = std::thread([this] { watch(); });
   loader_ = std::thread([this] { serve(); });
@@ -119,14 +123,16 @@ void StickService::scan_root(const std::string& root, double started_ms) {
 }
 
 void StickService::handle_add(const std::string& devnode) {
-  if (!can_mount_) return;  // said once at start
+  if (!can_mount()) return;  // said once at start
   if (mounted_) {
     spdlog::info("stick '{}': ignored, '{}' is in use (one stick at a time)", devnode, mounted_->devnode());
     return;
   }
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    mounted_ = std::make_unique<vision::MountedStick>(devnode, mount_root_, next_slot_++);
+    const int slot = next_slot_;
+    next_slot_ = (next_slot_ + 1) % (vision::kMaxStickSlot + 1);  // one stick at a time: slots are reused after 1000
+    mounted_ = vision::mount_stick(mounter_, devnode, mount_root_, slot, helper_path_);
   } catch (const std::exception& e) {
     spdlog::warn("{}", e.what());
     StickNews n;

@@ -4,8 +4,9 @@
 ///
 /// Two worker threads:
 /// - the watcher takes block events (vision::BlockEventSource), mounts an inserted stick read-only
-///   (vision::MountedStick), scans it and counts its PDFs' pages (list_stick), and unmounts it when it is
-///   taken out; without CAP_SYS_ADMIN it says once in the log how to grant it and ignores sticks;
+///   (vision::mount_stick: itself with CAP_SYS_ADMIN, else through the mount helper hk-stick-mount when it
+///   is installed), scans it and counts its PDFs' pages (list_stick), and unmounts it when it is taken out;
+///   with neither it says once in the log how to grant the capability and ignores sticks;
 /// - the loader builds the scene of a document page on request (the PDF drawn in its worker process,
 ///   edges, multiresolution, trees), so a slow or hostile page never blocks the window.
 /// The window thread polls both with poll_news() and poll_loaded() each frame (mutex-guarded queues: neither
@@ -24,6 +25,7 @@
 #include "config/settings.hpp"
 #include "documents.hpp"
 #include "image_scene.hpp"
+#include "vision/stick_mount.hpp"
 #include "vision/usb_stick.hpp"
 
 namespace hk::app {
@@ -50,7 +52,9 @@ struct LoadedDocument {
 /// Watcher and loader threads. Construct and use from the window thread.
 class StickService {
  public:
-  /// `events` may be null (no hot-plug: only insert_folder). `mount_root` is where sticks are mounted.
+  /// `events` may be null (no hot-plug: only insert_folder). `mount_root` is where sticks are mounted (the
+  /// helper always mounts under vision::kDefaultStickMountRoot). Who mounts is chosen once here:
+  /// vision::choose_stick_mounter(have_mount_capability(), stick_helper_path()).
   StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events, std::string mount_root);
   /// Stops both threads (a load in progress finishes first: at most the page time limit) and unmounts.
   ~StickService();
@@ -69,8 +73,10 @@ class StickService {
   std::vector<LoadedDocument> poll_loaded();
   /// Forget the stick's listing (a new session): later loads of it are refused. The mount stays until removal.
   void forget();
-  /// Whether sticks can be mounted (CAP_SYS_ADMIN); folders work regardless.
-  bool can_mount() const { return can_mount_; }
+  /// Whether sticks can be mounted (CAP_SYS_ADMIN, or the mount helper); folders work regardless.
+  bool can_mount() const { return mounter_ != vision::StickMounter::None; }
+  /// Who mounts sticks: this process, the helper, or nobody.
+  vision::StickMounter mounter() const { return mounter_; }
   /// Loads that have read their document and begun drawing and building it (for the operator's status and
   /// for tests that need a load to be under way).
   int loads_started() const { return loads_started_.load(); }
@@ -92,7 +98,8 @@ class StickService {
   config::Settings s_;
   std::unique_ptr<vision::BlockEventSource> events_;
   std::string mount_root_;
-  bool can_mount_ = false;
+  vision::StickMounter mounter_ = vision::StickMounter::None;
+  std::string helper_path_;
   std::atomic<vision::PdfFault> pdf_fault_{vision::PdfFault::None};
   std::atomic<int> loads_started_{0};
 
@@ -109,7 +116,7 @@ class StickService {
   std::vector<ListedDocument> stick_docs_;  // guarded by m_
 
   // watcher thread only
-  std::unique_ptr<vision::MountedStick> mounted_;
+  std::unique_ptr<vision::StickMount> mounted_;
   int next_stick_ = 1;
   int next_slot_ = 0;
 

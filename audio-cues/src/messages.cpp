@@ -6,6 +6,8 @@
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "hk/text.hpp"
+
 namespace hk::audio {
 namespace {
 
@@ -38,15 +40,12 @@ bool starts_sentence(const std::string& out) {
 }  // namespace
 
 MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& source) {
-  const std::string where = "messages '" + source + "': ";
+  const std::string where = "messages '" + hk::one_line(source) + "': ";
   toml::table t;
   try {
     t = toml::parse(text, source);
   } catch (const toml::parse_error& e) {
-    std::string d(e.description());
-    for (char& c : d) {
-      if (c == '\n' || c == '\r') c = ' ';
-    }
+    const std::string d = hk::one_line(e.description(), 160);  // toml++ quotes the offending character as it is
     throw MessageError(where + "not valid TOML: " + d + " (line " + std::to_string(e.source().begin.line) + ")");
   }
   MessageCatalog c;
@@ -59,7 +58,7 @@ MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& s
   for (const auto& [key, node] : *m) {
     bool known = false;
     for (std::string_view k : kMessageKeys) known = known || k == key.str();
-    if (!known) throw MessageError(where + "messages." + std::string(key.str()) + " is not a message the kiosk has");
+    if (!known) throw MessageError(where + "messages." + hk::one_line(key.str(), 60) + " is not a message the kiosk has");
   }
   // The English file is the reference for placeholders (it is parsed first, with itself as reference).
   const MessageCatalog* en = source == "en.toml (built in)" ? nullptr : &english();
@@ -73,7 +72,7 @@ MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& s
     if (en) {
       const auto allowed = placeholders(en->raw(static_cast<MessageId>(i)));
       for (const std::string& p : placeholders(*v)) {
-        if (!allowed.count(p)) throw MessageError(where + "messages." + key + " uses {" + p + "}, which the English text does not have");
+        if (!allowed.count(p)) throw MessageError(where + "messages." + key + " uses {" + hk::one_line(p, 60) + "}, which the English text does not have");
       }
     }
     c.texts_[static_cast<std::size_t>(i)] = *v;
@@ -83,13 +82,14 @@ MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& s
   if (!kn) throw MessageError(where + "has no [key_names] table");
   for (const auto& [key, node] : *kn) {
     const std::string name(key.str());
+    const std::string shown = hk::one_line(name, 60);  // a quoted TOML key may hold any character
     if (en && !en->key_names_.count(name)) {
-      throw MessageError(where + "key_names." + name + " is not a key name the English catalogue has");
+      throw MessageError(where + "key_names." + shown + " is not a key name the English catalogue has");
     }
     const auto v = node.value<std::string>();
-    if (!v) throw MessageError(where + "key_names." + name + " is not a string");
+    if (!v) throw MessageError(where + "key_names." + shown + " is not a string");
     if (v->empty() || v->size() > kMaxKeyNameBytes) {
-      throw MessageError(where + "key_names." + name + " must be 1 to " + std::to_string(kMaxKeyNameBytes) + " bytes");
+      throw MessageError(where + "key_names." + shown + " must be 1 to " + std::to_string(kMaxKeyNameBytes) + " bytes");
     }
     c.key_names_.emplace(name, *v);
   }
@@ -111,15 +111,15 @@ const MessageCatalog& MessageCatalog::english() {
 MessageCatalog MessageCatalog::load(const std::string& path) {
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw MessageError("messages '" + path + "': cannot read the file (" + ec.message() + ")");
+  if (ec) throw MessageError("messages '" + hk::one_line(path) + "': cannot read the file (" + ec.message() + ")");
   if (size > kMaxFileBytes) {
-    throw MessageError("messages '" + path + "': " + std::to_string(size) + " bytes is over the limit of " +
+    throw MessageError("messages '" + hk::one_line(path) + "': " + std::to_string(size) + " bytes is over the limit of " +
                        std::to_string(kMaxFileBytes) + " bytes");
   }
   std::ifstream f(path, std::ios::binary);
   std::stringstream ss;
   ss << f.rdbuf();
-  if (!f) throw MessageError("messages '" + path + "': cannot read the file");
+  if (!f) throw MessageError("messages '" + hk::one_line(path) + "': cannot read the file");
   return parse(ss.str(), path);
 }
 

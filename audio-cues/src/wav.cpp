@@ -1,5 +1,6 @@
 // WAV files through libsndfile (see wav.hpp).
 #include "audio/wav.hpp"
+#include "hk/text.hpp"
 
 #include <sndfile.h>
 
@@ -22,25 +23,8 @@ using SndPtr = std::unique_ptr<SNDFILE, SndCloser>;
 constexpr std::size_t kChunkFrames = 4096;                   // conversion buffer [frames]
 constexpr std::int64_t kMaxWriteFrames = (std::int64_t{1} << 31) - 64;  // 16-bit mono RIFF size limit
 
-// The path or a library message on one line: control characters become \xNN.
-std::string one_line(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (const char c : s) {
-    const auto b = static_cast<unsigned char>(c);
-    if (b < 0x20 || b == 0x7F) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02X", b);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
 [[noreturn]] void fail(const std::string& path, const std::string& problem) {
-  throw WavError("wav '" + one_line(path) + "': " + one_line(problem));
+  throw WavError("wav '" + hk::one_line(path) + "': " + hk::one_line(problem));
 }
 
 std::int16_t to_pcm16(float x) {

@@ -2,6 +2,7 @@
 /// @file detail.hpp
 /// Internal helpers shared by the config sources (not installed, not part of the API).
 
+#include "hk/text.hpp"
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -27,9 +28,8 @@ struct Source {
   bool is_file;       ///< true: messages start "config '<name>': ", false: "<name>: "
 };
 
-/// `s` made safe for a one-line message: control characters escaped (\n, \r, \t, \xNN), cut to
-/// `max_chars` bytes with "..." appended when longer.
-std::string one_line(std::string_view s, std::size_t max_chars = 120);
+/// The one escaper (hk/text.hpp), for the names and values config messages echo.
+using hk::one_line;
 
 /// Shortest text that reads back to exactly `v`, plain decimal when that fits in 32 characters
 /// ("800", "0.0005", "100000"), else with an exponent ("5e-324"); "nan", "inf", "-inf".

@@ -20,7 +20,7 @@
 namespace hk::config {
 
 ConfigError::ConfigError(std::string source, std::string key, const std::string& message)
-    : std::runtime_error(message), source_(std::move(source)), key_(std::move(key)) {}
+    : hk::Error(message), source_(std::move(source)), key_(std::move(key)) {}
 
 namespace {
 
@@ -366,34 +366,6 @@ const FieldDescriptor* find_field(std::string_view table, std::string_view key) 
 namespace detail {
 
 std::span<const TableInfo> tables() noexcept { return kTables; }
-
-std::string one_line(std::string_view s, std::size_t max_chars) {
-  std::string out;
-  bool cut = false;
-  for (char c : s) {
-    if (out.size() >= max_chars) {
-      cut = true;
-      break;
-    }
-    const auto u = static_cast<unsigned char>(c);
-    switch (c) {
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (u < 0x20 || u == 0x7f) {
-          static constexpr char kHex[] = "0123456789abcdef";
-          out += "\\x";
-          out += kHex[u >> 4];
-          out += kHex[u & 15];
-        } else {
-          out += c;
-        }
-    }
-  }
-  if (cut) out += "...";
-  return out;
-}
 
 std::string format_real(double v) {
   if (std::isnan(v)) return "nan";

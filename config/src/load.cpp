@@ -111,7 +111,7 @@ std::vector<std::string_view> table_names() {
         fail(src, std::string(name), body, line);
       }
     body += "; keys belong under a table: [haptics], [device], [hand], [vision], [workspace], [audio], [kiosk], [stick], [camera], [keys] or [operator]";
-    fail(src, std::string(name), body, line);
+    fail(src, shown, body, line);  // a quoted key may hold any character: key() is escaped as the message is
   }
   std::string body = "unknown table [" + shown + "]";
   if (auto s = closest(name, table_names()); !s.empty()) body += " (did you mean [" + std::string(s) + "]?)";

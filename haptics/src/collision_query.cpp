@@ -78,8 +78,8 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   removed_.assign(n, 0);
   candidates_.reserve(capacity_);
   merge_scratch_.reserve(capacity_);
-  // Widest fan-out, plus that many per level of curve and hierarchy (≤ 64 levels deep).
-  stack_.resize(widest_root * (Scene::kMaxLevels + 64) + 8);
+  // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
+  stack_.resize(tree_stack_entries(widest_root));
   hit_stamp_.assign(n, 0);
   merge_stamp_.assign(n, 0);
   reset();
@@ -216,8 +216,10 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
           refined = false;
           break;
         }
-        if (overlaps(sc.aabb(first + i), sweep, 0.0) && clip_segment_box(sc.box(first + i), a, b, 0.0, &te, &tx) && te <= best.t) {
-          stack_[top++] = {te, first + i};
+        if (overlaps(sc.aabb(first + i), sweep, 0.0) && clip_segment_box(sc.box(first + i), a, b, 0.0, &te, &tx) && te <= best.t &&
+            !push(top, {te, first + i})) {
+          refined = false;  // the stack is full: the box stays unrefined, as past the budget
+          break;
         }
       }
       if (!refined) {  // past the budget (before or amid its children): the box bounds what is proven clear
@@ -353,7 +355,10 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
     for (std::uint32_t i = 0; i < count; ++i) {
       if (budget && !budget->spend()) return false;  // unknown: the caller sees budget->ran_out
       const double d = box_distance(sc.box(first + i), p);
-      if (d <= best) stack_[top++] = {d, first + i};
+      if (d <= best && !push(top, {d, first + i})) {  // the stack is full: the answer is unknown, as past the budget
+        if (budget) budget->ran_out = true;
+        return false;
+      }
     }
     // Nearest child on top of the stack: the first leaf reached is close, so the bound prunes early.
     std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });

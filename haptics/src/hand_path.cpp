@@ -2,6 +2,7 @@
 /// Hand paths: interpolation, the raster, and the hand-file reader. See hand_path.hpp.
 
 #include "haptics/hand_path.hpp"
+#include "hk/text.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -78,18 +79,6 @@ HandPath raster_path(double width_m, double height_m, double spacing_m, double s
 
 namespace {
 
-/// Keeps an echoed fragment printable and short, so an error stays on one line: control characters
-/// become '?', and so do non-ASCII bytes of file content (binary junk is not UTF-8; a path may be).
-std::string printable(std::string_view s, std::size_t max_chars = 40, bool keep_non_ascii = false) {
-  std::string out;
-  for (const char c : s.substr(0, max_chars)) {
-    const auto u = static_cast<unsigned char>(c);
-    out += (u < 0x20 || u == 0x7f || (u >= 0x80 && !keep_non_ascii)) ? '?' : c;
-  }
-  if (s.size() > max_chars) out += "...";
-  return out;
-}
-
 /// A double in the shortest form that reads back the same (for messages).
 std::string fmt(double v) {
   char buf[32];
@@ -106,7 +95,7 @@ std::string_view trim(std::string_view s) {
 
 class Reader {
  public:
-  explicit Reader(const std::string& path) : path_(path), shown_path_(printable(path, 4096, true)) {}
+  explicit Reader(const std::string& path) : path_(path), shown_path_(hk::one_line(path)) {}
 
   [[noreturn]] void fail(std::size_t line, const std::string& problem) const {
     throw HandFileError("hand file '" + shown_path_ + "' line " + std::to_string(line) + ": " + problem);
@@ -132,7 +121,7 @@ class Reader {
       if (line_no == 1) {
         if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
         if (text != "t_s,x_m,y_m") {
-          fail(1, "header must be exactly 't_s,x_m,y_m', found '" + printable(text) + "'");
+          fail(1, "header must be exactly 't_s,x_m,y_m', found '" + hk::one_line(text, 40) + "'");
         }
         continue;
       }
@@ -190,10 +179,10 @@ class Reader {
         const auto [ptr, err] = std::from_chars(b, e, v[count]);
         // from_chars reports out-of-range (1e999) as result_out_of_range: that is a non-finite value.
         if (err == std::errc::result_out_of_range && ptr == e) {
-          fail(line_no, std::string("field ") + kNames[count] + " '" + printable(field) + "' is out of the range of a double");
+          fail(line_no, std::string("field ") + kNames[count] + " '" + hk::one_line(field, 40) + "' is out of the range of a double");
         }
         if (field.empty() || err != std::errc() || ptr != e) {
-          fail(line_no, std::string("field ") + kNames[count] + " '" + printable(field) + "' is not a number");
+          fail(line_no, std::string("field ") + kNames[count] + " '" + hk::one_line(field, 40) + "' is not a number");
         }
       }
       ++count;

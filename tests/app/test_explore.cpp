@@ -3,12 +3,14 @@
 // end in one clear line on stderr.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "crossing_grid.hpp"
 #include "kiosk_exe.hpp"
@@ -56,15 +58,21 @@ TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
   ASSERT_FALSE(scene["curves"].empty()) << img;
   for (const auto& c : scene["curves"]) {
     ASSERT_TRUE(c.contains("id") && c.contains("closed"));
-    double prev_err = -1.0;
+    // Coarser levels are no more accurate than level 0, and the coarsest carries (nearly) the largest
+    // error. Not strictly monotone: a pseudocoiflet level can sit a little closer to the curve than the
+    // finer one below it (up to 11 % on the test pictures sudoku, apple and fruits), so the coarse end is
+    // checked against the largest error with 15 % slack instead of level by level.
+    std::vector<double> errs;
     for (const auto& lv : c["levels"]) {
       ASSERT_GE(lv["points_m"].size(), 2u);
       const double err = lv["max_error_m"];
-      EXPECT_GE(err, 0.0);
       EXPECT_LT(err, 0.02);  // no level strays 2 cm from its curve
-      prev_err = err;
+      errs.push_back(err);
     }
-    (void)prev_err;
+    ASSERT_FALSE(errs.empty());
+    EXPECT_GE(errs.front(), 0.0);
+    for (std::size_t l = 1; l < errs.size(); ++l) EXPECT_GE(errs[l], errs.front()) << "level " << l;
+    EXPECT_GE(errs.back(), 0.85 * *std::max_element(errs.begin(), errs.end()));
   }
 
   // trace.csv: header, one row per tick (2 s at 1 kHz), consistent columns.
@@ -114,7 +122,8 @@ TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
   const json sum = json::parse(mf);
   EXPECT_EQ(sum["ticks"].get<long>(), rows);
   for (const char* k : {"p50", "p99", "p999", "max"}) EXPECT_TRUE(sum["tick_ns"].contains(k));
-  for (const char* k : {"load", "edges", "linking", "multires", "tree"}) EXPECT_GE(sum["build_ms"][k].get<double>(), 0.0);
+  // Each build stage ran and took some time (a stage skipped or timed in the wrong unit shows as 0).
+  for (const char* k : {"load", "edges", "linking", "multires", "tree"}) EXPECT_GT(sum["build_ms"][k].get<double>(), 0.0) << k;
   EXPECT_EQ(sum["curves"].get<std::size_t>(), scene["curves"].size());
   // Coverage (issue 14, item 5): a fraction, and no more curves touched than there are.
   const double covered = sum["coverage"]["length_fraction"].get<double>();

@@ -40,6 +40,10 @@ TEST(ServoThread, TicksCountsAMissedDeadlineAndStops) {
     const ServoTimingStats taken = t.take_stats();  // a session's report, then counting afresh
     EXPECT_GE(taken.ticks, 100);
     EXPECT_LT(t.stats().ticks, taken.ticks);
+    const ServoThread::Totals total = t.totals();  // ... while the totals since the start are kept
+    EXPECT_GE(total.ticks, taken.ticks);
+    EXPECT_GE(total.missed_deadlines, taken.missed_deadlines);
+    EXPECT_GE(total.lateness_max_us, 1000.0);
     t.stop();
     const std::int64_t ticks = t.stats().ticks;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -29,11 +29,24 @@ std::vector<float> pull(AudioSystem& a, double seconds) {
   return x;
 }
 
+// Pulls 5 ms buffers until one is not silent: the speech worker has begun to deliver. The give-up bound
+// (60 s) only keeps a broken build from hanging; the outcome is the sound, not the time.
+bool until_heard(AudioSystem& a) {
+  std::vector<float> x(240);
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < give_up) {
+    a.render(x.data(), x.size());
+    if (test::peak(x, 0, x.size()) > 0.0) return true;
+    std::this_thread::yield();
+  }
+  return false;
+}
+
 TEST(AudioSystem, SpeaksCatalogueMessagesThroughTheMix) {
   AudioSystem a(headless());
   ASSERT_TRUE(a.speech_available());
   a.say(MessageId::picture_loaded, {{"picture", "1"}, {"pictures", "4"}, {"shapes", "3"}});
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(until_heard(a));
   const std::vector<float> x = pull(a, 1.0);
   EXPECT_GT(test::rms(x, 0, x.size()), 0.01) << "the message is heard";
   const auto log = a.speech_log();
@@ -61,7 +74,7 @@ TEST(AudioSystem, NewSessionResetsTheVolumeAndStopsSpeech) {
   EXPECT_TRUE(a.volume_up());
   EXPECT_EQ(a.volume().step(), 7);
   a.say(MessageId::help);
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(until_heard(a));
   const std::vector<float> before = pull(a, 0.5);
   ASSERT_GT(test::rms(before, 0, before.size()), 0.01) << "help was being spoken";
   a.new_session();

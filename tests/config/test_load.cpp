@@ -208,7 +208,7 @@ TEST(ConfigLoad, WeirdQuotedKeyStaysOneLine) {
   auto e = capture_error([&] { (void)parse_settings("[haptics]\n\"a\\nb\" = 1\n", "t.toml"); });
   ASSERT_TRUE(e);
   EXPECT_TRUE(is_one_line(e->what())) << e->what();
-  EXPECT_TRUE(contains(e->what(), "haptics.a\\nb")) << e->what();
+  EXPECT_TRUE(contains(e->what(), "haptics.a\\x0Ab")) << e->what();
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -20,76 +20,156 @@ TEST(ConfigRoundTrip, Defaults) {
   EXPECT_EQ(parse_settings(to_toml(s), "defaults"), s) << to_toml(s);
 }
 
-/// Every field set by hand (not through the implementation's table) to a non-default valid value,
-/// so a field missing from the table would come back as its default and fail the comparison.
+/// Every field set by hand (not through the implementation's table) to a valid value that is not its
+/// default, so a field missing from the table (or written or read under the wrong key) comes back as
+/// its default and fails the comparison. kFieldsSetByHand counts the assignments below; the test checks
+/// it against the table, so a field added to Settings and the table but not here fails too.
+constexpr std::size_t kFieldsSetByHand = 116;
+
 Settings every_field_changed() {
   Settings s;
-  s.haptics.stiffness_n_per_m = 1234.5;
-  s.haptics.damping_n_s_per_m = 1.25;
-  s.haptics.max_force_n = 7.5;
-  s.haptics.servo_rate_hz = 2000;
-  s.haptics.level = 3;
-  s.haptics.max_levels = 9;
-  s.haptics.query_box_budget = 1500;
-  s.haptics.force_ramp_s = 1.5;
-  s.device.type = "haply";
-  s.device.handle_mass_kg = 0.1;
-  s.device.handle_damping_n_s_per_m = 3;
-  s.device.encoder_counts_per_rev = 4096;
-  s.device.max_torque_n_m = 0.25;
-  s.device.transport = "tty";
-  s.device.usb_vid = 0x239A;
-  s.device.usb_pid = 0x8013;
-  s.device.serial_path = "/dev/serial/by-id/usb-Haply_board-if00";
-  s.device.device_id = 7;
-  s.device.lost_after_ticks = 5;
-  s.device.actuator1_port = 1;
-  s.device.actuator1_dir = "ccw";
-  s.device.actuator2_port = 2;
-  s.device.actuator2_dir = "ccw";
-  s.device.encoder1_port = 1;
-  s.device.encoder1_dir = "cw";
-  s.device.encoder1_offset_deg = 181.5;
-  s.device.encoder1_resolution = 2048;
-  s.device.encoder2_port = 2;
-  s.device.encoder2_dir = "cw";
-  s.device.encoder2_offset_deg = -1.25;
-  s.device.encoder2_resolution = 8192;
-  s.device.link_proximal_m = 0.05;
-  s.device.link_distal_m = 0.07;
-  s.device.motor_spacing_m = 0.02;
-  s.device.torque_limit_n_m = 0.2;
-  s.device.rect_width_m = 0.08;
-  s.device.rect_height_m = 0.05;
-  s.device.rect_center_y_m = -0.08;
-  s.device.park_x_m = 0.01;
-  s.device.park_y_m = -0.02;
-  s.hand.stiffness_n_per_m = 300;
-  s.hand.damping_n_s_per_m = 6;
-  s.hand.max_force_n = 2.5;
-  s.hand.raster_speed_m_per_s = 0.05;
-  s.hand.raster_spacing_m = 0.004;
-  s.vision.max_file_bytes = 12345678;
-  s.vision.max_width_px = 4000;
-  s.vision.max_height_px = 3000;
-  s.vision.max_pixels = 12000000;
-  s.vision.blur_sigma_px = 2.25;
-  s.vision.canny_low = 50;
-  s.vision.canny_high = 150;
-  s.vision.min_chain_length_m = 0.002;
-  s.vision.max_image_side_px = 640;
+  auto& h = s.haptics;
+  h.stiffness_n_per_m = 1234.5;
+  h.damping_n_s_per_m = 1.25;
+  h.max_force_n = 7.5;
+  h.servo_rate_hz = 2000;
+  h.level = 3;
+  h.level_mode = "fixed";
+  h.level_error_at_rest_m = 2.5e-4;
+  h.level_blur_time_s = 0.02;
+  h.level_hysteresis = 0.45;
+  h.level_min_dwell_s = 0.3;
+  h.level_max_force_step_n = 0.125;
+  h.static_friction = 0.7;
+  h.dynamic_friction = 0.55;
+  h.max_levels = 9;
+  h.query_box_budget = 1500;
+  h.force_ramp_s = 1.5;
+  h.pop_force_n = 4.5;
+  h.pop_hold_s = 0.6;
+  h.pop_release_s = 0.05;
+  h.render = "grooves";
+  h.groove_capture_radius_m = 0.004;
+  h.groove_depth_n = 1.5;
+  h.tour_max_force_n = 0.9;
+  h.tour_speed_m_per_s = 0.045;
+  auto& d = s.device;
+  d.type = "haply";
+  d.handle_mass_kg = 0.1;
+  d.handle_damping_n_s_per_m = 3;
+  d.encoder_counts_per_rev = 4096;
+  d.max_torque_n_m = 0.25;
+  d.transport = "tty";
+  d.usb_vid = 0x239A;
+  d.usb_pid = 0x8013;
+  d.serial_path = "/dev/serial/by-id/usb-Haply_board-if00";
+  d.device_id = 7;
+  d.lost_after_ticks = 5;
+  d.actuator1_port = 1;
+  d.actuator1_dir = "ccw";
+  d.actuator2_port = 2;
+  d.actuator2_dir = "ccw";
+  d.encoder1_port = 1;
+  d.encoder1_dir = "cw";
+  d.encoder1_offset_deg = 181.5;
+  d.encoder1_resolution = 2048;
+  d.encoder2_port = 2;
+  d.encoder2_dir = "cw";
+  d.encoder2_offset_deg = -1.25;
+  d.encoder2_resolution = 8192;
+  d.link_proximal_m = 0.05;
+  d.link_distal_m = 0.07;
+  d.motor_spacing_m = 0.02;
+  d.torque_limit_n_m = 0.2;
+  d.rect_width_m = 0.08;
+  d.rect_height_m = 0.05;
+  d.rect_center_y_m = -0.08;
+  d.park_x_m = 0.01;
+  d.park_y_m = -0.02;
+  auto& hand = s.hand;
+  hand.stiffness_n_per_m = 300;
+  hand.damping_n_s_per_m = 6;
+  hand.max_force_n = 2.5;
+  hand.raster_speed_m_per_s = 0.05;
+  hand.raster_spacing_m = 0.004;
+  auto& v = s.vision;
+  v.max_file_bytes = 12345678;
+  v.max_width_px = 4000;
+  v.max_height_px = 3000;
+  v.max_pixels = 12000000;
+  v.blur_sigma_px = 2.25;
+  v.canny_low = 50;
+  v.canny_high = 150;
+  v.min_chain_length_m = 0.002;
+  v.max_image_side_px = 640;
+  v.max_segments = 12000;
+  v.max_shapes = 12;
+  v.thin_line_max_width_m = 0.0015;
+  v.gap_close_m = 0.002;
+  v.surround_inhibition = 2.25;
+  v.detector = "surround";
   s.workspace.width_m = 0.16;
   s.workspace.height_m = 0.1;
+  auto& a = s.audio;
+  a.volume_default_step = 4;
+  a.volume_step_db = 2.5;
+  a.earcon_gain = 0.75;
+  a.duck_db = -20;
+  a.speech_rate_wpm = 200;
+  a.buffer_frames = 512;
+  s.kiosk.timeout_s = 300;
+  s.kiosk.warning_s = 30;
+  auto& st = s.stick;
+  st.max_depth = 4;
+  st.max_entries = 2000;
+  st.max_documents = 50;
+  st.max_file_bytes = 50LL << 20;
+  st.scan_timeout_s = 3.5;
+  st.max_pdf_pages = 200;
+  st.page_max_pixels = 2e6;
+  st.page_max_dpi = 150;
+  st.page_timeout_s = 8;
+  auto& c = s.camera;
+  c.source = "v4l2:/dev/video2";
+  c.width_px = 1920;
+  c.height_px = 1080;
+  c.still_s = 1.5;
+  c.timeout_s = 90;
+  auto& k = s.keys;
+  k.help = "H";
+  k.next = "N";
+  k.previous = "P";
+  k.describe = "W";
+  k.finer = "F";
+  k.coarser = "X";
+  k.volume_up = "EQUAL";
+  k.volume_down = "MINUS";
+  k.tutorial = "U";
+  k.guide = "R";
+  k.capture = "ENTER";
+  auto& o = s.operator_;
+  o.open_chord = "CTRL+SHIFT+P";
+  o.idle_close_s = 120;
+  o.pin_hash = "$argon2id$v=19$m=65536,t=2,p=1$c29tZXNhbHQ$aGFzaA";
+  o.state_file = "/var/lib/haptic-kiosk/pin.state";
+  o.audit_log = "/var/log/haptic-kiosk/audit.log";
   return s;
+}
+
+/// Whether field `d` has the same value in `a` and `b`.
+bool same_field(const FieldDescriptor& d, const Settings& a, const Settings& b) {
+  return std::visit([&](const auto* pa) { return *pa == *std::get<std::decay_t<decltype(pa)>>(d.cref(b)); }, d.cref(a));
 }
 
 TEST(ConfigRoundTrip, EveryFieldChanged) {
   const Settings s = every_field_changed();
   ASSERT_NO_THROW(validate(s));
-  // Guard the guard: every numeric field differs from its default.
+  // Guard the guard: every field of the table differs from its default, and the table has exactly as
+  // many fields as every_field_changed() sets.
   const Settings d{};
-  EXPECT_NE(s.haptics, d.haptics);
-  EXPECT_NE(s.device.encoder_counts_per_rev, d.device.encoder_counts_per_rev);
+  for (const FieldDescriptor& f : field_descriptors())
+    EXPECT_FALSE(same_field(f, s, d)) << f.table << "." << f.key << " is left at its default";
+  EXPECT_EQ(field_descriptors().size(), kFieldsSetByHand);
   EXPECT_EQ(parse_settings(to_toml(s), "changed"), s) << to_toml(s);
 }
 

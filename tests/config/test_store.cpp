@@ -533,8 +533,8 @@ TEST(StoreAudit, ControlCharactersStayOnOneLine) {
   append_audit_event(log.string(), kNov22, "panel", "opened\nforged line");
   EXPECT_EQ(read_file(log),
             "2026-11-22T03:04:05Z panel operator.audit_log \"\" -> \"/var/log/a\\nb\"\n"
-            "2026-11-22T03:04:05Z pa\\nnel x.y \"a\\r\\nb\" -> c\\td\\x01\n"
-            "2026-11-22T03:04:05Z panel opened\\nforged line\n");
+            "2026-11-22T03:04:05Z pa\\x0Anel x.y \"a\\x0D\\x0Ab\" -> c\\x09d\\x01\n"
+            "2026-11-22T03:04:05Z panel opened\\x0Aforged line\n");
 }
 
 TEST(StoreAudit, AnUnwritableLogThrowsOneLineNamingIt) {
@@ -665,7 +665,7 @@ TEST(StorePanelEdit, ANonNumberIsRefusedWithOneLine) {
   EXPECT_EQ(set_field_from_text(s, field("haptics", "stiffness_n_per_m"), "1_000"),
             "operator panel: haptics.stiffness_n_per_m = \"1_000\" is not a number; expected a number in [10, 5000] N/m");
   EXPECT_EQ(set_field_from_text(s, field("haptics", "stiffness_n_per_m"), "12\n00"),
-            "operator panel: haptics.stiffness_n_per_m = \"12\\n00\" is not a number; expected a number in [10, 5000] N/m");
+            "operator panel: haptics.stiffness_n_per_m = \"12\\x0A00\" is not a number; expected a number in [10, 5000] N/m");
   EXPECT_EQ(set_field_from_text(s, field("haptics", "level"), "two"),
             "operator panel: haptics.level = \"two\" is not a number; expected an integer in [0, 12]");
   EXPECT_EQ(s, before);

@@ -233,14 +233,11 @@ TEST(LoadImage, RefusesEveryCommittedBadFile) {
 }
 
 TEST(LoadImage, RefusesADecompressionBombFromItsHeaderAlone) {
-  // 45 bytes declaring 10^10 pixels (30 GB as BGR): refused from the header, so quickly and
-  // without the allocation a decoder would make.
-  const auto t0 = std::chrono::steady_clock::now();
+  // 45 bytes declaring 10^10 pixels (30 GB as BGR): refused from the header alone, before any decoder
+  // runs: the message gives the declared size, which only the header holds.
   const std::string msg = refusal([] { load_image(kData + "/bad/huge_declared.png", {}); }, "huge_declared.png");
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(contains(msg, "100000 x 100000 px")) << msg;
   EXPECT_TRUE(contains(msg, "limit of 10000 x 10000 px")) << msg;
-  EXPECT_LT(s, 1.0);
 
   ImageLimits wide;  // within the side limits, over the pixel-count limit
   wide.max_width_px = 200000;

@@ -38,7 +38,7 @@ class FileFrameSource final : public FrameSource {
   }
 
   std::string name() const override {
-    const std::string path = "file '" + printable_path(spec_.path) + "'";
+    const std::string path = "file '" + hk::one_line(spec_.path) + "'";
     if (!folder_) return path + " (1 image)";
     return path + " (" + std::to_string(files_.size()) + (files_.size() == 1 ? " frame)" : " frames)");
   }

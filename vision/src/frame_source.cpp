@@ -19,7 +19,7 @@ namespace hk::vision {
 namespace detail {
 
 void throw_camera_error(const SourceSpec& spec, const std::string& problem) {
-  throw CameraError("camera '" + printable_path(spec.str()) + "': " + problem);
+  throw CameraError("camera '" + hk::one_line(spec.str()) + "': " + problem);
 }
 
 std::string errno_text(int err) { return std::system_category().message(err); }
@@ -31,7 +31,7 @@ namespace {
 constexpr const char* kExpectedKinds = "expected file:PATH, libcamera:N or v4l2:DEV";
 
 [[noreturn]] void throw_spec_error(const std::string& spec, const std::string& problem) {
-  throw CameraError("camera source '" + detail::printable_path(spec) + "': " + problem);
+  throw CameraError("camera source '" + hk::one_line(spec) + "': " + problem);
 }
 
 /// A non-negative decimal integer written with digits only (no sign, no space), or -1.
@@ -48,7 +48,7 @@ int parse_decimal(const std::string& text) {
 
 void check_params(const SourceSpec& spec, const FrameSourceParams& p) {
   const auto bad = [&](const std::string& what) {
-    throw std::invalid_argument("camera '" + detail::printable_path(spec.str()) + "': " + what);
+    throw std::invalid_argument("camera '" + hk::one_line(spec.str()) + "': " + what);
   };
   if (p.width_px < 64 || p.width_px > 8192) bad("width_px " + std::to_string(p.width_px) + " is outside [64, 8192]");
   if (p.height_px < 64 || p.height_px > 8192) bad("height_px " + std::to_string(p.height_px) + " is outside [64, 8192]");

@@ -5,14 +5,12 @@
 
 #include <string>
 
+#include "hk/text.hpp"
 #include "vision/intake.hpp"
 
 namespace hk::vision::detail {
 
-/// The path with control characters (< 0x20, 0x7F) written as \xNN, so it prints on one line.
-std::string printable_path(const std::string& path);
-
-/// Throws InputError("image '<printable path>': <problem>"). problem must be one line.
+/// Throws InputError("image '<hk::one_line(path)>': <problem>"). problem must be one line.
 [[noreturn]] void throw_input_error(const std::string& path, const std::string& problem);
 
 }  // namespace hk::vision::detail

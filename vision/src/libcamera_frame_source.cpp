@@ -165,7 +165,7 @@ std::optional<Conversion> conversion_of(const lc::PixelFormat& f) {
 /// The camera's model property, else its id; control characters escaped.
 std::string camera_model(const lc::Camera& camera) {
   const std::optional<std::string> model = camera.properties().get(lc::properties::Model);
-  return printable_path(model && !model->empty() ? *model : camera.id());
+  return hk::one_line(model && !model->empty() ? *model : camera.id());
 }
 
 double steady_now_s() {
@@ -285,14 +285,14 @@ class LibcameraFrameSource final : public FrameSource {
     if (!chosen) {
       std::string list;
       for (const lc::PixelFormat& f : offered) list += (list.empty() ? "" : ", ") + f.toString();
-      fail("no usable pixel format (offers " + (list.empty() ? std::string("none") : printable_path(list)) +
+      fail("no usable pixel format (offers " + (list.empty() ? std::string("none") : hk::one_line(list)) +
            "; RGB888, BGR888, XRGB8888, XBGR8888, YUYV, NV12 or MJPEG needed)");
     }
     cfg.pixelFormat = *chosen;
     cfg.size = lc::Size(static_cast<unsigned>(params_.width_px), static_cast<unsigned>(params_.height_px));
     if (config_->validate() == lc::CameraConfiguration::Invalid) fail("the stream configuration was refused");
     const std::optional<Conversion> conversion = conversion_of(cfg.pixelFormat);
-    if (!conversion) fail("the camera changed the pixel format to " + printable_path(cfg.pixelFormat.toString()));
+    if (!conversion) fail("the camera changed the pixel format to " + hk::one_line(cfg.pixelFormat.toString()));
     conversion_ = *conversion;
     width_ = static_cast<int>(cfg.size.width);
     height_ = static_cast<int>(cfg.size.height);

@@ -84,7 +84,7 @@ std::string fmt_num(double v) {
 }
 
 [[noreturn]] void fail(PdfError::Kind kind, const std::string& name, const std::string& problem) {
-  throw PdfError(kind, "pdf '" + detail::printable_path(name) + "': " + problem);
+  throw PdfError(kind, "pdf '" + hk::one_line(name) + "': " + problem);
 }
 
 // ---------------------------------------------------------------------------------------------------

@@ -8,6 +8,7 @@
 
 #include <cstring>
 
+#include "hk/text.hpp"
 #include "image_header_detail.hpp"
 #include "input_error.hpp"
 
@@ -42,7 +43,8 @@ std::vector<std::uint8_t> png_decodable_copy(std::span<const std::uint8_t> bytes
     const std::uint8_t* chunk = bytes.data() + pos;
     const std::uint32_t len = be32(chunk);
     const std::uint8_t* type = chunk + 4;
-    const std::string name(reinterpret_cast<const char*>(type), 4);
+    // The type's 4 bytes as the file has them: letters in a sound file, anything in a damaged one.
+    const std::string name = hk::one_line(std::string_view(reinterpret_cast<const char*>(type), 4));
     if (len > 0x7FFFFFFFU || len > n - pos - 12) {
       throw_input_error(path, "truncated PNG: chunk '" + name + "' at byte " + std::to_string(pos) +
                                   " runs past the end of the file");

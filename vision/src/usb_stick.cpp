@@ -120,38 +120,124 @@ std::string mount_failure(int err, const std::string& type) {
   }
 }
 
-/// Makes `dir` an empty folder with mode 0700 that is not a mount point. A folder left by a kiosk that
-/// crashed while a stick was mounted is detached and removed first.
-void fresh_mount_point(const std::string& devnode, const std::string& dir) {
-  struct stat st {};
-  if (::lstat(dir.c_str(), &st) == 0) {
-    if (!S_ISDIR(st.st_mode)) refuse(devnode, "the mount point " + dir + " exists and is not a folder");
-    (void)::umount2(dir.c_str(), MNT_DETACH | UMOUNT_NOFOLLOW);  // EINVAL when nothing is mounted there
-    if (::rmdir(dir.c_str()) != 0) {
-      refuse(devnode, "cannot clear the old mount point " + dir + ": " + errno_text(errno));
-    }
-  } else if (errno != ENOENT) {
-    refuse(devnode, "cannot examine the mount point " + dir + ": " + errno_text(errno));
+/// A descriptor owned by a scope, that can be handed on (release) or replaced (reset).
+class OwnedFd {
+ public:
+  explicit OwnedFd(int fd = -1) : fd_(fd) {}
+  ~OwnedFd() { reset(); }
+  OwnedFd(const OwnedFd&) = delete;
+  OwnedFd& operator=(const OwnedFd&) = delete;
+  int get() const { return fd_; }
+  void reset(int fd = -1) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = fd;
   }
-  if (::mkdir(dir.c_str(), 0700) != 0) refuse(devnode, "cannot create the mount point " + dir + ": " + errno_text(errno));
-  (void)::chmod(dir.c_str(), 0700);  // exactly 0700, whatever the umask
+
+ private:
+  int fd_;
+};
+
+/// "/proc/self/fd/N": the path that reaches exactly what descriptor N holds open, whatever happens to
+/// the names on the way to it meanwhile.
+std::string fd_path(int fd) { return "/proc/self/fd/" + std::to_string(fd); }
+
+/// `root` without trailing slashes ("/" stays "/").
+std::string trimmed_root(std::string root) {
+  while (root.size() > 1 && root.back() == '/') root.pop_back();
+  return root;
 }
 
-/// Creates `root` and its missing parents, each new one with mode 0700.
-void make_root(const std::string& devnode, const std::string& root) {
-  if (root.empty()) refuse(devnode, "no mount root given");
-  std::string path;
-  std::size_t pos = 0;
-  while (pos != std::string::npos) {
-    pos = root.find('/', pos + 1);
-    path = root.substr(0, pos);
-    if (path.empty() || path == "/") continue;
-    if (::mkdir(path.c_str(), 0700) != 0 && errno != EEXIST) {
-      refuse(devnode, "cannot create the mount root " + path + ": " + errno_text(errno));
+/// Opens the folder `root` (absolute) from "/" one component at a time with O_PATH | O_DIRECTORY |
+/// O_NOFOLLOW, so no symbolic link anywhere in it is followed; with `create`, missing folders are made
+/// with mode 0700. Returns the descriptor, or -1 when a component is missing and !create. Throws
+/// StickMountError "<who>: ..." for a relative path, "..", a link or a non-folder on the way.
+int open_root(const std::string& who, const std::string& root, bool create) {
+  const auto fail = [&who](const std::string& what) -> void {
+    std::string line = who + ": " + what;
+    for (char& c : line) {
+      if (c == '\n' || c == '\r') c = ' ';
     }
+    throw StickMountError(line);
+  };
+  if (root.empty() || root.front() != '/') fail("the mount root '" + root + "' is not an absolute path");
+  OwnedFd dir(::open("/", O_PATH | O_DIRECTORY | O_CLOEXEC));
+  if (dir.get() < 0) fail("cannot open / (" + errno_text(errno) + ")");
+  std::string walked;
+  std::size_t pos = 0;
+  while (pos < root.size()) {
+    const std::size_t next = root.find('/', pos);
+    const std::string part = root.substr(pos, next == std::string::npos ? std::string::npos : next - pos);
+    pos = next == std::string::npos ? root.size() : next + 1;
+    if (part.empty() || part == ".") continue;
+    if (part == "..") fail("the mount root '" + root + "' contains '..'");
+    walked += "/" + part;
+    int fd = ::openat(dir.get(), part.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0 && errno == ENOENT) {
+      if (!create) return -1;
+      if (::mkdirat(dir.get(), part.c_str(), 0700) != 0 && errno != EEXIST) {
+        fail("cannot create the mount root " + walked + ": " + errno_text(errno));
+      }
+      fd = ::openat(dir.get(), part.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    }
+    if (fd < 0) {
+      if (errno == ENOTDIR || errno == ELOOP) fail("the mount root's part " + walked + " is a symbolic link or not a folder");
+      fail("cannot open the mount root's part " + walked + ": " + errno_text(errno));
+    }
+    dir.reset(fd);
   }
+  const int out = ::fcntl(dir.get(), F_DUPFD_CLOEXEC, 0);
+  if (out < 0) fail("cannot open the mount root " + root + ": " + errno_text(errno));
+  return out;
+}
+
+/// umount2(MNT_DETACH) of the filesystem mounted on the folder `name` in `root_fd`, reached without
+/// following a link. 0, or the errno (EINVAL: nothing is mounted there; ENOENT: no such folder).
+int detach_at(int root_fd, const std::string& name) {
+  OwnedFd fd(::openat(root_fd, name.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  if (fd.get() < 0) return errno;
+  return ::umount2(fd_path(fd.get()).c_str(), MNT_DETACH) == 0 ? 0 : errno;
+}
+
+/// Makes `name` in the folder `root_fd` an empty folder with mode 0700 that is not a mount point (a
+/// folder left by a kiosk that crashed while a stick was mounted is detached and removed first) and
+/// returns a descriptor of it, checked to be a folder of this process's effective user (one swapped in
+/// by someone else between the mkdir and the open is refused). `shown` names it in messages.
+int fresh_mount_point(const std::string& devnode, int root_fd, const std::string& name, const std::string& shown) {
   struct stat st {};
-  if (::stat(root.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) refuse(devnode, "the mount root " + root + " is not a folder");
+  if (::fstatat(root_fd, name.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0) {
+    if (!S_ISDIR(st.st_mode)) refuse(devnode, "the mount point " + shown + " exists and is not a folder");
+    (void)detach_at(root_fd, name);  // EINVAL when nothing is mounted there
+    if (::unlinkat(root_fd, name.c_str(), AT_REMOVEDIR) != 0) {
+      refuse(devnode, "cannot clear the old mount point " + shown + ": " + errno_text(errno));
+    }
+  } else if (errno != ENOENT) {
+    refuse(devnode, "cannot examine the mount point " + shown + ": " + errno_text(errno));
+  }
+  if (::mkdirat(root_fd, name.c_str(), 0700) != 0) refuse(devnode, "cannot create the mount point " + shown + ": " + errno_text(errno));
+  const int fd = ::openat(root_fd, name.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) {
+    const int err = errno;
+    (void)::unlinkat(root_fd, name.c_str(), AT_REMOVEDIR);
+    refuse(devnode, "cannot open the mount point " + shown + ": " + errno_text(err));
+  }
+  if (::fstat(fd, &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != ::geteuid()) {
+    ::close(fd);
+    refuse(devnode, "the mount point " + shown + " was replaced while it was being made, so nothing is mounted");
+  }
+  (void)::fchmod(fd, 0700);  // exactly 0700, whatever the umask
+  return fd;
+}
+
+/// Whether the block device is free: its exclusive open (O_EXCL) succeeds, which the kernel refuses with
+/// EBUSY while a filesystem is mounted from it or, for a whole disk, from one of its partitions.
+void check_not_in_use(const std::string& devnode) {
+  const int fd = ::open(devnode.c_str(), O_RDONLY | O_EXCL | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
+  if (fd >= 0) {
+    ::close(fd);
+    return;
+  }
+  if (errno == EBUSY) refuse(devnode, "it is in use (mounted elsewhere, or a disk with a partition in use), so it is not mounted");
+  refuse(devnode, "cannot open the device exclusively: " + errno_text(errno));
 }
 
 }  // namespace
@@ -188,7 +274,9 @@ std::string mount_capability_hint() {
 // MountedStick
 
 MountedStick::MountedStick(const std::string& devnode, const std::string& mount_root, int slot) : devnode_(devnode) {
-  if (slot < 0) refuse(devnode, "invalid mount slot " + std::to_string(slot));
+  if (slot < 0 || slot > kMaxStickSlot) {
+    refuse(devnode, "invalid mount slot " + std::to_string(slot) + " (0 to " + std::to_string(kMaxStickSlot) + ")");
+  }
   struct stat st {};
   Fd fd(open_for_probe(devnode, &st));
   if (!S_ISBLK(st.st_mode)) refuse(devnode, "not a block device");
@@ -200,35 +288,54 @@ MountedStick::MountedStick(const std::string& devnode, const std::string& mount_
   }
   if (!have_mount_capability()) refuse(devnode, "cannot mount it: " + mount_capability_hint());
 
-  // 2. Read-only at the block layer, before any filesystem driver sees the device.
+  // The mount point, reached without links (a stale mount on it is detached here, which frees the device).
+  root_ = trimmed_root(mount_root);
+  const std::string name = std::to_string(slot);
+  mount_point_ = (root_ == "/" ? "" : root_) + "/" + name;
+  OwnedFd root_fd(open_root("stick '" + devnode + "'", root_, true));
+  OwnedFd point(fresh_mount_point(devnode, root_fd.get(), name, mount_point_));
+  const auto drop_point = [&] {
+    point.reset();
+    (void)::unlinkat(root_fd.get(), name.c_str(), AT_REMOVEDIR);
+  };
+
+  // 2. Read-only at the block layer, before any filesystem driver sees the device; never a device in use.
+  try {
+    check_not_in_use(devnode);
+  } catch (...) {
+    drop_point();
+    throw;
+  }
   const int one = 1;
   if (::ioctl(fd.get(), BLKROSET, &one) != 0) {
-    refuse(devnode, "cannot make the device read-only (BLKROSET: " + errno_text(errno) + "), so it is not mounted");
+    const int err = errno;
+    drop_point();
+    refuse(devnode, "cannot make the device read-only (BLKROSET: " + errno_text(err) + "), so it is not mounted");
   }
   int ro = 0;
   if (::ioctl(fd.get(), BLKROGET, &ro) != 0 || ro != 1) {
+    drop_point();
     refuse(devnode, "the device did not become read-only, so it is not mounted");
   }
 
-  // 3. Mount.
-  make_root(devnode, mount_root);
-  std::string root = mount_root;
-  while (root.size() > 1 && root.back() == '/') root.pop_back();
-  mount_point_ = (root == "/" ? "" : root) + "/" + std::to_string(slot);
-  fresh_mount_point(devnode, mount_point_);
+  // 3. Mount, onto the folder held open (not a path looked up again).
   const unsigned long flags = MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC | MS_NOSYMFOLLOW | MS_NOATIME;
   const std::string data = mount_data(fs_);
-  if (::mount(devnode.c_str(), mount_point_.c_str(), kernel_fs_type(fs_).c_str(), flags,
+  if (::mount(devnode.c_str(), fd_path(point.get()).c_str(), kernel_fs_type(fs_).c_str(), flags,
               data.empty() ? nullptr : data.c_str()) != 0) {
     const int err = errno;
-    (void)::rmdir(mount_point_.c_str());
+    drop_point();
     refuse(devnode, mount_failure(err, fs_));
   }
+  point.reset();
   mounted_ = true;
 
   // The device node is looked up again by mount(2): make sure it is still the device probed above.
   struct stat mounted {};
-  if (::stat(mount_point_.c_str(), &mounted) != 0 || mounted.st_dev != st.st_rdev) {
+  const int top = ::openat(root_fd.get(), name.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+  const bool same = top >= 0 && ::fstat(top, &mounted) == 0 && mounted.st_dev == st.st_rdev;
+  if (top >= 0) ::close(top);
+  if (!same) {
     unmount();
     refuse(devnode, "the device changed while it was being mounted, so it was unmounted again");
   }
@@ -239,9 +346,40 @@ MountedStick::~MountedStick() { (void)unmount(); }
 bool MountedStick::unmount() {
   if (!mounted_) return true;
   mounted_ = false;
-  bool ok = ::umount2(mount_point_.c_str(), MNT_DETACH | UMOUNT_NOFOLLOW) == 0;
-  ok = (::rmdir(mount_point_.c_str()) == 0) && ok;
-  return ok;
+  const std::string name = mount_point_.substr(mount_point_.rfind('/') + 1);
+  try {
+    OwnedFd root_fd(open_root("stick '" + devnode_ + "'", root_, false));
+    if (root_fd.get() < 0) return false;
+    bool ok = detach_at(root_fd.get(), name) == 0;
+    ok = ::unlinkat(root_fd.get(), name.c_str(), AT_REMOVEDIR) == 0 && ok;
+    return ok;
+  } catch (const StickMountError&) {
+    return false;
+  }
+}
+
+bool unmount_stick_slot(const std::string& mount_root, int slot) {
+  const std::string who = "stick slot " + std::to_string(slot);
+  if (slot < 0 || slot > kMaxStickSlot) {
+    throw StickMountError(who + ": not a slot (0 to " + std::to_string(kMaxStickSlot) + ")");
+  }
+  const std::string root = trimmed_root(mount_root);
+  const std::string name = std::to_string(slot);
+  const std::string shown = (root == "/" ? "" : root) + "/" + name;
+  OwnedFd root_fd(open_root(who, root, false));
+  if (root_fd.get() < 0) return false;  // no mount root: nothing was ever mounted there
+  struct stat st {};
+  if (::fstatat(root_fd.get(), name.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) {
+    if (errno == ENOENT) return false;
+    throw StickMountError(who + ": cannot examine " + shown + ": " + errno_text(errno));
+  }
+  if (!S_ISDIR(st.st_mode)) throw StickMountError(who + ": " + shown + " is not a folder, so nothing is unmounted");
+  const int err = detach_at(root_fd.get(), name);
+  if (err != 0 && err != EINVAL) throw StickMountError(who + ": cannot unmount " + shown + ": " + errno_text(err));
+  if (::unlinkat(root_fd.get(), name.c_str(), AT_REMOVEDIR) != 0) {
+    throw StickMountError(who + ": cannot remove " + shown + ": " + errno_text(errno));
+  }
+  return err == 0;
 }
 
 // ---------------------------------------------------------------------------------------------------

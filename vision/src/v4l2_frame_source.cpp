@@ -62,7 +62,7 @@ std::uint32_t node_caps(const v4l2_capability& cap) {
 /// A fixed-size, possibly unterminated driver string (card, driver), control characters escaped.
 std::string driver_string(const std::uint8_t* s, std::size_t size) {
   const auto* c = reinterpret_cast<const char*>(s);
-  return printable_path(std::string(c, strnlen(c, size)));
+  return hk::one_line(std::string(c, strnlen(c, size)));
 }
 
 /// "YUYV", "MJPG", ...: a fourcc as text, unprintable bytes as '?'.
@@ -161,7 +161,7 @@ class V4l2FrameSource final : public FrameSource {
     streaming_ = true;
   }
 
-  std::string name() const override { return "V4L2 camera " + printable_path(spec_.path) + " (" + card_ + ")"; }
+  std::string name() const override { return "V4L2 camera " + hk::one_line(spec_.path) + " (" + card_ + ")"; }
 
   bool next(Frame& out, double timeout_s) override {
     if (requeue_failed_) fail("VIDIOC_QBUF: " + errno_text(requeue_errno_));

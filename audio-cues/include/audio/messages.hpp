@@ -9,6 +9,7 @@
 /// table of the catalogue gives that spoken form for every key name ("UP" → "the Up arrow"). The
 /// catalogue knows nothing of the settings: the caller passes the key names (KeyArg).
 
+#include "hk/error.hpp"
 #include <array>
 #include <functional>
 #include <initializer_list>
@@ -53,9 +54,9 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".
-class MessageError : public std::runtime_error {
+class MessageError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// A named value for a {placeholder}.

@@ -10,6 +10,7 @@
 /// serialised by one process-wide mutex, and it is initialised once per process (on first use). Nothing
 /// else in the process should call espeak-ng directly.
 
+#include "hk/error.hpp"
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -40,9 +41,9 @@ struct SpeechParams {
 
 /// espeak-ng could not start, a voice or parameter was refused, or a text is too long. what() is one
 /// line naming the voice / parameter and the limit, e.g. "speech: espeak-ng has no voice 'xx'".
-class SpeechError : public std::runtime_error {
+class SpeechError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// Longest text spoken at once [bytes of UTF-8]; longer text is refused (a catalogue message is ≤ 1000).

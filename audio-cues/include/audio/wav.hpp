@@ -5,6 +5,7 @@
 /// file I/O, so never call them from the audio callback or the servo thread. Any thread may call them
 /// concurrently on different paths.
 
+#include "hk/error.hpp"
 #include <cstdint>
 #include <span>
 #include <stdexcept>
@@ -15,9 +16,9 @@ namespace hk::audio {
 
 /// A WAV file that cannot be written or read. what() is one line (control characters in the path are
 /// shown as \xNN) naming the file and the problem, e.g. "wav '/tmp/a.wav': not a sound file (...)".
-class WavError : public std::runtime_error {
+class WavError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// Longest file read_wav() accepts [frames]: one hour at 48 kHz (172 800 000 frames, 691 MB of

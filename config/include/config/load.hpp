@@ -11,6 +11,7 @@
 /// All field knowledge (table, key, range, unit, help) lives in one descriptor table,
 /// field_descriptors(), which load, validate and to_toml share.
 
+#include "hk/error.hpp"
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -27,7 +28,7 @@ namespace hk::config {
 /// what() is a single line (no newline characters; control characters in values are escaped)
 /// naming the source (the file path, or "settings" for an in-memory Settings), the key as
 /// `table.key` when one key is at fault, the bad value, and the allowed range or type.
-class ConfigError : public std::runtime_error {
+class ConfigError : public hk::Error {
  public:
   /// @param source  the file path or "settings"; @param key  `table.key` or empty;
   /// @param message the full one-line message returned by what().

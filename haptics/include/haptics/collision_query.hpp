@@ -132,10 +132,18 @@ class BoundarySection {
   std::vector<Aabb> section_box_;          // their rectangles, inline so the per-tick scan streams through memory
   std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
   std::vector<std::uint8_t> removed_;      // per node: 1 when split/merged away this tick (compacted at the end)
-  struct Candidate { double t_enter; std::uint32_t node; };
+  struct Candidate { double t_enter; std::uint32_t node; };  // 16 bytes
+  static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
+  /// Checked push onto the DFS stack (sized by hk::tree_stack_entries): false, and nothing pushed, when it
+  /// is full, which a tree within kMaxLevels + kMaxHierarchyDepth levels never fills.
+  bool push(int& top, Candidate c) noexcept {
+    if (static_cast<std::size_t>(top) >= stack_.size()) return false;
+    stack_[static_cast<std::size_t>(top++)] = c;
+    return true;
+  }
   std::vector<Candidate> candidates_;      // section nodes hit this tick
   std::vector<std::uint32_t> merge_scratch_;
-  std::vector<Candidate> stack_;           // DFS stack, sized for the widest root fan-out plus 2 per level
+  std::vector<Candidate> stack_;           // DFS stack, tree_stack_entries(widest fan-out) entries, sized at build
   std::vector<std::uint32_t> hit_stamp_;   // per node: tick at which its margin-grown box was last hit
   std::vector<std::uint32_t> merge_stamp_; // per node: tick at which it was last considered for a merge
   std::uint32_t tick_ = 0;

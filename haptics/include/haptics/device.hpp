@@ -8,6 +8,7 @@
 /// must not allocate, lock, throw or block. `open` and `close` are called outside the servo loop and may
 /// throw `DeviceError`.
 
+#include "hk/error.hpp"
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -32,9 +33,9 @@ struct DeviceSample {
 };
 
 /// Setup or I/O failure of a device (only thrown from `open` / `close`, never from the servo path).
-class DeviceError : public std::runtime_error {
+class DeviceError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// A 2-DOF force-feedback device seen through its handle.

@@ -4,6 +4,7 @@
 /// frame, linearly interpolated. Built in code (`raster_path`) or read from a hand file
 /// (`load_hand_csv`, header `t_s,x_m,y_m`).
 
+#include "hk/error.hpp"
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -59,9 +60,9 @@ HandPath raster_path_with_line_speeds(double width_m, double height_m, double sp
 
 /// A bad hand file. what() is one line: `hand file '<path>' line <n>: <problem>` (no line number
 /// when the file cannot be opened), naming the limit for limit violations.
-class HandFileError : public std::runtime_error {
+class HandFileError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// Limits applied by `load_hand_csv`. The defaults are the kiosk's; tests lower them.

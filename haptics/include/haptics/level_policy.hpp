@@ -20,6 +20,7 @@
 #include <cstdint>
 
 #include "haptics/vec2.hpp"
+#include "hk/constants.hpp"
 
 namespace hk {
 
@@ -36,7 +37,7 @@ struct LevelPolicyParams {
 /// Picks the level each tick. Level 0 is the finest.
 class LevelPolicy {
  public:
-  static constexpr int kMaxLevels = 16;
+  static constexpr int kMaxLevels = hk::kMaxLevels;  ///< see hk/constants.hpp
 
   /// `level_error_m[l]` is the scene's error bound at level l [m] (non-decreasing in l, e.g. the largest
   /// box half-width of the level), for l in [0, levels). `start_level` is used until the first change.

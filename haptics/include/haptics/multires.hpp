@@ -11,6 +11,7 @@
 /// coefficients outside the curve as zero and leaves the two end samples alone, so an open curve keeps
 /// its end points at every level.
 
+#include "hk/error.hpp"
 #include <cstddef>
 #include <stdexcept>
 #include <vector>
@@ -26,9 +27,9 @@ struct Polyline {
 };
 
 /// Thrown at setup for a curve the multiresolution cannot be built from (too few points, non-finite).
-class CurveError : public std::invalid_argument {
+class CurveError : public hk::Error {
  public:
-  using std::invalid_argument::invalid_argument;
+  using hk::Error::Error;
 };
 
 /// Resamples a polyline at `count` points equally spaced in arc length.

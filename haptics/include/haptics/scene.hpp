@@ -18,6 +18,7 @@
 
 #include "haptics/multires.hpp"
 #include "haptics/vec2.hpp"
+#include "hk/constants.hpp"
 
 namespace hk {
 
@@ -31,11 +32,13 @@ struct ErrorBox {
   double n_min = 0.0;   ///< extent along the left normal [m]
   double n_max = 0.0;
 };
+static_assert(sizeof(ErrorBox) == 64, "ErrorBox: one cache line per box");
 
 /// An axis-aligned rectangle [m]: the cheap first test before a box's exact clip. 32 bytes.
 struct Aabb {
   Vec2 lo, hi;
 };
+static_assert(sizeof(Aabb) == 32, "Aabb: two per cache line");
 
 /// True when two rectangles overlap after growing `a` by margin_m on every side.
 inline bool overlaps(const Aabb& a, const Aabb& b, double margin_m) {
@@ -53,20 +56,21 @@ double box_half_width(const ErrorBox& box);
 struct CurveInfo {
   bool closed = false;
   int levels = 0;
-  std::uint32_t point_offset[16] = {};   ///< index of level l's first point in Scene::points_m
-  std::uint32_t point_count[16] = {};    ///< points of level l
-  std::uint32_t box_offset[16] = {};     ///< node id of level l's first segment
-  std::uint32_t segment_count[16] = {};  ///< segments of level l (closed: points; open: points − 1)
-  double max_error_m[16] = {};           ///< largest distance of an original point from the level-l segment standing for it [m]
-  double max_box_half_width_m[16] = {};  ///< largest error box half-width at level l [m]
+  std::uint32_t point_offset[kMaxLevels] = {};   ///< index of level l's first point in Scene::points_m
+  std::uint32_t point_count[kMaxLevels] = {};    ///< points of level l
+  std::uint32_t box_offset[kMaxLevels] = {};     ///< node id of level l's first segment
+  std::uint32_t segment_count[kMaxLevels] = {};  ///< segments of level l (closed: points; open: points − 1)
+  double max_error_m[kMaxLevels] = {};           ///< largest distance of an original point from the level-l segment standing for it [m]
+  double max_box_half_width_m[kMaxLevels] = {};  ///< largest error box half-width at level l [m]
 };
 
-/// Identifies one segment of one level of one curve.
+/// Identifies one segment of one level of one curve. 12 bytes.
 struct SegmentRef {
   std::int32_t curve = -1;
   std::int32_t level = 0;
   std::int32_t segment = -1;
 };
+static_assert(sizeof(SegmentRef) == 12, "SegmentRef: passed by value in the servo path");
 constexpr bool operator==(SegmentRef a, SegmentRef b) { return a.curve == b.curve && a.level == b.level && a.segment == b.segment; }
 
 /// Per-node bookkeeping the tree walks need. 12 bytes.
@@ -75,6 +79,7 @@ struct NodeInfo {
   std::int32_t level = 0;     ///< segment level; `levels` of its curve for a chunk; kHierarchyLevel above
   std::uint32_t index = 0;    ///< segment index within its level; a chunk's first coarsest segment; 0 above
 };
+static_assert(sizeof(NodeInfo) == 12, "NodeInfo: 12 bytes per node");
 
 /// Build timings of a scene [ms].
 struct SceneBuildTimes {
@@ -85,7 +90,7 @@ struct SceneBuildTimes {
 /// All curves of a picture, ready for the servo loop. Immutable once built; shared read-only.
 class Scene {
  public:
-  static constexpr int kMaxLevels = 16;
+  static constexpr int kMaxLevels = hk::kMaxLevels;  ///< see hk/constants.hpp
   static constexpr std::int32_t kHierarchyLevel = 1000;  ///< NodeInfo::level of the nodes above the chunks
 
   /// Builds multiresolution models and collision trees for `curves` (workspace metres), with at most

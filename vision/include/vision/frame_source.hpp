@@ -10,6 +10,7 @@
 /// decided from frames over time (framing guidance: "hold still", "whole and still for 1 s") is the same
 /// for a camera in real time and for a folder of frames read as fast as the disk allows.
 
+#include "hk/error.hpp"
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -24,9 +25,9 @@ namespace hk::vision {
 /// naming the source and the problem (control characters escaped), e.g.
 /// "camera 'v4l2:/dev/video9': cannot open: No such file or directory",
 /// "camera source 'usb:1': unknown kind (expected file:PATH, libcamera:N or v4l2:DEV)".
-class CameraError : public std::runtime_error {
+class CameraError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// A parsed source spec.

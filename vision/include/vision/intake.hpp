@@ -9,6 +9,7 @@
 /// bytes already checked (not by reopening the path, which could have changed in between).
 /// Every refusal is an InputError whose message is one line naming the file and the problem.
 
+#include "hk/error.hpp"
 #include <cstdint>
 #include <span>
 #include <stdexcept>
@@ -30,9 +31,9 @@ struct ImageLimits {
 /// A refused input file. what() is a single line (control characters in the path are escaped)
 /// of the form "image '<path>': <problem>", e.g.
 /// "image 'x.png': declared size 100000 x 100000 px exceeds the limit of 10000 x 10000 px".
-class InputError : public std::runtime_error {
+class InputError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// What an image file's header declares, read without decoding any pixel data.

@@ -15,6 +15,7 @@
 /// then the page: rendered in grey (poppler::page_renderer, antialiasing on) at the DPI that keeps the
 /// page within the pixel budget, and its words (page::text_list) in the same pixel frame.
 
+#include "hk/error.hpp"
 #include <cstdint>
 #include <span>
 #include <stdexcept>
@@ -101,12 +102,12 @@ struct PdfPage {
 
 /// A refused or unreadable PDF or page. what() is one line: "pdf '<name>': <problem>", e.g.
 /// "pdf 'report.pdf': protected by a password", "pdf 'x.pdf': page 3 took longer than 5 s to draw".
-class PdfError : public std::runtime_error {
+class PdfError : public hk::Error {
  public:
   /// NotPdf: no "%PDF-" header; Damaged: poppler cannot read it; Locked: needs a password; NoSuchPage;
   /// TooLarge: a file, page or memory limit; Timeout: wall-clock or CPU limit; WorkerCrashed: the worker died.
   enum class Kind { NotPdf, Damaged, Locked, NoSuchPage, TooLarge, Timeout, WorkerCrashed };
-  PdfError(Kind kind, const std::string& what) : std::runtime_error(what), kind_(kind) {}
+  PdfError(Kind kind, const std::string& what) : hk::Error(what), kind_(kind) {}
   Kind kind() const { return kind_; }
 
  private:

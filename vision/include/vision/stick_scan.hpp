@@ -11,6 +11,7 @@
 /// File names are bytes: they are kept as found for opening, and made safe for speech and display with
 /// safe_display_name.
 
+#include "hk/error.hpp"
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -57,9 +58,9 @@ struct StickScan {
 };
 
 /// Refusal of the scan as a whole (the root cannot be opened, or is not a folder). One line naming it.
-class StickError : public std::runtime_error {
+class StickError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// Walks the folder `root` (a mounted stick, or any folder for tests and `haptic-kiosk stick DIR`).

@@ -15,8 +15,16 @@
 /// 3. mount(2) under `<mount_root>/<N>` with MS_RDONLY | MS_NOSUID | MS_NODEV | MS_NOEXEC |
 ///    MS_NOSYMFOLLOW | MS_NOATIME (plus, for ext4, "noload" so no journal is replayed);
 /// 4. on removal or destruction, umount2(MNT_DETACH) and remove the mount point.
-/// The kiosk needs CAP_SYS_ADMIN for steps 2 and 3; have_mount_capability() tells beforehand.
+/// The kiosk needs CAP_SYS_ADMIN for steps 2 and 3; have_mount_capability() tells beforehand. Without it,
+/// the installed kiosk mounts through the narrow helper hk-stick-mount (app/stick_helper, reached through
+/// vision/stick_mount.hpp), which runs this same code with the capability.
+///
+/// The mount root and the mount point are reached from "/" one folder at a time without following any
+/// symbolic link, and mount(2) and umount2(2) are given the opened folder (/proc/self/fd/N), never a path
+/// looked up again: the helper runs with CAP_SYS_ADMIN for a user who owns /run/haptic-kiosk, and a link
+/// or a folder swapped in there must not move a mount anywhere else.
 
+#include "hk/error.hpp"
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -72,9 +80,9 @@ class FakeBlockEventSource final : public BlockEventSource {
 };
 
 /// A refused stick or failed mount. what() is one line naming the device: "stick '/dev/sdb1': ...".
-class StickMountError : public std::runtime_error {
+class StickMountError : public hk::Error {
  public:
-  using std::runtime_error::runtime_error;
+  using hk::Error::Error;
 };
 
 /// The filesystem type libblkid finds on `devnode` ("vfat", "exfat", "ntfs", "ext4", "iso9660", "swap",
@@ -107,8 +115,13 @@ class MountedStick {
   /// checked to be the one probed (a device node swapped meanwhile is unmounted and refused).
   /// The read-only flag stays set on the device after unmounting (a removed stick takes it along; a loop
   /// device keeps it until `blockdev --setrw`).
-  /// @throws StickMountError (not a block device, unsupported filesystem, no capability, BLKROSET
-  /// refused, mount refused by the kernel, e.g. no driver for the filesystem), one line naming devnode.
+  /// A device in use (mounted elsewhere, or a disk with a partition mounted: its exclusive open fails) is
+  /// refused before it is made read-only, so a disk the system runs from is never touched. `mount_root`
+  /// must be an absolute path without symbolic links in it; the mount point must be a folder this process's
+  /// effective user owns (it created it), or nothing is mounted.
+  /// @throws StickMountError (not a block device, slot outside [0, kMaxStickSlot], unsupported filesystem,
+  /// no capability, device in use, BLKROSET refused, a symbolic link in the mount root, mount refused by
+  /// the kernel, e.g. no driver for the filesystem), one line naming devnode.
   /// Nothing stays mounted and no mount point is left when it throws.
   MountedStick(const std::string& devnode, const std::string& mount_root, int slot);
   ~MountedStick();
@@ -122,11 +135,27 @@ class MountedStick {
   /// failure is logged by the caller through the return value (false: the detach or the rmdir failed).
   /// Files still open on the stick stay readable until closed (lazy detach).
   bool unmount();
+  /// Forgets the mount without unmounting it, so the destructor leaves the stick mounted. For the mount
+  /// helper (hk-stick-mount), whose process ends while the kiosk goes on reading the stick; the kiosk has it
+  /// unmounted later through unmount_stick_slot() (the helper's "unmount" verb).
+  void release() { mounted_ = false; }
 
  private:
   std::string devnode_, mount_point_, fs_;
+  std::string root_;  ///< the mount root, without trailing slashes
   bool mounted_ = false;
 };
+
+/// The highest slot MountedStick accepts: slots are 0 to kMaxStickSlot.
+inline constexpr int kMaxStickSlot = 999;
+
+/// Detaches whatever is mounted at `<mount_root>/<slot>` (umount2 with MNT_DETACH) and removes that
+/// folder, as MountedStick::unmount() does for its own mount; the mount helper's "unmount" verb. The path is
+/// walked from "/" without following symbolic links. Returns true when a filesystem was mounted there,
+/// false when there was none (a missing folder, or an empty one, which is removed).
+/// @throws StickMountError, one line starting "stick slot N: ": a slot outside [0, kMaxStickSlot], a part of
+/// the path that is a symbolic link or not a folder, or a detach or removal the kernel refused.
+bool unmount_stick_slot(const std::string& mount_root, int slot);
 
 /// The default mount root, "/run/haptic-kiosk/usb".
 inline constexpr const char* kDefaultStickMountRoot = "/run/haptic-kiosk/usb";

@@ -1,0 +1,28 @@
+#pragma once
+/// @file constants.hpp
+/// The numbers the real-time structures are sized by, in one place (DESIGN.md "Real-time rules": hot data
+/// in flat arrays, fixed stacks with a checked push). Each struct on the servo path asserts its own size
+/// in bytes next to its definition (haptics/scene.hpp, haptics/collision_query.hpp, audio/cue_event.hpp).
+#include <cstddef>
+#include <cstdint>
+
+namespace hk {
+
+/// Levels a curve's multiresolution model can have, level 0 (the finest) included. The per-level arrays
+/// of a curve (CurveInfo) and of the level policy have this many entries; [haptics] max_levels ≤ 12
+/// stays below it.
+inline constexpr int kMaxLevels = 16;
+
+/// Deepest hierarchy of nodes above the curves' chunks in a scene's collision tree (the tree over
+/// chunks halves per level, so 64 covers any scene that fits in memory).
+inline constexpr int kMaxHierarchyDepth = 64;
+
+/// Entries of the depth-first stack of a collision-tree walk whose widest node has `widest_fanout`
+/// children: a walk pushes at most every child of one node per level it descends, through at most
+/// kMaxLevels curve levels and kMaxHierarchyDepth hierarchy levels, plus the entry it starts from.
+/// BoundarySection sizes its stack with this at build; its push is checked against it all the same.
+constexpr std::size_t tree_stack_entries(std::size_t widest_fanout) {
+  return widest_fanout * static_cast<std::size_t>(kMaxLevels + kMaxHierarchyDepth) + 8;
+}
+
+}  // namespace hk

@@ -1,0 +1,109 @@
+// Inputs the fuzz harnesses (fuzz/fuzz_image.cpp, fuzz_pdf.cpp; scripts/fuzz.sh) found breaking a property, kept in
+// tests/data/fuzz/<harness>/ and fed through the same entry points: each must be refused with a one-line
+// error naming the input (or read correctly).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "vision/intake.hpp"
+#include "vision/pdf.hpp"
+
+namespace hk::vision {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kFuzzData = fs::path(HK_TEST_DATA_DIR) / "fuzz";
+
+std::vector<std::uint8_t> read_bytes(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+std::vector<fs::path> kept_inputs(const std::string& harness) {
+  std::vector<fs::path> out;
+  for (const auto& e : fs::directory_iterator(kFuzzData / harness)) out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// No C0 control (newline, escape...), no DEL, no C1 control (UTF-8 C2 80..C2 9F).
+bool one_line(const std::string& s) {
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const auto u = static_cast<unsigned char>(s[i]);
+    if (u < 0x20 || u == 0x7F) return false;
+    if (u == 0xC2 && i + 1 < s.size() && (static_cast<unsigned char>(s[i + 1]) & 0xE0) == 0x80) return false;
+  }
+  return true;
+}
+
+/// what() of the InputError decode_image must throw for `file` (named "stick/<file>").
+std::string image_refusal(const fs::path& file) {
+  try {
+    (void)decode_image(read_bytes(file), "stick/" + file.filename().string(), ImageLimits{});
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << file << " was decoded";
+  return {};
+}
+
+TEST(ImageFuzzRegressions, EveryKeptInputIsRefusedOnOneLine) {
+  const std::vector<fs::path> files = kept_inputs("image");
+  ASSERT_FALSE(files.empty());
+  for (const fs::path& p : files) {
+    const std::string what = image_refusal(p);
+    EXPECT_TRUE(one_line(what)) << p << ": " << what;
+    EXPECT_EQ(what.rfind("image 'stick/" + p.filename().string() + "': ", 0), 0u) << what;
+  }
+}
+
+TEST(ImageFuzzRegressions, PngChunkTypeOfControlBytesIsEscaped) {
+  // IHDR, then a chunk header whose length runs past the end and whose type is "@\x0F\x84\x18": the message
+  // quoted the 4 type bytes raw (a control character and a stray UTF-8 byte in the kiosk's log line).
+  const std::string what = image_refusal(kFuzzData / "image" / "png_chunk_type_control_bytes.png");
+  EXPECT_NE(what.find("truncated PNG: chunk '@\\x0F\\x84\\x18' at byte 33 runs past the end of the file"), std::string::npos)
+      << what;
+}
+
+TEST(PdfFuzzRegressions, EveryKeptInputEndsWithinTheWorkerLimits) {
+  // poppler 22.12 (not our code) is slow on some of these: huge_xref_subsection.pdf, a 4 KB file whose xref
+  // subsection starts at object 85000000000000000000000..., makes it build and copy enormous tables (3.5 s
+  // and 300 MB in pdftoppm; over 10 s in the fuzz harness, which runs poppler in-process under ASan).
+  // The kiosk never runs poppler in its own process: the worker's CPU and wall-clock limits end it, and the
+  // visitor gets a one-line PdfError (or the page, on a machine fast enough).
+  PdfLimits limits;
+  limits.worker_cpu_s = 2.0;
+  limits.worker_wall_s = 3.0;
+  for (const fs::path& p : kept_inputs("pdf")) {
+    SCOPED_TRACE(p.filename().string());
+    const std::vector<std::uint8_t> bytes = read_bytes(p);
+    const std::string name = "stick/" + p.filename().string();
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      const PdfInfo info = probe_pdf(bytes, name, limits);
+      ASSERT_GE(info.pages, 1);
+      const PdfPage page = render_pdf_page(bytes, name, 1, limits);
+      EXPECT_FALSE(page.grey.empty());
+    } catch (const PdfError& e) {
+      const std::string what = e.what();
+      EXPECT_TRUE(one_line(what)) << what;
+      EXPECT_EQ(what.rfind("pdf '" + name + "': ", 0), 0u) << what;
+      EXPECT_TRUE(e.kind() == PdfError::Kind::Damaged || e.kind() == PdfError::Kind::TooLarge ||
+                  e.kind() == PdfError::Kind::Timeout || e.kind() == PdfError::Kind::WorkerCrashed)
+          << what;
+    }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_LT(s, 2 * limits.worker_wall_s + 2.0);  // a probe and a render, each killed at worker_wall_s
+  }
+}
+
+}  // namespace
+}  // namespace hk::vision
