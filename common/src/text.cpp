@@ -1,39 +1,42 @@
-// hk::one_line: the one escaper for text echoed in messages (see text.hpp).
+// hk::decode_utf8 and hk::one_line, the one escaper for text echoed in messages (see text.hpp).
 #include "hk/text.hpp"
 
 #include <algorithm>
 
 namespace hk {
-namespace {
 
-/// Length of the well-formed UTF-8 sequence starting at s[i] (1–4), or 0 when the bytes there are not
-/// one (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF).
-std::size_t utf8_sequence(std::string_view s, std::size_t i) {
-  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
-  const unsigned char c = b(i);
-  std::size_t n = 0;
-  unsigned char lo = 0x80, hi = 0xBF;  // allowed range of the second byte
-  if (c < 0x80) return 1;
-  if (c >= 0xC2 && c <= 0xDF) n = 2;
-  else if (c >= 0xE0 && c <= 0xEF) {
-    n = 3;
-    if (c == 0xE0) lo = 0xA0;  // overlong
-    if (c == 0xED) hi = 0x9F;  // surrogates
-  } else if (c >= 0xF0 && c <= 0xF4) {
-    n = 4;
-    if (c == 0xF0) lo = 0x90;  // overlong
-    if (c == 0xF4) hi = 0x8F;  // above U+10FFFF
+Utf8Step decode_utf8(std::string_view s, std::size_t i) noexcept {
+  const auto at = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char b = at(i);
+  if (b < 0x80) return {b, 1, true};
+  std::size_t len = 0;
+  unsigned char lo = 0x80, hi = 0xBF;  // range of the second byte
+  char32_t cp = 0;
+  if (b >= 0xC2 && b <= 0xDF) {
+    len = 2;
+    cp = b & 0x1F;
+  } else if (b >= 0xE0 && b <= 0xEF) {
+    len = 3;
+    cp = b & 0x0F;
+    if (b == 0xE0) lo = 0xA0;  // overlong
+    if (b == 0xED) hi = 0x9F;  // surrogates
+  } else if (b >= 0xF0 && b <= 0xF4) {
+    len = 4;
+    cp = b & 0x07;
+    if (b == 0xF0) lo = 0x90;  // overlong
+    if (b == 0xF4) hi = 0x8F;  // above U+10FFFF
   } else {
-    return 0;
+    return {0, 1, false};  // starts no sequence
   }
-  if (i + n > s.size()) return 0;
-  if (b(i + 1) < lo || b(i + 1) > hi) return 0;
-  for (std::size_t k = 2; k < n; ++k)
-    if (b(i + k) < 0x80 || b(i + k) > 0xBF) return 0;
-  return n;
+  std::size_t k = 1;
+  for (; k < len && i + k < s.size(); ++k) {
+    const unsigned char c = at(i + k);
+    if (k == 1 ? (c < lo || c > hi) : (c < 0x80 || c > 0xBF)) break;
+    cp = (cp << 6) | (c & 0x3F);
+  }
+  if (k == len) return {cp, len, true};
+  return {0, k, false};
 }
-
-}  // namespace
 
 std::string one_line(std::string_view s, std::size_t max_bytes) {
   static constexpr char kHex[] = "0123456789ABCDEF";
@@ -41,23 +44,21 @@ std::string one_line(std::string_view s, std::size_t max_bytes) {
   out.reserve(std::min(s.size(), max_bytes) + 8);
   std::size_t i = 0;
   while (i < s.size()) {
-    const std::size_t n = utf8_sequence(s, i);
-    if (i + (n == 0 ? 1 : n) > max_bytes) break;
-    const auto c = static_cast<unsigned char>(s[i]);
-    const bool c0 = n == 1 && (c < 0x20 || c == 0x7F);
-    const bool c1 = n == 2 && c == 0xC2 && static_cast<unsigned char>(s[i + 1]) <= 0x9F;  // U+0080–U+009F
-    if (n == 0 || c0 || c1) {
-      for (std::size_t k = 0; k < (c1 ? 2u : 1u); ++k) {
+    const Utf8Step u = decode_utf8(s, i);
+    const std::size_t n = u.well_formed ? u.length : 1;  // an ill-formed sequence is escaped byte by byte
+    if (i + n > max_bytes) break;
+    const char32_t cp = u.code_point;
+    if (!u.well_formed || cp < 0x20 || (cp >= 0x7F && cp <= 0x9F)) {  // C0, DEL, C1
+      for (std::size_t k = 0; k < n; ++k) {
         const auto b = static_cast<unsigned char>(s[i + k]);
         out += "\\x";
         out += kHex[b >> 4];
         out += kHex[b & 15];
       }
-      i += c1 ? 2 : 1;
     } else {
       out.append(s.substr(i, n));
-      i += n;
     }
+    i += n;
   }
   if (i < s.size()) out += "...";
   return out;

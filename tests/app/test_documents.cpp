@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "documents.hpp"
+#include "child_process.hpp"
 #include "image_scene.hpp"
 #include "stick_service.hpp"
 #include "vision/pdf.hpp"
@@ -532,33 +533,13 @@ namespace {
 /// Runs `body` in a forked child inside a private mount namespace; returns what it reports ("" = passed,
 /// "SKIP: ..." = could not run here, else the failure). The test process's own mounts are never touched.
 std::string in_mount_namespace(const std::function<std::string()>& body) {
-  int fds[2];
-  if (::pipe(fds) != 0) return "SKIP: no pipe";
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::close(fds[0]);
-    std::string r;
-    if (::unshare(CLONE_NEWNS) != 0 || ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0) {
-      r = "SKIP: no private mount namespace here";
-    } else {
-      try {
-        r = body();
-      } catch (const std::exception& e) {
-        r = std::string("exception: ") + e.what();
-      }
-    }
-    if (::write(fds[1], r.data(), r.size()) < 0) ::_exit(3);
-    ::_exit(0);
-  }
-  ::close(fds[1]);
-  std::string out;
-  char buf[512];
-  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) > 0;) out.append(buf, static_cast<std::size_t>(n));
-  ::close(fds[0]);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) out += " (child ended with status " + std::to_string(status) + ")";
-  return out;
+  return test::run_in_child(
+      [&]() -> std::string {
+        if (::unshare(CLONE_NEWNS) != 0 || ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0)
+          return "SKIP: no private mount namespace here";
+        return body();
+      },
+      "SKIP: no pipe or child process");
 }
 
 /// The first news, waiting (bounded) for it.

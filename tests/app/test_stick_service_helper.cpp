@@ -22,6 +22,7 @@
 #include <thread>
 
 #include "stick_service.hpp"
+#include "child_process.hpp"
 
 namespace hk::app {
 namespace {
@@ -51,34 +52,12 @@ bool drop_sys_admin() {
 
 /// Runs `body` in a forked child (which has no CAP_SYS_ADMIN); returns what it reported ("" = passed).
 std::string in_child_without_sys_admin(const std::function<std::string()>& body) {
-  int fds[2];
-  if (::pipe(fds) != 0) return "pipe failed";
-  const pid_t pid = ::fork();
-  if (pid < 0) return "fork failed";
-  if (pid == 0) {
-    ::close(fds[0]);
-    std::string r;
-    if (!drop_sys_admin() || vision::have_mount_capability()) {
-      r = "cannot drop CAP_SYS_ADMIN";
-    } else {
-      try {
-        r = body();
-      } catch (const std::exception& e) {
-        r = std::string("exception: ") + e.what();
-      }
-    }
-    (void)!::write(fds[1], r.data(), r.size());
-    ::_exit(0);
-  }
-  ::close(fds[1]);
-  std::string out;
-  char buf[512];
-  for (ssize_t n; (n = ::read(fds[0], buf, sizeof buf)) > 0;) out.append(buf, static_cast<std::size_t>(n));
-  ::close(fds[0]);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) out += " (child ended with status " + std::to_string(status) + ")";
-  return out;
+  return test::run_in_child(
+      [&]() -> std::string {
+        if (!drop_sys_admin() || vision::have_mount_capability()) return "cannot drop CAP_SYS_ADMIN";
+        return body();
+      },
+      "pipe or fork failed");
 }
 
 /// The first news within 20 s.

@@ -3,43 +3,24 @@
 // refused with a MessageError whose what() is one line naming the file.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "audio/messages.hpp"
+#include "fuzz_inputs.hpp"
 
 namespace hk::audio {
 namespace {
 
 namespace fs = std::filesystem;
-
-const fs::path kDir = fs::path(HK_TEST_DATA_DIR) / "fuzz" / "messages";
-
-std::string read_file(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
-/// No C0 control (newline, escape...), no DEL, no C1 control (UTF-8 C2 80..C2 9F).
-bool one_line(const std::string& s) {
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    const auto u = static_cast<unsigned char>(s[i]);
-    if (u < 0x20 || u == 0x7F) return false;
-    if (u == 0xC2 && i + 1 < s.size() && (static_cast<unsigned char>(s[i + 1]) & 0xE0) == 0x80) return false;
-  }
-  return true;
-}
+using test::is_one_line;
+using test::kept_inputs;
 
 /// what() of the MessageError that parsing `file` must throw.
 std::string refusal(const std::string& file) {
   try {
-    (void)MessageCatalog::parse(read_file(kDir / file), "stick/" + file);
+    (void)MessageCatalog::parse(test::read_text(test::fuzz_dir("messages") / file), "stick/" + file);
   } catch (const MessageError& e) {
     return e.what();
   }
@@ -48,13 +29,11 @@ std::string refusal(const std::string& file) {
 }
 
 TEST(MessagesFuzzRegressions, EveryKeptInputIsRefusedOnOneLine) {
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(kDir)) files.push_back(e.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = kept_inputs("messages");
   ASSERT_FALSE(files.empty());
   for (const fs::path& p : files) {
     const std::string what = refusal(p.filename().string());
-    EXPECT_TRUE(one_line(what)) << p << ": " << what;
+    EXPECT_TRUE(is_one_line(what)) << p << ": " << what;
     EXPECT_EQ(what.rfind("messages 'stick/" + p.filename().string() + "': ", 0), 0u) << what;
   }
 }

@@ -31,6 +31,24 @@ TEST(OneLine, WellFormedUtf8IsKeptAndJunkEscaped) {
   EXPECT_EQ(one_line("\xc2\x9b" "31m"), "\\xC2\\x9B" "31m");                                      // C1 CSI
 }
 
+TEST(DecodeUtf8, WellFormedSequencesAndMaximalSubparts) {
+  // Code points worked out from the bits; maximal subparts as in Unicode 15 §3.9, table 3-8.
+  const auto step = [](std::string_view s) { return decode_utf8(s, 0); };
+  EXPECT_EQ(step("A").code_point, U'A');
+  EXPECT_EQ(step("\xc3\x9f").code_point, U'\u00DF');
+  EXPECT_EQ(step("\xe6\x97\xa5").code_point, U'\u65E5');
+  EXPECT_EQ(step("\xf0\x9f\x90\x8e").code_point, U'\U0001F40E');
+  EXPECT_EQ(step("\xf0\x9f\x90\x8e").length, 4u);
+  for (std::string_view ill : {"\x80", "\xc0\xaf", "\xff"}) {
+    EXPECT_FALSE(step(ill).well_formed) << ill;
+    EXPECT_EQ(step(ill).length, 1u) << ill;  // starts no sequence
+  }
+  EXPECT_FALSE(step("\xe6\x97X").well_formed);
+  EXPECT_EQ(step("\xe6\x97X").length, 2u);      // E6 97 is the longest well-formed prefix
+  EXPECT_EQ(step("\xed\xa0\x80").length, 1u);  // a surrogate: ED A0 is no prefix
+  EXPECT_EQ(step("\xf4\x90\x80\x80").length, 1u);  // above U+10FFFF
+}
+
 TEST(OneLine, CutsAtTheLimitOnASequenceBoundary) {
   EXPECT_EQ(one_line("abcdef", 4), "abcd...");
   EXPECT_EQ(one_line("abcd", 4), "abcd");

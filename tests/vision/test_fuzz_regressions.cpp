@@ -14,35 +14,15 @@
 
 #include "vision/intake.hpp"
 #include "vision/pdf.hpp"
+#include "fuzz_inputs.hpp"
 
 namespace hk::vision {
 namespace {
 
 namespace fs = std::filesystem;
-
-const fs::path kFuzzData = fs::path(HK_TEST_DATA_DIR) / "fuzz";
-
-std::vector<std::uint8_t> read_bytes(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
-
-std::vector<fs::path> kept_inputs(const std::string& harness) {
-  std::vector<fs::path> out;
-  for (const auto& e : fs::directory_iterator(kFuzzData / harness)) out.push_back(e.path());
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-/// No C0 control (newline, escape...), no DEL, no C1 control (UTF-8 C2 80..C2 9F).
-bool one_line(const std::string& s) {
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    const auto u = static_cast<unsigned char>(s[i]);
-    if (u < 0x20 || u == 0x7F) return false;
-    if (u == 0xC2 && i + 1 < s.size() && (static_cast<unsigned char>(s[i + 1]) & 0xE0) == 0x80) return false;
-  }
-  return true;
-}
+using test::is_one_line;
+using test::kept_inputs;
+using test::read_bytes;
 
 /// what() of the InputError decode_image must throw for `file` (named "stick/<file>").
 std::string image_refusal(const fs::path& file) {
@@ -60,7 +40,7 @@ TEST(ImageFuzzRegressions, EveryKeptInputIsRefusedOnOneLine) {
   ASSERT_FALSE(files.empty());
   for (const fs::path& p : files) {
     const std::string what = image_refusal(p);
-    EXPECT_TRUE(one_line(what)) << p << ": " << what;
+    EXPECT_TRUE(is_one_line(what)) << p << ": " << what;
     EXPECT_EQ(what.rfind("image 'stick/" + p.filename().string() + "': ", 0), 0u) << what;
   }
 }
@@ -68,7 +48,7 @@ TEST(ImageFuzzRegressions, EveryKeptInputIsRefusedOnOneLine) {
 TEST(ImageFuzzRegressions, PngChunkTypeOfControlBytesIsEscaped) {
   // IHDR, then a chunk header whose length runs past the end and whose type is "@\x0F\x84\x18": the message
   // quoted the 4 type bytes raw (a control character and a stray UTF-8 byte in the kiosk's log line).
-  const std::string what = image_refusal(kFuzzData / "image" / "png_chunk_type_control_bytes.png");
+  const std::string what = image_refusal(test::fuzz_dir("image") / "png_chunk_type_control_bytes.png");
   EXPECT_NE(what.find("truncated PNG: chunk '@\\x0F\\x84\\x18' at byte 33 runs past the end of the file"), std::string::npos)
       << what;
 }
@@ -94,7 +74,7 @@ TEST(PdfFuzzRegressions, EveryKeptInputEndsWithinTheWorkerLimits) {
       EXPECT_FALSE(page.grey.empty());
     } catch (const PdfError& e) {
       const std::string what = e.what();
-      EXPECT_TRUE(one_line(what)) << what;
+      EXPECT_TRUE(is_one_line(what)) << what;
       EXPECT_EQ(what.rfind("pdf '" + name + "': ", 0), 0u) << what;
       EXPECT_TRUE(e.kind() == PdfError::Kind::Damaged || e.kind() == PdfError::Kind::TooLarge ||
                   e.kind() == PdfError::Kind::Timeout || e.kind() == PdfError::Kind::WorkerCrashed)

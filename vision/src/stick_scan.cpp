@@ -16,6 +16,7 @@
 // refused with a reason, without being opened or entered.
 
 #include "vision/stick_scan.hpp"
+#include "hk/text.hpp"
 
 #include "unique_fd.hpp"
 
@@ -373,46 +374,11 @@ std::string safe_display_name(std::string_view raw) {
     put_utf8(out, cp);
     if (out.size() + 3 <= kMaxBytes) cut = out.size();
   };
-  const auto* s = reinterpret_cast<const unsigned char*>(raw.data());
-  const std::size_t n = raw.size();
-  for (std::size_t i = 0; i < n && out.size() <= kMaxBytes;) {
-    const unsigned char b = s[i];
-    if (b < 0x80) {
-      emit(b);
-      ++i;
-      continue;
-    }
-    // Well-formed sequences per Unicode table 3-7; an ill-formed one is replaced, one U+FFFD per
-    // maximal subpart (the longest prefix of a well-formed sequence), or per byte that starts none.
-    std::size_t len;
-    unsigned char lo = 0x80, hi = 0xBF;  // range of the second byte
-    char32_t cp;
-    if (b >= 0xC2 && b <= 0xDF) {
-      len = 2;
-      cp = b & 0x1F;
-    } else if (b >= 0xE0 && b <= 0xEF) {
-      len = 3;
-      cp = b & 0x0F;
-      if (b == 0xE0) lo = 0xA0;
-      if (b == 0xED) hi = 0x9F;
-    } else if (b >= 0xF0 && b <= 0xF4) {
-      len = 4;
-      cp = b & 0x07;
-      if (b == 0xF0) lo = 0x90;
-      if (b == 0xF4) hi = 0x8F;
-    } else {
-      emit(kReplacement);
-      ++i;
-      continue;
-    }
-    std::size_t k = 1;
-    for (; k < len && i + k < n; ++k) {
-      const unsigned char c = s[i + k];
-      if (k == 1 ? (c < lo || c > hi) : (c < 0x80 || c > 0xBF)) break;
-      cp = (cp << 6) | (c & 0x3F);
-    }
-    emit(k == len ? cp : kReplacement);
-    i += k;
+  // An ill-formed sequence is replaced, one U+FFFD per maximal subpart (hk::decode_utf8).
+  for (std::size_t i = 0; i < raw.size() && out.size() <= kMaxBytes;) {
+    const hk::Utf8Step u = hk::decode_utf8(raw, i);
+    emit(u.well_formed ? u.code_point : kReplacement);
+    i += u.length;
   }
   if (out.size() > kMaxBytes) {
     out.resize(cut);

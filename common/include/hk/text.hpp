@@ -8,6 +8,19 @@
 
 namespace hk {
 
+/// One step of UTF-8 decoding (see decode_utf8).
+struct Utf8Step {
+  char32_t code_point = 0;  ///< the scalar value decoded; 0 when ill-formed
+  std::size_t length = 1;   ///< bytes consumed [1, 4]
+  bool well_formed = false; ///< a well-formed sequence (Unicode 15 table 3-7)
+};
+
+/// Decodes the UTF-8 sequence starting at s[i] (i < s.size()). Well-formed (Unicode table 3-7: no overlong
+/// forms, no surrogates, nothing above U+10FFFF): its code point and length. Ill-formed: well_formed false
+/// and `length` its maximal subpart (the longest prefix of a well-formed sequence, at least 1 byte), so
+/// replacing each step by U+FFFD follows Unicode's "one U+FFFD per maximal subpart" practice (§3.9).
+[[nodiscard]] Utf8Step decode_utf8(std::string_view s, std::size_t i) noexcept;
+
 /// Default cut of one_line() [bytes of input].
 inline constexpr std::size_t kOneLineMaxBytes = 512;
 
