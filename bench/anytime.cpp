@@ -68,7 +68,7 @@ nlohmann::json run(const std::string& name, const Scene& sc, const std::vector<S
         if (h.segment.curve >= 0) {
           const CurveInfo& ci = sc.curve(static_cast<std::size_t>(h.segment.curve));
           level = std::min(h.segment.level, ci.levels - 1);
-          err_m = ci.max_box_half_width_m[level];
+          err_m = ci.max_error_bound_m[level];
         } else {
           level = Scene::kMaxLevels;
           err_m = 0.01;  // no curve reached: the answer knows only a region (counted as 10 mm)

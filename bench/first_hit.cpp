@@ -1,6 +1,6 @@
-// Servo query against peers (issue 3 items 2 and 4): the same query streams answered by our collision
-// tree with its boundary section, by brute force, and by a Boost.Geometry R-tree; results checked equal
-// before anything is timed. One benchmark iteration is one query, timed on its own (manual time), so
+// Servo query against peers (issue 3 items 2 and 4, issue 18 item 1): the same query streams answered by
+// our collision tree with its boundary section, by brute force, by a Boost.Geometry R-tree and by Embree
+// (bench/support/embree_peer.hpp); results checked equal before anything is timed. One benchmark iteration is one query, timed on its own (manual time), so
 // the mean and the percentiles describe the same measurements; each includes ~30 ns of clock reads.
 //
 // Names: BM_FirstHit/<method>/<segments>  — synthetic scenes tiled from real pictures, random-walk hand
@@ -16,6 +16,7 @@
 #include <memory>
 
 #include "bench_scenes.hpp"
+#include "embree_peer.hpp"
 #include "peers.hpp"
 
 using namespace hk;
@@ -33,9 +34,10 @@ struct Case {
   std::vector<std::pair<Vec2, Vec2>> segs;
   std::unique_ptr<BruteForce> brute;
   std::unique_ptr<RtreeIndex> rtree;
+  std::unique_ptr<EmbreeIndex> embree;
   std::unique_ptr<BoundarySection> ours;
   std::vector<Sweep> stream;
-  double build_ms_ours = 0, build_ms_rtree = 0, build_ms_brute = 0;
+  double build_ms_ours = 0, build_ms_rtree = 0, build_ms_brute = 0, build_ms_embree = 0;
   double max_error_mm = 0;
 };
 
@@ -54,6 +56,9 @@ std::unique_ptr<Case> make_case(std::string name, std::vector<Polyline> curves, 
   t0 = now_ms();
   c->rtree = std::make_unique<RtreeIndex>(c->segs);
   c->build_ms_rtree = now_ms() - t0;
+  t0 = now_ms();
+  c->embree = std::make_unique<EmbreeIndex>(c->segs);
+  c->build_ms_embree = now_ms() - t0;
   c->stream = std::move(stream);
   for (std::size_t k = 0; k < c->scene->curve_count(); ++k) {
     const CurveInfo& ci = c->scene->curve(k);
@@ -71,19 +76,40 @@ void check_equal(Case& c, std::size_t n) {
     const SweepHit h = fresh.first_hit(s.a, s.b, c.level, nullptr, 0, QueryBudget{});
     const PeerHit b = c.brute->first_hit(s.a, s.b);
     const PeerHit r = c.rtree->first_hit(s.a, s.b);
-    if (h.hit != b.hit || r.hit != b.hit || (b.hit && (h.t != b.t || r.t != b.t))) {
-      std::fprintf(stderr, "first_hit: methods disagree on %s query %zu (ours %d %.17g, brute %d %.17g, rtree %d %.17g)\n", c.name.c_str(), i,
-                   h.hit, h.t, b.hit, b.t, r.hit, r.t);
+    const PeerHit e = c.embree->first_hit(s.a, s.b);
+    if (h.hit != b.hit || r.hit != b.hit || e.hit != b.hit || (b.hit && (h.t != b.t || r.t != b.t || e.t != b.t))) {
+      std::fprintf(stderr, "first_hit: methods disagree on %s query %zu (ours %d %.17g, brute %d %.17g, rtree %d %.17g, embree %d %.17g)\n",
+                   c.name.c_str(), i, h.hit, h.t, b.hit, b.t, r.hit, r.t, e.hit, e.t);
       std::exit(2);
     }
     hits += b.hit;
+    if (i % 10 == 0) {  // closest points too: ours, the R-tree and Embree against brute force
+      Vec2 q;
+      SegmentRef seg;
+      const double want = c.brute->closest_distance(s.b);
+      const double ours = fresh.closest_point(s.b, c.level, 1.0, &q, &seg) ? distance(s.b, q) : 1.0;
+      const double rt = c.rtree->closest_distance(s.b), em = c.embree->closest_distance(s.b);
+      if (std::abs(ours - want) > 1e-15 || std::abs(rt - want) > 1e-15 || std::abs(em - want) > 1e-15) {
+        std::fprintf(stderr, "closest: methods disagree on %s query %zu (ours %.17g, brute %.17g, rtree %.17g, embree %.17g)\n", c.name.c_str(), i,
+                     ours, want, rt, em);
+        std::exit(2);
+      }
+    }
   }
   std::fprintf(stderr, "first_hit: %s: %zu segments, %zu queries checked equal (%zu hits)\n", c.name.c_str(), c.segs.size(),
                std::min(n, c.stream.size()), hits);
 }
 
-enum class Method { Ours, Brute, Rtree };
-const char* method_name(Method m) { return m == Method::Ours ? "ours" : (m == Method::Brute ? "brute" : "rtree"); }
+enum class Method { Ours, Brute, Rtree, Embree };
+const char* method_name(Method m) {
+  switch (m) {
+    case Method::Ours: return "ours";
+    case Method::Brute: return "brute";
+    case Method::Rtree: return "rtree";
+    case Method::Embree: return "embree";
+  }
+  return "?";
+}
 
 void set_percentiles(benchmark::State& state, std::vector<double>& ns) {
   if (ns.empty()) return;
@@ -107,8 +133,10 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
       hit = c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}).hit;
     } else if (m == Method::Brute) {
       hit = c->brute->first_hit(s.a, s.b).hit;
-    } else {
+    } else if (m == Method::Rtree) {
       hit = c->rtree->first_hit(s.a, s.b).hit;
+    } else {
+      hit = c->embree->first_hit(s.a, s.b).hit;
     }
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     state.SetIterationTime(dt);
@@ -127,9 +155,12 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
   } else if (m == Method::Brute) {
     state.counters["build_ms"] = c->build_ms_brute;
     state.counters["bytes_per_segment"] = static_cast<double>(c->brute->bytes()) / segs;
-  } else {
+  } else if (m == Method::Rtree) {
     state.counters["build_ms"] = c->build_ms_rtree;
     state.counters["bytes_per_segment"] = static_cast<double>(c->rtree->bytes()) / segs;
+  } else {
+    state.counters["build_ms"] = c->build_ms_embree;
+    state.counters["bytes_per_segment"] = static_cast<double>(c->embree->bytes()) / segs;
   }
 }
 
@@ -148,8 +179,10 @@ void run_closest(benchmark::State& state, Case* c, Method m) {
       d = c->ours->closest_point(p, c->level, 1.0, &q, &s) ? distance(p, q) : 1.0;
     } else if (m == Method::Brute) {
       d = c->brute->closest_distance(p);
-    } else {
+    } else if (m == Method::Rtree) {
       d = c->rtree->closest_distance(p);
+    } else {
+      d = c->embree->closest_distance(p);
     }
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     state.SetIterationTime(dt);
@@ -189,7 +222,7 @@ int main(int argc, char** argv) {
     auto c = make_case(std::to_string(n), std::move(curves), 0, random_walk_stream(plane, 100000));
     check_equal(*c, n >= 1000000 ? 300 : 3000);
     Case* cp = c.get();
-    for (Method m : {Method::Ours, Method::Rtree, Method::Brute}) {
+    for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute}) {
       benchmark::RegisterBenchmark(("BM_FirstHit/" + std::string(method_name(m)) + "/" + std::to_string(n)).c_str(),
                                    [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
       benchmark::RegisterBenchmark(("BM_Closest/" + std::string(method_name(m)) + "/" + std::to_string(n)).c_str(),
@@ -210,7 +243,7 @@ int main(int argc, char** argv) {
     auto c = make_case(paths[i].stem().string(), pictures[i], 0, stream_of(i));
     check_equal(*c, c->stream.size());
     Case* cp = c.get();
-    for (Method m : {Method::Ours, Method::Rtree, Method::Brute}) {
+    for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute}) {
       benchmark::RegisterBenchmark(("BM_Picture/" + std::string(method_name(m)) + "/" + cp->name).c_str(),
                                    [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
     }
@@ -226,7 +259,7 @@ int main(int argc, char** argv) {
       auto c = make_case(std::string(name) + "@L" + std::to_string(level), pictures[i], level, stream_of(i));
       check_equal(*c, 2000);
       Case* cp = c.get();
-      for (Method m : {Method::Ours, Method::Rtree, Method::Brute}) {
+      for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute}) {
         benchmark::RegisterBenchmark(("BM_Level/" + std::string(method_name(m)) + "/" + std::to_string(level) + "/" + name).c_str(),
                                      [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
       }

@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
     pj["segments_tight_budget"] = tight_is.segments_after_budget;
     pj["chains_over_tight_budget"] = tight_is.chains_over_budget;
     std::vector<double> level_error;  // the policy's error ladder
-    for (int l = 0; l < levels; ++l) level_error.push_back(sc.max_box_half_width_m(l));
+    for (int l = 0; l < levels; ++l) level_error.push_back(sc.max_error_bound_m(l));
     pj["level_error_m"] = level_error;
     pj["speed_bin_edges_m_per_s"] = bin_edges;
     pj["level_ticks_per_speed_bin"] = hist;

@@ -18,7 +18,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 BENCH = sys.argv[1] if len(sys.argv) > 1 else "docs/bench"
 PERF = sys.argv[2] if len(sys.argv) > 2 else "docs/PERFORMANCE.md"
-COLORS = {"ours": "tab:blue", "rtree": "tab:orange", "brute": "tab:gray", "opencv": "tab:green"}
+COLORS = {"ours": "tab:blue", "rtree": "tab:orange", "embree": "tab:red", "brute": "tab:gray", "opencv": "tab:green"}
+METHODS = ["ours", "rtree", "embree", "brute"]
 
 
 def load_gbench(name):
@@ -54,7 +55,7 @@ for r in fh:
 if size_rows:
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
     for ax, kind in zip(axes, ["FirstHit", "Closest"]):
-        for method in ["ours", "rtree", "brute"]:
+        for method in METHODS:
             pts = sorted((n, rows[method]) for (k, n), rows in size_rows.items() if k == kind and method in rows)
             if not pts:
                 continue
@@ -71,20 +72,29 @@ if size_rows:
     fig.suptitle("Servo queries against peers, tiled scenes from real pictures, random-walk hand at 1 kHz")
     fig.tight_layout()
     fig.savefig(os.path.join(BENCH, "first_hit_vs_size.png"), dpi=110)
-    lines = ["| query | segments | method | mean ns | p50 ns | p99 ns | max ns | build ms | bytes/segment | ours vs rtree (mean) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    def versus(r, peer):
+        """'2.10x faster' or '1.30x slower': ours against a peer, by mean."""
+        if peer is None:
+            return ""
+        return "%.2fx faster" % (ns(peer) / ns(r)) if ns(r) < ns(peer) else "%.2fx slower" % (ns(r) / ns(peer))
+
+    lines = ["| query | segments | method | mean ns | p50 ns | p99 ns | max ns | build ms | bytes/segment | ours vs rtree (mean) | ours vs embree (mean) | ours p99 / rtree p99 |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for (kind, n) in sorted(size_rows):
         rows = size_rows[(kind, n)]
-        for method in ["ours", "rtree", "brute"]:
+        for method in METHODS:
             if method not in rows:
                 continue
             r = rows[method]
-            speed = ""
-            if method == "ours" and "rtree" in rows:
-                speed = "%.2fx faster" % (ns(rows["rtree"]) / ns(r)) if ns(r) < ns(rows["rtree"]) else "%.2fx slower" % (ns(r) / ns(rows["rtree"]))
-            lines.append("| %s | %d | %s | %.0f | %.0f | %.0f | %.0f | %s | %s | %s |" % (
+            vs_r = vs_e = p99_ratio = ""
+            if method == "ours":
+                vs_r, vs_e = versus(r, rows.get("rtree")), versus(r, rows.get("embree"))
+                if "rtree" in rows:
+                    p99_ratio = "%.2f" % (r["p99_ns"] / rows["rtree"]["p99_ns"])
+            lines.append("| %s | %d | %s | %.0f | %.0f | %.0f | %.0f | %s | %s | %s | %s | %s |" % (
                 kind, n, method, ns(r), r["p50_ns"], r["p99_ns"], r["max_ns"],
-                "%.1f" % r["build_ms"] if "build_ms" in r else "", "%.0f" % r["bytes_per_segment"] if "bytes_per_segment" in r else "", speed))
+                "%.1f" % r["build_ms"] if "build_ms" in r else "", "%.0f" % r["bytes_per_segment"] if "bytes_per_segment" in r else "",
+                vs_r, vs_e, p99_ratio))
     tables["first_hit"] = "\n".join(lines)
 
 # 2. Pictures: the explore sweeps.
@@ -94,11 +104,11 @@ for r in fh:
     if m:
         pic[m.group(2)][m.group(1)] = r
 if pic:
-    lines = ["| picture | segments | ours mean / p99 ns | rtree mean / p99 ns | brute mean / p99 ns |", "|---|---|---|---|---|"]
+    lines = ["| picture | segments | ours mean / p99 ns | rtree mean / p99 ns | embree mean / p99 ns | brute mean / p99 ns |", "|---|---|---|---|---|---|"]
     for name in sorted(pic):
         rows = pic[name]
         cell = lambda m: "%.0f / %.0f" % (ns(rows[m]), rows[m]["p99_ns"]) if m in rows else ""
-        lines.append("| %s | %d | %s | %s | %s |" % (name, rows["ours"]["segments"], cell("ours"), cell("rtree"), cell("brute")))
+        lines.append("| %s | %d | %s | %s | %s | %s |" % (name, rows["ours"]["segments"], cell("ours"), cell("rtree"), cell("embree"), cell("brute")))
     tables["pictures"] = "\n".join(lines)
 
 # 3. Speed against accuracy: per method and level, p99 over four pictures against max deviation.
@@ -110,7 +120,7 @@ for r in fh:
 if lvl:
     fig, ax = plt.subplots(figsize=(7.5, 5))
     lines = ["| method | level | p99 ns (mean of 4 pictures) | max deviation mm (max of 4) | segments (sum) |", "|---|---|---|---|---|"]
-    for method in ["ours", "rtree", "brute"]:
+    for method in METHODS:
         pts = []
         for level in sorted(lvl[method]):
             rows = lvl[method][level]

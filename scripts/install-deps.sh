@@ -5,7 +5,7 @@ packages=(
   g++ cmake ninja-build pkg-config
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-contrib-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libboost-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libembree-dev
   libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev sox
   libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri xvfb xauth
   libpoppler-cpp-dev libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev

@@ -56,7 +56,7 @@ json scene_json(const ImageScene& is, const config::Settings& s) {
       const Vec2* p = sc.points(c, l);
       for (std::uint32_t i = 0; i < ci.point_count[l]; ++i) pts.push_back({p[i].x, p[i].y});
       levels.push_back({{"level", l}, {"points_m", std::move(pts)}, {"max_error_m", ci.max_error_m[l]},
-                        {"max_box_half_width_m", ci.max_box_half_width_m[l]}});
+                        {"max_box_half_width_m", ci.max_box_half_width_m[l]}, {"max_error_bound_m", ci.max_error_bound_m[l]}});
     }
     curves.push_back({{"id", c}, {"closed", ci.closed}, {"levels", std::move(levels)}});
   }

@@ -1,6 +1,7 @@
 #pragma once
 // The methods our collision tree is compared with, answering the same queries on the same segments:
-// brute force over a flat array, and a Boost.Geometry R-tree (bulk-loaded, R*-style node size 16).
+// brute force over a flat array, and a Boost.Geometry R-tree (bulk-loaded, R*-style node size 16);
+// Embree is the third (embree_peer.hpp).
 // First hit = smallest entry parameter among the segments the sweep intersects; closest point =
 // the R-tree's `nearest`. Used by bench/first_hit.cpp and by the equal-results tests.
 #include <boost/geometry.hpp>
@@ -13,17 +14,12 @@
 
 #include "haptics/collision_query.hpp"
 #include "haptics/scene.hpp"
+#include "peer_hit.hpp"
 
 namespace hk::bench {
 
 namespace bg = boost::geometry;
 namespace bgi = boost::geometry::index;
-
-/// Answer of a peer: hit flag and sweep parameter (same meaning as SweepHit).
-struct PeerHit {
-  bool hit = false;
-  double t = 1.0;
-};
 
 /// Every segment of `level` (clamped per curve) as a flat array of end-point pairs.
 inline std::vector<std::pair<Vec2, Vec2>> flat_segments(const Scene& sc, int level) {

@@ -1,7 +1,7 @@
 // Scene index and collision tree construction (seed paper §3; DESIGN.md "Collision tree").
-// Boxes are built bottom-up: a level-0 box holds its segment and the original input vertices it
-// stands for; a level-l box holds its segment and the corners of its two children's boxes, so a miss
-// on a box proves a miss on everything under it, down to the original curve.
+// A level-0 box holds its segment and the original input vertices it stands for; a level-l box holds
+// its segment, every finer level's points under it and those original vertices, so a miss on a box
+// proves a miss on everything under it, down to the original curve.
 #include "haptics/scene.hpp"
 
 #include <algorithm>
@@ -95,6 +95,11 @@ void box_corners(const ErrorBox& box, Vec2 out[4]) {
 
 double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min), std::abs(box.n_max)); }
 
+double box_error_bound(const ErrorBox& box, double segment_length_m) {
+  const double overhang = std::max({0.0, -box.u_min, box.u_max - segment_length_m});
+  return std::hypot(overhang, box_half_width(box));
+}
+
 std::size_t Scene::hot_bytes() const {
   return boxes_.size() * sizeof(ErrorBox) + aabbs_.size() * sizeof(Aabb) + info_.size() * sizeof(NodeInfo) +
          (parent_.size() + child_first_.size() + child_count_.size()) * sizeof(std::uint32_t) + points_m_.size() * sizeof(Vec2);
@@ -121,154 +126,158 @@ double Scene::max_box_half_width_m(int level) const {
   return widest;
 }
 
+double Scene::max_error_bound_m(int level) const {
+  double bound = 0.0;
+  for (std::size_t c = 0; c < curves_.size(); ++c) bound = std::max(bound, curves_[c].max_error_bound_m[clamp_level(c, level)]);
+  return bound;
+}
+
 int Scene::max_curve_levels() const {
   int levels = 1;
   for (const CurveInfo& ci : curves_) levels = std::max(levels, ci.levels);
   return levels;
 }
 
-Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
-  Scene scene;
-  max_levels = std::clamp(max_levels, 0, kMaxLevels - 1);
-  const double t0 = now_ms();
-
-  // Multiresolution models first (they fix every array size).
-  for (std::size_t i = 0; i < input.size(); ++i) {
-    try {
-      scene.models_.push_back(build_multires(input[i], max_levels));
-      scene.source_index_.push_back(i);
-    } catch (const CurveError&) {
-      ++scene.skipped_;  // fewer than 2 points or zero length: nothing to feel
-    }
-  }
-  const double t1 = now_ms();
-
-  // Lay out points and segment nodes, level by level within each curve.
-  std::size_t npoints = 0, nnodes = 0;
-  scene.curves_.resize(scene.models_.size());
-  for (std::size_t c = 0; c < scene.models_.size(); ++c) {
-    const CurveMultires& m = scene.models_[c];
-    CurveInfo& ci = scene.curves_[c];
-    ci.closed = m.closed;
-    ci.levels = m.levels;
-    for (int l = 0; l < m.levels; ++l) {
-      ci.point_offset[l] = static_cast<std::uint32_t>(npoints);
-      ci.point_count[l] = static_cast<std::uint32_t>(m.scaling[l].size());
-      ci.box_offset[l] = static_cast<std::uint32_t>(nnodes);
-      ci.segment_count[l] = static_cast<std::uint32_t>(m.segment_count(l));
-      npoints += m.scaling[l].size();
-      nnodes += m.segment_count(l);
-    }
-  }
-  scene.segment_nodes_ = nnodes;
-  scene.points_m_.resize(npoints);
-
-  // Chunks: runs of at most kSegmentsPerChunk consecutive coarsest segments of one curve. They are the
-  // leaves of the scene hierarchy, so no node has more than a handful of children (a long curve would
-  // otherwise fan out to hundreds of coarsest segments, and the boundary section with it).
+// The phases of Scene::build, in order (DESIGN.md "Collision tree"). A friend of Scene: each phase
+// fills some of its arrays from what the phases before it left.
+class SceneBuild {
+ public:
+  // A run of at most kSegmentsPerChunk consecutive coarsest segments of one curve: a leaf of the hierarchy.
   struct Chunk {
     std::uint32_t curve, first_segment, count;
   };
-  std::vector<Chunk> chunks;
-  std::vector<Vec2> chunk_centre;
-  for (std::size_t c = 0; c < scene.models_.size(); ++c) {
-    const int top = scene.models_[c].levels - 1;
-    const auto& pts = scene.models_[c].scaling[static_cast<std::size_t>(top)];
-    const std::uint32_t k_top = scene.curves_[c].segment_count[top];
-    for (std::uint32_t k = 0; k < k_top; k += kSegmentsPerChunk) {
-      const std::uint32_t n = std::min<std::uint32_t>(kSegmentsPerChunk, k_top - k);
-      Vec2 lo = pts[k], hi = pts[k];
-      for (std::uint32_t i = k; i <= k + n; ++i) {
-        const Vec2 q = pts[i % pts.size()];
-        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
-        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+
+  // Multiresolution model of every curve that has one (fewer than 2 points or zero length: skipped).
+  static void build_models(Scene& scene, const std::vector<Polyline>& input, int max_levels) {
+    for (std::size_t i = 0; i < input.size(); ++i) {
+      try {
+        scene.models_.push_back(build_multires(input[i], max_levels));
+        scene.source_index_.push_back(i);
+      } catch (const CurveError&) {
+        ++scene.skipped_;  // nothing to feel
       }
-      chunks.push_back({static_cast<std::uint32_t>(c), k, n});
-      chunk_centre.push_back(0.5 * (lo + hi));
     }
   }
-  std::vector<HierarchyNode> hierarchy;
-  std::vector<std::size_t> chunk_order(chunks.size());
-  for (std::size_t i = 0; i < chunk_order.size(); ++i) chunk_order[i] = i;
-  build_hierarchy(chunk_order, chunk_centre, hierarchy);  // chunk_order becomes leaf order
-  scene.chunk_count_ = chunks.size();
-  const std::size_t hierarchy_base = nnodes + chunks.size();
-  const std::size_t total_nodes = hierarchy_base + (chunks.empty() ? 0 : hierarchy.size());
-  scene.boxes_.resize(total_nodes);
-  scene.info_.resize(total_nodes);
-  scene.parent_.assign(total_nodes, 0);
-  scene.child_first_.assign(total_nodes, 0);
-  scene.child_count_.assign(total_nodes, 0);
 
-  Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  Vec2 hi{-lo.x, -lo.y};
-  std::vector<double> orig_arc;
-  std::vector<std::uint32_t> orig_first;  // per level-0 segment: first original vertex strictly inside it
-  for (std::size_t c = 0; c < scene.models_.size(); ++c) {
-    const CurveMultires& m = scene.models_[c];
-    const CurveInfo& ci = scene.curves_[c];
-    const Polyline& src = input[scene.source_index_[c]];
-    for (int l = 0; l < m.levels; ++l) {
-      std::copy(m.scaling[l].begin(), m.scaling[l].end(), scene.points_m_.begin() + ci.point_offset[l]);
+  // Offsets of every level's points and segment nodes, level by level within each curve.
+  static void lay_out_curves(Scene& scene) {
+    std::size_t npoints = 0, nnodes = 0;
+    scene.curves_.resize(scene.models_.size());
+    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+      const CurveMultires& m = scene.models_[c];
+      CurveInfo& ci = scene.curves_[c];
+      ci.closed = m.closed;
+      ci.levels = m.levels;
+      for (int l = 0; l < m.levels; ++l) {
+        ci.point_offset[l] = static_cast<std::uint32_t>(npoints);
+        ci.point_count[l] = static_cast<std::uint32_t>(m.scaling[l].size());
+        ci.box_offset[l] = static_cast<std::uint32_t>(nnodes);
+        ci.segment_count[l] = static_cast<std::uint32_t>(m.segment_count(l));
+        npoints += m.scaling[l].size();
+        nnodes += m.segment_count(l);
+      }
     }
+    scene.segment_nodes_ = nnodes;
+    scene.points_m_.resize(npoints);
+    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+      const CurveMultires& m = scene.models_[c];
+      for (int l = 0; l < m.levels; ++l) std::copy(m.scaling[l].begin(), m.scaling[l].end(), scene.points_m_.begin() + scene.curves_[c].point_offset[l]);
+    }
+  }
 
-    // Arc length of every original vertex, to know which level-0 segment each one belongs to.
+  // Chunks of every curve's coarsest level, with the centres of their points (for the median split).
+  // They are the leaves of the scene hierarchy, so no node has more than a handful of children (a long
+  // curve would otherwise fan out to hundreds of coarsest segments, and the boundary section with it).
+  static void make_chunks(const Scene& scene, std::vector<Chunk>& chunks, std::vector<Vec2>& centre) {
+    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+      const int top = scene.models_[c].levels - 1;
+      const auto& pts = scene.models_[c].scaling[static_cast<std::size_t>(top)];
+      const std::uint32_t k_top = scene.curves_[c].segment_count[top];
+      for (std::uint32_t k = 0; k < k_top; k += Scene::kSegmentsPerChunk) {
+        const std::uint32_t n = std::min<std::uint32_t>(Scene::kSegmentsPerChunk, k_top - k);
+        Vec2 lo = pts[k], hi = pts[k];
+        for (std::uint32_t i = k; i <= k + n; ++i) {
+          const Vec2 q = pts[i % pts.size()];
+          lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+          hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+        }
+        chunks.push_back({static_cast<std::uint32_t>(c), k, n});
+        centre.push_back(0.5 * (lo + hi));
+      }
+    }
+  }
+
+  static void allocate_nodes(Scene& scene, std::size_t total_nodes) {
+    scene.boxes_.resize(total_nodes);
+    scene.info_.resize(total_nodes);
+    scene.parent_.assign(total_nodes, 0);
+    scene.child_first_.assign(total_nodes, 0);
+    scene.child_count_.assign(total_nodes, 0);
+  }
+
+  // Per level-0 segment k of curve c: the original vertices strictly inside it are
+  // [orig_first[k], orig_first[k+1]) (by arc length along the original).
+  static void map_originals(const CurveMultires& m, const Polyline& src, std::size_t s0, std::vector<double>& orig_arc,
+                            std::vector<std::uint32_t>& orig_first) {
     const auto& p = src.points_m;
     orig_arc.assign(p.size() + 1, 0.0);
     for (std::size_t i = 1; i < p.size(); ++i) orig_arc[i] = orig_arc[i - 1] + distance(p[i - 1], p[i]);
     const double total = src.closed ? orig_arc[p.size() - 1] + distance(p.back(), p.front()) : orig_arc[p.size() - 1];
     const std::size_t n0 = m.scaling[0].size();
-    const std::size_t s0 = ci.segment_count[0];
-    // Original vertex range [orig_first[k], orig_first[k+1]) lies within level-0 segment k.
     orig_first.assign(s0 + 1, 0);
-    {
-      std::size_t j = 0;
-      for (std::size_t k = 0; k <= s0; ++k) {
-        const double start = k < n0 ? m.arc_m[k] : total;
-        while (j < p.size() && orig_arc[j] < start) ++j;
-        orig_first[k] = static_cast<std::uint32_t>(j);
-      }
-      orig_first[s0] = static_cast<std::uint32_t>(p.size());
+    std::size_t j = 0;
+    for (std::size_t k = 0; k <= s0; ++k) {
+      const double start = k < n0 ? m.arc_m[k] : total;
+      while (j < p.size() && orig_arc[j] < start) ++j;
+      orig_first[k] = static_cast<std::uint32_t>(j);
     }
-    auto level0_end = [&](std::size_t k) { return m.scaling[0][k + 1 == n0 ? 0 : k + 1]; };
+    orig_first[s0] = static_cast<std::uint32_t>(p.size());
+  }
 
-    // Level 0: segment + original vertices it stands for.
-    for (std::size_t k = 0; k < s0; ++k) {
-      const Vec2 a = m.scaling[0][k], b = level0_end(k);
-      const Vec2 axis = normalized_or(b - a, Vec2{1.0, 0.0});
-      Extent e;
-      grow(e, a, axis, a);
-      grow(e, a, axis, b);
-      for (std::uint32_t j = orig_first[k]; j < orig_first[k + 1]; ++j) grow(e, a, axis, p[j]);
-      const std::uint32_t node = ci.box_offset[0] + static_cast<std::uint32_t>(k);
-      scene.boxes_[node] = make_box(a, axis, e);
-      scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), 0, static_cast<std::uint32_t>(k)};
-      scene.parent_[node] = m.levels > 1 ? ci.box_offset[1] + static_cast<std::uint32_t>(k / 2) : 0;  // coarsest: set with its chunk
-    }
-    // Coarser levels: segment + children's box corners.
-    for (int l = 1; l < m.levels; ++l) {
-      const auto& pts = m.scaling[l];
+  // Error boxes of every segment of curve c, as tight as containment allows: the box of level-l
+  // segment k is the extent, in the segment's frame, of its own end points, of every point of every
+  // finer level j < l under it (points k·2^(l−j) .. (k+1)·2^(l−j)), and of the original vertices under
+  // it. Convexity then puts every finer segment and the original sub-polyline inside, which is all a
+  // miss must prove (seed §3); children's boxes need not fit inside (issue 18: boxes built from the
+  // children's corners were 1.09–1.45x the true deviation).
+  static void build_segment_boxes(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first) {
+    const CurveMultires& m = scene.models_[c];
+    const CurveInfo& ci = scene.curves_[c];
+    const auto& orig = src.points_m;
+    for (int l = 0; l < m.levels; ++l) {
+      const auto& pts = m.scaling[static_cast<std::size_t>(l)];
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
         const Vec2 a = pts[k], b = pts[k + 1 == pts.size() ? 0 : k + 1];
         const Vec2 axis = normalized_or(b - a, Vec2{1.0, 0.0});
         Extent e;
         grow(e, a, axis, a);
         grow(e, a, axis, b);
-        for (std::uint32_t ch = 0; ch < 2; ++ch) {
-          Vec2 corners[4];
-          box_corners(scene.boxes_[ci.box_offset[l - 1] + 2 * k + ch], corners);
-          for (const Vec2& q : corners) grow(e, a, axis, q);
+        for (int j = 0; j < l; ++j) {  // finer levels' points under this segment
+          const auto& fine = m.scaling[static_cast<std::size_t>(j)];
+          const std::size_t span = std::size_t{1} << (l - j);
+          for (std::size_t i = k * span; i <= (k + 1) * span; ++i) grow(e, a, axis, fine[i == fine.size() ? 0 : i]);
         }
+        const std::size_t k0 = k << l, k1 = (k + 1) << l;  // level-0 segments under it
+        for (std::uint32_t v = orig_first[k0]; v < orig_first[k1]; ++v) grow(e, a, axis, orig[v]);
         const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k);
         scene.boxes_[node] = make_box(a, axis, e);
         scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), l, static_cast<std::uint32_t>(k)};
         scene.parent_[node] = l + 1 < m.levels ? ci.box_offset[l + 1] + static_cast<std::uint32_t>(k / 2) : 0;  // coarsest: set with its chunk
-        scene.child_first_[node] = ci.box_offset[l - 1] + 2 * static_cast<std::uint32_t>(k);
-        scene.child_count_[node] = 2;
+        if (l > 0) {
+          scene.child_first_[node] = ci.box_offset[l - 1] + 2 * static_cast<std::uint32_t>(k);
+          scene.child_count_[node] = 2;
+        }
       }
     }
-    // Error of each level: distance of every original vertex and level-0 point to the segment that stands for it.
-    CurveInfo& cw = scene.curves_[c];
+  }
+
+  // Error of each level of curve c: the largest distance of an original vertex or level-0 point from
+  // the segment that stands for it; the widest box of the level and the largest box error bound.
+  static void measure_errors(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first) {
+    const CurveMultires& m = scene.models_[c];
+    CurveInfo& ci = scene.curves_[c];
+    const auto& p = src.points_m;
+    const std::size_t s0 = ci.segment_count[0];
     for (int l = 0; l < m.levels; ++l) {
       const auto& pts = m.scaling[l];
       double worst = 0.0, widest = 0.0;
@@ -279,70 +288,116 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
         for (std::uint32_t j = orig_first[k]; j < orig_first[k + 1]; ++j) worst = std::max(worst, distance_sq_to_segment(p[j], a, b));
       }
       worst = std::sqrt(worst);  // squared above: one root per level
-      for (std::size_t k = 0; k < cw.segment_count[l]; ++k) widest = std::max(widest, box_half_width(scene.boxes_[cw.box_offset[l] + k]));
-      cw.max_error_m[l] = worst;
-      cw.max_box_half_width_m[l] = widest;
-    }
-    for (const Vec2& q : m.scaling[0]) {
-      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
-      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+      double bound = 0.0;
+      for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
+        const ErrorBox& box = scene.boxes_[ci.box_offset[l] + k];
+        widest = std::max(widest, box_half_width(box));
+        bound = std::max(bound, box_error_bound(box, distance(pts[k], pts[k + 1 == pts.size() ? 0 : k + 1])));
+      }
+      ci.max_error_m[l] = worst;
+      ci.max_box_half_width_m[l] = widest;
+      ci.max_error_bound_m[l] = bound;
     }
   }
-  if (!scene.curves_.empty()) {
-    scene.bounds_min_ = lo;
-    scene.bounds_max_ = hi;
-    // Chunk nodes, in the hierarchy's leaf order so that every leaf's chunks have consecutive ids.
-    for (std::size_t k = 0; k < chunks.size(); ++k) {
-      const Chunk& ch = chunks[chunk_order[k]];
-      const CurveInfo& ci = scene.curves_[ch.curve];
-      const int top = ci.levels - 1;
-      const std::uint32_t node = static_cast<std::uint32_t>(scene.segment_nodes_ + k);
-      const std::uint32_t first = ci.box_offset[top] + ch.first_segment;
-      Extent e;
-      for (std::uint32_t i = 0; i < ch.count; ++i) {
-        Vec2 corners[4];
-        box_corners(scene.boxes_[first + i], corners);
-        for (const Vec2& q : corners) grow(e, Vec2{0, 0}, Vec2{1, 0}, q);
-        scene.parent_[first + i] = node;
+
+  static void build_curves(Scene& scene, const std::vector<Polyline>& input) {
+    std::vector<double> orig_arc;
+    std::vector<std::uint32_t> orig_first;
+    Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    Vec2 hi{-lo.x, -lo.y};
+    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+      const Polyline& src = input[scene.source_index_[c]];
+      map_originals(scene.models_[c], src, scene.curves_[c].segment_count[0], orig_arc, orig_first);
+      build_segment_boxes(scene, c, src, orig_first);
+      measure_errors(scene, c, src, orig_first);
+      for (const Vec2& q : scene.models_[c].scaling[0]) {
+        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
       }
-      scene.boxes_[node] = make_box(Vec2{0, 0}, Vec2{1, 0}, e);
-      scene.info_[node] = NodeInfo{ch.curve, ci.levels, ch.first_segment};
-      scene.child_first_[node] = first;
-      scene.child_count_[node] = ch.count;
     }
-    // Hierarchy boxes bottom-up (children always have larger indices than their parent).
+    if (!scene.curves_.empty()) {
+      scene.bounds_min_ = lo;
+      scene.bounds_max_ = hi;
+    }
+  }
+
+  // An axis-aligned node around the boxes of children [first, first + count); links them to it.
+  static void make_aligned_node(Scene& scene, std::uint32_t node, std::uint32_t first, std::uint32_t count, NodeInfo info) {
+    Extent e;
+    for (std::uint32_t i = 0; i < count; ++i) {
+      Vec2 corners[4];
+      box_corners(scene.boxes_[first + i], corners);
+      for (const Vec2& q : corners) grow(e, Vec2{0, 0}, Vec2{1, 0}, q);
+      scene.parent_[first + i] = node;
+    }
+    scene.boxes_[node] = make_box(Vec2{0, 0}, Vec2{1, 0}, e);
+    scene.info_[node] = info;
+    scene.child_first_[node] = first;
+    scene.child_count_[node] = count;
+  }
+
+  // Chunk nodes, in the hierarchy's leaf order so that every leaf's chunks have consecutive ids.
+  static void build_chunk_nodes(Scene& scene, const std::vector<Chunk>& chunks, const std::vector<std::size_t>& leaf_order) {
+    for (std::size_t k = 0; k < chunks.size(); ++k) {
+      const Chunk& ch = chunks[leaf_order[k]];
+      const CurveInfo& ci = scene.curves_[ch.curve];
+      const std::uint32_t first = ci.box_offset[ci.levels - 1] + ch.first_segment;
+      make_aligned_node(scene, static_cast<std::uint32_t>(scene.segment_nodes_ + k), first, ch.count, NodeInfo{ch.curve, ci.levels, ch.first_segment});
+    }
+  }
+
+  // Hierarchy boxes bottom-up (children always have larger indices than their parent); the root is its own parent.
+  static void build_hierarchy_nodes(Scene& scene, const std::vector<HierarchyNode>& hierarchy, const std::vector<Chunk>& chunks,
+                                    const std::vector<std::size_t>& leaf_order, std::size_t hierarchy_base) {
     for (std::size_t i = hierarchy.size(); i-- > 0;) {
       const HierarchyNode& h = hierarchy[i];
-      const std::uint32_t node = static_cast<std::uint32_t>(hierarchy_base + i);
       const std::uint32_t first = h.leaf ? static_cast<std::uint32_t>(scene.segment_nodes_ + h.begin) : static_cast<std::uint32_t>(hierarchy_base + h.first_child);
       const std::uint32_t count = h.leaf ? static_cast<std::uint32_t>(h.end - h.begin) : 2u;
-      Extent e;
-      for (std::uint32_t k = 0; k < count; ++k) {
-        Vec2 corners[4];
-        box_corners(scene.boxes_[first + k], corners);
-        for (const Vec2& q : corners) grow(e, Vec2{0, 0}, Vec2{1, 0}, q);
-        scene.parent_[first + k] = node;
-      }
-      scene.boxes_[node] = make_box(Vec2{0, 0}, Vec2{1, 0}, e);
-      scene.info_[node] = NodeInfo{chunks[chunk_order[h.begin]].curve, kHierarchyLevel, 0};
-      scene.child_first_[node] = first;
-      scene.child_count_[node] = count;
+      make_aligned_node(scene, static_cast<std::uint32_t>(hierarchy_base + i), first, count, NodeInfo{chunks[leaf_order[h.begin]].curve, Scene::kHierarchyLevel, 0});
     }
     scene.scene_root_ = static_cast<std::uint32_t>(hierarchy_base);
     scene.parent_[scene.scene_root_] = scene.scene_root_;
   }
+
   // Rectangles around every box, for the cheap reject in the queries.
-  scene.aabbs_.resize(scene.boxes_.size());
-  for (std::size_t i = 0; i < scene.boxes_.size(); ++i) {
-    Vec2 corners[4];
-    box_corners(scene.boxes_[i], corners);
-    Aabb r{corners[0], corners[0]};
-    for (const Vec2& q : corners) {
-      r.lo = {std::min(r.lo.x, q.x), std::min(r.lo.y, q.y)};
-      r.hi = {std::max(r.hi.x, q.x), std::max(r.hi.y, q.y)};
+  static void build_aabbs(Scene& scene) {
+    scene.aabbs_.resize(scene.boxes_.size());
+    for (std::size_t i = 0; i < scene.boxes_.size(); ++i) {
+      Vec2 corners[4];
+      box_corners(scene.boxes_[i], corners);
+      Aabb r{corners[0], corners[0]};
+      for (const Vec2& q : corners) {
+        r.lo = {std::min(r.lo.x, q.x), std::min(r.lo.y, q.y)};
+        r.hi = {std::max(r.hi.x, q.x), std::max(r.hi.y, q.y)};
+      }
+      scene.aabbs_[i] = r;
     }
-    scene.aabbs_[i] = r;
   }
+};
+
+Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
+  Scene scene;
+  max_levels = std::clamp(max_levels, 0, kMaxLevels - 1);
+  const double t0 = now_ms();
+  SceneBuild::build_models(scene, input, max_levels);
+  const double t1 = now_ms();
+  SceneBuild::lay_out_curves(scene);
+  std::vector<SceneBuild::Chunk> chunks;
+  std::vector<Vec2> chunk_centre;
+  SceneBuild::make_chunks(scene, chunks, chunk_centre);
+  std::vector<HierarchyNode> hierarchy;
+  std::vector<std::size_t> leaf_order(chunks.size());
+  for (std::size_t i = 0; i < leaf_order.size(); ++i) leaf_order[i] = i;
+  build_hierarchy(leaf_order, chunk_centre, hierarchy);  // leaf_order becomes the hierarchy's leaf order
+  scene.chunk_count_ = chunks.size();
+  const std::size_t hierarchy_base = scene.segment_nodes_ + chunks.size();
+  SceneBuild::allocate_nodes(scene, hierarchy_base + (chunks.empty() ? 0 : hierarchy.size()));
+  SceneBuild::build_curves(scene, input);
+  if (!chunks.empty()) {
+    SceneBuild::build_chunk_nodes(scene, chunks, leaf_order);
+    SceneBuild::build_hierarchy_nodes(scene, hierarchy, chunks, leaf_order, hierarchy_base);
+  }
+  SceneBuild::build_aabbs(scene);
   const double t2 = now_ms();
   scene.times_.multires_ms = t1 - t0;
   scene.times_.tree_ms = t2 - t1;

@@ -34,7 +34,7 @@ namespace {
 // curve within tolerance). Returns the number of levels.
 int level_error_ladder(const Scene& scene, double* err) {
   const int levels = std::min(scene.max_curve_levels(), LevelPolicy::kMaxLevels);
-  for (int l = 0; l < levels; ++l) err[l] = scene.max_box_half_width_m(l);
+  for (int l = 0; l < levels; ++l) err[l] = scene.max_error_bound_m(l);
   return levels;
 }
 

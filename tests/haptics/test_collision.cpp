@@ -2,6 +2,9 @@
 // on ≥100,000 seeded swept segments, both coherent (servo-like) and random.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "curves.hpp"
@@ -22,8 +25,8 @@ std::vector<Polyline> random_scene(std::mt19937& rng, int blobs, int strokes) {
   return curves;
 }
 
-// Every original vertex lies in the box of the level-l segment that stands for it, at every level;
-// every child's box lies in its parent's. Arc positions computed here, independently of the tree.
+// Every original vertex lies in the box of the level-l segment that stands for it, at every level, and
+// so does every finer segment under it. Arc positions computed here, independently of the tree.
 void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
   constexpr double tol = 1e-12;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
@@ -47,12 +50,26 @@ void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
         Vec2 a, b;
         sc.segment({static_cast<int>(c), l, static_cast<int>(s)}, &a, &b);
         ASSERT_TRUE(box_contains(sc.box(node), a, tol) && box_contains(sc.box(node), b, tol));
+        // Every segment of every finer level under it (children, grandchildren, ... down to level 0),
+        // found by index arithmetic here rather than through the tree's links: a miss on the box must
+        // prove a miss on each of them, whatever level the query targets.
+        for (int j = 0; j < l; ++j) {
+          const std::uint32_t span = 1u << (l - j);
+          for (std::uint32_t f = s * span; f < (s + 1) * span; ++f) {
+            Vec2 fa, fb;
+            sc.segment({static_cast<int>(c), j, static_cast<int>(f)}, &fa, &fb);
+            ASSERT_TRUE(box_contains(sc.box(node), fa, tol) && box_contains(sc.box(node), fb, tol))
+                << "curve " << c << " level " << l << " segment " << s << ": level-" << j << " segment " << f << " outside";
+          }
+        }
+        // The links agree: a level-l segment's children are segments 2s and 2s+1 of level l−1.
         std::uint32_t first = 0, count = 0;
         sc.children(node, &first, &count);
-        for (std::uint32_t i = 0; i < count; ++i) {
-          Vec2 corners[4];
-          box_corners(sc.box(first + i), corners);
-          for (const Vec2& q : corners) ASSERT_TRUE(box_contains(sc.box(node), q, tol)) << "child of " << node;
+        if (l == 0) {
+          ASSERT_EQ(count, 0u);
+        } else {
+          ASSERT_EQ(count, 2u);
+          ASSERT_EQ(first, ci.box_offset[l - 1] + 2 * s);
         }
       }
     }
@@ -69,6 +86,54 @@ TEST(CollisionTree, BoxesContainOriginalsAndChildren) {
     ASSERT_EQ(sc.curve_count(), curves.size());
     check_containment(sc, curves);
   }
+}
+
+// Issue 18: a box is no wider than it must be. For every segment box, the true deviation of the original
+// under it (the largest distance of an original vertex or level-0 point under it from the segment's
+// line, found here by arc length, not through the tree) against the box half-width: never below it
+// (containment), and the median within 5 %.
+TEST(CollisionTree, BoxesAreTightAroundTheOriginalUnderThem) {
+  std::mt19937 rng(13);
+  std::vector<double> ratio;
+  for (int trial = 0; trial < 3; ++trial) {
+    const auto curves = random_scene(rng, 6, 6);
+    const Scene sc = Scene::build(curves, 6);
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      const CurveInfo& ci = sc.curve(c);
+      const CurveMultires& m = sc.model(c);
+      const Polyline& src = curves[sc.source_index(c)];
+      // Original vertices by the level-0 segment they fall in.
+      std::vector<std::vector<Vec2>> under(ci.segment_count[0]);
+      double arc = 0.0;
+      std::size_t k = 0;
+      for (std::size_t j = 0; j < src.points_m.size(); ++j) {
+        if (j > 0) arc += distance(src.points_m[j - 1], src.points_m[j]);
+        while (k + 1 < ci.segment_count[0] && m.arc_m[k + 1] <= arc) ++k;
+        under[k].push_back(src.points_m[j]);
+      }
+      for (int l = 0; l < ci.levels; ++l) {
+        for (std::uint32_t s = 0; s < ci.segment_count[l]; ++s) {
+          Vec2 a, b;
+          sc.segment({static_cast<int>(c), l, static_cast<int>(s)}, &a, &b);
+          if (distance(a, b) == 0.0) continue;
+          const Vec2 axis = (1.0 / distance(a, b)) * (b - a);
+          double dev = 0.0;
+          for (std::size_t k0 = static_cast<std::size_t>(s) << l; k0 < (static_cast<std::size_t>(s) + 1) << l; ++k0) {
+            dev = std::max(dev, std::abs(cross(axis, m.scaling[0][k0] - a)));
+            for (const Vec2& q : under[k0]) dev = std::max(dev, std::abs(cross(axis, q - a)));
+          }
+          const double half = box_half_width(sc.box(ci.box_offset[l] + s));
+          ASSERT_GE(half + 1e-12, dev) << "curve " << c << " level " << l << " segment " << s;
+          if (dev > 1e-6) ratio.push_back(half / dev);  // straight runs have no meaningful ratio
+        }
+      }
+    }
+  }
+  ASSERT_GT(ratio.size(), 1000u);
+  std::sort(ratio.begin(), ratio.end());
+  const double median = ratio[ratio.size() / 2];
+  EXPECT_LE(median, 1.05) << "median box half-width / true deviation over " << ratio.size() << " boxes";
+  std::printf("box half-width / true deviation: median %.4f, p90 %.4f over %zu boxes\n", median, ratio[ratio.size() * 9 / 10], ratio.size());
 }
 
 TEST(CollisionTree, SceneHierarchyHoldsEveryCoarsestSegmentOnce) {
@@ -113,8 +178,10 @@ TEST(CollisionTree, ErrorGrowsWithLevelAndBoxesBoundIt) {
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const CurveInfo& ci = sc.curve(c);
     for (int l = 0; l < ci.levels; ++l) {
-      // The box half-width bounds the measured deviation (plus the box padding).
-      EXPECT_LE(ci.max_error_m[l], ci.max_box_half_width_m[l] + 1e-8) << "curve " << c << " level " << l;
+      // The boxes' error bound bounds the measured deviation (plus the box padding), and is the
+      // half-width combined with the reach past the segment ends, so never below the half-width.
+      EXPECT_LE(ci.max_error_m[l], ci.max_error_bound_m[l] + 1e-8) << "curve " << c << " level " << l;
+      EXPECT_GE(ci.max_error_bound_m[l], ci.max_box_half_width_m[l]);
     }
     EXPECT_GE(ci.max_error_m[ci.levels - 1] + 1e-12, ci.max_error_m[0]);
   }

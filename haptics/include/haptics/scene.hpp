@@ -51,6 +51,10 @@ bool box_contains(const ErrorBox& box, Vec2 p, double margin_m = 0.0);
 void box_corners(const ErrorBox& box, Vec2 out[4]);
 /// Largest distance of a box point from the line through its segment [m]: max(|n_min|, |n_max|).
 double box_half_width(const ErrorBox& box);
+/// Largest distance of a box point from its segment, of length segment_length_m [m]: the half-width
+/// combined with how far the box reaches past the segment's ends. A point the box holds is no farther
+/// from the segment than this, so it bounds the error of what the box stands for.
+double box_error_bound(const ErrorBox& box, double segment_length_m);
 
 /// Where one curve's data sits in the scene arrays. Levels 0 .. levels−1.
 struct CurveInfo {
@@ -62,6 +66,7 @@ struct CurveInfo {
   std::uint32_t segment_count[kMaxLevels] = {};  ///< segments of level l (closed: points; open: points − 1)
   double max_error_m[kMaxLevels] = {};           ///< largest distance of an original point from the level-l segment standing for it [m]
   double max_box_half_width_m[kMaxLevels] = {};  ///< largest error box half-width at level l [m]
+  double max_error_bound_m[kMaxLevels] = {};     ///< largest box_error_bound of level l: bounds max_error_m[l] [m]
 };
 
 /// Identifies one segment of one level of one curve. 12 bytes.
@@ -137,9 +142,14 @@ class Scene {
   void segment(SegmentRef s, Vec2* a, Vec2* b) const;
   /// Segment count over all curves at `level` (curves with fewer levels use their coarsest).
   std::size_t total_segments(int level) const;
-  /// The scene's error bound at `level`: the largest error-box half-width of any curve there (curves with
-  /// fewer levels count with their coarsest) [m]; 0 for an empty scene. O(curves): for setup code.
+  /// The largest error-box half-width of any curve at `level` (curves with fewer levels count with their
+  /// coarsest) [m]: how far apart two levels' polylines can be across the curve; 0 for an empty scene.
+  /// O(curves): for setup code.
   double max_box_half_width_m(int level) const;
+  /// The scene's error bound at `level`: the largest box_error_bound of any curve there (curves with fewer
+  /// levels count with their coarsest) [m]; no original point is farther than this from the level-`level`
+  /// segment standing for it. 0 for an empty scene. O(curves): for setup code.
+  double max_error_bound_m(int level) const;
   /// Levels of the curve with the most levels (1 for an empty scene).
   int max_curve_levels() const;
   /// Coarsest level available in every curve clamped: min(level, levels−1 of curve c).
@@ -153,6 +163,7 @@ class Scene {
   const SceneBuildTimes& build_times() const { return times_; }
 
  private:
+  friend class SceneBuild;  // the build phases (scene.cpp)
   std::vector<CurveInfo> curves_;
   std::vector<CurveMultires> models_;
   std::vector<std::size_t> source_index_;
