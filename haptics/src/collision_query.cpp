@@ -110,139 +110,157 @@ void BoundarySection::split(std::uint32_t node) {
   }
 }
 
-SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                                    QueryBudget& budget, QueryStats* stats_out) {
+// One query's inputs, answer so far and counters, passed to each phase of first_hit.
+struct BoundarySection::Query {
+  Vec2 a, b;                    // the sweep [m]
+  Aabb sweep;                   // the rectangle around it
+  int level = 0;                // target level (clamped per curve)
+  const SegmentRef* excluded = nullptr;
+  int excluded_count = 0;
+  QueryBudget* budget = nullptr;
+  SweepHit best;                // nearest exact hit so far (t = +inf: none)
+  double unresolved_t = std::numeric_limits<double>::infinity();  // entry of the nearest box left unrefined
+  std::uint32_t unresolved_node = 0;
   QueryStats st;
-  SweepHit best;
-  best.t = std::numeric_limits<double>::infinity();
-  best.point_m = b;
-  const Scene& sc = *scene_;
-  if (level != last_level_) {  // the frontier was cut for another level: start again from the roots
-    reset();
-    last_level_ = level;
+
+  // A section entry's clip: always done and charged, even past the budget.
+  void charge_section_box() noexcept {
+    ++st.box_tests;
+    ++st.section_box_tests;
+    budget->charge();
   }
-  // Free-space ball (seed §3: "distances to the boxes ... can be used to schedule box updates"): the
-  // last full query proved that no box of the section comes within ball_radius_m_ of ball_center_m_,
-  // and the section covers every wall. A sweep inside that ball cannot hit anything: answer at once.
-  if (ball_radius_m_ > 0.0 && distance(a, ball_center_m_) < ball_radius_m_ && distance(b, ball_center_m_) < ball_radius_m_) {
-    st.section_size = static_cast<std::int32_t>(section_.size());
-    if (stats_out) *stats_out = st;
-    best.t = 1.0;
-    return best;
+  // Any other box test: only while the budget lasts.
+  bool spend_box() noexcept {
+    if (!budget->spend()) return false;
+    ++st.box_tests;
+    return true;
   }
+  bool is_excluded(SegmentRef s) const noexcept {
+    for (int i = 0; i < excluded_count; ++i) {
+      if (excluded[i] == s) return true;
+    }
+    return false;
+  }
+  // Boxes entered past this cannot hold anything nearer than what is known.
+  double horizon() const noexcept { return std::min(best.t, unresolved_t); }
+};
+
+// Free-space ball (seed §3: "distances to the boxes ... can be used to schedule box updates"): the
+// last full query proved that no box of the section comes within ball_radius_m_ of ball_center_m_, and
+// the section covers every wall. A sweep inside that ball cannot hit anything: answer at once.
+bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
+  return ball_radius_m_ > 0.0 && distance(a, ball_center_m_) < ball_radius_m_ && distance(b, ball_center_m_) < ball_radius_m_;
+}
+
+void BoundarySection::next_tick() noexcept {
   ++tick_;
   if (tick_ == 0) {  // stamp wrap-around: clear so old stamps cannot match
     std::fill(hit_stamp_.begin(), hit_stamp_.end(), 0u);
     std::fill(merge_stamp_.begin(), merge_stamp_.end(), 0u);
     tick_ = 1;
   }
-  // A section entry's clip is always done and charged; every other box test only while the budget lasts.
-  auto charge_section_box = [&]() {
-    ++st.box_tests;
-    ++st.section_box_tests;
-    budget.charge();
-  };
-  auto spend_box = [&]() {
-    if (!budget.spend()) return false;
-    ++st.box_tests;
-    return true;
-  };
-  auto is_excluded = [&](SegmentRef s) {
-    for (int i = 0; i < excluded_count; ++i) {
-      if (excluded[i] == s) return true;
-    }
-    return false;
-  };
-  auto test_segment = [&](std::uint32_t node) {
-    const NodeInfo& in = sc.info(node);
-    const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
-    if (is_excluded(ref)) return;
-    ++st.segment_tests;
-    st.coarsest_answer_level = std::max(st.coarsest_answer_level, in.level);
-    Vec2 p, q;
-    sc.segment(ref, &p, &q);
-    double t = 0.0;
-    if (intersect_sweep_segment(a, b, p, q, &t) && t < best.t) {
-      best.hit = true;
-      best.t = t;
-      best.segment = ref;
-    }
-  };
+}
 
-  // 1. Clip the sweep against the boundary section (boxes grown by the merge margin, so one clip
-  //    answers both "hit?" and "still near?").
+// Phase 1: clip the sweep against every box of the boundary section, grown by the merge margin, so one
+// clip answers both "hit?" (then an exact clip makes it a candidate) and "still near?" (else it may merge).
+void BoundarySection::clip_section(Query& q) {
+  const Scene& sc = *scene_;
   candidates_.clear();
   merge_scratch_.clear();
-  // Rectangle around the sweep: most boxes are rejected by four comparisons before the exact clip.
-  const Aabb sweep{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
   const std::size_t n_section = section_.size();
   for (std::size_t i = 0; i < n_section; ++i) {
     const std::uint32_t node = section_[i];
     double te = 0.0, tx = 0.0;
-    charge_section_box();
-    if (overlaps(section_box_[i], sweep, merge_margin_m_) && clip_segment_box(sc.box(node), a, b, merge_margin_m_, &te, &tx)) {
+    q.charge_section_box();
+    if (overlaps(section_box_[i], q.sweep, merge_margin_m_) && clip_segment_box(sc.box(node), q.a, q.b, merge_margin_m_, &te, &tx)) {
       hit_stamp_[node] = tick_;
-      if (clip_segment_box(sc.box(node), a, b, 0.0, &te, &tx)) candidates_.push_back({te, node});
+      if (clip_segment_box(sc.box(node), q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node});
     } else {
       merge_scratch_.push_back(node);
     }
   }
-  // 2. Nearest first: sort hit boxes by entry parameter, refine depth-first, prune past the best hit.
+}
+
+// Intersects the sweep with one segment of the target level; keeps the nearest hit.
+void BoundarySection::test_segment(Query& q, std::uint32_t node) {
+  const NodeInfo& in = scene_->info(node);
+  const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+  if (q.is_excluded(ref)) return;
+  ++q.st.segment_tests;
+  q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
+  Vec2 p0, p1;
+  scene_->segment(ref, &p0, &p1);
+  double t = 0.0;
+  if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && t < q.best.t) {
+    q.best.hit = true;
+    q.best.t = t;
+    q.best.segment = ref;
+  }
+}
+
+// Pushes the children of `node` the sweep enters, nearest on top. Returns false, with nothing pushed,
+// when the budget or the stack ran out first: the box then stays unrefined.
+bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) {
+  const Scene& sc = *scene_;
+  std::uint32_t first = 0, count = 0;
+  sc.children(node, &first, &count);
+  const int base = top;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    double te = 0.0, tx = 0.0;
+    if (!q.spend_box()) {
+      top = base;
+      return false;
+    }
+    if (overlaps(sc.aabb(first + i), q.sweep, 0.0) && clip_segment_box(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t &&
+        !push(top, {te, first + i})) {
+      top = base;  // the stack is full: as past the budget
+      return false;
+    }
+  }
+  std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
+  return true;
+}
+
+// Phase 2: nearest first. Hit boxes in order of entry, each refined depth-first (nearest child first)
+// down to the target level, pruned past the best hit. Past the budget, boxes are not refined: the nearest
+// such box bounds what is proven clear (a box holds everything finer).
+void BoundarySection::refine_candidates(Query& q) {
+  const Scene& sc = *scene_;
   std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& x, const Candidate& y) { return x.t_enter < y.t_enter; });
-  // Past the budget, boxes are not refined: the nearest such box bounds what is proven clear.
-  double unresolved_t = std::numeric_limits<double>::infinity();
-  std::uint32_t unresolved_node = 0;
   for (const Candidate& cand : candidates_) {
-    if (cand.t_enter > std::min(best.t, unresolved_t)) break;
+    if (cand.t_enter > q.horizon()) break;
     int top = 0;
     stack_[top++] = cand;
     while (top > 0) {
       const Candidate cur = stack_[--top];
-      if (cur.t_enter > std::min(best.t, unresolved_t)) continue;
-      const std::uint32_t node = cur.node;
-      const NodeInfo& in = sc.info(node);
-      if (sc.is_segment(node) && in.level <= sc.clamp_level(in.curve, level)) {
-        test_segment(node);
-        continue;
+      if (cur.t_enter > q.horizon()) continue;
+      const NodeInfo& in = sc.info(cur.node);
+      if (sc.is_segment(cur.node) && in.level <= sc.clamp_level(in.curve, q.level)) {
+        test_segment(q, cur.node);
+      } else if (!push_hit_children(q, cur.node, top) && cur.t_enter < q.unresolved_t) {
+        q.unresolved_t = cur.t_enter;
+        q.unresolved_node = cur.node;
       }
-      std::uint32_t first = 0, count = 0;
-      sc.children(node, &first, &count);
-      // Push hit children far-to-near so the nearest is popped first.
-      const int base = top;
-      bool refined = true;
-      for (std::uint32_t i = 0; i < count && refined; ++i) {
-        double te = 0.0, tx = 0.0;
-        if (!spend_box()) {
-          refined = false;
-          break;
-        }
-        if (overlaps(sc.aabb(first + i), sweep, 0.0) && clip_segment_box(sc.box(first + i), a, b, 0.0, &te, &tx) && te <= best.t &&
-            !push(top, {te, first + i})) {
-          refined = false;  // the stack is full: the box stays unrefined, as past the budget
-          break;
-        }
-      }
-      if (!refined) {  // past the budget (before or amid its children): the box bounds what is proven clear
-        top = base;
-        if (cur.t_enter < unresolved_t) {
-          unresolved_t = cur.t_enter;
-          unresolved_node = node;
-        }
-        continue;
-      }
-      std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
     }
   }
-  // 3. The boundary section follows the handle: split what was hit (one level per tick) ...
+}
+
+// Phase 3: the boundary section follows the handle: what was hit is split (one level per tick).
+void BoundarySection::split_hit_boxes(Query& q) {
+  const Scene& sc = *scene_;
   for (const Candidate& cand : candidates_) {
     const NodeInfo& in = sc.info(cand.node);
-    if (!sc.is_segment(cand.node) || in.level > sc.clamp_level(in.curve, level)) {
+    if (!sc.is_segment(cand.node) || in.level > sc.clamp_level(in.curve, q.level)) {
       split(cand.node);
-      ++st.splits;
+      ++q.st.splits;
     }
   }
-  // ... and merge siblings whose parent is clear of the sweep by the margin. Merging only shrinks the
-  // section, so it can be lazy: a few parents per tick, taken round-robin, bound the work.
+}
+
+// Phase 4: siblings whose parent is clear of the sweep by the margin merge into it. Merging only shrinks
+// the section, so it can be lazy: a few parents per tick, taken round-robin, bound the work.
+void BoundarySection::merge_idle_siblings(Query& q) {
+  const Scene& sc = *scene_;
   constexpr int kMergeChecksPerTick = 4;
   const std::size_t n_idle = merge_scratch_.size();
   int checks = 0;
@@ -250,7 +268,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     const std::uint32_t node = merge_scratch_[(j + tick_) % n_idle];
     if (!in_section_[node] || node == sc.scene_root()) continue;
     const std::uint32_t parent = sc.parent(node);
-    // One check per parent per tick: a curve root has many children, and each would ask again.
+    // One check per parent per tick: a node with many children would otherwise ask again for each.
     if (in_section_[parent] || merge_stamp_[parent] == tick_) continue;
     merge_stamp_[parent] = tick_;
     ++checks;
@@ -260,17 +278,19 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     for (std::uint32_t i = 0; i < count && all_idle; ++i) all_idle = in_section_[first + i] && hit_stamp_[first + i] != tick_;
     if (!all_idle) continue;
     double te = 0.0, tx = 0.0;
-    if (!spend_box()) break;  // merging can wait for a tick with budget left
-    if (overlaps(sc.aabb(parent), sweep, merge_margin_m_) && clip_segment_box(sc.box(parent), a, b, merge_margin_m_, &te, &tx)) continue;
+    if (!q.spend_box()) break;  // merging can wait for a tick with budget left
+    if (overlaps(sc.aabb(parent), q.sweep, merge_margin_m_) && clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
     for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
     in_section_[parent] = 1;
     section_.push_back(parent);
     section_box_.push_back(sc.aabb(parent));
-    ++st.merges;
+    ++q.st.merges;
   }
-  // Compact: drop entries that were split or merged away.
-  // Compact: drop entries that were split or merged away; on the way, measure how far the end of
-  // the sweep is from the nearest box of the section (the next free-space ball).
+}
+
+// Phase 5: drop the entries split or merged away; on the way, measure how far the end of the sweep is
+// from the nearest box of the section: the next free-space ball.
+void BoundarySection::compact_section(Vec2 b) {
   std::size_t w = 0;
   double nearest_sq = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < section_.size(); ++i) {
@@ -290,32 +310,72 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   section_.resize(w);
   section_box_.resize(w);
   for (std::uint32_t node : section_) removed_[node] = 0;
+}
 
-  if (unresolved_t < best.t) {
-    // Not resolved within the budget: report the finest level reached, and how far the sweep is proven clear.
+// Phase 6: the answer. An exact hit; or, when a box left unrefined begins before it, the finest level
+// reached and how far the sweep is proven clear; or clear to the end.
+SweepHit BoundarySection::finish(Query& q) const {
+  const Scene& sc = *scene_;
+  SweepHit best = q.best;
+  if (q.unresolved_t < best.t) {
     best.hit = false;
     best.blocked = true;
-    best.t = unresolved_t;
-    const NodeInfo& in = sc.info(unresolved_node);
-    if (sc.is_chunk(unresolved_node)) {
+    best.t = q.unresolved_t;
+    const NodeInfo& in = sc.info(q.unresolved_node);
+    if (sc.is_chunk(q.unresolved_node)) {
       const CurveInfo& ci = sc.curve(in.curve);
       best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), ci.levels - 1, static_cast<std::int32_t>(in.index)};
-    } else if (!sc.is_segment(unresolved_node)) {  // above the curves: no segment to name yet
+    } else if (!sc.is_segment(q.unresolved_node)) {  // above the curves: no segment to name yet
       best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
     } else {
       best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
     }
-    st.coarsest_answer_level = std::max(st.coarsest_answer_level, best.segment.level);
+    q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, best.segment.level);
   }
   if (best.hit || best.blocked) {
-    best.point_m = lerp(a, b, best.t);
+    best.point_m = lerp(q.a, q.b, best.t);
   } else {
     best.t = 1.0;
   }
-  st.budget_exhausted = budget.exhausted();
-  st.section_size = static_cast<std::int32_t>(section_.size());
-  if (stats_out) *stats_out = st;
+  q.st.budget_exhausted = q.budget->exhausted();
+  q.st.section_size = static_cast<std::int32_t>(section_.size());
   return best;
+}
+
+SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
+                                    QueryBudget& budget, QueryStats* stats_out) {
+  if (level != last_level_) {  // the frontier was cut for another level: start again from the roots
+    reset();
+    last_level_ = level;
+  }
+  if (inside_free_ball(a, b)) {
+    if (stats_out) {
+      *stats_out = QueryStats{};
+      stats_out->section_size = static_cast<std::int32_t>(section_.size());
+    }
+    SweepHit clear;
+    clear.point_m = b;
+    return clear;
+  }
+  Query q;
+  q.a = a;
+  q.b = b;
+  q.sweep = Aabb{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
+  q.level = level;
+  q.excluded = excluded;
+  q.excluded_count = excluded_count;
+  q.budget = &budget;
+  q.best.t = std::numeric_limits<double>::infinity();
+  q.best.point_m = b;
+  next_tick();
+  clip_section(q);
+  refine_candidates(q);
+  split_hit_boxes(q);
+  merge_idle_siblings(q);
+  compact_section(b);
+  const SweepHit answer = finish(q);
+  if (stats_out) *stats_out = q.st;
+  return answer;
 }
 
 bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,

@@ -125,6 +125,18 @@ class BoundarySection {
   const std::vector<std::uint32_t>& section() const { return section_; }
 
  private:
+  struct Query;  // one first_hit's inputs, answer so far and counters (collision_query.cpp)
+  // The phases of first_hit, in order (each documented where it is defined).
+  bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
+  void next_tick() noexcept;
+  void clip_section(Query& q);
+  void refine_candidates(Query& q);
+  bool push_hit_children(Query& q, std::uint32_t node, int& top);
+  void test_segment(Query& q, std::uint32_t node);
+  void split_hit_boxes(Query& q);
+  void merge_idle_siblings(Query& q);
+  void compact_section(Vec2 b);
+  SweepHit finish(Query& q) const;
   void split(std::uint32_t node);
   const Scene* scene_;
   double merge_margin_m_;
