@@ -7,7 +7,9 @@
 //        BM_Closest/<method>/<segments>   — closest point on the same scenes
 //        BM_Picture/<method>/<picture>    — the handle sweeps of an explore raster run on that picture
 //        BM_Level/<method>/<level>        — speed against accuracy: 4 pictures, queries at each level
-// Counters: p50_ns, p99_ns, max_ns per query; build_ms; bytes_per_segment; segments; max_error_mm.
+// Counters: p50_ns, p99_ns, max_ns per query; build_ms; bytes_per_segment; segments; max_error_mm; for
+//           ours, full_query_fraction (queries the free-space ball did not answer) and section_entries
+//           (mean boundary-section size after a query).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -123,14 +125,15 @@ void set_percentiles(benchmark::State& state, std::vector<double>& ns) {
 void run_first_hit(benchmark::State& state, Case* c, Method m) {
   std::vector<double> ns;
   ns.reserve(1 << 20);
-  std::size_t i = 0, hits = 0;
+  std::size_t i = 0, hits = 0, full = 0, section = 0;
   for (auto _ : state) {
     const Sweep& s = c->stream[i];
     i = i + 1 == c->stream.size() ? 0 : i + 1;
+    QueryStats st;
     const auto t0 = std::chrono::steady_clock::now();
     bool hit = false;
     if (m == Method::Ours) {
-      hit = c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}).hit;
+      hit = c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}, &st).hit;
     } else if (m == Method::Brute) {
       hit = c->brute->first_hit(s.a, s.b).hit;
     } else if (m == Method::Rtree) {
@@ -142,9 +145,16 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     state.SetIterationTime(dt);
     if (ns.size() < ns.capacity()) ns.push_back(dt * 1e9);
     hits += hit;
+    full += st.box_tests > 0;  // a full query (not answered by the free-space ball)
+    section += static_cast<std::size_t>(st.section_size);
     benchmark::DoNotOptimize(hit);
   }
   set_percentiles(state, ns);
+  if (m == Method::Ours) {
+    const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+    state.counters["full_query_fraction"] = static_cast<double>(full) / n;
+    state.counters["section_entries"] = static_cast<double>(section) / n;
+  }
   const double segs = static_cast<double>(c->segs.size());
   state.counters["segments"] = segs;
   state.counters["hit_fraction"] = static_cast<double>(hits) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));

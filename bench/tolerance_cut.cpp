@@ -1,0 +1,120 @@
+// Vertices per error (issue 18 item 3): a tolerance cut through our collision tree against
+// Douglas–Peucker on every test picture.
+//
+// Usage: bench_tolerance_cut [--out FILE.json]    (prints a markdown table)
+//
+// For a target error T, both methods must keep every original vertex within T:
+//   cut  hk::tolerance_cut at tolerance T on every curve (refine a segment while its box's error bound
+//        exceeds T; seed §3). Guaranteed where T is at least the curve's level-0 error; curves whose
+//        level-0 error exceeds T are counted apart (the cut stops at level 0 there).
+//   dp   Douglas & Peucker (1973), cv::approxPolyDP on the original vertices with epsilon = T (closed flag
+//        kept): every original vertex within T of the chord that replaced it.
+// Vertices: dp's count; the cut's drawn as a polyline (segments + breaks where it changes level, + 1
+// when open; CutStats::vertices). Measured error, the same way for both: the largest distance of an
+// original vertex from the nearest segment of the simplified polyline (OpenCV's closed-curve DP can exceed
+// epsilon there: its measured error is printed beside it). The ratio is the cut's vertices over dp's, per
+// picture (all its curves); the target is ≤ 1.2 on every picture.
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "bench_scenes.hpp"
+#include "haptics/tolerance_cut.hpp"
+
+using namespace hk;
+using namespace hk::bench;
+
+namespace {
+
+// Largest distance of any original vertex from the nearest of `segs` [m].
+double max_vertex_error(const std::vector<Vec2>& orig, const std::vector<std::pair<Vec2, Vec2>>& segs) {
+  double worst = 0.0;
+  for (const Vec2& p : orig) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const auto& s : segs) d = std::min(d, distance_to_segment(p, s.first, s.second));
+    worst = std::max(worst, d);
+  }
+  return worst;
+}
+
+struct Tally {
+  std::size_t cut_vertices = 0, cut_breaks = 0, dp_vertices = 0, curves_below_level0 = 0;
+  double cut_error_m = 0.0, dp_error_m = 0.0;
+};
+
+void cut_curve(const Scene& sc, std::size_t c, const Polyline& src, double tol_m, Tally& t) {
+  std::vector<SegmentRef> cut;
+  const CutStats st = tolerance_cut(sc, c, tol_m, &cut);
+  std::vector<std::pair<Vec2, Vec2>> segs;
+  for (const SegmentRef& s : cut) {
+    Vec2 a, b;
+    sc.segment(s, &a, &b);
+    segs.push_back({a, b});
+  }
+  t.cut_vertices += st.vertices;
+  t.cut_breaks += st.breaks;
+  t.cut_error_m = std::max(t.cut_error_m, max_vertex_error(src.points_m, segs));
+  if (sc.curve(c).max_error_bound_m[0] > tol_m) ++t.curves_below_level0;
+}
+
+void dp_curve(const Polyline& src, double tol_m, Tally& t) {
+  std::vector<cv::Point2f> in, out;  // approxPolyDP takes float or int points; 1e-8 m of rounding
+  for (const Vec2& p : src.points_m) in.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+  cv::approxPolyDP(in, out, tol_m, src.closed);
+  std::vector<std::pair<Vec2, Vec2>> segs;
+  for (std::size_t i = 0; i + 1 < out.size(); ++i) segs.push_back({{out[i].x, out[i].y}, {out[i + 1].x, out[i + 1].y}});
+  if (src.closed && out.size() > 1) segs.push_back({{out.back().x, out.back().y}, {out[0].x, out[0].y}});
+  if (segs.empty() && !out.empty()) segs.push_back({{out[0].x, out[0].y}, {out[0].x, out[0].y}});
+  t.dp_vertices += out.size();
+  t.dp_error_m = std::max(t.dp_error_m, max_vertex_error(src.points_m, segs));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string out_path = "docs/bench/tolerance_cut.json";
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (std::strcmp(argv[i], "--out") == 0) out_path = argv[i + 1];
+  }
+  const config::Settings settings;
+  const auto paths = picture_paths();
+  const auto pictures = picture_curves(settings);
+  const std::vector<double> tolerances_mm = {0.2, 0.3, 0.5, 1.0, 2.0};
+  nlohmann::json rows = nlohmann::json::array();
+  std::printf("| picture | curves | T mm | cut vertices (of which breaks) | dp vertices | cut / dp | cut error mm | dp error mm | curves with level-0 error > T |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  std::vector<double> worst_ratio(tolerances_mm.size(), 0.0);
+  for (std::size_t p = 0; p < paths.size(); ++p) {
+    const Scene sc = Scene::build(pictures[p], settings.haptics.max_levels);
+    for (std::size_t ti = 0; ti < tolerances_mm.size(); ++ti) {
+      const double tol_m = tolerances_mm[ti] * 1e-3;
+      Tally t;
+      for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+        const Polyline& src = pictures[p][sc.source_index(c)];
+        cut_curve(sc, c, src, tol_m, t);
+        dp_curve(src, tol_m, t);
+      }
+      const double ratio = static_cast<double>(t.cut_vertices) / static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
+      worst_ratio[ti] = std::max(worst_ratio[ti], ratio);
+      std::printf("| %s | %zu | %.1f | %zu (%zu) | %zu | %.2f | %.3f | %.3f | %zu |\n", paths[p].stem().c_str(), sc.curve_count(), tolerances_mm[ti], t.cut_vertices,
+                  t.cut_breaks, t.dp_vertices, ratio, 1e3 * t.cut_error_m, 1e3 * t.dp_error_m, t.curves_below_level0);
+      rows.push_back({{"picture", paths[p].stem().string()}, {"curves", sc.curve_count()}, {"tolerance_mm", tolerances_mm[ti]},
+                      {"cut_vertices", t.cut_vertices}, {"cut_breaks", t.cut_breaks}, {"dp_vertices", t.dp_vertices}, {"ratio", ratio},
+                      {"cut_error_mm", 1e3 * t.cut_error_m}, {"dp_error_mm", 1e3 * t.dp_error_m}, {"curves_below_level0", t.curves_below_level0}});
+    }
+  }
+  std::printf("\n| T mm | worst cut / dp over the pictures |\n|---|---|\n");
+  nlohmann::json worst = nlohmann::json::array();
+  for (std::size_t ti = 0; ti < tolerances_mm.size(); ++ti) {
+    std::printf("| %.1f | %.2f |\n", tolerances_mm[ti], worst_ratio[ti]);
+    worst.push_back({{"tolerance_mm", tolerances_mm[ti]}, {"worst_ratio", worst_ratio[ti]}});
+  }
+  std::ofstream(out_path) << nlohmann::json{{"rows", rows}, {"worst", worst}}.dump(1) << "\n";
+  return 0;
+}

@@ -1,0 +1,121 @@
+// Tolerance cut (issue 18): the cut covers the curve once, in order; every original vertex is within the
+// tolerance of the cut segment standing for it (distances computed here, from arc positions, not from the
+// tree); it never needs more segments than the coarsest single level that meets the same tolerance.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "curves.hpp"
+#include "haptics/scene.hpp"
+#include "haptics/tolerance_cut.hpp"
+
+using namespace hk;
+
+namespace {
+
+std::vector<Polyline> curves_for(std::mt19937& rng) {
+  std::vector<Polyline> curves;
+  for (int i = 0; i < 4; ++i) curves.push_back(test::random_blob(rng, {0.03 * i, 0.0}, 0.012, 300));
+  for (int i = 0; i < 3; ++i) curves.push_back(test::random_stroke(rng, {0.03 * i, 0.03}, 0.0003, 250));
+  curves.push_back(test::staircase_circle({0.0, -0.04}, 0.02, 0.0004));
+  curves.push_back(test::sampled_square(0.015, 0.0005));
+  return curves;
+}
+
+// Level-0 segment of every original vertex, by arc length (as the containment test finds it).
+std::vector<std::size_t> level0_of_vertices(const Scene& sc, std::size_t c, const Polyline& src) {
+  std::vector<std::size_t> seg(src.points_m.size());
+  const CurveMultires& m = sc.model(c);
+  const std::size_t s0 = sc.curve(c).segment_count[0];
+  double arc = 0.0;
+  std::size_t k = 0;
+  for (std::size_t j = 0; j < src.points_m.size(); ++j) {
+    if (j > 0) arc += distance(src.points_m[j - 1], src.points_m[j]);
+    while (k + 1 < s0 && m.arc_m[k + 1] <= arc) ++k;
+    seg[j] = k;
+  }
+  return seg;
+}
+
+}  // namespace
+
+TEST(ToleranceCut, CoversTheCurveOnceAndKeepsEveryVertexWithinTheTolerance) {
+  std::mt19937 rng(18);
+  const auto curves = curves_for(rng);
+  const Scene sc = Scene::build(curves, 6);
+  for (double tol_mm : {0.05, 0.1, 0.2, 0.5, 1.0, 2.0}) {
+    const double tol = tol_mm * 1e-3;
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      const CurveInfo& ci = sc.curve(c);
+      std::vector<SegmentRef> cut;
+      const CutStats st = tolerance_cut(sc, c, tol, &cut);
+      ASSERT_EQ(st.segments, cut.size());
+      // In order, each level-0 segment exactly once: the cut's level-0 ranges tile [0, s0).
+      std::vector<std::size_t> owner(ci.segment_count[0]);
+      std::size_t next = 0;
+      for (std::size_t i = 0; i < cut.size(); ++i) {
+        const SegmentRef s = cut[i];
+        ASSERT_EQ(s.curve, static_cast<int>(c));
+        const std::size_t k0 = static_cast<std::size_t>(s.segment) << s.level, k1 = (static_cast<std::size_t>(s.segment) + 1) << s.level;
+        ASSERT_EQ(k0, next) << "curve " << c << " tol " << tol_mm;
+        for (std::size_t k = k0; k < k1; ++k) owner[k] = i;
+        next = k1;
+      }
+      ASSERT_EQ(next, ci.segment_count[0]);
+      // Every original vertex and level-0 point within the tolerance of its cut segment, or, where the cut
+      // had to stop at level 0, within that level's own error.
+      const double allowed = std::max(tol, ci.max_error_bound_m[0]) + 1e-9;
+      const auto vseg = level0_of_vertices(sc, c, curves[sc.source_index(c)]);
+      const auto& orig = curves[sc.source_index(c)].points_m;
+      double worst = 0.0;
+      for (std::size_t j = 0; j < orig.size(); ++j) {
+        Vec2 a, b;
+        sc.segment(cut[owner[vseg[j]]], &a, &b);
+        worst = std::max(worst, distance_to_segment(orig[j], a, b));
+      }
+      for (std::size_t k = 0; k < ci.segment_count[0]; ++k) {
+        Vec2 a, b;
+        sc.segment(cut[owner[k]], &a, &b);
+        worst = std::max(worst, distance_to_segment(sc.points(c, 0)[k], a, b));
+      }
+      EXPECT_LE(worst, allowed) << "curve " << c << " tol " << tol_mm << " mm";
+      // No more segments than the coarsest single level that meets the tolerance everywhere.
+      int single = 0;
+      while (single + 1 < ci.levels && ci.max_error_bound_m[single + 1] <= tol) ++single;
+      if (ci.max_error_bound_m[single] <= tol) {
+        EXPECT_LE(st.segments, ci.segment_count[single]) << "curve " << c << " tol " << tol_mm;
+      }
+      EXPECT_EQ(st.vertices, st.segments + st.breaks + (ci.closed ? 0 : 1));
+    }
+  }
+}
+
+TEST(ToleranceCut, EndsAreTheCoarsestLevelAndLevelZero) {
+  std::mt19937 rng(19);
+  const Scene sc = Scene::build(curves_for(rng), 6);
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    std::vector<SegmentRef> coarse, fine;
+    const CutStats loose = tolerance_cut(sc, c, 1.0, &coarse);  // a metre: nothing is refined
+    EXPECT_EQ(loose.segments, ci.segment_count[ci.levels - 1]);
+    EXPECT_EQ(loose.breaks, 0u);  // one level: the polyline is unbroken
+    const CutStats tight = tolerance_cut(sc, c, 0.0, &fine);  // zero: everything down to level 0
+    EXPECT_EQ(tight.segments, ci.segment_count[0]);
+    EXPECT_EQ(tight.breaks, 0u);
+    for (const SegmentRef& s : fine) EXPECT_EQ(s.level, 0);
+  }
+}
+
+TEST(ToleranceCut, TighterToleranceNeverTakesFewerSegments) {
+  std::mt19937 rng(20);
+  const Scene sc = Scene::build(curves_for(rng), 6);
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    std::size_t last = 0;
+    for (double tol_mm : {5.0, 2.0, 1.0, 0.5, 0.2, 0.1, 0.05}) {
+      std::vector<SegmentRef> cut;
+      const std::size_t n = tolerance_cut(sc, c, tol_mm * 1e-3, &cut).segments;
+      EXPECT_GE(n, last) << "curve " << c << " tol " << tol_mm;
+      last = n;
+    }
+  }
+}
