@@ -300,7 +300,11 @@ void BoundarySection::compact_section(Vec2 b) {
       const Aabb& r = section_box_[i];
       const double dx = std::max({r.lo.x - b.x, 0.0, b.x - r.hi.x});
       const double dy = std::max({r.lo.y - b.y, 0.0, b.y - r.hi.y});
-      nearest_sq = std::min(nearest_sq, dx * dx + dy * dy);
+      const double aabb_sq = dx * dx + dy * dy;  // a lower bound of the distance to the box itself
+      if (aabb_sq < nearest_sq) {
+        const double d = box_distance(scene_->box(node), b);  // the box is tighter than its rectangle
+        nearest_sq = std::min(nearest_sq, d * d);
+      }
       section_box_[w] = r;
       section_[w++] = node;
     }
