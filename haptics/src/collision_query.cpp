@@ -8,15 +8,18 @@
 namespace hk {
 namespace {
 
-// Distance from p to a box (0 inside) [m].
-inline double box_distance(const ErrorBox& box, Vec2 p) {
+// Squared distance from p to a box (0 inside) [m²].
+inline double box_distance_sq(const ErrorBox& box, Vec2 p) {
   const Vec2 r = p - box.origin_m;
   const double u = dot(r, box.axis);
   const double n = cross(box.axis, r);
   const double du = std::max({box.u_min - u, 0.0, u - box.u_max});
   const double dn = std::max({box.n_min - n, 0.0, n - box.n_max});
-  return std::hypot(du, dn);
+  return du * du + dn * dn;
 }
+
+// Distance from p to a box (0 inside) [m].
+inline double box_distance(const ErrorBox& box, Vec2 p) { return std::sqrt(box_distance_sq(box, p)); }
 
 }  // namespace
 
@@ -75,7 +78,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   section_.reserve(capacity_);
   section_box_.reserve(capacity_);
   in_section_.assign(n, 0);
-  removed_.assign(n, 0);
+  compact_stamp_.assign(n, 0);
   candidates_.reserve(capacity_);
   merge_scratch_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
@@ -121,6 +124,7 @@ struct BoundarySection::Query {
   SweepHit best;                // nearest exact hit so far (t = +inf: none)
   double unresolved_t = std::numeric_limits<double>::infinity();  // entry of the nearest box left unrefined
   std::uint32_t unresolved_node = 0;
+  double nearest_sq = std::numeric_limits<double>::infinity();  // squared distance from b to the section's nearest box
   QueryStats st;
 
   // A section entry's clip: always done and charged, even past the budget.
@@ -149,7 +153,9 @@ struct BoundarySection::Query {
 // last full query proved that no box of the section comes within ball_radius_m_ of ball_center_m_, and
 // the section covers every wall. A sweep inside that ball cannot hit anything: answer at once.
 bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
-  return ball_radius_m_ > 0.0 && distance(a, ball_center_m_) < ball_radius_m_ && distance(b, ball_center_m_) < ball_radius_m_;
+  const double r_sq = ball_radius_m_ * ball_radius_m_;
+  const Vec2 da = a - ball_center_m_, db = b - ball_center_m_;
+  return dot(da, da) < r_sq && dot(db, db) < r_sq;  // r = 0 (unknown) admits nothing
 }
 
 void BoundarySection::next_tick() noexcept {
@@ -157,12 +163,15 @@ void BoundarySection::next_tick() noexcept {
   if (tick_ == 0) {  // stamp wrap-around: clear so old stamps cannot match
     std::fill(hit_stamp_.begin(), hit_stamp_.end(), 0u);
     std::fill(merge_stamp_.begin(), merge_stamp_.end(), 0u);
+    std::fill(compact_stamp_.begin(), compact_stamp_.end(), 0u);
     tick_ = 1;
   }
 }
 
 // Phase 1: clip the sweep against every box of the boundary section, grown by the merge margin, so one
 // clip answers both "hit?" (then an exact clip makes it a candidate) and "still near?" (else it may merge).
+// On the way, the distance from the end of the sweep to the nearest box: the next free-space ball, if
+// the section does not change this tick.
 void BoundarySection::clip_section(Query& q) {
   const Scene& sc = *scene_;
   candidates_.clear();
@@ -172,7 +181,12 @@ void BoundarySection::clip_section(Query& q) {
     const std::uint32_t node = section_[i];
     double te = 0.0, tx = 0.0;
     q.charge_section_box();
-    if (overlaps(section_box_[i], q.sweep, merge_margin_m_) && clip_segment_box(sc.box(node), q.a, q.b, merge_margin_m_, &te, &tx)) {
+    const Aabb& r = section_box_[i];
+    const double dx = std::max({r.lo.x - q.b.x, 0.0, q.b.x - r.hi.x});
+    const double dy = std::max({r.lo.y - q.b.y, 0.0, q.b.y - r.hi.y});
+    // The rectangle's distance bounds the box's from below: the exact one only when it could be nearer.
+    if (dx * dx + dy * dy < q.nearest_sq) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(sc.box(node), q.b));
+    if (overlaps(r, q.sweep, merge_margin_m_) && clip_segment_box(sc.box(node), q.a, q.b, merge_margin_m_, &te, &tx)) {
       hit_stamp_[node] = tick_;
       if (clip_segment_box(sc.box(node), q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node});
     } else {
@@ -288,32 +302,32 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   }
 }
 
-// Phase 5: drop the entries split or merged away; on the way, measure how far the end of the sweep is
-// from the nearest box of the section: the next free-space ball.
-void BoundarySection::compact_section(Vec2 b) {
+// Phase 5: when boxes were split or merged, drop the entries split or merged away and measure the
+// next free-space ball (the distance from the end of the sweep to the nearest box of the section) again;
+// otherwise the section is as phase 1 scanned it, and so is the ball.
+void BoundarySection::compact_section(Query& q) {
+  ball_center_m_ = q.b;
+  if (q.st.splits == 0 && q.st.merges == 0) {
+    ball_radius_m_ = std::sqrt(q.nearest_sq);
+    return;
+  }
   std::size_t w = 0;
   double nearest_sq = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < section_.size(); ++i) {
     const std::uint32_t node = section_[i];
-    if (in_section_[node] && removed_[node] == 0) {
-      removed_[node] = 1;  // de-duplicate within this pass
+    if (in_section_[node] && compact_stamp_[node] != tick_) {
+      compact_stamp_[node] = tick_;  // de-duplicate within this pass (a node merged back in appears twice)
       const Aabb& r = section_box_[i];
-      const double dx = std::max({r.lo.x - b.x, 0.0, b.x - r.hi.x});
-      const double dy = std::max({r.lo.y - b.y, 0.0, b.y - r.hi.y});
-      const double aabb_sq = dx * dx + dy * dy;  // a lower bound of the distance to the box itself
-      if (aabb_sq < nearest_sq) {
-        const double d = box_distance(scene_->box(node), b);  // the box is tighter than its rectangle
-        nearest_sq = std::min(nearest_sq, d * d);
-      }
+      const double dx = std::max({r.lo.x - q.b.x, 0.0, q.b.x - r.hi.x});
+      const double dy = std::max({r.lo.y - q.b.y, 0.0, q.b.y - r.hi.y});
+      if (dx * dx + dy * dy < nearest_sq) nearest_sq = std::min(nearest_sq, box_distance_sq(scene_->box(node), q.b));
       section_box_[w] = r;
       section_[w++] = node;
     }
   }
-  ball_center_m_ = b;
   ball_radius_m_ = std::sqrt(nearest_sq);
   section_.resize(w);
   section_box_.resize(w);
-  for (std::uint32_t node : section_) removed_[node] = 0;
 }
 
 // Phase 6: the answer. An exact hit; or, when a box left unrefined begins before it, the finest level
@@ -376,7 +390,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   refine_candidates(q);
   split_hit_boxes(q);
   merge_idle_siblings(q);
-  compact_section(b);
+  compact_section(q);
   const SweepHit answer = finish(q);
   if (stats_out) *stats_out = q.st;
   return answer;

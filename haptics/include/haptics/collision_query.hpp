@@ -135,7 +135,7 @@ class BoundarySection {
   void test_segment(Query& q, std::uint32_t node);
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
-  void compact_section(Vec2 b);
+  void compact_section(Query& q);
   SweepHit finish(Query& q) const;
   void split(std::uint32_t node);
   const Scene* scene_;
@@ -143,7 +143,7 @@ class BoundarySection {
   std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
   std::vector<Aabb> section_box_;          // their rectangles, inline so the per-tick scan streams through memory
   std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
-  std::vector<std::uint8_t> removed_;      // per node: 1 when split/merged away this tick (compacted at the end)
+  std::vector<std::uint32_t> compact_stamp_;  // per node: tick at which the compaction last kept it (de-duplication)
   struct Candidate { double t_enter; std::uint32_t node; };  // 16 bytes
   static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
   /// Checked push onto the DFS stack (sized by hk::tree_stack_entries): false, and nothing pushed, when it
