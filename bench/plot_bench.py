@@ -194,6 +194,57 @@ if sb:
         lines.append("| %s | %.2f | %.2f | %.2f |" % (n, ns(sb[n]["ours"]) / 1e6, ns(sb[n]["opencv"]) / 1e6, q))
     tables["scene_build"] = "\n".join(lines)
 
+# 6. Issue 18's targets, each with this run's figures (first_hit.json, scene_build.json, accuracy.json,
+#    tolerance_cut.json).
+def median(xs):
+    xs = sorted(xs)
+    n = len(xs)
+    return xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2])
+
+
+if size_rows:
+    rows2 = ["| target | figures in this run | met |", "|---|---|---|"]
+
+    def ratio_cells(kind, sizes, f):
+        return [(n, f(size_rows[(kind, n)])) for n in sizes if (kind, n) in size_rows and all(m in size_rows[(kind, n)] for m in ("ours", "rtree", "embree"))]
+
+    big = [10 ** 5, 10 ** 6]
+    fh_mean = ratio_cells("FirstHit", big, lambda r: ns(r["rtree"]) / ns(r["ours"]))
+    fh_p99 = ratio_cells("FirstHit", big, lambda r: r["ours"]["p99_ns"] / r["rtree"]["p99_ns"])
+    fh_emb = ratio_cells("FirstHit", big, lambda r: ns(r["embree"]) / ns(r["ours"]))
+    cp_mean = ratio_cells("Closest", big, lambda r: ns(r["rtree"]) / ns(r["ours"]))
+    cp_p99 = ratio_cells("Closest", big, lambda r: r["ours"]["p99_ns"] / r["rtree"]["p99_ns"])
+    fmt = lambda cells, unit: ", ".join("%.2f%s at 10^%d" % (v, unit, len(str(n)) - 1) for n, v in cells)
+    yes = lambda ok: "yes" if ok else "no"
+    rows2.append("| first hit: mean ≥ 6x faster than the R-tree at 10^5 and 10^6 | R-tree mean / ours: %s | %s |" % (fmt(fh_mean, "x"), yes(all(v >= 6 for _, v in fh_mean))))
+    rows2.append("| first hit: p99 ≤ 0.5x the R-tree's | ours p99 / R-tree p99: %s | %s |" % (fmt(fh_p99, ""), yes(all(v <= 0.5 for _, v in fh_p99))))
+    pic_faster = sum(1 for rows in pic.values() if "embree" in rows and ns(rows["ours"]) < ns(rows["embree"]))
+    rows2.append("| first hit: faster than Embree on the same streams | Embree mean / ours: %s; pictures where ours is faster: %d of %d | %s |" % (
+        fmt(fh_emb, "x"), pic_faster, len(pic), yes(all(v > 1 for _, v in fh_emb) and pic_faster == len(pic))))
+    rows2.append("| closest point: mean ≥ 3x faster than the R-tree | R-tree mean / ours: %s | %s |" % (fmt(cp_mean, "x"), yes(all(v >= 3 for _, v in cp_mean))))
+    rows2.append("| closest point: p99 ≤ 0.5x the R-tree's | ours p99 / R-tree p99: %s | %s |" % (fmt(cp_p99, ""), yes(all(v <= 0.5 for _, v in cp_p99))))
+    bps = [size_rows[("FirstHit", n)]["ours"]["bytes_per_segment"] for n in big if ("FirstHit", n) in size_rows]
+    rows2.append("| memory: all levels ≤ 64 bytes per level-0 segment | %s bytes per segment (R-tree %.0f, Embree %.0f at 10^6) | %s |" % (
+        ", ".join("%.0f" % b for b in bps), size_rows[("FirstHit", 10 ** 6)]["rtree"]["bytes_per_segment"] if ("FirstHit", 10 ** 6) in size_rows else float("nan"),
+        size_rows[("FirstHit", 10 ** 6)]["embree"]["bytes_per_segment"] if ("FirstHit", 10 ** 6) in size_rows else float("nan"), yes(all(b <= 64 for b in bps))))
+    if sb:
+        sbr = [ns(sb[n]["ours"]) / ns(sb[n]["opencv"]) for n in sorted(sb)]
+        rows2.append("| scene build: ≤ 1.5x OpenCV on every picture, median ≤ 1.2x | ours / OpenCV: median %.2f, worst %.2f, %d of %d pictures ≤ 1.5x | %s |" % (
+            median(sbr), max(sbr), sum(1 for q in sbr if q <= 1.5), len(sbr), yes(max(sbr) <= 1.5 and median(sbr) <= 1.2)))
+    rows2.append("| servo tick p99.9 ≤ 10 µs on a tiled scene of 10^6 segments, headless | not measured yet | — |")
+    acc_path = os.path.join(BENCH, "accuracy.json")
+    if os.path.exists(acc_path):
+        bt = json.load(open(acc_path))["box_tightness"]
+        meds = [(b["level"], b["ratio"]["median"]) for b in bt]
+        rows2.append("| error boxes: median half-width ≤ 1.05x the true max deviation under it | median per level (0–%d): %s; all pictures' curves | %s |" % (
+            meds[-1][0], ", ".join("%.3f" % m for _, m in meds), yes(all(m <= 1.05 for _, m in meds))))
+    tc_path = os.path.join(BENCH, "tolerance_cut.json")
+    if os.path.exists(tc_path):
+        worst = json.load(open(tc_path))["worst"]
+        rows2.append("| tolerance cut: ≤ 1.2x Douglas–Peucker's vertices for the same max error, every picture | worst cut / DP per target error: %s | %s |" % (
+            ", ".join("%.2f at %.1f mm" % (w["worst_ratio"], w["tolerance_mm"]) for w in worst), yes(all(w["worst_ratio"] <= 1.2 for w in worst))))
+    tables["round_two"] = "\n".join(rows2)
+
 if os.path.exists(PERF):
     text = open(PERF).read()
     for key, block in tables.items():

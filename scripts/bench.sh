@@ -45,7 +45,8 @@ doc = open(sys.argv[2]).read()
 for name, part in (("tolerance_cut", 1), ("earcon_latency", 0), ("servo_rate", 0), ("levels", 0), ("levels_speed", 1), ("stick_first_page", 0), ("pdf_pages", 0), ("device_loop", 0), ("device_loop_servo", 1)):
     md = "levels" if name.startswith("levels") else "device_loop" if name.startswith("device_loop") else name
     lines = [l for l in open(f"{sys.argv[1]}/{md}.md").read().strip().split("\n\n")[part].splitlines() if l.startswith("|")]
-    doc = re.sub(rf"(<!-- BEGIN {name} -->\n).*?(\n<!-- END {name} -->)", lambda m: m.group(1) + "\n".join(lines) + m.group(2), doc, flags=re.S)
+    # Whatever is between the markers (nothing, the first time) becomes the table.
+    doc = re.sub(rf"(<!-- BEGIN {name} -->\n).*?(<!-- END {name} -->)", lambda m: m.group(1) + "\n".join(lines) + "\n" + m.group(2), doc, flags=re.S)
 open(sys.argv[2], "w").write(doc)
 PY
 /usr/bin/python3 "$root/bench/plot_bench.py" "$out" "$root/docs/PERFORMANCE.md"
