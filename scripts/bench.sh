@@ -29,6 +29,7 @@ min_time=0.5
 "$b/bench_servo_rate" --seconds 5 --out "$out/servo_rate.json" 2>/dev/null > "$out/servo_rate.md"
 "$b/bench_levels" --out "$out/levels.json" > "$out/levels.md"
 "$b/bench_tolerance_cut" --out "$out/tolerance_cut.json" > "$out/tolerance_cut.md"
+"$b/bench_servo_tick" --cpu 0 --out "$out/servo_tick.json" > "$out/servo_tick.md"
 "$b/bench_stick_scan" --out "$out/stick_scan.json" > "$out/stick_scan.txt"
 "$b/bench_pdf_pages" --out "$out/pdf_pages.json" > "$out/pdf_pages.md"
 "$b/bench_stick_first_page" --out "$out/stick_first_page.json" > "$out/stick_first_page.md"
@@ -42,7 +43,7 @@ bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detecto
 /usr/bin/python3 - "$out" "$root/docs/PERFORMANCE.md" <<'PY'
 import re, sys
 doc = open(sys.argv[2]).read()
-for name, part in (("tolerance_cut", 1), ("earcon_latency", 0), ("servo_rate", 0), ("levels", 0), ("levels_speed", 1), ("stick_first_page", 0), ("pdf_pages", 0), ("device_loop", 0), ("device_loop_servo", 1)):
+for name, part in (("tolerance_cut", 1), ("servo_tick", 0), ("earcon_latency", 0), ("servo_rate", 0), ("levels", 0), ("levels_speed", 1), ("stick_first_page", 0), ("pdf_pages", 0), ("device_loop", 0), ("device_loop_servo", 1)):
     md = "levels" if name.startswith("levels") else "device_loop" if name.startswith("device_loop") else name
     lines = [l for l in open(f"{sys.argv[1]}/{md}.md").read().strip().split("\n\n")[part].splitlines() if l.startswith("|")]
     # Whatever is between the markers (nothing, the first time) becomes the table.

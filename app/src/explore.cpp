@@ -105,27 +105,6 @@ double percentile(std::vector<std::int64_t>& v, double q) {
   return static_cast<double>(v[k]);
 }
 
-// The explorer's parameters from the settings: the workspace, the hand's spring and force, the raster's
-// spacing and speed for its sweeps, the walls' push-through and the rendering mode.
-ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t seed) {
-  ExplorerParams ep;
-  ep.workspace_width_m = s.workspace.width_m;
-  ep.workspace_height_m = s.workspace.height_m;
-  ep.sweep_spacing_m = s.hand.raster_spacing_m;
-  // 1.5 x the raster's speed: the raster runs into walls blind, the explorer's plans keep it off the walls it
-  // remembers and it slows to the trace speed at every wall it meets.
-  ep.sweep_speed_m_per_s = std::min(5.0, 1.5 * s.hand.raster_speed_m_per_s);
-  ep.max_force_n = s.hand.max_force_n;
-  ep.press_force_n = std::min(ep.press_force_n, 0.5 * s.hand.max_force_n);
-  ep.contact_force_n = std::min(ep.contact_force_n, 0.25 * s.hand.max_force_n);
-  ep.hand_stiffness_n_per_m = s.hand.stiffness_n_per_m;
-  ep.pop_force_n = s.haptics.pop_force_n;
-  ep.pop_hold_s = s.haptics.pop_hold_s;
-  ep.grooves = s.haptics.render == "grooves";
-  ep.seed = seed;
-  return ep;
-}
-
 // --source: one capture (capture.hpp; a time-out keeps the last frame), written beside the outputs as capture.png
 // and capture.json, and the scene of what it captured.
 ImageScene build_capture_scene(const std::string& spec_text, int page, const config::Settings& s, const std::filesystem::path& out) {

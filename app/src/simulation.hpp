@@ -8,6 +8,7 @@
 
 #include "config/settings.hpp"
 #include "device_setup.hpp"
+#include "haptics/explorer_hand.hpp"
 #include "haptics/hand_controller.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/scene.hpp"
@@ -44,6 +45,11 @@ SimPantographParams sim_params_from(const config::Settings& s);
 
 /// Model hand parameters from the settings ([hand]).
 ModelHandParams hand_params_from(const config::Settings& s);
+
+/// The visitor-like explorer hand's parameters (`--hand explorer`) from the settings: the workspace, the hand's
+/// spring and force, the raster's spacing and 1.5x its speed for the sweeps (capped at 5 m/s), the walls'
+/// push-through and the rendering mode; `seed` drives its choices.
+ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t seed);
 
 /// Runs the device `device` chose (the simulated pantograph, or the Haply firmware emulator behind a pty
 /// reached through the tty transport and the hAPI driver, bytes and all) driven by the model hand `hand` over
