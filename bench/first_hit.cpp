@@ -177,7 +177,7 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
 void run_closest(benchmark::State& state, Case* c, Method m) {
   std::vector<double> ns;
   ns.reserve(1 << 20);
-  std::size_t i = 0;
+  std::size_t i = 0, walks = 0, walk_box_tests = 0;
   for (auto _ : state) {
     const Vec2 p = c->stream[i].b;
     i = i + 1 == c->stream.size() ? 0 : i + 1;
@@ -186,7 +186,10 @@ void run_closest(benchmark::State& state, Case* c, Method m) {
     if (m == Method::Ours) {
       Vec2 q;
       SegmentRef s;
-      d = c->ours->closest_point(p, c->level, 1.0, &q, &s) ? distance(p, q) : 1.0;
+      QueryBudget counted;  // no limit: counts the walk's box tests
+      d = c->ours->closest_point(p, c->level, 1.0, &q, &s, -1, &counted) ? distance(p, q) : 1.0;
+      walks += c->ours->last_closest_source() == BoundarySection::ClosestSource::Walk;
+      walk_box_tests += static_cast<std::size_t>(counted.box_tests_used);
     } else if (m == Method::Brute) {
       d = c->brute->closest_distance(p);
     } else if (m == Method::Rtree) {
@@ -201,6 +204,11 @@ void run_closest(benchmark::State& state, Case* c, Method m) {
   }
   set_percentiles(state, ns);
   state.counters["segments"] = static_cast<double>(c->segs.size());
+  if (m == Method::Ours) {
+    // Calls the neighbour list could not answer, and the box tests of those walks.
+    state.counters["walk_fraction"] = static_cast<double>(walks) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+    state.counters["box_tests_per_walk"] = static_cast<double>(walk_box_tests) / static_cast<double>(std::max<std::size_t>(1, walks));
+  }
 }
 
 }  // namespace

@@ -83,12 +83,14 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   merge_scratch_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
   stack_.resize(tree_stack_entries(widest_root));
+  list_entries_.resize(kClosestListCapacity);
   hit_stamp_.assign(n, 0);
   merge_stamp_.assign(n, 0);
   reset();
 }
 
 void BoundarySection::reset() {
+  list_.valid = false;  // a reset section answers like a new one, box test for box test
   for (std::uint32_t node : section_) in_section_[node] = 0;
   section_.clear();
   section_box_.clear();
@@ -396,21 +398,110 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   return answer;
 }
 
+namespace {
+
+// "d at s is a better closest answer than best_d at best_s": nearer, or as near and the smaller
+// (curve, level, segment), so ties do not depend on the order segments are met in.
+inline bool closer(double d, SegmentRef s, double best_d, SegmentRef best_s) {
+  if (d != best_d) return d < best_d;
+  if (s.curve != best_s.curve) return s.curve < best_s.curve;
+  if (s.level != best_s.level) return s.level < best_s.level;
+  return s.segment < best_s.segment;
+}
+
+// Larger than every real segment reference: "no answer yet".
+constexpr SegmentRef kNoSegment{std::numeric_limits<std::int32_t>::max(), std::numeric_limits<std::int32_t>::max(),
+                                std::numeric_limits<std::int32_t>::max()};
+
+}  // namespace
+
+// The nearest segment of the neighbour list built at centre_m to p, within max_distance_m, in *guess.
+// Returns true when the list provably holds every segment that could be the answer (closest_point says
+// why), so *guess is the answer; false when it cannot say (*guess is then only a first bound).
+bool BoundarySection::closest_from_list(Vec2 p, int level, double max_distance_m, int curve, ClosestGuess* guess) const noexcept {
+  guess->found = false;
+  if (!list_.valid || list_.level != level || list_.curve != curve) return false;
+  const double delta = distance(p, list_.centre_m);
+  double best = max_distance_m;
+  SegmentRef best_s = kNoSegment;
+  for (std::size_t i = 0; i < list_.count; ++i) {
+    const ListEntry& e = list_entries_[i];
+    // Sorted by distance from the centre, which is at most δ more than from p: no later entry is nearer.
+    if (e.distance_m - delta > best) break;
+    const Vec2 q = closest_point_on_segment(p, e.a_m, e.b_m);
+    const double d = distance(p, q);
+    if (closer(d, e.segment, best, best_s)) {
+      best = d;
+      best_s = e.segment;
+      guess->point_m = q;
+    }
+  }
+  guess->found = !(best_s == kNoSegment);
+  guess->distance_m = best;
+  guess->segment = best_s;
+  return best + delta < list_.radius_m;  // else something outside the list could be as near
+}
+
+// Adds a segment to the list being built; when the list is full the farthest entry (or the new one) is
+// dropped, and the list then vouches only for what is nearer than what it dropped.
+void BoundarySection::list_add(const ListEntry& e, double* radius_limit_m) noexcept {
+  std::size_t slot = list_.count;
+  if (slot == list_entries_.size()) {
+    slot = 0;
+    for (std::size_t i = 1; i < list_.count; ++i) {
+      if (list_entries_[i].distance_m > list_entries_[slot].distance_m) slot = i;
+    }
+    if (list_entries_[slot].distance_m <= e.distance_m) {
+      *radius_limit_m = std::min(*radius_limit_m, e.distance_m);
+      return;
+    }
+    *radius_limit_m = std::min(*radius_limit_m, list_entries_[slot].distance_m);
+  } else {
+    ++list_.count;
+  }
+  list_entries_[slot] = e;
+}
+
 bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
                                     QueryBudget* budget) {
   const Scene& sc = *scene_;
-  double best = max_distance_m;
-  bool found = false;
   if (sc.curve_count() == 0) return false;
+  ClosestGuess guess;
+  if (closest_from_list(p, level, max_distance_m, curve, &guess)) {
+    last_closest_source_ = ClosestSource::List;
+    if (guess.found) {
+      if (point_out) *point_out = guess.point_m;
+      if (segment_out) *segment_out = guess.segment;
+    }
+    return guess.found;
+  }
+  last_closest_source_ = ClosestSource::Walk;
+  // The walk: depth first, nearest child first, pruned at (best so far) + skin, so that everything the
+  // new neighbour list must hold is reached; the answer itself only takes what is within max_distance_m.
+  // It starts from the old list's nearest segment, when there is one: a real candidate, so the bound is
+  // tight from the root down.
+  list_.valid = false;
+  list_.count = 0;
+  bool found = guess.found;
+  double best = guess.found ? guess.distance_m : max_distance_m;
+  SegmentRef best_s = guess.found ? guess.segment : kNoSegment;
+  if (found) {
+    if (point_out) *point_out = guess.point_m;
+    if (segment_out) *segment_out = guess.segment;
+  }
+  double radius_limit = std::numeric_limits<double>::infinity();
+  // Prune at best + skin, for the list; once the list is full, at what it can still vouch for (but never
+  // below best, for the answer).
+  const auto bound = [&] { return std::min(best + kClosestListSkin_m, std::max(best, radius_limit)); };
   const std::uint32_t root = sc.scene_root();
   if (budget && !budget->spend()) return false;
   const double dr = box_distance(sc.box(root), p);
-  if (dr > best) return false;
   int top = 0;
-  stack_[top++] = {dr, root};
+  if (dr <= bound()) stack_[top++] = {dr, root};
+  else radius_limit = dr;  // no segment is nearer than the root's box
   while (top > 0) {
     const Candidate cur = stack_[--top];
-    if (cur.t_enter > best) continue;
+    if (cur.t_enter > bound()) continue;  // bound() only shrinks: nothing under it can matter any more
     const NodeInfo& in = sc.info(cur.node);
     if (curve >= 0 && (sc.is_segment(cur.node) || sc.is_chunk(cur.node)) && static_cast<int>(in.curve) != curve) continue;
     if (sc.is_segment(cur.node) && in.level <= sc.clamp_level(in.curve, level)) {
@@ -419,8 +510,10 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
       sc.segment(ref, &a, &b);
       const Vec2 q = closest_point_on_segment(p, a, b);
       const double d = distance(p, q);
-      if (d <= best) {
+      if (d < bound()) list_add(ListEntry{a, b, d, ref}, &radius_limit);
+      if (closer(d, ref, best, best_s)) {
         best = d;
+        best_s = ref;
         found = true;
         if (point_out) *point_out = q;
         if (segment_out) *segment_out = ref;
@@ -433,14 +526,25 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
     for (std::uint32_t i = 0; i < count; ++i) {
       if (budget && !budget->spend()) return false;  // unknown: the caller sees budget->ran_out
       const double d = box_distance(sc.box(first + i), p);
-      if (d <= best && !push(top, {d, first + i})) {  // the stack is full: the answer is unknown, as past the budget
+      if (d > bound()) continue;
+      if (!push(top, {d, first + i})) {  // the stack is full: the answer is unknown, as past the budget
         if (budget) budget->ran_out = true;
         return false;
       }
+      // Nearest child on top of the stack (insertion, at most a node's fan-out long): the first leaf
+      // reached is close, so the bound prunes early.
+      for (int k = top - 1; k > base && stack_[k].t_enter > stack_[k - 1].t_enter; --k) std::swap(stack_[k], stack_[k - 1]);
     }
-    // Nearest child on top of the stack: the first leaf reached is close, so the bound prunes early.
-    std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
   }
+  // Everything within the final bound was reached (boxes farther than the bound at the time were pruned,
+  // and the bound only shrank); the list vouches for that radius, sorted for the scans that use it.
+  std::sort(list_entries_.begin(), list_entries_.begin() + static_cast<std::ptrdiff_t>(list_.count),
+            [](const ListEntry& x, const ListEntry& y) { return x.distance_m < y.distance_m; });
+  list_.valid = true;
+  list_.level = level;
+  list_.curve = curve;
+  list_.centre_m = p;
+  list_.radius_m = std::min(best + kClosestListSkin_m, radius_limit);
   return found;
 }
 

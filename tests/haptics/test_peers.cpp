@@ -151,3 +151,160 @@ TEST_P(PeersAtSize, HundredThousandQueriesAgree) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, PeersAtSize, ::testing::Values(std::size_t{1000}, std::size_t{10000}, std::size_t{100000}));
+
+// ── The closest-point neighbour list (issue 18: closest points from coherence) ──────────────────────
+
+namespace {
+
+// A closest-point answer, compared whole: found, point and segment.
+struct Closest {
+  bool found = false;
+  Vec2 point;
+  SegmentRef segment;
+};
+Closest closest(BoundarySection& section, Vec2 p, int level, double max_distance_m, int curve = -1, QueryBudget* budget = nullptr) {
+  Closest c;
+  c.found = section.closest_point(p, level, max_distance_m, &c.point, &c.segment, curve, budget);
+  return c;
+}
+void expect_same(const Closest& a, const Closest& b, int query) {
+  ASSERT_EQ(a.found, b.found) << "query " << query;
+  if (!a.found) return;
+  ASSERT_EQ(a.point.x, b.point.x) << "query " << query;
+  ASSERT_EQ(a.point.y, b.point.y) << "query " << query;
+  ASSERT_TRUE(a.segment == b.segment) << "query " << query << ": segment " << a.segment.segment << " against " << b.segment.segment;
+}
+
+}  // namespace
+
+// Every tick of a hand's walk, with the neighbour list, against a section reset before every call (so it
+// always walks the tree) and against brute force: the same point and segment, bit for bit. Calls with a
+// 2 mm search radius are mixed in on the same list (it must also prove "nothing within 2 mm").
+TEST(ClosestPointList, EveryTickAgreesWithAFreshWalkAndBruteForce) {
+  std::mt19937 rng(52);
+  Vec2 half;
+  const Scene sc = Scene::build(scene_curves(rng, 10000, &half), 6);
+  for (int level : {0, 2}) {
+    const bench::BruteForce brute(bench::flat_segments(sc, level));
+    BoundarySection listed(sc), fresh(sc);
+    Walk walk{std::mt19937(53 + level), 0.0003, half};
+    int from_list = 0, found_near = 0, nothing_near = 0;
+    for (int i = 0; i < 20000; ++i) {
+      const Vec2 q = walk.next();
+      const double max_d = i % 3 == 2 ? 0.002 : 1.0;
+      const Closest a = closest(listed, q, level, max_d);
+      from_list += listed.last_closest_source() == BoundarySection::ClosestSource::List;
+      fresh.reset();
+      const Closest b = closest(fresh, q, level, max_d);
+      ASSERT_EQ(fresh.last_closest_source(), BoundarySection::ClosestSource::Walk);
+      expect_same(a, b, i);
+      if (max_d < 1.0) (a.found ? found_near : nothing_near) += 1;
+      if (i % 10 == 0 && max_d == 1.0) {
+        ASSERT_TRUE(a.found);
+        ASSERT_NEAR(distance(q, a.point), brute.closest_distance(q), 1e-15) << "query " << i;
+      }
+      walk.p = q;
+    }
+    EXPECT_GT(from_list, 10000) << "level " << level << ": the list answers most ticks of a slow hand";
+    EXPECT_GT(found_near, 500);
+    EXPECT_GT(nothing_near, 500);
+  }
+}
+
+// A list is for one level and one curve: a call for another level or curve walks, and answers right.
+TEST(ClosestPointList, AnotherLevelOrCurveWalks) {
+  std::mt19937 rng(54);
+  Vec2 half;
+  const Scene sc = Scene::build(scene_curves(rng, 2000, &half), 6);
+  BoundarySection listed(sc), fresh(sc);
+  const Vec2 p{0.001, -0.002};
+  const Closest first = closest(listed, p, 0, 1.0);
+  ASSERT_TRUE(first.found);
+  const Vec2 p2 = p + Vec2{1e-5, 0.0};
+  closest(listed, p2, 0, 1.0);
+  EXPECT_EQ(listed.last_closest_source(), BoundarySection::ClosestSource::List);
+  const Closest other_level = closest(listed, p2, 3, 1.0);
+  EXPECT_EQ(listed.last_closest_source(), BoundarySection::ClosestSource::Walk);
+  expect_same(other_level, closest(fresh, p2, 3, 1.0), 0);
+  const int other_curve = first.segment.curve == 0 ? 1 : 0;
+  fresh.reset();
+  const Closest on_curve = closest(listed, p2, 3, 1.0, other_curve);
+  EXPECT_EQ(listed.last_closest_source(), BoundarySection::ClosestSource::Walk);
+  ASSERT_TRUE(on_curve.found);
+  EXPECT_EQ(on_curve.segment.curve, other_curve);
+  expect_same(on_curve, closest(fresh, p2, 3, 1.0, other_curve), 0);
+}
+
+// A point on a vertex is as near to the two segments that share it: the answer is the smaller segment
+// index, from a walk and from the list alike (segment n−1 and 0 share vertex 0 of a closed curve).
+TEST(ClosestPointList, TiesGoToTheSmallerSegment) {
+  const Scene sc = Scene::build({test::sampled_square(0.01, 0.001)}, 3);
+  const Vec2* pts = sc.points(0, 0);
+  const std::uint32_t n = sc.curve(0).point_count[0];
+  ASSERT_GT(n, 8u);
+  for (std::uint32_t k : {0u, 5u, n - 1}) {
+    BoundarySection section(sc);
+    const Closest walked = closest(section, pts[k], 0, 1.0);
+    ASSERT_EQ(section.last_closest_source(), BoundarySection::ClosestSource::Walk);
+    ASSERT_TRUE(walked.found);
+    EXPECT_EQ(walked.segment.segment, static_cast<std::int32_t>(k == 0 ? 0 : k - 1)) << "vertex " << k;
+    EXPECT_EQ(walked.point.x, pts[k].x);
+    EXPECT_EQ(walked.point.y, pts[k].y);
+    closest(section, pts[k] + Vec2{2e-5, 1e-5}, 0, 1.0);
+    const Closest listed = closest(section, pts[k], 0, 1.0);
+    ASSERT_EQ(section.last_closest_source(), BoundarySection::ClosestSource::List);
+    expect_same(listed, walked, static_cast<int>(k));
+  }
+}
+
+// More segments within the skin than the list holds (60 parallel strokes 0.03 mm apart): it keeps the
+// nearest and vouches only for what is nearer than what it dropped; every answer stays exact.
+TEST(ClosestPointList, ACrowdedListStaysExact) {
+  std::vector<Polyline> curves;
+  for (int i = 0; i < 60; ++i) {
+    Polyline p;
+    for (int j = 0; j <= 40; ++j) p.points_m.push_back({-0.01 + 0.0005 * j, -0.0009 + 0.00003 * i});
+    curves.push_back(p);
+  }
+  const Scene sc = Scene::build(curves, 3);
+  BoundarySection listed(sc), fresh(sc);
+  std::mt19937 rng(55);
+  std::uniform_real_distribution<double> step(-2e-4, 2e-4);
+  Vec2 p{0.0, 0.003};
+  int from_list = 0;
+  for (int i = 0; i < 4000; ++i) {
+    p = {std::clamp(p.x + step(rng), -0.012, 0.012), std::clamp(p.y + step(rng), -0.004, 0.004)};
+    const Closest a = closest(listed, p, 0, 1.0);
+    from_list += listed.last_closest_source() == BoundarySection::ClosestSource::List;
+    fresh.reset();
+    expect_same(a, closest(fresh, p, 0, 1.0), i);
+  }
+  EXPECT_GT(from_list, 0);
+}
+
+// An answer from the list draws nothing from the tick's budget; a walk that runs out of it drops the list.
+TEST(ClosestPointList, AnswersFromTheListCostNoBoxTests) {
+  std::mt19937 rng(56);
+  Vec2 half;
+  const Scene sc = Scene::build(scene_curves(rng, 2000, &half), 6);
+  BoundarySection section(sc);
+  const Vec2 p{0.002, 0.001};
+  QueryBudget walk_budget;
+  const Closest walked = closest(section, p, 0, 1.0, -1, &walk_budget);
+  ASSERT_TRUE(walked.found);
+  EXPECT_GT(walk_budget.box_tests_used, 5);
+  QueryBudget one;
+  one.max_box_tests = 1;
+  const Closest listed = closest(section, p + Vec2{1e-5, 0.0}, 0, 1.0, -1, &one);
+  EXPECT_EQ(section.last_closest_source(), BoundarySection::ClosestSource::List);
+  EXPECT_EQ(one.box_tests_used, 0);
+  EXPECT_FALSE(one.ran_out);
+  ASSERT_TRUE(listed.found);
+  BoundarySection fresh(sc);
+  expect_same(listed, closest(fresh, p + Vec2{1e-5, 0.0}, 0, 1.0), 0);
+  const Vec2 far = p + Vec2{0.02, 0.0};  // beyond the list: a walk, which the budget cuts short
+  EXPECT_FALSE(closest(section, far, 0, 1.0, -1, &one).found);
+  EXPECT_TRUE(one.ran_out);
+  closest(section, p, 0, 1.0);
+  EXPECT_EQ(section.last_closest_source(), BoundarySection::ClosestSource::Walk) << "the cut-short walk dropped the list";
+}

@@ -330,18 +330,23 @@ TEST(ServoStep, LevelCheckDrawsOnTheTickBudget) {
   const Scene sc = Scene::build({test::square(0.02)}, 3);
   ContactParams cp;
   ContactSolver solver(sc, cp);
-  solver.reset({-0.0185, 0.003}, 2);
+  // Each check from the same state: reset forgets the closest-point neighbour list a check leaves behind
+  // (with it, a second check would walk less).
+  const auto fresh = [&] { solver.reset({-0.0185, 0.003}, 2); };
+  fresh();
   QueryBudget unlimited;
   ASSERT_TRUE(solver.level_change_is_safe(0, &unlimited));
   EXPECT_GT(unlimited.box_tests_used, 2) << "the check walks the tree";
   EXPECT_FALSE(unlimited.ran_out);
   for (std::int32_t limit = 1; limit < unlimited.box_tests_used; ++limit) {
+    fresh();
     QueryBudget b;
     b.max_box_tests = limit;
     EXPECT_FALSE(solver.level_change_is_safe(0, &b)) << "limit " << limit;
     EXPECT_LE(b.box_tests_used, limit);
     EXPECT_TRUE(b.ran_out);
   }
+  fresh();
   QueryBudget enough;
   enough.max_box_tests = unlimited.box_tests_used;
   EXPECT_TRUE(solver.level_change_is_safe(0, &enough));

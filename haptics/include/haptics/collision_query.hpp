@@ -98,7 +98,7 @@ class BoundarySection {
   /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots.
   explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4);
 
-  /// Forgets the frontier: back to one root per curve. Real-time safe.
+  /// Forgets the frontier (back to one root per curve) and the closest-point neighbour list. Real-time safe.
   void reset();
 
   /// First hit of the sweep a→b against the polylines at `level` (clamped per curve to its coarsest),
@@ -113,13 +113,30 @@ class BoundarySection {
     return first_hit(a, b, level, excluded, excluded_count, copy, stats);
   }
 
-  /// Closest point on the polylines at `level` to p within max_distance_m, by a box-distance-pruned
-  /// walk from the roots (does not use or change the frontier). Returns false when nothing is that close.
-  /// `curve` ≥ 0 restricts the search to that curve. With a `budget`, each box-distance test is an
-  /// optional box test charged to it; when it runs out the walk stops and returns false with
-  /// budget->ran_out set (the answer is then unknown, not "nothing close"). Allocates nothing.
+  /// Closest point on the polylines at `level` (clamped per curve) to p within max_distance_m. Returns
+  /// false when nothing is that close. `curve` ≥ 0 restricts the search to that curve. Among segments at
+  /// the same distance (a vertex two segments share) the smallest (curve, level, segment) is the answer,
+  /// so it does not depend on the order anything was visited in.
+  ///
+  /// Coherent between calls, like the first hit's free-space ball: a box-distance-pruned walk from the
+  /// root (which neither uses nor changes the frontier) also collects a neighbour list, every segment
+  /// within R = (closest distance) + kClosestListSkin_m of p0 (at most kClosestListCapacity of them; past
+  /// that the nearest are kept and R shrinks to the nearest one dropped). A later call with the same
+  /// level and curve at p, δ = |p − p0| from it, scans only the list: any segment within d of p is within
+  /// d + δ of p0, so when the list's best d (or max_distance_m when it has none within that) satisfies
+  /// d + δ < R, the list holds every candidate and its answer is exact; otherwise the walk runs again
+  /// (the Verlet neighbour list of molecular dynamics, Verlet 1967, with the proxy's coherence of seed §3).
+  ///
+  /// With a `budget`, each box-distance test of a walk is an optional box test charged to it (a call
+  /// answered from the list charges none); when it runs out the walk stops and returns false with
+  /// budget->ran_out set (the answer is then unknown, not "nothing close"), and the list is dropped.
+  /// Allocates nothing.
   bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
                      QueryBudget* budget = nullptr);
+
+  /// What the last closest_point call did (for tests and the benchmark's counters).
+  enum class ClosestSource : std::uint8_t { Walk, List };
+  ClosestSource last_closest_source() const { return last_closest_source_; }
 
   /// Node ids of the current boundary section (for the operator overlay and tests).
   const std::vector<std::uint32_t>& section() const { return section_; }
@@ -158,6 +175,35 @@ class BoundarySection {
   std::vector<Candidate> stack_;           // DFS stack, tree_stack_entries(widest fan-out) entries, sized at build
   std::vector<std::uint32_t> hit_stamp_;   // per node: tick at which its margin-grown box was last hit
   std::vector<std::uint32_t> merge_stamp_; // per node: tick at which it was last considered for a merge
+  // The closest-point neighbour list (see closest_point): segments within radius_m of centre_m at one
+  // (level, curve), with their end points so that a scan streams through them, sorted by their distance
+  // from centre_m so that a scan stops at the first that cannot be nearer. Capacity kClosestListCapacity.
+  struct ClosestList {
+    bool valid = false;
+    int level = 0, curve = -1;
+    Vec2 centre_m;
+    double radius_m = 0.0;  // [m]
+    std::size_t count = 0;
+  };
+  struct ListEntry {  // 56 bytes
+    Vec2 a_m, b_m;          // end points [m]
+    double distance_m;      // from the list's centre [m]
+    SegmentRef segment;
+  };
+  static_assert(sizeof(ListEntry) == 56, "ListEntry: 56 bytes");
+  // The nearest segment a list knows of at a point, even where it cannot vouch that nothing is nearer:
+  // the first bound of the walk that replaces it.
+  struct ClosestGuess {
+    bool found = false;
+    double distance_m = 0.0;
+    Vec2 point_m;
+    SegmentRef segment;
+  };
+  ClosestList list_;
+  std::vector<ListEntry> list_entries_;
+  ClosestSource last_closest_source_ = ClosestSource::Walk;
+  bool closest_from_list(Vec2 p, int level, double max_distance_m, int curve, ClosestGuess* guess) const noexcept;
+  void list_add(const ListEntry& e, double* radius_limit_m) noexcept;
   std::uint32_t tick_ = 0;
   int last_level_ = -1;
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
