@@ -104,8 +104,12 @@ bool KioskRuntime::try_open_usb() {
     device_note_.clear();
     return true;
   } catch (const std::exception& e) {
+    // Said once per reason: a kiosk without its handle probes every 10 s for months, and the journal
+    // should not fill with the same line (the boot of the package showed 360 an hour).
+    const bool news = device_note_ != e.what();
     device_note_ = e.what();
-    spdlog::warn("device: no USB pantograph ({}); the simulated pantograph stands in", e.what());
+    spdlog::log(news ? spdlog::level::warn : spdlog::level::debug, "device: no USB pantograph ({}); the simulated pantograph stands in",
+                e.what());
     return false;
   }
 }

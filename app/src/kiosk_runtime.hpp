@@ -106,6 +106,7 @@ class KioskRuntime final : public KioskEffects {
   /// 0.5 s and, after that, when it works again (the servo thread's display state carries the device
   /// status; shorter losses are not spoken), and, while the simulated pantograph stands in for a USB
   /// pantograph that was not found, switches to one that arrives (USB hot-plug, or a probe every 10 s).
+  /// A probe that fails logs a warning only when its reason differs from the last one's (else at debug).
   void poll_device(double now_s);
   /// The device the servo thread drives.
   Device& device() { return usb_ ? static_cast<Device&>(*usb_) : static_cast<Device&>(sim_); }

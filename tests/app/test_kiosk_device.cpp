@@ -11,6 +11,9 @@
 #include <string>
 #include <thread>
 
+#include <spdlog/sinks/ringbuffer_sink.h>
+#include <spdlog/spdlog.h>
+
 #include "audio/messages.hpp"
 #include "device_setup.hpp"
 #include "haptics/hapi_emulator.hpp"
@@ -107,6 +110,31 @@ TEST(KioskDevice, WithNoBoardTheSimulatedPantographStandsInAndSaysSo) {
   EXPECT_FALSE(rt.calibrate_usb(&o1, &o2, &why));
   EXPECT_NE(why.find("no USB pantograph"), std::string::npos) << why;
   rt.stop_servo();
+}
+
+// Probed every 10 s for months without a board: the warning is logged once per reason, not each time.
+TEST(KioskDevice, AMissingBoardIsLoggedOncePerReason) {
+  auto ring = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(256);
+  ring->set_level(spdlog::level::warn);
+  spdlog::default_logger()->sinks().push_back(ring);
+  const auto count_warnings = [&] {
+    int n = 0;
+    for (const std::string& line : ring->last_formatted()) n += line.find("no USB pantograph") != std::string::npos;
+    return n;
+  };
+  {
+    config::Settings s;
+    s.device.type = "auto";
+    s.device.transport = "tty";
+    s.device.serial_path = "/dev/hk-no-such-board";
+    const Library lib;
+    KioskRuntime rt(options(lib), s);
+    EXPECT_EQ(count_warnings(), 1) << "the first probe says why";
+    for (double t = 0.0; t < 120.0; t += 1.0) rt.poll_device(t);  // 12 more probes, the same reason
+    EXPECT_EQ(rt.usb_device(), nullptr);
+    EXPECT_EQ(count_warnings(), 1);
+  }
+  spdlog::default_logger()->sinks().pop_back();
 }
 
 TEST(KioskDevice, ChosenSimulatedIsNotAnnounced) {
