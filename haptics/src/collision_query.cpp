@@ -18,9 +18,6 @@ inline double box_distance_sq(const ErrorBox& box, Vec2 p) {
   return du * du + dn * dn;
 }
 
-// Distance from p to a box (0 inside) [m].
-inline double box_distance(const ErrorBox& box, Vec2 p) { return std::sqrt(box_distance_sq(box, p)); }
-
 }  // namespace
 
 bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit) {
@@ -491,17 +488,27 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   }
   double radius_limit = std::numeric_limits<double>::infinity();
   // Prune at best + skin, for the list; once the list is full, at what it can still vouch for (but never
-  // below best, for the answer).
-  const auto bound = [&] { return std::min(best + kClosestListSkin_m, std::max(best, radius_limit)); };
+  // below best, for the answer). The walk compares squared distances (no root per box); the squared bound
+  // is grown by a few ulps so that rounding never prunes a box the bound itself would keep.
+  double bound = 0.0, bound_sq = 0.0;
+  const auto update_bound = [&] {
+    bound = std::min(best + kClosestListSkin_m, std::max(best, radius_limit));
+    bound_sq = bound * bound * (1.0 + 1e-12);
+  };
+  update_bound();
   const std::uint32_t root = sc.scene_root();
   if (budget && !budget->spend()) return false;
-  const double dr = box_distance(sc.box(root), p);
+  const double dr_sq = box_distance_sq(sc.box(root), p);
   int top = 0;
-  if (dr <= bound()) stack_[top++] = {dr, root};
-  else radius_limit = dr;  // no segment is nearer than the root's box
+  if (dr_sq <= bound_sq) {
+    stack_[top++] = {dr_sq, root};
+  } else {
+    radius_limit = std::sqrt(dr_sq);  // no segment is nearer than the root's box
+    update_bound();
+  }
   while (top > 0) {
-    const Candidate cur = stack_[--top];
-    if (cur.t_enter > bound()) continue;  // bound() only shrinks: nothing under it can matter any more
+    const Candidate cur = stack_[--top];  // t_enter holds the box's squared distance here
+    if (cur.t_enter > bound_sq) continue;  // the bound only shrinks: nothing under it can matter any more
     const NodeInfo& in = sc.info(cur.node);
     if (curve >= 0 && (sc.is_segment(cur.node) || sc.is_chunk(cur.node)) && static_cast<int>(in.curve) != curve) continue;
     if (sc.is_segment(cur.node) && in.level <= sc.clamp_level(in.curve, level)) {
@@ -509,8 +516,10 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
       Vec2 a, b;
       sc.segment(ref, &a, &b);
       const Vec2 q = closest_point_on_segment(p, a, b);
-      const double d = distance(p, q);
-      if (d < bound()) list_add(ListEntry{a, b, d, ref}, &radius_limit);
+      const double d_sq = length_sq(p - q);
+      if (d_sq > bound_sq) continue;
+      const double d = std::sqrt(d_sq);  // bit for bit distance(p, q), as the list's scan computes it
+      if (d < bound) list_add(ListEntry{a, b, d, ref}, &radius_limit);
       if (closer(d, ref, best, best_s)) {
         best = d;
         best_s = ref;
@@ -518,6 +527,7 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
         if (point_out) *point_out = q;
         if (segment_out) *segment_out = ref;
       }
+      update_bound();
       continue;
     }
     std::uint32_t first = 0, count = 0;
@@ -525,9 +535,9 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
     const int base = top;
     for (std::uint32_t i = 0; i < count; ++i) {
       if (budget && !budget->spend()) return false;  // unknown: the caller sees budget->ran_out
-      const double d = box_distance(sc.box(first + i), p);
-      if (d > bound()) continue;
-      if (!push(top, {d, first + i})) {  // the stack is full: the answer is unknown, as past the budget
+      const double d_sq = box_distance_sq(sc.box(first + i), p);
+      if (d_sq > bound_sq) continue;
+      if (!push(top, {d_sq, first + i})) {  // the stack is full: the answer is unknown, as past the budget
         if (budget) budget->ran_out = true;
         return false;
       }
