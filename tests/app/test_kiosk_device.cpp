@@ -46,6 +46,15 @@ RuntimeOptions options(const Library& lib) {
   return ro;
 }
 
+// A USB pantograph looked for on a tty that does not exist.
+config::Settings no_board_settings() {
+  config::Settings s;
+  s.device.type = "auto";
+  s.device.transport = "tty";
+  s.device.serial_path = "/dev/hk-no-such-board";
+  return s;
+}
+
 const std::string& said(audio::MessageId id) {
   static std::string texts[audio::kMessageCount];
   std::string& t = texts[static_cast<int>(id)];
@@ -94,12 +103,8 @@ TEST(KioskDevice, ABoardOnItsTtyIsUsedAnnouncedAndItsLossSpoken) {
 }
 
 TEST(KioskDevice, WithNoBoardTheSimulatedPantographStandsInAndSaysSo) {
-  config::Settings s;
-  s.device.type = "auto";
-  s.device.transport = "tty";
-  s.device.serial_path = "/dev/hk-no-such-board";
   const Library lib;
-  KioskRuntime rt(options(lib), s);
+  KioskRuntime rt(options(lib), no_board_settings());
   EXPECT_EQ(rt.usb_device(), nullptr);
   EXPECT_NE(rt.device_note().find("/dev/hk-no-such-board"), std::string::npos) << rt.device_note();
   rt.start_servo();
@@ -123,12 +128,8 @@ TEST(KioskDevice, AMissingBoardIsLoggedOncePerReason) {
     return n;
   };
   {
-    config::Settings s;
-    s.device.type = "auto";
-    s.device.transport = "tty";
-    s.device.serial_path = "/dev/hk-no-such-board";
     const Library lib;
-    KioskRuntime rt(options(lib), s);
+    KioskRuntime rt(options(lib), no_board_settings());
     EXPECT_EQ(count_warnings(), 1) << "the first probe says why";
     for (double t = 0.0; t < 120.0; t += 1.0) rt.poll_device(t);  // 12 more probes, the same reason
     EXPECT_EQ(rt.usb_device(), nullptr);
