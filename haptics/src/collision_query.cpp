@@ -138,6 +138,11 @@ struct BoundarySection::Query {
     ++st.box_tests;
     return true;
   }
+  // A segment node at the target level (clamped to its curve's coarsest, which is as far as a walk
+  // can be above it: tag_level ≤ the curve's coarsest, so the clamp is the level itself, or 0).
+  bool at_target(const Scene& sc, std::uint32_t node) const noexcept {
+    return sc.is_segment(node) && sc.tag_level(node) <= std::max(level, 0);
+  }
   bool is_excluded(SegmentRef s) const noexcept {
     for (int i = 0; i < excluded_count; ++i) {
       if (excluded[i] == s) return true;
@@ -183,11 +188,18 @@ void BoundarySection::clip_section(Query& q) {
     const Aabb& r = section_box_[i];
     const double dx = std::max({r.lo.x - q.b.x, 0.0, q.b.x - r.hi.x});
     const double dy = std::max({r.lo.y - q.b.y, 0.0, q.b.y - r.hi.y});
+    const bool near = dx * dx + dy * dy < q.nearest_sq;
+    const bool overlapping = overlaps(r, q.sweep, merge_margin_m_);
+    if (!near && !overlapping) {  // the rectangle settles both: the box itself is not needed
+      merge_scratch_.push_back(node);
+      continue;
+    }
+    const ErrorBox box = sc.box(node);
     // The rectangle's distance bounds the box's from below: the exact one only when it could be nearer.
-    if (dx * dx + dy * dy < q.nearest_sq) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(sc.box(node), q.b));
-    if (overlaps(r, q.sweep, merge_margin_m_) && clip_segment_box(sc.box(node), q.a, q.b, merge_margin_m_, &te, &tx)) {
+    if (near) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
+    if (overlapping && clip_segment_box(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
       hit_stamp_[node] = tick_;
-      if (clip_segment_box(sc.box(node), q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node});
+      if (clip_segment_box(box, q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node});
     } else {
       merge_scratch_.push_back(node);
     }
@@ -196,13 +208,13 @@ void BoundarySection::clip_section(Query& q) {
 
 // Intersects the sweep with one segment of the target level; keeps the nearest hit.
 void BoundarySection::test_segment(Query& q, std::uint32_t node) {
-  const NodeInfo& in = scene_->info(node);
+  const NodeInfo in = scene_->info(node);
   const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
   if (q.is_excluded(ref)) return;
   ++q.st.segment_tests;
   q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
   Vec2 p0, p1;
-  scene_->segment(ref, &p0, &p1);
+  scene_->segment_points(node, &p0, &p1);
   double t = 0.0;
   if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && t < q.best.t) {
     q.best.hit = true;
@@ -224,8 +236,7 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
       top = base;
       return false;
     }
-    if (overlaps(sc.aabb(first + i), q.sweep, 0.0) && clip_segment_box(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t &&
-        !push(top, {te, first + i})) {
+    if (clip_segment_box(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t && !push(top, {te, first + i})) {
       top = base;  // the stack is full: as past the budget
       return false;
     }
@@ -247,8 +258,7 @@ void BoundarySection::refine_candidates(Query& q) {
     while (top > 0) {
       const Candidate cur = stack_[--top];
       if (cur.t_enter > q.horizon()) continue;
-      const NodeInfo& in = sc.info(cur.node);
-      if (sc.is_segment(cur.node) && in.level <= sc.clamp_level(in.curve, q.level)) {
+      if (q.at_target(sc, cur.node)) {
         test_segment(q, cur.node);
       } else if (!push_hit_children(q, cur.node, top) && cur.t_enter < q.unresolved_t) {
         q.unresolved_t = cur.t_enter;
@@ -262,8 +272,7 @@ void BoundarySection::refine_candidates(Query& q) {
 void BoundarySection::split_hit_boxes(Query& q) {
   const Scene& sc = *scene_;
   for (const Candidate& cand : candidates_) {
-    const NodeInfo& in = sc.info(cand.node);
-    if (!sc.is_segment(cand.node) || in.level > sc.clamp_level(in.curve, q.level)) {
+    if (!q.at_target(sc, cand.node)) {
       split(cand.node);
       ++q.st.splits;
     }
@@ -292,7 +301,7 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     if (!all_idle) continue;
     double te = 0.0, tx = 0.0;
     if (!q.spend_box()) break;  // merging can wait for a tick with budget left
-    if (overlaps(sc.aabb(parent), q.sweep, merge_margin_m_) && clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
+    if (clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
     for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
     in_section_[parent] = 1;
     section_.push_back(parent);
@@ -338,10 +347,10 @@ SweepHit BoundarySection::finish(Query& q) const {
     best.hit = false;
     best.blocked = true;
     best.t = q.unresolved_t;
-    const NodeInfo& in = sc.info(q.unresolved_node);
+    const NodeInfo in = sc.info(q.unresolved_node);
     if (sc.is_chunk(q.unresolved_node)) {
-      const CurveInfo& ci = sc.curve(in.curve);
-      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), ci.levels - 1, static_cast<std::int32_t>(in.index)};
+      const int top = static_cast<int>(sc.curve_nodes(in.curve).levels) - 1;
+      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), top, static_cast<std::int32_t>(in.index)};
     } else if (!sc.is_segment(q.unresolved_node)) {  // above the curves: no segment to name yet
       best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
     } else {
@@ -497,6 +506,7 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   };
   update_bound();
   const std::uint32_t root = sc.scene_root();
+  const int leaf_level = std::max(level, 0);
   if (budget && !budget->spend()) return false;
   const double dr_sq = box_distance_sq(sc.box(root), p);
   int top = 0;
@@ -509,12 +519,13 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   while (top > 0) {
     const Candidate cur = stack_[--top];  // t_enter holds the box's squared distance here
     if (cur.t_enter > bound_sq) continue;  // the bound only shrinks: nothing under it can matter any more
-    const NodeInfo& in = sc.info(cur.node);
-    if (curve >= 0 && (sc.is_segment(cur.node) || sc.is_chunk(cur.node)) && static_cast<int>(in.curve) != curve) continue;
-    if (sc.is_segment(cur.node) && in.level <= sc.clamp_level(in.curve, level)) {
+    const bool is_segment = sc.is_segment(cur.node);
+    if (curve >= 0 && (is_segment || sc.is_chunk(cur.node)) && static_cast<int>(sc.info(cur.node).curve) != curve) continue;
+    if (is_segment && sc.tag_level(cur.node) <= leaf_level) {  // at the level asked, clamped (see Query::at_target)
+      const NodeInfo in = sc.info(cur.node);
       const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
       Vec2 a, b;
-      sc.segment(ref, &a, &b);
+      sc.segment_points(cur.node, &a, &b);
       const Vec2 q = closest_point_on_segment(p, a, b);
       const double d_sq = length_sq(p - q);
       if (d_sq > bound_sq) continue;

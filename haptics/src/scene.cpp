@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <new>
 
 namespace hk {
 namespace {
@@ -33,8 +34,19 @@ inline void grow(Extent& e, Vec2 origin, Vec2 axis, Vec2 q) {
   e.n_max = std::max(e.n_max, n);
 }
 
-inline ErrorBox make_box(Vec2 origin, Vec2 axis, const Extent& e) {
-  return ErrorBox{origin, axis, e.u_min - kBoxPad_m, e.u_max + kBoxPad_m, e.n_min - kBoxPad_m, e.n_max + kBoxPad_m};
+// The float nearest v from below / above: stored extents only ever grow the box.
+inline float float_below(double v) {
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) > v ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+inline float float_above(double v) {
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) < v ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+inline BoxExtent make_extent(const Extent& e) {
+  return BoxExtent{float_below(e.u_min - kBoxPad_m), float_above(e.u_max + kBoxPad_m), float_below(e.n_min - kBoxPad_m),
+                   float_above(e.n_max + kBoxPad_m)};
 }
 
 // One node of the scene hierarchy while it is built: the chunk range it covers in leaf order and,
@@ -101,17 +113,30 @@ double box_error_bound(const ErrorBox& box, double segment_length_m) {
 }
 
 std::size_t Scene::hot_bytes() const {
-  return boxes_.size() * sizeof(ErrorBox) + aabbs_.size() * sizeof(Aabb) + info_.size() * sizeof(NodeInfo) +
-         (parent_.size() + child_first_.size() + child_count_.size()) * sizeof(std::uint32_t) + points_m_.size() * sizeof(Vec2);
+  return points_m_.size() * sizeof(Vec2) + extent_.size() * sizeof(BoxExtent) + tag_.size() * sizeof(std::uint32_t) +
+         curve_nodes_.size() * sizeof(CurveNodes) + group_box_.size() * sizeof(Aabb) + group_info_.size() * sizeof(NodeInfo) +
+         (group_parent_.size() + group_child_first_.size() + group_child_count_.size() + chunk_of_curve_.size()) * sizeof(std::uint32_t);
 }
 
-void Scene::segment(SegmentRef s, Vec2* a, Vec2* b) const {
-  const CurveInfo& c = curves_[static_cast<std::size_t>(s.curve)];
-  const Vec2* p = points_m_.data() + c.point_offset[s.level];
-  const std::uint32_t n = c.point_count[s.level];
-  const std::uint32_t k = static_cast<std::uint32_t>(s.segment);
-  *a = p[k];
-  *b = p[k + 1 == n ? 0 : k + 1];
+Aabb Scene::aabb(std::uint32_t node) const {
+  if (node >= segment_nodes_) return group_box_[node - segment_nodes_];
+  Vec2 corners[4];
+  box_corners(segment_box(node), corners);
+  Aabb r{corners[0], corners[0]};
+  for (const Vec2& q : corners) {
+    r.lo = {std::min(r.lo.x, q.x), std::min(r.lo.y, q.y)};
+    r.hi = {std::max(r.hi.x, q.x), std::max(r.hi.y, q.y)};
+  }
+  return r;
+}
+
+std::uint32_t Scene::parent(std::uint32_t node) const {
+  if (node >= segment_nodes_) return group_parent_[node - segment_nodes_];
+  const CurveNodes& cn = curve_nodes_[tag_curve(node)];
+  const int l = tag_level(node);
+  const std::uint32_t k = node - cn.box_offset[l];
+  if (static_cast<std::uint32_t>(l) + 1 < cn.levels) return cn.box_offset[l + 1] + k / 2;
+  return chunk_of_curve_[cn.chunk_offset + k / kSegmentsPerChunk];  // a coarsest segment: its chunk
 }
 
 std::size_t Scene::total_segments(int level) const {
@@ -159,37 +184,53 @@ class SceneBuild {
     }
   }
 
-  // Offsets of every level's points and segment nodes, level by level within each curve.
+  // Slots of every level, level by level within each curve (scene.hpp "Node numbering"): the points,
+  // a closed curve's first point again, each slot tagged with its curve and level.
   static void lay_out_curves(Scene& scene) {
-    std::size_t npoints = 0, nnodes = 0;
+    std::size_t nslots = 0;
     scene.curves_.resize(scene.models_.size());
+    scene.curve_nodes_.resize(scene.models_.size());
     for (std::size_t c = 0; c < scene.models_.size(); ++c) {
       const CurveMultires& m = scene.models_[c];
       CurveInfo& ci = scene.curves_[c];
       ci.closed = m.closed;
       ci.levels = m.levels;
+      scene.curve_nodes_[c].levels = static_cast<std::uint32_t>(m.levels);
       for (int l = 0; l < m.levels; ++l) {
-        ci.point_offset[l] = static_cast<std::uint32_t>(npoints);
+        ci.point_offset[l] = static_cast<std::uint32_t>(nslots);
+        ci.box_offset[l] = static_cast<std::uint32_t>(nslots);
+        scene.curve_nodes_[c].box_offset[l] = static_cast<std::uint32_t>(nslots);
         ci.point_count[l] = static_cast<std::uint32_t>(m.scaling[l].size());
-        ci.box_offset[l] = static_cast<std::uint32_t>(nnodes);
         ci.segment_count[l] = static_cast<std::uint32_t>(m.segment_count(l));
-        npoints += m.scaling[l].size();
-        nnodes += m.segment_count(l);
+        nslots += m.segment_count(l) + 1;
       }
     }
-    scene.segment_nodes_ = nnodes;
-    scene.points_m_.resize(npoints);
+    if (nslots >= std::numeric_limits<std::uint32_t>::max() / 2 || scene.models_.size() >= (std::size_t{1} << (32 - Scene::kTagLevelBits))) {
+      throw std::bad_alloc();  // ids would not fit: far beyond any memory this runs in
+    }
+    scene.segment_nodes_ = nslots;
+    scene.points_m_.resize(nslots);
+    scene.extent_.resize(nslots);
+    scene.tag_.resize(nslots);
     for (std::size_t c = 0; c < scene.models_.size(); ++c) {
       const CurveMultires& m = scene.models_[c];
-      for (int l = 0; l < m.levels; ++l) std::copy(m.scaling[l].begin(), m.scaling[l].end(), scene.points_m_.begin() + scene.curves_[c].point_offset[l]);
+      for (int l = 0; l < m.levels; ++l) {
+        const std::size_t at = scene.curves_[c].point_offset[l];
+        const auto& pts = m.scaling[static_cast<std::size_t>(l)];
+        std::copy(pts.begin(), pts.end(), scene.points_m_.begin() + static_cast<std::ptrdiff_t>(at));
+        if (m.closed) scene.points_m_[at + pts.size()] = pts.front();
+        const std::uint32_t tag = static_cast<std::uint32_t>(c) << Scene::kTagLevelBits | static_cast<std::uint32_t>(l);
+        std::fill_n(scene.tag_.begin() + static_cast<std::ptrdiff_t>(at), m.segment_count(l) + 1, tag);
+      }
     }
   }
 
   // Chunks of every curve's coarsest level, with the centres of their points (for the median split).
   // They are the leaves of the scene hierarchy, so no node has more than a handful of children (a long
   // curve would otherwise fan out to hundreds of coarsest segments, and the boundary section with it).
-  static void make_chunks(const Scene& scene, std::vector<Chunk>& chunks, std::vector<Vec2>& centre) {
+  static void make_chunks(Scene& scene, std::vector<Chunk>& chunks, std::vector<Vec2>& centre) {
     for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+      scene.curve_nodes_[c].chunk_offset = static_cast<std::uint32_t>(chunks.size());
       const int top = scene.models_[c].levels - 1;
       const auto& pts = scene.models_[c].scaling[static_cast<std::size_t>(top)];
       const std::uint32_t k_top = scene.curves_[c].segment_count[top];
@@ -207,12 +248,14 @@ class SceneBuild {
     }
   }
 
-  static void allocate_nodes(Scene& scene, std::size_t total_nodes) {
-    scene.boxes_.resize(total_nodes);
-    scene.info_.resize(total_nodes);
-    scene.parent_.assign(total_nodes, 0);
-    scene.child_first_.assign(total_nodes, 0);
-    scene.child_count_.assign(total_nodes, 0);
+  // The chunk and hierarchy nodes' arrays (the slots' were sized by lay_out_curves).
+  static void allocate_groups(Scene& scene, std::size_t groups, std::size_t chunks) {
+    scene.group_box_.resize(groups);
+    scene.group_info_.resize(groups);
+    scene.group_parent_.assign(groups, 0);
+    scene.group_child_first_.assign(groups, 0);
+    scene.group_child_count_.assign(groups, 0);
+    scene.chunk_of_curve_.assign(chunks, 0);
   }
 
   // Per level-0 segment k of curve c: the original vertices strictly inside it are
@@ -245,28 +288,22 @@ class SceneBuild {
     const CurveInfo& ci = scene.curves_[c];
     const auto& orig = src.points_m;
     for (int l = 0; l < m.levels; ++l) {
-      const auto& pts = m.scaling[static_cast<std::size_t>(l)];
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
-        const Vec2 a = pts[k], b = pts[k + 1 == pts.size() ? 0 : k + 1];
-        const Vec2 axis = normalized_or(b - a, Vec2{1.0, 0.0});
+        const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k);
+        Vec2 a, b;
+        scene.segment_points(node, &a, &b);
+        const Vec2 axis = Scene::segment_axis(a, b);  // the frame Scene::box() rebuilds
         Extent e;
         grow(e, a, axis, a);
         grow(e, a, axis, b);
         for (int j = 0; j < l; ++j) {  // finer levels' points under this segment
-          const auto& fine = m.scaling[static_cast<std::size_t>(j)];
+          const Vec2* fine = scene.points(c, j);  // a closed curve's first point repeats at its end
           const std::size_t span = std::size_t{1} << (l - j);
-          for (std::size_t i = k * span; i <= (k + 1) * span; ++i) grow(e, a, axis, fine[i == fine.size() ? 0 : i]);
+          for (std::size_t i = k * span; i <= (k + 1) * span; ++i) grow(e, a, axis, fine[i]);
         }
         const std::size_t k0 = k << l, k1 = (k + 1) << l;  // level-0 segments under it
         for (std::uint32_t v = orig_first[k0]; v < orig_first[k1]; ++v) grow(e, a, axis, orig[v]);
-        const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k);
-        scene.boxes_[node] = make_box(a, axis, e);
-        scene.info_[node] = NodeInfo{static_cast<std::uint32_t>(c), l, static_cast<std::uint32_t>(k)};
-        scene.parent_[node] = l + 1 < m.levels ? ci.box_offset[l + 1] + static_cast<std::uint32_t>(k / 2) : 0;  // coarsest: set with its chunk
-        if (l > 0) {
-          scene.child_first_[node] = ci.box_offset[l - 1] + 2 * static_cast<std::uint32_t>(k);
-          scene.child_count_[node] = 2;
-        }
+        scene.extent_[node] = make_extent(e);
       }
     }
   }
@@ -290,7 +327,7 @@ class SceneBuild {
       worst = std::sqrt(worst);  // squared above: one root per level
       double bound = 0.0;
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
-        const ErrorBox& box = scene.boxes_[ci.box_offset[l] + k];
+        const ErrorBox box = scene.segment_box(ci.box_offset[l] + static_cast<std::uint32_t>(k));
         widest = std::max(widest, box_half_width(box));
         bound = std::max(bound, box_error_bound(box, distance(pts[k], pts[k + 1 == pts.size() ? 0 : k + 1])));
       }
@@ -321,19 +358,21 @@ class SceneBuild {
     }
   }
 
-  // An axis-aligned node around the boxes of children [first, first + count); links them to it.
+  // An axis-aligned node around the boxes of children [first, first + count) (as Scene::box() rebuilds
+  // them, so the rounding of the stored extents is inside); links chunk and hierarchy children to it.
   static void make_aligned_node(Scene& scene, std::uint32_t node, std::uint32_t first, std::uint32_t count, NodeInfo info) {
     Extent e;
     for (std::uint32_t i = 0; i < count; ++i) {
       Vec2 corners[4];
-      box_corners(scene.boxes_[first + i], corners);
+      box_corners(scene.box(first + i), corners);
       for (const Vec2& q : corners) grow(e, Vec2{0, 0}, Vec2{1, 0}, q);
-      scene.parent_[first + i] = node;
+      if (!scene.is_segment(first + i)) scene.group_parent_[first + i - scene.segment_nodes_] = node;
     }
-    scene.boxes_[node] = make_box(Vec2{0, 0}, Vec2{1, 0}, e);
-    scene.info_[node] = info;
-    scene.child_first_[node] = first;
-    scene.child_count_[node] = count;
+    const std::size_t g = node - scene.segment_nodes_;
+    scene.group_box_[g] = Aabb{{e.u_min - kBoxPad_m, e.n_min - kBoxPad_m}, {e.u_max + kBoxPad_m, e.n_max + kBoxPad_m}};
+    scene.group_info_[g] = info;
+    scene.group_child_first_[g] = first;
+    scene.group_child_count_[g] = count;
   }
 
   // Chunk nodes, in the hierarchy's leaf order so that every leaf's chunks have consecutive ids.
@@ -342,7 +381,9 @@ class SceneBuild {
       const Chunk& ch = chunks[leaf_order[k]];
       const CurveInfo& ci = scene.curves_[ch.curve];
       const std::uint32_t first = ci.box_offset[ci.levels - 1] + ch.first_segment;
-      make_aligned_node(scene, static_cast<std::uint32_t>(scene.segment_nodes_ + k), first, ch.count, NodeInfo{ch.curve, ci.levels, ch.first_segment});
+      const auto node = static_cast<std::uint32_t>(scene.segment_nodes_ + k);
+      make_aligned_node(scene, node, first, ch.count, NodeInfo{ch.curve, ci.levels, ch.first_segment});
+      scene.chunk_of_curve_[leaf_order[k]] = node;  // chunks were made curve by curve, in order
     }
   }
 
@@ -356,23 +397,9 @@ class SceneBuild {
       make_aligned_node(scene, static_cast<std::uint32_t>(hierarchy_base + i), first, count, NodeInfo{chunks[leaf_order[h.begin]].curve, Scene::kHierarchyLevel, 0});
     }
     scene.scene_root_ = static_cast<std::uint32_t>(hierarchy_base);
-    scene.parent_[scene.scene_root_] = scene.scene_root_;
+    scene.group_parent_[scene.scene_root_ - scene.segment_nodes_] = scene.scene_root_;
   }
 
-  // Rectangles around every box, for the cheap reject in the queries.
-  static void build_aabbs(Scene& scene) {
-    scene.aabbs_.resize(scene.boxes_.size());
-    for (std::size_t i = 0; i < scene.boxes_.size(); ++i) {
-      Vec2 corners[4];
-      box_corners(scene.boxes_[i], corners);
-      Aabb r{corners[0], corners[0]};
-      for (const Vec2& q : corners) {
-        r.lo = {std::min(r.lo.x, q.x), std::min(r.lo.y, q.y)};
-        r.hi = {std::max(r.hi.x, q.x), std::max(r.hi.y, q.y)};
-      }
-      scene.aabbs_[i] = r;
-    }
-  }
 };
 
 Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
@@ -391,13 +418,12 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   build_hierarchy(leaf_order, chunk_centre, hierarchy);  // leaf_order becomes the hierarchy's leaf order
   scene.chunk_count_ = chunks.size();
   const std::size_t hierarchy_base = scene.segment_nodes_ + chunks.size();
-  SceneBuild::allocate_nodes(scene, hierarchy_base + (chunks.empty() ? 0 : hierarchy.size()));
+  SceneBuild::allocate_groups(scene, chunks.size() + (chunks.empty() ? 0 : hierarchy.size()), chunks.size());
   SceneBuild::build_curves(scene, input);
   if (!chunks.empty()) {
     SceneBuild::build_chunk_nodes(scene, chunks, leaf_order);
     SceneBuild::build_hierarchy_nodes(scene, hierarchy, chunks, leaf_order, hierarchy_base);
   }
-  SceneBuild::build_aabbs(scene);
   const double t2 = now_ms();
   scene.times_.multires_ms = t1 - t0;
   scene.times_.tree_ms = t2 - t1;

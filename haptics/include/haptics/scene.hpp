@@ -4,14 +4,23 @@
 /// (seed paper §3, DESIGN.md "Collision tree"), stored scene-wide in flat arrays addressed by node ids,
 /// so the servo tick walks them with indices and a fixed-size stack and never chases pointers.
 ///
-/// Node numbering. Segment k of level l of curve c is node `curves[c].box_offset[l] + k`; children of
-/// segment k at level l (l ≥ 1) are segments 2k and 2k+1 at level l−1. After all segment nodes come the
-/// chunks: runs of at most 4 consecutive coarsest-level segments of one curve, each with an axis-aligned
-/// box around its segments' boxes. Above the chunks sits a bounding-volume hierarchy (axis-aligned
-/// boxes, median split on the longer axis, at most 4 chunks per leaf), entered through one node,
-/// `scene_root()`. Chunks are numbered in the hierarchy's leaf order, so every node's children are
-/// consecutive ids, and no node has more than 4 children: the boundary section stays small however
-/// long or many the curves are.
+/// Node numbering. Each level l of curve c owns a run of slots starting at node
+/// `curves[c].box_offset[l]`: one per point of the level, plus, for a closed curve, one repeating its
+/// first point, so a level of s segments has s + 1 slots and segment k runs from slot k's point to slot
+/// k + 1's. Segment k is node `box_offset[l] + k`; the run's last slot starts no segment and no walk
+/// reaches it. Children of segment k at level l (l ≥ 1) are segments 2k and 2k+1 at level l−1: index
+/// arithmetic, no links stored. After all slots come the chunks: runs of at most 4 consecutive
+/// coarsest-level segments of one curve, each with an axis-aligned box around its segments' boxes.
+/// Above the chunks sits a bounding-volume hierarchy (axis-aligned boxes, median split on the longer
+/// axis, at most 4 chunks per leaf), entered through one node, `scene_root()`. Chunks are numbered in
+/// the hierarchy's leaf order, so every node's children are consecutive ids, and no node has more than
+/// 4 children: the boundary section stays small however long or many the curves are.
+///
+/// Storage (issue 18: compact boxes). A segment's error box is not stored whole: its frame follows
+/// from its end points (origin at the first, axis toward the second), so a slot keeps its point
+/// (16 bytes, shared by the segment ending there) and the box's four extents as floats rounded outward
+/// (16 bytes), plus a 4-byte tag (curve and level). Only the few chunk and hierarchy nodes keep an
+/// axis-aligned box and links.
 
 #include <cstdint>
 #include <vector>
@@ -22,7 +31,8 @@
 
 namespace hk {
 
-/// A box aligned with a segment (seed §3 "error bounding box"). 64 bytes.
+/// A box aligned with a segment (seed §3 "error bounding box"), as the queries use it. 64 bytes; the scene
+/// stores it compactly (BoxExtent) and Scene::box() rebuilds it.
 /// Points q inside satisfy u_min ≤ dot(q − origin, axis) ≤ u_max and n_min ≤ cross(axis, q − origin) ≤ n_max.
 struct ErrorBox {
   Vec2 origin_m;        ///< frame origin: the segment's first point [m]
@@ -56,18 +66,36 @@ double box_half_width(const ErrorBox& box);
 /// from the segment than this, so it bounds the error of what the box stands for.
 double box_error_bound(const ErrorBox& box, double segment_length_m);
 
-/// Where one curve's data sits in the scene arrays. Levels 0 .. levels−1.
+/// Where one curve's data sits in the scene arrays, and what was measured of it. Levels 0 .. levels−1.
+/// For setup code and tests; the servo path reads CurveNodes instead.
 struct CurveInfo {
   bool closed = false;
   int levels = 0;
-  std::uint32_t point_offset[kMaxLevels] = {};   ///< index of level l's first point in Scene::points_m
-  std::uint32_t point_count[kMaxLevels] = {};    ///< points of level l
+  std::uint32_t point_offset[kMaxLevels] = {};   ///< index of level l's first point in the scene's point array (= box_offset[l])
+  std::uint32_t point_count[kMaxLevels] = {};    ///< distinct points of level l (a closed curve's repeated first point not counted)
   std::uint32_t box_offset[kMaxLevels] = {};     ///< node id of level l's first segment
   std::uint32_t segment_count[kMaxLevels] = {};  ///< segments of level l (closed: points; open: points − 1)
   double max_error_m[kMaxLevels] = {};           ///< largest distance of an original point from the level-l segment standing for it [m]
   double max_box_half_width_m[kMaxLevels] = {};  ///< largest error box half-width at level l [m]
   double max_error_bound_m[kMaxLevels] = {};     ///< largest box_error_bound of level l: bounds max_error_m[l] [m]
 };
+
+/// What the tree walks need of a curve: its levels' first node ids and its level count. 72 bytes.
+struct CurveNodes {
+  std::uint32_t box_offset[kMaxLevels] = {};  ///< node id of level l's first segment (= slot of its first point)
+  std::uint32_t levels = 0;                   ///< levels of the curve (its coarsest is levels − 1)
+  std::uint32_t chunk_offset = 0;             ///< index of the curve's first chunk in Scene's chunk-of-curve array
+};
+static_assert(sizeof(CurveNodes) == 72, "CurveNodes: 72 bytes per curve");
+
+/// The stored part of a segment's error box: its extents [m] in the segment's frame (origin at the
+/// segment's first point, unit axis toward its second, n along the left normal), rounded outward to
+/// float so that the box only grows. 16 bytes.
+struct BoxExtent {
+  float u_min = 0.0f, u_max = 0.0f;  ///< along the axis [m]
+  float n_min = 0.0f, n_max = 0.0f;  ///< along the left normal [m]
+};
+static_assert(sizeof(BoxExtent) == 16, "BoxExtent: four per cache line");
 
 /// Identifies one segment of one level of one curve. 12 bytes.
 struct SegmentRef {
@@ -78,7 +106,8 @@ struct SegmentRef {
 static_assert(sizeof(SegmentRef) == 12, "SegmentRef: passed by value in the servo path");
 constexpr bool operator==(SegmentRef a, SegmentRef b) { return a.curve == b.curve && a.level == b.level && a.segment == b.segment; }
 
-/// Per-node bookkeeping the tree walks need. 12 bytes.
+/// What a node is: its curve, level and index. 12 bytes. Stored for chunk and hierarchy nodes; computed
+/// from a segment node's tag (Scene::info).
 struct NodeInfo {
   std::uint32_t curve = 0;    ///< curve of a segment or chunk; curve of the first chunk under a hierarchy node
   std::int32_t level = 0;     ///< segment level; `levels` of its curve for a chunk; kHierarchyLevel above
@@ -100,46 +129,101 @@ class Scene {
 
   /// Builds multiresolution models and collision trees for `curves` (workspace metres), with at most
   /// `max_levels` levels above level 0 (clamped to kMaxLevels − 1). Curves with fewer than 2 distinct
-  /// points or zero length are skipped (counted in skipped_curves()). Throws std::bad_alloc only.
+  /// points or zero length are skipped (counted in skipped_curves()). Throws std::bad_alloc only (also
+  /// when the nodes would not fit 32-bit ids, or the curves a 28-bit tag: far beyond any memory).
   static Scene build(const std::vector<Polyline>& curves, int max_levels);
 
   std::size_t curve_count() const { return curves_.size(); }
   const CurveInfo& curve(std::size_t c) const { return curves_[c]; }
+  /// What the tree walks read of curve c (node offsets, levels).
+  const CurveNodes& curve_nodes(std::size_t c) const { return curve_nodes_[c]; }
   /// The multiresolution model of curve c (scaling and wavelet coefficients; not used by the servo path).
   const CurveMultires& model(std::size_t c) const { return models_[c]; }
   /// Index of curve c in the `curves` handed to build().
   std::size_t source_index(std::size_t c) const { return source_index_[c]; }
   std::size_t skipped_curves() const { return skipped_; }
 
-  /// Total nodes: segment nodes of all levels of all curves, the chunks, the hierarchy above.
-  std::size_t node_count() const { return boxes_.size(); }
+  /// Total node ids: the slots of all levels of all curves, the chunks, the hierarchy above.
+  std::size_t node_count() const { return segment_nodes_ + group_box_.size(); }
   /// The one node every walk starts from (a hierarchy node; valid only when curve_count() > 0).
   std::uint32_t scene_root() const { return scene_root_; }
-  /// True for segment nodes (they carry a segment of some level); false for curve roots and above.
+  /// True for slot ids (segment nodes; the last slot of each level, which starts no segment, included);
+  /// false for chunks and the hierarchy.
   bool is_segment(std::uint32_t node) const { return node < segment_nodes_; }
   /// True for a chunk (a run of coarsest segments of one curve).
   bool is_chunk(std::uint32_t node) const { return node >= segment_nodes_ && node < segment_nodes_ + chunk_count_; }
   /// Coarsest segments per chunk, at most.
   static constexpr std::uint32_t kSegmentsPerChunk = 4;
-  const ErrorBox& box(std::uint32_t node) const { return boxes_[node]; }
-  /// Axis-aligned rectangle around a node's box (its four corners) [m].
-  const Aabb& aabb(std::uint32_t node) const { return aabbs_[node]; }
-  const NodeInfo& info(std::uint32_t node) const { return info_[node]; }
-  std::uint32_t node_of(SegmentRef s) const { return curves_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
+
+  /// Curve (bits 4..31) and level (bits 0..3) of a segment node, packed.
+  static constexpr std::uint32_t kTagLevelBits = 4;
+  static_assert(kMaxLevels <= (1 << kTagLevelBits), "a level fits the tag's level bits");
+  std::uint32_t tag_curve(std::uint32_t node) const { return tag_[node] >> kTagLevelBits; }
+  int tag_level(std::uint32_t node) const { return static_cast<int>(tag_[node] & ((1u << kTagLevelBits) - 1)); }
+
+  /// The error box of a node: a segment's, rebuilt from its end points and stored extents; a chunk's or
+  /// hierarchy node's axis-aligned box as an ErrorBox with origin (0, 0) and axis (1, 0). O(1), one root.
+  ErrorBox box(std::uint32_t node) const {
+    if (node >= segment_nodes_) {
+      const Aabb& r = group_box_[node - segment_nodes_];
+      return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo.x, r.hi.x, r.lo.y, r.hi.y};
+    }
+    return segment_box(node);
+  }
+  /// The error box of segment node `node` (is_segment(node)).
+  ErrorBox segment_box(std::uint32_t node) const {
+    const Vec2 a = points_m_[node];
+    const BoxExtent& e = extent_[node];
+    return ErrorBox{a, segment_axis(a, points_m_[node + 1]), e.u_min, e.u_max, e.n_min, e.n_max};
+  }
+  /// The frame axis of the segment a→b: the unit vector along it, (1, 0) for a zero-length one. The build
+  /// measures extents in this frame and box() rebuilds it with this same function.
+  static Vec2 segment_axis(Vec2 a, Vec2 b) { return normalized_or(b - a, Vec2{1.0, 0.0}); }
+  /// Axis-aligned rectangle around a node's box (its four corners) [m]: stored for chunks and the
+  /// hierarchy, computed for segments.
+  Aabb aabb(std::uint32_t node) const;
+  /// Curve, level and index of a node (see NodeInfo).
+  NodeInfo info(std::uint32_t node) const {
+    if (node >= segment_nodes_) return group_info_[node - segment_nodes_];
+    const std::uint32_t c = tag_curve(node);
+    const int l = tag_level(node);
+    return NodeInfo{c, l, node - curve_nodes_[c].box_offset[l]};
+  }
+  std::uint32_t node_of(SegmentRef s) const { return curve_nodes_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
   /// Parent of a node (the scene root's parent is itself).
-  std::uint32_t parent(std::uint32_t node) const { return parent_[node]; }
+  std::uint32_t parent(std::uint32_t node) const;
   /// First child and child count of a node; children are consecutive ids (0 for a level-0 segment).
   void children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const {
-    *first = child_first_[node];
-    *count = child_count_[node];
+    if (node >= segment_nodes_) {
+      const std::size_t g = node - segment_nodes_;
+      *first = group_child_first_[g];
+      *count = group_child_count_[g];
+      return;
+    }
+    const int l = tag_level(node);
+    if (l == 0) {
+      *first = 0;
+      *count = 0;
+      return;
+    }
+    const CurveNodes& cn = curve_nodes_[tag_curve(node)];
+    *first = cn.box_offset[l - 1] + 2 * (node - cn.box_offset[l]);
+    *count = 2;
   }
-  /// Bytes of the arrays the servo path reads (boxes, node links, points), for bytes-per-segment figures.
+  /// Bytes of the arrays the servo path reads (points, box extents, tags, per-curve node offsets, the
+  /// chunks' and hierarchy's boxes and links), for bytes-per-segment figures.
   std::size_t hot_bytes() const;
 
-  /// Level-l points of curve c (the scaling coefficients) [m].
+  /// Level-l points of curve c (the scaling coefficients) [m]: point_count[l] of them, then, for a closed
+  /// curve, the first again.
   const Vec2* points(std::size_t c, int level) const { return points_m_.data() + curves_[c].point_offset[level]; }
   /// End points of a segment [m].
-  void segment(SegmentRef s, Vec2* a, Vec2* b) const;
+  void segment(SegmentRef s, Vec2* a, Vec2* b) const { segment_points(node_of(s), a, b); }
+  /// End points of segment node `node` [m].
+  void segment_points(std::uint32_t node, Vec2* a, Vec2* b) const {
+    *a = points_m_[node];
+    *b = points_m_[node + 1];
+  }
   /// Segment count over all curves at `level` (curves with fewer levels use their coarsest).
   std::size_t total_segments(int level) const;
   /// The largest error-box half-width of any curve at `level` (curves with fewer levels count with their
@@ -154,7 +238,7 @@ class Scene {
   int max_curve_levels() const;
   /// Coarsest level available in every curve clamped: min(level, levels−1 of curve c).
   int clamp_level(std::size_t c, int level) const {
-    const int top = curves_[c].levels - 1;
+    const int top = static_cast<int>(curve_nodes_[c].levels) - 1;
     return level < 0 ? 0 : (level > top ? top : level);
   }
   /// Bounding rectangle of every curve's level-0 points [m].
@@ -165,13 +249,20 @@ class Scene {
  private:
   friend class SceneBuild;  // the build phases (scene.cpp)
   std::vector<CurveInfo> curves_;
+  std::vector<CurveNodes> curve_nodes_;
   std::vector<CurveMultires> models_;
   std::vector<std::size_t> source_index_;
+  // Per slot (node ids 0 .. segment_nodes_ − 1).
   std::vector<Vec2> points_m_;
-  std::vector<ErrorBox> boxes_;
-  std::vector<Aabb> aabbs_;
-  std::vector<NodeInfo> info_;
-  std::vector<std::uint32_t> parent_, child_first_, child_count_;
+  std::vector<BoxExtent> extent_;
+  std::vector<std::uint32_t> tag_;
+  // Per chunk and hierarchy node (node id − segment_nodes_).
+  std::vector<Aabb> group_box_;
+  std::vector<NodeInfo> group_info_;
+  std::vector<std::uint32_t> group_parent_, group_child_first_, group_child_count_;
+  // Chunk node of each curve's chunks, in the curve's order (CurveNodes::chunk_offset + k / kSegmentsPerChunk
+  // for its coarsest segment k): the parent of a coarsest segment.
+  std::vector<std::uint32_t> chunk_of_curve_;
   std::size_t segment_nodes_ = 0;
   std::size_t chunk_count_ = 0;
   std::uint32_t scene_root_ = 0;
