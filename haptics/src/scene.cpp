@@ -34,20 +34,26 @@ inline void grow(Extent& e, Vec2 origin, Vec2 axis, Vec2 q) {
   e.n_max = std::max(e.n_max, n);
 }
 
-// The float nearest v from below / above: stored extents only ever grow the box.
-inline float float_below(double v) {
-  const float f = static_cast<float>(v);
-  return static_cast<double>(f) > v ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
-}
-inline float float_above(double v) {
-  const float f = static_cast<float>(v);
-  return static_cast<double>(f) < v ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+// Largest |quantised extent| a level's quantum is chosen for (int16 holds ±32767: room for the outward steps).
+constexpr double kQuantumSteps = 32000.0;
+
+// The multiple of q at or below v (`below`), or at or above it: the stored extent only grows the box. The
+// product is checked as Scene::segment_box computes it, so rounding in the division cannot undercut v.
+inline std::int16_t quantise(double v, double q, bool below) {
+  double k = below ? std::floor(v / q) : std::ceil(v / q);
+  if (below) {
+    while (k * q > v) k -= 1.0;
+  } else {
+    while (k * q < v) k += 1.0;
+  }
+  return static_cast<std::int16_t>(k);
 }
 
-inline BoxExtent make_extent(const Extent& e) {
-  return BoxExtent{float_below(e.u_min - kBoxPad_m), float_above(e.u_max + kBoxPad_m), float_below(e.n_min - kBoxPad_m),
-                   float_above(e.n_max + kBoxPad_m)};
-}
+// A segment's measured extents, padded, in the frame of Scene::segment_frame; the segment's length [m].
+struct SegmentExtent {
+  Extent e;
+  double length_m = 0.0;
+};
 
 // One node of the scene hierarchy while it is built: the chunk range it covers in leaf order and,
 // for an inner node, the id of its first child (the second is first + 1).
@@ -283,17 +289,21 @@ class SceneBuild {
   // it. Convexity then puts every finer segment and the original sub-polyline inside, which is all a
   // miss must prove (seed §3); children's boxes need not fit inside (issue 18: boxes built from the
   // children's corners were 1.09–1.45x the true deviation).
-  static void build_segment_boxes(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first) {
+  static void build_segment_boxes(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first,
+                                  std::vector<SegmentExtent>& level) {
     const CurveMultires& m = scene.models_[c];
     const CurveInfo& ci = scene.curves_[c];
     const auto& orig = src.points_m;
     for (int l = 0; l < m.levels; ++l) {
+      level.resize(ci.segment_count[l]);
+      double widest = 0.0;  // largest |extent| of the level, what its quantum is chosen for [m]
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
-        const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k);
         Vec2 a, b;
-        scene.segment_points(node, &a, &b);
-        const Vec2 axis = Scene::segment_axis(a, b);  // the frame Scene::box() rebuilds
-        Extent e;
+        scene.segment_points(ci.box_offset[l] + static_cast<std::uint32_t>(k), &a, &b);
+        SegmentExtent& se = level[k];
+        const Vec2 axis = Scene::segment_frame(a, b, &se.length_m);  // the frame Scene::segment_box() rebuilds
+        Extent& e = se.e;
+        e = Extent{};
         grow(e, a, axis, a);
         grow(e, a, axis, b);
         for (int j = 0; j < l; ++j) {  // finer levels' points under this segment
@@ -303,7 +313,18 @@ class SceneBuild {
         }
         const std::size_t k0 = k << l, k1 = (k + 1) << l;  // level-0 segments under it
         for (std::uint32_t v = orig_first[k0]; v < orig_first[k1]; ++v) grow(e, a, axis, orig[v]);
-        scene.extent_[node] = make_extent(e);
+        e = Extent{e.u_min - kBoxPad_m, e.u_max + kBoxPad_m, e.n_min - kBoxPad_m, e.n_max + kBoxPad_m};
+        widest = std::max({widest, std::abs(e.u_min), std::abs(e.u_max - se.length_m), std::abs(e.n_min), std::abs(e.n_max)});
+      }
+      const float quantum = static_cast<float>(widest / kQuantumSteps);  // > 0: every extent holds the pad
+      scene.curve_nodes_[c].quantum_m[l] = quantum;
+      const double q = quantum;
+      for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
+        const SegmentExtent& se = level[k];
+        double over = std::ceil((se.e.u_max - se.length_m) / q);
+        while (se.length_m + over * q < se.e.u_max) over += 1.0;  // as segment_box() adds it up
+        scene.extent_[ci.box_offset[l] + k] = BoxExtent{quantise(se.e.u_min, q, true), static_cast<std::int16_t>(over),
+                                                        quantise(se.e.n_min, q, true), quantise(se.e.n_max, q, false)};
       }
     }
   }
@@ -340,12 +361,13 @@ class SceneBuild {
   static void build_curves(Scene& scene, const std::vector<Polyline>& input) {
     std::vector<double> orig_arc;
     std::vector<std::uint32_t> orig_first;
+    std::vector<SegmentExtent> level_extent;  // one level's measured extents, before quantising
     Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     Vec2 hi{-lo.x, -lo.y};
     for (std::size_t c = 0; c < scene.models_.size(); ++c) {
       const Polyline& src = input[scene.source_index_[c]];
       map_originals(scene.models_[c], src, scene.curves_[c].segment_count[0], orig_arc, orig_first);
-      build_segment_boxes(scene, c, src, orig_first);
+      build_segment_boxes(scene, c, src, orig_first, level_extent);
       measure_errors(scene, c, src, orig_first);
       for (const Vec2& q : scene.models_[c].scaling[0]) {
         lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};

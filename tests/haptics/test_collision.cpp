@@ -136,6 +136,46 @@ TEST(CollisionTree, BoxesAreTightAroundTheOriginalUnderThem) {
   std::printf("box half-width / true deviation: median %.4f, p90 %.4f over %zu boxes\n", median, ratio[ratio.size() * 9 / 10], ratio.size());
 }
 
+// Issue 18, compact storage: a level is a run of slots, one per point, a closed curve's first point
+// repeated at the end, so segment k runs from point k to point k + 1 and the last segment of a closed
+// level closes the loop on its first point (checked against the model's scaling coefficients).
+TEST(CollisionTree, SegmentsRunBetweenTheLevelsPointsAndClosedLevelsCloseTheLoop) {
+  std::mt19937 rng(14);
+  const auto curves = random_scene(rng, 5, 5);
+  const Scene sc = Scene::build(curves, 6);
+  int closed = 0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    closed += ci.closed ? 1 : 0;
+    for (int l = 0; l < ci.levels; ++l) {
+      const auto& pts = sc.model(c).scaling[static_cast<std::size_t>(l)];
+      ASSERT_EQ(ci.segment_count[l], ci.closed ? pts.size() : pts.size() - 1);
+      for (std::uint32_t k = 0; k < ci.segment_count[l]; ++k) {
+        Vec2 a, b;
+        sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
+        ASSERT_EQ(a, pts[k]);
+        ASSERT_EQ(b, pts[(k + 1) % pts.size()]) << "curve " << c << " level " << l << " segment " << k;
+        const NodeInfo in = sc.info(ci.box_offset[l] + k);
+        ASSERT_EQ(in.curve, c);
+        ASSERT_EQ(in.level, l);
+        ASSERT_EQ(in.index, k);
+      }
+    }
+  }
+  EXPECT_GT(closed, 0);
+}
+
+// Issue 18's memory target: every level's points, quantised boxes, tags and the tree above them in at
+// most 64 bytes per level-0 segment (was 270 with whole double boxes, rectangles and links per node).
+TEST(CollisionTree, AllLevelsFitSixtyFourBytesPerSegment) {
+  std::mt19937 rng(15);
+  const auto curves = random_scene(rng, 40, 40);
+  const Scene sc = Scene::build(curves, 6);
+  const double per_segment = static_cast<double>(sc.hot_bytes()) / static_cast<double>(sc.total_segments(0));
+  EXPECT_LE(per_segment, 64.0);
+  std::printf("scene storage: %.1f bytes per level-0 segment over %zu segments\n", per_segment, sc.total_segments(0));
+}
+
 TEST(CollisionTree, SceneHierarchyHoldsEveryCoarsestSegmentOnce) {
   std::mt19937 rng(12);
   const auto curves = random_scene(rng, 40, 40);

@@ -18,9 +18,9 @@
 ///
 /// Storage (issue 18: compact boxes). A segment's error box is not stored whole: its frame follows
 /// from its end points (origin at the first, axis toward the second), so a slot keeps its point
-/// (16 bytes, shared by the segment ending there) and the box's four extents as floats rounded outward
-/// (16 bytes), plus a 4-byte tag (curve and level). Only the few chunk and hierarchy nodes keep an
-/// axis-aligned box and links.
+/// (16 bytes, shared by the segment ending there) and the box's four extents quantised to 16 bits,
+/// rounded outward (8 bytes), plus a 4-byte tag (curve and level). Only the few chunk and hierarchy nodes
+/// keep an axis-aligned box and links.
 
 #include <cstdint>
 #include <vector>
@@ -80,22 +80,27 @@ struct CurveInfo {
   double max_error_bound_m[kMaxLevels] = {};     ///< largest box_error_bound of level l: bounds max_error_m[l] [m]
 };
 
-/// What the tree walks need of a curve: its levels' first node ids and its level count. 72 bytes.
+/// What the tree walks need of a curve: its levels' first node ids, the quantum of their box extents,
+/// its level count. 136 bytes.
 struct CurveNodes {
   std::uint32_t box_offset[kMaxLevels] = {};  ///< node id of level l's first segment (= slot of its first point)
+  float quantum_m[kMaxLevels] = {};           ///< the unit of level l's BoxExtent [m]
   std::uint32_t levels = 0;                   ///< levels of the curve (its coarsest is levels − 1)
   std::uint32_t chunk_offset = 0;             ///< index of the curve's first chunk in Scene's chunk-of-curve array
 };
-static_assert(sizeof(CurveNodes) == 72, "CurveNodes: 72 bytes per curve");
+static_assert(sizeof(CurveNodes) == 136, "CurveNodes: 136 bytes per curve");
 
-/// The stored part of a segment's error box: its extents [m] in the segment's frame (origin at the
-/// segment's first point, unit axis toward its second, n along the left normal), rounded outward to
-/// float so that the box only grows. 16 bytes.
+/// The stored part of a segment's error box: its extents in the segment's frame (origin at the
+/// segment's first point a, unit axis toward its second b, n along the left normal) as multiples of the
+/// level's quantum q (CurveNodes::quantum_m), rounded outward so that the box only grows:
+/// u from u_min·q to |b − a| + u_over·q, n from n_min·q to n_max·q [m]. The quantum is the level's
+/// largest extent over 32000, so a box is at most q ≈ 3·10⁻⁵ of the level's widest extent larger than
+/// exact. 8 bytes.
 struct BoxExtent {
-  float u_min = 0.0f, u_max = 0.0f;  ///< along the axis [m]
-  float n_min = 0.0f, n_max = 0.0f;  ///< along the left normal [m]
+  std::int16_t u_min = 0, u_over = 0;  ///< along the axis: before the segment's start, past its end [quanta]
+  std::int16_t n_min = 0, n_max = 0;   ///< along the left normal [quanta]
 };
-static_assert(sizeof(BoxExtent) == 16, "BoxExtent: four per cache line");
+static_assert(sizeof(BoxExtent) == 8, "BoxExtent: eight per cache line");
 
 /// Identifies one segment of one level of one curve. 12 bytes.
 struct SegmentRef {
@@ -173,12 +178,20 @@ class Scene {
   /// The error box of segment node `node` (is_segment(node)).
   ErrorBox segment_box(std::uint32_t node) const {
     const Vec2 a = points_m_[node];
+    double length_m = 0.0;
+    const Vec2 axis = segment_frame(a, points_m_[node + 1], &length_m);
+    const double q = curve_nodes_[tag_curve(node)].quantum_m[tag_level(node)];
     const BoxExtent& e = extent_[node];
-    return ErrorBox{a, segment_axis(a, points_m_[node + 1]), e.u_min, e.u_max, e.n_min, e.n_max};
+    return ErrorBox{a, axis, e.u_min * q, length_m + e.u_over * q, e.n_min * q, e.n_max * q};
   }
-  /// The frame axis of the segment a→b: the unit vector along it, (1, 0) for a zero-length one. The build
-  /// measures extents in this frame and box() rebuilds it with this same function.
-  static Vec2 segment_axis(Vec2 a, Vec2 b) { return normalized_or(b - a, Vec2{1.0, 0.0}); }
+  /// The frame of the segment a→b: returns the unit vector along it ((1, 0) for a zero-length one) and
+  /// writes its length [m]. The build measures extents in this frame and box() rebuilds it with this same
+  /// function.
+  static Vec2 segment_frame(Vec2 a, Vec2 b, double* length_m) {
+    const Vec2 d = b - a;
+    *length_m = length(d);
+    return *length_m > 1e-300 ? Vec2{d.x / *length_m, d.y / *length_m} : Vec2{1.0, 0.0};
+  }
   /// Axis-aligned rectangle around a node's box (its four corners) [m]: stored for chunks and the
   /// hierarchy, computed for segments.
   Aabb aabb(std::uint32_t node) const;
