@@ -236,7 +236,8 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
       top = base;
       return false;
     }
-    if (clip_segment_box(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t && !push(top, {te, first + i})) {
+    if (overlaps(sc.loose_aabb(first + i), q.sweep, 0.0) && clip_segment_box(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t &&
+        !push(top, {te, first + i})) {
       top = base;  // the stack is full: as past the budget
       return false;
     }

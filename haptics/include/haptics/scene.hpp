@@ -22,6 +22,7 @@
 /// rounded outward (8 bytes), plus a 4-byte tag (curve and level). Only the few chunk and hierarchy nodes
 /// keep an axis-aligned box and links.
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -190,7 +191,20 @@ class Scene {
   static Vec2 segment_frame(Vec2 a, Vec2 b, double* length_m) {
     const Vec2 d = b - a;
     *length_m = length(d);
-    return *length_m > 1e-300 ? Vec2{d.x / *length_m, d.y / *length_m} : Vec2{1.0, 0.0};
+    if (!(*length_m > 1e-300)) return Vec2{1.0, 0.0};
+    const double inverse = 1.0 / *length_m;  // one division for both components
+    return Vec2{d.x * inverse, d.y * inverse};
+  }
+  /// A rectangle that holds a node's box [m], cheaply: for a segment, the rectangle of its end points
+  /// grown by the box's largest overhang plus its largest half-width (no root, looser than aabb());
+  /// for a chunk or hierarchy node, its stored rectangle. For rejecting boxes before rebuilding them.
+  Aabb loose_aabb(std::uint32_t node) const {
+    if (node >= segment_nodes_) return group_box_[node - segment_nodes_];
+    const Vec2 a = points_m_[node], b = points_m_[node + 1];
+    const BoxExtent& e = extent_[node];
+    const int reach = std::max<int>(std::max<int>(-e.u_min, e.u_over), 0) + std::max<int>(std::max<int>(-e.n_min, e.n_max), 0);
+    const double r = reach * static_cast<double>(curve_nodes_[tag_curve(node)].quantum_m[tag_level(node)]);
+    return Aabb{{std::min(a.x, b.x) - r, std::min(a.y, b.y) - r}, {std::max(a.x, b.x) + r, std::max(a.y, b.y) + r}};
   }
   /// Axis-aligned rectangle around a node's box (its four corners) [m]: stored for chunks and the
   /// hierarchy, computed for segments.
