@@ -18,6 +18,13 @@ inline double box_distance_sq(const ErrorBox& box, Vec2 p) {
   return du * du + dn * dn;
 }
 
+// True for a segment node at the level a walk targets, clamped per curve to its coarsest. A walk reaches
+// a curve's segments from its coarsest level down, so a segment's level is never above that clamp, which
+// then comes down to comparing with the target itself (or 0, for a negative target).
+inline bool at_target_level(const Scene& sc, std::uint32_t node, int level) {
+  return sc.is_segment(node) && sc.tag_level(node) <= std::max(level, 0);
+}
+
 }  // namespace
 
 bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit) {
@@ -138,11 +145,6 @@ struct BoundarySection::Query {
     ++st.box_tests;
     return true;
   }
-  // A segment node at the target level (clamped to its curve's coarsest, which is as far as a walk
-  // can be above it: tag_level ≤ the curve's coarsest, so the clamp is the level itself, or 0).
-  bool at_target(const Scene& sc, std::uint32_t node) const noexcept {
-    return sc.is_segment(node) && sc.tag_level(node) <= std::max(level, 0);
-  }
   bool is_excluded(SegmentRef s) const noexcept {
     for (int i = 0; i < excluded_count; ++i) {
       if (excluded[i] == s) return true;
@@ -259,7 +261,7 @@ void BoundarySection::refine_candidates(Query& q) {
     while (top > 0) {
       const Candidate cur = stack_[--top];
       if (cur.t_enter > q.horizon()) continue;
-      if (q.at_target(sc, cur.node)) {
+      if (at_target_level(sc, cur.node, q.level)) {
         test_segment(q, cur.node);
       } else if (!push_hit_children(q, cur.node, top) && cur.t_enter < q.unresolved_t) {
         q.unresolved_t = cur.t_enter;
@@ -273,7 +275,7 @@ void BoundarySection::refine_candidates(Query& q) {
 void BoundarySection::split_hit_boxes(Query& q) {
   const Scene& sc = *scene_;
   for (const Candidate& cand : candidates_) {
-    if (!q.at_target(sc, cand.node)) {
+    if (!at_target_level(sc, cand.node, q.level)) {
       split(cand.node);
       ++q.st.splits;
     }
@@ -507,7 +509,6 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   };
   update_bound();
   const std::uint32_t root = sc.scene_root();
-  const int leaf_level = std::max(level, 0);
   if (budget && !budget->spend()) return false;
   const double dr_sq = box_distance_sq(sc.box(root), p);
   int top = 0;
@@ -520,9 +521,8 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   while (top > 0) {
     const Candidate cur = stack_[--top];  // t_enter holds the box's squared distance here
     if (cur.t_enter > bound_sq) continue;  // the bound only shrinks: nothing under it can matter any more
-    const bool is_segment = sc.is_segment(cur.node);
-    if (curve >= 0 && (is_segment || sc.is_chunk(cur.node)) && static_cast<int>(sc.info(cur.node).curve) != curve) continue;
-    if (is_segment && sc.tag_level(cur.node) <= leaf_level) {  // at the level asked, clamped (see Query::at_target)
+    if (curve >= 0 && (sc.is_segment(cur.node) || sc.is_chunk(cur.node)) && static_cast<int>(sc.info(cur.node).curve) != curve) continue;
+    if (at_target_level(sc, cur.node, level)) {
       const NodeInfo in = sc.info(cur.node);
       const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
       Vec2 a, b;
