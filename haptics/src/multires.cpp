@@ -10,11 +10,11 @@
 namespace hk {
 namespace {
 
-// Periodic index into a sequence of length n (k may be negative).
+// Periodic index into a sequence of length n, for k within one period of it (−n ≤ k < 2n: the lifting
+// steps reach at most two samples past either end, and n ≥ 4). No division: this runs for every sample.
 inline std::size_t wrap(long k, std::size_t n) {
   const long m = static_cast<long>(n);
-  long r = k % m;
-  return static_cast<std::size_t>(r < 0 ? r + m : r);
+  return static_cast<std::size_t>(k < 0 ? k + m : (k >= m ? k - m : k));
 }
 
 // Prediction of odd sample k from the even samples e (size ne), cubic interpolation (DESIGN.md).

@@ -115,7 +115,8 @@ double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min)
 
 double box_error_bound(const ErrorBox& box, double segment_length_m) {
   const double overhang = std::max({0.0, -box.u_min, box.u_max - segment_length_m});
-  return std::hypot(overhang, box_half_width(box));
+  const double half_width = box_half_width(box);
+  return std::sqrt(overhang * overhang + half_width * half_width);
 }
 
 std::size_t Scene::hot_bytes() const {
@@ -288,15 +289,18 @@ class SceneBuild {
   // finer level j < l under it (points k·2^(l−j) .. (k+1)·2^(l−j)), and of the original vertices under
   // it. Convexity then puts every finer segment and the original sub-polyline inside, which is all a
   // miss must prove (seed §3); children's boxes need not fit inside (issue 18: boxes built from the
-  // children's corners were 1.09–1.45x the true deviation).
+  // children's corners were 1.09–1.45x the true deviation). The same pass measures the level's error
+  // (measure_segment_error) from the frame coordinates it computes anyway, then quantises the extents
+  // (quantise_level).
   static void build_segment_boxes(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first,
                                   std::vector<SegmentExtent>& level) {
     const CurveMultires& m = scene.models_[c];
-    const CurveInfo& ci = scene.curves_[c];
+    CurveInfo& ci = scene.curves_[c];
     const auto& orig = src.points_m;
     for (int l = 0; l < m.levels; ++l) {
       level.resize(ci.segment_count[l]);
-      double widest = 0.0;  // largest |extent| of the level, what its quantum is chosen for [m]
+      double widest = 0.0;      // largest |extent| of the level, what its quantum is chosen for [m]
+      double worst_sq = 0.0;    // largest squared distance of a level-0 point or original vertex from its level-l segment [m²]
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
         Vec2 a, b;
         scene.segment_points(ci.box_offset[l] + static_cast<std::uint32_t>(k), &a, &b);
@@ -306,56 +310,64 @@ class SceneBuild {
         e = Extent{};
         grow(e, a, axis, a);
         grow(e, a, axis, b);
-        for (int j = 0; j < l; ++j) {  // finer levels' points under this segment
+        for (int j = 1; j < l; ++j) {  // finer levels' points under this segment (level 0 below, with the errors)
           const Vec2* fine = scene.points(c, j);  // a closed curve's first point repeats at its end
           const std::size_t span = std::size_t{1} << (l - j);
           for (std::size_t i = k * span; i <= (k + 1) * span; ++i) grow(e, a, axis, fine[i]);
         }
         const std::size_t k0 = k << l, k1 = (k + 1) << l;  // level-0 segments under it
-        for (std::uint32_t v = orig_first[k0]; v < orig_first[k1]; ++v) grow(e, a, axis, orig[v]);
+        if (l > 0) {
+          const Vec2* fine = scene.points(c, 0);
+          for (std::size_t i = k0; i < k1; ++i) worst_sq = std::max(worst_sq, grow_measuring(e, a, axis, se.length_m, fine[i]));
+          grow(e, a, axis, fine[k1]);  // the next segment's first point: in the box, measured with that segment
+        }
+        for (std::uint32_t v = orig_first[k0]; v < orig_first[k1]; ++v) worst_sq = std::max(worst_sq, grow_measuring(e, a, axis, se.length_m, orig[v]));
         e = Extent{e.u_min - kBoxPad_m, e.u_max + kBoxPad_m, e.n_min - kBoxPad_m, e.n_max + kBoxPad_m};
         widest = std::max({widest, std::abs(e.u_min), std::abs(e.u_max - se.length_m), std::abs(e.n_min), std::abs(e.n_max)});
       }
-      const float quantum = static_cast<float>(widest / kQuantumSteps);  // > 0: every extent holds the pad
-      scene.curve_nodes_[c].quantum_m[l] = quantum;
-      const double q = quantum;
-      for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
-        const SegmentExtent& se = level[k];
-        double over = std::ceil((se.e.u_max - se.length_m) / q);
-        while (se.length_m + over * q < se.e.u_max) over += 1.0;  // as segment_box() adds it up
-        scene.extent_[ci.box_offset[l] + k] = BoxExtent{quantise(se.e.u_min, q, true), static_cast<std::int16_t>(over),
-                                                        quantise(se.e.n_min, q, true), quantise(se.e.n_max, q, false)};
-      }
+      ci.max_error_m[l] = std::sqrt(worst_sq);  // one root per level
+      quantise_level(scene, c, l, level, widest);
     }
   }
 
-  // Error of each level of curve c: the largest distance of an original vertex or level-0 point from
-  // the segment that stands for it; the widest box of the level and the largest box error bound.
-  static void measure_errors(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first) {
-    const CurveMultires& m = scene.models_[c];
+  // Grows the extent by q, as grow(), and returns q's squared distance from the segment a + u·axis,
+  // 0 ≤ u ≤ length_m [m²]: from the frame coordinates, so that the error costs no second pass.
+  static double grow_measuring(Extent& e, Vec2 a, Vec2 axis, double length_m, Vec2 q) {
+    const Vec2 r = q - a;
+    const double u = dot(r, axis);
+    const double n = cross(axis, r);
+    e.u_min = std::min(e.u_min, u);
+    e.u_max = std::max(e.u_max, u);
+    e.n_min = std::min(e.n_min, n);
+    e.n_max = std::max(e.n_max, n);
+    const double past = u < 0.0 ? u : (u > length_m ? u - length_m : 0.0);  // along the axis, beyond an end
+    return past * past + n * n;
+  }
+
+  // Level l's quantum (its widest extent / kQuantumSteps) and every segment's extents in it, rounded
+  // outward; the widest box of the level and its largest box error bound, from the boxes as
+  // Scene::segment_box() rebuilds them.
+  static void quantise_level(Scene& scene, std::size_t c, int l, const std::vector<SegmentExtent>& level, double widest) {
     CurveInfo& ci = scene.curves_[c];
-    const auto& p = src.points_m;
-    const std::size_t s0 = ci.segment_count[0];
-    for (int l = 0; l < m.levels; ++l) {
-      const auto& pts = m.scaling[l];
-      double worst = 0.0, widest = 0.0;
-      for (std::size_t k = 0; k < s0; ++k) {
-        const std::size_t seg = k >> l;
-        const Vec2 a = pts[seg], b = pts[seg + 1 == pts.size() ? 0 : seg + 1];
-        worst = std::max(worst, distance_sq_to_segment(m.scaling[0][k], a, b));
-        for (std::uint32_t j = orig_first[k]; j < orig_first[k + 1]; ++j) worst = std::max(worst, distance_sq_to_segment(p[j], a, b));
-      }
-      worst = std::sqrt(worst);  // squared above: one root per level
-      double bound = 0.0;
-      for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
-        const ErrorBox box = scene.segment_box(ci.box_offset[l] + static_cast<std::uint32_t>(k));
-        widest = std::max(widest, box_half_width(box));
-        bound = std::max(bound, box_error_bound(box, distance(pts[k], pts[k + 1 == pts.size() ? 0 : k + 1])));
-      }
-      ci.max_error_m[l] = worst;
-      ci.max_box_half_width_m[l] = widest;
-      ci.max_error_bound_m[l] = bound;
+    const float quantum = static_cast<float>(widest / kQuantumSteps);  // > 0: every extent holds the pad
+    scene.curve_nodes_[c].quantum_m[l] = quantum;
+    const double q = quantum;
+    double half_width = 0.0, bound_sq = 0.0;  // the level's widest box [m]; its largest squared box_error_bound [m²]
+    for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
+      const SegmentExtent& se = level[k];
+      double over = std::ceil((se.e.u_max - se.length_m) / q);
+      while (se.length_m + over * q < se.e.u_max) over += 1.0;  // as segment_box() adds it up
+      const BoxExtent be{quantise(se.e.u_min, q, true), static_cast<std::int16_t>(over), quantise(se.e.n_min, q, true),
+                         quantise(se.e.n_max, q, false)};
+      scene.extent_[ci.box_offset[l] + k] = be;
+      // box_half_width and box_error_bound of the box as segment_box() rebuilds it, squared (one root per level).
+      const double hw = std::max(std::abs(be.n_min * q), std::abs(be.n_max * q));
+      const double overhang = std::max({0.0, -(be.u_min * q), (se.length_m + be.u_over * q) - se.length_m});
+      half_width = std::max(half_width, hw);
+      bound_sq = std::max(bound_sq, overhang * overhang + hw * hw);
     }
+    ci.max_box_half_width_m[l] = half_width;
+    ci.max_error_bound_m[l] = std::sqrt(bound_sq);
   }
 
   static void build_curves(Scene& scene, const std::vector<Polyline>& input) {
@@ -368,7 +380,6 @@ class SceneBuild {
       const Polyline& src = input[scene.source_index_[c]];
       map_originals(scene.models_[c], src, scene.curves_[c].segment_count[0], orig_arc, orig_first);
       build_segment_boxes(scene, c, src, orig_first, level_extent);
-      measure_errors(scene, c, src, orig_first);
       for (const Vec2& q : scene.models_[c].scaling[0]) {
         lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
         hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
