@@ -176,8 +176,7 @@ void BoundarySection::next_tick() noexcept {
 
 // Phase 1: clip the sweep against every box of the boundary section, grown by the merge margin, so one
 // clip answers both "hit?" (then an exact clip makes it a candidate) and "still near?" (else it may merge).
-// On the way, the distance from the end of the sweep to the nearest box: the next free-space ball, if
-// the section does not change this tick.
+// On the way, the distance from the end of the sweep to the nearest box: the next free-space ball.
 void BoundarySection::clip_section(Query& q) {
   const Scene& sc = *scene_;
   candidates_.clear();
@@ -313,30 +312,25 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   }
 }
 
-// Phase 5: when boxes were split or merged, drop the entries split or merged away and measure the
-// next free-space ball (the distance from the end of the sweep to the nearest box of the section) again;
-// otherwise the section is as phase 1 scanned it, and so is the ball.
+// Phase 5: the next free-space ball, and when boxes were split or merged, the section without the entries
+// split or merged away. The ball is the distance from the end of the sweep to the nearest box phase 1
+// scanned, even when the section changed since: a split box holds every wall its children hold and merged
+// children every wall their parent holds, so the boxes scanned still cover every wall and no wall comes
+// nearer than that. (Measuring the changed section again finds the children's boxes, which may be
+// farther, but cost more than the slightly larger ball saved: PERFORMANCE.md, round two.)
 void BoundarySection::compact_section(Query& q) {
   ball_center_m_ = q.b;
-  if (q.st.splits == 0 && q.st.merges == 0) {
-    ball_radius_m_ = std::sqrt(q.nearest_sq);
-    return;
-  }
+  ball_radius_m_ = std::sqrt(q.nearest_sq);
+  if (q.st.splits == 0 && q.st.merges == 0) return;
   std::size_t w = 0;
-  double nearest_sq = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < section_.size(); ++i) {
     const std::uint32_t node = section_[i];
     if (in_section_[node] && compact_stamp_[node] != tick_) {
       compact_stamp_[node] = tick_;  // de-duplicate within this pass (a node merged back in appears twice)
-      const Aabb& r = section_box_[i];
-      const double dx = std::max({r.lo.x - q.b.x, 0.0, q.b.x - r.hi.x});
-      const double dy = std::max({r.lo.y - q.b.y, 0.0, q.b.y - r.hi.y});
-      if (dx * dx + dy * dy < nearest_sq) nearest_sq = std::min(nearest_sq, box_distance_sq(scene_->box(node), q.b));
-      section_box_[w] = r;
+      section_box_[w] = section_box_[i];
       section_[w++] = node;
     }
   }
-  ball_radius_m_ = std::sqrt(nearest_sq);
   section_.resize(w);
   section_box_.resize(w);
 }

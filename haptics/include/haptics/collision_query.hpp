@@ -15,8 +15,9 @@
 /// so no wall of the target level lies before it). The caller can then stop short instead of crossing a
 /// wall it has not resolved; the boundary section keeps the refinement for the next tick.
 /// Between full queries a free-space ball answers at once: a full query measures how far the end of
-/// its sweep is from the nearest box of the section, and a later sweep wholly inside that distance
-/// cannot hit anything (seed §3 suggests scheduling box updates from box distances).
+/// its sweep is from the nearest box of the section (as it scanned it, before that tick's splits and
+/// merges: those boxes cover the same walls), and a later sweep wholly inside that distance cannot hit
+/// anything (seed §3 suggests scheduling box updates from box distances).
 ///
 /// Real-time: all storage is sized in the constructor; `first_hit` allocates nothing, takes no lock,
 /// throws nothing.
@@ -207,7 +208,7 @@ class BoundarySection {
   std::uint32_t tick_ = 0;
   int last_level_ = -1;
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
-  Vec2 ball_center_m_;          // free-space ball: no section box comes closer to its centre than its radius
+  Vec2 ball_center_m_;          // free-space ball: no box of the section as last scanned, so no wall, comes closer to its centre than its radius
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
 };
 
