@@ -282,13 +282,18 @@ void BoundarySection::split_hit_boxes(Query& q) {
 }
 
 // Phase 4: siblings whose parent is clear of the sweep by the margin merge into it. Merging only shrinks
-// the section, so it can be lazy: a few parents per tick, taken round-robin, bound the work.
+// the section, so it can be lazy: a few parents per tick (2, and one more per 8 idle entries), taken round-robin.
 void BoundarySection::merge_idle_siblings(Query& q) {
   const Scene& sc = *scene_;
-  constexpr int kMergeChecksPerTick = 4;
+  // Merges must keep up with the splits, or the section grows without bound: with 4 checks per tick and no
+  // more, a long walk over a dense scene grew it to 9 000–18 000 entries (CollisionQuery.
+  // BoundarySectionStaysSmallOnALongWalk; the tick's scan grows with it). So a few checks per tick plus one
+  // per kIdlePerMergeCheck idle entries: a section grown by a burst of splits is merged back.
+  constexpr int kMergeChecksPerTick = 2;
+  constexpr std::size_t kIdlePerMergeCheck = 8;
   const std::size_t n_idle = merge_scratch_.size();
   int checks = 0;
-  for (std::size_t j = 0; j < n_idle && checks < kMergeChecksPerTick; ++j) {
+  for (std::size_t j = 0; j < n_idle && checks < kMergeChecksPerTick + static_cast<int>(n_idle / kIdlePerMergeCheck); ++j) {
     const std::uint32_t node = merge_scratch_[(j + tick_) % n_idle];
     if (!in_section_[node] || node == sc.scene_root()) continue;
     const std::uint32_t parent = sc.parent(node);

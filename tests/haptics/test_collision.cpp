@@ -311,6 +311,38 @@ TEST(CollisionQuery, BoundarySectionFollowsTheHandle) {
   EXPECT_LT(section.section().size(), refined);
 }
 
+// Merges keep up with splits: on a long coherent walk over a dense scene (the hand passing through walls,
+// as bench_first_hit's random walk does) the section stays bounded. With a fixed number of merge checks
+// per tick, whatever the section's size, it grew to thousands of entries on this walk.
+TEST(CollisionQuery, BoundarySectionStaysSmallOnALongWalk) {
+  std::mt19937 rng(23);
+  const Scene sc = Scene::build(random_scene(rng, 150, 150), 6);
+  ASSERT_GT(sc.total_segments(0), 50000u);
+  BoundarySection section(sc);
+  std::normal_distribution<double> turn(0.0, 0.08), dv(0.0, 0.01);
+  Vec2 p{0.0, 0.0};
+  double heading = 0.3, speed = 0.1;  // [rad], [m/s]
+  std::size_t largest = 0, total = 0;
+  constexpr int kTicks = 200000;  // 200 s at 1 kHz
+  for (int i = 0; i < kTicks; ++i) {
+    heading += turn(rng);
+    speed = std::clamp(speed + dv(rng), 0.02, 0.4);
+    Vec2 q = p + (speed * 1e-3) * Vec2{std::cos(heading), std::sin(heading)};
+    if (std::abs(q.x) > 0.06) heading = M_PI - heading;
+    if (std::abs(q.y) > 0.035) heading = -heading;
+    q = {std::clamp(q.x, -0.06, 0.06), std::clamp(q.y, -0.035, 0.035)};
+    section.first_hit(p, q, 1, nullptr, 0, QueryBudget{});
+    largest = std::max(largest, section.section().size());
+    total += section.section().size();
+    p = q;
+  }
+  std::printf("[ info ] section over %d ticks: mean %.1f, largest %zu entries\n", kTicks, static_cast<double>(total) / kTicks, largest);
+  // This scene is dense (300 overlapping curves): ~120 entries near the hand on average are real work.
+  // Merges that could not keep up let the section reach 9 000–18 000 entries on this walk.
+  EXPECT_LE(static_cast<double>(total) / kTicks, 250.0);
+  EXPECT_LE(largest, 1000u);
+}
+
 TEST(CollisionQuery, ExcludedSegmentIsIgnored) {
   Polyline wall;
   wall.points_m = {{-0.02, 0.0}, {0.02, 0.0}};
