@@ -24,7 +24,9 @@ struct Extent {
   double n_max = -std::numeric_limits<double>::infinity();
 };
 
-inline void grow(Extent& e, Vec2 origin, Vec2 axis, Vec2 q) {
+// Grows the extent, in the frame at `origin` with unit `axis`, by q; returns q's frame coordinates (u, n):
+// along the axis and along its left normal [m].
+inline Vec2 grow(Extent& e, Vec2 origin, Vec2 axis, Vec2 q) {
   const Vec2 r = q - origin;
   const double u = dot(r, axis);
   const double n = cross(axis, r);
@@ -32,6 +34,7 @@ inline void grow(Extent& e, Vec2 origin, Vec2 axis, Vec2 q) {
   e.u_max = std::max(e.u_max, u);
   e.n_min = std::min(e.n_min, n);
   e.n_max = std::max(e.n_max, n);
+  return Vec2{u, n};
 }
 
 // Largest |quantised extent| a level's quantum is chosen for (int16 holds ±32767: room for the outward steps).
@@ -333,15 +336,9 @@ class SceneBuild {
   // Grows the extent by q, as grow(), and returns q's squared distance from the segment a + u·axis,
   // 0 ≤ u ≤ length_m [m²]: from the frame coordinates, so that the error costs no second pass.
   static double grow_measuring(Extent& e, Vec2 a, Vec2 axis, double length_m, Vec2 q) {
-    const Vec2 r = q - a;
-    const double u = dot(r, axis);
-    const double n = cross(axis, r);
-    e.u_min = std::min(e.u_min, u);
-    e.u_max = std::max(e.u_max, u);
-    e.n_min = std::min(e.n_min, n);
-    e.n_max = std::max(e.n_max, n);
-    const double past = u < 0.0 ? u : (u > length_m ? u - length_m : 0.0);  // along the axis, beyond an end
-    return past * past + n * n;
+    const Vec2 un = grow(e, a, axis, q);
+    const double past = un.x < 0.0 ? un.x : (un.x > length_m ? un.x - length_m : 0.0);  // along the axis, beyond an end
+    return past * past + un.y * un.y;
   }
 
   // Level l's quantum (its widest extent / kQuantumSteps) and every segment's extents in it, rounded
