@@ -293,7 +293,7 @@ class SceneBuild {
   // it. Convexity then puts every finer segment and the original sub-polyline inside, which is all a
   // miss must prove (seed §3); children's boxes need not fit inside (issue 18: boxes built from the
   // children's corners were 1.09–1.45x the true deviation). The same pass measures the level's error
-  // (measure_segment_error) from the frame coordinates it computes anyway, then quantises the extents
+  // (grow_measuring) from the frame coordinates it computes anyway, then quantises the extents
   // (quantise_level).
   static void build_segment_boxes(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first,
                                   std::vector<SegmentExtent>& level) {
