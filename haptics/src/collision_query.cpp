@@ -292,8 +292,9 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   constexpr int kMergeChecksPerTick = 2;
   constexpr std::size_t kIdlePerMergeCheck = 8;
   const std::size_t n_idle = merge_scratch_.size();
+  const int max_checks = kMergeChecksPerTick + static_cast<int>(n_idle / kIdlePerMergeCheck);
   int checks = 0;
-  for (std::size_t j = 0; j < n_idle && checks < kMergeChecksPerTick + static_cast<int>(n_idle / kIdlePerMergeCheck); ++j) {
+  for (std::size_t j = 0; j < n_idle && checks < max_checks; ++j) {
     const std::uint32_t node = merge_scratch_[(j + tick_) % n_idle];
     if (!in_section_[node] || node == sc.scene_root()) continue;
     const std::uint32_t parent = sc.parent(node);

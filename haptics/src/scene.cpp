@@ -116,11 +116,13 @@ void box_corners(const ErrorBox& box, Vec2 out[4]) {
 
 double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min), std::abs(box.n_max)); }
 
-double box_error_bound(const ErrorBox& box, double segment_length_m) {
+double box_error_bound_sq(const ErrorBox& box, double segment_length_m) {
   const double overhang = std::max({0.0, -box.u_min, box.u_max - segment_length_m});
   const double half_width = box_half_width(box);
-  return std::sqrt(overhang * overhang + half_width * half_width);
+  return overhang * overhang + half_width * half_width;
 }
+
+double box_error_bound(const ErrorBox& box, double segment_length_m) { return std::sqrt(box_error_bound_sq(box, segment_length_m)); }
 
 std::size_t Scene::hot_bytes() const {
   return points_m_.size() * sizeof(Vec2) + extent_.size() * sizeof(BoxExtent) + tag_.size() * sizeof(std::uint32_t) +
@@ -357,11 +359,10 @@ class SceneBuild {
       const BoxExtent be{quantise(se.e.u_min, q, true), static_cast<std::int16_t>(over), quantise(se.e.n_min, q, true),
                          quantise(se.e.n_max, q, false)};
       scene.extent_[ci.box_offset[l] + k] = be;
-      // box_half_width and box_error_bound of the box as segment_box() rebuilds it, squared (one root per level).
-      const double hw = std::max(std::abs(be.n_min * q), std::abs(be.n_max * q));
-      const double overhang = std::max({0.0, -(be.u_min * q), (se.length_m + be.u_over * q) - se.length_m});
-      half_width = std::max(half_width, hw);
-      bound_sq = std::max(bound_sq, overhang * overhang + hw * hw);
+      // The box's extents as segment_box() rebuilds them (its frame does not matter here).
+      const ErrorBox box{Vec2{}, Vec2{1.0, 0.0}, be.u_min * q, se.length_m + be.u_over * q, be.n_min * q, be.n_max * q};
+      half_width = std::max(half_width, box_half_width(box));
+      bound_sq = std::max(bound_sq, box_error_bound_sq(box, se.length_m));  // one root per level, below
     }
     ci.max_box_half_width_m[l] = half_width;
     ci.max_error_bound_m[l] = std::sqrt(bound_sq);

@@ -66,6 +66,8 @@ double box_half_width(const ErrorBox& box);
 /// combined with how far the box reaches past the segment's ends. A point the box holds is no farther
 /// from the segment than this, so it bounds the error of what the box stands for.
 double box_error_bound(const ErrorBox& box, double segment_length_m);
+/// The square of box_error_bound [m²], without the root: for taking the largest of many boxes with one root.
+double box_error_bound_sq(const ErrorBox& box, double segment_length_m);
 
 /// Where one curve's data sits in the scene arrays, and what was measured of it. Levels 0 .. levels−1.
 /// For setup code and tests; the servo path reads CurveNodes instead.
