@@ -3,13 +3,17 @@
 // (bench/support/embree_peer.hpp); results checked equal before anything is timed. One benchmark iteration is one query, timed on its own (manual time), so
 // the mean and the percentiles describe the same measurements; each includes ~30 ns of clock reads.
 //
+// Methods: ours (first_hit: boundary section, free-space ball, anytime answers at a coarser level),
+//          ours_wide (first_hit_wide: the scene's wide index alone, with a free-space ball from it; first hits
+//          on the synthetic scenes only), rtree, embree, brute.
 // Names: BM_FirstHit/<method>/<segments>  — synthetic scenes tiled from real pictures, random-walk hand
 //        BM_Closest/<method>/<segments>   — closest point on the same scenes
 //        BM_Picture/<method>/<picture>    — the handle sweeps of an explore raster run on that picture
 //        BM_Level/<method>/<level>        — speed against accuracy: 4 pictures, queries at each level
 // Counters: p50_ns, p99_ns, max_ns per query; build_ms; bytes_per_segment; segments; max_error_mm; for
-//           ours, full_query_fraction (queries the free-space ball did not answer) and section_entries
-//           (mean boundary-section size after a query).
+//           ours and ours_wide, full_query_fraction (queries the free-space ball did not answer),
+//           section_entries (mean boundary-section size after a query; 0 for ours_wide), box_tests and
+//           segment_tests (per query).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -77,6 +81,14 @@ void check_equal(Case& c, std::size_t n) {
     const Sweep& s = c.stream[i];
     const SweepHit h = fresh.first_hit(s.a, s.b, c.level, nullptr, 0, QueryBudget{});
     const PeerHit b = c.brute->first_hit(s.a, s.b);
+    {
+      QueryBudget unlimited;
+      const SweepHit w = fresh.first_hit_wide(s.a, s.b, c.level, nullptr, 0, unlimited);
+      if (w.hit != b.hit || (b.hit && w.t != b.t)) {
+        std::fprintf(stderr, "wide disagrees on %s query %zu (wide %d %.17g brute %d %.17g)\n", c.name.c_str(), i, w.hit, w.t, b.hit, b.t);
+        std::exit(2);
+      }
+    }
     const PeerHit r = c.rtree->first_hit(s.a, s.b);
     const PeerHit e = c.embree->first_hit(s.a, s.b);
     if (h.hit != b.hit || r.hit != b.hit || e.hit != b.hit || (b.hit && (h.t != b.t || r.t != b.t || e.t != b.t))) {
@@ -102,13 +114,14 @@ void check_equal(Case& c, std::size_t n) {
                std::min(n, c.stream.size()), hits);
 }
 
-enum class Method { Ours, Brute, Rtree, Embree };
+enum class Method { Ours, Brute, Rtree, Embree, Wide };
 const char* method_name(Method m) {
   switch (m) {
     case Method::Ours: return "ours";
     case Method::Brute: return "brute";
     case Method::Rtree: return "rtree";
     case Method::Embree: return "embree";
+    case Method::Wide: return "ours_wide";
   }
   return "?";
 }
@@ -125,7 +138,7 @@ void set_percentiles(benchmark::State& state, std::vector<double>& ns) {
 void run_first_hit(benchmark::State& state, Case* c, Method m) {
   std::vector<double> ns;
   ns.reserve(1 << 20);
-  std::size_t i = 0, hits = 0, full = 0, section = 0;
+  std::size_t i = 0, hits = 0, full = 0, section = 0, seg_tests = 0, box_tests = 0;
   for (auto _ : state) {
     const Sweep& s = c->stream[i];
     i = i + 1 == c->stream.size() ? 0 : i + 1;
@@ -134,6 +147,9 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     bool hit = false;
     if (m == Method::Ours) {
       hit = c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}, &st).hit;
+    } else if (m == Method::Wide) {
+      QueryBudget unlimited;
+      hit = c->ours->first_hit_wide(s.a, s.b, c->level, nullptr, 0, unlimited, &st).hit;
     } else if (m == Method::Brute) {
       hit = c->brute->first_hit(s.a, s.b).hit;
     } else if (m == Method::Rtree) {
@@ -145,12 +161,19 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     state.SetIterationTime(dt);
     if (ns.size() < ns.capacity()) ns.push_back(dt * 1e9);
     hits += hit;
+    seg_tests += static_cast<std::size_t>(st.segment_tests);
+    box_tests += static_cast<std::size_t>(st.box_tests);
     full += st.box_tests > 0;  // a full query (not answered by the free-space ball)
     section += static_cast<std::size_t>(st.section_size);
     benchmark::DoNotOptimize(hit);
   }
   set_percentiles(state, ns);
-  if (m == Method::Ours) {
+  if (m == Method::Ours || m == Method::Wide) {
+    const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+    state.counters["segment_tests"] = static_cast<double>(seg_tests) / n;  // per query
+    state.counters["box_tests"] = static_cast<double>(box_tests) / n;
+  }
+  if (m == Method::Ours || m == Method::Wide) {
     const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
     state.counters["full_query_fraction"] = static_cast<double>(full) / n;
     state.counters["section_entries"] = static_cast<double>(section) / n;
@@ -159,7 +182,7 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
   state.counters["segments"] = segs;
   state.counters["hit_fraction"] = static_cast<double>(hits) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
   state.counters["max_error_mm"] = c->max_error_mm;
-  if (m == Method::Ours) {
+  if (m == Method::Ours || m == Method::Wide) {
     state.counters["build_ms"] = c->build_ms_ours;
     state.counters["bytes_per_segment"] = static_cast<double>(c->scene->hot_bytes()) / segs;
   } else if (m == Method::Brute) {
@@ -240,9 +263,10 @@ int main(int argc, char** argv) {
     auto c = make_case(std::to_string(n), std::move(curves), 0, random_walk_stream(plane, 100000));
     check_equal(*c, n >= 1000000 ? 300 : 3000);
     Case* cp = c.get();
-    for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute}) {
+    for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute, Method::Wide}) {
       benchmark::RegisterBenchmark(("BM_FirstHit/" + std::string(method_name(m)) + "/" + std::to_string(n)).c_str(),
                                    [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+      if (m == Method::Wide) continue;  // a first-hit variant only: closest_point already walks the wide index
       benchmark::RegisterBenchmark(("BM_Closest/" + std::string(method_name(m)) + "/" + std::to_string(n)).c_str(),
                                    [cp, m](benchmark::State& s) { run_closest(s, cp, m); })->UseManualTime();
     }

@@ -5,6 +5,10 @@
 #include <cmath>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace hk {
 namespace {
 
@@ -90,6 +94,8 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   list_entries_.resize(kClosestListCapacity);
   hit_stamp_.assign(n, 0);
   merge_stamp_.assign(n, 0);
+  seen_stamp_.assign(n, 0);
+  wide_stack_.resize(scene.wide_index().stack_entries());
   reset();
 }
 
@@ -99,6 +105,7 @@ void BoundarySection::reset() {
   section_.clear();
   section_box_.clear();
   ball_radius_m_ = 0.0;
+  wide_ball_radius_m_ = 0.0;
   if (scene_->curve_count() == 0) return;
   const std::uint32_t r = scene_->scene_root();
   section_.push_back(r);
@@ -132,6 +139,7 @@ struct BoundarySection::Query {
   std::uint32_t unresolved_node = 0;
   double nearest_sq = std::numeric_limits<double>::infinity();  // squared distance from b to the section's nearest box
   QueryStats st;
+  bool wide_refused = false;  // a wide node was left unopened for want of budget (which may not be quite spent)
 
   // A section entry's clip: always done and charged, even past the budget.
   void charge_section_box() noexcept {
@@ -143,6 +151,15 @@ struct BoundarySection::Query {
   bool spend_box() noexcept {
     if (!budget->spend()) return false;
     ++st.box_tests;
+    return true;
+  }
+  // A wide node's four rectangles: all or none.
+  bool spend_wide_node() noexcept {
+    if (!budget->spend(kWideBoxTestsPerNode)) {
+      wide_refused = true;
+      return false;
+    }
+    st.box_tests += kWideBoxTestsPerNode;
     return true;
   }
   bool is_excluded(SegmentRef s) const noexcept {
@@ -350,8 +367,10 @@ SweepHit BoundarySection::finish(Query& q) const {
     best.hit = false;
     best.blocked = true;
     best.t = q.unresolved_t;
-    const NodeInfo in = sc.info(q.unresolved_node);
-    if (sc.is_chunk(q.unresolved_node)) {
+    const NodeInfo in = q.unresolved_node == kWideEmpty ? NodeInfo{} : sc.info(q.unresolved_node);
+    if (q.unresolved_node == kWideEmpty) {  // a node of the wide index: above the curves
+      best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
+    } else if (sc.is_chunk(q.unresolved_node)) {
       const int top = static_cast<int>(sc.curve_nodes(in.curve).levels) - 1;
       best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), top, static_cast<std::int32_t>(in.index)};
     } else if (!sc.is_segment(q.unresolved_node)) {  // above the curves: no segment to name yet
@@ -369,6 +388,217 @@ SweepHit BoundarySection::finish(Query& q) const {
   q.st.budget_exhausted = q.budget->exhausted();
   q.st.section_size = static_cast<std::int32_t>(section_.size());
   return best;
+}
+
+// ---- Walks of the wide index (wide_index.hpp) ----
+
+namespace {
+
+#if defined(__SSE2__)
+using F4 = __m128;
+inline F4 load4(const float* p) { return _mm_load_ps(p); }
+inline F4 splat(float x) { return _mm_set1_ps(x); }
+#endif
+
+// Entry parameters of the sweep into a node's four rectangles: bit i of the result is set when the
+// sweep meets rectangle i at a parameter ≤ horizon, and t_enter[i] is where it enters. The sweep is
+// given as its start and the reciprocals of its extent (±1e20 for a zero extent: a start inside the
+// slab spans every parameter, one outside it none).
+inline int sweep_node(const WideNode& n, float ax, float ay, float ix, float iy, float horizon, float t_enter[4]) {
+#if defined(__SSE2__)
+  const F4 vax = splat(ax), vay = splat(ay), vix = splat(ix), viy = splat(iy);
+  const F4 tx0 = _mm_mul_ps(_mm_sub_ps(load4(n.lo_x), vax), vix), tx1 = _mm_mul_ps(_mm_sub_ps(load4(n.hi_x), vax), vix);
+  const F4 ty0 = _mm_mul_ps(_mm_sub_ps(load4(n.lo_y), vay), viy), ty1 = _mm_mul_ps(_mm_sub_ps(load4(n.hi_y), vay), viy);
+  const F4 t_in = _mm_max_ps(_mm_max_ps(_mm_min_ps(tx0, tx1), _mm_min_ps(ty0, ty1)), _mm_setzero_ps());
+  const F4 t_out = _mm_min_ps(_mm_min_ps(_mm_max_ps(tx0, tx1), _mm_max_ps(ty0, ty1)), splat(1.0f));
+  _mm_storeu_ps(t_enter, t_in);
+  return _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t_in, t_out), _mm_cmple_ps(t_in, splat(horizon))));
+#else
+  int mask = 0;
+  for (int i = 0; i < 4; ++i) {
+    const float tx0 = (n.lo_x[i] - ax) * ix, tx1 = (n.hi_x[i] - ax) * ix;
+    const float ty0 = (n.lo_y[i] - ay) * iy, ty1 = (n.hi_y[i] - ay) * iy;
+    const float t_in = std::max(std::max(std::min(tx0, tx1), std::min(ty0, ty1)), 0.0f);
+    const float t_out = std::min(std::min(std::max(tx0, tx1), std::max(ty0, ty1)), 1.0f);
+    t_enter[i] = t_in;
+    if (t_in <= t_out && t_in <= horizon) mask |= 1 << i;
+  }
+  return mask;
+#endif
+}
+
+// Squared distances from (px, py) to a node's four rectangles [m²] (0 inside); bit i of the result is
+// set when rectangle i is within bound_sq.
+inline int near_node(const WideNode& n, float px, float py, float bound_sq, float d_sq[4]) {
+#if defined(__SSE2__)
+  const F4 vpx = splat(px), vpy = splat(py), zero = _mm_setzero_ps();
+  const F4 dx = _mm_max_ps(_mm_max_ps(_mm_sub_ps(load4(n.lo_x), vpx), _mm_sub_ps(vpx, load4(n.hi_x))), zero);
+  const F4 dy = _mm_max_ps(_mm_max_ps(_mm_sub_ps(load4(n.lo_y), vpy), _mm_sub_ps(vpy, load4(n.hi_y))), zero);
+  const F4 d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+  _mm_storeu_ps(d_sq, d2);
+  return _mm_movemask_ps(_mm_cmple_ps(d2, splat(bound_sq)));
+#else
+  int mask = 0;
+  for (int i = 0; i < 4; ++i) {
+    const float dx = std::max(std::max(n.lo_x[i] - px, px - n.hi_x[i]), 0.0f);
+    const float dy = std::max(std::max(n.lo_y[i] - py, py - n.hi_y[i]), 0.0f);
+    d_sq[i] = dx * dx + dy * dy;
+    if (d_sq[i] <= bound_sq) mask |= 1 << i;
+  }
+  return mask;
+#endif
+}
+
+// Reciprocal of a sweep extent for sweep_node: ±1e20 in place of 1/0 or of an overflow.
+inline float slab_reciprocal(double d) {
+  const float f = static_cast<float>(d);
+  if (std::abs(f) < 1e-20f) return d < 0.0 ? -1e20f : 1e20f;
+  return 1.0f / f;
+}
+
+// A float at least x (x ≥ 0): bounds compared against float distances must not shrink in the rounding.
+inline float float_at_least(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+}  // namespace
+
+// The segments a walk tests at an item (segment node `item` of the item level): the target level's
+// segments under it, or the one over it. Writes the first node and returns the count.
+std::uint32_t BoundarySection::item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept {
+  const Scene& sc = *scene_;
+  const std::uint32_t c = sc.tag_curve(item);
+  const int k_level = sc.tag_level(item);
+  const CurveNodes& cn = sc.curve_nodes(c);
+  const std::uint32_t k = item - cn.box_offset[k_level];
+  const int l = sc.clamp_level(c, level);
+  if (l >= k_level) {
+    *first = cn.box_offset[l] + (k >> (l - k_level));
+    return 1;
+  }
+  *first = cn.box_offset[l] + (k << (k_level - l));
+  return 1u << (k_level - l);
+}
+
+// Pushes the hit children of a wide node, the nearest on top. False when the stack is full.
+bool BoundarySection::push_wide(const WideNode& n, int mask, const float key[4], int& top) noexcept {
+  const int base = top;
+  for (int i = 0; i < 4; ++i) {
+    if (!(mask & (1 << i))) continue;
+    if (static_cast<std::size_t>(top) >= wide_stack_.size()) {
+      top = base;
+      return false;
+    }
+    WideEntry e{key[i], n.child[i]};
+    int k = top++;
+    for (; k > base && wide_stack_[static_cast<std::size_t>(k - 1)].key < e.key; --k) wide_stack_[static_cast<std::size_t>(k)] = wide_stack_[static_cast<std::size_t>(k - 1)];
+    wide_stack_[static_cast<std::size_t>(k)] = e;
+  }
+  return true;
+}
+
+// The first hit through the wide index: a depth-first walk, nearest entry first, pruned past the best
+// hit. Each wide node opened is four box tests (its four rectangles, in one SIMD test); past the budget
+// nodes are not opened, and the nearest of them bounds what is proven clear.
+void BoundarySection::wide_sweep(Query& q) {
+  const Scene& sc = *scene_;
+  const WideIndex& wi = sc.wide_index();
+  if (wi.nodes.empty()) return;
+  const float ax = static_cast<float>(q.a.x), ay = static_cast<float>(q.a.y);
+  const float ix = slab_reciprocal(q.b.x - q.a.x), iy = slab_reciprocal(q.b.y - q.a.y);
+  int top = 0;
+  wide_stack_[static_cast<std::size_t>(top++)] = WideEntry{0.0f, 0u};
+  while (top > 0) {
+    const WideEntry e = wide_stack_[static_cast<std::size_t>(--top)];
+    if (static_cast<double>(e.key) > q.horizon()) continue;
+    if (e.code & kWideLeaf) {
+      std::uint32_t first = 0;
+      const std::uint32_t count = item_segments(e.code & ~kWideLeaf, q.level, &first);
+      for (std::uint32_t i = 0; i < count; ++i) {
+        Vec2 p0, p1;
+        sc.segment_points(first + i, &p0, &p1);
+        const Aabb r{{std::min(p0.x, p1.x), std::min(p0.y, p1.y)}, {std::max(p0.x, p1.x), std::max(p0.y, p1.y)}};
+        if (overlaps(r, q.sweep, 0.0)) test_segment(q, first + i);  // the rectangles apart: no common point
+      }
+      continue;
+    }
+    if (!q.spend_wide_node()) {
+      if (e.key < q.unresolved_t) {
+        q.unresolved_t = e.key;
+        q.unresolved_node = kWideEmpty;
+      }
+      continue;
+    }
+    const WideNode& n = wi.nodes[e.code];
+    float t_enter[4];
+    const double h = q.horizon();
+    const int mask = sweep_node(n, ax, ay, ix, iy, h > 1.0 ? 1.0f : float_at_least(h), t_enter);
+    if (mask && !push_wide(n, mask, t_enter, top) && e.key < q.unresolved_t) {
+      q.unresolved_t = e.key;  // the stack is full: as past the budget
+      q.unresolved_node = kWideEmpty;
+    }
+  }
+}
+
+// The free-space ball of the wide path: a lower bound on the distance from p to every item rectangle,
+// so to every wall of every level, capped at cap_m [m]. A nearest-first walk that stops refining once
+// nothing nearer can be found; a leaf's rectangle distance is taken as it is (no exact segment tests).
+// Each node opened is four optional box tests: when the budget runs out the ball is unknown (0).
+double BoundarySection::wide_clearance(Query& q, double cap_m) {
+  const WideIndex& wi = scene_->wide_index();
+  if (wi.nodes.empty()) return cap_m;
+  const float px = static_cast<float>(q.b.x), py = static_cast<float>(q.b.y);
+  float bound_sq = static_cast<float>(cap_m * cap_m);
+  int top = 0;
+  wide_stack_[static_cast<std::size_t>(top++)] = WideEntry{0.0f, 0u};
+  while (top > 0) {
+    const WideEntry e = wide_stack_[static_cast<std::size_t>(--top)];
+    if (e.key >= bound_sq) continue;
+    if (e.code & kWideLeaf) {
+      bound_sq = e.key;  // a wall may be this near: the new bound (the walk goes on for anything nearer)
+      continue;
+    }
+    if (!q.spend_wide_node()) return 0.0;
+    const WideNode& n = wi.nodes[e.code];
+    float d_sq[4];
+    const int mask = near_node(n, px, py, bound_sq, d_sq);
+    if (mask && !push_wide(n, mask, d_sq, top)) return 0.0;  // the stack is full: unknown
+  }
+  // The float distances bound the padded rectangles' from below up to a few ulps; the factor keeps the
+  // ball strictly inside what the exact rectangles allow.
+  return std::sqrt(static_cast<double>(bound_sq)) * (1.0 - 1e-6);
+}
+
+SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
+                                         QueryBudget& budget, QueryStats* stats_out) {
+  const double r_sq = wide_ball_radius_m_ * wide_ball_radius_m_;
+  if (length_sq(a - wide_ball_center_m_) < r_sq && length_sq(b - wide_ball_center_m_) < r_sq) {
+    if (stats_out) *stats_out = QueryStats{};
+    SweepHit clear;
+    clear.point_m = b;
+    return clear;
+  }
+  Query q;
+  q.a = a;
+  q.b = b;
+  q.sweep = Aabb{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
+  q.level = level;
+  q.excluded = excluded;
+  q.excluded_count = excluded_count;
+  q.budget = &budget;
+  q.best.t = std::numeric_limits<double>::infinity();
+  q.best.point_m = b;
+  wide_sweep(q);
+  const bool clear = !q.best.hit && q.unresolved_t == std::numeric_limits<double>::infinity();
+  wide_ball_center_m_ = b;
+  wide_ball_radius_m_ = clear ? wide_clearance(q, kWideBallCap_m) : 0.0;
+  const SweepHit answer = finish(q);
+  q.st.section_size = 0;
+  q.st.budget_exhausted = q.st.budget_exhausted || q.wide_refused;
+  if (stats_out) *stats_out = q.st;
+  return answer;
 }
 
 SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
@@ -508,54 +738,59 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
     bound_sq = bound * bound * (1.0 + 1e-12);
   };
   update_bound();
-  const std::uint32_t root = sc.scene_root();
-  if (budget && !budget->spend()) return false;
-  const double dr_sq = box_distance_sq(sc.box(root), p);
-  int top = 0;
-  if (dr_sq <= bound_sq) {
-    stack_[top++] = {dr_sq, root};
-  } else {
-    radius_limit = std::sqrt(dr_sq);  // no segment is nearer than the root's box
-    update_bound();
+  const WideIndex& wi = sc.wide_index();
+  if (++seen_tick_ == 0) {  // stamp wrap-around
+    std::fill(seen_stamp_.begin(), seen_stamp_.end(), 0u);
+    seen_tick_ = 1;
   }
+  const float px = static_cast<float>(p.x), py = static_cast<float>(p.y);
+  int top = 0;
+  wide_stack_[static_cast<std::size_t>(top++)] = WideEntry{0.0f, 0u};
   while (top > 0) {
-    const Candidate cur = stack_[--top];  // t_enter holds the box's squared distance here
-    if (cur.t_enter > bound_sq) continue;  // the bound only shrinks: nothing under it can matter any more
-    if (curve >= 0 && (sc.is_segment(cur.node) || sc.is_chunk(cur.node)) && static_cast<int>(sc.info(cur.node).curve) != curve) continue;
-    if (at_target_level(sc, cur.node, level)) {
-      const NodeInfo in = sc.info(cur.node);
-      const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
-      Vec2 a, b;
-      sc.segment_points(cur.node, &a, &b);
-      const Vec2 q = closest_point_on_segment(p, a, b);
-      const double d_sq = length_sq(p - q);
-      if (d_sq > bound_sq) continue;
-      const double d = std::sqrt(d_sq);  // bit for bit distance(p, q), as the list's scan computes it
-      if (d < bound) list_add(ListEntry{a, b, d, ref}, &radius_limit);
-      if (closer(d, ref, best, best_s)) {
-        best = d;
-        best_s = ref;
-        found = true;
-        if (point_out) *point_out = q;
-        if (segment_out) *segment_out = ref;
+    const WideEntry e = wide_stack_[static_cast<std::size_t>(--top)];  // key: the rectangle's squared distance
+    if (static_cast<double>(e.key) > bound_sq) continue;  // the bound only shrinks: nothing under it can matter any more
+    if (e.code & kWideLeaf) {
+      const std::uint32_t item = e.code & ~kWideLeaf;
+      if (curve >= 0 && static_cast<int>(sc.tag_curve(item)) != curve) continue;
+      std::uint32_t first = 0;
+      const std::uint32_t count = item_segments(item, level, &first);
+      for (std::uint32_t i = 0; i < count; ++i) {
+        const std::uint32_t node = first + i;
+        if (sc.tag_level(node) > sc.tag_level(item)) {  // a coarser segment stands for several items: once per walk
+          if (seen_stamp_[node] == seen_tick_) continue;
+          seen_stamp_[node] = seen_tick_;
+        }
+        Vec2 a, b;
+        sc.segment_points(node, &a, &b);
+        // The rectangle of the end points bounds the distance from below, without a division.
+        const double rx = std::max({std::min(a.x, b.x) - p.x, 0.0, p.x - std::max(a.x, b.x)});
+        const double ry = std::max({std::min(a.y, b.y) - p.y, 0.0, p.y - std::max(a.y, b.y)});
+        if (rx * rx + ry * ry > bound_sq) continue;
+        const NodeInfo in = sc.info(node);
+        const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+        const Vec2 q = closest_point_on_segment(p, a, b);
+        const double d_sq = length_sq(p - q);
+        if (d_sq > bound_sq) continue;
+        const double d = std::sqrt(d_sq);  // bit for bit distance(p, q), as the list's scan computes it
+        if (d < bound) list_add(ListEntry{a, b, d, ref}, &radius_limit);
+        if (closer(d, ref, best, best_s)) {
+          best = d;
+          best_s = ref;
+          found = true;
+          if (point_out) *point_out = q;
+          if (segment_out) *segment_out = ref;
+        }
+        update_bound();
       }
-      update_bound();
       continue;
     }
-    std::uint32_t first = 0, count = 0;
-    sc.children(cur.node, &first, &count);
-    const int base = top;
-    for (std::uint32_t i = 0; i < count; ++i) {
-      if (budget && !budget->spend()) return false;  // unknown: the caller sees budget->ran_out
-      const double d_sq = box_distance_sq(sc.box(first + i), p);
-      if (d_sq > bound_sq) continue;
-      if (!push(top, {d_sq, first + i})) {  // the stack is full: the answer is unknown, as past the budget
-        if (budget) budget->ran_out = true;
-        return false;
-      }
-      // Nearest child on top of the stack (insertion, at most a node's fan-out long): the first leaf
-      // reached is close, so the bound prunes early.
-      for (int k = top - 1; k > base && stack_[k].t_enter > stack_[k - 1].t_enter; --k) std::swap(stack_[k], stack_[k - 1]);
+    if (budget && !budget->spend(kWideBoxTestsPerNode)) return false;  // unknown: the caller sees budget->ran_out
+    const WideNode& n = wi.nodes[e.code];
+    float d_sq[4];
+    const int mask = near_node(n, px, py, float_at_least(bound_sq), d_sq);
+    if (mask && !push_wide(n, mask, d_sq, top)) {  // the stack is full: the answer is unknown, as past the budget
+      if (budget) budget->ran_out = true;
+      return false;
     }
   }
   // Everything within the final bound was reached (boxes farther than the bound at the time were pruned,

@@ -127,7 +127,8 @@ double box_error_bound(const ErrorBox& box, double segment_length_m) { return st
 std::size_t Scene::hot_bytes() const {
   return points_m_.size() * sizeof(Vec2) + extent_.size() * sizeof(BoxExtent) + tag_.size() * sizeof(std::uint32_t) +
          curve_nodes_.size() * sizeof(CurveNodes) + group_box_.size() * sizeof(Aabb) + group_info_.size() * sizeof(NodeInfo) +
-         (group_parent_.size() + group_child_first_.size() + group_child_count_.size() + chunk_of_curve_.size()) * sizeof(std::uint32_t);
+         (group_parent_.size() + group_child_first_.size() + group_child_count_.size() + chunk_of_curve_.size()) * sizeof(std::uint32_t) +
+         wide_.bytes();
 }
 
 Aabb Scene::aabb(std::uint32_t node) const {
@@ -455,6 +456,7 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
     SceneBuild::build_chunk_nodes(scene, chunks, leaf_order);
     SceneBuild::build_hierarchy_nodes(scene, hierarchy, chunks, leaf_order, hierarchy_base);
   }
+  scene.wide_ = WideIndex::build(scene);
   const double t2 = now_ms();
   scene.times_.multires_ms = t1 - t0;
   scene.times_.tree_ms = t2 - t1;

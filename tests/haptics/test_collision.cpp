@@ -414,3 +414,126 @@ TEST(CollisionQuery, ClosestPointEqualsBruteForce) {
     EXPECT_NEAR(distance(p, q), best, 1e-12);
   }
 }
+
+// ── The wide index (wide_index.hpp) ──────────────────────────────────────────────────────────────────
+
+namespace {
+
+// The index's leaves: each item's segment node with its stored rectangle, found by walking every node.
+struct WideLeaf {
+  std::uint32_t node;
+  float lo_x, lo_y, hi_x, hi_y;
+};
+
+std::vector<WideLeaf> wide_leaves(const Scene& sc) {
+  std::vector<WideLeaf> out;
+  for (const WideNode& n : sc.wide_index().nodes) {
+    for (int i = 0; i < 4; ++i) {
+      if (n.child[i] != kWideEmpty && (n.child[i] & kWideLeaf)) out.push_back({n.child[i] & ~kWideLeaf, n.lo_x[i], n.lo_y[i], n.hi_x[i], n.hi_y[i]});
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+// A walk that opens every item rectangle a sweep or ball meets must meet every wall of every level: so
+// every point of every level's polyline lies in some item's rectangle. Checked here on points along each
+// segment of each level against all leaves, without the index's own item-to-segment arithmetic.
+TEST(WideIndex, EveryLevelsPolylineLiesInSomeItemRectangle) {
+  std::mt19937 rng(31);
+  const auto curves = random_scene(rng, 8, 8);
+  const Scene sc = Scene::build(curves, 6);
+  const std::vector<WideLeaf> leaves = wide_leaves(sc);
+  ASSERT_FALSE(leaves.empty());
+  std::size_t points = 0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    for (int l = 0; l < ci.levels; ++l) {
+      for (std::uint32_t s = 0; s < ci.segment_count[l]; ++s) {
+        Vec2 a, b;
+        sc.segment({static_cast<int>(c), l, static_cast<int>(s)}, &a, &b);
+        for (int k = 0; k <= 8; ++k) {
+          const Vec2 p = lerp(a, b, k / 8.0);
+          const bool held = std::any_of(leaves.begin(), leaves.end(), [p](const WideLeaf& r) {
+            return r.lo_x <= p.x && p.x <= r.hi_x && r.lo_y <= p.y && p.y <= r.hi_y;
+          });
+          ASSERT_TRUE(held) << "curve " << c << " level " << l << " segment " << s << " at " << k << "/8";
+          ++points;
+        }
+      }
+    }
+  }
+  EXPECT_GT(points, 20000u);
+}
+
+// Each segment of the item level (a curve's coarsest when it has fewer levels) is a leaf exactly once, and
+// every child slot's rectangle holds the rectangles of the node under it.
+TEST(WideIndex, ItemsAppearOnceAndNodesHoldTheirChildren) {
+  std::mt19937 rng(32);
+  const auto curves = random_scene(rng, 12, 12);
+  const Scene sc = Scene::build(curves, 6);
+  std::vector<int> seen(sc.node_count(), 0);
+  for (const WideLeaf& leaf : wide_leaves(sc)) ++seen[leaf.node];
+  std::size_t items = 0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    const int item = std::min(kWideItemLevel, ci.levels - 1);
+    for (std::uint32_t s = 0; s < ci.segment_count[item]; ++s) {
+      ASSERT_EQ(seen[ci.box_offset[item] + s], 1) << "curve " << c << " segment " << s;
+      ++items;
+    }
+  }
+  EXPECT_EQ(static_cast<std::size_t>(std::count(seen.begin(), seen.end(), 1)), items);
+  const auto& nodes = sc.wide_index().nodes;
+  for (const WideNode& n : nodes) {
+    for (int i = 0; i < 4; ++i) {
+      if (n.child[i] == kWideEmpty || (n.child[i] & kWideLeaf)) continue;
+      ASSERT_LT(n.child[i], nodes.size());
+      const WideNode& below = nodes[n.child[i]];
+      for (int j = 0; j < 4; ++j) {
+        if (below.child[j] == kWideEmpty) continue;
+        ASSERT_TRUE(n.lo_x[i] <= below.lo_x[j] && n.lo_y[i] <= below.lo_y[j] && below.hi_x[j] <= n.hi_x[i] && below.hi_y[j] <= n.hi_y[i]);
+      }
+    }
+  }
+}
+
+// first_hit_wide under a starved budget: never claims clear space past the true first wall, says the
+// budget ran out, and names no segment (no level is known above the items); with budget enough, exact.
+TEST(WideIndex, AnytimeAnswerIsConservative) {
+  std::mt19937 rng(33);
+  const auto curves = random_scene(rng, 6, 6);
+  const Scene sc = Scene::build(curves, 6);
+  std::uniform_real_distribution<double> ux(-0.075, 0.075), uy(-0.05, 0.05);
+  int blocked = 0, exact = 0;
+  for (int i = 0; i < 3000; ++i) {
+    BoundarySection section(sc);
+    const Vec2 a{ux(rng), uy(rng)}, b{ux(rng), uy(rng)};
+    QueryStats st;
+    QueryBudget budget;
+    budget.max_box_tests = 1 + i % 12;
+    const int level = i % 4 == 0 ? 4 : 0;
+    const SweepHit h = section.first_hit_wide(a, b, level, nullptr, 0, budget, &st);
+    double t_ref = 1.0;
+    const bool hit_ref = test::brute_first_hit(sc, a, b, level, &t_ref, nullptr);
+    ASSERT_FALSE(h.hit && h.blocked);
+    ASSERT_LE(budget.box_tests_used, budget.max_box_tests);  // no overrun: the wide walk has no section to scan
+    if (h.blocked) {
+      ++blocked;
+      if (hit_ref) {
+        ASSERT_LE(h.t, t_ref);
+      }
+      EXPECT_EQ(h.segment.level, Scene::kMaxLevels);
+      EXPECT_TRUE(st.budget_exhausted);
+    } else {
+      ++exact;
+      ASSERT_EQ(h.hit, hit_ref) << "query " << i;
+      if (hit_ref) {
+        ASSERT_NEAR(h.t, t_ref, 1e-9);
+      }
+    }
+  }
+  EXPECT_GT(blocked, 500);
+  EXPECT_GT(exact, 100);
+}

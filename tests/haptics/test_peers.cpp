@@ -1,9 +1,11 @@
-// Equal results: our collision tree, brute force, a Boost.Geometry R-tree and Embree answer the same
-// first-hit and closest-point queries identically (the benchmark's peers must be checked, not trusted).
+// Equal results: our collision tree (first_hit with its boundary section, first_hit_wide through the wide
+// index), brute force, a Boost.Geometry R-tree and Embree answer the same first-hit and closest-point
+// queries identically (the benchmark's peers must be checked, not trusted).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "curves.hpp"
@@ -51,32 +53,39 @@ struct Walk {
 
 }  // namespace
 
-// The original small scene, two levels, every query also against brute force and closest points.
+// The original small scene, finer than, at and coarser than the wide index's item level (3), every query
+// also against brute force and closest points.
 TEST(Peers, FirstHitAndClosestPointAgreeAcrossMethods) {
   std::mt19937 rng(40);
   Vec2 half;
   const Scene sc = Scene::build(scene_curves(rng, 24 * 200, &half), 6);
-  for (int level : {0, 3}) {
+  for (int level : {0, 1, 3, 5}) {
     const auto segs = bench::flat_segments(sc, level);
     const bench::BruteForce brute(segs);
     const bench::RtreeIndex rtree(segs);
     const bench::EmbreeIndex embree(segs);
-    BoundarySection ours(sc);
+    BoundarySection ours(sc), wide(sc);
     Walk walk{std::mt19937(41 + level), 0.0005, half};
-    int hits = 0;
+    int hits = 0, ball_answers = 0;
     for (int i = 0; i < 20000; ++i) {
       const Vec2 q = walk.next();
       const Vec2 p = walk.p;
       const SweepHit h = ours.first_hit(p, q, level, nullptr, 0, QueryBudget{});
+      QueryBudget unlimited;
+      QueryStats stw;
+      const SweepHit hw = wide.first_hit_wide(p, q, level, nullptr, 0, unlimited, &stw);
+      ball_answers += stw.box_tests == 0;
       const bench::PeerHit hb = brute.first_hit(p, q);
       const bench::PeerHit hr = rtree.first_hit(p, q);
       const bench::PeerHit he = embree.first_hit(p, q);
       ASSERT_EQ(h.hit, hb.hit) << "query " << i;
+      ASSERT_EQ(hw.hit, hb.hit) << "level " << level << " query " << i;
       ASSERT_EQ(hr.hit, hb.hit) << "query " << i;
       ASSERT_EQ(he.hit, hb.hit) << "query " << i;
       if (hb.hit) {
         ++hits;
         ASSERT_EQ(h.t, hb.t);  // same segment, same formula: bit-identical
+        ASSERT_EQ(hw.t, hb.t);
         ASSERT_EQ(hr.t, hb.t);
         ASSERT_EQ(he.t, hb.t);
       }
@@ -92,6 +101,8 @@ TEST(Peers, FirstHitAndClosestPointAgreeAcrossMethods) {
       walk.p = q;
     }
     EXPECT_GT(hits, 1000);
+    std::printf("level %d: first_hit_wide's ball answered %d of 20000 queries\n", level, ball_answers);
+    EXPECT_GT(ball_answers, 2000);  // the equality covers both of first_hit_wide's paths
   }
 }
 
@@ -110,20 +121,24 @@ TEST_P(PeersAtSize, HundredThousandQueriesAgree) {
   const bench::BruteForce brute(segs);
   const bench::RtreeIndex rtree(segs);
   const bench::EmbreeIndex embree(segs);
-  BoundarySection ours(sc);
+  BoundarySection ours(sc), wide(sc);
   Walk walk{std::mt19937(7), 0.001, half};
   const std::size_t brute_every = target <= 1000 ? 1 : 50;
   int hits = 0, brute_checked = 0, closest_checked = 0;
   for (int i = 0; i < 100000; ++i) {
     const Vec2 p = walk.p, q = walk.next();
     const SweepHit h = ours.first_hit(p, q, 0, nullptr, 0, QueryBudget{});
+    QueryBudget unlimited;
+    const SweepHit hw = wide.first_hit_wide(p, q, 0, nullptr, 0, unlimited);
     const bench::PeerHit hr = rtree.first_hit(p, q);
     const bench::PeerHit he = embree.first_hit(p, q);
     ASSERT_EQ(h.hit, hr.hit) << "query " << i;
+    ASSERT_EQ(hw.hit, hr.hit) << "query " << i;
     ASSERT_EQ(he.hit, hr.hit) << "query " << i;
     if (hr.hit) {
       ++hits;
       ASSERT_EQ(h.t, hr.t) << "query " << i;
+      ASSERT_EQ(hw.t, hr.t) << "query " << i;
       ASSERT_EQ(he.t, hr.t) << "query " << i;
     }
     if (i % brute_every == 0) {

@@ -35,4 +35,9 @@ inline constexpr std::size_t kClosestListCapacity = 64;
 /// 1 mm is 2.5–50 servo ticks of a hand at 0.02–0.4 m/s.
 inline constexpr double kClosestListSkin_m = 1e-3;
 
+/// Largest free-space ball of BoundarySection::first_hit_wide [m]: its clearance walk stops refining past
+/// this distance, so a hand far from every wall costs a few nodes. 4 mm is 10–200 servo ticks of a hand at
+/// 0.02–0.4 m/s.
+inline constexpr double kWideBallCap_m = 4e-3;
+
 }  // namespace hk

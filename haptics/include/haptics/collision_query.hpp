@@ -63,6 +63,16 @@ struct QueryBudget {
     ++box_tests_used;
     return true;
   }
+  /// Charges n optional box tests at once (a wide node's four rectangles, tested together), all or none:
+  /// false (and ran_out set), with nothing charged, when fewer than n are left.
+  bool spend(std::int32_t n) noexcept {
+    if (max_box_tests > 0 && box_tests_used + n > max_box_tests) {
+      ran_out = true;
+      return false;
+    }
+    box_tests_used += n;
+    return true;
+  }
   /// Charges one box test that is done regardless (a section entry's clip).
   void charge() noexcept { ++box_tests_used; }
 };
@@ -87,7 +97,8 @@ struct QueryStats {
   std::int32_t merges = 0;
   std::int32_t section_size = 0;       ///< boundary-section nodes after the query
   std::int32_t coarsest_answer_level = 0;  ///< coarsest level reached by an answer (> target when the budget ran out)
-  bool budget_exhausted = false;       ///< the budget was spent when (or before) this query ended
+  bool budget_exhausted = false;       ///< the budget was spent when (or before) this query ended; for first_hit_wide
+                                       ///< also when a wide node was refused with fewer than its four tests left
 };
 
 /// The boundary section of one scene plus the scratch space of the query. One per servo thread.
@@ -107,6 +118,19 @@ class BoundarySection {
   /// boundary section. Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                      QueryBudget& budget, QueryStats* stats = nullptr);
+  /// The same first hit through the scene's wide index alone (wide_index.hpp), for comparison with
+  /// first_hit: no boundary section. A depth-first walk from the index's root, nearest entry first, pruned
+  /// past the best hit; at an item it tests the target level's segments under or over it. Coherence comes
+  /// from a free-space ball of its own: after a sweep proven clear, a nearest-first walk measures the
+  /// distance from b to the nearest item rectangle (capped at kWideBallCap_m), and a later sweep inside that
+  /// ball is answered at once (the rectangles hold every level's walls, so the ball holds for any level).
+  /// Anytime: each wide node opened is four optional box tests charged to `budget` (its four rectangles,
+  /// in one SIMD test); past it, nodes are not opened and the answer is blocked at the entry of the nearest
+  /// one, with segment {-1, kMaxLevels, -1}: unlike first_hit, no coarser level's segment is known there.
+  /// Same answers as first_hit otherwise (t bit for bit; checked against brute force in the tests).
+  /// Does not read or change the boundary section. Real-time safe.
+  SweepHit first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
+                          QueryStats* stats = nullptr);
   /// The same for a one-off query: spends a copy of `budget` (tests, benches). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                      const QueryBudget& budget, QueryStats* stats = nullptr) {
@@ -119,8 +143,10 @@ class BoundarySection {
   /// the same distance (a vertex two segments share) the smallest (curve, level, segment) is the answer,
   /// so it does not depend on the order anything was visited in.
   ///
-  /// Coherent between calls, like the first hit's free-space ball: a box-distance-pruned walk from the
-  /// root (which neither uses nor changes the frontier) also collects a neighbour list, every segment
+  /// Coherent between calls, like the first hit's free-space ball: a distance-pruned walk of the scene's
+  /// wide index (wide_index.hpp; nearest rectangle first, four rectangles per SIMD test, the target level's
+  /// segments under or over each item reached; it neither uses nor changes the frontier) also collects a
+  /// neighbour list, every segment
   /// within R = (closest distance) + kClosestListSkin_m of p0 (at most kClosestListCapacity of them; past
   /// that the nearest are kept and R shrinks to the nearest one dropped). A later call with the same
   /// level and curve at p, δ = |p − p0| from it, scans only the list: any segment within d of p is within
@@ -128,7 +154,7 @@ class BoundarySection {
   /// d + δ < R, the list holds every candidate and its answer is exact; otherwise the walk runs again
   /// (the Verlet neighbour list of molecular dynamics, Verlet 1967, with the proxy's coherence of seed §3).
   ///
-  /// With a `budget`, each box-distance test of a walk is an optional box test charged to it (a call
+  /// With a `budget`, each wide node a walk opens is four optional box tests charged to it (a call
   /// answered from the list charges none); when it runs out the walk stops and returns false with
   /// budget->ran_out set (the answer is then unknown, not "nothing close"), and the list is dropped.
   /// Allocates nothing.
@@ -156,6 +182,16 @@ class BoundarySection {
   void compact_section(Query& q);
   SweepHit finish(Query& q) const;
   void split(std::uint32_t node);
+  // The walks of the wide index (wide_index.hpp).
+  struct WideEntry { float key; std::uint32_t code; };  // 8 bytes: an entry parameter or squared distance, a child code
+  static_assert(sizeof(WideEntry) == 8, "WideEntry: 8 bytes");
+  std::uint32_t item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept;
+  bool push_wide(const WideNode& n, int mask, const float key[4], int& top) noexcept;
+  void wide_sweep(Query& q);
+  double wide_clearance(Query& q, double cap_m);
+  std::vector<WideEntry> wide_stack_;      // the wide walks' stack (WideIndex::stack_entries)
+  std::vector<std::uint32_t> seen_stamp_;  // per node: closest-point walk in which a coarser segment was last tested
+  std::uint32_t seen_tick_ = 0;
   const Scene* scene_;
   double merge_margin_m_;
   std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
@@ -210,6 +246,8 @@ class BoundarySection {
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
   Vec2 ball_center_m_;          // free-space ball: no box of the section as last scanned, so no wall, comes closer to its centre than its radius
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
+  Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of any level) comes closer
+  double wide_ball_radius_m_ = 0.0;  // [m]; 0 = unknown
 };
 
 }  // namespace hk

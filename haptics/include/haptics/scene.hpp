@@ -28,6 +28,7 @@
 
 #include "haptics/multires.hpp"
 #include "haptics/vec2.hpp"
+#include "haptics/wide_index.hpp"
 #include "hk/constants.hpp"
 
 namespace hk {
@@ -274,6 +275,9 @@ class Scene {
   Vec2 bounds_min() const { return bounds_min_; }
   Vec2 bounds_max() const { return bounds_max_; }
   const SceneBuildTimes& build_times() const { return times_; }
+  /// The spatial 4-wide index over the item-level error boxes (wide_index.hpp), which the walks of
+  /// first_hit and closest_point use instead of the curve-following hierarchy above the items.
+  const WideIndex& wide_index() const { return wide_; }
 
  private:
   friend class SceneBuild;  // the build phases (scene.cpp)
@@ -298,6 +302,7 @@ class Scene {
   std::size_t skipped_ = 0;
   Vec2 bounds_min_{0, 0}, bounds_max_{0, 0};
   SceneBuildTimes times_;
+  WideIndex wide_;
 };
 
 }  // namespace hk

@@ -1,0 +1,160 @@
+// The spatial 4-wide index over the collision tree's item-level error boxes (wide_index.hpp).
+#include "haptics/wide_index.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "haptics/scene.hpp"
+
+namespace hk {
+namespace {
+
+// One item while building: its segment node, its rectangle (exact, in double) and the rectangle's centre.
+struct Item {
+  std::uint32_t node;
+  Aabb rect;
+  Vec2 centre;
+};
+
+void extend(Aabb& r, Vec2 p) {
+  r.lo = {std::min(r.lo.x, p.x), std::min(r.lo.y, p.y)};
+  r.hi = {std::max(r.hi.x, p.x), std::max(r.hi.y, p.y)};
+}
+
+Aabb merged(const Aabb& a, const Aabb& b) {
+  return Aabb{{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y)}, {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y)}};
+}
+
+// The rectangle of item k (segment k of level `item` of curve c): its error box and the pieces of every
+// coarser level's segments that stand for it (wide_index.hpp).
+Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) {
+  const CurveInfo& ci = sc.curve(c);
+  Aabb r = sc.aabb(ci.box_offset[item] + k);
+  for (int l = item + 1; l < ci.levels; ++l) {
+    const int d = l - item;
+    const std::uint32_t s = k >> d;
+    Vec2 p0, p1;
+    sc.segment(SegmentRef{static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(s)}, &p0, &p1);
+    if (ci.segment_count[l - 1] != 2 * ci.segment_count[l]) {  // not a dyadic split: the whole segment
+      extend(r, p0);
+      extend(r, p1);
+      continue;
+    }
+    const double pieces = std::ldexp(1.0, d);
+    const double i = static_cast<double>(k & ((1u << d) - 1u));
+    extend(r, lerp(p0, p1, i / pieces));
+    extend(r, lerp(p0, p1, (i + 1.0) / pieces));
+  }
+  return r;
+}
+
+// Largest float not above x, and smallest not below.
+float round_down(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+float round_up(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+class Builder {
+ public:
+  Builder(std::vector<Item>& items, double pad_m, WideIndex& out) : items_(items), pad_m_(pad_m), out_(out) {}
+
+  // Builds the node over items [begin, end) at `depth`; returns its rectangle. The items are cut into four
+  // runs along the longer axis of their centres, in sizes that are multiples of C, the largest power of 4
+  // below their count (the last run takes the rest): every run of C items then makes a full subtree, so the
+  // nodes are nearly all full, about one per three items.
+  Aabb build_node(std::size_t node, std::size_t begin, std::size_t end, int depth) {
+    out_.depth = std::max(out_.depth, depth);
+    const std::size_t m = end - begin;
+    std::size_t run = 1;  // C
+    while (run * 4 < m) run *= 4;
+    // Two cuts on the longer axis, then one in each half on the longer axis of that half.
+    std::size_t cut[5] = {begin, 0, 0, 0, end};
+    cut[2] = split(begin, end, begin + std::min(m, 2 * run));
+    cut[1] = split(begin, cut[2], begin + std::min(cut[2] - begin, run));
+    cut[3] = split(cut[2], end, cut[2] + std::min(end - cut[2], run));
+    Aabb whole{{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()},
+               {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}};
+    for (int i = 0; i < 4; ++i) {
+      const std::size_t b = cut[i], e = cut[i + 1];
+      if (b == e) {
+        set_slot(node, i, Aabb{{1e30, 1e30}, {1e30, 1e30}}, kWideEmpty, 0.0);
+        continue;
+      }
+      Aabb r;
+      std::uint32_t code = 0;
+      if (e - b == 1) {
+        r = items_[b].rect;
+        code = kWideLeaf | items_[b].node;
+      } else {
+        const std::size_t child = out_.nodes.size();
+        out_.nodes.emplace_back();
+        r = build_node(child, b, e, depth + 1);
+        code = static_cast<std::uint32_t>(child);
+      }
+      set_slot(node, i, r, code, pad_m_);
+      whole = merged(whole, r);
+    }
+    return whole;
+  }
+
+ private:
+  // Partial sort of [begin, end) on the longer axis of its centres so that [begin, mid) holds the lowest;
+  // returns mid (begin ≤ mid ≤ end).
+  std::size_t split(std::size_t begin, std::size_t end, std::size_t mid) {
+    if (mid <= begin || mid >= end) return mid;
+    Aabb c{items_[begin].centre, items_[begin].centre};
+    for (std::size_t i = begin; i < end; ++i) extend(c, items_[i].centre);
+    const bool along_x = c.hi.x - c.lo.x >= c.hi.y - c.lo.y;
+    std::nth_element(items_.begin() + static_cast<std::ptrdiff_t>(begin), items_.begin() + static_cast<std::ptrdiff_t>(mid),
+                     items_.begin() + static_cast<std::ptrdiff_t>(end), [along_x](const Item& x, const Item& y) {
+                       return along_x ? x.centre.x < y.centre.x : x.centre.y < y.centre.y;
+                     });
+    return mid;
+  }
+  void set_slot(std::size_t node, int i, const Aabb& r, std::uint32_t code, double pad_m) {
+    WideNode& n = out_.nodes[node];
+    n.lo_x[i] = round_down(r.lo.x - pad_m);
+    n.lo_y[i] = round_down(r.lo.y - pad_m);
+    n.hi_x[i] = round_up(r.hi.x + pad_m);
+    n.hi_y[i] = round_up(r.hi.y + pad_m);
+    n.child[i] = code;
+  }
+  std::vector<Item>& items_;
+  double pad_m_;
+  WideIndex& out_;
+};
+
+}  // namespace
+
+WideIndex WideIndex::build(const Scene& sc) {
+  WideIndex index;
+  std::vector<Item> items;
+  double largest = 0.0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    const int item = std::min(kWideItemLevel, ci.levels - 1);
+    for (std::uint32_t k = 0; k < ci.segment_count[item]; ++k) {
+      const Aabb r = item_rect(sc, c, item, k);
+      items.push_back(Item{ci.box_offset[item] + k, r, 0.5 * (r.lo + r.hi)});
+      largest = std::max({largest, std::abs(r.lo.x), std::abs(r.lo.y), std::abs(r.hi.x), std::abs(r.hi.y)});
+    }
+  }
+  if (items.empty()) return index;
+  const double pad_m = 1e-9 + std::ldexp(largest, -18);
+  index.nodes.reserve(items.size() / 3 + 64);
+  index.nodes.emplace_back();
+  Builder builder(items, pad_m, index);
+  // One item builds a root with three empty slots and a leaf.
+  builder.build_node(0, 0, items.size(), 1);
+  index.nodes.shrink_to_fit();
+  return index;
+}
+
+}  // namespace hk
