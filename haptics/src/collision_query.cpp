@@ -96,6 +96,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   merge_stamp_.assign(n, 0);
   seen_stamp_.assign(n, 0);
   wide_stack_.resize(scene.wide_index().stack_entries());
+  walk_stack_.resize(scene.wide_index().stack_entries());
   reset();
 }
 
@@ -499,76 +500,83 @@ bool BoundarySection::push_wide(const WideNode& n, int mask, const float key[4],
   return true;
 }
 
-// The first hit through the wide index: a depth-first walk, nearest entry first, pruned past the best
-// hit. Each wide node opened is four box tests (its four rectangles, in one SIMD test); past the budget
-// nodes are not opened, and the nearest of them bounds what is proven clear.
-void BoundarySection::wide_sweep(Query& q) {
+// Tests the sweep against the target level's segments at an item (a cheap rectangle test first).
+void BoundarySection::wide_test_item(Query& q, std::uint32_t item) {
   const Scene& sc = *scene_;
-  const WideIndex& wi = sc.wide_index();
-  if (wi.nodes.empty()) return;
+  std::uint32_t first = 0;
+  const std::uint32_t count = item_segments(item, q.level, &first);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    Vec2 p0, p1;
+    sc.segment_points(first + i, &p0, &p1);
+    const Aabb r{{std::min(p0.x, p1.x), std::min(p0.y, p1.y)}, {std::max(p0.x, p1.x), std::max(p0.y, p1.y)}};
+    if (overlaps(r, q.sweep, 0.0)) test_segment(q, first + i);  // the rectangles apart: no common point
+  }
+}
+
+// One walk of the wide index for both answers of first_hit_wide: the first hit of the sweep, and the
+// free-space ball at its end. A child is entered when the sweep meets its rectangle before the best hit
+// so far (for the hit) or when its rectangle is nearer to b than the ball so far (for the ball), nearest
+// to b first, so that the ball shrinks early. At an item the sweep is tested exactly; for the ball the
+// item rectangle's own distance is taken as it is (it bounds every wall under it from below). Each node
+// opened is four box tests (its four rectangles, in one SIMD test); past the budget nodes are not opened:
+// the nearest such node the sweep enters bounds what is proven clear, and the ball is unknown. Returns
+// the ball's radius [m] (0 when unknown).
+double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
+  const WideIndex& wi = scene_->wide_index();
+  if (wi.nodes.empty()) return ball_cap_m;
   const float ax = static_cast<float>(q.a.x), ay = static_cast<float>(q.a.y);
+  const float bx = static_cast<float>(q.b.x), by = static_cast<float>(q.b.y);
   const float ix = slab_reciprocal(q.b.x - q.a.x), iy = slab_reciprocal(q.b.y - q.a.y);
+  float ball_sq = static_cast<float>(ball_cap_m * ball_cap_m);
+  bool ball_known = true;
   int top = 0;
-  wide_stack_[static_cast<std::size_t>(top++)] = WideEntry{0.0f, 0u};
+  walk_stack_[static_cast<std::size_t>(top++)] = WalkEntry{0.0f, 0.0f, 0u};
   while (top > 0) {
-    const WideEntry e = wide_stack_[static_cast<std::size_t>(--top)];
-    if (static_cast<double>(e.key) > q.horizon()) continue;
+    const WalkEntry e = walk_stack_[static_cast<std::size_t>(--top)];
+    const bool for_hit = static_cast<double>(e.t_enter) <= q.horizon();
+    const bool for_ball = e.d_sq < ball_sq;
+    if (!for_hit && !for_ball) continue;
     if (e.code & kWideLeaf) {
-      std::uint32_t first = 0;
-      const std::uint32_t count = item_segments(e.code & ~kWideLeaf, q.level, &first);
-      for (std::uint32_t i = 0; i < count; ++i) {
-        Vec2 p0, p1;
-        sc.segment_points(first + i, &p0, &p1);
-        const Aabb r{{std::min(p0.x, p1.x), std::min(p0.y, p1.y)}, {std::max(p0.x, p1.x), std::max(p0.y, p1.y)}};
-        if (overlaps(r, q.sweep, 0.0)) test_segment(q, first + i);  // the rectangles apart: no common point
-      }
+      if (for_hit) wide_test_item(q, e.code & ~kWideLeaf);
+      if (for_ball) ball_sq = e.d_sq;
       continue;
     }
     if (!q.spend_wide_node()) {
-      if (e.key < q.unresolved_t) {
-        q.unresolved_t = e.key;
+      ball_known = false;
+      if (for_hit && e.t_enter < q.unresolved_t) {
+        q.unresolved_t = e.t_enter;
         q.unresolved_node = kWideEmpty;
       }
       continue;
     }
     const WideNode& n = wi.nodes[e.code];
-    float t_enter[4];
+    float t_enter[4], d_sq[4];
     const double h = q.horizon();
-    const int mask = sweep_node(n, ax, ay, ix, iy, h > 1.0 ? 1.0f : float_at_least(h), t_enter);
-    if (mask && !push_wide(n, mask, t_enter, top) && e.key < q.unresolved_t) {
-      q.unresolved_t = e.key;  // the stack is full: as past the budget
-      q.unresolved_node = kWideEmpty;
+    const int hit_mask = sweep_node(n, ax, ay, ix, iy, h > 1.0 ? 1.0f : float_at_least(h), t_enter);
+    const int near_mask = near_node(n, bx, by, ball_sq, d_sq);
+    const int base = top;
+    for (int i = 0; i < 4; ++i) {
+      const int bit = 1 << i;
+      if (!((hit_mask | near_mask) & bit)) continue;
+      if (static_cast<std::size_t>(top) >= walk_stack_.size()) {  // full: as past the budget
+        ball_known = false;
+        if (e.t_enter < q.unresolved_t) {
+          q.unresolved_t = e.t_enter;
+          q.unresolved_node = kWideEmpty;
+        }
+        top = base;
+        break;
+      }
+      const WalkEntry c{(hit_mask & bit) ? t_enter[i] : std::numeric_limits<float>::infinity(), d_sq[i], n.child[i]};
+      int k = top++;  // insertion: the nearest to b on top
+      for (; k > base && walk_stack_[static_cast<std::size_t>(k - 1)].d_sq < c.d_sq; --k) walk_stack_[static_cast<std::size_t>(k)] = walk_stack_[static_cast<std::size_t>(k - 1)];
+      walk_stack_[static_cast<std::size_t>(k)] = c;
     }
   }
-}
-
-// The free-space ball of the wide path: a lower bound on the distance from p to every item rectangle,
-// so to every wall of every level, capped at cap_m [m]. A nearest-first walk that stops refining once
-// nothing nearer can be found; a leaf's rectangle distance is taken as it is (no exact segment tests).
-// Each node opened is four optional box tests: when the budget runs out the ball is unknown (0).
-double BoundarySection::wide_clearance(Query& q, double cap_m) {
-  const WideIndex& wi = scene_->wide_index();
-  if (wi.nodes.empty()) return cap_m;
-  const float px = static_cast<float>(q.b.x), py = static_cast<float>(q.b.y);
-  float bound_sq = static_cast<float>(cap_m * cap_m);
-  int top = 0;
-  wide_stack_[static_cast<std::size_t>(top++)] = WideEntry{0.0f, 0u};
-  while (top > 0) {
-    const WideEntry e = wide_stack_[static_cast<std::size_t>(--top)];
-    if (e.key >= bound_sq) continue;
-    if (e.code & kWideLeaf) {
-      bound_sq = e.key;  // a wall may be this near: the new bound (the walk goes on for anything nearer)
-      continue;
-    }
-    if (!q.spend_wide_node()) return 0.0;
-    const WideNode& n = wi.nodes[e.code];
-    float d_sq[4];
-    const int mask = near_node(n, px, py, bound_sq, d_sq);
-    if (mask && !push_wide(n, mask, d_sq, top)) return 0.0;  // the stack is full: unknown
-  }
+  if (!ball_known) return 0.0;
   // The float distances bound the padded rectangles' from below up to a few ulps; the factor keeps the
   // ball strictly inside what the exact rectangles allow.
-  return std::sqrt(static_cast<double>(bound_sq)) * (1.0 - 1e-6);
+  return std::sqrt(static_cast<double>(ball_sq)) * (1.0 - 1e-6);
 }
 
 SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
@@ -590,10 +598,10 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
   q.budget = &budget;
   q.best.t = std::numeric_limits<double>::infinity();
   q.best.point_m = b;
-  wide_sweep(q);
+  const double ball_m = wide_walk(q, kWideBallCap_m);
   const bool clear = !q.best.hit && q.unresolved_t == std::numeric_limits<double>::infinity();
   wide_ball_center_m_ = b;
-  wide_ball_radius_m_ = clear ? wide_clearance(q, kWideBallCap_m) : 0.0;
+  wide_ball_radius_m_ = clear ? ball_m : 0.0;
   const SweepHit answer = finish(q);
   q.st.section_size = 0;
   q.st.budget_exhausted = q.st.budget_exhausted || q.wide_refused;

@@ -187,8 +187,11 @@ class BoundarySection {
   static_assert(sizeof(WideEntry) == 8, "WideEntry: 8 bytes");
   std::uint32_t item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept;
   bool push_wide(const WideNode& n, int mask, const float key[4], int& top) noexcept;
-  void wide_sweep(Query& q);
-  double wide_clearance(Query& q, double cap_m);
+  void wide_test_item(Query& q, std::uint32_t item);
+  double wide_walk(Query& q, double ball_cap_m);
+  struct WalkEntry { float t_enter; float d_sq; std::uint32_t code; };  // 12 bytes: first_hit_wide's stack
+  static_assert(sizeof(WalkEntry) == 12, "WalkEntry: 12 bytes");
+  std::vector<WalkEntry> walk_stack_;      // first_hit_wide's stack (WideIndex::stack_entries)
   std::vector<WideEntry> wide_stack_;      // the wide walks' stack (WideIndex::stack_entries)
   std::vector<std::uint32_t> seen_stamp_;  // per node: closest-point walk in which a coarser segment was last tested
   std::uint32_t seen_tick_ = 0;
