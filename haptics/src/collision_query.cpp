@@ -142,6 +142,13 @@ struct BoundarySection::Query {
   QueryStats st;
   bool wide_refused = false;  // a wide node was left unopened for want of budget (which may not be quite spent)
 
+  Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded, QueryBudget& shared_budget)
+      : a(a_m), b(b_m), sweep{{std::min(a_m.x, b_m.x), std::min(a_m.y, b_m.y)}, {std::max(a_m.x, b_m.x), std::max(a_m.y, b_m.y)}},
+        level(target_level), excluded(excluded_segments), excluded_count(n_excluded), budget(&shared_budget) {
+    best.t = std::numeric_limits<double>::infinity();  // no exact hit yet
+    best.point_m = b_m;
+  }
+
   // A section entry's clip: always done and charged, even past the budget.
   void charge_section_box() noexcept {
     ++st.box_tests;
@@ -588,16 +595,7 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
     clear.point_m = b;
     return clear;
   }
-  Query q;
-  q.a = a;
-  q.b = b;
-  q.sweep = Aabb{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
-  q.level = level;
-  q.excluded = excluded;
-  q.excluded_count = excluded_count;
-  q.budget = &budget;
-  q.best.t = std::numeric_limits<double>::infinity();
-  q.best.point_m = b;
+  Query q(a, b, level, excluded, excluded_count, budget);
   const double ball_m = wide_walk(q, kWideBallCap_m);
   const bool clear = !q.best.hit && q.unresolved_t == std::numeric_limits<double>::infinity();
   wide_ball_center_m_ = b;
@@ -624,16 +622,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     clear.point_m = b;
     return clear;
   }
-  Query q;
-  q.a = a;
-  q.b = b;
-  q.sweep = Aabb{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
-  q.level = level;
-  q.excluded = excluded;
-  q.excluded_count = excluded_count;
-  q.budget = &budget;
-  q.best.t = std::numeric_limits<double>::infinity();
-  q.best.point_m = b;
+  Query q(a, b, level, excluded, excluded_count, budget);
   next_tick();
   clip_section(q);
   refine_candidates(q);
