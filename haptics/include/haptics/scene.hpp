@@ -241,7 +241,7 @@ class Scene {
     *count = 2;
   }
   /// Bytes of the arrays the servo path reads (points, box extents, tags, per-curve node offsets, the
-  /// chunks' and hierarchy's boxes and links), for bytes-per-segment figures.
+  /// chunks' and hierarchy's boxes and links, the wide index's nodes), for bytes-per-segment figures.
   std::size_t hot_bytes() const;
 
   /// Level-l points of curve c (the scaling coefficients) [m]: point_count[l] of them, then, for a closed
