@@ -172,9 +172,6 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
     state.counters["segment_tests"] = static_cast<double>(seg_tests) / n;  // per query
     state.counters["box_tests"] = static_cast<double>(box_tests) / n;
-  }
-  if (m == Method::Ours || m == Method::Wide) {
-    const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
     state.counters["full_query_fraction"] = static_cast<double>(full) / n;
     state.counters["section_entries"] = static_cast<double>(section) / n;
   }

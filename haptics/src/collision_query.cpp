@@ -95,7 +95,6 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   hit_stamp_.assign(n, 0);
   merge_stamp_.assign(n, 0);
   seen_stamp_.assign(n, 0);
-  wide_stack_.resize(scene.wide_index().stack_entries());
   walk_stack_.resize(scene.wide_index().stack_entries());
   reset();
 }
@@ -140,7 +139,7 @@ struct BoundarySection::Query {
   std::uint32_t unresolved_node = 0;
   double nearest_sq = std::numeric_limits<double>::infinity();  // squared distance from b to the section's nearest box
   QueryStats st;
-  bool wide_refused = false;  // a wide node was left unopened for want of budget (which may not be quite spent)
+  bool refused = false;  // optional work was refused for want of budget (a wide node may be refused before it is quite spent)
 
   Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded, QueryBudget& shared_budget)
       : a(a_m), b(b_m), sweep{{std::min(a_m.x, b_m.x), std::min(a_m.y, b_m.y)}, {std::max(a_m.x, b_m.x), std::max(a_m.y, b_m.y)}},
@@ -156,18 +155,15 @@ struct BoundarySection::Query {
     budget->charge();
   }
   // Any other box test: only while the budget lasts.
-  bool spend_box() noexcept {
-    if (!budget->spend()) return false;
-    ++st.box_tests;
-    return true;
-  }
+  bool spend_box() noexcept { return spend_boxes(1); }
   // A wide node's four rectangles: all or none.
-  bool spend_wide_node() noexcept {
-    if (!budget->spend(kWideBoxTestsPerNode)) {
-      wide_refused = true;
+  bool spend_wide_node() noexcept { return spend_boxes(kWideBoxTestsPerNode); }
+  bool spend_boxes(std::int32_t n) noexcept {
+    if (!budget->spend(n)) {
+      refused = true;
       return false;
     }
-    st.box_tests += kWideBoxTestsPerNode;
+    st.box_tests += n;
     return true;
   }
   bool is_excluded(SegmentRef s) const noexcept {
@@ -375,16 +371,13 @@ SweepHit BoundarySection::finish(Query& q) const {
     best.hit = false;
     best.blocked = true;
     best.t = q.unresolved_t;
-    const NodeInfo in = q.unresolved_node == kWideEmpty ? NodeInfo{} : sc.info(q.unresolved_node);
-    if (q.unresolved_node == kWideEmpty) {  // a node of the wide index: above the curves
-      best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
-    } else if (sc.is_chunk(q.unresolved_node)) {
-      const int top = static_cast<int>(sc.curve_nodes(in.curve).levels) - 1;
-      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), top, static_cast<std::int32_t>(in.index)};
-    } else if (!sc.is_segment(q.unresolved_node)) {  // above the curves: no segment to name yet
-      best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
+    const std::uint32_t node = q.unresolved_node;
+    if (node == kWideEmpty || (!sc.is_segment(node) && !sc.is_chunk(node))) {
+      best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};  // above the curves (hierarchy or wide index): no segment to name yet
     } else {
-      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+      const NodeInfo in = sc.info(node);
+      const int level = sc.is_chunk(node) ? static_cast<int>(sc.curve_nodes(in.curve).levels) - 1 : in.level;  // a chunk: its coarsest segments
+      best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), level, static_cast<std::int32_t>(in.index)};
     }
     q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, best.segment.level);
   }
@@ -393,7 +386,7 @@ SweepHit BoundarySection::finish(Query& q) const {
   } else {
     best.t = 1.0;
   }
-  q.st.budget_exhausted = q.budget->exhausted();
+  q.st.budget_exhausted = q.budget->exhausted() || q.refused;
   q.st.section_size = static_cast<std::int32_t>(section_.size());
   return best;
 }
@@ -490,20 +483,14 @@ std::uint32_t BoundarySection::item_segments(std::uint32_t item, int level, std:
   return 1u << (k_level - l);
 }
 
-// Pushes the hit children of a wide node, the nearest on top. False when the stack is full.
-bool BoundarySection::push_wide(const WideNode& n, int mask, const float key[4], int& top) noexcept {
-  const int base = top;
-  for (int i = 0; i < 4; ++i) {
-    if (!(mask & (1 << i))) continue;
-    if (static_cast<std::size_t>(top) >= wide_stack_.size()) {
-      top = base;
-      return false;
-    }
-    WideEntry e{key[i], n.child[i]};
-    int k = top++;
-    for (; k > base && wide_stack_[static_cast<std::size_t>(k - 1)].key < e.key; --k) wide_stack_[static_cast<std::size_t>(k)] = wide_stack_[static_cast<std::size_t>(k - 1)];
-    wide_stack_[static_cast<std::size_t>(k)] = e;
-  }
+// Checked push onto the wide walks' stack, in order: among the entries pushed since `base` (a node's
+// children, at most four) the one nearest to the walk's point ends on top. False, with nothing pushed,
+// when the stack is full.
+bool BoundarySection::push_walk(WalkEntry e, int base, int& top) noexcept {
+  if (static_cast<std::size_t>(top) >= walk_stack_.size()) return false;
+  int k = top++;
+  for (; k > base && walk_stack_[static_cast<std::size_t>(k - 1)].d_sq < e.d_sq; --k) walk_stack_[static_cast<std::size_t>(k)] = walk_stack_[static_cast<std::size_t>(k - 1)];
+  walk_stack_[static_cast<std::size_t>(k)] = e;
   return true;
 }
 
@@ -565,7 +552,8 @@ double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
     for (int i = 0; i < 4; ++i) {
       const int bit = 1 << i;
       if (!((hit_mask | near_mask) & bit)) continue;
-      if (static_cast<std::size_t>(top) >= walk_stack_.size()) {  // full: as past the budget
+      const WalkEntry c{(hit_mask & bit) ? t_enter[i] : std::numeric_limits<float>::infinity(), d_sq[i], n.child[i]};
+      if (!push_walk(c, base, top)) {  // full: as past the budget
         ball_known = false;
         if (e.t_enter < q.unresolved_t) {
           q.unresolved_t = e.t_enter;
@@ -574,10 +562,6 @@ double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
         top = base;
         break;
       }
-      const WalkEntry c{(hit_mask & bit) ? t_enter[i] : std::numeric_limits<float>::infinity(), d_sq[i], n.child[i]};
-      int k = top++;  // insertion: the nearest to b on top
-      for (; k > base && walk_stack_[static_cast<std::size_t>(k - 1)].d_sq < c.d_sq; --k) walk_stack_[static_cast<std::size_t>(k)] = walk_stack_[static_cast<std::size_t>(k - 1)];
-      walk_stack_[static_cast<std::size_t>(k)] = c;
     }
   }
   if (!ball_known) return 0.0;
@@ -602,7 +586,6 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
   wide_ball_radius_m_ = clear ? ball_m : 0.0;
   const SweepHit answer = finish(q);
   q.st.section_size = 0;
-  q.st.budget_exhausted = q.st.budget_exhausted || q.wide_refused;
   if (stats_out) *stats_out = q.st;
   return answer;
 }
@@ -742,10 +725,10 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   }
   const float px = static_cast<float>(p.x), py = static_cast<float>(p.y);
   int top = 0;
-  wide_stack_[static_cast<std::size_t>(top++)] = WideEntry{0.0f, 0u};
+  walk_stack_[static_cast<std::size_t>(top++)] = WalkEntry{0.0f, 0.0f, 0u};
   while (top > 0) {
-    const WideEntry e = wide_stack_[static_cast<std::size_t>(--top)];  // key: the rectangle's squared distance
-    if (static_cast<double>(e.key) > bound_sq) continue;  // the bound only shrinks: nothing under it can matter any more
+    const WalkEntry e = walk_stack_[static_cast<std::size_t>(--top)];
+    if (static_cast<double>(e.d_sq) > bound_sq) continue;  // the bound only shrinks: nothing under it can matter any more
     if (e.code & kWideLeaf) {
       const std::uint32_t item = e.code & ~kWideLeaf;
       if (curve >= 0 && static_cast<int>(sc.tag_curve(item)) != curve) continue;
@@ -785,9 +768,13 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
     const WideNode& n = wi.nodes[e.code];
     float d_sq[4];
     const int mask = near_node(n, px, py, float_at_least(bound_sq), d_sq);
-    if (mask && !push_wide(n, mask, d_sq, top)) {  // the stack is full: the answer is unknown, as past the budget
-      if (budget) budget->ran_out = true;
-      return false;
+    const int base = top;
+    for (int i = 0; i < 4; ++i) {
+      if (!(mask & (1 << i))) continue;
+      if (!push_walk(WalkEntry{std::numeric_limits<float>::infinity(), d_sq[i], n.child[i]}, base, top)) {
+        if (budget) budget->ran_out = true;  // the stack is full: the answer is unknown, as past the budget
+        return false;
+      }
     }
   }
   // Everything within the final bound was reached (boxes farther than the bound at the time were pruned,

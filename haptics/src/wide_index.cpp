@@ -27,7 +27,8 @@ Aabb merged(const Aabb& a, const Aabb& b) {
 }
 
 // The rectangle of item k (segment k of level `item` of curve c): its error box and the pieces of every
-// coarser level's segments that stand for it (wide_index.hpp).
+// coarser level's segments that stand for it (wide_index.hpp). Levels halve exactly (plan_levels: K·2^L
+// level-0 segments), so segment k of a level lies under segment k >> d of the level d above.
 Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) {
   const CurveInfo& ci = sc.curve(c);
   Aabb r = sc.aabb(ci.box_offset[item] + k);
@@ -36,11 +37,6 @@ Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) {
     const std::uint32_t s = k >> d;
     Vec2 p0, p1;
     sc.segment(SegmentRef{static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(s)}, &p0, &p1);
-    if (ci.segment_count[l - 1] != 2 * ci.segment_count[l]) {  // not a dyadic split: the whole segment
-      extend(r, p0);
-      extend(r, p1);
-      continue;
-    }
     const double pieces = std::ldexp(1.0, d);
     const double i = static_cast<double>(k & ((1u << d) - 1u));
     extend(r, lerp(p0, p1, i / pieces));

@@ -76,6 +76,44 @@ void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
   }
 }
 
+// A starved-budget run for an anytime first hit: 3000 random sweeps over a small random scene (seed
+// `seed`), each through a fresh section with a budget of 1–12 box tests, at level `level_of(i)`. Checks
+// what every anytime answer must satisfy (never a hit and blocked at once; exact when not blocked; a
+// blocked answer never claims clear space past the true first wall) and hands each answer to
+// `check(h, budget, st)` for the method's own checks. Counts the blocked and the exact answers.
+template <class Query, class LevelOf, class Check>
+void starved_queries(unsigned seed, Query&& query, LevelOf&& level_of, Check&& check, int* blocked, int* exact) {
+  std::mt19937 rng(seed);
+  const auto curves = random_scene(rng, 6, 6);
+  const Scene sc = Scene::build(curves, 6);
+  std::uniform_real_distribution<double> ux(-0.075, 0.075), uy(-0.05, 0.05);
+  for (int i = 0; i < 3000; ++i) {
+    BoundarySection section(sc);
+    const Vec2 a{ux(rng), uy(rng)}, b{ux(rng), uy(rng)};
+    QueryStats st;
+    QueryBudget budget;
+    budget.max_box_tests = 1 + i % 12;
+    const int level = level_of(i);
+    const SweepHit h = query(section, a, b, level, budget, st);
+    double t_ref = 1.0;
+    const bool hit_ref = test::brute_first_hit(sc, a, b, level, &t_ref, nullptr);
+    ASSERT_FALSE(h.hit && h.blocked);
+    check(h, budget, st, hit_ref, t_ref);
+    if (h.blocked) {
+      ++*blocked;
+      if (hit_ref) {
+        ASSERT_LE(h.t, t_ref + 1e-12);
+      }
+    } else {
+      ++*exact;
+      ASSERT_EQ(h.hit, hit_ref) << "query " << i;
+      if (hit_ref) {
+        ASSERT_NEAR(h.t, t_ref, 1e-9);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 TEST(CollisionTree, BoxesContainOriginalsAndChildren) {
@@ -356,37 +394,17 @@ TEST(CollisionQuery, ExcludedSegmentIsIgnored) {
 }
 
 TEST(CollisionQuery, AnytimeAnswerIsConservativeAndFromACoarserLevel) {
-  std::mt19937 rng(6);
-  const auto curves = random_scene(rng, 6, 6);
-  const Scene sc = Scene::build(curves, 6);
-  std::uniform_real_distribution<double> ux(-0.075, 0.075), uy(-0.05, 0.05);
   int blocked = 0, exact = 0;
-  for (int i = 0; i < 3000; ++i) {
-    BoundarySection section(sc);
-    const Vec2 a{ux(rng), uy(rng)}, b{ux(rng), uy(rng)};
-    QueryStats st;
-    QueryBudget budget;
-    budget.max_box_tests = 1 + i % 12;
-    const SweepHit h = section.first_hit(a, b, 0, nullptr, 0, budget, &st);
-    double t_ref = 1.0;
-    const bool hit_ref = test::brute_first_hit(sc, a, b, 0, &t_ref, nullptr);
-    ASSERT_FALSE(h.hit && h.blocked);
-    if (h.blocked) {
-      ++blocked;
-      // Never claims clear space past the true first wall; the answer comes from a coarser level.
-      if (hit_ref) {
-        ASSERT_LE(h.t, t_ref + 1e-12);
-      }
-      EXPECT_GT(h.segment.level, 0);
-      EXPECT_TRUE(st.budget_exhausted);
-    } else {
-      ++exact;
-      ASSERT_EQ(h.hit, hit_ref);
-      if (hit_ref) {
-        ASSERT_NEAR(h.t, t_ref, 1e-9);
-      }
-    }
-  }
+  starved_queries(
+      6, [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) { return section.first_hit(a, b, level, nullptr, 0, budget, &st); },
+      [](int) { return 0; },
+      [](const SweepHit& h, const QueryBudget&, const QueryStats& st, bool, double) {
+        if (!h.blocked) return;
+        // Never claims clear space past the true first wall (starved_queries); the answer comes from a coarser level.
+        EXPECT_GT(h.segment.level, 0);
+        EXPECT_TRUE(st.budget_exhausted);
+      },
+      &blocked, &exact);
   EXPECT_GT(blocked, 500);
   EXPECT_GT(exact, 100);
 }
@@ -502,38 +520,20 @@ TEST(WideIndex, ItemsAppearOnceAndNodesHoldTheirChildren) {
 // first_hit_wide under a starved budget: never claims clear space past the true first wall, says the
 // budget ran out, and names no segment (no level is known above the items); with budget enough, exact.
 TEST(WideIndex, AnytimeAnswerIsConservative) {
-  std::mt19937 rng(33);
-  const auto curves = random_scene(rng, 6, 6);
-  const Scene sc = Scene::build(curves, 6);
-  std::uniform_real_distribution<double> ux(-0.075, 0.075), uy(-0.05, 0.05);
   int blocked = 0, exact = 0;
-  for (int i = 0; i < 3000; ++i) {
-    BoundarySection section(sc);
-    const Vec2 a{ux(rng), uy(rng)}, b{ux(rng), uy(rng)};
-    QueryStats st;
-    QueryBudget budget;
-    budget.max_box_tests = 1 + i % 12;
-    const int level = i % 4 == 0 ? 4 : 0;
-    const SweepHit h = section.first_hit_wide(a, b, level, nullptr, 0, budget, &st);
-    double t_ref = 1.0;
-    const bool hit_ref = test::brute_first_hit(sc, a, b, level, &t_ref, nullptr);
-    ASSERT_FALSE(h.hit && h.blocked);
-    ASSERT_LE(budget.box_tests_used, budget.max_box_tests);  // no overrun: the wide walk has no section to scan
-    if (h.blocked) {
-      ++blocked;
-      if (hit_ref) {
-        ASSERT_LE(h.t, t_ref);
-      }
-      EXPECT_EQ(h.segment.level, Scene::kMaxLevels);
-      EXPECT_TRUE(st.budget_exhausted);
-    } else {
-      ++exact;
-      ASSERT_EQ(h.hit, hit_ref) << "query " << i;
-      if (hit_ref) {
-        ASSERT_NEAR(h.t, t_ref, 1e-9);
-      }
-    }
-  }
+  starved_queries(
+      33, [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) { return section.first_hit_wide(a, b, level, nullptr, 0, budget, &st); },
+      [](int i) { return i % 4 == 0 ? 4 : 0; },
+      [](const SweepHit& h, const QueryBudget& budget, const QueryStats& st, bool hit_ref, double t_ref) {
+        ASSERT_LE(budget.box_tests_used, budget.max_box_tests);  // no overrun: the wide walk has no section to scan
+        if (!h.blocked) return;
+        if (hit_ref) {
+          ASSERT_LE(h.t, t_ref);
+        }
+        EXPECT_EQ(h.segment.level, Scene::kMaxLevels);
+        EXPECT_TRUE(st.budget_exhausted);
+      },
+      &blocked, &exact);
   EXPECT_GT(blocked, 500);
   EXPECT_GT(exact, 100);
 }

@@ -55,14 +55,7 @@ struct QueryBudget {
   /// True when no optional box test may be done any more.
   bool exhausted() const noexcept { return max_box_tests > 0 && box_tests_used >= max_box_tests; }
   /// Charges one optional box test. Returns false (and sets ran_out) when the budget is spent.
-  bool spend() noexcept {
-    if (exhausted()) {
-      ran_out = true;
-      return false;
-    }
-    ++box_tests_used;
-    return true;
-  }
+  bool spend() noexcept { return spend(1); }
   /// Charges n optional box tests at once (a wide node's four rectangles, tested together), all or none:
   /// false (and ran_out set), with nothing charged, when fewer than n are left.
   bool spend(std::int32_t n) noexcept {
@@ -97,8 +90,8 @@ struct QueryStats {
   std::int32_t merges = 0;
   std::int32_t section_size = 0;       ///< boundary-section nodes after the query
   std::int32_t coarsest_answer_level = 0;  ///< coarsest level reached by an answer (> target when the budget ran out)
-  bool budget_exhausted = false;       ///< the budget was spent when (or before) this query ended; for first_hit_wide
-                                       ///< also when a wide node was refused with fewer than its four tests left
+  bool budget_exhausted = false;       ///< the budget was spent when (or before) this query ended, or optional work of
+                                       ///< this query was refused for want of it (a wide node needs four tests at once)
 };
 
 /// The boundary section of one scene plus the scratch space of the query. One per servo thread.
@@ -182,17 +175,16 @@ class BoundarySection {
   void compact_section(Query& q);
   SweepHit finish(Query& q) const;
   void split(std::uint32_t node);
-  // The walks of the wide index (wide_index.hpp).
-  struct WideEntry { float key; std::uint32_t code; };  // 8 bytes: an entry parameter or squared distance, a child code
-  static_assert(sizeof(WideEntry) == 8, "WideEntry: 8 bytes");
+  // The walks of the wide index (wide_index.hpp). One stack serves both: an entry is a child code with its
+  // rectangle's squared distance from the walk's point (the order of the walk) and, for first_hit_wide,
+  // where the sweep enters it (+inf when it does not).
+  struct WalkEntry { float t_enter; float d_sq; std::uint32_t code; };  // 12 bytes
+  static_assert(sizeof(WalkEntry) == 12, "WalkEntry: 12 bytes");
   std::uint32_t item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept;
-  bool push_wide(const WideNode& n, int mask, const float key[4], int& top) noexcept;
+  bool push_walk(WalkEntry e, int base, int& top) noexcept;
   void wide_test_item(Query& q, std::uint32_t item);
   double wide_walk(Query& q, double ball_cap_m);
-  struct WalkEntry { float t_enter; float d_sq; std::uint32_t code; };  // 12 bytes: first_hit_wide's stack
-  static_assert(sizeof(WalkEntry) == 12, "WalkEntry: 12 bytes");
-  std::vector<WalkEntry> walk_stack_;      // first_hit_wide's stack (WideIndex::stack_entries)
-  std::vector<WideEntry> wide_stack_;      // the wide walks' stack (WideIndex::stack_entries)
+  std::vector<WalkEntry> walk_stack_;      // the wide walks' stack (WideIndex::stack_entries)
   std::vector<std::uint32_t> seen_stamp_;  // per node: closest-point walk in which a coarser segment was last tested
   std::uint32_t seen_tick_ = 0;
   const Scene* scene_;
