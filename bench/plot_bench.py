@@ -195,14 +195,10 @@ if sb:
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(os.path.join(BENCH, "scene_build.png"), dpi=110)
-    # ours: Scene::build picks its threads (as the app does; the counter says how many); ours_one_thread: all
-    # on one (absent in older runs).
-    lines = ["| picture | ours ms (threads) | ours on one thread ms | OpenCV ms | ratio | OpenCV, our thresholds ms | ratio |", "|---|---|---|---|---|---|---|"]
+    lines = ["| picture | ours ms | OpenCV ms | ratio | OpenCV, our thresholds ms | ratio |", "|---|---|---|---|---|---|"]
     for n, q, q2 in zip(names, ratios, same):
         t2 = "%.2f" % (ns(sb[n]["opencv_same_edges"]) / 1e6) if "opencv_same_edges" in sb[n] else ""
-        one = "%.2f" % (ns(sb[n]["ours_one_thread"]) / 1e6) if "ours_one_thread" in sb[n] else ""
-        lines.append("| %s | %.2f (%d) | %s | %.2f | %.2f | %s | %.2f |" % (n, ns(sb[n]["ours"]) / 1e6, int(sb[n]["ours"].get("threads", 1)), one,
-                                                             ns(sb[n]["opencv"]) / 1e6, q, t2, q2))
+        lines.append("| %s | %.2f | %.2f | %.2f | %s | %.2f |" % (n, ns(sb[n]["ours"]) / 1e6, ns(sb[n]["opencv"]) / 1e6, q, t2, q2))
     tables["scene_build"] = "\n".join(lines)
 
 # 6. Issue 18's targets, each with this run's figures (first_hit.json, scene_build.json, accuracy.json,

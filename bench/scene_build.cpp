@@ -33,25 +33,21 @@ std::vector<Picture>& pictures() {
   return v;
 }
 
-// threads: Scene::build's (0: it picks, as the app does; 1: everything on the calling thread).
-void build_ours(benchmark::State& state, const Picture* p, int threads) {
+void build_ours(benchmark::State& state, const Picture* p) {
   const config::Settings s;
   vision::EdgeParams ep;
   ep.blur_sigma_px = s.vision.blur_sigma_px;
   std::size_t segments = 0;
-  int build_threads = 1;
   for (auto _ : state) {
     const vision::EdgeMap em = vision::detect_edges(p->grey, ep);
     const auto chains = vision::link_edges(em.edges, 2.0);
     const vision::PxToM map = vision::fit_to_workspace(p->grey.cols, p->grey.rows, s.workspace.width_m, s.workspace.height_m);
     const std::vector<Polyline> curves = app::to_polylines(vision::chains_to_curves(chains, {}, map, s.vision.min_chain_length_m));
-    const Scene scene = Scene::build(curves, s.haptics.max_levels, threads);
+    const Scene scene = Scene::build(curves, s.haptics.max_levels);
     segments = scene.total_segments(0);
-    build_threads = scene.build_times().threads;
     benchmark::DoNotOptimize(scene.node_count());
   }
   state.counters["segments"] = static_cast<double>(segments);
-  state.counters["threads"] = build_threads;
 }
 
 void build_opencv(benchmark::State& state, const Picture* p) {
@@ -103,9 +99,7 @@ int main(int argc, char** argv) {
     pictures().push_back(std::move(p));
   }
   for (const Picture& p : pictures()) {
-    benchmark::RegisterBenchmark(("BM_SceneBuild/ours/" + p.name).c_str(), [&p](benchmark::State& st) { build_ours(st, &p, 0); })
-        ->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("BM_SceneBuild/ours_one_thread/" + p.name).c_str(), [&p](benchmark::State& st) { build_ours(st, &p, 1); })
+    benchmark::RegisterBenchmark(("BM_SceneBuild/ours/" + p.name).c_str(), [&p](benchmark::State& st) { build_ours(st, &p); })
         ->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("BM_SceneBuild/opencv/" + p.name).c_str(), [&p](benchmark::State& st) { build_opencv(st, &p); })
         ->Unit(benchmark::kMillisecond);

@@ -4,17 +4,11 @@
 // proves a miss on everything under it, down to the original curve.
 #include "haptics/scene.hpp"
 
-#include <sched.h>
-
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
-#include <mutex>
 #include <new>
-#include <thread>
 
 namespace hk {
 namespace {
@@ -101,54 +95,6 @@ void build_hierarchy(std::vector<std::size_t>& order, const std::vector<Vec2>& c
 
 double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-// CPUs this thread may run on (its affinity mask: taskset and cpusets count, a CFS quota does not); 1 when
-// unknown.
-int usable_cpus() {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  if (sched_getaffinity(0, sizeof set, &set) != 0) return 1;
-  return std::max(1, CPU_COUNT(&set));
-}
-
-// Threads for a scene of `points` input points: `requested` when ≥ 1; else one per
-// kSceneBuildPointsPerThread points, at most kSceneBuildMaxThreads and the CPUs this thread may use.
-int build_threads(std::size_t points, int requested) {
-  if (requested >= 1) return std::min(requested, kSceneBuildMaxThreads);
-  const auto by_work = static_cast<int>(std::min<std::size_t>(points / kSceneBuildPointsPerThread, kSceneBuildMaxThreads));
-  return std::max(1, std::min({by_work, usable_cpus(), kSceneBuildMaxThreads}));
-}
-
-// Calls work(worker, i) once for every i in [0, n), on `threads` threads (the calling thread is worker 0),
-// handing out indices from a shared counter so that one long curve does not leave the others idle. After
-// the first exception no further index is handed out; it is rethrown here once every thread has stopped.
-// With one thread (or n ≤ 1) it is a plain loop on the calling thread.
-template <class Work>
-void for_each_index(std::size_t n, int threads, Work&& work) {
-  threads = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(std::max(threads, 1)), std::max<std::size_t>(n, 1)));
-  if (threads == 1) {
-    for (std::size_t i = 0; i < n; ++i) work(0, i);
-    return;
-  }
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  const auto run = [&](int worker) {
-    try {
-      for (std::size_t i = next.fetch_add(1); i < n; i = next.fetch_add(1)) work(worker, i);
-    } catch (...) {
-      next.store(n);  // stop the hand-out
-      const std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-    }
-  };
-  std::vector<std::thread> helpers;
-  helpers.reserve(static_cast<std::size_t>(threads - 1));
-  for (int w = 1; w < threads; ++w) helpers.emplace_back(run, w);  // std::system_error if none can start
-  run(0);
-  for (std::thread& t : helpers) t.join();
-  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace
@@ -239,26 +185,15 @@ class SceneBuild {
     std::uint32_t curve, first_segment, count;
   };
 
-  // Multiresolution model of every curve that has one (fewer than 2 points or zero length: skipped), the
-  // curves spread over `threads` threads; the models keep the input's order.
-  static void build_models(Scene& scene, const std::vector<Polyline>& input, int max_levels, int threads) {
-    std::vector<CurveMultires> models(input.size());
-    std::vector<char> usable(input.size(), 0);
-    for_each_index(input.size(), threads, [&](int, std::size_t i) {
-      try {
-        models[i] = build_multires(input[i], max_levels);
-        usable[i] = 1;
-      } catch (const CurveError&) {
-        // nothing to feel: counted below
-      }
-    });
+  // Multiresolution model of every curve that has one (fewer than 2 points or zero length: skipped).
+  static void build_models(Scene& scene, const std::vector<Polyline>& input, int max_levels) {
     for (std::size_t i = 0; i < input.size(); ++i) {
-      if (!usable[i]) {
-        ++scene.skipped_;
-        continue;
+      try {
+        scene.models_.push_back(build_multires(input[i], max_levels));
+        scene.source_index_.push_back(i);
+      } catch (const CurveError&) {
+        ++scene.skipped_;  // nothing to feel
       }
-      scene.models_.push_back(std::move(models[i]));
-      scene.source_index_.push_back(i);
     }
   }
 
@@ -434,24 +369,16 @@ class SceneBuild {
     ci.max_error_bound_m[l] = std::sqrt(bound_sq);
   }
 
-  // Every curve's error boxes and errors, the curves spread over `threads` threads (each curve writes only
-  // its own slots and CurveInfo), then the scene's bounds.
-  static void build_curves(Scene& scene, const std::vector<Polyline>& input, int threads) {
-    struct Scratch {
-      std::vector<double> orig_arc;
-      std::vector<std::uint32_t> orig_first;
-      std::vector<SegmentExtent> level_extent;  // one level's measured extents, before quantising
-    };
-    std::vector<Scratch> scratch(static_cast<std::size_t>(std::max(threads, 1)));
-    for_each_index(scene.models_.size(), threads, [&](int worker, std::size_t c) {
-      Scratch& w = scratch[static_cast<std::size_t>(worker)];
-      const Polyline& src = input[scene.source_index_[c]];
-      map_originals(scene.models_[c], src, scene.curves_[c].segment_count[0], w.orig_arc, w.orig_first);
-      build_segment_boxes(scene, c, src, w.orig_first, w.level_extent);
-    });
+  static void build_curves(Scene& scene, const std::vector<Polyline>& input) {
+    std::vector<double> orig_arc;
+    std::vector<std::uint32_t> orig_first;
+    std::vector<SegmentExtent> level_extent;  // one level's measured extents, before quantising
     Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     Vec2 hi{-lo.x, -lo.y};
     for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+      const Polyline& src = input[scene.source_index_[c]];
+      map_originals(scene.models_[c], src, scene.curves_[c].segment_count[0], orig_arc, orig_first);
+      build_segment_boxes(scene, c, src, orig_first, level_extent);
       for (const Vec2& q : scene.models_[c].scaling[0]) {
         lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
         hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
@@ -507,14 +434,11 @@ class SceneBuild {
 
 };
 
-Scene Scene::build(const std::vector<Polyline>& input, int max_levels, int threads) {
+Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   Scene scene;
   max_levels = std::clamp(max_levels, 0, kMaxLevels - 1);
-  std::size_t points = 0;
-  for (const Polyline& p : input) points += p.points_m.size();
-  threads = build_threads(points, threads);
   const double t0 = now_ms();
-  SceneBuild::build_models(scene, input, max_levels, threads);
+  SceneBuild::build_models(scene, input, max_levels);
   const double t1 = now_ms();
   SceneBuild::lay_out_curves(scene);
   std::vector<SceneBuild::Chunk> chunks;
@@ -527,7 +451,7 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels, int threa
   scene.chunk_count_ = chunks.size();
   const std::size_t hierarchy_base = scene.segment_nodes_ + chunks.size();
   SceneBuild::allocate_groups(scene, chunks.size() + (chunks.empty() ? 0 : hierarchy.size()), chunks.size());
-  SceneBuild::build_curves(scene, input, threads);
+  SceneBuild::build_curves(scene, input);
   if (!chunks.empty()) {
     SceneBuild::build_chunk_nodes(scene, chunks, leaf_order);
     SceneBuild::build_hierarchy_nodes(scene, hierarchy, chunks, leaf_order, hierarchy_base);
@@ -536,7 +460,6 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels, int threa
   const double t2 = now_ms();
   scene.times_.multires_ms = t1 - t0;
   scene.times_.tree_ms = t2 - t1;
-  scene.times_.threads = threads;
   return scene;
 }
 

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <random>
 
 #include "curves.hpp"
@@ -294,56 +293,6 @@ TEST(CollisionTree, SkipsDegenerateCurves) {
   EXPECT_EQ(sc.curve_count(), 1u);
   EXPECT_EQ(sc.skipped_curves(), 2u);
   EXPECT_EQ(sc.source_index(0), 2u);
-}
-
-// Everything a walk or a tool reads of a scene, exactly: equal fingerprints mean the same scene bit for bit.
-std::vector<double> scene_fingerprint(const Scene& sc) {
-  std::vector<double> f{static_cast<double>(sc.curve_count()), static_cast<double>(sc.skipped_curves()), static_cast<double>(sc.node_count()),
-                        sc.bounds_min().x, sc.bounds_min().y, sc.bounds_max().x, sc.bounds_max().y};
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
-    const CurveInfo& ci = sc.curve(c);
-    f.push_back(static_cast<double>(sc.source_index(c)));
-    f.push_back(ci.closed ? 1.0 : 0.0);
-    for (int l = 0; l < ci.levels; ++l) {
-      f.insert(f.end(), {static_cast<double>(ci.box_offset[l]), static_cast<double>(ci.segment_count[l]), ci.max_error_m[l],
-                         ci.max_box_half_width_m[l], ci.max_error_bound_m[l], static_cast<double>(sc.curve_nodes(c).quantum_m[l])});
-    }
-  }
-  for (std::uint32_t n = 0; n < sc.node_count(); ++n) {
-    const ErrorBox b = sc.box(n);
-    const NodeInfo in = sc.info(n);
-    f.insert(f.end(), {b.origin_m.x, b.origin_m.y, b.axis.x, b.axis.y, b.u_min, b.u_max, b.n_min, b.n_max, static_cast<double>(in.curve),
-                       static_cast<double>(in.level), static_cast<double>(in.index), static_cast<double>(sc.parent(n))});
-  }
-  for (const WideNode& w : sc.wide_index().nodes) {
-    for (int i = 0; i < 4; ++i) f.insert(f.end(), {w.lo_x[i], w.lo_y[i], w.hi_x[i], w.hi_y[i], static_cast<double>(w.child[i])});
-  }
-  return f;
-}
-
-// Scene::build spreads its per-curve phases over threads: 1, 2, 3 and 4 of them build the same scene bit for
-// bit, with degenerate curves skipped in the same places; a scene too small to share out takes one thread.
-TEST(CollisionTree, ThreadsBuildTheSameSceneBitForBit) {
-  std::mt19937 rng(77);
-  std::vector<Polyline> curves;
-  for (int i = 0; i < 60; ++i) {
-    const Vec2 c{0.002 * (i % 10) - 0.01, 0.002 * (i / 10) - 0.006};
-    curves.push_back(i % 3 == 0 ? test::random_stroke(rng, c, 0.0002, 50 + 37 * i) : test::random_blob(rng, c, 0.004, 40 + 23 * i));
-    if (i % 17 == 5) curves.push_back(Polyline{{{0.01, 0.01}}, false});  // one point: skipped
-  }
-  const std::vector<double> one = scene_fingerprint(Scene::build(curves, 6, 1));
-  for (int threads = 2; threads <= 4; ++threads) {
-    const Scene sc = Scene::build(curves, 6, threads);
-    EXPECT_EQ(sc.build_times().threads, threads);
-    EXPECT_EQ(sc.skipped_curves(), 4u);
-    const std::vector<double> many = scene_fingerprint(sc);
-    ASSERT_EQ(many.size(), one.size()) << threads << " threads";
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < one.size(); ++i) differing += std::memcmp(&one[i], &many[i], sizeof(double)) != 0;
-    EXPECT_EQ(differing, 0u) << threads << " threads";
-  }
-  const std::vector<Polyline> small(curves.begin(), curves.begin() + 3);  // 3 curves, < kSceneBuildPointsPerThread points
-  EXPECT_EQ(Scene::build(small, 6).build_times().threads, 1);
 }
 
 class QueryVsBruteForce : public ::testing::TestWithParam<int> {};

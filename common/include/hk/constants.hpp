@@ -43,12 +43,4 @@ inline constexpr double kClosestListSkin_m = 1e-3;
 /// 510–541, 570 ns (docs/PERFORMANCE.md).
 inline constexpr double kWideBallCap_m = 1e-3;
 
-/// Threads Scene::build spreads its per-curve phases over, at most: the scene build is not on the servo
-/// path, but a kiosk PC has a few cores and one of them runs the servo.
-inline constexpr int kSceneBuildMaxThreads = 4;
-
-/// Input points per thread when Scene::build picks the count itself: below this a thread costs more to
-/// start than it saves (it takes ~20–50 µs; the per-curve phases take ~0.1 µs per point).
-inline constexpr std::size_t kSceneBuildPointsPerThread = 4096;
-
 }  // namespace hk

@@ -124,11 +124,10 @@ struct NodeInfo {
 };
 static_assert(sizeof(NodeInfo) == 12, "NodeInfo: 12 bytes per node");
 
-/// Build timings of a scene [ms], and how many threads its per-curve phases ran on.
+/// Build timings of a scene [ms].
 struct SceneBuildTimes {
   double multires_ms = 0.0;
   double tree_ms = 0.0;
-  int threads = 1;  ///< threads the per-curve phases ran on
 };
 
 /// All curves of a picture, ready for the servo loop. Immutable once built; shared read-only.
@@ -139,15 +138,9 @@ class Scene {
 
   /// Builds multiresolution models and collision trees for `curves` (workspace metres), with at most
   /// `max_levels` levels above level 0 (clamped to kMaxLevels − 1). Curves with fewer than 2 distinct
-  /// points or zero length are skipped (counted in skipped_curves()).
-  ///
-  /// The per-curve phases (the models, the error boxes) run on `threads` threads, the calling one among
-  /// them: ≥ 1 asks for that many (at most kSceneBuildMaxThreads); 0 picks one per
-  /// kSceneBuildPointsPerThread input points, at most the CPUs the calling thread may run on and
-  /// kSceneBuildMaxThreads (build_times().threads says how many ran). The scene is the same, bit for bit,
-  /// whatever the count. Throws std::bad_alloc only (also when the nodes would not fit 32-bit ids, or the
-  /// curves a 28-bit tag: far beyond any memory), or std::system_error when a thread cannot be started.
-  static Scene build(const std::vector<Polyline>& curves, int max_levels, int threads = 0);
+  /// points or zero length are skipped (counted in skipped_curves()). Throws std::bad_alloc only (also
+  /// when the nodes would not fit 32-bit ids, or the curves a 28-bit tag: far beyond any memory).
+  static Scene build(const std::vector<Polyline>& curves, int max_levels);
 
   std::size_t curve_count() const { return curves_.size(); }
   const CurveInfo& curve(std::size_t c) const { return curves_[c]; }
