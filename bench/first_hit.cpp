@@ -16,7 +16,9 @@
 //           segment_tests (per query).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -135,29 +137,50 @@ void set_percentiles(benchmark::State& state, std::vector<double>& ns) {
   state.counters["max_ns"] = ns.back();
 }
 
+// One first-hit query of method m.
+bool first_hit_once(Case* c, Method m, const Sweep& s, QueryStats* st) {
+  switch (m) {
+    case Method::Ours: return c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}, st).hit;
+    case Method::Wide: {
+      QueryBudget unlimited;
+      return c->ours->first_hit_wide(s.a, s.b, c->level, nullptr, 0, unlimited, st).hit;
+    }
+    case Method::Brute: return c->brute->first_hit(s.a, s.b).hit;
+    case Method::Rtree: return c->rtree->first_hit(s.a, s.b).hit;
+    case Method::Embree: return c->embree->first_hit(s.a, s.b).hit;
+  }
+  return false;
+}
+
+// The mean without a clock read per query [ns]: blocks of consecutive queries of the stream timed as a
+// whole (two clock reads per block), the fastest of three blocks. The per-query times (for the percentiles)
+// each carry the clock's own cost, ~40 ns on this VM, on every method alike. A block is as many queries as
+// ~20 ms holds at the per-query mean, at most the whole stream and at least 1000. query(i) runs query i.
+template <class Query>
+double batch_mean_ns(std::size_t stream_size, double per_query_mean_ns, Query&& query) {
+  const auto n = static_cast<std::size_t>(std::clamp(2e7 / std::max(per_query_mean_ns, 1.0), 1000.0, static_cast<double>(stream_size)));
+  double best = std::numeric_limits<double>::infinity();
+  for (int block = 0; block < 3; ++block) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < n; ++i) query(i);
+    best = std::min(best, std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / static_cast<double>(n));
+  }
+  return best;
+}
+
 void run_first_hit(benchmark::State& state, Case* c, Method m) {
   std::vector<double> ns;
   ns.reserve(1 << 20);
   std::size_t i = 0, hits = 0, full = 0, section = 0, seg_tests = 0, box_tests = 0;
+  double total_s = 0.0;
   for (auto _ : state) {
     const Sweep& s = c->stream[i];
     i = i + 1 == c->stream.size() ? 0 : i + 1;
     QueryStats st;
     const auto t0 = std::chrono::steady_clock::now();
-    bool hit = false;
-    if (m == Method::Ours) {
-      hit = c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}, &st).hit;
-    } else if (m == Method::Wide) {
-      QueryBudget unlimited;
-      hit = c->ours->first_hit_wide(s.a, s.b, c->level, nullptr, 0, unlimited, &st).hit;
-    } else if (m == Method::Brute) {
-      hit = c->brute->first_hit(s.a, s.b).hit;
-    } else if (m == Method::Rtree) {
-      hit = c->rtree->first_hit(s.a, s.b).hit;
-    } else {
-      hit = c->embree->first_hit(s.a, s.b).hit;
-    }
+    const bool hit = first_hit_once(c, m, s, &st);
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    total_s += dt;
     state.SetIterationTime(dt);
     if (ns.size() < ns.capacity()) ns.push_back(dt * 1e9);
     hits += hit;
@@ -168,6 +191,12 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     benchmark::DoNotOptimize(hit);
   }
   set_percentiles(state, ns);
+  if (m != Method::Brute) {  // brute force on 10^6 segments would take minutes
+    const double mean_ns = total_s * 1e9 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+    state.counters["batch_mean_ns"] = batch_mean_ns(c->stream.size(), mean_ns, [&](std::size_t k) {
+      benchmark::DoNotOptimize(first_hit_once(c, m, c->stream[k], nullptr));
+    });
+  }
   if (m == Method::Ours || m == Method::Wide) {
     const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
     state.counters["segment_tests"] = static_cast<double>(seg_tests) / n;  // per query
@@ -194,35 +223,51 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
   }
 }
 
+// One closest-point query of method m: the distance (1 m when nothing is within 1 m). `counted`, for ours,
+// counts the walk's box tests.
+double closest_once(Case* c, Method m, Vec2 p, QueryBudget* counted) {
+  switch (m) {
+    case Method::Ours: {
+      Vec2 q;
+      SegmentRef s;
+      return c->ours->closest_point(p, c->level, 1.0, &q, &s, -1, counted) ? distance(p, q) : 1.0;
+    }
+    case Method::Brute: return c->brute->closest_distance(p);
+    case Method::Rtree: return c->rtree->closest_distance(p);
+    case Method::Embree: return c->embree->closest_distance(p);
+    case Method::Wide: break;  // not a closest-point method
+  }
+  return 1.0;
+}
+
 void run_closest(benchmark::State& state, Case* c, Method m) {
   std::vector<double> ns;
   ns.reserve(1 << 20);
   std::size_t i = 0, walks = 0, walk_box_tests = 0;
+  double total_s = 0.0;
   for (auto _ : state) {
     const Vec2 p = c->stream[i].b;
     i = i + 1 == c->stream.size() ? 0 : i + 1;
+    QueryBudget counted;  // no limit: counts the walk's box tests
     const auto t0 = std::chrono::steady_clock::now();
-    double d = 0.0;
+    const double d = closest_once(c, m, p, &counted);
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    total_s += dt;
     if (m == Method::Ours) {
-      Vec2 q;
-      SegmentRef s;
-      QueryBudget counted;  // no limit: counts the walk's box tests
-      d = c->ours->closest_point(p, c->level, 1.0, &q, &s, -1, &counted) ? distance(p, q) : 1.0;
       walks += c->ours->last_closest_source() == BoundarySection::ClosestSource::Walk;
       walk_box_tests += static_cast<std::size_t>(counted.box_tests_used);
-    } else if (m == Method::Brute) {
-      d = c->brute->closest_distance(p);
-    } else if (m == Method::Rtree) {
-      d = c->rtree->closest_distance(p);
-    } else {
-      d = c->embree->closest_distance(p);
     }
-    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     state.SetIterationTime(dt);
     if (ns.size() < ns.capacity()) ns.push_back(dt * 1e9);
     benchmark::DoNotOptimize(d);
   }
   set_percentiles(state, ns);
+  if (m != Method::Brute) {
+    const double mean_ns = total_s * 1e9 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+    state.counters["batch_mean_ns"] = batch_mean_ns(c->stream.size(), mean_ns, [&](std::size_t k) {
+      benchmark::DoNotOptimize(closest_once(c, m, c->stream[k].b, nullptr));
+    });
+  }
   state.counters["segments"] = static_cast<double>(c->segs.size());
   if (m == Method::Ours) {
     // Calls the neighbour list could not answer, and the box tests of those walks.
