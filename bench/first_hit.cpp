@@ -1,7 +1,8 @@
 // Servo query against peers (issue 3 items 2 and 4, issue 18 item 1): the same query streams answered by
 // our collision tree with its boundary section, by brute force, by a Boost.Geometry R-tree and by Embree
 // (bench/support/embree_peer.hpp); results checked equal before anything is timed. One benchmark iteration is one query, timed on its own (manual time), so
-// the mean and the percentiles describe the same measurements; each includes ~30 ns of clock reads.
+// the mean and the percentiles describe the same measurements; each includes ~25–40 ns of clock reads.
+// batch_mean_ns gives the mean again without them (blocks of queries timed as a whole).
 //
 // Methods: ours (first_hit: boundary section, free-space ball, anytime answers at a coarser level),
 //          ours_wide (first_hit_wide: the scene's wide index alone, with a free-space ball from it; first hits
@@ -10,7 +11,7 @@
 //        BM_Closest/<method>/<segments>   — closest point on the same scenes
 //        BM_Picture/<method>/<picture>    — the handle sweeps of an explore raster run on that picture
 //        BM_Level/<method>/<level>        — speed against accuracy: 4 pictures, queries at each level
-// Counters: p50_ns, p99_ns, max_ns per query; build_ms; bytes_per_segment; segments; max_error_mm; for
+// Counters: p50_ns, p99_ns, max_ns per query; batch_mean_ns (not for brute); build_ms; bytes_per_segment; segments; max_error_mm; for
 //           ours and ours_wide, full_query_fraction (queries the free-space ball did not answer),
 //           section_entries (mean boundary-section size after a query; 0 for ours_wide), box_tests and
 //           segment_tests (per query).
@@ -154,7 +155,7 @@ bool first_hit_once(Case* c, Method m, const Sweep& s, QueryStats* st) {
 
 // The mean without a clock read per query [ns]: blocks of consecutive queries of the stream timed as a
 // whole (two clock reads per block), the fastest of three blocks. The per-query times (for the percentiles)
-// each carry the clock's own cost, ~40 ns on this VM, on every method alike. A block is as many queries as
+// each carry the clock's own cost, ~25–40 ns on this VM, on every method alike. A block is as many queries as
 // ~20 ms holds at the per-query mean, at most the whole stream and at least 1000. query(i) runs query i.
 template <class Query>
 double batch_mean_ns(std::size_t stream_size, double per_query_mean_ns, Query&& query) {
