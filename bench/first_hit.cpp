@@ -169,6 +169,15 @@ double batch_mean_ns(std::size_t stream_size, double per_query_mean_ns, Query&& 
   return best;
 }
 
+// The batch_mean_ns counter of a benchmark whose timed queries took total_s in all [s]; not for brute
+// force (at 10^6 segments its blocks would take minutes).
+template <class Query>
+void set_batch_mean(benchmark::State& state, const Case* c, Method m, double total_s, Query&& query) {
+  if (m == Method::Brute) return;
+  const double mean_ns = total_s * 1e9 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+  state.counters["batch_mean_ns"] = batch_mean_ns(c->stream.size(), mean_ns, query);
+}
+
 void run_first_hit(benchmark::State& state, Case* c, Method m) {
   std::vector<double> ns;
   ns.reserve(1 << 20);
@@ -192,12 +201,7 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     benchmark::DoNotOptimize(hit);
   }
   set_percentiles(state, ns);
-  if (m != Method::Brute) {  // brute force on 10^6 segments would take minutes
-    const double mean_ns = total_s * 1e9 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
-    state.counters["batch_mean_ns"] = batch_mean_ns(c->stream.size(), mean_ns, [&](std::size_t k) {
-      benchmark::DoNotOptimize(first_hit_once(c, m, c->stream[k], nullptr));
-    });
-  }
+  set_batch_mean(state, c, m, total_s, [&](std::size_t k) { benchmark::DoNotOptimize(first_hit_once(c, m, c->stream[k], nullptr)); });
   if (m == Method::Ours || m == Method::Wide) {
     const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
     state.counters["segment_tests"] = static_cast<double>(seg_tests) / n;  // per query
@@ -263,12 +267,7 @@ void run_closest(benchmark::State& state, Case* c, Method m) {
     benchmark::DoNotOptimize(d);
   }
   set_percentiles(state, ns);
-  if (m != Method::Brute) {
-    const double mean_ns = total_s * 1e9 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
-    state.counters["batch_mean_ns"] = batch_mean_ns(c->stream.size(), mean_ns, [&](std::size_t k) {
-      benchmark::DoNotOptimize(closest_once(c, m, c->stream[k].b, nullptr));
-    });
-  }
+  set_batch_mean(state, c, m, total_s, [&](std::size_t k) { benchmark::DoNotOptimize(closest_once(c, m, c->stream[k].b, nullptr)); });
   state.counters["segments"] = static_cast<double>(c->segs.size());
   if (m == Method::Ours) {
     // Calls the neighbour list could not answer, and the box tests of those walks.

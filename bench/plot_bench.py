@@ -237,16 +237,18 @@ if size_rows:
     fw_emb_b = wide_cells(lambda r: bm(r["embree"]) / bm(r["ours_wide"])) if has_batch else []
     cp_mean_b = ratio_cells("Closest", big, lambda r: bm(r["rtree"]) / bm(r["ours"])) if has_batch else []
     fmt = lambda cells, unit: ", ".join("%.2f%s at 10^%d" % (v, unit, len(str(n)) - 1) for n, v in cells)
-    def batch_txt(cells, wide_cells_, unit, ok):
+    yes = lambda ok: "yes" if ok else "no"
+
+    def batch_txt(cells, wide_cells_, unit, ok, label="first_hit "):
+        """The figures and the verdict from the batch means, to append to a row's cells ("" when absent)."""
         if not cells:
             return "", ""
-        txt = "; batch means (no clock read per query): first_hit %s" % fmt(cells, unit)
-        met = "; batch: first_hit %s" % yes(all(ok(v) for _, v in cells))
+        txt = "; batch means (no clock read per query): %s%s" % (label, fmt(cells, unit))
+        met = "; batch: %s%s" % (label, yes(all(ok(v) for _, v in cells)))
         if wide_cells_:
             txt += ", first_hit_wide %s" % fmt(wide_cells_, unit)
             met += ", first_hit_wide %s" % yes(all(ok(v) for _, v in wide_cells_))
         return txt, met
-    yes = lambda ok: "yes" if ok else "no"
     wide_txt = lambda cells, unit: ("; first_hit_wide (wide index alone): %s" % fmt(cells, unit)) if cells else ""
     wide_met = lambda cells, ok: ("; first_hit_wide: %s" % yes(all(ok(v) for _, v in cells))) if cells else ""
     bt, bmet = batch_txt(fh_mean_b, fw_mean_b, "x", lambda v: v >= 6)
@@ -259,8 +261,7 @@ if size_rows:
     rows2.append("| first hit: faster than Embree on the same streams | Embree mean / ours: first_hit %s, pictures where it is faster: %d of %d%s%s | first_hit: %s%s%s |" % (
         fmt(fh_emb, "x"), pic_faster, len(pic), wide_txt(fw_emb, "x"), bt, yes(all(v > 1 for _, v in fh_emb) and pic_faster == len(pic)),
         wide_met(fw_emb, lambda v: v > 1) + (" on the tiled scenes (not run on the pictures)" if fw_emb else ""), bmet))
-    cpb = ("; batch means (no clock read per query): %s" % fmt(cp_mean_b, "x")) if cp_mean_b else ""
-    cpb_met = ("; batch: %s" % yes(all(v >= 3 for _, v in cp_mean_b))) if cp_mean_b else ""
+    cpb, cpb_met = batch_txt(cp_mean_b, [], "x", lambda v: v >= 3, label="")
     rows2.append("| closest point: mean ≥ 3x faster than the R-tree | R-tree mean / ours: %s%s | %s%s |" % (fmt(cp_mean, "x"), cpb, yes(all(v >= 3 for _, v in cp_mean)), cpb_met))
     rows2.append("| closest point: p99 ≤ 0.5x the R-tree's | ours p99 / R-tree p99: %s | %s |" % (fmt(cp_p99, ""), yes(all(v <= 0.5 for _, v in cp_p99))))
     bps = [size_rows[("FirstHit", n)]["ours"]["bytes_per_segment"] for n in big if ("FirstHit", n) in size_rows]

@@ -37,10 +37,9 @@ inline constexpr double kClosestListSkin_m = 1e-3;
 
 /// Largest free-space ball of BoundarySection::first_hit_wide [m]: its clearance walk stops refining past
 /// this distance, so the walk opens only the nodes within it. 1 mm is 2.5–50 servo ticks of a hand at
-/// 0.02–0.4 m/s. A larger ball answers more ticks but every walk that makes it opens more nodes: on the
-/// random-walk streams at 10^5 segments, caps of 0.5, 1, 1.5, 2, 4 and 6 mm gave walks on 38, 26, 21, 19,
-/// 15 and 14 % of the ticks, a mean of 88, 80–83, 79, 81, 84–87, 88 ns and a p99 of 400, 401–421, 430, 452,
-/// 510–541, 570 ns (docs/PERFORMANCE.md).
+/// 0.02–0.4 m/s. A larger ball answers more ticks but every walk that measures it opens more nodes; of the
+/// caps measured (0.5–6 mm, docs/PERFORMANCE.md "The wide index"), 1 mm gave the lowest p99 within a few
+/// ns of the lowest mean.
 inline constexpr double kWideBallCap_m = 1e-3;
 
 }  // namespace hk
