@@ -91,7 +91,6 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   merge_scratch_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
   stack_.resize(tree_stack_entries(widest_root));
-  list_entries_.resize(kClosestListCapacity);
   hit_stamp_.assign(n, 0);
   merge_stamp_.assign(n, 0);
   seen_stamp_.assign(n, 0);
@@ -100,7 +99,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
 }
 
 void BoundarySection::reset() {
-  list_.valid = false;  // a reset section answers like a new one, box test for box test
+  last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
   for (std::uint32_t node : section_) in_section_[node] = 0;
   section_.clear();
   section_box_.clear();
@@ -486,11 +485,15 @@ std::uint32_t BoundarySection::item_segments(std::uint32_t item, int level, std:
 // Checked push onto the wide walks' stack, in order: among the entries pushed since `base` (a node's
 // children, at most four) the one nearest to the walk's point ends on top. False, with nothing pushed,
 // when the stack is full.
-bool BoundarySection::push_walk(WalkEntry e, int base, int& top) noexcept {
+bool BoundarySection::push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept {
   if (static_cast<std::size_t>(top) >= walk_stack_.size()) return false;
+  WalkEntry* s = walk_stack_.data();
   int k = top++;
-  for (; k > base && walk_stack_[static_cast<std::size_t>(k - 1)].d_sq < e.d_sq; --k) walk_stack_[static_cast<std::size_t>(k)] = walk_stack_[static_cast<std::size_t>(k - 1)];
-  walk_stack_[static_cast<std::size_t>(k)] = e;
+  for (; k > base && s[k - 1].d_sq < d_sq; --k) s[k] = s[k - 1];
+  // Field by field: an entry built whole on the stack and copied in one 8-byte load stalls on store forwarding.
+  s[k].t_enter = t_enter;
+  s[k].d_sq = d_sq;
+  s[k].code = code;
   return true;
 }
 
@@ -552,8 +555,7 @@ double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
     for (int i = 0; i < 4; ++i) {
       const int bit = 1 << i;
       if (!((hit_mask | near_mask) & bit)) continue;
-      const WalkEntry c{(hit_mask & bit) ? t_enter[i] : std::numeric_limits<float>::infinity(), d_sq[i], n.child[i]};
-      if (!push_walk(c, base, top)) {  // full: as past the budget
+      if (!push_walk((hit_mask & bit) ? t_enter[i] : std::numeric_limits<float>::infinity(), d_sq[i], n.child[i], base, top)) {  // full: as past the budget
         ball_known = false;
         if (e.t_enter < q.unresolved_t) {
           q.unresolved_t = e.t_enter;
@@ -634,159 +636,124 @@ constexpr SegmentRef kNoSegment{std::numeric_limits<std::int32_t>::max(), std::n
 
 }  // namespace
 
-// The nearest segment of the neighbour list built at centre_m to p, within max_distance_m, in *guess.
-// Returns true when the list provably holds every segment that could be the answer (closest_point says
-// why), so *guess is the answer; false when it cannot say (*guess is then only a first bound).
-bool BoundarySection::closest_from_list(Vec2 p, int level, double max_distance_m, int curve, ClosestGuess* guess) const noexcept {
-  guess->found = false;
-  if (!list_.valid || list_.level != level || list_.curve != curve) return false;
-  const double delta = distance(p, list_.centre_m);
-  double best = max_distance_m;
+// The best closest-point answer so far of one call, its pruning bound, and where to write the answer.
+struct BoundarySection::ClosestQuery {
+  Vec2 p;
+  int level = 0;
+  int curve = -1;
+  double best_m = 0.0;      // distance of the best answer so far, or max_distance_m before there is one [m]
+  double bound_sq = 0.0;    // best_m² grown by a few ulps: rounding never prunes what best_m itself would keep [m²]
   SegmentRef best_s = kNoSegment;
-  for (std::size_t i = 0; i < list_.count; ++i) {
-    const ListEntry& e = list_entries_[i];
-    // Sorted by distance from the centre, which is at most δ more than from p: no later entry is nearer.
-    if (e.distance_m - delta > best) break;
-    const Vec2 q = closest_point_on_segment(p, e.a_m, e.b_m);
-    const double d = distance(p, q);
-    if (closer(d, e.segment, best, best_s)) {
-      best = d;
-      best_s = e.segment;
-      guess->point_m = q;
-    }
+  std::uint32_t best_node = kWideEmpty;
+  Vec2 best_point;
+  ClosestQuery(Vec2 p_in, int level_in, int curve_in, double max_distance_m)
+      : p(p_in), level(level_in), curve(curve_in) { set_best(max_distance_m); }
+  void set_best(double d_m) {
+    best_m = d_m;
+    bound_sq = d_m * d_m * (1.0 + 1e-12);
   }
-  guess->found = !(best_s == kNoSegment);
-  guess->distance_m = best;
-  guess->segment = best_s;
-  return best + delta < list_.radius_m;  // else something outside the list could be as near
+  bool found() const { return best_node != kWideEmpty; }
+};
+
+// Offers segment node `node` (end points a, b) to the query: taken when nearer than the best so far, or as
+// near with the smaller (curve, level, segment). The end points' rectangle bounds the distance from below
+// without a division, and the segment's reference is looked up only where it decides a tie or wins.
+// Inlined: it runs ~20 times a call, and a call's overhead is a fair part of its cost.
+[[gnu::always_inline]] inline void BoundarySection::closest_offer(ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) const noexcept {
+  const Vec2 p = q.p;
+  const double rx = std::max({std::min(a.x, b.x) - p.x, 0.0, p.x - std::max(a.x, b.x)});
+  const double ry = std::max({std::min(a.y, b.y) - p.y, 0.0, p.y - std::max(a.y, b.y)});
+  if (rx * rx + ry * ry > q.bound_sq) return;
+  const Vec2 c = closest_point_on_segment(p, a, b);
+  const double d_sq = length_sq(p - c);
+  if (d_sq > q.bound_sq) return;
+  const double d = std::sqrt(d_sq);  // bit for bit distance(p, c)
+  if (d > q.best_m) return;
+  const NodeInfo in = scene_->info(node);
+  const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+  if (!closer(d, ref, q.best_m, q.best_s)) return;
+  q.set_best(d);
+  q.best_s = ref;
+  q.best_node = node;
+  q.best_point = c;
 }
 
-// Adds a segment to the list being built; when the list is full the farthest entry (or the new one) is
-// dropped, and the list then vouches only for what is nearer than what it dropped.
-void BoundarySection::list_add(const ListEntry& e, double* radius_limit_m) noexcept {
-  std::size_t slot = list_.count;
-  if (slot == list_entries_.size()) {
-    slot = 0;
-    for (std::size_t i = 1; i < list_.count; ++i) {
-      if (list_entries_[i].distance_m > list_entries_[slot].distance_m) slot = i;
-    }
-    if (list_entries_[slot].distance_m <= e.distance_m) {
-      *radius_limit_m = std::min(*radius_limit_m, e.distance_m);
-      return;
-    }
-    *radius_limit_m = std::min(*radius_limit_m, list_entries_[slot].distance_m);
-  } else {
-    ++list_.count;
-  }
-  list_entries_[slot] = e;
+// The seed: the previous call's answer, measured again at the new point, when that call was for the same
+// level and curve. A real candidate, so the walk's bound is tight from the root down; the hand moves
+// little between ticks, so it is nearly always the answer again or within a few of it.
+void BoundarySection::closest_seed(ClosestQuery& q) const noexcept {
+  if (last_closest_node_ == kWideEmpty || last_closest_level_ != q.level || last_closest_curve_ != q.curve) return;
+  Vec2 a, b;
+  scene_->segment_points(last_closest_node_, &a, &b);
+  closest_offer(q, last_closest_node_, a, b);
 }
 
-bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
-                                    QueryBudget* budget) {
+// At an item of the walk: offers the target level's segments under or over it (a coarser segment stands
+// for several items and is offered once per walk).
+void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noexcept {
   const Scene& sc = *scene_;
-  if (sc.curve_count() == 0) return false;
-  ClosestGuess guess;
-  if (closest_from_list(p, level, max_distance_m, curve, &guess)) {
-    last_closest_source_ = ClosestSource::List;
-    if (guess.found) {
-      if (point_out) *point_out = guess.point_m;
-      if (segment_out) *segment_out = guess.segment;
-    }
-    return guess.found;
+  if (q.curve >= 0 && static_cast<int>(sc.tag_curve(item)) != q.curve) return;
+  std::uint32_t first = 0;
+  const std::uint32_t count = item_segments(item, q.level, &first);
+  if (count == 1 && sc.tag_level(first) > sc.tag_level(item)) {
+    if (seen_stamp_[first] == seen_tick_) return;
+    seen_stamp_[first] = seen_tick_;
   }
-  last_closest_source_ = ClosestSource::Walk;
-  // The walk: depth first, nearest child first, pruned at (best so far) + skin, so that everything the
-  // new neighbour list must hold is reached; the answer itself only takes what is within max_distance_m.
-  // It starts from the old list's nearest segment, when there is one: a real candidate, so the bound is
-  // tight from the root down.
-  list_.valid = false;
-  list_.count = 0;
-  bool found = guess.found;
-  double best = guess.found ? guess.distance_m : max_distance_m;
-  SegmentRef best_s = guess.found ? guess.segment : kNoSegment;
-  if (found) {
-    if (point_out) *point_out = guess.point_m;
-    if (segment_out) *segment_out = guess.segment;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    Vec2 a, b;
+    sc.segment_points(first + i, &a, &b);
+    closest_offer(q, first + i, a, b);
   }
-  double radius_limit = std::numeric_limits<double>::infinity();
-  // Prune at best + skin, for the list; once the list is full, at what it can still vouch for (but never
-  // below best, for the answer). The walk compares squared distances (no root per box); the squared bound
-  // is grown by a few ulps so that rounding never prunes a box the bound itself would keep.
-  double bound = 0.0, bound_sq = 0.0;
-  const auto update_bound = [&] {
-    bound = std::min(best + kClosestListSkin_m, std::max(best, radius_limit));
-    bound_sq = bound * bound * (1.0 + 1e-12);
-  };
-  update_bound();
-  const WideIndex& wi = sc.wide_index();
+}
+
+// The walk of the wide index: depth first, nearest rectangle first, pruned at the best distance so far
+// (which only shrinks). False when the budget or the stack ran out (the answer is then unknown).
+bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcept {
+  const WideIndex& wi = scene_->wide_index();
+  if (wi.nodes.empty()) return true;
   if (++seen_tick_ == 0) {  // stamp wrap-around
     std::fill(seen_stamp_.begin(), seen_stamp_.end(), 0u);
     seen_tick_ = 1;
   }
-  const float px = static_cast<float>(p.x), py = static_cast<float>(p.y);
+  const float px = static_cast<float>(q.p.x), py = static_cast<float>(q.p.y);
   int top = 0;
   walk_stack_[static_cast<std::size_t>(top++)] = WalkEntry{0.0f, 0.0f, 0u};
   while (top > 0) {
     const WalkEntry e = walk_stack_[static_cast<std::size_t>(--top)];
-    if (static_cast<double>(e.d_sq) > bound_sq) continue;  // the bound only shrinks: nothing under it can matter any more
+    if (static_cast<double>(e.d_sq) > q.bound_sq) continue;
     if (e.code & kWideLeaf) {
-      const std::uint32_t item = e.code & ~kWideLeaf;
-      if (curve >= 0 && static_cast<int>(sc.tag_curve(item)) != curve) continue;
-      std::uint32_t first = 0;
-      const std::uint32_t count = item_segments(item, level, &first);
-      for (std::uint32_t i = 0; i < count; ++i) {
-        const std::uint32_t node = first + i;
-        if (sc.tag_level(node) > sc.tag_level(item)) {  // a coarser segment stands for several items: once per walk
-          if (seen_stamp_[node] == seen_tick_) continue;
-          seen_stamp_[node] = seen_tick_;
-        }
-        Vec2 a, b;
-        sc.segment_points(node, &a, &b);
-        // The rectangle of the end points bounds the distance from below, without a division.
-        const double rx = std::max({std::min(a.x, b.x) - p.x, 0.0, p.x - std::max(a.x, b.x)});
-        const double ry = std::max({std::min(a.y, b.y) - p.y, 0.0, p.y - std::max(a.y, b.y)});
-        if (rx * rx + ry * ry > bound_sq) continue;
-        const NodeInfo in = sc.info(node);
-        const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
-        const Vec2 q = closest_point_on_segment(p, a, b);
-        const double d_sq = length_sq(p - q);
-        if (d_sq > bound_sq) continue;
-        const double d = std::sqrt(d_sq);  // bit for bit distance(p, q), as the list's scan computes it
-        if (d < bound) list_add(ListEntry{a, b, d, ref}, &radius_limit);
-        if (closer(d, ref, best, best_s)) {
-          best = d;
-          best_s = ref;
-          found = true;
-          if (point_out) *point_out = q;
-          if (segment_out) *segment_out = ref;
-        }
-        update_bound();
-      }
+      closest_test_item(q, e.code & ~kWideLeaf);
       continue;
     }
-    if (budget && !budget->spend(kWideBoxTestsPerNode)) return false;  // unknown: the caller sees budget->ran_out
+    if (budget && !budget->spend(kWideBoxTestsPerNode)) return false;  // the caller sees budget->ran_out
     const WideNode& n = wi.nodes[e.code];
     float d_sq[4];
-    const int mask = near_node(n, px, py, float_at_least(bound_sq), d_sq);
+    const int mask = near_node(n, px, py, float_at_least(q.bound_sq), d_sq);
     const int base = top;
     for (int i = 0; i < 4; ++i) {
       if (!(mask & (1 << i))) continue;
-      if (!push_walk(WalkEntry{std::numeric_limits<float>::infinity(), d_sq[i], n.child[i]}, base, top)) {
+      if (!push_walk(std::numeric_limits<float>::infinity(), d_sq[i], n.child[i], base, top)) {
         if (budget) budget->ran_out = true;  // the stack is full: the answer is unknown, as past the budget
         return false;
       }
     }
   }
-  // Everything within the final bound was reached (boxes farther than the bound at the time were pruned,
-  // and the bound only shrank); the list vouches for that radius, sorted for the scans that use it.
-  std::sort(list_entries_.begin(), list_entries_.begin() + static_cast<std::ptrdiff_t>(list_.count),
-            [](const ListEntry& x, const ListEntry& y) { return x.distance_m < y.distance_m; });
-  list_.valid = true;
-  list_.level = level;
-  list_.curve = curve;
-  list_.centre_m = p;
-  list_.radius_m = std::min(best + kClosestListSkin_m, radius_limit);
-  return found;
+  return true;
+}
+
+bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
+                                    QueryBudget* budget) {
+  if (scene_->curve_count() == 0) return false;
+  ClosestQuery q(p, level, curve, max_distance_m);
+  closest_seed(q);
+  const bool complete = closest_walk(q, budget);
+  last_closest_level_ = level;
+  last_closest_curve_ = curve;
+  last_closest_node_ = complete ? q.best_node : kWideEmpty;
+  if (!complete || !q.found()) return false;
+  if (point_out) *point_out = q.best_point;
+  if (segment_out) *segment_out = q.best_s;
+  return true;
 }
 
 }  // namespace hk

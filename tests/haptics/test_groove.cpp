@@ -193,7 +193,7 @@ TEST(GrooveSolver, EventsOnEnteringAndLeavingTheRadius) {
   GrooveSolver solver(sc, gp);
   solver.reset({0.0, -0.005}, 0);
   ContactOutput out;
-  int begins = 0, ends = 0, walks = 0;
+  int begins = 0, ends = 0, walks = 0, most_box_tests = 0;
   for (int i = 0; i <= 100; ++i) {
     ContactInput in;
     in.handle_m = {0.0, -0.005 + 0.0001 * i};
@@ -207,11 +207,14 @@ TEST(GrooveSolver, EventsOnEnteringAndLeavingTheRadius) {
       EXPECT_GE(out.budget_used, 1) << "the first closest point walks the tree";
     }
     walks += out.budget_used > 0;
+    most_box_tests = std::max(most_box_tests, static_cast<int>(out.budget_used));
   }
   EXPECT_EQ(begins, 1);
   EXPECT_EQ(ends, 1);
-  // 0.1 mm a tick: the closest-point neighbour list (1 mm skin) answers most ticks without a box test.
-  EXPECT_LE(walks, 25);
+  // Every tick walks the wide index, charged to the tick's budget, and opens no more than the nodes on
+  // one path from the root and their neighbours.
+  EXPECT_EQ(walks, 101);
+  EXPECT_LE(most_box_tests, 2 * kWideBoxTestsPerNode * sc.wide_index().depth);
   EXPECT_EQ(out.state, ContactState::Free);
 }
 
@@ -228,8 +231,8 @@ TEST(GrooveSolver, OutOfBudgetKeepsTheLastClosestPointWhileWithinTheRadius) {
   ASSERT_EQ(out.state, ContactState::Edge);
   const Vec2 q = out.proxy_m;
   in.budget.max_box_tests = 1;  // too little for any walk below the root
-  // 1.5 mm on, 2.5 mm from the line: past what the neighbour list of the last tick (1 mm from the line,
-  // 1 mm skin) vouches for, so the closest point needs a walk; within R of the last closest point.
+  // 1.5 mm on, 2.5 mm from the line: the closest point needs a walk, which the budget refuses; within R of
+  // the last closest point.
   in.handle_m = {0.001, -0.0025};
   solver.update(in, out);
   EXPECT_NE(out.events & kEventQueryBudget, 0u);

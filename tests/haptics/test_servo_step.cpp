@@ -330,8 +330,8 @@ TEST(ServoStep, LevelCheckDrawsOnTheTickBudget) {
   const Scene sc = Scene::build({test::square(0.02)}, 3);
   ContactParams cp;
   ContactSolver solver(sc, cp);
-  // Each check from the same state: reset forgets the closest-point neighbour list a check leaves behind
-  // (with it, a second check would walk less).
+  // Each check from the same state: reset forgets the closest-point seed a check leaves behind (with it, a
+  // second check could walk less).
   const auto fresh = [&] { solver.reset({-0.0185, 0.003}, 2); };
   fresh();
   QueryBudget unlimited;

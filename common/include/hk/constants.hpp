@@ -25,16 +25,6 @@ constexpr std::size_t tree_stack_entries(std::size_t widest_fanout) {
   return widest_fanout * static_cast<std::size_t>(kMaxLevels + kMaxHierarchyDepth) + 8;
 }
 
-/// Segments a closest-point neighbour list holds at most (BoundarySection::closest_point): the level-l
-/// segments within its radius of the point it was built at. A walk that meets more keeps the nearest
-/// this many and shrinks the list's radius to the nearest one it dropped.
-inline constexpr std::size_t kClosestListCapacity = 64;
-
-/// Skin of the closest-point neighbour list [m]: the list built at p0 holds every segment within
-/// (closest distance at p0) + this, so the hand may move about this far before the list must be rebuilt.
-/// 1 mm is 2.5–50 servo ticks of a hand at 0.02–0.4 m/s.
-inline constexpr double kClosestListSkin_m = 1e-3;
-
 /// Largest free-space ball of BoundarySection::first_hit_wide [m]: its clearance walk stops refining past
 /// this distance, so the walk opens only the nodes within it. 1 mm is 2.5–50 servo ticks of a hand at
 /// 0.02–0.4 m/s. A larger ball answers more ticks but every walk that measures it opens more nodes; of the

@@ -103,7 +103,7 @@ class BoundarySection {
   /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots.
   explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4);
 
-  /// Forgets the frontier (back to one root per curve) and the closest-point neighbour list. Real-time safe.
+  /// Forgets the frontier (back to one root per curve), both free-space balls and the closest-point seed. Real-time safe.
   void reset();
 
   /// First hit of the sweep a→b against the polylines at `level` (clamped per curve to its coarsest),
@@ -136,27 +136,18 @@ class BoundarySection {
   /// the same distance (a vertex two segments share) the smallest (curve, level, segment) is the answer,
   /// so it does not depend on the order anything was visited in.
   ///
-  /// Coherent between calls, like the first hit's free-space ball: a distance-pruned walk of the scene's
-  /// wide index (wide_index.hpp; nearest rectangle first, four rectangles per SIMD test, the target level's
-  /// segments under or over each item reached; it neither uses nor changes the frontier) also collects a
-  /// neighbour list, every segment
-  /// within R = (closest distance) + kClosestListSkin_m of p0 (at most kClosestListCapacity of them; past
-  /// that the nearest are kept and R shrinks to the nearest one dropped). A later call with the same
-  /// level and curve at p, δ = |p − p0| from it, scans only the list: any segment within d of p is within
-  /// d + δ of p0, so when the list's best d (or max_distance_m when it has none within that) satisfies
-  /// d + δ < R, the list holds every candidate and its answer is exact; otherwise the walk runs again
-  /// (the Verlet neighbour list of molecular dynamics, Verlet 1967, with the proxy's coherence of seed §3).
+  /// A distance-pruned walk of the scene's wide index (wide_index.hpp): depth first, nearest rectangle
+  /// first, four rectangles per SIMD test, the target level's segments under or over each item reached;
+  /// it neither uses nor changes the frontier. Coherent between calls like the first hit's free-space
+  /// ball: the previous call's answer (same level and curve), measured again at p, seeds the bound, so
+  /// the walk is pruned tightly from the root down (the branch-and-bound nearest-neighbour search of
+  /// Roussopoulos, Kelley & Vincent 1995, with the proxy's coherence of seed §3).
   ///
-  /// With a `budget`, each wide node a walk opens is four optional box tests charged to it (a call
-  /// answered from the list charges none); when it runs out the walk stops and returns false with
-  /// budget->ran_out set (the answer is then unknown, not "nothing close"), and the list is dropped.
-  /// Allocates nothing.
+  /// With a `budget`, each wide node the walk opens is four optional box tests charged to it; when it
+  /// runs out the walk stops and returns false with budget->ran_out set (the answer is then unknown, not
+  /// "nothing close"), and the next call is not seeded. Allocates nothing.
   bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
                      QueryBudget* budget = nullptr);
-
-  /// What the last closest_point call did (for tests and the benchmark's counters).
-  enum class ClosestSource : std::uint8_t { Walk, List };
-  ClosestSource last_closest_source() const { return last_closest_source_; }
 
   /// Node ids of the current boundary section (for the operator overlay and tests).
   const std::vector<std::uint32_t>& section() const { return section_; }
@@ -181,7 +172,7 @@ class BoundarySection {
   struct WalkEntry { float t_enter; float d_sq; std::uint32_t code; };  // 12 bytes
   static_assert(sizeof(WalkEntry) == 12, "WalkEntry: 12 bytes");
   std::uint32_t item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept;
-  bool push_walk(WalkEntry e, int base, int& top) noexcept;
+  bool push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept;
   void wide_test_item(Query& q, std::uint32_t item);
   double wide_walk(Query& q, double ball_cap_m);
   std::vector<WalkEntry> walk_stack_;      // the wide walks' stack (WideIndex::stack_entries)
@@ -207,35 +198,14 @@ class BoundarySection {
   std::vector<Candidate> stack_;           // DFS stack, tree_stack_entries(widest fan-out) entries, sized at build
   std::vector<std::uint32_t> hit_stamp_;   // per node: tick at which its margin-grown box was last hit
   std::vector<std::uint32_t> merge_stamp_; // per node: tick at which it was last considered for a merge
-  // The closest-point neighbour list (see closest_point): segments within radius_m of centre_m at one
-  // (level, curve), with their end points so that a scan streams through them, sorted by their distance
-  // from centre_m so that a scan stops at the first that cannot be nearer. Capacity kClosestListCapacity.
-  struct ClosestList {
-    bool valid = false;
-    int level = 0, curve = -1;
-    Vec2 centre_m;
-    double radius_m = 0.0;  // [m]
-    std::size_t count = 0;
-  };
-  struct ListEntry {  // 56 bytes
-    Vec2 a_m, b_m;          // end points [m]
-    double distance_m;      // from the list's centre [m]
-    SegmentRef segment;
-  };
-  static_assert(sizeof(ListEntry) == 56, "ListEntry: 56 bytes");
-  // The nearest segment a list knows of at a point, even where it cannot vouch that nothing is nearer:
-  // the first bound of the walk that replaces it.
-  struct ClosestGuess {
-    bool found = false;
-    double distance_m = 0.0;
-    Vec2 point_m;
-    SegmentRef segment;
-  };
-  ClosestList list_;
-  std::vector<ListEntry> list_entries_;
-  ClosestSource last_closest_source_ = ClosestSource::Walk;
-  bool closest_from_list(Vec2 p, int level, double max_distance_m, int curve, ClosestGuess* guess) const noexcept;
-  void list_add(const ListEntry& e, double* radius_limit_m) noexcept;
+  // The closest-point walk (see closest_point), its phases in order.
+  struct ClosestQuery;  // one call's point, best answer so far and bound (collision_query.cpp)
+  void closest_seed(ClosestQuery& q) const noexcept;
+  bool closest_walk(ClosestQuery& q, QueryBudget* budget) noexcept;
+  void closest_test_item(ClosestQuery& q, std::uint32_t item) noexcept;
+  void closest_offer(ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) const noexcept;
+  std::uint32_t last_closest_node_ = kWideEmpty;  // the previous call's answer (segment node), the next call's seed
+  int last_closest_level_ = -1, last_closest_curve_ = -1;
   std::uint32_t tick_ = 0;
   int last_level_ = -1;
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
