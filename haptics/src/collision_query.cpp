@@ -643,6 +643,7 @@ struct BoundarySection::ClosestQuery {
   int curve = -1;
   double best_m = 0.0;      // distance of the best answer so far, or max_distance_m before there is one [m]
   double bound_sq = 0.0;    // best_m² grown by a few ulps: rounding never prunes what best_m itself would keep [m²]
+  float bound_sq_f = 0.0f;  // bound_sq as a float no smaller, for the SIMD rectangle tests [m²]
   SegmentRef best_s = kNoSegment;
   std::uint32_t best_node = kWideEmpty;
   Vec2 best_point;
@@ -651,6 +652,7 @@ struct BoundarySection::ClosestQuery {
   void set_best(double d_m) {
     best_m = d_m;
     bound_sq = d_m * d_m * (1.0 + 1e-12);
+    bound_sq_f = float_at_least(bound_sq);
   }
   bool found() const { return best_node != kWideEmpty; }
 };
@@ -728,7 +730,7 @@ bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcep
     if (budget && !budget->spend(kWideBoxTestsPerNode)) return false;  // the caller sees budget->ran_out
     const WideNode& n = wi.nodes[e.code];
     float d_sq[4];
-    const int mask = near_node(n, px, py, float_at_least(q.bound_sq), d_sq);
+    const int mask = near_node(n, px, py, q.bound_sq_f, d_sq);
     const int base = top;
     for (int i = 0; i < 4; ++i) {
       if (!(mask & (1 << i))) continue;
