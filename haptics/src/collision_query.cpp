@@ -105,6 +105,7 @@ void BoundarySection::reset() {
   section_box_.clear();
   ball_radius_m_ = 0.0;
   wide_ball_radius_m_ = 0.0;
+  wide_ball_seed_ = kWideEmpty;
   if (scene_->curve_count() == 0) return;
   const std::uint32_t r = scene_->scene_root();
   section_.push_back(r);
@@ -524,7 +525,7 @@ double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
   const float ax = static_cast<float>(q.a.x), ay = static_cast<float>(q.a.y);
   const float bx = static_cast<float>(q.b.x), by = static_cast<float>(q.b.y);
   const float ix = slab_reciprocal(q.b.x - q.a.x), iy = slab_reciprocal(q.b.y - q.a.y);
-  float ball_sq = static_cast<float>(ball_cap_m * ball_cap_m);
+  float ball_sq = seeded_ball_sq(wi, bx, by, static_cast<float>(ball_cap_m * ball_cap_m));
   bool ball_known = true;
   int top = 0;
   walk_stack_[static_cast<std::size_t>(top++)] = WalkEntry{0.0f, 0.0f, 0u};
@@ -533,9 +534,8 @@ double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
     const bool for_hit = static_cast<double>(e.t_enter) <= q.horizon();
     const bool for_ball = e.d_sq < ball_sq;
     if (!for_hit && !for_ball) continue;
-    if (e.code & kWideLeaf) {
-      if (for_hit) wide_test_item(q, e.code & ~kWideLeaf);
-      if (for_ball) ball_sq = e.d_sq;
+    if (e.code & kWideLeaf) {  // pushed for the hit only: its distance was taken for the ball when its node was opened
+      wide_test_item(q, e.code & ~kWideLeaf);
       continue;
     }
     if (!q.spend_wide_node()) {
@@ -555,6 +555,12 @@ double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
     for (int i = 0; i < 4; ++i) {
       const int bit = 1 << i;
       if (!((hit_mask | near_mask) & bit)) continue;
+      const bool leaf = (n.child[i] & kWideLeaf) != 0;
+      if (leaf && d_sq[i] < ball_sq) {  // an item's rectangle: its distance is final, the ball shrinks at once
+        ball_sq = d_sq[i];
+        wide_ball_seed_ = e.code << 2 | static_cast<std::uint32_t>(i);
+      }
+      if (leaf && !(hit_mask & bit)) continue;
       if (!push_walk((hit_mask & bit) ? t_enter[i] : std::numeric_limits<float>::infinity(), d_sq[i], n.child[i], base, top)) {  // full: as past the budget
         ball_known = false;
         if (e.t_enter < q.unresolved_t) {
@@ -570,6 +576,19 @@ double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
   // The float distances bound the padded rectangles' from below up to a few ulps; the factor keeps the
   // ball strictly inside what the exact rectangles allow.
   return std::sqrt(static_cast<double>(ball_sq)) * (1.0 - 1e-6);
+}
+
+// The ball's first bound: the squared distance from (bx, by) to the item rectangle nearest to the last
+// walk's end (a real rectangle, so an upper bound on the nearest one's, and pruning at it from the root
+// down opens fewer nodes; the hand moves little between ticks), computed as near_node computes it, or
+// cap_sq when there is no such rectangle or it is farther.
+float BoundarySection::seeded_ball_sq(const WideIndex& wi, float bx, float by, float cap_sq) const noexcept {
+  if (wide_ball_seed_ == kWideEmpty) return cap_sq;
+  const WideNode& n = wi.nodes[wide_ball_seed_ >> 2];
+  const std::uint32_t i = wide_ball_seed_ & 3u;
+  const float dx = std::max(std::max(n.lo_x[i] - bx, bx - n.hi_x[i]), 0.0f);
+  const float dy = std::max(std::max(n.lo_y[i] - by, by - n.hi_y[i]), 0.0f);
+  return std::min(dx * dx + dy * dy, cap_sq);
 }
 
 SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,

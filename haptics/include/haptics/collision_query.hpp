@@ -175,6 +175,7 @@ class BoundarySection {
   bool push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept;
   void wide_test_item(Query& q, std::uint32_t item);
   double wide_walk(Query& q, double ball_cap_m);
+  float seeded_ball_sq(const WideIndex& wi, float bx, float by, float cap_sq) const noexcept;
   std::vector<WalkEntry> walk_stack_;      // the wide walks' stack (WideIndex::stack_entries)
   std::vector<std::uint32_t> seen_stamp_;  // per node: closest-point walk in which a coarser segment was last tested
   std::uint32_t seen_tick_ = 0;
@@ -213,6 +214,7 @@ class BoundarySection {
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
   Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of any level) comes closer
   double wide_ball_radius_m_ = 0.0;  // [m]; 0 = unknown
+  std::uint32_t wide_ball_seed_ = kWideEmpty;  // the last walk's nearest item rectangle: wide node << 2 | slot
 };
 
 }  // namespace hk
