@@ -94,7 +94,9 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   hit_stamp_.assign(n, 0);
   merge_stamp_.assign(n, 0);
   seen_stamp_.assign(n, 0);
-  walk_stack_.resize(scene.wide_index().stack_entries());
+  walk_.t_enter.resize(scene.wide_index().stack_entries());
+  walk_.d_sq.resize(walk_.t_enter.size());
+  walk_.code.resize(walk_.t_enter.size());
   reset();
 }
 
@@ -487,14 +489,19 @@ std::uint32_t BoundarySection::item_segments(std::uint32_t item, int level, std:
 // children, at most four) the one nearest to the walk's point ends on top. False, with nothing pushed,
 // when the stack is full.
 bool BoundarySection::push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept {
-  if (static_cast<std::size_t>(top) >= walk_stack_.size()) return false;
-  WalkEntry* s = walk_stack_.data();
+  if (static_cast<std::size_t>(top) >= walk_.size()) return false;
+  float* t = walk_.t_enter.data();
+  float* d = walk_.d_sq.data();
+  std::uint32_t* c = walk_.code.data();
   int k = top++;
-  for (; k > base && s[k - 1].d_sq < d_sq; --k) s[k] = s[k - 1];
-  // Field by field: an entry built whole on the stack and copied in one 8-byte load stalls on store forwarding.
-  s[k].t_enter = t_enter;
-  s[k].d_sq = d_sq;
-  s[k].code = code;
+  for (; k > base && d[k - 1] < d_sq; --k) {
+    t[k] = t[k - 1];
+    d[k] = d[k - 1];
+    c[k] = c[k - 1];
+  }
+  t[k] = t_enter;
+  d[k] = d_sq;
+  c[k] = code;
   return true;
 }
 
@@ -528,9 +535,10 @@ double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
   float ball_sq = seeded_ball_sq(wi, bx, by, static_cast<float>(ball_cap_m * ball_cap_m));
   bool ball_known = true;
   int top = 0;
-  walk_stack_[static_cast<std::size_t>(top++)] = WalkEntry{0.0f, 0.0f, 0u};
+  push_walk(0.0f, 0.0f, 0u, 0, top);  // the root
   while (top > 0) {
-    const WalkEntry e = walk_stack_[static_cast<std::size_t>(--top)];
+    const std::size_t k = static_cast<std::size_t>(--top);
+    const WalkEntry e{walk_.t_enter[k], walk_.d_sq[k], walk_.code[k]};
     const bool for_hit = static_cast<double>(e.t_enter) <= q.horizon();
     const bool for_ball = e.d_sq < ball_sq;
     if (!for_hit && !for_ball) continue;
@@ -677,14 +685,12 @@ struct BoundarySection::ClosestQuery {
 };
 
 // Offers segment node `node` (end points a, b) to the query: taken when nearer than the best so far, or as
-// near with the smaller (curve, level, segment). The end points' rectangle bounds the distance from below
-// without a division, and the segment's reference is looked up only where it decides a tie or wins.
-// Inlined: it runs ~20 times a call, and a call's overhead is a fair part of its cost.
+// near with the smaller (curve, level, segment). The caller has checked that the end points' rectangle
+// is within the bound (rect_within_bound), perhaps before the bound last shrank: the exact distance is
+// compared with the bound as it is now. The segment's reference is looked up only where it decides a
+// tie or wins. Inlined: it runs several times a call.
 [[gnu::always_inline]] inline void BoundarySection::closest_offer(ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) const noexcept {
   const Vec2 p = q.p;
-  const double rx = std::max({std::min(a.x, b.x) - p.x, 0.0, p.x - std::max(a.x, b.x)});
-  const double ry = std::max({std::min(a.y, b.y) - p.y, 0.0, p.y - std::max(a.y, b.y)});
-  if (rx * rx + ry * ry > q.bound_sq) return;
   const Vec2 c = closest_point_on_segment(p, a, b);
   const double d_sq = length_sq(p - c);
   if (d_sq > q.bound_sq) return;
@@ -698,6 +704,35 @@ struct BoundarySection::ClosestQuery {
   q.best_node = node;
   q.best_point = c;
 }
+
+namespace {
+
+// True when the rectangle of a and b comes within sqrt(bound_sq) of p: a lower bound on the segment's
+// distance, without a division.
+inline bool rect_within_bound(Vec2 p, Vec2 a, Vec2 b, double bound_sq) {
+  const double rx = std::max({std::min(a.x, b.x) - p.x, 0.0, p.x - std::max(a.x, b.x)});
+  const double ry = std::max({std::min(a.y, b.y) - p.y, 0.0, p.y - std::max(a.y, b.y)});
+  return rx * rx + ry * ry <= bound_sq;
+}
+
+// rect_within_bound for the two segments s[0]→s[1] and s[1]→s[2] at once (SSE2, the same operations in
+// double, so the same answers): bit 0 for the first, bit 1 for the second.
+inline int rects_within_bound2(const Vec2* s, Vec2 p, double bound_sq) {
+#if defined(__SSE2__)
+  const __m128d p0 = _mm_loadu_pd(&s[0].x), p1 = _mm_loadu_pd(&s[1].x), p2 = _mm_loadu_pd(&s[2].x);
+  const __m128d ax = _mm_unpacklo_pd(p0, p1), ay = _mm_unpackhi_pd(p0, p1);
+  const __m128d bx = _mm_unpacklo_pd(p1, p2), by = _mm_unpackhi_pd(p1, p2);
+  const __m128d px = _mm_set1_pd(p.x), py = _mm_set1_pd(p.y), zero = _mm_setzero_pd();
+  const __m128d rx = _mm_max_pd(_mm_max_pd(_mm_sub_pd(_mm_min_pd(ax, bx), px), _mm_sub_pd(px, _mm_max_pd(ax, bx))), zero);
+  const __m128d ry = _mm_max_pd(_mm_max_pd(_mm_sub_pd(_mm_min_pd(ay, by), py), _mm_sub_pd(py, _mm_max_pd(ay, by))), zero);
+  const __m128d r2 = _mm_add_pd(_mm_mul_pd(rx, rx), _mm_mul_pd(ry, ry));
+  return _mm_movemask_pd(_mm_cmple_pd(r2, _mm_set1_pd(bound_sq)));
+#else
+  return (rect_within_bound(p, s[0], s[1], bound_sq) ? 1 : 0) | (rect_within_bound(p, s[1], s[2], bound_sq) ? 2 : 0);
+#endif
+}
+
+}  // namespace
 
 // The seed: the previous call's answer, measured again at the new point, when that call was for the same
 // level and curve. A real candidate, so the walk's bound is tight from the root down; the hand moves
@@ -720,11 +755,16 @@ void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noe
     if (seen_stamp_[first] == seen_tick_) return;
     seen_stamp_[first] = seen_tick_;
   }
-  for (std::uint32_t i = 0; i < count; ++i) {
-    Vec2 a, b;
-    sc.segment_points(first + i, &a, &b);
-    closest_offer(q, first + i, a, b);
+  // The segments under an item are consecutive slots: their rectangles two at a time, then the exact
+  // distance of those within the bound (which may shrink on the way).
+  const Vec2* s = sc.slot_points(first);
+  std::uint32_t i = 0;
+  for (; i + 1 < count; i += 2) {
+    const int mask = rects_within_bound2(s + i, q.p, q.bound_sq);
+    if (mask & 1) closest_offer(q, first + i, s[i], s[i + 1]);
+    if (mask & 2) closest_offer(q, first + i + 1, s[i + 1], s[i + 2]);
   }
+  if (i < count && rect_within_bound(q.p, s[i], s[i + 1], q.bound_sq)) closest_offer(q, first + i, s[i], s[i + 1]);
 }
 
 // The walk of the wide index: depth first, nearest rectangle first, pruned at the best distance so far
@@ -738,9 +778,10 @@ bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcep
   }
   const float px = static_cast<float>(q.p.x), py = static_cast<float>(q.p.y);
   int top = 0;
-  walk_stack_[static_cast<std::size_t>(top++)] = WalkEntry{0.0f, 0.0f, 0u};
+  push_walk(0.0f, 0.0f, 0u, 0, top);  // the root
   while (top > 0) {
-    const WalkEntry e = walk_stack_[static_cast<std::size_t>(--top)];
+    const std::size_t k = static_cast<std::size_t>(--top);
+    const WalkEntry e{walk_.t_enter[k], walk_.d_sq[k], walk_.code[k]};
     if (static_cast<double>(e.d_sq) > q.bound_sq) continue;
     if (e.code & kWideLeaf) {
       closest_test_item(q, e.code & ~kWideLeaf);

@@ -249,6 +249,9 @@ class Scene {
   const Vec2* points(std::size_t c, int level) const { return points_m_.data() + curves_[c].point_offset[level]; }
   /// End points of a segment [m].
   void segment(SegmentRef s, Vec2* a, Vec2* b) const { segment_points(node_of(s), a, b); }
+  /// The point of slot `node` [m]: segment node k runs from slot_points(k)[0] to slot_points(k)[1], and
+  /// consecutive segments of a level share their slots (for walks that read a run of segments at once).
+  const Vec2* slot_points(std::uint32_t node) const { return points_m_.data() + node; }
   /// End points of segment node `node` [m].
   void segment_points(std::uint32_t node, Vec2* a, Vec2* b) const {
     *a = points_m_[node];
