@@ -488,7 +488,7 @@ std::uint32_t BoundarySection::item_segments(std::uint32_t item, int level, std:
 // Checked push onto the wide walks' stack, in order: among the entries pushed since `base` (a node's
 // children, at most four) the one nearest to the walk's point ends on top. False, with nothing pushed,
 // when the stack is full.
-bool BoundarySection::push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept {
+[[gnu::always_inline]] inline bool BoundarySection::push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept {
   if (static_cast<std::size_t>(top) >= walk_.size()) return false;
   float* t = walk_.t_enter.data();
   float* d = walk_.d_sq.data();
@@ -767,8 +767,40 @@ void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noe
   if (i < count && rect_within_bound(q.p, s[i], s[i + 1], q.bound_sq)) closest_offer(q, first + i, s[i], s[i + 1]);
 }
 
+// Opens node n for the closest-point walk: *next is its nearest child within the bound (kWideEmpty when
+// none is), and the others within it are pushed. False, with *top as it was, when the stack is full.
+[[gnu::always_inline]] inline bool BoundarySection::closest_open_node(const ClosestQuery& q, const WideNode& n, float px, float py, int* top,
+                                                                      std::uint32_t* next) noexcept {
+  float d_sq[4];
+  const int mask = near_node(n, px, py, q.bound_sq_f, d_sq);
+  *next = kWideEmpty;
+  if (mask == 0) return true;
+  const int base = *top;
+  for (int i = 0; i < 4; ++i) {
+    if (!(mask & (1 << i))) continue;
+    if (!push_walk(std::numeric_limits<float>::infinity(), d_sq[i], n.child[i], base, *top)) {
+      *top = base;
+      return false;
+    }
+  }
+  *next = walk_.code[static_cast<std::size_t>(--*top)];  // pushed nearest last: on top
+  return true;
+}
+
+// The next entry of the closest-point walk still within the bound, taken off the stack; kWideEmpty when
+// none is left.
+[[gnu::always_inline]] inline std::uint32_t BoundarySection::closest_pop(const ClosestQuery& q, int* top) const noexcept {
+  while (*top > 0) {
+    const std::size_t k = static_cast<std::size_t>(--*top);
+    if (static_cast<double>(walk_.d_sq[k]) <= q.bound_sq) return walk_.code[k];
+  }
+  return kWideEmpty;
+}
+
 // The walk of the wide index: depth first, nearest rectangle first, pruned at the best distance so far
-// (which only shrinks). False when the budget or the stack ran out (the answer is then unknown).
+// (which only shrinks). At a node the nearest child within the bound is entered at once and the others
+// are pushed, farthest first, for later. False when the budget or the stack ran out (the answer is then
+// unknown).
 bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcept {
   const WideIndex& wi = scene_->wide_index();
   if (wi.nodes.empty()) return true;
@@ -778,29 +810,21 @@ bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcep
   }
   const float px = static_cast<float>(q.p.x), py = static_cast<float>(q.p.y);
   int top = 0;
-  push_walk(0.0f, 0.0f, 0u, 0, top);  // the root
-  while (top > 0) {
-    const std::size_t k = static_cast<std::size_t>(--top);
-    const WalkEntry e{walk_.t_enter[k], walk_.d_sq[k], walk_.code[k]};
-    if (static_cast<double>(e.d_sq) > q.bound_sq) continue;
-    if (e.code & kWideLeaf) {
-      closest_test_item(q, e.code & ~kWideLeaf);
-      continue;
+  std::uint32_t code = 0u;  // the entry being visited: the root first
+  for (;;) {
+    if (code & kWideLeaf) {
+      closest_test_item(q, code & ~kWideLeaf);
+    } else if (budget && !budget->spend(kWideBoxTestsPerNode)) {
+      return false;  // the caller sees budget->ran_out
+    } else if (!closest_open_node(q, wi.nodes[code], px, py, &top, &code)) {
+      if (budget) budget->ran_out = true;  // the stack is full: the answer is unknown, as past the budget
+      return false;
+    } else if (code != kWideEmpty) {
+      continue;  // the nearest child, entered at once
     }
-    if (budget && !budget->spend(kWideBoxTestsPerNode)) return false;  // the caller sees budget->ran_out
-    const WideNode& n = wi.nodes[e.code];
-    float d_sq[4];
-    const int mask = near_node(n, px, py, q.bound_sq_f, d_sq);
-    const int base = top;
-    for (int i = 0; i < 4; ++i) {
-      if (!(mask & (1 << i))) continue;
-      if (!push_walk(std::numeric_limits<float>::infinity(), d_sq[i], n.child[i], base, top)) {
-        if (budget) budget->ran_out = true;  // the stack is full: the answer is unknown, as past the budget
-        return false;
-      }
-    }
+    code = closest_pop(q, &top);
+    if (code == kWideEmpty) return true;
   }
-  return true;
 }
 
 bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,

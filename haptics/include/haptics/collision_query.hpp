@@ -209,6 +209,8 @@ class BoundarySection {
   void closest_seed(ClosestQuery& q) const noexcept;
   bool closest_walk(ClosestQuery& q, QueryBudget* budget) noexcept;
   void closest_test_item(ClosestQuery& q, std::uint32_t item) noexcept;
+  bool closest_open_node(const ClosestQuery& q, const WideNode& n, float px, float py, int* top, std::uint32_t* next) noexcept;
+  std::uint32_t closest_pop(const ClosestQuery& q, int* top) const noexcept;
   void closest_offer(ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) const noexcept;
   std::uint32_t last_closest_node_ = kWideEmpty;  // the previous call's answer (segment node), the next call's seed
   int last_closest_level_ = -1, last_closest_curve_ = -1;
