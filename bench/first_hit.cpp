@@ -6,7 +6,7 @@
 //
 // Methods: ours (first_hit: boundary section, free-space ball, anytime answers at a coarser level),
 //          ours_wide (first_hit_wide: the scene's wide index alone, with a free-space ball from it; first hits
-//          on the synthetic scenes only), rtree, embree, brute.
+//          on the synthetic scenes and the pictures), rtree, embree, brute.
 // Names: BM_FirstHit/<method>/<segments>  — synthetic scenes tiled from real pictures, random-walk hand
 //        BM_Closest/<method>/<segments>   — closest point on the same scenes
 //        BM_Picture/<method>/<picture>    — the handle sweeps of an explore raster run on that picture
@@ -325,7 +325,7 @@ int main(int argc, char** argv) {
     auto c = make_case(paths[i].stem().string(), pictures[i], 0, stream_of(i));
     check_equal(*c, c->stream.size());
     Case* cp = c.get();
-    for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute}) {
+    for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute, Method::Wide}) {
       benchmark::RegisterBenchmark(("BM_Picture/" + std::string(method_name(m)) + "/" + cp->name).c_str(),
                                    [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
     }

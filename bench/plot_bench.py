@@ -105,23 +105,63 @@ for r in fh:
     if m:
         pic[m.group(2)][m.group(1)] = r
 if pic:
-    lines = ["| picture | segments | ours mean / p99 ns | rtree mean / p99 ns | embree mean / p99 ns | brute mean / p99 ns |", "|---|---|---|---|---|---|"]
+    lines = ["| picture | segments | ours mean / p99 ns | ours_wide mean / p99 ns | rtree mean / p99 ns | embree mean / p99 ns | brute mean / p99 ns |", "|---|---|---|---|---|---|---|"]
     for name in sorted(pic):
         rows = pic[name]
         cell = lambda m: "%.0f / %.0f" % (ns(rows[m]), rows[m]["p99_ns"]) if m in rows else ""
-        lines.append("| %s | %d | %s | %s | %s | %s |" % (name, rows["ours"]["segments"], cell("ours"), cell("rtree"), cell("embree"), cell("brute")))
+        lines.append("| %s | %d | %s | %s | %s | %s | %s |" % (name, rows["ours"]["segments"], cell("ours"), cell("ours_wide"), cell("rtree"), cell("embree"), cell("brute")))
     tables["pictures"] = "\n".join(lines)
 
 # 3. Speed against accuracy: per method and level, p99 over four pictures against max deviation.
+def accuracy_per_vertex(ax, lvl, lines):
+    """Right panel: vertices against max deviation on the same four pictures, for our levels, the
+    tolerance cut (tolerance_cut.json: the cut's vertices, breaks included, and its measured error) and
+    Douglas-Peucker at the same targets. The cut is not queried yet (no query at a tolerance), so it has
+    no point on the time axis. A level's vertices are counted as its segments plus one per curve (the
+    open curves' last vertex; an upper bound). Appends the cut's rows to the table `lines`."""
+    names = ("horse", "camera", "fruits", "sudoku")
+    tc_path = os.path.join(BENCH, "tolerance_cut.json")
+    tc_rows = [r for r in json.load(open(tc_path))["rows"] if r["picture"] in names] if os.path.exists(tc_path) else []
+    curves = sum({r["picture"]: r["curves"] for r in tc_rows}.values())
+    ours = [(sum(r["segments"] for r in lvl["ours"][level]) + curves, max(r["max_error_mm"] for r in lvl["ours"][level]), level)
+            for level in sorted(lvl["ours"])]
+    ax.plot([p[0] for p in ours], [p[1] for p in ours], "o-", color=COLORS["ours"], label="ours, levels")
+    for p in ours:
+        ax.annotate("L%d" % p[2], (p[0], p[1]), textcoords="offset points", xytext=(4, 3), fontsize=7, color=COLORS["ours"])
+    by_tol = defaultdict(list)
+    for r in tc_rows:
+        by_tol[r["tolerance_mm"]].append(r)
+    cut, dp = [], []
+    for tol in sorted(by_tol):
+        rows = by_tol[tol]
+        if len(rows) != len(names):
+            continue
+        cut.append((sum(r["cut_vertices"] for r in rows), max(r["cut_error_mm"] for r in rows), tol))
+        dp.append((sum(r["dp_vertices"] for r in rows), max(r["dp_error_mm"] for r in rows), tol))
+        lines.append("| tolerance cut at %.1f mm (no query yet) | — | — | %.3f | %d vertices (DP: %d at %.3f mm) |" % (
+            tol, cut[-1][1], cut[-1][0], dp[-1][0], dp[-1][1]))
+    if cut:
+        ax.plot([p[0] for p in cut], [p[1] for p in cut], "s--", color="tab:cyan", label="ours, tolerance cut")
+        ax.plot([p[0] for p in dp], [p[1] for p in dp], "^:", color="black", label="Douglas–Peucker")
+        for p in cut:
+            ax.annotate("%.1f mm" % p[2], (p[0], p[1]), textcoords="offset points", xytext=(4, -9), fontsize=7, color="tab:cyan")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("vertices, sum over the four pictures")
+    ax.set_ylabel("max deviation from the original curve [mm]")
+    ax.set_title("Accuracy per vertex: levels, tolerance cut, Douglas–Peucker")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+
 lvl = defaultdict(lambda: defaultdict(list))
 for r in fh:
     m = re.match(r"BM_Level/(\w+)/(\d+)/(\w+)/manual_time", r["name"])
     if m:
         lvl[m.group(1)][int(m.group(2))].append(r)
 if lvl:
-    fig, ax = plt.subplots(figsize=(7.5, 5))
+    fig, (ax, ax_v) = plt.subplots(1, 2, figsize=(14, 5))
     lines = ["| method | level | p99 ns (mean of 4 pictures) | max deviation mm (max of 4) | segments (sum) |", "|---|---|---|---|---|"]
-    for method in METHODS:
+    for method in [m for m in METHODS if lvl[m]]:  # ours_wide is not run per level
         pts = []
         for level in sorted(lvl[method]):
             rows = lvl[method][level]
@@ -139,6 +179,7 @@ if lvl:
     ax.set_title("Speed against accuracy (horse, camera, fruits, sudoku; explore sweeps)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
+    accuracy_per_vertex(ax_v, lvl, lines)
     fig.tight_layout()
     fig.savefig(os.path.join(BENCH, "speed_accuracy.png"), dpi=110)
     tables["speed_accuracy"] = "\n".join(lines)
@@ -257,10 +298,15 @@ if size_rows:
     rows2.append("| first hit: p99 ≤ 0.5x the R-tree's | ours p99 / R-tree p99: first_hit %s%s | first_hit: %s%s |" % (
         fmt(fh_p99, ""), wide_txt(fw_p99, ""), yes(all(v <= 0.5 for _, v in fh_p99)), wide_met(fw_p99, lambda v: v <= 0.5)))
     pic_faster = sum(1 for rows in pic.values() if "embree" in rows and ns(rows["ours"]) < ns(rows["embree"]))
+    pic_wide = [rows for rows in pic.values() if "embree" in rows and "ours_wide" in rows]
+    wide_pic_faster = sum(1 for rows in pic_wide if ns(rows["ours_wide"]) < ns(rows["embree"]))
+    wide_pic_txt = (", pictures where it is faster: %d of %d" % (wide_pic_faster, len(pic_wide))) if fw_emb and pic_wide else ""
+    wide_pic_met = (" on the tiled scenes; on every picture: %s" % yes(wide_pic_faster == len(pic_wide))) if fw_emb and pic_wide else (
+        " on the tiled scenes (not run on the pictures)" if fw_emb else "")
     bt, bmet = batch_txt(fh_emb_b, fw_emb_b, "x", lambda v: v > 1)
-    rows2.append("| first hit: faster than Embree on the same streams | Embree mean / ours: first_hit %s, pictures where it is faster: %d of %d%s%s | first_hit: %s%s%s |" % (
-        fmt(fh_emb, "x"), pic_faster, len(pic), wide_txt(fw_emb, "x"), bt, yes(all(v > 1 for _, v in fh_emb) and pic_faster == len(pic)),
-        wide_met(fw_emb, lambda v: v > 1) + (" on the tiled scenes (not run on the pictures)" if fw_emb else ""), bmet))
+    rows2.append("| first hit: faster than Embree on the same streams | Embree mean / ours: first_hit %s, pictures where it is faster: %d of %d%s%s%s | first_hit: %s%s%s |" % (
+        fmt(fh_emb, "x"), pic_faster, len(pic), wide_txt(fw_emb, "x"), wide_pic_txt, bt, yes(all(v > 1 for _, v in fh_emb) and pic_faster == len(pic)),
+        wide_met(fw_emb, lambda v: v > 1) + wide_pic_met, bmet))
     cpb, cpb_met = batch_txt(cp_mean_b, [], "x", lambda v: v >= 3, label="")
     rows2.append("| closest point: mean ≥ 3x faster than the R-tree | R-tree mean / ours: %s%s | %s%s |" % (fmt(cp_mean, "x"), cpb, yes(all(v >= 3 for _, v in cp_mean)), cpb_met))
     rows2.append("| closest point: p99 ≤ 0.5x the R-tree's | ours p99 / R-tree p99: %s | %s |" % (fmt(cp_p99, ""), yes(all(v <= 0.5 for _, v in cp_p99))))
