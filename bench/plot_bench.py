@@ -31,6 +31,15 @@ def load_gbench(name):
     return [r for r in rows if r.get("run_type", "iteration") == "iteration"]
 
 
+def load_json(name):
+    """A JSON file of the bench folder, or None when that bench has not run."""
+    path = os.path.join(BENCH, name)
+    return json.load(open(path)) if os.path.exists(path) else None
+
+
+TOLERANCE_CUT = load_json("tolerance_cut.json")
+
+
 def ns(r):
     """Mean per-iteration time in ns whatever the benchmark's unit."""
     scale = {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[r.get("time_unit", "ns")]
@@ -120,8 +129,7 @@ def accuracy_per_vertex(ax, lvl, lines):
     no point on the time axis. A level's vertices are counted as its segments plus one per curve (the
     open curves' last vertex; an upper bound). Appends the cut's rows to the table `lines`."""
     names = ("horse", "camera", "fruits", "sudoku")
-    tc_path = os.path.join(BENCH, "tolerance_cut.json")
-    tc_rows = [r for r in json.load(open(tc_path))["rows"] if r["picture"] in names] if os.path.exists(tc_path) else []
+    tc_rows = [r for r in TOLERANCE_CUT["rows"] if r["picture"] in names] if TOLERANCE_CUT else []
     curves = sum({r["picture"]: r["curves"] for r in tc_rows}.values())
     ours = [(sum(r["segments"] for r in lvl["ours"][level]) + curves, max(r["max_error_mm"] for r in lvl["ours"][level]), level)
             for level in sorted(lvl["ours"])]
@@ -340,9 +348,8 @@ if size_rows:
         meds = [(b["level"], b["ratio"]["median"]) for b in bt]
         rows2.append("| error boxes: median half-width ≤ 1.05x the true max deviation under it | median per level (0–%d): %s; all pictures' curves | %s |" % (
             meds[-1][0], ", ".join("%.3f" % m for _, m in meds), yes(all(m <= 1.05 for _, m in meds))))
-    tc_path = os.path.join(BENCH, "tolerance_cut.json")
-    if os.path.exists(tc_path):
-        worst = json.load(open(tc_path))["worst"]
+    if TOLERANCE_CUT:
+        worst = TOLERANCE_CUT["worst"]
         rows2.append("| tolerance cut: ≤ 1.2x Douglas–Peucker's vertices for the same max error, every picture | worst cut / DP per target error: %s | %s |" % (
             ", ".join("%.2f at %.1f mm" % (w["worst_ratio"], w["tolerance_mm"]) for w in worst), yes(all(w["worst_ratio"] <= 1.2 for w in worst))))
     tables["round_two"] = "\n".join(rows2)

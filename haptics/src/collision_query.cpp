@@ -94,9 +94,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   hit_stamp_.assign(n, 0);
   merge_stamp_.assign(n, 0);
   seen_stamp_.assign(n, 0);
-  walk_.t_enter.resize(scene.wide_index().stack_entries());
-  walk_.d_sq.resize(walk_.t_enter.size());
-  walk_.code.resize(walk_.t_enter.size());
+  walk_.resize(scene.wide_index().stack_entries());
   reset();
 }
 

@@ -169,12 +169,14 @@ class BoundarySection {
   // The walks of the wide index (wide_index.hpp). One stack serves both: an entry is a child code with its
   // rectangle's squared distance from the walk's point (the order of the walk) and, for first_hit_wide,
   // where the sweep enters it (+inf when it does not). 12 bytes an entry, as three arrays: every access
-  // is one 4-byte field, so no load spans two stores (which stalls store forwarding, ~25 % of a walk).
+  // is one 4-byte field, so no load spans two stores (that stalls store forwarding: about half of the
+  // closest-point walk's own samples in perf when entries were 12-byte structs).
   struct WalkEntry { float t_enter; float d_sq; std::uint32_t code; };  // one popped entry, in registers
   struct WalkStack {
     std::vector<float> t_enter, d_sq;
     std::vector<std::uint32_t> code;
     std::size_t size() const { return code.size(); }
+    void resize(std::size_t n) { t_enter.resize(n); d_sq.resize(n); code.resize(n); }
   };
   std::uint32_t item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept;
   bool push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept;
