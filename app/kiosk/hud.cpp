@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "haptics/level_policy.hpp"
+
 namespace hk::app {
 void draw_captions(KioskRuntime& app, const KioskFlow& flow, int fw, int fh) {
   const std::string caption = flow.state() == KioskState::Attract ? app.audio().messages().raw(audio::MessageId::attract) : app.last_said();
@@ -20,7 +22,7 @@ void draw_overlay_status(KioskRuntime& app, const KioskFlow& flow) {
   const ServoDisplayState& d = app.core().display();
   ImGui::SetNextWindowPos(ImVec2(10, 10));
   ImGui::Begin("overlay", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoSavedSettings);
-  ImGui::Text("state %s   picture %d   level %d%s", state_name(flow.state()), flow.picture() + 1, d.level, d.auto_level ? " (auto)" : "");
+  ImGui::Text("state %s   picture %d   %s%s", state_name(flow.state()), flow.picture() + 1, level_label(d.level).c_str(), d.auto_level ? " (auto)" : "");
   ImGui::Text("contact %d   curve %d   force %.2f N", static_cast<int>(d.state), d.curve, length(d.force_n));
   if (ServoThread* st = app.servo()) {
     const ServoTimingStats t = st->stats();

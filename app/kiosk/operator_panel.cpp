@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "haptics/level_policy.hpp"
+
 #include "config/load.hpp"
 #include "device_setup.hpp"
 
@@ -271,7 +273,7 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
 void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, std::int64_t now_unix_s) {
   const config::Settings& s = runtime.settings();
   const ServoDisplayState& d = runtime.core().display();
-  ImGui::Text("Visitor: %s, picture %d, level %d%s", state_name(flow.state()), flow.picture() + 1, d.level, d.auto_level ? " (from hand speed)" : " (fixed)");
+  ImGui::Text("Visitor: %s, picture %d, %s%s", state_name(flow.state()), flow.picture() + 1, level_label(d.level).c_str(), d.auto_level ? " (from hand speed)" : " (fixed)");
   if (ServoThread* st = runtime.servo()) {
     const ServoTimingStats t = st->stats();
     ImGui::Text("Servo: %.0f Hz, %s; lateness p50 %.0f, p99 %.0f, max %.0f us; missed deadlines %lld", s.haptics.servo_rate_hz,

@@ -140,7 +140,8 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
   glColor4f(1.0f, 220.0f / 255.0f, 0.0f, 1.0f);
   glLineWidth(hc ? 6.0f : 3.0f);
   for (std::size_t c = 0; c < sh.levels.size(); ++c) {
-    const int l = std::min<int>(app.level(), static_cast<int>(sh.levels[c].size()) - 1);
+    const int top = static_cast<int>(sh.levels[c].size()) - 1;
+    const int l = sh.scene ? sh.scene->clamp_level(c, app.level()) : std::min(app.level(), top);  // a tolerance step: the curve's own level
     glBegin(sh.closed[c] ? GL_LINE_LOOP : GL_LINE_STRIP);
     for (const Vec2& p : sh.levels[c][static_cast<std::size_t>(l)]) glVertex2d(v.px(p.x), v.py(p.y));
     glEnd();

@@ -207,7 +207,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   double queries = 0, box_tests = 0, section_sum = 0;
   long section_max = 0, iteration_limited = 0;
   long level_changes = 0, level_waiting = 0, sticking = 0, pops = 0;
-  std::array<long, Scene::kMaxLevels> level_ticks{};
+  std::array<long, kLevelIds> level_ticks{};  // per level id (levels and tolerance steps)
   CueTrackerParams ctp;
   ctp.period_s = 1.0 / s.haptics.servo_rate_hz;
   ctp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
@@ -245,7 +245,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     level_changes += so.level_changed;
     level_waiting += so.level != so.level_wanted;
     sticking += c.sticking;
-    if (so.level >= 0 && so.level < Scene::kMaxLevels) ++level_ticks[static_cast<std::size_t>(so.level)];
+    if (so.level >= 0 && so.level < kLevelIds) ++level_ticks[static_cast<std::size_t>(so.level)];
   }, device, &sum.device);
   for (const Row& w : rows) {
     std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld,%d\n", w.t_s, w.handle_m.x, w.handle_m.y, w.proxy_m.x,
@@ -284,8 +284,11 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   }
   sj["segments_per_level"] = std::move(segs);
   json lt = json::array();
-  for (int l = 0; l < Scene::kMaxLevels; ++l) {
-    if (level_ticks[static_cast<std::size_t>(l)] > 0) lt.push_back({{"level", l}, {"ticks", level_ticks[static_cast<std::size_t>(l)]}});
+  for (int l = 0; l < kLevelIds; ++l) {
+    if (level_ticks[static_cast<std::size_t>(l)] == 0) continue;
+    json e = {{"level", l}, {"ticks", level_ticks[static_cast<std::size_t>(l)]}};
+    if (is_tolerance_level(l)) e["tolerance_m"] = kToleranceLadder_m[l - kToleranceLevelBase];  // a tolerance step's id
+    lt.push_back(std::move(e));
   }
   sj["levels"] = {{"mode", s.haptics.level_mode}, {"changes", level_changes}, {"ticks_waiting_for_a_safe_change", level_waiting},
                   {"ticks_per_level", std::move(lt)}};

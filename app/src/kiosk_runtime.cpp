@@ -64,7 +64,7 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
   cursor_.publish();
   cursor_in_ = sim_.true_position_m();
   level_ = s.haptics.level;
-  auto_level_ = s.haptics.level_mode == "auto";
+  auto_level_ = s.haptics.level_mode != "fixed";
   high_contrast_ = o.high_contrast;
   overlay_ = o.overlay;
 }
@@ -372,10 +372,21 @@ void KioskRuntime::remove_stick_folder() {
   sticks_.remove_folder();
 }
 
+int KioskRuntime::level_at_or_below(int id) const {
+  if (!is_tolerance_level(id) || !shown_.scene) return id;
+  const Scene& sc = *shown_.scene;
+  const double bound = sc.max_error_bound_m(id);
+  int level = 0;
+  for (int l = 0; l < sc.max_curve_levels(); ++l) {
+    if (sc.max_error_bound_m(l) <= bound) level = l;
+  }
+  return level;
+}
+
 bool KioskRuntime::change_level(int delta) {
   // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until the
-  // session ends.
-  const int next = level() + delta;
+  // session ends. A tolerance step in use counts as the coarsest level within its scene-wide bound.
+  const int next = level_at_or_below(level()) + delta;
   if (next < 0 || next > s_.haptics.max_levels) return false;
   level_ = next;
   auto_level_ = false;
@@ -394,7 +405,7 @@ void KioskRuntime::new_session() {
   capture_.cancel();
   audio_.new_session();
   level_ = s_.haptics.level;
-  auto_level_ = s_.haptics.level_mode == "auto";
+  auto_level_ = s_.haptics.level_mode != "fixed";
   core_.request_level(auto_level_ ? ServoCore::kAutoLevel : level_);
   high_contrast_ = opt_.high_contrast;
   if (tour_running_) {
@@ -571,7 +582,7 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
   if (r.timing) flow.set_timing(s_.kiosk.timeout_s, s_.kiosk.warning_s);
   if (rebuild) {
     level_ = s_.haptics.level;
-    auto_level_ = s_.haptics.level_mode == "auto";
+    auto_level_ = s_.haptics.level_mode != "fixed";
     rebuild_shown();
     r.scene_rebuilt = true;
   }

@@ -59,7 +59,8 @@ ServoParams servo_params_from(const config::Settings& s) {
   ServoParams sp;
   sp.period_s = 1.0 / s.haptics.servo_rate_hz;
   sp.level = s.haptics.level;
-  sp.auto_level = s.haptics.level_mode == "auto";
+  sp.auto_level = s.haptics.level_mode != "fixed";
+  sp.tolerance_steps = s.haptics.level_mode == "tolerance";
   sp.policy.error_at_rest_m = s.haptics.level_error_at_rest_m;
   sp.policy.blur_time_s = s.haptics.level_blur_time_s;
   sp.policy.hysteresis = s.haptics.level_hysteresis;

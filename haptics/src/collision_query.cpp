@@ -22,11 +22,14 @@ inline double box_distance_sq(const ErrorBox& box, Vec2 p) {
   return du * du + dn * dn;
 }
 
-// True for a segment node at the level a walk targets, clamped per curve to its coarsest. A walk reaches
-// a curve's segments from its coarsest level down, so a segment's level is never above that clamp, which
-// then comes down to comparing with the target itself (or 0, for a negative target).
+// True for a segment node at the level a walk targets, resolved per curve (Scene::clamp_level). A walk
+// reaches a curve's segments from its coarsest level down, so a segment's level is never above that
+// clamp, which for a level then comes down to comparing with the target itself (or 0, for a negative
+// target); a tolerance step needs the curve's own level for it.
 inline bool at_target_level(const Scene& sc, std::uint32_t node, int level) {
-  return sc.is_segment(node) && sc.tag_level(node) <= std::max(level, 0);
+  if (!sc.is_segment(node)) return false;
+  if (level >= kToleranceLevelBase) return sc.tag_level(node) <= sc.clamp_level(sc.tag_curve(node), level);
+  return sc.tag_level(node) <= std::max(level, 0);
 }
 
 }  // namespace

@@ -40,7 +40,11 @@ inline bool neighbour(const Scene& sc, SegmentRef s, int dir, SegmentRef* out) {
 
 ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
     : scene_(&scene), params_(params), section_(scene) {
-  for (int l = 0; l < Scene::kMaxLevels; ++l) max_half_width_m_[l] = scene.max_box_half_width_m(l);
+  for (int id = 0; id < kLevelIds; ++id) max_half_width_m_[id] = scene.max_box_half_width_m(id);
+}
+
+bool ContactSolver::on_level(SegmentRef s, int level) const {
+  return s.level == scene_->clamp_level(static_cast<std::size_t>(s.curve), level);
 }
 
 double ContactSolver::side_of(SegmentRef s, Vec2 p) const {
@@ -146,7 +150,7 @@ bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) {
   if (transition_level_ >= 0) return false;  // one change at a time
   // A curve's polylines at two levels lie within E = (largest error-box half-width at one level + at the
   // other) of each other, so a point between them lies within E of both; search twice as far.
-  const double e = max_half_width_m_[std::clamp(level_, 0, Scene::kMaxLevels - 1)] + max_half_width_m_[std::clamp(new_level, 0, Scene::kMaxLevels - 1)];
+  const double e = max_half_width_m_[std::clamp(level_, 0, kLevelIds - 1)] + max_half_width_m_[std::clamp(new_level, 0, kLevelIds - 1)];
   const double radius = 2.0 * e + 4.0 * params_.skin_m;
   // The curves that could have the proxy between their two levels: those it touches, and the nearest one
   // at either level.
@@ -429,7 +433,7 @@ void ContactSolver::finish_step(ContactState before, Vec2 force_n, ContactOutput
   }
   if (transition_level_ >= 0) {  // the old level's walls go once the proxy rests on none of them
     const bool on_old = state_ != ContactState::Free &&
-                        (c_[0].seg.level == transition_level_ || (state_ == ContactState::Vertex && c_[1].seg.level == transition_level_));
+                        (on_level(c_[0].seg, transition_level_) || (state_ == ContactState::Vertex && on_level(c_[1].seg, transition_level_)));
     if (!on_old) transition_level_ = -1;
   }
   out.transition_level = transition_level_;

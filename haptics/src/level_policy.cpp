@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace hk {
 
@@ -44,6 +45,13 @@ int LevelPolicy::update(Vec2 v, double dt) noexcept {
     ++changes_;
   }
   return level_;
+}
+
+std::string level_label(int id) {
+  if (!is_tolerance_level(id)) return "level " + std::to_string(id);
+  char text[40];
+  std::snprintf(text, sizeof text, "tolerance %.2f mm", kToleranceLadder_m[id - kToleranceLevelBase] * 1e3);
+  return text;
 }
 
 }  // namespace hk

@@ -334,6 +334,22 @@ class SceneBuild {
       ci.max_error_m[l] = std::sqrt(worst_sq);  // one root per level
       quantise_level(scene, c, l, level, widest);
     }
+    assign_tolerance_levels(scene, c);
+  }
+
+  // The curve's level at each tolerance step (CurveNodes::tolerance_level): the coarsest level whose error
+  // bound is within the step's tolerance, 0 when none is. A curve's bounds need not grow with the level,
+  // so every level is looked at, not just the first that fails.
+  static void assign_tolerance_levels(Scene& scene, std::size_t c) {
+    const CurveInfo& ci = scene.curves_[c];
+    CurveNodes& cn = scene.curve_nodes_[c];
+    for (int t = 0; t < kToleranceSteps; ++t) {
+      int level = 0;
+      for (int l = 0; l < ci.levels; ++l) {
+        if (ci.max_error_bound_m[l] <= kToleranceLadder_m[t]) level = l;
+      }
+      cn.tolerance_level[t] = static_cast<std::uint8_t>(level);
+    }
   }
 
   // Grows the extent by q, as grow(), and returns q's squared distance from the segment a + u·axis,

@@ -30,12 +30,30 @@ Vec2 ForceGuard::apply(Vec2 f, double since_start_s, DeviceStatus status, bool d
 
 namespace {
 
-// The scene's error bound per level for the policy (the worst curve's, so the level chosen keeps every
-// curve within tolerance). Returns the number of levels.
-int level_error_ladder(const Scene& scene, double* err) {
-  const int levels = std::min(scene.max_curve_levels(), LevelPolicy::kMaxLevels);
-  for (int l = 0; l < levels; ++l) err[l] = scene.max_error_bound_m(l);
-  return levels;
+// The policy's ladder: the level ids it chooses from, finest first, and the scene's error bound at each
+// (the worst curve's, so the id chosen keeps every curve within tolerance). Levels: every level of the
+// scene. Tolerance steps (ServoParams::tolerance_steps): every step (LevelPolicy keeps the bounds
+// non-decreasing, as a curve's bound need not grow with its level). Returns the ladder's length.
+int level_ladder(const Scene& scene, bool tolerance_steps, int* ids, double* err) {
+  if (!tolerance_steps) {
+    const int levels = std::min(scene.max_curve_levels(), LevelPolicy::kMaxLevels);
+    for (int l = 0; l < levels; ++l) {
+      ids[l] = l;
+      err[l] = scene.max_error_bound_m(l);
+    }
+    return levels;
+  }
+  static_assert(kToleranceSteps <= LevelPolicy::kMaxLevels, "the policy's ladder holds every tolerance step");
+  for (int t = 0; t < kToleranceSteps; ++t) {
+    ids[t] = kToleranceLevelBase + t;
+    err[t] = scene.max_error_bound_m(ids[t]);
+  }
+  return kToleranceSteps;
+}
+
+// The scene's error bound at every level (for placing a fixed level on a ladder of tolerance steps).
+void level_bounds(const Scene& scene, double* bound) {
+  for (int l = 0; l < kMaxLevels; ++l) bound[l] = scene.max_error_bound_m(l);
 }
 
 // The solver's parameters, stepped at the loop's period.
@@ -95,13 +113,29 @@ ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
       solver_(scene, contact_params(params)),
       groove_(scene, params.groove),
-      levels_(level_error_ladder(scene, level_error_m_)),
-      policy_(policy_params(params), level_error_m_, levels_, params.level),
+      levels_(level_ladder(scene, params.tolerance_steps, ladder_id_, level_error_m_)),
+      policy_(policy_params(params), level_error_m_, levels_, 0),
       level_(params.level),
-      guard_max_force_n_(params.guard.max_force_n) {}
+      guard_max_force_n_(params.guard.max_force_n) {
+  level_bounds(scene, level_bound_m_);
+  policy_ = LevelPolicy(policy_params(params), level_error_m_, levels_, ladder_index(params.level));
+}
+
+int ServoLoop::ladder_index(int id) const noexcept {
+  for (int i = 0; i < levels_; ++i) {
+    if (ladder_id_[i] == id) return i;
+  }
+  // A level on a ladder of tolerance steps (or the reverse): the coarsest rung no looser than its bound.
+  const double bound = is_tolerance_level(id) ? kToleranceLadder_m[id - kToleranceLevelBase] : level_bound_m_[std::clamp(id, 0, kMaxLevels - 1)];
+  int index = 0;
+  for (int i = 0; i < levels_; ++i) {
+    if (level_error_m_[i] <= bound) index = i;
+  }
+  return index;
+}
 
 void ServoLoop::start(Vec2 handle_m) {
-  level_ = params_.auto_level ? policy_.level() : params_.level;
+  level_ = params_.auto_level ? ladder_id_[policy_.level()] : params_.level;
   if (params_.render == RenderMode::Grooves) {
     groove_.reset(handle_m, level_);
   } else {
@@ -131,7 +165,7 @@ bool ServoLoop::transition_active() const noexcept {
 void ServoLoop::set_auto_level(bool on) noexcept {
   // The policy starts again from the level in use, its speed filter from rest (the ladder is kept: no
   // walk over the scene in the servo thread).
-  if (on && !params_.auto_level) policy_ = LevelPolicy(policy_params(params_), level_error_m_, levels_, level_);
+  if (on && !params_.auto_level) policy_ = LevelPolicy(policy_params(params_), level_error_m_, levels_, ladder_index(level_));
   params_.auto_level = on;
   if (!on) params_.level = level_;
 }
@@ -151,7 +185,7 @@ TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
   last_handle_ = h;
 
   // Level: from the hand's speed or fixed; changed only when the proxy can move to it without crossing.
-  const int wanted = params_.auto_level ? policy_.update(velocity_, dt) : params_.level;
+  const int wanted = params_.auto_level ? ladder_id_[policy_.update(velocity_, dt)] : params_.level;
   // One box-test budget for the whole tick: the level-change check first, then every query of the solver.
   QueryBudget budget;
   budget.max_box_tests = params_.query_box_budget;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,18 +53,26 @@ bool between_levels(const Scene& sc, std::size_t c, int lo, int ln, Vec2 p) {
 
 class LevelChanges : public ::testing::TestWithParam<const char*> {};
 
-TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) {
+// The raster over picture `name` with levels from hand speed (`level_mode` "auto": levels; "tolerance":
+// tolerance steps, each curve at its own level), checked as the file's comment says.
+void raster_changes_levels_without_crossing_or_force_steps(const char* name, const std::string& level_mode) {
   config::Settings s;
-  s.haptics.level_mode = "auto";
+  s.haptics.level_mode = level_mode;
   s.hand.max_force_n = 2.0;  // a visitor's push, under the device's clamp, so force steps are visible
-  const std::string path = std::string(HK_TEST_DATA_DIR) + "/images/" + GetParam();
+  const std::string path = std::string(HK_TEST_DATA_DIR) + "/images/" + name;
   const app::ImageScene is = app::build_image_scene(path, s);
   const Scene& sc = *is.scene;
   ASSERT_GT(sc.curve_count(), 0u);
   const HandPath hand = raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
 
-  std::vector<std::unique_ptr<test::CrossingGrid>> grids;
-  for (int l = 0; l <= s.haptics.max_levels; ++l) grids.push_back(std::make_unique<test::CrossingGrid>(sc, l));
+  // One crossing grid per level id in force (levels, or tolerance steps), built when first needed.
+  std::map<int, std::unique_ptr<test::CrossingGrid>> grid_of;
+  auto grid = [&](int id) -> test::CrossingGrid& {
+    auto& g = grid_of[id];
+    if (!g) g = std::make_unique<test::CrossingGrid>(sc, id);
+    return *g;
+  };
+  long tolerance_ticks = 0;
   const double k = s.haptics.stiffness_n_per_m;
   const double step = s.haptics.level_max_force_step_n;
 
@@ -72,15 +81,16 @@ TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) 
   int prev_level = -1;
   Vec2 prev_force, prev_handle, prev_gap;
   bool prev_unclamped = false;
-  app::run_simulation(sc, s, hand, hand.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
+  const long ticks = app::run_simulation(sc, s, hand, hand.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     // Every move of the proxy this tick, against the polyline of the level in force this tick.
     // Just after a change the old level is a wall too, until the proxy has left it: nor may it be crossed.
     const int old_wall = so.level_changed ? prev_level : prev_transition;
     for (int m = 1; m < c.path_count; ++m) {
-      crossings += grids[static_cast<std::size_t>(so.level)]->crossings(c.path_m[m - 1], c.path_m[m]);
-      if (old_wall >= 0) crossings += grids[static_cast<std::size_t>(old_wall)]->crossings(c.path_m[m - 1], c.path_m[m]);
+      crossings += grid(so.level).crossings(c.path_m[m - 1], c.path_m[m]);
+      if (old_wall >= 0) crossings += grid(old_wall).crossings(c.path_m[m - 1], c.path_m[m]);
     }
+    tolerance_ticks += is_tolerance_level(so.level);
     transition_ticks += old_wall >= 0;
     prev_transition = c.transition_level;
     waiting += so.level != so.level_wanted;
@@ -109,9 +119,9 @@ TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) 
     prev_force = so.force_n;
     prev_handle = r.handle_m;
   });
-  RecordProperty("level_changes", std::to_string(changes));
-  RecordProperty("ticks_waiting", std::to_string(waiting));
-  RecordProperty("ticks_with_two_levels", std::to_string(transition_ticks));
+  ::testing::Test::RecordProperty("level_changes", std::to_string(changes));
+  ::testing::Test::RecordProperty("ticks_waiting", std::to_string(waiting));
+  ::testing::Test::RecordProperty("ticks_with_two_levels", std::to_string(transition_ticks));
   EXPECT_GE(changes, 10) << "the fast rows must coarsen and the slow rows refine the level";
   EXPECT_GT(finer, 3);
   EXPECT_GT(coarser, 3);
@@ -119,6 +129,21 @@ TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) 
   EXPECT_EQ(crossings, 0);
   EXPECT_EQ(wrong_side, 0);
   EXPECT_EQ(force_steps, 0);
+  // The mode decides what the policy picks: tolerance steps on every tick, or never.
+  if (level_mode == "tolerance") {
+    EXPECT_EQ(tolerance_ticks, ticks) << "every tick at a tolerance step";
+  } else {
+    EXPECT_EQ(tolerance_ticks, 0);
+  }
+}
+
+TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) {
+  raster_changes_levels_without_crossing_or_force_steps(GetParam(), "auto");
+}
+
+// Issue 18: the policy picks a tolerance instead of a level; the same crossing checks stay at 0.
+TEST_P(LevelChanges, FastAndSlowRasterChangesToleranceStepsWithoutCrossingOrForceSteps) {
+  raster_changes_levels_without_crossing_or_force_steps(GetParam(), "tolerance");
 }
 
 INSTANTIATE_TEST_SUITE_P(RealImages, LevelChanges,

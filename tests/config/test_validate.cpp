@@ -63,8 +63,10 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     }
     if (name == "haptics.level_mode") {
       EXPECT_EQ(d.kind, FieldKind::text);
-      ASSERT_EQ(d.choices.size(), 2u);
+      ASSERT_EQ(d.choices.size(), 3u);
       EXPECT_EQ(d.choices[0], "auto");
+      EXPECT_EQ(d.choices[1], "tolerance");
+      EXPECT_EQ(d.choices[2], "fixed");
       ++texts;
       continue;
     }

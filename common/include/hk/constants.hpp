@@ -13,6 +13,23 @@ namespace hk {
 /// stays below it.
 inline constexpr int kMaxLevels = 16;
 
+/// Tolerance steps (issue 18: "the level policy may then pick a tolerance instead of a level"). A level id
+/// is either a level, 0 .. kMaxLevels − 1, the same for every curve (clamped to each curve's coarsest), or
+/// a tolerance step, kToleranceLevelBase + t: each curve at the coarsest of its own levels whose error
+/// bound is ≤ kToleranceLadder_m[t] (level 0 when none is), so a straight curve goes coarse while a
+/// wiggly one stays fine (Scene::clamp_level resolves both kinds per curve).
+inline constexpr int kToleranceSteps = 8;
+/// The first tolerance-step id: above every level.
+inline constexpr int kToleranceLevelBase = kMaxLevels;
+/// Level ids in all: the levels, then the tolerance steps. Per-id tables (the contact solver's widths) have
+/// this many entries.
+inline constexpr int kLevelIds = kMaxLevels + kToleranceSteps;
+/// The tolerance of each step [m], increasing by ~1.6x (the R10 series): from the fingertip's 0.1 mm at
+/// rest to 2.5 mm, the tolerable error of a hand at ~0.24 m/s (haptics/level_policy.hpp).
+inline constexpr double kToleranceLadder_m[kToleranceSteps] = {1.0e-4, 1.6e-4, 2.5e-4, 4.0e-4, 6.3e-4, 1.0e-3, 1.6e-3, 2.5e-3};
+/// True for a tolerance-step id.
+constexpr bool is_tolerance_level(int id) { return id >= kToleranceLevelBase && id < kLevelIds; }
+
 /// Deepest hierarchy of nodes above the curves' chunks in a scene's collision tree (the tree over
 /// chunks halves per level, so 64 covers any scene that fits in memory).
 inline constexpr int kMaxHierarchyDepth = 64;

@@ -87,7 +87,7 @@ struct ContactParams {
 struct ContactInput {
   Vec2 handle_m;                     ///< handle position [m]
   Vec2 handle_velocity_m_per_s;      ///< for rendered damping [m/s]
-  int level = 0;                     ///< level whose polylines are walls
+  int level = 0;                     ///< level id whose polylines are walls (a level, or a tolerance step: hk/constants.hpp)
   /// The tick's box-test budget (QueryBudget): its limit, and what was already spent this tick before the
   /// step (e.g. by level_change_is_safe). Every query of the step draws on it.
   QueryBudget budget;
@@ -102,14 +102,14 @@ struct ContactOutput {
   Vec2 force_n;                      ///< force on the handle, clamped [N]
   ContactState state = ContactState::Free;
   SegmentRef constraint[2];          ///< active constraints (edge: [0]; vertex: [0] and [1])
-  std::int32_t level = -1;           ///< level whose polyline constrained the proxy (−1 when free)
+  std::int32_t level = -1;           ///< level of the polyline that constrained the proxy (its curve's level, −1 when free)
   std::uint32_t events = kEventNone; ///< HapticEvent flags
   /// Sharpest turn of the corners met this tick (convex corners passed, the corner of a vertex contact
   /// entered) [rad], 0 when none: the direction change of the polyline there, in [0, π]. Lets sound and
   /// display mark only the corners a hand would call corners, not every vertex of a smooth curve.
   double corner_turn_rad = 0.0;
   bool sticking = false;             ///< edge contact held by static friction this tick
-  std::int32_t transition_level = -1; ///< ≥ 0: the previous level, still a wall after a level change (see level_change_is_safe)
+  std::int32_t transition_level = -1; ///< ≥ 0: the previous level id, still a wall after a level change (see level_change_is_safe)
   /// How long the hand has pressed with ≥ pop_force_n without a break, by the end of this tick [s]; 0 when
   /// push-through is off, the proxy is free or the press is lighter. The wall gives way once it reaches pop_hold_s.
   double press_s = 0.0;
@@ -153,6 +153,8 @@ class ContactSolver {
   /// either. No second change is made while the old level is still a wall. Allocates nothing (at most six
   /// closest-point walks). With a `budget`, the walks' box tests are charged to it and never take it past
   /// its limit: when it runs out before the answer is known, the answer is false (the change waits).
+  /// Levels and tolerance steps mix freely (level ids, hk/constants.hpp): each curve is compared at its own
+  /// level for each id, and a curve at the same level under both has nothing between its polylines.
   bool level_change_is_safe(int new_level, QueryBudget* budget = nullptr);
 
   Vec2 proxy() const { return proxy_; }
@@ -211,7 +213,9 @@ class ContactSolver {
   Vec2 release_from_n_;        // the force of the tick before the last pop [N]
   long release_left_ = 0;      // ticks of its fade still to go
   Vec2 last_force_n_;          // the force of the last tick [N]
-  double max_half_width_m_[Scene::kMaxLevels] = {};  // per level: the largest error-box half-width of any curve [m]
+  double max_half_width_m_[kLevelIds] = {};  // per level id (levels and tolerance steps): the largest error-box half-width of any curve [m]
+  // True when segment s belongs to the polyline of level id `level` (its curve's level for that id).
+  bool on_level(SegmentRef s, int level) const;
   // Side of p relative to curve `curve`'s polyline at `level`: +1 left, −1 right, 0 when the polyline is not
   // within radius_m or its nearest point is an open end, 2 when p lies on it, 3 when `budget` ran out first.
   int side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget);

@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 
 #include "haptics/vec2.hpp"
 #include "hk/constants.hpp"
@@ -66,5 +67,9 @@ class LevelPolicy {
   double since_change_s_ = 1e9;   ///< time since the last change [s]
   std::int64_t changes_ = 0;
 };
+
+/// How a level id (hk/constants.hpp) reads on a screen: "level 3", or "tolerance 0.25 mm" for a tolerance
+/// step. For display code (allocates).
+std::string level_label(int id);
 
 }  // namespace hk

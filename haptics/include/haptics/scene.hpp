@@ -85,14 +85,17 @@ struct CurveInfo {
 };
 
 /// What the tree walks need of a curve: its levels' first node ids, the quantum of their box extents,
-/// its level count. 136 bytes.
+/// its level count, its level at each tolerance step. 144 bytes.
 struct CurveNodes {
   std::uint32_t box_offset[kMaxLevels] = {};  ///< node id of level l's first segment (= slot of its first point)
   float quantum_m[kMaxLevels] = {};           ///< the unit of level l's BoxExtent [m]
   std::uint32_t levels = 0;                   ///< levels of the curve (its coarsest is levels − 1)
   std::uint32_t chunk_offset = 0;             ///< index of the curve's first chunk in Scene's chunk-of-curve array
+  /// Level of the curve at tolerance step t (hk/constants.hpp): the coarsest whose max_error_bound_m is
+  /// ≤ kToleranceLadder_m[t], 0 when none is.
+  std::uint8_t tolerance_level[kToleranceSteps] = {};
 };
-static_assert(sizeof(CurveNodes) == 136, "CurveNodes: 136 bytes per curve");
+static_assert(sizeof(CurveNodes) == 144, "CurveNodes: 144 bytes per curve");
 
 /// The stored part of a segment's error box: its extents in the segment's frame (origin at the
 /// segment's first point a, unit axis toward its second b, n along the left normal) as multiples of the
@@ -257,21 +260,25 @@ class Scene {
     *a = points_m_[node];
     *b = points_m_[node + 1];
   }
-  /// Segment count over all curves at `level` (curves with fewer levels use their coarsest).
+  /// Segment count over all curves at level id `level` (each curve at clamp_level(c, level)).
   std::size_t total_segments(int level) const;
-  /// The largest error-box half-width of any curve at `level` (curves with fewer levels count with their
-  /// coarsest) [m]: how far apart two levels' polylines can be across the curve; 0 for an empty scene.
-  /// O(curves): for setup code.
+  /// The largest error-box half-width of any curve at level id `level` (each curve at clamp_level(c, level))
+  /// [m]: how far apart two levels' polylines can be across the curve; 0 for an empty scene. O(curves): for
+  /// setup code.
   double max_box_half_width_m(int level) const;
-  /// The scene's error bound at `level`: the largest box_error_bound of any curve there (curves with fewer
-  /// levels count with their coarsest) [m]; no original point is farther than this from the level-`level`
+  /// The scene's error bound at level id `level`: the largest box_error_bound of any curve there (each curve
+  /// at clamp_level(c, level)) [m]; no original point is farther than this from the level-`level`
   /// segment standing for it. 0 for an empty scene. O(curves): for setup code.
   double max_error_bound_m(int level) const;
   /// Levels of the curve with the most levels (1 for an empty scene).
   int max_curve_levels() const;
-  /// Coarsest level available in every curve clamped: min(level, levels−1 of curve c).
+  /// The level curve c renders at for level id `level` (hk/constants.hpp): a level is clamped to the
+  /// curve's, min(level, levels−1) (0 below 0); a tolerance step gives the curve's own level for that
+  /// tolerance (CurveNodes::tolerance_level); ids past the last step count as the last.
   int clamp_level(std::size_t c, int level) const {
-    const int top = static_cast<int>(curve_nodes_[c].levels) - 1;
+    const CurveNodes& cn = curve_nodes_[c];
+    if (level >= kToleranceLevelBase) return cn.tolerance_level[std::min(level - kToleranceLevelBase, kToleranceSteps - 1)];
+    const int top = static_cast<int>(cn.levels) - 1;
     return level < 0 ? 0 : (level > top ? top : level);
   }
   /// Bounding rectangle of every curve's level-0 points [m].

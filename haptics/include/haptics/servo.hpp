@@ -103,6 +103,11 @@ struct ServoParams {
   double period_s = 0.001;          ///< servo period = 1 / servo rate [s]
   int level = 1;                    ///< resolution level at start, and always when !auto_level
   bool auto_level = false;          ///< the level follows the hand's speed (LevelPolicy; issue 6)
+  /// With auto_level: the policy picks a tolerance step instead of a level (issue 18; level ids,
+  /// hk/constants.hpp), so each curve renders at the coarsest of its own levels within the tolerance the
+  /// hand's speed allows, under the same crossing checks at changes. `level` is then only where it starts:
+  /// the coarsest step whose bound is within that level's.
+  bool tolerance_steps = false;
   LevelPolicyParams policy;         ///< used when auto_level (its fixed_level is ignored: see `auto_level`)
   /// At a level change the force passes from the old level's to the new level's by at most this much per
   /// tick [N] (on top of what the hand's own motion changes), so a coarser or finer wall never kicks.
@@ -146,8 +151,8 @@ struct ServoOutput {
   Vec2 force_n;                ///< force to write to the device [N] (after the guard)
   Vec2 handle_velocity_m_per_s;
   ContactOutput contact;       ///< proxy, state, constraints, events, query stats (budget_used: the whole tick's box tests)
-  std::int32_t level = 0;      ///< level in use this tick (walls the proxy met)
-  std::int32_t level_wanted = 0;  ///< level asked for (policy or fixed); differs from `level` while a change waits
+  std::int32_t level = 0;      ///< level id in use this tick (walls the proxy met): a level or a tolerance step (hk/constants.hpp)
+  std::int32_t level_wanted = 0;  ///< level id asked for (policy or fixed); differs from `level` while a change waits
   bool level_changed = false;  ///< the level in use changed at the start of this tick
   TickResult result = TickResult::Ok;
 };
@@ -193,7 +198,7 @@ class ServoLoop {
   /// yet at the new max force). False again from the tick on which the new gains' force law holds exactly.
   /// Real-time safe.
   bool transition_active() const noexcept;
-  /// Level in use (walls rendered) [0 = finest].
+  /// Level id in use (walls rendered): a level [0 = finest] or a tolerance step (hk/constants.hpp).
   int level() const noexcept { return level_; }
   std::int64_t ticks() const { return ticks_; }
   /// The contact solver (its proxy and boundary section), for display snapshots taken in the servo thread.
@@ -210,8 +215,14 @@ class ServoLoop {
   ServoParams params_;
   ContactSolver solver_;
   GrooveSolver groove_;
-  double level_error_m_[LevelPolicy::kMaxLevels] = {};  // the scene's error bound per level [m] (policy input)
+  // The policy's ladder (levels, or tolerance steps): rung i is level id ladder_id_[i], with the scene's
+  // error bound level_error_m_[i] [m] (non-decreasing); levels_ rungs.
+  int ladder_id_[LevelPolicy::kMaxLevels] = {};
+  double level_error_m_[LevelPolicy::kMaxLevels] = {};
   int levels_ = 1;
+  double level_bound_m_[kMaxLevels] = {};  // the scene's error bound at each level [m] (to place a level on the ladder)
+  // The rung for level id `id`: its own, or the coarsest whose bound is within the id's.
+  int ladder_index(int id) const noexcept;
   LevelPolicy policy_;
   int level_ = 0;              // level in use
   Vec2 force_residual_;        // old level's (or gains') force minus the new one's, fading out at max_force_step_n per tick [N]
