@@ -332,7 +332,73 @@ TEST_P(QueryVsBruteForce, FirstHitEqualsBruteForce) {
   EXPECT_GT(hits, 5000);  // the stream really tests hits, not only misses
 }
 
-INSTANTIATE_TEST_SUITE_P(Levels, QueryVsBruteForce, ::testing::Values(0, 2));
+// Levels, and a tolerance step (each curve at its own level: hk/constants.hpp).
+INSTANTIATE_TEST_SUITE_P(Levels, QueryVsBruteForce, ::testing::Values(0, 2, kToleranceLevelBase + 3));
+
+// At tolerance steps the curves of one scene render at different levels; all three walks (first_hit through
+// the boundary section, first_hit_wide and closest_point through the wide index) answer as brute force over
+// each curve's own level does.
+TEST(CollisionQuery, ToleranceStepsEqualBruteForceInEveryWalk) {
+  std::mt19937 rng(118);
+  const auto curves = random_scene(rng, 8, 8);
+  const Scene sc = Scene::build(curves, 6);
+  std::uniform_real_distribution<double> ux(-0.075, 0.075), uy(-0.05, 0.05), step(-0.0004, 0.0004);
+  int mixed = 0, hits = 0, checked = 0;
+  for (int t : {0, 3, 7}) {
+    const int id = kToleranceLevelBase + t;
+    int lo = 99, hi = -1;
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      lo = std::min(lo, sc.clamp_level(c, id));
+      hi = std::max(hi, sc.clamp_level(c, id));
+    }
+    mixed += lo < hi;
+    BoundarySection section(sc), wide(sc), closest(sc);
+    auto check = [&](Vec2 a, Vec2 b) {
+      const SweepHit h = section.first_hit(a, b, id, nullptr, 0, QueryBudget{});
+      QueryBudget unlimited;
+      const SweepHit hw = wide.first_hit_wide(a, b, id, nullptr, 0, unlimited);
+      double t_ref = 0.0;
+      SegmentRef ref;
+      const bool hit_ref = test::brute_first_hit(sc, a, b, id, &t_ref, &ref);
+      ++checked;
+      ASSERT_EQ(h.hit, hit_ref) << "step " << t;
+      ASSERT_EQ(hw.hit, hit_ref) << "step " << t;
+      if (hit_ref) {
+        ++hits;
+        ASSERT_NEAR(h.t, t_ref, 1e-9);
+        ASSERT_EQ(hw.t, h.t);
+        ASSERT_EQ(h.segment.level, sc.clamp_level(static_cast<std::size_t>(h.segment.curve), id)) << "a wall of the curve's own level";
+      }
+    };
+    Vec2 p{0.0, 0.0};
+    for (int i = 0; i < 25000; ++i) {
+      const Vec2 q{std::clamp(p.x + step(rng), -0.075, 0.075), std::clamp(p.y + step(rng), -0.05, 0.05)};
+      check(p, q);
+      p = q;
+    }
+    for (int i = 0; i < 10000; ++i) check({ux(rng), uy(rng)}, {ux(rng), uy(rng)});
+    for (int i = 0; i < 2000; ++i) {
+      const Vec2 x{ux(rng), uy(rng)};
+      double best = 1e9;
+      for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+        const int l = sc.clamp_level(c, id);
+        for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
+          Vec2 a, b;
+          sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
+          best = std::min(best, distance_to_segment(x, a, b));
+        }
+      }
+      Vec2 q;
+      SegmentRef s;
+      ASSERT_TRUE(closest.closest_point(x, id, 1.0, &q, &s));
+      ASSERT_NEAR(distance(x, q), best, 1e-12) << "step " << t;
+      ASSERT_EQ(s.level, sc.clamp_level(static_cast<std::size_t>(s.curve), id));
+    }
+  }
+  EXPECT_GE(mixed, 2) << "the steps must put curves of the scene at different levels, or this tests nothing new";
+  EXPECT_GE(checked, 100000);
+  EXPECT_GT(hits, 5000);
+}
 
 TEST(CollisionQuery, BoundarySectionFollowsTheHandle) {
   std::vector<Polyline> curves{test::random_blob(*std::make_unique<std::mt19937>(5), {0, 0}, 0.02, 400)};

@@ -1,12 +1,15 @@
 // Tolerance cut (issue 18): the cut covers the curve once, in order; every original vertex is within the
 // tolerance of the cut segment standing for it (distances computed here, from arc positions, not from the
-// tree); it never needs more segments than the coarsest single level that meets the same tolerance.
+// tree); it never needs more segments than the coarsest single level that meets the same tolerance. The
+// tolerance steps the level policy may pick (each curve at the coarsest of its levels within the step):
+// the level each curve gets, checked against the boxes and the original vertices.
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "curves.hpp"
 #include "haptics/scene.hpp"
+#include "haptics/level_policy.hpp"
 #include "haptics/tolerance_cut.hpp"
 
 using namespace hk;
@@ -118,4 +121,93 @@ TEST(ToleranceCut, TighterToleranceNeverTakesFewerSegments) {
       last = n;
     }
   }
+}
+
+// ── Tolerance steps (level ids kToleranceLevelBase + t, hk/constants.hpp): each curve at its own level ──
+
+namespace {
+
+// The largest box_error_bound of level l of curve c, from the boxes themselves (not CurveInfo's record).
+double level_bound_from_boxes(const Scene& sc, std::size_t c, int l) {
+  double worst = 0.0;
+  for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
+    const SegmentRef s{static_cast<int>(c), l, static_cast<int>(k)};
+    Vec2 a, b;
+    sc.segment(s, &a, &b);
+    worst = std::max(worst, box_error_bound(sc.box(sc.node_of(s)), distance(a, b)));
+  }
+  return worst;
+}
+
+// The test scene with a straight line added: its every level is the line itself.
+std::vector<Polyline> curves_with_a_line(std::mt19937& rng) {
+  auto curves = curves_for(rng);
+  Polyline line;
+  for (int i = 0; i <= 200; ++i) line.points_m.push_back({-0.05 + 0.0004 * i, 0.06 + 0.0001 * i});
+  curves.push_back(line);
+  return curves;
+}
+
+}  // namespace
+
+TEST(ToleranceSteps, EachCurveTakesTheCoarsestOfItsLevelsWithinTheStep) {
+  std::mt19937 rng(21);
+  const auto curves = curves_with_a_line(rng);
+  const Scene sc = Scene::build(curves, 6);
+  ASSERT_EQ(sc.curve_count(), curves.size());
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    std::vector<double> bound(static_cast<std::size_t>(ci.levels));
+    for (int l = 0; l < ci.levels; ++l) bound[static_cast<std::size_t>(l)] = level_bound_from_boxes(sc, c, l);
+    const auto vseg = level0_of_vertices(sc, c, curves[sc.source_index(c)]);
+    const auto& orig = curves[sc.source_index(c)].points_m;
+    int last = 0;
+    for (int t = 0; t < kToleranceSteps; ++t) {
+      const double tol = kToleranceLadder_m[t];
+      const int l = sc.clamp_level(c, kToleranceLevelBase + t);
+      ASSERT_GE(l, 0);
+      ASSERT_LT(l, ci.levels);
+      EXPECT_GE(l, last) << "a looser step never takes a finer level (curve " << c << ")";
+      last = l;
+      if (l > 0) EXPECT_LE(bound[static_cast<std::size_t>(l)], tol) << "curve " << c << " step " << t;
+      for (int coarser = l + 1; coarser < ci.levels; ++coarser) {
+        EXPECT_GT(bound[static_cast<std::size_t>(coarser)], tol) << "curve " << c << " step " << t << ": level " << coarser << " is within it too";
+      }
+      // What the bound promises, measured: every original vertex within the step's tolerance (or, at level
+      // 0, that level's own error) of the level-l segment standing for it.
+      const double allowed = (l > 0 ? tol : std::max(tol, bound[0])) + 1e-9;
+      for (std::size_t j = 0; j < orig.size(); ++j) {
+        Vec2 a, b;
+        sc.segment({static_cast<int>(c), l, static_cast<int>(vseg[j] >> l)}, &a, &b);
+        ASSERT_LE(distance_to_segment(orig[j], a, b), allowed) << "curve " << c << " step " << t << " vertex " << j;
+      }
+    }
+  }
+  // The straight line is exact at every level: its coarsest at every step.
+  const std::size_t line = sc.curve_count() - 1;
+  for (int t = 0; t < kToleranceSteps; ++t) EXPECT_EQ(sc.clamp_level(line, kToleranceLevelBase + t), sc.curve(line).levels - 1);
+}
+
+TEST(ToleranceSteps, NeverMoreSegmentsThanTheOneLevelWithinTheSameToleranceAndFewerOnAMixedScene) {
+  std::mt19937 rng(22);
+  const Scene sc = Scene::build(curves_with_a_line(rng), 6);
+  int fewer = 0;
+  for (int t = 0; t < kToleranceSteps; ++t) {
+    const double tol = kToleranceLadder_m[t];
+    int single = 0;  // the coarsest level, the same for every curve, within the tolerance everywhere
+    for (int l = 0; l < sc.max_curve_levels(); ++l) {
+      if (sc.max_error_bound_m(l) <= tol) single = l;
+    }
+    const std::size_t per_curve = sc.total_segments(kToleranceLevelBase + t), one_level = sc.total_segments(single);
+    EXPECT_LE(per_curve, one_level) << "step " << t;
+    fewer += per_curve < one_level;
+    EXPECT_LE(sc.max_error_bound_m(kToleranceLevelBase + t), std::max(tol, sc.max_error_bound_m(0))) << "step " << t;
+  }
+  EXPECT_GE(fewer, kToleranceSteps / 2) << "on a scene of blobs, strokes and a line, per-curve levels save segments";
+}
+
+TEST(ToleranceSteps, LabelsReadAsATolerance) {
+  EXPECT_EQ(level_label(3), "level 3");
+  EXPECT_EQ(level_label(kToleranceLevelBase + 2), "tolerance 0.25 mm");
+  EXPECT_EQ(level_label(kToleranceLevelBase + kToleranceSteps - 1), "tolerance 2.50 mm");
 }
