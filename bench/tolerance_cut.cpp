@@ -9,8 +9,10 @@
 //        level-0 error exceeds T are counted apart (the cut stops at level 0 there).
 //   dp   Douglas & Peucker (1973), cv::approxPolyDP on the original vertices with epsilon = T (closed flag
 //        kept): every original vertex within T of the chord that replaced it.
+//   curve levels  each curve at the coarsest of its levels whose error bound is ≤ T (Scene::
+//        coarsest_level_within; what the level policy's tolerance steps render, level_mode = "tolerance").
 // Vertices: dp's count; the cut's drawn as a polyline (segments + breaks where it changes level, + 1
-// when open; CutStats::vertices). Measured error, the same way for both: the largest distance of an
+// when open; CutStats::vertices); curve levels': that level's points. Measured error, the same way for both: the largest distance of an
 // original vertex from the nearest segment of the simplified polyline (OpenCV's closed-curve DP can exceed
 // epsilon there: its measured error is printed beside it). The ratio is the cut's vertices over dp's, per
 // picture (all its curves); the target is ≤ 1.2 on every picture.
@@ -44,9 +46,22 @@ double max_vertex_error(const std::vector<Vec2>& orig, const std::vector<std::pa
 }
 
 struct Tally {
-  std::size_t cut_vertices = 0, cut_breaks = 0, dp_vertices = 0, curves_below_level0 = 0;
-  double cut_error_m = 0.0, dp_error_m = 0.0;
+  std::size_t cut_vertices = 0, cut_breaks = 0, dp_vertices = 0, curves_below_level0 = 0, level_vertices = 0;
+  double cut_error_m = 0.0, dp_error_m = 0.0, level_error_m = 0.0;
 };
+
+void curve_level(const Scene& sc, std::size_t c, const Polyline& src, double tol_m, Tally& t) {
+  const int l = sc.coarsest_level_within(c, tol_m);
+  const CurveInfo& ci = sc.curve(c);
+  std::vector<std::pair<Vec2, Vec2>> segs;
+  for (std::uint32_t k = 0; k < ci.segment_count[l]; ++k) {
+    Vec2 a, b;
+    sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
+    segs.push_back({a, b});
+  }
+  t.level_vertices += ci.point_count[l];  // distinct points: an open curve's include both ends
+  t.level_error_m = std::max(t.level_error_m, max_vertex_error(src.points_m, segs));
+}
 
 void cut_curve(const Scene& sc, std::size_t c, const Polyline& src, double tol_m, Tally& t) {
   std::vector<SegmentRef> cut;
@@ -87,9 +102,9 @@ int main(int argc, char** argv) {
   const auto pictures = picture_curves(settings);
   const std::vector<double> tolerances_mm = {0.2, 0.3, 0.5, 1.0, 2.0};
   nlohmann::json rows = nlohmann::json::array();
-  std::printf("| picture | curves | T mm | cut vertices (of which breaks) | dp vertices | cut / dp | cut error mm | dp error mm | curves with level-0 error > T |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|\n");
-  std::vector<double> worst_ratio(tolerances_mm.size(), 0.0);
+  std::printf("| picture | curves | T mm | cut vertices (of which breaks) | dp vertices | cut / dp | cut error mm | dp error mm | curves with level-0 error > T | curve levels vertices | curve levels / dp | curve levels error mm |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::vector<double> worst_ratio(tolerances_mm.size(), 0.0), worst_level_ratio(tolerances_mm.size(), 0.0);
   for (std::size_t p = 0; p < paths.size(); ++p) {
     const Scene sc = Scene::build(pictures[p], settings.haptics.max_levels);
     for (std::size_t ti = 0; ti < tolerances_mm.size(); ++ti) {
@@ -99,21 +114,26 @@ int main(int argc, char** argv) {
         const Polyline& src = pictures[p][sc.source_index(c)];
         cut_curve(sc, c, src, tol_m, t);
         dp_curve(src, tol_m, t);
+        curve_level(sc, c, src, tol_m, t);
       }
-      const double ratio = static_cast<double>(t.cut_vertices) / static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
+      const double dp = static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
+      const double ratio = static_cast<double>(t.cut_vertices) / dp, level_ratio = static_cast<double>(t.level_vertices) / dp;
       worst_ratio[ti] = std::max(worst_ratio[ti], ratio);
-      std::printf("| %s | %zu | %.1f | %zu (%zu) | %zu | %.2f | %.3f | %.3f | %zu |\n", paths[p].stem().c_str(), sc.curve_count(), tolerances_mm[ti], t.cut_vertices,
-                  t.cut_breaks, t.dp_vertices, ratio, 1e3 * t.cut_error_m, 1e3 * t.dp_error_m, t.curves_below_level0);
+      worst_level_ratio[ti] = std::max(worst_level_ratio[ti], level_ratio);
+      std::printf("| %s | %zu | %.1f | %zu (%zu) | %zu | %.2f | %.3f | %.3f | %zu | %zu | %.2f | %.3f |\n", paths[p].stem().c_str(), sc.curve_count(), tolerances_mm[ti],
+                  t.cut_vertices, t.cut_breaks, t.dp_vertices, ratio, 1e3 * t.cut_error_m, 1e3 * t.dp_error_m, t.curves_below_level0, t.level_vertices,
+                  level_ratio, 1e3 * t.level_error_m);
       rows.push_back({{"picture", paths[p].stem().string()}, {"curves", sc.curve_count()}, {"tolerance_mm", tolerances_mm[ti]},
                       {"cut_vertices", t.cut_vertices}, {"cut_breaks", t.cut_breaks}, {"dp_vertices", t.dp_vertices}, {"ratio", ratio},
-                      {"cut_error_mm", 1e3 * t.cut_error_m}, {"dp_error_mm", 1e3 * t.dp_error_m}, {"curves_below_level0", t.curves_below_level0}});
+                      {"cut_error_mm", 1e3 * t.cut_error_m}, {"dp_error_mm", 1e3 * t.dp_error_m}, {"curves_below_level0", t.curves_below_level0},
+                      {"curve_levels_vertices", t.level_vertices}, {"curve_levels_ratio", level_ratio}, {"curve_levels_error_mm", 1e3 * t.level_error_m}});
     }
   }
-  std::printf("\n| T mm | worst cut / dp over the pictures |\n|---|---|\n");
+  std::printf("\n| T mm | worst cut / dp over the pictures | worst curve levels / dp |\n|---|---|---|\n");
   nlohmann::json worst = nlohmann::json::array();
   for (std::size_t ti = 0; ti < tolerances_mm.size(); ++ti) {
-    std::printf("| %.1f | %.2f |\n", tolerances_mm[ti], worst_ratio[ti]);
-    worst.push_back({{"tolerance_mm", tolerances_mm[ti]}, {"worst_ratio", worst_ratio[ti]}});
+    std::printf("| %.1f | %.2f | %.2f |\n", tolerances_mm[ti], worst_ratio[ti], worst_level_ratio[ti]);
+    worst.push_back({{"tolerance_mm", tolerances_mm[ti]}, {"worst_ratio", worst_ratio[ti]}, {"worst_curve_levels_ratio", worst_level_ratio[ti]}});
   }
   std::ofstream(out_path) << nlohmann::json{{"rows", rows}, {"worst", worst}}.dump(1) << "\n";
   return 0;

@@ -170,6 +170,16 @@ double Scene::max_error_bound_m(int level) const {
   return bound;
 }
 
+int Scene::coarsest_level_within(std::size_t c, double tol_m) const {
+  // A curve's bounds need not grow with the level, so every level is looked at, not just the first that fails.
+  const CurveInfo& ci = curves_[c];
+  int level = 0;
+  for (int l = 0; l < ci.levels; ++l) {
+    if (ci.max_error_bound_m[l] <= tol_m) level = l;
+  }
+  return level;
+}
+
 int Scene::max_curve_levels() const {
   int levels = 1;
   for (const CurveInfo& ci : curves_) levels = std::max(levels, ci.levels);
@@ -338,18 +348,10 @@ class SceneBuild {
   }
 
   // The curve's level at each tolerance step (CurveNodes::tolerance_level): the coarsest level whose error
-  // bound is within the step's tolerance, 0 when none is. A curve's bounds need not grow with the level,
-  // so every level is looked at, not just the first that fails.
+  // bound is within the step's tolerance, 0 when none is.
   static void assign_tolerance_levels(Scene& scene, std::size_t c) {
-    const CurveInfo& ci = scene.curves_[c];
     CurveNodes& cn = scene.curve_nodes_[c];
-    for (int t = 0; t < kToleranceSteps; ++t) {
-      int level = 0;
-      for (int l = 0; l < ci.levels; ++l) {
-        if (ci.max_error_bound_m[l] <= kToleranceLadder_m[t]) level = l;
-      }
-      cn.tolerance_level[t] = static_cast<std::uint8_t>(level);
-    }
+    for (int t = 0; t < kToleranceSteps; ++t) cn.tolerance_level[t] = static_cast<std::uint8_t>(scene.coarsest_level_within(c, kToleranceLadder_m[t]));
   }
 
   // Grows the extent by q, as grow(), and returns q's squared distance from the segment a + u·axis,

@@ -270,6 +270,9 @@ class Scene {
   /// at clamp_level(c, level)) [m]; no original point is farther than this from the level-`level`
   /// segment standing for it. 0 for an empty scene. O(curves): for setup code.
   double max_error_bound_m(int level) const;
+  /// The coarsest level of curve c whose error bound (CurveInfo::max_error_bound_m) is ≤ tol_m [m], 0 when none
+  /// is: the curve's level at a tolerance step (CurveNodes::tolerance_level), for any tolerance. O(levels).
+  int coarsest_level_within(std::size_t c, double tol_m) const;
   /// Levels of the curve with the most levels (1 for an empty scene).
   int max_curve_levels() const;
   /// The level curve c renders at for level id `level` (hk/constants.hpp): a level is clamped to the
