@@ -372,22 +372,13 @@ void KioskRuntime::remove_stick_folder() {
   sticks_.remove_folder();
 }
 
-int KioskRuntime::level_at_or_below(int id) const {
-  if (!is_tolerance_level(id) || !shown_.scene) return id;
-  const Scene& sc = *shown_.scene;
-  const double bound = sc.max_error_bound_m(id);
-  int level = 0;
-  for (int l = 0; l < sc.max_curve_levels(); ++l) {
-    if (sc.max_error_bound_m(l) <= bound) level = l;
-  }
-  return level;
-}
-
 bool KioskRuntime::change_level(int delta) {
   // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until the
-  // session ends. A tolerance step in use counts as the coarsest level within its scene-wide bound.
-  const int next = level_at_or_below(level()) + delta;
-  if (next < 0 || next > s_.haptics.max_levels) return false;
+  // session ends. With a tolerance step in use (level_mode = "tolerance") the keys move along the steps,
+  // so finer and coarser keep their order (and their earcons) without comparing a step with a level.
+  const int now = level();
+  const int next = now + delta;
+  if (is_tolerance_level(now) ? !is_tolerance_level(next) : (next < 0 || next > s_.haptics.max_levels)) return false;
   level_ = next;
   auto_level_ = false;
   core_.request_level(level_);

@@ -190,9 +190,6 @@ class KioskRuntime final : public KioskEffects {
   int shown_id() const { return shown_id_; }
   /// Level in use (the servo thread's, which follows the hand's speed in auto mode).
   int level() { return core_.display().level; }
-  /// `id` itself for a level; for a tolerance step (hk/constants.hpp), the coarsest level of the shown scene
-  /// whose scene-wide error bound is within the step's (the level the visitor's Finer/Coarser keys start from).
-  int level_at_or_below(int id) const;
   /// Half the workspace's extent [m].
   Vec2 half() const { return half_; }
   bool& high_contrast() { return high_contrast_; }

@@ -84,5 +84,56 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   fs::remove_all(lib);
 }
 
+// level_mode = "tolerance" (issue 18): the servo renders at a tolerance step, and the visitor's Finer /
+// Coarser keys move along the steps (a step is never compared with a level), stopping at the ends.
+TEST(ApplySettings, ToleranceModeRendersAtAStepAndTheKeysMoveAlongTheSteps) {
+  RuntimeOptions ro;
+  ro.library = (kData / "images").string();
+  ro.hotplug = false;
+  ro.open_audio_output = false;
+  ro.probe_usb_device = false;
+  config::Settings s;
+  s.haptics.level_mode = "tolerance";
+  KioskRuntime rt(ro, s);
+  KioskFlowParams fp;
+  KioskFlow flow(rt, rt.audio().messages(), fp);
+  flow.key(KioskKey::Other, 0.0);  // wake: the tutorial's square is shown
+  const auto tick = [&] {
+    ServoCommand cmd;
+    rt.core().step(rt.device().read(), false, cmd);
+    rt.device().write_force(cmd.force_n);
+    rt.core().publish_display();
+  };
+  for (int i = 0; i < 5; ++i) tick();
+  ASSERT_EQ(rt.core().display().scene_id, rt.shown_id());
+  const int start = rt.level();
+  ASSERT_TRUE(is_tolerance_level(start)) << start;
+  EXPECT_TRUE(rt.core().display().auto_level);
+  const auto settle = [&](int want) {  // a change waits for a tick at which it is safe: the handle rests in the air here
+    for (int i = 0; i < 400 && rt.level() != want; ++i) tick();
+    return rt.level();
+  };
+  if (start - kToleranceLevelBase < kToleranceSteps - 1) {
+    ASSERT_TRUE(rt.change_level(+1));
+    EXPECT_EQ(settle(start + 1), start + 1) << "Coarser: the next step";
+    EXPECT_FALSE(rt.core().display().auto_level) << "the visitor's choice holds";
+    ASSERT_TRUE(rt.change_level(-1));
+    EXPECT_EQ(settle(start), start) << "Finer: back";
+  }
+  // To the finest step, then no further; to the loosest, then no further.
+  while (rt.level() > kToleranceLevelBase) {
+    const int now = rt.level();
+    ASSERT_TRUE(rt.change_level(-1));
+    ASSERT_EQ(settle(now - 1), now - 1);
+  }
+  EXPECT_FALSE(rt.change_level(-1)) << "no step is finer than the first";
+  while (rt.level() < kToleranceLevelBase + kToleranceSteps - 1) {
+    const int now = rt.level();
+    ASSERT_TRUE(rt.change_level(+1));
+    ASSERT_EQ(settle(now + 1), now + 1);
+  }
+  EXPECT_FALSE(rt.change_level(+1)) << "no step is looser than the last";
+}
+
 }  // namespace
 }  // namespace hk::app
