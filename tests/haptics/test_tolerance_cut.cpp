@@ -169,7 +169,9 @@ TEST(ToleranceSteps, EachCurveTakesTheCoarsestOfItsLevelsWithinTheStep) {
       ASSERT_LT(l, ci.levels);
       EXPECT_GE(l, last) << "a looser step never takes a finer level (curve " << c << ")";
       last = l;
-      if (l > 0) EXPECT_LE(bound[static_cast<std::size_t>(l)], tol) << "curve " << c << " step " << t;
+      if (l > 0) {
+        EXPECT_LE(bound[static_cast<std::size_t>(l)], tol) << "curve " << c << " step " << t;
+      }
       for (int coarser = l + 1; coarser < ci.levels; ++coarser) {
         EXPECT_GT(bound[static_cast<std::size_t>(coarser)], tol) << "curve " << c << " step " << t << ": level " << coarser << " is within it too";
       }
