@@ -33,8 +33,11 @@ namespace {
 // The policy's ladder: the level ids it chooses from, finest first, and the scene's error bound at each
 // (the worst curve's, so the id chosen keeps every curve within tolerance). Levels: every level of the
 // scene. Tolerance steps (ServoParams::tolerance_steps): every step (LevelPolicy keeps the bounds
-// non-decreasing, as a curve's bound need not grow with its level). Returns the ladder's length.
-int level_ladder(const Scene& scene, bool tolerance_steps, int* ids, double* err) {
+// non-decreasing, as a curve's bound need not grow with its level). Also writes the scene's bound at every
+// level id to `id_bound` (kLevelIds entries), for placing an id that is not on the ladder. Returns the
+// ladder's length.
+int level_ladder(const Scene& scene, bool tolerance_steps, int* ids, double* err, double* id_bound) {
+  for (int id = 0; id < kLevelIds; ++id) id_bound[id] = scene.max_error_bound_m(id);
   if (!tolerance_steps) {
     const int levels = std::min(scene.max_curve_levels(), LevelPolicy::kMaxLevels);
     for (int l = 0; l < levels; ++l) {
@@ -49,11 +52,6 @@ int level_ladder(const Scene& scene, bool tolerance_steps, int* ids, double* err
     err[t] = scene.max_error_bound_m(ids[t]);
   }
   return kToleranceSteps;
-}
-
-// The scene's error bound at every level (for placing a fixed level on a ladder of tolerance steps).
-void level_bounds(const Scene& scene, double* bound) {
-  for (int l = 0; l < kMaxLevels; ++l) bound[l] = scene.max_error_bound_m(l);
 }
 
 // The solver's parameters, stepped at the loop's period.
@@ -113,20 +111,17 @@ ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
       solver_(scene, contact_params(params)),
       groove_(scene, params.groove),
-      levels_(level_ladder(scene, params.tolerance_steps, ladder_id_, level_error_m_)),
-      policy_(policy_params(params), level_error_m_, levels_, 0),
+      levels_(level_ladder(scene, params.tolerance_steps, ladder_id_, level_error_m_, id_bound_m_)),
+      policy_(policy_params(params), level_error_m_, levels_, ladder_index(params.level)),  // the ladder's members are set by now
       level_(params.level),
-      guard_max_force_n_(params.guard.max_force_n) {
-  level_bounds(scene, level_bound_m_);
-  policy_ = LevelPolicy(policy_params(params), level_error_m_, levels_, ladder_index(params.level));
-}
+      guard_max_force_n_(params.guard.max_force_n) {}
 
 int ServoLoop::ladder_index(int id) const noexcept {
   for (int i = 0; i < levels_; ++i) {
     if (ladder_id_[i] == id) return i;
   }
   // A level on a ladder of tolerance steps (or the reverse): the coarsest rung no looser than its bound.
-  const double bound = is_tolerance_level(id) ? kToleranceLadder_m[id - kToleranceLevelBase] : level_bound_m_[std::clamp(id, 0, kMaxLevels - 1)];
+  const double bound = id_bound_m_[std::clamp(id, 0, kLevelIds - 1)];
   int index = 0;
   for (int i = 0; i < levels_; ++i) {
     if (level_error_m_[i] <= bound) index = i;

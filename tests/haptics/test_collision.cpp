@@ -379,15 +379,7 @@ TEST(CollisionQuery, ToleranceStepsEqualBruteForceInEveryWalk) {
     for (int i = 0; i < 10000; ++i) check({ux(rng), uy(rng)}, {ux(rng), uy(rng)});
     for (int i = 0; i < 2000; ++i) {
       const Vec2 x{ux(rng), uy(rng)};
-      double best = 1e9;
-      for (std::size_t c = 0; c < sc.curve_count(); ++c) {
-        const int l = sc.clamp_level(c, id);
-        for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
-          Vec2 a, b;
-          sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
-          best = std::min(best, distance_to_segment(x, a, b));
-        }
-      }
+      const double best = test::brute_closest_distance(sc, x, id);
       Vec2 q;
       SegmentRef s;
       ASSERT_TRUE(closest.closest_point(x, id, 1.0, &q, &s));
@@ -483,15 +475,7 @@ TEST(CollisionQuery, ClosestPointEqualsBruteForce) {
   std::uniform_real_distribution<double> ux(-0.07, 0.07), uy(-0.045, 0.045);
   for (int i = 0; i < 2000; ++i) {
     const Vec2 p{ux(rng), uy(rng)};
-    double best = 1e9;
-    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
-      const int l = sc.clamp_level(c, 1);
-      for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
-        Vec2 a, b;
-        sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
-        best = std::min(best, distance_to_segment(p, a, b));
-      }
-    }
+    const double best = test::brute_closest_distance(sc, p, 1);
     Vec2 q;
     SegmentRef s;
     ASSERT_TRUE(section.closest_point(p, 1, 1.0, &q, &s));

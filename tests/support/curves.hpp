@@ -118,6 +118,21 @@ inline bool brute_first_hit(const Scene& sc, Vec2 a, Vec2 b, int level, double* 
 }
 
 /// Number of level-`level` segments that the move p→q crosses strictly.
+/// Distance from p to the nearest segment of any curve at level id `level` (each curve at
+/// Scene::clamp_level), by brute force over every segment [m]; 1e9 for an empty scene.
+inline double brute_closest_distance(const Scene& sc, Vec2 p, int level) {
+  double best = 1e9;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const int l = sc.clamp_level(c, level);
+    for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
+      Vec2 a, b;
+      sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
+      best = std::min(best, distance_to_segment(p, a, b));
+    }
+  }
+  return best;
+}
+
 inline int count_crossings(const Scene& sc, Vec2 p, Vec2 q, int level) {
   int n = 0;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {

@@ -216,11 +216,12 @@ class ServoLoop {
   ContactSolver solver_;
   GrooveSolver groove_;
   // The policy's ladder (levels, or tolerance steps): rung i is level id ladder_id_[i], with the scene's
-  // error bound level_error_m_[i] [m] (non-decreasing); levels_ rungs.
+  // error bound level_error_m_[i] [m] (non-decreasing); levels_ rungs. Declared before levels_ and policy_:
+  // levels_'s initializer fills them, policy_'s reads them.
   int ladder_id_[LevelPolicy::kMaxLevels] = {};
   double level_error_m_[LevelPolicy::kMaxLevels] = {};
+  double id_bound_m_[kLevelIds] = {};  // the scene's error bound at every level id [m] (to place an id not on the ladder)
   int levels_ = 1;
-  double level_bound_m_[kMaxLevels] = {};  // the scene's error bound at each level [m] (to place a level on the ladder)
   // The rung for level id `id`: its own, or the coarsest whose bound is within the id's.
   int ladder_index(int id) const noexcept;
   LevelPolicy policy_;
