@@ -9,6 +9,9 @@
 // their time is in explore's summary.json, build_ms.thin_lines).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
+
 #include <opencv2/imgproc.hpp>
 
 #include "bench_scenes.hpp"
@@ -28,6 +31,10 @@ struct Picture {
   double px_scale = 1.0;
 };
 
+using Clock = std::chrono::steady_clock;
+
+double ms(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+
 std::vector<Picture>& pictures() {
   static std::vector<Picture> v;
   return v;
@@ -38,16 +45,34 @@ void build_ours(benchmark::State& state, const Picture* p) {
   vision::EdgeParams ep;
   ep.blur_sigma_px = s.vision.blur_sigma_px;
   std::size_t segments = 0;
+  double edges_ms = 0.0, linking_ms = 0.0, curves_ms = 0.0, multires_ms = 0.0, tree_ms = 0.0;  // summed over iterations
   for (auto _ : state) {
+    const auto t0 = Clock::now();
     const vision::EdgeMap em = vision::detect_edges(p->grey, ep);
+    const auto t1 = Clock::now();
     const auto chains = vision::link_edges(em.edges, 2.0);
+    const auto t2 = Clock::now();
     const vision::PxToM map = vision::fit_to_workspace(p->grey.cols, p->grey.rows, s.workspace.width_m, s.workspace.height_m);
     const std::vector<Polyline> curves = app::to_polylines(vision::chains_to_curves(chains, {}, map, s.vision.min_chain_length_m));
+    const auto t3 = Clock::now();
     const Scene scene = Scene::build(curves, s.haptics.max_levels);
     segments = scene.total_segments(0);
     benchmark::DoNotOptimize(scene.node_count());
+    edges_ms += ms(t0, t1);
+    linking_ms += ms(t1, t2);
+    curves_ms += ms(t2, t3);
+    multires_ms += scene.build_times().multires_ms;
+    tree_ms += scene.build_times().tree_ms;
   }
   state.counters["segments"] = static_cast<double>(segments);
+  // Where the time goes, mean per build [ms]: edges (blur + Canny), linking, chains to curves in metres,
+  // the multiresolution models, the trees (error boxes, hierarchy, wide index).
+  const double n = static_cast<double>(std::max<benchmark::IterationCount>(state.iterations(), 1));
+  state.counters["edges_ms"] = edges_ms / n;
+  state.counters["linking_ms"] = linking_ms / n;
+  state.counters["curves_ms"] = curves_ms / n;
+  state.counters["multires_ms"] = multires_ms / n;
+  state.counters["tree_ms"] = tree_ms / n;
 }
 
 void build_opencv(benchmark::State& state, const Picture* p) {

@@ -10,6 +10,10 @@
 #include <limits>
 #include <new>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace hk {
 namespace {
 
@@ -36,6 +40,103 @@ inline Vec2 grow(Extent& e, Vec2 origin, Vec2 axis, Vec2 q) {
   e.n_max = std::max(e.n_max, n);
   return Vec2{u, n};
 }
+
+// Two doubles side by side, (lane 0, lane 1): the box pass keeps a point's frame coordinates (u, n) in
+// one, so a point costs one subtraction, two products, one sum and a min and max of pairs (SSE2 where
+// the target has it, two scalars elsewhere; both compute the same numbers bit for bit).
+#if defined(__SSE2__)
+struct Lanes2 {
+  __m128d v;
+};
+inline Lanes2 lanes(double lane0, double lane1) { return {_mm_set_pd(lane1, lane0)}; }
+inline Lanes2 load(const Vec2& q) { return {_mm_loadu_pd(&q.x)}; }
+inline Lanes2 operator+(Lanes2 a, Lanes2 b) { return {_mm_add_pd(a.v, b.v)}; }
+inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return {_mm_sub_pd(a.v, b.v)}; }
+inline Lanes2 operator*(Lanes2 a, Lanes2 b) { return {_mm_mul_pd(a.v, b.v)}; }
+inline Lanes2 min(Lanes2 a, Lanes2 b) { return {_mm_min_pd(a.v, b.v)}; }
+inline Lanes2 max(Lanes2 a, Lanes2 b) { return {_mm_max_pd(a.v, b.v)}; }
+inline Lanes2 swapped(Lanes2 a) { return {_mm_shuffle_pd(a.v, a.v, 1)}; }
+inline double lane0(Lanes2 a) { return _mm_cvtsd_f64(a.v); }
+inline double lane1(Lanes2 a) { return _mm_cvtsd_f64(_mm_unpackhi_pd(a.v, a.v)); }
+#else
+struct Lanes2 {
+  double a, b;
+};
+inline Lanes2 lanes(double lane0, double lane1) { return {lane0, lane1}; }
+inline Lanes2 load(const Vec2& q) { return {q.x, q.y}; }
+inline Lanes2 operator+(Lanes2 a, Lanes2 b) { return {a.a + b.a, a.b + b.b}; }
+inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return {a.a - b.a, a.b - b.b}; }
+inline Lanes2 operator*(Lanes2 a, Lanes2 b) { return {a.a * b.a, a.b * b.b}; }
+inline Lanes2 min(Lanes2 a, Lanes2 b) { return {a.a < b.a ? a.a : b.a, a.b < b.b ? a.b : b.b}; }
+inline Lanes2 max(Lanes2 a, Lanes2 b) { return {a.a > b.a ? a.a : b.a, a.b > b.b ? a.b : b.b}; }
+inline Lanes2 swapped(Lanes2 a) { return {a.b, a.a}; }
+inline double lane0(Lanes2 a) { return a.a; }
+inline double lane1(Lanes2 a) { return a.b; }
+#endif
+
+// A segment's frame for the box pass and what the pass grows in it: the extent of the points seen,
+// as (u_min, n_min) and (u_max, n_max) [m], and the largest squared distance from the segment of the
+// points measured [m²]. Two accumulators of each, for consecutive points, so that the min/max chains
+// of the next point need not wait for the last (they are merged by result()).
+class BoxGrower {
+ public:
+  BoxGrower(Vec2 a, Vec2 axis, double length_m)
+      : origin_(load(a)), axis_x_(lanes(axis.x, axis.x)), axis_y_(lanes(axis.y, -axis.y)), clamp_hi_(lanes(length_m, 0.0)) {}
+
+  // q's frame coordinates (u, n) = (r·axis, axis×r), r = q − a: r·(ax, ax) + swap(r)·(ay, −ay), bit for bit
+  // what dot() and cross() give.
+  Lanes2 coords(Vec2 q) const {
+    const Lanes2 r = load(q) - origin_;
+    return r * axis_x_ + swapped(r) * axis_y_;
+  }
+  // Grows the extent by the points q[0..count).
+  void grow(const Vec2* q, std::size_t count) {
+    std::size_t i = 0;
+    for (; i + 1 < count; i += 2) {
+      const Lanes2 w0 = coords(q[i]), w1 = coords(q[i + 1]);
+      lo_[0] = min(lo_[0], w0);
+      hi_[0] = max(hi_[0], w0);
+      lo_[1] = min(lo_[1], w1);
+      hi_[1] = max(hi_[1], w1);
+    }
+    if (i < count) add(0, coords(q[i]));
+  }
+  // Grows the extent by the points q[0..count) and measures their squared distances from the segment
+  // a + u·axis, 0 ≤ u ≤ length_m: (u − clamp(u, 0, length), n)², from the frame coordinates.
+  void grow_measuring(const Vec2* q, std::size_t count) {
+    std::size_t i = 0;
+    for (; i + 1 < count; i += 2) {
+      measure(0, coords(q[i]));
+      measure(1, coords(q[i + 1]));
+    }
+    if (i < count) measure(0, coords(q[i]));
+  }
+  // The extent grown so far, padded by pad_m on every side [m].
+  Extent extent(double pad_m) const {
+    const Lanes2 lo = min(lo_[0], lo_[1]), hi = max(hi_[0], hi_[1]);
+    return Extent{lane0(lo) - pad_m, lane0(hi) + pad_m, lane1(lo) - pad_m, lane1(hi) + pad_m};
+  }
+  // The largest squared distance measured [m²] (0 when none was).
+  double worst_sq() const { return lane0(max(worst_sq_[0], worst_sq_[1])); }
+
+ private:
+  void add(int k, Lanes2 w) {
+    lo_[k] = min(lo_[k], w);
+    hi_[k] = max(hi_[k], w);
+  }
+  void measure(int k, Lanes2 w) {
+    add(k, w);
+    const Lanes2 d = w - min(max(w, lanes(0.0, 0.0)), clamp_hi_);  // (distance past an end along the axis, n)
+    const Lanes2 d2 = d * d;
+    worst_sq_[k] = max(worst_sq_[k], d2 + swapped(d2));
+  }
+
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  Lanes2 origin_, axis_x_, axis_y_, clamp_hi_;
+  Lanes2 lo_[2] = {lanes(kInf, kInf), lanes(kInf, kInf)};
+  Lanes2 hi_[2] = {lanes(-kInf, -kInf), lanes(-kInf, -kInf)};
+  Lanes2 worst_sq_[2] = {lanes(0.0, 0.0), lanes(0.0, 0.0)};
+};
 
 // Largest |quantised extent| a level's quantum is chosen for (int16 holds ±32767: room for the outward steps).
 constexpr double kQuantumSteps = 32000.0;
@@ -312,39 +413,49 @@ class SceneBuild {
                                   std::vector<SegmentExtent>& level) {
     const CurveMultires& m = scene.models_[c];
     CurveInfo& ci = scene.curves_[c];
-    const auto& orig = src.points_m;
+    const Vec2* orig = src.points_m.data();
     for (int l = 0; l < m.levels; ++l) {
       level.resize(ci.segment_count[l]);
-      double widest = 0.0;      // largest |extent| of the level, what its quantum is chosen for [m]
-      double worst_sq = 0.0;    // largest squared distance of a level-0 point or original vertex from its level-l segment [m²]
+      double worst_sq = 0.0;  // largest squared distance of a level-0 point or original vertex from its level-l segment [m²]
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
         Vec2 a, b;
         scene.segment_points(ci.box_offset[l] + static_cast<std::uint32_t>(k), &a, &b);
         SegmentExtent& se = level[k];
         const Vec2 axis = Scene::segment_frame(a, b, &se.length_m);  // the frame Scene::segment_box() rebuilds
-        Extent& e = se.e;
-        e = Extent{};
-        grow(e, a, axis, a);
-        grow(e, a, axis, b);
+        BoxGrower box(a, axis, se.length_m);
+        const Vec2 ends[2] = {a, b};
+        box.grow(ends, 2);
         for (int j = 1; j < l; ++j) {  // finer levels' points under this segment (level 0 below, with the errors)
-          const Vec2* fine = scene.points(c, j);  // a closed curve's first point repeats at its end
           const std::size_t span = std::size_t{1} << (l - j);
-          for (std::size_t i = k * span; i <= (k + 1) * span; ++i) grow(e, a, axis, fine[i]);
+          box.grow(scene.points(c, j) + k * span, span + 1);  // a closed curve's first point repeats at its end
         }
         const std::size_t k0 = k << l, k1 = (k + 1) << l;  // level-0 segments under it
         if (l > 0) {
           const Vec2* fine = scene.points(c, 0);
-          for (std::size_t i = k0; i < k1; ++i) worst_sq = std::max(worst_sq, grow_measuring(e, a, axis, se.length_m, fine[i]));
-          grow(e, a, axis, fine[k1]);  // the next segment's first point: in the box, measured with that segment
+          box.grow_measuring(fine + k0, k1 - k0);
+          box.grow(fine + k1, 1);  // the next segment's first point: in the box, measured with that segment
         }
-        for (std::uint32_t v = orig_first[k0]; v < orig_first[k1]; ++v) worst_sq = std::max(worst_sq, grow_measuring(e, a, axis, se.length_m, orig[v]));
-        e = Extent{e.u_min - kBoxPad_m, e.u_max + kBoxPad_m, e.n_min - kBoxPad_m, e.n_max + kBoxPad_m};
-        widest = std::max({widest, std::abs(e.u_min), std::abs(e.u_max - se.length_m), std::abs(e.n_min), std::abs(e.n_max)});
+        box.grow_measuring(orig + orig_first[k0], orig_first[k1] - orig_first[k0]);
+        se.e = box.extent(kBoxPad_m);
+        worst_sq = std::max(worst_sq, box.worst_sq());
       }
       ci.max_error_m[l] = std::sqrt(worst_sq);  // one root per level
-      quantise_level(scene, c, l, level, widest);
+      quantise_level(scene, c, l, level, widest_extent(level));
     }
     assign_tolerance_levels(scene, c);
+  }
+
+  // The largest |extent| of a level's boxes, what its quantum is chosen for [m]: the most any box reaches
+  // before its start, past its end or to either side.
+  static double widest_extent(const std::vector<SegmentExtent>& level) {
+    double before = 0.0, past = 0.0, right = 0.0, left = 0.0;  // four chains, merged once
+    for (const SegmentExtent& se : level) {
+      before = std::max(before, -se.e.u_min);
+      past = std::max(past, std::abs(se.e.u_max - se.length_m));
+      right = std::max(right, -se.e.n_min);
+      left = std::max(left, se.e.n_max);
+    }
+    return std::max({before, past, right, left});
   }
 
   // The curve's level at each tolerance step (CurveNodes::tolerance_level): the coarsest level whose error
@@ -352,14 +463,6 @@ class SceneBuild {
   static void assign_tolerance_levels(Scene& scene, std::size_t c) {
     CurveNodes& cn = scene.curve_nodes_[c];
     for (int t = 0; t < kToleranceSteps; ++t) cn.tolerance_level[t] = static_cast<std::uint8_t>(scene.coarsest_level_within(c, kToleranceLadder_m[t]));
-  }
-
-  // Grows the extent by q, as grow(), and returns q's squared distance from the segment a + u·axis,
-  // 0 ≤ u ≤ length_m [m²]: from the frame coordinates, so that the error costs no second pass.
-  static double grow_measuring(Extent& e, Vec2 a, Vec2 axis, double length_m, Vec2 q) {
-    const Vec2 un = grow(e, a, axis, q);
-    const double past = un.x < 0.0 ? un.x : (un.x > length_m ? un.x - length_m : 0.0);  // along the axis, beyond an end
-    return past * past + un.y * un.y;
   }
 
   // Level l's quantum (its widest extent / kQuantumSteps) and every segment's extents in it, rounded
