@@ -124,7 +124,7 @@ if pic:
 # 3. Speed against accuracy: per method and level, p99 over four pictures against max deviation.
 def accuracy_per_vertex(ax, lvl, lines):
     """Right panel: vertices against max deviation on the same four pictures, for our levels, the
-    tolerance cut (tolerance_cut.json: the cut's vertices, breaks included, and its measured error), each
+    tolerance cut (tolerance_cut.json: the joined cut's vertices and its measured error), each
     curve at its own coarsest level within the target (what level_mode = "tolerance" renders) and
     Douglas-Peucker at the same targets. The cut is not queried yet (no query at a per-segment cut), so it
     has no point on the time axis. A level's vertices are counted as its segments plus one per curve (the
@@ -149,7 +149,7 @@ def accuracy_per_vertex(ax, lvl, lines):
             per_curve.append((sum(r["curve_levels_vertices"] for r in rows), max(r["curve_levels_error_mm"] for r in rows), tol))
         cut.append((sum(r["cut_vertices"] for r in rows), max(r["cut_error_mm"] for r in rows), tol))
         dp.append((sum(r["dp_vertices"] for r in rows), max(r["dp_error_mm"] for r in rows), tol))
-        lines.append("| tolerance cut at %.1f mm (no query yet) | — | — | %.3f | %d vertices (DP: %d at %.3f mm) |" % (
+        lines.append("| tolerance cut at %.1f mm, joined (no query yet) | — | — | %.3f | %d vertices (DP: %d at %.3f mm) |" % (
             tol, cut[-1][1], cut[-1][0], dp[-1][0], dp[-1][1]))
     if cut:
         ax.plot([p[0] for p in cut], [p[1] for p in cut], "s--", color="tab:cyan", label="ours, tolerance cut")
@@ -355,7 +355,7 @@ if size_rows:
             meds[-1][0], ", ".join("%.3f" % m for _, m in meds), yes(all(m <= 1.05 for _, m in meds))))
     if TOLERANCE_CUT:
         worst = TOLERANCE_CUT["worst"]
-        rows2.append("| tolerance cut: ≤ 1.2x Douglas–Peucker's vertices for the same max error, every picture | worst cut / DP per target error: %s | %s |" % (
+        rows2.append("| tolerance cut: ≤ 1.2x Douglas–Peucker's vertices for the same max error, every picture | worst joined cut / DP per target error: %s | %s |" % (
             ", ".join("%.2f at %.1f mm" % (w["worst_ratio"], w["tolerance_mm"]) for w in worst), yes(all(w["worst_ratio"] <= 1.2 for w in worst))))
         if all("worst_curve_levels_ratio" in w for w in worst):
             rows2.append("| the level policy may pick a tolerance, no crossings at changes | built at curve granularity (`level_mode = \"tolerance\"`: each curve at the coarsest of its levels within the step; "

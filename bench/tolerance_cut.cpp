@@ -3,19 +3,22 @@
 //
 // Usage: bench_tolerance_cut [--out FILE.json]    (prints a markdown table)
 //
-// For a target error T, both methods must keep every original vertex within T:
-//   cut  hk::tolerance_cut at tolerance T on every curve (refine a segment while its box's error bound
-//        exceeds T; seed §3). Guaranteed where T is at least the curve's level-0 error; curves whose
-//        level-0 error exceeds T are counted apart (the cut stops at level 0 there).
+// For a target error T, each method keeps every original vertex within T, measured:
+//   cut  hk::tolerance_cut on every curve (refine a segment while its box's error bound exceeds the
+//        tolerance; seed §3), drawn joined (hk::joined_cut_points: where the cut changes level, both pieces
+//        meet at the finer segment's end). Joining moves a coarser segment's end a little, so the cut's
+//        tolerance is searched per curve: the largest T·0.97^i (i = 0…79) whose joined polyline keeps
+//        every original vertex within T. Curves whose level-0 error bound exceeds T are counted apart
+//        (the cut stops at level 0 there).
 //   dp   Douglas & Peucker (1973), cv::approxPolyDP on the original vertices with epsilon = T (closed flag
 //        kept): every original vertex within T of the chord that replaced it.
 //   curve levels  each curve at the coarsest of its levels whose error bound is ≤ T (Scene::
 //        coarsest_level_within; what the level policy's tolerance steps render, level_mode = "tolerance").
-// Vertices: dp's count; the cut's drawn as a polyline (segments + breaks where it changes level, + 1
-// when open; CutStats::vertices); curve levels': that level's points. Measured error, the same way for both: the largest distance of an
-// original vertex from the nearest segment of the simplified polyline (OpenCV's closed-curve DP can exceed
-// epsilon there: its measured error is printed beside it). The ratio is the cut's vertices over dp's, per
-// picture (all its curves); the target is ≤ 1.2 on every picture.
+// Vertices: dp's count; the joined cut's (CutStats::vertices: segments, + 1 when open); curve levels':
+// that level's points. Measured error, the same way for all: the largest distance of an original vertex
+// from the nearest segment of the simplified polyline (OpenCV's closed-curve DP can exceed epsilon there:
+// its measured error is printed beside it). The ratio is the cut's vertices over dp's, per picture (all its
+// curves); the target is ≤ 1.2 on every picture.
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -63,18 +66,24 @@ void curve_level(const Scene& sc, std::size_t c, const Polyline& src, double tol
   t.level_error_m = std::max(t.level_error_m, max_vertex_error(src.points_m, segs));
 }
 
+// The joined cut of curve c at the largest searched tolerance whose measured error is within tol_m.
 void cut_curve(const Scene& sc, std::size_t c, const Polyline& src, double tol_m, Tally& t) {
-  std::vector<SegmentRef> cut;
-  const CutStats st = tolerance_cut(sc, c, tol_m, &cut);
-  std::vector<std::pair<Vec2, Vec2>> segs;
-  for (const SegmentRef& s : cut) {
-    Vec2 a, b;
-    sc.segment(s, &a, &b);
-    segs.push_back({a, b});
+  constexpr int kSearchSteps = 80;
+  double tried_m = tol_m;
+  for (int i = 0; i < kSearchSteps; ++i, tried_m *= 0.97) {
+    std::vector<SegmentRef> cut;
+    const CutStats st = tolerance_cut(sc, c, tried_m, &cut);
+    const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
+    std::vector<std::pair<Vec2, Vec2>> segs;
+    for (std::size_t k = 0; k < cut.size(); ++k) segs.push_back({pts[k], pts[(k + 1) % pts.size()]});
+    const double error_m = max_vertex_error(src.points_m, segs);
+    if (error_m <= tol_m || i + 1 == kSearchSteps) {
+      t.cut_vertices += st.vertices;
+      t.cut_breaks += st.breaks;
+      t.cut_error_m = std::max(t.cut_error_m, error_m);
+      break;
+    }
   }
-  t.cut_vertices += st.vertices;
-  t.cut_breaks += st.breaks;
-  t.cut_error_m = std::max(t.cut_error_m, max_vertex_error(src.points_m, segs));
   if (sc.curve(c).max_error_bound_m[0] > tol_m) ++t.curves_below_level0;
 }
 
@@ -102,7 +111,7 @@ int main(int argc, char** argv) {
   const auto pictures = picture_curves(settings);
   const std::vector<double> tolerances_mm = {0.2, 0.3, 0.5, 1.0, 2.0};
   nlohmann::json rows = nlohmann::json::array();
-  std::printf("| picture | curves | T mm | cut vertices (of which breaks) | dp vertices | cut / dp | cut error mm | dp error mm | curves with level-0 error > T | curve levels vertices | curve levels / dp | curve levels error mm |\n");
+  std::printf("| picture | curves | T mm | joined cut vertices (breaks joined) | dp vertices | cut / dp | cut error mm | dp error mm | curves with level-0 error > T | curve levels vertices | curve levels / dp | curve levels error mm |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<double> worst_ratio(tolerances_mm.size(), 0.0), worst_level_ratio(tolerances_mm.size(), 0.0);
   for (std::size_t p = 0; p < paths.size(); ++p) {

@@ -88,9 +88,60 @@ TEST(ToleranceCut, CoversTheCurveOnceAndKeepsEveryVertexWithinTheTolerance) {
       if (ci.max_error_bound_m[single] <= tol) {
         EXPECT_LE(st.segments, ci.segment_count[single]) << "curve " << c << " tol " << tol_mm;
       }
-      EXPECT_EQ(st.vertices, st.segments + st.breaks + (ci.closed ? 0 : 1));
+      EXPECT_EQ(st.vertices, st.segments + (ci.closed ? 0 : 1));
     }
   }
+}
+
+// The joined polyline (joined_cut_points): one vertex per junction; each piece inside its own segment's error
+// box (so the tree's miss proofs still hold for it); every original vertex within its segment's box error
+// bound plus how far the join moved that segment's ends, and the largest move is CutStats::max_join_shift_m.
+TEST(ToleranceCut, JoinedPiecesLieInTheirBoxesAndKeepVerticesWithinBoundPlusShift) {
+  std::mt19937 rng(21);
+  const auto curves = curves_for(rng);
+  const Scene sc = Scene::build(curves, 6);
+  std::size_t breaks = 0;
+  for (double tol_mm : {0.05, 0.1, 0.2, 0.5, 1.0, 2.0}) {
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      const CurveInfo& ci = sc.curve(c);
+      std::vector<SegmentRef> cut;
+      const CutStats st = tolerance_cut(sc, c, tol_mm * 1e-3, &cut);
+      breaks += st.breaks;
+      const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
+      ASSERT_EQ(pts.size(), st.vertices);
+      std::vector<double> shift(cut.size());
+      double largest_shift = 0.0;
+      for (std::size_t i = 0; i < cut.size(); ++i) {
+        const Vec2 p0 = pts[i], p1 = pts[(i + 1) % pts.size()];
+        const ErrorBox box = sc.box(sc.node_of(cut[i]));
+        EXPECT_TRUE(box_contains(box, p0, 1e-9) && box_contains(box, p1, 1e-9)) << "curve " << c << " piece " << i << " tol " << tol_mm;
+        Vec2 a, b;
+        sc.segment(cut[i], &a, &b);
+        shift[i] = std::max(distance(p0, a), distance(p1, b));
+        largest_shift = std::max(largest_shift, shift[i]);
+      }
+      EXPECT_DOUBLE_EQ(largest_shift, st.max_join_shift_m) << "curve " << c << " tol " << tol_mm;
+      if (st.breaks == 0) {
+        EXPECT_EQ(st.max_join_shift_m, 0.0);
+      }
+      // Original vertices, each against the piece of the cut segment over its level-0 segment.
+      std::vector<std::size_t> owner(ci.segment_count[0]);
+      for (std::size_t i = 0; i < cut.size(); ++i) {
+        for (std::size_t k = std::size_t(cut[i].segment) << cut[i].level; k < (std::size_t(cut[i].segment) + 1) << cut[i].level; ++k) owner[k] = i;
+      }
+      const auto vseg = level0_of_vertices(sc, c, curves[sc.source_index(c)]);
+      const auto& orig = curves[sc.source_index(c)].points_m;
+      for (std::size_t j = 0; j < orig.size(); ++j) {
+        const std::size_t i = owner[vseg[j]];
+        Vec2 a, b;
+        sc.segment(cut[i], &a, &b);
+        const double bound = box_error_bound(sc.box(sc.node_of(cut[i])), distance(a, b));
+        EXPECT_LE(distance_to_segment(orig[j], pts[i], pts[(i + 1) % pts.size()]), bound + shift[i] + 1e-9)
+            << "curve " << c << " vertex " << j << " tol " << tol_mm;
+      }
+    }
+  }
+  EXPECT_GT(breaks, 20u);  // the scene mixes levels, so the joins were exercised
 }
 
 TEST(ToleranceCut, EndsAreTheCoarsestLevelAndLevelZero) {
@@ -106,6 +157,10 @@ TEST(ToleranceCut, EndsAreTheCoarsestLevelAndLevelZero) {
     EXPECT_EQ(tight.segments, ci.segment_count[0]);
     EXPECT_EQ(tight.breaks, 0u);
     for (const SegmentRef& s : fine) EXPECT_EQ(s.level, 0);
+    // Unbroken: the joined polyline is level 0's own points, the first repeated at the end of a closed curve.
+    const std::vector<Vec2> pts = joined_cut_points(sc, c, fine.data(), fine.size());
+    ASSERT_EQ(pts.size(), ci.point_count[0]);
+    for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(pts[i], sc.points(c, 0)[i]);
   }
 }
 

@@ -12,9 +12,13 @@
 /// (nothing finer exists), so tolerances below the level-0 error are met only as far as level 0 meets them.
 ///
 /// Segments of two levels do not share their end points (each level is its own smoothing of the curve),
-/// so where the cut changes level its polyline has a break: two vertices where a single level has one.
-/// `CutStats::vertices` counts them; joining the break costs a segment no longer than the two levels'
-/// bounds together.
+/// so where the cut changes level it has a break. The cut is drawn joined (joined_cut_points): at a
+/// junction both pieces meet at the end point of the finer of the two segments. That point is a point of
+/// a finer level at the coarser segment's end, which the coarser segment's error box holds (Scene: a box
+/// holds every finer level's points under its segment, both ends included), so every piece of the joined
+/// polyline still lies inside its own segment's error box and a miss on the box still proves a miss on it.
+/// The join moves the coarser segment's end by `CutStats::max_join_shift_m` at most, so every original
+/// vertex lies within max_bound_m + max_join_shift_m of the joined piece standing for it.
 
 #include <cstdint>
 #include <vector>
@@ -25,15 +29,23 @@ namespace hk {
 
 /// Size and error of a tolerance cut of one curve.
 struct CutStats {
-  std::size_t segments = 0;  ///< segments in the cut
-  std::size_t breaks = 0;    ///< places where consecutive cut segments do not share an end point
-  std::size_t vertices = 0;  ///< vertices of the cut drawn as a polyline: segments + breaks (+1 when open)
-  double max_bound_m = 0.0;  ///< largest box_error_bound of a cut segment [m]
+  std::size_t segments = 0;      ///< segments in the cut
+  std::size_t breaks = 0;        ///< junctions where consecutive cut segments do not share an end point (joined)
+  std::size_t vertices = 0;      ///< vertices of the joined polyline: segments, + 1 when the curve is open
+  double max_bound_m = 0.0;      ///< largest box_error_bound of a cut segment [m]
+  double max_join_shift_m = 0.0; ///< largest distance a segment's end moved to join a finer neighbour [m]; 0 without breaks
 };
 
 /// The tolerance cut of curve `curve` of `scene`, in curve order (segment refs of mixed levels covering
 /// every level-0 segment exactly once), appended to `out`. tol_m ≥ 0 [m]; `curve` < curve_count().
 /// Allocates (setup and analysis code, not the servo path). Returns its size and error bound.
 CutStats tolerance_cut(const Scene& scene, std::size_t curve, double tol_m, std::vector<SegmentRef>* out);
+
+/// The joined polyline of a tolerance cut of curve `curve`: `cut` points to the `count` segment refs that
+/// tolerance_cut wrote for that curve, in order. Returns its vertices [m], count of them for a closed curve
+/// (the last piece runs back to the first vertex), count + 1 for an open one: piece i runs from vertex i
+/// to vertex i + 1. Each junction's vertex is the end point of the finer of the two segments meeting there
+/// (either, when they are at one level: they share it). Empty when count is 0. Allocates (analysis code).
+std::vector<Vec2> joined_cut_points(const Scene& scene, std::size_t curve, const SegmentRef* cut, std::size_t count);
 
 }  // namespace hk
