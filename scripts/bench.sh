@@ -19,7 +19,7 @@ b="$root/build/bench"
 min_time=0.5
 [ -n "$quick" ] && min_time=0.05
 "$b/bench_first_hit" $quick --benchmark_min_time=$min_time --benchmark_out="$out/first_hit.json" --benchmark_out_format=json >/dev/null
-"$b/bench_scene_build" --benchmark_min_time=$min_time --benchmark_out="$out/scene_build.json" --benchmark_out_format=json >/dev/null
+taskset -c 1 "$b/bench_scene_build" --benchmark_min_time=$min_time --benchmark_out="$out/scene_build.json" --benchmark_out_format=json >/dev/null
 "$b/bench_detectors" --benchmark_min_time=$min_time --benchmark_out="$out/detectors.json" --benchmark_out_format=json >/dev/null
 "$b/bench_anytime" --out "$out/anytime.json" 2>/dev/null
 [ -x "$b/bench_accuracy" ] && "$b/bench_accuracy" --images "$root/tests/data/images" --out "$out/accuracy.json"
