@@ -37,22 +37,6 @@ ContactOutput step(ContactSolver& s, Vec2 h, int level = 0) {
   return out;
 }
 
-/// Independent check: distance from p to the nearest level-`level` segment of the scene [m].
-double distance_to_walls(const Scene& sc, Vec2 p, int level) {
-  double best = 1e9;
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
-    const int l = sc.clamp_level(c, level);
-    for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
-      Vec2 a, b;
-      sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
-      const Vec2 d = b - a;
-      const double t = std::clamp(dot(p - a, d) / dot(d, d), 0.0, 1.0);
-      best = std::min(best, distance(p, a + t * d));
-    }
-  }
-  return best;
-}
-
 /// A 4 cm square; the handle comes from outside (left) and presses `depth_m` into its left wall (x = −0.02).
 struct LeftWall {
   Scene scene = Scene::build({test::square(0.02)}, 1);
@@ -156,7 +140,7 @@ TEST(PopThrough, ThroughTheSharedEdgeOfTwoTouchingShapesTheProxyEndsOffEveryWall
       bool popped = false;
       for (int k = 0; k < 400 && !popped; ++k) popped = (step(s, h).events & kEventPopThrough) != 0;
       ASSERT_TRUE(popped) << "depth " << depth << " y " << y;
-      EXPECT_GT(distance_to_walls(sc, s.proxy(), 0), p.skin_m) << "depth " << depth << " y " << y;
+      EXPECT_GT(test::brute_closest_distance(sc, s.proxy(), 0), p.skin_m) << "depth " << depth << " y " << y;
       Vec2 last = s.proxy();
       for (int k = 0; k < 200; ++k) {
         const ContactOutput o = step(s, {h.x + 0.00005 * std::sin(k * 0.1), y + 0.00005 * k});
@@ -185,7 +169,7 @@ TEST(PopThrough, IntoAConcaveCornerTheProxyEndsOffEveryWall) {
     ASSERT_TRUE(popped) << depth;
     EXPECT_GT(s.proxy().x, 0.02);
     EXPECT_GT(s.proxy().y, 0.02);
-    EXPECT_GT(distance_to_walls(sc, s.proxy(), 0), p.skin_m);
+    EXPECT_GT(test::brute_closest_distance(sc, s.proxy(), 0), p.skin_m);
   }
 }
 

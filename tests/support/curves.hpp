@@ -117,7 +117,6 @@ inline bool brute_first_hit(const Scene& sc, Vec2 a, Vec2 b, int level, double* 
   return found;
 }
 
-/// Number of level-`level` segments that the move p→q crosses strictly.
 /// Distance from p to the nearest segment of any curve at level id `level` (each curve at
 /// Scene::clamp_level), by brute force over every segment [m]; 1e9 for an empty scene.
 inline double brute_closest_distance(const Scene& sc, Vec2 p, int level) {
@@ -133,6 +132,7 @@ inline double brute_closest_distance(const Scene& sc, Vec2 p, int level) {
   return best;
 }
 
+/// Number of level-`level` segments that the move p→q crosses strictly.
 inline int count_crossings(const Scene& sc, Vec2 p, Vec2 q, int level) {
   int n = 0;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
