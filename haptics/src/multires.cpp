@@ -17,28 +17,35 @@ inline std::size_t wrap(long k, std::size_t n) {
   return static_cast<std::size_t>(k < 0 ? k + m : (k >= m ? k - m : k));
 }
 
+// Samples are double (one coordinate) or Vec2 (both at once): every component gets the same operations in
+// the same order, so a Vec2 step is bit for bit two double steps. The divisions by 16 and 32 are products
+// by 1/16 and 1/32, exact in binary floating point.
+constexpr double kSixteenth = 1.0 / 16.0, kThirtySecond = 1.0 / 32.0;
+
 // Prediction of odd sample k from the even samples e (size ne), cubic interpolation (DESIGN.md).
-inline double predict(const double* e, std::size_t ne, std::size_t k, bool closed) {
+template <class T>
+inline T predict(const T* e, std::size_t ne, std::size_t k, bool closed) {
   if (closed) {
     const long kk = static_cast<long>(k);
-    return (-e[wrap(kk - 1, ne)] + 9.0 * e[k] + 9.0 * e[wrap(kk + 1, ne)] - e[wrap(kk + 2, ne)]) / 16.0;
+    return (-e[wrap(kk - 1, ne)] + 9.0 * e[k] + 9.0 * e[wrap(kk + 1, ne)] - e[wrap(kk + 2, ne)]) * kSixteenth;
   }
   const std::size_t no = ne - 1;
-  if (k == 0) return (5.0 * e[0] + 15.0 * e[1] - 5.0 * e[2] + e[3]) / 16.0;
-  if (k == no - 1) return (5.0 * e[ne - 1] + 15.0 * e[ne - 2] - 5.0 * e[ne - 3] + e[ne - 4]) / 16.0;
-  return (-e[k - 1] + 9.0 * e[k] + 9.0 * e[k + 1] - e[k + 2]) / 16.0;
+  if (k == 0) return (5.0 * e[0] + 15.0 * e[1] - 5.0 * e[2] + e[3]) * kSixteenth;
+  if (k == no - 1) return (5.0 * e[ne - 1] + 15.0 * e[ne - 2] - 5.0 * e[ne - 3] + e[ne - 4]) * kSixteenth;
+  return (-e[k - 1] + 9.0 * e[k] + 9.0 * e[k + 1] - e[k + 2]) * kSixteenth;
 }
 
 // Update of even sample k from the wavelet coefficients d (size nd). Open curves: outside d are zero
 // and the two end samples are not updated, so the curve keeps its ends at every level.
-inline double update(const double* d, std::size_t nd, std::size_t ne, std::size_t k, bool closed) {
+template <class T>
+inline T update(const T* d, std::size_t nd, std::size_t ne, std::size_t k, bool closed) {
   const long kk = static_cast<long>(k);
   if (closed) {
-    return (-d[wrap(kk - 2, nd)] + 9.0 * d[wrap(kk - 1, nd)] + 9.0 * d[k] - d[wrap(kk + 1, nd)]) / 32.0;
+    return (-d[wrap(kk - 2, nd)] + 9.0 * d[wrap(kk - 1, nd)] + 9.0 * d[k] - d[wrap(kk + 1, nd)]) * kThirtySecond;
   }
-  if (k == 0 || k == ne - 1) return 0.0;
-  auto at = [&](long i) { return (i >= 0 && i < static_cast<long>(nd)) ? d[i] : 0.0; };
-  return (-at(kk - 2) + 9.0 * at(kk - 1) + 9.0 * at(kk) - at(kk + 1)) / 32.0;
+  if (k == 0 || k == ne - 1) return T{};
+  auto at = [&](long i) { return (i >= 0 && i < static_cast<long>(nd)) ? d[i] : T{}; };
+  return (-at(kk - 2) + 9.0 * at(kk - 1) + 9.0 * at(kk) - at(kk + 1)) * kThirtySecond;
 }
 
 void check_forward_size(std::size_t n, bool closed) {
@@ -48,19 +55,37 @@ void check_forward_size(std::size_t n, bool closed) {
   }
 }
 
+// One forward lifting step: x[0..n) (a size check_forward_size accepts) to s[0..ne) and d[0..no), with e
+// (size ne) as the even samples' scratch. The interior samples, whose stencils reach no end, run without
+// wraps or end cases (the same expressions as predict() and update(), so the same bits); the few at each
+// end go through predict() and update().
+template <class T>
+void forward_step(const T* x, std::size_t n, bool closed, T* e, T* s, T* d) {
+  const std::size_t ne = closed ? n / 2 : (n + 1) / 2;
+  const std::size_t no = n / 2;
+  for (std::size_t k = 0; k < ne; ++k) e[k] = x[2 * k];
+  // Predict: the stencil e[k − 1 .. k + 2] reaches no end for 1 ≤ k < ne − 2.
+  const std::size_t p_end = std::min(ne - 2, no);
+  std::size_t k = 0;
+  for (; k < 1; ++k) d[k] = x[2 * k + 1] - predict(e, ne, k, closed);
+  for (; k < p_end; ++k) d[k] = x[2 * k + 1] - (-e[k - 1] + 9.0 * e[k] + 9.0 * e[k + 1] - e[k + 2]) * kSixteenth;
+  for (; k < no; ++k) d[k] = x[2 * k + 1] - predict(e, ne, k, closed);
+  // Update: the stencil d[k − 2 .. k + 1] reaches no end for 2 ≤ k < no − 1.
+  const std::size_t u_end = no - 1;
+  for (k = 0; k < 2; ++k) s[k] = e[k] + update(d, no, ne, k, closed);
+  for (; k < u_end; ++k) s[k] = e[k] + (-d[k - 2] + 9.0 * d[k - 1] + 9.0 * d[k] - d[k + 1]) * kThirtySecond;
+  for (; k < ne; ++k) s[k] = e[k] + update(d, no, ne, k, closed);
+}
+
 }  // namespace
 
 void pseudocoiflet_forward(const std::vector<double>& x, bool closed, std::vector<double>& s, std::vector<double>& d) {
   const std::size_t n = x.size();
   check_forward_size(n, closed);
-  const std::size_t ne = closed ? n / 2 : (n + 1) / 2;
-  const std::size_t no = n / 2;
-  std::vector<double> e(ne);
-  for (std::size_t k = 0; k < ne; ++k) e[k] = x[2 * k];
-  d.assign(no, 0.0);
-  for (std::size_t k = 0; k < no; ++k) d[k] = x[2 * k + 1] - predict(e.data(), ne, k, closed);
-  s.assign(ne, 0.0);
-  for (std::size_t k = 0; k < ne; ++k) s[k] = e[k] + update(d.data(), no, ne, k, closed);
+  std::vector<double> e(closed ? n / 2 : (n + 1) / 2);
+  s.assign(e.size(), 0.0);
+  d.assign(n / 2, 0.0);
+  forward_step(x.data(), n, closed, e.data(), s.data(), d.data());
 }
 
 void pseudocoiflet_inverse(const std::vector<double>& s, const std::vector<double>& d, bool closed, std::vector<double>& x) {
@@ -84,10 +109,11 @@ std::vector<Vec2> resample_arc_length(const Polyline& curve, std::size_t count, 
     if (!is_finite(q)) throw CurveError("curve has a non-finite coordinate");
   }
   if (count < (curve.closed ? 3u : 2u)) throw CurveError("resampling count " + std::to_string(count) + " is too small");
+  const auto next = [n = p.size()](std::size_t i) { return i + 1 < n ? i + 1 : 0; };  // (i + 1) mod n, no division
   // Cumulative arc length of the input vertices; a closed curve adds its closing segment.
   const std::size_t nseg = curve.closed ? p.size() : p.size() - 1;
   std::vector<double> cum(nseg + 1, 0.0);
-  for (std::size_t i = 0; i < nseg; ++i) cum[i + 1] = cum[i] + distance(p[i], p[(i + 1) % p.size()]);
+  for (std::size_t i = 0; i < nseg; ++i) cum[i + 1] = cum[i] + distance(p[i], p[next(i)]);
   const double total = cum[nseg];
   if (!(total > 0.0)) throw CurveError("curve has zero length");
 
@@ -101,7 +127,7 @@ std::vector<Vec2> resample_arc_length(const Polyline& curve, std::size_t count, 
     while (seg + 1 < nseg && cum[seg + 1] < s) ++seg;
     const double len = cum[seg + 1] - cum[seg];
     const double t = len > 0.0 ? std::clamp((s - cum[seg]) / len, 0.0, 1.0) : 0.0;
-    out[i] = lerp(p[seg], p[(seg + 1) % p.size()], t);
+    out[i] = lerp(p[seg], p[next(seg)], t);
     if (arc_out) (*arc_out)[i] = s;
   }
   return out;
@@ -131,20 +157,16 @@ CurveMultires build_multires(const Polyline& curve, int max_levels) {
   m.wavelet.resize(static_cast<std::size_t>(m.levels));
   m.scaling[0] = resample_arc_length(curve, plan.level0_points, &m.arc_m);
 
-  std::vector<double> x, y, sx, sy, dx, dy;
-  for (int l = 1; l < m.levels; ++l) {
+  std::vector<Vec2> even;  // scratch: the even samples of the finer level
+  for (int l = 1; l < m.levels; ++l) {  // both coordinates in one pass (bit for bit the per-coordinate step)
     const auto& fine = m.scaling[static_cast<std::size_t>(l - 1)];
-    x.resize(fine.size());
-    y.resize(fine.size());
-    for (std::size_t i = 0; i < fine.size(); ++i) { x[i] = fine[i].x; y[i] = fine[i].y; }
-    pseudocoiflet_forward(x, curve.closed, sx, dx);
-    pseudocoiflet_forward(y, curve.closed, sy, dy);
+    check_forward_size(fine.size(), curve.closed);
     auto& coarse = m.scaling[static_cast<std::size_t>(l)];
     auto& w = m.wavelet[static_cast<std::size_t>(l)];
-    coarse.resize(sx.size());
-    for (std::size_t i = 0; i < sx.size(); ++i) coarse[i] = {sx[i], sy[i]};
-    w.resize(dx.size());
-    for (std::size_t i = 0; i < dx.size(); ++i) w[i] = {dx[i], dy[i]};
+    even.resize(curve.closed ? fine.size() / 2 : (fine.size() + 1) / 2);
+    coarse.resize(even.size());
+    w.resize(fine.size() / 2);
+    forward_step(fine.data(), fine.size(), curve.closed, even.data(), coarse.data(), w.data());
   }
   return m;
 }

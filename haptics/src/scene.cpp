@@ -58,6 +58,13 @@ inline Lanes2 max(Lanes2 a, Lanes2 b) { return {_mm_max_pd(a.v, b.v)}; }
 inline Lanes2 swapped(Lanes2 a) { return {_mm_shuffle_pd(a.v, a.v, 1)}; }
 inline double lane0(Lanes2 a) { return _mm_cvtsd_f64(a.v); }
 inline double lane1(Lanes2 a) { return _mm_cvtsd_f64(_mm_unpackhi_pd(a.v, a.v)); }
+// Each lane rounded toward zero (|lane| < 2^31).
+inline Lanes2 truncated(Lanes2 a) { return {_mm_cvtepi32_pd(_mm_cvttpd_epi32(a.v))}; }
+// 1 in each lane where a < b (ones_where_less) or a ≤ b (ones_where_less_equal), else 0.
+inline Lanes2 ones_where_less(Lanes2 a, Lanes2 b) { return {_mm_and_pd(_mm_cmplt_pd(a.v, b.v), _mm_set1_pd(1.0))}; }
+inline Lanes2 ones_where_less_equal(Lanes2 a, Lanes2 b) { return {_mm_and_pd(_mm_cmple_pd(a.v, b.v), _mm_set1_pd(1.0))}; }
+// Whether a lane of ones_where_*() is 1.
+inline bool any(Lanes2 ones) { return _mm_movemask_pd(_mm_cmpneq_pd(ones.v, _mm_setzero_pd())) != 0; }
 #else
 struct Lanes2 {
   double a, b;
@@ -72,6 +79,10 @@ inline Lanes2 max(Lanes2 a, Lanes2 b) { return {a.a > b.a ? a.a : b.a, a.b > b.b
 inline Lanes2 swapped(Lanes2 a) { return {a.b, a.a}; }
 inline double lane0(Lanes2 a) { return a.a; }
 inline double lane1(Lanes2 a) { return a.b; }
+inline Lanes2 truncated(Lanes2 a) { return {static_cast<double>(static_cast<int>(a.a)), static_cast<double>(static_cast<int>(a.b))}; }
+inline Lanes2 ones_where_less(Lanes2 a, Lanes2 b) { return {a.a < b.a ? 1.0 : 0.0, a.b < b.b ? 1.0 : 0.0}; }
+inline Lanes2 ones_where_less_equal(Lanes2 a, Lanes2 b) { return {a.a <= b.a ? 1.0 : 0.0, a.b <= b.b ? 1.0 : 0.0}; }
+inline bool any(Lanes2 ones) { return ones.a != 0.0 || ones.b != 0.0; }
 #endif
 
 // A segment's frame for the box pass and what the pass grows in it: the extent of the points seen,
@@ -141,16 +152,28 @@ class BoxGrower {
 // Largest |quantised extent| a level's quantum is chosen for (int16 holds ±32767: room for the outward steps).
 constexpr double kQuantumSteps = 32000.0;
 
-// The multiple of q at or below v (`below`), or at or above it: the stored extent only grows the box. The
-// product is checked as Scene::segment_box computes it, so rounding in the division cannot undercut v.
-inline std::int16_t quantise(double v, double q, bool below) {
-  double k = below ? std::floor(v / q) : std::ceil(v / q);
-  if (below) {
-    while (k * q > v) k -= 1.0;
-  } else {
-    while (k * q < v) k += 1.0;
-  }
-  return static_cast<std::int16_t>(k);
+// A segment's extents in quanta of q (inverse_q = 1/q), rounded outward so that the stored box only grows,
+// by less than one quantum on each side: u_min and n_min to the largest k with k·q ≤ v, n_max to the
+// smallest k with k·q ≥ v, u_over to the smallest with length_m + k·q ≥ u_max, each product as
+// Scene::segment_box computes it. Two lanes at a time: (u_min, n_min) from below, (n_max, u_max) from above
+// with offsets (0, length_m). The guess v·(1/q) truncated toward zero is a product instead of a division,
+// and can be a step or two off; the steps that follow make each k the last on the right side of v, so the
+// guess's rounding can neither undercut v nor add a quantum. |v/q| ≤ kQuantumSteps + a few (an int holds it).
+// Writes the box's extents as segment_box() rebuilds them to *rebuilt.
+inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, double inverse_q, Extent* rebuilt) {
+  const Lanes2 lq = lanes(q, q), one = lanes(1.0, 1.0);
+  const Lanes2 below = lanes(e.u_min, e.n_min);
+  Lanes2 k = truncated(below * lanes(inverse_q, inverse_q));
+  for (Lanes2 s = ones_where_less(below, k * lq); any(s); s = ones_where_less(below, k * lq)) k = k - s;
+  for (Lanes2 s = ones_where_less_equal((k + one) * lq, below); any(s); s = ones_where_less_equal((k + one) * lq, below)) k = k + s;
+  const Lanes2 above = lanes(e.n_max, e.u_max), offset = lanes(0.0, length_m);
+  Lanes2 m = truncated((above - offset) * lanes(inverse_q, inverse_q));
+  for (Lanes2 s = ones_where_less(offset + m * lq, above); any(s); s = ones_where_less(offset + m * lq, above)) m = m + s;
+  for (Lanes2 s = ones_where_less_equal(above, offset + (m - one) * lq); any(s); s = ones_where_less_equal(above, offset + (m - one) * lq)) m = m - s;
+  const Lanes2 lo = k * lq, hi = offset + m * lq;
+  *rebuilt = Extent{lane0(lo), lane1(hi), lane1(lo), lane0(hi)};
+  return BoxExtent{static_cast<std::int16_t>(lane0(k)), static_cast<std::int16_t>(lane1(m)), static_cast<std::int16_t>(lane1(k)),
+                   static_cast<std::int16_t>(lane0(m))};
 }
 
 // A segment's measured extents, padded, in the frame of Scene::segment_frame; the segment's length [m].
@@ -218,7 +241,7 @@ void box_corners(const ErrorBox& box, Vec2 out[4]) {
 double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min), std::abs(box.n_max)); }
 
 double box_error_bound_sq(const ErrorBox& box, double segment_length_m) {
-  const double overhang = std::max({0.0, -box.u_min, box.u_max - segment_length_m});
+  const double overhang = std::max(std::max(0.0, -box.u_min), box.u_max - segment_length_m);
   const double half_width = box_half_width(box);
   return overhang * overhang + half_width * half_width;
 }
@@ -472,19 +495,17 @@ class SceneBuild {
     CurveInfo& ci = scene.curves_[c];
     const float quantum = static_cast<float>(widest / kQuantumSteps);  // > 0: every extent holds the pad
     scene.curve_nodes_[c].quantum_m[l] = quantum;
-    const double q = quantum;
+    const double q = quantum, inverse_q = 1.0 / q;
     double half_width = 0.0, bound_sq = 0.0;  // the level's widest box [m]; its largest squared box_error_bound [m²]
     for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
       const SegmentExtent& se = level[k];
-      double over = std::ceil((se.e.u_max - se.length_m) / q);
-      while (se.length_m + over * q < se.e.u_max) over += 1.0;  // as segment_box() adds it up
-      const BoxExtent be{quantise(se.e.u_min, q, true), static_cast<std::int16_t>(over), quantise(se.e.n_min, q, true),
-                         quantise(se.e.n_max, q, false)};
-      scene.extent_[ci.box_offset[l] + k] = be;
-      // The box's extents as segment_box() rebuilds them (its frame does not matter here).
-      const ErrorBox box{Vec2{}, Vec2{1.0, 0.0}, be.u_min * q, se.length_m + be.u_over * q, be.n_min * q, be.n_max * q};
-      half_width = std::max(half_width, box_half_width(box));
-      bound_sq = std::max(bound_sq, box_error_bound_sq(box, se.length_m));  // one root per level, below
+      Extent box;  // the extents as segment_box() rebuilds them
+      scene.extent_[ci.box_offset[l] + k] = quantise_extent(se.e, se.length_m, q, inverse_q, &box);
+      // box_error_bound_sq() of that box, written out here (a call would spill every live xmm register).
+      const double width = std::max(std::abs(box.n_min), std::abs(box.n_max));
+      const double overhang = std::max(std::max(0.0, -box.u_min), box.u_max - se.length_m);
+      half_width = std::max(half_width, width);
+      bound_sq = std::max(bound_sq, overhang * overhang + width * width);  // one root per level, below
     }
     ci.max_box_half_width_m[l] = half_width;
     ci.max_error_bound_m[l] = std::sqrt(bound_sq);

@@ -81,6 +81,35 @@ TEST(Pseudocoiflet, MultiLevelCurveReconstruction) {
   }
 }
 
+// build_multires steps both coordinates at once; every level must be, bit for bit, the one-coordinate
+// pseudocoiflet_forward (checked against the filter bank below) applied to x and to y. The sizes include
+// the smallest curves the transform takes (8 closed and 7 open points at the coarsest level), where the
+// lifting stencils reach an end at nearly every sample.
+TEST(Pseudocoiflet, BothCoordinatesAtOnceAreBitForBitTheOneCoordinateStep) {
+  std::mt19937 rng(11);
+  for (bool closed : {true, false}) {
+    for (int points : {8, 9, 17, 33, 300}) {
+      const Polyline p = closed ? test::random_blob(rng, {0, 0}, 0.03, points) : test::random_stroke(rng, {0, 0}, 0.0005, points);
+      const CurveMultires m = build_multires(p, 6);
+      ASSERT_GE(m.levels, 2) << points;
+      for (int l = 1; l < m.levels; ++l) {
+        std::vector<double> x, y, sx, sy, dx, dy;
+        for (const Vec2& q : m.scaling[l - 1]) { x.push_back(q.x); y.push_back(q.y); }
+        pseudocoiflet_forward(x, closed, sx, dx);
+        pseudocoiflet_forward(y, closed, sy, dy);
+        ASSERT_EQ(m.scaling[l].size(), sx.size());
+        ASSERT_EQ(m.wavelet[l].size(), dx.size());
+        for (std::size_t i = 0; i < sx.size(); ++i) {
+          EXPECT_EQ(m.scaling[l][i], (Vec2{sx[i], sy[i]})) << (closed ? "closed " : "open ") << points << " level " << l << " i " << i;
+        }
+        for (std::size_t i = 0; i < dx.size(); ++i) {
+          EXPECT_EQ(m.wavelet[l][i], (Vec2{dx[i], dy[i]})) << (closed ? "closed " : "open ") << points << " level " << l << " i " << i;
+        }
+      }
+    }
+  }
+}
+
 TEST(Pseudocoiflet, CubicsGiveZeroWaveletCoefficientsIncludingEnds) {
   // Open: the one-sided end predictors are cubic too, so every coefficient vanishes.
   for (std::size_t n : {7u, 13u, 33u}) {
@@ -140,7 +169,7 @@ TEST(Pseudocoiflet, GoldenAgainstFilterBankConvolution) {
   for (double h : H) sum += h * norm;
   ASSERT_NEAR(sum, std::sqrt(2.0), 1e-15);  // lowpass gain √2 (DC preserved after the 1/√2)
   std::mt19937 rng(4);
-  for (std::size_t n : {16u, 40u, 128u}) {
+  for (std::size_t n : {8u, 10u, 16u, 40u, 128u}) {
     const auto x = random_signal(rng, n);
     std::vector<double> s, d;
     pseudocoiflet_forward(x, true, s, d);

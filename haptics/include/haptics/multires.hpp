@@ -39,8 +39,8 @@ class CurveError : public hk::Error {
 /// Throws CurveError for fewer than 2 points, zero total length, or non-finite coordinates.
 std::vector<Vec2> resample_arc_length(const Polyline& curve, std::size_t count, std::vector<double>* arc_out = nullptr);
 
-/// One forward lifting step on one coordinate. `x` has n samples: closed n even (≥ 4), open n odd (≥ 7:
-/// four even samples for the cubic end predictors). Writes s (scaling coefficients, n/2 closed,
+/// One forward lifting step on one coordinate. `x` has n samples: closed n even (≥ 8), open n odd (≥ 7):
+/// four even samples for the cubic predictor. Throws CurveError for any other n. Writes s (scaling coefficients, n/2 closed,
 /// (n+1)/2 open) and d (wavelet coefficients, n/2 closed, (n−1)/2 open). Source: DESIGN.md "Wavelets".
 void pseudocoiflet_forward(const std::vector<double>& x, bool closed, std::vector<double>& s, std::vector<double>& d);
 
