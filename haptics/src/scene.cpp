@@ -424,6 +424,22 @@ class SceneBuild {
     orig_first[s0] = static_cast<std::uint32_t>(p.size());
   }
 
+  // Level-0 points k0 < i < k1 that the box pass must still see once it has point k0 and the original
+  // vertices under level-0 segments [k0, k1): those from the returned index on. Level 0 is resampled on the
+  // original polyline (resample_arc_length), so every level-0 point lies on the polyline p_k0, the original
+  // vertices in order, p_k1, and the point is a convex combination of the two vertices of its piece. Frame
+  // coordinates, and the distance from a segment, are convex along a piece: such a point adds nothing to
+  // the extent or the measured error that the piece's ends do not (up to rounding of a few ulps, far inside
+  // the box pad). The last piece ends at p_k1, which the segment's box holds but its error does not measure,
+  // so the level-0 points on it, those after the last level-0 segment holding an original, are measured:
+  // returns that segment + 1, or k0 + 1 when none holds one (then every level-0 point is measured).
+  static std::size_t first_level0_after_originals(const std::vector<std::uint32_t>& orig_first, std::size_t k0, std::size_t k1) {
+    for (std::size_t i = k1; i > k0; --i) {
+      if (orig_first[i - 1] != orig_first[i]) return i;  // level-0 segment i − 1 holds originals
+    }
+    return k0 + 1;
+  }
+
   // Error boxes of every segment of curve c, as tight as containment allows: the box of level-l
   // segment k is the extent, in the segment's frame, of its own end points, of every point of every
   // finer level j < l under it (points k·2^(l−j) .. (k+1)·2^(l−j)), and of the original vertices under
@@ -455,7 +471,9 @@ class SceneBuild {
         const std::size_t k0 = k << l, k1 = (k + 1) << l;  // level-0 segments under it
         if (l > 0) {
           const Vec2* fine = scene.points(c, 0);
-          box.grow_measuring(fine + k0, k1 - k0);
+          const std::size_t tail = first_level0_after_originals(orig_first, k0, k1);
+          box.grow_measuring(fine + k0, 1);
+          box.grow_measuring(fine + tail, k1 - tail);
           box.grow(fine + k1, 1);  // the next segment's first point: in the box, measured with that segment
         }
         box.grow_measuring(orig + orig_first[k0], orig_first[k1] - orig_first[k0]);
