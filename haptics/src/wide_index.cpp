@@ -2,6 +2,7 @@
 #include "haptics/wide_index.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -46,15 +47,23 @@ Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) {
   return r;
 }
 
+// The next float toward −∞ (`down`) or +∞ from a finite f, by its bits (std::nextafter is a library call,
+// four per slot of every node).
+float next_float(float f, bool down) {
+  if (f == 0.0f) return down ? -std::numeric_limits<float>::denorm_min() : std::numeric_limits<float>::denorm_min();
+  const auto bits = std::bit_cast<std::uint32_t>(f);
+  return std::bit_cast<float>((f > 0.0f) == down ? bits - 1u : bits + 1u);  // magnitude down or up
+}
+
 // Largest float not above x, and smallest not below.
 float round_down(double x) {
   float f = static_cast<float>(x);
-  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  if (static_cast<double>(f) > x) f = next_float(f, true);
   return f;
 }
 float round_up(double x) {
   float f = static_cast<float>(x);
-  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  if (static_cast<double>(f) < x) f = next_float(f, false);
   return f;
 }
 
@@ -109,15 +118,52 @@ class Builder {
     if (mid <= begin || mid >= end) return mid;
     Aabb c{items_[begin].centre, items_[begin].centre};
     for (std::size_t i = begin; i < end; ++i) extend(c, items_[i].centre);
-    const auto first = items_.begin() + static_cast<std::ptrdiff_t>(begin), nth = items_.begin() + static_cast<std::ptrdiff_t>(mid),
-               last = items_.begin() + static_cast<std::ptrdiff_t>(end);
     if (c.hi.x - c.lo.x >= c.hi.y - c.lo.y) {  // one comparison per call, not one per pair
-      std::nth_element(first, nth, last, [](const Item& x, const Item& y) { return x.centre.x < y.centre.x; });
+      select(begin, end, mid, [](const Item& it) { return it.centre.x; });
     } else {
-      std::nth_element(first, nth, last, [](const Item& x, const Item& y) { return x.centre.y < y.centre.y; });
+      select(begin, end, mid, [](const Item& it) { return it.centre.y; });
     }
     return mid;
   }
+
+  // Quickselect: reorders items [begin, end) so that every item before position k has a key at or below
+  // the k-th's and every item after it at or above. Each round splits the range around a median-of-three
+  // pivot key with branchless partitions (below the pivot, then equal to it; the item at i is swapped in
+  // every step and the boundary advances by the comparison's outcome), so the unpredictable comparisons
+  // cost no branch mispredictions; a round always removes the pivot's key from one side, so the range
+  // shrinks. Short ranges, and any range still long after 64 rounds, finish with std::nth_element.
+  template <class Key>
+  void select(std::size_t begin, std::size_t end, std::size_t k, Key key) {
+    Item* a = items_.data();
+    std::size_t lo = begin, hi = end;
+    for (int round = 0; hi - lo > 16 && round < 64; ++round) {
+      const double p = median_of_three(key(a[lo]), key(a[lo + (hi - lo) / 2]), key(a[hi - 1]));
+      const std::size_t below = partition(a, lo, hi, [&](const Item& it) { return key(it) < p; });
+      if (k < below) {
+        hi = below;
+        continue;
+      }
+      const std::size_t equal = partition(a, below, hi, [&](const Item& it) { return !(p < key(it)); });
+      if (k < equal) return;  // position k holds the pivot's key, as do all of [below, equal)
+      lo = equal;
+    }
+    const auto cmp = [&](const Item& x, const Item& y) { return key(x) < key(y); };
+    std::nth_element(a + lo, a + k, a + hi, cmp);
+  }
+  // Moves the items of [lo, hi) that satisfy `first` to its front, without a branch on the outcome;
+  // returns the end of those.
+  template <class Pred>
+  static std::size_t partition(Item* a, std::size_t lo, std::size_t hi, Pred first) {
+    std::size_t store = lo;
+    for (std::size_t i = lo; i < hi; ++i) {
+      const Item x = a[i];
+      a[i] = a[store];
+      a[store] = x;
+      store += first(x) ? 1u : 0u;
+    }
+    return store;
+  }
+  static double median_of_three(double x, double y, double z) { return std::max(std::min(x, y), std::min(std::max(x, y), z)); }
   void set_slot(std::size_t node, int i, const Aabb& r, std::uint32_t code, double pad_m) {
     WideNode& n = out_.nodes[node];
     n.lo_x[i] = round_down(r.lo.x - pad_m);
