@@ -18,7 +18,7 @@ mkdir -p "$out"
 b="$root/build/bench"
 min_time=0.5
 [ -n "$quick" ] && min_time=0.05
-"$b/bench_first_hit" $quick --benchmark_min_time=$min_time --benchmark_out="$out/first_hit.json" --benchmark_out_format=json >/dev/null
+taskset -c 1 "$b/bench_first_hit" $quick --benchmark_min_time=$min_time --benchmark_out="$out/first_hit.json" --benchmark_out_format=json >/dev/null
 taskset -c 1 "$b/bench_scene_build" --benchmark_min_time=$min_time --benchmark_out="$out/scene_build.json" --benchmark_out_format=json >/dev/null
 "$b/bench_detectors" --benchmark_min_time=$min_time --benchmark_out="$out/detectors.json" --benchmark_out_format=json >/dev/null
 "$b/bench_anytime" --out "$out/anytime.json" 2>/dev/null
