@@ -85,6 +85,16 @@ inline Lanes2 ones_where_less_equal(Lanes2 a, Lanes2 b) { return {a.a <= b.a ? 1
 inline bool any(Lanes2 ones) { return ones.a != 0.0 || ones.b != 0.0; }
 #endif
 
+// Each lane rounded down or up to an integer (|lane| < 2^31), without a branch.
+inline Lanes2 floored(Lanes2 a) {
+  const Lanes2 t = truncated(a);
+  return t - ones_where_less(a, t);
+}
+inline Lanes2 ceiled(Lanes2 a) {
+  const Lanes2 t = truncated(a);
+  return t + ones_where_less(t, a);
+}
+
 // A segment's frame for the box pass and what the pass grows in it: the extent of the points seen,
 // as (u_min, n_min) and (u_max, n_max) [m], and the largest squared distance from the segment of the
 // points measured [m²]. Two accumulators of each, for consecutive points, so that the min/max chains
@@ -156,18 +166,19 @@ constexpr double kQuantumSteps = 32000.0;
 // by less than one quantum on each side: u_min and n_min to the largest k with k·q ≤ v, n_max to the
 // smallest k with k·q ≥ v, u_over to the smallest with length_m + k·q ≥ u_max, each product as
 // Scene::segment_box computes it. Two lanes at a time: (u_min, n_min) from below, (n_max, u_max) from above
-// with offsets (0, length_m). The guess v·(1/q) truncated toward zero is a product instead of a division,
-// and can be a step or two off; the steps that follow make each k the last on the right side of v, so the
-// guess's rounding can neither undercut v nor add a quantum. |v/q| ≤ kQuantumSteps + a few (an int holds it).
+// with offsets (0, length_m). The guess, v·(1/q) rounded down (below) or up, is a product instead of a
+// division and is off by a step only where the product's rounding crosses an integer; the steps that
+// follow (rarely taken, so their branches are predicted) make each k the last on the right side of v, so
+// the guess's rounding can neither undercut v nor add a quantum. |v/q| ≤ kQuantumSteps + a few (an int holds it).
 // Writes the box's extents as segment_box() rebuilds them to *rebuilt.
 inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, double inverse_q, Extent* rebuilt) {
   const Lanes2 lq = lanes(q, q), one = lanes(1.0, 1.0);
   const Lanes2 below = lanes(e.u_min, e.n_min);
-  Lanes2 k = truncated(below * lanes(inverse_q, inverse_q));
+  Lanes2 k = floored(below * lanes(inverse_q, inverse_q));
   for (Lanes2 s = ones_where_less(below, k * lq); any(s); s = ones_where_less(below, k * lq)) k = k - s;
   for (Lanes2 s = ones_where_less_equal((k + one) * lq, below); any(s); s = ones_where_less_equal((k + one) * lq, below)) k = k + s;
   const Lanes2 above = lanes(e.n_max, e.u_max), offset = lanes(0.0, length_m);
-  Lanes2 m = truncated((above - offset) * lanes(inverse_q, inverse_q));
+  Lanes2 m = ceiled((above - offset) * lanes(inverse_q, inverse_q));
   for (Lanes2 s = ones_where_less(offset + m * lq, above); any(s); s = ones_where_less(offset + m * lq, above)) m = m + s;
   for (Lanes2 s = ones_where_less_equal(above, offset + (m - one) * lq); any(s); s = ones_where_less_equal(above, offset + (m - one) * lq)) m = m - s;
   const Lanes2 lo = k * lq, hi = offset + m * lq;
