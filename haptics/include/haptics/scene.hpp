@@ -175,6 +175,7 @@ class Scene {
 
   /// The error box of a node: a segment's, rebuilt from its end points and stored extents; a chunk's or
   /// hierarchy node's axis-aligned box as an ErrorBox with origin (0, 0) and axis (1, 0). O(1), one root.
+  /// A slot id must start a segment (as segment_box()).
   ErrorBox box(std::uint32_t node) const {
     if (node >= segment_nodes_) {
       const Aabb& r = group_box_[node - segment_nodes_];
@@ -182,7 +183,9 @@ class Scene {
     }
     return segment_box(node);
   }
-  /// The error box of segment node `node` (is_segment(node)).
+  /// The error box of segment node `node`: a slot that starts a segment, not a level's last slot
+  /// (is_segment() is true for that one too, but it has no box: this would read the next level's first
+  /// point, or past the array for the scene's last slot). Unchecked, for the walks' speed.
   ErrorBox segment_box(std::uint32_t node) const {
     const Vec2 a = points_m_[node];
     double length_m = 0.0;
