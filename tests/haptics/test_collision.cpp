@@ -567,6 +567,41 @@ TEST(WideIndex, ItemsAppearOnceAndNodesHoldTheirChildren) {
   }
 }
 
+// The index's splits are rank splits along the longer axis of the item centres: with every item on one
+// horizontal line (curves side by side, given in shuffled order so the items do not arrive sorted), each
+// node's occupied slots must hold runs ordered along x, so a slot's rectangle ends where the next one
+// begins, up to 10 µm: neighbouring items touch, and a rectangle also holds the pieces of the coarser
+// levels' segments at its place, which reach about a micrometre past the item's own ends here. A split
+// that left the items unsorted would interleave the slots by millimetres.
+TEST(WideIndex, SplitsByRankAlongTheLongerAxis) {
+  std::mt19937 rng(41);
+  std::vector<int> place(300);
+  for (std::size_t i = 0; i < place.size(); ++i) place[i] = static_cast<int>(i);
+  std::shuffle(place.begin(), place.end(), rng);
+  std::vector<Polyline> curves;
+  for (int at : place) {
+    Polyline p;  // 8 points along x: 0.7 mm of line, 1 mm apart from the next curve's start
+    for (int k = 0; k < 8; ++k) p.points_m.push_back({0.001 * at + 0.0001 * k, 0.05});
+    curves.push_back(p);
+  }
+  const Scene sc = Scene::build(curves, 6);
+  const auto& nodes = sc.wide_index().nodes;
+  ASSERT_GT(nodes.size(), 20u);
+  int pairs = 0;
+  for (const WideNode& n : nodes) {
+    int last = -1;
+    for (int i = 0; i < 4; ++i) {
+      if (n.child[i] == kWideEmpty) continue;
+      if (last >= 0) {
+        EXPECT_LE(n.hi_x[last], n.lo_x[i] + 1e-5f) << "slots " << last << " and " << i << " overlap along x";
+        ++pairs;
+      }
+      last = i;
+    }
+  }
+  EXPECT_GT(pairs, 200);
+}
+
 // first_hit_wide under a starved budget: never claims clear space past the true first wall, says the
 // budget ran out, and names no segment (no level is known above the items); with budget enough, exact.
 TEST(WideIndex, AnytimeAnswerIsConservative) {
