@@ -66,14 +66,15 @@ void forward_step(const T* x, std::size_t n, bool closed, T* e, T* s, T* d) {
   for (std::size_t k = 0; k < ne; ++k) e[k] = x[2 * k];
   // Predict: the stencil e[k − 1 .. k + 2] reaches no end for 1 ≤ k < ne − 2.
   const std::size_t p_end = std::min(ne - 2, no);
-  std::size_t k = 0;
-  for (; k < 1; ++k) d[k] = x[2 * k + 1] - predict(e, ne, k, closed);
+  d[0] = x[1] - predict(e, ne, 0, closed);
+  std::size_t k = 1;
   for (; k < p_end; ++k) d[k] = x[2 * k + 1] - (-e[k - 1] + 9.0 * e[k] + 9.0 * e[k + 1] - e[k + 2]) * kSixteenth;
   for (; k < no; ++k) d[k] = x[2 * k + 1] - predict(e, ne, k, closed);
   // Update: the stencil d[k − 2 .. k + 1] reaches no end for 2 ≤ k < no − 1.
   const std::size_t u_end = no - 1;
-  for (k = 0; k < 2; ++k) s[k] = e[k] + update(d, no, ne, k, closed);
-  for (; k < u_end; ++k) s[k] = e[k] + (-d[k - 2] + 9.0 * d[k - 1] + 9.0 * d[k] - d[k + 1]) * kThirtySecond;
+  s[0] = e[0] + update(d, no, ne, 0, closed);
+  s[1] = e[1] + update(d, no, ne, 1, closed);
+  for (k = 2; k < u_end; ++k) s[k] = e[k] + (-d[k - 2] + 9.0 * d[k - 1] + 9.0 * d[k] - d[k + 1]) * kThirtySecond;
   for (; k < ne; ++k) s[k] = e[k] + update(d, no, ne, k, closed);
 }
 

@@ -173,14 +173,19 @@ constexpr double kQuantumSteps = 32000.0;
 // Writes the box's extents as segment_box() rebuilds them to *rebuilt.
 inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, double inverse_q, Extent* rebuilt) {
   const Lanes2 lq = lanes(q, q), one = lanes(1.0, 1.0);
+  // Adds `step` (±1) to the lanes of k where too(k) is 1, until it is 1 in none.
+  const auto step_while = [](Lanes2 k, double step, auto too) {
+    for (Lanes2 s = too(k); any(s); s = too(k)) k = k + s * lanes(step, step);
+    return k;
+  };
   const Lanes2 below = lanes(e.u_min, e.n_min);
   Lanes2 k = floored(below * lanes(inverse_q, inverse_q));
-  for (Lanes2 s = ones_where_less(below, k * lq); any(s); s = ones_where_less(below, k * lq)) k = k - s;
-  for (Lanes2 s = ones_where_less_equal((k + one) * lq, below); any(s); s = ones_where_less_equal((k + one) * lq, below)) k = k + s;
+  k = step_while(k, -1.0, [&](Lanes2 t) { return ones_where_less(below, t * lq); });            // k·q > v
+  k = step_while(k, +1.0, [&](Lanes2 t) { return ones_where_less_equal((t + one) * lq, below); });  // (k + 1)·q ≤ v
   const Lanes2 above = lanes(e.n_max, e.u_max), offset = lanes(0.0, length_m);
   Lanes2 m = ceiled((above - offset) * lanes(inverse_q, inverse_q));
-  for (Lanes2 s = ones_where_less(offset + m * lq, above); any(s); s = ones_where_less(offset + m * lq, above)) m = m + s;
-  for (Lanes2 s = ones_where_less_equal(above, offset + (m - one) * lq); any(s); s = ones_where_less_equal(above, offset + (m - one) * lq)) m = m - s;
+  m = step_while(m, +1.0, [&](Lanes2 t) { return ones_where_less(offset + t * lq, above); });             // short of v
+  m = step_while(m, -1.0, [&](Lanes2 t) { return ones_where_less_equal(above, offset + (t - one) * lq); });  // one less still reaches v
   const Lanes2 lo = k * lq, hi = offset + m * lq;
   *rebuilt = Extent{lane0(lo), lane1(hi), lane1(lo), lane0(hi)};
   return BoxExtent{static_cast<std::int16_t>(lane0(k)), static_cast<std::int16_t>(lane1(m)), static_cast<std::int16_t>(lane1(k)),
@@ -247,14 +252,6 @@ void box_corners(const ErrorBox& box, Vec2 out[4]) {
   out[1] = box.origin_m + box.u_max * box.axis + box.n_min * nrm;
   out[2] = box.origin_m + box.u_max * box.axis + box.n_max * nrm;
   out[3] = box.origin_m + box.u_min * box.axis + box.n_max * nrm;
-}
-
-double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min), std::abs(box.n_max)); }
-
-double box_error_bound_sq(const ErrorBox& box, double segment_length_m) {
-  const double overhang = std::max(std::max(0.0, -box.u_min), box.u_max - segment_length_m);
-  const double half_width = box_half_width(box);
-  return overhang * overhang + half_width * half_width;
 }
 
 double box_error_bound(const ErrorBox& box, double segment_length_m) { return std::sqrt(box_error_bound_sq(box, segment_length_m)); }
@@ -528,13 +525,11 @@ class SceneBuild {
     double half_width = 0.0, bound_sq = 0.0;  // the level's widest box [m]; its largest squared box_error_bound [m²]
     for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
       const SegmentExtent& se = level[k];
-      Extent box;  // the extents as segment_box() rebuilds them
-      scene.extent_[ci.box_offset[l] + k] = quantise_extent(se.e, se.length_m, q, inverse_q, &box);
-      // box_error_bound_sq() of that box, written out here (a call would spill every live xmm register).
-      const double width = std::max(std::abs(box.n_min), std::abs(box.n_max));
-      const double overhang = std::max(std::max(0.0, -box.u_min), box.u_max - se.length_m);
-      half_width = std::max(half_width, width);
-      bound_sq = std::max(bound_sq, overhang * overhang + width * width);  // one root per level, below
+      Extent e;  // the extents as segment_box() rebuilds them (its frame does not matter here)
+      scene.extent_[ci.box_offset[l] + k] = quantise_extent(se.e, se.length_m, q, inverse_q, &e);
+      const ErrorBox box{Vec2{}, Vec2{1.0, 0.0}, e.u_min, e.u_max, e.n_min, e.n_max};
+      half_width = std::max(half_width, box_half_width(box));
+      bound_sq = std::max(bound_sq, box_error_bound_sq(box, se.length_m));  // one root per level, below
     }
     ci.max_box_half_width_m[l] = half_width;
     ci.max_error_bound_m[l] = std::sqrt(bound_sq);
