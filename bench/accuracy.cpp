@@ -10,7 +10,8 @@
 //
 // Methods, per curve and per level l of our model, all with the same vertex count n_l:
 //   ours       Reissell's pseudocoiflets (UBC TR 93-17, 1993; seed paper §2): the level-l scaling
-//              coefficients of Scene::model(c), i.e. the polyline the contact solver uses.
+//              coefficients of curve c (build_multires; bit for bit the scene's level-l polyline, the one
+//              the contact solver uses).
 //   dp         Douglas & Peucker (1973), cv::approxPolyDP on the original vertices (closed flag kept),
 //              epsilon found by bisection so the vertex count is as close to n_l as it gets (it can
 //              stay below n_l at level 0, where n_l exceeds the original count: DP only keeps vertices).
@@ -19,7 +20,7 @@
 //   linear22   the (2,2) interpolating wavelet by lifting (Sweldens 1996, "The lifting scheme"):
 //              predict d_k = x_{2k+1} − (x_{2k} + x_{2k+2})/2, update s_k = x_{2k} + (d_{k−1} + d_k)/4,
 //              periodic on closed curves; open curves keep both end samples (missing d = 0), applied to
-//              the same level-0 samples model(c).scaling[0] for the same number of levels, so its point
+//              the same level-0 samples (build_multires' scaling[0]) for the same number of levels, so its point
 //              counts equal ours exactly. Same lifting structure as ours, two vanishing moments fewer.
 //
 // Errors of a simplified polyline A against the original O (closed curves include the closing segment):
@@ -285,8 +286,8 @@ CurveResult analyse_curve(const std::string& image, const Scene& scene, std::siz
   r.n_orig = o.points_m.size();
   r.closed = o.closed;
   r.length_m = polyline_length_m(o);
-  const CurveMultires& m = scene.model(c);
   const CurveInfo& ci = scene.curve(c);
+  const CurveMultires m = build_multires(o, ci.levels - 1);  // the scene keeps the scaling coefficients only; the same model
   r.level0_step_m = m.arc_m.size() > 1 ? m.arc_m[1] - m.arc_m[0] : r.length_m;
 
   const SegmentGrid o_grid(o.points_m, o.closed);
@@ -406,7 +407,7 @@ int main(int argc, char** argv) {
     for (std::size_t c = 0; c < scenes[i].scene->curve_count(); ++c) jobs.push_back({i, c});
   // Longest curves first, so the last thread does not finish alone with a big one.
   std::sort(jobs.begin(), jobs.end(), [&](const Job& a, const Job& b) {
-    const auto na = scenes[a.image].scene->model(a.curve).scaling[0].size(), nb = scenes[b.image].scene->model(b.curve).scaling[0].size();
+    const auto na = scenes[a.image].scene->curve(a.curve).point_count[0], nb = scenes[b.image].scene->curve(b.curve).point_count[0];
     return na != nb ? na > nb : (a.image != b.image ? a.image < b.image : a.curve < b.curve);
   });
 

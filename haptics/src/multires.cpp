@@ -103,24 +103,34 @@ void pseudocoiflet_inverse(const std::vector<double>& s, const std::vector<doubl
   for (std::size_t k = 0; k < no; ++k) x[2 * k + 1] = d[k] + predict(e.data(), ne, k, closed);
 }
 
-std::vector<Vec2> resample_arc_length(const Polyline& curve, std::size_t count, std::vector<double>* arc_out) {
+std::size_t arc_table_size(const Polyline& curve) { return curve.closed ? curve.points_m.size() + 1 : curve.points_m.size(); }
+
+double arc_table(const Polyline& curve, double* cum) {
   const auto& p = curve.points_m;
   if (p.size() < 2) throw CurveError("curve has " + std::to_string(p.size()) + " points; at least 2 are needed");
   for (const Vec2& q : p) {
     if (!is_finite(q)) throw CurveError("curve has a non-finite coordinate");
   }
-  if (count < (curve.closed ? 3u : 2u)) throw CurveError("resampling count " + std::to_string(count) + " is too small");
   const auto next = [n = p.size()](std::size_t i) { return i + 1 < n ? i + 1 : 0; };  // (i + 1) mod n, no division
-  // Cumulative arc length of the input vertices; a closed curve adds its closing segment.
-  const std::size_t nseg = curve.closed ? p.size() : p.size() - 1;
-  std::vector<double> cum(nseg + 1, 0.0);
+  const std::size_t nseg = arc_table_size(curve) - 1;  // a closed curve adds its closing segment
+  cum[0] = 0.0;
   for (std::size_t i = 0; i < nseg; ++i) cum[i + 1] = cum[i] + distance(p[i], p[next(i)]);
   const double total = cum[nseg];
   if (!(total > 0.0)) throw CurveError("curve has zero length");
+  return total;
+}
 
-  std::vector<Vec2> out(count);
-  if (arc_out) arc_out->assign(count, 0.0);
-  const double step = curve.closed ? total / static_cast<double>(count) : total / static_cast<double>(count - 1);
+double resample_step_m(double total_m, std::size_t count, bool closed) {
+  return closed ? total_m / static_cast<double>(count) : total_m / static_cast<double>(count - 1);
+}
+
+void resample_arc_length(const Polyline& curve, const double* cum, std::size_t count, Vec2* out) {
+  const auto& p = curve.points_m;
+  if (count < (curve.closed ? 3u : 2u)) throw CurveError("resampling count " + std::to_string(count) + " is too small");
+  const auto next = [n = p.size()](std::size_t i) { return i + 1 < n ? i + 1 : 0; };
+  const std::size_t nseg = arc_table_size(curve) - 1;
+  const double total = cum[nseg];
+  const double step = resample_step_m(total, count, curve.closed);
   std::size_t seg = 0;
   for (std::size_t i = 0; i < count; ++i) {
     double s = step * static_cast<double>(i);
@@ -129,9 +139,31 @@ std::vector<Vec2> resample_arc_length(const Polyline& curve, std::size_t count, 
     const double len = cum[seg + 1] - cum[seg];
     const double t = len > 0.0 ? std::clamp((s - cum[seg]) / len, 0.0, 1.0) : 0.0;
     out[i] = lerp(p[seg], p[next(seg)], t);
-    if (arc_out) (*arc_out)[i] = s;
+  }
+}
+
+std::vector<Vec2> resample_arc_length(const Polyline& curve, std::size_t count, std::vector<double>* arc_out) {
+  std::vector<double> cum(curve.points_m.size() < 2 ? 1 : arc_table_size(curve));
+  const double total = arc_table(curve, cum.data());
+  std::vector<Vec2> out(count);
+  resample_arc_length(curve, cum.data(), count, out.data());
+  if (arc_out) {
+    arc_out->resize(count);
+    for (std::size_t i = 0; i < count; ++i) (*arc_out)[i] = level0_arc_m(total, count, curve.closed, i);
   }
   return out;
+}
+
+std::size_t level_point_count(std::size_t level0_points, bool closed, int level) {
+  return closed ? level0_points >> level : ((level0_points - 1) >> level) + 1;
+}
+
+void forward_levels(Vec2* const* scaling, Vec2* const* wavelet, std::size_t level0_points, bool closed, int levels, Vec2* scratch) {
+  for (int l = 1; l < levels; ++l) {  // both coordinates in one pass (bit for bit the per-coordinate step)
+    const std::size_t n = level_point_count(level0_points, closed, l - 1);
+    check_forward_size(n, closed);
+    forward_step(scaling[l - 1], n, closed, scratch, scaling[l], wavelet[l] ? wavelet[l] : scratch + (n + 1) / 2);
+  }
 }
 
 LevelPlan plan_levels(std::size_t point_count, bool closed, int max_levels) {
@@ -157,18 +189,17 @@ CurveMultires build_multires(const Polyline& curve, int max_levels) {
   m.scaling.resize(static_cast<std::size_t>(m.levels));
   m.wavelet.resize(static_cast<std::size_t>(m.levels));
   m.scaling[0] = resample_arc_length(curve, plan.level0_points, &m.arc_m);
-
-  std::vector<Vec2> even;  // scratch: the even samples of the finer level
-  for (int l = 1; l < m.levels; ++l) {  // both coordinates in one pass (bit for bit the per-coordinate step)
-    const auto& fine = m.scaling[static_cast<std::size_t>(l - 1)];
-    check_forward_size(fine.size(), curve.closed);
-    auto& coarse = m.scaling[static_cast<std::size_t>(l)];
-    auto& w = m.wavelet[static_cast<std::size_t>(l)];
-    even.resize(curve.closed ? fine.size() / 2 : (fine.size() + 1) / 2);
-    coarse.resize(even.size());
-    w.resize(fine.size() / 2);
-    forward_step(fine.data(), fine.size(), curve.closed, even.data(), coarse.data(), w.data());
+  std::vector<Vec2*> s(static_cast<std::size_t>(m.levels)), w(static_cast<std::size_t>(m.levels));
+  for (int l = 1; l < m.levels; ++l) {
+    const auto i = static_cast<std::size_t>(l);
+    m.scaling[i].resize(level_point_count(plan.level0_points, curve.closed, l));
+    m.wavelet[i].resize(plan.level0_points >> l);  // closed: as many as the level's points; open: one fewer
+    s[i] = m.scaling[i].data();
+    w[i] = m.wavelet[i].data();
   }
+  s[0] = m.scaling[0].data();
+  std::vector<Vec2> scratch(forward_scratch_size(plan.level0_points));
+  forward_levels(s.data(), w.data(), plan.level0_points, curve.closed, m.levels, scratch.data());
   return m;
 }
 

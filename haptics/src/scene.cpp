@@ -327,55 +327,90 @@ class SceneBuild {
     std::uint32_t curve, first_segment, count;
   };
 
-  // Multiresolution model of every curve that has one (fewer than 2 points or zero length: skipped).
-  static void build_models(Scene& scene, const std::vector<Polyline>& input, int max_levels) {
+  // Where each curve's original vertices' arc table starts in the build's flat table (arc_table).
+  struct OriginalArcs {
+    std::vector<double> cum;          // every kept curve's arc table, one after the other [m]
+    std::vector<std::size_t> offset;  // per curve: its first entry in cum
+  };
+
+  // Each curve's level plan (plan_levels) and its original's arc table; curves without a model (fewer
+  // than 2 points, non-finite, zero length: arc_table's CurveError) are skipped and counted.
+  static void plan_curves(Scene& scene, const std::vector<Polyline>& input, int max_levels, OriginalArcs& arcs) {
     for (std::size_t i = 0; i < input.size(); ++i) {
+      const Polyline& src = input[i];
+      const std::size_t at = arcs.cum.size();
+      double length_m = 0.0;
       try {
-        scene.models_.push_back(build_multires(input[i], max_levels));
-        scene.source_index_.push_back(i);
+        arcs.cum.resize(at + std::max<std::size_t>(arc_table_size(src), 1));
+        length_m = arc_table(src, arcs.cum.data() + at);
       } catch (const CurveError&) {
+        arcs.cum.resize(at);
         ++scene.skipped_;  // nothing to feel
+        continue;
       }
+      const LevelPlan plan = plan_levels(src.points_m.size(), src.closed, max_levels);
+      CurveInfo ci;
+      ci.closed = src.closed;
+      ci.levels = plan.levels_above_0 + 1;
+      ci.length_m = length_m;
+      for (int l = 0; l < ci.levels; ++l) {
+        ci.point_count[l] = static_cast<std::uint32_t>(level_point_count(plan.level0_points, src.closed, l));
+        ci.segment_count[l] = src.closed ? ci.point_count[l] : ci.point_count[l] - 1;
+      }
+      scene.curves_.push_back(ci);
+      scene.source_index_.push_back(i);
+      arcs.offset.push_back(at);
     }
   }
 
-  // Slots of every level, level by level within each curve (scene.hpp "Node numbering"): the points,
-  // a closed curve's first point again, each slot tagged with its curve and level.
+  // Slots of every level, level by level within each curve (scene.hpp "Node numbering"): room for the
+  // points and a closed curve's first point again, each slot tagged with its curve and level.
   static void lay_out_curves(Scene& scene) {
     std::size_t nslots = 0;
-    scene.curves_.resize(scene.models_.size());
-    scene.curve_nodes_.resize(scene.models_.size());
-    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
-      const CurveMultires& m = scene.models_[c];
+    scene.curve_nodes_.resize(scene.curves_.size());
+    for (std::size_t c = 0; c < scene.curves_.size(); ++c) {
       CurveInfo& ci = scene.curves_[c];
-      ci.closed = m.closed;
-      ci.levels = m.levels;
-      scene.curve_nodes_[c].levels = static_cast<std::uint32_t>(m.levels);
-      for (int l = 0; l < m.levels; ++l) {
+      scene.curve_nodes_[c].levels = static_cast<std::uint32_t>(ci.levels);
+      for (int l = 0; l < ci.levels; ++l) {
         ci.point_offset[l] = static_cast<std::uint32_t>(nslots);
         ci.box_offset[l] = static_cast<std::uint32_t>(nslots);
         scene.curve_nodes_[c].box_offset[l] = static_cast<std::uint32_t>(nslots);
-        ci.point_count[l] = static_cast<std::uint32_t>(m.scaling[l].size());
-        ci.segment_count[l] = static_cast<std::uint32_t>(m.segment_count(l));
-        nslots += m.segment_count(l) + 1;
+        nslots += ci.segment_count[l] + 1;
       }
     }
-    if (nslots >= std::numeric_limits<std::uint32_t>::max() / 2 || scene.models_.size() >= (std::size_t{1} << (32 - Scene::kTagLevelBits))) {
+    if (nslots >= std::numeric_limits<std::uint32_t>::max() / 2 || scene.curves_.size() >= (std::size_t{1} << (32 - Scene::kTagLevelBits))) {
       throw std::bad_alloc();  // ids would not fit: far beyond any memory this runs in
     }
     scene.segment_nodes_ = nslots;
     scene.points_m_.resize(nslots);
     scene.extent_.resize(nslots);
     scene.tag_.resize(nslots);
-    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
-      const CurveMultires& m = scene.models_[c];
-      for (int l = 0; l < m.levels; ++l) {
-        const std::size_t at = scene.curves_[c].point_offset[l];
-        const auto& pts = m.scaling[static_cast<std::size_t>(l)];
-        std::copy(pts.begin(), pts.end(), scene.points_m_.begin() + static_cast<std::ptrdiff_t>(at));
-        if (m.closed) scene.points_m_[at + pts.size()] = pts.front();
+    for (std::size_t c = 0; c < scene.curves_.size(); ++c) {
+      const CurveInfo& ci = scene.curves_[c];
+      for (int l = 0; l < ci.levels; ++l) {
         const std::uint32_t tag = static_cast<std::uint32_t>(c) << Scene::kTagLevelBits | static_cast<std::uint32_t>(l);
-        std::fill_n(scene.tag_.begin() + static_cast<std::ptrdiff_t>(at), m.segment_count(l) + 1, tag);
+        std::fill_n(scene.tag_.begin() + static_cast<std::ptrdiff_t>(ci.point_offset[l]), ci.segment_count[l] + 1, tag);
+      }
+    }
+  }
+
+  // The multiresolution model of every curve, in its slots (seed §2): level 0 resampled on the original,
+  // each coarser level's scaling coefficients by the forward transform, a closed curve's first point
+  // repeated after each level's last. The wavelet coefficients are not kept: every level's scaling
+  // coefficients are, which is what the walks read (build_multires gives both, for analysis).
+  static void transform_curves(Scene& scene, const std::vector<Polyline>& input, const OriginalArcs& arcs) {
+    std::vector<Vec2> scratch;
+    Vec2* level[kMaxLevels] = {};
+    for (std::size_t c = 0; c < scene.curves_.size(); ++c) {
+      const CurveInfo& ci = scene.curves_[c];
+      const Polyline& src = input[scene.source_index_[c]];
+      for (int l = 0; l < ci.levels; ++l) level[l] = scene.points_m_.data() + ci.point_offset[l];
+      resample_arc_length(src, arcs.cum.data() + arcs.offset[c], ci.point_count[0], level[0]);
+      scratch.resize(std::max(scratch.size(), forward_scratch_size(ci.point_count[0])));
+      Vec2* const no_wavelets[kMaxLevels] = {};
+      forward_levels(level, no_wavelets, ci.point_count[0], ci.closed, ci.levels, scratch.data());
+      if (ci.closed) {
+        for (int l = 0; l < ci.levels; ++l) level[l][ci.point_count[l]] = level[l][0];
       }
     }
   }
@@ -384,16 +419,16 @@ class SceneBuild {
   // They are the leaves of the scene hierarchy, so no node has more than a handful of children (a long
   // curve would otherwise fan out to hundreds of coarsest segments, and the boundary section with it).
   static void make_chunks(Scene& scene, std::vector<Chunk>& chunks, std::vector<Vec2>& centre) {
-    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+    for (std::size_t c = 0; c < scene.curves_.size(); ++c) {
       scene.curve_nodes_[c].chunk_offset = static_cast<std::uint32_t>(chunks.size());
-      const int top = scene.models_[c].levels - 1;
-      const auto& pts = scene.models_[c].scaling[static_cast<std::size_t>(top)];
+      const int top = scene.curves_[c].levels - 1;
+      const Vec2* pts = scene.points(c, top);  // k_top + 1 slots: a closed curve's first point repeats
       const std::uint32_t k_top = scene.curves_[c].segment_count[top];
       for (std::uint32_t k = 0; k < k_top; k += Scene::kSegmentsPerChunk) {
         const std::uint32_t n = std::min<std::uint32_t>(Scene::kSegmentsPerChunk, k_top - k);
         Vec2 lo = pts[k], hi = pts[k];
         for (std::uint32_t i = k; i <= k + n; ++i) {
-          const Vec2 q = pts[i % pts.size()];
+          const Vec2 q = pts[i];
           lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
           hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
         }
@@ -414,22 +449,19 @@ class SceneBuild {
   }
 
   // Per level-0 segment k of curve c: the original vertices strictly inside it are
-  // [orig_first[k], orig_first[k+1]) (by arc length along the original).
-  static void map_originals(const CurveMultires& m, const Polyline& src, std::size_t s0, std::vector<double>& orig_arc,
-                            std::vector<std::uint32_t>& orig_first) {
-    const auto& p = src.points_m;
-    orig_arc.assign(p.size() + 1, 0.0);
-    for (std::size_t i = 1; i < p.size(); ++i) orig_arc[i] = orig_arc[i - 1] + distance(p[i - 1], p[i]);
-    const double total = src.closed ? orig_arc[p.size() - 1] + distance(p.back(), p.front()) : orig_arc[p.size() - 1];
-    const std::size_t n0 = m.scaling[0].size();
+  // [orig_first[k], orig_first[k+1]) (by arc length along the original: `cum` is its arc table, and the
+  // level-0 points' arc lengths are their resampling parameters, level0_arc_m).
+  static void map_originals(const CurveInfo& ci, const Polyline& src, const double* cum, std::vector<std::uint32_t>& orig_first) {
+    const std::size_t n = src.points_m.size();
+    const std::size_t s0 = ci.segment_count[0], n0 = ci.point_count[0];
     orig_first.assign(s0 + 1, 0);
     std::size_t j = 0;
     for (std::size_t k = 0; k <= s0; ++k) {
-      const double start = k < n0 ? m.arc_m[k] : total;
-      while (j < p.size() && orig_arc[j] < start) ++j;
+      const double start = k < n0 ? level0_arc_m(ci.length_m, n0, ci.closed, k) : ci.length_m;
+      while (j < n && cum[j] < start) ++j;
       orig_first[k] = static_cast<std::uint32_t>(j);
     }
-    orig_first[s0] = static_cast<std::uint32_t>(p.size());
+    orig_first[s0] = static_cast<std::uint32_t>(n);
   }
 
   // Level-0 points k0 < i < k1 that the box pass must still see once it has point k0 and the original
@@ -458,10 +490,9 @@ class SceneBuild {
   // (quantise_level).
   static void build_segment_boxes(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first,
                                   std::vector<SegmentExtent>& level) {
-    const CurveMultires& m = scene.models_[c];
     CurveInfo& ci = scene.curves_[c];
     const Vec2* orig = src.points_m.data();
-    for (int l = 0; l < m.levels; ++l) {
+    for (int l = 0; l < ci.levels; ++l) {
       level.resize(ci.segment_count[l]);
       double worst_sq = 0.0;  // largest squared distance of a level-0 point or original vertex from its level-l segment [m²]
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
@@ -535,17 +566,18 @@ class SceneBuild {
     ci.max_error_bound_m[l] = std::sqrt(bound_sq);
   }
 
-  static void build_curves(Scene& scene, const std::vector<Polyline>& input) {
-    std::vector<double> orig_arc;
+  static void build_curves(Scene& scene, const std::vector<Polyline>& input, const OriginalArcs& arcs) {
     std::vector<std::uint32_t> orig_first;
     std::vector<SegmentExtent> level_extent;  // one level's measured extents, before quantising
     Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     Vec2 hi{-lo.x, -lo.y};
-    for (std::size_t c = 0; c < scene.models_.size(); ++c) {
+    for (std::size_t c = 0; c < scene.curves_.size(); ++c) {
       const Polyline& src = input[scene.source_index_[c]];
-      map_originals(scene.models_[c], src, scene.curves_[c].segment_count[0], orig_arc, orig_first);
+      map_originals(scene.curves_[c], src, arcs.cum.data() + arcs.offset[c], orig_first);
       build_segment_boxes(scene, c, src, orig_first, level_extent);
-      for (const Vec2& q : scene.models_[c].scaling[0]) {
+      const Vec2* level0 = scene.points(c, 0);
+      for (std::uint32_t i = 0; i < scene.curves_[c].point_count[0]; ++i) {
+        const Vec2 q = level0[i];
         lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
         hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
       }
@@ -604,9 +636,11 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   Scene scene;
   max_levels = std::clamp(max_levels, 0, kMaxLevels - 1);
   const double t0 = now_ms();
-  SceneBuild::build_models(scene, input, max_levels);
-  const double t1 = now_ms();
+  SceneBuild::OriginalArcs arcs;
+  SceneBuild::plan_curves(scene, input, max_levels, arcs);
   SceneBuild::lay_out_curves(scene);
+  SceneBuild::transform_curves(scene, input, arcs);
+  const double t1 = now_ms();
   std::vector<SceneBuild::Chunk> chunks;
   std::vector<Vec2> chunk_centre;
   SceneBuild::make_chunks(scene, chunks, chunk_centre);
@@ -617,7 +651,7 @@ Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {
   scene.chunk_count_ = chunks.size();
   const std::size_t hierarchy_base = scene.segment_nodes_ + chunks.size();
   SceneBuild::allocate_groups(scene, chunks.size() + (chunks.empty() ? 0 : hierarchy.size()), chunks.size());
-  SceneBuild::build_curves(scene, input);
+  SceneBuild::build_curves(scene, input, arcs);
   if (!chunks.empty()) {
     SceneBuild::build_chunk_nodes(scene, chunks, leaf_order);
     SceneBuild::build_hierarchy_nodes(scene, hierarchy, chunks, leaf_order, hierarchy_base);

@@ -31,8 +31,8 @@ void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
   constexpr double tol = 1e-12;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const CurveInfo& ci = sc.curve(c);
-    const CurveMultires& m = sc.model(c);
     const Polyline& src = input[sc.source_index(c)];
+    const CurveMultires m = build_multires(src, ci.levels - 1);  // the model on its own, outside the scene
     double arc = 0.0;
     std::size_t k = 0;
     const std::size_t s0 = ci.segment_count[0];
@@ -138,8 +138,8 @@ TEST(CollisionTree, BoxesAreTightAroundTheOriginalUnderThem) {
     const Scene sc = Scene::build(curves, 6);
     for (std::size_t c = 0; c < sc.curve_count(); ++c) {
       const CurveInfo& ci = sc.curve(c);
-      const CurveMultires& m = sc.model(c);
       const Polyline& src = curves[sc.source_index(c)];
+      const CurveMultires m = build_multires(src, ci.levels - 1);  // the model on its own, outside the scene
       // Original vertices by the level-0 segment they fall in.
       std::vector<std::vector<Vec2>> under(ci.segment_count[0]);
       double arc = 0.0;
@@ -176,17 +176,28 @@ TEST(CollisionTree, BoxesAreTightAroundTheOriginalUnderThem) {
 
 // Issue 18, compact storage: a level is a run of slots, one per point, a closed curve's first point
 // repeated at the end, so segment k runs from point k to point k + 1 and the last segment of a closed
-// level closes the loop on its first point (checked against the model's scaling coefficients).
+// level closes the loop on its first point (checked against the scaling coefficients of build_multires,
+// the model built on its own: the scene transforms into its slots, bit for bit the same).
 TEST(CollisionTree, SegmentsRunBetweenTheLevelsPointsAndClosedLevelsCloseTheLoop) {
   std::mt19937 rng(14);
-  const auto curves = random_scene(rng, 5, 5);
+  auto curves = random_scene(rng, 5, 5);
+  // Curves without a model among them (one point; zero length): skipped, the others keep their sources.
+  curves.insert(curves.begin() + 2, Polyline{{{0.01, 0.02}}, false});
+  curves.insert(curves.begin() + 5, Polyline{{{0.03, 0.04}, {0.03, 0.04}, {0.03, 0.04}}, true});
   const Scene sc = Scene::build(curves, 6);
+  ASSERT_EQ(sc.skipped_curves(), 2u);
+  ASSERT_EQ(sc.curve_count(), curves.size() - 2);
+  EXPECT_EQ(sc.source_index(2), 3u);
+  EXPECT_EQ(sc.source_index(4), 6u);
   int closed = 0;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const CurveInfo& ci = sc.curve(c);
     closed += ci.closed ? 1 : 0;
+    const CurveMultires m = build_multires(curves[sc.source_index(c)], ci.levels - 1);
+    ASSERT_EQ(m.levels, ci.levels);
+    for (std::size_t i = 0; i < m.arc_m.size(); ++i) ASSERT_EQ(sc.level0_arc_m(c, i), m.arc_m[i]) << "curve " << c << " point " << i;
     for (int l = 0; l < ci.levels; ++l) {
-      const auto& pts = sc.model(c).scaling[static_cast<std::size_t>(l)];
+      const auto& pts = m.scaling[static_cast<std::size_t>(l)];
       ASSERT_EQ(ci.segment_count[l], ci.closed ? pts.size() : pts.size() - 1);
       for (std::uint32_t k = 0; k < ci.segment_count[l]; ++k) {
         Vec2 a, b;

@@ -28,7 +28,7 @@ std::vector<Polyline> curves_for(std::mt19937& rng) {
 // Level-0 segment of every original vertex, by arc length (as the containment test finds it).
 std::vector<std::size_t> level0_of_vertices(const Scene& sc, std::size_t c, const Polyline& src) {
   std::vector<std::size_t> seg(src.points_m.size());
-  const CurveMultires& m = sc.model(c);
+  const CurveMultires m = build_multires(src, sc.curve(c).levels - 1);  // the model on its own, outside the scene
   const std::size_t s0 = sc.curve(c).segment_count[0];
   double arc = 0.0;
   std::size_t k = 0;

@@ -39,6 +39,28 @@ class CurveError : public hk::Error {
 /// Throws CurveError for fewer than 2 points, zero total length, or non-finite coordinates.
 std::vector<Vec2> resample_arc_length(const Polyline& curve, std::size_t count, std::vector<double>* arc_out = nullptr);
 
+/// Entries of a polyline's arc table: its vertex count, + 1 for a closed curve (the loop back to its first vertex).
+std::size_t arc_table_size(const Polyline& curve);
+
+/// The arc table of a polyline: cum[i] = arc length from its first vertex to vertex i [m], and for a closed
+/// curve cum[n] = the whole loop. `cum` holds arc_table_size(curve) entries. Returns the total length [m].
+/// Throws CurveError for fewer than 2 points, non-finite coordinates or zero total length.
+double arc_table(const Polyline& curve, double* cum);
+
+/// resample_arc_length from the curve's arc table `cum` (as arc_table wrote it), into out[0..count).
+/// Allocates nothing; throws CurveError for a count too small (as below).
+void resample_arc_length(const Polyline& curve, const double* cum, std::size_t count, Vec2* out);
+
+/// Arc length between consecutive resampled points, for a curve of total length total_m resampled at `count`
+/// points [m]: total / count closed, total / (count − 1) open.
+double resample_step_m(double total_m, std::size_t count, bool closed);
+
+/// Arc-length parameter of resampled point i of `count` on a curve of total length total_m [m]: step · i,
+/// exactly total_m for an open curve's last point (resample_arc_length's own values, bit for bit).
+inline double level0_arc_m(double total_m, std::size_t count, bool closed, std::size_t i) {
+  return !closed && i + 1 == count ? total_m : resample_step_m(total_m, count, closed) * static_cast<double>(i);
+}
+
 /// One forward lifting step on one coordinate. `x` has n samples: closed n even (≥ 8), open n odd (≥ 7):
 /// four even samples for the cubic predictor. Throws CurveError for any other n. Writes s (scaling coefficients, n/2 closed,
 /// (n+1)/2 open) and d (wavelet coefficients, n/2 closed, (n−1)/2 open). Source: DESIGN.md "Wavelets".
@@ -69,6 +91,21 @@ struct CurveMultires {
 /// least 4 segments (closed) or 3 segments (open). Returns {K, L}.
 struct LevelPlan { std::size_t k = 0; int levels_above_0 = 0; std::size_t level0_points = 0; };
 LevelPlan plan_levels(std::size_t point_count, bool closed, int max_levels);
+
+/// Points of level `level` of a curve with level0_points points at level 0 (plan_levels' counts):
+/// level0_points / 2^level closed, (level0_points − 1) / 2^level + 1 open.
+std::size_t level_point_count(std::size_t level0_points, bool closed, int level);
+
+/// Scratch entries forward_levels needs for a curve of level0_points points at level 0.
+inline std::size_t forward_scratch_size(std::size_t level0_points) { return level0_points; }
+
+/// The forward transform of a curve from level 0 up, both coordinates at once, into caller storage (seed
+/// paper §2): scaling[0] holds level 0's level0_points points (a size plan_levels gives); writes level l's
+/// scaling coefficients to scaling[l] (level_point_count of them) and its wavelet coefficients to wavelet[l]
+/// (level0_points / 2^l of them), or only into `scratch` when wavelet[l] is null, for l = 1 .. levels − 1.
+/// `scratch` holds forward_scratch_size(level0_points) points. Bit for bit build_multires' levels.
+/// Allocates nothing; throws CurveError for a level size the lifting step does not take.
+void forward_levels(Vec2* const* scaling, Vec2* const* wavelet, std::size_t level0_points, bool closed, int levels, Vec2* scratch);
 
 /// Builds the multiresolution of a curve: resample to plan_levels' count, then apply the forward
 /// transform L times. Throws CurveError for a curve too short to resample (< 2 points or zero length).

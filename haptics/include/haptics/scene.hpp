@@ -21,6 +21,10 @@
 /// (16 bytes, shared by the segment ending there) and the box's four extents quantised to 16 bits,
 /// rounded outward (8 bytes), plus a 4-byte tag (curve and level). Only the few chunk and hierarchy nodes
 /// keep an axis-aligned box and links.
+/// The multiresolution is transformed straight into the slots (multires.hpp forward_levels): a level's
+/// slots are its scaling coefficients, and the scene keeps no other copy of the model. The wavelet
+/// coefficients are not kept (the walks never read them; build_multires gives the whole model, bit for
+/// bit the same levels, for analysis), nor the level-0 points' arc lengths (level0_arc_m computes them).
 
 #include <algorithm>
 #include <cmath>
@@ -81,6 +85,7 @@ inline double box_error_bound_sq(const ErrorBox& box, double segment_length_m) {
 struct CurveInfo {
   bool closed = false;
   int levels = 0;
+  double length_m = 0.0;                         ///< arc length of the original curve (closed: the whole loop) [m]
   std::uint32_t point_offset[kMaxLevels] = {};   ///< index of level l's first point in the scene's point array (= box_offset[l])
   std::uint32_t point_count[kMaxLevels] = {};    ///< distinct points of level l (a closed curve's repeated first point not counted)
   std::uint32_t box_offset[kMaxLevels] = {};     ///< node id of level l's first segment
@@ -155,8 +160,12 @@ class Scene {
   const CurveInfo& curve(std::size_t c) const { return curves_[c]; }
   /// What the tree walks read of curve c (node offsets, levels).
   const CurveNodes& curve_nodes(std::size_t c) const { return curve_nodes_[c]; }
-  /// The multiresolution model of curve c (scaling and wavelet coefficients; not used by the servo path).
-  const CurveMultires& model(std::size_t c) const { return models_[c]; }
+  /// Arc length along the original curve to curve c's level-0 point i [m]: its resampling parameter, bit
+  /// for bit build_multires' arc_m[i]. i < curve(c).point_count[0].
+  double level0_arc_m(std::size_t c, std::size_t i) const {
+    const CurveInfo& ci = curves_[c];
+    return hk::level0_arc_m(ci.length_m, ci.point_count[0], ci.closed, i);
+  }
   /// Index of curve c in the `curves` handed to build().
   std::size_t source_index(std::size_t c) const { return source_index_[c]; }
   std::size_t skipped_curves() const { return skipped_; }
@@ -305,7 +314,6 @@ class Scene {
   friend class SceneBuild;  // the build phases (scene.cpp)
   std::vector<CurveInfo> curves_;
   std::vector<CurveNodes> curve_nodes_;
-  std::vector<CurveMultires> models_;
   std::vector<std::size_t> source_index_;
   // Per slot (node ids 0 .. segment_nodes_ − 1).
   std::vector<Vec2> points_m_;
