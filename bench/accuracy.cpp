@@ -304,7 +304,7 @@ CurveResult analyse_curve(const std::string& image, const Scene& scene, std::siz
     const auto& ours = m.scaling[static_cast<std::size_t>(l)];
     const std::size_t n_l = ours.size();
     // The scene's flat copy must be the model's polyline: the contact solver uses the former.
-    if (ci.point_count[l] != n_l || !(scene.points(c, l)[0] == ours[0])) die("Scene::points differs from Scene::model");
+    if (ci.point_count[l] != n_l || !(scene.points(c, l)[0] == ours[0])) die("Scene::points differs from build_multires");
     if (l22[static_cast<std::size_t>(l)].size() != n_l) die("linear (2,2) wavelet point count differs from ours");
     LevelResult lr;
     lr.level = l;
