@@ -140,8 +140,8 @@ static_assert(sizeof(NodeInfo) == 12, "NodeInfo: 12 bytes per node");
 
 /// Build timings of a scene [ms].
 struct SceneBuildTimes {
-  double multires_ms = 0.0;
-  double tree_ms = 0.0;
+  double multires_ms = 0.0;  ///< level plans and arc tables, laying out the slots, the multiresolution into them [ms]
+  double tree_ms = 0.0;      ///< error boxes and their quantising, chunks, hierarchy, wide index [ms]
 };
 
 /// All curves of a picture, ready for the servo loop. Immutable once built; shared read-only.
