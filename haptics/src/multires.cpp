@@ -120,10 +120,6 @@ double arc_table(const Polyline& curve, double* cum) {
   return total;
 }
 
-double resample_step_m(double total_m, std::size_t count, bool closed) {
-  return closed ? total_m / static_cast<double>(count) : total_m / static_cast<double>(count - 1);
-}
-
 void resample_arc_length(const Polyline& curve, const double* cum, std::size_t count, Vec2* out) {
   const auto& p = curve.points_m;
   if (count < (curve.closed ? 3u : 2u)) throw CurveError("resampling count " + std::to_string(count) + " is too small");

@@ -53,7 +53,9 @@ void resample_arc_length(const Polyline& curve, const double* cum, std::size_t c
 
 /// Arc length between consecutive resampled points, for a curve of total length total_m resampled at `count`
 /// points [m]: total / count closed, total / (count − 1) open.
-double resample_step_m(double total_m, std::size_t count, bool closed);
+inline double resample_step_m(double total_m, std::size_t count, bool closed) {
+  return closed ? total_m / static_cast<double>(count) : total_m / static_cast<double>(count - 1);
+}
 
 /// Arc-length parameter of resampled point i of `count` on a curve of total length total_m [m]: step · i,
 /// exactly total_m for an open curve's last point (resample_arc_length's own values, bit for bit).
