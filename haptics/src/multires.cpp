@@ -129,8 +129,7 @@ void resample_arc_length(const Polyline& curve, const double* cum, std::size_t c
   const double step = resample_step_m(total, count, curve.closed);
   std::size_t seg = 0;
   for (std::size_t i = 0; i < count; ++i) {
-    double s = step * static_cast<double>(i);
-    if (!curve.closed && i + 1 == count) s = total;  // land exactly on the last point
+    const double s = level0_arc_m(total, step, count, curve.closed, i);  // an open curve lands exactly on its last point
     while (seg + 1 < nseg && cum[seg + 1] < s) ++seg;
     const double len = cum[seg + 1] - cum[seg];
     const double t = len > 0.0 ? std::clamp((s - cum[seg]) / len, 0.0, 1.0) : 0.0;

@@ -454,12 +454,11 @@ class SceneBuild {
   static void map_originals(const CurveInfo& ci, const Polyline& src, const double* cum, std::vector<std::uint32_t>& orig_first) {
     const std::size_t n = src.points_m.size();
     const std::size_t s0 = ci.segment_count[0], n0 = ci.point_count[0];
-    const double step = resample_step_m(ci.length_m, n0, ci.closed);  // level0_arc_m's, divided once
+    const double step = resample_step_m(ci.length_m, n0, ci.closed);  // divided once per curve
     orig_first.assign(s0 + 1, 0);
     std::size_t j = 0;
     for (std::size_t k = 0; k <= s0; ++k) {
-      const bool before_end = ci.closed ? k < n0 : k + 1 < n0;  // else the curve's end: its length, as level0_arc_m
-      const double start = before_end ? step * static_cast<double>(k) : ci.length_m;
+      const double start = k < n0 ? level0_arc_m(ci.length_m, step, n0, ci.closed, k) : ci.length_m;
       while (j < n && cum[j] < start) ++j;
       orig_first[k] = static_cast<std::uint32_t>(j);
     }

@@ -57,10 +57,16 @@ inline double resample_step_m(double total_m, std::size_t count, bool closed) {
   return closed ? total_m / static_cast<double>(count) : total_m / static_cast<double>(count - 1);
 }
 
-/// Arc-length parameter of resampled point i of `count` on a curve of total length total_m [m]: step · i,
-/// exactly total_m for an open curve's last point (resample_arc_length's own values, bit for bit).
+/// Arc-length parameter of resampled point i of `count` on a curve of total length total_m [m], with
+/// step_m = resample_step_m(total_m, count, closed): step · i, exactly total_m for an open curve's last
+/// point. resample_arc_length samples at these, so they are its points' arc lengths bit for bit.
+inline double level0_arc_m(double total_m, double step_m, std::size_t count, bool closed, std::size_t i) {
+  return !closed && i + 1 == count ? total_m : step_m * static_cast<double>(i);
+}
+
+/// The same, with the step computed here (one division a call).
 inline double level0_arc_m(double total_m, std::size_t count, bool closed, std::size_t i) {
-  return !closed && i + 1 == count ? total_m : resample_step_m(total_m, count, closed) * static_cast<double>(i);
+  return level0_arc_m(total_m, resample_step_m(total_m, count, closed), count, closed, i);
 }
 
 /// One forward lifting step on one coordinate. `x` has n samples: closed n even (≥ 8), open n odd (≥ 7):
