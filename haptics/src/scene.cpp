@@ -567,25 +567,21 @@ class SceneBuild {
     ci.max_error_bound_m[l] = std::sqrt(bound_sq);
   }
 
+  // Every curve's error boxes (build_segment_boxes) and the scene's bounds, those of the level-0 points.
   static void build_curves(Scene& scene, const std::vector<Polyline>& input, const OriginalArcs& arcs) {
     std::vector<std::uint32_t> orig_first;
     std::vector<SegmentExtent> level_extent;  // one level's measured extents, before quantising
-    Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-    Vec2 hi{-lo.x, -lo.y};
+    BoxGrower bounds(Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, 0.0);  // the identity frame: (u, n) = (x, y)
     for (std::size_t c = 0; c < scene.curves_.size(); ++c) {
       const Polyline& src = input[scene.source_index_[c]];
       map_originals(scene.curves_[c], src, arcs.cum.data() + arcs.offset[c], orig_first);
       build_segment_boxes(scene, c, src, orig_first, level_extent);
-      const Vec2* level0 = scene.points(c, 0);
-      for (std::uint32_t i = 0; i < scene.curves_[c].point_count[0]; ++i) {
-        const Vec2 q = level0[i];
-        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
-        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
-      }
+      bounds.grow(scene.points(c, 0), scene.curves_[c].point_count[0]);
     }
     if (!scene.curves_.empty()) {
-      scene.bounds_min_ = lo;
-      scene.bounds_max_ = hi;
+      const Extent e = bounds.extent(0.0);
+      scene.bounds_min_ = Vec2{e.u_min, e.n_min};
+      scene.bounds_max_ = Vec2{e.u_max, e.n_max};
     }
   }
 

@@ -39,7 +39,7 @@ Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) {
     const std::uint32_t s = k >> d;
     Vec2 p0, p1;
     sc.segment(SegmentRef{static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(s)}, &p0, &p1);
-    const double pieces = std::ldexp(1.0, d);
+    const auto pieces = static_cast<double>(1u << d);  // 2^d, d < kMaxLevels (exact; no scalbn call)
     const double i = static_cast<double>(k & ((1u << d) - 1u));
     extend(r, lerp(p0, p1, i / pieces));
     extend(r, lerp(p0, p1, (i + 1.0) / pieces));
