@@ -55,7 +55,17 @@ inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return {_mm_sub_pd(a.v, b.v)}; }
 inline Lanes2 operator*(Lanes2 a, Lanes2 b) { return {_mm_mul_pd(a.v, b.v)}; }
 inline Lanes2 min(Lanes2 a, Lanes2 b) { return {_mm_min_pd(a.v, b.v)}; }
 inline Lanes2 max(Lanes2 a, Lanes2 b) { return {_mm_max_pd(a.v, b.v)}; }
+inline Lanes2 operator/(Lanes2 a, Lanes2 b) { return {_mm_div_pd(a.v, b.v)}; }
+inline Lanes2 sqrt(Lanes2 a) { return {_mm_sqrt_pd(a.v)}; }
 inline Lanes2 swapped(Lanes2 a) { return {_mm_shuffle_pd(a.v, a.v, 1)}; }
+// (a's lane 0, b's lane 0) and (a's lane 1, b's lane 1).
+inline Lanes2 low_lanes(Lanes2 a, Lanes2 b) { return {_mm_unpacklo_pd(a.v, b.v)}; }
+inline Lanes2 high_lanes(Lanes2 a, Lanes2 b) { return {_mm_unpackhi_pd(a.v, b.v)}; }
+// Each lane of `if_true` where that lane of x > y (false for a NaN), else that of `otherwise`.
+inline Lanes2 where_greater(Lanes2 x, Lanes2 y, Lanes2 if_true, Lanes2 otherwise) {
+  const __m128d keep = _mm_cmpgt_pd(x.v, y.v);
+  return {_mm_or_pd(_mm_and_pd(keep, if_true.v), _mm_andnot_pd(keep, otherwise.v))};
+}
 inline double lane0(Lanes2 a) { return _mm_cvtsd_f64(a.v); }
 inline double lane1(Lanes2 a) { return _mm_cvtsd_f64(_mm_unpackhi_pd(a.v, a.v)); }
 // Each lane rounded toward zero (|lane| < 2^31).
@@ -76,7 +86,14 @@ inline Lanes2 operator-(Lanes2 a, Lanes2 b) { return {a.a - b.a, a.b - b.b}; }
 inline Lanes2 operator*(Lanes2 a, Lanes2 b) { return {a.a * b.a, a.b * b.b}; }
 inline Lanes2 min(Lanes2 a, Lanes2 b) { return {a.a < b.a ? a.a : b.a, a.b < b.b ? a.b : b.b}; }
 inline Lanes2 max(Lanes2 a, Lanes2 b) { return {a.a > b.a ? a.a : b.a, a.b > b.b ? a.b : b.b}; }
+inline Lanes2 operator/(Lanes2 a, Lanes2 b) { return {a.a / b.a, a.b / b.b}; }
+inline Lanes2 sqrt(Lanes2 a) { return {std::sqrt(a.a), std::sqrt(a.b)}; }
 inline Lanes2 swapped(Lanes2 a) { return {a.b, a.a}; }
+inline Lanes2 low_lanes(Lanes2 a, Lanes2 b) { return {a.a, b.a}; }
+inline Lanes2 high_lanes(Lanes2 a, Lanes2 b) { return {a.b, b.b}; }
+inline Lanes2 where_greater(Lanes2 x, Lanes2 y, Lanes2 if_true, Lanes2 otherwise) {
+  return {x.a > y.a ? if_true.a : otherwise.a, x.b > y.b ? if_true.b : otherwise.b};
+}
 inline double lane0(Lanes2 a) { return a.a; }
 inline double lane1(Lanes2 a) { return a.b; }
 inline Lanes2 truncated(Lanes2 a) { return {static_cast<double>(static_cast<int>(a.a)), static_cast<double>(static_cast<int>(a.b))}; }
@@ -179,24 +196,54 @@ inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, dou
     return k;
   };
   const Lanes2 below = lanes(e.u_min, e.n_min);
-  Lanes2 k = floored(below * lanes(inverse_q, inverse_q));
-  k = step_while(k, -1.0, [&](Lanes2 t) { return ones_where_less(below, t * lq); });            // k·q > v
-  k = step_while(k, +1.0, [&](Lanes2 t) { return ones_where_less_equal((t + one) * lq, below); });  // (k + 1)·q ≤ v
   const Lanes2 above = lanes(e.n_max, e.u_max), offset = lanes(0.0, length_m);
+  const auto k_over = [&](Lanes2 t) { return ones_where_less(below, t * lq); };                     // k·q > v
+  const auto k_short = [&](Lanes2 t) { return ones_where_less_equal((t + one) * lq, below); };       // (k + 1)·q ≤ v
+  const auto m_short = [&](Lanes2 t) { return ones_where_less(offset + t * lq, above); };           // short of v
+  const auto m_over = [&](Lanes2 t) { return ones_where_less_equal(above, offset + (t - one) * lq); };  // one less still reaches v
+  Lanes2 k = floored(below * lanes(inverse_q, inverse_q));
   Lanes2 m = ceiled((above - offset) * lanes(inverse_q, inverse_q));
-  m = step_while(m, +1.0, [&](Lanes2 t) { return ones_where_less(offset + t * lq, above); });             // short of v
-  m = step_while(m, -1.0, [&](Lanes2 t) { return ones_where_less_equal(above, offset + (t - one) * lq); });  // one less still reaches v
+  // One test of all four conditions (the guesses are almost always right); the steps only when one holds.
+  if (any(k_over(k) + k_short(k) + m_short(m) + m_over(m))) {
+    k = step_while(step_while(k, -1.0, k_over), +1.0, k_short);
+    m = step_while(step_while(m, +1.0, m_short), -1.0, m_over);
+  }
   const Lanes2 lo = k * lq, hi = offset + m * lq;
   *rebuilt = Extent{lane0(lo), lane1(hi), lane1(lo), lane0(hi)};
   return BoxExtent{static_cast<std::int16_t>(lane0(k)), static_cast<std::int16_t>(lane1(m)), static_cast<std::int16_t>(lane1(k)),
                    static_cast<std::int16_t>(lane0(m))};
 }
 
-// A segment's measured extents, padded, in the frame of Scene::segment_frame; the segment's length [m].
+// A segment's frame (Scene::segment_frame: its unit axis and length [m]) and its measured extents in it,
+// padded [m].
 struct SegmentExtent {
   Extent e;
+  Vec2 axis;
   double length_m = 0.0;
 };
+
+// The frames of segments k = 0 .. count−1 of a level, from points[k] to points[k + 1], into out[k].axis and
+// out[k].length_m: bit for bit Scene::segment_frame's (the same operations per lane), two segments at a
+// time, so that the square roots and divisions of neighbouring segments overlap instead of each box of the
+// box pass waiting on its own.
+void level_frames(const Vec2* points, std::size_t count, SegmentExtent* out) {
+  const Lanes2 tiny = lanes(1e-300, 1e-300), one = lanes(1.0, 1.0), zero = lanes(0.0, 0.0);
+  std::size_t k = 0;
+  for (; k + 1 < count; k += 2) {
+    const Lanes2 p1 = load(points[k + 1]);
+    const Lanes2 d0 = p1 - load(points[k]), d1 = load(points[k + 2]) - p1;  // (dx, dy) of each
+    const Lanes2 dx = low_lanes(d0, d1), dy = high_lanes(d0, d1);          // of both
+    const Lanes2 len = sqrt(dx * dx + dy * dy);
+    const Lanes2 inverse = one / len;
+    const Lanes2 ax = where_greater(len, tiny, dx * inverse, one), ay = where_greater(len, tiny, dy * inverse, zero);
+    const Lanes2 axis0 = low_lanes(ax, ay), axis1 = high_lanes(ax, ay);
+    out[k].axis = Vec2{lane0(axis0), lane1(axis0)};
+    out[k + 1].axis = Vec2{lane0(axis1), lane1(axis1)};
+    out[k].length_m = lane0(len);
+    out[k + 1].length_m = lane1(len);
+  }
+  if (k < count) out[k].axis = Scene::segment_frame(points[k], points[k + 1], &out[k].length_m);
+}
 
 // One node of the scene hierarchy while it is built: the chunk range it covers in leaf order and,
 // for an inner node, the id of its first child (the second is first + 1).
@@ -495,13 +542,13 @@ class SceneBuild {
     const Vec2* orig = src.points_m.data();
     for (int l = 0; l < ci.levels; ++l) {
       level.resize(ci.segment_count[l]);
+      level_frames(scene.points(c, l), ci.segment_count[l], level.data());  // the frames Scene::segment_box() rebuilds
       double worst_sq = 0.0;  // largest squared distance of a level-0 point or original vertex from its level-l segment [m²]
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
         Vec2 a, b;
         scene.segment_points(ci.box_offset[l] + static_cast<std::uint32_t>(k), &a, &b);
         SegmentExtent& se = level[k];
-        const Vec2 axis = Scene::segment_frame(a, b, &se.length_m);  // the frame Scene::segment_box() rebuilds
-        BoxGrower box(a, axis, se.length_m);
+        BoxGrower box(a, se.axis, se.length_m);
         const Vec2 ends[2] = {a, b};
         box.grow(ends, 2);
         for (int j = 1; j < l; ++j) {  // finer levels' points under this segment (level 0 below, with the errors)
