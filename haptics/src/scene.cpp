@@ -75,6 +75,11 @@ inline Lanes2 ones_where_less(Lanes2 a, Lanes2 b) { return {_mm_and_pd(_mm_cmplt
 inline Lanes2 ones_where_less_equal(Lanes2 a, Lanes2 b) { return {_mm_and_pd(_mm_cmple_pd(a.v, b.v), _mm_set1_pd(1.0))}; }
 // Whether a lane of ones_where_*() is 1.
 inline bool any(Lanes2 ones) { return _mm_movemask_pd(_mm_cmpneq_pd(ones.v, _mm_setzero_pd())) != 0; }
+// Whether a < b in some lane, or c ≤ d, or e < f, or g ≤ h.
+inline bool any_less_or_less_equal(Lanes2 a, Lanes2 b, Lanes2 c, Lanes2 d, Lanes2 e, Lanes2 f, Lanes2 g, Lanes2 h) {
+  const __m128d m = _mm_or_pd(_mm_or_pd(_mm_cmplt_pd(a.v, b.v), _mm_cmple_pd(c.v, d.v)), _mm_or_pd(_mm_cmplt_pd(e.v, f.v), _mm_cmple_pd(g.v, h.v)));
+  return _mm_movemask_pd(m) != 0;
+}
 #else
 struct Lanes2 {
   double a, b;
@@ -100,6 +105,9 @@ inline Lanes2 truncated(Lanes2 a) { return {static_cast<double>(static_cast<int>
 inline Lanes2 ones_where_less(Lanes2 a, Lanes2 b) { return {a.a < b.a ? 1.0 : 0.0, a.b < b.b ? 1.0 : 0.0}; }
 inline Lanes2 ones_where_less_equal(Lanes2 a, Lanes2 b) { return {a.a <= b.a ? 1.0 : 0.0, a.b <= b.b ? 1.0 : 0.0}; }
 inline bool any(Lanes2 ones) { return ones.a != 0.0 || ones.b != 0.0; }
+inline bool any_less_or_less_equal(Lanes2 a, Lanes2 b, Lanes2 c, Lanes2 d, Lanes2 e, Lanes2 f, Lanes2 g, Lanes2 h) {
+  return any(ones_where_less(a, b)) || any(ones_where_less_equal(c, d)) || any(ones_where_less(e, f)) || any(ones_where_less_equal(g, h));
+}
 #endif
 
 // Each lane rounded down or up to an integer (|lane| < 2^31), without a branch.
@@ -204,7 +212,7 @@ inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, dou
   Lanes2 k = floored(below * lanes(inverse_q, inverse_q));
   Lanes2 m = ceiled((above - offset) * lanes(inverse_q, inverse_q));
   // One test of all four conditions (the guesses are almost always right); the steps only when one holds.
-  if (any(k_over(k) + k_short(k) + m_short(m) + m_over(m))) {
+  if (any_less_or_less_equal(below, k * lq, (k + one) * lq, below, offset + m * lq, above, above, offset + (m - one) * lq)) {  // the four above
     k = step_while(step_while(k, -1.0, k_over), +1.0, k_short);
     m = step_while(step_while(m, +1.0, m_short), -1.0, m_over);
   }

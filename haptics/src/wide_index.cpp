@@ -52,19 +52,24 @@ Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) {
 float next_float(float f, bool down) {
   if (f == 0.0f) return down ? -std::numeric_limits<float>::denorm_min() : std::numeric_limits<float>::denorm_min();
   const auto bits = std::bit_cast<std::uint32_t>(f);
-  return std::bit_cast<float>((f > 0.0f) == down ? bits - 1u : bits + 1u);  // magnitude down or up
+  return std::bit_cast<float>(bits + 1u - 2u * static_cast<std::uint32_t>((f > 0.0f) == down));  // magnitude down or up
+}
+
+// `if_true` when `pick`, else `otherwise`, by their bits: the nearest float's side of x is a coin toss,
+// which a branch would mispredict half the time.
+float pick_float(bool pick, float if_true, float otherwise) {
+  const auto a = std::bit_cast<std::uint32_t>(if_true), b = std::bit_cast<std::uint32_t>(otherwise);
+  return std::bit_cast<float>(b ^ ((a ^ b) & (0u - static_cast<std::uint32_t>(pick))));
 }
 
 // Largest float not above x, and smallest not below.
 float round_down(double x) {
-  float f = static_cast<float>(x);
-  if (static_cast<double>(f) > x) f = next_float(f, true);
-  return f;
+  const float f = static_cast<float>(x);
+  return pick_float(static_cast<double>(f) > x, next_float(f, true), f);
 }
 float round_up(double x) {
-  float f = static_cast<float>(x);
-  if (static_cast<double>(f) < x) f = next_float(f, false);
-  return f;
+  const float f = static_cast<float>(x);
+  return pick_float(static_cast<double>(f) < x, next_float(f, false), f);
 }
 
 class Builder {
@@ -192,7 +197,7 @@ WideIndex WideIndex::build(const Scene& sc) {
       const Aabb r = item_rect(sc, c, item, k);
       items.push_back(Item{0.5 * (r.lo + r.hi), ci.box_offset[item] + k, static_cast<std::uint32_t>(rects.size())});
       rects.push_back(r);
-      largest = std::max({largest, std::abs(r.lo.x), std::abs(r.lo.y), std::abs(r.hi.x), std::abs(r.hi.y)});
+      largest = std::max(std::max(largest, std::max(std::abs(r.lo.x), std::abs(r.lo.y))), std::max(std::abs(r.hi.x), std::abs(r.hi.y)));
     }
   }
   if (items.empty()) return index;
