@@ -391,6 +391,12 @@ class SceneBuild {
   // Each curve's level plan (plan_levels) and its original's arc table; curves without a model (fewer
   // than 2 points, non-finite, zero length: arc_table's CurveError) are skipped and counted.
   static void plan_curves(Scene& scene, const std::vector<Polyline>& input, int max_levels, OriginalArcs& arcs) {
+    std::size_t arc_entries = 0;
+    for (const Polyline& src : input) arc_entries += src.points_m.size() + 1;  // arc_table_size's most
+    arcs.cum.reserve(arc_entries);
+    arcs.offset.reserve(input.size());
+    scene.curves_.reserve(input.size());
+    scene.source_index_.reserve(input.size());
     for (std::size_t i = 0; i < input.size(); ++i) {
       const Polyline& src = input[i];
       const std::size_t at = arcs.cum.size();
