@@ -46,40 +46,19 @@ constexpr std::size_t kHistBins = 1448;
 
 /// Histogram of floor(sqrt(gx^2 + gy^2)) over the pixels, 1-unit bins, filled row by row.
 /// A zero gradient lands in bin 0, which does not count (a non-zero one has magnitude >= 1).
-///
-/// Magnitudes below `exact_from` (a bin, >= 0) need not be told apart: a block of 8 pixels whose
-/// magnitudes all lie below it is only counted (its non-zero pixels, as if in bin 1), without the
-/// square root and the 8 scattered increments. The counts of bins >= exact_from, the number of
-/// non-zero pixels and so the cumulative count at exact_from - 1 stay exact; so the quantile and
-/// the largest magnitude are exact whenever the quantile's bin is >= exact_from, and otherwise
-/// both stay below exact_from - 0.5 (see detect_edges, which picks exact_from so that such a
-/// quantile cannot change the threshold).
 class MagnitudeHistogram {
  public:
-  explicit MagnitudeHistogram(int exact_from = 0)
-      : exact_from_(std::clamp(exact_from, 0, static_cast<int>(kHistBins))), below_sq_(exact_from_ * exact_from_) {}
-
-  /// The first bin counted exactly (the constructor's argument, clamped to [0, kHistBins]).
-  int exact_from() const { return exact_from_; }
-
   /// Adds one row of n pixels given their squared magnitudes, 8 at a time. Pixel x goes to
   /// partial histogram x % 4, so that runs of equal bins do not wait on each other's increments.
   void add(const std::int32_t* m2, int n) {
     int x = 0;
 #if CV_SIMD128
     const cv::v_int32x4 zero = cv::v_setzero_s32();
-    const cv::v_int32x4 below = cv::v_setall_s32(below_sq_);  // m2 < exact_from^2 <=> bin < exact_from
     const cv::v_uint16x8 last = cv::v_setall_u16(static_cast<std::uint16_t>(kHistBins - 1));
-    cv::v_int32x4 lumped = cv::v_setzero_s32();  // minus the non-zero pixels of lumped blocks, per lane
     for (; x + 8 <= n; x += 8) {
       const cv::v_int32x4 a = cv::v_load(m2 + x);
       const cv::v_int32x4 b = cv::v_load(m2 + x + 4);
-      const cv::v_int32x4 a_low = a < below;
-      const cv::v_int32x4 b_low = b < below;
-      if (cv::v_check_all(a_low & b_low)) {  // flat or weak: count, no bins (masks are -1)
-        lumped += (a != zero) + (b != zero);
-        continue;
-      }
+      if (!cv::v_check_any((a | b) != zero)) continue;  // flat: all in bin 0
       // Exact: m2 < 2^22 is exact in float, and for non-square m2 the distance of sqrt(m2)
       // below the next integer (> 1 / (2 * 1443)) exceeds half a float ulp there (2^-14), so
       // truncating the correctly rounded float square root gives floor(sqrt(m2)), as the
@@ -96,7 +75,6 @@ class MagnitudeHistogram {
       ++part_[2][cv::v_extract_n<6>(bins)];
       ++part_[3][cv::v_extract_n<7>(bins)];
     }
-    lumped_ -= cv::v_reduce_sum(lumped);
 #endif
     for (; x < n; ++x) {
       if (m2[x] == 0) continue;
@@ -109,7 +87,7 @@ class MagnitudeHistogram {
     if (pending_ > (std::int64_t{1} << 30)) flush();
   }
 
-  /// Adds the counts of another histogram (of other pixels, with the same exact_from).
+  /// Adds the counts of another histogram (of other pixels).
   void merge(MagnitudeHistogram& other) {
     other.flush();
     flush();
@@ -147,16 +125,11 @@ class MagnitudeHistogram {
       for (std::size_t b = 0; b < kHistBins; ++b) hist_[b] += h[b];
       h.fill(0);
     }
-    hist_[1] += lumped_;
-    lumped_ = 0;
     pending_ = 0;
   }
 
-  int exact_from_;
-  std::int32_t below_sq_;  // exact_from^2
   std::array<std::array<std::uint32_t, kHistBins>, 4> part_{};
   std::array<std::int64_t, kHistBins> hist_{};
-  std::int64_t lumped_ = 0;  // non-zero pixels of lumped blocks since the last flush
   std::int64_t pending_ = 0;
 };
 
@@ -228,8 +201,7 @@ void sobel_3x3(const cv::Mat& src, cv::Mat& dx, cv::Mat& dy, MagnitudeHistogram*
   dx.create(h, w, CV_16SC1);
   dy.create(h, w, CV_16SC1);
   const int n = stripe_count(h, w);
-  std::vector<MagnitudeHistogram> part(hist != nullptr ? static_cast<std::size_t>(n) : 0,
-                                       MagnitudeHistogram(hist != nullptr ? hist->exact_from() : 0));
+  std::vector<MagnitudeHistogram> part(hist != nullptr ? static_cast<std::size_t>(n) : 0);
   for_each_stripe(n, h, [&](int stripe, int y0, int y1) {
     std::vector<std::int32_t> m2(hist != nullptr ? static_cast<std::size_t>(w) : 0);
     for (int y = y0; y < y1; ++y) {
@@ -606,19 +578,15 @@ EdgeMap detect_edges(const cv::Mat& grey, const EdgeParams& p) {
     sobel_3x3(blurred, dx, dy, nullptr);
     out.high = p.canny_high;
   } else {
+    MagnitudeHistogram hist;
+    sobel_3x3(blurred, dx, dy, &hist);
     // Pure noise gives a Rayleigh-distributed magnitude with scale sigma_noise * gain, which
     // exceeds kNoiseSigmas scales with probability exp(-kNoiseSigmas^2 / 2) = 4e-6.
     const double noise_floor = kNoiseSigmas * noise_sigma(grey) * gradient_noise_gain(p.blur_sigma_px);
-    const double high_floor = std::max(noise_floor, kMinAutoHigh);
-    // A quantile in a bin b < high_floor + 1.5 is b - 0.5 <= high_floor and loses to it below, so
-    // such bins need not be told apart (MagnitudeHistogram's exact_from); the high threshold is
-    // the same as from the exact histogram.
-    MagnitudeHistogram hist(static_cast<int>(std::min(std::floor(high_floor + 1.5), static_cast<double>(kHistBins))));
-    sobel_3x3(blurred, dx, dy, &hist);
     // On images with few, clean edges (logos, silhouettes) the quantile sits at the strongest
     // edge; an edge half as strong as the strongest one is still a sure edge.
     const GradientStats st = hist.stats();
-    out.high = std::max(std::min(st.percentile, kMaxFraction * st.max), high_floor);
+    out.high = std::max({std::min(st.percentile, kMaxFraction * st.max), noise_floor, kMinAutoHigh});
   }
   out.low = p.canny_low > 0.0 ? p.canny_low : kLowRatio * out.high;
   if (out.low > out.high) std::swap(out.low, out.high);  // as cv::Canny does; report what it used
