@@ -201,7 +201,10 @@ void sobel_3x3(const cv::Mat& src, cv::Mat& dx, cv::Mat& dy, MagnitudeHistogram*
   dx.create(h, w, CV_16SC1);
   dy.create(h, w, CV_16SC1);
   const int n = stripe_count(h, w);
-  std::vector<MagnitudeHistogram> part(hist != nullptr ? static_cast<std::size_t>(n) : 0);
+  // A histogram of its own per stripe, merged at the end; with one stripe (images of fewer than 2 * 2^17
+  // pixels, or one thread) the pixels go straight into `hist` (each histogram is 35 KB to clear, flush
+  // and merge).
+  std::vector<MagnitudeHistogram> part(hist != nullptr && n > 1 ? static_cast<std::size_t>(n) : 0);
   for_each_stripe(n, h, [&](int stripe, int y0, int y1) {
     std::vector<std::int32_t> m2(hist != nullptr ? static_cast<std::size_t>(w) : 0);
     for (int y = y0; y < y1; ++y) {
@@ -237,7 +240,7 @@ void sobel_3x3(const cv::Mat& src, cv::Mat& dx, cv::Mat& dy, MagnitudeHistogram*
       for (; x < w; ++x) scalar(x);
       if (hist != nullptr) {
         squared_magnitudes(gx, gy, w, m2.data());
-        part[static_cast<std::size_t>(stripe)].add(m2.data(), w);
+        (n > 1 ? part[static_cast<std::size_t>(stripe)] : *hist).add(m2.data(), w);
       }
     }
   });
