@@ -70,16 +70,17 @@ inline double lane0(Lanes2 a) { return _mm_cvtsd_f64(a.v); }
 inline double lane1(Lanes2 a) { return _mm_cvtsd_f64(_mm_unpackhi_pd(a.v, a.v)); }
 // Each lane rounded toward zero (|lane| < 2^31).
 inline Lanes2 truncated(Lanes2 a) { return {_mm_cvtepi32_pd(_mm_cvttpd_epi32(a.v))}; }
-// 1 in each lane where a < b (ones_where_less) or a ≤ b (ones_where_less_equal), else 0.
-inline Lanes2 ones_where_less(Lanes2 a, Lanes2 b) { return {_mm_and_pd(_mm_cmplt_pd(a.v, b.v), _mm_set1_pd(1.0))}; }
-inline Lanes2 ones_where_less_equal(Lanes2 a, Lanes2 b) { return {_mm_and_pd(_mm_cmple_pd(a.v, b.v), _mm_set1_pd(1.0))}; }
-// Whether a lane of ones_where_*() is 1.
-inline bool any(Lanes2 ones) { return _mm_movemask_pd(_mm_cmpneq_pd(ones.v, _mm_setzero_pd())) != 0; }
-// Whether a < b in some lane, or c ≤ d, or e < f, or g ≤ h.
-inline bool any_less_or_less_equal(Lanes2 a, Lanes2 b, Lanes2 c, Lanes2 d, Lanes2 e, Lanes2 f, Lanes2 g, Lanes2 h) {
-  const __m128d m = _mm_or_pd(_mm_or_pd(_mm_cmplt_pd(a.v, b.v), _mm_cmple_pd(c.v, d.v)), _mm_or_pd(_mm_cmplt_pd(e.v, f.v), _mm_cmple_pd(g.v, h.v)));
-  return _mm_movemask_pd(m) != 0;
-}
+// Which lanes of a comparison hold: a < b (where_less) or a ≤ b (where_less_equal); `|` joins two.
+struct Mask2 {
+  __m128d v;
+};
+inline Mask2 where_less(Lanes2 a, Lanes2 b) { return {_mm_cmplt_pd(a.v, b.v)}; }
+inline Mask2 where_less_equal(Lanes2 a, Lanes2 b) { return {_mm_cmple_pd(a.v, b.v)}; }
+inline Mask2 operator|(Mask2 a, Mask2 b) { return {_mm_or_pd(a.v, b.v)}; }
+// Whether it holds in some lane.
+inline bool any(Mask2 m) { return _mm_movemask_pd(m.v) != 0; }
+// 1 in each lane where it holds, else 0.
+inline Lanes2 ones(Mask2 m) { return {_mm_and_pd(m.v, _mm_set1_pd(1.0))}; }
 #else
 struct Lanes2 {
   double a, b;
@@ -102,22 +103,24 @@ inline Lanes2 where_greater(Lanes2 x, Lanes2 y, Lanes2 if_true, Lanes2 otherwise
 inline double lane0(Lanes2 a) { return a.a; }
 inline double lane1(Lanes2 a) { return a.b; }
 inline Lanes2 truncated(Lanes2 a) { return {static_cast<double>(static_cast<int>(a.a)), static_cast<double>(static_cast<int>(a.b))}; }
-inline Lanes2 ones_where_less(Lanes2 a, Lanes2 b) { return {a.a < b.a ? 1.0 : 0.0, a.b < b.b ? 1.0 : 0.0}; }
-inline Lanes2 ones_where_less_equal(Lanes2 a, Lanes2 b) { return {a.a <= b.a ? 1.0 : 0.0, a.b <= b.b ? 1.0 : 0.0}; }
-inline bool any(Lanes2 ones) { return ones.a != 0.0 || ones.b != 0.0; }
-inline bool any_less_or_less_equal(Lanes2 a, Lanes2 b, Lanes2 c, Lanes2 d, Lanes2 e, Lanes2 f, Lanes2 g, Lanes2 h) {
-  return any(ones_where_less(a, b)) || any(ones_where_less_equal(c, d)) || any(ones_where_less(e, f)) || any(ones_where_less_equal(g, h));
-}
+struct Mask2 {
+  bool a, b;
+};
+inline Mask2 where_less(Lanes2 a, Lanes2 b) { return {a.a < b.a, a.b < b.b}; }
+inline Mask2 where_less_equal(Lanes2 a, Lanes2 b) { return {a.a <= b.a, a.b <= b.b}; }
+inline Mask2 operator|(Mask2 a, Mask2 b) { return {a.a || b.a, a.b || b.b}; }
+inline bool any(Mask2 m) { return m.a || m.b; }
+inline Lanes2 ones(Mask2 m) { return {m.a ? 1.0 : 0.0, m.b ? 1.0 : 0.0}; }
 #endif
 
 // Each lane rounded down or up to an integer (|lane| < 2^31), without a branch.
 inline Lanes2 floored(Lanes2 a) {
   const Lanes2 t = truncated(a);
-  return t - ones_where_less(a, t);
+  return t - ones(where_less(a, t));
 }
 inline Lanes2 ceiled(Lanes2 a) {
   const Lanes2 t = truncated(a);
-  return t + ones_where_less(t, a);
+  return t + ones(where_less(t, a));
 }
 
 // A segment's frame for the box pass and what the pass grows in it: the extent of the points seen,
@@ -198,21 +201,21 @@ constexpr double kQuantumSteps = 32000.0;
 // Writes the box's extents as segment_box() rebuilds them to *rebuilt.
 inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, double inverse_q, Extent* rebuilt) {
   const Lanes2 lq = lanes(q, q), one = lanes(1.0, 1.0);
-  // Adds `step` (±1) to the lanes of k where too(k) is 1, until it is 1 in none.
+  // Adds `step` (±1) to the lanes of k where too(k) holds, until it holds in none.
   const auto step_while = [](Lanes2 k, double step, auto too) {
-    for (Lanes2 s = too(k); any(s); s = too(k)) k = k + s * lanes(step, step);
+    for (Mask2 s = too(k); any(s); s = too(k)) k = k + ones(s) * lanes(step, step);
     return k;
   };
   const Lanes2 below = lanes(e.u_min, e.n_min);
   const Lanes2 above = lanes(e.n_max, e.u_max), offset = lanes(0.0, length_m);
-  const auto k_over = [&](Lanes2 t) { return ones_where_less(below, t * lq); };                     // k·q > v
-  const auto k_short = [&](Lanes2 t) { return ones_where_less_equal((t + one) * lq, below); };       // (k + 1)·q ≤ v
-  const auto m_short = [&](Lanes2 t) { return ones_where_less(offset + t * lq, above); };           // short of v
-  const auto m_over = [&](Lanes2 t) { return ones_where_less_equal(above, offset + (t - one) * lq); };  // one less still reaches v
+  const auto k_over = [&](Lanes2 t) { return where_less(below, t * lq); };                     // k·q > v
+  const auto k_short = [&](Lanes2 t) { return where_less_equal((t + one) * lq, below); };       // (k + 1)·q ≤ v
+  const auto m_short = [&](Lanes2 t) { return where_less(offset + t * lq, above); };           // short of v
+  const auto m_over = [&](Lanes2 t) { return where_less_equal(above, offset + (t - one) * lq); };  // one less still reaches v
   Lanes2 k = floored(below * lanes(inverse_q, inverse_q));
   Lanes2 m = ceiled((above - offset) * lanes(inverse_q, inverse_q));
   // One test of all four conditions (the guesses are almost always right); the steps only when one holds.
-  if (any_less_or_less_equal(below, k * lq, (k + one) * lq, below, offset + m * lq, above, above, offset + (m - one) * lq)) {  // the four above
+  if (any(k_over(k) | k_short(k) | m_short(m) | m_over(m))) {
     k = step_while(step_while(k, -1.0, k_over), +1.0, k_short);
     m = step_while(step_while(m, +1.0, m_short), -1.0, m_over);
   }
