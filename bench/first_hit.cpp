@@ -2,6 +2,7 @@
 // our collision tree with its boundary section, by brute force, by a Boost.Geometry R-tree and by Embree
 // (bench/support/embree_peer.hpp); results checked equal before anything is timed. One benchmark iteration is one query, timed on its own (manual time), so
 // the mean and the percentiles describe the same measurements; each includes ~25–40 ns of clock reads.
+// net_mean_ns is the per-query mean less the clock's cost (clock_ns, measured in the same benchmark);
 // batch_mean_ns gives the mean again without them (blocks of queries timed as a whole).
 //
 // Methods: ours (first_hit: boundary section, free-space ball, anytime answers at a coarser level),
@@ -11,7 +12,7 @@
 //        BM_Closest/<method>/<segments>   — closest point on the same scenes
 //        BM_Picture/<method>/<picture>    — the handle sweeps of an explore raster run on that picture
 //        BM_Level/<method>/<level>        — speed against accuracy: 4 pictures, queries at each level
-// Counters: p50_ns, p99_ns, max_ns per query; batch_mean_ns (not for brute); build_ms; bytes_per_segment; segments; max_error_mm; for
+// Counters: p50_ns, p99_ns, max_ns per query; clock_ns, net_mean_ns; batch_mean_ns (not for brute); build_ms; bytes_per_segment; segments; max_error_mm; for
 //           ours and ours_wide, full_query_fraction (queries the free-space ball did not answer),
 //           section_entries (mean boundary-section size after a query; 0 for ours_wide), box_tests and
 //           segment_tests (per query).
@@ -169,6 +170,36 @@ double batch_mean_ns(std::size_t stream_size, double per_query_mean_ns, Query&& 
   return best;
 }
 
+// The mean cost of timing one query on its own [ns]: an empty region timed exactly as run_first_hit and
+// run_closest time a query (two steady_clock reads and a subtraction), 2^16 regions, the smallest mean of
+// three rounds (so the net mean below errs high, against us). Each per-query time carries it once, and the
+// mean is linear: the per-query mean less it is the queries' own mean, which batch_mean_ns measures
+// another way (no clock read inside the block at all).
+double clock_overhead_ns() {
+  constexpr int kRegions = 1 << 16;
+  double best = std::numeric_limits<double>::infinity();
+  for (int round = 0; round < 3; ++round) {
+    double total_s = 0.0;
+    for (int i = 0; i < kRegions; ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      total_s += dt;
+      benchmark::DoNotOptimize(total_s);
+    }
+    best = std::min(best, total_s * 1e9 / kRegions);
+  }
+  return best;
+}
+
+// The clock_ns and net_mean_ns counters of a benchmark whose timed queries took total_s in all [s]:
+// the clock's own cost per timed query, and the per-query mean less it [ns].
+void set_net_mean(benchmark::State& state, double total_s) {
+  const double mean_ns = total_s * 1e9 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+  const double clock_ns = clock_overhead_ns();
+  state.counters["clock_ns"] = clock_ns;
+  state.counters["net_mean_ns"] = mean_ns - clock_ns;
+}
+
 // The batch_mean_ns counter of a benchmark whose timed queries took total_s in all [s]; not for brute
 // force (at 10^6 segments its blocks would take minutes).
 template <class Query>
@@ -201,6 +232,7 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     benchmark::DoNotOptimize(hit);
   }
   set_percentiles(state, ns);
+  set_net_mean(state, total_s);
   set_batch_mean(state, c, m, total_s, [&](std::size_t k) { benchmark::DoNotOptimize(first_hit_once(c, m, c->stream[k], nullptr)); });
   if (m == Method::Ours || m == Method::Wide) {
     const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
@@ -266,6 +298,7 @@ void run_closest(benchmark::State& state, Case* c, Method m) {
     benchmark::DoNotOptimize(d);
   }
   set_percentiles(state, ns);
+  set_net_mean(state, total_s);
   set_batch_mean(state, c, m, total_s, [&](std::size_t k) { benchmark::DoNotOptimize(closest_once(c, m, c->stream[k].b, nullptr)); });
   state.counters["segments"] = static_cast<double>(c->segs.size());
   if (m == Method::Ours) {
