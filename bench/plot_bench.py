@@ -384,8 +384,17 @@ if size_rows:
             meds[-1][0], ", ".join("%.3f" % m for _, m in meds), yes(all(m <= 1.05 for _, m in meds))))
     if TOLERANCE_CUT:
         worst = TOLERANCE_CUT["worst"]
-        rows2.append("| tolerance cut: ≤ 1.2x Douglas–Peucker's vertices for the same max error, every picture | worst joined cut / DP per target error: %s | %s |" % (
-            ", ".join("%.2f at %.1f mm" % (w["worst_ratio"], w["tolerance_mm"]) for w in worst), yes(all(w["worst_ratio"] <= 1.2 for w in worst))))
+        # The traced polygons (absent in older runs): sharp corners alone, where the dyadic smoothing's limit shows.
+        polys = TOLERANCE_CUT.get("polygons", [])
+        poly_txt = ""
+        if polys:
+            by_shape = {}
+            for r in polys:
+                by_shape.setdefault(r["polygon"], []).append(r["ratio"])
+            poly_txt = "; traced polygons (corners only; DP keeps exactly the corners): %s, so not reachable by a cut through this tree" % ", ".join(
+                "%s %.1f–%.1fx" % (n, min(v), max(v)) for n, v in by_shape.items())
+        rows2.append("| tolerance cut: ≤ 1.2x Douglas–Peucker's vertices for the same max error, every picture | worst joined cut / DP per target error: %s%s | %s |" % (
+            ", ".join("%.2f at %.1f mm" % (w["worst_ratio"], w["tolerance_mm"]) for w in worst), poly_txt, yes(all(w["worst_ratio"] <= 1.2 for w in worst))))
         if all("worst_curve_levels_ratio" in w for w in worst):
             rows2.append("| the level policy may pick a tolerance, no crossings at changes | built at curve granularity (`level_mode = \"tolerance\"`: each curve at the coarsest of its levels within the step; "
                          "crossings 0 in the level-change test on six pictures); worst vertices / DP per target error: %s; the per-segment cut is not queried yet | "
