@@ -107,5 +107,39 @@ TEST(SceneChains, InvalidSettingsAreRefused) {
   EXPECT_THROW(scene_chains(file, ExtractParams{}, p, points_cost), std::invalid_argument);
 }
 
+// chains_to_curves keeps a chain exactly when its length in metres is not below the minimum: at the
+// minimum it stays, a pixel short it goes, a closed chain's closing segment counts, and a kept chain keeps
+// every point. Lengths are exact here (2^-12 m per pixel, integer pixels), so the boundary is sharp.
+TEST(SceneChains, ChainsToCurvesKeepsExactlyTheChainsNotShorterThanTheMinimum) {
+  const double scale = std::ldexp(1.0, -12);  // [m/px], exact in binary
+  const PxToM map{scale, 0.0, 0.0};
+  const double min_m = 8 * scale;
+  const auto straight = [](int px) {
+    Chain c;
+    for (int u = 0; u <= px; ++u) c.points_px.emplace_back(u, 0);
+    return c;
+  };
+  const auto rectangle = [](int w) {  // w x 1 px, closed: w + 1 + w open, 1 closing
+    Chain c;
+    c.closed = true;
+    c.points_px = {{0, 0}, {static_cast<double>(w), 0}, {static_cast<double>(w), 1}, {0, 1}};
+    return c;
+  };
+  const std::vector<Chain> chains = {straight(8), straight(7), rectangle(3), rectangle(2), straight(1000)};
+  const PointValues strengths = {{1.0, 3.0}, {}, {}, {}, {5.0}};
+  std::size_t too_short = 0;
+  const std::vector<SceneCurve> kept = chains_to_curves(chains, strengths, map, min_m, &too_short);
+  ASSERT_EQ(kept.size(), 3u);  // 8 px (at the minimum), the 3 x 1 rectangle (7 + 1 closing), 1000 px
+  EXPECT_EQ(too_short, 2u);    // 7 px, and the 2 x 1 rectangle (5 + 1 closing)
+  EXPECT_EQ(kept[0].points_m.size(), 9u);
+  EXPECT_DOUBLE_EQ(kept[0].strength, 2.0);
+  EXPECT_TRUE(kept[1].closed);
+  EXPECT_EQ(kept[1].points_m.size(), 4u);
+  ASSERT_EQ(kept[2].points_m.size(), 1001u);
+  EXPECT_EQ(kept[2].points_m.back(), cv::Point2d(1000 * scale, 0.0));
+  EXPECT_DOUBLE_EQ(kept[2].strength, 5.0);
+  for (const SceneCurve& c : kept) EXPECT_GE(curve_length_m(c), min_m);
+}
+
 }  // namespace
 }  // namespace hk::vision

@@ -22,6 +22,24 @@ double curve_length_m(const SceneCurve& c) {
   return l;
 }
 
+namespace {
+
+// !(curve_length_m(c) < min_length_m), the same decision bit for bit, without measuring past the point
+// where it is settled: the length is a sum of non-negative terms added in the same order, so once a partial
+// sum is not below the minimum the whole is not either (floating-point addition of non-negatives never
+// decreases, and a NaN, once in, stays).
+bool reaches_length_m(const SceneCurve& c, double min_length_m) {
+  double l = 0.0;
+  for (std::size_t i = 1; i < c.points_m.size(); ++i) {
+    l += cv::norm(c.points_m[i] - c.points_m[i - 1]);
+    if (!(l < min_length_m)) return true;
+  }
+  if (c.closed && c.points_m.size() > 1) l += cv::norm(c.points_m.front() - c.points_m.back());
+  return !(l < min_length_m);
+}
+
+}  // namespace
+
 double enclosed_area_m2(const std::vector<cv::Point2d>& points_m) {
   const std::size_t n = points_m.size();
   if (n < 3) return 0.0;
@@ -68,7 +86,7 @@ std::vector<SceneCurve> chains_to_curves(const std::vector<Chain>& chains, const
     c.closed = chains[k].closed;
     c.points_m.reserve(chains[k].points_px.size());
     for (const cv::Point2d& q : chains[k].points_px) c.points_m.emplace_back(map.x_m(q.x), map.y_m(q.y));
-    if (curve_length_m(c) < min_length_m) {
+    if (!reaches_length_m(c, min_length_m)) {
       ++dropped;
       continue;
     }
