@@ -126,6 +126,47 @@ TEST(CollisionTree, BoxesContainOriginalsAndChildren) {
   }
 }
 
+// The box pass reads each level's originals in as many steps as the most any segment holds, except where
+// the vertices bunch up (then each segment takes its own count): both must hold every original vertex, and
+// the measured error must cover each one's distance from its segment. Curves: a long straight edge of two
+// vertices running into a tight curl of 600 (one level-0 segment holds hundreds), the same closed, and a
+// straight run whose vertices fall exactly on the level-0 points (3·2^6 segments of 2^-10 m: every arc
+// length exact, so every vertex sits where the rounding of its segment's guess can tip either way).
+TEST(CollisionTree, BoxesContainOriginalsWhereVerticesBunchUpOrSitOnLevelZeroPoints) {
+  Polyline curl;
+  curl.points_m.push_back({-0.06, 0.0});
+  for (int i = 0; i < 600; ++i) {
+    const double t = 0.05 * i;
+    curl.points_m.push_back({0.02 + 0.0002 * std::sin(t) * (1.0 + 0.001 * i), 0.0002 * (1.0 - std::cos(t))});
+  }
+  Polyline closed_curl = curl;
+  closed_curl.closed = true;
+  Polyline exact;
+  for (int i = 0; i <= 3 * 64; ++i) exact.points_m.push_back({std::ldexp(i, -10), 0.0});
+  const std::vector<Polyline> curves{curl, closed_curl, exact};
+  const Scene sc = Scene::build(curves, 6);
+  ASSERT_EQ(sc.curve_count(), 3u);
+  check_containment(sc, curves);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    const Polyline& src = curves[c];
+    const CurveMultires m = build_multires(src, ci.levels - 1);
+    double arc = 0.0;
+    std::size_t k = 0;
+    for (std::size_t j = 0; j < src.points_m.size(); ++j) {
+      if (j > 0) arc += distance(src.points_m[j - 1], src.points_m[j]);
+      while (k + 1 < ci.segment_count[0] && m.arc_m[k + 1] <= arc) ++k;
+      for (int l = 0; l < ci.levels; ++l) {
+        Vec2 a, b;
+        sc.segment({static_cast<int>(c), l, static_cast<int>(k >> l)}, &a, &b);
+        ASSERT_LE(distance_to_segment(src.points_m[j], a, b), ci.max_error_m[l] * (1.0 + 1e-12) + 1e-15) << "curve " << c << " vertex " << j << " level " << l;
+      }
+    }
+  }
+  // The straight run: level 0 is the original itself, so nothing deviates from it.
+  EXPECT_EQ(sc.curve(2).max_error_m[0], 0.0);
+}
+
 // Issue 18: a box is no wider than it must be. For every segment box, the true deviation of the original
 // under it (the largest distance of an original vertex or level-0 point under it from the segment's
 // line, found here by arc length, not through the tree) against the box half-width: never below it
