@@ -22,6 +22,8 @@ taskset -c 1 "$b/bench_first_hit" $quick --benchmark_min_time=$min_time --benchm
 # Five runs of each picture and method, one after the other; plot_bench.py keeps each one's fastest, the
 # run least disturbed by the shared machine's slow spells. (Not randomly interleaved: switching pictures
 # between runs makes every run resize the per-thread buffers, which is not the steady state measured.)
+# BM_SceneBuildPaired/<picture> runs ours and both OpenCV variants side by side, one build of each in turn,
+# and gives each one's fastest single build: the three sample the same moments of the machine.
 taskset -c 1 "$b/bench_scene_build" --benchmark_min_time=$(awk "BEGIN { print $min_time / 5 }") --benchmark_repetitions=5 \
   --benchmark_out="$out/scene_build.json" --benchmark_out_format=json >/dev/null
 "$b/bench_detectors" --benchmark_min_time=$min_time --benchmark_out="$out/detectors.json" --benchmark_out_format=json >/dev/null
