@@ -41,29 +41,76 @@ std::vector<Picture>& pictures() {
   return v;
 }
 
-void build_ours(benchmark::State& state, const Picture* p) {
-  const config::Settings s;
+// Our pipeline once, from the grey image to the scene, with its phases' times [ms].
+struct OursRun {
+  double edges_ms = 0.0, linking_ms = 0.0, curves_ms = 0.0;
+  std::size_t segments = 0;
+  SceneBuildTimes scene_times;
+};
+OursRun run_ours(const Picture& p, const config::Settings& s, const vision::EdgeParams& ep) {
+  OursRun r;
+  const auto t0 = Clock::now();
+  const vision::EdgeMap em = vision::detect_edges(p.grey, ep);
+  const auto t1 = Clock::now();
+  const auto chains = vision::link_edges(em.edges, 2.0);
+  const auto t2 = Clock::now();
+  const vision::PxToM map = vision::fit_to_workspace(p.grey.cols, p.grey.rows, s.workspace.width_m, s.workspace.height_m);
+  const std::vector<Polyline> curves = app::to_polylines(vision::chains_to_curves(chains, {}, map, s.vision.min_chain_length_m));
+  const auto t3 = Clock::now();
+  const Scene scene = Scene::build(curves, s.haptics.max_levels);
+  benchmark::DoNotOptimize(scene.node_count());
+  r.segments = scene.total_segments(0);
+  r.scene_times = scene.build_times();
+  r.edges_ms = ms(t0, t1);
+  r.linking_ms = ms(t1, t2);
+  r.curves_ms = ms(t2, t3);
+  return r;
+}
+
+// OpenCV's pipeline once: GaussianBlur (sigma, `border`) + Canny (low, high, L2) + findContours, with its
+// phases' times [ms].
+struct OpenCvRun {
+  double blur_ms = 0.0, canny_ms = 0.0, contours_ms = 0.0;
+  std::size_t contours = 0;
+};
+OpenCvRun run_opencv(const cv::Mat& grey, double sigma, double low, double high, int border) {
+  OpenCvRun r;
+  const auto t0 = Clock::now();
+  cv::Mat blurred, edges;
+  cv::GaussianBlur(grey, blurred, cv::Size(0, 0), sigma, sigma, border);
+  const auto t1 = Clock::now();
+  cv::Canny(blurred, edges, low, high, 3, true);
+  const auto t2 = Clock::now();
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(edges, contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
+  benchmark::DoNotOptimize(contours.data());
+  const auto t3 = Clock::now();
+  r.contours = contours.size();
+  r.blur_ms = ms(t0, t1);
+  r.canny_ms = ms(t1, t2);
+  r.contours_ms = ms(t2, t3);
+  return r;
+}
+
+vision::EdgeParams edge_params(const config::Settings& s) {
   vision::EdgeParams ep;
   ep.blur_sigma_px = s.vision.blur_sigma_px;
+  return ep;
+}
+
+void build_ours(benchmark::State& state, const Picture* p) {
+  const config::Settings s;
+  const vision::EdgeParams ep = edge_params(s);
   std::size_t segments = 0;
   double edges_ms = 0.0, linking_ms = 0.0, curves_ms = 0.0, multires_ms = 0.0, tree_ms = 0.0;  // summed over iterations
   for (auto _ : state) {
-    const auto t0 = Clock::now();
-    const vision::EdgeMap em = vision::detect_edges(p->grey, ep);
-    const auto t1 = Clock::now();
-    const auto chains = vision::link_edges(em.edges, 2.0);
-    const auto t2 = Clock::now();
-    const vision::PxToM map = vision::fit_to_workspace(p->grey.cols, p->grey.rows, s.workspace.width_m, s.workspace.height_m);
-    const std::vector<Polyline> curves = app::to_polylines(vision::chains_to_curves(chains, {}, map, s.vision.min_chain_length_m));
-    const auto t3 = Clock::now();
-    const Scene scene = Scene::build(curves, s.haptics.max_levels);
-    segments = scene.total_segments(0);
-    benchmark::DoNotOptimize(scene.node_count());
-    edges_ms += ms(t0, t1);
-    linking_ms += ms(t1, t2);
-    curves_ms += ms(t2, t3);
-    multires_ms += scene.build_times().multires_ms;
-    tree_ms += scene.build_times().tree_ms;
+    const OursRun r = run_ours(*p, s, ep);
+    segments = r.segments;
+    edges_ms += r.edges_ms;
+    linking_ms += r.linking_ms;
+    curves_ms += r.curves_ms;
+    multires_ms += r.scene_times.multires_ms;
+    tree_ms += r.scene_times.tree_ms;
   }
   state.counters["segments"] = static_cast<double>(segments);
   // Where the time goes, mean per build [ms]: edges (blur + Canny), linking, chains to curves in metres,
@@ -76,45 +123,28 @@ void build_ours(benchmark::State& state, const Picture* p) {
   state.counters["tree_ms"] = tree_ms / n;
 }
 
+// OpenCV with the issue-3 yardstick's fixed thresholds 50/150 and its default border.
 void build_opencv(benchmark::State& state, const Picture* p) {
   const double sigma = config::Settings{}.vision.blur_sigma_px;
   std::size_t contours_out = 0;
-  for (auto _ : state) {
-    cv::Mat blurred, edges;
-    cv::GaussianBlur(p->grey, blurred, cv::Size(0, 0), sigma);
-    cv::Canny(blurred, edges, 50, 150, 3, true);
-    std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(edges, contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
-    contours_out = contours.size();
-    benchmark::DoNotOptimize(contours.data());
-  }
+  for (auto _ : state) contours_out = run_opencv(p->grey, sigma, 50, 150, cv::BORDER_DEFAULT).contours;
   state.counters["contours"] = static_cast<double>(contours_out);
 }
 
 // The same OpenCV calls with the Canny thresholds our detector chose for the picture (computed once,
-// outside the timing): both sides then find the same edge pixels, so the ratio compares the work after
-// them rather than how many edges fixed thresholds happen to find (issue 18).
+// outside the timing) and our blur's border: both sides then find the same edge pixels, so the ratio
+// compares the work after them rather than how many edges fixed thresholds happen to find (issue 18).
 void build_opencv_same_edges(benchmark::State& state, const Picture* p) {
-  const config::Settings s;
-  vision::EdgeParams ep;
-  ep.blur_sigma_px = s.vision.blur_sigma_px;
+  const vision::EdgeParams ep = edge_params(config::Settings{});
   const vision::EdgeMap chosen = vision::detect_edges(p->grey, ep);
   std::size_t contours_out = 0;
   double blur_ms = 0.0, canny_ms = 0.0, contours_ms = 0.0;  // summed over iterations
   for (auto _ : state) {
-    const auto t0 = Clock::now();
-    cv::Mat blurred, edges;
-    cv::GaussianBlur(p->grey, blurred, cv::Size(0, 0), ep.blur_sigma_px, ep.blur_sigma_px, cv::BORDER_REPLICATE);
-    const auto t1 = Clock::now();
-    cv::Canny(blurred, edges, chosen.low, chosen.high, 3, true);
-    const auto t2 = Clock::now();
-    std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(edges, contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
-    contours_out = contours.size();
-    benchmark::DoNotOptimize(contours.data());
-    blur_ms += ms(t0, t1);
-    canny_ms += ms(t1, t2);
-    contours_ms += ms(t2, Clock::now());
+    const OpenCvRun r = run_opencv(p->grey, ep.blur_sigma_px, chosen.low, chosen.high, cv::BORDER_REPLICATE);
+    contours_out = r.contours;
+    blur_ms += r.blur_ms;
+    canny_ms += r.canny_ms;
+    contours_ms += r.contours_ms;
   }
   state.counters["contours"] = static_cast<double>(contours_out);
   // Its phases, mean per build [ms]: to set beside ours (edges = blur + Canny; linking against findContours).
@@ -128,37 +158,20 @@ void build_opencv_same_edges(benchmark::State& state, const Picture* p) {
 // single build [ms] as counters (issue 18). Runs of separate benchmarks sample the shared machine at
 // different moments, and a repetition's mean carries every disturbance within it; here the three sample
 // the same moments, and the fastest build of each is the one least disturbed, so the ratios of the fastest
-// builds compare the work itself. Same pipelines as build_ours, build_opencv and build_opencv_same_edges.
+// builds compare the work itself.
 void build_paired(benchmark::State& state, const Picture* p) {
   const config::Settings s;
-  vision::EdgeParams ep;
-  ep.blur_sigma_px = s.vision.blur_sigma_px;
+  const vision::EdgeParams ep = edge_params(s);
   const vision::EdgeMap chosen = vision::detect_edges(p->grey, ep);
-  const vision::PxToM map = vision::fit_to_workspace(p->grey.cols, p->grey.rows, s.workspace.width_m, s.workspace.height_m);
-  const auto ours = [&] {
-    const vision::EdgeMap em = vision::detect_edges(p->grey, ep);
-    const auto chains = vision::link_edges(em.edges, 2.0);
-    const std::vector<Polyline> curves = app::to_polylines(vision::chains_to_curves(chains, {}, map, s.vision.min_chain_length_m));
-    const Scene scene = Scene::build(curves, s.haptics.max_levels);
-    benchmark::DoNotOptimize(scene.node_count());
-  };
-  const auto opencv = [&](double low, double high, int border) {
-    cv::Mat blurred, edges;
-    cv::GaussianBlur(p->grey, blurred, cv::Size(0, 0), ep.blur_sigma_px, ep.blur_sigma_px, border);
-    cv::Canny(blurred, edges, low, high, 3, true);
-    std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(edges, contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
-    benchmark::DoNotOptimize(contours.data());
-  };
   double fastest[3] = {1e300, 1e300, 1e300};  // ours, OpenCV 50/150, OpenCV with our thresholds [ms]
   std::size_t turn = 0;
   for (auto _ : state) {
     for (std::size_t k = 0; k < 3; ++k) {
       const std::size_t which = (turn + k) % 3;
-      const auto t0 = Clock::now();
-      if (which == 0) ours();
-      if (which == 1) opencv(50, 150, cv::BORDER_DEFAULT);
-      if (which == 2) opencv(chosen.low, chosen.high, cv::BORDER_REPLICATE);
+      const auto t0 = Clock::now();  // each build timed whole, freeing its results included
+      if (which == 0) run_ours(*p, s, ep);
+      if (which == 1) run_opencv(p->grey, ep.blur_sigma_px, 50, 150, cv::BORDER_DEFAULT);
+      if (which == 2) run_opencv(p->grey, ep.blur_sigma_px, chosen.low, chosen.high, cv::BORDER_REPLICATE);
       fastest[which] = std::min(fastest[which], ms(t0, Clock::now()));
     }
     ++turn;

@@ -162,20 +162,22 @@ class BoxGrower {
   }
   // Grows the extent by, and measures, the one point q.
   void grow_measuring_one(Vec2 q) { measure(0, coords(q)); }
-  // Grows the extent by, and measures, the points q[0..count) in exactly `slots` steps (slots ≥ count):
-  // the steps past the last point take the last again, and with no points at all they take `fallback`,
-  // a point the box already holds at distance 0 from the segment. A repeated point changes neither the
-  // extent nor the largest distance, and a trip count that is the same for every segment of a level is
-  // predicted, where one that follows each segment's count of points is mispredicted at its exit.
+  // Grows the extent by, and measures, the points q[0..count) in exactly `slots` steps (slots ≥ count;
+  // slots = 0: count steps): the steps past the last point take the last again, and with no points at all
+  // they take `fallback`, a point the box already holds at distance 0 from the segment. A repeated point
+  // changes neither the extent nor the largest distance, and a trip count that is the same for every
+  // segment of a level is predicted, where one that follows each segment's count of points is mispredicted
+  // at its exit.
   void grow_measuring_slots(const Vec2* q, std::size_t count, std::size_t slots, const Vec2* fallback) {
     const Vec2* base = count > 0 ? q : fallback;
     const std::size_t last = count > 0 ? count - 1 : 0;
+    const std::size_t steps = slots > 0 ? slots : count;
     std::size_t i = 0;
-    for (; i + 1 < slots; i += 2) {
+    for (; i + 1 < steps; i += 2) {
       measure(0, coords(base[std::min(i, last)]));
       measure(1, coords(base[std::min(i + 1, last)]));
     }
-    if (i < slots) measure(0, coords(base[std::min(i, last)]));
+    if (i < steps) measure(0, coords(base[std::min(i, last)]));
   }
   // The extent grown so far, padded by pad_m on every side [m].
   Extent extent(double pad_m) const {
@@ -573,8 +575,8 @@ class SceneBuild {
     return k0 + 1;
   }
 
-  // How many original vertices every level-l segment of the box pass takes in (grow_measuring_slots): the
-  // most under one segment of the level, or 0 (each takes its own count) when that is more than twice the
+  // How many steps every level-l segment of the box pass takes its original vertices in (grow_measuring_slots):
+  // the most under one segment of the level, or 0 (each takes its own count) when that is more than twice the
   // mean + 4, so that a curve whose vertices bunch up (a long straight edge beside a tight curl) does not
   // make every segment pay for the bunch. On pictures' edge chains it is 1.1–1.7x the mean.
   static std::size_t original_slots(const std::vector<std::uint32_t>& orig_first, int l, std::size_t segments) {
@@ -620,12 +622,7 @@ class SceneBuild {
           box.grow_measuring(fine + tail, k1 - tail);
           box.grow(fine + k1, 1);  // the next segment's first point: in the box, measured with that segment
         }
-        const std::size_t originals = orig_first[k1] - orig_first[k0];
-        if (orig_slots > 0) {  // the same for the whole level: predicted
-          box.grow_measuring_slots(orig + orig_first[k0], originals, orig_slots, &ends[0]);
-        } else {
-          box.grow_measuring(orig + orig_first[k0], originals);
-        }
+        box.grow_measuring_slots(orig + orig_first[k0], orig_first[k1] - orig_first[k0], orig_slots, &ends[0]);
         se.e = box.extent(kBoxPad_m);
         worst_sq = std::max(worst_sq, box.worst_sq());
       }

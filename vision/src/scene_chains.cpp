@@ -15,30 +15,35 @@
 
 namespace hk::vision {
 
-double curve_length_m(const SceneCurve& c) {
+namespace {
+
+// The curve's length [m], its segments' lengths added in order (a closed curve's closing segment last),
+// or the partial sum at the first point where settled(partial sum) holds.
+template <class Settled>
+double summed_length_m(const SceneCurve& c, Settled settled) {
   double l = 0.0;
-  for (std::size_t i = 1; i < c.points_m.size(); ++i) l += cv::norm(c.points_m[i] - c.points_m[i - 1]);
+  for (std::size_t i = 1; i < c.points_m.size(); ++i) {
+    l += cv::norm(c.points_m[i] - c.points_m[i - 1]);
+    if (settled(l)) return l;
+  }
   if (c.closed && c.points_m.size() > 1) l += cv::norm(c.points_m.front() - c.points_m.back());
   return l;
 }
-
-namespace {
 
 // !(curve_length_m(c) < min_length_m), the same decision bit for bit, without measuring past the point
 // where it is settled: the length is a sum of non-negative terms added in the same order, so once a partial
 // sum is not below the minimum the whole is not either (floating-point addition of non-negatives never
 // decreases, and a NaN, once in, stays).
 bool reaches_length_m(const SceneCurve& c, double min_length_m) {
-  double l = 0.0;
-  for (std::size_t i = 1; i < c.points_m.size(); ++i) {
-    l += cv::norm(c.points_m[i] - c.points_m[i - 1]);
-    if (!(l < min_length_m)) return true;
-  }
-  if (c.closed && c.points_m.size() > 1) l += cv::norm(c.points_m.front() - c.points_m.back());
-  return !(l < min_length_m);
+  const auto reached = [min_length_m](double l) { return !(l < min_length_m); };
+  return reached(summed_length_m(c, reached));
 }
 
 }  // namespace
+
+double curve_length_m(const SceneCurve& c) {
+  return summed_length_m(c, [](double) { return false; });
+}
 
 double enclosed_area_m2(const std::vector<cv::Point2d>& points_m) {
   const std::size_t n = points_m.size();
