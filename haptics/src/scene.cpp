@@ -113,16 +113,6 @@ inline bool any(Mask2 m) { return m.a || m.b; }
 inline Lanes2 ones(Mask2 m) { return {m.a ? 1.0 : 0.0, m.b ? 1.0 : 0.0}; }
 #endif
 
-// Each lane rounded down or up to an integer (|lane| < 2^31), without a branch.
-inline Lanes2 floored(Lanes2 a) {
-  const Lanes2 t = truncated(a);
-  return t - ones(where_less(a, t));
-}
-inline Lanes2 ceiled(Lanes2 a) {
-  const Lanes2 t = truncated(a);
-  return t + ones(where_less(t, a));
-}
-
 // A segment's frame for the box pass and what the pass grows in it: the extent of the points seen,
 // as (u_min, n_min) and (u_max, n_max) [m], and the largest squared distance from the segment of the
 // points measured [m²]. Two accumulators of each, for consecutive points, so that the min/max chains
@@ -213,12 +203,14 @@ constexpr double kQuantumSteps = 32000.0;
 // by less than one quantum on each side: u_min and n_min to the largest k with k·q ≤ v, n_max to the
 // smallest k with k·q ≥ v, u_over to the smallest with length_m + k·q ≥ u_max, each product as
 // Scene::segment_box computes it. Two lanes at a time: (u_min, n_min) from below, (n_max, u_max) from above
-// with offsets (0, length_m). The guess, v·(1/q) rounded down (below) or up, is a product instead of a
-// division and is off by a step only where the product's rounding crosses an integer; the steps that
-// follow (rarely taken, so their branches are predicted) make each k the last on the right side of v, so
-// the guess's rounding can neither undercut v nor add a quantum. |v/q| ≤ kQuantumSteps + a few (an int holds it).
-// Writes the box's extents as segment_box() rebuilds them to *rebuilt.
-inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, double inverse_q, Extent* rebuilt) {
+// with offsets (0, length_m). The guess is a product instead of a division: v·(1/q) − 1 truncated from
+// below and v·(1/q) + 1 truncated from above, which is v/q rounded down and up where, as in every box the
+// pass makes, the lanes from below are < 0 (the box holds the segment's start, padded) and those from above
+// > 0 (it holds the end), and v/q is not an integer. Where the product's rounding crosses an integer, v/q
+// is one, or a lane has the other sign, the guess is off by a step; the steps that follow (rarely taken, so
+// their branches are predicted) make each k the last on the right side of v, so the guess can neither
+// undercut v nor add a quantum. |v/q| ≤ kQuantumSteps + a few (an int holds it).
+inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, double inverse_q) {
   const Lanes2 lq = lanes(q, q), one = lanes(1.0, 1.0);
   // Adds `step` (±1) to the lanes of k where too(k) holds, until it holds in none.
   const auto step_while = [](Lanes2 k, double step, auto too) {
@@ -231,15 +223,13 @@ inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, dou
   const auto k_short = [&](Lanes2 t) { return where_less_equal((t + one) * lq, below); };       // (k + 1)·q ≤ v
   const auto m_short = [&](Lanes2 t) { return where_less(offset + t * lq, above); };           // short of v
   const auto m_over = [&](Lanes2 t) { return where_less_equal(above, offset + (t - one) * lq); };  // one less still reaches v
-  Lanes2 k = floored(below * lanes(inverse_q, inverse_q));
-  Lanes2 m = ceiled((above - offset) * lanes(inverse_q, inverse_q));
+  Lanes2 k = truncated(below * lanes(inverse_q, inverse_q) - one);
+  Lanes2 m = truncated((above - offset) * lanes(inverse_q, inverse_q) + one);
   // One test of all four conditions (the guesses are almost always right); the steps only when one holds.
   if (any(k_over(k) | k_short(k) | m_short(m) | m_over(m))) {
     k = step_while(step_while(k, -1.0, k_over), +1.0, k_short);
     m = step_while(step_while(m, +1.0, m_short), -1.0, m_over);
   }
-  const Lanes2 lo = k * lq, hi = offset + m * lq;
-  *rebuilt = Extent{lane0(lo), lane1(hi), lane1(lo), lane0(hi)};
   return BoxExtent{static_cast<std::int16_t>(lane0(k)), static_cast<std::int16_t>(lane1(m)), static_cast<std::int16_t>(lane1(k)),
                    static_cast<std::int16_t>(lane0(m))};
 }
@@ -653,24 +643,39 @@ class SceneBuild {
   }
 
   // Level l's quantum (its widest extent / kQuantumSteps) and every segment's extents in it, rounded
-  // outward; the widest box of the level and its largest box error bound, from the boxes as
-  // Scene::segment_box() rebuilds them.
+  // outward; the widest box of the level and its largest box error bound (quantised_reach).
   static void quantise_level(Scene& scene, std::size_t c, int l, const std::vector<SegmentExtent>& level, double widest) {
     CurveInfo& ci = scene.curves_[c];
     const float quantum = static_cast<float>(widest / kQuantumSteps);  // > 0: every extent holds the pad
     scene.curve_nodes_[c].quantum_m[l] = quantum;
     const double q = quantum, inverse_q = 1.0 / q;
-    double half_width = 0.0, bound_sq = 0.0;  // the level's widest box [m]; its largest squared box_error_bound [m²]
-    for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
-      const SegmentExtent& se = level[k];
-      Extent e;  // the extents as segment_box() rebuilds them (its frame does not matter here)
-      scene.extent_[ci.box_offset[l] + k] = quantise_extent(se.e, se.length_m, q, inverse_q, &e);
-      const ErrorBox box{Vec2{}, Vec2{1.0, 0.0}, e.u_min, e.u_max, e.n_min, e.n_max};
-      half_width = std::max(half_width, box_half_width(box));
-      bound_sq = std::max(bound_sq, box_error_bound_sq(box, se.length_m));  // one root per level, below
+    BoxExtent* out = scene.extent_.data() + ci.box_offset[l];
+    for (std::size_t k = 0; k < ci.segment_count[l]; ++k) out[k] = quantise_extent(level[k].e, level[k].length_m, q, inverse_q);
+    const QuantisedReach reach = quantised_reach(out, ci.segment_count[l]);
+    ci.max_box_half_width_m[l] = static_cast<double>(reach.half_width) * q;
+    ci.max_error_bound_m[l] = std::sqrt(reach.bound_sq) * q;
+  }
+
+  // The most a level's boxes reach, in quanta: the widest half-width, max(−n_min, n_max) (= max(|n_min|,
+  // |n_max|): n_min < 0 < n_max, as every box holds its segment, padded), and the largest overhang² +
+  // half-width² of one box, overhang = max(0, −u_min, u_over), how far it reaches past either end of its
+  // segment. Both are exact (integers below 2^16, squares summed below 2^31, in doubles).
+  struct QuantisedReach {
+    double half_width = 0.0;
+    double bound_sq = 0.0;
+  };
+  // Times the quantum, these are the widest box as Scene::segment_box() rebuilds it, bit for bit (k·q is
+  // monotone in k), and its largest box_error_bound but for the rounding of the end's sum length_m + u_over·q
+  // there (a few ulps). Maxima over a flat array of BoxExtent, without a data-dependent branch.
+  static QuantisedReach quantised_reach(const BoxExtent* e, std::size_t count) {
+    double half_width = 0.0, bound_sq = 0.0;
+    for (std::size_t k = 0; k < count; ++k) {
+      const double hw = std::max(-static_cast<double>(e[k].n_min), static_cast<double>(e[k].n_max));
+      const double over = std::max(std::max(0.0, -static_cast<double>(e[k].u_min)), static_cast<double>(e[k].u_over));
+      half_width = std::max(half_width, hw);
+      bound_sq = std::max(bound_sq, over * over + hw * hw);
     }
-    ci.max_box_half_width_m[l] = half_width;
-    ci.max_error_bound_m[l] = std::sqrt(bound_sq);
+    return {half_width, bound_sq};
   }
 
   // Every curve's error boxes (build_segment_boxes) and the scene's bounds, those of the level-0 points.
