@@ -307,6 +307,32 @@ TEST(CollisionTree, ErrorGrowsWithLevelAndBoxesBoundIt) {
   }
 }
 
+TEST(CollisionTree, LevelMaximaAreThoseOfTheBoxesAsTheWalksRebuildThem) {
+  // The build takes a level's widest box and largest error bound from the quantised extents; rebuilding
+  // every box as the walks do (Scene::box) and taking the maxima here must give the same half-width, bit for
+  // bit, and the same bound up to the rounding of the box's far end (length + u_over·q) [a few ulps].
+  std::mt19937 rng(21);
+  auto curves = random_scene(rng, 5, 5);
+  curves.push_back(test::random_blob(rng, {0.02, -0.02}, 0.004, 24));  // a small closed curve, few levels
+  const Scene sc = Scene::build(curves, 6);
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    for (int l = 0; l < ci.levels; ++l) {
+      double widest = 0.0, bound = 0.0;
+      for (std::uint32_t k = 0; k < ci.segment_count[l]; ++k) {
+        Vec2 a, b;
+        sc.segment(SegmentRef{static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)}, &a, &b);
+        const ErrorBox box = sc.box(ci.box_offset[l] + k);
+        widest = std::max(widest, box_half_width(box));
+        bound = std::max(bound, box_error_bound(box, distance(a, b)));
+      }
+      EXPECT_EQ(ci.max_box_half_width_m[l], widest) << "curve " << c << " level " << l;
+      EXPECT_NEAR(ci.max_error_bound_m[l], bound, 1e-12 * bound + 1e-18) << "curve " << c << " level " << l;
+      EXPECT_GT(bound, 0.0);
+    }
+  }
+}
+
 TEST(CollisionTree, SceneErrorBoundIsTheWidestBoxOfAnyCurveAtThatLevel) {
   // A short curve (few levels) and a long one: past the short curve's coarsest level, its coarsest boxes
   // still count.
