@@ -92,7 +92,7 @@ struct CurveInfo {
   std::uint32_t segment_count[kMaxLevels] = {};  ///< segments of level l (closed: points; open: points − 1)
   double max_error_m[kMaxLevels] = {};           ///< largest distance of an original point from the level-l segment standing for it [m]
   double max_box_half_width_m[kMaxLevels] = {};  ///< largest error box half-width at level l [m]
-  double max_error_bound_m[kMaxLevels] = {};     ///< largest box_error_bound of level l: bounds max_error_m[l] [m]
+  double max_error_bound_m[kMaxLevels] = {};     ///< largest box_error_bound of level l (to a few ulps): bounds max_error_m[l] [m]
 };
 
 /// What the tree walks need of a curve: its levels' first node ids, the quantum of their box extents,
