@@ -28,19 +28,6 @@ struct Extent {
   double n_max = -std::numeric_limits<double>::infinity();
 };
 
-// Grows the extent, in the frame at `origin` with unit `axis`, by q; returns q's frame coordinates (u, n):
-// along the axis and along its left normal [m].
-inline Vec2 grow(Extent& e, Vec2 origin, Vec2 axis, Vec2 q) {
-  const Vec2 r = q - origin;
-  const double u = dot(r, axis);
-  const double n = cross(axis, r);
-  e.u_min = std::min(e.u_min, u);
-  e.u_max = std::max(e.u_max, u);
-  e.n_min = std::min(e.n_min, n);
-  e.n_max = std::max(e.n_max, n);
-  return Vec2{u, n};
-}
-
 // Two doubles side by side, (lane 0, lane 1): the box pass keeps a point's frame coordinates (u, n) in
 // one, so a point costs one subtraction, two products, one sum and a min and max of pairs (SSE2 where
 // the target has it, two scalars elsewhere; both compute the same numbers bit for bit).
@@ -696,18 +683,20 @@ class SceneBuild {
     }
   }
 
-  // An axis-aligned node around the boxes of children [first, first + count) (as Scene::box() rebuilds
-  // them, so the rounding of the stored extents is inside); links chunk and hierarchy children to it.
+  // An axis-aligned node around the rectangles of children [first, first + count) (Scene::aabb: a segment's
+  // error box as Scene::box() rebuilds it, so the rounding of the stored extents is inside, or a group's own
+  // rectangle), padded; links chunk and hierarchy children to it.
   static void make_aligned_node(Scene& scene, std::uint32_t node, std::uint32_t first, std::uint32_t count, NodeInfo info) {
-    Extent e;
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    Aabb r{{kInf, kInf}, {-kInf, -kInf}};
     for (std::uint32_t i = 0; i < count; ++i) {
-      Vec2 corners[4];
-      box_corners(scene.box(first + i), corners);
-      for (const Vec2& q : corners) grow(e, Vec2{0, 0}, Vec2{1, 0}, q);
+      const Aabb a = scene.aabb(first + i);
+      r.lo = {std::min(r.lo.x, a.lo.x), std::min(r.lo.y, a.lo.y)};
+      r.hi = {std::max(r.hi.x, a.hi.x), std::max(r.hi.y, a.hi.y)};
       if (!scene.is_segment(first + i)) scene.group_parent_[first + i - scene.segment_nodes_] = node;
     }
     const std::size_t g = node - scene.segment_nodes_;
-    scene.group_box_[g] = Aabb{{e.u_min - kBoxPad_m, e.n_min - kBoxPad_m}, {e.u_max + kBoxPad_m, e.n_max + kBoxPad_m}};
+    scene.group_box_[g] = Aabb{{r.lo.x - kBoxPad_m, r.lo.y - kBoxPad_m}, {r.hi.x + kBoxPad_m, r.hi.y + kBoxPad_m}};
     scene.group_info_[g] = info;
     scene.group_child_first_[g] = first;
     scene.group_child_count_[g] = count;

@@ -187,8 +187,12 @@ class Builder {
 
 WideIndex WideIndex::build(const Scene& sc) {
   WideIndex index;
+  std::size_t item_count = 0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) item_count += sc.curve(c).segment_count[std::min(kWideItemLevel, sc.curve(c).levels - 1)];
   std::vector<Item> items;
   std::vector<Aabb> rects;
+  items.reserve(item_count);
+  rects.reserve(item_count);
   double largest = 0.0;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const CurveInfo& ci = sc.curve(c);
