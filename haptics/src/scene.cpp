@@ -308,7 +308,11 @@ void box_corners(const ErrorBox& box, Vec2 out[4]) {
   out[3] = box.origin_m + box.u_min * box.axis + box.n_max * nrm;
 }
 
-double box_error_bound(const ErrorBox& box, double segment_length_m) { return std::sqrt(box_error_bound_sq(box, segment_length_m)); }
+double box_error_bound(const ErrorBox& box, double segment_length_m) {
+  const double overhang = std::max(std::max(0.0, -box.u_min), box.u_max - segment_length_m);
+  const double half_width = box_half_width(box);
+  return std::sqrt(overhang * overhang + half_width * half_width);
+}
 
 std::size_t Scene::hot_bytes() const {
   return points_m_.size() * sizeof(Vec2) + extent_.size() * sizeof(BoxExtent) + tag_.size() * sizeof(std::uint32_t) +

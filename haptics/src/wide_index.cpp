@@ -183,12 +183,15 @@ class Builder {
   WideIndex& out_;
 };
 
+// The level whose segments are a curve's items: kWideItemLevel, or the coarsest of a curve with fewer levels.
+int item_level(const CurveInfo& ci) { return std::min(kWideItemLevel, ci.levels - 1); }
+
 }  // namespace
 
 WideIndex WideIndex::build(const Scene& sc) {
   WideIndex index;
   std::size_t item_count = 0;
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) item_count += sc.curve(c).segment_count[std::min(kWideItemLevel, sc.curve(c).levels - 1)];
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) item_count += sc.curve(c).segment_count[item_level(sc.curve(c))];
   std::vector<Item> items;
   std::vector<Aabb> rects;
   items.reserve(item_count);
@@ -196,7 +199,7 @@ WideIndex WideIndex::build(const Scene& sc) {
   double largest = 0.0;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const CurveInfo& ci = sc.curve(c);
-    const int item = std::min(kWideItemLevel, ci.levels - 1);
+    const int item = item_level(ci);
     for (std::uint32_t k = 0; k < ci.segment_count[item]; ++k) {
       const Aabb r = item_rect(sc, c, item, k);
       items.push_back(Item{0.5 * (r.lo + r.hi), ci.box_offset[item] + k, static_cast<std::uint32_t>(rects.size())});

@@ -67,18 +67,11 @@ bool box_contains(const ErrorBox& box, Vec2 p, double margin_m = 0.0);
 /// The four corners of the box [m], counter-clockwise.
 void box_corners(const ErrorBox& box, Vec2 out[4]);
 /// Largest distance of a box point from the line through its segment [m]: max(|n_min|, |n_max|).
-/// Inline, as box_error_bound_sq: the scene build takes both for every box it makes.
 inline double box_half_width(const ErrorBox& box) { return std::max(std::abs(box.n_min), std::abs(box.n_max)); }
 /// Largest distance of a box point from its segment, of length segment_length_m [m]: the half-width
 /// combined with how far the box reaches past the segment's ends. A point the box holds is no farther
 /// from the segment than this, so it bounds the error of what the box stands for.
 double box_error_bound(const ErrorBox& box, double segment_length_m);
-/// The square of box_error_bound [m²], without the root: for taking the largest of many boxes with one root.
-inline double box_error_bound_sq(const ErrorBox& box, double segment_length_m) {
-  const double overhang = std::max(std::max(0.0, -box.u_min), box.u_max - segment_length_m);
-  const double half_width = box_half_width(box);
-  return overhang * overhang + half_width * half_width;
-}
 
 /// Where one curve's data sits in the scene arrays, and what was measured of it. Levels 0 .. levels−1.
 /// For setup code and tests; the servo path reads CurveNodes instead.
