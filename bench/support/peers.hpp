@@ -14,6 +14,7 @@
 
 #include "haptics/collision_query.hpp"
 #include "haptics/scene.hpp"
+#include "haptics/tolerance_cut.hpp"
 #include "peer_hit.hpp"
 
 namespace hk::bench {
@@ -32,6 +33,22 @@ inline std::vector<std::pair<Vec2, Vec2>> flat_segments(const Scene& sc, int lev
       sc.segment({static_cast<int>(c), l, static_cast<int>(k)}, &a, &b);
       v.push_back({a, b});
     }
+  }
+  return v;
+}
+
+/// Every piece of the joined tolerance cut at step `step` (kToleranceLadder_m[step]) of every curve, as a flat
+/// array of end-point pairs: hk::tolerance_cut, then hk::joined_cut_points, curve by curve (a closed curve's
+/// last piece runs back to its first vertex). Built from the cut's own functions, not from the masks that
+/// BoundarySection::first_hit_cut walks with, so a peer over these checks that walk.
+inline std::vector<std::pair<Vec2, Vec2>> cut_segments(const Scene& sc, int step) {
+  std::vector<std::pair<Vec2, Vec2>> v;
+  std::vector<SegmentRef> cut;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    cut.clear();
+    tolerance_cut(sc, c, kToleranceLadder_m[step], &cut);
+    const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
+    for (std::size_t i = 0; i < cut.size(); ++i) v.push_back({pts[i], pts[(i + 1) % pts.size()]});
   }
   return v;
 }

@@ -1,6 +1,8 @@
 // Anytime swept-point query over the collision trees (seed paper §3).
 #include "haptics/collision_query.hpp"
 
+#include "haptics/tolerance_cut.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -33,6 +35,13 @@ inline bool at_target_level(const Scene& sc, std::uint32_t node, int level) {
 }
 
 }  // namespace
+
+// at_target_level, and for a cut (kCutQueryBase + step) the cut's own segments. A walk comes down from the
+// roots and stops at the first cut segment on its way, so it never reaches a node below the cut.
+bool BoundarySection::at_target(std::uint32_t node, int level) const noexcept {
+  if (level >= kCutQueryBase) return scene_->is_segment(node) && ((cut_mask_[node] >> (level - kCutQueryBase)) & 1u) != 0;
+  return at_target_level(*scene_, node, level);
+}
 
 bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit) {
   // Work in the box frame: u along the axis, n along the left normal.
@@ -98,6 +107,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   merge_stamp_.assign(n, 0);
   seen_stamp_.assign(n, 0);
   walk_.resize(scene.wide_index().stack_entries());
+  cut_mask_ = tolerance_cut_masks(scene);
   reset();
 }
 
@@ -239,7 +249,11 @@ void BoundarySection::test_segment(Query& q, std::uint32_t node) {
   ++q.st.segment_tests;
   q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
   Vec2 p0, p1;
-  scene_->segment_points(node, &p0, &p1);
+  if (q.level >= kCutQueryBase) {
+    joined_cut_segment(*scene_, cut_mask_.data(), node, q.level - kCutQueryBase, &p0, &p1);
+  } else {
+    scene_->segment_points(node, &p0, &p1);
+  }
   double t = 0.0;
   if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && t < q.best.t) {
     q.best.hit = true;
@@ -275,7 +289,6 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
 // down to the target level, pruned past the best hit. Past the budget, boxes are not refined: the nearest
 // such box bounds what is proven clear (a box holds everything finer).
 void BoundarySection::refine_candidates(Query& q) {
-  const Scene& sc = *scene_;
   std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& x, const Candidate& y) { return x.t_enter < y.t_enter; });
   for (const Candidate& cand : candidates_) {
     if (cand.t_enter > q.horizon()) break;
@@ -284,7 +297,7 @@ void BoundarySection::refine_candidates(Query& q) {
     while (top > 0) {
       const Candidate cur = stack_[--top];
       if (cur.t_enter > q.horizon()) continue;
-      if (at_target_level(sc, cur.node, q.level)) {
+      if (at_target(cur.node, q.level)) {
         test_segment(q, cur.node);
       } else if (!push_hit_children(q, cur.node, top) && cur.t_enter < q.unresolved_t) {
         q.unresolved_t = cur.t_enter;
@@ -296,9 +309,8 @@ void BoundarySection::refine_candidates(Query& q) {
 
 // Phase 3: the boundary section follows the handle: what was hit is split (one level per tick).
 void BoundarySection::split_hit_boxes(Query& q) {
-  const Scene& sc = *scene_;
   for (const Candidate& cand : candidates_) {
-    if (!at_target_level(sc, cand.node, q.level)) {
+    if (!at_target(cand.node, q.level)) {
       split(cand.node);
       ++q.st.splits;
     }

@@ -37,7 +37,74 @@ Vec2 junction(const Scene& sc, SegmentRef before, SegmentRef after) {
   return a;
 }
 
+// Cut membership below segment s for the steps in `active` (the steps for which no segment above s is cut).
+// s is cut at the active steps whose tolerance its bound is within (every active step at level 0, which has
+// nothing finer); its children carry on with the rest. The bound and its comparison are refine()'s.
+void mark_cut(const Scene& sc, SegmentRef s, std::uint8_t active, std::uint8_t* masks) {
+  const double bound = segment_bound(sc, s);
+  std::uint8_t within = active;
+  if (s.level > 0) {
+    within = 0;
+    for (int t = 0; t < kToleranceSteps; ++t) {
+      if (bound <= kToleranceLadder_m[t]) within |= static_cast<std::uint8_t>(1u << t);
+    }
+    within &= active;
+  }
+  masks[sc.node_of(s)] = within;
+  const auto rest = static_cast<std::uint8_t>(active & ~within);
+  if (rest == 0) return;
+  mark_cut(sc, SegmentRef{s.curve, s.level - 1, 2 * s.segment}, rest, masks);
+  mark_cut(sc, SegmentRef{s.curve, s.level - 1, 2 * s.segment + 1}, rest, masks);
+}
+
 }  // namespace
+
+std::vector<std::uint8_t> tolerance_cut_masks(const Scene& scene) {
+  static_assert(kToleranceSteps <= 8, "a node's steps fit one byte");
+  std::vector<std::uint8_t> masks(scene.node_count(), 0);
+  constexpr auto kAllSteps = static_cast<std::uint8_t>((1u << kToleranceSteps) - 1);
+  for (std::size_t c = 0; c < scene.curve_count(); ++c) {
+    const CurveInfo& ci = scene.curve(c);
+    const int top = static_cast<int>(ci.levels) - 1;
+    for (std::uint32_t k = 0; k < ci.segment_count[top]; ++k) {
+      mark_cut(scene, SegmentRef{static_cast<std::int32_t>(c), top, static_cast<std::int32_t>(k)}, kAllSteps, masks.data());
+    }
+  }
+  return masks;
+}
+
+void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a, Vec2* b) {
+  scene.segment_points(node, a, b);
+  const std::uint32_t c = scene.tag_curve(node);
+  const int l = scene.tag_level(node);
+  const CurveInfo& ci = scene.curve(c);
+  const CurveNodes& cn = scene.curve_nodes(c);
+  const std::uint32_t i = node - cn.box_offset[l];
+  const auto bit = static_cast<std::uint8_t>(1u << step);
+  // The cut segment before s covers the level-0 segment just before s's start; if it is finer than s, it is
+  // the node of some level lev < l ending at s's start, level-lev point i·2^(l−lev). At most one is cut.
+  if (i > 0 || ci.closed) {
+    for (int lev = l - 1; lev >= 0; --lev) {
+      const std::uint32_t start = i << (l - lev);
+      const std::uint32_t before = (start == 0 ? ci.segment_count[lev] : start) - 1;
+      if (masks[cn.box_offset[lev] + before] & bit) {
+        *a = scene.points(c, lev)[start];
+        break;
+      }
+    }
+  }
+  // Likewise after s's end, level-lev point (i + 1)·2^(l−lev) (a closed curve's last point repeats its first).
+  if (i + 1 < ci.segment_count[l] || ci.closed) {
+    for (int lev = l - 1; lev >= 0; --lev) {
+      const std::uint32_t end = (i + 1) << (l - lev);
+      const std::uint32_t after = end == ci.segment_count[lev] ? 0 : end;
+      if (masks[cn.box_offset[lev] + after] & bit) {
+        *b = scene.points(c, lev)[end];
+        break;
+      }
+    }
+  }
+}
 
 CutStats tolerance_cut(const Scene& scene, std::size_t curve, double tol_m, std::vector<SegmentRef>* out) {
   CutStats st;

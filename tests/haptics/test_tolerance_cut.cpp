@@ -144,6 +144,42 @@ TEST(ToleranceCut, JoinedPiecesLieInTheirBoxesAndKeepVerticesWithinBoundPlusShif
   EXPECT_GT(breaks, 20u);  // the scene mixes levels, so the joins were exercised
 }
 
+// The masks first_hit_cut walks with mark exactly the segments of each step's cut, and joined_cut_segment
+// gives each cut segment the two vertices joined_cut_points gives its piece (bit for bit), on curves whose
+// cuts change level (counted).
+TEST(ToleranceCut, MasksMarkTheCutAndJoinedSegmentsAreThePiecesOfTheJoinedPolyline) {
+  std::mt19937 rng(19);
+  const auto curves = curves_for(rng);
+  const Scene sc = Scene::build(curves, 6);
+  const std::vector<std::uint8_t> masks = tolerance_cut_masks(sc);
+  ASSERT_EQ(masks.size(), sc.node_count());
+  std::size_t joins = 0;
+  for (int step = 0; step < kToleranceSteps; ++step) {
+    std::size_t marked = 0, in_cuts = 0;
+    for (std::uint32_t n = 0; n < sc.node_count(); ++n) marked += (masks[n] >> step) & 1u;
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      std::vector<SegmentRef> cut;
+      tolerance_cut(sc, c, kToleranceLadder_m[step], &cut);
+      in_cuts += cut.size();
+      const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
+      for (std::size_t i = 0; i < cut.size(); ++i) {
+        const std::uint32_t node = sc.node_of(cut[i]);
+        ASSERT_EQ((masks[node] >> step) & 1u, 1u) << "step " << step << " curve " << c << " piece " << i;
+        Vec2 a, b;
+        joined_cut_segment(sc, masks.data(), node, step, &a, &b);
+        const Vec2 want_b = pts[(i + 1) % pts.size()];
+        ASSERT_EQ(a.x, pts[i].x) << "step " << step << " curve " << c << " piece " << i;
+        ASSERT_EQ(a.y, pts[i].y) << "step " << step << " curve " << c << " piece " << i;
+        ASSERT_EQ(b.x, want_b.x) << "step " << step << " curve " << c << " piece " << i;
+        ASSERT_EQ(b.y, want_b.y) << "step " << step << " curve " << c << " piece " << i;
+        if (i + 1 < cut.size()) joins += cut[i].level != cut[i + 1].level;
+      }
+    }
+    EXPECT_EQ(marked, in_cuts) << "step " << step << ": a node marked that is not in the cut";
+  }
+  EXPECT_GT(joins, 20u);
+}
+
 TEST(ToleranceCut, EndsAreTheCoarsestLevelAndLevelZero) {
   std::mt19937 rng(19);
   const Scene sc = Scene::build(curves_for(rng), 6);

@@ -124,6 +124,25 @@ class BoundarySection {
   /// Does not read or change the boundary section. Real-time safe.
   SweepHit first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
                           QueryStats* stats = nullptr);
+  /// First hit against the tolerance cut at step `step` (0 ≤ step < kToleranceSteps, tolerance
+  /// kToleranceLadder_m[step]) instead of a level: each curve's segments of mixed levels that tolerance_cut
+  /// chooses (refined while a box's error bound exceeds the tolerance; seed §3, "contact computations at a
+  /// desired tolerance level"), drawn joined (joined_cut_segment: where the cut changes level, both pieces meet
+  /// at the finer segment's end). The walk is first_hit's, through the same boundary section, stopping at the
+  /// cut's segments instead of a level's: each joined piece lies inside its own segment's error box
+  /// (tolerance_cut.hpp), so the boxes prune it exactly as they prune a level. A change of step, or between a
+  /// step and a level, starts the section again from the roots. The answer's segment is the cut segment hit
+  /// (its own level and index); anytime and budget as first_hit. Answers equal a brute-force test of the
+  /// joined polylines (t bit for bit; tests). Only first hits are answered at a cut so far: the wide index's
+  /// rectangles hold each level's own pieces, not the joined ones, so first_hit_wide and closest_point take
+  /// levels and tolerance steps only. Real-time safe.
+  SweepHit first_hit_cut(Vec2 a, Vec2 b, int step, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
+                         QueryStats* stats = nullptr) {
+    return first_hit(a, b, kCutQueryBase + step, excluded, excluded_count, budget, stats);
+  }
+  /// Cut membership of the scene's nodes, computed at construction (tolerance_cut_masks; node_count() entries).
+  const std::uint8_t* cut_masks() const noexcept { return cut_mask_.data(); }
+
   /// The same for a one-off query: spends a copy of `budget` (tests, benches). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                      const QueryBudget& budget, QueryStats* stats = nullptr) {
@@ -153,7 +172,10 @@ class BoundarySection {
   const std::vector<std::uint32_t>& section() const { return section_; }
 
  private:
+  /// first_hit's internal target for the cut at step t: kCutQueryBase + t, past every level id.
+  static constexpr int kCutQueryBase = kLevelIds;
   struct Query;  // one first_hit's inputs, answer so far and counters (collision_query.cpp)
+  bool at_target(std::uint32_t node, int level) const noexcept;
   // The phases of first_hit, in order (each documented where it is defined).
   bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
   void next_tick() noexcept;
@@ -217,7 +239,8 @@ class BoundarySection {
   std::uint32_t last_closest_node_ = kWideEmpty;  // the previous call's answer (segment node), the next call's seed
   int last_closest_level_ = -1, last_closest_curve_ = -1;
   std::uint32_t tick_ = 0;
-  int last_level_ = -1;
+  int last_level_ = -1;         // target of the last first_hit: a level id, or kCutQueryBase + step
+  std::vector<std::uint8_t> cut_mask_;  // per node: the tolerance steps whose cut it is a segment of (tolerance_cut_masks)
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
   Vec2 ball_center_m_;          // free-space ball: no box of the section as last scanned, so no wall, comes closer to its centre than its radius
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "haptics/scene.hpp"
+#include "hk/constants.hpp"
 
 namespace hk {
 
@@ -47,5 +48,20 @@ CutStats tolerance_cut(const Scene& scene, std::size_t curve, double tol_m, std:
 /// to vertex i + 1. Each junction's vertex is the end point of the finer of the two segments meeting there
 /// (either, when they are at one level: they share it). Empty when count is 0. Allocates (analysis code).
 std::vector<Vec2> joined_cut_points(const Scene& scene, std::size_t curve, const SegmentRef* cut, std::size_t count);
+
+/// Cut membership of every segment node of `scene` at every tolerance step (hk/constants.hpp), for walks that
+/// stop at the cut instead of a level (BoundarySection::first_hit_cut): scene.node_count() entries; entry n
+/// has bit t set when segment node n is a segment of tolerance_cut(scene, its curve, kToleranceLadder_m[t]).
+/// The bounds are the ones tolerance_cut computes, compared the same way, so the cuts are the same; one pass
+/// down each curve's tree computes each segment's bound once for all steps. Group nodes (chunks, hierarchy)
+/// and segments below every step's cut are 0. Allocates (setup, not the servo path).
+std::vector<std::uint8_t> tolerance_cut_masks(const Scene& scene);
+
+/// The end points [m] of cut segment `node` at tolerance step `step` (0 ≤ step < kToleranceSteps), drawn
+/// joined as joined_cut_points draws them: where the cut segment next to it along the curve is finer, its
+/// end there is that finer segment's end point; otherwise its own. `masks` is tolerance_cut_masks(scene),
+/// and `node` must have bit `step` set in it (a segment of that cut). O(level of the node) mask reads per
+/// end; allocates nothing, real-time safe.
+void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a, Vec2* b);
 
 }  // namespace hk
