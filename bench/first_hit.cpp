@@ -7,11 +7,13 @@
 //
 // Methods: ours (first_hit: boundary section, free-space ball, anytime answers at a coarser level),
 //          ours_wide (first_hit_wide: the scene's wide index alone, with a free-space ball from it; first hits
-//          on the synthetic scenes and the pictures), rtree, embree, brute.
+//          on the synthetic scenes, the pictures and the levels, not the cuts), rtree, embree, brute.
 // Names: BM_FirstHit/<method>/<segments>  — synthetic scenes tiled from real pictures, random-walk hand
 //        BM_Closest/<method>/<segments>   — closest point on the same scenes
 //        BM_Picture/<method>/<picture>    — the handle sweeps of an explore raster run on that picture
 //        BM_Level/<method>/<level>        — speed against accuracy: 4 pictures, queries at each level
+//        BM_Cut/<method>/<step>/<picture> — the same at the tolerance cut of a step (ours: first_hit_cut; the
+//                                           peers over the cut's joined pieces, bench::cut_segments)
 // Counters: p50_ns, p99_ns, max_ns per query; clock_ns, net_mean_ns; batch_mean_ns (not for brute); build_ms; bytes_per_segment; segments; max_error_mm; for
 //           ours and ours_wide, full_query_fraction (queries the free-space ball did not answer),
 //           section_entries (mean boundary-section size after a query; 0 for ours_wide), box_tests and
@@ -49,18 +51,38 @@ struct Case {
   std::vector<Sweep> stream;
   double build_ms_ours = 0, build_ms_rtree = 0, build_ms_brute = 0, build_ms_embree = 0;
   double max_error_mm = 0;
+  int cut_step = -1;  // ≥ 0: queries at the tolerance cut of that step (first_hit_cut), not at `level`
 };
 
-std::unique_ptr<Case> make_case(std::string name, std::vector<Polyline> curves, int level, std::vector<Sweep> stream) {
+// Largest distance of an original vertex of each curve from the nearest joined piece of that curve's cut at
+// `step` [mm], measured (the cut's guarantee is a bound; this is what it keeps).
+double cut_error_mm(const Scene& sc, const std::vector<Polyline>& curves, int step) {
+  double worst = 0.0;
+  std::vector<SegmentRef> cut;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    cut.clear();
+    tolerance_cut(sc, c, kToleranceLadder_m[step], &cut);
+    const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
+    for (const Vec2& p : curves[sc.source_index(c)].points_m) {
+      double d = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < cut.size(); ++i) d = std::min(d, distance_to_segment(p, pts[i], pts[(i + 1) % pts.size()]));
+      worst = std::max(worst, d);
+    }
+  }
+  return 1e3 * worst;
+}
+
+std::unique_ptr<Case> make_case(std::string name, std::vector<Polyline> curves, int level, std::vector<Sweep> stream, int cut_step = -1) {
   auto c = std::make_unique<Case>();
   c->name = std::move(name);
   c->level = level;
+  c->cut_step = cut_step;
   double t0 = now_ms();
   c->scene = std::make_unique<Scene>(Scene::build(curves, config::Settings{}.haptics.max_levels));
   c->ours = std::make_unique<BoundarySection>(*c->scene);
   c->build_ms_ours = now_ms() - t0;
   t0 = now_ms();
-  c->segs = flat_segments(*c->scene, level);
+  c->segs = cut_step >= 0 ? cut_segments(*c->scene, cut_step) : flat_segments(*c->scene, level);
   c->brute = std::make_unique<BruteForce>(c->segs);
   c->build_ms_brute = now_ms() - t0;
   t0 = now_ms();
@@ -70,6 +92,10 @@ std::unique_ptr<Case> make_case(std::string name, std::vector<Polyline> curves, 
   c->embree = std::make_unique<EmbreeIndex>(c->segs);
   c->build_ms_embree = now_ms() - t0;
   c->stream = std::move(stream);
+  if (cut_step >= 0) {
+    c->max_error_mm = cut_error_mm(*c->scene, curves, cut_step);
+    return c;
+  }
   for (std::size_t k = 0; k < c->scene->curve_count(); ++k) {
     const CurveInfo& ci = c->scene->curve(k);
     c->max_error_mm = std::max(c->max_error_mm, 1e3 * ci.max_error_m[c->scene->clamp_level(k, level)]);
@@ -83,9 +109,11 @@ void check_equal(Case& c, std::size_t n) {
   std::size_t hits = 0;
   for (std::size_t i = 0; i < std::min(n, c.stream.size()); ++i) {
     const Sweep& s = c.stream[i];
-    const SweepHit h = fresh.first_hit(s.a, s.b, c.level, nullptr, 0, QueryBudget{});
+    QueryBudget unlimited_cut;
+    const SweepHit h = c.cut_step >= 0 ? fresh.first_hit_cut(s.a, s.b, c.cut_step, nullptr, 0, unlimited_cut)
+                                       : fresh.first_hit(s.a, s.b, c.level, nullptr, 0, QueryBudget{});
     const PeerHit b = c.brute->first_hit(s.a, s.b);
-    {
+    if (c.cut_step < 0) {  // first_hit_wide and closest_point take levels only
       QueryBudget unlimited;
       const SweepHit w = fresh.first_hit_wide(s.a, s.b, c.level, nullptr, 0, unlimited);
       if (w.hit != b.hit || (b.hit && w.t != b.t)) {
@@ -101,7 +129,7 @@ void check_equal(Case& c, std::size_t n) {
       std::exit(2);
     }
     hits += b.hit;
-    if (i % 10 == 0) {  // closest points too: ours, the R-tree and Embree against brute force
+    if (i % 10 == 0 && c.cut_step < 0) {  // closest points too: ours, the R-tree and Embree against brute force
       Vec2 q;
       SegmentRef seg;
       const double want = c.brute->closest_distance(s.b);
@@ -142,7 +170,11 @@ void set_percentiles(benchmark::State& state, std::vector<double>& ns) {
 // One first-hit query of method m.
 bool first_hit_once(Case* c, Method m, const Sweep& s, QueryStats* st) {
   switch (m) {
-    case Method::Ours: return c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}, st).hit;
+    case Method::Ours: {
+      if (c->cut_step < 0) return c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}, st).hit;
+      QueryBudget unlimited;
+      return c->ours->first_hit_cut(s.a, s.b, c->cut_step, nullptr, 0, unlimited, st).hit;
+    }
     case Method::Wide: {
       QueryBudget unlimited;
       return c->ours->first_hit_wide(s.a, s.b, c->level, nullptr, 0, unlimited, st).hit;
@@ -245,9 +277,12 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
   state.counters["segments"] = segs;
   state.counters["hit_fraction"] = static_cast<double>(hits) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
   state.counters["max_error_mm"] = c->max_error_mm;
+  if (c->cut_step >= 0) state.counters["tolerance_mm"] = 1e3 * kToleranceLadder_m[c->cut_step];
   if (m == Method::Ours || m == Method::Wide) {
     state.counters["build_ms"] = c->build_ms_ours;
-    state.counters["bytes_per_segment"] = static_cast<double>(c->scene->hot_bytes()) / segs;
+    // Per segment queried: every level's bytes over the cut's segments would say nothing (the memory target
+    // counts them per level-0 segment: BM_FirstHit).
+    if (c->cut_step < 0) state.counters["bytes_per_segment"] = static_cast<double>(c->scene->hot_bytes()) / segs;
   } else if (m == Method::Brute) {
     state.counters["build_ms"] = c->build_ms_brute;
     state.counters["bytes_per_segment"] = static_cast<double>(c->brute->bytes()) / segs;
@@ -374,8 +409,24 @@ int main(int argc, char** argv) {
       auto c = make_case(std::string(name) + "@L" + std::to_string(level), pictures[i], level, stream_of(i));
       check_equal(*c, 2000);
       Case* cp = c.get();
-      for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute}) {
+      for (Method m : {Method::Ours, Method::Wide, Method::Rtree, Method::Embree, Method::Brute}) {
         benchmark::RegisterBenchmark(("BM_Level/" + std::string(method_name(m)) + "/" + std::to_string(level) + "/" + name).c_str(),
+                                     [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+      }
+      cases.push_back(std::move(c));
+    }
+  }
+  // 4. The same sweeps at the tolerance cut of five of the steps (0.1, 0.25, 0.63, 1.0, 2.5 mm).
+  for (int step : {0, 2, 4, 5, 7}) {
+    for (const char* name : {"horse", "camera", "fruits", "sudoku"}) {
+      std::size_t i = 0;
+      while (i < paths.size() && paths[i].stem() != name) ++i;
+      if (i == paths.size()) continue;
+      auto c = make_case(std::string(name) + "@cut" + std::to_string(step), pictures[i], 0, stream_of(i), step);
+      check_equal(*c, 2000);
+      Case* cp = c.get();
+      for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute}) {
+        benchmark::RegisterBenchmark(("BM_Cut/" + std::string(method_name(m)) + "/" + std::to_string(step) + "/" + name).c_str(),
                                      [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
       }
       cases.push_back(std::move(c));

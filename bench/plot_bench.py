@@ -149,7 +149,7 @@ def accuracy_per_vertex(ax, lvl, lines):
             per_curve.append((sum(r["curve_levels_vertices"] for r in rows), max(r["curve_levels_error_mm"] for r in rows), tol))
         cut.append((sum(r["cut_vertices"] for r in rows), max(r["cut_error_mm"] for r in rows), tol))
         dp.append((sum(r["dp_vertices"] for r in rows), max(r["dp_error_mm"] for r in rows), tol))
-        lines.append("| tolerance cut at %.1f mm, joined (no query yet) | — | — | %.3f | %d vertices (DP: %d at %.3f mm) |" % (
+        lines.append("| tolerance cut at %.1f mm, joined, its tolerance searched per curve (bench_tolerance_cut) | — | — | %.3f | %d vertices (DP: %d at %.3f mm) |" % (
             tol, cut[-1][1], cut[-1][0], dp[-1][0], dp[-1][1]))
     if cut:
         ax.plot([p[0] for p in cut], [p[1] for p in cut], "s--", color="tab:cyan", label="ours, tolerance cut")
@@ -167,14 +167,18 @@ def accuracy_per_vertex(ax, lvl, lines):
     ax.legend()
 
 lvl = defaultdict(lambda: defaultdict(list))
+cuts = defaultdict(lambda: defaultdict(list))  # method -> tolerance step -> rows (BM_Cut: queries at the tolerance cut)
 for r in fh:
     m = re.match(r"BM_Level/(\w+)/(\d+)/(\w+)/manual_time", r["name"])
     if m:
         lvl[m.group(1)][int(m.group(2))].append(r)
+    m = re.match(r"BM_Cut/(\w+)/(\d+)/(\w+)/manual_time", r["name"])
+    if m:
+        cuts[m.group(1)][int(m.group(2))].append(r)
 if lvl:
     fig, (ax, ax_v) = plt.subplots(1, 2, figsize=(14, 5))
     lines = ["| method | level | p99 ns (mean of 4 pictures) | max deviation mm (max of 4) | segments (sum) |", "|---|---|---|---|---|"]
-    for method in [m for m in METHODS if lvl[m]]:  # ours_wide is not run per level
+    for method in [m for m in METHODS if lvl[m]]:
         pts = []
         for level in sorted(lvl[method]):
             rows = lvl[method][level]
@@ -185,6 +189,22 @@ if lvl:
         ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=COLORS[method], label=method)
         for p in pts:
             ax.annotate("L%d" % p[2], (p[0], p[1]), textcoords="offset points", xytext=(4, 3), fontsize=7, color=COLORS[method])
+    # Queries at the tolerance cut (ours: first_hit_cut; the peers over the cut's joined pieces): a point per
+    # step, its measured error on the y axis as for the levels.
+    for method in [m for m in METHODS if cuts[m]]:
+        pts = []
+        for step in sorted(cuts[method]):
+            rows = cuts[method][step]
+            if len(rows) != 4:
+                continue
+            p99 = sum(r["p99_ns"] for r in rows) / len(rows)
+            err = max(r["max_error_mm"] for r in rows)
+            tol = rows[0]["tolerance_mm"]
+            pts.append((p99, err, tol))
+            lines.append("| %s, tolerance cut | T = %.2f mm | %.0f | %.3f | %d |" % (method, tol, p99, err, sum(r["segments"] for r in rows)))
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], "s--", color=COLORS[method], alpha=0.7, label=method + ", tolerance cut")
+        for p in pts:
+            ax.annotate("%.2g mm" % p[2], (p[0], p[1]), textcoords="offset points", xytext=(4, -9), fontsize=6, color=COLORS[method])
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("query time per tick, p99 [ns]")

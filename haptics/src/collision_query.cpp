@@ -855,4 +855,53 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   return true;
 }
 
+// ---- Closest points at a tolerance cut (the tree of error boxes) ----
+
+bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
+                                        QueryBudget* budget) {
+  const Scene& sc = *scene_;
+  if (sc.curve_count() == 0) return false;
+  ClosestQuery q(p, kCutQueryBase + step, curve, max_distance_m);
+  // A node of another curve holds nothing of `curve` (a hierarchy node may: kept).
+  const auto other_curve = [&sc, curve](std::uint32_t node) {
+    if (curve < 0) return false;
+    if (sc.is_segment(node)) return sc.tag_curve(node) != static_cast<std::uint32_t>(curve);
+    return sc.is_chunk(node) && sc.info(node).curve != static_cast<std::uint32_t>(curve);
+  };
+  int top = 0;
+  stack_[static_cast<std::size_t>(top++)] = Candidate{0.0, sc.scene_root()};  // t_enter: the box's squared distance [m²]
+  while (top > 0) {
+    const Candidate cur = stack_[static_cast<std::size_t>(--top)];
+    if (cur.t_enter > q.bound_sq) continue;  // the bound shrank since it was pushed
+    if (sc.is_segment(cur.node) && ((cut_mask_[cur.node] >> step) & 1u) != 0) {
+      Vec2 a, b;
+      joined_cut_segment(sc, cut_mask_.data(), cur.node, step, &a, &b);
+      closest_offer(q, cur.node, a, b);
+      continue;
+    }
+    std::uint32_t first = 0, count = 0;
+    sc.children(cur.node, &first, &count);
+    const int base = top;
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const std::uint32_t child = first + i;
+      if (other_curve(child)) continue;
+      const Aabb r = sc.loose_aabb(child);  // holds the box: its distance is a cheaper lower bound
+      const double rx = std::max({r.lo.x - p.x, 0.0, p.x - r.hi.x}), ry = std::max({r.lo.y - p.y, 0.0, p.y - r.hi.y});
+      if (rx * rx + ry * ry > q.bound_sq) continue;
+      if (budget && !budget->spend()) return false;
+      const double d_sq = box_distance_sq(sc.box(child), p);
+      if (d_sq > q.bound_sq) continue;
+      if (!push(top, Candidate{d_sq, child})) {  // full (never, within the tree's depth): the answer is unknown
+        if (budget) budget->ran_out = true;
+        return false;
+      }
+    }
+    std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
+  }
+  if (!q.found()) return false;
+  if (point_out) *point_out = q.best_point;
+  if (segment_out) *segment_out = q.best_s;
+  return true;
+}
+
 }  // namespace hk

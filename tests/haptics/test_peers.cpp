@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "curves.hpp"
@@ -107,15 +108,16 @@ TEST(Peers, FirstHitAndClosestPointAgreeAcrossMethods) {
   }
 }
 
-// Issue 18 item 3: first hits at the tolerance cut instead of a level. Each of the eight steps' cuts (segments
+// Issue 18 item 3: first hits and closest points at the tolerance cut instead of a level. Each of the eight steps' cuts (segments
 // of mixed levels, joined where the level changes) is taken apart by the cut's own functions (tolerance_cut,
 // joined_cut_points: bench::cut_segments) and handed to brute force, the R-tree and Embree; first_hit_cut
 // walks the boundary section with the cut masks instead. 15 000 queries a step, 120 000 in all, every one
-// against the three peers: the same hits and t bit for bit. Every 7th query is repeated on a second section
+// against the three peers: the same hits and t bit for bit; every 5th also a closest point on the whole cut
+// (against brute force) and on one curve's (against its joined polyline, within 20 mm). Every 7th query is repeated on a second section
 // with a budget of 6 optional box tests: an exact answer there must be the same, a blocked one must not claim
 // the sweep clear past the true hit. The scene mixes smooth blobs and strokes with a staircase circle and
 // squares, so that the cuts change level along curves (counted: the check must cover joins).
-TEST(Peers, FirstHitAtTheToleranceCutAgreesAcrossMethods) {
+TEST(Peers, FirstHitAndClosestPointAtTheToleranceCutAgreeAcrossMethods) {
   std::mt19937 rng(44);
   Vec2 half;
   std::vector<Polyline> curves = scene_curves(rng, 20 * 200, &half);
@@ -130,11 +132,20 @@ TEST(Peers, FirstHitAtTheToleranceCutAgreesAcrossMethods) {
     const bench::BruteForce brute(segs);
     const bench::RtreeIndex rtree(segs);
     const bench::EmbreeIndex embree(segs);
+    std::vector<std::vector<Vec2>> joined(sc.curve_count());  // each curve's joined polyline, for closest points on one curve
     for (std::size_t c = 0; c < sc.curve_count(); ++c) {
       std::vector<SegmentRef> cut;
       tolerance_cut(sc, c, kToleranceLadder_m[step], &cut);
       for (std::size_t i = 0; i + 1 < cut.size(); ++i) joined_levels += cut[i].level != cut[i + 1].level;
+      joined[c] = joined_cut_points(sc, c, cut.data(), cut.size());  // closed: n vertices, open: n + 1
     }
+    const auto curve_distance = [&](Vec2 q, std::size_t c) {
+      const std::vector<Vec2>& v = joined[c];
+      const std::size_t pieces = sc.curve(c).closed ? v.size() : v.size() - 1;
+      double d = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < pieces; ++i) d = std::min(d, distance_to_segment(q, v[i], v[(i + 1) % v.size()]));
+      return d;
+    };
     Walk walk{std::mt19937(45 + step), 0.0005, half};
     int hits = 0, blocked = 0;
     for (int i = 0; i < 15000; ++i) {
@@ -154,6 +165,22 @@ TEST(Peers, FirstHitAtTheToleranceCutAgreesAcrossMethods) {
         ASSERT_EQ(hr.t, hb.t) << "step " << step << " query " << i;
         ASSERT_EQ(he.t, hb.t) << "step " << step << " query " << i;
         ASSERT_EQ(ours.cut_masks()[sc.node_of(h.segment)] >> step & 1, 1) << "the answer names a segment of the cut";
+      }
+      if (i % 5 == 0) {  // closest points on the cut: the whole scene, and one curve
+        Vec2 cp;
+        SegmentRef s;
+        ASSERT_TRUE(ours.closest_point_cut(q, step, 1.0, &cp, &s)) << "step " << step << " query " << i;
+        ASSERT_NEAR(distance(q, cp), brute.closest_distance(q), 1e-15) << "step " << step << " query " << i;
+        ASSERT_EQ(ours.cut_masks()[sc.node_of(s)] >> step & 1, 1);
+        const auto c = static_cast<std::size_t>(i / 5) % sc.curve_count();
+        const double want = curve_distance(q, c);
+        SegmentRef sc_seg;
+        const bool found = ours.closest_point_cut(q, step, 0.02, &cp, &sc_seg, static_cast<int>(c));
+        ASSERT_EQ(found, want <= 0.02) << "step " << step << " query " << i;
+        if (found) {
+          ASSERT_EQ(sc_seg.curve, static_cast<int>(c));
+          ASSERT_NEAR(distance(q, cp), want, 1e-15) << "step " << step << " query " << i;
+        }
       }
       if (i % 7 == 0) {
         QueryBudget small;

@@ -140,6 +140,16 @@ class BoundarySection {
                          QueryStats* stats = nullptr) {
     return first_hit(a, b, kCutQueryBase + step, excluded, excluded_count, budget, stats);
   }
+  /// Closest point on the tolerance cut at step `step` (its joined pieces, as first_hit_cut meets them) to p
+  /// within max_distance_m; false when nothing is that close. `curve` ≥ 0 restricts it to that curve. Ties as
+  /// closest_point (the smallest (curve, level, segment)). A distance-pruned depth-first walk of the tree of
+  /// error boxes from the scene root, nearest box first (branch and bound, as closest_point): each joined
+  /// piece lies inside its own segment's box, so a box's distance bounds every piece under it from below. Not
+  /// the wide index, whose rectangles hold each level's own pieces, and not seeded between calls. With a
+  /// `budget`, each box measured is one optional box test; when it runs out the walk stops and returns false
+  /// with budget->ran_out set (the answer is then unknown, not "nothing close"). Allocates nothing.
+  bool closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
+                         QueryBudget* budget = nullptr);
   /// Cut membership of the scene's nodes, computed at construction (tolerance_cut_masks; node_count() entries).
   const std::uint8_t* cut_masks() const noexcept { return cut_mask_.data(); }
 
