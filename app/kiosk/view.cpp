@@ -139,11 +139,13 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
   // The curves at the level in use: bright yellow (RGB 255, 220, 0), thicker in high contrast.
   glColor4f(1.0f, 220.0f / 255.0f, 0.0f, 1.0f);
   glLineWidth(hc ? 6.0f : 3.0f);
+  const int cut_step = is_cut_level(app.level()) && !sh.cuts.empty() ? tolerance_step_of(app.level()) : -1;
   for (std::size_t c = 0; c < sh.levels.size(); ++c) {
     const int top = static_cast<int>(sh.levels[c].size()) - 1;
     const int l = sh.scene ? sh.scene->clamp_level(c, app.level()) : std::min(app.level(), top);  // a tolerance step: the curve's own level
+    const std::vector<Vec2>& pts = cut_step >= 0 ? sh.cuts[c][static_cast<std::size_t>(cut_step)] : sh.levels[c][static_cast<std::size_t>(l)];
     glBegin(sh.closed[c] ? GL_LINE_LOOP : GL_LINE_STRIP);
-    for (const Vec2& p : sh.levels[c][static_cast<std::size_t>(l)]) glVertex2d(v.px(p.x), v.py(p.y));
+    for (const Vec2& p : pts) glVertex2d(v.px(p.x), v.py(p.y));
     glEnd();
   }
   // Error boxes of the level in use (operator overlay).
@@ -153,9 +155,15 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
     glLineWidth(1.0f);
     for (std::size_t c = 0; c < sc.curve_count(); ++c) {
       const int l = sc.clamp_level(c, app.level());
-      const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
-      for (std::uint32_t k = 0; k < segs; ++k) {
-        const ErrorBox& b = sc.box(sc.node_of({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)}));
+      std::vector<SegmentRef> refs;  // the walls' segments: the level's, or a cut step's own
+      if (cut_step >= 0) {
+        refs = sh.cut_segments[c][static_cast<std::size_t>(cut_step)];
+      } else {
+        const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
+        for (std::uint32_t k = 0; k < segs; ++k) refs.push_back({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)});
+      }
+      for (const SegmentRef& ref : refs) {
+        const ErrorBox& b = sc.box(sc.node_of(ref));
         const Vec2 n = left_perp(b.axis);
         glBegin(GL_LINE_LOOP);
         for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {

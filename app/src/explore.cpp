@@ -21,6 +21,7 @@
 #include "coverage.hpp"
 #include "cue_tracker.hpp"
 #include "documents.hpp"
+#include "haptics/tolerance_cut.hpp"
 #include "haptics/explorer_hand.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
@@ -87,8 +88,14 @@ void write_overlay(const std::filesystem::path& out, const ImageScene& is, int l
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const int l = sc.clamp_level(c, level);
     std::vector<cv::Point> pts;
-    const Vec2* p = sc.points(c, l);
-    for (std::uint32_t i = 0; i < sc.curve(c).point_count[l]; ++i) pts.push_back(fixed(to_px(is.px_to_m, p[i])));
+    if (is_cut_level(level)) {  // a cut step: the cut's joined polyline, what the walls were
+      std::vector<SegmentRef> cut;
+      tolerance_cut(sc, c, kToleranceLadder_m[tolerance_step_of(level)], &cut);
+      for (const Vec2& p : joined_cut_points(sc, c, cut.data(), cut.size())) pts.push_back(fixed(to_px(is.px_to_m, p)));
+    } else {
+      const Vec2* p = sc.points(c, l);
+      for (std::uint32_t i = 0; i < sc.curve(c).point_count[l]; ++i) pts.push_back(fixed(to_px(is.px_to_m, p[i])));
+    }
     cv::polylines(img, pts, sc.curve(c).closed, cv::Scalar(0, 220, 255), thick, cv::LINE_AA, kShift);
   }
   std::vector<cv::Point> path;
@@ -287,7 +294,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   for (int l = 0; l < kLevelIds; ++l) {
     if (level_ticks[static_cast<std::size_t>(l)] == 0) continue;
     json e = {{"level", l}, {"ticks", level_ticks[static_cast<std::size_t>(l)]}};
-    if (is_tolerance_level(l)) e["tolerance_m"] = kToleranceLadder_m[l - kToleranceLevelBase];  // a tolerance step's id
+    if (tolerance_step_of(l) >= 0) e["tolerance_m"] = kToleranceLadder_m[tolerance_step_of(l)];  // a tolerance or cut step's id
+    if (is_cut_level(l)) e["cut"] = true;
     lt.push_back(std::move(e));
   }
   sj["levels"] = {{"mode", s.haptics.level_mode}, {"changes", level_changes}, {"ticks_waiting_for_a_safe_change", level_waiting},

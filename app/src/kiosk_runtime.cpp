@@ -13,6 +13,7 @@
 #include "describe.hpp"
 #include "device_setup.hpp"
 #include "haptics/io/tty_transport.hpp"
+#include "haptics/tolerance_cut.hpp"
 #include "picture_library.hpp"
 #include "simulation.hpp"
 
@@ -374,11 +375,14 @@ void KioskRuntime::remove_stick_folder() {
 
 bool KioskRuntime::change_level(int delta) {
   // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until the
-  // session ends. With a tolerance step in use (level_mode = "tolerance") the keys move along the steps,
-  // so finer and coarser keep their order (and their earcons) without comparing a step with a level.
+  // session ends. With a tolerance or cut step in use (level_mode = "tolerance" or "cut") the keys move along
+  // the steps, so finer and coarser keep their order (and their earcons) without comparing a step with a level.
   const int now = level();
   const int next = now + delta;
-  if (is_tolerance_level(now) ? !is_tolerance_level(next) : (next < 0 || next > s_.haptics.max_levels)) return false;
+  const bool in_range = is_tolerance_level(now) ? is_tolerance_level(next)
+                        : is_cut_level(now)     ? is_cut_level(next)
+                                                : (next >= 0 && next <= s_.haptics.max_levels);
+  if (!in_range) return false;
   level_ = next;
   auto_level_ = false;
   core_.request_level(level_);
@@ -498,6 +502,19 @@ void KioskRuntime::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::
     for (int l = 0; l < sc.curve(c).levels; ++l) {
       const Vec2* p = sc.points(c, l);
       sh.levels[c].emplace_back(p, p + sc.curve(c).point_count[l]);
+    }
+  }
+  sh.cut_segments.clear();
+  sh.cuts.clear();
+  if (s_.haptics.level_mode == "cut") {
+    sh.cut_segments.assign(sc.curve_count(), std::vector<std::vector<SegmentRef>>(kToleranceSteps));
+    sh.cuts.assign(sc.curve_count(), std::vector<std::vector<Vec2>>(kToleranceSteps));
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      for (int t = 0; t < kToleranceSteps; ++t) {
+        std::vector<SegmentRef>& cut = sh.cut_segments[c][static_cast<std::size_t>(t)];
+        tolerance_cut(sc, c, kToleranceLadder_m[t], &cut);
+        sh.cuts[c][static_cast<std::size_t>(t)] = joined_cut_points(sc, c, cut.data(), cut.size());
+      }
     }
   }
   ServoParams sp = sp_;

@@ -61,6 +61,10 @@ struct RuntimeOptions {
 struct Shown {
   std::vector<Polyline> polylines;                     ///< level-0 source curves [m] (for Describe)
   std::vector<std::vector<std::vector<Vec2>>> levels;  ///< [curve][level] → points [m]
+  /// With level_mode = "cut": [curve][tolerance step] → the cut's segments (tolerance_cut) and its joined
+  /// polyline (joined_cut_points) [m], what the walls are at that cut step; empty otherwise.
+  std::vector<std::vector<std::vector<SegmentRef>>> cut_segments;
+  std::vector<std::vector<std::vector<Vec2>>> cuts;
   std::vector<bool> closed;                            ///< [curve]
   cv::Mat picture;                                     ///< BGR, empty for tutorial shapes
   vision::PxToM px_to_m{1, 0, 0};                      ///< picture pixels → workspace metres

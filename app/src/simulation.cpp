@@ -61,6 +61,7 @@ ServoParams servo_params_from(const config::Settings& s) {
   sp.level = s.haptics.level;
   sp.auto_level = s.haptics.level_mode != "fixed";
   sp.tolerance_steps = s.haptics.level_mode == "tolerance";
+  sp.cut_steps = s.haptics.level_mode == "cut";
   sp.policy.error_at_rest_m = s.haptics.level_error_at_rest_m;
   sp.policy.blur_time_s = s.haptics.level_blur_time_s;
   sp.policy.hysteresis = s.haptics.level_hysteresis;

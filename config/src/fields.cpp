@@ -110,7 +110,7 @@ std::string chord_problem(std::string_view v) {
 constexpr std::array<std::string_view, 3> kDeviceTypes{"auto", "simulated", "haply"};
 constexpr std::array<std::string_view, 3> kTransports{"auto", "usb", "tty"};
 constexpr std::array<std::string_view, 2> kRotations{"cw", "ccw"};
-constexpr std::array<std::string_view, 3> kLevelModes{"auto", "tolerance", "fixed"};
+constexpr std::array<std::string_view, 4> kLevelModes{"auto", "tolerance", "cut", "fixed"};
 constexpr std::array<std::string_view, 2> kRenderModes{"walls", "grooves"};
 constexpr std::array<std::string_view, 6> kDetectors{"auto", "canny", "surround", "bilateral", "edpf", "outline"};
 constexpr double kTwoPow31 = 2147483648.0;
@@ -144,7 +144,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(haptics, servo_rate_hz, FieldGroup::haptics, ApplyWhen::restart, 100, 10000, "Hz", "Servo loop rate."),
     HK_FIELD(haptics, level, FieldGroup::levels, ApplyWhen::scene, 0, 12, "",
              "Resolution level at the start, and always when level_mode = \"fixed\"; 0 = finest; must be <= max_levels."),
-    HK_FIELD(haptics, level_mode, FieldGroup::levels, ApplyWhen::scene, 0, 0, "", "\"auto\": the level follows the hand's speed; \"tolerance\": so does the tolerance, each shape at the coarsest of its own levels within it; \"fixed\": always `level`.", kLevelModes),
+    HK_FIELD(haptics, level_mode, FieldGroup::levels, ApplyWhen::scene, 0, 0, "", "\"auto\": the level follows the hand's speed; \"tolerance\": so does the tolerance, each shape at the coarsest of its own levels within it; \"cut\": so does the tolerance, each stretch of a shape as coarse as it allows (the tolerance cut); \"fixed\": always `level`.", kLevelModes),
     HK_FIELD(haptics, level_error_at_rest_m, FieldGroup::levels, ApplyWhen::scene, 0, 0.01, "m", "Deviation from the true curve a slowly moving fingertip cannot feel."),
     HK_FIELD(haptics, level_blur_time_s, FieldGroup::levels, ApplyWhen::scene, 0, 0.1, "s", "The tolerable deviation grows by the hand's speed times this."),
     HK_FIELD(haptics, level_hysteresis, FieldGroup::levels, ApplyWhen::scene, 0, 0.9, "", "Go coarser only when that level's error is this fraction below the tolerance."),

@@ -1,8 +1,6 @@
 // Anytime swept-point query over the collision trees (seed paper §3).
 #include "haptics/collision_query.hpp"
 
-#include "haptics/tolerance_cut.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -36,11 +34,41 @@ inline bool at_target_level(const Scene& sc, std::uint32_t node, int level) {
 
 }  // namespace
 
-// at_target_level, and for a cut (kCutQueryBase + step) the cut's own segments. A walk comes down from the
-// roots and stops at the first cut segment on its way, so it never reaches a node below the cut.
+// at_target_level, and for a cut step the cut's own segments. A walk comes down from the roots and stops at
+// the first cut segment on its way, so it never reaches a node below the cut.
 bool BoundarySection::at_target(std::uint32_t node, int level) const noexcept {
-  if (level >= kCutQueryBase) return scene_->is_segment(node) && ((cut_mask_[node] >> (level - kCutQueryBase)) & 1u) != 0;
+  if (is_cut_level(level)) return scene_->is_segment(node) && ((cut_mask_[node] >> (level - kCutLevelBase)) & 1u) != 0;
   return at_target_level(*scene_, node, level);
+}
+
+bool BoundarySection::wall_neighbour(SegmentRef s, int level, int dir, SegmentRef* out) const noexcept {
+  const Scene& sc = *scene_;
+  const CurveInfo& ci = sc.curve(static_cast<std::size_t>(s.curve));
+  const auto n = static_cast<std::int32_t>(ci.segment_count[s.level]);
+  std::int32_t k = s.segment + (dir > 0 ? 1 : -1);
+  if (k < 0 || k >= n) {
+    if (!ci.closed) return false;
+    k = (k + n) % n;
+  }
+  if (k == s.segment) return false;
+  if (!is_cut_level(level)) {
+    *out = SegmentRef{s.curve, s.level, k};
+    return true;
+  }
+  // The cut segment covering level-0 segment j, the first past s's end (or the last before its start):
+  // exactly one of its ancestors-or-self is in the cut. Same-level segment k's level-0 range holds j.
+  const int step = level - kCutLevelBase;
+  const auto n0 = static_cast<std::int64_t>(ci.segment_count[0]);
+  const std::int64_t j = dir > 0 ? (static_cast<std::int64_t>(k) << s.level) : ((static_cast<std::int64_t>(k) + 1) << s.level) - 1;
+  const CurveNodes& cn = sc.curve_nodes(static_cast<std::size_t>(s.curve));
+  for (int l = static_cast<int>(ci.levels) - 1; l >= 0; --l) {
+    const auto i = static_cast<std::uint32_t>((j % n0) >> l);
+    if ((cut_mask_[cn.box_offset[l] + i] >> step) & 1u) {
+      *out = SegmentRef{s.curve, l, static_cast<std::int32_t>(i)};
+      return !(out->level == s.level && out->segment == s.segment);
+    }
+  }
+  return false;  // not reached: every level-0 segment is under exactly one cut segment
 }
 
 bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit) {
@@ -108,6 +136,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   seen_stamp_.assign(n, 0);
   walk_.resize(scene.wide_index().stack_entries());
   cut_mask_ = tolerance_cut_masks(scene);
+  cut_bounds_ = hk::cut_bounds(scene, cut_mask_.data());
   reset();
 }
 
@@ -249,8 +278,8 @@ void BoundarySection::test_segment(Query& q, std::uint32_t node) {
   ++q.st.segment_tests;
   q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
   Vec2 p0, p1;
-  if (q.level >= kCutQueryBase) {
-    joined_cut_segment(*scene_, cut_mask_.data(), node, q.level - kCutQueryBase, &p0, &p1);
+  if (is_cut_level(q.level)) {
+    joined_cut_segment(*scene_, cut_mask_.data(), node, q.level - kCutLevelBase, &p0, &p1);
   } else {
     scene_->segment_points(node, &p0, &p1);
   }
@@ -614,6 +643,15 @@ float BoundarySection::seeded_ball_sq(const WideIndex& wi, float bx, float by, f
 
 SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                                          QueryBudget& budget, QueryStats* stats_out) {
+  if (is_cut_level(level)) {  // not walked here (first_hit walks cuts): nothing is proven clear, never guess
+    if (stats_out) *stats_out = QueryStats{};
+    SweepHit none;
+    none.blocked = true;
+    none.t = 0.0;
+    none.point_m = a;
+    none.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
+    return none;
+  }
   const double r_sq = wide_ball_radius_m_ * wide_ball_radius_m_;
   if (length_sq(a - wide_ball_center_m_) < r_sq && length_sq(b - wide_ball_center_m_) < r_sq) {
     if (stats_out) *stats_out = QueryStats{};
@@ -842,6 +880,7 @@ bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcep
 
 bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
                                     QueryBudget* budget) {
+  if (is_cut_level(level)) return closest_point_cut(p, level - kCutLevelBase, max_distance_m, point_out, segment_out, curve, budget);
   if (scene_->curve_count() == 0) return false;
   ClosestQuery q(p, level, curve, max_distance_m);
   closest_seed(q);
@@ -861,7 +900,7 @@ bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m,
                                         QueryBudget* budget) {
   const Scene& sc = *scene_;
   if (sc.curve_count() == 0) return false;
-  ClosestQuery q(p, kCutQueryBase + step, curve, max_distance_m);
+  ClosestQuery q(p, kCutLevelBase + step, curve, max_distance_m);
   // A node of another curve holds nothing of `curve` (a hierarchy node may: kept).
   const auto other_curve = [&sc, curve](std::uint32_t node) {
     if (curve < 0) return false;

@@ -5,51 +5,21 @@
 #include <cmath>
 
 namespace hk {
-namespace {
+ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
+    : scene_(&scene), params_(params), section_(scene) {
+  for (int id = 0; id < kLevelIds; ++id) {
+    max_half_width_m_[id] = is_cut_level(id) ? 2.0 * section_.cut_bounds().half_width_m[tolerance_step_of(id)] : scene.max_box_half_width_m(id);
+  }
+}
 
-struct SegGeom {
-  Vec2 a, b, u, n;  // end points, unit direction, unit left normal
-  double len = 0.0;
-};
-
-inline SegGeom geom(const Scene& sc, SegmentRef s) {
+ContactSolver::SegGeom ContactSolver::geom(SegmentRef s, int level) const {
   SegGeom g;
-  sc.segment(s, &g.a, &g.b);
+  section_.wall_points(s, level, &g.a, &g.b);
   const Vec2 d = g.b - g.a;
   g.len = length(d);
   g.u = normalized_or(d, Vec2{1.0, 0.0});
   g.n = left_perp(g.u);
   return g;
-}
-
-// The neighbour of segment s across its start (dir < 0) or end (dir > 0) vertex, if the curve has one.
-inline bool neighbour(const Scene& sc, SegmentRef s, int dir, SegmentRef* out) {
-  const CurveInfo& ci = sc.curve(static_cast<std::size_t>(s.curve));
-  const std::int32_t n = static_cast<std::int32_t>(ci.segment_count[s.level]);
-  std::int32_t k = s.segment + (dir > 0 ? 1 : -1);
-  if (k < 0 || k >= n) {
-    if (!ci.closed) return false;
-    k = (k + n) % n;
-  }
-  if (k == s.segment) return false;
-  *out = SegmentRef{s.curve, s.level, k};
-  return true;
-}
-
-}  // namespace
-
-ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
-    : scene_(&scene), params_(params), section_(scene) {
-  for (int id = 0; id < kLevelIds; ++id) max_half_width_m_[id] = scene.max_box_half_width_m(id);
-}
-
-bool ContactSolver::on_level(SegmentRef s, int level) const {
-  return s.level == scene_->clamp_level(static_cast<std::size_t>(s.curve), level);
-}
-
-double ContactSolver::side_of(SegmentRef s, Vec2 p) const {
-  const SegGeom g = geom(*scene_, s);
-  return dot(g.n, p - g.a) >= 0.0 ? 1.0 : -1.0;
 }
 
 void ContactSolver::reset(Vec2 p_m, int level) {
@@ -70,7 +40,7 @@ void ContactSolver::push_off_walls(QueryBudget* budget) {
   Vec2 q;
   SegmentRef s;
   if (section_.closest_point(proxy_, level_, 2.0 * params_.skin_m, &q, &s, -1, budget)) {
-    const SegGeom g = geom(*scene_, s);
+    const SegGeom g = geom(s, level_);
     const double side = dot(g.n, proxy_ - g.a) >= 0.0 ? 1.0 : -1.0;
     proxy_ = q + (2.0 * params_.skin_m * side) * g.n;
   }
@@ -123,11 +93,10 @@ void ContactSolver::count_press(const ContactInput& in, ContactOutput& out) {
 }
 
 int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget) {
-  const Scene& sc = *scene_;
   Vec2 q;
   SegmentRef s;
   if (!section_.closest_point(p, level, radius_m, &q, &s, curve, budget)) return budget && budget->ran_out ? 3 : 0;
-  const SegGeom g = geom(sc, s);
+  const SegGeom g = geom(s, level);
   // The sign of (p − q) against the normal at q decides the side; where q is a vertex that normal is the
   // angle-weighted pseudo-normal (in 2D the bisector of the two edges' normals), which makes the sign
   // exact (Bærentzen & Aanæs 2005, "Signed distance computation using the angle weighted pseudonormal",
@@ -138,8 +107,8 @@ int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, 
   for (int dir : {-1, +1}) {
     if (dir < 0 ? t > 1e-12 : t < g.len - 1e-12) continue;
     // Nearest to an open end: p is beyond the curve, not between its levels (the levels share their ends).
-    if (!neighbour(sc, s, dir, &nb)) return 0;
-    n = normalized_or(g.n + geom(sc, nb).n, g.n);
+    if (!section_.wall_neighbour(s, level, dir, &nb)) return 0;
+    n = normalized_or(g.n + geom(nb, level).n, g.n);
   }
   const double d = dot(p - q, n);
   return d > 0.0 ? 1 : (d < 0.0 ? -1 : 2);  // 2: on the polyline, no side
@@ -177,14 +146,28 @@ bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) {
   return true;
 }
 
-ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count,
-                            QueryBudget& budget, ContactOutput& out, Constraint* hit_out) {
+bool ContactSolver::excluded_at(const Constraint& c, int level) const {
+  if (c.level == level) return true;
+  if (!section_.is_wall(c.seg, level)) return false;
+  if (!is_cut_level(level) && !is_cut_level(c.level)) return true;  // a level's segment: the same end points under every id
+  Vec2 a0, b0, a1, b1;
+  section_.wall_points(c.seg, c.level, &a0, &b0);
+  section_.wall_points(c.seg, level, &a1, &b1);
+  return a0 == a1 && b0 == b1;
+}
+
+ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget, ContactOutput& out,
+                                           Constraint* hit_out) {
   QueryStats st;
-  SweepHit hit = section_.first_hit(proxy_, target, level, excluded, excluded_count, budget, &st);
+  const bool skip_new = excluded && excluded_at(*excluded, level);
+  SweepHit hit = section_.first_hit(proxy_, target, level, skip_new ? &excluded->seg : nullptr, skip_new ? 1 : 0, budget, &st);
+  int hit_level = level;
   if (transition_level_ >= 0) {
     // Just after a level change both levels are walls (see level_change_is_safe): the nearer one stops the move.
     QueryStats st2;
-    const SweepHit old_hit = section_.first_hit(proxy_, target, transition_level_, excluded, excluded_count, budget, &st2);
+    const bool skip_old = excluded && excluded_at(*excluded, transition_level_);
+    const SweepHit old_hit =
+        section_.first_hit(proxy_, target, transition_level_, skip_old ? &excluded->seg : nullptr, skip_old ? 1 : 0, budget, &st2);
     st.box_tests += st2.box_tests;
     st.section_box_tests += st2.section_box_tests;
     st.segment_tests += st2.segment_tests;
@@ -192,7 +175,10 @@ ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Segment
     st.merges += st2.merges;
     st.budget_exhausted = st.budget_exhausted || st2.budget_exhausted;
     const bool old_first = (old_hit.hit || old_hit.blocked) && (!(hit.hit || hit.blocked) || old_hit.t < hit.t);
-    if (old_first) hit = old_hit;
+    if (old_first) {
+      hit = old_hit;
+      hit_level = transition_level_;
+    }
   }
   out.query.box_tests += st.box_tests;
   out.query.section_box_tests += st.section_box_tests;
@@ -218,7 +204,7 @@ ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Segment
     return Move::Clear;
   }
   // Stop where the proxy is a skin away from the wall's line, along the path already proven clear.
-  const SegGeom g = geom(*scene_, hit.segment);
+  const SegGeom g = geom(hit.segment, hit_level);
   double side = dot(g.n, proxy_ - g.a);
   side = side > 0.0 ? 1.0 : (side < 0.0 ? -1.0 : (dot(g.n, target - g.a) > 0.0 ? -1.0 : 1.0));
   const double dist0 = side * dot(g.n, proxy_ - g.a);
@@ -229,6 +215,7 @@ ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Segment
   if (out.path_count < ContactOutput::kMaxPath) out.path_m[out.path_count++] = proxy_;
   hit_out->seg = hit.segment;
   hit_out->side = side;
+  hit_out->level = hit_level;
   return Move::Hit;
 }
 
@@ -268,7 +255,7 @@ void ContactSolver::begin_step(const ContactInput& in, ContactOutput& out) {
 
 bool ContactSolver::step_free(Step& s) {
   Constraint hit;
-  const Move m = move_to(s.in.handle_m, level_, nullptr, 0, s.budget, s.out, &hit);
+  const Move m = move_to(s.in.handle_m, level_, nullptr, s.budget, s.out, &hit);
   if (m != Move::Hit) return true;
   state_ = ContactState::Edge;
   c_[0] = hit;
@@ -277,11 +264,9 @@ bool ContactSolver::step_free(Step& s) {
 }
 
 bool ContactSolver::step_edge(Step& s) {
-  const Scene& sc = *scene_;
   const Vec2 h = s.in.handle_m;
-  const SegmentRef seg = c_[0].seg;
   const double side = c_[0].side;
-  const SegGeom g = geom(sc, seg);
+  const SegGeom g = geom(c_[0]);
   if (side * dot(g.n, h - g.a) >= 0.0) {  // handle back on the proxy's side: contact released
     state_ = ContactState::Free;
     return false;
@@ -303,13 +288,13 @@ bool ContactSolver::step_edge(Step& s) {
   const int clamped = tau < 0.0 ? -1 : (tau > g.len ? 1 : 0);
   const double tau_c = std::clamp(tau, 0.0, g.len);
   Constraint hit;
-  const Move m = move_to(g.a + tau_c * g.u + (side * params_.skin_m) * g.n, level_, &seg, 1, s.budget, s.out, &hit);
+  const Move m = move_to(g.a + tau_c * g.u + (side * params_.skin_m) * g.n, level_, &c_[0], s.budget, s.out, &hit);
   if (m == Move::Blocked) return true;
   if (m == Move::Hit) {
     state_ = ContactState::Vertex;  // a second wall while sliding
     c_[1] = hit;
     s.out.events |= kEventVertexBegin;
-    const SegGeom gh = geom(sc, hit.seg);  // the angle between the two walls' lines, in [0, π/2]
+    const SegGeom gh = geom(hit);  // the angle between the two walls' lines, in [0, π/2]
     s.out.corner_turn_rad = std::max(s.out.corner_turn_rad, std::atan2(std::fabs(cross(g.u, gh.u)), std::fabs(dot(g.u, gh.u))));
     return false;
   }
@@ -318,17 +303,16 @@ bool ContactSolver::step_edge(Step& s) {
 }
 
 bool ContactSolver::at_edge_vertex(Step& s, int clamped) {
-  const Scene& sc = *scene_;
   const Vec2 h = s.in.handle_m;
-  const SegmentRef seg = c_[0].seg;
   const double side = c_[0].side;
-  const SegGeom g = geom(sc, seg);
+  const int wall_level = c_[0].level;
+  const SegGeom g = geom(c_[0]);
   SegmentRef nb;
-  if (!neighbour(sc, seg, clamped, &nb)) {  // the open end of a curve: go round it
+  if (!section_.wall_neighbour(c_[0].seg, wall_level, clamped, &nb)) {  // the open end of a curve: go round it
     state_ = ContactState::Free;
     return false;
   }
-  const SegGeom gn = geom(sc, nb);
+  const SegGeom gn = geom(nb, wall_level);
   const Vec2 v = clamped > 0 ? g.b : g.a;
   const Vec2 u_in = clamped > 0 ? g.u : gn.u;
   const Vec2 u_out = clamped > 0 ? gn.u : g.u;
@@ -338,7 +322,7 @@ bool ContactSolver::at_edge_vertex(Step& s, int clamped) {
   if (turn > 0.0) {  // concave on the proxy's side: the two walls hold it
     if (!pen_nb) return true;
     state_ = ContactState::Vertex;
-    c_[1] = Constraint{nb, side};
+    c_[1] = Constraint{nb, side, wall_level};
     s.out.events |= kEventVertexBegin;
     s.out.corner_turn_rad = std::max(s.out.corner_turn_rad, turn_rad);
     return false;
@@ -351,7 +335,7 @@ bool ContactSolver::at_edge_vertex(Step& s, int clamped) {
   }
   const Vec2 bis = normalized_or(g.n + gn.n, clamped > 0 ? g.u : -g.u);
   Constraint hit;
-  const Move mc = move_to(v + (side * params_.skin_m) * bis, level_, nullptr, 0, s.budget, s.out, &hit);
+  const Move mc = move_to(v + (side * params_.skin_m) * bis, level_, nullptr, s.budget, s.out, &hit);
   if (mc == Move::Blocked) return true;
   if (mc == Move::Hit) {
     state_ = ContactState::Edge;
@@ -359,7 +343,7 @@ bool ContactSolver::at_edge_vertex(Step& s, int clamped) {
     return false;
   }
   if (pen_nb) {
-    c_[0] = Constraint{nb, side};
+    c_[0] = Constraint{nb, side, wall_level};
   } else {
     state_ = ContactState::Free;
   }
@@ -367,10 +351,9 @@ bool ContactSolver::at_edge_vertex(Step& s, int clamped) {
 }
 
 bool ContactSolver::step_vertex(Step& s) {
-  const Scene& sc = *scene_;
   const Vec2 h = s.in.handle_m;
-  const SegGeom ga = geom(sc, c_[0].seg);
-  const SegGeom gb = geom(sc, c_[1].seg);
+  const SegGeom ga = geom(c_[0]);
+  const SegGeom gb = geom(c_[1]);
   const double sa = c_[0].side, sb = c_[1].side;
   const bool pen_a = sa * dot(ga.n, h - ga.a) < 0.0;
   const bool pen_b = sb * dot(gb.n, h - gb.a) < 0.0;
@@ -409,7 +392,7 @@ Vec2 ContactSolver::contact_force(const ContactInput& in) const {
   const Vec2 h = in.handle_m;
   Vec2 f = params_.stiffness_n_per_m * (proxy_ - h);
   if (state_ != ContactState::Free && params_.damping_n_s_per_m > 0.0) {
-    const SegGeom g = geom(*scene_, c_[0].seg);
+    const SegGeom g = geom(c_[0]);
     f -= (params_.damping_n_s_per_m * dot(in.handle_velocity_m_per_s, g.n)) * g.n;
   }
   const double mag = length(f);
@@ -433,7 +416,8 @@ void ContactSolver::finish_step(ContactState before, Vec2 force_n, ContactOutput
   }
   if (transition_level_ >= 0) {  // the old level's walls go once the proxy rests on none of them
     const bool on_old = state_ != ContactState::Free &&
-                        (on_level(c_[0].seg, transition_level_) || (state_ == ContactState::Vertex && on_level(c_[1].seg, transition_level_)));
+                        (section_.is_wall(c_[0].seg, transition_level_) ||
+                         (state_ == ContactState::Vertex && section_.is_wall(c_[1].seg, transition_level_)));
     if (!on_old) transition_level_ = -1;
   }
   out.transition_level = transition_level_;

@@ -48,9 +48,10 @@ int LevelPolicy::update(Vec2 v, double dt) noexcept {
 }
 
 std::string level_label(int id) {
-  if (!is_tolerance_level(id)) return "level " + std::to_string(id);
+  const int step = tolerance_step_of(id);
+  if (step < 0) return "level " + std::to_string(id);
   char text[40];
-  std::snprintf(text, sizeof text, "tolerance %.2f mm", kToleranceLadder_m[id - kToleranceLevelBase] * 1e3);
+  std::snprintf(text, sizeof text, is_cut_level(id) ? "cut %.2f mm" : "tolerance %.2f mm", kToleranceLadder_m[step] * 1e3);
   return text;
 }
 

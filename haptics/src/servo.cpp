@@ -32,13 +32,23 @@ namespace {
 
 // The policy's ladder: the level ids it chooses from, finest first, and the scene's error bound at each
 // (the worst curve's, so the id chosen keeps every curve within tolerance). Levels: every level of the
-// scene. Tolerance steps (ServoParams::tolerance_steps): every step (LevelPolicy keeps the bounds
-// non-decreasing, as a curve's bound need not grow with its level). Also writes the scene's bound at every
-// level id to `id_bound` (kLevelIds entries), for placing an id that is not on the ladder. Returns the
-// ladder's length.
-int level_ladder(const Scene& scene, bool tolerance_steps, int* ids, double* err, double* id_bound) {
-  for (int id = 0; id < kLevelIds; ++id) id_bound[id] = scene.max_error_bound_m(id);
-  if (!tolerance_steps) {
+// scene. Tolerance steps (ServoParams::tolerance_steps) or cut steps (cut_steps): every step (LevelPolicy
+// keeps the bounds non-decreasing, as a curve's bound need not grow with its level); a cut step's bound is
+// its cut's (CutBounds: the largest segment bound plus the largest join shift). Also writes the scene's bound
+// at every level id to `id_bound` (kLevelIds entries), for placing an id that is not on the ladder. Returns
+// the ladder's length.
+int level_ladder(const Scene& scene, const CutBounds& cuts, const ServoParams& p, int* ids, double* err, double* id_bound) {
+  for (int id = 0; id < kLevelIds; ++id) {
+    id_bound[id] = is_cut_level(id) ? cuts.error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
+  }
+  if (p.cut_steps) {
+    for (int t = 0; t < kToleranceSteps; ++t) {
+      ids[t] = kCutLevelBase + t;
+      err[t] = id_bound[ids[t]];
+    }
+    return kToleranceSteps;
+  }
+  if (!p.tolerance_steps) {
     const int levels = std::min(scene.max_curve_levels(), LevelPolicy::kMaxLevels);
     for (int l = 0; l < levels; ++l) {
       ids[l] = l;
@@ -111,7 +121,7 @@ ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
       solver_(scene, contact_params(params)),
       groove_(scene, params.groove),
-      levels_(level_ladder(scene, params.tolerance_steps, ladder_id_, level_error_m_, id_bound_m_)),
+      levels_(level_ladder(scene, solver_.section().cut_bounds(), params, ladder_id_, level_error_m_, id_bound_m_)),
       policy_(policy_params(params), level_error_m_, levels_, ladder_index(params.level)),  // the ladder's members are set by now
       level_(params.level),
       guard_max_force_n_(params.guard.max_force_n) {}

@@ -106,6 +106,30 @@ void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint
   }
 }
 
+CutBounds cut_bounds(const Scene& scene, const std::uint8_t* masks) {
+  CutBounds cb;
+  double shift_m[kToleranceSteps] = {};
+  for (std::uint32_t node = 0; node < scene.node_count(); ++node) {
+    if (masks[node] == 0) continue;  // group nodes and segments in no cut
+    const NodeInfo in = scene.info(node);
+    const SegmentRef s{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
+    const ErrorBox box = scene.box(node);
+    const double bound = segment_bound(scene, s);
+    Vec2 a, b;
+    scene.segment_points(node, &a, &b);
+    for (int t = 0; t < kToleranceSteps; ++t) {
+      if (((masks[node] >> t) & 1u) == 0) continue;
+      Vec2 ja, jb;
+      joined_cut_segment(scene, masks, node, t, &ja, &jb);
+      cb.error_bound_m[t] = std::max(cb.error_bound_m[t], bound);
+      cb.half_width_m[t] = std::max(cb.half_width_m[t], box_half_width(box));
+      shift_m[t] = std::max({shift_m[t], distance(a, ja), distance(b, jb)});
+    }
+  }
+  for (int t = 0; t < kToleranceSteps; ++t) cb.error_bound_m[t] += shift_m[t];
+  return cb;
+}
+
 CutStats tolerance_cut(const Scene& scene, std::size_t curve, double tol_m, std::vector<SegmentRef>* out) {
   CutStats st;
   const CurveInfo& ci = scene.curve(curve);

@@ -21,32 +21,29 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// True when p lies strictly between curve c's polylines at levels `lo` and `ln` (an odd number of
-/// crossings of the ray p → +x with the loop old polyline → new polyline reversed; for an open curve the
-/// loop is closed by the two short joins between the levels' end points). Brute force over all segments,
-/// independent of the solver's trees.
+/// True when p lies strictly between curve c's polylines at level ids `lo` and `ln` (test::polyline_at: a
+/// level's points, or a cut step's joined polyline): an odd number of crossings of the ray p → +x with the loop
+/// old polyline → new polyline reversed; for an open curve the loop is closed by the two short joins between
+/// the polylines' end points. Brute force over all segments, independent of the solver's trees.
 bool between_levels(const Scene& sc, std::size_t c, int lo, int ln, Vec2 p) {
   const CurveInfo& ci = sc.curve(c);
-  lo = sc.clamp_level(c, lo);
-  ln = sc.clamp_level(c, ln);
-  if (lo == ln) return false;
+  const std::vector<Vec2> po = test::polyline_at(sc, c, lo);
+  const std::vector<Vec2> pn = test::polyline_at(sc, c, ln);
+  if (po == pn) return false;
   int crossings = 0;
   auto edge = [&](Vec2 a, Vec2 b) {
     if ((a.y > p.y) == (b.y > p.y)) return;
     const double x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
     if (x > p.x) ++crossings;
   };
-  for (int l : {lo, ln}) {
-    const Vec2* pts = sc.points(c, l);
-    const std::uint32_t n = ci.point_count[l];
-    for (std::uint32_t i = 0; i + 1 < n; ++i) edge(pts[i], pts[i + 1]);
-    if (ci.closed && n > 1) edge(pts[n - 1], pts[0]);
+  for (const std::vector<Vec2>* pts : {&po, &pn}) {
+    const std::size_t n = pts->size();
+    for (std::size_t i = 0; i + 1 < n; ++i) edge((*pts)[i], (*pts)[i + 1]);
+    if (ci.closed && n > 1) edge((*pts)[n - 1], (*pts)[0]);
   }
   if (!ci.closed) {
-    const Vec2* po = sc.points(c, lo);
-    const Vec2* pn = sc.points(c, ln);
-    edge(po[0], pn[0]);
-    edge(po[ci.point_count[lo] - 1], pn[ci.point_count[ln] - 1]);
+    edge(po.front(), pn.front());
+    edge(po.back(), pn.back());
   }
   return crossings % 2 == 1;
 }
@@ -54,7 +51,7 @@ bool between_levels(const Scene& sc, std::size_t c, int lo, int ln, Vec2 p) {
 class LevelChanges : public ::testing::TestWithParam<const char*> {};
 
 // The raster over picture `name` with levels from hand speed (`level_mode` "auto": levels; "tolerance":
-// tolerance steps, each curve at its own level), checked as the file's comment says.
+// tolerance steps, each curve at its own level; "cut": cut steps), checked as the file's comment says.
 void raster_changes_levels_without_crossing_or_force_steps(const char* name, const std::string& level_mode) {
   config::Settings s;
   s.haptics.level_mode = level_mode;
@@ -65,14 +62,14 @@ void raster_changes_levels_without_crossing_or_force_steps(const char* name, con
   ASSERT_GT(sc.curve_count(), 0u);
   const HandPath hand = raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
 
-  // One crossing grid per level id in force (levels, or tolerance steps), built when first needed.
+  // One crossing grid per level id in force (levels, tolerance steps or cut steps), built when first needed.
   std::map<int, std::unique_ptr<test::CrossingGrid>> grid_of;
   auto grid = [&](int id) -> test::CrossingGrid& {
     auto& g = grid_of[id];
     if (!g) g = std::make_unique<test::CrossingGrid>(sc, id);
     return *g;
   };
-  long tolerance_ticks = 0;
+  long tolerance_ticks = 0, cut_ticks = 0;
   const double k = s.haptics.stiffness_n_per_m;
   const double step = s.haptics.level_max_force_step_n;
 
@@ -91,6 +88,7 @@ void raster_changes_levels_without_crossing_or_force_steps(const char* name, con
       if (old_wall >= 0) crossings += grid(old_wall).crossings(c.path_m[m - 1], c.path_m[m]);
     }
     tolerance_ticks += is_tolerance_level(so.level);
+    cut_ticks += is_cut_level(so.level);
     transition_ticks += old_wall >= 0;
     prev_transition = c.transition_level;
     waiting += so.level != so.level_wanted;
@@ -129,12 +127,9 @@ void raster_changes_levels_without_crossing_or_force_steps(const char* name, con
   EXPECT_EQ(crossings, 0);
   EXPECT_EQ(wrong_side, 0);
   EXPECT_EQ(force_steps, 0);
-  // The mode decides what the policy picks: tolerance steps on every tick, or never.
-  if (level_mode == "tolerance") {
-    EXPECT_EQ(tolerance_ticks, ticks) << "every tick at a tolerance step";
-  } else {
-    EXPECT_EQ(tolerance_ticks, 0);
-  }
+  // The mode decides what the policy picks: tolerance steps (or cut steps) on every tick, or never.
+  EXPECT_EQ(tolerance_ticks, level_mode == "tolerance" ? ticks : 0) << "level_mode " << level_mode;
+  EXPECT_EQ(cut_ticks, level_mode == "cut" ? ticks : 0) << "level_mode " << level_mode;
 }
 
 TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) {
@@ -144,6 +139,12 @@ TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) 
 // Issue 18: the policy picks a tolerance instead of a level; the same crossing checks stay at 0.
 TEST_P(LevelChanges, FastAndSlowRasterChangesToleranceStepsWithoutCrossingOrForceSteps) {
   raster_changes_levels_without_crossing_or_force_steps(GetParam(), "tolerance");
+}
+
+// Issue 18: the policy picks a tolerance and the walls are its cut, refined per segment and joined where the
+// level changes; the same crossing checks stay at 0 (against the joined polylines).
+TEST_P(LevelChanges, FastAndSlowRasterChangesCutStepsWithoutCrossingOrForceSteps) {
+  raster_changes_levels_without_crossing_or_force_steps(GetParam(), "cut");
 }
 
 INSTANTIATE_TEST_SUITE_P(RealImages, LevelChanges,

@@ -63,10 +63,11 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     }
     if (name == "haptics.level_mode") {
       EXPECT_EQ(d.kind, FieldKind::text);
-      ASSERT_EQ(d.choices.size(), 3u);
+      ASSERT_EQ(d.choices.size(), 4u);
       EXPECT_EQ(d.choices[0], "auto");
       EXPECT_EQ(d.choices[1], "tolerance");
-      EXPECT_EQ(d.choices[2], "fixed");
+      EXPECT_EQ(d.choices[2], "cut");
+      EXPECT_EQ(d.choices[3], "fixed");
       ++texts;
       continue;
     }

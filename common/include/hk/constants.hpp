@@ -17,18 +17,33 @@ inline constexpr int kMaxLevels = 16;
 /// is either a level, 0 .. kMaxLevels − 1, the same for every curve (clamped to each curve's coarsest), or
 /// a tolerance step, kToleranceLevelBase + t: each curve at the coarsest of its own levels whose error
 /// bound is ≤ kToleranceLadder_m[t] (level 0 when none is), so a straight curve goes coarse while a
-/// wiggly one stays fine (Scene::clamp_level resolves both kinds per curve).
+/// wiggly one stays fine (Scene::clamp_level resolves both kinds per curve); or a cut step,
+/// kCutLevelBase + t: the tolerance cut at the same tolerance, chosen per segment (below).
 inline constexpr int kToleranceSteps = 8;
 /// The first tolerance-step id: above every level.
 inline constexpr int kToleranceLevelBase = kMaxLevels;
-/// Level ids in all: the levels, then the tolerance steps. Per-id tables (the contact solver's widths) have
-/// this many entries.
-inline constexpr int kLevelIds = kMaxLevels + kToleranceSteps;
+/// The first cut-step id, above the tolerance steps. Cut step kCutLevelBase + t renders the tolerance cut at
+/// kToleranceLadder_m[t] (haptics/tolerance_cut.hpp): on every curve, segments of mixed levels, each refined
+/// while its error box's bound exceeds the tolerance, joined where the level changes; a per-segment choice
+/// where a tolerance step is a per-curve one. BoundarySection and ContactSolver walk it; Scene::clamp_level
+/// gives a cut step its tolerance step's per-curve level, which the cut refines.
+inline constexpr int kCutLevelBase = kToleranceLevelBase + kToleranceSteps;
+/// Level ids in all: the levels, the tolerance steps, then the cut steps. Per-id tables (the contact solver's
+/// widths) have this many entries.
+inline constexpr int kLevelIds = kMaxLevels + 2 * kToleranceSteps;
 /// The tolerance of each step [m], increasing by ~1.6x (the R10 series): from the fingertip's 0.1 mm at
 /// rest to 2.5 mm, the tolerable error of a hand at ~0.24 m/s (haptics/level_policy.hpp).
 inline constexpr double kToleranceLadder_m[kToleranceSteps] = {1.0e-4, 1.6e-4, 2.5e-4, 4.0e-4, 6.3e-4, 1.0e-3, 1.6e-3, 2.5e-3};
 /// True for a tolerance-step id.
-constexpr bool is_tolerance_level(int id) { return id >= kToleranceLevelBase && id < kLevelIds; }
+constexpr bool is_tolerance_level(int id) { return id >= kToleranceLevelBase && id < kCutLevelBase; }
+/// True for a cut-step id.
+constexpr bool is_cut_level(int id) { return id >= kCutLevelBase && id < kLevelIds; }
+/// The tolerance step of a tolerance-step or cut-step id (0 .. kToleranceSteps − 1); −1 for a level.
+constexpr int tolerance_step_of(int id) {
+  if (is_tolerance_level(id)) return id - kToleranceLevelBase;
+  if (is_cut_level(id)) return id - kCutLevelBase;
+  return -1;
+}
 
 /// Deepest hierarchy of nodes above the curves' chunks in a scene's collision tree (the tree over
 /// chunks halves per level, so 64 covers any scene that fits in memory).

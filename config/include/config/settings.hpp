@@ -16,7 +16,7 @@ struct HapticsSettings {
   double max_force_n = 3.5;               ///< key max_force_n, force clamp, [0.1, 20] N (the simulated pantograph gives ≥ 3.78 N in every direction)
   double servo_rate_hz = 1000.0;          ///< key servo_rate_hz, [100, 10000] Hz
   int level = 1;                          ///< key level, resolution level at the start (and always, when level_mode = "fixed"), [0, 12] and <= max_levels; 0 = finest
-  std::string level_mode = "auto";        ///< key level_mode, "auto" (a level from hand speed, issue 6), "tolerance" (a tolerance from hand speed, each curve at its own level within it, issue 18) or "fixed" (always `level`)
+  std::string level_mode = "auto";        ///< key level_mode, "auto" (a level from hand speed, issue 6), "tolerance" (a tolerance from hand speed, each curve at its own level within it, issue 18), "cut" (a tolerance from hand speed, each segment refined only while its error box exceeds it: the tolerance cut, issue 18) or "fixed" (always `level`)
   double level_error_at_rest_m = 1e-4;    ///< key level_error_at_rest_m, deviation a slow fingertip cannot feel, [0, 0.01] m; 0 = the finest level whenever the hand rests
   double level_blur_time_s = 0.010;       ///< key level_blur_time_s, tolerable deviation grows by hand speed x this, [0, 0.1] s
   double level_hysteresis = 0.3;          ///< key level_hysteresis, go coarser only when the bound is this fraction under the tolerance, [0, 0.9]

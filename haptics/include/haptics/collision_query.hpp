@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "haptics/scene.hpp"
+#include "haptics/tolerance_cut.hpp"
 
 namespace hk {
 
@@ -106,7 +107,8 @@ class BoundarySection {
   /// Forgets the frontier (back to one root per curve), both free-space balls and the closest-point seed. Real-time safe.
   void reset();
 
-  /// First hit of the sweep a→b against the polylines at `level` (clamped per curve to its coarsest),
+  /// First hit of the sweep a→b against the polylines at level id `level` (clamped per curve to its coarsest;
+  /// a cut step: its cut's joined segments, see first_hit_cut),
   /// ignoring up to kMaxExcluded segments (the contact solver's active constraints). Updates the
   /// boundary section. Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
@@ -121,11 +123,13 @@ class BoundarySection {
   /// in one SIMD test); past it, nodes are not opened and the answer is blocked at the entry of the nearest
   /// one, with segment {-1, kMaxLevels, -1}: unlike first_hit, no coarser level's segment is known there.
   /// Same answers as first_hit otherwise (t bit for bit; checked against brute force in the tests).
-  /// Does not read or change the boundary section. Real-time safe.
+  /// Levels and tolerance steps only: at a cut step (whose joined pieces the item rectangles need not hold)
+  /// it answers blocked at t = 0, nothing proven clear. Does not read or change the boundary section.
+  /// Real-time safe.
   SweepHit first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
                           QueryStats* stats = nullptr);
   /// First hit against the tolerance cut at step `step` (0 ≤ step < kToleranceSteps, tolerance
-  /// kToleranceLadder_m[step]) instead of a level: each curve's segments of mixed levels that tolerance_cut
+  /// kToleranceLadder_m[step]) instead of a level; the same as first_hit at level id kCutLevelBase + step: each curve's segments of mixed levels that tolerance_cut
   /// chooses (refined while a box's error bound exceeds the tolerance; seed §3, "contact computations at a
   /// desired tolerance level"), drawn joined (joined_cut_segment: where the cut changes level, both pieces meet
   /// at the finer segment's end). The walk is first_hit's, through the same boundary section, stopping at the
@@ -133,12 +137,11 @@ class BoundarySection {
   /// (tolerance_cut.hpp), so the boxes prune it exactly as they prune a level. A change of step, or between a
   /// step and a level, starts the section again from the roots. The answer's segment is the cut segment hit
   /// (its own level and index); anytime and budget as first_hit. Answers equal a brute-force test of the
-  /// joined polylines (t bit for bit; tests). Only first hits are answered at a cut so far: the wide index's
-  /// rectangles hold each level's own pieces, not the joined ones, so first_hit_wide and closest_point take
-  /// levels and tolerance steps only. Real-time safe.
+  /// joined polylines (t bit for bit; tests). first_hit_wide does not walk a cut: the wide index's rectangles
+  /// hold each level's own pieces, not the joined ones (closest points at a cut: closest_point_cut). Real-time safe.
   SweepHit first_hit_cut(Vec2 a, Vec2 b, int step, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
                          QueryStats* stats = nullptr) {
-    return first_hit(a, b, kCutQueryBase + step, excluded, excluded_count, budget, stats);
+    return first_hit(a, b, kCutLevelBase + step, excluded, excluded_count, budget, stats);
   }
   /// Closest point on the tolerance cut at step `step` (its joined pieces, as first_hit_cut meets them) to p
   /// within max_distance_m; false when nothing is that close. `curve` ≥ 0 restricts it to that curve. Ties as
@@ -152,6 +155,30 @@ class BoundarySection {
                          QueryBudget* budget = nullptr);
   /// Cut membership of the scene's nodes, computed at construction (tolerance_cut_masks; node_count() entries).
   const std::uint8_t* cut_masks() const noexcept { return cut_mask_.data(); }
+  /// The bounds of each step's cut (cut_bounds), computed at construction.
+  const CutBounds& cut_bounds() const noexcept { return cut_bounds_; }
+  /// The end points [m] of segment `s` as a wall of level id `level`: joined (joined_cut_segment) when `level`
+  /// is a cut step and s is one of its segments, else the segment's own. Real-time safe.
+  void wall_points(SegmentRef s, int level, Vec2* a, Vec2* b) const noexcept {
+    const std::uint32_t node = scene_->node_of(s);
+    const int step = level - kCutLevelBase;
+    if (is_cut_level(level) && ((cut_mask_[node] >> step) & 1u) != 0) {
+      joined_cut_segment(*scene_, cut_mask_.data(), node, step, a, b);
+    } else {
+      scene_->segment_points(node, a, b);
+    }
+  }
+  /// Whether segment `s` is a wall of level id `level`: a segment of its cut (a cut step), or at its curve's
+  /// level for the id (Scene::clamp_level). Real-time safe.
+  bool is_wall(SegmentRef s, int level) const noexcept {
+    if (is_cut_level(level)) return ((cut_mask_[scene_->node_of(s)] >> (level - kCutLevelBase)) & 1u) != 0;
+    return s.level == scene_->clamp_level(static_cast<std::size_t>(s.curve), level);
+  }
+  /// The wall next to `s` along its curve at level id `level`, across its start (dir < 0) or end (dir > 0):
+  /// the next segment of the same level, or at a cut step the cut segment covering the next stretch of the
+  /// curve (any level; its joined end meets s's). False at an open curve's end (and for a one-segment
+  /// closed curve). O(levels) at a cut step; real-time safe.
+  bool wall_neighbour(SegmentRef s, int level, int dir, SegmentRef* out) const noexcept;
 
   /// The same for a one-off query: spends a copy of `budget` (tests, benches). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
@@ -161,7 +188,7 @@ class BoundarySection {
   }
 
   /// Closest point on the polylines at `level` (clamped per curve) to p within max_distance_m. Returns
-  /// false when nothing is that close. `curve` ≥ 0 restricts the search to that curve. Among segments at
+  /// false when nothing is that close. A cut step is answered by closest_point_cut. `curve` ≥ 0 restricts the search to that curve. Among segments at
   /// the same distance (a vertex two segments share) the smallest (curve, level, segment) is the answer,
   /// so it does not depend on the order anything was visited in.
   ///
@@ -182,8 +209,6 @@ class BoundarySection {
   const std::vector<std::uint32_t>& section() const { return section_; }
 
  private:
-  /// first_hit's internal target for the cut at step t: kCutQueryBase + t, past every level id.
-  static constexpr int kCutQueryBase = kLevelIds;
   struct Query;  // one first_hit's inputs, answer so far and counters (collision_query.cpp)
   bool at_target(std::uint32_t node, int level) const noexcept;
   // The phases of first_hit, in order (each documented where it is defined).
@@ -249,8 +274,9 @@ class BoundarySection {
   std::uint32_t last_closest_node_ = kWideEmpty;  // the previous call's answer (segment node), the next call's seed
   int last_closest_level_ = -1, last_closest_curve_ = -1;
   std::uint32_t tick_ = 0;
-  int last_level_ = -1;         // target of the last first_hit: a level id, or kCutQueryBase + step
+  int last_level_ = -1;         // level id of the last first_hit
   std::vector<std::uint8_t> cut_mask_;  // per node: the tolerance steps whose cut it is a segment of (tolerance_cut_masks)
+  CutBounds cut_bounds_;                // each step's cut: error bound and widest box (cut_bounds)
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
   Vec2 ball_center_m_;          // free-space ball: no box of the section as last scanned, so no wall, comes closer to its centre than its radius
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown

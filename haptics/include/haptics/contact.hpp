@@ -87,7 +87,7 @@ struct ContactParams {
 struct ContactInput {
   Vec2 handle_m;                     ///< handle position [m]
   Vec2 handle_velocity_m_per_s;      ///< for rendered damping [m/s]
-  int level = 0;                     ///< level id whose polylines are walls (a level, or a tolerance step: hk/constants.hpp)
+  int level = 0;                     ///< level id whose polylines are walls (a level, a tolerance step or a cut step: hk/constants.hpp)
   /// The tick's box-test budget (QueryBudget): its limit, and what was already spent this tick before the
   /// step (e.g. by level_change_is_safe). Every query of the step draws on it.
   QueryBudget budget;
@@ -153,8 +153,12 @@ class ContactSolver {
   /// either. No second change is made while the old level is still a wall. Allocates nothing (at most six
   /// closest-point walks). With a `budget`, the walks' box tests are charged to it and never take it past
   /// its limit: when it runs out before the answer is known, the answer is false (the change waits).
-  /// Levels and tolerance steps mix freely (level ids, hk/constants.hpp): each curve is compared at its own
-  /// level for each id, and a curve at the same level under both has nothing between its polylines.
+  /// Levels, tolerance steps and cut steps mix freely (level ids, hk/constants.hpp): each curve is compared
+  /// at its own polyline for each id (a cut step's: its joined cut, where E takes twice the cut's widest box,
+  /// as a joined piece may lie anywhere in its box), and a curve with the same polyline under both has nothing
+  /// between them. At a cut step a segment's ends depend on its neighbours in the cut, so a constraint keeps
+  /// the level id it was met at (its geometry), and the wall the proxy slides on is left out only of the
+  /// queries where it has that same geometry.
   bool level_change_is_safe(int new_level, QueryBudget* budget = nullptr);
 
   Vec2 proxy() const { return proxy_; }
@@ -167,12 +171,17 @@ class ContactSolver {
   struct Constraint {
     SegmentRef seg;
     double side = 1.0;  // +1: proxy on the segment's left, −1: right
+    int level = 0;      // the level id it is a wall of (a cut step's segments are drawn joined: their ends depend on it)
   };
   enum class Move : std::uint8_t { Clear, Hit, Blocked };
   // Moves the proxy towards `target`, stopping a skin short of the first wall (Hit, wall in hit_out),
-  // or short of the first box the query could not resolve in its budget (Blocked).
-  Move move_to(Vec2 target, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
-               ContactOutput& out, Constraint* hit_out);
+  // or short of the first box the query could not resolve in its budget (Blocked). The `excluded`
+  // constraint (the wall the proxy slides on, or null) is left out of each query whose walls include it
+  // with the same geometry (excluded_at).
+  Move move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget, ContactOutput& out, Constraint* hit_out);
+  // Whether constraint c is a wall of level id `level` with the same end points as its own (its own level;
+  // at a cut step the same segment may be joined to other neighbours, so it is another wall there).
+  bool excluded_at(const Constraint& c, int level) const;
   // What one update() works on: the handle, the tick's budget, the output. Passed to the state steps.
   struct Step {
     const ContactInput& in;
@@ -198,7 +207,13 @@ class ContactSolver {
   bool at_edge_vertex(Step& s, int clamped);
   Vec2 contact_force(const ContactInput& in) const;
   void finish_step(ContactState before, Vec2 force_n, ContactOutput& out);
-  double side_of(SegmentRef s, Vec2 p) const;
+  // The wall geometry of segment s at level id `level` (BoundarySection::wall_points), and of a constraint.
+  struct SegGeom {
+    Vec2 a, b, u, n;  // end points, unit direction, unit left normal
+    double len = 0.0;
+  };
+  SegGeom geom(SegmentRef s, int level) const;
+  SegGeom geom(const Constraint& c) const { return geom(c.seg, c.level); }
 
   const Scene* scene_;
   ContactParams params_;
@@ -213,9 +228,10 @@ class ContactSolver {
   Vec2 release_from_n_;        // the force of the tick before the last pop [N]
   long release_left_ = 0;      // ticks of its fade still to go
   Vec2 last_force_n_;          // the force of the last tick [N]
-  double max_half_width_m_[kLevelIds] = {};  // per level id (levels and tolerance steps): the largest error-box half-width of any curve [m]
-  // True when segment s belongs to the polyline of level id `level` (its curve's level for that id).
-  bool on_level(SegmentRef s, int level) const;
+  // Per level id: how far its walls can lie from the original curve, across it [m]: for a level or tolerance
+  // step, the largest error-box half-width of any curve (the wall is its boxes' axis); for a cut step, twice
+  // the widest box of its cut (a joined piece may lie anywhere in its box).
+  double max_half_width_m_[kLevelIds] = {};
   // Side of p relative to curve `curve`'s polyline at `level`: +1 left, −1 right, 0 when the polyline is not
   // within radius_m or its nearest point is an open end, 2 when p lies on it, 3 when `budget` ran out first.
   int side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget);

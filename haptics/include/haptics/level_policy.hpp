@@ -68,8 +68,8 @@ class LevelPolicy {
   std::int64_t changes_ = 0;
 };
 
-/// How a level id (hk/constants.hpp) reads on a screen: "level 3", or "tolerance 0.25 mm" for a tolerance
-/// step. For display code (allocates).
+/// How a level id (hk/constants.hpp) reads on a screen: "level 3", "tolerance 0.25 mm" for a tolerance
+/// step, "cut 0.25 mm" for a cut step. For display code (allocates).
 std::string level_label(int id);
 
 }  // namespace hk

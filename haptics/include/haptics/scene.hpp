@@ -288,10 +288,15 @@ class Scene {
   int max_curve_levels() const;
   /// The level curve c renders at for level id `level` (hk/constants.hpp): a level is clamped to the
   /// curve's, min(level, levels−1) (0 below 0); a tolerance step gives the curve's own level for that
-  /// tolerance (CurveNodes::tolerance_level); ids past the last step count as the last.
+  /// tolerance (CurveNodes::tolerance_level). A cut step renders no single level: it gives its tolerance
+  /// step's level, the one its cut refines (the cut's own segments: tolerance_cut.hpp). Ids past the last
+  /// cut step count as the last.
   int clamp_level(std::size_t c, int level) const {
     const CurveNodes& cn = curve_nodes_[c];
-    if (level >= kToleranceLevelBase) return cn.tolerance_level[std::min(level - kToleranceLevelBase, kToleranceSteps - 1)];
+    if (level >= kToleranceLevelBase) {
+      const int step = level >= kCutLevelBase ? level - kCutLevelBase : level - kToleranceLevelBase;
+      return cn.tolerance_level[std::min(step, kToleranceSteps - 1)];
+    }
     const int top = static_cast<int>(cn.levels) - 1;
     return level < 0 ? 0 : (level > top ? top : level);
   }

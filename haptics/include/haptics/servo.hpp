@@ -108,6 +108,10 @@ struct ServoParams {
   /// hand's speed allows, under the same crossing checks at changes. `level` is then only where it starts:
   /// the coarsest step whose bound is within that level's.
   bool tolerance_steps = false;
+  /// With auto_level: the policy picks a cut step (kCutLevelBase + t): the walls are the tolerance cut at that
+  /// tolerance, refined per segment rather than per curve (tolerance_cut.hpp), under the same crossing checks
+  /// at changes. Takes precedence over tolerance_steps. `level` is where it starts, as there.
+  bool cut_steps = false;
   LevelPolicyParams policy;         ///< used when auto_level (its fixed_level is ignored: see `auto_level`)
   /// At a level change the force passes from the old level's to the new level's by at most this much per
   /// tick [N] (on top of what the hand's own motion changes), so a coarser or finer wall never kicks.
@@ -215,7 +219,7 @@ class ServoLoop {
   ServoParams params_;
   ContactSolver solver_;
   GrooveSolver groove_;
-  // The policy's ladder (levels, or tolerance steps): rung i is level id ladder_id_[i], with the scene's
+  // The policy's ladder (levels, tolerance steps or cut steps): rung i is level id ladder_id_[i], with the scene's
   // error bound level_error_m_[i] [m] (non-decreasing); levels_ rungs. Declared before levels_ and policy_:
   // levels_'s initializer fills them, policy_'s reads them.
   int ladder_id_[LevelPolicy::kMaxLevels] = {};

@@ -57,6 +57,17 @@ std::vector<Vec2> joined_cut_points(const Scene& scene, std::size_t curve, const
 /// and segments below every step's cut are 0. Allocates (setup, not the servo path).
 std::vector<std::uint8_t> tolerance_cut_masks(const Scene& scene);
 
+/// What each tolerance step's cut keeps, over the whole scene, for the contact solver's level-change checks and
+/// the level policy (the cut's counterparts of Scene::max_box_half_width_m and Scene::max_error_bound_m).
+struct CutBounds {
+  double error_bound_m[kToleranceSteps] = {};  ///< largest box_error_bound of a cut segment + largest join shift: no original vertex is farther from its joined piece [m]
+  double half_width_m[kToleranceSteps] = {};   ///< largest error-box half-width of a cut segment [m]; a joined piece lies anywhere in its box
+};
+
+/// The CutBounds of every step of `scene`'s cuts; `masks` is tolerance_cut_masks(scene). O(nodes · steps);
+/// setup code.
+CutBounds cut_bounds(const Scene& scene, const std::uint8_t* masks);
+
 /// The end points [m] of cut segment `node` at tolerance step `step` (0 ≤ step < kToleranceSteps), drawn
 /// joined as joined_cut_points draws them: where the cut segment next to it along the curve is finer, its
 /// end there is that finer segment's end point; otherwise its own. `masks` is tolerance_cut_masks(scene),
