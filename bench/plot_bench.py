@@ -126,8 +126,7 @@ def accuracy_per_vertex(ax, lvl, lines):
     """Right panel: vertices against max deviation on the same four pictures, for our levels, the
     tolerance cut (tolerance_cut.json: the joined cut's vertices and its measured error), each
     curve at its own coarsest level within the target (what level_mode = "tolerance" renders) and
-    Douglas-Peucker at the same targets. The cut is not queried yet (no query at a per-segment cut), so it
-    has no point on the time axis. A level's vertices are counted as its segments plus one per curve (the
+    Douglas-Peucker at the same targets (the left panel has the cut's queries on the time axis). A level's vertices are counted as its segments plus one per curve (the
     open curves' last vertex; an upper bound). Appends the cut's rows to the table `lines`."""
     names = ("horse", "camera", "fruits", "sudoku")
     tc_rows = [r for r in TOLERANCE_CUT["rows"] if r["picture"] in names] if TOLERANCE_CUT else []
@@ -441,8 +440,9 @@ if size_rows:
             ", ".join("%.2f at %.1f mm" % (w["worst_ratio"], w["tolerance_mm"]) for w in worst), poly_txt, yes(all(w["worst_ratio"] <= 1.2 for w in worst))))
         if all("worst_curve_levels_ratio" in w for w in worst):
             rows2.append("| the level policy may pick a tolerance, no crossings at changes | built at curve granularity (`level_mode = \"tolerance\"`: each curve at the coarsest of its levels within the step; "
-                         "crossings 0 in the level-change test on six pictures); worst vertices / DP per target error: %s; the per-segment cut is not queried yet | "
-                         "policy and crossing checks: yes; per-segment cut: no |" % ", ".join("%.2f at %.1f mm" % (w["worst_curve_levels_ratio"], w["tolerance_mm"]) for w in worst))
+                         "worst vertices / DP per target error: %s) and per segment (`level_mode = \"cut\"`: the walls are the joined tolerance cut, the row above); "
+                         "crossings, wrong sides and force steps 0 in the level-change test on six pictures in both modes | "
+                         "yes (both) |" % ", ".join("%.2f at %.1f mm" % (w["worst_curve_levels_ratio"], w["tolerance_mm"]) for w in worst))
     tables["round_two"] = "\n".join(rows2)
 
 if os.path.exists(PERF):

@@ -180,6 +180,37 @@ TEST(ToleranceCut, MasksMarkTheCutAndJoinedSegmentsAreThePiecesOfTheJoinedPolyli
   EXPECT_GT(joins, 20u);
 }
 
+// What the contact solver and the policy take from cut_bounds, checked by measuring: every original vertex
+// lies within the step's error bound of its curve's joined cut, and every joined piece's ends lie within the
+// step's widest half-width of their own box's axis (a joined piece stays in its box).
+TEST(ToleranceCut, CutBoundsHoldTheOriginalAndThePieces) {
+  std::mt19937 rng(20);
+  const auto curves = curves_for(rng);
+  const Scene sc = Scene::build(curves, 6);
+  const std::vector<std::uint8_t> masks = tolerance_cut_masks(sc);
+  const CutBounds cb = cut_bounds(sc, masks.data());
+  for (int step = 0; step < kToleranceSteps; ++step) {
+    double worst_vertex = 0.0, worst_side = 0.0;
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      std::vector<SegmentRef> cut;
+      tolerance_cut(sc, c, kToleranceLadder_m[step], &cut);
+      const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
+      for (const Vec2& p : curves[sc.source_index(c)].points_m) {
+        double d = 1e9;
+        for (std::size_t i = 0; i < cut.size(); ++i) d = std::min(d, distance_to_segment(p, pts[i], pts[(i + 1) % pts.size()]));
+        worst_vertex = std::max(worst_vertex, d);
+      }
+      for (std::size_t i = 0; i < cut.size(); ++i) {
+        const ErrorBox box = sc.box(sc.node_of(cut[i]));
+        for (const Vec2& e : {pts[i], pts[(i + 1) % pts.size()]}) worst_side = std::max(worst_side, std::abs(cross(box.axis, e - box.origin_m)));
+      }
+    }
+    EXPECT_LE(worst_vertex, cb.error_bound_m[step]) << "step " << step;
+    EXPECT_LE(worst_side, cb.half_width_m[step] * (1.0 + 1e-9) + 1e-15) << "step " << step;
+    EXPECT_GT(worst_vertex, 0.0);  // the measurement is not vacuous
+  }
+}
+
 TEST(ToleranceCut, EndsAreTheCoarsestLevelAndLevelZero) {
   std::mt19937 rng(19);
   const Scene sc = Scene::build(curves_for(rng), 6);
