@@ -2,7 +2,7 @@
 // of 10^6 segments").
 //
 // Usage: bench_servo_tick [--sizes 1000,10000,100000,1000000] [--seconds S] [--repeats R] [--cpu N]
-//                         [--out FILE.json]                          (prints a markdown table)
+//                         [--level-mode auto|tolerance|cut|fixed] [--out FILE.json]   (prints a markdown table)
 //
 // Each size is a tiled scene (bench_scenes.hpp: whole test pictures side by side at the workspace scale,
 // at least that many level-0 segments, centred on the workspace origin), built with the default settings'
@@ -18,7 +18,8 @@
 // tick's fastest of the R runs: what the tick costs without the host's interrupts, preemptions and the
 // other core's cache traffic, which land on different ticks in each run (a single run's p99.9 is its
 // 30th-worst tick of 30 000, and on this shared VM one interrupt costs 20-100 µs). Both are written down;
-// the target is judged on both. --cpu pins the thread to one CPU (sched_setaffinity).
+// the target is judged on both. --cpu pins the thread to one CPU (sched_setaffinity). --level-mode sets
+// [haptics] level_mode (default "auto", the target's; "cut": the walls at the tolerance cut).
 #include <sched.h>
 
 #include <CLI/CLI.hpp>
@@ -117,11 +118,13 @@ int main(int argc, char** argv) {
   double seconds = 30.0;
   int repeats = 3, cpu = -1;
   std::string out_path;
+  std::string level_mode = "auto";
   cli.add_option("--sizes", sizes, "level-0 segments of each tiled scene")->delimiter(',')->check(CLI::PositiveNumber);
   cli.add_option("--seconds", seconds, "simulated seconds per run (the raster stops at its path's end)")->check(CLI::Range(0.1, 3600.0));
   cli.add_option("--repeats", repeats, "runs per size and hand")->check(CLI::Range(1, 100));
   cli.add_option("--cpu", cpu, "pin to this CPU (-1: leave it to the scheduler)");
   cli.add_option("--out", out_path, "JSON results");
+  cli.add_option("--level-mode", level_mode, "[haptics] level_mode of the runs")->check(CLI::IsMember({"auto", "tolerance", "cut", "fixed"}));
   CLI11_PARSE(cli, argc, argv);
   if (cpu >= 0) {
     cpu_set_t set;
@@ -130,7 +133,8 @@ int main(int argc, char** argv) {
     if (sched_setaffinity(0, sizeof set, &set) != 0) std::fprintf(stderr, "bench_servo_tick: cannot pin to CPU %d; running unpinned\n", cpu);
   }
 
-  const config::Settings settings;
+  config::Settings settings;
+  settings.haptics.level_mode = level_mode;
   const auto pictures = picture_curves(settings);
   nlohmann::json out = nlohmann::json::array();
   std::printf("| segments | hand | run | ticks | in contact | mean level | tick p50 µs | p99 µs | p99.9 µs | max µs |\n");
@@ -164,7 +168,7 @@ int main(int argc, char** argv) {
       fill_quantiles(fastest, min_f);
       print_row(level0, hand, "min of " + std::to_string(repeats), min_f);
       std::sort(p999s.begin(), p999s.end());
-      out.push_back({{"segments", level0}, {"requested_segments", n}, {"plane_m", {plane.x, plane.y}}, {"hand", hand},
+      out.push_back({{"segments", level0}, {"requested_segments", n}, {"plane_m", {plane.x, plane.y}}, {"hand", hand}, {"level_mode", level_mode},
                      {"hot_bytes", scene.hot_bytes()}, {"median_p999_ns", p999s[p999s.size() / 2]}, {"runs", runs},
                      {"per_tick_min", to_json(min_f)}});
     }
