@@ -8,6 +8,7 @@
 #include <random>
 
 #include "curves.hpp"
+#include "haptics/collision_query.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/level_policy.hpp"
 #include "haptics/tolerance_cut.hpp"
@@ -178,6 +179,48 @@ TEST(ToleranceCut, MasksMarkTheCutAndJoinedSegmentsAreThePiecesOfTheJoinedPolyli
     EXPECT_EQ(marked, in_cuts) << "step " << step << ": a node marked that is not in the cut";
   }
   EXPECT_GT(joins, 20u);
+}
+
+// What the contact solver reads of a cut step (BoundarySection): every cut segment is a wall of it, with the
+// joined polyline's end points, and its neighbours across each end are the cut's next and previous segments
+// in curve order (none past an open curve's ends); first_hit_wide, which does not walk cuts, proves nothing
+// clear there.
+TEST(ToleranceCut, TheSectionGivesEachCutSegmentItsJoinedEndsAndItsNeighboursAlongTheCut) {
+  std::mt19937 rng(21);
+  const auto curves = curves_for(rng);
+  const Scene sc = Scene::build(curves, 6);
+  const BoundarySection section(sc);
+  BoundarySection wide(sc);
+  for (int step = 0; step < kToleranceSteps; ++step) {
+    const int id = kCutLevelBase + step;
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+      std::vector<SegmentRef> cut;
+      tolerance_cut(sc, c, kToleranceLadder_m[step], &cut);
+      const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
+      const std::size_t n = cut.size();
+      const bool closed = sc.curve(c).closed;
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_TRUE(section.is_wall(cut[i], id));
+        Vec2 a, b;
+        section.wall_points(cut[i], id, &a, &b);
+        ASSERT_TRUE(a == pts[i] && b == pts[(i + 1) % pts.size()]) << "step " << step << " curve " << c << " piece " << i;
+        SegmentRef next, prev;
+        const bool has_next = section.wall_neighbour(cut[i], id, +1, &next);
+        const bool has_prev = section.wall_neighbour(cut[i], id, -1, &prev);
+        ASSERT_EQ(has_next, closed || i + 1 < n) << "step " << step << " curve " << c << " piece " << i;
+        ASSERT_EQ(has_prev, closed || i > 0) << "step " << step << " curve " << c << " piece " << i;
+        if (has_next) {
+          ASSERT_TRUE(next == cut[(i + 1) % n]) << "step " << step << " curve " << c << " piece " << i;
+        }
+        if (has_prev) {
+          ASSERT_TRUE(prev == cut[(i + n - 1) % n]) << "step " << step << " curve " << c << " piece " << i;
+        }
+      }
+    }
+    QueryBudget unlimited;
+    const SweepHit h = wide.first_hit_wide({-0.05, 0.0}, {0.05, 0.0}, id, nullptr, 0, unlimited);
+    EXPECT_TRUE(h.blocked && !h.hit && h.t == 0.0) << "step " << step;
+  }
 }
 
 // What the contact solver and the policy take from cut_bounds, checked by measuring: every original vertex
