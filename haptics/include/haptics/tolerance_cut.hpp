@@ -19,6 +19,10 @@
 /// polyline still lies inside its own segment's error box and a miss on the box still proves a miss on it.
 /// The join moves the coarser segment's end by `CutStats::max_join_shift_m` at most, so every original
 /// vertex lies within max_bound_m + max_join_shift_m of the joined piece standing for it.
+///
+/// The cut as walls (`[haptics] level_mode = "cut"`, the cut steps of hk/constants.hpp): the servo's walks
+/// do not build these lists. They read tolerance_cut_masks (which segments are cut at each step) and draw
+/// each one with joined_cut_segment (BoundarySection::first_hit, closest_point_cut, wall_points).
 
 #include <cstdint>
 #include <vector>
