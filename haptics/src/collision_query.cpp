@@ -42,6 +42,7 @@ bool BoundarySection::at_target(std::uint32_t node, int level) const noexcept {
 }
 
 bool BoundarySection::wall_neighbour(SegmentRef s, int level, int dir, SegmentRef* out) const noexcept {
+  level = walls_of(level);
   const Scene& sc = *scene_;
   const CurveInfo& ci = sc.curve(static_cast<std::size_t>(s.curve));
   const auto n = static_cast<std::int32_t>(ci.segment_count[s.level]);
@@ -111,7 +112,7 @@ bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) {
   return true;
 }
 
-BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : scene_(&scene), merge_margin_m_(merge_margin_m) {
+BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, bool cut_walls) : scene_(&scene), merge_margin_m_(merge_margin_m) {
   const std::size_t n = scene.node_count();
   std::size_t widest_root = 0;  // widest fan-out of any node (chunks and hierarchy leaves: 4)
   for (std::uint32_t node = 0; node < n; ++node) {
@@ -135,8 +136,10 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m) : sc
   merge_stamp_.assign(n, 0);
   seen_stamp_.assign(n, 0);
   walk_.resize(scene.wide_index().stack_entries());
-  cut_mask_ = tolerance_cut_masks(scene);
-  cut_bounds_ = hk::cut_bounds(scene, cut_mask_.data());
+  if (cut_walls) {
+    cut_mask_ = tolerance_cut_masks(scene);
+    cut_bounds_ = hk::cut_bounds(scene, cut_mask_.data());
+  }
   reset();
 }
 
@@ -643,6 +646,7 @@ float BoundarySection::seeded_ball_sq(const WideIndex& wi, float bx, float by, f
 
 SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                                          QueryBudget& budget, QueryStats* stats_out) {
+  level = walls_of(level);
   if (is_cut_level(level)) {  // not walked here (first_hit walks cuts): nothing is proven clear, never guess
     if (stats_out) *stats_out = QueryStats{};
     SweepHit none;
@@ -672,6 +676,7 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
 
 SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                                     QueryBudget& budget, QueryStats* stats_out) {
+  level = walls_of(level);
   if (level != last_level_) {  // the frontier was cut for another level: start again from the roots
     reset();
     last_level_ = level;
@@ -880,6 +885,7 @@ bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcep
 
 bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
                                     QueryBudget* budget) {
+  level = walls_of(level);
   if (is_cut_level(level)) return closest_point_cut(p, level - kCutLevelBase, max_distance_m, point_out, segment_out, curve, budget);
   if (scene_->curve_count() == 0) return false;
   ClosestQuery q(p, level, curve, max_distance_m);
@@ -898,6 +904,7 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
 
 bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
                                         QueryBudget* budget) {
+  if (!has_cuts()) return closest_point(p, kToleranceLevelBase + step, max_distance_m, point_out, segment_out, curve, budget);
   const Scene& sc = *scene_;
   if (sc.curve_count() == 0) return false;
   ClosestQuery q(p, kCutLevelBase + step, curve, max_distance_m);

@@ -6,9 +6,10 @@
 
 namespace hk {
 ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
-    : scene_(&scene), params_(params), section_(scene) {
-  for (int id = 0; id < kLevelIds; ++id) {
-    max_half_width_m_[id] = is_cut_level(id) ? 2.0 * section_.cut_bounds().half_width_m[tolerance_step_of(id)] : scene.max_box_half_width_m(id);
+    : scene_(&scene), params_(params), section_(scene, 3e-4, params.cut_walls) {
+  for (int id = 0; id < kLevelIds; ++id) {  // a cut step without the masks renders as its tolerance step, as Scene gives it
+    const bool cut = is_cut_level(id) && section_.has_cuts();
+    max_half_width_m_[id] = cut ? 2.0 * section_.cut_bounds().half_width_m[tolerance_step_of(id)] : scene.max_box_half_width_m(id);
   }
 }
 

@@ -14,7 +14,8 @@ double groove_profile_n(const GrooveParams& p, double r_m) noexcept {
   return std::clamp(f, 0.0, std::max(0.0, p.max_force_n));
 }
 
-GrooveSolver::GrooveSolver(const Scene& scene, const GrooveParams& params) : scene_(&scene), params_(params), section_(scene) {}
+GrooveSolver::GrooveSolver(const Scene& scene, const GrooveParams& params)
+    : scene_(&scene), params_(params), section_(scene, 3e-4, params.cut_walls) {}
 
 void GrooveSolver::reset(Vec2 p_m, int level) {
   proxy_ = p_m;

@@ -39,7 +39,7 @@ namespace {
 // the ladder's length.
 int level_ladder(const Scene& scene, const CutBounds& cuts, const ServoParams& p, int* ids, double* err, double* id_bound) {
   for (int id = 0; id < kLevelIds; ++id) {
-    id_bound[id] = is_cut_level(id) ? cuts.error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
+    id_bound[id] = is_cut_level(id) && p.cut_steps ? cuts.error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
   }
   if (p.cut_steps) {
     for (int t = 0; t < kToleranceSteps; ++t) {
@@ -68,7 +68,14 @@ int level_ladder(const Scene& scene, const CutBounds& cuts, const ServoParams& p
 ContactParams contact_params(const ServoParams& p) {
   ContactParams c = p.contact;
   c.period_s = p.period_s;
+  c.cut_walls = p.cut_steps;  // the cut masks only where the policy can pick a cut step
   return c;
+}
+
+GrooveParams groove_params(const ServoParams& p) {
+  GrooveParams g = p.groove;
+  g.cut_walls = p.cut_steps;
+  return g;
 }
 
 LevelPolicyParams policy_params(const ServoParams& p) {
@@ -120,7 +127,7 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
       solver_(scene, contact_params(params)),
-      groove_(scene, params.groove),
+      groove_(scene, groove_params(params)),
       levels_(level_ladder(scene, solver_.section().cut_bounds(), params, ladder_id_, level_error_m_, id_bound_m_)),
       policy_(policy_params(params), level_error_m_, levels_, ladder_index(params.level)),  // the ladder's members are set by now
       level_(params.level),

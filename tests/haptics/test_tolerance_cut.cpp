@@ -254,6 +254,44 @@ TEST(ToleranceCut, CutBoundsHoldTheOriginalAndThePieces) {
   }
 }
 
+// A section built without the cut masks (what ServoLoop builds outside level_mode = "cut") renders a cut
+// step as the tolerance step of the same tolerance, and says so: first hits and closest points equal the
+// tolerance step's, bit for bit.
+TEST(ToleranceCut, ASectionWithoutCutsRendersACutStepAsItsToleranceStep) {
+  std::mt19937 rng(22);
+  const auto curves = curves_for(rng);
+  const Scene sc = Scene::build(curves, 6);
+  BoundarySection plain(sc, 3e-4, false), steps(sc, 3e-4, false), cuts(sc);
+  EXPECT_FALSE(plain.has_cuts());
+  EXPECT_TRUE(cuts.has_cuts());
+  std::uniform_real_distribution<double> u(-0.03, 0.07);
+  int hits = 0, differs = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const int step = i % kToleranceSteps;
+    const Vec2 a{u(rng), u(rng)}, b{u(rng), u(rng)};
+    QueryBudget b1, b2, b3;
+    const SweepHit h_cut = plain.first_hit(a, b, kCutLevelBase + step, nullptr, 0, b1);
+    const SweepHit h_step = steps.first_hit(a, b, kToleranceLevelBase + step, nullptr, 0, b2);
+    ASSERT_EQ(h_cut.hit, h_step.hit) << "query " << i;
+    if (h_step.hit) {
+      ++hits;
+      ASSERT_EQ(h_cut.t, h_step.t) << "query " << i;
+    }
+    const SweepHit h_real = cuts.first_hit(a, b, kCutLevelBase + step, nullptr, 0, b3);
+    differs += h_real.hit != h_step.hit || (h_step.hit && h_real.t != h_step.t);
+    Vec2 p1, p2;
+    SegmentRef s1, s2;
+    const bool f1 = plain.closest_point_cut(b, step, 0.01, &p1, &s1);
+    const bool f2 = steps.closest_point(b, kToleranceLevelBase + step, 0.01, &p2, &s2);
+    ASSERT_EQ(f1, f2) << "query " << i;
+    if (f1) {
+      ASSERT_TRUE(p1 == p2 && s1 == s2) << "query " << i;
+    }
+  }
+  EXPECT_GT(hits, 500);
+  EXPECT_GT(differs, 0);  // the real cut is another set of walls: the fallback is not what cut mode renders
+}
+
 TEST(ToleranceCut, EndsAreTheCoarsestLevelAndLevelZero) {
   std::mt19937 rng(19);
   const Scene sc = Scene::build(curves_for(rng), 6);

@@ -101,8 +101,11 @@ class BoundarySection {
   static constexpr int kMaxExcluded = 2;
   static constexpr std::size_t kMaxSectionEntries = 1u << 16;  ///< bound on the section's storage (entries)
 
-  /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots.
-  explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4);
+  /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots. With
+  /// `cut_walls` it also computes the cut masks and their bounds (tolerance_cut_masks, cut_bounds: a byte
+  /// per node, about a tenth of a second at 10^6 segments), which the walls at cut steps need; without them a
+  /// cut step renders as the tolerance step of the same tolerance (each curve at its level for it).
+  explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4, bool cut_walls = true);
 
   /// Forgets the frontier (back to one root per curve), both free-space balls and the closest-point seed. Real-time safe.
   void reset();
@@ -150,16 +153,21 @@ class BoundarySection {
   /// piece lies inside its own segment's box, so a box's distance bounds every piece under it from below. Not
   /// the wide index, whose rectangles hold each level's own pieces, and not seeded between calls. With a
   /// `budget`, each box measured is one optional box test; when it runs out the walk stops and returns false
-  /// with budget->ran_out set (the answer is then unknown, not "nothing close"). Allocates nothing.
+  /// with budget->ran_out set (the answer is then unknown, not "nothing close"). Without has_cuts(), the
+  /// closest point at the tolerance step of the same tolerance. Allocates nothing.
   bool closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
                          QueryBudget* budget = nullptr);
-  /// Cut membership of the scene's nodes, computed at construction (tolerance_cut_masks; node_count() entries).
+  /// Whether the cut masks were computed (the constructor's `cut_walls`).
+  bool has_cuts() const noexcept { return !cut_mask_.empty(); }
+  /// Cut membership of the scene's nodes, computed at construction (tolerance_cut_masks; node_count() entries;
+  /// null without has_cuts()).
   const std::uint8_t* cut_masks() const noexcept { return cut_mask_.data(); }
   /// The bounds of each step's cut (cut_bounds), computed at construction.
   const CutBounds& cut_bounds() const noexcept { return cut_bounds_; }
   /// The end points [m] of segment `s` as a wall of level id `level`: joined (joined_cut_segment) when `level`
   /// is a cut step and s is one of its segments, else the segment's own. Real-time safe.
   void wall_points(SegmentRef s, int level, Vec2* a, Vec2* b) const noexcept {
+    level = walls_of(level);
     const std::uint32_t node = scene_->node_of(s);
     const int step = level - kCutLevelBase;
     if (is_cut_level(level) && ((cut_mask_[node] >> step) & 1u) != 0) {
@@ -171,6 +179,7 @@ class BoundarySection {
   /// Whether segment `s` is a wall of level id `level`: a segment of its cut (a cut step), or at its curve's
   /// level for the id (Scene::clamp_level). Real-time safe.
   bool is_wall(SegmentRef s, int level) const noexcept {
+    level = walls_of(level);
     if (is_cut_level(level)) return ((cut_mask_[scene_->node_of(s)] >> (level - kCutLevelBase)) & 1u) != 0;
     return s.level == scene_->clamp_level(static_cast<std::size_t>(s.curve), level);
   }
@@ -211,6 +220,9 @@ class BoundarySection {
  private:
   struct Query;  // one first_hit's inputs, answer so far and counters (collision_query.cpp)
   bool at_target(std::uint32_t node, int level) const noexcept;
+  // The level id whose walls stand for `level` here: itself, or for a cut step without the masks its
+  // tolerance step (see the constructor).
+  int walls_of(int level) const noexcept { return is_cut_level(level) && cut_mask_.empty() ? level - kToleranceSteps : level; }
   // The phases of first_hit, in order (each documented where it is defined).
   bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
   void next_tick() noexcept;

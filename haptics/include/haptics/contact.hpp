@@ -81,6 +81,9 @@ struct ContactParams {
   double pop_hold_s = 0.3;      ///< how long the press must last [s]
   double pop_release_s = 0.02;  ///< the force of the tick before a pop fades to zero over this [s]
   double period_s = 0.001;      ///< the servo period the solver is stepped at [s] (counts pop_hold_s and pop_release_s in ticks)
+  /// Build the cut masks for walls at cut steps (BoundarySection's `cut_walls`; read at construction);
+  /// without them a cut step renders as its tolerance step. ServoLoop sets it only for ServoParams::cut_steps.
+  bool cut_walls = true;
 };
 
 /// Input of one solver step.

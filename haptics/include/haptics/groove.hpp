@@ -49,6 +49,7 @@ struct GrooveParams {
   double stiffness_n_per_m = 800;      ///< k: slope of the profile at the centre and at the rim [N/m]
   double max_force_n = 4;              ///< clamp on the groove force [N]
   double jump_step_n = 0.05;           ///< force change per tick allowed beyond k·|Δhandle| where the closest point jumps [N]
+  bool cut_walls = true;               ///< build the cut masks (grooves along cut steps; read at construction); see ContactParams::cut_walls
 };
 
 /// The groove profile: F(r) = min(k·r, depth_n, k·(R − r)) for 0 ≤ r < R, 0 for r ≥ R (and for r < 0 or
