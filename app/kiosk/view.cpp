@@ -153,25 +153,24 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
     const Scene& sc = *sh.scene;
     glColor4f(0.2f, 0.9f, 1.0f, 0.5f);
     glLineWidth(1.0f);
-    for (std::size_t c = 0; c < sc.curve_count(); ++c) {
-      const int l = sc.clamp_level(c, app.level());
-      std::vector<SegmentRef> refs;  // the walls' segments: the level's, or a cut step's own
+    const auto draw_box = [&](SegmentRef ref) {
+      const ErrorBox& b = sc.box(sc.node_of(ref));
+      const Vec2 n = left_perp(b.axis);
+      glBegin(GL_LINE_LOOP);
+      for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
+        const Vec2 q = b.origin_m + u * b.axis + w * n;
+        glVertex2d(v.px(q.x), v.py(q.y));
+      }
+      glEnd();
+    };
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) {  // the walls' segments: a cut step's own, or the level's
       if (cut_step >= 0) {
-        refs = sh.cut_segments[c][static_cast<std::size_t>(cut_step)];
-      } else {
-        const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
-        for (std::uint32_t k = 0; k < segs; ++k) refs.push_back({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)});
+        for (const SegmentRef& ref : sh.cut_segments[c][static_cast<std::size_t>(cut_step)]) draw_box(ref);
+        continue;
       }
-      for (const SegmentRef& ref : refs) {
-        const ErrorBox& b = sc.box(sc.node_of(ref));
-        const Vec2 n = left_perp(b.axis);
-        glBegin(GL_LINE_LOOP);
-        for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
-          const Vec2 q = b.origin_m + u * b.axis + w * n;
-          glVertex2d(v.px(q.x), v.py(q.y));
-        }
-        glEnd();
-      }
+      const int l = sc.clamp_level(c, app.level());
+      const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
+      for (std::uint32_t k = 0; k < segs; ++k) draw_box({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)});
     }
   }
   const ServoDisplayState& d = app.core().display();

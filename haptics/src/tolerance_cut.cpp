@@ -111,12 +111,10 @@ CutBounds cut_bounds(const Scene& scene, const std::uint8_t* masks) {
   double shift_m[kToleranceSteps] = {};
   for (std::uint32_t node = 0; node < scene.node_count(); ++node) {
     if (masks[node] == 0) continue;  // group nodes and segments in no cut
-    const NodeInfo in = scene.info(node);
-    const SegmentRef s{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
     const ErrorBox box = scene.box(node);
-    const double bound = segment_bound(scene, s);
     Vec2 a, b;
     scene.segment_points(node, &a, &b);
+    const double bound = box_error_bound(box, distance(a, b));  // segment_bound's, without rebuilding the box
     for (int t = 0; t < kToleranceSteps; ++t) {
       if (((masks[node] >> t) & 1u) == 0) continue;
       Vec2 ja, jb;
