@@ -19,11 +19,14 @@
 // other core's cache traffic, which land on different ticks in each run (a single run's p99.9 is its
 // 30th-worst tick of 30 000, and on this shared VM one interrupt costs 20-100 µs). Both are written down;
 // the target is judged on both. --cpu pins the thread to one CPU (sched_setaffinity). --level-mode sets
-// [haptics] level_mode (default "auto", the target's; "cut": the walls at the tolerance cut).
+// [haptics] level_mode (default "auto", the target's; "cut": the walls at the tolerance cut). Before the runs of
+// each size it times the servo loop's setup on that scene (ServoLoop's constructor, fastest of R), printed on
+// stderr and written to the JSON as loop_setup_ms.
 #include <sched.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -110,6 +113,21 @@ nlohmann::json to_json(const RunFigures& f) {
           {"p50_ns", f.p50_ns}, {"p99_ns", f.p99_ns}, {"p999_ns", f.p999_ns}, {"max_ns", f.max_ns}};
 }
 
+/// Time to set up the servo loop on `scene` with the settings' servo parameters (its two solvers' boundary
+/// sections, and in cut mode the cut masks), the fastest of `repeats` [ms]: what a scene change costs the
+/// servo thread's setup before the first tick.
+double loop_setup_ms(const Scene& scene, const config::Settings& s, int repeats) {
+  const ServoParams params = app::servo_params_from(s);
+  double best = 1e300;
+  for (int r = 0; r < repeats; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const ServoLoop loop(scene, params);
+    const auto t1 = std::chrono::steady_clock::now();
+    best = std::min(best, std::chrono::duration<double, std::milli>(t1 - t0).count());
+  }
+  return best;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -143,6 +161,9 @@ int main(int argc, char** argv) {
     Vec2 plane{};
     const Scene scene = Scene::build(tiled_scene(pictures, n, settings.haptics.max_levels, &plane), settings.haptics.max_levels);
     const std::size_t level0 = scene.total_segments(0);
+    const double setup_ms = loop_setup_ms(scene, settings, repeats);
+    std::fprintf(stderr, "bench_servo_tick: %zu segments, level_mode %s: ServoLoop setup %.1f ms (fastest of %d)\n", level0, level_mode.c_str(),
+                 setup_ms, repeats);
     for (const std::string hand : {"raster", "explorer"}) {
       std::vector<double> p999s;
       nlohmann::json runs = nlohmann::json::array();
@@ -169,7 +190,7 @@ int main(int argc, char** argv) {
       print_row(level0, hand, "min of " + std::to_string(repeats), min_f);
       std::sort(p999s.begin(), p999s.end());
       out.push_back({{"segments", level0}, {"requested_segments", n}, {"plane_m", {plane.x, plane.y}}, {"hand", hand}, {"level_mode", level_mode},
-                     {"hot_bytes", scene.hot_bytes()}, {"median_p999_ns", p999s[p999s.size() / 2]}, {"runs", runs},
+                     {"hot_bytes", scene.hot_bytes()}, {"loop_setup_ms", setup_ms}, {"median_p999_ns", p999s[p999s.size() / 2]}, {"runs", runs},
                      {"per_tick_min", to_json(min_f)}});
     }
   }

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <utility>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -37,7 +39,7 @@ inline bool at_target_level(const Scene& sc, std::uint32_t node, int level) {
 // at_target_level, and for a cut step the cut's own segments. A walk comes down from the roots and stops at
 // the first cut segment on its way, so it never reaches a node below the cut.
 bool BoundarySection::at_target(std::uint32_t node, int level) const noexcept {
-  if (is_cut_level(level)) return scene_->is_segment(node) && ((cut_mask_[node] >> (level - kCutLevelBase)) & 1u) != 0;
+  if (is_cut_level(level)) return scene_->is_segment(node) && in_cut(cut_mask_, node, level - kCutLevelBase);
   return at_target_level(*scene_, node, level);
 }
 
@@ -64,7 +66,7 @@ bool BoundarySection::wall_neighbour(SegmentRef s, int level, int dir, SegmentRe
   const CurveNodes& cn = sc.curve_nodes(static_cast<std::size_t>(s.curve));
   for (int l = static_cast<int>(ci.levels) - 1; l >= 0; --l) {
     const auto i = static_cast<std::uint32_t>((j % n0) >> l);
-    if ((cut_mask_[cn.box_offset[l] + i] >> step) & 1u) {
+    if (in_cut(cut_mask_, cn.box_offset[l] + i, step)) {
       *out = SegmentRef{s.curve, l, static_cast<std::int32_t>(i)};
       return !(out->level == s.level && out->segment == s.segment);
     }
@@ -112,7 +114,13 @@ bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) {
   return true;
 }
 
-BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, bool cut_walls) : scene_(&scene), merge_margin_m_(merge_margin_m) {
+BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, bool cut_walls)
+    : BoundarySection(scene, merge_margin_m, cut_walls ? make_cut_walls(scene) : nullptr) {}
+
+BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std::shared_ptr<const CutWalls> cuts)
+    : scene_(&scene), merge_margin_m_(merge_margin_m), cuts_(std::move(cuts)) {
+  if (cuts_ && cuts_->scene != &scene) throw std::invalid_argument("BoundarySection: the cut walls were made for another scene");
+  cut_mask_ = cuts_ ? cuts_->masks.data() : nullptr;
   const std::size_t n = scene.node_count();
   std::size_t widest_root = 0;  // widest fan-out of any node (chunks and hierarchy leaves: 4)
   for (std::uint32_t node = 0; node < n; ++node) {
@@ -136,10 +144,6 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, bool
   merge_stamp_.assign(n, 0);
   seen_stamp_.assign(n, 0);
   walk_.resize(scene.wide_index().stack_entries());
-  if (cut_walls) {
-    cut_mask_ = tolerance_cut_masks(scene);
-    cut_bounds_ = hk::cut_bounds(scene, cut_mask_.data());
-  }
   reset();
 }
 
@@ -282,7 +286,7 @@ void BoundarySection::test_segment(Query& q, std::uint32_t node) {
   q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
   Vec2 p0, p1;
   if (is_cut_level(q.level)) {
-    joined_cut_segment(*scene_, cut_mask_.data(), node, q.level - kCutLevelBase, &p0, &p1);
+    joined_cut_segment(*scene_, cut_mask_, node, q.level - kCutLevelBase, &p0, &p1);
   } else {
     scene_->segment_points(node, &p0, &p1);
   }
@@ -919,9 +923,9 @@ bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m,
   while (top > 0) {
     const Candidate cur = stack_[static_cast<std::size_t>(--top)];
     if (cur.t_enter > q.bound_sq) continue;  // the bound shrank since it was pushed
-    if (sc.is_segment(cur.node) && ((cut_mask_[cur.node] >> step) & 1u) != 0) {
+    if (sc.is_segment(cur.node) && in_cut(cut_mask_, cur.node, step)) {
       Vec2 a, b;
-      joined_cut_segment(sc, cut_mask_.data(), cur.node, step, &a, &b);
+      joined_cut_segment(sc, cut_mask_, cur.node, step, &a, &b);
       closest_offer(q, cur.node, a, b);
       continue;
     }

@@ -3,10 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace hk {
 ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
-    : scene_(&scene), params_(params), section_(scene, 3e-4, params.cut_walls) {
+    : ContactSolver(scene, params, params.cut_walls ? make_cut_walls(scene) : nullptr) {}
+
+ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params, std::shared_ptr<const CutWalls> cuts)
+    : scene_(&scene), params_(params), section_(scene, 3e-4, std::move(cuts)) {
   for (int id = 0; id < kLevelIds; ++id) {  // a cut step without the masks renders as its tolerance step, as Scene gives it
     const bool cut = is_cut_level(id) && section_.has_cuts();
     max_half_width_m_[id] = cut ? 2.0 * section_.cut_bounds().half_width_m[tolerance_step_of(id)] : scene.max_box_half_width_m(id);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace hk {
 
@@ -15,7 +16,10 @@ double groove_profile_n(const GrooveParams& p, double r_m) noexcept {
 }
 
 GrooveSolver::GrooveSolver(const Scene& scene, const GrooveParams& params)
-    : scene_(&scene), params_(params), section_(scene, 3e-4, params.cut_walls) {}
+    : GrooveSolver(scene, params, params.cut_walls ? make_cut_walls(scene) : nullptr) {}
+
+GrooveSolver::GrooveSolver(const Scene& scene, const GrooveParams& params, std::shared_ptr<const CutWalls> cuts)
+    : scene_(&scene), params_(params), section_(scene, 3e-4, std::move(cuts)) {}
 
 void GrooveSolver::reset(Vec2 p_m, int level) {
   proxy_ = p_m;

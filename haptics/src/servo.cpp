@@ -64,18 +64,11 @@ int level_ladder(const Scene& scene, const CutBounds& cuts, const ServoParams& p
   return kToleranceSteps;
 }
 
-// The solver's parameters, stepped at the loop's period.
+// The solver's parameters, stepped at the loop's period. (Its cut masks come from the loop: ServoLoop::cuts_.)
 ContactParams contact_params(const ServoParams& p) {
   ContactParams c = p.contact;
   c.period_s = p.period_s;
-  c.cut_walls = p.cut_steps;  // the cut masks only where the policy can pick a cut step
   return c;
-}
-
-GrooveParams groove_params(const ServoParams& p) {
-  GrooveParams g = p.groove;
-  g.cut_walls = p.cut_steps;
-  return g;
 }
 
 LevelPolicyParams policy_params(const ServoParams& p) {
@@ -126,8 +119,9 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
 
 ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
     : params_(params),
-      solver_(scene, contact_params(params)),
-      groove_(scene, groove_params(params)),
+      cuts_(params.cut_steps ? make_cut_walls(scene) : nullptr),  // the cut masks only where the policy can pick a cut step
+      solver_(scene, contact_params(params), cuts_),
+      groove_(scene, params.groove, cuts_),
       levels_(level_ladder(scene, solver_.section().cut_bounds(), params, ladder_id_, level_error_m_, id_bound_m_)),
       policy_(policy_params(params), level_error_m_, levels_, ladder_index(params.level)),  // the ladder's members are set by now
       level_(params.level),

@@ -80,14 +80,13 @@ void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint
   const CurveInfo& ci = scene.curve(c);
   const CurveNodes& cn = scene.curve_nodes(c);
   const std::uint32_t i = node - cn.box_offset[l];
-  const auto bit = static_cast<std::uint8_t>(1u << step);
   // The cut segment before s covers the level-0 segment just before s's start; if it is finer than s, it is
   // the node of some level lev < l ending at s's start, level-lev point i·2^(l−lev). At most one is cut.
   if (i > 0 || ci.closed) {
     for (int lev = l - 1; lev >= 0; --lev) {
       const std::uint32_t start = i << (l - lev);
       const std::uint32_t before = (start == 0 ? ci.segment_count[lev] : start) - 1;
-      if (masks[cn.box_offset[lev] + before] & bit) {
+      if (in_cut(masks, cn.box_offset[lev] + before, step)) {
         *a = scene.points(c, lev)[start];
         break;
       }
@@ -98,7 +97,7 @@ void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint
     for (int lev = l - 1; lev >= 0; --lev) {
       const std::uint32_t end = (i + 1) << (l - lev);
       const std::uint32_t after = end == ci.segment_count[lev] ? 0 : end;
-      if (masks[cn.box_offset[lev] + after] & bit) {
+      if (in_cut(masks, cn.box_offset[lev] + after, step)) {
         *b = scene.points(c, lev)[end];
         break;
       }
@@ -116,7 +115,7 @@ CutBounds cut_bounds(const Scene& scene, const std::uint8_t* masks) {
     scene.segment_points(node, &a, &b);
     const double bound = box_error_bound(box, distance(a, b));  // segment_bound's, without rebuilding the box
     for (int t = 0; t < kToleranceSteps; ++t) {
-      if (((masks[node] >> t) & 1u) == 0) continue;
+      if (!in_cut(masks, node, t)) continue;
       Vec2 ja, jb;
       joined_cut_segment(scene, masks, node, t, &ja, &jb);
       cb.error_bound_m[t] = std::max(cb.error_bound_m[t], bound);
@@ -126,6 +125,14 @@ CutBounds cut_bounds(const Scene& scene, const std::uint8_t* masks) {
   }
   for (int t = 0; t < kToleranceSteps; ++t) cb.error_bound_m[t] += shift_m[t];
   return cb;
+}
+
+std::shared_ptr<const CutWalls> make_cut_walls(const Scene& scene) {
+  auto walls = std::make_shared<CutWalls>();
+  walls->scene = &scene;
+  walls->masks = tolerance_cut_masks(scene);
+  walls->bounds = cut_bounds(scene, walls->masks.data());
+  return walls;
 }
 
 CutStats tolerance_cut(const Scene& scene, std::size_t curve, double tol_m, std::vector<SegmentRef>* out) {

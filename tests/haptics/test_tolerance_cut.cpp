@@ -5,11 +5,14 @@
 // the level each curve gets, checked against the boxes and the original vertices.
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
+#include <stdexcept>
 
 #include "curves.hpp"
 #include "haptics/collision_query.hpp"
 #include "haptics/scene.hpp"
+#include "haptics/servo.hpp"
 #include "haptics/level_policy.hpp"
 #include "haptics/tolerance_cut.hpp"
 
@@ -290,6 +293,38 @@ TEST(ToleranceCut, ASectionWithoutCutsRendersACutStepAsItsToleranceStep) {
   }
   EXPECT_GT(hits, 500);
   EXPECT_GT(differs, 0);  // the real cut is another set of walls: the fallback is not what cut mode renders
+}
+
+// In level_mode = "cut" the servo loop computes the cut masks once and both its solvers read that one copy
+// (they were computed twice, a tenth of a second each at 10^6 segments); outside it neither has any. The
+// shared copy is the scene's masks and bounds, and a section refuses another scene's.
+TEST(ToleranceCut, TheServoLoopSharesOneCopyOfTheCutWallsBetweenItsSolvers) {
+  std::mt19937 rng(23);
+  const Scene sc = Scene::build(curves_for(rng), 6);
+  ServoParams p;
+  p.auto_level = true;
+  p.cut_steps = true;
+  const ServoLoop cut(sc, p);
+  const std::shared_ptr<const CutWalls>& walls = cut.solver().section().cut_walls();
+  ASSERT_NE(walls, nullptr);
+  EXPECT_EQ(walls.get(), cut.groove().section().cut_walls().get()) << "one copy for both solvers";
+  EXPECT_EQ(walls->masks, tolerance_cut_masks(sc));
+  const CutBounds cb = cut_bounds(sc, walls->masks.data());
+  for (int t = 0; t < kToleranceSteps; ++t) {
+    EXPECT_EQ(cut.solver().section().cut_bounds().error_bound_m[t], cb.error_bound_m[t]);
+    EXPECT_EQ(cut.solver().section().cut_bounds().half_width_m[t], cb.half_width_m[t]);
+    EXPECT_GT(cb.error_bound_m[t], 0.0);
+  }
+  p.cut_steps = false;
+  const ServoLoop levels(sc, p);
+  EXPECT_FALSE(levels.solver().section().has_cuts());
+  EXPECT_FALSE(levels.groove().section().has_cuts());
+  EXPECT_EQ(levels.solver().section().cut_bounds().error_bound_m[0], 0.0);
+
+  std::mt19937 rng2(24);
+  const Scene other = Scene::build(curves_for(rng2), 6);
+  EXPECT_THROW(BoundarySection(other, 3e-4, walls), std::invalid_argument);
+  EXPECT_NO_THROW(BoundarySection(sc, 3e-4, walls));
 }
 
 TEST(ToleranceCut, EndsAreTheCoarsestLevelAndLevelZero) {

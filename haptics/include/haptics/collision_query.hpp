@@ -23,6 +23,7 @@
 /// throws nothing.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "haptics/scene.hpp"
@@ -106,6 +107,10 @@ class BoundarySection {
   /// per node, about a tenth of a second at 10^6 segments), which the walls at cut steps need; without them a
   /// cut step renders as the tolerance step of the same tolerance (each curve at its level for it).
   explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4, bool cut_walls = true);
+  /// The same, reading the cut masks and bounds from `cuts` (make_cut_walls of the same `scene`, shared with
+  /// other sections of it) instead of computing its own; null: no cut masks, as `cut_walls` = false. Throws
+  /// std::invalid_argument when `cuts` was made for another scene.
+  BoundarySection(const Scene& scene, double merge_margin_m, std::shared_ptr<const CutWalls> cuts);
 
   /// Forgets the frontier (back to one root per curve), both free-space balls and the closest-point seed. Real-time safe.
   void reset();
@@ -157,21 +162,23 @@ class BoundarySection {
   /// closest point at the tolerance step of the same tolerance. Allocates nothing.
   bool closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
                          QueryBudget* budget = nullptr);
-  /// Whether the cut masks were computed (the constructor's `cut_walls`).
-  bool has_cuts() const noexcept { return !cut_mask_.empty(); }
-  /// Cut membership of the scene's nodes, computed at construction (tolerance_cut_masks; node_count() entries;
-  /// null without has_cuts()).
-  const std::uint8_t* cut_masks() const noexcept { return cut_mask_.data(); }
-  /// The bounds of each step's cut (cut_bounds), computed at construction.
-  const CutBounds& cut_bounds() const noexcept { return cut_bounds_; }
+  /// Whether the section has the cut masks (the constructor's `cut_walls`, or a non-null `cuts`).
+  bool has_cuts() const noexcept { return cut_mask_ != nullptr; }
+  /// Cut membership of the scene's nodes (tolerance_cut_masks; node_count() entries; null without has_cuts()).
+  const std::uint8_t* cut_masks() const noexcept { return cut_mask_; }
+  /// The cut masks and bounds this section reads (shared with the other sections built from them; null without
+  /// has_cuts()).
+  const std::shared_ptr<const CutWalls>& cut_walls() const noexcept { return cuts_; }
+  /// The bounds of each step's cut (cut_bounds; all 0 without has_cuts()).
+  const CutBounds& cut_bounds() const noexcept { return cuts_ ? cuts_->bounds : kNoCutBounds; }
   /// The end points [m] of segment `s` as a wall of level id `level`: joined (joined_cut_segment) when `level`
   /// is a cut step and s is one of its segments, else the segment's own. Real-time safe.
   void wall_points(SegmentRef s, int level, Vec2* a, Vec2* b) const noexcept {
     level = walls_of(level);
     const std::uint32_t node = scene_->node_of(s);
     const int step = level - kCutLevelBase;
-    if (is_cut_level(level) && ((cut_mask_[node] >> step) & 1u) != 0) {
-      joined_cut_segment(*scene_, cut_mask_.data(), node, step, a, b);
+    if (is_cut_level(level) && in_cut(cut_mask_, node, step)) {
+      joined_cut_segment(*scene_, cut_mask_, node, step, a, b);
     } else {
       scene_->segment_points(node, a, b);
     }
@@ -180,7 +187,7 @@ class BoundarySection {
   /// level for the id (Scene::clamp_level). Real-time safe.
   bool is_wall(SegmentRef s, int level) const noexcept {
     level = walls_of(level);
-    if (is_cut_level(level)) return ((cut_mask_[scene_->node_of(s)] >> (level - kCutLevelBase)) & 1u) != 0;
+    if (is_cut_level(level)) return in_cut(cut_mask_, scene_->node_of(s), level - kCutLevelBase);
     return s.level == scene_->clamp_level(static_cast<std::size_t>(s.curve), level);
   }
   /// The wall next to `s` along its curve at level id `level`, across its start (dir < 0) or end (dir > 0):
@@ -222,7 +229,7 @@ class BoundarySection {
   bool at_target(std::uint32_t node, int level) const noexcept;
   // The level id whose walls stand for `level` here: itself, or for a cut step without the masks its
   // tolerance step (see the constructor).
-  int walls_of(int level) const noexcept { return is_cut_level(level) && cut_mask_.empty() ? level - kToleranceSteps : level; }
+  int walls_of(int level) const noexcept { return is_cut_level(level) && cut_mask_ == nullptr ? level - kToleranceSteps : level; }
   // The phases of first_hit, in order (each documented where it is defined).
   bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
   void next_tick() noexcept;
@@ -287,8 +294,9 @@ class BoundarySection {
   int last_closest_level_ = -1, last_closest_curve_ = -1;
   std::uint32_t tick_ = 0;
   int last_level_ = -1;         // level id of the last first_hit
-  std::vector<std::uint8_t> cut_mask_;  // per node: the tolerance steps whose cut it is a segment of (tolerance_cut_masks)
-  CutBounds cut_bounds_;                // each step's cut: error bound and widest box (cut_bounds)
+  static constexpr CutBounds kNoCutBounds{};
+  std::shared_ptr<const CutWalls> cuts_;   // the cut masks and bounds (shared; null: none)
+  const std::uint8_t* cut_mask_ = nullptr; // cuts_->masks: per node, the tolerance steps whose cut it is a segment of
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
   Vec2 ball_center_m_;          // free-space ball: no box of the section as last scanned, so no wall, comes closer to its centre than its radius
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown

@@ -82,7 +82,8 @@ struct ContactParams {
   double pop_release_s = 0.02;  ///< the force of the tick before a pop fades to zero over this [s]
   double period_s = 0.001;      ///< the servo period the solver is stepped at [s] (counts pop_hold_s and pop_release_s in ticks)
   /// Build the cut masks for walls at cut steps (BoundarySection's `cut_walls`; read at construction);
-  /// without them a cut step renders as its tolerance step. ServoLoop sets it only for ServoParams::cut_steps.
+  /// without them a cut step renders as its tolerance step. ServoLoop does not read it: it computes the masks
+  /// once for ServoParams::cut_steps and hands them to both its solvers (the constructor that takes CutWalls).
   bool cut_walls = true;
 };
 
@@ -131,8 +132,12 @@ struct ContactOutput {
 /// The god-object solver for one scene. One per servo thread; sized at construction.
 class ContactSolver {
  public:
-  /// `scene` must outlive the solver. Allocates (at setup only).
+  /// `scene` must outlive the solver. Allocates (at setup only); with params.cut_walls it computes the scene's
+  /// cut masks (make_cut_walls).
   ContactSolver(const Scene& scene, const ContactParams& params);
+  /// The same, with the cut masks and bounds `cuts` (make_cut_walls of `scene`, shared with other solvers of
+  /// it; null: none) in place of params.cut_walls. Throws std::invalid_argument when they are another scene's.
+  ContactSolver(const Scene& scene, const ContactParams& params, std::shared_ptr<const CutWalls> cuts);
 
   /// Puts the proxy at p in free space and forgets the contact state. If p is within the skin of a
   /// polyline at `level`, it is pushed off along the wall's normal. Not for the servo path (may walk

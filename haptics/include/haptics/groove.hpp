@@ -49,7 +49,7 @@ struct GrooveParams {
   double stiffness_n_per_m = 800;      ///< k: slope of the profile at the centre and at the rim [N/m]
   double max_force_n = 4;              ///< clamp on the groove force [N]
   double jump_step_n = 0.05;           ///< force change per tick allowed beyond k·|Δhandle| where the closest point jumps [N]
-  bool cut_walls = true;               ///< build the cut masks (grooves along cut steps; read at construction); see ContactParams::cut_walls
+  bool cut_walls = true;               ///< build the cut masks (grooves along cut steps; read by the constructor without CutWalls); see ContactParams::cut_walls
 };
 
 /// The groove profile: F(r) = min(k·r, depth_n, k·(R − r)) for 0 ≤ r < R, 0 for r ≥ R (and for r < 0 or
@@ -74,8 +74,12 @@ double groove_profile_n(const GrooveParams& p, double r_m) noexcept;
 /// it is still within the radius (the groove is followed from where it was), else reports free space.
 class GrooveSolver {
  public:
-  /// `scene` must outlive the solver. Allocates (at setup only).
+  /// `scene` must outlive the solver. Allocates (at setup only); with params.cut_walls it computes the scene's
+  /// cut masks (make_cut_walls).
   GrooveSolver(const Scene& scene, const GrooveParams& params);
+  /// The same, with the cut masks and bounds `cuts` (make_cut_walls of `scene`, shared with other solvers of
+  /// it; null: none) in place of params.cut_walls. Throws std::invalid_argument when they are another scene's.
+  GrooveSolver(const Scene& scene, const GrooveParams& params, std::shared_ptr<const CutWalls> cuts);
 
   /// Starts at p [m] on `level`: free state, no force remembered (the next force is limited from zero).
   /// Real-time safe (allocates nothing).

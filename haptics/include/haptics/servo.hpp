@@ -110,7 +110,8 @@ struct ServoParams {
   bool tolerance_steps = false;
   /// With auto_level: the policy picks a cut step (kCutLevelBase + t): the walls are the tolerance cut at that
   /// tolerance, refined per segment rather than per curve (tolerance_cut.hpp), under the same crossing checks
-  /// at changes. Takes precedence over tolerance_steps. `level` is where it starts, as there.
+  /// at changes. Takes precedence over tolerance_steps. `level` is where it starts, as there. The loop then
+  /// computes the scene's cut masks (make_cut_walls) once, for both solvers; without it, none.
   bool cut_steps = false;
   LevelPolicyParams policy;         ///< used when auto_level (its fixed_level is ignored: see `auto_level`)
   /// At a level change the force passes from the old level's to the new level's by at most this much per
@@ -217,6 +218,9 @@ class ServoLoop {
 
  private:
   ServoParams params_;
+  // The cut masks and bounds (make_cut_walls), computed once and read by both solvers' sections; null unless
+  // params_.cut_steps. Declared before the solvers, which its initializer feeds.
+  std::shared_ptr<const CutWalls> cuts_;
   ContactSolver solver_;
   GrooveSolver groove_;
   // The policy's ladder (levels, tolerance steps or cut steps): rung i is level id ladder_id_[i], with the scene's

@@ -25,6 +25,7 @@
 /// each one with joined_cut_segment (BoundarySection::first_hit, closest_point_cut, wall_points).
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "haptics/scene.hpp"
@@ -61,6 +62,12 @@ std::vector<Vec2> joined_cut_points(const Scene& scene, std::size_t curve, const
 /// and segments below every step's cut are 0. Allocates (setup, not the servo path).
 std::vector<std::uint8_t> tolerance_cut_masks(const Scene& scene);
 
+/// Whether segment node `node` is a segment of tolerance step `step`'s cut: bit `step` of masks[node], where
+/// `masks` is tolerance_cut_masks(scene) and 0 ≤ step < kToleranceSteps. Real-time safe.
+inline bool in_cut(const std::uint8_t* masks, std::uint32_t node, int step) noexcept {
+  return ((masks[node] >> step) & 1u) != 0;
+}
+
 /// What each tolerance step's cut keeps, over the whole scene, for the contact solver's level-change checks and
 /// the level policy (the cut's counterparts of Scene::max_box_half_width_m and Scene::max_error_bound_m).
 struct CutBounds {
@@ -71,6 +78,19 @@ struct CutBounds {
 /// The CutBounds of every step of `scene`'s cuts; `masks` is tolerance_cut_masks(scene). O(nodes · steps);
 /// setup code.
 CutBounds cut_bounds(const Scene& scene, const std::uint8_t* masks);
+
+/// What the walls at the cut steps need of one scene, computed once and read by every boundary section of it
+/// (the servo loop's contact and groove solvers share one): the cut masks and their bounds. About a tenth of
+/// a second and one byte per node at 10^6 segments; immutable once built, so sharing it across threads is
+/// safe.
+struct CutWalls {
+  const Scene* scene = nullptr;     ///< the scene it was computed for (a section checks it is its own)
+  std::vector<std::uint8_t> masks;  ///< tolerance_cut_masks(*scene): scene->node_count() entries
+  CutBounds bounds;                 ///< cut_bounds(*scene, masks.data())
+};
+
+/// The CutWalls of `scene` (which must outlive them). Allocates (setup, not the servo path).
+std::shared_ptr<const CutWalls> make_cut_walls(const Scene& scene);
 
 /// The end points [m] of cut segment `node` at tolerance step `step` (0 ≤ step < kToleranceSteps), drawn
 /// joined as joined_cut_points draws them: where the cut segment next to it along the curve is finer, its
