@@ -14,6 +14,14 @@
 namespace hk {
 namespace {
 
+// Squared distance from p to an axis-aligned rectangle (0 inside) [m²]: a lower bound on the distance to the
+// box it holds.
+inline double rect_distance_sq(const Aabb& r, Vec2 p) {
+  const double dx = std::max({r.lo.x - p.x, 0.0, p.x - r.hi.x});
+  const double dy = std::max({r.lo.y - p.y, 0.0, p.y - r.hi.y});
+  return dx * dx + dy * dy;
+}
+
 // Squared distance from p to a box (0 inside) [m²].
 inline double box_distance_sq(const ErrorBox& box, Vec2 p) {
   const Vec2 r = p - box.origin_m;
@@ -257,9 +265,7 @@ void BoundarySection::clip_section(Query& q) {
     double te = 0.0, tx = 0.0;
     q.charge_section_box();
     const Aabb& r = section_box_[i];
-    const double dx = std::max({r.lo.x - q.b.x, 0.0, q.b.x - r.hi.x});
-    const double dy = std::max({r.lo.y - q.b.y, 0.0, q.b.y - r.hi.y});
-    const bool near = dx * dx + dy * dy < q.nearest_sq;
+    const bool near = rect_distance_sq(r, q.b) < q.nearest_sq;
     const bool overlapping = overlaps(r, q.sweep, merge_margin_m_);
     if (!near && !overlapping) {  // the rectangle settles both: the box itself is not needed
       merge_scratch_.push_back(node);
@@ -935,9 +941,7 @@ bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m,
     for (std::uint32_t i = 0; i < count; ++i) {
       const std::uint32_t child = first + i;
       if (other_curve(child)) continue;
-      const Aabb r = sc.loose_aabb(child);  // holds the box: its distance is a cheaper lower bound
-      const double rx = std::max({r.lo.x - p.x, 0.0, p.x - r.hi.x}), ry = std::max({r.lo.y - p.y, 0.0, p.y - r.hi.y});
-      if (rx * rx + ry * ry > q.bound_sq) continue;
+      if (rect_distance_sq(sc.loose_aabb(child), p) > q.bound_sq) continue;  // the rectangle holds the box: a cheaper lower bound
       if (budget && !budget->spend()) return false;
       const double d_sq = box_distance_sq(sc.box(child), p);
       if (d_sq > q.bound_sq) continue;
