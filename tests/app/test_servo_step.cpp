@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <memory>
 #include <new>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "curves.hpp"
@@ -96,7 +98,8 @@ struct Rig {
   std::vector<DeviceSample> samples;   // what step() was given
   std::vector<Vec2> commands;          // what it asked for
 
-  Rig() : sp(servo_params_from(s)), device(sim_params_from(s), {-0.03, 0.0}), hand(hand_params_from(s)), core(CueTrackerParams{}, &cues) {
+  explicit Rig(config::Settings settings = {})
+      : s(std::move(settings)), sp(servo_params_from(s)), device(sim_params_from(s), {-0.03, 0.0}), hand(hand_params_from(s)), core(CueTrackerParams{}, &cues) {
     device.open();
   }
   /// One tick: read, step (allocations counted when `count`), write, then the plant and the drain.
@@ -124,8 +127,25 @@ struct Rig {
   }
 };
 
-TEST(ServoStep, NothingIsAllocatedOrFreedInTheStep) {
-  Rig r;
+/// A level mode and a render mode of the kiosk's settings, and the level id the test fixes for a while in it.
+struct StepMode {
+  const char* level_mode;
+  const char* render;
+  int fixed_level;
+};
+
+class ServoStepModes : public ::testing::TestWithParam<StepMode> {};
+
+// Every level mode (levels, tolerance steps, the tolerance cut with its shared masks) and both render modes:
+// the step allocates and frees nothing through contact, a fixed level, the policy again, new gains, a slide
+// and a picture change (fade, swap, ramp in).
+TEST_P(ServoStepModes, NothingIsAllocatedOrFreedInTheStep) {
+  config::Settings settings;
+  settings.haptics.level_mode = GetParam().level_mode;
+  settings.haptics.render = GetParam().render;
+  Rig r(settings);
+  const bool grooves = std::string(GetParam().render) == "grooves";
+  if (grooves) r.target = {-0.02, 0.0};  // a groove does not stop the hand: pull it onto the left wall's line
   r.samples.reserve(10000);
   r.commands.reserve(10000);
   r.core.publish(bundle(r.sp, 1));
@@ -134,16 +154,18 @@ TEST(ServoStep, NothingIsAllocatedOrFreedInTheStep) {
   g_frees = 0;
   r.run(1.0, true);  // ramp in, press on the left wall
   ASSERT_NE(r.core.display().state, ContactState::Free) << "the hand must be in contact for this to test anything";
-  r.core.request_level(0);
+  const int fixed = GetParam().fixed_level;
+  ASSERT_NE(r.core.display().level, fixed) << "the fixed level must be a change";
+  r.core.request_level(fixed);
   r.run(0.3, true);
-  EXPECT_EQ(r.core.display().level, 0) << "a level change happened in the counted steps";
+  EXPECT_EQ(r.core.display().level, fixed) << "a level change happened in the counted steps";
   r.core.request_level(ServoCore::kAutoLevel);
   ServoGains g = servo_gains_from(r.s);
   g.stiffness_n_per_m *= 2.0;
   g.static_friction = 0.1;
   g.dynamic_friction = 0.05;
   r.core.set_gains(g);  // the caller's side
-  r.target = {0.0, 0.01};  // slide along the wall
+  r.target = {grooves ? -0.02 : 0.0, 0.01};  // slide along the wall
   r.run(0.5, true);
   EXPECT_EQ(r.core.display().stiffness_n_per_m, 2.0 * r.s.haptics.stiffness_n_per_m);
   r.core.publish(bundle(r.sp, 2, 0.015));  // built and handed over outside the count
@@ -161,6 +183,12 @@ TEST(ServoStep, NothingIsAllocatedOrFreedInTheStep) {
   EXPECT_EQ(g_allocations.load(), 1);
   EXPECT_EQ(g_frees.load(), 1);
 }
+
+INSTANTIATE_TEST_SUITE_P(LevelAndRenderModes, ServoStepModes,
+                         ::testing::Values(StepMode{"auto", "walls", 2}, StepMode{"tolerance", "walls", kToleranceLevelBase + 1},
+                                           StepMode{"cut", "walls", kCutLevelBase + 1}, StepMode{"auto", "grooves", 2},
+                                           StepMode{"cut", "grooves", kCutLevelBase + 1}),
+                         [](const ::testing::TestParamInfo<StepMode>& i) { return std::string(i.param.level_mode) + "_" + i.param.render; });
 
 TEST(ServoStep, NothingIsAllocatedOrFreedInAGuidedTour) {
   // The guided tour (issue 14, item 3) in the servo path: taken, led through the transit (walls
