@@ -441,7 +441,7 @@ if size_rows:
         if all("worst_curve_levels_ratio" in w for w in worst):
             rows2.append("| the level policy may pick a tolerance, no crossings at changes | built at curve granularity (`level_mode = \"tolerance\"`: each curve at the coarsest of its levels within the step; "
                          "worst vertices / DP per target error: %s) and per segment (`level_mode = \"cut\"`: the walls are the joined tolerance cut, the row above); "
-                         "crossings, wrong sides and force steps 0 in the level-change test on six pictures in both modes | "
+                         "crossings, wrong sides and force steps 0 in the level-change test on all 22 pictures in both modes | "
                          "yes (both) |" % ", ".join("%.2f at %.1f mm" % (w["worst_curve_levels_ratio"], w["tolerance_mm"]) for w in worst))
     tables["round_two"] = "\n".join(rows2)
 

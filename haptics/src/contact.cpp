@@ -111,8 +111,10 @@ int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, 
   SegmentRef nb;
   for (int dir : {-1, +1}) {
     if (dir < 0 ? t > 1e-12 : t < g.len - 1e-12) continue;
-    // Nearest to an open end: p is beyond the curve, not between its levels (the levels share their ends).
-    if (!section_.wall_neighbour(s, level, dir, &nb)) return 0;
+    // Nearest to an open end (which every level shares): the end segment's own line decides, as if it ran on
+    // past the end. Beyond the end, the wedge between two levels' end segments is between the polylines (their
+    // loop, closed at the shared end, holds it), and there the two lines give different sides.
+    if (!section_.wall_neighbour(s, level, dir, &nb)) continue;
     n = normalized_or(g.n + geom(nb, level).n, g.n);
   }
   const double d = dot(p - q, n);

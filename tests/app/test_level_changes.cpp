@@ -2,6 +2,8 @@
 // and fast makes the level change many times; no move of the proxy crosses the polyline of the level in
 // force, no level change leaves the proxy on the other side of the new polyline than it was of the old
 // one (an independent between-region test), and the force never jumps at a change by more than the limit.
+// Every picture of tests/data/images, in each level mode (six of them until 2026-11-26, when the other
+// sixteen found camera's proxy left between two cut steps' polylines at an open curve's shared end).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -123,7 +125,10 @@ void raster_changes_levels_without_crossing_or_force_steps(const char* name, con
   EXPECT_GE(changes, 10) << "the fast rows must coarsen and the slow rows refine the level";
   EXPECT_GT(finer, 3);
   EXPECT_GT(coarser, 3);
-  EXPECT_GT(contact_changes, 0) << "some changes must happen while the proxy is on a wall";
+  // LinuxLogo (six outlines far apart) in cut mode makes every change while the proxy is free.
+  if (!(fs::path(path).stem() == "LinuxLogo" && level_mode == "cut")) {
+    EXPECT_GT(contact_changes, 0) << "some changes must happen while the proxy is on a wall";
+  }
   EXPECT_EQ(crossings, 0);
   EXPECT_EQ(wrong_side, 0);
   EXPECT_EQ(force_steps, 0);
@@ -148,7 +153,7 @@ TEST_P(LevelChanges, FastAndSlowRasterChangesCutStepsWithoutCrossingOrForceSteps
 }
 
 INSTANTIATE_TEST_SUITE_P(RealImages, LevelChanges,
-                         ::testing::Values("horse.png", "butterfly.jpg", "coins.png", "silhouette_3.png", "fruits.jpg", "sudoku.png"),
+                         ::testing::Values("HappyFish.jpg", "LinuxLogo.jpg", "apple.jpg", "butterfly.jpg", "camera.png", "coins.png", "fruits.jpg", "horse.png", "page.png", "pic1.png", "pic3.png", "silhouette_1.png", "silhouette_10.png", "silhouette_2.png", "silhouette_3.png", "silhouette_4.png", "silhouette_5.png", "silhouette_6.png", "silhouette_7.png", "silhouette_8.png", "silhouette_9.png", "sudoku.png"),
                          [](const auto& info) { return fs::path(info.param).stem().string(); });
 
 }  // namespace

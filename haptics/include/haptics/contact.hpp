@@ -241,7 +241,10 @@ class ContactSolver {
   // the widest box of its cut (a joined piece may lie anywhere in its box).
   double max_half_width_m_[kLevelIds] = {};
   // Side of p relative to curve `curve`'s polyline at `level`: +1 left, −1 right, 0 when the polyline is not
-  // within radius_m or its nearest point is an open end, 2 when p lies on it, 3 when `budget` ran out first.
+  // within radius_m, 2 when p lies on it, 3 when `budget` ran out first. Where the nearest point is an open end,
+  // the side of the end segment's line: beyond the end, the wedge between two levels' end segments then has
+  // different sides, as it lies between the polylines; so does the opposite wedge, where a change waits
+  // although nothing is crossed (safe, and only while the proxy stays there).
   int side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget);
 };
 
