@@ -740,14 +740,23 @@ struct BoundarySection::ClosestQuery {
   SegmentRef best_s = kNoSegment;
   std::uint32_t best_node = kWideEmpty;
   Vec2 best_point;
-  ClosestQuery(Vec2 p_in, int level_in, int curve_in, double max_distance_m)
-      : p(p_in), level(level_in), curve(curve_in) { set_best(max_distance_m); }
+  const int* skip = nullptr;  // curves left out of the answer (skip_count of them)
+  int skip_count = 0;
+  ClosestQuery(Vec2 p_in, int level_in, int curve_in, double max_distance_m, const int* skip_in = nullptr, int skip_count_in = 0)
+      : p(p_in), level(level_in), curve(curve_in), skip(skip_in), skip_count(skip_count_in) { set_best(max_distance_m); }
   void set_best(double d_m) {
     best_m = d_m;
     bound_sq = d_m * d_m * (1.0 + 1e-12);
     bound_sq_f = float_at_least(bound_sq);
   }
   bool found() const { return best_node != kWideEmpty; }
+  // Whether curve c is left out (a short scan: the callers skip a handful).
+  bool skips(std::uint32_t c) const {
+    for (int i = 0; i < skip_count; ++i) {
+      if (static_cast<std::uint32_t>(skip[i]) == c) return true;
+    }
+    return false;
+  }
 };
 
 // Offers segment node `node` (end points a, b) to the query: taken when nearer than the best so far, or as
@@ -763,6 +772,7 @@ struct BoundarySection::ClosestQuery {
   const double d = std::sqrt(d_sq);  // bit for bit distance(p, c)
   if (d > q.best_m) return;
   const NodeInfo in = scene_->info(node);
+  if (q.skip_count > 0 && q.skips(in.curve)) return;
   const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
   if (!closer(d, ref, q.best_m, q.best_s)) return;
   q.set_best(d);
@@ -815,6 +825,7 @@ void BoundarySection::closest_seed(ClosestQuery& q) const noexcept {
 void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noexcept {
   const Scene& sc = *scene_;
   if (q.curve >= 0 && static_cast<int>(sc.tag_curve(item)) != q.curve) return;
+  if (q.skip_count > 0 && q.skips(sc.tag_curve(item))) return;
   std::uint32_t first = 0;
   const std::uint32_t count = item_segments(item, q.level, &first);
   if (count == 1 && sc.tag_level(first) > sc.tag_level(item)) {
@@ -894,11 +905,13 @@ bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcep
 }
 
 bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
-                                    QueryBudget* budget) {
+                                    QueryBudget* budget, const int* skip_curves, int skip_count) {
   level = walls_of(level);
-  if (is_cut_level(level)) return closest_point_cut(p, level - kCutLevelBase, max_distance_m, point_out, segment_out, curve, budget);
+  if (is_cut_level(level)) {
+    return closest_point_cut(p, level - kCutLevelBase, max_distance_m, point_out, segment_out, curve, budget, skip_curves, skip_count);
+  }
   if (scene_->curve_count() == 0) return false;
-  ClosestQuery q(p, level, curve, max_distance_m);
+  ClosestQuery q(p, level, curve, max_distance_m, skip_curves, skip_count);
   closest_seed(q);
   const bool complete = closest_walk(q, budget);
   last_closest_level_ = level;
@@ -913,16 +926,25 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
 // ---- Closest points at a tolerance cut (the tree of error boxes) ----
 
 bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
-                                        QueryBudget* budget) {
-  if (!has_cuts()) return closest_point(p, kToleranceLevelBase + step, max_distance_m, point_out, segment_out, curve, budget);
+                                        QueryBudget* budget, const int* skip_curves, int skip_count) {
+  if (!has_cuts()) {
+    return closest_point(p, kToleranceLevelBase + step, max_distance_m, point_out, segment_out, curve, budget, skip_curves, skip_count);
+  }
   const Scene& sc = *scene_;
   if (sc.curve_count() == 0) return false;
-  ClosestQuery q(p, kCutLevelBase + step, curve, max_distance_m);
-  // A node of another curve holds nothing of `curve` (a hierarchy node may: kept).
-  const auto other_curve = [&sc, curve](std::uint32_t node) {
-    if (curve < 0) return false;
-    if (sc.is_segment(node)) return sc.tag_curve(node) != static_cast<std::uint32_t>(curve);
-    return sc.is_chunk(node) && sc.info(node).curve != static_cast<std::uint32_t>(curve);
+  ClosestQuery q(p, kCutLevelBase + step, curve, max_distance_m, skip_curves, skip_count);
+  // A node of another curve than `curve`, or of a skipped one, holds nothing to answer (a hierarchy node may: kept).
+  const auto other_curve = [&sc, &q, curve](std::uint32_t node) {
+    if (curve < 0 && q.skip_count == 0) return false;
+    std::uint32_t c = 0;
+    if (sc.is_segment(node)) {
+      c = sc.tag_curve(node);
+    } else if (sc.is_chunk(node)) {
+      c = sc.info(node).curve;
+    } else {
+      return false;
+    }
+    return (curve >= 0 && c != static_cast<std::uint32_t>(curve)) || q.skips(c);
   };
   int top = 0;
   stack_[static_cast<std::size_t>(top++)] = Candidate{0.0, sc.scene_root()};  // t_enter: the box's squared distance [m²]

@@ -128,22 +128,22 @@ bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) {
   // other) of each other, so a point between them lies within E of both; search twice as far.
   const double e = max_half_width_m_[std::clamp(level_, 0, kLevelIds - 1)] + max_half_width_m_[std::clamp(new_level, 0, kLevelIds - 1)];
   const double radius = 2.0 * e + 4.0 * params_.skin_m;
-  // The curves that could have the proxy between their two levels: those it touches, and the nearest one
-  // at either level.
-  int curves[4];
+  // The curves that could have the proxy between their two levels: those it touches, and every curve within
+  // the radius at either level, found nearest first by closest points that skip the curves found so far.
+  int curves[kMaxSideCurves];
   int n = 0;
   if (state_ != ContactState::Free) curves[n++] = c_[0].seg.curve;
-  if (state_ == ContactState::Vertex) curves[n++] = c_[1].seg.curve;
+  if (state_ == ContactState::Vertex && c_[1].seg.curve != c_[0].seg.curve) curves[n++] = c_[1].seg.curve;
   for (int l : {level_, new_level}) {
     Vec2 q;
     SegmentRef s;
-    if (section_.closest_point(proxy_, l, radius, &q, &s, -1, budget)) curves[n++] = s.curve;
+    while (section_.closest_point(proxy_, l, radius, &q, &s, -1, budget, curves, n)) {
+      if (n == kMaxSideCurves) return false;  // more curves this close than one check takes: wait
+      curves[n++] = s.curve;
+    }
     if (budget && budget->ran_out) return false;  // not known within this tick's budget: wait
   }
   for (int i = 0; i < n; ++i) {
-    bool seen = false;
-    for (int j = 0; j < i; ++j) seen = seen || curves[j] == curves[i];
-    if (seen) continue;
     const int before = side_of_curve(proxy_, curves[i], level_, radius, budget);
     const int after = side_of_curve(proxy_, curves[i], new_level, radius, budget);
     if (before == 3 || after == 3) return false;  // not known within this tick's budget: wait

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <random>
 
+#include "crossing_grid.hpp"
 #include "curves.hpp"
 #include "haptics/collision_query.hpp"
 #include "haptics/scene.hpp"
@@ -458,6 +459,47 @@ TEST(CollisionQuery, ToleranceStepsEqualBruteForceInEveryWalk) {
   EXPECT_GE(mixed, 2) << "the steps must put curves of the scene at different levels, or this tests nothing new";
   EXPECT_GE(checked, 100000);
   EXPECT_GT(hits, 5000);
+}
+
+// closest_point skipping the curves found so far lists every curve within the radius, nearest first, at a
+// level, a tolerance step and a cut step (what level_change_is_safe gathers): the same set and distances as
+// brute force over each curve's polyline for the id (test::polyline_at; the cut from tolerance_cut).
+TEST(CollisionQuery, SkippingTheCurvesFoundListsEveryCurveWithinTheRadiusNearestFirst) {
+  std::mt19937 rng(131);
+  const auto curves = random_scene(rng, 10, 10);
+  const Scene sc = Scene::build(curves, 6);
+  BoundarySection section(sc);
+  std::uniform_real_distribution<double> ux(-0.06, 0.06), uy(-0.035, 0.035);
+  constexpr double kRadius_m = 0.004;
+  int several = 0;
+  for (const int id : {1, kToleranceLevelBase + 2, kCutLevelBase + 2}) {
+    std::vector<std::vector<Vec2>> pl(sc.curve_count());
+    for (std::size_t c = 0; c < sc.curve_count(); ++c) pl[c] = test::polyline_at(sc, c, id);
+    for (int i = 0; i < 1500; ++i) {
+      const Vec2 p{ux(rng), uy(rng)};
+      std::vector<std::pair<double, int>> want;  // (distance, curve) of every curve within the radius
+      for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+        const std::size_t n = pl[c].size(), pieces = sc.curve(c).closed ? n : n - 1;
+        double d = 1e9;
+        for (std::size_t k = 0; k < pieces; ++k) d = std::min(d, distance_to_segment(p, pl[c][k], pl[c][(k + 1) % n]));
+        if (d <= kRadius_m) want.push_back({d, static_cast<int>(c)});
+      }
+      std::sort(want.begin(), want.end());
+      int found[32];
+      int n = 0;
+      Vec2 q;
+      SegmentRef s;
+      while (n < 32 && section.closest_point(p, id, kRadius_m, &q, &s, -1, nullptr, found, n)) {
+        ASSERT_LT(static_cast<std::size_t>(n), want.size()) << "id " << id << ": a curve beyond the radius, or one already skipped";
+        ASSERT_EQ(s.curve, want[static_cast<std::size_t>(n)].second) << "id " << id << ", the " << n << "th nearest";
+        ASSERT_NEAR(distance(p, q), want[static_cast<std::size_t>(n)].first, 1e-12);
+        found[n++] = s.curve;
+      }
+      ASSERT_EQ(static_cast<std::size_t>(n), want.size()) << "id " << id << ": every curve within the radius";
+      several += n >= 3;
+    }
+  }
+  EXPECT_GT(several, 100) << "points with three or more curves near, or the skipping is hardly tested";
 }
 
 TEST(CollisionQuery, BoundarySectionFollowsTheHandle) {

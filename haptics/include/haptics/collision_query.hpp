@@ -160,8 +160,9 @@ class BoundarySection {
   /// `budget`, each box measured is one optional box test; when it runs out the walk stops and returns false
   /// with budget->ran_out set (the answer is then unknown, not "nothing close"). Without has_cuts(), the
   /// closest point at the tolerance step of the same tolerance. Allocates nothing.
+  /// `skip_curves` (skip_count of them) as closest_point's.
   bool closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
-                         QueryBudget* budget = nullptr);
+                         QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
   /// Whether the section has the cut masks (the constructor's `cut_walls`, or a non-null `cuts`).
   bool has_cuts() const noexcept { return cut_mask_ != nullptr; }
   /// Cut membership of the scene's nodes (tolerance_cut_masks; node_count() entries; null without has_cuts()).
@@ -218,8 +219,12 @@ class BoundarySection {
   /// With a `budget`, each wide node the walk opens is four optional box tests charged to it; when it
   /// runs out the walk stops and returns false with budget->ran_out set (the answer is then unknown, not
   /// "nothing close"), and the next call is not seeded. Allocates nothing.
+  ///
+  /// `skip_curves` (skip_count curve indices, a handful) are left out: the answer is the closest point of the
+  /// other curves, so repeated calls that skip the curves found so far list every curve within max_distance_m,
+  /// nearest first (ContactSolver::level_change_is_safe).
   bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
-                     QueryBudget* budget = nullptr);
+                     QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
 
   /// Node ids of the current boundary section (for the operator overlay and tests).
   const std::vector<std::uint32_t>& section() const { return section_; }

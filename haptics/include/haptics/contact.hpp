@@ -150,12 +150,14 @@ class ContactSolver {
 
   /// Whether the level in use may change to `new_level` now without the proxy ending up on the other side
   /// of the new level's polyline than it is of the old one (issue 6, item 2). For each curve the proxy
-  /// touches, and the nearest curve at either level, the proxy's side of the curve is found at both levels
+  /// touches, and every curve within the search radius (below) at either level (at most kMaxSideCurves in
+  /// all; more, and the change waits), the proxy's side of the curve is found at both levels
   /// (closest point and pseudo-normal, see side_of_curve); a curve on which the sides differ has the proxy
   /// between its two polylines, and the change must wait (the caller tries again next tick; as the hand
   /// moves on, the two levels' polylines cross each other and the sides agree again). Points between two
   /// levels lie within E = (largest error-box half-width of the old level + of the new) of both polylines,
-  /// so only curves within 2E are searched. When the change is made (the next update() with the new level),
+  /// so only curves within 2E are searched (until 2026-11-26 only the nearest curve at each level was, and a
+  /// second curve as near, where two edges cross, could have the proxy between its levels unseen). When the change is made (the next update() with the new level),
   /// the old level stays a wall, with the proxy's constraints on it, until the proxy rests on none of its
   /// segments: the proxy, on the same side of both polylines, then reaches the new one without crossing
   /// either. No second change is made while the old level is still a wall. Allocates nothing (at most six
@@ -168,6 +170,9 @@ class ContactSolver {
   /// the level id it was met at (its geometry), and the wall the proxy slides on is left out only of the
   /// queries where it has that same geometry.
   bool level_change_is_safe(int new_level, QueryBudget* budget = nullptr);
+  /// The most curves level_change_is_safe compares sides on in one check (where more lie within its radius,
+  /// as at a knot of many edges, the change waits).
+  static constexpr int kMaxSideCurves = 8;
 
   Vec2 proxy() const { return proxy_; }
   ContactState state() const { return state_; }
