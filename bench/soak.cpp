@@ -19,7 +19,8 @@
 // --csv. At the end it writes --json: the figures after
 // --warmup-s, the RSS growth per hour (least-squares slope of RSS over time after warm-up), and each target
 // of the issue met or not (RSS growth < 1 MB/h, no fd or thread growth, 0 missed deadlines at 1 kHz).
-// Exit status 0 unless --check is given and a target is missed.
+// Exit status 0 unless --check is given and a target is missed. --level-mode sets [haptics] level_mode (default
+// "auto"; "cut": the walls at the tolerance cut, whose masks every scene change computes again).
 //
 //   build/bench/bench_soak --duration-s 7200 --csv docs/bench/soak.csv --json docs/bench/soak.json
 
@@ -105,6 +106,7 @@ struct SoakOptions {
   std::string stick = std::string(HK_TEST_DATA_DIR) + "/documents";
   std::string csv, json;
   unsigned seed = 1;
+  std::string level_mode = "auto";  // [haptics] level_mode of the kiosk
   bool check = false;
 };
 
@@ -199,6 +201,7 @@ int run(const SoakOptions& o) {
   hk::config::Settings s;
   s.kiosk.timeout_s = 20;
   s.kiosk.warning_s = 5;
+  s.haptics.level_mode = o.level_mode;
   hk::app::RuntimeOptions ro;
   ro.library = o.library;
   ro.hotplug = false;
@@ -285,6 +288,7 @@ int run(const SoakOptions& o) {
   j["duration_s"] = o.duration_s;
   j["warmup_s"] = o.warmup_s;
   j["device"] = o.device;
+  j["level_mode"] = o.level_mode;
   j["visitors"] = script.visitors();
   j["keys"] = script.keys();
   j["sticks"] = script.sticks();
@@ -324,6 +328,7 @@ int main(int argc, char** argv) {
   cli.add_option("--csv", o.csv, "Write the samples here");
   cli.add_option("--json", o.json, "Write the summary here");
   cli.add_option("--seed", o.seed, "The visitors' seed");
+  cli.add_option("--level-mode", o.level_mode, "[haptics] level_mode of the kiosk")->check(CLI::IsMember({"auto", "tolerance", "cut", "fixed"}));
   cli.add_flag("--check", o.check, "Exit 1 when a target is missed");
   CLI11_PARSE(cli, argc, argv);
   if (o.warmup_s >= o.duration_s) o.warmup_s = o.duration_s / 2;
