@@ -190,11 +190,15 @@ INSTANTIATE_TEST_SUITE_P(LevelAndRenderModes, ServoStepModes,
                                            StepMode{"cut", "grooves", kCutLevelBase + 1}),
                          [](const ::testing::TestParamInfo<StepMode>& i) { return std::string(i.param.level_mode) + "_" + i.param.render; });
 
-TEST(ServoStep, NothingIsAllocatedOrFreedInAGuidedTour) {
+class ServoStepTourModes : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ServoStepTourModes, NothingIsAllocatedOrFreedInAGuidedTour) {
   // The guided tour (issue 14, item 3) in the servo path: taken, led through the transit (walls
   // suspended), round the outline, let go, and a second one cancelled by a key; the paths are planned and
-  // freed outside the count.
-  Rig r;
+  // freed outside the count. In each level mode (the walls the tour presses on: levels, tolerance steps, cut).
+  config::Settings settings;
+  settings.haptics.level_mode = GetParam();
+  Rig r(settings);
   r.hand = ModelHandParams{0.0, 0.0, 0.0};  // relaxed: the tour leads the handle
   r.samples.reserve(40000);
   r.commands.reserve(40000);
@@ -221,10 +225,16 @@ TEST(ServoStep, NothingIsAllocatedOrFreedInAGuidedTour) {
   r.core.cancel_tour();
   r.run(0.2, true);
   EXPECT_EQ(r.core.display().tour_phase, TourPhase::Stopped);
+  const int level = r.core.display().level;
+  EXPECT_EQ(is_cut_level(level), std::string(GetParam()) == "cut") << "the walls of the mode: level id " << level;
+  EXPECT_EQ(is_tolerance_level(level), std::string(GetParam()) == "tolerance") << "level id " << level;
   EXPECT_EQ(g_allocations.load(), 0) << "operator new called in ServoCore::step during a tour";
   EXPECT_EQ(g_frees.load(), 0) << "operator delete called in ServoCore::step during a tour";
   r.core.collect_retired();
 }
+
+INSTANTIATE_TEST_SUITE_P(LevelModes, ServoStepTourModes, ::testing::Values("auto", "tolerance", "cut"),
+                         [](const ::testing::TestParamInfo<const char*>& i) { return std::string(i.param); });
 
 TEST(ServoStep, SameSamplesGiveBitIdenticalCommands) {
   // A closed-loop run through the simulated pantograph, recorded; then a second core, given the same
