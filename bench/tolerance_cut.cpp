@@ -1,7 +1,10 @@
 // Vertices per error (issue 18 item 3): a tolerance cut through our collision tree against
 // Douglas–Peucker on every test picture.
 //
-// Usage: bench_tolerance_cut [--out FILE.json]    (prints a markdown table)
+// Usage: bench_tolerance_cut [--out FILE.json] [--max-levels N]    (prints a markdown table)
+//   --max-levels N  build every scene with N levels above level 0 instead of [haptics] max_levels (6), to see
+//                   what coarser levels would buy a long curve at a large T (it stops at length / 2^N
+//                   otherwise); the pictures' curves are chosen as with the default
 //
 // For a target error T, each method keeps every original vertex within T, measured:
 //   cut  hk::tolerance_cut on every curve (refine a segment while its box's error bound exceeds the
@@ -151,9 +154,16 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; ++i) {
     if (std::strcmp(argv[i], "--out") == 0) out_path = argv[i + 1];
   }
-  const config::Settings settings;
+  config::Settings settings;
   const auto paths = picture_paths();
   const auto pictures = picture_curves(settings);
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (std::strcmp(argv[i], "--max-levels") == 0) settings.haptics.max_levels = std::atoi(argv[i + 1]);
+  }
+  if (settings.haptics.max_levels < 0 || settings.haptics.max_levels >= kMaxLevels) {
+    std::fprintf(stderr, "bench_tolerance_cut: --max-levels %d is outside [0, %d]\n", settings.haptics.max_levels, kMaxLevels - 1);
+    return 2;
+  }
   const std::vector<double> tolerances_mm = {0.2, 0.3, 0.5, 1.0, 2.0};
   nlohmann::json rows = nlohmann::json::array();
   std::printf("| picture | curves | T mm | joined cut vertices (breaks joined) | dp vertices | cut / dp | cut error mm | dp error mm | curves with level-0 error > T | curve levels vertices | curve levels / dp | curve levels error mm |\n");

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "explore.hpp"
@@ -188,3 +189,32 @@ TEST(GroovesExplore, TraceHoldsTheClosestPointAndContactWithinTheRadius) {
   EXPECT_TRUE(fs::exists(dir / "out" / "overlay.png"));
   fs::remove_all(dir);
 }
+
+// Issue 18: grooves under every level mode that moves with the hand's speed (levels, tolerance steps, the
+// tolerance cut), on every picture: the raster whose rows alternate slow and fast changes the level (or step)
+// many times, and the force stays within stiffness × the handle's own motion plus the per-tick jump
+// allowance throughout (3.5 s for the 66 runs).
+class GroovesLevelModes : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {};
+
+TEST_P(GroovesLevelModes, ForceContinuousWhileLevelsFollowHandSpeed) {
+  config::Settings s = groove_settings();
+  s.haptics.level_mode = std::get<1>(GetParam());
+  s.haptics.force_ramp_s = 0.0;  // as above: the start-up ramp is not a force step
+  const app::ImageScene is = app::build_image_scene(kImages + std::get<0>(GetParam()), s);
+  ASSERT_GT(is.scene->curve_count(), 0u);
+  const HandPath hand = raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
+  const Continuity c = run_and_check(*is.scene, s, hand, hand.duration_s());
+  RecordProperty("level_changes", std::to_string(c.level_changes));
+  EXPECT_GE(c.level_changes, 10) << "the fast rows coarsen and the slow rows refine";
+  EXPECT_GT(c.contact_ticks, 1000) << "the raster crosses the grooves";
+  EXPECT_EQ(c.over_limit, 0) << "worst |ΔF| − k|Δh| = " << c.worst_excess_n << " N";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    RealImages, GroovesLevelModes,
+    ::testing::Combine(::testing::Values("HappyFish.jpg", "LinuxLogo.jpg", "apple.jpg", "butterfly.jpg", "camera.png", "coins.png", "fruits.jpg", "horse.png",
+                                         "page.png", "pic1.png", "pic3.png", "silhouette_1.png", "silhouette_10.png", "silhouette_2.png", "silhouette_3.png",
+                                         "silhouette_4.png", "silhouette_5.png", "silhouette_6.png", "silhouette_7.png", "silhouette_8.png", "silhouette_9.png",
+                                         "sudoku.png"),
+                       ::testing::Values("auto", "tolerance", "cut")),
+    [](const auto& info) { return fs::path(std::get<0>(info.param)).stem().string() + "_" + std::get<1>(info.param); });
