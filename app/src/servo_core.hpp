@@ -183,9 +183,20 @@ class ServoCore {
   TripleBuffer<ServoDisplayState> display_;
   ServoOutput out_;
   DeviceStatus last_status_ = DeviceStatus::Ok;        // the previous tick's sample status (a return restarts the picture)
+  // The phases of step, in order (each documented where it is defined; tour_* below).
+  void take_gains() noexcept;
+  void swap_scene(Vec2 handle_m) noexcept;
+  void apply_requests(const DeviceSample& sample, bool device_returned) noexcept;
+  TickResult render_walls(ServoInput& in) noexcept;
+  void add_guide_force() noexcept;
+  void emit_cues(Vec2 handle_m) noexcept;
+  void write_display(const DeviceSample& sample) noexcept;
   // The guided tour (servo thread but the atomics and the ring).
   void tour_before_update(const DeviceSample& sample) noexcept;
   void tour_after_update(const DeviceSample& sample) noexcept;
+  void track_tour_handle(Vec2 h, double period_s) noexcept;
+  TourPoint tour_point_pressed(double period_s) noexcept;
+  void advance_tour(Vec2 error_m, Vec2 press_n, double guide_len_n, double period_s) noexcept;
   void end_tour(TourPhase how) noexcept;
   std::atomic<TourPath*> tour_pending_{nullptr};
   std::atomic<bool> tour_cancel_{false};

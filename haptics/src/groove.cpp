@@ -31,22 +31,13 @@ void GrooveSolver::reset(Vec2 p_m, int level) {
   section_.reset();
 }
 
-void GrooveSolver::update(const ContactInput& in, ContactOutput& out) {
-  const Vec2 h = in.handle_m;
-  const ContactState before = state_;
-  out.events = kEventNone;
-  out.corner_turn_rad = 0.0;
-  out.sticking = false;
-  out.transition_level = -1;
-  out.press_s = 0.0;  // grooves never block, so nothing is pushed through
-  out.query = QueryStats{};
-  out.queries = 0;
-  out.path_count = 0;
-  out.path_m[out.path_count++] = proxy_;
-  level_ = in.level;
+// The phases of update, in order.
 
-  // The closest point of the polylines at the level in use, within the capture radius.
-  QueryBudget budget = in.budget;
+// The closest point of the polylines at the level in use within the capture radius (closest_point on the
+// tick's budget): there the state is Edge and the proxy that point; nothing within it, Free with the proxy at
+// the handle. Unknown within the budget: the groove is followed from where it was while the handle stays
+// within the radius of last tick's closest point (a point of the curve, so the pull is towards the curve).
+void GrooveSolver::find_groove(Vec2 h, QueryBudget& budget, ContactOutput& out) {
   const std::int32_t used_before = budget.box_tests_used;
   const double R = params_.capture_radius_m;
   Vec2 q;
@@ -62,8 +53,6 @@ void GrooveSolver::update(const ContactInput& in, ContactOutput& out) {
     proxy_ = q;
     seg_ = s;
   } else if (!found && budget.ran_out) {
-    // Unknown within this tick's budget: follow the groove from where it was if the handle is still within
-    // the radius of last tick's closest point (a point of the curve, so the pull is towards the curve).
     out.events |= kEventQueryBudget;
     out.query.budget_exhausted = true;
     if (!(state_ == ContactState::Edge && distance(h, proxy_) < R)) {
@@ -74,15 +63,17 @@ void GrooveSolver::update(const ContactInput& in, ContactOutput& out) {
     state_ = ContactState::Free;
     proxy_ = h;
   }
+}
 
-  // The pull of the profile towards the closest point.
+// The pull of the profile towards the closest point, then the per-tick limit (groove.hpp): it binds only where
+// the closest point jumps (the medial axis) or the law changes (level, gains); along a lone curve the target
+// moves by at most k·|Δh| and passes as is. Clamped to max_force_n; a non-finite force is zero.
+Vec2 GrooveSolver::groove_force(Vec2 h) {
   Vec2 target{0.0, 0.0};
   if (state_ == ContactState::Edge) {
     const double r = distance(h, proxy_);
     if (r > 0.0) target = (groove_profile_n(params_, r) / r) * (proxy_ - h);
   }
-  // The per-tick limit (groove.hpp): binds only where the closest point jumps (the medial axis) or the
-  // law changes (level, gains); along a lone curve the target moves by at most k·|Δh| and passes as is.
   const double allowed = params_.stiffness_n_per_m * distance(h, last_handle_) + params_.jump_step_n;
   const Vec2 delta = target - last_force_;
   const double dn = length(delta);
@@ -92,6 +83,26 @@ void GrooveSolver::update(const ContactInput& in, ContactOutput& out) {
   if (!is_finite(f)) f = Vec2{0.0, 0.0};
   last_force_ = f;
   last_handle_ = h;
+  return f;
+}
+
+void GrooveSolver::update(const ContactInput& in, ContactOutput& out) {
+  const Vec2 h = in.handle_m;
+  const ContactState before = state_;
+  out.events = kEventNone;
+  out.corner_turn_rad = 0.0;
+  out.sticking = false;
+  out.transition_level = -1;
+  out.press_s = 0.0;  // grooves never block, so nothing is pushed through
+  out.query = QueryStats{};
+  out.queries = 0;
+  out.path_count = 0;
+  out.path_m[out.path_count++] = proxy_;
+  level_ = in.level;
+
+  QueryBudget budget = in.budget;
+  find_groove(h, budget, out);
+  const Vec2 f = groove_force(h);
 
   out.path_m[out.path_count++] = proxy_;
   out.proxy_m = proxy_;

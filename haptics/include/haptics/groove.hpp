@@ -104,6 +104,9 @@ class GrooveSolver {
   ContactState state() const { return state_; }
 
  private:
+  // The phases of update, in order (each documented where it is defined).
+  void find_groove(Vec2 h, QueryBudget& budget, ContactOutput& out);
+  Vec2 groove_force(Vec2 h);
   const Scene* scene_;
   GrooveParams params_;
   BoundarySection section_;
