@@ -162,6 +162,7 @@ std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_
   const std::size_t c = static_cast<std::size_t>(chosen);
   const bool closed = scene.curve(c).closed;
   std::vector<Vec2> pts = curve_points(scene, c, chosen_level);
+  int direction = 1;  // along increasing segment indices (a closed curve's outline, an open one from its first point)
 
   // The base sequence (on the curve) and its unit normals, from the start of the outline to its end.
   std::vector<Vec2> base, normal;
@@ -184,7 +185,10 @@ std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_
     base.push_back(cl.q);
     normal.push_back(nq);
   } else {
-    if (distance(handle_m, pts.back()) < distance(handle_m, pts.front())) std::reverse(pts.begin(), pts.end());
+    if (distance(handle_m, pts.back()) < distance(handle_m, pts.front())) {
+      std::reverse(pts.begin(), pts.end());
+      direction = -1;
+    }
     std::vector<Vec2> seg_n(n - 1);
     for (std::size_t i = 0; i + 1 < n; ++i) seg_n[i] = seg_normal(pts[i], pts[i + 1], {1.0, 0.0});
     for (std::size_t i = 0; i < n; ++i) {
@@ -199,6 +203,7 @@ std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_
   TourPath path;
   path.scene_id = scene_id;
   path.curve = chosen;
+  path.direction = direction;
   path.params = p;
   const double v = p.speed_m_per_s;
   // 1. Transit: minimum-jerk from the handle to the start point off the curve, mean speed v.

@@ -24,6 +24,11 @@
 ///      nearer the handle to the far end.
 ///   4. release: back to offset_m on the handle's side, at tour_speed; then the servo lets go (the guide
 ///      force fades out over fade_s).
+/// The press keeps the handle on the wall, so in the outline it follows the wall into every narrow pocket,
+/// slot or hook of the rendered polyline, which the track, offset from the curve at the planning level, passes
+/// outside; from inside a hook the spring pulls into the wall. ServoCore then follows the wall instead (see
+/// TourParams::trap_s): the handle is led out of the pocket along it, and the spring takes over again near the
+/// waiting target. Without that, 13 tours on 9 of the 22 test pictures stopped as if held (2026-11-26).
 /// (The sketch put the outline 1.5 mm off the wall on the handle's side with no press; the handle
 /// would then be led round in the air and never touch the shape. A target 1.5 mm past the wall was tried
 /// next and fails: with the walls' friction (μ_s 0.4) the handle sticks on the wall wherever the pull
@@ -76,6 +81,12 @@ struct TourParams {
   double hold_s = 0.5;               ///< ...with the guide force at its limit for this long stops the tour [s]
   double min_shape_length_m = 0.006; ///< curves shorter than this (level 0) are specks, not toured [m]
   double plan_error_m = 0.0005;      ///< plan on the coarsest level whose error is below this [m]
+  /// Caught in a pocket of the shape (ServoCore): the handle on the toured shape's wall, the spring at its
+  /// limit and the handle not moving for trap_s, the guide pushes it along that wall in the outline's direction
+  /// with follow_force_n (plus the press) until it is within rejoin_m of the waiting target.
+  double trap_s = 0.15;              ///< [s]
+  double follow_force_n = 0.5;       ///< [N]; above the break-away friction of the press (μ_s 0.4 × 0.6 N)
+  double rejoin_m = 0.002;           ///< [m]; above the track's offset from the wall plus the press's depth
 };
 
 /// TourParams from the settings: [haptics] tour_max_force_n and tour_speed_m_per_s; the rest the defaults.
@@ -98,6 +109,7 @@ struct TourPath {
   int curve = -1;         ///< the shape: scene curve index
   TourParams params;
   double outline_start_s = 0.0;  ///< end of the transit: walls are on from here [s]
+  int direction = 1;             ///< the outline runs along increasing segment indices of the curve (+1) or decreasing (-1)
   std::vector<TourPoint> points; ///< timed targets; points.front() is the handle at planning time, t = 0
   /// Time of the last point [s] (0 for an empty path).
   double duration_s() const noexcept { return points.empty() ? 0.0 : points.back().t_s; }

@@ -1,6 +1,7 @@
 #include "servo_core.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 
 namespace hk::app {
@@ -74,7 +75,9 @@ void ServoCore::tour_before_update(const DeviceSample& sample) noexcept {
         tour_fade_left_ = 0;
         tour_prev_handle_ = sample.handle_m;
         tour_prev_target_ = next->points.front().target_m;
-        tour_velocity_ = tour_hold_velocity_ = tour_press_ = {0.0, 0.0};
+        tour_velocity_ = tour_hold_velocity_ = tour_press_ = tour_follow_dir_ = {0.0, 0.0};
+        tour_following_ = false;
+        tour_trap_ticks_ = 0;
       }
     }
   }
@@ -122,6 +125,59 @@ TourPoint ServoCore::tour_point_pressed(double period_s) noexcept {
   return here;
 }
 
+// Caught in a pocket of its own shape? The press keeps the handle on the wall, so it follows the wall into
+// every narrow pocket, slot or hook of the rendered polyline, which the planned track, offset from the curve
+// at the planning level, passes outside; there the spring's pull points into the wall and the handle stops.
+// On the toured shape's wall with the spring at its limit and the handle still for trap_s, the guide follows
+// the wall (follow_force) until the handle is within rejoin_m of the target, which waits (the path's clock
+// stops while the handle does not keep up). Outline only; a tour ending, or not in its outline, never follows.
+void ServoCore::track_trap(Vec2 error_m, Vec2 press_n, double period_s) noexcept {
+  const TourParams& p = tour_->params;
+  if (tour_phase_ != TourPhase::Outline || tour_ending_ != TourPhase::None) {
+    tour_following_ = false;
+    tour_trap_ticks_ = 0;
+    return;
+  }
+  const bool on_shape = out_.contact.state != ContactState::Free && out_.contact.constraint[0].curve == tour_->curve;
+  if (tour_following_) {  // back to the spring near the target, or off the wall (round a tip: the spring leads on)
+    if (length(error_m) < p.rejoin_m || !on_shape) tour_following_ = false;
+    return;
+  }
+  const bool saturated = length(p.stiffness_n_per_m * error_m + press_n) >= p.max_force_n;
+  const bool still = length(tour_hold_velocity_) < p.hold_speed_m_per_s;
+  tour_trap_ticks_ = on_shape && saturated && still ? tour_trap_ticks_ + 1 : 0;
+  if (static_cast<double>(tour_trap_ticks_) * period_s >= p.trap_s) {
+    tour_following_ = true;
+    tour_trap_ticks_ = 0;
+  }
+}
+
+// The guide while following the wall: the press plus follow_force_n along the toured shape's wall the proxy is
+// on, in the outline's direction (TourPath::direction along the segment's own end points, which every level
+// orders alike); at a vertex the wall that leads away from the proxy; off the walls, the last direction.
+// Never above max_force_n.
+Vec2 ServoCore::follow_force(Vec2 press_n) noexcept {
+  const TourParams& p = tour_->params;
+  const ContactOutput& c = out_.contact;
+  const int walls = c.state == ContactState::Vertex ? 2 : (c.state == ContactState::Edge ? 1 : 0);
+  double best_lead = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < walls; ++i) {
+    if (c.constraint[i].curve != tour_->curve) continue;
+    Vec2 a, b;
+    current_->scene->segment(c.constraint[i], &a, &b);
+    const Vec2 t = static_cast<double>(tour_->direction) * normalized_or(b - a, tour_follow_dir_);
+    const double lead = dot(t, 0.5 * (a + b) - c.proxy_m);  // > 0: the wall goes on ahead of the proxy
+    if (lead > best_lead) {
+      best_lead = lead;
+      tour_follow_dir_ = t;
+    }
+  }
+  Vec2 f = press_n + p.follow_force_n * tour_follow_dir_;
+  const double len = length(f);
+  if (len > p.max_force_n) f = (p.max_force_n / len) * f;
+  return f;
+}
+
 // The tour's progress on a tick that rendered: held still against it (the force at its limit, or the path's
 // clock stopped because the handle does not keep up, while the handle barely moves) for hold_s stops it; the
 // path's clock runs while the handle keeps up (within the spring's saturation distance); the outline begins
@@ -131,7 +187,7 @@ void ServoCore::advance_tour(Vec2 error_m, Vec2 press_n, double guide_len_n, dou
   const TourParams& p = tour_->params;
   const Vec2 pull = p.stiffness_n_per_m * error_m + press_n;
   const bool keeping_up = length(pull) < p.max_force_n;
-  const bool held = (guide_len_n >= 0.95 * p.max_force_n || !keeping_up) && length(tour_hold_velocity_) < p.hold_speed_m_per_s;
+  const bool held = (guide_len_n >= 0.95 * p.max_force_n || !keeping_up || tour_following_) && length(tour_hold_velocity_) < p.hold_speed_m_per_s;
   tour_hold_ticks_ = held ? tour_hold_ticks_ + 1 : 0;
   if (static_cast<double>(tour_hold_ticks_) * period_s >= p.hold_s) {
     tour_ending_ = TourPhase::Stopped;
@@ -174,8 +230,13 @@ void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
   // A spring to the target, damping of the velocity relative to the target's (PD tracking) and the press
   // towards the wall.
   Vec2 f = p.stiffness_n_per_m * e + p.damping_n_s_per_m * (target_v - tour_velocity_) + here.press_n;
-  const double f_len = length(f);
+  double f_len = length(f);
   if (f_len > p.max_force_n) f = (p.max_force_n / f_len) * f;
+  track_trap(e, here.press_n, period);
+  if (tour_following_) {  // out of a pocket along its wall, then back to the spring
+    f = follow_force(here.press_n);
+    f_len = length(f);
+  }
   double gain = std::min(1.0, static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_));  // fade in
   // The walls: faded out over the first fade_s of the transit, then off (relocate); on from the outline.
   if (tour_phase_ == TourPhase::Transit)

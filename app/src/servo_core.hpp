@@ -197,6 +197,8 @@ class ServoCore {
   void track_tour_handle(Vec2 h, double period_s) noexcept;
   TourPoint tour_point_pressed(double period_s) noexcept;
   void advance_tour(Vec2 error_m, Vec2 press_n, double guide_len_n, double period_s) noexcept;
+  void track_trap(Vec2 error_m, Vec2 press_n, double period_s) noexcept;
+  Vec2 follow_force(Vec2 press_n) noexcept;
   void end_tour(TourPhase how) noexcept;
   std::atomic<TourPath*> tour_pending_{nullptr};
   std::atomic<bool> tour_cancel_{false};
@@ -219,6 +221,9 @@ class ServoCore {
   static constexpr double kHoldVelocityHz = 5.0;       // low-pass of the "held still" velocity [Hz]
   static constexpr double kPressHz = 10.0;             // low-pass of the press force's direction changes [Hz]
   Vec2 tour_press_;                                    // the press force, low-passed [N]
+  bool tour_following_ = false;                        // caught in a pocket: following the wall (track_trap)
+  long tour_trap_ticks_ = 0;                           // consecutive ticks caught on the shape's wall, still
+  Vec2 tour_follow_dir_;                               // the wall's direction while following (unit)
   std::int64_t tick_ = 0;
 };
 
