@@ -19,6 +19,7 @@
 #include "haptics/hand_path.hpp"
 #include "image_scene.hpp"
 #include "simulation.hpp"
+#include "test_pictures.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -212,9 +213,6 @@ TEST_P(GroovesLevelModes, ForceContinuousWhileLevelsFollowHandSpeed) {
 
 INSTANTIATE_TEST_SUITE_P(
     RealImages, GroovesLevelModes,
-    ::testing::Combine(::testing::Values("HappyFish.jpg", "LinuxLogo.jpg", "apple.jpg", "butterfly.jpg", "camera.png", "coins.png", "fruits.jpg", "horse.png",
-                                         "page.png", "pic1.png", "pic3.png", "silhouette_1.png", "silhouette_10.png", "silhouette_2.png", "silhouette_3.png",
-                                         "silhouette_4.png", "silhouette_5.png", "silhouette_6.png", "silhouette_7.png", "silhouette_8.png", "silhouette_9.png",
-                                         "sudoku.png"),
+    ::testing::Combine(::testing::ValuesIn(test::kPictures),
                        ::testing::Values("auto", "tolerance", "cut")),
     [](const auto& info) { return fs::path(std::get<0>(info.param)).stem().string() + "_" + std::get<1>(info.param); });

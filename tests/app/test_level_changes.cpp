@@ -18,6 +18,7 @@
 #include "haptics/hand_path.hpp"
 #include "image_scene.hpp"
 #include "simulation.hpp"
+#include "test_pictures.hpp"
 
 namespace hk {
 namespace {
@@ -178,7 +179,7 @@ TEST_P(LevelChanges, ExplorerChangesToleranceStepsWithoutCrossingOrForceSteps) {
 TEST_P(LevelChanges, ExplorerChangesCutStepsWithoutCrossingOrForceSteps) { level_changes_hold(GetParam(), "cut", Hand::Explorer); }
 
 INSTANTIATE_TEST_SUITE_P(RealImages, LevelChanges,
-                         ::testing::Values("HappyFish.jpg", "LinuxLogo.jpg", "apple.jpg", "butterfly.jpg", "camera.png", "coins.png", "fruits.jpg", "horse.png", "page.png", "pic1.png", "pic3.png", "silhouette_1.png", "silhouette_10.png", "silhouette_2.png", "silhouette_3.png", "silhouette_4.png", "silhouette_5.png", "silhouette_6.png", "silhouette_7.png", "silhouette_8.png", "silhouette_9.png", "sudoku.png"),
+                         ::testing::ValuesIn(test::kPictures),
                          [](const auto& info) { return fs::path(info.param).stem().string(); });
 
 }  // namespace
