@@ -83,7 +83,7 @@ struct TourParams {
   double plan_error_m = 0.0005;      ///< plan on the coarsest level whose error is below this [m]
   /// Caught in a pocket of the shape (ServoCore): the handle on the toured shape's wall, the spring at its
   /// limit and the handle not moving for trap_s, the guide pushes it along that wall in the outline's direction
-  /// with follow_force_n (plus the press) until it is within rejoin_m of the waiting target.
+  /// with follow_force_n (plus the press) until it is within rejoin_m of the waiting target or off the wall.
   double trap_s = 0.15;              ///< [s]
   double follow_force_n = 0.5;       ///< [N]; above the break-away friction of the press (μ_s 0.4 × 0.6 N)
   double rejoin_m = 0.002;           ///< [m]; above the track's offset from the wall plus the press's depth

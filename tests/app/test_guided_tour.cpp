@@ -130,6 +130,10 @@ TEST(TourPlanner, AnOpenCurveGoesFromItsNearerEndToTheFarEnd) {
   const Vec2 end = plan->points.back().target_m;
   EXPECT_NEAR(end.x, -0.02, 0.001) << "ends at the far end";
   EXPECT_GT(end.y, 0.0);
+  EXPECT_EQ(plan->direction, -1) << "from the last point to the first: decreasing segment indices (the servo follows walls that way)";
+  const auto from_left = plan_tour(sc, 1, {-0.03, 0.004}, none, TourParams{});
+  ASSERT_TRUE(from_left.has_value());
+  EXPECT_EQ(from_left->direction, 1) << "from the first point: increasing segment indices";
 }
 
 TEST(TourPlanner, MovesAtTourSpeedAlongTheOutlineAndAtMostTwiceItInTransit) {
