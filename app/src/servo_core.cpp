@@ -131,7 +131,7 @@ TourPoint ServoCore::tour_point_pressed(double period_s) noexcept {
 // On the toured shape's wall with the spring at its limit and the handle still for trap_s, the guide follows
 // the wall (follow_force) until the handle is within rejoin_m of the target, which waits (the path's clock
 // stops while the handle does not keep up). Outline only; a tour ending, or not in its outline, never follows.
-void ServoCore::track_trap(Vec2 error_m, Vec2 press_n, double period_s) noexcept {
+void ServoCore::track_trap(Vec2 error_m, bool keeping_up, double period_s) noexcept {
   const TourParams& p = tour_->params;
   if (tour_phase_ != TourPhase::Outline || tour_ending_ != TourPhase::None) {
     tour_following_ = false;
@@ -143,9 +143,8 @@ void ServoCore::track_trap(Vec2 error_m, Vec2 press_n, double period_s) noexcept
     if (length(error_m) < p.rejoin_m || !on_shape) tour_following_ = false;
     return;
   }
-  const bool saturated = length(p.stiffness_n_per_m * error_m + press_n) >= p.max_force_n;
   const bool still = length(tour_hold_velocity_) < p.hold_speed_m_per_s;
-  tour_trap_ticks_ = on_shape && saturated && still ? tour_trap_ticks_ + 1 : 0;
+  tour_trap_ticks_ = on_shape && !keeping_up && still ? tour_trap_ticks_ + 1 : 0;
   if (static_cast<double>(tour_trap_ticks_) * period_s >= p.trap_s) {
     tour_following_ = true;
     tour_trap_ticks_ = 0;
@@ -154,8 +153,8 @@ void ServoCore::track_trap(Vec2 error_m, Vec2 press_n, double period_s) noexcept
 
 // The guide while following the wall: the press plus follow_force_n along the toured shape's wall the proxy is
 // on, in the outline's direction (TourPath::direction along the segment's own end points, which every level
-// orders alike); at a vertex the wall that leads away from the proxy; off the walls, the last direction.
-// Never above max_force_n.
+// orders alike); at a vertex the wall that leads away from the proxy (a zero-length wall keeps the last
+// direction). Called only while following, so on the toured shape's wall. Never above max_force_n.
 Vec2 ServoCore::follow_force(Vec2 press_n) noexcept {
   const TourParams& p = tour_->params;
   const ContactOutput& c = out_.contact;
@@ -181,12 +180,10 @@ Vec2 ServoCore::follow_force(Vec2 press_n) noexcept {
 // The tour's progress on a tick that rendered: held still against it (the force at its limit, or the path's
 // clock stopped because the handle does not keep up, while the handle barely moves) for hold_s stops it; the
 // path's clock runs while the handle keeps up (within the spring's saturation distance); the outline begins
-// (the TourStart earcon) and the path ends (Done) at their times. `error_m` is target − handle, `guide_len_n`
-// the guide force's length before the fades.
-void ServoCore::advance_tour(Vec2 error_m, Vec2 press_n, double guide_len_n, double period_s) noexcept {
+// (the TourStart earcon) and the path ends (Done) at their times. `keeping_up`: the spring's pull plus the
+// press is below max_force_n; `guide_len_n` the guide force's length before the fades.
+void ServoCore::advance_tour(bool keeping_up, double guide_len_n, double period_s) noexcept {
   const TourParams& p = tour_->params;
-  const Vec2 pull = p.stiffness_n_per_m * error_m + press_n;
-  const bool keeping_up = length(pull) < p.max_force_n;
   const bool held = (guide_len_n >= 0.95 * p.max_force_n || !keeping_up || tour_following_) && length(tour_hold_velocity_) < p.hold_speed_m_per_s;
   tour_hold_ticks_ = held ? tour_hold_ticks_ + 1 : 0;
   if (static_cast<double>(tour_hold_ticks_) * period_s >= p.hold_s) {
@@ -232,7 +229,9 @@ void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
   Vec2 f = p.stiffness_n_per_m * e + p.damping_n_s_per_m * (target_v - tour_velocity_) + here.press_n;
   double f_len = length(f);
   if (f_len > p.max_force_n) f = (p.max_force_n / f_len) * f;
-  track_trap(e, here.press_n, period);
+  // The handle keeps up while the spring's pull and the press stay under the limit (the clock runs).
+  const bool keeping_up = length(p.stiffness_n_per_m * e + here.press_n) < p.max_force_n;
+  track_trap(e, keeping_up, period);
   if (tour_following_) {  // out of a pocket along its wall, then back to the spring
     f = follow_force(here.press_n);
     f_len = length(f);
@@ -241,7 +240,7 @@ void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
   // The walls: faded out over the first fade_s of the transit, then off (relocate); on from the outline.
   if (tour_phase_ == TourPhase::Transit)
     out_.force_n = std::max(0.0, 1.0 - static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_)) * out_.force_n;
-  if (tour_ending_ == TourPhase::None && out_.result == TickResult::Ok) advance_tour(e, here.press_n, f_len, period);
+  if (tour_ending_ == TourPhase::None && out_.result == TickResult::Ok) advance_tour(keeping_up, f_len, period);
   if (tour_ending_ != TourPhase::None) {  // fading out (Done or Stopped)
     --tour_fade_left_;
     gain *= std::max(0.0, static_cast<double>(tour_fade_left_) / static_cast<double>(tour_fade_ticks_));

@@ -196,8 +196,8 @@ class ServoCore {
   void tour_after_update(const DeviceSample& sample) noexcept;
   void track_tour_handle(Vec2 h, double period_s) noexcept;
   TourPoint tour_point_pressed(double period_s) noexcept;
-  void advance_tour(Vec2 error_m, Vec2 press_n, double guide_len_n, double period_s) noexcept;
-  void track_trap(Vec2 error_m, Vec2 press_n, double period_s) noexcept;
+  void advance_tour(bool keeping_up, double guide_len_n, double period_s) noexcept;
+  void track_trap(Vec2 error_m, bool keeping_up, double period_s) noexcept;
   Vec2 follow_force(Vec2 press_n) noexcept;
   void end_tour(TourPhase how) noexcept;
   std::atomic<TourPath*> tour_pending_{nullptr};
