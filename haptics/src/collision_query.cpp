@@ -141,7 +141,9 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   // megabytes of scratch: when it is full, boxes are simply not split (the query still descends).
   capacity_ = std::min<std::size_t>(2 * n, kMaxSectionEntries) + widest_root + 8;
   section_.reserve(capacity_);
-  section_box_.reserve(capacity_);
+  section_rect_.size_for(capacity_ + 1);
+  rect_d_sq_.assign(capacity_ + 1, 0.0);
+  rect_overlap_.assign(capacity_ + 1, 0);
   in_section_.assign(n, 0);
   compact_stamp_.assign(n, 0);
   candidates_.reserve(capacity_);
@@ -159,15 +161,18 @@ void BoundarySection::reset() {
   last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
   for (std::uint32_t node : section_) in_section_[node] = 0;
   section_.clear();
-  section_box_.clear();
   ball_radius_m_ = 0.0;
   wide_ball_radius_m_ = 0.0;
   wide_ball_seed_ = kWideEmpty;
   if (scene_->curve_count() == 0) return;
   const std::uint32_t r = scene_->scene_root();
-  section_.push_back(r);
-  section_box_.push_back(scene_->aabb(r));
+  push_section(r);
   in_section_[r] = 1;
+}
+
+void BoundarySection::push_section(std::uint32_t node) {
+  section_rect_.set(section_.size(), scene_->aabb(node));
+  section_.push_back(node);
 }
 
 void BoundarySection::split(std::uint32_t node) {
@@ -177,8 +182,7 @@ void BoundarySection::split(std::uint32_t node) {
   if (section_.size() + count + 8 > capacity_) return;  // full: keep the node (room kept for this tick's merges)
   in_section_[node] = 0;
   for (std::uint32_t i = 0; i < count; ++i) {
-    section_.push_back(first + i);
-    section_box_.push_back(scene_->aabb(first + i));
+    push_section(first + i);
     in_section_[first + i] = 1;
   }
 }
@@ -205,11 +209,11 @@ struct BoundarySection::Query {
     best.point_m = b_m;
   }
 
-  // A section entry's clip: always done and charged, even past the budget.
-  void charge_section_box() noexcept {
-    ++st.box_tests;
-    ++st.section_box_tests;
-    budget->charge();
+  // The section entries' clips: always done and charged, even past the budget.
+  void charge_section_boxes(std::int32_t n) noexcept {
+    st.box_tests += n;
+    st.section_box_tests += n;
+    budget->charge(n);
   }
   // Any other box test: only while the budget lasts.
   bool spend_box() noexcept { return spend_boxes(1); }
@@ -254,33 +258,83 @@ void BoundarySection::next_tick() noexcept {
 
 // Phase 1: clip the sweep against every box of the boundary section, grown by the merge margin, so one
 // clip answers both "hit?" (then an exact clip makes it a candidate) and "still near?" (else it may merge).
-// On the way, the distance from the end of the sweep to the nearest box: the next free-space ball.
+// On the way, the distance from the end of the sweep to the nearest box: the next free-space ball. Two
+// passes: scan_section_rects measures every entry's rectangle (two per SSE2 instruction), then only
+// the entries whose rectangle could matter have their box rebuilt.
 void BoundarySection::clip_section(Query& q) {
   const Scene& sc = *scene_;
   candidates_.clear();
   merge_scratch_.clear();
   const std::size_t n_section = section_.size();
+  q.charge_section_boxes(static_cast<std::int32_t>(n_section));
+  const std::size_t nearest_rect = scan_section_rects(q);
+  // The free-space ball: the nearest box. A rectangle holds its box, so a box is nearer than the nearest
+  // found so far only when its rectangle is; starting from the box of the nearest rectangle leaves few others
+  // to rebuild. The minimum is the same whatever the order.
+  if (nearest_rect < n_section) q.nearest_sq = box_distance_sq(sc.box(section_[nearest_rect]), q.b);
   for (std::size_t i = 0; i < n_section; ++i) {
     const std::uint32_t node = section_[i];
-    double te = 0.0, tx = 0.0;
-    q.charge_section_box();
-    const Aabb& r = section_box_[i];
-    const bool near = rect_distance_sq(r, q.b) < q.nearest_sq;
-    const bool overlapping = overlaps(r, q.sweep, merge_margin_m_);
-    if (!near && !overlapping) {  // the rectangle settles both: the box itself is not needed
+    const bool near = i != nearest_rect && rect_d_sq_[i] < q.nearest_sq;
+    if (!near && !rect_overlap_[i]) {  // the rectangle settles both: the box itself is not needed
       merge_scratch_.push_back(node);
       continue;
     }
     const ErrorBox box = sc.box(node);
-    // The rectangle's distance bounds the box's from below: the exact one only when it could be nearer.
     if (near) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
-    if (overlapping && clip_segment_box(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
+    double te = 0.0, tx = 0.0;
+    if (rect_overlap_[i] && clip_segment_box(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
       hit_stamp_[node] = tick_;
       if (clip_segment_box(box, q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node});
     } else {
       merge_scratch_.push_back(node);
     }
   }
+}
+
+// The rectangle pass of clip_section: for every section entry, the squared distance from the sweep's end to
+// its rectangle (rect_d_sq_; rect_distance_sq, bit for bit) and whether the rectangle, grown by the merge
+// margin, meets the sweep's (rect_overlap_; overlaps()). Entries in pairs (the arrays hold an even count);
+// returns the entry of the nearest rectangle (the first of equals; n_section when the section is empty).
+std::size_t BoundarySection::scan_section_rects(const Query& q) {
+  const std::size_t n = section_.size();
+  const double* lo_x = section_rect_.lo_x.data();
+  const double* lo_y = section_rect_.lo_y.data();
+  const double* hi_x = section_rect_.hi_x.data();
+  const double* hi_y = section_rect_.hi_y.data();
+  double* d_sq = rect_d_sq_.data();
+  std::uint8_t* overlap = rect_overlap_.data();
+  const double m = merge_margin_m_;
+#if defined(__SSE2__)
+  const __m128d px = _mm_set1_pd(q.b.x), py = _mm_set1_pd(q.b.y), zero = _mm_setzero_pd();
+  const __m128d s_lo_x = _mm_set1_pd(q.sweep.lo.x), s_lo_y = _mm_set1_pd(q.sweep.lo.y);
+  const __m128d s_hi_x = _mm_set1_pd(q.sweep.hi.x), s_hi_y = _mm_set1_pd(q.sweep.hi.y), vm = _mm_set1_pd(m);
+  for (std::size_t i = 0; i < n; i += 2) {
+    const __m128d lx = _mm_loadu_pd(lo_x + i), ly = _mm_loadu_pd(lo_y + i), hx = _mm_loadu_pd(hi_x + i), hy = _mm_loadu_pd(hi_y + i);
+    const __m128d dx = _mm_max_pd(_mm_max_pd(_mm_sub_pd(lx, px), zero), _mm_sub_pd(px, hx));
+    const __m128d dy = _mm_max_pd(_mm_max_pd(_mm_sub_pd(ly, py), zero), _mm_sub_pd(py, hy));
+    _mm_storeu_pd(d_sq + i, _mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)));
+    const __m128d meets = _mm_and_pd(_mm_and_pd(_mm_cmple_pd(_mm_sub_pd(lx, vm), s_hi_x), _mm_cmple_pd(s_lo_x, _mm_add_pd(hx, vm))),
+                                     _mm_and_pd(_mm_cmple_pd(_mm_sub_pd(ly, vm), s_hi_y), _mm_cmple_pd(s_lo_y, _mm_add_pd(hy, vm))));
+    const int bits = _mm_movemask_pd(meets);
+    overlap[i] = static_cast<std::uint8_t>(bits & 1);
+    overlap[i + 1] = static_cast<std::uint8_t>(bits >> 1);
+  }
+#else
+  for (std::size_t i = 0; i < n; ++i) {
+    const Aabb r{{lo_x[i], lo_y[i]}, {hi_x[i], hi_y[i]}};
+    d_sq[i] = rect_distance_sq(r, q.b);
+    overlap[i] = overlaps(r, q.sweep, m) ? 1 : 0;
+  }
+#endif
+  std::size_t nearest = n;
+  double nearest_sq = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (d_sq[i] < nearest_sq) {
+      nearest_sq = d_sq[i];
+      nearest = i;
+    }
+  }
+  return nearest;
 }
 
 // Intersects the sweep with one segment of the target level; keeps the nearest hit.
@@ -385,13 +439,13 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     bool all_idle = true;
     for (std::uint32_t i = 0; i < count && all_idle; ++i) all_idle = in_section_[first + i] && hit_stamp_[first + i] != tick_;
     if (!all_idle) continue;
+    if (section_.size() >= capacity_) break;  // full until the compaction (a merge adds an entry before it removes any)
     double te = 0.0, tx = 0.0;
     if (!q.spend_box()) break;  // merging can wait for a tick with budget left
     if (clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
     for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
     in_section_[parent] = 1;
-    section_.push_back(parent);
-    section_box_.push_back(sc.aabb(parent));
+    push_section(parent);
     ++q.st.merges;
   }
 }
@@ -411,12 +465,11 @@ void BoundarySection::compact_section(Query& q) {
     const std::uint32_t node = section_[i];
     if (in_section_[node] && compact_stamp_[node] != tick_) {
       compact_stamp_[node] = tick_;  // de-duplicate within this pass (a node merged back in appears twice)
-      section_box_[w] = section_box_[i];
+      section_rect_.copy(w, i);
       section_[w++] = node;
     }
   }
   section_.resize(w);
-  section_box_.resize(w);
 }
 
 // Phase 6: the answer. An exact hit; or, when a box left unrefined begins before it, the finest level

@@ -70,6 +70,8 @@ struct QueryBudget {
   }
   /// Charges one box test that is done regardless (a section entry's clip).
   void charge() noexcept { ++box_tests_used; }
+  /// Charges n box tests that are done regardless (a scan of n section entries).
+  void charge(std::int32_t n) noexcept { box_tests_used += n; }
 };
 
 /// Result of a sweep query.
@@ -239,6 +241,7 @@ class BoundarySection {
   bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
   void next_tick() noexcept;
   void clip_section(Query& q);
+  std::size_t scan_section_rects(const Query& q);
   void refine_candidates(Query& q);
   bool push_hit_children(Query& q, std::uint32_t node, int& top);
   void test_segment(Query& q, std::uint32_t node);
@@ -270,7 +273,19 @@ class BoundarySection {
   const Scene* scene_;
   double merge_margin_m_;
   std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
-  std::vector<Aabb> section_box_;          // their rectangles, inline so the per-tick scan streams through memory
+  // The section entries' rectangles [m], in step with section_, as four arrays (structure of arrays) so the
+  // per-tick scan tests two entries per SSE2 instruction and streams through memory; sized capacity_ + 1
+  // (an even count: the scan reads entries in pairs) and never resized, so the servo path allocates nothing.
+  struct SectionRects {
+    std::vector<double> lo_x, lo_y, hi_x, hi_y;
+    void size_for(std::size_t n) { lo_x.assign(n, 0.0); lo_y.assign(n, 0.0); hi_x.assign(n, 0.0); hi_y.assign(n, 0.0); }
+    void set(std::size_t i, const Aabb& r) noexcept { lo_x[i] = r.lo.x; lo_y[i] = r.lo.y; hi_x[i] = r.hi.x; hi_y[i] = r.hi.y; }
+    void copy(std::size_t to, std::size_t from) noexcept { lo_x[to] = lo_x[from]; lo_y[to] = lo_y[from]; hi_x[to] = hi_x[from]; hi_y[to] = hi_y[from]; }
+  };
+  SectionRects section_rect_;
+  std::vector<double> rect_d_sq_;          // scan scratch, per entry: squared distance from the sweep's end to its rectangle [m²]
+  std::vector<std::uint8_t> rect_overlap_; // scan scratch, per entry: its rectangle, grown by the merge margin, meets the sweep's
+  void push_section(std::uint32_t node);   // appends node with its rectangle (the caller checked the room)
   std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
   std::vector<std::uint32_t> compact_stamp_;  // per node: tick at which the compaction last kept it (de-duplication)
   struct Candidate { double t_enter; std::uint32_t node; };  // 16 bytes
