@@ -143,11 +143,11 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   section_.reserve(capacity_);
   section_rect_.size_for(capacity_ + 1);
   rect_d_sq_.assign(capacity_ + 1, 0.0);
-  rect_overlap_.assign(capacity_ + 1, 0);
+  rect_overlap_bits_.assign((capacity_ + 1) / 64 + 1, 0);
+  rect_near_bits_.assign((capacity_ + 1) / 64 + 1, 0);
   in_section_.assign(n, 0);
   compact_stamp_.assign(n, 0);
   candidates_.reserve(capacity_);
-  merge_scratch_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
   stack_.resize(tree_stack_entries(widest_root));
   hit_stamp_.assign(n, 0);
@@ -201,6 +201,8 @@ struct BoundarySection::Query {
   double nearest_sq = std::numeric_limits<double>::infinity();  // squared distance from b to the section's nearest box
   QueryStats st;
   bool refused = false;  // optional work was refused for want of budget (a wide node may be refused before it is quite spent)
+  std::size_t scanned = 0;  // section entries phase 1 scanned (the first ones of section_)
+  std::size_t hit = 0;      // of which the sweep met, grown by the merge margin (hit_stamp_ this tick)
 
   Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded, QueryBudget& shared_budget)
       : a(a_m), b(b_m), sweep{{std::min(a_m.x, b_m.x), std::min(a_m.y, b_m.y)}, {std::max(a_m.x, b_m.x), std::max(a_m.y, b_m.y)}},
@@ -258,43 +260,47 @@ void BoundarySection::next_tick() noexcept {
 
 // Phase 1: clip the sweep against every box of the boundary section, grown by the merge margin, so one
 // clip answers both "hit?" (then an exact clip makes it a candidate) and "still near?" (else it may merge).
-// On the way, the distance from the end of the sweep to the nearest box: the next free-space ball. Two
-// passes: scan_section_rects measures every entry's rectangle (two per SSE2 instruction), then only
-// the entries whose rectangle could matter have their box rebuilt.
+// On the way, the distance from the end of the sweep to the nearest box: the next free-space ball. The
+// rectangles settle most entries: scan_section_rects measures them all (two per SSE2 instruction), and only
+// the entries whose rectangle meets the sweep, or is nearer than the nearest box found, have their box
+// rebuilt. An entry not hit is idle (hit_stamp_ not this tick): merge_idle_siblings may merge it.
 void BoundarySection::clip_section(Query& q) {
   const Scene& sc = *scene_;
   candidates_.clear();
-  merge_scratch_.clear();
   const std::size_t n_section = section_.size();
+  q.scanned = n_section;
   q.charge_section_boxes(static_cast<std::int32_t>(n_section));
   const std::size_t nearest_rect = scan_section_rects(q);
-  // The free-space ball: the nearest box. A rectangle holds its box, so a box is nearer than the nearest
-  // found so far only when its rectangle is; starting from the box of the nearest rectangle leaves few others
-  // to rebuild. The minimum is the same whatever the order.
-  if (nearest_rect < n_section) q.nearest_sq = box_distance_sq(sc.box(section_[nearest_rect]), q.b);
-  for (std::size_t i = 0; i < n_section; ++i) {
-    const std::uint32_t node = section_[i];
-    const bool near = i != nearest_rect && rect_d_sq_[i] < q.nearest_sq;
-    if (!near && !rect_overlap_[i]) {  // the rectangle settles both: the box itself is not needed
-      merge_scratch_.push_back(node);
-      continue;
-    }
-    const ErrorBox box = sc.box(node);
-    if (near) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
-    double te = 0.0, tx = 0.0;
-    if (rect_overlap_[i] && clip_segment_box(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
-      hit_stamp_[node] = tick_;
-      if (clip_segment_box(box, q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node});
-    } else {
-      merge_scratch_.push_back(node);
+  if (nearest_rect == n_section) return;  // an empty section (an empty scene)
+  // The free-space ball: the nearest box. A rectangle holds its box, so a box is nearer than the nearest found
+  // so far only when its rectangle is; starting from the box of the nearest rectangle leaves few others to
+  // rebuild. The minimum is the same whatever the order.
+  q.nearest_sq = box_distance_sq(sc.box(section_[nearest_rect]), q.b);
+  mark_near_rects(q.nearest_sq, nearest_rect);
+  const std::size_t words = (n_section + 63) / 64;
+  for (std::size_t w = 0; w < words; ++w) {
+    for (std::uint64_t m = rect_overlap_bits_[w] | rect_near_bits_[w]; m != 0; m &= m - 1) {
+      const std::size_t i = 64 * w + static_cast<std::size_t>(__builtin_ctzll(m));
+      if (i >= n_section) break;  // the odd entry's partner, past the end
+      const std::uint32_t node = section_[i];
+      const std::uint64_t bit = std::uint64_t{1} << (i % 64);
+      const ErrorBox box = sc.box(node);
+      if (rect_near_bits_[w] & bit) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
+      double te = 0.0, tx = 0.0;
+      if ((rect_overlap_bits_[w] & bit) && clip_segment_box(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
+        hit_stamp_[node] = tick_;
+        ++q.hit;
+        if (clip_segment_box(box, q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node});
+      }
     }
   }
 }
 
 // The rectangle pass of clip_section: for every section entry, the squared distance from the sweep's end to
 // its rectangle (rect_d_sq_; rect_distance_sq, bit for bit) and whether the rectangle, grown by the merge
-// margin, meets the sweep's (rect_overlap_; overlaps()). Entries in pairs (the arrays hold an even count);
-// returns the entry of the nearest rectangle (the first of equals; n_section when the section is empty).
+// margin, meets the sweep's (bit i % 64 of rect_overlap_bits_[i / 64]; overlaps()). Entries in pairs (the
+// arrays hold an even count; an odd section's last pair has a meaningless second entry). Returns the entry of
+// the nearest rectangle (the first of equals; section_.size() when the section is empty).
 std::size_t BoundarySection::scan_section_rects(const Query& q) {
   const std::size_t n = section_.size();
   const double* lo_x = section_rect_.lo_x.data();
@@ -302,39 +308,73 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
   const double* hi_x = section_rect_.hi_x.data();
   const double* hi_y = section_rect_.hi_y.data();
   double* d_sq = rect_d_sq_.data();
-  std::uint8_t* overlap = rect_overlap_.data();
+  std::uint64_t* overlap = rect_overlap_bits_.data();
   const double m = merge_margin_m_;
+  std::uint64_t word = 0;
+  std::size_t i = 0;
 #if defined(__SSE2__)
   const __m128d px = _mm_set1_pd(q.b.x), py = _mm_set1_pd(q.b.y), zero = _mm_setzero_pd();
   const __m128d s_lo_x = _mm_set1_pd(q.sweep.lo.x), s_lo_y = _mm_set1_pd(q.sweep.lo.y);
   const __m128d s_hi_x = _mm_set1_pd(q.sweep.hi.x), s_hi_y = _mm_set1_pd(q.sweep.hi.y), vm = _mm_set1_pd(m);
-  for (std::size_t i = 0; i < n; i += 2) {
+  for (; i < n; i += 2) {
     const __m128d lx = _mm_loadu_pd(lo_x + i), ly = _mm_loadu_pd(lo_y + i), hx = _mm_loadu_pd(hi_x + i), hy = _mm_loadu_pd(hi_y + i);
     const __m128d dx = _mm_max_pd(_mm_max_pd(_mm_sub_pd(lx, px), zero), _mm_sub_pd(px, hx));
     const __m128d dy = _mm_max_pd(_mm_max_pd(_mm_sub_pd(ly, py), zero), _mm_sub_pd(py, hy));
     _mm_storeu_pd(d_sq + i, _mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)));
     const __m128d meets = _mm_and_pd(_mm_and_pd(_mm_cmple_pd(_mm_sub_pd(lx, vm), s_hi_x), _mm_cmple_pd(s_lo_x, _mm_add_pd(hx, vm))),
                                      _mm_and_pd(_mm_cmple_pd(_mm_sub_pd(ly, vm), s_hi_y), _mm_cmple_pd(s_lo_y, _mm_add_pd(hy, vm))));
-    const int bits = _mm_movemask_pd(meets);
-    overlap[i] = static_cast<std::uint8_t>(bits & 1);
-    overlap[i + 1] = static_cast<std::uint8_t>(bits >> 1);
+    word |= static_cast<std::uint64_t>(_mm_movemask_pd(meets)) << (i % 64);
+    if (i % 64 == 62) {
+      overlap[i / 64] = word;
+      word = 0;
+    }
   }
 #else
-  for (std::size_t i = 0; i < n; ++i) {
-    const Aabb r{{lo_x[i], lo_y[i]}, {hi_x[i], hi_y[i]}};
-    d_sq[i] = rect_distance_sq(r, q.b);
-    overlap[i] = overlaps(r, q.sweep, m) ? 1 : 0;
+  for (; i < n; i += 2) {
+    for (std::size_t k = i; k < i + 2; ++k) {
+      const Aabb r{{lo_x[k], lo_y[k]}, {hi_x[k], hi_y[k]}};
+      d_sq[k] = rect_distance_sq(r, q.b);
+      if (overlaps(r, q.sweep, m)) word |= std::uint64_t{1} << (k % 64);
+    }
+    if (i % 64 == 62) {
+      overlap[i / 64] = word;
+      word = 0;
+    }
   }
 #endif
+  if (i % 64 != 0) overlap[i / 64] = word;  // the last, partial word
   std::size_t nearest = n;
   double nearest_sq = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (d_sq[i] < nearest_sq) {
-      nearest_sq = d_sq[i];
-      nearest = i;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (d_sq[k] < nearest_sq) {
+      nearest_sq = d_sq[k];
+      nearest = k;
     }
   }
   return nearest;
+}
+
+// The entries whose rectangle is nearer to the sweep's end than bound_sq [m²], but for `skip` (whose box
+// was measured already): bit i % 64 of rect_near_bits_[i / 64]. In pairs, as scan_section_rects.
+void BoundarySection::mark_near_rects(double bound_sq, std::size_t skip) {
+  const std::size_t n = section_.size();
+  const double* d_sq = rect_d_sq_.data();
+  std::uint64_t* near = rect_near_bits_.data();
+  std::uint64_t word = 0;
+  std::size_t i = 0;
+  for (; i < n; i += 2) {
+#if defined(__SSE2__)
+    word |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmplt_pd(_mm_loadu_pd(d_sq + i), _mm_set1_pd(bound_sq)))) << (i % 64);
+#else
+    word |= (std::uint64_t{d_sq[i] < bound_sq} | std::uint64_t{d_sq[i + 1] < bound_sq} << 1) << (i % 64);
+#endif
+    if (i % 64 == 62) {
+      near[i / 64] = word;
+      word = 0;
+    }
+  }
+  if (i % 64 != 0) near[i / 64] = word;
+  near[skip / 64] &= ~(std::uint64_t{1} << (skip % 64));
 }
 
 // Intersects the sweep with one segment of the target level; keeps the nearest hit.
@@ -423,12 +463,16 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   // per kIdlePerMergeCheck idle entries: a section grown by a burst of splits is merged back.
   constexpr int kMergeChecksPerTick = 2;
   constexpr std::size_t kIdlePerMergeCheck = 8;
-  const std::size_t n_idle = merge_scratch_.size();
-  const int max_checks = kMergeChecksPerTick + static_cast<int>(n_idle / kIdlePerMergeCheck);
+  // The entries phase 1 scanned (not the children split off since), in section order from a point that
+  // moves with the tick (round robin); the idle ones are those it did not find hit.
+  const std::size_t n = q.scanned;
+  if (n == 0) return;
+  const int max_checks = kMergeChecksPerTick + static_cast<int>((n - q.hit) / kIdlePerMergeCheck);
   int checks = 0;
-  for (std::size_t j = 0; j < n_idle && checks < max_checks; ++j) {
-    const std::uint32_t node = merge_scratch_[(j + tick_) % n_idle];
-    if (!in_section_[node] || node == sc.scene_root()) continue;
+  std::size_t e = tick_ % n;
+  for (std::size_t j = 0; j < n && checks < max_checks; ++j, e = e + 1 == n ? 0 : e + 1) {
+    const std::uint32_t node = section_[e];
+    if (!in_section_[node] || hit_stamp_[node] == tick_ || node == sc.scene_root()) continue;
     const std::uint32_t parent = sc.parent(node);
     // One check per parent per tick: a node with many children would otherwise ask again for each.
     if (in_section_[parent] || merge_stamp_[parent] == tick_) continue;

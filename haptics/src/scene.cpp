@@ -323,14 +323,17 @@ std::size_t Scene::hot_bytes() const {
 
 Aabb Scene::aabb(std::uint32_t node) const {
   if (node >= segment_nodes_) return group_box_[node - segment_nodes_];
-  Vec2 corners[4];
-  box_corners(segment_box(node), corners);
-  Aabb r{corners[0], corners[0]};
-  for (const Vec2& q : corners) {
-    r.lo = {std::min(r.lo.x, q.x), std::min(r.lo.y, q.y)};
-    r.hi = {std::max(r.hi.x, q.x), std::max(r.hi.y, q.y)};
-  }
-  return r;
+  // From the box's centre and half-extents rather than its four corners: half-width along x is
+  // |axis.x| hu + |axis.y| hn (the normal is (−axis.y, axis.x)), along y |axis.y| hu + |axis.x| hn. Grown by
+  // a few ulps of the largest coordinate, so it holds the corners as rounded by box_corners too.
+  const ErrorBox b = segment_box(node);
+  const double cu = 0.5 * (b.u_min + b.u_max), hu = 0.5 * (b.u_max - b.u_min);
+  const double cn = 0.5 * (b.n_min + b.n_max), hn = 0.5 * (b.n_max - b.n_min);
+  const Vec2 c{b.origin_m.x + cu * b.axis.x - cn * b.axis.y, b.origin_m.y + cu * b.axis.y + cn * b.axis.x};
+  const double ax = std::abs(b.axis.x), ay = std::abs(b.axis.y);
+  const double slack = 0x1p-48 * (std::abs(c.x) + std::abs(c.y) + hu + hn);
+  const double hx = ax * hu + ay * hn + slack, hy = ay * hu + ax * hn + slack;
+  return Aabb{{c.x - hx, c.y - hy}, {c.x + hx, c.y + hy}};
 }
 
 std::uint32_t Scene::parent(std::uint32_t node) const {

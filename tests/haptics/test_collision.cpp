@@ -292,6 +292,42 @@ TEST(CollisionTree, SceneHierarchyHoldsEveryCoarsestSegmentOnce) {
   }
 }
 
+// aabb() is computed from a box's centre and half-extents, not its corners: it must still hold every corner as
+// box_corners rounds it (the section's scan takes its distance as a lower bound on the box's, and the wide
+// index's rectangles are built from it) and be no wider than the corners' rectangle by more than rounding.
+TEST(CollisionTree, SegmentRectangleHoldsItsBoxCornersAndNoMore) {
+  std::mt19937 rng(21);
+  const auto curves = random_scene(rng, 30, 30);
+  const Scene sc = Scene::build(curves, 6);
+  std::size_t checked = 0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const CurveInfo& ci = sc.curve(c);
+    for (int l = 0; l < static_cast<int>(ci.levels); ++l) {
+      for (std::int32_t k = 0; k < static_cast<std::int32_t>(ci.segment_count[l]); ++k) {
+        const std::uint32_t node = sc.node_of(SegmentRef{static_cast<std::int32_t>(c), l, k});
+        const Aabb r = sc.aabb(node);
+        Vec2 corners[4];
+        box_corners(sc.box(node), corners);
+        Aabb tight{corners[0], corners[0]};
+        for (const Vec2& q : corners) {
+          ASSERT_LE(r.lo.x, q.x);
+          ASSERT_LE(r.lo.y, q.y);
+          ASSERT_GE(r.hi.x, q.x);
+          ASSERT_GE(r.hi.y, q.y);
+          tight.lo = {std::min(tight.lo.x, q.x), std::min(tight.lo.y, q.y)};
+          tight.hi = {std::max(tight.hi.x, q.x), std::max(tight.hi.y, q.y)};
+        }
+        EXPECT_NEAR(r.lo.x, tight.lo.x, 1e-12);
+        EXPECT_NEAR(r.lo.y, tight.lo.y, 1e-12);
+        EXPECT_NEAR(r.hi.x, tight.hi.x, 1e-12);
+        EXPECT_NEAR(r.hi.y, tight.hi.y, 1e-12);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 1000u);
+}
+
 TEST(CollisionTree, ErrorGrowsWithLevelAndBoxesBoundIt) {
   std::mt19937 rng(11);
   const auto curves = random_scene(rng, 4, 4);

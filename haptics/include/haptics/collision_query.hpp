@@ -242,6 +242,7 @@ class BoundarySection {
   void next_tick() noexcept;
   void clip_section(Query& q);
   std::size_t scan_section_rects(const Query& q);
+  void mark_near_rects(double bound_sq, std::size_t skip);
   void refine_candidates(Query& q);
   bool push_hit_children(Query& q, std::uint32_t node, int& top);
   void test_segment(Query& q, std::uint32_t node);
@@ -284,7 +285,8 @@ class BoundarySection {
   };
   SectionRects section_rect_;
   std::vector<double> rect_d_sq_;          // scan scratch, per entry: squared distance from the sweep's end to its rectangle [m²]
-  std::vector<std::uint8_t> rect_overlap_; // scan scratch, per entry: its rectangle, grown by the merge margin, meets the sweep's
+  std::vector<std::uint64_t> rect_overlap_bits_;  // scan scratch, a bit per entry: its rectangle, grown by the merge margin, meets the sweep's
+  std::vector<std::uint64_t> rect_near_bits_;     // scan scratch, a bit per entry: its rectangle is nearer than the nearest box so far
   void push_section(std::uint32_t node);   // appends node with its rectangle (the caller checked the room)
   std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
   std::vector<std::uint32_t> compact_stamp_;  // per node: tick at which the compaction last kept it (de-duplication)
@@ -298,7 +300,6 @@ class BoundarySection {
     return true;
   }
   std::vector<Candidate> candidates_;      // section nodes hit this tick
-  std::vector<std::uint32_t> merge_scratch_;
   std::vector<Candidate> stack_;           // DFS stack, tree_stack_entries(widest fan-out) entries, sized at build
   std::vector<std::uint32_t> hit_stamp_;   // per node: tick at which its margin-grown box was last hit
   std::vector<std::uint32_t> merge_stamp_; // per node: tick at which it was last considered for a merge

@@ -223,8 +223,8 @@ class Scene {
     const double r = reach * static_cast<double>(curve_nodes_[tag_curve(node)].quantum_m[tag_level(node)]);
     return Aabb{{std::min(a.x, b.x) - r, std::min(a.y, b.y) - r}, {std::max(a.x, b.x) + r, std::max(a.y, b.y) + r}};
   }
-  /// Axis-aligned rectangle around a node's box (its four corners) [m]: stored for chunks and the
-  /// hierarchy, computed for segments.
+  /// Axis-aligned rectangle around a node's box [m]: stored for chunks and the hierarchy, computed for
+  /// segments (from the box's centre and half-extents, a few ulps wider than its four corners' rectangle).
   Aabb aabb(std::uint32_t node) const;
   /// Curve, level and index of a node (see NodeInfo).
   NodeInfo info(std::uint32_t node) const {
