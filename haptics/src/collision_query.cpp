@@ -424,6 +424,30 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
   return true;
 }
 
+// A box near its target level: the target level's segments under it (at most 2^kDirectLevels, consecutive
+// nodes whose points are consecutive too) tested directly rather than through the boxes between, as the wide
+// index's walks test the segments under an item. Same first hit (the nearest of the segments under the box,
+// the boxes between only prune). Each segment costs one optional box test, all or none: false, with nothing
+// tested or charged, when the box is not a segment box within kDirectLevels of a level target (a cut step's
+// segments are of mixed levels) or the budget cannot cover them (the descent then goes box by box, anytime).
+bool BoundarySection::test_segments_under(Query& q, std::uint32_t node) {
+  constexpr int kDirectLevels = 3;
+  const Scene& sc = *scene_;
+  if (!sc.is_segment(node) || is_cut_level(q.level)) return false;
+  const std::uint32_t c = sc.tag_curve(node);
+  const int l = sc.tag_level(node);
+  const int target = sc.clamp_level(c, q.level);
+  if (l - target > kDirectLevels) return false;
+  const CurveNodes& cn = sc.curve_nodes(c);
+  const std::uint32_t first = cn.box_offset[target] + ((node - cn.box_offset[l]) << (l - target));
+  const std::uint32_t count = 1u << (l - target);
+  const QueryBudget& b = *q.budget;
+  if (b.max_box_tests > 0 && b.box_tests_used + static_cast<std::int32_t>(count) > b.max_box_tests) return false;  // not refused: the descent may still go part way
+  q.spend_boxes(static_cast<std::int32_t>(count));
+  for (std::uint32_t i = 0; i < count; ++i) test_segment(q, first + i);
+  return true;
+}
+
 // Phase 2: nearest first. Hit boxes in order of entry, each refined depth-first (nearest child first)
 // down to the target level, pruned past the best hit. Past the budget, boxes are not refined: the nearest
 // such box bounds what is proven clear (a box holds everything finer).
@@ -438,7 +462,7 @@ void BoundarySection::refine_candidates(Query& q) {
       if (cur.t_enter > q.horizon()) continue;
       if (at_target(cur.node, q.level)) {
         test_segment(q, cur.node);
-      } else if (!push_hit_children(q, cur.node, top) && cur.t_enter < q.unresolved_t) {
+      } else if (!test_segments_under(q, cur.node) && !push_hit_children(q, cur.node, top) && cur.t_enter < q.unresolved_t) {
         q.unresolved_t = cur.t_enter;
         q.unresolved_node = cur.node;
       }

@@ -245,6 +245,7 @@ class BoundarySection {
   void mark_near_rects(double bound_sq, std::size_t skip);
   void refine_candidates(Query& q);
   bool push_hit_children(Query& q, std::uint32_t node, int& top);
+  bool test_segments_under(Query& q, std::uint32_t node);
   void test_segment(Query& q, std::uint32_t node);
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
