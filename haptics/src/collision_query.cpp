@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -146,8 +145,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   rect_d_sq_.assign(capacity_ + 1, 0.0);
   rect_overlap_bits_.assign((capacity_ + 1) / 64 + 1, 0);
   rect_near_bits_.assign((capacity_ + 1) / 64 + 1, 0);
-  slot_.assign(n, kNoSlot);
-  removed_.reserve(capacity_);
+  in_section_.assign(n, 0);
   candidates_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
   stack_.resize(tree_stack_entries(widest_root));
@@ -160,35 +158,32 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
 
 void BoundarySection::reset() {
   last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
-  for (std::uint32_t node : section_) slot_[node] = kNoSlot;
+  for (std::uint32_t node : section_) in_section_[node] = 0;
   section_.clear();
-  removed_.clear();
   ball_radius_m_ = 0.0;
   wide_ball_radius_m_ = 0.0;
   wide_ball_seed_ = kWideEmpty;
   if (scene_->curve_count() == 0) return;
   const std::uint32_t r = scene_->scene_root();
   push_section(r);
+  in_section_[r] = 1;
 }
 
 void BoundarySection::push_section(std::uint32_t node) {
-  slot_[node] = static_cast<std::uint32_t>(section_.size());
   section_rect_.set(section_.size(), scene_->aabb(node));
   section_.push_back(node);
-}
-
-void BoundarySection::remove_section(std::uint32_t node) {
-  removed_.push_back(slot_[node]);
-  slot_[node] = kNoSlot;
 }
 
 void BoundarySection::split(std::uint32_t node) {
   std::uint32_t first = 0, count = 0;
   scene_->children(node, &first, &count);
-  if (count == 0 || !in_section(node)) return;
+  if (count == 0 || !in_section_[node]) return;
   if (section_.size() + count + 8 > capacity_) return;  // full: keep the node (room kept for this tick's merges)
-  remove_section(node);
-  for (std::uint32_t i = 0; i < count; ++i) push_section(first + i);
+  in_section_[node] = 0;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    push_section(first + i);
+    in_section_[first + i] = 1;
+  }
 }
 
 // One query's inputs, answer so far and counters, passed to each phase of first_hit.
@@ -499,51 +494,51 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   std::size_t e = tick_ % n;
   for (std::size_t j = 0; j < n && checks < max_checks; ++j, e = e + 1 == n ? 0 : e + 1) {
     const std::uint32_t node = section_[e];
-    if (!in_section(node) || hit_stamp_[node] == tick_ || node == sc.scene_root()) continue;
+    if (!in_section_[node] || hit_stamp_[node] == tick_ || node == sc.scene_root()) continue;
     const std::uint32_t parent = sc.parent(node);
     // One check per parent per tick: a node with many children would otherwise ask again for each.
-    if (in_section(parent) || merge_stamp_[parent] == tick_) continue;
+    if (in_section_[parent] || merge_stamp_[parent] == tick_) continue;
     merge_stamp_[parent] = tick_;
     ++checks;
     std::uint32_t first = 0, count = 0;
     sc.children(parent, &first, &count);
     bool all_idle = true;
-    for (std::uint32_t i = 0; i < count && all_idle; ++i) all_idle = in_section(first + i) && hit_stamp_[first + i] != tick_;
+    for (std::uint32_t i = 0; i < count && all_idle; ++i) all_idle = in_section_[first + i] && hit_stamp_[first + i] != tick_;
     if (!all_idle) continue;
     if (section_.size() >= capacity_) break;  // full until the compaction (a merge adds an entry before it removes any)
     double te = 0.0, tx = 0.0;
     if (!q.spend_box()) break;  // merging can wait for a tick with budget left
     if (clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
-    for (std::uint32_t i = 0; i < count; ++i) remove_section(first + i);
+    for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
+    in_section_[parent] = 1;
     push_section(parent);
     ++q.st.merges;
   }
 }
 
-// Phase 5: the next free-space ball, and the entries split or merged away taken out of the section (each
-// hole filled with the last entry, so the work is the removals', not the section's). The ball is the
-// distance from the end of the sweep to the nearest box phase 1 scanned, even when the section changed
-// since: a split box holds every wall its children hold and merged children every wall their parent holds,
-// so the boxes scanned still cover every wall and no wall comes nearer than that. (Measuring the changed
-// section again finds the children's boxes, which may be farther, but cost more than the slightly larger
-// ball saved: PERFORMANCE.md, round two.)
+// Phase 5: the next free-space ball, and when boxes were split or merged, the section without the entries
+// split or merged away. The ball is the distance from the end of the sweep to the nearest box phase 1
+// scanned, even when the section changed since: a split box holds every wall its children hold and merged
+// children every wall their parent holds, so the boxes scanned still cover every wall and no wall comes
+// nearer than that. (Measuring the changed section again finds the children's boxes, which may be
+// farther, but cost more than the slightly larger ball saved: PERFORMANCE.md, round two.) No node is in the
+// section twice, so keeping the entries still in it is enough: a split appends children of a node that was
+// in it (so they were not), a merge appends a parent it checked was not, and a node that left this tick cannot
+// come back in it (a split node's children, appended after the scan, are not among the merges' candidates).
+// CollisionQuery.BoundarySectionStaysSmallOnALongWalk checks the section stays a frontier.
 void BoundarySection::compact_section(Query& q) {
   ball_center_m_ = q.b;
   ball_radius_m_ = std::sqrt(q.nearest_sq);
-  // Highest entry first: every entry above the one being filled is then live (the removed ones above it
-  // are gone already), so the last entry moved down is never one still to be removed.
-  std::sort(removed_.begin(), removed_.end(), std::greater<std::uint32_t>());
-  for (const std::uint32_t r : removed_) {
-    const std::size_t last = section_.size() - 1;
-    if (r != last) {
-      const std::uint32_t moved = section_[last];
-      section_[r] = moved;
-      section_rect_.copy(r, last);
-      slot_[moved] = r;
+  if (q.st.splits == 0 && q.st.merges == 0) return;
+  std::size_t w = 0;
+  for (std::size_t i = 0; i < section_.size(); ++i) {
+    const std::uint32_t node = section_[i];
+    if (in_section_[node]) {
+      section_rect_.copy(w, i);
+      section_[w++] = node;
     }
-    section_.pop_back();
   }
-  removed_.clear();
+  section_.resize(w);
 }
 
 // Phase 6: the answer. An exact hit; or, when a box left unrefined begins before it, the finest level

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <unordered_set>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -577,6 +578,16 @@ TEST(CollisionQuery, BoundarySectionStaysSmallOnALongWalk) {
     largest = std::max(largest, section.section().size());
     total += section.section().size();
     p = q;
+    if (i % 997 == 0) {  // a frontier: each node once, and none below another (splits and merges leave no stale entry)
+      std::unordered_set<std::uint32_t> in(section.section().begin(), section.section().end());
+      ASSERT_EQ(in.size(), section.section().size()) << "a node twice in the section at tick " << i;
+      for (std::uint32_t node : section.section()) {
+        for (std::uint32_t up = node; up != sc.scene_root();) {
+          up = sc.parent(up);
+          ASSERT_EQ(in.count(up), 0u) << "node " << node << " and its ancestor " << up << " both in the section at tick " << i;
+        }
+      }
+    }
   }
   std::printf("[ info ] section over %d ticks: mean %.1f, largest %zu entries\n", kTicks, static_cast<double>(total) / kTicks, largest);
   // This scene is dense (300 overlapping curves): ~120 entries near the hand on average are real work.

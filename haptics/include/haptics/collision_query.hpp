@@ -289,11 +289,7 @@ class BoundarySection {
   std::vector<std::uint64_t> rect_overlap_bits_;  // scan scratch, a bit per entry: its rectangle, grown by the merge margin, meets the sweep's
   std::vector<std::uint64_t> rect_near_bits_;     // scan scratch, a bit per entry: its rectangle is nearer than the nearest box so far
   void push_section(std::uint32_t node);   // appends node with its rectangle (the caller checked the room)
-  static constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
-  std::vector<std::uint32_t> slot_;        // per node: its entry in section_ while in the frontier, else kNoSlot
-  std::vector<std::uint32_t> removed_;     // entries split or merged away this tick, taken out at its end (compact_section)
-  bool in_section(std::uint32_t node) const noexcept { return slot_[node] != kNoSlot; }
-  void remove_section(std::uint32_t node); // leaves the frontier now; its entry goes at the tick's end
+  std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
   struct Candidate { double t_enter; std::uint32_t node; };  // 16 bytes
   static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
   /// Checked push onto the DFS stack (sized by hk::tree_stack_entries): false, and nothing pushed, when it
