@@ -444,7 +444,8 @@ bool BoundarySection::test_segments_under(Query& q, std::uint32_t node) {
 }
 
 // Phase 2: nearest first. Hit boxes in order of entry, each refined depth-first (nearest child first)
-// down to the target level, pruned past the best hit. Past the budget, boxes are not refined: the nearest
+// down to the target level (within 3 levels of it, the segments under the box at once: test_segments_under),
+// pruned past the best hit. Past the budget, boxes are not refined: the nearest
 // such box bounds what is proven clear (a box holds everything finer).
 void BoundarySection::refine_candidates(Query& q) {
   std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& x, const Candidate& y) { return x.t_enter < y.t_enter; });

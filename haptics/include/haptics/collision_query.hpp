@@ -8,7 +8,10 @@
 /// children) and merges (two siblings whose parent is clear by a margin are replaced by the parent).
 /// Each tick the sweep is clipped (Liang–Barsky) against the boxes of the boundary section; hit boxes
 /// are sorted by entry parameter and refined depth-first, nearest first, down to the target level,
-/// where the sweep is intersected with that level's polyline. Boxes whose entry lies past the best hit
+/// where the sweep is intersected with that level's polyline (a box within 3 levels of a level target has
+/// the segments under it tested at once, as the wide index's items do). The rectangles of the section's
+/// entries settle most of them: only an entry whose rectangle meets the sweep or is nearer than the nearest
+/// box found has its box rebuilt. Boxes whose entry lies past the best hit
 /// so far are pruned. A budget of box tests (QueryBudget, shared by every query of a servo tick) makes it
 /// anytime: past it, boxes are no longer refined, and the answer is the one at the finest level reached — reported conservatively: the
 /// sweep is clear up to the entry of the nearest box not refined within the budget (a box holds everything finer,
@@ -43,8 +46,8 @@ bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t);
 /// The work limit that makes queries anytime: a count of box tests, shared by every query (and
 /// closest-point walk) it is passed to, so one number bounds a servo tick's collision work. No clock.
 ///
-/// Two kinds of box test draw on it. Optional work (refining a hit box into its children, merge checks,
-/// closest-point walks) is done only while the budget lasts: `spend()` refuses once `box_tests_used`
+/// Two kinds of box test draw on it. Optional work (refining a hit box into its children or testing the
+/// target level's segments under it, one per segment; merge checks; closest-point walks) is done only while the budget lasts: `spend()` refuses once `box_tests_used`
 /// has reached `max_box_tests`, so that work never takes the count past the limit. The clip of the
 /// sweep against the boundary section itself is always done in full (it is what proves the sweep clear
 /// at all) and is charged even past the limit: that is the only overrun, so after any number of queries
