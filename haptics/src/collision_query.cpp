@@ -297,8 +297,8 @@ void BoundarySection::clip_section(Query& q) {
 // The rectangle pass of clip_section: for every section entry, the squared distance from the sweep's end to
 // its rectangle (rect_d_sq_; rect_distance_sq, bit for bit) and whether the rectangle, grown by the merge
 // margin, meets the sweep's (bit i % 64 of rect_overlap_bits_[i / 64]; overlaps()). Entries in pairs (the
-// arrays hold an even count; an odd section's last pair has a meaningless second entry). Returns the entry of
-// the nearest rectangle (the first of equals; section_.size() when the section is empty).
+// arrays hold one entry past the most there can be; an odd section's last pair has a meaningless second
+// one). Returns the entry of the nearest rectangle (the first of equals; section_.size() when it is empty).
 std::size_t BoundarySection::scan_section_rects(const Query& q) {
   const std::size_t n = section_.size();
   const double* lo_x = section_rect_.lo_x.data();
@@ -426,7 +426,7 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
 // tested or charged, when the box is not a segment box within kDirectLevels of a level target (a cut step's
 // segments are of mixed levels) or the budget cannot cover them (the descent then goes box by box, anytime).
 bool BoundarySection::test_segments_under(Query& q, std::uint32_t node) {
-  constexpr int kDirectLevels = 3;
+  constexpr int kDirectLevels = kWideItemLevel;  // as many segments as lie under a wide-index item (8)
   const Scene& sc = *scene_;
   if (!sc.is_segment(node) || is_cut_level(q.level)) return false;
   const std::uint32_t c = sc.tag_curve(node);

@@ -280,7 +280,8 @@ class BoundarySection {
   std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
   // The section entries' rectangles [m], in step with section_, as four arrays (structure of arrays) so the
   // per-tick scan tests two entries per SSE2 instruction and streams through memory; sized capacity_ + 1
-  // (an even count: the scan reads entries in pairs) and never resized, so the servo path allocates nothing.
+  // (one past the most entries: the scan reads them in pairs) and never resized, so the servo path allocates
+  // nothing.
   struct SectionRects {
     std::vector<double> lo_x, lo_y, hi_x, hi_y;
     void size_for(std::size_t n) { lo_x.assign(n, 0.0); lo_y.assign(n, 0.0); hi_x.assign(n, 0.0); hi_y.assign(n, 0.0); }
