@@ -14,6 +14,23 @@
 namespace hk {
 namespace {
 
+// Writes the section scan's masks two bits at a time: the bits of entries i and i + 1 (i even, in increasing
+// order) go to bits i % 64 and i % 64 + 1 of words[i / 64]; finish(end) stores the last, partial word.
+struct PairBitWriter {
+  std::uint64_t* words;
+  std::uint64_t word = 0;
+  void put(std::size_t i, unsigned two_bits) noexcept {
+    word |= static_cast<std::uint64_t>(two_bits) << (i % 64);
+    if (i % 64 == 62) {
+      words[i / 64] = word;
+      word = 0;
+    }
+  }
+  void finish(std::size_t end) noexcept {
+    if (end % 64 != 0) words[end / 64] = word;
+  }
+};
+
 // Squared distance from p to an axis-aligned rectangle (0 inside) [m²]: a lower bound on the distance to the
 // box it holds.
 inline double rect_distance_sq(const Aabb& r, Vec2 p) {
@@ -166,12 +183,12 @@ void BoundarySection::reset() {
   if (scene_->curve_count() == 0) return;
   const std::uint32_t r = scene_->scene_root();
   push_section(r);
-  in_section_[r] = 1;
 }
 
 void BoundarySection::push_section(std::uint32_t node) {
   section_rect_.set(section_.size(), scene_->aabb(node));
   section_.push_back(node);
+  in_section_[node] = 1;
 }
 
 void BoundarySection::split(std::uint32_t node) {
@@ -180,10 +197,7 @@ void BoundarySection::split(std::uint32_t node) {
   if (count == 0 || !in_section_[node]) return;
   if (section_.size() + count + 8 > capacity_) return;  // full: keep the node (room kept for this tick's merges)
   in_section_[node] = 0;
-  for (std::uint32_t i = 0; i < count; ++i) {
-    push_section(first + i);
-    in_section_[first + i] = 1;
-  }
+  for (std::uint32_t i = 0; i < count; ++i) push_section(first + i);
 }
 
 // One query's inputs, answer so far and counters, passed to each phase of first_hit.
@@ -306,9 +320,8 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
   const double* hi_x = section_rect_.hi_x.data();
   const double* hi_y = section_rect_.hi_y.data();
   double* d_sq = rect_d_sq_.data();
-  std::uint64_t* overlap = rect_overlap_bits_.data();
+  PairBitWriter overlap{rect_overlap_bits_.data()};
   const double m = merge_margin_m_;
-  std::uint64_t word = 0;
   std::size_t i = 0;
 #if defined(__SSE2__)
   const __m128d px = _mm_set1_pd(q.b.x), py = _mm_set1_pd(q.b.y), zero = _mm_setzero_pd();
@@ -321,26 +334,20 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
     _mm_storeu_pd(d_sq + i, _mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)));
     const __m128d meets = _mm_and_pd(_mm_and_pd(_mm_cmple_pd(_mm_sub_pd(lx, vm), s_hi_x), _mm_cmple_pd(s_lo_x, _mm_add_pd(hx, vm))),
                                      _mm_and_pd(_mm_cmple_pd(_mm_sub_pd(ly, vm), s_hi_y), _mm_cmple_pd(s_lo_y, _mm_add_pd(hy, vm))));
-    word |= static_cast<std::uint64_t>(_mm_movemask_pd(meets)) << (i % 64);
-    if (i % 64 == 62) {
-      overlap[i / 64] = word;
-      word = 0;
-    }
+    overlap.put(i, static_cast<unsigned>(_mm_movemask_pd(meets)));
   }
 #else
   for (; i < n; i += 2) {
+    unsigned two_bits = 0;
     for (std::size_t k = i; k < i + 2; ++k) {
       const Aabb r{{lo_x[k], lo_y[k]}, {hi_x[k], hi_y[k]}};
       d_sq[k] = rect_distance_sq(r, q.b);
-      if (overlaps(r, q.sweep, m)) word |= std::uint64_t{1} << (k % 64);
+      if (overlaps(r, q.sweep, m)) two_bits |= 1u << (k - i);
     }
-    if (i % 64 == 62) {
-      overlap[i / 64] = word;
-      word = 0;
-    }
+    overlap.put(i, two_bits);
   }
 #endif
-  if (i % 64 != 0) overlap[i / 64] = word;  // the last, partial word
+  overlap.finish(i);
   std::size_t nearest = n;
   double nearest_sq = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < n; ++k) {
@@ -357,22 +364,17 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
 void BoundarySection::mark_near_rects(double bound_sq, std::size_t skip) {
   const std::size_t n = section_.size();
   const double* d_sq = rect_d_sq_.data();
-  std::uint64_t* near = rect_near_bits_.data();
-  std::uint64_t word = 0;
+  PairBitWriter near{rect_near_bits_.data()};
   std::size_t i = 0;
   for (; i < n; i += 2) {
 #if defined(__SSE2__)
-    word |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmplt_pd(_mm_loadu_pd(d_sq + i), _mm_set1_pd(bound_sq)))) << (i % 64);
+    near.put(i, static_cast<unsigned>(_mm_movemask_pd(_mm_cmplt_pd(_mm_loadu_pd(d_sq + i), _mm_set1_pd(bound_sq)))));
 #else
-    word |= (std::uint64_t{d_sq[i] < bound_sq} | std::uint64_t{d_sq[i + 1] < bound_sq} << 1) << (i % 64);
+    near.put(i, (d_sq[i] < bound_sq ? 1u : 0u) | (d_sq[i + 1] < bound_sq ? 2u : 0u));
 #endif
-    if (i % 64 == 62) {
-      near[i / 64] = word;
-      word = 0;
-    }
   }
-  if (i % 64 != 0) near[i / 64] = word;
-  near[skip / 64] &= ~(std::uint64_t{1} << (skip % 64));
+  near.finish(i);
+  rect_near_bits_[skip / 64] &= ~(std::uint64_t{1} << (skip % 64));
 }
 
 // Intersects the sweep with one segment of the target level; keeps the nearest hit.
@@ -436,8 +438,7 @@ bool BoundarySection::test_segments_under(Query& q, std::uint32_t node) {
   const CurveNodes& cn = sc.curve_nodes(c);
   const std::uint32_t first = cn.box_offset[target] + ((node - cn.box_offset[l]) << (l - target));
   const std::uint32_t count = 1u << (l - target);
-  const QueryBudget& b = *q.budget;
-  if (b.max_box_tests > 0 && b.box_tests_used + static_cast<std::int32_t>(count) > b.max_box_tests) return false;  // not refused: the descent may still go part way
+  if (!q.budget->affords(static_cast<std::int32_t>(count))) return false;  // not refused: the descent may still go part way
   q.spend_boxes(static_cast<std::int32_t>(count));
   for (std::uint32_t i = 0; i < count; ++i) test_segment(q, first + i);
   return true;
@@ -511,7 +512,6 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     if (!q.spend_box()) break;  // merging can wait for a tick with budget left
     if (clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
     for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
-    in_section_[parent] = 1;
     push_section(parent);
     ++q.st.merges;
   }

@@ -64,15 +64,15 @@ struct QueryBudget {
   /// Charges n optional box tests at once (a wide node's four rectangles, tested together), all or none:
   /// false (and ran_out set), with nothing charged, when fewer than n are left.
   bool spend(std::int32_t n) noexcept {
-    if (max_box_tests > 0 && box_tests_used + n > max_box_tests) {
+    if (!affords(n)) {
       ran_out = true;
       return false;
     }
     box_tests_used += n;
     return true;
   }
-  /// Charges one box test that is done regardless (a section entry's clip).
-  void charge() noexcept { ++box_tests_used; }
+  /// True when n more optional box tests fit in the budget (spend(n) would charge them). Marks nothing.
+  bool affords(std::int32_t n) const noexcept { return max_box_tests <= 0 || box_tests_used + n <= max_box_tests; }
   /// Charges n box tests that are done regardless (a scan of n section entries).
   void charge(std::int32_t n) noexcept { box_tests_used += n; }
 };
@@ -292,7 +292,7 @@ class BoundarySection {
   std::vector<double> rect_d_sq_;          // scan scratch, per entry: squared distance from the sweep's end to its rectangle [m²]
   std::vector<std::uint64_t> rect_overlap_bits_;  // scan scratch, a bit per entry: its rectangle, grown by the merge margin, meets the sweep's
   std::vector<std::uint64_t> rect_near_bits_;     // scan scratch, a bit per entry: its rectangle is nearer than the nearest box so far
-  void push_section(std::uint32_t node);   // appends node with its rectangle (the caller checked the room)
+  void push_section(std::uint32_t node);   // appends node with its rectangle and marks it in (the caller checked the room)
   std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
   struct Candidate { double t_enter; std::uint32_t node; };  // 16 bytes
   static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
