@@ -254,11 +254,66 @@ struct BoundarySection::Query {
 
 // Free-space ball (seed §3: "distances to the boxes ... can be used to schedule box updates"): the
 // last full query proved that no box of the section comes within ball_radius_m_ of ball_center_m_, and
-// the section covers every wall. A sweep inside that ball cannot hit anything: answer at once.
-bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
+// those boxes covered every wall of the level ids it served (ball_levels_). A sweep at one of those ids
+// inside that ball cannot hit anything: answer at once.
+bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b, int level) const noexcept {
+  if (level != ball_levels_[0] && level != ball_levels_[1]) return false;
   const double r_sq = ball_radius_m_ * ball_radius_m_;
   const Vec2 da = a - ball_center_m_, db = b - ball_center_m_;
   return dot(da, da) < r_sq && dot(db, db) < r_sq;  // r = 0 (unknown) admits nothing
+}
+
+// Phase 0: the section serves the level ids of this query and the one before it (two in turn while the
+// contact solver renders both walls of a level change; one otherwise): every segment entry is at or above
+// its curve's level for both (Scene::clamp_level), so its box holds their walls, and splits stop at the
+// coarser of the two (at_floor). A new id between levels or tolerance steps keeps the section: entries
+// finer than the new id on their curve give way to their ancestor at its level (coarsen_section), which
+// holds the same stretch of curve; to a finer id nothing changes. Only a change to or from a cut step,
+// whose segments are of mixed levels, starts again from the root.
+void BoundarySection::follow_level(int level) noexcept {
+  const int previous = last_level_;
+  other_level_ = previous < 0 ? level : previous;
+  last_level_ = level;
+  if (level == previous) return;
+  if (previous < 0 || is_cut_level(level) || is_cut_level(previous)) {
+    reset();
+    other_level_ = level;
+    return;
+  }
+  coarsen_section(level);
+}
+
+// Every segment entry finer than `level` on its curve replaced by its ancestor at that level (once, however
+// many of its descendants were in), so the section still covers the same stretches of curve, no node with
+// its ancestor. Without room for the ancestors (a section at its storage bound), the section starts again
+// from the root.
+void BoundarySection::coarsen_section(int level) noexcept {
+  const Scene& sc = *scene_;
+  const std::size_t n = section_.size();
+  bool changed = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t node = section_[i];
+    if (!sc.is_segment(node)) continue;
+    const std::uint32_t c = sc.tag_curve(node);
+    const int l = sc.tag_level(node);
+    const int target = sc.clamp_level(c, level);
+    if (l >= target) continue;
+    if (section_.size() >= capacity_) {
+      reset();
+      return;
+    }
+    const CurveNodes& cn = sc.curve_nodes(c);
+    const std::uint32_t ancestor = cn.box_offset[target] + ((node - cn.box_offset[l]) >> (target - l));
+    in_section_[node] = 0;
+    if (!in_section_[ancestor]) push_section(ancestor);
+    changed = true;
+  }
+  if (changed) drop_departed_entries();
+}
+
+// Splits stop here: a segment node at or below its curve's level for both ids the section serves.
+bool BoundarySection::at_floor(std::uint32_t node, int level) const noexcept {
+  return at_target(node, level) || at_target(node, other_level_);
 }
 
 void BoundarySection::next_tick() noexcept {
@@ -467,10 +522,11 @@ void BoundarySection::refine_candidates(Query& q) {
   }
 }
 
-// Phase 3: the boundary section follows the handle: what was hit is split (one level per tick).
+// Phase 3: the boundary section follows the handle: what was hit is split (one level per tick), down to
+// the coarser of the two ids the section serves (follow_level).
 void BoundarySection::split_hit_boxes(Query& q) {
   for (const Candidate& cand : candidates_) {
-    if (!at_target(cand.node, q.level)) {
+    if (!at_floor(cand.node, q.level)) {
       split(cand.node);
       ++q.st.splits;
     }
@@ -530,7 +586,14 @@ void BoundarySection::merge_idle_siblings(Query& q) {
 void BoundarySection::compact_section(Query& q) {
   ball_center_m_ = q.b;
   ball_radius_m_ = std::sqrt(q.nearest_sq);
+  ball_levels_[0] = q.level;  // the boxes scanned covered the walls of both ids the section served
+  ball_levels_[1] = other_level_;
   if (q.st.splits == 0 && q.st.merges == 0) return;
+  drop_departed_entries();
+}
+
+// The section without the entries that left it (in_section_ cleared), in order, rectangles with them.
+void BoundarySection::drop_departed_entries() noexcept {
   std::size_t w = 0;
   for (std::size_t i = 0; i < section_.size(); ++i) {
     const std::uint32_t node = section_[i];
@@ -810,11 +873,8 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
 SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                                     QueryBudget& budget, QueryStats* stats_out) {
   level = walls_of(level);
-  if (level != last_level_) {  // the frontier was cut for another level: start again from the roots
-    reset();
-    last_level_ = level;
-  }
-  if (inside_free_ball(a, b)) {
+  follow_level(level);
+  if (inside_free_ball(a, b, level)) {
     if (stats_out) {
       *stats_out = QueryStats{};
       stats_out->section_size = static_cast<std::int32_t>(section_.size());

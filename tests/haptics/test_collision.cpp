@@ -554,6 +554,95 @@ TEST(CollisionQuery, BoundarySectionFollowsTheHandle) {
   EXPECT_LT(section.section().size(), refined);
 }
 
+// A frontier: each node once, none below another, and every segment entry at or above its curve's level for
+// each id in `ids` (its box then holds that id's walls).
+void expect_frontier_serving(const Scene& sc, const BoundarySection& section, std::initializer_list<int> ids, const char* where) {
+  std::unordered_set<std::uint32_t> in(section.section().begin(), section.section().end());
+  ASSERT_EQ(in.size(), section.section().size()) << "a node twice in the section " << where;
+  for (std::uint32_t node : section.section()) {
+    for (std::uint32_t up = node; up != sc.scene_root();) {
+      up = sc.parent(up);
+      ASSERT_EQ(in.count(up), 0u) << "node " << node << " and its ancestor " << up << " both in the section " << where;
+    }
+    if (!sc.is_segment(node)) continue;
+    for (int id : ids) {
+      ASSERT_GE(sc.tag_level(node), sc.clamp_level(sc.tag_curve(node), id)) << "an entry finer than id " << id << " " << where;
+    }
+  }
+}
+
+// A change of level id between levels or tolerance steps keeps the boundary section (the contact solver
+// changes level with hand speed, and renders both levels in turn until the proxy leaves the old one's walls):
+// to a finer id the refined section stays as it is, to a coarser one its finer entries give way to their
+// ancestors at the new level; only cut steps start again from the root. Answers equal brute force throughout.
+TEST(CollisionQuery, LevelChangesKeepTheSectionAndEqualBruteForce) {
+  std::vector<Polyline> curves{test::random_blob(*std::make_unique<std::mt19937>(5), {0, 0}, 0.02, 400)};
+  const Scene sc = Scene::build(curves, 6);
+  ASSERT_GE(sc.curve_nodes(0).levels, 6u);
+  BoundarySection section(sc);
+  const Vec2 a{-0.05, 0.0}, b{0.0, 0.0};
+  for (int i = 0; i < 10; ++i) section.first_hit(a, b, 2, nullptr, 0, QueryBudget{});
+  const std::vector<std::uint32_t> refined = section.section();
+  ASSERT_GT(refined.size(), 8u);
+  // To a finer level: nothing to undo; the query descends below the section's level-2 entries without
+  // splitting them while it also serves level 2 (the id before it).
+  QueryStats st;
+  section.first_hit(a, b, 0, nullptr, 0, QueryBudget{}, &st);
+  EXPECT_EQ(st.splits, 0);
+  EXPECT_EQ(section.section(), refined);
+  expect_frontier_serving(sc, section, {0, 2}, "after a change to a finer level");
+  // To a coarser level: the entries below level 4 are replaced by their level-4 ancestors, not by the root.
+  section.first_hit(a, b, 4, nullptr, 0, QueryBudget{});
+  expect_frontier_serving(sc, section, {0, 4}, "after a change to a coarser level");
+  EXPECT_GT(section.section().size(), 4u);
+  int at_four = 0;
+  for (std::uint32_t node : section.section()) at_four += sc.is_segment(node) && sc.tag_level(node) == 4;
+  EXPECT_GT(at_four, 1) << "the refinement near the hit kept at the new level";
+  // A cut step starts again from the root (its segments are of mixed levels).
+  section.first_hit({0.07, 0.045}, {0.069, 0.045}, kCutLevelBase + 2, nullptr, 0, QueryBudget{});
+  EXPECT_LE(section.section().size(), 4u);
+
+  // A wandering hand whose level id changes as the servo's does: runs of one id, and runs of two ids in turn
+  // (a level change's transition), over levels and tolerance steps. Every answer against brute force at its
+  // id; the section a frontier serving both ids after every query.
+  std::mt19937 rng(41);
+  const auto many = random_scene(rng, 8, 8);
+  const Scene big = Scene::build(many, 6);
+  BoundarySection walk(big);
+  std::uniform_real_distribution<double> step(-0.0004, 0.0004);
+  std::uniform_int_distribution<int> pick(0, 6), run(20, 400);
+  const int ids[7] = {0, 1, 2, 3, 4, kToleranceLevelBase + 1, kToleranceLevelBase + 5};
+  Vec2 p{0.0, 0.0};
+  int id = 0, other = 0, left = 0, hits = 0, checked = 0, changes = 0;
+  bool alternate = false;
+  for (int i = 0; i < 100000; ++i) {
+    if (left-- == 0) {
+      other = id;
+      id = ids[pick(rng)];
+      alternate = (rng() & 1) != 0;
+      left = run(rng);
+      changes += id != other;
+    }
+    const int now = alternate && (i & 1) ? other : id;
+    const Vec2 q{std::clamp(p.x + step(rng), -0.075, 0.075), std::clamp(p.y + step(rng), -0.05, 0.05)};
+    const SweepHit h = walk.first_hit(p, q, now, nullptr, 0, QueryBudget{});
+    double t_ref = 0.0;
+    SegmentRef ref;
+    const bool hit_ref = test::brute_first_hit(big, p, q, now, &t_ref, &ref);
+    ++checked;
+    ASSERT_EQ(h.hit, hit_ref) << "tick " << i << ", id " << now;
+    if (hit_ref) {
+      ++hits;
+      ASSERT_NEAR(h.t, t_ref, 1e-9) << "tick " << i << ", id " << now;
+    }
+    if (i % 97 == 0) expect_frontier_serving(big, walk, {now}, "on the walk");
+    p = q;
+  }
+  EXPECT_GT(changes, 100);
+  EXPECT_GT(hits, 800);  // the walk really meets walls
+  EXPECT_EQ(checked, 100000);
+}
+
 // Merges keep up with splits: on a long coherent walk over a dense scene (the hand passing through walls,
 // as bench_first_hit's random walk does) the section stays bounded. With a fixed number of merge checks
 // per tick, whatever the section's size, it grew to thousands of entries on this walk.

@@ -21,6 +21,10 @@
 /// its sweep is from the nearest box of the section (as it scanned it, before that tick's splits and
 /// merges: those boxes cover the same walls), and a later sweep wholly inside that distance cannot hit
 /// anything (seed §3 suggests scheduling box updates from box distances).
+/// The section serves the level ids of the last two queries (the contact solver renders two levels in turn
+/// while it changes level): its entries stay at or above both, and a change of id between levels or tolerance
+/// steps keeps it (to a coarser id, entries finer than it give way to their ancestors at its level); only a
+/// change to or from a cut step starts it again from the root.
 ///
 /// Real-time: all storage is sized in the constructor; `first_hit` allocates nothing, takes no lock,
 /// throws nothing.
@@ -123,7 +127,9 @@ class BoundarySection {
   /// First hit of the sweep a→b against the polylines at level id `level` (clamped per curve to its coarsest;
   /// a cut step: its cut's joined segments, see first_hit_cut),
   /// ignoring up to kMaxExcluded segments (the contact solver's active constraints). Updates the
-  /// boundary section. Charges its box tests to `budget` (see QueryBudget). Real-time safe.
+  /// boundary section, which serves this id and the previous query's (splits stop at the coarser of the
+  /// two; a new id coarsens finer entries, O(section entries); to or from a cut step: back to the root).
+  /// Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                      QueryBudget& budget, QueryStats* stats = nullptr);
   /// The same first hit through the scene's wide index alone (wide_index.hpp), for comparison with
@@ -241,7 +247,10 @@ class BoundarySection {
   // tolerance step (see the constructor).
   int walls_of(int level) const noexcept { return is_cut_level(level) && cut_mask_ == nullptr ? level - kToleranceSteps : level; }
   // The phases of first_hit, in order (each documented where it is defined).
-  bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
+  void follow_level(int level) noexcept;
+  void coarsen_section(int level) noexcept;
+  bool at_floor(std::uint32_t node, int level) const noexcept;
+  bool inside_free_ball(Vec2 a, Vec2 b, int level) const noexcept;
   void next_tick() noexcept;
   void clip_section(Query& q);
   std::size_t scan_section_rects(const Query& q);
@@ -253,6 +262,7 @@ class BoundarySection {
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
   void compact_section(Query& q);
+  void drop_departed_entries() noexcept;
   SweepHit finish(Query& q) const;
   void split(std::uint32_t node);
   // The walks of the wide index (wide_index.hpp). One stack serves both: an entry is a child code with its
@@ -318,13 +328,15 @@ class BoundarySection {
   std::uint32_t last_closest_node_ = kWideEmpty;  // the previous call's answer (segment node), the next call's seed
   int last_closest_level_ = -1, last_closest_curve_ = -1;
   std::uint32_t tick_ = 0;
-  int last_level_ = -1;         // level id of the last first_hit
+  int last_level_ = -1;         // level id of the last first_hit (-1: none yet)
+  int other_level_ = -1;        // level id of the one before it: the section serves both (follow_level)
   static constexpr CutBounds kNoCutBounds{};
   std::shared_ptr<const CutWalls> cuts_;   // the cut masks and bounds (shared; null: none)
   const std::uint8_t* cut_mask_ = nullptr; // cuts_->masks: per node, the tolerance steps whose cut it is a segment of
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
   Vec2 ball_center_m_;          // free-space ball: no box of the section as last scanned, so no wall, comes closer to its centre than its radius
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
+  int ball_levels_[2] = {-1, -1};  // the level ids whose walls the ball was proven clear of
   Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of any level) comes closer
   double wide_ball_radius_m_ = 0.0;  // [m]; 0 = unknown
   std::uint32_t wide_ball_seed_ = kWideEmpty;  // the last walk's nearest item rectangle: wide node << 2 | slot
