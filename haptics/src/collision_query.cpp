@@ -254,10 +254,9 @@ struct BoundarySection::Query {
 
 // Free-space ball (seed §3: "distances to the boxes ... can be used to schedule box updates"): the
 // last full query proved that no box of the section comes within ball_radius_m_ of ball_center_m_, and
-// those boxes covered every wall of the level ids it served (ball_levels_). A sweep at one of those ids
-// inside that ball cannot hit anything: answer at once.
-bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b, int level) const noexcept {
-  if (level != ball_levels_[0] && level != ball_levels_[1]) return false;
+// those boxes covered every wall of the level ids it served (ball_levels_; follow_level forgets the ball for
+// any other id). A sweep inside that ball cannot hit anything: answer at once.
+bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
   const double r_sq = ball_radius_m_ * ball_radius_m_;
   const Vec2 da = a - ball_center_m_, db = b - ball_center_m_;
   return dot(da, da) < r_sq && dot(db, db) < r_sq;  // r = 0 (unknown) admits nothing
@@ -265,45 +264,60 @@ bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b, int level) const noexcept
 
 // Phase 0: the section serves the level ids of this query and the one before it (two in turn while the
 // contact solver renders both walls of a level change; one otherwise): every segment entry is at or above
-// its curve's level for both (Scene::clamp_level), so its box holds their walls, and splits stop at the
-// coarser of the two (at_floor). A new id between levels or tolerance steps keeps the section: entries
-// finer than the new id on their curve give way to their ancestor at its level (coarsen_section), which
-// holds the same stretch of curve; to a finer id nothing changes. Only a change to or from a cut step,
-// whose segments are of mixed levels, starts again from the root.
+// the walls of both on its curve (a level: its clamp_level; a cut step: the cut), so its box holds their
+// walls, and splits stop at the coarser of the two (at_floor). A new id keeps the section: entries below
+// its walls give way to their ancestor at them (coarsen_section), which holds the same stretch of curve; to
+// a finer id nothing changes. The free-space ball holds for the two ids it was measured for, and is
+// forgotten at any other. Called only when the ids change (first_hit).
 void BoundarySection::follow_level(int level) noexcept {
-  const int previous = last_level_;
+  const int previous = last_level_, served = other_level_;  // the section serves both
   other_level_ = previous < 0 ? level : previous;
   last_level_ = level;
   if (level == previous) return;
-  if (previous < 0 || is_cut_level(level) || is_cut_level(previous)) {
+  if (level != ball_levels_[0] && level != ball_levels_[1]) ball_radius_m_ = 0.0;
+  if (previous < 0) {
     reset();
-    other_level_ = level;
     return;
   }
-  coarsen_section(level);
+  if (level != served) coarsen_section(level);  // a transition's two ids in turn: nothing to coarsen
 }
 
-// Every segment entry finer than `level` on its curve replaced by its ancestor at that level (once, however
+// The node's ancestor at the walls of `level` on its curve (a segment of that level, or of that cut step's cut)
+// when the node lies below them, else the node itself. O(levels) at a cut step.
+std::uint32_t BoundarySection::wall_ancestor(std::uint32_t node, int level) const noexcept {
+  const Scene& sc = *scene_;
+  if (!sc.is_segment(node)) return node;
+  const std::uint32_t c = sc.tag_curve(node);
+  const int l = sc.tag_level(node);
+  const CurveNodes& cn = sc.curve_nodes(c);
+  const std::uint32_t k = node - cn.box_offset[l];
+  if (!is_cut_level(level)) {
+    const int target = sc.clamp_level(c, level);
+    return l >= target ? node : cn.box_offset[target] + (k >> (target - l));
+  }
+  const int step = level - kCutLevelBase;
+  for (int up = l + 1; up < static_cast<int>(cn.levels); ++up) {  // the cut is a frontier: at most one ancestor in it
+    const std::uint32_t a = cn.box_offset[up] + (k >> (up - l));
+    if (in_cut(cut_mask_, a, step)) return a;
+  }
+  return node;
+}
+
+// Every segment entry below the walls of `level` replaced by its ancestor at them (wall_ancestor; once, however
 // many of its descendants were in), so the section still covers the same stretches of curve, no node with
 // its ancestor. Without room for the ancestors (a section at its storage bound), the section starts again
 // from the root.
 void BoundarySection::coarsen_section(int level) noexcept {
-  const Scene& sc = *scene_;
   const std::size_t n = section_.size();
   bool changed = false;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t node = section_[i];
-    if (!sc.is_segment(node)) continue;
-    const std::uint32_t c = sc.tag_curve(node);
-    const int l = sc.tag_level(node);
-    const int target = sc.clamp_level(c, level);
-    if (l >= target) continue;
+    const std::uint32_t ancestor = wall_ancestor(node, level);
+    if (ancestor == node) continue;
     if (section_.size() >= capacity_) {
       reset();
       return;
     }
-    const CurveNodes& cn = sc.curve_nodes(c);
-    const std::uint32_t ancestor = cn.box_offset[target] + ((node - cn.box_offset[l]) >> (target - l));
     in_section_[node] = 0;
     if (!in_section_[ancestor]) push_section(ancestor);
     changed = true;
@@ -873,8 +887,8 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
 SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                                     QueryBudget& budget, QueryStats* stats_out) {
   level = walls_of(level);
-  follow_level(level);
-  if (inside_free_ball(a, b, level)) {
+  if (level != last_level_ || level != other_level_) follow_level(level);  // else it serves this id alone, as before
+  if (inside_free_ball(a, b)) {
     if (stats_out) {
       *stats_out = QueryStats{};
       stats_out->section_size = static_cast<std::int32_t>(section_.size());

@@ -554,8 +554,18 @@ TEST(CollisionQuery, BoundarySectionFollowsTheHandle) {
   EXPECT_LT(section.section().size(), refined);
 }
 
-// A frontier: each node once, none below another, and every segment entry at or above its curve's level for
-// each id in `ids` (its box then holds that id's walls).
+// True when segment node `node` lies below the walls of level id `id` on its curve: finer than its level there,
+// or at a cut step under a segment of the cut (read from the section's cut masks).
+bool below_walls(const Scene& sc, const BoundarySection& section, std::uint32_t node, int id) {
+  if (!is_cut_level(id)) return sc.tag_level(node) < sc.clamp_level(sc.tag_curve(node), id);
+  for (std::uint32_t up = sc.parent(node); sc.is_segment(up); up = sc.parent(up)) {
+    if (in_cut(section.cut_masks(), up, id - kCutLevelBase)) return true;
+  }
+  return false;
+}
+
+// A frontier: each node once, none below another, and no segment entry below the walls of any id in `ids`
+// (its box then holds those walls).
 void expect_frontier_serving(const Scene& sc, const BoundarySection& section, std::initializer_list<int> ids, const char* where) {
   std::unordered_set<std::uint32_t> in(section.section().begin(), section.section().end());
   ASSERT_EQ(in.size(), section.section().size()) << "a node twice in the section " << where;
@@ -565,16 +575,34 @@ void expect_frontier_serving(const Scene& sc, const BoundarySection& section, st
       ASSERT_EQ(in.count(up), 0u) << "node " << node << " and its ancestor " << up << " both in the section " << where;
     }
     if (!sc.is_segment(node)) continue;
-    for (int id : ids) {
-      ASSERT_GE(sc.tag_level(node), sc.clamp_level(sc.tag_curve(node), id)) << "an entry finer than id " << id << " " << where;
-    }
+    for (int id : ids) ASSERT_FALSE(below_walls(sc, section, node, id)) << "an entry below the walls of id " << id << " " << where;
   }
 }
 
-// A change of level id between levels or tolerance steps keeps the boundary section (the contact solver
-// changes level with hand speed, and renders both levels in turn until the proxy leaves the old one's walls):
-// to a finer id the refined section stays as it is, to a coarser one its finer entries give way to their
-// ancestors at the new level; only cut steps start again from the root. Answers equal brute force throughout.
+// Brute-force first hit of a→b over polylines (test::polyline_at of each curve), Cramer's rule as
+// test::brute_first_hit: the smallest sweep parameter, or false.
+bool brute_first_hit_of(const Scene& sc, const std::vector<std::vector<Vec2>>& pl, Vec2 a, Vec2 b, double* t_out) {
+  double best = 2.0;
+  for (std::size_t c = 0; c < pl.size(); ++c) {
+    const std::size_t n = pl[c].size(), pieces = sc.curve(c).closed ? n : n - 1;
+    for (std::size_t k = 0; k < pieces; ++k) {
+      const Vec2 p = pl[c][k], q = pl[c][(k + 1) % n];
+      const double m11 = b.x - a.x, m12 = p.x - q.x, m21 = b.y - a.y, m22 = p.y - q.y;
+      const double det = m11 * m22 - m12 * m21;
+      if (det == 0.0) continue;
+      const double rx = p.x - a.x, ry = p.y - a.y;
+      const double t = (rx * m22 - m12 * ry) / det, u = (m11 * ry - rx * m21) / det;
+      if (t >= 0 && t <= 1 && u >= 0 && u <= 1) best = std::min(best, t);
+    }
+  }
+  *t_out = best;
+  return best <= 1.0;
+}
+
+// A change of level id keeps the boundary section (the contact solver changes level with hand speed, and
+// renders both levels in turn until the proxy leaves the old one's walls): to a finer id the refined section
+// stays as it is, to a coarser one (or a cut step) its entries below the new walls give way to their
+// ancestors at them. Answers equal brute force throughout, over levels, tolerance steps and cut steps.
 TEST(CollisionQuery, LevelChangesKeepTheSectionAndEqualBruteForce) {
   std::vector<Polyline> curves{test::random_blob(*std::make_unique<std::mt19937>(5), {0, 0}, 0.02, 400)};
   const Scene sc = Scene::build(curves, 6);
@@ -594,48 +622,50 @@ TEST(CollisionQuery, LevelChangesKeepTheSectionAndEqualBruteForce) {
   // To a coarser level: the entries below level 4 are replaced by their level-4 ancestors, not by the root.
   section.first_hit(a, b, 4, nullptr, 0, QueryBudget{});
   expect_frontier_serving(sc, section, {0, 4}, "after a change to a coarser level");
-  EXPECT_GT(section.section().size(), 4u);
   int at_four = 0;
   for (std::uint32_t node : section.section()) at_four += sc.is_segment(node) && sc.tag_level(node) == 4;
   EXPECT_GT(at_four, 1) << "the refinement near the hit kept at the new level";
-  // A cut step starts again from the root (its segments are of mixed levels).
-  section.first_hit({0.07, 0.045}, {0.069, 0.045}, kCutLevelBase + 2, nullptr, 0, QueryBudget{});
-  EXPECT_LE(section.section().size(), 4u);
+  // To a cut step: entries under the cut give way to the cut's segments over them.
+  section.first_hit(a, b, kCutLevelBase + 6, nullptr, 0, QueryBudget{});
+  expect_frontier_serving(sc, section, {4, kCutLevelBase + 6}, "after a change to a cut step");
+  EXPECT_GT(section.section().size(), 4u);
 
   // A wandering hand whose level id changes as the servo's does: runs of one id, and runs of two ids in turn
-  // (a level change's transition), over levels and tolerance steps. Every answer against brute force at its
-  // id; the section a frontier serving both ids after every query.
+  // (a level change's transition), over levels, tolerance steps and cut steps. Every answer against brute
+  // force over the id's polylines; the section a frontier serving the id after every 97th query.
   std::mt19937 rng(41);
-  const auto many = random_scene(rng, 8, 8);
-  const Scene big = Scene::build(many, 6);
+  const Scene big = Scene::build(random_scene(rng, 8, 8), 6);
   BoundarySection walk(big);
+  const int ids[9] = {0, 1, 2, 3, 4, kToleranceLevelBase + 1, kToleranceLevelBase + 5, kCutLevelBase + 1, kCutLevelBase + 4};
+  std::vector<std::vector<std::vector<Vec2>>> walls(9);
+  for (int j = 0; j < 9; ++j) {
+    for (std::size_t c = 0; c < big.curve_count(); ++c) walls[static_cast<std::size_t>(j)].push_back(test::polyline_at(big, c, ids[j]));
+  }
   std::uniform_real_distribution<double> step(-0.0004, 0.0004);
-  std::uniform_int_distribution<int> pick(0, 6), run(20, 400);
-  const int ids[7] = {0, 1, 2, 3, 4, kToleranceLevelBase + 1, kToleranceLevelBase + 5};
+  std::uniform_int_distribution<int> pick(0, 8), run(20, 400);
   Vec2 p{0.0, 0.0};
   int id = 0, other = 0, left = 0, hits = 0, checked = 0, changes = 0;
   bool alternate = false;
   for (int i = 0; i < 100000; ++i) {
     if (left-- == 0) {
       other = id;
-      id = ids[pick(rng)];
+      id = pick(rng);
       alternate = (rng() & 1) != 0;
       left = run(rng);
       changes += id != other;
     }
     const int now = alternate && (i & 1) ? other : id;
     const Vec2 q{std::clamp(p.x + step(rng), -0.075, 0.075), std::clamp(p.y + step(rng), -0.05, 0.05)};
-    const SweepHit h = walk.first_hit(p, q, now, nullptr, 0, QueryBudget{});
+    const SweepHit h = walk.first_hit(p, q, ids[now], nullptr, 0, QueryBudget{});
     double t_ref = 0.0;
-    SegmentRef ref;
-    const bool hit_ref = test::brute_first_hit(big, p, q, now, &t_ref, &ref);
+    const bool hit_ref = brute_first_hit_of(big, walls[static_cast<std::size_t>(now)], p, q, &t_ref);
     ++checked;
-    ASSERT_EQ(h.hit, hit_ref) << "tick " << i << ", id " << now;
+    ASSERT_EQ(h.hit, hit_ref) << "tick " << i << ", id " << ids[now];
     if (hit_ref) {
       ++hits;
-      ASSERT_NEAR(h.t, t_ref, 1e-9) << "tick " << i << ", id " << now;
+      ASSERT_NEAR(h.t, t_ref, 1e-9) << "tick " << i << ", id " << ids[now];
     }
-    if (i % 97 == 0) expect_frontier_serving(big, walk, {now}, "on the walk");
+    if (i % 97 == 0) expect_frontier_serving(big, walk, {ids[now]}, "on the walk");
     p = q;
   }
   EXPECT_GT(changes, 100);

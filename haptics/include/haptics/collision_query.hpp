@@ -22,9 +22,8 @@
 /// merges: those boxes cover the same walls), and a later sweep wholly inside that distance cannot hit
 /// anything (seed §3 suggests scheduling box updates from box distances).
 /// The section serves the level ids of the last two queries (the contact solver renders two levels in turn
-/// while it changes level): its entries stay at or above both, and a change of id between levels or tolerance
-/// steps keeps it (to a coarser id, entries finer than it give way to their ancestors at its level); only a
-/// change to or from a cut step starts it again from the root.
+/// while it changes level): its entries stay at or above the walls of both, and a change of id keeps it
+/// (entries below the new id's walls give way to their ancestors at them).
 ///
 /// Real-time: all storage is sized in the constructor; `first_hit` allocates nothing, takes no lock,
 /// throws nothing.
@@ -128,7 +127,7 @@ class BoundarySection {
   /// a cut step: its cut's joined segments, see first_hit_cut),
   /// ignoring up to kMaxExcluded segments (the contact solver's active constraints). Updates the
   /// boundary section, which serves this id and the previous query's (splits stop at the coarser of the
-  /// two; a new id coarsens finer entries, O(section entries); to or from a cut step: back to the root).
+  /// two; a new id coarsens the entries below its walls, O(section entries), O(levels) each at a cut step).
   /// Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                      QueryBudget& budget, QueryStats* stats = nullptr);
@@ -247,10 +246,11 @@ class BoundarySection {
   // tolerance step (see the constructor).
   int walls_of(int level) const noexcept { return is_cut_level(level) && cut_mask_ == nullptr ? level - kToleranceSteps : level; }
   // The phases of first_hit, in order (each documented where it is defined).
-  void follow_level(int level) noexcept;
+  [[gnu::cold]] void follow_level(int level) noexcept;
   void coarsen_section(int level) noexcept;
+  std::uint32_t wall_ancestor(std::uint32_t node, int level) const noexcept;
   bool at_floor(std::uint32_t node, int level) const noexcept;
-  bool inside_free_ball(Vec2 a, Vec2 b, int level) const noexcept;
+  bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
   void next_tick() noexcept;
   void clip_section(Query& q);
   std::size_t scan_section_rects(const Query& q);
