@@ -152,8 +152,9 @@ class BoundarySection {
   /// desired tolerance level"), drawn joined (joined_cut_segment: where the cut changes level, both pieces meet
   /// at the finer segment's end). The walk is first_hit's, through the same boundary section, stopping at the
   /// cut's segments instead of a level's: each joined piece lies inside its own segment's error box
-  /// (tolerance_cut.hpp), so the boxes prune it exactly as they prune a level. A change of step, or between a
-  /// step and a level, starts the section again from the roots. The answer's segment is the cut segment hit
+  /// (tolerance_cut.hpp), so the boxes prune it exactly as they prune a level; a box above the cut holds every
+  /// joined piece under it (both its ends are points under the box). A change of step, or between a step and a
+  /// level, keeps the section (first_hit). The answer's segment is the cut segment hit
   /// (its own level and index); anytime and budget as first_hit. Answers equal a brute-force test of the
   /// joined polylines (t bit for bit; tests). first_hit_wide does not walk a cut: the wide index's rectangles
   /// hold each level's own pieces, not the joined ones (closest points at a cut: closest_point_cut). Real-time safe.
