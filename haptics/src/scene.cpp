@@ -336,15 +336,6 @@ Aabb Scene::aabb(std::uint32_t node) const {
   return Aabb{{c.x - hx, c.y - hy}, {c.x + hx, c.y + hy}};
 }
 
-std::uint32_t Scene::parent(std::uint32_t node) const {
-  if (node >= segment_nodes_) return group_parent_[node - segment_nodes_];
-  const CurveNodes& cn = curve_nodes_[tag_curve(node)];
-  const int l = tag_level(node);
-  const std::uint32_t k = node - cn.box_offset[l];
-  if (static_cast<std::uint32_t>(l) + 1 < cn.levels) return cn.box_offset[l + 1] + k / 2;
-  return chunk_of_curve_[cn.chunk_offset + k / kSegmentsPerChunk];  // a coarsest segment: its chunk
-}
-
 std::size_t Scene::total_segments(int level) const {
   std::size_t total = 0;
   for (std::size_t c = 0; c < curves_.size(); ++c) total += curves_[c].segment_count[clamp_level(c, level)];

@@ -234,8 +234,15 @@ class Scene {
     return NodeInfo{c, l, node - curve_nodes_[c].box_offset[l]};
   }
   std::uint32_t node_of(SegmentRef s) const { return curve_nodes_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
-  /// Parent of a node (the scene root's parent is itself).
-  std::uint32_t parent(std::uint32_t node) const;
+  /// Parent of a node (the scene root's parent is itself). Inline: the section's merge checks ask it per entry.
+  std::uint32_t parent(std::uint32_t node) const {
+    if (node >= segment_nodes_) return group_parent_[node - segment_nodes_];
+    const CurveNodes& cn = curve_nodes_[tag_curve(node)];
+    const int l = tag_level(node);
+    const std::uint32_t k = node - cn.box_offset[l];
+    if (static_cast<std::uint32_t>(l) + 1 < cn.levels) return cn.box_offset[l + 1] + k / 2;
+    return chunk_of_curve_[cn.chunk_offset + k / kSegmentsPerChunk];  // a coarsest segment: its chunk
+  }
   /// First child and child count of a node; children are consecutive ids (0 for a level-0 segment).
   void children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const {
     if (node >= segment_nodes_) {
