@@ -325,7 +325,8 @@ void BoundarySection::coarsen_section(int level) noexcept {
   if (changed) drop_departed_entries();
 }
 
-// Splits stop here: a segment node at or below its curve's level for both ids the section serves.
+// Splits stop here: a segment node at the walls of either id the section serves (so at the coarser of the
+// two; the section's entries are never below either, follow_level).
 bool BoundarySection::at_floor(std::uint32_t node, int level) const noexcept {
   return at_target(node, level) || at_target(node, other_level_);
 }
