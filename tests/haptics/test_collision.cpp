@@ -666,7 +666,9 @@ TEST(CollisionQuery, LevelChangesKeepTheSectionAndEqualBruteForce) {
       ++hits;
       ASSERT_NEAR(h.t, t_ref, 1e-9) << "tick " << i << ", id " << ids[now];
     }
-    if (i % 97 == 0) ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(big, walk, {ids[now]}, "on the walk"));
+    if (i % 97 == 0) {
+      ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(big, walk, {ids[now]}, "on the walk"));
+    }
     p = q;
   }
   EXPECT_GT(changes, 100);
