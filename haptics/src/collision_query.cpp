@@ -283,22 +283,18 @@ void BoundarySection::follow_level(int level) noexcept {
 }
 
 // The node's ancestor at the walls of `level` on its curve (a segment of that level, or of that cut step's cut)
-// when the node lies below them, else the node itself. O(levels) at a cut step.
+// when the node lies below them, else the node itself: up by Scene::parent, O(levels).
 std::uint32_t BoundarySection::wall_ancestor(std::uint32_t node, int level) const noexcept {
   const Scene& sc = *scene_;
   if (!sc.is_segment(node)) return node;
-  const std::uint32_t c = sc.tag_curve(node);
-  const int l = sc.tag_level(node);
-  const CurveNodes& cn = sc.curve_nodes(c);
-  const std::uint32_t k = node - cn.box_offset[l];
   if (!is_cut_level(level)) {
-    const int target = sc.clamp_level(c, level);
-    return l >= target ? node : cn.box_offset[target] + (k >> (target - l));
+    const int target = sc.clamp_level(sc.tag_curve(node), level);
+    std::uint32_t a = node;
+    while (sc.tag_level(a) < target) a = sc.parent(a);  // target ≤ the curve's coarsest: a stays a segment
+    return a;
   }
-  const int step = level - kCutLevelBase;
-  for (int up = l + 1; up < static_cast<int>(cn.levels); ++up) {  // the cut is a frontier: at most one ancestor in it
-    const std::uint32_t a = cn.box_offset[up] + (k >> (up - l));
-    if (in_cut(cut_mask_, a, step)) return a;
+  for (std::uint32_t a = sc.parent(node); sc.is_segment(a); a = sc.parent(a)) {  // the cut is a frontier: at most one
+    if (in_cut(cut_mask_, a, level - kCutLevelBase)) return a;
   }
   return node;
 }

@@ -580,20 +580,15 @@ void expect_frontier_serving(const Scene& sc, const BoundarySection& section, st
   }
 }
 
-// Brute-force first hit of a→b over polylines (test::polyline_at of each curve), Cramer's rule as
-// test::brute_first_hit: the smallest sweep parameter, or false.
+// Brute-force first hit of a→b over polylines (test::polyline_at of each curve; test::cramer_sweep_hit per
+// piece): the smallest sweep parameter, or false.
 bool brute_first_hit_of(const Scene& sc, const std::vector<std::vector<Vec2>>& pl, Vec2 a, Vec2 b, double* t_out) {
   double best = 2.0;
   for (std::size_t c = 0; c < pl.size(); ++c) {
     const std::size_t n = pl[c].size(), pieces = sc.curve(c).closed ? n : n - 1;
     for (std::size_t k = 0; k < pieces; ++k) {
-      const Vec2 p = pl[c][k], q = pl[c][(k + 1) % n];
-      const double m11 = b.x - a.x, m12 = p.x - q.x, m21 = b.y - a.y, m22 = p.y - q.y;
-      const double det = m11 * m22 - m12 * m21;
-      if (det == 0.0) continue;
-      const double rx = p.x - a.x, ry = p.y - a.y;
-      const double t = (rx * m22 - m12 * ry) / det, u = (m11 * ry - rx * m21) / det;
-      if (t >= 0 && t <= 1 && u >= 0 && u <= 1) best = std::min(best, t);
+      double t = 0.0;
+      if (test::cramer_sweep_hit(a, b, pl[c][k], pl[c][(k + 1) % n], &t)) best = std::min(best, t);
     }
   }
   *t_out = best;

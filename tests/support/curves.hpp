@@ -88,8 +88,20 @@ inline bool crosses_strictly(Vec2 p1, Vec2 p2, Vec2 q1, Vec2 q2) {
   return ((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0));
 }
 
-/// Brute-force first hit of a→b over every segment of `level`: smallest sweep parameter, computed by
-/// solving the 2x2 system with Cramer's rule in a different arrangement from the library's.
+/// Where the sweep a→b meets segment p→q: true with its sweep parameter `t` in [0, 1], by solving the 2x2
+/// system with Cramer's rule in a different arrangement from the library's (parallel pairs: false).
+inline bool cramer_sweep_hit(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) {
+  // a + t (b − a) = p + s (q − p)  →  [b−a, p−q] [t s]^T = p − a
+  const double m11 = b.x - a.x, m12 = p.x - q.x, m21 = b.y - a.y, m22 = p.y - q.y;
+  const double det = m11 * m22 - m12 * m21;
+  if (det == 0.0) return false;
+  const double rx = p.x - a.x, ry = p.y - a.y;
+  *t = (rx * m22 - m12 * ry) / det;
+  const double s = (m11 * ry - rx * m21) / det;
+  return *t >= 0 && *t <= 1 && s >= 0 && s <= 1;
+}
+
+/// Brute-force first hit of a→b over every segment of `level`: smallest sweep parameter (cramer_sweep_hit).
 inline bool brute_first_hit(const Scene& sc, Vec2 a, Vec2 b, int level, double* t_out, SegmentRef* seg_out) {
   double best = 2.0;
   bool found = false;
@@ -99,14 +111,8 @@ inline bool brute_first_hit(const Scene& sc, Vec2 a, Vec2 b, int level, double* 
       Vec2 p, q;
       const SegmentRef ref{static_cast<int>(c), l, static_cast<int>(k)};
       sc.segment(ref, &p, &q);
-      // a + t (b − a) = p + s (q − p)  →  [b−a, p−q] [t s]^T = p − a
-      const double m11 = b.x - a.x, m12 = p.x - q.x, m21 = b.y - a.y, m22 = p.y - q.y;
-      const double det = m11 * m22 - m12 * m21;
-      if (det == 0.0) continue;
-      const double rx = p.x - a.x, ry = p.y - a.y;
-      const double t = (rx * m22 - m12 * ry) / det;
-      const double s = (m11 * ry - rx * m21) / det;
-      if (t >= 0 && t <= 1 && s >= 0 && s <= 1 && t < best) {
+      double t = 0.0;
+      if (cramer_sweep_hit(a, b, p, q, &t) && t < best) {
         best = t;
         found = true;
         if (seg_out) *seg_out = ref;
