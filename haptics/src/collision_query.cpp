@@ -59,6 +59,15 @@ inline bool at_target_level(const Scene& sc, std::uint32_t node, int level) {
   return sc.tag_level(node) <= std::max(level, 0);
 }
 
+// "d at s is a better answer than best_d at best_s": smaller (a distance, or a first hit's sweep parameter), or
+// as small and the smaller (curve, level, segment), so ties do not depend on the order segments are met in.
+inline bool closer(double d, SegmentRef s, double best_d, SegmentRef best_s) {
+  if (d != best_d) return d < best_d;
+  if (s.curve != best_s.curve) return s.curve < best_s.curve;
+  if (s.level != best_s.level) return s.level < best_s.level;
+  return s.segment < best_s.segment;
+}
+
 }  // namespace
 
 // at_target_level, and for a cut step the cut's own segments. A walk comes down from the roots and stops at
@@ -178,6 +187,8 @@ void BoundarySection::reset() {
   for (std::uint32_t node : section_) in_section_[node] = 0;
   section_.clear();
   ball_radius_m_ = 0.0;
+  ball_walls_.radius_m = 0.0;
+  ball_walls_.count = 0;
   wide_ball_radius_m_ = 0.0;
   wide_ball_seed_ = kWideEmpty;
   if (scene_->curve_count() == 0) return;
@@ -216,6 +227,7 @@ struct BoundarySection::Query {
   bool refused = false;  // optional work was refused for want of budget (a wide node may be refused before it is quite spent)
   std::size_t scanned = 0;  // section entries phase 1 scanned (the first ones of section_)
   std::size_t hit = 0;      // of which the sweep met, grown by the merge margin (hit_stamp_ this tick)
+  std::size_t nearest_rect = 0;  // of which the one whose rectangle is nearest to b (scanned when none)
 
   Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded, QueryBudget& shared_budget)
       : a(a_m), b(b_m), sweep{{std::min(a_m.x, b_m.x), std::min(a_m.y, b_m.y)}, {std::max(a_m.x, b_m.x), std::max(a_m.y, b_m.y)}},
@@ -260,6 +272,51 @@ bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
   const double r_sq = ball_radius_m_ * ball_radius_m_;
   const Vec2 da = a - ball_center_m_, db = b - ball_center_m_;
   return dot(da, da) < r_sq && dot(db, db) < r_sq;  // r = 0 (unknown) admits nothing
+}
+
+// The ball's walls (gather_ball_walls) answer a sweep of their level id inside their ball: the first hit among
+// them, excluded ones left out, the same answer a full query gives (every wall within the ball is among them;
+// ties as test_segment). False, with nothing written, for a sweep they cannot answer. Charges no box test.
+bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
+                                             SweepHit* out, QueryStats* stats) const noexcept {
+  const BallWalls& w = ball_walls_;
+  if (level != w.level) return false;
+  const double r_sq = w.radius_m * w.radius_m;
+  const Vec2 da = a - w.center_m, db = b - w.center_m;
+  if (!(dot(da, da) < r_sq && dot(db, db) < r_sq)) return false;
+  const Aabb sweep{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
+  SweepHit best;
+  best.t = std::numeric_limits<double>::infinity();
+  std::int32_t tested = 0;
+  int coarsest = 0;
+  for (int k = 0; k < w.count; ++k) {
+    if (!overlaps(w.rect_m[k], sweep, 0.0)) continue;  // the rectangles apart: no common point
+    bool skip = false;
+    for (int e = 0; e < excluded_count; ++e) skip = skip || excluded[e] == w.ref[k];
+    if (skip) continue;
+    ++tested;
+    coarsest = std::max(coarsest, w.ref[k].level);
+    double t = 0.0;
+    if (intersect_sweep_segment(a, b, w.p0_m[k], w.p1_m[k], &t) && closer(t, w.ref[k], best.t, best.segment)) {
+      best.hit = true;
+      best.t = t;
+      best.segment = w.ref[k];
+    }
+  }
+  if (best.hit) {
+    best.point_m = lerp(a, b, best.t);
+  } else {
+    best.t = 1.0;
+    best.point_m = b;
+  }
+  if (stats) {
+    *stats = QueryStats{};
+    stats->segment_tests = tested;
+    stats->coarsest_answer_level = coarsest;
+    stats->section_size = static_cast<std::int32_t>(section_.size());
+  }
+  *out = best;
+  return true;
 }
 
 // Phase 0: the section serves the level ids of this query and the one before it (two in turn while the
@@ -349,6 +406,7 @@ void BoundarySection::clip_section(Query& q) {
   q.scanned = n_section;
   q.charge_section_boxes(static_cast<std::int32_t>(n_section));
   const std::size_t nearest_rect = scan_section_rects(q);
+  q.nearest_rect = nearest_rect;
   if (nearest_rect == n_section) return;  // an empty section (an empty scene)
   // The free-space ball: the nearest box. A rectangle holds its box, so a box is nearer than the nearest found
   // so far only when its rectangle is; starting from the box of the nearest rectangle leaves few others to
@@ -443,7 +501,8 @@ void BoundarySection::mark_near_rects(double bound_sq, std::size_t skip) {
   rect_near_bits_[skip / 64] &= ~(std::uint64_t{1} << (skip % 64));
 }
 
-// Intersects the sweep with one segment of the target level; keeps the nearest hit.
+// Intersects the sweep with one segment of the target level; keeps the nearest hit (of equals, the smallest
+// (curve, level, segment): the answer does not depend on the order of the walk, nor on the section's state).
 void BoundarySection::test_segment(Query& q, std::uint32_t node) {
   const NodeInfo in = scene_->info(node);
   const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
@@ -457,7 +516,7 @@ void BoundarySection::test_segment(Query& q, std::uint32_t node) {
     scene_->segment_points(node, &p0, &p1);
   }
   double t = 0.0;
-  if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && t < q.best.t) {
+  if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && closer(t, ref, q.best.t, q.best.segment)) {
     q.best.hit = true;
     q.best.t = t;
     q.best.segment = ref;
@@ -487,6 +546,22 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
   return true;
 }
 
+// The walls of level id `level` under a segment node at most kDirectLevels above them: their count (at most
+// 2^kDirectLevels) and, in *first, the first one's node (they are consecutive nodes, whose points are
+// consecutive too); 0 for any other node (a chunk or above, a node farther above its walls, a cut step's
+// walls, which are of mixed levels). The node must not lie below the walls (no section entry does).
+std::uint32_t BoundarySection::segments_under(std::uint32_t node, int level, std::uint32_t* first) const noexcept {
+  const Scene& sc = *scene_;
+  if (!sc.is_segment(node) || is_cut_level(level)) return 0;
+  const std::uint32_t c = sc.tag_curve(node);
+  const int l = sc.tag_level(node);
+  const int target = sc.clamp_level(c, level);
+  if (l - target > kDirectLevels) return 0;
+  const CurveNodes& cn = sc.curve_nodes(c);
+  *first = cn.box_offset[target] + ((node - cn.box_offset[l]) << (l - target));
+  return 1u << (l - target);
+}
+
 // A box near its target level: the target level's segments under it (at most 2^kDirectLevels, consecutive
 // nodes whose points are consecutive too) tested directly rather than through the boxes between, as the wide
 // index's walks test the segments under an item. Same first hit (the nearest of the segments under the box,
@@ -494,17 +569,9 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
 // tested or charged, when the box is not a segment box within kDirectLevels of a level target (a cut step's
 // segments are of mixed levels) or the budget cannot cover them (the descent then goes box by box, anytime).
 bool BoundarySection::test_segments_under(Query& q, std::uint32_t node) {
-  constexpr int kDirectLevels = kWideItemLevel;  // as many segments as lie under a wide-index item (8)
-  const Scene& sc = *scene_;
-  if (!sc.is_segment(node) || is_cut_level(q.level)) return false;
-  const std::uint32_t c = sc.tag_curve(node);
-  const int l = sc.tag_level(node);
-  const int target = sc.clamp_level(c, q.level);
-  if (l - target > kDirectLevels) return false;
-  const CurveNodes& cn = sc.curve_nodes(c);
-  const std::uint32_t first = cn.box_offset[target] + ((node - cn.box_offset[l]) << (l - target));
-  const std::uint32_t count = 1u << (l - target);
-  if (!q.budget->affords(static_cast<std::int32_t>(count))) return false;  // not refused: the descent may still go part way
+  std::uint32_t first = 0;
+  const std::uint32_t count = segments_under(node, q.level, &first);
+  if (count == 0 || !q.budget->affords(static_cast<std::int32_t>(count))) return false;  // not refused: the descent may still go part way
   q.spend_boxes(static_cast<std::int32_t>(count));
   for (std::uint32_t i = 0; i < count; ++i) test_segment(q, first + i);
   return true;
@@ -582,6 +649,71 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     push_section(parent);
     ++q.st.merges;
   }
+}
+
+// Phase 5a: the ball's walls, a second free-space ball around the same centre (the end of the sweep) that
+// reaches past the nearest boxes: the section entries nearest to it, in order of their rectangles' distance,
+// while each is a segment box within kDirectLevels of its walls and all their walls fit in kMaxBallWalls, have
+// those walls copied out (seed §3: coherence; the walls under a box are its only walls of the level); the ball's
+// radius is the distance to the nearest entry left out (its box's distance, and no more than the next one's
+// rectangle's, which bounds every farther box from below). Every wall of the level within that radius is then
+// among the copies, so a later sweep inside the ball is answered exactly by them alone (answer_from_ball_walls):
+// near a wall, or sliding along one in contact, where the plain ball is as small as the gap to it. Kept only
+// when it reaches farther than the plain ball. The entries as phase 1 scanned them: a box is a box whatever
+// the section became since.
+void BoundarySection::gather_ball_walls(const Query& q) noexcept {
+  constexpr int kNearest = 6;  // entries considered, nearest first
+  BallWalls& w = ball_walls_;
+  w.radius_m = 0.0;
+  w.count = 0;
+  const std::size_t n = q.scanned;
+  std::uint32_t unused = 0;
+  if (q.nearest_rect >= n || segments_under(section_[q.nearest_rect], q.level, &unused) == 0) return;  // no walls to copy
+  // The kNearest entries with the nearest rectangles, in order (insertion; a section holds ~20 entries).
+  std::uint32_t near_entry[kNearest];
+  double near_d_sq[kNearest];
+  int m = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = rect_d_sq_[i];
+    if (m == kNearest && d >= near_d_sq[kNearest - 1]) continue;
+    int k = m < kNearest ? m++ : kNearest - 1;
+    for (; k > 0 && near_d_sq[k - 1] > d; --k) {
+      near_d_sq[k] = near_d_sq[k - 1];
+      near_entry[k] = near_entry[k - 1];
+    }
+    near_d_sq[k] = d;
+    near_entry[k] = static_cast<std::uint32_t>(i);
+  }
+  const bool all_listed = n <= static_cast<std::size_t>(kNearest);
+  // Copy the walls of the nearest entries while they fit.
+  const Scene& sc = *scene_;
+  int j = 0;
+  for (; j < m; ++j) {
+    std::uint32_t first = 0;
+    const std::uint32_t count = segments_under(section_[near_entry[j]], q.level, &first);
+    if (count == 0 || w.count + static_cast<int>(count) > kMaxBallWalls) break;
+    const NodeInfo in = sc.info(first);  // the walls are consecutive segments of one level of one curve
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const int k = w.count++;
+      sc.segment_points(first + i, &w.p0_m[k], &w.p1_m[k]);
+      w.rect_m[k] = Aabb{{std::min(w.p0_m[k].x, w.p1_m[k].x), std::min(w.p0_m[k].y, w.p1_m[k].y)},
+                         {std::max(w.p0_m[k].x, w.p1_m[k].x), std::max(w.p0_m[k].y, w.p1_m[k].y)}};
+      w.ref[k] = SegmentRef{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index + i)};
+    }
+  }
+  // The radius: nothing left out comes nearer.
+  constexpr double kAllWallsRadius_m = 1.0;  // every entry's walls copied: any radius holds; the workspace is smaller
+  double r_sq = kAllWallsRadius_m * kAllWallsRadius_m;
+  if (j < m) r_sq = box_distance_sq(sc.box(section_[near_entry[j]]), q.b);
+  if (j + 1 < m) r_sq = std::min(r_sq, near_d_sq[j + 1]);
+  if (!all_listed) r_sq = std::min(r_sq, near_d_sq[m - 1]);  // entries not listed: their rectangles are no nearer
+  if (w.count == 0 || r_sq <= q.nearest_sq) {
+    w.count = 0;
+    return;
+  }
+  w.center_m = q.b;
+  w.radius_m = std::sqrt(r_sq);
+  w.level = q.level;
 }
 
 // Phase 5: the next free-space ball, and when boxes were split or merged, the section without the entries
@@ -894,12 +1026,15 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     clear.point_m = b;
     return clear;
   }
+  SweepHit near;
+  if (answer_from_ball_walls(a, b, level, excluded, excluded_count, &near, stats_out)) return near;
   Query q(a, b, level, excluded, excluded_count, budget);
   next_tick();
   clip_section(q);
   refine_candidates(q);
   split_hit_boxes(q);
   merge_idle_siblings(q);
+  gather_ball_walls(q);
   compact_section(q);
   const SweepHit answer = finish(q);
   if (stats_out) *stats_out = q.st;
@@ -907,15 +1042,6 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
 }
 
 namespace {
-
-// "d at s is a better closest answer than best_d at best_s": nearer, or as near and the smaller
-// (curve, level, segment), so ties do not depend on the order segments are met in.
-inline bool closer(double d, SegmentRef s, double best_d, SegmentRef best_s) {
-  if (d != best_d) return d < best_d;
-  if (s.curve != best_s.curve) return s.curve < best_s.curve;
-  if (s.level != best_s.level) return s.level < best_s.level;
-  return s.segment < best_s.segment;
-}
 
 // Larger than every real segment reference: "no answer yet".
 constexpr SegmentRef kNoSegment{std::numeric_limits<std::int32_t>::max(), std::numeric_limits<std::int32_t>::max(),

@@ -706,6 +706,92 @@ TEST(CollisionQuery, BoundarySectionStaysSmallOnALongWalk) {
   EXPECT_LE(largest, 1000u);
 }
 
+// Brute-force first hit of a→b over every segment of level id `level` (each curve at Scene::clamp_level) but
+// `excluded`: the smallest sweep parameter (cramer_sweep_hit), and in *near_out every segment hit within
+// 1e-9 of it (a shared vertex is met by two).
+bool brute_first_hit_except(const Scene& sc, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int n_excluded, double* t_out,
+                            std::vector<SegmentRef>* near_out) {
+  std::vector<std::pair<double, SegmentRef>> hits;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    const int l = sc.clamp_level(c, level);
+    for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
+      const SegmentRef ref{static_cast<int>(c), l, static_cast<int>(k)};
+      if (std::find(excluded, excluded + n_excluded, ref) != excluded + n_excluded) continue;
+      Vec2 p, q;
+      sc.segment(ref, &p, &q);
+      double t = 0.0;
+      if (test::cramer_sweep_hit(a, b, p, q, &t)) hits.push_back({t, ref});
+    }
+  }
+  double best = 2.0;
+  for (const auto& h : hits) best = std::min(best, h.first);
+  near_out->clear();
+  for (const auto& h : hits) {
+    if (h.first <= best + 1e-9) near_out->push_back(h.second);
+  }
+  *t_out = best;
+  return !hits.empty();
+}
+
+// The ball's walls: a hand that meets walls and slides along them, the wall it rests on excluded (as the
+// contact solver's edge contact does), is answered on most ticks near a wall without a full query (the plain
+// free-space ball there is only as large as the gap to the wall), and every answer, hit or clear, and the
+// segment hit, equals brute force over the level's polylines with the exclusion. Levels and a tolerance step.
+TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
+  std::mt19937 rng(61);
+  const Scene sc = Scene::build(random_scene(rng, 8, 8), 6);
+  BoundarySection section(sc);
+  const int ids[3] = {0, 2, kToleranceLevelBase + 3};
+  std::uniform_real_distribution<double> jitter(-0.0001, 0.0001), drift(-0.0004, 0.0004);
+  std::uniform_int_distribution<int> slide(5, 60);
+  int id = 0, hits = 0, near_walls = 0, near_walls_answered = 0;
+  Vec2 p{0.0, 0.0}, heading{0.0003, 0.0001};
+  SegmentRef resting{};  // the wall slid along (excluded), while `sliding` ticks are left
+  int sliding = 0;
+  std::vector<SegmentRef> near_refs;
+  for (int i = 0; i < 100000; ++i) {
+    if (i % 5000 == 0) id = ids[(i / 5000) % 3];
+    if (rng() % 50 == 0) heading = {drift(rng), drift(rng)};  // a new direction now and then
+    Vec2 move = heading + Vec2{jitter(rng), jitter(rng)};
+    if (sliding > 0) {  // along the wall, a little into it or away from it
+      Vec2 w0, w1;
+      sc.segment(resting, &w0, &w1);
+      const Vec2 along = (w1 - w0) * (1.0 / std::max(distance(w0, w1), 1e-12));
+      move = along * (dot(heading, along) >= 0 ? 0.0002 : -0.0002) + Vec2{jitter(rng), jitter(rng)};
+    }
+    const Vec2 q{std::clamp(p.x + move.x, -0.07, 0.07), std::clamp(p.y + move.y, -0.045, 0.045)};
+    const int n_excl = sliding > 0 ? 1 : 0;
+    QueryStats st;
+    const SweepHit h = section.first_hit(p, q, id, &resting, n_excl, QueryBudget{}, &st);
+    double t_ref = 0.0;
+    const bool hit_ref = brute_first_hit_except(sc, p, q, id, &resting, n_excl, &t_ref, &near_refs);
+    ASSERT_EQ(h.hit, hit_ref) << "tick " << i << ", id " << id;
+    if (hit_ref) {
+      ASSERT_NEAR(h.t, t_ref, 1e-9) << "tick " << i << ", id " << id;
+      ASSERT_NE(std::find(near_refs.begin(), near_refs.end(), h.segment), near_refs.end()) << "tick " << i << ": the segment hit";
+    }
+    if (test::brute_closest_distance(sc, q, id) < 0.001) {
+      ++near_walls;
+      near_walls_answered += st.box_tests == 0;  // no section scan: the ball or its walls answered
+    }
+    if (sliding > 0) --sliding;
+    if (h.hit) {  // rest just before the wall and slide along it
+      hits += 1;
+      p = lerp(p, q, std::max(0.0, h.t - 1e-3));
+      resting = h.segment;
+      sliding = slide(rng);
+      heading = Vec2{0.0, 0.0} - heading;  // and then back away from it
+    } else {
+      p = q;
+    }
+  }
+  std::printf("[ info ] sliding hand: %d hits, %d ticks within 1 mm of a wall, %.0f %% of them answered without a full query\n",
+              hits, near_walls, 100.0 * near_walls_answered / std::max(near_walls, 1));
+  EXPECT_GT(hits, 2000);
+  EXPECT_GT(near_walls, 20000);
+  EXPECT_GT(near_walls_answered, near_walls / 2);
+}
+
 TEST(CollisionQuery, ExcludedSegmentIsIgnored) {
   Polyline wall;
   wall.points_m = {{-0.02, 0.0}, {0.02, 0.0}};

@@ -252,16 +252,21 @@ class BoundarySection {
   std::uint32_t wall_ancestor(std::uint32_t node, int level) const noexcept;
   bool at_floor(std::uint32_t node, int level) const noexcept;
   bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
+  bool answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, SweepHit* out,
+                              QueryStats* stats) const noexcept;
   void next_tick() noexcept;
   void clip_section(Query& q);
   std::size_t scan_section_rects(const Query& q);
   void mark_near_rects(double bound_sq, std::size_t skip);
   void refine_candidates(Query& q);
   bool push_hit_children(Query& q, std::uint32_t node, int& top);
+  static constexpr int kDirectLevels = kWideItemLevel;  // a box this near its walls has them tested at once (8 at most)
+  std::uint32_t segments_under(std::uint32_t node, int level, std::uint32_t* first) const noexcept;
   bool test_segments_under(Query& q, std::uint32_t node);
   void test_segment(Query& q, std::uint32_t node);
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
+  void gather_ball_walls(const Query& q) noexcept;
   void compact_section(Query& q);
   void drop_departed_entries() noexcept;
   SweepHit finish(Query& q) const;
@@ -338,6 +343,20 @@ class BoundarySection {
   Vec2 ball_center_m_;          // free-space ball: no box of the section as last scanned, so no wall, comes closer to its centre than its radius
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
   int ball_levels_[2] = {-1, -1};  // the level ids whose walls the ball was proven clear of
+  // The ball's walls (gather_ball_walls): a larger ball, around the same centre, whose every wall of one level id
+  // is known, so a sweep inside it is answered exactly by testing those walls alone. 1 248 bytes.
+  static constexpr int kMaxBallWalls = 16;
+  struct BallWalls {
+    Vec2 center_m;
+    double radius_m = 0.0;  // [m]; 0 = none
+    int level = -1;         // the level id whose walls these are
+    int count = 0;          // walls [0, kMaxBallWalls]
+    Vec2 p0_m[kMaxBallWalls], p1_m[kMaxBallWalls];  // each wall's end points [m]
+    Aabb rect_m[kMaxBallWalls];                     // and the rectangle around them [m]
+    SegmentRef ref[kMaxBallWalls];
+  };
+  static_assert(sizeof(BallWalls) == 1248, "BallWalls: the byte count in its comment");
+  BallWalls ball_walls_;
   Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of any level) comes closer
   double wide_ball_radius_m_ = 0.0;  // [m]; 0 = unknown
   std::uint32_t wide_ball_seed_ = kWideEmpty;  // the last walk's nearest item rectangle: wide node << 2 | slot
