@@ -284,13 +284,29 @@ bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const Se
   const double r_sq = w.radius_m * w.radius_m;
   const Vec2 da = a - w.center_m, db = b - w.center_m;
   if (!(dot(da, da) < r_sq && dot(db, db) < r_sq)) return false;
+  // The walls whose rectangle meets the sweep's (the rectangles apart: no common point), as a bit mask, two
+  // walls per step (a slot past count meets nothing that counts: the mask drops it).
   const Aabb sweep{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
+  unsigned meets = 0;
+  for (int k = 0; k < w.count; k += 2) {
+#if defined(__SSE2__)
+    const __m128d lx = _mm_load_pd(w.lo_x + k), ly = _mm_load_pd(w.lo_y + k), hx = _mm_load_pd(w.hi_x + k), hy = _mm_load_pd(w.hi_y + k);
+    const __m128d m = _mm_and_pd(_mm_and_pd(_mm_cmple_pd(lx, _mm_set1_pd(sweep.hi.x)), _mm_cmple_pd(_mm_set1_pd(sweep.lo.x), hx)),
+                                 _mm_and_pd(_mm_cmple_pd(ly, _mm_set1_pd(sweep.hi.y)), _mm_cmple_pd(_mm_set1_pd(sweep.lo.y), hy)));
+    meets |= static_cast<unsigned>(_mm_movemask_pd(m)) << k;
+#else
+    for (int i = k; i < k + 2; ++i) {
+      meets |= (w.lo_x[i] <= sweep.hi.x && sweep.lo.x <= w.hi_x[i] && w.lo_y[i] <= sweep.hi.y && sweep.lo.y <= w.hi_y[i] ? 1u : 0u) << i;
+    }
+#endif
+  }
+  meets &= (1u << w.count) - 1u;
   SweepHit best;
   best.t = std::numeric_limits<double>::infinity();
   std::int32_t tested = 0;
   int coarsest = 0;
-  for (int k = 0; k < w.count; ++k) {
-    if (!overlaps(w.rect_m[k], sweep, 0.0)) continue;  // the rectangles apart: no common point
+  for (; meets != 0; meets &= meets - 1) {
+    const int k = __builtin_ctz(meets);
     bool skip = false;
     for (int e = 0; e < excluded_count; ++e) skip = skip || excluded[e] == w.ref[k];
     if (skip) continue;
@@ -696,8 +712,10 @@ void BoundarySection::gather_ball_walls(const Query& q) noexcept {
     for (std::uint32_t i = 0; i < count; ++i) {
       const int k = w.count++;
       sc.segment_points(first + i, &w.p0_m[k], &w.p1_m[k]);
-      w.rect_m[k] = Aabb{{std::min(w.p0_m[k].x, w.p1_m[k].x), std::min(w.p0_m[k].y, w.p1_m[k].y)},
-                         {std::max(w.p0_m[k].x, w.p1_m[k].x), std::max(w.p0_m[k].y, w.p1_m[k].y)}};
+      w.lo_x[k] = std::min(w.p0_m[k].x, w.p1_m[k].x);
+      w.lo_y[k] = std::min(w.p0_m[k].y, w.p1_m[k].y);
+      w.hi_x[k] = std::max(w.p0_m[k].x, w.p1_m[k].x);
+      w.hi_y[k] = std::max(w.p0_m[k].y, w.p1_m[k].y);
       w.ref[k] = SegmentRef{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index + i)};
     }
   }

@@ -352,9 +352,11 @@ class BoundarySection {
     int level = -1;         // the level id whose walls these are
     int count = 0;          // walls [0, kMaxBallWalls]
     Vec2 p0_m[kMaxBallWalls], p1_m[kMaxBallWalls];  // each wall's end points [m]
-    Aabb rect_m[kMaxBallWalls];                     // and the rectangle around them [m]
+    // the rectangle around them [m], as four arrays: answer_from_ball_walls tests two per SSE2 instruction
+    alignas(16) double lo_x[kMaxBallWalls] = {}, lo_y[kMaxBallWalls] = {}, hi_x[kMaxBallWalls] = {}, hi_y[kMaxBallWalls] = {};
     SegmentRef ref[kMaxBallWalls];
   };
+  static_assert(kMaxBallWalls % 2 == 0 && kMaxBallWalls <= 31, "BallWalls: tested in pairs, as bits of an unsigned");
   static_assert(sizeof(BallWalls) == 1248, "BallWalls: the byte count in its comment");
   BallWalls ball_walls_;
   Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of any level) comes closer
