@@ -20,7 +20,12 @@
 /// Between full queries a free-space ball answers at once: a full query measures how far the end of
 /// its sweep is from the nearest box of the section (as it scanned it, before that tick's splits and
 /// merges: those boxes cover the same walls), and a later sweep wholly inside that distance cannot hit
-/// anything (seed §3 suggests scheduling box updates from box distances).
+/// anything (seed §3 suggests scheduling box updates from box distances). Near a wall that ball is only as
+/// large as the gap, so a full query also copies out the walls under its nearest section entries (up to 16,
+/// from segment boxes within 3 levels of their walls) with a second, larger ball around the same centre,
+/// reaching to the nearest entry left out: a sweep of that level id inside it is answered exactly by testing
+/// those walls alone (a hand resting on or sliding along a wall). First hits of equal t go to the smallest
+/// (curve, level, segment), so no answer depends on which path gave it.
 /// The section serves the level ids of the last two queries (the contact solver renders two levels in turn
 /// while it changes level): its entries stay at or above the walls of both, and a change of id keeps it
 /// (entries below the new id's walls give way to their ancestors at them).
