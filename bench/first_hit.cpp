@@ -15,7 +15,7 @@
 //        BM_Cut/<method>/<step>/<picture> — the same at the tolerance cut of a step (ours: first_hit_cut; the
 //                                           peers over the cut's joined pieces, bench::cut_segments)
 // Counters: p50_ns, p99_ns, max_ns per query; clock_ns, net_mean_ns; batch_mean_ns (not for brute); build_ms; bytes_per_segment; segments; max_error_mm; for
-//           ours and ours_wide, full_query_fraction (queries the free-space ball did not answer),
+//           ours and ours_wide, full_query_fraction (queries neither the free-space ball nor its walls answered),
 //           section_entries (mean boundary-section size after a query; 0 for ours_wide), box_tests and
 //           segment_tests (per query).
 #include <benchmark/benchmark.h>
@@ -259,7 +259,7 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     hits += hit;
     seg_tests += static_cast<std::size_t>(st.segment_tests);
     box_tests += static_cast<std::size_t>(st.box_tests);
-    full += st.box_tests > 0;  // a full query (not answered by the free-space ball)
+    full += st.box_tests > 0;  // a full query (not answered by the free-space ball or its walls)
     section += static_cast<std::size_t>(st.section_size);
     benchmark::DoNotOptimize(hit);
   }

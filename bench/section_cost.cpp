@@ -12,6 +12,7 @@
 // (checked: the box tests per query agree). Each query is timed on its own with steady_clock, so every figure
 // includes one clock pair (the `clock` line: an empty region timed the same way). Kinds:
 //   ball         answered by the free-space ball (no box test)
+//   walls        answered by the ball's walls (no box test; a few segment tests)
 //   full         every other query; of those:
 //     quiet        no split and no merge
 //     split        at least one split (the section refined toward the sweep; the p99 lives here)
@@ -136,7 +137,8 @@ int main(int argc, char** argv) {
     std::printf("| kind | queries | mean ns | p50 ns | box tests | entries scanned | splits | merges | section | segment tests |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
     const auto full = [](const Sample& s) { return s.st.section_box_tests > 0; };
-    print_row("ball", all, [&](const Sample& s) { return !full(s); });
+    print_row("ball", all, [&](const Sample& s) { return !full(s) && !s.st.ball_walls; });
+    print_row("walls", all, [](const Sample& s) { return s.st.ball_walls; });
     print_row("full", all, full);
     print_row("full: quiet", all, [&](const Sample& s) { return full(s) && s.st.splits == 0 && s.st.merges == 0; });
     print_row("full: split", all, [](const Sample& s) { return s.st.splits > 0; });

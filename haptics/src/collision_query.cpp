@@ -329,6 +329,7 @@ bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const Se
     *stats = QueryStats{};
     stats->segment_tests = tested;
     stats->coarsest_answer_level = coarsest;
+    stats->ball_walls = true;
     stats->section_size = static_cast<std::int32_t>(section_.size());
   }
   *out = best;

@@ -744,7 +744,7 @@ TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
   const int ids[3] = {0, 2, kToleranceLevelBase + 3};
   std::uniform_real_distribution<double> jitter(-0.0001, 0.0001), drift(-0.0004, 0.0004);
   std::uniform_int_distribution<int> slide(5, 60);
-  int id = 0, hits = 0, near_walls = 0, near_walls_answered = 0;
+  int id = 0, hits = 0, near_walls = 0, near_walls_answered = 0, walls_answers = 0;
   Vec2 p{0.0, 0.0}, heading{0.0003, 0.0001};
   SegmentRef resting{};  // the wall slid along (excluded), while `sliding` ticks are left
   int sliding = 0;
@@ -770,6 +770,10 @@ TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
       ASSERT_NEAR(h.t, t_ref, 1e-9) << "tick " << i << ", id " << id;
       ASSERT_NE(std::find(near_refs.begin(), near_refs.end(), h.segment), near_refs.end()) << "tick " << i << ": the segment hit";
     }
+    if (st.ball_walls) {
+      ++walls_answers;
+      ASSERT_EQ(st.box_tests, 0) << "tick " << i << ": the walls answer without a box test";
+    }
     if (test::brute_closest_distance(sc, q, id) < 0.001) {
       ++near_walls;
       near_walls_answered += st.box_tests == 0;  // no section scan: the ball or its walls answered
@@ -785,11 +789,12 @@ TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
       p = q;
     }
   }
-  std::printf("[ info ] sliding hand: %d hits, %d ticks within 1 mm of a wall, %.0f %% of them answered without a full query\n",
-              hits, near_walls, 100.0 * near_walls_answered / std::max(near_walls, 1));
+  std::printf("[ info ] sliding hand: %d hits, %d ticks within 1 mm of a wall, %.0f %% of them answered without a full query; "
+              "%d answers by the ball's walls\n", hits, near_walls, 100.0 * near_walls_answered / std::max(near_walls, 1), walls_answers);
   EXPECT_GT(hits, 2000);
   EXPECT_GT(near_walls, 20000);
   EXPECT_GT(near_walls_answered, near_walls / 2);
+  EXPECT_GT(walls_answers, near_walls / 4);
 }
 
 TEST(CollisionQuery, ExcludedSegmentIsIgnored) {
