@@ -135,6 +135,8 @@ class BoundarySection {
   /// ignoring up to kMaxExcluded segments (the contact solver's active constraints). Updates the
   /// boundary section, which serves this id and the previous query's (splits stop at the coarser of the
   /// two; a new id coarsens the entries below its walls, O(section entries), O(levels) each at a cut step).
+  /// Of walls hit at the same t, the answer is the smallest (curve, level, segment). A sweep inside the free-space
+  /// ball, or inside the ball of its walls (at most 16 segment tests), is answered without a box test.
   /// Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                      QueryBudget& budget, QueryStats* stats = nullptr);
