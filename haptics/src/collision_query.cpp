@@ -68,6 +68,14 @@ inline bool closer(double d, SegmentRef s, double best_d, SegmentRef best_s) {
   return s.segment < best_s.segment;
 }
 
+// True when s is one of the count segments at excluded (the walls a query leaves out: edge contact's).
+inline bool is_excluded(SegmentRef s, const SegmentRef* excluded, int count) {
+  for (int i = 0; i < count; ++i) {
+    if (excluded[i] == s) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 // at_target_level, and for a cut step the cut's own segments. A walk comes down from the roots and stops at
@@ -189,6 +197,8 @@ void BoundarySection::reset() {
   ball_radius_m_ = 0.0;
   ball_walls_.radius_m = 0.0;
   ball_walls_.count = 0;
+  ball_walls_.runs = 0;
+  ball_walls_.copied = false;
   wide_ball_radius_m_ = 0.0;
   wide_ball_seed_ = kWideEmpty;
   if (scene_->curve_count() == 0) return;
@@ -230,7 +240,7 @@ struct BoundarySection::Query {
   std::size_t nearest_rect = 0;  // of which the one whose rectangle is nearest to b (scanned when none)
 
   Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded, QueryBudget& shared_budget)
-      : a(a_m), b(b_m), sweep{{std::min(a_m.x, b_m.x), std::min(a_m.y, b_m.y)}, {std::max(a_m.x, b_m.x), std::max(a_m.y, b_m.y)}},
+      : a(a_m), b(b_m), sweep(rect_of(a_m, b_m)),
         level(target_level), excluded(excluded_segments), excluded_count(n_excluded), budget(&shared_budget) {
     best.t = std::numeric_limits<double>::infinity();  // no exact hit yet
     best.point_m = b_m;
@@ -254,12 +264,7 @@ struct BoundarySection::Query {
     st.box_tests += n;
     return true;
   }
-  bool is_excluded(SegmentRef s) const noexcept {
-    for (int i = 0; i < excluded_count; ++i) {
-      if (excluded[i] == s) return true;
-    }
-    return false;
-  }
+  bool is_excluded(SegmentRef s) const noexcept { return hk::is_excluded(s, excluded, excluded_count); }
   // Boxes entered past this cannot hold anything nearer than what is known.
   double horizon() const noexcept { return std::min(best.t, unresolved_t); }
 };
@@ -276,17 +281,19 @@ bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
 
 // The ball's walls (gather_ball_walls) answer a sweep of their level id inside their ball: the first hit among
 // them, excluded ones left out, the same answer a full query gives (every wall within the ball is among them;
-// ties as test_segment). False, with nothing written, for a sweep they cannot answer. Charges no box test.
+// ties as test_segment). False, with nothing written, for a sweep they cannot answer. Charges no box test. The
+// first sweep inside the ball copies the walls (copy_ball_walls).
 bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                                             SweepHit* out, QueryStats* stats) const noexcept {
-  const BallWalls& w = ball_walls_;
+                                             SweepHit* out, QueryStats* stats) noexcept {
+  BallWalls& w = ball_walls_;
   if (level != w.level) return false;
   const double r_sq = w.radius_m * w.radius_m;
   const Vec2 da = a - w.center_m, db = b - w.center_m;
   if (!(dot(da, da) < r_sq && dot(db, db) < r_sq)) return false;
+  if (!w.copied) copy_ball_walls();
   // The walls whose rectangle meets the sweep's (the rectangles apart: no common point), as a bit mask, two
   // walls per step (a slot past count meets nothing that counts: the mask drops it).
-  const Aabb sweep{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}};
+  const Aabb sweep = rect_of(a, b);
   unsigned meets = 0;
   for (int k = 0; k < w.count; k += 2) {
 #if defined(__SSE2__)
@@ -307,9 +314,7 @@ bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const Se
   int coarsest = 0;
   for (; meets != 0; meets &= meets - 1) {
     const int k = __builtin_ctz(meets);
-    bool skip = false;
-    for (int e = 0; e < excluded_count; ++e) skip = skip || excluded[e] == w.ref[k];
-    if (skip) continue;
+    if (is_excluded(w.ref[k], excluded, excluded_count)) continue;
     ++tested;
     coarsest = std::max(coarsest, w.ref[k].level);
     double t = 0.0;
@@ -671,29 +676,30 @@ void BoundarySection::merge_idle_siblings(Query& q) {
 // Phase 5a: the ball's walls, a second free-space ball around the same centre (the end of the sweep) that
 // reaches past the nearest boxes: the section entries nearest to it, in order of their rectangles' distance,
 // while each is a segment box within kDirectLevels of its walls and all their walls fit in kMaxBallWalls, have
-// those walls copied out (seed §3: coherence; the walls under a box are its only walls of the level); the ball's
-// radius is the distance to the nearest entry left out (its box's distance, and no more than the next one's
-// rectangle's, which bounds every farther box from below). Every wall of the level within that radius is then
-// among the copies, so a later sweep inside the ball is answered exactly by them alone (answer_from_ball_walls):
+// those walls noted, as runs copied out when first needed (seed §3: coherence; the walls under a box are its
+// only walls of the level); the ball's radius is the distance to the nearest entry left out (its box's distance,
+// and no more than the next one's rectangle's, which bounds every farther box from below). Every wall of the
+// level within that radius is then among those noted, so a later sweep inside the ball is answered exactly by them alone (answer_from_ball_walls):
 // near a wall, or sliding along one in contact, where the plain ball is as small as the gap to it. Kept only
 // when it reaches farther than the plain ball. The entries as phase 1 scanned them: a box is a box whatever
 // the section became since.
 void BoundarySection::gather_ball_walls(const Query& q) noexcept {
-  constexpr int kNearest = 6;  // entries considered, nearest first
   BallWalls& w = ball_walls_;
   w.radius_m = 0.0;
   w.count = 0;
+  w.runs = 0;
+  w.copied = false;
   const std::size_t n = q.scanned;
   std::uint32_t unused = 0;
   if (q.nearest_rect >= n || segments_under(section_[q.nearest_rect], q.level, &unused) == 0) return;  // no walls to copy
-  // The kNearest entries with the nearest rectangles, in order (insertion; a section holds ~20 entries).
-  std::uint32_t near_entry[kNearest];
-  double near_d_sq[kNearest];
+  // The kBallWallEntries entries with the nearest rectangles, in order (insertion; a section holds ~20 entries).
+  std::uint32_t near_entry[kBallWallEntries];
+  double near_d_sq[kBallWallEntries];
   int m = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const double d = rect_d_sq_[i];
-    if (m == kNearest && d >= near_d_sq[kNearest - 1]) continue;
-    int k = m < kNearest ? m++ : kNearest - 1;
+    if (m == kBallWallEntries && d >= near_d_sq[kBallWallEntries - 1]) continue;
+    int k = m < kBallWallEntries ? m++ : kBallWallEntries - 1;
     for (; k > 0 && near_d_sq[k - 1] > d; --k) {
       near_d_sq[k] = near_d_sq[k - 1];
       near_entry[k] = near_entry[k - 1];
@@ -701,24 +707,18 @@ void BoundarySection::gather_ball_walls(const Query& q) noexcept {
     near_d_sq[k] = d;
     near_entry[k] = static_cast<std::uint32_t>(i);
   }
-  const bool all_listed = n <= static_cast<std::size_t>(kNearest);
-  // Copy the walls of the nearest entries while they fit.
+  const bool all_listed = n <= static_cast<std::size_t>(kBallWallEntries);
+  // Note the walls of the nearest entries while they fit (copied when first needed: copy_ball_walls).
   const Scene& sc = *scene_;
   int j = 0;
   for (; j < m; ++j) {
     std::uint32_t first = 0;
     const std::uint32_t count = segments_under(section_[near_entry[j]], q.level, &first);
     if (count == 0 || w.count + static_cast<int>(count) > kMaxBallWalls) break;
-    const NodeInfo in = sc.info(first);  // the walls are consecutive segments of one level of one curve
-    for (std::uint32_t i = 0; i < count; ++i) {
-      const int k = w.count++;
-      sc.segment_points(first + i, &w.p0_m[k], &w.p1_m[k]);
-      w.lo_x[k] = std::min(w.p0_m[k].x, w.p1_m[k].x);
-      w.lo_y[k] = std::min(w.p0_m[k].y, w.p1_m[k].y);
-      w.hi_x[k] = std::max(w.p0_m[k].x, w.p1_m[k].x);
-      w.hi_y[k] = std::max(w.p0_m[k].y, w.p1_m[k].y);
-      w.ref[k] = SegmentRef{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index + i)};
-    }
+    w.run_first[w.runs] = first;
+    w.run_count[w.runs] = count;
+    ++w.runs;
+    w.count += static_cast<int>(count);
   }
   // The radius: nothing left out comes nearer.
   constexpr double kAllWallsRadius_m = 1.0;  // every entry's walls copied: any radius holds; the workspace is smaller
@@ -728,11 +728,34 @@ void BoundarySection::gather_ball_walls(const Query& q) noexcept {
   if (!all_listed) r_sq = std::min(r_sq, near_d_sq[m - 1]);  // entries not listed: their rectangles are no nearer
   if (w.count == 0 || r_sq <= q.nearest_sq) {
     w.count = 0;
+    w.runs = 0;
     return;
   }
   w.center_m = q.b;
   w.radius_m = std::sqrt(r_sq);
   w.level = q.level;
+}
+
+// The ball's walls noted by gather_ball_walls, copied out: each run's consecutive segments (one level of one
+// curve), their end points, rectangles and references, in run order. Reads the scene only here, so a full query
+// whose walls ball no later sweep enters leaves their points where they are (on a large scene, seldom cached).
+void BoundarySection::copy_ball_walls() noexcept {
+  BallWalls& w = ball_walls_;
+  const Scene& sc = *scene_;
+  int k = 0;
+  for (int r = 0; r < w.runs; ++r) {
+    const NodeInfo in = sc.info(w.run_first[r]);
+    for (std::uint32_t i = 0; i < w.run_count[r]; ++i, ++k) {
+      sc.segment_points(w.run_first[r] + i, &w.p0_m[k], &w.p1_m[k]);
+      const Aabb rect = rect_of(w.p0_m[k], w.p1_m[k]);
+      w.lo_x[k] = rect.lo.x;
+      w.lo_y[k] = rect.lo.y;
+      w.hi_x[k] = rect.hi.x;
+      w.hi_y[k] = rect.hi.y;
+      w.ref[k] = SegmentRef{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index + i)};
+    }
+  }
+  w.copied = true;
 }
 
 // Phase 5: the next free-space ball, and when boxes were split or merged, the section without the entries
@@ -916,7 +939,7 @@ void BoundarySection::wide_test_item(Query& q, std::uint32_t item) {
   for (std::uint32_t i = 0; i < count; ++i) {
     Vec2 p0, p1;
     sc.segment_points(first + i, &p0, &p1);
-    const Aabb r{{std::min(p0.x, p1.x), std::min(p0.y, p1.y)}, {std::max(p0.x, p1.x), std::max(p0.y, p1.y)}};
+    const Aabb r = rect_of(p0, p1);
     if (overlaps(r, q.sweep, 0.0)) test_segment(q, first + i);  // the rectangles apart: no common point
   }
 }

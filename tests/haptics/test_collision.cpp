@@ -706,33 +706,6 @@ TEST(CollisionQuery, BoundarySectionStaysSmallOnALongWalk) {
   EXPECT_LE(largest, 1000u);
 }
 
-// Brute-force first hit of a→b over every segment of level id `level` (each curve at Scene::clamp_level) but
-// `excluded`: the smallest sweep parameter (cramer_sweep_hit), and in *near_out every segment hit within
-// 1e-9 of it (a shared vertex is met by two).
-bool brute_first_hit_except(const Scene& sc, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int n_excluded, double* t_out,
-                            std::vector<SegmentRef>* near_out) {
-  std::vector<std::pair<double, SegmentRef>> hits;
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
-    const int l = sc.clamp_level(c, level);
-    for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
-      const SegmentRef ref{static_cast<int>(c), l, static_cast<int>(k)};
-      if (std::find(excluded, excluded + n_excluded, ref) != excluded + n_excluded) continue;
-      Vec2 p, q;
-      sc.segment(ref, &p, &q);
-      double t = 0.0;
-      if (test::cramer_sweep_hit(a, b, p, q, &t)) hits.push_back({t, ref});
-    }
-  }
-  double best = 2.0;
-  for (const auto& h : hits) best = std::min(best, h.first);
-  near_out->clear();
-  for (const auto& h : hits) {
-    if (h.first <= best + 1e-9) near_out->push_back(h.second);
-  }
-  *t_out = best;
-  return !hits.empty();
-}
-
 // The ball's walls: a hand that meets walls and slides along them, the wall it rests on excluded (as the
 // contact solver's edge contact does), is answered on most ticks near a wall without a full query (the plain
 // free-space ball there is only as large as the gap to the wall), and every answer, hit or clear, and the
@@ -764,7 +737,7 @@ TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
     QueryStats st;
     const SweepHit h = section.first_hit(p, q, id, &resting, n_excl, QueryBudget{}, &st);
     double t_ref = 0.0;
-    const bool hit_ref = brute_first_hit_except(sc, p, q, id, &resting, n_excl, &t_ref, &near_refs);
+    const bool hit_ref = test::brute_first_hit(sc, p, q, id, &t_ref, nullptr, &resting, n_excl, &near_refs);
     ASSERT_EQ(h.hit, hit_ref) << "tick " << i << ", id " << id;
     if (hit_ref) {
       ASSERT_NEAR(h.t, t_ref, 1e-9) << "tick " << i << ", id " << id;

@@ -5,6 +5,7 @@
 // bug in the library's own geometry cannot hide itself.
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "haptics/multires.hpp"
@@ -101,26 +102,39 @@ inline bool cramer_sweep_hit(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) {
   return *t >= 0 && *t <= 1 && s >= 0 && s <= 1;
 }
 
-/// Brute-force first hit of a→b over every segment of `level`: smallest sweep parameter (cramer_sweep_hit).
-inline bool brute_first_hit(const Scene& sc, Vec2 a, Vec2 b, int level, double* t_out, SegmentRef* seg_out) {
-  double best = 2.0;
-  bool found = false;
+/// Brute-force first hit of a→b over every segment of level id `level` (each curve at Scene::clamp_level) but
+/// the n_excluded segments at `excluded`: the smallest sweep parameter (cramer_sweep_hit; 2.0 when none) in
+/// *t_out, in *seg_out the first segment hit at it in (curve, level, segment) order, and in *near_out (when
+/// given) every segment hit within 1e-9 of it (a shared vertex is met by two). Any output may be null.
+inline bool brute_first_hit(const Scene& sc, Vec2 a, Vec2 b, int level, double* t_out, SegmentRef* seg_out,
+                            const SegmentRef* excluded = nullptr, int n_excluded = 0, std::vector<SegmentRef>* near_out = nullptr) {
+  std::vector<std::pair<double, SegmentRef>> hits;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const int l = sc.clamp_level(c, level);
     for (std::uint32_t k = 0; k < sc.curve(c).segment_count[l]; ++k) {
-      Vec2 p, q;
       const SegmentRef ref{static_cast<int>(c), l, static_cast<int>(k)};
+      if (n_excluded > 0 && std::find(excluded, excluded + n_excluded, ref) != excluded + n_excluded) continue;
+      Vec2 p, q;
       sc.segment(ref, &p, &q);
       double t = 0.0;
-      if (cramer_sweep_hit(a, b, p, q, &t) && t < best) {
-        best = t;
-        found = true;
-        if (seg_out) *seg_out = ref;
-      }
+      if (cramer_sweep_hit(a, b, p, q, &t)) hits.push_back({t, ref});
+    }
+  }
+  double best = 2.0;
+  for (const auto& h : hits) {
+    if (h.first < best) {
+      best = h.first;
+      if (seg_out) *seg_out = h.second;
+    }
+  }
+  if (near_out) {
+    near_out->clear();
+    for (const auto& h : hits) {
+      if (h.first <= best + 1e-9) near_out->push_back(h.second);
     }
   }
   if (t_out) *t_out = best;
-  return found;
+  return !hits.empty();
 }
 
 /// Distance from p to the nearest segment of any curve at level id `level` (each curve at

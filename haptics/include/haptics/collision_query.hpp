@@ -21,10 +21,10 @@
 /// its sweep is from the nearest box of the section (as it scanned it, before that tick's splits and
 /// merges: those boxes cover the same walls), and a later sweep wholly inside that distance cannot hit
 /// anything (seed §3 suggests scheduling box updates from box distances). Near a wall that ball is only as
-/// large as the gap, so a full query also copies out the walls under its nearest section entries (up to 16,
+/// large as the gap, so a full query also notes the walls under its nearest section entries (up to 16,
 /// from segment boxes within 3 levels of their walls) with a second, larger ball around the same centre,
 /// reaching to the nearest entry left out: a sweep of that level id inside it is answered exactly by testing
-/// those walls alone (a hand resting on or sliding along a wall). First hits of equal t go to the smallest
+/// those walls alone (a hand resting on or sliding along a wall); the first such sweep copies them out. First hits of equal t go to the smallest
 /// (curve, level, segment), so no answer depends on which path gave it.
 /// The section serves the level ids of the last two queries (the contact solver renders two levels in turn
 /// while it changes level): its entries stay at or above the walls of both, and a change of id keeps it
@@ -262,7 +262,8 @@ class BoundarySection {
   bool at_floor(std::uint32_t node, int level) const noexcept;
   bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
   bool answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, SweepHit* out,
-                              QueryStats* stats) const noexcept;
+                              QueryStats* stats) noexcept;
+  void copy_ball_walls() noexcept;
   void next_tick() noexcept;
   void clip_section(Query& q);
   std::size_t scan_section_rects(const Query& q);
@@ -353,20 +354,26 @@ class BoundarySection {
   double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
   int ball_levels_[2] = {-1, -1};  // the level ids whose walls the ball was proven clear of
   // The ball's walls (gather_ball_walls): a larger ball, around the same centre, whose every wall of one level id
-  // is known, so a sweep inside it is answered exactly by testing those walls alone. 1 248 bytes.
+  // is known, so a sweep inside it is answered exactly by testing those walls alone. The full query notes them as
+  // runs of consecutive segments; their points are copied on the first sweep inside the ball (copy_ball_walls),
+  // so a full query whose walls ball is never entered reads none of them. 1 312 bytes.
   static constexpr int kMaxBallWalls = 16;
+  static constexpr int kBallWallEntries = 6;  // section entries whose walls may be copied, nearest first
   struct BallWalls {
     Vec2 center_m;
     double radius_m = 0.0;  // [m]; 0 = none
     int level = -1;         // the level id whose walls these are
     int count = 0;          // walls [0, kMaxBallWalls]
+    int runs = 0;           // runs of walls, one per section entry [0, kBallWallEntries]
+    bool copied = false;    // the arrays below hold the runs' walls
+    std::uint32_t run_first[kBallWallEntries] = {}, run_count[kBallWallEntries] = {};  // each run's first segment node, and its length
     Vec2 p0_m[kMaxBallWalls], p1_m[kMaxBallWalls];  // each wall's end points [m]
     // the rectangle around them [m], as four arrays: answer_from_ball_walls tests two per SSE2 instruction
     alignas(16) double lo_x[kMaxBallWalls] = {}, lo_y[kMaxBallWalls] = {}, hi_x[kMaxBallWalls] = {}, hi_y[kMaxBallWalls] = {};
     SegmentRef ref[kMaxBallWalls];
   };
   static_assert(kMaxBallWalls % 2 == 0 && kMaxBallWalls <= 31, "BallWalls: tested in pairs, as bits of an unsigned");
-  static_assert(sizeof(BallWalls) == 1248, "BallWalls: the byte count in its comment");
+  static_assert(sizeof(BallWalls) == 1312, "BallWalls: the byte count in its comment");
   BallWalls ball_walls_;
   Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of any level) comes closer
   double wide_ball_radius_m_ = 0.0;  // [m]; 0 = unknown

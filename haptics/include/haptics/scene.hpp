@@ -57,6 +57,11 @@ struct Aabb {
 };
 static_assert(sizeof(Aabb) == 32, "Aabb: two per cache line");
 
+/// The rectangle of two points [m] (a segment's, or a sweep's from a to b), grown by grow_m ≥ 0 on every side.
+inline Aabb rect_of(Vec2 a, Vec2 b, double grow_m = 0.0) {
+  return Aabb{{std::min(a.x, b.x) - grow_m, std::min(a.y, b.y) - grow_m}, {std::max(a.x, b.x) + grow_m, std::max(a.y, b.y) + grow_m}};
+}
+
 /// True when two rectangles overlap after growing `a` by margin_m on every side.
 inline bool overlaps(const Aabb& a, const Aabb& b, double margin_m) {
   return a.lo.x - margin_m <= b.hi.x && b.lo.x <= a.hi.x + margin_m && a.lo.y - margin_m <= b.hi.y && b.lo.y <= a.hi.y + margin_m;
@@ -221,7 +226,7 @@ class Scene {
     const BoxExtent& e = extent_[node];
     const int reach = std::max<int>(std::max<int>(-e.u_min, e.u_over), 0) + std::max<int>(std::max<int>(-e.n_min, e.n_max), 0);
     const double r = reach * static_cast<double>(curve_nodes_[tag_curve(node)].quantum_m[tag_level(node)]);
-    return Aabb{{std::min(a.x, b.x) - r, std::min(a.y, b.y) - r}, {std::max(a.x, b.x) + r, std::max(a.y, b.y) + r}};
+    return rect_of(a, b, r);
   }
   /// Axis-aligned rectangle around a node's box [m]: stored for chunks and the hierarchy, computed for
   /// segments (from the box's centre and half-extents, a few ulps wider than its four corners' rectangle).
