@@ -1,6 +1,8 @@
 // Hand-speed aware contact (issue 6, item 5): strokes at 2 m/s at the handle (2 mm per 1 kHz tick)
-// across thin curves and into acute corners (10°, 30°) never tunnel: every sub-move of the proxy is
-// checked with the independent orientation predicate, and the proxy ends every stroke on its own side.
+// across thin curves and into acute corners (10°, 30°) never tunnel, frictionless and with Coulomb
+// friction (the proxy then sticks and slides in its friction cone, each slide a collision-checked move):
+// every sub-move of the proxy is checked with the independent orientation predicate, and the proxy ends
+// every stroke on its own side.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,9 +18,18 @@ namespace {
 constexpr double kSpeed = 2.0;     // [m/s]
 constexpr double kPeriod = 0.001;  // [s]
 
+// The contact parameters the strokes run with: frictionless (the solver's default) and with friction.
+std::vector<ContactParams> contact_variants() {
+  ContactParams with_friction;
+  with_friction.static_friction = 0.4;
+  with_friction.dynamic_friction = 0.3;
+  return {ContactParams{}, with_friction};
+}
+
 // Drives the handle along straight strokes a → b at kSpeed; returns crossings of the level's polylines.
-int stroke_crossings(const Scene& sc, int level, const std::vector<std::pair<Vec2, Vec2>>& strokes, int* contact_ticks) {
-  ContactSolver solver(sc, ContactParams{});
+int stroke_crossings(const Scene& sc, int level, const std::vector<std::pair<Vec2, Vec2>>& strokes, int* contact_ticks,
+                     const ContactParams& params) {
+  ContactSolver solver(sc, params);
   int crossings = 0;
   ContactOutput out;
   for (const auto& [a, b] : strokes) {
@@ -28,6 +39,7 @@ int stroke_crossings(const Scene& sc, int level, const std::vector<std::pair<Vec
     for (int i = 1; i <= n; ++i) {
       ContactInput in;
       in.handle_m = lerp(a, b, static_cast<double>(i) / n);
+      in.handle_velocity_m_per_s = (b - a) * (1.0 / (n * kPeriod));
       in.level = level;
       solver.update(in, out);
       EXPECT_EQ(out.path_m[0], prev);
@@ -69,10 +81,13 @@ TEST(FastStrokes, ThinCurvesAt2MetresPerSecond) {
   }
   for (const std::vector<Polyline>& curves : {std::vector<Polyline>{single}, std::vector<Polyline>{upper, lower}}) {
     const Scene sc = Scene::build(curves, 3);
-    for (int level : {0, 1, 2}) {
-      int contacts = 0;
-      EXPECT_EQ(stroke_crossings(sc, level, strokes_through({0.0, 0.0}, 7), &contacts), 0) << curves.size() << " curves, level " << level;
-      EXPECT_GT(contacts, 1000) << "the strokes must actually hit the curve";
+    for (const ContactParams& cp : contact_variants()) {
+      for (int level : {0, 1, 2}) {
+        int contacts = 0;
+        EXPECT_EQ(stroke_crossings(sc, level, strokes_through({0.0, 0.0}, 7), &contacts, cp), 0)
+            << curves.size() << " curves, level " << level << ", μ_s " << cp.static_friction;
+        EXPECT_GT(contacts, 1000) << "the strokes must actually hit the curve";
+      }
     }
   }
 }
@@ -87,11 +102,13 @@ TEST(FastStrokes, AcuteCornersAt2MetresPerSecond) {
     sliver.points_m = {{0.0, 0.0}, {-0.03 * std::cos(half), 0.03 * std::sin(half)}, {-0.03 * std::cos(half), -0.03 * std::sin(half)}};
     for (const Polyline& p : {v, sliver}) {
       const Scene sc = Scene::build({p}, 0);
-      int contacts = 0;
-      // Through the apex, and through a point 5 mm inside the wedge where the walls are 0.9–2.6 mm apart.
-      EXPECT_EQ(stroke_crossings(sc, 0, strokes_through({0.0, 0.0}, 11), &contacts), 0) << deg << "° apex";
-      EXPECT_EQ(stroke_crossings(sc, 0, strokes_through({-0.005, 0.0}, 13), &contacts), 0) << deg << "° inside";
-      EXPECT_GT(contacts, 200) << "the strokes must actually hit the walls";
+      for (const ContactParams& cp : contact_variants()) {
+        int contacts = 0;
+        // Through the apex, and through a point 5 mm inside the wedge where the walls are 0.9–2.6 mm apart.
+        EXPECT_EQ(stroke_crossings(sc, 0, strokes_through({0.0, 0.0}, 11), &contacts, cp), 0) << deg << "° apex, μ_s " << cp.static_friction;
+        EXPECT_EQ(stroke_crossings(sc, 0, strokes_through({-0.005, 0.0}, 13), &contacts, cp), 0) << deg << "° inside, μ_s " << cp.static_friction;
+        EXPECT_GT(contacts, 200) << "the strokes must actually hit the walls";
+      }
     }
   }
 }
