@@ -88,6 +88,9 @@
 //                region, where the proxy has no way round the shape) and yet the state is Free.
 // A control run with a proxy glued to the handle (a renderer blind to walls) must be counted as failing
 // on every stroke, or the program stops: a checker that never fires proves nothing.
+// Part 2b (JSON "auto_levels"): the kinematic strokes again with the shipped auto levels (the level from
+// hand speed, issue 6), push-through still off, each sub-move checked against the polylines of the level
+// ids the proxy rendered that tick (auto_level_stroke).
 // The god-object keeps its proxy on its side of every polyline by construction (Zilles & Salisbury
 // 1995, "A constraint-based god-object method for haptic display", IROS); part 2 measures that at speeds
 // where a penalty method, which pushes the handle towards the nearest wall, pops through thin walls.
@@ -705,6 +708,7 @@ struct StrokeScene {
   std::function<bool(Vec2)> behind;    // where a handle is unambiguously behind the shape (see make_stroke_scenes)
   Scene scene;
   Segments segs;
+  std::vector<Segments> level_segs;    // every level id's segments (each curve at Scene::clamp_level), for part 2b
   std::vector<Stroke> strokes;         // kinematic strokes
   std::vector<Stroke> device_strokes;  // device strokes (a longer run-up where the shape allows it)
 };
@@ -729,6 +733,7 @@ std::vector<StrokeScene> make_stroke_scenes() {
     s.behind = behind;
     s.scene = Scene::build(curves, max_levels);
     s.segs = level_segments(s.scene, kTunnelLevel);
+    for (int l = 0; l < max_levels; ++l) s.level_segs.push_back(level_segments(s.scene, l));
     for (const auto* v : {&s.strokes, &s.device_strokes}) {
       for (const Stroke& st : *v) {
         if (!behind(st.end_m) || s.segs.crossings(st.start_m, st.end_m) == 0) {
@@ -895,12 +900,73 @@ struct TickChecker {
 /// presses that long). Both were default-off when part 2 was written; since they shipped on (issue 6 and
 /// issue 14), part 2 sets them off itself, so it measures what it says: whether the proxy ever crosses
 /// the wall it renders.
-ServoParams stroke_servo_params() {
+/// auto_levels: the shipped level_mode "auto" instead (part 2b), push-through still off.
+ServoParams stroke_servo_params(bool auto_levels = false) {
   config::Settings s;
-  s.haptics.level_mode = "fixed";
-  s.haptics.level = kTunnelLevel;
+  if (!auto_levels) {
+    s.haptics.level_mode = "fixed";
+    s.haptics.level = kTunnelLevel;
+  }
   s.haptics.pop_force_n = 0.0;
   return app::servo_params_from(s);
+}
+
+/// Part 2b's tally: the kinematic strokes with the shipped auto levels.
+struct AutoLevelTally {
+  int strokes = 0;
+  int ticks = 0;
+  int tunnel_ticks = 0;       // ticks with a proxy sub-move crossing a polyline of a level id rendered that tick
+  int strokes_tunnelled = 0;  // strokes with a tunnel tick, or ending on the far side of the final level's polyline
+  int contact_ticks = 0;
+  int level_changes = 0;
+  double level_sum = 0.0;     // sum over ticks of the level in use (for the mean)
+  void add(const AutoLevelTally& o) {
+    strokes += o.strokes; ticks += o.ticks; tunnel_ticks += o.tunnel_ticks; strokes_tunnelled += o.strokes_tunnelled;
+    contact_ticks += o.contact_ticks; level_changes += o.level_changes; level_sum += o.level_sum;
+  }
+};
+
+/// Part 2b: a kinematic stroke (as kinematic_stroke) with the shipped auto levels, push-through off. Each
+/// tick's proxy sub-moves are checked against the polylines of the level ids the proxy rendered that tick:
+/// the level in use (ServoOutput::level) and, while a change is in transition, the previous one
+/// (ContactOutput::transition_level), both walls then; the final proxy against the final level's polyline.
+/// No missed-contact rule here: a coarser level's wall lies up to its error from the level-0 polyline, so
+/// "clearly past the wall" would depend on the level.
+AutoLevelTally auto_level_stroke(const StrokeScene& sc, const Stroke& st, double speed_m_per_s) {
+  const ServoParams sp = stroke_servo_params(true);
+  ServoLoop servo(sc.scene, sp);
+  servo.start(st.start_m);
+  const double len = distance(st.start_m, st.end_m);
+  const Vec2 dir = (1.0 / len) * (st.end_m - st.start_m);
+  const long move_ticks = static_cast<long>(std::ceil(len / (speed_m_per_s * sp.period_s)));
+  const long dwell_ticks = 30;
+  const auto segs_of = [&](int id) -> const Segments& { return sc.level_segs[static_cast<std::size_t>(std::clamp<int>(id, 0, static_cast<int>(sc.level_segs.size()) - 1))]; };
+  AutoLevelTally t;
+  bool any_tunnel = false;
+  ServoOutput so;
+  for (long k = 1; k <= move_ticks + dwell_ticks; ++k) {
+    const double s = std::min(len, static_cast<double>(k) * speed_m_per_s * sp.period_s);
+    ServoInput in;
+    in.sample.handle_m = st.start_m + s * dir;
+    in.sample.status = DeviceStatus::Ok;
+    in.sample.time_ns = static_cast<std::int64_t>(k * 1000000);
+    servo.update(in, so);
+    ++t.ticks;
+    t.level_sum += so.level;
+    t.level_changes += so.level_changed;
+    t.contact_ticks += so.contact.state != ContactState::Free;
+    bool tunnel = false;
+    for (int i = 0; i + 1 < so.contact.path_count; ++i) {
+      const Vec2 p = so.contact.path_m[i], q = so.contact.path_m[i + 1];
+      if (segs_of(so.level).crossings(p, q) > 0) tunnel = true;
+      if (so.contact.transition_level >= 0 && segs_of(so.contact.transition_level).crossings(p, q) > 0) tunnel = true;
+    }
+    t.tunnel_ticks += tunnel;
+    any_tunnel = any_tunnel || tunnel;
+  }
+  ++t.strokes;
+  t.strokes_tunnelled += any_tunnel || (segs_of(so.level).crossings(st.start_m, so.contact.proxy_m) % 2) == 1;
+  return t;
 }
 
 /// A stroke with the ServoLoop alone: the handle is exactly on the stroke every tick.
@@ -1074,6 +1140,40 @@ json run_part2(bool quick) {
     }
   }
   out["control_wall_blind_proxy"] = control;
+  // Part 2b: the kinematic strokes again with the shipped auto levels.
+  struct AutoJob {
+    std::size_t scene;
+    double speed_m_per_s;
+    AutoLevelTally tally;
+  };
+  std::vector<AutoJob> auto_jobs;
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    for (double v : speeds) auto_jobs.push_back(AutoJob{i, v, {}});
+  }
+  parallel_for(auto_jobs.size(), [&](std::size_t j) {
+    AutoJob& job = auto_jobs[j];
+    for (const Stroke& st : scenes[job.scene].strokes) job.tally.add(auto_level_stroke(scenes[job.scene], st, job.speed_m_per_s));
+  });
+  json auto_scenes = json::array();
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    json rows = json::array();
+    int failing = 0;
+    for (const AutoJob& job : auto_jobs) {
+      if (job.scene != i) continue;
+      const AutoLevelTally& t = job.tally;
+      failing += t.strokes_tunnelled;
+      rows.push_back({{"speed_m_per_s", sig4(job.speed_m_per_s)}, {"strokes", t.strokes}, {"ticks", t.ticks}, {"tunnel_ticks", t.tunnel_ticks},
+                      {"strokes_tunnelled", t.strokes_tunnelled}, {"contact_ticks", t.contact_ticks}, {"level_changes", t.level_changes},
+                      {"mean_level", sig4(t.ticks > 0 ? t.level_sum / t.ticks : 0.0)}});
+    }
+    std::fprintf(stderr, "  %-14s auto levels, failing strokes: kinematic %d\n", scenes[i].name.c_str(), failing);
+    auto_scenes.push_back({{"name", scenes[i].name}, {"kinematic", rows}});
+  }
+  out["auto_levels"] = {{"level_mode", "auto"},
+                        {"pop_force_n", 0.0},
+                        {"rule", "a proxy sub-move crosses a segment of the level id in use or of the previous one while a change is in "
+                                 "transition, or the final proxy is on the far side of the final level's polyline; no missed-contact rule"},
+                        {"scenes", auto_scenes}};
   json jscenes = json::array();
   double first_fail_kin = 0.0, first_fail_dev = 0.0;
   for (std::size_t i = 0; i < scenes.size(); ++i) {

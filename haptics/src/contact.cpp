@@ -13,7 +13,7 @@ ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params, st
     : scene_(&scene), params_(params), section_(scene, 3e-4, std::move(cuts)) {
   for (int id = 0; id < kLevelIds; ++id) {  // a cut step without the masks renders as its tolerance step, as Scene gives it
     const bool cut = is_cut_level(id) && section_.has_cuts();
-    max_half_width_m_[id] = cut ? 2.0 * section_.cut_bounds().half_width_m[tolerance_step_of(id)] : scene.max_box_half_width_m(id);
+    max_wall_offset_m_[id] = cut ? 2.0 * section_.cut_bounds().error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
   }
 }
 
@@ -124,9 +124,9 @@ int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, 
 bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) {
   if (new_level == level_) return true;
   if (transition_level_ >= 0) return false;  // one change at a time
-  // A curve's polylines at two levels lie within E = (largest error-box half-width at one level + at the
-  // other) of each other, so a point between them lies within E of both; search twice as far.
-  const double e = max_half_width_m_[std::clamp(level_, 0, kLevelIds - 1)] + max_half_width_m_[std::clamp(new_level, 0, kLevelIds - 1)];
+  // A curve's polylines at two levels lie within E = (largest wall offset at one level + at the other) of
+  // each other, so a point between them lies within E of both; search twice as far.
+  const double e = max_wall_offset_m_[std::clamp(level_, 0, kLevelIds - 1)] + max_wall_offset_m_[std::clamp(new_level, 0, kLevelIds - 1)];
   const double radius = 2.0 * e + 4.0 * params_.skin_m;
   // The curves that could have the proxy between their two levels: those it touches, and every curve within
   // the radius at either level, found nearest first by closest points that skip the curves found so far.

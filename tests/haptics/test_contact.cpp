@@ -195,3 +195,41 @@ TEST(Contact, StartOnAWallIsPushedOff) {
   EXPECT_EQ(out.state, ContactState::Edge);
   EXPECT_EQ(out.proxy_m.y > 0, solver.proxy().y > 0);
 }
+
+// A level change at a sharp corner (found by bench_stability's strokes with auto levels): a coarse level
+// rounds a 30° wedge's apex off, so its apex lies 1.4 mm inside the original's, farther from it than any
+// error box is wide: the original runs on past the coarse segment's end, inside the box's reach past it, not
+// across it. A proxy held in the apex at level 2 is behind the coarser levels' polylines there, so a change
+// to any of them must wait. Judged independently: the parity of crossings of each level's polyline on the
+// line from a point deep inside the wedge to the proxy.
+TEST(Contact, NoLevelChangePutsTheProxyBehindACoarserApex) {
+  const double half = 15.0 * M_PI / 180.0;
+  const Vec2 apex{0.01, 0.0}, arm_a{-std::cos(half), std::sin(half)}, arm_b{-std::cos(half), -std::sin(half)};
+  Polyline v;
+  for (int i = 100; i >= 1; --i) v.points_m.push_back(apex + (0.05 * i / 100.0) * arm_a);
+  v.points_m.push_back(apex);
+  for (int i = 1; i <= 100; ++i) v.points_m.push_back(apex + (0.05 * i / 100.0) * arm_b);
+  const Scene sc = Scene::build({v}, 7);
+  ContactSolver solver(sc, ContactParams{});
+  const int held = 2;
+  const Vec2 inside{-0.02, 0.000037};
+  solver.reset(inside, held);
+  ContactOutput out;
+  for (int k = 1; k <= 200; ++k) {  // into the apex and 10 mm past it, 0.2 mm a tick
+    ContactInput in;
+    in.handle_m = inside + Vec2{0.0002 * k, 0.0};
+    in.level = held;
+    solver.update(in, out);
+  }
+  ASSERT_EQ(out.state, ContactState::Vertex) << "the proxy is held in the apex";
+  ASSERT_EQ(test::count_crossings(sc, inside, solver.proxy(), held) % 2, 0) << "on the inside of the level it renders";
+  int behind = 0;
+  for (int level = 0; level < sc.curve(0).levels; ++level) {
+    const bool same_side = test::count_crossings(sc, inside, solver.proxy(), level) % 2 == 0;
+    behind += !same_side;
+    if (!same_side) {
+      EXPECT_FALSE(solver.level_change_is_safe(level)) << "level " << level << ": the proxy is behind its apex";
+    }
+  }
+  EXPECT_GT(behind, 0) << "some coarser level's apex lies inside the proxy, or the test tests nothing";
+}

@@ -155,8 +155,10 @@ class ContactSolver {
   /// (closest point and pseudo-normal, see side_of_curve); a curve on which the sides differ has the proxy
   /// between its two polylines, and the change must wait (the caller tries again next tick; as the hand
   /// moves on, the two levels' polylines cross each other and the sides agree again). Points between two
-  /// levels lie within E = (largest error-box half-width of the old level + of the new) of both polylines,
-  /// so only curves within 2E are searched (until 2026-11-26 only the nearest curve at each level was, and a
+  /// levels lie within E = (largest wall offset of the old level + of the new: the boxes' error bound, their
+  /// half-width combined with their reach past their segments' ends, which at a sharp corner is the larger;
+  /// until 2026-11-26 the half-width alone, and a coarse level's apex could lie behind the proxy unseen) of
+  /// both polylines, so only curves within 2E are searched (until 2026-11-26 only the nearest curve at each level was, and a
   /// second curve as near, where two edges cross, could have the proxy between its levels unseen). When the change is made (the next update() with the new level),
   /// the old level stays a wall, with the proxy's constraints on it, until the proxy rests on none of its
   /// segments: the proxy, on the same side of both polylines, then reaches the new one without crossing
@@ -164,7 +166,7 @@ class ContactSolver {
   /// closest-point walks). With a `budget`, the walks' box tests are charged to it and never take it past
   /// its limit: when it runs out before the answer is known, the answer is false (the change waits).
   /// Levels, tolerance steps and cut steps mix freely (level ids, hk/constants.hpp): each curve is compared
-  /// at its own polyline for each id (a cut step's: its joined cut, where E takes twice the cut's widest box,
+  /// at its own polyline for each id (a cut step's: its joined cut, where E takes twice the cut's error bound,
   /// as a joined piece may lie anywhere in its box), and a curve with the same polyline under both has nothing
   /// between them. At a cut step a segment's ends depend on its neighbours in the cut, so a constraint keeps
   /// the level id it was met at (its geometry), and the wall the proxy slides on is left out only of the
@@ -241,10 +243,12 @@ class ContactSolver {
   Vec2 release_from_n_;        // the force of the tick before the last pop [N]
   long release_left_ = 0;      // ticks of its fade still to go
   Vec2 last_force_n_;          // the force of the last tick [N]
-  // Per level id: how far its walls can lie from the original curve, across it [m]: for a level or tolerance
-  // step, the largest error-box half-width of any curve (the wall is its boxes' axis); for a cut step, twice
-  // the widest box of its cut (a joined piece may lie anywhere in its box).
-  double max_half_width_m_[kLevelIds] = {};
+  // Per level id: how far its walls can lie from the original curve [m]: for a level or tolerance step, the
+  // largest error bound of any curve's boxes (Scene::max_error_bound_m: the half-width combined with how far a
+  // box reaches past its segment's ends; at a sharp corner the original runs on past a coarse segment's end,
+  // so the half-width alone was too small and a change of level could put the proxy behind the new level's
+  // apex); for a cut step, twice its cut's error bound (a joined piece may lie anywhere in its box).
+  double max_wall_offset_m_[kLevelIds] = {};
   // Side of p relative to curve `curve`'s polyline at `level`: +1 left, −1 right, 0 when the polyline is not
   // within radius_m, 2 when p lies on it, 3 when `budget` ran out first. Where the nearest point is an open end,
   // the side of the end segment's line: beyond the end, the wedge between two levels' end segments then has
