@@ -911,6 +911,30 @@ ServoParams stroke_servo_params(bool auto_levels = false) {
   return app::servo_params_from(s);
 }
 
+/// The handle of a kinematic stroke: moved along the stroke at speed_m_per_s, one sample per servo period,
+/// then parked at its end for kDwellTicks (the proxy must stay put with the handle parked past the wall).
+struct KinematicPath {
+  static constexpr long kDwellTicks = 30;
+  KinematicPath(const Stroke& st, double speed, double period)
+      : start(st.start_m), len(distance(st.start_m, st.end_m)), dir((1.0 / len) * (st.end_m - st.start_m)),
+        speed_m_per_s(speed), period_s(period), move_ticks(static_cast<long>(std::ceil(len / (speed * period)))) {}
+  long ticks() const { return move_ticks + kDwellTicks; }
+  /// The device sample of tick k, k in [1, ticks()].
+  ServoInput input(long k) const {
+    ServoInput in;
+    in.sample.handle_m = start + std::min(len, static_cast<double>(k) * speed_m_per_s * period_s) * dir;
+    in.sample.status = DeviceStatus::Ok;
+    in.sample.time_ns = static_cast<std::int64_t>(k * 1000000);
+    return in;
+  }
+  Vec2 start;
+  double len;
+  Vec2 dir;
+  double speed_m_per_s;
+  double period_s;
+  long move_ticks;
+};
+
 /// Part 2b's tally: the kinematic strokes with the shipped auto levels.
 struct AutoLevelTally {
   int strokes = 0;
@@ -936,21 +960,13 @@ AutoLevelTally auto_level_stroke(const StrokeScene& sc, const Stroke& st, double
   const ServoParams sp = stroke_servo_params(true);
   ServoLoop servo(sc.scene, sp);
   servo.start(st.start_m);
-  const double len = distance(st.start_m, st.end_m);
-  const Vec2 dir = (1.0 / len) * (st.end_m - st.start_m);
-  const long move_ticks = static_cast<long>(std::ceil(len / (speed_m_per_s * sp.period_s)));
-  const long dwell_ticks = 30;
+  const KinematicPath path(st, speed_m_per_s, sp.period_s);
   const auto segs_of = [&](int id) -> const Segments& { return sc.level_segs[static_cast<std::size_t>(std::clamp<int>(id, 0, static_cast<int>(sc.level_segs.size()) - 1))]; };
   AutoLevelTally t;
   bool any_tunnel = false;
   ServoOutput so;
-  for (long k = 1; k <= move_ticks + dwell_ticks; ++k) {
-    const double s = std::min(len, static_cast<double>(k) * speed_m_per_s * sp.period_s);
-    ServoInput in;
-    in.sample.handle_m = st.start_m + s * dir;
-    in.sample.status = DeviceStatus::Ok;
-    in.sample.time_ns = static_cast<std::int64_t>(k * 1000000);
-    servo.update(in, so);
+  for (long k = 1; k <= path.ticks(); ++k) {
+    servo.update(path.input(k), so);
     ++t.ticks;
     t.level_sum += so.level;
     t.level_changes += so.level_changed;
@@ -976,19 +992,12 @@ StrokeTally kinematic_stroke(const StrokeScene& sc, const Stroke& st, double spe
   const ServoParams sp = stroke_servo_params();
   ServoLoop servo(sc.scene, sp);
   servo.start(st.start_m);
-  const double len = distance(st.start_m, st.end_m);
-  const Vec2 dir = (1.0 / len) * (st.end_m - st.start_m);
-  const long move_ticks = static_cast<long>(std::ceil(len / (speed_m_per_s * sp.period_s)));
-  const long dwell_ticks = 30;  // the proxy must stay put with the handle parked past the wall
+  const KinematicPath path(st, speed_m_per_s, sp.period_s);
   StrokeTally t;
   TickChecker chk(sc, st.start_m);
   ServoOutput so;
-  for (long k = 1; k <= move_ticks + dwell_ticks; ++k) {
-    const double s = std::min(len, static_cast<double>(k) * speed_m_per_s * sp.period_s);
-    ServoInput in;
-    in.sample.handle_m = st.start_m + s * dir;
-    in.sample.status = DeviceStatus::Ok;
-    in.sample.time_ns = static_cast<std::int64_t>(k * 1000000);
+  for (long k = 1; k <= path.ticks(); ++k) {
+    const ServoInput in = path.input(k);
     if (control) {
       so.contact.path_m[0] = so.contact.path_count > 0 ? so.contact.proxy_m : st.start_m;
       so.contact.path_m[1] = in.sample.handle_m;

@@ -679,8 +679,8 @@ void BoundarySection::merge_idle_siblings(Query& q) {
 // those walls noted, as runs copied out when first needed (seed §3: coherence; the walls under a box are its
 // only walls of the level); the ball's radius is the distance to the nearest entry left out (its box's distance,
 // and no more than the next one's rectangle's, which bounds every farther box from below). Every wall of the
-// level within that radius is then among those noted, so a later sweep inside the ball is answered exactly by them alone (answer_from_ball_walls):
-// near a wall, or sliding along one in contact, where the plain ball is as small as the gap to it. Kept only
+// level within that radius is then among those noted, so a later sweep inside the ball is answered exactly by
+// them alone (answer_from_ball_walls): near a wall, or sliding along one in contact, where the plain ball is as small as the gap to it. Kept only
 // when it reaches farther than the plain ball. The entries as phase 1 scanned them: a box is a box whatever
 // the section became since.
 void BoundarySection::gather_ball_walls(const Query& q) noexcept {

@@ -24,8 +24,8 @@
 /// large as the gap, so a full query also notes the walls under its nearest section entries (up to 16,
 /// from segment boxes within 3 levels of their walls) with a second, larger ball around the same centre,
 /// reaching to the nearest entry left out: a sweep of that level id inside it is answered exactly by testing
-/// those walls alone (a hand resting on or sliding along a wall); the first such sweep copies them out. First hits of equal t go to the smallest
-/// (curve, level, segment), so no answer depends on which path gave it.
+/// those walls alone (a hand resting on or sliding along a wall); the first such sweep copies them out. First
+/// hits of equal t go to the smallest (curve, level, segment), so no answer depends on which path gave it.
 /// The section serves the level ids of the last two queries (the contact solver renders two levels in turn
 /// while it changes level): its entries stay at or above the walls of both, and a change of id keeps it
 /// (entries below the new id's walls give way to their ancestors at them).

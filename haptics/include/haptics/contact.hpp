@@ -155,11 +155,12 @@ class ContactSolver {
   /// (closest point and pseudo-normal, see side_of_curve); a curve on which the sides differ has the proxy
   /// between its two polylines, and the change must wait (the caller tries again next tick; as the hand
   /// moves on, the two levels' polylines cross each other and the sides agree again). Points between two
-  /// levels lie within E = (largest wall offset of the old level + of the new: the boxes' error bound, their
-  /// half-width combined with their reach past their segments' ends, which at a sharp corner is the larger;
-  /// until 2026-11-26 the half-width alone, and a coarse level's apex could lie behind the proxy unseen) of
-  /// both polylines, so only curves within 2E are searched (until 2026-11-26 only the nearest curve at each level was, and a
-  /// second curve as near, where two edges cross, could have the proxy between its levels unseen). When the change is made (the next update() with the new level),
+  /// levels lie within E = (largest wall offset of the old level + of the new) of both polylines, the offset
+  /// being the boxes' error bound: their half-width combined with their reach past their segments' ends, which
+  /// is the larger at a sharp corner, where a coarse level's apex lies inside the original's. So only curves
+  /// within 2E are searched. (Until 2026-11-26 only the nearest curve at each level was, and a second curve as
+  /// near, where two edges cross, could have the proxy between its levels unseen; until that night E took the
+  /// half-width alone, and a coarse apex could lie behind the proxy unseen.) When the change is made (the next update() with the new level),
   /// the old level stays a wall, with the proxy's constraints on it, until the proxy rests on none of its
   /// segments: the proxy, on the same side of both polylines, then reaches the new one without crossing
   /// either. No second change is made while the old level is still a wall. Allocates nothing (at most six
