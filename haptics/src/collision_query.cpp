@@ -124,20 +124,22 @@ bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, doub
   const double dp[2] = {dot(d, box.axis), cross(box.axis, d)};
   const double lo[2] = {box.u_min - margin_m, box.n_min - margin_m};
   const double hi[2] = {box.u_max + margin_m, box.n_max + margin_m};
+  // Both slabs always, without a branch on the data (a clip's outcome is a coin toss to the predictor): t0 only
+  // grows and t1 only shrinks, so an empty interval after the first slab stays empty.
   double t0 = 0.0, t1 = 1.0;
+  bool inside_parallel = true;
   for (int i = 0; i < 2; ++i) {
-    if (dp[i] == 0.0) {
-      if (p0[i] < lo[i] || p0[i] > hi[i]) return false;  // parallel to this slab and outside it
+    if (dp[i] == 0.0) {  // parallel to this slab: inside it or not at all (seldom: a predictable branch)
+      inside_parallel = inside_parallel && p0[i] >= lo[i] && p0[i] <= hi[i];
       continue;
     }
     const double inv = 1.0 / dp[i];
-    double ta = (lo[i] - p0[i]) * inv;
-    double tb = (hi[i] - p0[i]) * inv;
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return false;
+    const double ta = (lo[i] - p0[i]) * inv;
+    const double tb = (hi[i] - p0[i]) * inv;
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
   }
+  if (!inside_parallel || t0 > t1) return false;
   *t_enter = t0;
   *t_exit = t1;
   return true;
@@ -780,12 +782,11 @@ void BoundarySection::compact_section(Query& q) {
 // The section without the entries that left it (in_section_ cleared), in order, rectangles with them.
 void BoundarySection::drop_departed_entries() noexcept {
   std::size_t w = 0;
-  for (std::size_t i = 0; i < section_.size(); ++i) {
+  for (std::size_t i = 0; i < section_.size(); ++i) {  // every entry copied, kept by advancing w: no branch to mispredict
     const std::uint32_t node = section_[i];
-    if (in_section_[node]) {
-      section_rect_.copy(w, i);
-      section_[w++] = node;
-    }
+    section_rect_.copy(w, i);
+    section_[w] = node;
+    w += in_section_[node];
   }
   section_.resize(w);
 }
