@@ -278,7 +278,7 @@ struct BoundarySection::Query {
 bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
   const double r_sq = ball_radius_m_ * ball_radius_m_;
   const Vec2 da = a - ball_center_m_, db = b - ball_center_m_;
-  return dot(da, da) < r_sq && dot(db, db) < r_sq;  // r = 0 (unknown) admits nothing
+  return (dot(da, da) < r_sq) & (dot(db, db) < r_sq);  // r = 0 (unknown) admits nothing; & : one branch, not two
 }
 
 // The ball's walls (gather_ball_walls) answer a sweep of their level id inside their ball: the first hit among
@@ -1069,6 +1069,13 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
     clear.point_m = b;
     return clear;
   }
+  return first_hit_near_walls(a, b, level, excluded, excluded_count, budget, stats_out);
+}
+
+// first_hit past its free-space ball: the ball's walls, else a full query. Out of line, so the ball's answer (most
+// ticks) does not pay this part's stack frame and saved registers.
+[[gnu::noinline]] SweepHit BoundarySection::first_hit_near_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded,
+                                                                 int excluded_count, QueryBudget& budget, QueryStats* stats_out) {
   SweepHit near;
   if (answer_from_ball_walls(a, b, level, excluded, excluded_count, &near, stats_out)) return near;
   Query q(a, b, level, excluded, excluded_count, budget);

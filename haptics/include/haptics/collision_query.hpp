@@ -261,6 +261,8 @@ class BoundarySection {
   std::uint32_t wall_ancestor(std::uint32_t node, int level) const noexcept;
   bool at_floor(std::uint32_t node, int level) const noexcept;
   bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
+  SweepHit first_hit_near_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
+                                QueryStats* stats_out);
   bool answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, SweepHit* out,
                               QueryStats* stats) noexcept;
   void copy_ball_walls() noexcept;
