@@ -459,8 +459,9 @@ void BoundarySection::clip_section(Query& q) {
 // The rectangle pass of clip_section: for every section entry, the squared distance from the sweep's end to
 // its rectangle (rect_d_sq_; rect_distance_sq, bit for bit) and whether the rectangle, grown by the merge
 // margin, meets the sweep's (bit i % 64 of rect_overlap_bits_[i / 64]; overlaps()). Entries in pairs (the
-// arrays hold one entry past the most there can be; an odd section's last pair has a meaningless second
-// one). Returns the entry of the nearest rectangle (the first of equals; section_.size() when it is empty).
+// arrays hold one entry past the most there can be; an odd section's last pair has a second one made
+// infinitely far, SectionRects::set_far). Returns the entry of the nearest rectangle (the first of equals;
+// section_.size() when it is empty).
 std::size_t BoundarySection::scan_section_rects(const Query& q) {
   const std::size_t n = section_.size();
   const double* lo_x = section_rect_.lo_x.data();
@@ -470,40 +471,55 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
   double* d_sq = rect_d_sq_.data();
   PairBitWriter overlap{rect_overlap_bits_.data()};
   const double m = merge_margin_m_;
+  section_rect_.set_far(n);  // an odd entry's partner: infinitely far, meeting nothing (past an even section: unread)
+  double nearest_sq = std::numeric_limits<double>::infinity();
+  std::size_t nearest = n;
   std::size_t i = 0;
 #if defined(__SSE2__)
   const __m128d px = _mm_set1_pd(q.b.x), py = _mm_set1_pd(q.b.y), zero = _mm_setzero_pd();
   const __m128d s_lo_x = _mm_set1_pd(q.sweep.lo.x), s_lo_y = _mm_set1_pd(q.sweep.lo.y);
   const __m128d s_hi_x = _mm_set1_pd(q.sweep.hi.x), s_hi_y = _mm_set1_pd(q.sweep.hi.y), vm = _mm_set1_pd(m);
+  // The nearest rectangle per lane (even entries, odd entries) and its entry (as a double, exact below 2^53),
+  // kept without a branch: its place in the section is a coin toss to the branch predictor.
+  __m128d v_nearest = _mm_set1_pd(nearest_sq), v_entry = _mm_set1_pd(static_cast<double>(n));
+  __m128d v_i = _mm_set_pd(1.0, 0.0);
+  const __m128d two = _mm_set1_pd(2.0);
   for (; i < n; i += 2) {
     const __m128d lx = _mm_loadu_pd(lo_x + i), ly = _mm_loadu_pd(lo_y + i), hx = _mm_loadu_pd(hi_x + i), hy = _mm_loadu_pd(hi_y + i);
     const __m128d dx = _mm_max_pd(_mm_max_pd(_mm_sub_pd(lx, px), zero), _mm_sub_pd(px, hx));
     const __m128d dy = _mm_max_pd(_mm_max_pd(_mm_sub_pd(ly, py), zero), _mm_sub_pd(py, hy));
-    _mm_storeu_pd(d_sq + i, _mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy)));
+    const __m128d d = _mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy));
+    _mm_storeu_pd(d_sq + i, d);
+    const __m128d nearer = _mm_cmplt_pd(d, v_nearest);
+    v_nearest = _mm_min_pd(d, v_nearest);
+    v_entry = _mm_or_pd(_mm_and_pd(nearer, v_i), _mm_andnot_pd(nearer, v_entry));
+    v_i = _mm_add_pd(v_i, two);
     const __m128d meets = _mm_and_pd(_mm_and_pd(_mm_cmple_pd(_mm_sub_pd(lx, vm), s_hi_x), _mm_cmple_pd(s_lo_x, _mm_add_pd(hx, vm))),
                                      _mm_and_pd(_mm_cmple_pd(_mm_sub_pd(ly, vm), s_hi_y), _mm_cmple_pd(s_lo_y, _mm_add_pd(hy, vm))));
     overlap.put(i, static_cast<unsigned>(_mm_movemask_pd(meets)));
   }
+  // The nearer lane; of equals, the first entry.
+  alignas(16) double lane_d[2], lane_entry[2];
+  _mm_store_pd(lane_d, v_nearest);
+  _mm_store_pd(lane_entry, v_entry);
+  const bool odd_lane = (lane_d[1] < lane_d[0]) | ((lane_d[1] == lane_d[0]) & (lane_entry[1] < lane_entry[0]));
+  nearest = static_cast<std::size_t>(odd_lane ? lane_entry[1] : lane_entry[0]);
 #else
   for (; i < n; i += 2) {
     unsigned two_bits = 0;
     for (std::size_t k = i; k < i + 2; ++k) {
       const Aabb r{{lo_x[k], lo_y[k]}, {hi_x[k], hi_y[k]}};
       d_sq[k] = rect_distance_sq(r, q.b);
+      if (d_sq[k] < nearest_sq) {
+        nearest_sq = d_sq[k];
+        nearest = k;
+      }
       if (overlaps(r, q.sweep, m)) two_bits |= 1u << (k - i);
     }
     overlap.put(i, two_bits);
   }
 #endif
   overlap.finish(i);
-  std::size_t nearest = n;
-  double nearest_sq = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < n; ++k) {
-    if (d_sq[k] < nearest_sq) {
-      nearest_sq = d_sq[k];
-      nearest = k;
-    }
-  }
   return nearest;
 }
 

@@ -34,6 +34,7 @@
 /// throws nothing.
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -314,6 +315,11 @@ class BoundarySection {
     std::vector<double> lo_x, lo_y, hi_x, hi_y;
     void size_for(std::size_t n) { lo_x.assign(n, 0.0); lo_y.assign(n, 0.0); hi_x.assign(n, 0.0); hi_y.assign(n, 0.0); }
     void set(std::size_t i, const Aabb& r) noexcept { lo_x[i] = r.lo.x; lo_y[i] = r.lo.y; hi_x[i] = r.hi.x; hi_y[i] = r.hi.y; }
+    // Entry i as a rectangle infinitely far from every point, meeting none (lo = +inf, hi = -inf).
+    void set_far(std::size_t i) noexcept {
+      constexpr double kInf = std::numeric_limits<double>::infinity();
+      lo_x[i] = kInf; lo_y[i] = kInf; hi_x[i] = -kInf; hi_y[i] = -kInf;
+    }
     void copy(std::size_t to, std::size_t from) noexcept { lo_x[to] = lo_x[from]; lo_y[to] = lo_y[from]; hi_x[to] = hi_x[from]; hi_y[to] = hi_y[from]; }
   };
   SectionRects section_rect_;
