@@ -196,8 +196,8 @@ void BoundarySection::reset() {
   last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
   for (std::uint32_t node : section_) in_section_[node] = 0;
   section_.clear();
-  ball_radius_m_ = 0.0;
-  ball_walls_.radius_m = 0.0;
+  ball_radius_sq_ = 0.0;
+  ball_walls_.radius_sq = 0.0;
   ball_walls_.count = 0;
   ball_walls_.runs = 0;
   ball_walls_.copied = false;
@@ -272,11 +272,11 @@ struct BoundarySection::Query {
 };
 
 // Free-space ball (seed §3: "distances to the boxes ... can be used to schedule box updates"): the
-// last full query proved that no box of the section comes within ball_radius_m_ of ball_center_m_, and
+// last full query proved that no box of the section comes within the ball's radius of ball_center_m_, and
 // those boxes covered every wall of the level ids it served (ball_levels_; follow_level forgets the ball for
 // any other id). A sweep inside that ball cannot hit anything: answer at once.
 bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
-  const double r_sq = ball_radius_m_ * ball_radius_m_;
+  const double r_sq = ball_radius_sq_;
   const Vec2 da = a - ball_center_m_, db = b - ball_center_m_;
   return (dot(da, da) < r_sq) & (dot(db, db) < r_sq);  // r = 0 (unknown) admits nothing; & : one branch, not two
 }
@@ -289,7 +289,7 @@ bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const Se
                                              SweepHit* out, QueryStats* stats) noexcept {
   BallWalls& w = ball_walls_;
   if (level != w.level) return false;
-  const double r_sq = w.radius_m * w.radius_m;
+  const double r_sq = w.radius_sq;
   const Vec2 da = a - w.center_m, db = b - w.center_m;
   if (!(dot(da, da) < r_sq && dot(db, db) < r_sq)) return false;
   if (!w.copied) copy_ball_walls();
@@ -355,7 +355,7 @@ void BoundarySection::follow_level(int level) noexcept {
   other_level_ = previous < 0 ? level : previous;
   last_level_ = level;
   if (level == previous) return;
-  if (level != ball_levels_[0] && level != ball_levels_[1]) ball_radius_m_ = 0.0;
+  if (level != ball_levels_[0] && level != ball_levels_[1]) ball_radius_sq_ = 0.0;
   if (previous < 0) {
     reset();
     return;
@@ -703,7 +703,7 @@ void BoundarySection::merge_idle_siblings(Query& q) {
 // the section became since.
 void BoundarySection::gather_ball_walls(const Query& q) noexcept {
   BallWalls& w = ball_walls_;
-  w.radius_m = 0.0;
+  w.radius_sq = 0.0;
   w.count = 0;
   w.runs = 0;
   w.copied = false;
@@ -750,7 +750,7 @@ void BoundarySection::gather_ball_walls(const Query& q) noexcept {
     return;
   }
   w.center_m = q.b;
-  w.radius_m = std::sqrt(r_sq);
+  w.radius_sq = r_sq;
   w.level = q.level;
 }
 
@@ -788,7 +788,7 @@ void BoundarySection::copy_ball_walls() noexcept {
 // CollisionQuery.BoundarySectionStaysSmallOnALongWalk checks the section stays a frontier.
 void BoundarySection::compact_section(Query& q) {
   ball_center_m_ = q.b;
-  ball_radius_m_ = std::sqrt(q.nearest_sq);
+  ball_radius_sq_ = q.nearest_sq;
   ball_levels_[0] = q.level;  // the boxes scanned covered the walls of both ids the section served
   ball_levels_[1] = other_level_;
   if (q.st.splits == 0 && q.st.merges == 0) return;

@@ -359,7 +359,7 @@ class BoundarySection {
   const std::uint8_t* cut_mask_ = nullptr; // cuts_->masks: per node, the tolerance steps whose cut it is a segment of
   std::size_t capacity_ = 0;    // entries reserved in section_ and the scratch arrays
   Vec2 ball_center_m_;          // free-space ball: no box of the section as last scanned, so no wall, comes closer to its centre than its radius
-  double ball_radius_m_ = 0.0;  // [m]; 0 = unknown
+  double ball_radius_sq_ = 0.0;  // its radius squared [m²] (kept squared: the tests compare squares); 0 = unknown
   int ball_levels_[2] = {-1, -1};  // the level ids whose walls the ball was proven clear of
   // The ball's walls (gather_ball_walls): a larger ball, around the same centre, whose every wall of one level id
   // is known, so a sweep inside it is answered exactly by testing those walls alone. The full query notes them as
@@ -369,7 +369,7 @@ class BoundarySection {
   static constexpr int kBallWallEntries = 6;  // section entries whose walls may be copied, nearest first
   struct BallWalls {
     Vec2 center_m;
-    double radius_m = 0.0;  // [m]; 0 = none
+    double radius_sq = 0.0;  // radius squared [m²]; 0 = none
     int level = -1;         // the level id whose walls these are
     int count = 0;          // walls [0, kMaxBallWalls]
     int runs = 0;           // runs of walls, one per section entry [0, kBallWallEntries]
