@@ -214,13 +214,53 @@ void BoundarySection::push_section(std::uint32_t node) {
   in_section_[node] = 1;
 }
 
-void BoundarySection::split(std::uint32_t node) {
+// Puts node in the section at `entry` in place of the entry's node, with its rectangle, and marks it in (the
+// caller marks the node it replaces out).
+void BoundarySection::set_section_entry(std::size_t entry, std::uint32_t node) {
+  section_rect_.set(entry, scene_->aabb(node));
+  section_[entry] = node;
+  in_section_[node] = 1;
+}
+
+// Takes the entry out: the last entry moves into its place (the order of entries is no answer's business).
+void BoundarySection::remove_section_entry(std::size_t entry) noexcept {
+  const std::size_t last = section_.size() - 1;
+  if (entry != last) {
+    section_rect_.copy(entry, last);
+    section_[entry] = section_[last];
+  }
+  section_.pop_back();
+}
+
+// Splits the node at section entry `entry` into its children: the first takes its place, the others are
+// appended, so no entry is left to drop. Without room the node stays (a box holds its children's walls).
+void BoundarySection::split(std::uint32_t node, std::size_t entry) {
   std::uint32_t first = 0, count = 0;
   scene_->children(node, &first, &count);
   if (count == 0 || !in_section_[node]) return;
-  if (section_.size() + count + 8 > capacity_) return;  // full: keep the node (room kept for this tick's merges)
+  if (section_.size() + count + 8 > capacity_) return;  // full: keep the node
   in_section_[node] = 0;
-  for (std::uint32_t i = 0; i < count; ++i) push_section(first + i);
+  set_section_entry(entry, first);
+  for (std::uint32_t i = 1; i < count; ++i) push_section(first + i);
+}
+
+// Merges the children [first, first + count) of `parent`, all in the section, one of them at `entry`: the parent
+// takes that entry's place and the others' entries are taken out (found by a scan of the section's node ids, a
+// few dozen). False, with nothing changed, when they are not all found (never, for a frontier).
+bool BoundarySection::merge_children(std::size_t entry, std::uint32_t parent, std::uint32_t first, std::uint32_t count) {
+  constexpr std::size_t kMaxSiblings = 15;
+  std::size_t sibling_entry[kMaxSiblings];
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < section_.size(); ++i) {
+    if (section_[i] - first >= count || i == entry) continue;  // unsigned: outside [first, first + count)
+    if (k == kMaxSiblings) return false;
+    sibling_entry[k++] = i;  // increasing
+  }
+  if (k + 1 != count) return false;
+  for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
+  set_section_entry(entry, parent);
+  while (k > 0) remove_section_entry(sibling_entry[--k]);  // highest first: a later one is never the last moved
+  return true;
 }
 
 // One query's inputs, answer so far and counters, passed to each phase of first_hit.
@@ -450,7 +490,7 @@ void BoundarySection::clip_section(Query& q) {
       if ((rect_overlap_bits_[w] & bit) && clip_segment_box(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
         hit_stamp_[node] = tick_;
         ++q.hit;
-        if (clip_segment_box(box, q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node});
+        if (clip_segment_box(box, q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node, static_cast<std::uint32_t>(i)});
       }
     }
   }
@@ -577,7 +617,7 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
       return false;
     }
     if (overlaps(sc.loose_aabb(first + i), q.sweep, 0.0) && clip_segment_box(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t &&
-        !push(top, {te, first + i})) {
+        !push(top, {te, first + i, kNotAnEntry})) {
       top = base;  // the stack is full: as past the budget
       return false;
     }
@@ -640,58 +680,7 @@ void BoundarySection::refine_candidates(Query& q) {
   }
 }
 
-// Phase 3: the boundary section follows the handle: what was hit is split (one level per tick), down to
-// the coarser of the two ids the section serves (follow_level).
-void BoundarySection::split_hit_boxes(Query& q) {
-  for (const Candidate& cand : candidates_) {
-    if (!at_floor(cand.node, q.level)) {
-      split(cand.node);
-      ++q.st.splits;
-    }
-  }
-}
-
-// Phase 4: siblings whose parent is clear of the sweep by the margin merge into it. Merging only shrinks
-// the section, so it can be lazy: a few parents per tick (2, and one more per 8 idle entries), taken round-robin.
-void BoundarySection::merge_idle_siblings(Query& q) {
-  const Scene& sc = *scene_;
-  // Merges must keep up with the splits, or the section grows without bound: with 4 checks per tick and no
-  // more, a long walk over a dense scene grew it to 9 000–18 000 entries (CollisionQuery.
-  // BoundarySectionStaysSmallOnALongWalk; the tick's scan grows with it). So a few checks per tick plus one
-  // per kIdlePerMergeCheck idle entries: a section grown by a burst of splits is merged back.
-  constexpr int kMergeChecksPerTick = 2;
-  constexpr std::size_t kIdlePerMergeCheck = 8;
-  // The entries phase 1 scanned (not the children split off since), in section order from a point that
-  // moves with the tick (round robin); the idle ones are those it did not find hit.
-  const std::size_t n = q.scanned;
-  if (n == 0) return;
-  const int max_checks = kMergeChecksPerTick + static_cast<int>((n - q.hit) / kIdlePerMergeCheck);
-  int checks = 0;
-  std::size_t e = tick_ % n;
-  for (std::size_t j = 0; j < n && checks < max_checks; ++j, e = e + 1 == n ? 0 : e + 1) {
-    const std::uint32_t node = section_[e];
-    if (!in_section_[node] || hit_stamp_[node] == tick_ || node == sc.scene_root()) continue;
-    const std::uint32_t parent = sc.parent(node);
-    // One check per parent per tick: a node with many children would otherwise ask again for each.
-    if (in_section_[parent] || merge_stamp_[parent] == tick_) continue;
-    merge_stamp_[parent] = tick_;
-    ++checks;
-    std::uint32_t first = 0, count = 0;
-    sc.children(parent, &first, &count);
-    bool all_idle = true;
-    for (std::uint32_t i = 0; i < count && all_idle; ++i) all_idle = in_section_[first + i] && hit_stamp_[first + i] != tick_;
-    if (!all_idle) continue;
-    if (section_.size() >= capacity_) break;  // full until the compaction (a merge adds an entry before it removes any)
-    double te = 0.0, tx = 0.0;
-    if (!q.spend_box()) break;  // merging can wait for a tick with budget left
-    if (clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
-    for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
-    push_section(parent);
-    ++q.st.merges;
-  }
-}
-
-// Phase 5a: the ball's walls, a second free-space ball around the same centre (the end of the sweep) that
+// Phase 3: the ball's walls, a second free-space ball around the same centre (the end of the sweep) that
 // reaches past the nearest boxes: the section entries nearest to it, in order of their rectangles' distance,
 // while each is a segment box within kDirectLevels of its walls and all their walls fit in kMaxBallWalls, have
 // those walls noted, as runs copied out when first needed (seed §3: coherence; the walls under a box are its
@@ -776,26 +765,75 @@ void BoundarySection::copy_ball_walls() noexcept {
   w.copied = true;
 }
 
-// Phase 5: the next free-space ball, and when boxes were split or merged, the section without the entries
-// split or merged away. The ball is the distance from the end of the sweep to the nearest box phase 1
+// Phase 4: the boundary section follows the handle: what was hit is split (one level per tick), down to
+// the coarser of the two ids the section serves (follow_level).
+void BoundarySection::split_hit_boxes(Query& q) {
+  for (const Candidate& cand : candidates_) {
+    if (!at_floor(cand.node, q.level)) {
+      split(cand.node, cand.entry);
+      ++q.st.splits;
+    }
+  }
+}
+
+// Phase 5: siblings whose parent is clear of the sweep by the margin merge into it (merge_children: in place, no
+// entry left to drop). Merging only shrinks the section, so it can be lazy: a few parents per tick (2, and one
+// more per 8 idle entries), taken round-robin.
+void BoundarySection::merge_idle_siblings(Query& q) {
+  const Scene& sc = *scene_;
+  // Merges must keep up with the splits, or the section grows without bound: with 4 checks per tick and no
+  // more, a long walk over a dense scene grew it to 9 000–18 000 entries (CollisionQuery.
+  // BoundarySectionStaysSmallOnALongWalk; the tick's scan grows with it). So a few checks per tick plus one
+  // per kIdlePerMergeCheck idle entries: a section grown by a burst of splits is merged back.
+  constexpr int kMergeChecksPerTick = 2;
+  constexpr std::size_t kIdlePerMergeCheck = 8;
+  // As many entries as phase 1 scanned, in section order from a point that moves with the tick (round robin);
+  // the idle ones are those it did not find hit. Splits and merges since put other nodes at some of them (a
+  // child, a parent, the last entry moved into a merged sibling's place) and the section may be shorter now: a
+  // new node was not hit this tick, so its parent is checked too; the parent of a split one was hit and stays.
+  const std::size_t n = q.scanned;
+  if (n == 0) return;
+  const int max_checks = kMergeChecksPerTick + static_cast<int>((n - q.hit) / kIdlePerMergeCheck);
+  int checks = 0;
+  std::size_t e = tick_ % n;
+  for (std::size_t j = 0; j < n && checks < max_checks; ++j, e = e + 1 == n ? 0 : e + 1) {
+    if (e >= section_.size()) continue;
+    const std::uint32_t node = section_[e];
+    if (!in_section_[node] || hit_stamp_[node] == tick_ || node == sc.scene_root()) continue;
+    const std::uint32_t parent = sc.parent(node);
+    // One check per parent per tick: a node with many children would otherwise ask again for each.
+    if (in_section_[parent] || merge_stamp_[parent] == tick_) continue;
+    merge_stamp_[parent] = tick_;
+    ++checks;
+    std::uint32_t first = 0, count = 0;
+    sc.children(parent, &first, &count);
+    bool all_idle = true;
+    for (std::uint32_t i = 0; i < count && all_idle; ++i) all_idle = in_section_[first + i] && hit_stamp_[first + i] != tick_;
+    if (!all_idle) continue;
+    double te = 0.0, tx = 0.0;
+    if (!q.spend_box()) break;  // merging can wait for a tick with budget left
+    if (clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
+    if (merge_children(e, parent, first, count)) ++q.st.merges;
+  }
+}
+
+// Phase 6: the next free-space ball: the distance from the end of the sweep to the nearest box phase 1
 // scanned, even when the section changed since: a split box holds every wall its children hold and merged
 // children every wall their parent holds, so the boxes scanned still cover every wall and no wall comes
 // nearer than that. (Measuring the changed section again finds the children's boxes, which may be
-// farther, but cost more than the slightly larger ball saved: PERFORMANCE.md, round two.) No node is in the
-// section twice, so keeping the entries still in it is enough: a split appends children of a node that was
-// in it (so they were not), a merge appends a parent it checked was not, and a node that left this tick cannot
-// come back in it (a split node's children, appended after the scan, are not among the merges' candidates).
-// CollisionQuery.BoundarySectionStaysSmallOnALongWalk checks the section stays a frontier.
-void BoundarySection::compact_section(Query& q) {
+// farther, but cost more than the slightly larger ball saved: PERFORMANCE.md, round two.) The section needs
+// no compaction: splits and merges changed it in place, no node twice (a split puts in children of a node that
+// was in, so they were not; a merge a parent it checked was not), a frontier still
+// (CollisionQuery.BoundarySectionStaysSmallOnALongWalk checks it).
+void BoundarySection::place_free_ball(const Query& q) noexcept {
   ball_center_m_ = q.b;
   ball_radius_sq_ = q.nearest_sq;
   ball_levels_[0] = q.level;  // the boxes scanned covered the walls of both ids the section served
   ball_levels_[1] = other_level_;
-  if (q.st.splits == 0 && q.st.merges == 0) return;
-  drop_departed_entries();
 }
 
-// The section without the entries that left it (in_section_ cleared), in order, rectangles with them.
+// The section without the entries that left it (in_section_ cleared), in order, rectangles with them (after
+// coarsen_section).
 void BoundarySection::drop_departed_entries() noexcept {
   std::size_t w = 0;
   for (std::size_t i = 0; i < section_.size(); ++i) {  // every entry copied, kept by advancing w: no branch to mispredict
@@ -807,7 +845,7 @@ void BoundarySection::drop_departed_entries() noexcept {
   section_.resize(w);
 }
 
-// Phase 6: the answer. An exact hit; or, when a box left unrefined begins before it, the finest level
+// Phase 7: the answer. An exact hit; or, when a box left unrefined begins before it, the finest level
 // reached and how far the sweep is proven clear; or clear to the end.
 SweepHit BoundarySection::finish(Query& q) const {
   const Scene& sc = *scene_;
@@ -1098,10 +1136,10 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   next_tick();
   clip_section(q);
   refine_candidates(q);
+  gather_ball_walls(q);  // before the section changes: it reads the entries as phase 1 scanned them
   split_hit_boxes(q);
   merge_idle_siblings(q);
-  gather_ball_walls(q);
-  compact_section(q);
+  place_free_ball(q);
   const SweepHit answer = finish(q);
   if (stats_out) *stats_out = q.st;
   return answer;
@@ -1333,7 +1371,7 @@ bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m,
     return (curve >= 0 && c != static_cast<std::uint32_t>(curve)) || q.skips(c);
   };
   int top = 0;
-  stack_[static_cast<std::size_t>(top++)] = Candidate{0.0, sc.scene_root()};  // t_enter: the box's squared distance [m²]
+  stack_[static_cast<std::size_t>(top++)] = Candidate{0.0, sc.scene_root(), kNotAnEntry};  // t_enter: the box's squared distance [m²]
   while (top > 0) {
     const Candidate cur = stack_[static_cast<std::size_t>(--top)];
     if (cur.t_enter > q.bound_sq) continue;  // the bound shrank since it was pushed
@@ -1353,7 +1391,7 @@ bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m,
       if (budget && !budget->spend()) return false;
       const double d_sq = box_distance_sq(sc.box(child), p);
       if (d_sq > q.bound_sq) continue;
-      if (!push(top, Candidate{d_sq, child})) {  // full (never, within the tree's depth): the answer is unknown
+      if (!push(top, Candidate{d_sq, child, kNotAnEntry})) {  // full (never, within the tree's depth): the answer is unknown
         if (budget) budget->ran_out = true;
         return false;
       }

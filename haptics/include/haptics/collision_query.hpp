@@ -280,10 +280,13 @@ class BoundarySection {
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
   void gather_ball_walls(const Query& q) noexcept;
-  void compact_section(Query& q);
+  void place_free_ball(const Query& q) noexcept;
   void drop_departed_entries() noexcept;
   SweepHit finish(Query& q) const;
-  void split(std::uint32_t node);
+  void split(std::uint32_t node, std::size_t entry);
+  void set_section_entry(std::size_t entry, std::uint32_t node);
+  void remove_section_entry(std::size_t entry) noexcept;
+  bool merge_children(std::size_t entry, std::uint32_t parent, std::uint32_t first, std::uint32_t count);
   // The walks of the wide index (wide_index.hpp). One stack serves both: an entry is a child code with its
   // rectangle's squared distance from the walk's point (the order of the walk) and, for first_hit_wide,
   // where the sweep enters it (+inf when it does not). 12 bytes an entry, as three arrays: every access
@@ -328,7 +331,8 @@ class BoundarySection {
   std::vector<std::uint64_t> rect_near_bits_;     // scan scratch, a bit per entry: its rectangle is nearer than the nearest box so far
   void push_section(std::uint32_t node);   // appends node with its rectangle and marks it in (the caller checked the room)
   std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
-  struct Candidate { double t_enter; std::uint32_t node; };  // 16 bytes
+  struct Candidate { double t_enter; std::uint32_t node; std::uint32_t entry; };  // entry: its place in section_ (a hit entry), or kNotAnEntry. 16 bytes
+  static constexpr std::uint32_t kNotAnEntry = 0xffffffffu;
   static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
   /// Checked push onto the DFS stack (sized by hk::tree_stack_entries): false, and nothing pushed, when it
   /// is full, which a tree within kMaxLevels + kMaxHierarchyDepth levels never fills.
