@@ -172,7 +172,8 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
     scene.children(node, &first, &count);
     widest_root = std::max<std::size_t>(widest_root, count);
   }
-  // Room for every node twice: entries removed this tick stay until the compaction at its end.
+  // Room for every node twice: a level change's coarsening appends ancestors before its compaction drops the
+  // entries they replace (splits and merges change the section in place).
   // The section's storage is bounded so that a scene of millions of segments does not cost tens of
   // megabytes of scratch: when it is full, boxes are simply not split (the query still descends).
   capacity_ = std::min<std::size_t>(2 * n, kMaxSectionEntries) + widest_root + 8;

@@ -770,6 +770,64 @@ TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
   EXPECT_GT(walls_answers, near_walls / 4);
 }
 
+// The slab clip every box test of the query rests on (Liang–Barsky), checked against the segment's points
+// themselves: 1 001 points along each of 20 000 random segments, each tested inside or outside the box in the
+// box's own frame (dot and cross with its axis, not the clip). A clip that says "no" has no point well inside
+// (1e-12 m in from every side); one that says [t0, t1] has every point well inside within it, and the points at
+// t0 and t1 inside the box grown by 1e-12 m. Axis-aligned boxes with segments along an axis reach the
+// parallel-slab case (a zero extent in the box's frame), inside the slab and outside it.
+TEST(CollisionQuery, ClipSegmentBoxAgreesWithTheSegmentsPoints) {
+  std::mt19937 rng(2027);
+  std::uniform_real_distribution<double> u01(0.0, 1.0), pos(-0.03, 0.03), angle(0.0, 2.0 * M_PI);
+  int hits = 0, misses = 0, parallel = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const bool aligned = trial % 4 == 0;
+    const double phi = aligned ? 0.0 : angle(rng);
+    ErrorBox box;
+    box.origin_m = {pos(rng), pos(rng)};
+    box.axis = {std::cos(phi), std::sin(phi)};
+    box.u_min = -0.01 * u01(rng);
+    box.u_max = 0.03 * u01(rng);
+    box.n_min = -0.005 * u01(rng);
+    box.n_max = 0.005 * u01(rng);
+    const double margin = trial % 2 == 0 ? 0.0 : 3e-4;
+    Vec2 a{pos(rng), pos(rng)}, b{pos(rng), pos(rng)};
+    if (aligned && trial % 8 == 0) {  // along the axis: a zero extent across it
+      b.y = a.y;
+      ++parallel;
+    } else if (aligned && trial % 8 == 4) {  // across the axis: a zero extent along it
+      b.x = a.x;
+      ++parallel;
+    }
+    // Inside the box grown by margin + grow (grow < 0: well inside), in the box's frame.
+    auto inside = [&](Vec2 p, double grow) {
+      const Vec2 r = p - box.origin_m;
+      const double u = dot(r, box.axis), n = cross(box.axis, r), m = margin + grow;
+      return u >= box.u_min - m && u <= box.u_max + m && n >= box.n_min - m && n <= box.n_max + m;
+    };
+    double t0 = -1.0, t1 = -1.0;
+    const bool clipped = clip_segment_box(box, a, b, margin, &t0, &t1);
+    clipped ? ++hits : ++misses;
+    if (clipped) {
+      ASSERT_LE(0.0, t0);
+      ASSERT_LE(t0, t1);
+      ASSERT_LE(t1, 1.0);
+      ASSERT_TRUE(inside(lerp(a, b, t0), 1e-12)) << "trial " << trial;
+      ASSERT_TRUE(inside(lerp(a, b, t1), 1e-12)) << "trial " << trial;
+    }
+    for (int k = 0; k <= 1000; ++k) {
+      const double t = k / 1000.0;
+      if (!inside(lerp(a, b, t), -1e-12)) continue;
+      ASSERT_TRUE(clipped) << "trial " << trial << ": the point at t = " << t << " is inside";
+      ASSERT_GE(t, t0 - 1e-9) << "trial " << trial;
+      ASSERT_LE(t, t1 + 1e-9) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(hits, 2000);
+  EXPECT_GT(misses, 2000);
+  EXPECT_GT(parallel, 4000);
+}
+
 TEST(CollisionQuery, ExcludedSegmentIsIgnored) {
   Polyline wall;
   wall.points_m = {{-0.02, 0.0}, {0.02, 0.0}};
