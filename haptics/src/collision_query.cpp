@@ -247,7 +247,8 @@ void BoundarySection::split(std::uint32_t node, std::size_t entry) {
 
 // Merges the children [first, first + count) of `parent`, all in the section, one of them at `entry`: the parent
 // takes that entry's place and the others' entries are taken out (found by a scan of the section's node ids, a
-// few dozen). False, with nothing changed, when they are not all found (never, for a frontier).
+// few dozen). False, with nothing changed, when they are not all found (never, for a frontier) or there are more
+// than kMaxSiblings (never: no node has more than 4 children, scene.hpp).
 bool BoundarySection::merge_children(std::size_t entry, std::uint32_t parent, std::uint32_t first, std::uint32_t count) {
   constexpr std::size_t kMaxSiblings = 15;
   std::size_t sibling_entry[kMaxSiblings];
@@ -689,8 +690,8 @@ void BoundarySection::refine_candidates(Query& q) {
 // and no more than the next one's rectangle's, which bounds every farther box from below). Every wall of the
 // level within that radius is then among those noted, so a later sweep inside the ball is answered exactly by
 // them alone (answer_from_ball_walls): near a wall, or sliding along one in contact, where the plain ball is as small as the gap to it. Kept only
-// when it reaches farther than the plain ball. The entries as phase 1 scanned them: a box is a box whatever
-// the section became since.
+// when it reaches farther than the plain ball. Runs before the splits and merges, which change the entries in
+// place: it reads them as phase 1 scanned them.
 void BoundarySection::gather_ball_walls(const Query& q) noexcept {
   BallWalls& w = ball_walls_;
   w.radius_sq = 0.0;
