@@ -210,9 +210,8 @@ void BoundarySection::reset() {
 }
 
 void BoundarySection::push_section(std::uint32_t node) {
-  section_rect_.set(section_.size(), scene_->aabb(node));
-  section_.push_back(node);
-  in_section_[node] = 1;
+  section_.push_back(node);  // within the reserved capacity: no allocation
+  set_section_entry(section_.size() - 1, node);
 }
 
 // Puts node in the section at `entry` in place of the entry's node, with its rectangle, and marks it in (the
