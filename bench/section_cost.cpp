@@ -19,7 +19,9 @@
 //     merge only   merges and no split
 //   top 1 %      the slowest 1 % of all queries, whatever their kind
 // For each: how many, mean and p50 [ns], and the mean work (box tests, section entries scanned, splits, merges,
-// section size, segment tests). Prints a markdown table per size.
+// section size, segment tests). Prints a markdown table per size, and how many full queries came right after a
+// full query (the hand near walls tick after tick: work a full query leaves for the ticks after it lands on the
+// next full query that often).
 #include <CLI/CLI.hpp>
 #include <benchmark/benchmark.h>
 
@@ -144,6 +146,13 @@ int main(int argc, char** argv) {
     print_row("full: split", all, [](const Sample& s) { return s.st.splits > 0; });
     print_row("full: merge only", all, [](const Sample& s) { return s.st.splits == 0 && s.st.merges > 0; });
     print_row("top 1 %", all, [&](const Sample& s) { return s.ns >= p99; });
+    std::size_t after_full = 0, full_count = 0;
+    for (std::size_t i = 1; i < all.size(); ++i) {
+      if (!full(all[i])) continue;
+      ++full_count;
+      after_full += full(all[i - 1]) ? 1 : 0;
+    }
+    std::printf("\nfull queries right after a full query: %zu of %zu\n", after_full, full_count);
   }
   return 0;
 }

@@ -284,7 +284,7 @@ class BoundarySection {
   void drop_departed_entries() noexcept;
   SweepHit finish(Query& q) const;
   void split(std::uint32_t node, std::size_t entry);
-  void set_section_entry(std::size_t entry, std::uint32_t node);
+  void set_section_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent);
   void remove_section_entry(std::size_t entry) noexcept;
   bool merge_children(std::size_t entry, std::uint32_t parent, std::uint32_t first, std::uint32_t count);
   // The walks of the wide index (wide_index.hpp). One stack serves both: an entry is a child code with its
@@ -310,6 +310,7 @@ class BoundarySection {
   const Scene* scene_;
   double merge_margin_m_;
   std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
+  std::vector<std::uint32_t> section_parent_;  // per entry, in step with section_: its node's parent (kNoParent: the root)
   // The section entries' rectangles [m], in step with section_, as four arrays (structure of arrays) so the
   // per-tick scan tests two entries per SSE2 instruction and streams through memory; sized capacity_ + 1
   // (one past the most entries: the scan reads them in pairs) and never resized, so the servo path allocates
@@ -329,8 +330,13 @@ class BoundarySection {
   std::vector<double> rect_d_sq_;          // scan scratch, per entry: squared distance from the sweep's end to its rectangle [m²]
   std::vector<std::uint64_t> rect_overlap_bits_;  // scan scratch, a bit per entry: its rectangle, grown by the merge margin, meets the sweep's
   std::vector<std::uint64_t> rect_near_bits_;     // scan scratch, a bit per entry: its rectangle is nearer than the nearest box so far
-  void push_section(std::uint32_t node);   // appends node with its rectangle and marks it in (the caller checked the room)
+  static constexpr std::uint32_t kNoParent = 0xffffffffu;  // the root's `parent` below: counted nowhere
+  // Appends node with its rectangle and marks it in (the caller checked the room); parent: parent_or_none(node).
+  void push_section(std::uint32_t node, std::uint32_t parent);
+  std::uint32_t parent_or_none(std::uint32_t node) const noexcept;
+  void mark_out(std::uint32_t node, std::uint32_t parent) noexcept;
   std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
+  std::vector<std::uint8_t> children_in_;  // per node: how many of its children (at most 4, scene.hpp) are in the frontier
   struct Candidate { double t_enter; std::uint32_t node; std::uint32_t entry; };  // entry: its place in section_ (a hit entry), or kNotAnEntry. 16 bytes
   static constexpr std::uint32_t kNotAnEntry = 0xffffffffu;
   static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
