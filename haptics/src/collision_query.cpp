@@ -829,7 +829,7 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     ++checks;
     std::uint32_t first = 0, count = 0;
     sc.children(parent, &first, &count);
-    // All children in: most checks end here, a sibling split deeper (81 %), on one count rather than a loop
+    // All children in: most checks end here, a sibling split deeper (three in four), on one count rather than a loop
     // over the children whose exit the predictor cannot learn. Then none of them hit this tick.
     if (children_in_[parent] != count) continue;
     bool all_idle = true;
