@@ -197,9 +197,9 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
 
 void BoundarySection::reset() {
   last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
-  for (std::uint32_t node : section_) {
-    in_section_[node] = 0;
-    children_in_[scene_->parent(node)] = 0;  // only a section node's parent counts any (the root's own: unread)
+  for (std::size_t i = 0; i < section_.size(); ++i) {
+    in_section_[section_[i]] = 0;
+    if (section_parent_[i] != kNoParent) children_in_[section_parent_[i]] = 0;  // only a section node's parent counts any
   }
   section_.clear();
   ball_radius_sq_ = 0.0;
@@ -822,9 +822,10 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     if (e >= section_.size()) continue;
     const std::uint32_t node = section_[e];
     const std::uint32_t parent = section_parent_[e];  // kNoParent: the root
-    if (!in_section_[node] || hit_stamp_[node] == tick_ || parent == kNoParent) continue;
-    // One check per parent per tick: a node with many children would otherwise ask again for each.
-    if (in_section_[parent] || merge_stamp_[parent] == tick_) continue;
+    // Every entry is in the section and none of its ancestors is (splits and merges change it in place, a
+    // frontier), so only the stamps decide. One check per parent per tick: a node with many children would
+    // otherwise ask again for each.
+    if (hit_stamp_[node] == tick_ || parent == kNoParent || merge_stamp_[parent] == tick_) continue;
     merge_stamp_[parent] = tick_;
     ++checks;
     std::uint32_t first = 0, count = 0;
