@@ -186,6 +186,31 @@ class BoxGrower {
 // Largest |quantised extent| a level's quantum is chosen for (int16 holds ±32767: room for the outward steps).
 constexpr double kQuantumSteps = 32000.0;
 
+// The most a level's quantised boxes reach, in quanta, grown box by box from the quantised lanes
+// (quantise_extent) rather than from the stored int16s in a second pass: the widest half-width,
+// max(−n_min, n_max) (n_min < 0 < n_max, as every box holds its segment, padded), and the largest
+// overhang² + half-width² of one box, overhang = max(0, −u_min, u_over), how far it reaches past either end
+// of its segment. Both exact (integers below 2^16, squares summed below 2^31, in doubles). Times the
+// quantum, these are the widest box as Scene::segment_box() rebuilds it, bit for bit (k·q is monotone in
+// k), and its largest box_error_bound but for the rounding of the end's sum length_m + u_over·q there (a
+// few ulps).
+class ReachGrower {
+ public:
+  // One box's quantised lanes: k = (u_min, n_min), m = (n_max, u_over).
+  void add(Lanes2 k, Lanes2 m) {
+    const Lanes2 zero = lanes(0.0, 0.0);
+    const Lanes2 r = max(max(zero - k, swapped(m)), zero);  // (overhang, half-width)
+    const Lanes2 r2 = r * r;
+    most_ = max(most_, r);
+    bound_sq_ = max(bound_sq_, r2 + swapped(r2));
+  }
+  double half_width() const { return lane1(most_); }  // [quanta]
+  double bound_sq() const { return lane0(bound_sq_); }  // [quanta²]
+
+ private:
+  Lanes2 most_ = lanes(0.0, 0.0), bound_sq_ = lanes(0.0, 0.0);
+};
+
 // A segment's extents in quanta of q (inverse_q = 1/q), rounded outward so that the stored box only grows,
 // by less than one quantum on each side: u_min and n_min to the largest k with k·q ≤ v, n_max to the
 // smallest k with k·q ≥ v, u_over to the smallest with length_m + k·q ≥ u_max, each product as
@@ -196,8 +221,8 @@ constexpr double kQuantumSteps = 32000.0;
 // > 0 (it holds the end), and v/q is not an integer. Where the product's rounding crosses an integer, v/q
 // is one, or a lane has the other sign, the guess is off by a step; the steps that follow (rarely taken, so
 // their branches are predicted) make each k the last on the right side of v, so the guess can neither
-// undercut v nor add a quantum. |v/q| ≤ kQuantumSteps + a few (an int holds it).
-inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, double inverse_q) {
+// undercut v nor add a quantum. |v/q| ≤ kQuantumSteps + a few (an int holds it). Grows `reach` by the box.
+inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, double inverse_q, ReachGrower& reach) {
   const Lanes2 lq = lanes(q, q), one = lanes(1.0, 1.0);
   // Adds `step` (±1) to the lanes of k where too(k) holds, until it holds in none.
   const auto step_while = [](Lanes2 k, double step, auto too) {
@@ -217,6 +242,7 @@ inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, dou
     k = step_while(step_while(k, -1.0, k_over), +1.0, k_short);
     m = step_while(step_while(m, +1.0, m_short), -1.0, m_over);
   }
+  reach.add(k, m);
   return BoxExtent{static_cast<std::int16_t>(lane0(k)), static_cast<std::int16_t>(lane1(m)), static_cast<std::int16_t>(lane1(k)),
                    static_cast<std::int16_t>(lane0(m))};
 }
@@ -577,6 +603,7 @@ class SceneBuild {
       level.resize(ci.segment_count[l]);
       level_frames(scene.points(c, l), ci.segment_count[l], level.data());  // the frames Scene::segment_box() rebuilds
       double worst_sq = 0.0;  // largest squared distance of a level-0 point or original vertex from its level-l segment [m²]
+      WidestExtent widest;
       const std::size_t orig_slots = original_slots(orig_first, l, ci.segment_count[l]);
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
         Vec2 a, b;
@@ -599,26 +626,30 @@ class SceneBuild {
         }
         box.grow_measuring_slots(orig + orig_first[k0], orig_first[k1] - orig_first[k0], orig_slots, &ends[0]);
         se.e = box.extent(kBoxPad_m);
+        widest.add(se.e, se.length_m);
         worst_sq = std::max(worst_sq, box.worst_sq());
       }
       ci.max_error_m[l] = std::sqrt(worst_sq);  // one root per level
-      quantise_level(scene, c, l, level, widest_extent(level));
+      quantise_level(scene, c, l, level, widest.widest());
     }
     assign_tolerance_levels(scene, c);
   }
 
   // The largest |extent| of a level's boxes, what its quantum is chosen for [m]: the most any box reaches
-  // before its start, past its end or to either side.
-  static double widest_extent(const std::vector<SegmentExtent>& level) {
-    double before = 0.0, past = 0.0, right = 0.0, left = 0.0;  // four chains, merged once
-    for (const SegmentExtent& se : level) {
-      before = std::max(before, -se.e.u_min);
-      past = std::max(past, std::abs(se.e.u_max - se.length_m));
-      right = std::max(right, -se.e.n_min);
-      left = std::max(left, se.e.n_max);
+  // before its start, past its end or to either side, grown box by box as the pass measures them.
+  class WidestExtent {
+   public:
+    void add(const Extent& e, double length_m) {
+      before_ = std::max(before_, -e.u_min);
+      past_ = std::max(past_, std::abs(e.u_max - length_m));
+      right_ = std::max(right_, -e.n_min);
+      left_ = std::max(left_, e.n_max);
     }
-    return std::max({before, past, right, left});
-  }
+    double widest() const { return std::max({before_, past_, right_, left_}); }
+
+   private:
+    double before_ = 0.0, past_ = 0.0, right_ = 0.0, left_ = 0.0;  // four chains, merged once
+  };
 
   // The curve's level at each tolerance step (CurveNodes::tolerance_level): the coarsest level whose error
   // bound is within the step's tolerance, 0 when none is.
@@ -628,39 +659,17 @@ class SceneBuild {
   }
 
   // Level l's quantum (its widest extent / kQuantumSteps) and every segment's extents in it, rounded
-  // outward; the widest box of the level and its largest box error bound (quantised_reach).
+  // outward; the widest box of the level and its largest box error bound (ReachGrower).
   static void quantise_level(Scene& scene, std::size_t c, int l, const std::vector<SegmentExtent>& level, double widest) {
     CurveInfo& ci = scene.curves_[c];
     const float quantum = static_cast<float>(widest / kQuantumSteps);  // > 0: every extent holds the pad
     scene.curve_nodes_[c].quantum_m[l] = quantum;
     const double q = quantum, inverse_q = 1.0 / q;
     BoxExtent* out = scene.extent_.data() + ci.box_offset[l];
-    for (std::size_t k = 0; k < ci.segment_count[l]; ++k) out[k] = quantise_extent(level[k].e, level[k].length_m, q, inverse_q);
-    const QuantisedReach reach = quantised_reach(out, ci.segment_count[l]);
-    ci.max_box_half_width_m[l] = static_cast<double>(reach.half_width) * q;
-    ci.max_error_bound_m[l] = std::sqrt(reach.bound_sq) * q;
-  }
-
-  // The most a level's boxes reach, in quanta: the widest half-width, max(−n_min, n_max) (= max(|n_min|,
-  // |n_max|): n_min < 0 < n_max, as every box holds its segment, padded), and the largest overhang² +
-  // half-width² of one box, overhang = max(0, −u_min, u_over), how far it reaches past either end of its
-  // segment. Both are exact (integers below 2^16, squares summed below 2^31, in doubles).
-  struct QuantisedReach {
-    double half_width = 0.0;
-    double bound_sq = 0.0;
-  };
-  // Times the quantum, these are the widest box as Scene::segment_box() rebuilds it, bit for bit (k·q is
-  // monotone in k), and its largest box_error_bound but for the rounding of the end's sum length_m + u_over·q
-  // there (a few ulps). Maxima over a flat array of BoxExtent, without a data-dependent branch.
-  static QuantisedReach quantised_reach(const BoxExtent* e, std::size_t count) {
-    double half_width = 0.0, bound_sq = 0.0;
-    for (std::size_t k = 0; k < count; ++k) {
-      const double hw = std::max(-static_cast<double>(e[k].n_min), static_cast<double>(e[k].n_max));
-      const double over = std::max(std::max(0.0, -static_cast<double>(e[k].u_min)), static_cast<double>(e[k].u_over));
-      half_width = std::max(half_width, hw);
-      bound_sq = std::max(bound_sq, over * over + hw * hw);
-    }
-    return {half_width, bound_sq};
+    ReachGrower reach;
+    for (std::size_t k = 0; k < ci.segment_count[l]; ++k) out[k] = quantise_extent(level[k].e, level[k].length_m, q, inverse_q, reach);
+    ci.max_box_half_width_m[l] = reach.half_width() * q;
+    ci.max_error_bound_m[l] = std::sqrt(reach.bound_sq()) * q;
   }
 
   // Every curve's error boxes (build_segment_boxes) and the scene's bounds, those of the level-0 points.
