@@ -5,8 +5,10 @@
 #include "haptics/scene.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <new>
 
@@ -20,13 +22,6 @@ namespace {
 // Boxes grow by this much on every side so that corners computed in another frame, which carry
 // rounding of a few ulps, still test inside their parents.
 constexpr double kBoxPad_m = 1e-9;
-
-struct Extent {
-  double u_min = std::numeric_limits<double>::infinity();
-  double u_max = -std::numeric_limits<double>::infinity();
-  double n_min = std::numeric_limits<double>::infinity();
-  double n_max = -std::numeric_limits<double>::infinity();
-};
 
 // Two doubles side by side, (lane 0, lane 1): the box pass keeps a point's frame coordinates (u, n) in
 // one, so a point costs one subtraction, two products, one sum and a min and max of pairs (SSE2 where
@@ -68,6 +63,16 @@ inline Mask2 operator|(Mask2 a, Mask2 b) { return {_mm_or_pd(a.v, b.v)}; }
 inline bool any(Mask2 m) { return _mm_movemask_pd(m.v) != 0; }
 // 1 in each lane where it holds, else 0.
 inline Lanes2 ones(Mask2 m) { return {_mm_and_pd(m.v, _mm_set1_pd(1.0))}; }
+// A box's quantised extents, k = (u_min, n_min) and m = (n_max, u_over) (integers of |value| < 2^15 held in
+// doubles), as its BoxExtent: two conversions to int32 pairs, one interleave and shuffle into the struct's
+// order, one pack to int16 and a single 8-byte store, instead of a conversion and store per field.
+inline BoxExtent box_extent(Lanes2 k, Lanes2 m) {
+  const __m128i mixed = _mm_unpacklo_epi32(_mm_cvttpd_epi32(k.v), _mm_cvttpd_epi32(m.v));  // u_min, n_max, n_min, u_over
+  const __m128i ordered = _mm_shuffle_epi32(mixed, _MM_SHUFFLE(1, 2, 3, 0));                // u_min, u_over, n_min, n_max
+  std::int64_t bits = 0;
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(&bits), _mm_packs_epi32(ordered, ordered));
+  return std::bit_cast<BoxExtent>(bits);
+}
 #else
 struct Lanes2 {
   double a, b;
@@ -98,7 +103,15 @@ inline Mask2 where_less_equal(Lanes2 a, Lanes2 b) { return {a.a <= b.a, a.b <= b
 inline Mask2 operator|(Mask2 a, Mask2 b) { return {a.a || b.a, a.b || b.b}; }
 inline bool any(Mask2 m) { return m.a || m.b; }
 inline Lanes2 ones(Mask2 m) { return {m.a ? 1.0 : 0.0, m.b ? 1.0 : 0.0}; }
+inline BoxExtent box_extent(Lanes2 k, Lanes2 m) {
+  return BoxExtent{static_cast<std::int16_t>(k.a), static_cast<std::int16_t>(m.b), static_cast<std::int16_t>(k.b), static_cast<std::int16_t>(m.a)};
+}
 #endif
+
+// An extent in a segment's frame, as the box pass keeps it: lo = (u_min, n_min), hi = (u_max, n_max) [m].
+struct Extent {
+  Lanes2 lo, hi;
+};
 
 // A segment's frame for the box pass and what the pass grows in it: the extent of the points seen,
 // as (u_min, n_min) and (u_max, n_max) [m], and the largest squared distance from the segment of the
@@ -158,8 +171,8 @@ class BoxGrower {
   }
   // The extent grown so far, padded by pad_m on every side [m].
   Extent extent(double pad_m) const {
-    const Lanes2 lo = min(lo_[0], lo_[1]), hi = max(hi_[0], hi_[1]);
-    return Extent{lane0(lo) - pad_m, lane0(hi) + pad_m, lane1(lo) - pad_m, lane1(hi) + pad_m};
+    const Lanes2 pad = lanes(pad_m, pad_m);
+    return Extent{min(lo_[0], lo_[1]) - pad, max(hi_[0], hi_[1]) + pad};
   }
   // The largest squared distance measured [m²] (0 when none was).
   double worst_sq() const { return lane0(max(worst_sq_[0], worst_sq_[1])); }
@@ -229,8 +242,8 @@ inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, dou
     for (Mask2 s = too(k); any(s); s = too(k)) k = k + ones(s) * lanes(step, step);
     return k;
   };
-  const Lanes2 below = lanes(e.u_min, e.n_min);
-  const Lanes2 above = lanes(e.n_max, e.u_max), offset = lanes(0.0, length_m);
+  const Lanes2 below = e.lo;
+  const Lanes2 above = swapped(e.hi), offset = lanes(0.0, length_m);
   const auto k_over = [&](Lanes2 t) { return where_less(below, t * lq); };                     // k·q > v
   const auto k_short = [&](Lanes2 t) { return where_less_equal((t + one) * lq, below); };       // (k + 1)·q ≤ v
   const auto m_short = [&](Lanes2 t) { return where_less(offset + t * lq, above); };           // short of v
@@ -243,16 +256,16 @@ inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, dou
     m = step_while(step_while(m, +1.0, m_short), -1.0, m_over);
   }
   reach.add(k, m);
-  return BoxExtent{static_cast<std::int16_t>(lane0(k)), static_cast<std::int16_t>(lane1(m)), static_cast<std::int16_t>(lane1(k)),
-                   static_cast<std::int16_t>(lane0(m))};
+  return box_extent(k, m);
 }
 
 // A segment's frame (Scene::segment_frame: its unit axis and length [m]) and its measured extents in it,
 // padded [m].
 struct SegmentExtent {
+  SegmentExtent() {}  // not zeroed: level_frames and the box pass write every field of a level's entries before they are read
   Extent e;
   Vec2 axis;
-  double length_m = 0.0;
+  double length_m;
 };
 
 // The frames of segments k = 0 .. count−1 of a level, from points[k] to points[k + 1], into out[k].axis and
@@ -640,15 +653,19 @@ class SceneBuild {
   class WidestExtent {
    public:
     void add(const Extent& e, double length_m) {
-      before_ = std::max(before_, -e.u_min);
-      past_ = std::max(past_, std::abs(e.u_max - length_m));
-      right_ = std::max(right_, -e.n_min);
-      left_ = std::max(left_, e.n_max);
+      const Lanes2 zero = lanes(0.0, 0.0);
+      before_right_ = max(before_right_, zero - e.lo);
+      const Lanes2 d = e.hi - lanes(length_m, 0.0);  // (u_max − length, n_max)
+      past_left_ = max(past_left_, max(d, zero - d));  // (|u_max − length|, n_max): n_max > 0, as the box holds its segment
     }
-    double widest() const { return std::max({before_, past_, right_, left_}); }
+    double widest() const {
+      const Lanes2 w = max(before_right_, past_left_);
+      return std::max(lane0(w), lane1(w));
+    }
 
    private:
-    double before_ = 0.0, past_ = 0.0, right_ = 0.0, left_ = 0.0;  // four chains, merged once
+    Lanes2 before_right_ = lanes(0.0, 0.0);  // (−u_min, −n_min): the most before the start, to the right
+    Lanes2 past_left_ = lanes(0.0, 0.0);     // (|u_max − length|, n_max): the most past the end, to the left
   };
 
   // The curve's level at each tolerance step (CurveNodes::tolerance_level): the coarsest level whose error
@@ -685,8 +702,8 @@ class SceneBuild {
     }
     if (!scene.curves_.empty()) {
       const Extent e = bounds.extent(0.0);
-      scene.bounds_min_ = Vec2{e.u_min, e.n_min};
-      scene.bounds_max_ = Vec2{e.u_max, e.n_max};
+      scene.bounds_min_ = Vec2{lane0(e.lo), lane1(e.lo)};
+      scene.bounds_max_ = Vec2{lane0(e.hi), lane1(e.hi)};
     }
   }
 
