@@ -80,17 +80,21 @@ class Builder {
   // Builds the node over items [begin, end) at `depth`; returns its rectangle. The items are cut into four
   // runs along the longer axis of their centres, in sizes that are multiples of C, the largest power of 4
   // below their count (the last run takes the rest): every run of C items then makes a full subtree, so the
-  // nodes are nearly all full, about one per three items.
+  // nodes are nearly all full, about one per three items. At most four items take a slot each as they lie:
+  // a walk orders a node's slots by distance itself, so sorting them would only cost the build.
   Aabb build_node(std::size_t node, std::size_t begin, std::size_t end, int depth) {
     out_.depth = std::max(out_.depth, depth);
     const std::size_t m = end - begin;
     std::size_t run = 1;  // C
     while (run * 4 < m) run *= 4;
-    // Two cuts on the longer axis, then one in each half on the longer axis of that half.
     std::size_t cut[5] = {begin, 0, 0, 0, end};
-    cut[2] = split(begin, end, begin + std::min(m, 2 * run));
-    cut[1] = split(begin, cut[2], begin + std::min(cut[2] - begin, run));
-    cut[3] = split(cut[2], end, cut[2] + std::min(end - cut[2], run));
+    if (m <= 4) {
+      for (std::size_t i = 1; i < 4; ++i) cut[i] = begin + std::min(i, m);
+    } else {  // two cuts on the longer axis, then one in each half on the longer axis of that half
+      cut[2] = split(begin, end, begin + std::min(m, 2 * run));
+      cut[1] = split(begin, cut[2], begin + std::min(cut[2] - begin, run));
+      cut[3] = split(cut[2], end, cut[2] + std::min(end - cut[2], run));
+    }
     Aabb whole{{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()},
                {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}};
     for (int i = 0; i < 4; ++i) {

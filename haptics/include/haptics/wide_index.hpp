@@ -22,7 +22,8 @@
 /// coordinate), so float tests, with their rounding, never miss what the exact rectangle holds.
 /// Nodes are laid out depth first. A node cuts its items into four runs along the longer axis of their
 /// centres (twice: the whole, then each half), in sizes that fill subtrees completely, so nearly every node
-/// is full. A leaf is a child slot that names one item's segment node directly. With an item every 8
+/// is full; a node of at most four items takes them in the order they come (walks order a node's slots by
+/// distance). A leaf is a child slot that names one item's segment node directly. With an item every 8
 /// level-0 segments and a node per ~3 items, the index adds ~3.4 bytes per level-0 segment.
 
 #include <cstdint>
