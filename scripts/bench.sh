@@ -50,8 +50,8 @@ bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detecto
 /usr/bin/python3 - "$out" "$root/docs/PERFORMANCE.md" <<'PY'
 import re, sys
 doc = open(sys.argv[2]).read()
-for name, part in (("tolerance_cut", 1), ("tolerance_cut_polygons", 2), ("tolerance_cut_corners", 3), ("servo_tick", 0), ("earcon_latency", 0), ("servo_rate", 0), ("levels", 0), ("levels_speed", 1), ("stick_first_page", 0), ("pdf_pages", 0), ("device_loop", 0), ("device_loop_servo", 1)):
-    md = next((p for p in ("levels", "device_loop", "tolerance_cut") if name.startswith(p)), name)
+for name, part in (("tolerance_cut", 1), ("tolerance_cut_polygons", 2), ("tolerance_cut_corners", 3), ("servo_tick", 0), ("earcon_latency", 0), ("servo_rate", 0), ("levels", 0), ("levels_speed", 1), ("stick_first_page", 0), ("pdf_pages", 0), ("device_loop", 0), ("device_loop_servo", 1), ("capture_latency", 0), ("scene_detectors", 0), ("scene_detectors_compare", 1)):
+    md = next((p for p in ("levels", "device_loop", "tolerance_cut", "scene_detectors") if name.startswith(p)), name)
     lines = [l for l in open(f"{sys.argv[1]}/{md}.md").read().strip().split("\n\n")[part].splitlines() if l.startswith("|")]
     # Whatever is between the markers (nothing, the first time) becomes the table.
     doc = re.sub(rf"(<!-- BEGIN {name} -->\n).*?(<!-- END {name} -->)", lambda m: m.group(1) + "\n".join(lines) + "\n" + m.group(2), doc, flags=re.S)
