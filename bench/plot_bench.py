@@ -445,6 +445,22 @@ if size_rows:
                          "yes (both) |" % ", ".join("%.2f at %.1f mm" % (w["worst_curve_levels_ratio"], w["tolerance_mm"]) for w in worst))
     tables["round_two"] = "\n".join(rows2)
 
+# Finding and rectifying a page in a camera frame (bench_rectify): time per frame size, and the corner error.
+rect = {}
+for r in load_gbench("rectify.json"):
+    parts = r["name"].split("/")  # BM_<what>/<width>/<height>
+    if len(parts) >= 3:
+        rect.setdefault((int(parts[1]), int(parts[2])), {})[parts[0]] = r
+if rect:
+    rows = ["| frame | find_page + rectify_page | find_page | rectify_page | mean corner error |", "|---|---|---|---|---|"]
+    for (w, h), by in sorted(rect.items()):
+        def cell(name):
+            return "%.*f ms" % (2 if ns(by[name]) < 1e6 else 1, ns(by[name]) / 1e6) if name in by else "—"
+        both = by.get("BM_FindAndRectify", {})
+        err = "%.3f %%" % both["corner_error_pct"] if "corner_error_pct" in both else "—"
+        rows.append("| %d × %d | %s | %s | %s | %s |" % (w, h, cell("BM_FindAndRectify"), cell("BM_FindPage"), cell("BM_RectifyPage"), err))
+    tables["rectify"] = "\n".join(rows)
+
 if os.path.exists(PERF):
     text = open(PERF).read()
     for key, block in tables.items():
