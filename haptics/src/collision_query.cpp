@@ -9,19 +9,20 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <xmmintrin.h>
 #endif
 
 namespace hk {
 namespace {
 
-// Writes the section scan's masks two bits at a time: the bits of entries i and i + 1 (i even, in increasing
-// order) go to bits i % 64 and i % 64 + 1 of words[i / 64]; finish(end) stores the last, partial word.
-struct PairBitWriter {
+// Writes the section scan's masks four bits at a time: the bits of entries i .. i + 3 (i a multiple of 4, in
+// increasing order) go to bits i % 64 .. i % 64 + 3 of words[i / 64]; finish(end) stores the last, partial word.
+struct QuadBitWriter {
   std::uint64_t* words;
   std::uint64_t word = 0;
-  void put(std::size_t i, unsigned two_bits) noexcept {
-    word |= static_cast<std::uint64_t>(two_bits) << (i % 64);
-    if (i % 64 == 62) {
+  void put(std::size_t i, unsigned four_bits) noexcept {
+    word |= static_cast<std::uint64_t>(four_bits) << (i % 64);
+    if (i % 64 == 60) {
       words[i / 64] = word;
       word = 0;
     }
@@ -179,10 +180,14 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   capacity_ = std::min<std::size_t>(2 * n, kMaxSectionEntries) + widest_root + 8;
   section_.reserve(capacity_);
   section_parent_.assign(capacity_, kNoParent);
-  section_rect_.size_for(capacity_ + 1);
-  rect_d_sq_.assign(capacity_ + 1, 0.0);
-  rect_overlap_bits_.assign((capacity_ + 1) / 64 + 1, 0);
-  rect_near_bits_.assign((capacity_ + 1) / 64 + 1, 0);
+  section_rect_.size_for(capacity_ + kScanLanes);
+  rect_d_sq_.assign(capacity_ + kScanLanes, 0.0f);
+  rect_overlap_bits_.assign((capacity_ + kScanLanes) / 64 + 1, 0);
+  rect_near_bits_.assign((capacity_ + kScanLanes) / 64 + 1, 0);
+  if (scene.curve_count() > 0) {  // every section rectangle lies within the root's
+    const Aabb root = scene.aabb(scene.scene_root());
+    scale_m_ = std::max({std::abs(root.lo.x), std::abs(root.lo.y), std::abs(root.hi.x), std::abs(root.hi.y)});
+  }
   in_section_.assign(n, 0);
   children_in_.assign(n, 0);
   candidates_.reserve(capacity_);
@@ -482,7 +487,7 @@ void BoundarySection::next_tick() noexcept {
 // Phase 1: clip the sweep against every box of the boundary section, grown by the merge margin, so one
 // clip answers both "hit?" (then an exact clip makes it a candidate) and "still near?" (else it may merge).
 // On the way, the distance from the end of the sweep to the nearest box: the next free-space ball. The
-// rectangles settle most entries: scan_section_rects measures them all (two per SSE2 instruction), and only
+// rectangles settle most entries: scan_section_rects bounds them all (four per SSE instruction), and only
 // the entries whose rectangle meets the sweep, or is nearer than the nearest box found, have their box
 // rebuilt. An entry not hit is idle (hit_stamp_ not this tick): merge_idle_siblings may merge it.
 void BoundarySection::clip_section(Query& q) {
@@ -503,7 +508,7 @@ void BoundarySection::clip_section(Query& q) {
   for (std::size_t w = 0; w < words; ++w) {
     for (std::uint64_t m = rect_overlap_bits_[w] | rect_near_bits_[w]; m != 0; m &= m - 1) {
       const std::size_t i = 64 * w + static_cast<std::size_t>(__builtin_ctzll(m));
-      if (i >= n_section) break;  // the odd entry's partner, past the end
+      if (i >= n_section) break;  // past the end: the last group's far entries (never marked)
       const std::uint32_t node = section_[i];
       const std::uint64_t bit = std::uint64_t{1} << (i % 64);
       const ErrorBox box = sc.box(node);
@@ -518,85 +523,111 @@ void BoundarySection::clip_section(Query& q) {
   }
 }
 
-// The rectangle pass of clip_section: for every section entry, the squared distance from the sweep's end to
-// its rectangle (rect_d_sq_; rect_distance_sq, bit for bit) and whether the rectangle, grown by the merge
-// margin, meets the sweep's (bit i % 64 of rect_overlap_bits_[i / 64]; overlaps()). Entries in pairs (the
-// arrays hold one entry past the most there can be; an odd section's last pair has a second one made
-// infinitely far, SectionRects::set_far). Returns the entry of the nearest rectangle (the first of equals;
-// section_.size() when it is empty).
+// The rectangle pass of clip_section: for every section entry, a lower bound on the squared distance from the
+// sweep's end to its rectangle (rect_d_sq_) and whether the rectangle, grown by the merge margin, may meet the
+// sweep's (bit i % 64 of rect_overlap_bits_[i / 64]), four entries per SSE instruction. The rectangles are floats
+// widened outward (SectionRects::set), so both answers are conservative: every entry whose exact rectangle meets
+// the sweep's grown by the margin has its bit (the comparisons are against the sweep's bounds widened outward as
+// well, with no arithmetic on the rectangles), and each distance is at most the exact one (a slack of 2^-20 of
+// the largest coordinate, four times what rounding the point and the subtractions can add, is taken off each
+// axis's distance; with it the squares' rounding cannot lift the sum above the exact distance either). The exact
+// boxes decide after it (clip_section). Entries in groups of four: the arrays hold four past the most there can
+// be, and the four past the section are made infinitely far (SectionRects::set_far), so the last group's extra
+// lanes measure +inf and meet nothing. Returns the entry of the nearest rectangle by these bounds (the first of
+// equals; section_.size() when it is empty).
 std::size_t BoundarySection::scan_section_rects(const Query& q) {
   const std::size_t n = section_.size();
-  const double* lo_x = section_rect_.lo_x.data();
-  const double* lo_y = section_rect_.lo_y.data();
-  const double* hi_x = section_rect_.hi_x.data();
-  const double* hi_y = section_rect_.hi_y.data();
-  double* d_sq = rect_d_sq_.data();
-  PairBitWriter overlap{rect_overlap_bits_.data()};
+  const float* lo_x = section_rect_.lo_x.data();
+  const float* lo_y = section_rect_.lo_y.data();
+  const float* hi_x = section_rect_.hi_x.data();
+  const float* hi_y = section_rect_.hi_y.data();
+  float* d_sq = rect_d_sq_.data();
+  QuadBitWriter overlap{rect_overlap_bits_.data()};
+  // The sweep's rectangle grown by the margin, widened outward as the entries' are: an entry may meet it when
+  // lo ≤ s_hi and s_lo ≤ hi.
   const double m = merge_margin_m_;
-  section_rect_.set_far(n);  // an odd entry's partner: infinitely far, meeting nothing (past an even section: unread)
-  double nearest_sq = std::numeric_limits<double>::infinity();
+  const float s_lo_x = float_below(q.sweep.lo.x - m), s_lo_y = float_below(q.sweep.lo.y - m);
+  const float s_hi_x = float_above(q.sweep.hi.x + m), s_hi_y = float_above(q.sweep.hi.y + m);
+  const float px = static_cast<float>(q.b.x), py = static_cast<float>(q.b.y);
+  const double largest = std::max({scale_m_, std::abs(q.b.x), std::abs(q.b.y)});
+  const float slack = float_above(1e-12 + largest * 0x1p-20);
   std::size_t nearest = n;
   std::size_t i = 0;
 #if defined(__SSE2__)
-  const __m128d px = _mm_set1_pd(q.b.x), py = _mm_set1_pd(q.b.y), zero = _mm_setzero_pd();
-  const __m128d s_lo_x = _mm_set1_pd(q.sweep.lo.x), s_lo_y = _mm_set1_pd(q.sweep.lo.y);
-  const __m128d s_hi_x = _mm_set1_pd(q.sweep.hi.x), s_hi_y = _mm_set1_pd(q.sweep.hi.y), vm = _mm_set1_pd(m);
-  // The nearest rectangle per lane (even entries, odd entries) and its entry (as a double, exact below 2^53),
-  // kept without a branch: its place in the section is a coin toss to the branch predictor.
-  __m128d v_nearest = _mm_set1_pd(nearest_sq), v_entry = _mm_set1_pd(static_cast<double>(n));
-  __m128d v_i = _mm_set_pd(1.0, 0.0);
-  const __m128d two = _mm_set1_pd(2.0);
-  for (; i < n; i += 2) {
-    const __m128d lx = _mm_loadu_pd(lo_x + i), ly = _mm_loadu_pd(lo_y + i), hx = _mm_loadu_pd(hi_x + i), hy = _mm_loadu_pd(hi_y + i);
-    const __m128d dx = _mm_max_pd(_mm_max_pd(_mm_sub_pd(lx, px), zero), _mm_sub_pd(px, hx));
-    const __m128d dy = _mm_max_pd(_mm_max_pd(_mm_sub_pd(ly, py), zero), _mm_sub_pd(py, hy));
-    const __m128d d = _mm_add_pd(_mm_mul_pd(dx, dx), _mm_mul_pd(dy, dy));
-    _mm_storeu_pd(d_sq + i, d);
-    const __m128d nearer = _mm_cmplt_pd(d, v_nearest);
-    v_nearest = _mm_min_pd(d, v_nearest);
-    v_entry = _mm_or_pd(_mm_and_pd(nearer, v_i), _mm_andnot_pd(nearer, v_entry));
-    v_i = _mm_add_pd(v_i, two);
-    const __m128d meets = _mm_and_pd(_mm_and_pd(_mm_cmple_pd(_mm_sub_pd(lx, vm), s_hi_x), _mm_cmple_pd(s_lo_x, _mm_add_pd(hx, vm))),
-                                     _mm_and_pd(_mm_cmple_pd(_mm_sub_pd(ly, vm), s_hi_y), _mm_cmple_pd(s_lo_y, _mm_add_pd(hy, vm))));
-    overlap.put(i, static_cast<unsigned>(_mm_movemask_pd(meets)));
+  const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), zero = _mm_setzero_ps(), vslack = _mm_set1_ps(slack);
+  const __m128 v_slo_x = _mm_set1_ps(s_lo_x), v_slo_y = _mm_set1_ps(s_lo_y), v_shi_x = _mm_set1_ps(s_hi_x), v_shi_y = _mm_set1_ps(s_hi_y);
+  // The nearest rectangle per lane and its entry (as a float, exact below 2^24), kept without a branch: its place
+  // in the section is a coin toss to the branch predictor.
+  static_assert(kMaxSectionEntries < (1u << 24), "entries are exact as floats");
+  __m128 v_nearest = _mm_set1_ps(std::numeric_limits<float>::infinity()), v_entry = _mm_set1_ps(static_cast<float>(n));
+  __m128 v_i = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
+  const __m128 four = _mm_set1_ps(4.0f), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  // The last group's entries past the section: infinitely far, meeting nothing (SectionRects::set_far).
+  _mm_storeu_ps(section_rect_.lo_x.data() + n, inf);
+  _mm_storeu_ps(section_rect_.lo_y.data() + n, inf);
+  _mm_storeu_ps(section_rect_.hi_x.data() + n, _mm_sub_ps(_mm_setzero_ps(), inf));
+  _mm_storeu_ps(section_rect_.hi_y.data() + n, _mm_sub_ps(_mm_setzero_ps(), inf));
+  for (; i < n; i += kScanLanes) {
+    const __m128 lx = _mm_loadu_ps(lo_x + i), ly = _mm_loadu_ps(lo_y + i), hx = _mm_loadu_ps(hi_x + i), hy = _mm_loadu_ps(hi_y + i);
+    const __m128 dx = _mm_max_ps(_mm_sub_ps(_mm_max_ps(_mm_sub_ps(lx, vpx), _mm_sub_ps(vpx, hx)), vslack), zero);
+    const __m128 dy = _mm_max_ps(_mm_sub_ps(_mm_max_ps(_mm_sub_ps(ly, vpy), _mm_sub_ps(vpy, hy)), vslack), zero);
+    const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+    _mm_storeu_ps(d_sq + i, d);
+    const __m128 nearer = _mm_cmplt_ps(d, v_nearest);
+    v_nearest = _mm_min_ps(d, v_nearest);
+    v_entry = _mm_or_ps(_mm_and_ps(nearer, v_i), _mm_andnot_ps(nearer, v_entry));
+    v_i = _mm_add_ps(v_i, four);
+    const __m128 meets = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(lx, v_shi_x), _mm_cmple_ps(v_slo_x, hx)),
+                                    _mm_and_ps(_mm_cmple_ps(ly, v_shi_y), _mm_cmple_ps(v_slo_y, hy)));
+    overlap.put(i, static_cast<unsigned>(_mm_movemask_ps(meets)));
   }
-  // The nearer lane; of equals, the first entry.
-  alignas(16) double lane_d[2], lane_entry[2];
-  _mm_store_pd(lane_d, v_nearest);
-  _mm_store_pd(lane_entry, v_entry);
-  const bool odd_lane = (lane_d[1] < lane_d[0]) | ((lane_d[1] == lane_d[0]) & (lane_entry[1] < lane_entry[0]));
-  nearest = static_cast<std::size_t>(odd_lane ? lane_entry[1] : lane_entry[0]);
+  // The nearest lane; of equals, the first entry: the smallest distance over the lanes, then the smallest entry
+  // of the lanes at it (each a minimum of four by two shuffles).
+  const auto min4 = [](__m128 v) {
+    v = _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2)));
+    return _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+  };
+  const __m128 d_min = min4(v_nearest);
+  const __m128 at_min = _mm_cmpeq_ps(v_nearest, d_min);
+  nearest = static_cast<std::size_t>(_mm_cvtss_f32(min4(_mm_or_ps(_mm_and_ps(at_min, v_entry), _mm_andnot_ps(at_min, _mm_set1_ps(static_cast<float>(n)))))));
 #else
-  for (; i < n; i += 2) {
-    unsigned two_bits = 0;
-    for (std::size_t k = i; k < i + 2; ++k) {
-      const Aabb r{{lo_x[k], lo_y[k]}, {hi_x[k], hi_y[k]}};
-      d_sq[k] = rect_distance_sq(r, q.b);
+  for (std::size_t k = n; k < n + kScanLanes; ++k) section_rect_.set_far(k);  // the last group's entries past the section
+  float nearest_sq = std::numeric_limits<float>::infinity();
+  for (; i < n; i += kScanLanes) {
+    unsigned four_bits = 0;
+    for (std::size_t k = i; k < i + kScanLanes; ++k) {
+      const float dx = std::max(std::max(lo_x[k] - px, px - hi_x[k]) - slack, 0.0f);
+      const float dy = std::max(std::max(lo_y[k] - py, py - hi_y[k]) - slack, 0.0f);
+      d_sq[k] = dx * dx + dy * dy;
       if (d_sq[k] < nearest_sq) {
         nearest_sq = d_sq[k];
         nearest = k;
       }
-      if (overlaps(r, q.sweep, m)) two_bits |= 1u << (k - i);
+      if (lo_x[k] <= s_hi_x && s_lo_x <= hi_x[k] && lo_y[k] <= s_hi_y && s_lo_y <= hi_y[k]) four_bits |= 1u << (k - i);
     }
-    overlap.put(i, two_bits);
+    overlap.put(i, four_bits);
   }
 #endif
   overlap.finish(i);
   return nearest;
 }
 
-// The entries whose rectangle is nearer to the sweep's end than bound_sq [m²], but for `skip` (whose box
-// was measured already): bit i % 64 of rect_near_bits_[i / 64]. In pairs, as scan_section_rects.
+// The entries whose rectangle may be nearer to the sweep's end than bound_sq [m²] (their distance bound is
+// below it, rounded up to a float), but for `skip` (whose box was measured already): bit i % 64 of
+// rect_near_bits_[i / 64]. In groups of four, as scan_section_rects.
 void BoundarySection::mark_near_rects(double bound_sq, std::size_t skip) {
   const std::size_t n = section_.size();
-  const double* d_sq = rect_d_sq_.data();
-  PairBitWriter near{rect_near_bits_.data()};
+  const float* d_sq = rect_d_sq_.data();
+  const float bound = float_above(bound_sq);
+  QuadBitWriter near{rect_near_bits_.data()};
   std::size_t i = 0;
-  for (; i < n; i += 2) {
+  for (; i < n; i += kScanLanes) {
 #if defined(__SSE2__)
-    near.put(i, static_cast<unsigned>(_mm_movemask_pd(_mm_cmplt_pd(_mm_loadu_pd(d_sq + i), _mm_set1_pd(bound_sq)))));
+    near.put(i, static_cast<unsigned>(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(d_sq + i), _mm_set1_ps(bound)))));
 #else
-    near.put(i, (d_sq[i] < bound_sq ? 1u : 0u) | (d_sq[i + 1] < bound_sq ? 2u : 0u));
+    unsigned four_bits = 0;
+    for (std::size_t k = 0; k < kScanLanes; ++k) four_bits |= (d_sq[i + k] < bound ? 1u : 0u) << k;
+    near.put(i, four_bits);
 #endif
   }
   near.finish(i);
@@ -965,13 +996,6 @@ inline float slab_reciprocal(double d) {
   const float f = static_cast<float>(d);
   if (std::abs(f) < 1e-20f) return d < 0.0 ? -1e20f : 1e20f;
   return 1.0f / f;
-}
-
-// A float at least x (x ≥ 0): bounds compared against float distances must not shrink in the rounding.
-inline float float_at_least(double x) {
-  float f = static_cast<float>(x);
-  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
 }
 
 }  // namespace

@@ -2,10 +2,10 @@
 #include "haptics/wide_index.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 
+#include "haptics/float_round.hpp"
 #include "haptics/scene.hpp"
 
 namespace hk {
@@ -45,31 +45,6 @@ Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) {
     extend(r, lerp(p0, p1, (i + 1.0) / pieces));
   }
   return r;
-}
-
-// The next float toward −∞ (`down`) or +∞ from a finite f, by its bits (std::nextafter is a library call,
-// four per slot of every node).
-float next_float(float f, bool down) {
-  if (f == 0.0f) return down ? -std::numeric_limits<float>::denorm_min() : std::numeric_limits<float>::denorm_min();
-  const auto bits = std::bit_cast<std::uint32_t>(f);
-  return std::bit_cast<float>(bits + 1u - 2u * static_cast<std::uint32_t>((f > 0.0f) == down));  // magnitude down or up
-}
-
-// `if_true` when `pick`, else `otherwise`, by their bits: the nearest float's side of x is a coin toss,
-// which a branch would mispredict half the time.
-float pick_float(bool pick, float if_true, float otherwise) {
-  const auto a = std::bit_cast<std::uint32_t>(if_true), b = std::bit_cast<std::uint32_t>(otherwise);
-  return std::bit_cast<float>(b ^ ((a ^ b) & (0u - static_cast<std::uint32_t>(pick))));
-}
-
-// Largest float not above x, and smallest not below.
-float round_down(double x) {
-  const float f = static_cast<float>(x);
-  return pick_float(static_cast<double>(f) > x, next_float(f, true), f);
-}
-float round_up(double x) {
-  const float f = static_cast<float>(x);
-  return pick_float(static_cast<double>(f) < x, next_float(f, false), f);
 }
 
 class Builder {
@@ -175,10 +150,10 @@ class Builder {
   static double median_of_three(double x, double y, double z) { return std::max(std::min(x, y), std::min(std::max(x, y), z)); }
   void set_slot(std::size_t node, int i, const Aabb& r, std::uint32_t code, double pad_m) {
     WideNode& n = out_.nodes[node];
-    n.lo_x[i] = round_down(r.lo.x - pad_m);
-    n.lo_y[i] = round_down(r.lo.y - pad_m);
-    n.hi_x[i] = round_up(r.hi.x + pad_m);
-    n.hi_y[i] = round_up(r.hi.y + pad_m);
+    n.lo_x[i] = float_at_most(r.lo.x - pad_m);
+    n.lo_y[i] = float_at_most(r.lo.y - pad_m);
+    n.hi_x[i] = float_at_least(r.hi.x + pad_m);
+    n.hi_y[i] = float_at_least(r.hi.y + pad_m);
     n.child[i] = code;
   }
   std::vector<Item>& items_;

@@ -12,6 +12,7 @@
 #include "crossing_grid.hpp"
 #include "curves.hpp"
 #include "haptics/collision_query.hpp"
+#include "haptics/float_round.hpp"
 #include "haptics/scene.hpp"
 
 using namespace hk;
@@ -710,15 +711,27 @@ TEST(CollisionQuery, BoundarySectionStaysSmallOnALongWalk) {
 // contact solver's edge contact does), is answered on most ticks near a wall without a full query (the plain
 // free-space ball there is only as large as the gap to the wall), and every answer, hit or clear, and the
 // segment hit, equals brute force over the level's polylines with the exclusion. Levels and a tolerance step.
-TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
+// What a sliding hand's walk did: its hits, its ticks within 1 mm of a wall, how many of those were answered
+// without a full query, and the answers of the ball's walls.
+struct SlideCounts {
+  int hits = 0, near_walls = 0, near_walls_answered = 0, walls_answers = 0;
+};
+
+// A hand sliding along walls and resting on them, 100 000 ticks over three level ids, with the scene and the hand
+// moved by `offset` [m]: every answer equal to brute force (asserted here; its counts in *out).
+void slide_along_walls(Vec2 offset, SlideCounts* out) {
   std::mt19937 rng(61);
-  const Scene sc = Scene::build(random_scene(rng, 8, 8), 6);
+  std::vector<Polyline> curves = random_scene(rng, 8, 8);
+  for (Polyline& c : curves) {
+    for (Vec2& v : c.points_m) v = v + offset;
+  }
+  const Scene sc = Scene::build(curves, 6);
   BoundarySection section(sc);
   const int ids[3] = {0, 2, kToleranceLevelBase + 3};
   std::uniform_real_distribution<double> jitter(-0.0001, 0.0001), drift(-0.0004, 0.0004);
   std::uniform_int_distribution<int> slide(5, 60);
   int id = 0, hits = 0, near_walls = 0, near_walls_answered = 0, walls_answers = 0;
-  Vec2 p{0.0, 0.0}, heading{0.0003, 0.0001};
+  Vec2 p = offset, heading{0.0003, 0.0001};
   SegmentRef resting{};  // the wall slid along (excluded), while `sliding` ticks are left
   int sliding = 0;
   std::vector<SegmentRef> near_refs;
@@ -732,7 +745,7 @@ TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
       const Vec2 along = (w1 - w0) * (1.0 / std::max(distance(w0, w1), 1e-12));
       move = along * (dot(heading, along) >= 0 ? 0.0002 : -0.0002) + Vec2{jitter(rng), jitter(rng)};
     }
-    const Vec2 q{std::clamp(p.x + move.x, -0.07, 0.07), std::clamp(p.y + move.y, -0.045, 0.045)};
+    const Vec2 q{std::clamp(p.x + move.x, offset.x - 0.07, offset.x + 0.07), std::clamp(p.y + move.y, offset.y - 0.045, offset.y + 0.045)};
     const int n_excl = sliding > 0 ? 1 : 0;
     QueryStats st;
     const SweepHit h = section.first_hit(p, q, id, &resting, n_excl, QueryBudget{}, &st);
@@ -764,10 +777,61 @@ TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
   }
   std::printf("[ info ] sliding hand: %d hits, %d ticks within 1 mm of a wall, %.0f %% of them answered without a full query; "
               "%d answers by the ball's walls\n", hits, near_walls, 100.0 * near_walls_answered / std::max(near_walls, 1), walls_answers);
-  EXPECT_GT(hits, 2000);
-  EXPECT_GT(near_walls, 20000);
-  EXPECT_GT(near_walls_answered, near_walls / 2);
-  EXPECT_GT(walls_answers, near_walls / 4);
+  *out = SlideCounts{hits, near_walls, near_walls_answered, walls_answers};
+}
+
+// Near the origin, as the kiosk's scenes are: every answer as brute force, and most ticks near a wall answered by
+// the ball or its walls.
+TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
+  SlideCounts n;
+  ASSERT_NO_FATAL_FAILURE(slide_along_walls(Vec2{0.0, 0.0}, &n));
+  EXPECT_GT(n.hits, 2000);
+  EXPECT_GT(n.near_walls, 20000);
+  EXPECT_GT(n.near_walls_answered, n.near_walls / 2);
+  EXPECT_GT(n.walls_answers, n.near_walls / 4);
+}
+
+// Kilometres from the origin, where a float's step (0.5 mm at 4 km) is as large as the hand's step: the section's
+// float rectangles and the scan's bounds must widen with the coordinates to stay conservative (without the
+// widening and the scan's slack, a wall is missed within 150 ticks). Every answer as brute force; the balls are
+// smaller there (the slack is 4 mm), so fewer ticks skip the full query, and that is not asserted.
+TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForceFarFromTheOrigin) {
+  SlideCounts n;
+  ASSERT_NO_FATAL_FAILURE(slide_along_walls(Vec2{4000.0, -2500.0}, &n));
+  EXPECT_GT(n.hits, 2000);
+  EXPECT_GT(n.near_walls, 20000);
+}
+
+// The roundings of float_round.hpp, on doubles of every magnitude the scenes use and far past it, floats
+// themselves and their neighbours, and zero: float_at_most and float_at_least on the right side of x and the
+// nearest such floats (the next float out is past x); float_below and float_above on the right side of x and
+// within 2^-19 of |x| (+ 2^-99) of it.
+TEST(FloatRound, EachRoundingStaysOnItsSideOfX) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-40, 40);
+  std::vector<double> xs = {0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1e-30, -1e-30, 1e30, -1e30};
+  for (int i = 0; i < 200000; ++i) {
+    const double x = std::ldexp(mantissa(rng), exponent(rng));
+    xs.push_back(x);
+    const auto f = static_cast<double>(static_cast<float>(x));  // a float itself, and a double just either side of it
+    xs.push_back(f);
+    xs.push_back(std::nextafter(f, 1e300));
+    xs.push_back(std::nextafter(f, -1e300));
+  }
+  for (const double x : xs) {
+    const float lo = float_at_most(x), hi = float_at_least(x);
+    ASSERT_LE(static_cast<double>(lo), x) << x;
+    ASSERT_GE(static_cast<double>(hi), x) << x;
+    ASSERT_GT(static_cast<double>(std::nextafter(lo, std::numeric_limits<float>::infinity())), x) << x;
+    ASSERT_LT(static_cast<double>(std::nextafter(hi, -std::numeric_limits<float>::infinity())), x) << x;
+    const float below = float_below(x), above = float_above(x);
+    ASSERT_LT(static_cast<double>(below), x) << x;
+    ASSERT_GT(static_cast<double>(above), x) << x;
+    const double loose = std::ldexp(std::abs(x), -19) + 0x1p-99;
+    ASSERT_GE(static_cast<double>(below), x - loose) << x;
+    ASSERT_LE(static_cast<double>(above), x + loose) << x;
+  }
 }
 
 // The slab clip every box test of the query rests on (Liang–Barsky), checked against the segment's points

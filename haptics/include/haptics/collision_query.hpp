@@ -38,6 +38,7 @@
 #include <memory>
 #include <vector>
 
+#include "haptics/float_round.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/tolerance_cut.hpp"
 
@@ -311,25 +312,31 @@ class BoundarySection {
   double merge_margin_m_;
   std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
   std::vector<std::uint32_t> section_parent_;  // per entry, in step with section_: its node's parent (kNoParent: the root)
-  // The section entries' rectangles [m], in step with section_, as four arrays (structure of arrays) so the
-  // per-tick scan tests two entries per SSE2 instruction and streams through memory; sized capacity_ + 1
-  // (one past the most entries: the scan reads them in pairs) and never resized, so the servo path allocates
-  // nothing.
+  // The section entries' rectangles [m], in step with section_, as four arrays (structure of arrays) of floats
+  // widened outward (float_below, float_above: each holds the exact rectangle, Scene::aabb), so the per-tick scan
+  // tests four entries per SSE instruction and streams through memory; sized capacity_ + kScanLanes (the scan
+  // reads and pads whole groups of four past the last entry) and never resized, so the servo path allocates nothing.
+  static constexpr std::size_t kScanLanes = 4;
   struct SectionRects {
-    std::vector<double> lo_x, lo_y, hi_x, hi_y;
-    void size_for(std::size_t n) { lo_x.assign(n, 0.0); lo_y.assign(n, 0.0); hi_x.assign(n, 0.0); hi_y.assign(n, 0.0); }
-    void set(std::size_t i, const Aabb& r) noexcept { lo_x[i] = r.lo.x; lo_y[i] = r.lo.y; hi_x[i] = r.hi.x; hi_y[i] = r.hi.y; }
+    std::vector<float> lo_x, lo_y, hi_x, hi_y;
+    void size_for(std::size_t n) { lo_x.assign(n, 0.0f); lo_y.assign(n, 0.0f); hi_x.assign(n, 0.0f); hi_y.assign(n, 0.0f); }
+    void set(std::size_t i, const Aabb& r) noexcept {
+      lo_x[i] = float_below(r.lo.x); lo_y[i] = float_below(r.lo.y); hi_x[i] = float_above(r.hi.x); hi_y[i] = float_above(r.hi.y);
+    }
     // Entry i as a rectangle infinitely far from every point, meeting none (lo = +inf, hi = -inf).
     void set_far(std::size_t i) noexcept {
-      constexpr double kInf = std::numeric_limits<double>::infinity();
+      constexpr float kInf = std::numeric_limits<float>::infinity();
       lo_x[i] = kInf; lo_y[i] = kInf; hi_x[i] = -kInf; hi_y[i] = -kInf;
     }
     void copy(std::size_t to, std::size_t from) noexcept { lo_x[to] = lo_x[from]; lo_y[to] = lo_y[from]; hi_x[to] = hi_x[from]; hi_y[to] = hi_y[from]; }
   };
   SectionRects section_rect_;
-  std::vector<double> rect_d_sq_;          // scan scratch, per entry: squared distance from the sweep's end to its rectangle [m²]
-  std::vector<std::uint64_t> rect_overlap_bits_;  // scan scratch, a bit per entry: its rectangle, grown by the merge margin, meets the sweep's
-  std::vector<std::uint64_t> rect_near_bits_;     // scan scratch, a bit per entry: its rectangle is nearer than the nearest box so far
+  // scan scratch, per entry: a lower bound on the squared distance from the sweep's end to its rectangle [m²]
+  // (scan_section_rects), in step with section_ and sized as section_rect_
+  std::vector<float> rect_d_sq_;
+  std::vector<std::uint64_t> rect_overlap_bits_;  // scan scratch, a bit per entry: its rectangle, grown by the merge margin, may meet the sweep's
+  std::vector<std::uint64_t> rect_near_bits_;     // scan scratch, a bit per entry: its rectangle may be nearer than the nearest box so far
+  double scale_m_ = 0.0;                   // the largest coordinate magnitude of any section rectangle (the scene root's) [m]
   static constexpr std::uint32_t kNoParent = 0xffffffffu;  // the root's `parent` below: counted nowhere
   // Appends node with its rectangle and marks it in (the caller checked the room); parent: parent_or_none(node).
   void push_section(std::uint32_t node, std::uint32_t parent);
