@@ -62,6 +62,13 @@ for r in fh:
     m = re.match(r"BM_(FirstHit|Closest)/(\w+)/(\d+)/manual_time", r["name"])
     if m:
         size_rows[(m.group(1), int(m.group(3)))][m.group(2)] = r
+# The first-hit methods side by side, round by round (BM_FirstHitPaired/<segments>; absent in older runs): each
+# method at its best round (fastest block, lowest p99), the ratios of those.
+paired_fh = {}
+for r in fh:
+    m = re.match(r"BM_FirstHitPaired/(\d+)", r["name"])
+    if m:
+        paired_fh[int(m.group(1))] = r
 if size_rows:
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
     for ax, kind in zip(axes, ["FirstHit", "Closest"]):
@@ -358,10 +365,20 @@ if size_rows:
                 if clock_ns else "")
     nt, nmet = batch_txt(fh_mean_n, fw_mean_n, "x", lambda v: v >= 6, what=net_what, short="net")
     bt, bmet = batch_txt(fh_mean_b, fw_mean_b, "x", lambda v: v >= 6)
-    rows2.append("| first hit: mean ≥ 6x faster than the R-tree at 10^5 and 10^6 | R-tree mean / ours, per query with its clock reads: first_hit (boundary section) %s%s%s%s | per query: first_hit %s%s%s%s |" % (
-        fmt(fh_mean, "x"), wide_txt(fw_mean, "x"), nt, bt, yes(all(v >= 6 for _, v in fh_mean)), wide_met(fw_mean, lambda v: v >= 6), nmet, bmet))
-    rows2.append("| first hit: p99 ≤ 0.5x the R-tree's | ours p99 / R-tree p99: first_hit %s%s | first_hit: %s%s |" % (
-        fmt(fh_p99, ""), wide_txt(fw_p99, ""), yes(all(v <= 0.5 for _, v in fh_p99)), wide_met(fw_p99, lambda v: v <= 0.5)))
+    paired_cells = lambda key: [(n, paired_fh[n][key]) for n in big if n in paired_fh]
+    paired_rounds = ", ".join(sorted({"%d" % paired_fh[n]["rounds"] for n in paired_fh}))
+
+    def paired_txt(key, unit, ok, what):
+        """The side-by-side figures and verdict (BM_FirstHitPaired) for a row, first_hit then first_hit_wide ("" when absent)."""
+        return batch_txt(paired_cells(key), paired_cells(key + "_wide"), unit, ok,
+                         what="side by side (BM_FirstHitPaired: the methods in turn, %s rounds, each at its best round; %s)" % (paired_rounds, what),
+                         short="side by side")
+    pt, pmet = paired_txt("rtree_over_ours_batch", "x", lambda v: v >= 6, "batch means")
+    rows2.append("| first hit: mean ≥ 6x faster than the R-tree at 10^5 and 10^6 | R-tree mean / ours, per query with its clock reads: first_hit (boundary section) %s%s%s%s%s | per query: first_hit %s%s%s%s%s |" % (
+        fmt(fh_mean, "x"), wide_txt(fw_mean, "x"), nt, bt, pt, yes(all(v >= 6 for _, v in fh_mean)), wide_met(fw_mean, lambda v: v >= 6), nmet, bmet, pmet))
+    pt, pmet = paired_txt("ours_p99_over_rtree", "", lambda v: v <= 0.5, "lowest p99s")
+    rows2.append("| first hit: p99 ≤ 0.5x the R-tree's | ours p99 / R-tree p99: first_hit %s%s%s | first_hit: %s%s%s |" % (
+        fmt(fh_p99, ""), wide_txt(fw_p99, ""), pt, yes(all(v <= 0.5 for _, v in fh_p99)), wide_met(fw_p99, lambda v: v <= 0.5), pmet))
     pic_faster = sum(1 for rows in pic.values() if "embree" in rows and ns(rows["ours"]) < ns(rows["embree"]))
     pic_wide = [rows for rows in pic.values() if "embree" in rows and "ours_wide" in rows]
     wide_pic_faster = sum(1 for rows in pic_wide if ns(rows["ours_wide"]) < ns(rows["embree"]))
@@ -369,9 +386,10 @@ if size_rows:
     wide_pic_met = (" on the tiled scenes; on every picture: %s" % yes(wide_pic_faster == len(pic_wide))) if fw_emb and pic_wide else (
         " on the tiled scenes (not run on the pictures)" if fw_emb else "")
     bt, bmet = batch_txt(fh_emb_b, fw_emb_b, "x", lambda v: v > 1)
-    rows2.append("| first hit: faster than Embree on the same streams | Embree mean / ours: first_hit %s, pictures where it is faster: %d of %d%s%s%s | first_hit: %s%s%s |" % (
-        fmt(fh_emb, "x"), pic_faster, len(pic), wide_txt(fw_emb, "x"), wide_pic_txt, bt, yes(all(v > 1 for _, v in fh_emb) and pic_faster == len(pic)),
-        wide_met(fw_emb, lambda v: v > 1) + wide_pic_met, bmet))
+    pt, pmet = paired_txt("embree_over_ours_batch", "x", lambda v: v > 1, "batch means, the tiled scenes")
+    rows2.append("| first hit: faster than Embree on the same streams | Embree mean / ours: first_hit %s, pictures where it is faster: %d of %d%s%s%s%s | first_hit: %s%s%s%s |" % (
+        fmt(fh_emb, "x"), pic_faster, len(pic), wide_txt(fw_emb, "x"), wide_pic_txt, bt, pt, yes(all(v > 1 for _, v in fh_emb) and pic_faster == len(pic)),
+        wide_met(fw_emb, lambda v: v > 1) + wide_pic_met, bmet, pmet))
     cpb, cpb_met = batch_txt(cp_mean_b, [], "x", lambda v: v >= 3, label="")
     cpn, cpn_met = batch_txt(cp_mean_n, [], "x", lambda v: v >= 3, label="", what=net_what, short="net")
     rows2.append("| closest point: mean ≥ 3x faster than the R-tree | R-tree mean / ours, per query with its clock reads: %s%s%s | per query: %s%s%s |" % (
