@@ -532,7 +532,7 @@ void BoundarySection::clip_section(Query& q) {
 // the largest coordinate, four times what rounding the point and the subtractions can add, is taken off each
 // axis's distance; with it the squares' rounding cannot lift the sum above the exact distance either). The exact
 // boxes decide after it (clip_section). Entries in groups of four: the arrays hold four past the most there can
-// be, and the four past the section are made infinitely far (SectionRects::set_far), so the last group's extra
+// be, and the four past the section are made infinitely far (SectionRects::set_far_group), so the last group's extra
 // lanes measure +inf and meet nothing. Returns the entry of the nearest rectangle by these bounds (the first of
 // equals; section_.size() when it is empty).
 std::size_t BoundarySection::scan_section_rects(const Query& q) {
@@ -551,6 +551,7 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
   const float px = static_cast<float>(q.b.x), py = static_cast<float>(q.b.y);
   const double largest = std::max({scale_m_, std::abs(q.b.x), std::abs(q.b.y)});
   const float slack = float_above(1e-12 + largest * 0x1p-20);
+  section_rect_.set_far_group(n);  // the last group's entries past the section
   std::size_t nearest = n;
   std::size_t i = 0;
 #if defined(__SSE2__)
@@ -561,12 +562,7 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
   static_assert(kMaxSectionEntries < (1u << 24), "entries are exact as floats");
   __m128 v_nearest = _mm_set1_ps(std::numeric_limits<float>::infinity()), v_entry = _mm_set1_ps(static_cast<float>(n));
   __m128 v_i = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
-  const __m128 four = _mm_set1_ps(4.0f), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
-  // The last group's entries past the section: infinitely far, meeting nothing (SectionRects::set_far).
-  _mm_storeu_ps(section_rect_.lo_x.data() + n, inf);
-  _mm_storeu_ps(section_rect_.lo_y.data() + n, inf);
-  _mm_storeu_ps(section_rect_.hi_x.data() + n, _mm_sub_ps(_mm_setzero_ps(), inf));
-  _mm_storeu_ps(section_rect_.hi_y.data() + n, _mm_sub_ps(_mm_setzero_ps(), inf));
+  const __m128 four = _mm_set1_ps(4.0f);
   for (; i < n; i += kScanLanes) {
     const __m128 lx = _mm_loadu_ps(lo_x + i), ly = _mm_loadu_ps(lo_y + i), hx = _mm_loadu_ps(hi_x + i), hy = _mm_loadu_ps(hi_y + i);
     const __m128 dx = _mm_max_ps(_mm_sub_ps(_mm_max_ps(_mm_sub_ps(lx, vpx), _mm_sub_ps(vpx, hx)), vslack), zero);
@@ -591,7 +587,6 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
   const __m128 at_min = _mm_cmpeq_ps(v_nearest, d_min);
   nearest = static_cast<std::size_t>(_mm_cvtss_f32(min4(_mm_or_ps(_mm_and_ps(at_min, v_entry), _mm_andnot_ps(at_min, _mm_set1_ps(static_cast<float>(n)))))));
 #else
-  for (std::size_t k = n; k < n + kScanLanes; ++k) section_rect_.set_far(k);  // the last group's entries past the section
   float nearest_sq = std::numeric_limits<float>::infinity();
   for (; i < n; i += kScanLanes) {
     unsigned four_bits = 0;

@@ -707,18 +707,18 @@ TEST(CollisionQuery, BoundarySectionStaysSmallOnALongWalk) {
   EXPECT_LE(largest, 1000u);
 }
 
-// The ball's walls: a hand that meets walls and slides along them, the wall it rests on excluded (as the
-// contact solver's edge contact does), is answered on most ticks near a wall without a full query (the plain
-// free-space ball there is only as large as the gap to the wall), and every answer, hit or clear, and the
-// segment hit, equals brute force over the level's polylines with the exclusion. Levels and a tolerance step.
 // What a sliding hand's walk did: its hits, its ticks within 1 mm of a wall, how many of those were answered
 // without a full query, and the answers of the ball's walls.
 struct SlideCounts {
   int hits = 0, near_walls = 0, near_walls_answered = 0, walls_answers = 0;
 };
 
-// A hand sliding along walls and resting on them, 100 000 ticks over three level ids, with the scene and the hand
-// moved by `offset` [m]: every answer equal to brute force (asserted here; its counts in *out).
+// The ball's walls: a hand that meets walls and slides along them, the wall it rests on excluded (as the
+// contact solver's edge contact does), 100 000 ticks over three level ids (levels and a tolerance step), with
+// the scene and the hand moved by `offset` [m]. Every answer, hit or clear, and the segment hit, equals brute
+// force over the level's polylines with the exclusion (asserted here); the counts go to *out, for the callers
+// to say how many ticks near a wall were answered without a full query (the plain free-space ball there is
+// only as large as the gap to the wall).
 void slide_along_walls(Vec2 offset, SlideCounts* out) {
   std::mt19937 rng(61);
   std::vector<Polyline> curves = random_scene(rng, 8, 8);

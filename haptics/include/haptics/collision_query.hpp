@@ -33,6 +33,7 @@
 /// Real-time: all storage is sized in the constructor; `first_hit` allocates nothing, takes no lock,
 /// throws nothing.
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -323,10 +324,14 @@ class BoundarySection {
     void set(std::size_t i, const Aabb& r) noexcept {
       lo_x[i] = float_below(r.lo.x); lo_y[i] = float_below(r.lo.y); hi_x[i] = float_above(r.hi.x); hi_y[i] = float_above(r.hi.y);
     }
-    // Entry i as a rectangle infinitely far from every point, meeting none (lo = +inf, hi = -inf).
-    void set_far(std::size_t i) noexcept {
+    // Entries first .. first + kScanLanes − 1 as rectangles infinitely far from every point, meeting none (lo = +inf,
+    // hi = -inf): what the scan reads past the section's last entry, in its last group of four.
+    void set_far_group(std::size_t first) noexcept {
       constexpr float kInf = std::numeric_limits<float>::infinity();
-      lo_x[i] = kInf; lo_y[i] = kInf; hi_x[i] = -kInf; hi_y[i] = -kInf;
+      std::fill_n(lo_x.data() + first, kScanLanes, kInf);  // one four-float store each
+      std::fill_n(lo_y.data() + first, kScanLanes, kInf);
+      std::fill_n(hi_x.data() + first, kScanLanes, -kInf);
+      std::fill_n(hi_y.data() + first, kScanLanes, -kInf);
     }
     void copy(std::size_t to, std::size_t from) noexcept { lo_x[to] = lo_x[from]; lo_y[to] = lo_y[from]; hi_x[to] = hi_x[from]; hi_y[to] = hi_y[from]; }
   };
