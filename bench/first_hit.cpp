@@ -17,7 +17,8 @@
 //        BM_Cut/<method>/<step>/<picture> — the same at the tolerance cut of a step (ours: first_hit_cut; the
 //                                           peers over the cut's joined pieces, bench::cut_segments)
 // Counters: p50_ns, p99_ns, max_ns per query; clock_ns, net_mean_ns; batch_mean_ns (not for brute); build_ms; bytes_per_segment; segments; max_error_mm; for
-//           ours and ours_wide, full_query_fraction (queries neither the free-space ball nor its walls answered),
+//           ours and ours_wide, section_bytes_per_segment (the boundary section's own storage, BoundarySection::bytes,
+//           per level-0 segment; not in bytes_per_segment, which is the scene's), full_query_fraction (queries neither the free-space ball nor its walls answered),
 //           section_entries (mean boundary-section size after a query; 0 for ours_wide), box_tests and
 //           segment_tests (per query).
 #include <benchmark/benchmark.h>
@@ -284,7 +285,10 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     state.counters["build_ms"] = c->build_ms_ours;
     // Per segment queried: every level's bytes over the cut's segments would say nothing (the memory target
     // counts them per level-0 segment: BM_FirstHit).
-    if (c->cut_step < 0) state.counters["bytes_per_segment"] = static_cast<double>(c->scene->hot_bytes()) / segs;
+    if (c->cut_step < 0) {
+      state.counters["bytes_per_segment"] = static_cast<double>(c->scene->hot_bytes()) / segs;
+      state.counters["section_bytes_per_segment"] = static_cast<double>(c->ours->bytes()) / segs;  // the query's own state
+    }
   } else if (m == Method::Brute) {
     state.counters["build_ms"] = c->build_ms_brute;
     state.counters["bytes_per_segment"] = static_cast<double>(c->brute->bytes()) / segs;

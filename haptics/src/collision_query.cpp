@@ -193,11 +193,18 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   candidates_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
   stack_.resize(tree_stack_entries(widest_root));
-  hit_stamp_.assign(n, 0);
-  merge_stamp_.assign(n, 0);
-  seen_stamp_.assign(n, 0);
+  marks_.assign(n, 0);
+  marked_.assign(2 * capacity_, 0);
   walk_.resize(scene.wide_index().stack_entries());
   reset();
+}
+
+std::size_t BoundarySection::bytes() const noexcept {
+  const auto of = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return of(section_) + of(section_parent_) + of(section_rect_.lo_x) + of(section_rect_.lo_y) + of(section_rect_.hi_x) +
+         of(section_rect_.hi_y) + of(rect_d_sq_) + of(rect_overlap_bits_) + of(rect_near_bits_) + of(in_section_) +
+         of(children_in_) + of(marks_) + of(marked_) + of(candidates_) + of(stack_) + of(walk_.t_enter) + of(walk_.d_sq) +
+         of(walk_.code);
 }
 
 void BoundarySection::reset() {
@@ -305,7 +312,7 @@ struct BoundarySection::Query {
   QueryStats st;
   bool refused = false;  // optional work was refused for want of budget (a wide node may be refused before it is quite spent)
   std::size_t scanned = 0;  // section entries phase 1 scanned (the first ones of section_)
-  std::size_t hit = 0;      // of which the sweep met, grown by the merge margin (hit_stamp_ this tick)
+  std::size_t hit = 0;      // of which the sweep met, grown by the merge margin (kHitMark)
   std::size_t nearest_rect = 0;  // of which the one whose rectangle is nearest to b (scanned when none)
 
   Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded, QueryBudget& shared_budget)
@@ -475,13 +482,12 @@ bool BoundarySection::at_floor(std::uint32_t node, int level) const noexcept {
   return at_target(node, level) || at_target(node, other_level_);
 }
 
-void BoundarySection::next_tick() noexcept {
-  ++tick_;
-  if (tick_ == 0) {  // stamp wrap-around: clear so old stamps cannot match
-    std::fill(hit_stamp_.begin(), hit_stamp_.end(), 0u);
-    std::fill(merge_stamp_.begin(), merge_stamp_.end(), 0u);
-    tick_ = 1;
-  }
+void BoundarySection::next_tick() noexcept { ++tick_; }  // wraps harmlessly: it only turns the merges' round robin
+
+// The end of a full query: every mark its phases set, cleared (the next query starts with none).
+void BoundarySection::clear_marks() noexcept {
+  for (std::size_t i = 0; i < marked_count_; ++i) marks_[marked_[i]] = 0;
+  marked_count_ = 0;
 }
 
 // Phase 1: clip the sweep against every box of the boundary section, grown by the merge margin, so one
@@ -489,7 +495,7 @@ void BoundarySection::next_tick() noexcept {
 // On the way, the distance from the end of the sweep to the nearest box: the next free-space ball. The
 // rectangles settle most entries: scan_section_rects bounds them all (four per SSE instruction), and only
 // the entries whose rectangle meets the sweep, or is nearer than the nearest box found, have their box
-// rebuilt. An entry not hit is idle (hit_stamp_ not this tick): merge_idle_siblings may merge it.
+// rebuilt. An entry not hit is idle (no kHitMark): merge_idle_siblings may merge it.
 void BoundarySection::clip_section(Query& q) {
   const Scene& sc = *scene_;
   candidates_.clear();
@@ -515,7 +521,7 @@ void BoundarySection::clip_section(Query& q) {
       if (rect_near_bits_[w] & bit) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
       double te = 0.0, tx = 0.0;
       if ((rect_overlap_bits_[w] & bit) && clip_segment_box(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
-        hit_stamp_[node] = tick_;
+        mark(node, kHitMark);
         ++q.hit;
         if (clip_segment_box(box, q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node, static_cast<std::uint32_t>(i)});
       }
@@ -849,10 +855,10 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     const std::uint32_t node = section_[e];
     const std::uint32_t parent = section_parent_[e];  // kNoParent: the root
     // Every entry is in the section and none of its ancestors is (splits and merges change it in place, a
-    // frontier), so only the stamps decide. One check per parent per tick: a node with many children would
+    // frontier), so only the marks decide. One check per parent per tick: a node with many children would
     // otherwise ask again for each.
-    if (hit_stamp_[node] == tick_ || parent == kNoParent || merge_stamp_[parent] == tick_) continue;
-    merge_stamp_[parent] = tick_;
+    if ((marks_[node] & kHitMark) || parent == kNoParent || (marks_[parent] & kCheckedMark)) continue;
+    mark(parent, kCheckedMark);
     ++checks;
     std::uint32_t first = 0, count = 0;
     sc.children(parent, &first, &count);
@@ -860,7 +866,7 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     // over the children whose exit the predictor cannot learn. Then none of them hit this tick.
     if (children_in_[parent] != count) continue;
     bool all_idle = true;
-    for (std::uint32_t i = 0; i < count; ++i) all_idle &= hit_stamp_[first + i] != tick_;
+    for (std::uint32_t i = 0; i < count; ++i) all_idle &= (marks_[first + i] & kHitMark) == 0;
     if (!all_idle) continue;
     double te = 0.0, tx = 0.0;
     if (!q.spend_box()) break;  // merging can wait for a tick with budget left
@@ -1185,6 +1191,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   gather_ball_walls(q);  // before the section changes: it reads the entries as phase 1 scanned them
   split_hit_boxes(q);
   merge_idle_siblings(q);
+  clear_marks();
   place_free_ball(q);
   const SweepHit answer = finish(q);
   if (stats_out) *stats_out = q.st;
@@ -1220,6 +1227,20 @@ struct BoundarySection::ClosestQuery {
     bound_sq_f = float_at_least(bound_sq);
   }
   bool found() const { return best_node != kWideEmpty; }
+  // The coarser segments this walk offered for an item (each stands for several), the last kSeen of them: true when
+  // `node` is among them, else it is noted. Offering one again changes no answer (closest_offer keeps the nearer, of
+  // equals the smaller reference): this only saves the work.
+  static constexpr int kSeen = 8;
+  std::uint32_t seen[kSeen] = {};
+  int seen_count = 0;
+  bool seen_before(std::uint32_t node) noexcept {
+    const int n = std::min(seen_count, kSeen);
+    for (int i = 0; i < n; ++i) {
+      if (seen[i] == node) return true;
+    }
+    seen[seen_count++ % kSeen] = node;
+    return false;
+  }
   // Whether curve c is left out (a short scan: the callers skip a handful).
   bool skips(std::uint32_t c) const {
     for (int i = 0; i < skip_count; ++i) {
@@ -1299,8 +1320,7 @@ void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noe
   std::uint32_t first = 0;
   const std::uint32_t count = item_segments(item, q.level, &first);
   if (count == 1 && sc.tag_level(first) > sc.tag_level(item)) {
-    if (seen_stamp_[first] == seen_tick_) return;
-    seen_stamp_[first] = seen_tick_;
+    if (q.seen_before(first)) return;
   }
   // The segments under an item are consecutive slots: their rectangles two at a time, then the exact
   // distance of those within the bound (which may shrink on the way).
@@ -1351,10 +1371,6 @@ void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noe
 bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcept {
   const WideIndex& wi = scene_->wide_index();
   if (wi.nodes.empty()) return true;
-  if (++seen_tick_ == 0) {  // stamp wrap-around
-    std::fill(seen_stamp_.begin(), seen_stamp_.end(), 0u);
-    seen_tick_ = 1;
-  }
   const float px = static_cast<float>(q.p.x), py = static_cast<float>(q.p.y);
   int top = 0;
   std::uint32_t code = 0u;  // the entry being visited: the root first

@@ -186,6 +186,11 @@ class BoundarySection {
   /// `skip_curves` (skip_count of them) as closest_point's.
   bool closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
                          QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
+  /// Bytes of this section's own storage [B]: per scene node, 3 (in the frontier, children in it, a full query's
+  /// marks); per entry of its capacity (at most kMaxSectionEntries + a few), its node, parent, float rectangle,
+  /// scan scratch and candidate; the walks' stacks. Not the scene's, nor the cut masks (shared: cut_walls()).
+  /// One section per servo thread. O(1).
+  std::size_t bytes() const noexcept;
   /// Whether the section has the cut masks (the constructor's `cut_walls`, or a non-null `cuts`).
   bool has_cuts() const noexcept { return cut_mask_ != nullptr; }
   /// Cut membership of the scene's nodes (tolerance_cut_masks; node_count() entries; null without has_cuts()).
@@ -307,11 +312,9 @@ class BoundarySection {
   double wide_walk(Query& q, double ball_cap_m);
   float seeded_ball_sq(const WideIndex& wi, float bx, float by, float cap_sq) const noexcept;
   WalkStack walk_;                         // the wide walks' stack (WideIndex::stack_entries)
-  std::vector<std::uint32_t> seen_stamp_;  // per node: closest-point walk in which a coarser segment was last tested
-  std::uint32_t seen_tick_ = 0;
   const Scene* scene_;
   double merge_margin_m_;
-  std::vector<std::uint32_t> section_;     // frontier node ids (capacity = node count)
+  std::vector<std::uint32_t> section_;     // frontier node ids (capacity_ reserved)
   std::vector<std::uint32_t> section_parent_;  // per entry, in step with section_: its node's parent (kNoParent: the root)
   // The section entries' rectangles [m], in step with section_, as four arrays (structure of arrays) of floats
   // widened outward (float_below, float_above: each holds the exact rectangle, Scene::aabb), so the per-tick scan
@@ -361,8 +364,22 @@ class BoundarySection {
   }
   std::vector<Candidate> candidates_;      // section nodes hit this tick
   std::vector<Candidate> stack_;           // DFS stack, tree_stack_entries(widest fan-out) entries, sized at build
-  std::vector<std::uint32_t> hit_stamp_;   // per node: tick at which its margin-grown box was last hit
-  std::vector<std::uint32_t> merge_stamp_; // per node: tick at which it was last considered for a merge
+  // Marks of one full query, a byte per node, set by its phases and cleared by clear_marks (the nodes marked are
+  // listed in marked_, so clearing costs what marking did): kHitMark, the node's box grown by the merge margin met
+  // the sweep (clip_section); kCheckedMark, a parent considered for a merge (merge_idle_siblings).
+  static constexpr std::uint8_t kHitMark = 1, kCheckedMark = 2;
+  std::vector<std::uint8_t> marks_;
+  std::vector<std::uint32_t> marked_;      // the nodes marked so far this query, marked_count_ of them (2 × capacity_ slots)
+  std::size_t marked_count_ = 0;
+  // Checked: a node is marked at most once per bit in a query, and only section entries (kHitMark) and their
+  // parents (kCheckedMark) are, so the list never fills; were it full, the mark is not set, which costs only work
+  // (a hit entry's parent box meets the sweep too, so it is not merged; a parent may be checked twice).
+  void mark(std::uint32_t node, std::uint8_t bit) noexcept {
+    if (marked_count_ == marked_.size()) return;
+    marks_[node] |= bit;
+    marked_[marked_count_++] = node;
+  }
+  void clear_marks() noexcept;
   // The closest-point walk (see closest_point), its phases in order.
   struct ClosestQuery;  // one call's point, best answer so far and bound (collision_query.cpp)
   void closest_seed(ClosestQuery& q) const noexcept;
