@@ -175,8 +175,10 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   }
   // Room for every node twice: a level change's coarsening appends ancestors before its compaction drops the
   // entries they replace (splits and merges change the section in place).
-  // The section's storage is bounded so that a scene of millions of segments does not cost tens of
-  // megabytes of scratch: when it is full, boxes are simply not split (the query still descends).
+  // The section is bounded (kMaxSectionEntries), and with it its storage (about 52 bytes an entry) and its scan,
+  // the one work a full query does past its budget (about 20 instructions an entry): when it is full, boxes are
+  // simply not split (the query still descends, and answers the same), and a level change starts again from the
+  // roots.
   capacity_ = std::min<std::size_t>(2 * n, kMaxSectionEntries) + widest_root + 8;
   section_.reserve(capacity_);
   section_parent_.assign(capacity_, kNoParent);
