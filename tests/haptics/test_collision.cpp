@@ -707,6 +707,72 @@ TEST(CollisionQuery, BoundarySectionStaysSmallOnALongWalk) {
   EXPECT_LE(largest, 1000u);
 }
 
+// The section's bound (kMaxSectionEntries): a sweep across 2 000 wavy strokes, repeated, splits every box it
+// meets each tick and leaves none idle, so the section grows until it is full. Then splits are refused and the
+// answers are still brute force's, the section still a frontier; a change to a coarser level at a full section
+// starts again from the roots and answers the same. The section's storage stays within its bound whatever the
+// scene's size.
+TEST(CollisionQuery, AFullSectionRefusesSplitsAndStillAnswersAsBruteForce) {
+  std::vector<Polyline> strokes;
+  for (int k = 0; k < 2000; ++k) {  // vertical strokes 60 µm apart, each crossing y = 0 with a small wave
+    Polyline s;
+    const double x = -0.06 + 6e-5 * k;
+    for (int i = 0; i < 64; ++i) {
+      const double y = -0.005 + 0.01 * i / 63.0;
+      s.points_m.push_back({x + 1e-5 * std::sin(400.0 * y + k), y});
+    }
+    strokes.push_back(s);
+  }
+  const Scene sc = Scene::build(strokes, 6);
+  BoundarySection section(sc);
+  std::vector<std::vector<Vec2>> walls0, walls3;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    walls0.push_back(test::polyline_at(sc, c, 0));
+    walls3.push_back(test::polyline_at(sc, c, 3));
+  }
+  const auto expect_brute = [&](Vec2 a, Vec2 b, int level, const std::vector<std::vector<Vec2>>& walls, const char* where) {
+    const SweepHit h = section.first_hit(a, b, level, nullptr, 0, QueryBudget{});
+    double t_ref = 0.0;
+    const bool hit_ref = brute_first_hit_of(sc, walls, a, b, &t_ref);
+    ASSERT_EQ(h.hit, hit_ref) << where;
+    if (hit_ref) {
+      ASSERT_NEAR(h.t, t_ref, 1e-9) << where;
+    }
+  };
+  const Vec2 left{-0.061, 0.0}, right{0.061, 0.0};
+  const std::size_t full = BoundarySection::kMaxSectionEntries - 16;  // within a node's children of the bound
+  const auto fill = [&](const char* where) {
+    for (int i = 0; i < 40; ++i) ASSERT_NO_FATAL_FAILURE(expect_brute(i % 2 ? right : left, i % 2 ? left : right, 0, walls0, where));
+    ASSERT_GE(section.section().size(), full) << where;
+    ASSERT_LE(section.section().size(), BoundarySection::kMaxSectionEntries + 16) << where;
+    ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {0}, where));
+  };
+  ASSERT_NO_FATAL_FAILURE(fill("filling the section"));
+  // Sweeps across and along the strokes while the line keeps the section full (merges take idle entries back).
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> x(-0.06, 0.06), y(-0.004, 0.004);
+  int while_full = 0;
+  for (int i = 0; i < 300; ++i) {
+    ASSERT_NO_FATAL_FAILURE(expect_brute(i % 2 ? right : left, i % 2 ? left : right, 0, walls0, "the line, at the bound"));
+    while_full += section.section().size() >= full;
+    const Vec2 a{x(rng), y(rng)}, b{x(rng), y(rng)};
+    ASSERT_NO_FATAL_FAILURE(expect_brute(a, b, 0, walls0, "a sweep at the bound"));
+    ASSERT_LE(section.section().size(), BoundarySection::kMaxSectionEntries + 16);
+  }
+  EXPECT_GT(while_full, 150) << "sweeps made with the section full";
+  ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {0}, "after the sweeps at the bound"));
+  // A coarser level at a full section: the entries' ancestors at it do not fit beside them, so the section starts
+  // again from the roots (a few entries after one tick, where coarsening in place would keep thousands).
+  ASSERT_NO_FATAL_FAILURE(fill("filling it again"));
+  ASSERT_NO_FATAL_FAILURE(expect_brute(left, right, 3, walls3, "at the change to level 3"));
+  EXPECT_LT(section.section().size(), 100u);
+  for (int i = 0; i < 20; ++i) {
+    ASSERT_NO_FATAL_FAILURE(expect_brute(i % 2 ? left : right, i % 2 ? right : left, 3, walls3, "after a change to level 3"));
+  }
+  ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {0, 3}, "after the change"));
+  EXPECT_LT(section.bytes(), 3 * sc.node_count() + (std::size_t{1} << 20));  // 3 bytes a node and the bounded entries
+}
+
 // What a sliding hand's walk did: its hits, its ticks within 1 mm of a wall, how many of those were answered
 // without a full query, and the answers of the ball's walls.
 struct SlideCounts {
