@@ -1232,12 +1232,12 @@ struct BoundarySection::ClosestQuery {
   // The coarser segments this walk offered for an item (each stands for several), the last kSeen of them: true when
   // `node` is among them, else it is noted. Offering one again changes no answer (closest_offer keeps the nearer, of
   // equals the smaller reference): this only saves the work.
-  static constexpr int kSeen = 8;
+  static constexpr unsigned kSeen = 8;
   std::uint32_t seen[kSeen] = {};
-  int seen_count = 0;
+  unsigned seen_count = 0;  // noted so far (the last kSeen kept; unsigned: wraps harmlessly)
   bool seen_before(std::uint32_t node) noexcept {
-    const int n = std::min(seen_count, kSeen);
-    for (int i = 0; i < n; ++i) {
+    const unsigned n = std::min(seen_count, kSeen);
+    for (unsigned i = 0; i < n; ++i) {
       if (seen[i] == node) return true;
     }
     seen[seen_count++ % kSeen] = node;
