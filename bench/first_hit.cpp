@@ -18,7 +18,8 @@
 //                                           peers over the cut's joined pieces, bench::cut_segments)
 // Counters: p50_ns, p99_ns, max_ns per query; clock_ns, net_mean_ns; batch_mean_ns (not for brute); build_ms; bytes_per_segment; segments; max_error_mm; for
 //           ours and ours_wide, section_bytes_per_segment (the boundary section's own storage, BoundarySection::bytes,
-//           per level-0 segment; not in bytes_per_segment, which is the scene's), full_query_fraction (queries neither the free-space ball nor its walls answered),
+//           per level-0 segment; not in bytes_per_segment, which is the scene's), full_query_fraction (queries
+//           neither the free-space ball nor its walls answered),
 //           section_entries (mean boundary-section size after a query; 0 for ours_wide), box_tests and
 //           segment_tests (per query).
 #include <benchmark/benchmark.h>

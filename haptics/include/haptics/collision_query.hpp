@@ -190,7 +190,7 @@ class BoundarySection {
                          QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
   /// Bytes of this section's own storage [B]: per scene node, 3 (in the frontier, children in it, a full query's
   /// marks); per entry of its capacity (at most kMaxSectionEntries + a few), its node, parent, float rectangle,
-  /// scan scratch and candidate; the walks' stacks. Not the scene's, nor the cut masks (shared: cut_walls()).
+  /// scan scratch, candidate and two slots of the marks' list; the walks' stacks. Not the scene's, nor the cut masks (shared: cut_walls()).
   /// One section per servo thread. O(1).
   std::size_t bytes() const noexcept;
   /// Whether the section has the cut masks (the constructor's `cut_walls`, or a non-null `cuts`).
