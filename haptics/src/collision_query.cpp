@@ -190,12 +190,10 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
     const Aabb root = scene.aabb(scene.scene_root());
     scale_m_ = std::max({std::abs(root.lo.x), std::abs(root.lo.y), std::abs(root.hi.x), std::abs(root.hi.y)});
   }
-  in_section_.assign(n, 0);
-  children_in_.assign(n, 0);
+  node_state_.assign(n, 0);
   candidates_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
   stack_.resize(tree_stack_entries(widest_root));
-  marks_.assign(n, 0);
   marked_.assign(2 * capacity_, 0);
   walk_.resize(scene.wide_index().stack_entries());
   reset();
@@ -204,16 +202,16 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
 std::size_t BoundarySection::bytes() const noexcept {
   const auto of = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return of(section_) + of(section_parent_) + of(section_rect_.lo_x) + of(section_rect_.lo_y) + of(section_rect_.hi_x) +
-         of(section_rect_.hi_y) + of(rect_d_sq_) + of(rect_overlap_bits_) + of(rect_near_bits_) + of(in_section_) +
-         of(children_in_) + of(marks_) + of(marked_) + of(candidates_) + of(stack_) + of(walk_.t_enter) + of(walk_.d_sq) +
+         of(section_rect_.hi_y) + of(rect_d_sq_) + of(rect_overlap_bits_) + of(rect_near_bits_) + of(node_state_) +
+         of(marked_) + of(candidates_) + of(stack_) + of(walk_.t_enter) + of(walk_.d_sq) +
          of(walk_.code);
 }
 
 void BoundarySection::reset() {
   last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
   for (std::size_t i = 0; i < section_.size(); ++i) {
-    in_section_[section_[i]] = 0;
-    if (section_parent_[i] != kNoParent) children_in_[section_parent_[i]] = 0;  // only a section node's parent counts any
+    node_state_[section_[i]] &= static_cast<std::uint8_t>(~kInSection);
+    if (section_parent_[i] != kNoParent) node_state_[section_parent_[i]] &= static_cast<std::uint8_t>(~kChildrenInMask);  // only a section node's parent counts any
   }
   section_.clear();
   ball_radius_sq_ = 0.0;
@@ -240,8 +238,8 @@ void BoundarySection::set_section_entry(std::size_t entry, std::uint32_t node, s
   section_rect_.set(entry, scene_->aabb(node));
   section_[entry] = node;
   section_parent_[entry] = parent;
-  in_section_[node] = 1;
-  if (parent != kNoParent) ++children_in_[parent];
+  node_state_[node] |= kInSection;
+  if (parent != kNoParent) node_state_[parent] = static_cast<std::uint8_t>(node_state_[parent] + kChildInUnit);  // at most 4: within its bits
 }
 
 // Scene::parent(node), or kNoParent for the root (its own parent in the scene).
@@ -251,8 +249,8 @@ std::uint32_t BoundarySection::parent_or_none(std::uint32_t node) const noexcept
 
 // Marks a node out of the section, and no longer counted among its parent's children in.
 void BoundarySection::mark_out(std::uint32_t node, std::uint32_t parent) noexcept {
-  in_section_[node] = 0;
-  if (parent != kNoParent) --children_in_[parent];
+  node_state_[node] &= static_cast<std::uint8_t>(~kInSection);
+  if (parent != kNoParent) node_state_[parent] = static_cast<std::uint8_t>(node_state_[parent] - kChildInUnit);  // it was counted
 }
 
 // Takes the entry out: the last entry moves into its place (the order of entries is no answer's business).
@@ -271,7 +269,7 @@ void BoundarySection::remove_section_entry(std::size_t entry) noexcept {
 void BoundarySection::split(std::uint32_t node, std::size_t entry) {
   std::uint32_t first = 0, count = 0;
   scene_->children(node, &first, &count);
-  if (count == 0 || !in_section_[node]) return;
+  if (count == 0 || !in_section(node)) return;
   if (section_.size() + count + 8 > capacity_) return;  // full: keep the node
   mark_out(node, section_parent_[entry]);
   set_section_entry(entry, first, node);
@@ -292,8 +290,8 @@ bool BoundarySection::merge_children(std::size_t entry, std::uint32_t parent, st
     sibling_entry[k++] = i;  // increasing
   }
   if (k + 1 != count) return false;
-  for (std::uint32_t i = 0; i < count; ++i) in_section_[first + i] = 0;
-  children_in_[parent] = 0;
+  for (std::uint32_t i = 0; i < count; ++i) node_state_[first + i] &= static_cast<std::uint8_t>(~kInSection);
+  node_state_[parent] &= static_cast<std::uint8_t>(~kChildrenInMask);
   set_section_entry(entry, parent, parent_or_none(parent));
   while (k > 0) remove_section_entry(sibling_entry[--k]);  // highest first: a later one is never the last moved
   return true;
@@ -472,7 +470,7 @@ void BoundarySection::coarsen_section(int level) noexcept {
       return;
     }
     mark_out(node, section_parent_[i]);
-    if (!in_section_[ancestor]) push_section(ancestor, parent_or_none(ancestor));
+    if (!in_section(ancestor)) push_section(ancestor, parent_or_none(ancestor));
     changed = true;
   }
   if (changed) drop_departed_entries();
@@ -488,7 +486,7 @@ void BoundarySection::next_tick() noexcept { ++tick_; }  // wraps harmlessly: it
 
 // The end of a full query: every mark its phases set, cleared (the next query starts with none).
 void BoundarySection::clear_marks() noexcept {
-  for (std::size_t i = 0; i < marked_count_; ++i) marks_[marked_[i]] = 0;
+  for (std::size_t i = 0; i < marked_count_; ++i) node_state_[marked_[i]] &= static_cast<std::uint8_t>(~kMarks);
   marked_count_ = 0;
 }
 
@@ -859,16 +857,16 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     // Every entry is in the section and none of its ancestors is (splits and merges change it in place, a
     // frontier), so only the marks decide. One check per parent per tick: a node with many children would
     // otherwise ask again for each.
-    if ((marks_[node] & kHitMark) || parent == kNoParent || (marks_[parent] & kCheckedMark)) continue;
+    if ((node_state_[node] & kHitMark) || parent == kNoParent || (node_state_[parent] & kCheckedMark)) continue;
     mark(parent, kCheckedMark);
     ++checks;
     std::uint32_t first = 0, count = 0;
     sc.children(parent, &first, &count);
     // All children in: most checks end here, a sibling split deeper (three in four), on one count rather than a loop
     // over the children whose exit the predictor cannot learn. Then none of them hit this tick.
-    if (children_in_[parent] != count) continue;
+    if (children_in(parent) != count) continue;
     bool all_idle = true;
-    for (std::uint32_t i = 0; i < count; ++i) all_idle &= (marks_[first + i] & kHitMark) == 0;
+    for (std::uint32_t i = 0; i < count; ++i) all_idle &= (node_state_[first + i] & kHitMark) == 0;
     if (!all_idle) continue;
     double te = 0.0, tx = 0.0;
     if (!q.spend_box()) break;  // merging can wait for a tick with budget left
@@ -892,7 +890,7 @@ void BoundarySection::place_free_ball(const Query& q) noexcept {
   ball_levels_[1] = other_level_;
 }
 
-// The section without the entries that left it (in_section_ cleared), in order, rectangles with them (after
+// The section without the entries that left it (kInSection cleared), in order, rectangles with them (after
 // coarsen_section).
 void BoundarySection::drop_departed_entries() noexcept {
   std::size_t w = 0;
@@ -901,7 +899,7 @@ void BoundarySection::drop_departed_entries() noexcept {
     section_rect_.copy(w, i);
     section_[w] = node;
     section_parent_[w] = section_parent_[i];
-    w += in_section_[node];
+    w += node_state_[node] & kInSection;
   }
   section_.resize(w);
 }

@@ -188,7 +188,7 @@ class BoundarySection {
   /// `skip_curves` (skip_count of them) as closest_point's.
   bool closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
                          QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
-  /// Bytes of this section's own storage [B]: per scene node, 3 (in the frontier, children in it, a full query's
+  /// Bytes of this section's own storage [B]: per scene node, 1 (in the frontier, children in it, a full query's
   /// marks); per entry of its capacity (at most kMaxSectionEntries + a few), its node, parent, float rectangle,
   /// scan scratch, candidate and two slots of the marks' list; the walks' stacks. Not the scene's, nor the cut masks (shared: cut_walls()).
   /// One section per servo thread. O(1).
@@ -352,8 +352,13 @@ class BoundarySection {
   void push_section(std::uint32_t node, std::uint32_t parent);
   std::uint32_t parent_or_none(std::uint32_t node) const noexcept;
   void mark_out(std::uint32_t node, std::uint32_t parent) noexcept;
-  std::vector<std::uint8_t> in_section_;   // per node: 1 while in the frontier
-  std::vector<std::uint8_t> children_in_;  // per node: how many of its children (at most 4, scene.hpp) are in the frontier
+  // The section's state of each node, one byte (node_state_): bit 0 (kInSection) while the node is in the frontier;
+  // bits 1 and 2 the marks of one full query (kHitMark, kCheckedMark, below); bits 3 to 5 how many of its children
+  // (at most 4, scene.hpp) are in the frontier, in units of kChildInUnit. Bits 6 and 7 stay clear.
+  static constexpr std::uint8_t kInSection = 1, kChildInUnit = 8, kChildrenInMask = 0x38;
+  std::vector<std::uint8_t> node_state_;
+  bool in_section(std::uint32_t node) const noexcept { return (node_state_[node] & kInSection) != 0; }
+  std::uint32_t children_in(std::uint32_t node) const noexcept { return node_state_[node] / kChildInUnit; }
   struct Candidate { double t_enter; std::uint32_t node; std::uint32_t entry; };  // entry: its place in section_ (a hit entry), or kNotAnEntry. 16 bytes
   static constexpr std::uint32_t kNotAnEntry = 0xffffffffu;
   static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
@@ -366,11 +371,12 @@ class BoundarySection {
   }
   std::vector<Candidate> candidates_;      // section nodes hit this tick
   std::vector<Candidate> stack_;           // DFS stack, tree_stack_entries(widest fan-out) entries, sized at build
-  // Marks of one full query, a byte per node, set by its phases and cleared by clear_marks (the nodes marked are
+  // Marks of one full query, bits of node_state_, set by its phases and cleared by clear_marks (the nodes marked are
   // listed in marked_, so clearing costs what marking did): kHitMark, the node's box grown by the merge margin met
   // the sweep (clip_section); kCheckedMark, a parent considered for a merge (merge_idle_siblings).
-  static constexpr std::uint8_t kHitMark = 1, kCheckedMark = 2;
-  std::vector<std::uint8_t> marks_;
+  static constexpr std::uint8_t kHitMark = 2, kCheckedMark = 4, kMarks = kHitMark | kCheckedMark;
+  static_assert(((kInSection | kMarks) & kChildrenInMask) == 0 && kChildrenInMask / kChildInUnit >= 4,
+                "node_state_: the flags and a count of up to 4 children in, in separate bits");
   std::vector<std::uint32_t> marked_;      // the nodes marked so far this query, marked_count_ of them (2 × capacity_ slots)
   std::size_t marked_count_ = 0;
   // Checked: a node is marked at most once per bit in a query, and only section entries (kHitMark) and their
@@ -378,7 +384,7 @@ class BoundarySection {
   // (a hit entry's parent box meets the sweep too, so it is not merged; a parent may be checked twice).
   void mark(std::uint32_t node, std::uint8_t bit) noexcept {
     if (marked_count_ == marked_.size()) return;
-    marks_[node] |= bit;
+    node_state_[node] |= bit;
     marked_[marked_count_++] = node;
   }
   void clear_marks() noexcept;
