@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #if defined(__SSE2__)
@@ -172,6 +173,11 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
     std::uint32_t first = 0, count = 0;
     scene.children(node, &first, &count);
     widest_root = std::max<std::size_t>(widest_root, count);
+  }
+  // A node's state counts its children in the frontier in three bits (node_state_); the scene has at most 4 a node.
+  if (widest_root > kChildrenInMask / kChildInUnit) {
+    throw std::invalid_argument("BoundarySection: a scene node has " + std::to_string(widest_root) +
+                                " children; the section counts at most " + std::to_string(kChildrenInMask / kChildInUnit));
   }
   // Room for every node twice: a level change's coarsening appends ancestors before its compaction drops the
   // entries they replace (splits and merges change the section in place).

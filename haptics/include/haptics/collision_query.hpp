@@ -125,11 +125,12 @@ class BoundarySection {
   /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots. With
   /// `cut_walls` it also computes the cut masks and their bounds (tolerance_cut_masks, cut_bounds: a byte
   /// per node, about a tenth of a second at 10^6 segments), which the walls at cut steps need; without them a
-  /// cut step renders as the tolerance step of the same tolerance (each curve at its level for it).
+  /// cut step renders as the tolerance step of the same tolerance (each curve at its level for it). Throws
+  /// std::invalid_argument for a scene node with more than 7 children (a Scene has at most 4).
   explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4, bool cut_walls = true);
   /// The same, reading the cut masks and bounds from `cuts` (make_cut_walls of the same `scene`, shared with
   /// other sections of it) instead of computing its own; null: no cut masks, as `cut_walls` = false. Throws
-  /// std::invalid_argument when `cuts` was made for another scene.
+  /// std::invalid_argument when `cuts` was made for another scene, or as the constructor above.
   BoundarySection(const Scene& scene, double merge_margin_m, std::shared_ptr<const CutWalls> cuts);
 
   /// Forgets the frontier (back to one root per curve), both free-space balls and the closest-point seed. Real-time safe.
