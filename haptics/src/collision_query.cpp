@@ -217,7 +217,8 @@ void BoundarySection::reset() {
   last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
   for (std::size_t i = 0; i < section_.size(); ++i) {
     node_state_[section_[i]] &= static_cast<std::uint8_t>(~kInSection);
-    if (section_parent_[i] != kNoParent) node_state_[section_parent_[i]] &= static_cast<std::uint8_t>(~kChildrenInMask);  // only a section node's parent counts any
+    // Only a section node's parent counts any children in.
+    if (section_parent_[i] != kNoParent) node_state_[section_parent_[i]] &= static_cast<std::uint8_t>(~kChildrenInMask);
   }
   section_.clear();
   ball_radius_sq_ = 0.0;
@@ -245,7 +246,8 @@ void BoundarySection::set_section_entry(std::size_t entry, std::uint32_t node, s
   section_[entry] = node;
   section_parent_[entry] = parent;
   node_state_[node] |= kInSection;
-  if (parent != kNoParent) node_state_[parent] = static_cast<std::uint8_t>(node_state_[parent] + kChildInUnit);  // at most 4: within its bits
+  // The count stays within its bits: at most the widest fan-out, checked at construction.
+  if (parent != kNoParent) node_state_[parent] = static_cast<std::uint8_t>(node_state_[parent] + kChildInUnit);
 }
 
 // Scene::parent(node), or kNoParent for the root (its own parent in the scene).
