@@ -216,9 +216,9 @@ std::size_t BoundarySection::bytes() const noexcept {
 void BoundarySection::reset() {
   last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
   for (std::size_t i = 0; i < section_.size(); ++i) {
-    node_state_[section_[i]] &= static_cast<std::uint8_t>(~kInSection);
+    clear_state(section_[i], kInSection);
     // Only a section node's parent counts any children in.
-    if (section_parent_[i] != kNoParent) node_state_[section_parent_[i]] &= static_cast<std::uint8_t>(~kChildrenInMask);
+    if (section_parent_[i] != kNoParent) clear_state(section_parent_[i], kChildrenInMask);
   }
   section_.clear();
   ball_radius_sq_ = 0.0;
@@ -257,7 +257,7 @@ std::uint32_t BoundarySection::parent_or_none(std::uint32_t node) const noexcept
 
 // Marks a node out of the section, and no longer counted among its parent's children in.
 void BoundarySection::mark_out(std::uint32_t node, std::uint32_t parent) noexcept {
-  node_state_[node] &= static_cast<std::uint8_t>(~kInSection);
+  clear_state(node, kInSection);
   if (parent != kNoParent) node_state_[parent] = static_cast<std::uint8_t>(node_state_[parent] - kChildInUnit);  // it was counted
 }
 
@@ -298,8 +298,8 @@ bool BoundarySection::merge_children(std::size_t entry, std::uint32_t parent, st
     sibling_entry[k++] = i;  // increasing
   }
   if (k + 1 != count) return false;
-  for (std::uint32_t i = 0; i < count; ++i) node_state_[first + i] &= static_cast<std::uint8_t>(~kInSection);
-  node_state_[parent] &= static_cast<std::uint8_t>(~kChildrenInMask);
+  for (std::uint32_t i = 0; i < count; ++i) clear_state(first + i, kInSection);
+  clear_state(parent, kChildrenInMask);
   set_section_entry(entry, parent, parent_or_none(parent));
   while (k > 0) remove_section_entry(sibling_entry[--k]);  // highest first: a later one is never the last moved
   return true;
@@ -494,7 +494,7 @@ void BoundarySection::next_tick() noexcept { ++tick_; }  // wraps harmlessly: it
 
 // The end of a full query: every mark its phases set, cleared (the next query starts with none).
 void BoundarySection::clear_marks() noexcept {
-  for (std::size_t i = 0; i < marked_count_; ++i) node_state_[marked_[i]] &= static_cast<std::uint8_t>(~kMarks);
+  for (std::size_t i = 0; i < marked_count_; ++i) clear_state(marked_[i], kMarks);
   marked_count_ = 0;
 }
 

@@ -360,6 +360,7 @@ class BoundarySection {
   std::vector<std::uint8_t> node_state_;
   bool in_section(std::uint32_t node) const noexcept { return (node_state_[node] & kInSection) != 0; }
   std::uint32_t children_in(std::uint32_t node) const noexcept { return node_state_[node] / kChildInUnit; }
+  void clear_state(std::uint32_t node, std::uint8_t bits) noexcept { node_state_[node] &= static_cast<std::uint8_t>(~bits); }
   struct Candidate { double t_enter; std::uint32_t node; std::uint32_t entry; };  // entry: its place in section_ (a hit entry), or kNotAnEntry. 16 bytes
   static constexpr std::uint32_t kNotAnEntry = 0xffffffffu;
   static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
