@@ -202,6 +202,12 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   stack_.resize(tree_stack_entries(widest_root));
   marked_.assign(2 * capacity_, 0);
   walk_.resize(scene.wide_index().stack_entries());
+  // The level ids whose walls the wide index holds: those at which every curve is at or below its item level.
+  for (int id = 0; id < kCutLevelBase; ++id) {
+    bool served = true;
+    for (std::size_t c = 0; c < scene.curve_count() && served; ++c) served = scene.clamp_level(c, id) <= wide_item_level(scene.curve(c).levels);
+    wide_serves_[static_cast<std::size_t>(id)] = served;
+  }
   reset();
 }
 
@@ -1009,19 +1015,16 @@ inline float slab_reciprocal(double d) {
 
 }  // namespace
 
-// The segments a walk tests at an item (segment node `item` of the item level): the target level's
-// segments under it, or the one over it. Writes the first node and returns the count.
+// The segments a walk tests at an item (segment node `item` of the item level): the target level's segments
+// under it (the item itself at the item level). Writes the first node and returns the count. The walks of the
+// wide index take only the level ids it serves (wide_serves), whose level is at or below every curve's items.
 std::uint32_t BoundarySection::item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept {
   const Scene& sc = *scene_;
   const std::uint32_t c = sc.tag_curve(item);
   const int k_level = sc.tag_level(item);
   const CurveNodes& cn = sc.curve_nodes(c);
   const std::uint32_t k = item - cn.box_offset[k_level];
-  const int l = sc.clamp_level(c, level);
-  if (l >= k_level) {
-    *first = cn.box_offset[l] + (k >> (l - k_level));
-    return 1;
-  }
+  const int l = sc.clamp_level(c, level);  // ≤ k_level (wide_serves)
   *first = cn.box_offset[l] + (k << (k_level - l));
   return 1u << (k_level - l);
 }
@@ -1152,6 +1155,7 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
     none.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
     return none;
   }
+  if (!wide_serves(level)) return first_hit_tree(a, b, level, excluded, excluded_count, budget, stats_out);
   const double r_sq = wide_ball_radius_m_ * wide_ball_radius_m_;
   if (length_sq(a - wide_ball_center_m_) < r_sq && length_sq(b - wide_ball_center_m_) < r_sq) {
     if (stats_out) *stats_out = QueryStats{};
@@ -1164,6 +1168,32 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
   const bool clear = !q.best.hit && q.unresolved_t == std::numeric_limits<double>::infinity();
   wide_ball_center_m_ = b;
   wide_ball_radius_m_ = clear ? ball_m : 0.0;
+  const SweepHit answer = finish(q);
+  q.st.section_size = 0;
+  if (stats_out) *stats_out = q.st;
+  return answer;
+}
+
+// first_hit_wide at a level id coarser than the wide index's items: the descent of first_hit's phase 2 from the
+// scene root, with no section and no ball (refine_candidates: nearest box first, pruned past the best hit, one
+// optional box test per box). Past the budget the answer is blocked at the nearest box left unrefined, named as
+// first_hit names it (finish).
+SweepHit BoundarySection::first_hit_tree(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
+                                         QueryBudget& budget, QueryStats* stats_out) {
+  const Scene& sc = *scene_;
+  Query q(a, b, level, excluded, excluded_count, budget);
+  candidates_.clear();
+  if (sc.curve_count() > 0) {
+    const std::uint32_t root = sc.scene_root();
+    double te = 0.0, tx = 0.0;
+    if (!q.spend_box()) {
+      q.unresolved_t = 0.0;  // nothing proven clear
+      q.unresolved_node = root;
+    } else if (clip_segment_box(sc.box(root), a, b, 0.0, &te, &tx)) {
+      candidates_.push_back({te, root, kNotAnEntry});
+    }
+  }
+  refine_candidates(q);
   const SweepHit answer = finish(q);
   q.st.section_size = 0;
   if (stats_out) *stats_out = q.st;
@@ -1235,20 +1265,6 @@ struct BoundarySection::ClosestQuery {
     bound_sq_f = float_at_least(bound_sq);
   }
   bool found() const { return best_node != kWideEmpty; }
-  // The coarser segments this walk offered for an item (each stands for several), the last kSeen of them: true when
-  // `node` is among them, else it is noted. Offering one again changes no answer (closest_offer keeps the nearer, of
-  // equals the smaller reference): this only saves the work.
-  static constexpr unsigned kSeen = 8;
-  std::uint32_t seen[kSeen] = {};
-  unsigned seen_count = 0;  // noted so far (the last kSeen kept; unsigned: wraps harmlessly)
-  bool seen_before(std::uint32_t node) noexcept {
-    const unsigned n = std::min(seen_count, kSeen);
-    for (unsigned i = 0; i < n; ++i) {
-      if (seen[i] == node) return true;
-    }
-    seen[seen_count++ % kSeen] = node;
-    return false;
-  }
   // Whether curve c is left out (a short scan: the callers skip a handful).
   bool skips(std::uint32_t c) const {
     for (int i = 0; i < skip_count; ++i) {
@@ -1319,17 +1335,13 @@ void BoundarySection::closest_seed(ClosestQuery& q) const noexcept {
   closest_offer(q, last_closest_node_, a, b);
 }
 
-// At an item of the walk: offers the target level's segments under or over it (a coarser segment stands
-// for several items and is offered once per walk).
+// At an item of the walk: offers the target level's segments under it.
 void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noexcept {
   const Scene& sc = *scene_;
   if (q.curve >= 0 && static_cast<int>(sc.tag_curve(item)) != q.curve) return;
   if (q.skip_count > 0 && q.skips(sc.tag_curve(item))) return;
   std::uint32_t first = 0;
   const std::uint32_t count = item_segments(item, q.level, &first);
-  if (count == 1 && sc.tag_level(first) > sc.tag_level(item)) {
-    if (q.seen_before(first)) return;
-  }
   // The segments under an item are consecutive slots: their rectangles two at a time, then the exact
   // distance of those within the bound (which may shrink on the way).
   const Vec2* s = sc.slot_points(first);
@@ -1407,7 +1419,7 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   if (scene_->curve_count() == 0) return false;
   ClosestQuery q(p, level, curve, max_distance_m, skip_curves, skip_count);
   closest_seed(q);
-  const bool complete = closest_walk(q, budget);
+  const bool complete = wide_serves(level) ? closest_walk(q, budget) : closest_tree_walk(q, budget);
   last_closest_level_ = level;
   last_closest_curve_ = curve;
   last_closest_node_ = complete ? q.best_node : kWideEmpty;
@@ -1419,14 +1431,17 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
 
 // ---- Closest points at a tolerance cut (the tree of error boxes) ----
 
-bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
-                                        QueryBudget* budget, const int* skip_curves, int skip_count) {
-  if (!has_cuts()) {
-    return closest_point(p, kToleranceLevelBase + step, max_distance_m, point_out, segment_out, curve, budget, skip_curves, skip_count);
-  }
+// The walk of the tree of error boxes for closest points, from the scene root: depth first, nearest box first,
+// pruned at the best distance so far (branch and bound, as closest_walk). Each box's distance bounds every wall
+// under it from below: a level's segments (a box holds everything finer) and a cut's joined pieces (each inside its
+// own segment's box, tolerance_cut.hpp). Stops at the walls of q.level (at_target), offering each, joined at a cut
+// step. With a `budget`, each box measured is one optional box test; false when it or the stack ran out (the
+// answer is then unknown, budget->ran_out set).
+bool BoundarySection::closest_tree_walk(ClosestQuery& q, QueryBudget* budget) noexcept {
   const Scene& sc = *scene_;
-  if (sc.curve_count() == 0) return false;
-  ClosestQuery q(p, kCutLevelBase + step, curve, max_distance_m, skip_curves, skip_count);
+  const Vec2 p = q.p;
+  const int curve = q.curve;
+  const bool cut = is_cut_level(q.level);
   // A node of another curve than `curve`, or of a skipped one, holds nothing to answer (a hierarchy node may: kept).
   const auto other_curve = [&sc, &q, curve](std::uint32_t node) {
     if (curve < 0 && q.skip_count == 0) return false;
@@ -1445,9 +1460,13 @@ bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m,
   while (top > 0) {
     const Candidate cur = stack_[static_cast<std::size_t>(--top)];
     if (cur.t_enter > q.bound_sq) continue;  // the bound shrank since it was pushed
-    if (sc.is_segment(cur.node) && in_cut(cut_mask_, cur.node, step)) {
+    if (at_target(cur.node, q.level)) {
       Vec2 a, b;
-      joined_cut_segment(sc, cut_mask_, cur.node, step, &a, &b);
+      if (cut) {
+        joined_cut_segment(sc, cut_mask_, cur.node, q.level - kCutLevelBase, &a, &b);
+      } else {
+        sc.segment_points(cur.node, &a, &b);
+      }
       closest_offer(q, cur.node, a, b);
       continue;
     }
@@ -1468,6 +1487,18 @@ bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m,
     }
     std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
   }
+  return true;
+}
+
+bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
+                                        QueryBudget* budget, const int* skip_curves, int skip_count) {
+  if (!has_cuts()) {
+    return closest_point(p, kToleranceLevelBase + step, max_distance_m, point_out, segment_out, curve, budget, skip_curves, skip_count);
+  }
+  const Scene& sc = *scene_;
+  if (sc.curve_count() == 0) return false;
+  ClosestQuery q(p, kCutLevelBase + step, curve, max_distance_m, skip_curves, skip_count);
+  if (!closest_tree_walk(q, budget)) return false;
   if (!q.found()) return false;
   if (point_out) *point_out = q.best_point;
   if (segment_out) *segment_out = q.best_s;

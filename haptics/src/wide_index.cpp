@@ -28,24 +28,8 @@ Aabb merged(const Aabb& a, const Aabb& b) {
   return Aabb{{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y)}, {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y)}};
 }
 
-// The rectangle of item k (segment k of level `item` of curve c): its error box and the pieces of every
-// coarser level's segments that stand for it (wide_index.hpp). Levels halve exactly (plan_levels: K·2^L
-// level-0 segments), so segment k of a level lies under segment k >> d of the level d above.
-Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) {
-  const CurveInfo& ci = sc.curve(c);
-  Aabb r = sc.aabb(ci.box_offset[item] + k);
-  for (int l = item + 1; l < ci.levels; ++l) {
-    const int d = l - item;
-    const std::uint32_t s = k >> d;
-    Vec2 p0, p1;
-    sc.segment(SegmentRef{static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(s)}, &p0, &p1);
-    const auto pieces = static_cast<double>(1u << d);  // 2^d, d < kMaxLevels (exact; no scalbn call)
-    const double i = static_cast<double>(k & ((1u << d) - 1u));
-    extend(r, lerp(p0, p1, i / pieces));
-    extend(r, lerp(p0, p1, (i + 1.0) / pieces));
-  }
-  return r;
-}
+// The rectangle of item k (segment k of level `item` of curve c): its error box's (wide_index.hpp).
+Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) { return sc.aabb(sc.curve(c).box_offset[item] + k); }
 
 class Builder {
  public:
@@ -163,7 +147,7 @@ class Builder {
 };
 
 // The level whose segments are a curve's items: kWideItemLevel, or the coarsest of a curve with fewer levels.
-int item_level(const CurveInfo& ci) { return std::min(kWideItemLevel, ci.levels - 1); }
+int item_level(const CurveInfo& ci) { return wide_item_level(ci.levels); }
 
 }  // namespace
 

@@ -90,7 +90,7 @@ void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
 // `seed`), each through a fresh section with a budget of 1–12 box tests, at level `level_of(i)`. Checks
 // what every anytime answer must satisfy (never a hit and blocked at once; exact when not blocked; a
 // blocked answer never claims clear space past the true first wall) and hands each answer to
-// `check(h, budget, st)` for the method's own checks. Counts the blocked and the exact answers.
+// `check(h, budget, st, hit_ref, t_ref, scene)` for the method's own checks. Counts the blocked and the exact answers.
 template <class Query, class LevelOf, class Check>
 void starved_queries(unsigned seed, Query&& query, LevelOf&& level_of, Check&& check, int* blocked, int* exact) {
   std::mt19937 rng(seed);
@@ -108,7 +108,7 @@ void starved_queries(unsigned seed, Query&& query, LevelOf&& level_of, Check&& c
     double t_ref = 1.0;
     const bool hit_ref = test::brute_first_hit(sc, a, b, level, &t_ref, nullptr);
     ASSERT_FALSE(h.hit && h.blocked);
-    check(h, budget, st, hit_ref, t_ref);
+    check(h, budget, st, hit_ref, t_ref, sc);
     if (h.blocked) {
       ++*blocked;
       if (hit_ref) {
@@ -977,7 +977,7 @@ TEST(CollisionQuery, AnytimeAnswerIsConservativeAndFromACoarserLevel) {
   starved_queries(
       6, [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) { return section.first_hit(a, b, level, nullptr, 0, budget, &st); },
       [](int) { return 0; },
-      [](const SweepHit& h, const QueryBudget&, const QueryStats& st, bool, double) {
+      [](const SweepHit& h, const QueryBudget&, const QueryStats& st, bool, double, const Scene&) {
         if (!h.blocked) return;
         // Never claims clear space past the true first wall (starved_queries); the answer comes from a coarser level.
         EXPECT_GT(h.segment.level, 0);
@@ -1026,10 +1026,11 @@ std::vector<WideLeaf> wide_leaves(const Scene& sc) {
 
 }  // namespace
 
-// A walk that opens every item rectangle a sweep or ball meets must meet every wall of every level: so
-// every point of every level's polyline lies in some item's rectangle. Checked here on points along each
-// segment of each level against all leaves, without the index's own item-to-segment arithmetic.
-TEST(WideIndex, EveryLevelsPolylineLiesInSomeItemRectangle) {
+// A walk that opens every item rectangle a sweep or ball meets must meet every wall of every level the index
+// holds (those at or below a curve's items): so every point of such a level's polyline lies in some item's
+// rectangle. Checked here on points along each segment of each such level against all leaves, without the
+// index's own item-to-segment arithmetic. The coarser levels are not held (their walks go through the tree).
+TEST(WideIndex, EveryHeldLevelsPolylineLiesInSomeItemRectangle) {
   std::mt19937 rng(31);
   const auto curves = random_scene(rng, 8, 8);
   const Scene sc = Scene::build(curves, 6);
@@ -1038,7 +1039,7 @@ TEST(WideIndex, EveryLevelsPolylineLiesInSomeItemRectangle) {
   std::size_t points = 0;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const CurveInfo& ci = sc.curve(c);
-    for (int l = 0; l < ci.levels; ++l) {
+    for (int l = 0; l <= wide_item_level(ci.levels); ++l) {
       for (std::uint32_t s = 0; s < ci.segment_count[l]; ++s) {
         Vec2 a, b;
         sc.segment({static_cast<int>(c), l, static_cast<int>(s)}, &a, &b);
@@ -1139,8 +1140,8 @@ TEST(WideIndex, AnytimeAnswerIsConservative) {
   int blocked = 0, exact = 0;
   starved_queries(
       33, [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) { return section.first_hit_wide(a, b, level, nullptr, 0, budget, &st); },
-      [](int i) { return i % 4 == 0 ? 4 : 0; },
-      [](const SweepHit& h, const QueryBudget& budget, const QueryStats& st, bool hit_ref, double t_ref) {
+      [](int i) { return i % 4 == 0 ? 2 : 0; },
+      [](const SweepHit& h, const QueryBudget& budget, const QueryStats& st, bool hit_ref, double t_ref, const Scene&) {
         ASSERT_LE(budget.box_tests_used, budget.max_box_tests);  // no overrun: the wide walk has no section to scan
         if (!h.blocked) return;
         if (hit_ref) {
@@ -1152,4 +1153,54 @@ TEST(WideIndex, AnytimeAnswerIsConservative) {
       &blocked, &exact);
   EXPECT_GT(blocked, 500);
   EXPECT_GT(exact, 100);
+}
+
+// Each item's rectangle is its error box's, grown only by the index's pad and the outward rounding to floats (a
+// micrometre here, against the millimetres the coarser levels' chords added when the rectangles held them).
+TEST(WideIndex, ItemRectanglesAreTheirErrorBoxes) {
+  std::mt19937 rng(32);
+  const Scene sc = Scene::build(random_scene(rng, 8, 8), 6);
+  const std::vector<WideLeaf> leaves = wide_leaves(sc);
+  ASSERT_FALSE(leaves.empty());
+  constexpr double kSlack_m = 1e-6;  // pad (1 nm + 2^-18 of the largest coordinate, 0.1 m here) and float rounding
+  for (const WideLeaf& leaf : leaves) {
+    const Aabb box = sc.aabb(leaf.node);
+    ASSERT_LE(leaf.lo_x, box.lo.x);
+    ASSERT_LE(leaf.lo_y, box.lo.y);
+    ASSERT_GE(leaf.hi_x, box.hi.x);
+    ASSERT_GE(leaf.hi_y, box.hi.y);
+    ASSERT_LE(box.lo.x - leaf.lo_x, kSlack_m);
+    ASSERT_LE(box.lo.y - leaf.lo_y, kSlack_m);
+    ASSERT_LE(leaf.hi_x - box.hi.x, kSlack_m);
+    ASSERT_LE(leaf.hi_y - box.hi.y, kSlack_m);
+  }
+}
+
+// The same at a level the wide index does not hold (coarser than its items): first_hit_wide descends the tree of
+// error boxes, and a blocked answer names the box it stopped at, a segment at or above its curve's walls (or,
+// above the curves, none), as first_hit's do.
+TEST(WideIndex, AnytimeAnswerAboveTheItemsIsConservativeAndNamesABoxAtOrAboveTheWalls) {
+  int blocked = 0, exact = 0, named = 0;
+  static constexpr int kLevel = kWideItemLevel + 1;
+  starved_queries(
+      34, [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) { return section.first_hit_wide(a, b, level, nullptr, 0, budget, &st); },
+      [](int) { return kLevel; },
+      [&named](const SweepHit& h, const QueryBudget& budget, const QueryStats& st, bool hit_ref, double t_ref, const Scene& sc) {
+        ASSERT_LE(budget.box_tests_used, budget.max_box_tests);  // the descent's box tests are all optional
+        if (!h.blocked) return;
+        if (hit_ref) {
+          ASSERT_LE(h.t, t_ref);
+        }
+        EXPECT_TRUE(st.budget_exhausted);
+        if (h.segment.level == Scene::kMaxLevels) return;  // above the curves
+        ++named;
+        // A box at or above its curve's walls at this level: a segment of that level or coarser (a chunk is named
+        // by its coarsest segments, which may be the walls themselves when the curve has no coarser level).
+        EXPECT_GE(h.segment.level, sc.clamp_level(static_cast<std::size_t>(h.segment.curve), kLevel));
+        EXPECT_LT(h.segment.level, sc.curve(static_cast<std::size_t>(h.segment.curve)).levels);
+      },
+      &blocked, &exact);
+  EXPECT_GT(blocked, 500);
+  EXPECT_GT(exact, 50);  // 98 here: a descent from the root needs more of the 1–12 box tests than a wide walk
+  EXPECT_GT(named, 100);  // the descent got below the hierarchy before the budget ran out, often
 }

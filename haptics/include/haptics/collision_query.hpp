@@ -34,6 +34,7 @@
 /// throws nothing.
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -148,17 +149,21 @@ class BoundarySection {
                      QueryBudget& budget, QueryStats* stats = nullptr);
   /// The same first hit through the scene's wide index alone (wide_index.hpp), for comparison with
   /// first_hit: no boundary section. A depth-first walk from the index's root, nearest entry first, pruned
-  /// past the best hit; at an item it tests the target level's segments under or over it. Coherence comes
+  /// past the best hit; at an item it tests the target level's segments under it. Coherence comes
   /// from a free-space ball of its own: after a sweep proven clear, a nearest-first walk measures the
   /// distance from b to the nearest item rectangle (capped at kWideBallCap_m), and a later sweep inside that
-  /// ball is answered at once (the rectangles hold every level's walls, so the ball holds for any level).
+  /// ball is answered at once (the rectangles hold the walls of every level id the index serves, and only
+  /// those ids use the ball).
   /// Anytime: each wide node opened is four optional box tests charged to `budget` (its four rectangles,
   /// in one SIMD test); past it, nodes are not opened and the answer is blocked at the entry of the nearest
   /// one, with segment {-1, kMaxLevels, -1}: unlike first_hit, no coarser level's segment is known there.
   /// Same answers as first_hit otherwise (t bit for bit; checked against brute force in the tests).
-  /// Levels and tolerance steps only: at a cut step (whose joined pieces the item rectangles need not hold)
-  /// it answers blocked at t = 0, nothing proven clear. Does not read or change the boundary section.
-  /// Real-time safe.
+  /// The index holds the levels at or below its items (wide_index.hpp): at a level id where some curve is
+  /// coarser, the sweep descends the tree of error boxes from the scene root instead, as first_hit's
+  /// descent does (no ball; one optional box test a box; blocked answers name the box's segment as
+  /// first_hit's do, or {-1, kMaxLevels, -1} above the curves). At a cut step (whose joined pieces the item
+  /// rectangles need not hold) it answers blocked at t = 0, nothing proven clear. Does not read or change
+  /// the boundary section. Real-time safe.
   SweepHit first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
                           QueryStats* stats = nullptr);
   /// First hit against the tolerance cut at step `step` (0 ≤ step < kToleranceSteps, tolerance
@@ -241,13 +246,16 @@ class BoundarySection {
   /// so it does not depend on the order anything was visited in.
   ///
   /// A distance-pruned walk of the scene's wide index (wide_index.hpp): depth first, nearest rectangle
-  /// first, four rectangles per SIMD test, the target level's segments under or over each item reached;
-  /// it neither uses nor changes the frontier. Coherent between calls like the first hit's free-space
+  /// first, four rectangles per SIMD test, the target level's segments under each item reached; it neither
+  /// uses nor changes the frontier. At a level id where some curve is coarser than its items (which the
+  /// index does not hold), the same branch and bound walks the tree of error boxes from the scene root,
+  /// one box a step, as closest_point_cut does. Coherent between calls like the first hit's free-space
   /// ball: the previous call's answer (same level and curve), measured again at p, seeds the bound, so
   /// the walk is pruned tightly from the root down (the branch-and-bound nearest-neighbour search of
   /// Roussopoulos, Kelley & Vincent 1995, with the proxy's coherence of seed §3).
   ///
-  /// With a `budget`, each wide node the walk opens is four optional box tests charged to it; when it
+  /// With a `budget`, each wide node the walk opens is four optional box tests charged to it (each box of
+  /// the tree walk, one); when it
   /// runs out the walk stops and returns false with budget->ran_out set (the answer is then unknown, not
   /// "nothing close"), and the next call is not seeded. Allocates nothing.
   ///
@@ -274,6 +282,11 @@ class BoundarySection {
   bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
   SweepHit first_hit_near_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
                                 QueryStats* stats_out);
+  SweepHit first_hit_tree(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
+                          QueryStats* stats_out);
+  // Whether the wide index holds the walls of level id `level` (not a cut step): every curve is at or below its item
+  // level there (wide_index.hpp). The walks of coarser ids go through the tree of error boxes.
+  bool wide_serves(int level) const noexcept { return level >= 0 && level < kCutLevelBase && wide_serves_[static_cast<std::size_t>(level)]; }
   bool answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, SweepHit* out,
                               QueryStats* stats) noexcept;
   void copy_ball_walls() noexcept;
@@ -394,6 +407,7 @@ class BoundarySection {
   struct ClosestQuery;  // one call's point, best answer so far and bound (collision_query.cpp)
   void closest_seed(ClosestQuery& q) const noexcept;
   bool closest_walk(ClosestQuery& q, QueryBudget* budget) noexcept;
+  bool closest_tree_walk(ClosestQuery& q, QueryBudget* budget) noexcept;
   void closest_test_item(ClosestQuery& q, std::uint32_t item) noexcept;
   bool closest_open_node(const ClosestQuery& q, const WideNode& n, float px, float py, int* top, std::uint32_t* next) noexcept;
   std::uint32_t closest_pop(const ClosestQuery& q, int* top) const noexcept;
@@ -434,6 +448,7 @@ class BoundarySection {
   BallWalls ball_walls_;
   Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of any level) comes closer
   double wide_ball_radius_m_ = 0.0;  // [m]; 0 = unknown
+  std::array<bool, kCutLevelBase> wide_serves_{};  // per level id below the cut steps: wide_serves (set at construction)
   std::uint32_t wide_ball_seed_ = kWideEmpty;  // the last walk's nearest item rectangle: wide node << 2 | slot
 };
 

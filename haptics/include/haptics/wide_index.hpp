@@ -8,15 +8,15 @@
 /// child rectangles at once.
 ///
 /// Items. One item per segment of level kWideItemLevel of every curve (a curve with fewer levels: its
-/// coarsest). An item's rectangle holds
-/// - the item segment's error box, so every finer level's points and the original under it (scene.hpp),
-///   and so every finer-level segment under it;
-/// - the piece of every coarser level's polyline that stands for it: coarser segment k covers 2^d items
-///   of the item level (d levels apart), and the i-th of them gets the i-th of 2^d equal pieces of it.
-/// So every level's polyline lies in the union of the item rectangles: a walk that opens every rectangle
-/// the sweep (or a ball) meets finds every segment of any level it meets. At an item, a walk targeting a
-/// finer level tests the segments under the item's (at most 2^kWideItemLevel), and one targeting the
-/// item level or coarser tests the one segment of that level over it.
+/// coarsest, wide_item_level). An item's rectangle is its segment's error box's, which holds every finer
+/// level's points and the original under it (scene.hpp), and so every segment of the item level or finer
+/// under it. So the polylines of every level at or below the items lie in the union of the item rectangles:
+/// a walk that opens every rectangle the sweep (or a ball) meets finds every segment of such a level it meets,
+/// and at an item tests the segments of the target level under it (at most 2^kWideItemLevel). Coarser levels
+/// (a sixteenth of the segments or fewer) are not held: their chords cut across the shapes, and rectangles
+/// grown to hold them were 2.4x the area on the tiled benchmark scenes and up to 4.4x on the silhouettes
+/// (docs/PERFORMANCE.md, "Why silhouette_6 walks"), widening every prune at the fine levels the servo feels.
+/// BoundarySection walks the tree of error boxes for those levels instead.
 ///
 /// Storage. Rectangles are floats rounded outward and grown by a pad of 1 nm + 2⁻¹⁸·(largest
 /// coordinate), so float tests, with their rounding, never miss what the exact rectangle holds.
@@ -37,6 +37,9 @@ class Scene;
 
 /// The level whose error boxes are the index's items (clamped per curve to its coarsest).
 inline constexpr int kWideItemLevel = 3;
+/// The item level of a curve with `curve_levels` levels (levels 0 … curve_levels − 1): kWideItemLevel, or its
+/// coarsest when it has fewer.
+constexpr int wide_item_level(int curve_levels) { return curve_levels - 1 < kWideItemLevel ? curve_levels - 1 : kWideItemLevel; }
 /// Box tests a walk charges to its QueryBudget per wide node it opens: one per child rectangle.
 inline constexpr std::int32_t kWideBoxTestsPerNode = 4;
 
