@@ -446,7 +446,7 @@ class BoundarySection {
   static_assert(kMaxBallWalls % 2 == 0 && kMaxBallWalls <= 31, "BallWalls: tested in pairs, as bits of an unsigned");
   static_assert(sizeof(BallWalls) == 1312, "BallWalls: the byte count in its comment");
   BallWalls ball_walls_;
-  Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of any level) comes closer
+  Vec2 wide_ball_center_m_;     // first_hit_wide's free-space ball: no item rectangle (so no wall of a level id it serves) comes closer
   double wide_ball_radius_m_ = 0.0;  // [m]; 0 = unknown
   std::array<bool, kCutLevelBase> wide_serves_{};  // per level id below the cut steps: wide_serves (set at construction)
   std::uint32_t wide_ball_seed_ = kWideEmpty;  // the last walk's nearest item rectangle: wide node << 2 | slot
