@@ -9,7 +9,8 @@
 //   --queries   sweeps in the stream (default 100000, as bench_first_hit)
 //
 // The same stream from a new section each replay, so every replay does the same work query for query
-// (checked: the box tests per query agree). Each query is timed on its own with steady_clock, so every figure
+// (checked: the box tests per query agree), and the first replay's answers equal the R-tree's (else it stops with
+// the query). Each query is timed on its own with steady_clock, so every figure
 // includes one clock pair (the `clock` line: an empty region timed the same way). Kinds:
 //   ball         answered by the free-space ball (no box test)
 //   walls        answered by the ball's walls (no box test; a few segment tests)
@@ -33,6 +34,7 @@
 #include <vector>
 
 #include "bench_scenes.hpp"
+#include "peers.hpp"
 
 using namespace hk;
 using namespace hk::bench;
@@ -61,10 +63,14 @@ double clock_pair_ns() {
   return best;
 }
 
-// A new section each replay (reset() keeps the tick count, which the merges' round robin reads).
+// A new section each replay (reset() keeps the tick count, which the merges' round robin reads). Every answer of
+// the first replay is checked against the Boost R-tree over the level-0 segments (itself checked against brute
+// force in the tests and in bench_first_hit): a build whose queries are fast because they are wrong stops here.
 std::vector<Sample> replay(const Scene& scene, const std::vector<Sweep>& stream, int replays) {
   std::vector<Sample> out(stream.size());
   for (auto& s : out) s.ns = 1e300;
+  const std::vector<std::pair<Vec2, Vec2>> segments = flat_segments(scene, 0);
+  const RtreeIndex rtree(segments);  // keeps a reference to the segments
   for (int r = 0; r < replays; ++r) {
     BoundarySection section(scene);
     for (std::size_t i = 0; i < stream.size(); ++i) {
@@ -73,6 +79,14 @@ std::vector<Sample> replay(const Scene& scene, const std::vector<Sweep>& stream,
       const SweepHit h = section.first_hit(stream[i].a, stream[i].b, 0, nullptr, 0, QueryBudget{}, &st);
       const auto t1 = Clock::now();
       benchmark::DoNotOptimize(h);
+      if (r == 0) {
+        const PeerHit want = rtree.first_hit(stream[i].a, stream[i].b);
+        if (h.hit != want.hit || (want.hit && h.t != want.t)) {
+          std::fprintf(stderr, "bench_section_cost: query %zu answers %s t=%.17g, the R-tree %s t=%.17g\n", i, h.hit ? "hit" : "clear", h.t,
+                       want.hit ? "hit" : "clear", want.t);
+          std::exit(2);
+        }
+      }
       out[i].ns = std::min(out[i].ns, std::chrono::duration<double, std::nano>(t1 - t0).count());
       if (r > 0 && st.box_tests != out[i].st.box_tests) {
         std::fprintf(stderr, "bench_section_cost: replay %d does other work at query %zu\n", r, i);
