@@ -87,6 +87,16 @@ bool BoundarySection::at_target(std::uint32_t node, int level) const noexcept {
   return at_target_level(*scene_, node, level);
 }
 
+// The end points of wall node `node` (at_target of `level`, already walls_of): joined at a cut step, else the
+// segment's own.
+void BoundarySection::wall_node_points(std::uint32_t node, int level, Vec2* a, Vec2* b) const noexcept {
+  if (is_cut_level(level)) {
+    joined_cut_segment(*scene_, cut_mask_, node, level - kCutLevelBase, a, b);
+  } else {
+    scene_->segment_points(node, a, b);
+  }
+}
+
 bool BoundarySection::wall_neighbour(SegmentRef s, int level, int dir, SegmentRef* out) const noexcept {
   level = walls_of(level);
   const Scene& sc = *scene_;
@@ -658,11 +668,7 @@ void BoundarySection::test_segment(Query& q, std::uint32_t node) {
   ++q.st.segment_tests;
   q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
   Vec2 p0, p1;
-  if (is_cut_level(q.level)) {
-    joined_cut_segment(*scene_, cut_mask_, node, q.level - kCutLevelBase, &p0, &p1);
-  } else {
-    scene_->segment_points(node, &p0, &p1);
-  }
+  wall_node_points(node, q.level, &p0, &p1);
   double t = 0.0;
   if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && closer(t, ref, q.best.t, q.best.segment)) {
     q.best.hit = true;
@@ -1441,7 +1447,6 @@ bool BoundarySection::closest_tree_walk(ClosestQuery& q, QueryBudget* budget) no
   const Scene& sc = *scene_;
   const Vec2 p = q.p;
   const int curve = q.curve;
-  const bool cut = is_cut_level(q.level);
   // A node of another curve than `curve`, or of a skipped one, holds nothing to answer (a hierarchy node may: kept).
   const auto other_curve = [&sc, &q, curve](std::uint32_t node) {
     if (curve < 0 && q.skip_count == 0) return false;
@@ -1462,11 +1467,7 @@ bool BoundarySection::closest_tree_walk(ClosestQuery& q, QueryBudget* budget) no
     if (cur.t_enter > q.bound_sq) continue;  // the bound shrank since it was pushed
     if (at_target(cur.node, q.level)) {
       Vec2 a, b;
-      if (cut) {
-        joined_cut_segment(sc, cut_mask_, cur.node, q.level - kCutLevelBase, &a, &b);
-      } else {
-        sc.segment_points(cur.node, &a, &b);
-      }
+      wall_node_points(cur.node, q.level, &a, &b);
       closest_offer(q, cur.node, a, b);
       continue;
     }

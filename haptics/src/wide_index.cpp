@@ -28,9 +28,6 @@ Aabb merged(const Aabb& a, const Aabb& b) {
   return Aabb{{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y)}, {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y)}};
 }
 
-// The rectangle of item k (segment k of level `item` of curve c): its error box's (wide_index.hpp).
-Aabb item_rect(const Scene& sc, std::size_t c, int item, std::uint32_t k) { return sc.aabb(sc.curve(c).box_offset[item] + k); }
-
 class Builder {
  public:
   Builder(std::vector<Item>& items, const std::vector<Aabb>& rects, double pad_m, WideIndex& out)
@@ -146,15 +143,12 @@ class Builder {
   WideIndex& out_;
 };
 
-// The level whose segments are a curve's items: kWideItemLevel, or the coarsest of a curve with fewer levels.
-int item_level(const CurveInfo& ci) { return wide_item_level(ci.levels); }
-
 }  // namespace
 
 WideIndex WideIndex::build(const Scene& sc) {
   WideIndex index;
   std::size_t item_count = 0;
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) item_count += sc.curve(c).segment_count[item_level(sc.curve(c))];
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) item_count += sc.curve(c).segment_count[wide_item_level(sc.curve(c).levels)];
   std::vector<Item> items;
   std::vector<Aabb> rects;
   items.reserve(item_count);
@@ -162,9 +156,9 @@ WideIndex WideIndex::build(const Scene& sc) {
   double largest = 0.0;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const CurveInfo& ci = sc.curve(c);
-    const int item = item_level(ci);
+    const int item = wide_item_level(ci.levels);
     for (std::uint32_t k = 0; k < ci.segment_count[item]; ++k) {
-      const Aabb r = item_rect(sc, c, item, k);
+      const Aabb r = sc.aabb(ci.box_offset[item] + k);  // the item's error box's rectangle (wide_index.hpp)
       items.push_back(Item{0.5 * (r.lo + r.hi), ci.box_offset[item] + k, static_cast<std::uint32_t>(rects.size())});
       rects.push_back(r);
       largest = std::max(std::max(largest, std::max(std::abs(r.lo.x), std::abs(r.lo.y))), std::max(std::abs(r.hi.x), std::abs(r.hi.y)));

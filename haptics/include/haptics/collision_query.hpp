@@ -271,6 +271,7 @@ class BoundarySection {
  private:
   struct Query;  // one first_hit's inputs, answer so far and counters (collision_query.cpp)
   bool at_target(std::uint32_t node, int level) const noexcept;
+  void wall_node_points(std::uint32_t node, int level, Vec2* a, Vec2* b) const noexcept;
   // The level id whose walls stand for `level` here: itself, or for a cut step without the masks its
   // tolerance step (see the constructor).
   int walls_of(int level) const noexcept { return is_cut_level(level) && cut_mask_ == nullptr ? level - kToleranceSteps : level; }
@@ -286,7 +287,8 @@ class BoundarySection {
                           QueryStats* stats_out);
   // Whether the wide index holds the walls of level id `level` (not a cut step): every curve is at or below its item
   // level there (wide_index.hpp). The walks of coarser ids go through the tree of error boxes.
-  bool wide_serves(int level) const noexcept { return level >= 0 && level < kCutLevelBase && wide_serves_[static_cast<std::size_t>(level)]; }
+  // A level below 0 is level 0 (Scene::clamp_level).
+  bool wide_serves(int level) const noexcept { return level < kCutLevelBase && wide_serves_[static_cast<std::size_t>(std::max(level, 0))]; }
   bool answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, SweepHit* out,
                               QueryStats* stats) noexcept;
   void copy_ball_walls() noexcept;
