@@ -851,15 +851,18 @@ void BoundarySection::split_hit_boxes(Query& q) {
 }
 
 // Phase 5: siblings whose parent is clear of the sweep by the margin merge into it (merge_children: in place, no
-// entry left to drop). Merging only shrinks the section, so it can be lazy: a few parents per tick (2, and one
-// more per 8 idle entries), taken round-robin.
+// entry left to drop). Merging only shrinks the section, so it can be lazy: one parent per 8 idle entries a full
+// query, taken round-robin.
 void BoundarySection::merge_idle_siblings(Query& q) {
   const Scene& sc = *scene_;
   // Merges must keep up with the splits, or the section grows without bound: with 4 checks per tick and no
   // more, a long walk over a dense scene grew it to 9 000–18 000 entries (CollisionQuery.
-  // BoundarySectionStaysSmallOnALongWalk; the tick's scan grows with it). So a few checks per tick plus one
-  // per kIdlePerMergeCheck idle entries: a section grown by a burst of splits is merged back.
-  constexpr int kMergeChecksPerTick = 2;
+  // BoundarySectionStaysSmallOnALongWalk; the tick's scan grows with it). So one check per kIdlePerMergeCheck
+  // idle entries: a section grown by a burst of splits is merged back (one per 12 or 16 fell behind on that walk,
+  // 826 and 3 037 entries at most, against 811). Nothing more: two checks more every full query, whatever the
+  // section's size (until 2026-11-27), cost more than the smaller section they kept saved; without them the
+  // bench's random walk keeps 24.5 entries instead of 21 at 10^5 segments, has 1.7 % fewer full queries and runs
+  // 3–5 % fewer instructions (PERFORMANCE.md, round two).
   constexpr std::size_t kIdlePerMergeCheck = 8;
   // As many entries as phase 1 scanned, in section order from a point that moves with the tick (round robin);
   // the idle ones are those it did not find hit. Splits and merges since put other nodes at some of them (a
@@ -867,7 +870,7 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   // new node was not hit this tick, so its parent is checked too; the parent of a split one was hit and stays.
   const std::size_t n = q.scanned;
   if (n == 0) return;
-  const int max_checks = kMergeChecksPerTick + static_cast<int>((n - q.hit) / kIdlePerMergeCheck);
+  const int max_checks = static_cast<int>((n - q.hit) / kIdlePerMergeCheck);
   int checks = 0;
   std::size_t e = tick_ % n;
   for (std::size_t j = 0; j < n && checks < max_checks; ++j, e = e + 1 == n ? 0 : e + 1) {
