@@ -460,7 +460,12 @@ std::string allowed_text(const FieldDescriptor& d) {
     }
     return s;
   }
-  return with_unit("[" + format_bound(d, d.min) + ", " + format_bound(d, d.max) + "]", d.unit);
+  std::string range = "[";  // appended piece by piece: "literal" + a temporary trips GCC 12's -Wrestrict (bug 105329)
+  range += format_bound(d, d.min);
+  range += ", ";
+  range += format_bound(d, d.max);
+  range += ']';
+  return with_unit(std::move(range), d.unit);
 }
 
 std::optional<std::string> real_problem(const FieldDescriptor& d, double v) {

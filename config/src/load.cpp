@@ -48,7 +48,7 @@ const char* type_name(toml::node_type t) {
 std::string value_text(const toml::node& n) {
   if (auto* v = n.as_integer()) return std::to_string(v->get());
   if (auto* v = n.as_floating_point()) return detail::format_real(v->get());
-  if (auto* v = n.as_string()) return "\"" + one_line(v->get(), 80) + "\"";
+  if (auto* v = n.as_string()) return hk::quoted(v->get(), 80, '"');
   if (auto* v = n.as_boolean()) return v->get() ? "true" : "false";
   if (n.is_table()) return "{...}";
   if (n.is_array()) return "[...]";
@@ -206,7 +206,7 @@ Settings parse_from(std::string_view text, const Source& src) {
     if (!is_table_name(tname)) unknown_table(src, tname, tnode, line_of(tkey.source()));
     const toml::table* table = tnode.as_table();
     if (!table)
-      fail(src, "[" + std::string(tname) + "]",
+      fail(src, std::string(1, '[').append(tname).append("]"),
            std::string(tname) + " = " + value_text(tnode) + " has the wrong type (" + type_name(tnode.type()) +
                "); expected a table [" + std::string(tname) + "]",
            line_of(tnode.source()));

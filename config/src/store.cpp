@@ -196,7 +196,7 @@ std::optional<double> parse_real(std::string_view t) {
 }
 
 /// The typed text as the loader shows a string value: quoted, one line, at most 80 bytes.
-std::string quoted(std::string_view t) { return "\"" + one_line(t, 80) + "\""; }
+std::string quoted(std::string_view t) { return hk::quoted(t, 80, '"'); }
 
 /// Sets field `d` of `edited` from `text`, or throws ConfigError (source "operator panel") with the
 /// loader's message for that value.

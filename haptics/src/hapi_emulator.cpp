@@ -238,19 +238,22 @@ void FirmwareEmulator::do_torques(std::uint8_t id, const std::uint8_t* floats, i
   // read_states: [id, sensor floats, encoder floats in port order].
   std::vector<std::uint8_t> reply;
   reply.push_back(id);
-  std::uint8_t seg[4];
+  // Byte by byte: GCC 12's -Wstringop-overflow misreads vector::insert of a 4-byte range here (a false positive in
+  // the package's -O2 build).
+  const auto put_f32 = [&reply](float v) {
+    std::uint8_t seg[4];
+    put_f32_le(v, seg);
+    for (const std::uint8_t byte : seg) reply.push_back(byte);
+  };
   if (id != 0) {
     for (const std::uint8_t h : sensor_host_) {
-      if (h != id) continue;
-      put_f32_le(0.0f, seg);  // nothing is wired to the analog inputs
-      reply.insert(reply.end(), seg, seg + 4);
+      if (h == id) put_f32(0.0f);  // nothing is wired to the analog inputs
     }
     for (int port = 0; port < kPorts; ++port) {
       const PortState& ps = ports_[port];
       if (ps.encoder_host != id) continue;
       const double deg = 360.0 * encoder_count(port) / static_cast<double>(ps.enc_resolution_half);
-      put_f32_le(static_cast<float>(deg), seg);
-      reply.insert(reply.end(), seg, seg + 4);
+      put_f32(static_cast<float>(deg));
     }
   }
   emit_reply(std::move(reply));

@@ -32,7 +32,8 @@ inline constexpr std::size_t kOneLineMaxBytes = 512;
 /// "..." marks a cut. Never throws but std::bad_alloc.
 [[nodiscard]] std::string one_line(std::string_view s, std::size_t max_bytes = kOneLineMaxBytes);
 
-/// one_line(s) in single quotes: the form messages use to name an input, e.g. "image '/media/a.png': ...".
-[[nodiscard]] std::string quoted(std::string_view s, std::size_t max_bytes = kOneLineMaxBytes);
+/// one_line(s) between two `quote` characters: the form messages use to name an input, e.g. "image '/media/a.png':
+/// ..." (single quotes, the default), or a settings value as the file spells it ('"', config).
+[[nodiscard]] std::string quoted(std::string_view s, std::size_t max_bytes = kOneLineMaxBytes, char quote = '\'');
 
 }  // namespace hk
