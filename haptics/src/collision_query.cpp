@@ -858,11 +858,11 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   // Merges must keep up with the splits, or the section grows without bound: with 4 checks per tick and no
   // more, a long walk over a dense scene grew it to 9 000–18 000 entries (CollisionQuery.
   // BoundarySectionStaysSmallOnALongWalk; the tick's scan grows with it). So one check per kIdlePerMergeCheck
-  // idle entries: a section grown by a burst of splits is merged back (one per 12 or 16 fell behind on that walk,
-  // 826 and 3 037 entries at most, against 811). Nothing more: two checks more every full query, whatever the
-  // section's size (until 2026-11-27), cost more than the smaller section they kept saved; without them the
-  // bench's random walk keeps 24.5 entries instead of 21 at 10^5 segments, has 1.7 % fewer full queries and runs
-  // 3–5 % fewer instructions (PERFORMANCE.md, round two).
+  // idle entries: a section grown by a burst of splits is merged back (884 entries at most on that walk; one per 16
+  // fell behind there, 3 037). Nothing more, so a section with fewer than 8 idle entries does not merge: two checks
+  // more every full query, whatever the section's size (until 2026-11-27), cost more than the smaller section they
+  // kept saved; without them the bench's random walk keeps 24.5 entries instead of 21 at 10^5 segments, has 1.7 %
+  // fewer full queries and runs 3–5 % fewer instructions (PERFORMANCE.md, round two).
   constexpr std::size_t kIdlePerMergeCheck = 8;
   // As many entries as phase 1 scanned, in section order from a point that moves with the tick (round robin);
   // the idle ones are those it did not find hit. Splits and merges since put other nodes at some of them (a
