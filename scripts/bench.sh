@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every benchmark and regenerates every chart and table of docs/PERFORMANCE.md (issue 3):
 # Google Benchmark JSON and analysis JSON in docs/bench/, PNG charts beside them, tables in
-# docs/PERFORMANCE.md between its BEGIN/END markers. Takes ~10 minutes on 2 cores.
+# docs/PERFORMANCE.md between its BEGIN/END markers. Takes ~15–20 minutes on 2 cores.
 # Usage: scripts/bench.sh [--quick]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
