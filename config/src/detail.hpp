@@ -47,6 +47,10 @@ std::string toml_value(const FieldDescriptor& d, const Settings& s);
 /// Writes all of `text` to `fd` (retrying short writes and EINTR); returns 0 or an errno value.
 int write_all(int fd, std::string_view text);
 
+/// The start of every temporary file name a save of `target` writes beside it, in `dir` (its folder, "." for
+/// none): "<dir>/.<name>.tmp.", so one pattern finds what a crash left (the settings and the PIN's lockout state).
+std::string temp_prefix(const std::string& dir, const std::string& target_name);
+
 /// "table.key" of a descriptor.
 std::string qualified(const FieldDescriptor& d);
 

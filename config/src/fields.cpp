@@ -428,6 +428,16 @@ std::string toml_value(const FieldDescriptor& d, const Settings& s) {
       d.cref(s));
 }
 
+std::string temp_prefix(const std::string& dir, const std::string& target_name) {
+  // Appended piece by piece: "literal" + a temporary trips GCC 12's -Wrestrict (bug 105329) in the package build.
+  std::string out = dir;
+  if (!out.empty() && out.back() != '/') out += '/';
+  out += '.';
+  out += target_name;
+  out += ".tmp.";
+  return out;
+}
+
 int write_all(int fd, std::string_view text) {
   const char* p = text.data();
   std::size_t left = text.size();

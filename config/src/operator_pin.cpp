@@ -251,10 +251,8 @@ void write_lockout_state(const std::string& path, const LockoutState& s) {
   if (target.filename().empty()) state_fail(path, "not saved: the path names no file");
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
-  std::string temp_name = ".";  // appended piece by piece: "literal" + a temporary trips GCC 12's -Wrestrict (bug 105329)
-  temp_name += target.filename().string();
-  temp_name += ".tmp.XXXXXX";
-  std::string tmp = (dir / temp_name).string();
+  std::string tmp = detail::temp_prefix(dir.string(), target.filename().string());
+  tmp += "XXXXXX";
   std::vector<char> tmpl(tmp.begin(), tmp.end());
   tmpl.push_back('\0');
   const int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);

@@ -153,10 +153,7 @@ void save_settings_atomic(const Settings& settings, const std::string& path, con
   if (!settings.operator_.pin_hash.empty()) mode = 0600;
 
   // Every temporary name is ".<name>.tmp.*" beside the target, so one pattern finds what a crash left.
-  std::string temp_name = ".";  // appended piece by piece: "literal" + a temporary trips GCC 12's -Wrestrict (bug 105329)
-  temp_name += target.filename().string();
-  temp_name += ".tmp.";
-  const std::string temp_prefix = (dir / temp_name).string();
+  const std::string temp_prefix = detail::temp_prefix(dir.string(), target.filename().string());
   const std::string tmp = write_temp(src, temp_prefix, text, mode);
   bool tmp_renamed = false;  // after the commit point `tmp` no longer names our file
   const auto reached = [&](SaveStage stage) {
