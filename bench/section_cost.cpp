@@ -160,6 +160,10 @@ int main(int argc, char** argv) {
     print_row("full: split", all, [](const Sample& s) { return s.st.splits > 0; });
     print_row("full: merge only", all, [](const Sample& s) { return s.st.splits == 0 && s.st.merges > 0; });
     print_row("top 1 %", all, [&](const Sample& s) { return s.ns >= p99; });
+    print_row("top 1 %: quiet", all, [&](const Sample& s) { return s.ns >= p99 && full(s) && s.st.splits == 0 && s.st.merges == 0; });
+    print_row("top 1 %: split", all, [&](const Sample& s) { return s.ns >= p99 && s.st.splits > 0; });
+    print_row("top 1 %: merge only", all, [&](const Sample& s) { return s.ns >= p99 && s.st.splits == 0 && s.st.merges > 0; });
+    print_row("top 1 %: not full", all, [&](const Sample& s) { return s.ns >= p99 && !full(s); });
     std::size_t after_full = 0, full_count = 0;
     for (std::size_t i = 1; i < all.size(); ++i) {
       if (!full(all[i])) continue;

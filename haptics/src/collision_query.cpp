@@ -80,6 +80,87 @@ inline bool is_excluded(SegmentRef s, const SegmentRef* excluded, int count) {
 
 }  // namespace
 
+namespace {
+
+#if defined(__SSE2__)
+using F4 = __m128;
+inline F4 load4(const float* p) { return _mm_load_ps(p); }
+inline F4 splat(float x) { return _mm_set1_ps(x); }
+#endif
+
+// Entry parameters of the sweep into a node's four rectangles: bit i of the result is set when the
+// sweep meets rectangle i at a parameter ≤ horizon, and t_enter[i] is where it enters. The sweep is
+// given as its start and the reciprocals of its extent (±1e20 for a zero extent: a start inside the
+// slab spans every parameter, one outside it none).
+inline int sweep_node(const WideNode& n, float ax, float ay, float ix, float iy, float horizon, float t_enter[4]) {
+#if defined(__SSE2__)
+  const F4 vax = splat(ax), vay = splat(ay), vix = splat(ix), viy = splat(iy);
+  const F4 tx0 = _mm_mul_ps(_mm_sub_ps(load4(n.lo_x), vax), vix), tx1 = _mm_mul_ps(_mm_sub_ps(load4(n.hi_x), vax), vix);
+  const F4 ty0 = _mm_mul_ps(_mm_sub_ps(load4(n.lo_y), vay), viy), ty1 = _mm_mul_ps(_mm_sub_ps(load4(n.hi_y), vay), viy);
+  const F4 t_in = _mm_max_ps(_mm_max_ps(_mm_min_ps(tx0, tx1), _mm_min_ps(ty0, ty1)), _mm_setzero_ps());
+  const F4 t_out = _mm_min_ps(_mm_min_ps(_mm_max_ps(tx0, tx1), _mm_max_ps(ty0, ty1)), splat(1.0f));
+  _mm_storeu_ps(t_enter, t_in);
+  return _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t_in, t_out), _mm_cmple_ps(t_in, splat(horizon))));
+#else
+  int mask = 0;
+  for (int i = 0; i < 4; ++i) {
+    const float tx0 = (n.lo_x[i] - ax) * ix, tx1 = (n.hi_x[i] - ax) * ix;
+    const float ty0 = (n.lo_y[i] - ay) * iy, ty1 = (n.hi_y[i] - ay) * iy;
+    const float t_in = std::max(std::max(std::min(tx0, tx1), std::min(ty0, ty1)), 0.0f);
+    const float t_out = std::min(std::min(std::max(tx0, tx1), std::max(ty0, ty1)), 1.0f);
+    t_enter[i] = t_in;
+    if (t_in <= t_out && t_in <= horizon) mask |= 1 << i;
+  }
+  return mask;
+#endif
+}
+
+// Squared distances from (px, py) to a node's four rectangles [m²] (0 inside); bit i of the result is
+// set when rectangle i is within bound_sq.
+inline int near_node(const WideNode& n, float px, float py, float bound_sq, float d_sq[4]) {
+#if defined(__SSE2__)
+  const F4 vpx = splat(px), vpy = splat(py), zero = _mm_setzero_ps();
+  const F4 dx = _mm_max_ps(_mm_max_ps(_mm_sub_ps(load4(n.lo_x), vpx), _mm_sub_ps(vpx, load4(n.hi_x))), zero);
+  const F4 dy = _mm_max_ps(_mm_max_ps(_mm_sub_ps(load4(n.lo_y), vpy), _mm_sub_ps(vpy, load4(n.hi_y))), zero);
+  const F4 d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
+  _mm_storeu_ps(d_sq, d2);
+  return _mm_movemask_ps(_mm_cmple_ps(d2, splat(bound_sq)));
+#else
+  int mask = 0;
+  for (int i = 0; i < 4; ++i) {
+    const float dx = std::max(std::max(n.lo_x[i] - px, px - n.hi_x[i]), 0.0f);
+    const float dy = std::max(std::max(n.lo_y[i] - py, py - n.hi_y[i]), 0.0f);
+    d_sq[i] = dx * dx + dy * dy;
+    if (d_sq[i] <= bound_sq) mask |= 1 << i;
+  }
+  return mask;
+#endif
+}
+
+#if defined(__SSE2__)
+// Of four lanes' smallest distances (d) and their entries (entry, as floats: n for a lane that found none below
+// +inf), the nearest lane's entry, in every lane; of equals, the smallest entry: the smallest distance over the
+// lanes, then the smallest entry of the lanes at it (each a minimum of four by two shuffles). n when every distance
+// is +inf.
+inline __m128 nearest_lane(__m128 d, __m128 entry, std::size_t n) {
+  const auto min4 = [](__m128 v) {
+    v = _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2)));
+    return _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+  };
+  const __m128 at_min = _mm_cmpeq_ps(d, min4(d));
+  return min4(_mm_or_ps(_mm_and_ps(at_min, entry), _mm_andnot_ps(at_min, _mm_set1_ps(static_cast<float>(n)))));
+}
+#endif
+
+// Reciprocal of a sweep extent for sweep_node: ±1e20 in place of 1/0 or of an overflow.
+inline float slab_reciprocal(double d) {
+  const float f = static_cast<float>(d);
+  if (std::abs(f) < 1e-20f) return d < 0.0 ? -1e20f : 1e20f;
+  return 1.0f / f;
+}
+
+}  // namespace
+
 // at_target_level, and for a cut step the cut's own segments. A walk comes down from the roots and stops at
 // the first cut segment on its way, so it never reaches a node below the cut.
 bool BoundarySection::at_target(std::uint32_t node, int level) const noexcept {
@@ -195,7 +276,10 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   // the one work a full query does past its budget (about 20 instructions an entry): when it is full, boxes are
   // simply not split (the query still descends, and answers the same), and a level change starts again from the
   // roots.
-  capacity_ = std::min<std::size_t>(2 * n, kMaxSectionEntries) + widest_root + 8;
+  const WideIndex& wi = scene.wide_index();
+  wide_base_ = static_cast<std::uint32_t>(n);
+  const std::size_t ids = n + wi.nodes.size();  // scene nodes, then wide nodes (the wide frontier's ids)
+  capacity_ = std::min<std::size_t>(2 * ids, kMaxSectionEntries) + widest_root + 8;
   section_.reserve(capacity_);
   section_parent_.assign(capacity_, kNoParent);
   section_rect_.size_for(capacity_ + kScanLanes);
@@ -206,12 +290,19 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
     const Aabb root = scene.aabb(scene.scene_root());
     scale_m_ = std::max({std::abs(root.lo.x), std::abs(root.lo.y), std::abs(root.hi.x), std::abs(root.hi.y)});
   }
-  node_state_.assign(n, 0);
+  if (!wi.nodes.empty()) {  // and the wide root's (its rectangles are padded)
+    Vec2 lo, hi;
+    wi.node_rect(0, &lo, &hi);
+    scale_m_ = std::max({scale_m_, std::abs(lo.x), std::abs(lo.y), std::abs(hi.x), std::abs(hi.y)});
+  }
+  node_state_.assign(ids, 0);
   candidates_.reserve(capacity_);
   // Widest fan-out, plus that many per level of curve and hierarchy (hk/constants.hpp).
-  stack_.resize(tree_stack_entries(widest_root));
+  // and for the wide frontier three per wide level and one per curve level below the items.
+  stack_.resize(std::max(tree_stack_entries(widest_root), wi.stack_entries() + static_cast<std::size_t>(kMaxLevels)));
   marked_.assign(2 * capacity_, 0);
-  walk_.resize(scene.wide_index().stack_entries());
+  walk_.resize(wi.stack_entries());
+  link_wide_nodes();
   // The level ids whose walls the wide index holds: those at which every curve is at or below its item level.
   for (int id = 0; id < kCutLevelBase; ++id) {
     bool served = true;
@@ -245,8 +336,7 @@ void BoundarySection::reset() {
   wide_ball_radius_m_ = 0.0;
   wide_ball_seed_ = kWideEmpty;
   if (scene_->curve_count() == 0) return;
-  const std::uint32_t r = scene_->scene_root();
-  push_section(r, kNoParent);
+  push_section(wide_mode_ ? wide_base_ : scene_->scene_root(), kNoParent);
 }
 
 void BoundarySection::push_section(std::uint32_t node, std::uint32_t parent) {
@@ -258,7 +348,7 @@ void BoundarySection::push_section(std::uint32_t node, std::uint32_t parent) {
 // counted among its parent's children in (`parent`: Scene::parent(node), or kNoParent for the root). The caller
 // marks the node it replaces out (mark_out).
 void BoundarySection::set_section_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent) {
-  section_rect_.set(entry, scene_->aabb(node));
+  section_rect_.set(entry, entry_rect(node));
   section_[entry] = node;
   section_parent_[entry] = parent;
   node_state_[node] |= kInSection;
@@ -266,9 +356,111 @@ void BoundarySection::set_section_entry(std::size_t entry, std::uint32_t node, s
   if (parent != kNoParent) node_state_[parent] = static_cast<std::uint8_t>(node_state_[parent] + kChildInUnit);
 }
 
-// Scene::parent(node), or kNoParent for the root (its own parent in the scene).
+// The parent of section id `node` in the frontier's hierarchy, or kNoParent for its root. The tree's: Scene::parent
+// (the scene root's parent is itself). The wide frontier's: a wide node's is the wide node naming it, an item's the
+// wide node whose slot names it, below the items Scene::parent.
 std::uint32_t BoundarySection::parent_or_none(std::uint32_t node) const noexcept {
-  return node == scene_->scene_root() ? kNoParent : scene_->parent(node);
+  const Scene& sc = *scene_;
+  if (wide_mode_) {
+    if (is_wide_id(node)) {
+      const std::uint32_t up = wide_up_[node - wide_base_];
+      return up == kNoParent ? kNoParent : wide_base_ + (up >> 2);
+    }
+    const std::uint32_t c = sc.tag_curve(node);
+    const CurveNodes& cn = sc.curve_nodes(c);
+    const int item = wide_item_level(static_cast<int>(cn.levels));
+    if (sc.tag_level(node) == item) return wide_base_ + (item_up_[item_first_[c] + (node - cn.box_offset[item])] >> 2);
+  }
+  return node == sc.scene_root() ? kNoParent : sc.parent(node);
+}
+
+// The wide frontier's links (wide_up_, item_up_, item_first_) and the root's rectangle, from the index. O(wide nodes).
+void BoundarySection::link_wide_nodes() {
+  const Scene& sc = *scene_;
+  const WideIndex& wi = sc.wide_index();
+  item_first_.assign(sc.curve_count(), 0);
+  std::uint32_t items = 0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {  // the index's item order (WideIndex::build)
+    item_first_[c] = items;
+    items += sc.curve(c).segment_count[wide_item_level(sc.curve(c).levels)];
+  }
+  item_up_.assign(items, kNoParent);
+  wide_up_.assign(wi.nodes.size(), kNoParent);
+  if (!wi.nodes.empty()) wi.node_rect(0, &wide_root_rect_.lo, &wide_root_rect_.hi);
+  for (std::uint32_t w = 0; w < wi.nodes.size(); ++w) {
+    const WideNode& nd = wi.nodes[w];
+    for (std::uint32_t i = 0; i < 4; ++i) {
+      const std::uint32_t code = nd.child[i];
+      if (code == kWideEmpty) continue;
+      if (code & kWideLeaf) {
+        const std::uint32_t item = code & ~kWideLeaf;
+        const std::uint32_t c = sc.tag_curve(item);
+        const std::uint32_t k = item - sc.curve_nodes(c).box_offset[sc.tag_level(item)];
+        item_up_[item_first_[c] + k] = w << 2 | i;
+      } else {
+        wide_up_[code] = w << 2 | i;
+      }
+    }
+  }
+}
+
+// The rectangle of section id `id` [m]: a wide node's, its slot's in its parent (the root's, its slots' union); a
+// scene node's, Scene::aabb.
+Aabb BoundarySection::entry_rect(std::uint32_t id) const noexcept {
+  if (!is_wide_id(id)) return scene_->aabb(id);
+  const std::uint32_t up = wide_up_[id - wide_base_];
+  if (up == kNoParent) return wide_root_rect_;
+  const WideNode& n = scene_->wide_index().nodes[up >> 2];
+  const std::uint32_t i = up & 3u;
+  return Aabb{{n.lo_x[i], n.lo_y[i]}, {n.hi_x[i], n.hi_y[i]}};
+}
+
+// The box of section id `id`: a scene node's (Scene::box), or a wide node's rectangle as an axis-aligned box (as
+// Scene::box gives a chunk's).
+ErrorBox BoundarySection::entry_box(std::uint32_t id) const noexcept {
+  if (!is_wide_id(id)) return scene_->box(id);
+  const Aabb r = entry_rect(id);
+  return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo.x, r.hi.x, r.lo.y, r.hi.y};
+}
+
+// entry_box of section entry i: a wide node's rectangle read from the section's own (the floats of its slots'
+// union, exactly), not from the index.
+ErrorBox BoundarySection::entry_box_at(std::size_t i) const noexcept {
+  const std::uint32_t id = section_[i];
+  if (!is_wide_id(id)) return scene_->box(id);
+  const SectionRects& r = section_rect_;
+  return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo_x[i], r.hi_x[i], r.lo_y[i], r.hi_y[i]};
+}
+
+// How many children section id `id` has in the frontier's hierarchy (entry_children's count), cheaply.
+std::uint32_t BoundarySection::child_count(std::uint32_t id) const noexcept {
+  if (is_wide_id(id)) {
+    const WideNode& n = scene_->wide_index().nodes[id - wide_base_];
+    return static_cast<std::uint32_t>((n.child[0] != kWideEmpty) + (n.child[1] != kWideEmpty) + (n.child[2] != kWideEmpty) +
+                                      (n.child[3] != kWideEmpty));
+  }
+  std::uint32_t first = 0, count = 0;
+  scene_->children(id, &first, &count);
+  return count;
+}
+
+// The children of section id `id` in the frontier's hierarchy, written to out (at most kMaxEntryChildren); returns
+// their count. A wide node's: its slots' wide nodes and items, empty slots left out; a scene node's: Scene::children
+// (the wide frontier never holds a scene node above the items).
+std::uint32_t BoundarySection::entry_children(std::uint32_t id, std::uint32_t* out) const noexcept {
+  if (is_wide_id(id)) {
+    const WideNode& nd = scene_->wide_index().nodes[id - wide_base_];
+    std::uint32_t count = 0;
+    for (std::uint32_t code : nd.child) {
+      if (code == kWideEmpty) continue;
+      out[count++] = (code & kWideLeaf) ? (code & ~kWideLeaf) : wide_base_ + code;
+    }
+    return count;
+  }
+  std::uint32_t first = 0, count = 0;
+  scene_->children(id, &first, &count);
+  for (std::uint32_t i = 0; i < count; ++i) out[i] = first + i;
+  return count;
 }
 
 // Marks a node out of the section, and no longer counted among its parent's children in.
@@ -291,6 +483,10 @@ void BoundarySection::remove_section_entry(std::size_t entry) noexcept {
 // Splits the node at section entry `entry` into its children: the first takes its place, the others are
 // appended, so no entry is left to drop. Without room the node stays (a box holds its children's walls).
 void BoundarySection::split(std::uint32_t node, std::size_t entry) {
+  if (is_wide_id(node)) {
+    split_wide(node, entry);
+    return;
+  }
   std::uint32_t first = 0, count = 0;
   scene_->children(node, &first, &count);
   if (count == 0 || !in_section(node)) return;
@@ -300,21 +496,46 @@ void BoundarySection::split(std::uint32_t node, std::size_t entry) {
   for (std::uint32_t i = 1; i < count; ++i) push_section(first + i, node);
 }
 
-// Merges the children [first, first + count) of `parent`, all in the section, one of them at `entry`: the parent
-// takes that entry's place and the others' entries are taken out (found by a scan of the section's node ids, a
-// few dozen). False, with nothing changed, when they are not all found (never, for a frontier) or there are more
-// than kMaxSiblings (never: no node has more than 4 children, scene.hpp).
-bool BoundarySection::merge_children(std::size_t entry, std::uint32_t parent, std::uint32_t first, std::uint32_t count) {
+// split for a wide node: its slots' wide nodes and items take its place, each with its slot's rectangle (which
+// holds it: the slot is its rectangle padded outward, wide_index.hpp), read from the node itself.
+void BoundarySection::split_wide(std::uint32_t node, std::size_t entry) {
+  const WideNode& n = scene_->wide_index().nodes[node - wide_base_];
+  if (!in_section(node) || section_.size() + 4 + 8 > capacity_) return;  // full: keep the node
+  mark_out(node, section_parent_[entry]);
+  bool first = true;
+  for (int i = 0; i < 4; ++i) {
+    const std::uint32_t code = n.child[i];
+    if (code == kWideEmpty) continue;
+    const std::uint32_t id = (code & kWideLeaf) ? (code & ~kWideLeaf) : wide_base_ + code;
+    const std::size_t at = first ? entry : section_.size();
+    if (!first) section_.push_back(id);  // within the reserved capacity: no allocation
+    first = false;
+    section_rect_.lo_x[at] = n.lo_x[i];
+    section_rect_.lo_y[at] = n.lo_y[i];
+    section_rect_.hi_x[at] = n.hi_x[i];
+    section_rect_.hi_y[at] = n.hi_y[i];
+    section_[at] = id;
+    section_parent_[at] = node;
+    node_state_[id] |= kInSection;
+    node_state_[node] = static_cast<std::uint8_t>(node_state_[node] + kChildInUnit);
+  }
+}
+
+// Merges the children (count of them) of `parent`, all in the section, one of them at `entry`: the parent takes
+// that entry's place and the others' entries are taken out (found by a scan of the section's parents, a few dozen).
+// False, with nothing changed, when they are not all found (never, for a frontier) or there are more than
+// kMaxSiblings (never: no node has more than 4 children, scene.hpp and wide_index.hpp).
+bool BoundarySection::merge_children(std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count) {
   constexpr std::size_t kMaxSiblings = 15;
   std::size_t sibling_entry[kMaxSiblings];
   std::size_t k = 0;
   for (std::size_t i = 0; i < section_.size(); ++i) {
-    if (section_[i] - first >= count || i == entry) continue;  // unsigned: outside [first, first + count)
+    if (section_parent_[i] != parent || i == entry) continue;
     if (k == kMaxSiblings) return false;
     sibling_entry[k++] = i;  // increasing
   }
   if (k + 1 != count) return false;
-  for (std::uint32_t i = 0; i < count; ++i) clear_state(first + i, kInSection);
+  for (std::uint32_t i = 0; i < count; ++i) clear_state(children[i], kInSection);
   clear_state(parent, kChildrenInMask);
   set_section_entry(entry, parent, parent_or_none(parent));
   while (k > 0) remove_section_entry(sibling_entry[--k]);  // highest first: a later one is never the last moved
@@ -339,11 +560,17 @@ struct BoundarySection::Query {
   std::size_t hit = 0;      // of which the sweep met, grown by the merge margin (kHitMark)
   std::size_t nearest_rect = 0;  // of which the one whose rectangle is nearest to b (scanned when none)
 
+  float ax = 0.0f, ay = 0.0f, ix = 0.0f, iy = 0.0f;  // the sweep for sweep_node: its start, the reciprocals of its extent
+
   Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded, QueryBudget& shared_budget)
       : a(a_m), b(b_m), sweep(rect_of(a_m, b_m)),
         level(target_level), excluded(excluded_segments), excluded_count(n_excluded), budget(&shared_budget) {
     best.t = std::numeric_limits<double>::infinity();  // no exact hit yet
     best.point_m = b_m;
+    ax = static_cast<float>(a_m.x);
+    ay = static_cast<float>(a_m.y);
+    ix = slab_reciprocal(b_m.x - a_m.x);
+    iy = slab_reciprocal(b_m.y - a_m.y);
   }
 
   // The section entries' clips: always done and charged, even past the budget.
@@ -447,17 +674,21 @@ bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const Se
 // walls, and splits stop at the coarser of the two (at_floor). A new id keeps the section: entries below
 // its walls give way to their ancestor at them (coarsen_section), which holds the same stretch of curve; to
 // a finer id nothing changes. The free-space ball holds for the two ids it was measured for, and is
-// forgotten at any other. Called only when the ids change (first_hit).
+// forgotten at any other. The frontier is the wide one while the wide index serves both ids (wide_frontier), else
+// the tree's; a change of ids that changes which starts the section again from that frontier's root (reset).
+// Called only when the ids change (first_hit).
 void BoundarySection::follow_level(int level) noexcept {
   const int previous = last_level_, served = other_level_;  // the section serves both
   other_level_ = previous < 0 ? level : previous;
   last_level_ = level;
-  if (level == previous) return;
-  if (level != ball_levels_[0] && level != ball_levels_[1]) ball_radius_sq_ = 0.0;
-  if (previous < 0) {
+  const bool wide = wide_frontier(level) && wide_frontier(other_level_);
+  if (previous < 0 || wide != wide_mode_) {  // the other frontier: start it from its root
+    wide_mode_ = wide;
     reset();
     return;
   }
+  if (level == previous) return;
+  if (level != ball_levels_[0] && level != ball_levels_[1]) ball_radius_sq_ = 0.0;
   if (level != served) coarsen_section(level);  // a transition's two ids in turn: nothing to coarsen
 }
 
@@ -521,7 +752,6 @@ void BoundarySection::clear_marks() noexcept {
 // the entries whose rectangle meets the sweep, or is nearer than the nearest box found, have their box
 // rebuilt. An entry not hit is idle (no kHitMark): merge_idle_siblings may merge it.
 void BoundarySection::clip_section(Query& q) {
-  const Scene& sc = *scene_;
   candidates_.clear();
   const std::size_t n_section = section_.size();
   q.scanned = n_section;
@@ -532,7 +762,7 @@ void BoundarySection::clip_section(Query& q) {
   // The free-space ball: the nearest box. A rectangle holds its box, so a box is nearer than the nearest found
   // so far only when its rectangle is; starting from the box of the nearest rectangle leaves few others to
   // rebuild. The minimum is the same whatever the order.
-  q.nearest_sq = box_distance_sq(sc.box(section_[nearest_rect]), q.b);
+  q.nearest_sq = box_distance_sq(entry_box_at(nearest_rect), q.b);
   mark_near_rects(q.nearest_sq, nearest_rect);
   const std::size_t words = (n_section + 63) / 64;
   for (std::size_t w = 0; w < words; ++w) {
@@ -541,7 +771,7 @@ void BoundarySection::clip_section(Query& q) {
       if (i >= n_section) break;  // past the end: the last group's far entries (never marked)
       const std::uint32_t node = section_[i];
       const std::uint64_t bit = std::uint64_t{1} << (i % 64);
-      const ErrorBox box = sc.box(node);
+      const ErrorBox box = entry_box_at(i);
       if (rect_near_bits_[w] & bit) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
       double te = 0.0, tx = 0.0;
       if ((rect_overlap_bits_[w] & bit) && clip_segment_box(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
@@ -607,15 +837,7 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
                                     _mm_and_ps(_mm_cmple_ps(ly, v_shi_y), _mm_cmple_ps(v_slo_y, hy)));
     overlap.put(i, static_cast<unsigned>(_mm_movemask_ps(meets)));
   }
-  // The nearest lane; of equals, the first entry: the smallest distance over the lanes, then the smallest entry
-  // of the lanes at it (each a minimum of four by two shuffles).
-  const auto min4 = [](__m128 v) {
-    v = _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2)));
-    return _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
-  };
-  const __m128 d_min = min4(v_nearest);
-  const __m128 at_min = _mm_cmpeq_ps(v_nearest, d_min);
-  nearest = static_cast<std::size_t>(_mm_cvtss_f32(min4(_mm_or_ps(_mm_and_ps(at_min, v_entry), _mm_andnot_ps(at_min, _mm_set1_ps(static_cast<float>(n)))))));
+  nearest = static_cast<std::size_t>(_mm_cvtss_f32(nearest_lane(v_nearest, v_entry, n)));
 #else
   float nearest_sq = std::numeric_limits<float>::infinity();
   for (; i < n; i += kScanLanes) {
@@ -680,6 +902,7 @@ void BoundarySection::test_segment(Query& q, std::uint32_t node) {
 // Pushes the children of `node` the sweep enters, nearest on top. Returns false, with nothing pushed,
 // when the budget or the stack ran out first: the box then stays unrefined.
 bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) {
+  if (is_wide_id(node)) return push_wide_children(q, node, top);
   const Scene& sc = *scene_;
   std::uint32_t first = 0, count = 0;
   sc.children(node, &first, &count);
@@ -692,6 +915,29 @@ bool BoundarySection::push_hit_children(Query& q, std::uint32_t node, int& top) 
     }
     if (overlaps(sc.loose_aabb(first + i), q.sweep, 0.0) && clip_segment_box(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t &&
         !push(top, {te, first + i, kNotAnEntry})) {
+      top = base;  // the stack is full: as past the budget
+      return false;
+    }
+  }
+  std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
+  return true;
+}
+
+// push_hit_children for a wide node (the wide frontier): its four rectangles in one SIMD test (sweep_node, as the
+// wide index's walks), four optional box tests, all or none; the slots the sweep enters before the horizon pushed,
+// nearest on top, as their section ids (a wide node, or an item's segment node).
+bool BoundarySection::push_wide_children(Query& q, std::uint32_t node, int& top) {
+  if (!q.spend_wide_node()) return false;
+  const WideNode& n = scene_->wide_index().nodes[node - wide_base_];
+  float t_enter[4];
+  const double h = q.horizon();
+  const int mask = sweep_node(n, q.ax, q.ay, q.ix, q.iy, h > 1.0 ? 1.0f : float_at_least(h), t_enter);
+  const int base = top;
+  for (int i = 0; i < 4; ++i) {
+    if (!(mask & (1 << i))) continue;
+    const std::uint32_t code = n.child[i];
+    const std::uint32_t id = (code & kWideLeaf) ? (code & ~kWideLeaf) : wide_base_ + code;
+    if (!push(top, {static_cast<double>(t_enter[i]), id, kNotAnEntry})) {
       top = base;  // the stack is full: as past the budget
       return false;
     }
@@ -773,40 +1019,28 @@ void BoundarySection::gather_ball_walls(const Query& q) noexcept {
   const std::size_t n = q.scanned;
   std::uint32_t unused = 0;
   if (q.nearest_rect >= n || segments_under(section_[q.nearest_rect], q.level, &unused) == 0) return;  // no walls to copy
-  // The kBallWallEntries entries with the nearest rectangles, in order (insertion; a section holds ~20 entries).
-  std::uint32_t near_entry[kBallWallEntries];
-  double near_d_sq[kBallWallEntries];
-  int m = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double d = rect_d_sq_[i];
-    if (m == kBallWallEntries && d >= near_d_sq[kBallWallEntries - 1]) continue;
-    int k = m < kBallWallEntries ? m++ : kBallWallEntries - 1;
-    for (; k > 0 && near_d_sq[k - 1] > d; --k) {
-      near_d_sq[k] = near_d_sq[k - 1];
-      near_entry[k] = near_entry[k - 1];
-    }
-    near_d_sq[k] = d;
-    near_entry[k] = static_cast<std::uint32_t>(i);
-  }
-  const bool all_listed = n <= static_cast<std::size_t>(kBallWallEntries);
-  // Note the walls of the nearest entries while they fit (copied when first needed: copy_ball_walls).
-  const Scene& sc = *scene_;
-  int j = 0;
-  for (; j < m; ++j) {
+  // Note the walls of the nearest entries, in order of their rectangles' distance (each taken out of rect_d_sq_ as it
+  // is reached, so the next is the nearest left), while they fit (copied when first needed: copy_ball_walls).
+  float* d_sq = rect_d_sq_.data();
+  constexpr double kAllWallsRadius_m = 1.0;  // every entry's walls noted: any radius holds; the workspace is smaller
+  double r_sq = kAllWallsRadius_m * kAllWallsRadius_m;
+  for (std::size_t e = q.nearest_rect; e < n;) {
     std::uint32_t first = 0;
-    const std::uint32_t count = segments_under(section_[near_entry[j]], q.level, &first);
-    if (count == 0 || w.count + static_cast<int>(count) > kMaxBallWalls) break;
+    const std::uint32_t count = w.runs == kBallWallEntries ? 0 : segments_under(section_[e], q.level, &first);
+    d_sq[e] = std::numeric_limits<float>::infinity();
+    if (count == 0 || w.count + static_cast<int>(count) > kMaxBallWalls) {
+      // The radius: the first entry left out, by its box; every other one is no nearer than the next rectangle.
+      r_sq = box_distance_sq(entry_box_at(e), q.b);
+      const std::size_t next = nearest_rect_left(n);
+      if (next < n) r_sq = std::min(r_sq, static_cast<double>(d_sq[next]));
+      break;
+    }
     w.run_first[w.runs] = first;
     w.run_count[w.runs] = count;
     ++w.runs;
     w.count += static_cast<int>(count);
+    e = nearest_rect_left(n);
   }
-  // The radius: nothing left out comes nearer.
-  constexpr double kAllWallsRadius_m = 1.0;  // every entry's walls copied: any radius holds; the workspace is smaller
-  double r_sq = kAllWallsRadius_m * kAllWallsRadius_m;
-  if (j < m) r_sq = box_distance_sq(sc.box(section_[near_entry[j]]), q.b);
-  if (j + 1 < m) r_sq = std::min(r_sq, near_d_sq[j + 1]);
-  if (!all_listed) r_sq = std::min(r_sq, near_d_sq[m - 1]);  // entries not listed: their rectangles are no nearer
   if (w.count == 0 || r_sq <= q.nearest_sq) {
     w.count = 0;
     w.runs = 0;
@@ -815,6 +1049,35 @@ void BoundarySection::gather_ball_walls(const Query& q) noexcept {
   w.center_m = q.b;
   w.radius_sq = r_sq;
   w.level = q.level;
+}
+
+// The entry of the nearest rectangle left in rect_d_sq_ (the first of equals; entries taken out are +inf), or n when
+// none is left: four entries per SSE instruction, no branch on the data (the scan's groups of four, its padding +inf).
+std::size_t BoundarySection::nearest_rect_left(std::size_t n) const noexcept {
+  const float* d_sq = rect_d_sq_.data();
+  std::size_t nearest = n;
+#if defined(__SSE2__)
+  __m128 v_nearest = _mm_set1_ps(std::numeric_limits<float>::infinity()), v_entry = _mm_set1_ps(static_cast<float>(n));
+  __m128 v_i = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
+  const __m128 four = _mm_set1_ps(4.0f);
+  for (std::size_t i = 0; i < n; i += kScanLanes) {
+    const __m128 d = _mm_loadu_ps(d_sq + i);
+    const __m128 nearer = _mm_cmplt_ps(d, v_nearest);
+    v_nearest = _mm_min_ps(d, v_nearest);
+    v_entry = _mm_or_ps(_mm_and_ps(nearer, v_i), _mm_andnot_ps(nearer, v_entry));
+    v_i = _mm_add_ps(v_i, four);
+  }
+  nearest = static_cast<std::size_t>(_mm_cvtss_f32(nearest_lane(v_nearest, v_entry, n)));
+#else
+  float best = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (d_sq[i] < best) {
+      best = d_sq[i];
+      nearest = i;
+    }
+  }
+#endif
+  return nearest;
 }
 
 // The ball's walls noted by gather_ball_walls, copied out: each run's consecutive segments (one level of one
@@ -854,7 +1117,6 @@ void BoundarySection::split_hit_boxes(Query& q) {
 // entry left to drop). Merging only shrinks the section, so it can be lazy: one parent per 8 idle entries a full
 // query, taken round-robin.
 void BoundarySection::merge_idle_siblings(Query& q) {
-  const Scene& sc = *scene_;
   // Merges must keep up with the splits, or the section grows without bound: with 4 checks per tick and no
   // more, a long walk over a dense scene grew it to 9 000–18 000 entries (CollisionQuery.
   // BoundarySectionStaysSmallOnALongWalk; the tick's scan grows with it). So one check per kIdlePerMergeCheck
@@ -883,18 +1145,18 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     if ((node_state_[node] & kHitMark) || parent == kNoParent || (node_state_[parent] & kCheckedMark)) continue;
     mark(parent, kCheckedMark);
     ++checks;
-    std::uint32_t first = 0, count = 0;
-    sc.children(parent, &first, &count);
     // All children in: most checks end here, a sibling split deeper (three in four), on one count rather than a loop
     // over the children whose exit the predictor cannot learn. Then none of them hit this tick.
-    if (children_in(parent) != count) continue;
+    if (children_in(parent) != child_count(parent)) continue;
+    std::uint32_t child[kMaxEntryChildren];
+    const std::uint32_t count = entry_children(parent, child);
     bool all_idle = true;
-    for (std::uint32_t i = 0; i < count; ++i) all_idle &= (node_state_[first + i] & kHitMark) == 0;
+    for (std::uint32_t i = 0; i < count; ++i) all_idle &= (node_state_[child[i]] & kHitMark) == 0;
     if (!all_idle) continue;
     double te = 0.0, tx = 0.0;
     if (!q.spend_box()) break;  // merging can wait for a tick with budget left
-    if (clip_segment_box(sc.box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
-    if (merge_children(e, parent, first, count)) ++q.st.merges;
+    if (clip_segment_box(entry_box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
+    if (merge_children(e, parent, child, count)) ++q.st.merges;
   }
 }
 
@@ -958,71 +1220,6 @@ SweepHit BoundarySection::finish(Query& q) const {
 
 // ---- Walks of the wide index (wide_index.hpp) ----
 
-namespace {
-
-#if defined(__SSE2__)
-using F4 = __m128;
-inline F4 load4(const float* p) { return _mm_load_ps(p); }
-inline F4 splat(float x) { return _mm_set1_ps(x); }
-#endif
-
-// Entry parameters of the sweep into a node's four rectangles: bit i of the result is set when the
-// sweep meets rectangle i at a parameter ≤ horizon, and t_enter[i] is where it enters. The sweep is
-// given as its start and the reciprocals of its extent (±1e20 for a zero extent: a start inside the
-// slab spans every parameter, one outside it none).
-inline int sweep_node(const WideNode& n, float ax, float ay, float ix, float iy, float horizon, float t_enter[4]) {
-#if defined(__SSE2__)
-  const F4 vax = splat(ax), vay = splat(ay), vix = splat(ix), viy = splat(iy);
-  const F4 tx0 = _mm_mul_ps(_mm_sub_ps(load4(n.lo_x), vax), vix), tx1 = _mm_mul_ps(_mm_sub_ps(load4(n.hi_x), vax), vix);
-  const F4 ty0 = _mm_mul_ps(_mm_sub_ps(load4(n.lo_y), vay), viy), ty1 = _mm_mul_ps(_mm_sub_ps(load4(n.hi_y), vay), viy);
-  const F4 t_in = _mm_max_ps(_mm_max_ps(_mm_min_ps(tx0, tx1), _mm_min_ps(ty0, ty1)), _mm_setzero_ps());
-  const F4 t_out = _mm_min_ps(_mm_min_ps(_mm_max_ps(tx0, tx1), _mm_max_ps(ty0, ty1)), splat(1.0f));
-  _mm_storeu_ps(t_enter, t_in);
-  return _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t_in, t_out), _mm_cmple_ps(t_in, splat(horizon))));
-#else
-  int mask = 0;
-  for (int i = 0; i < 4; ++i) {
-    const float tx0 = (n.lo_x[i] - ax) * ix, tx1 = (n.hi_x[i] - ax) * ix;
-    const float ty0 = (n.lo_y[i] - ay) * iy, ty1 = (n.hi_y[i] - ay) * iy;
-    const float t_in = std::max(std::max(std::min(tx0, tx1), std::min(ty0, ty1)), 0.0f);
-    const float t_out = std::min(std::min(std::max(tx0, tx1), std::max(ty0, ty1)), 1.0f);
-    t_enter[i] = t_in;
-    if (t_in <= t_out && t_in <= horizon) mask |= 1 << i;
-  }
-  return mask;
-#endif
-}
-
-// Squared distances from (px, py) to a node's four rectangles [m²] (0 inside); bit i of the result is
-// set when rectangle i is within bound_sq.
-inline int near_node(const WideNode& n, float px, float py, float bound_sq, float d_sq[4]) {
-#if defined(__SSE2__)
-  const F4 vpx = splat(px), vpy = splat(py), zero = _mm_setzero_ps();
-  const F4 dx = _mm_max_ps(_mm_max_ps(_mm_sub_ps(load4(n.lo_x), vpx), _mm_sub_ps(vpx, load4(n.hi_x))), zero);
-  const F4 dy = _mm_max_ps(_mm_max_ps(_mm_sub_ps(load4(n.lo_y), vpy), _mm_sub_ps(vpy, load4(n.hi_y))), zero);
-  const F4 d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
-  _mm_storeu_ps(d_sq, d2);
-  return _mm_movemask_ps(_mm_cmple_ps(d2, splat(bound_sq)));
-#else
-  int mask = 0;
-  for (int i = 0; i < 4; ++i) {
-    const float dx = std::max(std::max(n.lo_x[i] - px, px - n.hi_x[i]), 0.0f);
-    const float dy = std::max(std::max(n.lo_y[i] - py, py - n.hi_y[i]), 0.0f);
-    d_sq[i] = dx * dx + dy * dy;
-    if (d_sq[i] <= bound_sq) mask |= 1 << i;
-  }
-  return mask;
-#endif
-}
-
-// Reciprocal of a sweep extent for sweep_node: ±1e20 in place of 1/0 or of an overflow.
-inline float slab_reciprocal(double d) {
-  const float f = static_cast<float>(d);
-  if (std::abs(f) < 1e-20f) return d < 0.0 ? -1e20f : 1e20f;
-  return 1.0f / f;
-}
-
-}  // namespace
 
 // The segments a walk tests at an item (segment node `item` of the item level): the target level's segments
 // under it (the item itself at the item level). Writes the first node and returns the count. The walks of the

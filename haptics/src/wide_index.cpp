@@ -145,6 +145,20 @@ class Builder {
 
 }  // namespace
 
+void WideIndex::node_rect(std::uint32_t w, Vec2* lo, Vec2* hi) const noexcept {
+  const WideNode& n = nodes[w];
+  float lx = std::numeric_limits<float>::infinity(), ly = lx, hx = -lx, hy = -lx;
+  for (int i = 0; i < 4; ++i) {
+    if (n.child[i] == kWideEmpty) continue;
+    lx = std::min(lx, n.lo_x[i]);
+    ly = std::min(ly, n.lo_y[i]);
+    hx = std::max(hx, n.hi_x[i]);
+    hy = std::max(hy, n.hi_y[i]);
+  }
+  *lo = Vec2{lx, ly};
+  *hi = Vec2{hx, hy};
+}
+
 WideIndex WideIndex::build(const Scene& sc) {
   WideIndex index;
   std::size_t item_count = 0;

@@ -265,8 +265,17 @@ class BoundarySection {
   bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
                      QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
 
-  /// Node ids of the current boundary section (for the operator overlay and tests).
+  /// Ids of the current boundary section's entries (for the operator overlay and tests): scene node ids, and with
+  /// the wide frontier (wide_frontier_active) also wide index nodes, node w as Scene::node_count() + w.
   const std::vector<std::uint32_t>& section() const { return section_; }
+  /// Whether the section's entries above the items are the wide index's nodes rather than the tree's chunks,
+  /// hierarchy and coarse segments: at level ids the wide index serves (both ids the section serves); a change
+  /// of id that changes this starts the section again from its root. The frontier of first_hit.
+  bool wide_frontier_active() const noexcept { return wide_mode_; }
+  /// The parent of section entry id `id` in the frontier's hierarchy, or 0xffffffff for its root: the scene's
+  /// (Scene::parent) in the tree's frontier and below the items; above them in the wide frontier, the wide node
+  /// whose slot names it (an item's, or a wide node's). For tests.
+  std::uint32_t entry_parent(std::uint32_t id) const noexcept { return parent_or_none(id); }
 
  private:
   struct Query;  // one first_hit's inputs, answer so far and counters (collision_query.cpp)
@@ -298,6 +307,7 @@ class BoundarySection {
   void mark_near_rects(double bound_sq, std::size_t skip);
   void refine_candidates(Query& q);
   bool push_hit_children(Query& q, std::uint32_t node, int& top);
+  bool push_wide_children(Query& q, std::uint32_t node, int& top);
   static constexpr int kDirectLevels = kWideItemLevel;  // a box this near its walls has them tested at once (8 at most)
   std::uint32_t segments_under(std::uint32_t node, int level, std::uint32_t* first) const noexcept;
   bool test_segments_under(Query& q, std::uint32_t node);
@@ -305,13 +315,40 @@ class BoundarySection {
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
   void gather_ball_walls(const Query& q) noexcept;
+  std::size_t nearest_rect_left(std::size_t n) const noexcept;
   void place_free_ball(const Query& q) noexcept;
   void drop_departed_entries() noexcept;
   SweepHit finish(Query& q) const;
   void split(std::uint32_t node, std::size_t entry);
+  void split_wide(std::uint32_t node, std::size_t entry);
   void set_section_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent);
   void remove_section_entry(std::size_t entry) noexcept;
-  bool merge_children(std::size_t entry, std::uint32_t parent, std::uint32_t first, std::uint32_t count);
+  bool merge_children(std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count);
+  // The wide frontier. At level ids the wide index serves (wide_serves; both ids the section serves), the section's
+  // entries above the items are the wide index's nodes rather than the tree's chunks, hierarchy and coarse segments
+  // (whose boxes follow the curves and overlap: a descent from them opens many): the frontier is then a cut through
+  // the index's nodes, its items (segment nodes of the item level) and the tree of error boxes below them. Wide node
+  // w is the section id wide_base_ + w, past every scene node; its box is its rectangle in its parent's slot.
+  // follow_level switches between the two frontiers (from the roots) when the ids' service changes.
+#ifdef HK_NO_WIDE_FRONTIER
+  bool wide_frontier(int) const noexcept { return false; }
+#else
+  bool wide_frontier(int level) const noexcept { return wide_serves(level) && !scene_->wide_index().nodes.empty(); }
+#endif
+  bool is_wide_id(std::uint32_t id) const noexcept { return id >= wide_base_; }
+  Aabb entry_rect(std::uint32_t id) const noexcept;
+  ErrorBox entry_box(std::uint32_t id) const noexcept;
+  ErrorBox entry_box_at(std::size_t entry) const noexcept;
+  std::uint32_t entry_children(std::uint32_t id, std::uint32_t* out) const noexcept;
+  std::uint32_t child_count(std::uint32_t id) const noexcept;
+  static constexpr std::uint32_t kMaxEntryChildren = 7;  // a node's children in the frontier are counted in three bits
+  bool wide_mode_ = false;       // the frontier is the wide one (follow_level)
+  std::uint32_t wide_base_ = 0;  // section id of wide node 0: the scene's node_count()
+  std::vector<std::uint32_t> wide_up_;     // per wide node: its parent node << 2 | its slot there (kNoParent: the root)
+  std::vector<std::uint32_t> item_up_;     // per item, in the index's item order (curve by curve): the wide node << 2 | slot naming it
+  std::vector<std::uint32_t> item_first_;  // per curve: the order of its first item
+  Aabb wide_root_rect_{};                  // the wide root's rectangle: its slots' union
+  void link_wide_nodes();
   // The walks of the wide index (wide_index.hpp). One stack serves both: an entry is a child code with its
   // rectangle's squared distance from the walk's point (the order of the walk) and, for first_hit_wide,
   // where the sweep enters it (+inf when it does not). 12 bytes an entry, as three arrays: every access

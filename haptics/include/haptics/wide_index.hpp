@@ -63,6 +63,9 @@ struct WideIndex {
   std::size_t stack_entries() const { return static_cast<std::size_t>(depth) * 3 + 8; }
   /// Bytes of the nodes.
   std::size_t bytes() const { return nodes.size() * sizeof(WideNode); }
+  /// The rectangle of node w [m]: the union of its slots' (empty slots left out), so it holds every item under
+  /// it. Writes lo and hi; w < nodes.size().
+  void node_rect(std::uint32_t w, Vec2* lo, Vec2* hi) const noexcept;
   /// Builds the index of `scene`'s curves (its segments, boxes and levels must be final). Throws
   /// std::bad_alloc only.
   static WideIndex build(const Scene& scene);
