@@ -182,9 +182,17 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
     const int n = std::min(d.section_count, ServoDisplayState::kMaxSection);
     for (int i = 0; i < n; ++i) {
       const std::uint32_t node = d.section[i];
-      if (node >= sc.node_count()) continue;
+      const std::size_t wide_node = node - sc.node_count();  // the wide frontier's entries (BoundarySection::section)
+      if (node >= sc.node_count() && wide_node >= sc.wide_index().nodes.size()) continue;
       glBegin(GL_LINE_LOOP);
-      if (sc.is_segment(node)) {
+      if (node >= sc.node_count()) {
+        Vec2 lo, hi;
+        sc.wide_index().node_rect(static_cast<std::uint32_t>(wide_node), &lo, &hi);
+        glVertex2d(v.px(lo.x), v.py(lo.y));
+        glVertex2d(v.px(hi.x), v.py(lo.y));
+        glVertex2d(v.px(hi.x), v.py(hi.y));
+        glVertex2d(v.px(lo.x), v.py(hi.y));
+      } else if (sc.is_segment(node)) {
         const ErrorBox& b = sc.box(node);
         const Vec2 nrm = left_perp(b.axis);
         for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {

@@ -330,11 +330,7 @@ class BoundarySection {
   // the index's nodes, its items (segment nodes of the item level) and the tree of error boxes below them. Wide node
   // w is the section id wide_base_ + w, past every scene node; its box is its rectangle in its parent's slot.
   // follow_level switches between the two frontiers (from the roots) when the ids' service changes.
-#ifdef HK_NO_WIDE_FRONTIER
-  bool wide_frontier(int) const noexcept { return false; }
-#else
   bool wide_frontier(int level) const noexcept { return wide_serves(level) && !scene_->wide_index().nodes.empty(); }
-#endif
   bool is_wide_id(std::uint32_t id) const noexcept { return id >= wide_base_; }
   Aabb entry_rect(std::uint32_t id) const noexcept;
   ErrorBox entry_box(std::uint32_t id) const noexcept;
