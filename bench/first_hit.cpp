@@ -263,7 +263,7 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     hits += hit;
     seg_tests += static_cast<std::size_t>(st.segment_tests);
     box_tests += static_cast<std::size_t>(st.box_tests);
-    full += st.box_tests > 0;  // a full query (not answered by the free-space ball or its walls)
+    full += st.section_box_tests > 0;  // a full query (not answered by the free-space ball or its walls): it scans the section
     section += static_cast<std::size_t>(st.section_size);
     benchmark::DoNotOptimize(hit);
   }

@@ -1132,7 +1132,10 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   // new node was not hit this tick, so its parent is checked too; the parent of a split one was hit and stays.
   const std::size_t n = q.scanned;
   if (n == 0) return;
-  const int max_checks = static_cast<int>((n - q.hit) / kIdlePerMergeCheck);
+  merge_debt_ += static_cast<int>((n - q.hit) / kIdlePerMergeCheck);
+  if (merge_debt_ <= kMaxMergeDebt) return;  // the ball ticks after this one pay (merge_on_ball_tick)
+  const int max_checks = merge_debt_ - kMaxMergeDebt;  // what is owed past the cap: at most this query's own share
+  merge_debt_ = kMaxMergeDebt;
   int checks = 0;
   std::size_t e = tick_ % n;
   for (std::size_t j = 0; j < n && checks < max_checks; ++j, e = e + 1 == n ? 0 : e + 1) {
@@ -1158,6 +1161,25 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     if (clip_segment_box(entry_box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
     if (merge_children(e, parent, child, count)) ++q.st.merges;
   }
+}
+
+// One merge check of the round robin on a tick the free-space ball answered (a → b the sweep), while full queries
+// have left some owed (merge_debt_): the parent of the next entry, when all its children are in the section (none was
+// hit: a ball tick hits nothing) and its box is clear of the sweep by the margin, takes their place. One optional
+// box test, charged to `budget` and counted in st (box_tests; merges when it merged).
+[[gnu::noinline]] void BoundarySection::merge_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept {
+  --merge_debt_;
+  const std::size_t n = section_.size();
+  if (n == 0) return;
+  const std::size_t e = merge_cursor_++ % n;
+  const std::uint32_t parent = section_parent_[e];
+  if (parent == kNoParent || children_in(parent) != child_count(parent) || !budget.spend()) return;
+  ++st.box_tests;
+  double te = 0.0, tx = 0.0;
+  if (clip_segment_box(entry_box(parent), a, b, merge_margin_m_, &te, &tx)) return;
+  std::uint32_t child[kMaxEntryChildren];
+  const std::uint32_t count = entry_children(parent, child);
+  if (merge_children(e, parent, child, count)) ++st.merges;
 }
 
 // Phase 6: the next free-space ball: the distance from the end of the sweep to the nearest box phase 1
@@ -1411,8 +1433,10 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
   level = walls_of(level);
   if (level != last_level_ || level != other_level_) follow_level(level);  // else it serves this id alone, as before
   if (inside_free_ball(a, b)) {
+    QueryStats st;
+    if (merge_debt_ > 0) merge_on_ball_tick(a, b, budget, st);
     if (stats_out) {
-      *stats_out = QueryStats{};
+      *stats_out = st;
       stats_out->section_size = static_cast<std::int32_t>(section_.size());
     }
     SweepHit clear;

@@ -314,6 +314,10 @@ class BoundarySection {
   void test_segment(Query& q, std::uint32_t node);
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
+  void merge_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
+  static constexpr int kMaxMergeDebt = 16;  // merge checks full queries leave to the ball ticks, at most
+  int merge_debt_ = 0;                      // merge checks owed (merge_idle_siblings)
+  std::size_t merge_cursor_ = 0;            // the ball ticks' round robin over the entries
   void gather_ball_walls(const Query& q) noexcept;
   std::size_t nearest_rect_left(std::size_t n) const noexcept;
   void place_free_ball(const Query& q) noexcept;
