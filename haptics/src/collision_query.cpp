@@ -973,7 +973,24 @@ bool BoundarySection::test_segments_under(Query& q, std::uint32_t node) {
   const std::uint32_t count = segments_under(node, q.level, &first);
   if (count == 0 || !q.budget->affords(static_cast<std::int32_t>(count))) return false;  // not refused: the descent may still go part way
   q.spend_boxes(static_cast<std::int32_t>(count));
-  for (std::uint32_t i = 0; i < count; ++i) test_segment(q, first + i);
+  // test_segment for each, with what they share found once: their curve and level (their indices run on from the
+  // first's), their points (consecutive slots), and a level's own points as walls (segments_under takes no cut step).
+  const NodeInfo in = scene_->info(first);
+  const Vec2* pts = scene_->slot_points(first);
+  q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index + i)};
+    if (q.is_excluded(ref)) continue;
+    ++q.st.segment_tests;
+    const Vec2 p0 = pts[i], p1 = pts[i + 1];
+    if (!overlaps(rect_of(p0, p1), q.sweep, 0.0)) continue;  // the rectangles apart: no common point
+    double t = 0.0;
+    if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && closer(t, ref, q.best.t, q.best.segment)) {
+      q.best.hit = true;
+      q.best.t = t;
+      q.best.segment = ref;
+    }
+  }
   return true;
 }
 
