@@ -317,7 +317,7 @@ std::size_t BoundarySection::bytes() const noexcept {
   return of(section_) + of(section_parent_) + of(section_rect_.lo_x) + of(section_rect_.lo_y) + of(section_rect_.hi_x) +
          of(section_rect_.hi_y) + of(rect_d_sq_) + of(rect_overlap_bits_) + of(rect_near_bits_) + of(node_state_) +
          of(marked_) + of(candidates_) + of(stack_) + of(walk_.t_enter) + of(walk_.d_sq) +
-         of(walk_.code);
+         of(walk_.code) + of(wide_up_) + of(item_up_) + of(item_first_);
 }
 
 void BoundarySection::reset() {
@@ -1131,17 +1131,19 @@ void BoundarySection::split_hit_boxes(Query& q) {
 }
 
 // Phase 5: siblings whose parent is clear of the sweep by the margin merge into it (merge_children: in place, no
-// entry left to drop). Merging only shrinks the section, so it can be lazy: one parent per 8 idle entries a full
-// query, taken round-robin.
+// entry left to drop). Merging only shrinks the section, so it can be lazy: a full query owes one check per 8 idle
+// entries (merge_debt_), which the ticks the free-space ball answers pay, one each (merge_on_ball_tick); past
+// kMaxMergeDebt owed (a walk through walls, few ball ticks) the full query pays the excess itself, parents taken
+// round robin.
 void BoundarySection::merge_idle_siblings(Query& q) {
   // Merges must keep up with the splits, or the section grows without bound: with 4 checks per tick and no
   // more, a long walk over a dense scene grew it to 9 000–18 000 entries (CollisionQuery.
   // BoundarySectionStaysSmallOnALongWalk; the tick's scan grows with it). So one check per kIdlePerMergeCheck
-  // idle entries: a section grown by a burst of splits is merged back (884 entries at most on that walk; one per 16
-  // fell behind there, 3 037). Nothing more, so a section with fewer than 8 idle entries does not merge: two checks
-  // more every full query, whatever the section's size (until 2026-11-27), cost more than the smaller section they
-  // kept saved; without them the bench's random walk keeps 24.5 entries instead of 21 at 10^5 segments, has 1.7 %
-  // fewer full queries and runs 3–5 % fewer instructions (PERFORMANCE.md, round two).
+  // idle entries: a section grown by a burst of splits is merged back (with the tree's frontier and the checks made
+  // by the full query itself, 884 entries at most on that walk, one per 16 fell behind there, 3 037; with the wide
+  // frontier and the checks paid by the ball ticks, 174). Nothing more, so a section with fewer than 8 idle entries
+  // owes none: two checks more every full query, whatever the section's size (until 2026-11-27), cost more than the
+  // smaller section they kept saved (PERFORMANCE.md, round two).
   constexpr std::size_t kIdlePerMergeCheck = 8;
   // As many entries as phase 1 scanned, in section order from a point that moves with the tick (round robin);
   // the idle ones are those it did not find hit. Splits and merges since put other nodes at some of them (a

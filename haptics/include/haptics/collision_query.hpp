@@ -5,7 +5,10 @@
 ///
 /// The handle moves from a to b in one tick. The boundary section — the frontier of tree nodes near the
 /// handle — is kept from tick to tick and changes by splits (a box hit by the sweep is refined to its
-/// children) and merges (two siblings whose parent is clear by a margin are replaced by the parent).
+/// children) and merges (siblings whose parent is clear by a margin are replaced by the parent; a full query owes
+/// the checks, the ticks the free-space ball answers pay them, one each). At level ids the wide index serves
+/// (wide_index.hpp), the frontier's nodes above the items are the index's spatial nodes rather than the tree's
+/// curve-following ones (wide_frontier_active).
 /// Each tick the sweep is clipped (Liang–Barsky) against the boxes of the boundary section; hit boxes
 /// are sorted by entry parameter and refined depth-first, nearest first, down to the target level,
 /// where the sweep is intersected with that level's polyline (a box within 3 levels of a level target has
@@ -119,8 +122,9 @@ struct QueryStats {
 class BoundarySection {
  public:
   static constexpr int kMaxExcluded = 2;
-  /// Bound on the section's entries [count], so on its storage and on its scan (done even past the budget). Ten
-  /// times the largest section seen on the dense long walk of the tests (811 entries); the bench's walks keep ~20.
+  /// Bound on the section's entries [count], so on its storage and on its scan (done even past the budget). The
+  /// dense long walk of the tests keeps at most 174 entries (811–884 with the tree's frontier alone); the bench's
+  /// walks keep ~25.
   static constexpr std::size_t kMaxSectionEntries = 1u << 13;
 
   /// Sizes every buffer for `scene` (which must outlive this object) and starts at the roots. With
@@ -143,7 +147,8 @@ class BoundarySection {
   /// boundary section, which serves this id and the previous query's (splits stop at the coarser of the
   /// two; a new id coarsens the entries below its walls, O(section entries), O(levels) each at a cut step).
   /// Of walls hit at the same t, the answer is the smallest (curve, level, segment). A sweep inside the free-space
-  /// ball, or inside the ball of its walls (at most 16 segment tests), is answered without a box test.
+  /// ball, or inside the ball of its walls (at most 16 segment tests), is answered without a box test of its own; a
+  /// sweep inside the free-space ball pays one merge check a full query left owed (one optional box test).
   /// Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                      QueryBudget& budget, QueryStats* stats = nullptr);
@@ -195,7 +200,8 @@ class BoundarySection {
   bool closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
                          QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
   /// Bytes of this section's own storage [B]: per scene node, 1 (in the frontier, children in it, a full query's
-  /// marks); per entry of its capacity (at most kMaxSectionEntries + a few), its node, parent, float rectangle,
+  /// marks); per wide index node, 5 (the same byte, and its parent for the wide frontier) and per item 4 (its parent);
+  /// per entry of its capacity (at most kMaxSectionEntries + a few), its node, parent, float rectangle,
   /// scan scratch, candidate and two slots of the marks' list; the walks' stacks. Not the scene's, nor the cut masks (shared: cut_walls()).
   /// One section per servo thread. O(1).
   std::size_t bytes() const noexcept;
