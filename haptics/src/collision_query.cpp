@@ -279,6 +279,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   const WideIndex& wi = scene.wide_index();
   wide_base_ = static_cast<std::uint32_t>(n);
   const std::size_t ids = n + wi.nodes.size();  // scene nodes, then wide nodes (the wide frontier's ids)
+  if (ids >= kNoParent) throw std::invalid_argument("BoundarySection: the scene's nodes and wide nodes exceed 32-bit section ids");
   capacity_ = std::min<std::size_t>(2 * ids, kMaxSectionEntries) + widest_root + 8;
   section_.reserve(capacity_);
   section_parent_.assign(capacity_, kNoParent);
@@ -380,7 +381,7 @@ void BoundarySection::link_wide_nodes() {
   const WideIndex& wi = sc.wide_index();
   item_first_.assign(sc.curve_count(), 0);
   std::uint32_t items = 0;
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) {  // the index's item order (WideIndex::build)
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {  // items numbered curve by curve
     item_first_[c] = items;
     items += sc.curve(c).segment_count[wide_item_level(sc.curve(c).levels)];
   }
@@ -453,7 +454,7 @@ std::uint32_t BoundarySection::entry_children(std::uint32_t id, std::uint32_t* o
     std::uint32_t count = 0;
     for (std::uint32_t code : nd.child) {
       if (code == kWideEmpty) continue;
-      out[count++] = (code & kWideLeaf) ? (code & ~kWideLeaf) : wide_base_ + code;
+      out[count++] = wide_child_id(code);
     }
     return count;
   }
@@ -506,7 +507,7 @@ void BoundarySection::split_wide(std::uint32_t node, std::size_t entry) {
   for (int i = 0; i < 4; ++i) {
     const std::uint32_t code = n.child[i];
     if (code == kWideEmpty) continue;
-    const std::uint32_t id = (code & kWideLeaf) ? (code & ~kWideLeaf) : wide_base_ + code;
+    const std::uint32_t id = wide_child_id(code);
     const std::size_t at = first ? entry : section_.size();
     if (!first) section_.push_back(id);  // within the reserved capacity: no allocation
     first = false;
@@ -592,6 +593,19 @@ struct BoundarySection::Query {
     return true;
   }
   bool is_excluded(SegmentRef s) const noexcept { return hk::is_excluded(s, excluded, excluded_count); }
+  // One wall (segment ref from p0 to p1 [m], not excluded) tested against the sweep; kept when it is the nearest hit
+  // so far (of equals, the smallest (curve, level, segment): the answer does not depend on the order of the walk).
+  // A rectangle test first: the rectangles apart, no common point.
+  void test_wall(SegmentRef ref, Vec2 p0, Vec2 p1) noexcept {
+    ++st.segment_tests;
+    st.coarsest_answer_level = std::max(st.coarsest_answer_level, ref.level);
+    double t = 0.0;
+    if (overlaps(rect_of(p0, p1), sweep, 0.0) && intersect_sweep_segment(a, b, p0, p1, &t) && closer(t, ref, best.t, best.segment)) {
+      best.hit = true;
+      best.t = t;
+      best.segment = ref;
+    }
+  }
   // Boxes entered past this cannot hold anything nearer than what is known.
   double horizon() const noexcept { return std::min(best.t, unresolved_t); }
 };
@@ -887,16 +901,9 @@ void BoundarySection::test_segment(Query& q, std::uint32_t node) {
   const NodeInfo in = scene_->info(node);
   const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
   if (q.is_excluded(ref)) return;
-  ++q.st.segment_tests;
-  q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
   Vec2 p0, p1;
   wall_node_points(node, q.level, &p0, &p1);
-  double t = 0.0;
-  if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && closer(t, ref, q.best.t, q.best.segment)) {
-    q.best.hit = true;
-    q.best.t = t;
-    q.best.segment = ref;
-  }
+  q.test_wall(ref, p0, p1);
 }
 
 // Pushes the children of `node` the sweep enters, nearest on top. Returns false, with nothing pushed,
@@ -935,8 +942,7 @@ bool BoundarySection::push_wide_children(Query& q, std::uint32_t node, int& top)
   const int base = top;
   for (int i = 0; i < 4; ++i) {
     if (!(mask & (1 << i))) continue;
-    const std::uint32_t code = n.child[i];
-    const std::uint32_t id = (code & kWideLeaf) ? (code & ~kWideLeaf) : wide_base_ + code;
+    const std::uint32_t id = wide_child_id(n.child[i]);
     if (!push(top, {static_cast<double>(t_enter[i]), id, kNotAnEntry})) {
       top = base;  // the stack is full: as past the budget
       return false;
@@ -973,25 +979,20 @@ bool BoundarySection::test_segments_under(Query& q, std::uint32_t node) {
   const std::uint32_t count = segments_under(node, q.level, &first);
   if (count == 0 || !q.budget->affords(static_cast<std::int32_t>(count))) return false;  // not refused: the descent may still go part way
   q.spend_boxes(static_cast<std::int32_t>(count));
-  // test_segment for each, with what they share found once: their curve and level (their indices run on from the
-  // first's), their points (consecutive slots), and a level's own points as walls (segments_under takes no cut step).
+  test_level_run(q, first, count);
+  return true;
+}
+
+// test_segment for the `count` consecutive segment nodes of one level of one curve from `first` (not a cut step's),
+// with what they share found once: their curve and level (their indices run on from the first's) and their points
+// (consecutive slots), each its own level's wall.
+void BoundarySection::test_level_run(Query& q, std::uint32_t first, std::uint32_t count) {
   const NodeInfo in = scene_->info(first);
   const Vec2* pts = scene_->slot_points(first);
-  q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, in.level);
   for (std::uint32_t i = 0; i < count; ++i) {
     const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index + i)};
-    if (q.is_excluded(ref)) continue;
-    ++q.st.segment_tests;
-    const Vec2 p0 = pts[i], p1 = pts[i + 1];
-    if (!overlaps(rect_of(p0, p1), q.sweep, 0.0)) continue;  // the rectangles apart: no common point
-    double t = 0.0;
-    if (intersect_sweep_segment(q.a, q.b, p0, p1, &t) && closer(t, ref, q.best.t, q.best.segment)) {
-      q.best.hit = true;
-      q.best.t = t;
-      q.best.segment = ref;
-    }
+    if (!q.is_excluded(ref)) q.test_wall(ref, pts[i], pts[i + 1]);
   }
-  return true;
 }
 
 // Phase 2: nearest first. Hit boxes in order of entry, each refined depth-first (nearest child first)
@@ -1296,17 +1297,11 @@ std::uint32_t BoundarySection::item_segments(std::uint32_t item, int level, std:
   return true;
 }
 
-// Tests the sweep against the target level's segments at an item (a cheap rectangle test first).
+// Tests the sweep against the target level's segments at an item (test_level_run).
 void BoundarySection::wide_test_item(Query& q, std::uint32_t item) {
-  const Scene& sc = *scene_;
   std::uint32_t first = 0;
   const std::uint32_t count = item_segments(item, q.level, &first);
-  for (std::uint32_t i = 0; i < count; ++i) {
-    Vec2 p0, p1;
-    sc.segment_points(first + i, &p0, &p1);
-    const Aabb r = rect_of(p0, p1);
-    if (overlaps(r, q.sweep, 0.0)) test_segment(q, first + i);  // the rectangles apart: no common point
-  }
+  test_level_run(q, first, count);
 }
 
 // One walk of the wide index for both answers of first_hit_wide: the first hit of the sweep, and the

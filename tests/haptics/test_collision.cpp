@@ -805,9 +805,11 @@ TEST(CollisionQuery, AFullSectionRefusesSplitsAndStillAnswersAsBruteForce) {
     ASSERT_NO_FATAL_FAILURE(expect_brute(i % 2 ? left : right, i % 2 ? right : left, 3, walls3, "after a change to level 3"));
   }
   ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {0, 3}, "after the change"));
-  // One byte a node and the bounded entries (~53 B each, 0.43 MB here; with 3 bytes a node this scene's 261 023
-  // nodes made 1.2 MB).
-  EXPECT_LT(section.bytes(), sc.node_count() + (std::size_t{1} << 19));
+  // One byte a node, the wide frontier's parent links (4 B a wide node, with its byte, and 4 B an item) and the
+  // bounded entries (~53 B each, 0.43 MB here; with 3 bytes a node this scene's 261 023 nodes made 1.2 MB).
+  std::size_t items = 0;
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) items += sc.curve(c).segment_count[wide_item_level(static_cast<int>(sc.curve(c).levels))];
+  EXPECT_LT(section.bytes(), sc.node_count() + 5 * sc.wide_index().nodes.size() + 4 * items + (std::size_t{1} << 19));
 }
 
 // What a sliding hand's walk did: its hits, its ticks within 1 mm of a wall, how many of those were answered

@@ -131,7 +131,8 @@ class BoundarySection {
   /// `cut_walls` it also computes the cut masks and their bounds (tolerance_cut_masks, cut_bounds: a byte
   /// per node, about a tenth of a second at 10^6 segments), which the walls at cut steps need; without them a
   /// cut step renders as the tolerance step of the same tolerance (each curve at its level for it). Throws
-  /// std::invalid_argument for a scene node with more than 7 children (a Scene has at most 4).
+  /// std::invalid_argument for a scene node with more than 7 children (a Scene has at most 4), or when the scene's
+  /// nodes and wide index nodes together do not fit 32-bit section ids.
   explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4, bool cut_walls = true);
   /// The same, reading the cut masks and bounds from `cuts` (make_cut_walls of the same `scene`, shared with
   /// other sections of it) instead of computing its own; null: no cut masks, as `cut_walls` = false. Throws
@@ -318,6 +319,7 @@ class BoundarySection {
   std::uint32_t segments_under(std::uint32_t node, int level, std::uint32_t* first) const noexcept;
   bool test_segments_under(Query& q, std::uint32_t node);
   void test_segment(Query& q, std::uint32_t node);
+  void test_level_run(Query& q, std::uint32_t first, std::uint32_t count);
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
   void merge_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
@@ -342,6 +344,8 @@ class BoundarySection {
   // follow_level switches between the two frontiers (from the roots) when the ids' service changes.
   bool wide_frontier(int level) const noexcept { return wide_serves(level) && !scene_->wide_index().nodes.empty(); }
   bool is_wide_id(std::uint32_t id) const noexcept { return id >= wide_base_; }
+  // The section id of a wide node's child code (WideNode::child, not kWideEmpty): an item's segment node, or a wide node.
+  std::uint32_t wide_child_id(std::uint32_t code) const noexcept { return (code & kWideLeaf) ? (code & ~kWideLeaf) : wide_base_ + code; }
   Aabb entry_rect(std::uint32_t id) const noexcept;
   ErrorBox entry_box(std::uint32_t id) const noexcept;
   ErrorBox entry_box_at(std::size_t entry) const noexcept;
