@@ -184,27 +184,20 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
       const std::uint32_t node = d.section[i];
       const std::size_t wide_node = node - sc.node_count();  // the wide frontier's entries (BoundarySection::section)
       if (node >= sc.node_count() && wide_node >= sc.wide_index().nodes.size()) continue;
-      glBegin(GL_LINE_LOOP);
+      // Every entry as a box: a segment's rotated one; a chunk's, hierarchy node's or wide node's rectangle (rect_box).
+      ErrorBox b;
       if (node >= sc.node_count()) {
-        Vec2 lo, hi;
-        sc.wide_index().node_rect(static_cast<std::uint32_t>(wide_node), &lo, &hi);
-        glVertex2d(v.px(lo.x), v.py(lo.y));
-        glVertex2d(v.px(hi.x), v.py(lo.y));
-        glVertex2d(v.px(hi.x), v.py(hi.y));
-        glVertex2d(v.px(lo.x), v.py(hi.y));
-      } else if (sc.is_segment(node)) {
-        const ErrorBox& b = sc.box(node);
-        const Vec2 nrm = left_perp(b.axis);
-        for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
-          const Vec2 q = b.origin_m + u * b.axis + w * nrm;
-          glVertex2d(v.px(q.x), v.py(q.y));
-        }
+        Aabb r;
+        sc.wide_index().node_rect(static_cast<std::uint32_t>(wide_node), &r.lo, &r.hi);
+        b = rect_box(r);
       } else {
-        const Aabb& a = sc.aabb(node);
-        glVertex2d(v.px(a.lo.x), v.py(a.lo.y));
-        glVertex2d(v.px(a.hi.x), v.py(a.lo.y));
-        glVertex2d(v.px(a.hi.x), v.py(a.hi.y));
-        glVertex2d(v.px(a.lo.x), v.py(a.hi.y));
+        b = sc.box(node);
+      }
+      const Vec2 nrm = left_perp(b.axis);
+      glBegin(GL_LINE_LOOP);
+      for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
+        const Vec2 q = b.origin_m + u * b.axis + w * nrm;
+        glVertex2d(v.px(q.x), v.py(q.y));
       }
       glEnd();
     }

@@ -350,6 +350,11 @@ void BoundarySection::push_section(std::uint32_t node, std::uint32_t parent) {
 // marks the node it replaces out (mark_out).
 void BoundarySection::set_section_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent) {
   section_rect_.set(entry, entry_rect(node));
+  place_entry(entry, node, parent);
+}
+
+// set_section_entry but for the rectangle, which the caller stores.
+void BoundarySection::place_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept {
   section_[entry] = node;
   section_parent_[entry] = parent;
   node_state_[node] |= kInSection;
@@ -420,17 +425,17 @@ Aabb BoundarySection::entry_rect(std::uint32_t id) const noexcept {
 // Scene::box gives a chunk's).
 ErrorBox BoundarySection::entry_box(std::uint32_t id) const noexcept {
   if (!is_wide_id(id)) return scene_->box(id);
-  const Aabb r = entry_rect(id);
-  return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo.x, r.hi.x, r.lo.y, r.hi.y};
+  return rect_box(entry_rect(id));
 }
 
-// entry_box of section entry i: a wide node's rectangle read from the section's own (the floats of its slots'
-// union, exactly), not from the index.
+// entry_box of section entry i, for a wide node read from the section's own rectangle rather than the index: its
+// slot's in its parent, stored as it is by a split (split_wide) or widened outward a little (set_section_entry);
+// either holds everything under the node.
 ErrorBox BoundarySection::entry_box_at(std::size_t i) const noexcept {
   const std::uint32_t id = section_[i];
   if (!is_wide_id(id)) return scene_->box(id);
   const SectionRects& r = section_rect_;
-  return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo_x[i], r.hi_x[i], r.lo_y[i], r.hi_y[i]};
+  return rect_box(Aabb{{r.lo_x[i], r.lo_y[i]}, {r.hi_x[i], r.hi_y[i]}});
 }
 
 // How many children section id `id` has in the frontier's hierarchy (entry_children's count), cheaply.
@@ -507,18 +512,11 @@ void BoundarySection::split_wide(std::uint32_t node, std::size_t entry) {
   for (int i = 0; i < 4; ++i) {
     const std::uint32_t code = n.child[i];
     if (code == kWideEmpty) continue;
-    const std::uint32_t id = wide_child_id(code);
     const std::size_t at = first ? entry : section_.size();
-    if (!first) section_.push_back(id);  // within the reserved capacity: no allocation
+    if (!first) section_.push_back(0);  // within the reserved capacity: no allocation (place_entry fills it)
     first = false;
-    section_rect_.lo_x[at] = n.lo_x[i];
-    section_rect_.lo_y[at] = n.lo_y[i];
-    section_rect_.hi_x[at] = n.hi_x[i];
-    section_rect_.hi_y[at] = n.hi_y[i];
-    section_[at] = id;
-    section_parent_[at] = node;
-    node_state_[id] |= kInSection;
-    node_state_[node] = static_cast<std::uint8_t>(node_state_[node] + kChildInUnit);
+    section_rect_.set_floats(at, n.lo_x[i], n.lo_y[i], n.hi_x[i], n.hi_y[i]);
+    place_entry(at, wide_child_id(code), node);
   }
 }
 
@@ -1315,9 +1313,8 @@ void BoundarySection::wide_test_item(Query& q, std::uint32_t item) {
 double BoundarySection::wide_walk(Query& q, double ball_cap_m) {
   const WideIndex& wi = scene_->wide_index();
   if (wi.nodes.empty()) return ball_cap_m;
-  const float ax = static_cast<float>(q.a.x), ay = static_cast<float>(q.a.y);
+  const float ax = q.ax, ay = q.ay, ix = q.ix, iy = q.iy;
   const float bx = static_cast<float>(q.b.x), by = static_cast<float>(q.b.y);
-  const float ix = slab_reciprocal(q.b.x - q.a.x), iy = slab_reciprocal(q.b.y - q.a.y);
   float ball_sq = seeded_ball_sq(wi, bx, by, static_cast<float>(ball_cap_m * ball_cap_m));
   bool ball_known = true;
   int top = 0;

@@ -334,6 +334,7 @@ class BoundarySection {
   void split(std::uint32_t node, std::size_t entry);
   void split_wide(std::uint32_t node, std::size_t entry);
   void set_section_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent);
+  void place_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept;
   void remove_section_entry(std::size_t entry) noexcept;
   bool merge_children(std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count);
   // The wide frontier. At level ids the wide index serves (wide_serves; both ids the section serves), the section's
@@ -401,6 +402,8 @@ class BoundarySection {
       std::fill_n(hi_x.data() + first, kScanLanes, -kInf);
       std::fill_n(hi_y.data() + first, kScanLanes, -kInf);
     }
+    // Entry i's rectangle from floats that already hold it (a wide index slot's), as they are.
+    void set_floats(std::size_t i, float lx, float ly, float hx, float hy) noexcept { lo_x[i] = lx; lo_y[i] = ly; hi_x[i] = hx; hi_y[i] = hy; }
     void copy(std::size_t to, std::size_t from) noexcept { lo_x[to] = lo_x[from]; lo_y[to] = lo_y[from]; hi_x[to] = hi_x[from]; hi_y[to] = hi_y[from]; }
   };
   SectionRects section_rect_;

@@ -57,6 +57,10 @@ struct Aabb {
 };
 static_assert(sizeof(Aabb) == 32, "Aabb: two per cache line");
 
+/// An axis-aligned rectangle as an ErrorBox [m]: origin (0, 0), axis (1, 0), its extents the rectangle's (how a
+/// chunk's, a hierarchy node's or a wide index node's box is tested like a segment's).
+inline ErrorBox rect_box(const Aabb& r) { return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo.x, r.hi.x, r.lo.y, r.hi.y}; }
+
 /// The rectangle of two points [m] (a segment's, or a sweep's from a to b), grown by grow_m ≥ 0 on every side.
 inline Aabb rect_of(Vec2 a, Vec2 b, double grow_m = 0.0) {
   return Aabb{{std::min(a.x, b.x) - grow_m, std::min(a.y, b.y) - grow_m}, {std::max(a.x, b.x) + grow_m, std::max(a.y, b.y) + grow_m}};
@@ -190,10 +194,7 @@ class Scene {
   /// hierarchy node's axis-aligned box as an ErrorBox with origin (0, 0) and axis (1, 0). O(1), one root.
   /// A slot id must start a segment (as segment_box()).
   ErrorBox box(std::uint32_t node) const {
-    if (node >= segment_nodes_) {
-      const Aabb& r = group_box_[node - segment_nodes_];
-      return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo.x, r.hi.x, r.lo.y, r.hi.y};
-    }
+    if (node >= segment_nodes_) return rect_box(group_box_[node - segment_nodes_]);
     return segment_box(node);
   }
   /// The error box of segment node `node`: a slot that starts a segment, not a level's last slot
