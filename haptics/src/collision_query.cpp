@@ -1131,7 +1131,7 @@ void BoundarySection::split_hit_boxes(Query& q) {
 
 // Phase 5: siblings whose parent is clear of the sweep by the margin merge into it (merge_children: in place, no
 // entry left to drop). Merging only shrinks the section, so it can be lazy: a full query owes one check per 8 idle
-// entries (merge_debt_), which the ticks the free-space ball answers pay, one each (merge_on_ball_tick); past
+// entries (merge_debt_), which the ticks the free-space ball or its walls answer pay, one or two each (merge_on_ball_tick); past
 // kMaxMergeDebt owed (a walk through walls, few ball ticks) the full query pays the excess itself, parents taken
 // round robin.
 void BoundarySection::merge_idle_siblings(Query& q) {
@@ -1181,11 +1181,19 @@ void BoundarySection::merge_idle_siblings(Query& q) {
   }
 }
 
-// One merge check of the round robin on a tick the free-space ball answered (a → b the sweep), while full queries
-// have left some owed (merge_debt_): the parent of the next entry, when all its children are in the section (none was
-// hit: a ball tick hits nothing) and its box is clear of the sweep by the margin, takes their place. One optional
-// box test, charged to `budget` and counted in st (box_tests; merges when it merged).
+// The merge checks full queries left owed (merge_debt_, at least one), paid on a ball tick: one the free-space ball or
+// its walls answered (a → b the sweep). One check, two while more than half of kMaxMergeDebt is owed (so that runs of
+// full queries seldom leave any past the cap for a full query to pay: PERFORMANCE.md, round two). Each is
+// merge_check_on_ball_tick's: at most one optional box test, charged to `budget` and counted in st.
 [[gnu::noinline]] void BoundarySection::merge_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept {
+  const int checks = merge_debt_ > kMaxMergeDebt / 2 ? 2 : 1;
+  for (int i = 0; i < checks; ++i) merge_check_on_ball_tick(a, b, budget, st);
+}
+
+// One merge check of the round robin on a ball tick: the parent of the next entry, when all its children are in the
+// section and its box is clear of the sweep by the margin (so none of them meets the sweep either), takes their place.
+// One optional box test, charged to `budget` and counted in st (box_tests; merges when it merged).
+void BoundarySection::merge_check_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept {
   --merge_debt_;
   const std::size_t n = section_.size();
   if (n == 0) return;
@@ -1462,7 +1470,18 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
 [[gnu::noinline]] SweepHit BoundarySection::first_hit_near_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded,
                                                                  int excluded_count, QueryBudget& budget, QueryStats* stats_out) {
   SweepHit near;
-  if (answer_from_ball_walls(a, b, level, excluded, excluded_count, &near, stats_out)) return near;
+  if (answer_from_ball_walls(a, b, level, excluded, excluded_count, &near, stats_out)) {
+    if (merge_debt_ > 0) {  // a ball tick too: it pays merge checks owed
+      QueryStats st;
+      merge_on_ball_tick(a, b, budget, st);
+      if (stats_out) {
+        stats_out->box_tests += st.box_tests;
+        stats_out->merges += st.merges;
+        stats_out->section_size = static_cast<std::int32_t>(section_.size());
+      }
+    }
+    return near;
+  }
   Query q(a, b, level, excluded, excluded_count, budget);
   next_tick();
   clip_section(q);

@@ -816,6 +816,7 @@ TEST(CollisionQuery, AFullSectionRefusesSplitsAndStillAnswersAsBruteForce) {
 // without a full query, and the answers of the ball's walls.
 struct SlideCounts {
   int hits = 0, near_walls = 0, near_walls_answered = 0, walls_answers = 0;
+  int walls_merges = 0;  // merges made by the merge checks the walls' answers paid
 };
 
 // The ball's walls: a hand that meets walls and slides along them, the wall it rests on excluded (as the
@@ -835,7 +836,7 @@ void slide_along_walls(Vec2 offset, SlideCounts* out) {
   const int ids[3] = {0, 2, kToleranceLevelBase + 3};
   std::uniform_real_distribution<double> jitter(-0.0001, 0.0001), drift(-0.0004, 0.0004);
   std::uniform_int_distribution<int> slide(5, 60);
-  int id = 0, hits = 0, near_walls = 0, near_walls_answered = 0, walls_answers = 0;
+  int id = 0, hits = 0, near_walls = 0, near_walls_answered = 0, walls_answers = 0, walls_merges = 0;
   Vec2 p = offset, heading{0.0003, 0.0001};
   SegmentRef resting{};  // the wall slid along (excluded), while `sliding` ticks are left
   int sliding = 0;
@@ -863,7 +864,9 @@ void slide_along_walls(Vec2 offset, SlideCounts* out) {
     }
     if (st.ball_walls) {
       ++walls_answers;
-      ASSERT_EQ(st.box_tests, 0) << "tick " << i << ": the walls answer without a box test";
+      ASSERT_EQ(st.section_box_tests, 0) << "tick " << i << ": the walls answer without a section scan";
+      ASSERT_LE(st.box_tests, 2) << "tick " << i << ": the walls answer without a box test but the merge checks it pays";
+      walls_merges += st.merges;
     }
     if (test::brute_closest_distance(sc, q, id) < 0.001) {
       ++near_walls;
@@ -881,8 +884,9 @@ void slide_along_walls(Vec2 offset, SlideCounts* out) {
     }
   }
   std::printf("[ info ] sliding hand: %d hits, %d ticks within 1 mm of a wall, %.0f %% of them answered without a full query; "
-              "%d answers by the ball's walls\n", hits, near_walls, 100.0 * near_walls_answered / std::max(near_walls, 1), walls_answers);
-  *out = SlideCounts{hits, near_walls, near_walls_answered, walls_answers};
+              "%d answers by the ball's walls, which made %d merges\n", hits, near_walls, 100.0 * near_walls_answered / std::max(near_walls, 1),
+              walls_answers, walls_merges);
+  *out = SlideCounts{hits, near_walls, near_walls_answered, walls_answers, walls_merges};
 }
 
 // Near the origin, as the kiosk's scenes are: every answer as brute force, and most ticks near a wall answered by
@@ -894,6 +898,7 @@ TEST(CollisionQuery, BallWallsAnswerASlidingHandAsBruteForce) {
   EXPECT_GT(n.near_walls, 20000);
   EXPECT_GT(n.near_walls_answered, n.near_walls / 2);
   EXPECT_GT(n.walls_answers, n.near_walls / 4);
+  EXPECT_GT(n.walls_merges, 0) << "the walls' answers pay the merge checks full queries left owed";
 }
 
 // Kilometres from the origin, where a float's step (0.5 mm at 4 km) is as large as the hand's step: the section's

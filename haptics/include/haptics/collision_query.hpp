@@ -148,8 +148,8 @@ class BoundarySection {
   /// boundary section, which serves this id and the previous query's (splits stop at the coarser of the
   /// two; a new id coarsens the entries below its walls, O(section entries), O(levels) each at a cut step).
   /// Of walls hit at the same t, the answer is the smallest (curve, level, segment). A sweep inside the free-space
-  /// ball, or inside the ball of its walls (at most 16 segment tests), is answered without a box test of its own; a
-  /// sweep inside the free-space ball pays one merge check a full query left owed (one optional box test).
+  /// ball, or inside the ball of its walls (at most 16 segment tests), is answered without a box test of its own, and
+  /// pays one merge check full queries left owed, two while more than 8 are (one optional box test each).
   /// Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                      QueryBudget& budget, QueryStats* stats = nullptr);
@@ -323,7 +323,8 @@ class BoundarySection {
   void split_hit_boxes(Query& q);
   void merge_idle_siblings(Query& q);
   void merge_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
-  static constexpr int kMaxMergeDebt = 16;  // merge checks full queries leave to the ball ticks, at most
+  void merge_check_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
+  static constexpr int kMaxMergeDebt = 16;  // merge checks full queries leave to the ball ticks (ball or walls answers), at most
   int merge_debt_ = 0;                      // merge checks owed (merge_idle_siblings)
   std::size_t merge_cursor_ = 0;            // the ball ticks' round robin over the entries
   void gather_ball_walls(const Query& q) noexcept;
