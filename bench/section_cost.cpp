@@ -12,8 +12,8 @@
 // (checked: the box tests per query agree), and the first replay's answers equal the R-tree's (else it stops with
 // the query). Each query is timed on its own with steady_clock, so every figure
 // includes one clock pair (the `clock` line: an empty region timed the same way). Kinds:
-//   ball         answered by the free-space ball (no box test but, while full queries owe merge checks, one)
-//   walls        answered by the ball's walls (no box test; a few segment tests)
+//   ball         answered by the free-space ball (no box test but, while full queries owe merge checks, one or two)
+//   walls        answered by the ball's walls (a few segment tests; no box test but the merge checks, as a ball tick)
 //   full         every other query; of those:
 //     quiet        no split and no merge
 //     split        at least one split (the section refined toward the sweep; the p99 lives here)

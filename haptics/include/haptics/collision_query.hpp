@@ -114,8 +114,9 @@ struct QueryStats {
   std::int32_t coarsest_answer_level = 0;  ///< coarsest level reached by an answer (> target when the budget ran out)
   bool budget_exhausted = false;       ///< the budget was spent when (or before) this query ended, or optional work of
                                        ///< this query was refused for want of it (a wide node needs four tests at once)
-  bool ball_walls = false;             ///< answered by the free-space ball's walls (first_hit: no box test, its
-                                       ///< segment tests those walls'; false for the plain ball and a full query)
+  bool ball_walls = false;             ///< answered by the free-space ball's walls (first_hit: no box test but the merge
+                                       ///< checks it pays, its segment tests those walls'; false for the plain ball and a
+                                       ///< full query)
 };
 
 /// The boundary section of one scene plus the scratch space of the query. One per servo thread.
