@@ -138,18 +138,36 @@ inline int near_node(const WideNode& n, float px, float py, float bound_sq, floa
 }
 
 #if defined(__SSE2__)
-// Of four lanes' smallest distances (d) and their entries (entry, as floats: n for a lane that found none below
-// +inf), the nearest lane's entry, in every lane; of equals, the smallest entry: the smallest distance over the
-// lanes, then the smallest entry of the lanes at it (each a minimum of four by two shuffles). n when every distance
-// is +inf.
-inline __m128 nearest_lane(__m128 d, __m128 entry, std::size_t n) {
-  const auto min4 = [](__m128 v) {
-    v = _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2)));
-    return _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
-  };
-  const __m128 at_min = _mm_cmpeq_ps(d, min4(d));
-  return min4(_mm_or_ps(_mm_and_ps(at_min, entry), _mm_andnot_ps(at_min, _mm_set1_ps(static_cast<float>(n)))));
-}
+// The entry of the smallest of n squared distances taken four at a time (entries 0–3, then 4–7, ...), kept without a
+// branch: its place among the entries is a coin toss to the branch predictor. Each lane keeps its smallest distance
+// and that one's entry (as a float, exact below 2^24); nearest() then gives the nearest lane's entry, of equals the
+// smallest entry (the smallest distance over the lanes, then the smallest entry of the lanes at it, each a minimum
+// of four by two shuffles), or n when every distance is +inf.
+class NearestOfFours {
+ public:
+  explicit NearestOfFours(std::size_t n) : n_(n), entry_(_mm_set1_ps(static_cast<float>(n))) {}
+  void take(__m128 d) noexcept {  // the next four entries' distances
+    const __m128 nearer = _mm_cmplt_ps(d, d_);
+    d_ = _mm_min_ps(d, d_);
+    entry_ = _mm_or_ps(_mm_and_ps(nearer, i_), _mm_andnot_ps(nearer, entry_));
+    i_ = _mm_add_ps(i_, _mm_set1_ps(4.0f));
+  }
+  std::size_t nearest() const noexcept {
+    const auto min4 = [](__m128 v) {
+      v = _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2)));
+      return _mm_min_ps(v, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1)));
+    };
+    const __m128 at_min = _mm_cmpeq_ps(d_, min4(d_));
+    const __m128 none = _mm_set1_ps(static_cast<float>(n_));
+    return static_cast<std::size_t>(_mm_cvtss_f32(min4(_mm_or_ps(_mm_and_ps(at_min, entry_), _mm_andnot_ps(at_min, none)))));
+  }
+
+ private:
+  std::size_t n_;
+  __m128 d_ = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  __m128 entry_;
+  __m128 i_ = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
+};
 #endif
 
 // Reciprocal of a sweep extent for sweep_node: ±1e20 in place of 1/0 or of an overflow.
@@ -829,27 +847,20 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) {
 #if defined(__SSE2__)
   const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), zero = _mm_setzero_ps(), vslack = _mm_set1_ps(slack);
   const __m128 v_slo_x = _mm_set1_ps(s_lo_x), v_slo_y = _mm_set1_ps(s_lo_y), v_shi_x = _mm_set1_ps(s_hi_x), v_shi_y = _mm_set1_ps(s_hi_y);
-  // The nearest rectangle per lane and its entry (as a float, exact below 2^24), kept without a branch: its place
-  // in the section is a coin toss to the branch predictor.
-  static_assert(kMaxSectionEntries < (1u << 24), "entries are exact as floats");
-  __m128 v_nearest = _mm_set1_ps(std::numeric_limits<float>::infinity()), v_entry = _mm_set1_ps(static_cast<float>(n));
-  __m128 v_i = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
-  const __m128 four = _mm_set1_ps(4.0f);
+  static_assert(kMaxSectionEntries < (1u << 24), "entries are exact as floats (NearestOfFours)");
+  NearestOfFours nearest_rect(n);
   for (; i < n; i += kScanLanes) {
     const __m128 lx = _mm_loadu_ps(lo_x + i), ly = _mm_loadu_ps(lo_y + i), hx = _mm_loadu_ps(hi_x + i), hy = _mm_loadu_ps(hi_y + i);
     const __m128 dx = _mm_max_ps(_mm_sub_ps(_mm_max_ps(_mm_sub_ps(lx, vpx), _mm_sub_ps(vpx, hx)), vslack), zero);
     const __m128 dy = _mm_max_ps(_mm_sub_ps(_mm_max_ps(_mm_sub_ps(ly, vpy), _mm_sub_ps(vpy, hy)), vslack), zero);
     const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));
     _mm_storeu_ps(d_sq + i, d);
-    const __m128 nearer = _mm_cmplt_ps(d, v_nearest);
-    v_nearest = _mm_min_ps(d, v_nearest);
-    v_entry = _mm_or_ps(_mm_and_ps(nearer, v_i), _mm_andnot_ps(nearer, v_entry));
-    v_i = _mm_add_ps(v_i, four);
+    nearest_rect.take(d);
     const __m128 meets = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(lx, v_shi_x), _mm_cmple_ps(v_slo_x, hx)),
                                     _mm_and_ps(_mm_cmple_ps(ly, v_shi_y), _mm_cmple_ps(v_slo_y, hy)));
     overlap.put(i, static_cast<unsigned>(_mm_movemask_ps(meets)));
   }
-  nearest = static_cast<std::size_t>(_mm_cvtss_f32(nearest_lane(v_nearest, v_entry, n)));
+  nearest = nearest_rect.nearest();
 #else
   float nearest_sq = std::numeric_limits<float>::infinity();
   for (; i < n; i += kScanLanes) {
@@ -1073,17 +1084,9 @@ std::size_t BoundarySection::nearest_rect_left(std::size_t n) const noexcept {
   const float* d_sq = rect_d_sq_.data();
   std::size_t nearest = n;
 #if defined(__SSE2__)
-  __m128 v_nearest = _mm_set1_ps(std::numeric_limits<float>::infinity()), v_entry = _mm_set1_ps(static_cast<float>(n));
-  __m128 v_i = _mm_set_ps(3.0f, 2.0f, 1.0f, 0.0f);
-  const __m128 four = _mm_set1_ps(4.0f);
-  for (std::size_t i = 0; i < n; i += kScanLanes) {
-    const __m128 d = _mm_loadu_ps(d_sq + i);
-    const __m128 nearer = _mm_cmplt_ps(d, v_nearest);
-    v_nearest = _mm_min_ps(d, v_nearest);
-    v_entry = _mm_or_ps(_mm_and_ps(nearer, v_i), _mm_andnot_ps(nearer, v_entry));
-    v_i = _mm_add_ps(v_i, four);
-  }
-  nearest = static_cast<std::size_t>(_mm_cvtss_f32(nearest_lane(v_nearest, v_entry, n)));
+  NearestOfFours nearest_rect(n);
+  for (std::size_t i = 0; i < n; i += kScanLanes) nearest_rect.take(_mm_loadu_ps(d_sq + i));
+  nearest = nearest_rect.nearest();
 #else
   float best = std::numeric_limits<float>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
@@ -1174,11 +1177,18 @@ void BoundarySection::merge_idle_siblings(Query& q) {
     bool all_idle = true;
     for (std::uint32_t i = 0; i < count; ++i) all_idle &= (node_state_[child[i]] & kHitMark) == 0;
     if (!all_idle) continue;
-    double te = 0.0, tx = 0.0;
     if (!q.spend_box()) break;  // merging can wait for a tick with budget left
-    if (clip_segment_box(entry_box(parent), q.a, q.b, merge_margin_m_, &te, &tx)) continue;
-    if (merge_children(e, parent, child, count)) ++q.st.merges;
+    q.st.merges += merge_if_clear(e, parent, child, count, q.a, q.b);
   }
+}
+
+// The merge of a check that found all `count` children of `parent` in the section (`child`, one at entry e): when the
+// parent's box is clear of the sweep a → b by the merge margin (so none of them meets it either), it takes their place
+// (merge_children). One box test, which the caller charges. True when it merged.
+bool BoundarySection::merge_if_clear(std::size_t e, std::uint32_t parent, const std::uint32_t* child, std::uint32_t count, Vec2 a, Vec2 b) {
+  double te = 0.0, tx = 0.0;
+  if (clip_segment_box(entry_box(parent), a, b, merge_margin_m_, &te, &tx)) return false;
+  return merge_children(e, parent, child, count);
 }
 
 // The merge checks full queries left owed (merge_debt_, at least one), paid on a ball tick: one the free-space ball or
@@ -1201,11 +1211,9 @@ void BoundarySection::merge_check_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budg
   const std::uint32_t parent = section_parent_[e];
   if (parent == kNoParent || children_in(parent) != child_count(parent) || !budget.spend()) return;
   ++st.box_tests;
-  double te = 0.0, tx = 0.0;
-  if (clip_segment_box(entry_box(parent), a, b, merge_margin_m_, &te, &tx)) return;
   std::uint32_t child[kMaxEntryChildren];
   const std::uint32_t count = entry_children(parent, child);
-  if (merge_children(e, parent, child, count)) ++st.merges;
+  st.merges += merge_if_clear(e, parent, child, count, a, b);
 }
 
 // Phase 6: the next free-space ball: the distance from the end of the sweep to the nearest box phase 1
@@ -1447,17 +1455,22 @@ SweepHit BoundarySection::first_hit_tree(Vec2 a, Vec2 b, int level, const Segmen
   return answer;
 }
 
+// What a ball tick (a → b answered by the free-space ball or its walls) does to the section: the merge checks full
+// queries left owed, while some are (merge_on_ball_tick), counted in *stats (box_tests, merges) with the section's
+// size after them.
+inline void BoundarySection::pay_merge_debt(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats* stats) noexcept {
+  QueryStats unused;
+  if (merge_debt_ > 0) merge_on_ball_tick(a, b, budget, stats ? *stats : unused);
+  if (stats) stats->section_size = static_cast<std::int32_t>(section_.size());
+}
+
 SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                                     QueryBudget& budget, QueryStats* stats_out) {
   level = walls_of(level);
   if (level != last_level_ || level != other_level_) follow_level(level);  // else it serves this id alone, as before
   if (inside_free_ball(a, b)) {
-    QueryStats st;
-    if (merge_debt_ > 0) merge_on_ball_tick(a, b, budget, st);
-    if (stats_out) {
-      *stats_out = st;
-      stats_out->section_size = static_cast<std::int32_t>(section_.size());
-    }
+    if (stats_out) *stats_out = QueryStats{};
+    pay_merge_debt(a, b, budget, stats_out);
     SweepHit clear;
     clear.point_m = b;
     return clear;
@@ -1471,15 +1484,7 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
                                                                  int excluded_count, QueryBudget& budget, QueryStats* stats_out) {
   SweepHit near;
   if (answer_from_ball_walls(a, b, level, excluded, excluded_count, &near, stats_out)) {
-    if (merge_debt_ > 0) {  // a ball tick too: it pays merge checks owed
-      QueryStats st;
-      merge_on_ball_tick(a, b, budget, st);
-      if (stats_out) {
-        stats_out->box_tests += st.box_tests;
-        stats_out->merges += st.merges;
-        stats_out->section_size = static_cast<std::int32_t>(section_.size());
-      }
-    }
+    pay_merge_debt(a, b, budget, stats_out);  // a ball tick too
     return near;
   }
   Query q(a, b, level, excluded, excluded_count, budget);

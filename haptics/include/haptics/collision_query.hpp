@@ -325,6 +325,8 @@ class BoundarySection {
   void merge_idle_siblings(Query& q);
   void merge_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
   void merge_check_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
+  void pay_merge_debt(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats* stats) noexcept;
+  bool merge_if_clear(std::size_t e, std::uint32_t parent, const std::uint32_t* child, std::uint32_t count, Vec2 a, Vec2 b);
   static constexpr int kMaxMergeDebt = 16;  // merge checks full queries leave to the ball ticks (ball or walls answers), at most
   int merge_debt_ = 0;                      // merge checks owed (merge_idle_siblings)
   std::size_t merge_cursor_ = 0;            // the ball ticks' round robin over the entries
