@@ -28,13 +28,20 @@ int glfw_key(const std::string& name) {
   return it == named.end() ? GLFW_KEY_UNKNOWN : it->second;
 }
 
+std::string key_name_of(int key) {
+  if (key == GLFW_KEY_UNKNOWN) return {};
+  for (const std::string_view name : config::visitor_key_names())
+    if (glfw_key(std::string(name)) == key) return std::string(name);
+  for (const char* name : {"O", "C", "ESCAPE"})
+    if (glfw_key(name) == key) return name;
+  return {};
+}
+
 std::map<int, KioskKey> visitor_key_map(const config::KeysSettings& k) {
-  return {{glfw_key(k.help), KioskKey::Help},         {glfw_key(k.next), KioskKey::Next},
-          {glfw_key(k.previous), KioskKey::Previous}, {glfw_key(k.describe), KioskKey::Describe},
-          {glfw_key(k.finer), KioskKey::Finer},       {glfw_key(k.coarser), KioskKey::Coarser},
-          {glfw_key(k.volume_up), KioskKey::VolumeUp}, {glfw_key(k.volume_down), KioskKey::VolumeDown},
-          {glfw_key(k.tutorial), KioskKey::Tutorial}, {glfw_key(k.guide), KioskKey::Guide},
-          {glfw_key(k.capture), KioskKey::Capture}};
+  std::map<int, KioskKey> map;
+  const auto actions = config::key_actions(k);
+  for (std::size_t i = 0; i < actions.size(); ++i) map[glfw_key(std::string(actions[i].second))] = static_cast<KioskKey>(i);
+  return map;
 }
 
 int glfw_mods(const config::KeyChord& c) {

@@ -16,7 +16,11 @@ namespace hk::app {
 /// GLFW_KEY_UNKNOWN (−1) for a name the settings do not allow.
 int glfw_key(const std::string& name);
 
-/// The visitor's actions by GLFW key code, from [keys].
+/// The settings' name of GLFW key code `key` ("Q", "F5", "O"; config::visitor_key_names() and O, C,
+/// ESCAPE), or "" for a key the settings do not name. For speaking the name of a key that does nothing.
+std::string key_name_of(int key);
+
+/// The visitor's actions by GLFW key code, from [keys] (config::key_actions: Help .. Finish).
 std::map<int, KioskKey> visitor_key_map(const config::KeysSettings& keys);
 
 /// GLFW modifier bits (GLFW_MOD_CONTROL, GLFW_MOD_ALT, GLFW_MOD_SHIFT, GLFW_MOD_SUPER) of a chord.

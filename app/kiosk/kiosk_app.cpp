@@ -99,7 +99,10 @@ class Kiosk final : public ScriptTarget {
       window_.to_imgui(e);  // the panel's: typed into its boxes, never a visitor's action
       return;
     }
+    const auto it = e.kind == InputEvent::Kind::key ? keys_.find(e.key) : keys_.end();
+    const bool help = it != keys_.end() && it->second == KioskKey::Help;
     if (e.kind == InputEvent::Kind::mouse_button || (e.kind == InputEvent::Kind::key && e.action == GLFW_RELEASE)) {
+      if (help && e.action == GLFW_RELEASE) flow_.help_held(false);  // learning mode ends
       window_.to_imgui(e);  // buttons and releases always (ImGui must not see a key held for ever)
       return;
     }
@@ -109,20 +112,13 @@ class Kiosk final : public ScriptTarget {
       return;
     }
     if (e.mods & (GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SUPER)) return;  // no visitor key has modifiers
-    if (e.key == GLFW_KEY_O) {
-      rt_.overlay() = !rt_.overlay();
-      return;
-    }
-    if (e.key == GLFW_KEY_C) {
-      rt_.high_contrast() = !rt_.high_contrast();
-      return;
-    }
     if (e.key == GLFW_KEY_ESCAPE && o_.windowed) {
       window_.request_close();
       return;
     }
-    const auto it = keys_.find(e.key);
-    flow_.key(it == keys_.end() ? KioskKey::Other : it->second, now_s_);
+    // High contrast and the overlay are the operator's (the panel): O and C are keys like any other here.
+    flow_.key(it == keys_.end() ? KioskKey::Other : it->second, now_s_, key_name_of(e.key));
+    if (help) flow_.help_held(true);  // held: the next keys are named, not done (learning mode)
   }
 
   // ---- ScriptTarget ----
@@ -150,9 +146,10 @@ class Kiosk final : public ScriptTarget {
     rt_.set_cursor({std::clamp(m.x, -rt_.half().x, rt_.half().x), std::clamp(m.y, -rt_.half().y, rt_.half().y)});
   }
 
-  /// The handle moved noticeably (5 mm) since the last report: the visitor is there.
+  /// The handle moved noticeably (5 mm) since the last report, or rests against a shape: the visitor is there.
   void watch_handle() {
     const ServoDisplayState& d = rt_.core().display();
+    if (d.state != ContactState::Free) flow_.touching(now_s_);
     if (!have_baseline_ && d.tick > 0) {  // the first sample from the servo thread: where the handle rests
       have_baseline_ = true;
       last_moved_at_ = d.handle_m;
@@ -224,6 +221,7 @@ int run_kiosk(const KioskOptions& o) {
   KioskFlowParams fp;
   fp.timeout_s = start.settings.kiosk.timeout_s;
   fp.warning_s = start.settings.kiosk.warning_s;
+  fp.attract_every_s = start.settings.kiosk.attract_every_s;
   fp.keys = start.settings.keys;
   fp.camera = rt.has_camera();
   KioskFlow flow(rt, rt.audio().messages(), fp);
@@ -261,6 +259,7 @@ int run_kiosk(const KioskOptions& o) {
     if (!scripted) kiosk.follow_mouse();
     kiosk.watch_handle();
     rt.poll_tour();
+    rt.poll_display_modes();
     flow.tick(kiosk.now_s_);
     session.tick(kiosk.now_s_, unix_now_s());
     rt.collect();

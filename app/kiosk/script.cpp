@@ -20,7 +20,9 @@ const std::map<std::string, KioskKey>& action_names() {
                                                  {"finer", KioskKey::Finer},       {"coarser", KioskKey::Coarser},
                                                  {"volume_up", KioskKey::VolumeUp}, {"volume_down", KioskKey::VolumeDown},
                                                  {"tutorial", KioskKey::Tutorial}, {"guide", KioskKey::Guide},
-                                                 {"capture", KioskKey::Capture}, {"other", KioskKey::Other}};
+                                                 {"capture", KioskKey::Capture}, {"repeat", KioskKey::Repeat},
+                                                 {"pause", KioskKey::Pause},       {"where", KioskKey::Where},
+                                                 {"finish", KioskKey::Finish},     {"other", KioskKey::Other}};
   return m;
 }
 

@@ -1,8 +1,12 @@
 #include "kiosk_flow.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
+#include <exception>
 
 namespace hk::app {
 
@@ -15,23 +19,31 @@ const char* state_name(KioskState s) {
   return "?";
 }
 
-
 using audio::MessageId;
+
+namespace {
+
+/// The message naming what key `k` does (learning mode), in KioskKey order.
+constexpr std::array<MessageId, static_cast<std::size_t>(KioskKey::Other)> kKeyDoes{
+    MessageId::key_help,     MessageId::key_next,        MessageId::key_previous,      MessageId::key_describe,
+    MessageId::key_finer,    MessageId::key_coarser,     MessageId::key_volume_up,     MessageId::key_volume_down,
+    MessageId::key_tutorial, MessageId::key_guide,       MessageId::key_capture,       MessageId::key_repeat,
+    MessageId::key_pause,    MessageId::key_where,       MessageId::key_finish};
+
+}  // namespace
 
 KioskFlow::KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params)
     : fx_(effects), msg_(messages), p_(params) {
   p_.warning_s = std::min(p_.warning_s, 0.5 * p_.timeout_s);  // a warning must leave time to answer it
+  v_.next_invitation_s = p_.attract_every_s;
 }
 
 std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings& k) {
-  // In the order of kKeyPlaceholders: help, next, previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide,
-  // capture.
-  return {{{audio::kKeyPlaceholders[0], k.help},      {audio::kKeyPlaceholders[1], k.next},
-           {audio::kKeyPlaceholders[2], k.previous},  {audio::kKeyPlaceholders[3], k.describe},
-           {audio::kKeyPlaceholders[4], k.finer},     {audio::kKeyPlaceholders[5], k.coarser},
-           {audio::kKeyPlaceholders[6], k.volume_up}, {audio::kKeyPlaceholders[7], k.volume_down},
-           {audio::kKeyPlaceholders[8], k.tutorial},  {audio::kKeyPlaceholders[9], k.guide},
-           {audio::kKeyPlaceholders[10], k.capture}}};
+  static_assert(audio::kKeyPlaceholders.size() == config::kKeyActionCount, "one placeholder per [keys] action");
+  const auto actions = config::key_actions(k);
+  std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> args;
+  for (std::size_t i = 0; i < args.size(); ++i) args[i] = {audio::kKeyPlaceholders[i], actions[i].second};
+  return args;
 }
 
 std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageArg> args) const {
@@ -40,18 +52,248 @@ std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageAr
 
 void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say(text(id, args)); }
 
+void KioskFlow::say_brief(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say_brief(text(id, args)); }
+
+void KioskFlow::set_timing(double timeout_s, double warning_s, double attract_every_s) {
+  p_.timeout_s = timeout_s;
+  p_.warning_s = std::min(warning_s, 0.5 * timeout_s);
+  p_.attract_every_s = attract_every_s;
+}
+
+// ---- the guard ---------------------------------------------------------------------------------------
+
+template <class Action>
+void KioskFlow::guarded(const char* what, Action&& action) {
+  const Visit before = v_;
+  try {
+    action();
+  } catch (const std::exception& e) {
+    // The visit as it was; what failed goes to the log, the visitor hears one short line.
+    v_ = before;
+    ++failures_;
+    spdlog::error("kiosk: {} failed: {}", what, e.what());
+    try {
+      say_brief(MessageId::sorry);
+    } catch (const std::exception& again) {
+      spdlog::error("kiosk: the sorry line failed too: {}", again.what());
+    }
+  }
+}
+
+// ---- keys --------------------------------------------------------------------------------------------
+
+void KioskFlow::key(KioskKey k, double now_s, std::string_view key_name) {
+  guarded("a key press", [&] { act_on_key(k, now_s, key_name); });
+}
+
+void KioskFlow::act_on_key(KioskKey k, double now_s, std::string_view key_name) {
+  if (v_.state == KioskState::Attract) {
+    wake(now_s);
+    return;
+  }
+  activity(now_s);
+  if (learning_ && k != KioskKey::Help) {
+    learn_key(k, key_name);
+    return;
+  }
+  if (k == KioskKey::VolumeUp || k == KioskKey::VolumeDown) {
+    volume_key(k == KioskKey::VolumeUp ? +1 : -1);
+    return;
+  }
+  fx_.key_pressed();
+  if (v_.capturing) {  // any key stops a capture, and does nothing else
+    v_.capturing = false;
+    fx_.cancel_capture();
+    say(MessageId::capture_cancelled);
+    return;
+  }
+  const int help_layer = v_.help_layer;
+  v_.help_layer = 0;
+  if (k == KioskKey::Help) {
+    v_.help_layer = help_layer;
+    help_key();
+    return;
+  }
+  if (session_key(k, now_s)) return;
+  if (v_.source == KioskSource::Stick && (k == KioskKey::Next || k == KioskKey::Previous)) {
+    step_document(k == KioskKey::Next ? +1 : -1, now_s);
+    return;
+  }
+  if (k == KioskKey::Other) {
+    stray_key(key_name);
+    return;
+  }
+  if (v_.state == KioskState::Tutorial) {
+    tutorial_key(k);
+  } else {
+    picture_key(k);
+  }
+}
+
+bool KioskFlow::session_key(KioskKey k, double now_s) {
+  switch (k) {
+    case KioskKey::Capture:
+      if (fx_.start_capture()) {
+        v_.capturing = true;
+        say(MessageId::capture_start);
+      } else {
+        say(MessageId::capture_no_camera);
+      }
+      return true;
+    case KioskKey::Guide:
+      fx_.guide();
+      return true;
+    case KioskKey::Tutorial:
+      start_tutorial();
+      say(MessageId::tutorial_start);
+      return true;
+    case KioskKey::Repeat:
+      if (!fx_.repeat()) say_brief(MessageId::nothing_to_repeat);
+      return true;
+    case KioskKey::Pause:
+      pause_key();
+      return true;
+    case KioskKey::Where: {
+      const std::string here = fx_.where();
+      if (!here.empty()) fx_.say(here);
+      else fx_.say(place());
+      return true;
+    }
+    case KioskKey::Finish:
+      end_session(now_s);
+      return true;
+    default:
+      return false;
+  }
+}
+
+void KioskFlow::volume_key(int delta) {
+  // Never cuts speech: while something is being said, it getting louder or quieter is the answer.
+  const bool changed = fx_.change_volume(delta);
+  if (fx_.speaking()) return;
+  say_brief(!changed ? MessageId::volume_limit : delta > 0 ? MessageId::volume_up : MessageId::volume_down);
+}
+
+void KioskFlow::pause_key() {
+  if (fx_.resume_speech()) return;  // pressed again: goes on from where it stopped
+  if (fx_.pause_speech()) return;   // silence is the answer
+  say_brief(MessageId::nothing_to_pause);
+}
+
+void KioskFlow::help_key() {
+  // One sentence for where the visitor is and the two most useful keys; the same key again for every key.
+  if (v_.help_layer == 1) {
+    v_.help_layer = 0;
+    say_help();
+    return;
+  }
+  v_.help_layer = 1;
+  say(MessageId::help_brief, {{"place", place()}});
+}
+
+void KioskFlow::learn_key(KioskKey k, std::string_view key_name) {
+  if (k == KioskKey::Other) {
+    stray_key(key_name);
+    return;
+  }
+  say_brief(kKeyDoes[static_cast<std::size_t>(k)]);
+}
+
+void KioskFlow::stray_key(std::string_view key_name) { say_brief(MessageId::key_other, {{"key", spoken_key(key_name)}}); }
+
+std::string KioskFlow::spoken_key(std::string_view key_name) const {
+  if (key_name.empty() || !msg_.key_names().contains(key_name)) return text(MessageId::this_key);
+  std::string name = msg_.key_name(key_name);
+  if (!name.empty()) name[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(name[0])));
+  return name;
+}
+
+void KioskFlow::tutorial_key(KioskKey k) {
+  switch (k) {
+    case KioskKey::Next:
+      if (v_.shape == TutorialShape::Square) {
+        v_.shape = TutorialShape::Circle;
+        fx_.show_tutorial(v_.shape);
+        say(MessageId::tutorial_circle);
+      } else if (v_.shape == TutorialShape::Circle) {
+        v_.shape = TutorialShape::Triangle;
+        fx_.show_tutorial(v_.shape);
+        say(MessageId::tutorial_triangle);
+      } else {
+        show(0, text(MessageId::tutorial_done));
+      }
+      return;
+    case KioskKey::Previous:
+      if (v_.shape != TutorialShape::Square) v_.shape = static_cast<TutorialShape>(static_cast<int>(v_.shape) - 1);
+      fx_.show_tutorial(v_.shape);
+      say(v_.shape == TutorialShape::Square ? MessageId::tutorial_start : MessageId::tutorial_circle);
+      return;
+    case KioskKey::Describe:
+      fx_.say(fx_.describe());
+      return;
+    default:  // Finer and Coarser have no levels to change on a practice shape
+      say_brief(kKeyDoes[static_cast<std::size_t>(k)]);
+      return;
+  }
+}
+
+void KioskFlow::picture_key(KioskKey k) {
+  switch (k) {
+    case KioskKey::Next:
+      show(v_.picture + 1);
+      return;
+    case KioskKey::Previous:
+      show(v_.picture - 1);
+      return;
+    case KioskKey::Describe:
+      fx_.say(text(MessageId::describe, {{"description", fx_.describe()}}));
+      return;
+    case KioskKey::Finer:
+      say_brief(fx_.change_level(-1) ? MessageId::level_finer : MessageId::level_finest);
+      return;
+    case KioskKey::Coarser:
+      say_brief(fx_.change_level(+1) ? MessageId::level_coarser : MessageId::level_coarsest);
+      return;
+    default:
+      return;
+  }
+}
+
+void KioskFlow::say_help() {
+  fx_.say(p_.camera ? text(MessageId::help) + " " + text(MessageId::help_camera) : text(MessageId::help));
+}
+
+std::string KioskFlow::place() const {
+  if (v_.state == KioskState::Tutorial) return text(MessageId::place_tutorial);
+  if (v_.source == KioskSource::Stick && v_.doc >= 0) {
+    return text(MessageId::place_document, {{"page", std::to_string(v_.page)},
+                                             {"pages", std::to_string(v_.stick[static_cast<std::size_t>(v_.doc)].pages)}});
+  }
+  if (v_.captured) return text(MessageId::place_capture);
+  return text(MessageId::place_picture, {{"picture", std::to_string(v_.picture + 1)}, {"pictures", std::to_string(fx_.picture_count())}});
+}
+
+// ---- the session -------------------------------------------------------------------------------------
+
+void KioskFlow::activity(double now_s) {
+  v_.last_activity_s = now_s;
+  v_.warned = false;
+}
+
 void KioskFlow::start_tutorial() {
-  state_ = KioskState::Tutorial;
-  shape_ = TutorialShape::Square;
-  fx_.show_tutorial(shape_);
+  v_.state = KioskState::Tutorial;
+  v_.shape = TutorialShape::Square;
+  v_.captured = false;
+  fx_.show_tutorial(v_.shape);
 }
 
 void KioskFlow::show(int index, const std::string& before) {
   const int n = fx_.picture_count();
-  picture_ = ((index % n) + n) % n;  // wraps round both ways
-  state_ = KioskState::Picture;
-  const int shapes = fx_.show_picture(picture_);
-  const std::string num = std::to_string(picture_ + 1), total = std::to_string(n);
+  v_.picture = ((index % n) + n) % n;  // wraps round both ways
+  v_.state = KioskState::Picture;
+  v_.captured = false;
+  const int shapes = fx_.show_picture(v_.picture);
+  const std::string num = std::to_string(v_.picture + 1), total = std::to_string(n);
   const std::string title = fx_.shown_notes().title;
   std::string line;
   if (!title.empty()) {
@@ -69,142 +311,77 @@ void KioskFlow::show(int index, const std::string& before) {
 }
 
 void KioskFlow::wake(double now_s) {
-  last_activity_s_ = now_s;
-  warned_ = false;
+  activity(now_s);
+  v_.help_layer = 0;
   start_tutorial();
-  fx_.say(text(MessageId::welcome) + " " + text(MessageId::tutorial_start));
+  say(MessageId::welcome);
+}
+
+void KioskFlow::end_session(double now_s) {
+  if (v_.capturing) fx_.cancel_capture();
+  fx_.new_session();  // first: it stops speech, and the goodbye must be heard
+  if (v_.source == KioskSource::Stick || !v_.stick.empty()) fx_.forget_stick();
+  v_ = Visit{};
+  v_.next_invitation_s = now_s + p_.attract_every_s;
+  say_brief(MessageId::goodbye);
 }
 
 void KioskFlow::handle_moved(double now_s) {
-  if (state_ == KioskState::Attract) {
-    wake(now_s);
-    return;
-  }
-  last_activity_s_ = now_s;
-  warned_ = false;
+  guarded("handle motion", [&] {
+    if (v_.state == KioskState::Attract) {
+      wake(now_s);
+      return;
+    }
+    activity(now_s);
+  });
 }
 
-void KioskFlow::key(KioskKey k, double now_s) {
-  if (state_ == KioskState::Attract) {
-    wake(now_s);
-    return;
-  }
-  last_activity_s_ = now_s;
-  warned_ = false;
-  fx_.key_pressed();
-  if (capturing_) {  // any key stops a capture, and does nothing else
-    capturing_ = false;
-    fx_.cancel_capture();
-    say(MessageId::capture_cancelled);
-    return;
-  }
-  switch (k) {
-    case KioskKey::Capture:
-      if (fx_.start_capture()) {
-        capturing_ = true;
-        say(MessageId::capture_start);
-      } else {
-        say(MessageId::capture_no_camera);
+void KioskFlow::touching(double now_s) {
+  if (v_.state != KioskState::Attract) activity(now_s);
+}
+
+void KioskFlow::tick(double now_s) {
+  guarded("the session's clock", [&] {
+    if (v_.state == KioskState::Attract) {
+      if (p_.attract_every_s > 0 && now_s >= v_.next_invitation_s) {
+        v_.next_invitation_s = now_s + p_.attract_every_s;
+        if (!fx_.quiet_hours()) say_brief(MessageId::attract);
       }
       return;
-    case KioskKey::Guide:
-      fx_.guide();
-      return;
-    case KioskKey::Help:
-      say_help();
-      return;
-    case KioskKey::Tutorial:
-      start_tutorial();
-      say(MessageId::tutorial_start);
-      return;
-    case KioskKey::VolumeUp:
-      say(fx_.change_volume(+1) ? MessageId::volume_up : MessageId::volume_limit);
-      return;
-    case KioskKey::VolumeDown:
-      say(fx_.change_volume(-1) ? MessageId::volume_down : MessageId::volume_limit);
-      return;
-    default:
-      break;
-  }
-  if (source_ == KioskSource::Stick) {
-    switch (k) {
-      case KioskKey::Next:
-        step_document(+1, now_s);
-        return;
-      case KioskKey::Previous:
-        step_document(-1, now_s);
-        return;
-      default:
-        break;
     }
-  }
-  if (state_ == KioskState::Tutorial) {
-    switch (k) {
-      case KioskKey::Next:
-        if (shape_ == TutorialShape::Square) {
-          shape_ = TutorialShape::Circle;
-          fx_.show_tutorial(shape_);
-          say(MessageId::tutorial_circle);
-        } else if (shape_ == TutorialShape::Circle) {
-          shape_ = TutorialShape::Triangle;
-          fx_.show_tutorial(shape_);
-          say(MessageId::tutorial_triangle);
-        } else {
-          show(0, text(MessageId::tutorial_done));
-        }
-        return;
-      case KioskKey::Previous:
-        if (shape_ != TutorialShape::Square) shape_ = static_cast<TutorialShape>(static_cast<int>(shape_) - 1);
-        fx_.show_tutorial(shape_);
-        say(shape_ == TutorialShape::Square ? MessageId::tutorial_start : MessageId::tutorial_circle);
-        return;
-      case KioskKey::Describe:
-        fx_.say(fx_.describe());
-        return;
-      default:
-        say_help();  // any other key still gets an answer
-        return;
+    // Speech being heard is the visitor listening (a long text being read is never cut by the time-out);
+    // the warning's own speech is not.
+    if (!v_.warned && fx_.speaking()) activity(now_s);
+    if (v_.pending_doc >= 0 && !v_.loading_said && now_s - v_.pending_since_s > p_.loading_cue_s) {
+      v_.loading_said = true;
+      say_brief(MessageId::loading);
     }
-  }
-  switch (k) {  // Picture
-    case KioskKey::Next:
-      show(picture_ + 1);
+    const double idle = now_s - v_.last_activity_s;
+    if (idle >= p_.timeout_s) {
+      end_session(now_s);
       return;
-    case KioskKey::Previous:
-      show(picture_ - 1);
-      return;
-    case KioskKey::Describe:
-      fx_.say(text(MessageId::describe, {{"description", fx_.describe()}}));
-      return;
-    case KioskKey::Finer:
-      say(fx_.change_level(-1) ? MessageId::level_finer : MessageId::level_finest);
-      return;
-    case KioskKey::Coarser:
-      say(fx_.change_level(+1) ? MessageId::level_coarser : MessageId::level_coarsest);
-      return;
-    default:
-      say_help();
-      return;
-  }
+    }
+    if (!v_.warned && idle >= p_.timeout_s - p_.warning_s) {
+      v_.warned = true;
+      say_brief(MessageId::timeout_warning, {{"seconds", std::to_string(static_cast<int>(std::lround(p_.timeout_s - idle)))}});
+    }
+  });
 }
 
-void KioskFlow::say_help() {
-  fx_.say(p_.camera ? text(MessageId::help) + " " + text(MessageId::help_camera) : text(MessageId::help));
-}
+// ---- the camera --------------------------------------------------------------------------------------
 
 void KioskFlow::capture_advice(MessageId advice, double now_s) {
-  if (!capturing_) return;
-  last_activity_s_ = now_s;
-  warned_ = false;
+  if (!v_.capturing) return;
+  activity(now_s);
   say(advice);
 }
 
 void KioskFlow::capture_done(int shapes, double now_s) {
-  if (!capturing_) return;
-  capturing_ = false;
-  last_activity_s_ = now_s;
-  warned_ = false;
-  state_ = KioskState::Picture;
+  if (!v_.capturing) return;
+  v_.capturing = false;
+  activity(now_s);
+  v_.state = KioskState::Picture;
+  v_.captured = true;
   if (shapes == 0) {
     say(MessageId::captured_empty);
   } else if (shapes == 1) {
@@ -215,48 +392,24 @@ void KioskFlow::capture_done(int shapes, double now_s) {
 }
 
 void KioskFlow::capture_failed(bool timeout, double now_s) {
-  if (!capturing_) return;
-  capturing_ = false;
-  last_activity_s_ = now_s;
+  if (!v_.capturing) return;
+  v_.capturing = false;
+  v_.last_activity_s = now_s;
   say(timeout ? MessageId::capture_timeout : MessageId::capture_failed);
 }
 
-void KioskFlow::tick(double now_s) {
-  if (state_ == KioskState::Attract) return;
-  if (pending_doc_ >= 0 && !loading_said_ && now_s - pending_since_s_ > p_.loading_cue_s) {
-    loading_said_ = true;
-    say(MessageId::loading);
-  }
-  const double idle = now_s - last_activity_s_;
-  if (idle >= p_.timeout_s) {
-    if (capturing_) fx_.cancel_capture();
-    capturing_ = false;
-    fx_.new_session();  // first: it stops speech, and the goodbye must be heard
-    if (source_ == KioskSource::Stick || !stick_.empty()) fx_.forget_stick();
-    source_ = KioskSource::Library;
-    stick_.clear();
-    doc_ = at_doc_ = pending_doc_ = -1;
-    say(MessageId::goodbye);
-    state_ = KioskState::Attract;
-    warned_ = false;
-    return;
-  }
-  if (!warned_ && idle >= p_.timeout_s - p_.warning_s) {
-    warned_ = true;
-    say(MessageId::timeout_warning, {{"seconds", std::to_string(static_cast<int>(std::lround(p_.timeout_s - idle)))}});
-  }
-}
+// ---- USB sticks --------------------------------------------------------------------------------------
 
 std::string KioskFlow::stick_summary() const {
   // English phrase for {summary}; the sentence around it comes from the catalogue.
   int pictures = 0, pdfs = 0, pages = 0;
-  for (const StickEntry& e : stick_) {
+  for (const StickEntry& e : v_.stick) {
     pictures += !e.pdf;
     pdfs += e.pdf;
     pages += e.pdf ? e.pages : 0;
   }
   auto count = [](int n, const char* one, const char* many) { return n == 1 ? std::string(one) : std::to_string(n) + " " + many; };
-  const int n = static_cast<int>(stick_.size());
+  const int n = static_cast<int>(v_.stick.size());
   std::string s = count(n, "one document", "documents") + ": ";
   std::string pdf_part;
   if (pdfs == 1) {
@@ -270,98 +423,96 @@ std::string KioskFlow::stick_summary() const {
 }
 
 void KioskFlow::request(int document, int page, double now_s) {
-  pending_doc_ = at_doc_ = document;
-  pending_page_ = at_page_ = page;
-  pending_since_s_ = now_s;
-  loading_said_ = false;
+  v_.pending_doc = v_.at_doc = document;
+  v_.pending_page = v_.at_page = page;
+  v_.pending_since_s = now_s;
+  v_.loading_said = false;
   fx_.show_document(document, page);
 }
 
 void KioskFlow::step_document(int delta, double now_s) {
   // From the last page asked for: the one awaited (a key pressed while loading moves on from there), or
   // the last one shown or found unreadable (so a visitor can step past a page that cannot be read).
-  int d = at_doc_;
-  int p = at_page_;
-  const int n = static_cast<int>(stick_.size());
+  int d = v_.at_doc;
+  int p = v_.at_page;
+  const int n = static_cast<int>(v_.stick.size());
   if (d < 0) {
     d = delta > 0 ? 0 : n - 1;
-    p = delta > 0 ? 1 : stick_[static_cast<std::size_t>(d)].pages;
+    p = delta > 0 ? 1 : v_.stick[static_cast<std::size_t>(d)].pages;
   } else if (delta > 0) {
-    if (++p > stick_[static_cast<std::size_t>(d)].pages) {
+    if (++p > v_.stick[static_cast<std::size_t>(d)].pages) {
       d = (d + 1) % n;
       p = 1;
     }
   } else if (--p < 1) {
     d = (d - 1 + n) % n;
-    p = stick_[static_cast<std::size_t>(d)].pages;
+    p = v_.stick[static_cast<std::size_t>(d)].pages;
   }
   request(d, p, now_s);
 }
 
 void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double now_s) {
-  last_activity_s_ = now_s;
-  warned_ = false;
-  if (state_ == KioskState::Attract) state_ = KioskState::Picture;  // a stick is someone at the kiosk
-  if (state_ == KioskState::Tutorial) state_ = KioskState::Picture;
-  stick_ = documents;
-  doc_ = at_doc_ = pending_doc_ = -1;
-  if (stick_.empty()) {
-    source_ = KioskSource::Library;
+  activity(now_s);
+  if (v_.state == KioskState::Attract) v_.state = KioskState::Picture;  // a stick is someone at the kiosk
+  if (v_.state == KioskState::Tutorial) v_.state = KioskState::Picture;
+  v_.stick = documents;
+  v_.doc = v_.at_doc = v_.pending_doc = -1;
+  if (v_.stick.empty()) {
+    v_.source = KioskSource::Library;
     say(MessageId::stick_empty);
     return;
   }
-  source_ = KioskSource::Stick;
-  announce_summary_ = stick_summary();
+  v_.source = KioskSource::Stick;
+  v_.announce_summary = stick_summary();
   request(0, 1, now_s);
 }
 
 void KioskFlow::stick_refused(const std::string& reason, double now_s) {
-  last_activity_s_ = now_s;
-  warned_ = false;
-  if (state_ == KioskState::Attract) state_ = KioskState::Picture;
+  activity(now_s);
+  if (v_.state == KioskState::Attract) v_.state = KioskState::Picture;
   say(MessageId::stick_unreadable, {{"reason", reason}});
 }
 
 void KioskFlow::stick_removed(double now_s) {
-  const bool browsing = source_ == KioskSource::Stick;
-  stick_.clear();
-  source_ = KioskSource::Library;
-  doc_ = at_doc_ = pending_doc_ = -1;
-  announce_summary_.clear();
-  if (!browsing || state_ == KioskState::Attract) return;  // nothing of the stick was in use
-  last_activity_s_ = now_s;
-  warned_ = false;
-  if (state_ == KioskState::Tutorial) {
+  const bool browsing = v_.source == KioskSource::Stick;
+  v_.stick.clear();
+  v_.source = KioskSource::Library;
+  v_.doc = v_.at_doc = v_.pending_doc = -1;
+  v_.announce_summary.clear();
+  if (!browsing || v_.state == KioskState::Attract) return;  // nothing of the stick was in use
+  activity(now_s);
+  if (v_.state == KioskState::Tutorial) {
     say(MessageId::stick_removed);
     return;
   }
-  show(picture_, text(MessageId::stick_removed));
+  show(v_.picture, text(MessageId::stick_removed));
 }
 
 void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
   (void)now_s;
-  if (source_ != KioskSource::Stick || r.document != pending_doc_ || r.page != pending_page_) return;  // superseded
-  pending_doc_ = -1;
-  const StickEntry& e = stick_[static_cast<std::size_t>(r.document)];
+  if (v_.source != KioskSource::Stick || r.document != v_.pending_doc || r.page != v_.pending_page) return;  // superseded
+  v_.pending_doc = -1;
+  const StickEntry& e = v_.stick[static_cast<std::size_t>(r.document)];
   // A PDF's own title, when it has a usable one, names it: "Page 1 of 3 of Annual report 2025."
   const std::string& name = e.title.empty() ? e.name : e.title;
   std::string line;
   if (r.ok) {
-    doc_ = r.document;
-    page_ = r.page;
-    state_ = KioskState::Picture;
+    v_.doc = r.document;
+    v_.page = r.page;
+    v_.state = KioskState::Picture;
+    v_.captured = false;
     line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(e.pages)},
                                                           {"name", name}, {"description", r.description}})
                  : text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
-                                                             {"documents", std::to_string(stick_.size())},
+                                                             {"documents", std::to_string(v_.stick.size())},
                                                              {"name", name}, {"description", r.description}});
   } else {
     const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + name : name;
     line = text(MessageId::document_unreadable, {{"name", what}, {"reason", r.reason}});
   }
-  if (!announce_summary_.empty()) {  // said now, so it names the keys of now
-    line = text(MessageId::stick_inserted, {{"summary", announce_summary_}}) + " " + line;
-    announce_summary_.clear();
+  if (!v_.announce_summary.empty()) {  // said now, so it names the keys of now
+    line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) + " " + line;
+    v_.announce_summary.clear();
   }
   fx_.say(line);
 }

@@ -1,35 +1,51 @@
 #pragma once
 /// @file kiosk_flow.hpp
-/// What a visitor walks through (issue 5, item 5), as a state machine apart from windows and devices so
-/// it can be driven by scripted input in tests:
-///   Attract   — waiting; the first key press or handle motion speaks the welcome and starts the tutorial;
+/// What a visitor walks through, as a state machine apart from windows and devices so it can be driven by
+/// scripted input in tests:
+///   Attract   — waiting; a short spoken invitation every attract_every_s (not in quiet hours); the first key
+///               press or handle motion speaks a short welcome (≤ 8 s) and puts the tutorial's square on the
+///               device;
 ///   Tutorial  — a square, a circle, a triangle (Next moves on); after the triangle, the first picture;
-///   Picture   — Next / Previous picture, Describe, Finer / Coarser level, Volume, Help, Tutorial again,
-///               Guide (the guided tour, also on the tutorial's shapes; any key stops a running tour).
-/// Every key press is answered in speech at once (the speech cuts off what was being said). With no key
-/// and no handle motion for `timeout_s`, the kiosk warns `warning_s` ahead, then says goodbye, restores the
-/// operator's defaults and returns to Attract. Any key or motion extends the time.
+///   Picture   — Next / Previous picture, Describe, Where ("what is here"), Finer / Coarser level, Volume,
+///               Repeat, Pause, Help, Tutorial again, Guide (the guided tour), Capture, Finish.
 ///
-/// USB sticks (issue 11, item 5): a stick inserted (stick_inserted) makes Next / Previous walk its documents
-/// and their pages instead of the picture library. Its first page is loaded at once and announced after a
-/// summary of the stick ("A USB stick with 3 documents: 2 pictures and a PDF of 12 pages. Press the Right arrow ...").
+/// The visitor is in charge (ADA §707, EN 301 549 §5, the EZ Access conventions):
+/// - every key press is answered in speech at once, cutting off what was being said, but Volume, which never
+///   cuts speech (while something is said the speech itself gets louder or quieter: that is the answer);
+/// - Repeat says the last thing said again from its start (acknowledgements such as "Louder." are passed
+///   over); Pause holds the speech where it is and, pressed again, goes on;
+/// - Help comes in two layers: one sentence for where the visitor is and the two most useful keys, then, on
+///   the same key again, every key; a key that does nothing says its own name and that it does nothing;
+///   holding Help while pressing a key names that key and what it does, without doing it (learning mode);
+/// - no time pressure: speech in progress (not paused), contact with a shape, keys and handle motion all
+///   count as activity, so the time-out never cuts a text being read; with none of them for timeout_s the
+///   kiosk warns warning_s ahead (naming how to get more time: any key), then says goodbye, restores the
+///   operator's defaults and returns to Attract; Finish does the same at once;
+/// - nothing a visitor does ends the kiosk: each key press, handle motion and time step runs under one guard
+///   that, on an exception, restores the flow's state as it was before, logs the failure and says one short
+///   sorry line.
+///
+/// USB sticks: a stick inserted (stick_inserted) makes Next / Previous walk its documents and their pages
+/// instead of the picture library. Its first page is loaded at once and announced after a summary of the
+/// stick ("A USB stick with 3 documents: 2 pictures and a PDF of 12 pages. Press the Right arrow ...").
 /// Documents load asynchronously (KioskEffects::show_document; the window layer reports back with
 /// document_ready), so slow work never blocks; "Loading." is said when a load takes longer than
 /// loading_cue_s. A page that cannot be read is reported and the picture felt before stays. Removing the
 /// stick goes back to the library picture; a new session forgets the stick.
 ///
-/// The camera (issue 16, item 3): the Capture key starts a capture (KioskEffects::start_capture) guided by voice
-/// (capture_advice, each advice said as it comes, cutting off the one before); any key cancels it; when the
-/// picture is taken (capture_done) the Shutter earcon has sounded and the flow says "Captured. It has N shapes."
-/// and stays on it (Next and Previous go on in the library). A failure or a time-out is said. Without a camera
-/// the key says so, and the help names the key only when there is a camera (KioskFlowParams::camera).
+/// The camera: the Capture key starts a capture (KioskEffects::start_capture) guided by voice (capture_advice,
+/// each advice said as it comes, cutting off the one before); any key cancels it; when the picture is taken
+/// (capture_done) the Shutter earcon has sounded and the flow says "Captured. It has N shapes." and stays on it
+/// (Next and Previous go on in the library). A failure or a time-out is said. Without a camera the key says so,
+/// and the help names the key only when there is a camera (KioskFlowParams::camera).
 ///
-/// Keys (issue 12, item 6): what the kiosk says names the keys that work. Every message is said with its
-/// key placeholders ({help_key}, {next_key}, …) filled from the [keys] settings (KioskFlowParams::keys, changed
-/// live with set_keys()), as the catalogue's spoken form of each key ("Press the Up arrow for more detail.").
+/// Keys: what the kiosk says names the keys that work. Every message is said with its key placeholders
+/// ({help_key}, {next_key}, …) filled from the [keys] settings (KioskFlowParams::keys, changed live with
+/// set_keys()), as the catalogue's spoken form of each key ("Press the Up arrow for more detail.").
 
 #include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "audio/messages.hpp"
@@ -38,8 +54,10 @@
 
 namespace hk::app {
 
-/// Keys a blind visitor can find (mapped to physical keys in the config by the window layer).
-enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Guide, Capture, Other };
+/// Keys a blind visitor can find (mapped to physical keys in the config by the window layer), in the order of
+/// config::key_actions (Help .. Finish); Other is any key that is none of them.
+enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Guide, Capture,
+                      Repeat, Pause, Where, Finish, Other };
 
 /// States of the flow.
 enum class KioskState { Attract, Tutorial, Picture };
@@ -75,8 +93,22 @@ struct DocumentResult {
 class KioskEffects {
  public:
   virtual ~KioskEffects() = default;
-  /// Speak `text` now, cutting off what is being said.
+  /// Speak `text` now, cutting off what is being said; Repeat says it again later.
   virtual void say(const std::string& text) = 0;
+  /// Speak an acknowledgement ("Louder.", a key's name) now, cutting off what is being said; Repeat passes it
+  /// over and says the text before it. Default: say().
+  virtual void say_brief(const std::string& text) { say(text); }
+  /// Say the last text said with say() again, from its start. False when there is none (nothing said).
+  /// Default: nothing to repeat.
+  virtual bool repeat() { return false; }
+  /// Speech is being heard (not paused). Default: never.
+  virtual bool speaking() const { return false; }
+  /// Hold the speech where it is; false when nothing is being said. Default: nothing is.
+  virtual bool pause_speech() { return false; }
+  /// Go on from a pause; false when speech is not paused. Default: never paused.
+  virtual bool resume_speech() { return false; }
+  /// Whether now is within the operator's quiet hours ([kiosk] quiet_hours): no spoken invitation. Default: no.
+  virtual bool quiet_hours() const { return false; }
   /// Put a tutorial shape on the device.
   virtual void show_tutorial(TutorialShape shape) = 0;
   /// Put picture `index` (0-based) on the device. Returns its number of shapes.
@@ -85,31 +117,34 @@ class KioskEffects {
   virtual int picture_count() const = 0;
   /// The title and description a person wrote for the picture shown (picture_notes.hpp); empty when none.
   virtual PictureNotes shown_notes() const { return {}; }
-  /// A spoken description of what is shown (describe.hpp).
+  /// A spoken description of what is shown, starting from where the hand is (describe.hpp).
   virtual std::string describe() = 0;
+  /// "What is here": the shape or block of text under or nearest the hand and where the hand is, one or two
+  /// sentences (describe.hpp, where_message). Default: nothing to say ("").
+  virtual std::string where() { return {}; }
   /// Level one finer (delta −1) or coarser (+1). Returns false at the limit (nothing changes).
   virtual bool change_level(int delta) = 0;
   /// Volume one step up (+1) or down (−1). Returns false at the limit.
   virtual bool change_volume(int delta) = 0;
-  /// A new visitor: the operator's default settings (volume, level), speech stopped.
+  /// A new visitor: the operator's default settings (volume, level), speech stopped and forgotten.
   virtual void new_session() = 0;
   /// Start loading page `page` (from 1) of stick document `document` (0-based) off the window thread; when
   /// done, the window layer calls KioskFlow::document_ready. A newer request supersedes an older one.
   virtual void show_document(int document, int page) = 0;
   /// Drop the stick's listing (a new visitor must not browse the last one's stick).
   virtual void forget_stick() = 0;
-  /// Any key was pressed (before the flow acts on it): a guided tour that runs stops (issue 14, item 3).
-  /// Default: nothing.
+  /// Any key that acts was pressed (before the flow acts on it): a guided tour that runs, or is about to,
+  /// stops. Not called for Volume, nor for a key named in learning mode. Default: nothing.
   virtual void key_pressed() {}
-  /// The Capture key (issue 16): start a guided camera capture off the window thread; the window layer then
-  /// reports with KioskFlow::capture_advice / capture_done / capture_failed. False when there is no camera
-  /// (nothing starts). Default: no camera.
+  /// The Capture key: start a guided camera capture off the window thread; the window layer then reports
+  /// with KioskFlow::capture_advice / capture_done / capture_failed. False when there is no camera (nothing
+  /// starts). Default: no camera.
   virtual bool start_capture() { return false; }
   /// Stop the capture under way (a key was pressed or the session ended); no report follows. Default: nothing.
   virtual void cancel_capture() {}
-  /// The Guide key (issue 14, item 3): lead the handle to the nearest shape not yet touched and round it,
-  /// or, when the press stopped a running tour (key_pressed), say so. What is said is up to the
-  /// implementation (the tour's end is reported later). Default: nothing.
+  /// The Guide key: say that the hand will be guided, then lead the handle to the nearest shape not yet
+  /// touched and round it, or, when the press stopped a running tour (key_pressed), say so. What is said is
+  /// up to the implementation (the tour's end is reported later). Default: nothing.
   virtual void guide() {}
 };
 
@@ -120,9 +155,10 @@ std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config:
 
 /// Timing of the flow. Units in names.
 struct KioskFlowParams {
-  double timeout_s = 120.0;  ///< no key and no motion for this long ends the session
+  double timeout_s = 120.0;  ///< no activity (key, motion, contact, speech heard) for this long ends the session
   double warning_s = 20.0;   ///< the spoken warning comes this long before the end (at most timeout_s / 2)
   double loading_cue_s = 0.5; ///< "Loading." is said when a document takes longer than this to load
+  double attract_every_s = 30.0;  ///< the spoken invitation in Attract comes this often (0: never)
   config::KeysSettings keys{};  ///< the key of each action ([keys]), named in what is said; default: the shipped keys
   bool camera = false;          ///< a camera is there: the help names the Capture key
 };
@@ -132,11 +168,19 @@ class KioskFlow {
  public:
   KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params = {});
 
-  /// A key press at time `now_s` [s] (any monotonic clock).
-  void key(KioskKey k, double now_s);
+  /// A key press at time `now_s` [s] (any monotonic clock). `key_name`: the settings' name of the key pressed
+  /// ("Q", "F5"; config/keys.hpp), spoken when `k` is Other (and when learning); empty when unknown.
+  void key(KioskKey k, double now_s, std::string_view key_name = {});
+  /// The Help key is held down (true) or let go (false). While held, a key press names the key and what it
+  /// does without doing it (learning mode).
+  void help_held(bool held) { learning_ = held; }
   /// The handle moved noticeably (the caller decides, e.g. > 5 mm since the last call) at `now_s`.
   void handle_moved(double now_s);
-  /// Time passes (call every frame): warnings, the time-out and the loading cue.
+  /// The handle is in contact with a shape at `now_s` (the visitor is feeling it): activity, but it does not
+  /// wake the kiosk from Attract (a handle resting against a wall is not a visitor).
+  void touching(double now_s);
+  /// Time passes (call every frame): the invitation, speech heard as activity, warnings, the time-out and the
+  /// loading cue.
   void tick(double now_s);
   /// A USB stick was inserted and scanned: its documents (may be empty), at `now_s`. Wakes the kiosk.
   void stick_inserted(const std::vector<StickEntry>& documents, double now_s);
@@ -156,37 +200,73 @@ class KioskFlow {
   /// lay still long enough (timeout = true). Said; the picture felt before stays.
   void capture_failed(bool timeout, double now_s);
   /// A capture is under way.
-  bool capturing() const { return capturing_; }
+  bool capturing() const { return v_.capturing; }
   /// The operator changed the keys ([keys]): from now on every message names these (the next thing said
   /// already does). Does not speak and does not touch the session.
   void set_keys(const config::KeysSettings& keys) { p_.keys = keys; }
-  /// The operator changed the session's time-out ([kiosk] timeout_s, warning_s [s]): counted from the last
-  /// activity, as before. A warning already given stays given.
-  void set_timing(double timeout_s, double warning_s) {
-    p_.timeout_s = timeout_s;
-    p_.warning_s = warning_s;
-  }
+  /// The operator changed the session's timing ([kiosk] timeout_s, warning_s, attract_every_s [s]): counted
+  /// from the last activity, as before. A warning already given stays given.
+  void set_timing(double timeout_s, double warning_s, double attract_every_s);
   /// The keys named in what is said.
   const config::KeysSettings& keys() const { return p_.keys; }
   /// The text of `id` as the flow says it: `args` filled in, and every key placeholder naming the current key.
   std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) const;
 
-  KioskSource source() const { return source_; }
-  int document() const { return doc_; }        ///< stick document shown (0-based), −1 before the first
-  int page() const { return page_; }           ///< its page (from 1)
-  bool loading() const { return pending_doc_ >= 0; }  ///< a document load is awaited
+  KioskSource source() const { return v_.source; }
+  int document() const { return v_.doc; }        ///< stick document shown (0-based), −1 before the first
+  int page() const { return v_.page; }           ///< its page (from 1)
+  bool loading() const { return v_.pending_doc >= 0; }  ///< a document load is awaited
 
-  KioskState state() const { return state_; }
-  TutorialShape tutorial_shape() const { return shape_; }
-  int picture() const { return picture_; }
-  bool warned() const { return warned_; }
+  KioskState state() const { return v_.state; }
+  TutorialShape tutorial_shape() const { return v_.shape; }
+  int picture() const { return v_.picture; }
+  bool warned() const { return v_.warned; }
+  /// Visitor actions that failed and were answered with the sorry line (logged), since the start.
+  int failures() const { return failures_; }
 
  private:
+  /// Everything the flow knows of the visit, one value, so that a failed action can be undone whole.
+  struct Visit {
+    KioskState state = KioskState::Attract;
+    TutorialShape shape = TutorialShape::Square;
+    int picture = 0;
+    double last_activity_s = 0;
+    double next_invitation_s = 0;   // Attract: when the next spoken invitation is due
+    bool warned = false;
+    int help_layer = 0;             // 1 right after the first layer of help: Help again gives every key
+    KioskSource source = KioskSource::Library;
+    std::vector<StickEntry> stick;
+    int doc = -1, page = 1;                  // shown
+    int at_doc = -1, at_page = 1;            // where browsing stands: the last page asked for, shown or not
+    int pending_doc = -1, pending_page = 1;  // awaited
+    double pending_since_s = 0;
+    bool loading_said = false;
+    std::string announce_summary;            // the stick's summary, said before the first page's announcement
+    bool capturing = false;                  // a camera capture is under way
+    bool captured = false;                   // the picture shown is the visitor's own capture
+  };
+
+  template <class Action>
+  void guarded(const char* what, Action&& action);  // runs action; on an exception: undo, log, sorry
+  void act_on_key(KioskKey k, double now_s, std::string_view key_name);
+  bool session_key(KioskKey k, double now_s);  // keys that act the same everywhere; true when handled
+  void volume_key(int delta);
+  void pause_key();
+  void help_key();
+  void learn_key(KioskKey k, std::string_view key_name);
+  void stray_key(std::string_view key_name);
+  void tutorial_key(KioskKey k);
+  void picture_key(KioskKey k);
+  void activity(double now_s);
   void wake(double now_s);
+  void end_session(double now_s);
   void start_tutorial();
   void show(int index, const std::string& before = {});
   void say(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
-  void say_help();  // the help, and the Capture key's sentence when there is a camera
+  void say_brief(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
+  void say_help();  // every key, and the Capture key's sentence when there is a camera
+  std::string place() const;  // where the visitor is, one sentence (a place_* message)
+  std::string spoken_key(std::string_view key_name) const;  // "The Q key", "That key"
   void request(int document, int page, double now_s);
   void step_document(int delta, double now_s);
   std::string stick_summary() const;
@@ -194,20 +274,9 @@ class KioskFlow {
   KioskEffects& fx_;
   const audio::MessageCatalog& msg_;
   KioskFlowParams p_;
-  KioskState state_ = KioskState::Attract;
-  TutorialShape shape_ = TutorialShape::Square;
-  int picture_ = 0;
-  double last_activity_s_ = 0;
-  bool warned_ = false;
-  KioskSource source_ = KioskSource::Library;
-  std::vector<StickEntry> stick_;
-  int doc_ = -1, page_ = 1;                 // shown
-  int at_doc_ = -1, at_page_ = 1;           // where browsing stands: the last page asked for, shown or not
-  int pending_doc_ = -1, pending_page_ = 1; // awaited
-  double pending_since_s_ = 0;
-  bool loading_said_ = false;
-  std::string announce_summary_;            // the stick's summary, said before the first page's announcement
-  bool capturing_ = false;                  // a camera capture is under way
+  Visit v_;
+  bool learning_ = false;  // Help held down
+  int failures_ = 0;
 };
 
 }  // namespace hk::app

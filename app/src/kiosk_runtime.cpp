@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
@@ -66,8 +68,8 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
   cursor_in_ = sim_.true_position_m();
   level_ = s.haptics.level;
   auto_level_ = s.haptics.level_mode != "fixed";
-  high_contrast_ = o.high_contrast;
-  overlay_ = o.overlay;
+  high_contrast_ = said_contrast_ = o.high_contrast;
+  overlay_ = said_overlay_ = o.overlay;
 }
 
 KioskRuntime::~KioskRuntime() {
@@ -245,7 +247,56 @@ void KioskRuntime::stop_servo() {
 void KioskRuntime::say(const std::string& text) {
   spdlog::info("say: {}", text);
   last_said_ = text;
+  repeatable_ = text;
   audio_.say_text(text);
+}
+
+void KioskRuntime::say_brief(const std::string& text) {
+  spdlog::info("say: {}", text);
+  last_said_ = text;
+  audio_.say_text(text, false);
+}
+
+bool KioskRuntime::repeat() {
+  if (repeatable_.empty()) return false;
+  say(std::string(repeatable_));
+  return true;
+}
+
+bool KioskRuntime::quiet_hours() const {
+  const std::optional<config::QuietHours> hours = config::parse_quiet_hours(s_.kiosk.quiet_hours);
+  if (!hours) return false;
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  if (localtime_r(&now, &local) == nullptr) return false;
+  return config::in_quiet_hours(*hours, local.tm_hour * 60 + local.tm_min);
+}
+
+std::string KioskRuntime::where() {
+  const ServoDisplayState& d = core_.display();
+  const std::string place = place_words(d.handle_m, half_);
+  const audio::MessageCatalog& m = audio_.messages();
+  if (const TextBlockM* b = text_block_at(shown_.text_blocks, d.handle_m)) {
+    const auto index = b - shown_.text_blocks.data();
+    return m.text(audio::MessageId::where_text, {{"block", std::to_string(index + 1)}, {"blocks", std::to_string(shown_.text_blocks.size())},
+                                                  {"where", place}, {"text", first_words(b->text, 12)}});
+  }
+  const ShapeAtHand at = shape_at_hand(shown_.polylines, d.handle_m, d.scene_id == shown_id_ ? d.curve : -1);
+  if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}});
+  return m.text(at.on ? audio::MessageId::where_on : audio::MessageId::where_near,
+                {{"shape", std::to_string(at.curve + 1)}, {"shapes", std::to_string(shown_.polylines.size())},
+                 {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(at.curve), half_)}, {"where", place}});
+}
+
+void KioskRuntime::poll_display_modes() {
+  if (high_contrast_ != said_contrast_) {
+    said_contrast_ = high_contrast_;
+    say_brief(audio_.messages().text(high_contrast_ ? audio::MessageId::high_contrast_on : audio::MessageId::high_contrast_off));
+  }
+  if (overlay_ != said_overlay_) {
+    said_overlay_ = overlay_;
+    say_brief(audio_.messages().text(overlay_ ? audio::MessageId::overlay_on : audio::MessageId::overlay_off));
+  }
 }
 
 void KioskRuntime::show_tutorial(TutorialShape shape) {
@@ -292,7 +343,7 @@ std::string KioskRuntime::describe() {
       return audio_.messages().text(audio::MessageId::text_block, {{"text", b->text}});
     }
     const std::string page = describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
-    return shown_.polylines.empty() ? page : page + " " + describe_scene(shown_.polylines, half_);
+    return shown_.polylines.empty() ? page : page + " " + describe_scene(shown_.polylines, half_, 3, core_.display().handle_m);
   }
   // A picture: what a person wrote of it first ("A horse, seen from the side. A horse standing, ..."), then
   // its shapes.
@@ -304,7 +355,7 @@ std::string KioskRuntime::describe() {
     words += ' ';
   }
   if (!shown_.notes.description.empty()) words += shown_.notes.description + ' ';
-  return words + describe_scene(shown_.polylines, half_);
+  return words + describe_scene(shown_.polylines, half_, 3, core_.display().handle_m);
 }
 
 void KioskRuntime::show_document(int document, int page) { sticks_.load(stick_id_, document, page); }
@@ -399,10 +450,12 @@ void KioskRuntime::new_session() {
   }
   capture_.cancel();
   audio_.new_session();
+  repeatable_.clear();
+  tour_asked_ = false;
   level_ = s_.haptics.level;
   auto_level_ = s_.haptics.level_mode != "fixed";
   core_.request_level(auto_level_ ? ServoCore::kAutoLevel : level_);
-  high_contrast_ = opt_.high_contrast;
+  high_contrast_ = said_contrast_ = opt_.high_contrast;
   if (tour_running_) {
     core_.cancel_tour();
     tour_quiet_ = true;
@@ -425,7 +478,8 @@ void KioskRuntime::set_cursor(Vec2 m) {
 }
 
 void KioskRuntime::key_pressed() {
-  guide_stops_ = tour_running_ != 0;
+  guide_stops_ = tour_running_ != 0 || tour_asked_;
+  tour_asked_ = false;  // an announced tour does not start
   if (tour_running_) {
     core_.cancel_tour();
     tour_quiet_ = true;
@@ -440,16 +494,30 @@ void KioskRuntime::guide() {
   }
   if (!shown_.scene) return;
   const TourParams tp = tour_params_from(s_);
-  std::optional<TourPath> plan = plan_tour(*shown_.scene, shown_id_, core_.display().handle_m, touches_, tp);
-  if (!plan) {
+  if (!plan_tour(*shown_.scene, shown_id_, core_.display().handle_m, touches_, tp)) {
     bool any_shape = false;
     for (std::size_t c = 0; c < shown_.scene->curve_count(); ++c) any_shape = any_shape || is_tour_shape(*shown_.scene, c, tp);
     say(audio_.messages().text(any_shape ? audio::MessageId::tour_all_touched : audio::MessageId::tour_nothing));
     return;
   }
+  // Ask first: the pull starts once the visitor has heard what is coming (counted in servo ticks, so the
+  // same in a headless run as at the kiosk).
+  const std::string ask = audio_.messages().text(audio::MessageId::tour_ask);
+  say_brief(ask);
+  tour_asked_ = true;
+  tour_scene_ = shown_id_;
+  tour_due_tick_ = core_.display().tick +
+                   static_cast<std::int64_t>(std::ceil((audio_.speech_duration_s(ask) + kTourAskMargin_s) * s_.haptics.servo_rate_hz));
+}
+
+void KioskRuntime::hand_over_tour() {
+  tour_asked_ = false;
+  if (!shown_.scene || tour_scene_ != shown_id_) return;  // another picture came meanwhile
+  const TourParams tp = tour_params_from(s_);
+  std::optional<TourPath> plan = plan_tour(*shown_.scene, shown_id_, core_.display().handle_m, touches_, tp);
+  if (!plan) return;  // touched meanwhile: nothing left to lead to
   plan->id = ++tour_seq_;
   tour_running_ = plan->id;
-  tour_scene_ = shown_id_;
   tour_quiet_ = false;
   tour_cursor_ref_ = cursor_in_;
   spdlog::info("tour {}: to shape {} ({:.1f} s)", plan->id, plan->curve, plan->duration_s());
@@ -460,6 +528,7 @@ void KioskRuntime::guide() {
 void KioskRuntime::poll_tour() {
   const ServoDisplayState& d = core_.display();
   if (d.scene_id == touches_.scene_id() && d.curve >= 0) touches_.touch(d.scene_id, d.curve);
+  if (tour_asked_ && d.tick >= tour_due_tick_) hand_over_tour();
   if (!tour_running_ || d.tour_id != tour_running_ || (d.tour_phase != TourPhase::Done && d.tour_phase != TourPhase::Stopped)) return;
   if (d.tour_phase == TourPhase::Done) touches_.touch(tour_scene_, d.tour_curve);
   tour_running_ = 0;
@@ -470,11 +539,22 @@ void KioskRuntime::poll_tour() {
     hand_limp_.store(false, std::memory_order_relaxed);
   }
   if (tour_quiet_ || !shown_.scene || tour_scene_ != shown_id_) return;
+  report_tour_end(d);
+}
+
+void KioskRuntime::report_tour_end(const ServoDisplayState& d) {
+  const audio::MessageCatalog& m = audio_.messages();
+  std::string text;
+  if (d.tour_phase == TourPhase::Stopped) {
+    text = m.text(audio::MessageId::tour_stopped) + " ";
+  } else if (d.tour_curve >= 0 && static_cast<std::size_t>(d.tour_curve) < shown_.polylines.size()) {
+    text = m.text(audio::MessageId::tour_traced, {{"shape", std::to_string(d.tour_curve + 1)},
+                                                   {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(d.tour_curve), half_)}}) + " ";
+  }
   const int left = shapes_remaining(*shown_.scene, touches_, tour_params_from(s_));
-  std::string text = d.tour_phase == TourPhase::Stopped ? audio_.messages().text(audio::MessageId::tour_stopped) + " " : std::string{};
-  if (left == 0) text += audio_.messages().text(audio::MessageId::tour_all_touched);
-  else if (left == 1) text += audio_.messages().text(audio::MessageId::tour_one_remaining);
-  else text += audio_.messages().text(audio::MessageId::tour_remaining, {{"count", std::to_string(left)}});
+  if (left == 0) text += m.text(audio::MessageId::tour_all_touched);
+  else if (left == 1) text += m.text(audio::MessageId::tour_one_remaining);
+  else text += m.text(audio::MessageId::tour_remaining, {{"count", std::to_string(left)}});
   say(text);
 }
 
@@ -527,6 +607,7 @@ void KioskRuntime::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::
   shown_ = std::move(sh);
   shown_id_ = id;
   touches_.reset(id, static_cast<int>(sc.curve_count()));  // touches are kept per picture
+  tour_asked_ = false;
   if (tour_running_) {
     core_.cancel_tour();  // the servo stops it at the swap anyway; nothing to say of it
     tour_quiet_ = true;
@@ -587,7 +668,7 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
   sp_ = servo_params_from(s_);
   if (r.gains) core_.set_gains(servo_gains_from(s_));
   if (r.keys) flow.set_keys(s_.keys);
-  if (r.timing) flow.set_timing(s_.kiosk.timeout_s, s_.kiosk.warning_s);
+  if (r.timing) flow.set_timing(s_.kiosk.timeout_s, s_.kiosk.warning_s, s_.kiosk.attract_every_s);
   if (rebuild) {
     level_ = s_.haptics.level;
     auto_level_ = s_.haptics.level_mode != "fixed";

@@ -125,7 +125,21 @@ class KioskRuntime final : public KioskEffects {
   const std::string& device_note() const { return device_note_; }
 
   // ---- KioskEffects (kiosk_flow.hpp) ----
+  /// Logs "say: TEXT", shows it as the caption and speaks it; Repeat says it again.
   void say(const std::string& text) override;
+  /// As say(), but Repeat passes it over.
+  void say_brief(const std::string& text) override;
+  /// Says the last text given to say() again (false when there is none in this visit).
+  bool repeat() override;
+  bool speaking() const override { return audio_.speaking(); }
+  bool pause_speech() override { return audio_.pause_speech(); }
+  bool resume_speech() override { return audio_.resume_speech(); }
+  /// Whether the local time of day lies in [kiosk] quiet_hours.
+  bool quiet_hours() const override;
+  /// "What is here": on a document page, the block of text under the hand (its number and first words);
+  /// else the shape the proxy touches or the hand is nearest (describe.hpp shape_at_hand: its number, size,
+  /// kind, what lies in it and what it lies in), and where the hand is (place_words).
+  std::string where() override;
   void show_tutorial(TutorialShape shape) override;
   int show_picture(int index) override;
   int picture_count() const override { return static_cast<int>(pictures_.size()); }
@@ -147,19 +161,27 @@ class KioskRuntime final : public KioskEffects {
   void poll_capture(KioskFlow& flow, double now_s);
   /// The capture under way's latest frame and page (for the preview), empty when none is under way.
   CapturePreview capture_preview() const { return capture_.busy() ? capture_.preview() : CapturePreview{}; }
-  /// The Guide key: plans the tour from the handle to the nearest shape of the picture shown not yet
-  /// touched in this visit (plan_tour) and hands it to the servo thread; nothing left: says so
-  /// (tour_all_touched, or tour_nothing for a picture without shapes). A press that stopped a running tour
-  /// says tour_stopped instead. With the simulated pantograph the model hand goes limp while the tour runs
-  /// (it follows the handle), so the tour leads the handle.
+  /// The Guide key: when the picture shown has a shape not yet touched in this visit (plan_tour), asks
+  /// first: "I will guide your hand to a shape. Hold the handle lightly." The tour is planned from where the
+  /// handle is then and handed to the servo thread once that has been said (poll_tour: the announcement's
+  /// length in servo ticks, kTourAskMargin_s more), so no guide force comes before the visitor has heard it.
+  /// Nothing left: says so (tour_all_touched, or tour_nothing for a picture without shapes). A press that
+  /// stopped a running or announced tour says tour_stopped instead. With the simulated pantograph the model
+  /// hand goes limp while the tour runs (it follows the handle), so the tour leads the handle.
   void guide() override;
   /// Window thread, every frame: keeps what the handle touches (the servo's contact curve) in this visit's
-  /// touches, and when the tour handed over has ended, says what remains ("3 shapes not yet touched.";
-  /// "Tour stopped. …" first when the hand held it back or the device was lost; nothing when a key or the
-  /// mouse stopped it, or a new picture or visitor came) and gives the handle back to the cursor where it is.
+  /// touches; hands an announced tour to the servo thread when it is due; and when the tour handed over has
+  /// ended, says what it traced and what remains ("That was shape 2, a small closed shape, on the left. 3
+  /// shapes not yet touched."; "Tour stopped. …" instead of what it traced when the hand held it back or the
+  /// device was lost; nothing when a key or the mouse stopped it, or a new picture or visitor came) and gives
+  /// the handle back to the cursor where it is.
   void poll_tour();
-  /// Whether a tour handed to the servo thread has not yet been reported ended (poll_tour).
-  bool tour_running() const { return tour_running_ != 0; }
+  /// Whether a tour announced or handed to the servo thread has not yet been reported ended (poll_tour).
+  bool tour_running() const { return tour_running_ != 0 || tour_asked_; }
+  /// A tour is announced and not yet handed to the servo thread.
+  bool tour_announced() const { return tour_asked_; }
+  /// Extra time after the tour's announcement before its force may start [s] (the sound device's latency).
+  static constexpr double kTourAskMargin_s = 0.3;
   /// The shapes touched in this visit of the picture shown.
   const VisitTouches& touches() const { return touches_; }
 
@@ -196,8 +218,11 @@ class KioskRuntime final : public KioskEffects {
   int level() { return core_.display().level; }
   /// Half the workspace's extent [m].
   Vec2 half() const { return half_; }
+  /// The operator's display switches (the panel's checkboxes). A change is announced by poll_display_modes.
   bool& high_contrast() { return high_contrast_; }
   bool& overlay() { return overlay_; }
+  /// Window thread, every frame: says and logs a change of high contrast or the overlay ("High contrast on.").
+  void poll_display_modes();
   /// Null before start_servo().
   ServoThread* servo() { return servo_.get(); }
   /// Index of `path` in the library, −1 when it is not there.
@@ -218,6 +243,8 @@ class KioskRuntime final : public KioskEffects {
   void rebuild_shown();
   bool try_open_usb();  // the USB pantograph per [device]; false (device_note_ says why) when none answers
   void open_emulated_board(const std::string& choice);  // RuntimeOptions::device
+  void hand_over_tour();   // plans the announced tour from the handle and publishes it
+  void report_tour_end(const ServoDisplayState& d);  // what it traced and what remains
 
   RuntimeOptions opt_;
   config::Settings s_;
@@ -244,7 +271,9 @@ class KioskRuntime final : public KioskEffects {
   int level_ = 1;           // the fixed level (auto_level_ false)
   bool auto_level_ = true;  // levels from hand speed
   bool high_contrast_ = false, overlay_ = false;
+  bool said_contrast_ = false, said_overlay_ = false;  // the switches as last announced
   std::string last_said_;
+  std::string repeatable_;  // the last text given to say(), for Repeat
   int shown_id_ = -100;
   int shown_picture_ = -1;  // library index shown, −1 for none
   int shown_page_ = 0;      // a document page shown (from 1), 0 for a picture
@@ -260,7 +289,9 @@ class KioskRuntime final : public KioskEffects {
   int tour_running_ = 0;       // its id until poll_tour sees it ended, else 0
   int tour_scene_ = 0;         // the picture it was planned for
   bool tour_quiet_ = false;    // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
-  bool guide_stops_ = false;   // this key press stopped a running tour
+  bool guide_stops_ = false;   // this key press stopped a running or announced tour
+  bool tour_asked_ = false;    // announced, not yet handed to the servo thread
+  std::int64_t tour_due_tick_ = 0;  // the servo tick from which the announced tour may start
   std::atomic<bool> hand_limp_{false};  // the model hand follows the handle (a tour leads it)
   Vec2 cursor_in_;             // the last cursor given to set_cursor [m]
   Vec2 cursor_offset_;         // added to it: where tours left the hand [m]

@@ -3,6 +3,7 @@
 // (set or check the operator's PIN), speak (a message or text rendered to WAV), devices (USB and serial devices
 // found) and calibrate (the USB pantograph's encoder offsets).
 #include <CLI/CLI.hpp>
+#include <spdlog/cfg/env.h>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -30,6 +31,7 @@ void print_error(const std::string& what) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows e.g. each piece of speech as it is handed on
   CLI::App cli{"haptic-kiosk: feel the shapes in a picture through a force-feedback pantograph"};
   cli.require_subcommand(0, 1);
   hk::app::KioskOptions ko;
@@ -37,8 +39,8 @@ int main(int argc, char** argv) {
   cli.add_option("--config", ko.config_path, "Settings file (TOML)");
   cli.add_option("--library", ko.library, "Picture folder (default: the shipped data/pictures)");
   cli.add_option("--show", ko.show, "Start on this picture, past the welcome and tutorial (documentation, tests)");
-  cli.add_flag("--high-contrast", ko.high_contrast, "Start in high contrast: dimmed picture, thick bright curves (key C)");
-  cli.add_flag("--overlay", ko.overlay, "Start with the operator overlay (key O)");
+  cli.add_flag("--high-contrast", ko.high_contrast, "Start in high contrast: dimmed picture, thick bright curves (also in the operator's panel)");
+  cli.add_flag("--overlay", ko.overlay, "Start with the operator overlay (also in the operator's panel)");
   cli.add_option("--screenshot", ko.screenshot, "Run --frames frames (scripted input from --script), write the last as PNG, quit");
   cli.add_option("--frames", ko.frames, "Frames to run before the screenshot (60 per second)");
   cli.add_option("--script", ko.script, "Scripted input: lines 'FRAME key NAME', 'FRAME cursor X_M Y_M', 'FRAME move', 'FRAME stick DIR', 'FRAME unstick', 'FRAME wait_loaded'");

@@ -100,6 +100,35 @@ void check_text(std::string_view text) {
   }
 }
 
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+
+/// Where the sentence starting at `from` ends (one past its last byte): after '.', '!', '?', ';' or ':'
+/// followed by white space, or at a line break; text.size() when none.
+std::size_t sentence_end(std::string_view text, std::size_t from) {
+  for (std::size_t i = from; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') return i;
+    if ((c == '.' || c == '!' || c == '?' || c == ';' || c == ':') && i + 1 < text.size() && is_space(text[i + 1])) return i + 1;
+  }
+  return text.size();
+}
+
+/// Where a run of `text` longer than `max` bytes is cut: after the last space within max bytes, else at
+/// the last UTF-8 sequence boundary within them (never 0).
+std::size_t word_cut(std::string_view text, std::size_t max) {
+  for (std::size_t i = max; i > 0; --i)
+    if (is_space(text[i])) return i;
+  std::size_t i = max;
+  while (i > 1 && (static_cast<unsigned char>(text[i]) & 0xC0) == 0x80) --i;  // not inside a sequence
+  return i;
+}
+
+std::string_view trimmed(std::string_view t) {
+  while (!t.empty() && is_space(t.front())) t.remove_prefix(1);
+  while (!t.empty() && is_space(t.back())) t.remove_suffix(1);
+  return t;
+}
+
 void check_params(const SpeechParams& p) {
   if (p.rate_wpm < espeakRATE_MINIMUM || p.rate_wpm > espeakRATE_MAXIMUM) {
     throw SpeechError("speech: rate_wpm " + std::to_string(p.rate_wpm) + " words/min is outside [" +
@@ -156,16 +185,36 @@ std::int64_t steady_ns() {
 
 }  // namespace
 
+std::vector<std::string> speech_pieces(std::string_view text, std::size_t piece_bytes) {
+  const std::size_t max = std::clamp<std::size_t>(piece_bytes, 16, kMaxSpeechPieceBytes);
+  std::vector<std::string> pieces;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t end = sentence_end(text, at);
+    std::string_view sentence = trimmed(text.substr(at, end - at));
+    at = end + 1;
+    while (sentence.size() > max) {
+      const std::size_t cut = word_cut(sentence, max);
+      const std::string_view head = trimmed(sentence.substr(0, cut));
+      if (!head.empty()) pieces.emplace_back(head);
+      sentence = trimmed(sentence.substr(cut));
+    }
+    if (!sentence.empty()) pieces.emplace_back(sentence);
+  }
+  return pieces;
+}
+
 std::vector<float> synthesize_speech(std::string_view text, const SpeechParams& params) {
   check_text(text);
   std::lock_guard<std::mutex> lock(espeak_mutex());
   configure_locked(params);
   std::vector<float> out;
-  if (text.empty()) return out;
-  synthesize_locked(std::string(text), [&](const float* x, std::size_t n) {
-    out.insert(out.end(), x, x + n);
-    return true;
-  });
+  for (const std::string& piece : speech_pieces(text)) {
+    synthesize_locked(piece, [&](const float* x, std::size_t n) {
+      out.insert(out.end(), x, x + n);
+      return true;
+    });
+  }
   return out;
 }
 
@@ -188,23 +237,29 @@ Speaker::~Speaker() {
   worker_.join();
 }
 
-void Speaker::submit(std::string text) {
+void Speaker::submit(std::string text, bool keep) {
   // Under m_, so two concurrent say() calls queue in the order of their generations.
   job_generation_ = stream_.cancel();
+  stream_.set_paused(false);
   has_job_ = !text.empty();
   log_.emplace_back(steady_ns(), text);
   while (log_.size() > kLogEntries) log_.pop_front();
   if (!text.empty()) {
-    last_ = text;
+    if (keep) last_ = text;
     job_text_ = std::move(text);
   }
 }
 
-void Speaker::say(std::string text) {
-  check_text(text);
+void Speaker::say(std::string text, bool keep) {
+  if (text.size() > kMaxSpeechTextBytes) {
+    // Cut where a piece ends, so no word is cut in two; what is left out is said in the log.
+    const std::size_t cut = word_cut(text, kMaxSpeechTextBytes);
+    spdlog::warn("speech: a text of {} bytes is over the limit of {} bytes; the first {} bytes are spoken", text.size(), kMaxSpeechTextBytes, cut);
+    text.resize(cut);
+  }
   {
     std::lock_guard<std::mutex> lock(m_);
-    submit(std::move(text));
+    submit(std::move(text), keep);
   }
   cv_.notify_all();
 }
@@ -213,7 +268,7 @@ void Speaker::repeat() {
   {
     std::lock_guard<std::mutex> lock(m_);
     if (last_.empty()) return;
-    submit(last_);
+    submit(last_, true);
   }
   cv_.notify_all();
 }
@@ -222,10 +277,34 @@ void Speaker::cancel() {
   std::lock_guard<std::mutex> lock(m_);
   has_job_ = false;
   stream_.cancel();
+  stream_.set_paused(false);
 }
+
+void Speaker::forget() {
+  cancel();
+  std::lock_guard<std::mutex> lock(m_);
+  last_.clear();
+}
+
+bool Speaker::pause() {
+  std::lock_guard<std::mutex> lock(m_);
+  if (stream_.paused() || !(working_ || has_job_ || stream_.speaking())) return false;
+  stream_.set_paused(true);
+  return true;
+}
+
+bool Speaker::resume() {
+  std::lock_guard<std::mutex> lock(m_);
+  if (!stream_.paused()) return false;
+  stream_.set_paused(false);
+  return true;
+}
+
+bool Speaker::paused() const { return stream_.paused(); }
 
 bool Speaker::busy() const {
   std::lock_guard<std::mutex> lock(m_);
+  if (stream_.paused()) return false;
   if (working_ || has_job_ || stream_.speaking()) return true;
   return handed_ && handed_generation_ == stream_.generation() &&
          steady_ns() - handed_at_ns_ < static_cast<std::int64_t>(kHandOverGrace * 1e9);
@@ -247,6 +326,38 @@ std::vector<std::pair<std::int64_t, std::string>> Speaker::log() const {
   return {log_.begin(), log_.end()};
 }
 
+std::vector<std::string> Speaker::pieces_spoken() const {
+  std::lock_guard<std::mutex> lock(m_);
+  return {pieces_.begin(), pieces_.end()};
+}
+
+bool Speaker::speak_piece(const std::string& piece, std::uint32_t gen) {
+  const auto retry = std::chrono::duration<double>(kFullRingRetry);
+  {
+    std::lock_guard<std::mutex> lock(espeak_mutex());
+    configure_locked(params_);
+    synthesize_locked(piece, [&](const float* x, std::size_t n) {
+      // Hand the samples to the mixer; when its ring is full, wait for the callback to make room.
+      while (n > 0) {
+        std::size_t taken = 0;
+        const bool ok = stream_.push(gen, x, n, &taken);
+        x += taken;
+        n -= taken;
+        if (ok) break;
+        if (stream_.generation() != gen) return false;  // cancelled: abort espeak-ng now
+        std::this_thread::sleep_for(retry);
+      }
+      return stream_.generation() == gen;
+    });
+  }
+  if (stream_.generation() != gen) return false;
+  spdlog::debug("speech: piece: {}", piece);
+  std::lock_guard<std::mutex> lock(m_);
+  pieces_.push_back(piece);
+  while (pieces_.size() > kLogEntries) pieces_.pop_front();
+  return true;
+}
+
 void Speaker::run() {
   const auto retry = std::chrono::duration<double>(kFullRingRetry);
   for (;;) {
@@ -264,24 +375,14 @@ void Speaker::run() {
     bool finished = false;
     if (gen == stream_.generation()) {
       try {
-        {
-          std::lock_guard<std::mutex> lock(espeak_mutex());
-          configure_locked(params_);
-          synthesize_locked(text, [&](const float* x, std::size_t n) {
-            // Hand the samples to the mixer; when its ring is full, wait for the callback to make room.
-            while (n > 0) {
-              std::size_t taken = 0;
-              const bool ok = stream_.push(gen, x, n, &taken);
-              x += taken;
-              n -= taken;
-              if (ok) break;
-              if (stream_.generation() != gen) return false;  // cancelled: abort espeak-ng now
-              std::this_thread::sleep_for(retry);
-            }
-            return stream_.generation() == gen;
-          });
+        bool whole = true;
+        for (const std::string& piece : speech_pieces(text)) {
+          if (!speak_piece(piece, gen)) {
+            whole = false;
+            break;
+          }
         }
-        while (stream_.generation() == gen) {
+        while (whole && stream_.generation() == gen) {
           if (stream_.finish(gen)) {
             finished = true;
             break;

@@ -51,7 +51,22 @@ bool SpeechStream::finish(std::uint32_t generation) noexcept {
   return true;
 }
 
+std::size_t SpeechStream::read_paused(float* out, std::size_t frames) noexcept {
+  const std::uint32_t gen = generation_.load(std::memory_order_acquire);
+  std::size_t n = 0;
+  while (n < frames && pause_fade_left_ > 0 && have_current_ && current_.generation == gen && offset_ < current_.count) {
+    out[n++] = current_.samples[offset_++] * static_cast<float>(pause_fade_left_) / static_cast<float>(kFadeSamples);
+    --pause_fade_left_;
+  }
+  pause_fade_left_ = 0;  // the fade is over (or there was nothing to fade)
+  if (n < frames) std::memset(out + n, 0, (frames - n) * sizeof(float));
+  speaking_.store(false, std::memory_order_relaxed);
+  return n;
+}
+
 std::size_t SpeechStream::read(float* out, std::size_t frames) noexcept {
+  if (paused_.load(std::memory_order_acquire)) return read_paused(out, frames);
+  pause_fade_left_ = kFadeSamples;
   const std::uint32_t gen = generation_.load(std::memory_order_acquire);
   std::size_t n = 0;
   std::size_t spoken = 0;

@@ -18,11 +18,13 @@ AudioSystem::AudioSystem(const AudioSystemParams& p)
       mixer_(p.mixer, &cues_, &speech_stream_, &volume_, &ui_cues_) {
   SpeechParams sp = p.speech;
   if (sp.voice.empty()) sp.voice = catalog_.voice();
+  speech_params_ = sp;
   try {
     speaker_ = std::make_unique<Speaker>(speech_stream_, sp);
   } catch (const SpeechError& e) {
     spdlog::warn("audio: no speech ({}); the kiosk continues with earcons only", e.what());
   }
+  pulled_ = !p.open_output;
   if (p.open_output) output_ = std::make_unique<AudioOutput>(mixer_, p.output);  // logs its own state
 }
 
@@ -39,8 +41,8 @@ AudioSystem::~AudioSystem() {
 
 void AudioSystem::say(MessageId id, std::initializer_list<MessageArg> args) { say_text(catalog_.text(id, args)); }
 
-void AudioSystem::say_text(std::string text) {
-  if (speaker_) speaker_->say(std::move(text));
+void AudioSystem::say_text(std::string text, bool keep) {
+  if (speaker_) speaker_->say(std::move(text), keep);
 }
 
 void AudioSystem::repeat() {
@@ -51,9 +53,25 @@ void AudioSystem::stop_speech() {
   if (speaker_) speaker_->cancel();
 }
 
+bool AudioSystem::pause_speech() { return speaker_ && speaker_->pause(); }
+
+bool AudioSystem::resume_speech() { return speaker_ && speaker_->resume(); }
+
+double AudioSystem::speech_duration_s(const std::string& text) const {
+  if (!speaker_ || text.empty()) return 0.0;
+  try {
+    return static_cast<double>(synthesize_speech(text, speech_params_).size()) / kSampleRateHz;
+  } catch (const SpeechError& e) {
+    spdlog::warn("audio: {}", e.what());
+    return 0.0;
+  }
+}
+
+bool AudioSystem::speaking() const { return speaker_ && (pulled_ || sound_output()) && speaker_->busy(); }
+
 void AudioSystem::new_session() {
   volume_.reset();
-  stop_speech();
+  if (speaker_) speaker_->forget();
 }
 
 std::vector<std::pair<std::int64_t, std::string>> AudioSystem::speech_log() const {

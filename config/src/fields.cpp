@@ -101,6 +101,12 @@ std::string pin_hash_problem(std::string_view v) {
   return {};
 }
 
+/// The check of [kiosk] quiet_hours (parse_quiet_hours).
+std::string quiet_hours_problem(std::string_view v) {
+  std::string why;
+  return v.empty() || parse_quiet_hours(v, &why) ? std::string{} : why;
+}
+
 /// The check of [operator] open_chord (parse_chord).
 std::string chord_problem(std::string_view v) {
   std::string why;
@@ -132,7 +138,7 @@ constexpr std::array<detail::TableInfo, 11> kTables{{
     {"kiosk", "The visitor's session."},
     {"stick", "Documents from USB sticks: how far a scan goes and how PDF pages are drawn."},
     {"camera", "The camera a visitor puts a picture under: the source, the frame size and when a capture happens."},
-    {"keys", "The key for each of the visitor's actions (O, C and ESCAPE are the operator's)."},
+    {"keys", "The key for each of the visitor's actions (O, C and ESCAPE are never a visitor's)."},
     {"operator", "The operator's panel: how it opens, its PIN (set with 'haptic-kiosk pin set') and its records."},
 }};
 
@@ -237,8 +243,11 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(audio, speech_rate_wpm, FieldGroup::audio, ApplyWhen::restart, 80, 450, "words/min", "Speaking rate."),
     HK_FIELD(audio, buffer_frames, FieldGroup::audio, ApplyWhen::restart, 32, 4096, "frames", "Audio output buffer at 48 kHz (256 = 5.3 ms)."),
     // [kiosk]
-    HK_FIELD(kiosk, timeout_s, FieldGroup::kiosk, ApplyWhen::live, 10, 3600, "s", "No key and no handle motion for this long ends the session."),
-    HK_FIELD(kiosk, warning_s, FieldGroup::kiosk, ApplyWhen::live, 1, 600, "s", "The spoken warning comes this long before the end (at most half the timeout)."),
+    HK_FIELD(kiosk, timeout_s, FieldGroup::kiosk, ApplyWhen::live, 20, 3600, "s", "No key, no handle motion, no contact and no speech for this long ends the session."),
+    HK_FIELD(kiosk, warning_s, FieldGroup::kiosk, ApplyWhen::live, 10, 600, "s", "The spoken warning comes this long before the end (at most half the timeout)."),
+    HK_FIELD(kiosk, attract_every_s, FieldGroup::kiosk, ApplyWhen::live, 0, 3600, "s", "While nobody is there, a short spoken invitation comes this often (0: never)."),
+    HK_FIELD(kiosk, quiet_hours, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
+             "Local times with no spoken invitation, \"HH:MM-HH:MM\" (e.g. \"22:00-07:00\"); empty: none.", {}, &quiet_hours_problem),
     // [stick]
     HK_FIELD(stick, max_depth, FieldGroup::devices, ApplyWhen::restart, 1, 64, "", "Deepest folder of a stick that is entered (its root is 0)."),
     HK_FIELD(stick, max_entries, FieldGroup::devices, ApplyWhen::restart, 10, 1000000, "", "Directory entries looked at per scan of a stick."),
@@ -268,6 +277,10 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(keys, tutorial, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Start the tutorial again.", kKeyNames),
     HK_FIELD(keys, guide, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Guided tour: lead the handle to the next shape not yet touched and round it.", kKeyNames),
     HK_FIELD(keys, capture, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Capture a picture with the camera, guided by voice (any key cancels).", kKeyNames),
+    HK_FIELD(keys, repeat, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Say the last message again, from its start.", kKeyNames),
+    HK_FIELD(keys, pause, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Pause the speech; pressed again, it goes on.", kKeyNames),
+    HK_FIELD(keys, where, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "What is here: the shape under or nearest the hand, and where the hand is.", kKeyNames),
+    HK_FIELD(keys, finish, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Finish: end the visit at once, for the next visitor.", kKeyNames),
     // [operator]
     HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
                 "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),
@@ -568,23 +581,38 @@ void validate_as(const Settings& s, const Source& src) {
   // Each visitor action on its own key: one key cannot do two things, and the help names each action's key.
   // The first pair in table order is reported, attributed to the earlier key and naming the later.
   {
-    const std::array<std::pair<std::string_view, const std::string*>, 11> keys{{
-        {"help", &s.keys.help}, {"next", &s.keys.next}, {"previous", &s.keys.previous},
-        {"describe", &s.keys.describe}, {"finer", &s.keys.finer}, {"coarser", &s.keys.coarser},
-        {"volume_up", &s.keys.volume_up}, {"volume_down", &s.keys.volume_down}, {"tutorial", &s.keys.tutorial},
-        {"guide", &s.keys.guide}, {"capture", &s.keys.capture}}};
+    const auto keys = key_actions(s.keys);
     for (std::size_t i = 0; i < keys.size(); ++i)
       for (std::size_t j = i + 1; j < keys.size(); ++j)
-        if (*keys[i].second == *keys[j].second) {
+        if (keys[i].second == keys[j].second) {
           const std::string earlier = "keys." + std::string(keys[i].first);
           fail(src, earlier,
-               earlier + " = \"" + one_line(*keys[i].second, 80) + "\" is also keys." + std::string(keys[j].first) +
+               earlier + " = \"" + one_line(keys[i].second, 80) + "\" is also keys." + std::string(keys[j].first) +
                    "; each action needs its own key");
         }
   }
 }
 
 }  // namespace detail
+
+std::optional<QuietHours> parse_quiet_hours(std::string_view t, std::string* why) {
+  auto fail = [&](const char* what) -> std::optional<QuietHours> {
+    if (why) *why = what;
+    return std::nullopt;
+  };
+  if (t.empty()) return std::nullopt;
+  auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  auto minute = [&](std::string_view hm) -> int {  // "HH:MM" → minutes, −1 when malformed
+    if (hm.size() != 5 || hm[2] != ':' || !digit(hm[0]) || !digit(hm[1]) || !digit(hm[3]) || !digit(hm[4])) return -1;
+    const int h = (hm[0] - '0') * 10 + (hm[1] - '0'), m = (hm[3] - '0') * 10 + (hm[4] - '0');
+    return h < 24 && m < 60 ? h * 60 + m : -1;
+  };
+  if (t.size() != 11 || t[5] != '-') return fail("must be two times \"HH:MM-HH:MM\", e.g. \"22:00-07:00\"");
+  const int from = minute(t.substr(0, 5)), to = minute(t.substr(6, 5));
+  if (from < 0 || to < 0) return fail("holds a time outside 00:00 to 23:59");
+  if (from == to) return fail("starts and ends at the same time");
+  return QuietHours{from, to};
+}
 
 void validate(const Settings& settings) { detail::validate_as(settings, {"settings", false}); }
 

@@ -13,6 +13,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <tuple>
@@ -481,23 +482,29 @@ struct RuntimeRig {
     fs::remove_all(dir);
   }
   /// What the servo thread does, with the limp model hand the runtime asks for during a tour (no hand
-  /// force: the cursor is not moved in these tests), then the window thread's poll.
-  void run(double seconds) {
+  /// force unless `hand_target_m` is given: then the model hand pulls the handle there), then the window
+  /// thread's poll. Each tick's guide force is kept in guide_n (the trace).
+  void run(double seconds, std::optional<Vec2> hand_target_m = std::nullopt) {
     auto& sim = dynamic_cast<SimulatedPantograph&>(rt->device());
     const double dt = 1.0 / s.haptics.servo_rate_hz;
+    const ModelHandParams hand = hand_params_from(s);
     for (long k = 0, n = static_cast<long>(seconds / dt + 0.5); k < n; ++k) {
       ServoCommand cmd;
       rt->core().step(sim.read(), false, cmd);
       rt->core().publish_display();
+      guide_n.push_back(length(rt->core().display().guide_force_n));
       sim.write_force(cmd.force_n);
-      sim.step(dt, {});
+      sim.step(dt, hand_target_m ? model_hand_force(hand, *hand_target_m, sim.true_position_m(), sim.velocity_m_per_s()) : Vec2{});
       rt->collect();
       if (k % 16 == 0) rt->poll_tour();  // a frame
     }
     rt->poll_tour();
   }
+  std::vector<double> guide_n;  // every tick's guide force [N], from the first run
   std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) { return audio::MessageCatalog::english().text(id, args); }
 };
+
+bool ends_with(const std::string& s, const std::string& tail) { return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0; }
 
 TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) {
   RuntimeRig r;
@@ -506,37 +513,50 @@ TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) 
   r.rt->key_pressed();
   r.rt->guide();
   ASSERT_TRUE(r.rt->tour_running()) << r.rt->last_said();
-  r.run(12.0);
+  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_ask));
+  for (int i = 0; i < 60 && r.rt->tour_running(); ++i) r.run(0.5);
   EXPECT_FALSE(r.rt->tour_running());
   EXPECT_EQ(r.rt->touches().count(), 1);
-  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}}));
+  EXPECT_EQ(r.rt->last_said().rfind("That was shape ", 0), 0u) << "it names what it traced: " << r.rt->last_said();
+  EXPECT_TRUE(ends_with(r.rt->last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}}))) << r.rt->last_said();
   // A key during the next tour stops it, quietly; the Guide key stopping it says so.
   r.rt->key_pressed();
   r.rt->guide();
-  r.run(0.5);
+  r.run(5.0);  // past the announcement: the tour runs
+  ASSERT_TRUE(r.rt->tour_running());
+  ASSERT_FALSE(r.rt->tour_announced());
   r.rt->key_pressed();  // e.g. Describe: its own answer is what the visitor hears
   r.run(0.2);
   EXPECT_FALSE(r.rt->tour_running());
-  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}})) << "nothing said of a tour a key stopped";
+  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_ask)) << "nothing said of a tour a key stopped";
   r.rt->key_pressed();
   r.rt->guide();
-  r.run(0.5);
+  r.run(5.0);
   r.rt->key_pressed();
   r.rt->guide();  // the Guide key again: stops it
   EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_stopped));
   r.run(0.2);
   EXPECT_FALSE(r.rt->tour_running());
+  // A key while the tour is being announced: it never starts.
+  r.rt->key_pressed();
+  r.rt->guide();
+  r.run(0.5);
+  r.rt->key_pressed();
+  const std::size_t from = r.guide_n.size();
+  r.run(8.0);
+  EXPECT_FALSE(r.rt->tour_running());
+  EXPECT_EQ(*std::max_element(r.guide_n.begin() + static_cast<std::ptrdiff_t>(from), r.guide_n.end()), 0.0);
   // The rest, one Guide after another.
   // (A shape may be touched on the way to another: then fewer tours are needed.)
   for (int tours = 0; tours < 4 && r.rt->touches().count() < 5; ++tours) {
     r.rt->key_pressed();
     r.rt->guide();
     ASSERT_TRUE(r.rt->tour_running()) << tours;
-    for (int i = 0; i < 40 && r.rt->tour_running(); ++i) r.run(0.5);
+    for (int i = 0; i < 60 && r.rt->tour_running(); ++i) r.run(0.5);
     EXPECT_FALSE(r.rt->tour_running());
   }
   EXPECT_EQ(r.rt->touches().count(), 5);
-  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_all_touched));
+  EXPECT_TRUE(ends_with(r.rt->last_said(), r.text(audio::MessageId::tour_all_touched))) << r.rt->last_said();
   r.rt->key_pressed();
   r.rt->guide();
   EXPECT_FALSE(r.rt->tour_running());
@@ -546,6 +566,63 @@ TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) 
   EXPECT_EQ(r.rt->touches().count(), 0);
 }
 
+// The tour asks first: "I will guide your hand to a shape. Hold the handle lightly." is said, and the trace
+// of the guide force stays at zero for as long as that takes to say (synthesised at the kiosk's voice and
+// rate), so the pull never comes before the words.
+TEST(GuidedTourRuntime, TheTourAsksFirstAndPullsOnlyOnceThatHasBeenSaid) {
+  RuntimeRig r;
+  ASSERT_EQ(r.rt->show_picture(0), 5);
+  r.run(0.6);
+  const std::size_t asked = r.guide_n.size();
+  r.rt->key_pressed();
+  r.rt->guide();
+  ASSERT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_ask));
+  ASSERT_TRUE(r.rt->tour_announced());
+  const double ask_s = r.rt->audio().speech_duration_s(r.rt->last_said());
+  ASSERT_GT(ask_s, 2.0) << "the announcement is spoken (espeak-ng present)";
+  for (int i = 0; i < 60 && r.rt->tour_running(); ++i) r.run(0.5);
+  const auto first = std::find_if(r.guide_n.begin() + static_cast<std::ptrdiff_t>(asked), r.guide_n.end(), [](double f) { return f > 0.0; });
+  ASSERT_NE(first, r.guide_n.end()) << "the tour pulled at some point";
+  const double first_force_s = static_cast<double>(first - (r.guide_n.begin() + static_cast<std::ptrdiff_t>(asked))) / r.s.haptics.servo_rate_hz;
+  EXPECT_GE(first_force_s, ask_s) << "the first guide force came " << first_force_s << " s after the announcement of " << ask_s << " s began";
+  EXPECT_LE(first_force_s, ask_s + KioskRuntime::kTourAskMargin_s + 0.1) << "and not much later";
+  EXPECT_EQ(r.rt->touches().count(), 1);
+}
+
+// "What is here": the handle pressed against the square from below. Where names it by its number, size and
+// kind, and the hand's place in near / far terms; Describe starts from it.
+TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
+  RuntimeRig r;
+  ASSERT_EQ(r.rt->show_picture(0), 5);
+  const vision::PxToM& px = r.rt->shown().px_to_m;
+  auto at = [&](double u, double v) { return Vec2{px.x_m(u), px.y_m(v)}; };
+  // Up the free corridor between the ellipse and the rotated rectangle, then into the square's bottom side.
+  r.run(2.0, at(360, 230));
+  r.run(1.5, at(355, 100));
+  const ServoDisplayState& d = r.rt->core().display();
+  ASSERT_GE(d.curve, 0) << "the handle rests against a shape";
+  int square = -1;
+  for (std::size_t c = 0; c < r.rt->shown().polylines.size(); ++c) {
+    Vec2 lo{1e9, 1e9}, hi{-1e9, -1e9};
+    for (Vec2 p : r.rt->shown().polylines[c].points_m) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    }
+    if (length(0.5 * (lo + hi) - at(355, 105)) < 0.003) square = static_cast<int>(c);
+  }
+  ASSERT_GE(square, 0);
+  EXPECT_EQ(d.curve, square) << "it is the square the hand presses on";
+  const std::string where = r.rt->where();
+  EXPECT_EQ(where.rfind("Your hand is on shape " + std::to_string(square + 1) + " of 5, a medium closed shape", 0), 0u) << where;
+  EXPECT_NE(where.find("far from you, in the middle."), std::string::npos) << "the square's place: " << where;
+  EXPECT_TRUE(ends_with(where, "It is far from you, in the middle.")) << "the hand's place (below the square, in the far third): " << where;
+  const std::string describe = r.rt->describe();
+  EXPECT_EQ(describe.rfind("5 shapes. Nearest your hand, a medium closed shape far from you, in the middle", 0), 0u) << describe;
+  // The hand away from every shape, near the visitor: the nearest shape, and where the hand is.
+  r.run(2.0, at(360, 230));
+  const std::string near = r.rt->where();
+  EXPECT_EQ(near.rfind("Your hand is near shape ", 0), 0u) << near;
+}
 
 // Tours on real pictures (found 2026-11-26: 13 tours on 9 of the 22 pictures stopped although the hand was
 // relaxed). The press keeps the handle on the wall, so it follows the wall into narrow pockets, slots and

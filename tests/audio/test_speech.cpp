@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -135,7 +136,10 @@ TEST(Speech, ConcurrentCallersAreSerialised) {
   EXPECT_TRUE(speaker.wait_idle(30));
   done = true;
   audio.join();
-  for (std::size_t n : sizes) EXPECT_NEAR(static_cast<double>(n), static_cast<double>(ref), 0.05 * static_cast<double>(ref));
+  // espeak-ng carries a little state from the text it said last: "Hello there." comes out 7 % longer right
+  // after "... because a key is pressed." (the first of kLong's two pieces, which the worker says between
+  // these calls) than fresh. A call run inside another synthesis would give a mix of both, far longer.
+  for (std::size_t n : sizes) EXPECT_NEAR(static_cast<double>(n), static_cast<double>(ref), 0.10 * static_cast<double>(ref));
 }
 
 TEST(Speech, StreamsBeforeTheSentenceIsDone) {
@@ -263,6 +267,161 @@ TEST(Speech, DestroyedWhileSpeakingDoesNotHang) {
   ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy() && !speech.empty(); }, &speech));
   const double expected = static_cast<double>(synthesize_speech(kShort, {}).size());
   EXPECT_NEAR(static_cast<double>(speech.size()), expected, 0.05 * expected);
+}
+
+}  // namespace
+}  // namespace hk::audio
+
+// ── Long text: spoken piece by piece, whatever its length ─────────────────────────────────────────────
+namespace hk::audio {
+namespace {
+
+/// The bytes of `text` but its white space: what the pieces must add up to (a 700-byte run with no space
+/// is cut inside the run, so word boundaries alone would not do).
+std::string letters_of(const std::string& text) {
+  std::string out;
+  for (char c : text)
+    if (!std::isspace(static_cast<unsigned char>(c))) out += c;
+  return out;
+}
+
+std::string joined(const std::vector<std::string>& pieces) {
+  std::string out;
+  for (const std::string& p : pieces) out += p;
+  return out;
+}
+
+bool valid_utf8(const std::string& s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const std::size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    if (n == 0 || i + n > s.size()) return false;
+    for (std::size_t k = 1; k < n; ++k)
+      if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return false;
+    i += n;
+  }
+  return true;
+}
+
+/// A paragraph as a scanned page gives it: ~9 KB, sentences of every length, one run of 1 200 bytes with
+/// no full stop, a line break, and a 700-byte "word" of two-byte letters with no space at all.
+std::string long_paragraph() {
+  std::string t;
+  for (int i = 0; t.size() < 7000; ++i)
+    t += "Sentence " + std::to_string(i) + " of the manual tells how the part number " + std::to_string(1000 + 7 * i) +
+         (i % 5 == 0 ? " fits, and why; then" : " fits.") + " ";
+  t += "\n";
+  for (int i = 0; i < 200; ++i) t += "word" + std::to_string(i) + " ";
+  for (int i = 0; i < 350; ++i) t += "\xC3\xA9";  // é, 700 bytes
+  t += ". The end.";
+  return t;
+}
+
+TEST(SpeechPieces, SentenceSizedPiecesThatAddUpToTheWholeText) {
+  const std::string text = long_paragraph();
+  ASSERT_GT(text.size(), 8000u);
+  const std::vector<std::string> pieces = speech_pieces(text);
+  ASSERT_GT(pieces.size(), 100u);
+  for (const std::string& p : pieces) {
+    EXPECT_FALSE(p.empty());
+    EXPECT_LE(p.size(), kSpeechPieceBytes) << p.substr(0, 60);
+    EXPECT_TRUE(valid_utf8(p)) << "a piece cut inside a UTF-8 sequence: " << p.substr(0, 60);
+    EXPECT_FALSE(std::isspace(static_cast<unsigned char>(p.front())) || std::isspace(static_cast<unsigned char>(p.back())));
+  }
+  EXPECT_EQ(letters_of(joined(pieces)), letters_of(text)) << "every word, in order, none doubled";
+  EXPECT_EQ(pieces[0], "Sentence 0 of the manual tells how the part number 1000 fits, and why;") << "a sentence ends at ';' too";
+  EXPECT_EQ(pieces[1], "then Sentence 1 of the manual tells how the part number 1007 fits.");
+  EXPECT_EQ(pieces.back(), "The end.");
+  // A short text is one piece, as it was.
+  EXPECT_EQ(speech_pieces("Louder."), std::vector<std::string>{"Louder."});
+  EXPECT_TRUE(speech_pieces(" \n\t ").empty());
+}
+
+TEST(SpeechPieces, ALongTextIsSpokenWholeAndInOrder) {
+  const std::string text = long_paragraph();
+  SpeechStream stream;
+  SpeechParams fast;
+  fast.rate_wpm = 450;  // fewer samples to read through; the pieces are the same
+  Speaker speaker(stream, fast);
+  speaker.say(text);  // over the 4 000 bytes espeak-ng is handed at once: never refused
+  EXPECT_EQ(speaker.last_text(), text);
+  // Read as the audio callback would, without keeping the minutes of samples.
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(600);
+  float buf[4096];
+  std::size_t heard = 0;
+  while (speaker.busy() && std::chrono::steady_clock::now() < end) {
+    const std::size_t n = stream.read(buf, 4096);
+    heard += n;
+    if (n == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_FALSE(speaker.busy()) << "not done after 600 s";
+  EXPECT_GT(heard, static_cast<std::size_t>(60 * kSampleRateHz)) << "minutes of speech, not a refusal";
+  EXPECT_EQ(letters_of(joined(speaker.pieces_spoken())), letters_of(text)) << "every word was handed on, in order";
+}
+
+TEST(SpeechPieces, TextOverTheLimitIsCutNotRefused) {
+  SpeechStream stream(4);
+  Speaker speaker(stream, {});
+  std::string huge;
+  while (huge.size() <= kMaxSpeechTextBytes) huge += "many words ";
+  EXPECT_NO_THROW(speaker.say(huge));
+  const std::string kept = speaker.last_text();
+  EXPECT_LE(kept.size(), kMaxSpeechTextBytes);
+  EXPECT_GT(kept.size(), kMaxSpeechTextBytes - 16);
+  EXPECT_EQ(huge.rfind(kept, 0), 0u) << "the start of the text, cut between words";
+  EXPECT_NE(kept.back(), ' ');
+  speaker.cancel();
+}
+
+TEST(SpeechPieces, AnAcknowledgementIsNotKeptForRepeat) {
+  SpeechStream stream;
+  Speaker speaker(stream, {});
+  speaker.say(kLong);
+  speaker.say(kShort, false);
+  EXPECT_EQ(speaker.last_text(), kLong);
+  speaker.forget();
+  EXPECT_EQ(speaker.last_text(), "");
+}
+
+TEST(SpeechPause, PauseHoldsTheSpeechWhereItIsAndResumeGoesOn) {
+  SpeechStream stream;
+  Speaker speaker(stream, {});
+  EXPECT_FALSE(speaker.pause()) << "nothing is being said";
+  speaker.say(kLong);
+  std::vector<float> all, speech;
+  ASSERT_TRUE(pull(stream, all, [&] { return speech.size() > static_cast<std::size_t>(1.0 * kSampleRateHz); }, &speech));
+  ASSERT_TRUE(speaker.pause());
+  EXPECT_TRUE(speaker.paused());
+  EXPECT_FALSE(speaker.busy()) << "paused speech is not being heard";
+  const std::size_t cut = all.size();
+  for (int i = 0; i < 200; ++i) {  // 1 s of audio while paused
+    float buf[kChunk];
+    speech.insert(speech.end(), buf, buf + stream.read(buf, kChunk));
+    all.insert(all.end(), buf, buf + kChunk);
+  }
+  EXPECT_EQ(test::peak(all, cut + SpeechStream::kFadeSamples, all.size()), 0.0) << "silent after the fade";
+  EXPECT_FALSE(speaker.pause()) << "already paused";
+  ASSERT_TRUE(speaker.resume());
+  EXPECT_FALSE(speaker.resume());
+  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy(); }, &speech));
+  // Nothing was dropped: the whole text was heard, in two parts.
+  const double expected = static_cast<double>(synthesize_speech(kLong, {}).size());
+  EXPECT_NEAR(static_cast<double>(speech.size()), expected, 0.05 * expected);
+}
+
+TEST(SpeechPause, ANewTextEndsThePause) {
+  SpeechStream stream;
+  Speaker speaker(stream, {});
+  speaker.say(kLong);
+  std::vector<float> all, speech;
+  ASSERT_TRUE(pull(stream, all, [&] { return !speech.empty(); }, &speech));
+  ASSERT_TRUE(speaker.pause());
+  speaker.say(kShort);
+  EXPECT_FALSE(speaker.paused());
+  speech.clear();
+  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy() && !speech.empty(); }, &speech));
+  const double expected = static_cast<double>(synthesize_speech(kShort, {}).size());
+  EXPECT_NEAR(static_cast<double>(speech.size()), expected, 0.05 * expected + SpeechStream::kFadeSamples);
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ TEST(ConfigRoundTrip, Defaults) {
 /// default, so a field missing from the table (or written or read under the wrong key) comes back as
 /// its default and fails the comparison. kFieldsSetByHand counts the assignments below; the test checks
 /// it against the table, so a field added to Settings and the table but not here fails too.
-constexpr std::size_t kFieldsSetByHand = 116;
+constexpr std::size_t kFieldsSetByHand = 122;
 
 Settings every_field_changed() {
   Settings s;
@@ -119,6 +119,8 @@ Settings every_field_changed() {
   a.buffer_frames = 512;
   s.kiosk.timeout_s = 300;
   s.kiosk.warning_s = 30;
+  s.kiosk.attract_every_s = 45;
+  s.kiosk.quiet_hours = "22:00-07:00";
   auto& st = s.stick;
   st.max_depth = 4;
   st.max_entries = 2000;
@@ -147,6 +149,10 @@ Settings every_field_changed() {
   k.tutorial = "U";
   k.guide = "R";
   k.capture = "ENTER";
+  k.repeat = "A";
+  k.pause = "B";
+  k.where = "E";
+  k.finish = "HOME";
   auto& o = s.operator_;
   o.open_chord = "CTRL+SHIFT+P";
   o.idle_close_s = 120;

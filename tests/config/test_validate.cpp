@@ -104,7 +104,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
-    if (name == "operator.open_chord" || name == "device.serial_path" || name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log") {
+    if (name == "operator.open_chord" || name == "device.serial_path" || name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log" || name == "kiosk.quiet_hours") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -114,7 +114,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 26u);
+  EXPECT_EQ(texts, 31u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -353,6 +353,47 @@ TEST(OperatorPinHash, OnlyAnArgon2idHashOrNothingIsAccepted) {
       EXPECT_EQ(e.key(), "operator.pin_hash");
       EXPECT_NE(std::string(e.what()).find("pin set"), std::string::npos) << e.what();
     }
+  }
+}
+
+}  // namespace
+}  // namespace hk::config
+
+namespace hk::config {
+namespace {
+
+// [kiosk] quiet_hours: two times "HH:MM-HH:MM", possibly across midnight; anything else is refused in one
+// line naming the key.
+TEST(QuietHours, ReadsTwoTimesAndKnowsWhetherAMinuteIsInThem) {
+  const auto night = parse_quiet_hours("22:00-07:00");
+  ASSERT_TRUE(night);
+  EXPECT_EQ(night->first, 22 * 60);
+  EXPECT_EQ(night->second, 7 * 60);
+  EXPECT_TRUE(in_quiet_hours(*night, 23 * 60 + 59));
+  EXPECT_TRUE(in_quiet_hours(*night, 0));
+  EXPECT_TRUE(in_quiet_hours(*night, 6 * 60 + 59));
+  EXPECT_FALSE(in_quiet_hours(*night, 7 * 60));
+  EXPECT_FALSE(in_quiet_hours(*night, 12 * 60));
+  const auto lunch = parse_quiet_hours("12:00-13:30");
+  ASSERT_TRUE(lunch);
+  EXPECT_TRUE(in_quiet_hours(*lunch, 13 * 60 + 29));
+  EXPECT_FALSE(in_quiet_hours(*lunch, 13 * 60 + 30));
+  EXPECT_FALSE(in_quiet_hours(*lunch, 11 * 60 + 59));
+  EXPECT_FALSE(parse_quiet_hours(""));  // none
+  std::string why;
+  for (const char* bad : {"24:00-07:00", "7:00-8:00", "22:00-22:00", "22:00 07:00", "22:60-07:00", "22:00-07:00x", "ab:cd-ef:gh"}) {
+    why.clear();
+    EXPECT_FALSE(parse_quiet_hours(bad, &why)) << bad;
+    EXPECT_FALSE(why.empty()) << bad;
+  }
+  EXPECT_NO_THROW((void)parse_settings("[kiosk]\nquiet_hours = \"\"\n", "k.toml"));
+  EXPECT_NO_THROW((void)parse_settings("[kiosk]\nquiet_hours = \"21:30-06:45\"\n", "k.toml"));
+  try {
+    (void)parse_settings("[kiosk]\nquiet_hours = \"25:00-07:00\"\n", "k.toml");
+    FAIL() << "a time past 23:59 was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "kiosk.quiet_hours");
+    EXPECT_NE(std::string(e.what()).find("00:00 to 23:59"), std::string::npos) << e.what();
   }
 }
 

@@ -4,8 +4,8 @@
     python3 make_pdfs.py
 
 Writes bad/locked.pdf and bad/pages_5000.pdf (need qpdf), bad/page_14400pt.pdf, bad/truncated.pdf,
-bad/empty.pdf, bad/text_named.pdf, bad/title_2000_bytes.pdf, documents/rotated_text.pdf and
-documents/titled.pdf. See bad/IMAGES.md and SOURCES.md.
+bad/empty.pdf, bad/text_named.pdf, bad/title_2000_bytes.pdf, documents/rotated_text.pdf,
+documents/titled.pdf and documents/long_paragraph.pdf (with its text in long_paragraph.txt). See bad/IMAGES.md and SOURCES.md.
 """
 import math
 import os
@@ -99,6 +99,43 @@ def titled(path, title):
     ], info=5)
 
 
+def long_paragraph_text():
+    """About 9 KB of plain English in sentences, the words a test expects to hear in order."""
+    words = []
+    i = 0
+    while len(" ".join(words)) < 9000:
+        i += 1
+        words += ("Sentence %d of this long paragraph tells the visitor how the kiosk reads a page aloud, "
+                  "one piece after another, so that no word is lost." % i).split()
+    return " ".join(words)
+
+
+def long_paragraph(path):
+    """One letter-size page holding one paragraph of ~9 KB (long_paragraph_text) in 7 pt Helvetica, 8.5 pt
+    apart, 150 characters a line: one text block, as a dense page of a manual gives."""
+    lines, line = [], ""
+    for w in long_paragraph_text().split():
+        if len(line) + 1 + len(w) > 150:
+            lines.append(line)
+            line = w
+        else:
+            line = (line + " " + w).strip()
+    lines.append(line)
+    ops = [b"BT /F1 7 Tf 8.5 TL 40 760 Td"]
+    for ln in lines:
+        ops.append(b"(" + ln.encode("ascii") + b") '")
+    ops.append(b"ET")
+    write_pdf(path, [
+        b"<< /Type /Catalog /Pages 2 0 R >>",
+        b"<< /Type /Pages /Count 1 /Kids [3 0 R] >>",
+        b"<< /Type /Page /Parent 2 0 R /MediaBox [0 0 612 792] /Contents 4 0 R /Resources << /Font << /F1 5 0 R >> >> >>",
+        stream(b" ".join(ops)),
+        b"<< /Type /Font /Subtype /Type1 /BaseFont /Helvetica >>",
+    ])
+    with open(os.path.splitext(path)[0] + ".txt", "w") as f:
+        f.write(long_paragraph_text() + "\n")
+
+
 def main():
     os.makedirs("bad", exist_ok=True)
     subprocess.run(["qpdf", "--encrypt", "user", "owner", "256", "--", "documents/horse_and_page.pdf", "bad/locked.pdf"], check=True)
@@ -115,6 +152,7 @@ def main():
         f.write("This is a plain text file with a .pdf name, not a PDF.\n")
     rotated_text("documents/rotated_text.pdf")
     titled("documents/titled.pdf", "A ring, drawn for the hand \u2014 caf\u00e9 edition")
+    long_paragraph("documents/long_paragraph.pdf")
     titled("bad/title_2000_bytes.pdf", "x" * 2000)
 
 

@@ -35,8 +35,11 @@ enum class MessageId : int {
   capture_cut_off_bottom, capture_cut_off_left, capture_cut_off_right, capture_move_left, capture_move_right,
   capture_move_up, capture_move_down, capture_hold_still, captured, captured_one, captured_empty, capture_cancelled,
   capture_failed, capture_timeout,
+  help_brief, place_tutorial, place_picture, place_document, place_capture, key_help, key_next, key_previous, key_describe, key_finer, key_coarser, key_volume_up, key_volume_down,
+  key_tutorial, key_guide, key_capture, key_repeat, key_pause, key_where, key_finish, key_other, this_key, nothing_to_pause, nothing_to_repeat, where_on, where_near,
+  where_none, where_text, sorry, tour_ask, tour_traced, high_contrast_on, high_contrast_off, overlay_on, overlay_off,
 };
-inline constexpr int kMessageCount = 64;
+inline constexpr int kMessageCount = 99;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -50,7 +53,11 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "tour_nothing", "help_camera", "camera_ready", "camera_none", "capture_start", "capture_no_camera", "capture_place",
     "capture_too_dark", "capture_cut_off_top", "capture_cut_off_bottom", "capture_cut_off_left", "capture_cut_off_right",
     "capture_move_left", "capture_move_right", "capture_move_up", "capture_move_down", "capture_hold_still", "captured",
-    "captured_one", "captured_empty", "capture_cancelled", "capture_failed", "capture_timeout"};
+    "captured_one", "captured_empty", "capture_cancelled", "capture_failed", "capture_timeout",
+    "help_brief", "place_tutorial", "place_picture", "place_document", "place_capture", "key_help", "key_next", "key_previous", "key_describe", "key_finer",
+    "key_coarser", "key_volume_up", "key_volume_down", "key_tutorial", "key_guide", "key_capture", "key_repeat", "key_pause", "key_where", "key_finish",
+    "key_other", "this_key", "nothing_to_pause", "nothing_to_repeat", "where_on", "where_near", "where_none", "where_text", "sorry", "tour_ask",
+    "tour_traced", "high_contrast_on", "high_contrast_off", "overlay_on", "overlay_off"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".
@@ -63,10 +70,12 @@ class MessageError : public hk::Error {
 using MessageArg = std::pair<std::string_view, std::string>;
 
 /// The placeholders that name one of the visitor's keys, one per action of the [keys] settings (help, next,
-/// previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide, capture), in that order.
-inline constexpr std::array<std::string_view, 11> kKeyPlaceholders{
+/// previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide, capture, repeat, pause, where,
+/// finish), in that order.
+inline constexpr std::array<std::string_view, 15> kKeyPlaceholders{
     "help_key", "next_key", "previous_key", "describe_key", "finer_key", "coarser_key",
-    "volume_up_key", "volume_down_key", "tutorial_key", "guide_key", "capture_key"};
+    "volume_up_key", "volume_down_key", "tutorial_key", "guide_key", "capture_key",
+    "repeat_key", "pause_key", "where_key", "finish_key"};
 
 /// A key placeholder and the key it stands for, by its settings name: {"help_key", "F1"}. MessageCatalog::text()
 /// puts the spoken form of the key (MessageCatalog::key_name()) in its place.

@@ -46,24 +46,39 @@ class SpeechError : public hk::Error {
   using hk::Error::Error;
 };
 
-/// Longest text spoken at once [bytes of UTF-8]; longer text is refused (a catalogue message is ≤ 1000).
-inline constexpr std::size_t kMaxSpeechTextBytes = 4000;
+/// Most bytes of UTF-8 handed to espeak-ng in one call. A longer text is spoken as several pieces
+/// (speech_pieces), one after the other, so no length a visitor can reach is refused.
+inline constexpr std::size_t kMaxSpeechPieceBytes = 4000;
+/// Longest text spoken [bytes of UTF-8] (1 MiB, about 40 hours of speech): Speaker::say cuts a longer one
+/// at a piece boundary (logged); synthesize_speech refuses it.
+inline constexpr std::size_t kMaxSpeechTextBytes = std::size_t{1} << 20;
+/// The size a piece aims at [bytes]: one sentence, or a run of words of about this size where a sentence
+/// is longer (a paragraph of a scanned page with no full stop).
+inline constexpr std::size_t kSpeechPieceBytes = 400;
 
-/// Blocking: `text` (UTF-8, plain text, not SSML) → mono samples in [−1, 1] at kSampleRateHz, including
-/// espeak-ng's short trailing pause. Empty text → empty result (the parameters are still checked).
-/// Thread-safe: serialised with every other espeak-ng call of the process, so it also waits while a
-/// Speaker synthesises an utterance. Allocates; not for the audio callback. About 600× faster than real
-/// time on a desktop core (6 s of speech in ~10 ms).
+/// Cuts `text` into the pieces it is spoken in, in order: one sentence each (ending at '.', '!', '?', ';' or
+/// ':' followed by white space, or at a line break); a sentence over `piece_bytes` is cut at the last space
+/// before that size (or, with no space, at the last UTF-8 sequence boundary). White space at a cut is
+/// dropped; pieces of white space only are left out. Concatenated with single spaces the pieces give the
+/// text's words in order. `piece_bytes` is clamped to [16, kMaxSpeechPieceBytes]. Allocates.
+std::vector<std::string> speech_pieces(std::string_view text, std::size_t piece_bytes = kSpeechPieceBytes);
+
+/// Blocking: `text` (UTF-8, plain text, not SSML) → mono samples in [−1, 1] at kSampleRateHz, piece by
+/// piece (speech_pieces), including espeak-ng's short trailing pause after each. Empty text → empty result
+/// (the parameters are still checked). Thread-safe: serialised with every other espeak-ng call of the
+/// process, so it also waits while a Speaker synthesises a piece. Allocates; not for the audio callback.
+/// About 600× faster than real time on a desktop core (6 s of speech in ~10 ms).
 /// @throws SpeechError on an unknown voice, rate / pitch out of range, text over kMaxSpeechTextBytes, or
 ///         when espeak-ng cannot be initialised (its data missing) or fails.
 std::vector<float> synthesize_speech(std::string_view text, const SpeechParams& params);
 
-/// The kiosk's speaker: one worker thread synthesises each text into a SpeechStream as it goes (every
-/// ~100 ms of espeak-ng output is resampled and pushed at once, so the first block reaches the mixer long
-/// before the sentence is done). The Speaker is the stream's only producer: one Speaker per stream.
+/// The kiosk's speaker: one worker thread synthesises each text into a SpeechStream as it goes, piece by
+/// piece (speech_pieces; every ~100 ms of espeak-ng output is resampled and pushed at once, so the first
+/// block reaches the mixer long before the sentence is done, and a long text starts as fast as a short one).
+/// The Speaker is the stream's only producer: one Speaker per stream.
 ///
-/// Threads: say / repeat / cancel / busy / last_text / log / wait_idle may be called from any thread
-/// except the audio callback; each takes a short lock and returns in microseconds (wait_idle waits).
+/// Threads: every member but the destructor may be called from any thread except the audio callback; each
+/// takes a short lock and returns in microseconds (wait_idle waits).
 class Speaker {
  public:
   /// Checks the voice and parameters and starts the worker. `stream` must outlive the speaker.
@@ -76,37 +91,53 @@ class Speaker {
   Speaker& operator=(const Speaker&) = delete;
 
   /// Cuts off what is playing or queued (stream.cancel(): the mixer drops it within one audio buffer plus
-  /// SpeechStream::kFadeSamples) and speaks `text` instead. Returns at once: the text is handed to the
-  /// worker. Empty text only cancels (it is logged, but last_text() keeps the previous text).
-  /// @throws SpeechError if text is over kMaxSpeechTextBytes (nothing is cancelled then).
-  void say(std::string text);
+  /// SpeechStream::kFadeSamples), ends a pause, and speaks `text` instead, piece by piece. Returns at once:
+  /// the text is handed to the worker. `keep`: the text becomes last_text(), what repeat() says again (false
+  /// for an acknowledgement such as "Louder." that a visitor asking to hear it again does not mean). Empty
+  /// text only cancels (it is logged, and last_text() keeps the previous text). Never throws for a text's
+  /// length: over kMaxSpeechTextBytes it is cut at the last piece that fits (logged as a warning).
+  void say(std::string text, bool keep = true);
   /// Says last_text() again, from its start (nothing if there was none). Logged like say().
   void repeat();
-  /// Silence now: cancels what is playing and drops what waits. Not logged.
+  /// Silence now: cancels what is playing and drops what waits, and ends a pause. Not logged.
   void cancel();
+  /// cancel(), and last_text() forgotten: a new visitor must not hear the last one's texts again.
+  void forget();
+  /// Holds what is being said where it is (SpeechStream::set_paused: a 2 ms fade, then silence; synthesis
+  /// goes on into the stream's buffer). Returns false, doing nothing, when nothing is being said.
+  bool pause();
+  /// Goes on from where pause() held it. Returns false, doing nothing, when not paused.
+  bool resume();
+  /// Speech is held by pause().
+  bool paused() const;
   /// True while a text waits or is being synthesised, while the stream is speaking() the current
   /// utterance, or for up to kHandOverGrace after the worker finished an utterance (speaking() is only
   /// updated when the mixer reads, so a short utterance could otherwise sit unheard in the ring while
-  /// busy() said false). speaking() is updated only by the consumer: with no audio callback running it
-  /// keeps its last value.
+  /// busy() said false); false while paused. speaking() is updated only by the consumer: with no audio
+  /// callback running it keeps its last value.
   bool busy() const;
   /// Waits until no text waits or is being synthesised (the stream may still play it) or `timeout_s` [s]
   /// passes. Returns false on time-out. For tests and shutdown.
   bool wait_idle(double timeout_s);
-  /// The last non-empty text asked for ("" before the first).
+  /// The last non-empty text asked for with `keep` ("" before the first).
   std::string last_text() const;
   /// Every text passed to say() / repeat(), oldest first, with the std::chrono::steady_clock time it was
   /// asked at [ns since the clock's epoch]; the newest kLogEntries are kept. The "message log" that flow
   /// tests read.
   std::vector<std::pair<std::int64_t, std::string>> log() const;
+  /// Pieces handed whole to the stream since the start, in order, with the text they belong to (its
+  /// position in log(), counted from the start), the newest kLogEntries kept: tests check that a long text
+  /// was spoken whole and in order. Each piece is also logged at spdlog's debug level.
+  std::vector<std::string> pieces_spoken() const;
 
-  static constexpr std::size_t kLogEntries = 256;       ///< entries kept in log()
+  static constexpr std::size_t kLogEntries = 256;       ///< entries kept in log() and pieces_spoken()
   static constexpr double kHandOverGrace = 0.25;        ///< see busy() [s]
   static constexpr double kFullRingRetry = 0.005;       ///< worker's wait when the stream is full [s]
 
  private:
   void run();
-  void submit(std::string text);  // cancels and queues; caller holds m_
+  void submit(std::string text, bool keep);  // cancels and queues; caller holds m_
+  bool speak_piece(const std::string& piece, std::uint32_t gen);  // false: cancelled
 
   SpeechStream& stream_;
   SpeechParams params_;
@@ -116,6 +147,7 @@ class Speaker {
   std::uint32_t job_generation_ = 0;
   std::string job_text_;
   std::deque<std::pair<std::int64_t, std::string>> log_;
+  std::deque<std::string> pieces_;
   std::string last_;
   bool working_ = false;         // the worker is synthesising
   std::uint32_t handed_generation_ = 0;  // the last utterance the worker finished, and when [steady ns]

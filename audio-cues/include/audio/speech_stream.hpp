@@ -39,8 +39,13 @@ class SpeechStream {
   std::uint32_t cancel() noexcept { return generation_.fetch_add(1, std::memory_order_acq_rel) + 1; }
   /// The current generation: blocks with an older one are dropped.
   std::uint32_t generation() const noexcept { return generation_.load(std::memory_order_acquire); }
-  /// True while the consumer is playing (or has queued) samples of the current generation.
+  /// True while the consumer is playing (or has queued) samples of the current generation; false while paused.
   bool speaking() const noexcept { return speaking_.load(std::memory_order_relaxed); }
+  /// Holds the consumer where it is (true: a kFadeSamples fade-out, then silence, nothing dropped) or lets it
+  /// go on from there (false). cancel() does not end a pause: the producer's next utterance does (Speaker).
+  void set_paused(bool paused) noexcept { paused_.store(paused, std::memory_order_release); }
+  /// Held by set_paused(true).
+  bool paused() const noexcept { return paused_.load(std::memory_order_acquire); }
 
   // ---- producer (the speech worker) ---------------------------------------------------------------
   /// Appends samples of utterance `generation`. Returns false if that generation was cancelled (stop
@@ -59,9 +64,12 @@ class SpeechStream {
   std::uint64_t full_waits() const noexcept { return ring_.overflows(); }
 
  private:
+  std::size_t read_paused(float* out, std::size_t frames) noexcept;  // the fade into a pause, then silence
+
   SpscRing<Block> ring_;
   std::atomic<std::uint32_t> generation_{0};
   std::atomic<bool> speaking_{false};
+  std::atomic<bool> paused_{false};
   // producer state
   Block pending_{};
   // consumer state
@@ -70,6 +78,7 @@ class SpeechStream {
   bool have_current_ = false;
   float last_sample_ = 0.0f;
   std::size_t fade_left_ = 0;
+  std::size_t pause_fade_left_ = kFadeSamples;  // fade-out samples left on entering a pause
   std::uint32_t playing_generation_ = 0;
 };
 

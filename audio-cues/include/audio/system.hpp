@@ -54,16 +54,27 @@ class AudioSystem {
 
   /// Speaks message `id` (placeholders filled from `args`), cutting off whatever is being said. Returns at once.
   void say(MessageId id, std::initializer_list<MessageArg> args = {});
-  /// Speaks free text (e.g. a picture description), cutting off whatever is being said.
-  void say_text(std::string text);
-  /// Says the last text again.
+  /// Speaks free text (e.g. a picture description), cutting off whatever is being said. `keep` as
+  /// Speaker::say: false for an acknowledgement that repeat() should pass over. Any length (Speaker::say).
+  void say_text(std::string text, bool keep = true);
+  /// Says the last text kept again, from its start.
   void repeat();
   /// Stops speech now.
   void stop_speech();
+  /// Holds speech where it is (Speaker::pause); false when nothing is being said.
+  bool pause_speech();
+  /// Goes on from the pause (Speaker::resume); false when not paused.
+  bool resume_speech();
+  /// Speech is being said to someone: the speaker is busy, not paused, and its sound reaches a device (or
+  /// the caller pulls render(), open_output false). Without a sound device nobody hears it: false.
+  bool speaking() const;
+  /// How long `text` takes to say [s] at the speaker's voice and rate (synthesised, not played: ~1/600 of
+  /// that in CPU time); 0 without speech. Allocates; not for the audio callback.
+  double speech_duration_s(const std::string& text) const;
   /// Volume one step up / down; false at the limit (the kiosk then says volume_limit).
   bool volume_up() noexcept { return volume_.up(); }
   bool volume_down() noexcept { return volume_.down(); }
-  /// A new visitor: volume back to the operator's default, speech stopped.
+  /// A new visitor: volume back to the operator's default, speech stopped and the last text forgotten.
   void new_session();
 
   /// Headless: pulls `frames` samples of the mix (only when open_output was false; otherwise PortAudio pulls).
@@ -91,6 +102,8 @@ class AudioSystem {
   Mixer mixer_;
   std::unique_ptr<Speaker> speaker_;
   std::unique_ptr<AudioOutput> output_;
+  SpeechParams speech_params_;  // the speaker's
+  bool pulled_ = false;  // open_output was false: the caller pulls render()
 };
 
 }  // namespace hk::audio

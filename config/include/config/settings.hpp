@@ -4,8 +4,12 @@
 /// its allowed range in its comment; `config/load.hpp` reads them from TOML and enforces the ranges.
 /// The TOML table and key of each field are given as [table] key.
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 
 namespace hk::config {
 
@@ -141,8 +145,10 @@ struct AudioSettings {
 
 /// [kiosk] — the visitor's session.
 struct KioskSettings {
-  double timeout_s = 120.0;               ///< key timeout_s, no key and no handle motion for this long ends the session, [10, 3600] s
-  double warning_s = 20.0;                ///< key warning_s, the spoken warning comes this long before the end, [1, 600] s (at most half of timeout_s)
+  double timeout_s = 120.0;               ///< key timeout_s, no key, no handle motion, no contact and no speech for this long ends the session, [20, 3600] s
+  double warning_s = 20.0;                ///< key warning_s, the spoken warning comes this long before the end, [10, 600] s (at most half of timeout_s)
+  double attract_every_s = 30.0;          ///< key attract_every_s, while nobody is there a short spoken invitation comes this often, [0, 3600] s (0 = never)
+  std::string quiet_hours;                ///< key quiet_hours, local times with no invitation, "HH:MM-HH:MM" (may pass midnight: "22:00-07:00"); empty = none
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const KioskSettings&) const = default;
@@ -181,7 +187,7 @@ struct CameraSettings {
 /// [keys] — the key for each of the visitor's actions (issue 5: keys a blind visitor can find). Each value
 /// is one key name: F1..F12, A..Z, 0..9, SPACE, ENTER, TAB, BACKSPACE, LEFT, RIGHT, UP, DOWN, PAGE_UP,
 /// PAGE_DOWN, HOME, END, INSERT, DELETE, MINUS, EQUAL, KP_0..KP_9, KP_ADD, KP_SUBTRACT, KP_ENTER.
-/// O, C and ESCAPE are the operator's (overlay, contrast, quit in windowed mode).
+/// O, C and ESCAPE are never a visitor's (ESCAPE quits in windowed mode).
 struct KeysSettings {
   std::string help = "F1";                ///< key help
   std::string next = "RIGHT";             ///< key next, next picture (next tutorial shape)
@@ -194,10 +200,43 @@ struct KeysSettings {
   std::string tutorial = "T";             ///< key tutorial, start the tutorial again
   std::string guide = "G";                ///< key guide, the guided tour: the handle is led to the next shape not yet touched and round it
   std::string capture = "SPACE";          ///< key capture, capture a picture with the camera, guided by voice (any key cancels)
+  std::string repeat = "R";               ///< key repeat, the last thing said, again from its start
+  std::string pause = "P";                ///< key pause, speech stops where it is; pressed again, it goes on
+  std::string where = "W";                ///< key where, "what is here": the shape under or nearest the hand, and where the hand is
+  std::string finish = "END";             ///< key finish, ends the visit at once (goodbye, defaults restored, waiting for the next visitor)
 
   /// Field-by-field equality; used by round-trip checks.
   bool operator==(const KeysSettings&) const = default;
 };
+
+/// Visitor actions in [keys].
+inline constexpr std::size_t kKeyActionCount = 15;
+
+/// Each [keys] action's name and its key, in table order: help, next, previous, describe, finer, coarser,
+/// volume_up, volume_down, tutorial, guide, capture, repeat, pause, where, finish. The one list that the
+/// validation, the spoken key placeholders (audio::kKeyPlaceholders, the same order) and the window's key map
+/// follow. The views point into `keys`: keep it alive while they are used.
+inline std::array<std::pair<std::string_view, std::string_view>, kKeyActionCount> key_actions(const KeysSettings& k) {
+  return {{{"help", k.help}, {"next", k.next}, {"previous", k.previous}, {"describe", k.describe}, {"finer", k.finer},
+           {"coarser", k.coarser}, {"volume_up", k.volume_up}, {"volume_down", k.volume_down}, {"tutorial", k.tutorial},
+           {"guide", k.guide}, {"capture", k.capture}, {"repeat", k.repeat}, {"pause", k.pause}, {"where", k.where},
+           {"finish", k.finish}}};
+}
+
+/// Quiet hours as minutes after local midnight: from `first` (inclusive) to `second` (exclusive), passing
+/// midnight when second < first.
+using QuietHours = std::pair<int, int>;
+
+/// Reads [kiosk] quiet_hours: "HH:MM-HH:MM" (00:00 to 23:59 each, two digits each; the two times differ).
+/// Empty → nullopt with no error. On a malformed value returns nullopt and, when `why` is given, sets it to
+/// one phrase saying what is wrong.
+std::optional<QuietHours> parse_quiet_hours(std::string_view text, std::string* why = nullptr);
+
+/// Whether `minute_of_day` [0, 1440) lies in `hours`.
+inline bool in_quiet_hours(const QuietHours& hours, int minute_of_day) {
+  return hours.first <= hours.second ? minute_of_day >= hours.first && minute_of_day < hours.second
+                                     : minute_of_day >= hours.first || minute_of_day < hours.second;
+}
 
 /// [operator] — the operator's panel (issue 12): how it is opened, its PIN and where its records go.
 /// Paths left empty are beside the settings file: `<settings>.state` and `<settings>.audit.log`.

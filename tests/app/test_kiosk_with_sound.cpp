@@ -1,0 +1,105 @@
+// The kiosk as a visitor meets it: with a sound device (ALSA's null PCM, so the speaker and the audio
+// callback exist as at a real kiosk), under Xvfb, driven by a script. Describe with the hand on a PDF page
+// whose one paragraph is over 8 000 bytes: the kiosk keeps running (it used to exit on a text over 4 000
+// bytes), the whole paragraph is given to the speaker, and its pieces are spoken in order from its start.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "kiosk_exe.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kData = HK_TEST_DATA_DIR;
+
+int sh(const std::string& cmd) {
+  const int raw = std::system(cmd.c_str());
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+/// The bytes of `text` but its white space.
+std::string letters_of(const std::string& text) {
+  std::string out;
+  for (char c : text)
+    if (!std::isspace(static_cast<unsigned char>(c))) out += c;
+  return out;
+}
+
+/// The text after `marker` on every line of `log` that has it, in order.
+std::vector<std::string> lines_after(const std::string& log, const std::string& marker) {
+  std::vector<std::string> out;
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    const auto at = line.find(marker);
+    if (at != std::string::npos) out.push_back(line.substr(at + marker.size()));
+  }
+  return out;
+}
+
+/// A HOME whose ~/.asoundrc makes ALSA's default PCM the null device: sound "plays" at the real rate and
+/// goes nowhere. The kiosk's PortAudio output opens it as it would a sound card.
+fs::path null_sound_home(const fs::path& dir) {
+  const fs::path home = dir / "home";
+  fs::create_directories(home);
+  std::ofstream(home / ".asoundrc") << "pcm.!default { type null }\nctl.!default { type hw card 0 }\n";
+  return home;
+}
+
+TEST(KioskWithSound, DescribeReadsAnEightKilobyteParagraphWholeAndTheKioskRunsOn) {
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  const fs::path dir = hk::test::fresh_dir("kiosk_sound");
+  fs::create_directories(dir / "stick");
+  fs::copy_file(kData / "documents" / "long_paragraph.pdf", dir / "stick" / "manual.pdf");
+  const std::string paragraph = read(kData / "documents" / "long_paragraph.txt");
+  ASSERT_GT(paragraph.size(), 8000u);
+  // The stick's page comes up by itself; the hand goes to the middle of the page (on the paragraph), then
+  // Describe. 12 s of kiosk time in all.
+  std::ofstream(dir / "script.txt") << "1 wait\n2 cursor 0 0\n120 key describe\n";
+  const fs::path home = null_sound_home(dir);
+  const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 SPDLOG_LEVEL=debug HOME=" + hk::test::quoted(home) +
+                          " timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + std::string(HK_KIOSK_EXE) +
+                          " --library " + hk::test::quoted(kData / "images") + " --stick " + hk::test::quoted(dir / "stick") +
+                          " --script " + hk::test::quoted(dir / "script.txt") + " --screenshot " + hk::test::quoted(dir / "end.png") +
+                          " --frames 720 >" + hk::test::quoted(dir / "log.txt") + " 2>&1";
+  ASSERT_EQ(sh(cmd), 0) << "the kiosk ended: " << read(dir / "log.txt").substr(0, 4000);
+  const std::string log = read(dir / "log.txt");
+  EXPECT_EQ(log.find("audio: no output device"), std::string::npos) << "the null PCM is a sound device: " << log.substr(0, 2000);
+  EXPECT_TRUE(fs::exists(dir / "end.png")) << "it ran to its last frame";
+  // Describe gave the speaker the whole block, every word in order.
+  const std::vector<std::string> said = lines_after(log, "say: ");
+  const std::string want = "Text: " + paragraph.substr(0, paragraph.find_last_not_of("\n") + 1);
+  bool whole = false;
+  for (const std::string& s : said) whole = whole || letters_of(s) == letters_of(want);
+  EXPECT_TRUE(whole) << "no 'say:' line holds the whole paragraph; said " << said.size() << " lines";
+  // The pieces handed to the sound device so far follow the paragraph from its start, in order (the rest
+  // would take minutes to play: the unit tests read a long text through to its end).
+  std::string spoken;
+  bool reading = false;
+  for (const std::string& piece : lines_after(log, "speech: piece: ")) {
+    if (piece.rfind("Text:", 0) == 0) {
+      reading = true;
+      spoken.clear();
+    }
+    if (reading) spoken += piece;
+  }
+  ASSERT_TRUE(reading) << "the reading never started";
+  const std::string heard = letters_of(spoken), whole_text = letters_of(want);
+  EXPECT_GT(heard.size(), 300u) << "more than its first sentence was handed on";
+  EXPECT_EQ(whole_text.rfind(heard, 0), 0u) << "the pieces spoken are the paragraph's start, in order";
+  fs::remove_all(dir);
+}
+
+}  // namespace
