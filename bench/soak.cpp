@@ -200,7 +200,7 @@ class Script {
 int run(const SoakOptions& o) {
   hk::config::Settings s;
   s.kiosk.timeout_s = 20;
-  s.kiosk.warning_s = 5;
+  s.kiosk.warning_s = 10;
   s.haptics.level_mode = o.level_mode;
   hk::app::RuntimeOptions ro;
   ro.library = o.library;

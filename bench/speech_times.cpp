@@ -70,7 +70,8 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; ++i)
     if (std::string(argv[i]) == "--repeats") repeats = std::max(1, std::atoi(argv[i + 1]));
   const hk::audio::MessageCatalog& en = hk::audio::MessageCatalog::english();
-  const auto keys = hk::app::key_args(hk::config::KeysSettings{});
+  const hk::config::KeysSettings shipped;  // key_args views its strings
+  const auto keys = hk::app::key_args(shipped);
 
   std::map<std::string, std::pair<double, std::string>> longest;  // part → (seconds, message key)
   std::vector<std::pair<std::string, double>> all;

@@ -106,9 +106,9 @@ std::string place_words(Vec2 c, Vec2 half) {
   // cannot see it knows only near and far.)
   const int col = c.x < -half.x / 3 ? 0 : (c.x > half.x / 3 ? 2 : 1);
   const int row = c.y > half.y / 3 ? 0 : (c.y < -half.y / 3 ? 2 : 1);
-  static const char* const names[3][3] = {{"at the far left", "far from you, in the middle", "at the far right"},
+  static const char* const names[3][3] = {{"at the far left", "in the far middle", "at the far right"},
                                           {"on the left", "in the middle", "on the right"},
-                                          {"at the near left", "near you, in the middle", "at the near right"}};
+                                          {"at the near left", "in the near middle", "at the near right"}};
   return names[row][col];
 }
 
@@ -131,18 +131,18 @@ ShapeAtHand shape_at_hand(const std::vector<Polyline>& curves, Vec2 hand_m, int 
   return r;
 }
 
-std::string describe_one_shape(const std::vector<Polyline>& curves, std::size_t index, Vec2 half) {
+std::string describe_one_shape(const std::vector<Polyline>& curves, std::size_t index, Vec2 half, bool with_place) {
   const std::vector<Shape> all = shapes_of(curves);
   const auto it = std::find_if(all.begin(), all.end(), [&](const Shape& s) { return s.curve == index; });
   if (it == all.end()) return "an empty shape";
   const Shape& s = *it;
   std::string out = std::string("a ") + size_word(s, half) + (s.closed ? " closed shape" : " line");
-  if (s.inside > 0) out += s.inside == 1 ? " with a smaller shape inside it" : " with " + std::to_string(s.inside) + " smaller shapes inside it";
+  if (s.inside > 0) out += s.inside == 1 ? " with one inside it" : " with " + std::to_string(s.inside) + " inside it";
   if (s.parent >= 0) {
     const Shape& p = all[static_cast<std::size_t>(s.parent)];
-    out += std::string(s.inside > 0 ? ", " : " ") + "inside a " + size_word(p, half) + " closed shape";
+    out += std::string(s.inside > 0 ? ", in a " : " in a ") + size_word(p, half) + " closed shape";
   }
-  return out + ", " + place_words(s.centre_m, half);
+  return with_place ? out + ", " + place_words(s.centre_m, half) : out;
 }
 
 std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half, int max_named, std::optional<Vec2> hand_m) {

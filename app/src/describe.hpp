@@ -17,8 +17,8 @@
 namespace hk::app {
 
 /// Where point `p_m` lies in a workspace of half extents `half_extent_m` [m], in the visitor's terms: the cell
-/// of a 3 x 3 grid, "at the far left", "far from you, in the middle", "at the far right", "on the left", "in
-/// the middle", "on the right", "at the near left", "near you, in the middle", "at the near right".
+/// of a 3 x 3 grid, "at the far left", "in the far middle", "at the far right", "on the left", "in the
+/// middle", "on the right", "at the near left", "in the near middle", "at the near right".
 std::string place_words(Vec2 p_m, Vec2 half_extent_m);
 
 /// The shape under or nearest a hand.
@@ -33,9 +33,10 @@ struct ShapeAtHand {
 /// contact or within `on_within_m` [m]. Cost: O(points).
 ShapeAtHand shape_at_hand(const std::vector<Polyline>& curves, Vec2 hand_m, int contact_curve, double on_within_m = 0.003);
 
-/// One shape, `curves[index]`, for speech: size (as describe_scene), kind, the shapes inside it, the smallest
-/// closed shape it lies inside, and its place: "a small closed shape inside a large closed shape, on the left".
-std::string describe_one_shape(const std::vector<Polyline>& curves, std::size_t index, Vec2 half_extent_m);
+/// One shape, `curves[index]`, for speech: size (as describe_scene), kind, how many shapes lie inside it and
+/// the smallest closed shape it lies in: "a small closed shape with 2 inside it, in a large closed shape"; `with_place`
+/// adds its place (place_words of its bounding-box centre): "..., on the left".
+std::string describe_one_shape(const std::vector<Polyline>& curves, std::size_t index, Vec2 half_extent_m, bool with_place = true);
 
 /// Describes `curves` (workspace metres) in a workspace of half extents `half_extent_m` [m]: how many shapes,
 /// then `max_named` of those inside no other shape (the largest first or, given `hand_m`, the nearest to the

@@ -377,6 +377,10 @@ void KioskFlow::capture_advice(MessageId advice, double now_s) {
 }
 
 void KioskFlow::capture_done(int shapes, double now_s) {
+  guarded("a camera capture", [&] { capture_done_now(shapes, now_s); });
+}
+
+void KioskFlow::capture_done_now(int shapes, double now_s) {
   if (!v_.capturing) return;
   v_.capturing = false;
   activity(now_s);
@@ -452,6 +456,10 @@ void KioskFlow::step_document(int delta, double now_s) {
 }
 
 void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double now_s) {
+  guarded("a USB stick", [&] { stick_inserted_now(documents, now_s); });
+}
+
+void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, double now_s) {
   activity(now_s);
   if (v_.state == KioskState::Attract) v_.state = KioskState::Picture;  // a stick is someone at the kiosk
   if (v_.state == KioskState::Tutorial) v_.state = KioskState::Picture;
@@ -474,6 +482,10 @@ void KioskFlow::stick_refused(const std::string& reason, double now_s) {
 }
 
 void KioskFlow::stick_removed(double now_s) {
+  guarded("taking out a USB stick", [&] { stick_removed_now(now_s); });
+}
+
+void KioskFlow::stick_removed_now(double now_s) {
   const bool browsing = v_.source == KioskSource::Stick;
   v_.stick.clear();
   v_.source = KioskSource::Library;
@@ -489,6 +501,10 @@ void KioskFlow::stick_removed(double now_s) {
 }
 
 void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
+  guarded("a page of a USB stick", [&] { document_ready_now(r, now_s); });
+}
+
+void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
   (void)now_s;
   if (v_.source != KioskSource::Stick || r.document != v_.pending_doc || r.page != v_.pending_page) return;  // superseded
   v_.pending_doc = -1;

@@ -21,9 +21,9 @@
 ///   count as activity, so the time-out never cuts a text being read; with none of them for timeout_s the
 ///   kiosk warns warning_s ahead (naming how to get more time: any key), then says goodbye, restores the
 ///   operator's defaults and returns to Attract; Finish does the same at once;
-/// - nothing a visitor does ends the kiosk: each key press, handle motion and time step runs under one guard
-///   that, on an exception, restores the flow's state as it was before, logs the failure and says one short
-///   sorry line.
+/// - nothing a visitor does ends the kiosk: each key press, handle motion, time step, stick and capture event
+///   runs under one guard that, on an exception, restores the flow's state as it was before, logs the
+///   failure and says one short sorry line.
 ///
 /// USB sticks: a stick inserted (stick_inserted) makes Next / Previous walk its documents and their pages
 /// instead of the picture library. Its first page is loaded at once and announced after a summary of the
@@ -152,6 +152,8 @@ class KioskEffects {
 /// keys of `keys`, for audio::MessageCatalog::text(). The pairs view the strings of `keys`: keep it alive while
 /// they are used. For anything outside the flow that says a message naming keys (e.g. `haptic-kiosk speak`).
 std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings& keys);
+/// Not for a temporary: the pairs would view strings already gone.
+std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings&& keys) = delete;
 
 /// Timing of the flow. Units in names.
 struct KioskFlowParams {
@@ -249,6 +251,11 @@ class KioskFlow {
   template <class Action>
   void guarded(const char* what, Action&& action);  // runs action; on an exception: undo, log, sorry
   void act_on_key(KioskKey k, double now_s, std::string_view key_name);
+  // The bodies of the public entry points of the same names, run under guarded().
+  void stick_inserted_now(const std::vector<StickEntry>& documents, double now_s);
+  void stick_removed_now(double now_s);
+  void document_ready_now(const DocumentResult& result, double now_s);
+  void capture_done_now(int shapes, double now_s);
   bool session_key(KioskKey k, double now_s);  // keys that act the same everywhere; true when handled
   void volume_key(int delta);
   void pause_key();

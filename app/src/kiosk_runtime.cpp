@@ -279,13 +279,13 @@ std::string KioskRuntime::where() {
   if (const TextBlockM* b = text_block_at(shown_.text_blocks, d.handle_m)) {
     const auto index = b - shown_.text_blocks.data();
     return m.text(audio::MessageId::where_text, {{"block", std::to_string(index + 1)}, {"blocks", std::to_string(shown_.text_blocks.size())},
-                                                  {"where", place}, {"text", first_words(b->text, 12)}});
+                                                  {"where", place}, {"text", first_words(b->text, kWhereTextWords)}});
   }
   const ShapeAtHand at = shape_at_hand(shown_.polylines, d.handle_m, d.scene_id == shown_id_ ? d.curve : -1);
   if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}});
   return m.text(at.on ? audio::MessageId::where_on : audio::MessageId::where_near,
                 {{"shape", std::to_string(at.curve + 1)}, {"shapes", std::to_string(shown_.polylines.size())},
-                 {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(at.curve), half_)}, {"where", place}});
+                 {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(at.curve), half_, false)}, {"where", place}});
 }
 
 void KioskRuntime::poll_display_modes() {
@@ -549,7 +549,7 @@ void KioskRuntime::report_tour_end(const ServoDisplayState& d) {
     text = m.text(audio::MessageId::tour_stopped) + " ";
   } else if (d.tour_curve >= 0 && static_cast<std::size_t>(d.tour_curve) < shown_.polylines.size()) {
     text = m.text(audio::MessageId::tour_traced, {{"shape", std::to_string(d.tour_curve + 1)},
-                                                   {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(d.tour_curve), half_)}}) + " ";
+                                                   {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(d.tour_curve), half_, false)}}) + " ";
   }
   const int left = shapes_remaining(*shown_.scene, touches_, tour_params_from(s_));
   if (left == 0) text += m.text(audio::MessageId::tour_all_touched);

@@ -136,6 +136,8 @@ class KioskRuntime final : public KioskEffects {
   bool resume_speech() override { return audio_.resume_speech(); }
   /// Whether the local time of day lies in [kiosk] quiet_hours.
   bool quiet_hours() const override;
+  /// Words of a block of text that Where reads (Describe reads it whole).
+  static constexpr int kWhereTextWords = 8;
   /// "What is here": on a document page, the block of text under the hand (its number and first words);
   /// else the shape the proxy touches or the hand is nearest (describe.hpp shape_at_hand: its number, size,
   /// kind, what lies in it and what it lies in), and where the hand is (place_words).

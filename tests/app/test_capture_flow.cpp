@@ -107,10 +107,12 @@ TEST(CaptureFlow, WithoutACameraTheKeySaysSoAndTheHelpDoesNotNameIt) {
   EXPECT_EQ(fx.said.back(), "There is no camera on this kiosk.");
   EXPECT_FALSE(flow.capturing());
   flow.key(KioskKey::Help, 2.0);
+  flow.key(KioskKey::Help, 2.5);  // the second layer: every key
   EXPECT_EQ(fx.said.back().find("camera"), std::string::npos) << fx.said.back();
   CameraRecorder fx2;
   KioskFlow with = on_picture(fx2, true);
   with.key(KioskKey::Help, 2.0);
+  with.key(KioskKey::Help, 2.5);
   EXPECT_NE(fx2.said.back().find("Press the space bar to feel a picture of your own under the camera."), std::string::npos) << fx2.said.back();
 }
 

@@ -71,13 +71,13 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   EXPECT_EQ(flow.state(), KioskState::Tutorial);
   ASSERT_EQ(fx.said.size(), 1u);
   EXPECT_EQ(fx.said.back().rfind("Welcome.", 0), 0u);
-  EXPECT_NE(fx.said.back().find("First, a square."), std::string::npos);
-  EXPECT_NE(fx.said.back().find("Press F1 at any time for help."), std::string::npos) << "the shipped help key";
-  EXPECT_NE(fx.said.back().find("Press the Right arrow for the next shape."), std::string::npos) << "the shipped next key";
+  EXPECT_NE(fx.said.back().find("to feel a square."), std::string::npos);
+  EXPECT_NE(fx.said.back().find("Press F1 for help."), std::string::npos) << "the shipped help key";
   EXPECT_EQ(fx.shown.back(), "tutorial 0");
 
   flow.key(KioskKey::Next, 20.0);
-  EXPECT_EQ(fx.said.back(), "Now a circle. Follow it all the way round. Press the Right arrow for the next shape, or the Left arrow to go back.");
+  EXPECT_EQ(fx.said.back(), "Now a circle. Far means away from you, near means towards you. Press the Right arrow for the next shape.")
+      << "the tutorial says once what far and near mean (Where and Describe use them)";
   EXPECT_EQ(fx.said.back(), flow.text(audio::MessageId::tutorial_circle));
   EXPECT_EQ(fx.shown.back(), "tutorial 1");
   flow.key(KioskKey::Next, 30.0);
@@ -95,12 +95,14 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   flow.key(KioskKey::Describe, 53.0);
   EXPECT_EQ(fx.said.back(), "4 shapes. A large closed shape in the middle.");
   flow.key(KioskKey::Help, 53.5);
+  flow.key(KioskKey::Help, 53.6);  // the second layer: every key
   EXPECT_EQ(fx.said.back(),
             "Move the handle slowly to feel the outlines. Press the Right arrow for the next picture and the Left arrow for the one "
-            "before. Press the Up arrow for more detail and the Down arrow for less. Press the D key to hear what the picture "
-            "holds. Press Page Up for louder and Page Down for quieter. Press the G key to be led to a shape you have not touched "
-            "yet. Press the T key to practise with the shapes again, and F1 "
-            "to hear this again.")
+            "before. Press the W key to hear what is under your hand, and the D key to hear what the picture holds. Press the R key "
+            "to hear the last message again, and the P key to pause the speech and go on. Press the Up arrow for more detail and "
+            "the Down arrow for less. Press Page Up for louder and Page Down for quieter. Press the G key to be led to a shape you "
+            "have not touched yet. Press the T key to practise with the shapes again, and the End key when you have finished. "
+            "Hold F1 and press another key to learn what it does.")
       << "the help names the shipped keys";
   flow.key(KioskKey::Finer, 54.0);
   EXPECT_EQ(fx.said.back(), "More detail.");
@@ -307,24 +309,24 @@ TEST(Describe, SizesKindsAndPlaces) {
   const std::vector<Polyline> curves{rect({0.06, -0.035}, {0.004, 0.004}), rect({0, 0}, {0.05, 0.03}),
                                      rect({-0.05, 0.03}, {0.006, 0.003}, false)};
   EXPECT_EQ(describe_scene(curves, half),
-            "3 shapes. A large closed shape in the middle, a small line at the top left, and a small closed shape at the bottom right.");
+            "3 shapes. A large closed shape in the middle, a small line at the far left, and a small closed shape at the near right.");
   EXPECT_EQ(describe_scene({curves[1]}, half), "One shape. A large closed shape in the middle.");
   EXPECT_EQ(describe_scene({}, half), "There are no shapes in this picture.");
   std::vector<Polyline> many(6, rect({0.05, 0.03}, {0.002, 0.002}));
   many.push_back(rect({-0.04, 0}, {0.015, 0.01}));
-  EXPECT_EQ(describe_scene(many, half, 2), "7 shapes. A medium closed shape on the left, a small closed shape at the top right, and 5 more, smaller ones.");
+  EXPECT_EQ(describe_scene(many, half, 2), "7 shapes. A medium closed shape on the left, a small closed shape at the far right, and 5 more, smaller ones.");
 }
 
 TEST(Describe, ShapesInsideAClosedShapeAreToldWithIt) {
   const Vec2 half{0.07, 0.045};
-  // A plate at the top left with three holes, and a small line at the bottom right: the holes are told with
+  // A plate at the far left with three holes, and a small line at the near right: the holes are told with
   // the plate.
   const Polyline plate = rect({-0.035, 0.02}, {0.03, 0.02});
   const std::vector<Polyline> holes{rect({-0.05, 0.025}, {0.004, 0.004}), rect({-0.035, 0.015}, {0.005, 0.003}),
                                     rect({-0.02, 0.03}, {0.003, 0.003}, false)};
   std::vector<Polyline> scene{holes[0], plate, holes[1], rect({0.05, -0.035}, {0.003, 0.002}, false), holes[2]};
   EXPECT_EQ(describe_scene(scene, half),
-            "5 shapes. A large closed shape with 3 smaller shapes inside it, at the top left, and a small line at the bottom right.");
+            "5 shapes. A large closed shape with 3 smaller shapes inside it, at the far left, and a small line at the near right.");
   // Nesting at any depth: a face, an eye in it, a pupil in the eye; the eye alone holds one.
   const std::vector<Polyline> face{rect({0, 0}, {0.04, 0.03}), rect({-0.015, 0.01}, {0.008, 0.005}), rect({-0.015, 0.01}, {0.002, 0.002})};
   EXPECT_EQ(describe_scene(face, half), "3 shapes. A large closed shape with 2 smaller shapes inside it, in the middle.");
@@ -337,9 +339,9 @@ TEST(Describe, ShapesInsideAClosedShapeAreToldWithIt) {
   const Polyline in_notch = rect({0.03, 0.02}, {0.005, 0.005});
   const Polyline across = rect({-0.04, 0.0}, {0.006, 0.004});
   EXPECT_EQ(describe_scene({ell, in_notch, across}, half),
-            "3 shapes. A large closed shape in the middle, a small closed shape on the left, and a small closed shape at the top right.");
+            "3 shapes. A large closed shape in the middle, a small closed shape on the left, and a small closed shape at the far right.");
   // Only the largest few named: the rest counted, the nested ones as told.
-  EXPECT_EQ(describe_scene(scene, half, 1), "5 shapes. A large closed shape with 3 smaller shapes inside it, at the top left, and 1 more, smaller.");
+  EXPECT_EQ(describe_scene(scene, half, 1), "5 shapes. A large closed shape with 3 smaller shapes inside it, at the far left, and 1 more, smaller.");
 }
 
 TEST(Describe, FiguresAreGroupsOfTouchingCurves) {

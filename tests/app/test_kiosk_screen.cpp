@@ -93,12 +93,12 @@ TEST(KioskScreen, ScriptedVisitWalksTheFlowAndSaysEachStep) {
   fs::create_directories(dir / "library");
   fs::copy_file(kData / "images" / "horse.png", dir / "library" / "a_horse.png");
   fs::copy_file(kData / "images" / "silhouette_3.png", dir / "library" / "b_silhouette.png");
-  std::ofstream(dir / "kiosk.toml") << "[kiosk]\ntimeout_s = 10\nwarning_s = 1\n";
+  std::ofstream(dir / "kiosk.toml") << "[kiosk]\ntimeout_s = 20\nwarning_s = 10\n";
   std::ofstream(dir / "script.txt") << "# frame action\n1 move\n30 key next\n60 key next\n90 key next\n120 key next\n";
   const std::string exe = HK_KIOSK_EXE;
   ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --config '" + (dir / "kiosk.toml").string() + "' --library '" +
                (dir / "library").string() + "' --script '" + (dir / "script.txt").string() + "' --screenshot '" + (dir / "end.png").string() +
-               "' --frames 760 >'" + (dir / "log.txt").string() + "' 2>&1"),
+               "' --frames 1400 >'" + (dir / "log.txt").string() + "' 2>&1"),
             0)
       << std::ifstream(dir / "log.txt").rdbuf();
   std::ifstream log(dir / "log.txt");
@@ -108,7 +108,7 @@ TEST(KioskScreen, ScriptedVisitWalksTheFlowAndSaysEachStep) {
     if (at != std::string::npos) said.push_back(line.substr(at + 5));
   }
   const std::vector<std::string> want_prefix{"Welcome.", "Now a circle.", "Now a triangle.", "Well done. Here is the first picture. Picture 1 of 2.",
-                                             "Picture 2 of 2.", "Are you still there? The kiosk will start again in 1 seconds.",
+                                             "Picture 2 of 2.", "Are you still there? Press any key for more time. The kiosk starts again in 10 seconds.",
                                              "Thank you for visiting. Goodbye."};
   ASSERT_EQ(said.size(), want_prefix.size()) << std::ifstream(dir / "log.txt").rdbuf();
   for (std::size_t i = 0; i < said.size(); ++i) EXPECT_EQ(said[i].rfind(want_prefix[i], 0), 0u) << said[i];

@@ -35,7 +35,8 @@ TEST(MessageLengths, TheFirstWordsAVisitorHearsAreShort) {
   // Walking up: the welcome is the first speech before any action; the help's first layer is the answer
   // to the first key a lost visitor presses. Both well under the 8 s.
   const audio::MessageCatalog& en = audio::MessageCatalog::english();
-  const auto key_names = key_args(config::KeysSettings{});
+  const config::KeysSettings keys;  // key_args views its strings
+  const auto key_names = key_args(keys);
   for (const audio::MessageId id : {audio::MessageId::welcome, audio::MessageId::help_brief, audio::MessageId::attract}) {
     const std::string text = test::sample_message(en, id, key_names);
     EXPECT_LE(static_cast<double>(audio::synthesize_speech(text, {}).size()) / audio::kSampleRateHz, 7.0) << text;

@@ -38,17 +38,18 @@ TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
   const KioskKey actions[] = {KioskKey::Help,     KioskKey::Next,        KioskKey::Previous,
                               KioskKey::Describe, KioskKey::Finer,       KioskKey::Coarser,
                               KioskKey::VolumeUp, KioskKey::VolumeDown,  KioskKey::Tutorial,
-                              KioskKey::Guide,    KioskKey::Capture};
-  for (int a = 0; a < 11; ++a) {
+                              KioskKey::Guide,    KioskKey::Capture,     KioskKey::Repeat,
+                              KioskKey::Pause,    KioskKey::Where,       KioskKey::Finish};
+  for (int a = 0; a < 15; ++a) {
     for (std::string_view name : config::visitor_key_names()) {
       config::KeysSettings k;
       std::string* slot[] = {&k.help, &k.next, &k.previous, &k.describe, &k.finer, &k.coarser, &k.volume_up, &k.volume_down, &k.tutorial, &k.guide,
-                             &k.capture};
-      for (int b = 0; b < 11; ++b)
+                             &k.capture, &k.repeat, &k.pause, &k.where, &k.finish};
+      for (int b = 0; b < 15; ++b)
         if (b != a && *slot[b] == name) *slot[b] = *slot[a];  // swap: the set stays one key per action
       *slot[a] = std::string(name);
       const auto map = visitor_key_map(k);
-      ASSERT_EQ(map.size(), 11u) << name;
+      ASSERT_EQ(map.size(), 15u) << name;
       const auto it = map.find(glfw_key(std::string(name)));
       ASSERT_NE(it, map.end()) << name;
       EXPECT_EQ(it->second, actions[a]) << name;
@@ -60,10 +61,27 @@ TEST(Keymap, TheChordNeedsExactlyItsModifiers) {
   const config::KeyChord c = *config::parse_chord("CTRL+ALT+O");
   EXPECT_TRUE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT));
   EXPECT_TRUE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_NUM_LOCK)) << "Num Lock is not a modifier";
-  EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, 0)) << "O alone is the overlay's key";
+  EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, 0)) << "O alone is a key like any other";
   EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL));
   EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SHIFT));
   EXPECT_FALSE(chord_pressed(c, GLFW_KEY_P, GLFW_MOD_CONTROL | GLFW_MOD_ALT));
+}
+
+}  // namespace
+}  // namespace hk::app
+
+namespace hk::app {
+namespace {
+
+// A key that does nothing is spoken by its settings name's spoken form: the window finds that name from the
+// key code, for every name the settings know, and for the operator's O, C and Escape.
+TEST(Keymap, EveryKeyCodeFindsItsSettingsName) {
+  for (std::string_view name : config::visitor_key_names()) EXPECT_EQ(key_name_of(glfw_key(std::string(name))), name);
+  EXPECT_EQ(key_name_of(GLFW_KEY_O), "O");
+  EXPECT_EQ(key_name_of(GLFW_KEY_C), "C");
+  EXPECT_EQ(key_name_of(GLFW_KEY_ESCAPE), "ESCAPE");
+  EXPECT_EQ(key_name_of(GLFW_KEY_PRINT_SCREEN), "") << "a key the settings do not name";
+  EXPECT_EQ(key_name_of(GLFW_KEY_UNKNOWN), "");
 }
 
 }  // namespace
