@@ -57,19 +57,14 @@
 #include <poppler/cpp/poppler-page.h>
 
 #include "input_error.hpp"
-
-#if defined(__SANITIZE_ADDRESS__)
-#define HK_PDF_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define HK_PDF_ASAN 1
-#endif
-#endif
-
-extern char** environ;  // the kiosk's environment, passed on to the worker (sanitizer options)
+#include "worker_process.hpp"
 
 namespace hk::vision {
 namespace {
+
+using Writer = worker::WireWriter;
+using Reader = worker::WireReader;
+using worker::WorkerRun;
 
 constexpr std::uint32_t kMagic = 0x44504B48;    // "HKPD"
 constexpr std::uint32_t kMaxWords = 200000;      // words accepted per page
@@ -95,33 +90,6 @@ struct Refusal {
   PdfError::Kind kind;
   std::string problem;
 };
-
-class Writer {
- public:
-  void u8(std::uint8_t v) { buf_.push_back(static_cast<char>(v)); }
-  void u32(std::uint32_t v) { raw(&v, sizeof v); }
-  void i32(std::int32_t v) { raw(&v, sizeof v); }
-  void f64(double v) { raw(&v, sizeof v); }
-  void str(const std::string& s) {
-    u32(static_cast<std::uint32_t>(s.size()));
-    buf_.append(s);
-  }
-  void raw(const void* p, std::size_t n) { buf_.append(static_cast<const char*>(p), n); }
-  const std::string& bytes() const { return buf_; }
-
- private:
-  std::string buf_;
-};
-
-void write_all(int fd, const std::string& s) {
-  std::size_t off = 0;
-  while (off < s.size()) {
-    const ssize_t n = ::write(fd, s.data() + off, s.size() - off);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return;  // the parent gave up on us; nothing else to do
-    off += static_cast<std::size_t>(n);
-  }
-}
 
 void no_poppler_output(const std::string&, void*) {}
 
@@ -260,35 +228,8 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
 }
 
 /// Everything the worker does once its document is mapped; never returns.
-[[noreturn]] void worker_main(int fd, std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits) {
-  // Only the answer pipe stays open: a PDF that takes over poppler finds no kiosk file, socket or device.
-  if (fd > 3) ::syscall(SYS_close_range, 3u, static_cast<unsigned>(fd - 1), 0u);
-  ::syscall(SYS_close_range, static_cast<unsigned>(fd + 1), ~0u, 0u);
-  const int devnull = ::open("/dev/null", O_RDWR | O_CLOEXEC);
-  if (devnull >= 0) {
-    ::dup2(devnull, STDOUT_FILENO);
-#if !defined(HK_PDF_ASAN)
-    ::dup2(devnull, STDERR_FILENO);  // sanitizer builds keep stderr, so a sanitizer report in the worker is seen
-#endif
-    if (devnull > STDERR_FILENO) ::close(devnull);
-  }
-  const auto cpu = static_cast<rlim_t>(std::ceil(std::max(limits.worker_cpu_s, 0.001)));
-  const rlimit cpu_limit{cpu, cpu + 1};  // SIGXCPU at the soft limit, SIGKILL a second later
-  ::setrlimit(RLIMIT_CPU, &cpu_limit);
-#if !defined(HK_PDF_ASAN)
-  if (limits.worker_max_memory_mb > 0) {
-    long pages = 0;
-    if (FILE* f = std::fopen("/proc/self/statm", "r")) {
-      if (std::fscanf(f, "%ld", &pages) != 1) pages = 0;
-      std::fclose(f);
-    }
-    const double inherited = static_cast<double>(pages) * static_cast<double>(::sysconf(_SC_PAGESIZE));
-    const auto as = static_cast<rlim_t>(inherited + limits.worker_max_memory_mb * 1048576.0);
-    const rlimit as_limit{as, as};
-    ::setrlimit(RLIMIT_AS, &as_limit);
-  }
-#endif
-
+[[noreturn]] void worker_main(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits) {
+  worker::confine_worker(limits.worker_cpu_s, limits.worker_max_memory_mb);
   if (limits.fault == PdfFault::Crash) {
     ::signal(SIGSEGV, SIG_DFL);  // not ASan's handler: die of the signal, as an unsanitized crash would
     ::raise(SIGSEGV);
@@ -320,172 +261,34 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
     out.u8(static_cast<std::uint8_t>(PdfError::Kind::Damaged));
     out.str("poppler failed on it");
   }
-  write_all(fd, out.bytes());
+  worker::write_all(worker::kAnswerFd, out.bytes());
   ::_exit(0);
 }
 
 // ---------------------------------------------------------------------------------------------------
 // Parent side.
 
-struct WorkerRun {
-  std::string answer;          // bytes read from the pipe
-  bool timed_out = false;      // the wall-clock deadline passed
-  bool overflow = false;       // the worker sent more than it may
-  int status = 0;              // from wait4
-  double cpu_s = 0.0;          // user + system time of the worker [s]
-  double ms = 0.0;             // wall time [ms]
-  long max_rss_kb = 0;
-};
-
-/// The worker executable: $HK_PDF_WORKER if set; else hk-pdf-worker beside this executable (an installed
-/// kiosk); else the one this build made (tests and bench binaries live elsewhere in the build tree).
-const std::string& worker_path() {
-  static const std::string path = [] {
-    if (const char* env = std::getenv("HK_PDF_WORKER"); env && *env) return std::string(env);
-    char self[4096];
-    const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
-    if (n > 0) {
-      std::string beside(self, static_cast<std::size_t>(n));
-      beside = beside.substr(0, beside.rfind('/') + 1) + "hk-pdf-worker";
-      if (::access(beside.c_str(), X_OK) == 0) return beside;
-    }
+/// Runs the worker on `bytes` for `page` (0: open and count only); a worker that cannot start is a PdfError.
+WorkerRun run_pdf_worker(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits, const std::string& name, std::size_t max_answer) {
 #ifdef HK_PDF_WORKER_PATH
-    return std::string(HK_PDF_WORKER_PATH);
+  static const std::string path = worker::find_worker("HK_PDF_WORKER", "hk-pdf-worker", HK_PDF_WORKER_PATH);
 #else
-    return std::string("hk-pdf-worker");
+  static const std::string path = worker::find_worker("HK_PDF_WORKER", "hk-pdf-worker", "hk-pdf-worker");
 #endif
-  }();
-  return path;
+  const std::vector<std::string> args{std::to_string(page),
+                                      std::to_string(limits.max_pages),
+                                      worker::arg(limits.max_page_pixels),
+                                      worker::arg(limits.max_dpi),
+                                      worker::arg(limits.worker_cpu_s),
+                                      worker::arg(limits.worker_max_memory_mb),
+                                      std::to_string(static_cast<int>(limits.fault)),
+                                      std::to_string(bytes.size())};
+  try {
+    return worker::run_worker(path, args, bytes, limits.worker_wall_s, max_answer);
+  } catch (const worker::WorkerStartFailure& f) {
+    fail(PdfError::Kind::WorkerCrashed, name, "cannot start the reader (" + f.why + ")");
+  }
 }
-
-std::string arg(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
-
-/// A descriptor moved to 10 or above (so dup2 onto 3 and 4 in the child never meets it), close-on-exec.
-int high_fd(int fd) {
-  const int h = ::fcntl(fd, F_DUPFD_CLOEXEC, 10);
-  ::close(fd);
-  return h;
-}
-
-WorkerRun run_worker(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits, const std::string& name, std::size_t max_answer) {
-  auto cannot_start = [&](const char* what, int e) {
-    fail(PdfError::Kind::WorkerCrashed, name, std::string("cannot start the reader (") + what + ": " + std::strerror(e) + ")");
-  };
-  // The document, in memory the worker maps read-only (sealed: it cannot be changed after it is written).
-  const int doc = high_fd(::memfd_create("hk-pdf", MFD_CLOEXEC | MFD_ALLOW_SEALING));
-  if (doc < 0) cannot_start("memfd", errno);
-  std::size_t off = 0;
-  while (off < bytes.size()) {
-    const ssize_t n = ::write(doc, bytes.data() + off, bytes.size() - off);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int e = errno;
-      ::close(doc);
-      cannot_start("memfd write", e);
-    }
-    off += static_cast<std::size_t>(n);
-  }
-  ::fcntl(doc, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_WRITE | F_SEAL_SEAL);
-  int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) {
-    const int e = errno;
-    ::close(doc);
-    cannot_start("pipe", e);
-  }
-  fds[0] = high_fd(fds[0]);
-  fds[1] = high_fd(fds[1]);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_adddup2(&fa, doc, 3);
-  posix_spawn_file_actions_adddup2(&fa, fds[1], 4);
-  const std::string path = worker_path();
-  std::vector<std::string> args{path,
-                                std::to_string(page),
-                                std::to_string(limits.max_pages),
-                                arg(limits.max_page_pixels),
-                                arg(limits.max_dpi),
-                                arg(limits.worker_cpu_s),
-                                arg(limits.worker_max_memory_mb),
-                                std::to_string(static_cast<int>(limits.fault)),
-                                std::to_string(bytes.size())};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const auto t0 = std::chrono::steady_clock::now();
-  pid_t pid = -1;
-  const int rc = ::posix_spawn(&pid, path.c_str(), &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  ::close(doc);
-  ::close(fds[1]);
-  if (rc != 0) {
-    ::close(fds[0]);
-    cannot_start(path.c_str(), rc);
-  }
-
-  WorkerRun run;
-  const auto deadline = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(limits.worker_wall_s));
-  char buf[1 << 16];
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
-    if (left <= 0) {
-      run.timed_out = true;
-      break;
-    }
-    pollfd p{fds[0], POLLIN, 0};
-    const int rc = ::poll(&p, 1, static_cast<int>(std::min<long long>(left, INT_MAX)));
-    if (rc < 0 && errno == EINTR) continue;
-    if (rc < 0) break;
-    if (rc == 0) continue;  // the loop head sees the deadline
-    const ssize_t n = ::read(fds[0], buf, sizeof buf);
-    if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
-    if (n <= 0) break;  // EOF: the worker has finished or died
-    if (run.answer.size() + static_cast<std::size_t>(n) > max_answer) {
-      run.overflow = true;
-      break;
-    }
-    run.answer.append(buf, static_cast<std::size_t>(n));
-  }
-  ::kill(pid, SIGKILL);  // in every case: a worker that closed its pipe but lives on is not left behind
-  ::close(fds[0]);
-  rusage ru{};
-  while (::wait4(pid, &run.status, 0, &ru) < 0 && errno == EINTR) {
-  }
-  run.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  run.max_rss_kb = ru.ru_maxrss;
-  run.cpu_s = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-  return run;
-}
-
-class Reader {
- public:
-  explicit Reader(const std::string& s) : s_(s) {}
-  bool u8(std::uint8_t& v) { return raw(&v, 1); }
-  bool u32(std::uint32_t& v) { return raw(&v, sizeof v); }
-  bool i32(std::int32_t& v) { return raw(&v, sizeof v); }
-  bool f64(double& v) { return raw(&v, sizeof v) && std::isfinite(v); }
-  bool str(std::string& v, std::uint32_t max) {
-    std::uint32_t n = 0;
-    if (!u32(n) || n > max || n > left()) return false;
-    v.assign(s_.data() + pos_, n);
-    pos_ += n;
-    return true;
-  }
-  bool raw(void* p, std::size_t n) {
-    if (n > left()) return false;
-    std::memcpy(p, s_.data() + pos_, n);
-    pos_ += n;
-    return true;
-  }
-  std::size_t left() const { return s_.size() - pos_; }
-
- private:
-  const std::string& s_;
-  std::size_t pos_ = 0;
-};
 
 /// Where the worker was when it stopped, for messages: "page 3" or "opening it".
 std::string doing(int page) { return page == 0 ? "opening the document" : "page " + std::to_string(page); }
@@ -560,7 +363,6 @@ bool looks_like_pdf(std::span<const std::uint8_t> bytes) {
 }
 
 int pdf_worker_entry(int argc, char** argv) {
-  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (argc != 9) return 64;
   PdfLimits limits;
   const int page = std::atoi(argv[1]);
@@ -572,16 +374,14 @@ int pdf_worker_entry(int argc, char** argv) {
   const int fault = std::atoi(argv[7]);
   limits.fault = fault == 1 ? PdfFault::Crash : fault == 2 ? PdfFault::Hang : PdfFault::None;
   const auto size = static_cast<std::size_t>(std::strtoull(argv[8], nullptr, 10));
-  struct stat st {};
-  if (::fstat(3, &st) != 0 || static_cast<std::size_t>(st.st_size) != size || size == 0) return 65;
-  void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, 3, 0);
-  if (map == MAP_FAILED) return 66;
-  worker_main(4, std::span<const std::uint8_t>(static_cast<const std::uint8_t*>(map), size), page, limits);
+  const std::span<const std::uint8_t> bytes = worker::map_input(size);
+  if (bytes.empty()) return 65;
+  worker_main(bytes, page, limits);
 }
 
 PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits) {
   check_input(bytes, name, limits);
-  const WorkerRun run = run_worker(bytes, 0, limits, name, 64 * 1024);
+  const WorkerRun run = run_pdf_worker(bytes, 0, limits, name, 64 * 1024);
   Reader in(run.answer);
   read_head(in, run, name, 0, limits);
   std::int32_t n = 0;
@@ -599,7 +399,7 @@ PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& 
   check_input(bytes, name, limits);
   if (page < 1) fail(PdfError::Kind::NoSuchPage, name, "page " + std::to_string(page) + " does not exist (pages count from 1)");
   const std::size_t max_answer = 1024 + static_cast<std::size_t>(std::min(limits.max_page_pixels, 1e10)) + kMaxTextBytes + 2 * (kMaxWordBytes + 40);
-  const WorkerRun run = run_worker(bytes, page, limits, name, max_answer);
+  const WorkerRun run = run_pdf_worker(bytes, page, limits, name, max_answer);
   Reader in(run.answer);
   read_head(in, run, name, page, limits);
   std::int32_t n = 0, w = 0, h = 0;

@@ -1,0 +1,109 @@
+#pragma once
+/// @file ocr.hpp
+/// Text in pictures of pages, read with Tesseract (OCR), so that a scan, a photo of a page or a PDF whose
+/// pages are images is read aloud instead of felt as bumps.
+///
+/// Tesseract is a large engine run on a stranger's pixels: it runs only in the worker executable
+/// hk-ocr-worker (worker_process.hpp: posix_spawn, the pixels in a sealed memfd, RLIMIT_CPU and RLIMIT_AS,
+/// a wall-clock kill), so a page that crashes, hangs or exhausts it costs the text, never the kiosk. The
+/// worker is found as $HK_OCR_WORKER, else beside the running executable, else where the build put it.
+///
+/// In the worker: tesseract::TessBaseAPI with the LSTM engine and automatic page segmentation on the grey
+/// pixels; the layout read back with its ResultIterator at block, paragraph, line and word level (boxes and
+/// confidences). A word below the confidence threshold is dropped (never speak garbage); a paragraph with
+/// none left, or whose words are mostly not letters or digits, is dropped; the rest are the text blocks, in
+/// Tesseract's reading order.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "hk/error.hpp"
+
+namespace hk::vision {
+
+/// Test hook: the worker fails on purpose as soon as it has started. Never set outside tests.
+enum class OcrFault {
+  None,    ///< normal work
+  Crash,   ///< dies of SIGSEGV
+  Hang,    ///< spins on the CPU until a limit stops it
+  Memory,  ///< allocates until RLIMIT_AS refuses (reported as out of memory)
+};
+
+/// What OCR is asked to do, and its limits. Units in names.
+struct OcrParams {
+  /// Tesseract languages, '+'-joined ("eng", "eng+deu"): each needs LANG.traineddata in the data folder.
+  std::string languages = "eng";
+  /// Tesseract's data folder; empty: Tesseract's own default (Debian: /usr/share/tesseract-ocr/5/tessdata).
+  std::string tessdata_dir;
+  double min_word_confidence = 0.6;   ///< a word below this (Tesseract's confidence / 100, [0, 1]) is dropped
+  double min_letter_share = 0.5;      ///< a block whose characters are less than this share letters or digits is dropped
+  double max_pixels = 4e7;            ///< a larger picture is refused before the worker starts [px]
+  double worker_cpu_s = 30.0;         ///< RLIMIT_CPU of the worker [s]
+  double worker_wall_s = 30.0;        ///< the worker is killed after this wall-clock time [s]
+  double worker_max_memory_mb = 1536.0;  ///< address space the worker may add at start [MiB] (not under ASan); 0 = no limit
+  OcrFault fault = OcrFault::None;    ///< test hook only
+};
+
+/// One word Tesseract read, in the picture's pixels (u right, v down, origin at the top-left pixel's corner).
+struct OcrWord {
+  std::string text;      ///< UTF-8
+  cv::Rect2d box_px;     ///< bounding box [px]
+  double confidence = 0; ///< [0, 1]
+};
+
+/// A block of text (one of Tesseract's paragraphs), in reading order.
+struct OcrBlock {
+  cv::Rect2d box_px;      ///< union of its kept words' boxes [px]
+  std::string text;       ///< its kept words, line by line, joined by single spaces
+  double confidence = 0;  ///< mean confidence of its kept words, [0, 1]
+  int lines = 0;          ///< lines with a kept word
+};
+
+/// What OCR found in one picture.
+struct OcrResult {
+  std::vector<OcrWord> words;    ///< every kept word (in the blocks), in reading order
+  std::vector<OcrBlock> blocks;  ///< the text blocks
+  int words_seen = 0;            ///< words Tesseract read, kept or not
+  double mean_confidence = 0;    ///< over the kept words, [0, 1]; 0 when none
+  double ms = 0;                 ///< wall time of the worker [ms]
+  long worker_max_rss_kb = 0;    ///< the worker's peak resident memory [KiB]
+};
+
+/// OCR could not run or gave no usable answer. what() is one line: "ocr '<name>': <problem>".
+class OcrError : public hk::Error {
+ public:
+  /// Unavailable: a language's traineddata is missing, or the engine cannot start; TooLarge: the picture or
+  /// the worker's memory; Timeout: wall-clock or CPU limit; WorkerCrashed: the worker died or answered badly.
+  enum class Kind { Unavailable, TooLarge, Timeout, WorkerCrashed };
+  OcrError(Kind kind, const std::string& what) : hk::Error(what), kind_(kind) {}
+  Kind kind() const { return kind_; }
+
+ private:
+  Kind kind_;
+};
+
+/// Whether every language of `params` has its traineddata: "" when it does, else one line naming the
+/// missing file and the folder looked in, e.g. "Tesseract has no 'fra' (no fra.traineddata in
+/// /usr/share/tesseract-ocr/5/tessdata)". Also refuses a malformed language list.
+std::string ocr_languages_problem(const OcrParams& params);
+
+/// Reads the text of `grey` (CV_8UC1, the picture at the resolution to read it at) in a worker.
+/// @param name how to name the picture in errors (made printable on one line)
+/// @throws OcrError as its kinds say; std::invalid_argument for an empty or non-CV_8UC1 picture or a limit
+///         that is not positive.
+OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const OcrParams& params);
+
+/// Whether `grey` looks like a page of text, judged from the picture alone: binarised (Otsu), its dark
+/// connected components of letter size (height 0.6–6 % of the shorter side, not much wider than 3 heights)
+/// number at least 60, are at least 40 % of all components, and half of them stand on a line shared with
+/// two others (bottoms within a fifth of the median letter height). Photographs and silhouettes have few
+/// such runs. Cost: one threshold and one connected-component pass.
+bool looks_like_text_page(const cv::Mat& grey);
+
+/// Entry point of the worker executable (vision/worker/ocr_worker_main.cpp), not for other callers.
+int ocr_worker_entry(int argc, char** argv);
+
+}  // namespace hk::vision

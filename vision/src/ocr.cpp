@@ -1,0 +1,189 @@
+// OCR in a worker process: the kiosk's side (vision/ocr.hpp for the contract, ocr_wire.hpp for the request,
+// vision/worker/ocr_engine.cpp for the worker and its answer), and the page-of-text test.
+#include "vision/ocr.hpp"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hk/text.hpp"
+#include "ocr_wire.hpp"
+#include "worker_process.hpp"
+
+namespace hk::vision {
+namespace {
+
+constexpr std::uint32_t kMaxWords = 200000;      // words accepted per picture
+constexpr std::uint32_t kMaxWordBytes = 1024;    // UTF-8 bytes accepted per word
+constexpr std::uint32_t kMaxProblemBytes = 512;  // bytes accepted in a worker's refusal
+constexpr std::size_t kMaxAnswerBytes = 64u << 20;
+
+[[noreturn]] void fail(OcrError::Kind kind, const std::string& name, const std::string& problem) {
+  throw OcrError(kind, "ocr '" + hk::one_line(name) + "': " + problem);
+}
+
+/// Throws the OcrError for a worker that gave no complete answer.
+[[noreturn]] void fail_run(const worker::WorkerRun& run, const std::string& name, const OcrParams& p) {
+  const double cpu_limit = std::ceil(std::max(p.worker_cpu_s, 0.001));
+  if (run.timed_out) fail(OcrError::Kind::Timeout, name, "reading the text took longer than " + worker::arg(p.worker_wall_s) + " s");
+  if (run.overflow) fail(OcrError::Kind::WorkerCrashed, name, "the text reader sent an oversized answer");
+  if (WIFSIGNALED(run.status)) {
+    const int sig = WTERMSIG(run.status);
+    if (sig == SIGXCPU || (sig == SIGKILL && run.cpu_s >= cpu_limit)) {
+      fail(OcrError::Kind::Timeout, name, "reading the text used more than " + worker::arg(cpu_limit) + " s of processor time");
+    }
+    fail(OcrError::Kind::WorkerCrashed, name, "the text reader stopped (signal " + std::to_string(sig) + ")");
+  }
+  if (WIFEXITED(run.status) && WEXITSTATUS(run.status) != 0) {
+    fail(OcrError::Kind::WorkerCrashed, name, "the text reader stopped (exit status " + std::to_string(WEXITSTATUS(run.status)) + ")");
+  }
+  fail(OcrError::Kind::WorkerCrashed, name, "the text reader gave no usable answer");
+}
+
+void check_params(const cv::Mat& grey, const OcrParams& p) {
+  if (grey.empty() || grey.type() != CV_8UC1) throw std::invalid_argument("recognise_text: the picture must be a non-empty CV_8UC1 image");
+  if (!(p.max_pixels > 0 && p.worker_cpu_s > 0 && p.worker_wall_s > 0 && p.worker_max_memory_mb >= 0 && p.min_word_confidence >= 0 &&
+        p.min_word_confidence <= 1 && p.min_letter_share >= 0 && p.min_letter_share <= 1)) {
+    throw std::invalid_argument("OcrParams: limits must be positive and shares within [0, 1]");
+  }
+}
+
+/// The picture's rows, packed (the worker reads width x height bytes).
+std::vector<std::uint8_t> packed(const cv::Mat& grey) {
+  std::vector<std::uint8_t> px(static_cast<std::size_t>(grey.cols) * static_cast<std::size_t>(grey.rows));
+  for (int y = 0; y < grey.rows; ++y) std::copy_n(grey.ptr<std::uint8_t>(y), grey.cols, px.data() + static_cast<std::size_t>(y) * grey.cols);
+  return px;
+}
+
+/// Reads one block of the answer into `out` (its words appended to out.words, the block to out.blocks).
+bool read_block(worker::WireReader& in, OcrResult& out, double& confidence_sum) {
+  std::uint32_t lines = 0, words = 0;
+  if (!in.u32(lines) || !in.u32(words) || words == 0 || words > kMaxWords || out.words.size() + words > kMaxWords) return false;
+  OcrBlock b;
+  b.lines = static_cast<int>(lines);
+  double block_sum = 0;
+  for (std::uint32_t i = 0; i < words; ++i) {
+    OcrWord w;
+    if (!in.str(w.text, kMaxWordBytes) || !in.f64(w.box_px.x) || !in.f64(w.box_px.y) || !in.f64(w.box_px.width) || !in.f64(w.box_px.height) ||
+        !in.f64(w.confidence) || w.confidence < 0 || w.confidence > 1 || w.box_px.width < 0 || w.box_px.height < 0) {
+      return false;
+    }
+    b.box_px = i == 0 ? w.box_px : (b.box_px | w.box_px);
+    b.text += (i == 0 ? "" : " ") + w.text;
+    block_sum += w.confidence;
+    out.words.push_back(std::move(w));
+  }
+  b.confidence = block_sum / words;
+  confidence_sum += block_sum;
+  out.blocks.push_back(std::move(b));
+  return true;
+}
+
+}  // namespace
+
+std::string ocr_languages_problem(const OcrParams& p) {
+  if (p.languages.empty() || p.languages.size() > 200) return "the OCR languages must be 1 to 200 characters, e.g. \"eng\" or \"eng+deu\"";
+  const std::string dir = p.tessdata_dir.empty() ? std::string("/usr/share/tesseract-ocr/5/tessdata") : p.tessdata_dir;
+  std::size_t from = 0;
+  while (from <= p.languages.size()) {
+    const std::size_t plus = std::min(p.languages.find('+', from), p.languages.size());
+    const std::string lang = p.languages.substr(from, plus - from);
+    const bool name_ok = !lang.empty() && lang.size() <= 32 && std::all_of(lang.begin(), lang.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+    });
+    if (!name_ok) return "'" + hk::one_line(p.languages, 80) + "' is not a '+'-joined list of Tesseract languages, e.g. \"eng+deu\"";
+    const std::string file = dir + "/" + lang + ".traineddata";
+    if (::access(file.c_str(), R_OK) != 0) return "Tesseract has no '" + lang + "' (no " + lang + ".traineddata in " + hk::one_line(dir, 200) + ")";
+    from = plus + 1;
+  }
+  return {};
+}
+
+OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const OcrParams& p) {
+  check_params(grey, p);
+  const double pixels = static_cast<double>(grey.cols) * grey.rows;
+  if (pixels > p.max_pixels) {
+    fail(OcrError::Kind::TooLarge, name, std::to_string(grey.cols) + " x " + std::to_string(grey.rows) + " pixels is over the limit of " +
+                                             worker::arg(p.max_pixels));
+  }
+  if (const std::string why = ocr_languages_problem(p); !why.empty()) fail(OcrError::Kind::Unavailable, name, why);
+#ifdef HK_OCR_WORKER_PATH
+  static const std::string path = worker::find_worker("HK_OCR_WORKER", "hk-ocr-worker", HK_OCR_WORKER_PATH);
+#else
+  static const std::string path = worker::find_worker("HK_OCR_WORKER", "hk-ocr-worker", "hk-ocr-worker");
+#endif
+  worker::WorkerRun run;
+  try {
+    run = worker::run_worker(path, ocr_request_args(grey.cols, grey.rows, p), packed(grey), p.worker_wall_s, kMaxAnswerBytes);
+  } catch (const worker::WorkerStartFailure& f) {
+    fail(OcrError::Kind::WorkerCrashed, name, "cannot start the text reader (" + f.why + ")");
+  }
+  worker::WireReader in(run.answer);
+  std::uint32_t magic = 0;
+  std::uint8_t status = 0;
+  if (!in.u32(magic) || magic != kOcrMagic || !in.u8(status) || status > 1) fail_run(run, name, p);
+  if (status == 1) {
+    std::uint8_t kind = 0;
+    std::string problem;
+    if (!in.u8(kind) || kind > static_cast<std::uint8_t>(OcrError::Kind::WorkerCrashed) || !in.str(problem, kMaxProblemBytes)) fail_run(run, name, p);
+    fail(static_cast<OcrError::Kind>(kind), name, hk::one_line(problem, kMaxProblemBytes));
+  }
+  OcrResult out;
+  std::uint32_t seen = 0, blocks = 0;
+  if (!in.u32(seen) || !in.u32(blocks) || seen > kMaxWords || blocks > seen) fail_run(run, name, p);
+  out.words_seen = static_cast<int>(seen);
+  double confidence_sum = 0;
+  for (std::uint32_t i = 0; i < blocks; ++i)
+    if (!read_block(in, out, confidence_sum)) fail_run(run, name, p);
+  if (in.left() != 0) fail_run(run, name, p);
+  out.mean_confidence = out.words.empty() ? 0.0 : confidence_sum / static_cast<double>(out.words.size());
+  out.ms = run.ms;
+  out.worker_max_rss_kb = run.max_rss_kb;
+  return out;
+}
+
+bool looks_like_text_page(const cv::Mat& grey) {
+  if (grey.empty() || grey.type() != CV_8UC1) return false;
+  cv::Mat ink;
+  cv::threshold(grey, ink, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(ink, labels, stats, centroids, 8, CV_32S);
+  const double side = std::min(grey.cols, grey.rows);
+  struct Letter {
+    int bottom, left, right, height;
+  };
+  std::vector<Letter> letters;  // letter-sized components, by bottom
+  for (int i = 1; i < n; ++i) {
+    const int x = stats.at<int>(i, cv::CC_STAT_LEFT), y = stats.at<int>(i, cv::CC_STAT_TOP);
+    const int w = stats.at<int>(i, cv::CC_STAT_WIDTH), h = stats.at<int>(i, cv::CC_STAT_HEIGHT);
+    if (h >= 0.006 * side && h <= 0.06 * side && w <= 3 * h) letters.push_back({y + h, x, x + w, h});
+  }
+  if (letters.size() < 60 || static_cast<double>(letters.size()) < 0.4 * (n - 1)) return false;
+  std::vector<int> heights;
+  for (const Letter& l : letters) heights.push_back(l.height);
+  std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2), heights.end());
+  const double median = heights[heights.size() / 2];
+  const double tolerance = std::max(1.0, 0.2 * median);
+  std::sort(letters.begin(), letters.end(), [](const Letter& a, const Letter& b) { return a.bottom < b.bottom; });
+  // A letter on a line has two others standing on the same baseline within two letter heights of it.
+  std::size_t on_lines = 0;
+  for (std::size_t i = 0, from = 0; i < letters.size(); ++i) {
+    while (letters[i].bottom - letters[from].bottom > tolerance) ++from;
+    int beside = 0;
+    for (std::size_t j = from; j < letters.size() && letters[j].bottom - letters[i].bottom <= tolerance && beside < 2; ++j) {
+      if (j == i) continue;
+      const int gap = std::max(letters[j].left - letters[i].right, letters[i].left - letters[j].right);
+      beside += gap <= 2 * median;
+    }
+    on_lines += beside >= 2;
+  }
+  return 2 * on_lines >= letters.size();
+}
+
+}  // namespace hk::vision
