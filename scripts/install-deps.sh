@@ -8,7 +8,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libembree-dev
   libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev sox
   libglfw3-dev libimgui-dev libgl-dev libgl1-mesa-dri xvfb xauth
-  libpoppler-cpp-dev libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev
+  libpoppler-cpp-dev libtesseract-dev tesseract-ocr-eng tesseract-ocr-deu libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev
   poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools
   dpkg-dev file lintian systemd cage
   clang libclang-rt-14-dev llvm-14

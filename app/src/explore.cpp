@@ -62,12 +62,15 @@ json scene_json(const ImageScene& is, const config::Settings& s) {
     curves.push_back({{"id", c}, {"closed", ci.closed}, {"levels", std::move(levels)}});
   }
   j["curves"] = std::move(curves);
-  if (is.page > 0) {  // a document page: its text is spoken, not felt
+  if (is.page > 0) {
     j["page"] = is.page;
     j["pages"] = is.pages;
+  }
+  if (is.page > 0 || !is.text_blocks.empty()) {  // a page with text: its text is spoken, not felt
     json blocks = json::array();
     for (const TextBlockM& b : is.text_blocks) {
-      blocks.push_back({{"id", b.id}, {"bbox_m", {b.lo_m.x, b.lo_m.y, b.hi_m.x, b.hi_m.y}}, {"text", b.text}});
+      blocks.push_back({{"id", b.id}, {"bbox_m", {b.lo_m.x, b.lo_m.y, b.hi_m.x, b.hi_m.y}}, {"text", b.text}, {"source", b.source},
+                        {"confidence", b.confidence}});
     }
     j["text_blocks"] = std::move(blocks);
   }
@@ -320,6 +323,8 @@ ExploreSummary run_explore(const ExploreOptions& o) {
                       {"dpi", is.render_dpi}, {"worker_ms", is.worker_ms}, {"worker_max_rss_kb", is.worker_max_rss_kb},
                       {"title", is.document_title}};
   }
+  sj["ocr"] = {{"ran", is.ocr.ran}, {"why", is.ocr.why}, {"words", is.ocr.words}, {"mean_confidence", is.ocr.mean_confidence},
+               {"ms", is.ocr.ms}, {"worker_max_rss_kb", is.ocr.worker_max_rss_kb}};
   sj["segments_in_use"] = scene.total_segments(s.haptics.level);
   sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};
   sj["detector"] = vision::detector_name(is.detector);

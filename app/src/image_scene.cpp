@@ -5,8 +5,10 @@
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
 
 #include "haptics/multires.hpp"
+#include "vision/intake.hpp"
 
 namespace hk::app {
 
@@ -112,23 +114,123 @@ void build_from_chains(ImageScene& out, vision::SceneChains sc, const config::Se
   out.times.tree_ms = out.scene->build_times().tree_ms;
 }
 
+/// OCR's words as a text layer's, for the text mask.
+std::vector<vision::PdfWord> as_page_words(const std::vector<vision::OcrWord>& words) {
+  std::vector<vision::PdfWord> out;
+  out.reserve(words.size());
+  for (const vision::OcrWord& w : words) out.push_back({w.text, w.box_px, true});
+  return out;
+}
+
+/// A text block's box in pixels (origin at the top-left pixel's corner) in workspace metres (PxToM maps
+/// pixel centres).
+TextBlockM block_in_metres(const cv::Rect2d& box_px, const vision::PxToM& m, int id) {
+  TextBlockM t;
+  t.id = id;
+  t.lo_m = {m.x_m(box_px.x - 0.5), m.y_m(box_px.y + box_px.height - 0.5)};
+  t.hi_m = {m.x_m(box_px.x + box_px.width - 0.5), m.y_m(box_px.y - 0.5)};
+  return t;
+}
+
+/// OCR's blocks in metres, after the scene's pixel mapping is known.
+void add_ocr_blocks(ImageScene& out, const vision::OcrResult& text) {
+  for (const vision::OcrBlock& b : text.blocks) {
+    TextBlockM t = block_in_metres(b.box_px, out.px_to_m, static_cast<int>(out.text_blocks.size()));
+    t.text = b.text;
+    t.source = "ocr";
+    t.confidence = b.confidence;
+    out.text_blocks.push_back(std::move(t));
+  }
+}
+
+/// The scene of a picture (BGR) whose text is read when [vision] ocr asks: the words masked from the edges,
+/// the blocks kept in metres.
+void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& s) {
+  cv::Mat grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  vision::OcrResult text;
+  if (wants_picture_text(grey, s, out.ocr.why)) text = read_text(grey, out.image_path, s, out.ocr);
+  out.text_words_masked = text.words.size();
+  const cv::Mat mask = text.words.empty() ? cv::Mat() : text_mask(grey.size(), as_page_words(text.words));
+  build_from_chains(out, vision::scene_chains_from_image(bgr, extract_params(s), simplify_params(s), segment_cost(s), mask), s);
+  add_ocr_blocks(out, text);
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 }  // namespace
+
+vision::OcrParams ocr_params_from(const config::Settings& s) {
+  vision::OcrParams p;
+  p.languages = s.vision.ocr_languages.empty() ? std::string("eng") : s.vision.ocr_languages;
+  p.min_word_confidence = s.vision.ocr_min_confidence;
+  return p;
+}
+
+bool wants_picture_text(const cv::Mat& grey, const config::Settings& s, std::string& why) {
+  if (s.vision.ocr == "off") {
+    why = "off";
+    return false;
+  }
+  if (s.vision.ocr == "always") {
+    why = "always";
+    return true;
+  }
+  constexpr int kJudgedSidePx = 1600;
+  cv::Mat judged = grey;
+  const int side = std::max(grey.cols, grey.rows);
+  if (side > kJudgedSidePx) cv::resize(grey, judged, cv::Size(), static_cast<double>(kJudgedSidePx) / side, static_cast<double>(kJudgedSidePx) / side, cv::INTER_AREA);
+  const bool page = vision::looks_like_text_page(judged);
+  why = page ? "a page of text" : "not a page of text";
+  return page;
+}
+
+vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& s, OcrReport& report) {
+  const int side = std::max(grey.cols, grey.rows);
+  const double scale = side > kOcrMaxSidePx ? static_cast<double>(kOcrMaxSidePx) / side : 1.0;
+  cv::Mat read = grey;
+  if (scale < 1.0) cv::resize(grey, read, cv::Size(), scale, scale, cv::INTER_AREA);
+  vision::OcrResult r;
+  try {
+    r = vision::recognise_text(read, name, ocr_params_from(s));
+  } catch (const vision::OcrError& e) {
+    spdlog::warn("{}; the picture is felt without its text", e.what());
+    report.ran = false;
+    report.why = std::string("failed: ") + e.what();
+    return {};
+  }
+  if (scale < 1.0) {  // back to the picture's pixels
+    for (vision::OcrWord& w : r.words) w.box_px = cv::Rect2d(w.box_px.x / scale, w.box_px.y / scale, w.box_px.width / scale, w.box_px.height / scale);
+    for (vision::OcrBlock& b : r.blocks) b.box_px = cv::Rect2d(b.box_px.x / scale, b.box_px.y / scale, b.box_px.width / scale, b.box_px.height / scale);
+  }
+  report.ran = true;
+  report.words = static_cast<int>(r.words.size());
+  report.mean_confidence = r.mean_confidence;
+  report.ms = r.ms;
+  report.worker_max_rss_kb = r.worker_max_rss_kb;
+  return r;
+}
 
 ImageScene build_image_scene(const std::string& path, const config::Settings& s) {
   ImageScene out;
   out.image_path = path;
-  build_from_chains(out, vision::scene_chains(path, extract_params(s), simplify_params(s), segment_cost(s)), s);
+  const auto t0 = std::chrono::steady_clock::now();
+  const cv::Mat bgr = vision::load_image(path, extract_params(s).limits);
+  const double load_ms = ms_since(t0);
+  build_picture(out, bgr, s);
+  out.times.load_ms += load_ms;
   return out;
 }
 
 ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& s) {
   ImageScene out;
   out.image_path = name;
-  const vision::ExtractParams p = extract_params(s);
   const auto t0 = std::chrono::steady_clock::now();
-  out.picture = vision::decode_image(bytes, name, p.limits);
-  const double decode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  build_from_chains(out, vision::scene_chains_from_image(out.picture, p, simplify_params(s), segment_cost(s)), s);
+  out.picture = vision::decode_image(bytes, name, extract_params(s).limits);
+  const double decode_ms = ms_since(t0);
+  build_picture(out, out.picture, s);
   out.times.load_ms += decode_ms;
   return out;
 }
@@ -138,7 +240,7 @@ ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string&
   ImageScene out;
   out.image_path = name;
   out.picture = bgr.clone();
-  build_from_chains(out, vision::scene_chains_from_image(out.picture, extract_params(s), simplify_params(s), segment_cost(s)), s);
+  build_picture(out, out.picture, s);
   return out;
 }
 
@@ -178,21 +280,41 @@ cv::Mat text_mask(cv::Size size, const std::vector<vision::PdfWord>& words, doub
   return mask;
 }
 
+bool wants_page_text(const vision::PdfPage& page, const config::Settings& s, std::string& why) {
+  if (s.vision.ocr == "off") {
+    why = "off";
+    return false;
+  }
+  if (page.words.empty()) {
+    why = "no text layer";
+    return true;
+  }
+  cv::Mat uncovered = page.grey.clone();  // the page with its text layer's words whited out
+  uncovered.setTo(255, text_mask(page.grey.size(), page.words));
+  const bool little = vision::looks_like_text_page(uncovered);
+  why = little ? "text layer covers little of the text" : "a text layer";
+  return little;
+}
+
 ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& s) {
   ImageScene out;
   out.image_path = name;
   out.page = page_number;
   out.pages = page.pages;
   cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
-  out.text_words_masked = page.words.size();
-  const cv::Mat mask = page.words.empty() ? cv::Mat() : text_mask(page.grey.size(), page.words);
+  vision::OcrResult text;
+  if (wants_page_text(page, s, out.ocr.why)) text = read_text(page.grey, name, s, out.ocr);
+  const bool read = !text.words.empty();  // else the text layer's words, if any
+  const std::vector<vision::PdfWord> words = read ? as_page_words(text.words) : page.words;
+  out.text_words_masked = words.size();
+  const cv::Mat mask = words.empty() ? cv::Mat() : text_mask(page.grey.size(), words);
   build_from_chains(out, vision::scene_chains_from_image(page.grey, extract_params(s), simplify_params(s), segment_cost(s), mask), s);
-  // Word boxes have their origin at the top-left pixel's corner; PxToM maps pixel centres.
+  if (read) {
+    add_ocr_blocks(out, text);
+    return out;
+  }
   for (const vision::TextBlock& b : page.blocks) {
-    TextBlockM t;
-    t.id = static_cast<int>(out.text_blocks.size());
-    t.lo_m = {out.px_to_m.x_m(b.box_px.x - 0.5), out.px_to_m.y_m(b.box_px.y + b.box_px.height - 0.5)};
-    t.hi_m = {out.px_to_m.x_m(b.box_px.x + b.box_px.width - 0.5), out.px_to_m.y_m(b.box_px.y - 0.5)};
+    TextBlockM t = block_in_metres(b.box_px, out.px_to_m, static_cast<int>(out.text_blocks.size()));
     t.text = b.text;
     out.text_blocks.push_back(std::move(t));
   }

@@ -13,6 +13,7 @@
 #include "config/settings.hpp"
 #include "haptics/scene.hpp"
 #include "vision/mapping.hpp"
+#include "vision/ocr.hpp"
 #include "vision/pdf.hpp"
 #include "vision/pipeline.hpp"
 #include "vision/scene_chains.hpp"
@@ -24,11 +25,13 @@ struct BuildTimes {
   double load_ms = 0, edges_ms = 0, linking_ms = 0, thin_lines_ms = 0, gaps_ms = 0, multires_ms = 0, tree_ms = 0;
 };
 
-/// A block of text of a document page in workspace metres (issue 11, item 4): spoken, not felt.
+/// A block of text of a page in workspace metres: spoken, not felt.
 struct TextBlockM {
   int id = 0;             ///< index in ImageScene::text_blocks
   Vec2 lo_m, hi_m;        ///< bounding box [m]: lo = (x0, y0) lower left, hi = (x1, y1) upper right
   std::string text;       ///< its words in reading order (UTF-8)
+  std::string source = "pdf";  ///< where the text came from: "pdf" (a PDF's text layer) or "ocr" (read from the pixels)
+  double confidence = 1.0;     ///< how sure the reading is, [0, 1] (1 for a text layer; OCR: its words' mean)
   /// Whether the point p [m] lies in the box (edges included).
   bool contains(Vec2 p) const { return p.x >= lo_m.x && p.x <= hi_m.x && p.y >= lo_m.y && p.y <= hi_m.y; }
   /// Distance from p to the box [m] (0 inside).
@@ -50,6 +53,18 @@ std::vector<Aabb> text_block_regions(const std::vector<TextBlockM>& blocks);
 /// null when none.
 const TextBlockM* text_block_at(const std::vector<TextBlockM>& blocks, Vec2 p);
 
+/// What text reading (OCR) did for a scene: summary.json's "ocr".
+struct OcrReport {
+  bool ran = false;            ///< Tesseract read the picture
+  /// Why it ran or not, one phrase: "off", "not a page of text", "a page of text", "always", "no text layer",
+  /// "text layer covers little of the text", "a text layer", or what stopped it ("failed: ocr '...': ...").
+  std::string why;
+  int words = 0;               ///< words kept (in the text blocks)
+  double mean_confidence = 0;  ///< over the kept words, [0, 1]
+  double ms = 0;               ///< wall time of the worker [ms]
+  long worker_max_rss_kb = 0;  ///< the worker's peak memory [KiB]
+};
+
 /// A picture turned into a scene. `polylines[i]` is the curve built into `scene` as the curve whose
 /// `source_index` is i.
 ///
@@ -63,6 +78,7 @@ struct ImageScene {
   std::string document_title;               ///< a PDF's own title (documents.hpp pdf_title), "" when none or a picture file
   cv::Mat picture;                          ///< BGR pixels of a page built from memory; empty for a picture file (read it from image_path)
   std::vector<TextBlockM> text_blocks;      ///< a page's text blocks (masked from the edges), in reading order
+  OcrReport ocr;                            ///< whether the text was read from the pixels, and how it went
   std::size_t text_words_masked = 0;        ///< words whose outlines were kept out of the edges
   double render_dpi = 0;                    ///< a PDF page: the DPI it was drawn at
   double worker_ms = 0;                     ///< a PDF page: wall time of the drawing worker [ms]
@@ -103,8 +119,9 @@ double polyline_length_m(const Polyline& p);
 /// vision's curves as haptics' polylines (same points, same closedness).
 std::vector<Polyline> to_polylines(const std::vector<vision::SceneCurve>& curves);
 
-/// Loads the image at `path` and builds its scene with `settings`: vision::scene_chains (extraction, thin
-/// lines, gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the
+/// Loads the image at `path` and builds its scene with `settings`: text read from it when [vision] ocr asks
+/// (read_picture_text), then vision::scene_chains_from_image with the words masked (extraction, thin lines,
+/// gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the
 /// level-0 segments plan_levels gives it), then Scene::build (haptics.max_levels) of the curves kept.
 /// Throws vision::InputError for bad image files (one line naming the file and the limit).
 ImageScene build_image_scene(const std::string& path, const config::Settings& settings);
@@ -120,16 +137,39 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
 /// @throws std::invalid_argument for an empty or non-CV_8UC3 image (and as scene_chains_from_image).
 ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& settings);
 
-/// Builds the scene of a rendered document page (issue 11, items 3-4) the way build_image_scene builds a
-/// picture's, except that text is spoken, not felt: every word's box, grown by a quarter of its height on
-/// each side (the blurred glyphs' edges reach past the box), is masked from edge detection
-/// (vision::extract_chains_from_image), and the page's text blocks are kept in metres for the earcon and
-/// the Describe key. Figures, rules and drawings stay curves.
+/// Builds the scene of a rendered document page the way build_image_scene builds a picture's, except that
+/// text is spoken, not felt: its words (the text layer's, or OCR's when wants_page_text) each have their box,
+/// grown by a quarter of its height on each side (the blurred glyphs' edges reach past the box), masked from
+/// edge detection (vision::extract_chains_from_image), and the page's text blocks are kept in metres for the
+/// earcon, Where and Describe. Figures, rules and drawings stay curves.
 /// @param name  the document's name for scene.json and messages (image_path).
 ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& settings);
 
 /// The mask of a page's text for vision::extract_chains_from_image: CV_8UC1 of `size`, 255 inside each
 /// word box grown by `grow` x its height on every side, 0 elsewhere.
 cv::Mat text_mask(cv::Size size, const std::vector<vision::PdfWord>& words, double grow = 0.25);
+
+/// vision::OcrParams from the [vision] settings: the languages (empty: "eng", the language of the kiosk's
+/// message catalogue) and the confidence threshold.
+vision::OcrParams ocr_params_from(const config::Settings& settings);
+
+/// Longest side a picture is read at [px]: a letter-size page at 400 dpi. Larger pictures (a 24-megapixel
+/// photo of a page) are scaled down to it first.
+inline constexpr int kOcrMaxSidePx = 4400;
+
+/// Whether the text of a picture is read: [vision] ocr "off" never, "always" always, "auto" when the picture
+/// looks like a page of text (vision::looks_like_text_page, judged at up to 1600 px). `why` gets the reason
+/// in OcrReport::why's words.
+bool wants_picture_text(const cv::Mat& grey, const config::Settings& settings, std::string& why);
+
+/// Whether a rendered PDF page's text is read from its pixels: [vision] ocr "off" never; otherwise when it
+/// has no text layer (a scanned page), or when the page with its text layer's words whited out still looks
+/// like a page of text (the layer leaves most of the text out). `why` as wants_picture_text.
+bool wants_page_text(const vision::PdfPage& page, const config::Settings& settings, std::string& why);
+
+/// Reads the text of `grey` (CV_8UC1) with vision::recognise_text at up to kOcrMaxSidePx; the words come back
+/// in `grey`'s pixel frame. Fills `report` (ran, words, confidence, time, memory). A failure (OcrError) is
+/// logged in one line and costs the text only: report.why says what happened, the result is empty.
+vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& settings, OcrReport& report);
 
 }  // namespace hk::app

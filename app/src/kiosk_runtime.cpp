@@ -38,9 +38,24 @@ audio::AudioSystemParams audio_params(const config::Settings& s, bool open_outpu
   return p;
 }
 
+/// The settings the kiosk runs with: as given, but with OCR off when a language it needs has no traineddata
+/// (said once in the log; the kiosk runs on without reading text).
+config::Settings with_usable_ocr(const config::Settings& s) {
+  if (s.vision.ocr == "off") return s;
+  const std::string why = vision::ocr_languages_problem(ocr_params_from(s));
+  if (why.empty()) return s;
+  spdlog::error("ocr: {}; text in pictures is not read (set [vision] ocr_languages, or install the language)", why);
+  config::Settings off = s;
+  off.vision.ocr = "off";
+  return off;
+}
+
 }  // namespace
 
-KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s)
+KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& given)
+    : KioskRuntime(o, with_usable_ocr(given), 0) {}
+
+KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, int /*checked*/)
     : opt_(o), s_(s), audio_(audio_params(s, o.open_audio_output)), half_{s.workspace.width_m / 2, s.workspace.height_m / 2},
       sp_(servo_params_from(s)), sim_(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2}),
       core_(cue_params(), &audio_.cues()),

@@ -88,6 +88,7 @@ class KioskRuntime final : public KioskEffects {
  public:
   /// Opens the device (the USB pantograph when [device] type is "auto" or "haply" and one answers, else the
   /// simulated pantograph), the audio side and the stick service. Call start_servo() next.
+  /// OCR ([vision] ocr) is turned off, said once in the log, when a language it needs has no traineddata.
   /// @throws AppError (one line) for an empty library; audio::MessageError for a bad catalogue.
   KioskRuntime(const RuntimeOptions& options, const config::Settings& settings);
   ~KioskRuntime() override;
@@ -239,6 +240,7 @@ class KioskRuntime final : public KioskEffects {
   const StickService& sticks() const { return sticks_; }
 
  private:
+  KioskRuntime(const RuntimeOptions& options, const config::Settings& checked_settings, int);  // settings already checked
   CueTrackerParams cue_params() const;
   void show_built(ImageScene& is, int id);
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});

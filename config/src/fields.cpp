@@ -107,6 +107,23 @@ std::string quiet_hours_problem(std::string_view v) {
   return v.empty() || parse_quiet_hours(v, &why) ? std::string{} : why;
 }
 
+/// The check of [vision] ocr_languages: empty, or Tesseract language codes joined by '+'.
+std::string ocr_languages_problem(std::string_view v) {
+  if (v.empty()) return {};
+  if (v.size() > 200) return "is longer than 200 characters";
+  std::size_t from = 0;
+  while (from <= v.size()) {
+    const std::size_t plus = std::min(v.find('+', from), v.size());
+    const std::string_view lang = v.substr(from, plus - from);
+    if (lang.empty() || lang.size() > 32) return "must be Tesseract languages joined by '+', e.g. \"eng+deu\"";
+    for (char c : lang)
+      if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_'))
+        return "must be Tesseract languages joined by '+', e.g. \"eng+deu\"";
+    from = plus + 1;
+  }
+  return {};
+}
+
 /// The check of [operator] open_chord (parse_chord).
 std::string chord_problem(std::string_view v) {
   std::string why;
@@ -119,6 +136,7 @@ constexpr std::array<std::string_view, 2> kRotations{"cw", "ccw"};
 constexpr std::array<std::string_view, 4> kLevelModes{"auto", "tolerance", "cut", "fixed"};
 constexpr std::array<std::string_view, 2> kRenderModes{"walls", "grooves"};
 constexpr std::array<std::string_view, 6> kDetectors{"auto", "canny", "surround", "bilateral", "edpf", "outline"};
+constexpr std::array<std::string_view, 3> kOcrModes{"auto", "always", "off"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>({
@@ -232,6 +250,13 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(vision, detector, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
              "\"auto\": two-tone pictures (silhouettes, logos) traced from a threshold, two-tone line drawings by \"canny\", others by \"surround\"; \"canny\": Canny alone; \"surround\": Canny, edges that do not stand out from the texture around them dropped; \"bilateral\": Canny after a bilateral filter; \"edpf\": Edge Drawing (parameter-free); \"outline\": always traced from a threshold.",
              kDetectors),
+    HK_FIELD(vision, ocr, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
+             "\"auto\": text is read aloud (Tesseract) from pictures that look like a page of text and PDF pages without a text layer; \"always\": from every picture; \"off\": never.",
+             kOcrModes),
+    HK_FIELD(vision, ocr_languages, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
+             "Tesseract languages joined by '+' (\"eng\", \"eng+deu\"); empty: the message catalogue's language. A missing one turns OCR off at start, said in the log.",
+             {}, &ocr_languages_problem),
+    HK_FIELD(vision, ocr_min_confidence, FieldGroup::scene, ApplyWhen::scene, 0, 1, "", "Words Tesseract is less sure of than this are not read aloud."),
     // [workspace]
     HK_FIELD(workspace, width_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Width of the usable rectangle."),
     HK_FIELD(workspace, height_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Height of the usable rectangle."),

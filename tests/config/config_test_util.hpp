@@ -111,6 +111,7 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"audio", "duck_db", -40, 0, false},
       {"audio", "speech_rate_wpm", 80, 450, true},
       {"audio", "buffer_frames", 32, 4096, true},
+      {"vision", "ocr_min_confidence", 0, 1, false},
       {"kiosk", "timeout_s", 20, 3600, false},
       {"kiosk", "warning_s", 10, 600, false},
       {"kiosk", "attract_every_s", 0, 3600, false},

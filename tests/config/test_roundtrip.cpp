@@ -24,7 +24,7 @@ TEST(ConfigRoundTrip, Defaults) {
 /// default, so a field missing from the table (or written or read under the wrong key) comes back as
 /// its default and fails the comparison. kFieldsSetByHand counts the assignments below; the test checks
 /// it against the table, so a field added to Settings and the table but not here fails too.
-constexpr std::size_t kFieldsSetByHand = 122;
+constexpr std::size_t kFieldsSetByHand = 125;
 
 Settings every_field_changed() {
   Settings s;
@@ -120,6 +120,9 @@ Settings every_field_changed() {
   s.kiosk.timeout_s = 300;
   s.kiosk.warning_s = 30;
   s.kiosk.attract_every_s = 45;
+  s.vision.ocr = "always";
+  s.vision.ocr_languages = "eng+deu";
+  s.vision.ocr_min_confidence = 0.7;
   s.kiosk.quiet_hours = "22:00-07:00";
   auto& st = s.stick;
   st.max_depth = 4;

@@ -20,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "scans.hpp"
 #include "vision/ocr.hpp"
 
 namespace fs = std::filesystem;
@@ -29,12 +30,8 @@ namespace {
 
 const fs::path kData = HK_TEST_DATA_DIR;
 
-int sh(const std::string& cmd) {
-  const int raw = std::system(cmd.c_str());
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-}
-
-bool have(const char* tool) { return sh(std::string("command -v ") + tool + " >/dev/null 2>&1") == 0; }
+using test::have_poppler_utils;
+using test::words_of;
 
 fs::path scratch(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("hk_ocr_" + name + "_" + std::to_string(::getpid()));
@@ -43,69 +40,10 @@ fs::path scratch(const std::string& name) {
   return d;
 }
 
-/// The words of `text`: lower case, letters and digits only, empty ones left out.
-std::vector<std::string> words_of(const std::string& text) {
-  std::vector<std::string> out;
-  std::string w;
-  for (char c : text + " ") {
-    if (std::isalnum(static_cast<unsigned char>(c))) {
-      w += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    } else if (!w.empty()) {
-      out.push_back(w);
-      w.clear();
-    }
-  }
-  return out;
-}
-
-/// Share of the words of `truth` that `read` has too (each read word counts once: a multiset intersection).
-double recall(const std::vector<std::string>& truth, const std::vector<std::string>& read) {
-  std::map<std::string, int> have;
-  for (const std::string& w : read) ++have[w];
-  int found = 0;
-  for (const std::string& w : truth)
-    if (have[w] > 0) {
-      --have[w];
-      ++found;
-    }
-  return truth.empty() ? 0.0 : static_cast<double>(found) / static_cast<double>(truth.size());
-}
-
 std::string all_text(const OcrResult& r) {
   std::string t;
   for (const OcrBlock& b : r.blocks) t += b.text + "\n";
   return t;
-}
-
-/// A scan of `page` of `pdf` as a scanner or a phone gives it: drawn at `dpi`, turned by `degrees`, with
-/// Gaussian sensor noise (sigma 6 grey levels) and saved as JPEG at quality 80, read back in grey.
-cv::Mat scan(const fs::path& pdf, int page, int dpi, double degrees, const fs::path& dir) {
-  const fs::path stem = dir / ("p" + std::to_string(page) + "_" + std::to_string(dpi));
-  EXPECT_EQ(sh("pdftoppm -gray -r " + std::to_string(dpi) + " -f " + std::to_string(page) + " -l " + std::to_string(page) +
-               " -singlefile -png '" + pdf.string() + "' '" + stem.string() + "'"),
-            0);
-  cv::Mat grey = cv::imread(stem.string() + ".png", cv::IMREAD_GRAYSCALE);
-  if (grey.empty()) return grey;
-  const cv::Mat turn = cv::getRotationMatrix2D(cv::Point2f(grey.cols / 2.0f, grey.rows / 2.0f), degrees, 1.0);
-  cv::warpAffine(grey, grey, turn, grey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(255));
-  cv::Mat noise(grey.size(), CV_16SC1);
-  cv::randn(noise, 0, 6);
-  cv::Mat noisy;
-  grey.convertTo(noisy, CV_16SC1);
-  noisy += noise;
-  noisy.convertTo(grey, CV_8UC1);
-  std::vector<std::uint8_t> jpeg;
-  cv::imencode(".jpg", grey, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
-  return cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE);
-}
-
-std::string pdftotext(const fs::path& pdf, int page, const fs::path& dir) {
-  const fs::path out = dir / "truth.txt";
-  EXPECT_EQ(sh("pdftotext -f " + std::to_string(page) + " -l " + std::to_string(page) + " '" + pdf.string() + "' '" + out.string() + "'"), 0);
-  std::ifstream f(out);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
 }
 
 struct ScanCase {
@@ -117,17 +55,17 @@ struct ScanCase {
 class OcrScans : public ::testing::TestWithParam<ScanCase> {};
 
 TEST_P(OcrScans, ReadsAScannedPageAsItsTextLayerSaysWithRecallOver90Percent) {
-  if (!have("pdftoppm") || !have("pdftotext")) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   const ScanCase c = GetParam();
   const fs::path dir = scratch("scan");
   const fs::path pdf = kData / "documents" / "shared-mime-info-spec.pdf";
-  const cv::Mat grey = scan(pdf, c.page, c.dpi, c.degrees, dir);
+  const cv::Mat grey = cv::imdecode(test::scan_jpeg(pdf, c.page, c.dpi, c.degrees, dir), cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(grey.empty());
   EXPECT_TRUE(looks_like_text_page(grey)) << "a page of text is seen as one from its pixels";
   const OcrResult r = recognise_text(grey, "scan.jpg", {});
-  const std::vector<std::string> truth = words_of(pdftotext(pdf, c.page, dir));
+  const std::vector<std::string> truth = words_of(test::pdftotext_page(pdf, c.page, dir));
   ASSERT_GT(truth.size(), 100u);
-  const double got = recall(truth, words_of(all_text(r)));
+  const double got = test::word_recall(truth, words_of(all_text(r)));
   EXPECT_GE(got, 0.9) << r.words.size() << " words kept of " << r.words_seen << "; text: " << all_text(r).substr(0, 600);
   EXPECT_GE(r.mean_confidence, 0.8);
   EXPECT_GE(r.blocks.size(), 3u) << "paragraphs, headings: more than one block";
@@ -166,6 +104,21 @@ TEST(Ocr, EvenWhenAskedAPhotographGivesNoGarbage) {
     const OcrResult r = recognise_text(grey, name, {});
     EXPECT_TRUE(r.blocks.empty()) << name << ": " << all_text(r);
   }
+}
+
+TEST(Ocr, TheWordsOfAStreetSignInAPhotographAreRead) {
+  // White capitals on a green sign over a photograph of fruit: no page layout, light on dark.
+  cv::Mat photo = cv::imread((kData / "images" / "fruits.jpg").string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(photo.empty());
+  cv::resize(photo, photo, cv::Size(1200, 800));
+  cv::rectangle(photo, cv::Rect(150, 200, 900, 400), cv::Scalar(30, 90, 20), cv::FILLED);
+  cv::putText(photo, "MAIN STREET", {200, 350}, cv::FONT_HERSHEY_DUPLEX, 3.2, cv::Scalar(255, 255, 255), 8, cv::LINE_AA);
+  cv::putText(photo, "CITY MUSEUM", {200, 520}, cv::FONT_HERSHEY_DUPLEX, 3.2, cv::Scalar(255, 255, 255), 8, cv::LINE_AA);
+  cv::Mat grey;
+  cv::cvtColor(photo, grey, cv::COLOR_BGR2GRAY);
+  EXPECT_TRUE(looks_like_text_page(grey)) << "a sign's line of large letters is text worth reading";
+  const OcrResult r = recognise_text(grey, "sign.jpg", {});
+  EXPECT_EQ(words_of(all_text(r)), (std::vector<std::string>{"main", "street", "city", "museum"})) << all_text(r);
 }
 
 TEST(Ocr, ThePageOfTextAmongTheTestPicturesIsRead) {

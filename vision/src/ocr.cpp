@@ -148,30 +148,40 @@ OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const Ocr
   return out;
 }
 
-bool looks_like_text_page(const cv::Mat& grey) {
-  if (grey.empty() || grey.type() != CV_8UC1) return false;
-  cv::Mat ink;
-  cv::threshold(grey, ink, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
+namespace {
+
+struct Blob {
+  int bottom, left, right, height;
+};
+
+/// The connected components of `binary` (255 = the side looked at) with their boxes and areas.
+std::vector<std::pair<cv::Rect, int>> components(const cv::Mat& binary) {
   cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(ink, labels, stats, centroids, 8, CV_32S);
-  const double side = std::min(grey.cols, grey.rows);
-  struct Letter {
-    int bottom, left, right, height;
-  };
-  std::vector<Letter> letters;  // letter-sized components, by bottom
+  const int n = cv::connectedComponentsWithStats(binary, labels, stats, centroids, 8, CV_32S);
+  std::vector<std::pair<cv::Rect, int>> out;
+  out.reserve(static_cast<std::size_t>(std::max(0, n - 1)));
   for (int i = 1; i < n; ++i) {
-    const int x = stats.at<int>(i, cv::CC_STAT_LEFT), y = stats.at<int>(i, cv::CC_STAT_TOP);
-    const int w = stats.at<int>(i, cv::CC_STAT_WIDTH), h = stats.at<int>(i, cv::CC_STAT_HEIGHT);
-    if (h >= 0.006 * side && h <= 0.06 * side && w <= 3 * h) letters.push_back({y + h, x, x + w, h});
+    out.push_back({cv::Rect(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP), stats.at<int>(i, cv::CC_STAT_WIDTH),
+                            stats.at<int>(i, cv::CC_STAT_HEIGHT)),
+                   stats.at<int>(i, cv::CC_STAT_AREA)});
   }
-  if (letters.size() < 60 || static_cast<double>(letters.size()) < 0.4 * (n - 1)) return false;
+  return out;
+}
+
+/// Printed lines: letter-sized dark components, most of which stand on a baseline shared with two others
+/// nearby (see looks_like_text_page).
+bool printed_lines(const cv::Mat& ink, double side) {
+  const auto all = components(ink);
+  std::vector<Blob> letters;  // by bottom
+  for (const auto& [r, area] : all)
+    if (r.height >= 0.006 * side && r.height <= 0.06 * side && r.width <= 3 * r.height) letters.push_back({r.y + r.height, r.x, r.x + r.width, r.height});
+  if (letters.size() < 60 || static_cast<double>(letters.size()) < 0.4 * static_cast<double>(all.size())) return false;
   std::vector<int> heights;
-  for (const Letter& l : letters) heights.push_back(l.height);
+  for (const Blob& l : letters) heights.push_back(l.height);
   std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2), heights.end());
   const double median = heights[heights.size() / 2];
   const double tolerance = std::max(1.0, 0.2 * median);
-  std::sort(letters.begin(), letters.end(), [](const Letter& a, const Letter& b) { return a.bottom < b.bottom; });
-  // A letter on a line has two others standing on the same baseline within two letter heights of it.
+  std::sort(letters.begin(), letters.end(), [](const Blob& a, const Blob& b) { return a.bottom < b.bottom; });
   std::size_t on_lines = 0;
   for (std::size_t i = 0, from = 0; i < letters.size(); ++i) {
     while (letters[i].bottom - letters[from].bottom > tolerance) ++from;
@@ -184,6 +194,52 @@ bool looks_like_text_page(const cv::Mat& grey) {
     on_lines += beside >= 2;
   }
   return 2 * on_lines >= letters.size();
+}
+
+/// A line of large letters (a sign, a poster), light on dark or dark on light: at least kSignLetters
+/// letter-like components (height 3–30 % of the shorter side, width 15–120 % of it, filling 15–70 % of their
+/// box: strokes, not discs) of one height (within 25 %) on one baseline (within 15 % of it), each no further
+/// than a height from the next, and narrower than tall on the whole (the median width under 0.9 heights: a
+/// row of coins or pebbles is as wide as tall).
+bool a_line_of_large_letters(const cv::Mat& side_up, double side) {
+  constexpr std::size_t kSignLetters = 5;
+  std::vector<Blob> letters;
+  for (const auto& [r, area] : components(side_up)) {
+    const double fill = static_cast<double>(area) / (static_cast<double>(r.width) * r.height);
+    if (r.height >= 0.03 * side && r.height <= 0.3 * side && r.width >= 0.15 * r.height && r.width <= 1.2 * r.height && fill >= 0.15 && fill <= 0.7)
+      letters.push_back({r.y + r.height, r.x, r.x + r.width, r.height});
+  }
+  std::sort(letters.begin(), letters.end(), [](const Blob& a, const Blob& b) { return a.left < b.left; });
+  for (std::size_t i = 0; i < letters.size(); ++i) {
+    std::vector<double> aspects{static_cast<double>(letters[i].right - letters[i].left) / letters[i].height};
+    Blob last = letters[i];
+    for (std::size_t j = i + 1; j < letters.size() && aspects.size() < kSignLetters; ++j) {
+      const Blob& b = letters[j];
+      const bool same = std::abs(b.height - letters[i].height) <= 0.25 * letters[i].height &&
+                        std::abs(b.bottom - letters[i].bottom) <= 0.15 * letters[i].height;
+      if (!same) continue;
+      if (b.left - last.right > letters[i].height) break;
+      last = b;
+      aspects.push_back(static_cast<double>(b.right - b.left) / b.height);
+    }
+    if (aspects.size() < kSignLetters) continue;
+    std::nth_element(aspects.begin(), aspects.begin() + static_cast<std::ptrdiff_t>(aspects.size() / 2), aspects.end());
+    if (aspects[aspects.size() / 2] < 0.9) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool looks_like_text_page(const cv::Mat& grey) {
+  if (grey.empty() || grey.type() != CV_8UC1) return false;
+  cv::Mat ink;
+  cv::threshold(grey, ink, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
+  const double side = std::min(grey.cols, grey.rows);
+  if (printed_lines(ink, side)) return true;
+  cv::Mat light;
+  cv::bitwise_not(ink, light);
+  return a_line_of_large_letters(ink, side) || a_line_of_large_letters(light, side);
 }
 
 }  // namespace hk::vision

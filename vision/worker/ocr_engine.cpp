@@ -91,6 +91,16 @@ std::vector<Block> read_blocks(tesseract::TessBaseAPI& api, const OcrParams& p, 
   return blocks;
 }
 
+/// Words kept in `blocks`.
+std::size_t kept_words(const std::vector<Block>& blocks) {
+  std::size_t n = 0;
+  for (const Block& b : blocks) n += b.words.size();
+  return n;
+}
+
+/// Words the page layout must keep for sparse text not to be tried as well.
+constexpr std::size_t kEnoughForALayout = 3;
+
 /// The worker's work: an answer in `out`, or a Refusal thrown.
 void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p, worker::WireWriter& out) {
   ::setenv("OMP_THREAD_LIMIT", "1", 1);  // one core: the servo thread and the window keep theirs
@@ -99,12 +109,23 @@ void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p,
     throw Refusal{OcrError::Kind::Unavailable, "Tesseract cannot start with the languages '" + p.languages + "'"};
   }
   api.SetVariable("debug_file", "/dev/null");
-  api.SetPageSegMode(tesseract::PSM_AUTO);
   api.SetImage(pixels, width, height, 1, width);
   api.SetSourceResolution(300);
-  if (api.Recognize(nullptr) != 0) throw Refusal{OcrError::Kind::WorkerCrashed, "Tesseract could not read the picture"};
+  // Pages: Tesseract's layout analysis. A sign or a poster in a photograph is no page layout: where that
+  // finds (almost) nothing, sparse text (words wherever they stand) is tried too, and the better taken.
   std::uint32_t seen = 0;
-  const std::vector<Block> blocks = read_blocks(api, p, seen);
+  std::vector<Block> blocks;
+  for (const tesseract::PageSegMode mode : {tesseract::PSM_AUTO, tesseract::PSM_SPARSE_TEXT}) {
+    api.SetPageSegMode(mode);
+    if (api.Recognize(nullptr) != 0) throw Refusal{OcrError::Kind::WorkerCrashed, "Tesseract could not read the picture"};
+    std::uint32_t mode_seen = 0;
+    std::vector<Block> found = read_blocks(api, p, mode_seen);
+    if (kept_words(found) > kept_words(blocks)) {
+      blocks = std::move(found);
+      seen = mode_seen;
+    }
+    if (kept_words(blocks) >= kEnoughForALayout) break;
+  }
   out.u32(seen);
   out.u32(static_cast<std::uint32_t>(blocks.size()));
   for (const Block& b : blocks) {

@@ -96,11 +96,14 @@ std::string ocr_languages_problem(const OcrParams& params);
 ///         that is not positive.
 OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const OcrParams& params);
 
-/// Whether `grey` looks like a page of text, judged from the picture alone: binarised (Otsu), its dark
-/// connected components of letter size (height 0.6–6 % of the shorter side, not much wider than 3 heights)
-/// number at least 60, are at least 40 % of all components, and half of them stand on a line shared with
-/// two others (bottoms within a fifth of the median letter height). Photographs and silhouettes have few
-/// such runs. Cost: one threshold and one connected-component pass.
+/// Whether `grey` holds text worth reading, judged from the picture alone, binarised (Otsu):
+/// - a page of text: its dark connected components of letter size (height 0.6–6 % of the shorter side, not
+///   much wider than 3 heights) number at least 60, are at least 40 % of all components, and half of them
+///   stand on a baseline shared with two others within two letter heights (within a fifth of the median
+///   letter height);
+/// - or a sign or poster: five letter-like components, light on dark or dark on light, of one height (3–30 %
+///   of the shorter side) on one baseline, side by side.
+/// Photographs and silhouettes have neither. Cost: one threshold and three connected-component passes.
 bool looks_like_text_page(const cv::Mat& grey);
 
 /// Entry point of the worker executable (vision/worker/ocr_worker_main.cpp), not for other callers.

@@ -1,0 +1,174 @@
+// Pages that are pictures of text are read, never felt: a scan made here from the shipped PDF (150 dpi,
+// turned 1.5°, noise, JPEG 80) becomes text blocks read by OCR ("source": "ocr", with their confidence)
+// whose words are 90 % of pdftotext's, with at most 5 curves left inside them; the same scan wrapped in an
+// image-only PDF (no text layer, as scan-to-PDF apps write) gives the same text; every shipped photograph
+// and silhouette gives no text block; [vision] ocr = "off" feels the page as before; explore writes it all.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "image_pdf.hpp"
+#include "image_scene.hpp"
+#include "kiosk_exe.hpp"
+#include "scans.hpp"
+#include "vision/pdf.hpp"
+
+namespace fs = std::filesystem;
+
+namespace hk::app {
+namespace {
+
+const fs::path kData = HK_TEST_DATA_DIR;
+const fs::path kSpec = kData / "documents" / "shared-mime-info-spec.pdf";
+constexpr int kPage = 3;
+constexpr int kDpi = 150;
+
+std::string all_text(const ImageScene& is) {
+  std::string t;
+  for (const TextBlockM& b : is.text_blocks) t += b.text + "\n";
+  return t;
+}
+
+/// Curves whose bounding box's centre lies inside a text block: what a hand would feel of the text.
+int curves_in_text(const ImageScene& is) {
+  int n = 0;
+  for (const Polyline& p : is.polylines) {
+    Vec2 lo = p.points_m[0], hi = p.points_m[0];
+    for (Vec2 q : p.points_m) {
+      lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+      hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+    }
+    const Vec2 c = 0.5 * (lo + hi);
+    for (const TextBlockM& b : is.text_blocks) {
+      if (b.contains(c)) {
+        ++n;
+        break;
+      }
+    }
+  }
+  return n;
+}
+
+struct ScanRig {
+  fs::path dir = test::fresh_dir("ocr_scene");
+  std::vector<std::uint8_t> jpeg;
+  std::vector<std::string> truth;
+  ScanRig() {
+    jpeg = test::scan_jpeg(kSpec, kPage, kDpi, 1.5, dir);
+    truth = test::words_of(test::pdftotext_page(kSpec, kPage, dir));
+  }
+  ~ScanRig() { fs::remove_all(dir); }
+};
+
+TEST(OcrScene, AScannedPageIsReadAsTextBlocksNotFeltAsBumps) {
+  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  ScanRig r;
+  ASSERT_FALSE(r.jpeg.empty());
+  const config::Settings s;
+  const ImageScene is = build_image_scene_from_bytes(r.jpeg, "scan.jpg", s);
+  EXPECT_TRUE(is.ocr.ran) << is.ocr.why;
+  EXPECT_EQ(is.ocr.why, "a page of text");
+  ASSERT_GE(is.text_blocks.size(), 3u);
+  for (const TextBlockM& b : is.text_blocks) {
+    EXPECT_EQ(b.source, "ocr");
+    EXPECT_GE(b.confidence, 0.6);
+    EXPECT_LE(b.confidence, 1.0);
+    EXPECT_LT(b.lo_m.x, b.hi_m.x);
+    EXPECT_LT(b.lo_m.y, b.hi_m.y);
+  }
+  EXPECT_GE(test::word_recall(r.truth, test::words_of(all_text(is))), 0.9) << all_text(is).substr(0, 800);
+  EXPECT_LE(curves_in_text(is), 5) << "of " << is.polylines.size() << " curves";
+  EXPECT_EQ(is.ocr.words, static_cast<int>(is.text_words_masked));
+  EXPECT_GT(is.ocr.worker_max_rss_kb, 0);
+
+  // [vision] ocr = "off": the words are felt as bumps again, as a check that the mask is what removed them.
+  config::Settings off;
+  off.vision.ocr = "off";
+  const ImageScene felt = build_image_scene_from_bytes(r.jpeg, "scan.jpg", off);
+  EXPECT_FALSE(felt.ocr.ran);
+  EXPECT_EQ(felt.ocr.why, "off");
+  EXPECT_TRUE(felt.text_blocks.empty());
+  EXPECT_GT(felt.polylines.size(), 10u) << "outlines of words";
+}
+
+TEST(OcrScene, TheSameScanInAnImageOnlyPdfGivesTheSameText) {
+  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  ScanRig r;
+  const cv::Mat grey = cv::imdecode(r.jpeg, cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(grey.empty());
+  const std::string pdf = test::image_only_pdf(r.jpeg, grey.cols, grey.rows, kDpi);
+  const std::span<const std::uint8_t> bytes(reinterpret_cast<const std::uint8_t*>(pdf.data()), pdf.size());
+  vision::PdfLimits limits;
+  limits.max_dpi = kDpi;  // drawn at the scan's own resolution
+  const vision::PdfPage page = vision::render_pdf_page(bytes, "scan.pdf", 1, limits);
+  EXPECT_TRUE(page.words.empty()) << "no text layer";
+  const config::Settings s;
+  const ImageScene from_pdf = build_page_scene(page, "scan.pdf", 1, s);
+  EXPECT_TRUE(from_pdf.ocr.ran);
+  EXPECT_EQ(from_pdf.ocr.why, "no text layer");
+  const ImageScene from_jpeg = build_image_scene_from_bytes(r.jpeg, "scan.jpg", s);
+  ASSERT_FALSE(from_pdf.text_blocks.empty());
+  EXPECT_NEAR(static_cast<double>(from_pdf.text_blocks.size()), static_cast<double>(from_jpeg.text_blocks.size()), 1.0);
+  EXPECT_GE(test::word_recall(test::words_of(all_text(from_jpeg)), test::words_of(all_text(from_pdf))), 0.97);
+  EXPECT_GE(test::word_recall(r.truth, test::words_of(all_text(from_pdf))), 0.9);
+  for (const TextBlockM& b : from_pdf.text_blocks) EXPECT_EQ(b.source, "ocr");
+}
+
+TEST(OcrScene, APdfWithATextLayerKeepsItsOwnText) {
+  const std::vector<std::uint8_t> bytes = [] {
+    std::ifstream f(kSpec, std::ios::binary);
+    return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(f), {});
+  }();
+  const vision::PdfPage page = vision::render_pdf_page(bytes, "spec.pdf", kPage, {});
+  const ImageScene is = build_page_scene(page, "spec.pdf", kPage, config::Settings{});
+  EXPECT_FALSE(is.ocr.ran);
+  EXPECT_EQ(is.ocr.why, "a text layer");
+  ASSERT_FALSE(is.text_blocks.empty());
+  for (const TextBlockM& b : is.text_blocks) {
+    EXPECT_EQ(b.source, "pdf");
+    EXPECT_EQ(b.confidence, 1.0);
+  }
+}
+
+TEST(OcrScene, PhotographsAndSilhouettesGiveNoTextBlock) {
+  const config::Settings s;
+  for (const fs::path& p : test::test_images()) {
+    if (p.filename() == "page.png") continue;  // a photo of a book page: text
+    const ImageScene is = build_image_scene(p.string(), s);
+    EXPECT_TRUE(is.text_blocks.empty()) << p.filename() << ": " << all_text(is);
+    EXPECT_FALSE(is.ocr.ran) << p.filename() << " was taken for text: " << is.ocr.why;
+  }
+}
+
+TEST(OcrScene, ExploreWritesTheBlocksWithTheirSourceAndTheOcrSummary) {
+  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  ScanRig r;
+  {
+    std::ofstream f(r.dir / "scan.jpg", std::ios::binary);
+    f.write(reinterpret_cast<const char*>(r.jpeg.data()), static_cast<std::streamsize>(r.jpeg.size()));
+  }
+  const test::ExeResult run = test::run_kiosk("explore " + test::quoted(r.dir / "scan.jpg") + " --out " + test::quoted(r.dir / "out") + " --duration 0.5", r.dir);
+  ASSERT_EQ(run.status, 0) << run.err;
+  std::ifstream sf(r.dir / "out" / "summary.json"), jf(r.dir / "out" / "scene.json");
+  const nlohmann::json summary = nlohmann::json::parse(sf), scene = nlohmann::json::parse(jf);
+  EXPECT_EQ(summary["ocr"]["ran"], true);
+  EXPECT_EQ(summary["ocr"]["why"], "a page of text");
+  EXPECT_GT(summary["ocr"]["words"].get<int>(), 200);
+  EXPECT_GT(summary["ocr"]["mean_confidence"].get<double>(), 0.8);
+  EXPECT_GT(summary["ocr"]["ms"].get<double>(), 0.0);
+  ASSERT_GE(scene["text_blocks"].size(), 3u);
+  for (const auto& b : scene["text_blocks"]) {
+    EXPECT_EQ(b["source"], "ocr");
+    EXPECT_GE(b["confidence"].get<double>(), 0.6);
+    EXPECT_EQ(b["bbox_m"].size(), 4u);
+  }
+}
+
+}  // namespace
+}  // namespace hk::app

@@ -1,0 +1,47 @@
+#pragma once
+/// @file image_pdf.hpp
+/// An image-only PDF, as every scanner and phone "scan to PDF" app writes: one page the size of the picture
+/// at `dpi`, holding nothing but the JPEG (DCTDecode, grey), no text layer.
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace hk::test {
+
+/// The bytes of a one-page PDF showing `jpeg` (a grey JPEG of width x height pixels) at `dpi`.
+inline std::string image_only_pdf(const std::vector<std::uint8_t>& jpeg, int width, int height, double dpi) {
+  const double w_pt = width * 72.0 / dpi, h_pt = height * 72.0 / dpi;
+  char content[128];
+  std::snprintf(content, sizeof content, "q %.3f 0 0 %.3f 0 0 cm /Im0 Do Q", w_pt, h_pt);
+  char page[256];
+  std::snprintf(page, sizeof page,
+                "<< /Type /Page /Parent 2 0 R /MediaBox [0 0 %.3f %.3f] /Contents 4 0 R /Resources << /XObject << /Im0 5 0 R >> >> >>", w_pt, h_pt);
+  const std::string image_head = "<< /Type /XObject /Subtype /Image /Width " + std::to_string(width) + " /Height " + std::to_string(height) +
+                                 " /ColorSpace /DeviceGray /BitsPerComponent 8 /Filter /DCTDecode /Length " + std::to_string(jpeg.size()) + " >>\nstream\n";
+  const std::vector<std::string> objects{
+      "<< /Type /Catalog /Pages 2 0 R >>",
+      "<< /Type /Pages /Count 1 /Kids [3 0 R] >>",
+      page,
+      "<< /Length " + std::to_string(std::string(content).size()) + " >>\nstream\n" + content + "\nendstream",
+      image_head + std::string(jpeg.begin(), jpeg.end()) + "\nendstream",
+  };
+  std::string out = "%PDF-1.4\n%\xe2\xe3\xcf\xd3\n";
+  std::vector<std::size_t> offsets;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    offsets.push_back(out.size());
+    out += std::to_string(i + 1) + " 0 obj\n" + objects[i] + "\nendobj\n";
+  }
+  const std::size_t xref = out.size();
+  out += "xref\n0 " + std::to_string(objects.size() + 1) + "\n0000000000 65535 f \n";
+  for (std::size_t off : offsets) {
+    char line[24];
+    std::snprintf(line, sizeof line, "%010zu 00000 n \n", off);
+    out += line;
+  }
+  out += "trailer\n<< /Size " + std::to_string(objects.size() + 1) + " /Root 1 0 R >>\nstartxref\n" + std::to_string(xref) + "\n%%EOF\n";
+  return out;
+}
+
+}  // namespace hk::test
