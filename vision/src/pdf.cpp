@@ -230,15 +230,8 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
 /// Everything the worker does once its document is mapped; never returns.
 [[noreturn]] void worker_main(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits) {
   worker::confine_worker(limits.worker_cpu_s, limits.worker_max_memory_mb);
-  if (limits.fault == PdfFault::Crash) {
-    ::signal(SIGSEGV, SIG_DFL);  // not ASan's handler: die of the signal, as an unsanitized crash would
-    ::raise(SIGSEGV);
-    ::_exit(98);
-  }
-  if (limits.fault == PdfFault::Hang) {
-    volatile unsigned long spin = 0;
-    for (;;) spin = spin + 1;
-  }
+  if (limits.fault == PdfFault::Crash) worker::crash_on_purpose();
+  if (limits.fault == PdfFault::Hang) worker::hang_on_purpose();
 
   poppler::set_debug_error_function(no_poppler_output, nullptr);
   Writer out;

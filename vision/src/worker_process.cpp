@@ -85,6 +85,17 @@ void confine_worker(double cpu_s, double max_memory_mb) {
 #endif
 }
 
+void crash_on_purpose() {
+  ::signal(SIGSEGV, SIG_DFL);
+  ::raise(SIGSEGV);
+  ::_exit(98);
+}
+
+void hang_on_purpose() {
+  volatile unsigned long spin = 0;
+  for (;;) spin = spin + 1;
+}
+
 std::span<const std::uint8_t> map_input(std::size_t size) {
   struct stat st {};
   if (::fstat(kInputFd, &st) != 0 || static_cast<std::size_t>(st.st_size) != size || size == 0) return {};

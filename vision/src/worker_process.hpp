@@ -78,6 +78,13 @@ void write_all(int fd, const std::string& s);
 /// terabytes of shadow memory), RLIMIT_AS to its present size plus `max_memory_mb` (0: no limit).
 void confine_worker(double cpu_s, double max_memory_mb);
 
+/// Worker side, test hooks (a worker that fails on purpose, so that tests of crashes and hangs need no
+/// special input): dies of SIGSEGV with the default action (not a sanitizer's handler, as an unsanitized
+/// crash would).
+[[noreturn]] void crash_on_purpose();
+/// Spins on the CPU until a limit stops it.
+[[noreturn]] void hang_on_purpose();
+
 /// Worker side: maps descriptor kInputFd, which must hold exactly `size` > 0 bytes, read-only. Empty span on
 /// failure.
 std::span<const std::uint8_t> map_input(std::size_t size);

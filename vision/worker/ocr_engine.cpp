@@ -144,15 +144,8 @@ void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p,
 }
 
 [[noreturn]] void fail_on_purpose(OcrFault fault) {
-  if (fault == OcrFault::Crash) {
-    ::signal(SIGSEGV, SIG_DFL);  // not ASan's handler: die of the signal, as an unsanitized crash would
-    ::raise(SIGSEGV);
-    ::_exit(98);
-  }
-  if (fault == OcrFault::Hang) {
-    volatile unsigned long spin = 0;
-    for (;;) spin = spin + 1;
-  }
+  if (fault == OcrFault::Crash) worker::crash_on_purpose();
+  if (fault == OcrFault::Hang) worker::hang_on_purpose();
   // Memory: allocate and touch until the limit says no.
   std::vector<std::unique_ptr<char[]>> hog;
   for (;;) {
