@@ -352,8 +352,8 @@ void KioskRuntime::show_built(ImageScene& is, int id) {
 }
 
 std::string KioskRuntime::describe() {
-  if (shown_page_ > 0) {
-    // A document page: the block of text under the hand is read; elsewhere, what the page holds.
+  if (shown_page_ > 0 || !shown_.text_blocks.empty()) {
+    // A page (or a picture of one): the block of text under the hand is read; elsewhere, what the page holds.
     if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m)) {
       return audio_.messages().text(audio::MessageId::text_block, {{"text", b->text}});
     }
@@ -414,8 +414,9 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
     if (d.scene) {
       ImageScene& is = *d.scene;
       r.ok = true;
-      r.description = is.page > 0 ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
-                                  : describe_shapes(static_cast<int>(is.scene->curve_count()));
+      // A page, or a picture of one (its text read): blocks of text and figures; else shapes.
+      r.description = is.page > 0 || !is.text_blocks.empty() ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
+                                                             : describe_shapes(static_cast<int>(is.scene->curve_count()));
       show_built(is, id);
       shown_page_ = is.page;
       shown_document_ = d.document;
