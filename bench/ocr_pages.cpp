@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
   const fs::path pdf = data / "documents" / "shared-mime-info-spec.pdf";
   const fs::path dir = fs::temp_directory_path() / ("hk_bench_ocr_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  const hk::config::Settings s;
+  hk::config::Settings s;
+  s.vision.ocr = "auto";
   std::printf("| picture | pixels | OCR ran | words | recall | blocks | mean confidence | OCR ms | worker peak MiB | scene ms |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   auto row = [](const std::string& name, const cv::Size& size, const hk::app::ImageScene& is, double recall, double scene_ms) {

@@ -1,4 +1,4 @@
-// Pages that are pictures of text are read, never felt: a scan made here from the shipped PDF (150 dpi,
+// With [vision] ocr = "auto", pages that are pictures of text are read, never felt: a scan made here from the shipped PDF (150 dpi,
 // turned 1.5°, noise, JPEG 80) becomes text blocks read by OCR ("source": "ocr", with their confidence)
 // whose words are 90 % of pdftotext's, with at most 5 curves left inside them; the same scan wrapped in an
 // image-only PDF (no text layer, as scan-to-PDF apps write) gives the same text; every shipped photograph
@@ -28,6 +28,13 @@ const fs::path kData = HK_TEST_DATA_DIR;
 const fs::path kSpec = kData / "documents" / "shared-mime-info-spec.pdf";
 constexpr int kPage = 3;
 constexpr int kDpi = 150;
+
+/// The shipped settings with text reading on ("auto").
+config::Settings reading() {
+  config::Settings s;
+  s.vision.ocr = "auto";
+  return s;
+}
 
 std::string all_text(const ImageScene& is) {
   std::string t;
@@ -70,7 +77,7 @@ TEST(OcrScene, AScannedPageIsReadAsTextBlocksNotFeltAsBumps) {
   if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   ScanRig r;
   ASSERT_FALSE(r.jpeg.empty());
-  const config::Settings s;
+  const config::Settings s = reading();
   const ImageScene is = build_image_scene_from_bytes(r.jpeg, "scan.jpg", s);
   EXPECT_TRUE(is.ocr.ran) << is.ocr.why;
   EXPECT_EQ(is.ocr.why, "a page of text");
@@ -87,9 +94,9 @@ TEST(OcrScene, AScannedPageIsReadAsTextBlocksNotFeltAsBumps) {
   EXPECT_EQ(is.ocr.words, static_cast<int>(is.text_words_masked));
   EXPECT_GT(is.ocr.worker_max_rss_kb, 0);
 
-  // [vision] ocr = "off": the words are felt as bumps again, as a check that the mask is what removed them.
+  // [vision] ocr = "off" (the default): the words are felt as bumps again, as a check that the mask is what removed them.
   config::Settings off;
-  off.vision.ocr = "off";
+  ASSERT_EQ(off.vision.ocr, "off");
   const ImageScene felt = build_image_scene_from_bytes(r.jpeg, "scan.jpg", off);
   EXPECT_FALSE(felt.ocr.ran);
   EXPECT_EQ(felt.ocr.why, "off");
@@ -108,7 +115,7 @@ TEST(OcrScene, TheSameScanInAnImageOnlyPdfGivesTheSameText) {
   limits.max_dpi = kDpi;  // drawn at the scan's own resolution
   const vision::PdfPage page = vision::render_pdf_page(bytes, "scan.pdf", 1, limits);
   EXPECT_TRUE(page.words.empty()) << "no text layer";
-  const config::Settings s;
+  const config::Settings s = reading();
   const ImageScene from_pdf = build_page_scene(page, "scan.pdf", 1, s);
   EXPECT_TRUE(from_pdf.ocr.ran);
   EXPECT_EQ(from_pdf.ocr.why, "no text layer");
@@ -126,7 +133,7 @@ TEST(OcrScene, APdfWithATextLayerKeepsItsOwnText) {
     return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(f), {});
   }();
   const vision::PdfPage page = vision::render_pdf_page(bytes, "spec.pdf", kPage, {});
-  const ImageScene is = build_page_scene(page, "spec.pdf", kPage, config::Settings{});
+  const ImageScene is = build_page_scene(page, "spec.pdf", kPage, reading());
   EXPECT_FALSE(is.ocr.ran);
   EXPECT_EQ(is.ocr.why, "a text layer");
   ASSERT_FALSE(is.text_blocks.empty());
@@ -137,7 +144,7 @@ TEST(OcrScene, APdfWithATextLayerKeepsItsOwnText) {
 }
 
 TEST(OcrScene, PhotographsAndSilhouettesGiveNoTextBlock) {
-  const config::Settings s;
+  const config::Settings s = reading();
   for (const fs::path& p : test::test_images()) {
     if (p.filename() == "page.png") continue;  // a photo of a book page: text
     const ImageScene is = build_image_scene(p.string(), s);
@@ -153,7 +160,10 @@ TEST(OcrScene, ExploreWritesTheBlocksWithTheirSourceAndTheOcrSummary) {
     std::ofstream f(r.dir / "scan.jpg", std::ios::binary);
     f.write(reinterpret_cast<const char*>(r.jpeg.data()), static_cast<std::streamsize>(r.jpeg.size()));
   }
-  const test::ExeResult run = test::run_kiosk("explore " + test::quoted(r.dir / "scan.jpg") + " --out " + test::quoted(r.dir / "out") + " --duration 0.5", r.dir);
+  std::ofstream(r.dir / "reading.toml") << "[vision]\nocr = \"auto\"\n";
+  const test::ExeResult run = test::run_kiosk("explore " + test::quoted(r.dir / "scan.jpg") + " --config " + test::quoted(r.dir / "reading.toml") +
+                                                  " --out " + test::quoted(r.dir / "out") + " --duration 0.5",
+                                              r.dir);
   ASSERT_EQ(run.status, 0) << run.err;
   std::ifstream sf(r.dir / "out" / "summary.json"), jf(r.dir / "out" / "scene.json");
   const nlohmann::json summary = nlohmann::json::parse(sf), scene = nlohmann::json::parse(jf);
