@@ -57,7 +57,8 @@ inline double word_recall(const std::vector<std::string>& truth, const std::vect
 }
 
 /// A scan of `page` of `pdf` as a scanner or a phone gives it: drawn at `dpi`, turned by `degrees`, with
-/// Gaussian sensor noise (sigma 6 grey levels), as JPEG bytes at quality 80 (grey).
+/// Gaussian sensor noise (sigma 6 grey levels, the same for the same page and dpi), as JPEG bytes at quality
+/// 80 (grey).
 inline std::vector<std::uint8_t> scan_jpeg(const std::filesystem::path& pdf, int page, int dpi, double degrees, const std::filesystem::path& dir) {
   const std::filesystem::path stem = dir / ("p" + std::to_string(page) + "_" + std::to_string(dpi));
   if (shell("pdftoppm -gray -r " + std::to_string(dpi) + " -f " + std::to_string(page) + " -l " + std::to_string(page) + " -singlefile -png '" +
@@ -68,7 +69,8 @@ inline std::vector<std::uint8_t> scan_jpeg(const std::filesystem::path& pdf, int
   const cv::Mat turn = cv::getRotationMatrix2D(cv::Point2f(grey.cols / 2.0f, grey.rows / 2.0f), degrees, 1.0);
   cv::warpAffine(grey, grey, turn, grey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(255));
   cv::Mat noise(grey.size(), CV_16SC1), noisy;
-  cv::randn(noise, 0, 6);
+  cv::RNG rng(static_cast<std::uint64_t>(page) * 1000 + static_cast<std::uint64_t>(dpi));  // the same scan every run
+  rng.fill(noise, cv::RNG::NORMAL, 0, 6);
   grey.convertTo(noisy, CV_16SC1);
   noisy += noise;
   noisy.convertTo(grey, CV_8UC1);
