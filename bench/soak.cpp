@@ -237,6 +237,7 @@ int run(const SoakOptions& o) {
     if (now_s >= o.duration_s) break;
     script.frame(now_s);
     rt.poll_sticks(flow, now_s);
+    rt.poll_text(now_s);
     rt.poll_device(now_s);
     rt.poll_tour();
     flow.tick(now_s);

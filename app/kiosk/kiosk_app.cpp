@@ -127,7 +127,7 @@ class Kiosk final : public ScriptTarget {
   void moved() override { flow_.handle_moved(now_s_); }
   void stick(const std::string& dir) override { rt_.insert_stick_folder(dir); }
   void unstick() override { rt_.remove_stick_folder(); }
-  bool busy() override { return rt_.stick_busy() || session_.state() == PanelState::checking; }
+  bool busy() override { return rt_.stick_busy() || rt_.text_busy() || session_.state() == PanelState::checking; }
   std::optional<WidgetRect> widget(const std::string& name) override { return panel_.widget(name); }
 
   /// The mouse stands in for the visitor's hand, but only once it has moved: where the pointer happens to
@@ -254,6 +254,7 @@ int run_kiosk(const KioskOptions& o) {
     for (const InputEvent& e : window.poll()) kiosk.input(e);
     rt.poll_sticks(flow, kiosk.now_s_);
     rt.poll_capture(flow, kiosk.now_s_);
+    rt.poll_text(kiosk.now_s_);
     rt.poll_device(kiosk.now_s_);
     const bool holding = scripted && script.step(frame, kiosk);
     if (!scripted) kiosk.follow_mouse();

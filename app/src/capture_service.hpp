@@ -2,7 +2,7 @@
 /// @file capture_service.hpp
 /// The kiosk's camera (issue 16): which camera it has ([camera] source), and captures run off the window
 /// thread. A capture opens the source, runs run_capture (capture.hpp) on a worker thread, and builds the scene
-/// of what it took (build_image_scene_from_picture); the window thread polls the news (advice to speak, the
+/// of what it took (build_image_scene_from_picture, its text left for the kiosk's TextReader); the window thread polls the news (advice to speak, the
 /// scene, a failure) and the latest preview frame for sighted companions.
 ///
 /// Threads: construct, call and destroy on one thread (the window thread); the worker is owned here and joined

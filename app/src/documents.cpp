@@ -118,13 +118,13 @@ nlohmann::json stick_listing_json(const StickListing& l) {
 }
 
 ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
-                                vision::PdfFault fault) {
+                                vision::PdfFault fault, TextTiming timing) {
   const auto t0 = std::chrono::steady_clock::now();
   vision::PdfLimits limits = pdf_limits_from(s);
   limits.fault = fault;
   const vision::PdfPage pg = vision::render_pdf_page(bytes, name, page, limits);
   const double render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  ImageScene is = build_page_scene(pg, name, page, s);
+  ImageScene is = build_page_scene(pg, name, page, s, timing);
   is.times.load_ms += render_ms;
   is.render_dpi = pg.dpi;
   is.worker_ms = pg.worker_ms;

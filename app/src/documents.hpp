@@ -59,10 +59,10 @@ nlohmann::json stick_listing_json(const StickListing& listing);
 
 /// Builds the scene of page `page` (from 1) of the PDF held in `bytes`, named `name`: drawn in the worker
 /// (vision::render_pdf_page with the [stick] limits), then build_page_scene (text masked, kept as blocks).
-/// The drawing time is added to times.load_ms.
+/// The drawing time is added to times.load_ms. `timing` as build_page_scene's.
 /// @throws vision::PdfError (one line: not a PDF, locked, damaged, no such page, worker stopped).
 /// `fault` is the worker's test hook (vision::PdfFault): None outside tests.
 ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
-                                vision::PdfFault fault = vision::PdfFault::None);
+                                vision::PdfFault fault = vision::PdfFault::None, TextTiming timing = TextTiming::now);
 
 }  // namespace hk::app

@@ -143,17 +143,83 @@ void add_ocr_blocks(ImageScene& out, const vision::OcrResult& text) {
   }
 }
 
-/// The scene of a picture (BGR) whose text is read when [vision] ocr asks: the words masked from the edges,
-/// the blocks kept in metres.
-void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& s) {
+/// Shrinks `grey` to at most `side_px` on its longer side (INTER_AREA); the scale used in `scale`.
+cv::Mat at_most(const cv::Mat& grey, int side_px, double& scale) {
+  const int side = std::max(grey.cols, grey.rows);
+  scale = side > side_px ? static_cast<double>(side_px) / side : 1.0;
+  if (scale == 1.0) return grey;
+  cv::Mat out;
+  cv::resize(grey, out, cv::Size(), scale, scale, cv::INTER_AREA);
+  return out;
+}
+
+/// Side a picture is judged at for being a page of text [px].
+constexpr int kJudgedSidePx = 1600;
+
+/// The scene of a picture (BGR) whose text is read when [vision] ocr asks (now, or later by with_text): the
+/// words masked from the edges, the blocks kept in metres.
+void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel) {
   cv::Mat grey;
   cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
   vision::OcrResult text;
-  if (wants_picture_text(grey, s, out.ocr.why)) text = read_text(grey, out.image_path, s, out.ocr);
+  cv::Mat mask;
+  if (wants_picture_text(grey, s, out.ocr.why)) {
+    if (timing == TextTiming::now) {
+      text = read_text(grey, out.image_path, s, out.ocr, cancel);
+      if (!text.words.empty()) mask = text_mask(grey.size(), as_page_words(text.words));
+    } else {
+      mask = printed_letters_mask_of(grey);
+      out.text_pending = true;
+      out.with_text = [bgr, name = out.image_path, s](const std::atomic<bool>* stop) {
+        ImageScene again;
+        again.image_path = name;
+        again.picture = bgr;
+        build_picture(again, bgr, s, TextTiming::now, stop);
+        return again;
+      };
+    }
+  }
   out.text_words_masked = text.words.size();
-  const cv::Mat mask = text.words.empty() ? cv::Mat() : text_mask(grey.size(), as_page_words(text.words));
   build_from_chains(out, vision::scene_chains_from_image(bgr, extract_params(s), simplify_params(s), segment_cost(s), mask), s);
   add_ocr_blocks(out, text);
+}
+
+/// The scene of a rendered document page (see build_page_scene).
+void build_page(ImageScene& out, const vision::PdfPage& page, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel) {
+  cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
+  vision::OcrResult text;
+  cv::Mat letters;  // printed letters, until OCR has read the words
+  if (wants_page_text(page, s, out.ocr.why)) {
+    if (timing == TextTiming::now) {
+      text = read_text(page.grey, out.image_path, s, out.ocr, cancel);
+    } else {
+      letters = printed_letters_mask_of(page.grey);
+      out.text_pending = true;
+      out.with_text = [kept = std::make_shared<const vision::PdfPage>(page), name = out.image_path, number = out.page, s](const std::atomic<bool>* stop) {
+        ImageScene again;
+        again.image_path = name;
+        again.page = number;
+        again.pages = kept->pages;
+        build_page(again, *kept, s, TextTiming::now, stop);
+        return again;
+      };
+    }
+  }
+  const bool read = !text.words.empty();  // else the text layer's words, if any
+  const std::vector<vision::PdfWord> words = read ? as_page_words(text.words) : page.words;
+  out.text_words_masked = words.size();
+  cv::Mat mask = words.empty() ? cv::Mat() : text_mask(page.grey.size(), words);
+  if (!letters.empty()) mask = mask.empty() ? letters : (mask | letters);
+  build_from_chains(out, vision::scene_chains_from_image(page.grey, extract_params(s), simplify_params(s), segment_cost(s), mask), s);
+  if (read) {
+    add_ocr_blocks(out, text);
+    return;
+  }
+  for (const vision::TextBlock& b : page.blocks) {
+    TextBlockM t = block_in_metres(b.box_px, out.px_to_m, static_cast<int>(out.text_blocks.size()));
+    t.text = b.text;
+    out.text_blocks.push_back(std::move(t));
+  }
 }
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -178,27 +244,40 @@ bool wants_picture_text(const cv::Mat& grey, const config::Settings& s, std::str
     why = "always";
     return true;
   }
-  constexpr int kJudgedSidePx = 1600;
-  cv::Mat judged = grey;
-  const int side = std::max(grey.cols, grey.rows);
-  if (side > kJudgedSidePx) cv::resize(grey, judged, cv::Size(), static_cast<double>(kJudgedSidePx) / side, static_cast<double>(kJudgedSidePx) / side, cv::INTER_AREA);
-  const bool page = vision::looks_like_text_page(judged);
+  double scale = 1.0;
+  const bool page = vision::looks_like_text_page(at_most(grey, kJudgedSidePx, scale));
   why = page ? "a page of text" : "not a page of text";
   return page;
 }
 
-vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& s, OcrReport& report) {
-  const int side = std::max(grey.cols, grey.rows);
-  const double scale = side > kOcrMaxSidePx ? static_cast<double>(kOcrMaxSidePx) / side : 1.0;
-  cv::Mat read = grey;
-  if (scale < 1.0) cv::resize(grey, read, cv::Size(), scale, scale, cv::INTER_AREA);
+cv::Mat printed_letters_mask_of(const cv::Mat& grey) {
+  double scale = 1.0;
+  const cv::Mat judged = at_most(grey, kJudgedSidePx, scale);
+  cv::Mat mask = vision::printed_letters_mask(judged);
+  if (mask.empty() || scale == 1.0) return mask;
+  cv::Mat full;
+  cv::resize(mask, full, grey.size(), 0, 0, cv::INTER_NEAREST);
+  return full;
+}
+
+vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& s, OcrReport& report,
+                            const std::atomic<bool>* cancel) {
+  double scale = 1.0;
+  const cv::Mat read = at_most(grey, kOcrMaxSidePx, scale);
+  vision::OcrParams params = ocr_params_from(s);
+  params.cancel = cancel;
   vision::OcrResult r;
   try {
-    r = vision::recognise_text(read, name, ocr_params_from(s));
+    r = vision::recognise_text(read, name, params);
   } catch (const vision::OcrError& e) {
-    spdlog::warn("{}; the picture is felt without its text", e.what());
     report.ran = false;
-    report.why = std::string("failed: ") + e.what();
+    if (e.kind() == vision::OcrError::Kind::Cancelled) {
+      spdlog::info("{}", e.what());
+      report.why = "cancelled";
+    } else {
+      spdlog::warn("{}; the picture is felt without its text", e.what());
+      report.why = std::string("failed: ") + e.what();
+    }
     return {};
   }
   if (scale < 1.0) {  // back to the picture's pixels
@@ -213,34 +292,35 @@ vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const 
   return r;
 }
 
-ImageScene build_image_scene(const std::string& path, const config::Settings& s) {
+ImageScene build_image_scene(const std::string& path, const config::Settings& s, TextTiming timing) {
   ImageScene out;
   out.image_path = path;
   const auto t0 = std::chrono::steady_clock::now();
   const cv::Mat bgr = vision::load_image(path, extract_params(s).limits);
   const double load_ms = ms_since(t0);
-  build_picture(out, bgr, s);
+  build_picture(out, bgr, s, timing, nullptr);
   out.times.load_ms += load_ms;
   return out;
 }
 
-ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& s) {
+ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& s,
+                                        TextTiming timing) {
   ImageScene out;
   out.image_path = name;
   const auto t0 = std::chrono::steady_clock::now();
   out.picture = vision::decode_image(bytes, name, extract_params(s).limits);
   const double decode_ms = ms_since(t0);
-  build_picture(out, out.picture, s);
+  build_picture(out, out.picture, s, timing, nullptr);
   out.times.load_ms += decode_ms;
   return out;
 }
 
-ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& s) {
+ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& s, TextTiming timing) {
   if (bgr.empty() || bgr.type() != CV_8UC3) throw std::invalid_argument("picture '" + name + "': must be a non-empty 8-bit BGR image");
   ImageScene out;
   out.image_path = name;
   out.picture = bgr.clone();
-  build_picture(out, out.picture, s);
+  build_picture(out, out.picture, s, timing, nullptr);
   return out;
 }
 
@@ -296,28 +376,12 @@ bool wants_page_text(const vision::PdfPage& page, const config::Settings& s, std
   return little;
 }
 
-ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& s) {
+ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& s, TextTiming timing) {
   ImageScene out;
   out.image_path = name;
   out.page = page_number;
   out.pages = page.pages;
-  cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
-  vision::OcrResult text;
-  if (wants_page_text(page, s, out.ocr.why)) text = read_text(page.grey, name, s, out.ocr);
-  const bool read = !text.words.empty();  // else the text layer's words, if any
-  const std::vector<vision::PdfWord> words = read ? as_page_words(text.words) : page.words;
-  out.text_words_masked = words.size();
-  const cv::Mat mask = words.empty() ? cv::Mat() : text_mask(page.grey.size(), words);
-  build_from_chains(out, vision::scene_chains_from_image(page.grey, extract_params(s), simplify_params(s), segment_cost(s), mask), s);
-  if (read) {
-    add_ocr_blocks(out, text);
-    return out;
-  }
-  for (const vision::TextBlock& b : page.blocks) {
-    TextBlockM t = block_in_metres(b.box_px, out.px_to_m, static_cast<int>(out.text_blocks.size()));
-    t.text = b.text;
-    out.text_blocks.push_back(std::move(t));
-  }
+  build_page(out, page, s, timing, nullptr);
   return out;
 }
 

@@ -5,7 +5,9 @@
 /// (DESIGN.md "Data flow").
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +67,19 @@ struct OcrReport {
   long worker_max_rss_kb = 0;  ///< the worker's peak memory [KiB]
 };
 
+/// When a scene's text is read (OCR takes seconds a page).
+enum class TextTiming {
+  now,    ///< in the build: the scene comes back complete (explore, scripted runs, tests)
+  later,  ///< the build only decides whether to read it; ImageScene::with_text reads it (the kiosk's TextReader)
+};
+
+struct ImageScene;
+
+/// Builds a scene again with its text read (OCR in its worker process, the words masked from the edges, the
+/// blocks kept). A raised `cancel` (may be null) kills the worker within 50 ms; the scene then comes back
+/// without its text (OcrReport::why "cancelled").
+using TextBuild = std::function<ImageScene(const std::atomic<bool>* cancel)>;
+
 /// A picture turned into a scene. `polylines[i]` is the curve built into `scene` as the curve whose
 /// `source_index` is i.
 ///
@@ -79,6 +94,11 @@ struct ImageScene {
   cv::Mat picture;                          ///< BGR pixels of a page built from memory; empty for a picture file (read it from image_path)
   std::vector<TextBlockM> text_blocks;      ///< a page's text blocks (masked from the edges), in reading order
   OcrReport ocr;                            ///< whether the text was read from the pixels, and how it went
+  /// The text is still to be read (built with TextTiming::later and OCR wanted): the curves are the
+  /// picture's with the letters of printed lines kept out (vision::printed_letters_mask), there are no OCR
+  /// text blocks yet, and `with_text` reads them.
+  bool text_pending = false;
+  TextBuild with_text;                      ///< set with text_pending; slow (seconds): call it off the window thread
   std::size_t text_words_masked = 0;        ///< words whose outlines were kept out of the edges
   double render_dpi = 0;                    ///< a PDF page: the DPI it was drawn at
   double worker_ms = 0;                     ///< a PDF page: wall time of the drawing worker [ms]
@@ -123,27 +143,33 @@ std::vector<Polyline> to_polylines(const std::vector<vision::SceneCurve>& curves
 /// (read_picture_text), then vision::scene_chains_from_image with the words masked (extraction, thin lines,
 /// gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the
 /// level-0 segments plan_levels gives it), then Scene::build (haptics.max_levels) of the curves kept.
+/// `timing` later: the text is not read here (ImageScene::text_pending, with_text).
 /// Throws vision::InputError for bad image files (one line naming the file and the limit).
-ImageScene build_image_scene(const std::string& path, const config::Settings& settings);
+ImageScene build_image_scene(const std::string& path, const config::Settings& settings, TextTiming timing = TextTiming::now);
 
 /// build_image_scene on a picture's bytes already read (a document from a USB stick, read once through
 /// vision::read_stick_file): vision::decode_image with the [vision] limits, then the same steps. `name`
 /// names it in errors and scene.json; ImageScene::picture holds the decoded pixels.
 /// @throws vision::InputError (one line naming `name` and the limit).
-ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& settings);
+ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& settings,
+                                        TextTiming timing = TextTiming::now);
 
 /// build_image_scene on pixels already in memory (a camera capture, issue 16): the same steps from
 /// vision::scene_chains_from_image. `name` names it in errors and scene.json; ImageScene::picture holds a copy.
 /// @throws std::invalid_argument for an empty or non-CV_8UC3 image (and as scene_chains_from_image).
-ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& settings);
+ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& settings,
+                                          TextTiming timing = TextTiming::now);
 
 /// Builds the scene of a rendered document page the way build_image_scene builds a picture's, except that
 /// text is spoken, not felt: its words (the text layer's, or OCR's when wants_page_text) each have their box,
 /// grown by a quarter of its height on each side (the blurred glyphs' edges reach past the box), masked from
 /// edge detection (vision::extract_chains_from_image), and the page's text blocks are kept in metres for the
 /// earcon, Where and Describe. Figures, rules and drawings stay curves.
+/// `timing` later: OCR's words are not read here (ImageScene::text_pending, with_text); meanwhile the text
+/// layer's words and the letters of printed lines are masked.
 /// @param name  the document's name for scene.json and messages (image_path).
-ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& settings);
+ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& settings,
+                            TextTiming timing = TextTiming::now);
 
 /// The mask of a page's text for vision::extract_chains_from_image: CV_8UC1 of `size`, 255 inside each
 /// word box grown by `grow` x its height on every side, 0 elsewhere.
@@ -169,7 +195,14 @@ bool wants_page_text(const vision::PdfPage& page, const config::Settings& settin
 
 /// Reads the text of `grey` (CV_8UC1) with vision::recognise_text at up to kOcrMaxSidePx; the words come back
 /// in `grey`'s pixel frame. Fills `report` (ran, words, confidence, time, memory). A failure (OcrError) is
-/// logged in one line and costs the text only: report.why says what happened, the result is empty.
-vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& settings, OcrReport& report);
+/// logged in one line and costs the text only: report.why says what happened ("cancelled" when `cancel` was
+/// raised), the result is empty.
+vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& settings, OcrReport& report,
+                            const std::atomic<bool>* cancel = nullptr);
+
+/// Where the letters of printed lines lie in `grey` (vision::printed_letters_mask judged at up to 1600 px,
+/// scaled back to grey's size); empty when it is not a page of text. What a page's curves leave out until
+/// OCR has read its words.
+cv::Mat printed_letters_mask_of(const cv::Mat& grey);
 
 }  // namespace hk::app

@@ -319,6 +319,8 @@ void KioskRuntime::show_tutorial(TutorialShape shape) {
   sh.polylines = {tutorial_polyline(shape, half_)};
   publish(std::move(sh), std::make_unique<Scene>(Scene::build({tutorial_polyline(shape, half_)}, s_.haptics.max_levels)),
           -1 - static_cast<int>(shape));
+  text_.cancel();
+  text_news_.clear();
   shown_picture_ = -1;
   shown_document_ = -1;
   shown_page_ = 0;
@@ -326,7 +328,7 @@ void KioskRuntime::show_tutorial(TutorialShape shape) {
 
 int KioskRuntime::show_picture(int index) {
   const std::string& path = pictures_[static_cast<std::size_t>(index)];
-  ImageScene is = build_image_scene(path, s_);
+  ImageScene is = build_image_scene(path, s_, TextTiming::later);
   const int shapes = static_cast<int>(is.scene->curve_count());
   PictureNotes notes;
   try {
@@ -349,9 +351,64 @@ void KioskRuntime::show_built(ImageScene& is, int id) {
   sh.px_to_m = is.px_to_m;
   sh.text_blocks = is.text_blocks;
   publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
+  text_news_.clear();
+  if (is.text_pending && is.with_text) {
+    text_.start(id, std::move(is.with_text));
+    text_since_s_ = -1.0;
+    text_said_ = false;
+  } else {
+    text_.cancel();
+  }
+}
+
+void KioskRuntime::poll_text(double now_s) {
+  if (!text_news_.empty() && (text_news_id_ != shown_id_ || !audio_.speaking())) {
+    if (text_news_id_ == shown_id_) say(text_news_);
+    text_news_.clear();
+  }
+  if (!text_.pending()) return;
+  if (text_.pending_id() != shown_id_) {  // another picture came meanwhile
+    text_.cancel();
+    return;
+  }
+  if (text_since_s_ < 0) text_since_s_ = now_s;
+  if (std::optional<TextRead> read = text_.poll()) {
+    text_arrived(*read);
+    return;
+  }
+  if (!text_said_ && now_s - text_since_s_ > kTextWait_s && !audio_.speaking()) {
+    text_said_ = true;
+    say_brief(audio_.messages().text(audio::MessageId::text_reading));
+  }
+}
+
+void KioskRuntime::text_arrived(TextRead& read) {
+  ImageScene& is = read.scene;
+  spdlog::info("text of scene {}: {}, {} words in {} blocks, read in {:.0f} ms", read.id, is.ocr.why, is.ocr.words, is.text_blocks.size(), read.wall_ms);
+  const audio::MessageCatalog& m = audio_.messages();
+  text_news_id_ = read.id;
+  const bool built = is.scene != nullptr;
+  if (built) {
+    PictureNotes notes = std::move(shown_.notes);
+    show_built(is, read.id);  // the fade: no force step as the letters' curves go and the blocks come
+    shown_.notes = std::move(notes);
+  }
+  if (built && !is.text_blocks.empty()) {
+    text_news_ = m.text(audio::MessageId::text_ready, {{"description", describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))}});
+  } else if (is.ocr.why.rfind("failed", 0) == 0 || !built) {
+    text_news_ = m.text(audio::MessageId::text_unavailable);
+  } else if (text_said_) {
+    text_news_ = m.text(audio::MessageId::text_none);
+  }
 }
 
 std::string KioskRuntime::describe() {
+  // Its text still being read: said first, so the visitor knows more is coming.
+  const std::string reading = text_.pending() ? audio_.messages().text(audio::MessageId::text_reading) + " " : std::string();
+  return reading + describe_shown();
+}
+
+std::string KioskRuntime::describe_shown() {
   if (shown_page_ > 0 || !shown_.text_blocks.empty()) {
     // A page (or a picture of one): the block of text under the hand is read; elsewhere, what the page holds.
     if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m)) {
@@ -415,9 +472,13 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
       ImageScene& is = *d.scene;
       r.ok = true;
       // A page, or a picture of one (its text read): blocks of text and figures; else shapes.
-      r.description = is.page > 0 || !is.text_blocks.empty() ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
-                                                             : describe_shapes(static_cast<int>(is.scene->curve_count()));
+      // A page, or a picture of one (its text read): blocks of text and figures; its text still being read:
+      // said so at once; else shapes.
+      r.description = is.text_pending ? audio_.messages().text(audio::MessageId::text_reading)
+                      : is.page > 0 || !is.text_blocks.empty() ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
+                                                               : describe_shapes(static_cast<int>(is.scene->curve_count()));
       show_built(is, id);
+      text_said_ = is.text_pending;
       shown_page_ = is.page;
       shown_document_ = d.document;
       shown_picture_ = -1;
@@ -638,7 +699,7 @@ void KioskRuntime::rebuild_shown() {
   } else if (shown_picture_ >= 0) {
     show_picture(shown_picture_);
   } else if (shown_id_ <= kFirstCaptureId && !shown_.picture.empty()) {
-    ImageScene is = build_image_scene_from_picture(shown_.picture.clone(), "camera capture", s_);
+    ImageScene is = build_image_scene_from_picture(shown_.picture.clone(), "camera capture", s_, TextTiming::later);
     show_built(is, shown_id_);
   } else if (shown_document_ >= 0 && stick_id_ != 0) {
     rebuild_page_id_ = 1000 + shown_document_ * 100000 + shown_page_;

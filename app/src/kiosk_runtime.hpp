@@ -34,6 +34,7 @@
 #include "servo_core.hpp"
 #include "servo_thread.hpp"
 #include "stick_service.hpp"
+#include "text_reader.hpp"
 
 namespace hk::app {
 
@@ -147,6 +148,7 @@ class KioskRuntime final : public KioskEffects {
   int show_picture(int index) override;
   int picture_count() const override { return static_cast<int>(pictures_.size()); }
   PictureNotes shown_notes() const override { return shown_.notes; }
+  /// What the picture or page holds (describe.hpp), led by "Reading the text." while its text is read.
   std::string describe() override;
   void show_document(int document, int page) override;
   void forget_stick() override;
@@ -190,6 +192,18 @@ class KioskRuntime final : public KioskEffects {
 
   /// Window thread, every frame: news of sticks and finished loads, handed to the flow.
   void poll_sticks(KioskFlow& flow, double now_s);
+  /// Window thread, every frame (`now_s` the frame clock [s]): the text of the page shown, read by the
+  /// TextReader since it was shown (a page or picture built with its text pending is felt at once). Says
+  /// "Reading the text." once when the reading has taken more than kTextWait_s and nothing else is being
+  /// said (a stick page's announcement says it at once). When the text comes, the scene with the words
+  /// masked and its blocks is swapped in with the fade, and, once nothing else is being said, "The text is
+  /// ready. It has 3 blocks of text and one figure."; or "No text was found." (only after "Reading the
+  /// text."); or "The text could not be read." (a worker that crashed, hung or ran out of memory).
+  void poll_text(double now_s);
+  /// Whether the text of the page shown is being read, or its news not yet said (scripted runs wait for it).
+  bool text_busy() const { return text_.pending() || !text_news_.empty(); }
+  /// How long a reading may take before "Reading the text." is said [s].
+  static constexpr double kTextWait_s = 1.0;
   /// Whether stick work (scan or load) may still bring news (scripted runs wait for it).
   bool stick_busy() const { return stick_busy_; }
   /// A folder treated as an inserted USB stick / taken out again (documentation, tests).
@@ -242,7 +256,9 @@ class KioskRuntime final : public KioskEffects {
  private:
   KioskRuntime(const RuntimeOptions& options, const config::Settings& checked_settings, int);  // settings already checked
   CueTrackerParams cue_params() const;
-  void show_built(ImageScene& is, int id);
+  void show_built(ImageScene& is, int id);  // publishes it; starts reading its text when pending
+  void text_arrived(TextRead& read);        // swaps in the page with its text and words what came
+  std::string describe_shown();             // describe() of what is shown, without the reading's news
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
   void rebuild_shown();
   bool try_open_usb();  // the USB pantograph per [device]; false (device_note_ says why) when none answers
@@ -300,6 +316,12 @@ class KioskRuntime final : public KioskEffects {
   Vec2 cursor_in_;             // the last cursor given to set_cursor [m]
   Vec2 cursor_offset_;         // added to it: where tours left the hand [m]
   Vec2 tour_cursor_ref_;       // cursor_in_ when the tour was handed over [m]
+  // The text of the page shown (window thread).
+  TextReader text_;
+  double text_since_s_ = -1.0;  // poll_text's clock when the reading was first seen, −1 before
+  bool text_said_ = false;      // "Reading the text." was said for it
+  std::string text_news_;       // what came of it, said once nothing else is being said
+  int text_news_id_ = 0;        // the scene it is about
   CaptureService capture_;  // the camera; its worker stops before the rest goes
   StickService sticks_;     // last: its threads stop first
 };

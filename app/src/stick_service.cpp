@@ -221,8 +221,8 @@ LoadedDocument StickService::build(const Request& r) {
   try {
     const std::vector<std::uint8_t> bytes = vision::read_stick_file(root, doc.doc.path, s_.stick.max_file_bytes);
     loads_started_.fetch_add(1);
-    out.scene = doc.doc.kind == vision::DocumentKind::Pdf ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s_, pdf_fault_.load())
-                                                          : build_image_scene_from_bytes(bytes, doc.doc.display_name, s_);
+    out.scene = doc.doc.kind == vision::DocumentKind::Pdf ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s_, pdf_fault_.load(), TextTiming::later)
+                                                          : build_image_scene_from_bytes(bytes, doc.doc.display_name, s_, TextTiming::later);
   } catch (const std::exception& e) {  // InputError, PdfError, StickError: this page only
     spdlog::warn("stick {}: {}", r.stick, e.what());
     out.reason = problem_of(e.what());

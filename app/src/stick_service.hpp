@@ -8,7 +8,8 @@
 ///   is installed), scans it and counts its PDFs' pages (list_stick), and unmounts it when it is taken out;
 ///   with neither it says once in the log how to grant the capability and ignores sticks;
 /// - the loader builds the scene of a document page on request (the PDF drawn in its worker process,
-///   edges, multiresolution, trees), so a slow or hostile page never blocks the window.
+///   edges, multiresolution, trees; OCR's text left for the kiosk's TextReader: TextTiming::later), so a slow
+///   or hostile page never blocks the window.
 /// The window thread polls both with poll_news() and poll_loaded() each frame (mutex-guarded queues: neither
 /// thread is real-time). A folder can stand in for a stick (insert_folder), for tests and `--stick DIR`.
 

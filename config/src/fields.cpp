@@ -251,7 +251,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
              "\"auto\": two-tone pictures (silhouettes, logos) traced from a threshold, two-tone line drawings by \"canny\", others by \"surround\"; \"canny\": Canny alone; \"surround\": Canny, edges that do not stand out from the texture around them dropped; \"bilateral\": Canny after a bilateral filter; \"edpf\": Edge Drawing (parameter-free); \"outline\": always traced from a threshold.",
              kDetectors),
     HK_FIELD(vision, ocr, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
-             "\"auto\": text is read aloud (Tesseract) from pictures that look like a page of text and PDF pages without a text layer; \"always\": from every picture; \"off\": never (a page takes about 10 s to read, and the picture is felt only when it is read).",
+             "\"auto\": text is read aloud (Tesseract) from pictures that look like a page of text and PDF pages without a text layer; \"always\": from every picture; \"off\": never. The picture is felt at once; its text (about 10 s a page) comes when it is read.",
              kOcrModes),
     HK_FIELD(vision, ocr_languages, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
              "Tesseract languages joined by '+' (\"eng\", \"eng+deu\"); empty: the message catalogue's language. A missing one turns OCR off at start, said in the log.",

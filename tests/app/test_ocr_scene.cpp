@@ -2,7 +2,7 @@
 // turned 1.5°, noise, JPEG 80) becomes text blocks read by OCR ("source": "ocr", with their confidence)
 // whose words are 90 % of pdftotext's, with at most 5 curves left inside them; the same scan wrapped in an
 // image-only PDF (no text layer, as scan-to-PDF apps write) gives the same text; every shipped photograph
-// and silhouette gives no text block; [vision] ocr = "off" feels the page as before; explore writes it all.
+// and silhouette gives no text block; [vision] ocr = "off" feels the page's words; explore writes it all.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -95,9 +95,9 @@ TEST(OcrScene, AScannedPageIsReadAsTextBlocksNotFeltAsBumps) {
   EXPECT_EQ(is.ocr.words, static_cast<int>(is.text_words_masked));
   EXPECT_GT(is.ocr.worker_max_rss_kb, 0);
 
-  // [vision] ocr = "off" (the default): the words are felt as bumps again, as a check that the mask is what removed them.
+  // [vision] ocr = "off": the words are felt as bumps again, as a check that the mask is what removed them.
   config::Settings off;
-  ASSERT_EQ(off.vision.ocr, "off");
+  off.vision.ocr = "off";
   const ImageScene felt = build_image_scene_from_bytes(r.jpeg, "scan.jpg", off);
   EXPECT_FALSE(felt.ocr.ran);
   EXPECT_EQ(felt.ocr.why, "off");

@@ -31,6 +31,7 @@ constexpr std::size_t kMaxAnswerBytes = 64u << 20;
 /// Throws the OcrError for a worker that gave no complete answer.
 [[noreturn]] void fail_run(const worker::WorkerRun& run, const std::string& name, const OcrParams& p) {
   const double cpu_limit = std::ceil(std::max(p.worker_cpu_s, 0.001));
+  if (run.cancelled) fail(OcrError::Kind::Cancelled, name, "reading the text was cancelled");
   if (run.timed_out) fail(OcrError::Kind::Timeout, name, "reading the text took longer than " + worker::arg(p.worker_wall_s) + " s");
   if (run.overflow) fail(OcrError::Kind::WorkerCrashed, name, "the text reader sent an oversized answer");
   if (WIFSIGNALED(run.status)) {
@@ -64,13 +65,15 @@ std::vector<std::uint8_t> packed(const cv::Mat& grey) {
 /// Reads one block of the answer into `out` (its words appended to out.words, the block to out.blocks).
 bool read_block(worker::WireReader& in, OcrResult& out, double& confidence_sum) {
   std::uint32_t lines = 0, words = 0;
-  if (!in.u32(lines) || !in.u32(words) || words == 0 || words > kMaxWords || out.words.size() + words > kMaxWords) return false;
+  if (!in.u32(lines) || !in.u32(words) || words == 0 || words > kMaxWords || out.words.size() + words > kMaxWords || lines == 0 || lines > words) {
+    return false;
+  }
   OcrBlock b;
   b.lines = static_cast<int>(lines);
   double block_sum = 0;
   for (std::uint32_t i = 0; i < words; ++i) {
     OcrWord w;
-    if (!in.str(w.text, kMaxWordBytes) || !in.f64(w.box_px.x) || !in.f64(w.box_px.y) || !in.f64(w.box_px.width) || !in.f64(w.box_px.height) ||
+    if (!in.str(w.text, kMaxWordBytes) || w.text.empty() || !in.f64(w.box_px.x) || !in.f64(w.box_px.y) || !in.f64(w.box_px.width) || !in.f64(w.box_px.height) ||
         !in.f64(w.confidence) || w.confidence < 0 || w.confidence > 1 || w.box_px.width < 0 || w.box_px.height < 0) {
       return false;
     }
@@ -105,25 +108,8 @@ std::string ocr_languages_problem(const OcrParams& p) {
   return {};
 }
 
-OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const OcrParams& p) {
-  check_params(grey, p);
-  const double pixels = static_cast<double>(grey.cols) * grey.rows;
-  if (pixels > p.max_pixels) {
-    fail(OcrError::Kind::TooLarge, name, std::to_string(grey.cols) + " x " + std::to_string(grey.rows) + " pixels is over the limit of " +
-                                             worker::arg(p.max_pixels));
-  }
-  if (const std::string why = ocr_languages_problem(p); !why.empty()) fail(OcrError::Kind::Unavailable, name, why);
-#ifdef HK_OCR_WORKER_PATH
-  static const std::string path = worker::find_worker("HK_OCR_WORKER", "hk-ocr-worker", HK_OCR_WORKER_PATH);
-#else
-  static const std::string path = worker::find_worker("HK_OCR_WORKER", "hk-ocr-worker", "hk-ocr-worker");
-#endif
-  worker::WorkerRun run;
-  try {
-    run = worker::run_worker(path, ocr_request_args(grey.cols, grey.rows, p), packed(grey), p.worker_wall_s, kMaxAnswerBytes);
-  } catch (const worker::WorkerStartFailure& f) {
-    fail(OcrError::Kind::WorkerCrashed, name, "cannot start the text reader (" + f.why + ")");
-  }
+OcrResult read_ocr_answer(const worker::WorkerRun& run, const std::string& name, const OcrParams& p) {
+  if (run.cancelled) fail_run(run, name, p);
   worker::WireReader in(run.answer);
   std::uint32_t magic = 0;
   std::uint8_t status = 0;
@@ -148,6 +134,28 @@ OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const Ocr
   return out;
 }
 
+OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const OcrParams& p) {
+  check_params(grey, p);
+  const double pixels = static_cast<double>(grey.cols) * grey.rows;
+  if (pixels > p.max_pixels) {
+    fail(OcrError::Kind::TooLarge, name, std::to_string(grey.cols) + " x " + std::to_string(grey.rows) + " pixels is over the limit of " +
+                                             worker::arg(p.max_pixels));
+  }
+  if (const std::string why = ocr_languages_problem(p); !why.empty()) fail(OcrError::Kind::Unavailable, name, why);
+#ifdef HK_OCR_WORKER_PATH
+  static const std::string path = worker::find_worker("HK_OCR_WORKER", "hk-ocr-worker", HK_OCR_WORKER_PATH);
+#else
+  static const std::string path = worker::find_worker("HK_OCR_WORKER", "hk-ocr-worker", "hk-ocr-worker");
+#endif
+  worker::WorkerRun run;
+  try {
+    run = worker::run_worker(path, ocr_request_args(grey.cols, grey.rows, p), packed(grey), p.worker_wall_s, kMaxAnswerBytes, p.cancel);
+  } catch (const worker::WorkerStartFailure& f) {
+    fail(OcrError::Kind::WorkerCrashed, name, "cannot start the text reader (" + f.why + ")");
+  }
+  return read_ocr_answer(run, name, p);
+}
+
 namespace {
 
 struct Blob {
@@ -168,21 +176,27 @@ std::vector<std::pair<cv::Rect, int>> components(const cv::Mat& binary) {
   return out;
 }
 
-/// Printed lines: letter-sized dark components, most of which stand on a baseline shared with two others
-/// nearby (see looks_like_text_page).
-bool printed_lines(const cv::Mat& ink, double side) {
+/// The letters of printed lines in a binarised picture (see looks_like_text_page).
+struct PrintedLetters {
+  std::vector<Blob> on_lines;  ///< letter-sized dark components standing on a baseline shared with two others nearby
+  double median_height = 0;    ///< of all letter-sized components [px]
+  bool page = false;           ///< they make a page of text
+};
+
+PrintedLetters printed_letters(const cv::Mat& ink, double side) {
+  PrintedLetters out;
   const auto all = components(ink);
   std::vector<Blob> letters;  // by bottom
   for (const auto& [r, area] : all)
     if (r.height >= 0.006 * side && r.height <= 0.06 * side && r.width <= 3 * r.height) letters.push_back({r.y + r.height, r.x, r.x + r.width, r.height});
-  if (letters.size() < 60 || static_cast<double>(letters.size()) < 0.4 * static_cast<double>(all.size())) return false;
+  if (letters.size() < 60 || static_cast<double>(letters.size()) < 0.4 * static_cast<double>(all.size())) return out;
   std::vector<int> heights;
   for (const Blob& l : letters) heights.push_back(l.height);
   std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2), heights.end());
   const double median = heights[heights.size() / 2];
+  out.median_height = median;
   const double tolerance = std::max(1.0, 0.2 * median);
   std::sort(letters.begin(), letters.end(), [](const Blob& a, const Blob& b) { return a.bottom < b.bottom; });
-  std::size_t on_lines = 0;
   for (std::size_t i = 0, from = 0; i < letters.size(); ++i) {
     while (letters[i].bottom - letters[from].bottom > tolerance) ++from;
     int beside = 0;
@@ -191,9 +205,10 @@ bool printed_lines(const cv::Mat& ink, double side) {
       const int gap = std::max(letters[j].left - letters[i].right, letters[i].left - letters[j].right);
       beside += gap <= 2 * median;
     }
-    on_lines += beside >= 2;
+    if (beside >= 2) out.on_lines.push_back(letters[i]);
   }
-  return 2 * on_lines >= letters.size();
+  out.page = 2 * out.on_lines.size() >= letters.size();
+  return out;
 }
 
 /// A line of large letters (a sign, a poster), light on dark or dark on light: at least kSignLetters
@@ -236,10 +251,24 @@ bool looks_like_text_page(const cv::Mat& grey) {
   cv::Mat ink;
   cv::threshold(grey, ink, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
   const double side = std::min(grey.cols, grey.rows);
-  if (printed_lines(ink, side)) return true;
+  if (printed_letters(ink, side).page) return true;
   cv::Mat light;
   cv::bitwise_not(ink, light);
   return a_line_of_large_letters(ink, side) || a_line_of_large_letters(light, side);
+}
+
+cv::Mat printed_letters_mask(const cv::Mat& grey) {
+  if (grey.empty() || grey.type() != CV_8UC1) return {};
+  cv::Mat ink;
+  cv::threshold(grey, ink, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
+  const PrintedLetters letters = printed_letters(ink, std::min(grey.cols, grey.rows));
+  if (!letters.page) return {};
+  cv::Mat mask(grey.size(), CV_8UC1, cv::Scalar(0));
+  const int grow = static_cast<int>(std::ceil(0.5 * letters.median_height));
+  for (const Blob& b : letters.on_lines) {
+    cv::rectangle(mask, cv::Point(b.left - grow, b.bottom - b.height - grow), cv::Point(b.right - 1 + grow, b.bottom - 1 + grow), cv::Scalar(255), cv::FILLED);
+  }
+  return mask;
 }
 
 }  // namespace hk::vision

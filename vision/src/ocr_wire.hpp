@@ -52,4 +52,10 @@ inline bool parse_ocr_request(int argc, char** argv, OcrRequest& rq) {
   return rq.width > 0 && rq.height > 0 && !rq.params.languages.empty();
 }
 
+/// The kiosk's side of the answer: what the worker of `run` sent, read with every size and value checked
+/// (the worker reads a stranger's pixels, so its answer is not trusted either).
+/// @throws OcrError: the worker's own refusal, or what went wrong with the run (cancelled, timed out, crashed,
+///         or an answer that does not parse: "the text reader gave no usable answer").
+OcrResult read_ocr_answer(const worker::WorkerRun& run, const std::string& name, const OcrParams& params);
+
 }  // namespace hk::vision

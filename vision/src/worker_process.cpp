@@ -152,20 +152,25 @@ int sealed_input(std::span<const std::uint8_t> input) {
   return fd;
 }
 
-/// Reads `fd` into run.answer until EOF, the deadline or max_answer bytes.
-void read_answer(int fd, std::chrono::steady_clock::time_point deadline, std::size_t max_answer, WorkerRun& run) {
+/// Reads `fd` into run.answer until EOF, the deadline, max_answer bytes or the cancel flag.
+void read_answer(int fd, std::chrono::steady_clock::time_point deadline, std::size_t max_answer, const std::atomic<bool>* cancel, WorkerRun& run) {
   char buf[1 << 16];
   for (;;) {
+    if (cancel && cancel->load(std::memory_order_relaxed)) {
+      run.cancelled = true;
+      return;
+    }
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
     if (left <= 0) {
       run.timed_out = true;
       return;
     }
     pollfd p{fd, POLLIN, 0};
-    const int rc = ::poll(&p, 1, static_cast<int>(std::min<long long>(left, INT_MAX)));
+    const long long slice = cancel ? std::min<long long>(left, kCancelPoll_ms) : std::min<long long>(left, INT_MAX);
+    const int rc = ::poll(&p, 1, static_cast<int>(slice));
     if (rc < 0 && errno == EINTR) continue;
     if (rc < 0) return;
-    if (rc == 0) continue;  // the loop head sees the deadline
+    if (rc == 0) continue;  // the loop head sees the deadline and the flag
     const ssize_t n = ::read(fd, buf, sizeof buf);
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
     if (n <= 0) return;  // EOF: the worker has finished or died
@@ -180,7 +185,7 @@ void read_answer(int fd, std::chrono::steady_clock::time_point deadline, std::si
 }  // namespace
 
 WorkerRun run_worker(const std::string& path, const std::vector<std::string>& args, std::span<const std::uint8_t> input, double wall_s,
-                     std::size_t max_answer) {
+                     std::size_t max_answer, const std::atomic<bool>* cancel) {
   const int in = sealed_input(input);
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) {
@@ -210,7 +215,7 @@ WorkerRun run_worker(const std::string& path, const std::vector<std::string>& ar
     cannot_start(path.c_str(), rc);
   }
   WorkerRun run;
-  read_answer(fds[0], t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall_s)), max_answer, run);
+  read_answer(fds[0], t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall_s)), max_answer, cancel, run);
   ::kill(pid, SIGKILL);  // in every case: a worker that closed its pipe but lives on is not left behind
   ::close(fds[0]);
   rusage ru{};

@@ -9,6 +9,7 @@
 /// WireWriter and read with WireReader, every size checked before anything is allocated; numbers are in the
 /// machine's byte order (the worker runs on the same machine). Private to vision.
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -94,6 +95,7 @@ struct WorkerRun {
   std::string answer;          ///< bytes read from the pipe
   bool timed_out = false;      ///< the wall-clock deadline passed
   bool overflow = false;       ///< the worker sent more than max_answer
+  bool cancelled = false;      ///< the caller's cancel flag was raised (checked every kCancelPoll_ms)
   int status = 0;              ///< from wait4
   double cpu_s = 0.0;          ///< user + system time of the worker [s]
   double ms = 0.0;             ///< wall time [ms]
@@ -105,12 +107,16 @@ struct WorkerStartFailure {
   std::string why;
 };
 
+/// How often run_worker looks at its cancel flag while it waits for the answer [ms].
+inline constexpr int kCancelPoll_ms = 50;
+
 /// Parent side: runs the worker executable `path` with `args` (argv[1..]) on `input`, reads its answer until
-/// EOF, `wall_s` [s] or `max_answer` bytes, then kills and reaps it. The kiosk's environment is passed on
-/// (sanitizer options). Blocks the calling thread for at most about wall_s.
+/// EOF, `wall_s` [s], `max_answer` bytes or `*cancel` (when given) becoming true, then kills and reaps it.
+/// The kiosk's environment is passed on (sanitizer options). Blocks the calling thread for at most about
+/// wall_s (kCancelPoll_ms after a cancel).
 /// @throws WorkerStartFailure when it cannot be started.
 WorkerRun run_worker(const std::string& path, const std::vector<std::string>& args, std::span<const std::uint8_t> input, double wall_s,
-                     std::size_t max_answer);
+                     std::size_t max_answer, const std::atomic<bool>* cancel = nullptr);
 
 /// The worker executable: $`env_var` if set; else `file_name` beside this executable (an installed kiosk);
 /// else `built_path` (tests and bench binaries live elsewhere in the build tree).

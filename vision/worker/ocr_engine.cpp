@@ -101,14 +101,19 @@ std::size_t kept_words(const std::vector<Block>& blocks) {
 /// Words the page layout must keep for sparse text not to be tried as well.
 constexpr std::size_t kEnoughForALayout = 3;
 
-/// The worker's work: an answer in `out`, or a Refusal thrown.
-void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p, worker::WireWriter& out) {
+/// Starts Tesseract with the languages of `p` (LSTM engine, one thread, no debug output); a Refusal thrown
+/// when it cannot.
+void start_engine(tesseract::TessBaseAPI& api, const OcrParams& p) {
   ::setenv("OMP_THREAD_LIMIT", "1", 1);  // one core: the servo thread and the window keep theirs
-  tesseract::TessBaseAPI api;
   if (api.Init(p.tessdata_dir.empty() ? nullptr : p.tessdata_dir.c_str(), p.languages.c_str(), tesseract::OEM_LSTM_ONLY) != 0) {
     throw Refusal{OcrError::Kind::Unavailable, "Tesseract cannot start with the languages '" + p.languages + "'"};
   }
   api.SetVariable("debug_file", "/dev/null");
+}
+
+/// Reads the `width` x `height` grey `pixels` with a started engine: the answer (after the status byte) in
+/// `out`, or a Refusal thrown.
+void read_page(tesseract::TessBaseAPI& api, const std::uint8_t* pixels, int width, int height, const OcrParams& p, worker::WireWriter& out) {
   api.SetImage(pixels, width, height, 1, width);
   api.SetSourceResolution(300);
   // Pages: Tesseract's layout analysis. A sign or a poster in a photograph is no page layout: where that
@@ -140,6 +145,13 @@ void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p,
       out.f64(w.confidence);
     }
   }
+}
+
+/// The worker's work: an answer in `out`, or a Refusal thrown.
+void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p, worker::WireWriter& out) {
+  tesseract::TessBaseAPI api;
+  start_engine(api, p);
+  read_page(api, pixels, width, height, p, out);
   api.End();
 }
 

@@ -116,7 +116,7 @@ struct VisionSettings {
   double gap_close_m = 0.001;                 ///< key gap_close_m, chain ends facing each other across a gap up to this are joined, [0, 0.005] m; 0 = off
   double surround_inhibition = 1.5;           ///< key surround_inhibition, texture test α of the "surround" detector (vision::stands_out), [0, 4]; 0 = none
   std::string detector = "auto";              ///< key detector, how boundaries are found: "auto" (two-tone pictures traced from a threshold, line drawings "canny", others "surround"), "canny", "surround", "bilateral", "edpf" or "outline"
-  std::string ocr = "off";                    ///< key ocr, text in pictures read aloud (Tesseract): "auto" (pictures that look like a page of text, PDF pages without a text layer), "always" (every picture), "off" (the default: a page takes the reader about 10 s, and the scene waits for it)
+  std::string ocr = "auto";                   ///< key ocr, text in pictures read aloud (Tesseract): "auto" (pictures that look like a page of text, PDF pages without a text layer), "always" (every picture), "off"; the kiosk feels the picture at once and reads its text meanwhile (about 10 s a page)
   std::string ocr_languages;                  ///< key ocr_languages, Tesseract languages '+'-joined ("eng", "eng+deu"); empty = the message catalogue's language
   double ocr_min_confidence = 0.6;            ///< key ocr_min_confidence, words Tesseract is less sure of are dropped, [0, 1]
 

@@ -14,6 +14,7 @@
 /// none left, or whose words are mostly not letters or digits, is dropped; the rest are the text blocks, in
 /// Tesseract's reading order.
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -44,6 +45,9 @@ struct OcrParams {
   double worker_cpu_s = 30.0;         ///< RLIMIT_CPU of the worker [s]
   double worker_wall_s = 30.0;        ///< the worker is killed after this wall-clock time [s]
   double worker_max_memory_mb = 1536.0;  ///< address space the worker may add at start [MiB] (not under ASan); 0 = no limit
+  /// When given and it becomes true, the worker is killed within worker::kCancelPoll_ms (50 ms) and
+  /// recognise_text throws OcrError Cancelled (a newer page no longer needs this one's text).
+  const std::atomic<bool>* cancel = nullptr;
   OcrFault fault = OcrFault::None;    ///< test hook only
 };
 
@@ -76,8 +80,9 @@ struct OcrResult {
 class OcrError : public hk::Error {
  public:
   /// Unavailable: a language's traineddata is missing, or the engine cannot start; TooLarge: the picture or
-  /// the worker's memory; Timeout: wall-clock or CPU limit; WorkerCrashed: the worker died or answered badly.
-  enum class Kind { Unavailable, TooLarge, Timeout, WorkerCrashed };
+  /// the worker's memory; Timeout: wall-clock or CPU limit; WorkerCrashed: the worker died or answered badly;
+  /// Cancelled: OcrParams::cancel was raised (never sent by a worker).
+  enum class Kind { Unavailable, TooLarge, Timeout, WorkerCrashed, Cancelled };
   OcrError(Kind kind, const std::string& what) : hk::Error(what), kind_(kind) {}
   Kind kind() const { return kind_; }
 
@@ -105,6 +110,14 @@ OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const Ocr
 ///   of the shorter side) on one baseline, side by side.
 /// Photographs and silhouettes have neither. Cost: one threshold and three connected-component passes.
 bool looks_like_text_page(const cv::Mat& grey);
+
+/// Where the letters of printed lines lie in `grey` (CV_8UC1), judged as looks_like_text_page judges a page
+/// of text: CV_8UC1 of grey's size, 255 over the box of each letter-sized component that stands on a baseline
+/// shared with two others, grown by half the median letter height on every side (which joins the letters of a
+/// word and the words of a line); an empty Mat when `grey` is not a page of text. Cheap (one threshold, one
+/// connected-component pass): it keeps the letters' outlines out of a page's curves for the seconds before
+/// OCR has read where its words are. Signs and posters (large letters) are left to OCR.
+cv::Mat printed_letters_mask(const cv::Mat& grey);
 
 /// Entry point of the worker executable (vision/worker/ocr_worker_main.cpp), not for other callers.
 int ocr_worker_entry(int argc, char** argv);
