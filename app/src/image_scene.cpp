@@ -170,6 +170,7 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
     } else {
       mask = printed_letters_mask_of(grey);
       out.text_pending = true;
+      out.text_likely = true;  // it looks like a page of text, or [vision] ocr "always" asks for it
       out.with_text = [bgr, name = out.image_path, s](const std::atomic<bool>* stop) {
         ImageScene again;
         again.image_path = name;
@@ -195,6 +196,7 @@ void build_page(ImageScene& out, const vision::PdfPage& page, const config::Sett
     } else {
       letters = printed_letters_mask_of(page.grey);
       out.text_pending = true;
+      out.text_likely = !letters.empty() || !page.words.empty();
       out.with_text = [kept = std::make_shared<const vision::PdfPage>(page), name = out.image_path, number = out.page, s](const std::atomic<bool>* stop) {
         ImageScene again;
         again.image_path = name;

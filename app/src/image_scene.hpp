@@ -98,6 +98,10 @@ struct ImageScene {
   /// picture's with the letters of printed lines kept out (vision::printed_letters_mask), there are no OCR
   /// text blocks yet, and `with_text` reads them.
   bool text_pending = false;
+  /// With text_pending: the picture looks like a page of text (printed lines were found), so the kiosk says
+  /// "Reading the text." with it at once; false for a picture page of a PDF without a text layer, which is
+  /// read all the same but may well hold no text.
+  bool text_likely = false;
   TextBuild with_text;                      ///< set with text_pending; slow (seconds): call it off the window thread
   std::size_t text_words_masked = 0;        ///< words whose outlines were kept out of the edges
   double render_dpi = 0;                    ///< a PDF page: the DPI it was drawn at

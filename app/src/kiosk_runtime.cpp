@@ -471,14 +471,14 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
     if (d.scene) {
       ImageScene& is = *d.scene;
       r.ok = true;
-      // A page, or a picture of one (its text read): blocks of text and figures; else shapes.
       // A page, or a picture of one (its text read): blocks of text and figures; its text still being read:
       // said so at once; else shapes.
-      r.description = is.text_pending ? audio_.messages().text(audio::MessageId::text_reading)
+      r.description = is.text_pending && is.text_likely ? audio_.messages().text(audio::MessageId::text_reading)
                       : is.page > 0 || !is.text_blocks.empty() ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
                                                                : describe_shapes(static_cast<int>(is.scene->curve_count()));
+      const bool said_reading = is.text_pending && is.text_likely;
       show_built(is, id);
-      text_said_ = is.text_pending;
+      text_said_ = said_reading;
       shown_page_ = is.page;
       shown_document_ = d.document;
       shown_picture_ = -1;

@@ -153,6 +153,7 @@ TEST(PdfPages, PicturePagesGiveThePngsCurvesWithinAPixel) {
     s.stick.page_max_dpi = 72.0;  // the DPI img2pdf embedded the pictures at: one page pixel per picture pixel
     s.vision.max_shapes = 1000;   // every curve: the pages' geometry is compared, not which 30 rank first
     s.vision.detector = "canny";  // nor which edges stand out from their surround (vision/texture.hpp)
+    s.vision.ocr = "off";         // nor which words OCR reads and masks (page.png is a photo of a page of text)
     const ImageScene from_png = build_image_scene((kData / "images" / png).string(), s);
     s.vision.canny_low = from_png.canny_low;
     s.vision.canny_high = from_png.canny_high;
@@ -180,6 +181,7 @@ TEST(PdfPages, PicturePagesGiveThePngsCurvesWithinAPixel) {
 // curves that remain do not run through the text, and the text is kept as blocks in the workspace.
 TEST(PdfPages, TextIsSpokenNotFelt) {
   config::Settings s = test_settings();
+  s.vision.ocr = "off";  // the text layer's words alone (without them the page would be read by OCR)
   const vision::PdfPage page = vision::render_pdf_page(bytes_of(kSpecPdf), "shared-mime-info-spec.pdf", 2, pdf_limits_from(s));
   ASSERT_GT(page.words.size(), 50u) << "page 2 of the specification is a page of text";
   const ImageScene masked = build_page_scene(page, "spec.pdf", 2, s);
@@ -463,8 +465,9 @@ TEST(StickService, InsertBrowseCrashRemoveInsertAgain) {
 }
 
 // The kiosk under Xvfb with a folder inserted as a stick: the summary and first document are said, Next
-// walks to the PDF's pages, Describe on a page says what it holds, taking the stick out goes back to the
-// library (its speech log, one "say:" line per message).
+// walks to the PDF's pages (the second, a photo of a page of text, is read by OCR: said at once, then that its
+// text is ready), Describe on a page says what it holds, taking the stick out goes back to the library (its
+// speech log, one "say:" line per message).
 TEST(KioskScreen, StickIsBrowsedPageByPageAndTakenOut) {
   if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = fresh_dir("kiosk_stick");
@@ -489,7 +492,8 @@ TEST(KioskScreen, StickIsBrowsedPageByPageAndTakenOut) {
   }
   const std::vector<std::string> want_prefix{
       "A USB stick with 2 documents: a picture and a PDF of 2 pages. Press the Right arrow to go through them. Document 1 of 2, a horse.png. It has",
-      "Page 1 of 2 of b two pages.pdf. It has no text and", "Page 2 of 2 of b two pages.pdf. It has", "It has",
+      "Page 1 of 2 of b two pages.pdf. It has no text and", "Page 2 of 2 of b two pages.pdf. Reading the text.", "The text is ready. It has",
+      "It has",
       "The USB stick was taken out. Back to the picture library. Picture 1 of 1."};
   ASSERT_EQ(said.size(), want_prefix.size()) << slurp(dir / "log.txt");
   for (std::size_t i = 0; i < said.size(); ++i) EXPECT_EQ(said[i].rfind(want_prefix[i], 0), 0u) << said[i];

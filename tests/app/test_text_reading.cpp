@@ -21,6 +21,7 @@
 
 #include "image_scene.hpp"
 #include "kiosk_exe.hpp"
+#include "kiosk_flow.hpp"
 #include "kiosk_runtime.hpp"
 #include "scans.hpp"
 #include "text_reader.hpp"
@@ -277,6 +278,35 @@ TEST(KioskText, AnotherPictureCancelsTheReadingAndNothingIsSaidOfIt) {
   for (int frame = 0; frame < 30; ++frame, now_s += 0.1) k.rt->poll_text(now_s);
   EXPECT_EQ(k.rt->last_said(), "") << "nothing said of the page left";
   EXPECT_TRUE(k.rt->shown().text_blocks.empty());
+}
+
+TEST(KioskText, AScanOnAStickIsAnnouncedAsBeingReadThenItsTextIsReady) {
+  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
+  KioskRig k;
+  const fs::path stick = k.scan.dir / "stick";
+  fs::create_directories(stick);
+  std::ofstream(stick / "letter.jpg", std::ios::binary).write(reinterpret_cast<const char*>(k.scan.jpeg.data()), static_cast<std::streamsize>(k.scan.jpeg.size()));
+  KioskFlowParams fp;
+  KioskFlow flow(*k.rt, k.rt->audio().messages(), fp);
+  double now_s = 0.0;
+  flow.key(KioskKey::Other, now_s);  // a visitor is there
+  k.rt->insert_stick_folder(stick.string());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  std::string announced;
+  while (std::chrono::steady_clock::now() < deadline && announced.empty()) {
+    k.rt->poll_sticks(flow, now_s);
+    if (k.rt->last_said().find("letter.jpg") != std::string::npos && !k.rt->stick_busy()) announced = k.rt->last_said();
+    now_s += 0.1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_FALSE(announced.empty()) << "the stick's picture was not shown within 60 s; last said: " << k.rt->last_said();
+  EXPECT_NE(announced.find("letter.jpg. Reading the text."), std::string::npos) << announced;
+  EXPECT_TRUE(k.rt->text_busy());
+  const std::vector<std::string> said = k.frames_until_read(now_s);
+  ASSERT_EQ(said.size(), 1u) << "'Reading the text.' is not said twice";
+  EXPECT_EQ(said[0].rfind("The text is ready. It has ", 0), 0u) << said[0];
+  EXPECT_GE(k.rt->shown().text_blocks.size(), 3u);
 }
 
 }  // namespace
