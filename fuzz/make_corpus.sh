@@ -9,7 +9,7 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 [ $# -ge 1 ] || { echo "usage: $0 DEST [harness ...]" >&2; exit 2; }
 dest=$1
 shift
-all=(image pdf config messages hand_csv hapi_reply stick_name)
+all=(image pdf config messages hand_csv hapi_reply stick_name ocr)
 [ $# -gt 0 ] && harnesses=("$@") || harnesses=("${all[@]}")
 data=$repo/tests/data
 seeds=$repo/fuzz/seeds
@@ -63,6 +63,9 @@ for h in "${harnesses[@]}"; do
         while IFS= read -r p; do i=$((i + 1)); printf '%s' "$p" > "$dest/corpus/stick_name/path_$i"; done
       }
       cp "$dicts/name.dict" "$dest/dicts/stick_name.dict" ;;
+    ocr)
+      copy_seeds ocr 16384 "$seeds"/ocr/*
+      cp "$dicts/ocr.dict" "$dest/dicts/ocr.dict" ;;
     *)
       echo "make_corpus: unknown harness '$h' (known: ${all[*]})" >&2
       exit 2 ;;
