@@ -164,11 +164,16 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
   vision::OcrResult text;
   cv::Mat mask;
   if (wants_picture_text(grey, s, out.ocr.why)) {
+    // The letters of printed lines are kept out of the curves whether OCR reads them or not (a word too
+    // uncertain to speak is still no shape to feel).
+    mask = printed_letters_mask_of(grey);
     if (timing == TextTiming::now) {
       text = read_text(grey, out.image_path, s, out.ocr, cancel);
-      if (!text.words.empty()) mask = text_mask(grey.size(), as_page_words(text.words));
+      if (!text.words.empty()) {
+        const cv::Mat words = text_mask(grey.size(), as_page_words(text.words));
+        mask = mask.empty() ? words : (mask | words);
+      }
     } else {
-      mask = printed_letters_mask_of(grey);
       out.text_pending = true;
       out.text_likely = true;  // it looks like a page of text, or [vision] ocr "always" asks for it
       out.with_text = [bgr, name = out.image_path, s](const std::atomic<bool>* stop) {
@@ -189,12 +194,12 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
 void build_page(ImageScene& out, const vision::PdfPage& page, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel) {
   cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
   vision::OcrResult text;
-  cv::Mat letters;  // printed letters, until OCR has read the words
+  cv::Mat letters;  // printed letters, kept out whether OCR reads them or not
   if (wants_page_text(page, s, out.ocr.why)) {
+    letters = printed_letters_mask_of(page.grey);
     if (timing == TextTiming::now) {
       text = read_text(page.grey, out.image_path, s, out.ocr, cancel);
     } else {
-      letters = printed_letters_mask_of(page.grey);
       out.text_pending = true;
       out.text_likely = !letters.empty() || !page.words.empty();
       out.with_text = [kept = std::make_shared<const vision::PdfPage>(page), name = out.image_path, number = out.page, s](const std::atomic<bool>* stop) {

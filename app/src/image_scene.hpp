@@ -144,7 +144,8 @@ double polyline_length_m(const Polyline& p);
 std::vector<Polyline> to_polylines(const std::vector<vision::SceneCurve>& curves);
 
 /// Loads the image at `path` and builds its scene with `settings`: text read from it when [vision] ocr asks
-/// (read_picture_text), then vision::scene_chains_from_image with the words masked (extraction, thin lines,
+/// (wants_picture_text, read_text), then vision::scene_chains_from_image with the words and the letters of
+/// printed lines (printed_letters_mask_of: words too uncertain to speak are no shapes either) masked (extraction, thin lines,
 /// gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the
 /// level-0 segments plan_levels gives it), then Scene::build (haptics.max_levels) of the curves kept.
 /// `timing` later: the text is not read here (ImageScene::text_pending, with_text).
@@ -168,7 +169,8 @@ ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string&
 /// text is spoken, not felt: its words (the text layer's, or OCR's when wants_page_text) each have their box,
 /// grown by a quarter of its height on each side (the blurred glyphs' edges reach past the box), masked from
 /// edge detection (vision::extract_chains_from_image), and the page's text blocks are kept in metres for the
-/// earcon, Where and Describe. Figures, rules and drawings stay curves.
+/// earcon, Where and Describe. When OCR is wanted the letters of printed lines are masked too. Figures, rules
+/// and drawings stay curves.
 /// `timing` later: OCR's words are not read here (ImageScene::text_pending, with_text); meanwhile the text
 /// layer's words and the letters of printed lines are masked.
 /// @param name  the document's name for scene.json and messages (image_path).
