@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <stdlib.h>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "image_pdf.hpp"
@@ -181,6 +183,32 @@ TEST(OcrScene, ExploreWritesTheBlocksWithTheirSourceAndTheOcrSummary) {
     EXPECT_GE(b["confidence"].get<double>(), 0.6);
     EXPECT_EQ(b["bbox_m"].size(), 4u);
   }
+}
+
+// A text reader that crashes (a worker killed by SIGSEGV, as a Tesseract bug on a stranger's pixels would
+// kill it): the page is still felt, its text is reported unavailable in one line, and explore ends normally.
+TEST(OcrScene, AWorkerThatCrashesCostsTheTextNeverThePage) {
+  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  ScanRig r;
+  {
+    std::ofstream f(r.dir / "scan.jpg", std::ios::binary);
+    f.write(reinterpret_cast<const char*>(r.jpeg.data()), static_cast<std::streamsize>(r.jpeg.size()));
+  }
+  const fs::path crash = r.dir / "crashing-worker.sh";
+  std::ofstream(crash) << "#!/bin/sh\nkill -SEGV $$\n";
+  fs::permissions(crash, fs::perms::owner_all);
+  ASSERT_EQ(::setenv("HK_OCR_WORKER", crash.c_str(), 1), 0);
+  const test::ExeResult run =
+      test::run_kiosk("explore " + test::quoted(r.dir / "scan.jpg") + " --out " + test::quoted(r.dir / "out") + " --duration 0.5", r.dir);
+  ::unsetenv("HK_OCR_WORKER");
+  ASSERT_EQ(run.status, 0) << run.err;
+  std::ifstream sf(r.dir / "out" / "summary.json"), jf(r.dir / "out" / "scene.json");
+  const nlohmann::json summary = nlohmann::json::parse(sf), scene = nlohmann::json::parse(jf);
+  EXPECT_EQ(summary["ocr"]["ran"], false);
+  const std::string why = summary["ocr"]["why"];
+  EXPECT_EQ(why, "failed: ocr '" + (r.dir / "scan.jpg").string() + "': the text reader stopped (signal 11)");
+  EXPECT_TRUE(!scene.contains("text_blocks") || scene["text_blocks"].empty());
+  EXPECT_GT(scene["curves"].size(), 0u) << "the page is still felt";
 }
 
 }  // namespace
