@@ -79,6 +79,16 @@ inline std::vector<std::uint8_t> scan_jpeg(const std::filesystem::path& pdf, int
   return jpeg;
 }
 
+/// `page` of `pdf` as pdftoppm draws it at `dpi`, grey (CV_8UC1), clean (not turned, no noise); empty when pdftoppm
+/// fails. The PNG is left in `dir`.
+inline cv::Mat draw_page(const std::filesystem::path& pdf, int page, int dpi, const std::filesystem::path& dir) {
+  const std::filesystem::path stem = dir / ("page" + std::to_string(page) + "_" + std::to_string(dpi));
+  if (shell("pdftoppm -gray -r " + std::to_string(dpi) + " -f " + std::to_string(page) + " -l " + std::to_string(page) + " -singlefile -png '" +
+            pdf.string() + "' '" + stem.string() + "'") != 0)
+    return {};
+  return cv::imread(stem.string() + ".png", cv::IMREAD_GRAYSCALE);
+}
+
 /// The text layer of `page` of `pdf`, as pdftotext gives it.
 inline std::string pdftotext_page(const std::filesystem::path& pdf, int page, const std::filesystem::path& dir) {
   const std::filesystem::path out = dir / "truth.txt";

@@ -148,6 +148,25 @@ inline std::array<cv::Point2d, 4> photo_corners(cv::Size picture, cv::Size frame
   return moved;
 }
 
+/// `c` with offset_px chosen so that the picture lies against the frame's edge `edge` (0 top, 1 right, 2 bottom,
+/// 3 left): its corner nearest that edge `gap_px` inside it, measured from the frame's outer boundary (half a pixel
+/// beyond the outermost pixel centres), or that far outside it for a negative gap; centred along the edge.
+inline PhotoConditions near_edge(cv::Size picture, cv::Size frame, PhotoConditions c, int edge, double gap_px) {
+  c.offset_px = {0, 0};
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+  for (const cv::Point2d& p : photo_corners(picture, frame, c)) {
+    x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+  }
+  const double left = -0.5 + gap_px, right = frame.width - 0.5 - gap_px, top = -0.5 + gap_px, bottom = frame.height - 0.5 - gap_px;
+  switch (edge) {
+    case 0: c.offset_px = {0, top - y0}; break;
+    case 1: c.offset_px = {right - x1, 0}; break;
+    case 2: c.offset_px = {0, bottom - y1}; break;
+    default: c.offset_px = {left - x0, 0}; break;
+  }
+  return c;
+}
+
 /// Renders `picture` (CV_8UC1 or CV_8UC3) into a `frame`-sized photo under conditions `c`. The picture is first
 /// shrunk (INTER_AREA) to about its size in the frame so the perspective warp (bilinear) does not alias; the
 /// frame is then backdrop·(1 − coverage) + picture·coverage (cv::blendLinear), times the light, blurred, plus

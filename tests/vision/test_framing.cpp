@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "synthetic_photo.hpp"
 #include "vision/framing.hpp"
 
 namespace hk::vision {
@@ -189,6 +190,35 @@ TEST(FrameLook, MotionAndDetailFromRealPixels) {
   const FrameLook moved = look_at_frame(b, 0.2, &same, small, {});
   EXPECT_GT(moved.motion, 4.0);
   EXPECT_THROW(look_at_frame(cv::Mat(), 0, nullptr, small, {}), std::invalid_argument);
+}
+
+// Real frames of a page near the frame's bottom edge (turned, tilted, lit unevenly, noisy): lying whole 6 px (1.3 %)
+// from it, the page is ready to capture (nothing to say); with a corner 6 px beyond it, it is cut off at the bottom.
+TEST(FrameLook, APageWholeNearTheBottomIsReadyAndOneJustBeyondItIsCutOff) {
+  const cv::Mat page = hk::test::text_page();
+  const cv::Size size(kW, kH);
+  for (const double gap_px : {6.0, -6.0}) {
+    hk::test::PhotoConditions pc;
+    pc.rotation_deg = 3;
+    pc.perspective = 0.12;
+    pc.blur_sigma_px = 0.8;
+    pc.noise_sigma = 4;
+    pc.uneven_light = true;
+    pc.backdrop = hk::test::Backdrop::blobs;
+    pc.seed = 43;
+    pc.fill = 0.85;
+    const cv::Mat frame = hk::test::synthetic_photo(page, size, hk::test::near_edge(page.size(), size, pc, 2, gap_px)).frame;
+    cv::Mat small;
+    const FrameLook first = look_at_frame(frame, 0.0, nullptr, small);
+    const FrameLook still = look_at_frame(frame, 0.1, &first, small);
+    ASSERT_TRUE(still.page.found) << gap_px;
+    const FramingGuide g;
+    if (gap_px > 0) {
+      EXPECT_EQ(g.advice_for(still), std::nullopt) << "whole, " << gap_px << " px from the bottom";
+    } else {
+      EXPECT_EQ(g.advice_for(still), FramingAdvice::CutOffBottom) << -gap_px << " px beyond the bottom";
+    }
+  }
 }
 
 }  // namespace

@@ -248,6 +248,119 @@ TEST(PageCutOff, TopEdgeOutsideTheFrame) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
+// A page lying whole in the frame close to its edge is found with its own corners and is not cut off; a page whose
+// corner lies just outside the frame is. A page that fills the kiosk camera's 3264 x 2448 frame lies within 2 % of
+// its edge.
+
+/// A page against the frame's edge `edge` (0 top, 1 right, 2 bottom, 3 left), its nearest corner `gap_px` inside
+/// it (outside for a negative gap), turned and tilted, lit unevenly, blurred and noisy.
+struct NearEdge {
+  const char* name;
+  int edge;
+  double gap_px;
+  double rotation_deg, perspective;
+  Backdrop backdrop;
+  std::uint64_t seed;
+};
+
+SyntheticPhoto photo_near_edge(const cv::Mat& picture, cv::Size frame, const NearEdge& k, double fill) {
+  PhotoConditions pc;
+  pc.rotation_deg = k.rotation_deg;
+  pc.perspective = k.perspective;
+  pc.blur_sigma_px = 0.8;
+  pc.noise_sigma = 4;
+  pc.uneven_light = true;
+  pc.backdrop = k.backdrop;
+  pc.seed = k.seed;
+  pc.fill = fill;
+  return hk::test::synthetic_photo(picture, frame, hk::test::near_edge(picture.size(), frame, pc, k.edge, k.gap_px));
+}
+
+/// How far `p` lies inside the frame's edge `edge` (from its outer boundary); negative outside.
+double inside_edge(cv::Point2d p, cv::Size frame, int edge) {
+  switch (edge) {
+    case 0: return p.y + 0.5;
+    case 1: return frame.width - 0.5 - p.x;
+    case 2: return frame.height - 0.5 - p.y;
+    default: return p.x + 0.5;
+  }
+}
+
+/// Finds the page of a photo made whole near the edge and checks it: every corner within max_error_px of the truth,
+/// touching no edge of the frame.
+void expect_whole_near_edge(const char* picture_name, const cv::Mat& picture, cv::Size frame, const NearEdge& k, double fill,
+                            double max_error_px) {
+  SCOPED_TRACE(std::string(picture_name) + " " + k.name);
+  const SyntheticPhoto photo = photo_near_edge(picture, frame, k, fill);
+  // The set-up itself: the page inside the frame, its nearest corner gap_px from the edge.
+  double nearest = 1e300;
+  for (const cv::Point2d& p : photo.corners_px) {
+    for (int e = 0; e < 4; ++e) ASSERT_GT(inside_edge(p, frame, e), 0.0) << "corner " << p << " outside the frame";
+    nearest = std::min(nearest, inside_edge(p, frame, k.edge));
+  }
+  ASSERT_NEAR(nearest, k.gap_px, 1e-6);
+  const PageDetection d = find_page(photo.frame);
+  ASSERT_TRUE(d.found);
+  const double err = worst_corner_px(d.corners_px, photo.corners_px);
+  const double share = 100.0 * k.gap_px / (k.edge % 2 == 0 ? frame.height : frame.width);
+  std::printf("[page near edge] %-10s %-11s %4d x %4d, %3.0f px (%.1f %%) from the edge: worst corner error %.2f px, touches %d%d%d%d\n",
+              picture_name, k.name, frame.width, frame.height, k.gap_px, share, err, d.touches_frame[0], d.touches_frame[1], d.touches_frame[2],
+              d.touches_frame[3]);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_LE(cv::norm(d.corners_px[i] - photo.corners_px[i]), max_error_px)
+        << "corner " << i << " found at " << d.corners_px[i] << ", truth " << photo.corners_px[i];
+  }
+  for (int e = 0; e < 4; ++e) EXPECT_FALSE(d.touches_frame[static_cast<std::size_t>(e)]) << "edge " << e;
+}
+
+// A page filling a 3264 x 2448 camera frame, its bottom corner 40 px (1.6 %) from the frame's
+// bottom edge; and one 30 px from the left edge.
+TEST(PageNearTheEdge, AWholePageInACameraFrameIsFoundWithItsOwnCornersAndNotCutOff) {
+  const cv::Size camera(3264, 2448);
+  const cv::Mat page = hk::test::text_page(1680, 2376);
+  expect_whole_near_edge("page", page, camera, {"bottom_40px", 2, 40, 3, 0.06, Backdrop::wood, 5}, 0.93, 2.0);
+  expect_whole_near_edge("page", page, camera, {"left_30px", 3, 30, -4, 0.08, Backdrop::blobs, 6}, 0.93, 2.0);
+}
+
+// The same at 640 x 480, 8 px (1.7 % of the height) from each edge.
+TEST(PageNearTheEdge, AWholePageNearEachEdgeIsFoundWithItsOwnCornersAndNotCutOff) {
+  const cv::Mat page = load_picture("page"), camera = load_picture("camera.png");
+  const NearEdge cases[] = {
+      {"top_8px", 0, 8, 4, 0.08, Backdrop::wood, 41},     {"right_8px", 1, 8, -5, 0.10, Backdrop::blobs, 42},
+      {"bottom_8px", 2, 8, 3, 0.12, Backdrop::blobs, 43}, {"left_8px", 3, 8, -3, 0.06, Backdrop::wood, 44},
+  };
+  for (const NearEdge& k : cases) {
+    expect_whole_near_edge("page", page, kFrame, k, 0.85, 1.0);
+    NearEdge c = k;
+    c.seed += 100;
+    expect_whole_near_edge("camera.png", camera, kFrame, c, 0.85, 1.0);
+  }
+}
+
+// A page with a corner just outside the frame (6 px beyond each edge in turn) is cut off there, and there only.
+TEST(PageCutOff, ACornerJustOutsideTheFrameIsCutOffAtThatEdge) {
+  const cv::Mat page = load_picture("page");
+  const NearEdge cases[] = {
+      {"top", 0, -6, 4, 0.08, Backdrop::wood, 51},     {"right", 1, -6, -5, 0.10, Backdrop::blobs, 52},
+      {"bottom", 2, -6, 3, 0.12, Backdrop::blobs, 53}, {"left", 3, -6, -3, 0.06, Backdrop::wood, 54},
+  };
+  for (const NearEdge& k : cases) {
+    SCOPED_TRACE(k.name);
+    const SyntheticPhoto photo = photo_near_edge(page, kFrame, k, 0.85);
+    const PageDetection d = find_page(photo.frame);
+    ASSERT_TRUE(d.found);
+    for (int e = 0; e < 4; ++e) EXPECT_EQ(d.touches_frame[static_cast<std::size_t>(e)], e == k.edge) << "edge " << e;
+    // The two corners away from that edge are the page's own (those at it may be where its sides meet the frame).
+    std::array<std::size_t, 4> order{0, 1, 2, 3};
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return inside_edge(photo.corners_px[a], kFrame, k.edge) > inside_edge(photo.corners_px[b], kFrame, k.edge);
+    });
+    for (std::size_t i : {order[0], order[1]})
+      EXPECT_LE(cv::norm(d.corners_px[i] - photo.corners_px[i]), 0.01 * diagonal(photo.corners_px)) << "corner " << i;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
 // Aspect ratio: against a rectangle projected here with a pinhole camera (an independent derivation).
 
 /// The corners (TL, TR, BR, BL) of a w x h rectangle centred 1 m in front of a pinhole camera (focal length f px,

@@ -109,7 +109,8 @@ std::optional<FramingAdvice> FramingGuide::advice_for(const FrameLook& look) con
   if (look.mean_grey < p_.min_mean_grey) return FramingAdvice::TooDark;
   const PageDetection& page = look.page;
   if (!page.found) return FramingAdvice::PlacePicture;
-  // Cut off: a side on the frame's edge (top, right, bottom, left of the frame).
+  // Cut off: a corner of the page on the frame's edge or beyond it (top, bottom, left, right of the frame); a page
+  // lying whole in the frame, however near its edge, is not.
   if (page.touches_frame[0]) return FramingAdvice::CutOffTop;
   if (page.touches_frame[2]) return FramingAdvice::CutOffBottom;
   if (page.touches_frame[3]) return FramingAdvice::CutOffLeft;

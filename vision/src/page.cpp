@@ -270,7 +270,10 @@ double side_support(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double u
 /// Contrast across the sides of a quadrilateral (corners clockwise on screen; each side a → b, or the part of it
 /// inside the frame) in `image` (grey, or BGR: the distance between mean colours): per side not on the frame's
 /// edge, in stretches of an eighth of the side, the difference between the mean of a band just inside
-/// the quad and the mean of a band just outside it; bands `depth` px deep starting `gap` px from the side.
+/// the quad and the mean of a band just outside it; bands `depth` px deep starting `gap` px from the side. Where
+/// the side lies nearer the frame's edge than that, the outer band is cut short at the frame's edge (a page whole
+/// in the frame but close to its edge shows only a strip of the background beyond its side); a position whose
+/// outer band would start outside the frame is not measured.
 struct SideContrast {
   std::array<std::vector<double>, 4> stretches;  ///< per side, the contrast of each stretch measured
   /// Mean over all stretches measured; negative when none.
@@ -308,18 +311,24 @@ SideContrast border_contrast(const cv::Mat& image, const Segments& sides, const 
       for (int i = 0; i < kPerStretch; ++i) {
         const double u = 0.08 + 0.84 * (st * kPerStretch + i + 0.5) / (kStretches * kPerStretch);
         const cv::Point2d p = a + u * d;
-        if (in_frame(p + reach * n) && in_frame(p - reach * n)) base.push_back(p);
+        if (in_frame(p + gap * n) && in_frame(p - reach * n)) base.push_back(p);
       }
       if (base.size() < 2) continue;
       const cv::Mat v = sample_across(image, base, t, n, {0.0}, offs);
       double dist2 = 0.0;
       for (int c = 0; c < cn; ++c) {
         double out_sum = 0.0, in_sum = 0.0;
+        int out_count = 0;
         for (int i = 0; i < v.rows; ++i) {
           const uchar* r = v.ptr<uchar>(i);
-          for (int k = 0; k < kDepths; ++k) out_sum += r[k * cn + c], in_sum += r[(kDepths + k) * cn + c];
+          for (int k = 0; k < kDepths; ++k) {
+            in_sum += r[(kDepths + k) * cn + c];
+            if (!in_frame(base[static_cast<std::size_t>(i)] + offs[static_cast<std::size_t>(k)] * n)) continue;  // beyond the frame's edge
+            out_sum += r[k * cn + c];
+            ++out_count;
+          }
         }
-        const double diff = (out_sum - in_sum) / (v.rows * kDepths);
+        const double diff = out_sum / out_count - in_sum / (v.rows * kDepths);
         dist2 += diff * diff;
       }
       out.stretches[s].push_back(std::sqrt(dist2));
@@ -688,10 +697,11 @@ void check_params(const PageParams& p) {
 struct Frame {
   const cv::Mat& image;  ///< CV_8UC3 or CV_8UC1
   cv::Mat grey;
-  double sx, sy;      ///< frame px per downscaled px, along x and y
-  double unit;        ///< the larger of sx, sy
-  double touch_tol;   ///< 1 % of the frame's diagonal [px]
-  double area;        ///< [px²]
+  double sx, sy;         ///< frame px per downscaled px, along x and y
+  double unit;           ///< the larger of sx, sy
+  double same_side_tol;  ///< 1 % of the frame's diagonal [px]: sides of two quadrilaterals this close are one side
+  double band_start;     ///< the contrast bands start this far off a side: 1.5 + 1.5 x unit [px]
+  double area;           ///< [px²]
 };
 
 /// A candidate that passed: the page it would be, and the colour contrast across each of its sides (in the order of
@@ -714,10 +724,12 @@ struct Memo {
 };
 
 /// Refines a candidate at full resolution and checks it; the page when it passes. Each side off the frame's edge is
-/// refined (refine_side) and must be an edge over most of the candidate's side; the corners are where the refined
-/// lines meet, at most a quarter of the frame's size outside it; the part inside the frame covers at least
-/// min_area_fraction; the quadrilateral is convex; every side off the frame's edge is backed by an edge over 60 %
-/// of its visible length and, where it meets the frame's edge, over 50 % of its last 10 % (or 15 px); the mean
+/// refined (refine_side) and must be an edge over most of the candidate's side; one found nearer the frame's edge
+/// than band_start (both ends) is taken as that edge, and at most two sides may be on the frame's edge; the
+/// corners are where the lines meet, at most a quarter of the frame's size outside it; the part inside the frame
+/// covers at least min_area_fraction; the quadrilateral is convex; every side off the frame's edge is backed by an
+/// edge over 60 % of its visible length and, where it meets the frame's edge, over 50 % of its last 10 % (or 15 px)
+/// from 2 px inside the frame; the mean
 /// grey contrast across the sides is at least min_contrast and each side's median colour contrast (bands 3 to 11 px
 /// deep, deeper than the grain of a table) at least 1.5 x min_contrast, including at its end on the frame's edge
 /// (at least 0.35 x its median there).
@@ -754,12 +766,34 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
     if (l->d.dot(b - a) < 0) l->d = -l->d;
     lines[s] = *l;
   }
-  Quad q;
-  for (std::size_t i = 0; i < 4; ++i) {
-    const auto p = intersect(lines[(i + 3) % 4], lines[i]);
-    if (!p || !finite(*p)) return std::nullopt;
-    q[i] = *p;
+  const auto corners = [&lines]() -> std::optional<Quad> {
+    Quad q;
+    for (std::size_t i = 0; i < 4; ++i) {
+      const auto p = intersect(lines[(i + 3) % 4], lines[i]);
+      if (!p || !finite(*p)) return std::nullopt;
+      q[i] = *p;
+    }
+    return q;
+  };
+  std::optional<Quad> corners_found = corners();
+  if (!corners_found) return std::nullopt;
+  std::array<bool, 4> on_frame{};
+  for (std::size_t s = 0; s < 4; ++s) on_frame[s] = c.frame_edge[s] >= 0;
+  // A side found nearer the frame's edge than the contrast test's outer band starts (both ends) shows too little of
+  // the background beyond it to be told from that edge: it is taken as on the edge (the page may go on beyond it).
+  bool snapped = false;
+  for (std::size_t s = 0; s < 4; ++s) {
+    if (on_frame[s]) continue;
+    const cv::Point2d half(0.5, 0.5);
+    const int e = frame_edge_of((*corners_found)[s] + half, (*corners_found)[(s + 1) % 4] + half, frame.size() + cv::Size(1, 1), f.band_start);
+    if (e < 0) continue;
+    lines[s] = frame_line(e, frame.size());
+    on_frame[s] = snapped = true;
   }
+  if (std::count(on_frame.begin(), on_frame.end(), true) > 2) return std::nullopt;  // at least two sides the page's own
+  if (snapped) corners_found = corners();
+  if (!corners_found) return std::nullopt;
+  const Quad q = *corners_found;
   if (std::any_of(memo.quads.begin(), memo.quads.end(), [&](const Quad& seen) {
         return std::all_of(q.begin(), q.end(), [&](cv::Point2d p) {
           return std::any_of(seen.begin(), seen.end(), [&](cv::Point2d r) { return cv::norm(p - r) <= unit; });
@@ -778,8 +812,6 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
   std::vector<cv::Point2f> poly;
   for (const cv::Point2d& p : q) poly.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
   if (!cv::isContourConvex(poly)) return std::nullopt;
-  std::array<bool, 4> on_frame{};
-  for (std::size_t s = 0; s < 4; ++s) on_frame[s] = c.frame_edge[s] >= 0;
   // The visible part of each side, and whether it ends at the frame's edge (at a side on the frame's edge, or
   // where the side leaves the frame) rather than at a corner of the page.
   Segments visible;
@@ -801,13 +833,18 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
     if (on_frame[s]) continue;
     float typical = 0.0f;
     if (side_support(frame, a, b, unit, 0.05, 0.95, &typical) < 0.6) return std::nullopt;
-    const double len = cv::norm(b - a), stretch = std::max(0.1, 15.0 * unit / len), tip = std::min(0.02, 3.0 / len);
-    if (ends_at_frame[s].first && side_support(frame, a, b, unit, tip, stretch, &typical) < 0.5) return std::nullopt;
-    if (ends_at_frame[s].second && side_support(frame, a, b, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5) return std::nullopt;
+    // The ends at the frame's edge from where the edge is looked for (2 px inside the frame), so that a side that
+    // meets the frame's edge at a slant is looked at along its whole last stretch.
+    const auto inner = clip_segment(a, b, frame.size(), 2.0);
+    if (!inner) return std::nullopt;
+    const cv::Point2d ia = a + inner->first * (b - a), ib = a + inner->second * (b - a);
+    const double len = cv::norm(ib - ia), stretch = std::max(0.1, 15.0 * unit / len), tip = std::min(0.02, 3.0 / len);
+    if (ends_at_frame[s].first && side_support(frame, ia, ib, unit, tip, stretch, &typical) < 0.5) return std::nullopt;
+    if (ends_at_frame[s].second && side_support(frame, ia, ib, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5) return std::nullopt;
   }
-  const double contrast = border_contrast(f.grey, visible, on_frame, 1.5 + 1.5 * unit, 3.0 * unit).mean();
+  const double contrast = border_contrast(f.grey, visible, on_frame, f.band_start, 3.0 * unit).mean();
   if (contrast < params.min_contrast) return std::nullopt;
-  const SideContrast colour = border_contrast(frame, visible, on_frame, 1.5 + 1.5 * unit, 8.0 * unit);
+  const SideContrast colour = border_contrast(frame, visible, on_frame, f.band_start, 8.0 * unit);
   // A side that meets the frame's edge is set off from the background there as it is elsewhere: where it runs on
   // past the page's corner along a grain of the background, the stretch at the frame has no step across it.
   // And every side is set off from its surroundings along most of its length (median stretch at least 1.5 x
@@ -835,12 +872,14 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
   }
   det.area_fraction = area / f.area;
   det.contrast = contrast;
-  // The page reaches (or passes) an edge of the frame where a corner lies within touch_tol of it or beyond.
+  // The page is cut off at an edge of the frame where a corner lies on it or beyond, or nearer it than band_start
+  // (too near for the page's outline to be told from the frame's edge, as for a side above). A side on the frame's
+  // edge has its corners there; a page lying whole in the frame, its outline seen between it and the edge, none.
   for (const cv::Point2d& p : q) {
-    det.touches_frame[0] = det.touches_frame[0] || p.y <= -0.5 + f.touch_tol;
-    det.touches_frame[1] = det.touches_frame[1] || p.x >= frame.cols - 0.5 - f.touch_tol;
-    det.touches_frame[2] = det.touches_frame[2] || p.y >= frame.rows - 0.5 - f.touch_tol;
-    det.touches_frame[3] = det.touches_frame[3] || p.x <= -0.5 + f.touch_tol;
+    det.touches_frame[0] = det.touches_frame[0] || p.y < -0.5 + f.band_start;
+    det.touches_frame[1] = det.touches_frame[1] || p.x > frame.cols - 0.5 - f.band_start;
+    det.touches_frame[2] = det.touches_frame[2] || p.y > frame.rows - 0.5 - f.band_start;
+    det.touches_frame[3] = det.touches_frame[3] || p.x < -0.5 + f.band_start;
   }
   return out;
 }
@@ -878,15 +917,59 @@ double colour_distance(const cv::Scalar& a, const cv::Scalar& b) {
   return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
 }
 
+/// Whether the side a → b lies on the line l: both ends within `tol` px of it, directions within 3°.
+bool on_line(const Line& l, cv::Point2d a, cv::Point2d b, double tol) {
+  const cv::Point2d d = (b - a) / cv::norm(b - a);
+  return std::abs(l.d.dot(d)) >= std::cos(3.0 * CV_PI / 180.0) && distance(l, a) <= tol && distance(l, b) <= tol;
+}
+
+/// Whether the larger quadrilateral `x` (its sides that are not sides of the smaller `y` all on the frame's edge)
+/// runs on past y's corners over the background: along each side of x that y shares, the stretch from y's corner
+/// (less a margin of 3 x unit + 2 px, where y's own side still shows) to x's corner on the frame's edge is not backed
+/// by an edge (side_support under 0.5, strengths judged against that of the page's edge along y's side). Stretches
+/// shorter than 4 x unit px are not looked at (y's corner lies within a few pixels of the frame's edge); when none
+/// is left, the answer is yes too. A page whose sides run on to the frame's edge is cut off there (x); one whose
+/// sides end at its corners, with the background between them and the frame's edge, lies whole in the frame (y).
+bool runs_past_over_background(const Found& x, const Found& y, const cv::Mat& image, double unit, double tol) {
+  const Quad& qx = x.det.corners_px;
+  const Quad& qy = y.det.corners_px;
+  const double margin = 3.0 * unit + 2.0, least = 4.0 * std::max(1.0, unit);
+  for (std::size_t s = 0; s < 4; ++s) {
+    if (x.side_contrast[s].empty()) continue;  // on the frame's edge
+    const cv::Point2d A = qx[s], B = qx[(s + 1) % 4];
+    const double len = cv::norm(B - A);
+    const Line l{A, (B - A) / len};
+    for (std::size_t t = 0; t < 4; ++t) {
+      const cv::Point2d a = qy[t], b = qy[(t + 1) % 4];
+      if (!on_line(l, a, b, tol)) continue;
+      float typical = 0.0f;  // the strength of the page's edge along y's side
+      if (side_support(image, a, b, unit, 0.05, 0.95, &typical) <= 0.0) break;
+      const double u0 = std::min((a - A).dot(l.d), (b - A).dot(l.d)), u1 = std::max((a - A).dot(l.d), (b - A).dot(l.d));
+      // Beyond y's side towards x's corner where x meets the frame's edge: before s (at A), after s (at B).
+      const std::array<std::pair<bool, std::pair<double, double>>, 2> beyond{{{x.side_contrast[(s + 3) % 4].empty(), {0.0, u0 - margin}},
+                                                                             {x.side_contrast[(s + 1) % 4].empty(), {u1 + margin, len}}}};
+      for (const auto& [to_frame, span] : beyond) {
+        if (!to_frame || span.second - span.first < least) continue;
+        float strength = typical;
+        if (side_support(image, A + span.first * l.d, A + span.second * l.d, unit, 0.0, 1.0, &strength) >= 0.5) return false;
+      }
+      break;
+    }
+  }
+  return true;
+}
+
 /// The page among the quadrilaterals that passed: the largest, unless a smaller one shares some of its sides and
 /// the larger runs past it over the background: the larger's other sides are weak (their lower quartile of stretch
 /// contrasts under half that of the shared sides), the smaller's other sides at least twice as strong, and the
 /// strip between them looks like the background outside the smaller's shared sides more than like the inside of
 /// the smaller (a grain line of the table beyond the page's edge, not a line in the picture on it). A smaller one
-/// sharing no side lies inside the page: a picture on it. And a larger one whose other sides are all on the frame's
-/// edge loses to a smaller one whose other sides lie just inside it (within `tol`): the page's own side, not cut
-/// off, near the frame's edge. Bands for the colours: `gap` to `gap` + `depth` px off a side.
-PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap, double depth, double tol) {
+/// sharing no side lies inside the page: a picture on it. And a larger one with sides on the frame's edge, its
+/// other sides shared by a smaller one with fewer sides on the frame's edge, loses to it when its shared sides run
+/// on from the smaller's corners to the frame's edge over the background (runs_past_over_background): the page's
+/// own side, seen near the frame's edge; the page lies whole in the frame. Bands for the colours: `gap` to `gap` +
+/// `depth` px off a side; `tol`: sides this close are the same side; `unit`: frame px per downscaled px.
+PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap, double depth, double tol, double unit) {
   std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.det.area_fraction > b.det.area_fraction; });
   // Lower quartile of the stretch contrasts of x's sides that are (shared = true) or are not sides of y.
   const auto lower_quartile = [&](const Found& x, const Found& y, bool shared) {
@@ -923,22 +1006,28 @@ PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap,
   for (std::size_t i = 0; i < found.size(); ++i) {
     bool beaten = false;
     for (std::size_t j = i + 1; j < found.size() && !beaten; ++j) {
+      // The larger's sides on the frame's edge, the rest sides of the smaller too, which has fewer on the edge: the
+      // same page with a side either on the frame's edge or just inside it. The page's own side, seen between the
+      // page and the frame's edge, wins when the larger's shared sides run on past the smaller's corners over the
+      // background; when they run on along the page's edge, the page goes on beyond the frame (a line in the
+      // picture near the frame's edge made the smaller).
+      int on_edge_i = 0, on_edge_j = 0;
+      bool rest_shared = true;
+      for (std::size_t s = 0; s < 4; ++s) {
+        on_edge_j += found[j].side_contrast[s].empty();
+        if (found[i].side_contrast[s].empty()) ++on_edge_i;
+        else rest_shared = rest_shared && shares_side(found[j].det.corners_px, found[i].det.corners_px, s, tol);
+      }
+      if (on_edge_i > on_edge_j && rest_shared) {
+        beaten = runs_past_over_background(found[i], found[j], image, unit, tol);
+        continue;
+      }
       int shared = 0;
       for (std::size_t s = 0; s < 4; ++s) shared += shares_side(found[i].det.corners_px, found[j].det.corners_px, s, tol);
       if (shared == 0 || shared == 4) continue;
       const double own = lower_quartile(found[i], found[j], false), common = lower_quartile(found[i], found[j], true);
       const double other = lower_quartile(found[j], found[i], false);
       beaten = own >= 0 && own < 0.5 * common && other >= 2.0 * own && strip_is_background(found[j], found[i]);
-      // The larger's other sides all on the frame's edge, the smaller's just inside it: the page's own side, seen.
-      bool frame_only = true, near_frame = true;
-      for (std::size_t s = 0; s < 4; ++s) {
-        if (!shares_side(found[j].det.corners_px, found[i].det.corners_px, s, tol)) frame_only = frame_only && found[i].side_contrast[s].empty();
-        if (!shares_side(found[i].det.corners_px, found[j].det.corners_px, s, tol)) {
-          const cv::Point2d a = found[j].det.corners_px[s], b = found[j].det.corners_px[(s + 1) % 4];
-          near_frame = near_frame && frame_edge_of(a + cv::Point2d(0.5, 0.5), b + cv::Point2d(0.5, 0.5), image.size() + cv::Size(1, 1), tol) >= 0;
-        }
-      }
-      beaten = beaten || (frame_only && near_frame);
     }
     if (!beaten) return found[i].det;
   }
@@ -952,7 +1041,7 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
   if (frame.type() != CV_8UC3 && frame.type() != CV_8UC1)
     throw std::invalid_argument("find_page: the frame must be CV_8UC3 (BGR) or CV_8UC1 (grey)");
   check_params(params);
-  Frame f{frame, {}, 1.0, 1.0, 1.0, 0.01 * std::hypot(frame.cols, frame.rows), static_cast<double>(frame.cols) * frame.rows};
+  Frame f{frame, {}, 1.0, 1.0, 1.0, 0.01 * std::hypot(frame.cols, frame.rows), 3.0, static_cast<double>(frame.cols) * frame.rows};
   if (frame.channels() == 3) cv::cvtColor(frame, f.grey, cv::COLOR_BGR2GRAY);
   else f.grey = frame;
 
@@ -965,6 +1054,7 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
   f.sx = static_cast<double>(frame.cols) / small.cols;
   f.sy = static_cast<double>(frame.rows) / small.rows;
   f.unit = std::max(f.sx, f.sy);
+  f.band_start = 1.5 + 1.5 * f.unit;
   cv::Mat half;
   cv::pyrDown(small, half);
   const std::vector<Candidate> cands = candidates(small, half, 0.8 * params.min_area_fraction * small.cols * small.rows);
@@ -1006,7 +1096,7 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
   for (const Candidate* c : order) {
     if (std::optional<Found> d = verify(f, *c, params, memo)) found.push_back(*d);
   }
-  return choose(found, frame, 1.5 + 1.5 * f.unit, 8.0 * f.unit, f.touch_tol + 1.0);
+  return choose(found, frame, f.band_start, 8.0 * f.unit, f.same_side_tol + 1.0, f.unit);
 }
 
 double page_aspect_ratio(const std::array<cv::Point2d, 4>& corners_px, cv::Point2d centre_px) {

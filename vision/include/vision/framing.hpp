@@ -6,8 +6,10 @@
 /// has been whole, roughly centred, lit and still for `still_s`.
 ///
 /// The advice, most urgent first (only the first that applies is given):
-///   too dark → no page ("place the picture under the camera") → cut off (top, bottom, left, right) →
-///   off centre ("move it left / right / up / down") → moving ("hold still") → still for still_s: capture.
+///   too dark → no page ("place the picture under the camera") → cut off (top, bottom, left, right: a corner of
+///   the page on that edge of the frame or beyond it, PageDetection::touches_frame; a page lying whole in the
+///   frame is not cut off, however near the edge) → off centre ("move it left / right / up / down") → moving
+///   ("hold still") → still for still_s: capture.
 /// Directions are the visitor's, with the camera looking down from the visitor's side of the table: the
 /// frame's left is the visitor's left and the frame's top is away from the visitor ("up"). A page whose
 /// centre lies right of the frame's centre must move left, and so on. Advice is said when it changes, and

@@ -19,7 +19,8 @@ struct PageParams {
   /// one just outside it| (bands 3 to 6 px off the side for frames up to max_side_px, in proportion for larger
   /// ones) must reach this; and each such side must be set off from its surroundings along most of its length: the
   /// median over its stretches of the colour distance between deeper bands (3 to 11 px off the side, deeper than
-  /// the grain of a table or the weave of a cloth) at least 1.5 x this.
+  /// the grain of a table or the weave of a cloth) at least 1.5 x this. For a side nearer the frame's edge than
+  /// that, the outer bands are cut short at the frame's edge (they must start inside it).
   double min_contrast = 12.0;
   int max_side_px = 800;  ///< the frame is searched at most this large (longer side) [px], >= 64; corners are refined at full size
 };
@@ -37,8 +38,11 @@ struct PageDetection {
   std::array<cv::Point2d, 4> corners_px{};
   double area_fraction = 0.0;  ///< the area of the quadrilateral's part inside the frame / the frame's area
   double contrast = 0.0;       ///< as PageParams::min_contrast (the mean over the stretches), measured
-  /// Per edge of the frame, in the order top, right, bottom, left: the quadrilateral reaches within 1 % of the
-  /// frame's diagonal of that edge, or beyond it (a corner there or past it): the page may be cut off there.
+  /// Per edge of the frame, in the order top, right, bottom, left: the page is cut off there — a corner lies on
+  /// that edge or beyond it, as the corners of a side on the frame's edge do, or so near it that the page's
+  /// outline cannot be told from the edge: nearer than the contrast test's bands start (PageParams::min_contrast;
+  /// 3 px at 640 x 480, 7.6 px at 3264 x 2448, from the frame's outer boundary). A page lying whole in the frame
+  /// touches no edge however close to it, as long as its outline is seen between it and the edge.
   std::array<bool, 4> touches_frame{};
 };
 
@@ -56,8 +60,11 @@ struct PageDetection {
 /// side, derivative peak by a parabola) and a line fitted (cv::fitLine, Huber, then least squares on the inliers);
 /// the corners are where adjacent lines meet. A refined quadrilateral passes when it is convex, covers
 /// min_area_fraction of the frame, every side is backed by an edge along most of its length (up to the frame's edge
-/// where it meets it) and the contrast tests of PageParams::min_contrast hold. Of those that pass, the largest is
-/// the page, unless it only runs past a smaller one's corners along a grain of the background (see page.cpp).
+/// where it meets it) and the contrast tests of PageParams::min_contrast hold; a refined side nearer the frame's edge
+/// than those tests' bands start is taken as on the frame's edge. Of those that pass, the largest is
+/// the page, unless it only runs past a smaller one's corners along a grain of the background, or has sides on the
+/// frame's edge and runs past a smaller one's corners over the background to the frame's edge where the smaller one
+/// has its own side (a page whole in the frame near its edge, not cut off; see page.cpp).
 /// @throws std::invalid_argument for an empty frame, another type, or bad params.
 PageDetection find_page(const cv::Mat& frame, const PageParams& params = {});
 
