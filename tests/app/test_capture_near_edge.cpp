@@ -3,16 +3,19 @@
 // wooden table), lying whole with its bottom corner 40 px (1.6 %) from the frame's bottom edge, served by the file
 // source at 10 frames a second. It is not cut off: the guide says nothing, run_capture takes it by stillness within
 // 3 s of frame time with the page's own corners, and OCR of the rectified page (outcome.image, full resolution)
-// reads at least 90 % of the words pdftotext gives for that page.
+// reads at least 90 % of the words pdftotext gives for that page; `explore --source` on the same frames writes
+// those text blocks ("source": "ocr") in scene.json.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -100,6 +103,23 @@ TEST(CaptureNearTheEdge, AWholePageFillingTheFrameIsCapturedByStillnessAndItsTex
               "page %d x %d px, OCR recall %.3f of %zu words\n",
               capture_end_name(o.end), taken_after_s, o.frames, o.advice.size(), worst_px, o.image.cols, o.image.rows, recall, truth.size());
   EXPECT_GE(recall, 0.9) << text.substr(0, 600);
+
+  // The same frames through `explore --source`: the capture's text blocks in scene.json, read by OCR.
+  const test::ExeResult run = test::run_kiosk("explore --source " + test::quoted("file:" + frames.string()) + " --out " +
+                                                  test::quoted(dir / "out") + " --duration 0.5",
+                                              dir);
+  ASSERT_EQ(run.status, 0) << run.err;
+  std::ifstream sf(dir / "out" / "summary.json"), jf(dir / "out" / "scene.json");
+  const nlohmann::json summary = nlohmann::json::parse(sf), scene = nlohmann::json::parse(jf);
+  EXPECT_EQ(summary["ocr"]["ran"], true) << summary["ocr"].dump();
+  EXPECT_EQ(summary["ocr"]["why"], "a page of text");
+  ASSERT_GE(scene["text_blocks"].size(), 3u);
+  std::string explored;
+  for (const auto& b : scene["text_blocks"]) {
+    EXPECT_EQ(b["source"], "ocr");
+    explored += b["text"].get<std::string>() + "\n";
+  }
+  EXPECT_GE(test::word_recall(truth, test::words_of(explored)), 0.9);
   fs::remove_all(dir);
 }
 
