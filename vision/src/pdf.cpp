@@ -234,26 +234,10 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   if (limits.fault == PdfFault::Hang) worker::hang_on_purpose();
 
   poppler::set_debug_error_function(no_poppler_output, nullptr);
-  Writer out;
-  out.u32(kMagic);
-  try {
-    Writer answer;
-    work(bytes, page, limits, answer);
-    out.u8(0);
-    out.raw(answer.bytes().data(), answer.bytes().size());
-  } catch (const Refusal& r) {
-    out.u8(1);
-    out.u8(static_cast<std::uint8_t>(r.kind));
-    out.str(r.problem);
-  } catch (const std::bad_alloc&) {
-    out.u8(1);
-    out.u8(static_cast<std::uint8_t>(PdfError::Kind::TooLarge));
-    out.str("the reader ran out of memory (limit " + fmt_num(limits.worker_max_memory_mb) + " MiB)");
-  } catch (...) {
-    out.u8(1);
-    out.u8(static_cast<std::uint8_t>(PdfError::Kind::Damaged));
-    out.str("poppler failed on it");
-  }
+  const Writer out = worker::worker_answer<Refusal>(
+      kMagic, [&](Writer& answer) { work(bytes, page, limits, answer); },
+      std::pair{PdfError::Kind::TooLarge, "the reader ran out of memory (limit " + fmt_num(limits.worker_max_memory_mb) + " MiB)"},
+      std::pair{PdfError::Kind::Damaged, std::string("poppler failed on it")});
   worker::write_all(worker::kAnswerFd, out.bytes());
   ::_exit(0);
 }

@@ -12,8 +12,10 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -68,6 +70,33 @@ class WireReader {
   const std::string& s_;
   std::size_t pos_ = 0;
 };
+
+/// Worker side: the whole answer of a worker: u32 `magic`, then u8 0 and what `work(WireWriter&)` wrote, or
+/// u8 1, u8 kind and the problem (str) when it fails: a thrown `Refusal` (a type with `kind`, an enum, and
+/// `problem`, a string) as it says, std::bad_alloc as `out_of_memory`, anything else as `failed`.
+template <class Refusal, class Kind, class Work>
+WireWriter worker_answer(std::uint32_t magic, Work&& work, std::pair<Kind, std::string> out_of_memory, std::pair<Kind, std::string> failed) {
+  WireWriter out;
+  out.u32(magic);
+  auto refuse = [&out](Kind kind, const std::string& problem) {
+    out.u8(1);
+    out.u8(static_cast<std::uint8_t>(kind));
+    out.str(problem);
+  };
+  try {
+    WireWriter answer;
+    work(answer);
+    out.u8(0);
+    out.raw(answer.bytes().data(), answer.bytes().size());
+  } catch (const Refusal& r) {
+    refuse(r.kind, r.problem);
+  } catch (const std::bad_alloc&) {
+    refuse(out_of_memory.first, out_of_memory.second);
+  } catch (...) {
+    refuse(failed.first, failed.second);
+  }
+  return out;
+}
 
 /// Worker side: writes all of `s` to `fd` (gives up silently when the parent is gone).
 void write_all(int fd, const std::string& s);

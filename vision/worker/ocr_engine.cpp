@@ -174,27 +174,14 @@ int ocr_worker_entry(int argc, char** argv) {
   const std::span<const std::uint8_t> pixels = worker::map_input(static_cast<std::size_t>(rq.width) * static_cast<std::size_t>(rq.height));
   if (pixels.empty()) return 65;
   worker::confine_worker(rq.params.worker_cpu_s, rq.params.worker_max_memory_mb);
-  worker::WireWriter out;
-  out.u32(kOcrMagic);
-  try {
-    if (rq.params.fault != OcrFault::None) fail_on_purpose(rq.params.fault);
-    worker::WireWriter answer;
-    work(pixels.data(), rq.width, rq.height, rq.params, answer);
-    out.u8(0);
-    out.raw(answer.bytes().data(), answer.bytes().size());
-  } catch (const Refusal& r) {
-    out.u8(1);
-    out.u8(static_cast<std::uint8_t>(r.kind));
-    out.str(r.problem);
-  } catch (const std::bad_alloc&) {
-    out.u8(1);
-    out.u8(static_cast<std::uint8_t>(OcrError::Kind::TooLarge));
-    out.str("the text reader ran out of memory (limit " + worker::arg(rq.params.worker_max_memory_mb) + " MiB)");
-  } catch (...) {
-    out.u8(1);
-    out.u8(static_cast<std::uint8_t>(OcrError::Kind::WorkerCrashed));
-    out.str("Tesseract failed on it");
-  }
+  const worker::WireWriter out = worker::worker_answer<Refusal>(
+      kOcrMagic,
+      [&](worker::WireWriter& answer) {
+        if (rq.params.fault != OcrFault::None) fail_on_purpose(rq.params.fault);
+        work(pixels.data(), rq.width, rq.height, rq.params, answer);
+      },
+      std::pair{OcrError::Kind::TooLarge, "the text reader ran out of memory (limit " + worker::arg(rq.params.worker_max_memory_mb) + " MiB)"},
+      std::pair{OcrError::Kind::WorkerCrashed, std::string("Tesseract failed on it")});
   worker::write_all(worker::kAnswerFd, out.bytes());
   ::_exit(0);
 }
