@@ -723,25 +723,17 @@ struct Memo {
   std::vector<Quad> quads;
 };
 
-/// Refines a candidate at full resolution and checks it; the page when it passes. Each side off the frame's edge is
-/// refined (refine_side) and must be an edge over most of the candidate's side; one found nearer the frame's edge
-/// than band_start (both ends) is taken as that edge, and at most two sides may be on the frame's edge; the
-/// corners are where the lines meet, at most a quarter of the frame's size outside it; the part inside the frame
-/// covers at least min_area_fraction; the quadrilateral is convex; every side off the frame's edge is backed by an
-/// edge over 60 % of its visible length and, where it meets the frame's edge, over 50 % of its last 10 % (or 15 px)
-/// from 2 px inside the frame; the mean
-/// grey contrast across the sides is at least min_contrast and each side's median colour contrast (bands 3 to 11 px
-/// deep, deeper than the grain of a table) at least 1.5 x min_contrast, including at its end on the frame's edge
-/// (at least 0.35 x its median there).
-std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams& params, Memo& memo) {
-  const cv::Mat& frame = f.image;
+/// The lines of a candidate's sides at full resolution: a side on the frame's edge is that edge; every other side
+/// is refined (refine_side, shared through `memo` with candidates that have the same side) and must be an edge over
+/// most of the candidate's side. Empty when a side fails.
+std::optional<std::array<Line, 4>> refined_lines(const Frame& f, const Candidate& c, Memo& memo) {
   const double unit = f.unit;
   Quad full;
   for (std::size_t i = 0; i < 4; ++i) full[i] = {(c.q[i].x + 0.5) * f.sx - 0.5, (c.q[i].y + 0.5) * f.sy - 0.5};
   std::array<Line, 4> lines;
   for (std::size_t s = 0; s < 4; ++s) {
     if (c.frame_edge[s] >= 0) {
-      lines[s] = frame_line(c.frame_edge[s], frame.size());
+      lines[s] = frame_line(c.frame_edge[s], f.image.size());
       continue;
     }
     const cv::Point2d a = full[s], b = full[(s + 1) % 4];
@@ -751,12 +743,12 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
     });
     if (known == memo.sides.end()) {
       const double window = std::max(4.0 * unit + 2.0, 0.04 * cv::norm(b - a));
-      std::optional<Line> l = refine_side(frame, a, b, window, unit);
+      std::optional<Line> l = refine_side(f.image, a, b, window, unit);
       // Early out: the refined line, over the candidate's side, must be mostly an edge.
       if (l) {
         const cv::Point2d pa = l->p + (a - l->p).dot(l->d) * l->d, pb = l->p + (b - l->p).dot(l->d) * l->d;
         float typical = 0.0f;
-        if (side_support(frame, pa, pb, unit, 0.1, 0.9, &typical) < 0.5) l.reset();
+        if (side_support(f.image, pa, pb, unit, 0.1, 0.9, &typical) < 0.5) l.reset();
       }
       memo.sides.push_back({a, b, l});
       known = memo.sides.end() - 1;
@@ -766,42 +758,52 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
     if (l->d.dot(b - a) < 0) l->d = -l->d;
     lines[s] = *l;
   }
-  const auto corners = [&lines]() -> std::optional<Quad> {
-    Quad q;
-    for (std::size_t i = 0; i < 4; ++i) {
-      const auto p = intersect(lines[(i + 3) % 4], lines[i]);
-      if (!p || !finite(*p)) return std::nullopt;
-      q[i] = *p;
-    }
-    return q;
-  };
-  std::optional<Quad> corners_found = corners();
-  if (!corners_found) return std::nullopt;
-  std::array<bool, 4> on_frame{};
-  for (std::size_t s = 0; s < 4; ++s) on_frame[s] = c.frame_edge[s] >= 0;
-  // A side found nearer the frame's edge than the contrast test's outer band starts (both ends) shows too little of
-  // the background beyond it to be told from that edge: it is taken as on the edge (the page may go on beyond it).
+  return lines;
+}
+
+/// The corners where adjacent lines meet (corner i between lines i − 1 and i); empty when two are parallel.
+std::optional<Quad> corners_of(const std::array<Line, 4>& lines) {
+  Quad q;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto p = intersect(lines[(i + 3) % 4], lines[i]);
+    if (!p || !finite(*p)) return std::nullopt;
+    q[i] = *p;
+  }
+  return q;
+}
+
+/// A side found nearer the frame's edge than the contrast test's outer band starts (both ends) shows too little of
+/// the background beyond it to be told from that edge: it is taken as on the edge (the page may go on beyond it).
+/// Returns whether a side was moved.
+bool snap_to_frame(const Frame& f, const Quad& corners, std::array<Line, 4>& lines, std::array<bool, 4>& on_frame) {
   bool snapped = false;
   for (std::size_t s = 0; s < 4; ++s) {
     if (on_frame[s]) continue;
     const cv::Point2d half(0.5, 0.5);
-    const int e = frame_edge_of((*corners_found)[s] + half, (*corners_found)[(s + 1) % 4] + half, frame.size() + cv::Size(1, 1), f.band_start);
+    const int e = frame_edge_of(corners[s] + half, corners[(s + 1) % 4] + half, f.image.size() + cv::Size(1, 1), f.band_start);
     if (e < 0) continue;
-    lines[s] = frame_line(e, frame.size());
+    lines[s] = frame_line(e, f.image.size());
     on_frame[s] = snapped = true;
   }
-  if (std::count(on_frame.begin(), on_frame.end(), true) > 2) return std::nullopt;  // at least two sides the page's own
-  if (snapped) corners_found = corners();
-  if (!corners_found) return std::nullopt;
-  const Quad q = *corners_found;
-  if (std::any_of(memo.quads.begin(), memo.quads.end(), [&](const Quad& seen) {
-        return std::all_of(q.begin(), q.end(), [&](cv::Point2d p) {
-          return std::any_of(seen.begin(), seen.end(), [&](cv::Point2d r) { return cv::norm(p - r) <= unit; });
-        });
-      }))
-    return std::nullopt;  // checked already
-  memo.quads.push_back(q);
-  // Corners inside the frame or, for a page cut off at a corner, not far beyond it.
+  return snapped;
+}
+
+/// Whether `q` was checked already (every corner within `unit` of one of a checked quadrilateral's); if not, it is
+/// remembered.
+bool checked_before(Memo& memo, const Quad& q, double unit) {
+  const bool seen = std::any_of(memo.quads.begin(), memo.quads.end(), [&](const Quad& old) {
+    return std::all_of(q.begin(), q.end(), [&](cv::Point2d p) {
+      return std::any_of(old.begin(), old.end(), [&](cv::Point2d r) { return cv::norm(p - r) <= unit; });
+    });
+  });
+  if (!seen) memo.quads.push_back(q);
+  return seen;
+}
+
+/// The part of `q` inside the frame [px²] when it can be a page: corners inside the frame or, for a page cut off at
+/// a corner, not far beyond it; that part at least min_area_fraction of the frame; convex. Empty otherwise.
+std::optional<double> page_shaped(const Frame& f, const Quad& q, const PageParams& params) {
+  const cv::Mat& frame = f.image;
   const double beyond = 0.25 * std::max(frame.cols, frame.rows);
   if (!std::all_of(q.begin(), q.end(), [&](cv::Point2d p) {
         return p.x >= -beyond && p.y >= -beyond && p.x <= frame.cols - 1 + beyond && p.y <= frame.rows - 1 + beyond;
@@ -812,56 +814,81 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
   std::vector<cv::Point2f> poly;
   for (const cv::Point2d& p : q) poly.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
   if (!cv::isContourConvex(poly)) return std::nullopt;
-  // The visible part of each side, and whether it ends at the frame's edge (at a side on the frame's edge, or
-  // where the side leaves the frame) rather than at a corner of the page.
-  Segments visible;
+  return area;
+}
+
+/// The visible part of each side of `q`, and whether it ends at the frame's edge (at a side on the frame's edge, or
+/// where the side leaves the frame) rather than at a corner of the page, per end.
+struct VisibleSides {
+  Segments segments;
   std::array<std::pair<bool, bool>, 4> ends_at_frame{};
+};
+
+/// The sides of `q` as far as they are in the frame; empty when a side off the frame's edge shows less than 3 % of
+/// the frame's diagonal.
+std::optional<VisibleSides> visible_sides(const cv::Size& frame, const Quad& q, const std::array<bool, 4>& on_frame) {
+  VisibleSides v;
   for (std::size_t s = 0; s < 4; ++s) {
     const cv::Point2d a = q[s], b = q[(s + 1) % 4];
-    visible[s] = {a, b};
+    v.segments[s] = {a, b};
     if (on_frame[s]) continue;
-    const auto t = clip_segment(a, b, frame.size(), 0.0);
-    if (!t || (t->second - t->first) * cv::norm(b - a) < 0.03 * std::hypot(frame.cols, frame.rows)) return std::nullopt;
-    visible[s] = {a + t->first * (b - a), a + t->second * (b - a)};
-    ends_at_frame[s] = {on_frame[(s + 3) % 4] || t->first > 0.0, on_frame[(s + 1) % 4] || t->second < 1.0};
+    const auto t = clip_segment(a, b, frame, 0.0);
+    if (!t || (t->second - t->first) * cv::norm(b - a) < 0.03 * std::hypot(frame.width, frame.height)) return std::nullopt;
+    v.segments[s] = {a + t->first * (b - a), a + t->second * (b - a)};
+    v.ends_at_frame[s] = {on_frame[(s + 3) % 4] || t->first > 0.0, on_frame[(s + 1) % 4] || t->second < 1.0};
   }
-  // Every side off the frame's edge backed by an edge along most of its length. A page cut off by the frame
-  // shows its sides right up to the frame's edge: two sides of a page and two edges of the frame make a larger,
-  // false quadrilateral whose sides run on past the page's corners, over the background, to the frame.
+  return v;
+}
+
+/// Every side off the frame's edge backed by an edge along most of its length (60 %), and, where it meets the frame's
+/// edge, over 50 % of its last 10 % (or 15 px) from 2 px inside the frame. A page cut off by the frame shows its sides
+/// right up to the frame's edge: two sides of a page and two edges of the frame make a larger, false quadrilateral
+/// whose sides run on past the page's corners, over the background, to the frame.
+bool backed_by_edges(const Frame& f, const VisibleSides& v, const std::array<bool, 4>& on_frame) {
+  const cv::Mat& frame = f.image;
+  const double unit = f.unit;
   for (std::size_t s = 0; s < 4; ++s) {
-    const auto [a, b] = visible[s];
+    const auto [a, b] = v.segments[s];
     if (on_frame[s]) continue;
     float typical = 0.0f;
-    if (side_support(frame, a, b, unit, 0.05, 0.95, &typical) < 0.6) return std::nullopt;
+    if (side_support(frame, a, b, unit, 0.05, 0.95, &typical) < 0.6) return false;
     // The ends at the frame's edge from where the edge is looked for (2 px inside the frame), so that a side that
     // meets the frame's edge at a slant is looked at along its whole last stretch.
     const auto inner = clip_segment(a, b, frame.size(), 2.0);
-    if (!inner) return std::nullopt;
+    if (!inner) return false;
     const cv::Point2d ia = a + inner->first * (b - a), ib = a + inner->second * (b - a);
     const double len = cv::norm(ib - ia), stretch = std::max(0.1, 15.0 * unit / len), tip = std::min(0.02, 3.0 / len);
-    if (ends_at_frame[s].first && side_support(frame, ia, ib, unit, tip, stretch, &typical) < 0.5) return std::nullopt;
-    if (ends_at_frame[s].second && side_support(frame, ia, ib, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5) return std::nullopt;
+    if (v.ends_at_frame[s].first && side_support(frame, ia, ib, unit, tip, stretch, &typical) < 0.5) return false;
+    if (v.ends_at_frame[s].second && side_support(frame, ia, ib, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5) return false;
   }
-  const double contrast = border_contrast(f.grey, visible, on_frame, f.band_start, 3.0 * unit).mean();
-  if (contrast < params.min_contrast) return std::nullopt;
-  const SideContrast colour = border_contrast(frame, visible, on_frame, f.band_start, 8.0 * unit);
-  // A side that meets the frame's edge is set off from the background there as it is elsewhere: where it runs on
-  // past the page's corner along a grain of the background, the stretch at the frame has no step across it.
-  // And every side is set off from its surroundings along most of its length (median stretch at least 1.5 x
-  // min_contrast): a grain line of a table or a fold of a cloth has the same stuff on both sides.
+  return true;
+}
+
+/// Every side off the frame's edge set off from its surroundings along most of its length (its median stretch of
+/// colour contrast at least 1.5 x min_contrast: a grain line of a table or a fold of a cloth has the same stuff on
+/// both sides), and at its end on the frame's edge as elsewhere (at least 0.35 x its median there: where a side
+/// runs on past the page's corner along a grain of the background, the stretch at the frame has no step across it).
+bool set_off(const SideContrast& colour, const VisibleSides& v, const std::array<bool, 4>& on_frame, const PageParams& params) {
   for (std::size_t s = 0; s < 4; ++s) {
-    const std::vector<double>& v = colour.stretches[s];
+    const std::vector<double>& c = colour.stretches[s];
     if (on_frame[s]) continue;
-    if (v.size() < 2) return std::nullopt;
-    std::vector<double> sorted = v;
+    if (c.size() < 2) return false;
+    std::vector<double> sorted = c;
     std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
     const double median = sorted[sorted.size() / 2];
-    if (median < 1.5 * params.min_contrast) return std::nullopt;
-    if (v.size() < 4) continue;
-    if (ends_at_frame[s].first && v.front() < 0.35 * median) return std::nullopt;
-    if (ends_at_frame[s].second && v.back() < 0.35 * median) return std::nullopt;
+    if (median < 1.5 * params.min_contrast) return false;
+    if (c.size() < 4) continue;
+    if (v.ends_at_frame[s].first && c.front() < 0.35 * median) return false;
+    if (v.ends_at_frame[s].second && c.back() < 0.35 * median) return false;
   }
+  return true;
+}
 
+/// The page that `q` is, its corners in PageDetection's order with their sides' contrast, and the frame's edges it
+/// is cut off at: where a corner lies on the edge or beyond, or nearer it than band_start (too near for the page's
+/// outline to be told from the frame's edge, as snap_to_frame judges a side). A side on the frame's edge has its
+/// corners there; a page lying whole in the frame, its outline seen between it and the edge, none.
+Found page_found(const Frame& f, const Quad& q, const SideContrast& colour, double area, double contrast) {
   Found out;
   PageDetection& det = out.det;
   det.found = true;
@@ -872,9 +899,7 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
   }
   det.area_fraction = area / f.area;
   det.contrast = contrast;
-  // The page is cut off at an edge of the frame where a corner lies on it or beyond, or nearer it than band_start
-  // (too near for the page's outline to be told from the frame's edge, as for a side above). A side on the frame's
-  // edge has its corners there; a page lying whole in the frame, its outline seen between it and the edge, none.
+  const cv::Mat& frame = f.image;
   for (const cv::Point2d& p : q) {
     det.touches_frame[0] = det.touches_frame[0] || p.y < -0.5 + f.band_start;
     det.touches_frame[1] = det.touches_frame[1] || p.x > frame.cols - 0.5 - f.band_start;
@@ -882,6 +907,35 @@ std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams
     det.touches_frame[3] = det.touches_frame[3] || p.x < -0.5 + f.band_start;
   }
   return out;
+}
+
+/// Refines a candidate at full resolution and checks it; the page when it passes. Its sides' lines
+/// (refined_lines), the corners where they meet (corners_of), sides too near the frame's edge taken as on it
+/// (snap_to_frame; at most two sides may be on the frame's edge), a quadrilateral not checked before
+/// (checked_before) that can be a page (page_shaped), whose visible sides (visible_sides) are backed by edges
+/// (backed_by_edges), with a mean grey contrast across them of at least min_contrast (bands 3 px deep) and each set
+/// off from its surroundings (set_off, colour bands 3 to 11 px deep, deeper than the grain of a table).
+std::optional<Found> verify(const Frame& f, const Candidate& c, const PageParams& params, Memo& memo) {
+  std::optional<std::array<Line, 4>> lines = refined_lines(f, c, memo);
+  if (!lines) return std::nullopt;
+  std::optional<Quad> corners = corners_of(*lines);
+  if (!corners) return std::nullopt;
+  std::array<bool, 4> on_frame{};
+  for (std::size_t s = 0; s < 4; ++s) on_frame[s] = c.frame_edge[s] >= 0;
+  const bool snapped = snap_to_frame(f, *corners, *lines, on_frame);
+  if (std::count(on_frame.begin(), on_frame.end(), true) > 2) return std::nullopt;  // at least two sides the page's own
+  if (snapped) corners = corners_of(*lines);
+  if (!corners || checked_before(memo, *corners, f.unit)) return std::nullopt;
+  const Quad& q = *corners;
+  const std::optional<double> area = page_shaped(f, q, params);
+  if (!area) return std::nullopt;
+  const std::optional<VisibleSides> visible = visible_sides(f.image.size(), q, on_frame);
+  if (!visible || !backed_by_edges(f, *visible, on_frame)) return std::nullopt;
+  const double contrast = border_contrast(f.grey, visible->segments, on_frame, f.band_start, 3.0 * f.unit).mean();
+  if (contrast < params.min_contrast) return std::nullopt;
+  const SideContrast colour = border_contrast(f.image, visible->segments, on_frame, f.band_start, 8.0 * f.unit);
+  if (!set_off(colour, *visible, on_frame, params)) return std::nullopt;
+  return page_found(f, q, colour, *area, contrast);
 }
 
 /// Whether side `s` of quadrilateral `b` lies on a side of `a` (both its ends within `tol` px of that side's line,
