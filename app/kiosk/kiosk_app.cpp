@@ -214,7 +214,9 @@ int run_kiosk(const KioskOptions& o) {
   ro.mount_root = o.mount_root;
   ro.high_contrast = o.high_contrast;
   ro.overlay = o.overlay;
-  ro.probe_usb_device = o.screenshot.empty();  // scripted runs (documentation, tests) never depend on hardware
+  // Scripted runs (documentation, tests) never depend on hardware they were not told of: [device] type "auto"
+  // stays simulated there, a type the settings name ("haply") is looked for as at the kiosk.
+  ro.probe_usb_device = o.screenshot.empty() || start.settings.device.type == "haply";
   ro.probe_camera = o.screenshot.empty();
   ro.device = o.device;
   KioskRuntime rt(ro, start.settings);

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -77,6 +78,38 @@ TEST(KioskScreen, CurvesAreDrawnWhereSceneJsonSaysFullScreenUnderXvfb) {
   ASSERT_GT(points, 100);
   EXPECT_GT(static_cast<double>(hits) / points, 0.95) << hits << " of " << points << " curve points have a curve pixel within 2 px";
   EXPECT_LT(static_cast<double>(shifted_hits) / points, 0.2) << "control: 25 px off the curves there should be little yellow";
+  fs::remove_all(dir);
+}
+
+// A scripted run looks for the USB pantograph only when the settings name it: with [device] type "haply" and no
+// such board it says so (logged, and spoken: the simulated handle stands in); with "auto" it stays simulated
+// without looking (documentation runs never depend on what is plugged in).
+TEST(KioskScreen, AScriptedRunLooksForADeviceTheSettingsName) {
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  const fs::path dir = fs::temp_directory_path() / ("hk_named_device_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "library");
+  fs::copy_file(kData / "images" / "horse.png", dir / "library" / "a_horse.png");
+  std::ofstream(dir / "script.txt") << "1 move\n";
+  const std::string exe = HK_KIOSK_EXE;
+  auto run = [&](const std::string& type) {
+    // An id no board has, so that a pantograph plugged into the machine running the tests is not found either.
+    std::ofstream(dir / "kiosk.toml") << "[device]\ntype = \"" << type << "\"\nusb_vid = 65535\nusb_pid = 65535\n";
+    EXPECT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug --config '" + (dir / "kiosk.toml").string() +
+                 "' --library '" + (dir / "library").string() + "' --script '" + (dir / "script.txt").string() + "' --screenshot '" +
+                 (dir / "end.png").string() + "' --frames 10 >'" + (dir / "log.txt").string() + "' 2>&1"),
+              0)
+        << std::ifstream(dir / "log.txt").rdbuf();
+    std::stringstream log;
+    log << std::ifstream(dir / "log.txt").rdbuf();
+    return log.str();
+  };
+  const std::string named = run("haply");
+  EXPECT_NE(named.find("device: no USB pantograph ("), std::string::npos) << named;
+  EXPECT_NE(named.find("say: No handle is connected. The kiosk runs on its simulated handle."), std::string::npos) << named;
+  const std::string automatic = run("auto");
+  EXPECT_EQ(automatic.find("no USB pantograph"), std::string::npos) << automatic;
+  EXPECT_EQ(automatic.find("No handle is connected"), std::string::npos) << automatic;
   fs::remove_all(dir);
 }
 
