@@ -3,8 +3,9 @@
 // god-object proxy tunnels through a wall or misses a contact. An analysis, not a timing benchmark:
 // plain main(), one JSON file with every raw number, charts by bench/plot_stability.py.
 //
-// Usage: bench_stability [--out docs/bench/stability.json] [--quick]
+// Usage: bench_stability [--out docs/bench/stability.json] [--quick] [--profiles]
 //   --quick: 3 rates, 10 stiffnesses, 5 + 3 speeds (~10 s on 2 cores); the full run takes ~40 s.
+//   --profiles: part 3 alone.
 //
 // ── Part 1: largest stable wall stiffness per servo rate ─────────────────────────────────────────────
 // One long straight open polyline (y = 0, x in [−0.06, 0.06] m, 241 points, Scene::build, level 1) is
@@ -65,6 +66,12 @@
 // and release (Gillespie & Cutkosky 1996, "Stable user-specific haptic rendering of the virtual wall",
 // ASME IMECE DSC 58).
 //
+// ── Part 3: each device profile (config/device_profile.hpp) ──
+// Part 1's push and let-go runs at the profile's servo rate on the profile's model (profile_device: its
+// five-bar in the workspace frame, mass, damping, encoder quantisation, and one tick of delay for a USB
+// board), stiffness on a log grid 100 N/m – 20 kN/m, bisected. The smaller of the two limits is what the
+// profile's stiffness limit and default are chosen under; JSON "profiles".
+//
 // ── Part 2: tunnelling and missed contacts against hand speed ───────────────────────────────────────
 // Strokes straight across a thin closed curve (an ellipse 0.2 mm wide, 60 mm long), an open straight
 // wall, and into acute corners (10° and 30° wedges, polylines whose apex is a level-0 vertex), at hand
@@ -112,6 +119,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config/device_profile.hpp"
 #include "config/settings.hpp"
 #include "haptics/pantograph.hpp"
 #include "haptics/scene.hpp"
@@ -208,6 +216,13 @@ double normal_encoder_step_m(const SimPantographParams& dp, Vec2 at_m) {
   return std::max(std::abs(J.a21), std::abs(J.a22)) * step_rad;
 }
 
+/// The device a wall run drives: the simulated pantograph's parameters, and whether the servo sees the
+/// handle one tick late (a USB board's reply to the previous tick's packet, as io::HaplyDevice reads it).
+struct WallDevice {
+  SimPantographParams params;
+  int delay_ticks = 0;  ///< 0 or 1
+};
+
 /// The straight-wall scene, shared read-only by every run (and thread).
 class WallBench {
  public:
@@ -217,12 +232,12 @@ class WallBench {
     scene_ = Scene::build({wall}, config::Settings{}.haptics.max_levels);
   }
 
-  /// The device of every run: shipped parameters, torque limit out of the way.
-  static SimPantographParams device_params(int encoder_counts) {
-    SimPantographParams dp;
-    dp.max_torque_n_m = 1e4;  // far above what any stable wall asks for: the clamp must not hide instability
-    dp.encoder_counts_per_rev = encoder_counts;
-    return dp;
+  /// The simulated pantograph of parts 1 and 2: shipped parameters, torque limit out of the way.
+  static WallDevice shipped_device(int encoder_counts) {
+    WallDevice d;
+    d.params.max_torque_n_m = 1e4;  // far above what any stable wall asks for: the clamp must not hide instability
+    d.params.encoder_counts_per_rev = encoder_counts;
+    return d;
   }
 
   /// One classified case: the worst of several runs that differ only in phase, because a quantised,
@@ -235,9 +250,9 @@ class WallBench {
   ///     off switching depends on that phase).
   /// Worst = unstable before limit cycle before stable, then the larger energy ratio (let-go) or
   /// peak-to-peak (push).
-  WallRun run(double rate_hz, double k_n_per_m, HandMode mode, int encoder_counts) const {
+  WallRun run(double rate_hz, double k_n_per_m, HandMode mode, const WallDevice& device) const {
     const bool push = mode == HandMode::Push;
-    const int phases = push ? (encoder_counts >= kIdealEncoderCounts ? 1 : kPushPhases) : kLetGoPhases;
+    const int phases = push ? (device.params.encoder_counts_per_rev >= kIdealEncoderCounts ? 1 : kPushPhases) : kLetGoPhases;
     auto severity = [](const WallRun& r) { return r.cls == "unstable" ? 2 : (r.cls == "limit_cycle" ? 1 : 0); };
     auto score = [push](const WallRun& r) {
       return push ? r.p2p_tail_m : (r.energy_in_j > 0.0 ? r.energy_out_j / r.energy_in_j : 0.0);
@@ -246,7 +261,7 @@ class WallBench {
     std::vector<double> scores;
     for (int i = 0; i < phases; ++i) {
       const Vec2 shift = push ? Vec2{0.00037 * i, 0.0} : Vec2{0.0, 0.00037 * i};
-      const WallRun r = run_one(rate_hz, k_n_per_m, mode, encoder_counts, kWallStart + shift, kHandTarget + Vec2{shift.x, 0.0});
+      const WallRun r = run_one(rate_hz, k_n_per_m, mode, device, kWallStart + shift, kHandTarget + Vec2{shift.x, 0.0});
       scores.push_back(score(r));
       if (i == 0 || severity(r) > severity(worst) || (severity(r) == severity(worst) && score(r) > score(worst))) worst = r;
     }
@@ -255,15 +270,15 @@ class WallBench {
   }
 
  private:
-  WallRun run_one(double rate_hz, double k_n_per_m, HandMode mode, int encoder_counts, Vec2 start_m, Vec2 target_m) const {
+  WallRun run_one(double rate_hz, double k_n_per_m, HandMode mode, const WallDevice& device, Vec2 start_m, Vec2 target_m) const {
     WallRun r;
     r.rate_hz = rate_hz;
     r.stiffness_n_per_m = k_n_per_m;
     r.mode = mode;
-    r.encoder_counts = encoder_counts;
+    r.encoder_counts = device.params.encoder_counts_per_rev;
     const double period_s = 1.0 / rate_hz;
     const Chunking ch = chunking_for(period_s);
-    SimPantographParams dp = device_params(encoder_counts);
+    SimPantographParams dp = device.params;
     dp.substeps = ch.substeps;
     const double step_normal_m = normal_encoder_step_m(dp, {0.0, 0.0});
     SimulatedPantograph dev(dp, start_m);
@@ -298,9 +313,12 @@ class WallBench {
     long tail_ticks = 0, tail_free = 0;
     const long tail_start_tick = n_ticks - std::lround(kTailS / period_s);
     ServoOutput so;
+    DeviceSample older = dev.read();  // the sample of the tick before, for a device one tick late
     for (long k = 0; k < n_ticks; ++k) {
       ServoInput in;
-      in.sample = dev.read();
+      const DeviceSample now = dev.read();
+      in.sample = device.delay_ticks > 0 ? older : now;
+      older = now;
       servo.update(in, so);
       dev.write_force(so.force_n);
       r.max_force_n = std::max(r.max_force_n, length(so.force_n));
@@ -509,7 +527,7 @@ void parallel_for(std::size_t n, const std::function<void(std::size_t)>& f) {
 struct Series {
   double rate_hz = 0;
   HandMode mode = HandMode::Push;
-  int encoder_counts = 0;
+  WallDevice device;
   json result;
 };
 
@@ -522,7 +540,7 @@ void run_series(const WallBench& bench, const std::vector<double>& grid, int ref
   double no_divergence_below = 0.0;  // the same, counting limit cycles as acceptable
   bool seen_not_stable = false, seen_divergent = false, islands = false;
   for (double k : grid) {
-    const WallRun r = bench.run(s.rate_hz, k, s.mode, s.encoder_counts);
+    const WallRun r = bench.run(s.rate_hz, k, s.mode, s.device);
     cases.push_back(wall_run_json(r));
     if (r.stable) {
       largest_stable_anywhere = k;
@@ -541,16 +559,17 @@ void run_series(const WallBench& bench, const std::vector<double>& grid, int ref
   if (lo > 0.0 && hi > 0.0) {
     for (int i = 0; i < refine_steps; ++i) {
       const double mid = std::sqrt(lo * hi);
-      const WallRun r = bench.run(s.rate_hz, mid, s.mode, s.encoder_counts);
+      const WallRun r = bench.run(s.rate_hz, mid, s.mode, s.device);
       refine.push_back(wall_run_json(r));
       (r.stable ? lo : hi) = mid;
     }
   }
-  const double bound = 2.0 * WallBench::device_params(s.encoder_counts).handle_damping_n_s_per_m * s.rate_hz;
+  const double bound = 2.0 * s.device.params.handle_damping_n_s_per_m * s.rate_hz;
   json& j = s.result;
   j["rate_hz"] = s.rate_hz;
   j["mode"] = mode_name(s.mode);
-  j["encoder_counts_per_rev"] = s.encoder_counts;
+  j["encoder_counts_per_rev"] = s.device.params.encoder_counts_per_rev;
+  j["delay_ticks"] = s.device.delay_ticks;
   j["largest_stable_grid_n_per_m"] = sig4(stable_below);              // every grid value up to it stable
   j["first_unstable_grid_n_per_m"] = sig4(first_not_stable);           // first grid value not stable
   j["largest_stable_n_per_m"] = sig4(lo);                              // after bisection
@@ -569,7 +588,7 @@ json run_part1(bool quick) {
   const int refine_steps = quick ? 3 : 7;
   const int default_counts = SimPantographParams{}.encoder_counts_per_rev;
   const WallBench bench;
-  const SimPantographParams dp = WallBench::device_params(default_counts);
+  const SimPantographParams dp = WallBench::shipped_device(default_counts).params;
   const ModelHandParams hand;
   json out;
   out["wall"] = "open straight polyline y = 0, x in [-0.06, 0.06] m, 241 points, rendered at level " +
@@ -625,14 +644,14 @@ json run_part1(bool quick) {
   std::vector<Series> series;
   for (int counts : {default_counts, kIdealEncoderCounts}) {
     for (double rate : rates_hz) {
-      for (HandMode mode : {HandMode::Push, HandMode::LetGo}) series.push_back(Series{rate, mode, counts, json()});
+      for (HandMode mode : {HandMode::Push, HandMode::LetGo}) series.push_back(Series{rate, mode, WallBench::shipped_device(counts), json()});
     }
   }
   parallel_for(series.size(), [&](std::size_t i) { run_series(bench, grid, refine_steps, series[i]); });
   json js = json::array();
   for (const Series& s : series) {
     js.push_back(s.result);
-    std::fprintf(stderr, "  %5.0f Hz %-6s encoder %8d: largest stable %7.0f N/m (2b/T %6.0f)%s\n", s.rate_hz, mode_name(s.mode), s.encoder_counts,
+    std::fprintf(stderr, "  %5.0f Hz %-6s encoder %8d: largest stable %7.0f N/m (2b/T %6.0f)%s\n", s.rate_hz, mode_name(s.mode), s.device.params.encoder_counts_per_rev,
                  s.result["largest_stable_n_per_m"].get<double>(), 2.0 * dp.handle_damping_n_s_per_m * s.rate_hz,
                  s.result["non_monotonic"].get<bool>() ? "  [non-monotonic]" : "");
   }
@@ -1226,16 +1245,103 @@ json run_part2(bool quick) {
 
 }  // namespace
 
+
+// ───────────────────────────── Part 3: each device profile's model ─────────────────────────────
+
+/// The wall device of a profile's shipped settings, in the workspace frame the servo loop works in:
+///   simulated — the simulated pantograph as the kiosk runs it (read, step, write: no delay);
+///   a Haply   — its five-bar mapped onto the workspace by the driver's uniform scale s (io::workspace_scale:
+///               links and motor spacing × s, the motors s·|rect_center_y| above the rectangle's centre),
+///               mass m/s and damping b/s (the same force moves a workspace metre s times further), the
+///               firmware's encoder counting at half its resolution (Encoder library), and one tick of
+///               delay (the driver reads the reply to the packet of the tick before).
+/// The torque limit is lifted as in part 1.
+WallDevice profile_device(const config::Settings& s) {
+  WallDevice d;
+  d.params = app::sim_params_from(s);
+  d.params.max_torque_n_m = 1e4;
+  if (!config::is_usb_type(s.device.type)) return d;
+  const double scale = std::min(s.workspace.width_m / s.device.rect_width_m, s.workspace.height_m / s.device.rect_height_m);
+  d.params.geometry.motor_half_spacing_m = scale * 0.5 * s.device.motor_spacing_m;
+  d.params.geometry.base_m = {0.0, -scale * s.device.rect_center_y_m};
+  d.params.geometry.proximal_m = scale * s.device.link_proximal_m;
+  d.params.geometry.distal_m = scale * s.device.link_distal_m;
+  d.params.handle_mass_kg = s.device.handle_mass_kg / scale;
+  d.params.handle_damping_n_s_per_m = s.device.handle_damping_n_s_per_m / scale;
+  d.params.encoder_counts_per_rev = static_cast<int>(std::lround(s.device.encoder1_resolution / 2.0));
+  d.params.stop_margin_m = scale * 0.005;  // the firmware emulator's stops, 5 mm outside the device rectangle
+  d.delay_ticks = 1;
+  return d;
+}
+
+json run_part3(bool quick) {
+  const std::vector<double> grid = log_grid(100.0, 20000.0, quick ? 10 : 19);
+  const int refine_steps = quick ? 3 : 6;
+  const WallBench bench;
+  struct Case {
+    config::Settings s;
+    WallDevice device;
+  };
+  std::vector<Case> cases;
+  std::vector<Series> series;
+  for (const config::DeviceProfile& p : config::device_profiles()) {
+    const config::Settings s = config::profile_defaults(p.type);
+    const WallDevice d = profile_device(s);
+    for (HandMode mode : {HandMode::Push, HandMode::LetGo}) series.push_back(Series{s.haptics.servo_rate_hz, mode, d, json()});
+    cases.push_back({s, d});
+  }
+  parallel_for(series.size(), [&](std::size_t i) { run_series(bench, grid, refine_steps, series[i]); });
+  json out;
+  out["grid_n_per_m"] = json::array();
+  for (double k : grid) out["grid_n_per_m"].push_back(sig4(k));
+  json profiles = json::array();
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const config::Settings& s = cases[i].s;
+    const config::DeviceProfile& p = config::device_profile(s.device.type);
+    const json& push = series[2 * i].result;
+    const json& let_go = series[2 * i + 1].result;
+    const double limit = std::min(push["largest_stable_n_per_m"].get<double>(), let_go["largest_stable_n_per_m"].get<double>());
+    json j;
+    j["type"] = std::string(p.type);
+    j["name"] = std::string(p.name);
+    j["servo_rate_hz"] = s.haptics.servo_rate_hz;
+    j["handle_mass_kg"] = sig4(cases[i].device.params.handle_mass_kg);
+    j["handle_damping_n_s_per_m"] = sig4(cases[i].device.params.handle_damping_n_s_per_m);
+    j["encoder_counts_per_rev"] = cases[i].device.params.encoder_counts_per_rev;
+    j["encoder_step_normal_m"] = sig4(normal_encoder_step_m(cases[i].device.params, {0.0, 0.0}));
+    j["delay_ticks"] = cases[i].device.delay_ticks;
+    j["largest_stable_push_n_per_m"] = push["largest_stable_n_per_m"];
+    j["largest_stable_let_go_n_per_m"] = let_go["largest_stable_n_per_m"];
+    j["largest_stable_n_per_m"] = sig4(limit);
+    j["profile_limit_n_per_m"] = p.stable_stiffness_n_per_m;
+    j["default_n_per_m"] = s.haptics.stiffness_n_per_m;
+    j["default_margin"] = sig4(limit / s.haptics.stiffness_n_per_m);
+    j["force_everywhere_n"] = sig4(config::force_everywhere_n(s, s.device.type));
+    j["max_force_n"] = s.haptics.max_force_n;
+    j["pop_force_n"] = s.haptics.pop_force_n;
+    j["push"] = push;
+    j["let_go"] = let_go;
+    std::fprintf(stderr, "  %-22s push %6.0f  let-go %6.0f N/m: limit %6.0f, profile allows %6.0f, default %4.0f (margin %.1fx)\n",
+                 std::string(p.name).c_str(), push["largest_stable_n_per_m"].get<double>(), let_go["largest_stable_n_per_m"].get<double>(), limit,
+                 p.stable_stiffness_n_per_m, s.haptics.stiffness_n_per_m, limit / s.haptics.stiffness_n_per_m);
+    profiles.push_back(j);
+  }
+  out["profiles"] = profiles;
+  return out;
+}
+
 int main(int argc, char** argv) {
   std::string out_path = "docs/bench/stability.json";
-  bool quick = false;
+  bool quick = false, profiles_only = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
       out_path = argv[++i];
     } else if (std::strcmp(argv[i], "--quick") == 0) {
       quick = true;
+    } else if (std::strcmp(argv[i], "--profiles") == 0) {
+      profiles_only = true;
     } else {
-      std::fprintf(stderr, "usage: %s [--out FILE.json] [--quick]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--out FILE.json] [--quick] [--profiles]\n", argv[0]);
       return 2;
     }
   }
@@ -1243,14 +1349,20 @@ int main(int argc, char** argv) {
   json root;
   root["generator"] = "bench_stability";
   root["quick"] = quick;
-  std::fprintf(stderr, "part 1: largest stable wall stiffness per servo rate\n");
-  const auto t1 = std::chrono::steady_clock::now();
-  root["stiffness"] = run_part1(quick);
-  root["stiffness"]["elapsed_s"] = sig4(seconds_since(t1));
-  std::fprintf(stderr, "part 2: tunnelling and missed contacts against hand speed\n");
-  const auto t2 = std::chrono::steady_clock::now();
-  root["tunnelling"] = run_part2(quick);
-  root["tunnelling"]["elapsed_s"] = sig4(seconds_since(t2));
+  if (!profiles_only) {
+    std::fprintf(stderr, "part 1: largest stable wall stiffness per servo rate\n");
+    const auto t1 = std::chrono::steady_clock::now();
+    root["stiffness"] = run_part1(quick);
+    root["stiffness"]["elapsed_s"] = sig4(seconds_since(t1));
+    std::fprintf(stderr, "part 2: tunnelling and missed contacts against hand speed\n");
+    const auto t2 = std::chrono::steady_clock::now();
+    root["tunnelling"] = run_part2(quick);
+    root["tunnelling"]["elapsed_s"] = sig4(seconds_since(t2));
+  }
+  std::fprintf(stderr, "part 3: each device profile's model\n");
+  const auto t3 = std::chrono::steady_clock::now();
+  root["profiles"] = run_part3(quick);
+  root["profiles"]["elapsed_s"] = sig4(seconds_since(t3));
   root["elapsed_s"] = sig4(seconds_since(t0));
 
   try {

@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "config/device_profile.hpp"
 #include "config/keys.hpp"
 #include "config/load.hpp"
 #include "config/store.hpp"
@@ -198,6 +199,7 @@ std::string describe_apply(const ApplyReport& r) {
   if (r.timing) s += "; session timing changed";
   if (!r.next_session.empty()) s += "; " + std::to_string(r.next_session.size()) + " for the next visitor";
   if (!r.restart.empty()) s += "; " + std::to_string(r.restart.size()) + " after a restart";
+  for (const std::string& why : r.refused) s += "; refused: " + why;
   return s + ".";
 }
 
@@ -216,7 +218,7 @@ int run_kiosk(const KioskOptions& o) {
   ro.overlay = o.overlay;
   // Scripted runs (documentation, tests) never depend on hardware they were not told of: [device] type "auto"
   // stays simulated there, a type the settings name ("haply") is looked for as at the kiosk.
-  ro.probe_usb_device = o.screenshot.empty() || start.settings.device.type == "haply";
+  ro.probe_usb_device = o.screenshot.empty() || config::is_usb_type(start.settings.device.type);
   ro.probe_camera = o.screenshot.empty();
   ro.device = o.device;
   KioskRuntime rt(ro, start.settings);

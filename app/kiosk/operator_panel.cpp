@@ -8,6 +8,7 @@
 
 #include "haptics/level_policy.hpp"
 
+#include "config/device_profile.hpp"
 #include "config/load.hpp"
 #include "device_setup.hpp"
 
@@ -128,7 +129,7 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
       const bool open = ImGui::BeginTabItem(name.c_str());
       record("tab:" + name);
       if (open) {
-        draw_fields(g, now_unix_s);
+        draw_fields(g, runtime.profile_type(), now_unix_s);
         ImGui::EndTabItem();
       }
     }
@@ -139,7 +140,7 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
   ImGui::End();
 }
 
-void OperatorPanel::draw_fields(config::FieldGroup group, std::int64_t now_unix_s) {
+void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& profile_type, std::int64_t now_unix_s) {
   if (!ImGui::BeginTable("fields", 4, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_SizingStretchProp)) return;
   ImGui::TableSetupColumn("setting", ImGuiTableColumnFlags_WidthStretch, 1.3f);
   ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch, 1.0f);
@@ -174,6 +175,12 @@ void OperatorPanel::draw_fields(config::FieldGroup group, std::int64_t now_unix_
       ImGui::TextWrapped("text");
     } else {
       ImGui::TextWrapped("%s", config::field_allowed_text(d).c_str());
+      const std::string limit = config::profile_limit_text(s_.working(), profile_type, d.table, d.key);
+      if (!limit.empty()) {
+        ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
+        ImGui::TextWrapped("%s", limit.c_str());
+        ImGui::PopStyleColor();
+      }
     }
     ImGui::TableNextColumn();
     ImGui::TextUnformatted(apply_text(d.apply));
@@ -242,11 +249,8 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
     ImGui::TextColored(kOrange, "(no force while it does not answer)");
   }
   const double can_n = io::min_force_capability_n(usb->params());
-  ImGui::Text("It gives at least %.2f N in every direction everywhere in its rectangle.", can_n);
-  if (runtime.settings().haptics.max_force_n > can_n) {
-    ImGui::SameLine();
-    ImGui::TextColored(kOrange, "Max force %.2f N is more: walls saturate above it.", runtime.settings().haptics.max_force_n);
-  }
+  ImGui::Text("%s profile: it gives at least %.2f N in every direction everywhere in its rectangle.",
+              std::string(config::device_profile(runtime.profile_type()).name).c_str(), can_n);
   if (ImGui::Button("Calibrate: the handle rests at the park place")) {
     double o1 = 0, o2 = 0;
     std::string why;

@@ -1,10 +1,12 @@
 #include "device_setup.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <memory>
 #include <vector>
 
+#include "config/device_profile.hpp"
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/io/usb_transport.hpp"
 
@@ -155,6 +157,13 @@ io::TransportFactory board_transport_factory(const config::Settings& s) {
       return tty();
     }
   };
+}
+
+std::string board_profile_type(const config::Settings& s) { return config::is_usb_type(s.device.type) ? s.device.type : std::string("haply"); }
+
+config::Settings settings_for_board(const config::Settings& s, std::vector<std::string>* notes) {
+  if (config::is_usb_type(s.device.type)) return s;
+  return config::fit_to_profile(s, board_profile_type(s), notes);
 }
 
 const char* device_status_name(DeviceStatus status) noexcept {

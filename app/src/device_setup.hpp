@@ -9,6 +9,7 @@
 #include "hk/error.hpp"
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "config/settings.hpp"
 #include "haptics/device.hpp"
@@ -53,6 +54,15 @@ hapi::EmulatorParams emulator_params_from(const config::Settings& s, const Devic
 /// "tty" → serial_path, or the first /dev/serial/by-id entry; "auto" → usb, and the tty when libusb finds
 /// no such device. The factory throws DeviceError (one line) when there is nothing to open.
 io::TransportFactory board_transport_factory(const config::Settings& s);
+
+/// The device profile a USB board runs under: [device] type when it names a board ("haply", "haply-gen2"),
+/// else "haply" (an "auto" kiosk, or the firmware emulator, drives a gen3 board).
+std::string board_profile_type(const config::Settings& s);
+
+/// The settings a run on a USB board uses: `s` itself when [device] type names the board, else
+/// config::fit_to_profile(s, board_profile_type(s)): untouched force-budget defaults become the board's,
+/// values the board's profile refuses take its own (one line each in `notes`, naming the limit).
+config::Settings settings_for_board(const config::Settings& s, std::vector<std::string>* notes);
 
 /// Lower-case name of a device status for summary.json and logs: "closed", "ok", "lost", "fault".
 const char* device_status_name(DeviceStatus status) noexcept;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
 
 #include "audio/mixer.hpp"
 #include "audio/wav.hpp"
@@ -150,11 +151,17 @@ ImageScene build_input_scene(const std::string& path, int page, const config::Se
 }
 
 ExploreSummary run_explore(const ExploreOptions& o) {
-  const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
+  config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
   if (!std::isfinite(o.duration_s) || o.duration_s > 24 * 3600.0) {
     throw ExploreError("--duration " + std::to_string(o.duration_s) + " s is outside (0, 86400] s");
   }
   const DeviceChoice device = parse_device_choice(o.device);
+  if (device.kind == DeviceChoice::Kind::HaplyEmulator) {
+    // The emulated board is a Haply: its profile's forces and stiffness, as the kiosk would take it.
+    std::vector<std::string> notes;
+    s = settings_for_board(s, &notes);
+    for (const std::string& n : notes) spdlog::warn("device: {}", n);
+  }
   const bool explorer = o.hand == "explorer";
   if (explorer && device.kind == DeviceChoice::Kind::HaplyEmulator) {
     throw ExploreError("--hand explorer: the explorer needs the device's force each tick, which only --device sim gives");

@@ -1,5 +1,7 @@
 #include "kiosk_runtime.hpp"
 
+#include "config/device_profile.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -69,8 +71,9 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
   hand_.max_force_n = std::max(hand_.max_force_n, 1.5 * s.haptics.pop_force_n);
   if (!o.device.empty()) {
     open_emulated_board(o.device);
+    adopt_board_profile();
   } else if (s.device.type != "simulated" && o.probe_usb_device) {
-    try_open_usb();
+    if (try_open_usb()) adopt_board_profile();
     try {
       usb_watch_ = std::make_unique<io::UsbHotplugMonitor>(static_cast<std::uint16_t>(s.device.usb_vid), static_cast<std::uint16_t>(s.device.usb_pid),
                                                            [this](bool arrived) { if (arrived) usb_arrived_.store(true); });
@@ -113,11 +116,8 @@ bool KioskRuntime::try_open_usb() {
   try {
     auto dev = std::make_unique<io::HaplyDevice>(haply_params_from(s_), board_transport_factory(s_));
     dev->open();
-    spdlog::info("device: {}", dev->name());
-    const double can_n = io::min_force_capability_n(dev->params());
-    if (s_.haptics.max_force_n > can_n)
-      spdlog::warn("device: [haptics] max_force_n = {} N is more than this handle can give everywhere ({:.2f} N); walls saturate above it",
-                   s_.haptics.max_force_n, can_n);
+    spdlog::info("device: {} ({} profile: {:.2f} N everywhere)", dev->name(), config::device_profile(board_profile_type(s_)).name,
+                 io::min_force_capability_n(dev->params()));
     usb_ = std::move(dev);
     device_note_.clear();
     return true;
@@ -131,6 +131,19 @@ bool KioskRuntime::try_open_usb() {
     return false;
   }
 }
+
+void KioskRuntime::adopt_board_profile() {
+  std::vector<std::string> notes;
+  s_ = settings_for_board(s_, &notes);
+  for (const std::string& n : notes) spdlog::warn("device: {}", n);
+  sp_ = servo_params_from(s_);
+  hand_ = hand_params_from(s_);
+  hand_.max_force_n = std::max(hand_.max_force_n, 1.5 * s_.haptics.pop_force_n);
+  core_.set_gains(servo_gains_from(s_));
+  capture_.set_settings(s_);
+}
+
+std::string KioskRuntime::profile_type() const { return usb_ ? board_profile_type(s_) : s_.device.type; }
 
 bool KioskRuntime::calibrate_usb(double* offset1_deg, double* offset2_deg, std::string* why) {
   if (!usb_) {
@@ -246,6 +259,8 @@ void KioskRuntime::poll_device(double now_s) {
   next_probe_s_ = now_s + 10.0;
   const bool running = servo_ != nullptr;
   if (!try_open_usb()) return;
+  adopt_board_profile();
+  rebuild_shown();  // the groove depth is built into the scene
   if (running) {
     servo_->stop();
     servo_.reset();
@@ -739,6 +754,11 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
       using P = decltype(dst);
       *dst = *std::get<std::add_pointer_t<std::add_const_t<std::remove_pointer_t<P>>>>(d.cref(before));
     }, d.ref(in_use));
+  }
+  // A board's profile bounds what the panel may ask of it (device_profile.hpp): refused values take the profile's.
+  if (usb_) {
+    in_use = settings_for_board(in_use, &r.refused);
+    for (const std::string& n : r.refused) spdlog::warn("settings: {}", n);
   }
   s_ = in_use;
   capture_.set_settings(s_);

@@ -82,6 +82,7 @@ struct ApplyReport {
   bool timing = false;         ///< the session's time-out changed
   std::vector<std::string> next_session;  ///< keys (table.key) that take effect with the next visitor
   std::vector<std::string> restart;       ///< keys that take effect at the next start
+  std::vector<std::string> refused;       ///< values the device's profile refused, each "<table.key> = <value> <why>; ..." (the profile's value is used)
 };
 
 /// The kiosk without its window. Not thread-safe: one thread.
@@ -123,6 +124,10 @@ class KioskRuntime final : public KioskEffects {
   bool calibrate_usb(double* offset1_deg, double* offset2_deg, std::string* why);
   /// The USB pantograph in use, or null when the simulated one is.
   io::HaplyDevice* usb_device() { return usb_.get(); }
+  /// The device profile in force (config/device_profile.hpp): the board's ("haply", "haply-gen2") while a USB
+  /// pantograph or the emulated board is in use, else [device] type ("auto" and "simulated" both mean the
+  /// simulated pantograph's). The operator's panel shows and applies its limits.
+  std::string profile_type() const;
   /// Why the simulated pantograph is in use (empty when the USB pantograph is, or [device] type is "simulated").
   const std::string& device_note() const { return device_note_; }
 
@@ -261,6 +266,7 @@ class KioskRuntime final : public KioskEffects {
   std::string describe_shown();             // describe() of what is shown, without the reading's news
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
   void rebuild_shown();
+  void adopt_board_profile();  // the board's profile in force: settings_for_board, then servo params, hand and gains from them
   bool try_open_usb();  // the USB pantograph per [device]; false (device_note_ says why) when none answers
   void open_emulated_board(const std::string& choice);  // RuntimeOptions::device
   void hand_over_tour();   // plans the announced tour from the handle and publishes it

@@ -15,6 +15,7 @@
 
 #include "config/keys.hpp"
 #include "config/load.hpp"
+#include "config/device_profile.hpp"
 #include "detail.hpp"
 
 namespace hk::config {
@@ -130,7 +131,7 @@ std::string chord_problem(std::string_view v) {
   return parse_chord(v, &why) ? std::string{} : why;
 }
 
-constexpr std::array<std::string_view, 3> kDeviceTypes{"auto", "simulated", "haply"};
+constexpr std::array<std::string_view, 4> kDeviceTypes{"auto", "simulated", "haply", "haply-gen2"};
 constexpr std::array<std::string_view, 3> kTransports{"auto", "usb", "tty"};
 constexpr std::array<std::string_view, 2> kRotations{"cw", "ccw"};
 constexpr std::array<std::string_view, 4> kLevelModes{"auto", "tolerance", "cut", "fixed"};
@@ -192,11 +193,11 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(haptics, tour_max_force_n, FieldGroup::haptics, ApplyWhen::live, 0.1, 5, "N", "The guided tour never pulls the handle harder than this; below pop_force_n."),
     HK_FIELD(haptics, tour_speed_m_per_s, FieldGroup::haptics, ApplyWhen::live, 0.005, 0.2, "m/s", "Speed of the guided tour along an outline."),
     // [device]
-    HK_FIELD(device, type, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Device driving the handle.", kDeviceTypes),
+    HK_FIELD(device, type, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Device driving the handle, and the profile whose forces, stiffness and board it brings: \"auto\" (a USB Haply when one answers, else simulated), \"simulated\", \"haply\" (2DIY gen3) or \"haply-gen2\" (the original 2DIY).", kDeviceTypes),
     HK_FIELD(device, handle_mass_kg, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "kg", "Effective handle mass (simulated pantograph)."),
     HK_FIELD(device, handle_damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 100, "N·s/m", "Device viscous damping."),
     HK_FIELD(device, encoder_counts_per_rev, FieldGroup::devices, ApplyWhen::restart, 64, 1048576, "counts/rev", "Encoder resolution."),
-    HK_FIELD(device, max_torque_n_m, FieldGroup::devices, ApplyWhen::restart, 0.001, 10, "N·m", "Per-motor torque limit (simulated pantograph)."),
+    HK_FIELD(device, max_torque_n_m, FieldGroup::devices, ApplyWhen::restart, 0.02, 10, "N·m", "Per-motor torque limit (simulated pantograph)."),
     HK_FIELD(device, transport, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "How to reach the USB pantograph: \"auto\" (libusb, then the kernel's tty), \"usb\" or \"tty\".", kTransports),
     HK_FIELD(device, usb_vid, FieldGroup::devices, ApplyWhen::restart, 0, 65535, "", "USB vendor id of the pantograph's board ('haptic-kiosk devices' lists what is plugged in)."),
     HK_FIELD(device, usb_pid, FieldGroup::devices, ApplyWhen::restart, 0, 65535, "", "USB product id of the pantograph's board."),
@@ -584,6 +585,12 @@ void validate_as(const Settings& s, const Source& src) {
          "haptics.dynamic_friction = " + format_real(s.haptics.dynamic_friction) +
              " must be <= haptics.static_friction = " + format_real(s.haptics.static_friction) +
              " (a wall that holds less at rest than while sliding would chatter)");
+  // What the device of [device] type can give and render stably (device_profile.hpp).
+  {
+    std::string key;
+    const std::string why = profile_problem(s, s.device.type, &key);
+    if (!why.empty()) fail(src, key, why);
+  }
   if (s.haptics.pop_force_n > 0.0 && s.haptics.tour_max_force_n >= s.haptics.pop_force_n)
     fail(src, "haptics.tour_max_force_n",
          "haptics.tour_max_force_n = " + format_real(s.haptics.tour_max_force_n) +

@@ -16,6 +16,7 @@
 
 #include <toml++/toml.h>
 
+#include "config/device_profile.hpp"
 #include "config/load.hpp"
 #include "detail.hpp"
 
@@ -200,7 +201,11 @@ Settings parse_from(std::string_view text, const Source& src) {
              ": " + one_line(e.description(), 160));
   }
 
+  // A [device] type that names a USB board brings its profile: the defaults every key not in the file takes.
   Settings s;
+  if (const toml::table* device = root["device"].as_table())
+    if (const auto* type = device->get("type"); type && type->is_string() && is_usb_type(type->as_string()->get()))
+      s = profile_defaults(type->as_string()->get());
   for (auto&& [tkey, tnode] : root) {
     const std::string_view tname = tkey.str();
     if (!is_table_name(tname)) unknown_table(src, tname, tnode, line_of(tkey.source()));

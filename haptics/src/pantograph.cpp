@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace hk {
@@ -106,6 +107,28 @@ Vec2 handle_force(const Mat2& J, Torques tau) noexcept {
   const Vec2 f{(J.a22 * tau.tau1_n_m - J.a21 * tau.tau2_n_m) / d,
                (-J.a12 * tau.tau1_n_m + J.a11 * tau.tau2_n_m) / d};
   return is_finite(f) ? f : Vec2{};
+}
+
+double min_force_everywhere_n(const PantographGeometry& g, Vec2 rect_center_m, Vec2 rect_size_m, double torque_limit_n_m) noexcept {
+  if (!is_finite(rect_center_m) || !is_finite(rect_size_m) || !(rect_size_m.x > 0.0) || !(rect_size_m.y > 0.0) ||
+      !(torque_limit_n_m > 0.0) || !std::isfinite(torque_limit_n_m))
+    return 0.0;
+  constexpr int kGrid = 21, kDirections = 72;
+  double least = std::numeric_limits<double>::infinity();
+  for (int iy = 0; iy < kGrid; ++iy)
+    for (int ix = 0; ix < kGrid; ++ix) {
+      const Vec2 at = rect_center_m + Vec2{(ix / (kGrid - 1.0) - 0.5) * rect_size_m.x, (iy / (kGrid - 1.0) - 0.5) * rect_size_m.y};
+      JointAngles q;
+      if (!inverse_kinematics(g, at, &q)) return 0.0;
+      const Mat2 J = jacobian(g, q);
+      for (int k = 0; k < kDirections; ++k) {
+        const double a = 2.0 * std::numbers::pi * k / kDirections;
+        const Torques t = joint_torques(J, {std::cos(a), std::sin(a)});  // torques per newton along u
+        const double worst = std::max(std::fabs(t.tau1_n_m), std::fabs(t.tau2_n_m));
+        if (worst > 0.0) least = std::min(least, torque_limit_n_m / worst);
+      }
+    }
+  return std::isfinite(least) ? least : 0.0;
 }
 
 }  // namespace hk

@@ -254,8 +254,19 @@ TEST(ConfigLoad, EveryKeyAtItsBoundsIsAccepted) {
       if (spec.name() == "haptics.level") text += "max_levels = 12\n";
       if (spec.name() == "haptics.dynamic_friction") text += "static_friction = 2.0\n";
       if (spec.name() == "haptics.static_friction") text += "dynamic_friction = 0.0\n";
+      // The device profile bounds these (device_profile.hpp): the simulated pantograph's motors made strong
+      // enough for the largest forces, its servo rate fast enough for the largest stiffness.
+      const std::string strong = "max_force_n = 20.0\n[device]\nmax_torque_n_m = 10.0\n";
+      const std::string weak = "pop_force_n = 0.0\ntour_max_force_n = 0.1\ngroove_depth_n = 0.05\nmax_force_n = 0.1\n";
       if (spec.name() == "haptics.tour_max_force_n") text += "pop_force_n = 20.0\n";  // the tour stays below the push-through force
       if (spec.name() == "haptics.pop_force_n") text += "tour_max_force_n = 0.1\n";
+      if (spec.name() == "haptics.tour_max_force_n" || (ok == spec.max && (spec.name() == "haptics.pop_force_n" || spec.name() == "haptics.groove_depth_n")))
+        text += strong;
+      if (ok == spec.max && spec.name() == "haptics.max_force_n") text += "[device]\nmax_torque_n_m = 10.0\n";
+      if (ok == spec.min && spec.name() == "haptics.max_force_n") text += "pop_force_n = 0.0\ntour_max_force_n = 0.1\ngroove_depth_n = 0.05\n";
+      if (ok == spec.min && spec.name() == "device.max_torque_n_m") text += "[haptics]\n" + weak;
+      if (ok == spec.max && spec.name() == "haptics.stiffness_n_per_m") text += "servo_rate_hz = 2000\n";
+      if (ok == spec.min && spec.name() == "haptics.servo_rate_hz") text += "stiffness_n_per_m = 100.0\n";
       // The other actuator/encoder moves off a port this bound takes (each needs its own board port).
       if (spec.name() == "device.actuator1_port") text += ok == 1 ? "actuator2_port = 2\n" : "actuator2_port = 1\n";
       if (spec.name() == "device.actuator2_port") text += ok == 2 ? "actuator1_port = 1\n" : "actuator1_port = 2\n";
@@ -317,7 +328,7 @@ TEST(ConfigLoad, DeviceTypeMustBeAKnownStringValue) {
   auto e = capture_error([&] { (void)parse_settings("[device]\ntype = \"usb\"\n", "t.toml"); });
   ASSERT_TRUE(e);
   EXPECT_EQ(std::string(e->what()),
-            "config 't.toml': device.type = \"usb\" is not a known value; allowed: one of \"auto\", \"simulated\", \"haply\" (line 2)");
+            "config 't.toml': device.type = \"usb\" is not a known value; allowed: one of \"auto\", \"simulated\", \"haply\", \"haply-gen2\" (line 2)");
   e = capture_error([&] { (void)parse_settings("[device]\ntype = 3\n", "t.toml"); });
   ASSERT_TRUE(e);
   EXPECT_TRUE(contains(e->what(), "device.type = 3 has the wrong type (integer)")) << e->what();

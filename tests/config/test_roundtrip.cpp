@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "config/device_profile.hpp"
 #include "config/load.hpp"
 #include "config_test_util.hpp"
 
@@ -31,7 +32,7 @@ Settings every_field_changed() {
   auto& h = s.haptics;
   h.stiffness_n_per_m = 1234.5;
   h.damping_n_s_per_m = 1.25;
-  h.max_force_n = 7.5;
+  h.max_force_n = 3.25;  // within what the Haply below gives everywhere with its torque limit
   h.servo_rate_hz = 2000;
   h.level = 3;
   h.level_mode = "fixed";
@@ -45,7 +46,7 @@ Settings every_field_changed() {
   h.max_levels = 9;
   h.query_box_budget = 1500;
   h.force_ramp_s = 1.5;
-  h.pop_force_n = 4.5;
+  h.pop_force_n = 2.5;
   h.pop_hold_s = 0.6;
   h.pop_release_s = 0.05;
   h.render = "grooves";
@@ -214,6 +215,12 @@ Settings random_settings(std::mt19937_64& rng) {
   if (s.haptics.level > s.haptics.max_levels) s.haptics.level = s.haptics.max_levels;
   if (s.vision.canny_low > s.vision.canny_high) std::swap(s.vision.canny_low, s.vision.canny_high);
   if (s.haptics.dynamic_friction > s.haptics.static_friction) std::swap(s.haptics.dynamic_friction, s.haptics.static_friction);
+  // Within the simulated pantograph's profile (device_profile.hpp): forces it gives, stiffness it holds.
+  s.haptics.stiffness_n_per_m = std::min(s.haptics.stiffness_n_per_m, stiffness_limit_n_per_m(s.device.type, s.haptics.servo_rate_hz));
+  if (const double f = force_everywhere_n(s, s.device.type); f > 0.0) s.haptics.max_force_n = std::max(0.1, std::min(s.haptics.max_force_n, f));
+  s.haptics.pop_force_n = std::min(s.haptics.pop_force_n, s.haptics.max_force_n);
+  s.haptics.tour_max_force_n = std::min(s.haptics.tour_max_force_n, s.haptics.max_force_n);
+  s.haptics.groove_depth_n = std::min(s.haptics.groove_depth_n, s.haptics.max_force_n);
   if (s.haptics.pop_force_n > 0.0 && s.haptics.tour_max_force_n >= s.haptics.pop_force_n) {
     if (s.haptics.pop_force_n > 0.2) s.haptics.tour_max_force_n = s.haptics.pop_force_n / 2; else s.haptics.pop_force_n = 0.0;
   }
@@ -300,6 +307,7 @@ TEST(ConfigRoundTrip, TinyAndHugeRealsKeepEveryBit) {
   s.vision.min_chain_length_m = 5e-324;             // smallest subnormal
   s.hand.raster_spacing_m = 0.0005000000000000001;  // not the shortest-looking neighbour
   s.workspace.width_m = 0.1 + 0.2;                  // 0.30000000000000004
+  s.haptics.max_force_n = 3.0;                      // what the simulated pantograph gives over that width
   ASSERT_NO_THROW(validate(s));
   EXPECT_EQ(parse_settings(to_toml(s), "bits"), s) << to_toml(s);
 }

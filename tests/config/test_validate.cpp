@@ -54,10 +54,11 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     const std::string name = std::string(d.table) + "." + std::string(d.key);
     if (name == "device.type") {
       EXPECT_EQ(d.kind, FieldKind::text);
-      ASSERT_EQ(d.choices.size(), 3u);
+      ASSERT_EQ(d.choices.size(), 4u);
       EXPECT_EQ(d.choices[0], "auto");
       EXPECT_EQ(d.choices[1], "simulated");
       EXPECT_EQ(d.choices[2], "haply");
+      EXPECT_EQ(d.choices[3], "haply-gen2");
       ++texts;
       continue;
     }
@@ -175,6 +176,19 @@ TEST(ConfigValidate, BoundsThemselvesAreAccepted) {
       s.device.link_distal_m = 0.5;  // so that any motor spacing lets the links meet
       s.haptics.pop_force_n = 20.0;  // so that any tour force stays below the push-through force...
       s.haptics.tour_max_force_n = 0.1;  // ...and any push-through force above the tour's
+      // Within the simulated pantograph's profile (device_profile.hpp): motors strong enough for the largest
+      // forces and a servo rate fast enough for the largest stiffness; the weakest motors and the slowest
+      // rate with forces and a stiffness they can hold.
+      s.haptics.max_force_n = 20.0;
+      s.device.max_torque_n_m = 10.0;
+      s.haptics.servo_rate_hz = 2000.0;
+      const bool weak = (spec.name() == "haptics.max_force_n" || spec.name() == "device.max_torque_n_m") && ok == spec.min;
+      if (weak) {
+        s.haptics.max_force_n = 0.1;
+        s.haptics.pop_force_n = 0.0;
+        s.haptics.groove_depth_n = 0.05;
+      }
+      if (spec.name() == "haptics.servo_rate_hz" && ok == spec.min) s.haptics.stiffness_n_per_m = 100.0;
       set_numeric(s, spec, ok);
       // The other actuator/encoder moves off a port this bound takes (each needs its own board port).
       if (spec.name() == "device.actuator1_port" && ok == s.device.actuator2_port) s.device.actuator2_port = 3;
@@ -309,7 +323,7 @@ TEST(ConfigValidate, UnknownDeviceTypeIsRefused) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "device.type");
   EXPECT_EQ(std::string(e->what()),
-            "settings: device.type = \"mouse\" is not a known value; allowed: one of \"auto\", \"simulated\", \"haply\"");
+            "settings: device.type = \"mouse\" is not a known value; allowed: one of \"auto\", \"simulated\", \"haply\", \"haply-gen2\"");
 }
 
 TEST(ConfigValidate, ControlCharactersInValuesDoNotBreakTheLine) {

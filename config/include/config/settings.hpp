@@ -15,9 +15,9 @@ namespace hk::config {
 
 /// [haptics] — force rendering and the servo loop.
 struct HapticsSettings {
-  double stiffness_n_per_m = 800.0;       ///< key stiffness_n_per_m, wall stiffness, [10, 5000] N/m
+  double stiffness_n_per_m = 800.0;       ///< key stiffness_n_per_m, wall stiffness, [10, 5000] N/m and at most the device profile's stable limit
   double damping_n_s_per_m = 0.0;         ///< key damping_n_s_per_m, rendered damping in contact, [0, 20] N·s/m
-  double max_force_n = 3.5;               ///< key max_force_n, force clamp, [0.1, 20] N (the simulated pantograph gives ≥ 3.78 N in every direction)
+  double max_force_n = 3.5;               ///< key max_force_n, force clamp, [0.1, 20] N and at most what the device gives everywhere (device_profile.hpp; the simulated pantograph 3.78 N)
   double servo_rate_hz = 1000.0;          ///< key servo_rate_hz, [100, 10000] Hz
   int level = 1;                          ///< key level, resolution level at the start (and always, when level_mode = "fixed"), [0, 12] and <= max_levels; 0 = finest
   std::string level_mode = "auto";        ///< key level_mode, "auto" (a level from hand speed, issue 6), "tolerance" (a tolerance from hand speed, each curve at its own level within it, issue 18), "cut" (a tolerance from hand speed, each segment refined only while its error box exceeds it: the tolerance cut, issue 18) or "fixed" (always `level`)
@@ -50,11 +50,11 @@ struct HapticsSettings {
 /// torque limit, its usable rectangle and its calibration pose. The defaults are the gen3 2DIY's (Haply's
 /// hAPI examples and firmware Haply_M0_Firmware_V0_3; ports cross-wired: actuator/encoder 1 on port 2).
 struct DeviceSettings {
-  std::string type = "auto";              ///< key type, "auto" (the USB pantograph when one answers, else simulated), "simulated" or "haply"
+  std::string type = "auto";              ///< key type, "auto" (the USB pantograph when one answers, else simulated), "simulated", "haply" (2DIY gen3) or "haply-gen2" (the original 2DIY); picks the device profile (device_profile.hpp)
   double handle_mass_kg = 0.08;           ///< key handle_mass_kg, effective handle mass, [0.001, 5] kg
   double handle_damping_n_s_per_m = 2.0;  ///< key handle_damping_n_s_per_m, device viscous damping, [0, 100] N·s/m
   int encoder_counts_per_rev = 16384;     ///< key encoder_counts_per_rev, [64, 1048576] counts/rev
-  double max_torque_n_m = 0.5;            ///< key max_torque_n_m, per-motor torque limit, [0.001, 10] N·m
+  double max_torque_n_m = 0.5;            ///< key max_torque_n_m, per-motor torque limit, [0.02, 10] N·m
   std::string transport = "auto";         ///< key transport, "auto" (libusb, then the kernel's tty), "usb" or "tty"
   int usb_vid = 0x2341;                   ///< key usb_vid, USB vendor id of the pantograph's board, [0, 65535]
   int usb_pid = 0x804D;                   ///< key usb_pid, USB product id, [0, 65535]
@@ -80,8 +80,8 @@ struct DeviceSettings {
   double rect_width_m = 0.112;            ///< key rect_width_m, the USB pantograph's usable rectangle, mapped onto [workspace], [0.01, 1] m
   double rect_height_m = 0.072;           ///< key rect_height_m, [0.01, 1] m
   double rect_center_y_m = -0.088;        ///< key rect_center_y_m, its centre's distance from the motor axis line (negative: towards the user), [-1, 1] m
-  double park_x_m = 0.0;                  ///< key park_x_m, where the handle rests for calibration (a dimple in the kiosk's surface), workspace frame, [-0.5, 0.5] m
-  double park_y_m = 0.0;                  ///< key park_y_m, [-0.5, 0.5] m
+  double park_x_m = 0.0;                  ///< key park_x_m, where the handle rests for calibration, workspace frame, [-0.5, 0.5] m; the default is the board's home pose, the pose the encoder offsets name (both arms stretched out sideways: device_profile.hpp home_park_place)
+  double park_y_m = 0.093276;             ///< key park_y_m, [-0.5, 0.5] m (beyond the far edge of the usable rectangle)
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const DeviceSettings&) const = default;

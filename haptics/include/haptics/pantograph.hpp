@@ -119,4 +119,11 @@ Torques joint_torques(const Mat2& J, Vec2 force_n) noexcept;
 /// by `jacobian` on failure) there is no unique force: returns the zero vector.
 Vec2 handle_force(const Mat2& J, Torques tau) noexcept;
 
+/// The force a five-bar can give in every direction everywhere in a rectangle [N]: at each point of a
+/// 21 × 21 grid over the rectangle (centre `rect_center_m`, size `rect_size_m`, frame of `g`) and each of
+/// 72 directions u, the largest f with |(Jᵀ·f·u)_i| ≤ `torque_limit_n_m` for both motors; the minimum over
+/// all. Above it a wall saturates somewhere: a force clamp beyond it cannot be felt everywhere.
+/// 0 when some grid point is out of reach or an input is not finite or not positive.
+double min_force_everywhere_n(const PantographGeometry& g, Vec2 rect_center_m, Vec2 rect_size_m, double torque_limit_n_m) noexcept;
+
 }  // namespace hk

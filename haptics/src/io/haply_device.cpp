@@ -40,24 +40,7 @@ bool calibrated_offsets(const HaplyDeviceParams& p, Vec2 park_workspace_m, doubl
 }
 
 double min_force_capability_n(const HaplyDeviceParams& p) noexcept {
-  const PantographGeometry g = hapi::geometry_of(p.mechanism);
-  double least = 1e300;
-  constexpr int kGrid = 21, kDirections = 72;
-  for (int iy = 0; iy < kGrid; ++iy)
-    for (int ix = 0; ix < kGrid; ++ix) {
-      const Vec2 at = p.rect_center_device_m + Vec2{(ix / (kGrid - 1.0) - 0.5) * p.rect_size_device_m.x,
-                                                    (iy / (kGrid - 1.0) - 0.5) * p.rect_size_device_m.y};
-      JointAngles q;
-      if (!inverse_kinematics(g, at, &q)) return 0.0;
-      const Mat2 J = jacobian(g, q);
-      for (int k = 0; k < kDirections; ++k) {
-        const double a = 2.0 * M_PI * k / kDirections;
-        const Torques t = joint_torques(J, {std::cos(a), std::sin(a)});  // torques per newton along u
-        const double worst = std::max(std::fabs(t.tau1_n_m), std::fabs(t.tau2_n_m));
-        if (worst > 0.0) least = std::min(least, p.torque_limit_n_m / worst);
-      }
-    }
-  return least == 1e300 ? 0.0 : least;
+  return min_force_everywhere_n(hapi::geometry_of(p.mechanism), p.rect_center_device_m, p.rect_size_device_m, p.torque_limit_n_m);
 }
 
 HaplyDevice::HaplyDevice(const HaplyDeviceParams& params, TransportFactory factory)
