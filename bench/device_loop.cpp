@@ -7,6 +7,8 @@
 //     step, write the next packet) on butterfly.jpg with a still handle: wake-up lateness, tick work,
 //     missed deadlines, replies missing, and the servo thread's CPU use (CLOCK_THREAD_CPUTIME_ID), next to
 //     the same run on the simulated pantograph. The emulator's own thread is the "board" and is not counted.
+//  3. The servo step's calls alone, paced at 1 kHz and never waiting (read, then write_force): their p50 /
+//     p99 / max times, and the writes skipped while a packet's reply was not yet in.
 // Usage: bench_device_loop [--seconds S] [--out FILE.json]
 #include <pthread.h>
 #include <spdlog/spdlog.h>
@@ -48,9 +50,8 @@ double pct(std::vector<double> v, double q) {
 }
 
 struct Board {
-  explicit Board(const config::Settings& s, int reply_wait_us) {
+  explicit Board(const config::Settings& s) {
     dp = app::haply_params_from(s);
-    dp.reply_wait_us = reply_wait_us;
     emulator = std::make_unique<hapi::FirmwareEmulator>(app::emulator_params_from(s, {}), dp.rect_center_device_m,
                                                         [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
     pty = std::make_unique<hapi::PtyEmulator>(*emulator);
@@ -69,7 +70,7 @@ struct Board {
 };
 
 nlohmann::json round_trip(const config::Settings& s, double seconds) {
-  Board b(s, 5000);
+  Board b(s);
   std::vector<double> us;
   const long n = static_cast<long>(seconds * 1000);
   us.reserve(static_cast<std::size_t>(n));
@@ -86,6 +87,7 @@ nlohmann::json round_trip(const config::Settings& s, double seconds) {
     const auto t0 = std::chrono::steady_clock::now();
     b.device->write_force({0.0, 0.0});
     const auto before = b.device->counters().replies;
+    b.device->wait_reply(5000);
     b.device->read();
     const auto t1 = std::chrono::steady_clock::now();
     if (b.device->counters().replies == before) {
@@ -99,6 +101,43 @@ nlohmann::json round_trip(const config::Settings& s, double seconds) {
   return {{"ticks", n}, {"round_trip_us", {{"p50", pct(us, 0.5)}, {"p99", pct(us, 0.99)}, {"max", pct(us, 1.0)}}}, {"missing", missing}};
 }
 
+/// The driver's calls as the servo thread makes them (read, then write_force, paced at 1 kHz, never waiting):
+/// how long each took at most, and how many writes were skipped because the last packet's reply was not in.
+nlohmann::json step_calls(const config::Settings& s, double seconds) {
+  Board b(s);
+  std::vector<double> read_us, write_us;
+  const long n = static_cast<long>(seconds * 1000);
+  read_us.reserve(static_cast<std::size_t>(n));
+  write_us.reserve(static_cast<std::size_t>(n));
+  timespec next{};
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  for (long k = 0; k < n; ++k) {
+    next.tv_nsec += 1000000;
+    if (next.tv_nsec >= 1000000000) {
+      next.tv_nsec -= 1000000000;
+      ++next.tv_sec;
+    }
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    const auto t0 = std::chrono::steady_clock::now();
+    b.device->read();
+    const auto t1 = std::chrono::steady_clock::now();
+    b.device->write_force({0.0, 0.0});
+    const auto t2 = std::chrono::steady_clock::now();
+    read_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+    write_us.push_back(std::chrono::duration<double, std::micro>(t2 - t1).count());
+  }
+  const io::HaplyCounters c = b.device->counters();
+  std::printf("| servo step's read / write_force, never waiting | %ld | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f | %lld skipped, %lld late |\n", n,
+              pct(read_us, 0.5), pct(write_us, 0.5), pct(read_us, 0.99), pct(write_us, 0.99), pct(read_us, 1.0), pct(write_us, 1.0),
+              static_cast<long long>(c.writes_skipped), static_cast<long long>(c.replies_missing));
+  return {{"ticks", n},
+          {"read_us", {{"p50", pct(read_us, 0.5)}, {"p99", pct(read_us, 0.99)}, {"max", pct(read_us, 1.0)}}},
+          {"write_us", {{"p50", pct(write_us, 0.5)}, {"p99", pct(write_us, 0.99)}, {"max", pct(write_us, 1.0)}}},
+          {"packets_sent", c.ticks},
+          {"writes_skipped", c.writes_skipped},
+          {"ticks_without_reply", c.replies_missing}};
+}
+
 nlohmann::json servo_run(const config::Settings& s, double seconds, bool usb) {
   app::ImageScene is = app::build_image_scene(std::string(HK_TEST_DATA_DIR) + "/images/butterfly.jpg", s);
   app::ServoCore core(app::CueTrackerParams{}, nullptr);
@@ -107,7 +146,7 @@ nlohmann::json servo_run(const config::Settings& s, double seconds, bool usb) {
   std::unique_ptr<SimulatedPantograph> sim;
   Device* device = nullptr;
   if (usb) {
-    board = std::make_unique<Board>(s, 0);
+    board = std::make_unique<Board>(s);
     device = board->device.get();
   } else {
     sim = std::make_unique<SimulatedPantograph>(app::sim_params_from(s), Vec2{0.0, 0.0});
@@ -159,6 +198,7 @@ int main(int argc, char** argv) {
   nlohmann::json j;
   std::printf("| measurement | ticks | p50 µs | p99 µs | max µs | missing |\n|---|---|---|---|---|---|\n");
   j["round_trip"] = round_trip(s, seconds);
+  j["step_calls"] = step_calls(s, seconds);
   std::printf("\n| run | ticks | lateness p50 µs | p99 µs | max µs | tick work p50 µs | p99 µs | missed | replies missing | servo thread CPU | priority |\n"
               "|---|---|---|---|---|---|---|---|---|---|---|\n");
   j["servo"] = {servo_run(s, seconds, false), servo_run(s, seconds, true)};

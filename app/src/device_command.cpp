@@ -41,8 +41,7 @@ int run_devices(const DevicesOptions& o) {
 
 int run_calibrate(const CalibrateOptions& o) {
   config::Settings s = config::load_settings(o.config_path);
-  io::HaplyDeviceParams dp = haply_params_from(s);
-  dp.reply_wait_us = 20000;
+  const io::HaplyDeviceParams dp = haply_params_from(s);
   const Vec2 park{s.device.park_x_m, s.device.park_y_m};
   std::unique_ptr<hapi::FirmwareEmulator> emulator;
   std::unique_ptr<hapi::PtyEmulator> pty;
@@ -72,6 +71,7 @@ int run_calibrate(const CalibrateOptions& o) {
   constexpr int kTicks = 50;
   for (int k = 0; k < kTicks; ++k) {
     device.write_force({0.0, 0.0});
+    device.wait_reply(20000);
     const DeviceSample smp = device.read();
     if (smp.status != DeviceStatus::Ok) throw DeviceError(device.name() + ": stopped answering during calibration");
     double a1 = 0, a2 = 0;

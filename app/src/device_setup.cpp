@@ -92,7 +92,6 @@ io::HaplyDeviceParams haply_params_from(const config::Settings& s) {
   p.rect_size_device_m = {d.rect_width_m, d.rect_height_m};
   p.workspace_size_m = {s.workspace.width_m, s.workspace.height_m};
   p.lost_after_ticks = d.lost_after_ticks;
-  p.reply_wait_us = 0;
   return p;
 }
 

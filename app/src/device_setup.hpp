@@ -42,7 +42,7 @@ DeviceChoice parse_device_choice(const std::string& text);
 /// The hAPI board layout of [device] (ports, directions, encoder offsets and resolutions, device id).
 hapi::BoardLayout board_layout_from(const config::Settings& s);
 
-/// The USB pantograph driver's parameters from [device] and [workspace]; reply_wait_us 0 (kiosk timing).
+/// The USB pantograph driver's parameters from [device] and [workspace].
 io::HaplyDeviceParams haply_params_from(const config::Settings& s);
 
 /// The firmware emulator's parameters: the board wired as [device] describes it (so a right configuration

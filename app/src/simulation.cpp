@@ -157,8 +157,7 @@ long run_simulated(const Scene& scene, const config::Settings& s, HandController
 
 long run_emulated(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
                   const TickObserver& observe, const DeviceChoice& choice, DeviceReport* report) {
-  io::HaplyDeviceParams dp = haply_params_from(s);
-  dp.reply_wait_us = 10000;  // headless: wait for the reply instead of depending on the machine's speed
+  const io::HaplyDeviceParams dp = haply_params_from(s);
   const double scale = io::workspace_scale(dp);
   const Vec2 centre = dp.rect_center_device_m;
   const ModelHandParams hp = hand_params_from(s);
@@ -194,6 +193,8 @@ long run_emulated(const Scene& scene, const config::Settings& s, HandController&
       if (unplugged || done >= sent || steady_ns() >= give_up) break;
       std::this_thread::sleep_for(std::chrono::microseconds(20));
     }
+    // And its reply in, as a real board's would be by the next tick: the servo step itself never waits.
+    device.wait_reply(10000);
   });
   if (report) {
     const io::HaplyCounters c = device.counters();

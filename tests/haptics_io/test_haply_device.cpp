@@ -4,6 +4,7 @@
 // stalled boards, garbage and dropped replies, and calibration.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -273,4 +274,114 @@ TEST(HaplyDevice, TheGen3CanGiveAboutOneAndAHalfNewtonsEverywhere) {
   io::HaplyDeviceParams far = p;
   far.rect_center_device_m = {0.0, -0.5};
   EXPECT_EQ(io::min_force_capability_n(far), 0.0);
+}
+
+namespace {
+
+/// A loopback whose board answers a tick late: what the emulator says reaches the driver one read() later.
+class LateLoopback final : public io::ByteTransport {
+ public:
+  explicit LateLoopback(hapi::FirmwareEmulator& e) : emu_(e) {}
+  void open() override { open_ = true; }
+  void close() noexcept override { open_ = false; }
+  int write(const std::uint8_t* data, int n, int) noexcept override {
+    emu_.receive(data, n);
+    return n;
+  }
+  int read(std::uint8_t* buf, int capacity, int) noexcept override {
+    const int n = std::min(capacity, held_);
+    std::copy(held_bytes_, held_bytes_ + n, buf);
+    std::copy(held_bytes_ + n, held_bytes_ + held_, held_bytes_);
+    held_ -= n;
+    held_ += emu_.take_output(held_bytes_ + held_, static_cast<int>(sizeof held_bytes_) - held_);  // heard now, delivered next read
+    return n;
+  }
+  void flush_input() noexcept override {}
+  bool is_open() const noexcept override { return open_; }
+  std::string name() const override { return "late loopback"; }
+
+ private:
+  hapi::FirmwareEmulator& emu_;
+  std::uint8_t held_bytes_[512] = {};
+  int held_ = 0;
+  bool open_ = false;
+};
+
+/// A loopback whose output buffer takes at most `per_write` bytes per call: a transport that is full.
+class NarrowLoopback final : public io::ByteTransport {
+ public:
+  NarrowLoopback(hapi::FirmwareEmulator& e, int per_write) : emu_(e), per_write_(per_write) {}
+  void open() override { open_ = true; }
+  void close() noexcept override { open_ = false; }
+  int write(const std::uint8_t* data, int n, int timeout_us) noexcept override {
+    max_timeout_us = std::max(max_timeout_us, timeout_us);
+    const int k = std::min(n, per_write_);
+    emu_.receive(data, k);
+    return k;
+  }
+  int read(std::uint8_t* buf, int capacity, int) noexcept override { return emu_.take_output(buf, capacity); }
+  void flush_input() noexcept override {}
+  bool is_open() const noexcept override { return open_; }
+  std::string name() const override { return "narrow loopback"; }
+  int max_timeout_us = 0;  ///< the longest wait any write asked for [µs]
+
+ private:
+  hapi::FirmwareEmulator& emu_;
+  int per_write_;
+  bool open_ = false;
+};
+
+}  // namespace
+
+TEST(HaplyDeviceNeverWaits, AReplyOneTickLateIsTakenOnTheNextTickAndTheWriteBetweenIsSkipped) {
+  const io::HaplyDeviceParams dp;
+  hapi::FirmwareEmulator emu(Rig::fill({}, dp), Rig::device_of(dp, {0.01, -0.005}), [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+  io::HaplyDevice dev(dp, [&emu] { return std::make_unique<LateLoopback>(emu); });
+  dev.open();  // its zero-torque packets until the first (late) reply
+  // Settle: whatever open() left outstanding is answered or given up.
+  for (int k = 0; k < 4; ++k) {
+    dev.read();
+    dev.write_force({0.0, 0.0});
+  }
+  const io::HaplyCounters before = dev.counters();
+  const long commands_before = emu.torque_commands();
+  for (int k = 0; k < 100; ++k) {
+    const DeviceSample s = dev.read();
+    EXPECT_EQ(s.status, DeviceStatus::Ok) << k;  // a tick late is not lost
+    dev.write_force({0.1, 0.0});
+  }
+  const io::HaplyCounters after = dev.counters();
+  // Lock-step with a board a tick late: a packet every other tick, each reply taken, the tick between skipped.
+  EXPECT_EQ(after.ticks - before.ticks, 50);
+  EXPECT_EQ(after.replies - before.replies, 50);
+  EXPECT_EQ(after.writes_skipped - before.writes_skipped, 50);
+  EXPECT_EQ(after.malformed, 0);
+  EXPECT_EQ(emu.torque_commands() - commands_before, after.ticks - before.ticks);  // nothing sent twice, nothing lost
+}
+
+TEST(HaplyDeviceNeverWaits, AFullTransportSkipsTheWriteAndNeverCutsAPacket) {
+  const io::HaplyDeviceParams dp;
+  hapi::FirmwareEmulator emu(Rig::fill({}, dp), Rig::device_of(dp, {0.0, 0.0}), [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+  NarrowLoopback* narrow = nullptr;
+  io::HaplyDevice dev(dp, [&emu, &narrow] {
+    auto t = std::make_unique<NarrowLoopback>(emu, 4);  // a 10-byte torque packet takes three ticks to go out
+    narrow = t.get();
+    return t;
+  });
+  dev.open();
+  narrow->max_timeout_us = 0;  // open() may wait; the servo step's calls may not
+  const io::HaplyCounters before = dev.counters();
+  const long commands_before = emu.torque_commands();
+  for (int k = 0; k < 300; ++k) {
+    const DeviceSample s = dev.read();
+    EXPECT_NE(s.status, DeviceStatus::Closed) << k;
+    dev.write_force({0.0, 0.2});
+  }
+  const io::HaplyCounters after = dev.counters();
+  EXPECT_EQ(narrow->max_timeout_us, 0);                // no call in the step waited for room
+  EXPECT_GT(after.writes_skipped - before.writes_skipped, 100);  // most ticks found the last packet still going out
+  EXPECT_GT(after.ticks - before.ticks, 50);
+  EXPECT_EQ(after.malformed, 0);                       // the board never saw a packet cut by another:
+  EXPECT_GE(emu.torque_commands() - commands_before, after.ticks - before.ticks - 1);  // every packet but one on its way, whole
+  EXPECT_GT(after.replies - before.replies, 50);       // and answered
 }

@@ -12,6 +12,21 @@ std::int64_t steady_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+/// Setup-time write of a whole packet: as many calls as the transport needs, within `timeout_us` [µs] in all.
+/// Returns n, or what the last call returned (kGone, or fewer bytes than n when time ran out).
+int write_whole(ByteTransport& t, const std::uint8_t* data, int n, int timeout_us) {
+  const std::int64_t give_up = steady_ns() + static_cast<std::int64_t>(timeout_us) * 1000;
+  int at = 0;
+  while (at < n) {
+    const int left_us = static_cast<int>(std::max<std::int64_t>(0, (give_up - steady_ns()) / 1000));
+    const int r = t.write(data + at, n - at, left_us);
+    if (r == ByteTransport::kGone) return r;
+    at += r;
+    if (at < n && left_us == 0) break;
+  }
+  return at;
+}
+
 bool finite_positive(Vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y) && v.x > 0.0 && v.y > 0.0; }
 
 }  // namespace
@@ -83,9 +98,9 @@ bool HaplyDevice::device_position(double th1_deg, double th2_deg, Vec2* device_m
 void HaplyDevice::send_setup(ByteTransport& t) {
   std::uint8_t buf[hapi::kMaxPacketBytes];
   int n = hapi::encode_reset(params_.layout.device_id, buf);
-  if (t.write(buf, n, 100000) != n) throw DeviceError(t.name() + ": the reset packet could not be written");
+  if (write_whole(t, buf, n, 100000) != n) throw DeviceError(t.name() + ": the reset packet could not be written");
   n = hapi::encode_setup(params_.layout, buf, static_cast<int>(sizeof buf));
-  if (n < 0 || t.write(buf, n, 100000) != n) throw DeviceError(t.name() + ": the setup packet could not be written");
+  if (n < 0 || write_whole(t, buf, n, 100000) != n) throw DeviceError(t.name() + ": the setup packet could not be written");
 }
 
 void HaplyDevice::open() {
@@ -97,7 +112,9 @@ void HaplyDevice::open() {
   send_setup(*t);
   transport_ = std::move(t);
   rx_len_ = 0;
+  tx_len_ = tx_at_ = 0;
   outstanding_ = false;
+  fresh_ = false;
   have_angles_ = false;
   missing_in_row_ = 0;
   // Zero-torque packets until the first valid reply.
@@ -107,7 +124,7 @@ void HaplyDevice::open() {
   const int n = hapi::encode_torques(params_.layout, zero, params_.torque_limit_n_m, pkt, static_cast<int>(sizeof pkt));
   bool answered = false;
   while (!answered && steady_ns() < give_up) {
-    if (transport_->write(pkt, n, 100000) == ByteTransport::kGone) break;
+    if (write_whole(*transport_, pkt, n, 100000) == ByteTransport::kGone) break;
     answered = take_replies(20000);
   }
   if (!answered) {
@@ -187,7 +204,9 @@ void HaplyDevice::adopt_pending() noexcept {
   retired_.store(transport_.release(), std::memory_order_release);  // closed and freed by the re-open thread
   transport_.reset(fresh);
   rx_len_ = 0;
+  tx_len_ = tx_at_ = 0;
   outstanding_ = false;
+  fresh_ = false;
   gone_.store(false, std::memory_order_release);
 }
 
@@ -199,10 +218,11 @@ DeviceSample HaplyDevice::read() {
     return s;
   }
   adopt_pending();
-  bool got = false;
-  // Wait for the reply only while the board answers: a lost board costs no time per tick.
-  if (!gone_.load(std::memory_order_acquire)) got = take_replies(outstanding_ && st == DeviceStatus::Ok ? params_.reply_wait_us : 0);
+  bool got = fresh_;
+  fresh_ = false;
+  if (!gone_.load(std::memory_order_acquire)) got = take_replies(0) || got;
   if (got) {
+    outstanding_ = false;
     if (st == DeviceStatus::Lost) {
       reconnects_.fetch_add(1, std::memory_order_relaxed);
       status_.store(DeviceStatus::Ok, std::memory_order_release);
@@ -211,33 +231,58 @@ DeviceSample HaplyDevice::read() {
     ++missing_in_row_;
     missing_.fetch_add(1, std::memory_order_relaxed);
     if (missing_in_row_ >= params_.lost_after_ticks) status_.store(DeviceStatus::Lost, std::memory_order_release);
+    if (outstanding_ && ++outstanding_age_ >= kReplyWaitTicks) outstanding_ = false;  // given up: the next packet goes out
   }
-  outstanding_ = false;
   s.handle_m = handle_ws_m_;
   s.time_ns = steady_ns() - t0_ns_;
   s.status = status();
   return s;
 }
 
+bool HaplyDevice::wait_reply(int timeout_us) noexcept {
+  if (!transport_ || !outstanding_ || fresh_ || gone_.load(std::memory_order_acquire)) return !outstanding_ || fresh_;
+  fresh_ = take_replies(timeout_us);
+  return fresh_;
+}
+
+bool HaplyDevice::flush_tx() noexcept {
+  if (tx_at_ >= tx_len_) return true;
+  const int r = transport_->write(tx_ + tx_at_, tx_len_ - tx_at_, 0);
+  if (r == ByteTransport::kGone) {
+    gone_.store(true, std::memory_order_release);
+    return false;
+  }
+  tx_at_ += r;
+  return tx_at_ >= tx_len_;
+}
+
 void HaplyDevice::write_force(Vec2 force_n) {
   if (!transport_ || status() == DeviceStatus::Closed || gone_.load(std::memory_order_acquire)) return;
+  // At most one packet outstanding while the board answers, and never a packet cut by another. A board that
+  // stopped answering gets zero torque at once (the first packet after the loss), then a zero-torque probe
+  // each tick.
+  const bool answering = status() == DeviceStatus::Ok;
+  if (!flush_tx() || (answering && outstanding_ && outstanding_age_ < kReplyWaitTicks)) {
+    if (!gone_.load(std::memory_order_relaxed)) skipped_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
   double tau_by_index[4] = {0, 0, 0, 0};
-  if (status() == DeviceStatus::Ok && have_angles_ && is_finite(force_n)) {
+  if (answering && have_angles_ && is_finite(force_n)) {
     // The force is the same vector in the device and workspace frames (no rotation between them).
     const Torques ours = joint_torques(jacobian(geometry_, q_), force_n);
     hapi::haply_torques_from(ours, &tau_by_index[0], &tau_by_index[1]);
   }
-  std::uint8_t pkt[hapi::kMaxPacketBytes];
-  const int n = hapi::encode_torques(params_.layout, tau_by_index, params_.torque_limit_n_m, pkt, static_cast<int>(sizeof pkt));
+  const int n = hapi::encode_torques(params_.layout, tau_by_index, params_.torque_limit_n_m, tx_, static_cast<int>(sizeof tx_));
   const double lim = params_.torque_limit_n_m;
   tau1_.store(std::isfinite(tau_by_index[0]) ? std::clamp(tau_by_index[0], -lim, lim) : 0.0, std::memory_order_relaxed);
   tau2_.store(std::isfinite(tau_by_index[1]) ? std::clamp(tau_by_index[1], -lim, lim) : 0.0, std::memory_order_relaxed);
-  if (transport_->write(pkt, n, params_.write_timeout_us) == ByteTransport::kGone) {
-    gone_.store(true, std::memory_order_release);
-    return;
-  }
+  tx_len_ = n > 0 ? n : 0;
+  tx_at_ = 0;
+  flush_tx();
+  if (gone_.load(std::memory_order_acquire)) return;
   ticks_.fetch_add(1, std::memory_order_relaxed);
   outstanding_ = true;
+  outstanding_age_ = 0;
 }
 
 void HaplyDevice::reopen_loop() {
@@ -276,7 +321,7 @@ void HaplyDevice::close() noexcept {
     std::uint8_t pkt[hapi::kMaxPacketBytes];
     const double zero[4] = {0, 0, 0, 0};
     const int n = hapi::encode_torques(params_.layout, zero, params_.torque_limit_n_m, pkt, static_cast<int>(sizeof pkt));
-    (void)transport_->write(pkt, n, 100000);
+    if (tx_at_ >= tx_len_) (void)write_whole(*transport_, pkt, n, 100000);  // not into the middle of a packet
   }
   if (transport_) transport_->close();
   transport_.reset();
@@ -299,6 +344,7 @@ HaplyCounters HaplyDevice::counters() const noexcept {
   c.malformed = malformed_.load(std::memory_order_relaxed);
   c.reconnects = reconnects_.load(std::memory_order_relaxed);
   c.reopens = reopens_.load(std::memory_order_relaxed);
+  c.writes_skipped = skipped_.load(std::memory_order_relaxed);
   return c;
 }
 

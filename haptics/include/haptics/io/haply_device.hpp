@@ -4,15 +4,22 @@
 /// (hapi_protocol.hpp) over a byte stream (byte_transport.hpp: libusb CDC-ACM, the kernel's tty, or a pty
 /// to the firmware emulator), seen through the `Device` interface.
 ///
-/// Per servo tick: `read()` takes the reply to the torque packet the previous tick sent (waiting at most
-/// `reply_wait_us` for it: 0 in the kiosk, where the reply had the whole period to arrive; a headless run
-/// waits so that it is deterministic), decodes the encoder angles, and maps them to the handle position:
+/// Per servo tick: `read()` takes the reply to the torque packet sent before, if it has come (it never
+/// waits: a headless run that must not depend on the machine's speed calls `wait_reply` first, outside the
+/// servo step), decodes the encoder angles, and maps them to the handle position:
 /// Haply joint angles → our joint angles (haply_mechanism.hpp) → five-bar forward kinematics
 /// (pantograph.hpp) in the device frame → the workspace frame, by the uniform scale and shift that map the
 /// device's usable rectangle onto the kiosk's (`workspace_scale`). `write_force(F)` sends one torque
 /// packet: τ = Jᵀ·F at the last decoded pose (the force in newtons is the same in both frames: what the
 /// visitor feels is what the solver asked for; the stiffness felt per device metre is k·scale), each τ
 /// clamped to the board's torque limit, zero for a non-finite force.
+///
+/// The servo step never waits on the board: while it answers, at most one packet is outstanding. While the
+/// reply to the last packet has not come (for fewer than kReplyWaitTicks ticks), or the transport has not
+/// taken all of the last packet (it is finished first, without waiting), `write_force` sends nothing and
+/// counts a skipped write; a reply one tick late is taken on the next tick. A board counted Lost gets a
+/// zero-torque packet every tick the transport takes one. Every transport call in read and write_force
+/// has a timeout of 0.
 ///
 /// A reply missing or malformed (wrong id, non-finite or absurd angle, a jump of more than
 /// `max_step_deg` since the last good one, bytes out of step) for `lost_after_ticks` ticks in a row makes
@@ -23,7 +30,7 @@
 /// transport reaches the servo thread through one atomic exchange.
 ///
 /// Real-time contract (device.hpp): read, write_force, status and counters do not allocate, lock or throw;
-/// their only system calls are the transport's bounded read/write. open/close may throw DeviceError.
+/// their only system calls are the transport's read/write with a timeout of 0. open/close may throw DeviceError.
 ///
 /// The board's encoder counters start at the offsets sent in the setup packet (firmware
 /// Haply_M0_Firmware_V0_3 `initialize_encoder`), so positions are right when the handle rests at the
@@ -55,8 +62,6 @@ struct HaplyDeviceParams {
   Vec2 rect_size_device_m{0.112, 0.072};   ///< its width and height [m]
   Vec2 workspace_size_m{0.14, 0.09};       ///< the kiosk's usable rectangle ([workspace]) it maps onto [m]
   int lost_after_ticks = 3;                ///< ticks without a valid reply before Lost, ≥ 1
-  int reply_wait_us = 0;                   ///< read() waits this long for the reply [µs]; 0 = take what is there
-  int write_timeout_us = 500;              ///< write() waits at most this long for room [µs]
   int open_timeout_ms = 1000;              ///< open() waits this long for the first reply [ms]
   double reopen_interval_s = 0.5;          ///< a gone transport is re-opened this often [s]
   double max_step_deg = 20.0;              ///< a reply whose angle moved more than this since the last good one is refused [deg]
@@ -73,7 +78,11 @@ struct HaplyCounters {
   std::int64_t malformed = 0;        ///< replies refused (wrong id, bad angle, out of step): bytes dropped
   std::int64_t reconnects = 0;       ///< times the status went from Lost back to Ok
   std::int64_t reopens = 0;          ///< transports re-opened in the background
+  std::int64_t writes_skipped = 0;   ///< ticks whose packet was not sent: the last one's reply not yet in, or the transport full
 };
+
+/// Ticks a packet's reply is waited for before the next packet goes out anyway (the reply is then missing).
+inline constexpr int kReplyWaitTicks = 2;
 
 /// The uniform scale from device metres to workspace metres: min(workspace w / rect w, workspace h / rect h).
 double workspace_scale(const HaplyDeviceParams& p) noexcept;
@@ -108,10 +117,16 @@ class HaplyDevice final : public Device {
   /// first valid reply (at most open_timeout_ms): status Ok. Starts the re-open thread. Throws DeviceError
   /// naming the transport when it cannot be opened or the board does not answer.
   void open() override;
-  /// Real-time. The handle from the newest valid reply (the last good one when none came), and the status.
+  /// Real-time, never waits. The handle from the newest valid reply (the last good one when none came), and
+  /// the status.
   DeviceSample read() override;
-  /// Real-time. One torque packet: τ = Jᵀ·F clamped to the torque limit; zero unless the status is Ok.
+  /// Real-time, never waits. One torque packet: τ = Jᵀ·F clamped to the torque limit; zero unless the status
+  /// is Ok. Skipped (and counted) while the last packet's reply is not in or the last packet not all written.
   void write_force(Vec2 force_n) override;
+  /// Not for the servo step: waits up to `timeout_us` [µs] for the reply to the outstanding packet and keeps
+  /// it for the next read(). True when it came (or nothing is outstanding). Headless runs call it before
+  /// read() so that they do not depend on how busy the machine is; the kiosk never does.
+  bool wait_reply(int timeout_us) noexcept;
   /// Sends zero torque (when it can), stops the re-open thread, closes the transport. Never throws.
   void close() noexcept override;
   /// Closed, Ok or Lost. Real-time.
@@ -145,6 +160,7 @@ class HaplyDevice final : public Device {
  private:
   void send_setup(ByteTransport& t);
   bool take_replies(int wait_us) noexcept;  // true when a valid reply was taken
+  bool flush_tx() noexcept;                 // writes what is left of the last packet; true when all of it is out
   void adopt_pending() noexcept;
   void reopen_loop();
 
@@ -160,6 +176,10 @@ class HaplyDevice final : public Device {
   std::uint8_t rx_[256] = {};
   int rx_len_ = 0;
   bool outstanding_ = false;                  // a torque packet waits for its reply
+  int outstanding_age_ = 0;                   // reads since it was sent without its reply
+  bool fresh_ = false;                        // a valid reply was taken since the last read()
+  std::uint8_t tx_[hapi::kMaxPacketBytes] = {};  // the last packet
+  int tx_len_ = 0, tx_at_ = 0;                // its length and how much of it the transport took
   int missing_in_row_ = 0;
   bool have_angles_ = false;
   std::atomic<double> th1_deg_{0.0}, th2_deg_{0.0};
@@ -168,7 +188,7 @@ class HaplyDevice final : public Device {
   JointAngles q_;                             // our joint angles of the newest valid reply
   Vec2 handle_ws_m_;                          // its handle, workspace frame
   std::int64_t t0_ns_ = 0;
-  std::atomic<std::int64_t> ticks_{0}, replies_{0}, missing_{0}, malformed_{0}, reconnects_{0}, reopens_{0};
+  std::atomic<std::int64_t> ticks_{0}, replies_{0}, missing_{0}, malformed_{0}, reconnects_{0}, reopens_{0}, skipped_{0};
   std::mutex reopen_mutex_;
   std::condition_variable reopen_cv_;
   bool stop_reopen_ = false;
