@@ -1,5 +1,6 @@
 #include "device_command.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -20,22 +21,32 @@ namespace hk::app {
 
 int run_devices(const DevicesOptions& o) {
   const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
+  const std::vector<config::UsbId> ids = config::parse_usb_ids(s.device.usb_ids);
   std::string reason;
   const std::vector<io::UsbDeviceInfo> usb = io::list_usb_devices(&reason);
   std::printf("USB devices:\n");
   if (usb.empty()) std::printf("  no USB device found%s%s\n", reason.empty() ? "" : ": ", reason.c_str());
   for (const io::UsbDeviceInfo& d : usb) {
-    const bool supported = d.vid == s.device.usb_vid && d.pid == s.device.usb_pid;
+    const bool listed = std::any_of(ids.begin(), ids.end(), [&](const config::UsbId& id) { return id.vid == d.vid && id.pid == d.pid; });
     std::string label = d.manufacturer;
     if (!d.product.empty()) label += (label.empty() ? "" : " ") + d.product;
     if (label.empty()) label = "(no name readable)";
     std::printf("  %04x:%04x bus %d address %d  %s  %s\n", d.vid, d.pid, d.bus, d.address, label.c_str(),
-                supported ? "supported: USB pantograph (hAPI, [device] usb_vid:usb_pid)" : "not supported");
+                listed ? "an id of [device] usb_ids: asked below" : "not a pantograph id");
   }
   std::printf("Serial devices (/dev/serial/by-id):\n");
   const std::vector<std::string> ttys = io::list_serial_by_id();
   if (ttys.empty()) std::printf("  none\n");
-  for (const std::string& t : ttys) std::printf("  %s  %s\n", t.c_str(), "usable with [device] transport = \"tty\"");
+  for (const std::string& t : ttys) std::printf("  %s\n", t.c_str());
+  // Each way to a board asked on its own: reset, setup, zero-torque packets, a well-formed reply in time.
+  std::printf("Boards ([device] transport = \"%s\"; each asked for an hAPI reply):\n", s.device.transport.c_str());
+  const std::vector<io::BoardCandidate> candidates = board_candidates(s);
+  if (candidates.empty()) std::printf("  none to ask\n");
+  for (const io::BoardCandidate& c : candidates) {
+    std::vector<io::BoardProbe> probe;
+    if (std::unique_ptr<io::HaplyDevice> board = io::open_first_board(haply_params_from(s), {c}, &probe)) board->close();
+    for (const io::BoardProbe& p : probe) std::printf("  %s  %s: %s\n", p.name.c_str(), p.answered ? "answered" : "refused", p.how.c_str());
+  }
   return 0;
 }
 
@@ -46,8 +57,9 @@ int run_calibrate(const CalibrateOptions& o) {
   std::unique_ptr<hapi::FirmwareEmulator> emulator;
   std::unique_ptr<hapi::PtyEmulator> pty;
   io::TransportFactory factory;
+  std::unique_ptr<io::HaplyDevice> board;
   if (o.device == "haply") {
-    factory = board_transport_factory(s);
+    board = open_board(s, nullptr);
   } else {
     const DeviceChoice choice = parse_device_choice(o.device);
     if (choice.kind != DeviceChoice::Kind::HaplyEmulator)
@@ -65,8 +77,11 @@ int run_calibrate(const CalibrateOptions& o) {
     const std::string path = pty->device_path();
     factory = [path] { return std::make_unique<io::TtyTransport>(path); };
   }
-  io::HaplyDevice device(dp, factory);
-  device.open();
+  if (!board) {
+    board = std::make_unique<io::HaplyDevice>(dp, factory);
+    board->open();
+  }
+  io::HaplyDevice& device = *board;
   double sum1 = 0, sum2 = 0;
   constexpr int kTicks = 50;
   for (int k = 0; k < kTicks; ++k) {

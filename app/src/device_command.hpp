@@ -1,8 +1,9 @@
 #pragma once
 /// @file device_command.hpp
-/// `haptic-kiosk devices` (issue 13, item 6): the USB devices on the bus and the serial devices of
-/// /dev/serial/by-id, each marked supported or not; and `haptic-kiosk calibrate` (item 3): with the handle
-/// resting at the park place ([device] park_x_m, park_y_m), set the encoder offsets so the angles read right.
+/// `haptic-kiosk devices`: the USB devices on the bus (those with an id of [device] usb_ids marked), the
+/// serial devices of /dev/serial/by-id, and each way to a board asked for an hAPI reply, with what it
+/// answered; and `haptic-kiosk calibrate`: with the handle resting at the park place ([device] park_x_m,
+/// park_y_m; by default the board's home pose), set the encoder offsets so the angles read right.
 
 #include <string>
 
@@ -10,11 +11,11 @@ namespace hk::app {
 
 /// What `haptic-kiosk devices` was asked to do.
 struct DevicesOptions {
-  std::string config_path;  ///< settings ([device] usb_vid, usb_pid); empty: defaults
+  std::string config_path;  ///< settings ([device] usb_ids, transport, serial_path); empty: defaults
 };
 
 /// Prints the listing to standard output. Exit code 0, also when nothing is found ("no USB device found"
-/// with the reason, e.g. no USB bus in a container). Throws config::ConfigError for a bad settings file.
+/// with the reason, e.g. no USB bus in a container; "none to ask"). Throws config::ConfigError for a bad settings file.
 int run_devices(const DevicesOptions& options);
 
 /// What `haptic-kiosk calibrate` was asked to do.

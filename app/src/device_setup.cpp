@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <memory>
 #include <vector>
 
 #include "config/device_profile.hpp"
 #include "haptics/io/tty_transport.hpp"
+#include "haptics/io/usb_devices.hpp"
 #include "haptics/io/usb_transport.hpp"
 
 namespace hk::app {
@@ -129,33 +131,41 @@ hapi::EmulatorParams emulator_params_from(const config::Settings& s, const Devic
   return e;
 }
 
-io::TransportFactory board_transport_factory(const config::Settings& s) {
-  const config::DeviceSettings d = s.device;
-  return [d]() -> std::unique_ptr<io::ByteTransport> {
-    auto tty = [&d]() -> std::unique_ptr<io::ByteTransport> {
-      std::string path = d.serial_path;
-      if (path.empty()) {
-        const std::vector<std::string> ids = io::list_serial_by_id();
-        if (ids.empty()) throw DeviceError("no serial device in /dev/serial/by-id (set [device] serial_path)");
-        path = ids.front();
-      }
-      return std::make_unique<io::TtyTransport>(path);
-    };
-    auto usb = [&d]() -> std::unique_ptr<io::ByteTransport> {
-      return std::make_unique<io::UsbCdcTransport>(static_cast<std::uint16_t>(d.usb_vid), static_cast<std::uint16_t>(d.usb_pid));
-    };
-    if (d.transport == "tty") return tty();
-    if (d.transport == "usb") return usb();
-    // auto: libusb when the board is on the bus (probe by opening), else the kernel's tty.
-    try {
-      auto t = usb();
-      t->open();
-      t->close();
-      return usb();
-    } catch (const std::exception&) {
-      return tty();
+std::vector<io::BoardCandidate> board_candidates(const config::Settings& s) {
+  std::vector<io::BoardCandidate> out;
+  const config::DeviceSettings& d = s.device;
+  if (d.transport != "tty") {
+    std::string reason;
+    const std::vector<io::UsbDeviceInfo> bus = io::list_usb_devices(&reason);
+    const bool listed = reason.empty();
+    for (const config::UsbId& id : config::parse_usb_ids(d.usb_ids)) {
+      const bool present = std::any_of(bus.begin(), bus.end(), [&](const io::UsbDeviceInfo& u) { return u.vid == id.vid && u.pid == id.pid; });
+      if (listed && !present) continue;
+      char name[32];
+      std::snprintf(name, sizeof name, "usb %04x:%04x", id.vid, id.pid);
+      out.push_back({name, [id] { return std::make_unique<io::UsbCdcTransport>(id.vid, id.pid); }});
     }
-  };
+  }
+  if (d.transport != "usb") {
+    const std::vector<std::string> ttys = d.serial_path.empty() ? io::list_serial_by_id() : std::vector<std::string>{d.serial_path};
+    for (const std::string& path : ttys) out.push_back({"tty " + path, [path] { return std::make_unique<io::TtyTransport>(path); }});
+  }
+  return out;
+}
+
+std::unique_ptr<io::HaplyDevice> open_board(const config::Settings& s, std::vector<io::BoardProbe>* probes) {
+  const std::vector<io::BoardCandidate> candidates = board_candidates(s);
+  if (candidates.empty())
+    throw DeviceError(s.device.transport == "tty" ? std::string("no serial device in /dev/serial/by-id (set [device] serial_path)")
+                                                  : "no USB device with an id of [device] usb_ids" +
+                                                        std::string(s.device.transport == "auto" ? " and no serial device" : ""));
+  std::vector<io::BoardProbe> tried;
+  std::unique_ptr<io::HaplyDevice> device = io::open_first_board(haply_params_from(s), candidates, &tried);
+  if (probes) probes->insert(probes->end(), tried.begin(), tried.end());
+  if (device) return device;
+  std::string why = "no board answered";
+  for (const io::BoardProbe& p : tried) why += (&p == &tried.front() ? ": " : "; ") + p.how;
+  throw DeviceError(why);
 }
 
 std::string board_profile_type(const config::Settings& s) { return config::is_usb_type(s.device.type) ? s.device.type : std::string("haply"); }

@@ -50,10 +50,15 @@ io::HaplyDeviceParams haply_params_from(const config::Settings& s);
 /// 5 mm, and the choice's faults and calibration errors.
 hapi::EmulatorParams emulator_params_from(const config::Settings& s, const DeviceChoice& choice);
 
-/// Opens transports to a real board as [device] transport says: "usb" → libusb CDC-ACM at usb_vid:usb_pid;
-/// "tty" → serial_path, or the first /dev/serial/by-id entry; "auto" → usb, and the tty when libusb finds
-/// no such device. The factory throws DeviceError (one line) when there is nothing to open.
-io::TransportFactory board_transport_factory(const config::Settings& s);
+/// The ways to reach a real board, in the order they are tried, as [device] transport says: "usb" → libusb
+/// CDC-ACM at each id of usb_ids that is on the bus (every id when the bus cannot be listed); "tty" →
+/// serial_path, or every /dev/serial/by-id entry; "auto" → the USB ones, then the ttys.
+std::vector<io::BoardCandidate> board_candidates(const config::Settings& s);
+
+/// The first board of board_candidates(s) that answers the protocol (io::open_first_board), opened; the
+/// probes of every candidate tried are appended to `probes` (may be null). Throws DeviceError (one line)
+/// when none answered, naming each candidate and why, or saying that there was none.
+std::unique_ptr<io::HaplyDevice> open_board(const config::Settings& s, std::vector<io::BoardProbe>* probes);
 
 /// The device profile a USB board runs under: [device] type when it names a board ("haply", "haply-gen2"),
 /// else "haply" (an "auto" kiosk, or the firmware emulator, drives a gen3 board).

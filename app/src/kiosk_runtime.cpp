@@ -75,8 +75,11 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
   } else if (s.device.type != "simulated" && o.probe_usb_device) {
     if (try_open_usb()) adopt_board_profile();
     try {
-      usb_watch_ = std::make_unique<io::UsbHotplugMonitor>(static_cast<std::uint16_t>(s.device.usb_vid), static_cast<std::uint16_t>(s.device.usb_pid),
-                                                           [this](bool arrived) { if (arrived) usb_arrived_.store(true); });
+      // Any product of the first id's vendor (Arduino's, for every Haply board): an arrival only starts a probe,
+      // and the probe takes the ids of [device] usb_ids alone.
+      const std::vector<config::UsbId> ids = config::parse_usb_ids(s.device.usb_ids);
+      if (!ids.empty())
+        usb_watch_ = std::make_unique<io::UsbHotplugMonitor>(ids.front().vid, -1, [this](bool arrived) { if (arrived) usb_arrived_.store(true); });
     } catch (const std::exception& e) {
       spdlog::warn("device: no USB hot-plug ({}); the kiosk probes for the handle every 10 s", e.what());
     }
@@ -114,8 +117,7 @@ void KioskRuntime::start_servo() {
 
 bool KioskRuntime::try_open_usb() {
   try {
-    auto dev = std::make_unique<io::HaplyDevice>(haply_params_from(s_), board_transport_factory(s_));
-    dev->open();
+    std::unique_ptr<io::HaplyDevice> dev = open_board(s_, nullptr);
     spdlog::info("device: {} ({} profile: {:.2f} N everywhere)", dev->name(), config::device_profile(board_profile_type(s_)).name,
                  io::min_force_capability_n(dev->params()));
     usb_ = std::move(dev);

@@ -81,8 +81,8 @@ int main(int argc, char** argv) {
   capture->add_option("--config", cao.config_path, "Settings file (TOML): [camera]");
   CLI::App* cameras = cli.add_subcommand("cameras", "List the cameras found (libcamera, then V4L2)");
   hk::app::DevicesOptions dvo;
-  CLI::App* devices = cli.add_subcommand("devices", "List the USB and serial devices found, and which are supported");
-  devices->add_option("--config", dvo.config_path, "Settings file (TOML): [device] usb_vid, usb_pid");
+  CLI::App* devices = cli.add_subcommand("devices", "List the USB and serial devices found, and ask each way to a board for an hAPI reply");
+  devices->add_option("--config", dvo.config_path, "Settings file (TOML): [device] usb_ids, transport, serial_path");
   hk::app::CalibrateOptions co;
   CLI::App* calibrate = cli.add_subcommand("calibrate", "With the handle resting at the park place, set the encoder offsets");
   calibrate->add_option("--config", co.config_path, "Settings file (TOML) to read and to write the offsets into")->required();

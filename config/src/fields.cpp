@@ -79,6 +79,12 @@ std::string path_problem(std::string_view v) {
   return {};
 }
 
+/// The check of [device] usb_ids (parse_usb_ids).
+std::string usb_ids_problem(std::string_view v) {
+  std::string why;
+  return parse_usb_ids(v, &why).empty() ? why : std::string{};
+}
+
 /// The check of [camera] source: "auto", "none", or "file:PATH" (a path field's rules), "libcamera:N" or
 /// "v4l2:DEV" (vision::parse_source_spec reads it when the camera is opened, and refuses a bad index there).
 std::string camera_source_problem(std::string_view v) {
@@ -199,8 +205,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(device, encoder_counts_per_rev, FieldGroup::devices, ApplyWhen::restart, 64, 1048576, "counts/rev", "Encoder resolution."),
     HK_FIELD(device, max_torque_n_m, FieldGroup::devices, ApplyWhen::restart, 0.02, 10, "N·m", "Per-motor torque limit (simulated pantograph)."),
     HK_FIELD(device, transport, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "How to reach the USB pantograph: \"auto\" (libusb, then the kernel's tty), \"usb\" or \"tty\".", kTransports),
-    HK_FIELD(device, usb_vid, FieldGroup::devices, ApplyWhen::restart, 0, 65535, "", "USB vendor id of the pantograph's board ('haptic-kiosk devices' lists what is plugged in)."),
-    HK_FIELD(device, usb_pid, FieldGroup::devices, ApplyWhen::restart, 0, 65535, "", "USB product id of the pantograph's board."),
+    HK_FIELD(device, usb_ids, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "USB ids (VVVV:PPPP, comma-separated) the pantograph's board is looked for at, in order; one found is taken once it answers hAPI ('haptic-kiosk devices' says which answered).", {}, &usb_ids_problem),
     HK_FIELD(device, serial_path, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "The board's tty for the tty transport; empty: the first /dev/serial/by-id entry.", {}, &path_problem),
     HK_FIELD(device, device_id, FieldGroup::devices, ApplyWhen::restart, 1, 255, "", "hAPI device id the board is set up with."),
     HK_FIELD(device, lost_after_ticks, FieldGroup::devices, ApplyWhen::restart, 1, 1000, "ticks", "Servo ticks without a valid reply before the device counts as lost (force off, spoken)."),
@@ -626,6 +631,41 @@ void validate_as(const Settings& s, const Source& src) {
 }
 
 }  // namespace detail
+
+std::vector<UsbId> parse_usb_ids(std::string_view text, std::string* why) {
+  auto fail = [&](const char* what) {
+    if (why) *why = what;
+    return std::vector<UsbId>{};
+  };
+  auto hex4 = [](std::string_view h, std::uint16_t* out) {
+    if (h.size() != 4) return false;
+    unsigned v = 0;
+    for (char c : h) {
+      const int d = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+      if (d < 0) return false;
+      v = v * 16 + static_cast<unsigned>(d);
+    }
+    *out = static_cast<std::uint16_t>(v);
+    return true;
+  };
+  constexpr std::size_t kMaxIds = 16;
+  std::vector<UsbId> ids;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    std::size_t comma = text.find(',', at);
+    if (comma == std::string_view::npos) comma = text.size();
+    std::string_view item = text.substr(at, comma - at);
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
+    UsbId id;
+    if (item.size() != 9 || item[4] != ':' || !hex4(item.substr(0, 4), &id.vid) || !hex4(item.substr(5, 4), &id.pid))
+      return fail("must be USB ids \"VVVV:PPPP\" (four hex digits each), comma-separated, e.g. \"2341:804d,2341:003e\"");
+    ids.push_back(id);
+    if (ids.size() > kMaxIds) return fail("holds more than 16 USB ids");
+    at = comma + 1;
+  }
+  return ids;
+}
 
 std::optional<QuietHours> parse_quiet_hours(std::string_view t, std::string* why) {
   auto fail = [&](const char* what) -> std::optional<QuietHours> {

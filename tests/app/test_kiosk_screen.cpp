@@ -94,7 +94,7 @@ TEST(KioskScreen, AScriptedRunLooksForADeviceTheSettingsName) {
   const std::string exe = HK_KIOSK_EXE;
   auto run = [&](const std::string& type) {
     // An id no board has, so that a pantograph plugged into the machine running the tests is not found either.
-    std::ofstream(dir / "kiosk.toml") << "[device]\ntype = \"" << type << "\"\nusb_vid = 65535\nusb_pid = 65535\n";
+    std::ofstream(dir / "kiosk.toml") << "[device]\ntype = \"" << type << "\"\nusb_ids = \"ffff:ffff\"\n";
     EXPECT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug --config '" + (dir / "kiosk.toml").string() +
                  "' --library '" + (dir / "library").string() + "' --script '" + (dir / "script.txt").string() + "' --screenshot '" +
                  (dir / "end.png").string() + "' --frames 10 >'" + (dir / "log.txt").string() + "' 2>&1"),

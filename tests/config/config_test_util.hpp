@@ -63,8 +63,6 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"device", "handle_damping_n_s_per_m", 0, 100, false},
       {"device", "encoder_counts_per_rev", 64, 1048576, true},
       {"device", "max_torque_n_m", 0.02, 10, false},
-      {"device", "usb_vid", 0, 65535, true},
-      {"device", "usb_pid", 0, 65535, true},
       {"device", "device_id", 1, 255, true},
       {"device", "lost_after_ticks", 1, 1000, true},
       {"device", "actuator1_port", 1, 4, true},

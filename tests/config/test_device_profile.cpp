@@ -147,3 +147,35 @@ TEST(DeviceProfile, AnAutoKioskThatTakesABoardMovesIntoItsProfile) {
 
 }  // namespace
 }  // namespace hk::config
+
+namespace hk::config {
+namespace {
+
+TEST(UsbIds, TheDefaultListHoldsEveryIdHaplysBoardsEnumerateWith) {
+  const std::vector<UsbId> ids = parse_usb_ids(Settings{}.device.usb_ids);
+  const std::vector<UsbId> expected = {{0x2341, 0x003e}, {0x2341, 0x804d}, {0x2341, 0x004d}, {0x2341, 0x824d}, {0x2341, 0x024d}};
+  EXPECT_EQ(ids, expected);
+  EXPECT_EQ(parse_usb_ids(" 239A:8013 , 2341:804D"), (std::vector<UsbId>{{0x239a, 0x8013}, {0x2341, 0x804d}}));
+}
+
+TEST(UsbIds, AMalformedListIsRefusedWithItsKeyAndTheForm) {
+  for (const char* bad : {"", "2341", "2341:80", "2341:804g", "2341:804d,", "2341-804d", "2341:804d;2341:003e"}) {
+    std::string why;
+    EXPECT_TRUE(parse_usb_ids(bad, &why).empty()) << bad;
+    EXPECT_FALSE(why.empty()) << bad;
+  }
+  std::string many;
+  for (int i = 0; i < 17; ++i) many += (i ? "," : "") + std::string("2341:804d");
+  std::string why;
+  EXPECT_TRUE(parse_usb_ids(many, &why).empty());
+  EXPECT_EQ(why, "holds more than 16 USB ids");
+  auto e = test::capture_error([] { (void)parse_settings("[device]\nusb_ids = \"2341:80\"\n", "ids.toml"); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "device.usb_ids");
+  EXPECT_EQ(std::string(e->what()),
+            "config 'ids.toml': device.usb_ids = \"2341:80\" must be USB ids \"VVVV:PPPP\" (four hex digits each), comma-separated, e.g. "
+            "\"2341:804d,2341:003e\" (line 2)");
+}
+
+}  // namespace
+}  // namespace hk::config

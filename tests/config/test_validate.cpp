@@ -114,7 +114,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
-    if (name == "operator.open_chord" || name == "device.serial_path" || name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "vision.ocr_languages") {
+    if (name == "operator.open_chord" || name == "device.serial_path" || name == "device.usb_ids" || name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "vision.ocr_languages") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -124,7 +124,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 33u);
+  EXPECT_EQ(texts, 34u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 

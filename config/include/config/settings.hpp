@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 namespace hk::config {
 
@@ -56,8 +57,7 @@ struct DeviceSettings {
   int encoder_counts_per_rev = 16384;     ///< key encoder_counts_per_rev, [64, 1048576] counts/rev
   double max_torque_n_m = 0.5;            ///< key max_torque_n_m, per-motor torque limit, [0.02, 10] N·m
   std::string transport = "auto";         ///< key transport, "auto" (libusb, then the kernel's tty), "usb" or "tty"
-  int usb_vid = 0x2341;                   ///< key usb_vid, USB vendor id of the pantograph's board, [0, 65535]
-  int usb_pid = 0x804D;                   ///< key usb_pid, USB product id, [0, 65535]
+  std::string usb_ids = "2341:003e,2341:804d,2341:004d,2341:824d,2341:024d";  ///< key usb_ids, the USB ids a board is looked for at, "VVVV:PPPP" (hex) comma-separated, 1 to 16, in order: Haply's boards enumerate as an Arduino Due's native port (2341:003e, the original dev board and M3) or an Arduino Zero's (804d, 004d, 824d, 024d: the M0 boards); each found is taken only once it answers hAPI
   std::string serial_path;                ///< key serial_path, tty of the board for the tty transport; empty = the first /dev/serial/by-id entry
   int device_id = 5;                      ///< key device_id, hAPI device id, [1, 255]
   int lost_after_ticks = 3;               ///< key lost_after_ticks, ticks without a valid reply before the device counts as lost, [1, 1000]
@@ -225,6 +225,18 @@ inline std::array<std::pair<std::string_view, std::string_view>, kKeyActionCount
            {"guide", k.guide}, {"capture", k.capture}, {"repeat", k.repeat}, {"pause", k.pause}, {"where", k.where},
            {"finish", k.finish}}};
 }
+
+/// One USB id of [device] usb_ids.
+struct UsbId {
+  std::uint16_t vid = 0;  ///< vendor id
+  std::uint16_t pid = 0;  ///< product id
+  bool operator==(const UsbId&) const = default;
+};
+
+/// Reads [device] usb_ids: "VVVV:PPPP" with four hex digits each (either case), comma-separated, spaces
+/// around the commas allowed, 1 to 16 of them. On a malformed value returns an empty list and, when `why`
+/// is given, sets it to one phrase saying what is wrong.
+std::vector<UsbId> parse_usb_ids(std::string_view text, std::string* why = nullptr);
 
 /// Quiet hours as minutes after local midnight: from `first` (inclusive) to `second` (exclusive), passing
 /// midnight when second < first.

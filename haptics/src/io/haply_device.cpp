@@ -58,6 +58,27 @@ double min_force_capability_n(const HaplyDeviceParams& p) noexcept {
   return min_force_everywhere_n(hapi::geometry_of(p.mechanism), p.rect_center_device_m, p.rect_size_device_m, p.torque_limit_n_m);
 }
 
+std::unique_ptr<HaplyDevice> open_first_board(const HaplyDeviceParams& params, const std::vector<BoardCandidate>& candidates,
+                                              std::vector<BoardProbe>* probes) {
+  for (const BoardCandidate& c : candidates) {
+    BoardProbe probe{c.name, false, {}};
+    try {
+      auto device = std::make_unique<HaplyDevice>(params, c.factory);
+      const std::int64_t t0 = steady_ns();
+      device->open();
+      probe.answered = true;
+      probe.how = "hAPI reply from device id " + std::to_string(params.layout.device_id) + " after " +
+                  std::to_string((steady_ns() - t0) / 1000000) + " ms";
+      if (probes) probes->push_back(probe);
+      return device;
+    } catch (const std::exception& e) {
+      probe.how = e.what();
+      if (probes) probes->push_back(probe);
+    }
+  }
+  return nullptr;
+}
+
 HaplyDevice::HaplyDevice(const HaplyDeviceParams& params, TransportFactory factory)
     : params_(params), factory_(std::move(factory)), geometry_(hapi::geometry_of(params.mechanism)) {
   hapi::validate(params_.layout);
@@ -129,10 +150,14 @@ void HaplyDevice::open() {
   }
   if (!answered) {
     const std::string what = transport_->name();
+    const std::int64_t refused = malformed_.exchange(0);
     transport_->close();
     transport_.reset();
-    throw DeviceError(what + ": no hAPI reply from device id " + std::to_string(params_.layout.device_id) + " within " +
-                      std::to_string(params_.open_timeout_ms) + " ms (is the board a Haply running hAPI firmware?)");
+    const std::string id = std::to_string(params_.layout.device_id), within = std::to_string(params_.open_timeout_ms) + " ms";
+    if (refused > 0)
+      throw DeviceError(what + ": answered, but with no well-formed hAPI reply from device id " + id + " within " + within + " (" +
+                        std::to_string(refused) + " replies refused: another device, or another firmware)");
+    throw DeviceError(what + ": no reply from device id " + id + " within " + within + " (is the board a Haply running hAPI firmware?)");
   }
   t0_ns_ = steady_ns();
   gone_.store(false);

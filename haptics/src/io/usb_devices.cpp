@@ -64,7 +64,7 @@ std::vector<UsbDeviceInfo> list_usb_devices(std::string* reason) {
   return out;
 }
 
-UsbHotplugMonitor::UsbHotplugMonitor(std::uint16_t vid, std::uint16_t pid, std::function<void(bool)> on_change)
+UsbHotplugMonitor::UsbHotplugMonitor(std::uint16_t vid, int pid, std::function<void(bool)> on_change)
     : on_change_(std::move(on_change)) {
   libusb_context* ctx = nullptr;
   if (const int r = libusb_init(&ctx); r != 0) {
@@ -79,7 +79,7 @@ UsbHotplugMonitor::UsbHotplugMonitor(std::uint16_t vid, std::uint16_t pid, std::
   libusb_hotplug_callback_handle handle = 0;
   const int r = libusb_hotplug_register_callback(
       ctx, static_cast<libusb_hotplug_event>(LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED | LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT),
-      LIBUSB_HOTPLUG_ENUMERATE, vid, pid, LIBUSB_HOTPLUG_MATCH_ANY, &on_hotplug, &on_change_, &handle);
+      LIBUSB_HOTPLUG_ENUMERATE, vid, pid < 0 ? LIBUSB_HOTPLUG_MATCH_ANY : pid, LIBUSB_HOTPLUG_MATCH_ANY, &on_hotplug, &on_change_, &handle);
   if (r != LIBUSB_SUCCESS) {
     reason_ = usb_error("libusb_hotplug_register_callback", r);
     return;

@@ -44,6 +44,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "haptics/device.hpp"
 #include "haptics/hapi_protocol.hpp"
@@ -102,6 +103,28 @@ bool calibrated_offsets(const HaplyDeviceParams& p, Vec2 park_workspace_m, doubl
 /// Above it, walls saturate somewhere: an operator's max_force_n over this cannot be felt everywhere.
 double min_force_capability_n(const HaplyDeviceParams& p) noexcept;
 
+class HaplyDevice;
+
+/// One way to reach a board (a USB id, a tty), tried by open_first_board.
+struct BoardCandidate {
+  std::string name;          ///< for people and logs: "usb 2341:804d", "tty /dev/serial/by-id/..."
+  TransportFactory factory;  ///< makes the transport (the device re-opens through it after an unplug)
+};
+
+/// What trying one candidate found.
+struct BoardProbe {
+  std::string name;        ///< the candidate's name
+  bool answered = false;   ///< its board answered the protocol and was taken
+  std::string how;         ///< answered: "hAPI reply from device id 5 after 12 ms"; else why not (one line)
+};
+
+/// Opens the first candidate whose board answers the protocol — reset, setup, zero-torque packets until a
+/// well-formed reply (HaplyDevice::open, within open_timeout_ms) — and returns it open; a later reply, a
+/// tick or more behind, is taken as it comes. One BoardProbe per candidate tried is appended to `probes`
+/// (may be null). Null when none answered; the probes say why (missing, busy, no permission, garbage, silence).
+std::unique_ptr<HaplyDevice> open_first_board(const HaplyDeviceParams& params, const std::vector<BoardCandidate>& candidates,
+                                              std::vector<BoardProbe>* probes);
+
 /// The hAPI pantograph as a `Device`.
 class HaplyDevice final : public Device {
  public:
@@ -115,7 +138,8 @@ class HaplyDevice final : public Device {
 
   /// Opens a transport through the factory, sends reset and setup, then zero-torque packets until the
   /// first valid reply (at most open_timeout_ms): status Ok. Starts the re-open thread. Throws DeviceError
-  /// naming the transport when it cannot be opened or the board does not answer.
+  /// naming the transport when it cannot be opened or the board does not answer: silent, or answering only
+  /// bytes that are no hAPI reply (another device on the port).
   void open() override;
   /// Real-time, never waits. The handle from the newest valid reply (the last good one when none came), and
   /// the status.

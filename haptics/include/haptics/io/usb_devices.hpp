@@ -33,7 +33,8 @@ struct UsbDeviceInfo {
 /// on success. Setup-time: allocates and does I/O.
 std::vector<UsbDeviceInfo> list_usb_devices(std::string* reason = nullptr);
 
-/// Calls `on_change(true)` when a device with `vid`:`pid` arrives and `on_change(false)` when one leaves.
+/// Calls `on_change(true)` when a device with `vid`:`pid` (any product of `vid` when pid < 0) arrives and
+/// `on_change(false)` when one leaves.
 /// Devices already attached are reported as arrivals too (LIBUSB_HOTPLUG_ENUMERATE), from inside the
 /// constructor on the constructing thread; the libusb docs warn that with ENUMERATE one arrival may be
 /// reported twice and a departure may come without its arrival, so treat calls as "state may have
@@ -43,7 +44,7 @@ std::vector<UsbDeviceInfo> list_usb_devices(std::string* reason = nullptr);
 /// and callers poll list_usb_devices() instead. Never throws from the constructor for lack of USB.
 class UsbHotplugMonitor {
  public:
-  UsbHotplugMonitor(std::uint16_t vid, std::uint16_t pid, std::function<void(bool arrived)> on_change);
+  UsbHotplugMonitor(std::uint16_t vid, int pid, std::function<void(bool arrived)> on_change);
   /// Deregisters the callback and joins the event thread; no call to on_change after it returns.
   ~UsbHotplugMonitor();
   UsbHotplugMonitor(const UsbHotplugMonitor&) = delete;
