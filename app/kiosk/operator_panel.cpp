@@ -251,6 +251,7 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
   const double can_n = io::min_force_capability_n(usb->params());
   ImGui::Text("%s profile: it gives at least %.2f N in every direction everywhere in its rectangle.",
               std::string(config::device_profile(runtime.profile_type()).name).c_str(), can_n);
+  if (!runtime.home_note().empty()) ImGui::TextColored(kOrange, "%s", runtime.home_note().c_str());
   if (ImGui::Button("Calibrate: the handle rests at the park place")) {
     double o1 = 0, o2 = 0;
     std::string why;

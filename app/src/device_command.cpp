@@ -64,14 +64,9 @@ int run_calibrate(const CalibrateOptions& o) {
     const DeviceChoice choice = parse_device_choice(o.device);
     if (choice.kind != DeviceChoice::Kind::HaplyEmulator)
       throw DeviceChoiceError("--device '" + o.device + "': calibrate needs 'haply' or 'haply-emulator[:...]'");
-    const double scale = io::workspace_scale(dp);
-    // The emulated handle rests at the park place, untouched, its stops hugging it: the board's home pose lies
-    // beyond the usable rectangle, at the edge of the links' reach, where the emulator's usual stops do not go.
-    hapi::EmulatorParams ep = emulator_params_from(s, choice);
-    const Vec2 park_device = (1.0 / scale) * park + dp.rect_center_device_m;
-    ep.workspace_center_m = park_device;
-    ep.workspace_half_extent_m = {0.0005, 0.0005};
-    ep.stop_margin_m = 0.0;
+    // The emulated handle rests at the park place, untouched.
+    Vec2 park_device;
+    const hapi::EmulatorParams ep = emulator_resting_at_park(s, choice, &park_device);
     emulator = std::make_unique<hapi::FirmwareEmulator>(ep, park_device, [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
     pty = std::make_unique<hapi::PtyEmulator>(*emulator);
     const std::string path = pty->device_path();

@@ -61,10 +61,11 @@ DeviceChoice parse_device_choice(const std::string& text) {
     else if (key == "seed") c.faults.seed = static_cast<std::uint64_t>(number_of(key, value, 0, 9007199254740992.0, true));
     else if (key == "calib_error1_deg") c.calibration_error_deg[0] = number_of(key, value, -90, 90, false);
     else if (key == "calib_error2_deg") c.calibration_error_deg[1] = number_of(key, value, -90, 90, false);
+    else if (key == "rest_at_park") c.rest_at_park = number_of(key, value, 0, 1, true) == 1.0;
     else
       throw DeviceChoiceError("--device haply-emulator: unknown fault '" + key +
                               "'; known: disconnect_at_s, drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed, "
-                              "calib_error1_deg, calib_error2_deg");
+                              "calib_error1_deg, calib_error2_deg, rest_at_park");
   }
   return c;
 }
@@ -129,6 +130,40 @@ hapi::EmulatorParams emulator_params_from(const config::Settings& s, const Devic
   e.stop_margin_m = 0.005;
   e.faults = choice.faults;
   return e;
+}
+
+hapi::EmulatorParams emulator_resting_at_park(const config::Settings& s, const DeviceChoice& choice, Vec2* start_device_m) {
+  const io::HaplyDeviceParams dp = haply_params_from(s);
+  hapi::EmulatorParams ep = emulator_params_from(s, choice);
+  *start_device_m = (1.0 / io::workspace_scale(dp)) * Vec2{s.device.park_x_m, s.device.park_y_m} + dp.rect_center_device_m;
+  ep.workspace_center_m = *start_device_m;
+  ep.workspace_half_extent_m = {0.0005, 0.0005};
+  ep.stop_margin_m = 0.0;
+  return ep;
+}
+
+HomeCheck check_home_pose(const io::HaplyDevice& device, const config::Settings& s) {
+  HomeCheck c;
+  c.park_m = {s.device.park_x_m, s.device.park_y_m};
+  if (device.counters().replies == 0) return c;
+  double th1 = 0, th2 = 0;
+  device.joint_angles_deg(&th1, &th2);
+  Vec2 at_device;
+  if (!device.device_position(th1, th2, &at_device)) return c;
+  c.read_m = device.to_workspace(at_device);
+  c.off_m = distance(c.read_m, c.park_m);
+  c.at_home = c.off_m <= kHomeTolerance_m;
+  return c;
+}
+
+std::string home_check_line(const HomeCheck& c) {
+  char b[320];
+  std::snprintf(b, sizeof b,
+                "the handle reads (%.1f, %.1f) mm at start, %.1f mm from its home pose at the park place (%.1f, %.1f) mm: positions read wrong "
+                "until it is calibrated; rest the handle at home (both arms stretched out sideways) and press Calibrate in the operator's "
+                "panel, or run 'haptic-kiosk calibrate'",
+                1000 * c.read_m.x, 1000 * c.read_m.y, 1000 * c.off_m, 1000 * c.park_m.x, 1000 * c.park_m.y);
+  return b;
 }
 
 std::vector<io::BoardCandidate> board_candidates(const config::Settings& s) {

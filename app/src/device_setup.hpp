@@ -31,11 +31,12 @@ struct DeviceChoice {
   Kind kind = Kind::Simulated;
   hapi::EmulatorFaults faults;             ///< haply-emulator faults (disconnect_at_s, drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed)
   double calibration_error_deg[2] = {0, 0};///< haply-emulator: encoder zero errors of joints 1 and 2 (calib_error1_deg, calib_error2_deg) [deg]
+  bool rest_at_park = false;                ///< haply-emulator: the handle rests at the park place, its stops hugging it (rest_at_park=1), as a board waits at its home pose for a kiosk to start
 };
 
 /// Parses `sim` (or `simulated`) and `haply-emulator[:KEY=VALUE,...]` with keys disconnect_at_s, stall_at_s,
 /// stall_s (seconds ≥ 0), drop_every, garbage_every, wrong_id_every (integers in [0, 1000000]; 0 = never),
-/// seed (integer ≥ 0), calib_error1_deg, calib_error2_deg ([-90, 90]). Throws DeviceChoiceError naming the
+/// seed (integer ≥ 0), calib_error1_deg, calib_error2_deg ([-90, 90]), rest_at_park (0 or 1). Throws DeviceChoiceError naming the
 /// key or value and its limit.
 DeviceChoice parse_device_choice(const std::string& text);
 
@@ -49,6 +50,33 @@ io::HaplyDeviceParams haply_params_from(const config::Settings& s);
 /// reads right), the mechanism and handle physics of [device], the stop box = the usable rectangle plus
 /// 5 mm, and the choice's faults and calibration errors.
 hapi::EmulatorParams emulator_params_from(const config::Settings& s, const DeviceChoice& choice);
+
+/// The firmware emulator with its handle resting at the park place ([device] park_x_m, park_y_m: by default
+/// the board's home pose, beyond the usable rectangle at the edge of the links' reach): emulator_params_from
+/// with stops hugging the park place (0.5 mm each way). `*start_device_m` is the place, device frame [m].
+hapi::EmulatorParams emulator_resting_at_park(const config::Settings& s, const DeviceChoice& choice, Vec2* start_device_m);
+
+/// Where the handle read at start against where it should rest (the park place), workspace frame.
+struct HomeCheck {
+  bool at_home = true;   ///< within kHomeTolerance_m of the park place (or nothing read yet)
+  Vec2 read_m;           ///< where the first reply puts the handle [m]
+  Vec2 park_m;           ///< [device] park_x_m, park_y_m [m]
+  double off_m = 0.0;    ///< the distance between them [m]
+};
+
+/// How far from the park place a handle may read at start and still count as resting there [m]: a few
+/// encoder counts at the home pose, far less than a handle put down elsewhere.
+inline constexpr double kHomeTolerance_m = 0.003;
+
+/// The check a kiosk makes right after it takes a board: a board's encoder counters start at the offsets
+/// of its setup, so the first reply reads the home pose they name wherever the handle really is; read
+/// anywhere else (offsets and park place disagree, or an encoder zero is off), the handle did not start
+/// at its home pose and every position reads wrong until it is calibrated.
+HomeCheck check_home_pose(const io::HaplyDevice& device, const config::Settings& s);
+
+/// The one line that tells the operator (log, panel): where the handle read, how far from the park place,
+/// and how to fix it (rest the handle there, then Calibrate in the panel or `haptic-kiosk calibrate`).
+std::string home_check_line(const HomeCheck& c);
 
 /// The ways to reach a real board, in the order they are tried, as [device] transport says: "usb" → libusb
 /// CDC-ACM at each id of usb_ids that is on the bus (every id when the bus cannot be listed); "tty" →

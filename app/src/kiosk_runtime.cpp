@@ -73,7 +73,10 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
     open_emulated_board(o.device);
     adopt_board_profile();
   } else if (s.device.type != "simulated" && o.probe_usb_device) {
-    if (try_open_usb()) adopt_board_profile();
+    if (try_open_usb()) {
+      adopt_board_profile();
+      check_home(true);
+    }
     try {
       // Any product of the first id's vendor (Arduino's, for every Haply board): an arrival only starts a probe,
       // and the probe takes the ids of [device] usb_ids alone.
@@ -160,6 +163,7 @@ bool KioskRuntime::calibrate_usb(double* offset1_deg, double* offset2_deg, std::
     *why = "the park place is out of the links' reach";
     return false;
   }
+  home_note_.clear();  // the handle rests at home, and now reads there
   return true;
 }
 
@@ -171,8 +175,10 @@ void KioskRuntime::open_emulated_board(const std::string& text) {
   const double scale = io::workspace_scale(dp);
   const Vec2 centre = dp.rect_center_device_m;
   // The board's handle follows the cursor through the model hand (workspace frame ↔ device frame).
+  Vec2 start_device = (1.0 / scale) * cursor_.read() + centre;
+  const hapi::EmulatorParams ep = choice.rest_at_park ? emulator_resting_at_park(s_, choice, &start_device) : emulator_params_from(s_, choice);
   board_ = std::make_unique<hapi::FirmwareEmulator>(
-      emulator_params_from(s_, choice), (1.0 / scale) * cursor_.read() + centre,
+      ep, start_device,
       [this, scale, centre](double, Vec2 handle_device_m, Vec2 velocity_device_m_per_s) {
         const Vec2 handle = scale * (handle_device_m - centre);
         const Vec2 target = hand_limp_.load(std::memory_order_relaxed) ? handle : cursor_.read();
@@ -183,12 +189,24 @@ void KioskRuntime::open_emulated_board(const std::string& text) {
   usb_ = std::make_unique<io::HaplyDevice>(dp, [path] { return std::make_unique<io::TtyTransport>(path); });
   usb_->open();
   spdlog::info("device: {} on the firmware emulator", usb_->name());
+  if (choice.rest_at_park) check_home(true);  // a board at rest, as a real one waits for the kiosk to start
+}
+
+void KioskRuntime::check_home(bool at_start) {
+  const HomeCheck c = check_home_pose(*usb_, s_);
+  home_note_ = c.at_home ? std::string{} : home_check_line(c);
+  home_unspoken_ = at_start && !c.at_home;
+  if (!c.at_home) spdlog::warn("device: {}", home_note_);
 }
 
 void KioskRuntime::announce_device() {
   if (s_.device.type == "simulated" && opt_.device.empty()) return;  // chosen: nothing to tell
   if (!opt_.probe_usb_device && opt_.device.empty()) return;
-  say(audio_.messages().text(usb_ ? audio::MessageId::device_ready : audio::MessageId::device_simulated));
+  std::string text = audio_.messages().text(usb_ ? audio::MessageId::device_ready : audio::MessageId::device_simulated);
+  // A handle that did not start at home is the staff's to fix: said at start only, before any visitor.
+  if (usb_ && home_unspoken_) text += " " + audio_.messages().text(audio::MessageId::device_not_home);
+  home_unspoken_ = false;
+  say(text);
 }
 
 void KioskRuntime::announce_camera() {
@@ -262,6 +280,7 @@ void KioskRuntime::poll_device(double now_s) {
   const bool running = servo_ != nullptr;
   if (!try_open_usb()) return;
   adopt_board_profile();
+  check_home(false);  // a visitor may be there: the log and the panel only
   rebuild_shown();  // the groove depth is built into the scene
   if (running) {
     servo_->stop();

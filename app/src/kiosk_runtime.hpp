@@ -103,6 +103,8 @@ class KioskRuntime final : public KioskEffects {
   void stop_servo();
   /// Says which device is in use: "The handle is ready." or that the kiosk runs on its simulated handle
   /// (nothing when the simulated pantograph was chosen: [device] type "simulated", or probe_usb_device off).
+  /// The first time after a start whose board did not read its home pose, the staff's line follows
+  /// (device_not_home); never again, so no visitor hears it.
   void announce_device();
   /// Says which camera there is (issue 16): "There is a camera: press … to feel a picture of your own." or "No
   /// camera was found." (nothing when [camera] source is "none", or "auto" was not probed). Logged either way.
@@ -128,6 +130,9 @@ class KioskRuntime final : public KioskEffects {
   /// pantograph or the emulated board is in use, else [device] type ("auto" and "simulated" both mean the
   /// simulated pantograph's). The operator's panel shows and applies its limits.
   std::string profile_type() const;
+  /// Empty, or the one line saying that the board's handle did not start at its home pose (the park place)
+  /// and how to fix it (device_setup.hpp check_home_pose); the operator's panel shows it.
+  const std::string& home_note() const { return home_note_; }
   /// Why the simulated pantograph is in use (empty when the USB pantograph is, or [device] type is "simulated").
   const std::string& device_note() const { return device_note_; }
 
@@ -266,6 +271,7 @@ class KioskRuntime final : public KioskEffects {
   std::string describe_shown();             // describe() of what is shown, without the reading's news
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
   void rebuild_shown();
+  void check_home(bool at_start);  // check_home_pose on the board just taken; at start the staff also hear it (announce_device)
   void adopt_board_profile();  // the board's profile in force: settings_for_board, then servo params, hand and gains from them
   bool try_open_usb();  // the USB pantograph per [device]; false (device_note_ says why) when none answers
   void open_emulated_board(const std::string& choice);  // RuntimeOptions::device
@@ -282,6 +288,8 @@ class KioskRuntime final : public KioskEffects {
   std::unique_ptr<hapi::PtyEmulator> board_pty_;    // ...behind its pty
   std::unique_ptr<io::HaplyDevice> usb_;  // the USB pantograph, when one answered
   std::string device_note_;
+  std::string home_note_;          // check_home_pose said the handle did not start at home (empty: it did)
+  bool home_unspoken_ = false;     // ... at start: announce_device says so once
   DeviceStatus last_status_ = DeviceStatus::Ok;
   double lost_since_s_ = 0.0;   // when the device stopped answering [s, poll_device's clock]
   bool lost_spoken_ = false;    // the loss was said (the return will be)

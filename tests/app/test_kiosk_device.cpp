@@ -71,14 +71,16 @@ TEST(KioskDevice, ABoardOnItsTtyIsUsedAnnouncedAndItsLossSpoken) {
   DeviceChoice unplug;
   unplug.kind = DeviceChoice::Kind::HaplyEmulator;
   unplug.faults.disconnect_at_s = 0.5;  // of the board's own time: 500 torque packets
-  const io::HaplyDeviceParams dp = haply_params_from(s);
-  hapi::FirmwareEmulator board(emulator_params_from(s, unplug), dp.rect_center_device_m, [](double, Vec2, Vec2) { return Vec2{}; });
+  Vec2 home;  // the board waits at its home pose, as one does for the kiosk to start
+  const hapi::EmulatorParams at_rest = emulator_resting_at_park(s, unplug, &home);
+  hapi::FirmwareEmulator board(at_rest, home, [](double, Vec2, Vec2) { return Vec2{}; });
   hapi::PtyEmulator pty(board);
   s.device.serial_path = pty.device_path();
 
   const Library lib;
   KioskRuntime rt(options(lib), s);
   ASSERT_NE(rt.usb_device(), nullptr) << rt.device_note();
+  EXPECT_EQ(rt.home_note(), "");
   EXPECT_EQ(&rt.device(), rt.usb_device());
   EXPECT_TRUE(rt.device_note().empty());
   rt.start_servo();
@@ -225,6 +227,54 @@ TEST(KioskDevice, ALongLossIsSpokenAndSoIsTheReturn) {
 TEST(KioskDevice, AShortLossIsNotSpoken) {
   const std::vector<std::string> s = run_stall(0.02, [](KioskRuntime& rt) { return rt.usb_device()->counters().reconnects >= 1; });
   EXPECT_TRUE(s.empty()) << s.front();
+}
+
+}  // namespace hk::app
+
+namespace hk::app {
+
+TEST(KioskDevice, AHandleThatDidNotStartAtHomeIsToldToTheStaffAtStartAndNeverToAVisitor) {
+  // The board was set up with its handle 8 degrees of joint 1 away from home: every position reads wrong.
+  const Library lib;
+  RuntimeOptions ro = options(lib);
+  ro.device = "haply-emulator:rest_at_park=1,calib_error1_deg=8";
+  auto sink = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(64);
+  auto logger = std::make_shared<spdlog::logger>("home", sink);
+  auto before = spdlog::default_logger();
+  spdlog::set_default_logger(logger);
+  KioskRuntime rt(ro, config::Settings{});
+  spdlog::set_default_logger(before);
+  ASSERT_NE(rt.usb_device(), nullptr);
+  // The operator: one logged line, kept for the panel, naming the distance and the fix.
+  EXPECT_NE(rt.home_note().find("from its home pose at the park place"), std::string::npos) << rt.home_note();
+  EXPECT_NE(rt.home_note().find("press Calibrate in the operator's panel, or run 'haptic-kiosk calibrate'"), std::string::npos);
+  int logged = 0;
+  for (const std::string& line : sink->last_formatted())
+    logged += line.find("device: the handle reads") != std::string::npos && line.find("[warning]") != std::string::npos;
+  EXPECT_EQ(logged, 1);
+  // Spoken once, with the start's announcement, before any visitor.
+  rt.announce_device();
+  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready) + " " + said(audio::MessageId::device_not_home));
+  // A visitor who comes later does not hear it: not again with the device, not in the picture's description.
+  rt.announce_device();
+  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
+  EXPECT_EQ(rt.describe().find(said(audio::MessageId::device_not_home)), std::string::npos);
+  // Calibrated where it rests: the note is gone.
+  double o1 = 0, o2 = 0;
+  std::string why;
+  ASSERT_TRUE(rt.calibrate_usb(&o1, &o2, &why)) << why;
+  EXPECT_EQ(rt.home_note(), "");
+}
+
+TEST(KioskDevice, AHandleAtHomeIsNotMentioned) {
+  const Library lib;
+  RuntimeOptions ro = options(lib);
+  ro.device = "haply-emulator:rest_at_park=1";
+  KioskRuntime rt(ro, config::Settings{});
+  ASSERT_NE(rt.usb_device(), nullptr);
+  EXPECT_EQ(rt.home_note(), "");
+  rt.announce_device();
+  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
 }
 
 }  // namespace hk::app
