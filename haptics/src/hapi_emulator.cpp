@@ -43,9 +43,9 @@ double wrap180(double deg) {
 FirmwareEmulator::FirmwareEmulator(const EmulatorParams& params, Vec2 start_handle_device_m, HandForce hand)
     : params_(params), hand_(std::move(hand)), rng_(params.faults.seed) {
   const EmulatorParams& p = params_;
-  if (!finite_pos(p.mechanism.proximal_m) || !finite_pos(p.mechanism.distal_m) ||
-      !finite_pos(p.mechanism.motor_spacing_m)) {
-    bad_param("mechanism lengths must be finite and > 0");
+  if (!finite_pos(p.mechanism.proximal_m) || !finite_pos(p.mechanism.distal_m) || !std::isfinite(p.mechanism.motor_spacing_m) ||
+      p.mechanism.motor_spacing_m < 0.0) {
+    bad_param("link lengths must be finite and > 0, the motor spacing finite and >= 0 (0: coaxial motors, the original 2DIY)");
   }
   if (!finite_pos(p.torque_limit_n_m)) bad_param("torque_limit_n_m must be finite and > 0");
   if (!finite_pos(p.period_s)) bad_param("period_s must be finite and > 0");
