@@ -9,6 +9,8 @@
 //     the same run on the simulated pantograph. The emulator's own thread is the "board" and is not counted.
 //  3. The servo step's calls alone, paced at 1 kHz and never waiting (read, then write_force): their p50 /
 //     p99 / max times, and the writes skipped while a packet's reply was not yet in.
+//  4. Plug-in to force: a new board's tty asked until it answers hAPI (io::open_first_board), ten boards;
+//     the force then ramps in over [haptics] force_ramp_s.
 // Usage: bench_device_loop [--seconds S] [--out FILE.json]
 #include <pthread.h>
 #include <spdlog/spdlog.h>
@@ -101,10 +103,41 @@ nlohmann::json round_trip(const config::Settings& s, double seconds) {
   return {{"ticks", n}, {"round_trip_us", {{"p50", pct(us, 0.5)}, {"p99", pct(us, 0.99)}, {"max", pct(us, 1.0)}}}, {"missing", missing}};
 }
 
+/// Plug-in to force: from the moment the kiosk asks a board that just arrived (its tty, through
+/// io::open_first_board: reset, setup, zero-torque packets until a well-formed reply) to the board taken and
+/// answering; the servo then ramps the force in over [haptics] force_ramp_s. `runs` boards, each new.
+nlohmann::json plug_in_to_force(const config::Settings& s, int runs) {
+  std::vector<double> ms;
+  for (int k = 0; k < runs; ++k) {
+    hapi::FirmwareEmulator emulator(app::emulator_params_from(s, {}), app::haply_params_from(s).rect_center_device_m,
+                                    [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+    hapi::PtyEmulator pty(emulator);
+    const std::string path = pty.device_path();
+    const auto t0 = std::chrono::steady_clock::now();
+    std::unique_ptr<io::HaplyDevice> board =
+        io::open_first_board(app::haply_params_from(s), {{"tty " + path, [path] { return std::make_unique<io::TtyTransport>(path); }}}, nullptr);
+    const auto t1 = std::chrono::steady_clock::now();
+    if (board) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    if (board) board->close();
+    pty.stop();
+  }
+  std::printf("| plug-in to the board answering (open_first_board on its tty) | %d | %.1f ms | %.1f ms | %.1f ms | %d |\n", runs, pct(ms, 0.5),
+              pct(ms, 0.99), pct(ms, 1.0), runs - static_cast<int>(ms.size()));
+  return {{"runs", runs}, {"answered", ms.size()}, {"open_ms", {{"p50", pct(ms, 0.5)}, {"max", pct(ms, 1.0)}}}, {"force_ramp_s", s.haptics.force_ramp_s}};
+}
+
 /// The driver's calls as the servo thread makes them (read, then write_force, paced at 1 kHz, never waiting):
 /// how long each took at most, and how many writes were skipped because the last packet's reply was not in.
 nlohmann::json step_calls(const config::Settings& s, double seconds) {
   Board b(s);
+  // On a thread scheduled as the kiosk's servo thread is (SCHED_FIFO where allowed), so that the times are
+  // the calls' own and not the scheduler's.
+  int old_policy = 0;
+  sched_param old_param{};
+  pthread_getschedparam(pthread_self(), &old_policy, &old_param);
+  sched_param fifo{};
+  fifo.sched_priority = app::ServoThreadParams{}.fifo_priority;
+  const bool realtime = pthread_setschedparam(pthread_self(), SCHED_FIFO, &fifo) == 0;
   std::vector<double> read_us, write_us;
   const long n = static_cast<long>(seconds * 1000);
   read_us.reserve(static_cast<std::size_t>(n));
@@ -126,13 +159,16 @@ nlohmann::json step_calls(const config::Settings& s, double seconds) {
     read_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
     write_us.push_back(std::chrono::duration<double, std::micro>(t2 - t1).count());
   }
+  if (realtime) pthread_setschedparam(pthread_self(), old_policy, &old_param);
   const io::HaplyCounters c = b.device->counters();
-  std::printf("| servo step's read / write_force, never waiting | %ld | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f | %lld skipped, %lld late |\n", n,
+  std::printf("| servo step's read / write_force, never waiting (%s) | %ld | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f | %lld skipped, %lld late |\n",
+              realtime ? "SCHED_FIFO" : "normal priority", n,
               pct(read_us, 0.5), pct(write_us, 0.5), pct(read_us, 0.99), pct(write_us, 0.99), pct(read_us, 1.0), pct(write_us, 1.0),
               static_cast<long long>(c.writes_skipped), static_cast<long long>(c.replies_missing));
   return {{"ticks", n},
           {"read_us", {{"p50", pct(read_us, 0.5)}, {"p99", pct(read_us, 0.99)}, {"max", pct(read_us, 1.0)}}},
           {"write_us", {{"p50", pct(write_us, 0.5)}, {"p99", pct(write_us, 0.99)}, {"max", pct(write_us, 1.0)}}},
+          {"sched_fifo", realtime},
           {"packets_sent", c.ticks},
           {"writes_skipped", c.writes_skipped},
           {"ticks_without_reply", c.replies_missing}};
@@ -199,6 +235,7 @@ int main(int argc, char** argv) {
   std::printf("| measurement | ticks | p50 µs | p99 µs | max µs | missing |\n|---|---|---|---|---|---|\n");
   j["round_trip"] = round_trip(s, seconds);
   j["step_calls"] = step_calls(s, seconds);
+  j["plug_in"] = plug_in_to_force(s, 10);
   std::printf("\n| run | ticks | lateness p50 µs | p99 µs | max µs | tick work p50 µs | p99 µs | missed | replies missing | servo thread CPU | priority |\n"
               "|---|---|---|---|---|---|---|---|---|---|---|\n");
   j["servo"] = {servo_run(s, seconds, false), servo_run(s, seconds, true)};

@@ -9,6 +9,9 @@ Writes, next to the JSON unless --outdir is given:
                     passivity bound 2b/T and the exact limit of the linearised sampled-data loop;
                     (b), (c) the stable / limit-cycle / unstable map over (rate, stiffness) for the push and
                     let-go cases with the shipped encoder.
+  stability_profiles.png — per device profile (part 3, JSON "profiles"): stable / limit-cycle / unstable
+                    over stiffness for push and let-go on the profile's model, with its default stiffness
+                    and the limit its settings allow.
   tunnelling.png  — (a) failing strokes (proxy tunnelled or contact missed) against hand speed per shape,
                     ServoLoop with a kinematic handle and through the simulated device, with the wall-blind
                     control that the checker must catch; (b) how hard the strokes were: handle jump per
@@ -186,6 +189,36 @@ def plot_tunnelling(d, out_png):
     plt.close(fig)
 
 
+def plot_profiles(d, out_png):
+    profiles = d["profiles"]["profiles"]
+    fig, ax = plt.subplots(figsize=(9, 2.0 + 0.8 * len(profiles)))
+    rows, labels = [], []
+    for i, p in enumerate(profiles):
+        for j, mode in enumerate(("push", "let_go")):
+            y = 2 * i + j
+            rows.append(y)
+            labels.append(f"{p['name']}, {mode.replace('_', '-')}")
+            cases = p[mode]["grid"] + p[mode]["refinement"]
+            for cls, style in CLASS_STYLE.items():
+                ks = [c["stiffness_n_per_m"] for c in cases if c["class"] == cls]
+                ax.scatter(ks, [y] * len(ks), marker=style["marker"], color=style["color"], s=22,
+                           label=style["label"] if (i == 0 and j == 0) else None)
+        ax.plot([p["default_n_per_m"]] * 2, [2 * i - 0.4, 2 * i + 1.4], color="black", lw=2,
+                label="default stiffness" if i == 0 else None)
+        ax.plot([p["profile_limit_n_per_m"]] * 2, [2 * i - 0.4, 2 * i + 1.4], color="#d62728", lw=1.5, ls="--",
+                label="largest the settings allow" if i == 0 else None)
+    ax.set_xscale("log")
+    ax.set_yticks(rows)
+    ax.set_yticklabels(labels)
+    ax.invert_yaxis()
+    ax.set_xlabel("wall stiffness [N/m] (workspace frame)")
+    ax.set_title("Stable wall stiffness on each device profile's model at its servo rate (1 kHz)")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.4, -0.22), ncol=3)
+    fig.tight_layout()
+    fig.savefig(out_png, dpi=110)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("json", nargs="?", default="docs/bench/stability.json")
@@ -199,9 +232,15 @@ def main():
         return 1
     outdir = a.outdir or os.path.dirname(os.path.abspath(a.json))
     os.makedirs(outdir, exist_ok=True)
-    plot_stability(d, os.path.join(outdir, "stability.png"))
-    plot_tunnelling(d, os.path.join(outdir, "tunnelling.png"))
-    print(f"wrote {os.path.join(outdir, 'stability.png')} and {os.path.join(outdir, 'tunnelling.png')}")
+    wrote = []
+    if "stiffness" in d:
+        plot_stability(d, os.path.join(outdir, "stability.png"))
+        plot_tunnelling(d, os.path.join(outdir, "tunnelling.png"))
+        wrote += ["stability.png", "tunnelling.png"]
+    if "profiles" in d:
+        plot_profiles(d, os.path.join(outdir, "stability_profiles.png"))
+        wrote.append("stability_profiles.png")
+    print("wrote " + ", ".join(os.path.join(outdir, w) for w in wrote))
     return 0
 
 

@@ -68,7 +68,7 @@ config::Settings non_default_settings() {
   config::Settings s;
   s.haptics.stiffness_n_per_m = 1234.5;
   s.haptics.level_mode = "fixed";
-  s.device.max_torque_n_m = 0.3;
+  s.device.max_torque_n_m = 0.6;  // strong enough for the 3.5 N walls over the taller workspace
   s.hand.max_force_n = 2.5;
   s.vision.max_segments = 12345;
   s.workspace.height_m = 0.1;
