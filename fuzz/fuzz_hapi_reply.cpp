@@ -184,7 +184,9 @@ void check_device(const BoardLayout& board_layout, const std::vector<std::uint8_
     const hk::io::HaplyCounters c = dev.counters();
     FUZZ_CHECK(c.replies >= 1 && c.replies <= 1 + static_cast<std::int64_t>(stream.size()) / 9, std::to_string(c.replies));
     FUZZ_CHECK(c.malformed <= static_cast<std::int64_t>(stream.size()), std::to_string(c.malformed));
-    FUZZ_CHECK(c.replies_missing <= c.ticks + 1, std::to_string(c.replies_missing));
+    // A packet's reply is waited for at most kReplyWaitTicks reads (the writes between are skipped).
+    FUZZ_CHECK(c.replies_missing <= hk::io::kReplyWaitTicks * (c.ticks + 1), std::to_string(c.replies_missing));
+    FUZZ_CHECK(c.writes_skipped <= tick + 1, std::to_string(c.writes_skipped));
   }
   dev.close();
   FUZZ_CHECK(dev.status() == hk::DeviceStatus::Closed, "");
