@@ -51,6 +51,16 @@ double pct(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
 }
 
+/// Sleeps until one millisecond after `*next` (CLOCK_MONOTONIC) and moves `*next` there: a 1 kHz pace.
+void sleep_until_next_ms(timespec* next) {
+  next->tv_nsec += 1000000;
+  if (next->tv_nsec >= 1000000000) {
+    next->tv_nsec -= 1000000000;
+    ++next->tv_sec;
+  }
+  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, next, nullptr);
+}
+
 struct Board {
   explicit Board(const config::Settings& s) {
     dp = app::haply_params_from(s);
@@ -80,12 +90,7 @@ nlohmann::json round_trip(const config::Settings& s, double seconds) {
   clock_gettime(CLOCK_MONOTONIC, &next);
   long missing = 0;
   for (long k = 0; k < n; ++k) {
-    next.tv_nsec += 1000000;
-    if (next.tv_nsec >= 1000000000) {
-      next.tv_nsec -= 1000000000;
-      ++next.tv_sec;
-    }
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    sleep_until_next_ms(&next);
     const auto t0 = std::chrono::steady_clock::now();
     b.device->write_force({0.0, 0.0});
     const auto before = b.device->counters().replies;
@@ -145,12 +150,7 @@ nlohmann::json step_calls(const config::Settings& s, double seconds) {
   timespec next{};
   clock_gettime(CLOCK_MONOTONIC, &next);
   for (long k = 0; k < n; ++k) {
-    next.tv_nsec += 1000000;
-    if (next.tv_nsec >= 1000000000) {
-      next.tv_nsec -= 1000000000;
-      ++next.tv_sec;
-    }
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+    sleep_until_next_ms(&next);
     const auto t0 = std::chrono::steady_clock::now();
     b.device->read();
     const auto t1 = std::chrono::steady_clock::now();
