@@ -225,19 +225,18 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   long section_max = 0, iteration_limited = 0;
   long level_changes = 0, level_waiting = 0, sticking = 0, pops = 0;
   std::array<long, kLevelIds> level_ticks{};  // per level id (levels and tolerance steps)
-  CueTrackerParams ctp;
-  ctp.period_s = 1.0 / s.haptics.servo_rate_hz;
-  ctp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
-  CueTracker tracker(ctp);
-  const std::vector<Aabb> text_boxes = text_block_regions(is.text_blocks);
-  tracker.set_text_blocks(text_boxes.data(), static_cast<int>(text_boxes.size()));
+  const CueTrackerParams ctp = cue_params_from(s);
+  audio::SpscRing<audio::CueEvent> cue_ring(64);  // the step's earcons, drained after every tick
+  RunOptions run;
+  run.device = device;
+  run.report = &sum.device;
+  run.cues = &cue_ring;
+  run.text_blocks_m = text_block_regions(is.text_blocks);
   std::vector<audio::CueEvent> cues;
   CoverageMeter coverage(0.001);
   run_simulation(scene, s, *hand, duration, [&](const TickRecord& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
-    audio::CueEvent tick_cues[CueTracker::kMaxCuesPerTick];
-    const int nc = tracker.update(r.index, so, r.handle_m, so.level, tick_cues);
-    cues.insert(cues.end(), tick_cues, tick_cues + nc);
+    for (audio::CueEvent e; cue_ring.try_pop(e);) cues.push_back(e);
     const int state = static_cast<int>(c.state);
     const int curve = c.state == ContactState::Free ? -1 : c.constraint[0].curve;
     // Rows are kept in memory and formatted after the run: printf between ticks would evict the
@@ -263,7 +262,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
     level_waiting += so.level != so.level_wanted;
     sticking += c.sticking;
     if (so.level >= 0 && so.level < kLevelIds) ++level_ticks[static_cast<std::size_t>(so.level)];
-  }, device, &sum.device);
+  }, run);
   for (const Row& w : rows) {
     std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld,%d\n", w.t_s, w.handle_m.x, w.handle_m.y, w.proxy_m.x,
                  w.proxy_m.y, w.force_n.x, w.force_n.y, w.contact, w.curve, w.level, static_cast<long long>(w.tick_ns), w.pop);

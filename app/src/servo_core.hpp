@@ -62,8 +62,12 @@ namespace hk::app {
 /// A picture ready for the servo thread: its scene and a servo loop sized for it. Build on any thread
 /// but the servo's (allocates).
 struct SceneBundle {
+  /// Owns `s` (the kiosk's pictures).
   SceneBundle(std::unique_ptr<Scene> s, const ServoParams& params) : scene(std::move(s)), loop(*scene, params) {}
-  std::unique_ptr<Scene> scene;
+  /// Shares `s`: a headless run borrows its caller's scene with a non-owning pointer
+  /// (std::shared_ptr's aliasing constructor), which must outlive the bundle.
+  SceneBundle(std::shared_ptr<const Scene> s, const ServoParams& params) : scene(std::move(s)), loop(*scene, params) {}
+  std::shared_ptr<const Scene> scene;
   ServoLoop loop;
   int id = 0;  ///< caller's picture number (shown in the display state)
   /// Text blocks of a document page [m] (TextBlock cues, CueTracker::set_text_blocks); empty for a picture.

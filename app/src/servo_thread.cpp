@@ -3,7 +3,6 @@
 #include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
-#include <time.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -15,19 +14,6 @@ namespace hk::app {
 namespace {
 
 constexpr std::int64_t kNsPerS = 1'000'000'000;
-
-std::int64_t mono_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerS + ts.tv_nsec;
-}
-
-timespec to_timespec(std::int64_t ns) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(ns / kNsPerS);
-  ts.tv_nsec = static_cast<long>(ns % kNsPerS);
-  return ts;
-}
 
 double percentile_us(const std::array<std::atomic<std::uint32_t>, 2048>& h, double q) {
   std::uint64_t total = 0;
@@ -60,54 +46,46 @@ void ServoThread::stop() {
 }
 
 void ServoThread::run() {
-  if (params_.realtime) {
-    sched_param sp{};
-    sp.sched_priority = params_.fifo_priority;
-    const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-    if (err == 0) {
-      realtime_.store(true);
-      spdlog::info("servo: SCHED_FIFO priority {} at {} Hz", params_.fifo_priority, params_.rate_hz);
-    } else {
-      spdlog::warn("servo: SCHED_FIFO refused ({}); running at normal priority at {} Hz (grant CAP_SYS_NICE or an rtprio limit)",
-                   std::strerror(err), params_.rate_hz);
-    }
-  }
+  if (params_.realtime) ask_for_fifo();
   const auto period_ns = static_cast<std::int64_t>(static_cast<double>(kNsPerS) / params_.rate_hz + 0.5);
   const double period_s = static_cast<double>(period_ns) / static_cast<double>(kNsPerS);
-  std::int64_t deadline = mono_ns() + period_ns;
-  ServoCommand cmd;
-  while (!stop_.load(std::memory_order_relaxed)) {
-    const timespec ts = to_timespec(deadline);
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-    }
-    const std::int64_t woke = mono_ns();
-    const std::int64_t late = woke - deadline;
-    const bool missed = late >= period_ns;
-    const DeviceSample sample = device_.read();
-    core_.step(sample, missed, cmd);
-    device_.write_force(cmd.force_n);
+  DeadlineClock clock(period_ns, stop_);
+  ServoRunner runner(core_, device_);
+  runner.run(clock, [this, period_s](ServoTick& t) {
     if (after_tick_) after_tick_(period_s);
-    const std::int64_t done = mono_ns();
+    record(t, monotonic_ns() - t.woke_ns);
+  });
+}
 
-    ServoDisplayState& d = core_.display_back();
-    d.tick_compute_ns = done - woke;
-    d.period_error_ns = late;
-    d.missed_deadlines = missed_.load(std::memory_order_relaxed) + (missed ? 1 : 0);
-    core_.publish_display();
+void ServoThread::ask_for_fifo() {
+  sched_param sp{};
+  sp.sched_priority = params_.fifo_priority;
+  const int err = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+  if (err == 0) {
+    realtime_.store(true);
+    spdlog::info("servo: SCHED_FIFO priority {} at {} Hz", params_.fifo_priority, params_.rate_hz);
+  } else {
+    spdlog::warn("servo: SCHED_FIFO refused ({}); running at normal priority at {} Hz (grant CAP_SYS_NICE or an rtprio limit)",
+                 std::strerror(err), params_.rate_hz);
+  }
+}
 
-    late_[static_cast<std::size_t>(std::clamp<std::int64_t>(late / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
-    compute_[static_cast<std::size_t>(std::clamp<std::int64_t>((done - woke) / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
-    if (late > max_late_ns_.load(std::memory_order_relaxed)) max_late_ns_.store(late, std::memory_order_relaxed);
-    if (late > total_max_late_ns_.load(std::memory_order_relaxed)) total_max_late_ns_.store(late, std::memory_order_relaxed);
-    ticks_.fetch_add(1, std::memory_order_relaxed);
-    total_ticks_.fetch_add(1, std::memory_order_relaxed);
-    if (missed) {
-      missed_.fetch_add(1, std::memory_order_relaxed);
-      total_missed_.fetch_add(1, std::memory_order_relaxed);
-      // Skip ahead to the next deadline in the future rather than bursting ticks to catch up.
-      deadline += ((done - deadline) / period_ns) * period_ns;
-    }
-    deadline += period_ns;
+void ServoThread::record(const ServoTick& t, std::int64_t work_ns) noexcept {
+  ServoDisplayState& d = core_.display_back();
+  d.tick_compute_ns = work_ns;
+  d.period_error_ns = t.late_ns;
+  d.missed_deadlines = missed_.load(std::memory_order_relaxed) + (t.deadline_missed ? 1 : 0);
+  core_.publish_display();
+
+  late_[static_cast<std::size_t>(std::clamp<std::int64_t>(t.late_ns / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
+  compute_[static_cast<std::size_t>(std::clamp<std::int64_t>(work_ns / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
+  if (t.late_ns > max_late_ns_.load(std::memory_order_relaxed)) max_late_ns_.store(t.late_ns, std::memory_order_relaxed);
+  if (t.late_ns > total_max_late_ns_.load(std::memory_order_relaxed)) total_max_late_ns_.store(t.late_ns, std::memory_order_relaxed);
+  ticks_.fetch_add(1, std::memory_order_relaxed);
+  total_ticks_.fetch_add(1, std::memory_order_relaxed);
+  if (t.deadline_missed) {
+    missed_.fetch_add(1, std::memory_order_relaxed);
+    total_missed_.fetch_add(1, std::memory_order_relaxed);
   }
 }
 

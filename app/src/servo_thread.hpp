@@ -1,12 +1,10 @@
 #pragma once
 /// @file servo_thread.hpp
-/// The kiosk's servo thread (issue 5, item 2): at the configured rate on its own thread, read the device,
-/// ServoCore::step, write the force (the step itself holds no device and reads no clock; this thread times it),
-/// SCHED_FIFO where the system permits it (a logged warning where not), absolute-deadline sleeps
-/// (clock_nanosleep TIMER_ABSTIME on CLOCK_MONOTONIC, so lateness does not accumulate), and measured
-/// wake-up lateness and missed deadlines. A tick that starts a whole period late is a missed deadline: it
-/// runs with deadline_missed (the force guard sends zero force) and the schedule skips ahead instead of
-/// bursting to catch up.
+/// The kiosk's servo thread: the servo loop (ServoRunner: read the device, ServoCore::step, write the force)
+/// on its own thread at the configured rate on a DeadlineClock (absolute deadlines; a tick a whole period
+/// late is a missed deadline, sent zero force, and the schedule skips ahead), SCHED_FIFO where the system
+/// permits it (a logged warning where not), with histograms of wake-up lateness and tick work for the
+/// operator's panel and the soak's accounting.
 
 #include <array>
 #include <atomic>
@@ -15,6 +13,7 @@
 #include <thread>
 
 #include "servo_core.hpp"
+#include "servo_runner.hpp"
 
 namespace hk::app {
 
@@ -67,6 +66,9 @@ class ServoThread {
 
  private:
   void run();
+  void ask_for_fifo();
+  /// Real-time: the tick's timing into the display state (published) and the histograms.
+  void record(const ServoTick& t, std::int64_t work_ns) noexcept;
   static constexpr int kBins = 2048;  // 1 µs bins up to 2 ms; the last bin holds everything later
   ServoCore& core_;
   Device& device_;

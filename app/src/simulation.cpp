@@ -10,6 +10,7 @@
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/pty_emulator.hpp"
 #include "haptics/sim_pantograph.hpp"
+#include "servo_runner.hpp"
 
 namespace hk::app {
 
@@ -32,13 +33,12 @@ ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t see
   return ep;
 }
 
-namespace {
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+CueTrackerParams cue_params_from(const config::Settings& s) {
+  CueTrackerParams p;
+  p.period_s = 1.0 / s.haptics.servo_rate_hz;
+  p.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
+  return p;
 }
-
-}  // namespace
 
 ServoGains servo_gains_from(const config::Settings& s) {
   ServoGains g;
@@ -96,44 +96,46 @@ ModelHandParams hand_params_from(const config::Settings& s) {
 
 namespace {
 
-// The headless servo loop over any device: read, step (timed; the step reads no clock), write, then
-// `after_write(rec, servo output)` (the simulated pantograph's physics and torques, or the driver's torques), observe.
-// A device that comes back after being lost restarts the servo at the handle: the force ramps in again.
+// The headless servo loop over any device: the kiosk's ServoRunner on a HeadlessClock, `scene` the first
+// picture of a ServoCore. After each tick's write: `after_write(rec, servo output)` (the simulated pantograph's
+// physics and torques, or the driver's torques), the observer, the script, and the owner's collection of
+// what the servo let go of.
 template <class AfterWrite>
-long run_ticks(const Scene& scene, const ServoParams& sp, Device& device, double duration_s, const TickObserver& observe,
-               AfterWrite after_write) {
-  ServoLoop servo(scene, sp);
-  servo.start(device.read().handle_m);
-  const long n_ticks = static_cast<long>(std::ceil(duration_s / sp.period_s - 1e-9));
-  ServoOutput so;
+long run_ticks(const Scene& scene, const config::Settings& s, Device& device, double duration_s, const TickObserver& observe,
+               const RunOptions& o, AfterWrite after_write) {
+  const ServoParams sp = servo_params_from(s);
+  ServoCore core(cue_params_from(s), o.cues);
+  auto bundle = std::make_unique<SceneBundle>(std::shared_ptr<const Scene>(std::shared_ptr<const Scene>(), &scene), sp);
+  bundle->id = o.scene_id;
+  bundle->text_blocks_m = o.text_blocks_m;
+  core.publish(std::move(bundle));
+  const auto n_ticks = static_cast<std::int64_t>(std::ceil(duration_s / sp.period_s - 1e-9));
+  HeadlessClock clock(n_ticks, sp.period_s);
+  ServoRunner runner(core, device);
   TickRecord rec;
-  DeviceStatus last_status = DeviceStatus::Ok;
-  for (long k = 0; k < n_ticks; ++k) {
-    rec.index = k;
-    rec.t_s = static_cast<double>(k) * sp.period_s;
-    ServoInput in;
-    in.sample = device.read();
-    if (in.sample.status == DeviceStatus::Ok && last_status != DeviceStatus::Ok) servo.start(in.sample.handle_m);
-    last_status = in.sample.status;
-    const std::int64_t t0 = steady_ns();
-    servo.update(in, so);
-    rec.tick_ns = steady_ns() - t0;
-    rec.handle_m = in.sample.handle_m;
-    rec.device_status = in.sample.status;
-    device.write_force(so.force_n);
+  runner.run(clock, [&](ServoTick& t) {
+    core.publish_display();
+    rec.index = static_cast<long>(t.index);
+    rec.t_s = t.t_s;
+    rec.tick_ns = t.step_ns;
+    rec.handle_m = t.sample.handle_m;
+    rec.device_status = t.sample.status;
+    const ServoOutput& so = core.last_output();
     after_write(rec, so);
     if (observe) observe(rec, so);
-  }
-  return n_ticks;
+    if (o.script) o.script(t.index, core);
+    core.collect_retired();
+  });
+  return static_cast<long>(n_ticks);
 }
 
 long run_simulated(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
-                   const TickObserver& observe, DeviceReport* report) {
+                   const TickObserver& observe, const RunOptions& o) {
   SimulatedPantograph device(sim_params_from(s), hand.start_m());
   device.open();
   const ModelHandParams hp = hand_params_from(s);
   const ServoParams sp = servo_params_from(s);
-  const long n_ticks = run_ticks(scene, sp, device, duration_s, observe, [&](TickRecord& rec, const ServoOutput& so) {
+  const long n_ticks = run_ticks(scene, s, device, duration_s, observe, o, [&](TickRecord& rec, const ServoOutput& so) {
     // What the hand feels: where the handle is and the force the device was told to put on it (last write);
     // what it hears: the push-through earcon of this tick.
     const bool heard_pop = (so.contact.events & kEventPopThrough) != 0;
@@ -146,17 +148,17 @@ long run_simulated(const Scene& scene, const config::Settings& s, HandController
     rec.motor_torque_n_m[0] = tau.tau1_n_m;
     rec.motor_torque_n_m[1] = tau.tau2_n_m;
   });
-  if (report) {
-    *report = DeviceReport{};
-    report->name = device.name();
-    report->status = device_status_name(device.status());
+  if (o.report) {
+    *o.report = DeviceReport{};
+    o.report->name = device.name();
+    o.report->status = device_status_name(device.status());
   }
   device.close();
   return n_ticks;
 }
 
 long run_emulated(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
-                  const TickObserver& observe, const DeviceChoice& choice, DeviceReport* report) {
+                  const TickObserver& observe, const RunOptions& o) {
   const io::HaplyDeviceParams dp = haply_params_from(s);
   const double scale = io::workspace_scale(dp);
   const Vec2 centre = dp.rect_center_device_m;
@@ -171,18 +173,18 @@ long run_emulated(const Scene& scene, const config::Settings& s, HandController&
     tick_hp.max_force_n = cmd.max_force_n;
     return model_hand_force(tick_hp, cmd.target_m, handle, velocity);
   };
-  hapi::FirmwareEmulator emulator(emulator_params_from(s, choice), (1.0 / scale) * hand.start_m() + centre, hand_force);
+  hapi::FirmwareEmulator emulator(emulator_params_from(s, o.device), (1.0 / scale) * hand.start_m() + centre, hand_force);
   hapi::PtyEmulator pty(emulator);
   const std::string tty_path = pty.device_path();
   io::HaplyDevice device(dp, [tty_path] { return std::make_unique<io::TtyTransport>(tty_path); });
   device.open();
-  const long n_ticks = run_ticks(scene, servo_params_from(s), device, duration_s, observe, [&](TickRecord& rec, const ServoOutput&) {
+  const long n_ticks = run_ticks(scene, s, device, duration_s, observe, o, [&](TickRecord& rec, const ServoOutput&) {
     device.last_torques_n_m(&rec.motor_torque_n_m[0], &rec.motor_torque_n_m[1]);
     // Keep the emulated board in step with the run, Lost or not: wait (up to 20 ms) until it has executed
     // every torque packet sent, so the emulated time, and what a fault does, never depends on how busy the
     // machine is (a loaded machine once let the run end while a stalled board still had a backlog).
     const std::int64_t sent = device.counters().ticks;
-    const std::int64_t give_up = steady_ns() + 20'000'000;
+    const std::int64_t give_up = monotonic_ns() + 20'000'000;
     for (;;) {
       long done = 0;
       bool unplugged = false;
@@ -190,19 +192,19 @@ long run_emulated(const Scene& scene, const config::Settings& s, HandController&
         done = e.torque_commands();
         unplugged = e.disconnected();  // a disconnected board executes nothing more
       });
-      if (unplugged || done >= sent || steady_ns() >= give_up) break;
+      if (unplugged || done >= sent || monotonic_ns() >= give_up) break;
       std::this_thread::sleep_for(std::chrono::microseconds(20));
     }
     // And its reply in, as a real board's would be by the next tick: the servo step itself never waits.
     device.wait_reply(10000);
   });
-  if (report) {
+  if (o.report) {
     const io::HaplyCounters c = device.counters();
-    report->name = "haply-emulator (" + device.name() + ")";
-    report->status = device_status_name(device.status());
-    report->replies_missing = c.replies_missing;
-    report->reconnects = c.reconnects;
-    report->malformed = c.malformed;
+    o.report->name = "haply-emulator (" + device.name() + ")";
+    o.report->status = device_status_name(device.status());
+    o.report->replies_missing = c.replies_missing;
+    o.report->reconnects = c.reconnects;
+    o.report->malformed = c.malformed;
   }
   device.close();
   pty.stop();
@@ -212,9 +214,17 @@ long run_emulated(const Scene& scene, const config::Settings& s, HandController&
 }  // namespace
 
 long run_simulation(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
+                    const TickObserver& observe, const RunOptions& o) {
+  if (o.device.kind == DeviceChoice::Kind::HaplyEmulator) return run_emulated(scene, s, hand, duration_s, observe, o);
+  return run_simulated(scene, s, hand, duration_s, observe, o);
+}
+
+long run_simulation(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
                     const TickObserver& observe, const DeviceChoice& device, DeviceReport* report) {
-  if (device.kind == DeviceChoice::Kind::HaplyEmulator) return run_emulated(scene, s, hand, duration_s, observe, device, report);
-  return run_simulated(scene, s, hand, duration_s, observe, report);
+  RunOptions o;
+  o.device = device;
+  o.report = report;
+  return run_simulation(scene, s, hand, duration_s, observe, o);
 }
 
 long run_simulation(const Scene& scene, const config::Settings& s, const HandPath& hand, double duration_s,

@@ -1,11 +1,16 @@
 #pragma once
 /// @file simulation.hpp
-/// The headless servo run: simulated pantograph + model hand + servo loop, tick by tick as fast as the
-/// machine goes (DESIGN.md "Headless runs"). Shared by `explore` and the integration tests.
+/// The headless servo run: simulated pantograph (or the emulated Haply board) + model hand + the kiosk's own
+/// servo loop (ServoRunner driving ServoCore::step), tick by tick as fast as the machine goes (DESIGN.md
+/// "Headless runs"). Shared by `explore`, the integration tests and the benchmarks. A RunScript plays the
+/// kiosk's other threads between ticks (a new picture, a tour, new gains, a level), so a headless run
+/// feels what the visitor feels.
 
 #include <cstdint>
 #include <functional>
 
+#include "audio/cue_event.hpp"
+#include "audio/spsc_ring.hpp"
 #include "config/settings.hpp"
 #include "device_setup.hpp"
 #include "haptics/explorer_hand.hpp"
@@ -14,6 +19,7 @@
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
 #include "haptics/sim_pantograph.hpp"
+#include "servo_core.hpp"
 
 namespace hk::app {
 
@@ -22,7 +28,7 @@ struct TickRecord {
   long index = 0;
   double t_s = 0.0;             ///< tick k at t = k · period [s]
   Vec2 handle_m;                ///< handle position the servo saw (encoder-quantised) [m]
-  std::int64_t tick_ns = 0;     ///< measured time of collision + contact + force [ns]
+  std::int64_t tick_ns = 0;     ///< measured time of ServoCore::step (collision, contact, force, cues) [ns]
   /// Motor torques the device was commanded this tick [N·m]: the simulated pantograph's (left, right motor),
   /// or the USB pantograph's (actuator 1, actuator 2) as sent in the torque packet.
   double motor_torque_n_m[2] = {0.0, 0.0};
@@ -32,6 +38,24 @@ struct TickRecord {
 /// Called after every tick with its record and the servo's full output (proxy path, events, stats).
 using TickObserver = std::function<void(const TickRecord&, const ServoOutput&)>;
 
+/// The owner's side of a headless run, called after tick `index` (after the observer): what the kiosk's
+/// other threads do while a visitor explores, e.g. core.publish(bundle) (a new picture, faded in as in the
+/// kiosk), core.publish_tour(path), core.set_gains(g), core.request_level(l), core.cancel_tour().
+/// ServoCore::display() is the tick's state. Retired bundles and tours are collected after it.
+using RunScript = std::function<void(std::int64_t index, ServoCore& core)>;
+
+/// What a headless run may add to the scene and the hand.
+struct RunOptions {
+  DeviceChoice device;                                 ///< the simulated pantograph or the emulated board
+  DeviceReport* report = nullptr;                      ///< receives the device's name, status, counters
+  RunScript script;                                    ///< the owner's calls between ticks (may be empty)
+  audio::SpscRing<audio::CueEvent>* cues = nullptr;    ///< the step's earcons (drain it each tick), or none
+  std::vector<Aabb> text_blocks_m;                     ///< the scene's text blocks [m] (TextBlock cues)
+  int scene_id = 0;                                    ///< SceneBundle::id of the scene (a tour names it)
+};
+
+/// The earcon tracker's parameters from the settings: the servo period and the workspace rectangle.
+CueTrackerParams cue_params_from(const config::Settings& s);
 /// The live-changeable servo gains from the settings ([haptics]: stiffness, damping, max force, friction,
 /// level_max_force_step_n, query box budget), as ServoCore::set_gains takes them at Apply.
 ServoGains servo_gains_from(const config::Settings& s);
@@ -51,9 +75,11 @@ ModelHandParams hand_params_from(const config::Settings& s);
 /// push-through and the rendering mode; `seed` drives its choices.
 ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t seed);
 
-/// Runs the device `device` chose (the simulated pantograph, or the Haply firmware emulator behind a pty
+/// Runs the device `o.device` chose (the simulated pantograph, or the Haply firmware emulator behind a pty
 /// reached through the tty transport and the hAPI driver, bytes and all) driven by the model hand `hand` over
-/// `scene` for `duration_s` seconds, tick by tick as fast as the machine goes. Each tick the simulated
+/// `scene` for `duration_s` seconds, tick by tick as fast as the machine goes, through the kiosk's servo
+/// loop: a ServoRunner on a HeadlessClock driving a ServoCore whose first picture is `scene` (with
+/// servo_params_from(s)), taken and started at the handle at tick 0. Each tick the simulated
 /// pantograph is pushed by model_hand_force(hand_params_from(s) with max_force_n = the command's max_force_n,
 /// command.target_m, ...), the command being hand.command(feel) with feel = {t, true handle position, its
 /// velocity, the force the servo wrote to the device at the previous tick (after the guard)}.
@@ -62,9 +88,13 @@ ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t see
 /// elsewhere during the run. A tick waits up to 10 ms for the reply to the previous tick's packet while the
 /// device is Ok (not while it is Lost), and up to 20 ms after each write for the emulator to have executed
 /// every packet sent, Lost or not, until it is disconnected (so the run does not depend on the machine's
-/// speed); a device that comes back restarts the servo at the handle (force ramped in again). `report` (may
-/// be null) receives the device's name, final status and counters. Returns the number of ticks run. Throws
-/// DeviceError when the emulator cannot be reached.
+/// speed); a device that comes back restarts the servo at the handle (force ramped in again: ServoCore).
+/// `o.script` runs after each tick. Returns the number of ticks run. Throws DeviceError when the emulator
+/// cannot be reached. `scene` outlives the call.
+long run_simulation(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
+                    const TickObserver& observe, const RunOptions& o);
+
+/// The same with only a device choice and its report.
 long run_simulation(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
                     const TickObserver& observe, const DeviceChoice& device = {}, DeviceReport* report = nullptr);
 

@@ -76,7 +76,7 @@ SimulatedPantograph::SimulatedPantograph(const SimPantographParams& params, Vec2
 
 void SimulatedPantograph::open() { status_ = DeviceStatus::Ok; }
 
-DeviceSample SimulatedPantograph::read() {
+DeviceSample SimulatedPantograph::read() noexcept {
   DeviceSample s;
   s.time_ns = time_ns_;
   s.status = status_;
@@ -90,14 +90,14 @@ DeviceSample SimulatedPantograph::read() {
   return s;
 }
 
-void SimulatedPantograph::write_force(Vec2 force_n) { commanded_force_n_ = is_finite(force_n) ? force_n : Vec2{}; }
+void SimulatedPantograph::write_force(Vec2 force_n) noexcept { commanded_force_n_ = is_finite(force_n) ? force_n : Vec2{}; }
 
 void SimulatedPantograph::close() noexcept {
   commanded_force_n_ = {};
   status_ = DeviceStatus::Closed;
 }
 
-DeviceStatus SimulatedPantograph::status() const { return status_; }
+DeviceStatus SimulatedPantograph::status() const noexcept { return status_; }
 
 std::string SimulatedPantograph::name() const { return "simulated pantograph"; }
 

@@ -1,9 +1,14 @@
-// ServoCore::step as a pure step (issue 13, item 5): no device inside it, the same samples give the same
-// commands bit for bit, nothing is allocated or freed in it (counted by a replaced global operator new in
-// this translation unit), and a device that comes back gets its force back through the start-up ramp.
+// ServoCore::step as a pure step, driven by the kiosk's ServoRunner: no device inside it, the same samples give
+// the same commands bit for bit, nothing is allocated or freed in a tick (counted by a replaced global operator
+// new in this translation unit) and nothing in it waits on the device (a transport that records every wait),
+// through a whole run with a tour, picture swaps, new gains and a device that stalls and comes back; and a
+// device that comes back gets its force back through the start-up ramp.
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
 #include <cstdlib>
 #include <memory>
 #include <new>
@@ -12,9 +17,15 @@
 #include <vector>
 
 #include "curves.hpp"
+#include "device_setup.hpp"
 #include "guided_tour.hpp"
+#include "haptics/hapi_emulator.hpp"
+#include "haptics/io/haply_device.hpp"
+#include "haptics/io/tty_transport.hpp"
+#include "haptics/pty_emulator.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "servo_core.hpp"
+#include "servo_runner.hpp"
 #include "simulation.hpp"
 
 // ── Counting allocation ───────────────────────────────────────────────────────────────────────────
@@ -102,21 +113,20 @@ struct Rig {
       : s(std::move(settings)), sp(servo_params_from(s)), device(sim_params_from(s), {-0.03, 0.0}), hand(hand_params_from(s)), core(CueTrackerParams{}, &cues) {
     device.open();
   }
-  /// One tick: read, step (allocations counted when `count`), write, then the plant and the drain.
+  ServoRunner runner{core, device};
+  /// One ServoRunner tick: read, step, write (allocations counted when `count`), then the plant and the drain.
   void tick(bool count = false) {
-    const DeviceSample sample = device.read();
-    ServoCommand cmd;
+    ServoTick t;
     if (count) {
       CountAllocations c;
-      core.step(sample, false, cmd);
+      runner.tick(t);
       core.publish_display();
     } else {
-      core.step(sample, false, cmd);
+      runner.tick(t);
       core.publish_display();
     }
-    device.write_force(cmd.force_n);
-    samples.push_back(sample);
-    commands.push_back(cmd.force_n);
+    samples.push_back(t.sample);
+    commands.push_back(t.command.force_n);
     device.step(sp.period_s, model_hand_force(hand, target, device.true_position_m(), device.velocity_m_per_s()));
     audio::CueEvent e;
     while (cues.try_pop(e)) {
@@ -235,6 +245,164 @@ TEST_P(ServoStepTourModes, NothingIsAllocatedOrFreedInAGuidedTour) {
 
 INSTANTIATE_TEST_SUITE_P(LevelModes, ServoStepTourModes, ::testing::Values("auto", "tolerance", "cut"),
                          [](const ::testing::TestParamInfo<const char*>& i) { return std::string(i.param); });
+
+// ── Tripwires over a whole run on the emulated board ─────────────────────────────────────────────
+/// Set on the servo's thread from the device's read to its write: inside ServoRunner::tick.
+thread_local bool g_in_tick = false;
+std::atomic<long> g_waits{0};       // transport calls inside a tick that could wait (timeout_us > 0)
+std::atomic<long> g_tick_io{0};     // transport calls inside a tick (the tripwire is on the path)
+
+/// The tty transport, recording every call made inside a tick that is allowed to wait.
+class WaitRecordingTransport final : public io::ByteTransport {
+ public:
+  explicit WaitRecordingTransport(std::string path) : inner_(std::move(path)) {}
+  void open() override { inner_.open(); }
+  void close() noexcept override { inner_.close(); }
+  int write(const std::uint8_t* data, int n, int timeout_us) noexcept override {
+    note(timeout_us);
+    return inner_.write(data, n, timeout_us);
+  }
+  int read(std::uint8_t* buf, int capacity, int timeout_us) noexcept override {
+    note(timeout_us);
+    return inner_.read(buf, capacity, timeout_us);
+  }
+  void flush_input() noexcept override { inner_.flush_input(); }
+  bool is_open() const noexcept override { return inner_.is_open(); }
+  std::string name() const override { return inner_.name(); }
+
+ private:
+  static void note(int timeout_us) noexcept {
+    if (!g_in_tick) return;
+    g_tick_io.fetch_add(1, std::memory_order_relaxed);
+    if (timeout_us > 0) g_waits.fetch_add(1, std::memory_order_relaxed);
+  }
+  io::TtyTransport inner_;
+};
+
+/// The board, with allocations counted and transport waits recorded from its read to its write (the tick).
+class TripwireDevice final : public Device {
+ public:
+  explicit TripwireDevice(Device& inner) : inner_(inner) {}
+  void open() override { inner_.open(); }
+  DeviceSample read() noexcept override {
+    g_in_tick = true;
+    g_counting = true;
+    return inner_.read();
+  }
+  void write_force(Vec2 force_n) noexcept override {
+    inner_.write_force(force_n);
+    g_counting = false;
+    g_in_tick = false;
+  }
+  void close() noexcept override { inner_.close(); }
+  DeviceStatus status() const noexcept override { return inner_.status(); }
+  std::string name() const override { return inner_.name(); }
+
+ private:
+  Device& inner_;
+};
+
+TEST(ServoStep, AWholeRunOnTheEmulatedBoardNeitherAllocatesNorWaitsInATick) {
+  // The kiosk's runner over the emulated Haply board, bytes through a pty: a hand circling through a square's
+  // walls, a guided tour, new gains, a second picture swapped in (faded), a level request, and the board
+  // stalling for 0.3 s (the device Lost, then back: the picture restarts at the handle). In every tick:
+  // no allocation or free, and no transport call that may wait.
+  std::vector<std::string> notes;
+  const config::Settings s = settings_for_board(config::Settings{}, &notes);
+  const ServoParams sp = servo_params_from(s);
+  const io::HaplyDeviceParams dp = haply_params_from(s);
+  const double scale = io::workspace_scale(dp);
+  const Vec2 centre = dp.rect_center_device_m;
+  std::atomic<bool> relaxed{false};  // the hand lets the tour lead
+  const ModelHandParams hp = hand_params_from(s);
+  hapi::HandForce hand = [&](double t_s, Vec2 handle_device_m, Vec2 velocity_device_m_per_s) {
+    if (relaxed.load()) return Vec2{};
+    const Vec2 h = scale * (handle_device_m - centre), v = scale * velocity_device_m_per_s;
+    const Vec2 target{0.03 * std::cos(0.8 * t_s), 0.03 * std::sin(0.8 * t_s)};
+    return model_hand_force(hp, target, h, v);  // the same vector in both frames
+  };
+  DeviceChoice choice;
+  choice.kind = DeviceChoice::Kind::HaplyEmulator;
+  choice.faults.stall_at_s = 6.0;
+  choice.faults.stall_s = 0.3;
+  hapi::FirmwareEmulator emulator(emulator_params_from(s, choice), centre + Vec2{0.03 / scale, 0.0}, hand);
+  hapi::PtyEmulator pty(emulator);
+  const std::string tty = pty.device_path();
+  io::HaplyDevice board(dp, [tty] { return std::make_unique<WaitRecordingTransport>(tty); });
+  board.open();
+  TripwireDevice device(board);
+
+  audio::SpscRing<audio::CueEvent> cues(1024);
+  ServoCore core(cue_params_from(s), &cues);
+  core.publish(bundle(sp, 1));
+  const Scene square = Scene::build({test::square(0.02)}, 3);  // bundle 1's picture
+  const TourParams tp = tour_params_from(s);
+  long contact_ticks = 0, lost_ticks = 0, tour_ticks = 0, fade_ticks = 0;
+  DeviceStatus last_status = DeviceStatus::Closed;
+  const auto script = [&](std::int64_t k) {
+    if (k == 1500) {
+      relaxed = true;
+      VisitTouches none;
+      none.reset(1, 1);
+      auto plan = plan_tour(square, 1, core.display().handle_m, none, tp);
+      ASSERT_TRUE(plan.has_value());
+      plan->id = 1;
+      core.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
+    }
+    if (k == 3500) {
+      core.cancel_tour();
+      relaxed = false;
+    }
+    if (k == 4000) {
+      ServoGains g = gains_of(sp);
+      g.stiffness_n_per_m *= 0.6;
+      core.set_gains(g);
+    }
+    if (k == 5000) core.publish(bundle(sp, 2, 0.015));
+    if (k == 7500) core.request_level(0);
+  };
+  HeadlessClock clock(9000, sp.period_s);
+  ServoRunner runner(core, device);
+  g_allocations = 0;
+  g_frees = 0;
+  g_waits = 0;
+  g_tick_io = 0;
+  runner.run(clock, [&](ServoTick& t) {
+    core.publish_display();
+    const ServoDisplayState& d = core.display();
+    contact_ticks += d.state != ContactState::Free;
+    lost_ticks += t.sample.status != DeviceStatus::Ok;
+    last_status = t.sample.status;
+    tour_ticks += d.tour_phase == TourPhase::Transit || d.tour_phase == TourPhase::Outline;
+    fade_ticks += t.index > 5000 && d.scene_id == 1;
+    for (audio::CueEvent e; cues.try_pop(e);) {
+    }
+    script(t.index);
+    core.collect_retired();
+    // The board in step with the run (as run_simulation does), outside the tick.
+    const std::int64_t sent = board.counters().ticks;
+    for (int i = 0; i < 1000; ++i) {
+      long done = 0;
+      pty.with_emulator([&](hapi::FirmwareEmulator& e) { done = e.torque_commands(); });
+      if (done >= sent) break;
+      std::this_thread::sleep_for(std::chrono::microseconds(20));
+    }
+    board.wait_reply(10000);
+  });
+  board.close();
+  pty.stop();
+  EXPECT_EQ(g_allocations.load(), 0) << "operator new called in a tick";
+  EXPECT_EQ(g_frees.load(), 0) << "operator delete called in a tick";
+  EXPECT_EQ(g_waits.load(), 0) << "a transport call in a tick was allowed to wait";
+  EXPECT_GT(g_tick_io.load(), 9000) << "the tripwire sits on the board's path";
+  EXPECT_GT(contact_ticks, 500) << "the hand must press on walls";
+  EXPECT_GT(tour_ticks, 200) << "the tour must run";
+  EXPECT_GT(lost_ticks, 10) << "the stall must lose the board";
+  EXPECT_EQ(last_status, DeviceStatus::Ok) << "and it must come back";
+  EXPECT_GT(fade_ticks, 10) << "the old picture fades before the swap";
+  EXPECT_EQ(core.display().scene_id, 2);
+  EXPECT_EQ(core.display().level, 0);
+}
 
 TEST(ServoStep, SameSamplesGiveBitIdenticalCommands) {
   // A closed-loop run through the simulated pantograph, recorded; then a second core, given the same

@@ -45,14 +45,14 @@ class Device {
   /// Connects and starts streaming. Throws DeviceError with a one-line reason.
   virtual void open() = 0;
   /// Latest handle sample. Real-time safe.
-  virtual DeviceSample read() = 0;
+  virtual DeviceSample read() noexcept = 0;
   /// Commands a force on the handle [N], workspace frame, held until the next call. Real-time safe.
   /// The device may clamp it further to what its motors can give.
-  virtual void write_force(Vec2 force_n) = 0;
+  virtual void write_force(Vec2 force_n) noexcept = 0;
   /// Stops the motors and disconnects. Never throws.
   virtual void close() noexcept = 0;
   /// Current status. Real-time safe.
-  virtual DeviceStatus status() const = 0;
+  virtual DeviceStatus status() const noexcept = 0;
   /// Short human-readable name for logs ("simulated pantograph").
   virtual std::string name() const = 0;
 };

@@ -57,14 +57,14 @@ class SimulatedPantograph final : public Device {
   /// Handle position as the encoders report it: IK of the true position, each joint angle rounded to
   /// the nearest multiple of 2π/encoder_counts_per_rev, then FK [m]. time_ns = simulated time [ns].
   /// Works in any status (the encoders are passive); `status` tells the servo loop whether to trust it.
-  DeviceSample read() override;
+  DeviceSample read() noexcept override;
   /// Commands a handle force [N], held until the next call. A non-finite force is stored as zero.
   /// Torque saturation is applied in `step` at the configuration of that moment.
-  void write_force(Vec2 force_n) override;
+  void write_force(Vec2 force_n) noexcept override;
   /// Disables the motors (commanded force zeroed) and sets status Closed.
   void close() noexcept override;
   /// Closed before `open` and after `close`, Ok in between.
-  DeviceStatus status() const override;
+  DeviceStatus status() const noexcept override;
   /// "simulated pantograph".
   std::string name() const override;
 

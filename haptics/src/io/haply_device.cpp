@@ -235,7 +235,7 @@ void HaplyDevice::adopt_pending() noexcept {
   gone_.store(false, std::memory_order_release);
 }
 
-DeviceSample HaplyDevice::read() {
+DeviceSample HaplyDevice::read() noexcept {
   DeviceSample s;
   const DeviceStatus st = status();
   if (st == DeviceStatus::Closed || !transport_) {
@@ -281,7 +281,7 @@ bool HaplyDevice::flush_tx() noexcept {
   return tx_at_ >= tx_len_;
 }
 
-void HaplyDevice::write_force(Vec2 force_n) {
+void HaplyDevice::write_force(Vec2 force_n) noexcept {
   if (!transport_ || status() == DeviceStatus::Closed || gone_.load(std::memory_order_acquire)) return;
   // At most one packet outstanding while the board answers, and never a packet cut by another. A board that
   // stopped answering gets zero torque at once (the first packet after the loss), then a zero-torque probe

@@ -143,10 +143,10 @@ class HaplyDevice final : public Device {
   void open() override;
   /// Real-time, never waits. The handle from the newest valid reply (the last good one when none came), and
   /// the status.
-  DeviceSample read() override;
+  DeviceSample read() noexcept override;
   /// Real-time, never waits. One torque packet: τ = Jᵀ·F clamped to the torque limit; zero unless the status
   /// is Ok. Skipped (and counted) while the last packet's reply is not in or the last packet not all written.
-  void write_force(Vec2 force_n) override;
+  void write_force(Vec2 force_n) noexcept override;
   /// Not for the servo step: waits up to `timeout_us` [µs] for the reply to the outstanding packet and keeps
   /// it for the next read(). True when it came (or nothing is outstanding). Headless runs call it before
   /// read() so that they do not depend on how busy the machine is; the kiosk never does.
@@ -154,7 +154,7 @@ class HaplyDevice final : public Device {
   /// Sends zero torque (when it can), stops the re-open thread, closes the transport. Never throws.
   void close() noexcept override;
   /// Closed, Ok or Lost. Real-time.
-  DeviceStatus status() const override { return status_.load(std::memory_order_acquire); }
+  DeviceStatus status() const noexcept override { return status_.load(std::memory_order_acquire); }
   /// "Haply pantograph (<transport name>)".
   std::string name() const override;
 
