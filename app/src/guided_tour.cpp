@@ -13,22 +13,6 @@ TourParams tour_params_from(const config::Settings& s) {
   return p;
 }
 
-TourPoint TourPath::at(double t_s, std::size_t& cursor) const noexcept {
-  const std::size_t n = points.size();
-  if (n == 1 || t_s <= points.front().t_s) return points.front();
-  if (t_s >= points.back().t_s) {
-    cursor = n - 1;
-    return points.back();
-  }
-  if (cursor >= n - 1) cursor = 0;
-  while (cursor + 1 < n - 1 && points[cursor + 1].t_s <= t_s) ++cursor;
-  const TourPoint& a = points[cursor];
-  const TourPoint& b = points[cursor + 1];
-  const double span = b.t_s - a.t_s;
-  const double f = span > 0.0 ? (t_s - a.t_s) / span : 1.0;
-  return {t_s, lerp(a.target_m, b.target_m, f), lerp(a.press_n, b.press_n, f)};
-}
-
 void VisitTouches::reset(int scene_id, int curve_count) {
   scene_id_ = scene_id;
   count_ = 0;

@@ -47,77 +47,13 @@
 
 #include "config/settings.hpp"
 #include "haptics/scene.hpp"
+#include "haptics/tour_guide.hpp"
 #include "haptics/vec2.hpp"
 
 namespace hk::app {
 
-/// One timed target of a tour: where the spring pulls the handle at time t_s after the tour was taken,
-/// and the force that presses it against the wall there.
-struct TourPoint {
-  double t_s = 0.0;  ///< time since the tour started [s], increasing along the path
-  Vec2 target_m;     ///< target of the guide spring [m], workspace frame
-  Vec2 press_n;      ///< force towards the wall [N] where the handle touches no wall (zero in the transit)
-};
-
-/// Tuning of the guided tour. Units in names. Defaults: the shipped settings ([haptics] tour_max_force_n,
-/// tour_speed_m_per_s) and the constants chosen here.
-struct TourParams {
-  double max_force_n = 1.2;          ///< |guide force| never exceeds this [N] ([haptics] tour_max_force_n)
-  double speed_m_per_s = 0.03;       ///< speed along the outline [m/s] ([haptics] tour_speed_m_per_s)
-  /// Guide spring [N/m]. 300 N/m with the 0.08 kg handle and 2 + 5 N·s/m of damping is a second-order
-  /// follower with ω ≈ 61 rad/s and ζ ≈ 0.7 (no overshoot worth feeling); it lags ~0.7 mm at 3 cm/s and
-  /// saturates at max_force_n after 4 mm of error.
-  double stiffness_n_per_m = 300.0;
-  double damping_n_s_per_m = 5.0;    ///< guide damping on the handle's velocity relative to the target's [N·s/m]
-  double offset_m = 0.0015;          ///< start and end points lie this far off the curve on the handle's side [m]
-  double track_offset_m = 0.001;     ///< the outline's targets lie this far off the curve on the handle's side [m]
-  double press_force_n = 0.6;        ///< force pressing the handle onto the wall along the outline [N]
-  double press_ramp_m = 0.002;       ///< the press grows in over this much of the outline's start and fades over its end [m]
-  double sample_m = 0.0005;          ///< spacing of the outline's targets [m]
-  double transit_sample_s = 0.005;   ///< spacing of the transit's targets [s]
-  double min_transit_s = 0.2;        ///< the shortest transit [s] (a start right by the shape still eases in)
-  double fade_s = 0.05;              ///< the guide force fades in and out over this [s]; walls fade out over it at the start
-  double hold_speed_m_per_s = 0.005; ///< "holding still": the handle slower than this...
-  double hold_s = 0.5;               ///< ...with the guide force at its limit for this long stops the tour [s]
-  double min_shape_length_m = 0.006; ///< curves shorter than this (level 0) are specks, not toured [m]
-  double plan_error_m = 0.0005;      ///< plan on the coarsest level whose error is below this [m]
-  /// Caught in a pocket of the shape (ServoCore): the handle on the toured shape's wall, the spring at its
-  /// limit and the handle not moving for trap_s, the guide pushes it along that wall in the outline's direction
-  /// with follow_force_n (plus the press) until it is within rejoin_m of the waiting target or off the wall.
-  double trap_s = 0.15;              ///< [s]
-  double follow_force_n = 0.5;       ///< [N]; above the break-away friction of the press (μ_s 0.4 × 0.6 N)
-  double rejoin_m = 0.002;           ///< [m]; above the track's offset from the wall plus the press's depth
-};
-
 /// TourParams from the settings: [haptics] tour_max_force_n and tour_speed_m_per_s; the rest the defaults.
 TourParams tour_params_from(const config::Settings& s);
-
-/// The tour's phase as the servo thread reports it (ServoDisplayState::tour_phase).
-enum class TourPhase : std::uint8_t {
-  None,     ///< no tour taken yet
-  Transit,  ///< leading the handle to the shape (walls suspended)
-  Outline,  ///< tracing the outline (walls on)
-  Done,     ///< traced to the end and let go (the force has faded out)
-  Stopped,  ///< stopped before the end: a key, the hand holding still, the device lost or a new picture
-};
-
-/// A planned tour, handed to the servo thread (ServoCore::publish_tour). Built off the servo thread;
-/// the servo thread only reads it.
-struct TourPath {
-  int id = 0;             ///< caller's tour number (ServoDisplayState::tour_id)
-  int scene_id = 0;       ///< SceneBundle::id the tour is for; the servo drops it for another picture
-  int curve = -1;         ///< the shape: scene curve index
-  TourParams params;
-  double outline_start_s = 0.0;  ///< end of the transit: walls are on from here [s]
-  int direction = 1;             ///< the outline runs along increasing segment indices of the curve (+1) or decreasing (-1)
-  std::vector<TourPoint> points; ///< timed targets; points.front() is the handle at planning time, t = 0
-  /// Time of the last point [s] (0 for an empty path).
-  double duration_s() const noexcept { return points.empty() ? 0.0 : points.back().t_s; }
-  /// The target and press at time t [s], linear between points, clamped to the ends. `cursor` is the
-  /// index of the segment used last (start at 0); t must not decrease between calls with the same cursor.
-  /// Real-time safe; amortised O(1). Requires a non-empty path.
-  TourPoint at(double t_s, std::size_t& cursor) const noexcept;
-};
 
 /// The shapes touched in this visit of this picture (issue 14: "the kiosk keeps what was touched per
 /// visit"). Fed with the servo display state's contact curve and with completed tours. Forgotten with a

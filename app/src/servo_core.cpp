@@ -41,213 +41,72 @@ void ServoCore::publish_tour(std::unique_ptr<TourPath> path) {
 
 void ServoCore::end_tour(TourPhase how) noexcept {
   tour_phase_ = how;
-  tour_ending_ = TourPhase::None;
+  guide_.abandon();
   if (tour_ && !tour_retired_.try_push(tour_)) tour_to_retire_ = tour_;  // step() takes no tour while this is set
   tour_ = nullptr;
 }
 
+// A new tour waits while a picture is being swapped in (it may be for the new one), then is taken for the
+// picture in use or dropped (Stopped).
+void ServoCore::take_tour(const DeviceSample& sample) noexcept {
+  if (tour_ || tour_to_retire_ || !current_ || fading_) return;
+  TourPath* next = tour_pending_.exchange(nullptr, std::memory_order_acq_rel);
+  if (!next) return;
+  tour_id_ = next->id;
+  tour_curve_ = next->curve;
+  tour_ = next;
+  if (current_->id != next->scene_id || next->points.empty()) {
+    end_tour(TourPhase::Stopped);  // for another picture: dropped
+    return;
+  }
+  guide_.start(*next, sample.handle_m, current_->loop.params().period_s);
+  tour_phase_ = TourPhase::Transit;
+}
+
+// Before the walls' step: a cancel or a picture changing ends the tour (its force fades out); a pending tour
+// is taken; and where the guide suspends the walls the proxy goes with the handle (TourGuide::walls_suspended).
 void ServoCore::tour_before_update(const DeviceSample& sample) noexcept {
   if (tour_to_retire_ && tour_retired_.try_push(tour_to_retire_)) tour_to_retire_ = nullptr;
   const bool cancel = tour_cancel_.exchange(false, std::memory_order_acq_rel);
   const bool picture_changing = fading_ || !current_ || (tour_ && current_->id != tour_->scene_id);
-  if (tour_ && tour_ending_ == TourPhase::None && (cancel || picture_changing)) {
-    tour_ending_ = TourPhase::Stopped;
-    tour_fade_left_ = tour_fade_ticks_;
-  }
-  // A new tour waits while a picture is being swapped in (it may be for the new one), then is taken for
-  // the picture in use or dropped.
-  if (!tour_ && !tour_to_retire_ && current_ && !fading_) {
-    if (TourPath* next = tour_pending_.exchange(nullptr, std::memory_order_acq_rel)) {
-      tour_id_ = next->id;
-      tour_curve_ = next->curve;
-      tour_ = next;
-      if (current_->id != next->scene_id || next->points.empty()) {
-        end_tour(TourPhase::Stopped);  // for another picture: dropped
-      } else {
-        const double period = current_->loop.params().period_s;
-        tour_phase_ = TourPhase::Transit;
-        tour_ending_ = TourPhase::None;
-        tour_t_s_ = 0.0;
-        tour_cursor_ = 0;
-        tour_ticks_ = 0;
-        tour_hold_ticks_ = 0;
-        tour_fade_ticks_ = std::max(1L, static_cast<long>(next->params.fade_s / period + 0.5));
-        tour_fade_left_ = 0;
-        tour_prev_handle_ = sample.handle_m;
-        tour_prev_target_ = next->points.front().target_m;
-        tour_velocity_ = tour_hold_velocity_ = tour_press_ = tour_follow_dir_ = {0.0, 0.0};
-        tour_following_ = false;
-        tour_trap_ticks_ = 0;
-      }
-    }
-  }
-  // Walls suspended in the transit once they have faded out: the proxy goes with the handle. In the
-  // outline only the toured shape is a wall: a contact (last tick) with other shapes only, met one tick
-  // before at one tick's depth, is let go of, so a neighbouring outline never holds the handle back.
-  bool other_walls_only = false;
-  if (tour_ && tour_phase_ == TourPhase::Outline && out_.contact.state != ContactState::Free) {
-    const int n = out_.contact.state == ContactState::Vertex ? 2 : 1;
-    other_walls_only = true;
-    for (int i = 0; i < n; ++i) other_walls_only = other_walls_only && out_.contact.constraint[i].curve != tour_->curve;
-  }
-  if (tour_ && ((tour_phase_ == TourPhase::Transit && tour_ticks_ >= tour_fade_ticks_) || other_walls_only) && is_finite(sample.handle_m))
-    current_->loop.relocate(sample.handle_m);
+  if (tour_ && (cancel || picture_changing)) guide_.stop();
+  take_tour(sample);
+  if (tour_ && guide_.walls_suspended(out_.contact) && is_finite(sample.handle_m)) current_->loop.relocate(sample.handle_m);
 }
 
-// The handle's velocity through two low-passes of its own (the servo loop's 100 Hz one passes the encoder's
-// steps: ~38 µm in one tick is 38 mm/s raw): kTourVelocityHz for the damping (tour_velocity_), kHoldVelocityHz
-// to tell a handle held still (tour_hold_velocity_).
-void ServoCore::track_tour_handle(Vec2 h, double period_s) noexcept {
-  const Vec2 raw_v = (1.0 / period_s) * (h - tour_prev_handle_);
-  tour_prev_handle_ = h;
-  const double a_v = 1.0 - std::exp(-2.0 * M_PI * kTourVelocityHz * period_s);
-  const double a_h = 1.0 - std::exp(-2.0 * M_PI * kHoldVelocityHz * period_s);
-  tour_velocity_ = tour_velocity_ + a_v * (raw_v - tour_velocity_);
-  tour_hold_velocity_ = tour_hold_velocity_ + a_h * (raw_v - tour_hold_velocity_);
-}
-
-// The path's point at its clock, its press low-passed (kPressHz) so that contact beginning or ending and the
-// polyline's vertices turn it smoothly. The press goes along the wall's inward normal where the handle touches
-// the toured shape (so it never pushes along the wall the handle is on, into a corner), else along the path's.
-TourPoint ServoCore::tour_point_pressed(double period_s) noexcept {
-  TourPoint here = tour_->at(tour_t_s_, tour_cursor_);
-  const double press_len = length(here.press_n);
-  if (press_len > 0.0 && out_.contact.state != ContactState::Free && out_.contact.constraint[0].curve == tour_->curve) {
-    Vec2 a, b;
-    current_->scene->segment(out_.contact.constraint[0], &a, &b);
-    Vec2 n = left_perp(normalized_or(b - a, {1.0, 0.0}));
-    if (dot(out_.contact.proxy_m - a, n) < 0.0) n = -n;  // outward: the proxy's side
-    here.press_n = -press_len * n;
-  }
-  const double a_p = 1.0 - std::exp(-2.0 * M_PI * kPressHz * period_s);
-  tour_press_ = tour_press_ + a_p * (here.press_n - tour_press_);
-  here.press_n = tour_press_;
-  return here;
-}
-
-// Caught in a pocket of its own shape? The press keeps the handle on the wall, so it follows the wall into
-// every narrow pocket, slot or hook of the rendered polyline, which the planned track, offset from the curve
-// at the planning level, passes outside; there the spring's pull points into the wall and the handle stops.
-// On the toured shape's wall with the spring at its limit and the handle still for trap_s, the guide follows
-// the wall (follow_force) until the handle is within rejoin_m of the target, which waits (the path's clock
-// stops while the handle does not keep up). Outline only; a tour ending, or not in its outline, never follows.
-void ServoCore::track_trap(Vec2 error_m, bool keeping_up, double period_s) noexcept {
-  const TourParams& p = tour_->params;
-  if (tour_phase_ != TourPhase::Outline || tour_ending_ != TourPhase::None) {
-    tour_following_ = false;
-    tour_trap_ticks_ = 0;
+// After the walls' step: the guide force of the tick (TourGuide::update), the walls faded in the transit,
+// the TourStart earcon where the outline begins, and the tour let go of once its force has faded out. A
+// device not Ok or a sample not finite ends it at once (no force goes out anyway; it does not resume).
+void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
+  guide_force_ = {0.0, 0.0};
+  if (!tour_) return;
+  if (out_.result == TickResult::DeviceNotOk || out_.result == TickResult::NonFinite) {
+    end_tour(TourPhase::Stopped);
     return;
   }
-  const bool on_shape = out_.contact.state != ContactState::Free && out_.contact.constraint[0].curve == tour_->curve;
-  if (tour_following_) {  // back to the spring near the target, or off the wall (round a tip: the spring leads on)
-    if (length(error_m) < p.rejoin_m || !on_shape) tour_following_ = false;
-    return;
-  }
-  const bool still = length(tour_hold_velocity_) < p.hold_speed_m_per_s;
-  tour_trap_ticks_ = on_shape && !keeping_up && still ? tour_trap_ticks_ + 1 : 0;
-  if (static_cast<double>(tour_trap_ticks_) * period_s >= p.trap_s) {
-    tour_following_ = true;
-    tour_trap_ticks_ = 0;
-  }
-}
-
-// The guide while following the wall: the press plus follow_force_n along the toured shape's wall the proxy is
-// on, in the outline's direction (TourPath::direction along the segment's own end points, which every level
-// orders alike); at a vertex the wall that leads away from the proxy (a zero-length wall keeps the last
-// direction). Called only while following, so on the toured shape's wall. Never above max_force_n.
-Vec2 ServoCore::follow_force(Vec2 press_n) noexcept {
-  const TourParams& p = tour_->params;
-  const ContactOutput& c = out_.contact;
-  const int walls = c.state == ContactState::Vertex ? 2 : (c.state == ContactState::Edge ? 1 : 0);
-  double best_lead = -std::numeric_limits<double>::infinity();
-  for (int i = 0; i < walls; ++i) {
-    if (c.constraint[i].curve != tour_->curve) continue;
-    Vec2 a, b;
-    current_->scene->segment(c.constraint[i], &a, &b);
-    const Vec2 t = static_cast<double>(tour_->direction) * normalized_or(b - a, tour_follow_dir_);
-    const double lead = dot(t, 0.5 * (a + b) - c.proxy_m);  // > 0: the wall goes on ahead of the proxy
-    if (lead > best_lead) {
-      best_lead = lead;
-      tour_follow_dir_ = t;
-    }
-  }
-  Vec2 f = press_n + p.follow_force_n * tour_follow_dir_;
-  const double len = length(f);
-  if (len > p.max_force_n) f = (p.max_force_n / len) * f;
-  return f;
-}
-
-// The tour's progress on a tick that rendered: held still against it (the force at its limit, or the path's
-// clock stopped because the handle does not keep up, while the handle barely moves) for hold_s stops it; the
-// path's clock runs while the handle keeps up (within the spring's saturation distance); the outline begins
-// (the TourStart earcon) and the path ends (Done) at their times. `keeping_up`: the spring's pull plus the
-// press is below max_force_n; `guide_len_n` the guide force's length before the fades.
-void ServoCore::advance_tour(bool keeping_up, double guide_len_n, double period_s) noexcept {
-  const TourParams& p = tour_->params;
-  const bool held = (guide_len_n >= 0.95 * p.max_force_n || !keeping_up || tour_following_) && length(tour_hold_velocity_) < p.hold_speed_m_per_s;
-  tour_hold_ticks_ = held ? tour_hold_ticks_ + 1 : 0;
-  if (static_cast<double>(tour_hold_ticks_) * period_s >= p.hold_s) {
-    tour_ending_ = TourPhase::Stopped;
-    tour_fade_left_ = tour_fade_ticks_;
-  }
-  if (tour_ending_ == TourPhase::None && keeping_up) tour_t_s_ += period_s;
-  if (tour_phase_ == TourPhase::Transit && tour_t_s_ >= tour_->outline_start_s) {
+  TourInput in;
+  in.handle_m = sample.handle_m;
+  in.contact = &out_.contact;
+  in.scene = current_->scene.get();
+  in.walls_result = out_.result;
+  in.period_s = current_->loop.params().period_s;
+  TourOutput to;
+  guide_.update(in, to);
+  out_.force_n = to.walls_gain * out_.force_n;
+  guide_force_ = to.guide_force_n;
+  if (to.outline_began) {
     tour_phase_ = TourPhase::Outline;
     if (cues_) {
       audio::CueEvent c;
       c.tick = tick_;
       c.kind = audio::CueKind::TourStart;
       c.curve = tour_->curve;
-      c.speed_m_per_s = static_cast<float>(p.speed_m_per_s);
+      c.speed_m_per_s = static_cast<float>(tour_->params.speed_m_per_s);
       c.level = static_cast<std::int16_t>(out_.level);
       cues_->try_push(c);  // a full ring drops and counts
     }
   }
-  if (tour_ending_ == TourPhase::None && tour_t_s_ >= tour_->duration_s()) {
-    tour_ending_ = TourPhase::Done;
-    tour_fade_left_ = tour_fade_ticks_;
-  }
-}
-
-void ServoCore::tour_after_update(const DeviceSample& sample) noexcept {
-  guide_force_ = {0.0, 0.0};
-  if (!tour_) return;
-  if (out_.result == TickResult::DeviceNotOk || out_.result == TickResult::NonFinite) {
-    end_tour(TourPhase::Stopped);  // no force goes out anyway; the tour does not resume on its own
-    return;
-  }
-  const TourParams& p = tour_->params;
-  const double period = current_->loop.params().period_s;
-  const Vec2 h = sample.handle_m;
-  track_tour_handle(h, period);
-  const TourPoint here = tour_point_pressed(period);
-  const Vec2 target_v = (1.0 / period) * (here.target_m - tour_prev_target_);
-  tour_prev_target_ = here.target_m;
-  const Vec2 e = here.target_m - h;
-  // A spring to the target, damping of the velocity relative to the target's (PD tracking) and the press
-  // towards the wall.
-  Vec2 f = p.stiffness_n_per_m * e + p.damping_n_s_per_m * (target_v - tour_velocity_) + here.press_n;
-  double f_len = length(f);
-  if (f_len > p.max_force_n) f = (p.max_force_n / f_len) * f;
-  // The handle keeps up while the spring's pull and the press stay under the limit (the clock runs).
-  const bool keeping_up = length(p.stiffness_n_per_m * e + here.press_n) < p.max_force_n;
-  track_trap(e, keeping_up, period);
-  if (tour_following_) {  // out of a pocket along its wall, then back to the spring
-    f = follow_force(here.press_n);
-    f_len = length(f);
-  }
-  double gain = std::min(1.0, static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_));  // fade in
-  // The walls: faded out over the first fade_s of the transit, then off (relocate); on from the outline.
-  if (tour_phase_ == TourPhase::Transit)
-    out_.force_n = std::max(0.0, 1.0 - static_cast<double>(tour_ticks_ + 1) / static_cast<double>(tour_fade_ticks_)) * out_.force_n;
-  if (tour_ending_ == TourPhase::None && out_.result == TickResult::Ok) advance_tour(keeping_up, f_len, period);
-  if (tour_ending_ != TourPhase::None) {  // fading out (Done or Stopped)
-    --tour_fade_left_;
-    gain *= std::max(0.0, static_cast<double>(tour_fade_left_) / static_cast<double>(tour_fade_ticks_));
-  }
-  if (out_.result == TickResult::Ok) guide_force_ = gain * f;  // a late tick (DeadlineMissed) sends nothing
-  ++tour_ticks_;
-  if (tour_ending_ != TourPhase::None && tour_fade_left_ <= 0) end_tour(tour_ending_);
+  if (to.ended != TourPhase::None) end_tour(to.ended);
 }
 
 void ServoCore::set_gains(const ServoGains& g) noexcept {

@@ -1,11 +1,11 @@
 #pragma once
 /// @file servo_core.hpp
-/// What the kiosk's servo thread does each tick (issue 5, item 2; issue 13, item 5; DESIGN.md "Data flow",
-/// "Real-time rules"): a pure step from the device sample to the force command. The caller reads the
-/// device, calls step(), writes the command's force: `sample = device.read(); core.step(sample, late, cmd);
-/// device.write_force(cmd.force_n);`. The step swaps in a newly published picture, runs the servo loop,
-/// pushes audio cues and fills the display state. It holds no device, reads no clock and is deterministic,
-/// so tests drive it tick by tick; ServoThread (servo_thread.hpp) calls it on time.
+/// What the servo does each tick (DESIGN.md "Data flow", "Real-time rules"): a pure step from the device
+/// sample to the force command, ServoCore::step. It holds no device and reads no clock, so it is
+/// deterministic; ServoRunner (servo_runner.hpp) reads the device, calls it and writes the force, for the
+/// kiosk's servo thread and for every headless run alike. The step swaps in a newly published picture,
+/// applies the owner's requests, runs the servo loop on the picture in use, adds the guided tour's force,
+/// pushes audio cues and fills the display state.
 ///
 /// A device that comes back (the sample's status Ok again after Lost, Fault or Closed) gets its force back
 /// gently: the picture in use restarts at the handle (ServoLoop::start: proxy there, force ramped in from
@@ -19,29 +19,19 @@
 /// passes the previous bundle back through a small ring, so it is freed outside the servo thread
 /// (collect_retired()). Every force step of a swap is thus at most max_force_n · period / ramp_s.
 ///
-/// Live gains (issue 12, item 4): set_gains() hands stiffness, damping, max force and friction to the servo
-/// thread through a triple buffer (latest value wins, no lock, no allocation). The servo thread takes them
-/// at its next tick for the picture in use (ServoLoop::set_gains: the force moves to the new law at no more
-/// than max_force_step_n per tick) and gives them to every picture it takes afterwards, before starting it,
-/// so a bundle built with older ServoParams cannot bring the old gains back.
+/// Live gains: set_gains() hands stiffness, damping, max force and friction to the servo thread through a
+/// triple buffer (latest value wins, no lock, no allocation). The servo thread takes them at its next tick
+/// for the picture in use (ServoLoop::set_gains: the force moves to the new law at no more than
+/// max_force_step_n per tick) and gives them to every picture it takes afterwards, before starting it, so a
+/// bundle built with older ServoParams cannot bring the old gains back.
 ///
-/// The guided tour (issue 14, item 3; guided_tour.hpp): publish_tour() hands a planned TourPath to the
-/// servo thread as publish() hands a picture (one atomic exchange; the path the servo let go of goes back
-/// through a ring and is freed by collect_retired()). Each tick of a tour the target is read off the path
-/// and the guide force is F_g = k_g·(target − handle) + b_g·(target velocity − handle velocity) + press
-/// (the handle's velocity low-passed at 30 Hz: encoder steps are noise to a damper; press: the path's force
-/// onto the wall along the outline, turned along the inward normal of the wall segment the handle touches
-/// when it touches the shape, low-passed at 10 Hz so it turns smoothly), clamped in length to TourParams::max_force_n; it fades in and out over fade_s. The command is the walls' force (after the
-/// guard) plus F_g, clamped to the guard's max_force_n. During the transit the walls are suspended: they
-/// fade out over fade_s, then the proxy is put at the handle every tick (ServoLoop::relocate); from the
-/// outline on the toured shape is a wall, and a contact with other shapes only is let go of at the next
-/// tick (relocate again: one tick's depth, a few hundredths of a newton), so a neighbouring outline never
-/// holds the handle back. The path's clock runs only while |spring + press| stays below max_force_n, so
-/// a held handle is not left behind by a target running away; the tour stops (force faded out)
-/// at cancel_tour(), when the hand holds still against it (guide force at ≥ 95 % of its limit, or the
-/// clock stopped, while the handle, its velocity low-passed at 5 Hz, moves slower than
-/// hold_speed_m_per_s, for hold_s), when the device is not Ok or the sample not
-/// finite (at once), or when the picture changes. A TourStart cue marks the outline's start.
+/// The guided tour (guided_tour.hpp plans it): publish_tour() hands a planned TourPath to the servo thread
+/// as publish() hands a picture (one atomic exchange; the path the servo let go of goes back through a ring
+/// and is freed by collect_retired()). A TourGuide (haptics/tour_guide.hpp: the force law, the walls
+/// suspended in the transit, the pocket-following, the tour's clock and ending) follows it; the command is
+/// the walls' force (after the guard) plus the guide force, clamped to the guard's max_force_n. The tour
+/// stops (force faded out) at cancel_tour() or when the picture changes, and at once when the device is not
+/// Ok or the sample not finite. A TourStart cue marks the outline's start.
 
 #include <atomic>
 #include <cstdint>
@@ -55,6 +45,7 @@
 #include "haptics/device.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
+#include "haptics/tour_guide.hpp"
 #include "haptics/triple_buffer.hpp"
 
 namespace hk::app {
@@ -195,39 +186,20 @@ class ServoCore {
   void add_guide_force() noexcept;
   void emit_cues(Vec2 handle_m) noexcept;
   void write_display(const DeviceSample& sample) noexcept;
-  // The guided tour (servo thread but the atomics and the ring).
+  // The guided tour: the path handed over (atomics, ring) and the force law following it (TourGuide).
   void tour_before_update(const DeviceSample& sample) noexcept;
+  void take_tour(const DeviceSample& sample) noexcept;
   void tour_after_update(const DeviceSample& sample) noexcept;
-  void track_tour_handle(Vec2 h, double period_s) noexcept;
-  TourPoint tour_point_pressed(double period_s) noexcept;
-  void advance_tour(bool keeping_up, double guide_len_n, double period_s) noexcept;
-  void track_trap(Vec2 error_m, bool keeping_up, double period_s) noexcept;
-  Vec2 follow_force(Vec2 press_n) noexcept;
   void end_tour(TourPhase how) noexcept;
   std::atomic<TourPath*> tour_pending_{nullptr};
   std::atomic<bool> tour_cancel_{false};
   audio::SpscRing<TourPath*> tour_retired_{8};         // servo → owner
   TourPath* tour_ = nullptr;                           // running (or fading out)
   TourPath* tour_to_retire_ = nullptr;                 // waiting for room in tour_retired_
+  TourGuide guide_;                                    // the force law following tour_
   TourPhase tour_phase_ = TourPhase::None;             // reported
-  TourPhase tour_ending_ = TourPhase::None;            // Done / Stopped while the force fades out
   int tour_id_ = 0, tour_curve_ = -1;
-  double tour_t_s_ = 0.0;                              // the path's clock [s]
-  std::size_t tour_cursor_ = 0;
-  long tour_ticks_ = 0;                                // ticks since the tour was taken
-  long tour_fade_ticks_ = 1;                           // fade_s in ticks
-  long tour_fade_left_ = 0;                            // while ending: ticks of fade left
-  long tour_hold_ticks_ = 0;                           // consecutive ticks "held still against it"
   Vec2 guide_force_;                                   // this tick's guide force [N]
-  Vec2 tour_prev_handle_, tour_prev_target_;           // last tick's handle and target [m]
-  Vec2 tour_velocity_, tour_hold_velocity_;            // the handle's velocity, low-passed [m/s]
-  static constexpr double kTourVelocityHz = 30.0;      // low-pass of the guide's damping velocity [Hz]
-  static constexpr double kHoldVelocityHz = 5.0;       // low-pass of the "held still" velocity [Hz]
-  static constexpr double kPressHz = 10.0;             // low-pass of the press force's direction changes [Hz]
-  Vec2 tour_press_;                                    // the press force, low-passed [N]
-  bool tour_following_ = false;                        // caught in a pocket: following the wall (track_trap)
-  long tour_trap_ticks_ = 0;                           // consecutive ticks caught on the shape's wall, still
-  Vec2 tour_follow_dir_;                               // the wall's direction while following (unit)
   std::int64_t tick_ = 0;
 };
 
