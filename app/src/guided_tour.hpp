@@ -1,10 +1,10 @@
 #pragma once
 /// @file guided_tour.hpp
-/// The guided tour (issue 14, item 3): the Guide key leads the handle to the nearest shape not yet touched
+/// The guided tour: the Guide key leads the handle to the nearest shape not yet touched
 /// in this visit, traces its outline once and lets go. This file is the planning half, GL-free and off the
 /// servo thread: which shapes were touched (VisitTouches), which shape comes next and the timed path of
-/// the handle's target (plan_tour). The servo half (ServoCore::publish_tour) follows the path with a
-/// force-limited spring.
+/// the handle's target (plan_tour). The servo half (ServoCore::publish_tour, haptics/tour_guide.hpp's
+/// TourGuide) follows the path with a force-limited spring.
 ///
 /// The path, as a flat list of timed targets (TourPath::points, built here, read by the servo thread):
 ///   1. transit: from the handle to a start point offset_m (1.5 mm) off the shape on the handle's side, in a
@@ -26,12 +26,11 @@
 ///      force fades out over fade_s).
 /// The press keeps the handle on the wall, so in the outline it follows the wall into every narrow pocket,
 /// slot or hook of the rendered polyline, which the track, offset from the curve at the planning level, passes
-/// outside; from inside a hook the spring pulls into the wall. ServoCore then follows the wall instead (see
+/// outside; from inside a hook the spring pulls into the wall. The TourGuide then follows the wall instead (see
 /// TourParams::trap_s): the handle is led out of the pocket along it, and the spring takes over again near the
-/// waiting target. Without that, 13 tours on 9 of the 22 test pictures stopped as if held (2026-11-26).
-/// (The issue's sketch put the outline 1.5 mm off the wall on the handle's side with no press; the handle
-/// would then be led round in the air and never touch the shape. A target 1.5 mm past the wall was tried
-/// next and fails: with the walls' friction (μ_s 0.4) the handle sticks on the wall wherever the pull
+/// waiting target; without it, tours on 9 of the 22 test pictures stop as if held.
+/// (An outline 1.5 mm off the wall on the handle's side with no press would lead the handle round in the
+/// air, never touching the shape. A target 1.5 mm past the wall fails: with the walls' friction (μ_s 0.4) the handle sticks on the wall wherever the pull
 /// points mostly into it — round every convex corner — while the target runs on. A target outside pulls
 /// the handle round convex corners; the press, a force along the wall's normal where the handle is,
 /// keeps it on the wall without pulling it into a corner.)
@@ -55,8 +54,7 @@ namespace hk::app {
 /// TourParams from the settings: [haptics] tour_max_force_n and tour_speed_m_per_s; the rest the defaults.
 TourParams tour_params_from(const config::Settings& s);
 
-/// The shapes touched in this visit of this picture (issue 14: "the kiosk keeps what was touched per
-/// visit"). Fed with the servo display state's contact curve and with completed tours. Forgotten with a
+/// The shapes touched in this visit of this picture (the kiosk keeps what was touched per visit). Fed with the servo display state's contact curve and with completed tours. Forgotten with a
 /// new picture (reset) and a new visitor.
 class VisitTouches {
  public:

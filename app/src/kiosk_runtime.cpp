@@ -67,7 +67,7 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
   sim_.open();
   hand_ = hand_params_from(s);
   // The cursor's hand may press harder than a model visitor: a cursor held well past a wall (about 2 cm at
-  // the hand's 200 N/m) pushes through it, as a visitor at the real handle would (issue 14, push-through).
+  // the hand's 200 N/m) pushes through it, as a visitor at the real handle would.
   hand_.max_force_n = std::max(hand_.max_force_n, 1.5 * s.haptics.pop_force_n);
   if (!o.device.empty()) {
     open_emulated_board(o.device);

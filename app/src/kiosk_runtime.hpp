@@ -1,7 +1,6 @@
 #pragma once
 /// @file kiosk_runtime.hpp
-/// Everything the kiosk runs apart from its window (issue 5; split out of run_kiosk in issue 12, item 7):
-/// the device (issue 13: the USB pantograph when one answers — [device] type "auto" or "haply" — else the
+/// Everything the kiosk runs apart from its window: the device (the USB pantograph when one answers — [device] type "auto" or "haply" — else the
 /// simulated pantograph driven by the cursor through the model hand), the servo thread, the audio side,
 /// the USB stick service and what is shown (scene on the device, curves for the screen). It implements the
 /// visitor's flow's KioskEffects, and applies settings changed by the operator while it runs
@@ -106,7 +105,7 @@ class KioskRuntime final : public KioskEffects {
   /// The first time after a start whose board did not read its home pose, the staff's line follows
   /// (device_not_home); never again, so no visitor hears it.
   void announce_device();
-  /// Says which camera there is (issue 16): "There is a camera: press … to feel a picture of your own." or "No
+  /// Says which camera there is: "There is a camera: press … to feel a picture of your own." or "No
   /// camera was found." (nothing when [camera] source is "none", or "auto" was not probed). Logged either way.
   void announce_camera();
   /// Whether there is a camera to capture from.
@@ -119,7 +118,7 @@ class KioskRuntime final : public KioskEffects {
   void poll_device(double now_s);
   /// The device the servo thread drives.
   Device& device() { return usb_ ? static_cast<Device&>(*usb_) : static_cast<Device&>(sim_); }
-  /// The operator's Calibrate (issue 13, item 3): with the handle resting at the park place, the encoder
+  /// The operator's Calibrate: with the handle resting at the park place, the encoder
   /// offsets that make it read right (io::calibrated_offsets from the angles read now), applied to the
   /// running board at once (io::HaplyDevice::apply_offsets). Returns false with `why` when no USB pantograph
   /// is in use or the park place is out of reach. The caller stores the offsets in the settings.
@@ -220,7 +219,7 @@ class KioskRuntime final : public KioskEffects {
   void insert_stick_folder(const std::string& dir);
   void remove_stick_folder();
 
-  /// The operator changed settings (issue 12, item 4). Compared with the settings in use, field by field
+  /// The operator changed settings. Compared with the settings in use, field by field
   /// (config::FieldDescriptor::apply): servo gains go to the servo thread at once (no force step beyond
   /// level_max_force_step_n per tick: ServoCore::set_gains); level and scene settings rebuild what is shown
   /// here, off the servo thread, and it is swapped in with the fade; keys and the session's timing change

@@ -66,7 +66,7 @@ ServoParams servo_params_from(const config::Settings& s) {
   sp.policy.blur_time_s = s.haptics.level_blur_time_s;
   sp.policy.hysteresis = s.haptics.level_hysteresis;
   sp.policy.min_dwell_s = s.haptics.level_min_dwell_s;
-  // Walls or grooves (issue 14, item 2). The groove's stiffness, max force and per-tick jump limit come from
+  // Walls or grooves. The groove's stiffness, max force and per-tick jump limit come from
   // the gains below (stiffness_n_per_m, max_force_n, level_max_force_step_n) through apply_gains.
   sp.render = s.haptics.render == "grooves" ? RenderMode::Grooves : RenderMode::Walls;
   sp.groove.capture_radius_m = s.haptics.groove_capture_radius_m;

@@ -131,7 +131,7 @@ TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
     EXPECT_GT(sum["build_ms"]["edges"].get<double>(), 0.0);
   }
   EXPECT_EQ(sum["curves"].get<std::size_t>(), scene["curves"].size());
-  // Coverage (issue 14, item 5): a fraction, and no more curves touched than there are.
+  // Coverage: a fraction, and no more curves touched than there are.
   const double covered = sum["coverage"]["length_fraction"].get<double>();
   EXPECT_TRUE(covered >= 0.0 && covered <= 1.0) << covered;
   EXPECT_EQ(sum["coverage"]["curves"].get<std::size_t>(), scene["curves"].size());
@@ -187,7 +187,7 @@ TEST_P(RasterNeverCrosses, ProxyStaysOnItsSideOfEveryWall) {
 class RasterPushThrough : public ::testing::TestWithParam<fs::path> {};
 
 TEST_P(RasterPushThrough, AGentleHandNeverPopsAHardOneOnlyOnPopTicks) {
-  // Issue 14, item 1, on every test picture with the shipped push-through (3 N for 0.3 s):
+  // Push-through on every test picture with the shipped push-through (3 N for 0.3 s):
   // (a) the visitor's usual 2 N raster never pops and the proxy never crosses a curve;
   // (b) a 6 N raster pops through, the proxy crossing curves only on ticks marked pop, and every pop
   //     crosses; outside the 20 ms after a pop the force is the spring's, up to the clamp.

@@ -1,5 +1,5 @@
 // explore --audio-out on real pictures: the WAV is on trace.csv's timeline and every contact onset in the
-// trace is heard within 10 ms after it (issue 4, "Tests it must have").
+// trace is heard within 10 ms after it.
 #include <gtest/gtest.h>
 
 #include <algorithm>

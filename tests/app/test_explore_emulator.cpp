@@ -1,4 +1,4 @@
-// The headless pipeline through the Haply firmware emulator behind a pty (issue 13, "Tests it must have"):
+// The headless pipeline through the Haply firmware emulator behind a pty:
 // the same crossing and force-law checks as the simulated device on real pictures; a board that is
 // unplugged mid-run gets zero force and torque from lost_after_ticks ticks on and the run ends well with
 // device.status "lost"; garbage and dropped replies never give a non-finite or over-limit torque; bad

@@ -1,4 +1,4 @@
-// `explore --hand explorer` (issue 14, item 4): the visitor-like model hand end to end. Same seed, same run;
+// `explore --hand explorer`: the visitor-like model hand end to end. Same seed, same run;
 // bad seeds are one line naming --seed; a square inside a square is traced (both curves), which needs the
 // walls' push-through; and the issue's coverage target on every test picture, figures printed per picture.
 #include <gtest/gtest.h>
@@ -134,9 +134,8 @@ TEST(Explorer, TracesASquareInsideASquare) {
   EXPECT_GE(ci, 0.8) << "the inner square is reached by pushing through the outer one";
 }
 
-// Issue 14's target: with --hand explorer --duration 120, coverage >= 80 % of the curves' length on at least
-// 90 % of the pictures (20 of the 22). 21 of 22 on 2026-11-22 with seed 1 (and with seeds 2 and 3; sudoku or
-// the butterfly just under, 0.79-0.80); figures in docs/PERFORMANCE.md, "Every shape within reach". Two runs at
+// The target: with --hand explorer --duration 120, coverage >= 80 % of the curves' length on at least
+// 90 % of the pictures (20 of the 22); figures in docs/PERFORMANCE.md, "Every shape within reach". Two runs at
 // a time (the machine's two cores).
 TEST(Explorer, CoversFourFifthsOfTheCurvesOnMostPictures) {
   const std::vector<fs::path> images = test_images();
@@ -170,6 +169,6 @@ TEST(Explorer, CoversFourFifthsOfTheCurvesOnMostPictures) {
     reached += coverage[i] >= 0.80;
   }
   std::printf("explorer coverage >= 0.80 on %zu of %zu pictures\n", reached, images.size());
-  EXPECT_GE(10 * reached, 9 * images.size()) << reached << " of " << images.size() << " pictures at >= 80 % (issue 14: 90 %)";
+  EXPECT_GE(10 * reached, 9 * images.size()) << reached << " of " << images.size() << " pictures at >= 80 % (target: 90 % of them)";
   fs::remove_all(tmp);
 }

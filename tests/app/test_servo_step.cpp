@@ -203,7 +203,7 @@ INSTANTIATE_TEST_SUITE_P(LevelAndRenderModes, ServoStepModes,
 class ServoStepTourModes : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(ServoStepTourModes, NothingIsAllocatedOrFreedInAGuidedTour) {
-  // The guided tour (issue 14, item 3) in the servo path: taken, led through the transit (walls
+  // The guided tour in the servo path: taken, led through the transit (walls
   // suspended), round the outline, let go, and a second one cancelled by a key; the paths are planned and
   // freed outside the count. In each level mode (the walls the tour presses on: levels, tolerance steps, cut).
   config::Settings settings;
