@@ -8,14 +8,14 @@ namespace hk {
 // them, excluded ones left out, the same answer a full query gives (every wall within the ball is among them;
 // ties as test_segment). False, with nothing written, for a sweep they cannot answer. Charges no box test. The
 // first sweep inside the ball copies the walls (copy_ball_walls).
-bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                                             SweepHit* out, QueryStats* stats) noexcept {
-  BallWalls& w = ball_walls_;
+bool BoundarySection::Ops::answer_from_ball_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
+                                                  SweepHit* out, QueryStats* stats) noexcept {
+  BallWalls& w = self.ball_walls_;
   if (level != w.level) return false;
   const double r_sq = w.radius_sq;
   const Vec2 da = a - w.center_m, db = b - w.center_m;
   if (!(dot(da, da) < r_sq && dot(db, db) < r_sq)) return false;
-  if (!w.copied) copy_ball_walls();
+  if (!w.copied) copy_ball_walls(self);
   // The walls whose rectangle meets the sweep's (the rectangles apart: no common point), as a bit mask, two
   // walls per step (a slot past count meets nothing that counts: the mask drops it).
   const Aabb sweep = rect_of(a, b);
@@ -60,7 +60,7 @@ bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const Se
     stats->segment_tests = tested;
     stats->coarsest_answer_level = coarsest;
     stats->ball_walls = true;
-    stats->section_size = static_cast<std::int32_t>(section_.size());
+    stats->section_size = static_cast<std::int32_t>(self.section_.size());
   }
   *out = best;
   return true;
@@ -76,28 +76,28 @@ bool BoundarySection::answer_from_ball_walls(Vec2 a, Vec2 b, int level, const Se
 // them alone (answer_from_ball_walls): near a wall, or sliding along one in contact, where the plain ball is as small as the gap to it. Kept only
 // when it reaches farther than the plain ball. Runs before the splits and merges, which change the entries in
 // place: it reads them as phase 1 scanned them.
-void BoundarySection::gather_ball_walls(const Query& q) noexcept {
-  BallWalls& w = ball_walls_;
+void BoundarySection::Ops::gather_ball_walls(BoundarySection& self, const Query& q) noexcept {
+  BallWalls& w = self.ball_walls_;
   w.radius_sq = 0.0;
   w.count = 0;
   w.runs = 0;
   w.copied = false;
   const std::size_t n = q.scanned;
   std::uint32_t unused = 0;
-  if (q.nearest_rect >= n || segments_under(section_[q.nearest_rect], q.level, &unused) == 0) return;  // no walls to copy
+  if (q.nearest_rect >= n || segments_under(self, self.section_[q.nearest_rect], q.level, &unused) == 0) return;  // no walls to copy
   // Note the walls of the nearest entries, in order of their rectangles' distance (each taken out of rect_d_sq_ as it
   // is reached, so the next is the nearest left), while they fit (copied when first needed: copy_ball_walls).
-  float* d_sq = rect_d_sq_.data();
+  float* d_sq = self.rect_d_sq_.data();
   constexpr double kAllWallsRadius_m = 1.0;  // every entry's walls noted: any radius holds; the workspace is smaller
   double r_sq = kAllWallsRadius_m * kAllWallsRadius_m;
   for (std::size_t e = q.nearest_rect; e < n;) {
     std::uint32_t first = 0;
-    const std::uint32_t count = w.runs == kBallWallEntries ? 0 : segments_under(section_[e], q.level, &first);
+    const std::uint32_t count = w.runs == kBallWallEntries ? 0 : segments_under(self, self.section_[e], q.level, &first);
     d_sq[e] = std::numeric_limits<float>::infinity();
     if (count == 0 || w.count + static_cast<int>(count) > kMaxBallWalls) {
       // The radius: the first entry left out, by its box; every other one is no nearer than the next rectangle.
-      r_sq = box_distance_sq(entry_box_at(e), q.b);
-      const std::size_t next = nearest_rect_left(n);
+      r_sq = box_distance_sq(entry_box_at(self, e), q.b);
+      const std::size_t next = nearest_rect_left(self, n);
       if (next < n) r_sq = std::min(r_sq, static_cast<double>(d_sq[next]));
       break;
     }
@@ -105,7 +105,7 @@ void BoundarySection::gather_ball_walls(const Query& q) noexcept {
     w.run_count[w.runs] = count;
     ++w.runs;
     w.count += static_cast<int>(count);
-    e = nearest_rect_left(n);
+    e = nearest_rect_left(self, n);
   }
   if (w.count == 0 || r_sq <= q.nearest_sq) {
     w.count = 0;
@@ -119,8 +119,8 @@ void BoundarySection::gather_ball_walls(const Query& q) noexcept {
 
 // The entry of the nearest rectangle left in rect_d_sq_ (the first of equals; entries taken out are +inf), or n when
 // none is left: four entries per SSE instruction, no branch on the data (the scan's groups of four, its padding +inf).
-std::size_t BoundarySection::nearest_rect_left(std::size_t n) const noexcept {
-  const float* d_sq = rect_d_sq_.data();
+std::size_t BoundarySection::Ops::nearest_rect_left(const BoundarySection& self, std::size_t n) noexcept {
+  const float* d_sq = self.rect_d_sq_.data();
   std::size_t nearest = n;
 #if defined(__SSE2__)
   NearestOfFours nearest_rect(n);
@@ -141,9 +141,9 @@ std::size_t BoundarySection::nearest_rect_left(std::size_t n) const noexcept {
 // The ball's walls noted by gather_ball_walls, copied out: each run's consecutive segments (one level of one
 // curve), their end points, rectangles and references, in run order. Reads the scene only here, so a full query
 // whose walls ball no later sweep enters leaves their points where they are (on a large scene, seldom cached).
-void BoundarySection::copy_ball_walls() noexcept {
-  BallWalls& w = ball_walls_;
-  const Scene& sc = *scene_;
+void BoundarySection::Ops::copy_ball_walls(BoundarySection& self) noexcept {
+  BallWalls& w = self.ball_walls_;
+  const Scene& sc = *self.scene_;
   int k = 0;
   for (int r = 0; r < w.runs; ++r) {
     const NodeInfo in = sc.info(w.run_first[r]);
@@ -168,11 +168,11 @@ void BoundarySection::copy_ball_walls() noexcept {
 // no compaction: splits and merges changed it in place, no node twice (a split puts in children of a node that
 // was in, so they were not; a merge a parent it checked was not), a frontier still
 // (CollisionQuery.BoundarySectionStaysSmallOnALongWalk checks it).
-void BoundarySection::place_free_ball(const Query& q) noexcept {
-  ball_center_m_ = q.b;
-  ball_radius_sq_ = q.nearest_sq;
-  ball_levels_[0] = q.level;  // the boxes scanned covered the walls of both ids the section served
-  ball_levels_[1] = other_level_;
+void BoundarySection::Ops::place_free_ball(BoundarySection& self, const Query& q) noexcept {
+  self.ball_center_m_ = q.b;
+  self.ball_radius_sq_ = q.nearest_sq;
+  self.ball_levels_[0] = q.level;  // the boxes scanned covered the walls of both ids the section served
+  self.ball_levels_[1] = self.other_level_;
 }
 
 }  // namespace hk

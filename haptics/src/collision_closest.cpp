@@ -39,14 +39,14 @@ struct BoundarySection::ClosestQuery {
 // is within the bound (rect_within_bound), perhaps before the bound last shrank: the exact distance is
 // compared with the bound as it is now. The segment's reference is looked up only where it decides a
 // tie or wins. Inlined: it runs several times a call.
-[[gnu::always_inline]] inline void BoundarySection::closest_offer(ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) const noexcept {
+[[gnu::always_inline]] inline void BoundarySection::Ops::closest_offer(const BoundarySection& self, ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) noexcept {
   const Vec2 p = q.p;
   const Vec2 c = closest_point_on_segment(p, a, b);
   const double d_sq = length_sq(p - c);
   if (d_sq > q.bound_sq) return;
   const double d = std::sqrt(d_sq);  // bit for bit distance(p, c)
   if (d > q.best_m) return;
-  const NodeInfo in = scene_->info(node);
+  const NodeInfo in = self.scene_->info(node);
   if (q.skip_count > 0 && q.skips(in.curve)) return;
   const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index)};
   if (!closer(d, ref, q.best_m, q.best_s)) return;
@@ -88,36 +88,36 @@ inline int rects_within_bound2(const Vec2* s, Vec2 p, double bound_sq) {
 // The seed: the previous call's answer, measured again at the new point, when that call was for the same
 // level and curve. A real candidate, so the walk's bound is tight from the root down; the hand moves
 // little between ticks, so it is nearly always the answer again or within a few of it.
-void BoundarySection::closest_seed(ClosestQuery& q) const noexcept {
-  if (last_closest_node_ == kWideEmpty || last_closest_level_ != q.level || last_closest_curve_ != q.curve) return;
+void BoundarySection::Ops::closest_seed(const BoundarySection& self, ClosestQuery& q) noexcept {
+  if (self.last_closest_node_ == kWideEmpty || self.last_closest_level_ != q.level || self.last_closest_curve_ != q.curve) return;
   Vec2 a, b;
-  scene_->segment_points(last_closest_node_, &a, &b);
-  closest_offer(q, last_closest_node_, a, b);
+  self.scene_->segment_points(self.last_closest_node_, &a, &b);
+  closest_offer(self, q, self.last_closest_node_, a, b);
 }
 
 // At an item of the walk: offers the target level's segments under it.
-void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noexcept {
-  const Scene& sc = *scene_;
+void BoundarySection::Ops::closest_test_item(BoundarySection& self, ClosestQuery& q, std::uint32_t item) noexcept {
+  const Scene& sc = *self.scene_;
   if (q.curve >= 0 && static_cast<int>(sc.tag_curve(item)) != q.curve) return;
   if (q.skip_count > 0 && q.skips(sc.tag_curve(item))) return;
   std::uint32_t first = 0;
-  const std::uint32_t count = item_segments(item, q.level, &first);
+  const std::uint32_t count = item_segments(self, item, q.level, &first);
   // The segments under an item are consecutive slots: their rectangles two at a time, then the exact
   // distance of those within the bound (which may shrink on the way).
   const Vec2* s = sc.slot_points(first);
   std::uint32_t i = 0;
   for (; i + 1 < count; i += 2) {
     const int mask = rects_within_bound2(s + i, q.p, q.bound_sq);
-    if (mask & 1) closest_offer(q, first + i, s[i], s[i + 1]);
-    if (mask & 2) closest_offer(q, first + i + 1, s[i + 1], s[i + 2]);
+    if (mask & 1) closest_offer(self, q, first + i, s[i], s[i + 1]);
+    if (mask & 2) closest_offer(self, q, first + i + 1, s[i + 1], s[i + 2]);
   }
-  if (i < count && rect_within_bound(q.p, s[i], s[i + 1], q.bound_sq)) closest_offer(q, first + i, s[i], s[i + 1]);
+  if (i < count && rect_within_bound(q.p, s[i], s[i + 1], q.bound_sq)) closest_offer(self, q, first + i, s[i], s[i + 1]);
 }
 
 // Opens node n for the closest-point walk: *next is its nearest child within the bound (kWideEmpty when
 // none is), and the others within it are pushed. False, with *top as it was, when the stack is full.
-[[gnu::always_inline]] inline bool BoundarySection::closest_open_node(const ClosestQuery& q, const WideNode& n, float px, float py, int* top,
-                                                                      std::uint32_t* next) noexcept {
+[[gnu::always_inline]] inline bool BoundarySection::Ops::closest_open_node(BoundarySection& self, const ClosestQuery& q, const WideNode& n, float px, float py, int* top,
+                                                                           std::uint32_t* next) noexcept {
   float d_sq[4];
   const int mask = near_node(n, px, py, q.bound_sq_f, d_sq);
   *next = kWideEmpty;
@@ -125,21 +125,21 @@ void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noe
   const int base = *top;
   for (int i = 0; i < 4; ++i) {
     if (!(mask & (1 << i))) continue;
-    if (!push_walk(std::numeric_limits<float>::infinity(), d_sq[i], n.child[i], base, *top)) {
+    if (!push_walk(self, std::numeric_limits<float>::infinity(), d_sq[i], n.child[i], base, *top)) {
       *top = base;
       return false;
     }
   }
-  *next = walk_.code[static_cast<std::size_t>(--*top)];  // pushed nearest last: on top
+  *next = self.walk_.code[static_cast<std::size_t>(--*top)];  // pushed nearest last: on top
   return true;
 }
 
 // The next entry of the closest-point walk still within the bound, taken off the stack; kWideEmpty when
 // none is left.
-[[gnu::always_inline]] inline std::uint32_t BoundarySection::closest_pop(const ClosestQuery& q, int* top) const noexcept {
+[[gnu::always_inline]] inline std::uint32_t BoundarySection::Ops::closest_pop(const BoundarySection& self, const ClosestQuery& q, int* top) noexcept {
   while (*top > 0) {
     const std::size_t k = static_cast<std::size_t>(--*top);
-    if (static_cast<double>(walk_.d_sq[k]) <= q.bound_sq) return walk_.code[k];
+    if (static_cast<double>(self.walk_.d_sq[k]) <= q.bound_sq) return self.walk_.code[k];
   }
   return kWideEmpty;
 }
@@ -148,24 +148,24 @@ void BoundarySection::closest_test_item(ClosestQuery& q, std::uint32_t item) noe
 // (which only shrinks). At a node the nearest child within the bound is entered at once and the others
 // are pushed, farthest first, for later. False when the budget or the stack ran out (the answer is then
 // unknown).
-bool BoundarySection::closest_walk(ClosestQuery& q, QueryBudget* budget) noexcept {
-  const WideIndex& wi = scene_->wide_index();
+bool BoundarySection::Ops::closest_walk(BoundarySection& self, ClosestQuery& q, QueryBudget* budget) noexcept {
+  const WideIndex& wi = self.scene_->wide_index();
   if (wi.nodes.empty()) return true;
   const float px = static_cast<float>(q.p.x), py = static_cast<float>(q.p.y);
   int top = 0;
   std::uint32_t code = 0u;  // the entry being visited: the root first
   for (;;) {
     if (code & kWideLeaf) {
-      closest_test_item(q, code & ~kWideLeaf);
+      closest_test_item(self, q, code & ~kWideLeaf);
     } else if (budget && !budget->spend(kWideBoxTestsPerNode)) {
       return false;  // the caller sees budget->ran_out
-    } else if (!closest_open_node(q, wi.nodes[code], px, py, &top, &code)) {
+    } else if (!closest_open_node(self, q, wi.nodes[code], px, py, &top, &code)) {
       if (budget) budget->ran_out = true;  // the stack is full: the answer is unknown, as past the budget
       return false;
     } else if (code != kWideEmpty) {
       continue;  // the nearest child, entered at once
     }
-    code = closest_pop(q, &top);
+    code = closest_pop(self, q, &top);
     if (code == kWideEmpty) return true;
   }
 }
@@ -178,8 +178,8 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
   }
   if (scene_->curve_count() == 0) return false;
   ClosestQuery q(p, level, curve, max_distance_m, skip_curves, skip_count);
-  closest_seed(q);
-  const bool complete = wide_serves(level) ? closest_walk(q, budget) : closest_tree_walk(q, budget);
+  Ops::closest_seed(*this, q);
+  const bool complete = Ops::wide_serves(*this, level) ? Ops::closest_walk(*this, q, budget) : Ops::closest_tree_walk(*this, q, budget);
   last_closest_level_ = level;
   last_closest_curve_ = curve;
   last_closest_node_ = complete ? q.best_node : kWideEmpty;
@@ -195,8 +195,8 @@ bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Ve
 // own segment's box, tolerance_cut.hpp). Stops at the walls of q.level (at_target), offering each, joined at a cut
 // step. With a `budget`, each box measured is one optional box test; false when it or the stack ran out (the
 // answer is then unknown, budget->ran_out set).
-bool BoundarySection::closest_tree_walk(ClosestQuery& q, QueryBudget* budget) noexcept {
-  const Scene& sc = *scene_;
+bool BoundarySection::Ops::closest_tree_walk(BoundarySection& self, ClosestQuery& q, QueryBudget* budget) noexcept {
+  const Scene& sc = *self.scene_;
   const Vec2 p = q.p;
   const int curve = q.curve;
   // A node of another curve than `curve`, or of a skipped one, holds nothing to answer (a hierarchy node may: kept).
@@ -213,14 +213,14 @@ bool BoundarySection::closest_tree_walk(ClosestQuery& q, QueryBudget* budget) no
     return (curve >= 0 && c != static_cast<std::uint32_t>(curve)) || q.skips(c);
   };
   int top = 0;
-  stack_[static_cast<std::size_t>(top++)] = Candidate{0.0, sc.scene_root(), kNotAnEntry};  // t_enter: the box's squared distance [m²]
+  self.stack_[static_cast<std::size_t>(top++)] = Candidate{0.0, sc.scene_root(), kNotAnEntry};  // t_enter: the box's squared distance [m²]
   while (top > 0) {
-    const Candidate cur = stack_[static_cast<std::size_t>(--top)];
+    const Candidate cur = self.stack_[static_cast<std::size_t>(--top)];
     if (cur.t_enter > q.bound_sq) continue;  // the bound shrank since it was pushed
-    if (at_target(cur.node, q.level)) {
+    if (at_target(self, cur.node, q.level)) {
       Vec2 a, b;
-      wall_node_points(cur.node, q.level, &a, &b);
-      closest_offer(q, cur.node, a, b);
+      wall_node_points(self, cur.node, q.level, &a, &b);
+      closest_offer(self, q, cur.node, a, b);
       continue;
     }
     std::uint32_t first = 0, count = 0;
@@ -233,12 +233,12 @@ bool BoundarySection::closest_tree_walk(ClosestQuery& q, QueryBudget* budget) no
       if (budget && !budget->spend()) return false;
       const double d_sq = box_distance_sq(sc.box(child), p);
       if (d_sq > q.bound_sq) continue;
-      if (!push(top, Candidate{d_sq, child, kNotAnEntry})) {  // full (never, within the tree's depth): the answer is unknown
+      if (!push(self, top, Candidate{d_sq, child, kNotAnEntry})) {  // full (never, within the tree's depth): the answer is unknown
         if (budget) budget->ran_out = true;
         return false;
       }
     }
-    std::sort(stack_.begin() + base, stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
+    std::sort(self.stack_.begin() + base, self.stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
   }
   return true;
 }
@@ -251,7 +251,7 @@ bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m,
   const Scene& sc = *scene_;
   if (sc.curve_count() == 0) return false;
   ClosestQuery q(p, kCutLevelBase + step, curve, max_distance_m, skip_curves, skip_count);
-  if (!closest_tree_walk(q, budget)) return false;
+  if (!Ops::closest_tree_walk(*this, q, budget)) return false;
   if (!q.found()) return false;
   if (point_out) *point_out = q.best_point;
   if (segment_out) *segment_out = q.best_s;

@@ -44,25 +44,25 @@ bool BoundarySection::wall_neighbour(SegmentRef s, int level, int dir, SegmentRe
 // forgotten at any other. The frontier is the wide one while the wide index serves both ids (wide_frontier), else
 // the tree's; a change of ids that changes which starts the section again from that frontier's root (reset).
 // Called only when the ids change (first_hit).
-void BoundarySection::follow_level(int level) noexcept {
-  const int previous = last_level_, served = other_level_;  // the section serves both
-  other_level_ = previous < 0 ? level : previous;
-  last_level_ = level;
-  const bool wide = wide_frontier(level) && wide_frontier(other_level_);
-  if (previous < 0 || wide != wide_mode_) {  // the other frontier: start it from its root
-    wide_mode_ = wide;
-    reset();
+void BoundarySection::Ops::follow_level(BoundarySection& self, int level) noexcept {
+  const int previous = self.last_level_, served = self.other_level_;  // the section serves both
+  self.other_level_ = previous < 0 ? level : previous;
+  self.last_level_ = level;
+  const bool wide = wide_frontier(self, level) && wide_frontier(self, self.other_level_);
+  if (previous < 0 || wide != self.wide_mode_) {  // the other frontier: start it from its root
+    self.wide_mode_ = wide;
+    self.reset();
     return;
   }
   if (level == previous) return;
-  if (level != ball_levels_[0] && level != ball_levels_[1]) ball_radius_sq_ = 0.0;
-  if (level != served) coarsen_section(level);  // a transition's two ids in turn: nothing to coarsen
+  if (level != self.ball_levels_[0] && level != self.ball_levels_[1]) self.ball_radius_sq_ = 0.0;
+  if (level != served) coarsen_section(self, level);  // a transition's two ids in turn: nothing to coarsen
 }
 
 // The node's ancestor at the walls of `level` on its curve (a segment of that level, or of that cut step's cut)
 // when the node lies below them, else the node itself: up by Scene::parent, O(levels).
-std::uint32_t BoundarySection::wall_ancestor(std::uint32_t node, int level) const noexcept {
-  const Scene& sc = *scene_;
+std::uint32_t BoundarySection::Ops::wall_ancestor(const BoundarySection& self, std::uint32_t node, int level) noexcept {
+  const Scene& sc = *self.scene_;
   if (!sc.is_segment(node)) return node;
   if (!is_cut_level(level)) {
     const int target = sc.clamp_level(sc.tag_curve(node), level);
@@ -71,7 +71,7 @@ std::uint32_t BoundarySection::wall_ancestor(std::uint32_t node, int level) cons
     return a;
   }
   for (std::uint32_t a = sc.parent(node); sc.is_segment(a); a = sc.parent(a)) {  // the cut is a frontier: at most one
-    if (in_cut(cut_mask_, a, level - kCutLevelBase)) return a;
+    if (in_cut(self.cut_mask_, a, level - kCutLevelBase)) return a;
   }
   return node;
 }
@@ -80,36 +80,36 @@ std::uint32_t BoundarySection::wall_ancestor(std::uint32_t node, int level) cons
 // many of its descendants were in), so the section still covers the same stretches of curve, no node with
 // its ancestor. Without room for the ancestors (a section at its storage bound), the section starts again
 // from the root.
-void BoundarySection::coarsen_section(int level) noexcept {
-  const std::size_t n = section_.size();
+void BoundarySection::Ops::coarsen_section(BoundarySection& self, int level) noexcept {
+  const std::size_t n = self.section_.size();
   bool changed = false;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t node = section_[i];
-    const std::uint32_t ancestor = wall_ancestor(node, level);
+    const std::uint32_t node = self.section_[i];
+    const std::uint32_t ancestor = wall_ancestor(self, node, level);
     if (ancestor == node) continue;
-    if (section_.size() >= capacity_) {
-      reset();
+    if (self.section_.size() >= self.capacity_) {
+      self.reset();
       return;
     }
-    mark_out(node, section_parent_[i]);
-    if (!in_section(ancestor)) push_section(ancestor, parent_or_none(ancestor));
+    mark_out(self, node, self.section_parent_[i]);
+    if (!in_section(self, ancestor)) push_section(self, ancestor, parent_or_none(self, ancestor));
     changed = true;
   }
-  if (changed) drop_departed_entries();
+  if (changed) drop_departed_entries(self);
 }
 
 // The section without the entries that left it (kInSection cleared), in order, rectangles with them (after
 // coarsen_section).
-void BoundarySection::drop_departed_entries() noexcept {
+void BoundarySection::Ops::drop_departed_entries(BoundarySection& self) noexcept {
   std::size_t w = 0;
-  for (std::size_t i = 0; i < section_.size(); ++i) {  // every entry copied, kept by advancing w: no branch to mispredict
-    const std::uint32_t node = section_[i];
-    section_rect_.copy(w, i);
-    section_[w] = node;
-    section_parent_[w] = section_parent_[i];
-    w += node_state_[node] & kInSection;
+  for (std::size_t i = 0; i < self.section_.size(); ++i) {  // every entry copied, kept by advancing w: no branch to mispredict
+    const std::uint32_t node = self.section_[i];
+    self.section_rect_.copy(w, i);
+    self.section_[w] = node;
+    self.section_parent_[w] = self.section_parent_[i];
+    w += self.node_state_[node] & kInSection;
   }
-  section_.resize(w);
+  self.section_.resize(w);
 }
 
 }  // namespace hk

@@ -1,7 +1,8 @@
 #pragma once
 // What the files of the collision query share and the public header leaves out: small geometric helpers, the
-// tie-break of answers, one first_hit's state (BoundarySection::Query), and the small member functions its
-// inner loops call from several files, defined inline here so they stay inlined (collision_query.hpp).
+// tie-break of answers, the section's private operations (BoundarySection::Ops, static functions taking the
+// section), one first_hit's state (BoundarySection::Query), and the small operations its inner loops call from
+// several files, defined inline here so they stay inlined (collision_query.hpp).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -128,6 +129,105 @@ inline bool intersect_sweep_segment_inline(Vec2 a, Vec2 b, Vec2 p, Vec2 q, doubl
 // The collision query's files use these helpers unqualified.
 using namespace collision_detail;
 
+// The section's private operations, as static functions of a nested struct (so they reach its members) declared
+// here rather than in the public header: the phases of first_hit, the frontier's edits, the wide and
+// closest-point walks. Each takes the section as its first argument `self`.
+struct BoundarySection::Ops {
+  static bool at_target(const BoundarySection& self, std::uint32_t node, int level) noexcept;
+  static void wall_node_points(const BoundarySection& self, std::uint32_t node, int level, Vec2* a, Vec2* b) noexcept;
+  // The phases of first_hit, in order (each documented where it is defined).
+  [[gnu::cold]] static void follow_level(BoundarySection& self, int level) noexcept;
+  static void coarsen_section(BoundarySection& self, int level) noexcept;
+  static std::uint32_t wall_ancestor(const BoundarySection& self, std::uint32_t node, int level) noexcept;
+  static bool at_floor(const BoundarySection& self, std::uint32_t node, int level) noexcept;
+  static bool inside_free_ball(const BoundarySection& self, Vec2 a, Vec2 b) noexcept;
+  static SweepHit first_hit_near_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
+                                       QueryStats* stats_out) noexcept;
+  static SweepHit first_hit_tree(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
+                                 QueryStats* stats_out) noexcept;
+  // Whether the wide index holds the walls of level id `level` (not a cut step): every curve is at or below its item
+  // level there (wide_index.hpp). The walks of coarser ids go through the tree of error boxes.
+  // A level below 0 is level 0 (Scene::clamp_level).
+  static bool wide_serves(const BoundarySection& self, int level) noexcept { return level < kCutLevelBase && self.wide_serves_[static_cast<std::size_t>(std::max(level, 0))]; }
+  static bool answer_from_ball_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, SweepHit* out,
+                                     QueryStats* stats) noexcept;
+  static void copy_ball_walls(BoundarySection& self) noexcept;
+  static void next_tick(BoundarySection& self) noexcept;
+  static void clip_section(BoundarySection& self, Query& q) noexcept;
+  static std::size_t scan_section_rects(BoundarySection& self, const Query& q) noexcept;
+  static void mark_near_rects(BoundarySection& self, double bound_sq, std::size_t skip) noexcept;
+  static void refine_candidates(BoundarySection& self, Query& q) noexcept;
+  static bool push_hit_children(BoundarySection& self, Query& q, std::uint32_t node, int& top) noexcept;
+  static bool push_wide_children(BoundarySection& self, Query& q, std::uint32_t node, int& top) noexcept;
+  static std::uint32_t segments_under(const BoundarySection& self, std::uint32_t node, int level, std::uint32_t* first) noexcept;
+  static bool test_segments_under(BoundarySection& self, Query& q, std::uint32_t node) noexcept;
+  static void test_segment(BoundarySection& self, Query& q, std::uint32_t node) noexcept;
+  static void test_level_run(BoundarySection& self, Query& q, std::uint32_t first, std::uint32_t count) noexcept;
+  static void split_hit_boxes(BoundarySection& self, Query& q) noexcept;
+  static void merge_idle_siblings(BoundarySection& self, Query& q) noexcept;
+  static void merge_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
+  static void merge_check_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
+  static void pay_merge_debt(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats* stats) noexcept;
+  static bool merge_if_clear(BoundarySection& self, std::size_t e, std::uint32_t parent, const std::uint32_t* child, std::uint32_t count, Vec2 a, Vec2 b) noexcept;
+  static void gather_ball_walls(BoundarySection& self, const Query& q) noexcept;
+  static std::size_t nearest_rect_left(const BoundarySection& self, std::size_t n) noexcept;
+  static void place_free_ball(BoundarySection& self, const Query& q) noexcept;
+  static void drop_departed_entries(BoundarySection& self) noexcept;
+  static SweepHit finish(const BoundarySection& self, Query& q) noexcept;
+  static void split(BoundarySection& self, std::uint32_t node, std::size_t entry) noexcept;
+  static void split_wide(BoundarySection& self, std::uint32_t node, std::size_t entry) noexcept;
+  static void set_section_entry(BoundarySection& self, std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept;
+  static void place_entry(BoundarySection& self, std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept;
+  static void remove_section_entry(BoundarySection& self, std::size_t entry) noexcept;
+  static bool merge_children(BoundarySection& self, std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count) noexcept;
+  // The wide frontier (collision_query.hpp, before wide_mode_): whether it serves `level`, and its section ids.
+  static bool wide_frontier(const BoundarySection& self, int level) noexcept { return wide_serves(self, level) && !self.scene_->wide_index().nodes.empty(); }
+  static bool is_wide_id(const BoundarySection& self, std::uint32_t id) noexcept { return id >= self.wide_base_; }
+  // The section id of a wide node's child code (WideNode::child, not kWideEmpty): an item's segment node, or a wide node.
+  static std::uint32_t wide_child_id(const BoundarySection& self, std::uint32_t code) noexcept { return (code & kWideLeaf) ? (code & ~kWideLeaf) : self.wide_base_ + code; }
+  static Aabb entry_rect(const BoundarySection& self, std::uint32_t id) noexcept;
+  static ErrorBox entry_box(const BoundarySection& self, std::uint32_t id) noexcept;
+  static ErrorBox entry_box_at(const BoundarySection& self, std::size_t entry) noexcept;
+  static std::uint32_t entry_children(const BoundarySection& self, std::uint32_t id, std::uint32_t* out) noexcept;
+  static std::uint32_t child_count(const BoundarySection& self, std::uint32_t id) noexcept;
+  static void link_wide_nodes(BoundarySection& self);
+  static std::uint32_t item_segments(const BoundarySection& self, std::uint32_t item, int level, std::uint32_t* first) noexcept;
+  static bool push_walk(BoundarySection& self, float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept;
+  static void wide_test_item(BoundarySection& self, Query& q, std::uint32_t item) noexcept;
+  static double wide_walk(BoundarySection& self, Query& q, double ball_cap_m) noexcept;
+  static float seeded_ball_sq(const BoundarySection& self, const WideIndex& wi, float bx, float by, float cap_sq) noexcept;
+  // Appends node with its rectangle and marks it in (the caller checked the room); parent: parent_or_none(node).
+  static void push_section(BoundarySection& self, std::uint32_t node, std::uint32_t parent) noexcept;
+  static std::uint32_t parent_or_none(const BoundarySection& self, std::uint32_t node) noexcept;
+  static void mark_out(BoundarySection& self, std::uint32_t node, std::uint32_t parent) noexcept;
+  static bool in_section(const BoundarySection& self, std::uint32_t node) noexcept { return (self.node_state_[node] & kInSection) != 0; }
+  static std::uint32_t children_in(const BoundarySection& self, std::uint32_t node) noexcept { return self.node_state_[node] / kChildInUnit; }
+  static void clear_state(BoundarySection& self, std::uint32_t node, std::uint8_t bits) noexcept { self.node_state_[node] &= static_cast<std::uint8_t>(~bits); }
+  /// Checked push onto the DFS stack (sized by hk::tree_stack_entries): false, and nothing pushed, when it
+  /// is full, which a tree within kMaxLevels + kMaxHierarchyDepth levels never fills.
+  static bool push(BoundarySection& self, int& top, Candidate c) noexcept {
+    if (static_cast<std::size_t>(top) >= self.stack_.size()) return false;
+    self.stack_[static_cast<std::size_t>(top++)] = c;
+    return true;
+  }
+  // Checked: a node is marked at most once per bit in a query, and only section entries (kHitMark) and their
+  // parents (kCheckedMark) are, so the list never fills; were it full, the mark is not set, which costs only work
+  // (a hit entry's parent box meets the sweep too, so it is not merged; a parent may be checked twice).
+  static void mark(BoundarySection& self, std::uint32_t node, std::uint8_t bit) noexcept {
+    if (self.marked_count_ == self.marked_.size()) return;
+    self.node_state_[node] |= bit;
+    self.marked_[self.marked_count_++] = node;
+  }
+  static void clear_marks(BoundarySection& self) noexcept;
+  static void closest_seed(const BoundarySection& self, ClosestQuery& q) noexcept;
+  static bool closest_walk(BoundarySection& self, ClosestQuery& q, QueryBudget* budget) noexcept;
+  static bool closest_tree_walk(BoundarySection& self, ClosestQuery& q, QueryBudget* budget) noexcept;
+  static void closest_test_item(BoundarySection& self, ClosestQuery& q, std::uint32_t item) noexcept;
+  static bool closest_open_node(BoundarySection& self, const ClosestQuery& q, const WideNode& n, float px, float py, int* top, std::uint32_t* next) noexcept;
+  static std::uint32_t closest_pop(const BoundarySection& self, const ClosestQuery& q, int* top) noexcept;
+  static void closest_offer(const BoundarySection& self, ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) noexcept;
+};
+
 // One query's inputs, answer so far and counters, passed to each phase of first_hit.
 struct BoundarySection::Query {
   Vec2 a, b;                    // the sweep [m]
@@ -195,81 +295,81 @@ struct BoundarySection::Query {
   double horizon() const noexcept { return std::min(best.t, unresolved_t); }
 };
 
-// ---- Small member functions the phases in several files call, inline so that they stay inlined ----
+// ---- Small operations the phases in several files call, inline so that they stay inlined ----
 
 // at_target_level, and for a cut step the cut's own segments. A walk comes down from the roots and stops at
 // the first cut segment on its way, so it never reaches a node below the cut.
-inline bool BoundarySection::at_target(std::uint32_t node, int level) const noexcept {
-  if (is_cut_level(level)) return scene_->is_segment(node) && in_cut(cut_mask_, node, level - kCutLevelBase);
-  return at_target_level(*scene_, node, level);
+inline bool BoundarySection::Ops::at_target(const BoundarySection& self, std::uint32_t node, int level) noexcept {
+  if (is_cut_level(level)) return self.scene_->is_segment(node) && in_cut(self.cut_mask_, node, level - kCutLevelBase);
+  return at_target_level(*self.scene_, node, level);
 }
 
 // The end points of wall node `node` (at_target of `level`, already walls_of): joined at a cut step, else the
 // segment's own.
-inline void BoundarySection::wall_node_points(std::uint32_t node, int level, Vec2* a, Vec2* b) const noexcept {
+inline void BoundarySection::Ops::wall_node_points(const BoundarySection& self, std::uint32_t node, int level, Vec2* a, Vec2* b) noexcept {
   if (is_cut_level(level)) {
-    joined_cut_segment(*scene_, cut_mask_, node, level - kCutLevelBase, a, b);
+    joined_cut_segment(*self.scene_, self.cut_mask_, node, level - kCutLevelBase, a, b);
   } else {
-    scene_->segment_points(node, a, b);
+    self.scene_->segment_points(node, a, b);
   }
 }
 
 // Splits stop here: a segment node at the walls of either id the section serves (so at the coarser of the
 // two; the section's entries are never below either, follow_level).
-inline bool BoundarySection::at_floor(std::uint32_t node, int level) const noexcept {
-  return at_target(node, level) || at_target(node, other_level_);
+inline bool BoundarySection::Ops::at_floor(const BoundarySection& self, std::uint32_t node, int level) noexcept {
+  return at_target(self, node, level) || at_target(self, node, self.other_level_);
 }
 
 // The box of section id `id`: a scene node's (Scene::box), or a wide node's rectangle as an axis-aligned box (as
 // Scene::box gives a chunk's).
-inline ErrorBox BoundarySection::entry_box(std::uint32_t id) const noexcept {
-  if (!is_wide_id(id)) return scene_->box(id);
-  return rect_box(entry_rect(id));
+inline ErrorBox BoundarySection::Ops::entry_box(const BoundarySection& self, std::uint32_t id) noexcept {
+  if (!is_wide_id(self, id)) return self.scene_->box(id);
+  return rect_box(entry_rect(self, id));
 }
 
 // entry_box of section entry i, for a wide node read from the section's own rectangle rather than the index: its
 // slot's in its parent, stored as it is by a split (split_wide) or widened outward a little (set_section_entry);
 // either holds everything under the node.
-inline ErrorBox BoundarySection::entry_box_at(std::size_t i) const noexcept {
-  const std::uint32_t id = section_[i];
-  if (!is_wide_id(id)) return scene_->box(id);
-  const SectionRects& r = section_rect_;
+inline ErrorBox BoundarySection::Ops::entry_box_at(const BoundarySection& self, std::size_t i) noexcept {
+  const std::uint32_t id = self.section_[i];
+  if (!is_wide_id(self, id)) return self.scene_->box(id);
+  const SectionRects& r = self.section_rect_;
   return rect_box(Aabb{{r.lo_x[i], r.lo_y[i]}, {r.hi_x[i], r.hi_y[i]}});
 }
 
 // How many children section id `id` has in the frontier's hierarchy (entry_children's count), cheaply.
-inline std::uint32_t BoundarySection::child_count(std::uint32_t id) const noexcept {
-  if (is_wide_id(id)) {
-    const WideNode& n = scene_->wide_index().nodes[id - wide_base_];
+inline std::uint32_t BoundarySection::Ops::child_count(const BoundarySection& self, std::uint32_t id) noexcept {
+  if (is_wide_id(self, id)) {
+    const WideNode& n = self.scene_->wide_index().nodes[id - self.wide_base_];
     return static_cast<std::uint32_t>((n.child[0] != kWideEmpty) + (n.child[1] != kWideEmpty) + (n.child[2] != kWideEmpty) +
                                       (n.child[3] != kWideEmpty));
   }
   std::uint32_t first = 0, count = 0;
-  scene_->children(id, &first, &count);
+  self.scene_->children(id, &first, &count);
   return count;
 }
 
 // Marks a node out of the section, and no longer counted among its parent's children in.
-inline void BoundarySection::mark_out(std::uint32_t node, std::uint32_t parent) noexcept {
-  clear_state(node, kInSection);
-  if (parent != kNoParent) node_state_[parent] = static_cast<std::uint8_t>(node_state_[parent] - kChildInUnit);  // it was counted
+inline void BoundarySection::Ops::mark_out(BoundarySection& self, std::uint32_t node, std::uint32_t parent) noexcept {
+  clear_state(self, node, kInSection);
+  if (parent != kNoParent) self.node_state_[parent] = static_cast<std::uint8_t>(self.node_state_[parent] - kChildInUnit);  // it was counted
 }
 
-inline void BoundarySection::next_tick() noexcept { ++tick_; }  // wraps harmlessly: it only turns the merges' round robin
+inline void BoundarySection::Ops::next_tick(BoundarySection& self) noexcept { ++self.tick_; }  // wraps harmlessly: it only turns the merges' round robin
 
 // The end of a full query: every mark its phases set, cleared (the next query starts with none).
-inline void BoundarySection::clear_marks() noexcept {
-  for (std::size_t i = 0; i < marked_count_; ++i) clear_state(marked_[i], kMarks);
-  marked_count_ = 0;
+inline void BoundarySection::Ops::clear_marks(BoundarySection& self) noexcept {
+  for (std::size_t i = 0; i < self.marked_count_; ++i) clear_state(self, self.marked_[i], kMarks);
+  self.marked_count_ = 0;
 }
 
 // Free-space ball (seed §3: "distances to the boxes ... can be used to schedule box updates"): the
 // last full query proved that no box of the section comes within the ball's radius of ball_center_m_, and
 // those boxes covered every wall of the level ids it served (ball_levels_; follow_level forgets the ball for
 // any other id). A sweep inside that ball cannot hit anything: answer at once.
-inline bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
-  const double r_sq = ball_radius_sq_;
-  const Vec2 da = a - ball_center_m_, db = b - ball_center_m_;
+inline bool BoundarySection::Ops::inside_free_ball(const BoundarySection& self, Vec2 a, Vec2 b) noexcept {
+  const double r_sq = self.ball_radius_sq_;
+  const Vec2 da = a - self.ball_center_m_, db = b - self.ball_center_m_;
   return (dot(da, da) < r_sq) & (dot(db, db) < r_sq);  // r = 0 (unknown) admits nothing; & : one branch, not two
 }
 
@@ -277,8 +377,8 @@ inline bool BoundarySection::inside_free_ball(Vec2 a, Vec2 b) const noexcept {
 // 2^kDirectLevels) and, in *first, the first one's node (they are consecutive nodes, whose points are
 // consecutive too); 0 for any other node (a chunk or above, a node farther above its walls, a cut step's
 // walls, which are of mixed levels). The node must not lie below the walls (no section entry does).
-inline std::uint32_t BoundarySection::segments_under(std::uint32_t node, int level, std::uint32_t* first) const noexcept {
-  const Scene& sc = *scene_;
+inline std::uint32_t BoundarySection::Ops::segments_under(const BoundarySection& self, std::uint32_t node, int level, std::uint32_t* first) noexcept {
+  const Scene& sc = *self.scene_;
   if (!sc.is_segment(node) || is_cut_level(level)) return 0;
   const std::uint32_t c = sc.tag_curve(node);
   const int l = sc.tag_level(node);
@@ -292,9 +392,9 @@ inline std::uint32_t BoundarySection::segments_under(std::uint32_t node, int lev
 // test_segment for the `count` consecutive segment nodes of one level of one curve from `first` (not a cut step's),
 // with what they share found once: their curve and level (their indices run on from the first's) and their points
 // (consecutive slots), each its own level's wall.
-inline void BoundarySection::test_level_run(Query& q, std::uint32_t first, std::uint32_t count) noexcept {
-  const NodeInfo in = scene_->info(first);
-  const Vec2* pts = scene_->slot_points(first);
+inline void BoundarySection::Ops::test_level_run(BoundarySection& self, Query& q, std::uint32_t first, std::uint32_t count) noexcept {
+  const NodeInfo in = self.scene_->info(first);
+  const Vec2* pts = self.scene_->slot_points(first);
   for (std::uint32_t i = 0; i < count; ++i) {
     const SegmentRef ref{static_cast<std::int32_t>(in.curve), in.level, static_cast<std::int32_t>(in.index + i)};
     if (!q.is_excluded(ref)) q.test_wall(ref, pts[i], pts[i + 1]);
@@ -304,8 +404,8 @@ inline void BoundarySection::test_level_run(Query& q, std::uint32_t first, std::
 // The segments a walk tests at an item (segment node `item` of the item level): the target level's segments
 // under it (the item itself at the item level). Writes the first node and returns the count. The walks of the
 // wide index take only the level ids it serves (wide_serves), whose level is at or below every curve's items.
-inline std::uint32_t BoundarySection::item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept {
-  const Scene& sc = *scene_;
+inline std::uint32_t BoundarySection::Ops::item_segments(const BoundarySection& self, std::uint32_t item, int level, std::uint32_t* first) noexcept {
+  const Scene& sc = *self.scene_;
   const std::uint32_t c = sc.tag_curve(item);
   const int k_level = sc.tag_level(item);
   const CurveNodes& cn = sc.curve_nodes(c);
@@ -318,11 +418,11 @@ inline std::uint32_t BoundarySection::item_segments(std::uint32_t item, int leve
 // Checked push onto the wide walks' stack, in order: among the entries pushed since `base` (a node's
 // children, at most four) the one nearest to the walk's point ends on top. False, with nothing pushed,
 // when the stack is full.
-[[gnu::always_inline]] inline bool BoundarySection::push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept {
-  if (static_cast<std::size_t>(top) >= walk_.size()) return false;
-  float* t = walk_.t_enter.data();
-  float* d = walk_.d_sq.data();
-  std::uint32_t* c = walk_.code.data();
+[[gnu::always_inline]] inline bool BoundarySection::Ops::push_walk(BoundarySection& self, float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept {
+  if (static_cast<std::size_t>(top) >= self.walk_.size()) return false;
+  float* t = self.walk_.t_enter.data();
+  float* d = self.walk_.d_sq.data();
+  std::uint32_t* c = self.walk_.code.data();
   int k = top++;
   for (; k > base && d[k - 1] < d_sq; --k) {
     t[k] = t[k - 1];

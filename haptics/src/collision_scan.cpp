@@ -10,33 +10,33 @@ namespace hk {
 // rectangles settle most entries: scan_section_rects bounds them all (four per SSE instruction), and only
 // the entries whose rectangle meets the sweep, or is nearer than the nearest box found, have their box
 // rebuilt. An entry not hit is idle (no kHitMark): merge_idle_siblings may merge it.
-void BoundarySection::clip_section(Query& q) noexcept {
-  candidates_.clear();
-  const std::size_t n_section = section_.size();
+void BoundarySection::Ops::clip_section(BoundarySection& self, Query& q) noexcept {
+  self.candidates_.clear();
+  const std::size_t n_section = self.section_.size();
   q.scanned = n_section;
   q.charge_section_boxes(static_cast<std::int32_t>(n_section));
-  const std::size_t nearest_rect = scan_section_rects(q);
+  const std::size_t nearest_rect = scan_section_rects(self, q);
   q.nearest_rect = nearest_rect;
   if (nearest_rect == n_section) return;  // an empty section (an empty scene)
   // The free-space ball: the nearest box. A rectangle holds its box, so a box is nearer than the nearest found
   // so far only when its rectangle is; starting from the box of the nearest rectangle leaves few others to
   // rebuild. The minimum is the same whatever the order.
-  q.nearest_sq = box_distance_sq(entry_box_at(nearest_rect), q.b);
-  mark_near_rects(q.nearest_sq, nearest_rect);
+  q.nearest_sq = box_distance_sq(entry_box_at(self, nearest_rect), q.b);
+  mark_near_rects(self, q.nearest_sq, nearest_rect);
   const std::size_t words = (n_section + 63) / 64;
   for (std::size_t w = 0; w < words; ++w) {
-    for (std::uint64_t m = rect_overlap_bits_[w] | rect_near_bits_[w]; m != 0; m &= m - 1) {
+    for (std::uint64_t m = self.rect_overlap_bits_[w] | self.rect_near_bits_[w]; m != 0; m &= m - 1) {
       const std::size_t i = 64 * w + static_cast<std::size_t>(__builtin_ctzll(m));
       if (i >= n_section) break;  // past the end: the last group's far entries (never marked)
-      const std::uint32_t node = section_[i];
+      const std::uint32_t node = self.section_[i];
       const std::uint64_t bit = std::uint64_t{1} << (i % 64);
-      const ErrorBox box = entry_box_at(i);
-      if (rect_near_bits_[w] & bit) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
+      const ErrorBox box = entry_box_at(self, i);
+      if (self.rect_near_bits_[w] & bit) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
       double te = 0.0, tx = 0.0;
-      if ((rect_overlap_bits_[w] & bit) && clip_segment_box_inline(box, q.a, q.b, merge_margin_m_, &te, &tx)) {
-        mark(node, kHitMark);
+      if ((self.rect_overlap_bits_[w] & bit) && clip_segment_box_inline(box, q.a, q.b, self.merge_margin_m_, &te, &tx)) {
+        mark(self, node, kHitMark);
         ++q.hit;
-        if (clip_segment_box_inline(box, q.a, q.b, 0.0, &te, &tx)) candidates_.push_back({te, node, static_cast<std::uint32_t>(i)});
+        if (clip_segment_box_inline(box, q.a, q.b, 0.0, &te, &tx)) self.candidates_.push_back({te, node, static_cast<std::uint32_t>(i)});
       }
     }
   }
@@ -54,23 +54,23 @@ void BoundarySection::clip_section(Query& q) noexcept {
 // be, and the four past the section are made infinitely far (SectionRects::set_far_group), so the last group's extra
 // lanes measure +inf and meet nothing. Returns the entry of the nearest rectangle by these bounds (the first of
 // equals; section_.size() when it is empty).
-std::size_t BoundarySection::scan_section_rects(const Query& q) noexcept {
-  const std::size_t n = section_.size();
-  const float* lo_x = section_rect_.lo_x.data();
-  const float* lo_y = section_rect_.lo_y.data();
-  const float* hi_x = section_rect_.hi_x.data();
-  const float* hi_y = section_rect_.hi_y.data();
-  float* d_sq = rect_d_sq_.data();
-  QuadBitWriter overlap{rect_overlap_bits_.data()};
+std::size_t BoundarySection::Ops::scan_section_rects(BoundarySection& self, const Query& q) noexcept {
+  const std::size_t n = self.section_.size();
+  const float* lo_x = self.section_rect_.lo_x.data();
+  const float* lo_y = self.section_rect_.lo_y.data();
+  const float* hi_x = self.section_rect_.hi_x.data();
+  const float* hi_y = self.section_rect_.hi_y.data();
+  float* d_sq = self.rect_d_sq_.data();
+  QuadBitWriter overlap{self.rect_overlap_bits_.data()};
   // The sweep's rectangle grown by the margin, widened outward as the entries' are: an entry may meet it when
   // lo ≤ s_hi and s_lo ≤ hi.
-  const double m = merge_margin_m_;
+  const double m = self.merge_margin_m_;
   const float s_lo_x = float_below(q.sweep.lo.x - m), s_lo_y = float_below(q.sweep.lo.y - m);
   const float s_hi_x = float_above(q.sweep.hi.x + m), s_hi_y = float_above(q.sweep.hi.y + m);
   const float px = static_cast<float>(q.b.x), py = static_cast<float>(q.b.y);
-  const double largest = std::max({scale_m_, std::abs(q.b.x), std::abs(q.b.y)});
+  const double largest = std::max({self.scale_m_, std::abs(q.b.x), std::abs(q.b.y)});
   const float slack = float_above(1e-12 + largest * 0x1p-20);
-  section_rect_.set_far_group(n);  // the last group's entries past the section
+  self.section_rect_.set_far_group(n);  // the last group's entries past the section
   std::size_t nearest = n;
   std::size_t i = 0;
 #if defined(__SSE2__)
@@ -114,11 +114,11 @@ std::size_t BoundarySection::scan_section_rects(const Query& q) noexcept {
 // The entries whose rectangle may be nearer to the sweep's end than bound_sq [m²] (their distance bound is
 // below it, rounded up to a float), but for `skip` (whose box was measured already): bit i % 64 of
 // rect_near_bits_[i / 64]. In groups of four, as scan_section_rects.
-void BoundarySection::mark_near_rects(double bound_sq, std::size_t skip) noexcept {
-  const std::size_t n = section_.size();
-  const float* d_sq = rect_d_sq_.data();
+void BoundarySection::Ops::mark_near_rects(BoundarySection& self, double bound_sq, std::size_t skip) noexcept {
+  const std::size_t n = self.section_.size();
+  const float* d_sq = self.rect_d_sq_.data();
   const float bound = float_above(bound_sq);
-  QuadBitWriter near{rect_near_bits_.data()};
+  QuadBitWriter near{self.rect_near_bits_.data()};
   std::size_t i = 0;
   for (; i < n; i += kScanLanes) {
 #if defined(__SSE2__)
@@ -130,7 +130,7 @@ void BoundarySection::mark_near_rects(double bound_sq, std::size_t skip) noexcep
 #endif
   }
   near.finish(i);
-  rect_near_bits_[skip / 64] &= ~(std::uint64_t{1} << (skip % 64));
+  self.rect_near_bits_[skip / 64] &= ~(std::uint64_t{1} << (skip % 64));
 }
 
 }  // namespace hk

@@ -59,7 +59,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   stack_.resize(std::max(tree_stack_entries(widest_root), wi.stack_entries() + static_cast<std::size_t>(kMaxLevels)));
   marked_.assign(2 * capacity_, 0);
   walk_.resize(wi.stack_entries());
-  link_wide_nodes();
+  Ops::link_wide_nodes(*this);
   // The level ids whose walls the wide index holds: those at which every curve is at or below its item level.
   for (int id = 0; id < kCutLevelBase; ++id) {
     bool served = true;
@@ -80,9 +80,9 @@ std::size_t BoundarySection::bytes() const noexcept {
 void BoundarySection::reset() noexcept {
   last_closest_node_ = kWideEmpty;  // a reset section answers like a new one, box test for box test
   for (std::size_t i = 0; i < section_.size(); ++i) {
-    clear_state(section_[i], kInSection);
+    Ops::clear_state(*this, section_[i], kInSection);
     // Only a section node's parent counts any children in.
-    if (section_parent_[i] != kNoParent) clear_state(section_parent_[i], kChildrenInMask);
+    if (section_parent_[i] != kNoParent) Ops::clear_state(*this, section_parent_[i], kChildrenInMask);
   }
   section_.clear();
   ball_radius_sq_ = 0.0;
@@ -93,62 +93,62 @@ void BoundarySection::reset() noexcept {
   wide_ball_radius_m_ = 0.0;
   wide_ball_seed_ = kWideEmpty;
   if (scene_->curve_count() == 0) return;
-  push_section(wide_mode_ ? wide_base_ : scene_->scene_root(), kNoParent);
+  Ops::push_section(*this, wide_mode_ ? wide_base_ : scene_->scene_root(), kNoParent);
 }
 
-void BoundarySection::push_section(std::uint32_t node, std::uint32_t parent) noexcept {
-  section_.push_back(node);  // within the reserved capacity: no allocation
-  set_section_entry(section_.size() - 1, node, parent);
+void BoundarySection::Ops::push_section(BoundarySection& self, std::uint32_t node, std::uint32_t parent) noexcept {
+  self.section_.push_back(node);  // within the reserved capacity: no allocation
+  set_section_entry(self, self.section_.size() - 1, node, parent);
 }
 
 // Puts node in the section at `entry` in place of the entry's node, with its rectangle, and marks it in and
 // counted among its parent's children in (`parent`: Scene::parent(node), or kNoParent for the root). The caller
 // marks the node it replaces out (mark_out).
-void BoundarySection::set_section_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept {
-  section_rect_.set(entry, entry_rect(node));
-  place_entry(entry, node, parent);
+void BoundarySection::Ops::set_section_entry(BoundarySection& self, std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept {
+  self.section_rect_.set(entry, entry_rect(self, node));
+  place_entry(self, entry, node, parent);
 }
 
 // set_section_entry but for the rectangle, which the caller stores.
-void BoundarySection::place_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept {
-  section_[entry] = node;
-  section_parent_[entry] = parent;
-  node_state_[node] |= kInSection;
+void BoundarySection::Ops::place_entry(BoundarySection& self, std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept {
+  self.section_[entry] = node;
+  self.section_parent_[entry] = parent;
+  self.node_state_[node] |= kInSection;
   // The count stays within its bits: at most the widest fan-out, checked at construction.
-  if (parent != kNoParent) node_state_[parent] = static_cast<std::uint8_t>(node_state_[parent] + kChildInUnit);
+  if (parent != kNoParent) self.node_state_[parent] = static_cast<std::uint8_t>(self.node_state_[parent] + kChildInUnit);
 }
 
 // The parent of section id `node` in the frontier's hierarchy, or kNoParent for its root. The tree's: Scene::parent
 // (the scene root's parent is itself). The wide frontier's: a wide node's is the wide node naming it, an item's the
 // wide node whose slot names it, below the items Scene::parent.
-std::uint32_t BoundarySection::parent_or_none(std::uint32_t node) const noexcept {
-  const Scene& sc = *scene_;
-  if (wide_mode_) {
-    if (is_wide_id(node)) {
-      const std::uint32_t up = wide_up_[node - wide_base_];
-      return up == kNoParent ? kNoParent : wide_base_ + (up >> 2);
+std::uint32_t BoundarySection::Ops::parent_or_none(const BoundarySection& self, std::uint32_t node) noexcept {
+  const Scene& sc = *self.scene_;
+  if (self.wide_mode_) {
+    if (is_wide_id(self, node)) {
+      const std::uint32_t up = self.wide_up_[node - self.wide_base_];
+      return up == kNoParent ? kNoParent : self.wide_base_ + (up >> 2);
     }
     const std::uint32_t c = sc.tag_curve(node);
     const CurveNodes& cn = sc.curve_nodes(c);
     const int item = wide_item_level(static_cast<int>(cn.levels));
-    if (sc.tag_level(node) == item) return wide_base_ + (item_up_[item_first_[c] + (node - cn.box_offset[item])] >> 2);
+    if (sc.tag_level(node) == item) return self.wide_base_ + (self.item_up_[self.item_first_[c] + (node - cn.box_offset[item])] >> 2);
   }
   return node == sc.scene_root() ? kNoParent : sc.parent(node);
 }
 
 // The wide frontier's links (wide_up_, item_up_, item_first_) and the root's rectangle, from the index. O(wide nodes).
-void BoundarySection::link_wide_nodes() {
-  const Scene& sc = *scene_;
+void BoundarySection::Ops::link_wide_nodes(BoundarySection& self) {
+  const Scene& sc = *self.scene_;
   const WideIndex& wi = sc.wide_index();
-  item_first_.assign(sc.curve_count(), 0);
+  self.item_first_.assign(sc.curve_count(), 0);
   std::uint32_t items = 0;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {  // items numbered curve by curve
-    item_first_[c] = items;
+    self.item_first_[c] = items;
     items += sc.curve(c).segment_count[wide_item_level(sc.curve(c).levels)];
   }
-  item_up_.assign(items, kNoParent);
-  wide_up_.assign(wi.nodes.size(), kNoParent);
-  if (!wi.nodes.empty()) wi.node_rect(0, &wide_root_rect_.lo, &wide_root_rect_.hi);
+  self.item_up_.assign(items, kNoParent);
+  self.wide_up_.assign(wi.nodes.size(), kNoParent);
+  if (!wi.nodes.empty()) wi.node_rect(0, &self.wide_root_rect_.lo, &self.wide_root_rect_.hi);
   for (std::uint32_t w = 0; w < wi.nodes.size(); ++w) {
     const WideNode& nd = wi.nodes[w];
     for (std::uint32_t i = 0; i < 4; ++i) {
@@ -158,9 +158,9 @@ void BoundarySection::link_wide_nodes() {
         const std::uint32_t item = code & ~kWideLeaf;
         const std::uint32_t c = sc.tag_curve(item);
         const std::uint32_t k = item - sc.curve_nodes(c).box_offset[sc.tag_level(item)];
-        item_up_[item_first_[c] + k] = w << 2 | i;
+        self.item_up_[self.item_first_[c] + k] = w << 2 | i;
       } else {
-        wide_up_[code] = w << 2 | i;
+        self.wide_up_[code] = w << 2 | i;
       }
     }
   }
@@ -168,11 +168,11 @@ void BoundarySection::link_wide_nodes() {
 
 // The rectangle of section id `id` [m]: a wide node's, its slot's in its parent (the root's, its slots' union); a
 // scene node's, Scene::aabb.
-Aabb BoundarySection::entry_rect(std::uint32_t id) const noexcept {
-  if (!is_wide_id(id)) return scene_->aabb(id);
-  const std::uint32_t up = wide_up_[id - wide_base_];
-  if (up == kNoParent) return wide_root_rect_;
-  const WideNode& n = scene_->wide_index().nodes[up >> 2];
+Aabb BoundarySection::Ops::entry_rect(const BoundarySection& self, std::uint32_t id) noexcept {
+  if (!is_wide_id(self, id)) return self.scene_->aabb(id);
+  const std::uint32_t up = self.wide_up_[id - self.wide_base_];
+  if (up == kNoParent) return self.wide_root_rect_;
+  const WideNode& n = self.scene_->wide_index().nodes[up >> 2];
   const std::uint32_t i = up & 3u;
   return Aabb{{n.lo_x[i], n.lo_y[i]}, {n.hi_x[i], n.hi_y[i]}};
 }
@@ -180,64 +180,64 @@ Aabb BoundarySection::entry_rect(std::uint32_t id) const noexcept {
 // The children of section id `id` in the frontier's hierarchy, written to out (at most kMaxEntryChildren); returns
 // their count. A wide node's: its slots' wide nodes and items, empty slots left out; a scene node's: Scene::children
 // (the wide frontier never holds a scene node above the items).
-std::uint32_t BoundarySection::entry_children(std::uint32_t id, std::uint32_t* out) const noexcept {
-  if (is_wide_id(id)) {
-    const WideNode& nd = scene_->wide_index().nodes[id - wide_base_];
+std::uint32_t BoundarySection::Ops::entry_children(const BoundarySection& self, std::uint32_t id, std::uint32_t* out) noexcept {
+  if (is_wide_id(self, id)) {
+    const WideNode& nd = self.scene_->wide_index().nodes[id - self.wide_base_];
     std::uint32_t count = 0;
     for (std::uint32_t code : nd.child) {
       if (code == kWideEmpty) continue;
-      out[count++] = wide_child_id(code);
+      out[count++] = wide_child_id(self, code);
     }
     return count;
   }
   std::uint32_t first = 0, count = 0;
-  scene_->children(id, &first, &count);
+  self.scene_->children(id, &first, &count);
   for (std::uint32_t i = 0; i < count; ++i) out[i] = first + i;
   return count;
 }
 
 // Takes the entry out: the last entry moves into its place (the order of entries is no answer's business).
-void BoundarySection::remove_section_entry(std::size_t entry) noexcept {
-  const std::size_t last = section_.size() - 1;
+void BoundarySection::Ops::remove_section_entry(BoundarySection& self, std::size_t entry) noexcept {
+  const std::size_t last = self.section_.size() - 1;
   if (entry != last) {
-    section_rect_.copy(entry, last);
-    section_[entry] = section_[last];
-    section_parent_[entry] = section_parent_[last];
+    self.section_rect_.copy(entry, last);
+    self.section_[entry] = self.section_[last];
+    self.section_parent_[entry] = self.section_parent_[last];
   }
-  section_.pop_back();
+  self.section_.pop_back();
 }
 
 // Splits the node at section entry `entry` into its children: the first takes its place, the others are
 // appended, so no entry is left to drop. Without room the node stays (a box holds its children's walls).
-void BoundarySection::split(std::uint32_t node, std::size_t entry) noexcept {
-  if (is_wide_id(node)) {
-    split_wide(node, entry);
+void BoundarySection::Ops::split(BoundarySection& self, std::uint32_t node, std::size_t entry) noexcept {
+  if (is_wide_id(self, node)) {
+    split_wide(self, node, entry);
     return;
   }
   std::uint32_t first = 0, count = 0;
-  scene_->children(node, &first, &count);
-  if (count == 0 || !in_section(node)) return;
-  if (section_.size() + count + 8 > capacity_) return;  // full: keep the node
-  mark_out(node, section_parent_[entry]);
-  set_section_entry(entry, first, node);
-  for (std::uint32_t i = 1; i < count; ++i) push_section(first + i, node);
+  self.scene_->children(node, &first, &count);
+  if (count == 0 || !in_section(self, node)) return;
+  if (self.section_.size() + count + 8 > self.capacity_) return;  // full: keep the node
+  mark_out(self, node, self.section_parent_[entry]);
+  set_section_entry(self, entry, first, node);
+  for (std::uint32_t i = 1; i < count; ++i) push_section(self, first + i, node);
 }
 
 // split for a wide node: its slots' wide nodes and items take its place, each with its slot's rectangle (which
 // holds it: the slot is its rectangle padded outward, wide_index.hpp), read from the node itself.
-void BoundarySection::split_wide(std::uint32_t node, std::size_t entry) noexcept {
-  const WideNode& n = scene_->wide_index().nodes[node - wide_base_];
-  if (!in_section(node) || section_.size() + 4 + 8 > capacity_) return;  // full: keep the node
-  mark_out(node, section_parent_[entry]);
+void BoundarySection::Ops::split_wide(BoundarySection& self, std::uint32_t node, std::size_t entry) noexcept {
+  const WideNode& n = self.scene_->wide_index().nodes[node - self.wide_base_];
+  if (!in_section(self, node) || self.section_.size() + 4 + 8 > self.capacity_) return;  // full: keep the node
+  mark_out(self, node, self.section_parent_[entry]);
   bool first = true;
   for (int i = 0; i < 4; ++i) {
     const std::uint32_t code = n.child[i];
     if (code == kWideEmpty) continue;
-    const std::size_t at = first ? entry : section_.size();
-    if (!first) section_.push_back(0);  // within the reserved capacity: no allocation (place_entry fills it)
+    const std::size_t at = first ? entry : self.section_.size();
+    if (!first) self.section_.push_back(0);  // within the reserved capacity: no allocation (place_entry fills it)
     first = false;
-    section_rect_.set_floats(at, n.lo_x[i], n.lo_y[i], n.hi_x[i], n.hi_y[i]);
-    place_entry(at, wide_child_id(code), node);
+    self.section_rect_.set_floats(at, n.lo_x[i], n.lo_y[i], n.hi_x[i], n.hi_y[i]);
+    place_entry(self, at, wide_child_id(self, code), node);
   }
 }
 
@@ -245,21 +245,24 @@ void BoundarySection::split_wide(std::uint32_t node, std::size_t entry) noexcept
 // that entry's place and the others' entries are taken out (found by a scan of the section's parents, a few dozen).
 // False, with nothing changed, when they are not all found (never, for a frontier) or there are more than
 // kMaxSiblings (never: no node has more than 4 children, scene.hpp and wide_index.hpp).
-bool BoundarySection::merge_children(std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count) noexcept {
+bool BoundarySection::Ops::merge_children(BoundarySection& self, std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count) noexcept {
   constexpr std::size_t kMaxSiblings = 15;
   std::size_t sibling_entry[kMaxSiblings];
   std::size_t k = 0;
-  for (std::size_t i = 0; i < section_.size(); ++i) {
-    if (section_parent_[i] != parent || i == entry) continue;
+  for (std::size_t i = 0; i < self.section_.size(); ++i) {
+    if (self.section_parent_[i] != parent || i == entry) continue;
     if (k == kMaxSiblings) return false;
     sibling_entry[k++] = i;  // increasing
   }
   if (k + 1 != count) return false;
-  for (std::uint32_t i = 0; i < count; ++i) clear_state(children[i], kInSection);
-  clear_state(parent, kChildrenInMask);
-  set_section_entry(entry, parent, parent_or_none(parent));
-  while (k > 0) remove_section_entry(sibling_entry[--k]);  // highest first: a later one is never the last moved
+  for (std::uint32_t i = 0; i < count; ++i) clear_state(self, children[i], kInSection);
+  clear_state(self, parent, kChildrenInMask);
+  set_section_entry(self, entry, parent, parent_or_none(self, parent));
+  while (k > 0) remove_section_entry(self, sibling_entry[--k]);  // highest first: a later one is never the last moved
   return true;
 }
+
+// The frontier's parent of an entry, for tests (collision_query.hpp).
+std::uint32_t BoundarySection::entry_parent(std::uint32_t id) const noexcept { return Ops::parent_or_none(*this, id); }
 
 }  // namespace hk
