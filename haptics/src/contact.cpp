@@ -17,7 +17,7 @@ ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params, st
   }
 }
 
-ContactSolver::SegGeom ContactSolver::geom(SegmentRef s, int level) const {
+ContactSolver::SegGeom ContactSolver::geom(SegmentRef s, int level) const noexcept {
   SegGeom g;
   section_.wall_points(s, level, &g.a, &g.b);
   const Vec2 d = g.b - g.a;
@@ -27,7 +27,7 @@ ContactSolver::SegGeom ContactSolver::geom(SegmentRef s, int level) const {
   return g;
 }
 
-void ContactSolver::reset(Vec2 p_m, int level) {
+void ContactSolver::reset(Vec2 p_m, int level) noexcept {
   proxy_ = p_m;
   state_ = ContactState::Free;
   sticking_ = false;
@@ -40,7 +40,7 @@ void ContactSolver::reset(Vec2 p_m, int level) {
   push_off_walls(nullptr);
 }
 
-void ContactSolver::push_off_walls(QueryBudget* budget) {
+void ContactSolver::push_off_walls(QueryBudget* budget) noexcept {
   // A proxy on a wall would have no side: push it off along the wall's normal, to the side it is on.
   Vec2 q;
   SegmentRef s;
@@ -53,16 +53,16 @@ void ContactSolver::push_off_walls(QueryBudget* budget) {
 
 namespace {
 // A duration in servo ticks, at least one.
-long ticks_of(double duration_s, double period_s) {
+long ticks_of(double duration_s, double period_s) noexcept {
   return std::max(1L, std::lround(duration_s / (period_s > 0.0 ? period_s : 0.001)));
 }
 }  // namespace
 
-bool ContactSolver::pop_due() const {
+bool ContactSolver::pop_due() const noexcept {
   return params_.pop_force_n > 0.0 && state_ != ContactState::Free && press_ticks_ >= ticks_of(params_.pop_hold_s, params_.period_s);
 }
 
-void ContactSolver::pop_through(Step& s) {
+void ContactSolver::pop_through(Step& s) noexcept {
   // The wall gives way: the proxy goes to the handle, beyond the wall(s) it was held by, off any polyline.
   proxy_ = s.in.handle_m;
   push_off_walls(&s.budget);
@@ -76,7 +76,7 @@ void ContactSolver::pop_through(Step& s) {
   s.out.events |= kEventPopThrough;
 }
 
-Vec2 ContactSolver::release_force(Vec2 f) {
+Vec2 ContactSolver::release_force(Vec2 f) noexcept {
   if (release_left_ > 0) {
     const double share = static_cast<double>(release_left_) / static_cast<double>(ticks_of(params_.pop_release_s, params_.period_s));
     f += std::min(share, 1.0) * release_from_n_;
@@ -89,7 +89,7 @@ Vec2 ContactSolver::release_force(Vec2 f) {
   return f;
 }
 
-void ContactSolver::count_press(const ContactInput& in, ContactOutput& out) {
+void ContactSolver::count_press(const ContactInput& in, ContactOutput& out) noexcept {
   // How hard the hand presses: the spring's force, unclamped (the clamp is what the device can give).
   const bool pressing = params_.pop_force_n > 0.0 && in.press_counts && state_ != ContactState::Free &&
                         params_.stiffness_n_per_m * distance(proxy_, in.handle_m) >= params_.pop_force_n;
@@ -97,7 +97,7 @@ void ContactSolver::count_press(const ContactInput& in, ContactOutput& out) {
   out.press_s = static_cast<double>(press_ticks_) * params_.period_s;
 }
 
-int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget) {
+int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget) noexcept {
   Vec2 q;
   SegmentRef s;
   if (!section_.closest_point(p, level, radius_m, &q, &s, curve, budget)) return budget && budget->ran_out ? 3 : 0;
@@ -121,7 +121,7 @@ int ContactSolver::side_of_curve(Vec2 p, int curve, int level, double radius_m, 
   return d > 0.0 ? 1 : (d < 0.0 ? -1 : 2);  // 2: on the polyline, no side
 }
 
-bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) {
+bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) noexcept {
   if (new_level == level_) return true;
   if (transition_level_ >= 0) return false;  // one change at a time
   // A curve's polylines at two levels lie within E = (largest wall offset at one level + at the other) of
@@ -153,7 +153,7 @@ bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) {
   return true;
 }
 
-bool ContactSolver::excluded_at(const Constraint& c, int level) const {
+bool ContactSolver::excluded_at(const Constraint& c, int level) const noexcept {
   if (c.level == level) return true;
   if (!section_.is_wall(c.seg, level)) return false;
   if (!is_cut_level(level) && !is_cut_level(c.level)) return true;  // a level's segment: the same end points under every id
@@ -164,7 +164,7 @@ bool ContactSolver::excluded_at(const Constraint& c, int level) const {
 }
 
 ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget, ContactOutput& out,
-                                           Constraint* hit_out) {
+                                           Constraint* hit_out) noexcept {
   QueryStats st;
   const bool skip_new = excluded && excluded_at(*excluded, level);
   SweepHit hit = section_.first_hit(proxy_, target, level, skip_new ? &excluded->seg : nullptr, skip_new ? 1 : 0, budget, &st);
@@ -226,7 +226,7 @@ ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Constra
   return Move::Hit;
 }
 
-void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
+void ContactSolver::update(const ContactInput& in, ContactOutput& out) noexcept {
   const ContactState before = state_;
   begin_step(in, out);
   Step s{in, out, in.budget};
@@ -245,7 +245,7 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) {
   count_press(in, out);
 }
 
-void ContactSolver::begin_step(const ContactInput& in, ContactOutput& out) {
+void ContactSolver::begin_step(const ContactInput& in, ContactOutput& out) noexcept {
   out.events = kEventNone;
   out.corner_turn_rad = 0.0;
   out.query = QueryStats{};
@@ -260,7 +260,7 @@ void ContactSolver::begin_step(const ContactInput& in, ContactOutput& out) {
   }
 }
 
-bool ContactSolver::step_free(Step& s) {
+bool ContactSolver::step_free(Step& s) noexcept {
   Constraint hit;
   const Move m = move_to(s.in.handle_m, level_, nullptr, s.budget, s.out, &hit);
   if (m != Move::Hit) return true;
@@ -270,7 +270,7 @@ bool ContactSolver::step_free(Step& s) {
   return false;
 }
 
-bool ContactSolver::step_edge(Step& s) {
+bool ContactSolver::step_edge(Step& s) noexcept {
   const Vec2 h = s.in.handle_m;
   const double side = c_[0].side;
   const SegGeom g = geom(c_[0]);
@@ -309,7 +309,7 @@ bool ContactSolver::step_edge(Step& s) {
   return at_edge_vertex(s, clamped);
 }
 
-bool ContactSolver::at_edge_vertex(Step& s, int clamped) {
+bool ContactSolver::at_edge_vertex(Step& s, int clamped) noexcept {
   const Vec2 h = s.in.handle_m;
   const double side = c_[0].side;
   const int wall_level = c_[0].level;
@@ -357,7 +357,7 @@ bool ContactSolver::at_edge_vertex(Step& s, int clamped) {
   return false;
 }
 
-bool ContactSolver::step_vertex(Step& s) {
+bool ContactSolver::step_vertex(Step& s) noexcept {
   const Vec2 h = s.in.handle_m;
   const SegGeom ga = geom(c_[0]);
   const SegGeom gb = geom(c_[1]);
@@ -394,7 +394,7 @@ bool ContactSolver::step_vertex(Step& s) {
   return true;
 }
 
-Vec2 ContactSolver::contact_force(const ContactInput& in) const {
+Vec2 ContactSolver::contact_force(const ContactInput& in) const noexcept {
   // Spring from handle to proxy, damping along the contact normal, one clamp.
   const Vec2 h = in.handle_m;
   Vec2 f = params_.stiffness_n_per_m * (proxy_ - h);
@@ -408,7 +408,7 @@ Vec2 ContactSolver::contact_force(const ContactInput& in) const {
   return f;
 }
 
-void ContactSolver::finish_step(ContactState before, Vec2 force_n, ContactOutput& out) {
+void ContactSolver::finish_step(ContactState before, Vec2 force_n, ContactOutput& out) noexcept {
   out.proxy_m = proxy_;
   out.force_n = force_n;
   out.state = state_;

@@ -1,12 +1,12 @@
-// The visitor-like model hand (`--hand explorer`, issue 14 item 4): sweep, trace, push through.
+// The visitor-like model hand (`--hand explorer`): sweep, trace, push through.
 #include "haptics/explorer_hand.hpp"
+#include "hk/error.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <queue>
-#include <stdexcept>
 #include <utility>
 
 namespace hk {
@@ -14,7 +14,7 @@ namespace {
 
 void require(bool ok, const char* field, const std::string& limit, double value) {
   if (!ok || !std::isfinite(value)) {
-    throw std::invalid_argument(std::string("explorer hand: ") + field + " = " + std::to_string(value) + " is outside " + limit);
+    throw hk::ArgumentError(std::string("explorer hand: ") + field + " = " + std::to_string(value) + " is outside " + limit);
   }
 }
 
@@ -477,7 +477,21 @@ void ExplorerHand::check_goal(const HandFeel& f) {
   }
 }
 
+// One tick of a trace: the wall felt, the travel noted, then the trace ends (back to moving) or goes on along the wall.
 HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
+  const bool touching = feel_trace_wall(f, dt);
+  note_trace_travel(f, touching);
+  if (trace_ends(f)) {
+    enter_move(f.handle_m);
+    return HandCommand{f.handle_m, p_.max_force_n};
+  }
+  return trace_command(f, dt, touching);
+}
+
+// The wall's normal n_ as the trace feels it: while the force says the hand touches, smoothed towards the force's
+// direction; when the wall falls away (a convex corner, an open end), turned towards it round a circle of
+// kTurnRadiusM, and the time it was lost noted. Returns whether the hand touches.
+bool ExplorerHand::feel_trace_wall(const HandFeel& f, double dt) {
   const double felt = length(f.device_force_n);
   const bool touching = felt > 0.5 * p_.contact_force_n;
   if (touching) {
@@ -485,10 +499,15 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
     lost_since_ = -1.0;
   } else {
     if (lost_since_ < 0) lost_since_ = f.t_s;
-    // The wall fell away (a convex corner, an open end): turn towards it, round a circle of kTurnRadiusM.
     const double turn = static_cast<double>(sense_) * std::max(p_.trace_speed_m_per_s, length(f.handle_velocity_m_per_s)) / kTurnRadiusM * dt;
     n_ = Vec2{n_.x * std::cos(turn) - n_.y * std::sin(turn), n_.x * std::sin(turn) + n_.y * std::cos(turn)};
   }
+  return touching;
+}
+
+// The trace's bookkeeping of where the hand went: distance travelled, travel over walls felt before (retraced_),
+// the path, the cells traced, and once the trace has settled its start (the loop is judged from there).
+void ExplorerHand::note_trace_travel(const HandFeel& f, bool touching) {
   const double moved = distance(f.handle_m, last_handle_);
   travelled_ += moved;
   stats_.traced_m += moved;
@@ -513,39 +532,44 @@ HandCommand ExplorerHand::step_trace(const HandFeel& f, double dt) {
     start_heading_ = static_cast<double>(sense_) * left_perp(n_);
     travelled_at_start_ = travelled_;
   }
-  // When the trace ends.
-  bool done = false;
-  // Round when back at the start going the same way (not passing it on the far side of a thin stroke).
+}
+
+// Whether the trace ends this tick, each end counted in stats_: round (back at the start going the same way, not
+// passing it on the far side of a thin stroke), timed out, lost the wall, retracing old walls, or stalled.
+bool ExplorerHand::trace_ends(const HandFeel& f) {
   if (start_settled_ && travelled_ - travelled_at_start_ > p_.loop_min_m && distance(f.handle_m, trace_start_) < p_.loop_close_m &&
       dot(static_cast<double>(sense_) * left_perp(n_), start_heading_) > 0.5) {
-    done = true;
     ++stats_.traces_closed;
     skip_small_loop();
+    return true;
   }
-  if (!done && f.t_s - trace_t0_ > p_.trace_max_s) {
-    done = true;
+  if (f.t_s - trace_t0_ > p_.trace_max_s) {
     ++stats_.traces_timed_out;
+    return true;
   }
-  if (!done && lost_since_ >= 0 && f.t_s - lost_since_ > p_.lost_s) {
-    done = true;
+  if (lost_since_ >= 0 && f.t_s - lost_since_ > p_.lost_s) {
     ++stats_.traces_lost;
+    return true;
   }
-  if (!done && retraced_ > p_.retrace_max_m) {
-    done = true;
+  if (retraced_ > p_.retrace_max_m) {
     ++stats_.traces_retraced;
+    return true;
   }
-  if (!done && f.t_s - stall_t_ > p_.stall_s) {
+  bool stalled = false;
+  if (f.t_s - stall_t_ > p_.stall_s) {
     if (distance(f.handle_m, stall_pos_) < 0.001) {
-      done = true;
+      stalled = true;
       ++stats_.traces_stalled;
     }
     stall_t_ = f.t_s;
     stall_pos_ = f.handle_m;
   }
-  if (done) {
-    enter_move(f.handle_m);
-    return HandCommand{f.handle_m, p_.max_force_n};
-  }
+  return stalled;
+}
+
+// The command of a trace going on: with grooves, on along the handle's way, pulled lightly towards the curve; with
+// walls, pressed against the wall (−n̂) and sliding along t̂, the lookahead trimmed to hold the trace speed.
+HandCommand ExplorerHand::trace_command(const HandFeel& f, double dt, bool touching) {
   const double k = p_.hand_stiffness_n_per_m;
   if (p_.grooves) {
     // The groove steers: keep going the way the handle goes, pulled lightly towards the curve.

@@ -1,4 +1,4 @@
-// The grooves rendering mode (issue 14, item 2). See groove.hpp for the model and the profile.
+// The grooves rendering mode. See groove.hpp for the model and the profile.
 #include "haptics/groove.hpp"
 
 #include <algorithm>
@@ -21,7 +21,7 @@ GrooveSolver::GrooveSolver(const Scene& scene, const GrooveParams& params)
 GrooveSolver::GrooveSolver(const Scene& scene, const GrooveParams& params, std::shared_ptr<const CutWalls> cuts)
     : scene_(&scene), params_(params), section_(scene, 3e-4, std::move(cuts)) {}
 
-void GrooveSolver::reset(Vec2 p_m, int level) {
+void GrooveSolver::reset(Vec2 p_m, int level) noexcept {
   proxy_ = p_m;
   state_ = ContactState::Free;
   seg_ = SegmentRef{};
@@ -37,7 +37,7 @@ void GrooveSolver::reset(Vec2 p_m, int level) {
 // tick's budget): there the state is Edge and the proxy that point; nothing within it, Free with the proxy at
 // the handle. Unknown within the budget: the groove is followed from where it was while the handle stays
 // within the radius of last tick's closest point (a point of the curve, so the pull is towards the curve).
-void GrooveSolver::find_groove(Vec2 h, QueryBudget& budget, ContactOutput& out) {
+void GrooveSolver::find_groove(Vec2 h, QueryBudget& budget, ContactOutput& out) noexcept {
   const std::int32_t used_before = budget.box_tests_used;
   const double R = params_.capture_radius_m;
   Vec2 q;
@@ -68,7 +68,7 @@ void GrooveSolver::find_groove(Vec2 h, QueryBudget& budget, ContactOutput& out) 
 // The pull of the profile towards the closest point, then the per-tick limit (groove.hpp): it binds only where
 // the closest point jumps (the medial axis) or the law changes (level, gains); along a lone curve the target
 // moves by at most k·|Δh| and passes as is. Clamped to max_force_n; a non-finite force is zero.
-Vec2 GrooveSolver::groove_force(Vec2 h) {
+Vec2 GrooveSolver::groove_force(Vec2 h) noexcept {
   Vec2 target{0.0, 0.0};
   if (state_ == ContactState::Edge) {
     const double r = distance(h, proxy_);
@@ -86,7 +86,7 @@ Vec2 GrooveSolver::groove_force(Vec2 h) {
   return f;
 }
 
-void GrooveSolver::update(const ContactInput& in, ContactOutput& out) {
+void GrooveSolver::update(const ContactInput& in, ContactOutput& out) noexcept {
   const Vec2 h = in.handle_m;
   const ContactState before = state_;
   out.events = kEventNone;

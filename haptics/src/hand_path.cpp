@@ -2,6 +2,7 @@
 /// Hand paths: interpolation, the raster, and the hand-file reader. See hand_path.hpp.
 
 #include "haptics/hand_path.hpp"
+#include "hk/error.hpp"
 #include "hk/text.hpp"
 
 #include <algorithm>
@@ -16,15 +17,15 @@
 namespace hk {
 
 HandPath::HandPath(std::vector<HandSample> samples) : samples_(std::move(samples)) {
-  if (samples_.empty()) throw std::invalid_argument("hand path: no samples");
+  if (samples_.empty()) throw hk::ArgumentError("hand path: no samples");
   for (std::size_t i = 0; i < samples_.size(); ++i) {
     const HandSample& s = samples_[i];
     if (!std::isfinite(s.t_s) || !is_finite(s.target_m)) {
-      throw std::invalid_argument("hand path: sample " + std::to_string(i) + " is not finite");
+      throw hk::ArgumentError("hand path: sample " + std::to_string(i) + " is not finite");
     }
-    if (s.t_s < 0.0) throw std::invalid_argument("hand path: sample " + std::to_string(i) + " has a negative time");
+    if (s.t_s < 0.0) throw hk::ArgumentError("hand path: sample " + std::to_string(i) + " has a negative time");
     if (i > 0 && !(s.t_s > samples_[i - 1].t_s)) {
-      throw std::invalid_argument("hand path: time of sample " + std::to_string(i) + " is not strictly increasing");
+      throw hk::ArgumentError("hand path: time of sample " + std::to_string(i) + " is not strictly increasing");
     }
   }
 }
@@ -44,14 +45,14 @@ Vec2 HandPath::at(double t_s) const noexcept {
 HandPath raster_path(double width_m, double height_m, double spacing_m, double speed_m_per_s) {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!positive(width_m) || !positive(height_m) || !positive(spacing_m) || !positive(speed_m_per_s)) {
-    throw std::invalid_argument("raster path: width, height, spacing and speed must be finite and > 0");
+    throw hk::ArgumentError("raster path: width, height, spacing and speed must be finite and > 0");
   }
   constexpr double kMaxLines = 1'000'000.0;
   // Round the gap count up so the real spacing never exceeds the requested one; the tiny tolerance keeps
   // an exact multiple (0.09 / 0.006 = 15.000000000000002) from gaining a needless extra line.
   const double gaps_real = std::ceil(height_m / spacing_m - 1e-9);
   if (!(gaps_real + 1.0 <= kMaxLines)) {
-    throw std::invalid_argument("raster path: more than 1000000 lines (spacing too small for the height)");
+    throw hk::ArgumentError("raster path: more than 1000000 lines (spacing too small for the height)");
   }
   const int gaps = std::max(1, static_cast<int>(gaps_real));
   const double x0 = -0.5 * width_m;
@@ -220,7 +221,7 @@ HandPath raster_path_with_line_speeds(double width_m, double height_m, double sp
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   bool ok = !line_speeds_m_per_s.empty() && positive(step_speed_m_per_s);
   for (double v : line_speeds_m_per_s) ok = ok && positive(v);
-  if (!ok) throw std::invalid_argument("raster path: line speeds (at least one) and step speed must be finite and > 0");
+  if (!ok) throw hk::ArgumentError("raster path: line speeds (at least one) and step speed must be finite and > 0");
   const HandPath unit = raster_path(width_m, height_m, spacing_m, 1.0);
   const std::vector<HandSample>& in = unit.samples();
   std::vector<HandSample> out;

@@ -12,18 +12,18 @@
 /// direction. tests/haptics/test_hapi_emulator.cpp re-checks these bounds with our IK and Jacobian.
 
 #include "haptics/hapi_emulator.hpp"
+#include "hk/error.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <stdexcept>
 #include <string>
 
 namespace hk::hapi {
 
 namespace {
 
-[[noreturn]] void bad_param(const std::string& what) { throw std::invalid_argument("hAPI emulator: " + what); }
+[[noreturn]] void bad_param(const std::string& what) { throw hk::ArgumentError("hAPI emulator: " + what); }
 
 bool finite_pos(double v) { return std::isfinite(v) && v > 0.0; }
 

@@ -6,7 +6,7 @@
 
 namespace hk {
 
-Vec2 ForceGuard::apply(Vec2 f, double since_start_s, DeviceStatus status, bool deadline_missed, TickResult* why) const {
+Vec2 ForceGuard::apply(Vec2 f, double since_start_s, DeviceStatus status, bool deadline_missed, TickResult* why) const noexcept {
   *why = TickResult::Ok;
   if (status != DeviceStatus::Ok) {
     *why = TickResult::DeviceNotOk;
@@ -78,7 +78,7 @@ LevelPolicyParams policy_params(const ServoParams& p) {
 }
 
 // `v` one fade step shorter: its length less `step` [N], or zero when that is (within rounding) all of it.
-Vec2 fade(Vec2 v, double step) {
+Vec2 fade(Vec2 v, double step) noexcept {
   const double r = length(v);
   return r - step > 1e-12 ? ((r - step) / r) * v : Vec2{0.0, 0.0};
 }
@@ -176,7 +176,7 @@ void ServoLoop::set_auto_level(bool on) noexcept {
   if (!on) params_.level = level_;
 }
 
-TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) {
+TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) noexcept {
   const Vec2 h = in.sample.handle_m;
   if (!is_finite(h)) {
     out.force_n = {0.0, 0.0};

@@ -2,11 +2,11 @@
 /// The simulated pantograph and the model hand. See sim_pantograph.hpp for the physics model.
 
 #include "haptics/sim_pantograph.hpp"
+#include "hk/error.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <stdexcept>
 #include <string>
 
 namespace hk {
@@ -14,7 +14,7 @@ namespace hk {
 namespace {
 
 [[noreturn]] void bad_param(const std::string& what) {
-  throw std::invalid_argument("simulated pantograph: " + what);
+  throw hk::ArgumentError("simulated pantograph: " + what);
 }
 
 bool finite_nonneg(double v) { return std::isfinite(v) && v >= 0.0; }

@@ -73,7 +73,7 @@ std::vector<std::uint8_t> tolerance_cut_masks(const Scene& scene) {
   return masks;
 }
 
-void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a, Vec2* b) {
+void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a, Vec2* b) noexcept {
   scene.segment_points(node, a, b);
   const std::uint32_t c = scene.tag_curve(node);
   const int l = scene.tag_level(node);

@@ -161,7 +161,7 @@ TEST(CollisionTree, BoxesContainOriginalsWhereVerticesBunchUpOrSitOnLevelZeroPoi
   EXPECT_EQ(sc.curve(2).max_error_m[0], 0.0);
 }
 
-// Issue 18: a box is no wider than it must be. For every segment box, the true deviation of the original
+// A box is no wider than it must be. For every segment box, the true deviation of the original
 // under it (the largest distance of an original vertex or level-0 point under it from the segment's
 // line, found here by arc length, not through the tree) against the box half-width: never below it
 // (containment), and the median within 5 %.
@@ -209,7 +209,7 @@ TEST(CollisionTree, BoxesAreTightAroundTheOriginalUnderThem) {
   std::printf("box half-width / true deviation: median %.4f, p90 %.4f over %zu boxes\n", median, ratio[ratio.size() * 9 / 10], ratio.size());
 }
 
-// Issue 18, compact storage: a level is a run of slots, one per point, a closed curve's first point
+// Compact storage: a level is a run of slots, one per point, a closed curve's first point
 // repeated at the end, so segment k runs from point k to point k + 1 and the last segment of a closed
 // level closes the loop on its first point (checked against the scaling coefficients of build_multires,
 // the model built on its own: the scene transforms into its slots, bit for bit the same).
@@ -249,7 +249,7 @@ TEST(CollisionTree, SegmentsRunBetweenTheLevelsPointsAndClosedLevelsCloseTheLoop
   EXPECT_GT(closed, 0);
 }
 
-// Issue 18's memory target: every level's points, quantised boxes, tags and the tree above them in at
+// The memory target: every level's points, quantised boxes, tags and the tree above them in at
 // most 64 bytes per level-0 segment (was 270 with whole double boxes, rectangles and links per node).
 TEST(CollisionTree, AllLevelsFitSixtyFourBytesPerSegment) {
   std::mt19937 rng(15);

@@ -1,11 +1,10 @@
-// The visitor-like explorer hand (issue 14, item 4) on its own: parameter checks, determinism from the seed,
+// The visitor-like explorer hand on its own: parameter checks, determinism from the seed,
 // and in a closed loop with the simulated pantograph and the servo (walls at the default 800 N/m, friction
 // 0.4/0.3 as the kiosk's defaults) that it traces a shape round, remembers it, and then pushes at it with
 // 1.4 x pop_force_n.
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,6 +13,7 @@
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
 #include "haptics/sim_pantograph.hpp"
+#include "hk/error.hpp"
 
 namespace hk {
 namespace {
@@ -105,7 +105,7 @@ TEST(ExplorerHand, RefusesBadParametersNamingTheField) {
   auto message = [](ExplorerParams p) {
     try {
       ExplorerHand h(p);
-    } catch (const std::invalid_argument& e) {
+    } catch (const hk::ArgumentError& e) {
       return std::string(e.what());
     }
     return std::string();

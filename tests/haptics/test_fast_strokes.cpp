@@ -1,4 +1,4 @@
-// Hand-speed aware contact (issue 6, item 5): strokes at 2 m/s at the handle (2 mm per 1 kHz tick)
+// Hand-speed aware contact: strokes at 2 m/s at the handle (2 mm per 1 kHz tick)
 // across thin curves and into acute corners (10°, 30°) never tunnel, frictionless and with Coulomb
 // friction (the proxy then sticks and slides in its friction cone, each slide a collision-checked move):
 // every sub-move of the proxy is checked with the independent orientation predicate, and the proxy ends

@@ -1,4 +1,4 @@
-// Friction on the god-object (issue 6, item 3): the proxy sticks inside the static cone and slides on the
+// Friction on the god-object: the proxy sticks inside the static cone and slides on the
 // dynamic cone (golden offsets μ_s·d and μ_d·d from Coulomb's law), re-sticks only when the hand stops,
 // is frictionless with both coefficients 0, and never creates energy round a closed loop.
 #include <gtest/gtest.h>

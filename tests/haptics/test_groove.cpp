@@ -1,4 +1,4 @@
-// The grooves rendering mode (issue 14, item 2): each curve an engraved line that pulls the hand towards
+// The grooves rendering mode: each curve an engraved line that pulls the hand towards
 // its closest point within a capture radius, with a continuous trapezoid profile, and never blocks.
 // Checked here on synthetic scenes: the golden profile, force continuity along sweeps (a lone line, where
 // the per-tick limiter is never needed, and a hairpin, where the closest point jumps), a released hand

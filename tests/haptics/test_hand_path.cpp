@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "haptics/hand_path.hpp"
+#include "hk/error.hpp"
 
 namespace hk {
 namespace {
@@ -82,11 +83,11 @@ TEST(HandPath, InterpolatesAndClamps) {
 
 TEST(HandPath, RejectsBadSamples) {
   using V = std::vector<HandSample>;
-  EXPECT_THROW(HandPath(V{}), std::invalid_argument);
-  EXPECT_THROW(HandPath(V{{0.0, {}}, {0.0, {}}}), std::invalid_argument);
-  EXPECT_THROW(HandPath(V{{0.0, {}}, {1.0, {}}, {0.5, {}}}), std::invalid_argument);
-  EXPECT_THROW(HandPath(V{{-1.0, {}}}), std::invalid_argument);
-  EXPECT_THROW(HandPath(V{{0.0, {NAN, 0.0}}}), std::invalid_argument);
+  EXPECT_THROW(HandPath(V{}), hk::ArgumentError);
+  EXPECT_THROW(HandPath(V{{0.0, {}}, {0.0, {}}}), hk::ArgumentError);
+  EXPECT_THROW(HandPath(V{{0.0, {}}, {1.0, {}}, {0.5, {}}}), hk::ArgumentError);
+  EXPECT_THROW(HandPath(V{{-1.0, {}}}), hk::ArgumentError);
+  EXPECT_THROW(HandPath(V{{0.0, {NAN, 0.0}}}), hk::ArgumentError);
   EXPECT_NO_THROW(HandPath(V{{0.0, {}}}));
 }
 
@@ -168,11 +169,11 @@ INSTANTIATE_TEST_SUITE_P(HandPath, Raster,
                                            RasterCase{0.03, 0.02, 0.0011, 0.3}));
 
 TEST(HandPath, RasterRejectsBadArguments) {
-  EXPECT_THROW(raster_path(0.0, 0.09, 0.006, 0.08), std::invalid_argument);
-  EXPECT_THROW(raster_path(0.14, -0.09, 0.006, 0.08), std::invalid_argument);
-  EXPECT_THROW(raster_path(0.14, 0.09, NAN, 0.08), std::invalid_argument);
-  EXPECT_THROW(raster_path(0.14, 0.09, 0.006, 0.0), std::invalid_argument);
-  EXPECT_THROW(raster_path(0.14, 0.09, 1e-12, 0.08), std::invalid_argument) << "too many lines";
+  EXPECT_THROW(raster_path(0.0, 0.09, 0.006, 0.08), hk::ArgumentError);
+  EXPECT_THROW(raster_path(0.14, -0.09, 0.006, 0.08), hk::ArgumentError);
+  EXPECT_THROW(raster_path(0.14, 0.09, NAN, 0.08), hk::ArgumentError);
+  EXPECT_THROW(raster_path(0.14, 0.09, 0.006, 0.0), hk::ArgumentError);
+  EXPECT_THROW(raster_path(0.14, 0.09, 1e-12, 0.08), hk::ArgumentError) << "too many lines";
 }
 
 TEST(HandPath, RasterWithLineSpeedsTimesEachLineAtItsSpeed) {
@@ -185,9 +186,9 @@ TEST(HandPath, RasterWithLineSpeedsTimesEachLineAtItsSpeed) {
   EXPECT_NEAR(p.duration_s(), 17.2, 1e-9);
   EXPECT_NEAR(p.samples()[1].t_s, 7.0, 1e-9);
   EXPECT_NEAR(p.samples()[3].t_s - p.samples()[2].t_s, 0.7, 1e-9);
-  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {}, 0.05), std::invalid_argument);
-  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {0.1, 0.0}, 0.05), std::invalid_argument);
-  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {0.1}, NAN), std::invalid_argument);
+  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {}, 0.05), hk::ArgumentError);
+  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {0.1, 0.0}, 0.05), hk::ArgumentError);
+  EXPECT_THROW(raster_path_with_line_speeds(0.14, 0.09, 0.03, {0.1}, NAN), hk::ArgumentError);
 }
 
 // ---------------------------------------------------------------------------------------------

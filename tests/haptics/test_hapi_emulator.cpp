@@ -14,7 +14,6 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
-#include <stdexcept>
 #include <vector>
 
 #include "haptics/hapi_emulator.hpp"
@@ -22,6 +21,7 @@
 #include "haptics/haply_mechanism.hpp"
 #include "haptics/pantograph.hpp"
 #include "haptics/pty_emulator.hpp"
+#include "hk/error.hpp"
 
 namespace hk::hapi {
 namespace {
@@ -66,13 +66,13 @@ void start_gen3(FirmwareEmulator& e) {
 TEST(HapiEmulator, RejectsBadParams) {
   EmulatorParams p;
   p.period_s = 0;
-  EXPECT_THROW(make(p), std::invalid_argument);
+  EXPECT_THROW(make(p), hk::ArgumentError);
   p = {};
   p.port_joint[1] = 2;
-  EXPECT_THROW(make(p), std::invalid_argument);
+  EXPECT_THROW(make(p), hk::ArgumentError);
   p = {};
   p.workspace_half_extent_m = {0.2, 0.2};  // far outside the linkage's reach
-  EXPECT_THROW(make(p), std::invalid_argument);
+  EXPECT_THROW(make(p), hk::ArgumentError);
 }
 
 TEST(HapiEmulator, DefaultRectangleIsReachableAndWellConditioned) {

@@ -1,4 +1,4 @@
-// The cases where proxy methods usually fail (issue 6): hand tremor at a wall (level flapping, contact
+// The cases where proxy methods usually fail: hand tremor at a wall (level flapping, contact
 // chatter), coincident and touching curves, a curve through the proxy's start, a zero-length chain and a
 // chain of two points — each driven through the servo loop with levels from hand speed and friction on,
 // every proxy move checked against the walls in force with the independent crossing predicate.

@@ -1,4 +1,4 @@
-// Gains changed live under a pressing hand (issue 12, item 4, ServoLoop level): stiffness, damping, max
+// Gains changed live under a pressing hand (ServoLoop level): stiffness, damping, max
 // force and friction take effect from the next tick, yet the force never moves by more than the configured
 // step per tick (plus what the hand's own motion does to the wall), and it ends exactly on the new force
 // law (golden values from F = k · penetration, Coulomb's μ_d · F_n, damping b · v), after the number of

@@ -10,11 +10,11 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
-#include <stdexcept>
 #include <vector>
 
 #include "haptics/pantograph.hpp"
 #include "haptics/sim_pantograph.hpp"
+#include "hk/error.hpp"
 
 namespace hk {
 namespace {
@@ -385,20 +385,20 @@ TEST(SimPantograph, MechanicalStopHoldsHandle) {
 TEST(SimPantograph, RejectsBadParameters) {
   SimPantographParams p;
   p.handle_mass_kg = 0.0;
-  EXPECT_THROW(SimulatedPantograph(p, {}), std::invalid_argument);
+  EXPECT_THROW(SimulatedPantograph(p, {}), hk::ArgumentError);
   p = {};
   p.substeps = 0;
-  EXPECT_THROW(SimulatedPantograph(p, {}), std::invalid_argument);
+  EXPECT_THROW(SimulatedPantograph(p, {}), hk::ArgumentError);
   p = {};
   p.encoder_counts_per_rev = 0;
-  EXPECT_THROW(SimulatedPantograph(p, {}), std::invalid_argument);
+  EXPECT_THROW(SimulatedPantograph(p, {}), hk::ArgumentError);
   p = {};
   p.max_torque_n_m = NAN;
-  EXPECT_THROW(SimulatedPantograph(p, {}), std::invalid_argument);
+  EXPECT_THROW(SimulatedPantograph(p, {}), hk::ArgumentError);
   p = {};
   p.geometry.proximal_m = 0.05;  // too short to reach the far corners of the stop box
-  EXPECT_THROW(SimulatedPantograph(p, {}), std::invalid_argument);
-  EXPECT_THROW(SimulatedPantograph({}, {NAN, 0.0}), std::invalid_argument);
+  EXPECT_THROW(SimulatedPantograph(p, {}), hk::ArgumentError);
+  EXPECT_THROW(SimulatedPantograph({}, {NAN, 0.0}), hk::ArgumentError);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -112,7 +112,7 @@ TEST(Peers, FirstHitAndClosestPointAgreeAcrossMethods) {
   }
 }
 
-// Issue 18 item 3: first hits and closest points at the tolerance cut instead of a level. Each of the eight steps' cuts (segments
+// First hits and closest points at the tolerance cut instead of a level. Each of the eight steps' cuts (segments
 // of mixed levels, joined where the level changes) is taken apart by the cut's own functions (tolerance_cut,
 // joined_cut_points: bench::cut_segments) and handed to brute force, the R-tree and Embree; first_hit_cut
 // walks the boundary section with the cut masks instead. 15 000 queries a step, 120 000 in all, every one
@@ -213,7 +213,7 @@ TEST(Peers, FirstHitAndClosestPointAtTheToleranceCutAgreeAcrossMethods) {
   EXPECT_GT(joined_levels, 100u);
 }
 
-// Issue 18: 100 000 queries per size, ours against the R-tree and Embree on every one, and against brute
+// 100 000 queries per size, ours against the R-tree and Embree on every one, and against brute
 // force on every query of the smallest size and on every 50th of the larger ones (brute force costs a
 // pass over all segments per query). Closest points on every 10th query.
 class PeersAtSize : public ::testing::TestWithParam<std::size_t> {};
@@ -274,7 +274,7 @@ TEST_P(PeersAtSize, HundredThousandQueriesAgree) {
 
 INSTANTIATE_TEST_SUITE_P(Sizes, PeersAtSize, ::testing::Values(std::size_t{1000}, std::size_t{10000}, std::size_t{100000}));
 
-// ── Closest points seeded by the previous answer (issue 18: closest points from coherence) ───────────
+// ── Closest points seeded by the previous answer (closest points from coherence) ───────────
 
 namespace {
 

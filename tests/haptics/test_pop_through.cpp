@@ -1,4 +1,4 @@
-// Push-through (issue 14, item 1): a wall gives way to a press of pop_force_n held for pop_hold_s, never to
+// Push-through: a wall gives way to a press of pop_force_n held for pop_hold_s, never to
 // less (weaker, or shorter), the proxy crosses on exactly that tick, the force before the pop fades out over
 // pop_release_s, and a push through two touching shapes or into a corner leaves the proxy off every wall.
 #include <gtest/gtest.h>

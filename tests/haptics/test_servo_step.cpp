@@ -1,4 +1,4 @@
-// The servo step (issue 13, item 5): the force guard every force passes, the tick as a pure function of
+// The servo step: the force guard every force passes, the tick as a pure function of
 // (state, sample, scene), and the tick's one box-test budget shared by its collision queries and its
 // level-change check.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Tolerance cut (issue 18): the cut covers the curve once, in order; every original vertex is within the
+// Tolerance cut: the cut covers the curve once, in order; every original vertex is within the
 // tolerance of the cut segment standing for it (distances computed here, from arc positions, not from the
 // tree); it never needs more segments than the coarsest single level that meets the same tolerance. The
 // tolerance steps the level policy may pick (each curve at the coarsest of its levels within the step):
@@ -7,7 +7,6 @@
 
 #include <memory>
 #include <random>
-#include <stdexcept>
 
 #include "curves.hpp"
 #include "haptics/collision_query.hpp"
@@ -15,6 +14,7 @@
 #include "haptics/servo.hpp"
 #include "haptics/level_policy.hpp"
 #include "haptics/tolerance_cut.hpp"
+#include "hk/error.hpp"
 
 using namespace hk;
 
@@ -323,7 +323,7 @@ TEST(ToleranceCut, TheServoLoopSharesOneCopyOfTheCutWallsBetweenItsSolvers) {
 
   std::mt19937 rng2(24);
   const Scene other = Scene::build(curves_for(rng2), 6);
-  EXPECT_THROW(BoundarySection(other, 3e-4, walls), std::invalid_argument);
+  EXPECT_THROW(BoundarySection(other, 3e-4, walls), hk::ArgumentError);
   EXPECT_NO_THROW(BoundarySection(sc, 3e-4, walls));
 }
 

@@ -51,12 +51,12 @@ namespace hk {
 
 /// Liang–Barsky clipping of the segment a→b against a box (grown by margin_m on every side).
 /// Returns true on overlap and writes the entry and exit parameters in [0, 1].
-bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit);
+bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit) noexcept;
 
 /// Proper or touching intersection of the sweep a→b with segment p→q. Returns true with `t` the sweep
 /// parameter in [0, 1] of the first common point; parallel (including collinear) pairs never hit,
 /// because a sweep sliding along a wall does not cross it.
-bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t);
+bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) noexcept;
 
 /// The work limit that makes queries anytime: a count of box tests, shared by every query (and
 /// closest-point walk) it is passed to, so one number bounds a servo tick's collision work. No clock.
@@ -132,16 +132,16 @@ class BoundarySection {
   /// `cut_walls` it also computes the cut masks and their bounds (tolerance_cut_masks, cut_bounds: a byte
   /// per node, about a tenth of a second at 10^6 segments), which the walls at cut steps need; without them a
   /// cut step renders as the tolerance step of the same tolerance (each curve at its level for it). Throws
-  /// std::invalid_argument for a scene node with more than 7 children (a Scene has at most 4), or when the scene's
+  /// hk::ArgumentError for a scene node with more than 7 children (a Scene has at most 4), or when the scene's
   /// nodes and wide index nodes together do not fit 32-bit section ids.
   explicit BoundarySection(const Scene& scene, double merge_margin_m = 3e-4, bool cut_walls = true);
   /// The same, reading the cut masks and bounds from `cuts` (make_cut_walls of the same `scene`, shared with
   /// other sections of it) instead of computing its own; null: no cut masks, as `cut_walls` = false. Throws
-  /// std::invalid_argument when `cuts` was made for another scene, or as the constructor above.
+  /// hk::ArgumentError when `cuts` was made for another scene, or as the constructor above.
   BoundarySection(const Scene& scene, double merge_margin_m, std::shared_ptr<const CutWalls> cuts);
 
   /// Forgets the frontier (back to one root per curve), both free-space balls and the closest-point seed. Real-time safe.
-  void reset();
+  void reset() noexcept;
 
   /// First hit of the sweep a→b against the polylines at level id `level` (clamped per curve to its coarsest;
   /// a cut step: its cut's joined segments, see first_hit_cut),
@@ -153,7 +153,7 @@ class BoundarySection {
   /// pays one merge check full queries left owed, two while more than 8 are (one optional box test each).
   /// Charges its box tests to `budget` (see QueryBudget). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                     QueryBudget& budget, QueryStats* stats = nullptr);
+                     QueryBudget& budget, QueryStats* stats = nullptr) noexcept;
   /// The same first hit through the scene's wide index alone (wide_index.hpp), for comparison with
   /// first_hit: no boundary section. A depth-first walk from the index's root, nearest entry first, pruned
   /// past the best hit; at an item it tests the target level's segments under it. Coherence comes
@@ -172,7 +172,7 @@ class BoundarySection {
   /// rectangles need not hold) it answers blocked at t = 0, nothing proven clear. Does not read or change
   /// the boundary section. Real-time safe.
   SweepHit first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
-                          QueryStats* stats = nullptr);
+                          QueryStats* stats = nullptr) noexcept;
   /// First hit against the tolerance cut at step `step` (0 ≤ step < kToleranceSteps, tolerance
   /// kToleranceLadder_m[step]) instead of a level; the same as first_hit at level id kCutLevelBase + step: each curve's segments of mixed levels that tolerance_cut
   /// chooses (refined while a box's error bound exceeds the tolerance; seed §3, "contact computations at a
@@ -186,7 +186,7 @@ class BoundarySection {
   /// joined polylines (t bit for bit; tests). first_hit_wide does not walk a cut: the wide index's rectangles
   /// hold each level's own pieces, not the joined ones (closest points at a cut: closest_point_cut). Real-time safe.
   SweepHit first_hit_cut(Vec2 a, Vec2 b, int step, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
-                         QueryStats* stats = nullptr) {
+                         QueryStats* stats = nullptr) noexcept {
     return first_hit(a, b, kCutLevelBase + step, excluded, excluded_count, budget, stats);
   }
   /// Closest point on the tolerance cut at step `step` (its joined pieces, as first_hit_cut meets them) to p
@@ -200,7 +200,7 @@ class BoundarySection {
   /// closest point at the tolerance step of the same tolerance. Allocates nothing.
   /// `skip_curves` (skip_count of them) as closest_point's.
   bool closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
-                         QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
+                         QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0) noexcept;
   /// Bytes of this section's own storage [B]: per scene node, 1 (in the frontier, children in it, a full query's
   /// marks); per wide index node, 5 (the same byte, and its parent for the wide frontier) and per item 4 (its parent);
   /// per entry of its capacity (at most kMaxSectionEntries + a few), its node, parent, float rectangle,
@@ -243,7 +243,7 @@ class BoundarySection {
 
   /// The same for a one-off query: spends a copy of `budget` (tests, benches). Real-time safe.
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                     const QueryBudget& budget, QueryStats* stats = nullptr) {
+                     const QueryBudget& budget, QueryStats* stats = nullptr) noexcept {
     QueryBudget copy = budget;
     return first_hit(a, b, level, excluded, excluded_count, copy, stats);
   }
@@ -271,7 +271,7 @@ class BoundarySection {
   /// other curves, so repeated calls that skip the curves found so far list every curve within max_distance_m,
   /// nearest first (ContactSolver::level_change_is_safe).
   bool closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve = -1,
-                     QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0);
+                     QueryBudget* budget = nullptr, const int* skip_curves = nullptr, int skip_count = 0) noexcept;
 
   /// Ids of the current boundary section's entries (for the operator overlay and tests): scene node ids, and with
   /// the wide frontier (wide_frontier_active) also wide index nodes, node w as Scene::node_count() + w.
@@ -283,79 +283,24 @@ class BoundarySection {
   /// The parent of section entry id `id` in the frontier's hierarchy, or 0xffffffff for its root: the scene's
   /// (Scene::parent) in the tree's frontier and below the items; above them in the wide frontier, the wide node
   /// whose slot names it (an item's, or a wide node's). For tests.
-  std::uint32_t entry_parent(std::uint32_t id) const noexcept { return parent_or_none(id); }
+  std::uint32_t entry_parent(std::uint32_t id) const noexcept;
 
  private:
-  struct Query;  // one first_hit's inputs, answer so far and counters (collision_query.cpp)
-  bool at_target(std::uint32_t node, int level) const noexcept;
-  void wall_node_points(std::uint32_t node, int level, Vec2* a, Vec2* b) const noexcept;
+  struct Ops;  // the private operations (static functions taking the section; collision_query_internal.hpp)
+  struct Query;  // one first_hit's inputs, answer so far and counters (collision_query_internal.hpp)
   // The level id whose walls stand for `level` here: itself, or for a cut step without the masks its
   // tolerance step (see the constructor).
   int walls_of(int level) const noexcept { return is_cut_level(level) && cut_mask_ == nullptr ? level - kToleranceSteps : level; }
-  // The phases of first_hit, in order (each documented where it is defined).
-  [[gnu::cold]] void follow_level(int level) noexcept;
-  void coarsen_section(int level) noexcept;
-  std::uint32_t wall_ancestor(std::uint32_t node, int level) const noexcept;
-  bool at_floor(std::uint32_t node, int level) const noexcept;
-  bool inside_free_ball(Vec2 a, Vec2 b) const noexcept;
-  SweepHit first_hit_near_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
-                                QueryStats* stats_out);
-  SweepHit first_hit_tree(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
-                          QueryStats* stats_out);
-  // Whether the wide index holds the walls of level id `level` (not a cut step): every curve is at or below its item
-  // level there (wide_index.hpp). The walks of coarser ids go through the tree of error boxes.
-  // A level below 0 is level 0 (Scene::clamp_level).
-  bool wide_serves(int level) const noexcept { return level < kCutLevelBase && wide_serves_[static_cast<std::size_t>(std::max(level, 0))]; }
-  bool answer_from_ball_walls(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, SweepHit* out,
-                              QueryStats* stats) noexcept;
-  void copy_ball_walls() noexcept;
-  void next_tick() noexcept;
-  void clip_section(Query& q);
-  std::size_t scan_section_rects(const Query& q);
-  void mark_near_rects(double bound_sq, std::size_t skip);
-  void refine_candidates(Query& q);
-  bool push_hit_children(Query& q, std::uint32_t node, int& top);
-  bool push_wide_children(Query& q, std::uint32_t node, int& top);
   static constexpr int kDirectLevels = kWideItemLevel;  // a box this near its walls has them tested at once (8 at most)
-  std::uint32_t segments_under(std::uint32_t node, int level, std::uint32_t* first) const noexcept;
-  bool test_segments_under(Query& q, std::uint32_t node);
-  void test_segment(Query& q, std::uint32_t node);
-  void test_level_run(Query& q, std::uint32_t first, std::uint32_t count);
-  void split_hit_boxes(Query& q);
-  void merge_idle_siblings(Query& q);
-  void merge_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
-  void merge_check_on_ball_tick(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
-  void pay_merge_debt(Vec2 a, Vec2 b, QueryBudget& budget, QueryStats* stats) noexcept;
-  bool merge_if_clear(std::size_t e, std::uint32_t parent, const std::uint32_t* child, std::uint32_t count, Vec2 a, Vec2 b);
   static constexpr int kMaxMergeDebt = 16;  // merge checks full queries leave to the ball ticks (ball or walls answers), at most
   int merge_debt_ = 0;                      // merge checks owed (merge_idle_siblings)
   std::size_t merge_cursor_ = 0;            // the ball ticks' round robin over the entries
-  void gather_ball_walls(const Query& q) noexcept;
-  std::size_t nearest_rect_left(std::size_t n) const noexcept;
-  void place_free_ball(const Query& q) noexcept;
-  void drop_departed_entries() noexcept;
-  SweepHit finish(Query& q) const;
-  void split(std::uint32_t node, std::size_t entry);
-  void split_wide(std::uint32_t node, std::size_t entry);
-  void set_section_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent);
-  void place_entry(std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept;
-  void remove_section_entry(std::size_t entry) noexcept;
-  bool merge_children(std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count);
   // The wide frontier. At level ids the wide index serves (wide_serves; both ids the section serves), the section's
   // entries above the items are the wide index's nodes rather than the tree's chunks, hierarchy and coarse segments
   // (whose boxes follow the curves and overlap: a descent from them opens many): the frontier is then a cut through
   // the index's nodes, its items (segment nodes of the item level) and the tree of error boxes below them. Wide node
   // w is the section id wide_base_ + w, past every scene node; its box is its rectangle in its parent's slot.
   // follow_level switches between the two frontiers (from the roots) when the ids' service changes.
-  bool wide_frontier(int level) const noexcept { return wide_serves(level) && !scene_->wide_index().nodes.empty(); }
-  bool is_wide_id(std::uint32_t id) const noexcept { return id >= wide_base_; }
-  // The section id of a wide node's child code (WideNode::child, not kWideEmpty): an item's segment node, or a wide node.
-  std::uint32_t wide_child_id(std::uint32_t code) const noexcept { return (code & kWideLeaf) ? (code & ~kWideLeaf) : wide_base_ + code; }
-  Aabb entry_rect(std::uint32_t id) const noexcept;
-  ErrorBox entry_box(std::uint32_t id) const noexcept;
-  ErrorBox entry_box_at(std::size_t entry) const noexcept;
-  std::uint32_t entry_children(std::uint32_t id, std::uint32_t* out) const noexcept;
-  std::uint32_t child_count(std::uint32_t id) const noexcept;
   static constexpr std::uint32_t kMaxEntryChildren = 7;  // a node's children in the frontier are counted in three bits
   bool wide_mode_ = false;       // the frontier is the wide one (follow_level)
   std::uint32_t wide_base_ = 0;  // section id of wide node 0: the scene's node_count()
@@ -363,7 +308,6 @@ class BoundarySection {
   std::vector<std::uint32_t> item_up_;     // per item, in the index's item order (curve by curve): the wide node << 2 | slot naming it
   std::vector<std::uint32_t> item_first_;  // per curve: the order of its first item
   Aabb wide_root_rect_{};                  // the wide root's rectangle: its slots' union
-  void link_wide_nodes();
   // The walks of the wide index (wide_index.hpp). One stack serves both: an entry is a child code with its
   // rectangle's squared distance from the walk's point (the order of the walk) and, for first_hit_wide,
   // where the sweep enters it (+inf when it does not). 12 bytes an entry, as three arrays: every access
@@ -376,11 +320,6 @@ class BoundarySection {
     std::size_t size() const { return code.size(); }
     void resize(std::size_t n) { t_enter.resize(n); d_sq.resize(n); code.resize(n); }
   };
-  std::uint32_t item_segments(std::uint32_t item, int level, std::uint32_t* first) const noexcept;
-  bool push_walk(float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept;
-  void wide_test_item(Query& q, std::uint32_t item);
-  double wide_walk(Query& q, double ball_cap_m);
-  float seeded_ball_sq(const WideIndex& wi, float bx, float by, float cap_sq) const noexcept;
   WalkStack walk_;                         // the wide walks' stack (WideIndex::stack_entries)
   const Scene* scene_;
   double merge_margin_m_;
@@ -418,28 +357,14 @@ class BoundarySection {
   std::vector<std::uint64_t> rect_near_bits_;     // scan scratch, a bit per entry: its rectangle may be nearer than the nearest box so far
   double scale_m_ = 0.0;                   // the largest coordinate magnitude of any section rectangle (the scene root's) [m]
   static constexpr std::uint32_t kNoParent = 0xffffffffu;  // the root's `parent` below: counted nowhere
-  // Appends node with its rectangle and marks it in (the caller checked the room); parent: parent_or_none(node).
-  void push_section(std::uint32_t node, std::uint32_t parent);
-  std::uint32_t parent_or_none(std::uint32_t node) const noexcept;
-  void mark_out(std::uint32_t node, std::uint32_t parent) noexcept;
   // The section's state of each node, one byte (node_state_): bit 0 (kInSection) while the node is in the frontier;
   // bits 1 and 2 the marks of one full query (kHitMark, kCheckedMark, below); bits 3 to 5 how many of its children
   // (at most 4, scene.hpp) are in the frontier, in units of kChildInUnit. Bits 6 and 7 stay clear.
   static constexpr std::uint8_t kInSection = 1, kChildInUnit = 8, kChildrenInMask = 0x38;
   std::vector<std::uint8_t> node_state_;
-  bool in_section(std::uint32_t node) const noexcept { return (node_state_[node] & kInSection) != 0; }
-  std::uint32_t children_in(std::uint32_t node) const noexcept { return node_state_[node] / kChildInUnit; }
-  void clear_state(std::uint32_t node, std::uint8_t bits) noexcept { node_state_[node] &= static_cast<std::uint8_t>(~bits); }
   struct Candidate { double t_enter; std::uint32_t node; std::uint32_t entry; };  // entry: its place in section_ (a hit entry), or kNotAnEntry. 16 bytes
   static constexpr std::uint32_t kNotAnEntry = 0xffffffffu;
   static_assert(sizeof(Candidate) == 16, "Candidate: four per cache line");
-  /// Checked push onto the DFS stack (sized by hk::tree_stack_entries): false, and nothing pushed, when it
-  /// is full, which a tree within kMaxLevels + kMaxHierarchyDepth levels never fills.
-  bool push(int& top, Candidate c) noexcept {
-    if (static_cast<std::size_t>(top) >= stack_.size()) return false;
-    stack_[static_cast<std::size_t>(top++)] = c;
-    return true;
-  }
   std::vector<Candidate> candidates_;      // section nodes hit this tick
   std::vector<Candidate> stack_;           // DFS stack, tree_stack_entries(widest fan-out) entries, sized at build
   // Marks of one full query, bits of node_state_, set by its phases and cleared by clear_marks (the nodes marked are
@@ -450,24 +375,8 @@ class BoundarySection {
                 "node_state_: the flags and a count of up to 4 children in, in separate bits");
   std::vector<std::uint32_t> marked_;      // the nodes marked so far this query, marked_count_ of them (2 × capacity_ slots)
   std::size_t marked_count_ = 0;
-  // Checked: a node is marked at most once per bit in a query, and only section entries (kHitMark) and their
-  // parents (kCheckedMark) are, so the list never fills; were it full, the mark is not set, which costs only work
-  // (a hit entry's parent box meets the sweep too, so it is not merged; a parent may be checked twice).
-  void mark(std::uint32_t node, std::uint8_t bit) noexcept {
-    if (marked_count_ == marked_.size()) return;
-    node_state_[node] |= bit;
-    marked_[marked_count_++] = node;
-  }
-  void clear_marks() noexcept;
-  // The closest-point walk (see closest_point), its phases in order.
-  struct ClosestQuery;  // one call's point, best answer so far and bound (collision_query.cpp)
-  void closest_seed(ClosestQuery& q) const noexcept;
-  bool closest_walk(ClosestQuery& q, QueryBudget* budget) noexcept;
-  bool closest_tree_walk(ClosestQuery& q, QueryBudget* budget) noexcept;
-  void closest_test_item(ClosestQuery& q, std::uint32_t item) noexcept;
-  bool closest_open_node(const ClosestQuery& q, const WideNode& n, float px, float py, int* top, std::uint32_t* next) noexcept;
-  std::uint32_t closest_pop(const ClosestQuery& q, int* top) const noexcept;
-  void closest_offer(ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) const noexcept;
+  // The closest-point walk (see closest_point; its phases are Ops::closest_*).
+  struct ClosestQuery;  // one call's point, best answer so far and bound (collision_closest.cpp)
   std::uint32_t last_closest_node_ = kWideEmpty;  // the previous call's answer (segment node), the next call's seed
   int last_closest_level_ = -1, last_closest_curve_ = -1;
   std::uint32_t tick_ = 0;

@@ -17,7 +17,7 @@
 /// Force on the handle = stiffness · (proxy − handle) − damping · (handle velocity along the contact
 /// normal), clamped to max_force_n.
 ///
-/// Friction (issue 6, item 3; the friction cone of the god-object, Salisbury, Brock, Massie, Swarup &
+/// Friction (the friction cone of the god-object, Salisbury, Brock, Massie, Swarup &
 /// Zilles 1995, "Haptic rendering: programming touch interaction with virtual objects", §"friction", and
 /// CHAI3D's finger-proxy algorithm): in edge contact the handle's offset from the proxy has a normal part
 /// d (the penetration) and a tangential part t. The proxy sticks while |t| ≤ μ_s·d (inside the static
@@ -28,7 +28,7 @@
 /// frictionless, the seed paper's model. Friction only ever holds the proxy back, so it takes energy out
 /// (the work the hand does round a closed loop is ≥ 0).
 ///
-/// Push-through (issue 14, item 1; DESIGN.md "Contact"): a blind visitor cannot lift the handle over a wall,
+/// Push-through (DESIGN.md "Contact"): a blind visitor cannot lift the handle over a wall,
 /// so a wall gives way, as a membrane, to a deliberate press. While in contact, the spring force
 /// stiffness·|proxy − handle| (unclamped: how hard the hand presses) is counted tick by tick (not while the
 /// force ramps in: ContactInput::press_counts); once it has
@@ -136,20 +136,20 @@ class ContactSolver {
   /// cut masks (make_cut_walls).
   ContactSolver(const Scene& scene, const ContactParams& params);
   /// The same, with the cut masks and bounds `cuts` (make_cut_walls of `scene`, shared with other solvers of
-  /// it; null: none) in place of params.cut_walls. Throws std::invalid_argument when they are another scene's.
+  /// it; null: none) in place of params.cut_walls. Throws hk::ArgumentError when they are another scene's.
   ContactSolver(const Scene& scene, const ContactParams& params, std::shared_ptr<const CutWalls> cuts);
 
   /// Puts the proxy at p in free space and forgets the contact state. If p is within the skin of a
   /// polyline at `level`, it is pushed off along the wall's normal. Not for the servo path (may walk
   /// the tree from the roots), but allocates nothing.
-  void reset(Vec2 p_m, int level);
+  void reset(Vec2 p_m, int level) noexcept;
 
   /// One tick: move the proxy towards the handle under the constraints, then compute the force.
   /// Real-time safe: no allocation, lock, throw or I/O.
-  void update(const ContactInput& in, ContactOutput& out);
+  void update(const ContactInput& in, ContactOutput& out) noexcept;
 
   /// Whether the level in use may change to `new_level` now without the proxy ending up on the other side
-  /// of the new level's polyline than it is of the old one (issue 6, item 2). For each curve the proxy
+  /// of the new level's polyline than it is of the old one. For each curve the proxy
   /// touches, and every curve within the search radius (below) at either level (at most kMaxSideCurves in
   /// all; more, and the change waits), the proxy's side of the curve is found at both levels
   /// (closest point and pseudo-normal, see side_of_curve); a curve on which the sides differ has the proxy
@@ -158,9 +158,9 @@ class ContactSolver {
   /// levels lie within E = (largest wall offset of the old level + of the new) of both polylines, the offset
   /// being the boxes' error bound: their half-width combined with their reach past their segments' ends, which
   /// is the larger at a sharp corner, where a coarse level's apex lies inside the original's. So only curves
-  /// within 2E are searched. (Until 2026-11-26 only the nearest curve at each level was, and a second curve as
-  /// near, where two edges cross, could have the proxy between its levels unseen; until that night E took the
-  /// half-width alone, and a coarse apex could lie behind the proxy unseen.) When the change is made (the next update() with the new level),
+  /// within 2E are searched, and every one of them, not only the nearest at each level: a second curve as
+  /// near, where two edges cross, could have the proxy between its levels; and E takes the reach as well as the
+  /// half-width, since with the half-width alone a coarse apex could lie behind the proxy unseen. When the change is made (the next update() with the new level),
   /// the old level stays a wall, with the proxy's constraints on it, until the proxy rests on none of its
   /// segments: the proxy, on the same side of both polylines, then reaches the new one without crossing
   /// either. No second change is made while the old level is still a wall. Allocates nothing (at most six
@@ -172,7 +172,7 @@ class ContactSolver {
   /// between them. At a cut step a segment's ends depend on its neighbours in the cut, so a constraint keeps
   /// the level id it was met at (its geometry), and the wall the proxy slides on is left out only of the
   /// queries where it has that same geometry.
-  bool level_change_is_safe(int new_level, QueryBudget* budget = nullptr);
+  bool level_change_is_safe(int new_level, QueryBudget* budget = nullptr) noexcept;
   /// The most curves level_change_is_safe compares sides on in one check (where more lie within its radius,
   /// as at a knot of many edges, the change waits).
   static constexpr int kMaxSideCurves = 8;
@@ -194,10 +194,10 @@ class ContactSolver {
   // or short of the first box the query could not resolve in its budget (Blocked). The `excluded`
   // constraint (the wall the proxy slides on, or null) is left out of each query whose walls include it
   // with the same geometry (excluded_at).
-  Move move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget, ContactOutput& out, Constraint* hit_out);
+  Move move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget, ContactOutput& out, Constraint* hit_out) noexcept;
   // Whether constraint c is a wall of level id `level` with the same end points as its own (its own level;
   // at a cut step the same segment may be joined to other neighbours, so it is another wall there).
-  bool excluded_at(const Constraint& c, int level) const;
+  bool excluded_at(const Constraint& c, int level) const noexcept;
   // What one update() works on: the handle, the tick's budget, the output. Passed to the state steps.
   struct Step {
     const ContactInput& in;
@@ -207,29 +207,29 @@ class ContactSolver {
   // The phases of update(), in order: begin_step, pop_through (when a press has lasted pop_hold_s), then per
   // iteration the step of the current state (each returns true when the proxy is at rest for this tick),
   // then contact_force, release_force and finish_step (which also counts the press for the next tick).
-  void begin_step(const ContactInput& in, ContactOutput& out);
+  void begin_step(const ContactInput& in, ContactOutput& out) noexcept;
   // Push-through, its own transition Edge/Vertex → Free: true when the press counted so far is due.
-  bool pop_due() const;
-  void pop_through(Step& s);
+  bool pop_due() const noexcept;
+  void pop_through(Step& s) noexcept;
   // The contact force plus what remains of the force before a pop (fading over pop_release_s), clamped.
-  Vec2 release_force(Vec2 contact_force_n);
-  void count_press(const ContactInput& in, ContactOutput& out);
+  Vec2 release_force(Vec2 contact_force_n) noexcept;
+  void count_press(const ContactInput& in, ContactOutput& out) noexcept;
   // Pushes the proxy off any polyline of the level in use within the skin, to the side it is on.
-  void push_off_walls(QueryBudget* budget);
-  bool step_free(Step& s);
-  bool step_edge(Step& s);
-  bool step_vertex(Step& s);
+  void push_off_walls(QueryBudget* budget) noexcept;
+  bool step_free(Step& s) noexcept;
+  bool step_edge(Step& s) noexcept;
+  bool step_vertex(Step& s) noexcept;
   // Edge state: the slide along c_[0] reached its vertex at the end `clamped` (−1 start, +1 end).
-  bool at_edge_vertex(Step& s, int clamped);
-  Vec2 contact_force(const ContactInput& in) const;
-  void finish_step(ContactState before, Vec2 force_n, ContactOutput& out);
+  bool at_edge_vertex(Step& s, int clamped) noexcept;
+  Vec2 contact_force(const ContactInput& in) const noexcept;
+  void finish_step(ContactState before, Vec2 force_n, ContactOutput& out) noexcept;
   // The wall geometry of segment s at level id `level` (BoundarySection::wall_points), and of a constraint.
   struct SegGeom {
     Vec2 a, b, u, n;  // end points, unit direction, unit left normal
     double len = 0.0;
   };
-  SegGeom geom(SegmentRef s, int level) const;
-  SegGeom geom(const Constraint& c) const { return geom(c.seg, c.level); }
+  SegGeom geom(SegmentRef s, int level) const noexcept;
+  SegGeom geom(const Constraint& c) const noexcept { return geom(c.seg, c.level); }
 
   const Scene* scene_;
   ContactParams params_;
@@ -255,7 +255,7 @@ class ContactSolver {
   // the side of the end segment's line: beyond the end, the wedge between two levels' end segments then has
   // different sides, as it lies between the polylines; so does the opposite wedge, where a change waits
   // although nothing is crossed (safe, and only while the proxy stays there).
-  int side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget);
+  int side_of_curve(Vec2 p, int curve, int level, double radius_m, QueryBudget* budget) noexcept;
 };
 
 }  // namespace hk

@@ -1,6 +1,6 @@
 #pragma once
 /// @file explorer_hand.hpp
-/// The visitor-like model hand of headless runs, `--hand explorer` (issue 14, item 4): a closed-loop
+/// The visitor-like model hand of headless runs, `--hand explorer`: a closed-loop
 /// HandController that knows only what a visitor knows, what it feels (HandFeel: force, handle, and the
 /// push-through earcon it hears) and its own memory of where it has been, never the scene. The memory is a grid
 /// of cell_m cells: which cells a trace ran along (walls felt round) and which the handle has passed over in this
@@ -72,7 +72,7 @@ struct ExplorerParams {
   double retrace_max_m = 0.02;          ///< a trace running this far over walls traced before ends [m], > 0
   double pop_travel_max_m = 0.008;      ///< a push that carried the handle this far without the wall giving way failed [m], > 0
 
-  /// Throws std::invalid_argument (one line naming the field and its limit) when a value is out of range.
+  /// Throws hk::ArgumentError (one line naming the field and its limit) when a value is out of range.
   void validate() const;
 };
 
@@ -131,6 +131,11 @@ class ExplorerHand final : public HandController {
   void advance_carrot(Vec2 handle, double dt);
   void check_goal(const HandFeel& f);
   HandCommand step_trace(const HandFeel& f, double dt);
+  // Trace's stages: the wall's normal as felt, the travel noted, the end tests, the command along the wall.
+  bool feel_trace_wall(const HandFeel& f, double dt);
+  void note_trace_travel(const HandFeel& f, bool touching);
+  bool trace_ends(const HandFeel& f);
+  HandCommand trace_command(const HandFeel& f, double dt, bool touching);
   HandCommand step_pop(const HandFeel& f);
   // Phase entries.
   void enter_move(Vec2 handle);

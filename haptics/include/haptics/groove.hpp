@@ -1,6 +1,6 @@
 #pragma once
 /// @file groove.hpp
-/// The grooves rendering mode (issue 14, item 2; DESIGN.md "Contact": `[haptics] render = "grooves"`).
+/// The grooves rendering mode (DESIGN.md "Contact": `[haptics] render = "grooves"`).
 ///
 /// Each curve is an engraved line, the convention of haptic line graphs (Yu & Brewster 2002, "Comparing
 /// two haptic interfaces for multimodal graph rendering", HAPTICS'02, and Yu, Ramloll & Brewster 2001,
@@ -78,17 +78,17 @@ class GrooveSolver {
   /// cut masks (make_cut_walls).
   GrooveSolver(const Scene& scene, const GrooveParams& params);
   /// The same, with the cut masks and bounds `cuts` (make_cut_walls of `scene`, shared with other solvers of
-  /// it; null: none) in place of params.cut_walls. Throws std::invalid_argument when they are another scene's.
+  /// it; null: none) in place of params.cut_walls. Throws hk::ArgumentError when they are another scene's.
   GrooveSolver(const Scene& scene, const GrooveParams& params, std::shared_ptr<const CutWalls> cuts);
 
   /// Starts at p [m] on `level`: free state, no force remembered (the next force is limited from zero).
   /// Real-time safe (allocates nothing).
-  void reset(Vec2 p_m, int level);
+  void reset(Vec2 p_m, int level) noexcept;
 
   /// One tick: the closest point within the capture radius at in.level, the groove force towards it,
   /// limited per tick. in.handle_velocity_m_per_s is not used. Every box test is charged to a copy of
   /// in.budget (see BoundarySection::closest_point). Real-time safe: no allocation, lock, throw or I/O.
-  void update(const ContactInput& in, ContactOutput& out);
+  void update(const ContactInput& in, ContactOutput& out) noexcept;
 
   /// The boundary section (the grooves mode walks from the roots and leaves it at the roots; kept for
   /// the display, which shows the active solver's section).
@@ -105,8 +105,8 @@ class GrooveSolver {
 
  private:
   // The phases of update, in order (each documented where it is defined).
-  void find_groove(Vec2 h, QueryBudget& budget, ContactOutput& out);
-  Vec2 groove_force(Vec2 h);
+  void find_groove(Vec2 h, QueryBudget& budget, ContactOutput& out) noexcept;
+  Vec2 groove_force(Vec2 h) noexcept;
   const Scene* scene_;
   GrooveParams params_;
   BoundarySection section_;

@@ -1,6 +1,6 @@
 #pragma once
 /// @file hand_controller.hpp
-/// A closed-loop model hand for headless runs (issue 14, item 4; DESIGN.md "Headless runs"): each tick the
+/// A closed-loop model hand for headless runs (DESIGN.md "Headless runs"): each tick the
 /// hand is told what it feels (where the handle is, how fast it moves, the force the device puts on it) and
 /// answers where it pulls the handle and how hard it may push. A HandPath (open loop: a target that ignores
 /// what is felt) is one such hand (PathHand); the visitor-like explorer (`--hand explorer`) is another.

@@ -24,7 +24,7 @@ struct HandSample {
 /// them and held constant before the first and after the last sample. The path starts at t = 0.
 class HandPath {
  public:
-  /// Takes the samples. Throws std::invalid_argument (one line) when `samples` is empty, a value is
+  /// Takes the samples. Throws hk::ArgumentError (one line) when `samples` is empty, a value is
   /// not finite, a time is negative, or times are not strictly increasing.
   explicit HandPath(std::vector<HandSample> samples);
 
@@ -47,13 +47,13 @@ class HandPath {
 /// h / ceil(h / spacing_m) ≤ spacing_m, so every point of the rectangle is within spacing_m/2 of the
 /// path and both horizontal edges are traced. Constant speed speed_m_per_s [m/s]: a sample at every
 /// corner, timed by arc length, so duration = (n_lines·w + h) / speed.
-/// Throws std::invalid_argument when an argument is not finite and > 0, or the raster would need more
+/// Throws hk::ArgumentError when an argument is not finite and > 0, or the raster would need more
 /// than 1,000,000 lines.
 HandPath raster_path(double width_m, double height_m, double spacing_m, double speed_m_per_s);
 
 /// The raster of `raster_path`, re-timed so that its lines run at `line_speeds_m_per_s` in turn (line k at
 /// speed k mod size) and the steps between lines at `step_speed_m_per_s` [m/s]: a hand that keeps changing
-/// pace, for the level policy (issue 6). Throws std::invalid_argument (one line) when a speed is not finite
+/// pace, for the level policy. Throws hk::ArgumentError (one line) when a speed is not finite
 /// and > 0, `line_speeds_m_per_s` is empty, or raster_path refuses its arguments.
 HandPath raster_path_with_line_speeds(double width_m, double height_m, double spacing_m,
                                       const std::vector<double>& line_speeds_m_per_s, double step_speed_m_per_s);

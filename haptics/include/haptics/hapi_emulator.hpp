@@ -85,7 +85,7 @@ using HandForce = std::function<Vec2(double t_s, Vec2 handle_device_m, Vec2 velo
 class FirmwareEmulator {
  public:
   /// Builds the board at power-up (nothing assigned, all direction bytes 0) with the handle at rest at
-  /// `start_handle_device_m` [m] (clamped into the stop box). Throws std::invalid_argument (one line)
+  /// `start_handle_device_m` [m] (clamped into the stop box). Throws hk::ArgumentError (one line)
   /// when a parameter is out of range or not finite, or the stop box is not reachable.
   FirmwareEmulator(const EmulatorParams& params, Vec2 start_handle_device_m, HandForce hand);
   ~FirmwareEmulator();

@@ -1,6 +1,6 @@
 #pragma once
 /// @file level_policy.hpp
-/// Resolution level from hand speed (issue 6, item 1; seed §1 and §5: "finer levels only when the hand
+/// Resolution level from hand speed (seed §1 and §5: "finer levels only when the hand
 /// moves slowly"). Each tick: filter the hand's speed, ask how large a deviation from the true curve the
 /// hand cannot feel at that speed, and pick the coarsest level whose error bound is below it — with
 /// hysteresis and a dwell time so the level does not flap.

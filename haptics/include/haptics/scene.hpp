@@ -16,7 +16,7 @@
 /// the hierarchy's leaf order, so every node's children are consecutive ids, and no node has more than
 /// 4 children: the boundary section stays small however long or many the curves are.
 ///
-/// Storage (issue 18: compact boxes). A segment's error box is not stored whole: its frame follows
+/// Storage (compact boxes). A segment's error box is not stored whole: its frame follows
 /// from its end points (origin at the first, axis toward the second), so a slot keeps its point
 /// (16 bytes, shared by the segment ending there) and the box's four extents quantised to 16 bits,
 /// rounded outward (8 bytes), plus a 4-byte tag (curve and level). Only the few chunk and hierarchy nodes
@@ -158,10 +158,10 @@ class Scene {
   /// when the nodes would not fit 32-bit ids, or the curves a 28-bit tag: far beyond any memory).
   static Scene build(const std::vector<Polyline>& curves, int max_levels);
 
-  std::size_t curve_count() const { return curves_.size(); }
-  const CurveInfo& curve(std::size_t c) const { return curves_[c]; }
+  std::size_t curve_count() const noexcept { return curves_.size(); }
+  const CurveInfo& curve(std::size_t c) const noexcept { return curves_[c]; }
   /// What the tree walks read of curve c (node offsets, levels).
-  const CurveNodes& curve_nodes(std::size_t c) const { return curve_nodes_[c]; }
+  const CurveNodes& curve_nodes(std::size_t c) const noexcept { return curve_nodes_[c]; }
   /// Arc length along the original curve to curve c's level-0 point i [m]: its resampling parameter, bit
   /// for bit build_multires' arc_m[i]. i < curve(c).point_count[0].
   double level0_arc_m(std::size_t c, std::size_t i) const {
@@ -173,34 +173,34 @@ class Scene {
   std::size_t skipped_curves() const { return skipped_; }
 
   /// Total node ids: the slots of all levels of all curves, the chunks, the hierarchy above.
-  std::size_t node_count() const { return segment_nodes_ + group_box_.size(); }
+  std::size_t node_count() const noexcept { return segment_nodes_ + group_box_.size(); }
   /// The one node every walk starts from (a hierarchy node; valid only when curve_count() > 0).
-  std::uint32_t scene_root() const { return scene_root_; }
+  std::uint32_t scene_root() const noexcept { return scene_root_; }
   /// True for slot ids (segment nodes; the last slot of each level, which starts no segment, included);
   /// false for chunks and the hierarchy.
-  bool is_segment(std::uint32_t node) const { return node < segment_nodes_; }
+  bool is_segment(std::uint32_t node) const noexcept { return node < segment_nodes_; }
   /// True for a chunk (a run of coarsest segments of one curve).
-  bool is_chunk(std::uint32_t node) const { return node >= segment_nodes_ && node < segment_nodes_ + chunk_count_; }
+  bool is_chunk(std::uint32_t node) const noexcept { return node >= segment_nodes_ && node < segment_nodes_ + chunk_count_; }
   /// Coarsest segments per chunk, at most.
   static constexpr std::uint32_t kSegmentsPerChunk = 4;
 
   /// Curve (bits 4..31) and level (bits 0..3) of a segment node, packed.
   static constexpr std::uint32_t kTagLevelBits = 4;
   static_assert(kMaxLevels <= (1 << kTagLevelBits), "a level fits the tag's level bits");
-  std::uint32_t tag_curve(std::uint32_t node) const { return tag_[node] >> kTagLevelBits; }
-  int tag_level(std::uint32_t node) const { return static_cast<int>(tag_[node] & ((1u << kTagLevelBits) - 1)); }
+  std::uint32_t tag_curve(std::uint32_t node) const noexcept { return tag_[node] >> kTagLevelBits; }
+  int tag_level(std::uint32_t node) const noexcept { return static_cast<int>(tag_[node] & ((1u << kTagLevelBits) - 1)); }
 
   /// The error box of a node: a segment's, rebuilt from its end points and stored extents; a chunk's or
   /// hierarchy node's axis-aligned box as an ErrorBox with origin (0, 0) and axis (1, 0). O(1), one root.
   /// A slot id must start a segment (as segment_box()).
-  ErrorBox box(std::uint32_t node) const {
+  ErrorBox box(std::uint32_t node) const noexcept {
     if (node >= segment_nodes_) return rect_box(group_box_[node - segment_nodes_]);
     return segment_box(node);
   }
   /// The error box of segment node `node`: a slot that starts a segment, not a level's last slot
   /// (is_segment() is true for that one too, but it has no box: this would read the next level's first
   /// point, or past the array for the scene's last slot). Unchecked, for the walks' speed.
-  ErrorBox segment_box(std::uint32_t node) const {
+  ErrorBox segment_box(std::uint32_t node) const noexcept {
     const Vec2 a = points_m_[node];
     double length_m = 0.0;
     const Vec2 axis = segment_frame(a, points_m_[node + 1], &length_m);
@@ -221,7 +221,7 @@ class Scene {
   /// A rectangle that holds a node's box [m], cheaply: for a segment, the rectangle of its end points
   /// grown by the box's largest overhang plus its largest half-width (no root, looser than aabb());
   /// for a chunk or hierarchy node, its stored rectangle. For rejecting boxes before rebuilding them.
-  Aabb loose_aabb(std::uint32_t node) const {
+  Aabb loose_aabb(std::uint32_t node) const noexcept {
     if (node >= segment_nodes_) return group_box_[node - segment_nodes_];
     const Vec2 a = points_m_[node], b = points_m_[node + 1];
     const BoxExtent& e = extent_[node];
@@ -231,17 +231,17 @@ class Scene {
   }
   /// Axis-aligned rectangle around a node's box [m]: stored for chunks and the hierarchy, computed for
   /// segments (from the box's centre and half-extents, a few ulps wider than its four corners' rectangle).
-  Aabb aabb(std::uint32_t node) const;
+  Aabb aabb(std::uint32_t node) const noexcept;
   /// Curve, level and index of a node (see NodeInfo).
-  NodeInfo info(std::uint32_t node) const {
+  NodeInfo info(std::uint32_t node) const noexcept {
     if (node >= segment_nodes_) return group_info_[node - segment_nodes_];
     const std::uint32_t c = tag_curve(node);
     const int l = tag_level(node);
     return NodeInfo{c, l, node - curve_nodes_[c].box_offset[l]};
   }
-  std::uint32_t node_of(SegmentRef s) const { return curve_nodes_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
+  std::uint32_t node_of(SegmentRef s) const noexcept { return curve_nodes_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
   /// Parent of a node (the scene root's parent is itself). Inline: the section's merge checks ask it per entry.
-  std::uint32_t parent(std::uint32_t node) const {
+  std::uint32_t parent(std::uint32_t node) const noexcept {
     if (node >= segment_nodes_) return group_parent_[node - segment_nodes_];
     const CurveNodes& cn = curve_nodes_[tag_curve(node)];
     const int l = tag_level(node);
@@ -250,7 +250,7 @@ class Scene {
     return chunk_of_curve_[cn.chunk_offset + k / kSegmentsPerChunk];  // a coarsest segment: its chunk
   }
   /// First child and child count of a node; children are consecutive ids (0 for a level-0 segment).
-  void children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const {
+  void children(std::uint32_t node, std::uint32_t* first, std::uint32_t* count) const noexcept {
     if (node >= segment_nodes_) {
       const std::size_t g = node - segment_nodes_;
       *first = group_child_first_[g];
@@ -273,14 +273,14 @@ class Scene {
 
   /// Level-l points of curve c (the scaling coefficients) [m]: point_count[l] of them, then, for a closed
   /// curve, the first again.
-  const Vec2* points(std::size_t c, int level) const { return points_m_.data() + curves_[c].point_offset[level]; }
+  const Vec2* points(std::size_t c, int level) const noexcept { return points_m_.data() + curves_[c].point_offset[level]; }
   /// End points of a segment [m].
-  void segment(SegmentRef s, Vec2* a, Vec2* b) const { segment_points(node_of(s), a, b); }
+  void segment(SegmentRef s, Vec2* a, Vec2* b) const noexcept { segment_points(node_of(s), a, b); }
   /// The point of slot `node` [m]: segment node k runs from slot_points(k)[0] to slot_points(k)[1], and
   /// consecutive segments of a level share their slots (for walks that read a run of segments at once).
-  const Vec2* slot_points(std::uint32_t node) const { return points_m_.data() + node; }
+  const Vec2* slot_points(std::uint32_t node) const noexcept { return points_m_.data() + node; }
   /// End points of segment node `node` [m].
-  void segment_points(std::uint32_t node, Vec2* a, Vec2* b) const {
+  void segment_points(std::uint32_t node, Vec2* a, Vec2* b) const noexcept {
     *a = points_m_[node];
     *b = points_m_[node + 1];
   }
@@ -304,7 +304,7 @@ class Scene {
   /// tolerance (CurveNodes::tolerance_level). A cut step renders no single level: it gives its tolerance
   /// step's level, the one its cut refines (the cut's own segments: tolerance_cut.hpp). Ids past the last
   /// cut step count as the last.
-  int clamp_level(std::size_t c, int level) const {
+  int clamp_level(std::size_t c, int level) const noexcept {
     const CurveNodes& cn = curve_nodes_[c];
     if (level >= kToleranceLevelBase) {
       const int step = level >= kCutLevelBase ? level - kCutLevelBase : level - kToleranceLevelBase;
@@ -319,10 +319,10 @@ class Scene {
   const SceneBuildTimes& build_times() const { return times_; }
   /// The spatial 4-wide index over the item-level error boxes (wide_index.hpp), which the walks of
   /// first_hit and closest_point use instead of the curve-following hierarchy above the items.
-  const WideIndex& wide_index() const { return wide_; }
+  const WideIndex& wide_index() const noexcept { return wide_; }
 
  private:
-  friend class SceneBuild;  // the build phases (scene.cpp)
+  friend class SceneBuild;  // the build phases (scene_build.cpp)
   std::vector<CurveInfo> curves_;
   std::vector<CurveNodes> curve_nodes_;
   std::vector<std::size_t> source_index_;

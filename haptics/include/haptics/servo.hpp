@@ -1,23 +1,23 @@
 #pragma once
 /// @file servo.hpp
-/// The servo tick (DESIGN.md "Data flow", "Real-time rules"): device sample → level policy (hand speed,
-/// issue 6) → collision query and contact solver at the level in use → force-step limit at level changes →
+/// The servo tick (DESIGN.md "Data flow", "Real-time rules"): device sample → level policy (hand speed)
+/// → collision query and contact solver at the level in use → force-step limit at level changes →
 /// force guard → force command, plus haptic events.
 ///
-/// Level changes (issue 6, item 2): the level wanted (LevelPolicy in auto mode, else the fixed level) is
+/// Level changes: the level wanted (LevelPolicy in auto mode, else the fixed level) is
 /// taken only at a tick where ContactSolver::level_change_is_safe says the proxy is on the same side of the
 /// new level's polyline as of the old one; until then the old level stays (ServoOutput::level_wanted shows
 /// the wait). After the change the old level remains a wall until the proxy leaves it, and any difference
 /// between the force of the last tick and the new level's force fades out at max_force_step_n per tick.
 ///
-/// Live gains (issue 12, item 4): stiffness, damping, maximum force and friction may change while a hand
+/// Live gains: stiffness, damping, maximum force and friction may change while a hand
 /// presses on a wall (ServoLoop::set_gains). The solver uses the new gains at once; the difference between
 /// the last tick's force and the new gains' force goes into the same fading residual as a level change, and
 /// the guard's clamp walks to the new maximum force at max_force_step_n per tick, so no change of gains
 /// (or of level, or both in one tick) moves the force by more than max_force_step_n per tick beyond what
 /// the hand's own motion does. A difference of D [N] is gone after ceil(D / max_force_step_n) ticks,
 /// counting the tick that takes the change.
-/// Push-through (issue 14) is the contact solver's (ContactSolver::pop_through); the loop only keeps a press
+/// Push-through is the contact solver's (ContactSolver::pop_through); the loop only keeps a press
 /// from counting while its force ramps in (start-up, ServoInput::press_counts false while the caller fades).
 /// The tick is `update(input, output) -> TickResult`: a function of (state, sample, scene), with no
 /// allocation, lock, throw, I/O, logging or clock read. Its collision work is bounded by one number, the
@@ -26,7 +26,7 @@
 /// solver; past it the proxy waits where the sweep is proven clear and a level change waits for a later
 /// tick. Timing the tick is the caller's business. Status enums here; exceptions only at setup.
 ///
-/// Grooves (issue 14, item 2; ServoParams::render): the loop holds both solvers, sized at construction, and
+/// Grooves (ServoParams::render): the loop holds both solvers, sized at construction, and
 /// steps the one in use: GrooveSolver (groove.hpp) in grooves mode, whose output fills the same
 /// ContactOutput (proxy = closest point within the capture radius, state Edge inside it). Level changes are
 /// then taken at once (no wall to cross), and the force-step limit at level and gains changes is the groove
@@ -60,12 +60,12 @@ struct ForceGuard {
   /// Zero force when `status` is not Ok (why = DeviceNotOk), when `deadline_missed` (DeadlineMissed) or
   /// when `force_n` is NaN/inf (NonFinite), checked in that order; otherwise the force clamped in length
   /// to max_force_n · min(1, since_start_s / ramp_s), direction kept (why = Ok). `why` must not be null.
-  Vec2 apply(Vec2 force_n, double since_start_s, DeviceStatus status, bool deadline_missed, TickResult* why) const;
+  Vec2 apply(Vec2 force_n, double since_start_s, DeviceStatus status, bool deadline_missed, TickResult* why) const noexcept;
 };
 
 /// Default box-test budget of a servo tick (ServoParams::query_box_budget; config key
 /// [haptics] query_box_budget), sized so a tick's collision work stays near 200 µs, a fifth of the 1 ms
-/// period. Measured 2026-11-22 on the 2-core development machine with a build running on the other core:
+/// period. Measured on the 2-core development machine with a build running on the other core:
 ///   cmake --build build --target bench_anytime && build/bench/bench_anytime --out /tmp/anytime.json
 /// which reports whole cold-query time divided by its box tests (sorting, segment tests and section
 /// upkeep included): 42 ns per box test on horse, 46 ns on sudoku, 70 ns on a tiled 100k-segment scene
@@ -74,7 +74,7 @@ struct ForceGuard {
 /// A cold query needs 30–60 box tests to answer exactly at level 0, so the budget binds only in pathologies.
 inline constexpr std::int32_t kDefaultQueryBoxBudget = 4000;
 
-/// How curves are felt (issue 14, item 2; config key [haptics] render): as walls the proxy cannot cross
+/// How curves are felt (config key [haptics] render): as walls the proxy cannot cross
 /// (ContactSolver, the seed paper's god-object) or as engraved grooves that pull the hand in within a
 /// capture radius and never block (GrooveSolver, groove.hpp).
 enum class RenderMode : std::uint8_t {
@@ -82,7 +82,7 @@ enum class RenderMode : std::uint8_t {
   Grooves,  ///< engraved lines (GrooveSolver)
 };
 
-/// The servo settings an operator may change while a visitor touches a wall (issue 12, item 4). Units in
+/// The servo settings an operator may change while a visitor touches a wall. Units in
 /// names. Values are assumed checked (config ranges): finite, max_force_step_n > 0, the rest ≥ 0.
 struct ServoGains {
   double stiffness_n_per_m = 800.0;   ///< wall stiffness [N/m] (ContactParams::stiffness_n_per_m)
@@ -102,8 +102,8 @@ struct ServoGains {
 struct ServoParams {
   double period_s = 0.001;          ///< servo period = 1 / servo rate [s]
   int level = 1;                    ///< resolution level at start, and always when !auto_level
-  bool auto_level = false;          ///< the level follows the hand's speed (LevelPolicy; issue 6)
-  /// With auto_level: the policy picks a tolerance step instead of a level (issue 18; level ids,
+  bool auto_level = false;          ///< the level follows the hand's speed (LevelPolicy)
+  /// With auto_level: the policy picks a tolerance step instead of a level (level ids,
   /// hk/constants.hpp), so each curve renders at the coarsest of its own levels within the tolerance the
   /// hand's speed allows, under the same crossing checks at changes. `level` is then only where it starts:
   /// the coarsest step whose bound is within that level's.
@@ -178,7 +178,7 @@ class ServoLoop {
   void relocate(Vec2 handle_m) noexcept { solver_.reset(handle_m, level_); }
   /// One servo tick: a function of (state, in, scene); no clock is read. A non-finite handle position
   /// gives zero force and NonFinite with the state kept. Real-time safe.
-  TickResult update(const ServoInput& in, ServoOutput& out);
+  TickResult update(const ServoInput& in, ServoOutput& out) noexcept;
   const ServoParams& params() const { return params_; }
   /// Fixes the level (automatic selection off). Takes effect at the next tick at which the proxy can move to
   /// it without crossing (see ContactSolver::level_change_is_safe). Real-time safe.

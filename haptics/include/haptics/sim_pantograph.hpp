@@ -47,7 +47,7 @@ class SimulatedPantograph final : public Device {
  public:
   /// Builds the device at rest with the handle at `start_handle_m` [m] (clamped into the stop box),
   /// status Closed, zero commanded force, time 0.
-  /// Throws std::invalid_argument (one line) when a parameter is out of range or not finite, or when
+  /// Throws hk::ArgumentError (one line) when a parameter is out of range or not finite, or when
   /// some point of the stop box (the usable rectangle enlarged by stop_margin_m) is not reachable by
   /// the linkage on its working branch (a sampled check on a 41 × 41 grid).
   SimulatedPantograph(const SimPantographParams& params, Vec2 start_handle_m);

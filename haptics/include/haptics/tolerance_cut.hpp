@@ -1,6 +1,6 @@
 #pragma once
 /// @file tolerance_cut.hpp
-/// A cut through one curve's collision tree at a tolerance instead of a level (issue 18; seed paper §3,
+/// A cut through one curve's collision tree at a tolerance instead of a level (seed paper §3,
 /// "contact computations at a desired tolerance level"): start from the coarsest segments and refine a
 /// segment into its two children only while its error box allows an error above the tolerance. Flat
 /// parts of the curve stay coarse, bends get fine segments, so a given maximum error takes fewer
@@ -97,6 +97,6 @@ std::shared_ptr<const CutWalls> make_cut_walls(const Scene& scene);
 /// end there is that finer segment's end point; otherwise its own. `masks` is tolerance_cut_masks(scene),
 /// and `node` must have bit `step` set in it (a segment of that cut). O(level of the node) mask reads per
 /// end; allocates nothing, real-time safe.
-void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a, Vec2* b);
+void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a, Vec2* b) noexcept;
 
 }  // namespace hk

@@ -1,6 +1,6 @@
 #pragma once
 /// @file wide_index.hpp
-/// A spatial 4-wide bounding-volume hierarchy over the collision tree (issue 18, "a faster tree": wide
+/// A spatial 4-wide bounding-volume hierarchy over the collision tree (wide
 /// nodes with SIMD box tests). The curve-following tree of error boxes (seed §3) is fat at the top: a
 /// chunk of coarsest segments spans hundreds of level-0 segments and its box overlaps its neighbours', so a
 /// walk from the root opens many boxes before it gets near the handle. This index sorts the error boxes

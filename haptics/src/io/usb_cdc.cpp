@@ -21,9 +21,11 @@ struct Iface {
 
 std::string at(int offset) { return " at byte " + std::to_string(offset); }
 
-}  // namespace
+// The phases of find_cdc_endpoints, in order.
 
-CdcEndpoints find_cdc_endpoints(const std::uint8_t* d, int length) {
+// Checks the configuration descriptor's own header (its length, type and wTotalLength against the bytes given) and
+// returns wTotalLength: the bytes the walk of its descriptors may read.
+int checked_total_length(const std::uint8_t* d, int length) {
   if (d == nullptr || length < 9) {
     throw DeviceError("USB configuration descriptor: " + std::to_string(length < 0 ? 0 : length) +
                       " bytes, need at least 9");
@@ -37,6 +39,13 @@ CdcEndpoints find_cdc_endpoints(const std::uint8_t* d, int length) {
     throw DeviceError("USB configuration descriptor: wTotalLength " + std::to_string(total) +
                       " outside [" + std::to_string(d[0]) + ", " + std::to_string(length) + "] bytes given");
   }
+  return total;
+}
+
+// Walks the descriptors after the header, each length checked against what is left, and lists the interfaces with
+// what a CDC-ACM match needs: class and subclass, the IAD holding each, its first bulk IN and OUT endpoints, and a
+// control interface's Union subordinate.
+std::vector<Iface> list_interfaces(const std::uint8_t* d, int total) {
   struct Iad {
     int first, count;
   };
@@ -76,25 +85,44 @@ CdcEndpoints find_cdc_endpoints(const std::uint8_t* d, int length) {
     }
     off += len;
   }
-  auto usable = [](const Iface& f) {
-    return f.cls == kCdcClassData && f.bulk_in != 0 && f.bulk_out != 0 && f.max_in > 0 && f.max_out > 0;
-  };
+  return ifaces;
+}
+
+// A data interface a byte stream can use: class 0x0A with bulk IN and OUT endpoints of non-zero packet size.
+bool usable_data(const Iface& f) {
+  return f.cls == kCdcClassData && f.bulk_in != 0 && f.bulk_out != 0 && f.max_in > 0 && f.max_out > 0;
+}
+
+// The data interface of the control interface ifaces[c], or null: boards describe the pairing differently, so
+// tried in order of how explicit it is: 1. the Union's subordinate interface, 2. one in the same IAD, 3. the next
+// usable data interface after it.
+const Iface* data_interface_of(const std::vector<Iface>& ifaces, std::size_t c) {
+  const Iface& ctl = ifaces[c];
+  const Iface* data = nullptr;
+  for (const Iface& f : ifaces) {  // 1. the Union's subordinate interface
+    if (ctl.union_data >= 0 && f.number == ctl.union_data && usable_data(f)) {
+      data = &f;
+      break;
+    }
+  }
+  for (std::size_t i = 0; data == nullptr && ctl.iad >= 0 && i < ifaces.size(); ++i) {  // 2. same IAD
+    if (ifaces[i].iad == ctl.iad && usable_data(ifaces[i])) data = &ifaces[i];
+  }
+  for (std::size_t i = c + 1; data == nullptr && i < ifaces.size(); ++i) {  // 3. the next data interface
+    if (usable_data(ifaces[i])) data = &ifaces[i];
+  }
+  return data;
+}
+
+}  // namespace
+
+CdcEndpoints find_cdc_endpoints(const std::uint8_t* d, int length) {
+  const int total = checked_total_length(d, length);
+  const std::vector<Iface> ifaces = list_interfaces(d, total);
   for (std::size_t c = 0; c < ifaces.size(); ++c) {
     const Iface& ctl = ifaces[c];
     if (ctl.cls != kCdcClassComm || ctl.subclass != kCdcSubclassAcm) continue;
-    const Iface* data = nullptr;
-    for (const Iface& f : ifaces) {  // 1. the Union's subordinate interface
-      if (ctl.union_data >= 0 && f.number == ctl.union_data && usable(f)) {
-        data = &f;
-        break;
-      }
-    }
-    for (std::size_t i = 0; data == nullptr && ctl.iad >= 0 && i < ifaces.size(); ++i) {  // 2. same IAD
-      if (ifaces[i].iad == ctl.iad && usable(ifaces[i])) data = &ifaces[i];
-    }
-    for (std::size_t i = c + 1; data == nullptr && i < ifaces.size(); ++i) {  // 3. the next data interface
-      if (usable(ifaces[i])) data = &ifaces[i];
-    }
+    const Iface* data = data_interface_of(ifaces, c);
     if (data == nullptr) continue;
     CdcEndpoints e;
     e.control_interface = ctl.number;

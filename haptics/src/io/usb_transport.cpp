@@ -232,7 +232,166 @@ struct UsbCdcTransport::Impl {
     }
     ctx = nullptr;
   }
+
+  // The phases of UsbCdcTransport::open, in order (each defined below with what it does).
+  void start_libusb(std::uint16_t vid, std::uint16_t pid);
+  void open_device(std::uint16_t vid, std::uint16_t pid, const std::string& serial, const std::string& who);
+  int active_config_index(const std::string& here);
+  void read_cdc_endpoints(const std::string& here);
+  void set_up_line(int baud, const std::string& here);
+  void allocate_transfers(const std::string& here);
+  void start_reading(const std::string& here);
 };
+
+// The phases of UsbCdcTransport::open, in order. Each throws DeviceError naming the device and the libusb call
+// that failed; what a phase leaves behind is undone by ~Impl (teardown), so a failed open leaks nothing.
+
+// Starts this transport's own libusb context.
+void UsbCdcTransport::Impl::start_libusb(std::uint16_t vid, std::uint16_t pid) {
+  if (const int r = libusb_init(&ctx); r != 0) {
+    ctx = nullptr;
+    throw DeviceError("no USB device " + vidpid(vid, pid) + " found (" + usb_error("libusb_init", r) + ")");
+  }
+}
+
+// Opens the first device with this vendor and product id (and this serial string, when one is asked for), so
+// that two boards of one kind can be told apart; notes its bus and address for the messages that follow.
+void UsbCdcTransport::Impl::open_device(std::uint16_t vid, std::uint16_t pid, const std::string& serial, const std::string& who) {
+  libusb_device** list = nullptr;
+  const ssize_t count = libusb_get_device_list(ctx, &list);
+  if (count < 0) throw DeviceError(who + ": " + usb_error("libusb_get_device_list", static_cast<int>(count)));
+  std::string open_error;
+  for (ssize_t i = 0; i < count && h == nullptr; ++i) {
+    libusb_device_descriptor desc{};
+    if (libusb_get_device_descriptor(list[i], &desc) != 0 || desc.idVendor != vid || desc.idProduct != pid) continue;
+    libusb_device_handle* opened = nullptr;
+    if (const int r = libusb_open(list[i], &opened); r != 0) {
+      open_error = usb_error("libusb_open", r);
+      continue;
+    }
+    if (!serial.empty()) {
+      unsigned char s[256];
+      const int n = desc.iSerialNumber ? libusb_get_string_descriptor_ascii(opened, desc.iSerialNumber, s, sizeof s) : 0;
+      if (n <= 0 || std::string(reinterpret_cast<char*>(s), static_cast<std::size_t>(n)) != serial) {
+        libusb_close(opened);
+        continue;
+      }
+    }
+    h = opened;
+    bus = libusb_get_bus_number(list[i]);
+    address = libusb_get_device_address(list[i]);
+  }
+  libusb_free_device_list(list, 1);  // the handle keeps its own reference to the device
+  if (h == nullptr) {
+    const std::string what = serial.empty() ? vidpid(vid, pid) : vidpid(vid, pid) + " serial " + serial;
+    if (!open_error.empty()) throw DeviceError(who + ": " + open_error);
+    throw DeviceError("no USB device " + what + " found");
+  }
+}
+
+// The index of the device's active configuration among its configurations (GET_DESCRIPTOR takes an index, the
+// active configuration is known by its value); 0 when none matches.
+int UsbCdcTransport::Impl::active_config_index(const std::string& here) {
+  libusb_device* dev = libusb_get_device(h);
+  libusb_config_descriptor* active = nullptr;
+  if (const int r = libusb_get_active_config_descriptor(dev, &active); r != 0) {
+    throw DeviceError(here + ": " + usb_error("libusb_get_active_config_descriptor", r));
+  }
+  const std::uint8_t value = active->bConfigurationValue;
+  libusb_free_config_descriptor(active);
+  libusb_device_descriptor desc{};
+  libusb_get_device_descriptor(dev, &desc);
+  for (int i = 0; i < desc.bNumConfigurations; ++i) {
+    libusb_config_descriptor* c = nullptr;
+    if (libusb_get_config_descriptor(dev, static_cast<std::uint8_t>(i), &c) != 0) continue;
+    const bool match = c->bConfigurationValue == value;
+    libusb_free_config_descriptor(c);
+    if (match) return i;
+  }
+  return 0;
+}
+
+// Reads the raw bytes of the active configuration and finds the CDC-ACM function's interfaces and bulk endpoints in
+// them (find_cdc_endpoints), after letting libusb detach any kernel driver from the interfaces it claims.
+void UsbCdcTransport::Impl::read_cdc_endpoints(const std::string& here) {
+  if (const int r = libusb_set_auto_detach_kernel_driver(h, 1); r != 0 && r != LIBUSB_ERROR_NOT_SUPPORTED) {
+    throw DeviceError(here + ": " + usb_error("libusb_set_auto_detach_kernel_driver", r));
+  }
+  const int config_index = active_config_index(here);
+  std::vector<std::uint8_t> raw(4096);
+  const int raw_n = libusb_get_descriptor(h, LIBUSB_DT_CONFIG, static_cast<std::uint8_t>(config_index), raw.data(),
+                                          static_cast<int>(raw.size()));
+  if (raw_n < 0) throw DeviceError(here + ": " + usb_error("libusb_get_descriptor(CONFIGURATION)", raw_n));
+  try {
+    ep = find_cdc_endpoints(raw.data(), raw_n);
+  } catch (const DeviceError& e) {
+    throw DeviceError(here + ": " + e.what());
+  }
+}
+
+// Claims both interfaces and sets the line as a serial port's open would: the line coding for `baud`, then DTR and
+// RTS raised.
+void UsbCdcTransport::Impl::set_up_line(int baud, const std::string& here) {
+  if (const int r = libusb_claim_interface(h, ep.control_interface); r != 0) {
+    throw DeviceError(here + ": " + usb_error("libusb_claim_interface(control)", r));
+  }
+  claimed_control = true;
+  if (const int r = libusb_claim_interface(h, ep.data_interface); r != 0) {
+    throw DeviceError(here + ": " + usb_error("libusb_claim_interface(data)", r));
+  }
+  claimed_data = true;
+  auto coding = line_coding_bytes(baud);
+  const auto ctl_if = static_cast<std::uint16_t>(ep.control_interface);
+  if (const int r = libusb_control_transfer(h, kCdcRequestTypeOut, kCdcSetLineCoding, 0, ctl_if, coding.data(),
+                                            static_cast<std::uint16_t>(coding.size()), kControlTimeoutMs);
+      r < 0) {
+    throw DeviceError(here + ": " + usb_error("SET_LINE_CODING", r));
+  }
+  if (const int r = libusb_control_transfer(h, kCdcRequestTypeOut, kCdcSetControlLineState, kCdcDtr | kCdcRts,
+                                            ctl_if, nullptr, 0, kControlTimeoutMs);
+      r < 0) {
+    throw DeviceError(here + ": " + usb_error("SET_CONTROL_LINE_STATE", r));
+  }
+}
+
+// Everything the real-time path needs, allocated now: the wake-up eventfd, the IN transfers and their buffers (a
+// whole number of packets each, at least one: a short buffer would overflow on a full packet), the OUT transfer.
+void UsbCdcTransport::Impl::allocate_transfers(const std::string& here) {
+  wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (wake_fd < 0) throw DeviceError(here + ": eventfd: " + std::strerror(errno));
+  const int mps_in = ep.max_packet_in;
+  in_transfer_bytes = std::max(mps_in, kInTransferBytes / mps_in * mps_in);
+  in_bufs = std::make_unique<std::uint8_t[]>(static_cast<std::size_t>(kInTransfers) * in_transfer_bytes);
+  out_buf = std::make_unique<std::uint8_t[]>(kOutTransferBytes);
+  for (int i = 0; i < kInTransfers; ++i) {
+    Slot& s = in_slots[i];
+    s.impl = this;
+    s.t = libusb_alloc_transfer(0);
+    if (s.t == nullptr) throw DeviceError(here + ": libusb_alloc_transfer failed");
+    libusb_fill_bulk_transfer(s.t, h, ep.bulk_in, in_bufs.get() + i * in_transfer_bytes, in_transfer_bytes, &Impl::on_in, &s, 0);
+  }
+  out_slot.impl = this;
+  out_slot.t = libusb_alloc_transfer(0);
+  if (out_slot.t == nullptr) throw DeviceError(here + ": libusb_alloc_transfer failed");
+  libusb_fill_bulk_transfer(out_slot.t, h, ep.bulk_out, out_buf.get(), 0, &Impl::on_out, &out_slot, 0);
+  out_slot.t->flags = LIBUSB_TRANSFER_ADD_ZERO_PACKET;
+}
+
+// Submits every IN transfer and starts the event thread that reaps them. When a submit fails, the ones submitted
+// are cancelled and the thread still starts, to reap them, before the error is thrown.
+void UsbCdcTransport::Impl::start_reading(const std::string& here) {
+  libusb_set_pollfd_notifiers(ctx, &Impl::on_pollfd_added, &Impl::on_pollfd_removed, this);
+  for (Slot& s : in_slots) {
+    if (!submit(s)) {
+      for (Slot& o : in_slots) {
+        if (o.active) libusb_cancel_transfer(o.t);
+      }
+      thread = std::thread([p = this] { p->event_loop(); });  // reaps the cancelled transfers
+      throw DeviceError(here + ": libusb_submit_transfer(bulk IN) failed");
+    }
+  }
+  thread = std::thread([p = this] { p->event_loop(); });
+}
 
 UsbCdcTransport::UsbCdcTransport(std::uint16_t vid, std::uint16_t pid, int baud, std::string serial)
     : vid_(vid), pid_(pid), baud_(baud), serial_(std::move(serial)) {
@@ -249,132 +408,13 @@ void UsbCdcTransport::open() {
   if (impl_) return;
   const std::string who = "usb " + vidpid(vid_, pid_);
   auto m = std::make_unique<Impl>();
-  if (const int r = libusb_init(&m->ctx); r != 0) {
-    m->ctx = nullptr;
-    throw DeviceError("no USB device " + vidpid(vid_, pid_) + " found (" + usb_error("libusb_init", r) + ")");
-  }
-  // Find the device (and its serial string when asked).
-  libusb_device** list = nullptr;
-  const ssize_t count = libusb_get_device_list(m->ctx, &list);
-  if (count < 0) throw DeviceError(who + ": " + usb_error("libusb_get_device_list", static_cast<int>(count)));
-  libusb_device* dev = nullptr;
-  std::string open_error;
-  for (ssize_t i = 0; i < count && m->h == nullptr; ++i) {
-    libusb_device_descriptor desc{};
-    if (libusb_get_device_descriptor(list[i], &desc) != 0 || desc.idVendor != vid_ || desc.idProduct != pid_) continue;
-    libusb_device_handle* h = nullptr;
-    if (const int r = libusb_open(list[i], &h); r != 0) {
-      open_error = usb_error("libusb_open", r);
-      continue;
-    }
-    if (!serial_.empty()) {
-      unsigned char s[256];
-      const int n = desc.iSerialNumber ? libusb_get_string_descriptor_ascii(h, desc.iSerialNumber, s, sizeof s) : 0;
-      if (n <= 0 || std::string(reinterpret_cast<char*>(s), static_cast<std::size_t>(n)) != serial_) {
-        libusb_close(h);
-        continue;
-      }
-    }
-    m->h = h;
-    dev = list[i];
-    m->bus = libusb_get_bus_number(dev);
-    m->address = libusb_get_device_address(dev);
-  }
-  libusb_free_device_list(list, 1);  // the handle keeps its own reference to the device
-  if (m->h == nullptr) {
-    const std::string what = serial_.empty() ? vidpid(vid_, pid_) : vidpid(vid_, pid_) + " serial " + serial_;
-    if (!open_error.empty()) throw DeviceError(who + ": " + open_error);
-    throw DeviceError("no USB device " + what + " found");
-  }
+  m->start_libusb(vid_, pid_);
+  m->open_device(vid_, pid_, serial_, who);
   const std::string here = who + " bus " + std::to_string(m->bus) + " addr " + std::to_string(m->address);
-  dev = libusb_get_device(m->h);
-
-  if (const int r = libusb_set_auto_detach_kernel_driver(m->h, 1); r != 0 && r != LIBUSB_ERROR_NOT_SUPPORTED) {
-    throw DeviceError(here + ": " + usb_error("libusb_set_auto_detach_kernel_driver", r));
-  }
-  // Raw bytes of the active configuration: find its index, then GET_DESCRIPTOR(CONFIGURATION, index).
-  int config_index = 0;
-  {
-    libusb_config_descriptor* active = nullptr;
-    if (const int r = libusb_get_active_config_descriptor(dev, &active); r != 0) {
-      throw DeviceError(here + ": " + usb_error("libusb_get_active_config_descriptor", r));
-    }
-    const std::uint8_t value = active->bConfigurationValue;
-    libusb_free_config_descriptor(active);
-    libusb_device_descriptor desc{};
-    libusb_get_device_descriptor(dev, &desc);
-    for (int i = 0; i < desc.bNumConfigurations; ++i) {
-      libusb_config_descriptor* c = nullptr;
-      if (libusb_get_config_descriptor(dev, static_cast<std::uint8_t>(i), &c) != 0) continue;
-      const bool match = c->bConfigurationValue == value;
-      libusb_free_config_descriptor(c);
-      if (match) {
-        config_index = i;
-        break;
-      }
-    }
-  }
-  std::vector<std::uint8_t> raw(4096);
-  const int raw_n = libusb_get_descriptor(m->h, LIBUSB_DT_CONFIG, static_cast<std::uint8_t>(config_index), raw.data(),
-                                          static_cast<int>(raw.size()));
-  if (raw_n < 0) throw DeviceError(here + ": " + usb_error("libusb_get_descriptor(CONFIGURATION)", raw_n));
-  try {
-    m->ep = find_cdc_endpoints(raw.data(), raw_n);
-  } catch (const DeviceError& e) {
-    throw DeviceError(here + ": " + e.what());
-  }
-  if (const int r = libusb_claim_interface(m->h, m->ep.control_interface); r != 0) {
-    throw DeviceError(here + ": " + usb_error("libusb_claim_interface(control)", r));
-  }
-  m->claimed_control = true;
-  if (const int r = libusb_claim_interface(m->h, m->ep.data_interface); r != 0) {
-    throw DeviceError(here + ": " + usb_error("libusb_claim_interface(data)", r));
-  }
-  m->claimed_data = true;
-  auto coding = line_coding_bytes(baud_);
-  const auto ctl_if = static_cast<std::uint16_t>(m->ep.control_interface);
-  if (const int r = libusb_control_transfer(m->h, kCdcRequestTypeOut, kCdcSetLineCoding, 0, ctl_if, coding.data(),
-                                            static_cast<std::uint16_t>(coding.size()), kControlTimeoutMs);
-      r < 0) {
-    throw DeviceError(here + ": " + usb_error("SET_LINE_CODING", r));
-  }
-  if (const int r = libusb_control_transfer(m->h, kCdcRequestTypeOut, kCdcSetControlLineState, kCdcDtr | kCdcRts,
-                                            ctl_if, nullptr, 0, kControlTimeoutMs);
-      r < 0) {
-    throw DeviceError(here + ": " + usb_error("SET_CONTROL_LINE_STATE", r));
-  }
-  // Everything the real-time path needs, allocated now.
-  m->wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  if (m->wake_fd < 0) throw DeviceError(here + ": eventfd: " + std::strerror(errno));
-  // IN transfers: a whole number of packets, at least one (a short buffer would overflow on a full packet).
-  const int mps_in = m->ep.max_packet_in;
-  m->in_transfer_bytes = std::max(mps_in, kInTransferBytes / mps_in * mps_in);
-  m->in_bufs = std::make_unique<std::uint8_t[]>(static_cast<std::size_t>(kInTransfers) * m->in_transfer_bytes);
-  m->out_buf = std::make_unique<std::uint8_t[]>(kOutTransferBytes);
-  for (int i = 0; i < kInTransfers; ++i) {
-    Impl::Slot& s = m->in_slots[i];
-    s.impl = m.get();
-    s.t = libusb_alloc_transfer(0);
-    if (s.t == nullptr) throw DeviceError(here + ": libusb_alloc_transfer failed");
-    libusb_fill_bulk_transfer(s.t, m->h, m->ep.bulk_in, m->in_bufs.get() + i * m->in_transfer_bytes, m->in_transfer_bytes,
-                              &Impl::on_in, &s, 0);
-  }
-  m->out_slot.impl = m.get();
-  m->out_slot.t = libusb_alloc_transfer(0);
-  if (m->out_slot.t == nullptr) throw DeviceError(here + ": libusb_alloc_transfer failed");
-  libusb_fill_bulk_transfer(m->out_slot.t, m->h, m->ep.bulk_out, m->out_buf.get(), 0, &Impl::on_out, &m->out_slot, 0);
-  m->out_slot.t->flags = LIBUSB_TRANSFER_ADD_ZERO_PACKET;
-  libusb_set_pollfd_notifiers(m->ctx, &Impl::on_pollfd_added, &Impl::on_pollfd_removed, m.get());
-  for (Impl::Slot& s : m->in_slots) {
-    if (!m->submit(s)) {
-      for (Impl::Slot& o : m->in_slots) {
-        if (o.active) libusb_cancel_transfer(o.t);
-      }
-      m->thread = std::thread([p = m.get()] { p->event_loop(); });  // reaps the cancelled transfers
-      throw DeviceError(here + ": libusb_submit_transfer(bulk IN) failed");
-    }
-  }
-  m->thread = std::thread([p = m.get()] { p->event_loop(); });
+  m->read_cdc_endpoints(here);
+  m->set_up_line(baud_, here);
+  m->allocate_transfers(here);
+  m->start_reading(here);
   impl_ = std::move(m);
 }
 

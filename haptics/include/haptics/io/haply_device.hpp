@@ -1,6 +1,6 @@
 #pragma once
 /// @file haply_device.hpp
-/// The USB pantograph (issue 13, item 3; DESIGN.md "Devices"): a Haply 2DIY (gen3) board speaking hAPI
+/// The USB pantograph (DESIGN.md "Devices"): a Haply 2DIY (gen3) board speaking hAPI
 /// (hapi_protocol.hpp) over a byte stream (byte_transport.hpp: libusb CDC-ACM, the kernel's tty, or a pty
 /// to the firmware emulator), seen through the `Device` interface.
 ///
@@ -88,7 +88,7 @@ inline constexpr int kReplyWaitTicks = 2;
 /// The uniform scale from device metres to workspace metres: min(workspace w / rect w, workspace h / rect h).
 double workspace_scale(const HaplyDeviceParams& p) noexcept;
 
-/// Encoder offsets that make the angles read right (issue 13, item 3, calibration): the handle rests at
+/// Encoder offsets that make the angles read right (calibration): the handle rests at
 /// `park_workspace_m` (a known place, config [device] park_x_m/park_y_m) and the board reported
 /// `reported_th1_deg`/`reported_th2_deg` with the offsets of `p.layout`; each new offset is the old one plus
 /// (the joint angle the park place has, by inverse kinematics, − the angle reported), the difference
