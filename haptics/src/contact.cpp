@@ -27,7 +27,7 @@ ContactSolver::SegGeom ContactSolver::geom(SegmentRef s, int level) const noexce
   return g;
 }
 
-void ContactSolver::reset(Vec2 p_m, int level) noexcept {
+void ContactSolver::reset(Vec2 p_m, int level, std::int32_t max_box_tests) noexcept {
   proxy_ = p_m;
   state_ = ContactState::Free;
   sticking_ = false;
@@ -37,7 +37,9 @@ void ContactSolver::reset(Vec2 p_m, int level) noexcept {
   release_left_ = 0;
   last_force_n_ = Vec2{0.0, 0.0};
   section_.reset();
-  push_off_walls(nullptr);
+  QueryBudget budget;
+  budget.max_box_tests = max_box_tests;
+  push_off_walls(&budget);
 }
 
 void ContactSolver::push_off_walls(QueryBudget* budget) noexcept {

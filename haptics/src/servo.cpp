@@ -140,12 +140,12 @@ int ServoLoop::ladder_index(int id) const noexcept {
   return index;
 }
 
-void ServoLoop::start(Vec2 handle_m) {
+void ServoLoop::start(Vec2 handle_m) noexcept {
   level_ = params_.auto_level ? ladder_id_[policy_.level()] : params_.level;
   if (params_.render == RenderMode::Grooves) {
     groove_.reset(handle_m, level_);
   } else {
-    solver_.reset(handle_m, level_);
+    solver_.reset(handle_m, level_, params_.query_box_budget);
   }
   last_handle_ = handle_m;
   velocity_ = {0.0, 0.0};

@@ -140,9 +140,10 @@ class ContactSolver {
   ContactSolver(const Scene& scene, const ContactParams& params, std::shared_ptr<const CutWalls> cuts);
 
   /// Puts the proxy at p in free space and forgets the contact state. If p is within the skin of a
-  /// polyline at `level`, it is pushed off along the wall's normal. Not for the servo path (may walk
-  /// the tree from the roots), but allocates nothing.
-  void reset(Vec2 p_m, int level) noexcept;
+  /// polyline at `level`, it is pushed off along the wall's normal (closest_point within two skins, its
+  /// box tests charged to a budget of `max_box_tests`, 0 = no limit; past the budget the proxy stays at
+  /// p). Real-time safe: allocates nothing, and with a budget its work is bounded like a tick's queries.
+  void reset(Vec2 p_m, int level, std::int32_t max_box_tests = 0) noexcept;
 
   /// One tick: move the proxy towards the handle under the constraints, then compute the force.
   /// Real-time safe: no allocation, lock, throw or I/O.

@@ -168,14 +168,16 @@ class ServoLoop {
   /// `scene` must outlive the loop. Allocates (setup only).
   ServoLoop(const Scene& scene, const ServoParams& params);
   /// Starts (or restarts) at the handle position: proxy placed there, force ramp from zero. Resets the
-  /// solver in use (walls: ContactSolver, grooves: GrooveSolver).
-  void start(Vec2 handle_m);
+  /// solver in use (walls: ContactSolver, grooves: GrooveSolver), the walls' push-off charged to the tick's
+  /// box-test budget (query_box_budget). Real-time safe: the servo calls it when it takes a picture and
+  /// when a lost device comes back.
+  void start(Vec2 handle_m) noexcept;
   /// Puts the proxy at the handle, free, its contact state forgotten (ContactSolver::reset at the level in
   /// use), without restarting the force ramp, the velocity filter or the level: called before update() on
   /// every tick the guided tour leads the handle through the air (app guided_tour.hpp), so the walls give
   /// no force then and are on again, on the handle's side, when it stops. Allocates nothing; walks the
-  /// tree only within two skins of the handle.
-  void relocate(Vec2 handle_m) noexcept { solver_.reset(handle_m, level_); }
+  /// tree only within two skins of the handle, on the tick's box-test budget (query_box_budget).
+  void relocate(Vec2 handle_m) noexcept { solver_.reset(handle_m, level_, params_.query_box_budget); }
   /// One servo tick: a function of (state, in, scene); no clock is read. A non-finite handle position
   /// gives zero force and NonFinite with the state kept. Real-time safe.
   TickResult update(const ServoInput& in, ServoOutput& out) noexcept;
