@@ -77,7 +77,7 @@ struct CaptureHooks {
 
 /// Runs one capture on `source` until the guide captures, the time-out or the cancel flag.
 /// @throws vision::CameraError when the source fails or sends no frame for frame_wait_s;
-///         std::invalid_argument for bad params.
+///         hk::ArgumentError for bad params.
 CaptureOutcome run_capture(vision::FrameSource& source, const CaptureParams& params, const CaptureHooks& hooks = {});
 
 /// The message that speaks an advice (capture_place, capture_move_left, ...).

@@ -17,6 +17,7 @@
 #include "config/load.hpp"
 #include "image_scene.hpp"
 #include "kiosk_exe.hpp"
+#include "hk/error.hpp"
 
 namespace hk::app {
 namespace {
@@ -160,7 +161,7 @@ TEST(OutlineScene, TheSettingsOfferExactlyTheDetectorsVisionKnows) {
   ASSERT_NE(d, nullptr);
   ASSERT_EQ(d->choices.size(), 6u);
   for (const auto& name : d->choices) EXPECT_EQ(vision::detector_name(vision::detector_from_name(std::string(name))), name);
-  EXPECT_THROW(vision::detector_from_name("sobel"), std::invalid_argument);
+  EXPECT_THROW(vision::detector_from_name("sobel"), hk::ArgumentError);
 }
 
 TEST(OutlineScene, MadeSilhouettesGiveOneClosedCurvePerOutlineOnTheBoundary) {

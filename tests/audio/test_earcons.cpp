@@ -7,6 +7,7 @@
 #include "audio/earcons.hpp"
 #include "audio/mixer.hpp"
 #include "audio_analysis.hpp"
+#include "hk/error.hpp"
 
 namespace hk::audio {
 namespace {
@@ -194,9 +195,9 @@ TEST(Earcons, VoicePoolSurvivesAFlood) {
 }
 
 TEST(Earcons, TimelineRejectsBadArguments) {
-  EXPECT_THROW(render_cue_timeline({}, 0.0, 1.0), std::invalid_argument);
-  EXPECT_THROW(render_cue_timeline({}, 0.001, -1.0), std::invalid_argument);
-  EXPECT_THROW(render_cue_timeline({}, 0.001, 1e6), std::invalid_argument);
+  EXPECT_THROW(render_cue_timeline({}, 0.0, 1.0), hk::ArgumentError);
+  EXPECT_THROW(render_cue_timeline({}, 0.001, -1.0), hk::ArgumentError);
+  EXPECT_THROW(render_cue_timeline({}, 0.001, 1e6), hk::ArgumentError);
   // Cues past the end or before the start are ignored, not a crash.
   const std::vector<float> x = render_cue_timeline(std::vector{cue(-5, CueKind::ContactBegin), cue(999999, CueKind::ContactBegin)}, 0.001, 0.1);
   EXPECT_EQ(test::peak(x, 0, x.size()), 0.0);

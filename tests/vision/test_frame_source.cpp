@@ -21,6 +21,7 @@
 
 #include "vision/frame_source.hpp"
 #include "vision/intake.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -257,11 +258,11 @@ TEST(FrameSourceFile, ParametersOutOfRangeAreInvalidArguments) {
     change(p);
     return p;
   };
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.width_px = 63; })), std::invalid_argument);
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.height_px = 8193; })), std::invalid_argument);
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 0.0; })), std::invalid_argument);
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 1001.0; })), std::invalid_argument);
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.max_frame_bytes = 0; })), std::invalid_argument);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.width_px = 63; })), hk::ArgumentError);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.height_px = 8193; })), hk::ArgumentError);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 0.0; })), hk::ArgumentError);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 1001.0; })), hk::ArgumentError);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.max_frame_bytes = 0; })), hk::ArgumentError);
   EXPECT_NO_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 1000.0; })));
 }
 

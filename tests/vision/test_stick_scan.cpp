@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "vision/stick_scan.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -676,12 +677,12 @@ TEST(StickScan, BadRootOrLimitsAreTypedOneLineErrors) {
     change(l);
     return l;
   };
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_depth = 0; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_entries = -1; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_documents = 0; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_file_bytes = 0; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = 0.0; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = std::nan(""); })), std::invalid_argument);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_depth = 0; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_entries = -1; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_documents = 0; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_file_bytes = 0; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = 0.0; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = std::nan(""); })), hk::ArgumentError);
   EXPECT_NE(read_error(t / "missing", "file.png").find("stick file 'file.png'"), std::string::npos);
 }
 

@@ -27,6 +27,8 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 namespace {
 
@@ -560,11 +562,11 @@ cv::Mat canny_l2(const cv::Mat& dx, const cv::Mat& dy, double low_thresh, double
 
 EdgeMap detect_edges(const cv::Mat& grey, const EdgeParams& p) {
   if (grey.empty() || grey.type() != CV_8UC1) {
-    throw std::invalid_argument("detect_edges: expected a non-empty CV_8UC1 image");
+    throw hk::ArgumentError("detect_edges: expected a non-empty CV_8UC1 image");
   }
   for (const double v : {p.blur_sigma_px, p.canny_low, p.canny_high}) {
     if (!std::isfinite(v) || v < 0.0) {
-      throw std::invalid_argument("detect_edges: parameters must be finite and >= 0");
+      throw hk::ArgumentError("detect_edges: parameters must be finite and >= 0");
     }
   }
   thread_local Scratch scratch;

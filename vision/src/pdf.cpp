@@ -58,6 +58,7 @@
 
 #include "input_error.hpp"
 #include "worker_process.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -298,7 +299,7 @@ std::string doing(int page) { return page == 0 ? "opening the document" : "page 
 void check_input(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits) {
   if (!(limits.max_file_bytes > 0 && limits.max_pages > 0 && limits.max_page_pixels > 0 && limits.max_dpi > 0 && limits.worker_cpu_s > 0 &&
         limits.worker_wall_s > 0 && limits.worker_max_memory_mb >= 0)) {
-    throw std::invalid_argument("PdfLimits: every limit must be positive");
+    throw hk::ArgumentError("PdfLimits: every limit must be positive");
   }
   if (bytes.empty()) fail(PdfError::Kind::NotPdf, name, "the file is empty");
   if (!looks_like_pdf(bytes)) fail(PdfError::Kind::NotPdf, name, "not a PDF (no %PDF- header)");

@@ -12,6 +12,7 @@
 
 #include "vision/gaps.hpp"
 #include "vision/thin_lines.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 
@@ -112,10 +113,10 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 void check(const SimplifyParams& p) {
   for (const double v : {p.workspace_width_m, p.workspace_height_m})
-    if (!std::isfinite(v) || v <= 0.0) throw std::invalid_argument("simplify_chains: the workspace must be finite and > 0");
+    if (!std::isfinite(v) || v <= 0.0) throw hk::ArgumentError("simplify_chains: the workspace must be finite and > 0");
   for (const double v : {p.thin_line_max_width_m, p.gap_close_m, p.min_chain_length_m})
-    if (!std::isfinite(v) || v < 0.0) throw std::invalid_argument("simplify_chains: lengths must be finite and >= 0");
-  if (p.max_shapes < 1 || p.max_segments < 1) throw std::invalid_argument("simplify_chains: max_shapes and max_segments must be >= 1");
+    if (!std::isfinite(v) || v < 0.0) throw hk::ArgumentError("simplify_chains: lengths must be finite and >= 0");
+  if (p.max_shapes < 1 || p.max_segments < 1) throw hk::ArgumentError("simplify_chains: max_shapes and max_segments must be >= 1");
 }
 
 /// The chains and their strengths between the stages.

@@ -14,6 +14,8 @@
 #include <string>
 #include <utility>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 namespace {
 
@@ -186,15 +188,15 @@ struct Flat {
   std::vector<char> closed;
 };
 
-/// Checks the input (throws std::invalid_argument) and flattens it (step 1).
+/// Checks the input (throws hk::ArgumentError) and flattens it (step 1).
 Flat flatten(const std::vector<Chain>& chains, double w, const PointValues* values_in) {
   if (!std::isfinite(w) || w < 0.0) {
-    throw std::invalid_argument("merge_thin_lines: max_width_px must be finite and >= 0, got " + number(w));
+    throw hk::ArgumentError("merge_thin_lines: max_width_px must be finite and >= 0, got " + number(w));
   }
   if (values_in != nullptr) {
     bool ok = values_in->size() == chains.size();
     for (std::size_t k = 0; ok && k < chains.size(); ++k) ok = (*values_in)[k].size() == chains[k].points_px.size();
-    if (!ok) throw std::invalid_argument("merge_thin_lines: values_in must have one value per chain point");
+    if (!ok) throw hk::ArgumentError("merge_thin_lines: values_in must have one value per chain point");
   }
   Flat f;
   f.K = chains.size();
@@ -202,7 +204,7 @@ Flat flatten(const std::vector<Chain>& chains, double w, const PointValues* valu
   for (std::size_t k = 0; k < f.K; ++k) {
     for (const cv::Point2d& p : chains[k].points_px) {
       if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
-        throw std::invalid_argument("merge_thin_lines: chain " + std::to_string(k) + " has a non-finite point");
+        throw hk::ArgumentError("merge_thin_lines: chain " + std::to_string(k) + " has a non-finite point");
       }
     }
     f.off[k + 1] = f.off[k] + chains[k].points_px.size();

@@ -68,7 +68,7 @@ class Mixer final : public AudioSource {
 /// Renders the earcons of `cues` (sorted by tick, or not: they are sorted here) on the timeline of a servo
 /// run: tick k sounds at sample round(k · period_s · sample_rate_hz). Returns duration_s of mono audio at
 /// kSampleRateHz (volume: unity). Allocates (not real-time). Cues past the end are ignored.
-/// @throws std::invalid_argument if period_s ≤ 0 or duration_s is not in [0, 3600] s.
+/// @throws hk::ArgumentError if period_s ≤ 0 or duration_s is not in [0, 3600] s.
 std::vector<float> render_cue_timeline(std::span<const CueEvent> cues, double period_s, double duration_s,
                                        const MixerParams& params = {});
 

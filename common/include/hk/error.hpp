@@ -20,4 +20,11 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A parameter outside the range its docstring gives (a caller's or a settings mistake), thrown at setup,
+/// never in the servo path. what() is one line naming the parameter and its limit.
+class ArgumentError : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace hk

@@ -83,7 +83,7 @@ class FrameSource {
 /// @throws CameraError for a source that cannot be opened (no such file or camera, no usable format), and for
 ///         a file source with no readable image (a folder: none of its files is an image; files that are not
 ///         images are skipped, an image refused by load_image's limits is an error naming it).
-/// @throws std::invalid_argument if a parameter is outside the range its docstring gives.
+/// @throws hk::ArgumentError if a parameter is outside the range its docstring gives.
 std::unique_ptr<FrameSource> open_frame_source(const SourceSpec& spec, const FrameSourceParams& params);
 
 /// A camera found on this machine.

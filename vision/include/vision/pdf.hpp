@@ -118,7 +118,7 @@ class PdfError : public hk::Error {
 /// @param name   how to name it in errors (made printable on one line)
 /// @throws PdfError (NotPdf: no "%PDF-" header; Damaged: poppler cannot load it or it has no page;
 ///         Locked: needs a password; TooLarge: over max_file_bytes; Timeout / WorkerCrashed);
-///         std::invalid_argument when a limit is not positive.
+///         hk::ArgumentError when a limit is not positive.
 PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits);
 
 /// Renders page `page` (from 1) in a worker: grey, at dpi = min(max_dpi, 72 · sqrt(max_page_pixels /

@@ -137,16 +137,16 @@ struct SceneChains {
 };
 
 /// Steps 1-4 above on an extraction. `cost` prices each curve for max_segments.
-/// @throws std::invalid_argument for invalid parameters (a non-positive workspace or max_shapes, a negative or
+/// @throws hk::ArgumentError for invalid parameters (a non-positive workspace or max_shapes, a negative or
 ///         non-finite length).
 SceneChains simplify_chains(Extraction ex, const SimplifyParams& p, const SegmentCost& cost);
 
 /// extract_chains(path, ep) then simplify_chains.
-/// @throws InputError when the file is refused (see load_image); std::invalid_argument as above.
+/// @throws InputError when the file is refused (see load_image); hk::ArgumentError as above.
 SceneChains scene_chains(const std::string& path, const ExtractParams& ep, const SimplifyParams& p, const SegmentCost& cost);
 
 /// extract_chains_from_image(image, ep, ignore_mask) then simplify_chains.
-/// @throws std::invalid_argument as extract_chains_from_image and simplify_chains.
+/// @throws hk::ArgumentError as extract_chains_from_image and simplify_chains.
 SceneChains scene_chains_from_image(const cv::Mat& image, const ExtractParams& ep, const SimplifyParams& p, const SegmentCost& cost,
                                     const cv::Mat& ignore_mask = {});
 

@@ -82,7 +82,7 @@ class StickError : public hk::Error {
 /// A stopping limit sets complete=false and stopped_by, which also ends `refused` (path "").
 /// Failures on single entries (unreadable folder, open errors, entries vanishing) are refusals, not errors.
 /// @throws StickError if root cannot be opened as a folder.
-/// @throws std::invalid_argument if a limit is not positive.
+/// @throws hk::ArgumentError if a limit is not positive.
 StickScan scan_stick(const std::string& root, const ScanLimits& limits);
 
 /// The kind a file's first bytes announce: "png", "jpeg", "bmp", "tiff", "webp", "pdf", or "" (not a
