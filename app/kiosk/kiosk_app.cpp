@@ -40,7 +40,7 @@ namespace {
 std::int64_t unix_now_s() { return static_cast<std::int64_t>(std::time(nullptr)); }
 
 /// The settings the kiosk starts with: the file, or (when it is corrupt) its .bak or the defaults, said in
-/// the log and kept for the operator's panel (issue 12, item 5).
+/// the log and kept for the operator's panel.
 struct StartSettings {
   config::Settings settings;
   std::string notice;

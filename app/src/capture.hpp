@@ -1,6 +1,6 @@
 #pragma once
 /// @file capture.hpp
-/// One camera capture (issue 16): frames from a vision::FrameSource are looked at (vision::look_at_frame), the
+/// One camera capture: frames from a vision::FrameSource are looked at (vision::look_at_frame), the
 /// framing guide (vision::FramingGuide) says what to do and decides when to take the picture, and the page is
 /// rectified (vision::rectify_page) or, when none was found, the whole frame kept. The same loop serves the
 /// headless `capture` command, `explore --source` and the kiosk's Capture key (on a worker thread, with a

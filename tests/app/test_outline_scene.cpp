@@ -1,4 +1,4 @@
-// Issue 15, "exact on silhouettes": every binary silhouette of tests/data/images and silhouettes made here
+// Exact on silhouettes: every binary silhouette of tests/data/images and silhouettes made here
 // (holes, two blobs, a thin neck, sharp cusps) go through build_image_scene ([vision] detector "auto" chooses
 // the traced outline); the scene must hold exactly one closed curve per outline of the mask that does not meet
 // the picture's frame, and at level 0 lie within 1.5 px of the mask's true boundary (the crack between dark and

@@ -1,5 +1,5 @@
-// The cue queue between the 1 kHz servo thread and the audio callback (issue 4: "no blocking, overflow
-// counted, not crashed").
+// The cue queue between the 1 kHz servo thread and the audio callback: no blocking, overflow
+// counted, not crashed.
 #include <gtest/gtest.h>
 
 #include <atomic>

@@ -1,4 +1,4 @@
-// Frame sources (vision/frame_source.hpp, issue 16 item 1): the spec parser, the file source on one image and
+// Frame sources (vision/frame_source.hpp): the spec parser, the file source on one image and
 // on a folder of frames written here, and the camera paths on a machine that may have no camera at all (the
 // CI machine has none): listing never throws and prints nothing, a missing camera or a node that is not a
 // camera is refused with one line.

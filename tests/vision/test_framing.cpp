@@ -1,4 +1,4 @@
-// The framing guide's state machine on hand-made frame looks (issue 16, item 3); the same guide on real frame
+// The framing guide's state machine on hand-made frame looks; the same guide on real frame
 // sequences from the file source is tested end to end in tests/app/test_capture.cpp.
 
 #include <gtest/gtest.h>

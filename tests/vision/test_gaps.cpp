@@ -1,4 +1,4 @@
-// Closing small gaps in outlines (issue 15, item 3): close_gaps on synthetic chains whose gaps are known.
+// Closing small gaps in outlines: close_gaps on synthetic chains whose gaps are known.
 #include <gtest/gtest.h>
 
 #include <cmath>

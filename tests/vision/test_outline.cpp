@@ -1,4 +1,4 @@
-// Two-tone pictures traced from a threshold (issue 15): classify_two_tone and trace_outlines on synthetic
+// Two-tone pictures traced from a threshold: classify_two_tone and trace_outlines on synthetic
 // masks whose outlines are known, and on the shipped pictures.
 #include <gtest/gtest.h>
 

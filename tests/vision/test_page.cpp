@@ -1,4 +1,4 @@
-// Tests of vision/page.hpp (issue 16, item 2): the page found in a camera frame, its aspect ratio, the flat warp.
+// Tests of vision/page.hpp: the page found in a camera frame, its aspect ratio, the flat warp.
 // The frames are synthetic photos (tests/support/synthetic_photo.hpp): a test picture warped by a known homography
 // onto a generated wood or cloth backdrop, lit unevenly, blurred and noisy; the truth is where its corners went.
 

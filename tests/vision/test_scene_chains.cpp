@@ -1,4 +1,4 @@
-// Scene simplification in one call (issue 15, item 5): vision::scene_chains on every test picture — the report
+// Scene simplification in one call: vision::scene_chains on every test picture — the report
 // accounts for every chain, the budgets keep the most salient curves and no more than they allow, traced
 // outlines are left as they are.
 

@@ -1,4 +1,4 @@
-// The stick scan (issue 11, item 2): a stick comes from a stranger, so every test here builds a small
+// The stick scan: a stick comes from a stranger, so every test here builds a small
 // hostile tree in a fresh temp folder — links out of the tree, loops, FIFOs, device nodes, deep nesting,
 // floods of entries and documents, empty, mislabelled and oversized files, names that are not UTF-8 or
 // carry bidi and control characters — and checks what the scan lists, what it refuses and why, that every

@@ -1,4 +1,4 @@
-// Texture out (issue 15, item 1): the surround annulus, the surround at chain points, the stand-out test, and
+// Texture out: the surround annulus, the surround at chain points, the stand-out test, and
 // the detectors side by side on generated texture and real pictures.
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Thin-line merging (issue 6, item 4): strokes drawn with OpenCV go through the real pipeline
+// Thin-line merging: strokes drawn with OpenCV go through the real pipeline
 // (detect_edges + link_edges + merge_thin_lines) and the output is checked against the stroke's
 // analytical centre line (segment, circle arc), which the pipeline never sees.
 

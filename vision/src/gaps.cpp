@@ -1,4 +1,4 @@
-// Closing small gaps in outlines (issue 15, item 3): close_gaps, in three phases (candidates, greedy joins,
+// Closing small gaps in outlines: close_gaps, in three phases (candidates, greedy joins,
 // walks), see gaps.hpp.
 #include "vision/gaps.hpp"
 

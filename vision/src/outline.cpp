@@ -1,4 +1,4 @@
-// Two-tone pictures traced from a threshold (issue 15): classify_two_tone and trace_outlines.
+// Two-tone pictures traced from a threshold: classify_two_tone and trace_outlines.
 #include "vision/outline.hpp"
 
 #include <algorithm>

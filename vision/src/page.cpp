@@ -1,4 +1,4 @@
-// Pages made flat (issue 16, item 2): find the page in a camera frame, its aspect ratio, the warp flat.
+// Pages made flat: find the page in a camera frame, its aspect ratio, the warp flat.
 // See vision/page.hpp for the contract; the steps are described at each function below.
 
 #include "vision/page.hpp"

@@ -125,7 +125,7 @@ struct Work {
   PointValues strength;
 };
 
-/// Step 1 (issue 6, item 4): the two edges of a stroke thinner than a fingertip can resolve become its centre
+/// Step 1: the two edges of a stroke thinner than a fingertip can resolve become its centre
 /// line. Merged at the resolution the edges were found at (extract_chains returns original pixels; the
 /// inverse of its scale-back is exact), where the chains are 8-connected pixel walks.
 void merge_strokes(Work& w, const Extraction& ex, const PxToM& map, const SimplifyParams& p, SimplifyReport& r) {
@@ -146,7 +146,7 @@ void merge_strokes(Work& w, const Extraction& ex, const PxToM& map, const Simpli
   r.thin_lines_ms = ms_since(t0);
 }
 
-/// Step 2 (issue 15, item 3): chain ends facing each other across at most gap_close_m are joined, so outlines
+/// Step 2: chain ends facing each other across at most gap_close_m are joined, so outlines
 /// Canny broke at a highlight or a notch are felt closed.
 void join_gaps(Work& w, const Extraction& ex, const PxToM& map, const SimplifyParams& p, SimplifyReport& r) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -167,7 +167,7 @@ void join_gaps(Work& w, const Extraction& ex, const PxToM& map, const SimplifyPa
   r.gaps_ms = ms_since(t0);
 }
 
-/// Step 4 (issue 6, item 4; issue 15, item 2): curves along the picture's frame dropped; the rest taken in
+/// Step 4: curves along the picture's frame dropped; the rest taken in
 /// decreasing shape_salience (ties: picture order), each kept while fewer than max_shapes are and its
 /// segments still fit max_segments (a less salient one further down may still fit). The kept curves stay in
 /// picture order, so curve ids follow the picture, not the ranking.

@@ -1,4 +1,4 @@
-// The scan of a USB stick handed in by a stranger (issue 11, item 2): a bounded walk that cannot be
+// The scan of a USB stick handed in by a stranger: a bounded walk that cannot be
 // led outside the stick, and the re-open of a document it found.
 //
 // Every folder and file is opened with openat2(2) relative to the folder that listed it, with

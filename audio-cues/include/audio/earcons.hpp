@@ -1,6 +1,6 @@
 #pragma once
 /// @file earcons.hpp
-/// Earcon synthesis from haptic cues (issue 4, item 1). Each cue kind has its own short sound, designed
+/// Earcon synthesis from haptic cues. Each cue kind has its own short sound, designed
 /// so that a listener can tell them apart without seeing anything:
 ///   ContactBegin  a pitched "tock" at the curve's pitch, loudness from approach speed;
 ///   ContactEnd    a soft, lower tock;

@@ -1,6 +1,6 @@
 #pragma once
 /// @file mixer.hpp
-/// The kiosk's one audio mix (issue 4, items 1–2, 4–5): earcons from haptic cues plus speech, earcons
+/// The kiosk's one audio mix: earcons from haptic cues plus speech, earcons
 /// ducked under speech, master volume, and a soft limiter. Live, the audio callback drains the cue
 /// queue the servo thread fills; headless, render_cue_timeline() places every cue sample-exactly at its
 /// tick's time so the WAV lines up with trace.csv.

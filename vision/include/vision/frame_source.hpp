@@ -1,6 +1,6 @@
 #pragma once
 /// @file frame_source.hpp
-/// Camera capture (issue 16, item 1): frames from a camera or from files, behind one interface.
+/// Camera capture: frames from a camera or from files, behind one interface.
 ///
 /// Three sources, named by a spec string (the `--source` of `capture` and `explore`, `[camera] source`):
 /// - `file:PATH`: an image file, or a folder of frames served in name order (tests and demos);

@@ -1,6 +1,6 @@
 #pragma once
 /// @file framing.hpp
-/// Spoken framing for someone who cannot see the preview (issue 16, item 3). Each camera frame is looked at
+/// Spoken framing for someone who cannot see the preview. Each camera frame is looked at
 /// once (look_at_frame: the page found in it, how bright it is, how much it moved since the frame before);
 /// FramingGuide turns the looks into advice, one piece at a time, and decides when to capture: once the page
 /// has been whole, roughly centred, lit and still for `still_s`.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file gaps.hpp
-/// Closing small gaps in outlines (issue 15, item 3): Canny breaks an object's outline where a highlight or
+/// Closing small gaps in outlines: Canny breaks an object's outline where a highlight or
 /// a notch lowers the contrast for a few pixels, and a hand then feels several open strokes where the eye
 /// sees one closed shape. Chain ends that face each other across a gap no wider than a fingertip can tell
 /// from a join are joined with a straight piece; a real gap, wider than that, stays open.

@@ -1,7 +1,7 @@
 #pragma once
 /// @file outline.hpp
 /// Two-tone pictures (silhouettes, logos, diagrams, scanned drawings) traced from a threshold instead of
-/// found by Canny (issue 15): every boundary between the two tones becomes one chain, closed where it does not
+/// found by Canny: every boundary between the two tones becomes one chain, closed where it does not
 /// run into the picture's frame, lying on the boundary to within one pixel. Canny on such a picture breaks
 /// outlines at corners and junctions (non-maximum suppression thins the ridge and hysteresis loses its weak
 /// ends), so a silhouette is felt as open strokes; a threshold's boundary is closed by construction.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file page.hpp
-/// Pages made flat (issue 16, item 2): find the page, card or photo a visitor holds under the camera — the
+/// Pages made flat: find the page, card or photo a visitor holds under the camera — the
 /// largest convex quadrilateral with enough contrast against the background — and rectify it with a
 /// perspective warp to its own aspect ratio, so the scene is built from the picture and not from the
 /// table around it.

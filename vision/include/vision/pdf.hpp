@@ -1,6 +1,6 @@
 #pragma once
 /// @file pdf.hpp
-/// PDF pages as pictures, with their text (issue 11, items 3 and 4).
+/// PDF pages as pictures, with their text.
 ///
 /// A PDF from a stick is hostile input, and poppler is a large parser: every poppler call runs in a
 /// worker process, the executable hk-pdf-worker started with posix_spawn (not a fork of the kiosk, whose

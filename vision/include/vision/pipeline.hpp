@@ -110,7 +110,7 @@ Extraction extract_chains(const std::string& path, const ExtractParams& p);
 /// extract_chains on pixels already in memory (a rendered PDF page, a camera frame), with regions where
 /// edges are ignored: to_grey (shrink) -> detect_edges -> edge pixels under `ignore_mask` cleared ->
 /// link_edges -> edge strength -> chains scaled back to `image`'s pixels. Used for document pages, whose
-/// text is spoken, not felt (issue 11, item 4): the letters' outlines never become curves.
+/// text is spoken, not felt: the letters' outlines never become curves.
 ///
 /// @param image        CV_8UC1 (grey), CV_8UC3 (BGR) or CV_8UC4 (BGRA); not empty.
 /// @param ignore_mask  empty (nothing ignored) or CV_8UC1 of image's size; nonzero = ignore edges there. It

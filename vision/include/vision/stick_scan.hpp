@@ -1,6 +1,6 @@
 #pragma once
 /// @file stick_scan.hpp
-/// What a USB stick offers: a bounded, symlink-proof walk of a mounted stick (issue 11, item 2).
+/// What a USB stick offers: a bounded, symlink-proof walk of a mounted stick.
 ///
 /// A stick comes from a stranger, so the walk treats it as hostile: every open is an openat2(2) with
 /// RESOLVE_BENEATH | RESOLVE_NO_SYMLINKS | RESOLVE_NO_XDEV | RESOLVE_NO_MAGICLINKS and

@@ -1,6 +1,6 @@
 #pragma once
 /// @file texture.hpp
-/// Texture out (issue 15, item 1): an edge in texture (grain, gravel, fur, print) is surrounded by edges like
+/// Texture out: an edge in texture (grain, gravel, fur, print) is surrounded by edges like
 /// itself; an object's outline stands alone. Surround inhibition after Grigorescu, Petkov & Westenberg,
 /// "Contour detection based on nonclassical receptive field inhibition", IEEE TIP 12(7), 2003: the gradient
 /// magnitude around each pixel, in an annulus that leaves the pixel itself out, is taken off its own

@@ -1,6 +1,6 @@
 #pragma once
 /// @file thin_lines.hpp
-/// Thin-line merging: one curve along a thin stroke instead of its two edges (issue 6, item 4).
+/// Thin-line merging: one curve along a thin stroke instead of its two edges.
 ///
 /// Canny finds boundaries, so a thin dark stroke (a line drawing, a grid line, a letter, a road
 /// on a map) gives TWO parallel edge chains, one each side of the stroke, usually one closed loop
