@@ -1,4 +1,4 @@
-// Accuracy against size (issue 3 item 3): how far each level of our multiresolution model lies from
+// Accuracy against size: how far each level of our multiresolution model lies from
 // the original curve, compared at equal vertex counts with three other ways of shrinking the same curve.
 //
 // Usage: bench_accuracy [--images DIR] [--out FILE.json] [--rms-step-mm S] [--tol-mm T] [--threads N]

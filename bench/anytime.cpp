@@ -1,4 +1,4 @@
-// Anytime chart (issue 3 item 5; box budgets since issue 13 item 5): with box-test budgets from 8 to 4096
+// Anytime chart (box-test budgets): with box-test budgets from 8 to 4096
 // (QueryBudget: the servo's work limit, no clock), which level does a cold query reach, what does that
 // level cost in accuracy, and how long does it take? "Cold" = the boundary section starts at the scene
 // root, as after a new picture or a level change; a warm section (every other tick) rarely needs

@@ -1,4 +1,4 @@
-// PortAudio output on this machine (issue 4, "Measure and write down"): opens an output with the
+// PortAudio output on this machine: opens an output with the
 // kiosk's settings, plays a quiet 440 Hz tone for a while and prints one JSON object per line: the
 // device, host API, buffer size, the output latency PortAudio reports, callbacks, underflows, and the
 // spread of the period between callbacks (p50 / p99 / max, and the mean rate the device pulled at;

@@ -1,4 +1,4 @@
-// Time from a still page under the camera to its scene being felt (issue 16, "Measure and write down").
+// Time from a still page under the camera to its scene being felt.
 //
 // Each picture is photographed synthetically (tests/support/synthetic_photo.hpp: on a wooden table, turned
 // 12 degrees, a little keystone, blur, noise and uneven light) at the camera's default 1280 x 960, written as a

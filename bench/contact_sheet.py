@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Contact sheet (issue 15): every test picture's overlay (summary.json's picture with the scene's curves drawn
+"""Contact sheet: every test picture's overlay (summary.json's picture with the scene's curves drawn
 on it, explore's overlay.png) before and after, side by side, in one PNG a person can judge at a glance.
 
 Usage: contact_sheet.py WORK OUT.png   where WORK/canny/NAME and WORK/auto/NAME are explore output folders
-(bench/scene_detectors.sh makes them: "before" = the pipeline before issue 15, "after" = the defaults)."""
+(bench/scene_detectors.sh makes them: "before" = the old pipeline (canny, no gap closing, no shape budget), "after" = the defaults)."""
 import json
 import os
 import sys

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Coverage per picture (issue 14): how much of the curves' length (summary.json coverage.length_fraction, the
+# Coverage per picture: how much of the curves' length (summary.json coverage.length_fraction, the
 # level-0 length within 1 mm of the proxy's path) three model hands reach on every picture of tests/data/images:
 #   raster            --hand raster (its natural duration: one boustrophedon, ~27 s)
 #   explorer          --hand explorer --duration 120 (seed 1)

@@ -1,4 +1,4 @@
-// The edge detectors side by side (issue 15, item 1): vision::extract_chains_from_image with each
+// The edge detectors side by side: vision::extract_chains_from_image with each
 // [vision] detector (canny, surround, bilateral, edpf) on every test picture and on generated texture
 // (tests/support/textures.hpp), from the decoded, downscaled grey image. Counters: chains found (before
 // any simplification) and their total length [processed px]. What each gives a hand after the

@@ -1,4 +1,4 @@
-// The USB pantograph's driver in the loop (issue 13, "Measure and write down"), on the Haply firmware
+// The USB pantograph's driver in the loop, on the Haply firmware
 // emulator behind a pty, reached through the tty transport and the hAPI driver exactly as a board on
 // /dev/ttyACM0 would be:
 //  1. Round trip at 1 kHz: from just before a torque packet is written (HaplyDevice::write_force) to its

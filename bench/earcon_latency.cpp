@@ -1,4 +1,4 @@
-// Event-to-sound latency in the rendered timeline (issue 4, "Measure and write down"), and the cost of
+// Event-to-sound latency in the rendered timeline, and the cost of
 // the mix. For each picture: the explore raster on the simulated pantograph (as `haptic-kiosk explore`),
 // its cues rendered on the trace's timeline exactly as --audio-out does, then for every cue the time from
 // its tick to the first onset the independent analysis of tests/support/audio_analysis.hpp finds at or

@@ -1,4 +1,4 @@
-// Servo query against peers (issue 3 items 2 and 4, issue 18 item 1): the same query streams answered by
+// Servo query against peers: the same query streams answered by
 // our collision tree with its boundary section, by brute force, by a Boost.Geometry R-tree and by Embree
 // (bench/support/embree_peer.hpp); results checked equal before anything is timed. One benchmark iteration is one query, timed on its own (manual time), so
 // the mean and the percentiles describe the same measurements; each includes ~25–40 ns of clock reads.
@@ -302,7 +302,7 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
   }
 }
 
-// The first-hit methods side by side (BM_FirstHitPaired/<segments>). Issue 18's targets are ratios within one
+// The first-hit methods side by side (BM_FirstHitPaired/<segments>). The performance targets are ratios within one
 // run, and this host's speed drifts by up to 1.6x between benchmarks run minutes apart, so the separate
 // benchmarks' ratios carry that drift. Here each round replays the whole stream with each method in turn (ours,
 // ours_wide, rtree, embree; ~100 ms a round at 10^5), once as one block (its batch mean: no clock read per
@@ -435,7 +435,7 @@ int main(int argc, char** argv) {
     auto c = make_case(std::to_string(n), std::move(curves), 0, random_walk_stream(plane, 100000));
     check_equal(*c, n >= 1000000 ? 300 : 3000);
     Case* cp = c.get();
-    if (n >= 100000) {  // the sizes issue 18's targets name
+    if (n >= 100000) {  // the sizes the performance targets name
       benchmark::RegisterBenchmark(("BM_FirstHitPaired/" + std::to_string(n)).c_str(), [cp](benchmark::State& s) { run_paired(s, cp); })
           ->Iterations(1)
           ->Unit(benchmark::kMillisecond);

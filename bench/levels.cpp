@@ -1,4 +1,4 @@
-// Levels from hand speed, and what a scene costs (issue 6, "Measure and write down"): for every shipped
+// Levels from hand speed, and what a scene costs: for every shipped
 // picture, a raster whose rows cycle through hand speeds from 1 cm/s to 40 cm/s is run on the simulated
 // pantograph with levels chosen from the hand's speed; per tick the handle speed and the level in use are
 // binned. Also per picture: level-0 segments before and after the scene budget (and thin lines merged),

@@ -1,4 +1,4 @@
-// PDF pages in the forked poppler worker (issue 11): for each shipped PDF in tests/data/documents, probe it
+// PDF pages in the forked poppler worker: for each shipped PDF in tests/data/documents, probe it
 // and render each of its pages (at most 20 per document) with the default limits (4 MP budget, 300 dpi at
 // most), one worker per page as the kiosk does. Per page: the worker's wall time (fork to reap, so it
 // includes loading the document again), its peak resident memory (wait4's ru_maxrss, which includes the

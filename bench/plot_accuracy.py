@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Charts of bench_accuracy's JSON (issue 3 item 3, accuracy against size).
+"""Charts of bench_accuracy's JSON (accuracy against size).
 
     /usr/bin/python3 bench/plot_accuracy.py [docs/bench/accuracy.json] [--outdir docs/bench]
 

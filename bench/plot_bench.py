@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Charts and tables from the benchmark outputs in docs/bench (issue 3).
+"""Charts and tables from the benchmark outputs in docs/bench.
 
 Reads first_hit.json and scene_build.json (Google Benchmark JSON) and anytime.json, writes
 first_hit_vs_size.png, speed_accuracy.png, anytime.png, scene_build.png, and the Markdown tables
@@ -302,7 +302,7 @@ if sb:
         lines.append("| %s | %.2f | %.2f | %.2f | %s | %.2f | %s | %s | %s |" % (n, ns(o) / 1e6, ns(sb[n]["opencv"]) / 1e6, q, t2, q2, front, model, side))
     tables["scene_build"] = "\n".join(lines)
 
-# 6. Issue 18's targets, each with this run's figures (first_hit.json, scene_build.json, accuracy.json,
+# 6. The performance targets, each with this run's figures (first_hit.json, scene_build.json, accuracy.json,
 #    tolerance_cut.json, servo_tick.json).
 def median(xs):
     xs = sorted(xs)

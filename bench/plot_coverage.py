@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Chart and table of bench/coverage.sh's CSV (issue 14): coverage of the curves' length per picture for the
+"""Chart and table of bench/coverage.sh's CSV: coverage of the curves' length per picture for the
 raster hand, the explorer hand, and the explorer in grooves mode.
 
 Usage: plot_coverage.py coverage.csv --outdir DIR [--doc docs/PERFORMANCE.md]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Charts of bench_levels' JSON (issue 6): levels used against hand speed, and tick time against picture size.
+"""Charts of bench_levels' JSON: levels used against hand speed, and tick time against picture size.
 
 Usage: plot_levels.py levels.json --outdir DIR
 Writes DIR/levels_vs_speed.png and DIR/tick_vs_complexity.png.

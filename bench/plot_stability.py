@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Charts of bench_stability's JSON (issue 3 item 6, "stability where methods fail").
+"""Charts of bench_stability's JSON: stability where methods fail.
 
 Usage: /usr/bin/python3 bench/plot_stability.py [docs/bench/stability.json] [--outdir DIR]
 

@@ -1,4 +1,4 @@
-// Pages made flat (issue 16, item 2): the time per camera frame of vision::find_page and vision::rectify_page at
+// Pages made flat: the time per camera frame of vision::find_page and vision::rectify_page at
 // 640 x 480, 1280 x 960 and 1920 x 1080, on synthetic photos (tests/support/synthetic_photo.hpp) of four test
 // pictures (a photograph, a silhouette, a drawing, a printed page) under two conditions (clean on wood; turned
 // 25°, tilted, blurred, noisy and unevenly lit on a cloth), cycled through frame by frame. The photos are made

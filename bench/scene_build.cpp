@@ -1,4 +1,4 @@
-// Scene build against OpenCV (issue 3 item 7): picture → collision trees with our pipeline, next to
+// Scene build against OpenCV: picture → collision trees with our pipeline, next to
 // OpenCV's own GaussianBlur + Canny + findContours on the same grey image, in the same run.
 // A third variant runs the same OpenCV calls with the Canny thresholds ours chose for the picture, so that
 // both find the same edges (OpenCV's fixed 50/150 finds 2 contours on apple where ours links 166 curves).
@@ -133,7 +133,7 @@ void build_opencv(benchmark::State& state, const Picture* p) {
 
 // The same OpenCV calls with the Canny thresholds our detector chose for the picture (computed once,
 // outside the timing) and our blur's border: both sides then find the same edge pixels, so the ratio
-// compares the work after them rather than how many edges fixed thresholds happen to find (issue 18).
+// compares the work after them rather than how many edges fixed thresholds happen to find.
 void build_opencv_same_edges(benchmark::State& state, const Picture* p) {
   const vision::EdgeParams ep = edge_params(config::Settings{});
   const vision::EdgeMap chosen = vision::detect_edges(p->grey, ep);
@@ -155,7 +155,7 @@ void build_opencv_same_edges(benchmark::State& state, const Picture* p) {
 }
 
 // The three side by side, one build of each per iteration in a rotating order, and each one's fastest
-// single build [ms] as counters (issue 18). Runs of separate benchmarks sample the shared machine at
+// single build [ms] as counters. Runs of separate benchmarks sample the shared machine at
 // different moments, and a repetition's mean carries every disturbance within it; here the three sample
 // the same moments, and the fastest build of each is the one least disturbed, so the ratios of the fastest
 // builds compare the work itself.

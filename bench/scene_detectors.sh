@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The scene of every picture of tests/data/images and of two generated textures (bench_detectors
-# --write-textures: fine noise, wood grain), before and after issue 15, and with each edge detector.
+# --write-textures: fine noise, wood grain), with the old pipeline and the defaults, and with each edge detector.
 #  - Before → after: the old pipeline ([vision] detector = "canny", gap_close_m = 0, max_shapes = 1000: no
 #    shape budget) against the defaults (two-tone pictures traced, line drawings by Canny, the rest by
 #    "surround": texture dropped; gaps closed; 30 shapes): the detector used, shapes (curves kept), closed share,

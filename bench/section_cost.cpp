@@ -1,4 +1,4 @@
-// Where first_hit's time goes (issue 18): the servo path's query (the boundary section, seed §3) on the
+// Where first_hit's time goes: the servo path's query (the boundary section, seed §3) on the
 // random-walk stream of bench_first_hit's tiled scenes, its queries sorted by kind, each query's cost the
 // fastest of several replays of the whole stream, so the host's stalls and neighbours' cache traffic drop out
 // and two builds can be compared on a noisy machine.

@@ -1,4 +1,4 @@
-// The servo thread under load (issue 5: "The servo thread under a loaded second core keeps its rate").
+// The servo thread under load: it must keep its rate with the second core loaded.
 // Runs the kiosk's servo thread (ServoThread + ServoCore + the simulated pantograph driven by the raster
 // hand) on a real picture for a few seconds at 1 kHz, first on an idle machine, then with a busy thread
 // spinning on the other core, and reports wake-up lateness (p50/p99/max), tick work and missed deadlines.

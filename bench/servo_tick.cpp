@@ -1,5 +1,5 @@
-// The servo tick on large scenes (issue 18: "Servo tick in the headless run: p99.9 ≤ 10 µs on a tiled scene
-// of 10^6 segments").
+// The servo tick on large scenes: the tick in the headless run, whose target is p99.9 ≤ 10 µs on a tiled
+// scene of 10^6 segments.
 //
 // Usage: bench_servo_tick [--sizes 1000,10000,100000,1000000] [--seconds S] [--repeats R] [--cpu N]
 //                         [--level-mode auto|tolerance|cut|fixed] [--out FILE.json]   (prints a markdown table)

@@ -1,4 +1,4 @@
-// Soak (issue 17, item 2): the kiosk without its window, run for a given wall-clock time with everything a
+// Soak: the kiosk without its window, run for a given wall-clock time with everything a
 // day at a museum brings, while its process is watched.
 //
 // Every frame (60 Hz, wall clock) the loop does what app/kiosk/kiosk_app.cpp's frame loop does without

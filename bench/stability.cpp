@@ -1,4 +1,4 @@
-// Stability where methods fail (issue 3 item 6): how stiff a wall the servo loop can render at each
+// Stability where methods fail: how stiff a wall the servo loop can render at each
 // servo rate before the sampled-data loop goes unstable, and how fast a hand can move before the
 // god-object proxy tunnels through a wall or misses a contact. An analysis, not a timing benchmark:
 // plain main(), one JSON file with every raw number, charts by bench/plot_stability.py.
@@ -96,7 +96,7 @@
 // A control run with a proxy glued to the handle (a renderer blind to walls) must be counted as failing
 // on every stroke, or the program stops: a checker that never fires proves nothing.
 // Part 2b (JSON "auto_levels"): the kinematic strokes again with the shipped auto levels (the level from
-// hand speed, issue 6), push-through still off, each sub-move checked against the polylines of the level
+// hand speed), push-through still off, each sub-move checked against the polylines of the level
 // ids the proxy rendered that tick (auto_level_stroke).
 // The god-object keeps its proxy on its side of every polyline by construction (Zilles & Salisbury
 // 1995, "A constraint-based god-object method for haptic display", IROS); part 2 measures that at speeds
@@ -916,8 +916,7 @@ struct TickChecker {
 /// coarser level's wall lies up to its error away from the level-0 polyline, across it at a thin curve or
 /// a wedge's apex), and push-through is off (the shipped pop_force_n lets a proxy pressed that hard for
 /// pop_hold_s through a wall on purpose, kEventPopThrough: a slow stroke that ends 29 mm past a wedge's apex
-/// presses that long). Both were default-off when part 2 was written; since they shipped on (issue 6 and
-/// issue 14), part 2 sets them off itself, so it measures what it says: whether the proxy ever crosses
+/// presses that long). Both are on by default, so part 2 sets them off itself, so it measures what it says: whether the proxy ever crosses
 /// the wall it renders.
 /// auto_levels: the shipped level_mode "auto" instead (part 2b), push-through still off.
 ServoParams stroke_servo_params(bool auto_levels = false) {

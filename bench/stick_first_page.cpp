@@ -1,4 +1,4 @@
-// Stick inserted -> first page felt (issue 11, "Measure and write down"): the kiosk's own StickService on a
+// Stick inserted -> first page felt: the kiosk's own StickService on a
 // folder standing in for a mounted stick. For each shipped document (and a picture), a stick holding just
 // it is inserted; the clock runs from insert_folder() to the moment its first page's scene is built and
 // ready to publish (scan + page counting in the PDF worker + drawing the page in the worker + edges +

@@ -1,4 +1,4 @@
-// Stick scan speed (issue 11, item 2): how long scan_stick takes over a stick of 10 000 files in 100
+// Stick scan speed: how long scan_stick takes over a stick of 10 000 files in 100
 // folders — six in ten tiny files with a picture's or a PDF's first bytes, the rest text, empty files
 // and macOS "._" files — built in a fresh folder under /tmp and removed afterwards. Timed with the page
 // cache warm (the first, cold walk is reported on its own), several repeats: min / median / max.

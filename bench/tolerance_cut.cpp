@@ -1,4 +1,4 @@
-// Vertices per error (issue 18 item 3): a tolerance cut through our collision tree against
+// Vertices per error: a tolerance cut through our collision tree against
 // Douglas–Peucker on every test picture.
 //
 // Usage: bench_tolerance_cut [--out FILE.json] [--max-levels N]    (prints a markdown table)

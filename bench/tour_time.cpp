@@ -1,4 +1,4 @@
-// Time to touch every shape once with the guided tour (issue 14, item 3): on the five-shape test picture
+// Time to touch every shape once with the guided tour: on the five-shape test picture
 // (tests/support/tour_picture.hpp) and on pictures of tests/data/images, the handle starts where the kiosk
 // parks it (bottom centre), the visitor's hand is relaxed (no force) and Guide is pressed again as soon as
 // a tour ends, until every shape is touched. Servo time (1 kHz ticks through the simulated pantograph with

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs every benchmark and regenerates every chart and table of docs/PERFORMANCE.md (issue 3):
+# Runs every benchmark and regenerates every chart and table of docs/PERFORMANCE.md:
 # Google Benchmark JSON and analysis JSON in docs/bench/, PNG charts beside them, tables in
 # docs/PERFORMANCE.md between its BEGIN/END markers. Takes ~15–20 minutes on 2 cores.
 # Usage: scripts/bench.sh [--quick]
@@ -47,7 +47,7 @@ taskset -c 1 "$b/bench_section_cost" --segments 100000 1000000 > "$out/section_c
 "$b/bench_capture_latency" --out "$out/capture_latency.json" > "$out/capture_latency.md"
 [ -x "$b/bench_rectify" ] && "$b/bench_rectify" --benchmark_min_time=$min_time --benchmark_out="$out/rectify.json" --benchmark_out_format=json >/dev/null
 bash "$root/bench/coverage.sh" "$root/build" "$out" >/dev/null  # coverage per picture: CSV, chart and its table
-bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detectors.md"  # issue 15: each picture's scene, canny → auto, and per detector
+bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detectors.md"  # each picture's scene, canny → auto, and per detector
 # Tables printed by the audio and servo benches go between their markers in PERFORMANCE.md.
 /usr/bin/python3 - "$out" "$root/docs/PERFORMANCE.md" <<'PY'
 import re, sys

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Boots a fresh Debian 12 with the package installed, in qemu, and checks that it lands in the kiosk
-# (issue 17: "a Debian package that boots into the kiosk").
+# (a Debian package that boots into the kiosk).
 #
 #   scripts/boot-check.sh [--deb dist/haptic-kiosk_<version>_amd64.deb] [--work DIR] [--wait-s S] [--accel tcg|kvm] [--keep]
 #

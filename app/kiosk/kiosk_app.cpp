@@ -40,7 +40,7 @@ namespace {
 std::int64_t unix_now_s() { return static_cast<std::int64_t>(std::time(nullptr)); }
 
 /// The settings the kiosk starts with: the file, or (when it is corrupt) its .bak or the defaults, said in
-/// the log and kept for the operator's panel (issue 12, item 5).
+/// the log and kept for the operator's panel.
 struct StartSettings {
   config::Settings settings;
   std::string notice;
@@ -203,13 +203,8 @@ std::string describe_apply(const ApplyReport& r) {
   return s + ".";
 }
 
-}  // namespace
-
-int run_kiosk(const KioskOptions& o) {
-  check_screenshot_options(o);
-  const StartSettings start = start_settings(o.config_path);
-  const std::vector<ScriptLine> script_lines = o.script.empty() ? std::vector<ScriptLine>{} : load_script(o.script);
-
+/// The runtime's options from the command line and the settings in use.
+RuntimeOptions runtime_options(const KioskOptions& o, const config::Settings& settings) {
   RuntimeOptions ro;
   ro.library = o.library.empty() ? std::string(HK_DATA_DIR) + "/pictures" : o.library;
   ro.hotplug = o.hotplug;
@@ -218,17 +213,78 @@ int run_kiosk(const KioskOptions& o) {
   ro.overlay = o.overlay;
   // Scripted runs (documentation, tests) never depend on hardware they were not told of: [device] type "auto"
   // stays simulated there, a type the settings name ("haply") is looked for as at the kiosk.
-  ro.probe_usb_device = o.screenshot.empty() || config::is_usb_type(start.settings.device.type);
+  ro.probe_usb_device = o.screenshot.empty() || config::is_usb_type(settings.device.type);
   ro.probe_camera = o.screenshot.empty();
   ro.device = o.device;
-  KioskRuntime rt(ro, start.settings);
+  return ro;
+}
+
+/// The visitor's flow's timing and keys from the settings in use; `camera`: whether a camera was found.
+KioskFlowParams flow_params(const config::Settings& settings, bool camera) {
   KioskFlowParams fp;
-  fp.timeout_s = start.settings.kiosk.timeout_s;
-  fp.warning_s = start.settings.kiosk.warning_s;
-  fp.attract_every_s = start.settings.kiosk.attract_every_s;
-  fp.keys = start.settings.keys;
-  fp.camera = rt.has_camera();
-  KioskFlow flow(rt, rt.audio().messages(), fp);
+  fp.timeout_s = settings.kiosk.timeout_s;
+  fp.warning_s = settings.kiosk.warning_s;
+  fp.attract_every_s = settings.kiosk.attract_every_s;
+  fp.keys = settings.keys;
+  fp.camera = camera;
+  return fp;
+}
+
+/// Starts the servo thread, says which device and camera are in use, and takes --stick and --show.
+void start_kiosk(const KioskOptions& o, const RuntimeOptions& ro, KioskRuntime& rt, KioskFlow& flow) {
+  rt.start_servo();
+  if (ro.probe_usb_device || !ro.device.empty()) rt.announce_device();
+  rt.announce_camera();
+  if (!o.stick.empty()) rt.insert_stick_folder(o.stick);
+  if (!o.show.empty()) show_first(o.show, rt, flow);
+}
+
+/// One frame's input and time: events (real, then the script's step), sticks, capture, text, device, mouse,
+/// handle, tour, display modes, the flow and the operator's session. Returns whether the script holds this
+/// frame (waiting for the runtime).
+bool update_frame(Kiosk& kiosk, KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, KioskWindow& window,
+                  ScriptPlayer& script, bool scripted, int frame) {
+  for (const InputEvent& e : window.poll()) kiosk.input(e);
+  rt.poll_sticks(flow, kiosk.now_s_);
+  rt.poll_capture(flow, kiosk.now_s_);
+  rt.poll_text(kiosk.now_s_);
+  rt.poll_device(kiosk.now_s_);
+  const bool holding = scripted && script.step(frame, kiosk);
+  if (!scripted) kiosk.follow_mouse();
+  kiosk.watch_handle();
+  rt.poll_tour();
+  rt.poll_display_modes();
+  flow.tick(kiosk.now_s_);
+  session.tick(kiosk.now_s_, unix_now_s());
+  rt.collect();
+  return holding;
+}
+
+/// The frame's drawing, not yet shown: the scene, the camera preview while capturing, then (ImGui) the
+/// captions, the overlay's status and the operator's panel.
+void draw_frame(KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, OperatorPanel& panel, KioskWindow& window,
+                const ScriptPlayer& script, bool scripted, double now_s, PictureTexture& texture, CapturePreviewView& preview) {
+  const auto [fw, fh] = window.framebuffer_size();
+  texture.update(rt.shown());
+  draw_scene(rt, make_view(fw, fh, rt.half()), texture);
+  if (flow.capturing()) preview.draw(rt.capture_preview(), make_view(fw, fh, rt.half()), rt.half());
+  window.begin_frame(scripted ? script.mouse() : std::nullopt);
+  draw_captions(rt, flow, fw, fh);
+  if (rt.overlay() && session.state() != PanelState::open) draw_overlay_status(rt, flow);
+  panel.draw(rt, flow, fw, fh, now_s, unix_now_s());
+  window.end_frame();
+}
+
+}  // namespace
+
+int run_kiosk(const KioskOptions& o) {
+  check_screenshot_options(o);
+  const StartSettings start = start_settings(o.config_path);
+  const std::vector<ScriptLine> script_lines = o.script.empty() ? std::vector<ScriptLine>{} : load_script(o.script);
+
+  const RuntimeOptions ro = runtime_options(o, start.settings);
+  KioskRuntime rt(ro, start.settings);
+  KioskFlow flow(rt, rt.audio().messages(), flow_params(start.settings, rt.has_camera()));
 
   KioskWindow window(o.windowed);
   Kiosk* kiosk_ptr = nullptr;
@@ -241,12 +297,7 @@ int run_kiosk(const KioskOptions& o) {
   Kiosk kiosk(o, rt, flow, session, panel, window);
   kiosk_ptr = &kiosk;
   ScriptPlayer script(script_lines, o.script);
-
-  rt.start_servo();
-  if (ro.probe_usb_device || !ro.device.empty()) rt.announce_device();
-  rt.announce_camera();
-  if (!o.stick.empty()) rt.insert_stick_folder(o.stick);
-  if (!o.show.empty()) show_first(o.show, rt, flow);
+  start_kiosk(o, ro, rt, flow);
 
   PictureTexture texture;
   CapturePreviewView preview;
@@ -255,29 +306,8 @@ int run_kiosk(const KioskOptions& o) {
   int frame = 0;
   while (!window.should_close()) {
     kiosk.now_s_ = scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    for (const InputEvent& e : window.poll()) kiosk.input(e);
-    rt.poll_sticks(flow, kiosk.now_s_);
-    rt.poll_capture(flow, kiosk.now_s_);
-    rt.poll_text(kiosk.now_s_);
-    rt.poll_device(kiosk.now_s_);
-    const bool holding = scripted && script.step(frame, kiosk);
-    if (!scripted) kiosk.follow_mouse();
-    kiosk.watch_handle();
-    rt.poll_tour();
-    rt.poll_display_modes();
-    flow.tick(kiosk.now_s_);
-    session.tick(kiosk.now_s_, unix_now_s());
-    rt.collect();
-
-    const auto [fw, fh] = window.framebuffer_size();
-    texture.update(rt.shown());
-    draw_scene(rt, make_view(fw, fh, rt.half()), texture);
-    if (flow.capturing()) preview.draw(rt.capture_preview(), make_view(fw, fh, rt.half()), rt.half());
-    window.begin_frame(scripted ? script.mouse() : std::nullopt);
-    draw_captions(rt, flow, fw, fh);
-    if (rt.overlay() && session.state() != PanelState::open) draw_overlay_status(rt, flow);
-    panel.draw(rt, flow, fw, fh, kiosk.now_s_, unix_now_s());
-    window.end_frame();
+    const bool holding = update_frame(kiosk, rt, flow, session, window, script, scripted, frame);
+    draw_frame(rt, flow, session, panel, window, script, scripted, kiosk.now_s_, texture, preview);
     if (!holding) ++frame;
     if (scripted && frame >= o.frames) {
       if (!cv::imwrite(o.screenshot, window.read_pixels())) throw AppError("--screenshot '" + o.screenshot + "': cannot write the PNG");

@@ -1,13 +1,13 @@
 #pragma once
 /// @file kiosk_app.hpp
-/// The kiosk a visitor walks up to (issue 5): `haptic-kiosk` with no subcommand. One window (full screen
+/// The kiosk a visitor walks up to: `haptic-kiosk` with no subcommand. One window (full screen
 /// on the primary monitor, or `--windowed`), the servo thread driving the simulated pantograph from the
 /// mouse (the model hand pulls the handle towards the cursor), the audio side, and the visitor's flow
 /// (kiosk_flow.hpp) on the keyboard. USB sticks are watched, mounted read-only and scanned, and their
 /// documents built, on worker threads (stick_service.hpp). The operator's panel (operator_panel.hpp) opens
 /// with the [operator] open_chord and the PIN.
 ///
-/// The pieces, each in a file of its own (issue 12, item 7): window.hpp (GLFW, GL context, Dear ImGui, the
+/// The pieces, each in a file of its own: window.hpp (GLFW, GL context, Dear ImGui, the
 /// input queue), view.hpp (the scene drawn), hud.hpp (captions, overlay status), operator_panel.hpp and
 /// app/src/operator_session.hpp (the panel and its logic), script.hpp (scripted input), keymap.hpp (key
 /// names), app/src/kiosk_runtime.hpp (everything but the window); this file's run_kiosk puts them together.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file operator_panel.hpp
-/// The operator's panel drawn with Dear ImGui (issue 12, item 3): the PIN prompt, notices, and the panel
+/// The operator's panel drawn with Dear ImGui: the PIN prompt, notices, and the panel
 /// with every setting of the field table grouped in tabs (Haptics, Levels, Scene, Audio, Kiosk, Keys,
 /// Devices), each with its unit, range, help text and when a change takes effect, plus a Status tab with
 /// the servo's lateness and missed deadlines, the device, sound, the stick, the level in use and a live

@@ -76,6 +76,7 @@ void CapturePreviewView::draw(const CapturePreview& p, const View& v, Vec2 half)
 
 namespace {
 
+/// A circle of radius r_px pixels around c (m), filled or as a ring, drawn as 24 sides.
 void disc(const View& v, Vec2 c, double r_px, bool filled) {
   glBegin(filled ? GL_TRIANGLE_FAN : GL_LINE_LOOP);
   for (int k = 0; k < 24; ++k) {
@@ -85,9 +86,8 @@ void disc(const View& v, Vec2 c, double r_px, bool filled) {
   glEnd();
 }
 
-}  // namespace
-
-void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
+/// Sets up a frame: the whole window in pixels (y down), cleared to the background, with alpha blending.
+void begin_frame(const View& v) {
   glViewport(0, 0, v.w, v.h);
   glClearColor(0.05f, 0.05f, 0.08f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
@@ -98,34 +98,40 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
   glLoadIdentity();
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-  const Shown& sh = app.shown();
-  const bool hc = app.high_contrast();
-  // The picture, in the workspace where its pixels map.
-  if (tex.valid()) {
-    const vision::PxToM& m = sh.px_to_m;
-    const double x0 = m.x_m(-0.5), x1 = m.x_m(tex.width() - 0.5), y0 = m.y_m(-0.5), y1 = m.y_m(tex.height() - 0.5);
-    glEnable(GL_TEXTURE_2D);
-    glBindTexture(GL_TEXTURE_2D, tex.id());
-    const float dim = hc ? 0.25f : 0.8f;
-    glColor4f(dim, dim, dim, 1.0f);
-    glBegin(GL_QUADS);
-    glTexCoord2f(0, 0); glVertex2d(v.px(x0), v.py(y0));
-    glTexCoord2f(1, 0); glVertex2d(v.px(x1), v.py(y0));
-    glTexCoord2f(1, 1); glVertex2d(v.px(x1), v.py(y1));
-    glTexCoord2f(0, 1); glVertex2d(v.px(x0), v.py(y1));
-    glEnd();
-    glDisable(GL_TEXTURE_2D);
-  }
-  // The usable rectangle's frame.
+}
+
+/// The picture, in the workspace where its pixels map; dimmed (more in high contrast) so the curves stand out.
+void draw_picture(const View& v, const PictureTexture& tex, const Shown& sh, bool hc) {
+  if (!tex.valid()) return;
+  const vision::PxToM& m = sh.px_to_m;
+  const double x0 = m.x_m(-0.5), x1 = m.x_m(tex.width() - 0.5), y0 = m.y_m(-0.5), y1 = m.y_m(tex.height() - 0.5);
+  glEnable(GL_TEXTURE_2D);
+  glBindTexture(GL_TEXTURE_2D, tex.id());
+  const float dim = hc ? 0.25f : 0.8f;
+  glColor4f(dim, dim, dim, 1.0f);
+  glBegin(GL_QUADS);
+  glTexCoord2f(0, 0); glVertex2d(v.px(x0), v.py(y0));
+  glTexCoord2f(1, 0); glVertex2d(v.px(x1), v.py(y0));
+  glTexCoord2f(1, 1); glVertex2d(v.px(x1), v.py(y1));
+  glTexCoord2f(0, 1); glVertex2d(v.px(x0), v.py(y1));
+  glEnd();
+  glDisable(GL_TEXTURE_2D);
+}
+
+/// The usable rectangle's frame (half its size `half`, m), so a companion sees where the handle can go.
+void draw_workspace_frame(const View& v, Vec2 half) {
   glColor4f(0.4f, 0.4f, 0.45f, 1.0f);
   glLineWidth(1.0f);
   glBegin(GL_LINE_LOOP);
-  glVertex2d(v.px(-app.half().x), v.py(-app.half().y));
-  glVertex2d(v.px(app.half().x), v.py(-app.half().y));
-  glVertex2d(v.px(app.half().x), v.py(app.half().y));
-  glVertex2d(v.px(-app.half().x), v.py(app.half().y));
+  glVertex2d(v.px(-half.x), v.py(-half.y));
+  glVertex2d(v.px(half.x), v.py(-half.y));
+  glVertex2d(v.px(half.x), v.py(half.y));
+  glVertex2d(v.px(-half.x), v.py(half.y));
   glEnd();
-  // Text blocks of a document page (spoken, not felt): pale blue frames, for a companion who sees.
+}
+
+/// Text blocks of a document page (spoken, not felt): pale blue frames, for a companion who sees.
+void draw_text_blocks(const View& v, const Shown& sh, bool hc) {
   glColor4f(0.45f, 0.7f, 1.0f, hc ? 1.0f : 0.8f);
   glLineWidth(hc ? 3.0f : 1.5f);
   for (const TextBlockM& b : sh.text_blocks) {
@@ -136,10 +142,13 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
     glVertex2d(v.px(b.lo_m.x), v.py(b.hi_m.y));
     glEnd();
   }
-  // The curves at the level in use: bright yellow (RGB 255, 220, 0), thicker in high contrast.
+}
+
+/// The curves at the level in use (a tolerance step's cuts when cut_step >= 0): bright yellow (RGB 255, 220,
+/// 0), thicker in high contrast.
+void draw_curves(KioskRuntime& app, const View& v, const Shown& sh, bool hc, int cut_step) {
   glColor4f(1.0f, 220.0f / 255.0f, 0.0f, 1.0f);
   glLineWidth(hc ? 6.0f : 3.0f);
-  const int cut_step = is_cut_level(app.level()) && !sh.cuts.empty() ? tolerance_step_of(app.level()) : -1;
   for (std::size_t c = 0; c < sh.levels.size(); ++c) {
     const int top = static_cast<int>(sh.levels[c].size()) - 1;
     const int l = sh.scene ? sh.scene->clamp_level(c, app.level()) : std::min(app.level(), top);  // a tolerance step: the curve's own level
@@ -148,61 +157,61 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
     for (const Vec2& p : pts) glVertex2d(v.px(p.x), v.py(p.y));
     glEnd();
   }
-  // Error boxes of the level in use (operator overlay).
-  if (app.overlay() && sh.scene) {
-    const Scene& sc = *sh.scene;
-    glColor4f(0.2f, 0.9f, 1.0f, 0.5f);
-    glLineWidth(1.0f);
-    const auto draw_box = [&](SegmentRef ref) {
-      const ErrorBox& b = sc.box(sc.node_of(ref));
-      const Vec2 n = left_perp(b.axis);
-      glBegin(GL_LINE_LOOP);
-      for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
-        const Vec2 q = b.origin_m + u * b.axis + w * n;
-        glVertex2d(v.px(q.x), v.py(q.y));
-      }
-      glEnd();
-    };
-    for (std::size_t c = 0; c < sc.curve_count(); ++c) {  // the walls' segments: a cut step's own, or the level's
-      if (cut_step >= 0) {
-        for (const SegmentRef& ref : sh.cut_segments[c][static_cast<std::size_t>(cut_step)]) draw_box(ref);
-        continue;
-      }
-      const int l = sc.clamp_level(c, app.level());
-      const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
-      for (std::uint32_t k = 0; k < segs; ++k) draw_box({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)});
+}
+
+/// One error box (a rotated rectangle: origin, axis, [u_min, u_max] × [n_min, n_max] in m) as a line loop,
+/// in the colour and width already set.
+void draw_box(const View& v, const ErrorBox& b) {
+  const Vec2 n = left_perp(b.axis);
+  glBegin(GL_LINE_LOOP);
+  for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
+    const Vec2 q = b.origin_m + u * b.axis + w * n;
+    glVertex2d(v.px(q.x), v.py(q.y));
+  }
+  glEnd();
+}
+
+/// Error boxes of the walls' segments at the level in use, or of a tolerance step's own segments when
+/// cut_step >= 0 (operator overlay): cyan.
+void draw_error_boxes(KioskRuntime& app, const View& v, const Shown& sh, int cut_step) {
+  const Scene& sc = *sh.scene;
+  glColor4f(0.2f, 0.9f, 1.0f, 0.5f);
+  glLineWidth(1.0f);
+  const auto segment_box = [&](SegmentRef ref) { draw_box(v, sc.box(sc.node_of(ref))); };
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    if (cut_step >= 0) {
+      for (const SegmentRef& ref : sh.cut_segments[c][static_cast<std::size_t>(cut_step)]) segment_box(ref);
+      continue;
+    }
+    const int l = sc.clamp_level(c, app.level());
+    const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
+    for (std::uint32_t k = 0; k < segs; ++k) segment_box({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)});
+  }
+}
+
+/// The boundary section the servo thread keeps (operator overlay): magenta, every entry as a box (a segment's
+/// rotated one; a chunk's, hierarchy node's or wide node's rectangle, rect_box).
+void draw_section(const View& v, const Scene& sc, const ServoDisplayState& d) {
+  glColor4f(1.0f, 0.3f, 1.0f, 0.8f);
+  glLineWidth(1.5f);
+  const int n = std::min(d.section_count, ServoDisplayState::kMaxSection);
+  for (int i = 0; i < n; ++i) {
+    const std::uint32_t node = d.section[i];
+    const std::size_t wide_node = node - sc.node_count();  // the wide frontier's entries (BoundarySection::section)
+    if (node >= sc.node_count() && wide_node >= sc.wide_index().nodes.size()) continue;
+    if (node >= sc.node_count()) {
+      Aabb r;
+      sc.wide_index().node_rect(static_cast<std::uint32_t>(wide_node), &r.lo, &r.hi);
+      draw_box(v, rect_box(r));
+    } else {
+      draw_box(v, sc.box(node));
     }
   }
-  const ServoDisplayState& d = app.core().display();
-  // The boundary section the servo thread keeps (operator overlay): magenta, segment boxes or node rectangles.
-  if (app.overlay() && sh.scene && d.scene_id == app.shown_id()) {
-    const Scene& sc = *sh.scene;
-    glColor4f(1.0f, 0.3f, 1.0f, 0.8f);
-    glLineWidth(1.5f);
-    const int n = std::min(d.section_count, ServoDisplayState::kMaxSection);
-    for (int i = 0; i < n; ++i) {
-      const std::uint32_t node = d.section[i];
-      const std::size_t wide_node = node - sc.node_count();  // the wide frontier's entries (BoundarySection::section)
-      if (node >= sc.node_count() && wide_node >= sc.wide_index().nodes.size()) continue;
-      // Every entry as a box: a segment's rotated one; a chunk's, hierarchy node's or wide node's rectangle (rect_box).
-      ErrorBox b;
-      if (node >= sc.node_count()) {
-        Aabb r;
-        sc.wide_index().node_rect(static_cast<std::uint32_t>(wide_node), &r.lo, &r.hi);
-        b = rect_box(r);
-      } else {
-        b = sc.box(node);
-      }
-      const Vec2 nrm = left_perp(b.axis);
-      glBegin(GL_LINE_LOOP);
-      for (const auto& [u, w] : {std::pair{b.u_min, b.n_min}, {b.u_max, b.n_min}, {b.u_max, b.n_max}, {b.u_min, b.n_max}}) {
-        const Vec2 q = b.origin_m + u * b.axis + w * nrm;
-        glVertex2d(v.px(q.x), v.py(q.y));
-      }
-      glEnd();
-    }
-  }
-  // Handle (red ring), proxy (white disc, on the curve in contact: seed §4), force arrow from the handle.
+}
+
+/// Handle (red ring), proxy (white disc, on the curve in contact: seed §4), force arrow from the handle
+/// (6 mm per newton, drawn above 0.05 N).
+void draw_handle(const View& v, const ServoDisplayState& d) {
   glLineWidth(2.0f);
   glColor4f(1.0f, 0.3f, 0.3f, 1.0f);
   disc(v, d.handle_m, 9, false);
@@ -220,5 +229,21 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
   }
 }
 
+}  // namespace
+
+void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
+  begin_frame(v);
+  const Shown& sh = app.shown();
+  const bool hc = app.high_contrast();
+  draw_picture(v, tex, sh, hc);
+  draw_workspace_frame(v, app.half());
+  draw_text_blocks(v, sh, hc);
+  const int cut_step = is_cut_level(app.level()) && !sh.cuts.empty() ? tolerance_step_of(app.level()) : -1;
+  draw_curves(app, v, sh, hc, cut_step);
+  if (app.overlay() && sh.scene) draw_error_boxes(app, v, sh, cut_step);
+  const ServoDisplayState& d = app.core().display();
+  if (app.overlay() && sh.scene && d.scene_id == app.shown_id()) draw_section(v, *sh.scene, d);
+  draw_handle(v, d);
+}
 
 }  // namespace hk::app

@@ -48,7 +48,7 @@ class PictureTexture {
   int w_ = 0, h_ = 0;
 };
 
-/// The camera's preview while a capture is under way (issue 16, for sighted companions): the latest frame
+/// The camera's preview while a capture is under way (for sighted companions): the latest frame
 /// fitted into the workspace rectangle, over the scene, with the page the guide found outlined in green.
 class CapturePreviewView {
  public:

@@ -1,6 +1,6 @@
 #pragma once
 /// @file window.hpp
-/// The kiosk's window and its input (issue 12, item 7: the window and input set-up apart from the core, as
+/// The kiosk's window and its input (the window and input set-up kept apart from the core, as
 /// Dear ImGui keeps its backends apart): GLFW (full screen on the primary monitor, or a 1280 x 720 window),
 /// an OpenGL 2 context, Dear ImGui with its GLFW and OpenGL 2 backends. GLFW's key, character and mouse
 /// button callbacks only queue events; the kiosk routes each one (to the visitor's flow, the operator's

@@ -13,6 +13,7 @@
 
 #include "config/load.hpp"
 #include "app_error.hpp"
+#include "hk/error.hpp"
 
 namespace hk::app {
 namespace {
@@ -85,7 +86,7 @@ audio::MessageId advice_message(vision::FramingAdvice a) {
 
 CaptureOutcome run_capture(vision::FrameSource& source, const CaptureParams& params, const CaptureHooks& hooks) {
   if (!(params.timeout_s > 0.0) || !(params.frame_wait_s > 0.0)) {
-    throw std::invalid_argument("capture: timeout_s and frame_wait_s must be > 0 s");
+    throw hk::ArgumentError("capture: timeout_s and frame_wait_s must be > 0 s");
   }
   vision::FramingGuide guide(params.framing);
   CaptureOutcome o;

@@ -1,6 +1,6 @@
 #pragma once
 /// @file capture.hpp
-/// One camera capture (issue 16): frames from a vision::FrameSource are looked at (vision::look_at_frame), the
+/// One camera capture: frames from a vision::FrameSource are looked at (vision::look_at_frame), the
 /// framing guide (vision::FramingGuide) says what to do and decides when to take the picture, and the page is
 /// rectified (vision::rectify_page) or, when none was found, the whole frame kept. The same loop serves the
 /// headless `capture` command, `explore --source` and the kiosk's Capture key (on a worker thread, with a
@@ -77,7 +77,7 @@ struct CaptureHooks {
 
 /// Runs one capture on `source` until the guide captures, the time-out or the cancel flag.
 /// @throws vision::CameraError when the source fails or sends no frame for frame_wait_s;
-///         std::invalid_argument for bad params.
+///         hk::ArgumentError for bad params.
 CaptureOutcome run_capture(vision::FrameSource& source, const CaptureParams& params, const CaptureHooks& hooks = {});
 
 /// The message that speaks an advice (capture_place, capture_move_left, ...).

@@ -1,6 +1,6 @@
 #pragma once
 /// @file capture_service.hpp
-/// The kiosk's camera (issue 16): which camera it has ([camera] source), and captures run off the window
+/// The kiosk's camera: which camera it has ([camera] source), and captures run off the window
 /// thread. A capture opens the source, runs run_capture (capture.hpp) on a worker thread, and builds the scene
 /// of what it took (build_image_scene_from_picture, its text left for the kiosk's TextReader); the window thread polls the news (advice to speak, the
 /// scene, a failure) and the latest preview frame for sighted companions.

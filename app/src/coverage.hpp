@@ -1,6 +1,6 @@
 #pragma once
 /// @file coverage.hpp
-/// How much of a scene a run reached (issue 14, item 5; DESIGN.md "Headless runs": summary.json
+/// How much of a scene a run reached (DESIGN.md "Headless runs": summary.json
 /// `coverage {length_fraction, curves_touched, curves}`): the fraction of the level-0 curves' length that
 /// the proxy came within a radius of (1 mm), and the curves the proxy touched (was in contact with) at all.
 

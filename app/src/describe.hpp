@@ -62,7 +62,7 @@ std::string first_words(const std::string& text, int n);
 /// How many shapes a picture has, for speech: "It has 4 shapes.", "It has one shape.", "I found no shapes in it."
 std::string describe_shapes(int shapes);
 
-/// What a document page holds, for speech (issue 11, item 4): "It has 2 blocks of text and one figure.",
+/// What a document page holds, for speech: "It has 2 blocks of text and one figure.",
 /// "It has one block of text and no figures.", "It has no text and no figures."
 std::string describe_page(int text_blocks, int figures);
 

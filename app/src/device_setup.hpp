@@ -1,6 +1,6 @@
 #pragma once
 /// @file device_setup.hpp
-/// Which device a run or the kiosk uses, built from the settings (issue 13, items 3, 4 and 6): the
+/// Which device a run or the kiosk uses, built from the settings: the
 /// `--device` choice of headless runs (`sim`, or `haply-emulator[:FAULT=VALUE,...]`: the firmware emulator
 /// behind a pty, reached through the same tty transport and driver as a real board), the USB pantograph's
 /// driver parameters from [device] and [workspace], and the transport to a real board ([device] transport:

@@ -1,6 +1,6 @@
 #pragma once
 /// @file documents.hpp
-/// Documents (pictures and PDF pages) as the app sees them (issue 11): the settings turned into the vision
+/// Documents (pictures and PDF pages) as the app sees them: the settings turned into the vision
 /// module's limits, a document's bytes read with a size limit, one page of it built into a scene, and the
 /// listing of a stick that the `stick` command prints and the kiosk speaks.
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <utility>
 
 namespace hk::app {
 
@@ -65,6 +67,7 @@ std::vector<Vec2> curve_points(const Scene& scene, std::size_t c, int level) {
   return {p, p + scene.curve(c).point_count[l]};
 }
 
+/// The point of a polyline nearest a given point: its distance [m], the segment, the parameter along it.
 struct Closest {
   double dist_m = std::numeric_limits<double>::infinity();
   std::size_t segment = 0;  // segment i: points i → i+1 (mod n when closed)
@@ -121,92 +124,91 @@ void append_polyline(std::vector<TourPoint>& out, const std::vector<Vec2>& pts, 
   }
 }
 
-}  // namespace
+/// The shape a tour goes round: its curve index and the level its outline is planned at (tour_plan_level).
+struct ChosenShape {
+  std::size_t curve = 0;
+  int level = 0;
+};
 
-double distance_to_curve_m(const Scene& scene, std::size_t c, int level, Vec2 p) {
-  return closest_on(curve_points(scene, c, level), scene.curve(c).closed, p).dist_m;
+/// The outline a tour follows: its points on the curve from start to end, the unit (vertex: miter-scaled)
+/// normal at each, and the direction along the curve's own points (+1 increasing, -1 reversed).
+struct Outline {
+  std::vector<Vec2> base, normal;
+  int direction = 1;
+};
+
+/// A closed curve's outline from its point nearest the handle, once round and back to that point.
+Outline closed_outline(const std::vector<Vec2>& pts, Vec2 handle_m) {
+  Outline o;
+  const std::size_t n = pts.size();
+  const Closest cl = closest_on(pts, true, handle_m);
+  const std::size_t k = cl.segment;
+  std::vector<Vec2> seg_n(n);
+  for (std::size_t i = 0; i < n; ++i) seg_n[i] = seg_normal(pts[i], pts[(i + 1) % n], {1.0, 0.0});
+  const auto vn = [&](std::size_t v) { return vertex_normal(seg_n[(v + n - 1) % n], seg_n[v % n]); };
+  Vec2 nq = seg_n[k];
+  if (cl.t <= 1e-9) nq = vn(k);
+  if (cl.t >= 1.0 - 1e-9) nq = vn(k + 1);
+  o.base.push_back(cl.q);
+  o.normal.push_back(nq);
+  for (std::size_t i = 1; i <= n; ++i) {  // vertices k+1 … k+n (= k), then back to q
+    o.base.push_back(pts[(k + i) % n]);
+    o.normal.push_back(vn((k + i) % n));
+  }
+  o.base.push_back(cl.q);
+  o.normal.push_back(nq);
+  return o;
 }
 
-std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_m, const VisitTouches& touched, const TourParams& p) {
-  // The nearest shape not yet touched.
-  int chosen = -1;
-  int chosen_level = 0;
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t c = 0; c < scene.curve_count(); ++c) {
-    if (touched.touched(static_cast<int>(c)) || !is_tour_shape(scene, c, p)) continue;
-    const int l = tour_plan_level(scene, c, p);
-    const double d = distance_to_curve_m(scene, c, l, handle_m);
-    if (d < best) {
-      best = d;
-      chosen = static_cast<int>(c);
-      chosen_level = l;
-    }
-  }
-  if (chosen < 0) return std::nullopt;
-  const std::size_t c = static_cast<std::size_t>(chosen);
-  const bool closed = scene.curve(c).closed;
-  std::vector<Vec2> pts = curve_points(scene, c, chosen_level);
-  int direction = 1;  // along increasing segment indices (a closed curve's outline, an open one from its first point)
-
-  // The base sequence (on the curve) and its unit normals, from the start of the outline to its end.
-  std::vector<Vec2> base, normal;
+/// An open curve's outline from its end nearer the handle to the other end.
+Outline open_outline(std::vector<Vec2> pts, Vec2 handle_m) {
+  Outline o;
   const std::size_t n = pts.size();
-  if (closed) {
-    const Closest cl = closest_on(pts, true, handle_m);
-    const std::size_t k = cl.segment;
-    std::vector<Vec2> seg_n(n);
-    for (std::size_t i = 0; i < n; ++i) seg_n[i] = seg_normal(pts[i], pts[(i + 1) % n], {1.0, 0.0});
-    const auto vn = [&](std::size_t v) { return vertex_normal(seg_n[(v + n - 1) % n], seg_n[v % n]); };
-    Vec2 nq = seg_n[k];
-    if (cl.t <= 1e-9) nq = vn(k);
-    if (cl.t >= 1.0 - 1e-9) nq = vn(k + 1);
-    base.push_back(cl.q);
-    normal.push_back(nq);
-    for (std::size_t i = 1; i <= n; ++i) {  // vertices k+1 … k+n (= k), then back to q
-      base.push_back(pts[(k + i) % n]);
-      normal.push_back(vn((k + i) % n));
-    }
-    base.push_back(cl.q);
-    normal.push_back(nq);
-  } else {
-    if (distance(handle_m, pts.back()) < distance(handle_m, pts.front())) {
-      std::reverse(pts.begin(), pts.end());
-      direction = -1;
-    }
-    std::vector<Vec2> seg_n(n - 1);
-    for (std::size_t i = 0; i + 1 < n; ++i) seg_n[i] = seg_normal(pts[i], pts[i + 1], {1.0, 0.0});
-    for (std::size_t i = 0; i < n; ++i) {
-      base.push_back(pts[i]);
-      normal.push_back(i == 0 ? seg_n[0] : (i == n - 1 ? seg_n[n - 2] : vertex_normal(seg_n[i - 1], seg_n[i])));
-    }
+  if (distance(handle_m, pts.back()) < distance(handle_m, pts.front())) {
+    std::reverse(pts.begin(), pts.end());
+    o.direction = -1;
   }
-  // The handle's side of the curve at the start (+1: along the normal); on the curve, +1.
-  const double along = dot(handle_m - base.front(), normal.front());
-  const double side = along < 0.0 ? -1.0 : 1.0;
+  std::vector<Vec2> seg_n(n - 1);
+  for (std::size_t i = 0; i + 1 < n; ++i) seg_n[i] = seg_normal(pts[i], pts[i + 1], {1.0, 0.0});
+  for (std::size_t i = 0; i < n; ++i) {
+    o.base.push_back(pts[i]);
+    o.normal.push_back(i == 0 ? seg_n[0] : (i == n - 1 ? seg_n[n - 2] : vertex_normal(seg_n[i - 1], seg_n[i])));
+  }
+  return o;
+}
 
-  TourPath path;
-  path.scene_id = scene_id;
-  path.curve = chosen;
-  path.direction = direction;
-  path.params = p;
-  const double v = p.speed_m_per_s;
-  // 1. Transit: minimum-jerk from the handle to the start point off the curve, mean speed v.
-  const Vec2 start = base.front() + (side * p.offset_m) * normalized_or(normal.front(), {0.0, 1.0});
+/// Appends the transit to `path`: minimum-jerk from the handle to `start` (m), at mean speed
+/// p.speed_m_per_s but taking at least p.min_transit_s, sampled every p.transit_sample_s. Returns its
+/// duration [s]. `base_points` sizes the reservation for the rest of the path.
+double append_transit(TourPath& path, Vec2 handle_m, Vec2 start, std::size_t base_points, const TourParams& p) {
   const double transit_len = distance(handle_m, start);
-  const double T = std::max(transit_len / v, p.min_transit_s);
+  const double T = std::max(transit_len / p.speed_m_per_s, p.min_transit_s);
   const int steps = std::max(1, static_cast<int>(std::ceil(T / p.transit_sample_s)));
-  path.points.reserve(static_cast<std::size_t>(steps) + 4 * base.size() + 64);
+  path.points.reserve(static_cast<std::size_t>(steps) + 4 * base_points + 64);
   for (int i = 0; i <= steps; ++i) {
     const double tau = static_cast<double>(i) / steps;
     const double s = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
     path.points.push_back({tau * T, lerp(handle_m, start, s), {}});
   }
-  path.outline_start_s = T;
-  // 2.–4. Onto the outline's track, round it with the press towards the wall (ramped in and out), the
-  // release to the start's offset.
-  // The track: the offset outline, densified to sample_m so the press ramps over press_ramp_m; inside a
-  // segment the press is along its normal, at a vertex along the bisector.
-  std::vector<Vec2> rest, press, press_dir;
+  return T;
+}
+
+/// The track round the outline: points and the press force [N] at each.
+struct Track {
+  std::vector<Vec2> rest, press;
+};
+
+/// The track on the handle's `side` (±1 along the normals): the outline offset by p.track_offset_m and
+/// densified to p.sample_m, the press towards the wall (inside a segment along its normal, at a vertex
+/// along the bisector) ramped in and out over p.press_ramp_m, then the release to the start's offset
+/// p.offset_m with no press.
+Track outline_track(const Outline& o, double side, const TourParams& p) {
+  const std::vector<Vec2>& base = o.base;
+  const std::vector<Vec2>& normal = o.normal;
+  Track t;
+  std::vector<Vec2>& rest = t.rest;
+  std::vector<Vec2>& press = t.press;
+  std::vector<Vec2> press_dir;
   std::vector<double> arc;
   const double k_off = side * p.track_offset_m;
   for (std::size_t i = 0; i < base.size(); ++i) {
@@ -236,7 +238,59 @@ std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_
   }
   rest.push_back(base.back() + (side * p.offset_m) * normalized_or(normal.back(), {0.0, 1.0}));
   press.push_back({});
-  append_polyline(path.points, rest, press, v, p.sample_m);
+  return t;
+}
+
+}  // namespace
+
+double distance_to_curve_m(const Scene& scene, std::size_t c, int level, Vec2 p) {
+  return closest_on(curve_points(scene, c, level), scene.curve(c).closed, p).dist_m;
+}
+
+namespace {
+
+/// The tour shape (is_tour_shape) not yet touched that is nearest the handle (m), if any is left.
+std::optional<ChosenShape> nearest_untouched_shape(const Scene& scene, Vec2 handle_m, const VisitTouches& touched, const TourParams& p) {
+  std::optional<ChosenShape> chosen;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t c = 0; c < scene.curve_count(); ++c) {
+    if (touched.touched(static_cast<int>(c)) || !is_tour_shape(scene, c, p)) continue;
+    const int l = tour_plan_level(scene, c, p);
+    const double d = distance_to_curve_m(scene, c, l, handle_m);
+    if (d < best) {
+      best = d;
+      chosen = ChosenShape{c, l};
+    }
+  }
+  return chosen;
+}
+
+}  // namespace
+
+std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_m, const VisitTouches& touched, const TourParams& p) {
+  const std::optional<ChosenShape> chosen = nearest_untouched_shape(scene, handle_m, touched, p);
+  if (!chosen) return std::nullopt;
+  const std::size_t c = chosen->curve;
+  std::vector<Vec2> pts = curve_points(scene, c, chosen->level);
+  // The base sequence (on the curve) and its unit normals, from the start of the outline to its end; the
+  // direction is along increasing segment indices (a closed curve's outline, an open one from its first point)
+  // unless an open curve is taken from its last point.
+  const Outline outline = scene.curve(c).closed ? closed_outline(pts, handle_m) : open_outline(std::move(pts), handle_m);
+  // The handle's side of the curve at the start (+1: along the normal); on the curve, +1.
+  const double along = dot(handle_m - outline.base.front(), outline.normal.front());
+  const double side = along < 0.0 ? -1.0 : 1.0;
+
+  TourPath path;
+  path.scene_id = scene_id;
+  path.curve = static_cast<int>(c);
+  path.direction = outline.direction;
+  path.params = p;
+  // Transit to the start point off the curve, then onto the outline's track, round it with the press
+  // towards the wall, and the release to the start's offset.
+  const Vec2 start = outline.base.front() + (side * p.offset_m) * normalized_or(outline.normal.front(), {0.0, 1.0});
+  path.outline_start_s = append_transit(path, handle_m, start, outline.base.size(), p);
+  const Track track = outline_track(outline, side, p);
+  append_polyline(path.points, track.rest, track.press, p.speed_m_per_s, p.sample_m);
   return path;
 }
 

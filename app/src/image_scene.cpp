@@ -9,6 +9,7 @@
 
 #include "haptics/multires.hpp"
 #include "vision/intake.hpp"
+#include "hk/error.hpp"
 
 namespace hk::app {
 
@@ -323,7 +324,7 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
 }
 
 ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& s, TextTiming timing) {
-  if (bgr.empty() || bgr.type() != CV_8UC3) throw std::invalid_argument("picture '" + name + "': must be a non-empty 8-bit BGR image");
+  if (bgr.empty() || bgr.type() != CV_8UC3) throw hk::ArgumentError("picture '" + name + "': must be a non-empty 8-bit BGR image");
   ImageScene out;
   out.image_path = name;
   out.picture = bgr.clone();

@@ -159,9 +159,9 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& se
 ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& settings,
                                         TextTiming timing = TextTiming::now);
 
-/// build_image_scene on pixels already in memory (a camera capture, issue 16): the same steps from
+/// build_image_scene on pixels already in memory (a camera capture): the same steps from
 /// vision::scene_chains_from_image. `name` names it in errors and scene.json; ImageScene::picture holds a copy.
-/// @throws std::invalid_argument for an empty or non-CV_8UC3 image (and as scene_chains_from_image).
+/// @throws hk::ArgumentError for an empty or non-CV_8UC3 image (and as scene_chains_from_image).
 ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& settings,
                                           TextTiming timing = TextTiming::now);
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file operator_session.hpp
-/// The operator's panel without its drawing (issue 12, items 1-5): the key chord asks for the PIN, the PIN
+/// The operator's panel without its drawing: the key chord asks for the PIN, the PIN
 /// is checked on a worker thread (PinVerifier) under the persisted lockout, and the panel then edits a
 /// working copy of the settings, field by field, each checked exactly as the TOML loader checks it. Apply
 /// hands the copy to the running kiosk (KioskRuntime::apply_settings); Save writes the settings file

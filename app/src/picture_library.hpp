@@ -1,6 +1,6 @@
 #pragma once
 /// @file picture_library.hpp
-/// The pictures a visitor can feel (issue 5, item 5): the tutorial shapes, made here, and the image files
+/// The pictures a visitor can feel: the tutorial shapes, made here, and the image files
 /// of a library folder (PNG, JPEG, BMP, TIFF, WebP; sorted by name; shipped: data/pictures).
 
 #include <string>

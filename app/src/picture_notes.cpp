@@ -1,4 +1,4 @@
-// A picture's title and description from its sidecar file (issue 15, item 4): read_picture_notes.
+// A picture's title and description from its sidecar file: read_picture_notes.
 #include "picture_notes.hpp"
 
 #include <filesystem>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file picture_notes.hpp
-/// What a person wrote about a picture (issue 15, item 4): a title and a description in a sidecar file
+/// What a person wrote about a picture: a title and a description in a sidecar file
 /// beside it, `horse.toml` for `horse.png`:
 ///
 ///     title = "a horse, seen from the side"

@@ -1,6 +1,6 @@
 #pragma once
 /// @file pin_command.hpp
-/// `haptic-kiosk pin set|check --config FILE` (issue 12): sets or checks the operator's PIN, read from
+/// `haptic-kiosk pin set|check --config FILE`: sets or checks the operator's PIN, read from
 /// standard input, with the lockout of config/operator_pin.hpp (shared with the kiosk's panel).
 
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file png_text.hpp
-/// A PNG's own words about itself (issue 15, item 4): the `Title` and `Description` of its text chunks
+/// A PNG's own words about itself: the `Title` and `Description` of its text chunks
 /// (tEXt, zTXt, iTXt; W3C PNG 2nd ed. §11.3.4), read with libpng. exiv2, which reads the pictures' other
 /// metadata (picture_notes.cpp), ignores a PNG's Title.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file stick_command.hpp
-/// `haptic-kiosk stick DIR|--device DEV [--json FILE]` (issue 11, item 6; DESIGN.md "Headless runs"): what
+/// `haptic-kiosk stick DIR|--device DEV [--json FILE]` (DESIGN.md "Headless runs"): what
 /// a USB stick offers, exactly as the kiosk scans it, and what was refused and why.
 
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file stick_service.hpp
-/// The kiosk's USB-stick work off the window and servo threads (issue 11, items 1 and 5).
+/// The kiosk's USB-stick work off the window and servo threads.
 ///
 /// Two worker threads:
 /// - the watcher takes block events (vision::BlockEventSource), mounts an inserted stick read-only

@@ -6,6 +6,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "hk/error.hpp"
+
 namespace hk::app {
 
 TextReader::TextReader() : worker_([this] { run(); }) {}
@@ -22,7 +24,7 @@ TextReader::~TextReader() {
 }
 
 void TextReader::start(int id, TextBuild build) {
-  if (!build) throw std::invalid_argument("TextReader::start: no text build given");
+  if (!build) throw hk::ArgumentError("TextReader::start: no text build given");
   {
     std::lock_guard<std::mutex> lock(m_);
     if (running_) running_->store(true);

@@ -1,6 +1,6 @@
 #pragma once
 /// @file stick_helper.hpp
-/// hk-stick-mount, the narrow mount helper of the installed kiosk (issue 17, item 5).
+/// hk-stick-mount, the narrow mount helper of the installed kiosk.
 ///
 /// The kiosk runs as the unprivileged user haptic-kiosk; mounting a USB stick needs CAP_SYS_ADMIN (and
 /// opening the stick's block device, owned root:disk, needs CAP_DAC_READ_SEARCH). Instead of giving the

@@ -113,6 +113,29 @@ double EarconSynth::transient_delay_s(bool claim) noexcept {
 }
 
 void EarconSynth::trigger(const CueEvent& e) noexcept {
+  switch (e.kind) {
+    case CueKind::ContactBegin:
+    case CueKind::ContactEnd:
+    case CueKind::Slide:
+      contact_cue(e);
+      break;
+    case CueKind::ConvexCorner:
+    case CueKind::VertexContact:
+    case CueKind::WorkspaceEdge:
+    case CueKind::PopThrough:
+      knock_cue(e.kind);
+      break;
+    case CueKind::LevelFiner:
+    case CueKind::LevelCoarser:
+    case CueKind::TextBlock:
+    case CueKind::TourStart:
+    case CueKind::Shutter:
+      signal_cue(e.kind);
+      break;
+  }
+}
+
+void EarconSynth::contact_cue(const CueEvent& e) noexcept {
   const double g = params_.gain;
   const double f = curve_pitch_hz(e.curve);
   switch (e.kind) {
@@ -138,45 +161,58 @@ void EarconSynth::trigger(const CueEvent& e) noexcept {
       slide_since_update_ = 0;
       slide_active_ = true;
       break;
+    default:
+      break;
+  }
+}
+
+void EarconSynth::knock_cue(CueKind kind) noexcept {
+  const double g = params_.gain;
+  switch (kind) {
     case CueKind::ConvexCorner:
       start({2500, 2500, 0.008, 0.0001, 0.001, 0.002, g * 0.45, 0.5, 5000, 2.0, transient_delay_s(true)});
       break;
-    case CueKind::VertexContact:
-    {
+    case CueKind::VertexContact: {
       const double d = transient_delay_s(true);
       start({2000, 2000, 0.012, 0.0001, 0.0015, 0.003, g * 0.6, 0.5, 4000, 2.0, d});
       start({2000, 2000, 0.012, 0.0001, 0.0015, 0.003, g * 0.6, 0.5, 4000, 2.0, d + 0.030});
+      break;
     }
-      break;
-    case CueKind::LevelFiner:
-      start({500, 1000, 0.16, 0.005, 0.0, 0.03, g * 0.35, 0.0, 0, 1, 0});
-      break;
-    case CueKind::LevelCoarser:
-      start({1000, 500, 0.16, 0.005, 0.0, 0.03, g * 0.35, 0.0, 0, 1, 0});
-      break;
-    case CueKind::WorkspaceEdge:
-    {
+    case CueKind::WorkspaceEdge: {
       // A knock on a wooden frame: a low thud with a short woody strike on top.
       const double d = transient_delay_s(true);
       start({180, 150, 0.15, 0.002, 0.06, 0.02, g * 0.6, 0.3, 400, 1.0, d});
       start({180, 180, 0.003, 0.00005, 0.0007, 0.0005, g * 0.5, 1.0, 1500, 0.8, d});
+      break;
     }
-      break;
-    case CueKind::TextBlock:
-      // Text here (press Describe to hear it): two soft rising sine notes, a fifth apart (G5 then D6),
-      // unlike every contact sound (no strike, no noise) and unlike the level chirps (two steps, not a glide).
-      start({784, 784, 0.09, 0.004, 0.0, 0.04, g * 0.3, 0.0, 0, 1, 0});
-      start({1175, 1175, 0.12, 0.004, 0.0, 0.05, g * 0.3, 0.0, 0, 1, 0.08});
-      break;
-    case CueKind::PopThrough:
-    {
+    case CueKind::PopThrough: {
       // A membrane giving way: a noisy burst sweeping down two octaves over a low plop. Nothing else
       // glides down this fast (the coarser chirp falls one octave in 160 ms, as a pure tone).
       const double d = transient_delay_s(true);
       start({1600, 400, 0.05, 0.0005, 0.0, 0.015, g * 0.7, 0.8, 1000, 1.5, d});
       start({220, 110, 0.09, 0.001, 0.04, 0.02, g * 0.6, 0.0, 0, 1, d});
       slide_active_ = false;
+      break;
     }
+    default:
+      break;
+  }
+}
+
+void EarconSynth::signal_cue(CueKind kind) noexcept {
+  const double g = params_.gain;
+  switch (kind) {
+    case CueKind::LevelFiner:
+      start({500, 1000, 0.16, 0.005, 0.0, 0.03, g * 0.35, 0.0, 0, 1, 0});
+      break;
+    case CueKind::LevelCoarser:
+      start({1000, 500, 0.16, 0.005, 0.0, 0.03, g * 0.35, 0.0, 0, 1, 0});
+      break;
+    case CueKind::TextBlock:
+      // Text here (press Describe to hear it): two soft rising sine notes, a fifth apart (G5 then D6),
+      // unlike every contact sound (no strike, no noise) and unlike the level chirps (two steps, not a glide).
+      start({784, 784, 0.09, 0.004, 0.0, 0.04, g * 0.3, 0.0, 0, 1, 0});
+      start({1175, 1175, 0.12, 0.004, 0.0, 0.05, g * 0.3, 0.0, 0, 1, 0.08});
       break;
     case CueKind::TourStart:
       // "Follow me": a rising C-major arpeggio, soft sine notes with no strike.
@@ -191,6 +227,8 @@ void EarconSynth::trigger(const CueEvent& e) noexcept {
       start({2500, 2500, 0.012, 0.0003, 0.003, 0.004, g * 0.55, 1.0, 3000, 1.2, 0.060});
       start({150, 150, 0.02, 0.001, 0.006, 0.008, g * 0.3, 0.0, 0, 1, 0.0});
       slide_active_ = false;
+      break;
+    default:
       break;
   }
 }

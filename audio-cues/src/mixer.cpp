@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "hk/error.hpp"
+
 namespace hk::audio {
 namespace {
 
@@ -64,10 +66,10 @@ void Mixer::render(float* out, std::size_t frames) noexcept {
 std::vector<float> render_cue_timeline(std::span<const CueEvent> cues, double period_s, double duration_s,
                                        const MixerParams& params) {
   if (!(period_s > 0) || !std::isfinite(period_s)) {
-    throw std::invalid_argument("servo period " + std::to_string(period_s) + " s must be > 0");
+    throw hk::ArgumentError("servo period " + std::to_string(period_s) + " s must be > 0");
   }
   if (!(duration_s >= 0 && duration_s <= 3600)) {
-    throw std::invalid_argument("audio duration " + std::to_string(duration_s) + " s is outside [0, 3600] s");
+    throw hk::ArgumentError("audio duration " + std::to_string(duration_s) + " s is outside [0, 3600] s");
   }
   std::vector<CueEvent> sorted(cues.begin(), cues.end());
   std::stable_sort(sorted.begin(), sorted.end(), [](const CueEvent& a, const CueEvent& b) { return a.tick < b.tick; });

@@ -1,6 +1,6 @@
 #pragma once
 /// @file embree_peer.hpp
-/// Embree 3 as a peer of our collision tree (issue 18): the same segments in an Embree BVH, queried
+/// Embree 3 as a peer of our collision tree: the same segments in an Embree BVH, queried
 /// with the same first-hit and closest-point questions, so its answers can be checked equal and its
 /// speed measured on the same streams (bench/first_hit.cpp, tests/haptics/test_peers.cpp).
 ///

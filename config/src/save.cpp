@@ -25,7 +25,7 @@ using detail::fail;
 using detail::one_line;
 using detail::Source;
 
-
+/// Throws ConfigError for `src`: "not saved: <what>: <strerror(err)> (nothing was changed)".
 [[noreturn]] void io_fail(const Source& src, const std::string& what, int err) {
   fail(src, "", "not saved: " + what + ": " + one_line(std::strerror(err)) + " (nothing was changed)");
 }
@@ -93,6 +93,71 @@ int read_whole(const std::string& path, std::string& text, mode_t& mode) {
   return 0;
 }
 
+/// The mode a saved file gets: an existing regular file's own (`replaces_a_file`), else 0644; 0600 whenever
+/// it holds the PIN's hash.
+struct TargetMode {
+  mode_t mode = 0644;
+  bool replaces_a_file = false;
+};
+
+/// TargetMode of the file at `path` for `settings`.
+TargetMode target_mode(const std::string& path, const Settings& settings) {
+  TargetMode t;
+  struct stat st{};
+  t.replaces_a_file = ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+  if (t.replaces_a_file) t.mode = st.st_mode & 07777;
+  if (!settings.operator_.pin_hash.empty()) t.mode = 0600;
+  return t;
+}
+
+/// Keeps the file at `path` as `path`.bak before it is replaced: a second name for the old file (a copy
+/// where hard links are not possible), renamed over .bak, so .bak is always a complete file. On failure
+/// removes `tmp` (the new file not yet renamed) and throws ConfigError ("not saved: ...").
+void keep_backup(const Source& src, const std::string& path, const std::string& tmp, const std::string& temp_prefix) {
+  const std::string bak = path + ".bak";
+  const std::string what = "cannot keep the old file as '" + one_line(bak) + "'";
+  std::string bak_tmp = tmp + ".bak";
+  if (::linkat(AT_FDCWD, path.c_str(), AT_FDCWD, bak_tmp.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+    const int err = errno;
+    bak_tmp.clear();
+    // No hard links here (vfat: EPERM), or the target is a symbolic link to another file system:
+    // a copy does the same job.
+    if (err == EPERM || err == EOPNOTSUPP || err == EXDEV || err == EMLINK) {
+      std::string old_text;
+      mode_t old_mode = 0600;
+      if (int rerr = read_whole(path, old_text, old_mode)) {
+        ::unlink(tmp.c_str());
+        io_fail(src, what + " (copying it)", rerr);
+      }
+      try {
+        bak_tmp = write_temp(src, temp_prefix, old_text, old_mode);
+      } catch (...) {
+        ::unlink(tmp.c_str());
+        throw;
+      }
+    } else {
+      ::unlink(tmp.c_str());
+      io_fail(src, what, err);
+    }
+  }
+  if (::rename(bak_tmp.c_str(), bak.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(bak_tmp.c_str());
+    ::unlink(tmp.c_str());
+    io_fail(src, what, err);
+  }
+}
+
+/// Makes a rename in `dir` durable. Best effort: some file systems refuse fsync on a directory, and the
+/// rename before it is already the commit point, so a failure is never reported.
+void flush_directory(const std::filesystem::path& dir) {
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    (void)::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
 }  // namespace
 
 std::string to_toml(const Settings& settings) {
@@ -144,17 +209,11 @@ void save_settings_atomic(const Settings& settings, const std::string& path, con
   if (target.filename().empty()) fail(src, "", "not saved: the path names no file");
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
-
-  // Keep the mode of an existing file; a new file gets 0644. A file holding the PIN's hash is 0600.
-  mode_t mode = 0644;
-  struct stat st{};
-  const bool replaces_a_file = ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-  if (replaces_a_file) mode = st.st_mode & 07777;
-  if (!settings.operator_.pin_hash.empty()) mode = 0600;
+  const TargetMode mode = target_mode(path, settings);
 
   // Every temporary name is ".<name>.tmp.*" beside the target, so one pattern finds what a crash left.
   const std::string temp_prefix = detail::temp_prefix(dir.string(), target.filename().string());
-  const std::string tmp = write_temp(src, temp_prefix, text, mode);
+  const std::string tmp = write_temp(src, temp_prefix, text, mode.mode);
   bool tmp_renamed = false;  // after the commit point `tmp` no longer names our file
   const auto reached = [&](SaveStage stage) {
     if (!options.hook) return;
@@ -166,42 +225,7 @@ void save_settings_atomic(const Settings& settings, const std::string& path, con
     }
   };
   reached(SaveStage::temp_written);
-
-  if (replaces_a_file && options.keep_backup) {
-    const std::string bak = path + ".bak";
-    const std::string what = "cannot keep the old file as '" + one_line(bak) + "'";
-    // A second name for the old file, then renamed over .bak: .bak is always a complete file.
-    std::string bak_tmp = tmp + ".bak";
-    if (::linkat(AT_FDCWD, path.c_str(), AT_FDCWD, bak_tmp.c_str(), AT_SYMLINK_FOLLOW) != 0) {
-      const int err = errno;
-      bak_tmp.clear();
-      // No hard links here (vfat: EPERM), or the target is a symbolic link to another file system:
-      // a copy does the same job.
-      if (err == EPERM || err == EOPNOTSUPP || err == EXDEV || err == EMLINK) {
-        std::string old_text;
-        mode_t old_mode = 0600;
-        if (int rerr = read_whole(path, old_text, old_mode)) {
-          ::unlink(tmp.c_str());
-          io_fail(src, what + " (copying it)", rerr);
-        }
-        try {
-          bak_tmp = write_temp(src, temp_prefix, old_text, old_mode);
-        } catch (...) {
-          ::unlink(tmp.c_str());
-          throw;
-        }
-      } else {
-        ::unlink(tmp.c_str());
-        io_fail(src, what, err);
-      }
-    }
-    if (::rename(bak_tmp.c_str(), bak.c_str()) != 0) {
-      const int err = errno;
-      ::unlink(bak_tmp.c_str());
-      ::unlink(tmp.c_str());
-      io_fail(src, what, err);
-    }
-  }
+  if (mode.replaces_a_file && options.keep_backup) keep_backup(src, path, tmp, temp_prefix);
   reached(SaveStage::backup_kept);
 
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
@@ -211,14 +235,7 @@ void save_settings_atomic(const Settings& settings, const std::string& path, con
   }
   tmp_renamed = true;
   reached(SaveStage::renamed);
-
-  // The rename is the commit point. Flushing the directory makes it durable; some file systems
-  // refuse fsync on a directory, so this is best effort and never reported as a failure.
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    (void)::fsync(dfd);
-    ::close(dfd);
-  }
+  flush_directory(dir);  // the rename is the commit point; this makes it durable
 }
 
 }  // namespace hk::config

@@ -1,4 +1,4 @@
-// Settings changed by the operator while the kiosk runs (issue 12, item 4), on the kiosk's runtime without
+// Settings changed by the operator while the kiosk runs, on the kiosk's runtime without
 // its window: servo gains reach the servo thread's core, keys and the session's timing change in the flow,
 // level settings rebuild the scene shown, and what needs a restart is listed and kept as it runs.
 #include <gtest/gtest.h>
@@ -84,7 +84,7 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   fs::remove_all(lib);
 }
 
-// level_mode = "tolerance" (issue 18): the servo renders at a tolerance step, and the visitor's Finer /
+// level_mode = "tolerance": the servo renders at a tolerance step, and the visitor's Finer /
 // Coarser keys move along the steps (a step is never compared with a level), stopping at the ends.
 TEST(ApplySettings, ToleranceModeRendersAtAStepAndTheKeysMoveAlongTheSteps) {
   RuntimeOptions ro;

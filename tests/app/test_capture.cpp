@@ -1,4 +1,4 @@
-// Camera capture end to end (issue 16): frame sequences written to a folder and served by the file source
+// Camera capture end to end: frame sequences written to a folder and served by the file source
 // (`--source file:DIR`, 10 frames a second), through `haptic-kiosk capture` and `explore --source`: what the
 // guide says, in order, when it captures, and what it writes; then the kiosk's runtime capturing from the same
 // kind of source on its worker thread.

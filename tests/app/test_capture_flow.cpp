@@ -1,4 +1,4 @@
-// The Capture key in the visitor's flow (issue 16, item 3): started, guided aloud, cancelled by any key,
+// The Capture key in the visitor's flow: started, guided aloud, cancelled by any key,
 // captured or failed, and said so; without a camera the key says there is none and the help does not name it.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Coverage of a run (issue 14, item 5): the fraction of the level-0 curves' length the proxy came within
+// Coverage of a run: the fraction of the level-0 curves' length the proxy came within
 // 1 mm of, and the curves it touched. Golden values from the geometry of hand-made scenes and paths.
 #include <gtest/gtest.h>
 

@@ -128,7 +128,7 @@ TEST(CueTracker, WorkspaceEdgeOnceUntilTheHandComesBack) {
   EXPECT_EQ(r.count(CueKind::WorkspaceEdge), 2) << "still latched";
 }
 
-// Issue 11, item 4: a chime when the proxy enters a block of text, once per entry, not on its border.
+// A chime when the proxy enters a block of text, once per entry, not on its border.
 TEST(CueTracker, TextBlockOnEnteringEachBlockOnce) {
   CueRun r;
   const Aabb blocks[2] = {{{0.0, 0.0}, {0.02, 0.01}}, {{0.03, 0.0}, {0.05, 0.01}}};

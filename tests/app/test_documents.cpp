@@ -1,4 +1,4 @@
-// Documents from USB sticks, end to end (issue 11, "Tests it must have"): PDF pages whose pictures give the
+// Documents from USB sticks, end to end: PDF pages whose pictures give the
 // PNG's own curves, text spoken not felt, explore on a PDF page, the `stick` command on a folder and on a
 // real read-only mount of a loop device, the kiosk's stick service (insert, browse, a worker that crashes,
 // remove mid-load, insert again), and the kiosk under Xvfb walking a stick.
@@ -555,7 +555,7 @@ std::optional<StickNews> next_news(StickService& svc) {
 
 }  // namespace
 
-// Hot-plug with a fake event source and a real device (issue 11, "Tests it must have"): a read-only loop
+// Hot-plug with a fake event source and a real device: a read-only loop
 // device "inserted" is mounted by the kiosk's own code and listed; a page is browsed; the stick is taken
 // out while a page is still being drawn (the worker made to hang), and the removal is not held up by it;
 // inserted again, it is a new stick. The image is unchanged.

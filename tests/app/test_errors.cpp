@@ -1,4 +1,4 @@
-// One way to fail (issue 17, item 3): every module's error derives from hk::Error, so a caller that only
+// One way to fail: every module's error derives from hk::Error, so a caller that only
 // reports catches one type; and a bad input through the CLI ends in exactly one line naming it.
 #include <gtest/gtest.h>
 

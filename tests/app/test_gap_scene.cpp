@@ -1,4 +1,4 @@
-// Gap closing end to end (issue 15, item 3): a line drawing whose outlines are cut by gaps of 0.5, 1 and 2 mm
+// Gap closing end to end: a line drawing whose outlines are cut by gaps of 0.5, 1 and 2 mm
 // at the kiosk's scale, through build_image_scene (Canny, thin-line merging, close_gaps). The gaps between
 // the chains' ends are not the picture's: Canny's blur pulls the edges back from a stroke's end by up to
 // 2.5 px either side of a narrow gap, so the 1 mm gap (4 px) is 10 px between the centre lines' ends and stays

@@ -1,4 +1,4 @@
-// The grooves rendering mode end to end (issue 14, item 2): on real pictures the force stays continuous
+// The grooves rendering mode end to end: on real pictures the force stays continuous
 // (no step beyond stiffness × the handle's own motion, plus the per-tick jump allowance where the closest
 // point jumps), levels still follow the hand's speed, and `explore` with [haptics] render = "grooves"
 // writes a trace whose proxy columns hold the closest point, with contact 1 exactly within the capture
@@ -191,7 +191,7 @@ TEST(GroovesExplore, TraceHoldsTheClosestPointAndContactWithinTheRadius) {
   fs::remove_all(dir);
 }
 
-// Issue 18: grooves under every level mode that moves with the hand's speed (levels, tolerance steps, the
+// Grooves under every level mode that moves with the hand's speed (levels, tolerance steps, the
 // tolerance cut), on every picture: the raster whose rows alternate slow and fast changes the level (or step)
 // many times, and the force stays within stiffness × the handle's own motion plus the per-tick jump
 // allowance throughout (3.5 s for the 66 runs).

@@ -1,4 +1,4 @@
-// The guided tour (issue 14, item 3): the planner (nearest untouched shape, side, closed and open outlines,
+// The guided tour: the planner (nearest untouched shape, side, closed and open outlines,
 // speed, specks) and the servo side driven tick by tick through the simulated pantograph: on a picture
 // with 5 shapes repeated Guide reaches each shape once, nearest first, the guide force never above its
 // limit and the total never above max force; a hand holding still stops it, and so does a key, with the
@@ -638,8 +638,8 @@ TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
   EXPECT_TRUE(ends_with(near, "Your hand is in the middle.")) << near;
 }
 
-// Tours on real pictures (found 2026-11-26: 13 tours on 9 of the 22 pictures stopped although the hand was
-// relaxed). The press keeps the handle on the wall, so it follows the wall into narrow pockets, slots and
+// Tours on real pictures: a tour must not stop while the hand is relaxed (13 tours on 9 of the 22 pictures
+// once did). The press keeps the handle on the wall, so it follows the wall into narrow pockets, slots and
 // hooks of the rendered polyline that the planned track passes outside: the horse's ear, the gap between
 // the apple's stem and leaf (silhouette_1), a curl of the bat's wing (silhouette_3). There the spring pulls
 // into the wall, the handle stops and the tour took it for a hand holding still. Now the guide follows the

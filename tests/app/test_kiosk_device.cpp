@@ -1,4 +1,4 @@
-// The kiosk's runtime and the USB pantograph (issue 13, items 3 and 6), without its window: a board on a
+// The kiosk's runtime and the USB pantograph, without its window: a board on a
 // tty (the firmware emulator behind a pty, named in [device] serial_path) is opened, used by the servo
 // thread and announced; when it stops answering the kiosk says so; with no board the simulated pantograph
 // stands in and the kiosk says that, and why is kept for the operator.

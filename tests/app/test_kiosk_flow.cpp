@@ -1,5 +1,5 @@
 // The visitor's walk through the kiosk, driven by scripted keys and handle motion, checked by what the
-// kiosk says (issue 5: attract → tutorial → picture → next picture → time-out → attract), and the
+// kiosk says (attract → tutorial → picture → next picture → time-out → attract), and the
 // spoken description of a picture.
 #include <gtest/gtest.h>
 
@@ -154,7 +154,7 @@ TEST(KioskFlow, EveryKeyIsAnsweredInSpeech) {
   }
 }
 
-// Issue 15, item 4: a PDF with a title of its own is named by it, in what is said and when a page fails.
+// A PDF with a title of its own is named by it, in what is said and when a page fails.
 TEST(KioskFlow, APdfIsNamedByItsOwnTitle) {
   Recorder fx;
   KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
@@ -171,7 +171,7 @@ TEST(KioskFlow, APdfIsNamedByItsOwnTitle) {
   EXPECT_EQ(fx.said.back().rfind("Page 2 of A ring, drawn for the hand cannot be shown", 0), 0u) << fx.said.back();
 }
 
-// Issue 11, item 5: a stick inserted, browsed, a page that cannot be read, a load superseded, the stick
+// A stick inserted, browsed, a page that cannot be read, a load superseded, the stick
 // taken out mid-load and inserted again, and a new visitor who does not inherit it.
 TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   Recorder fx;

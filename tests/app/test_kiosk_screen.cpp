@@ -1,4 +1,4 @@
-// The kiosk under Xvfb (issue 5, "Tests it must have"): it starts full screen, shows a picture with its
+// The kiosk under Xvfb: it starts full screen, shows a picture with its
 // curves, and writes a screenshot in which the curves are where scene.json says they are, through the
 // documented view mapping (kiosk_app.hpp), checked from the pixels.
 #include <gtest/gtest.h>

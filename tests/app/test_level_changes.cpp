@@ -1,9 +1,9 @@
-// Levels from hand speed on real pictures (issue 6, items 1 and 2): a raster whose rows alternate slow
+// Levels from hand speed on real pictures: a raster whose rows alternate slow
 // and fast makes the level change many times; no move of the proxy crosses the polyline of the level in
 // force, no level change leaves the proxy on the other side of the new polyline than it was of the old
 // one (an independent between-region test), and the force never jumps at a change by more than the limit.
-// Every picture of tests/data/images, in each level mode (six of them until 2026-11-26, when the other
-// sixteen found camera's proxy left between two cut steps' polylines at an open curve's shared end).
+// Every picture of tests/data/images, in each level mode, not a sample of them: a picture outside a sample
+// (camera) left the proxy between two cut steps' polylines at an open curve's shared end.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -161,19 +161,19 @@ TEST_P(LevelChanges, FastAndSlowRasterChangesLevelsWithoutCrossingOrForceSteps) 
   level_changes_hold(GetParam(), "auto", Hand::Raster);
 }
 
-// Issue 18: the policy picks a tolerance instead of a level; the same crossing checks stay at 0.
+// The policy picks a tolerance instead of a level; the same crossing checks stay at 0.
 TEST_P(LevelChanges, FastAndSlowRasterChangesToleranceStepsWithoutCrossingOrForceSteps) {
   level_changes_hold(GetParam(), "tolerance", Hand::Raster);
 }
 
-// Issue 18: the policy picks a tolerance and the walls are its cut, refined per segment and joined where the
+// The policy picks a tolerance and the walls are its cut, refined per segment and joined where the
 // level changes; the same crossing checks stay at 0 (against the joined polylines).
 TEST_P(LevelChanges, FastAndSlowRasterChangesCutStepsWithoutCrossingOrForceSteps) {
   level_changes_hold(GetParam(), "cut", Hand::Raster);
 }
 
-// The visitor-like explorer in each mode (added 2026-11-26: on sudoku it found a level change that left the
-// proxy between two levels of a curve crossing the one it slid on, which the check had not looked at).
+// The visitor-like explorer in each mode: it reaches level changes the raster does not (on sudoku, one that
+// left the proxy between two levels of a curve crossing the one it slid on).
 TEST_P(LevelChanges, ExplorerChangesLevelsWithoutCrossingOrForceSteps) { level_changes_hold(GetParam(), "auto", Hand::Explorer); }
 TEST_P(LevelChanges, ExplorerChangesToleranceStepsWithoutCrossingOrForceSteps) { level_changes_hold(GetParam(), "tolerance", Hand::Explorer); }
 TEST_P(LevelChanges, ExplorerChangesCutStepsWithoutCrossingOrForceSteps) { level_changes_hold(GetParam(), "cut", Hand::Explorer); }

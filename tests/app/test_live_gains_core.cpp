@@ -1,4 +1,4 @@
-// Gains changed live on the kiosk's servo thread (issue 12, item 4, ServoCore level): the simulated
+// Gains changed live on the kiosk's servo thread (ServoCore level): the simulated
 // pantograph held by a model hand pressing on a wall with the kiosk's defaults (800 N/m, 2 N push,
 // 0.05 N per tick, 1 kHz); ServoCore::set_gains doubles the stiffness between two ticks. The force never
 // steps by more than the limit per tick (plus what the hand's own motion does to the wall), the display

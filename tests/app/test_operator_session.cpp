@@ -1,4 +1,4 @@
-// The operator's panel's logic (issue 12, items 1-5) without its drawing: the chord asks for the PIN, a
+// The operator's panel's logic without its drawing: the chord asks for the PIN, a
 // wrong PIN is refused and counted, the right one opens the panel, edits are checked as the loader checks
 // them, Apply hands the copy over and audits it, Save keeps the .bak, and the panel closes itself when idle.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// A scripted operator's visit to the real kiosk under Xvfb (issue 12, "Tests it must have"): the key chord,
+// A scripted operator's visit to the real kiosk under Xvfb: the key chord,
 // a wrong PIN, the right PIN, stiffness 800 → 1200 N/m typed into the panel, Apply, Save. Every key and
 // click goes through the kiosk's input routing and Dear ImGui, as a real one would. Afterwards the settings
 // file has 1200, its .bak 800, the audit log the change, and neither PIN appears in anything the kiosk wrote.

@@ -1,4 +1,4 @@
-// Issue 15, "exact on silhouettes": every binary silhouette of tests/data/images and silhouettes made here
+// Exact on silhouettes: every binary silhouette of tests/data/images and silhouettes made here
 // (holes, two blobs, a thin neck, sharp cusps) go through build_image_scene ([vision] detector "auto" chooses
 // the traced outline); the scene must hold exactly one closed curve per outline of the mask that does not meet
 // the picture's frame, and at level 0 lie within 1.5 px of the mask's true boundary (the crack between dark and
@@ -17,6 +17,7 @@
 #include "config/load.hpp"
 #include "image_scene.hpp"
 #include "kiosk_exe.hpp"
+#include "hk/error.hpp"
 
 namespace hk::app {
 namespace {
@@ -160,7 +161,7 @@ TEST(OutlineScene, TheSettingsOfferExactlyTheDetectorsVisionKnows) {
   ASSERT_NE(d, nullptr);
   ASSERT_EQ(d->choices.size(), 6u);
   for (const auto& name : d->choices) EXPECT_EQ(vision::detector_name(vision::detector_from_name(std::string(name))), name);
-  EXPECT_THROW(vision::detector_from_name("sobel"), std::invalid_argument);
+  EXPECT_THROW(vision::detector_from_name("sobel"), hk::ArgumentError);
 }
 
 TEST(OutlineScene, MadeSilhouettesGiveOneClosedCurvePerOutlineOnTheBoundary) {

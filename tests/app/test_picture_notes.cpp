@@ -1,4 +1,4 @@
-// A picture's title and description from its sidecar (issue 15, item 4): read_picture_notes on good and bad
+// A picture's title and description from its sidecar: read_picture_notes on good and bad
 // files written here, and on the shipped library.
 #include <gtest/gtest.h>
 

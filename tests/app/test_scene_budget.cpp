@@ -1,4 +1,4 @@
-// The scene budget (issue 6, item 4): a cluttered photo stays within the segment budget, and the kept
+// The scene budget: a cluttered photo stays within the segment budget, and the kept
 // curves are the most salient ones (long and strong, image_scene.hpp curve_salience) — checked against
 // the unbudgeted scene with an independent greedy replay of the documented rule, on a synthetic
 // picture where strength must beat length, and on a real photo.

@@ -1,4 +1,4 @@
-// The shape budget (issue 15, item 2): curves ranked by what matters to a hand (shape_salience: length,
+// The shape budget: curves ranked by what matters to a hand (shape_salience: length,
 // contrast, closedness, enclosed area), lines along the picture's frame dropped, at most vision.max_shapes
 // kept; on synthetic scenes with known answers and on every shipped picture.
 #include <gtest/gtest.h>

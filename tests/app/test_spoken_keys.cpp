@@ -1,4 +1,4 @@
-// Keys the visitor is told about are the keys that work (issue 12, item 6): for every key name the settings
+// Keys the visitor is told about are the keys that work: for every key name the settings
 // allow and every action, the kiosk configured that way names that key for that action in its welcome, its
 // help, its tutorial and its USB stick announcement; the operator's change (set_keys) is heard at once.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The kiosk's stick service without CAP_SYS_ADMIN (issue 17, item 5): it mounts through the mount helper.
+// The kiosk's stick service without CAP_SYS_ADMIN: it mounts through the mount helper.
 // A fake helper (a shell script named by $HK_STICK_HELPER) answers as hk-stick-mount does, with a folder of
 // documents standing for the mounted stick, so this runs without root and mounts nothing. When the test
 // runs as root, a forked child first drops CAP_SYS_ADMIN, so the service has to choose the helper.

@@ -1,5 +1,5 @@
-// Texture out, end to end (issue 15: "a picture of pure texture (noise, wood grain you generate) gives few
-// shapes"): generated texture written as PNG and built into a scene with the default settings, the kiosk's
+// Texture out, end to end (a picture of pure texture, such as noise or wood grain, gives few
+// shapes): generated texture written as PNG and built into a scene with the default settings, the kiosk's
 // summary.json saying why the edges went; and the coins, whose every outline stays and nothing else.
 #include <gtest/gtest.h>
 

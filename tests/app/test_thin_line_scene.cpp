@@ -1,4 +1,4 @@
-// Thin lines in the scene (issue 6, item 4): end to end on real pictures, build_image_scene with
+// Thin lines in the scene: end to end on real pictures, build_image_scene with
 // thin-line merging on gives fewer level-0 segments than with it off, and no two walls of the scene
 // run side by side closer than vision.thin_line_max_width_m — checked on the output polylines by an
 // independent search for parallel stretches, which finds plenty of them with merging off.

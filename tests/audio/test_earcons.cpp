@@ -1,5 +1,5 @@
 // Earcons rendered on a servo timeline and analysed as a listener's ear would have to: onsets, spectra,
-// envelopes, pitch (issue 4, "Tests it must have").
+// envelopes, pitch.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -7,6 +7,7 @@
 #include "audio/earcons.hpp"
 #include "audio/mixer.hpp"
 #include "audio_analysis.hpp"
+#include "hk/error.hpp"
 
 namespace hk::audio {
 namespace {
@@ -95,7 +96,7 @@ TEST(Earcons, TwoCurvesDifferInPitch) {
   EXPECT_NEAR(fb, 293.66, 293.66 * 0.02);
 }
 
-// The text-block chime (issue 11): two soft notes, G5 (784 Hz) then D6 (1175 Hz) 80 ms later, and no strike:
+// The text-block chime: two soft notes, G5 (784 Hz) then D6 (1175 Hz) 80 ms later, and no strike:
 // unlike a contact click it has no noise burst at its start (low spectral centroid over its first 5 ms).
 TEST(Earcons, TextBlockIsTwoRisingNotesWithoutAStrike) {
   const std::vector<float> x = render_cue_timeline(std::vector{cue(10, CueKind::TextBlock, 0)}, kPeriod, 0.4);
@@ -108,7 +109,7 @@ TEST(Earcons, TextBlockIsTwoRisingNotesWithoutAStrike) {
   EXPECT_LT(test::peak(x, t + at(350), x.size()), 1e-4) << "over within 350 ms";
 }
 
-// The push-through earcon (issue 14): a bright noisy burst at once, then a low plop falling from 220 Hz,
+// The push-through earcon: a bright noisy burst at once, then a low plop falling from 220 Hz,
 // all over within 150 ms; unlike the coarser chirp, which starts as a pure tone near 1 kHz.
 TEST(Earcons, PopThroughIsABurstOverALowFallingPlop) {
   const std::vector<float> x = render_cue_timeline(std::vector{cue(10, CueKind::PopThrough, 0)}, kPeriod, 0.4);
@@ -122,7 +123,7 @@ TEST(Earcons, PopThroughIsABurstOverALowFallingPlop) {
   EXPECT_LT(test::peak(x, t + at(150), x.size()), 1e-4) << "over within 150 ms";
 }
 
-// The guided tour's start (issue 14): three rising notes, C5, E5, G5, 70 ms apart.
+// The guided tour's start: three rising notes, C5, E5, G5, 70 ms apart.
 TEST(Earcons, TourStartIsARisingArpeggio) {
   const std::vector<float> x = render_cue_timeline(std::vector{cue(10, CueKind::TourStart, 0)}, kPeriod, 0.5);
   const std::size_t t = at(10);
@@ -131,7 +132,7 @@ TEST(Earcons, TourStartIsARisingArpeggio) {
   EXPECT_LT(test::peak(x, t + at(400), x.size()), 1e-4);
 }
 
-// The camera's shutter (issue 16): two bright clicks 60 ms apart, the second softer, silence between them and
+// The camera's shutter: two bright clicks 60 ms apart, the second softer, silence between them and
 // after, over within 120 ms.
 TEST(Earcons, ShutterIsTwoBrightClicksSixtyMillisecondsApart) {
   const std::vector<float> x = render_cue_timeline(std::vector{cue(10, CueKind::Shutter, -1)}, kPeriod, 0.3);
@@ -194,9 +195,9 @@ TEST(Earcons, VoicePoolSurvivesAFlood) {
 }
 
 TEST(Earcons, TimelineRejectsBadArguments) {
-  EXPECT_THROW(render_cue_timeline({}, 0.0, 1.0), std::invalid_argument);
-  EXPECT_THROW(render_cue_timeline({}, 0.001, -1.0), std::invalid_argument);
-  EXPECT_THROW(render_cue_timeline({}, 0.001, 1e6), std::invalid_argument);
+  EXPECT_THROW(render_cue_timeline({}, 0.0, 1.0), hk::ArgumentError);
+  EXPECT_THROW(render_cue_timeline({}, 0.001, -1.0), hk::ArgumentError);
+  EXPECT_THROW(render_cue_timeline({}, 0.001, 1e6), hk::ArgumentError);
   // Cues past the end or before the start are ignored, not a crash.
   const std::vector<float> x = render_cue_timeline(std::vector{cue(-5, CueKind::ContactBegin), cue(999999, CueKind::ContactBegin)}, 0.001, 0.1);
   EXPECT_EQ(test::peak(x, 0, x.size()), 0.0);

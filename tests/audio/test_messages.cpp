@@ -59,7 +59,7 @@ TEST(Messages, BadTranslationsAreRefusedInOneLine) {
   expect_refused("does_not_exist.toml", "cannot read");
 }
 
-// --- Keys (issue 12, item 6): messages name keys with placeholders filled from [key_names]. ---
+// --- Keys: messages name keys with placeholders filled from [key_names]. ---
 
 std::string read_text(const std::string& path) {
   std::ifstream f(path, std::ios::binary);

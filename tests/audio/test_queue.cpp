@@ -1,5 +1,5 @@
-// The cue queue between the 1 kHz servo thread and the audio callback (issue 4: "no blocking, overflow
-// counted, not crashed").
+// The cue queue between the 1 kHz servo thread and the audio callback: no blocking, overflow
+// counted, not crashed.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -9,6 +9,7 @@
 
 #include "audio/cue_event.hpp"
 #include "audio/spsc_ring.hpp"
+#include "hk/error.hpp"
 
 namespace hk::audio {
 namespace {
@@ -18,8 +19,8 @@ using Clock = std::chrono::steady_clock;
 TEST(CueQueue, CapacityIsRoundedToAPowerOfTwoAndBadSizesAreRefused) {
   EXPECT_EQ(SpscRing<int>(1).capacity(), 1u);
   EXPECT_EQ(SpscRing<int>(100).capacity(), 128u);
-  EXPECT_THROW(SpscRing<int>(0), std::invalid_argument);
-  EXPECT_THROW(SpscRing<int>(std::size_t{1} << 25), std::invalid_argument);
+  EXPECT_THROW(SpscRing<int>(0), hk::ArgumentError);
+  EXPECT_THROW(SpscRing<int>(std::size_t{1} << 25), hk::ArgumentError);
 }
 
 TEST(CueQueue, FullRingDropsAndCountsInsteadOfBlocking) {

@@ -1,4 +1,4 @@
-// The cross-field rule of [keys] (issue 12, item 6): each visitor action needs its own key, so a key does one
+// The cross-field rule of [keys]: each visitor action needs its own key, so a key does one
 // thing and the spoken help can name each action's key. The first clash in table order is refused, attributed
 // to the earlier action and naming the later one.
 

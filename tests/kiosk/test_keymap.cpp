@@ -1,4 +1,4 @@
-// The keys the settings name are the keys that work (issue 12, item 6): every name [keys] allows maps to
+// The keys the settings name are the keys that work: every name [keys] allows maps to
 // one GLFW key, different names to different keys, each action to its configured key, and the operator's
 // chord only with exactly its modifiers.
 #include <GLFW/glfw3.h>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file synthetic_photo.hpp
-/// Synthetic camera photos of a picture held under the kiosk's camera (issue 16, item 2), shared by
+/// Synthetic camera photos of a picture held under the kiosk's camera, shared by
 /// tests/vision/test_page.cpp and bench/rectify.cpp: a picture warped by a known homography onto a generated,
 /// textured backdrop (a wooden table top or a cloth of coloured blobs), then lit unevenly, blurred and made
 /// noisy as a cheap camera would. Deterministic from the seed (cv::RNG). Header-only; OpenCV core and imgproc.

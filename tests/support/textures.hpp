@@ -1,6 +1,6 @@
 #pragma once
 /// @file textures.hpp
-/// Pictures of pure texture, generated (issue 15: "a picture of pure texture gives few shapes"): what a
+/// Pictures of pure texture, generated (a picture of pure texture must give few shapes): what a
 /// photograph of a gravel path or a wooden table top would be with nothing on it. Deterministic from the seed
 /// (cv::RNG), 8-bit grey, written as PNG by bench/textures (docs/bench/textures/).
 

@@ -1,5 +1,5 @@
 #pragma once
-// The guided tour's test picture (issue 14, item 3): five separate filled shapes, black on white, drawn
+// The guided tour's test picture: five separate filled shapes, black on white, drawn
 // with OpenCV, so each is one closed outline after edge detection. Shared by tests/app/test_guided_tour.cpp
 // and bench/tour_time.cpp.
 #include <opencv2/imgcodecs.hpp>

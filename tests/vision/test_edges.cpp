@@ -11,6 +11,7 @@
 
 #include "vision/edges.hpp"
 #include "vision/intake.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -136,14 +137,14 @@ TEST(DetectEdges, LeavesItsInputUntouched) {
 }
 
 TEST(DetectEdges, RejectsBadArguments) {
-  EXPECT_THROW(detect_edges(cv::Mat(), {}), std::invalid_argument);
-  EXPECT_THROW(detect_edges(cv::Mat(5, 5, CV_8UC3), {}), std::invalid_argument);
+  EXPECT_THROW(detect_edges(cv::Mat(), {}), hk::ArgumentError);
+  EXPECT_THROW(detect_edges(cv::Mat(5, 5, CV_8UC3), {}), hk::ArgumentError);
   EdgeParams p;
   p.blur_sigma_px = -1;
-  EXPECT_THROW(detect_edges(cv::Mat(5, 5, CV_8UC1), p), std::invalid_argument);
+  EXPECT_THROW(detect_edges(cv::Mat(5, 5, CV_8UC1), p), hk::ArgumentError);
   p = {};
   p.canny_high = std::numeric_limits<double>::infinity();
-  EXPECT_THROW(detect_edges(cv::Mat(5, 5, CV_8UC1), p), std::invalid_argument);
+  EXPECT_THROW(detect_edges(cv::Mat(5, 5, CV_8UC1), p), hk::ArgumentError);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Frame sources (vision/frame_source.hpp, issue 16 item 1): the spec parser, the file source on one image and
+// Frame sources (vision/frame_source.hpp): the spec parser, the file source on one image and
 // on a folder of frames written here, and the camera paths on a machine that may have no camera at all (the
 // CI machine has none): listing never throws and prints nothing, a missing camera or a node that is not a
 // camera is refused with one line.
@@ -21,6 +21,7 @@
 
 #include "vision/frame_source.hpp"
 #include "vision/intake.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -257,11 +258,11 @@ TEST(FrameSourceFile, ParametersOutOfRangeAreInvalidArguments) {
     change(p);
     return p;
   };
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.width_px = 63; })), std::invalid_argument);
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.height_px = 8193; })), std::invalid_argument);
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 0.0; })), std::invalid_argument);
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 1001.0; })), std::invalid_argument);
-  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.max_frame_bytes = 0; })), std::invalid_argument);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.width_px = 63; })), hk::ArgumentError);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.height_px = 8193; })), hk::ArgumentError);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 0.0; })), hk::ArgumentError);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 1001.0; })), hk::ArgumentError);
+  EXPECT_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.max_frame_bytes = 0; })), hk::ArgumentError);
   EXPECT_NO_THROW(open_spec(spec, with([](FrameSourceParams& p) { p.file_fps = 1000.0; })));
 }
 

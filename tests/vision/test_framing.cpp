@@ -1,4 +1,4 @@
-// The framing guide's state machine on hand-made frame looks (issue 16, item 3); the same guide on real frame
+// The framing guide's state machine on hand-made frame looks; the same guide on real frame
 // sequences from the file source is tested end to end in tests/app/test_capture.cpp.
 
 #include <gtest/gtest.h>
@@ -13,6 +13,7 @@
 
 #include "synthetic_photo.hpp"
 #include "vision/framing.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -165,13 +166,13 @@ TEST(FramingGuide, APictureFillingTheFrameIsCapturedWholeAfterWholeFrameAfterS) 
 TEST(FramingGuide, BadParametersAreRefused) {
   FramingParams p;
   p.still_s = 0;
-  EXPECT_THROW(FramingGuide{p}, std::invalid_argument);
+  EXPECT_THROW(FramingGuide{p}, hk::ArgumentError);
   p = {};
   p.centre_tolerance = 0.7;
-  EXPECT_THROW(FramingGuide{p}, std::invalid_argument);
+  EXPECT_THROW(FramingGuide{p}, hk::ArgumentError);
   p = {};
   p.max_motion = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(FramingGuide{p}, std::invalid_argument);
+  EXPECT_THROW(FramingGuide{p}, hk::ArgumentError);
 }
 
 TEST(FrameLook, MotionAndDetailFromRealPixels) {
@@ -189,7 +190,7 @@ TEST(FrameLook, MotionAndDetailFromRealPixels) {
   cv::rectangle(b, cv::Rect(260, 150, 240, 180), cv::Scalar(230, 230, 230), cv::FILLED);  // moved 60 px right
   const FrameLook moved = look_at_frame(b, 0.2, &same, small, {});
   EXPECT_GT(moved.motion, 4.0);
-  EXPECT_THROW(look_at_frame(cv::Mat(), 0, nullptr, small, {}), std::invalid_argument);
+  EXPECT_THROW(look_at_frame(cv::Mat(), 0, nullptr, small, {}), hk::ArgumentError);
 }
 
 // Real frames of a page near the frame's bottom edge (turned, tilted, lit unevenly, noisy): lying whole 6 px (1.3 %)

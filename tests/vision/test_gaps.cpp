@@ -1,4 +1,4 @@
-// Closing small gaps in outlines (issue 15, item 3): close_gaps on synthetic chains whose gaps are known.
+// Closing small gaps in outlines: close_gaps on synthetic chains whose gaps are known.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "vision/gaps.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -149,16 +150,16 @@ TEST(CloseGaps, TheNearestFacingEndIsTakenAndValuesFollowTheirPoints) {
 TEST(CloseGaps, RefusesBadInput) {
   GapParams p = at_one_mm();
   p.max_gap_px = -1;
-  EXPECT_THROW(close_gaps({}, p), std::invalid_argument);
+  EXPECT_THROW(close_gaps({}, p), hk::ArgumentError);
   p = at_one_mm();
   p.max_turn_deg = 0;
-  EXPECT_THROW(close_gaps({}, p), std::invalid_argument);
+  EXPECT_THROW(close_gaps({}, p), hk::ArgumentError);
   p.max_turn_deg = 91;
-  EXPECT_THROW(close_gaps({}, p), std::invalid_argument);
-  EXPECT_THROW(close_gaps({Chain{}}, at_one_mm()), std::invalid_argument);
+  EXPECT_THROW(close_gaps({}, p), hk::ArgumentError);
+  EXPECT_THROW(close_gaps({Chain{}}, at_one_mm()), hk::ArgumentError);
   Chain a;
   a.points_px = {{0, 0}, {1, 0}};
-  EXPECT_THROW(close_gaps({a}, at_one_mm(), nullptr, PointValues{{1.0}}), std::invalid_argument);
+  EXPECT_THROW(close_gaps({a}, at_one_mm(), nullptr, PointValues{{1.0}}), hk::ArgumentError);
   EXPECT_TRUE(close_gaps({}, at_one_mm()).empty());
 }
 

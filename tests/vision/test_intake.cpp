@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vision/intake.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -268,7 +269,7 @@ TEST(LoadImage, AppliesEachLimit) {
   EXPECT_EQ(load_image(fruits, exact).size(), cv::Size(512, 480));
   ImageLimits zero;
   zero.max_pixels = 0;
-  EXPECT_THROW(load_image(fruits, zero), std::invalid_argument);
+  EXPECT_THROW(load_image(fruits, zero), hk::ArgumentError);
 }
 
 TEST(LoadImage, MessageStaysOnOneLineForAHostileFileName) {
@@ -385,9 +386,9 @@ TEST(ToGrey, ShrinksTheLongSideToTheLimitAndReportsTheScale) {
 }
 
 TEST(ToGrey, RejectsBadArguments) {
-  EXPECT_THROW(to_grey(cv::Mat(), 800, nullptr), std::invalid_argument);
-  EXPECT_THROW(to_grey(cv::Mat(4, 4, CV_32FC3), 800, nullptr), std::invalid_argument);
-  EXPECT_THROW(to_grey(cv::Mat(4, 4, CV_8UC3), 0, nullptr), std::invalid_argument);
+  EXPECT_THROW(to_grey(cv::Mat(), 800, nullptr), hk::ArgumentError);
+  EXPECT_THROW(to_grey(cv::Mat(4, 4, CV_32FC3), 800, nullptr), hk::ArgumentError);
+  EXPECT_THROW(to_grey(cv::Mat(4, 4, CV_8UC3), 0, nullptr), hk::ArgumentError);
 }
 
 }  // namespace

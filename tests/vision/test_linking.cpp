@@ -15,6 +15,7 @@
 #include "vision/edges.hpp"
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -236,9 +237,9 @@ TEST(LinkEdges, OutputIsDeterministicAndInRasterOrderOfFirstPoints) {
 }
 
 TEST(LinkEdges, RejectsBadArguments) {
-  EXPECT_THROW(link_edges(cv::Mat::zeros(5, 5, CV_32F), 0.0), std::invalid_argument);
-  EXPECT_THROW(link_edges(blank(), -1.0), std::invalid_argument);
-  EXPECT_THROW(link_edges(blank(), std::nan("")), std::invalid_argument);
+  EXPECT_THROW(link_edges(cv::Mat::zeros(5, 5, CV_32F), 0.0), hk::ArgumentError);
+  EXPECT_THROW(link_edges(blank(), -1.0), hk::ArgumentError);
+  EXPECT_THROW(link_edges(blank(), std::nan("")), hk::ArgumentError);
 }
 
 }  // namespace

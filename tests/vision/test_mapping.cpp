@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "vision/mapping.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -64,12 +65,12 @@ TEST(FitToWorkspace, RoundTripsBetweenPixelsAndMetres) {
 }
 
 TEST(FitToWorkspace, RejectsNonPositiveSizes) {
-  EXPECT_THROW(fit_to_workspace(0, 10, kW, kH), std::invalid_argument);
-  EXPECT_THROW(fit_to_workspace(10, -1, kW, kH), std::invalid_argument);
-  EXPECT_THROW(fit_to_workspace(10, 10, 0.0, kH), std::invalid_argument);
-  EXPECT_THROW(fit_to_workspace(10, 10, kW, -0.1), std::invalid_argument);
-  EXPECT_THROW(fit_to_workspace(10, 10, std::nan(""), kH), std::invalid_argument);
-  EXPECT_THROW(fit_to_workspace(10, 10, kW, INFINITY), std::invalid_argument);
+  EXPECT_THROW(fit_to_workspace(0, 10, kW, kH), hk::ArgumentError);
+  EXPECT_THROW(fit_to_workspace(10, -1, kW, kH), hk::ArgumentError);
+  EXPECT_THROW(fit_to_workspace(10, 10, 0.0, kH), hk::ArgumentError);
+  EXPECT_THROW(fit_to_workspace(10, 10, kW, -0.1), hk::ArgumentError);
+  EXPECT_THROW(fit_to_workspace(10, 10, std::nan(""), kH), hk::ArgumentError);
+  EXPECT_THROW(fit_to_workspace(10, 10, kW, INFINITY), hk::ArgumentError);
 }
 
 }  // namespace

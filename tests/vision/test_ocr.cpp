@@ -22,6 +22,7 @@
 
 #include "scans.hpp"
 #include "vision/ocr.hpp"
+#include "hk/error.hpp"
 
 namespace fs = std::filesystem;
 
@@ -192,8 +193,8 @@ TEST(Ocr, AWorkerThatCrashesHangsOrRunsOutOfMemoryCostsTheTextInOneLine) {
 }
 
 TEST(Ocr, BadArgumentsAreRefusedBeforeAnyWorkerStarts) {
-  EXPECT_THROW((void)recognise_text(cv::Mat(), "x", {}), std::invalid_argument);
-  EXPECT_THROW((void)recognise_text(cv::Mat(10, 10, CV_8UC3), "x", {}), std::invalid_argument);
+  EXPECT_THROW((void)recognise_text(cv::Mat(), "x", {}), hk::ArgumentError);
+  EXPECT_THROW((void)recognise_text(cv::Mat(10, 10, CV_8UC3), "x", {}), hk::ArgumentError);
   OcrParams p;
   p.max_pixels = 100;
   try {

@@ -1,4 +1,4 @@
-// Two-tone pictures traced from a threshold (issue 15): classify_two_tone and trace_outlines on synthetic
+// Two-tone pictures traced from a threshold: classify_two_tone and trace_outlines on synthetic
 // masks whose outlines are known, and on the shipped pictures.
 #include <gtest/gtest.h>
 
@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vision/outline.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -61,8 +62,8 @@ TEST(TwoTone, ABlackShapeOnWhiteIsTwoToneAndGradientsAndNoiseAreNot) {
   EXPECT_FALSE(classify_two_tone(low_contrast).two_tone) << "tones 50 levels apart: shading, not ink";
 
   EXPECT_FALSE(classify_two_tone(blank()).two_tone) << "one tone: nothing to trace";
-  EXPECT_THROW(classify_two_tone(cv::Mat()), std::invalid_argument);
-  EXPECT_THROW(classify_two_tone(cv::Mat(10, 10, CV_8UC3)), std::invalid_argument);
+  EXPECT_THROW(classify_two_tone(cv::Mat()), hk::ArgumentError);
+  EXPECT_THROW(classify_two_tone(cv::Mat(10, 10, CV_8UC3)), hk::ArgumentError);
 }
 
 TEST(TwoTone, TheShippedSilhouettesAreTwoToneAndThePhotographsAreNot) {
@@ -144,9 +145,9 @@ TEST(TraceOutlines, TheForegroundIsTheToneOffTheFrameWhicheverItIs) {
 }
 
 TEST(TraceOutlines, RefusesBadInput) {
-  EXPECT_THROW(trace_outlines(cv::Mat(), 127), std::invalid_argument);
-  EXPECT_THROW(trace_outlines(cv::Mat(10, 10, CV_32F), 127), std::invalid_argument);
-  EXPECT_THROW(trace_outlines(blank(), 127, 0), std::invalid_argument);
+  EXPECT_THROW(trace_outlines(cv::Mat(), 127), hk::ArgumentError);
+  EXPECT_THROW(trace_outlines(cv::Mat(10, 10, CV_32F), 127), hk::ArgumentError);
+  EXPECT_THROW(trace_outlines(blank(), 127, 0), hk::ArgumentError);
   EXPECT_TRUE(trace_outlines(blank(), 127).empty()) << "one tone: no outline";
 }
 

@@ -1,4 +1,4 @@
-// Tests of vision/page.hpp (issue 16, item 2): the page found in a camera frame, its aspect ratio, the flat warp.
+// Tests of vision/page.hpp: the page found in a camera frame, its aspect ratio, the flat warp.
 // The frames are synthetic photos (tests/support/synthetic_photo.hpp): a test picture warped by a known homography
 // onto a generated wood or cloth backdrop, lit unevenly, blurred and noisy; the truth is where its corners went.
 
@@ -23,6 +23,7 @@
 
 #include "synthetic_photo.hpp"
 #include "vision/page.hpp"
+#include "hk/error.hpp"
 
 namespace {
 
@@ -424,26 +425,26 @@ TEST(PageAspectRatio, RectifiedSizeFollowsTheRatio) {
 
 TEST(PageBadInput, Rejected) {
   const cv::Mat colour(120, 160, CV_8UC3, cv::Scalar(0));
-  EXPECT_THROW(find_page(cv::Mat()), std::invalid_argument);
-  EXPECT_THROW(find_page(cv::Mat(120, 160, CV_32F, cv::Scalar(0))), std::invalid_argument);
-  EXPECT_THROW(find_page(cv::Mat(120, 160, CV_8UC4, cv::Scalar(0))), std::invalid_argument);
+  EXPECT_THROW(find_page(cv::Mat()), hk::ArgumentError);
+  EXPECT_THROW(find_page(cv::Mat(120, 160, CV_32F, cv::Scalar(0))), hk::ArgumentError);
+  EXPECT_THROW(find_page(cv::Mat(120, 160, CV_8UC4, cv::Scalar(0))), hk::ArgumentError);
   PageParams p;
   p.min_area_fraction = 0.0;
-  EXPECT_THROW(find_page(colour, p), std::invalid_argument);
+  EXPECT_THROW(find_page(colour, p), hk::ArgumentError);
   p = {};
   p.min_contrast = -1.0;
-  EXPECT_THROW(find_page(colour, p), std::invalid_argument);
+  EXPECT_THROW(find_page(colour, p), hk::ArgumentError);
   p = {};
   p.max_side_px = 32;
-  EXPECT_THROW(find_page(colour, p), std::invalid_argument);
+  EXPECT_THROW(find_page(colour, p), hk::ArgumentError);
 
   const Corners good{cv::Point2d(10, 10), cv::Point2d(100, 12), cv::Point2d(98, 90), cv::Point2d(12, 88)};
-  EXPECT_THROW(rectify_page(cv::Mat(), good), std::invalid_argument);
+  EXPECT_THROW(rectify_page(cv::Mat(), good), hk::ArgumentError);
   const Corners flat{cv::Point2d(10, 10), cv::Point2d(50, 10), cv::Point2d(90, 10), cv::Point2d(130, 10)};
-  EXPECT_THROW(rectify_page(colour, flat), std::invalid_argument);
+  EXPECT_THROW(rectify_page(colour, flat), hk::ArgumentError);
   const Corners nan{cv::Point2d(std::nan(""), 10), cv::Point2d(100, 12), cv::Point2d(98, 90), cv::Point2d(12, 88)};
-  EXPECT_THROW(rectify_page(colour, nan), std::invalid_argument);
-  EXPECT_THROW(page_aspect_ratio(nan, {80, 60}), std::invalid_argument);
+  EXPECT_THROW(rectify_page(colour, nan), hk::ArgumentError);
+  EXPECT_THROW(page_aspect_ratio(nan, {80, 60}), hk::ArgumentError);
   // A uniform frame has no page, and says so without throwing; nor do tiny frames.
   EXPECT_FALSE(find_page(colour).found);
   EXPECT_FALSE(find_page(cv::Mat(1, 1, CV_8UC3, cv::Scalar(9))).found);

@@ -14,6 +14,7 @@
 
 #include "chain_checks.hpp"
 #include "vision/pipeline.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -157,10 +158,10 @@ TEST(ExtractChains, RejectsBadParameters) {
   const std::string img = std::string(HK_TEST_DATA_DIR) + "/images/horse.png";
   ExtractParams p;
   p.max_image_side_px = 0;
-  EXPECT_THROW(extract_chains(img, p), std::invalid_argument);
+  EXPECT_THROW(extract_chains(img, p), hk::ArgumentError);
   p = {};
   p.min_chain_length_px = -1;
-  EXPECT_THROW(extract_chains(img, p), std::invalid_argument);
+  EXPECT_THROW(extract_chains(img, p), hk::ArgumentError);
 }
 
 }  // namespace

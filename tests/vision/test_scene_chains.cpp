@@ -1,4 +1,4 @@
-// Scene simplification in one call (issue 15, item 5): vision::scene_chains on every test picture — the report
+// Scene simplification in one call: vision::scene_chains on every test picture — the report
 // accounts for every chain, the budgets keep the most salient curves and no more than they allow, traced
 // outlines are left as they are.
 
@@ -10,6 +10,7 @@
 #include <string>
 
 #include "vision/scene_chains.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -98,13 +99,13 @@ TEST(SceneChains, InvalidSettingsAreRefused) {
   const std::string file = std::string(HK_TEST_DATA_DIR) + "/images/coins.png";
   SimplifyParams p = defaults();
   p.max_shapes = 0;
-  EXPECT_THROW(scene_chains(file, ExtractParams{}, p, points_cost), std::invalid_argument);
+  EXPECT_THROW(scene_chains(file, ExtractParams{}, p, points_cost), hk::ArgumentError);
   p = defaults();
   p.gap_close_m = -1.0;
-  EXPECT_THROW(scene_chains(file, ExtractParams{}, p, points_cost), std::invalid_argument);
+  EXPECT_THROW(scene_chains(file, ExtractParams{}, p, points_cost), hk::ArgumentError);
   p = defaults();
   p.workspace_width_m = 0.0;
-  EXPECT_THROW(scene_chains(file, ExtractParams{}, p, points_cost), std::invalid_argument);
+  EXPECT_THROW(scene_chains(file, ExtractParams{}, p, points_cost), hk::ArgumentError);
 }
 
 // chains_to_curves keeps a chain exactly when its length in metres is not below the minimum: at the

@@ -1,4 +1,4 @@
-// The stick scan (issue 11, item 2): a stick comes from a stranger, so every test here builds a small
+// The stick scan: a stick comes from a stranger, so every test here builds a small
 // hostile tree in a fresh temp folder — links out of the tree, loops, FIFOs, device nodes, deep nesting,
 // floods of entries and documents, empty, mislabelled and oversized files, names that are not UTF-8 or
 // carry bidi and control characters — and checks what the scan lists, what it refuses and why, that every
@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "vision/stick_scan.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -676,12 +677,12 @@ TEST(StickScan, BadRootOrLimitsAreTypedOneLineErrors) {
     change(l);
     return l;
   };
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_depth = 0; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_entries = -1; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_documents = 0; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_file_bytes = 0; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = 0.0; })), std::invalid_argument);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = std::nan(""); })), std::invalid_argument);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_depth = 0; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_entries = -1; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_documents = 0; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_file_bytes = 0; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = 0.0; })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = std::nan(""); })), hk::ArgumentError);
   EXPECT_NE(read_error(t / "missing", "file.png").find("stick file 'file.png'"), std::string::npos);
 }
 

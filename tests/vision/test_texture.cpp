@@ -1,4 +1,4 @@
-// Texture out (issue 15, item 1): the surround annulus, the surround at chain points, the stand-out test, and
+// Texture out: the surround annulus, the surround at chain points, the stand-out test, and
 // the detectors side by side on generated texture and real pictures.
 
 #include <gtest/gtest.h>
@@ -15,6 +15,7 @@
 #include "vision/intake.hpp"
 #include "vision/pipeline.hpp"
 #include "vision/texture.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -51,8 +52,8 @@ TEST(SurroundMean, IsANormalisedAnnulusThatLeavesThePixelOut) {
   // A constant stays that constant.
   const cv::Mat flat = surround_mean(cv::Mat(40, 60, CV_32F, cv::Scalar(7.0)), sigma);
   EXPECT_NEAR(cv::norm(flat - 7.0, cv::NORM_INF), 0.0, 1e-4);
-  EXPECT_THROW(surround_mean(cv::Mat(10, 10, CV_8U), sigma), std::invalid_argument);
-  EXPECT_THROW(surround_mean(impulse, 0.0), std::invalid_argument);
+  EXPECT_THROW(surround_mean(cv::Mat(10, 10, CV_8U), sigma), hk::ArgumentError);
+  EXPECT_THROW(surround_mean(impulse, 0.0), hk::ArgumentError);
 }
 
 TEST(StandsOut, CountsThePointsThatKeepTheLowThreshold) {
@@ -93,8 +94,8 @@ TEST(ChainSurround, IsLowBesideALoneEdgeAndHighInTextureAndLeavesTheImageAlone) 
   for (const auto& v : ns)
     for (const double x : v) surround += x, n += 1;
   EXPECT_GT(surround / n, 0.4 * en.high) << "texture all round";
-  EXPECT_THROW(chain_surround(cv::Mat(), 1.5, {}), std::invalid_argument);
-  EXPECT_THROW(chain_surround(step, -1.0, {}), std::invalid_argument);
+  EXPECT_THROW(chain_surround(cv::Mat(), 1.5, {}), hk::ArgumentError);
+  EXPECT_THROW(chain_surround(step, -1.0, {}), hk::ArgumentError);
 }
 
 TEST(Detectors, SurroundKeepsExactlyTheCannyChainsThatStandOut) {

@@ -1,4 +1,4 @@
-// Thin-line merging (issue 6, item 4): strokes drawn with OpenCV go through the real pipeline
+// Thin-line merging: strokes drawn with OpenCV go through the real pipeline
 // (detect_edges + link_edges + merge_thin_lines) and the output is checked against the stroke's
 // analytical centre line (segment, circle arc), which the pipeline never sees.
 
@@ -20,6 +20,7 @@
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
 #include "vision/thin_lines.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -248,7 +249,7 @@ TEST(MergeThinLines, CarriesPointValuesAsTheMeanOfTheTwoSides) {
   // Untouched chains keep their values.
   EXPECT_EQ(merge_thin_lines(chains, 0.0, nullptr, in, &values).size(), chains.size());
   EXPECT_EQ(values, in);
-  EXPECT_THROW(merge_thin_lines(chains, kWidthPx, nullptr, PointValues(1), &values), std::invalid_argument);
+  EXPECT_THROW(merge_thin_lines(chains, kWidthPx, nullptr, PointValues(1), &values), hk::ArgumentError);
 }
 
 TEST(MergeThinLines, ZeroWidthIsOffAndOutputIsDeterministic) {
@@ -278,14 +279,14 @@ TEST(MergeThinLines, RejectsABadWidthWithOneLineNamingIt) {
     try {
       merge_thin_lines(chains, w);
       ADD_FAILURE() << "no exception for width " << w;
-    } catch (const std::invalid_argument& e) {
+    } catch (const hk::ArgumentError& e) {
       const std::string what = e.what();
       EXPECT_NE(what.find("max_width_px"), std::string::npos) << what;
       EXPECT_EQ(what.find('\n'), std::string::npos) << what;
     }
   }
   const std::vector<Chain> bad{Chain{{{0, 0}, {std::numeric_limits<double>::quiet_NaN(), 0}}, false}};
-  EXPECT_THROW(merge_thin_lines(bad, kWidthPx), std::invalid_argument);
+  EXPECT_THROW(merge_thin_lines(bad, kWidthPx), hk::ArgumentError);
 }
 
 TEST(MergeThinLines, RealImagesStayInsideTheImageAndShrink) {

@@ -27,6 +27,8 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 namespace {
 
@@ -381,67 +383,78 @@ constexpr std::uint8_t kWeak = 0;    // candidate, edge if connected to a strong
 constexpr std::uint8_t kNone = 1;    // not an edge
 constexpr std::uint8_t kStrong = 2;  // edge
 
-/// One row of suppression: fills map[0 .. n-1] with kWeak / kNone / kStrong and pushes the strong
-/// pixels. mp, mc, mn: magnitudes of the previous, current and next row, each readable at -1 and n
-/// (zeros there).
-void suppress_row(const std::int32_t* mp, const std::int32_t* mc, const std::int32_t* mn, const std::int16_t* gx,
-                  const std::int16_t* gy, int n, int low, int high, std::uint8_t* map,
-                  std::vector<std::uint8_t*>& stack) {
-  int x = 0;
 #if CV_SIMD128
-  const cv::v_int32x4 vlow = cv::v_setall_s32(low);
-  const cv::v_int32x4 vhigh = cv::v_setall_s32(high);
-  const cv::v_int32x4 one = cv::v_setall_s32(1);
-  const cv::v_int16x8 zero16 = cv::v_setzero_s16();
-  const cv::v_int32x4 zero32 = cv::v_setzero_s32();
+/// The vectorised part of suppress_row: one row's inputs (as suppress_row's) and the thresholds as
+/// vectors, suppressing 16 pixels per block. Its functions are forced inline, so a block compiles to the
+/// straight-line code of one loop body.
+struct SimdRowSuppressor {
+  const std::int32_t* mp;
+  const std::int32_t* mc;
+  const std::int32_t* mn;
+  const std::int16_t* gx;
+  const std::int16_t* gy;
+  cv::v_int32x4 vlow;
+  cv::v_int32x4 vhigh;
+  cv::v_int32x4 one = cv::v_setall_s32(1);
+  cv::v_int16x8 zero16 = cv::v_setzero_s16();
+  cv::v_int32x4 zero32 = cv::v_setzero_s32();
   // pmaddwd of (2|dy|, |dx|) pairs with (2^14, -TG22): |dy| * 2^15 - |dx| * TG22.
-  const cv::v_int16x8 coef(16384, -kTg22, 16384, -kTg22, 16384, -kTg22, 16384, -kTg22);
-  for (; x + 16 <= n; x += 16) {
+  cv::v_int16x8 coef{16384, -kTg22, 16384, -kTg22, 16384, -kTg22, 16384, -kTg22};
+
+  SimdRowSuppressor(const std::int32_t* mp_, const std::int32_t* mc_, const std::int32_t* mn_, const std::int16_t* gx_,
+                    const std::int16_t* gy_, int low, int high)
+      : mp(mp_), mc(mc_), mn(mn_), gx(gx_), gy(gy_), vlow(cv::v_setall_s32(low)), vhigh(cv::v_setall_s32(high)) {}
+
+  /// Suppression of the 4 pixels at xq: dev = |dy| 2^15 - |dx| TG22, x16 = |dx| 2^16, neg =
+  /// (dx ^ dy < 0); gives the map value and the strong mask (-1 / 0 per lane).
+  [[gnu::always_inline]] void quad(int xq, const cv::v_int32x4& m, const cv::v_int32x4& dev, const cv::v_int32x4& x16,
+                                   const cv::v_int32x4& neg, cv::v_int32x4& value, cv::v_int32x4& strong) const {
+    const cv::v_int32x4 horizontal = dev < zero32;  // y < tg22x
+    const cv::v_int32x4 vertical = dev > x16;       // y > tg22x + (x << 16)
+    const cv::v_int32x4 up_l = cv::v_load(mp + xq - 1);
+    const cv::v_int32x4 up_r = cv::v_load(mp + xq + 1);
+    const cv::v_int32x4 dn_l = cv::v_load(mn + xq - 1);
+    const cv::v_int32x4 dn_r = cv::v_load(mn + xq + 1);
+    const cv::v_int32x4 pass_h = (m > cv::v_load(mc + xq - 1)) & ~(cv::v_load(mc + xq + 1) > m);  // m > l, m >= r
+    const cv::v_int32x4 pass_v = (m > cv::v_load(mp + xq)) & ~(cv::v_load(mn + xq) > m);
+    const cv::v_int32x4 pass_d = cv::v_select(neg, (m > up_r) & (m > dn_l), (m > up_l) & (m > dn_r));
+    const cv::v_int32x4 pass = cv::v_select(horizontal, pass_h, cv::v_select(vertical, pass_v, pass_d));
+    const cv::v_int32x4 cand = pass & (m > vlow);
+    strong = cand & (m > vhigh);
+    value = one + cand - (strong + strong);  // masks are -1: kNone, kWeak, kStrong
+  }
+
+  /// The direction terms of the 8 pixels at xh (magnitudes ma, mb), and their suppression.
+  [[gnu::always_inline]] void half(int xh, const cv::v_int32x4& ma, const cv::v_int32x4& mb, cv::v_int32x4& value_a,
+                                   cv::v_int32x4& value_b, cv::v_int32x4& strong_a, cv::v_int32x4& strong_b) const {
+    const cv::v_int16x8 sx = cv::v_load(gx + xh);
+    const cv::v_int16x8 sy = cv::v_load(gy + xh);
+    const cv::v_int16x8 ax = cv::v_reinterpret_as_s16(cv::v_abs(sx));
+    const cv::v_int16x8 ay = cv::v_reinterpret_as_s16(cv::v_abs(sy));
+    cv::v_int16x8 z0;
+    cv::v_int16x8 z1;
+    cv::v_zip(ay + ay, ax, z0, z1);
+    cv::v_uint32x4 ax0;
+    cv::v_uint32x4 ax1;
+    cv::v_expand(cv::v_reinterpret_as_u16(ax), ax0, ax1);
+    cv::v_int32x4 neg0;  // dx ^ dy < 0: the diagonal is the anti-diagonal (s = -1)
+    cv::v_int32x4 neg1;
+    cv::v_expand((sx ^ sy) < zero16, neg0, neg1);
+    quad(xh, ma, cv::v_dotprod(z0, coef), cv::v_reinterpret_as_s32(ax0 << 16), neg0, value_a, strong_a);
+    quad(xh + 4, mb, cv::v_dotprod(z1, coef), cv::v_reinterpret_as_s32(ax1 << 16), neg1, value_b, strong_b);
+  }
+
+  /// The 16 pixels at x: their map values stored, the strong ones pushed; a block with no magnitude over
+  /// the low threshold is all kNone at once.
+  [[gnu::always_inline]] void block(int x, std::uint8_t* map, std::vector<std::uint8_t*>& stack) const {
     const cv::v_int32x4 m0 = cv::v_load(mc + x);
     const cv::v_int32x4 m1 = cv::v_load(mc + x + 4);
     const cv::v_int32x4 m2 = cv::v_load(mc + x + 8);
     const cv::v_int32x4 m3 = cv::v_load(mc + x + 12);
     if (!cv::v_check_any((m0 > vlow) | (m1 > vlow) | (m2 > vlow) | (m3 > vlow))) {
       cv::v_store(map + x, cv::v_setall_u8(kNone));
-      continue;
+      return;
     }
-    // Suppression of the 4 pixels at xq: dev = |dy| 2^15 - |dx| TG22, x16 = |dx| 2^16, neg =
-    // (dx ^ dy < 0); gives the map value and the strong mask (-1 / 0 per lane).
-    const auto quad = [&](int xq, const cv::v_int32x4& m, const cv::v_int32x4& dev, const cv::v_int32x4& x16,
-                          const cv::v_int32x4& neg, cv::v_int32x4& value, cv::v_int32x4& strong) {
-      const cv::v_int32x4 horizontal = dev < zero32;  // y < tg22x
-      const cv::v_int32x4 vertical = dev > x16;       // y > tg22x + (x << 16)
-      const cv::v_int32x4 up_l = cv::v_load(mp + xq - 1);
-      const cv::v_int32x4 up_r = cv::v_load(mp + xq + 1);
-      const cv::v_int32x4 dn_l = cv::v_load(mn + xq - 1);
-      const cv::v_int32x4 dn_r = cv::v_load(mn + xq + 1);
-      const cv::v_int32x4 pass_h = (m > cv::v_load(mc + xq - 1)) & ~(cv::v_load(mc + xq + 1) > m);  // m > l, m >= r
-      const cv::v_int32x4 pass_v = (m > cv::v_load(mp + xq)) & ~(cv::v_load(mn + xq) > m);
-      const cv::v_int32x4 pass_d = cv::v_select(neg, (m > up_r) & (m > dn_l), (m > up_l) & (m > dn_r));
-      const cv::v_int32x4 pass = cv::v_select(horizontal, pass_h, cv::v_select(vertical, pass_v, pass_d));
-      const cv::v_int32x4 cand = pass & (m > vlow);
-      strong = cand & (m > vhigh);
-      value = one + cand - (strong + strong);  // masks are -1: kNone, kWeak, kStrong
-    };
-    // The direction terms of the 8 pixels at xh, and their suppression.
-    const auto half = [&](int xh, const cv::v_int32x4& ma, const cv::v_int32x4& mb, cv::v_int32x4& value_a,
-                          cv::v_int32x4& value_b, cv::v_int32x4& strong_a, cv::v_int32x4& strong_b) {
-      const cv::v_int16x8 sx = cv::v_load(gx + xh);
-      const cv::v_int16x8 sy = cv::v_load(gy + xh);
-      const cv::v_int16x8 ax = cv::v_reinterpret_as_s16(cv::v_abs(sx));
-      const cv::v_int16x8 ay = cv::v_reinterpret_as_s16(cv::v_abs(sy));
-      cv::v_int16x8 z0;
-      cv::v_int16x8 z1;
-      cv::v_zip(ay + ay, ax, z0, z1);
-      cv::v_uint32x4 ax0;
-      cv::v_uint32x4 ax1;
-      cv::v_expand(cv::v_reinterpret_as_u16(ax), ax0, ax1);
-      cv::v_int32x4 neg0;  // dx ^ dy < 0: the diagonal is the anti-diagonal (s = -1)
-      cv::v_int32x4 neg1;
-      cv::v_expand((sx ^ sy) < zero16, neg0, neg1);
-      quad(xh, ma, cv::v_dotprod(z0, coef), cv::v_reinterpret_as_s32(ax0 << 16), neg0, value_a, strong_a);
-      quad(xh + 4, mb, cv::v_dotprod(z1, coef), cv::v_reinterpret_as_s32(ax1 << 16), neg1, value_b, strong_b);
-    };
     cv::v_int32x4 value[4];
     cv::v_int32x4 strong[4];
     half(x, m0, m1, value[0], value[1], strong[0], strong[1]);
@@ -450,8 +463,15 @@ void suppress_row(const std::int32_t* mp, const std::int32_t* mc, const std::int
     int bits = cv::v_signmask(cv::v_pack(cv::v_pack(strong[0], strong[1]), cv::v_pack(strong[2], strong[3])));
     for (; bits != 0; bits &= bits - 1) stack.push_back(map + x + std::countr_zero(static_cast<unsigned>(bits)));
   }
+};
 #endif
-  for (; x < n; ++x) {
+
+/// The scalar suppression of pixels x0 .. n-1 of a row (the ones the vectorised blocks leave, or all of
+/// them without SIMD), with the same inputs and result as suppress_row.
+[[gnu::always_inline]] inline void suppress_row_scalar(const std::int32_t* mp, const std::int32_t* mc, const std::int32_t* mn,
+                                                       const std::int16_t* gx, const std::int16_t* gy, int x0, int n, int low,
+                                                       int high, std::uint8_t* map, std::vector<std::uint8_t*>& stack) {
+  for (int x = x0; x < n; ++x) {
     const int m = mc[x];
     bool cand = false;
     if (m > low) {
@@ -478,6 +498,20 @@ void suppress_row(const std::int32_t* mp, const std::int32_t* mc, const std::int
       map[x] = kWeak;
     }
   }
+}
+
+/// One row of suppression: fills map[0 .. n-1] with kWeak / kNone / kStrong and pushes the strong
+/// pixels. mp, mc, mn: magnitudes of the previous, current and next row, each readable at -1 and n
+/// (zeros there). 16 pixels at a time with SIMD, the rest one by one.
+void suppress_row(const std::int32_t* mp, const std::int32_t* mc, const std::int32_t* mn, const std::int16_t* gx,
+                  const std::int16_t* gy, int n, int low, int high, std::uint8_t* map,
+                  std::vector<std::uint8_t*>& stack) {
+  int x = 0;
+#if CV_SIMD128
+  const SimdRowSuppressor simd(mp, mc, mn, gx, gy, low, high);
+  for (; x + 16 <= n; x += 16) simd.block(x, map, stack);
+#endif
+  suppress_row_scalar(mp, mc, mn, gx, gy, x, n, low, high, map, stack);
 }
 
 /// cv::Canny(dx, dy, edges, low_thresh, high_thresh, true) for CV_16SC1 derivatives and
@@ -560,11 +594,11 @@ cv::Mat canny_l2(const cv::Mat& dx, const cv::Mat& dy, double low_thresh, double
 
 EdgeMap detect_edges(const cv::Mat& grey, const EdgeParams& p) {
   if (grey.empty() || grey.type() != CV_8UC1) {
-    throw std::invalid_argument("detect_edges: expected a non-empty CV_8UC1 image");
+    throw hk::ArgumentError("detect_edges: expected a non-empty CV_8UC1 image");
   }
   for (const double v : {p.blur_sigma_px, p.canny_low, p.canny_high}) {
     if (!std::isfinite(v) || v < 0.0) {
-      throw std::invalid_argument("detect_edges: parameters must be finite and >= 0");
+      throw hk::ArgumentError("detect_edges: parameters must be finite and >= 0");
     }
   }
   thread_local Scratch scratch;

@@ -13,6 +13,7 @@
 
 #include "frame_sources.hpp"
 #include "input_error.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 
@@ -48,7 +49,7 @@ int parse_decimal(const std::string& text) {
 
 void check_params(const SourceSpec& spec, const FrameSourceParams& p) {
   const auto bad = [&](const std::string& what) {
-    throw std::invalid_argument("camera '" + hk::one_line(spec.str()) + "': " + what);
+    throw hk::ArgumentError("camera '" + hk::one_line(spec.str()) + "': " + what);
   };
   if (p.width_px < 64 || p.width_px > 8192) bad("width_px " + std::to_string(p.width_px) + " is outside [64, 8192]");
   if (p.height_px < 64 || p.height_px > 8192) bad("height_px " + std::to_string(p.height_px) + " is outside [64, 8192]");

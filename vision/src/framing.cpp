@@ -9,6 +9,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 namespace {
 
@@ -38,14 +40,14 @@ double largest_corner_move(const PageDetection& a, const PageDetection& b, doubl
 }
 
 void check(bool ok, const char* what) {
-  if (!ok) throw std::invalid_argument(std::string("framing: ") + what);
+  if (!ok) throw hk::ArgumentError(std::string("framing: ") + what);
 }
 
 }  // namespace
 
 FrameLook look_at_frame(const cv::Mat& frame, double t_s, const FrameLook* previous, cv::Mat& small, const PageParams& page) {
   if (frame.empty() || (frame.type() != CV_8UC3 && frame.type() != CV_8UC1)) {
-    throw std::invalid_argument("look_at_frame: the frame must be a non-empty CV_8UC3 or CV_8UC1 image");
+    throw hk::ArgumentError("look_at_frame: the frame must be a non-empty CV_8UC3 or CV_8UC1 image");
   }
   FrameLook look;
   look.t_s = t_s;

@@ -1,4 +1,4 @@
-// Closing small gaps in outlines (issue 15, item 3): close_gaps, in three phases (candidates, greedy joins,
+// Closing small gaps in outlines: close_gaps, in three phases (candidates, greedy joins,
 // walks), see gaps.hpp.
 #include "vision/gaps.hpp"
 
@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -28,19 +30,19 @@ double end_value(const PointValues& values, int end) {
 
 void check_input(const std::vector<Chain>& chains, const GapParams& p, const PointValues& values) {
   if (!std::isfinite(p.max_gap_px) || p.max_gap_px < 0.0)
-    throw std::invalid_argument("close_gaps: max_gap_px must be finite and >= 0, got " + std::to_string(p.max_gap_px));
+    throw hk::ArgumentError("close_gaps: max_gap_px must be finite and >= 0, got " + std::to_string(p.max_gap_px));
   if (!(p.max_turn_deg > 0.0 && p.max_turn_deg <= 90.0))
-    throw std::invalid_argument("close_gaps: max_turn_deg must be in (0, 90], got " + std::to_string(p.max_turn_deg));
+    throw hk::ArgumentError("close_gaps: max_turn_deg must be in (0, 90], got " + std::to_string(p.max_turn_deg));
   if (!(p.direction_span_px > 0.0) || !std::isfinite(p.direction_span_px))
-    throw std::invalid_argument("close_gaps: direction_span_px must be finite and > 0");
+    throw hk::ArgumentError("close_gaps: direction_span_px must be finite and > 0");
   if (!(p.min_piece_px >= 0.0) || !std::isfinite(p.min_piece_px))
-    throw std::invalid_argument("close_gaps: min_piece_px must be finite and >= 0");
+    throw hk::ArgumentError("close_gaps: min_piece_px must be finite and >= 0");
   for (const Chain& c : chains)
-    if (c.points_px.empty()) throw std::invalid_argument("close_gaps: a chain has no point");
+    if (c.points_px.empty()) throw hk::ArgumentError("close_gaps: a chain has no point");
   if (values.empty()) return;
-  if (values.size() != chains.size()) throw std::invalid_argument("close_gaps: values must have one entry per chain");
+  if (values.size() != chains.size()) throw hk::ArgumentError("close_gaps: values must have one entry per chain");
   for (std::size_t k = 0; k < chains.size(); ++k)
-    if (values[k].size() != chains[k].points_px.size()) throw std::invalid_argument("close_gaps: values must have one value per chain point");
+    if (values[k].size() != chains[k].points_px.size()) throw hk::ArgumentError("close_gaps: values must have one value per chain point");
 }
 
 /// A possible join: its gap [px], how far it turns from the ends' directions (the larger of the two) and

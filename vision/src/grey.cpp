@@ -10,18 +10,19 @@
 #include <opencv2/imgproc.hpp>
 
 #include "vision/intake.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 
 cv::Mat to_grey(const cv::Mat& bgr, int max_side_px, double* px_scale_out) {
-  if (bgr.empty()) throw std::invalid_argument("to_grey: empty image");
-  if (max_side_px < 1) throw std::invalid_argument("to_grey: max_side_px must be >= 1");
+  if (bgr.empty()) throw hk::ArgumentError("to_grey: empty image");
+  if (max_side_px < 1) throw hk::ArgumentError("to_grey: max_side_px must be >= 1");
   cv::Mat grey;
   switch (bgr.type()) {
     case CV_8UC3: cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY); break;
     case CV_8UC4: cv::cvtColor(bgr, grey, cv::COLOR_BGRA2GRAY); break;
     case CV_8UC1: grey = bgr.clone(); break;
-    default: throw std::invalid_argument("to_grey: expected CV_8UC3, CV_8UC4 or CV_8UC1");
+    default: throw hk::ArgumentError("to_grey: expected CV_8UC3, CV_8UC4 or CV_8UC1");
   }
   const int long_side = std::max(grey.cols, grey.rows);
   if (long_side <= max_side_px) {

@@ -16,6 +16,7 @@
 
 #include "image_header_detail.hpp"
 #include "input_error.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -84,13 +85,13 @@ cv::Mat composite_over_white(const cv::Mat& bgra) {
 cv::Mat load_image(const std::string& path, const ImageLimits& limits) {
   if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
       limits.max_pixels <= 0) {
-    throw std::invalid_argument("load_image: every ImageLimits field must be positive");
+    throw hk::ArgumentError("load_image: every ImageLimits field must be positive");
   }
   return decode_image(read_input_file(path, limits.max_file_bytes), path, limits);
 }
 
 std::vector<std::uint8_t> read_input_file(const std::string& path, std::int64_t max_bytes) {
-  if (max_bytes <= 0) throw std::invalid_argument("read_input_file: max_bytes must be positive");
+  if (max_bytes <= 0) throw hk::ArgumentError("read_input_file: max_bytes must be positive");
   const std::uint64_t size = detail::checked_file_size(path);
   if (size > static_cast<std::uint64_t>(max_bytes)) {
     detail::throw_input_error(path, "file size " + std::to_string(size) + " bytes exceeds the limit of " + std::to_string(max_bytes) + " bytes");
@@ -101,7 +102,7 @@ std::vector<std::uint8_t> read_input_file(const std::string& path, std::int64_t 
 cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits) {
   if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
       limits.max_pixels <= 0) {
-    throw std::invalid_argument("decode_image: every ImageLimits field must be positive");
+    throw hk::ArgumentError("decode_image: every ImageLimits field must be positive");
   }
   if (bytes.empty()) detail::throw_input_error(path, "empty file (0 bytes)");
   if (bytes.size() > static_cast<std::uint64_t>(limits.max_file_bytes)) {

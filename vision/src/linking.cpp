@@ -36,6 +36,8 @@
 
 #include <opencv2/core/hal/intrin.hpp>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 namespace {
 
@@ -567,10 +569,10 @@ double chain_length_px(const Chain& chain) {
 
 std::vector<Chain> link_edges(const cv::Mat& edges, double min_length_px) {
   if (std::isnan(min_length_px) || min_length_px < 0.0) {
-    throw std::invalid_argument("link_edges: min_length_px must be >= 0");
+    throw hk::ArgumentError("link_edges: min_length_px must be >= 0");
   }
   if (edges.empty()) return {};
-  if (edges.type() != CV_8UC1) throw std::invalid_argument("link_edges: expected a CV_8UC1 edge map");
+  if (edges.type() != CV_8UC1) throw hk::ArgumentError("link_edges: expected a CV_8UC1 edge map");
   thread_local Linker linker;
   return linker.link(edges, min_length_px);
 }

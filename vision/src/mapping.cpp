@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 
 double PxToM::x_m(double u) const { return offset_x_m + scale_m_per_px * u; }
@@ -15,10 +17,10 @@ double PxToM::v_px(double y) const { return (offset_y_m - y) / scale_m_per_px; }
 
 PxToM fit_to_workspace(int width_px, int height_px, double width_m, double height_m) {
   if (width_px <= 0 || height_px <= 0) {
-    throw std::invalid_argument("fit_to_workspace: image size must be positive");
+    throw hk::ArgumentError("fit_to_workspace: image size must be positive");
   }
   if (!(std::isfinite(width_m) && std::isfinite(height_m) && width_m > 0.0 && height_m > 0.0)) {
-    throw std::invalid_argument("fit_to_workspace: workspace size must be positive and finite");
+    throw hk::ArgumentError("fit_to_workspace: workspace size must be positive and finite");
   }
   const double scale = std::min(width_m / width_px, height_m / height_px);
   // Centre pixel ((w - 1) / 2, (h - 1) / 2) -> (0, 0).

@@ -15,6 +15,7 @@
 #include "hk/text.hpp"
 #include "ocr_wire.hpp"
 #include "worker_process.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -48,10 +49,10 @@ constexpr std::size_t kMaxAnswerBytes = 64u << 20;
 }
 
 void check_params(const cv::Mat& grey, const OcrParams& p) {
-  if (grey.empty() || grey.type() != CV_8UC1) throw std::invalid_argument("recognise_text: the picture must be a non-empty CV_8UC1 image");
+  if (grey.empty() || grey.type() != CV_8UC1) throw hk::ArgumentError("recognise_text: the picture must be a non-empty CV_8UC1 image");
   if (!(p.max_pixels > 0 && p.worker_cpu_s > 0 && p.worker_wall_s > 0 && p.worker_max_memory_mb >= 0 && p.min_word_confidence >= 0 &&
         p.min_word_confidence <= 1 && p.min_letter_share >= 0 && p.min_letter_share <= 1)) {
-    throw std::invalid_argument("OcrParams: limits must be positive and shares within [0, 1]");
+    throw hk::ArgumentError("OcrParams: limits must be positive and shares within [0, 1]");
   }
 }
 

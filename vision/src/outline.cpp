@@ -1,4 +1,4 @@
-// Two-tone pictures traced from a threshold (issue 15): classify_two_tone and trace_outlines.
+// Two-tone pictures traced from a threshold: classify_two_tone and trace_outlines.
 #include "vision/outline.hpp"
 
 #include <algorithm>
@@ -7,11 +7,13 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 namespace {
 
 void check_grey(const cv::Mat& grey, const char* who) {
-  if (grey.empty() || grey.type() != CV_8UC1) throw std::invalid_argument(std::string(who) + ": the image must be CV_8UC1 and not empty");
+  if (grey.empty() || grey.type() != CV_8UC1) throw hk::ArgumentError(std::string(who) + ": the image must be CV_8UC1 and not empty");
 }
 
 bool on_frame(const cv::Point& p, int w, int h) { return p.x == 0 || p.y == 0 || p.x == w - 1 || p.y == h - 1; }
@@ -122,7 +124,7 @@ TwoTone classify_two_tone(const cv::Mat& grey) {
 
 std::vector<Chain> trace_outlines(const cv::Mat& grey, double threshold, int min_points) {
   check_grey(grey, "trace_outlines");
-  if (min_points < 1) throw std::invalid_argument("trace_outlines: min_points must be >= 1");
+  if (min_points < 1) throw hk::ArgumentError("trace_outlines: min_points must be >= 1");
   const cv::Mat fg = foreground(grey, threshold);
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(fg, contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);

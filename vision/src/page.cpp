@@ -1,4 +1,4 @@
-// Pages made flat (issue 16, item 2): find the page in a camera frame, its aspect ratio, the warp flat.
+// Pages made flat: find the page in a camera frame, its aspect ratio, the warp flat.
 // See vision/page.hpp for the contract; the steps are described at each function below.
 
 #include "vision/page.hpp"
@@ -12,6 +12,8 @@
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
+
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -688,9 +690,9 @@ double quick_support(const Gradient& grad, const Candidate& c, double min_grad) 
 
 void check_params(const PageParams& p) {
   if (!(p.min_area_fraction > 0.0 && p.min_area_fraction < 1.0))
-    throw std::invalid_argument("find_page: min_area_fraction must be in (0, 1)");
-  if (!(p.min_contrast >= 0.0 && p.min_contrast <= 255.0)) throw std::invalid_argument("find_page: min_contrast must be in [0, 255]");
-  if (p.max_side_px < 64) throw std::invalid_argument("find_page: max_side_px must be at least 64");
+    throw hk::ArgumentError("find_page: min_area_fraction must be in (0, 1)");
+  if (!(p.min_contrast >= 0.0 && p.min_contrast <= 255.0)) throw hk::ArgumentError("find_page: min_contrast must be in [0, 255]");
+  if (p.max_side_px < 64) throw hk::ArgumentError("find_page: max_side_px must be at least 64");
 }
 
 /// The frame being searched, and how the downscaled copy maps onto it.
@@ -1091,9 +1093,9 @@ PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap,
 }  // namespace
 
 PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
-  if (frame.empty()) throw std::invalid_argument("find_page: empty frame");
+  if (frame.empty()) throw hk::ArgumentError("find_page: empty frame");
   if (frame.type() != CV_8UC3 && frame.type() != CV_8UC1)
-    throw std::invalid_argument("find_page: the frame must be CV_8UC3 (BGR) or CV_8UC1 (grey)");
+    throw hk::ArgumentError("find_page: the frame must be CV_8UC3 (BGR) or CV_8UC1 (grey)");
   check_params(params);
   Frame f{frame, {}, 1.0, 1.0, 1.0, 0.01 * std::hypot(frame.cols, frame.rows), 3.0, static_cast<double>(frame.cols) * frame.rows};
   if (frame.channels() == 3) cv::cvtColor(frame, f.grey, cv::COLOR_BGR2GRAY);
@@ -1155,11 +1157,11 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
 
 double page_aspect_ratio(const std::array<cv::Point2d, 4>& corners_px, cv::Point2d centre_px) {
   for (const cv::Point2d& p : corners_px)
-    if (!finite(p)) throw std::invalid_argument("page_aspect_ratio: corners must be finite");
-  if (!finite(centre_px)) throw std::invalid_argument("page_aspect_ratio: the centre must be finite");
+    if (!finite(p)) throw hk::ArgumentError("page_aspect_ratio: corners must be finite");
+  if (!finite(centre_px)) throw hk::ArgumentError("page_aspect_ratio: the centre must be finite");
   const cv::Point2d tl = corners_px[0], tr = corners_px[1], br = corners_px[2], bl = corners_px[3];
   const double across = cv::norm(tr - tl) + cv::norm(br - bl), down = cv::norm(bl - tl) + cv::norm(br - tr);
-  if (!(down > 0.0) || !(across > 0.0)) throw std::invalid_argument("page_aspect_ratio: degenerate quadrilateral");
+  if (!(down > 0.0) || !(across > 0.0)) throw hk::ArgumentError("page_aspect_ratio: degenerate quadrilateral");
   const double mean_sides = across / down;
   // Zhang & He's m1..m4 are the rectangle's (0,0), (w,0), (0,h), (w,h): top-left, top-right, bottom-left,
   // bottom-right. Coordinates relative to the principal point, so u0 = v0 = 0 below.
@@ -1181,14 +1183,14 @@ double page_aspect_ratio(const std::array<cv::Point2d, 4>& corners_px, cv::Point
 }
 
 cv::Mat rectify_page(const cv::Mat& frame, const std::array<cv::Point2d, 4>& corners_px) {
-  if (frame.empty()) throw std::invalid_argument("rectify_page: empty frame");
+  if (frame.empty()) throw hk::ArgumentError("rectify_page: empty frame");
   for (const cv::Point2d& p : corners_px)
-    if (!finite(p)) throw std::invalid_argument("rectify_page: corners must be finite");
-  if (std::abs(signed_area(corners_px)) < 1.0) throw std::invalid_argument("rectify_page: degenerate quadrilateral (area < 1 px²)");
+    if (!finite(p)) throw hk::ArgumentError("rectify_page: corners must be finite");
+  if (std::abs(signed_area(corners_px)) < 1.0) throw hk::ArgumentError("rectify_page: degenerate quadrilateral (area < 1 px²)");
   double longest = 0.0;
   for (std::size_t i = 0; i < 4; ++i) longest = std::max(longest, cv::norm(corners_px[(i + 1) % 4] - corners_px[i]));
   const double diag = std::hypot(frame.cols, frame.rows);
-  if (longest > 4.0 * diag) throw std::invalid_argument("rectify_page: a side is longer than 4 times the frame's diagonal");
+  if (longest > 4.0 * diag) throw hk::ArgumentError("rectify_page: a side is longer than 4 times the frame's diagonal");
   const double ratio = page_aspect_ratio(corners_px, {(frame.cols - 1) / 2.0, (frame.rows - 1) / 2.0});
   const double w = ratio >= 1.0 ? longest : longest * ratio, h = ratio >= 1.0 ? longest / ratio : longest;
   const int W = std::max(1, static_cast<int>(std::lround(w))), H = std::max(1, static_cast<int>(std::lround(h)));

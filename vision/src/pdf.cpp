@@ -58,6 +58,7 @@
 
 #include "input_error.hpp"
 #include "worker_process.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -132,55 +133,63 @@ cv::Mat render_grey(const poppler::page& pg, double dpi) {
   return {};
 }
 
-/// The worker's work: an answer in `out`, or a Refusal thrown.
-void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits, Writer& out) {
-  std::unique_ptr<poppler::document> doc(
-      poppler::document::load_from_raw_data(reinterpret_cast<const char*>(bytes.data()), static_cast<int>(bytes.size())));
-  if (!doc) throw Refusal{PdfError::Kind::Damaged, "poppler cannot read it (damaged or not a PDF)"};
-  if (doc->is_locked()) throw Refusal{PdfError::Kind::Locked, "protected by a password"};
-  const int n = doc->pages();
-  if (n <= 0) throw Refusal{PdfError::Kind::Damaged, "the document has no pages"};
-  const int offered = std::min(n, limits.max_pages);
-  const auto title = [&] {
-    const poppler::byte_array utf8 = doc->get_title().to_utf8();
-    std::string t(utf8.begin(), utf8.end());
-    while (!t.empty() && t.back() == '\0') t.pop_back();
-    return t.size() <= kMaxPdfTitleBytes ? t : std::string();  // a "title" that long is no title
-  };
-  if (page == 0) {  // probe
-    out.i32(n);
-    out.str(title());
-    return;
+/// The document's title (UTF-8, trailing NULs dropped), or "" when it is longer than kMaxPdfTitleBytes (a
+/// "title" that long is no title).
+std::string pdf_title(const poppler::document& doc) {
+  const poppler::byte_array utf8 = doc.get_title().to_utf8();
+  std::string t(utf8.begin(), utf8.end());
+  while (!t.empty() && t.back() == '\0') t.pop_back();
+  return t.size() <= kMaxPdfTitleBytes ? t : std::string();
+}
+
+/// Refuses (NoSuchPage) a page number past the `offered` first of the document's n pages, saying which.
+void check_page_number(int page, int n, int offered) {
+  if (page <= offered) return;
+  if (offered < n) {
+    throw Refusal{PdfError::Kind::NoSuchPage, "page " + std::to_string(page) + " is beyond the first " + std::to_string(offered) +
+                                                  " pages offered (the document has " + std::to_string(n) + ")"};
   }
-  if (page > offered) {
-    if (offered < n) {
-      throw Refusal{PdfError::Kind::NoSuchPage, "page " + std::to_string(page) + " is beyond the first " + std::to_string(offered) +
-                                                    " pages offered (the document has " + std::to_string(n) + ")"};
-    }
-    throw Refusal{PdfError::Kind::NoSuchPage, "page " + std::to_string(page) + " does not exist (the document has " + std::to_string(n) +
-                                                  (n == 1 ? " page)" : " pages)")};
-  }
-  const std::unique_ptr<poppler::page> pg(doc->create_page(page - 1));
-  const std::string pname = "page " + std::to_string(page);
-  if (!pg) throw Refusal{PdfError::Kind::Damaged, pname + " cannot be read"};
-  const poppler::rectf r = pg->page_rect(poppler::crop_box);
+  throw Refusal{PdfError::Kind::NoSuchPage, "page " + std::to_string(page) + " does not exist (the document has " + std::to_string(n) +
+                                                (n == 1 ? " page)" : " pages)")};
+}
+
+/// A page's size as it is shown [pt]: its crop box, turned for landscape and seascape pages.
+struct PageSize {
+  double w_pt = 0, h_pt = 0;
+};
+
+/// The page's size (PageSize), refused as Damaged when it is not a usable size (under 1e-3 pt or not finite).
+PageSize page_size(const poppler::page& pg, const std::string& pname) {
+  const poppler::rectf r = pg.page_rect(poppler::crop_box);
   double w_pt = std::abs(r.width()), h_pt = std::abs(r.height());
-  const auto orient = pg->orientation();
+  const auto orient = pg.orientation();
   if (orient == poppler::page::landscape || orient == poppler::page::seascape) std::swap(w_pt, h_pt);
   if (!(w_pt >= 1e-3 && h_pt >= 1e-3 && std::isfinite(w_pt * h_pt))) {
     throw Refusal{PdfError::Kind::Damaged, pname + " has no usable size (" + fmt_num(w_pt) + " x " + fmt_num(h_pt) + " pt)"};
   }
-  const double dpi = dpi_for(w_pt, h_pt, limits);
+  return {w_pt, h_pt};
+}
+
+/// The resolution to draw the page at (dpi_for), refused as TooLarge when even 1 dpi would exceed the
+/// pixel budget.
+double page_dpi(PageSize size, const PdfLimits& limits, const std::string& pname) {
+  const double dpi = dpi_for(size.w_pt, size.h_pt, limits);
   if (!(dpi >= 1.0)) {
     char buf[200];
-    std::snprintf(buf, sizeof buf, "%s: page size %g x %g pt would need %.2g dpi to stay within %.0f pixels", pname.c_str(), w_pt, h_pt, dpi,
-                  limits.max_page_pixels);
+    std::snprintf(buf, sizeof buf, "%s: page size %g x %g pt would need %.2g dpi to stay within %.0f pixels", pname.c_str(), size.w_pt,
+                  size.h_pt, dpi, limits.max_page_pixels);
     throw Refusal{PdfError::Kind::TooLarge, buf};
   }
-  const cv::Mat grey = render_grey(*pg, dpi);
+  return dpi;
+}
+
+/// The page drawn in grey at `dpi`, checked: refused as Damaged when not drawn, as TooLarge when poppler
+/// returned another size than asked (Splash answers a failed bitmap allocation under RLIMIT_AS with a
+/// 1 x 1 picture) or more pixels than the budget.
+cv::Mat render_checked(const poppler::page& pg, PageSize size, double dpi, const PdfLimits& limits, const std::string& pname) {
+  const cv::Mat grey = render_grey(pg, dpi);
   if (grey.empty()) throw Refusal{PdfError::Kind::Damaged, pname + " could not be drawn"};
-  // Splash answers a failed bitmap allocation (RLIMIT_AS) with a 1 x 1 picture: check the size.
-  const double want_w = w_pt * dpi / 72.0, want_h = h_pt * dpi / 72.0;
+  const double want_w = size.w_pt * dpi / 72.0, want_h = size.h_pt * dpi / 72.0;
   if (std::abs(grey.cols - want_w) > 2.0 || std::abs(grey.rows - want_h) > 2.0) {
     char buf[200];
     std::snprintf(buf, sizeof buf, "%s could not be drawn at %.0f x %.0f px (poppler returned %d x %d; out of memory?)", pname.c_str(), want_w,
@@ -191,21 +200,16 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
     throw Refusal{PdfError::Kind::TooLarge, pname + " came out " + std::to_string(grey.cols) + " x " + std::to_string(grey.rows) +
                                                 " px, over the budget of " + fmt_num(limits.max_page_pixels) + " pixels"};
   }
+  return grey;
+}
 
-  out.i32(n);
-  out.str(title());
-  out.f64(w_pt);
-  out.f64(h_pt);
-  out.f64(dpi);
-  out.i32(grey.cols);
-  out.i32(grey.rows);
-  for (int y = 0; y < grey.rows; ++y) out.raw(grey.ptr(y), static_cast<std::size_t>(grey.cols));
-
-  const double k = dpi / 72.0;
-  const cv::Rect2d frame(0, 0, grey.cols, grey.rows);
+/// Writes the page's words to `out`: their count, then each word's text (at most kMaxWordBytes), box in
+/// the drawn page's pixels (pt × k, clipped to `frame`; words with nothing visible dropped) and whether a
+/// space follows it; at most kMaxWords words and about kMaxTextBytes bytes.
+void write_words(const poppler::page& pg, double k, const cv::Rect2d& frame, Writer& out) {
   Writer words;
   std::uint32_t count = 0;
-  for (const poppler::text_box& tb : pg->text_list()) {
+  for (const poppler::text_box& tb : pg.text_list()) {
     if (count >= kMaxWords || words.bytes().size() > kMaxTextBytes) break;
     const poppler::byte_array utf8 = tb.text().to_utf8();
     std::string text(utf8.begin(), utf8.end());
@@ -225,6 +229,39 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   }
   out.u32(count);
   out.raw(words.bytes().data(), words.bytes().size());
+}
+
+/// The worker's work: an answer in `out` (page 0: the page count and title; else those, the page's size
+/// [pt], dpi, grey picture and words), or a Refusal thrown.
+void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits, Writer& out) {
+  std::unique_ptr<poppler::document> doc(
+      poppler::document::load_from_raw_data(reinterpret_cast<const char*>(bytes.data()), static_cast<int>(bytes.size())));
+  if (!doc) throw Refusal{PdfError::Kind::Damaged, "poppler cannot read it (damaged or not a PDF)"};
+  if (doc->is_locked()) throw Refusal{PdfError::Kind::Locked, "protected by a password"};
+  const int n = doc->pages();
+  if (n <= 0) throw Refusal{PdfError::Kind::Damaged, "the document has no pages"};
+  if (page == 0) {  // probe
+    out.i32(n);
+    out.str(pdf_title(*doc));
+    return;
+  }
+  check_page_number(page, n, std::min(n, limits.max_pages));
+  const std::unique_ptr<poppler::page> pg(doc->create_page(page - 1));
+  const std::string pname = "page " + std::to_string(page);
+  if (!pg) throw Refusal{PdfError::Kind::Damaged, pname + " cannot be read"};
+  const PageSize size = page_size(*pg, pname);
+  const double dpi = page_dpi(size, limits, pname);
+  const cv::Mat grey = render_checked(*pg, size, dpi, limits, pname);
+
+  out.i32(n);
+  out.str(pdf_title(*doc));
+  out.f64(size.w_pt);
+  out.f64(size.h_pt);
+  out.f64(dpi);
+  out.i32(grey.cols);
+  out.i32(grey.rows);
+  for (int y = 0; y < grey.rows; ++y) out.raw(grey.ptr(y), static_cast<std::size_t>(grey.cols));
+  write_words(*pg, dpi / 72.0, cv::Rect2d(0, 0, grey.cols, grey.rows), out);
 }
 
 /// Everything the worker does once its document is mapped; never returns.
@@ -298,7 +335,7 @@ std::string doing(int page) { return page == 0 ? "opening the document" : "page 
 void check_input(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits) {
   if (!(limits.max_file_bytes > 0 && limits.max_pages > 0 && limits.max_page_pixels > 0 && limits.max_dpi > 0 && limits.worker_cpu_s > 0 &&
         limits.worker_wall_s > 0 && limits.worker_max_memory_mb >= 0)) {
-    throw std::invalid_argument("PdfLimits: every limit must be positive");
+    throw hk::ArgumentError("PdfLimits: every limit must be positive");
   }
   if (bytes.empty()) fail(PdfError::Kind::NotPdf, name, "the file is empty");
   if (!looks_like_pdf(bytes)) fail(PdfError::Kind::NotPdf, name, "not a PDF (no %PDF- header)");
@@ -416,19 +453,19 @@ PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& 
 
 namespace {
 
+/// A line of text: its words and its box [px].
 struct Line {
   std::vector<std::size_t> words;  // indices, left to right
   double left = 0, top = 0, right = 0, bottom = 0;
   double height() const { return bottom - top; }
 };
 
+/// How much the intervals [a0, a1] and [b0, b1] overlap (negative: the gap between them).
 double overlap(double a0, double a1, double b0, double b1) { return std::min(a1, b1) - std::max(a0, b0); }
 
-}  // namespace
-
-std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words) {
-  // Words -> lines: words taken left to right, each joins the open line it overlaps most vertically when
-  // the gap from that line's last word is under 1.5 line heights (a small overlap counts as no gap).
+/// Words -> lines: words taken left to right, each joins the open line it overlaps most vertically when
+/// the gap from that line's last word is under 1.5 line heights (a small overlap counts as no gap).
+std::vector<Line> words_to_lines(const std::vector<PdfWord>& words) {
   std::vector<std::size_t> order(words.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return words[a].box_px.x < words[b].box_px.x; });
@@ -458,13 +495,18 @@ std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words) {
       lines.push_back(Line{{i}, b.x, b.y, b.x + b.width, b.y + b.height});
     }
   }
+  return lines;
+}
 
-  // Lines -> blocks: lines taken top to bottom; each joins the block whose last line is closest above it
-  // when the gap is under one line height, the heights differ by less than 1.5x and they overlap horizontally.
+/// A block of text: indices of its lines, top to bottom.
+struct Block {
+  std::vector<std::size_t> lines;
+};
+
+/// Lines -> blocks: sorts the lines top to bottom; each joins the block whose last line is closest above it
+/// when the gap is under one line height, the heights differ by less than 1.5x and they overlap horizontally.
+std::vector<Block> lines_to_blocks(std::vector<Line>& lines) {
   std::stable_sort(lines.begin(), lines.end(), [](const Line& a, const Line& b) { return a.top != b.top ? a.top < b.top : a.left < b.left; });
-  struct Block {
-    std::vector<std::size_t> lines;
-  };
   std::vector<Block> blocks;
   for (std::size_t li = 0; li < lines.size(); ++li) {
     const Line& l = lines[li];
@@ -488,7 +530,12 @@ std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words) {
       blocks.push_back(Block{{li}});
     }
   }
+  return blocks;
+}
 
+/// Each block's text (its words joined by spaces, except where poppler glued two words that touch), box
+/// (the union of its words' boxes, px) and line count.
+std::vector<TextBlock> block_texts(const std::vector<PdfWord>& words, const std::vector<Line>& lines, const std::vector<Block>& blocks) {
   std::vector<TextBlock> out;
   out.reserve(blocks.size());
   for (const Block& blk : blocks) {
@@ -510,8 +557,12 @@ std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words) {
     tb.lines = static_cast<int>(blk.lines.size());
     out.push_back(std::move(tb));
   }
-  // Reading order: top to bottom; blocks whose tops lie within half a line of the row's first block form a
-  // row, read left to right.
+  return out;
+}
+
+/// Sorts blocks into reading order: top to bottom; blocks whose tops lie within half a line of the row's
+/// first block form a row, read left to right.
+void sort_reading_order(std::vector<TextBlock>& out) {
   std::stable_sort(out.begin(), out.end(), [](const TextBlock& a, const TextBlock& b) { return a.box_px.y < b.box_px.y; });
   for (std::size_t row = 0; row < out.size();) {
     const double tol = 0.5 * out[row].box_px.height / std::max(out[row].lines, 1);
@@ -521,6 +572,15 @@ std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words) {
                      [](const TextBlock& a, const TextBlock& b) { return a.box_px.x < b.box_px.x; });
     row = end;
   }
+}
+
+}  // namespace
+
+std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words) {
+  std::vector<Line> lines = words_to_lines(words);
+  const std::vector<Block> blocks = lines_to_blocks(lines);
+  std::vector<TextBlock> out = block_texts(words, lines, blocks);
+  sort_reading_order(out);
   return out;
 }
 

@@ -5,6 +5,7 @@
 
 #include "vision/mapping.hpp"
 #include "vision/texture.hpp"
+#include "hk/error.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -74,22 +75,22 @@ const char* detector_name(Detector d) {
 Detector detector_from_name(const std::string& name) {
   for (Detector d : {Detector::Auto, Detector::Canny, Detector::Surround, Detector::Bilateral, Detector::Edpf, Detector::Outline})
     if (name == detector_name(d)) return d;
-  throw std::invalid_argument("detector '" + name + "' is not one of auto, canny, surround, bilateral, edpf, outline");
+  throw hk::ArgumentError("detector '" + name + "' is not one of auto, canny, surround, bilateral, edpf, outline");
 }
 
 namespace {
 
 void check_params(const ExtractParams& p) {
-  if (p.max_image_side_px < 1) throw std::invalid_argument("extract_chains: max_image_side_px must be >= 1");
+  if (p.max_image_side_px < 1) throw hk::ArgumentError("extract_chains: max_image_side_px must be >= 1");
   if (std::isnan(p.min_chain_length_px) || p.min_chain_length_px < 0.0) {
-    throw std::invalid_argument("extract_chains: min_chain_length_px must be >= 0");
+    throw hk::ArgumentError("extract_chains: min_chain_length_px must be >= 0");
   }
   if (!std::isfinite(p.surround_inhibition) || p.surround_inhibition < 0.0)
-    throw std::invalid_argument("extract_chains: surround_inhibition must be finite and >= 0");
+    throw hk::ArgumentError("extract_chains: surround_inhibition must be finite and >= 0");
   if (!std::isfinite(p.line_drawing_max_ink_m) || p.line_drawing_max_ink_m < 0.0)
-    throw std::invalid_argument("extract_chains: line_drawing_max_ink_m must be finite and >= 0");
+    throw hk::ArgumentError("extract_chains: line_drawing_max_ink_m must be finite and >= 0");
   if (!(p.workspace_width_m > 0.0) || !(p.workspace_height_m > 0.0) || !std::isfinite(p.workspace_width_m) || !std::isfinite(p.workspace_height_m))
-    throw std::invalid_argument("extract_chains: the workspace must be finite and > 0");
+    throw hk::ArgumentError("extract_chains: the workspace must be finite and > 0");
 }
 
 /// The ignore mask at the processed size: area-averaged, so any coverage of a processed pixel counts (nonzero).
@@ -277,9 +278,9 @@ Extraction extract_chains(const std::string& path, const ExtractParams& p) {
 
 Extraction extract_chains_from_image(const cv::Mat& image, const ExtractParams& p, const cv::Mat& ignore_mask) {
   check_params(p);
-  if (image.empty()) throw std::invalid_argument("extract_chains_from_image: the image is empty");
+  if (image.empty()) throw hk::ArgumentError("extract_chains_from_image: the image is empty");
   if (!ignore_mask.empty() && (ignore_mask.type() != CV_8UC1 || ignore_mask.size() != image.size())) {
-    throw std::invalid_argument("extract_chains_from_image: ignore_mask must be CV_8UC1 of the image's size");
+    throw hk::ArgumentError("extract_chains_from_image: ignore_mask must be CV_8UC1 of the image's size");
   }
   Extraction out{};
   const auto t0 = std::chrono::steady_clock::now();

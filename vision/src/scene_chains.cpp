@@ -12,6 +12,7 @@
 
 #include "vision/gaps.hpp"
 #include "vision/thin_lines.hpp"
+#include "hk/error.hpp"
 
 namespace hk::vision {
 
@@ -112,10 +113,10 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 void check(const SimplifyParams& p) {
   for (const double v : {p.workspace_width_m, p.workspace_height_m})
-    if (!std::isfinite(v) || v <= 0.0) throw std::invalid_argument("simplify_chains: the workspace must be finite and > 0");
+    if (!std::isfinite(v) || v <= 0.0) throw hk::ArgumentError("simplify_chains: the workspace must be finite and > 0");
   for (const double v : {p.thin_line_max_width_m, p.gap_close_m, p.min_chain_length_m})
-    if (!std::isfinite(v) || v < 0.0) throw std::invalid_argument("simplify_chains: lengths must be finite and >= 0");
-  if (p.max_shapes < 1 || p.max_segments < 1) throw std::invalid_argument("simplify_chains: max_shapes and max_segments must be >= 1");
+    if (!std::isfinite(v) || v < 0.0) throw hk::ArgumentError("simplify_chains: lengths must be finite and >= 0");
+  if (p.max_shapes < 1 || p.max_segments < 1) throw hk::ArgumentError("simplify_chains: max_shapes and max_segments must be >= 1");
 }
 
 /// The chains and their strengths between the stages.
@@ -124,7 +125,7 @@ struct Work {
   PointValues strength;
 };
 
-/// Step 1 (issue 6, item 4): the two edges of a stroke thinner than a fingertip can resolve become its centre
+/// Step 1: the two edges of a stroke thinner than a fingertip can resolve become its centre
 /// line. Merged at the resolution the edges were found at (extract_chains returns original pixels; the
 /// inverse of its scale-back is exact), where the chains are 8-connected pixel walks.
 void merge_strokes(Work& w, const Extraction& ex, const PxToM& map, const SimplifyParams& p, SimplifyReport& r) {
@@ -145,7 +146,7 @@ void merge_strokes(Work& w, const Extraction& ex, const PxToM& map, const Simpli
   r.thin_lines_ms = ms_since(t0);
 }
 
-/// Step 2 (issue 15, item 3): chain ends facing each other across at most gap_close_m are joined, so outlines
+/// Step 2: chain ends facing each other across at most gap_close_m are joined, so outlines
 /// Canny broke at a highlight or a notch are felt closed.
 void join_gaps(Work& w, const Extraction& ex, const PxToM& map, const SimplifyParams& p, SimplifyReport& r) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -166,7 +167,7 @@ void join_gaps(Work& w, const Extraction& ex, const PxToM& map, const SimplifyPa
   r.gaps_ms = ms_since(t0);
 }
 
-/// Step 4 (issue 6, item 4; issue 15, item 2): curves along the picture's frame dropped; the rest taken in
+/// Step 4: curves along the picture's frame dropped; the rest taken in
 /// decreasing shape_salience (ties: picture order), each kept while fewer than max_shapes are and its
 /// segments still fit max_segments (a less salient one further down may still fit). The kept curves stay in
 /// picture order, so curve ids follow the picture, not the ranking.

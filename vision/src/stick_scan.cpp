@@ -1,4 +1,4 @@
-// The scan of a USB stick handed in by a stranger (issue 11, item 2): a bounded walk that cannot be
+// The scan of a USB stick handed in by a stranger: a bounded walk that cannot be
 // led outside the stick, and the re-open of a document it found.
 //
 // Every folder and file is opened with openat2(2) relative to the folder that listed it, with
@@ -19,6 +19,7 @@
 #include "hk/text.hpp"
 
 #include "unique_fd.hpp"
+#include "hk/error.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -282,7 +283,7 @@ class Walker {
 
 void check_limits(const ScanLimits& l) {
   auto bad = [](const std::string& what, const std::string& value) {
-    throw std::invalid_argument("scan_stick: limit " + what + " must be positive (got " + value + ")");
+    throw hk::ArgumentError("scan_stick: limit " + what + " must be positive (got " + value + ")");
   };
   if (l.max_depth <= 0) bad("max_depth", std::to_string(l.max_depth));
   if (l.max_entries <= 0) bad("max_entries", std::to_string(l.max_entries));

@@ -9,11 +9,13 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 
 cv::Mat surround_mean(const cv::Mat& src, double sigma) {
-  if (src.empty() || src.type() != CV_32FC1) throw std::invalid_argument("surround_mean: expected a non-empty CV_32FC1 image");
-  if (!(sigma > 0.0) || !std::isfinite(sigma)) throw std::invalid_argument("surround_mean: sigma must be finite and > 0");
+  if (src.empty() || src.type() != CV_32FC1) throw hk::ArgumentError("surround_mean: expected a non-empty CV_32FC1 image");
+  if (!(sigma > 0.0) || !std::isfinite(sigma)) throw hk::ArgumentError("surround_mean: sigma must be finite and > 0");
   const double so = kSurroundRatio * sigma;
   const double c = (sigma / so) * (sigma / so);
   cv::Mat outer, inner, out;
@@ -43,8 +45,8 @@ cv::Mat gradient_magnitude(const cv::Mat& grey, double blur_sigma_px) {
 }  // namespace
 
 PointValues chain_surround(const cv::Mat& grey, double blur_sigma_px, const std::vector<Chain>& chains) {
-  if (grey.empty() || grey.type() != CV_8UC1) throw std::invalid_argument("chain_surround: expected a non-empty CV_8UC1 image");
-  if (!std::isfinite(blur_sigma_px) || blur_sigma_px < 0.0) throw std::invalid_argument("chain_surround: blur_sigma_px must be finite and >= 0");
+  if (grey.empty() || grey.type() != CV_8UC1) throw hk::ArgumentError("chain_surround: expected a non-empty CV_8UC1 image");
+  if (!std::isfinite(blur_sigma_px) || blur_sigma_px < 0.0) throw hk::ArgumentError("chain_surround: blur_sigma_px must be finite and >= 0");
   const cv::Mat m = gradient_magnitude(grey, blur_sigma_px);
   // The annulus is smooth (σo = 4σ): averaged at half resolution (area-averaged, σ halved), enlarged back
   // bilinearly — a quarter of the pixels to blur.

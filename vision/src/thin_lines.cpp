@@ -14,6 +14,8 @@
 #include <string>
 #include <utility>
 
+#include "hk/error.hpp"
+
 namespace hk::vision {
 namespace {
 
@@ -186,15 +188,15 @@ struct Flat {
   std::vector<char> closed;
 };
 
-/// Checks the input (throws std::invalid_argument) and flattens it (step 1).
+/// Checks the input (throws hk::ArgumentError) and flattens it (step 1).
 Flat flatten(const std::vector<Chain>& chains, double w, const PointValues* values_in) {
   if (!std::isfinite(w) || w < 0.0) {
-    throw std::invalid_argument("merge_thin_lines: max_width_px must be finite and >= 0, got " + number(w));
+    throw hk::ArgumentError("merge_thin_lines: max_width_px must be finite and >= 0, got " + number(w));
   }
   if (values_in != nullptr) {
     bool ok = values_in->size() == chains.size();
     for (std::size_t k = 0; ok && k < chains.size(); ++k) ok = (*values_in)[k].size() == chains[k].points_px.size();
-    if (!ok) throw std::invalid_argument("merge_thin_lines: values_in must have one value per chain point");
+    if (!ok) throw hk::ArgumentError("merge_thin_lines: values_in must have one value per chain point");
   }
   Flat f;
   f.K = chains.size();
@@ -202,7 +204,7 @@ Flat flatten(const std::vector<Chain>& chains, double w, const PointValues* valu
   for (std::size_t k = 0; k < f.K; ++k) {
     for (const cv::Point2d& p : chains[k].points_px) {
       if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
-        throw std::invalid_argument("merge_thin_lines: chain " + std::to_string(k) + " has a non-finite point");
+        throw hk::ArgumentError("merge_thin_lines: chain " + std::to_string(k) + " has a non-finite point");
       }
     }
     f.off[k + 1] = f.off[k] + chains[k].points_px.size();
@@ -288,80 +290,92 @@ long index_step(const Flat& f, std::size_t k, std::size_t i, std::size_t j) {
   return d;
 }
 
-/// Step 3: runs of paired points along each chain; `kept` marks those long enough to be lines (short runs
-/// are corners and crossings).
-std::vector<Run> find_runs(const Flat& f, const std::vector<std::size_t>& partner, double w) {
-  const std::size_t max_skip = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(w / 2.0)));
-  // Partners of consecutive run points (walk steps apart) must stay on one chain and move on
-  // slowly; a leap is another stroke.
-  const auto partners_follow = [&](std::size_t g0, std::size_t g1, std::size_t steps) {
-    const std::size_t q0 = partner[g0];
-    const std::size_t q1 = partner[g1];
-    if (f.chain_of[q0] != f.chain_of[q1]) return false;
-    return std::labs(index_step(f, f.chain_of[q0], f.idx[q0], f.idx[q1])) <= 2 * static_cast<long>(steps) + 3;
-  };
+/// Whether the partners of consecutive run points g0 and g1 (walk `steps` apart) follow each other: on one
+/// chain and moving on slowly; a leap is another stroke.
+bool partners_follow(const Flat& f, const std::vector<std::size_t>& partner, std::size_t g0, std::size_t g1, std::size_t steps) {
+  const std::size_t q0 = partner[g0];
+  const std::size_t q1 = partner[g1];
+  if (f.chain_of[q0] != f.chain_of[q1]) return false;
+  return std::labs(index_step(f, f.chain_of[q0], f.idx[q0], f.idx[q1])) <= 2 * static_cast<long>(steps) + 3;
+}
+
+/// The runs found so far, and for each point the run it is in and the run its partner is in (kNone: none).
+struct RunWalk {
   std::vector<Run> runs;
-  std::vector<std::size_t> run_of(f.N, kNone), partner_of_run(f.N, kNone);
-  for (std::size_t k = 0; k < f.K; ++k) {
-    const std::size_t n = f.off[k + 1] - f.off[k];
-    if (n == 0) continue;
-    // A closed chain's walk starts at an unpaired point, so that no run is cut at index 0.
-    std::size_t start = 0;
-    if (f.closed[k]) {
-      for (std::size_t i = 0; i < n; ++i) {
-        if (partner[f.off[k] + i] == kNone) {
-          start = i;
-          break;
-        }
-      }
-    }
-    const std::size_t first_run = runs.size();
-    std::size_t cur = kNone;
-    for (std::size_t t = 0; t < n; ++t) {
-      const std::size_t g = f.off[k] + (start + t) % n;
-      if (partner[g] == kNone) continue;
-      bool extend = false;
-      if (cur != kNone) {
-        const Run& r = runs[cur];
-        const std::size_t steps = t - r.walk_pos.back();
-        // The fold test: g's partner already in this run, or g the partner of one of its points,
-        // means the walk went round a stroke's end and came back along its other side.
-        extend = steps - 1 <= max_skip && partners_follow(r.members.back(), g, steps) && run_of[partner[g]] != cur &&
-                 partner_of_run[g] != cur;
-      }
-      if (!extend) {
-        cur = runs.size();
-        runs.push_back(Run{});
-        runs[cur].chain = k;
-      }
-      runs[cur].members.push_back(g);
-      runs[cur].walk_pos.push_back(t);
-      run_of[g] = cur;
-      partner_of_run[partner[g]] = cur;
-    }
-    if (!f.closed[k] || runs.size() == first_run) continue;
-    // Closed chain: the last run may go on across the walk's start into the first.
-    Run& first = runs[first_run];
-    Run& last = runs.back();
-    const std::size_t steps = first.walk_pos.front() + n - last.walk_pos.back();
-    if (steps - 1 > max_skip || !partners_follow(last.members.back(), first.members.front(), steps)) continue;
-    if (&first == &last) {
-      first.closed = true;
-      continue;
-    }
-    const std::size_t last_id = runs.size() - 1;
-    bool fold = false;
-    for (const std::size_t g : first.members) fold = fold || run_of[partner[g]] == last_id;
-    for (const std::size_t g : last.members) fold = fold || run_of[partner[g]] == first_run;
-    if (fold) continue;
-    for (std::size_t j = 0; j < first.members.size(); ++j) {
-      last.members.push_back(first.members[j]);
-      last.walk_pos.push_back(first.walk_pos[j] + n);
-      run_of[first.members[j]] = last_id;
-    }
-    first.members.clear();
-    first.walk_pos.clear();
+  std::vector<std::size_t> run_of, partner_of_run;
+};
+
+/// Where the walk of chain k (n points) starts: a closed chain's at an unpaired point, so that no run is cut
+/// at index 0; an open chain's at 0.
+std::size_t walk_start(const Flat& f, const std::vector<std::size_t>& partner, std::size_t k, std::size_t n) {
+  if (!f.closed[k]) return 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (partner[f.off[k] + i] == kNone) return i;
   }
+  return 0;
+}
+
+/// Walks chain k (n points) from `start`, extending the current run with each paired point while at most
+/// max_skip points were skipped, the partners follow and the walk did not fold, else starting a new run.
+void walk_chain(const Flat& f, const std::vector<std::size_t>& partner, std::size_t k, std::size_t n, std::size_t start,
+                std::size_t max_skip, RunWalk& rw) {
+  std::vector<Run>& runs = rw.runs;
+  std::size_t cur = kNone;
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::size_t g = f.off[k] + (start + t) % n;
+    if (partner[g] == kNone) continue;
+    bool extend = false;
+    if (cur != kNone) {
+      const Run& r = runs[cur];
+      const std::size_t steps = t - r.walk_pos.back();
+      // The fold test: g's partner already in this run, or g the partner of one of its points,
+      // means the walk went round a stroke's end and came back along its other side.
+      extend = steps - 1 <= max_skip && partners_follow(f, partner, r.members.back(), g, steps) && rw.run_of[partner[g]] != cur &&
+               rw.partner_of_run[g] != cur;
+    }
+    if (!extend) {
+      cur = runs.size();
+      runs.push_back(Run{});
+      runs[cur].chain = k;
+    }
+    runs[cur].members.push_back(g);
+    runs[cur].walk_pos.push_back(t);
+    rw.run_of[g] = cur;
+    rw.partner_of_run[partner[g]] = cur;
+  }
+}
+
+/// Closed chain k (n points), whose runs start at first_run: the last run may go on across the walk's start
+/// into the first (then the first's points move to the last), or be the first itself going round the whole
+/// chain (then it is marked closed); not when the two runs are a fold of one stroke.
+void join_across_start(const Flat& f, const std::vector<std::size_t>& partner, std::size_t n, std::size_t first_run,
+                       std::size_t max_skip, RunWalk& rw) {
+  std::vector<Run>& runs = rw.runs;
+  Run& first = runs[first_run];
+  Run& last = runs.back();
+  const std::size_t steps = first.walk_pos.front() + n - last.walk_pos.back();
+  if (steps - 1 > max_skip || !partners_follow(f, partner, last.members.back(), first.members.front(), steps)) return;
+  if (&first == &last) {
+    first.closed = true;
+    return;
+  }
+  const std::size_t last_id = runs.size() - 1;
+  bool fold = false;
+  for (const std::size_t g : first.members) fold = fold || rw.run_of[partner[g]] == last_id;
+  for (const std::size_t g : last.members) fold = fold || rw.run_of[partner[g]] == first_run;
+  if (fold) return;
+  for (std::size_t j = 0; j < first.members.size(); ++j) {
+    last.members.push_back(first.members[j]);
+    last.walk_pos.push_back(first.walk_pos[j] + n);
+    rw.run_of[first.members[j]] = last_id;
+  }
+  first.members.clear();
+  first.walk_pos.clear();
+}
+
+/// Marks `kept` the runs (of 2 points or more) whose length along their chain is at least kMinRunWidths × w;
+/// shorter ones are corners and crossings.
+void mark_kept_runs(const Flat& f, std::vector<Run>& runs, double w) {
   for (Run& r : runs) {
     if (r.members.size() < 2) continue;
     double len = 0.0;
@@ -376,7 +390,22 @@ std::vector<Run> find_runs(const Flat& f, const std::vector<std::size_t>& partne
     }
     r.kept = len >= kMinRunWidths * w;
   }
-  return runs;
+}
+
+/// Step 3: runs of paired points along each chain; `kept` marks those long enough to be lines (short runs
+/// are corners and crossings).
+std::vector<Run> find_runs(const Flat& f, const std::vector<std::size_t>& partner, double w) {
+  const std::size_t max_skip = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(w / 2.0)));
+  RunWalk rw{{}, std::vector<std::size_t>(f.N, kNone), std::vector<std::size_t>(f.N, kNone)};
+  for (std::size_t k = 0; k < f.K; ++k) {
+    const std::size_t n = f.off[k + 1] - f.off[k];
+    if (n == 0) continue;
+    const std::size_t first_run = rw.runs.size();
+    walk_chain(f, partner, k, n, walk_start(f, partner, k, n), max_skip, rw);
+    if (f.closed[k] && rw.runs.size() != first_run) join_across_start(f, partner, n, first_run, max_skip, rw);
+  }
+  mark_kept_runs(f, rw.runs, w);
+  return std::move(rw.runs);
 }
 
 /// The value of chain k's point i, 0 without values.

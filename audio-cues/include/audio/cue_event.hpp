@@ -19,9 +19,9 @@ enum class CueKind : std::uint8_t {
   LevelCoarser,   ///< the rendered resolution level became coarser (level = the new level)
   WorkspaceEdge,  ///< the handle reached the edge of the usable workspace
   TextBlock,      ///< the proxy entered a block of text on a document page (curve = the block's id)
-  PopThrough,     ///< the visitor pushed through a wall on purpose (issue 14: pop_force_n for pop_hold_s)
+  PopThrough,     ///< the visitor pushed through a wall on purpose (pressed over pop_force_n for pop_hold_s)
   TourStart,      ///< the guided tour starts tracing a shape's outline (curve = the shape)
-  Shutter,        ///< the camera took the picture (issue 16; sent by the window thread, AudioSystem::play)
+  Shutter,        ///< the camera took the picture (sent by the window thread, AudioSystem::play)
 };
 
 /// Number of CueKind values.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file earcons.hpp
-/// Earcon synthesis from haptic cues (issue 4, item 1). Each cue kind has its own short sound, designed
+/// Earcon synthesis from haptic cues. Each cue kind has its own short sound, designed
 /// so that a listener can tell them apart without seeing anything:
 ///   ContactBegin  a pitched "tock" at the curve's pitch, loudness from approach speed;
 ///   ContactEnd    a soft, lower tock;
@@ -88,6 +88,12 @@ class EarconSynth {
   };
   void start(const Shape& s) noexcept;
   double transient_delay_s(bool claim) noexcept;
+  /// The contact cues (ContactBegin, ContactEnd, Slide): pitched by the curve, the slide's state updated.
+  void contact_cue(const CueEvent& e) noexcept;
+  /// The knocks (ConvexCorner, VertexContact, WorkspaceEdge, PopThrough): strikes and thuds in transient slots.
+  void knock_cue(CueKind kind) noexcept;
+  /// The signals (LevelFiner, LevelCoarser, TextBlock, TourStart, Shutter): chirps, notes and the shutter.
+  void signal_cue(CueKind kind) noexcept;
   static constexpr double kMinTransientGapS = 0.003;   ///< clicks start at least this far apart [s]
   static constexpr double kMaxTransientDelayS = 0.006; ///< and are never pushed back further [s]
   float next_noise() noexcept;

@@ -1,10 +1,10 @@
 #pragma once
 /// @file messages.hpp
-/// Everything the kiosk says, in one catalogue (issue 4, item 6). The English text lives in
+/// Everything the kiosk says, in one catalogue. The English text lives in
 /// audio-cues/messages/en.toml and is compiled in; a translation is a copy of that file with the
 /// right-hand sides translated, loaded with MessageCatalog::load().
 ///
-/// Keys (issue 12, item 6): a message names the visitor's keys with placeholders ({help_key}, {next_key},
+/// Keys: a message names the visitor's keys with placeholders ({help_key}, {next_key},
 /// …: kKeyPlaceholders), filled with the spoken form of the key the operator configured; the [key_names]
 /// table of the catalogue gives that spoken form for every key name ("UP" → "the Up arrow"). The
 /// catalogue knows nothing of the settings: the caller passes the key names (KeyArg).

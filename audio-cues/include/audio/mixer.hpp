@@ -1,6 +1,6 @@
 #pragma once
 /// @file mixer.hpp
-/// The kiosk's one audio mix (issue 4, items 1–2, 4–5): earcons from haptic cues plus speech, earcons
+/// The kiosk's one audio mix: earcons from haptic cues plus speech, earcons
 /// ducked under speech, master volume, and a soft limiter. Live, the audio callback drains the cue
 /// queue the servo thread fills; headless, render_cue_timeline() places every cue sample-exactly at its
 /// tick's time so the WAV lines up with trace.csv.
@@ -68,7 +68,7 @@ class Mixer final : public AudioSource {
 /// Renders the earcons of `cues` (sorted by tick, or not: they are sorted here) on the timeline of a servo
 /// run: tick k sounds at sample round(k · period_s · sample_rate_hz). Returns duration_s of mono audio at
 /// kSampleRateHz (volume: unity). Allocates (not real-time). Cues past the end are ignored.
-/// @throws std::invalid_argument if period_s ≤ 0 or duration_s is not in [0, 3600] s.
+/// @throws hk::ArgumentError if period_s ≤ 0 or duration_s is not in [0, 3600] s.
 std::vector<float> render_cue_timeline(std::span<const CueEvent> cues, double period_s, double duration_s,
                                        const MixerParams& params = {});
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file output.hpp
-/// Audio out through PortAudio (issue 4, item 3): a float32 stream at kSampleRateHz with small buffers,
+/// Audio out through PortAudio: a float32 stream at kSampleRateHz with small buffers,
 /// pulling one AudioSource (the mixer) in PortAudio's callback. The output latency PortAudio reports is
 /// logged at start. With no audio device, or any PortAudio error, the kiosk keeps running silent: the
 /// constructor does not throw, running() is false, info().why_not says why and one warning is logged.

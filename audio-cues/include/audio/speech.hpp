@@ -1,6 +1,6 @@
 #pragma once
 /// @file speech.hpp
-/// Speech with espeak-ng, synthesised into our own mixer (issue 4, item 2): espeak-ng only makes
+/// Speech with espeak-ng, synthesised into our own mixer: espeak-ng only makes
 /// samples (AUDIO_OUTPUT_SYNCHRONOUS + espeak_SetSynthCallback, never its own playback); they are
 /// resampled from espeak-ng's rate (22050 Hz) to kSampleRateHz with libsamplerate and handed to the audio
 /// callback through a SpeechStream, so speech can be cut at once, repeated, and mixed with the earcons

@@ -2,7 +2,7 @@
 /// @file speech_stream.hpp
 /// The hand-over of synthesised speech from the speech worker (producer) to the mixer in the audio
 /// callback (consumer), so speech is mixed with earcons in our own mixer and can be cut at once
-/// (issue 4: "interrupted at once, repeated, and mixed with earcons").
+/// (interrupted at once, repeated, and mixed with earcons).
 ///
 /// Samples travel in fixed blocks through an SpscRing; every block carries the generation of the
 /// utterance it belongs to. cancel() bumps the generation from any thread: the consumer then drops every

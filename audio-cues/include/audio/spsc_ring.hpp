@@ -18,6 +18,8 @@
 #include <string>
 #include <type_traits>
 
+#include "hk/error.hpp"
+
 namespace hk::audio {
 
 /// Bounded SPSC ring of trivially copyable T. Capacity is rounded up to a power of two.
@@ -28,10 +30,10 @@ class SpscRing {
 
  public:
   /// @param capacity  entries [1, 2^24]; rounded up to a power of two.
-  /// @throws std::invalid_argument outside that range (setup only).
+  /// @throws hk::ArgumentError outside that range (setup only).
   explicit SpscRing(std::size_t capacity) {
     if (capacity < 1 || capacity > (std::size_t{1} << 24)) {
-      throw std::invalid_argument("SpscRing capacity " + std::to_string(capacity) + " is outside [1, 16777216]");
+      throw hk::ArgumentError("SpscRing capacity " + std::to_string(capacity) + " is outside [1, 16777216]");
     }
     std::size_t n = 1;
     while (n < capacity) n <<= 1;

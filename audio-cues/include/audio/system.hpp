@@ -1,6 +1,6 @@
 #pragma once
 /// @file system.hpp
-/// The kiosk's whole audio side in one object (issue 4): the cue ring the servo thread fills, the mixer
+/// The kiosk's whole audio side in one object: the cue ring the servo thread fills, the mixer
 /// (earcons + speech, ducking, volume), the espeak-ng speaker, the message catalogue and the PortAudio
 /// output. Any part that cannot start (no sound card, no espeak-ng data) is logged once and the rest goes
 /// on: a kiosk without a speaker still renders forces, and tests run it headless and pull render().

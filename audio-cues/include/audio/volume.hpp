@@ -1,6 +1,6 @@
 #pragma once
 /// @file volume.hpp
-/// Master volume in steps a visitor can count (issue 4, item 4): Volume up / down move one step, and
+/// Master volume in steps a visitor can count: Volume up / down move one step, and
 /// every new session starts again at the operator's default.
 
 #include <atomic>

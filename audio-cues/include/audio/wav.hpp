@@ -1,7 +1,7 @@
 #pragma once
 /// @file wav.hpp
 /// WAV files through libsndfile: the headless `explore --audio-out` rendering and the tests that
-/// analyse it (issue 4, item 5). Plain functions for set-up and offline threads: they allocate and do
+/// analyse it. Plain functions for set-up and offline threads: they allocate and do
 /// file I/O, so never call them from the audio callback or the servo thread. Any thread may call them
 /// concurrently on different paths.
 

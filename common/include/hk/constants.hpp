@@ -13,7 +13,7 @@ namespace hk {
 /// stays below it.
 inline constexpr int kMaxLevels = 16;
 
-/// Tolerance steps (issue 18: "the level policy may then pick a tolerance instead of a level"). A level id
+/// Tolerance steps: the level policy may pick a tolerance instead of a level. A level id
 /// is either a level, 0 .. kMaxLevels − 1, the same for every curve (clamped to each curve's coarsest), or
 /// a tolerance step, kToleranceLevelBase + t: each curve at the coarsest of its own levels whose error
 /// bound is ≤ kToleranceLadder_m[t] (level 0 when none is), so a straight curve goes coarse while a

@@ -52,14 +52,14 @@ enum class FieldKind {
   text,     ///< std::string; TOML string; one of `choices`, or (no choices) accepted by `check`
 };
 
-/// Where a field sits in the operator's panel (issue 12, item 3). `hidden` fields are never shown
+/// Where a field sits in the operator's panel. `hidden` fields are never shown
 /// (the PIN's hash).
 enum class FieldGroup { haptics, levels, scene, audio, kiosk, keys, devices, hidden };
 
 /// Display name of a group: "Haptics", "Levels", "Scene", "Audio", "Kiosk", "Keys", "Devices", "".
 [[nodiscard]] std::string_view group_name(FieldGroup g) noexcept;
 
-/// When a change made in the running kiosk takes effect (issue 12, item 4).
+/// When a change made in the running kiosk takes effect.
 enum class ApplyWhen {
   live,     ///< at once: servo gains through the lock-free hand-over, keys, session timing
   scene,    ///< the scene is rebuilt off the servo thread and swapped in with the fade

@@ -1,6 +1,6 @@
 #pragma once
 /// @file operator_pin.hpp
-/// The operator's PIN (issue 12): its rules, its argon2id hash (libsodium), and the lockout after failed
+/// The operator's PIN: its rules, its argon2id hash (libsodium), and the lockout after failed
 /// attempts, persisted in a small state file so that it survives restarts and every `haptic-kiosk pin
 /// check` process. Shared by the command line (`haptic-kiosk pin set|check`) and the kiosk's panel.
 ///

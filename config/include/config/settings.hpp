@@ -21,7 +21,7 @@ struct HapticsSettings {
   double max_force_n = 3.5;               ///< key max_force_n, force clamp, [0.1, 20] N and at most what the device gives everywhere (device_profile.hpp; the simulated pantograph 3.78 N)
   double servo_rate_hz = 1000.0;          ///< key servo_rate_hz, [100, 10000] Hz
   int level = 1;                          ///< key level, resolution level at the start (and always, when level_mode = "fixed"), [0, 12] and <= max_levels; 0 = finest
-  std::string level_mode = "auto";        ///< key level_mode, "auto" (a level from hand speed, issue 6), "tolerance" (a tolerance from hand speed, each curve at its own level within it, issue 18), "cut" (a tolerance from hand speed, each segment refined only while its error box exceeds it: the tolerance cut, issue 18) or "fixed" (always `level`)
+  std::string level_mode = "auto";        ///< key level_mode, "auto" (a level from hand speed), "tolerance" (a tolerance from hand speed, each curve at its own level within it), "cut" (a tolerance from hand speed, each segment refined only while its error box exceeds it: the tolerance cut) or "fixed" (always `level`)
   double level_error_at_rest_m = 1e-4;    ///< key level_error_at_rest_m, deviation a slow fingertip cannot feel, [0, 0.01] m; 0 = the finest level whenever the hand rests
   double level_blur_time_s = 0.010;       ///< key level_blur_time_s, tolerable deviation grows by hand speed x this, [0, 0.1] s
   double level_hysteresis = 0.3;          ///< key level_hysteresis, go coarser only when the bound is this fraction under the tolerance, [0, 0.9]
@@ -32,7 +32,7 @@ struct HapticsSettings {
   int max_levels = 6;                     ///< key max_levels, levels built above level 0, [1, 12]
   int query_box_budget = 4000;            ///< key query_box_budget, box tests the collision queries and level-change checks of one servo tick may do, [0, 10000000] box tests; 0 = no limit (default measured: see hk::kDefaultQueryBoxBudget in haptics/servo.hpp)
   double force_ramp_s = 0.5;              ///< key force_ramp_s, start-up force ramp, [0, 10] s
-  double pop_force_n = 3.0;               ///< key pop_force_n, pressing a wall harder than this for pop_hold_s lets the proxy through (issue 14), [0, 20] N; 0 = walls never give way
+  double pop_force_n = 3.0;               ///< key pop_force_n, pressing a wall harder than this for pop_hold_s lets the proxy through, [0, 20] N; 0 = walls never give way
   double pop_hold_s = 0.3;                ///< key pop_hold_s, how long the press must last, [0.01, 5] s
   double pop_release_s = 0.02;            ///< key pop_release_s, the force falls to zero over this after a push-through, [0.001, 1] s
   std::string render = "walls";           ///< key render, "walls" (the seed paper's god-object walls) or "grooves" (each curve an engraved line that pulls the hand in, never blocks)
@@ -46,7 +46,7 @@ struct HapticsSettings {
 };
 
 /// [device] — which device drives the handle: the simulated pantograph's physics, and the USB pantograph
-/// (Haply 2DIY gen3 speaking hAPI over CDC serial, issue 13): where to find it, its board layout (which
+/// (Haply 2DIY gen3 speaking hAPI over CDC serial): where to find it, its board layout (which
 /// actuator and encoder sit on which port, their directions, offsets and resolutions), its links, its
 /// torque limit, its usable rectangle and its calibration pose. The defaults are the gen3 2DIY's (Haply's
 /// hAPI examples and firmware Haply_M0_Firmware_V0_3; ports cross-wired: actuator/encoder 1 on port 2).
@@ -157,7 +157,7 @@ struct KioskSettings {
   bool operator==(const KioskSettings&) const = default;
 };
 
-/// [stick] — documents from USB sticks (issue 11): how far a scan goes and how PDF pages are drawn. A stick
+/// [stick] — documents from USB sticks: how far a scan goes and how PDF pages are drawn. A stick
 /// is a stranger's: every limit here bounds what one can make the kiosk do.
 struct StickSettings {
   int max_depth = 8;                          ///< key max_depth, deepest folder entered (the stick's root is 0), [1, 64]
@@ -174,7 +174,7 @@ struct StickSettings {
   bool operator==(const StickSettings&) const = default;
 };
 
-/// [camera] — the camera a visitor puts a picture under (issue 16): which source, the frame size asked
+/// [camera] — the camera a visitor puts a picture under: which source, the frame size asked
 /// for, and when the framing guide captures.
 struct CameraSettings {
   std::string source = "auto";    ///< key source, "auto" (the first camera found: libcamera, then V4L2), "none" (no capture), or a source "file:PATH" | "libcamera:N" | "v4l2:DEV"
@@ -187,7 +187,7 @@ struct CameraSettings {
   bool operator==(const CameraSettings&) const = default;
 };
 
-/// [keys] — the key for each of the visitor's actions (issue 5: keys a blind visitor can find). Each value
+/// [keys] — the key for each of the visitor's actions (keys a blind visitor can find). Each value
 /// is one key name: F1..F12, A..Z, 0..9, SPACE, ENTER, TAB, BACKSPACE, LEFT, RIGHT, UP, DOWN, PAGE_UP,
 /// PAGE_DOWN, HOME, END, INSERT, DELETE, MINUS, EQUAL, KP_0..KP_9, KP_ADD, KP_SUBTRACT, KP_ENTER.
 /// O, C and ESCAPE are never a visitor's (ESCAPE quits in windowed mode).
@@ -253,7 +253,7 @@ inline bool in_quiet_hours(const QuietHours& hours, int minute_of_day) {
                                      : minute_of_day >= hours.first || minute_of_day < hours.second;
 }
 
-/// [operator] — the operator's panel (issue 12): how it is opened, its PIN and where its records go.
+/// [operator] — the operator's panel: how it is opened, its PIN and where its records go.
 /// Paths left empty are beside the settings file: `<settings>.state` and `<settings>.audit.log`.
 struct OperatorSettings {
   std::string open_chord = "CTRL+ALT+O";  ///< key open_chord, the key chord that asks for the PIN: modifiers (CTRL, ALT, SHIFT, SUPER; at least one of CTRL, ALT, SUPER) and one key, joined by '+'

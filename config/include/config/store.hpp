@@ -1,6 +1,6 @@
 #pragma once
 /// @file store.hpp
-/// Settings that are never lost (issue 12): the start-up load that keeps a corrupt file aside and falls
+/// Settings that are never lost: the start-up load that keeps a corrupt file aside and falls
 /// back to `<path>.bak` or the defaults, the audit log of the operator's changes, and the operator
 /// panel's one-field edits, checked exactly as the TOML loader checks them.
 ///

@@ -56,7 +56,7 @@ struct EdgeMap {
 /// calls, for images of up to 2^22 pixels; concurrent calls from different threads are safe.
 ///
 /// @param grey CV_8UC1 image, non-empty.
-/// @throws std::invalid_argument if grey is empty or not CV_8UC1, or a parameter is negative or
+/// @throws hk::ArgumentError if grey is empty or not CV_8UC1, or a parameter is negative or
 ///         not finite.
 EdgeMap detect_edges(const cv::Mat& grey, const EdgeParams& p);
 

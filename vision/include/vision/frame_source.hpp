@@ -1,6 +1,6 @@
 #pragma once
 /// @file frame_source.hpp
-/// Camera capture (issue 16, item 1): frames from a camera or from files, behind one interface.
+/// Camera capture: frames from a camera or from files, behind one interface.
 ///
 /// Three sources, named by a spec string (the `--source` of `capture` and `explore`, `[camera] source`):
 /// - `file:PATH`: an image file, or a folder of frames served in name order (tests and demos);
@@ -83,7 +83,7 @@ class FrameSource {
 /// @throws CameraError for a source that cannot be opened (no such file or camera, no usable format), and for
 ///         a file source with no readable image (a folder: none of its files is an image; files that are not
 ///         images are skipped, an image refused by load_image's limits is an error naming it).
-/// @throws std::invalid_argument if a parameter is outside the range its docstring gives.
+/// @throws hk::ArgumentError if a parameter is outside the range its docstring gives.
 std::unique_ptr<FrameSource> open_frame_source(const SourceSpec& spec, const FrameSourceParams& params);
 
 /// A camera found on this machine.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file framing.hpp
-/// Spoken framing for someone who cannot see the preview (issue 16, item 3). Each camera frame is looked at
+/// Spoken framing for someone who cannot see the preview. Each camera frame is looked at
 /// once (look_at_frame: the page found in it, how bright it is, how much it moved since the frame before);
 /// FramingGuide turns the looks into advice, one piece at a time, and decides when to capture: once the page
 /// has been whole, roughly centred, lit and still for `still_s`.
@@ -45,7 +45,7 @@ struct FrameLook {
 /// Looks at one frame (CV_8UC3 BGR or CV_8UC1): find_page at `page`'s settings, brightness, detail, and motion
 /// against `previous`. `previous` is the look at the frame before (nullptr for the first) and `small` carries a
 /// small blurred grey copy from one call to the next (empty at the first call; replaced by this frame's).
-/// @throws std::invalid_argument as find_page.
+/// @throws hk::ArgumentError as find_page.
 FrameLook look_at_frame(const cv::Mat& frame, double t_s, const FrameLook* previous, cv::Mat& small, const PageParams& page = {});
 
 /// What the guide says (one message of the catalogue each).
@@ -89,7 +89,7 @@ struct FramingStep {
 /// The guide: a state machine over frame looks. Deterministic: the same looks give the same steps.
 class FramingGuide {
  public:
-  /// @throws std::invalid_argument for a parameter outside its range.
+  /// @throws hk::ArgumentError for a parameter outside its range.
   explicit FramingGuide(const FramingParams& p = {});
   /// The advice for one look (looks in time order). After a capture the guide starts again as new.
   FramingStep update(const FrameLook& look);

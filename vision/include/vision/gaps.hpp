@@ -1,6 +1,6 @@
 #pragma once
 /// @file gaps.hpp
-/// Closing small gaps in outlines (issue 15, item 3): Canny breaks an object's outline where a highlight or
+/// Closing small gaps in outlines: Canny breaks an object's outline where a highlight or
 /// a notch lowers the contrast for a few pixels, and a hand then feels several open strokes where the eye
 /// sees one closed shape. Chain ends that face each other across a gap no wider than a fingertip can tell
 /// from a join are joined with a straight piece; a real gap, wider than that, stays open.
@@ -51,7 +51,7 @@ cv::Point2d end_direction(const Chain& c, bool at_start, double span_px);
 /// CGIP 13, 1980).
 /// @param chains chains in pixel coordinates, each with at least one point.
 /// @param values one value per point of each chain, or empty for none; values_out then stays untouched.
-/// @throws std::invalid_argument for bad params, a chain with no point, or values not shaped like chains.
+/// @throws hk::ArgumentError for bad params, a chain with no point, or values not shaped like chains.
 std::vector<Chain> close_gaps(const std::vector<Chain>& chains, const GapParams& p, GapStats* stats = nullptr,
                               const PointValues& values = {}, PointValues* values_out = nullptr);
 

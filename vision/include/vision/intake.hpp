@@ -78,20 +78,20 @@ ImageHeader read_image_header(const std::string& path);
 /// @return CV_8UC3 BGR image, rows = height, cols = width (as decoded; an EXIF rotation may swap
 ///         the declared width and height).
 /// @throws InputError for every refusal above and when decoding fails.
-/// @throws std::invalid_argument if a limit is not positive.
+/// @throws hk::ArgumentError if a limit is not positive.
 cv::Mat load_image(const std::string& path, const ImageLimits& limits);
 
 /// The whole file at `path` (an input named on the command line), read once, after checking it is a
 /// regular file of 1 to max_bytes bytes.
 /// @throws InputError "image '<path>': <problem>" (not found, not a regular file, empty, over max_bytes with
 ///         both sizes named, changed size while read).
-/// @throws std::invalid_argument if max_bytes is not positive.
+/// @throws hk::ArgumentError if max_bytes is not positive.
 std::vector<std::uint8_t> read_input_file(const std::string& path, std::int64_t max_bytes);
 
 /// load_image on bytes already read (a document from a USB stick, read through stick_scan's
 /// read_stick_file so that no path is opened twice). `name` names the input in errors. Same checks and
 /// decoding as load_image after the file has been read.
-/// @throws InputError as load_image; std::invalid_argument if a limit is not positive.
+/// @throws InputError as load_image; hk::ArgumentError if a limit is not positive.
 cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& name, const ImageLimits& limits);
 
 /// Converts to one grey channel and shrinks so that max(width, height) <= max_side_px.
@@ -106,7 +106,7 @@ cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& nam
 /// @param px_scale_out if not null, receives original px per processed px along the long side
 ///                     (>= 1; exactly 1 when not resized).
 /// @return CV_8UC1 grey image.
-/// @throws std::invalid_argument if bgr is empty or of another type, or max_side_px < 1.
+/// @throws hk::ArgumentError if bgr is empty or of another type, or max_side_px < 1.
 cv::Mat to_grey(const cv::Mat& bgr, int max_side_px, double* px_scale_out);
 
 }  // namespace hk::vision

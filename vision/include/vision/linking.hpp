@@ -65,7 +65,7 @@ using PointValues = std::vector<std::vector<double>>;
 ///
 /// @param edges         CV_8UC1; non-zero = edge pixel. May be empty (no chains).
 /// @param min_length_px smallest polyline length kept [px], >= 0.
-/// @throws std::invalid_argument if edges is not CV_8UC1 or min_length_px is negative or NaN.
+/// @throws hk::ArgumentError if edges is not CV_8UC1 or min_length_px is negative or NaN.
 std::vector<Chain> link_edges(const cv::Mat& edges, double min_length_px);
 
 /// Polyline length of a chain [px]: sum of its segment lengths, plus the segment from the last

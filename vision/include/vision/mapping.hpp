@@ -37,7 +37,7 @@ struct PxToM {
 /// @param width_px, height_px image size [px], > 0.
 /// @param width_m, height_m   usable rectangle of the device [m], > 0 and finite
 ///                            (default workspace 0.14 m x 0.09 m, DESIGN.md).
-/// @throws std::invalid_argument on a non-positive or non-finite size.
+/// @throws hk::ArgumentError on a non-positive or non-finite size.
 PxToM fit_to_workspace(int width_px, int height_px, double width_m, double height_m);
 
 }  // namespace hk::vision

@@ -97,7 +97,7 @@ std::string ocr_languages_problem(const OcrParams& params);
 
 /// Reads the text of `grey` (CV_8UC1, the picture at the resolution to read it at) in a worker.
 /// @param name how to name the picture in errors (made printable on one line)
-/// @throws OcrError as its kinds say; std::invalid_argument for an empty or non-CV_8UC1 picture or a limit
+/// @throws OcrError as its kinds say; hk::ArgumentError for an empty or non-CV_8UC1 picture or a limit
 ///         that is not positive.
 OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const OcrParams& params);
 

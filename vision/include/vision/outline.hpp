@@ -1,7 +1,7 @@
 #pragma once
 /// @file outline.hpp
 /// Two-tone pictures (silhouettes, logos, diagrams, scanned drawings) traced from a threshold instead of
-/// found by Canny (issue 15): every boundary between the two tones becomes one chain, closed where it does not
+/// found by Canny: every boundary between the two tones becomes one chain, closed where it does not
 /// run into the picture's frame, lying on the boundary to within one pixel. Canny on such a picture breaks
 /// outlines at corners and junctions (non-maximum suppression thins the ridge and hysteresis loses its weak
 /// ends), so a silhouette is felt as open strokes; a threshold's boundary is closed by construction.
@@ -42,7 +42,7 @@ inline constexpr double kMinNearShare = 0.98;
 /// the Linux logo and the line drawings (0.983-0.988) are two-tone; photographs (0.49-0.95 or tones < 50
 /// levels apart) are not. Also measures the foreground's ink_width_px (on every picture, two-tone or not).
 /// @param grey CV_8UC1, not empty.
-/// @throws std::invalid_argument for an empty or non-CV_8UC1 image.
+/// @throws hk::ArgumentError for an empty or non-CV_8UC1 image.
 TwoTone classify_two_tone(const cv::Mat& grey);
 
 /// The boundaries between the two tones of `grey` (split at `threshold`: dark <= threshold) as chains in pixel
@@ -60,7 +60,7 @@ TwoTone classify_two_tone(const cv::Mat& grey);
 ///   one open chain per stretch between them;
 /// - chains of fewer than `min_points` points are dropped.
 /// @param grey CV_8UC1, not empty.
-/// @throws std::invalid_argument for an empty or non-CV_8UC1 image, or min_points < 1.
+/// @throws hk::ArgumentError for an empty or non-CV_8UC1 image, or min_points < 1.
 std::vector<Chain> trace_outlines(const cv::Mat& grey, double threshold, int min_points = 3);
 
 }  // namespace hk::vision

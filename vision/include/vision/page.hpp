@@ -1,6 +1,6 @@
 #pragma once
 /// @file page.hpp
-/// Pages made flat (issue 16, item 2): find the page, card or photo a visitor holds under the camera — the
+/// Pages made flat: find the page, card or photo a visitor holds under the camera — the
 /// largest convex quadrilateral with enough contrast against the background — and rectify it with a
 /// perspective warp to its own aspect ratio, so the scene is built from the picture and not from the
 /// table around it.
@@ -65,7 +65,7 @@ struct PageDetection {
 /// the page, unless it only runs past a smaller one's corners along a grain of the background, or has sides on the
 /// frame's edge and runs past a smaller one's corners over the background to the frame's edge where the smaller one
 /// has its own side (a page whole in the frame near its edge, not cut off; see page.cpp).
-/// @throws std::invalid_argument for an empty frame, another type, or bad params.
+/// @throws hk::ArgumentError for an empty frame, another type, or bad params.
 PageDetection find_page(const cv::Mat& frame, const PageParams& params = {});
 
 /// The aspect ratio (width / height) of the rectangle whose perspective image is the quadrilateral `corners_px`
@@ -76,14 +76,14 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params = {});
 /// MSR-TR-2003-39: k2, k3, n2 = k2·m2 − m1, n3 = k3·m3 − m1, f² from n2ᵀA⁻ᵀA⁻¹n3 = 0, (w/h)² = n2ᵀA⁻ᵀA⁻¹n2 /
 /// n3ᵀA⁻ᵀA⁻¹n3). Where that estimate is degenerate — a pair of opposite sides parallel in the image (a fronto-parallel
 /// view, or one turned about one axis only), or f² not positive — the ratio of the mean lengths of opposite sides.
-/// @throws std::invalid_argument for corners or centre not finite, or a pair of opposite sides of zero length.
+/// @throws hk::ArgumentError for corners or centre not finite, or a pair of opposite sides of zero length.
 double page_aspect_ratio(const std::array<cv::Point2d, 4>& corners_px, cv::Point2d centre_px);
 
 /// The page warped flat (cv::getPerspectiveTransform, cv::warpPerspective, bilinear, border replicated): a
 /// width × height image with width / height = page_aspect_ratio(corners, frame centre) and the quadrilateral's
 /// longest side kept at its length in the frame; the page's corners map to the outer corners of the output's
 /// corner pixels. Same type as `frame`.
-/// @throws std::invalid_argument for an empty frame, corners not finite, a degenerate quadrilateral (area < 1 px²),
+/// @throws hk::ArgumentError for an empty frame, corners not finite, a degenerate quadrilateral (area < 1 px²),
 /// or a side longer than 4 times the frame's diagonal.
 cv::Mat rectify_page(const cv::Mat& frame, const std::array<cv::Point2d, 4>& corners_px);
 

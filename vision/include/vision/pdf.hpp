@@ -1,6 +1,6 @@
 #pragma once
 /// @file pdf.hpp
-/// PDF pages as pictures, with their text (issue 11, items 3 and 4).
+/// PDF pages as pictures, with their text.
 ///
 /// A PDF from a stick is hostile input, and poppler is a large parser: every poppler call runs in a
 /// worker process, the executable hk-pdf-worker started with posix_spawn (not a fork of the kiosk, whose
@@ -118,7 +118,7 @@ class PdfError : public hk::Error {
 /// @param name   how to name it in errors (made printable on one line)
 /// @throws PdfError (NotPdf: no "%PDF-" header; Damaged: poppler cannot load it or it has no page;
 ///         Locked: needs a password; TooLarge: over max_file_bytes; Timeout / WorkerCrashed);
-///         std::invalid_argument when a limit is not positive.
+///         hk::ArgumentError when a limit is not positive.
 PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits);
 
 /// Renders page `page` (from 1) in a worker: grey, at dpi = min(max_dpi, 72 · sqrt(max_page_pixels /

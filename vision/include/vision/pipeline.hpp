@@ -34,7 +34,7 @@ inline constexpr Detector kAutoEdgeDetector = Detector::Surround;
 
 /// The [vision] detector name of `d`: "auto", "canny", "surround", "bilateral", "edpf" or "outline".
 const char* detector_name(Detector d);
-/// The Detector named `name`; throws std::invalid_argument (naming the choices) for any other name.
+/// The Detector named `name`; throws hk::ArgumentError (naming the choices) for any other name.
 Detector detector_from_name(const std::string& name);
 
 /// Bilateral filter of Detector::Bilateral, at the processed resolution: neighbourhood diameter [px], colour
@@ -104,20 +104,20 @@ struct Extraction {
 /// chains scaled back to original pixels.
 ///
 /// @throws InputError when the file is refused (see load_image).
-/// @throws std::invalid_argument on invalid parameters.
+/// @throws hk::ArgumentError on invalid parameters.
 Extraction extract_chains(const std::string& path, const ExtractParams& p);
 
 /// extract_chains on pixels already in memory (a rendered PDF page, a camera frame), with regions where
 /// edges are ignored: to_grey (shrink) -> detect_edges -> edge pixels under `ignore_mask` cleared ->
 /// link_edges -> edge strength -> chains scaled back to `image`'s pixels. Used for document pages, whose
-/// text is spoken, not felt (issue 11, item 4): the letters' outlines never become curves.
+/// text is spoken, not felt: the letters' outlines never become curves.
 ///
 /// @param image        CV_8UC1 (grey), CV_8UC3 (BGR) or CV_8UC4 (BGRA); not empty.
 /// @param ignore_mask  empty (nothing ignored) or CV_8UC1 of image's size; nonzero = ignore edges there. It
 ///                     is shrunk with the image by area averaging and any coverage counts, so an ignored
 ///                     region never shrinks away.
 /// Extraction::times.load_ms covers the grey conversion and shrinking only.
-/// @throws std::invalid_argument on invalid parameters, an empty or unsupported image, or a mask of
+/// @throws hk::ArgumentError on invalid parameters, an empty or unsupported image, or a mask of
 ///         another size or type.
 Extraction extract_chains_from_image(const cv::Mat& image, const ExtractParams& p, const cv::Mat& ignore_mask = {});
 

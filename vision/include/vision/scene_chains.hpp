@@ -1,7 +1,7 @@
 #pragma once
 /// @file scene_chains.hpp
-/// A picture → the curves a hand is given, in workspace metres, and why the others were left out (issue 15,
-/// item 5: scene simplification in one place; DESIGN.md "Data flow"). One call: scene_chains (a file) or
+/// A picture → the curves a hand is given, in workspace metres, and why the others were left out (scene
+/// simplification in one place; DESIGN.md "Data flow"). One call: scene_chains (a file) or
 /// scene_chains_from_image (pixels in memory) runs extract_chains and then simplify_chains:
 ///   1. thin lines: the two edges of a stroke thinner than a fingertip resolves become its centre line
 ///      (merge_thin_lines, at the processed resolution);
@@ -41,8 +41,8 @@ double curve_length_m(const SceneCurve& c);
 /// than 3 points.
 double enclosed_area_m2(const std::vector<cv::Point2d>& points_m);
 
-/// Salience of a curve as the segment budget ranked curves before issue 15 (now shape_salience; kept as
-/// the baseline the shape budget's test compares with).
+/// Salience of a curve as the segment budget used to rank curves, before shape_salience replaced it; kept
+/// as the baseline the shape budget's test compares with.
 ///
 ///   salience = length_m · clamp(strength / canny_high, 0, 1)
 ///
@@ -55,7 +55,7 @@ double enclosed_area_m2(const std::vector<cv::Point2d>& points_m);
 /// clip at 1. Returns 0 for a non-positive canny_high or a non-finite input.
 double curve_salience(double length_m, double strength, double canny_high);
 
-/// What a curve offers a hand, for ranking it against the others (issue 15, item 2).
+/// What a curve offers a hand, for ranking it against the others.
 struct ShapeFeatures {
   double length_m = 0.0;  ///< curve length [m]
   double strength = 0.0;  ///< mean edge strength along it (SceneCurve::strength) [Canny threshold units]
@@ -63,7 +63,7 @@ struct ShapeFeatures {
   double area_m2 = 0.0;   ///< area it encloses when closed [m²], else 0
 };
 
-/// Salience of a shape for the budgets (issue 15, item 2): its length plus, when closed, twice the square
+/// Salience of a shape for the budgets: its length plus, when closed, twice the square
 /// root of the area it encloses, weighted by its mean edge strength relative to canny_high:
 ///
 ///   shape_salience = (length_m + closed · 2·√area_m2) · max(strength, 0) / canny_high
@@ -137,16 +137,16 @@ struct SceneChains {
 };
 
 /// Steps 1-4 above on an extraction. `cost` prices each curve for max_segments.
-/// @throws std::invalid_argument for invalid parameters (a non-positive workspace or max_shapes, a negative or
+/// @throws hk::ArgumentError for invalid parameters (a non-positive workspace or max_shapes, a negative or
 ///         non-finite length).
 SceneChains simplify_chains(Extraction ex, const SimplifyParams& p, const SegmentCost& cost);
 
 /// extract_chains(path, ep) then simplify_chains.
-/// @throws InputError when the file is refused (see load_image); std::invalid_argument as above.
+/// @throws InputError when the file is refused (see load_image); hk::ArgumentError as above.
 SceneChains scene_chains(const std::string& path, const ExtractParams& ep, const SimplifyParams& p, const SegmentCost& cost);
 
 /// extract_chains_from_image(image, ep, ignore_mask) then simplify_chains.
-/// @throws std::invalid_argument as extract_chains_from_image and simplify_chains.
+/// @throws hk::ArgumentError as extract_chains_from_image and simplify_chains.
 SceneChains scene_chains_from_image(const cv::Mat& image, const ExtractParams& ep, const SimplifyParams& p, const SegmentCost& cost,
                                     const cv::Mat& ignore_mask = {});
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file stick_mount.hpp
-/// How the kiosk mounts a USB stick (issue 17, item 5): itself, or through the mount helper.
+/// How the kiosk mounts a USB stick: itself, or through the mount helper.
 ///
 /// Mounting needs CAP_SYS_ADMIN. A kiosk that holds it (root, or a developer's setcap) mounts directly
 /// with MountedStick (usb_stick.hpp). The installed kiosk runs as the unprivileged user haptic-kiosk and

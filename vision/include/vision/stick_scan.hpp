@@ -1,6 +1,6 @@
 #pragma once
 /// @file stick_scan.hpp
-/// What a USB stick offers: a bounded, symlink-proof walk of a mounted stick (issue 11, item 2).
+/// What a USB stick offers: a bounded, symlink-proof walk of a mounted stick.
 ///
 /// A stick comes from a stranger, so the walk treats it as hostile: every open is an openat2(2) with
 /// RESOLVE_BENEATH | RESOLVE_NO_SYMLINKS | RESOLVE_NO_XDEV | RESOLVE_NO_MAGICLINKS and
@@ -82,7 +82,7 @@ class StickError : public hk::Error {
 /// A stopping limit sets complete=false and stopped_by, which also ends `refused` (path "").
 /// Failures on single entries (unreadable folder, open errors, entries vanishing) are refusals, not errors.
 /// @throws StickError if root cannot be opened as a folder.
-/// @throws std::invalid_argument if a limit is not positive.
+/// @throws hk::ArgumentError if a limit is not positive.
 StickScan scan_stick(const std::string& root, const ScanLimits& limits);
 
 /// The kind a file's first bytes announce: "png", "jpeg", "bmp", "tiff", "webp", "pdf", or "" (not a

@@ -1,6 +1,6 @@
 #pragma once
 /// @file texture.hpp
-/// Texture out (issue 15, item 1): an edge in texture (grain, gravel, fur, print) is surrounded by edges like
+/// Texture out: an edge in texture (grain, gravel, fur, print) is surrounded by edges like
 /// itself; an object's outline stands alone. Surround inhibition after Grigorescu, Petkov & Westenberg,
 /// "Contour detection based on nonclassical receptive field inhibition", IEEE TIP 12(7), 2003: the gradient
 /// magnitude around each pixel, in an annulus that leaves the pixel itself out, is taken off its own
@@ -24,7 +24,7 @@ inline constexpr double kStandOutShare = 0.4;
 /// normalised to sum 1: zero at the pixel itself, non-negative everywhere (σo > σi), largest a little over σi
 /// away and fading like the outer Gaussian — the role of Grigorescu et al.'s DoG⁺ annulus (eq. 6), as a
 /// difference of two separable Gaussians: (G_o∗src − (σi/σo)²·G_i∗src) / (1 − (σi/σo)²). Replicated border.
-/// @throws std::invalid_argument if src is not a non-empty CV_32FC1 image or sigma is not finite and > 0.
+/// @throws hk::ArgumentError if src is not a non-empty CV_32FC1 image or sigma is not finite and > 0.
 cv::Mat surround_mean(const cv::Mat& src, double sigma);
 
 /// The surround of the gradient at every point of every chain (out[k][i] at chains[k].points_px[i], integer
@@ -36,7 +36,7 @@ cv::Mat surround_mean(const cv::Mat& src, double sigma);
 /// measured and not kept: they spare noise (docs/PERFORMANCE.md, "Texture out before edges").
 /// `grey` is not modified.
 /// @param grey  CV_8UC1, not empty.
-/// @throws std::invalid_argument for an empty or non-CV_8UC1 image or a negative or non-finite sigma.
+/// @throws hk::ArgumentError for an empty or non-CV_8UC1 image or a negative or non-finite sigma.
 PointValues chain_surround(const cv::Mat& grey, double blur_sigma_px, const std::vector<Chain>& chains);
 
 /// Texture test of one chain, after Grigorescu et al.'s inhibition (the inhibited strength of a point is

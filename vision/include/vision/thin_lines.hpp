@@ -1,6 +1,6 @@
 #pragma once
 /// @file thin_lines.hpp
-/// Thin-line merging: one curve along a thin stroke instead of its two edges (issue 6, item 4).
+/// Thin-line merging: one curve along a thin stroke instead of its two edges.
 ///
 /// Canny finds boundaries, so a thin dark stroke (a line drawing, a grid line, a letter, a road
 /// on a map) gives TWO parallel edge chains, one each side of the stroke, usually one closed loop
@@ -81,7 +81,7 @@ struct ThinLineStats {
 ///                      >= 0 and finite; 0 = off (chains returned unchanged).
 /// @param stats         optional; receives the counts.
 /// @return the chains with each thin stroke's pair of sides replaced by one centre line.
-/// @throws std::invalid_argument if max_width_px is negative, NaN or infinite, or a point is not
+/// @throws hk::ArgumentError if max_width_px is negative, NaN or infinite, or a point is not
 ///         finite (one line naming the parameter).
 std::vector<Chain> merge_thin_lines(const std::vector<Chain>& chains, double max_width_px, ThinLineStats* stats = nullptr);
 
@@ -91,7 +91,7 @@ std::vector<Chain> merge_thin_lines(const std::vector<Chain>& chains, double max
 ///
 /// @param values_in  values of `chains` (see PointValues).
 /// @param values_out optional; receives the values of the returned chains.
-/// @throws std::invalid_argument as merge_thin_lines, and if values_in does not match chains in
+/// @throws hk::ArgumentError as merge_thin_lines, and if values_in does not match chains in
 ///         shape.
 std::vector<Chain> merge_thin_lines(const std::vector<Chain>& chains, double max_width_px, ThinLineStats* stats,
                                     const PointValues& values_in, PointValues* values_out);

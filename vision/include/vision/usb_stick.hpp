@@ -1,6 +1,6 @@
 #pragma once
 /// @file usb_stick.hpp
-/// USB sticks coming and going (issue 11, item 1): block-device events, filesystem identification, and a
+/// USB sticks coming and going: block-device events, filesystem identification, and a
 /// read-only mount that nothing can write through.
 ///
 /// Events come through the small BlockEventSource interface: UdevBlockEventSource watches the kernel's
