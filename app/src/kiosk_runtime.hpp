@@ -96,7 +96,7 @@ class KioskRuntime final : public KioskEffects {
   KioskRuntime(const KioskRuntime&) = delete;
   KioskRuntime& operator=(const KioskRuntime&) = delete;
 
-  /// Starts the servo thread at [haptics] servo_rate_hz. @throws std::invalid_argument for a bad rate.
+  /// Starts the servo thread at [haptics] servo_rate_hz. @throws hk::ArgumentError for a bad rate.
   void start_servo();
   /// Stops it (idempotent).
   void stop_servo();

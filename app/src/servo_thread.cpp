@@ -7,8 +7,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <stdexcept>
 #include <string>
+
+#include "hk/error.hpp"
 
 namespace hk::app {
 namespace {
@@ -33,7 +34,7 @@ double percentile_us(const std::array<std::atomic<std::uint32_t>, 2048>& h, doub
 ServoThread::ServoThread(ServoCore& core, Device& device, const ServoThreadParams& params, AfterTick after_tick)
     : core_(core), device_(device), params_(params), after_tick_(std::move(after_tick)) {
   if (!(params.rate_hz >= 100 && params.rate_hz <= 10000)) {
-    throw std::invalid_argument("servo rate " + std::to_string(params.rate_hz) + " Hz is outside [100, 10000] Hz");
+    throw hk::ArgumentError("servo rate " + std::to_string(params.rate_hz) + " Hz is outside [100, 10000] Hz");
   }
   thread_ = std::thread([this] { run(); });
 }

@@ -40,7 +40,7 @@ class ServoThread {
   using AfterTick = std::function<void(double period_s)>;
 
   /// Starts the thread, which reads `device` and writes its force each tick. `core` and `device` (open)
-  /// must outlive the thread. @throws std::invalid_argument for a rate outside [100, 10000] Hz.
+  /// must outlive the thread. @throws hk::ArgumentError for a rate outside [100, 10000] Hz.
   ServoThread(ServoCore& core, Device& device, const ServoThreadParams& params, AfterTick after_tick = {});
   /// Stops and joins.
   ~ServoThread();

@@ -8,8 +8,10 @@
 #include <cstdint>
 #include <limits>
 #include <new>
+#include <string>
 
 #include "haptics/scene.hpp"
+#include "hk/error.hpp"
 #include "scene_box_quantise.hpp"
 #include "scene_hierarchy.hpp"
 #include "scene_lanes.hpp"
@@ -91,7 +93,8 @@ class SceneBuild {
       }
     }
     if (nslots >= std::numeric_limits<std::uint32_t>::max() / 2 || scene.curves_.size() >= (std::size_t{1} << (32 - Scene::kTagLevelBits))) {
-      throw std::bad_alloc();  // ids would not fit: far beyond any memory this runs in
+      throw hk::ArgumentError("scene: " + std::to_string(scene.curves_.size()) + " curves and " + std::to_string(nslots) +
+                              " segment slots are over the 32-bit node ids' limit");  // far beyond any picture's budget
     }
     scene.segment_nodes_ = nslots;
     scene.points_m_.resize(nslots);

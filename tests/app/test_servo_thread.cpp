@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "haptics/sim_pantograph.hpp"
+#include "hk/error.hpp"
 #include "servo_thread.hpp"
 #include "simulation.hpp"
 
@@ -58,7 +59,7 @@ TEST(ServoThread, RefusesARateOutsideItsRange) {
   ServoCore core(CueTrackerParams{}, nullptr);
   ServoThreadParams p;
   p.rate_hz = 50;
-  EXPECT_THROW(ServoThread(core, device, p), std::invalid_argument);
+  EXPECT_THROW(ServoThread(core, device, p), hk::ArgumentError);
 }
 
 }  // namespace

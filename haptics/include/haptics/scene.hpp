@@ -154,8 +154,9 @@ class Scene {
 
   /// Builds multiresolution models and collision trees for `curves` (workspace metres), with at most
   /// `max_levels` levels above level 0 (clamped to kMaxLevels − 1). Curves with fewer than 2 distinct
-  /// points or zero length are skipped (counted in skipped_curves()). Throws std::bad_alloc only (also
-  /// when the nodes would not fit 32-bit ids, or the curves a 28-bit tag: far beyond any memory).
+  /// points or zero length are skipped (counted in skipped_curves()). Throws std::bad_alloc when memory
+  /// runs out, and hk::ArgumentError when the nodes would not fit 32-bit ids, or the curves a 28-bit tag
+  /// (far beyond any picture's segment budget).
   static Scene build(const std::vector<Polyline>& curves, int max_levels);
 
   std::size_t curve_count() const noexcept { return curves_.size(); }
