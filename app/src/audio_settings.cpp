@@ -7,18 +7,6 @@
 
 namespace hk::app {
 
-audio::AudioSystemParams audio_params_from(const config::Settings& s) {
-  audio::AudioSystemParams p;
-  p.mixer.earcons.gain = s.audio.earcon_gain;
-  p.mixer.duck_db = s.audio.duck_db;
-  p.speech.voice.clear();  // the catalogue's voice
-  p.speech.rate_wpm = s.audio.speech_rate_wpm;
-  p.output.frames_per_buffer = s.audio.buffer_frames;
-  p.volume_default_step = s.audio.volume_default_step;
-  p.volume_step_db = s.audio.volume_step_db;
-  return p;
-}
-
 std::string run_speak(const SpeakOptions& o) {
   const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
   const audio::MessageCatalog catalog =

@@ -1,7 +1,7 @@
 #pragma once
 /// @file audio_settings.hpp
-/// [audio] settings → the audio side's parameters, and the headless `speak` command that renders a
-/// message or a text to a WAV file (to hear a translation or a voice without a sound card).
+/// The headless `speak` command: renders a message or a text to a WAV file (to hear a translation or a
+/// voice without a sound card), with the [audio] settings' voice.
 
 #include <stdexcept>
 #include <string>
@@ -10,9 +10,6 @@
 #include "config/settings.hpp"
 
 namespace hk::app {
-
-/// The audio side's parameters from the settings (volume, earcon level, ducking, speech rate, buffer).
-audio::AudioSystemParams audio_params_from(const config::Settings& s);
 
 /// What `haptic-kiosk speak` was asked to do.
 struct SpeakOptions {

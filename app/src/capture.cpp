@@ -14,6 +14,7 @@
 #include "config/load.hpp"
 #include "app_error.hpp"
 #include "hk/error.hpp"
+#include "settings_params.hpp"
 
 namespace hk::app {
 namespace {
@@ -40,21 +41,6 @@ void take(CaptureOutcome& o, const cv::Mat& frame, const vision::FrameLook& look
 }
 
 }  // namespace
-
-CaptureParams capture_params_from(const config::Settings& s) {
-  CaptureParams p;
-  p.framing.still_s = s.camera.still_s;
-  p.timeout_s = s.camera.timeout_s;
-  return p;
-}
-
-vision::FrameSourceParams frame_source_params_from(const config::Settings& s) {
-  vision::FrameSourceParams p;
-  p.width_px = s.camera.width_px;
-  p.height_px = s.camera.height_px;
-  p.max_frame_bytes = s.vision.max_file_bytes;
-  return p;
-}
 
 const char* capture_end_name(CaptureEnd e) {
   switch (e) {

@@ -33,12 +33,6 @@ struct CaptureParams {
   double frame_wait_s = 2.0;      ///< a source silent this long (wall clock) ends the capture with CameraError [s]
 };
 
-/// The capture settings from [camera]: still_s and timeout_s; the rest at its defaults.
-CaptureParams capture_params_from(const config::Settings& s);
-
-/// The source settings from [camera]: the frame size asked for; the file source at 10 frames a second.
-vision::FrameSourceParams frame_source_params_from(const config::Settings& s);
-
 /// How a capture ended.
 enum class CaptureEnd {
   Still,       ///< the page lay whole, centred and still for still_s

@@ -1,6 +1,7 @@
 // The kiosk's camera and its captures on a worker thread (see capture_service.hpp).
 
 #include "capture_service.hpp"
+#include "settings_params.hpp"
 
 #include <exception>
 #include <utility>

@@ -16,6 +16,7 @@
 #include "haptics/io/usb_devices.hpp"
 #include "haptics/pty_emulator.hpp"
 #include "app_error.hpp"
+#include "settings_params.hpp"
 
 namespace hk::app {
 

@@ -11,11 +11,10 @@
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/io/usb_devices.hpp"
 #include "haptics/io/usb_transport.hpp"
+#include "settings_params.hpp"
 
 namespace hk::app {
 namespace {
-
-hapi::Rotation rotation_of(const std::string& dir) { return dir == "ccw" ? hapi::Rotation::CCW : hapi::Rotation::CW; }
 
 double number_of(const std::string& key, const std::string& value, double lo, double hi, bool integer) {
   double v = 0.0;
@@ -68,68 +67,6 @@ DeviceChoice parse_device_choice(const std::string& text) {
                               "calib_error1_deg, calib_error2_deg, rest_at_park");
   }
   return c;
-}
-
-hapi::BoardLayout board_layout_from(const config::Settings& s) {
-  const config::DeviceSettings& d = s.device;
-  hapi::BoardLayout b;
-  b.device_id = static_cast<std::uint8_t>(d.device_id);
-  b.actuator_count = 2;
-  b.actuators[0] = {1, rotation_of(d.actuator1_dir), d.actuator1_port};
-  b.actuators[1] = {2, rotation_of(d.actuator2_dir), d.actuator2_port};
-  b.encoder_count = 2;
-  b.encoders[0] = {1, rotation_of(d.encoder1_dir), d.encoder1_offset_deg, d.encoder1_resolution, d.encoder1_port};
-  b.encoders[1] = {2, rotation_of(d.encoder2_dir), d.encoder2_offset_deg, d.encoder2_resolution, d.encoder2_port};
-  return b;
-}
-
-io::HaplyDeviceParams haply_params_from(const config::Settings& s) {
-  const config::DeviceSettings& d = s.device;
-  io::HaplyDeviceParams p;
-  p.layout = board_layout_from(s);
-  p.mechanism.proximal_m = d.link_proximal_m;
-  p.mechanism.distal_m = d.link_distal_m;
-  p.mechanism.motor_spacing_m = d.motor_spacing_m;
-  p.torque_limit_n_m = d.torque_limit_n_m;
-  p.rect_center_device_m = {0.0, d.rect_center_y_m};
-  p.rect_size_device_m = {d.rect_width_m, d.rect_height_m};
-  p.workspace_size_m = {s.workspace.width_m, s.workspace.height_m};
-  p.lost_after_ticks = d.lost_after_ticks;
-  return p;
-}
-
-hapi::EmulatorParams emulator_params_from(const config::Settings& s, const DeviceChoice& choice) {
-  const config::DeviceSettings& d = s.device;
-  hapi::EmulatorParams e;
-  e.mechanism.proximal_m = d.link_proximal_m;
-  e.mechanism.distal_m = d.link_distal_m;
-  e.mechanism.motor_spacing_m = d.motor_spacing_m;
-  e.handle_mass_kg = d.handle_mass_kg;
-  e.handle_damping_n_s_per_m = d.handle_damping_n_s_per_m;
-  e.torque_limit_n_m = d.torque_limit_n_m;
-  e.period_s = 1.0 / s.haptics.servo_rate_hz;
-  // The board wired as configured: port → joint and the true directions per port.
-  for (int port = 1; port <= 2; ++port) {
-    if (d.actuator1_port == port) e.wired_motor_dir[port - 1] = rotation_of(d.actuator1_dir);
-    if (d.actuator2_port == port) e.wired_motor_dir[port - 1] = rotation_of(d.actuator2_dir);
-    if (d.encoder1_port == port) {
-      e.wired_encoder_dir[port - 1] = rotation_of(d.encoder1_dir);
-      e.port_joint[port - 1] = 1;
-    }
-    if (d.encoder2_port == port) {
-      e.wired_encoder_dir[port - 1] = rotation_of(d.encoder2_dir);
-      e.port_joint[port - 1] = 2;
-    }
-  }
-  e.reference_deg[0] = d.encoder1_offset_deg;
-  e.reference_deg[1] = d.encoder2_offset_deg;
-  e.calibration_error_deg[0] = choice.calibration_error_deg[0];
-  e.calibration_error_deg[1] = choice.calibration_error_deg[1];
-  e.workspace_half_extent_m = {d.rect_width_m / 2, d.rect_height_m / 2};
-  e.workspace_center_m = {0.0, d.rect_center_y_m};
-  e.stop_margin_m = 0.005;
-  e.faults = choice.faults;
-  return e;
 }
 
 hapi::EmulatorParams emulator_resting_at_park(const config::Settings& s, const DeviceChoice& choice, Vec2* start_device_m) {

@@ -40,17 +40,6 @@ struct DeviceChoice {
 /// key or value and its limit.
 DeviceChoice parse_device_choice(const std::string& text);
 
-/// The hAPI board layout of [device] (ports, directions, encoder offsets and resolutions, device id).
-hapi::BoardLayout board_layout_from(const config::Settings& s);
-
-/// The USB pantograph driver's parameters from [device] and [workspace].
-io::HaplyDeviceParams haply_params_from(const config::Settings& s);
-
-/// The firmware emulator's parameters: the board wired as [device] describes it (so a right configuration
-/// reads right), the mechanism and handle physics of [device], the stop box = the usable rectangle plus
-/// 5 mm, and the choice's faults and calibration errors.
-hapi::EmulatorParams emulator_params_from(const config::Settings& s, const DeviceChoice& choice);
-
 /// The firmware emulator with its handle resting at the park place ([device] park_x_m, park_y_m: by default
 /// the board's home pose, beyond the usable rectangle at the edge of the links' reach): emulator_params_from
 /// with stops hugging the park place (0.5 mm each way). `*start_device_m` is the place, device frame [m].

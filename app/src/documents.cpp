@@ -10,30 +10,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "settings_params.hpp"
 #include "vision/intake.hpp"
 
 namespace hk::app {
-
-vision::ScanLimits scan_limits_from(const config::Settings& s) {
-  vision::ScanLimits l;
-  l.max_depth = s.stick.max_depth;
-  l.max_entries = s.stick.max_entries;
-  l.max_documents = s.stick.max_documents;
-  l.max_file_bytes = s.stick.max_file_bytes;
-  l.max_seconds = s.stick.scan_timeout_s;
-  return l;
-}
-
-vision::PdfLimits pdf_limits_from(const config::Settings& s) {
-  vision::PdfLimits l;
-  l.max_file_bytes = s.stick.max_file_bytes;
-  l.max_pages = s.stick.max_pdf_pages;
-  l.max_page_pixels = s.stick.page_max_pixels;
-  l.max_dpi = s.stick.page_max_dpi;
-  l.worker_cpu_s = s.stick.page_timeout_s;
-  l.worker_wall_s = s.stick.page_timeout_s;
-  return l;
-}
 
 bool is_pdf_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);

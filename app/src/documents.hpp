@@ -17,11 +17,6 @@
 
 namespace hk::app {
 
-/// [stick] settings as the scan's limits.
-vision::ScanLimits scan_limits_from(const config::Settings& s);
-/// [stick] settings as the PDF worker's limits (page_timeout_s is both the wall-clock and the CPU limit).
-vision::PdfLimits pdf_limits_from(const config::Settings& s);
-
 /// Whether the file at `path` starts with "%PDF-" (reads its first kilobyte; false when unreadable).
 bool is_pdf_file(const std::string& path);
 

@@ -27,6 +27,7 @@
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
 #include "image_scene.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 
 namespace hk::app {

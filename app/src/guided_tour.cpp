@@ -8,13 +8,6 @@
 
 namespace hk::app {
 
-TourParams tour_params_from(const config::Settings& s) {
-  TourParams p;
-  p.max_force_n = s.haptics.tour_max_force_n;
-  p.speed_m_per_s = s.haptics.tour_speed_m_per_s;
-  return p;
-}
-
 void VisitTouches::reset(int scene_id, int curve_count) {
   scene_id_ = scene_id;
   count_ = 0;

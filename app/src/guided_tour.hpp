@@ -51,9 +51,6 @@
 
 namespace hk::app {
 
-/// TourParams from the settings: [haptics] tour_max_force_n and tour_speed_m_per_s; the rest the defaults.
-TourParams tour_params_from(const config::Settings& s);
-
 /// The shapes touched in this visit of this picture (the kiosk keeps what was touched per visit). Fed with the servo display state's contact curve and with completed tours. Forgotten with a
 /// new picture (reset) and a new visitor.
 class VisitTouches {

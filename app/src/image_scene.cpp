@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "haptics/multires.hpp"
+#include "settings_params.hpp"
 #include "vision/intake.hpp"
 #include "hk/error.hpp"
 
@@ -34,38 +35,6 @@ std::vector<Polyline> to_polylines(const std::vector<vision::SceneCurve>& curves
 }
 
 namespace {
-
-vision::ExtractParams extract_params(const config::Settings& s) {
-  vision::ExtractParams p;
-  p.limits.max_file_bytes = s.vision.max_file_bytes;
-  p.limits.max_width_px = s.vision.max_width_px;
-  p.limits.max_height_px = s.vision.max_height_px;
-  p.limits.max_pixels = s.vision.max_pixels;
-  p.edges.blur_sigma_px = s.vision.blur_sigma_px;
-  p.edges.canny_low = s.vision.canny_low;
-  p.edges.canny_high = s.vision.canny_high;
-  p.max_image_side_px = s.vision.max_image_side_px;
-  p.detector = vision::detector_from_name(s.vision.detector);
-  p.surround_inhibition = s.vision.surround_inhibition;
-  p.line_drawing_max_ink_m = s.vision.thin_line_max_width_m;
-  p.workspace_width_m = s.workspace.width_m;
-  p.workspace_height_m = s.workspace.height_m;
-  // Length is judged in metres by simplify_chains, where the workspace scale is known; keep every real chain here.
-  p.min_chain_length_px = 2.0;
-  return p;
-}
-
-vision::SimplifyParams simplify_params(const config::Settings& s) {
-  vision::SimplifyParams p;
-  p.workspace_width_m = s.workspace.width_m;
-  p.workspace_height_m = s.workspace.height_m;
-  p.thin_line_max_width_m = s.vision.thin_line_max_width_m;
-  p.gap_close_m = s.vision.gap_close_m;
-  p.min_chain_length_m = s.vision.min_chain_length_m;
-  p.max_shapes = static_cast<std::size_t>(s.vision.max_shapes);
-  p.max_segments = static_cast<std::size_t>(s.vision.max_segments);
-  return p;
-}
 
 /// The level-0 segments Scene::build will give a curve: plan_levels' sample count (closed: points; open:
 /// points − 1).
@@ -187,7 +156,7 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
     }
   }
   out.text_words_masked = text.words.size();
-  build_from_chains(out, vision::scene_chains_from_image(bgr, extract_params(s), simplify_params(s), segment_cost(s), mask), s);
+  build_from_chains(out, vision::scene_chains_from_image(bgr, extract_params_from(s), simplify_params_from(s), segment_cost(s), mask), s);
   add_ocr_blocks(out, text);
 }
 
@@ -218,7 +187,7 @@ void build_page(ImageScene& out, const vision::PdfPage& page, const config::Sett
   out.text_words_masked = words.size();
   cv::Mat mask = words.empty() ? cv::Mat() : text_mask(page.grey.size(), words);
   if (!letters.empty()) mask = mask.empty() ? letters : (mask | letters);
-  build_from_chains(out, vision::scene_chains_from_image(page.grey, extract_params(s), simplify_params(s), segment_cost(s), mask), s);
+  build_from_chains(out, vision::scene_chains_from_image(page.grey, extract_params_from(s), simplify_params_from(s), segment_cost(s), mask), s);
   if (read) {
     add_ocr_blocks(out, text);
     return;
@@ -235,13 +204,6 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 }  // namespace
-
-vision::OcrParams ocr_params_from(const config::Settings& s) {
-  vision::OcrParams p;
-  p.languages = s.vision.ocr_languages.empty() ? std::string("eng") : s.vision.ocr_languages;
-  p.min_word_confidence = s.vision.ocr_min_confidence;
-  return p;
-}
 
 bool wants_picture_text(const cv::Mat& grey, const config::Settings& s, std::string& why) {
   if (s.vision.ocr == "off") {
@@ -304,7 +266,7 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s,
   ImageScene out;
   out.image_path = path;
   const auto t0 = std::chrono::steady_clock::now();
-  const cv::Mat bgr = vision::load_image(path, extract_params(s).limits);
+  const cv::Mat bgr = vision::load_image(path, extract_params_from(s).limits);
   const double load_ms = ms_since(t0);
   build_picture(out, bgr, s, timing, nullptr);
   out.times.load_ms += load_ms;
@@ -316,7 +278,7 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
   ImageScene out;
   out.image_path = name;
   const auto t0 = std::chrono::steady_clock::now();
-  out.picture = vision::decode_image(bytes, name, extract_params(s).limits);
+  out.picture = vision::decode_image(bytes, name, extract_params_from(s).limits);
   const double decode_ms = ms_since(t0);
   build_picture(out, out.picture, s, timing, nullptr);
   out.times.load_ms += decode_ms;

@@ -181,10 +181,6 @@ ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name
 /// word box grown by `grow` x its height on every side, 0 elsewhere.
 cv::Mat text_mask(cv::Size size, const std::vector<vision::PdfWord>& words, double grow = 0.25);
 
-/// vision::OcrParams from the [vision] settings: the languages (empty: "eng", the language of the kiosk's
-/// message catalogue) and the confidence threshold.
-vision::OcrParams ocr_params_from(const config::Settings& settings);
-
 /// Longest side a picture is read at [px]: a letter-size page at 400 dpi. Larger pictures (a 24-megapixel
 /// photo of a page) are scaled down to it first.
 inline constexpr int kOcrMaxSidePx = 4400;

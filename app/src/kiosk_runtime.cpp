@@ -19,6 +19,7 @@
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/tolerance_cut.hpp"
 #include "picture_library.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 
 namespace hk::app {
@@ -679,12 +680,7 @@ int KioskRuntime::find_picture(const std::string& path) const {
   return -1;
 }
 
-CueTrackerParams KioskRuntime::cue_params() const {
-  CueTrackerParams p;
-  p.period_s = 1.0 / s_.haptics.servo_rate_hz;
-  p.workspace_half_extent_m = half_;
-  return p;
-}
+CueTrackerParams KioskRuntime::cue_params() const { return cue_params_from(s_); }
 
 void KioskRuntime::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes) {
   const Scene& sc = *scene;

@@ -11,88 +11,9 @@
 #include "haptics/pty_emulator.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "servo_runner.hpp"
+#include "settings_params.hpp"
 
 namespace hk::app {
-
-ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t seed) {
-  ExplorerParams ep;
-  ep.workspace_width_m = s.workspace.width_m;
-  ep.workspace_height_m = s.workspace.height_m;
-  ep.sweep_spacing_m = s.hand.raster_spacing_m;
-  // 1.5 x the raster's speed: the raster runs into walls blind, the explorer's plans keep it off the walls it
-  // remembers and it slows to the trace speed at every wall it meets.
-  ep.sweep_speed_m_per_s = std::min(5.0, 1.5 * s.hand.raster_speed_m_per_s);
-  ep.max_force_n = s.hand.max_force_n;
-  ep.press_force_n = std::min(ep.press_force_n, 0.5 * s.hand.max_force_n);
-  ep.contact_force_n = std::min(ep.contact_force_n, 0.25 * s.hand.max_force_n);
-  ep.hand_stiffness_n_per_m = s.hand.stiffness_n_per_m;
-  ep.pop_force_n = s.haptics.pop_force_n;
-  ep.pop_hold_s = s.haptics.pop_hold_s;
-  ep.grooves = s.haptics.render == "grooves";
-  ep.seed = seed;
-  return ep;
-}
-
-CueTrackerParams cue_params_from(const config::Settings& s) {
-  CueTrackerParams p;
-  p.period_s = 1.0 / s.haptics.servo_rate_hz;
-  p.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
-  return p;
-}
-
-ServoGains servo_gains_from(const config::Settings& s) {
-  ServoGains g;
-  g.stiffness_n_per_m = s.haptics.stiffness_n_per_m;
-  g.damping_n_s_per_m = s.haptics.damping_n_s_per_m;
-  g.max_force_n = s.haptics.max_force_n;
-  g.static_friction = s.haptics.static_friction;
-  g.dynamic_friction = s.haptics.dynamic_friction;
-  g.max_force_step_n = s.haptics.level_max_force_step_n;
-  g.query_box_budget = s.haptics.query_box_budget;
-  g.pop_force_n = s.haptics.pop_force_n;
-  g.pop_hold_s = s.haptics.pop_hold_s;
-  g.pop_release_s = s.haptics.pop_release_s;
-  return g;
-}
-
-ServoParams servo_params_from(const config::Settings& s) {
-  ServoParams sp;
-  sp.period_s = 1.0 / s.haptics.servo_rate_hz;
-  sp.level = s.haptics.level;
-  sp.auto_level = s.haptics.level_mode != "fixed";
-  sp.tolerance_steps = s.haptics.level_mode == "tolerance";
-  sp.cut_steps = s.haptics.level_mode == "cut";
-  sp.policy.error_at_rest_m = s.haptics.level_error_at_rest_m;
-  sp.policy.blur_time_s = s.haptics.level_blur_time_s;
-  sp.policy.hysteresis = s.haptics.level_hysteresis;
-  sp.policy.min_dwell_s = s.haptics.level_min_dwell_s;
-  // Walls or grooves. The groove's stiffness, max force and per-tick jump limit come from
-  // the gains below (stiffness_n_per_m, max_force_n, level_max_force_step_n) through apply_gains.
-  sp.render = s.haptics.render == "grooves" ? RenderMode::Grooves : RenderMode::Walls;
-  sp.groove.capture_radius_m = s.haptics.groove_capture_radius_m;
-  sp.groove.depth_n = s.haptics.groove_depth_n;
-  apply_gains(sp, servo_gains_from(s));
-  sp.guard.ramp_s = s.haptics.force_ramp_s;
-  return sp;
-}
-
-SimPantographParams sim_params_from(const config::Settings& s) {
-  SimPantographParams dp;
-  dp.handle_mass_kg = s.device.handle_mass_kg;
-  dp.handle_damping_n_s_per_m = s.device.handle_damping_n_s_per_m;
-  dp.encoder_counts_per_rev = s.device.encoder_counts_per_rev;
-  dp.max_torque_n_m = s.device.max_torque_n_m;
-  dp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
-  return dp;
-}
-
-ModelHandParams hand_params_from(const config::Settings& s) {
-  ModelHandParams hp;
-  hp.stiffness_n_per_m = s.hand.stiffness_n_per_m;
-  hp.damping_n_s_per_m = s.hand.damping_n_s_per_m;
-  hp.max_force_n = s.hand.max_force_n;
-  return hp;
-}
 
 namespace {
 

@@ -54,27 +54,6 @@ struct RunOptions {
   int scene_id = 0;                                    ///< SceneBundle::id of the scene (a tour names it)
 };
 
-/// The earcon tracker's parameters from the settings: the servo period and the workspace rectangle.
-CueTrackerParams cue_params_from(const config::Settings& s);
-/// The live-changeable servo gains from the settings ([haptics]: stiffness, damping, max force, friction,
-/// level_max_force_step_n, query box budget), as ServoCore::set_gains takes them at Apply.
-ServoGains servo_gains_from(const config::Settings& s);
-
-/// Servo parameters from the settings. Its gains part is servo_gains_from(s) (gains_of(servo_params_from(s))
-/// == servo_gains_from(s)).
-ServoParams servo_params_from(const config::Settings& s);
-
-/// Simulated pantograph parameters from the settings ([device] and the [workspace] rectangle).
-SimPantographParams sim_params_from(const config::Settings& s);
-
-/// Model hand parameters from the settings ([hand]).
-ModelHandParams hand_params_from(const config::Settings& s);
-
-/// The visitor-like explorer hand's parameters (`--hand explorer`) from the settings: the workspace, the hand's
-/// spring and force, the raster's spacing and 1.5x its speed for the sweeps (capped at 5 m/s), the walls'
-/// push-through and the rendering mode; `seed` drives its choices.
-ExplorerParams explorer_params_from(const config::Settings& s, std::uint64_t seed);
-
 /// Runs the device `o.device` chose (the simulated pantograph, or the Haply firmware emulator behind a pty
 /// reached through the tty transport and the hAPI driver, bytes and all) driven by the model hand `hand` over
 /// `scene` for `duration_s` seconds, tick by tick as fast as the machine goes, through the kiosk's servo
