@@ -9,7 +9,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 image="${1:-$root/tests/data/images/horse.png}"
 out="${2:-$root/out/demo}"
 build="${HK_DEMO_BUILD_DIR:-$root/build-demo}"
-bash "$root/scripts/install-deps.sh"
+bash "$root/scripts/install-deps.sh" --demo
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHK_BUILD_TESTS=OFF -DHK_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "$(nproc)" --target haptic-kiosk
 mkdir -p "$out"
