@@ -29,6 +29,7 @@
 
 #include "capture.hpp"
 #include "image_scene.hpp"
+#include "settings_params.hpp"
 #include "synthetic_photo.hpp"
 
 using namespace hk;

@@ -33,6 +33,7 @@
 #include "haptics/pty_emulator.hpp"
 #include "image_scene.hpp"
 #include "servo_thread.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 
 using namespace hk;

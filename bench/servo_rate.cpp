@@ -16,6 +16,7 @@
 #include "haptics/sim_pantograph.hpp"
 #include "image_scene.hpp"
 #include "servo_thread.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 
 using namespace hk;

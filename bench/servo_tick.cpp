@@ -36,6 +36,7 @@
 
 #include "bench_scenes.hpp"
 #include "haptics/explorer_hand.hpp"
+#include "settings_params.hpp"
 
 using namespace hk;
 using namespace hk::bench;

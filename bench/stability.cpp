@@ -125,6 +125,7 @@
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
 #include "haptics/sim_pantograph.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 
 using namespace hk;

@@ -22,6 +22,7 @@
 #include "haptics/sim_pantograph.hpp"
 #include "image_scene.hpp"
 #include "servo_core.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 #include "tour_picture.hpp"
 

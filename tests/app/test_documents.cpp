@@ -28,6 +28,7 @@
 #include "documents.hpp"
 #include "child_process.hpp"
 #include "image_scene.hpp"
+#include "settings_params.hpp"
 #include "stick_service.hpp"
 #include "vision/pdf.hpp"
 

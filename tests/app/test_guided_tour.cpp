@@ -28,6 +28,7 @@
 #include "kiosk_runtime.hpp"
 #include "kiosk_flow.hpp"
 #include "servo_core.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 #include "test_pictures.hpp"
 #include "tour_picture.hpp"

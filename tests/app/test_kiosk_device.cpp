@@ -19,6 +19,7 @@
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/pty_emulator.hpp"
 #include "kiosk_runtime.hpp"
+#include "settings_params.hpp"
 
 namespace fs = std::filesystem;
 

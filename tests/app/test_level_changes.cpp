@@ -17,6 +17,7 @@
 #include "haptics/explorer_hand.hpp"
 #include "haptics/hand_path.hpp"
 #include "image_scene.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 #include "test_pictures.hpp"
 

@@ -10,6 +10,7 @@
 #include "haptics/hand_path.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "servo_core.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 
 namespace hk::app {

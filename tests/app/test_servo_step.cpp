@@ -26,6 +26,7 @@
 #include "haptics/sim_pantograph.hpp"
 #include "servo_core.hpp"
 #include "servo_runner.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 
 // ── Counting allocation ───────────────────────────────────────────────────────────────────────────

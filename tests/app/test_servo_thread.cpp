@@ -10,6 +10,7 @@
 #include "haptics/sim_pantograph.hpp"
 #include "hk/error.hpp"
 #include "servo_thread.hpp"
+#include "settings_params.hpp"
 #include "simulation.hpp"
 
 namespace hk::app {
