@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Makes the PDF test files of tests/vision/test_pdf.cpp (issue 11). Run from tests/data:
+"""Makes the PDF test files of tests/vision/test_pdf.cpp. Run from tests/data:
 
     python3 make_pdfs.py
 
