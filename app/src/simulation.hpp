@@ -64,10 +64,10 @@ struct RunOptions {
 /// velocity, the force the servo wrote to the device at the previous tick (after the guard)}.
 /// With the emulator the hand force is computed on the emulator's own thread and the feel carries no device
 /// force (zero): only open-loop hands (PathHand) are meaningful there, and `hand` must not be used
-/// elsewhere during the run. A tick waits up to 10 ms for the reply to the previous tick's packet while the
-/// device is Ok (not while it is Lost), and up to 20 ms after each write for the emulator to have executed
-/// every packet sent, Lost or not, until it is disconnected (so the run does not depend on the machine's
-/// speed); a device that comes back restarts the servo at the handle (force ramped in again: ServoCore).
+/// elsewhere during the run. Between ticks (never inside one) the run waits up to 20 ms for the emulator to
+/// have executed every packet sent, Lost or not, until it is disconnected, then up to 10 ms for the reply
+/// to the packet, as a real board's would be in by the next tick (so the run does not depend on the
+/// machine's speed); a device that comes back restarts the servo at the handle (force ramped in again: ServoCore).
 /// `o.script` runs after each tick. Returns the number of ticks run. Throws DeviceError when the emulator
 /// cannot be reached. `scene` outlives the call.
 long run_simulation(const Scene& scene, const config::Settings& s, HandController& hand, double duration_s,
