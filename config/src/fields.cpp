@@ -108,6 +108,12 @@ std::string pin_hash_problem(std::string_view v) {
   return {};
 }
 
+/// The check of [kiosk] scene_cache: "auto", "off" or an absolute folder.
+std::string scene_cache_problem(std::string_view v) {
+  if (v == "auto" || v == "off" || (!v.empty() && v.front() == '/')) return {};
+  return "must be \"auto\", \"off\" or an absolute folder";
+}
+
 /// The check of [kiosk] quiet_hours (parse_quiet_hours).
 std::string quiet_hours_problem(std::string_view v) {
   std::string why;
@@ -279,6 +285,11 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(kiosk, attract_every_s, FieldGroup::kiosk, ApplyWhen::live, 0, 3600, "s", "While nobody is there, a short spoken invitation comes this often (0: never)."),
     HK_FIELD(kiosk, quiet_hours, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
              "Local times with no spoken invitation, \"HH:MM-HH:MM\" (e.g. \"22:00-07:00\"); empty: none.", {}, &quiet_hours_problem),
+    HK_FIELD(kiosk, prefetch_mb, FieldGroup::kiosk, ApplyWhen::live, 0, 4096, "MiB",
+             "Memory for the next and previous pictures, built while the visitor explores this one, so Next is at once (0: none built ahead)."),
+    HK_FIELD(kiosk, scene_cache, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+             "Where built scenes of the library's pictures are kept, so the first picture after a restart is felt at once: \"auto\" (the service's cache folder, else ~/.cache/haptic-kiosk/scenes), \"off\", or an absolute folder.",
+             {}, &scene_cache_problem),
     // [stick]
     HK_FIELD(stick, max_depth, FieldGroup::devices, ApplyWhen::restart, 1, 64, "", "Deepest folder of a stick that is entered (its root is 0)."),
     HK_FIELD(stick, max_entries, FieldGroup::devices, ApplyWhen::restart, 10, 1000000, "", "Directory entries looked at per scan of a stick."),

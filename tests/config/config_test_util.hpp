@@ -113,6 +113,7 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"kiosk", "timeout_s", 20, 3600, false},
       {"kiosk", "warning_s", 10, 600, false},
       {"kiosk", "attract_every_s", 0, 3600, false},
+      {"kiosk", "prefetch_mb", 0, 4096, true},
       {"stick", "max_depth", 1, 64, true},
       {"stick", "max_entries", 10, 1000000, true},
       {"stick", "max_documents", 1, 100000, true},

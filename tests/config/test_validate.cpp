@@ -114,7 +114,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
-    if (name == "operator.open_chord" || name == "device.serial_path" || name == "device.usb_ids" || name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "vision.ocr_languages") {
+    if (name == "operator.open_chord" || name == "device.serial_path" || name == "device.usb_ids" || name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "kiosk.scene_cache" || name == "vision.ocr_languages") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -124,7 +124,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 34u);
+  EXPECT_EQ(texts, 35u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -417,6 +417,22 @@ TEST(QuietHours, ReadsTwoTimesAndKnowsWhetherAMinuteIsInThem) {
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.key(), "kiosk.quiet_hours");
     EXPECT_NE(std::string(e.what()).find("00:00 to 23:59"), std::string::npos) << e.what();
+  }
+}
+
+// [kiosk] scene_cache: "auto", "off" or an absolute folder; a relative one (which would land wherever the
+// service happens to start) is refused naming the key.
+TEST(SceneCacheSetting, TakesAutoOffOrAnAbsoluteFolderOnly) {
+  for (const char* good : {"auto", "off", "/var/cache/haptic-kiosk/scenes"})
+    EXPECT_NO_THROW((void)parse_settings(std::string("[kiosk]\nscene_cache = \"") + good + "\"\n", "k.toml")) << good;
+  for (const char* bad : {"", "scenes", "./cache", "Off"}) {
+    try {
+      (void)parse_settings(std::string("[kiosk]\nscene_cache = \"") + bad + "\"\n", "k.toml");
+      ADD_FAILURE() << "'" << bad << "' was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), "kiosk.scene_cache") << bad;
+      EXPECT_NE(std::string(e.what()).find("absolute folder"), std::string::npos) << e.what();
+    }
   }
 }
 
