@@ -128,7 +128,7 @@ class Kiosk final : public ScriptTarget {
   void moved() override { flow_.handle_moved(now_s_); }
   void stick(const std::string& dir) override { rt_.insert_stick_folder(dir); }
   void unstick() override { rt_.remove_stick_folder(); }
-  bool busy() override { return rt_.stick_busy() || rt_.text_busy() || session_.state() == PanelState::checking; }
+  bool busy() override { return rt_.stick_busy() || rt_.text_busy() || rt_.picture_busy() || session_.state() == PanelState::checking; }
   std::optional<WidgetRect> widget(const std::string& name) override { return panel_.widget(name); }
 
   /// The mouse stands in for the visitor's hand, but only once it has moved: where the pointer happens to
@@ -245,11 +245,14 @@ void start_kiosk(const KioskOptions& o, const RuntimeOptions& ro, KioskRuntime& 
 bool update_frame(Kiosk& kiosk, KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, KioskWindow& window,
                   ScriptPlayer& script, bool scripted, int frame) {
   for (const InputEvent& e : window.poll()) kiosk.input(e);
+  rt.poll_pictures(&flow, kiosk.now_s_);
   rt.poll_sticks(flow, kiosk.now_s_);
   rt.poll_capture(flow, kiosk.now_s_);
   rt.poll_text(kiosk.now_s_);
   rt.poll_device(kiosk.now_s_);
-  const bool holding = scripted && script.step(frame, kiosk);
+  // A scripted run's clock is its frame count: it holds while a picture asked for is being built, so the
+  // same script shows the same frames however fast the machine builds.
+  const bool holding = scripted && (rt.picture_busy() || script.step(frame, kiosk));
   if (!scripted) kiosk.follow_mouse();
   kiosk.watch_handle();
   rt.poll_tour();

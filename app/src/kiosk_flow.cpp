@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <exception>
+#include <utility>
 
 namespace hk::app {
 
@@ -293,6 +294,19 @@ void KioskFlow::show(int index, const std::string& before) {
   v_.state = KioskState::Picture;
   v_.captured = false;
   const int shapes = fx_.show_picture(v_.picture);
+  if (shapes == KioskEffects::kPicturePending) {  // built off the window thread: announced when it is felt
+    v_.pending_picture = v_.picture;
+    v_.pending_before = before;
+    v_.pending_since_s = v_.last_activity_s;
+    v_.loading_said = false;
+    return;
+  }
+  v_.pending_picture = -1;
+  announce_picture(shapes, before);
+}
+
+void KioskFlow::announce_picture(int shapes, const std::string& before) {
+  const int n = fx_.picture_count();
   const std::string num = std::to_string(v_.picture + 1), total = std::to_string(n);
   const std::string title = fx_.shown_notes().title;
   std::string line;
@@ -352,7 +366,7 @@ void KioskFlow::tick(double now_s) {
     // Speech being heard is the visitor listening (a long text being read is never cut by the time-out);
     // the warning's own speech is not.
     if (!v_.warned && fx_.speaking()) activity(now_s);
-    if (v_.pending_doc >= 0 && !v_.loading_said && now_s - v_.pending_since_s > p_.loading_cue_s) {
+    if ((v_.pending_doc >= 0 || v_.pending_picture >= 0) && !v_.loading_said && now_s - v_.pending_since_s > p_.loading_cue_s) {
       v_.loading_said = true;
       say_brief(MessageId::loading);
     }
@@ -531,6 +545,27 @@ void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
     v_.announce_summary.clear();
   }
   fx_.say(line);
+}
+
+void KioskFlow::picture_ready(int index, int shapes, double now_s) {
+  guarded("a picture of the library", [&] {
+    (void)now_s;
+    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured || v_.source != KioskSource::Library) return;  // superseded
+    v_.pending_picture = -1;
+    announce_picture(shapes, std::exchange(v_.pending_before, {}));
+  });
+}
+
+void KioskFlow::picture_failed(int index, const std::string& reason, double now_s) {
+  guarded("a picture of the library", [&] {
+    (void)now_s;
+    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured || v_.source != KioskSource::Library) return;  // superseded
+    v_.pending_picture = -1;
+    const std::string name = "Picture " + std::to_string(index + 1) + " of " + std::to_string(fx_.picture_count());
+    const std::string line = text(MessageId::document_unreadable, {{"name", name}, {"reason", reason}});
+    const std::string before = std::exchange(v_.pending_before, {});
+    fx_.say(before.empty() ? line : before + " " + line);
+  });
 }
 
 }  // namespace hk::app

@@ -30,7 +30,9 @@
 /// stick ("A USB stick with 3 documents: 2 pictures and a PDF of 12 pages. Press the Right arrow ...").
 /// Documents load asynchronously (KioskEffects::show_document; the window layer reports back with
 /// document_ready), so slow work never blocks; "Loading." is said when a load takes longer than
-/// loading_cue_s. A page that cannot be read is reported and the picture felt before stays. Removing the
+/// loading_cue_s. A page that cannot be read is reported and the picture felt before stays. Library pictures
+/// that are not at hand are built the same way (show_picture answers kPicturePending; picture_ready follows),
+/// with the same "Loading." cue and the picture felt before kept until the new one is on the device. Removing the
 /// stick goes back to the library picture; a new session forgets the stick.
 ///
 /// The camera: the Capture key starts a capture (KioskEffects::start_capture) guided by voice (capture_advice,
@@ -111,7 +113,12 @@ class KioskEffects {
   virtual bool quiet_hours() const { return false; }
   /// Put a tutorial shape on the device.
   virtual void show_tutorial(TutorialShape shape) = 0;
-  /// Put picture `index` (0-based) on the device. Returns its number of shapes.
+  /// show_picture's answer while the picture is still being built: the picture felt before stays, and
+  /// KioskFlow::picture_ready (or picture_failed) follows.
+  static constexpr int kPicturePending = -1;
+  /// Put picture `index` (0-based) on the device. Returns its number of shapes when it is on the device now
+  /// (built ahead, or quick), else kPicturePending: it is built off the window thread, and the window layer
+  /// calls KioskFlow::picture_ready or picture_failed when it is done. A newer request supersedes an older one.
   virtual int show_picture(int index) = 0;
   /// Pictures in the library (≥ 1).
   virtual int picture_count() const = 0;
@@ -192,6 +199,14 @@ class KioskFlow {
   void stick_removed(double now_s);
   /// A load asked for with show_document finished (ignored unless it is the one awaited).
   void document_ready(const DocumentResult& result, double now_s);
+  /// Library picture `index`, asked for with show_picture (which answered kPicturePending), is on the device
+  /// with `shapes` shapes: announced as show_picture's answer would have been. Ignored unless it is the one awaited.
+  void picture_ready(int index, int shapes, double now_s);
+  /// Library picture `index` could not be built (`reason`, one line): said, and the picture felt before stays.
+  /// Next and Previous go on from `index`. Ignored unless it is the one awaited.
+  void picture_failed(int index, const std::string& reason, double now_s);
+  /// A library picture is awaited (asked for, not yet on the device).
+  bool picture_pending() const { return v_.pending_picture >= 0; }
   /// The capture under way says `advice` (one of the capture_* messages, capture.hpp advice_message). Counts as
   /// activity (the visitor is busy placing the picture). Ignored when no capture is under way.
   void capture_advice(audio::MessageId advice, double now_s);
@@ -241,6 +256,8 @@ class KioskFlow {
     int doc = -1, page = 1;                  // shown
     int at_doc = -1, at_page = 1;            // where browsing stands: the last page asked for, shown or not
     int pending_doc = -1, pending_page = 1;  // awaited
+    int pending_picture = -1;                // a library picture awaited
+    std::string pending_before;              // said before its announcement ("Tutorial done.")
     double pending_since_s = 0;
     bool loading_said = false;
     std::string announce_summary;            // the stick's summary, said before the first page's announcement
@@ -269,6 +286,7 @@ class KioskFlow {
   void end_session(double now_s);
   void start_tutorial();
   void show(int index, const std::string& before = {});
+  void announce_picture(int shapes, const std::string& before);  // "Picture 2 of 5: ... It has 3 shapes."
   void say(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
   void say_brief(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
   void say_help();  // every key, and the Capture key's sentence when there is a camera

@@ -222,7 +222,11 @@ void KioskRuntime::announce_camera() {
   say(audio_.messages().text(audio::MessageId::camera_none));
 }
 
-bool KioskRuntime::start_capture() { return capture_.start(); }
+bool KioskRuntime::start_capture() {
+  const bool started = capture_.start();
+  if (started) drop_want();  // the visitor's own picture comes next, not a library picture still being built
+  return started;
+}
 
 void KioskRuntime::cancel_capture() { capture_.cancel(); }
 
@@ -351,7 +355,13 @@ void KioskRuntime::poll_display_modes() {
   }
 }
 
+void KioskRuntime::drop_want() {
+  wanted_id_ = kNoWant;
+  wanted_done_.reset();
+}
+
 void KioskRuntime::show_tutorial(TutorialShape shape) {
+  drop_want();  // a picture still being built is not wanted any more
   Shown sh;
   sh.polylines = {tutorial_polyline(shape, half_)};
   publish(std::move(sh), std::make_unique<Scene>(Scene::build({tutorial_polyline(shape, half_)}, s_.haptics.max_levels)),
@@ -363,9 +373,44 @@ void KioskRuntime::show_tutorial(TutorialShape shape) {
   shown_page_ = 0;
 }
 
+namespace {
+
+/// Memory a scene built ahead holds [bytes]: its picture, its curves and its collision trees (about 150
+/// bytes a level-0 segment over all levels and boxes; Scene's own layout, scene.hpp).
+std::size_t approx_bytes(const ImageScene& is) {
+  std::size_t b = is.picture.total() * is.picture.elemSize();
+  for (const Polyline& p : is.polylines) b += p.points_m.size() * sizeof(Vec2);
+  if (is.scene) b += is.scene->total_segments(0) * 150;
+  return b + sizeof(ImageScene);
+}
+
+}  // namespace
+
+SceneJob KioskRuntime::picture_job(int index) const {
+  // A copy of what the build needs: the worker never touches the runtime.
+  return [path = pictures_[static_cast<std::size_t>(index)], s = s_] { return build_image_scene(path, s, TextTiming::later); };
+}
+
 int KioskRuntime::show_picture(int index) {
+  absorb_built();
+  for (auto it = ahead_.begin(); it != ahead_.end(); ++it) {
+    if (it->index != index) continue;
+    std::unique_ptr<ImageScene> is = std::move(it->scene);
+    ahead_.erase(it);
+    wanted_id_ = kNoWant;  // the visitor moved on: an older ask is not wanted any more
+    wanted_done_.reset();
+    spdlog::info("picture {}: built ahead, on the device at once", index + 1);
+    return put_picture(index, *is);
+  }
+  wanted_id_ = index;
+  wanted_kind_ = WantKind::Picture;
+  wanted_done_.reset();
+  builder_.want(index, generation_, picture_job(index));
+  return KioskEffects::kPicturePending;
+}
+
+int KioskRuntime::put_picture(int index, ImageScene& is) {
   const std::string& path = pictures_[static_cast<std::size_t>(index)];
-  ImageScene is = build_image_scene(path, s_, TextTiming::later);
   const int shapes = static_cast<int>(is.scene->curve_count());
   PictureNotes notes;
   try {
@@ -378,7 +423,99 @@ int KioskRuntime::show_picture(int index) {
   shown_picture_ = index;
   shown_document_ = -1;
   shown_page_ = 0;
+  build_ahead();
   return shapes;
+}
+
+void KioskRuntime::absorb_built() {
+  for (BuiltScene& b : builder_.poll()) {
+    if (b.generation != generation_) continue;  // built with settings no longer in use
+    if (b.id == wanted_id_) {
+      wanted_done_ = std::move(b);
+      continue;
+    }
+    if (b.id < 0 || b.id >= picture_count()) continue;  // a rebuild nobody waits for
+    if (!b.scene) {  // not asked again until the settings change (the visitor asking for it hears why)
+      ahead_refused_.push_back(b.id);
+      continue;
+    }
+    Ahead a;
+    a.index = b.id;
+    a.bytes = approx_bytes(*b.scene);
+    a.scene = std::make_unique<ImageScene>(std::move(*b.scene));
+    ahead_.push_back(std::move(a));
+  }
+}
+
+void KioskRuntime::poll_pictures(KioskFlow* flow, double now_s) {
+  absorb_built();
+  if (wanted_done_) {
+    BuiltScene b = std::move(*wanted_done_);
+    wanted_done_.reset();
+    const WantKind kind = wanted_kind_;
+    wanted_id_ = kNoWant;
+    spdlog::info("scene {}: built in {:.0f} ms (waited {:.0f} ms to start)", b.id, b.build_ms, b.queued_ms);
+    if (!b.scene) {
+      spdlog::warn("scene {}: {}; the picture felt before stays", b.id, b.error);
+      if (kind == WantKind::Picture && flow) flow->picture_failed(b.id, b.error, now_s);
+    } else if (kind == WantKind::Rebuild) {
+      PictureNotes notes = std::move(shown_.notes);
+      show_built(*b.scene, b.id);  // the same picture with the new settings: no new announcement
+      shown_.notes = std::move(notes);
+      if (b.id >= 0 && b.id < picture_count()) build_ahead();
+    } else {
+      const int shapes = put_picture(b.id, *b.scene);
+      if (flow) flow->picture_ready(b.id, shapes, now_s);
+    }
+  }
+  build_ahead();
+}
+
+bool KioskRuntime::finish_picture(KioskFlow* flow, double now_s, double timeout_s) {
+  if (wanted_id_ == kNoWant) return true;
+  const bool came = builder_.wait_want(timeout_s);
+  poll_pictures(flow, now_s);
+  return came;
+}
+
+std::vector<int> KioskRuntime::pictures_ahead() const {
+  std::vector<int> out;
+  for (const Ahead& a : ahead_) out.push_back(a.index);
+  return out;
+}
+
+void KioskRuntime::build_ahead() {
+  const int n = picture_count();
+  const int at = wanted_id_ >= 0 && wanted_id_ < n ? wanted_id_ : shown_picture_;
+  if (at < 0) {
+    ahead_.clear();
+    return;
+  }
+  const int next = (at + 1) % n, previous = (at + n - 1) % n;
+  // Kept: the neighbours of where the visitor is (and is going), within the budget, the next one first.
+  const std::size_t budget = static_cast<std::size_t>(s_.kiosk.prefetch_mb) << 20;
+  std::vector<Ahead> kept;
+  std::size_t used = 0;
+  for (const int want : {next, previous}) {
+    for (Ahead& a : ahead_) {
+      if (a.index != want || !a.scene) continue;
+      if (used + a.bytes > budget) {
+        spdlog::info("picture {}: its scene ({} MiB) is over [kiosk] prefetch_mb; built when asked for", a.index + 1, a.bytes >> 20);
+        ahead_refused_.push_back(a.index);
+        continue;
+      }
+      used += a.bytes;
+      kept.push_back(std::move(a));
+    }
+  }
+  ahead_ = std::move(kept);
+  if (budget == 0 || n < 2) return;
+  for (const int want : {next, previous}) {
+    if (want == shown_picture_) continue;
+    const bool have = std::any_of(ahead_.begin(), ahead_.end(), [&](const Ahead& a) { return a.index == want; });
+    const bool refused = std::find(ahead_refused_.begin(), ahead_refused_.end(), want) != ahead_refused_.end();
+    if (!have && !refused && !builder_.has(want, generation_)) builder_.ahead(want, generation_, picture_job(want));
+  }
 }
 
 void KioskRuntime::show_built(ImageScene& is, int id) {
@@ -467,7 +604,10 @@ std::string KioskRuntime::describe_shown() {
   return words + describe_scene(shown_.polylines, half_, 3, core_.display().handle_m);
 }
 
-void KioskRuntime::show_document(int document, int page) { sticks_.load(stick_id_, document, page); }
+void KioskRuntime::show_document(int document, int page) {
+  drop_want();  // the stick's page, not a library picture still being built
+  sticks_.load(stick_id_, document, page);
+}
 
 void KioskRuntime::forget_stick() {
   sticks_.forget();
@@ -563,6 +703,7 @@ void KioskRuntime::new_session() {
                  t.ticks, t.missed_deadlines, t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us, t.compute_p99_us);
   }
   capture_.cancel();
+  drop_want();
   audio_.new_session();
   repeatable_.clear();
   tour_asked_ = false;
@@ -725,14 +866,27 @@ void KioskRuntime::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::
 }
 
 void KioskRuntime::rebuild_shown() {
+  // New settings: what was built ahead, or is being built, with the old ones is not used.
+  ++generation_;
+  ahead_.clear();
+  ahead_refused_.clear();
+  builder_.drop_ahead();
+  drop_want();
   if (shown_id_ <= -1 && shown_id_ >= -3) {
     const int shape = -1 - shown_id_;
     show_tutorial(static_cast<TutorialShape>(shape));
   } else if (shown_picture_ >= 0) {
-    show_picture(shown_picture_);
+    wanted_id_ = shown_picture_;
+    wanted_kind_ = WantKind::Rebuild;
+    wanted_done_.reset();
+    builder_.want(shown_picture_, generation_, picture_job(shown_picture_));
   } else if (shown_id_ <= kFirstCaptureId && !shown_.picture.empty()) {
-    ImageScene is = build_image_scene_from_picture(shown_.picture.clone(), "camera capture", s_, TextTiming::later);
-    show_built(is, shown_id_);
+    wanted_id_ = shown_id_;
+    wanted_kind_ = WantKind::Rebuild;
+    wanted_done_.reset();
+    builder_.want(shown_id_, generation_, [picture = shown_.picture.clone(), s = s_] {
+      return build_image_scene_from_picture(picture, "camera capture", s, TextTiming::later);
+    });
   } else if (shown_document_ >= 0 && stick_id_ != 0) {
     rebuild_page_id_ = 1000 + shown_document_ * 100000 + shown_page_;
     stick_busy_ = true;

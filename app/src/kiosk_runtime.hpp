@@ -12,6 +12,7 @@
 
 #include <atomic>
 #include <memory>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -30,6 +31,7 @@
 #include "image_scene.hpp"
 #include "kiosk_flow.hpp"
 #include "picture_notes.hpp"
+#include "scene_builder.hpp"
 #include "servo_core.hpp"
 #include "servo_thread.hpp"
 #include "stick_service.hpp"
@@ -154,6 +156,9 @@ class KioskRuntime final : public KioskEffects {
   /// kind, what lies in it and what it lies in), and where the hand is (place_words).
   std::string where() override;
   void show_tutorial(TutorialShape shape) override;
+  /// Picture `index` of the library: put on the device at once when it was built ahead (returns its shapes),
+  /// else asked of the scene builder (returns kPicturePending; poll_pictures puts it on the device and tells
+  /// the flow). The picture felt before stays until then.
   int show_picture(int index) override;
   int picture_count() const override { return static_cast<int>(pictures_.size()); }
   PictureNotes shown_notes() const override { return shown_.notes; }
@@ -199,6 +204,21 @@ class KioskRuntime final : public KioskEffects {
   /// The shapes touched in this visit of the picture shown.
   const VisitTouches& touches() const { return touches_; }
 
+  /// Window thread, every frame (`now_s` the frame clock [s]): scenes the builder has finished. The one asked
+  /// for is put on the device with the fade and handed to `flow` (picture_ready or picture_failed; null: a
+  /// headless caller that only wants it felt); scenes built ahead are kept within [kiosk] prefetch_mb; then
+  /// the next and previous pictures of the one shown are asked for ahead.
+  void poll_pictures(KioskFlow* flow, double now_s);
+  /// Whether a scene asked for (a picture, or a rebuild after Apply) is not yet on the device (scripted runs
+  /// hold their frames for it).
+  bool picture_busy() const { return wanted_id_ != kNoWant; }
+  /// Blocks until the scene asked for is built, then poll_pictures(flow, now_s) (tests, scripted and headless
+  /// runs; never the frame loop). At most `timeout_s` [s]; returns whether it came.
+  bool finish_picture(KioskFlow* flow, double now_s, double timeout_s = 60.0);
+  /// Scene builds started since the start (asked for and built ahead): what the visitor's keys cost.
+  std::uint64_t scene_builds() const { return builder_.builds_started(); }
+  /// Library pictures built ahead and waiting (their indices).
+  std::vector<int> pictures_ahead() const;
   /// Window thread, every frame: news of sticks and finished loads, handed to the flow.
   void poll_sticks(KioskFlow& flow, double now_s);
   /// Window thread, every frame (`now_s` the frame clock [s]): the text of the page shown, read by the
@@ -266,6 +286,11 @@ class KioskRuntime final : public KioskEffects {
   KioskRuntime(const RuntimeOptions& options, const config::Settings& checked_settings, int);  // settings already checked
   CueTrackerParams cue_params() const;
   void show_built(ImageScene& is, int id);  // publishes it; starts reading its text when pending
+  int put_picture(int index, ImageScene& is);  // library picture `index` on the device, with its notes; its shapes
+  SceneJob picture_job(int index) const;      // builds library picture `index` with the settings in use
+  void absorb_built();                        // the builder's finished scenes: kept ahead, or the wanted one noted
+  void build_ahead();                         // asks for the shown picture's neighbours, drops what is not one
+  void drop_want();                           // the scene asked for is not wanted any more (the visitor went elsewhere)
   void text_arrived(TextRead& read);        // swaps in the page with its text and words what came
   std::string describe_shown();             // describe() of what is shown, without the reading's news
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
@@ -301,6 +326,21 @@ class KioskRuntime final : public KioskEffects {
   std::unique_ptr<ServoThread> servo_;
   std::vector<std::string> pictures_;
   Shown shown_;
+  // Scenes built off the window thread (scene_builder.hpp).
+  static constexpr int kNoWant = -1000000;
+  enum class WantKind { Picture, Rebuild };  // a library picture the visitor asked for / the shown scene rebuilt on Apply
+  struct Ahead {
+    int index = 0;                   // library picture
+    std::unique_ptr<ImageScene> scene;
+    std::size_t bytes = 0;           // its memory (approx_bytes)
+  };
+  SceneBuilder builder_;
+  std::uint64_t generation_ = 1;     // bumped when the settings that shape a scene change: older builds are dropped
+  int wanted_id_ = kNoWant;          // the scene asked for, not yet on the device
+  WantKind wanted_kind_ = WantKind::Picture;
+  std::vector<Ahead> ahead_;         // library pictures built ahead (and the wanted one once built)
+  std::optional<BuiltScene> wanted_done_;  // the wanted scene's build, once ended
+  std::vector<int> ahead_refused_;   // built ahead in this generation but failed or over the budget: not asked again
   int level_ = 1;           // the fixed level (auto_level_ false)
   bool auto_level_ = true;  // levels from hand speed
   bool high_contrast_ = false, overlay_ = false;

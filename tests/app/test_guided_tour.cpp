@@ -29,6 +29,7 @@
 #include "kiosk_flow.hpp"
 #include "servo_core.hpp"
 #include "settings_params.hpp"
+#include "show_now.hpp"
 #include "simulation.hpp"
 #include "test_pictures.hpp"
 #include "tour_picture.hpp"
@@ -523,7 +524,7 @@ bool ends_with(const std::string& s, const std::string& tail) { return s.size() 
 
 TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) {
   RuntimeRig r;
-  ASSERT_EQ(r.rt->show_picture(0), 5);
+  ASSERT_EQ(test::show_now(*r.rt, 0), 5);
   r.run(0.6);
   r.rt->key_pressed();
   r.rt->guide();
@@ -586,7 +587,7 @@ TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) 
 // rate), so the pull never comes before the words.
 TEST(GuidedTourRuntime, TheTourAsksFirstAndPullsOnlyOnceThatHasBeenSaid) {
   RuntimeRig r;
-  ASSERT_EQ(r.rt->show_picture(0), 5);
+  ASSERT_EQ(test::show_now(*r.rt, 0), 5);
   r.run(0.6);
   const std::size_t asked = r.guide_n.size();
   r.rt->key_pressed();
@@ -608,7 +609,7 @@ TEST(GuidedTourRuntime, TheTourAsksFirstAndPullsOnlyOnceThatHasBeenSaid) {
 // kind, and the hand's place in near / far terms; Describe starts from it.
 TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
   RuntimeRig r;
-  ASSERT_EQ(r.rt->show_picture(0), 5);
+  ASSERT_EQ(test::show_now(*r.rt, 0), 5);
   const vision::PxToM& px = r.rt->shown().px_to_m;
   auto at = [&](double u, double v) { return Vec2{px.x_m(u), px.y_m(v)}; };
   // Up the free corridor between the ellipse and the rotated rectangle, then into the square's bottom side.

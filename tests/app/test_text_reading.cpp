@@ -24,6 +24,7 @@
 #include "kiosk_flow.hpp"
 #include "kiosk_runtime.hpp"
 #include "scans.hpp"
+#include "show_now.hpp"
 #include "text_reader.hpp"
 #include "vision/ocr.hpp"
 
@@ -247,7 +248,7 @@ TEST(KioskText, APageIsFeltAtOnceThenItsTextComesWithoutLeavingThePage) {
   KioskRig k;
   const int scan = k.rt->find_picture((k.lib / "a_scan.jpg").string());
   ASSERT_GE(scan, 0);
-  k.rt->show_picture(scan);
+  ASSERT_GE(test::show_now(*k.rt, scan), 0);
   const int id = k.rt->shown_id();
   EXPECT_TRUE(k.rt->text_busy());
   EXPECT_TRUE(k.rt->shown().text_blocks.empty()) << "not read yet";
@@ -270,9 +271,9 @@ TEST(KioskText, AnotherPictureCancelsTheReadingAndNothingIsSaidOfIt) {
   if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
   KioskRig k;
-  k.rt->show_picture(k.rt->find_picture((k.lib / "a_scan.jpg").string()));
+  ASSERT_GE(test::show_now(*k.rt, k.rt->find_picture((k.lib / "a_scan.jpg").string())), 0);
   ASSERT_TRUE(k.rt->text_busy());
-  k.rt->show_picture(k.rt->find_picture((k.lib / "b_horse.png").string()));
+  ASSERT_GE(test::show_now(*k.rt, k.rt->find_picture((k.lib / "b_horse.png").string())), 0);
   EXPECT_FALSE(k.rt->text_busy()) << "the horse has no text to read";
   double now_s = 0.0;
   for (int frame = 0; frame < 30; ++frame, now_s += 0.1) k.rt->poll_text(now_s);

@@ -1,0 +1,246 @@
+// Scenes built off the window thread: the builder's order (the visitor's want first, a newer want replacing a
+// waiting one, a build ahead taken over rather than run twice), and the kiosk on top of it: Next pressed three
+// times builds at most two scenes, the picture felt before stays until the new one is on the device, the next
+// picture built ahead is a swap, a picture that cannot be read is said with the old one kept.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "kiosk_flow.hpp"
+#include "kiosk_runtime.hpp"
+#include "scene_builder.hpp"
+#include "show_now.hpp"
+
+namespace fs = std::filesystem;
+
+namespace hk::app {
+namespace {
+
+const fs::path kData = HK_TEST_DATA_DIR;
+
+/// A build that waits for the test to let it finish, and says when it has started.
+struct Gate {
+  std::promise<void> open;
+  std::shared_future<void> opened = open.get_future().share();
+  std::promise<void> started;
+  std::future<void> has_started = started.get_future();
+  SceneJob job(int marker) {
+    return [this, marker] {
+      started.set_value();
+      opened.wait();
+      ImageScene is;
+      is.page = marker;  // which build this was
+      return is;
+    };
+  }
+};
+
+SceneJob marked(int marker, std::atomic<int>* runs) {
+  return [marker, runs] {
+    runs->fetch_add(1);
+    ImageScene is;
+    is.page = marker;
+    return is;
+  };
+}
+
+TEST(SceneBuilder, ANewerWantReplacesAWaitingOneAndTheRunningOneFinishes) {
+  SceneBuilder b;
+  Gate first;
+  std::atomic<int> runs{0};
+  b.want(1, 1, first.job(1));
+  first.has_started.wait();           // 1 runs
+  b.want(2, 1, marked(2, &runs));     // waits...
+  b.want(3, 1, marked(3, &runs));     // ...and is replaced
+  first.open.set_value();
+  ASSERT_TRUE(b.wait_want(60.0));
+  std::vector<BuiltScene> done = b.poll();
+  ASSERT_EQ(done.size(), 2u);
+  EXPECT_EQ(done[0].id, 1);
+  EXPECT_FALSE(done[0].wanted) << "superseded while it ran";
+  EXPECT_EQ(done[1].id, 3);
+  EXPECT_TRUE(done[1].wanted);
+  EXPECT_EQ(done[1].scene->page, 3);
+  EXPECT_EQ(runs.load(), 1) << "2 was never built";
+  EXPECT_EQ(b.builds_started(), 2u);
+}
+
+TEST(SceneBuilder, AWantForASceneBeingBuiltAheadTakesThatBuildOver) {
+  SceneBuilder b;
+  Gate ahead;
+  std::atomic<int> runs{0};
+  b.ahead(5, 1, ahead.job(5));
+  ahead.has_started.wait();
+  b.want(5, 1, marked(55, &runs));  // the same scene: not built again
+  EXPECT_TRUE(b.want_pending());
+  ahead.open.set_value();
+  ASSERT_TRUE(b.wait_want(60.0));
+  std::vector<BuiltScene> done = b.poll();
+  ASSERT_EQ(done.size(), 1u);
+  EXPECT_TRUE(done[0].wanted);
+  EXPECT_EQ(done[0].scene->page, 5);
+  EXPECT_EQ(runs.load(), 0);
+  EXPECT_EQ(b.builds_started(), 1u);
+}
+
+TEST(SceneBuilder, WantsGoBeforeBuildsAheadAndAnotherGenerationIsAnotherScene) {
+  SceneBuilder b;
+  Gate hold;
+  std::atomic<int> runs{0};
+  b.ahead(9, 1, hold.job(9));  // keeps the worker busy while the queue is set up
+  hold.has_started.wait();
+  b.ahead(1, 1, marked(1, &runs));
+  b.ahead(2, 1, marked(2, &runs));
+  b.ahead(3, 1, marked(3, &runs));  // kMaxAhead waiting: the oldest (1) is dropped
+  b.ahead(2, 1, marked(22, &runs)); // already waiting: not queued twice
+  EXPECT_TRUE(b.has(2, 1));
+  EXPECT_FALSE(b.has(2, 2)) << "another generation (other settings) is another scene";
+  EXPECT_FALSE(b.has(1, 1)) << "dropped for a newer one";
+  b.want(7, 1, marked(7, &runs));
+  hold.open.set_value();
+  ASSERT_TRUE(b.wait_want(60.0));
+  std::vector<int> order;
+  for (int i = 0; i < 1000 && order.size() < 4; ++i) {  // the two ahead finish after the want
+    for (const BuiltScene& d : b.poll()) order.push_back(d.scene->page);
+    if (order.size() < 4) std::this_thread::yield();
+    if (order.size() < 4 && !b.has(2, 1) && !b.has(3, 1)) break;
+  }
+  for (const BuiltScene& d : b.poll()) order.push_back(d.scene->page);
+  ASSERT_EQ(order.size(), 4u);
+  EXPECT_EQ(order[0], 9);
+  EXPECT_EQ(order[1], 7) << "the visitor's want before the builds ahead";
+  EXPECT_EQ(order[2], 2);
+  EXPECT_EQ(order[3], 3);
+}
+
+TEST(SceneBuilder, AFailedBuildComesBackWithItsReason) {
+  SceneBuilder b;
+  b.want(4, 1, []() -> ImageScene { throw std::runtime_error("image 'x.png': truncated"); });
+  ASSERT_TRUE(b.wait_want(60.0));
+  std::vector<BuiltScene> done = b.poll();
+  ASSERT_EQ(done.size(), 1u);
+  EXPECT_FALSE(done[0].scene);
+  EXPECT_EQ(done[0].error, "image 'x.png': truncated");
+}
+
+// ---- the kiosk on the builder ----
+
+struct LibraryRig {
+  fs::path lib;
+  std::unique_ptr<KioskRuntime> rt;
+  std::unique_ptr<KioskFlow> flow;
+  std::vector<std::string> said;
+
+  /// A library of `files` (names in tests/data/images, copied as 0_name, 1_name, ... to keep their order).
+  LibraryRig(const std::vector<std::string>& files, int prefetch_mb, const std::string& tag) {
+    lib = fs::temp_directory_path() / ("hk_builder_" + tag + "_" + std::to_string(::getpid()));
+    fs::remove_all(lib);
+    fs::create_directories(lib);
+    for (std::size_t i = 0; i < files.size(); ++i) fs::copy_file(kData / "images" / files[i], lib / (std::to_string(i) + "_" + files[i]));
+    RuntimeOptions ro;
+    ro.library = lib.string();
+    ro.hotplug = false;
+    ro.open_audio_output = false;
+    ro.probe_usb_device = false;
+    config::Settings s;
+    s.kiosk.prefetch_mb = prefetch_mb;
+    s.vision.ocr = "off";
+    rt = std::make_unique<KioskRuntime>(ro, s);
+    flow = std::make_unique<KioskFlow>(*rt, rt->audio().messages(), KioskFlowParams{});
+  }
+  ~LibraryRig() {
+    flow.reset();
+    rt.reset();
+    fs::remove_all(lib);
+  }
+  /// Frames until nothing asked for is pending (at most 60 s of waiting in all).
+  void settle(double now_s) {
+    ASSERT_TRUE(rt->finish_picture(flow.get(), now_s));
+  }
+  /// Polls until the pictures built ahead are `want` (or 60 s pass).
+  bool ahead_becomes(std::vector<int> want) {
+    std::sort(want.begin(), want.end());
+    for (int i = 0; i < 6000; ++i) {
+      rt->poll_pictures(flow.get(), 0.0);
+      std::vector<int> have = rt->pictures_ahead();
+      std::sort(have.begin(), have.end());
+      if (have == want) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+};
+
+TEST(KioskBuilds, ThreeQuickNextPressesBuildAtMostTwoScenesAndLandOnTheThird) {
+  LibraryRig r({"horse.png", "coins.png", "apple.jpg", "fruits.jpg", "butterfly.jpg"}, 0, "next3");  // nothing built ahead
+  r.flow->key(KioskKey::Other, 0.0);  // wake: the tutorial
+  for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.0);
+  r.settle(0.0);  // picture 1 of the library
+  ASSERT_EQ(r.rt->shown_id(), 0);
+  const std::uint64_t before = r.rt->scene_builds();
+  for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.1);
+  EXPECT_EQ(r.rt->shown_id(), 0) << "the picture felt before stays while the new one is built";
+  r.settle(0.2);
+  EXPECT_LE(r.rt->scene_builds() - before, 2u) << "the second picture is not built";
+  EXPECT_EQ(r.rt->shown_id(), 3);
+  EXPECT_EQ(r.rt->last_said().rfind("Picture 4 of 5", 0), 0u) << r.rt->last_said();
+}
+
+TEST(KioskBuilds, TheNextPictureBuiltAheadIsASwapAndThePreviousIsKept) {
+  LibraryRig r({"horse.png", "coins.png", "apple.jpg", "fruits.jpg"}, 256, "ahead");
+  ASSERT_GE(test::show_now(*r.rt, 1), 0);
+  ASSERT_TRUE(r.ahead_becomes({0, 2})) << "the neighbours of picture 2 are built ahead";
+  const std::uint64_t before = r.rt->scene_builds();
+  const int shapes = r.rt->show_picture(2);
+  EXPECT_NE(shapes, KioskEffects::kPicturePending) << "on the device at once";
+  EXPECT_EQ(r.rt->shown_id(), 2);
+  EXPECT_EQ(shapes, static_cast<int>(r.rt->shown().scene->curve_count()));
+  EXPECT_EQ(r.rt->scene_builds(), before) << "not built again";
+  ASSERT_TRUE(r.ahead_becomes({1, 3})) << "picture 2's neighbours: 1 (built before) and 3";
+}
+
+TEST(KioskBuilds, NothingIsBuiltAheadOverTheBudgetAndNothingIsBuiltTwice) {
+  LibraryRig r({"horse.png", "fruits.jpg", "apple.jpg"}, 0, "budget0");
+  ASSERT_GE(test::show_now(*r.rt, 0), 0);
+  const std::uint64_t after_first = r.rt->scene_builds();
+  for (int i = 0; i < 50; ++i) r.rt->poll_pictures(r.flow.get(), 0.0);
+  EXPECT_EQ(r.rt->scene_builds(), after_first) << "prefetch_mb = 0: nothing built ahead";
+  EXPECT_TRUE(r.rt->pictures_ahead().empty());
+}
+
+TEST(KioskBuilds, APictureThatCannotBeReadIsSaidAndTheOldOneStays) {
+  LibraryRig r({"horse.png", "coins.png", "apple.jpg"}, 0, "bad");
+  {  // the second picture is cut short, as a copy to a stick pulled too soon leaves it
+    const fs::path bad = r.lib / "1_coins.png";
+    const auto size = fs::file_size(bad);
+    fs::resize_file(bad, size / 2);
+  }
+  r.flow->key(KioskKey::Other, 0.0);
+  for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.0);
+  r.settle(0.0);
+  ASSERT_EQ(r.rt->shown_id(), 0);
+  const Scene* before = r.rt->shown().scene;
+  r.flow->key(KioskKey::Next, 1.0);
+  r.settle(1.0);
+  EXPECT_EQ(r.rt->shown_id(), 0) << "the horse is still felt";
+  EXPECT_EQ(r.rt->shown().scene, before);
+  EXPECT_EQ(r.rt->last_said().rfind("Picture 2 of 3 cannot be shown: ", 0), 0u) << r.rt->last_said();
+  EXPECT_NE(r.rt->last_said().find("1_coins.png"), std::string::npos) << "names the file";
+  r.flow->key(KioskKey::Next, 2.0);  // steps past it
+  r.settle(2.0);
+  EXPECT_EQ(r.rt->shown_id(), 2);
+  EXPECT_EQ(r.flow->failures(), 0);
+}
+
+}  // namespace
+}  // namespace hk::app
