@@ -15,9 +15,12 @@ double ms_between(FrameStats::Clock::time_point a, FrameStats::Clock::time_point
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
+/// `ms` to the microsecond, for the file.
+double to_us(double ms) { return std::round(ms * 1000.0) / 1000.0; }
+
 nlohmann::json summary_json(const FrameTimeSummary& s) {
-  return {{"frames", s.frames}, {"p50_ms", s.p50_ms}, {"p95_ms", s.p95_ms}, {"p99_ms", s.p99_ms},
-          {"max_ms", s.max_ms}, {"mean_ms", s.mean_ms}, {"over_20_ms", s.over_20_ms}};
+  return {{"frames", s.frames}, {"p50_ms", to_us(s.p50_ms)}, {"p95_ms", to_us(s.p95_ms)}, {"p99_ms", to_us(s.p99_ms)},
+          {"max_ms", to_us(s.max_ms)}, {"mean_ms", to_us(s.mean_ms)}, {"over_20_ms", s.over_20_ms}};
 }
 
 }  // namespace
@@ -98,7 +101,7 @@ nlohmann::json FrameStats::to_json(const std::string& measured) const {
           {"interval", {{"all", summary_json(interval_all_.summary())}, {"changing", summary_json(interval_changing_.summary())}}},
           {"work", {{"all", summary_json(work_all_.summary())}, {"changing", summary_json(work_changing_.summary())}}},
           {"changes", changes_},
-          {"max_change_ms", max_change_ms_}};
+          {"max_change_ms", to_us(max_change_ms_)}};
 }
 
 std::string FrameStats::log_line() const {

@@ -80,11 +80,12 @@ void check_screenshot_options(const KioskOptions& o) {
 
 /// What --frame-stats measured, said in its file.
 constexpr const char* kScriptedFrames =
-    "scripted run (--screenshot): interval = work + buffer swap + the fixed 16.7 ms pause per frame (no vsync under Xvfb); "
+    "scripted run (--screenshot): interval = work + buffer swap + the fixed 16.7 ms pause per frame (under Xvfb the swap is "
+    "Mesa's software GL drawing and copying the frame, tens of ms at 1920 x 1080, not a vsync wait); "
     "work = frame start to before the swap";
 constexpr const char* kLiveFrames =
-    "live run: interval = frame start to next frame start, paced by the buffer swap (vsync on a monitor; under Xvfb "
-    "the swap does not wait, so frames run back to back); work = frame start to before the swap";
+    "live run: interval = frame start to next frame start, paced by the buffer swap (vsync on a monitor; Xvfb has no "
+    "vsync, there the swap's cost paces it); work = frame start to before the swap";
 
 /// Input routing and the frame loop's state: what a key does depends on who has the keyboard.
 class Kiosk final : public ScriptTarget {
