@@ -14,11 +14,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <thread>
+#include <memory>
+#include <utility>
 
 #include "config/device_profile.hpp"
 #include "config/keys.hpp"
 #include "config/load.hpp"
 #include "config/store.hpp"
+#include "frame_stats.hpp"
 #include "hud.hpp"
 #include "keymap.hpp"
 #include "kiosk_flow.hpp"
@@ -75,6 +78,15 @@ void check_screenshot_options(const KioskOptions& o) {
   if (o.frames < 1 || o.frames > 100000) throw AppError("--frames " + std::to_string(o.frames) + " is outside [1, 100000]");
 }
 
+/// What --frame-stats measured, said in its file.
+constexpr const char* kScriptedFrames =
+    "scripted run (--screenshot): interval = work + buffer swap + the fixed 16.7 ms pause per frame (under Xvfb the swap is "
+    "Mesa's software GL drawing and copying the frame, tens of ms at 1920 x 1080, not a vsync wait); "
+    "work = frame start to before the swap";
+constexpr const char* kLiveFrames =
+    "live run: interval = frame start to next frame start, paced by the buffer swap (vsync on a monitor; Xvfb has no "
+    "vsync, there the swap's cost paces it); work = frame start to before the swap";
+
 /// Input routing and the frame loop's state: what a key does depends on who has the keyboard.
 class Kiosk final : public ScriptTarget {
  public:
@@ -118,12 +130,17 @@ class Kiosk final : public ScriptTarget {
       return;
     }
     // High contrast and the overlay are the operator's (the panel): O and C are keys like any other here.
-    flow_.key(it == keys_.end() ? KioskKey::Other : it->second, now_s_, key_name_of(e.key));
+    const KioskKey k = it == keys_.end() ? KioskKey::Other : it->second;
+    note_picture_key(k);
+    flow_.key(k, now_s_, key_name_of(e.key));
     if (help) flow_.help_held(true);  // held: the next keys are named, not done (learning mode)
   }
 
   // ---- ScriptTarget ----
-  void action_key(KioskKey k) override { flow_.key(k, now_s_); }
+  void action_key(KioskKey k) override {
+    note_picture_key(k);
+    flow_.key(k, now_s_);
+  }
   void cursor(Vec2 m) override { rt_.set_cursor(m); }
   void moved() override { flow_.handle_moved(now_s_); }
   void stick(const std::string& dir) override { rt_.insert_stick_folder(dir); }
@@ -161,9 +178,14 @@ class Kiosk final : public ScriptTarget {
     }
   }
 
+  /// Whether a Next or Previous key went to the visitor's flow since the last call (--frame-stats).
+  bool take_picture_key() { return std::exchange(picture_key_, false); }
+
   double now_s_ = 0;
 
  private:
+  void note_picture_key(KioskKey k) { picture_key_ = picture_key_ || k == KioskKey::Next || k == KioskKey::Previous; }
+
   const KioskOptions& o_;
   KioskRuntime& rt_;
   KioskFlow& flow_;
@@ -176,6 +198,7 @@ class Kiosk final : public ScriptTarget {
   Vec2 mouse_rest_;
   bool have_baseline_ = false;
   Vec2 last_moved_at_;
+  bool picture_key_ = false;
 };
 
 /// --show: straight to a picture, past the welcome and the tutorial.
@@ -305,12 +328,19 @@ int run_kiosk(const KioskOptions& o) {
   PictureTexture texture;
   CapturePreviewView preview;
   const bool scripted = !o.screenshot.empty();
+  // Allocated once, here: recording a frame never allocates (frame_stats.hpp).
+  const auto stats = o.frame_stats.empty() ? nullptr : std::make_unique<FrameStats>();
   const auto t0 = std::chrono::steady_clock::now();
   int frame = 0;
   while (!window.should_close()) {
+    if (stats) stats->frame_started(std::chrono::steady_clock::now());
+    const Scene* const scene_at_start = rt.shown().scene;
+    const int id_at_start = rt.shown_id();
     kiosk.now_s_ = scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const bool holding = update_frame(kiosk, rt, flow, session, window, script, scripted, frame);
+    if (kiosk.take_picture_key() && stats) stats->picture_key(scene_at_start, id_at_start);
     draw_frame(rt, flow, session, panel, window, script, scripted, kiosk.now_s_, texture, preview);
+    if (stats) stats->frame_drawn(std::chrono::steady_clock::now(), rt.shown().scene, rt.shown_id());
     if (!holding) ++frame;
     if (scripted && frame >= o.frames) {
       if (!cv::imwrite(o.screenshot, window.read_pixels())) throw AppError("--screenshot '" + o.screenshot + "': cannot write the PNG");
@@ -320,6 +350,10 @@ int run_kiosk(const KioskOptions& o) {
     if (scripted) std::this_thread::sleep_for(std::chrono::microseconds(16667));  // 60 Hz of servo time per frame
   }
   rt.stop_servo();
+  if (stats) {
+    write_frame_stats(*stats, o.frame_stats, scripted ? kScriptedFrames : kLiveFrames);
+    spdlog::info("{} -> {}", stats->log_line(), o.frame_stats);
+  }
   return 0;
 }
 

@@ -30,6 +30,8 @@ struct KioskOptions {
   bool overlay = false;         ///< start with the operator overlay
   std::string screenshot;       ///< write the last frame here as PNG and quit
   int frames = 0;               ///< frames to run before the screenshot (at 60 Hz)
+  /// Write the window's frame times here as JSON at exit (frame_stats.hpp); empty: not measured.
+  std::string frame_stats;
   std::string script;           ///< scripted input (script.hpp): key, press, type, click, cursor, move, stick, unstick, wait
   std::string stick;            ///< a folder treated as a USB stick inserted at start (documentation, tests)
   bool hotplug = true;          ///< watch for USB sticks (libudev); off: only --stick and scripted sticks
