@@ -11,10 +11,10 @@
 #include <ctime>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <thread>
-#include <memory>
 #include <utility>
 
 #include "config/device_profile.hpp"

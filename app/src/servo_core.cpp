@@ -124,15 +124,20 @@ void ServoCore::take_gains() noexcept {
   if (g.seq != gains_.seq) gains_ = g;
 }
 
-// A new picture waits while the old one's force fades out over the force ramp time (a wall must not vanish
-// under a pressing hand in one tick); then it is taken and started at the handle (proxy there, force ramped
-// in from zero by the guard), and the old one is retired. A bundle that found no room in the ring last
-// time is handed back first.
+// A new picture waits while the old one's force fades out (a wall must not vanish under a pressing hand in
+// one tick); then it is taken and started at the handle (proxy there, force ramped in from zero by the
+// guard), and the old one is retired. The fade takes the share of the force ramp time that the force in use
+// is of the clamp, so no step is larger than the ramp's (max_force_n · period / ramp_s): a hand in free
+// space (no force) gets the new picture at the next tick, a hand pressing at the clamp waits the whole ramp.
+// A bundle that found no room in the ring last time is handed back first.
 void ServoCore::swap_scene(Vec2 handle_m) noexcept {
   if (to_retire_ && retired_.try_push(to_retire_)) to_retire_ = nullptr;
   if (!fading_ && current_ && pending_.load(std::memory_order_acquire) != nullptr) {
     const ServoParams& p = current_->loop.params();
-    fade_total_ = p.guard.ramp_s > 0.0 ? static_cast<long>(p.guard.ramp_s / p.period_s + 0.5) : 0;
+    const double ramp_ticks = p.guard.ramp_s > 0.0 ? p.guard.ramp_s / p.period_s : 0.0;
+    const double share = p.guard.max_force_n > 0.0 ? std::min(1.0, length(out_.force_n) / p.guard.max_force_n) : 1.0;
+    fade_total_ = static_cast<long>(std::ceil(share * ramp_ticks));
+    fade_step_n_ = ramp_ticks > 0.0 ? p.guard.max_force_n / ramp_ticks : 0.0;
     fade_left_ = fade_total_;
     fading_ = fade_total_ > 0;
   }
@@ -171,7 +176,10 @@ TickResult ServoCore::render_walls(ServoInput& in) noexcept {
     out_ = ServoOutput{};
     out_.contact.proxy_m = in.sample.handle_m;
   }
-  if (fading_ && fade_total_ > 0) out_.force_n = (static_cast<double>(fade_left_) / static_cast<double>(fade_total_)) * out_.force_n;
+  if (fading_ && fade_total_ > 0) {  // at most fade_left_ ramp steps of force left: down one step a tick
+    const double cap_n = static_cast<double>(fade_left_) * fade_step_n_, f_n = length(out_.force_n);
+    if (f_n > cap_n) out_.force_n = (cap_n / f_n) * out_.force_n;
+  }
   return r;
 }
 

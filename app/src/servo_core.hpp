@@ -13,8 +13,9 @@
 ///
 /// A picture crosses threads as a SceneBundle built on another thread (the scene and a ServoLoop sized for
 /// it: all allocation happens there). publish() hands it over with one atomic exchange. The servo thread
-/// first fades the old picture's force to zero over the force ramp time (guard.ramp_s), so a wall never
-/// vanishes under a pressing hand in one tick; then it takes the new bundle, places the proxy where the
+/// first fades the old picture's force to zero, one force ramp step (max_force_n · period / ramp_s) a tick
+/// at most, so a wall never vanishes under a pressing hand in one tick (no force: no wait; at the clamp: the
+/// whole ramp time, guard.ramp_s); then it takes the new bundle, places the proxy where the
 /// handle is (ServoLoop::start: outside every curve, forces ramped in from zero by the force guard), and
 /// passes the previous bundle back through a small ring, so it is freed outside the servo thread
 /// (collect_retired()). Every force step of a swap is thus at most max_force_n · period / ramp_s.
@@ -175,6 +176,7 @@ class ServoCore {
   GainsSlot gains_;                                    // servo thread: the gains last taken
   bool fading_ = false;                                // the old picture's force fades before a swap
   long fade_total_ = 0, fade_left_ = 0;                // [ticks]
+  double fade_step_n_ = 0.0;                           // the force may fall this much a tick while fading [N]
   TripleBuffer<ServoDisplayState> display_;
   ServoOutput out_;
   DeviceStatus last_status_ = DeviceStatus::Ok;        // the previous tick's sample status (a return restarts the picture)

