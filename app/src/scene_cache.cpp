@@ -225,7 +225,7 @@ json to_payload(const std::string& key, const ImageScene& is) {
 /// what to_payload writes.
 ImageScene from_payload(const json& j, const std::string& key) {
   if (!j.is_object()) throw BadEntry{"the payload is not a map"};
-  if (j.at("key").get<std::string>() != key) throw BadEntry{"it holds the scene of another key"};
+  if (j.at("key").get<std::string>() != key) throw BadEntry{"holds the scene of another key"};
   ImageScene is;
   is.image_path = j.at("image_path").get<std::string>();
   is.page = j.at("page").get<int>();
@@ -497,7 +497,7 @@ std::optional<ImageScene> SceneCache::load(const std::string& key, const config:
   try {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
     if (fd < 0) {
-      if (errno == ENOENT) return std::nullopt;
+      if (errno == ENOENT || errno == ENOTDIR) return std::nullopt;  // no entry, or no folder (store says why)
       if (errno == ELOOP) return bad("is a symbolic link");
       spdlog::warn("scene cache: cannot read entry '{}': {}", path, errno_text(errno));
       return std::nullopt;
