@@ -80,6 +80,8 @@ class SceneCache {
   /// times are the build's, except multires_ms and tree_ms, this rebuild's. with_text is empty and
   /// text_pending false (only complete scenes are stored). The entry's modification time is set to now
   /// (least recently used order); a folder that refuses it still loads.
+  /// The rebuilt trees must have segments_after_budget level-0 segments (as every build's do), else the
+  /// entry is taken for corrupt.
   /// @return nullopt when off, when there is no entry, or when the entry is corrupt or stale (the file is
   ///         then removed and logged in one line, spdlog::warn). Never throws.
   std::optional<ImageScene> load(const std::string& key, const config::Settings& s) const;
