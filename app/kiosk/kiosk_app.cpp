@@ -239,6 +239,8 @@ RuntimeOptions runtime_options(const KioskOptions& o, const config::Settings& se
   ro.probe_usb_device = o.screenshot.empty() || config::is_usb_type(settings.device.type);
   ro.probe_camera = o.screenshot.empty();
   ro.device = o.device;
+  // Scripted runs (documentation, tests) build every scene afresh and leave no cache behind.
+  ro.scene_cache_dir = o.screenshot.empty() ? scene_cache_dir(settings) : std::string{};
   return ro;
 }
 

@@ -21,6 +21,7 @@
 #include "picture_library.hpp"
 #include "settings_params.hpp"
 #include "simulation.hpp"
+#include "vision/intake.hpp"
 
 namespace hk::app {
 namespace {
@@ -65,6 +66,10 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
       capture_(s, o.probe_camera || s.camera.source != "auto" ? choose_camera(s.camera) : CameraChoice{{}, {}, "not looked for (a scripted run)"}),
       sticks_(s, block_events(o.hotplug), o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
   pictures_ = list_pictures(o.library);
+  if (!o.scene_cache_dir.empty()) {
+    cache_ = std::make_shared<SceneCache>(o.scene_cache_dir);
+    spdlog::info("scenes: kept in {}", o.scene_cache_dir);
+  }
   sim_.open();
   hand_ = hand_params_from(s);
   // The cursor's hand may press harder than a model visitor: a cursor held well past a wall (about 2 cm at
@@ -384,11 +389,36 @@ std::size_t approx_bytes(const ImageScene& is) {
   return b + sizeof(ImageScene);
 }
 
+/// Library picture `path`'s scene: from the scene cache when it holds one for these bytes and settings, else
+/// built from the bytes read once and stored; a scene whose text is still to be read is stored once it has
+/// been read (its with_text stores what it builds). Runs on the builder's worker.
+ImageScene cached_or_built(const std::string& path, const config::Settings& s, const std::shared_ptr<SceneCache>& cache) {
+  if (!cache) return build_image_scene(path, s, TextTiming::later);
+  const std::vector<std::uint8_t> bytes = vision::read_input_file(path, extract_params_from(s).limits.max_file_bytes);
+  const std::string key = SceneCache::key(bytes, s);
+  if (std::optional<ImageScene> hit = cache->load(key, s)) {
+    hit->image_path = path;
+    return std::move(*hit);
+  }
+  ImageScene is = build_image_scene_from_bytes(bytes, path, s, TextTiming::later);
+  if (!is.text_pending) {
+    cache->store(key, is);
+    return is;
+  }
+  is.with_text = [read = std::move(is.with_text), cache, key](const std::atomic<bool>* cancel) {
+    ImageScene with_text = read(cancel);
+    const bool whole = with_text.scene && with_text.ocr.why != "cancelled" && with_text.ocr.why.rfind("failed", 0) != 0;
+    if (whole) cache->store(key, with_text);
+    return with_text;
+  };
+  return is;
+}
+
 }  // namespace
 
 SceneJob KioskRuntime::picture_job(int index) const {
   // A copy of what the build needs: the worker never touches the runtime.
-  return [path = pictures_[static_cast<std::size_t>(index)], s = s_] { return build_image_scene(path, s, TextTiming::later); };
+  return [path = pictures_[static_cast<std::size_t>(index)], s = s_, cache = cache_] { return cached_or_built(path, s, cache); };
 }
 
 int KioskRuntime::show_picture(int index) {

@@ -32,6 +32,7 @@
 #include "kiosk_flow.hpp"
 #include "picture_notes.hpp"
 #include "scene_builder.hpp"
+#include "scene_cache.hpp"
 #include "servo_core.hpp"
 #include "servo_thread.hpp"
 #include "stick_service.hpp"
@@ -54,6 +55,9 @@ struct RuntimeOptions {
   /// pantograph's driver on the firmware emulator behind a pty, its handle pulled by the cursor through the
   /// model hand (demonstrations, documentation, tests). @throws DeviceChoiceError for anything else.
   std::string device;
+  /// Where built scenes of library pictures are kept (scene_cache.hpp; KioskApp passes scene_cache_dir of the
+  /// settings); empty: none kept (tests, scripted runs).
+  std::string scene_cache_dir;
   /// Look for a camera when [camera] source is "auto" (list_cameras); false: "auto" means no camera (scripted
   /// runs, tests). A source named in the settings ("file:...", "libcamera:N", "v4l2:DEV") is used either way.
   bool probe_camera = false;
@@ -334,6 +338,7 @@ class KioskRuntime final : public KioskEffects {
     std::unique_ptr<ImageScene> scene;
     std::size_t bytes = 0;           // its memory (approx_bytes)
   };
+  std::shared_ptr<SceneCache> cache_;  // shared with the builds under way (null: none)
   SceneBuilder builder_;
   std::uint64_t generation_ = 1;     // bumped when the settings that shape a scene change: older builds are dropped
   int wanted_id_ = kNoWant;          // the scene asked for, not yet on the device

@@ -153,7 +153,7 @@ struct KioskSettings {
   double attract_every_s = 30.0;          ///< key attract_every_s, while nobody is there a short spoken invitation comes this often, [0, 3600] s (0 = never)
   std::string quiet_hours;                ///< key quiet_hours, local times with no invitation, "HH:MM-HH:MM" (may pass midnight: "22:00-07:00"); empty = none
   int prefetch_mb = 256;                  ///< key prefetch_mb, memory for the next and previous pictures' scenes built ahead of the visitor, [0, 4096] MiB (0 = none built ahead)
-  std::string scene_cache = "auto";       ///< key scene_cache, where built scenes of library pictures are kept on disk: "auto" ($CACHE_DIRECTORY, else $XDG_CACHE_HOME or ~/.cache, + "/haptic-kiosk/scenes"), "off", or an absolute folder
+  std::string scene_cache = "auto";       ///< key scene_cache, where built scenes of library pictures are kept on disk: "auto" ($CACHE_DIRECTORY/scenes under the service, else $XDG_CACHE_HOME/haptic-kiosk/scenes, else ~/.cache/haptic-kiosk/scenes), "off", or an absolute folder
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const KioskSettings&) const = default;
