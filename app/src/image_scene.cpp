@@ -333,7 +333,8 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s,
   out.image_path = path;
   const vision::ImageLimits limits = extract_params_from(s).limits;
   const auto t0 = std::chrono::steady_clock::now();
-  keep_decoded(out, vision::load_image_reduced(path, limits, picture_keep_side_px(s)), ms_since(t0));
+  vision::DecodedImage decoded = vision::load_image_reduced(path, limits, picture_keep_side_px(s));
+  keep_decoded(out, std::move(decoded), ms_since(t0));
   OcrSource source;
   if (out.decode_scale > 1 && s.vision.ocr != "off") {
     source = [path, limits] { return vision::load_image_reduced(path, limits, kOcrMaxSidePx); };
@@ -349,7 +350,8 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
   out.image_path = name;
   const vision::ImageLimits limits = extract_params_from(s).limits;
   const auto t0 = std::chrono::steady_clock::now();
-  keep_decoded(out, vision::decode_image_reduced(bytes, name, limits, picture_keep_side_px(s)), ms_since(t0));
+  vision::DecodedImage decoded = vision::decode_image_reduced(bytes, name, limits, picture_keep_side_px(s));
+  keep_decoded(out, std::move(decoded), ms_since(t0));
   OcrSource source;
   if (out.decode_scale > 1 && s.vision.ocr != "off") {
     source = [kept = std::make_shared<const std::vector<std::uint8_t>>(bytes), name, limits] {
