@@ -82,8 +82,8 @@ json scene_json(const ImageScene& is, const config::Settings& s) {
 cv::Point2d to_px(const vision::PxToM& m, Vec2 q) { return {m.u_px(q.x), m.v_px(q.y)}; }
 
 void write_overlay(const std::filesystem::path& out, const ImageScene& is, int level, const std::vector<Vec2>& proxy_path) {
-  cv::Mat img = is.picture.empty() ? cv::imread(is.image_path, cv::IMREAD_COLOR) : is.picture.clone();
-  if (img.empty()) throw ExploreError("image '" + is.image_path + "': could not be read again for the overlay");
+  if (is.picture.empty()) throw ExploreError("image '" + is.image_path + "': the scene holds no picture for the overlay");
+  cv::Mat img = is.picture.clone();
   // Dim the picture so the drawn curves stand out; draw at 4x sub-pixel precision.
   img = img * 0.55;
   const int thick = std::max(1, static_cast<int>(std::lround(std::max(img.cols, img.rows) / 400.0)));
@@ -371,7 +371,9 @@ void add_picture_summary(json& sj, const ImageScene& is) {
   sj["detector"] = vision::detector_name(is.detector);
   sj["two_tone"] = {{"two_tone", is.tones.two_tone}, {"threshold", is.tones.threshold}, {"near_share", is.tones.near_share},
                     {"ink_width_px", is.tones.ink_width_px}, {"line_drawing", is.line_drawing}};
-  sj["build_ms"] = {{"load", is.times.load_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms},
+  sj["picture"] = {{"file_width_px", is.file_width_px}, {"file_height_px", is.file_height_px}, {"decode_scale", is.decode_scale},
+                   {"width_px", is.width_px}, {"height_px", is.height_px}};
+  sj["build_ms"] = {{"load", is.times.load_ms}, {"decode", is.times.decode_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms},
                     {"thin_lines", is.times.thin_lines_ms}, {"gaps", is.times.gaps_ms}, {"multires", is.times.multires_ms},
                     {"tree", is.times.tree_ms}};
 }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <memory>
 
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
@@ -126,9 +128,50 @@ cv::Mat at_most(const cv::Mat& grey, int side_px, double& scale) {
 /// Side a picture is judged at for being a page of text [px].
 constexpr int kJudgedSidePx = 1600;
 
+/// The picture decoded again in more detail for OCR (at up to kOcrMaxSidePx), when the scene's picture was
+/// decoded reduced; empty when the scene's picture is all the detail there is. May throw vision::InputError.
+using OcrSource = std::function<vision::DecodedImage()>;
+
+/// Scales OCR's boxes by `k` (from one pixel frame to another; corner origin, so no offset).
+void scale_boxes(vision::OcrResult& r, double k) {
+  if (k == 1.0) return;
+  const auto sc = [k](const cv::Rect2d& b) { return cv::Rect2d(b.x * k, b.y * k, b.width * k, b.height * k); };
+  for (vision::OcrWord& w : r.words) w.box_px = sc(w.box_px);
+  for (vision::OcrBlock& b : r.blocks) b.box_px = sc(b.box_px);
+}
+
+/// The text of the scene's picture (`grey`, at 1/decode_scale of the file), read at full detail: from `source`
+/// when given (its boxes scaled into grey's frame), else from `grey`. A refused second decode costs the text
+/// only, as an OCR failure does.
+vision::OcrResult read_picture_text(const cv::Mat& grey, int decode_scale, const OcrSource& source, const std::string& name,
+                                    const config::Settings& s, OcrReport& report, const std::atomic<bool>* cancel) {
+  if (!source) return read_text(grey, name, s, report, cancel);
+  cv::Mat detail_grey;
+  int detail_scale = 1;
+  try {
+    const vision::DecodedImage detail = source();
+    cv::cvtColor(detail.bgr, detail_grey, cv::COLOR_BGR2GRAY);
+    detail_scale = detail.scale;
+  } catch (const vision::InputError& e) {
+    spdlog::warn("{}; the picture is felt without its text", e.what());
+    report.ran = false;
+    report.why = std::string("failed: ") + e.what();
+    return {};
+  }
+  vision::OcrResult r = read_text(detail_grey, name, s, report, cancel);
+  // A position x in the detail decode's pixels is x * detail_scale at full detail, x * detail_scale /
+  // decode_scale in the scene's picture.
+  scale_boxes(r, static_cast<double>(detail_scale) / decode_scale);
+  return r;
+}
+
 /// The scene of a picture (BGR) whose text is read when [vision] ocr asks (now, or later by with_text): the
 /// words masked from the edges, the blocks kept in metres.
-void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel) {
+/// `source` (may be empty): the picture in more detail for OCR, see OcrSource; out.decode_scale is bgr's.
+void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel,
+                   const OcrSource& source = {}) {
+  out.width_px = bgr.cols;
+  out.height_px = bgr.rows;
   cv::Mat grey;
   cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
   vision::OcrResult text;
@@ -138,7 +181,7 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
     // uncertain to speak is still no shape to feel).
     mask = printed_letters_mask_of(grey);
     if (timing == TextTiming::now) {
-      text = read_text(grey, out.image_path, s, out.ocr, cancel);
+      text = read_picture_text(grey, out.decode_scale, source, out.image_path, s, out.ocr, cancel);
       if (!text.words.empty()) {
         const cv::Mat words = text_mask(grey.size(), as_page_words(text.words));
         mask = mask.empty() ? words : (mask | words);
@@ -146,11 +189,15 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
     } else {
       out.text_pending = true;
       out.text_likely = true;  // it looks like a page of text, or [vision] ocr "always" asks for it
-      out.with_text = [bgr, name = out.image_path, s](const std::atomic<bool>* stop) {
+      out.with_text = [bgr, name = out.image_path, s, source, fw = out.file_width_px, fh = out.file_height_px,
+                       scale = out.decode_scale](const std::atomic<bool>* stop) {
         ImageScene again;
         again.image_path = name;
         again.picture = bgr;
-        build_picture(again, bgr, s, TextTiming::now, stop);
+        again.file_width_px = fw;
+        again.file_height_px = fh;
+        again.decode_scale = scale;
+        build_picture(again, bgr, s, TextTiming::now, stop, source);
         return again;
       };
     }
@@ -163,6 +210,8 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
 /// The scene of a rendered document page (see build_page_scene).
 void build_page(ImageScene& out, const vision::PdfPage& page, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel) {
   cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
+  out.file_width_px = page.grey.cols;
+  out.file_height_px = page.grey.rows;
   vision::OcrResult text;
   cv::Mat letters;  // printed letters, kept out whether OCR reads them or not
   if (wants_page_text(page, s, out.ocr.why)) {
@@ -262,14 +311,36 @@ vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const 
   return r;
 }
 
+int picture_keep_side_px(const config::Settings& s) {
+  return s.vision.ocr == "off" ? s.vision.max_image_side_px : std::max(s.vision.max_image_side_px, kPictureTextJudgedMinSidePx);
+}
+
+namespace {
+
+/// The decoded picture's pixels and sizes into `out`.
+void keep_decoded(ImageScene& out, vision::DecodedImage&& d, double decode_ms) {
+  out.picture = std::move(d.bgr);
+  out.file_width_px = d.file_width_px;
+  out.file_height_px = d.file_height_px;
+  out.decode_scale = d.scale;
+  out.times.decode_ms = decode_ms;
+}
+
+}  // namespace
+
 ImageScene build_image_scene(const std::string& path, const config::Settings& s, TextTiming timing) {
   ImageScene out;
   out.image_path = path;
+  const vision::ImageLimits limits = extract_params_from(s).limits;
   const auto t0 = std::chrono::steady_clock::now();
-  const cv::Mat bgr = vision::load_image(path, extract_params_from(s).limits);
-  const double load_ms = ms_since(t0);
-  build_picture(out, bgr, s, timing, nullptr);
-  out.times.load_ms += load_ms;
+  vision::DecodedImage decoded = vision::load_image_reduced(path, limits, picture_keep_side_px(s));
+  keep_decoded(out, std::move(decoded), ms_since(t0));
+  OcrSource source;
+  if (out.decode_scale > 1 && s.vision.ocr != "off") {
+    source = [path, limits] { return vision::load_image_reduced(path, limits, kOcrMaxSidePx); };
+  }
+  build_picture(out, out.picture, s, timing, nullptr, source);
+  out.times.load_ms += out.times.decode_ms;
   return out;
 }
 
@@ -277,11 +348,18 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
                                         TextTiming timing) {
   ImageScene out;
   out.image_path = name;
+  const vision::ImageLimits limits = extract_params_from(s).limits;
   const auto t0 = std::chrono::steady_clock::now();
-  out.picture = vision::decode_image(bytes, name, extract_params_from(s).limits);
-  const double decode_ms = ms_since(t0);
-  build_picture(out, out.picture, s, timing, nullptr);
-  out.times.load_ms += decode_ms;
+  vision::DecodedImage decoded = vision::decode_image_reduced(bytes, name, limits, picture_keep_side_px(s));
+  keep_decoded(out, std::move(decoded), ms_since(t0));
+  OcrSource source;
+  if (out.decode_scale > 1 && s.vision.ocr != "off") {
+    source = [kept = std::make_shared<const std::vector<std::uint8_t>>(bytes), name, limits] {
+      return vision::decode_image_reduced(*kept, name, limits, kOcrMaxSidePx);
+    };
+  }
+  build_picture(out, out.picture, s, timing, nullptr, source);
+  out.times.load_ms += out.times.decode_ms;
   return out;
 }
 
@@ -290,6 +368,8 @@ ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string&
   ImageScene out;
   out.image_path = name;
   out.picture = bgr.clone();
+  out.file_width_px = bgr.cols;
+  out.file_height_px = bgr.rows;
   build_picture(out, out.picture, s, timing, nullptr);
   return out;
 }

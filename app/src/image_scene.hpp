@@ -25,6 +25,9 @@ namespace hk::app {
 /// Build time of each stage [ms].
 struct BuildTimes {
   double load_ms = 0, edges_ms = 0, linking_ms = 0, thin_lines_ms = 0, gaps_ms = 0, multires_ms = 0, tree_ms = 0;
+  /// Of load_ms, a picture file's checks and decoding (vision::load_image_reduced / decode_image_reduced);
+  /// 0 for pixels already in memory (a camera capture, a rendered page).
+  double decode_ms = 0;
 };
 
 /// A block of text of a page in workspace metres: spoken, not felt.
@@ -91,7 +94,16 @@ struct ImageScene {
   int page = 0;                             ///< document page shown (from 1); 0 for a picture file
   int pages = 0;                            ///< pages the document offers; 0 for a picture file
   std::string document_title;               ///< a PDF's own title (documents.hpp pdf_title), "" when none or a picture file
-  cv::Mat picture;                          ///< BGR pixels of a page built from memory; empty for a picture file (read it from image_path)
+  /// The BGR pixels the scene was built from, always set: a picture file's as decoded (at 1/decode_scale of
+  /// its size, see picture_keep_side_px), a rendered page's, a camera capture's. px_to_m maps these pixels,
+  /// so the picture is shown from here (never decoded again from image_path).
+  cv::Mat picture;
+  /// The picture's own size at full detail [px], upright as `picture` is: a picture file's (its EXIF
+  /// orientation applied), otherwise picture's size.
+  int file_width_px = 0, file_height_px = 0;
+  /// Full-detail pixels per `picture` pixel along each side: 1, 2, 4 or 8 (a JPEG decoded reduced, "decoded at
+  /// 1/4"); 1 for everything else.
+  int decode_scale = 1;
   std::vector<TextBlockM> text_blocks;      ///< a page's text blocks (masked from the edges), in reading order
   OcrReport ocr;                            ///< whether the text was read from the pixels, and how it went
   /// The text is still to be read (built with TextTiming::later and OCR wanted): the curves are the
@@ -107,7 +119,7 @@ struct ImageScene {
   double render_dpi = 0;                    ///< a PDF page: the DPI it was drawn at
   double worker_ms = 0;                     ///< a PDF page: wall time of the drawing worker [ms]
   long worker_max_rss_kb = 0;               ///< a PDF page: the worker's peak memory [KiB]
-  int width_px = 0, height_px = 0;
+  int width_px = 0, height_px = 0;          ///< size of `picture` [px] (what px_to_m maps)
   vision::PxToM px_to_m{};
   std::size_t chains_texture = 0;           ///< dropped before chains_found: edges that do not stand out from their surround (detector "surround", vision::stands_out)
   std::size_t chains_found = 0;             ///< chains out of edge linking (after the texture test)
@@ -143,18 +155,34 @@ double polyline_length_m(const Polyline& p);
 /// vision's curves as haptics' polylines (same points, same closedness).
 std::vector<Polyline> to_polylines(const std::vector<vision::SceneCurve>& curves);
 
+/// Fewest pixels the long side of a picture file is decoded at for its scene [px]: [vision]
+/// max_image_side_px, or at least kPictureTextJudgedMinSidePx when [vision] ocr is not "off" (whether it is a
+/// page of text is judged at up to 1600 px and must see its letters). A JPEG is decoded at the largest
+/// reduction 1/2, 1/4 or 1/8 that keeps this many (vision::jpeg_reduction_for).
+int picture_keep_side_px(const config::Settings& settings);
+
+/// The least long side a picture is decoded at when its text may be read [px] (picture_keep_side_px).
+inline constexpr int kPictureTextJudgedMinSidePx = 1200;
+
 /// Loads the image at `path` and builds its scene with `settings`: text read from it when [vision] ocr asks
 /// (wants_picture_text, read_text), then vision::scene_chains_from_image with the words and the letters of
 /// printed lines (printed_letters_mask_of: words too uncertain to speak are no shapes either) masked (extraction, thin lines,
 /// gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the
 /// level-0 segments plan_levels gives it), then Scene::build (haptics.max_levels) of the curves kept.
 /// `timing` later: the text is not read here (ImageScene::text_pending, with_text).
+/// The file is decoded by vision::load_image_reduced at picture_keep_side_px (a large JPEG at 1/2, 1/4 or 1/8:
+/// ImageScene::picture, decode_scale, file_width_px, file_height_px). When its text is read and the decode was
+/// reduced, the file is decoded again for OCR at up to kOcrMaxSidePx (all intake checks again) and the words'
+/// boxes are scaled into `picture`'s pixels; if that second decode is refused, the picture is felt without its
+/// text (OcrReport::why "failed: ...").
 /// Throws vision::InputError for bad image files (one line naming the file and the limit).
 ImageScene build_image_scene(const std::string& path, const config::Settings& settings, TextTiming timing = TextTiming::now);
 
 /// build_image_scene on a picture's bytes already read (a document from a USB stick, read once through
-/// vision::read_stick_file): vision::decode_image with the [vision] limits, then the same steps. `name`
-/// names it in errors and scene.json; ImageScene::picture holds the decoded pixels.
+/// vision::read_stick_file): vision::decode_image_reduced with the [vision] limits at picture_keep_side_px, then
+/// the same steps. `name` names it in errors and scene.json; ImageScene::picture holds the decoded pixels.
+/// When OCR needs more detail than the reduced decode kept, a copy of `bytes` is kept (shared by
+/// ImageScene::with_text) and decoded again for it.
 /// @throws vision::InputError (one line naming `name` and the limit).
 ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& settings,
                                         TextTiming timing = TextTiming::now);

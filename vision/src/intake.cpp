@@ -5,6 +5,7 @@
 // decode cannot slip past the limits. OpenCV's logger is silenced while decoding because the
 // kiosk reports refusals itself, in one line, and its log must not fill with decoder chatter.
 
+#include <algorithm>
 #include <climits>
 #include <fstream>
 #include <mutex>
@@ -82,12 +83,30 @@ cv::Mat composite_over_white(const cv::Mat& bgra) {
 
 }  // namespace
 
+int jpeg_reduction_for(int width_px, int height_px, int keep_side_px) {
+  if (keep_side_px <= 0) return 1;
+  const std::int64_t side = std::max(width_px, height_px);
+  int scale = 1;
+  for (int f = 2; f <= 8; f *= 2) {
+    if ((side + f - 1) / f >= keep_side_px) scale = f;  // libjpeg's scaled size rounds up
+  }
+  return scale;
+}
+
 cv::Mat load_image(const std::string& path, const ImageLimits& limits) {
   if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
       limits.max_pixels <= 0) {
     throw hk::ArgumentError("load_image: every ImageLimits field must be positive");
   }
   return decode_image(read_input_file(path, limits.max_file_bytes), path, limits);
+}
+
+DecodedImage load_image_reduced(const std::string& path, const ImageLimits& limits, int keep_side_px) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
+      limits.max_pixels <= 0) {
+    throw hk::ArgumentError("load_image_reduced: every ImageLimits field must be positive");
+  }
+  return decode_image_reduced(read_input_file(path, limits.max_file_bytes), path, limits, keep_side_px);
 }
 
 std::vector<std::uint8_t> read_input_file(const std::string& path, std::int64_t max_bytes) {
@@ -103,6 +122,15 @@ cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& pat
   if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
       limits.max_pixels <= 0) {
     throw hk::ArgumentError("decode_image: every ImageLimits field must be positive");
+  }
+  return decode_image_reduced(bytes, path, limits, 0).bgr;
+}
+
+DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits,
+                                  int keep_side_px) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
+      limits.max_pixels <= 0) {
+    throw hk::ArgumentError("decode_image_reduced: every ImageLimits field must be positive");
   }
   if (bytes.empty()) detail::throw_input_error(path, "empty file (0 bytes)");
   if (bytes.size() > static_cast<std::uint64_t>(limits.max_file_bytes)) {
@@ -136,24 +164,31 @@ cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& pat
   if (to_decode.size() > static_cast<std::size_t>(INT_MAX)) {  // cv::Mat's column count is an int
     detail::throw_input_error(path, "file too large for the decoder (over 2 GiB)");
   }
+  // Only libjpeg decodes less for a reduced size (DCT scaling); other decoders would decode in full and resize.
+  const int scale = h.format == "jpeg" ? jpeg_reduction_for(h.width_px, h.height_px, keep_side_px) : 1;
+  const int flags = scale == 8   ? cv::IMREAD_REDUCED_COLOR_8
+                    : scale == 4 ? cv::IMREAD_REDUCED_COLOR_4
+                    : scale == 2 ? cv::IMREAD_REDUCED_COLOR_2
+                                 : cv::IMREAD_COLOR;
   const QuietOpenCvLog quiet;
   const cv::Mat buffer(1, static_cast<int>(to_decode.size()), CV_8UC1, const_cast<std::uint8_t*>(to_decode.data()));
   cv::Mat bgr;
   try {
-    bgr = cv::imdecode(buffer, cv::IMREAD_COLOR);
+    bgr = cv::imdecode(buffer, flags);
   } catch (const cv::Exception&) {
     bgr.release();  // reported below as a decoding failure
   }
   if (bgr.empty()) {
     detail::throw_input_error(path, "the " + h.format + " data could not be decoded (corrupt or unsupported)");
   }
-  const bool as_declared = bgr.cols == h.width_px && bgr.rows == h.height_px;
-  const bool transposed = bgr.cols == h.height_px && bgr.rows == h.width_px;  // EXIF rotation
+  const int want_w = (h.width_px + scale - 1) / scale, want_h = (h.height_px + scale - 1) / scale;
+  const bool as_declared = bgr.cols == want_w && bgr.rows == want_h;
+  const bool transposed = bgr.cols == want_h && bgr.rows == want_w;  // EXIF rotation
   if (!as_declared && !transposed) {
-    detail::throw_input_error(path, "decoded size " + std::to_string(bgr.cols) + " x " + std::to_string(bgr.rows) +
-                                        " px differs from the " + declared);
+    detail::throw_input_error(path, "decoded size " + std::to_string(bgr.cols) + " x " + std::to_string(bgr.rows) + " px differs from the " +
+                                        declared + (scale > 1 ? " reduced to 1/" + std::to_string(scale) : std::string()));
   }
-  if (hd.may_have_alpha) {
+  if (hd.may_have_alpha && scale == 1) {
     cv::Mat with_alpha;
     try {
       with_alpha = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
@@ -167,7 +202,13 @@ cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& pat
   if (bgr.type() != CV_8UC3) {
     detail::throw_input_error(path, "decoder returned an unexpected pixel type");
   }
-  return bgr;
+  DecodedImage out;
+  out.bgr = std::move(bgr);
+  out.file_width_px = as_declared ? h.width_px : h.height_px;
+  out.file_height_px = as_declared ? h.height_px : h.width_px;
+  out.scale = scale;
+  out.format = h.format;
+  return out;
 }
 
 }  // namespace hk::vision

@@ -81,6 +81,41 @@ ImageHeader read_image_header(const std::string& path);
 /// @throws hk::ArgumentError if a limit is not positive.
 cv::Mat load_image(const std::string& path, const ImageLimits& limits);
 
+/// An image decoded at reduced detail (see load_image_reduced), with what a report needs to say about it.
+struct DecodedImage {
+  /// CV_8UC3 BGR pixels as decoded: the picture shown upright (EXIF orientation applied), each side
+  /// ceil(file side / scale) [px].
+  cv::Mat bgr;
+  /// The picture's own size at full detail, upright like `bgr` (an EXIF rotation of 90 or 270 degrees
+  /// swaps the header's width and height) [px].
+  int file_width_px = 0;
+  int file_height_px = 0;
+  /// Full-detail pixels per decoded pixel along each side: 1 (full decode), 2, 4 or 8. A decoded pixel
+  /// (u, v) covers the full-detail pixels [u * scale, (u + 1) * scale) x [v * scale, (v + 1) * scale)
+  /// (libjpeg's scaled inverse DCT averages each block), so a position x in full-detail pixels
+  /// (origin at the top-left pixel's corner) is x / scale in decoded pixels.
+  int scale = 1;
+  std::string format;  ///< container format, as ImageHeader::format
+};
+
+/// The reduction factor a JPEG of `width_px` x `height_px` is decoded at so that its long side still has
+/// at least `keep_side_px` pixels: the largest 2^k, k <= 3, with ceil(max(width, height) / 2^k) >=
+/// keep_side_px (libjpeg rounds a scaled side up). 1 when keep_side_px <= 0 (full decode) or when even
+/// 1/2 would leave fewer than keep_side_px pixels. Sizes [px], both > 0.
+int jpeg_reduction_for(int width_px, int height_px, int keep_side_px);
+
+/// load_image at reduced detail: the same checks in the same order (file bytes, declared size, JPEG end
+/// marker, PNG chunks), all made before any pixel is decoded, then a JPEG is decoded at 1/scale of its size
+/// with libjpeg's DCT scaling (cv::IMREAD_REDUCED_COLOR_2/4/8, scale from jpeg_reduction_for: its long side
+/// stays >= keep_side_px), which spends a fraction of a full decode's time. EXIF orientation is applied as
+/// in a full decode. Other formats are decoded in full (scale 1): their decoders have no cheaper reduced
+/// path (OpenCV decodes them in full and then resizes).
+/// @param keep_side_px  fewest pixels the decoded long side may have [px]; 0 (or less) decodes in full, so
+///                      that bgr is exactly load_image's result.
+/// @throws InputError as load_image (and when the decoded size is not the declared one reduced by scale).
+/// @throws hk::ArgumentError if a limit is not positive.
+DecodedImage load_image_reduced(const std::string& path, const ImageLimits& limits, int keep_side_px);
+
 /// The whole file at `path` (an input named on the command line), read once, after checking it is a
 /// regular file of 1 to max_bytes bytes.
 /// @throws InputError "image '<path>': <problem>" (not found, not a regular file, empty, over max_bytes with
@@ -93,6 +128,11 @@ std::vector<std::uint8_t> read_input_file(const std::string& path, std::int64_t 
 /// decoding as load_image after the file has been read.
 /// @throws InputError as load_image; hk::ArgumentError if a limit is not positive.
 cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& name, const ImageLimits& limits);
+
+/// decode_image at reduced detail: load_image_reduced on bytes already read. `name` names the input in errors.
+/// @throws InputError as decode_image; hk::ArgumentError if a limit is not positive.
+DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& name, const ImageLimits& limits,
+                                  int keep_side_px);
 
 /// Converts to one grey channel and shrinks so that max(width, height) <= max_side_px.
 ///
