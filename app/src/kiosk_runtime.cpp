@@ -551,7 +551,7 @@ void KioskRuntime::build_ahead() {
 void KioskRuntime::show_built(ImageScene& is, int id) {
   Shown sh;
   sh.polylines = is.polylines;
-  sh.picture = is.picture.empty() ? cv::imread(is.image_path, cv::IMREAD_COLOR) : is.picture;
+  sh.picture = is.picture;  // the pixels the scene was built from (a picture file decoded once, reduced)
   sh.px_to_m = is.px_to_m;
   sh.text_blocks = is.text_blocks;
   publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
