@@ -517,11 +517,9 @@ std::vector<int> KioskRuntime::pictures_ahead() const {
 void KioskRuntime::build_ahead() {
   const int n = picture_count();
   const int at = wanted_id_ >= 0 && wanted_id_ < n ? wanted_id_ : shown_picture_;
-  if (at < 0) {
-    ahead_.clear();
-    return;
-  }
-  const int next = (at + 1) % n, previous = (at + n - 1) % n;
+  // No library picture under the hand (the tutorial, a stick, a capture): the first picture is the one a
+  // visitor reaches next (after the tutorial), so it is built ahead, from the scene cache after a restart.
+  const int next = at < 0 ? 0 : (at + 1) % n, previous = at < 0 ? 0 : (at + n - 1) % n;
   // Kept: the neighbours of where the visitor is (and is going), within the budget, the next one first.
   const std::size_t budget = static_cast<std::size_t>(s_.kiosk.prefetch_mb) << 20;
   std::vector<Ahead> kept;

@@ -211,7 +211,8 @@ class KioskRuntime final : public KioskEffects {
   /// Window thread, every frame (`now_s` the frame clock [s]): scenes the builder has finished. The one asked
   /// for is put on the device with the fade and handed to `flow` (picture_ready or picture_failed; null: a
   /// headless caller that only wants it felt); scenes built ahead are kept within [kiosk] prefetch_mb; then
-  /// the next and previous pictures of the one shown are asked for ahead.
+  /// the next and previous pictures of the one shown are asked for ahead (the first picture while none is
+  /// shown: the one the tutorial leads to).
   void poll_pictures(KioskFlow* flow, double now_s);
   /// Whether a scene asked for (a picture, or a rebuild after Apply) is not yet on the device (scripted runs
   /// hold their frames for it).

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <future>
 #include <stdexcept>
 #include <string>
@@ -19,6 +20,7 @@
 #include "kiosk_flow.hpp"
 #include "kiosk_runtime.hpp"
 #include "scene_builder.hpp"
+#include "scene_cache.hpp"
 #include "show_now.hpp"
 
 namespace fs = std::filesystem;
@@ -140,14 +142,16 @@ struct LibraryRig {
   std::unique_ptr<KioskRuntime> rt;
   std::unique_ptr<KioskFlow> flow;
   std::vector<std::string> said;
+  config::Settings settings;
 
   /// A library of `files` (names in tests/data/images, copied as 0_name, 1_name, ... to keep their order).
-  LibraryRig(const std::vector<std::string>& files, int prefetch_mb, const std::string& tag) {
+  LibraryRig(const std::vector<std::string>& files, int prefetch_mb, const std::string& tag, const std::string& cache_dir = "") {
     lib = fs::temp_directory_path() / ("hk_builder_" + tag + "_" + std::to_string(::getpid()));
     fs::remove_all(lib);
     fs::create_directories(lib);
     for (std::size_t i = 0; i < files.size(); ++i) fs::copy_file(kData / "images" / files[i], lib / (std::to_string(i) + "_" + files[i]));
     RuntimeOptions ro;
+    ro.scene_cache_dir = cache_dir;
     ro.library = lib.string();
     ro.hotplug = false;
     ro.open_audio_output = false;
@@ -155,6 +159,7 @@ struct LibraryRig {
     config::Settings s;
     s.kiosk.prefetch_mb = prefetch_mb;
     s.vision.ocr = "off";
+    settings = s;
     rt = std::make_unique<KioskRuntime>(ro, s);
     flow = std::make_unique<KioskFlow>(*rt, rt->audio().messages(), KioskFlowParams{});
   }
@@ -209,6 +214,17 @@ TEST(KioskBuilds, TheNextPictureBuiltAheadIsASwapAndThePreviousIsKept) {
   ASSERT_TRUE(r.ahead_becomes({1, 3})) << "picture 2's neighbours: 1 (built before) and 3";
 }
 
+TEST(KioskBuilds, TheFirstPictureIsBuiltDuringTheTutorialSoItsEndIsASwap) {
+  LibraryRig r({"fruits.jpg", "horse.png", "apple.jpg"}, 256, "first");
+  r.flow->key(KioskKey::Other, 0.0);  // wake: the tutorial's square
+  ASSERT_TRUE(r.ahead_becomes({0})) << "picture 1 is built while the visitor learns the shapes";
+  for (int i = 0; i < 2; ++i) r.flow->key(KioskKey::Next, 1.0);  // circle, triangle
+  r.flow->key(KioskKey::Next, 2.0);                              // the first picture
+  EXPECT_EQ(r.rt->shown_id(), 0) << "on the device at the key, not after a build";
+  EXPECT_FALSE(r.rt->picture_busy());
+  EXPECT_NE(r.rt->last_said().find("Picture 1 of 3"), std::string::npos) << r.rt->last_said();
+}
+
 TEST(KioskBuilds, NothingIsBuiltAheadOverTheBudgetAndNothingIsBuiltTwice) {
   LibraryRig r({"horse.png", "fruits.jpg", "apple.jpg"}, 0, "budget0");
   ASSERT_GE(test::show_now(*r.rt, 0), 0);
@@ -216,6 +232,84 @@ TEST(KioskBuilds, NothingIsBuiltAheadOverTheBudgetAndNothingIsBuiltTwice) {
   for (int i = 0; i < 50; ++i) r.rt->poll_pictures(r.flow.get(), 0.0);
   EXPECT_EQ(r.rt->scene_builds(), after_first) << "prefetch_mb = 0: nothing built ahead";
   EXPECT_TRUE(r.rt->pictures_ahead().empty());
+}
+
+/// The level-0 points of every curve of the scene shown.
+std::vector<std::vector<Vec2>> shown_points(KioskRuntime& rt) {
+  std::vector<std::vector<Vec2>> out;
+  for (const Polyline& p : rt.shown().polylines) out.push_back(p.points_m);
+  return out;
+}
+
+TEST(KioskBuilds, ACorruptCacheEntryIsRebuiltAndAnUnwritableCacheCostsOnlyTheCache) {
+  const fs::path cache = fs::temp_directory_path() / ("hk_builder_cache_" + std::to_string(::getpid()));
+  fs::remove_all(cache);
+  std::vector<std::vector<Vec2>> built;
+  fs::path entry;
+  {
+    LibraryRig r({"horse.png", "coins.png"}, 0, "cache1", cache.string());
+    ASSERT_GT(test::show_now(*r.rt, 0), 0);
+    built = shown_points(*r.rt);
+    for (const auto& e : fs::directory_iterator(cache / "")) entry = e.path();
+    ASSERT_FALSE(entry.empty()) << "the scene was kept";
+  }
+  {  // a byte flipped in the middle of the entry, as a failing disk leaves it
+    std::fstream f(entry, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(static_cast<std::streamoff>(fs::file_size(entry) / 2));
+    char c = 0;
+    f.read(&c, 1);
+    c = static_cast<char>(c ^ 0x5a);
+    f.seekp(static_cast<std::streamoff>(fs::file_size(entry) / 2));
+    f.write(&c, 1);
+  }
+  {
+    LibraryRig r({"horse.png", "coins.png"}, 0, "cache2", cache.string());
+    ASSERT_GT(test::show_now(*r.rt, 0), 0) << "built again";
+    EXPECT_EQ(shown_points(*r.rt), built);
+    const fs::path horse = r.lib / "0_horse.png";
+    std::ifstream in(horse, std::ios::binary);
+    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_TRUE(SceneCache(cache.string()).load(SceneCache::key(bytes, r.settings), r.settings)) << "and kept again, whole";
+  }
+  fs::remove_all(cache);
+  {  // the cache's folder cannot be made (a file stands where it should be): the pictures are felt all the same
+    std::ofstream(cache) << "not a folder";
+    LibraryRig r({"horse.png", "coins.png"}, 0, "cache3", (cache / "scenes").string());
+    ASSERT_GT(test::show_now(*r.rt, 0), 0);
+    EXPECT_EQ(shown_points(*r.rt), built);
+    ASSERT_GT(test::show_now(*r.rt, 1), 0);
+  }
+  fs::remove(cache);
+}
+
+TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibrary) {
+  LibraryRig r({"horse.png", "coins.png"}, 0, "stick");
+  const fs::path stick = r.lib.parent_path() / ("hk_builder_stickdir_" + std::to_string(::getpid()));
+  fs::remove_all(stick);
+  fs::create_directories(stick);
+  fs::copy_file(kData / "documents" / "shared-mime-info-spec.pdf", stick / "spec.pdf");
+  r.flow->key(KioskKey::Other, 0.0);
+  for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.0);
+  r.settle(0.0);
+  ASSERT_EQ(r.rt->shown_id(), 0);
+  r.rt->insert_stick_folder(stick.string());
+  double now_s = 1.0;
+  for (int i = 0; i < 6000 && r.rt->shown_id() != 1001; ++i, now_s += 0.01) {
+    r.rt->poll_sticks(*r.flow, now_s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(r.rt->shown_id(), 1001) << "the stick's first page is felt";
+  r.flow->key(KioskKey::Next, now_s);  // page 2 asked for...
+  r.rt->remove_stick_folder();         // ...and the stick pulled out while it is drawn
+  for (int i = 0; i < 6000 && (r.rt->stick_busy() || r.rt->picture_busy()); ++i, now_s += 0.01) {
+    r.rt->poll_sticks(*r.flow, now_s);
+    r.rt->poll_pictures(r.flow.get(), now_s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  for (int i = 0; i < 50; ++i, now_s += 0.01) r.rt->poll_sticks(*r.flow, now_s);  // page 2's drawing, if it ends now, is dropped
+  EXPECT_EQ(r.rt->shown_id(), 0) << "back on the library's picture, never page 2";
+  EXPECT_EQ(r.flow->failures(), 0);
+  fs::remove_all(stick);
 }
 
 TEST(KioskBuilds, APictureThatCannotBeReadIsSaidAndTheOldOneStays) {
