@@ -23,6 +23,20 @@ double polyline_length_m(const Polyline& p) {
   return l;
 }
 
+void fit_picture(ImageScene& is, int max_side_px) {
+  if (max_side_px < 1) throw hk::ArgumentError("fit_picture: max_side_px must be >= 1");
+  const int side = std::max(is.picture.cols, is.picture.rows);
+  if (is.picture.empty() || side <= max_side_px) return;
+  const double f = static_cast<double>(max_side_px) / side;  // new pixels per old pixel
+  cv::Mat small;
+  cv::resize(is.picture, small, cv::Size(), f, f, cv::INTER_AREA);
+  // Old pixel u sits at new pixel u' = (u + 0.5) f − 0.5 (centres), so u = (u' + 0.5) / f − 0.5.
+  const vision::PxToM& m = is.px_to_m;
+  const double back = 0.5 / f - 0.5;
+  is.px_to_m = {m.scale_m_per_px / f, m.x_m(back), m.y_m(back)};
+  is.picture = small;
+}
+
 std::vector<Polyline> to_polylines(const std::vector<vision::SceneCurve>& curves) {
   std::vector<Polyline> out;
   out.reserve(curves.size());

@@ -149,6 +149,16 @@ struct ImageScene {
   BuildTimes times;
 };
 
+/// Longest side of the picture a screen shows [px]: a full-HD screen's width (the workspace never fills more).
+inline constexpr int kScreenPictureMaxSidePx = 1920;
+
+/// Shrinks `is.picture` (INTER_AREA) so that its long side is at most `max_side_px`, and moves `is.px_to_m`
+/// with it (pixel centres kept: the same workspace rectangle), so the picture shown is no larger than a screen
+/// needs and crosses to the GPU in one small upload. The curves, text blocks and scene are untouched (they are
+/// in metres). Nothing happens to an empty or small enough picture.
+/// @throws hk::ArgumentError if max_side_px < 1.
+void fit_picture(ImageScene& is, int max_side_px = kScreenPictureMaxSidePx);
+
 /// Polyline length [m], with the closing segment of a closed curve (what a hand can follow).
 double polyline_length_m(const Polyline& p);
 

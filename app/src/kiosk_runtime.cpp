@@ -393,7 +393,11 @@ std::size_t approx_bytes(const ImageScene& is) {
 /// built from the bytes read once and stored; a scene whose text is still to be read is stored once it has
 /// been read (its with_text stores what it builds). Runs on the builder's worker.
 ImageScene cached_or_built(const std::string& path, const config::Settings& s, const std::shared_ptr<SceneCache>& cache) {
-  if (!cache) return build_image_scene(path, s, TextTiming::later);
+  if (!cache) {
+    ImageScene is = build_image_scene(path, s, TextTiming::later);
+    fit_picture(is);
+    return is;
+  }
   const std::vector<std::uint8_t> bytes = vision::read_input_file(path, extract_params_from(s).limits.max_file_bytes);
   const std::string key = SceneCache::key(bytes, s);
   if (std::optional<ImageScene> hit = cache->load(key, s)) {
@@ -401,12 +405,14 @@ ImageScene cached_or_built(const std::string& path, const config::Settings& s, c
     return std::move(*hit);
   }
   ImageScene is = build_image_scene_from_bytes(bytes, path, s, TextTiming::later);
+  fit_picture(is);
   if (!is.text_pending) {
     cache->store(key, is);
     return is;
   }
   is.with_text = [read = std::move(is.with_text), cache, key](const std::atomic<bool>* cancel) {
     ImageScene with_text = read(cancel);
+    fit_picture(with_text);
     const bool whole = with_text.scene && with_text.ocr.why != "cancelled" && with_text.ocr.why.rfind("failed", 0) != 0;
     if (whole) cache->store(key, with_text);
     return with_text;
@@ -555,7 +561,11 @@ void KioskRuntime::show_built(ImageScene& is, int id) {
   publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
   text_news_.clear();
   if (is.text_pending && is.with_text) {
-    text_.start(id, std::move(is.with_text));
+    text_.start(id, [read = std::move(is.with_text)](const std::atomic<bool>* cancel) {
+      ImageScene with_text = read(cancel);
+      fit_picture(with_text);  // on the reader's worker, not the window thread
+      return with_text;
+    });
     text_since_s_ = -1.0;
     text_said_ = false;
   } else {

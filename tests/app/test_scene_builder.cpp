@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "hk/error.hpp"
 #include "kiosk_flow.hpp"
 #include "kiosk_runtime.hpp"
 #include "scene_builder.hpp"
@@ -133,6 +134,31 @@ TEST(SceneBuilder, AFailedBuildComesBackWithItsReason) {
   ASSERT_EQ(done.size(), 1u);
   EXPECT_FALSE(done[0].scene);
   EXPECT_EQ(done[0].error, "image 'x.png': truncated");
+}
+
+TEST(FitPicture, AScreensWorthOfPixelsCoveringTheSameWorkspaceRectangle) {
+  ImageScene is;
+  is.picture = cv::Mat(2000, 4000, CV_8UC3, cv::Scalar(10, 20, 30));
+  is.picture(cv::Rect(0, 0, 2000, 2000)).setTo(cv::Scalar(200, 200, 200));  // left half light
+  is.px_to_m = {0.1 / 4000, -0.05, 0.025};  // 10 cm wide, centred
+  const vision::PxToM before = is.px_to_m;
+  fit_picture(is, 1920);
+  EXPECT_EQ(is.picture.cols, 1920);
+  EXPECT_EQ(is.picture.rows, 960);
+  // The picture's outer edges (pixel corners) land where they did: x from -5 cm to 5 cm, y from 2.5 cm down.
+  EXPECT_NEAR(is.px_to_m.x_m(-0.5), before.x_m(-0.5), 1e-12);
+  EXPECT_NEAR(is.px_to_m.x_m(1920 - 0.5), before.x_m(4000 - 0.5), 1e-12);
+  EXPECT_NEAR(is.px_to_m.y_m(-0.5), before.y_m(-0.5), 1e-12);
+  EXPECT_NEAR(is.px_to_m.y_m(960 - 0.5), before.y_m(2000 - 0.5), 1e-12);
+  // The light half stays where it was: the boundary between pixel 959 and 960 is the old one at 2000.
+  EXPECT_NEAR(is.px_to_m.x_m(959.5), before.x_m(1999.5), 1e-12);
+  EXPECT_EQ(is.picture.at<cv::Vec3b>(480, 959)[0], 200);
+  EXPECT_EQ(is.picture.at<cv::Vec3b>(480, 960)[0], 10);
+  const vision::PxToM fitted = is.px_to_m;
+  fit_picture(is, 1920);  // small enough: untouched
+  EXPECT_EQ(is.picture.cols, 1920);
+  EXPECT_EQ(is.px_to_m.scale_m_per_px, fitted.scale_m_per_px);
+  EXPECT_THROW(fit_picture(is, 0), hk::ArgumentError);
 }
 
 // ---- the kiosk on the builder ----
