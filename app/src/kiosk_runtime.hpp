@@ -7,8 +7,9 @@
 /// (apply_settings). No OpenGL here: the window layer (app/kiosk) draws what `shown()` holds, and tests
 /// drive the runtime headless.
 ///
-/// Threads: construct, call and destroy on one thread (the window thread); the servo thread and the stick
-/// service's threads are owned here.
+/// Threads: construct, call and destroy on one thread (the window thread); the servo thread, the scene
+/// builder's worker (every library picture and every rebuild after Apply is built there, never on the window
+/// thread: scene_builder.hpp), the text reader's and the stick service's threads are owned here.
 
 #include <atomic>
 #include <memory>
