@@ -180,6 +180,7 @@ json to_payload(const std::string& key, const ImageScene& is) {
   j["worker_max_rss_kb"] = is.worker_max_rss_kb;
   j["width_px"] = is.width_px;
   j["height_px"] = is.height_px;
+  j["file_px"] = {is.file_width_px, is.file_height_px, is.decode_scale};
   j["px_to_m"] = {is.px_to_m.scale_m_per_px, is.px_to_m.offset_x_m, is.px_to_m.offset_y_m};
   j["counts"] = {{"chains_texture", is.chains_texture},
                  {"chains_found", is.chains_found},
@@ -269,6 +270,11 @@ ImageScene from_payload(const json& j, const std::string& key) {
   is.worker_max_rss_kb = j.at("worker_max_rss_kb").get<long>();
   is.width_px = j.at("width_px").get<int>();
   is.height_px = j.at("height_px").get<int>();
+  const json& f = j.at("file_px");
+  if (!f.is_array() || f.size() != 3) throw BadEntry{"file_px is not 3 numbers"};
+  is.file_width_px = f[0].get<int>();
+  is.file_height_px = f[1].get<int>();
+  is.decode_scale = f[2].get<int>();
   const json& m = j.at("px_to_m");
   if (!m.is_array() || m.size() != 3) throw BadEntry{"px_to_m is not 3 numbers"};
   is.px_to_m = {m[0].get<double>(), m[1].get<double>(), m[2].get<double>()};

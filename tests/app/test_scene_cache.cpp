@@ -127,6 +127,9 @@ void expect_same(const ImageScene& a, const ImageScene& b) {
   EXPECT_EQ(a.worker_max_rss_kb, b.worker_max_rss_kb);
   EXPECT_EQ(a.width_px, b.width_px);
   EXPECT_EQ(a.height_px, b.height_px);
+  EXPECT_EQ(a.file_width_px, b.file_width_px);
+  EXPECT_EQ(a.file_height_px, b.file_height_px);
+  EXPECT_EQ(a.decode_scale, b.decode_scale);
   EXPECT_EQ(a.px_to_m.scale_m_per_px, b.px_to_m.scale_m_per_px);
   EXPECT_EQ(a.px_to_m.offset_x_m, b.px_to_m.offset_x_m);
   EXPECT_EQ(a.px_to_m.offset_y_m, b.px_to_m.offset_y_m);
