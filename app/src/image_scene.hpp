@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "config/settings.hpp"
+#include "picture_notes.hpp"
 #include "haptics/scene.hpp"
 #include "vision/mapping.hpp"
 #include "vision/ocr.hpp"
@@ -94,6 +95,9 @@ struct ImageScene {
   int page = 0;                             ///< document page shown (from 1); 0 for a picture file
   int pages = 0;                            ///< pages the document offers; 0 for a picture file
   std::string document_title;               ///< a PDF's own title (documents.hpp pdf_title), "" when none or a picture file
+  /// A library picture's title and description (picture_notes.hpp), read where the scene was built (reading
+  /// them parses the whole file, too slow for the window thread); empty for everything else.
+  PictureNotes notes;
   /// The BGR pixels the scene was built from, always set: a picture file's as decoded (at 1/decode_scale of
   /// its size, see picture_keep_side_px), a rendered page's, a camera capture's. px_to_m maps these pixels,
   /// so the picture is shown from here (never decoded again from image_path).

@@ -420,11 +420,25 @@ ImageScene cached_or_built(const std::string& path, const config::Settings& s, c
   return is;
 }
 
+/// A library picture's notes; one that cannot be used is logged and the picture shown without it.
+PictureNotes notes_of(const std::string& path) {
+  try {
+    return read_picture_notes(path);
+  } catch (const PictureNotesError& e) {
+    spdlog::warn("{}; the picture is shown without it", e.what());
+    return {};
+  }
+}
+
 }  // namespace
 
 SceneJob KioskRuntime::picture_job(int index) const {
   // A copy of what the build needs: the worker never touches the runtime.
-  return [path = pictures_[static_cast<std::size_t>(index)], s = s_, cache = cache_] { return cached_or_built(path, s, cache); };
+  return [path = pictures_[static_cast<std::size_t>(index)], s = s_, cache = cache_] {
+    ImageScene is = cached_or_built(path, s, cache);
+    is.notes = notes_of(path);
+    return is;
+  };
 }
 
 int KioskRuntime::show_picture(int index) {
@@ -446,14 +460,8 @@ int KioskRuntime::show_picture(int index) {
 }
 
 int KioskRuntime::put_picture(int index, ImageScene& is) {
-  const std::string& path = pictures_[static_cast<std::size_t>(index)];
   const int shapes = static_cast<int>(is.scene->curve_count());
-  PictureNotes notes;
-  try {
-    notes = read_picture_notes(path);
-  } catch (const PictureNotesError& e) {
-    spdlog::warn("{}; the picture is shown without it", e.what());  // the picture still shows
-  }
+  PictureNotes notes = std::move(is.notes);  // read on the worker
   show_built(is, index);
   shown_.notes = std::move(notes);
   shown_picture_ = index;
