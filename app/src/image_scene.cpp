@@ -23,6 +23,13 @@ double polyline_length_m(const Polyline& p) {
   return l;
 }
 
+std::size_t approx_scene_bytes(const ImageScene& is) {
+  std::size_t b = is.picture.total() * is.picture.elemSize();
+  for (const Polyline& p : is.polylines) b += p.points_m.size() * sizeof(Vec2);
+  if (is.scene) b += is.scene->total_segments(0) * 150;
+  return b + sizeof(ImageScene);
+}
+
 void fit_picture(ImageScene& is, int max_side_px) {
   if (max_side_px < 1) throw hk::ArgumentError("fit_picture: max_side_px must be >= 1");
   const int side = std::max(is.picture.cols, is.picture.rows);

@@ -98,6 +98,9 @@ struct ImageScene {
   /// A library picture's title and description (picture_notes.hpp), read where the scene was built (reading
   /// them parses the whole file, too slow for the window thread); empty for everything else.
   PictureNotes notes;
+  /// What a library picture file itself says of it (embedded_notes: its metadata), read with its scene and
+  /// kept with it in the scene cache; `notes` is this unless a sidecar says otherwise. Empty for the rest.
+  PictureNotes file_notes;
   /// The BGR pixels the scene was built from, always set: a picture file's as decoded (at 1/decode_scale of
   /// its size, see picture_keep_side_px), a rendered page's, a camera capture's. px_to_m maps these pixels,
   /// so the picture is shown from here (never decoded again from image_path).
@@ -162,6 +165,11 @@ inline constexpr int kScreenPictureMaxSidePx = 1920;
 /// in metres). Nothing happens to an empty or small enough picture.
 /// @throws hk::ArgumentError if max_side_px < 1.
 void fit_picture(ImageScene& is, int max_side_px = kScreenPictureMaxSidePx);
+
+/// Memory an ImageScene holds [bytes], roughly: its picture, its curves and its collision trees (about 150
+/// bytes a level-0 segment over all levels and boxes; Scene's own layout, scene.hpp). What budgets of scenes
+/// built ahead ([kiosk] prefetch_mb) count. Never throws.
+std::size_t approx_scene_bytes(const ImageScene& is);
 
 /// Polyline length [m], with the closing segment of a closed curve (what a hand can follow).
 double polyline_length_m(const Polyline& p);

@@ -1,5 +1,7 @@
 #include "kiosk_flow.hpp"
 
+#include "stick_pages.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -451,22 +453,12 @@ void KioskFlow::request(int document, int page, double now_s) {
 void KioskFlow::step_document(int delta, double now_s) {
   // From the last page asked for: the one awaited (a key pressed while loading moves on from there), or
   // the last one shown or found unreadable (so a visitor can step past a page that cannot be read).
-  int d = v_.at_doc;
-  int p = v_.at_page;
-  const int n = static_cast<int>(v_.stick.size());
-  if (d < 0) {
-    d = delta > 0 ? 0 : n - 1;
-    p = delta > 0 ? 1 : v_.stick[static_cast<std::size_t>(d)].pages;
-  } else if (delta > 0) {
-    if (++p > v_.stick[static_cast<std::size_t>(d)].pages) {
-      d = (d + 1) % n;
-      p = 1;
-    }
-  } else if (--p < 1) {
-    d = (d - 1 + n) % n;
-    p = v_.stick[static_cast<std::size_t>(d)].pages;
-  }
-  request(d, p, now_s);
+  if (v_.stick.empty()) return;
+  std::vector<int> pages;
+  pages.reserve(v_.stick.size());
+  for (const StickEntry& e : v_.stick) pages.push_back(e.pages);
+  const StickPage to = step_stick_page(pages, {v_.at_doc, v_.at_page}, delta);
+  request(to.document, to.page, now_s);
 }
 
 void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double now_s) {

@@ -380,50 +380,59 @@ void KioskRuntime::show_tutorial(TutorialShape shape) {
 
 namespace {
 
-/// Memory a scene built ahead holds [bytes]: its picture, its curves and its collision trees (about 150
-/// bytes a level-0 segment over all levels and boxes; Scene's own layout, scene.hpp).
-std::size_t approx_bytes(const ImageScene& is) {
-  std::size_t b = is.picture.total() * is.picture.elemSize();
-  for (const Polyline& p : is.polylines) b += p.points_m.size() * sizeof(Vec2);
-  if (is.scene) b += is.scene->total_segments(0) * 150;
-  return b + sizeof(ImageScene);
-}
-
-/// Library picture `path`'s scene: from the scene cache when it holds one for these bytes and settings, else
-/// built from the bytes read once and stored; a scene whose text is still to be read is stored once it has
-/// been read (its with_text stores what it builds). Runs on the builder's worker.
+/// Library picture `path`'s scene, with what the file itself says of it (file_notes): from the scene cache
+/// when it holds one for this file and these settings (found by the file's stamp without reading it, else
+/// by its bytes' key), else built from the bytes read once and stored; a scene whose text is still to be
+/// read is stored once it has been read (its with_text stores what it builds). Runs on the builder's worker.
 ImageScene cached_or_built(const std::string& path, const config::Settings& s, const std::shared_ptr<SceneCache>& cache) {
   if (!cache) {
     ImageScene is = build_image_scene(path, s, TextTiming::later);
     fit_picture(is);
+    is.file_notes = embedded_notes(path);
     return is;
+  }
+  const std::optional<FileStamp> stamp = SceneCache::stamp(path);  // before the bytes are read
+  if (stamp) {
+    if (const std::optional<std::string> known = cache->known_key(*stamp, s)) {
+      if (std::optional<ImageScene> hit = cache->load(*known, s)) {
+        hit->image_path = path;
+        return std::move(*hit);
+      }
+    }
   }
   const std::vector<std::uint8_t> bytes = vision::read_input_file(path, extract_params_from(s).limits.max_file_bytes);
   const std::string key = SceneCache::key(bytes, s);
   if (std::optional<ImageScene> hit = cache->load(key, s)) {
+    if (stamp) cache->remember_key(*stamp, s, key);
     hit->image_path = path;
     return std::move(*hit);
   }
   ImageScene is = build_image_scene_from_bytes(bytes, path, s, TextTiming::later);
   fit_picture(is);
+  is.file_notes = embedded_notes(path);
+  auto keep = [cache, key, stamp, s](const ImageScene& built) {
+    if (cache->store(key, built) && stamp) cache->remember_key(*stamp, s, key);
+  };
   if (!is.text_pending) {
-    cache->store(key, is);
+    keep(is);
     return is;
   }
-  is.with_text = [read = std::move(is.with_text), cache, key](const std::atomic<bool>* cancel) {
+  is.with_text = [read = std::move(is.with_text), keep, file_notes = is.file_notes](const std::atomic<bool>* cancel) {
     ImageScene with_text = read(cancel);
     fit_picture(with_text);
+    with_text.file_notes = file_notes;
     const bool whole = with_text.scene && with_text.ocr.why != "cancelled" && with_text.ocr.why.rfind("failed", 0) != 0;
-    if (whole) cache->store(key, with_text);
+    if (whole) keep(with_text);
     return with_text;
   };
   return is;
 }
 
-/// A library picture's notes; one that cannot be used is logged and the picture shown without it.
-PictureNotes notes_of(const std::string& path) {
+/// A library picture's notes: its sidecar's, else `file_notes` (what the file says, read with its scene);
+/// a sidecar that cannot be used is logged and the picture shown without notes.
+PictureNotes notes_of(const std::string& path, const PictureNotes& file_notes) {
   try {
-    return read_picture_notes(path);
+    return read_picture_notes(path, &file_notes);
   } catch (const PictureNotesError& e) {
     spdlog::warn("{}; the picture is shown without it", e.what());
     return {};
@@ -436,7 +445,7 @@ SceneJob KioskRuntime::picture_job(int index) const {
   // A copy of what the build needs: the worker never touches the runtime.
   return [path = pictures_[static_cast<std::size_t>(index)], s = s_, cache = cache_] {
     ImageScene is = cached_or_built(path, s, cache);
-    is.notes = notes_of(path);
+    is.notes = notes_of(path, is.file_notes);
     return is;
   };
 }
@@ -485,7 +494,7 @@ void KioskRuntime::absorb_built() {
     }
     Ahead a;
     a.index = b.id;
-    a.bytes = approx_bytes(*b.scene);
+    a.bytes = approx_scene_bytes(*b.scene);
     a.scene = std::make_unique<ImageScene>(std::move(*b.scene));
     ahead_.push_back(std::move(a));
   }
@@ -979,6 +988,7 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
   }
   s_ = in_use;
   capture_.set_settings(s_);
+  sticks_.set_settings(s_);  // pages built ahead with the old settings are dropped
   sp_ = servo_params_from(s_);
   if (r.gains) core_.set_gains(servo_gains_from(s_));
   if (r.keys) flow.set_keys(s_.keys);

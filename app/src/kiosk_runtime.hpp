@@ -338,7 +338,7 @@ class KioskRuntime final : public KioskEffects {
   struct Ahead {
     int index = 0;                   // library picture
     std::unique_ptr<ImageScene> scene;
-    std::size_t bytes = 0;           // its memory (approx_bytes)
+    std::size_t bytes = 0;           // its memory (approx_scene_bytes)
   };
   std::shared_ptr<SceneCache> cache_;  // shared with the builds under way (null: none)
   SceneBuilder builder_;

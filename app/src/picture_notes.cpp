@@ -124,10 +124,10 @@ PictureNotes embedded_notes(const std::string& image_path) {
 
 std::string notes_path(const std::string& image_path) { return fs::path(image_path).replace_extension(".toml").string(); }
 
-PictureNotes read_picture_notes(const std::string& image_path) {
+PictureNotes read_picture_notes(const std::string& image_path, const PictureNotes* file_notes) {
   const std::string file = notes_path(image_path);
   std::error_code ec;
-  if (!fs::exists(file, ec)) return embedded_notes(image_path);
+  if (!fs::exists(file, ec)) return file_notes != nullptr ? *file_notes : embedded_notes(image_path);
   if (!fs::is_regular_file(file, ec)) fail(file, "is not a regular file");
   const auto size = fs::file_size(file, ec);
   if (ec) fail(file, "cannot be read: " + ec.message());

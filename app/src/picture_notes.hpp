@@ -51,12 +51,13 @@ std::string usable_note(const std::string& raw, std::size_t max_bytes, bool line
 /// The sidecar of `image_path`: the file of the same name with the extension `.toml` in the same folder.
 std::string notes_path(const std::string& image_path);
 
-/// Reads the sidecar of `image_path` (notes_path). No sidecar: embedded_notes, what the file itself says
-/// (a sidecar wins over the file: it is the operator's). The sidecar must be at most
+/// Reads the sidecar of `image_path` (notes_path). No sidecar: what the file itself says, `*file_notes` when
+/// given (embedded_notes read earlier, e.g. kept with a cached scene), else embedded_notes (a sidecar wins
+/// over the file: it is the operator's). The sidecar must be at most
 /// kMaxNotesFileBytes, valid TOML, with only the string keys `title` (one line, no control characters, at
 /// most kMaxTitleBytes) and `description` (no control characters but line breaks, at most
 /// kMaxDescriptionBytes), both valid UTF-8 and not blank; surrounding white space is trimmed.
 /// @throws PictureNotesError (one line) for a sidecar that breaks any of these, or cannot be read.
-PictureNotes read_picture_notes(const std::string& image_path);
+PictureNotes read_picture_notes(const std::string& image_path, const PictureNotes* file_notes = nullptr);
 
 }  // namespace hk::app

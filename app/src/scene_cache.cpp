@@ -37,6 +37,8 @@ constexpr std::size_t kHeaderBytes = 8 + 4 + 8;                  // magic, forma
 constexpr std::size_t kChecksumBytes = crypto_generichash_BYTES;  // 32
 constexpr std::size_t kPrefixBytes = kHeaderBytes + kChecksumBytes;
 constexpr std::string_view kSuffix = ".scene";
+constexpr std::string_view kRefSuffix = ".ref";
+constexpr std::size_t kRefBytes = 2 * crypto_generichash_BYTES + 1;  // a key and a line feed
 constexpr std::string_view kTempPrefix = ".tmp-";
 /// CBOR values a payload may hold: far above a scene's (a few hundred per curve at most, the points being
 /// byte strings), far below what would make the parsed tree large (about 100 bytes a value).
@@ -175,6 +177,7 @@ json to_payload(const std::string& key, const ImageScene& is) {
               {"worker_max_rss_kb", is.ocr.worker_max_rss_kb}};
   j["text_likely"] = is.text_likely;
   j["text_words_masked"] = is.text_words_masked;
+  j["file_notes"] = {{"title", is.file_notes.title}, {"description", is.file_notes.description}};
   j["render_dpi"] = is.render_dpi;
   j["worker_ms"] = is.worker_ms;
   j["worker_max_rss_kb"] = is.worker_max_rss_kb;
@@ -222,28 +225,22 @@ json to_payload(const std::string& key, const ImageScene& is) {
   return j;
 }
 
-/// The ImageScene of a payload (its Scene not built). Throws BadEntry or json::exception on anything but
-/// what to_payload writes.
-ImageScene from_payload(const json& j, const std::string& key) {
-  if (!j.is_object()) throw BadEntry{"the payload is not a map"};
-  if (j.at("key").get<std::string>() != key) throw BadEntry{"holds the scene of another key"};
-  ImageScene is;
-  is.image_path = j.at("image_path").get<std::string>();
-  is.page = j.at("page").get<int>();
-  is.pages = j.at("pages").get<int>();
-  is.document_title = j.at("document_title").get<std::string>();
-  if (j.contains("picture")) {
-    const json& p = j.at("picture");
-    const int cols = p.at("cols").get<int>(), rows = p.at("rows").get<int>();
-    const json& jpeg = p.at("jpeg");
-    if (!jpeg.is_binary()) throw BadEntry{"the picture is not a byte string"};
-    int w = 0, h = 0;
-    if (!jpeg_size(jpeg.get_binary(), w, h) || w != cols || h != rows || cols <= 0 || rows <= 0 ||
-        static_cast<std::int64_t>(cols) * rows > kMaxPicturePixels)
-      throw BadEntry{"the picture's JPEG header disagrees with its size"};
-    is.picture = cv::imdecode(jpeg.get_binary(), cv::IMREAD_COLOR);
-    if (is.picture.cols != cols || is.picture.rows != rows) throw BadEntry{"the picture does not decode"};
-  }
+/// The screen's picture of a payload's "picture" map: a JPEG whose header agrees with the size given.
+cv::Mat picture_from(const json& p) {
+  const int cols = p.at("cols").get<int>(), rows = p.at("rows").get<int>();
+  const json& jpeg = p.at("jpeg");
+  if (!jpeg.is_binary()) throw BadEntry{"the picture is not a byte string"};
+  int w = 0, h = 0;
+  if (!jpeg_size(jpeg.get_binary(), w, h) || w != cols || h != rows || cols <= 0 || rows <= 0 ||
+      static_cast<std::int64_t>(cols) * rows > kMaxPicturePixels)
+    throw BadEntry{"the picture's JPEG header disagrees with its size"};
+  cv::Mat picture = cv::imdecode(jpeg.get_binary(), cv::IMREAD_COLOR);
+  if (picture.cols != cols || picture.rows != rows) throw BadEntry{"the picture does not decode"};
+  return picture;
+}
+
+/// A payload's text: its blocks, what OCR did, and the file's own notes.
+void text_from(const json& j, ImageScene& is) {
   for (const json& b : j.at("text_blocks")) {
     TextBlockM t;
     t.id = b.at("id").get<int>();
@@ -265,6 +262,13 @@ ImageScene from_payload(const json& j, const std::string& key) {
   is.ocr.worker_max_rss_kb = o.at("worker_max_rss_kb").get<long>();
   is.text_likely = j.at("text_likely").get<bool>();
   is.text_words_masked = j.at("text_words_masked").get<std::size_t>();
+  const json& n = j.at("file_notes");
+  is.file_notes.title = n.at("title").get<std::string>();
+  is.file_notes.description = n.at("description").get<std::string>();
+}
+
+/// A payload's sizes: the rendered page's, the picture's, the file's, and the pixel map.
+void geometry_from(const json& j, ImageScene& is) {
   is.render_dpi = j.at("render_dpi").get<double>();
   is.worker_ms = j.at("worker_ms").get<double>();
   is.worker_max_rss_kb = j.at("worker_max_rss_kb").get<long>();
@@ -278,7 +282,10 @@ ImageScene from_payload(const json& j, const std::string& key) {
   const json& m = j.at("px_to_m");
   if (!m.is_array() || m.size() != 3) throw BadEntry{"px_to_m is not 3 numbers"};
   is.px_to_m = {m[0].get<double>(), m[1].get<double>(), m[2].get<double>()};
-  const json& c = j.at("counts");
+}
+
+/// A payload's counts of what the build found and dropped.
+void counts_from(const json& c, ImageScene& is) {
   is.chains_texture = c.at("chains_texture").get<std::size_t>();
   is.chains_found = c.at("chains_found").get<std::size_t>();
   is.thin_line_pairs_merged = c.at("thin_line_pairs_merged").get<std::size_t>();
@@ -292,6 +299,10 @@ ImageScene from_payload(const json& j, const std::string& key) {
   is.chains_over_budget = c.at("chains_over_budget").get<std::size_t>();
   is.segments_before_budget = c.at("segments_before_budget").get<std::size_t>();
   is.segments_after_budget = c.at("segments_after_budget").get<std::size_t>();
+}
+
+/// A payload's edge detection: thresholds, detector, the picture's tones.
+void detection_from(const json& j, ImageScene& is) {
   const json& canny = j.at("canny");
   if (!canny.is_array() || canny.size() != 2) throw BadEntry{"canny is not 2 numbers"};
   is.canny_low = canny[0].get<double>();
@@ -309,6 +320,10 @@ ImageScene from_payload(const json& j, const std::string& key) {
   is.tones.near_share = tn.at("near_share").get<double>();
   is.tones.ink_width_px = tn.at("ink_width_px").get<double>();
   is.line_drawing = j.at("line_drawing").get<bool>();
+}
+
+/// A payload's curves and their strengths.
+void curves_from(const json& j, ImageScene& is) {
   for (const json& p : j.at("polylines")) {
     const std::vector<double> xy = from_binary(p.at("points_m"), "a polyline's points");
     if (xy.size() % 2 != 0) throw BadEntry{"a polyline has an odd number of coordinates"};
@@ -320,6 +335,24 @@ ImageScene from_payload(const json& j, const std::string& key) {
   }
   is.strength = from_binary(j.at("strength"), "strength");
   if (is.strength.size() != is.polylines.size()) throw BadEntry{"strength and polylines differ in count"};
+}
+
+/// The ImageScene of a payload (its Scene not built). Throws BadEntry or json::exception on anything but
+/// what to_payload writes.
+ImageScene from_payload(const json& j, const std::string& key) {
+  if (!j.is_object()) throw BadEntry{"the payload is not a map"};
+  if (j.at("key").get<std::string>() != key) throw BadEntry{"holds the scene of another key"};
+  ImageScene is;
+  is.image_path = j.at("image_path").get<std::string>();
+  is.page = j.at("page").get<int>();
+  is.pages = j.at("pages").get<int>();
+  is.document_title = j.at("document_title").get<std::string>();
+  if (j.contains("picture")) is.picture = picture_from(j.at("picture"));
+  text_from(j, is);
+  geometry_from(j, is);
+  counts_from(j.at("counts"), is);
+  detection_from(j, is);
+  curves_from(j, is);
   const json& t = j.at("times_ms");
   if (!t.is_array() || t.size() != 7) throw BadEntry{"times_ms is not 7 numbers"};
   is.times = {t[0].get<double>(), t[1].get<double>(), t[2].get<double>(), t[3].get<double>(),
@@ -411,6 +444,48 @@ void hash_text(crypto_generichash_state& st, std::string_view s) {
   crypto_generichash_update(&st, reinterpret_cast<const unsigned char*>(s.data()), s.size());
 }
 
+/// Starts a BLAKE2b-256 over `domain`, the entry format, the program version and every
+/// scene_shaping_fields() setting ("table.key" and its exact value: doubles by their bits).
+void begin_settings_hash(crypto_generichash_state& st, std::string_view domain, const config::Settings& s) {
+  [[maybe_unused]] const int ready = sodium_init();  // picks the fastest BLAKE2b; the portable one serves when it fails
+  crypto_generichash_init(&st, nullptr, 0, crypto_generichash_BYTES);
+  hash_text(st, domain);
+  hash_u64(st, kSceneCacheFormat);
+  hash_text(st, HK_PROGRAM_VERSION);
+  for (const config::FieldDescriptor* d : scene_shaping_fields()) {
+    hash_text(st, std::string(d->table) + "." + std::string(d->key));
+    std::visit(
+        [&st](const auto* p) {
+          using T = std::remove_cv_t<std::remove_pointer_t<decltype(p)>>;
+          if constexpr (std::is_same_v<T, double>) {
+            hash_text(st, "d");
+            hash_u64(st, std::bit_cast<std::uint64_t>(*p));
+          } else if constexpr (std::is_same_v<T, std::string>) {
+            hash_text(st, "s");
+            hash_text(st, *p);
+          } else {
+            hash_text(st, "i");
+            hash_u64(st, static_cast<std::uint64_t>(static_cast<std::int64_t>(*p)));
+          }
+        },
+        d->cref(s));
+  }
+}
+
+/// The hash as 64 lower-case hex digits.
+std::string final_hex(crypto_generichash_state& st) {
+  std::array<std::uint8_t, crypto_generichash_BYTES> h{};
+  crypto_generichash_final(&st, h.data(), h.size());
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(2 * h.size());
+  for (std::uint8_t b : h) {
+    out.push_back(kHex[b >> 4]);
+    out.push_back(kHex[b & 15]);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string scene_cache_dir(const config::Settings& s) {
@@ -453,43 +528,88 @@ std::string SceneCache::entry_path(const std::string& key) const {
 }
 
 std::string SceneCache::key(std::span<const std::uint8_t> file_bytes, const config::Settings& s) {
-  [[maybe_unused]] const int ready = sodium_init();  // picks the fastest BLAKE2b; the portable one serves when it fails
   crypto_generichash_state st;
-  crypto_generichash_init(&st, nullptr, 0, crypto_generichash_BYTES);
-  hash_text(st, "haptic-kiosk scene");
-  hash_u64(st, kSceneCacheFormat);
-  hash_text(st, HK_PROGRAM_VERSION);
-  for (const config::FieldDescriptor* d : scene_shaping_fields()) {
-    hash_text(st, std::string(d->table) + "." + std::string(d->key));
-    std::visit(
-        [&st](const auto* p) {
-          using T = std::remove_cv_t<std::remove_pointer_t<decltype(p)>>;
-          if constexpr (std::is_same_v<T, double>) {
-            hash_text(st, "d");
-            hash_u64(st, std::bit_cast<std::uint64_t>(*p));
-          } else if constexpr (std::is_same_v<T, std::string>) {
-            hash_text(st, "s");
-            hash_text(st, *p);
-          } else {
-            hash_text(st, "i");
-            hash_u64(st, static_cast<std::uint64_t>(static_cast<std::int64_t>(*p)));
-          }
-        },
-        d->cref(s));
-  }
+  begin_settings_hash(st, "haptic-kiosk scene", s);
   hash_text(st, "file");
   hash_u64(st, file_bytes.size());
   crypto_generichash_update(&st, file_bytes.data(), file_bytes.size());
-  std::array<std::uint8_t, crypto_generichash_BYTES> h{};
-  crypto_generichash_final(&st, h.data(), h.size());
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string out;
-  out.reserve(2 * h.size());
-  for (std::uint8_t b : h) {
-    out.push_back(kHex[b >> 4]);
-    out.push_back(kHex[b & 15]);
+  return final_hex(st);
+}
+
+std::optional<FileStamp> SceneCache::stamp(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return std::nullopt;
+  FileStamp f;
+  f.path = path;
+  f.device = static_cast<std::uint64_t>(st.st_dev);
+  f.inode = static_cast<std::uint64_t>(st.st_ino);
+  f.size_bytes = static_cast<std::uint64_t>(st.st_size);
+  f.mtime_ns = static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec;
+  f.ctime_ns = static_cast<std::int64_t>(st.st_ctim.tv_sec) * 1'000'000'000 + st.st_ctim.tv_nsec;
+  return f;
+}
+
+namespace {
+
+/// The name of the ref file of a stamp under settings (64 hex digits and ".ref").
+std::string ref_name(const FileStamp& f, const config::Settings& s) {
+  crypto_generichash_state st;
+  begin_settings_hash(st, "haptic-kiosk file stamp", s);
+  hash_text(st, f.path);
+  for (const std::uint64_t v : {f.device, f.inode, f.size_bytes, static_cast<std::uint64_t>(f.mtime_ns), static_cast<std::uint64_t>(f.ctime_ns)})
+    hash_u64(st, v);
+  return final_hex(st) + std::string(kRefSuffix);
+}
+
+}  // namespace
+
+std::optional<std::string> SceneCache::known_key(const FileStamp& stamp, const config::Settings& s) const {
+  if (dir_.empty()) return std::nullopt;
+  const std::string path = dir_ + "/" + ref_name(stamp, s);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) return std::nullopt;
+  std::array<char, kRefBytes + 1> buf{};
+  const ssize_t n = ::read(fd, buf.data(), buf.size());
+  ::close(fd);
+  const std::string key(buf.data(), n > 0 ? static_cast<std::size_t>(n) : 0);
+  if (key.size() == kRefBytes && key.back() == '\n' && is_key(key.substr(0, kRefBytes - 1))) return key.substr(0, kRefBytes - 1);
+  ::unlink(path.c_str());
+  spdlog::warn("scene cache: ref '{}' does not hold a key; removed", path);
+  return std::nullopt;
+}
+
+void SceneCache::remember_key(const FileStamp& stamp, const config::Settings& s, const std::string& key) {
+  if (dir_.empty() || !is_key(key)) return;
+  const std::string text = key + "\n";
+  const std::string failed = write_atomically(ref_name(stamp, s), std::vector<std::uint8_t>(text.begin(), text.end()));
+  if (!failed.empty()) warn_once(failed, "in '" + dir_ + "': cannot " + failed + "; pictures are read again to find their scenes");
+}
+
+std::string SceneCache::write_atomically(const std::string& name, const std::vector<std::uint8_t>& bytes) const {
+  auto failed = [](const std::string& stage, int err) { return stage + ": " + errno_text(err); };
+  if (!make_dirs(dir_)) return failed("create the folder", errno);
+  std::string temp = dir_ + "/" + std::string(kTempPrefix) + name + "-XXXXXX";
+  const int fd = ::mkostemp(temp.data(), O_CLOEXEC);
+  if (fd < 0) return failed("create a file", errno);
+  const bool written = write_all(fd, bytes.data(), bytes.size()) && ::fsync(fd) == 0;
+  const int write_errno = errno;
+  const bool closed = ::close(fd) == 0;
+  if (!written || !closed) {
+    const int err = written ? errno : write_errno;
+    ::unlink(temp.c_str());
+    return failed("write a file", err);
   }
-  return out;
+  if (::rename(temp.c_str(), (dir_ + "/" + name).c_str()) != 0) {
+    const int err = errno;
+    ::unlink(temp.c_str());
+    return failed("rename a file", err);
+  }
+  const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {  // the rename itself durable; a failure here costs only that
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+  return "";
 }
 
 std::optional<ImageScene> SceneCache::load(const std::string& key, const config::Settings& s) const {
@@ -588,31 +708,10 @@ bool SceneCache::store(const std::string& key, const ImageScene& is) {
                           std::to_string(std::min(max_bytes_, kSceneCacheMaxEntryBytes)) + " bytes); not stored");
     return false;
   }
-  auto fail = [this](const std::string& stage, int err) {
-    warn_once(stage + ": " + errno_text(err), "cannot " + stage + " in '" + dir_ + "': " + errno_text(err) + "; built scenes are not kept");
+  const std::string failed = write_atomically(key + std::string(kSuffix), bytes);
+  if (!failed.empty()) {
+    warn_once(failed, "in '" + dir_ + "': cannot " + failed + "; built scenes are not kept");
     return false;
-  };
-  if (!make_dirs(dir_)) return fail("create the folder", errno);
-  std::string temp = dir_ + "/" + std::string(kTempPrefix) + key + "-XXXXXX";
-  const int fd = ::mkostemp(temp.data(), O_CLOEXEC);
-  if (fd < 0) return fail("create a file", errno);
-  const bool written = write_all(fd, bytes.data(), bytes.size()) && ::fsync(fd) == 0;
-  const int write_errno = errno;
-  const bool closed = ::close(fd) == 0;
-  if (!written || !closed) {
-    const int err = written ? errno : write_errno;
-    ::unlink(temp.c_str());
-    return fail("write a file", err);
-  }
-  if (::rename(temp.c_str(), entry_path(key).c_str()) != 0) {
-    const int err = errno;
-    ::unlink(temp.c_str());
-    return fail("rename a file", err);
-  }
-  const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {  // the rename itself durable; a failure here costs only that
-    ::fsync(dfd);
-    ::close(dfd);
   }
   try {
     evict(key);
@@ -630,6 +729,7 @@ void SceneCache::evict(const std::string& keep) {
     std::int64_t mtime_ns;
   };
   std::vector<Entry> entries;
+  std::vector<std::string> refs;
   std::int64_t total = 0;
   const auto now = std::chrono::system_clock::now();
   std::error_code ec;
@@ -645,17 +745,33 @@ void SceneCache::evict(const std::string& keep) {
       if (age > kStaleTemp) ::unlink(path.c_str());
       continue;
     }
+    if (name.ends_with(kRefSuffix)) {
+      refs.push_back(path);
+      continue;
+    }
     if (!name.ends_with(kSuffix) || !is_key(name.substr(0, name.size() - kSuffix.size()))) continue;
     total += st.st_size;
     if (name.substr(0, name.size() - kSuffix.size()) != keep) entries.push_back({path, st.st_size, mtime_ns});
   }
-  if (total <= max_bytes_) return;
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-    return a.mtime_ns != b.mtime_ns ? a.mtime_ns < b.mtime_ns : a.path < b.path;
-  });
-  for (const Entry& e : entries) {
-    if (total <= max_bytes_) break;
-    if (::unlink(e.path.c_str()) == 0 || errno == ENOENT) total -= e.bytes;
+  if (total > max_bytes_) {
+    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+      return a.mtime_ns != b.mtime_ns ? a.mtime_ns < b.mtime_ns : a.path < b.path;
+    });
+    for (const Entry& e : entries) {
+      if (total <= max_bytes_) break;
+      if (::unlink(e.path.c_str()) == 0 || errno == ENOENT) total -= e.bytes;
+    }
+  }
+  // A ref whose entry is gone points nowhere: removed (a lookup through it would read the file anyway).
+  for (const std::string& ref : refs) {
+    std::array<char, kRefBytes> buf{};
+    const int fd = ::open(ref.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0) continue;
+    const ssize_t n = ::read(fd, buf.data(), buf.size());
+    ::close(fd);
+    const std::string key(buf.data(), n == static_cast<ssize_t>(kRefBytes) ? kRefBytes - 1 : 0);
+    struct stat st {};
+    if (!is_key(key) || ::stat(entry_path(key).c_str(), &st) != 0) ::unlink(ref.c_str());
   }
 }
 

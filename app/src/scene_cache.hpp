@@ -37,7 +37,7 @@
 namespace hk::app {
 
 /// Version of the entry layout and payload; entries of any other version are stale (removed on load).
-inline constexpr std::uint32_t kSceneCacheFormat = 1;
+inline constexpr std::uint32_t kSceneCacheFormat = 2;
 
 /// Largest entry read or written [bytes] (64 MiB); larger files are not entries.
 inline constexpr std::int64_t kSceneCacheMaxEntryBytes = 64LL << 20;
@@ -55,6 +55,15 @@ std::string scene_cache_dir(const config::Settings& s);
 /// [workspace] table (a restart field, but it sets px_to_m) and haptics.max_levels. What SceneCache::key
 /// hashes besides the file.
 std::vector<const config::FieldDescriptor*> scene_shaping_fields();
+
+/// What tells a picture file as it is now without reading it: its path and stat (device, inode, size,
+/// modification and status-change times). Writing to the file, renaming another over it or copying one in
+/// its place changes it (the status-change time cannot be set back by a program).
+struct FileStamp {
+  std::string path;
+  std::uint64_t device = 0, inode = 0, size_bytes = 0;
+  std::int64_t mtime_ns = 0, ctime_ns = 0;  ///< [ns since the epoch]
+};
 
 /// Built scenes on disk, keyed by picture bytes and settings (file layout: see the file comment). Thread
 /// safe: load and store may run on several threads at once, and several kiosks may share a folder (the
@@ -97,14 +106,34 @@ class SceneCache {
   ///         Never throws.
   bool store(const std::string& key, const ImageScene& is);
 
+  /// The stamp of the file at `path` now (stat, links followed); nullopt when it cannot be taken. Never throws.
+  static std::optional<FileStamp> stamp(const std::string& path);
+
+  /// The key remembered (remember_key) for a file with this stamp under these settings, read from its ref
+  /// file `<dir>/<ref>.ref` (ref: BLAKE2b-256 over the format, program version, scene-shaping settings and
+  /// the stamp; content: the key and a line feed). So a picture seen before is found without reading or
+  /// hashing its bytes (tens to hundreds of ms for a large photo). nullopt when off, when nothing is
+  /// remembered, or when the ref file is not one (then removed). Never throws.
+  std::optional<std::string> known_key(const FileStamp& stamp, const config::Settings& s) const;
+
+  /// Remembers that the file with `stamp` (taken before its bytes were read, so a file changed meanwhile
+  /// is read again next time) has key `key` (a key() value): its ref file written atomically. Refs whose
+  /// entry is gone are removed with the entries evicted. A failure costs only the lookup (logged once).
+  /// Never throws.
+  void remember_key(const FileStamp& stamp, const config::Settings& s, const std::string& key);
+
   /// The path of the entry of `key` ("" when off).
   std::string entry_path(const std::string& key) const;
 
  private:
   /// Logs `what` with spdlog::warn unless `reason` was already logged by this cache.
   void warn_once(const std::string& reason, const std::string& what);
-  /// Removes the least recently used entries until they total at most max_bytes_; `keep` is never removed.
+  /// Removes the least recently used entries until they total at most max_bytes_ (`keep` is never removed),
+  /// then the ref files whose entry is gone.
   void evict(const std::string& keep);
+  /// Writes `bytes` to `<dir_>/<name>` atomically (temporary file, fsync, rename, folder fsync), creating
+  /// the folder when missing. @return "" when done, else the failed stage and errno text.
+  std::string write_atomically(const std::string& name, const std::vector<std::uint8_t>& bytes) const;
 
   std::string dir_;
   std::int64_t max_bytes_;

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "vision/intake.hpp"
@@ -66,9 +67,106 @@ std::vector<StickNews> StickService::poll_news() {
 void StickService::load(int stick, int document, int page) {
   {
     const std::lock_guard<std::mutex> lock(m_);
-    request_ = Request{stick, document, page};
+    const Request r{stick, document, page};
+    at_ = r;
+    request_.reset();
+    // Kept: the neighbours of the page asked for; the page itself, built ahead, goes to the visitor.
+    const std::vector<Request> near = neighbours();
+    std::vector<AheadPage> kept;
+    bool served = false;
+    for (AheadPage& a : ahead_) {
+      if (a.at == r) {
+        served = true;
+        a.loaded.load_ms = 0;
+        spdlog::info("stick {}: page {} of document {} built ahead, on the device at once", r.stick, r.page, r.document + 1);
+        loaded_.push_back(std::move(a.loaded));
+      } else if (std::find(near.begin(), near.end(), a.at) != near.end()) {
+        kept.push_back(std::move(a));
+      }
+    }
+    ahead_ = std::move(kept);
+    if (!served) {
+      if (building_ && *building_ == r) {
+        building_wanted_ = std::chrono::steady_clock::now();  // handed over when its build ends
+      } else {
+        request_ = r;
+      }
+    }
   }
   cv_.notify_all();
+}
+
+void StickService::set_settings(const config::Settings& s) {
+  const std::lock_guard<std::mutex> lock(m_);
+  s_ = s;
+  drop_ahead();
+  ahead_refused_.clear();
+}
+
+void StickService::set_pdf_fault(vision::PdfFault fault) {
+  pdf_fault_.store(fault);
+  const std::lock_guard<std::mutex> lock(m_);
+  drop_ahead();
+}
+
+int StickService::pages_ahead() const {
+  const std::lock_guard<std::mutex> lock(m_);
+  return static_cast<int>(ahead_.size());
+}
+
+void StickService::drop_ahead() {
+  ahead_.clear();
+  ++ahead_generation_;
+}
+
+std::vector<StickService::Request> StickService::neighbours() const {
+  std::vector<Request> out;
+  if (!at_ || at_->stick != stick_id_ || stick_docs_.empty()) return out;
+  if (at_->document < 0 || at_->document >= static_cast<int>(stick_docs_.size())) return out;
+  std::vector<int> pages;
+  pages.reserve(stick_docs_.size());
+  for (const ListedDocument& d : stick_docs_) pages.push_back(d.pages);
+  for (const int delta : {+1, -1}) {
+    const StickPage p = step_stick_page(pages, {at_->document, at_->page}, delta);
+    const Request r{at_->stick, p.document, p.page};
+    if (r != *at_ && std::find(out.begin(), out.end(), r) == out.end()) out.push_back(r);
+  }
+  return out;
+}
+
+std::optional<StickService::Request> StickService::next_ahead() const {
+  const std::size_t budget = static_cast<std::size_t>(s_.kiosk.prefetch_mb) << 20;
+  if (budget == 0) return std::nullopt;
+  std::size_t used = 0;
+  for (const AheadPage& a : ahead_) used += a.bytes;
+  if (used >= budget) return std::nullopt;
+  for (const Request& r : neighbours()) {
+    const bool have = std::any_of(ahead_.begin(), ahead_.end(), [&](const AheadPage& a) { return a.at == r; });
+    const bool refused = std::find(ahead_refused_.begin(), ahead_refused_.end(), r) != ahead_refused_.end();
+    if (!have && !refused) return r;
+  }
+  return std::nullopt;
+}
+
+void StickService::keep_ahead(const Request& r, LoadedDocument d, std::uint64_t generation) {
+  if (generation != ahead_generation_) return;  // settings, fault or stick changed meanwhile
+  const std::vector<Request> near = neighbours();
+  if (std::find(near.begin(), near.end(), r) == near.end()) return;  // the visitor went elsewhere
+  if (!d.scene) {  // said when the visitor asks for it (built again then)
+    ahead_refused_.push_back(r);
+    return;
+  }
+  const std::size_t budget = static_cast<std::size_t>(s_.kiosk.prefetch_mb) << 20;
+  std::size_t used = 0;
+  for (const AheadPage& a : ahead_) used += a.bytes;
+  const std::size_t bytes = approx_scene_bytes(*d.scene);
+  if (used + bytes > budget) {
+    spdlog::info("stick {}: page {} of document {} ({} MiB) is over [kiosk] prefetch_mb; built when asked for", r.stick, r.page, r.document + 1,
+                 bytes >> 20);
+    ahead_refused_.push_back(r);
+    return;
+  }
+  ahead_.push_back(AheadPage{r, std::move(d), bytes});
 }
 
 std::vector<LoadedDocument> StickService::poll_loaded() {
@@ -84,6 +182,9 @@ void StickService::forget() {
   stick_root_.clear();
   stick_docs_.clear();
   request_.reset();
+  at_.reset();
+  drop_ahead();
+  ahead_refused_.clear();
 }
 
 void StickService::post(StickNews n) {
@@ -94,8 +195,13 @@ void StickService::post(StickNews n) {
 void StickService::scan_root(const std::string& root, double started_ms) {
   const auto t0 = std::chrono::steady_clock::now();
   const int id = next_stick_++;
+  config::Settings s;
+  {
+    const std::lock_guard<std::mutex> lock(m_);
+    s = s_;
+  }
   try {
-    StickListing l = list_stick(root, s_);
+    StickListing l = list_stick(root, s);
     for (const vision::RefusedEntry& r : l.refused) spdlog::info("stick {}: left out '{}': {}", id, r.path, r.reason);
     StickNews n;
     n.kind = StickNews::Kind::Inserted;
@@ -110,6 +216,9 @@ void StickService::scan_root(const std::string& root, double started_ms) {
       stick_id_ = id;
       stick_root_ = root;
       stick_docs_ = std::move(l.documents);
+      at_.reset();
+      drop_ahead();
+      ahead_refused_.clear();
     }
     post(std::move(n));
   } catch (const std::exception& e) {
@@ -153,6 +262,7 @@ void StickService::handle_remove(const std::string& devnode) {
     stick_id_ = 0;
     stick_root_.clear();
     stick_docs_.clear();
+    drop_ahead();
   }
   spdlog::info("stick '{}': taken out, unmounted", devnode);
   StickNews n;
@@ -176,6 +286,7 @@ void StickService::watch() {
         stick_id_ = 0;
         stick_root_.clear();
         stick_docs_.clear();
+        drop_ahead();
       }
       StickNews n;
       n.kind = StickNews::Kind::Removed;
@@ -201,7 +312,7 @@ void StickService::watch() {
   }
 }
 
-LoadedDocument StickService::build(const Request& r) {
+LoadedDocument StickService::build(const Request& r, bool ahead) {
   const auto t0 = std::chrono::steady_clock::now();
   LoadedDocument out;
   out.stick = r.stick;
@@ -209,6 +320,7 @@ LoadedDocument StickService::build(const Request& r) {
   out.page = r.page;
   std::string root;
   ListedDocument doc;
+  config::Settings s;
   {
     const std::lock_guard<std::mutex> lock(m_);
     if (r.stick != stick_id_ || r.document < 0 || r.document >= static_cast<int>(stick_docs_.size())) {
@@ -217,35 +329,58 @@ LoadedDocument StickService::build(const Request& r) {
     }
     root = stick_root_;
     doc = stick_docs_[static_cast<std::size_t>(r.document)];
+    s = s_;
   }
   try {
-    const std::vector<std::uint8_t> bytes = vision::read_stick_file(root, doc.doc.path, s_.stick.max_file_bytes);
-    loads_started_.fetch_add(1);
-    out.scene = doc.doc.kind == vision::DocumentKind::Pdf ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s_, pdf_fault_.load(), TextTiming::later)
-                                                          : build_image_scene_from_bytes(bytes, doc.doc.display_name, s_, TextTiming::later);
+    const std::vector<std::uint8_t> bytes = vision::read_stick_file(root, doc.doc.path, s.stick.max_file_bytes);
+    (ahead ? ahead_started_ : loads_started_).fetch_add(1);
+    out.scene = doc.doc.kind == vision::DocumentKind::Pdf ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s, pdf_fault_.load(), TextTiming::later)
+                                                          : build_image_scene_from_bytes(bytes, doc.doc.display_name, s, TextTiming::later);
     if (out.scene) fit_picture(*out.scene);  // the screen's copy, made here rather than on the window thread
   } catch (const std::exception& e) {  // InputError, PdfError, StickError: this page only
     spdlog::warn("stick {}: {}", r.stick, e.what());
     out.reason = problem_of(e.what());
   }
   out.load_ms = ms_since(t0);
-  if (out.scene) spdlog::info("stick {}: '{}' page {} built in {:.0f} ms", r.stick, doc.doc.display_name, r.page, out.load_ms);
+  if (out.scene) spdlog::info("stick {}: '{}' page {} built{} in {:.0f} ms", r.stick, doc.doc.display_name, r.page, ahead ? " ahead" : "", out.load_ms);
   return out;
 }
 
 void StickService::serve() {
+  std::unique_lock<std::mutex> lock(m_);
   for (;;) {
-    Request r;
-    {
-      std::unique_lock<std::mutex> lock(m_);
-      cv_.wait(lock, [this] { return stop_ || request_.has_value(); });
-      if (stop_) return;
-      r = *request_;
+    std::optional<Request> ahead;
+    cv_.wait(lock, [&] {
+      if (stop_ || request_) return true;
+      ahead = next_ahead();  // between requests: the neighbours of the page last asked for
+      return ahead.has_value();
+    });
+    if (stop_) return;
+    if (request_) {
+      const Request r = *request_;
       request_.reset();
+      lock.unlock();
+      LoadedDocument d = build(r, false);
+      lock.lock();
+      loaded_.push_back(std::move(d));
+      continue;
     }
-    LoadedDocument d = build(r);
-    const std::lock_guard<std::mutex> lock(m_);
-    loaded_.push_back(std::move(d));
+    const std::uint64_t generation = ahead_generation_;
+    building_ = *ahead;
+    building_wanted_.reset();
+    lock.unlock();
+    LoadedDocument d = build(*ahead, true);
+    lock.lock();
+    building_.reset();
+    if (!building_wanted_) {
+      keep_ahead(*ahead, std::move(d), generation);
+    } else if (generation == ahead_generation_) {  // the visitor asked for it while it was built
+      d.load_ms = ms_since(*building_wanted_);
+      loaded_.push_back(std::move(d));
+    } else if (!request_) {  // asked for, but built with what no longer holds: built again
+      request_ = *ahead;
+    }
+    building_wanted_.reset();
   }
 }
 

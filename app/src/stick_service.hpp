@@ -9,11 +9,16 @@
 ///   with neither it says once in the log how to grant the capability and ignores sticks;
 /// - the loader builds the scene of a document page on request (the PDF drawn in its worker process,
 ///   edges, multiresolution, trees; OCR's text left for the kiosk's TextReader: TextTiming::later), so a slow
-///   or hostile page never blocks the window.
+///   or hostile page never blocks the window. Between requests it builds the pages Next and Previous lead to
+///   from the page last asked for (step_stick_page), the next one first, and keeps them within the prefetch
+///   budget ([kiosk] prefetch_mb), so Next on a stick is a swap: a request for a page built ahead is
+///   answered at once, and one for the page being built ahead takes that build over.
 /// The window thread polls both with poll_news() and poll_loaded() each frame (mutex-guarded queues: neither
 /// thread is real-time). A folder can stand in for a stick (insert_folder), for tests and `--stick DIR`.
 
 #include <atomic>
+#include <chrono>
+#include <cstdint>
 #include <condition_variable>
 #include <deque>
 #include <memory>
@@ -25,6 +30,7 @@
 
 #include "config/settings.hpp"
 #include "documents.hpp"
+#include "stick_pages.hpp"
 #include "image_scene.hpp"
 #include "vision/stick_mount.hpp"
 #include "vision/usb_stick.hpp"
@@ -68,8 +74,13 @@ class StickService {
   void remove_folder();
   /// News since the last call, oldest first.
   std::vector<StickNews> poll_news();
-  /// Ask for page `page` of document `document` of stick `stick`; supersedes a request not yet started.
+  /// Ask for page `page` of document `document` of stick `stick`; supersedes a request not yet started. A
+  /// page built ahead is handed over at once (poll_loaded returns it, load_ms 0); a page being built ahead is
+  /// handed over when that build ends.
   void load(int stick, int document, int page);
+  /// New settings ([kiosk] prefetch_mb and the scene-shaping ones; the [stick] limits are read at start):
+  /// pages built ahead with other settings are dropped, and later loads use these.
+  void set_settings(const config::Settings& s);
   /// Finished loads since the last call.
   std::vector<LoadedDocument> poll_loaded();
   /// Forget the stick's listing (a new session): later loads of it are refused. The mount stays until removal.
@@ -80,31 +91,54 @@ class StickService {
   vision::StickMounter mounter() const { return mounter_; }
   /// Loads that have read their document and begun drawing and building it (for the operator's status and
   /// for tests that need a load to be under way).
+  /// Pages built ahead are not counted.
   int loads_started() const { return loads_started_.load(); }
+  /// Pages whose building ahead has begun (for tests and the benchmark).
+  int ahead_started() const { return ahead_started_.load(); }
+  /// Pages built ahead and kept now.
+  int pages_ahead() const;
   /// Test hook: the PDF worker of every later load fails on purpose (vision::PdfFault). None in the kiosk.
-  void set_pdf_fault(vision::PdfFault fault) { pdf_fault_.store(fault); }
+  /// Pages built ahead before it are dropped (they were drawn without the fault).
+  void set_pdf_fault(vision::PdfFault fault);
 
  private:
   struct Request {
     int stick = 0, document = 0, page = 1;
+    friend bool operator==(const Request&, const Request&) = default;
+  };
+  /// A page built ahead and kept.
+  struct AheadPage {
+    Request at;
+    LoadedDocument loaded;
+    std::size_t bytes = 0;  ///< approx_scene_bytes
   };
   void watch();
   void serve();
+  /// The page to build ahead next, if any (m_ held): a neighbour of at_ not built, not refused, within budget.
+  std::optional<Request> next_ahead() const;
+  /// The pages Next and Previous lead to from at_ (m_ held; empty when at_ is not a page of the current stick).
+  std::vector<Request> neighbours() const;
+  /// Drops every page built ahead and makes a build ahead under way unusable (m_ held).
+  void drop_ahead();
+  /// Keeps or drops a page just built ahead (m_ held; `generation` the ahead_generation_ it began under).
+  void keep_ahead(const Request& r, LoadedDocument d, std::uint64_t generation);
   void handle_add(const std::string& devnode);
   void handle_remove(const std::string& devnode);
   void scan_root(const std::string& root, double started_ms_offset);
   void post(StickNews n);
-  LoadedDocument build(const Request& r);
+  /// Builds page r (m_ not held); `ahead`: for the budget, not asked for yet (counted in ahead_started_).
+  LoadedDocument build(const Request& r, bool ahead);
 
-  config::Settings s_;
+  config::Settings s_;  // guarded by m_ (set_settings); each job works on a copy
   std::unique_ptr<vision::BlockEventSource> events_;
   std::string mount_root_;
   vision::StickMounter mounter_ = vision::StickMounter::None;
   std::string helper_path_;
   std::atomic<vision::PdfFault> pdf_fault_{vision::PdfFault::None};
   std::atomic<int> loads_started_{0};
+  std::atomic<int> ahead_started_{0};
 
-  std::mutex m_;
+  mutable std::mutex m_;
   std::condition_variable cv_;
   bool stop_ = false;
   std::deque<std::string> folder_inserts_;  // guarded by m_
@@ -115,6 +149,12 @@ class StickService {
   int stick_id_ = 0;                        // guarded by m_: the stick whose listing is current (0: none)
   std::string stick_root_;                  // guarded by m_
   std::vector<ListedDocument> stick_docs_;  // guarded by m_
+  std::optional<Request> at_;               // guarded by m_: the page last asked for (its neighbours are built ahead)
+  std::vector<AheadPage> ahead_;            // guarded by m_: pages built ahead, the next one first
+  std::vector<Request> ahead_refused_;      // guarded by m_: neighbours that failed or did not fit (not tried again)
+  std::optional<Request> building_;         // guarded by m_: the page being built ahead now
+  std::optional<std::chrono::steady_clock::time_point> building_wanted_;  // guarded by m_: asked for meanwhile, when
+  std::uint64_t ahead_generation_ = 0;      // guarded by m_: bumped when pages built so far must not be used
 
   // watcher thread only
   std::unique_ptr<vision::StickMount> mounted_;

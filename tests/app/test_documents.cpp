@@ -465,6 +465,113 @@ TEST(StickService, InsertBrowseCrashRemoveInsertAgain) {
   fs::remove_all(dir);
 }
 
+/// Waits (bounded) until `ready()` holds; the outcome is decided by the state reached, not by the time taken.
+template <class Ready>
+bool wait_until(Ready ready) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!ready()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+/// A folder standing in for a stick, inserted: a_shape.png (document 0) and b_pages.pdf (document 1, two
+/// pages). Returns the stick's number (0 when the insertion failed).
+int insert_shape_and_pages(StickService& svc, const fs::path& dir) {
+  fs::copy_file(kData / "images" / "silhouette_3.png", dir / "a_shape.png");
+  fs::copy_file(kHorsePdf, dir / "b_pages.pdf");
+  svc.insert_folder(dir.string());
+  const std::vector<StickNews> news = wait_for([&] { return svc.poll_news(); });
+  if (news.size() != 1 || news[0].kind != StickNews::Kind::Inserted || news[0].documents.size() != 2) return 0;
+  return news[0].stick;
+}
+
+// Between requests the loader builds the pages Next and Previous lead to; Next then gets its page at once,
+// without a build of its own; new settings drop what was built ahead, and [kiosk] prefetch_mb = 0 builds
+// nothing ahead.
+TEST(StickService, NextAndPreviousPagesAreBuiltAheadAndHandedOverAtOnce) {
+  const fs::path dir = fresh_dir("service_ahead");
+  config::Settings s = test_settings();
+  StickService svc(s, nullptr, (dir / "mnt").string());
+  const int stick = insert_shape_and_pages(svc, dir);
+  ASSERT_NE(stick, 0);
+
+  svc.load(stick, 1, 1);
+  std::vector<LoadedDocument> got = wait_for([&] { return svc.poll_loaded(); });
+  ASSERT_EQ(got.size(), 1u);
+  ASSERT_TRUE(got[0].scene.has_value()) << got[0].reason;
+  EXPECT_EQ(svc.loads_started(), 1);
+  // The neighbours of the PDF's first page: its second page (Next) and the picture before it (Previous).
+  ASSERT_TRUE(wait_until([&] { return svc.pages_ahead() == 2; })) << svc.pages_ahead() << " pages built ahead";
+  EXPECT_EQ(svc.ahead_started(), 2);
+
+  svc.load(stick, 1, 2);
+  got = svc.poll_loaded();  // handed over inside load(): no wait
+  ASSERT_EQ(got.size(), 1u) << "a page built ahead is there at once";
+  ASSERT_TRUE(got[0].scene.has_value());
+  EXPECT_EQ(got[0].scene->page, 2);
+  EXPECT_EQ(got[0].document, 1);
+  EXPECT_EQ(got[0].load_ms, 0.0);
+  EXPECT_GT(got[0].scene->scene->curve_count(), 0u);
+  EXPECT_EQ(svc.loads_started(), 1) << "Next needed no build of its own";
+  // From page 2: Next wraps to the picture (kept: it was built ahead already), Previous is page 1 (built again).
+  ASSERT_TRUE(wait_until([&] { return svc.pages_ahead() == 2; }));
+  EXPECT_EQ(svc.ahead_started(), 3);
+
+  s.kiosk.prefetch_mb = 0;
+  svc.set_settings(s);
+  EXPECT_EQ(svc.pages_ahead(), 0) << "pages built with other settings are dropped";
+  svc.load(stick, 0, 1);
+  got = wait_for([&] { return svc.poll_loaded(); });
+  ASSERT_EQ(got.size(), 1u);
+  ASSERT_TRUE(got[0].scene.has_value()) << got[0].reason;
+  EXPECT_EQ(svc.loads_started(), 2) << "the picture built ahead went with the old settings: built when asked for";
+  EXPECT_EQ(svc.pages_ahead(), 0);
+  EXPECT_EQ(svc.ahead_started(), 3) << "prefetch_mb = 0: nothing built ahead";
+  fs::remove_all(dir);
+}
+
+// A request for the page being built ahead takes that build over (no second build), and a page that cannot
+// be drawn is said as for any request; a stick taken out drops its pages built ahead.
+TEST(StickService, ARequestForThePageBeingBuiltAheadTakesItOver) {
+  const fs::path dir = fresh_dir("service_takeover");
+  config::Settings s = test_settings();
+  s.stick.page_timeout_s = 3.0;  // the hanging worker below is stopped after this
+  StickService svc(s, nullptr, (dir / "mnt").string());
+  svc.set_pdf_fault(vision::PdfFault::Hang);  // every PDF page hangs until the page limit; the picture is drawn
+  const int stick = insert_shape_and_pages(svc, dir);
+  ASSERT_NE(stick, 0);
+
+  svc.load(stick, 0, 1);
+  std::vector<LoadedDocument> got = wait_for([&] { return svc.poll_loaded(); });
+  ASSERT_EQ(got.size(), 1u);
+  ASSERT_TRUE(got[0].scene.has_value()) << got[0].reason;
+  // Next from the picture is the PDF's first page: built ahead first, its worker hanging for 3 s.
+  ASSERT_TRUE(wait_until([&] { return svc.ahead_started() >= 1; }));
+  svc.load(stick, 1, 1);
+  got = wait_for([&] { return svc.poll_loaded(); });
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].document, 1);
+  EXPECT_EQ(got[0].page, 1);
+  EXPECT_FALSE(got[0].scene.has_value()) << "the hanging page is unreadable";
+  EXPECT_FALSE(got[0].reason.empty());
+  EXPECT_EQ(svc.loads_started(), 1) << "the request took the build ahead over instead of starting its own";
+
+  svc.set_pdf_fault(vision::PdfFault::None);
+  ASSERT_TRUE(wait_until([&] { return svc.pages_ahead() >= 1; })) << "the neighbours of page 1 are built ahead";
+  svc.remove_folder();
+  const std::vector<StickNews> news = wait_for([&] { return svc.poll_news(); });
+  ASSERT_EQ(news.size(), 1u);
+  EXPECT_EQ(news[0].kind, StickNews::Kind::Removed);
+  EXPECT_EQ(svc.pages_ahead(), 0) << "a stick taken out keeps nothing built ahead";
+  svc.load(stick, 1, 2);
+  got = wait_for([&] { return svc.poll_loaded(); });
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_FALSE(got[0].scene.has_value()) << "a stick taken out is not read, even a page built ahead";
+  fs::remove_all(dir);
+}
+
 // The kiosk under Xvfb with a folder inserted as a stick: the summary and first document are said, Next
 // walks to the PDF's pages (the second, a photo of a page of text, is read by OCR: said at once, then that its
 // text is ready), Describe on a page says what it holds, taking the stick out goes back to the library (its

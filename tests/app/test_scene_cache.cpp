@@ -62,6 +62,7 @@ ImageScene copy_of(const ImageScene& is, const config::Settings& s) {
   c.ocr = is.ocr;
   c.text_likely = is.text_likely;
   c.text_words_masked = is.text_words_masked;
+  c.file_notes = is.file_notes;
   c.render_dpi = is.render_dpi;
   c.worker_ms = is.worker_ms;
   c.worker_max_rss_kb = is.worker_max_rss_kb;
@@ -98,6 +99,8 @@ ImageScene copy_of(const ImageScene& is, const config::Settings& s) {
 void expect_same(const ImageScene& a, const ImageScene& b) {
   EXPECT_EQ(a.image_path, b.image_path);
   EXPECT_EQ(a.page, b.page);
+  EXPECT_EQ(a.file_notes.title, b.file_notes.title);
+  EXPECT_EQ(a.file_notes.description, b.file_notes.description);
   EXPECT_EQ(a.pages, b.pages);
   EXPECT_EQ(a.document_title, b.document_title);
   ASSERT_EQ(a.text_blocks.size(), b.text_blocks.size());
@@ -460,6 +463,69 @@ TEST_F(SceneCacheTest, SizeCapRemovesTheLeastRecentlyUsedEntry) {
   // An entry larger than the whole cache is not stored.
   SceneCache tiny(dir_, static_cast<std::int64_t>(entry / 2));
   EXPECT_FALSE(tiny.store(a, horse()));
+}
+
+// A picture seen before is found by its stamp (path and stat) without reading its bytes; what the file
+// says of itself comes back with the scene; any change to the file, or to a setting that shapes scenes,
+// misses; a ref that holds no key, or whose entry was evicted, is removed.
+TEST_F(SceneCacheTest, AFileSeenBeforeIsFoundByItsStampWithTheFilesOwnNotes) {
+  const fs::path pic = root_ / "pic.png";
+  fs::copy_file(kImages + "horse.png", pic);
+  SceneCache cache(dir_);
+  const std::optional<FileStamp> stamp = SceneCache::stamp(pic.string());
+  ASSERT_TRUE(stamp);
+  EXPECT_EQ(stamp->size_bytes, fs::file_size(pic));
+  EXPECT_FALSE(cache.known_key(*stamp, s_)) << "nothing remembered yet";
+  EXPECT_FALSE(SceneCache::stamp((root_ / "missing.png").string()));
+
+  ImageScene is = copy_of(horse(), s_);
+  is.file_notes = {"A horse", "Drawn from the side."};
+  const std::string key = SceneCache::key(read_bytes(pic), s_);
+  ASSERT_TRUE(cache.store(key, is));
+  cache.remember_key(*stamp, s_, key);
+  const std::vector<std::string> files = files_in(dir_);
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(std::count_if(files.begin(), files.end(), [](const std::string& f) { return f.ends_with(".ref"); }), 1);
+
+  const std::optional<std::string> known = cache.known_key(*SceneCache::stamp(pic.string()), s_);
+  ASSERT_TRUE(known);
+  EXPECT_EQ(*known, key);
+  const std::optional<ImageScene> back = cache.load(*known, s_);
+  ASSERT_TRUE(back);
+  expect_same(is, *back);
+
+  config::Settings gains = s_;
+  gains.haptics.stiffness_n_per_m *= 2;  // does not shape a scene
+  EXPECT_EQ(cache.known_key(*stamp, gains), key);
+  config::Settings shaping = s_;
+  shaping.vision.max_image_side_px += 100;
+  EXPECT_FALSE(cache.known_key(*stamp, shaping)) << "a setting that shapes scenes is part of the ref";
+
+  {  // a byte appended: another size
+    std::ofstream(pic, std::ios::app | std::ios::binary) << 'x';
+  }
+  EXPECT_FALSE(cache.known_key(*SceneCache::stamp(pic.string()), s_));
+  // Another file renamed over it, byte for byte the old one: another inode.
+  fs::copy_file(kImages + "horse.png", root_ / "other.png");
+  fs::rename(root_ / "other.png", pic);
+  EXPECT_FALSE(cache.known_key(*SceneCache::stamp(pic.string()), s_));
+
+  // A ref that holds no key is removed; then nothing is known.
+  fs::path ref;
+  for (const std::string& f : files_in(dir_))
+    if (f.ends_with(".ref")) ref = fs::path(dir_) / f;
+  write_bytes(ref, {'n', 'o', '\n'});
+  EXPECT_FALSE(cache.known_key(*stamp, s_));
+  EXPECT_FALSE(fs::exists(ref));
+
+  // A ref whose entry is gone is removed when entries are next evicted.
+  cache.remember_key(*stamp, s_, key);
+  ASSERT_TRUE(fs::exists(ref));
+  fs::remove(cache.entry_path(key));
+  ASSERT_TRUE(cache.store(key_of("another"), horse()));
+  EXPECT_FALSE(fs::exists(ref));
+  cache.remember_key(*stamp, s_, "not a key");
+  EXPECT_FALSE(fs::exists(ref)) << "only keys are remembered";
 }
 
 TEST_F(SceneCacheTest, OffFindsNothingAndWritesNothing) {
