@@ -12,7 +12,7 @@
 // 24-megapixel phone photos (6000 x 4000 JPEG q92: fruits.jpg and butterfly.jpg upscaled, with sensor-like
 // noise), a 12-megapixel one (4000 x 3000), and a 13-megapixel PNG (3723 x 3595) as a photo and as a
 // chessboard. Stick pages: a 51-page PDF (shared-mime-info-spec.pdf three times, pdfunite) on a folder
-// standing in for a stick, paged through with Next (cold only: stick pages are not built ahead).
+// standing in for a stick, paged through with Next, cold and with the pages Next leads to built ahead.
 // Usage: bench_next_picture [--repeats N] [--out FILE.md] [--quick]
 #include <sys/resource.h>
 #include <unistd.h>
@@ -173,6 +173,30 @@ void walk(Rig& r, int pictures, int repeats, bool linger, std::vector<std::vecto
   }
 }
 
+/// Pages 2-51 of the stick's PDF paged through with Next from page 1, each timed key -> felt. With
+/// prefetch_mb > 0 the visitor lingers on each page until the pages Next and Previous lead to are built ahead.
+std::vector<double> stick_walk(const fs::path& lib, const fs::path& stick, int prefetch_mb) {
+  std::vector<double> out;
+  Rig r(lib, prefetch_mb, "");
+  r.flow->key(KioskKey::Other, r.now_s);
+  r.rt->insert_stick_folder(stick.string());
+  const Clock::time_point t0 = Clock::now();
+  while (r.rt->core().display().scene_id != 1000 + 1 && ms_between(t0, Clock::now()) < 60000) {
+    r.frame();
+    std::this_thread::sleep_for(std::chrono::microseconds(16667));
+  }
+  for (int page = 2; page <= 51; ++page) {
+    const Clock::time_point l0 = Clock::now();
+    while (prefetch_mb > 0 && r.rt->sticks().pages_ahead() < 2 && ms_between(l0, Clock::now()) < 30000) {
+      r.frame();
+      std::this_thread::sleep_for(std::chrono::microseconds(16667));
+    }
+    out.push_back(r.press_until_felt(KioskKey::Next, 1000 + page));
+    r.linger(0.0);
+  }
+  return out;
+}
+
 std::string ms_text(double ms) {
   char b[32];
   std::snprintf(b, sizeof b, "%.0f", ms);
@@ -222,26 +246,15 @@ int main(int argc, char** argv) {
   for (auto& v : cached) v.clear();
   { Rig r(lib, 0, cache.string()); walk(r, n, repeats, false, cached); }  // a fresh start over it
 
-  // Stick: a 51-page PDF paged through with Next.
-  std::vector<double> stick_pages;
+  // Stick: a 51-page PDF paged through with Next, cold and built ahead.
+  std::vector<double> stick_cold, stick_ahead;
   const fs::path stick = tmp / "stick";
   fs::create_directories(stick);
   const std::string spec = std::string(HK_TEST_DATA_DIR) + "/documents/shared-mime-info-spec.pdf";
   const std::string cmd = "pdfunite '" + spec + "' '" + spec + "' '" + spec + "' '" + (stick / "long.pdf").string() + "' 2>/dev/null";
   if (!quick && std::system(cmd.c_str()) == 0) {
-    Rig r(lib, 0, "");
-    r.flow->key(KioskKey::Other, r.now_s);
-    r.rt->insert_stick_folder(stick.string());
-    const Clock::time_point t0 = Clock::now();
-    while (r.rt->core().display().scene_id != 1000 + 1 && ms_between(t0, Clock::now()) < 60000) {
-      r.frame();
-      std::this_thread::sleep_for(std::chrono::microseconds(16667));
-    }
-    for (int page = 2; page <= 51; ++page) {
-      const double ms = r.press_until_felt(KioskKey::Next, 1000 + page);
-      stick_pages.push_back(ms);
-      r.linger(0.0);
-    }
+    stick_cold = stick_walk(lib, stick, 0);
+    stick_ahead = stick_walk(lib, stick, 256);
   }
 
   std::ostringstream md;
@@ -265,8 +278,9 @@ int main(int argc, char** argv) {
   };
   line("cold: tests/data pictures and JPEG phone photos", small_cold);
   line("cold: 13 MP PNGs", big_cold);
-  line("cold: pages 2-51 of a 51-page PDF on a stick", stick_pages);
+  line("cold: pages 2-51 of a 51-page PDF on a stick", stick_cold);
   line("prefetched", all_ahead);
+  line("prefetched: pages 2-51 of a 51-page PDF on a stick", stick_ahead);
   line("cached (after a restart)", all_cached);
   md << "\nPeak resident memory of the process: " << rss_cold_kb / 1024 << " MiB after the cold walk, " << rss_prefetch_kb / 1024
      << " MiB after the prefetched walk ([kiosk] prefetch_mb = 256).\n";

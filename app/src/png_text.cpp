@@ -1,31 +1,34 @@
-// PNG text chunks with libpng (see png_text.hpp).
-//
-// libpng reports errors by longjmp to the setjmp point: between that point and the last libpng call no
-// object with a destructor lives in read_png_text's frame (the row buffer is libpng's own, freed by the
-// clean-up), and the values are copied out only after libpng has finished.
+// PNG text chunks (see png_text.hpp): the file is walked chunk by chunk (PNG 2nd ed. §5.3: length, type,
+// data, CRC-32) and only the text chunks are read; the image data is skipped, not decoded, so a 20 MB photo
+// costs a few hundred small reads and seeks rather than a second full decode. zlib checks each text chunk's
+// CRC and inflates the compressed ones.
 
 #include "png_text.hpp"
 
-#include <png.h>
+#include <zlib.h>
 
-#include <csetjmp>
+#include <array>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <memory>
+#include <optional>
+#include <string_view>
+#include <vector>
 
 namespace hk::app {
 namespace {
 
-constexpr png_alloc_size_t kMaxChunkBytes = 1u << 20;  // a text chunk inflated beyond this is refused
-
-void silent_warning(png_structp, png_const_charp) {}
-void jump_on_error(png_structp png, png_const_charp) { png_longjmp(png, 1); }
+constexpr std::size_t kMaxChunkBytes = 1u << 20;  // a text chunk, stored or inflated, larger than this is skipped
+constexpr int kMaxChunks = 1 << 20;                // chunks looked at before giving up on a file
+constexpr std::array<std::uint8_t, 8> kSignature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
 
 /// Latin-1 (tEXt, zTXt) to UTF-8.
-std::string latin1_to_utf8(const char* s, std::size_t n) {
+std::string latin1_to_utf8(std::string_view s) {
   std::string out;
-  out.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(s[i]);
+  out.reserve(s.size());
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
     if (c < 0x80) {
       out.push_back(static_cast<char>(c));
     } else {
@@ -36,56 +39,94 @@ std::string latin1_to_utf8(const char* s, std::size_t n) {
   return out;
 }
 
-/// The file's text chunks after libpng read it whole; false when it could not.
-bool read_chunks(std::FILE* f, png_structp png, png_infop info, png_bytep* row) {
-  if (setjmp(png_jmpbuf(png))) return false;
-  png_init_io(png, f);
-  png_set_chunk_malloc_max(png, kMaxChunkBytes);
-  png_read_info(png, info);
-  // The image data must be read to reach the chunks after it; one row at a time, into one buffer.
-  const int passes = png_set_interlace_handling(png);
-  png_read_update_info(png, info);
-  const png_uint_32 height = png_get_image_height(png, info);
-  *row = static_cast<png_bytep>(png_malloc(png, png_get_rowbytes(png, info)));
-  for (int pass = 0; pass < passes; ++pass)
-    for (png_uint_32 y = 0; y < height; ++y) png_read_row(png, *row, nullptr);
-  png_read_end(png, info);
-  return true;
+/// A zlib stream inflated, when it is whole and inflates to at most kMaxChunkBytes.
+std::optional<std::string> inflated(std::string_view z) {
+  z_stream zs{};
+  if (inflateInit(&zs) != Z_OK) return std::nullopt;
+  std::string out(kMaxChunkBytes, '\0');
+  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(z.data()));
+  zs.avail_in = static_cast<uInt>(z.size());
+  zs.next_out = reinterpret_cast<Bytef*>(out.data());
+  zs.avail_out = static_cast<uInt>(out.size());
+  const int rc = inflate(&zs, Z_FINISH);
+  const std::size_t n = zs.total_out;
+  inflateEnd(&zs);
+  if (rc != Z_STREAM_END) return std::nullopt;  // damaged, or larger than the limit (a bomb)
+  out.resize(n);
+  return out;
 }
+
+/// The text of a tEXt, zTXt or iTXt chunk's data, as UTF-8, under `keyword`; nullopt when the chunk is
+/// malformed (PNG 2nd ed. §11.3.4: keyword, NUL, then per type: text | method, zlib | flag, method, language
+/// NUL, translated keyword NUL, text or zlib).
+std::optional<std::string> chunk_text(std::string_view type, std::string_view data, std::string& keyword) {
+  const std::size_t nul = data.find('\0');
+  if (nul == std::string_view::npos || nul == 0 || nul > 79) return std::nullopt;
+  keyword.assign(data.substr(0, nul));
+  std::string_view rest = data.substr(nul + 1);
+  if (type == "tEXt") return latin1_to_utf8(rest);
+  if (type == "zTXt") {
+    if (rest.empty() || rest[0] != 0) return std::nullopt;
+    const std::optional<std::string> t = inflated(rest.substr(1));
+    return t ? std::optional<std::string>(latin1_to_utf8(*t)) : std::nullopt;
+  }
+  if (rest.size() < 2) return std::nullopt;  // iTXt
+  const bool compressed = rest[0] != 0;
+  if (compressed && rest[1] != 0) return std::nullopt;
+  rest.remove_prefix(2);
+  for (int field = 0; field < 2; ++field) {  // language tag, translated keyword
+    const std::size_t end = rest.find('\0');
+    if (end == std::string_view::npos) return std::nullopt;
+    rest.remove_prefix(end + 1);
+  }
+  return compressed ? inflated(rest) : std::optional<std::string>(std::string(rest));
+}
+
+std::uint32_t big_endian(const std::uint8_t* p) {
+  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) | p[3];
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
 
 }  // namespace
 
 PngText read_png_text(const std::string& path) {
   PngText out;
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return out;
-  png_byte sig[8] = {};
-  if (std::fread(sig, 1, 8, f) != 8 || png_sig_cmp(sig, 0, 8) != 0) {
-    std::fclose(f);
-    return out;
-  }
-  std::rewind(f);
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, jump_on_error, silent_warning);
-  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-  png_bytep row = nullptr;
-  if (info != nullptr && read_chunks(f, png, info, &row)) {
-    png_textp text = nullptr;
-    int n = 0;
-    png_get_text(png, info, &text, &n);
-    bool have_title = false, have_description = false;
-    for (int i = 0; i < n; ++i) {
-      const bool title = std::strcmp(text[i].key, "Title") == 0, description = std::strcmp(text[i].key, "Description") == 0;
-      if ((!title || have_title) && (!description || have_description)) continue;
-      const bool utf8 = text[i].compression >= PNG_ITXT_COMPRESSION_NONE;  // iTXt
-      const std::size_t len = utf8 ? text[i].itxt_length : text[i].text_length;
-      std::string value = utf8 ? std::string(text[i].text, len) : latin1_to_utf8(text[i].text, len);
-      (title ? out.title : out.description) = std::move(value);
-      (title ? have_title : have_description) = true;
+  const std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "rb"));
+  if (!f) return out;
+  std::array<std::uint8_t, 8> sig{};
+  if (std::fread(sig.data(), 1, sig.size(), f.get()) != sig.size() || sig != kSignature) return out;
+  bool have_title = false, have_description = false;
+  std::string data, keyword;
+  for (int chunk = 0; chunk < kMaxChunks && !(have_title && have_description); ++chunk) {
+    std::array<std::uint8_t, 8> head{};
+    if (std::fread(head.data(), 1, head.size(), f.get()) != head.size()) break;
+    const std::uint32_t length = big_endian(head.data());
+    const std::string_view type(reinterpret_cast<const char*>(head.data() + 4), 4);
+    if (length > 0x7fffffffu || type == "IEND") break;
+    const bool text = type == "tEXt" || type == "zTXt" || type == "iTXt";
+    if (!text || length > kMaxChunkBytes) {  // the image data and everything else: skipped, with its CRC
+      if (std::fseek(f.get(), static_cast<long>(length) + 4, SEEK_CUR) != 0) break;
+      continue;
+    }
+    data.resize(length);
+    std::array<std::uint8_t, 4> crc{};
+    if ((length > 0 && std::fread(data.data(), 1, length, f.get()) != length) || std::fread(crc.data(), 1, 4, f.get()) != 4) break;
+    uLong sum = crc32(0L, head.data() + 4, 4);
+    sum = crc32(sum, reinterpret_cast<const Bytef*>(data.data()), static_cast<uInt>(length));
+    if (sum != big_endian(crc.data())) continue;  // a damaged chunk says nothing
+    const std::optional<std::string> value = chunk_text(type, data, keyword);
+    if (!value) continue;
+    if (keyword == "Title" && !have_title) {
+      out.title = *value;
+      have_title = true;
+    } else if (keyword == "Description" && !have_description) {
+      out.description = *value;
+      have_description = true;
     }
   }
-  if (row != nullptr) png_free(png, row);
-  png_destroy_read_struct(png != nullptr ? &png : nullptr, info != nullptr ? &info : nullptr, nullptr);
-  std::fclose(f);
   return out;
 }
 

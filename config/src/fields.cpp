@@ -286,7 +286,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(kiosk, quiet_hours, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
              "Local times with no spoken invitation, \"HH:MM-HH:MM\" (e.g. \"22:00-07:00\"); empty: none.", {}, &quiet_hours_problem),
     HK_FIELD(kiosk, prefetch_mb, FieldGroup::kiosk, ApplyWhen::live, 0, 4096, "MiB",
-             "Memory for the next and previous pictures, built while the visitor explores this one, so Next is at once (0: none built ahead)."),
+             "Memory for the next and previous pictures (of the library, and the pages of a USB stick), built while the visitor explores this one, so Next is at once (0: none built ahead)."),
     HK_FIELD(kiosk, scene_cache, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
              "Where built scenes of the library's pictures are kept, so the first picture after a restart is felt at once: \"auto\" (the service's cache folder, else ~/.cache/haptic-kiosk/scenes), \"off\", or an absolute folder.",
              {}, &scene_cache_problem),
