@@ -315,6 +315,10 @@ int run_kiosk(const KioskOptions& o) {
   KioskFlow flow(rt, rt.audio().messages(), flow_params(start.settings, rt.has_camera()));
 
   KioskWindow window(o.windowed);
+  {
+    const auto [fw, fh] = window.framebuffer_size();
+    rt.set_screen_picture_side_px(picture_side_px(make_view(fw, fh, rt.half()), rt.half()));
+  }
   Kiosk* kiosk_ptr = nullptr;
   OperatorSession session(o.config_path, start.settings, start.notice, [&](const config::Settings& s) {
     const ApplyReport r = rt.apply_settings(s, flow);

@@ -8,6 +8,11 @@ namespace hk::app {
 
 View make_view(int w, int h, Vec2 half) { return {w, h, 0.9 * std::min(w / (2 * half.x), 0.8 * h / (2 * half.y))}; }
 
+int picture_side_px(const View& v, Vec2 half) {
+  const double side = std::ceil(2.0 * std::max(half.x, half.y) * v.s);
+  return static_cast<int>(std::clamp(side, 256.0, static_cast<double>(kScreenPictureMaxSidePx)));
+}
+
 PictureTexture::PictureTexture() { glGenTextures(1, &tex_); }
 PictureTexture::~PictureTexture() { glDeleteTextures(1, &tex_); }
 
@@ -16,15 +21,15 @@ void PictureTexture::update(const Shown& shown) {
   for_ = shown.scene;
   valid_ = !shown.picture.empty();
   if (!valid_) return;
-  cv::Mat rgb;
-  cv::cvtColor(shown.picture, rgb, cv::COLOR_BGR2RGB);
-  w_ = rgb.cols;
-  h_ = rgb.rows;
+  // OpenCV's BGR rows go up as they are (GL_BGR, OpenGL 1.2): no converted copy on the window thread.
+  const cv::Mat bgr = shown.picture.isContinuous() ? shown.picture : shown.picture.clone();
+  w_ = bgr.cols;
+  h_ = bgr.rows;
   glBindTexture(GL_TEXTURE_2D, tex_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE, rgb.data);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, bgr.cols, bgr.rows, 0, GL_BGR, GL_UNSIGNED_BYTE, bgr.data);
 }
 
 CapturePreviewView::CapturePreviewView() { glGenTextures(1, &tex_); }

@@ -27,6 +27,12 @@ struct View {
 /// The view of a `w` x `h` pixel window onto a workspace of half extent `half` [m].
 View make_view(int w, int h, Vec2 half);
 
+/// The longest side a picture needs on this view [px]: the workspace rectangle's longer side on the screen
+/// (a picture spans at most the workspace), within [256, kScreenPictureMaxSidePx]. Pictures are shrunk to
+/// it on the workers that build them (KioskRuntime::set_screen_picture_side_px): a larger texture would only
+/// be minified when drawn (and alias), and would cost its upload on the window thread.
+int picture_side_px(const View& v, Vec2 half);
+
 /// The shown picture as an OpenGL texture, uploaded again when the scene shown changes.
 class PictureTexture {
  public:

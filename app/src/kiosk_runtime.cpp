@@ -384,10 +384,10 @@ namespace {
 /// when it holds one for this file and these settings (found by the file's stamp without reading it, else
 /// by its bytes' key), else built from the bytes read once and stored; a scene whose text is still to be
 /// read is stored once it has been read (its with_text stores what it builds). Runs on the builder's worker.
-ImageScene cached_or_built(const std::string& path, const config::Settings& s, const std::shared_ptr<SceneCache>& cache) {
+ImageScene cached_or_built(const std::string& path, const config::Settings& s, const std::shared_ptr<SceneCache>& cache, int side_px) {
   if (!cache) {
     ImageScene is = build_image_scene(path, s, TextTiming::later);
-    fit_picture(is);
+    fit_picture(is, side_px);
     is.file_notes = embedded_notes(path);
     return is;
   }
@@ -396,6 +396,7 @@ ImageScene cached_or_built(const std::string& path, const config::Settings& s, c
     if (const std::optional<std::string> known = cache->known_key(*stamp, s)) {
       if (std::optional<ImageScene> hit = cache->load(*known, s)) {
         hit->image_path = path;
+        fit_picture(*hit, side_px);  // kept at the size of the screen that stored it
         return std::move(*hit);
       }
     }
@@ -405,10 +406,11 @@ ImageScene cached_or_built(const std::string& path, const config::Settings& s, c
   if (std::optional<ImageScene> hit = cache->load(key, s)) {
     if (stamp) cache->remember_key(*stamp, s, key);
     hit->image_path = path;
+    fit_picture(*hit, side_px);
     return std::move(*hit);
   }
   ImageScene is = build_image_scene_from_bytes(bytes, path, s, TextTiming::later);
-  fit_picture(is);
+  fit_picture(is, side_px);
   is.file_notes = embedded_notes(path);
   auto keep = [cache, key, stamp, s](const ImageScene& built) {
     if (cache->store(key, built) && stamp) cache->remember_key(*stamp, s, key);
@@ -417,9 +419,9 @@ ImageScene cached_or_built(const std::string& path, const config::Settings& s, c
     keep(is);
     return is;
   }
-  is.with_text = [read = std::move(is.with_text), keep, file_notes = is.file_notes](const std::atomic<bool>* cancel) {
+  is.with_text = [read = std::move(is.with_text), keep, file_notes = is.file_notes, side_px](const std::atomic<bool>* cancel) {
     ImageScene with_text = read(cancel);
-    fit_picture(with_text);
+    fit_picture(with_text, side_px);
     with_text.file_notes = file_notes;
     const bool whole = with_text.scene && with_text.ocr.why != "cancelled" && with_text.ocr.why.rfind("failed", 0) != 0;
     if (whole) keep(with_text);
@@ -443,8 +445,8 @@ PictureNotes notes_of(const std::string& path, const PictureNotes& file_notes) {
 
 SceneJob KioskRuntime::picture_job(int index) const {
   // A copy of what the build needs: the worker never touches the runtime.
-  return [path = pictures_[static_cast<std::size_t>(index)], s = s_, cache = cache_] {
-    ImageScene is = cached_or_built(path, s, cache);
+  return [path = pictures_[static_cast<std::size_t>(index)], s = s_, cache = cache_, side_px = screen_side_px_] {
+    ImageScene is = cached_or_built(path, s, cache, side_px);
     is.notes = notes_of(path, is.file_notes);
     return is;
   };
@@ -578,9 +580,9 @@ void KioskRuntime::show_built(ImageScene& is, int id) {
   publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
   text_news_.clear();
   if (is.text_pending && is.with_text) {
-    text_.start(id, [read = std::move(is.with_text)](const std::atomic<bool>* cancel) {
+    text_.start(id, [read = std::move(is.with_text), side_px = screen_side_px_](const std::atomic<bool>* cancel) {
       ImageScene with_text = read(cancel);
-      fit_picture(with_text);  // on the reader's worker, not the window thread
+      fit_picture(with_text, side_px);  // on the reader's worker, not the window thread
       return with_text;
     });
     text_since_s_ = -1.0;
@@ -657,6 +659,11 @@ std::string KioskRuntime::describe_shown() {
   }
   if (!shown_.notes.description.empty()) words += shown_.notes.description + ' ';
   return words + describe_scene(shown_.polylines, half_, 3, core_.display().handle_m);
+}
+
+void KioskRuntime::set_screen_picture_side_px(int px) {
+  screen_side_px_ = std::clamp(px, 256, kScreenPictureMaxSidePx);
+  sticks_.set_screen_picture_side_px(screen_side_px_);
 }
 
 void KioskRuntime::show_document(int document, int page) {

@@ -223,6 +223,10 @@ class KioskRuntime final : public KioskEffects {
   bool finish_picture(KioskFlow* flow, double now_s, double timeout_s = 60.0);
   /// Scene builds started since the start (asked for and built ahead): what the visitor's keys cost.
   std::uint64_t scene_builds() const { return builder_.builds_started(); }
+  /// The longest side the screen shows a picture at [px] (the kiosk's window: picture_side_px), clamped to
+  /// [256, kScreenPictureMaxSidePx] (the default). Pictures built after this call (library, stick pages, text
+  /// read) are shrunk to it on their workers (fit_picture). Window thread.
+  void set_screen_picture_side_px(int px);
   /// Library pictures built ahead and waiting (their indices).
   std::vector<int> pictures_ahead() const;
   /// Window thread, every frame: news of sticks and finished loads, handed to the flow.
@@ -357,6 +361,7 @@ class KioskRuntime final : public KioskEffects {
   int shown_id_ = -100;
   int shown_picture_ = -1;  // library index shown, −1 for none
   int shown_page_ = 0;      // a document page shown (from 1), 0 for a picture
+  int screen_side_px_ = kScreenPictureMaxSidePx;  // set_screen_picture_side_px
   int shown_document_ = -1; // stick document shown, −1 for none
   int rebuild_page_id_ = 0; // a stick page re-requested by apply_settings (shown without a new announcement)
   static constexpr int kFirstCaptureId = -100;  // shown_id_ of the first camera capture; later ones count down

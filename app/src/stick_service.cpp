@@ -336,7 +336,7 @@ LoadedDocument StickService::build(const Request& r, bool ahead) {
     (ahead ? ahead_started_ : loads_started_).fetch_add(1);
     out.scene = doc.doc.kind == vision::DocumentKind::Pdf ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s, pdf_fault_.load(), TextTiming::later)
                                                           : build_image_scene_from_bytes(bytes, doc.doc.display_name, s, TextTiming::later);
-    if (out.scene) fit_picture(*out.scene);  // the screen's copy, made here rather than on the window thread
+    if (out.scene) fit_picture(*out.scene, screen_side_px_.load());  // the screen's copy, made here rather than on the window thread
   } catch (const std::exception& e) {  // InputError, PdfError, StickError: this page only
     spdlog::warn("stick {}: {}", r.stick, e.what());
     out.reason = problem_of(e.what());

@@ -95,6 +95,8 @@ class StickService {
   int loads_started() const { return loads_started_.load(); }
   /// Pages whose building ahead has begun (for tests and the benchmark).
   int ahead_started() const { return ahead_started_.load(); }
+  /// The longest side of the pictures it builds [px] (fit_picture), kScreenPictureMaxSidePx until set.
+  void set_screen_picture_side_px(int px) { screen_side_px_.store(px); }
   /// Pages built ahead and kept now.
   int pages_ahead() const;
   /// Test hook: the PDF worker of every later load fails on purpose (vision::PdfFault). None in the kiosk.
@@ -137,6 +139,7 @@ class StickService {
   std::atomic<vision::PdfFault> pdf_fault_{vision::PdfFault::None};
   std::atomic<int> loads_started_{0};
   std::atomic<int> ahead_started_{0};
+  std::atomic<int> screen_side_px_{kScreenPictureMaxSidePx};
 
   mutable std::mutex m_;
   std::condition_variable cv_;

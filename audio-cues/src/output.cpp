@@ -11,6 +11,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 
 namespace hk::audio {
 
@@ -122,10 +123,28 @@ std::string output_device_names() {
 
 }  // namespace
 
+std::chrono::nanoseconds OutputPacer::after(std::size_t frames, std::chrono::steady_clock::time_point now) noexcept {
+  using std::chrono::duration;
+  if (!started_ || now - window_start_ > duration<double>(kWindow_s)) {
+    started_ = true;
+    window_start_ = now;
+    window_frames_ = 0;
+  }
+  window_frames_ += frames;
+  const double lead_s = static_cast<double>(window_frames_) / rate_hz_ - duration<double>(now - window_start_).count();
+  if (lead_s <= kMaxLead_s) return std::chrono::nanoseconds(0);
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(duration<double>(lead_s - kMaxLead_s));
+}
+
 void AudioOutput::on_callback(float* out, std::size_t frames, bool underflow) noexcept {
   render_interleaved(source_, mono_, out, frames, channels_);
   callbacks_.fetch_add(1, std::memory_order_relaxed);
   if (underflow) underflows_.fetch_add(1, std::memory_order_relaxed);
+  const std::chrono::nanoseconds wait = pacer_.after(frames, std::chrono::steady_clock::now());
+  if (wait.count() > 0) {  // a device that discards (ALSA null): held to the wall clock
+    const timespec ts{static_cast<time_t>(wait.count() / 1'000'000'000), static_cast<long>(wait.count() % 1'000'000'000)};
+    ::nanosleep(&ts, nullptr);
+  }
 }
 
 void AudioOutput::give_up(const std::string& why) {

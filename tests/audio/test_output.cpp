@@ -135,6 +135,48 @@ TEST(Output, StopIsIdempotentAndEndsTheCallbacks) {
 
 // The callback's copy, checked without a device: mono pulled in scratch-sized chunks, in order, and
 // written to every channel of the interleaved buffer.
+// A device that discards each buffer at once (ALSA's null device) is held to the wall clock: audio runs at
+// most kMaxLead_s ahead, and each wait is exactly what brings the lead back to it.
+TEST(OutputPacer, ADeviceFasterThanRealTimeWaitsForTheWallClock) {
+  using namespace std::chrono;
+  OutputPacer pacer(48000);
+  auto t = steady_clock::time_point{} + hours(1);
+  std::size_t frames_before_wait = 0;
+  nanoseconds first_wait{0};
+  for (int i = 0; i < 100 && first_wait.count() == 0; ++i) {  // no time passes between callbacks
+    first_wait = pacer.after(512, t);
+    if (first_wait.count() == 0) frames_before_wait += 512;
+  }
+  // 0.25 s is 12000 frames: the 24th buffer (12288 frames) is the first past it, by 288 frames = 6 ms.
+  EXPECT_EQ(frames_before_wait, 23u * 512u);
+  EXPECT_NEAR(duration<double>(first_wait).count(), 288.0 / 48000.0, 1e-9);
+  // Waiting as asked, the stream then runs at the wall clock's pace: one buffer's time a buffer (for the rest
+  // of the 10 s window; the next window starts the count again).
+  t += first_wait;
+  for (int i = 0; i < 900; ++i) {
+    const nanoseconds w = pacer.after(512, t);
+    EXPECT_NEAR(duration<double>(w).count(), 512.0 / 48000.0, 1e-6);
+    t += w;
+  }
+}
+
+// A real device never waits: its buffer primed at the start, callbacks with jitter, and a clock 0.1 % fast
+// for a whole day.
+TEST(OutputPacer, ARealDeviceNeverWaitsEvenWithJitterAndDrift) {
+  using namespace std::chrono;
+  OutputPacer pacer(48000);
+  const auto start = steady_clock::time_point{} + hours(1);
+  EXPECT_EQ(pacer.after(4096, start).count(), 0) << "the buffer primed at once";
+  const double period_s = 512.0 / 48000.0 / 1.001;  // the card plays 0.1 % fast
+  int waits = 0;
+  for (long i = 1; i < 24L * 3600 * 94; ++i) {  // a day of callbacks
+    const double jitter_s = ((i * 7919) % 11 - 5) * 1e-3;  // ±5 ms
+    const auto now = start + duration_cast<nanoseconds>(duration<double>(i * period_s + jitter_s));
+    waits += pacer.after(512, now).count() > 0;
+  }
+  EXPECT_EQ(waits, 0);
+}
+
 TEST(Output, RenderInterleavedDuplicatesMonoAcrossChannelsInChunks) {
   std::vector<float> scratch(4096);
   for (int channels : {1, 2}) {

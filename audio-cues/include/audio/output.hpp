@@ -10,6 +10,7 @@
 /// follows DESIGN.md "Real-time rules": it only calls AudioSource::render() and copies samples.
 
 #include <array>
+#include <chrono>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -51,6 +52,31 @@ struct OutputInfo {
 /// No allocation, lock, log or throw.
 void render_interleaved(AudioSource& source, std::span<float> scratch, float* out, std::size_t frames,
                         int channels) noexcept;
+
+/// Holds an output stream that takes samples faster than it could play them to the wall clock. ALSA's null
+/// device (the kiosk's tests and any machine without a sound card configured that way) discards each buffer
+/// at once, so PortAudio would call back flat out and the mixer would take a whole core. Over a window of
+/// kWindow_s [s] of wall time the audio taken since the window began may run at most kMaxLead_s [s] ahead of
+/// the wall clock; past that the callback waits. A real device never comes near it: within a window it takes
+/// what it plays plus at most its buffer (tens of ms), and restarting the window every kWindow_s keeps a
+/// sound card's clock drift (≤ 0.1 %: ≤ 10 ms a window) from adding up. Real-time: no allocation, lock or
+/// throw.
+class OutputPacer {
+ public:
+  static constexpr double kMaxLead_s = 0.25;  ///< audio taken ahead of the wall clock before waiting [s]
+  static constexpr double kWindow_s = 10.0;   ///< the wall time over which the lead is counted [s]
+  /// A pacer for a stream of `rate_hz` (> 0) frames a second.
+  explicit OutputPacer(int rate_hz) noexcept : rate_hz_(rate_hz) {}
+  /// `frames` frames were just taken at `now`: how long to wait so that the lead is at most kMaxLead_s
+  /// (zero when it is within).
+  std::chrono::nanoseconds after(std::size_t frames, std::chrono::steady_clock::time_point now) noexcept;
+
+ private:
+  int rate_hz_;
+  bool started_ = false;
+  std::chrono::steady_clock::time_point window_start_{};
+  std::uint64_t window_frames_ = 0;  // frames taken since window_start_
+};
 
 /// One PortAudio output stream pulling one AudioSource. Not copyable or movable (PortAudio holds a
 /// pointer to it). Several may exist; PortAudio is initialised by each and terminated when the last
@@ -98,6 +124,7 @@ class AudioOutput {
   int channels_ = 1;         // fixed before the stream starts; read by the callback
   std::atomic<std::uint64_t> callbacks_{0}, underflows_{0};
   std::array<float, kMaxFrames> mono_{};  // the callback's scratch buffer
+  OutputPacer pacer_{kSampleRateHz};      // the callback's; a device faster than real time waits here
 };
 
 }  // namespace hk::audio
