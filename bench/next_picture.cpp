@@ -2,7 +2,8 @@
 // pantograph (the handle at rest in free space), driven by the visitor's flow. Each Next press is timed from
 // the key to the first servo tick on the new scene (ServoDisplayState::scene_id). The window thread is
 // played as the kiosk plays it: the flow's key, then poll_pictures / poll_sticks once a frame (60 Hz), so a
-// scene built off the window thread waits up to one frame to be put on the device, as at the kiosk.
+// scene built off the window thread waits up to one frame to be put on the device, as at the kiosk. The
+// screen is a 1920 x 1080 one: pictures are shrunk to the size it draws them (picture_side_px), as there.
 //
 // Three ways a picture can be at hand:
 //   cold       nothing built ahead, no scene cache ([kiosk] prefetch_mb = 0, scene_cache off);
@@ -36,6 +37,7 @@
 
 #include "kiosk_flow.hpp"
 #include "kiosk_runtime.hpp"
+#include "view_geometry.hpp"
 
 using namespace hk;
 using namespace hk::app;
@@ -95,6 +97,8 @@ struct Rig {
     s.kiosk.prefetch_mb = prefetch_mb;
     s.kiosk.timeout_s = 3600;
     rt = std::make_unique<KioskRuntime>(ro, s);
+    // Pictures shrunk to what a full-HD kiosk screen draws, as the kiosk's window sets it.
+    rt->set_screen_picture_side_px(picture_side_px(make_view(1920, 1080, rt->half()), rt->half()));
     flow = std::make_unique<KioskFlow>(*rt, rt->audio().messages(), KioskFlowParams{});
     rt->start_servo();
   }

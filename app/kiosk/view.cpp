@@ -6,12 +6,6 @@
 
 namespace hk::app {
 
-View make_view(int w, int h, Vec2 half) { return {w, h, 0.9 * std::min(w / (2 * half.x), 0.8 * h / (2 * half.y))}; }
-
-int picture_side_px(const View& v, Vec2 half) {
-  const double side = std::ceil(2.0 * std::max(half.x, half.y) * v.s);
-  return static_cast<int>(std::clamp(side, 256.0, static_cast<double>(kScreenPictureMaxSidePx)));
-}
 
 PictureTexture::PictureTexture() { glGenTextures(1, &tex_); }
 PictureTexture::~PictureTexture() { glDeleteTextures(1, &tex_); }

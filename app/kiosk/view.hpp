@@ -4,34 +4,14 @@
 /// vertices): the picture where its pixels map in the workspace, the usable rectangle, a document page's
 /// text blocks, the curves at the level in use, the handle, the proxy and the force; with the operator
 /// overlay also the error boxes of the level in use and the boundary section the servo thread keeps.
-///
-/// View mapping (tests rely on it; kiosk_app.hpp documents it): workspace metres → window pixels with one
-/// uniform scale s = 0.9 · min(W / width_m, 0.8 · H / height_m) [px/m], y up, the bottom 14 % left to
-/// the captions:  px = W/2 + s·x,  py = 0.43·H − s·y  (py counted from the top row).
+/// Where the workspace lands on the screen (View, make_view): view_geometry.hpp.
 
 #include <GL/gl.h>
 
 #include "kiosk_runtime.hpp"
+#include "view_geometry.hpp"
 
 namespace hk::app {
-
-/// Workspace metres ↔ window pixels.
-struct View {
-  int w = 0, h = 0;  ///< window (or framebuffer) size [px]
-  double s = 1;      ///< scale [px/m]
-  double px(double x) const { return w / 2.0 + s * x; }
-  double py(double y) const { return 0.43 * h - s * y; }
-  Vec2 to_m(double x_px, double y_px) const { return {(x_px - w / 2.0) / s, (0.43 * h - y_px) / s}; }
-};
-
-/// The view of a `w` x `h` pixel window onto a workspace of half extent `half` [m].
-View make_view(int w, int h, Vec2 half);
-
-/// The longest side a picture needs on this view [px]: the workspace rectangle's longer side on the screen
-/// (a picture spans at most the workspace), within [256, kScreenPictureMaxSidePx]. Pictures are shrunk to
-/// it on the workers that build them (KioskRuntime::set_screen_picture_side_px): a larger texture would only
-/// be minified when drawn (and alias), and would cost its upload on the window thread.
-int picture_side_px(const View& v, Vec2 half);
 
 /// The shown picture as an OpenGL texture, uploaded again when the scene shown changes.
 class PictureTexture {

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
+#include "app_error.hpp"
 #include "audio_settings.hpp"
 #include "config/load.hpp"
 #include "describe.hpp"
@@ -512,7 +513,7 @@ void KioskRuntime::poll_pictures(KioskFlow* flow, double now_s) {
     spdlog::info("scene {}: built in {:.0f} ms (waited {:.0f} ms to start)", b.id, b.build_ms, b.queued_ms);
     if (!b.scene) {
       spdlog::warn("scene {}: {}; the picture felt before stays", b.id, b.error);
-      if (kind == WantKind::Picture && flow) flow->picture_failed(b.id, b.error, now_s);
+      if (kind == WantKind::Picture && flow) flow->picture_failed(b.id, problem_of(b.error), now_s);  // "Picture N of M" names it
     } else if (kind == WantKind::Rebuild) {
       PictureNotes notes = std::move(shown_.notes);
       show_built(*b.scene, b.id);  // the same picture with the new settings: no new announcement

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "app_error.hpp"
 #include "vision/intake.hpp"
 
 namespace hk::app {
@@ -12,12 +13,6 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-/// The problem part of a one-line error "kind 'name': problem", for speech (the name is said separately).
-std::string problem_of(const std::string& what) {
-  const std::size_t k = what.find("': ");
-  return k == std::string::npos ? what : what.substr(k + 3);
 }
 
 }  // namespace

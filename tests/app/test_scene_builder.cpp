@@ -356,7 +356,8 @@ TEST(KioskBuilds, APictureThatCannotBeReadIsSaidAndTheOldOneStays) {
   EXPECT_EQ(r.rt->shown_id(), 0) << "the horse is still felt";
   EXPECT_EQ(r.rt->shown().scene, before);
   EXPECT_EQ(r.rt->last_said().rfind("Picture 2 of 3 cannot be shown: ", 0), 0u) << r.rt->last_said();
-  EXPECT_NE(r.rt->last_said().find("1_coins.png"), std::string::npos) << "names the file";
+  EXPECT_EQ(r.rt->last_said().find("1_coins.png"), std::string::npos) << "the picture's number names it, not its path";
+  EXPECT_NE(r.rt->last_said().find("PNG"), std::string::npos) << "what is wrong with it is said";
   r.flow->key(KioskKey::Next, 2.0);  // steps past it
   r.settle(2.0);
   EXPECT_EQ(r.rt->shown_id(), 2);

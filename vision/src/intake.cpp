@@ -126,19 +126,13 @@ cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& pat
   return decode_image_reduced(bytes, path, limits, 0).bgr;
 }
 
-DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits,
-                                  int keep_side_px) {
-  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
-      limits.max_pixels <= 0) {
-    throw hk::ArgumentError("decode_image_reduced: every ImageLimits field must be positive");
-  }
-  if (bytes.empty()) detail::throw_input_error(path, "empty file (0 bytes)");
-  if (bytes.size() > static_cast<std::uint64_t>(limits.max_file_bytes)) {
-    detail::throw_input_error(path, "file size " + std::to_string(bytes.size()) + " bytes exceeds the limit of " +
-                                        std::to_string(limits.max_file_bytes) + " bytes");
-  }
+namespace {
+
+/// The header of `bytes`, checked before any pixel is decoded: declared width, height and pixel count
+/// within `limits`, and a JPEG's stream reaching its end-of-image marker. Throws InputError naming `path`.
+detail::HeaderDetails checked_header(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits) {
   detail::MemorySource src(bytes);
-  const detail::HeaderDetails hd = detail::parse_image_header(src, path);
+  detail::HeaderDetails hd = detail::parse_image_header(src, path);
   const ImageHeader& h = hd.header;
   const std::string declared = "declared size " + std::to_string(h.width_px) + " x " + std::to_string(h.height_px) + " px";
   if (h.width_px > limits.max_width_px || h.height_px > limits.max_height_px) {
@@ -153,6 +147,25 @@ DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std
   if (h.format == "jpeg" && !detail::jpeg_is_complete(bytes)) {
     detail::throw_input_error(path, "truncated or corrupt JPEG: the stream does not reach its end-of-image marker (0xFFD9)");
   }
+  return hd;
+}
+
+}  // namespace
+
+DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits,
+                                  int keep_side_px) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
+      limits.max_pixels <= 0) {
+    throw hk::ArgumentError("decode_image_reduced: every ImageLimits field must be positive");
+  }
+  if (bytes.empty()) detail::throw_input_error(path, "empty file (0 bytes)");
+  if (bytes.size() > static_cast<std::uint64_t>(limits.max_file_bytes)) {
+    detail::throw_input_error(path, "file size " + std::to_string(bytes.size()) + " bytes exceeds the limit of " +
+                                        std::to_string(limits.max_file_bytes) + " bytes");
+  }
+  const detail::HeaderDetails hd = checked_header(bytes, path, limits);
+  const ImageHeader& h = hd.header;
+  const std::string declared = "declared size " + std::to_string(h.width_px) + " x " + std::to_string(h.height_px) + " px";
 
   std::vector<std::uint8_t> png_copy;
   std::span<const std::uint8_t> to_decode = bytes;
