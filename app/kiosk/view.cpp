@@ -11,19 +11,34 @@ PictureTexture::PictureTexture() { glGenTextures(1, &tex_); }
 PictureTexture::~PictureTexture() { glDeleteTextures(1, &tex_); }
 
 void PictureTexture::update(const Shown& shown) {
-  if (shown.scene == for_) return;
-  for_ = shown.scene;
-  valid_ = !shown.picture.empty();
-  if (!valid_) return;
+  if (shown.scene != for_) {
+    for_ = shown.scene;
+    valid_ = false;
+    pending_.release();
+    rows_up_ = 0;
+    if (shown.picture.empty() || shown.picture.type() != CV_8UC3) return;
+    pending_ = shown.picture;  // shares the pixels: they outlive a later change of what is shown
+    if (pending_.step[0] % 3 != 0) pending_ = pending_.clone();  // rows given to OpenGL in whole pixels
+    w_ = pending_.cols;
+    h_ = pending_.rows;
+    glBindTexture(GL_TEXTURE_2D, tex_);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, w_, h_, 0, GL_BGR, GL_UNSIGNED_BYTE, nullptr);  // storage only
+  }
+  if (pending_.empty()) return;
   // OpenCV's BGR rows go up as they are (GL_BGR, OpenGL 1.2): no converted copy on the window thread.
-  const cv::Mat bgr = shown.picture.isContinuous() ? shown.picture : shown.picture.clone();
-  w_ = bgr.cols;
-  h_ = bgr.rows;
+  const std::size_t row_bytes = pending_.step[0];
+  const int rows = std::clamp(static_cast<int>(kUploadBytesPerFrame / std::max<std::size_t>(row_bytes, 1)), 1, h_ - rows_up_);
   glBindTexture(GL_TEXTURE_2D, tex_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, bgr.cols, bgr.rows, 0, GL_BGR, GL_UNSIGNED_BYTE, bgr.data);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(row_bytes / 3));
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, rows_up_, w_, rows, GL_BGR, GL_UNSIGNED_BYTE, pending_.ptr(rows_up_));
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  rows_up_ += rows;
+  if (rows_up_ < h_) return;
+  valid_ = true;
+  pending_.release();
 }
 
 CapturePreviewView::CapturePreviewView() { glGenTextures(1, &tex_); }

@@ -13,14 +13,20 @@
 
 namespace hk::app {
 
-/// The shown picture as an OpenGL texture, uploaded again when the scene shown changes.
+/// The shown picture as an OpenGL texture, uploaded again when the scene shown changes, a slice of rows a
+/// frame (at most kUploadBytesPerFrame), so a change never costs the window thread more than one slice.
 class PictureTexture {
  public:
+  /// Bytes of picture rows uploaded per frame [bytes]: about 9 ms under Mesa's software OpenGL, far less on a
+  /// GPU; a picture the screen draws at 1040 px is up in 3 frames.
+  static constexpr std::size_t kUploadBytesPerFrame = 1u << 20;
   PictureTexture();
   ~PictureTexture();
   PictureTexture(const PictureTexture&) = delete;
   PictureTexture& operator=(const PictureTexture&) = delete;
-  /// Uploads `shown.picture` when `shown.scene` is not the one uploaded last.
+  /// Once a frame: when `shown.scene` is not the one uploaded last, starts uploading `shown.picture` (BGR) and
+  /// stops drawing the old one (its pixel map is not the new picture's); then uploads the next slice of rows.
+  /// valid() once every row is up.
   void update(const Shown& shown);
   bool valid() const { return valid_; }
   GLuint id() const { return tex_; }
@@ -32,6 +38,8 @@ class PictureTexture {
   const Scene* for_ = nullptr;
   bool valid_ = false;
   int w_ = 0, h_ = 0;
+  cv::Mat pending_;   // the picture being uploaded (shares the shown picture's pixels), empty when up
+  int rows_up_ = 0;   // rows of pending_ uploaded so far
 };
 
 /// The camera's preview while a capture is under way (for sighted companions): the latest frame
