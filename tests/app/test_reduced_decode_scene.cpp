@@ -87,13 +87,13 @@ config::Settings curves_only() {
   return s;
 }
 
-/// Pictures whose scenes' curves are not stable under a change of a grey level or two (measured: the full
-/// decode with +-1 grey-level noise added differs from the plain full decode by as much as the reduced decode
-/// does): textured photographs and pages, where Canny's hysteresis, edge linking and the salience budget
-/// (max_shapes) pick different chains among many of nearly equal strength. And silhouette_9, which is stable
-/// under that noise (1 px) but one of whose three curves differs by 32 processed px between the 1/2 decode
-/// and the full one (its 1/4 decode agrees within 1 px): a real difference, not yet explained. For these only
-/// the curve count is compared (within 2); the printed figures show the distances.
+/// Pictures whose scenes' curves are not stable under a change of a grey level or two (measured when this list
+/// was made: the full decode with +-1 grey-level noise added differed from the plain full decode by as much as
+/// the reduced decode does): textured photographs and pages, where Canny's hysteresis, edge linking and the
+/// salience budget (max_shapes) pick different chains among many of nearly equal strength. And silhouette_9,
+/// which is stable under that noise (1 px) but one of whose three curves differs by 32 processed px between
+/// the 1/2 decode and the full one (its 1/4 decode agrees within 1 px): a real difference, not yet explained.
+/// For these only the curve count is compared (within 2); the printed figures show the distances.
 bool unstable(const std::string& stem) {
   for (const char* name : {"HappyFish", "apple", "butterfly", "camera", "coins", "fruits", "page", "sudoku", "silhouette_9"}) {
     if (stem == name) return true;
@@ -101,65 +101,53 @@ bool unstable(const std::string& stem) {
   return false;
 }
 
-TEST(ReducedDecodeScene, GivesTheCurvesOfTheFullDecodeOnEveryTestPicture) {
-  const fs::path dir = test::fresh_dir("reduced_decode_curves");
+class ReducedDecodeCurves : public ::testing::TestWithParam<fs::path> {};
+
+// Each test picture made large enough that its scene's decode is reduced to 1/4 (long side >= 3200 px) and,
+// as a second case, to 1/2 (long side 1600 to 3199 px): the reduced decode's scene against the full decode's.
+TEST_P(ReducedDecodeCurves, AreTheCurvesOfTheFullDecode) {
+  const fs::path& p = GetParam();
+  const fs::path dir = test::fresh_dir("reduced_decode_curves_" + p.stem().string());
   const config::Settings s = curves_only();
   ASSERT_EQ(picture_keep_side_px(s), s.vision.max_image_side_px);
-  int pictures = 0, compared = 0;
-  for (const fs::path& p : test::test_images()) {
-    // Each picture made large enough that its scene's decode is reduced to 1/4 (long side >= 3200 px) and,
-    // as a second case, to 1/2 (long side 1600 to 3199 px).
-    const cv::Mat original = cv::imread(p.string(), cv::IMREAD_COLOR);
-    const int side = std::max(original.cols, original.rows);
-    ++pictures;
-    for (const int target : {3200, 1600}) {
-      const double k = std::max(4.0, std::ceil(static_cast<double>(target) / side));
-      const std::string path = large_jpeg(p, k, dir);
-      SCOPED_TRACE(fs::path(path).filename().string());
-      const ImageScene reduced = build_image_scene(path, s);
-      const cv::Mat full_bgr = vision::load_image(path, {});
-      const ImageScene full = build_image_scene_from_picture(full_bgr, path, s);
-      const int expected_scale = vision::jpeg_reduction_for(full.width_px, full.height_px, s.vision.max_image_side_px);
-      ASSERT_GT(expected_scale, 1);
-      EXPECT_EQ(reduced.decode_scale, expected_scale);
-      EXPECT_EQ(reduced.file_width_px, full.width_px);
-      EXPECT_EQ(reduced.file_height_px, full.height_px);
-      EXPECT_EQ(reduced.picture.cols, (full.width_px + expected_scale - 1) / expected_scale);
-      EXPECT_EQ(reduced.picture.rows, (full.height_px + expected_scale - 1) / expected_scale);
-      EXPECT_EQ(reduced.width_px, reduced.picture.cols);
+  const cv::Mat original = cv::imread(p.string(), cv::IMREAD_COLOR);
+  const int side = std::max(original.cols, original.rows);
+  for (const int target : {3200, 1600}) {
+    const double k = std::max(4.0, std::ceil(static_cast<double>(target) / side));
+    const std::string path = large_jpeg(p, k, dir);
+    SCOPED_TRACE(fs::path(path).filename().string());
+    const ImageScene reduced = build_image_scene(path, s);
+    const ImageScene full = build_image_scene_from_picture(vision::load_image(path, {}), path, s);
+    const int expected_scale = vision::jpeg_reduction_for(full.width_px, full.height_px, s.vision.max_image_side_px);
+    ASSERT_GT(expected_scale, 1);
+    EXPECT_EQ(reduced.decode_scale, expected_scale);
+    EXPECT_EQ(reduced.file_width_px, full.width_px);
+    EXPECT_EQ(reduced.file_height_px, full.height_px);
+    EXPECT_EQ(reduced.picture.cols, (full.width_px + expected_scale - 1) / expected_scale);
+    EXPECT_EQ(reduced.picture.rows, (full.height_px + expected_scale - 1) / expected_scale);
+    EXPECT_EQ(reduced.width_px, reduced.picture.cols);
 
-      const double px = m_per_processed_px(full, s);
-      EXPECT_NEAR(m_per_processed_px(reduced, s) / px, 1.0, 0.01);
-      const double there = worst_partner_distance(reduced.polylines, full.polylines) / px;
-      const double back = worst_partner_distance(full.polylines, reduced.polylines) / px;
-      // Control: the full decode with +-1 grey level of noise, against the plain full decode.
-      cv::Mat noise(full_bgr.size(), CV_16SC3), noisy;
-      cv::randu(noise, -1, 2);
-      cv::Mat wide;
-      full_bgr.convertTo(wide, CV_16SC3);
-      cv::Mat(wide + noise).convertTo(noisy, CV_8UC3);
-      const ImageScene control = build_image_scene_from_picture(noisy, path, s);
-      const double control_d = std::max(worst_partner_distance(control.polylines, full.polylines),
-                                        worst_partner_distance(full.polylines, control.polylines)) / px;
-      std::printf("  %-24s 1/%d  curves %3zu / %3zu  worst partner distance %.3f / %.3f processed px; +-1 noise control: %3zu curves, %.3f px\n",
-                  fs::path(path).filename().string().c_str(), reduced.decode_scale, reduced.polylines.size(), full.polylines.size(), there,
-                  back, control.polylines.size(), control_d);
-      if (unstable(p.stem().string())) {
-        EXPECT_NEAR(static_cast<double>(reduced.polylines.size()), static_cast<double>(full.polylines.size()), 2.0);
-        continue;
-      }
-      ++compared;
-      EXPECT_EQ(reduced.polylines.size(), full.polylines.size());
-      // Curve points lie on the processed pixel grid (chain points are pixel centres scaled back), so a
-      // boundary pixel that moved one step diagonally is sqrt(2) away: the bound is that step.
-      EXPECT_LE(there, std::sqrt(2.0) + 0.1);
-      EXPECT_LE(back, std::sqrt(2.0) + 0.1);
+    const double px = m_per_processed_px(full, s);
+    EXPECT_NEAR(m_per_processed_px(reduced, s) / px, 1.0, 0.01);
+    const double there = worst_partner_distance(reduced.polylines, full.polylines) / px;
+    const double back = worst_partner_distance(full.polylines, reduced.polylines) / px;
+    std::printf("  %-24s 1/%d  curves %3zu / %3zu  worst partner distance %.3f / %.3f processed px\n", fs::path(path).filename().string().c_str(),
+                reduced.decode_scale, reduced.polylines.size(), full.polylines.size(), there, back);
+    if (unstable(p.stem().string())) {
+      EXPECT_NEAR(static_cast<double>(reduced.polylines.size()), static_cast<double>(full.polylines.size()), 2.0);
+      continue;
     }
+    EXPECT_EQ(reduced.polylines.size(), full.polylines.size());
+    // Curve points lie on the processed pixel grid (chain points are pixel centres scaled back), so a
+    // boundary pixel that moved one step diagonally is sqrt(2) away: the bound is that step.
+    EXPECT_LE(there, std::sqrt(2.0) + 0.1);
+    EXPECT_LE(back, std::sqrt(2.0) + 0.1);
   }
-  EXPECT_EQ(pictures, static_cast<int>(test::test_images().size()));
-  EXPECT_GE(compared, 2 * 13);  // every picture but the unstable ones, at 1/4 and 1/2
   fs::remove_all(dir);
 }
+
+INSTANTIATE_TEST_SUITE_P(RealImages, ReducedDecodeCurves, ::testing::ValuesIn(test::test_images()),
+                         [](const auto& info) { return info.param.stem().string(); });
 
 TEST(ReducedDecodeScene, KeepsTheDecodedPicturesPixelsAndSizes) {
   const fs::path dir = test::fresh_dir("reduced_decode_picture");
