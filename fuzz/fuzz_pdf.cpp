@@ -7,7 +7,7 @@
 // kiosk side relies on:
 //  - a refusal has a kind the parent accepts and a problem of at most kMaxProblemBytes bytes (the parent
 //    turns a longer one into "no usable answer"), one line;
-//  - an answer has the exact layout the parent parses (probe: page count, title; render: page size, dpi,
+//  - an answer has the exact layout the parent parses (probe: page count, title; render: page size, dpi, screen-sized flag,
 //    w x h grey bytes within the pixel budget, words with finite boxes inside the page), and the parent's
 //    group_text_blocks (which runs in the kiosk process) digests the words.
 // The budget is lower than the kiosk's (40000 px instead of 4 MP) so that a run takes milliseconds.
@@ -76,9 +76,11 @@ int run(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits) 
   }
   double w_pt = 0, h_pt = 0, dpi = 0;
   std::int32_t w = 0, h = 0;
+  std::uint8_t screen_sized = 0;
   FUZZ_CHECK(n >= page, "rendered a page beyond the count");
-  FUZZ_CHECK(in.f64(w_pt) && in.f64(h_pt) && in.f64(dpi) && in.i32(w) && in.i32(h), "page header");
+  FUZZ_CHECK(in.f64(w_pt) && in.f64(h_pt) && in.f64(dpi) && in.u8(screen_sized) && screen_sized <= 1 && in.i32(w) && in.i32(h), "page header");
   FUZZ_CHECK(w > 0 && h > 0 && static_cast<double>(w) * h <= limits.max_page_pixels, std::to_string(w) + "x" + std::to_string(h));
+  FUZZ_CHECK(screen_sized == 0 || std::max(w, h) <= limits.text_layer_max_side_px + 2.0, std::to_string(w) + "x" + std::to_string(h));
   FUZZ_CHECK(dpi > 0 && dpi <= limits.max_dpi, std::to_string(dpi));
   FUZZ_CHECK(std::abs(w - w_pt * dpi / 72.0) <= 2.0 && std::abs(h - h_pt * dpi / 72.0) <= 2.0, std::to_string(w_pt));
   std::vector<std::uint8_t> grey(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
@@ -110,6 +112,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size == 0 || !hk::vision::looks_like_pdf(bytes)) return 0;
   hk::vision::PdfLimits limits;
   limits.max_page_pixels = 4e4;
+  limits.text_layer_max_side_px = 120;  // a page with words is drawn smaller still (the kiosk's screen size)
   const int n = hk::vision::run(bytes, 0, limits);
   if (n > 0) hk::vision::run(bytes, 1, limits);
   return 0;

@@ -2,6 +2,7 @@
 
 #include "picture_notes.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -98,11 +99,17 @@ nlohmann::json stick_listing_json(const StickListing& l) {
 }
 
 ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
-                                vision::PdfFault fault, TextTiming timing) {
+                                vision::PdfFault fault, TextTiming timing, int text_layer_side_px) {
   const auto t0 = std::chrono::steady_clock::now();
   vision::PdfLimits limits = pdf_limits_from(s);
   limits.fault = fault;
-  const vision::PdfPage pg = vision::render_pdf_page(bytes, name, page, limits);
+  limits.text_layer_max_side_px = std::max(text_layer_side_px, 0);
+  vision::PdfPage pg = vision::render_pdf_page(bytes, name, page, limits);
+  std::string why;
+  if (pg.screen_sized && wants_page_text(pg, s, why)) {  // the layer leaves text out: OCR reads the page at the full budget
+    limits.text_layer_max_side_px = 0;
+    pg = vision::render_pdf_page(bytes, name, page, limits);
+  }
   const double render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   ImageScene is = build_page_scene(pg, name, page, s, timing);
   is.times.load_ms += render_ms;

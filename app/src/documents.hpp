@@ -55,9 +55,14 @@ nlohmann::json stick_listing_json(const StickListing& listing);
 /// Builds the scene of page `page` (from 1) of the PDF held in `bytes`, named `name`: drawn in the worker
 /// (vision::render_pdf_page with the [stick] limits), then build_page_scene (text masked, kept as blocks).
 /// The drawing time is added to times.load_ms. `timing` as build_page_scene's.
+/// `text_layer_side_px` > 0: a page with a text layer is drawn with its long side at most this [px] (the
+/// screen's picture side; vision::PdfLimits::text_layer_max_side_px), which takes a fraction of the full
+/// budget's drawing. When that page's layer leaves its text out (wants_page_text), it is drawn again at the
+/// full budget, for OCR. 0: every page at the full budget (explore, whose outputs keep the page's detail).
 /// @throws vision::PdfError (one line: not a PDF, locked, damaged, no such page, worker stopped).
 /// `fault` is the worker's test hook (vision::PdfFault): None outside tests.
 ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
-                                vision::PdfFault fault = vision::PdfFault::None, TextTiming timing = TextTiming::now);
+                                vision::PdfFault fault = vision::PdfFault::None, TextTiming timing = TextTiming::now,
+                                int text_layer_side_px = 0);
 
 }  // namespace hk::app

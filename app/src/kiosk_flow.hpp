@@ -233,6 +233,10 @@ class KioskFlow {
   int document() const { return v_.doc; }        ///< stick document shown (0-based), −1 before the first
   int page() const { return v_.page; }           ///< its page (from 1)
   bool loading() const { return v_.pending_doc >= 0; }  ///< a document load is awaited
+  /// Whether page `page` of stick document `document` is the load awaited (else a result for it is superseded).
+  bool awaits_document(int document, int page) const {
+    return v_.source == KioskSource::Stick && v_.pending_doc == document && v_.pending_page == page;
+  }
 
   KioskState state() const { return v_.state; }
   TutorialShape tutorial_shape() const { return v_.shape; }

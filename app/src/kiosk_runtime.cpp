@@ -705,6 +705,7 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
       stick_busy_ = false;
       continue;
     }
+    if (!flow.awaits_document(d.document, d.page)) continue;  // superseded by a later Next or Previous: never on the device
     DocumentResult r;
     r.document = d.document;
     r.page = d.page;
@@ -887,6 +888,7 @@ int KioskRuntime::find_picture(const std::string& path) const {
 CueTrackerParams KioskRuntime::cue_params() const { return cue_params_from(s_); }
 
 void KioskRuntime::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes) {
+  ++scenes_published_;
   const Scene& sc = *scene;
   sh.levels.resize(sc.curve_count());
   sh.closed.resize(sc.curve_count());

@@ -223,6 +223,8 @@ class KioskRuntime final : public KioskEffects {
   bool finish_picture(KioskFlow* flow, double now_s, double timeout_s = 60.0);
   /// Scene builds started since the start (asked for and built ahead): what the visitor's keys cost.
   std::uint64_t scene_builds() const { return builder_.builds_started(); }
+  /// Scenes put on the device so far (publish): what tests count to see that a superseded page never was.
+  std::uint64_t scenes_published() const { return scenes_published_; }
   /// The longest side the screen shows a picture at [px] (the kiosk's window: picture_side_px), clamped to
   /// [256, kScreenPictureMaxSidePx] (the default). Pictures built after this call (library, stick pages, text
   /// read) are shrunk to it on their workers (fit_picture). Window thread.
@@ -359,6 +361,7 @@ class KioskRuntime final : public KioskEffects {
   std::string last_said_;
   std::string repeatable_;  // the last text given to say(), for Repeat
   int shown_id_ = -100;
+  std::uint64_t scenes_published_ = 0;
   int shown_picture_ = -1;  // library index shown, −1 for none
   int shown_page_ = 0;      // a document page shown (from 1), 0 for a picture
   int screen_side_px_ = kScreenPictureMaxSidePx;  // set_screen_picture_side_px

@@ -65,6 +65,7 @@ void StickService::load(int stick, int document, int page) {
     const Request r{stick, document, page};
     at_ = r;
     request_.reset();
+    building_wanted_.reset();  // a build ahead asked for before this is no longer wanted
     // Kept: the neighbours of the page asked for; the page itself, built ahead, goes to the visitor.
     const std::vector<Request> near = neighbours();
     std::vector<AheadPage> kept;
@@ -129,12 +130,17 @@ std::vector<StickService::Request> StickService::neighbours() const {
   return out;
 }
 
-std::optional<StickService::Request> StickService::next_ahead() const {
-  const std::size_t budget = static_cast<std::size_t>(s_.kiosk.prefetch_mb) << 20;
-  if (budget == 0) return std::nullopt;
+std::size_t StickService::ahead_budget_bytes() const { return static_cast<std::size_t>(s_.kiosk.prefetch_mb) << 20; }
+
+std::size_t StickService::ahead_bytes() const {
   std::size_t used = 0;
   for (const AheadPage& a : ahead_) used += a.bytes;
-  if (used >= budget) return std::nullopt;
+  return used;
+}
+
+std::optional<StickService::Request> StickService::next_ahead() const {
+  const std::size_t budget = ahead_budget_bytes();
+  if (budget == 0 || ahead_bytes() >= budget) return std::nullopt;
   for (const Request& r : neighbours()) {
     const bool have = std::any_of(ahead_.begin(), ahead_.end(), [&](const AheadPage& a) { return a.at == r; });
     const bool refused = std::find(ahead_refused_.begin(), ahead_refused_.end(), r) != ahead_refused_.end();
@@ -151,11 +157,8 @@ void StickService::keep_ahead(const Request& r, LoadedDocument d, std::uint64_t 
     ahead_refused_.push_back(r);
     return;
   }
-  const std::size_t budget = static_cast<std::size_t>(s_.kiosk.prefetch_mb) << 20;
-  std::size_t used = 0;
-  for (const AheadPage& a : ahead_) used += a.bytes;
   const std::size_t bytes = approx_scene_bytes(*d.scene);
-  if (used + bytes > budget) {
+  if (ahead_bytes() + bytes > ahead_budget_bytes()) {
     spdlog::info("stick {}: page {} of document {} ({} MiB) is over [kiosk] prefetch_mb; built when asked for", r.stick, r.page, r.document + 1,
                  bytes >> 20);
     ahead_refused_.push_back(r);
@@ -329,9 +332,11 @@ LoadedDocument StickService::build(const Request& r, bool ahead) {
   try {
     const std::vector<std::uint8_t> bytes = vision::read_stick_file(root, doc.doc.path, s.stick.max_file_bytes);
     (ahead ? ahead_started_ : loads_started_).fetch_add(1);
-    out.scene = doc.doc.kind == vision::DocumentKind::Pdf ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s, pdf_fault_.load(), TextTiming::later)
-                                                          : build_image_scene_from_bytes(bytes, doc.doc.display_name, s, TextTiming::later);
-    if (out.scene) fit_picture(*out.scene, screen_side_px_.load());  // the screen's copy, made here rather than on the window thread
+    const int side_px = screen_side_px_.load();
+    out.scene = doc.doc.kind == vision::DocumentKind::Pdf
+                    ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s, pdf_fault_.load(), TextTiming::later, side_px)
+                    : build_image_scene_from_bytes(bytes, doc.doc.display_name, s, TextTiming::later);
+    if (out.scene) fit_picture(*out.scene, side_px);  // the screen's copy, made here rather than on the window thread
   } catch (const std::exception& e) {  // InputError, PdfError, StickError: this page only
     spdlog::warn("stick {}: {}", r.stick, e.what());
     out.reason = problem_of(e.what());

@@ -116,6 +116,10 @@ class StickService {
   };
   void watch();
   void serve();
+  /// [kiosk] prefetch_mb [bytes] (m_ held).
+  std::size_t ahead_budget_bytes() const;
+  /// What the pages built ahead hold [bytes] (m_ held; approx_scene_bytes each).
+  std::size_t ahead_bytes() const;
   /// The page to build ahead next, if any (m_ held): a neighbour of at_ not built, not refused, within budget.
   std::optional<Request> next_ahead() const;
   /// The pages Next and Previous lead to from at_ (m_ held; empty when at_ is not a page of the current stick).

@@ -534,7 +534,7 @@ TEST(StickService, NextAndPreviousPagesAreBuiltAheadAndHandedOverAtOnce) {
 
 // A request for the page being built ahead takes that build over (no second build), and a page that cannot
 // be drawn is said as for any request; a stick taken out drops its pages built ahead.
-TEST(StickService, ARequestForThePageBeingBuiltAheadTakesItOver) {
+TEST(StickService, ARequestForThePageBeingBuiltAheadTakesItOverUntilAnotherIsAsked) {
   const fs::path dir = fresh_dir("service_takeover");
   config::Settings s = test_settings();
   s.stick.page_timeout_s = 3.0;  // the hanging worker below is stopped after this
@@ -557,6 +557,16 @@ TEST(StickService, ARequestForThePageBeingBuiltAheadTakesItOver) {
   EXPECT_FALSE(got[0].scene.has_value()) << "the hanging page is unreadable";
   EXPECT_FALSE(got[0].reason.empty());
   EXPECT_EQ(svc.loads_started(), 1) << "the request took the build ahead over instead of starting its own";
+
+  // Next to page 2 takes its build ahead over; Previous back to the picture before that build ends leaves
+  // page 2 unwanted: only the picture comes.
+  ASSERT_TRUE(wait_until([&] { return svc.ahead_started() >= 2; })) << "page 2 is built ahead, hanging";
+  svc.load(stick, 1, 2);
+  svc.load(stick, 0, 1);
+  got = wait_for([&] { return svc.poll_loaded(); });
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].document, 0) << "page " << got[0].page << " of document " << got[0].document << " was handed over after it was passed by";
+  EXPECT_TRUE(got[0].scene.has_value()) << got[0].reason;
 
   svc.set_pdf_fault(vision::PdfFault::None);
   ASSERT_TRUE(wait_until([&] { return svc.pages_ahead() >= 1; })) << "the neighbours of page 1 are built ahead";

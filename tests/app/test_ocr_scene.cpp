@@ -16,10 +16,12 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "documents.hpp"
 #include "image_pdf.hpp"
 #include "image_scene.hpp"
 #include "kiosk_exe.hpp"
 #include "scans.hpp"
+#include "settings_params.hpp"
 #include "vision/pdf.hpp"
 
 namespace fs = std::filesystem;
@@ -130,6 +132,49 @@ TEST(OcrScene, TheSameScanInAnImageOnlyPdfGivesTheSameText) {
   EXPECT_GE(test::word_recall(test::words_of(all_text(from_jpeg)), test::words_of(all_text(from_pdf))), 0.93);  // measured 0.96
   EXPECT_GE(test::word_recall(r.truth, test::words_of(all_text(from_pdf))), 0.9);
   for (const TextBlockM& b : from_pdf.text_blocks) EXPECT_EQ(b.source, "ocr");
+}
+
+TEST(OcrScene, AStickPageIsDrawnAtTheScreenSideUnlessItsTextLayerLeavesTextForOcr) {
+  constexpr int kSide = 1037;  // the picture side of a 1920 x 1080 screen
+  const config::Settings s = reading();
+  // A page whose text layer is its text: drawn at the screen side, with the blocks and the decision the
+  // full drawing gives.
+  const std::vector<std::uint8_t> spec = [] {
+    std::ifstream f(kSpec, std::ios::binary);
+    return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(f), {});
+  }();
+  const ImageScene small = build_pdf_page_scene(spec, "spec.pdf", kPage, s, vision::PdfFault::None, TextTiming::later, kSide);
+  const ImageScene full = build_pdf_page_scene(spec, "spec.pdf", kPage, s, vision::PdfFault::None, TextTiming::later, 0);
+  EXPECT_EQ(std::max(small.file_width_px, small.file_height_px), kSide);
+  EXPECT_GT(std::max(full.file_width_px, full.file_height_px), 2000);
+  EXPECT_EQ(small.ocr.why, "a text layer");
+  EXPECT_EQ(full.ocr.why, "a text layer");
+  EXPECT_FALSE(small.text_pending);
+  ASSERT_EQ(small.text_blocks.size(), full.text_blocks.size());
+  for (std::size_t i = 0; i < full.text_blocks.size(); ++i) {
+    SCOPED_TRACE(full.text_blocks[i].text);
+    EXPECT_EQ(small.text_blocks[i].text, full.text_blocks[i].text);
+    EXPECT_NEAR(small.text_blocks[i].lo_m.x, full.text_blocks[i].lo_m.x, 1e-3);
+    EXPECT_NEAR(small.text_blocks[i].lo_m.y, full.text_blocks[i].lo_m.y, 1e-3);
+    EXPECT_NEAR(small.text_blocks[i].hi_m.x, full.text_blocks[i].hi_m.x, 1e-3);
+    EXPECT_NEAR(small.text_blocks[i].hi_m.y, full.text_blocks[i].hi_m.y, 1e-3);
+  }
+
+  // A scan whose text layer is one stamped line: the layer covers little, so the page is drawn again at the
+  // full budget and its text is left for OCR.
+  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  ScanRig r;
+  const cv::Mat grey = cv::imdecode(r.jpeg, cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(grey.empty());
+  const std::string pdf = test::image_only_pdf(r.jpeg, grey.cols, grey.rows, kDpi, "Scanned at the library");
+  const std::vector<std::uint8_t> bytes(pdf.begin(), pdf.end());
+  const ImageScene scan = build_pdf_page_scene(bytes, "scan.pdf", 1, s, vision::PdfFault::None, TextTiming::later, kSide);
+  EXPECT_EQ(scan.ocr.why, "text layer covers little of the text");
+  EXPECT_TRUE(scan.text_pending);
+  const vision::PdfPage drawn = vision::render_pdf_page(bytes, "scan.pdf", 1, pdf_limits_from(s));
+  EXPECT_EQ(scan.file_width_px, drawn.grey.cols);
+  EXPECT_EQ(scan.file_height_px, drawn.grey.rows);
+  EXPECT_GT(std::max(scan.file_width_px, scan.file_height_px), kSide);
 }
 
 TEST(OcrScene, APdfWithATextLayerKeepsItsOwnText) {

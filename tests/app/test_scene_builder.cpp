@@ -339,6 +339,39 @@ TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibr
   fs::remove_all(stick);
 }
 
+TEST(KioskBuilds, StickPagesPassedByQuicklyAreNeverPutOnTheDevice) {
+  LibraryRig r({"horse.png"}, 0, "stickquick");  // prefetch_mb 0: each page is built when asked for
+  const fs::path stick = r.lib.parent_path() / ("hk_builder_stickquick_" + std::to_string(::getpid()));
+  fs::remove_all(stick);
+  fs::create_directories(stick);
+  fs::copy_file(kData / "documents" / "shared-mime-info-spec.pdf", stick / "spec.pdf");
+  r.flow->key(KioskKey::Other, 0.0);
+  r.rt->insert_stick_folder(stick.string());
+  double now_s = 1.0;
+  for (int i = 0; i < 6000 && r.rt->shown_id() != 1001; ++i, now_s += 0.01) {
+    r.rt->poll_sticks(*r.flow, now_s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(r.rt->shown_id(), 1001) << "the stick's first page is felt";
+  const std::uint64_t published = r.rt->scenes_published();
+  const int loads = r.rt->sticks().loads_started();
+  r.flow->key(KioskKey::Next, now_s);  // page 2...
+  for (int i = 0; i < 6000 && r.rt->sticks().loads_started() == loads; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_EQ(r.rt->sticks().loads_started(), loads + 1) << "page 2 is being drawn";
+  for (int i = 0; i < 2; ++i) r.flow->key(KioskKey::Next, now_s);  // ...then pages 3 and 4 before it is done
+  for (int i = 0; i < 6000 && r.rt->shown_id() != 1004; ++i, now_s += 0.01) {
+    r.rt->poll_sticks(*r.flow, now_s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(r.rt->shown_id(), 1004);
+  for (int i = 0; i < 50; ++i, now_s += 0.01) r.rt->poll_sticks(*r.flow, now_s);
+  EXPECT_EQ(r.rt->scenes_published() - published, 1u) << "page 2, drawn before Next was pressed again, was dropped, not shown";
+  EXPECT_EQ(r.rt->shown_id(), 1004);
+  EXPECT_EQ(r.rt->last_said().rfind("Page 4 of ", 0), 0u) << r.rt->last_said();
+  EXPECT_EQ(r.flow->failures(), 0);
+  fs::remove_all(stick);
+}
+
 TEST(KioskBuilds, APictureThatCannotBeReadIsSaidAndTheOldOneStays) {
   LibraryRig r({"horse.png", "coins.png", "apple.jpg"}, 0, "bad");
   {  // the second picture is cut short, as a copy to a stick pulled too soon leaves it

@@ -19,6 +19,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "image_pdf.hpp"
 #include "vision/pdf.hpp"
 
 namespace hk::vision {
@@ -163,6 +164,68 @@ TEST(PdfDocuments, HorsePageAtThePngResolutionMatchesThePng) {
   cv::Mat diff;
   cv::absdiff(p.grey, png, diff);
   EXPECT_LT(cv::mean(diff)[0], 2.0);  // the same picture, resampled by poppler at scale 1
+}
+
+TEST(PdfDocuments, APageWithATextLayerIsDrawnAtTheScreenSideWithTheSameWordsInItsFrame) {
+  const auto bytes = read_file(kSpec);
+  const PdfPage full = render_pdf_page(bytes, "spec", 3, generous());
+  PdfLimits screen = generous();
+  screen.text_layer_max_side_px = 1000;
+  const PdfPage small = render_pdf_page(bytes, "spec", 3, screen);
+  ASSERT_GT(full.words.size(), 50u);
+  EXPECT_FALSE(full.screen_sized);
+  EXPECT_TRUE(small.screen_sized);
+  // The highest DPI whose long side stays within 1000 whole pixels.
+  const double side_pt = std::max(full.width_pt, full.height_pt);
+  EXPECT_NEAR(small.dpi, 72.0 * 1000.0 / side_pt, 0.01);
+  EXPECT_LE(std::max(small.grey.cols, small.grey.rows), 1000);
+  EXPECT_GE(std::max(small.grey.cols, small.grey.rows), 999);
+  EXPECT_LT(small.dpi, full.dpi);
+  // The same words, their boxes the full drawing's scaled by the ratio of the DPIs.
+  ASSERT_EQ(small.words.size(), full.words.size());
+  const double k = small.dpi / full.dpi;
+  for (std::size_t i = 0; i < full.words.size(); ++i) {
+    SCOPED_TRACE(full.words[i].text);
+    EXPECT_EQ(small.words[i].text, full.words[i].text);
+    EXPECT_NEAR(small.words[i].box_px.x, k * full.words[i].box_px.x, 0.5);
+    EXPECT_NEAR(small.words[i].box_px.y, k * full.words[i].box_px.y, 0.5);
+    EXPECT_NEAR(small.words[i].box_px.width, k * full.words[i].box_px.width, 1.0);
+    EXPECT_NEAR(small.words[i].box_px.height, k * full.words[i].box_px.height, 1.0);
+  }
+  ASSERT_EQ(small.blocks.size(), full.blocks.size());
+  for (std::size_t i = 0; i < full.blocks.size(); ++i) EXPECT_EQ(small.blocks[i].text, full.blocks[i].text);
+
+  // A side the budget already keeps to draws the page as the budget does.
+  screen.text_layer_max_side_px = 1e5;
+  const PdfPage roomy = render_pdf_page(bytes, "spec", 3, screen);
+  EXPECT_FALSE(roomy.screen_sized);
+  EXPECT_EQ(roomy.dpi, full.dpi);
+  EXPECT_EQ(roomy.grey.size(), full.grey.size());
+}
+
+TEST(PdfDocuments, APageWithoutATextLayerIsDrawnAtTheFullBudgetForOcr) {
+  const cv::Mat horse = cv::imread(kData + "/images/horse.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(horse.empty());
+  std::vector<std::uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", horse, jpeg));
+  const std::string pdf = test::image_only_pdf(jpeg, horse.cols, horse.rows, 72.0);
+  const std::vector<std::uint8_t> bytes(pdf.begin(), pdf.end());
+  PdfLimits screen = generous();
+  screen.text_layer_max_side_px = 100;
+  const PdfPage p = render_pdf_page(bytes, "scan.pdf", 1, screen);
+  const PdfPage full = render_pdf_page(bytes, "scan.pdf", 1, generous());
+  EXPECT_TRUE(p.words.empty());
+  EXPECT_FALSE(p.screen_sized);
+  EXPECT_EQ(p.dpi, full.dpi);
+  EXPECT_EQ(p.grey.size(), full.grey.size());
+  EXPECT_GT(std::max(p.grey.cols, p.grey.rows), 1000) << "the full budget, not the side asked for pages with a text layer";
+
+  // The same scan with a one-line text layer is drawn at the side: the layer is what decides.
+  const std::string captioned = test::image_only_pdf(jpeg, horse.cols, horse.rows, 72.0, "Scanned at the library");
+  const PdfPage c = render_pdf_page(std::vector<std::uint8_t>(captioned.begin(), captioned.end()), "captioned.pdf", 1, screen);
+  EXPECT_EQ(c.words.size(), 4u);
+  EXPECT_TRUE(c.screen_sized);
+  EXPECT_LE(std::max(c.grey.cols, c.grey.rows), 100);
 }
 
 TEST(PdfText, ParagraphPageBlocksGiveThePdftotextWords) {

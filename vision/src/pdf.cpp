@@ -183,6 +183,15 @@ double page_dpi(PageSize size, const PdfLimits& limits, const std::string& pname
   return dpi;
 }
 
+/// The resolution to draw a page with a text layer at when text_layer_max_side_px asks: the highest that keeps
+/// its long side within that many whole pixels, but never above `full` (the budget's) nor below 1 dpi.
+double text_layer_dpi(PageSize size, double full, const PdfLimits& limits) {
+  const double side_pt = std::max(size.w_pt, size.h_pt);
+  double dpi = std::min(full, 72.0 * limits.text_layer_max_side_px / side_pt);
+  for (int i = 0; i < 100 && std::ceil(side_pt * dpi / 72.0) > limits.text_layer_max_side_px; ++i) dpi *= 0.999;
+  return std::max(dpi, std::min(full, 1.0));
+}
+
 /// The page drawn in grey at `dpi`, checked: refused as Damaged when not drawn, as TooLarge when poppler
 /// returned another size than asked (Splash answers a failed bitmap allocation under RLIMIT_AS with a
 /// 1 x 1 picture) or more pixels than the budget.
@@ -203,13 +212,13 @@ cv::Mat render_checked(const poppler::page& pg, PageSize size, double dpi, const
   return grey;
 }
 
-/// Writes the page's words to `out`: their count, then each word's text (at most kMaxWordBytes), box in
+/// Writes the page's words (`text`, its page::text_list) to `out`: their count, then each word's text (at most kMaxWordBytes), box in
 /// the drawn page's pixels (pt × k, clipped to `frame`; words with nothing visible dropped) and whether a
 /// space follows it; at most kMaxWords words and about kMaxTextBytes bytes.
-void write_words(const poppler::page& pg, double k, const cv::Rect2d& frame, Writer& out) {
+void write_words(const std::vector<poppler::text_box>& text, double k, const cv::Rect2d& frame, Writer& out) {
   Writer words;
   std::uint32_t count = 0;
-  for (const poppler::text_box& tb : pg.text_list()) {
+  for (const poppler::text_box& tb : text) {
     if (count >= kMaxWords || words.bytes().size() > kMaxTextBytes) break;
     const poppler::byte_array utf8 = tb.text().to_utf8();
     std::string text(utf8.begin(), utf8.end());
@@ -232,7 +241,7 @@ void write_words(const poppler::page& pg, double k, const cv::Rect2d& frame, Wri
 }
 
 /// The worker's work: an answer in `out` (page 0: the page count and title; else those, the page's size
-/// [pt], dpi, grey picture and words), or a Refusal thrown.
+/// [pt], dpi, whether it was drawn screen-sized, grey picture and words), or a Refusal thrown.
 void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits, Writer& out) {
   std::unique_ptr<poppler::document> doc(
       poppler::document::load_from_raw_data(reinterpret_cast<const char*>(bytes.data()), static_cast<int>(bytes.size())));
@@ -250,7 +259,10 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   const std::string pname = "page " + std::to_string(page);
   if (!pg) throw Refusal{PdfError::Kind::Damaged, pname + " cannot be read"};
   const PageSize size = page_size(*pg, pname);
-  const double dpi = page_dpi(size, limits, pname);
+  const std::vector<poppler::text_box> text = pg->text_list();
+  const double full_dpi = page_dpi(size, limits, pname);
+  const bool screen_sized = !text.empty() && limits.text_layer_max_side_px > 0;
+  const double dpi = screen_sized ? text_layer_dpi(size, full_dpi, limits) : full_dpi;
   const cv::Mat grey = render_checked(*pg, size, dpi, limits, pname);
 
   out.i32(n);
@@ -258,10 +270,11 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   out.f64(size.w_pt);
   out.f64(size.h_pt);
   out.f64(dpi);
+  out.u8(screen_sized && dpi < full_dpi ? 1 : 0);
   out.i32(grey.cols);
   out.i32(grey.rows);
   for (int y = 0; y < grey.rows; ++y) out.raw(grey.ptr(y), static_cast<std::size_t>(grey.cols));
-  write_words(*pg, dpi / 72.0, cv::Rect2d(0, 0, grey.cols, grey.rows), out);
+  write_words(text, dpi / 72.0, cv::Rect2d(0, 0, grey.cols, grey.rows), out);
 }
 
 /// Everything the worker does once its document is mapped; never returns.
@@ -293,6 +306,7 @@ WorkerRun run_pdf_worker(std::span<const std::uint8_t> bytes, int page, const Pd
                                       std::to_string(limits.max_pages),
                                       worker::arg(limits.max_page_pixels),
                                       worker::arg(limits.max_dpi),
+                                      worker::arg(limits.text_layer_max_side_px),
                                       worker::arg(limits.worker_cpu_s),
                                       worker::arg(limits.worker_max_memory_mb),
                                       std::to_string(static_cast<int>(limits.fault)),
@@ -334,7 +348,7 @@ std::string doing(int page) { return page == 0 ? "opening the document" : "page 
 /// Checks what every caller checks before starting a worker.
 void check_input(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits) {
   if (!(limits.max_file_bytes > 0 && limits.max_pages > 0 && limits.max_page_pixels > 0 && limits.max_dpi > 0 && limits.worker_cpu_s > 0 &&
-        limits.worker_wall_s > 0 && limits.worker_max_memory_mb >= 0)) {
+        limits.worker_wall_s > 0 && limits.worker_max_memory_mb >= 0 && limits.text_layer_max_side_px >= 0)) {
     throw hk::ArgumentError("PdfLimits: every limit must be positive");
   }
   if (bytes.empty()) fail(PdfError::Kind::NotPdf, name, "the file is empty");
@@ -377,17 +391,18 @@ bool looks_like_pdf(std::span<const std::uint8_t> bytes) {
 }
 
 int pdf_worker_entry(int argc, char** argv) {
-  if (argc != 9) return 64;
+  if (argc != 10) return 64;
   PdfLimits limits;
   const int page = std::atoi(argv[1]);
   limits.max_pages = std::atoi(argv[2]);
   limits.max_page_pixels = std::strtod(argv[3], nullptr);
   limits.max_dpi = std::strtod(argv[4], nullptr);
-  limits.worker_cpu_s = std::strtod(argv[5], nullptr);
-  limits.worker_max_memory_mb = std::strtod(argv[6], nullptr);
-  const int fault = std::atoi(argv[7]);
+  limits.text_layer_max_side_px = std::strtod(argv[5], nullptr);
+  limits.worker_cpu_s = std::strtod(argv[6], nullptr);
+  limits.worker_max_memory_mb = std::strtod(argv[7], nullptr);
+  const int fault = std::atoi(argv[8]);
   limits.fault = fault == 1 ? PdfFault::Crash : fault == 2 ? PdfFault::Hang : PdfFault::None;
-  const auto size = static_cast<std::size_t>(std::strtoull(argv[8], nullptr, 10));
+  const auto size = static_cast<std::size_t>(std::strtoull(argv[9], nullptr, 10));
   const std::span<const std::uint8_t> bytes = worker::map_input(size);
   if (bytes.empty()) return 65;
   worker_main(bytes, page, limits);
@@ -417,12 +432,15 @@ PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& 
   Reader in(run.answer);
   read_head(in, run, name, page, limits);
   std::int32_t n = 0, w = 0, h = 0;
+  std::uint8_t screen_sized = 0;
   PdfPage out;
-  if (!in.i32(n) || n < page || !in.str(out.title, kMaxPdfTitleBytes) || !in.f64(out.width_pt) || !in.f64(out.height_pt) || !in.f64(out.dpi) || !in.i32(w) || !in.i32(h) || w <= 0 ||
+  if (!in.i32(n) || n < page || !in.str(out.title, kMaxPdfTitleBytes) || !in.f64(out.width_pt) || !in.f64(out.height_pt) || !in.f64(out.dpi) ||
+      !in.u8(screen_sized) || screen_sized > 1 || (screen_sized == 1 && !(limits.text_layer_max_side_px > 0)) || !in.i32(w) || !in.i32(h) || w <= 0 ||
       h <= 0 || static_cast<double>(w) * h > limits.max_page_pixels || !(out.dpi > 0 && out.dpi <= limits.max_dpi) ||
       std::abs(w - out.width_pt * out.dpi / 72.0) > 2.0 || std::abs(h - out.height_pt * out.dpi / 72.0) > 2.0) {
     fail_run(run, name, page, limits);
   }
+  out.screen_sized = screen_sized == 1;
   out.grey.create(h, w, CV_8UC1);
   for (int y = 0; y < h; ++y) {
     if (!in.raw(out.grey.ptr(y), static_cast<std::size_t>(w))) fail_run(run, name, page, limits);

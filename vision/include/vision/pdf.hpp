@@ -12,8 +12,9 @@
 ///
 /// Order inside the worker: poppler::document::load_from_raw_data, then is_locked() before anything
 /// else (a locked document crashes pages() in Debian 12's poppler 22.12), then the page count (capped),
-/// then the page: rendered in grey (poppler::page_renderer, antialiasing on) at the DPI that keeps the
-/// page within the pixel budget, and its words (page::text_list) in the same pixel frame.
+/// then the page: its words (page::text_list), then the page rendered in grey (poppler::page_renderer,
+/// antialiasing on) at the DPI that keeps it within the pixel budget (or, with words and
+/// text_layer_max_side_px set, within that side), the words put in the same pixel frame.
 
 #include "hk/error.hpp"
 #include <cstdint>
@@ -34,13 +35,18 @@ enum class PdfFault {
   Hang,   ///< the worker spins on the CPU forever (until RLIMIT_CPU or the wall-clock kill)
 };
 
-/// Limits of PDF work. Defaults are the config's (`[stick]`). All must be positive (worker_max_memory_mb
+/// Limits of PDF work. Defaults are the config's (`[stick]`). All must be positive (worker_max_memory_mb and text_layer_max_side_px
 /// may be 0).
 struct PdfLimits {
   std::int64_t max_file_bytes = 200LL << 20;  ///< largest PDF [bytes]
   int max_pages = 1000;                       ///< pages offered; a longer document offers its first max_pages
   double max_page_pixels = 4e6;               ///< render budget [px]: DPI chosen so width x height <= this
   double max_dpi = 300.0;                     ///< never rendered finer than this [dots per inch]
+  /// A page with a text layer (poppler finds words on it) is drawn with its long side at most this [px],
+  /// below the budget's DPI, never above it: the size a screen shows it, since its text comes from the layer
+  /// and not from OCR, which wants every pixel. A page without words is drawn at the full budget. 0 = always
+  /// the full budget.
+  double text_layer_max_side_px = 0.0;
   double worker_cpu_s = 5.0;                  ///< RLIMIT_CPU of the worker [s]
   double worker_wall_s = 5.0;                 ///< the worker is killed after this wall-clock time [s]
   /// Address space the worker may add to its size at start [MiB] (RLIMIT_AS, set in the worker to its size
@@ -91,6 +97,9 @@ struct TextBlock {
 struct PdfPage {
   cv::Mat grey;                   ///< CV_8UC1, the page on white
   double dpi = 0.0;               ///< the DPI it was rendered at
+  /// Drawn smaller than the budget allows, for its text layer (PdfLimits::text_layer_max_side_px). Reading
+  /// text the layer leaves out needs the page drawn again at the full budget.
+  bool screen_sized = false;
   double width_pt = 0, height_pt = 0;  ///< page size [pt] (1/72 inch), after its rotation
   std::vector<PdfWord> words;     ///< every word on the page, in poppler's reading order
   std::vector<TextBlock> blocks;  ///< words grouped (group_text_blocks)
@@ -123,7 +132,8 @@ PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, 
 
 /// Renders page `page` (from 1) in a worker: grey, at dpi = min(max_dpi, 72 · sqrt(max_page_pixels /
 /// (width_pt · height_pt))) (lowered by a fraction of a percent when rounding up to whole pixels would
-/// overshoot the budget), with its words and text blocks.
+/// overshoot the budget), or lower for a page with a text layer when text_layer_max_side_px asks
+/// (PdfPage::screen_sized), with its words and text blocks.
 /// @throws PdfError as probe_pdf, plus NoSuchPage (page outside [1, pages offered]) and TooLarge (a page so
 ///         large that even 1 DPI would exceed the budget). Timeout: the worker outlived worker_wall_s or
 ///         used up worker_cpu_s; WorkerCrashed: it died (a signal, or an exit without an answer).
@@ -142,7 +152,7 @@ bool looks_like_pdf(std::span<const std::uint8_t> bytes);
 
 /// Entry point of the worker executable (vision/worker/pdf_worker_main.cpp), not for other callers: maps the
 /// document from descriptor 3, limits itself, runs poppler for the request in argv (page, max_pages,
-/// max_page_pixels, max_dpi, worker_cpu_s, worker_max_memory_mb, fault, document size), writes the answer
+/// max_page_pixels, max_dpi, text_layer_max_side_px, worker_cpu_s, worker_max_memory_mb, fault, document size), writes the answer
 /// to descriptor 4 and exits. Returns 64-66 (never reaching poppler) for a malformed request.
 int pdf_worker_entry(int argc, char** argv);
 
