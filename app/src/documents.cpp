@@ -100,18 +100,25 @@ nlohmann::json stick_listing_json(const StickListing& l) {
 
 ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
                                 vision::PdfFault fault, TextTiming timing, int text_layer_side_px) {
-  const auto t0 = std::chrono::steady_clock::now();
   vision::PdfLimits limits = pdf_limits_from(s);
   limits.fault = fault;
   limits.text_layer_max_side_px = std::max(text_layer_side_px, 0);
-  vision::PdfPage pg = vision::render_pdf_page(bytes, name, page, limits);
-  std::string why;
-  if (pg.screen_sized && wants_page_text(pg, s, why)) {  // the layer leaves text out: OCR reads the page at the full budget
+  double render_ms = 0;
+  const auto draw = [&] {
+    const auto t0 = std::chrono::steady_clock::now();
+    vision::PdfPage drawn = vision::render_pdf_page(bytes, name, page, limits);
+    render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return drawn;
+  };
+  vision::PdfPage pg = draw();
+  PageTextChoice text;
+  text.read = wants_page_text(pg, s, text.why);
+  if (pg.screen_sized && text.read) {  // the layer leaves text out: OCR reads the page drawn at the full budget
     limits.text_layer_max_side_px = 0;
-    pg = vision::render_pdf_page(bytes, name, page, limits);
+    pg = draw();
+    text.read = wants_page_text(pg, s, text.why);
   }
-  const double render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  ImageScene is = build_page_scene(pg, name, page, s, timing);
+  ImageScene is = build_page_scene(pg, name, page, s, timing, &text);
   is.times.load_ms += render_ms;
   is.render_dpi = pg.dpi;
   is.worker_ms = pg.worker_ms;

@@ -229,13 +229,22 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
 }
 
 /// The scene of a rendered document page (see build_page_scene).
-void build_page(ImageScene& out, const vision::PdfPage& page, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel) {
+/// `choice`: wants_page_text's answer when the caller has it, else null (judged here).
+void build_page(ImageScene& out, const vision::PdfPage& page, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel,
+                const PageTextChoice* choice) {
   cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
   out.file_width_px = page.grey.cols;
   out.file_height_px = page.grey.rows;
   vision::OcrResult text;
   cv::Mat letters;  // printed letters, kept out whether OCR reads them or not
-  if (wants_page_text(page, s, out.ocr.why)) {
+  bool wanted = false;
+  if (choice) {
+    wanted = choice->read;
+    out.ocr.why = choice->why;
+  } else {
+    wanted = wants_page_text(page, s, out.ocr.why);
+  }
+  if (wanted) {
     letters = printed_letters_mask_of(page.grey);
     if (timing == TextTiming::now) {
       text = read_text(page.grey, out.image_path, s, out.ocr, cancel);
@@ -247,7 +256,7 @@ void build_page(ImageScene& out, const vision::PdfPage& page, const config::Sett
         again.image_path = name;
         again.page = number;
         again.pages = kept->pages;
-        build_page(again, *kept, s, TextTiming::now, stop);
+        build_page(again, *kept, s, TextTiming::now, stop, nullptr);
         return again;
       };
     }
@@ -447,12 +456,13 @@ bool wants_page_text(const vision::PdfPage& page, const config::Settings& s, std
   return little;
 }
 
-ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& s, TextTiming timing) {
+ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& s, TextTiming timing,
+                            const PageTextChoice* choice) {
   ImageScene out;
   out.image_path = name;
   out.page = page_number;
   out.pages = page.pages;
-  build_page(out, page, s, timing, nullptr);
+  build_page(out, page, s, timing, nullptr, choice);
   return out;
 }
 

@@ -215,6 +215,12 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
 ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& settings,
                                           TextTiming timing = TextTiming::now);
 
+/// wants_page_text's answer for a page: whether its text is read from its pixels, and why.
+struct PageTextChoice {
+  bool read = false;
+  std::string why;  ///< in OcrReport::why's words
+};
+
 /// Builds the scene of a rendered document page the way build_image_scene builds a picture's, except that
 /// text is spoken, not felt: its words (the text layer's, or OCR's when wants_page_text) each have their box,
 /// grown by a quarter of its height on each side (the blurred glyphs' edges reach past the box), masked from
@@ -224,8 +230,10 @@ ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string&
 /// `timing` later: OCR's words are not read here (ImageScene::text_pending, with_text); meanwhile the text
 /// layer's words and the letters of printed lines are masked.
 /// @param name  the document's name for scene.json and messages (image_path).
+/// @param choice  wants_page_text's answer for this page when the caller has it, so the page is not judged
+///        twice; null: judged here.
 ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& settings,
-                            TextTiming timing = TextTiming::now);
+                            TextTiming timing = TextTiming::now, const PageTextChoice* choice = nullptr);
 
 /// The mask of a page's text for vision::extract_chains_from_image: CV_8UC1 of `size`, 255 inside each
 /// word box grown by `grow` x its height on every side, 0 elsewhere.
