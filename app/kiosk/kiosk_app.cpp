@@ -315,10 +315,11 @@ int run_kiosk(const KioskOptions& o) {
   KioskFlow flow(rt, rt.audio().messages(), flow_params(start.settings, rt.has_camera()));
 
   KioskWindow window(o.windowed);
-  {
+  const int picture_side = [&] {
     const auto [fw, fh] = window.framebuffer_size();
-    rt.set_screen_picture_side_px(picture_side_px(make_view(fw, fh, rt.half()), rt.half()));
-  }
+    return picture_side_px(make_view(fw, fh, rt.half()), rt.half());
+  }();
+  rt.set_screen_picture_side_px(picture_side);
   Kiosk* kiosk_ptr = nullptr;
   OperatorSession session(o.config_path, start.settings, start.notice, [&](const config::Settings& s) {
     const ApplyReport r = rt.apply_settings(s, flow);
@@ -331,7 +332,7 @@ int run_kiosk(const KioskOptions& o) {
   ScriptPlayer script(script_lines, o.script);
   start_kiosk(o, ro, rt, flow);
 
-  PictureTexture texture;
+  PictureTexture texture(picture_side);
   CapturePreviewView preview;
   const bool scripted = !o.screenshot.empty();
   // Allocated once, here: recording a frame never allocates (frame_stats.hpp).

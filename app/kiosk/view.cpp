@@ -7,12 +7,27 @@
 namespace hk::app {
 
 
-PictureTexture::PictureTexture() { glGenTextures(1, &tex_); }
-PictureTexture::~PictureTexture() { glDeleteTextures(1, &tex_); }
+PictureTexture::PictureTexture(int side_px) {
+  glGenTextures(2, tex_);
+  for (int i = 0; i < 2; ++i) allocate(i, std::max(side_px, 1));
+}
+
+PictureTexture::~PictureTexture() { glDeleteTextures(2, tex_); }
+
+void PictureTexture::allocate(int i, int side_px) {
+  glBindTexture(GL_TEXTURE_2D, tex_[i]);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, side_px, side_px, 0, GL_BGR, GL_UNSIGNED_BYTE, nullptr);  // storage only
+  side_[i] = side_px;
+}
 
 void PictureTexture::update(const Shown& shown) {
   if (shown.scene != for_) {
     for_ = shown.scene;
+    if (valid_) drawn_ = 1 - drawn_;  // the texture drawn until now may still be read by frames in flight
     valid_ = false;
     pending_.release();
     rows_up_ = 0;
@@ -21,16 +36,13 @@ void PictureTexture::update(const Shown& shown) {
     if (pending_.step[0] % 3 != 0) pending_ = pending_.clone();  // rows given to OpenGL in whole pixels
     w_ = pending_.cols;
     h_ = pending_.rows;
-    glBindTexture(GL_TEXTURE_2D, tex_);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, w_, h_, 0, GL_BGR, GL_UNSIGNED_BYTE, nullptr);  // storage only
+    if (side_[drawn_] < std::max(w_, h_)) allocate(drawn_, std::max(w_, h_));  // kept for later pictures
   }
   if (pending_.empty()) return;
   // OpenCV's BGR rows go up as they are (GL_BGR, OpenGL 1.2): no converted copy on the window thread.
   const std::size_t row_bytes = pending_.step[0];
   const int rows = std::clamp(static_cast<int>(kUploadBytesPerFrame / std::max<std::size_t>(row_bytes, 1)), 1, h_ - rows_up_);
-  glBindTexture(GL_TEXTURE_2D, tex_);
+  glBindTexture(GL_TEXTURE_2D, tex_[drawn_]);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   glPixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(row_bytes / 3));
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, rows_up_, w_, rows, GL_BGR, GL_UNSIGNED_BYTE, pending_.ptr(rows_up_));
@@ -123,11 +135,15 @@ void draw_picture(const View& v, const PictureTexture& tex, const Shown& sh, boo
   glBindTexture(GL_TEXTURE_2D, tex.id());
   const float dim = hc ? 0.25f : 0.8f;
   glColor4f(dim, dim, dim, 1.0f);
+  // The picture's corner of the texture, its far edges at the last texels' centres (half a texel in), so
+  // linear filtering never blends in the texels past the picture, left there by a larger one.
+  const float side = static_cast<float>(tex.side());
+  const float u1 = (static_cast<float>(tex.width()) - 0.5f) / side, v1 = (static_cast<float>(tex.height()) - 0.5f) / side;
   glBegin(GL_QUADS);
   glTexCoord2f(0, 0); glVertex2d(v.px(x0), v.py(y0));
-  glTexCoord2f(1, 0); glVertex2d(v.px(x1), v.py(y0));
-  glTexCoord2f(1, 1); glVertex2d(v.px(x1), v.py(y1));
-  glTexCoord2f(0, 1); glVertex2d(v.px(x0), v.py(y1));
+  glTexCoord2f(u1, 0); glVertex2d(v.px(x1), v.py(y0));
+  glTexCoord2f(u1, v1); glVertex2d(v.px(x1), v.py(y1));
+  glTexCoord2f(0, v1); glVertex2d(v.px(x0), v.py(y1));
   glEnd();
   glDisable(GL_TEXTURE_2D);
 }

@@ -15,12 +15,17 @@ namespace hk::app {
 
 /// The shown picture as an OpenGL texture, uploaded again when the scene shown changes, a slice of rows a
 /// frame (at most kUploadBytesPerFrame), so a change never costs the window thread more than one slice.
+/// Two square textures take turns, allocated at start at the screen's picture side: a picture goes up into
+/// the corner of the one not drawn last, and is drawn from that corner. Allocating a texture's storage
+/// (glTexImage2D) for every picture took 17-27 ms of the frame that changed it under Mesa's software OpenGL.
 class PictureTexture {
  public:
   /// Bytes of picture rows uploaded per frame [bytes]: about 9 ms under Mesa's software OpenGL, far less on a
   /// GPU; a picture the screen draws at 1040 px is up in 3 frames.
   static constexpr std::size_t kUploadBytesPerFrame = 1u << 20;
-  PictureTexture();
+  /// Allocates both textures at `side_px` x `side_px` (the screen's picture side, picture_side_px), so that
+  /// no picture of the kiosk's needs storage allocated while a visitor waits. A larger picture grows them.
+  explicit PictureTexture(int side_px);
   ~PictureTexture();
   PictureTexture(const PictureTexture&) = delete;
   PictureTexture& operator=(const PictureTexture&) = delete;
@@ -29,12 +34,19 @@ class PictureTexture {
   /// valid() once every row is up.
   void update(const Shown& shown);
   bool valid() const { return valid_; }
-  GLuint id() const { return tex_; }
+  /// The texture to draw (valid() only).
+  GLuint id() const { return tex_[drawn_]; }
+  /// The picture's size [px]: it fills texture coordinates [0, width / side] x [0, height / side].
   int width() const { return w_; }
   int height() const { return h_; }
+  /// The side of the texture drawn [texels] (>= width and height).
+  int side() const { return side_[drawn_]; }
 
  private:
-  GLuint tex_ = 0;
+  void allocate(int i, int side_px);  // texture i's storage, side_px square (glTexImage2D, no pixels)
+  GLuint tex_[2] = {0, 0};
+  int side_[2] = {0, 0};  // each texture's allocated side [texels] (0: not yet allocated)
+  int drawn_ = 0;     // the texture drawn when valid_, else the one being filled (never the one drawn last)
   const Scene* for_ = nullptr;
   bool valid_ = false;
   int w_ = 0, h_ = 0;
