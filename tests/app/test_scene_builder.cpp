@@ -198,6 +198,22 @@ struct LibraryRig {
   void settle(double now_s) {
     ASSERT_TRUE(rt->finish_picture(flow.get(), now_s));
   }
+  /// A folder holding the shipped spec PDF (tests/data/documents), to insert as a stick; the test removes it.
+  fs::path spec_stick(const std::string& tag) const {
+    const fs::path stick = lib.parent_path() / ("hk_builder_" + tag + "_" + std::to_string(::getpid()));
+    fs::remove_all(stick);
+    fs::create_directories(stick);
+    fs::copy_file(kData / "documents" / "shared-mime-info-spec.pdf", stick / "spec.pdf");
+    return stick;
+  }
+  /// Polls the stick service every 10 ms until scene `id` is shown (or 60 s pass), advancing `now_s`.
+  bool stick_shows(int id, double& now_s) {
+    for (int i = 0; i < 6000 && rt->shown_id() != id; ++i, now_s += 0.01) {
+      rt->poll_sticks(*flow, now_s);
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return rt->shown_id() == id;
+  }
   /// Polls until the pictures built ahead are `want` (or 60 s pass).
   bool ahead_becomes(std::vector<int> want) {
     std::sort(want.begin(), want.end());
@@ -311,21 +327,14 @@ TEST(KioskBuilds, ACorruptCacheEntryIsRebuiltAndAnUnwritableCacheCostsOnlyTheCac
 
 TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibrary) {
   LibraryRig r({"horse.png", "coins.png"}, 0, "stick");
-  const fs::path stick = r.lib.parent_path() / ("hk_builder_stickdir_" + std::to_string(::getpid()));
-  fs::remove_all(stick);
-  fs::create_directories(stick);
-  fs::copy_file(kData / "documents" / "shared-mime-info-spec.pdf", stick / "spec.pdf");
+  const fs::path stick = r.spec_stick("stickdir");
   r.flow->key(KioskKey::Other, 0.0);
   for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.0);
   r.settle(0.0);
   ASSERT_EQ(r.rt->shown_id(), 0);
   r.rt->insert_stick_folder(stick.string());
   double now_s = 1.0;
-  for (int i = 0; i < 6000 && r.rt->shown_id() != 1001; ++i, now_s += 0.01) {
-    r.rt->poll_sticks(*r.flow, now_s);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ASSERT_EQ(r.rt->shown_id(), 1001) << "the stick's first page is felt";
+  ASSERT_TRUE(r.stick_shows(1001, now_s)) << "the stick's first page is felt";
   r.flow->key(KioskKey::Next, now_s);  // page 2 asked for...
   r.rt->remove_stick_folder();         // ...and the stick pulled out while it is drawn
   for (int i = 0; i < 6000 && (r.rt->stick_busy() || r.rt->picture_busy()); ++i, now_s += 0.01) {
@@ -341,29 +350,18 @@ TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibr
 
 TEST(KioskBuilds, StickPagesPassedByQuicklyAreNeverPutOnTheDevice) {
   LibraryRig r({"horse.png"}, 0, "stickquick");  // prefetch_mb 0: each page is built when asked for
-  const fs::path stick = r.lib.parent_path() / ("hk_builder_stickquick_" + std::to_string(::getpid()));
-  fs::remove_all(stick);
-  fs::create_directories(stick);
-  fs::copy_file(kData / "documents" / "shared-mime-info-spec.pdf", stick / "spec.pdf");
+  const fs::path stick = r.spec_stick("stickquick");
   r.flow->key(KioskKey::Other, 0.0);
   r.rt->insert_stick_folder(stick.string());
   double now_s = 1.0;
-  for (int i = 0; i < 6000 && r.rt->shown_id() != 1001; ++i, now_s += 0.01) {
-    r.rt->poll_sticks(*r.flow, now_s);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ASSERT_EQ(r.rt->shown_id(), 1001) << "the stick's first page is felt";
+  ASSERT_TRUE(r.stick_shows(1001, now_s)) << "the stick's first page is felt";
   const std::uint64_t published = r.rt->scenes_published();
   const int loads = r.rt->sticks().loads_started();
   r.flow->key(KioskKey::Next, now_s);  // page 2...
   for (int i = 0; i < 6000 && r.rt->sticks().loads_started() == loads; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   ASSERT_EQ(r.rt->sticks().loads_started(), loads + 1) << "page 2 is being drawn";
   for (int i = 0; i < 2; ++i) r.flow->key(KioskKey::Next, now_s);  // ...then pages 3 and 4 before it is done
-  for (int i = 0; i < 6000 && r.rt->shown_id() != 1004; ++i, now_s += 0.01) {
-    r.rt->poll_sticks(*r.flow, now_s);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ASSERT_EQ(r.rt->shown_id(), 1004);
+  ASSERT_TRUE(r.stick_shows(1004, now_s));
   for (int i = 0; i < 50; ++i, now_s += 0.01) r.rt->poll_sticks(*r.flow, now_s);
   EXPECT_EQ(r.rt->scenes_published() - published, 1u) << "page 2, drawn before Next was pressed again, was dropped, not shown";
   EXPECT_EQ(r.rt->shown_id(), 1004);
