@@ -1,6 +1,6 @@
 // Decoding a picture file for its scene: the full decode (vision::load_image) beside the decode the scene
 // build does (vision::load_image_reduced at app::picture_keep_side_px: a large JPEG at 1/2, 1/4 or 1/8 with
-// libjpeg's DCT scaling), and the rest of the scene build after it (app::build_image_scene with its text
+// libjpeg's DCT scaling, a large PNG read by rows and averaged by blocks), and the rest of the scene build after it (app::build_image_scene with its text
 // left for later, as the kiosk builds it, minus its decode). Every shipped test picture, and large ones
 // generated into a temporary folder (removed at the end): a 24-megapixel phone photo stand-in (fruits.jpg
 // upscaled to 6000 x 4000 with a little Gaussian noise, JPEG quality 92), a 12-megapixel JPEG (4000 x 3000)

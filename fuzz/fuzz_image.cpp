@@ -1,10 +1,13 @@
 // Fuzz harness: image files from a stranger's stick (vision/intake.hpp).
 //
 // Entry points: hk::vision::decode_image (in memory: header, limits, JPEG completeness, PNG chunk check,
-// OpenCV decode) and hk::vision::read_image_header (the same header parser reading a file lazily, here a
+// OpenCV decode), hk::vision::decode_image_reduced (the same at a reduced size: libjpeg's DCT scaling, a PNG
+// read by rows with libpng) and hk::vision::read_image_header (the same header parser reading a file lazily, here a
 // memfd). Properties:
 //  - decode_image returns a CV_8UC3 image of the declared size (or transposed, EXIF) within the limits,
 //    or throws InputError whose what() is one line "image '<name, escaped>': <problem>"; nothing else;
+//  - decode_image_reduced returns ceil(file size / scale) pixels, scale 1, 2, 4 or 8, the file's size being
+//    decode_image's where both decode; or throws InputError as above;
 //  - read_image_header on the same bytes agrees with decode_image's header: it accepts a file whose
 //    decode succeeded, and with the same dimensions.
 // Limits are lower than the kiosk's (4096 x 4096 px, 4 MP) so that a run decodes in milliseconds.
@@ -61,6 +64,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(hk::fuzz::is_one_line(what), what);
     FUZZ_CHECK(what.starts_with(kShown), what);
     FUZZ_CHECK(what.size() > kShown.size(), what);
+  }
+
+  // A reduced decode (libjpeg's DCT scaling, a PNG read by rows) keeps the same promises, at 1/scale of the
+  // full size; and where both decode, the file's own size is the full decode's.
+  try {
+    const hk::vision::DecodedImage d = hk::vision::decode_image_reduced(bytes, kName, limits, 64);
+    FUZZ_CHECK(!d.bgr.empty() && d.bgr.type() == CV_8UC3, d.format);
+    FUZZ_CHECK(d.scale == 1 || d.scale == 2 || d.scale == 4 || d.scale == 8, std::to_string(d.scale));
+    FUZZ_CHECK(d.bgr.cols == (d.file_width_px + d.scale - 1) / d.scale && d.bgr.rows == (d.file_height_px + d.scale - 1) / d.scale,
+               d.format + " " + std::to_string(d.bgr.cols) + "x" + std::to_string(d.bgr.rows) + " at 1/" + std::to_string(d.scale));
+    if (decoded) FUZZ_CHECK(d.file_width_px == cols && d.file_height_px == rows, d.format);
+  } catch (const hk::vision::InputError& e) {
+    const std::string what = e.what();
+    FUZZ_CHECK(hk::fuzz::is_one_line(what), what);
+    FUZZ_CHECK(what.starts_with(kShown), what);
   }
 
   // The lazy file reader must agree with the in-memory one.

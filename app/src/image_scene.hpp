@@ -179,8 +179,8 @@ std::vector<Polyline> to_polylines(const std::vector<vision::SceneCurve>& curves
 
 /// Fewest pixels the long side of a picture file is decoded at for its scene [px]: [vision]
 /// max_image_side_px, or at least kPictureTextJudgedMinSidePx when [vision] ocr is not "off" (whether it is a
-/// page of text is judged at up to 1600 px and must see its letters). A JPEG is decoded at the largest
-/// reduction 1/2, 1/4 or 1/8 that keeps this many (vision::jpeg_reduction_for).
+/// page of text is judged at up to 1600 px and must see its letters). A JPEG or PNG is decoded at the
+/// largest reduction 1/2, 1/4 or 1/8 that keeps this many (vision::decode_reduction_for).
 int picture_keep_side_px(const config::Settings& settings);
 
 /// The least long side a picture is decoded at when its text may be read [px] (picture_keep_side_px).
@@ -192,7 +192,7 @@ inline constexpr int kPictureTextJudgedMinSidePx = 1200;
 /// gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the
 /// level-0 segments plan_levels gives it), then Scene::build (haptics.max_levels) of the curves kept.
 /// `timing` later: the text is not read here (ImageScene::text_pending, with_text).
-/// The file is decoded by vision::load_image_reduced at picture_keep_side_px (a large JPEG at 1/2, 1/4 or 1/8:
+/// The file is decoded by vision::load_image_reduced at picture_keep_side_px (a large JPEG or PNG at 1/2, 1/4 or 1/8:
 /// ImageScene::picture, decode_scale, file_width_px, file_height_px). When its text is read and the decode was
 /// reduced, the file is decoded again for OCR at up to kOcrMaxSidePx (all intake checks again) and the words'
 /// boxes are scaled into `picture`'s pixels; if that second decode is refused, the picture is felt without its

@@ -118,7 +118,7 @@ TEST_P(ReducedDecodeCurves, AreTheCurvesOfTheFullDecode) {
     SCOPED_TRACE(fs::path(path).filename().string());
     const ImageScene reduced = build_image_scene(path, s);
     const ImageScene full = build_image_scene_from_picture(vision::load_image(path, {}), path, s);
-    const int expected_scale = vision::jpeg_reduction_for(full.width_px, full.height_px, s.vision.max_image_side_px);
+    const int expected_scale = vision::decode_reduction_for(full.width_px, full.height_px, s.vision.max_image_side_px);
     ASSERT_GT(expected_scale, 1);
     EXPECT_EQ(reduced.decode_scale, expected_scale);
     EXPECT_EQ(reduced.file_width_px, full.width_px);

@@ -14,6 +14,8 @@
 #include <system_error>
 #include <vector>
 
+#include <zlib.h>
+
 #include "image_header_detail.hpp"
 #include "input_error.hpp"
 
@@ -27,19 +29,8 @@ bool MemorySource::read(std::uint64_t offset, std::size_t n, std::uint8_t* out) 
 }
 
 std::uint32_t crc32_png(const std::uint8_t* data, std::size_t n) {
-  // PNG Annex D: CRC-32, polynomial 0xEDB88320 (reflected), init and final xor 0xFFFFFFFF.
-  static const std::array<std::uint32_t, 256> table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1U) ? 0xEDB88320U ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  std::uint32_t c = 0xFFFFFFFFU;
-  for (std::size_t i = 0; i < n; ++i) c = table[(c ^ data[i]) & 0xFFU] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFU;
+  // PNG Annex D's CRC-32 is zlib's (ISO 3309 polynomial, init and final xor 0xFFFFFFFF).
+  return static_cast<std::uint32_t>(::crc32_z(0UL, data, n));
 }
 
 namespace {

@@ -65,7 +65,10 @@ std::vector<std::uint8_t> read_all(const std::string& path, std::uint64_t expect
   return bytes;
 }
 
-/// out = alpha * colour + (1 - alpha) * white, for 8- or 16-bit BGRA.
+}  // namespace
+
+namespace detail {
+
 cv::Mat composite_over_white(const cv::Mat& bgra) {
   cv::Mat f;
   bgra.convertTo(f, CV_32F, bgra.depth() == CV_16U ? 1.0 / 65535.0 : 1.0 / 255.0);
@@ -81,9 +84,9 @@ cv::Mat composite_over_white(const cv::Mat& bgra) {
   return out;
 }
 
-}  // namespace
+}  // namespace detail
 
-int jpeg_reduction_for(int width_px, int height_px, int keep_side_px) {
+int decode_reduction_for(int width_px, int height_px, int keep_side_px) {
   if (keep_side_px <= 0) return 1;
   const std::int64_t side = std::max(width_px, height_px);
   int scale = 1;
@@ -152,6 +155,38 @@ detail::HeaderDetails checked_header(std::span<const std::uint8_t> bytes, const 
 
 }  // namespace
 
+namespace {
+
+/// `bytes` decoded by OpenCV at 1/scale (libjpeg's DCT scaling for a JPEG; other formats at scale 1) and,
+/// when the format may carry alpha, composited over white from a second decode with the alpha channel.
+/// Empty when OpenCV cannot decode it.
+cv::Mat decoded_by_opencv(std::span<const std::uint8_t> bytes, const detail::HeaderDetails& hd, int scale) {
+  const int flags = scale == 8   ? cv::IMREAD_REDUCED_COLOR_8
+                    : scale == 4 ? cv::IMREAD_REDUCED_COLOR_4
+                    : scale == 2 ? cv::IMREAD_REDUCED_COLOR_2
+                                 : cv::IMREAD_COLOR;
+  const QuietOpenCvLog quiet;
+  const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
+  cv::Mat bgr;
+  try {
+    bgr = cv::imdecode(buffer, flags);
+  } catch (const cv::Exception&) {
+    return {};
+  }
+  if (bgr.empty() || !hd.may_have_alpha || scale != 1) return bgr;
+  cv::Mat with_alpha;
+  try {
+    with_alpha = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception&) {
+    return bgr;  // keep the colour decode
+  }
+  const bool usable = with_alpha.channels() == 4 && with_alpha.size() == bgr.size() &&
+                      (with_alpha.depth() == CV_8U || with_alpha.depth() == CV_16U);
+  return usable ? detail::composite_over_white(with_alpha) : bgr;
+}
+
+}  // namespace
+
 DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits,
                                   int keep_side_px) {
   if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
@@ -167,30 +202,18 @@ DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std
   const ImageHeader& h = hd.header;
   const std::string declared = "declared size " + std::to_string(h.width_px) + " x " + std::to_string(h.height_px) + " px";
 
-  std::vector<std::uint8_t> png_copy;
+  std::vector<std::uint8_t> png_storage;
   std::span<const std::uint8_t> to_decode = bytes;
-  if (h.format == "png") {
-    png_copy = detail::png_decodable_copy(bytes, path);
-    to_decode = png_copy;
-  }
-
+  if (h.format == "png") to_decode = detail::png_decodable(bytes, path, png_storage);
   if (to_decode.size() > static_cast<std::size_t>(INT_MAX)) {  // cv::Mat's column count is an int
     detail::throw_input_error(path, "file too large for the decoder (over 2 GiB)");
   }
-  // Only libjpeg decodes less for a reduced size (DCT scaling); other decoders would decode in full and resize.
-  const int scale = h.format == "jpeg" ? jpeg_reduction_for(h.width_px, h.height_px, keep_side_px) : 1;
-  const int flags = scale == 8   ? cv::IMREAD_REDUCED_COLOR_8
-                    : scale == 4 ? cv::IMREAD_REDUCED_COLOR_4
-                    : scale == 2 ? cv::IMREAD_REDUCED_COLOR_2
-                                 : cv::IMREAD_COLOR;
-  const QuietOpenCvLog quiet;
-  const cv::Mat buffer(1, static_cast<int>(to_decode.size()), CV_8UC1, const_cast<std::uint8_t*>(to_decode.data()));
-  cv::Mat bgr;
-  try {
-    bgr = cv::imdecode(buffer, flags);
-  } catch (const cv::Exception&) {
-    bgr.release();  // reported below as a decoding failure
-  }
+  // libjpeg decodes less for a reduced size (DCT scaling). A PNG read by rows is averaged as it is read, so
+  // its full-size pixels are never held, and libpng's reason for refusing it reaches the message instead of
+  // stderr. Other decoders would decode in full and resize.
+  const bool png_by_rows = h.format == "png" && detail::png_decodes_by_rows(to_decode);
+  const int scale = h.format == "jpeg" || png_by_rows ? decode_reduction_for(h.width_px, h.height_px, keep_side_px) : 1;
+  const cv::Mat bgr = png_by_rows ? detail::decode_png_by_rows(to_decode, path, scale) : decoded_by_opencv(to_decode, hd, scale);
   if (bgr.empty()) {
     detail::throw_input_error(path, "the " + h.format + " data could not be decoded (corrupt or unsupported)");
   }
@@ -201,22 +224,11 @@ DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std
     detail::throw_input_error(path, "decoded size " + std::to_string(bgr.cols) + " x " + std::to_string(bgr.rows) + " px differs from the " +
                                         declared + (scale > 1 ? " reduced to 1/" + std::to_string(scale) : std::string()));
   }
-  if (hd.may_have_alpha && scale == 1) {
-    cv::Mat with_alpha;
-    try {
-      with_alpha = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception&) {
-      with_alpha.release();  // keep the colour decode
-    }
-    const bool usable = with_alpha.channels() == 4 && with_alpha.size() == bgr.size() &&
-                        (with_alpha.depth() == CV_8U || with_alpha.depth() == CV_16U);
-    if (usable) bgr = composite_over_white(with_alpha);
-  }
   if (bgr.type() != CV_8UC3) {
     detail::throw_input_error(path, "decoder returned an unexpected pixel type");
   }
   DecodedImage out;
-  out.bgr = std::move(bgr);
+  out.bgr = bgr;
   out.file_width_px = as_declared ? h.width_px : h.height_px;
   out.file_height_px = as_declared ? h.height_px : h.width_px;
   out.scale = scale;

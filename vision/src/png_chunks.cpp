@@ -30,9 +30,11 @@ std::uint32_t be32(const std::uint8_t* p) {
 
 }  // namespace
 
-std::vector<std::uint8_t> png_decodable_copy(std::span<const std::uint8_t> bytes, const std::string& path) {
+std::span<const std::uint8_t> png_decodable(std::span<const std::uint8_t> bytes, const std::string& path,
+                                            std::vector<std::uint8_t>& storage) {
   const std::size_t n = bytes.size();
-  std::vector<std::uint8_t> out(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(n, 8)));
+  storage.clear();
+  bool copying = false;  // a chunk has been dropped: `storage` holds the kept chunks so far
   std::size_t pos = 8;
   bool idat = false;
   // W3C PNG 2nd ed. §5.3: length (4, <= 2^31 - 1), type (4), data, CRC over type + data (4).
@@ -49,21 +51,29 @@ std::vector<std::uint8_t> png_decodable_copy(std::span<const std::uint8_t> bytes
       throw_input_error(path, "truncated PNG: chunk '" + name + "' at byte " + std::to_string(pos) +
                                   " runs past the end of the file");
     }
-    const bool crc_ok = crc32_png(type, 4 + std::size_t{len}) == be32(type + 4 + len);
+    const std::size_t chunk_bytes = 12 + std::size_t{len};
     if (kept_chunk(type) || is_critical(type)) {
       // Unknown critical chunks are passed on: libpng refuses them, as the standard requires.
-      if (!crc_ok) {
+      if (crc32_png(type, 4 + std::size_t{len}) != be32(type + 4 + len)) {
         throw_input_error(path, "corrupt PNG: checksum (CRC) mismatch in chunk '" + name + "' at byte " +
                                     std::to_string(pos));
       }
-      out.insert(out.end(), chunk, chunk + 12 + std::size_t{len});
+      if (copying) storage.insert(storage.end(), chunk, chunk + chunk_bytes);
       idat = idat || std::memcmp(type, "IDAT", 4) == 0;
-      if (std::memcmp(type, "IEND", 4) == 0) break;
+      if (std::memcmp(type, "IEND", 4) == 0) {
+        pos += chunk_bytes;
+        break;
+      }
+    } else if (!copying) {  // the first chunk dropped: copy what was kept before it
+      storage.reserve(n);
+      storage.assign(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(pos));
+      copying = true;
     }
-    pos += 12 + std::size_t{len};
+    pos += chunk_bytes;
   }
   if (!idat) throw_input_error(path, "corrupt PNG: no image data (IDAT chunk)");
-  return out;
+  if (copying) return storage;
+  return bytes.first(pos);  // every chunk kept; bytes after IEND are not part of the PNG
 }
 
 }  // namespace hk::vision::detail

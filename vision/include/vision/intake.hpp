@@ -68,8 +68,11 @@ ImageHeader read_image_header(const std::string& path);
 /// would show as a false edge), a PNG must have intact chunks (CRC) up to IEND.
 /// Decoding is cv::imdecode(IMREAD_COLOR) of the bytes that were checked, equivalent to
 /// cv::imread(path, IMREAD_COLOR) (EXIF orientation is applied; same pixels) but without
-/// reopening the path. For PNG, ancillary chunks OpenCV ignores (colour profiles, text) are left
-/// out of the decoded copy so libpng does not print warnings about them.
+/// reopening the path. A PNG that is not interlaced and has no eXIf chunk is decoded by libpng
+/// directly, a strip of rows at a time, with the transformations OpenCV's PNG decoder sets (the
+/// same pixels), so that libpng's reason for refusing a damaged one is in the message ("... could
+/// not be decoded (corrupt or unsupported): Not enough image data") and not on stderr. For PNG,
+/// ancillary chunks OpenCV ignores (colour profiles, text) are left out of what libpng is given.
 /// Images with an alpha channel (PNG colour types 4/6 or tRNS, WebP alpha, TIFF extra samples)
 /// are composited over white, as a viewer would show them, so transparent areas do not turn black.
 /// OpenCV's own log output is silenced while decoding (libjpeg may still print a warning for
@@ -92,24 +95,31 @@ struct DecodedImage {
   int file_height_px = 0;
   /// Full-detail pixels per decoded pixel along each side: 1 (full decode), 2, 4 or 8. A decoded pixel
   /// (u, v) covers the full-detail pixels [u * scale, (u + 1) * scale) x [v * scale, (v + 1) * scale)
-  /// (libjpeg's scaled inverse DCT averages each block), so a position x in full-detail pixels
-  /// (origin at the top-left pixel's corner) is x / scale in decoded pixels.
+  /// (libjpeg's scaled inverse DCT averages each block; a PNG read by rows averages them with
+  /// cv::INTER_AREA), so a position x in full-detail pixels (origin at the top-left pixel's corner) is
+  /// x / scale in decoded pixels.
   int scale = 1;
   std::string format;  ///< container format, as ImageHeader::format
 };
 
-/// The reduction factor a JPEG of `width_px` x `height_px` is decoded at so that its long side still has
-/// at least `keep_side_px` pixels: the largest 2^k, k <= 3, with ceil(max(width, height) / 2^k) >=
-/// keep_side_px (libjpeg rounds a scaled side up). 1 when keep_side_px <= 0 (full decode) or when even
-/// 1/2 would leave fewer than keep_side_px pixels. Sizes [px], both > 0.
-int jpeg_reduction_for(int width_px, int height_px, int keep_side_px);
+/// The reduction factor a JPEG or PNG of `width_px` x `height_px` is decoded at so that its long side still
+/// has at least `keep_side_px` pixels: the largest 2^k, k <= 3, with ceil(max(width, height) / 2^k) >=
+/// keep_side_px (libjpeg rounds a scaled side up; a PNG's partial edge blocks do the same). 1 when
+/// keep_side_px <= 0 (full decode) or when even 1/2 would leave fewer than keep_side_px pixels. Sizes [px],
+/// both > 0.
+int decode_reduction_for(int width_px, int height_px, int keep_side_px);
 
 /// load_image at reduced detail: the same checks in the same order (file bytes, declared size, JPEG end
-/// marker, PNG chunks), all made before any pixel is decoded, then a JPEG is decoded at 1/scale of its size
-/// with libjpeg's DCT scaling (cv::IMREAD_REDUCED_COLOR_2/4/8, scale from jpeg_reduction_for: its long side
-/// stays >= keep_side_px), which spends a fraction of a full decode's time. EXIF orientation is applied as
-/// in a full decode. Other formats are decoded in full (scale 1): their decoders have no cheaper reduced
-/// path (OpenCV decodes them in full and then resizes).
+/// marker, PNG chunks), all made before any pixel is decoded, then the picture is decoded at 1/scale of its
+/// size (scale from decode_reduction_for: its long side stays >= keep_side_px):
+///  - a JPEG with libjpeg's DCT scaling (cv::IMREAD_REDUCED_COLOR_2/4/8), which spends a fraction of a full
+///    decode's time;
+///  - a PNG (not interlaced, without eXIf) with libpng a strip of rows at a time, each scale x scale block
+///    averaged (cv::INTER_AREA) as the strip arrives, a partial block at the right or bottom edge completed
+///    by repeating the last column or row. Every byte is still inflated, but the full-size pixels are never
+///    held: the result is load_image's pixels (alpha composited over white) averaged by block.
+/// EXIF orientation is applied as in a full decode. Other formats, interlaced PNGs and PNGs with an eXIf
+/// chunk are decoded in full (scale 1): their decoders have no reduced path.
 /// @param keep_side_px  fewest pixels the decoded long side may have [px]; 0 (or less) decodes in full, so
 ///                      that bgr is exactly load_image's result.
 /// @throws InputError as load_image (and when the decoded size is not the declared one reduced by scale).
