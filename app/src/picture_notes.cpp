@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <mutex>
 #include <string_view>
 
 #include <exiv2/exiv2.hpp>
@@ -100,6 +101,10 @@ std::string xmp_text(const Exiv2::XmpData& xmp, const char* key) {
 }  // namespace
 
 PictureNotes embedded_notes(const std::string& image_path) {
+  // exiv2's XMP toolkit is not safe to use from two threads at once, and pictures are read on the scene
+  // builder's worker, the stick service's and beside a build: one file at a time.
+  static std::mutex exiv2_mutex;
+  const std::lock_guard<std::mutex> lock(exiv2_mutex);
   PictureNotes notes;
   try {
     Exiv2::LogMsg::setLevel(Exiv2::LogMsg::mute);  // exiv2 would print to stderr about odd files

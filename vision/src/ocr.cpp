@@ -163,9 +163,11 @@ struct Blob {
   int bottom, left, right, height;
 };
 
-/// The connected components of `binary` (255 = the side looked at) with their boxes and areas.
-std::vector<std::pair<cv::Rect, int>> components(const cv::Mat& binary) {
-  cv::Mat labels, stats, centroids;
+/// The connected components of `binary` (255 = the side looked at) with their boxes and areas. `labels` is
+/// scratch (CV_32S, binary's size once allocated): the judgements below share one, since a fresh label image
+/// of a 1600 px picture is 10 MB of new pages each time.
+std::vector<std::pair<cv::Rect, int>> components(const cv::Mat& binary, cv::Mat& labels) {
+  cv::Mat stats, centroids;
   const int n = cv::connectedComponentsWithStats(binary, labels, stats, centroids, 8, CV_32S);
   std::vector<std::pair<cv::Rect, int>> out;
   out.reserve(static_cast<std::size_t>(std::max(0, n - 1)));
@@ -184,9 +186,9 @@ struct PrintedLetters {
   bool page = false;           ///< they make a page of text
 };
 
-PrintedLetters printed_letters(const cv::Mat& ink, double side) {
+PrintedLetters printed_letters(const cv::Mat& ink, double side, cv::Mat& labels) {
   PrintedLetters out;
-  const auto all = components(ink);
+  const auto all = components(ink, labels);
   std::vector<Blob> letters;  // by bottom
   for (const auto& [r, area] : all)
     if (r.height >= 0.006 * side && r.height <= 0.06 * side && r.width <= 3 * r.height) letters.push_back({r.y + r.height, r.x, r.x + r.width, r.height});
@@ -217,10 +219,10 @@ PrintedLetters printed_letters(const cv::Mat& ink, double side) {
 /// box: strokes, not discs) of one height (within 25 %) on one baseline (within 15 % of it), each no further
 /// than a height from the next, and narrower than tall on the whole (the median width under 0.9 heights: a
 /// row of coins or pebbles is as wide as tall).
-bool a_line_of_large_letters(const cv::Mat& side_up, double side) {
+bool a_line_of_large_letters(const cv::Mat& side_up, double side, cv::Mat& labels) {
   constexpr std::size_t kSignLetters = 5;
   std::vector<Blob> letters;
-  for (const auto& [r, area] : components(side_up)) {
+  for (const auto& [r, area] : components(side_up, labels)) {
     const double fill = static_cast<double>(area) / (static_cast<double>(r.width) * r.height);
     if (r.height >= 0.03 * side && r.height <= 0.3 * side && r.width >= 0.15 * r.height && r.width <= 1.2 * r.height && fill >= 0.15 && fill <= 0.7)
       letters.push_back({r.y + r.height, r.x, r.x + r.width, r.height});
@@ -252,17 +254,19 @@ bool looks_like_text_page(const cv::Mat& grey) {
   cv::Mat ink;
   cv::threshold(grey, ink, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
   const double side = std::min(grey.cols, grey.rows);
-  if (printed_letters(ink, side).page) return true;
-  cv::Mat light;
-  cv::bitwise_not(ink, light);
-  return a_line_of_large_letters(ink, side) || a_line_of_large_letters(light, side);
+  cv::Mat labels;
+  if (printed_letters(ink, side, labels).page) return true;
+  if (a_line_of_large_letters(ink, side, labels)) return true;
+  cv::bitwise_not(ink, ink);  // light letters on a dark ground
+  return a_line_of_large_letters(ink, side, labels);
 }
 
 cv::Mat printed_letters_mask(const cv::Mat& grey) {
   if (grey.empty() || grey.type() != CV_8UC1) return {};
   cv::Mat ink;
   cv::threshold(grey, ink, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
-  const PrintedLetters letters = printed_letters(ink, std::min(grey.cols, grey.rows));
+  cv::Mat labels;
+  const PrintedLetters letters = printed_letters(ink, std::min(grey.cols, grey.rows), labels);
   if (!letters.page) return {};
   cv::Mat mask(grey.size(), CV_8UC1, cv::Scalar(0));
   const int grow = static_cast<int>(std::ceil(0.5 * letters.median_height));
