@@ -20,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "vision/frame_source.hpp"
+#include "temp_dir.hpp"
 #include "vision/intake.hpp"
 #include "hk/error.hpp"
 
@@ -30,33 +31,7 @@ namespace fs = std::filesystem;
 
 const std::string kImages = std::string(HK_TEST_DATA_DIR) + "/images";
 
-/// A scratch directory, removed with its contents at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("hk_frames_" + std::string(info->name()) + "_" +
-                                        std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
-    fs::create_directories(dir_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  std::string write(const std::string& name, const std::vector<std::uint8_t>& bytes) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary)
-        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    return p.string();
-  }
-  std::string path() const { return dir_.string(); }
-
- private:
-  fs::path dir_;
-};
+using test::TempDir;  // a scratch folder for the test, removed at its end
 
 /// PNG bytes of a 64 x 48 px frame: noise (so the file is a few kB) with its top-left pixel set to `mark`.
 std::vector<std::uint8_t> png_frame(std::uint8_t mark) {

@@ -15,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "temp_dir.hpp"
 #include "vision/intake.hpp"
 #include "hk/error.hpp"
 
@@ -35,30 +36,7 @@ std::vector<fs::path> test_images() {
   return out;
 }
 
-/// A scratch directory, removed with its contents at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("hk_vision_" + std::string(info->name()) + "_" +
-                                        std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
-    fs::create_directories(dir_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string write(const std::string& name, const std::vector<std::uint8_t>& bytes) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                             static_cast<std::streamsize>(bytes.size()));
-    return p.string();
-  }
-  fs::path path() const { return dir_; }
-
- private:
-  fs::path dir_;
-};
+using test::TempDir;  // a scratch folder for the test, removed at its end
 
 /// Runs f, which must throw InputError; returns its message after checking it is one line and
 /// names the file.

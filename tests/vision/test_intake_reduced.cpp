@@ -20,6 +20,7 @@
 #include <png.h>
 #include <zlib.h>
 
+#include "temp_dir.hpp"
 #include "vision/intake.hpp"
 #include "hk/error.hpp"
 
@@ -30,28 +31,7 @@ namespace fs = std::filesystem;
 
 const std::string kData = HK_TEST_DATA_DIR;
 
-/// A scratch directory, removed with its contents at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("hk_reduced_" + std::string(info->name()) + "_" +
-                                        std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
-    fs::create_directories(dir_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string write(const std::string& name, const std::vector<std::uint8_t>& bytes) const {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    return p.string();
-  }
-
- private:
-  fs::path dir_;
-};
+using test::TempDir;  // a scratch folder for the test, removed at its end
 
 /// fruits.jpg scaled to `size` (INTER_CUBIC): a photograph with detail at every scale.
 cv::Mat photo(cv::Size size) {
@@ -98,7 +78,7 @@ std::string refusal(F&& f) {
   return {};
 }
 
-TEST(JpegReductionFor, ChoosesTheLargestReductionThatKeepsTheSide) {
+TEST(DecodeReductionFor, ChoosesTheLargestReductionThatKeepsTheSide) {
   EXPECT_EQ(decode_reduction_for(6000, 4000, 800), 4);   // 1500 x 1000 (1/8 would give 750)
   EXPECT_EQ(decode_reduction_for(6000, 4000, 1200), 4);  // 1500 >= 1200
   EXPECT_EQ(decode_reduction_for(6000, 4000, 1600), 2);  // 3000 x 2000 (1/4 would give 1500)
