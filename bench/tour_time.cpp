@@ -76,11 +76,11 @@ Row run(const std::string& name, const std::string& path, const config::Settings
       tick();
       const ServoDisplayState& d = core.display();
       if (d.curve >= 0) touches.touch(1, d.curve);
-      if (d.tour_id == id && (d.tour_phase == TourPhase::Done || d.tour_phase == TourPhase::Stopped)) {
-        row.stopped += d.tour_phase == TourPhase::Stopped;
-        if (d.tour_phase == TourPhase::Stopped)
-          std::fprintf(stderr, "%s: tour %d to shape %d (%.1f mm long) stopped after %.2f s: handle (%.1f, %.1f) mm, in contact with %d\n", name.c_str(), id,
-                       curve, 1000 * curve_length_m(sc, static_cast<std::size_t>(curve)), ticks * sp.period_s, 1000 * d.handle_m.x, 1000 * d.handle_m.y, last_contact);
+      if (d.tour_id == id && tour_ended(d.tour_phase)) {
+        row.stopped += d.tour_phase != TourPhase::Done;
+        if (d.tour_phase != TourPhase::Done)
+          std::fprintf(stderr, "%s: tour %d to shape %d (%.1f mm long) %s after %.2f s: handle (%.1f, %.1f) mm, in contact with %d\n", name.c_str(), id,
+                       curve, 1000 * curve_length_m(sc, static_cast<std::size_t>(curve)), d.tour_phase == TourPhase::Stuck ? "stuck" : "stopped", ticks * sp.period_s, 1000 * d.handle_m.x, 1000 * d.handle_m.y, last_contact);
         break;
       }
       if (d.curve >= 0) last_contact = d.curve;

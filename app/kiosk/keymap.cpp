@@ -28,6 +28,16 @@ int glfw_key(const std::string& name) {
   return it == named.end() ? GLFW_KEY_UNKNOWN : it->second;
 }
 
+bool is_modifier_key(int key) {
+  switch (key) {
+    case GLFW_KEY_LEFT_SHIFT: case GLFW_KEY_RIGHT_SHIFT: case GLFW_KEY_LEFT_CONTROL: case GLFW_KEY_RIGHT_CONTROL:
+    case GLFW_KEY_LEFT_ALT: case GLFW_KEY_RIGHT_ALT: case GLFW_KEY_LEFT_SUPER: case GLFW_KEY_RIGHT_SUPER:
+      return true;
+    default:
+      return false;
+  }
+}
+
 std::string key_name_of(int key) {
   if (key == GLFW_KEY_UNKNOWN) return {};
   for (const std::string_view name : config::visitor_key_names())

@@ -20,6 +20,9 @@ int glfw_key(const std::string& name);
 /// ESCAPE), or "" for a key the settings do not name. For speaking the name of a key that does nothing.
 std::string key_name_of(int key);
 
+/// Whether GLFW key code `key` is a modifier (Shift, Control, Alt or Super, left or right).
+bool is_modifier_key(int key);
+
 /// The visitor's actions by GLFW key code, from [keys] (config::key_actions: Help .. Finish).
 std::map<int, KioskKey> visitor_key_map(const config::KeysSettings& keys);
 

@@ -116,15 +116,29 @@ class Kiosk final : public ScriptTarget {
     const bool help = it != keys_.end() && it->second == KioskKey::Help;
     if (e.kind == InputEvent::Kind::mouse_button || (e.kind == InputEvent::Kind::key && e.action == GLFW_RELEASE)) {
       if (help && e.action == GLFW_RELEASE) flow_.help_held(false);  // learning mode ends
+      if (e.kind == InputEvent::Kind::key && e.key == lone_modifier_) {  // a modifier pressed and let go alone
+        lone_modifier_ = 0;
+        flow_.key(KioskKey::Other, now_s_, key_name_of(e.key));
+      }
       window_.to_imgui(e);  // buttons and releases always (ImGui must not see a key held for ever)
       return;
     }
     if (e.kind != InputEvent::Kind::key || e.action != GLFW_PRESS) return;
     if (chord_pressed(chord_, e.key, e.mods)) {
+      lone_modifier_ = 0;
       session_.chord(now_s_, unix_now_s());
       return;
     }
-    if (e.mods & (GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SUPER)) return;  // no visitor key has modifiers
+    // A modifier is half of a chord: answered when it is let go alone, else with its chord.
+    if (is_modifier_key(e.key)) {
+      lone_modifier_ = e.mods == 0 ? e.key : 0;
+      return;
+    }
+    lone_modifier_ = 0;
+    if (e.mods & (GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SUPER)) {  // no visitor key has modifiers: a chord
+      flow_.key(KioskKey::Other, now_s_);  // Ctrl+Q, Alt+F4: "That key does nothing here."
+      return;
+    }
     if (e.key == GLFW_KEY_ESCAPE && o_.windowed) {
       window_.request_close();
       return;
@@ -164,10 +178,14 @@ class Kiosk final : public ScriptTarget {
     rt_.set_cursor({std::clamp(m.x, -rt_.half().x, rt_.half().x), std::clamp(m.y, -rt_.half().y, rt_.half().y)});
   }
 
-  /// The handle moved noticeably (5 mm) since the last report, or rests against a shape: the visitor is there.
+  /// The handle moved noticeably (5 mm) since the last report, or slides along a shape (1 mm in contact since
+  /// the last report): the visitor is there. A handle resting against a wall, or pinned, keeps no visit alive.
   void watch_handle() {
     const ServoDisplayState& d = rt_.core().display();
-    if (d.state != ContactState::Free) flow_.touching(now_s_);
+    if (d.state != ContactState::Free && length(d.handle_m - last_touched_at_) > 0.001) {
+      last_touched_at_ = d.handle_m;
+      flow_.touching(now_s_);
+    }
     if (!have_baseline_ && d.tick > 0) {  // the first sample from the servo thread: where the handle rests
       have_baseline_ = true;
       last_moved_at_ = d.handle_m;
@@ -198,7 +216,9 @@ class Kiosk final : public ScriptTarget {
   Vec2 mouse_rest_;
   bool have_baseline_ = false;
   Vec2 last_moved_at_;
+  Vec2 last_touched_at_;
   bool picture_key_ = false;
+  int lone_modifier_ = 0;  // a modifier key pressed with no other key down yet (GLFW key code), else 0
 };
 
 /// --show: straight to a picture, past the welcome and the tutorial.

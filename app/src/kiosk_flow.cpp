@@ -103,6 +103,7 @@ void KioskFlow::act_on_key(KioskKey k, double now_s, std::string_view key_name) 
     volume_key(k == KioskKey::VolumeUp ? +1 : -1);
     return;
   }
+  if (k != KioskKey::Finish) v_.finish_asked_s = -1;  // any other key: Finish asks again
   fx_.key_pressed();
   if (v_.capturing) {  // any key stops a capture, and does nothing else
     v_.capturing = false;
@@ -163,7 +164,7 @@ bool KioskFlow::session_key(KioskKey k, double now_s) {
       return true;
     }
     case KioskKey::Finish:
-      end_session(now_s);
+      finish_key(now_s);
       return true;
     default:
       return false;
@@ -175,6 +176,24 @@ void KioskFlow::volume_key(int delta) {
   const bool changed = fx_.change_volume(delta);
   if (fx_.speaking()) return;
   say_brief(!changed ? MessageId::volume_limit : delta > 0 ? MessageId::volume_up : MessageId::volume_down);
+}
+
+void KioskFlow::finish_key(double now_s) {
+  if (v_.finish_asked_s >= 0 && now_s - v_.finish_asked_s <= kFinishConfirm_s) {
+    end_session(now_s);
+    return;
+  }
+  v_.finish_asked_s = now_s;
+  say_brief(MessageId::finish_ask);
+}
+
+void KioskFlow::level_key(int delta) {
+  const bool was_auto = fx_.auto_level();
+  const bool changed = fx_.change_level(delta);
+  std::string line = text(changed ? (delta < 0 ? MessageId::level_finer : MessageId::level_coarser)
+                                   : (delta < 0 ? MessageId::level_finest : MessageId::level_coarsest));
+  if (changed && was_auto) line += " " + text(MessageId::level_manual);
+  fx_.say_brief(line);
 }
 
 void KioskFlow::pause_key() {
@@ -252,10 +271,10 @@ void KioskFlow::picture_key(KioskKey k) {
       fx_.say(text(MessageId::describe, {{"description", fx_.describe()}}));
       return;
     case KioskKey::Finer:
-      say_brief(fx_.change_level(-1) ? MessageId::level_finer : MessageId::level_finest);
+      level_key(-1);
       return;
     case KioskKey::Coarser:
-      say_brief(fx_.change_level(+1) ? MessageId::level_coarser : MessageId::level_coarsest);
+      level_key(+1);
       return;
     default:
       return;
@@ -269,8 +288,8 @@ void KioskFlow::say_help() {
 std::string KioskFlow::place() const {
   if (v_.state == KioskState::Tutorial) return text(MessageId::place_tutorial);
   if (v_.source == KioskSource::Stick && v_.doc >= 0) {
-    return text(MessageId::place_document, {{"page", std::to_string(v_.page)},
-                                             {"pages", std::to_string(v_.stick[static_cast<std::size_t>(v_.doc)].pages)}});
+    const StickEntry& e = v_.stick[static_cast<std::size_t>(v_.doc)];
+    return text(MessageId::place_document, {{"page", std::to_string(v_.page)}, {"pages", std::to_string(std::max(e.pages, e.pages_in_file))}});
   }
   if (v_.captured) return text(MessageId::place_capture);
   return text(MessageId::place_picture, {{"picture", std::to_string(v_.picture + 1)}, {"pictures", std::to_string(fx_.picture_count())}});
@@ -281,9 +300,11 @@ std::string KioskFlow::place() const {
 void KioskFlow::activity(double now_s) {
   v_.last_activity_s = now_s;
   v_.warned = false;
+  v_.rewarned = false;
 }
 
 void KioskFlow::start_tutorial() {
+  v_.felt = true;
   v_.state = KioskState::Tutorial;
   v_.shape = TutorialShape::Square;
   v_.captured = false;
@@ -294,6 +315,7 @@ void KioskFlow::show(int index, const std::string& before) {
   const int n = fx_.picture_count();
   v_.picture = ((index % n) + n) % n;  // wraps round both ways
   v_.state = KioskState::Picture;
+  v_.felt = true;
   v_.captured = false;
   const int shapes = fx_.show_picture(v_.picture);
   if (shapes == KioskEffects::kPicturePending) {  // built off the window thread: announced when it is felt
@@ -379,9 +401,18 @@ void KioskFlow::tick(double now_s) {
     }
     if (!v_.warned && idle >= p_.timeout_s - p_.warning_s) {
       v_.warned = true;
-      say_brief(MessageId::timeout_warning, {{"seconds", std::to_string(static_cast<int>(std::lround(p_.timeout_s - idle)))}});
+      v_.warned_at_s = now_s;
+      warn(idle);
+    } else if (v_.warned && !v_.rewarned && now_s - v_.warned_at_s >= kRewarn_s && p_.timeout_s - idle >= 3.0) {
+      v_.rewarned = true;  // once more, while there is still time to answer it
+      warn(idle);
     }
   });
+}
+
+void KioskFlow::warn(double idle_s) {
+  const MessageId id = v_.source == KioskSource::Stick ? MessageId::timeout_warning_stick : MessageId::timeout_warning;
+  say_brief(id, {{"seconds", std::to_string(static_cast<int>(std::lround(p_.timeout_s - idle_s)))}});
 }
 
 // ---- the camera --------------------------------------------------------------------------------------
@@ -422,11 +453,12 @@ void KioskFlow::capture_failed(bool timeout, double now_s) {
 
 std::string KioskFlow::stick_summary() const {
   // English phrase for {summary}; the sentence around it comes from the catalogue.
-  int pictures = 0, pdfs = 0, pages = 0;
+  int pictures = 0, pdfs = 0, pages = 0, capped = 0;
   for (const StickEntry& e : v_.stick) {
     pictures += !e.pdf;
     pdfs += e.pdf;
-    pages += e.pdf ? e.pages : 0;
+    pages += e.pdf ? std::max(e.pages, e.pages_in_file) : 0;
+    capped = std::max(capped, e.pdf && e.pages_in_file > e.pages ? e.pages : 0);
   }
   auto count = [](int n, const char* one, const char* many) { return n == 1 ? std::string(one) : std::to_string(n) + " " + many; };
   const int n = static_cast<int>(v_.stick.size());
@@ -437,9 +469,32 @@ std::string KioskFlow::stick_summary() const {
   } else if (pdfs > 1) {
     pdf_part = std::to_string(pdfs) + " PDFs of " + count(pages, "one page", "pages") + " in all";
   }
+  if (capped > 0) pdf_part += " (the first " + std::to_string(capped) + " pages of each can be read)";
   if (pictures > 0 && pdfs > 0) return s + count(pictures, "a picture", "pictures") + " and " + pdf_part;
   if (pictures > 0) return s + count(pictures, "a picture", "pictures");
   return s + pdf_part;
+}
+
+std::string spoken_name(const std::string& name, bool file_name) {
+  std::string s = name;
+  if (file_name) {
+    const auto dot = s.find_last_of('.');
+    if (dot != std::string::npos && dot > 0 && s.size() - dot <= 5) s.erase(dot);
+    for (char& c : s)
+      if (c == '_' || c == '-') c = ' ';
+  }
+  if (s.size() <= kSpokenNameBytes) return s;
+  std::size_t cut = kSpokenNameBytes;
+  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;  // a whole UTF-8 character
+  const std::size_t space = s.rfind(' ', cut);
+  if (space != std::string::npos && space >= kSpokenNameBytes / 2) cut = space;  // at a word
+  s.erase(cut);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '.')) s.pop_back();
+  return s;
+}
+
+std::string KioskFlow::document_name(const StickEntry& e) const {
+  return e.title.empty() ? spoken_name(e.name, true) : spoken_name(e.title, false);
 }
 
 void KioskFlow::request(int document, int page, double now_s) {
@@ -516,21 +571,23 @@ void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
   v_.pending_doc = -1;
   const StickEntry& e = v_.stick[static_cast<std::size_t>(r.document)];
   // A PDF's own title, when it has a usable one, names it: "Page 1 of 3 of Annual report 2025."
-  const std::string& name = e.title.empty() ? e.name : e.title;
+  const std::string name = document_name(e);
   std::string line;
   if (r.ok) {
+    v_.felt = true;
     v_.doc = r.document;
     v_.page = r.page;
     v_.state = KioskState::Picture;
     v_.captured = false;
-    line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(e.pages)},
+    line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(std::max(e.pages, e.pages_in_file))},
                                                           {"name", name}, {"description", r.description}})
                  : text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
                                                              {"documents", std::to_string(v_.stick.size())},
                                                              {"name", name}, {"description", r.description}});
   } else {
     const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + name : name;
-    line = text(MessageId::document_unreadable, {{"name", what}, {"reason", r.reason}});
+    // "You still feel the picture before" only when there was one.
+    line = text(v_.felt ? MessageId::document_unreadable : MessageId::document_unreadable_alone, {{"name", what}, {"reason", r.reason}});
   }
   if (!v_.announce_summary.empty()) {  // said now, so it names the keys of now
     line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) + " " + line;

@@ -17,10 +17,12 @@
 /// - Help comes in two layers: one sentence for where the visitor is and the two most useful keys, then, on
 ///   the same key again, every key; a key that does nothing says its own name and that it does nothing;
 ///   holding Help while pressing a key names that key and what it does, without doing it (learning mode);
-/// - no time pressure: speech in progress (not paused), contact with a shape, keys and handle motion all
+/// - no time pressure: speech in progress (not paused), sliding along a shape, keys and handle motion all
 ///   count as activity, so the time-out never cuts a text being read; with none of them for timeout_s the
-///   kiosk warns warning_s ahead (naming how to get more time: any key), then says goodbye, restores the
-///   operator's defaults and returns to Attract; Finish does the same at once;
+///   kiosk warns warning_s ahead (naming how to get more time: any key, and what will be lost), warns again
+///   kRewarn_s later, then says goodbye, restores the operator's defaults and returns to Attract; Finish does
+///   the same, once pressed twice within kFinishConfirm_s (the first press only asks: one press by accident
+///   loses nothing);
 /// - nothing a visitor does ends the kiosk: each key press, handle motion, time step, stick and capture event
 ///   runs under one guard that, on an exception, restores the flow's state as it was before, logs the
 ///   failure and says one short sorry line.
@@ -76,7 +78,14 @@ struct StickEntry {
   bool pdf = false;   ///< a PDF (pages) or a picture
   int pages = 1;      ///< pages offered (1 for a picture)
   std::string title;  ///< the document's own title (ListedDocument::title), spoken in place of `name`; "" when none
+  int pages_in_file = 0;  ///< pages the document has (more than `pages` when capped); 0: the same as `pages`
 };
+
+/// A document's name as it is spoken: a file name without its extension, underscores and dashes read as
+/// spaces, and at most kSpokenNameBytes bytes (cut at a word, UTF-8 whole) so that a 254-byte name is not
+/// read out in full. A title is only cut.
+std::string spoken_name(const std::string& name, bool file_name);
+inline constexpr std::size_t kSpokenNameBytes = 60;
 
 /// Where Next and Previous go.
 enum class KioskSource { Library, Stick };
@@ -129,8 +138,12 @@ class KioskEffects {
   /// "What is here": the shape or block of text under or nearest the hand and where the hand is, one or two
   /// sentences (describe.hpp, where_message). Default: nothing to say ("").
   virtual std::string where() { return {}; }
-  /// Level one finer (delta −1) or coarser (+1). Returns false at the limit (nothing changes).
+  /// Level one finer (delta −1) or coarser (+1). Returns false at the limit (nothing changes). A change turns
+  /// the level from hand speed off for the picture shown (it comes back with another picture).
   virtual bool change_level(int delta) = 0;
+  /// Whether the level is chosen from hand speed now (Finer and Coarser then say, once, that they turn it
+  /// off). Default: false.
+  virtual bool auto_level() const { return false; }
   /// Volume one step up (+1) or down (−1). Returns false at the limit.
   virtual bool change_volume(int delta) = 0;
   /// A new visitor: the operator's default settings (volume, level), speech stopped and forgotten.
@@ -175,6 +188,11 @@ struct KioskFlowParams {
 /// The state machine. Not thread-safe: call from the window thread.
 class KioskFlow {
  public:
+  /// Finish ends the visit only when pressed again within this long of the first press [s].
+  static constexpr double kFinishConfirm_s = 5.0;
+  /// The time-out warning is said again this long after the first, when time is left [s].
+  static constexpr double kRewarn_s = 10.0;
+
   KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params = {});
 
   /// A key press at time `now_s` [s] (any monotonic clock). `key_name`: the settings' name of the key pressed
@@ -185,8 +203,8 @@ class KioskFlow {
   void help_held(bool held) { learning_ = held; }
   /// The handle moved noticeably (the caller decides, e.g. > 5 mm since the last call) at `now_s`.
   void handle_moved(double now_s);
-  /// The handle is in contact with a shape at `now_s` (the visitor is feeling it): activity, but it does not
-  /// wake the kiosk from Attract (a handle resting against a wall is not a visitor).
+  /// The handle slides along a shape at `now_s` (the visitor is feeling it; the caller reports contact with
+  /// motion, not a handle resting against a wall): activity, but it does not wake the kiosk from Attract.
   void touching(double now_s);
   /// Time passes (call every frame): the invitation, speech heard as activity, warnings, the time-out and the
   /// loading cue.
@@ -254,6 +272,9 @@ class KioskFlow {
     double last_activity_s = 0;
     double next_invitation_s = 0;   // Attract: when the next spoken invitation is due
     bool warned = false;
+    double warned_at_s = 0;         // when the first time-out warning was said
+    bool rewarned = false;          // the second warning was said
+    double finish_asked_s = -1;     // Finish pressed once at this time (asks for a second press); −1: not asked
     int help_layer = 0;             // 1 right after the first layer of help: Help again gives every key
     KioskSource source = KioskSource::Library;
     std::vector<StickEntry> stick;
@@ -267,6 +288,7 @@ class KioskFlow {
     std::string announce_summary;            // the stick's summary, said before the first page's announcement
     bool capturing = false;                  // a camera capture is under way
     bool captured = false;                   // the picture shown is the visitor's own capture
+    bool felt = false;                       // a shape, picture or page has been put under the hand in this visit
   };
 
   template <class Action>
@@ -279,6 +301,9 @@ class KioskFlow {
   void capture_done_now(int shapes, double now_s);
   bool session_key(KioskKey k, double now_s);  // keys that act the same everywhere; true when handled
   void volume_key(int delta);
+  void finish_key(double now_s);
+  void level_key(int delta);
+  void warn(double idle_s);
   void pause_key();
   void help_key();
   void learn_key(KioskKey k, std::string_view key_name);
@@ -299,6 +324,7 @@ class KioskFlow {
   void request(int document, int page, double now_s);
   void step_document(int delta, double now_s);
   std::string stick_summary() const;
+  std::string document_name(const StickEntry& e) const;  // the title, else the file name, as spoken
 
   KioskEffects& fx_;
   const audio::MessageCatalog& msg_;

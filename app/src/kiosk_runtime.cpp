@@ -460,6 +460,7 @@ SceneJob KioskRuntime::picture_job(int index) const {
 }
 
 int KioskRuntime::show_picture(int index) {
+  reset_level();  // a level the visitor chose holds for one picture
   absorb_built();
   for (auto it = ahead_.begin(); it != ahead_.end(); ++it) {
     if (it->index != index) continue;
@@ -674,6 +675,7 @@ void KioskRuntime::set_screen_picture_side_px(int px) {
 }
 
 void KioskRuntime::show_document(int document, int page) {
+  reset_level();  // a level the visitor chose holds for one page
   drop_want();  // the stick's page, not a library picture still being built
   sticks_.load(stick_id_, document, page);
 }
@@ -681,6 +683,8 @@ void KioskRuntime::show_document(int document, int page) {
 void KioskRuntime::forget_stick() {
   sticks_.forget();
   stick_id_ = 0;
+  stick_busy_ = false;  // a page still being built for the forgotten stick is dropped when it comes
+  rebuild_page_id_ = 0;
 }
 
 void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
@@ -688,7 +692,8 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
     if (n.kind == StickNews::Kind::Inserted) {
       stick_id_ = n.stick;
       std::vector<StickEntry> entries;
-      for (const ListedDocument& d : n.documents) entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages, d.title});
+      for (const ListedDocument& d : n.documents)
+        entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages, d.title, d.pages_in_file});
       stick_busy_ = !entries.empty();
       flow.stick_inserted(entries, now_s);
     } else if (n.kind == StickNews::Kind::Refused) {
@@ -749,8 +754,8 @@ void KioskRuntime::remove_stick_folder() {
 }
 
 bool KioskRuntime::change_level(int delta) {
-  // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until the
-  // session ends. With a tolerance or cut step in use (level_mode = "tolerance" or "cut") the keys move along
+  // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until
+  // another picture or page is asked for (reset_level) or the session ends. With a tolerance or cut step in use (level_mode = "tolerance" or "cut") the keys move along
   // the steps, so finer and coarser keep their order (and their earcons) without comparing a step with a level.
   const int now = level();
   const int next = now + delta;
@@ -762,6 +767,12 @@ bool KioskRuntime::change_level(int delta) {
   auto_level_ = false;
   core_.request_level(level_);
   return true;
+}
+
+void KioskRuntime::reset_level() {
+  level_ = s_.haptics.level;
+  auto_level_ = s_.haptics.level_mode != "fixed";
+  core_.request_level(auto_level_ ? ServoCore::kAutoLevel : level_);
 }
 
 bool KioskRuntime::change_volume(int delta) { return delta > 0 ? audio_.volume_up() : audio_.volume_down(); }
@@ -777,9 +788,7 @@ void KioskRuntime::new_session() {
   audio_.new_session();
   repeatable_.clear();
   tour_asked_ = false;
-  level_ = s_.haptics.level;
-  auto_level_ = s_.haptics.level_mode != "fixed";
-  core_.request_level(auto_level_ ? ServoCore::kAutoLevel : level_);
+  reset_level();
   high_contrast_ = said_contrast_ = opt_.high_contrast;
   if (tour_running_) {
     core_.cancel_tour();
@@ -854,7 +863,7 @@ void KioskRuntime::poll_tour() {
   const ServoDisplayState& d = core_.display();
   if (d.scene_id == touches_.scene_id() && d.curve >= 0) touches_.touch(d.scene_id, d.curve);
   if (tour_asked_ && d.tick >= tour_due_tick_) hand_over_tour();
-  if (!tour_running_ || d.tour_id != tour_running_ || (d.tour_phase != TourPhase::Done && d.tour_phase != TourPhase::Stopped)) return;
+  if (!tour_running_ || d.tour_id != tour_running_ || !tour_ended(d.tour_phase)) return;
   if (d.tour_phase == TourPhase::Done) touches_.touch(tour_scene_, d.tour_curve);
   tour_running_ = 0;
   // The hand lets go where the tour left the handle (unless the visitor's own hand took over).
@@ -872,6 +881,9 @@ void KioskRuntime::report_tour_end(const ServoDisplayState& d) {
   std::string text;
   if (d.tour_phase == TourPhase::Stopped) {
     text = m.text(audio::MessageId::tour_stopped) + " ";
+  } else if (d.tour_phase == TourPhase::Stuck) {
+    spdlog::warn("tour {}: stuck on shape {} (no progress), let go", d.tour_id, d.tour_curve);
+    text = m.text(audio::MessageId::tour_stuck) + " ";
   } else if (d.tour_curve >= 0 && static_cast<std::size_t>(d.tour_curve) < shown_.polylines.size()) {
     text = m.text(audio::MessageId::tour_traced, {{"shape", std::to_string(d.tour_curve + 1)},
                                                    {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(d.tour_curve), half_, false)}}) + " ";

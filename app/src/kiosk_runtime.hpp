@@ -172,6 +172,7 @@ class KioskRuntime final : public KioskEffects {
   void show_document(int document, int page) override;
   void forget_stick() override;
   bool change_level(int delta) override;
+  bool auto_level() const override { return auto_level_; }
   bool change_volume(int delta) override;
   void new_session() override;
   void key_pressed() override;
@@ -303,6 +304,7 @@ class KioskRuntime final : public KioskEffects {
   void absorb_built();                        // the builder's finished scenes: kept ahead, or the wanted one noted
   void build_ahead();                         // asks for the shown picture's neighbours, drops what is not one
   void drop_want();                           // the scene asked for is not wanted any more (the visitor went elsewhere)
+  void reset_level();                         // the operator's level and mode again (a new picture or visitor)
   void text_arrived(TextRead& read);        // swaps in the page with its text and words what came
   std::string describe_shown();             // describe() of what is shown, without the reading's news
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});

@@ -363,6 +363,7 @@ void StickService::serve() {
       LoadedDocument d = build(r, false);
       lock.lock();
       loaded_.push_back(std::move(d));
+      loads_done_.fetch_add(1);
       continue;
     }
     const std::uint64_t generation = ahead_generation_;

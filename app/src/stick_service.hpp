@@ -93,6 +93,9 @@ class StickService {
   /// for tests that need a load to be under way).
   /// Pages built ahead are not counted.
   int loads_started() const { return loads_started_.load(); }
+  /// Loads asked for whose result (a page or why not) has been posted for poll_loaded, whether or not anyone
+  /// still wants it (for tests that wait for a load to end). Pages built ahead are not counted.
+  int loads_done() const { return loads_done_.load(); }
   /// Pages whose building ahead has begun (for tests and the benchmark).
   int ahead_started() const { return ahead_started_.load(); }
   /// The longest side of the pictures it builds [px] (fit_picture), kScreenPictureMaxSidePx until set.
@@ -142,6 +145,7 @@ class StickService {
   std::string helper_path_;
   std::atomic<vision::PdfFault> pdf_fault_{vision::PdfFault::None};
   std::atomic<int> loads_started_{0};
+  std::atomic<int> loads_done_{0};
   std::atomic<int> ahead_started_{0};
   std::atomic<int> screen_side_px_{kScreenPictureMaxSidePx};
 

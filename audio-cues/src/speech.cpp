@@ -333,22 +333,29 @@ std::vector<std::string> Speaker::pieces_spoken() const {
 
 bool Speaker::speak_piece(const std::string& piece, std::uint32_t gen) {
   const auto retry = std::chrono::duration<double>(kFullRingRetry);
+  // Synthesised whole under the synthesiser's lock (a piece is a sentence: tens of milliseconds), then handed
+  // to the mixer outside it. Waiting for room in the mixer's ring takes as long as the piece plays; holding
+  // the lock meanwhile would block every other caller of espeak-ng (synthesize_speech: the window thread
+  // timing the Guide key's announcement) for seconds.
+  std::vector<float> samples;
   {
     std::lock_guard<std::mutex> lock(espeak_mutex());
     configure_locked(params_);
     synthesize_locked(piece, [&](const float* x, std::size_t n) {
-      // Hand the samples to the mixer; when its ring is full, wait for the callback to make room.
-      while (n > 0) {
-        std::size_t taken = 0;
-        const bool ok = stream_.push(gen, x, n, &taken);
-        x += taken;
-        n -= taken;
-        if (ok) break;
-        if (stream_.generation() != gen) return false;  // cancelled: abort espeak-ng now
-        std::this_thread::sleep_for(retry);
-      }
-      return stream_.generation() == gen;
+      samples.insert(samples.end(), x, x + n);
+      return stream_.generation() == gen;  // cancelled: abort espeak-ng now
     });
+  }
+  const float* x = samples.data();
+  std::size_t n = samples.size();
+  while (n > 0 && stream_.generation() == gen) {
+    // Hand the samples to the mixer; when its ring is full, wait for the callback to make room.
+    std::size_t taken = 0;
+    const bool ok = stream_.push(gen, x, n, &taken);
+    x += taken;
+    n -= taken;
+    if (ok) break;
+    std::this_thread::sleep_for(retry);
   }
   if (stream_.generation() != gen) return false;
   spdlog::debug("speech: piece: {}", piece);

@@ -33,6 +33,10 @@ void TourGuide::start(const TourPath& path, Vec2 handle_m, double period_s) noex
   ticks_ = 0;
   hold_ticks_ = 0;
   fade_ticks_ = std::max(1L, static_cast<long>(path.params.fade_s / period_s + 0.5));
+  stall_ticks_ = std::max(1L, static_cast<long>(path.params.stall_s / period_s + 0.5));
+  progress_tick_ = 0;
+  progress_t_s_ = 0.0;
+  overrun_ticks_ = std::max(stall_ticks_, static_cast<long>(path.params.overrun_factor * path.duration_s() / period_s + 0.5));
   fade_left_ = 0;
   prev_handle_ = handle_m;
   prev_target_ = path.points.front().target_m;
@@ -43,8 +47,23 @@ void TourGuide::start(const TourPath& path, Vec2 handle_m, double period_s) noex
 
 void TourGuide::stop() noexcept {
   if (!path_ || ending_ != TourPhase::None) return;
-  ending_ = TourPhase::Stopped;
+  end(TourPhase::Stopped);
+}
+
+void TourGuide::end(TourPhase how) noexcept {
+  ending_ = how;
   fade_left_ = fade_ticks_;
+}
+
+// No progress: the clock gained less than progress_min_s in the last stall_s of ticks, or the tour has run
+// overrun_factor times its planned duration. Counted in ticks, whether they rendered or not.
+bool TourGuide::stalled() noexcept {
+  const TourParams& p = path_->params;
+  if (t_s_ - progress_t_s_ >= p.progress_min_s) {
+    progress_t_s_ = t_s_;
+    progress_tick_ = ticks_;
+  }
+  return ticks_ - progress_tick_ >= stall_ticks_ || ticks_ >= overrun_ticks_;
 }
 
 bool TourGuide::on_toured_wall(const ContactOutput& c) const noexcept {
@@ -155,19 +174,13 @@ void TourGuide::advance(bool keeping_up, double guide_len_n, double period_s, To
   const TourParams& p = path_->params;
   const bool held = (guide_len_n >= 0.95 * p.max_force_n || !keeping_up || following_) && length(hold_velocity_) < p.hold_speed_m_per_s;
   hold_ticks_ = held ? hold_ticks_ + 1 : 0;
-  if (static_cast<double>(hold_ticks_) * period_s >= p.hold_s) {
-    ending_ = TourPhase::Stopped;
-    fade_left_ = fade_ticks_;
-  }
+  if (static_cast<double>(hold_ticks_) * period_s >= p.hold_s) end(TourPhase::Stopped);
   if (ending_ == TourPhase::None && keeping_up) t_s_ += period_s;
   if (phase_ == TourPhase::Transit && t_s_ >= path_->outline_start_s) {
     phase_ = TourPhase::Outline;
     out.outline_began = true;
   }
-  if (ending_ == TourPhase::None && t_s_ >= path_->duration_s()) {
-    ending_ = TourPhase::Done;
-    fade_left_ = fade_ticks_;
-  }
+  if (ending_ == TourPhase::None && t_s_ >= path_->duration_s()) end(TourPhase::Done);
 }
 
 void TourGuide::update(const TourInput& in, TourOutput& out) noexcept {
@@ -195,6 +208,7 @@ void TourGuide::update(const TourInput& in, TourOutput& out) noexcept {
   // The walls: faded out over the first fade_s of the transit, then off (walls_suspended); on from the outline.
   if (phase_ == TourPhase::Transit) out.walls_gain = std::max(0.0, 1.0 - static_cast<double>(ticks_ + 1) / static_cast<double>(fade_ticks_));
   if (ending_ == TourPhase::None && in.walls_result == TickResult::Ok) advance(keeping_up, f_len, in.period_s, out);
+  if (ending_ == TourPhase::None && stalled()) end(TourPhase::Stuck);
   if (ending_ != TourPhase::None) {  // fading out (Done or Stopped)
     --fade_left_;
     gain *= std::max(0.0, static_cast<double>(fade_left_) / static_cast<double>(fade_ticks_));

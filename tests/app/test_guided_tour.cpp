@@ -322,7 +322,7 @@ void tour_five_shapes(const config::Settings& s) {
       if (std::getenv("HK_TOUR_DEBUG") && ticks % 50 == 0)
         std::printf("press %d t %ld phase %d handle %.4f %.4f guide %.3f %.3f curve %d level %d state %d\n", press, ticks, static_cast<int>(d.tour_phase),
                     d.handle_m.x, d.handle_m.y, d.guide_force_n.x, d.guide_force_n.y, d.curve, d.level, static_cast<int>(d.state));
-      if (d.tour_id == press && (d.tour_phase == TourPhase::Done || d.tour_phase == TourPhase::Stopped)) break;
+      if (d.tour_id == press && tour_ended(d.tour_phase)) break;
       ASSERT_LT(ticks, 60000) << "press " << press << ": the tour did not end within 60 s; phase " << static_cast<int>(d.tour_phase)
                               << " handle " << d.handle_m.x << ", " << d.handle_m.y << " guide " << d.guide_force_n.x << ", "
                               << d.guide_force_n.y << " contact " << d.curve << " level " << d.level;
@@ -690,7 +690,7 @@ TEST_P(GuidedTourOnPictures, ToursEndDoneWithARelaxedHandAndTheProxyCrossesNoWal
       }
       prev_level = so.level;
       if (d.curve >= 0) touches.touch(r.scene_id, d.curve);
-      if (d.tour_id == press && (d.tour_phase == TourPhase::Done || d.tour_phase == TourPhase::Stopped)) break;
+      if (d.tour_id == press && tour_ended(d.tour_phase)) break;
       ASSERT_LT(ticks, 120000) << "tour " << press << " did not end within 120 s";
     }
     done += r.core.display().tour_phase == TourPhase::Done;

@@ -118,7 +118,7 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   EXPECT_EQ(fx.said.size(), before) << "no warning before timeout - warning";
   flow.tick(156.0);
   ASSERT_EQ(fx.said.size(), before + 1);
-  EXPECT_NE(fx.said.back().find("in 20 seconds"), std::string::npos) << fx.said.back();
+  EXPECT_NE(fx.said.back().find("In 20 seconds"), std::string::npos) << fx.said.back();
   flow.tick(157.0);
   EXPECT_EQ(fx.said.size(), before + 1) << "warned once";
   flow.handle_moved(160.0);
@@ -195,13 +195,13 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   flow.document_ready(ready(0, 1, "It has 4 shapes."), 2.0);
   EXPECT_EQ(fx.said.back(),
             "A USB stick with 3 documents: 2 pictures and a PDF of 3 pages. Press the Right arrow to go through them. "
-            "Document 1 of 3, cat.png. It has 4 shapes.");
+            "Document 1 of 3, cat. It has 4 shapes.");
   EXPECT_EQ(flow.document(), 0);
 
   flow.key(KioskKey::Next, 3.0);
   EXPECT_EQ(fx.requested.back(), std::make_pair(1, 1));
   flow.document_ready(ready(1, 1), 3.1);
-  EXPECT_EQ(fx.said.back(), "Page 1 of 3 of report.pdf. It has 2 blocks of text and one figure.");
+  EXPECT_EQ(fx.said.back(), "Page 1 of 3 of report. It has 2 blocks of text and one figure.");
   flow.key(KioskKey::Next, 4.0);
   EXPECT_EQ(fx.requested.back(), std::make_pair(1, 2)) << "Next walks the pages of a PDF";
   // A page the worker cannot draw: reported, the page felt before stays.
@@ -210,7 +210,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   bad.page = 2;
   bad.reason = "the reader stopped on page 2 (signal 11)";
   flow.document_ready(bad, 4.2);
-  EXPECT_EQ(fx.said.back(), "Page 2 of report.pdf cannot be shown: the reader stopped on page 2 (signal 11). You still feel the picture before.");
+  EXPECT_EQ(fx.said.back(), "Page 2 of report cannot be shown: the reader stopped on page 2 (signal 11). You still feel the picture before.");
   EXPECT_EQ(flow.document(), 1);
   EXPECT_EQ(flow.page(), 1) << "the page shown is still page 1";
   // Next moves on from the unreadable page; a second press while loading moves on from the first; the
@@ -223,7 +223,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   flow.document_ready(ready(1, 3), 5.2);
   EXPECT_EQ(fx.said.size(), said) << "a superseded load says nothing";
   flow.document_ready(ready(2, 1, "It has one shape."), 5.3);
-  EXPECT_EQ(fx.said.back(), "Document 3 of 3, dog.jpg. It has one shape.");
+  EXPECT_EQ(fx.said.back(), "Document 3 of 3, dog. It has one shape.");
   flow.key(KioskKey::Next, 6.0);
   EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1)) << "wraps round to the first document";
   flow.key(KioskKey::Previous, 6.1);
@@ -246,7 +246,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
   flow.document_ready(ready(0, 1, "It has no text and one figure."), 9.1);
   EXPECT_EQ(fx.said.back(),
-            "A USB stick with one document: a PDF of one page. Press the Right arrow to go through them. Page 1 of 1 of only.pdf. It has no text and one figure.");
+            "A USB stick with one document: a PDF of one page. Press the Right arrow to go through them. Page 1 of 1 of only. It has no text and one figure.");
 
   // The visitor leaves; the next one does not get the stick.
   flow.tick(9.1 + 120.0);
@@ -255,6 +255,52 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   EXPECT_EQ(flow.source(), KioskSource::Library);
   flow.key(KioskKey::Other, 300.0);
   EXPECT_EQ(flow.state(), KioskState::Tutorial);
+}
+
+// A stick put in while the kiosk waits, its first file unreadable: nothing was felt before, so nothing
+// "still" is; a PDF over the page cap is counted as it is and said to be readable in part; a 254-byte file
+// name is said shortened, without its extension.
+TEST(KioskFlow, StickNamesPageCountsAndNothingFeltBefore) {
+  Recorder fx;
+  KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
+  const std::string long_name = std::string("minutes_of_the_annual_general_meeting_of_the_society_") + std::string(197, 'x') + ".pdf";
+  ASSERT_EQ(long_name.size(), 254u);
+  flow.stick_inserted({{"bad_crc.png", false, 1, ""}, {"atlas.pdf", true, 1000, "", 5000}, {long_name, true, 2, ""}}, 1.0);
+  DocumentResult bad;
+  bad.document = 0;
+  bad.page = 1;
+  bad.reason = "it is damaged";
+  flow.document_ready(bad, 1.1);
+  EXPECT_EQ(fx.said.back(),
+            "A USB stick with 3 documents: a picture and 2 PDFs of 5002 pages in all (the first 1000 pages of each can be read). "
+            "Press the Right arrow to go through them. bad crc cannot be shown: it is damaged.")
+      << "no picture was felt before";
+  flow.key(KioskKey::Next, 2.0);
+  flow.document_ready(ready(1, 1), 2.1);
+  EXPECT_EQ(fx.said.back(), "Page 1 of 5000 of atlas. It has 2 blocks of text and one figure.");
+  flow.key(KioskKey::Previous, 3.0);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
+  flow.key(KioskKey::Previous, 3.1);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(2, 2)) << "the third document's last page";
+  flow.document_ready(ready(2, 2), 3.2);
+  EXPECT_EQ(fx.said.back(), "Page 2 of 2 of minutes of the annual general meeting of the society. It has 2 blocks of text and one figure.");
+  flow.key(KioskKey::Next, 4.0);
+  EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
+  flow.document_ready(bad, 4.1);
+  EXPECT_EQ(fx.said.back(), "bad crc cannot be shown: it is damaged. You still feel the picture before.") << "now there was one";
+}
+
+TEST(KioskFlow, SpokenNamesAreShortWholeWordsAndWholeCharacters) {
+  EXPECT_EQ(spoken_name("holiday-photo_2025.JPG", true), "holiday photo 2025");
+  EXPECT_EQ(spoken_name("notes.v2.pdf", true), "notes.v2");
+  EXPECT_EQ(spoken_name(std::string(80, 'a'), false).size(), kSpokenNameBytes);
+  // 45 two-byte letters after one one-byte letter: cut at a character, never inside one.
+  std::string umlauts = "a";
+  for (int i = 0; i < 45; ++i) umlauts += "\xc3\xa4";
+  const std::string cut = spoken_name(umlauts, false);
+  EXPECT_EQ(cut.size(), kSpokenNameBytes - 1);
+  EXPECT_EQ(cut.size() % 2, 1u);
+  EXPECT_EQ(spoken_name("A ring, drawn for the hand", false), "A ring, drawn for the hand");
 }
 
 TEST(KioskFlow, EmptyAndRefusedSticksAreSaidAndChangeNothing) {

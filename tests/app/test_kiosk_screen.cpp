@@ -141,7 +141,7 @@ TEST(KioskScreen, ScriptedVisitWalksTheFlowAndSaysEachStep) {
     if (at != std::string::npos) said.push_back(line.substr(at + 5));
   }
   const std::vector<std::string> want_prefix{"Welcome.", "Now a circle.", "Now a triangle.", "Well done. Here is the first picture. Picture 1 of 2.",
-                                             "Picture 2 of 2.", "Are you still there? Press any key for more time. The kiosk starts again in 10 seconds.",
+                                             "Picture 2 of 2.", "Still there? Press any key for more time. In 10 seconds this visit ends",
                                              "Thank you for visiting. Goodbye."};
   ASSERT_EQ(said.size(), want_prefix.size()) << std::ifstream(dir / "log.txt").rdbuf();
   for (std::size_t i = 0; i < said.size(); ++i) EXPECT_EQ(said[i].rfind(want_prefix[i], 0), 0u) << said[i];

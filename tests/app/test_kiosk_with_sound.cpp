@@ -4,6 +4,7 @@
 // bytes), the whole paragraph is given to the speaker, and its pieces are spoken in order from its start.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -99,6 +100,34 @@ TEST(KioskWithSound, DescribeReadsAnEightKilobyteParagraphWholeAndTheKioskRunsOn
   const std::string heard = letters_of(spoken), whole_text = letters_of(want);
   EXPECT_GT(heard.size(), 300u) << "more than its first sentence was handed on";
   EXPECT_EQ(whole_text.rfind(heard, 0), 0u) << "the pieces spoken are the paragraph's start, in order";
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+// A scripted visit heard through its spoken lines: chords a visitor may press by accident (Ctrl+Q, Alt+F4) are
+// answered like any key that does nothing; Finish pressed once only asks, pressed again too late asks again,
+// and pressed twice within 5 s ends the visit.
+TEST(KioskWithSound, ChordsAreAnsweredAndFinishAsksOnce) {
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  const fs::path dir = hk::test::fresh_dir("kiosk_finish");
+  std::ofstream(dir / "script.txt") << "1 wait\n10 press CTRL+Q\n40 press ALT+F4\n70 key finish\n500 key finish\n530 key finish\n";
+  const fs::path home = null_sound_home(dir);
+  const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 HOME=" + hk::test::quoted(home) + " timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " +
+                          std::string(HK_KIOSK_EXE) + " --library " + hk::test::quoted(kData / "images") + " --show " +
+                          hk::test::quoted(kData / "images" / "horse.png") + " --script " + hk::test::quoted(dir / "script.txt") +
+                          " --screenshot " + hk::test::quoted(dir / "end.png") + " --frames 600 >" + hk::test::quoted(dir / "log.txt") + " 2>&1";
+  ASSERT_EQ(sh(cmd), 0) << read(dir / "log.txt").substr(0, 4000);
+  std::vector<std::string> said = lines_after(read(dir / "log.txt"), "say: ");
+  const auto first = std::find_if(said.begin(), said.end(), [](const std::string& s) { return s.rfind("That key", 0) == 0; });
+  ASSERT_NE(first, said.end()) << "Ctrl+Q was answered";
+  const std::vector<std::string> want{"That key does nothing here. Press F1 for help.", "That key does nothing here. Press F1 for help.",
+                                      "Press the End key again to finish your visit.", "Press the End key again to finish your visit.",
+                                      "Thank you for visiting. Goodbye."};
+  const std::vector<std::string> got(first, said.end());
+  EXPECT_EQ(got, want);
   fs::remove_all(dir);
 }
 

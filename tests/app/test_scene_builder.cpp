@@ -348,6 +348,37 @@ TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibr
   fs::remove_all(stick);
 }
 
+// Finish pressed twice while a stick's page is drawn: the visit ends, the stick is forgotten, and the page that
+// arrives afterwards is dropped without leaving the stick "busy" (a scripted `wait` would never return, and the
+// operator's panel would say "working" for good).
+TEST(KioskBuilds, FinishWhileAStickPageIsBuiltLeavesNothingBusy) {
+  LibraryRig r({"horse.png"}, 0, "stickfinish");
+  const fs::path stick = r.spec_stick("stickfinish");
+  r.flow->key(KioskKey::Other, 0.0);
+  r.rt->insert_stick_folder(stick.string());
+  double now_s = 1.0;
+  ASSERT_TRUE(r.stick_shows(1001, now_s)) << "the stick's first page is felt";
+  const int loads = r.rt->sticks().loads_started();
+  const int done = r.rt->sticks().loads_done();
+  r.flow->key(KioskKey::Next, now_s);  // page 2...
+  for (int i = 0; i < 6000 && r.rt->sticks().loads_started() == loads; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_EQ(r.rt->sticks().loads_started(), loads + 1) << "page 2 is being drawn";
+  r.rt->poll_sticks(*r.flow, now_s);
+  ASSERT_TRUE(r.rt->stick_busy()) << "the kiosk waits for page 2";
+  r.flow->key(KioskKey::Finish, now_s);  // ...and Finish, twice, before it is done
+  r.flow->key(KioskKey::Finish, now_s + 0.5);
+  ASSERT_EQ(r.flow->state(), KioskState::Attract);
+  EXPECT_FALSE(r.rt->stick_busy()) << "nothing of the forgotten stick is awaited";
+  // Page 2's drawing ends (or has ended), and the window polls it in.
+  for (int i = 0; i < 6000 && r.rt->sticks().loads_done() == done; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_EQ(r.rt->sticks().loads_done(), done + 1) << "page 2's load ended within 60 s";
+  r.rt->poll_sticks(*r.flow, now_s);
+  EXPECT_FALSE(r.rt->stick_busy()) << "the page that arrived for the forgotten stick left nothing busy";
+  EXPECT_EQ(r.flow->state(), KioskState::Attract) << "and did not wake the kiosk";
+  EXPECT_EQ(r.flow->failures(), 0);
+  fs::remove_all(stick);
+}
+
 TEST(KioskBuilds, StickPagesPassedByQuicklyAreNeverPutOnTheDevice) {
   LibraryRig r({"horse.png"}, 0, "stickquick");  // prefetch_mb 0: each page is built when asked for
   const fs::path stick = r.spec_stick("stickquick");

@@ -69,7 +69,12 @@ struct Speaker final : KioskEffects {
   int picture_count() const override { return 3; }
   std::string describe() override { return "4 shapes. Nearest your hand, a small closed shape on the left."; }
   std::string where() override { return here; }
-  bool change_level(int) override { return true; }
+  bool automatic = false;              // the level follows hand speed (Finer and Coarser turn it off)
+  bool change_level(int) override {
+    automatic = false;
+    return true;
+  }
+  bool auto_level() const override { return automatic; }
   bool change_volume(int d) override {
     if (volume + d < 1 || volume + d > 10) return false;
     volume += d;
@@ -160,20 +165,54 @@ TEST(VisitorInCharge, WhereSaysWhatIsUnderTheHand) {
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::place_picture, {{"picture", "1"}, {"pictures", "3"}}));
 }
 
-TEST(VisitorInCharge, FinishEndsTheVisitAtOnce) {
+TEST(VisitorInCharge, FinishPressedTwiceEndsTheVisit) {
   Visit v;
   v.flow.key(KioskKey::Next, 3.0);
   ASSERT_EQ(v.flow.picture(), 1);
   v.flow.key(KioskKey::Finish, 4.0);
+  EXPECT_EQ(v.flow.state(), KioskState::Picture) << "one press only asks";
+  EXPECT_EQ(v.fx.said.back(), "Press the End key again to finish your visit.");
+  EXPECT_EQ(v.fx.sessions, 0);
+  v.flow.key(KioskKey::Finish, 4.0 + KioskFlow::kFinishConfirm_s - 0.1);
   EXPECT_EQ(v.flow.state(), KioskState::Attract);
   EXPECT_EQ(v.fx.sessions, 1) << "the operator's defaults again";
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::goodbye));
   // The next visitor starts from the beginning.
-  v.flow.key(KioskKey::Next, 5.0);
+  v.flow.key(KioskKey::Next, 10.0);
   EXPECT_EQ(v.flow.state(), KioskState::Tutorial);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::welcome));
-  v.flow.key(KioskKey::Repeat, 6.0);
+  v.flow.key(KioskKey::Repeat, 11.0);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::welcome)) << "Repeat never reaches the last visitor's words";
+}
+
+TEST(VisitorInCharge, OneFinishByAccidentLosesNothing) {
+  Visit v;
+  v.flow.key(KioskKey::Next, 3.0);
+  // Too late for a second press: it asks again.
+  v.flow.key(KioskKey::Finish, 4.0);
+  v.flow.key(KioskKey::Finish, 4.0 + KioskFlow::kFinishConfirm_s + 0.5);
+  EXPECT_EQ(v.flow.state(), KioskState::Picture);
+  EXPECT_EQ(v.fx.said.back(), "Press the End key again to finish your visit.");
+  // Another key in between: the next Finish asks again.
+  v.flow.key(KioskKey::Where, 10.5);
+  v.flow.key(KioskKey::Finish, 11.0);
+  EXPECT_EQ(v.flow.state(), KioskState::Picture);
+  EXPECT_EQ(v.flow.picture(), 1) << "the picture is still the one felt";
+  EXPECT_EQ(v.fx.sessions, 0);
+  // Volume (next to it on the keypad) neither finishes nor cancels the question.
+  v.flow.key(KioskKey::VolumeDown, 11.5);
+  v.flow.key(KioskKey::Finish, 12.0);
+  EXPECT_EQ(v.flow.state(), KioskState::Attract);
+}
+
+TEST(VisitorInCharge, FinerOrCoarserSaysOnceThatAutomaticDetailIsOffAndWhatBringsItBack) {
+  Visit v;
+  v.fx.automatic = true;
+  v.flow.key(KioskKey::Finer, 3.0);
+  EXPECT_EQ(v.fx.said.back(), "More detail. Automatic detail is off until you press the Right arrow or the Left arrow for another "
+                            "picture.");
+  v.flow.key(KioskKey::Coarser, 4.0);
+  EXPECT_EQ(v.fx.said.back(), "Less detail.") << "said once, while it is off";
 }
 
 TEST(VisitorInCharge, HelpComesInTwoLayers) {
@@ -234,8 +273,15 @@ TEST(VisitorInCharge, TheTimeOutNeverCutsATextBeingRead) {
   EXPECT_TRUE(v.flow.warned());
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::timeout_warning, {{"seconds", "19"}}));
   EXPECT_NE(v.fx.said.back().find("Press any key for more time."), std::string::npos);
-  // The warning's own speech does not count: with nothing done the visit ends.
-  for (double t = 404.5; t <= 424.0; t += 0.5) v.flow.tick(t);
+  EXPECT_NE(v.fx.said.back().find("this visit ends"), std::string::npos) << "what is at stake";
+  // Said again 10 s later, with the seconds left then; the warning's own speech does not count: with nothing
+  // done the visit ends.
+  const std::size_t before = v.fx.said.size();
+  for (double t = 404.5; t < 414.0; t += 0.5) v.flow.tick(t);
+  EXPECT_EQ(v.fx.said.size(), before) << "nothing more within the 10 s";
+  v.flow.tick(414.0);
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::timeout_warning, {{"seconds", "9"}}));
+  for (double t = 414.5; t <= 424.0; t += 0.5) v.flow.tick(t);
   EXPECT_EQ(v.flow.state(), KioskState::Attract);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::goodbye));
 }
@@ -248,7 +294,8 @@ TEST(VisitorInCharge, PausedSpeechAndTouchingAShape) {
   EXPECT_FALSE(v.flow.warned());
   v.flow.tick(104.5);
   EXPECT_TRUE(v.flow.warned()) << "a paused text holds no one's session";
-  // Touching a shape is activity: a hand feeling an outline without moving 5 mm is there.
+  // Sliding along a shape is activity (the window layer reports contact with motion): a hand feeling an
+  // outline without moving 5 mm is there.
   for (double t = 105.0; t < 400.0; t += 0.5) {
     v.flow.touching(t);
     v.flow.tick(t);

@@ -87,6 +87,58 @@ TEST(TourGuide, AHandleHeldStillStopsTheTourAndTheClock) {
   EXPECT_LT(ticks, 500 + 50 + 200);
 }
 
+// A handle pinned 5 mm off the target (the spring at its limit: the clock stops) that jitters ±1 mm every
+// tick (2 m/s raw, ~30 mm/s low-passed at 5 Hz, above hold_speed: never "held still") is what a handle caught in a
+// shape's tip does. The tour must still end: Stuck, stall_s (2 s) after the clock last moved, then the fade.
+TEST(TourGuide, AHandleThatJittersWithoutProgressEndsTheTourStuckAfterTheStallTime) {
+  const TourPath path = straight_path();
+  TourGuide g;
+  g.start(path, {0.0, 0.0}, 0.001);
+  const ContactOutput free_contact;
+  TourOutput out;
+  int ticks = 0;
+  while (g.active() && ticks < 20000) {
+    const double jitter = (ticks % 2 == 0 ? 0.001 : -0.001);
+    g.update(input({-0.005, jitter}, free_contact), out);
+    EXPECT_LE(length(out.guide_force_n), path.params.max_force_n + 1e-12);
+    ++ticks;
+  }
+  EXPECT_FALSE(g.active());
+  EXPECT_EQ(out.ended, TourPhase::Stuck);
+  EXPECT_EQ(g.phase(), TourPhase::Stuck);
+  EXPECT_TRUE(tour_ended(g.phase()));
+  // The clock never gains 0.25 s (the spring is at its limit from the first tick), so: 2 s, then the fade.
+  const long stall = static_cast<long>(path.params.stall_s / 0.001);
+  EXPECT_GE(ticks, stall);
+  EXPECT_LE(ticks, stall + 50 + 2);
+}
+
+// A handle that keeps up only now and then (the clock gains a little, more than progress_min_s in every
+// stall_s, but far slower than planned) still ends: Stuck once overrun_factor × the path's duration is up.
+TEST(TourGuide, ATourThatCrawlsEndsStuckAtOneAndAHalfTimesItsPlannedDuration) {
+  const TourPath path = straight_path();  // 1.5 s planned
+  TourGuide g;
+  g.start(path, {0.0, 0.0}, 0.001);
+  const ContactOutput free_contact;
+  TourOutput out;
+  int ticks = 0;
+  double t = 0.0;
+  while (g.active() && ticks < 20000) {
+    std::size_t cursor = 0;
+    // On the target one tick in three (the clock runs), 5 mm behind it otherwise (the clock stops).
+    const Vec2 target = path.at(t, cursor).target_m;
+    const bool keep_up = ticks % 3 == 0;
+    g.update(input(keep_up ? target : target - Vec2{0.005, 0.0}, free_contact), out);
+    if (keep_up) t += 0.001;
+    ++ticks;
+  }
+  EXPECT_EQ(out.ended, TourPhase::Stuck);
+  const long overrun = static_cast<long>(path.params.overrun_factor * path.duration_s() / 0.001 + 0.5);
+  EXPECT_GE(ticks, overrun);
+  EXPECT_LE(ticks, overrun + 50 + 2);
+  EXPECT_LT(t, path.duration_s()) << "it ended before the path's end";
+}
+
 TEST(TourGuide, WallsAreSuspendedInTheTransitOnceFadedAndInTheOutlineOnlyForOtherShapes) {
   const TourPath path = straight_path();
   TourGuide g;

@@ -38,9 +38,10 @@ enum class MessageId : int {
   help_brief, place_tutorial, place_picture, place_document, place_capture, key_help, key_next, key_previous, key_describe, key_finer, key_coarser, key_volume_up, key_volume_down,
   key_tutorial, key_guide, key_capture, key_repeat, key_pause, key_where, key_finish, key_other, this_key, nothing_to_pause, nothing_to_repeat, where_on, where_near,
   where_none, where_text, sorry, tour_ask, tour_traced, high_contrast_on, high_contrast_off, overlay_on, overlay_off,
-  text_reading, text_ready, text_none, text_unavailable, device_not_home,
+  text_reading, text_ready, text_none, text_unavailable, device_not_home, tour_stuck, finish_ask,
+  timeout_warning_stick, level_manual, files_unreadable, file_unreadable, document_unreadable_alone,
 };
-inline constexpr int kMessageCount = 104;
+inline constexpr int kMessageCount = 111;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -59,7 +60,8 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "key_coarser", "key_volume_up", "key_volume_down", "key_tutorial", "key_guide", "key_capture", "key_repeat", "key_pause", "key_where", "key_finish",
     "key_other", "this_key", "nothing_to_pause", "nothing_to_repeat", "where_on", "where_near", "where_none", "where_text", "sorry", "tour_ask",
     "tour_traced", "high_contrast_on", "high_contrast_off", "overlay_on", "overlay_off", "text_reading", "text_ready", "text_none",
-    "text_unavailable", "device_not_home"};
+    "text_unavailable", "device_not_home", "tour_stuck", "finish_ask", "timeout_warning_stick", "level_manual",
+    "files_unreadable", "file_unreadable", "document_unreadable_alone"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".

@@ -17,7 +17,10 @@
 /// (follow_force_n along it, plus the press) until the handle is within rejoin_m of the target. The tour ends
 /// (force faded out over fade_s) at the path's end (Done), when the hand holds still against it (guide force
 /// at ≥ 95 % of its limit, or the clock stopped, while the handle, its velocity low-passed at 5 Hz, moves
-/// slower than hold_speed_m_per_s, for hold_s), or at stop() (Stopped).
+/// slower than hold_speed_m_per_s, for hold_s), or at stop() (Stopped). Whatever the handle does, a tour
+/// always ends: one whose clock gains less than progress_min_s in stall_s of ticks, or that has run
+/// overrun_factor times its planned duration, ends Stuck (a handle pinned in a tip, jittering too much to
+/// count as held, would otherwise keep it going for good).
 ///
 /// The spring and damper follow a minimum-jerk target (Flash & Hogan 1985, "The coordination of arm
 /// movements", J. Neurosci. 5(7)); tuning in TourParams. Real-time: update, stop and walls_suspended
@@ -70,6 +73,12 @@ struct TourParams {
   double trap_s = 0.15;              ///< [s]
   double follow_force_n = 0.5;       ///< [N]; above the break-away friction of the press (μ_s 0.4 × 0.6 N)
   double rejoin_m = 0.002;           ///< [m]; above the track's offset from the wall plus the press's depth
+  /// A tour that makes no progress ends Stuck: its clock gained less than progress_min_s of path time in the
+  /// last stall_s of ticks. At 3 cm/s, 0.25 s of path is 7.5 mm of outline.
+  double stall_s = 2.0;              ///< [s] of ticks
+  double progress_min_s = 0.25;      ///< [s] of path time
+  /// A tour that has run this many times its planned duration (TourPath::duration_s) ends Stuck.
+  double overrun_factor = 1.5;
 };
 
 /// The tour's phase (as the kiosk's servo reports it).
@@ -79,7 +88,13 @@ enum class TourPhase : std::uint8_t {
   Outline,  ///< tracing the outline (walls on)
   Done,     ///< traced to the end and let go (the force has faded out)
   Stopped,  ///< stopped before the end: a key, the hand holding still, the device lost or a new picture
+  Stuck,    ///< ended before the end because it made no progress (TourParams::stall_s, overrun_factor)
 };
+
+/// Whether a tour in `phase` has ended (Done, Stopped or Stuck).
+constexpr bool tour_ended(TourPhase phase) noexcept {
+  return phase == TourPhase::Done || phase == TourPhase::Stopped || phase == TourPhase::Stuck;
+}
 
 /// A planned tour. Built off the servo thread; the servo thread only reads it.
 struct TourPath {
@@ -141,6 +156,8 @@ class TourGuide {
   void track_trap(const TourInput& in, Vec2 error_m, bool keeping_up) noexcept;
   Vec2 follow_force(const TourInput& in, Vec2 press_n) noexcept;
   void advance(bool keeping_up, double guide_len_n, double period_s, TourOutput& out) noexcept;
+  bool stalled() noexcept;
+  void end(TourPhase how) noexcept;
   bool on_toured_wall(const ContactOutput& c) const noexcept;
 
   static constexpr double kVelocityHz = 30.0;  // low-pass of the guide's damping velocity [Hz]
@@ -155,6 +172,10 @@ class TourGuide {
   long fade_ticks_ = 1;                        // fade_s in ticks
   long fade_left_ = 0;                         // while ending: ticks of fade left
   long hold_ticks_ = 0;                        // consecutive ticks "held still against it"
+  long stall_ticks_ = 1;                       // stall_s in ticks
+  long progress_tick_ = 0;                     // the tick the clock last gained progress_min_s
+  double progress_t_s_ = 0.0;                  // the clock then [s]
+  long overrun_ticks_ = 0;                     // overrun_factor × the planned duration, in ticks
   Vec2 prev_handle_, prev_target_;             // last tick's handle and target [m]
   Vec2 velocity_, hold_velocity_;              // the handle's velocity, low-passed [m/s]
   Vec2 press_;                                 // the press force, low-passed [N]
