@@ -187,6 +187,34 @@ void KioskFlow::finish_key(double now_s) {
   say_brief(MessageId::finish_ask);
 }
 
+void KioskFlow::describe_key() {
+  const std::string description = fx_.describe();
+  std::string before;
+  // A visitor's own document is about to be heard by everyone near the kiosk: said once a visit, first.
+  if (v_.source == KioskSource::Stick && v_.doc >= 0 && !v_.read_aloud_said) {
+    v_.read_aloud_said = true;
+    before = text(MessageId::read_aloud_warning) + " ";
+  }
+  // A long text says how long it is before it starts (words at the voice's rate).
+  const double seconds = spoken_seconds(description);
+  if (seconds > kLongText_s) {
+    const int minutes = static_cast<int>(std::lround(seconds / 60.0));
+    before += (minutes <= 1 ? text(MessageId::long_text_minute) : text(MessageId::long_text_minutes, {{"minutes", std::to_string(minutes)}})) + " ";
+  }
+  fx_.say(before + text(MessageId::describe, {{"description", description}}));
+}
+
+double spoken_seconds(std::string_view text) {
+  int words = 0;
+  bool in_word = false;
+  for (const char c : text) {
+    const bool space = std::isspace(static_cast<unsigned char>(c)) != 0;
+    words += !space && !in_word;
+    in_word = !space;
+  }
+  return 60.0 * words / kWordsPerMinute;
+}
+
 void KioskFlow::level_key(int delta) {
   const bool was_auto = fx_.auto_level();
   const bool changed = fx_.change_level(delta);
@@ -268,7 +296,7 @@ void KioskFlow::picture_key(KioskKey k) {
       show(v_.picture - 1);
       return;
     case KioskKey::Describe:
-      fx_.say(text(MessageId::describe, {{"description", fx_.describe()}}));
+      describe_key();
       return;
     case KioskKey::Finer:
       level_key(-1);

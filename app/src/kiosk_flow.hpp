@@ -185,6 +185,12 @@ struct KioskFlowParams {
   bool camera = false;          ///< a camera is there: the help names the Capture key
 };
 
+/// The voice's rate [words per minute] (espeak-ng's default, the kiosk's [audio] default).
+inline constexpr double kWordsPerMinute = 165.0;
+/// How long `text` takes to say at kWordsPerMinute [s]: its words (runs of non-space bytes) counted, not
+/// synthesised, so a text of hours costs a pass over its bytes.
+double spoken_seconds(std::string_view text);
+
 /// The state machine. Not thread-safe: call from the window thread.
 class KioskFlow {
  public:
@@ -192,6 +198,8 @@ class KioskFlow {
   static constexpr double kFinishConfirm_s = 5.0;
   /// The time-out warning is said again this long after the first, when time is left [s].
   static constexpr double kRewarn_s = 10.0;
+  /// Describe says how long a text is before one that takes longer than this to say [s].
+  static constexpr double kLongText_s = 30.0;
 
   KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params = {});
 
@@ -289,6 +297,7 @@ class KioskFlow {
     bool capturing = false;                  // a camera capture is under way
     bool captured = false;                   // the picture shown is the visitor's own capture
     bool felt = false;                       // a shape, picture or page has been put under the hand in this visit
+    bool read_aloud_said = false;            // the visitor was told that their document is heard by people nearby
   };
 
   template <class Action>
@@ -302,6 +311,7 @@ class KioskFlow {
   bool session_key(KioskKey k, double now_s);  // keys that act the same everywhere; true when handled
   void volume_key(int delta);
   void finish_key(double now_s);
+  void describe_key();
   void level_key(int delta);
   void warn(double idle_s);
   void pause_key();

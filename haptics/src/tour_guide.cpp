@@ -35,7 +35,9 @@ void TourGuide::start(const TourPath& path, Vec2 handle_m, double period_s) noex
   fade_ticks_ = std::max(1L, static_cast<long>(path.params.fade_s / period_s + 0.5));
   stall_ticks_ = std::max(1L, static_cast<long>(path.params.stall_s / period_s + 0.5));
   progress_tick_ = 0;
+  rendered_ticks_ = 0;
   progress_t_s_ = 0.0;
+  progress_error_m_ = std::numeric_limits<double>::infinity();
   overrun_ticks_ = std::max(stall_ticks_, static_cast<long>(path.params.overrun_factor * path.duration_s() / period_s + 0.5));
   fade_left_ = 0;
   prev_handle_ = handle_m;
@@ -55,15 +57,18 @@ void TourGuide::end(TourPhase how) noexcept {
   fade_left_ = fade_ticks_;
 }
 
-// No progress: the clock gained less than progress_min_s in the last stall_s of ticks, or the tour has run
-// overrun_factor times its planned duration. Counted in ticks, whether they rendered or not.
-bool TourGuide::stalled() noexcept {
+// No progress: in the last stall_s of ticks that rendered (a late tick moves no clock), the clock gained less
+// than progress_min_s and the handle came no nearer its waiting target by progress_min_m (a handle led out of a
+// pocket along the wall, the clock stopped, is progress); or the tour has run overrun_factor times its planned
+// duration in ticks of any kind.
+bool TourGuide::stalled(double error_m) noexcept {
   const TourParams& p = path_->params;
-  if (t_s_ - progress_t_s_ >= p.progress_min_s) {
+  if (t_s_ - progress_t_s_ >= p.progress_min_s || error_m <= progress_error_m_ - p.progress_min_m) {
     progress_t_s_ = t_s_;
-    progress_tick_ = ticks_;
+    progress_error_m_ = error_m;
+    progress_tick_ = rendered_ticks_;
   }
-  return ticks_ - progress_tick_ >= stall_ticks_ || ticks_ >= overrun_ticks_;
+  return rendered_ticks_ - progress_tick_ >= stall_ticks_ || ticks_ >= overrun_ticks_;
 }
 
 bool TourGuide::on_toured_wall(const ContactOutput& c) const noexcept {
@@ -207,8 +212,11 @@ void TourGuide::update(const TourInput& in, TourOutput& out) noexcept {
   double gain = std::min(1.0, static_cast<double>(ticks_ + 1) / static_cast<double>(fade_ticks_));  // fade in
   // The walls: faded out over the first fade_s of the transit, then off (walls_suspended); on from the outline.
   if (phase_ == TourPhase::Transit) out.walls_gain = std::max(0.0, 1.0 - static_cast<double>(ticks_ + 1) / static_cast<double>(fade_ticks_));
-  if (ending_ == TourPhase::None && in.walls_result == TickResult::Ok) advance(keeping_up, f_len, in.period_s, out);
-  if (ending_ == TourPhase::None && stalled()) end(TourPhase::Stuck);
+  if (ending_ == TourPhase::None && in.walls_result == TickResult::Ok) {
+    advance(keeping_up, f_len, in.period_s, out);
+    rendered_ticks_ += 1;
+  }
+  if (ending_ == TourPhase::None && stalled(length(e))) end(TourPhase::Stuck);
   if (ending_ != TourPhase::None) {  // fading out (Done or Stopped)
     --fade_left_;
     gain *= std::max(0.0, static_cast<double>(fade_left_) / static_cast<double>(fade_ticks_));

@@ -303,6 +303,14 @@ TEST(KioskFlow, SpokenNamesAreShortWholeWordsAndWholeCharacters) {
   EXPECT_EQ(spoken_name("A ring, drawn for the hand", false), "A ring, drawn for the hand");
 }
 
+TEST(KioskFlow, SpokenSecondsCountWordsAtTheVoicesRate) {
+  std::string text;
+  for (int i = 0; i < 330; ++i) text += "word\t \n";
+  EXPECT_DOUBLE_EQ(spoken_seconds(text), 120.0);  // 330 words at 165 a minute
+  EXPECT_DOUBLE_EQ(spoken_seconds("  "), 0.0);
+  EXPECT_DOUBLE_EQ(spoken_seconds("one"), 60.0 / 165.0);
+}
+
 TEST(KioskFlow, EmptyAndRefusedSticksAreSaidAndChangeNothing) {
   Recorder fx;
   KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});

@@ -1,7 +1,7 @@
 // A guided tour always ends. On every picture of tests/data/images and of the shipped library
 // (data/pictures), the kiosk's own runtime is asked for a tour again and again until every shape has been
 // led to, with the model hand limp as the kiosk makes it during a tour (nobody holds the handle): each tour
-// must end within its bound — one and a half times its planned duration, or the 2 s without progress, plus
+// must end within its bound — one and a half times its planned duration, or the 3 s without progress, plus
 // the fade — with one of the lines that say how it ended ("That was shape …", "Tour stopped.", or that the
 // guide could not go on and let go), followed by what remains. The shipped horse's tour once held the
 // handle pinned in the tip of the tail for good, saying nothing more.

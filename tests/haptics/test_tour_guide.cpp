@@ -4,6 +4,7 @@
 // never above its limit, the walls suspended only in the transit after the fade.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "haptics/tour_guide.hpp"
@@ -89,7 +90,7 @@ TEST(TourGuide, AHandleHeldStillStopsTheTourAndTheClock) {
 
 // A handle pinned 5 mm off the target (the spring at its limit: the clock stops) that jitters ±1 mm every
 // tick (2 m/s raw, ~30 mm/s low-passed at 5 Hz, above hold_speed: never "held still") is what a handle caught in a
-// shape's tip does. The tour must still end: Stuck, stall_s (2 s) after the clock last moved, then the fade.
+// shape's tip does. The tour must still end: Stuck, stall_s (3 s) after the clock last moved, then the fade.
 TEST(TourGuide, AHandleThatJittersWithoutProgressEndsTheTourStuckAfterTheStallTime) {
   const TourPath path = straight_path();
   TourGuide g;
@@ -107,7 +108,7 @@ TEST(TourGuide, AHandleThatJittersWithoutProgressEndsTheTourStuckAfterTheStallTi
   EXPECT_EQ(out.ended, TourPhase::Stuck);
   EXPECT_EQ(g.phase(), TourPhase::Stuck);
   EXPECT_TRUE(tour_ended(g.phase()));
-  // The clock never gains 0.25 s (the spring is at its limit from the first tick), so: 2 s, then the fade.
+  // The clock never gains 0.25 s (the spring is at its limit from the first tick), so: stall_s, then the fade.
   const long stall = static_cast<long>(path.params.stall_s / 0.001);
   EXPECT_GE(ticks, stall);
   EXPECT_LE(ticks, stall + 50 + 2);
@@ -133,7 +134,9 @@ TEST(TourGuide, ATourThatCrawlsEndsStuckAtOneAndAHalfTimesItsPlannedDuration) {
     ++ticks;
   }
   EXPECT_EQ(out.ended, TourPhase::Stuck);
-  const long overrun = static_cast<long>(path.params.overrun_factor * path.duration_s() / 0.001 + 0.5);
+  // overrun_factor × the duration, but never sooner than stall_s (a short path still gets that long).
+  const long overrun = std::max(static_cast<long>(path.params.stall_s / 0.001 + 0.5),
+                                static_cast<long>(path.params.overrun_factor * path.duration_s() / 0.001 + 0.5));
   EXPECT_GE(ticks, overrun);
   EXPECT_LE(ticks, overrun + 50 + 2);
   EXPECT_LT(t, path.duration_s()) << "it ended before the path's end";

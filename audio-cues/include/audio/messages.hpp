@@ -40,8 +40,9 @@ enum class MessageId : int {
   where_none, where_text, sorry, tour_ask, tour_traced, high_contrast_on, high_contrast_off, overlay_on, overlay_off,
   text_reading, text_ready, text_none, text_unavailable, device_not_home, tour_stuck, finish_ask,
   timeout_warning_stick, level_manual, files_unreadable, file_unreadable, document_unreadable_alone,
+  read_aloud_warning, long_text_minutes, long_text_minute,
 };
-inline constexpr int kMessageCount = 111;
+inline constexpr int kMessageCount = 114;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -61,7 +62,8 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "key_other", "this_key", "nothing_to_pause", "nothing_to_repeat", "where_on", "where_near", "where_none", "where_text", "sorry", "tour_ask",
     "tour_traced", "high_contrast_on", "high_contrast_off", "overlay_on", "overlay_off", "text_reading", "text_ready", "text_none",
     "text_unavailable", "device_not_home", "tour_stuck", "finish_ask", "timeout_warning_stick", "level_manual",
-    "files_unreadable", "file_unreadable", "document_unreadable_alone"};
+    "files_unreadable", "file_unreadable", "document_unreadable_alone", "read_aloud_warning",
+    "long_text_minutes", "long_text_minute"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".

@@ -18,7 +18,8 @@
 /// (force faded out over fade_s) at the path's end (Done), when the hand holds still against it (guide force
 /// at ≥ 95 % of its limit, or the clock stopped, while the handle, its velocity low-passed at 5 Hz, moves
 /// slower than hold_speed_m_per_s, for hold_s), or at stop() (Stopped). Whatever the handle does, a tour
-/// always ends: one whose clock gains less than progress_min_s in stall_s of ticks, or that has run
+/// always ends: one that makes no progress (its clock gains less than progress_min_s, and the handle comes no
+/// nearer its target by progress_min_m, in stall_s of ticks), or that has run
 /// overrun_factor times its planned duration, ends Stuck (a handle pinned in a tip, jittering too much to
 /// count as held, would otherwise keep it going for good).
 ///
@@ -73,11 +74,16 @@ struct TourParams {
   double trap_s = 0.15;              ///< [s]
   double follow_force_n = 0.5;       ///< [N]; above the break-away friction of the press (μ_s 0.4 × 0.6 N)
   double rejoin_m = 0.002;           ///< [m]; above the track's offset from the wall plus the press's depth
-  /// A tour that makes no progress ends Stuck: its clock gained less than progress_min_s of path time in the
-  /// last stall_s of ticks. At 3 cm/s, 0.25 s of path is 7.5 mm of outline.
-  double stall_s = 2.0;              ///< [s] of ticks
+  /// A tour that makes no progress ends Stuck: in the last stall_s of ticks its clock gained less than
+  /// progress_min_s of path time (at 3 cm/s, 0.25 s of path is 7.5 mm of outline) and the handle came no
+  /// nearer its waiting target by progress_min_m (being led out of a pocket along the wall is progress).
+  /// 3 s: a relaxed hand led round silhouette_2 at the cut level rests 2-3 s in a pocket before the guide
+  /// leads it out along the wall, and that tour ends Done.
+  double stall_s = 3.0;              ///< [s] of ticks
   double progress_min_s = 0.25;      ///< [s] of path time
-  /// A tour that has run this many times its planned duration (TourPath::duration_s) ends Stuck.
+  double progress_min_m = 0.001;     ///< [m]
+  /// A tour that has run this many times its planned duration (TourPath::duration_s), and at least stall_s,
+  /// ends Stuck.
   double overrun_factor = 1.5;
 };
 
@@ -156,7 +162,7 @@ class TourGuide {
   void track_trap(const TourInput& in, Vec2 error_m, bool keeping_up) noexcept;
   Vec2 follow_force(const TourInput& in, Vec2 press_n) noexcept;
   void advance(bool keeping_up, double guide_len_n, double period_s, TourOutput& out) noexcept;
-  bool stalled() noexcept;
+  bool stalled(double error_m) noexcept;
   void end(TourPhase how) noexcept;
   bool on_toured_wall(const ContactOutput& c) const noexcept;
 
@@ -173,8 +179,10 @@ class TourGuide {
   long fade_left_ = 0;                         // while ending: ticks of fade left
   long hold_ticks_ = 0;                        // consecutive ticks "held still against it"
   long stall_ticks_ = 1;                       // stall_s in ticks
-  long progress_tick_ = 0;                     // the tick the clock last gained progress_min_s
+  long rendered_ticks_ = 0;                    // ticks since the tour was taken whose walls' step rendered
+  long progress_tick_ = 0;                     // rendered_ticks_ when the clock last gained progress_min_s
   double progress_t_s_ = 0.0;                  // the clock then [s]
+  double progress_error_m_ = 0.0;              // the handle's distance to its target then [m]
   long overrun_ticks_ = 0;                     // overrun_factor × the planned duration, in ticks
   Vec2 prev_handle_, prev_target_;             // last tick's handle and target [m]
   Vec2 velocity_, hold_velocity_;              // the handle's velocity, low-passed [m/s]
