@@ -281,7 +281,11 @@ void KioskFlow::tutorial_key(KioskKey k) {
     case KioskKey::Describe:
       fx_.say(fx_.describe());
       return;
-    default:  // Finer and Coarser have no levels to change on a practice shape
+    case KioskKey::Finer:
+    case KioskKey::Coarser:  // no levels to change on a practice shape: said why
+      say_brief(MessageId::tutorial_no_levels);
+      return;
+    default:
       say_brief(kKeyDoes[static_cast<std::size_t>(k)]);
       return;
   }
@@ -403,7 +407,15 @@ void KioskFlow::handle_moved(double now_s) {
 }
 
 void KioskFlow::touching(double now_s) {
-  if (v_.state != KioskState::Attract) activity(now_s);
+  guarded("touching a shape", [&] {
+    if (v_.state == KioskState::Attract) return;
+    activity(now_s);
+    // On the tutorial's square, once the welcome has been heard: the wall the hand feels can be pushed through.
+    if (v_.state == KioskState::Tutorial && v_.shape == TutorialShape::Square && !v_.push_taught && !fx_.speaking()) {
+      v_.push_taught = true;
+      say_brief(MessageId::tutorial_push);
+    }
+  });
 }
 
 void KioskFlow::tick(double now_s) {

@@ -5,7 +5,11 @@
 ///   Attract   — waiting; a short spoken invitation every attract_every_s (not in quiet hours); the first key
 ///               press or handle motion speaks a short welcome (≤ 8 s) and puts the tutorial's square on the
 ///               device;
-///   Tutorial  — a square, a circle, a triangle (Next moves on); after the triangle, the first picture;
+///   Tutorial  — a square, a circle, a triangle (Next moves on); after the triangle, the first picture. It
+///               teaches the keys a visitor needs: the welcome names the key that moves on; touching the
+///               square, that a wall can be pushed through; the circle, Where (whose answer on a practice
+///               shape says what far and near mean); the triangle, Guide; the first picture, Describe and
+///               Repeat. Finer and Coarser on a practice shape say why they do nothing there;
 ///   Picture   — Next / Previous picture, Describe, Where ("what is here"), Finer / Coarser level, Volume,
 ///               Repeat, Pause, Help, Tutorial again, Guide (the guided tour), Capture, Finish.
 ///
@@ -298,6 +302,7 @@ class KioskFlow {
     bool captured = false;                   // the picture shown is the visitor's own capture
     bool felt = false;                       // a shape, picture or page has been put under the hand in this visit
     bool read_aloud_said = false;            // the visitor was told that their document is heard by people nearby
+    bool push_taught = false;                // the tutorial said that a wall can be pushed through
   };
 
   template <class Action>

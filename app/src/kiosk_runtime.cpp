@@ -345,10 +345,19 @@ std::string KioskRuntime::where() {
                                                   {"where", place}, {"text", first_words(b->text, kWhereTextWords)}});
   }
   const ShapeAtHand at = shape_at_hand(shown_.polylines, d.handle_m, d.scene_id == shown_id_ ? d.curve : -1);
-  if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}});
+  // A practice shape: far and near explained with the first answer that uses them.
+  const std::string far_near = showing_tutorial() ? " " + m.text(audio::MessageId::far_near) : std::string();
+  if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}}) + far_near;
   return m.text(at.on ? audio::MessageId::where_on : audio::MessageId::where_near,
                 {{"shape", std::to_string(at.curve + 1)}, {"shapes", std::to_string(shown_.polylines.size())},
-                 {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(at.curve), half_, false)}, {"where", place}});
+                 {"description", shape_words(static_cast<std::size_t>(at.curve))}, {"where", place}}) + far_near;
+}
+
+bool KioskRuntime::showing_tutorial() const { return shown_id_ <= -1 && shown_id_ >= -3; }
+
+std::string KioskRuntime::shape_words(std::size_t curve) const {
+  if (showing_tutorial() && !shown_.notes.title.empty()) return shown_.notes.title;  // "a square"
+  return describe_one_shape(shown_.polylines, curve, half_, false);
 }
 
 void KioskRuntime::poll_display_modes() {
@@ -371,6 +380,8 @@ void KioskRuntime::show_tutorial(TutorialShape shape) {
   drop_want();  // a picture still being built is not wanted any more
   Shown sh;
   sh.polylines = {tutorial_polyline(shape, half_)};
+  static constexpr audio::MessageId kNames[] = {audio::MessageId::shape_square, audio::MessageId::shape_circle, audio::MessageId::shape_triangle};
+  sh.notes.title = audio_.messages().text(kNames[static_cast<int>(shape)]);  // Where, Describe and the tour name it
   publish(std::move(sh), std::make_unique<Scene>(Scene::build({tutorial_polyline(shape, half_)}, s_.haptics.max_levels)),
           -1 - static_cast<int>(shape));
   text_.cancel();
@@ -656,6 +667,11 @@ std::string KioskRuntime::describe_shown() {
     const std::string page = describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
     return shown_.polylines.empty() ? page : page + " " + describe_scene(shown_.polylines, half_, 3, core_.display().handle_m);
   }
+  if (showing_tutorial() && !shown_.notes.title.empty()) {  // a practice shape: "A square, in the middle."
+    std::string words = shown_.notes.title + ", " + place_words({0.0, 0.0}, half_) + ".";
+    words[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(words[0])));
+    return words;
+  }
   // A picture: what a person wrote of it first ("A horse, seen from the side. A horse standing, ..."), then
   // its shapes.
   std::string words;
@@ -886,7 +902,7 @@ void KioskRuntime::report_tour_end(const ServoDisplayState& d) {
     text = m.text(audio::MessageId::tour_stuck) + " ";
   } else if (d.tour_curve >= 0 && static_cast<std::size_t>(d.tour_curve) < shown_.polylines.size()) {
     text = m.text(audio::MessageId::tour_traced, {{"shape", std::to_string(d.tour_curve + 1)},
-                                                   {"description", describe_one_shape(shown_.polylines, static_cast<std::size_t>(d.tour_curve), half_, false)}}) + " ";
+                                                   {"description", shape_words(static_cast<std::size_t>(d.tour_curve))}}) + " ";
   }
   const int left = shapes_remaining(*shown_.scene, touches_, tour_params_from(s_));
   if (left == 0) text += m.text(audio::MessageId::tour_all_touched);

@@ -305,6 +305,8 @@ class KioskRuntime final : public KioskEffects {
   void build_ahead();                         // asks for the shown picture's neighbours, drops what is not one
   void drop_want();                           // the scene asked for is not wanted any more (the visitor went elsewhere)
   void reset_level();                         // the operator's level and mode again (a new picture or visitor)
+  bool showing_tutorial() const;              // a practice shape is shown (ids -1 .. -3)
+  std::string shape_words(std::size_t curve) const;  // what curve `curve` of what is shown is, for Where and the tour
   void text_arrived(TextRead& read);        // swaps in the page with its text and words what came
   std::string describe_shown();             // describe() of what is shown, without the reading's news
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});

@@ -640,6 +640,29 @@ TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
   EXPECT_TRUE(ends_with(near, "Your hand is in the middle.")) << near;
 }
 
+// The practice shapes are named ("a square"), and Where on one says what far and near mean; Describe names it
+// too, and a tour round it says what it traced by that name.
+TEST(GuidedTourRuntime, PracticeShapesAreNamedAndWhereExplainsFarAndNear) {
+  RuntimeRig r;
+  r.rt->show_tutorial(TutorialShape::Circle);
+  r.run(0.6);  // the handle at rest, off the circle
+  r.rt->key_pressed();
+  r.rt->guide();
+  ASSERT_TRUE(r.rt->tour_running()) << r.rt->last_said();
+  for (int i = 0; i < 80 && r.rt->tour_running(); ++i) r.run(0.5);
+  EXPECT_FALSE(r.rt->tour_running());
+  EXPECT_EQ(r.rt->last_said().rfind("That was shape 1: a circle.", 0), 0u) << r.rt->last_said();
+  r.run(1.5, Vec2{0.0, 0.0});  // the hand pulled towards the middle, against the circle's wall
+  const std::string where = r.rt->where();
+  EXPECT_EQ(where.rfind("On shape 1 of 1: a circle. Your hand is ", 0), 0u) << where;
+  EXPECT_TRUE(ends_with(where, ". Far means away from you, near means towards you.")) << where;
+  EXPECT_EQ(r.rt->describe(), "A circle, in the middle.");
+  // A picture is described by its shapes again.
+  ASSERT_EQ(test::show_now(*r.rt, 0), 5);
+  r.run(0.5, Vec2{0.0, 0.0});
+  EXPECT_EQ(r.rt->where().find("Far means"), std::string::npos) << r.rt->where();
+}
+
 // Tours on real pictures: a tour must not stop while the hand is relaxed (13 tours on 9 of the 22 pictures
 // once did). The press keeps the handle on the wall, so it follows the wall into narrow pockets, slots and
 // hooks of the rendered polyline that the planned track passes outside: the horse's ear, the gap between

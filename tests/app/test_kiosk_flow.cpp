@@ -71,20 +71,22 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   EXPECT_EQ(flow.state(), KioskState::Tutorial);
   ASSERT_EQ(fx.said.size(), 1u);
   EXPECT_EQ(fx.said.back().rfind("Welcome.", 0), 0u);
-  EXPECT_NE(fx.said.back().find("to feel a square."), std::string::npos);
+  EXPECT_NE(fx.said.back().find("Feel the square with the handle. Press the Right arrow to move on."), std::string::npos)
+      << "the welcome names the key that moves on";
   EXPECT_NE(fx.said.back().find("Press F1 for help."), std::string::npos) << "the shipped help key";
   EXPECT_EQ(fx.shown.back(), "tutorial 0");
 
   flow.key(KioskKey::Next, 20.0);
-  EXPECT_EQ(fx.said.back(), "Now a circle. Far means away from you, near means towards you. Press the Right arrow for the next shape.")
-      << "the tutorial says once what far and near mean (Where and Describe use them)";
+  EXPECT_EQ(fx.said.back(), "A circle. Press the W key to hear where your hand is. Press the Right arrow for the next shape.")
+      << "the circle practises Where";
   EXPECT_EQ(fx.said.back(), flow.text(audio::MessageId::tutorial_circle));
   EXPECT_EQ(fx.shown.back(), "tutorial 1");
   flow.key(KioskKey::Next, 30.0);
-  EXPECT_EQ(fx.said.back(), "Now a triangle. Feel its three corners. Press the Right arrow for the first picture.");
+  EXPECT_EQ(fx.said.back(), "A triangle. Press the G key to be led round it. Press the Right arrow for the first picture.");
   flow.key(KioskKey::Next, 40.0);
   EXPECT_EQ(flow.state(), KioskState::Picture);
-  EXPECT_EQ(fx.said.back(), "Well done. Here is the first picture. Picture 1 of 3. It has 4 shapes.");
+  EXPECT_EQ(fx.said.back(), "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. "
+                            "Picture 1 of 3. It has 4 shapes.");
   EXPECT_EQ(fx.shown.back(), "picture 0");
 
   flow.key(KioskKey::Next, 50.0);
@@ -334,7 +336,8 @@ TEST(KioskFlow, APictureWithATitleIsAnnouncedByIt) {
   flow.handle_moved(1.0);
   for (int k = 0; k < 3; ++k) flow.key(KioskKey::Next, 2.0 + k);  // square, circle, triangle, then pictures
   EXPECT_EQ(fx.shown.back(), "picture 0");
-  EXPECT_EQ(fx.said.back(), "Well done. Here is the first picture. Picture 1 of 3: a horse, seen from the side. It has 4 shapes.");
+  EXPECT_EQ(fx.said.back(), "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. "
+                            "Picture 1 of 3: a horse, seen from the side. It has 4 shapes.");
   flow.key(KioskKey::Next, 10.0);
   EXPECT_EQ(fx.said.back(), "Picture 2 of 3: a horse, seen from the side. It has one shape.");
   fx.notes = {};

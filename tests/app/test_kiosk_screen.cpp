@@ -140,7 +140,7 @@ TEST(KioskScreen, ScriptedVisitWalksTheFlowAndSaysEachStep) {
     const auto at = line.find("say: ");
     if (at != std::string::npos) said.push_back(line.substr(at + 5));
   }
-  const std::vector<std::string> want_prefix{"Welcome.", "Now a circle.", "Now a triangle.", "Well done. Here is the first picture. Picture 1 of 2.",
+  const std::vector<std::string> want_prefix{"Welcome.", "A circle.", "A triangle.", "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. Picture 1 of 2.",
                                              "Picture 2 of 2.", "Still there? Press any key for more time. In 10 seconds this visit ends",
                                              "Thank you for visiting. Goodbye."};
   ASSERT_EQ(said.size(), want_prefix.size()) << std::ifstream(dir / "log.txt").rdbuf();

@@ -335,12 +335,38 @@ TEST(VisitorInCharge, AttractInvitesEveryIntervalButNotInQuietHours) {
   EXPECT_EQ(fx.said.size(), 3u) << "attract_every_s = 0: never";
 }
 
+// The tutorial teaches: touching the square (once the welcome is heard) says that its wall can be pushed
+// through, once; Finer and Coarser on a practice shape say why they do nothing there.
+TEST(VisitorInCharge, TheTutorialTeachesPushingThroughAndSaysWhyLevelsDoNothing) {
+  Speaker fx;
+  KioskFlow flow(fx, en(), KioskFlowParams{120.0, 20.0, 0.5, 30.0});
+  flow.handle_moved(1.0);
+  ASSERT_EQ(flow.state(), KioskState::Tutorial);
+  const std::size_t welcome = fx.said.size();
+  flow.touching(1.5);
+  EXPECT_EQ(fx.said.size(), welcome) << "never over the welcome";
+  fx.heard = false;  // the welcome is over
+  flow.touching(2.0);
+  EXPECT_EQ(fx.said.back(), "That is the square's wall. Push hard on it to pass through.");
+  fx.heard = false;
+  flow.touching(3.0);
+  EXPECT_EQ(fx.said.size(), welcome + 1) << "said once";
+  flow.key(KioskKey::Finer, 4.0);
+  EXPECT_EQ(fx.said.back(), "A practice shape has one level of detail. The Up arrow and the Down arrow work on the pictures.");
+  flow.key(KioskKey::Coarser, 5.0);
+  EXPECT_EQ(fx.said.back(), "A practice shape has one level of detail. The Up arrow and the Down arrow work on the pictures.");
+  flow.key(KioskKey::Next, 6.0);
+  fx.heard = false;
+  flow.touching(7.0);
+  EXPECT_EQ(fx.said.back().rfind("A circle.", 0), 0u) << "only on the square";
+}
+
 TEST(VisitorInCharge, TheWelcomeIsShortAndPutsAShapeUnderTheHand) {
   Speaker fx;
   KioskFlow flow(fx, en());
   flow.key(KioskKey::Describe, 1.0);
   ASSERT_EQ(fx.said.size(), 1u);
-  EXPECT_EQ(fx.said[0], "Welcome. Move the handle gently to feel a square. Press F1 for help.");
+  EXPECT_EQ(fx.said[0], "Welcome. Feel the square with the handle. Press the Right arrow to move on. Press F1 for help.");
   EXPECT_EQ(flow.state(), KioskState::Tutorial);
 }
 

@@ -121,7 +121,7 @@ TEST(MessageKeys, KeyPlaceholdersAreFilledWithTheSpokenForm) {
   EXPECT_EQ(en.text(MessageId::stick_inserted, {{"summary", "one document: a picture"}}, keys),
             "A USB stick with one document: a picture. Press the space bar to go through them.");
   EXPECT_EQ(en.text(MessageId::tutorial_circle, {}, keys),
-            "Now a circle. Far means away from you, near means towards you. Press the space bar for the next shape.");
+            "A circle. Press {where_key} to hear where your hand is. Press the space bar for the next shape.");
   EXPECT_EQ(en.text(MessageId::key_previous, {}, keys), "The Backspace key: the picture before.") << "a key first in the text is capitalised";
   // Without the keys, the placeholder stays visible (a caller that forgot them is seen at once).
   EXPECT_NE(en.text(MessageId::welcome).find("{help_key}"), std::string::npos);

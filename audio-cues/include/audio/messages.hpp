@@ -40,9 +40,10 @@ enum class MessageId : int {
   where_none, where_text, sorry, tour_ask, tour_traced, high_contrast_on, high_contrast_off, overlay_on, overlay_off,
   text_reading, text_ready, text_none, text_unavailable, device_not_home, tour_stuck, finish_ask,
   timeout_warning_stick, level_manual, files_unreadable, file_unreadable, document_unreadable_alone,
-  read_aloud_warning, long_text_minutes, long_text_minute,
+  read_aloud_warning, long_text_minutes, long_text_minute, tutorial_push, tutorial_no_levels, far_near, shape_square,
+  shape_circle, shape_triangle,
 };
-inline constexpr int kMessageCount = 114;
+inline constexpr int kMessageCount = 120;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -63,7 +64,8 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "tour_traced", "high_contrast_on", "high_contrast_off", "overlay_on", "overlay_off", "text_reading", "text_ready", "text_none",
     "text_unavailable", "device_not_home", "tour_stuck", "finish_ask", "timeout_warning_stick", "level_manual",
     "files_unreadable", "file_unreadable", "document_unreadable_alone", "read_aloud_warning",
-    "long_text_minutes", "long_text_minute"};
+    "long_text_minutes", "long_text_minute", "tutorial_push", "tutorial_no_levels", "far_near", "shape_square", "shape_circle",
+    "shape_triangle"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".
