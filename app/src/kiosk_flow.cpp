@@ -118,6 +118,14 @@ void KioskFlow::act_on_key(KioskKey k, double now_s, std::string_view key_name) 
     help_key();
     return;
   }
+  if (v_.help_group >= 0) {  // stepping through help: Next and Previous move within it, any other key leaves it
+    if (k == KioskKey::Previous || (k == KioskKey::Next && v_.help_group + 1 < help_group_count())) {
+      v_.help_group = std::max(0, v_.help_group + (k == KioskKey::Next ? 1 : -1));
+      say_help_group();
+      return;
+    }
+    v_.help_group = -1;
+  }
   if (session_key(k, now_s)) return;
   if (v_.source == KioskSource::Stick && (k == KioskKey::Next || k == KioskKey::Previous)) {
     step_document(k == KioskKey::Next ? +1 : -1, now_s);
@@ -231,14 +239,62 @@ void KioskFlow::pause_key() {
 }
 
 void KioskFlow::help_key() {
-  // One sentence for where the visitor is and the two most useful keys; the same key again for every key.
+  // One sentence for where the visitor is and the two most useful keys; the same key again for every key, a
+  // few at a time.
   if (v_.help_layer == 1) {
     v_.help_layer = 0;
-    say_help();
+    v_.help_group = 0;
+    say_help_group();
     return;
   }
   v_.help_layer = 1;
+  v_.help_group = -1;
   say(MessageId::help_brief, {{"place", place()}});
+}
+
+std::vector<std::string> KioskFlow::help_groups() const {
+  // The catalogue's help (and the camera's sentence) cut into sentences, kHelpSentencesPerGroup to a group.
+  std::string all = msg_.raw(MessageId::help);
+  if (p_.camera) all += " " + msg_.raw(MessageId::help_camera);
+  std::vector<std::string> sentences;
+  std::size_t from = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const bool end = (all[i] == '.' || all[i] == '!' || all[i] == '?') && (i + 1 == all.size() || all[i + 1] == ' ');
+    if (!end) continue;
+    sentences.push_back(all.substr(from, i + 1 - from));
+    from = i + 1;
+    while (from < all.size() && all[from] == ' ') ++from;
+  }
+  if (from < all.size()) sentences.push_back(all.substr(from));
+  std::vector<std::string> groups;
+  for (std::size_t i = 0; i < sentences.size(); ++i) {
+    if (i % kHelpSentencesPerGroup == 0) groups.emplace_back();
+    groups.back() += (groups.back().empty() ? "" : " ") + sentences[i];
+  }
+  return groups;
+}
+
+int KioskFlow::help_group_count() const { return static_cast<int>(help_groups().size()); }
+
+void KioskFlow::say_help_group() {
+  const std::vector<std::string> groups = help_groups();
+  if (groups.empty()) return;
+  const int g = std::clamp(v_.help_group, 0, static_cast<int>(groups.size()) - 1);
+  std::string line = msg_.expand(groups[static_cast<std::size_t>(g)], {}, key_args(p_.keys));
+  // Where each key of the group lies, in the order the group names them.
+  const auto actions = config::key_actions(p_.keys);
+  for (std::size_t i = 0; i < audio::kKeyPlaceholders.size(); ++i) {
+    const std::string tag = "{" + std::string(audio::kKeyPlaceholders[i]) + "}";
+    if (groups[static_cast<std::size_t>(g)].find(tag) != std::string::npos) line += key_place_sentence(actions[i].second);
+  }
+  line += " " + text(g + 1 < static_cast<int>(groups.size()) ? MessageId::help_next : MessageId::help_last);
+  fx_.say(line);
+}
+
+std::string KioskFlow::key_place_sentence(std::string_view key_name) const {
+  const std::string place = msg_.key_place(key_name);
+  if (place.empty()) return {};
+  return " " + text(MessageId::key_place, {{"key", spoken_key(key_name)}, {"place", place}});
 }
 
 void KioskFlow::learn_key(KioskKey k, std::string_view key_name) {
@@ -246,7 +302,8 @@ void KioskFlow::learn_key(KioskKey k, std::string_view key_name) {
     stray_key(key_name);
     return;
   }
-  say_brief(kKeyDoes[static_cast<std::size_t>(k)]);
+  const std::string name(config::key_actions(p_.keys)[static_cast<std::size_t>(k)].second);
+  fx_.say_brief(text(kKeyDoes[static_cast<std::size_t>(k)]) + key_place_sentence(name));
 }
 
 void KioskFlow::stray_key(std::string_view key_name) { say_brief(MessageId::key_other, {{"key", spoken_key(key_name)}}); }
@@ -313,9 +370,6 @@ void KioskFlow::picture_key(KioskKey k) {
   }
 }
 
-void KioskFlow::say_help() {
-  fx_.say(p_.camera ? text(MessageId::help) + " " + text(MessageId::help_camera) : text(MessageId::help));
-}
 
 std::string KioskFlow::place() const {
   if (v_.state == KioskState::Tutorial) return text(MessageId::place_tutorial);

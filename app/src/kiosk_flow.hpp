@@ -202,6 +202,8 @@ class KioskFlow {
   static constexpr double kFinishConfirm_s = 5.0;
   /// The time-out warning is said again this long after the first, when time is left [s].
   static constexpr double kRewarn_s = 10.0;
+  /// Every key's help is said this many sentences at a time (Next and Previous step through it).
+  static constexpr std::size_t kHelpSentencesPerGroup = 2;
   /// Describe says how long a text is before one that takes longer than this to say [s].
   static constexpr double kLongText_s = 30.0;
 
@@ -274,6 +276,8 @@ class KioskFlow {
   bool warned() const { return v_.warned; }
   /// Visitor actions that failed and were answered with the sorry line (logged), since the start.
   int failures() const { return failures_; }
+  /// Whether the visitor is stepping through the help's groups (Next and Previous move within it).
+  bool in_help() const { return v_.help_group >= 0; }
 
  private:
   /// Everything the flow knows of the visit, one value, so that a failed action can be undone whole.
@@ -288,6 +292,7 @@ class KioskFlow {
     bool rewarned = false;          // the second warning was said
     double finish_asked_s = -1;     // Finish pressed once at this time (asks for a second press); −1: not asked
     int help_layer = 0;             // 1 right after the first layer of help: Help again gives every key
+    int help_group = -1;            // stepping through every key: the group said last (Next / Previous move); −1: not
     KioskSource source = KioskSource::Library;
     std::vector<StickEntry> stick;
     int doc = -1, page = 1;                  // shown
@@ -333,7 +338,10 @@ class KioskFlow {
   void announce_picture(int shapes, const std::string& before);  // "Picture 2 of 5: ... It has 3 shapes."
   void say(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
   void say_brief(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
-  void say_help();  // every key, and the Capture key's sentence when there is a camera
+  std::vector<std::string> help_groups() const;  // the help's templates, a few sentences each (every key; Capture's with a camera)
+  int help_group_count() const;
+  void say_help_group();  // group v_.help_group, where its keys lie, and how to go on
+  std::string key_place_sentence(std::string_view key_name) const;  // " The W key is ..." or "" (no place in the catalogue)
   std::string place() const;  // where the visitor is, one sentence (a place_* message)
   std::string spoken_key(std::string_view key_name) const;  // "The Q key", "That key"
   void request(int document, int page, double now_s);

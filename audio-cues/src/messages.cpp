@@ -37,6 +37,29 @@ bool starts_sentence(const std::string& out) {
   return c == '.' || c == '!' || c == '?';
 }
 
+using KeyMap = std::map<std::string, std::string, std::less<>>;
+
+/// [key_places] (optional, any of the key names): where each key lies on the keypad, as a blind visitor finds it.
+KeyMap key_places(const toml::table& t, const std::string& where, const KeyMap& key_names) {
+  KeyMap out;
+  const toml::node* node = t.get("key_places");
+  if (!node) return out;
+  const toml::table* kp = node->as_table();
+  if (!kp) throw MessageError(where + "key_places must be a table");
+  for (const auto& [key, value] : *kp) {
+    const std::string name(key.str());
+    const std::string shown = hk::one_line(name, 60);
+    if (!key_names.count(name)) throw MessageError(where + "key_places." + shown + " is not a key name of [key_names]");
+    const auto v = value.value<std::string>();
+    if (!v) throw MessageError(where + "key_places." + shown + " is not a string");
+    if (v->empty() || v->size() > MessageCatalog::kMaxKeyPlaceBytes) {
+      throw MessageError(where + "key_places." + shown + " must be 1 to " + std::to_string(MessageCatalog::kMaxKeyPlaceBytes) + " bytes");
+    }
+    out.emplace(name, *v);
+  }
+  return out;
+}
+
 }  // namespace
 
 MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& source) {
@@ -100,7 +123,13 @@ MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& s
   } else if (c.key_names_.empty()) {
     throw MessageError(where + "[key_names] is empty");
   }
+  c.key_places_ = key_places(t, where, c.key_names_);
   return c;
+}
+
+std::string MessageCatalog::key_place(std::string_view name) const {
+  const auto it = key_places_.find(name);
+  return it == key_places_.end() ? std::string() : it->second;
 }
 
 const MessageCatalog& MessageCatalog::english() {
@@ -129,7 +158,10 @@ std::string MessageCatalog::key_name(std::string_view name) const {
 }
 
 std::string MessageCatalog::text(MessageId id, std::initializer_list<MessageArg> args, std::span<const KeyArg> keys) const {
-  const std::string& s = raw(id);
+  return expand(raw(id), args, keys);
+}
+
+std::string MessageCatalog::expand(std::string_view s, std::initializer_list<MessageArg> args, std::span<const KeyArg> keys) const {
   std::string out;
   out.reserve(s.size());
   std::size_t i = 0;
@@ -139,8 +171,8 @@ std::string MessageCatalog::text(MessageId id, std::initializer_list<MessageArg>
     const std::size_t close = s.find('}', open + 1);
     if (close == std::string::npos) break;
     open = s.rfind('{', close);  // the innermost: "{{seconds}}" keeps its outer braces
-    const std::string_view name = std::string_view(s).substr(open + 1, close - open - 1);
-    out.append(s, i, open - i);
+    const std::string_view name = s.substr(open + 1, close - open - 1);
+    out.append(s.substr(i, open - i));
     const MessageArg* arg = nullptr;
     for (const MessageArg& a : args) {
       if (!arg && a.first == name) arg = &a;
@@ -157,11 +189,11 @@ std::string MessageCatalog::text(MessageId id, std::initializer_list<MessageArg>
       if (!form.empty() && starts_sentence(out) && form[0] >= 'a' && form[0] <= 'z') form[0] = static_cast<char>(form[0] - 'a' + 'A');
       out += form;
     } else {
-      out.append(s, open, close - open + 1);  // unknown: left as it is
+      out.append(s.substr(open, close - open + 1));  // unknown: left as it is
     }
     i = close + 1;
   }
-  out.append(s, i, std::string::npos);
+  out.append(s.substr(i));
   return out;
 }
 

@@ -224,10 +224,43 @@ TEST(VisitorInCharge, HelpComesInTwoLayers) {
   EXPECT_NE(first.find("the Right arrow"), std::string::npos) << first;
   EXPECT_NE(first.find("the W key"), std::string::npos) << "the two most useful keys: " << first;
   v.flow.key(KioskKey::Help, 4.0);
-  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::help)) << "the same key again: every key";
-  v.flow.key(KioskKey::Help, 5.0);
+  // The same key again: every key, two sentences at a time, each key with where it lies on the keypad.
+  const std::string group1 = v.fx.said.back();
+  EXPECT_EQ(group1,
+            "Move the handle slowly to feel the outlines. Press the Right arrow for the next picture and the Left arrow for the one "
+            "before. The Right arrow is the right one of the four arrow keys, at the bottom right of the keyboard. The Left arrow is "
+            "the left one of the four arrow keys, at the bottom right of the keyboard. Press the Right arrow for more help, the Left "
+            "arrow to go back.");
+  EXPECT_TRUE(v.flow.in_help());
+  std::string every = group1;
+  for (int g = 0; g < 10 && v.fx.said.back().find("That is every key.") == std::string::npos; ++g) {
+    v.flow.key(KioskKey::Next, 4.1 + 0.1 * g);
+    every += " " + v.fx.said.back();
+  }
+  EXPECT_EQ(v.flow.picture(), 0) << "Next stepped through the help, not the pictures";
+  for (const char* key : {"the W key", "the D key", "the R key", "the P key", "the Up arrow", "the Down arrow", "Page Up", "Page Down",
+                          "the G key", "the T key", "the End key", "F1"}) {
+    EXPECT_NE(every.find(key), std::string::npos) << key << " in: " << every;
+  }
+  EXPECT_NE(every.find("The End key is in the block of six keys above the arrow keys, the middle of its bottom row."), std::string::npos);
+  v.flow.key(KioskKey::Previous, 5.5);
+  EXPECT_EQ(v.flow.picture(), 0) << "Previous goes back within the help";
+  EXPECT_EQ(v.fx.said.back().rfind("Press the Up arrow for more detail", 0), std::string::npos);
+  v.flow.key(KioskKey::Next, 5.6);  // back on the last group
+  v.flow.key(KioskKey::Next, 5.7);  // past it: Next moves on again
+  EXPECT_FALSE(v.flow.in_help());
+  EXPECT_EQ(v.flow.picture(), 1);
+  v.flow.key(KioskKey::Previous, 5.8);
+  EXPECT_EQ(v.flow.picture(), 0);
+  v.flow.key(KioskKey::Help, 5.9);
+  v.flow.key(KioskKey::Help, 5.95);
+  v.flow.key(KioskKey::Where, 5.97);  // any other key leaves the help
+  EXPECT_FALSE(v.flow.in_help());
+  v.flow.key(KioskKey::Help, 6.0);
+  v.flow.key(KioskKey::Help, 6.05);
+  v.flow.key(KioskKey::Help, 6.1);
   EXPECT_EQ(v.fx.said.back(), first) << "and again the first layer";
-  v.flow.key(KioskKey::Next, 6.0);
+  v.flow.key(KioskKey::Next, 6.3);
   v.flow.key(KioskKey::Help, 7.0);
   EXPECT_EQ(v.fx.said.back().rfind("Picture 2 of 3.", 0), 0u) << "another key in between: the first layer, where the visitor is now";
 }
@@ -247,10 +280,13 @@ TEST(VisitorInCharge, HoldingHelpNamesAKeyWithoutActing) {
   v.flow.help_held(true);
   const int acting = v.fx.keys_acting;
   v.flow.key(KioskKey::Next, 3.2);
-  EXPECT_EQ(v.fx.said.back(), "The Right arrow: the next picture.");
+  EXPECT_EQ(v.fx.said.back(), "The Right arrow: the next picture. The Right arrow is the right one of the four arrow keys, at the "
+                              "bottom right of the keyboard.");
   EXPECT_EQ(v.flow.picture(), 0) << "named, not done";
   v.flow.key(KioskKey::Finish, 3.4);
-  EXPECT_EQ(v.fx.said.back(), "The End key: finish, and leave the kiosk for the next visitor.");
+  EXPECT_EQ(v.fx.said.back(), "The End key: finish, and leave the kiosk for the next visitor. The End key is in the block of six keys "
+                              "above the arrow keys, the middle of its bottom row.")
+      << "named, what it does, and where it lies";
   EXPECT_EQ(v.flow.state(), KioskState::Picture);
   v.flow.key(KioskKey::Other, 3.6, "Z");
   EXPECT_EQ(v.fx.said.back(), "The Z key does nothing here. Press F1 for help.");

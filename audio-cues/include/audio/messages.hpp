@@ -41,9 +41,9 @@ enum class MessageId : int {
   text_reading, text_ready, text_none, text_unavailable, device_not_home, tour_stuck, finish_ask,
   timeout_warning_stick, level_manual, files_unreadable, file_unreadable, document_unreadable_alone,
   read_aloud_warning, long_text_minutes, long_text_minute, tutorial_push, tutorial_no_levels, far_near, shape_square,
-  shape_circle, shape_triangle,
+  shape_circle, shape_triangle, help_next, help_last, key_place,
 };
-inline constexpr int kMessageCount = 120;
+inline constexpr int kMessageCount = 123;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -65,7 +65,7 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "text_unavailable", "device_not_home", "tour_stuck", "finish_ask", "timeout_warning_stick", "level_manual",
     "files_unreadable", "file_unreadable", "document_unreadable_alone", "read_aloud_warning",
     "long_text_minutes", "long_text_minute", "tutorial_push", "tutorial_no_levels", "far_near", "shape_square", "shape_circle",
-    "shape_triangle"};
+    "shape_triangle", "help_next", "help_last", "key_place"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".
@@ -107,11 +107,21 @@ class MessageCatalog {
   /// the text or a sentence ("the Up arrow" → "The Up arrow gives more detail."). Unknown names are left as
   /// they are. One pass: the text put in is never searched for placeholders again.
   std::string text(MessageId id, std::initializer_list<MessageArg> args = {}, std::span<const KeyArg> keys = {}) const;
+  /// text() of a template of this catalogue's own, e.g. one sentence of raw(id): the same placeholders, keys and
+  /// capitals.
+  std::string expand(std::string_view text_template, std::initializer_list<MessageArg> args = {}, std::span<const KeyArg> keys = {}) const;
   /// The spoken form of the key that the settings call `name` ("UP" → "the Up arrow", "F1" → "F1"), lower
   /// case as it reads after "Press"; for a name the catalogue does not know, `name` itself.
   std::string key_name(std::string_view name) const;
   /// Every entry of [key_names]: settings name → spoken form.
   const std::map<std::string, std::string, std::less<>>& key_names() const { return key_names_; }
+  /// Where the key the settings call `name` lies on the kiosk's keypad, as the optional [key_places] table of
+  /// the catalogue describes it for a visitor who finds keys by touch ("the right one of the four arrow keys,
+  /// at the bottom right"); "" when it does not say. Each entry names a key of [key_names] and is 1 to
+  /// kMaxKeyPlaceBytes bytes (else load() refuses the file).
+  std::string key_place(std::string_view name) const;
+  /// The longest [key_places] entry [bytes].
+  static constexpr std::size_t kMaxKeyPlaceBytes = 200;
   /// The raw text (placeholders unexpanded).
   const std::string& raw(MessageId id) const { return texts_[static_cast<std::size_t>(id)]; }
   /// espeak-ng voice for this language (e.g. "en", "de").
@@ -122,6 +132,7 @@ class MessageCatalog {
  private:
   std::array<std::string, kMessageCount> texts_;
   std::map<std::string, std::string, std::less<>> key_names_;
+  std::map<std::string, std::string, std::less<>> key_places_;
   std::string voice_, language_;
 };
 
