@@ -64,7 +64,7 @@ StickListing list_stick(const std::string& root, const config::Settings& s) {
         ld.pages_in_file = info.pages_in_file;
         ld.title = pdf_title(info.title);
       } catch (const std::exception& e) {  // PdfError, StickError: this document only
-        out.refused.push_back({d.display_name, e.what()});
+        out.refused.push_back({d.display_name, e.what(), true});
         continue;
       }
     }

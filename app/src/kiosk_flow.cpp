@@ -610,11 +610,16 @@ void KioskFlow::step_document(int delta, double now_s) {
   request(to.document, to.page, now_s);
 }
 
-void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double now_s) {
-  guarded("a USB stick", [&] { stick_inserted_now(documents, now_s); });
+void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double now_s, int unreadable) {
+  guarded("a USB stick", [&] { stick_inserted_now(documents, now_s, unreadable); });
 }
 
-void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, double now_s) {
+std::string KioskFlow::unreadable_line(int unreadable) const {
+  if (unreadable <= 0) return {};
+  return " " + (unreadable == 1 ? text(MessageId::file_unreadable) : text(MessageId::files_unreadable, {{"count", std::to_string(unreadable)}}));
+}
+
+void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable) {
   activity(now_s);
   if (v_.state == KioskState::Attract) v_.state = KioskState::Picture;  // a stick is someone at the kiosk
   if (v_.state == KioskState::Tutorial) v_.state = KioskState::Picture;
@@ -622,11 +627,12 @@ void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, dou
   v_.doc = v_.at_doc = v_.pending_doc = -1;
   if (v_.stick.empty()) {
     v_.source = KioskSource::Library;
-    say(MessageId::stick_empty);
+    fx_.say(text(MessageId::stick_empty) + unreadable_line(unreadable));
     return;
   }
   v_.source = KioskSource::Stick;
   v_.announce_summary = stick_summary();
+  v_.announce_unreadable = unreadable_line(unreadable);
   request(0, 1, now_s);
 }
 
@@ -684,7 +690,7 @@ void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
     line = text(v_.felt ? MessageId::document_unreadable : MessageId::document_unreadable_alone, {{"name", what}, {"reason", r.reason}});
   }
   if (!v_.announce_summary.empty()) {  // said now, so it names the keys of now
-    line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) + " " + line;
+    line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) + std::exchange(v_.announce_unreadable, {}) + " " + line;
     v_.announce_summary.clear();
   }
   fx_.say(line);

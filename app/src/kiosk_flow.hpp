@@ -224,7 +224,9 @@ class KioskFlow {
   /// loading cue.
   void tick(double now_s);
   /// A USB stick was inserted and scanned: its documents (may be empty), at `now_s`. Wakes the kiosk.
-  void stick_inserted(const std::vector<StickEntry>& documents, double now_s);
+  /// `unreadable`: pictures and PDFs on it that cannot be read, said in one line after what it holds ("2 files
+  /// cannot be read."; which and why are in the log and the operator's panel).
+  void stick_inserted(const std::vector<StickEntry>& documents, double now_s, int unreadable = 0);
   /// A stick was refused (unsupported filesystem, unreadable): `reason` is spoken.
   void stick_refused(const std::string& reason, double now_s);
   /// The stick was taken out: back to the library.
@@ -303,6 +305,7 @@ class KioskFlow {
     double pending_since_s = 0;
     bool loading_said = false;
     std::string announce_summary;            // the stick's summary, said before the first page's announcement
+    std::string announce_unreadable;         // how many of its files cannot be read, said after the summary
     bool capturing = false;                  // a camera capture is under way
     bool captured = false;                   // the picture shown is the visitor's own capture
     bool felt = false;                       // a shape, picture or page has been put under the hand in this visit
@@ -314,7 +317,8 @@ class KioskFlow {
   void guarded(const char* what, Action&& action);  // runs action; on an exception: undo, log, sorry
   void act_on_key(KioskKey k, double now_s, std::string_view key_name);
   // The bodies of the public entry points of the same names, run under guarded().
-  void stick_inserted_now(const std::vector<StickEntry>& documents, double now_s);
+  void stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable);
+  std::string unreadable_line(int unreadable) const;  // "" or the line that counts them, after a space
   void stick_removed_now(double now_s);
   void document_ready_now(const DocumentResult& result, double now_s);
   void capture_done_now(int shapes, double now_s);

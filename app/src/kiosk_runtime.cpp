@@ -711,7 +711,7 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
       for (const ListedDocument& d : n.documents)
         entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages, d.title, d.pages_in_file});
       stick_busy_ = !entries.empty();
-      flow.stick_inserted(entries, now_s);
+      flow.stick_inserted(entries, now_s, n.unreadable_documents);
     } else if (n.kind == StickNews::Kind::Refused) {
       stick_busy_ = false;
       flow.stick_refused(n.reason, now_s);

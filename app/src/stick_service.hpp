@@ -44,6 +44,7 @@ struct StickNews {
   int stick = 0;                        ///< the stick's number (every insertion gets a new one)
   std::vector<ListedDocument> documents;///< Inserted: what it offers
   std::size_t refused_entries = 0;      ///< Inserted: entries left out (reasons in the log)
+  int unreadable_documents = 0;         ///< Inserted: of those, pictures and PDFs that cannot be read (RefusedEntry::document)
   std::string reason;                   ///< Refused: why, one line for speech
   double scan_ms = 0;                   ///< Inserted: mount + scan + page counting [ms]
 };

@@ -300,6 +300,22 @@ TEST(KioskFlow, StickNamesPageCountsAndNothingFeltBefore) {
   EXPECT_EQ(fx.said.back(), "bad crc cannot be shown: it is damaged. You still feel the picture before.") << "now there was one";
 }
 
+// What cannot be read is one short line after what the stick holds, counted; never file by file.
+TEST(KioskFlow, UnreadableFilesOfAStickAreOneCountedLine) {
+  Recorder fx;
+  KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
+  flow.stick_inserted({{"cat.png", false, 1, ""}}, 1.0, 2);
+  flow.document_ready(ready(0, 1, "It has 4 shapes."), 1.1);
+  EXPECT_EQ(fx.said.back(), "A USB stick with one document: a picture. Press the Right arrow to go through them. 2 files cannot be read. "
+                            "Document 1 of 1, cat. It has 4 shapes.");
+  flow.stick_removed(2.0);
+  flow.stick_inserted({}, 3.0, 1);
+  EXPECT_EQ(fx.said.back(), "I found no pictures and no PDF documents on this USB stick. One file cannot be read.");
+  flow.stick_inserted({{"cat.png", false, 1, ""}}, 4.0);
+  flow.document_ready(ready(0, 1, "It has 4 shapes."), 4.1);
+  EXPECT_EQ(fx.said.back().find("cannot be read"), std::string::npos) << fx.said.back();
+}
+
 TEST(KioskFlow, SpokenNamesAreShortWholeWordsAndWholeCharacters) {
   EXPECT_EQ(spoken_name("holiday-photo_2025.JPG", true), "holiday photo 2025");
   EXPECT_EQ(spoken_name("notes.v2.pdf", true), "notes.v2");

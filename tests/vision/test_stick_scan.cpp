@@ -542,6 +542,33 @@ TEST(StickScan, EmptyMislabelledAndOversizedFilesAreRefused) {
   EXPECT_NE(read_error(t.root(), "ok.png", 0).find("not positive"), std::string::npos);
 }
 
+// With check_picture_headers, a picture whose header cannot be read (real bad files from tests/data/bad: a
+// PNG whose IHDR checksum is wrong, an empty PNG, a PNG whose image data is damaged but header whole) is
+// refused at the scan, as a document, with the header parser's one line; a whole picture is listed. Without
+// it, the magic bytes alone decide.
+TEST(StickScan, PicturesWhoseHeaderCannotBeReadAreRefusedAsDocuments) {
+  TempTree t;
+  const std::string bad = std::string(HK_TEST_DATA_DIR) + "/bad/";
+  const auto copy = [&](const std::string& from, const std::string& to) {
+    std::ifstream in(from, std::ios::binary);
+    t.write(to, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+  };
+  copy(bad + "bad_crc.png", "bad_crc.png");
+  copy(bad + "damaged_idat.png", "damaged_idat.png");
+  copy(std::string(HK_TEST_DATA_DIR) + "/images/horse.png", "horse.png");
+  ScanLimits limits;
+  limits.check_picture_headers = true;
+  const StickScan s = scan_stick(t.root(), limits);
+  expect_well_formed(s, limits);
+  EXPECT_EQ(doc_paths(s), (std::vector<std::string>{"damaged_idat.png", "horse.png"})) << "a whole header is listed; its pixels are read when shown";
+  EXPECT_NE(refusal(s, "bad_crc.png").find("CRC"), std::string::npos) << refusal(s, "bad_crc.png");
+  ASSERT_EQ(s.refused.size(), 1u);
+  EXPECT_TRUE(s.refused[0].document);
+  EXPECT_EQ(s.refused[0].reason.find('\n'), std::string::npos);
+  const StickScan plain = scan_stick(t.root(), ScanLimits{});
+  EXPECT_EQ(doc_paths(plain), (std::vector<std::string>{"bad_crc.png", "damaged_idat.png", "horse.png"}));
+}
+
 TEST(StickScan, HostileNamesAreShownSafelyAndStillOpen) {
   TempTree t;
   const std::string cafe = "caf\xe9.png";                          // Latin-1, not UTF-8

@@ -27,6 +27,9 @@ struct ScanLimits {
   int max_documents = 500;                   ///< documents listed; later ones are refused
   std::int64_t max_file_bytes = 200LL << 20; ///< largest document [bytes] (200 MB)
   double max_seconds = 2.0;                  ///< wall-clock time of the walk [s]
+  /// Read each picture's header too (read_image_header's parsers) and refuse one that cannot be read, so that
+  /// what a stick offers is what can be shown. Off: the magic bytes alone decide (the kiosk turns it on).
+  bool check_picture_headers = false;
 };
 
 /// Kind of a document, from its magic bytes.
@@ -45,6 +48,9 @@ struct StickDocument {
 struct RefusedEntry {
   std::string path;    ///< relative to the root, made safe (safe_display_name)
   std::string reason;  ///< one line, e.g. "a symbolic link (links are not followed)"
+  /// A picture or PDF by its bytes that cannot be read (a damaged header, over the size limit, a PDF the
+  /// worker refuses): what a visitor is told of, counted. Else a link, a device, another kind of file.
+  bool document = false;
 };
 
 /// Result of a scan. Documents are sorted by path (byte order), so the order is stable between scans.
@@ -64,16 +70,19 @@ class StickError : public hk::Error {
 };
 
 /// Walks the folder `root` (a mounted stick, or any folder for tests and `haptic-kiosk stick DIR`).
-/// Never follows a symbolic link, never leaves the tree or its filesystem, reads at most 16 bytes of each
-/// regular file (its magic bytes), writes nothing.
+/// Never follows a symbolic link, never leaves the tree or its filesystem, reads of each regular file its
+/// magic bytes and, with check_picture_headers, a picture's header (read_image_header's parsers: a few hundred
+/// bytes, a JPEG's segments skipped), writes nothing.
 ///
 /// Each folder's entries are sorted by name (byte order) before they are visited, so the walk, and what a
 /// limit cuts off, is the same on every scan of an unchanged stick. FIFOs, sockets, device nodes and
 /// symbolic links are refused from their directory entry type without being opened. Hidden entries (name
 /// starting with '.', e.g. .Trash-1000, .fseventsd, macOS "._*" AppleDouble files) and the Windows system
 /// folders "System Volume Information" and "$RECYCLE.BIN" are refused with a reason, never opened or
-/// entered. A regular file is refused when empty, when its first bytes are not a document's, or when it
-/// is larger than max_file_bytes, in that order. Limits while walking:
+/// entered. A regular file is refused when empty, when its first bytes are not a document's, when it
+/// is larger than max_file_bytes, or (check_picture_headers) when it is a picture whose header cannot be read
+/// (the InputError's line as its reason), in that order; the last two are refusals of a document (RefusedEntry::document).
+/// Limits while walking:
 ///  - a folder deeper than max_depth is refused ("folder deeper than 8 levels is not entered"), the walk goes on;
 ///  - entries: once max_entries entries have been counted and another one is met, the walk stops reading
 ///    folders; entries already read are still classified, folders among them are refused unentered;
