@@ -29,6 +29,7 @@
 #include "kiosk_flow.hpp"
 #include "servo_core.hpp"
 #include "settings_params.hpp"
+#include "runtime_ticks.hpp"
 #include "show_now.hpp"
 #include "simulation.hpp"
 #include "test_pictures.hpp"
@@ -486,12 +487,7 @@ struct RuntimeRig {
     fs::remove_all(dir);
     fs::create_directories(dir);
     EXPECT_TRUE(test::write_five_shapes_png((dir / "five.png").string()));
-    RuntimeOptions ro;
-    ro.library = dir.string();
-    ro.hotplug = false;
-    ro.open_audio_output = false;
-    ro.probe_usb_device = false;
-    rt = std::make_unique<KioskRuntime>(ro, s);
+    rt = std::make_unique<KioskRuntime>(test::headless_runtime_options(dir), s);
   }
   ~RuntimeRig() {
     rt.reset();
@@ -501,17 +497,14 @@ struct RuntimeRig {
   /// force unless `hand_target_m` is given: then the model hand pulls the handle there), then the window
   /// thread's poll. Each tick's guide force is kept in guide_n (the trace).
   void run(double seconds, std::optional<Vec2> hand_target_m = std::nullopt) {
-    auto& sim = dynamic_cast<SimulatedPantograph&>(rt->device());
     const double dt = 1.0 / s.haptics.servo_rate_hz;
     const ModelHandParams hand = hand_params_from(s);
+    const auto hand_force = [&](const SimulatedPantograph& sim) {
+      return hand_target_m ? model_hand_force(hand, *hand_target_m, sim.true_position_m(), sim.velocity_m_per_s()) : Vec2{};
+    };
     for (long k = 0, n = static_cast<long>(seconds / dt + 0.5); k < n; ++k) {
-      ServoCommand cmd;
-      rt->core().step(sim.read(), false, cmd);
-      rt->core().publish_display();
+      test::runtime_tick(*rt, dt, hand_force);
       guide_n.push_back(length(rt->core().display().guide_force_n));
-      sim.write_force(cmd.force_n);
-      sim.step(dt, hand_target_m ? model_hand_force(hand, *hand_target_m, sim.true_position_m(), sim.velocity_m_per_s()) : Vec2{});
-      rt->collect();
       if (k % 16 == 0) rt->poll_tour();  // a frame
     }
     rt->poll_tour();

@@ -16,8 +16,8 @@
 
 #include "audio/messages.hpp"
 #include "guided_tour.hpp"
-#include "haptics/sim_pantograph.hpp"
 #include "kiosk_runtime.hpp"
+#include "runtime_ticks.hpp"
 #include "settings_params.hpp"
 #include "show_now.hpp"
 #include "simulation.hpp"
@@ -41,12 +41,7 @@ struct OnePictureKiosk {
     fs::remove_all(dir);
     fs::create_directories(dir);
     fs::copy_file(picture, dir / picture.filename());
-    RuntimeOptions ro;
-    ro.library = dir.string();
-    ro.hotplug = false;
-    ro.open_audio_output = false;
-    ro.probe_usb_device = false;
-    rt = std::make_unique<KioskRuntime>(ro, s);
+    rt = std::make_unique<KioskRuntime>(test::headless_runtime_options(dir), s);
   }
   ~OnePictureKiosk() {
     rt.reset();
@@ -54,15 +49,9 @@ struct OnePictureKiosk {
   }
   /// `seconds` of servo ticks; nobody holds the handle (no hand force).
   void run(double seconds) {
-    auto& sim = dynamic_cast<SimulatedPantograph&>(rt->device());
     const double dt = 1.0 / s.haptics.servo_rate_hz;
     for (long k = 0, n = static_cast<long>(seconds / dt + 0.5); k < n; ++k, ++ticks) {
-      ServoCommand cmd;
-      rt->core().step(sim.read(), false, cmd);
-      rt->core().publish_display();
-      sim.write_force(cmd.force_n);
-      sim.step(dt, Vec2{});
-      rt->collect();
+      test::runtime_tick(*rt, dt, nullptr);
       if (ticks % 16 == 0) rt->poll_tour();
     }
     rt->poll_tour();
