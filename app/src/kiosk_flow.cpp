@@ -621,15 +621,19 @@ std::string KioskFlow::unreadable_line(int unreadable) const {
 
 void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable) {
   activity(now_s);
-  if (v_.state == KioskState::Attract) v_.state = KioskState::Picture;  // a stick is someone at the kiosk
-  if (v_.state == KioskState::Tutorial) v_.state = KioskState::Picture;
   v_.stick = documents;
   v_.doc = v_.at_doc = v_.pending_doc = -1;
-  if (v_.stick.empty()) {
+  if (v_.stick.empty()) {  // nothing to show: the visitor stays where they are (the tutorial's shape, a picture)
     v_.source = KioskSource::Library;
-    fx_.say(text(MessageId::stick_empty) + unreadable_line(unreadable));
+    std::string line = text(MessageId::stick_empty) + unreadable_line(unreadable);
+    if (v_.state == KioskState::Attract) {  // a stick is someone at the kiosk: the tutorial starts, welcomed
+      start_tutorial();
+      line += " " + text(MessageId::welcome);
+    }
+    fx_.say(line);
     return;
   }
+  v_.state = KioskState::Picture;  // from Attract or the tutorial: the stick's first page comes
   v_.source = KioskSource::Stick;
   v_.announce_summary = stick_summary();
   v_.announce_unreadable = unreadable_line(unreadable);
@@ -637,9 +641,16 @@ void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, dou
 }
 
 void KioskFlow::stick_refused(const std::string& reason, double now_s) {
-  activity(now_s);
-  if (v_.state == KioskState::Attract) v_.state = KioskState::Picture;
-  say(MessageId::stick_unreadable, {{"reason", reason}});
+  guarded("a USB stick", [&] {
+    activity(now_s);
+    std::string line = text(MessageId::stick_unreadable, {{"reason", reason}});
+    if (v_.state == KioskState::Attract) {  // someone is at the kiosk: the tutorial starts, welcomed
+      start_tutorial();
+      if (!line.empty() && line.back() != '.' && line.back() != '!' && line.back() != '?') line += '.';
+      line += " " + text(MessageId::welcome);
+    }
+    fx_.say(line);
+  });
 }
 
 void KioskFlow::stick_removed(double now_s) {

@@ -316,6 +316,37 @@ TEST(KioskFlow, UnreadableFilesOfAStickAreOneCountedLine) {
   EXPECT_EQ(fx.said.back().find("cannot be read"), std::string::npos) << fx.said.back();
 }
 
+// An empty stick put in during the tutorial leaves the visitor on the practice shape: Help says so, and Next
+// goes on with the tutorial, not to a picture.
+TEST(KioskFlow, AnEmptyStickDuringTheTutorialLeavesTheTutorialAsItWas) {
+  Recorder fx;
+  KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
+  flow.key(KioskKey::Other, 0.0);
+  ASSERT_EQ(flow.state(), KioskState::Tutorial);
+  flow.stick_inserted({}, 1.0, 0);
+  EXPECT_EQ(fx.said.back(), "I found no pictures and no PDF documents on this USB stick.");
+  EXPECT_EQ(flow.state(), KioskState::Tutorial);
+  flow.key(KioskKey::Help, 2.0);
+  EXPECT_EQ(fx.said.back().rfind("Practising with a shape.", 0), 0u) << fx.said.back();
+  flow.key(KioskKey::Next, 3.0);
+  EXPECT_EQ(fx.shown.back(), "tutorial 1") << "Next goes on to the circle";
+  // In Attract, an empty stick wakes the kiosk into the tutorial, as any visitor's first act does.
+  Recorder fx2;
+  KioskFlow waiting(fx2, audio::MessageCatalog::english(), {120.0, 20.0});
+  waiting.stick_inserted({}, 1.0, 0);
+  EXPECT_EQ(waiting.state(), KioskState::Tutorial);
+  EXPECT_EQ(fx2.shown.back(), "tutorial 0");
+  EXPECT_EQ(fx2.said.back(), "I found no pictures and no PDF documents on this USB stick. Welcome. Feel the square with the handle. "
+                             "Press the Right arrow to move on. Press F1 for help.");
+  // A stick that cannot be read at all, likewise.
+  Recorder fx3;
+  KioskFlow refused(fx3, audio::MessageCatalog::english(), {120.0, 20.0});
+  refused.stick_refused("its filesystem (btrfs) is not one the kiosk reads", 1.0);
+  EXPECT_EQ(refused.state(), KioskState::Tutorial);
+  EXPECT_EQ(fx3.said.back(), "I cannot read this USB stick. its filesystem (btrfs) is not one the kiosk reads. Welcome. Feel the square "
+                             "with the handle. Press the Right arrow to move on. Press F1 for help.");
+}
+
 TEST(KioskFlow, SpokenNamesAreShortWholeWordsAndWholeCharacters) {
   EXPECT_EQ(spoken_name("holiday-photo_2025.JPG", true), "holiday photo 2025");
   EXPECT_EQ(spoken_name("notes.v2.pdf", true), "notes.v2");
