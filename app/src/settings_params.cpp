@@ -1,6 +1,8 @@
 // The settings mapped to each part's parameters (settings_params.hpp).
 #include "settings_params.hpp"
 
+#include "vision/intake.hpp"
+
 #include <algorithm>
 #include <string>
 
@@ -107,7 +109,7 @@ vision::ScanLimits scan_limits_from(const config::Settings& s) {
   l.max_documents = s.stick.max_documents;
   l.max_file_bytes = s.stick.max_file_bytes;
   l.max_seconds = s.stick.scan_timeout_s;
-  l.check_picture_headers = true;  // a visitor hears what can be read, and one line for what cannot
+  l.picture_check = vision::image_header_problem;  // a visitor hears what can be read, and one line for what cannot
   return l;
 }
 

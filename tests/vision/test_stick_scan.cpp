@@ -28,6 +28,7 @@
 #include <tuple>
 #include <vector>
 
+#include "vision/intake.hpp"
 #include "vision/stick_scan.hpp"
 #include "hk/error.hpp"
 
@@ -542,7 +543,7 @@ TEST(StickScan, EmptyMislabelledAndOversizedFilesAreRefused) {
   EXPECT_NE(read_error(t.root(), "ok.png", 0).find("not positive"), std::string::npos);
 }
 
-// With check_picture_headers, a picture whose header cannot be read (real bad files from tests/data/bad: a
+// With picture_check = image_header_problem (as at the kiosk), a picture whose header cannot be read (real bad files from tests/data/bad: a
 // PNG whose IHDR checksum is wrong, an empty PNG, a PNG whose image data is damaged but header whole) is
 // refused at the scan, as a document, with the header parser's one line; a whole picture is listed. Without
 // it, the magic bytes alone decide.
@@ -557,7 +558,7 @@ TEST(StickScan, PicturesWhoseHeaderCannotBeReadAreRefusedAsDocuments) {
   copy(bad + "damaged_idat.png", "damaged_idat.png");
   copy(std::string(HK_TEST_DATA_DIR) + "/images/horse.png", "horse.png");
   ScanLimits limits;
-  limits.check_picture_headers = true;
+  limits.picture_check = image_header_problem;
   const StickScan s = scan_stick(t.root(), limits);
   expect_well_formed(s, limits);
   EXPECT_EQ(doc_paths(s), (std::vector<std::string>{"damaged_idat.png", "horse.png"})) << "a whole header is listed; its pixels are read when shown";

@@ -14,7 +14,10 @@
 #include <system_error>
 #include <vector>
 
+#include <unistd.h>
 #include <zlib.h>
+
+#include <cerrno>
 
 #include "image_header_detail.hpp"
 #include "input_error.hpp"
@@ -359,6 +362,42 @@ std::uint64_t checked_file_size(const std::string& path) {
 }
 
 }  // namespace detail
+
+namespace {
+
+/// The bytes of an open file, read with pread where the parser asks (a JPEG's walk skips its segments).
+class FdSource final : public detail::ByteSource {
+ public:
+  FdSource(int fd, std::uint64_t size) : fd_(fd), size_(size) {}
+  std::uint64_t size() const override { return size_; }
+  bool read(std::uint64_t offset, std::size_t n, std::uint8_t* out) override {
+    if (offset > size_ || n > size_ - offset) return false;
+    std::size_t done = 0;
+    while (done < n) {
+      const long got = ::pread(fd_, out + done, n - done, static_cast<off_t>(offset + done));
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) return false;
+      done += static_cast<std::size_t>(got);
+    }
+    return true;
+  }
+
+ private:
+  int fd_;
+  std::uint64_t size_;
+};
+
+}  // namespace
+
+std::string image_header_problem(int fd, std::uint64_t size_bytes, const std::string& name) {
+  FdSource src(fd, size_bytes);
+  try {
+    detail::parse_image_header(src, name);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return {};
+}
 
 ImageHeader read_image_header(const std::string& path) {
   const std::uint64_t size = detail::checked_file_size(path);

@@ -18,7 +18,6 @@
 #include "vision/stick_scan.hpp"
 #include "hk/text.hpp"
 
-#include "image_header_detail.hpp"
 #include "unique_fd.hpp"
 #include "hk/error.hpp"
 
@@ -40,28 +39,6 @@
 
 namespace hk::vision {
 namespace {
-
-/// The bytes of an open file, read with pread where the parser asks (a JPEG's walk skips its segments).
-class FdSource final : public detail::ByteSource {
- public:
-  FdSource(int fd, std::uint64_t size) : fd_(fd), size_(size) {}
-  std::uint64_t size() const override { return size_; }
-  bool read(std::uint64_t offset, std::size_t n, std::uint8_t* out) override {
-    if (offset > size_ || n > size_ - offset) return false;
-    std::size_t done = 0;
-    while (done < n) {
-      const long got = ::pread(fd_, out + done, n - done, static_cast<off_t>(offset + done));
-      if (got < 0 && errno == EINTR) continue;
-      if (got <= 0) return false;
-      done += static_cast<std::size_t>(got);
-    }
-    return true;
-  }
-
- private:
-  int fd_;
-  std::uint64_t size_;
-};
 
 constexpr std::uint64_t kResolve = RESOLVE_BENEATH | RESOLVE_NO_SYMLINKS | RESOLVE_NO_XDEV | RESOLVE_NO_MAGICLINKS;
 constexpr std::size_t kMagicBytes = 16;
@@ -282,13 +259,9 @@ class Walker {
       return refuse(path, "file size " + std::to_string(st.st_size) + " bytes exceeds the limit of " +
                               std::to_string(limits_.max_file_bytes) + " bytes", true);
     }
-    if (limits_.check_picture_headers && format != "pdf") {  // refused here, with the others, not when visited
-      FdSource src(fd.get(), static_cast<std::uint64_t>(st.st_size));
-      try {
-        detail::parse_image_header(src, safe_display_name(path));
-      } catch (const InputError& e) {
-        return refuse(path, e.what(), true);
-      }
+    if (limits_.picture_check && format != "pdf") {  // refused here, with the others, not when visited
+      std::string why = limits_.picture_check(fd.get(), static_cast<std::uint64_t>(st.st_size), safe_display_name(path));
+      if (!why.empty()) return refuse(path, std::move(why), true);
     }
     if (static_cast<long>(out_.documents.size()) >= limits_.max_documents) {
       const std::string why = "document limit: more than " + std::to_string(limits_.max_documents) + " documents; the rest were not listed";

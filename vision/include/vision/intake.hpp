@@ -59,6 +59,11 @@ struct ImageHeader {
 ///         or out-of-range size.
 ImageHeader read_image_header(const std::string& path);
 
+/// read_image_header's check of a file already open as `fd` (read with pread, the offset untouched) of
+/// `size_bytes` bytes, named `name` in the answer: "" when its header is whole, else the InputError's one line
+/// (a USB stick's scan refuses such a picture: ScanLimits::picture_check). Never throws for a bad file.
+std::string image_header_problem(int fd, std::uint64_t size_bytes, const std::string& name);
+
 /// Loads an image file as 8-bit BGR after checking it against the limits.
 ///
 /// Order of checks: file exists and is a regular file; size in (0, max_file_bytes]; header

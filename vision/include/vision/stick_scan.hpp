@@ -14,6 +14,7 @@
 #include "hk/error.hpp"
 #include <cstdint>
 #include <stdexcept>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,9 +28,11 @@ struct ScanLimits {
   int max_documents = 500;                   ///< documents listed; later ones are refused
   std::int64_t max_file_bytes = 200LL << 20; ///< largest document [bytes] (200 MB)
   double max_seconds = 2.0;                  ///< wall-clock time of the walk [s]
-  /// Read each picture's header too (read_image_header's parsers) and refuse one that cannot be read, so that
-  /// what a stick offers is what can be shown. Off: the magic bytes alone decide (the kiosk turns it on).
-  bool check_picture_headers = false;
+  /// When set, called for each picture (not a PDF) with its open file descriptor, its size [bytes] and its
+  /// safe name; a non-empty answer (one line) refuses it as a document that cannot be read, so that what a
+  /// stick offers is what can be shown. The kiosk passes vision::image_header_problem (intake.hpp); empty: the
+  /// magic bytes alone decide. Kept as a function so the walk itself needs no image library.
+  std::function<std::string(int fd, std::uint64_t size_bytes, const std::string& name)> picture_check;
 };
 
 /// Kind of a document, from its magic bytes.
@@ -71,8 +74,8 @@ class StickError : public hk::Error {
 
 /// Walks the folder `root` (a mounted stick, or any folder for tests and `haptic-kiosk stick DIR`).
 /// Never follows a symbolic link, never leaves the tree or its filesystem, reads of each regular file its
-/// magic bytes and, with check_picture_headers, a picture's header (read_image_header's parsers: a few hundred
-/// bytes, a JPEG's segments skipped), writes nothing.
+/// magic bytes and, with picture_check, what that reads of a picture (image_header_problem: its header, a few
+/// hundred bytes, a JPEG's segments skipped), writes nothing.
 ///
 /// Each folder's entries are sorted by name (byte order) before they are visited, so the walk, and what a
 /// limit cuts off, is the same on every scan of an unchanged stick. FIFOs, sockets, device nodes and
@@ -80,8 +83,8 @@ class StickError : public hk::Error {
 /// starting with '.', e.g. .Trash-1000, .fseventsd, macOS "._*" AppleDouble files) and the Windows system
 /// folders "System Volume Information" and "$RECYCLE.BIN" are refused with a reason, never opened or
 /// entered. A regular file is refused when empty, when its first bytes are not a document's, when it
-/// is larger than max_file_bytes, or (check_picture_headers) when it is a picture whose header cannot be read
-/// (the InputError's line as its reason), in that order; the last two are refusals of a document (RefusedEntry::document).
+/// is larger than max_file_bytes, or (picture_check) when it is a picture the check refuses (its line as the
+/// reason), in that order; the last two are refusals of a document (RefusedEntry::document).
 /// Limits while walking:
 ///  - a folder deeper than max_depth is refused ("folder deeper than 8 levels is not entered"), the walk goes on;
 ///  - entries: once max_entries entries have been counted and another one is met, the walk stops reading
