@@ -345,8 +345,10 @@ std::string KioskRuntime::where() {
                                                   {"where", place}, {"text", first_words(b->text, kWhereTextWords)}});
   }
   const ShapeAtHand at = shape_at_hand(shown_.polylines, d.handle_m, d.scene_id == shown_id_ ? d.curve : -1);
-  // A practice shape: far and near explained with the first answer that uses them.
-  const std::string far_near = showing_tutorial() ? " " + m.text(audio::MessageId::far_near) : std::string();
+  // A practice shape: far and near explained with the first answer of the visit, not again.
+  const bool explain = showing_tutorial() && !far_near_said_;
+  far_near_said_ = far_near_said_ || explain;
+  const std::string far_near = explain ? " " + m.text(audio::MessageId::far_near) : std::string();
   if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}}) + far_near;
   return m.text(at.on ? audio::MessageId::where_on : audio::MessageId::where_near,
                 {{"shape", std::to_string(at.curve + 1)}, {"shapes", std::to_string(shown_.polylines.size())},
@@ -794,6 +796,7 @@ void KioskRuntime::reset_level() {
 bool KioskRuntime::change_volume(int delta) { return delta > 0 ? audio_.volume_up() : audio_.volume_down(); }
 
 void KioskRuntime::new_session() {
+  far_near_said_ = false;
   if (servo_) {  // the servo thread's timing, once per visitor's session
     const ServoTimingStats t = servo_->take_stats();
     spdlog::info("session: servo {} ticks, {} missed deadlines, lateness p50 {:.0f} p99 {:.0f} max {:.0f} us, tick work p99 {:.0f} us",

@@ -380,6 +380,7 @@ class KioskRuntime final : public KioskEffects {
   int tour_seq_ = 0;           // TourPath::id of the last tour handed over
   int tour_running_ = 0;       // its id until poll_tour sees it ended, else 0
   int tour_scene_ = 0;         // the picture it was planned for
+  bool far_near_said_ = false;  // Where on a practice shape has said what far and near mean in this visit
   bool tour_quiet_ = false;    // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
   bool guide_stops_ = false;   // this key press stopped a running or announced tour
   bool tour_asked_ = false;    // announced, not yet handed to the servo thread

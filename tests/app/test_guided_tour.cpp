@@ -649,6 +649,9 @@ TEST(GuidedTourRuntime, PracticeShapesAreNamedAndWhereExplainsFarAndNear) {
   const std::string where = r.rt->where();
   EXPECT_EQ(where.rfind("On shape 1 of 1: a circle. Your hand is ", 0), 0u) << where;
   EXPECT_TRUE(ends_with(where, ". Far means away from you, near means towards you.")) << where;
+  EXPECT_EQ(r.rt->where().find("Far means"), std::string::npos) << "said once a visit";
+  r.rt->new_session();
+  EXPECT_NE(r.rt->where().find("Far means"), std::string::npos) << "and again for the next visitor";
   EXPECT_EQ(r.rt->describe(), "A circle, in the middle.");
   // A picture is described by its shapes again.
   ASSERT_EQ(test::show_now(*r.rt, 0), 5);
