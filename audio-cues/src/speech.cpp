@@ -310,6 +310,18 @@ bool Speaker::busy() const {
          steady_ns() - handed_at_ns_ < static_cast<std::int64_t>(kHandOverGrace * 1e9);
 }
 
+int Speaker::piece_heard() const {
+  std::lock_guard<std::mutex> lock(m_);
+  const std::uint32_t gen = stream_.generation();
+  if (gen != job_generation_) return -1;  // cancelled, with nothing newer asked for
+  if (starts_generation_ != gen || piece_starts_.empty()) return has_job_ || working_ ? 0 : -1;
+  const SpeechStream::Heard heard = stream_.heard();
+  if (heard.generation_low != (gen & SpeechStream::kHeardGenerationMask)) return 0;  // not reached the mixer yet
+  if (!working_ && heard.samples >= utterance_samples_) return -1;                      // played to its end
+  const auto after = std::upper_bound(piece_starts_.begin(), piece_starts_.end(), heard.samples);
+  return std::max(0, static_cast<int>(after - piece_starts_.begin()) - 1);
+}
+
 bool Speaker::wait_idle(double timeout_s) {
   std::unique_lock<std::mutex> lock(m_);
   return cv_.wait_for(lock, std::chrono::duration<double>(std::max(timeout_s, 0.0)),
@@ -331,7 +343,7 @@ std::vector<std::string> Speaker::pieces_spoken() const {
   return {pieces_.begin(), pieces_.end()};
 }
 
-bool Speaker::speak_piece(const std::string& piece, std::uint32_t gen) {
+bool Speaker::speak_piece(const std::string& piece, std::uint32_t gen, std::uint64_t* pushed) {
   const auto retry = std::chrono::duration<double>(kFullRingRetry);
   // Synthesised whole under the synthesiser's lock (a piece is a sentence: tens of milliseconds), then handed
   // to the mixer outside it. Waiting for room in the mixer's ring takes as long as the piece plays; holding
@@ -352,6 +364,7 @@ bool Speaker::speak_piece(const std::string& piece, std::uint32_t gen) {
     // Hand the samples to the mixer; when its ring is full, wait for the callback to make room.
     std::size_t taken = 0;
     const bool ok = stream_.push(gen, x, n, &taken);
+    *pushed += taken;
     x += taken;
     n -= taken;
     if (ok) break;
@@ -383,11 +396,25 @@ void Speaker::run() {
     if (gen == stream_.generation()) {
       try {
         bool whole = true;
+        std::uint64_t pushed = 0;  // samples of this utterance handed to the stream
         for (const std::string& piece : speech_pieces(text)) {
-          if (!speak_piece(piece, gen)) {
+          {
+            std::lock_guard<std::mutex> lock(m_);
+            if (starts_generation_ != gen) {
+              starts_generation_ = gen;
+              piece_starts_.clear();
+              utterance_samples_ = UINT64_MAX;  // not known before the last piece is handed over
+            }
+            piece_starts_.push_back(pushed);
+          }
+          if (!speak_piece(piece, gen, &pushed)) {
             whole = false;
             break;
           }
+        }
+        {
+          std::lock_guard<std::mutex> lock(m_);
+          if (starts_generation_ == gen) utterance_samples_ = pushed;
         }
         while (whole && stream_.generation() == gen) {
           if (stream_.finish(gen)) {

@@ -58,10 +58,18 @@ std::size_t SpeechStream::read_paused(float* out, std::size_t frames) noexcept {
     out[n++] = current_.samples[offset_++] * static_cast<float>(pause_fade_left_) / static_cast<float>(kFadeSamples);
     --pause_fade_left_;
   }
+  heard_samples_ += n;
+  publish_heard();
   pause_fade_left_ = 0;  // the fade is over (or there was nothing to fade)
   if (n < frames) std::memset(out + n, 0, (frames - n) * sizeof(float));
   speaking_.store(false, std::memory_order_relaxed);
   return n;
+}
+
+void SpeechStream::publish_heard() noexcept {
+  constexpr unsigned shift = 64 - kHeardGenerationBits;
+  const std::uint64_t samples = std::min<std::uint64_t>(heard_samples_, (std::uint64_t{1} << shift) - 1);
+  heard_.store((std::uint64_t{playing_generation_ & kHeardGenerationMask} << shift) | samples, std::memory_order_release);
 }
 
 std::size_t SpeechStream::read(float* out, std::size_t frames) noexcept {
@@ -80,7 +88,10 @@ std::size_t SpeechStream::read(float* out, std::size_t frames) noexcept {
         have_current_ = false;
         continue;
       }
-      if (playing_generation_ != gen) fade_left_ = 0;
+      if (playing_generation_ != gen) {
+        fade_left_ = 0;
+        heard_samples_ = 0;
+      }
       playing_generation_ = gen;
       continue;
     }
@@ -103,8 +114,10 @@ std::size_t SpeechStream::read(float* out, std::size_t frames) noexcept {
     n += take;
     offset_ += take;
     spoken += take;
+    heard_samples_ += take;
     speaking_.store(true, std::memory_order_relaxed);
   }
+  publish_heard();
   if (n < frames) std::memset(out + n, 0, (frames - n) * sizeof(float));
   // Still speaking while a block of the current utterance plays or waits in the ring (the producer may be
   // behind the consumer for a moment without the utterance being over).

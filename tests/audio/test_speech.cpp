@@ -359,6 +359,46 @@ TEST(SpeechPieces, ALongTextIsSpokenWholeAndInOrder) {
   EXPECT_EQ(letters_of(joined(speaker.pieces_spoken())), letters_of(text)) << "every word was handed on, in order";
 }
 
+TEST(SpeechPieces, ThePieceHeardFollowsTheMixer) {
+  // Three sentences; the piece heard moves from one to the next where the mixer reaches the samples of the
+  // next, i.e. after as many samples as the first sentence takes when synthesised on its own.
+  const std::string text = "The first sentence is here. A second one follows it. And the third ends the text.";
+  const std::vector<std::string> pieces = speech_pieces(text);
+  ASSERT_EQ(pieces.size(), 3u);
+  SpeechStream stream;
+  Speaker speaker(stream, {});
+  EXPECT_EQ(speaker.piece_heard(), -1) << "nothing said yet";
+  speaker.say(text);
+  EXPECT_EQ(speaker.piece_heard(), 0) << "asked for, not heard yet: its first piece is next";
+  std::vector<float> all, speech;
+  std::vector<std::pair<std::size_t, int>> changes;  // (samples of speech read, piece heard after them)
+  ASSERT_TRUE(pull(stream, all, [&] {
+    const int p = speaker.piece_heard();
+    if (changes.empty() || changes.back().second != p) changes.emplace_back(speech.size(), p);
+    return p < 0;
+  }, &speech));
+  ASSERT_EQ(changes.size(), 4u) << "0, 1, 2, then over";
+  EXPECT_EQ(changes[0].second, 0);
+  EXPECT_EQ(changes[1].second, 1);
+  EXPECT_EQ(changes[2].second, 2);
+  EXPECT_EQ(changes[3].second, -1);
+  const double first = static_cast<double>(synthesize_speech(pieces[0], {}).size());
+  const double second = static_cast<double>(synthesize_speech(pieces[1], {}).size());
+  EXPECT_NEAR(static_cast<double>(changes[1].first), first, 0.05 * first + kChunk);
+  EXPECT_NEAR(static_cast<double>(changes[2].first), first + second, 0.05 * (first + second) + kChunk);
+  // Held by a pause it stays; cut off it is over.
+  speaker.say(text);
+  ASSERT_TRUE(pull(stream, all, [&] { return speaker.piece_heard() == 1; }));
+  ASSERT_TRUE(speaker.pause());
+  for (int i = 0; i < 100; ++i) {
+    float buf[kChunk];
+    stream.read(buf, kChunk);
+  }
+  EXPECT_EQ(speaker.piece_heard(), 1);
+  speaker.cancel();
+  EXPECT_EQ(speaker.piece_heard(), -1);
+}
+
 TEST(SpeechPieces, TextOverTheLimitIsCutNotRefused) {
   SpeechStream stream(4);
   Speaker speaker(stream, {});

@@ -73,8 +73,8 @@ std::vector<std::string> speech_pieces(std::string_view text, std::size_t piece_
 std::vector<float> synthesize_speech(std::string_view text, const SpeechParams& params);
 
 /// The kiosk's speaker: one worker thread synthesises each text into a SpeechStream as it goes, piece by
-/// piece (speech_pieces; every ~100 ms of espeak-ng output is resampled and pushed at once, so the first
-/// block reaches the mixer long before the sentence is done, and a long text starts as fast as a short one).
+/// piece (speech_pieces; each piece, one sentence, is synthesised whole, tens of milliseconds, then handed to the
+/// mixer, so a long text starts as fast as a short one).
 /// The Speaker is the stream's only producer: one Speaker per stream.
 ///
 /// Threads: every member but the destructor may be called from any thread except the audio callback; each
@@ -119,6 +119,12 @@ class Speaker {
   /// Waits until no text waits or is being synthesised (the stream may still play it) or `timeout_s` [s]
   /// passes. Returns false on time-out. For tests and shutdown.
   bool wait_idle(double timeout_s);
+  /// Which piece (speech_pieces, counted from 0) of the newest text asked for is being heard: 0 while it waits
+  /// for its first sample to reach the mixer, the piece whose samples the mixer reads now (or held by a pause),
+  /// and −1 once it has been played to its end, when it was cut off (cancel(), a newer text) or was empty, and
+  /// before the first text. Follows the mixer within one audio buffer: with nothing pulling the stream it stays
+  /// at 0. The kiosk's sentence keys move from here (a sentence is a piece).
+  int piece_heard() const;
   /// The last non-empty text asked for with `keep` ("" before the first).
   std::string last_text() const;
   /// Every text passed to say() / repeat(), oldest first, with the std::chrono::steady_clock time it was
@@ -137,7 +143,7 @@ class Speaker {
  private:
   void run();
   void submit(std::string text, bool keep);  // cancels and queues; caller holds m_
-  bool speak_piece(const std::string& piece, std::uint32_t gen);  // false: cancelled
+  bool speak_piece(const std::string& piece, std::uint32_t gen, std::uint64_t* pushed);  // false: cancelled; *pushed += samples handed over
 
   SpeechStream& stream_;
   SpeechParams params_;
@@ -153,6 +159,9 @@ class Speaker {
   std::uint32_t handed_generation_ = 0;  // the last utterance the worker finished, and when [steady ns]
   std::int64_t handed_at_ns_ = 0;
   bool handed_ = false;
+  std::uint32_t starts_generation_ = 0;      // the utterance piece_starts_ belongs to
+  std::vector<std::uint64_t> piece_starts_;  // its pieces' first samples in the stream [samples], as synthesised
+  std::uint64_t utterance_samples_ = 0;      // all its samples, once the last piece is handed over [samples]
   bool stop_ = false;
   std::thread worker_;
 };

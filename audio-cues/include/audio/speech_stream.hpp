@@ -60,16 +60,32 @@ class SpeechStream {
   /// rest of `out` is zero). Returns the number of speech samples written. Wait-free, no allocation.
   std::size_t read(float* out, std::size_t frames) noexcept;
 
+  /// How far the consumer has played into the utterance it plays or played last: that utterance's generation
+  /// (its low kHeardGenerationBits bits) and the samples of it read so far, paused or not. Updated at the end of
+  /// each read(); any thread. Speaker::piece_heard maps it to the piece being heard.
+  struct Heard {
+    std::uint32_t generation_low = 0;  ///< generation & kHeardGenerationMask
+    std::uint64_t samples = 0;         ///< samples of it read [samples at the mixer's rate]
+  };
+  static constexpr unsigned kHeardGenerationBits = 24;
+  static constexpr std::uint32_t kHeardGenerationMask = (1u << kHeardGenerationBits) - 1;
+  Heard heard() const noexcept {
+    const std::uint64_t v = heard_.load(std::memory_order_acquire);
+    return {static_cast<std::uint32_t>(v >> (64 - kHeardGenerationBits)), v & ((std::uint64_t{1} << (64 - kHeardGenerationBits)) - 1)};
+  }
+
   /// Blocks dropped because the ring was full (the producer retries; this counts the waits).
   std::uint64_t full_waits() const noexcept { return ring_.overflows(); }
 
  private:
   std::size_t read_paused(float* out, std::size_t frames) noexcept;  // the fade into a pause, then silence
+  void publish_heard() noexcept;  // heard_ from playing_generation_ and heard_samples_
 
   SpscRing<Block> ring_;
   std::atomic<std::uint32_t> generation_{0};
   std::atomic<bool> speaking_{false};
   std::atomic<bool> paused_{false};
+  std::atomic<std::uint64_t> heard_{0};  // Heard packed: generation_low in the top bits, samples below
   // producer state
   Block pending_{};
   // consumer state
@@ -78,6 +94,7 @@ class SpeechStream {
   bool have_current_ = false;
   float last_sample_ = 0.0f;
   std::size_t fade_left_ = 0;
+  std::uint64_t heard_samples_ = 0;  // samples of playing_generation_ read
   std::size_t pause_fade_left_ = kFadeSamples;  // fade-out samples left on entering a pause
   std::uint32_t playing_generation_ = 0;
 };

@@ -68,6 +68,9 @@ class AudioSystem {
   /// Speech is being said to someone: the speaker is busy, not paused, and its sound reaches a device (or
   /// the caller pulls render(), open_output false). Without a sound device nobody hears it: false.
   bool speaking() const;
+  /// Which piece (speech_pieces) of the newest text said is being heard (Speaker::piece_heard); −1 when it is
+  /// over or cut off, and without speech or without anyone hearing it (no sound device, nothing pulled).
+  int piece_heard() const { return speaker_ && (pulled_ || sound_output()) ? speaker_->piece_heard() : -1; }
   /// How long `text` takes to say [s] at the speaker's voice and rate (synthesised, not played: ~1/600 of
   /// that in CPU time); 0 without speech. Allocates; not for the audio callback.
   double speech_duration_s(const std::string& text) const;
