@@ -22,7 +22,10 @@ const std::map<std::string, KioskKey>& action_names() {
                                                  {"tutorial", KioskKey::Tutorial}, {"guide", KioskKey::Guide},
                                                  {"capture", KioskKey::Capture}, {"repeat", KioskKey::Repeat},
                                                  {"pause", KioskKey::Pause},       {"where", KioskKey::Where},
-                                                 {"finish", KioskKey::Finish},     {"other", KioskKey::Other}};
+                                                 {"finish", KioskKey::Finish},     {"next_sentence", KioskKey::NextSentence},
+                                                 {"previous_sentence", KioskKey::PreviousSentence},
+                                                 {"next_paragraph", KioskKey::NextParagraph},
+                                                 {"previous_paragraph", KioskKey::PreviousParagraph}, {"other", KioskKey::Other}};
   return m;
 }
 

@@ -1,6 +1,7 @@
 #include "kiosk_flow.hpp"
 
 #include "stick_pages.hpp"
+#include "audio/speech.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -31,7 +32,8 @@ constexpr std::array<MessageId, static_cast<std::size_t>(KioskKey::Other)> kKeyD
     MessageId::key_help,     MessageId::key_next,        MessageId::key_previous,      MessageId::key_describe,
     MessageId::key_finer,    MessageId::key_coarser,     MessageId::key_volume_up,     MessageId::key_volume_down,
     MessageId::key_tutorial, MessageId::key_guide,       MessageId::key_capture,       MessageId::key_repeat,
-    MessageId::key_pause,    MessageId::key_where,       MessageId::key_finish};
+    MessageId::key_pause,    MessageId::key_where,       MessageId::key_finish,        MessageId::key_next_sentence,
+    MessageId::key_previous_sentence, MessageId::key_next_paragraph, MessageId::key_previous_paragraph};
 
 }  // namespace
 
@@ -160,7 +162,13 @@ bool KioskFlow::session_key(KioskKey k, double now_s) {
       say(MessageId::tutorial_start);
       return true;
     case KioskKey::Repeat:
-      if (!fx_.repeat()) say_brief(MessageId::nothing_to_repeat);
+      repeat_key();
+      return true;
+    case KioskKey::NextSentence:
+    case KioskKey::PreviousSentence:
+    case KioskKey::NextParagraph:
+    case KioskKey::PreviousParagraph:
+      reading_key(k);
       return true;
     case KioskKey::Pause:
       pause_key();
@@ -196,20 +204,100 @@ void KioskFlow::finish_key(double now_s) {
 }
 
 void KioskFlow::describe_key() {
-  const std::string description = fx_.describe();
   std::string before;
   // A visitor's own document is about to be heard by everyone near the kiosk: said once a visit, first.
   if (v_.source == KioskSource::Stick && v_.doc >= 0 && !v_.read_aloud_said) {
     v_.read_aloud_said = true;
     before = text(MessageId::read_aloud_warning) + " ";
   }
-  // A long text says how long it is before it starts (words at the voice's rate).
-  const double seconds = spoken_seconds(description);
-  if (seconds > kLongText_s) {
-    const int minutes = static_cast<int>(std::lround(seconds / 60.0));
-    before += (minutes <= 1 ? text(MessageId::long_text_minute) : text(MessageId::long_text_minutes, {{"minutes", std::to_string(minutes)}})) + " ";
+  // The hand on a block of text: that paragraph is read, by sentence (the reading keys move within the page).
+  PageText page = fx_.page_text();
+  v_.reading = ReadAloud(page.paragraphs);
+  v_.reading_on = false;
+  if (page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs()) {
+    const ReadingPlace at{page.at_hand, 0};
+    // The catalogue's words before the text ("Text:"), as the block's text would be said with text_block.
+    const std::string& block = msg_.raw(MessageId::text_block);
+    const std::string lead = msg_.expand(std::string_view(block).substr(0, block.find("{text}")), {}, key_args(p_.keys));
+    read_from(at, before + long_text_line(v_.reading.text_from(at)) + lead);
+    return;
   }
-  fx_.say(before + text(MessageId::describe, {{"description", description}}));
+  const std::string description = fx_.describe();
+  fx_.say(before + long_text_line(description) + text(MessageId::describe, {{"description", description}}));
+}
+
+std::string KioskFlow::long_text_line(const std::string& said) const {
+  // A long text says how long it is before it starts (words at the voice's rate), and how to move through it.
+  const double seconds = spoken_seconds(said);
+  if (seconds <= kLongText_s) return {};
+  const int minutes = static_cast<int>(std::lround(seconds / 60.0));
+  return (minutes <= 1 ? text(MessageId::long_text_minute) : text(MessageId::long_text_minutes, {{"minutes", std::to_string(minutes)}})) + " ";
+}
+
+// ---- reading a page's text by sentence and paragraph ---------------------------------------------------
+
+void KioskFlow::follow_reading() {
+  if (!reading()) return;
+  const int piece = fx_.heard_piece();
+  if (piece >= 0) v_.reading.heard(piece);
+}
+
+void KioskFlow::read_from(ReadingPlace at, const std::string& before) {
+  // The lead is said in the same text, so the pieces heard count from its start; a line break ends it, so it
+  // is cut as its own pieces whatever its last character.
+  std::string said = before;
+  while (!said.empty() && said.back() == ' ') said.pop_back();
+  const int lead = static_cast<int>(audio::speech_pieces(said).size());
+  if (!said.empty()) said += '\n';
+  said += v_.reading.text_from(at);
+  fx_.say(said);
+  v_.reading.started(at, lead);
+  v_.reading_on = true;
+  v_.reading_kept = fx_.kept_texts();
+}
+
+void KioskFlow::reading_key(KioskKey k) {
+  follow_reading();
+  if (!reading()) {
+    // Nothing being read: the page's text from the paragraph under the hand (else its first), if it has any.
+    const PageText page = fx_.page_text();
+    v_.reading = ReadAloud(page.paragraphs);
+    v_.reading_on = false;
+    if (v_.reading.empty()) {
+      say_brief(MessageId::reading_none);
+      return;
+    }
+    const int p = page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs() ? page.at_hand : 0;
+    read_from({p, 0}, paragraph_line(p));
+    return;
+  }
+  const bool by_paragraph = k == KioskKey::NextParagraph || k == KioskKey::PreviousParagraph;
+  const ReadAloud::Step step = k == KioskKey::NextSentence     ? v_.reading.next_sentence()
+                                 : k == KioskKey::PreviousSentence ? v_.reading.previous_sentence()
+                                 : k == KioskKey::NextParagraph    ? v_.reading.next_paragraph()
+                                                                   : v_.reading.previous_paragraph();
+  if (step.edge == ReadAloud::Edge::End) {
+    say_brief(MessageId::reading_end);  // the reading stays where it is: Repeat and the keys go on from there
+    return;
+  }
+  std::string before = step.edge == ReadAloud::Edge::Start ? text(MessageId::reading_start) + " " : std::string();
+  if (by_paragraph || step.at.paragraph != v_.reading.place().paragraph) before += paragraph_line(step.at.paragraph);
+  read_from(step.at, before);
+}
+
+std::string KioskFlow::paragraph_line(int p) const {
+  if (v_.reading.paragraphs() < 2) return {};
+  return text(MessageId::reading_paragraph, {{"block", std::to_string(p + 1)}, {"blocks", std::to_string(v_.reading.paragraphs())}});
+}
+
+void KioskFlow::repeat_key() {
+  // Reading a text: the sentence being heard, and on from there; else the last thing said, from its start.
+  follow_reading();
+  if (reading()) {
+    read_from(v_.reading.place(), {});
+    return;
+  }
+  if (!fx_.repeat()) say_brief(MessageId::nothing_to_repeat);
 }
 
 double spoken_seconds(std::string_view text) {
@@ -484,6 +572,7 @@ void KioskFlow::tick(double now_s) {
     // Speech being heard is the visitor listening (a long text being read is never cut by the time-out);
     // the warning's own speech is not.
     if (!v_.warned && fx_.speaking()) activity(now_s);
+    follow_reading();
     if ((v_.pending_doc >= 0 || v_.pending_picture >= 0) && !v_.loading_said && now_s - v_.pending_since_s > p_.loading_cue_s) {
       v_.loading_said = true;
       say_brief(MessageId::loading);

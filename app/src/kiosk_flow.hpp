@@ -52,12 +52,14 @@
 /// set_keys()), as the catalogue's spoken form of each key ("Press the Up arrow for more detail.").
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "audio/messages.hpp"
 #include "picture_notes.hpp"
+#include "read_aloud.hpp"
 #include "config/settings.hpp"
 
 namespace hk::app {
@@ -65,7 +67,8 @@ namespace hk::app {
 /// Keys a blind visitor can find (mapped to physical keys in the config by the window layer), in the order of
 /// config::key_actions (Help .. Finish); Other is any key that is none of them.
 enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Guide, Capture,
-                      Repeat, Pause, Where, Finish, Other };
+                      Repeat, Pause, Where, Finish, NextSentence, PreviousSentence, NextParagraph, PreviousParagraph,
+                      Other };
 
 /// States of the flow.
 enum class KioskState { Attract, Tutorial, Picture };
@@ -90,6 +93,12 @@ struct StickEntry {
 /// read out in full. A title is only cut.
 std::string spoken_name(const std::string& name, bool file_name);
 inline constexpr std::size_t kSpokenNameBytes = 60;
+
+/// The text of the page shown, for reading by sentence and paragraph (read_aloud.hpp).
+struct PageText {
+  std::vector<std::string> paragraphs;  ///< its blocks of text in reading order; empty: no text
+  int at_hand = -1;                     ///< the paragraph under the hand, −1 when none is
+};
 
 /// Where Next and Previous go.
 enum class KioskSource { Library, Stick };
@@ -116,6 +125,15 @@ class KioskEffects {
   /// Say the last text said with say() again, from its start. False when there is none (nothing said).
   /// Default: nothing to repeat.
   virtual bool repeat() { return false; }
+  /// Texts said with say() so far (a count that only grows): the flow knows whether what it said last is
+  /// still the last text kept, or something else (a tour's line, a page's text arriving) has been said since.
+  /// Default: 0.
+  virtual std::uint64_t kept_texts() const { return 0; }
+  /// Which piece (audio::speech_pieces, from 0) of the last text said with say() is being heard now; −1 when it
+  /// is over, was cut off by anything said since, or nothing was said. Default: −1.
+  virtual int heard_piece() const { return -1; }
+  /// The text of the page shown, paragraph by paragraph, and which is under the hand. Default: no text.
+  virtual PageText page_text() { return {}; }
   /// Speech is being heard (not paused). Default: never.
   virtual bool speaking() const { return false; }
   /// Hold the speech where it is; false when nothing is being said. Default: nothing is.
@@ -206,6 +224,10 @@ class KioskFlow {
   static constexpr std::size_t kHelpSentencesPerGroup = 2;
   /// Describe says how long a text is before one that takes longer than this to say [s].
   static constexpr double kLongText_s = 30.0;
+  /// Where reading a page's text stands (the sentence heard last), and whether it is what is being read: the
+  /// last text said is the reading and no other text has been said since.
+  ReadingPlace reading_place() const { return v_.reading.place(); }
+  bool reading() const { return v_.reading_on && !v_.reading.empty() && fx_.kept_texts() == v_.reading_kept; }
 
   KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params = {});
 
@@ -311,6 +333,9 @@ class KioskFlow {
     bool felt = false;                       // a shape, picture or page has been put under the hand in this visit
     bool read_aloud_said = false;            // the visitor was told that their document is heard by people nearby
     bool push_taught = false;                // the tutorial said that a wall can be pushed through
+    ReadAloud reading;                     // the page's text being read, and where the visitor is in it
+    bool reading_on = false;                 // the reading was said, as the text kept numbered reading_kept
+    std::uint64_t reading_kept = 0;
   };
 
   template <class Action>
@@ -326,6 +351,13 @@ class KioskFlow {
   void volume_key(int delta);
   void finish_key(double now_s);
   void describe_key();
+  void reading_key(KioskKey k);               // the sentence and paragraph keys
+  void repeat_key();
+  void follow_reading();                      // the place follows the sentence heard
+  /// Reads from `at` to the end of its paragraph, after `before` (said first, in the same text).
+  void read_from(ReadingPlace at, const std::string& before);
+  std::string long_text_line(const std::string& text) const;
+  std::string paragraph_line(int paragraph) const;  // "Paragraph 2 of 5." on a page of more than one, else ""  // "" or "About 9 minutes of text. …" and a space
   void level_key(int delta);
   void warn(double idle_s);
   void pause_key();

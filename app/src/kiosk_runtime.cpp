@@ -307,16 +307,29 @@ void KioskRuntime::stop_servo() {
   if (servo_) servo_->stop();
 }
 
+namespace {
+
+/// `text` with its line breaks (a reading's sentences are joined by them) as spaces: one line of the log.
+std::string one_line(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  return text;
+}
+
+}  // namespace
+
 void KioskRuntime::say(const std::string& text) {
-  spdlog::info("say: {}", text);
+  spdlog::info("say: {}", one_line(text));
   last_said_ = text;
   repeatable_ = text;
+  ++kept_texts_;
+  brief_last_ = false;
   audio_.say_text(text);
 }
 
 void KioskRuntime::say_brief(const std::string& text) {
-  spdlog::info("say: {}", text);
+  spdlog::info("say: {}", one_line(text));
   last_said_ = text;
+  brief_last_ = true;
   audio_.say_text(text, false);
 }
 
@@ -342,7 +355,7 @@ std::string KioskRuntime::where() {
   if (const TextBlockM* b = text_block_at(shown_.text_blocks, d.handle_m)) {
     const auto index = b - shown_.text_blocks.data();
     return m.text(audio::MessageId::where_text, {{"block", std::to_string(index + 1)}, {"blocks", std::to_string(shown_.text_blocks.size())},
-                                                  {"where", place}, {"text", first_words(b->text, kWhereTextWords)}});
+                                                  {"where", place}, {"text", first_words(name_unclear_words(b->text, m), kWhereTextWords)}});
   }
   const ShapeAtHand at = shape_at_hand(shown_.polylines, d.handle_m, d.scene_id == shown_id_ ? d.curve : -1);
   // A practice shape: far and near explained with the first answer of the visit, not again.
@@ -660,11 +673,18 @@ std::string KioskRuntime::describe() {
   return reading + describe_shown();
 }
 
+PageText KioskRuntime::page_text() {
+  PageText page;
+  for (const TextBlockM& b : shown_.text_blocks) page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
+  if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m)) page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
+  return page;
+}
+
 std::string KioskRuntime::describe_shown() {
   if (shown_page_ > 0 || !shown_.text_blocks.empty()) {
     // A page (or a picture of one): the block of text under the hand is read; elsewhere, what the page holds.
     if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m)) {
-      return audio_.messages().text(audio::MessageId::text_block, {{"text", b->text}});
+      return audio_.messages().text(audio::MessageId::text_block, {{"text", name_unclear_words(b->text, audio_.messages())}});
     }
     const std::string page = describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
     return shown_.polylines.empty() ? page : page + " " + describe_scene(shown_.polylines, half_, 3, core_.display().handle_m);

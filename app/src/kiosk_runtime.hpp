@@ -149,6 +149,12 @@ class KioskRuntime final : public KioskEffects {
   void say_brief(const std::string& text) override;
   /// Says the last text given to say() again (false when there is none in this visit).
   bool repeat() override;
+  std::uint64_t kept_texts() const override { return kept_texts_; }
+  /// The piece of the last text given to say() being heard (audio::AudioSystem::piece_heard); −1 once an
+  /// acknowledgement (say_brief) has cut it off.
+  int heard_piece() const override { return brief_last_ ? -1 : audio_.piece_heard(); }
+  /// The blocks of text of the page shown, and the one under the proxy (as Describe reads it).
+  PageText page_text() override;
   bool speaking() const override { return audio_.speaking(); }
   bool pause_speech() override { return audio_.pause_speech(); }
   bool resume_speech() override { return audio_.resume_speech(); }
@@ -364,6 +370,8 @@ class KioskRuntime final : public KioskEffects {
   bool said_contrast_ = false, said_overlay_ = false;  // the switches as last announced
   std::string last_said_;
   std::string repeatable_;  // the last text given to say(), for Repeat
+  std::uint64_t kept_texts_ = 0;  // texts given to say()
+  bool brief_last_ = false;       // the last text said was given to say_brief()
   int shown_id_ = -100;
   std::uint64_t scenes_published_ = 0;
   int shown_picture_ = -1;  // library index shown, −1 for none

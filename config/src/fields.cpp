@@ -322,7 +322,11 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(keys, repeat, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Say the last message again, from its start.", kKeyNames),
     HK_FIELD(keys, pause, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Pause the speech; pressed again, it goes on.", kKeyNames),
     HK_FIELD(keys, where, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "What is here: the shape under or nearest the hand, and where the hand is.", kKeyNames),
-    HK_FIELD(keys, finish, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Finish: end the visit at once, for the next visitor.", kKeyNames),
+    HK_FIELD(keys, finish, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Finish: end the visit, for the next visitor (pressed twice).", kKeyNames),
+    HK_FIELD(keys, next_sentence, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Reading a text: on from the next sentence.", kKeyNames),
+    HK_FIELD(keys, previous_sentence, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Reading a text: back to the sentence before.", kKeyNames),
+    HK_FIELD(keys, next_paragraph, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Reading a text: on from the next paragraph (block of text).", kKeyNames),
+    HK_FIELD(keys, previous_paragraph, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Reading a text: back to the paragraph before.", kKeyNames),
     // [operator]
     HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
                 "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),

@@ -44,7 +44,7 @@ struct Action {
   std::string_view help_after;   ///< ... and just after it
 };
 
-constexpr std::array<Action, 15> kActions{{
+constexpr std::array<Action, config::kKeyActionCount> kActions{{
     {"help", &config::KeysSettings::help, "Hold ", " and press another key to learn what it does."},
     {"next", &config::KeysSettings::next, "Press ", " for the next picture"},
     {"previous", &config::KeysSettings::previous, "and ", " for the one before."},
@@ -60,6 +60,10 @@ constexpr std::array<Action, 15> kActions{{
     {"pause", &config::KeysSettings::pause, "and ", " to pause the speech and go on."},
     {"where", &config::KeysSettings::where, "Press ", " to hear what is under your hand"},
     {"finish", &config::KeysSettings::finish, "and ", " when you have finished."},
+    {"next_sentence", &config::KeysSettings::next_sentence, "press ", " or "},
+    {"previous_sentence", &config::KeysSettings::previous_sentence, "or ", " to move by sentence"},
+    {"next_paragraph", &config::KeysSettings::next_paragraph, "and ", " or "},
+    {"previous_paragraph", &config::KeysSettings::previous_paragraph, "or ", " by paragraph."},
 }};
 
 /// Every key's help as a visitor hears it: Help pressed (twice when `fresh`: the first layer, then every key),
@@ -121,7 +125,7 @@ TEST(SpokenKeys, EnglishAndGermanHaveASpokenFormForEveryKeyName) {
   }
 }
 
-// Every action (15) x every key name (75), each a kiosk configured so, woken, asked for help twice (the
+// Every action (19) x every key name (75), each a kiosk configured so, woken, asked for help twice (the
 // first layer names the two most useful keys, the second every key).
 TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
   const audio::MessageCatalog& en = audio::MessageCatalog::english();
@@ -193,7 +197,7 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
       ++cases;
     }
   }
-  EXPECT_EQ(cases, 15 * static_cast<int>(config::visitor_key_names().size()));
+  EXPECT_EQ(cases, static_cast<int>(config::kKeyActionCount * config::visitor_key_names().size()));
 }
 
 TEST(SpokenKeys, KeyArgsPairEachPlaceholderWithItsAction) {

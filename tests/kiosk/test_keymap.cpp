@@ -39,17 +39,21 @@ TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
                               KioskKey::Describe, KioskKey::Finer,       KioskKey::Coarser,
                               KioskKey::VolumeUp, KioskKey::VolumeDown,  KioskKey::Tutorial,
                               KioskKey::Guide,    KioskKey::Capture,     KioskKey::Repeat,
-                              KioskKey::Pause,    KioskKey::Where,       KioskKey::Finish};
-  for (int a = 0; a < 15; ++a) {
+                              KioskKey::Pause,    KioskKey::Where,       KioskKey::Finish,
+                              KioskKey::NextSentence, KioskKey::PreviousSentence, KioskKey::NextParagraph,
+                              KioskKey::PreviousParagraph};
+  static_assert(std::size(actions) == config::kKeyActionCount);
+  for (int a = 0; a < static_cast<int>(config::kKeyActionCount); ++a) {
     for (std::string_view name : config::visitor_key_names()) {
       config::KeysSettings k;
       std::string* slot[] = {&k.help, &k.next, &k.previous, &k.describe, &k.finer, &k.coarser, &k.volume_up, &k.volume_down, &k.tutorial, &k.guide,
-                             &k.capture, &k.repeat, &k.pause, &k.where, &k.finish};
-      for (int b = 0; b < 15; ++b)
+                             &k.capture, &k.repeat, &k.pause, &k.where, &k.finish, &k.next_sentence, &k.previous_sentence,
+                             &k.next_paragraph, &k.previous_paragraph};
+      for (int b = 0; b < static_cast<int>(config::kKeyActionCount); ++b)
         if (b != a && *slot[b] == name) *slot[b] = *slot[a];  // swap: the set stays one key per action
       *slot[a] = std::string(name);
       const auto map = visitor_key_map(k);
-      ASSERT_EQ(map.size(), 15u) << name;
+      ASSERT_EQ(map.size(), config::kKeyActionCount) << name;
       const auto it = map.find(glfw_key(std::string(name)));
       ASSERT_NE(it, map.end()) << name;
       EXPECT_EQ(it->second, actions[a]) << name;

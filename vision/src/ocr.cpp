@@ -63,8 +63,9 @@ std::vector<std::uint8_t> packed(const cv::Mat& grey) {
   return px;
 }
 
-/// Reads one block of the answer into `out` (its words appended to out.words, the block to out.blocks).
-bool read_block(worker::WireReader& in, OcrResult& out, double& confidence_sum) {
+/// Reads one block of the answer into `out` (its words appended to out.words, the block to out.blocks); a word
+/// below p.min_word_confidence stands in the block's text as kUnclearWord.
+bool read_block(worker::WireReader& in, const OcrParams& p, OcrResult& out, double& confidence_sum) {
   std::uint32_t lines = 0, words = 0;
   if (!in.u32(lines) || !in.u32(words) || words == 0 || words > kMaxWords || out.words.size() + words > kMaxWords || lines == 0 || lines > words) {
     return false;
@@ -79,7 +80,7 @@ bool read_block(worker::WireReader& in, OcrResult& out, double& confidence_sum) 
       return false;
     }
     b.box_px = i == 0 ? w.box_px : (b.box_px | w.box_px);
-    b.text += (i == 0 ? "" : " ") + w.text;
+    b.text += (i == 0 ? "" : " ") + (w.confidence < p.min_word_confidence ? std::string(kUnclearWord) : w.text);
     block_sum += w.confidence;
     out.words.push_back(std::move(w));
   }
@@ -127,7 +128,7 @@ OcrResult read_ocr_answer(const worker::WorkerRun& run, const std::string& name,
   out.words_seen = static_cast<int>(seen);
   double confidence_sum = 0;
   for (std::uint32_t i = 0; i < blocks; ++i)
-    if (!read_block(in, out, confidence_sum)) fail_run(run, name, p);
+    if (!read_block(in, p, out, confidence_sum)) fail_run(run, name, p);
   if (in.left() != 0) fail_run(run, name, p);
   out.mean_confidence = out.words.empty() ? 0.0 : confidence_sum / static_cast<double>(out.words.size());
   out.ms = run.ms;

@@ -8,6 +8,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
@@ -57,8 +58,8 @@ double letter_share(const std::string& s) {
   return all == 0 ? 0.0 : static_cast<double>(letters) / all;
 }
 
-/// Tesseract's paragraphs, each with its words at or above the confidence threshold; empty and garbled ones
-/// left out.
+/// Tesseract's paragraphs, each with its words above noise (kNoiseWordConfidence); those with no clear word
+/// (at or above the threshold) and garbled ones left out.
 std::vector<Block> read_blocks(tesseract::TessBaseAPI& api, const OcrParams& p, std::uint32_t& seen) {
   std::vector<Block> blocks;
   std::unique_ptr<tesseract::ResultIterator> it(api.GetIterator());
@@ -67,9 +68,10 @@ std::vector<Block> read_blocks(tesseract::TessBaseAPI& api, const OcrParams& p, 
   Block current;
   bool line_has_word = false;
   auto close_block = [&] {
-    std::string text;
-    for (const Word& w : current.words) text += w.text + ' ';
-    if (!current.words.empty() && letter_share(text) >= p.min_letter_share) blocks.push_back(std::move(current));
+    std::string clear;  // its clear words: what it is judged by
+    for (const Word& w : current.words)
+      if (w.confidence >= p.min_word_confidence) clear += w.text + ' ';
+    if (!clear.empty() && letter_share(clear) >= p.min_letter_share) blocks.push_back(std::move(current));
     current = Block{};
   };
   do {
@@ -82,7 +84,7 @@ std::vector<Block> read_blocks(tesseract::TessBaseAPI& api, const OcrParams& p, 
     Word w;
     w.text = text.get();
     w.confidence = it->Confidence(kWord) / 100.0;
-    if (w.confidence < p.min_word_confidence || !it->BoundingBox(kWord, &w.l, &w.t, &w.r, &w.b)) continue;
+    if (w.confidence < std::min(p.min_word_confidence, kNoiseWordConfidence) || !it->BoundingBox(kWord, &w.l, &w.t, &w.r, &w.b)) continue;
     if (!line_has_word) ++current.lines;
     line_has_word = true;
     current.words.push_back(std::move(w));
@@ -91,10 +93,11 @@ std::vector<Block> read_blocks(tesseract::TessBaseAPI& api, const OcrParams& p, 
   return blocks;
 }
 
-/// Words kept in `blocks`.
-std::size_t kept_words(const std::vector<Block>& blocks) {
+/// Clear words (at or above the threshold) kept in `blocks`.
+std::size_t kept_words(const std::vector<Block>& blocks, const OcrParams& p) {
   std::size_t n = 0;
-  for (const Block& b : blocks) n += b.words.size();
+  for (const Block& b : blocks)
+    for (const Word& w : b.words) n += w.confidence >= p.min_word_confidence;
   return n;
 }
 
@@ -125,11 +128,11 @@ void read_page(tesseract::TessBaseAPI& api, const std::uint8_t* pixels, int widt
     if (api.Recognize(nullptr) != 0) throw Refusal{OcrError::Kind::WorkerCrashed, "Tesseract could not read the picture"};
     std::uint32_t mode_seen = 0;
     std::vector<Block> found = read_blocks(api, p, mode_seen);
-    if (kept_words(found) > kept_words(blocks)) {
+    if (kept_words(found, p) > kept_words(blocks, p)) {
       blocks = std::move(found);
       seen = mode_seen;
     }
-    if (kept_words(blocks) >= kEnoughForALayout) break;
+    if (kept_words(blocks, p) >= kEnoughForALayout) break;
   }
   out.u32(seen);
   out.u32(static_cast<std::uint32_t>(blocks.size()));

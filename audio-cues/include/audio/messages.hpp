@@ -41,9 +41,11 @@ enum class MessageId : int {
   text_reading, text_ready, text_none, text_unavailable, device_not_home, tour_stuck, finish_ask,
   timeout_warning_stick, level_manual, files_unreadable, file_unreadable, document_unreadable_alone,
   read_aloud_warning, long_text_minutes, long_text_minute, tutorial_push, tutorial_no_levels, far_near, shape_square,
-  shape_circle, shape_triangle, help_next, help_last, key_place,
+  shape_circle, shape_triangle, help_next, help_last, key_place, key_next_sentence, key_previous_sentence,
+  key_next_paragraph, key_previous_paragraph, reading_none, reading_start, reading_end, reading_paragraph,
+  unclear_word, unclear_words,
 };
-inline constexpr int kMessageCount = 123;
+inline constexpr int kMessageCount = 133;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
@@ -65,7 +67,9 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{
     "text_unavailable", "device_not_home", "tour_stuck", "finish_ask", "timeout_warning_stick", "level_manual",
     "files_unreadable", "file_unreadable", "document_unreadable_alone", "read_aloud_warning",
     "long_text_minutes", "long_text_minute", "tutorial_push", "tutorial_no_levels", "far_near", "shape_square", "shape_circle",
-    "shape_triangle", "help_next", "help_last", "key_place"};
+    "shape_triangle", "help_next", "help_last", "key_place", "key_next_sentence", "key_previous_sentence",
+    "key_next_paragraph", "key_previous_paragraph", "reading_none", "reading_start", "reading_end", "reading_paragraph",
+    "unclear_word", "unclear_words"};
 
 /// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
 /// fault, its key, e.g. "messages 'de.toml': messages.help uses {colour}, which the English text does not have".
@@ -79,11 +83,12 @@ using MessageArg = std::pair<std::string_view, std::string>;
 
 /// The placeholders that name one of the visitor's keys, one per action of the [keys] settings (help, next,
 /// previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide, capture, repeat, pause, where,
-/// finish), in that order.
-inline constexpr std::array<std::string_view, 15> kKeyPlaceholders{
+/// finish, next_sentence, previous_sentence, next_paragraph, previous_paragraph), in that order.
+inline constexpr std::array<std::string_view, 19> kKeyPlaceholders{
     "help_key", "next_key", "previous_key", "describe_key", "finer_key", "coarser_key",
     "volume_up_key", "volume_down_key", "tutorial_key", "guide_key", "capture_key",
-    "repeat_key", "pause_key", "where_key", "finish_key"};
+    "repeat_key", "pause_key", "where_key", "finish_key", "next_sentence_key", "previous_sentence_key",
+    "next_paragraph_key", "previous_paragraph_key"};
 
 /// A key placeholder and the key it stands for, by its settings name: {"help_key", "F1"}. MessageCatalog::text()
 /// puts the spoken form of the key (MessageCatalog::key_name()) in its place.

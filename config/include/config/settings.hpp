@@ -208,24 +208,30 @@ struct KeysSettings {
   std::string repeat = "R";               ///< key repeat, the last thing said, again from its start
   std::string pause = "P";                ///< key pause, speech stops where it is; pressed again, it goes on
   std::string where = "W";                ///< key where, "what is here": the shape under or nearest the hand, and where the hand is
-  std::string finish = "END";             ///< key finish, ends the visit at once (goodbye, defaults restored, waiting for the next visitor)
+  std::string finish = "END";             ///< key finish, ends the visit (pressed twice: goodbye, defaults restored, waiting for the next visitor)
+  std::string next_sentence = "K";        ///< key next_sentence, reading a text: on from the next sentence
+  std::string previous_sentence = "J";    ///< key previous_sentence, reading a text: back to the sentence before
+  std::string next_paragraph = "I";       ///< key next_paragraph, reading a text: on from the next paragraph (block of text)
+  std::string previous_paragraph = "U";   ///< key previous_paragraph, reading a text: back to the paragraph before
 
   /// Field-by-field equality; used by round-trip checks.
   bool operator==(const KeysSettings&) const = default;
 };
 
 /// Visitor actions in [keys].
-inline constexpr std::size_t kKeyActionCount = 15;
+inline constexpr std::size_t kKeyActionCount = 19;
 
 /// Each [keys] action's name and its key, in table order: help, next, previous, describe, finer, coarser,
-/// volume_up, volume_down, tutorial, guide, capture, repeat, pause, where, finish. The one list that the
+/// volume_up, volume_down, tutorial, guide, capture, repeat, pause, where, finish, next_sentence,
+/// previous_sentence, next_paragraph, previous_paragraph. The one list that the
 /// validation, the spoken key placeholders (audio::kKeyPlaceholders, the same order) and the window's key map
 /// follow. The views point into `keys`: keep it alive while they are used.
 inline std::array<std::pair<std::string_view, std::string_view>, kKeyActionCount> key_actions(const KeysSettings& k) {
   return {{{"help", k.help}, {"next", k.next}, {"previous", k.previous}, {"describe", k.describe}, {"finer", k.finer},
            {"coarser", k.coarser}, {"volume_up", k.volume_up}, {"volume_down", k.volume_down}, {"tutorial", k.tutorial},
            {"guide", k.guide}, {"capture", k.capture}, {"repeat", k.repeat}, {"pause", k.pause}, {"where", k.where},
-           {"finish", k.finish}}};
+           {"finish", k.finish}, {"next_sentence", k.next_sentence}, {"previous_sentence", k.previous_sentence},
+           {"next_paragraph", k.next_paragraph}, {"previous_paragraph", k.previous_paragraph}}};
 }
 
 /// One USB id of [device] usb_ids.

@@ -10,13 +10,16 @@
 ///
 /// In the worker: tesseract::TessBaseAPI with the LSTM engine and automatic page segmentation on the grey
 /// pixels; the layout read back with its ResultIterator at block, paragraph, line and word level (boxes and
-/// confidences). A word below the confidence threshold is dropped (never speak garbage); a paragraph with
-/// none left, or whose words are mostly not letters or digits, is dropped; the rest are the text blocks, in
-/// Tesseract's reading order.
+/// confidences). A word below the confidence threshold is unclear: it is kept in its place in the block's text
+/// as kUnclearWord, never read as if certain (the kiosk says "unclear word" there); a word below
+/// kNoiseWordConfidence as well is dropped as noise. A paragraph with no word at or above the threshold, or
+/// whose clear words are mostly not letters or digits, is dropped; the rest are the text blocks, in Tesseract's
+/// reading order.
 
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -24,6 +27,12 @@
 #include "hk/error.hpp"
 
 namespace hk::vision {
+
+/// What stands in an OcrBlock's text for one unclear word (a word Tesseract is less sure of than
+/// OcrParams::min_word_confidence): U+FFFD, the replacement character, as a word of its own.
+inline constexpr std::string_view kUnclearWord = "\xEF\xBF\xBD";
+/// A word below this confidence, and below OcrParams::min_word_confidence, is noise: left out altogether [0, 1].
+inline constexpr double kNoiseWordConfidence = 0.3;
 
 /// Test hook: the worker fails on purpose as soon as it has started. Never set outside tests.
 enum class OcrFault {
@@ -39,7 +48,7 @@ struct OcrParams {
   std::string languages = "eng";
   /// Tesseract's data folder; empty: Tesseract's own default (Debian: /usr/share/tesseract-ocr/5/tessdata).
   std::string tessdata_dir;
-  double min_word_confidence = 0.6;   ///< a word below this (Tesseract's confidence / 100, [0, 1]) is dropped
+  double min_word_confidence = 0.6;   ///< a word below this (Tesseract's confidence / 100, [0, 1]) is unclear (kUnclearWord)
   double min_letter_share = 0.5;      ///< a block whose characters are less than this share letters or digits is dropped
   double max_pixels = 4e7;            ///< a larger picture is refused before the worker starts [px]
   double worker_cpu_s = 30.0;         ///< RLIMIT_CPU of the worker [s]
@@ -61,14 +70,14 @@ struct OcrWord {
 /// A block of text (one of Tesseract's paragraphs), in reading order.
 struct OcrBlock {
   cv::Rect2d box_px;      ///< union of its kept words' boxes [px]
-  std::string text;       ///< its kept words, line by line, joined by single spaces
-  double confidence = 0;  ///< mean confidence of its kept words, [0, 1]
+  std::string text;       ///< its kept words, line by line, joined by single spaces; each unclear word as kUnclearWord
+  double confidence = 0;  ///< mean confidence of its kept words (unclear ones too), [0, 1]
   int lines = 0;          ///< lines with a kept word
 };
 
 /// What OCR found in one picture.
 struct OcrResult {
-  std::vector<OcrWord> words;    ///< every kept word (in the blocks), in reading order
+  std::vector<OcrWord> words;    ///< every kept word (in the blocks; unclear ones with their own text), in reading order
   std::vector<OcrBlock> blocks;  ///< the text blocks
   int words_seen = 0;            ///< words Tesseract read, kept or not
   double mean_confidence = 0;    ///< over the kept words, [0, 1]; 0 when none

@@ -1,0 +1,219 @@
+// A page's text read with handles: the sentences the kiosk reads are the pieces the speaker says (so the piece
+// heard is the sentence the visitor is at); the sentence and paragraph keys move from the sentence heard, across
+// paragraphs, and say where the text starts and ends; Repeat says the sentence heard again; a long text says how
+// long it is and which keys move through it; a page without text says so. Driven through the flow with a recorder
+// that keeps what a speaker would, and the piece heard set by the test as a mixer would move it.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "audio/speech.hpp"
+#include "kiosk_flow.hpp"
+#include "read_aloud.hpp"
+#include "vision/ocr.hpp"
+
+namespace hk::app {
+namespace {
+
+using audio::MessageId;
+
+const std::string kData = HK_TEST_DATA_DIR;
+
+}  // namespace
+
+void PrintTo(const ReadingPlace& p, std::ostream* os) { *os << "{paragraph " << p.paragraph << ", sentence " << p.sentence << "}"; }
+
+namespace {
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Three paragraphs: two short ones round the 8 KB paragraph of tests/data/documents (long_paragraph.txt, the
+/// text of long_paragraph.pdf).
+std::vector<std::string> page_paragraphs() {
+  return {"Opening hours. The museum opens at nine; it closes at five.",
+          read_file(kData + "/documents/long_paragraph.txt"),
+          "Thank you for reading. Come again soon!"};
+}
+
+struct Reader final : KioskEffects {
+  std::vector<std::string> said;
+  std::vector<bool> brief;
+  std::string kept;
+  std::uint64_t kept_count = 0;
+  int piece = -1;  // the piece of the last kept text being heard (the test moves it)
+  PageText page;
+
+  void say(const std::string& t) override {
+    said.push_back(t);
+    brief.push_back(false);
+    kept = t;
+    ++kept_count;
+    piece = 0;
+  }
+  void say_brief(const std::string& t) override {
+    said.push_back(t);
+    brief.push_back(true);
+    piece = -1;
+  }
+  bool repeat() override {
+    if (kept.empty()) return false;
+    say(std::string(kept));
+    return true;
+  }
+  std::uint64_t kept_texts() const override { return kept_count; }
+  int heard_piece() const override { return piece; }
+  PageText page_text() override { return page; }
+  void show_tutorial(TutorialShape) override {}
+  int show_picture(int) override { return 2; }
+  int picture_count() const override { return 3; }
+  std::string describe() override { return "It has 3 blocks of text and no figures."; }
+  bool change_level(int) override { return true; }
+  bool change_volume(int) override { return true; }
+  void new_session() override { kept.clear(); }
+  void show_document(int, int) override {}
+  void forget_stick() override {}
+};
+
+/// A flow woken and walked to the first picture, on a page of three paragraphs with the hand on `at_hand`.
+struct Page {
+  Reader fx;
+  KioskFlow flow{fx, audio::MessageCatalog::english()};
+  double now = 1.0;
+  explicit Page(int at_hand) {
+    flow.handle_moved(now);
+    for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, now += 0.1);
+    fx.page = {page_paragraphs(), at_hand};
+  }
+  void key(KioskKey k) { flow.key(k, now += 0.1); }
+  /// The mixer reaches piece `p` of the last text said; the flow follows at its next tick.
+  void hear(int p) {
+    fx.piece = p;
+    flow.tick(now += 0.02);
+  }
+  std::string text(MessageId id, std::initializer_list<audio::MessageArg> args = {}) const { return flow.text(id, args); }
+};
+
+TEST(ReadAloud, SentencesAreThePiecesTheSpeakerSays) {
+  const ReadAloud r(page_paragraphs());
+  ASSERT_EQ(r.paragraphs(), 3);
+  EXPECT_EQ(r.sentences(0), 3) << "\"Opening hours.\", then two: ';' ends a spoken piece too";
+  EXPECT_EQ(r.sentence({0, 0}), "Opening hours.");
+  EXPECT_GT(r.sentences(1), 50);
+  for (int p = 0; p < r.paragraphs(); ++p) {
+    for (int s = 0; s < r.sentences(p); s += 7) {
+      // Said from any sentence, the speaker cuts the text into exactly the sentences that follow: the piece it
+      // reports heard is a sentence of this reading.
+      const std::vector<std::string> pieces = audio::speech_pieces(r.text_from({p, s}));
+      ASSERT_EQ(static_cast<int>(pieces.size()), r.sentences(p) - s) << p << ", " << s;
+      for (std::size_t i = 0; i < pieces.size(); ++i) EXPECT_EQ(pieces[i], r.sentence({p, s + static_cast<int>(i)}));
+    }
+  }
+  EXPECT_EQ(ReadAloud(std::vector<std::string>{" ", "\n"}).paragraphs(), 0) << "paragraphs without words are left out";
+}
+
+TEST(ReadAloud, MovesCrossParagraphsAndStopAtTheEdges) {
+  ReadAloud r(page_paragraphs());
+  r.started({0, 0}, 1);
+  r.heard(0);
+  EXPECT_EQ(r.place(), (ReadingPlace{0, 0})) << "the lead's pieces keep the place at the start";
+  r.heard(2);
+  EXPECT_EQ(r.place(), (ReadingPlace{0, 1}));
+  r.heard(9);
+  EXPECT_EQ(r.place(), (ReadingPlace{0, 2})) << "past the paragraph's end: its last sentence";
+  EXPECT_EQ(r.next_sentence().at, (ReadingPlace{1, 0}));
+  EXPECT_EQ(r.previous_sentence().at, (ReadingPlace{0, 1}));
+  EXPECT_EQ(r.next_paragraph().at, (ReadingPlace{1, 0}));
+  EXPECT_EQ(r.previous_paragraph().edge, ReadAloud::Edge::Start);
+  r.started({1, 0}, 0);
+  EXPECT_EQ(r.previous_sentence().at, (ReadingPlace{0, 2})) << "back into the paragraph before, at its last sentence";
+  r.started({2, 1}, 0);
+  EXPECT_EQ(r.next_sentence().edge, ReadAloud::Edge::End);
+  EXPECT_EQ(r.next_sentence().at, (ReadingPlace{2, 1})) << "at the end the place stays";
+  EXPECT_EQ(r.next_paragraph().edge, ReadAloud::Edge::End);
+  EXPECT_EQ(r.previous_paragraph().at, (ReadingPlace{1, 0}));
+}
+
+TEST(ReadAloud, DescribeReadsTheParagraphUnderTheHandAndTheKeysMoveFromTheSentenceHeard) {
+  Page v(1);
+  const ReadAloud r(page_paragraphs());
+  v.key(KioskKey::Describe);
+  const std::string& said = v.fx.said.back();
+  // A long paragraph: its length and the keys that move through it, then the catalogue's "Text:", then the text.
+  const std::string lead = "About 10 minutes of text. Press the K key to skip a sentence, the I key a paragraph. Text:\n";
+  EXPECT_EQ(said.rfind(lead, 0), 0u) << said.substr(0, 200);
+  EXPECT_EQ(said.substr(lead.size()), r.text_from({1, 0}));
+  EXPECT_TRUE(v.flow.reading());
+  const int lead_pieces = static_cast<int>(audio::speech_pieces(lead).size());
+  ASSERT_EQ(lead_pieces, 3);
+  v.hear(lead_pieces + 5);  // the visitor hears sentence 5
+  EXPECT_EQ(v.flow.reading_place(), (ReadingPlace{1, 5}));
+  v.key(KioskKey::NextSentence);
+  EXPECT_EQ(v.fx.said.back(), r.text_from({1, 6})) << "on from the next sentence, nothing before it";
+  v.hear(2);
+  EXPECT_EQ(v.flow.reading_place(), (ReadingPlace{1, 8}));
+  v.key(KioskKey::Repeat);
+  EXPECT_EQ(v.fx.said.back(), r.text_from({1, 8})) << "Repeat: the sentence heard, again";
+  v.key(KioskKey::PreviousSentence);
+  EXPECT_EQ(v.fx.said.back(), r.text_from({1, 7}));
+  v.key(KioskKey::NextParagraph);
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_paragraph, {{"block", "3"}, {"blocks", "3"}}) + "\n" + r.text_from({2, 0}));
+  v.hear(2);  // the second sentence of the last paragraph
+  v.key(KioskKey::NextSentence);
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_end)) << "the end of the text";
+  EXPECT_TRUE(v.fx.brief.back());
+  v.key(KioskKey::Repeat);
+  EXPECT_EQ(v.fx.said.back(), r.text_from({2, 1})) << "the place stayed at the last sentence";
+  v.key(KioskKey::PreviousParagraph);
+  v.key(KioskKey::PreviousParagraph);
+  v.key(KioskKey::PreviousParagraph);
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_start) + " " + v.text(MessageId::reading_paragraph, {{"block", "1"}, {"blocks", "3"}}) +
+                                  "\n" + r.text_from({0, 0}));
+}
+
+TEST(ReadAloud, AfterSomethingElseIsSaidTheKeysStartAgainFromTheHand) {
+  Page v(2);
+  const ReadAloud r(page_paragraphs());
+  v.key(KioskKey::Describe);
+  EXPECT_EQ(v.fx.said.back(), "Text:\n" + r.text_from({2, 0})) << "a short paragraph: no length said";
+  v.key(KioskKey::Where);  // something else is said: the reading is over
+  EXPECT_FALSE(v.flow.reading());
+  v.key(KioskKey::Repeat);
+  EXPECT_EQ(v.fx.said.back(), v.fx.said[v.fx.said.size() - 2]) << "Repeat says what was said last, whole";
+  v.fx.page.at_hand = -1;  // the hand off the text
+  v.key(KioskKey::NextSentence);
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_paragraph, {{"block", "1"}, {"blocks", "3"}}) + "\n" + r.text_from({0, 0}))
+      << "the page's first paragraph";
+  EXPECT_TRUE(v.flow.reading());
+}
+
+TEST(ReadAloud, UnclearWordsAreNamedNotReadAsIfCertain) {
+  const std::string u(vision::kUnclearWord);
+  const audio::MessageCatalog& en = audio::MessageCatalog::english();
+  EXPECT_EQ(name_unclear_words("The " + u + " opens at " + u + " " + u + " " + u + ", daily.", en),
+            "The unclear word opens at 3 unclear words, daily.");
+  EXPECT_EQ(name_unclear_words(u, en), "unclear word");
+  EXPECT_EQ(name_unclear_words("Nothing unsure here.", en), "Nothing unsure here.");
+  const audio::MessageCatalog de = audio::MessageCatalog::load(kData + "/messages/de.toml");
+  EXPECT_EQ(name_unclear_words(u + " " + u + " Uhr", de), "2 unklare Wörter Uhr") << "in the visitor's language";
+}
+
+TEST(ReadAloud, APictureWithoutTextSaysSo) {
+  Page v(-1);
+  v.fx.page = {};
+  v.key(KioskKey::NextParagraph);
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_none));
+  v.key(KioskKey::Describe);
+  EXPECT_EQ(v.fx.said.back(), v.fx.describe()) << "Describe as ever: what the picture holds";
+  EXPECT_FALSE(v.flow.reading());
+}
+
+}  // namespace
+}  // namespace hk::app
