@@ -58,7 +58,7 @@ void add_kiosk_options(CLI::App& cli, hk::app::KioskOptions& ko) {
   cli.add_option("--show", ko.show, "Start on this picture, past the welcome and tutorial (documentation, tests)");
   cli.add_flag("--high-contrast", ko.high_contrast, "Start in high contrast: dimmed picture, thick bright curves (also in the operator's panel)");
   cli.add_flag("--overlay", ko.overlay, "Start with the operator overlay (also in the operator's panel)");
-  cli.add_option("--screenshot", ko.screenshot, "Run --frames frames (scripted input from --script), write the last as PNG, quit");
+  CLI::Option* screenshot = cli.add_option("--screenshot", ko.screenshot, "Run --frames frames (scripted input from --script), write the last as PNG, quit");
   cli.add_option("--frames", ko.frames, "Frames to run before the screenshot (60 per second)");
   cli.add_option("--frame-stats", ko.frame_stats,
                  "At exit (after --frames, or when the window closes) write the window's frame times as JSON: frames, p50/p95/p99/max ms "
@@ -66,7 +66,8 @@ void add_kiosk_options(CLI::App& cli, hk::app::KioskOptions& ko) {
                  "drawn). 'interval' is frame start to next frame start, the buffer swap included: with --screenshot it also holds "
                  "a fixed 16.7 ms pause per frame, live it is paced by vsync (under Xvfb, no vsync: by the software GL's swap); "
                  "'work' is frame start to before the swap");
-  cli.add_option("--script", ko.script, "Scripted input: lines 'FRAME key NAME', 'FRAME cursor X_M Y_M', 'FRAME move', 'FRAME stick DIR', 'FRAME unstick', 'FRAME wait_loaded'");
+  cli.add_option("--script", ko.script, "Scripted input (with --screenshot: a scripted run's clock is its frames): lines 'FRAME key NAME', 'FRAME cursor X_M Y_M', 'FRAME move', 'FRAME stick DIR', 'FRAME unstick', 'FRAME wait_loaded'")
+      ->needs(screenshot);
   cli.add_option("--stick", ko.stick, "A folder treated as a USB stick inserted at start");
   cli.add_flag("!--no-hotplug", ko.hotplug, "Do not watch for USB sticks");
   cli.add_option("--mount-root", ko.mount_root, "Where USB sticks are mounted (default /run/haptic-kiosk/usb)");

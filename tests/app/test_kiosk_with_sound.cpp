@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "audio/speech.hpp"
 #include "kiosk_exe.hpp"
 
 namespace fs = std::filesystem;
@@ -106,6 +107,52 @@ TEST(KioskWithSound, DescribeReadsAnEightKilobyteParagraphWholeAndTheKioskRunsOn
   const std::string heard = letters_of(spoken), whole_text = letters_of(want);
   EXPECT_GT(heard.size(), 300u) << "more than its first sentence was handed on";
   EXPECT_EQ(whole_text.rfind(heard, 0), 0u) << "the pieces spoken are the paragraph's start, in order";
+  fs::remove_all(dir);
+}
+
+/// The sentence of `sentences` from which `said` reads to the end (white space aside); −1 when it is no such text.
+int reads_from(const std::vector<std::string>& sentences, const std::string& said) {
+  const std::string heard = letters_of(said);
+  std::string tail;
+  for (int k = static_cast<int>(sentences.size()) - 1; k >= 0; --k) {
+    tail = letters_of(sentences[static_cast<std::size_t>(k)]) + tail;
+    if (tail == heard) return k;
+  }
+  return -1;
+}
+
+// The sentence keys on the same paragraph, heard as a visitor hears them (the null sound device plays at the
+// real rate): each press reads on from the sentence being heard, never from the top; Previous goes one back,
+// Repeat says the sentence heard again, and a page of one paragraph has no next one.
+TEST(KioskWithSound, TheSentenceKeysMoveThroughALongParagraphFromTheSentenceHeard) {
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  const fs::path dir = hk::test::fresh_dir("kiosk_sentences");
+  fs::create_directories(dir / "stick");
+  fs::copy_file(kData / "documents" / "long_paragraph.pdf", dir / "stick" / "manual.pdf");
+  const std::vector<std::string> sentences = hk::audio::speech_pieces(read(kData / "documents" / "long_paragraph.txt"));
+  ASSERT_GT(sentences.size(), 20u);
+  // Describe at 2 s; the text itself starts after the warning and the length (~10 s); then the keys.
+  std::ofstream(dir / "script.txt") << "1 wait\n2 cursor 0 0\n120 key describe\n900 key next_sentence\n1000 key next_sentence\n"
+                                       "1060 key previous_sentence\n1120 key repeat\n1180 key next_paragraph\n";
+  const fs::path home = null_sound_home(dir);
+  const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 HOME=" + hk::test::quoted(home) + " timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " +
+                          std::string(HK_KIOSK_EXE) + " --library " + hk::test::quoted(kData / "images") + " --stick " +
+                          hk::test::quoted(dir / "stick") + " --script " + hk::test::quoted(dir / "script.txt") + " --screenshot " +
+                          hk::test::quoted(dir / "end.png") + " --frames 1200 >" +
+                          hk::test::quoted(dir / "log.txt") + " 2>&1";
+  ASSERT_EQ(sh(cmd), 0) << read(dir / "log.txt").substr(0, 4000);
+  const std::vector<std::string> said = lines_after(read(dir / "log.txt"), "say: ");
+  ASSERT_GE(said.size(), 5u);
+  const std::vector<std::string> last(said.end() - 5, said.end());
+  const int a = reads_from(sentences, last[0]), b = reads_from(sentences, last[1]), c = reads_from(sentences, last[2]),
+            d = reads_from(sentences, last[3]);
+  EXPECT_GE(a, 1) << "the first press reads on from a sentence after the first: " << last[0].substr(0, 120);
+  EXPECT_GT(b, a) << "the second press goes on past the first: " << last[1].substr(0, 120);
+  EXPECT_GE(c, b - 1) << "Previous goes back one from the sentence heard: " << last[2].substr(0, 120);
+  EXPECT_LT(c, b + 1) << last[2].substr(0, 120);
+  EXPECT_GE(d, c) << "Repeat says the sentence heard, not the top: " << last[3].substr(0, 120);
+  EXPECT_LE(d, c + 1) << last[3].substr(0, 120);
+  EXPECT_EQ(last[4], "That is the end of the text. Press the J key to go back.") << "one paragraph: no next one";
   fs::remove_all(dir);
 }
 
