@@ -233,6 +233,18 @@ void OperatorPanel::sample_plot(KioskRuntime& runtime) {
   plot_at_ = (plot_at_ + 1) % kPlotSamples;
 }
 
+void OperatorPanel::draw_stick_problems(const KioskRuntime& runtime) {
+  const std::vector<std::string>& problems = runtime.stick_problems();
+  if (problems.empty()) return;
+  const std::string title = "The last stick: " + std::to_string(problems.size()) + (problems.size() == 1 ? " file" : " files") +
+                            " left out (" + (problems.size() >= KioskRuntime::kStickProblems ? "the first ones; " : "") + "all in the log)";
+  if (ImGui::TreeNode("stick_problems", "%s", title.c_str())) {
+    for (const std::string& p : problems) ImGui::BulletText("%s", p.c_str());
+    ImGui::TreePop();
+  }
+  record("stick_problems");
+}
+
 void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) {
   const ServoDisplayState& d = runtime.core().display();
   io::HaplyDevice* usb = runtime.usb_device();
@@ -296,6 +308,7 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, st
               a.speech_available() ? "on" : "unavailable", a.volume().step(), static_cast<unsigned long long>(a.cues_dropped()));
   ImGui::Text("USB sticks: %s%s%s", runtime.sticks().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
               flow.source() == KioskSource::Stick ? "; a stick is being browsed" : "", runtime.stick_busy() ? "; working" : "");
+  draw_stick_problems(runtime);
   ImGui::Checkbox("Show the collision tree's boxes and the boundary section on screen", &runtime.overlay());
   ImGui::Checkbox("High contrast", &runtime.high_contrast());
   ImGui::Separator();

@@ -786,8 +786,9 @@ void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
                                                              {"name", name}, {"description", r.description}});
   } else {
     const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + name : name;
-    // "You still feel the picture before" only when there was one.
-    line = text(v_.felt ? MessageId::document_unreadable : MessageId::document_unreadable_alone, {{"name", what}, {"reason", r.reason}});
+    // "You still feel the picture before" only when there was one. Why is for the operator (the log and the
+    // panel: KioskRuntime::stick_problems), not words a visitor can act on.
+    line = text(v_.felt ? MessageId::document_unreadable : MessageId::document_unreadable_alone, {{"name", what}});
   }
   if (!v_.announce_summary.empty()) {  // said now, so it names the keys of now
     line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) + std::exchange(v_.announce_unreadable, {}) + " " + line;
@@ -811,7 +812,8 @@ void KioskFlow::picture_failed(int index, const std::string& reason, double now_
     if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured || v_.source != KioskSource::Library) return;  // superseded
     v_.pending_picture = -1;
     const std::string name = "Picture " + std::to_string(index + 1) + " of " + std::to_string(fx_.picture_count());
-    const std::string line = text(MessageId::document_unreadable, {{"name", name}, {"reason", reason}});
+    spdlog::warn("kiosk: picture {} cannot be shown: {}", index + 1, reason);
+    const std::string line = text(MessageId::document_unreadable, {{"name", name}});
     const std::string before = std::exchange(v_.pending_before, {});
     fx_.say(before.empty() ? line : before + " " + line);
   });

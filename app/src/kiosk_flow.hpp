@@ -109,7 +109,7 @@ struct DocumentResult {
   int page = 1;              ///< as requested (from 1)
   bool ok = false;           ///< the scene is on the device
   std::string description;   ///< ok: what the page holds, one sentence ("It has 3 shapes and 2 blocks of text.")
-  std::string reason;        ///< !ok: why it cannot be shown, one line for speech
+  std::string reason;        ///< !ok: why it cannot be shown, one line for the log and the operator (the visitor hears that it cannot be read)
 };
 
 /// What the flow asks of the rest of the kiosk. The window layer implements it with the AudioSystem, the
@@ -258,7 +258,8 @@ class KioskFlow {
   /// Library picture `index`, asked for with show_picture (which answered kPicturePending), is on the device
   /// with `shapes` shapes: announced as show_picture's answer would have been. Ignored unless it is the one awaited.
   void picture_ready(int index, int shapes, double now_s);
-  /// Library picture `index` could not be built (`reason`, one line): said, and the picture felt before stays.
+  /// Library picture `index` could not be built (`reason`, one line, logged): that it cannot be read is said, and
+  /// the picture felt before stays.
   /// Next and Previous go on from `index`. Ignored unless it is the one awaited.
   void picture_failed(int index, const std::string& reason, double now_s);
   /// A library picture is awaited (asked for, not yet on the device).
@@ -287,6 +288,8 @@ class KioskFlow {
 
   KioskSource source() const { return v_.source; }
   int document() const { return v_.doc; }        ///< stick document shown (0-based), −1 before the first
+  /// The stick's documents as the flow lists them (empty without a stick).
+  const std::vector<StickEntry>& stick_documents() const { return v_.stick; }
   int page() const { return v_.page; }           ///< its page (from 1)
   bool loading() const { return v_.pending_doc >= 0; }  ///< a document load is awaited
   /// Whether page `page` of stick document `document` is the load awaited (else a result for it is superseded).

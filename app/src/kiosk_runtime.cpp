@@ -733,6 +733,11 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
       for (const ListedDocument& d : n.documents)
         entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages, d.title, d.pages_in_file});
       stick_busy_ = !entries.empty();
+      stick_problems_.clear();
+      // Pictures and PDFs first: what the visitor was told of; then the rest left out.
+      for (const bool documents : {true, false})
+        for (const vision::RefusedEntry& r : n.refused)
+          if (r.document == documents) note_stick_problem("'" + r.path + "': " + r.reason);
       flow.stick_inserted(entries, now_s, n.unreadable_documents);
     } else if (n.kind == StickNews::Kind::Refused) {
       stick_busy_ = false;
@@ -774,11 +779,18 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
       shown_picture_ = -1;
     } else {
       r.reason = d.reason;
+      const std::vector<StickEntry>& docs = flow.stick_documents();
+      const std::string name = d.document >= 0 && d.document < static_cast<int>(docs.size()) ? docs[static_cast<std::size_t>(d.document)].name : "?";
+      note_stick_problem("'" + name + "' page " + std::to_string(d.page) + ": " + d.reason);
     }
     stick_busy_ = false;
     flow.document_ready(r, now_s);
   }
   if (flow.loading()) stick_busy_ = true;
+}
+
+void KioskRuntime::note_stick_problem(std::string line) {
+  if (stick_problems_.size() < kStickProblems) stick_problems_.push_back(std::move(line));
 }
 
 void KioskRuntime::insert_stick_folder(const std::string& dir) {

@@ -254,6 +254,12 @@ class KioskRuntime final : public KioskEffects {
   static constexpr double kTextWait_s = 1.0;
   /// Whether stick work (scan or load) may still bring news (scripted runs wait for it).
   bool stick_busy() const { return stick_busy_; }
+  /// What the last stick could not give, for the operator's panel (a visitor hears only a count): one line a
+  /// file, "'bad_crc.png': corrupt PNG header: …" for pictures and PDFs left out at the scan and "'manual.pdf'
+  /// page 3: …" for pages that could not be built, then other entries left out (links, other files); at most
+  /// kStickProblems (the log has them all). Kept until the next stick is inserted.
+  const std::vector<std::string>& stick_problems() const { return stick_problems_; }
+  static constexpr std::size_t kStickProblems = 200;
   /// A folder treated as an inserted USB stick / taken out again (documentation, tests).
   void insert_stick_folder(const std::string& dir);
   void remove_stick_folder();
@@ -383,6 +389,8 @@ class KioskRuntime final : public KioskEffects {
   int captures_ = 0;        // camera captures shown so far
   int stick_id_ = 0;        // the stick the flow browses (StickNews::stick), 0 for none
   bool stick_busy_ = false;
+  std::vector<std::string> stick_problems_;  // stick_problems()
+  void note_stick_problem(std::string line);
   // The guided tour (window thread but hand_limp_).
   VisitTouches touches_;
   int tour_seq_ = 0;           // TourPath::id of the last tour handed over

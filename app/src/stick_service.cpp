@@ -207,6 +207,7 @@ void StickService::scan_root(const std::string& root, double started_ms) {
     n.documents = l.documents;
     n.refused_entries = l.refused.size();
     n.unreadable_documents = static_cast<int>(std::count_if(l.refused.begin(), l.refused.end(), [](const vision::RefusedEntry& r) { return r.document; }));
+    n.refused = l.refused;
     n.scan_ms = started_ms + ms_since(t0);
     spdlog::info("stick {}: {} documents ({} pictures, {} PDFs), {} entries left out, {} ms", id, l.documents.size(), l.pictures(), l.pdfs(),
                  l.refused.size(), n.scan_ms);

@@ -43,7 +43,8 @@ struct StickNews {
   Kind kind = Kind::Inserted;
   int stick = 0;                        ///< the stick's number (every insertion gets a new one)
   std::vector<ListedDocument> documents;///< Inserted: what it offers
-  std::size_t refused_entries = 0;      ///< Inserted: entries left out (reasons in the log)
+  std::size_t refused_entries = 0;      ///< Inserted: entries left out (reasons in the log and in `refused`)
+  std::vector<vision::RefusedEntry> refused;  ///< Inserted: those entries and why (for the operator's panel)
   int unreadable_documents = 0;         ///< Inserted: of those, pictures and PDFs that cannot be read (RefusedEntry::document)
   std::string reason;                   ///< Refused: why, one line for speech
   double scan_ms = 0;                   ///< Inserted: mount + scan + page counting [ms]

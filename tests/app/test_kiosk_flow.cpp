@@ -178,7 +178,7 @@ TEST(KioskFlow, APdfIsNamedByItsOwnTitle) {
   bad.page = 2;
   bad.reason = "it took longer than 5 s to draw";
   flow.document_ready(bad, 2.1);
-  EXPECT_EQ(fx.said.back().rfind("Page 2 of A ring, drawn for the hand cannot be shown", 0), 0u) << fx.said.back();
+  EXPECT_EQ(fx.said.back().rfind("Page 2 of A ring, drawn for the hand cannot be read", 0), 0u) << fx.said.back();
 }
 
 // A stick inserted, browsed, a page that cannot be read, a load superseded, the stick
@@ -220,7 +220,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   bad.page = 2;
   bad.reason = "the reader stopped on page 2 (signal 11)";
   flow.document_ready(bad, 4.2);
-  EXPECT_EQ(fx.said.back(), "Page 2 of report cannot be shown: the reader stopped on page 2 (signal 11). You still feel the picture before.");
+  EXPECT_EQ(fx.said.back(), "Page 2 of report cannot be read. You still feel the picture before.");
   EXPECT_EQ(flow.document(), 1);
   EXPECT_EQ(flow.page(), 1) << "the page shown is still page 1";
   // Next moves on from the unreadable page; a second press while loading moves on from the first; the
@@ -283,7 +283,7 @@ TEST(KioskFlow, StickNamesPageCountsAndNothingFeltBefore) {
   flow.document_ready(bad, 1.1);
   EXPECT_EQ(fx.said.back(),
             "A USB stick with 3 documents: a picture and 2 PDFs of 5002 pages in all (the first 1000 pages of each can be read). "
-            "Press the Right arrow to go through them. bad crc cannot be shown: it is damaged.")
+            "Press the Right arrow to go through them. bad crc cannot be read.")
       << "no picture was felt before";
   flow.key(KioskKey::Next, 2.0);
   flow.document_ready(ready(1, 1), 2.1);
@@ -297,7 +297,7 @@ TEST(KioskFlow, StickNamesPageCountsAndNothingFeltBefore) {
   flow.key(KioskKey::Next, 4.0);
   EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
   flow.document_ready(bad, 4.1);
-  EXPECT_EQ(fx.said.back(), "bad crc cannot be shown: it is damaged. You still feel the picture before.") << "now there was one";
+  EXPECT_EQ(fx.said.back(), "bad crc cannot be read. You still feel the picture before.") << "now there was one";
 }
 
 // What cannot be read is one short line after what the stick holds, counted; never file by file.
