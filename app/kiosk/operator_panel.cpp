@@ -308,6 +308,7 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, st
               a.speech_available() ? "on" : "unavailable", a.volume().step(), static_cast<unsigned long long>(a.cues_dropped()));
   ImGui::Text("USB sticks: %s%s%s", runtime.sticks().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
               flow.source() == KioskSource::Stick ? "; a stick is being browsed" : "", runtime.stick_busy() ? "; working" : "");
+  record(runtime.stick_busy() ? "sticks:working" : "sticks:idle");
   draw_stick_problems(runtime);
   ImGui::Checkbox("Show the collision tree's boxes and the boundary section on screen", &runtime.overlay());
   ImGui::Checkbox("High contrast", &runtime.high_contrast());

@@ -10,7 +10,9 @@
 /// Scripted runs click widgets by name (script lines "FRAME click NAME"): every clickable widget drawn in a
 /// frame is recorded with its screen rectangle — a setting's edit box by its `table.key`, buttons by their
 /// label ("OK", "Apply", "Save", "Reset to defaults", "Reset", "Keep", "Close"), tabs as "tab:Haptics", and
-/// the PIN box as "pin".
+/// the PIN box as "pin". Some lines of the Status tab are recorded by what they say, for "FRAME shows NAME":
+/// the USB stick line as "sticks:idle" or "sticks:working", the last stick's list of files left out as
+/// "stick_problems".
 
 #include <array>
 #include <map>

@@ -30,7 +30,7 @@ const std::map<std::string, KioskKey>& action_names() {
 }
 
 constexpr const char* kAllowed =
-    "'FRAME key ACTION', 'FRAME press KEYS', 'FRAME type TEXT', 'FRAME click NAME', 'FRAME cursor X_M Y_M', 'FRAME move', "
+    "'FRAME key ACTION', 'FRAME press KEYS', 'FRAME type TEXT', 'FRAME click NAME', 'FRAME shows NAME', 'FRAME cursor X_M Y_M', 'FRAME move', "
     "'FRAME stick DIR', 'FRAME unstick' or 'FRAME wait'";
 
 /// KEYS of a press line: a key name, or modifiers and a key joined by '+'. False when it is neither.
@@ -88,7 +88,7 @@ std::vector<ScriptLine> load_script(const std::string& path) {
       if (ok) s.action = action_names().at(s.arg);
     } else if (ok && s.what == "press") {
       ok = static_cast<bool>(ss >> s.arg) && parse_keys(s.arg, &s.glfw_key, &s.glfw_mods);
-    } else if (ok && (s.what == "type" || s.what == "click")) {
+    } else if (ok && (s.what == "type" || s.what == "click" || s.what == "shows")) {
       s.arg = rest_of_line(ss);
       ok = !s.arg.empty();
     } else if (ok && s.what == "cursor") {
@@ -133,6 +133,9 @@ bool ScriptPlayer::step(int frame, ScriptTarget& t) {
     }
     if (l.what == "type") {
       for (unsigned char c : l.arg) t.input({InputEvent::Kind::character, 0, 0, 0, 0, c, 0});
+    }
+    if (l.what == "shows" && !t.widget(l.arg)) {
+      throw AppError("script '" + path_ + "': line " + std::to_string(l.number) + ": '" + l.arg + "' is not on screen at frame " + std::to_string(frame));
     }
     if (l.what == "click") {
       const std::optional<WidgetRect> r = t.widget(l.arg);

@@ -4,13 +4,16 @@
 /// line, "FRAME COMMAND [ARGUMENT]", '#' starts a comment. FRAME counts rendered frames (60 per second of
 /// kiosk time); lines run in file order once their frame is reached.
 ///   key ACTION      a visitor's action straight to the flow (help, next, previous, describe, finer, coarser,
-///                   volume_up, volume_down, tutorial, guide, capture, repeat, pause, where, finish, other)
+///                   volume_up, volume_down, tutorial, guide, capture, repeat, pause, where, finish,
+///                   next_sentence, previous_sentence, next_paragraph, previous_paragraph, other)
 ///   press KEYS      a key as the keyboard sends it, through the same routing as a real key: a key name of
 ///                   the settings (F1, A, UP, ENTER, ESCAPE, BACKSPACE, TAB, O, ...) or a chord (CTRL+ALT+O);
 ///                   pressed in this frame, released in the next
 ///   type TEXT       the rest of the line typed as characters (into whatever has the keyboard)
 ///   click NAME      the left mouse button on a widget of the operator's panel, by name (operator_panel.hpp):
 ///                   the pointer moves there, the button goes down a frame later and up the frame after
+///   shows NAME      the run fails (exit 1, one line) unless the widget NAME of the operator's panel was drawn in
+///                   the last frame: what a test reads off the panel ("sticks:idle")
 ///   cursor X Y      the model hand's target [m]
 ///   move            the handle moved (wakes the kiosk)
 ///   stick DIR       a folder inserted as a USB stick; unstick: taken out

@@ -91,3 +91,46 @@ TEST(OperatorVisit, WrongPinRightPinStiffness800To1200ApplySaveUnderXvfb) {
 }
 
 }  // namespace
+
+namespace {
+
+// Finish pressed twice while a stick's page is still being drawn, then a scripted `wait`: the run goes on (the
+// wait returns: nothing of the forgotten stick is awaited), and the operator's panel, opened with the PIN,
+// says on its Status tab that the sticks are idle, not "working".
+TEST(OperatorVisit, FinishWhileAStickPageIsDrawnLeavesThePanelsStatusIdle) {
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  const fs::path dir = fs::temp_directory_path() / ("hk_opfinish_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "library");
+  fs::create_directories(dir / "stick");
+  fs::copy_file(kData / "images" / "horse.png", dir / "library" / "horse.png");
+  fs::copy_file(kData / "documents" / "shared-mime-info-spec.pdf", dir / "stick" / "spec.pdf");  // 17 pages to draw
+  const fs::path settings = dir / "kiosk.toml";
+  hk::config::Settings s;
+  s.kiosk.prefetch_mb = 0;  // page 2 is drawn when Next asks for it, not ahead
+  hk::config::save_settings_atomic(s, settings.string());
+  const std::string exe = HK_KIOSK_EXE;
+  ASSERT_EQ(sh("printf '90817263\\n' | " + exe + " pin set --config '" + settings.string() + "' 2>/dev/null"), 0);
+  std::ofstream(dir / "visit.txt") << "1 stick " << (dir / "stick").string() << "\n"
+                                      "2 wait\n"
+                                      "3 key next\n"      // page 2 is drawn...
+                                      "4 key finish\n"    // ...and Finish, twice, meanwhile
+                                      "5 key finish\n"
+                                      "6 wait\n"
+                                      "10 press CTRL+ALT+O\n"
+                                      "20 type 90817263\n"
+                                      "21 press ENTER\n"
+                                      "22 wait\n"
+                                      "40 shows sticks:idle\n";
+  const fs::path png = dir / "panel.png", log = dir / "log.txt";
+  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug --config '" + settings.string() +
+               "' --library '" + (dir / "library").string() + "' --script '" + (dir / "visit.txt").string() + "' --screenshot '" +
+               png.string() + "' --frames 50 >'" + log.string() + "' 2>&1"),
+            0)
+      << read(log);
+  const std::string said = read(log);
+  EXPECT_NE(said.find("say: Thank you for visiting. Goodbye."), std::string::npos) << said;
+  fs::remove_all(dir);
+}
+
+}  // namespace
