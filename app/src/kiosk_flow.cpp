@@ -493,10 +493,10 @@ void KioskFlow::show(int index, const std::string& before) {
   v_.captured = false;
   const int shapes = fx_.show_picture(v_.picture);
   if (shapes == KioskEffects::kPicturePending) {  // built off the window thread: announced when it is felt
+    const bool awaited = v_.pending_picture >= 0 || v_.pending_doc >= 0;
     v_.pending_picture = v_.picture;
     v_.pending_before = before;
-    v_.pending_since_s = v_.last_activity_s;
-    v_.loading_said = false;
+    start_loading_clock(v_.last_activity_s, awaited);
     return;
   }
   v_.pending_picture = -1;
@@ -681,11 +681,19 @@ std::string KioskFlow::document_name(const StickEntry& e) const {
 }
 
 void KioskFlow::request(int document, int page, double now_s) {
+  const bool awaited = v_.pending_picture >= 0 || v_.pending_doc >= 0;
   v_.pending_doc = v_.at_doc = document;
   v_.pending_page = v_.at_page = page;
+  start_loading_clock(now_s, awaited);
+  fx_.show_document(document, page);
+}
+
+void KioskFlow::start_loading_clock(double now_s, bool awaited) {
+  // Keys pressed in a row while nothing has been said of the load awaited keep its clock, so "Loading." comes
+  // loading_cue_s after the first of them, not after the last; once said, the next key gets its own.
+  if (awaited && !v_.loading_said) return;
   v_.pending_since_s = now_s;
   v_.loading_said = false;
-  fx_.show_document(document, page);
 }
 
 void KioskFlow::step_document(int delta, double now_s) {

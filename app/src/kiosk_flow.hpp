@@ -360,7 +360,9 @@ class KioskFlow {
   /// Reads from `at` to the end of its paragraph, after `before` (said first, in the same text).
   void read_from(ReadingPlace at, const std::string& before);
   std::string long_text_line(const std::string& text) const;
-  std::string paragraph_line(int paragraph) const;  // "Paragraph 2 of 5." on a page of more than one, else ""  // "" or "About 9 minutes of text. …" and a space
+  std::string paragraph_line(int paragraph) const;
+  /// A load was asked for at `now_s`; `awaited`: another was awaited already (see the .cpp).
+  void start_loading_clock(double now_s, bool awaited);  // "Paragraph 2 of 5." on a page of more than one, else ""  // "" or "About 9 minutes of text. …" and a space
   void level_key(int delta);
   void warn(double idle_s);
   void pause_key();

@@ -322,6 +322,7 @@ void KioskRuntime::say(const std::string& text) {
   last_said_ = text;
   repeatable_ = text;
   ++kept_texts_;
+  ++texts_said_;
   brief_last_ = false;
   audio_.say_text(text);
 }
@@ -329,6 +330,7 @@ void KioskRuntime::say(const std::string& text) {
 void KioskRuntime::say_brief(const std::string& text) {
   spdlog::info("say: {}", one_line(text));
   last_said_ = text;
+  ++texts_said_;
   brief_last_ = true;
   audio_.say_text(text, false);
 }
@@ -727,6 +729,7 @@ void KioskRuntime::forget_stick() {
 
 void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
   for (StickNews& n : sticks_.poll_news()) {
+    stick_folder_ops_ = std::max(0, stick_folder_ops_ - 1);
     if (n.kind == StickNews::Kind::Inserted) {
       stick_id_ = n.stick;
       std::vector<StickEntry> entries;
@@ -795,11 +798,13 @@ void KioskRuntime::note_stick_problem(std::string line) {
 
 void KioskRuntime::insert_stick_folder(const std::string& dir) {
   stick_busy_ = true;
+  ++stick_folder_ops_;
   sticks_.insert_folder(dir);
 }
 
 void KioskRuntime::remove_stick_folder() {
   stick_busy_ = true;  // until the news of the removal arrives
+  ++stick_folder_ops_;
   sticks_.remove_folder();
 }
 

@@ -150,6 +150,8 @@ class KioskRuntime final : public KioskEffects {
   /// Says the last text given to say() again (false when there is none in this visit).
   bool repeat() override;
   std::uint64_t kept_texts() const override { return kept_texts_; }
+  /// Texts given to say() or say_brief() since the start: a key press that leaves it unchanged said nothing.
+  std::uint64_t texts_said() const { return texts_said_; }
   /// The piece of the last text given to say() being heard (audio::AudioSystem::piece_heard); −1 once an
   /// acknowledgement (say_brief) has cut it off.
   int heard_piece() const override { return brief_last_ ? -1 : audio_.piece_heard(); }
@@ -253,7 +255,7 @@ class KioskRuntime final : public KioskEffects {
   /// How long a reading may take before "Reading the text." is said [s].
   static constexpr double kTextWait_s = 1.0;
   /// Whether stick work (scan or load) may still bring news (scripted runs wait for it).
-  bool stick_busy() const { return stick_busy_; }
+  bool stick_busy() const { return stick_busy_ || stick_folder_ops_ > 0; }
   /// What the last stick could not give, for the operator's panel (a visitor hears only a count): one line a
   /// file, "'bad_crc.png': corrupt PNG header: …" for pictures and PDFs left out at the scan and "'manual.pdf'
   /// page 3: …" for pages that could not be built, then other entries left out (links, other files); at most
@@ -377,6 +379,7 @@ class KioskRuntime final : public KioskEffects {
   std::string last_said_;
   std::string repeatable_;  // the last text given to say(), for Repeat
   std::uint64_t kept_texts_ = 0;  // texts given to say()
+  std::uint64_t texts_said_ = 0;  // texts given to say() or say_brief()
   bool brief_last_ = false;       // the last text said was given to say_brief()
   int shown_id_ = -100;
   std::uint64_t scenes_published_ = 0;
@@ -389,6 +392,7 @@ class KioskRuntime final : public KioskEffects {
   int captures_ = 0;        // camera captures shown so far
   int stick_id_ = 0;        // the stick the flow browses (StickNews::stick), 0 for none
   bool stick_busy_ = false;
+  int stick_folder_ops_ = 0;  // folders put in or taken out whose news has not come yet (one news each)
   std::vector<std::string> stick_problems_;  // stick_problems()
   void note_stick_problem(std::string line);
   // The guided tour (window thread but hand_limp_).

@@ -44,12 +44,12 @@ StickService::~StickService() {
 
 void StickService::insert_folder(const std::string& folder) {
   const std::lock_guard<std::mutex> lock(m_);
-  folder_inserts_.push_back(folder);
+  folder_ops_.emplace_back(folder);
 }
 
 void StickService::remove_folder() {
   const std::lock_guard<std::mutex> lock(m_);
-  folder_remove_ = true;
+  folder_ops_.emplace_back(std::nullopt);
 }
 
 std::vector<StickNews> StickService::poll_news() {
@@ -272,15 +272,18 @@ void StickService::handle_remove(const std::string& devnode) {
 
 void StickService::watch() {
   for (;;) {
-    std::deque<std::string> inserts;
-    bool remove_folder = false;
+    std::deque<std::optional<std::string>> ops;
     {
       const std::lock_guard<std::mutex> lock(m_);
       if (stop_) return;
-      inserts.swap(folder_inserts_);
-      std::swap(remove_folder, folder_remove_);
+      ops.swap(folder_ops_);
     }
-    if (remove_folder) {
+    // In the order asked: a folder put in and taken out at once ends taken out.
+    for (const std::optional<std::string>& op : ops) {
+      if (op) {
+        scan_root(*op, 0.0);
+        continue;
+      }
       {
         const std::lock_guard<std::mutex> lock(m_);
         stick_id_ = 0;
@@ -292,10 +295,9 @@ void StickService::watch() {
       n.kind = StickNews::Kind::Removed;
       post(std::move(n));
     }
-    for (const std::string& f : inserts) scan_root(f, 0.0);
     if (!events_) {
       std::unique_lock<std::mutex> lock(m_);
-      cv_.wait_for(lock, std::chrono::milliseconds(50), [this] { return stop_ || !folder_inserts_.empty() || folder_remove_; });
+      cv_.wait_for(lock, std::chrono::milliseconds(50), [this] { return stop_ || !folder_ops_.empty(); });
       continue;
     }
     std::optional<vision::BlockEvent> e;

@@ -154,8 +154,7 @@ class StickService {
   mutable std::mutex m_;
   std::condition_variable cv_;
   bool stop_ = false;
-  std::deque<std::string> folder_inserts_;  // guarded by m_
-  bool folder_remove_ = false;              // guarded by m_
+  std::deque<std::optional<std::string>> folder_ops_;  // guarded by m_: folders put in (a path) and taken out (nullopt), in order
   std::vector<StickNews> news_;             // guarded by m_
   std::optional<Request> request_;          // guarded by m_
   std::vector<LoadedDocument> loaded_;      // guarded by m_
