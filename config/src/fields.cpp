@@ -268,7 +268,7 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(vision, ocr_languages, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
              "Tesseract languages joined by '+' (\"eng\", \"eng+deu\"); empty: the message catalogue's language. A missing one turns OCR off at start, said in the log.",
              {}, &ocr_languages_problem),
-    HK_FIELD(vision, ocr_min_confidence, FieldGroup::scene, ApplyWhen::scene, 0, 1, "", "Words Tesseract is less sure of than this are not read aloud."),
+    HK_FIELD(vision, ocr_min_confidence, FieldGroup::scene, ApplyWhen::scene, 0, 1, "", "Words Tesseract is less sure of than this are said as \"unclear word\", never read as if certain."),
     // [workspace]
     HK_FIELD(workspace, width_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Width of the usable rectangle."),
     HK_FIELD(workspace, height_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Height of the usable rectangle."),

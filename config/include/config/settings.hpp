@@ -118,7 +118,7 @@ struct VisionSettings {
   std::string detector = "auto";              ///< key detector, how boundaries are found: "auto" (two-tone pictures traced from a threshold, line drawings "canny", others "surround"), "canny", "surround", "bilateral", "edpf" or "outline"
   std::string ocr = "auto";                   ///< key ocr, text in pictures read aloud (Tesseract): "auto" (pictures that look like a page of text, PDF pages without a text layer), "always" (every picture), "off"; the kiosk feels the picture at once and reads its text meanwhile (about 10 s a page)
   std::string ocr_languages;                  ///< key ocr_languages, Tesseract languages '+'-joined ("eng", "eng+deu"); empty = the message catalogue's language
-  double ocr_min_confidence = 0.6;            ///< key ocr_min_confidence, words Tesseract is less sure of are dropped, [0, 1]
+  double ocr_min_confidence = 0.6;            ///< key ocr_min_confidence, words Tesseract is less sure of are said as "unclear word", [0, 1]
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const VisionSettings&) const = default;
