@@ -3,6 +3,8 @@
 // help, its tutorial and its USB stick announcement; the operator's change (set_keys) is heard at once.
 #include <gtest/gtest.h>
 
+#include <cctype>
+
 #include <array>
 #include <string>
 #include <string_view>
@@ -157,8 +159,10 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
       const std::string brief = fx.caption();
       flow.key(KioskKey::Where, 1.05);  // leaves the first layer: the next Help starts it again
       expect_no_stale_key_words(brief);
-      EXPECT_NE(brief.find("Press " + en.key_name(s.keys.next) + " to go on, " + en.key_name(s.keys.where) +
-                           " for what is here, and " + en.key_name(s.keys.help) + " again for all the keys."),
+      std::string help_form = en.key_name(s.keys.help);  // it starts a sentence
+      help_form[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(help_form[0])));
+      EXPECT_NE(brief.find("Press " + en.key_name(s.keys.next) + " to go on, " + en.key_name(s.keys.where) + " for what is here. " + help_form +
+                           " again gives every key."),
                 std::string::npos)
           << brief;
       const std::string help = whole_help(flow, fx, 1.5);
