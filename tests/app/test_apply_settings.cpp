@@ -79,8 +79,8 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   EXPECT_LE(rt.shown().scene->max_curve_levels(), 5) << "levels 0..max_levels";
   // The keys changed: the help names the new key.
   flow.key(KioskKey::Help, 1.0);
-  EXPECT_NE(rt.last_said().find(rt.audio().messages().key_name("H")), std::string::npos) << rt.last_said();
-  EXPECT_EQ(rt.last_said().find(rt.audio().messages().key_name("F1")), std::string::npos) << rt.last_said();
+  EXPECT_NE(rt.last_said().find("H key again gives every key"), std::string::npos) << rt.last_said();
+  EXPECT_EQ(rt.last_said().find("F1"), std::string::npos) << rt.last_said();
   fs::remove_all(lib);
 }
 
