@@ -33,6 +33,13 @@ std::string read(const fs::path& p) {
   return ss.str();
 }
 
+/// Saves `s` as `settings` and sets the operator's PIN 90817263 in it with `haptic-kiosk pin set`, as an
+/// operator would; true when it worked.
+bool settings_with_pin(const hk::config::Settings& s, const fs::path& settings) {
+  hk::config::save_settings_atomic(s, settings.string());
+  return sh("printf '90817263\\n' | " + std::string(HK_KIOSK_EXE) + " pin set --config '" + settings.string() + "' 2>/dev/null") == 0;
+}
+
 TEST(OperatorVisit, WrongPinRightPinStiffness800To1200ApplySaveUnderXvfb) {
   if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = fs::temp_directory_path() / ("hk_opvisit_" + std::to_string(::getpid()));
@@ -42,9 +49,8 @@ TEST(OperatorVisit, WrongPinRightPinStiffness800To1200ApplySaveUnderXvfb) {
   const fs::path settings = dir / "kiosk.toml";
   hk::config::Settings s;
   s.stick.page_timeout_s = 60;  // generous under a loaded CI machine; not what is tested
-  hk::config::save_settings_atomic(s, settings.string());
+  ASSERT_TRUE(settings_with_pin(s, settings));
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh("printf '90817263\\n' | " + exe + " pin set --config '" + settings.string() + "' 2>/dev/null"), 0);
   const std::string hash = hk::config::load_settings(settings.string()).operator_.pin_hash;
 
   std::ofstream(dir / "visit.txt") << "# the operator's visit\n"
@@ -108,9 +114,8 @@ TEST(OperatorVisit, FinishWhileAStickPageIsDrawnLeavesThePanelsStatusIdle) {
   const fs::path settings = dir / "kiosk.toml";
   hk::config::Settings s;
   s.kiosk.prefetch_mb = 0;  // page 2 is drawn when Next asks for it, not ahead
-  hk::config::save_settings_atomic(s, settings.string());
+  ASSERT_TRUE(settings_with_pin(s, settings));
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh("printf '90817263\\n' | " + exe + " pin set --config '" + settings.string() + "' 2>/dev/null"), 0);
   std::ofstream(dir / "visit.txt") << "1 stick " << (dir / "stick").string() << "\n"
                                       "2 wait\n"
                                       "3 key next\n"      // page 2 is drawn...
