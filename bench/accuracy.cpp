@@ -68,7 +68,8 @@
 #include "config/settings.hpp"
 #include "haptics/multires.hpp"
 #include "haptics/scene.hpp"
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 using namespace hk::bench;

@@ -27,10 +27,12 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "capture.hpp"
-#include "image_scene.hpp"
-#include "settings_params.hpp"
+#include "pictures/capture.hpp"
+#include "pictures/image_scene.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
 #include "synthetic_photo.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 using namespace hk::app;

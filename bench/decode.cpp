@@ -21,8 +21,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bench_scenes.hpp"
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
 #include "vision/intake.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 namespace fs = std::filesystem;

@@ -26,15 +26,17 @@
 #include <thread>
 #include <vector>
 
-#include "device_setup.hpp"
+#include "runtime/device_setup.hpp"
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/io/haply_device.hpp"
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/pty_emulator.hpp"
-#include "image_scene.hpp"
-#include "servo_thread.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/servo_thread.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 
@@ -177,7 +179,7 @@ nlohmann::json step_calls(const config::Settings& s, double seconds) {
 
 nlohmann::json servo_run(const config::Settings& s, double seconds, bool usb) {
   app::ImageScene is = app::build_image_scene(std::string(HK_TEST_DATA_DIR) + "/images/butterfly.jpg", s);
-  app::ServoCore core(app::CueTrackerParams{}, nullptr);
+  app::ServoStep core(app::CueTrackerParams{}, nullptr);
   core.publish(std::make_unique<app::SceneBundle>(std::move(is.scene), app::servo_params_from(s)));
   std::unique_ptr<Board> board;
   std::unique_ptr<SimulatedPantograph> sim;

@@ -16,10 +16,11 @@
 
 #include "audio/mixer.hpp"
 #include "audio_analysis.hpp"
-#include "cue_tracker.hpp"
+#include "runtime/cue_tracker.hpp"
 #include "haptics/hand_path.hpp"
-#include "image_scene.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 

@@ -14,8 +14,9 @@
 #include <vector>
 
 #include "haptics/hand_path.hpp"
-#include "image_scene.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 namespace fs = std::filesystem;

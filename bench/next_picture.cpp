@@ -35,9 +35,10 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
-#include "kiosk_flow.hpp"
-#include "kiosk_runtime.hpp"
-#include "view_geometry.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "pictures/view_geometry.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 using namespace hk::app;

@@ -19,10 +19,11 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
 #include "scans.hpp"
 #include "synthetic_photo.hpp"
 #include "vision/page.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "vision/pdf.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using namespace hk::vision;

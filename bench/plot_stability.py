@@ -13,7 +13,7 @@ Writes, next to the JSON unless --outdir is given:
                     over stiffness for push and let-go on the profile's model, with its default stiffness
                     and the limit its settings allow.
   tunnelling.png  — (a) failing strokes (proxy tunnelled or contact missed) against hand speed per shape,
-                    ServoLoop with a kinematic handle and through the simulated device, with the wall-blind
+                    SceneStep with a kinematic handle and through the simulated device, with the wall-blind
                     control that the checker must catch; (b) how hard the strokes were: handle jump per
                     servo tick and handle depth behind the wall while the proxy held, against the 0.2 mm
                     thickness of the thin curve.
@@ -143,7 +143,7 @@ def plot_tunnelling(d, out_png):
             fails = [r["strokes_tunnelled"] + r["strokes_missed_contact"] for r in rows]
             max_strokes = max(max_strokes, max(r["strokes"] for r in rows))
             ax.plot(v, np.array(fails) + off, ls=ls, marker=st["marker"], color=st["color"], mfc=mfc, ms=6,
-                    label=f"{st['label']}, {'ServoLoop, kinematic handle' if drive == 'kinematic' else 'simulated device'}")
+                    label=f"{st['label']}, {'SceneStep, kinematic handle' if drive == 'kinematic' else 'simulated device'}")
     ctrl = tun.get("control_wall_blind_proxy", [])
     if ctrl:
         ax.scatter([0.5] * len(ctrl), [c["strokes_tunnelled"] for c in ctrl], marker="*", s=160, color="black", zorder=5,

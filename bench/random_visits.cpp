@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "random_visit.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -17,6 +17,7 @@
 
 #include "synthetic_photo.hpp"
 #include "vision/page.hpp"
+#include "test_paths.hpp"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // The servo thread under load: it must keep its rate with the second core loaded.
-// Runs the kiosk's servo thread (ServoThread + ServoCore + the simulated pantograph driven by the raster
+// Runs the kiosk's servo thread (ServoThread + ServoStep + the simulated pantograph driven by the raster
 // hand) on a real picture for a few seconds at 1 kHz, first on an idle machine, then with a busy thread
 // spinning on the other core, and reports wake-up lateness (p50/p99/max), tick work and missed deadlines.
 // Usage: bench_servo_rate [--seconds S] [--out FILE.json]
@@ -14,10 +14,12 @@
 
 #include "haptics/hand_path.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "image_scene.hpp"
-#include "servo_thread.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/servo_thread.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 
@@ -40,7 +42,7 @@ int main(int argc, char** argv) {
     device.open();
     ModelHandParams hp;
     hp.max_force_n = s.hand.max_force_n;
-    app::ServoCore core(app::CueTrackerParams{}, nullptr);
+    app::ServoStep core(app::CueTrackerParams{}, nullptr);
     const ServoParams sp = app::servo_params_from(s);
     core.publish(std::make_unique<app::SceneBundle>(std::move(is.scene), sp));
     std::atomic<bool> spin{loaded};

@@ -20,7 +20,7 @@
 // 30th-worst tick of 30 000, and on this shared VM one interrupt costs 20-100 µs). Both are written down;
 // the target is judged on both. --cpu pins the thread to one CPU (sched_setaffinity). --level-mode sets
 // [haptics] level_mode (default "auto", the target's; "cut": the walls at the tolerance cut). Before the runs of
-// each size it times the servo loop's setup on that scene (ServoLoop's constructor, fastest of R), printed on
+// each size it times the servo loop's setup on that scene (SceneStep's constructor, fastest of R), printed on
 // stderr and written to the JSON as loop_setup_ms.
 #include <sched.h>
 
@@ -36,7 +36,8 @@
 
 #include "bench_scenes.hpp"
 #include "haptics/explorer_hand.hpp"
-#include "settings_params.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
 
 using namespace hk;
 using namespace hk::bench;
@@ -122,7 +123,7 @@ double loop_setup_ms(const Scene& scene, const config::Settings& s, int repeats)
   double best = 1e300;
   for (int r = 0; r < repeats; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
-    const ServoLoop loop(scene, params);
+    const SceneStep loop(scene, params);
     const auto t1 = std::chrono::steady_clock::now();
     best = std::min(best, std::chrono::duration<double, std::milli>(t1 - t0).count());
   }
@@ -163,7 +164,7 @@ int main(int argc, char** argv) {
     const Scene scene = Scene::build(tiled_scene(pictures, n, settings.haptics.max_levels, &plane), settings.haptics.max_levels);
     const std::size_t level0 = scene.total_segments(0);
     const double setup_ms = loop_setup_ms(scene, settings, repeats);
-    std::fprintf(stderr, "bench_servo_tick: %zu segments, level_mode %s: ServoLoop setup %.1f ms (fastest of %d)\n", level0, level_mode.c_str(),
+    std::fprintf(stderr, "bench_servo_tick: %zu segments, level_mode %s: SceneStep setup %.1f ms (fastest of %d)\n", level0, level_mode.c_str(),
                  setup_ms, repeats);
     for (const std::string hand : {"raster", "explorer"}) {
       std::vector<double> p999s;

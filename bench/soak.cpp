@@ -1,7 +1,7 @@
 // Soak: the kiosk without its window, run for a given wall-clock time with everything a
 // day at a museum brings, while its process is watched.
 //
-// Every frame (60 Hz, wall clock) the loop does what app/kiosk/kiosk_app.cpp's frame loop does without
+// Every frame (60 Hz, wall clock) the loop does what app/kiosk/src/kiosk_app.cpp's frame loop does without
 // drawing: poll sticks, device and tour, tick the visitor's flow, collect retired scenes, and pull the
 // audio mix as a sound card would (800 frames at 48 kHz). Around it a script plays:
 // - visitors: one wakes the kiosk, walks through the tutorial, presses a key every 3 s (next and previous
@@ -40,9 +40,10 @@
 #include <vector>
 
 #include "config/settings.hpp"
-#include "device_setup.hpp"
-#include "kiosk_flow.hpp"
-#include "kiosk_runtime.hpp"
+#include "runtime/device_setup.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "test_paths.hpp"
 
 namespace {
 
@@ -246,8 +247,8 @@ int run(const SoakOptions& o) {
     if (now_s >= next_report_s) {
       next_report_s += o.report_every_s;
       // Totals since the start, not take_stats(): the runtime takes its own report at every new visitor.
-      const hk::app::ServoThread::Totals tot = rt.servo()->totals();
-      hk::app::ServoTimingStats st = rt.servo()->stats();  // since the last visitor: for the compute p99
+      const hk::app::ServoThread::Totals tot = rt.devices().servo()->totals();
+      hk::app::ServoTimingStats st = rt.devices().servo()->stats();  // since the last visitor: for the compute p99
       st.ticks = tot.ticks - ticks;
       st.missed_deadlines = tot.missed_deadlines - missed;
       st.lateness_max_us = tot.lateness_max_us;

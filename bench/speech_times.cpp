@@ -17,7 +17,7 @@
 #include "audio/messages.hpp"
 #include "audio/speech.hpp"
 #include "config/settings.hpp"
-#include "kiosk_flow.hpp"
+#include "visit/kiosk_flow.hpp"
 #include "message_samples.hpp"
 
 namespace {

@@ -10,8 +10,8 @@
 // ── Part 1: largest stable wall stiffness per servo rate ─────────────────────────────────────────────
 // One long straight open polyline (y = 0, x in [−0.06, 0.06] m, 241 points, Scene::build, level 1) is
 // the wall. The simulated pantograph (default geometry, mass m = 0.08 kg, device damping b = 2 N·s/m,
-// 16384-count encoders) is driven by the model hand, wired as app/src/simulation.cpp does it (read →
-// ServoLoop::update → write_force → step), with these changes, each so that the loop under test and
+// 16384-count encoders) is driven by the model hand, wired as app/runtime/src/simulation.cpp does it (read →
+// SceneStep::update → write_force → step), with these changes, each so that the loop under test and
 // not a limiter decides the outcome:
 //   * the force clamps (contact and guard max_force_n) are 1e6 N and the per-motor torque limit
 //     1e4 N·m: a clamp bounds the energy a wall can inject and would hide instability;
@@ -78,7 +78,7 @@
 // speeds on a log grid from 0.05 to 5 m/s, rendered at level 0 (the sharpest geometry) with the
 // shipped servo settings (800 N/m, 3.5 N, 1 kHz, the default box-test budget per tick, friction) but for
 // two that are off here (stroke_servo_params: the level fixed at 0, and no push-through):
-//   kinematic — the ServoLoop alone, the handle put exactly on the stroke every 1 ms tick (no device),
+//   kinematic — the SceneStep alone, the handle put exactly on the stroke every 1 ms tick (no device),
 //               so 5 m/s is a 5 mm jump per tick, 25 times the thin curve's width;
 //   device    — the simulated pantograph (shipped parameters, substeps ≤ 1 µs), the servo run 0.6 s
 //               first so the start-up force ramp is over, then a firm hand (400 N/m, 4 N·s/m relative to
@@ -125,8 +125,9 @@
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
 
 using namespace hk;
 using json = nlohmann::ordered_json;
@@ -294,7 +295,7 @@ class WallBench {
     sp.contact.max_force_n = 1e6;
     sp.guard.max_force_n = 1e6;
     sp.guard.ramp_s = 0.0;
-    ServoLoop servo(scene_, sp);
+    SceneStep servo(scene_, sp);
     servo.start(dev.read().handle_m);
 
     const long n_ticks = std::lround(kRunS / period_s);
@@ -977,7 +978,7 @@ struct AutoLevelTally {
 /// "clearly past the wall" would depend on the level.
 AutoLevelTally auto_level_stroke(const StrokeScene& sc, const Stroke& st, double speed_m_per_s) {
   const ServoParams sp = stroke_servo_params(true);
-  ServoLoop servo(sc.scene, sp);
+  SceneStep servo(sc.scene, sp);
   servo.start(st.start_m);
   const KinematicPath path(st, speed_m_per_s, sp.period_s);
   const auto segs_of = [&](int id) -> const Segments& { return sc.level_segs[static_cast<std::size_t>(std::clamp<int>(id, 0, static_cast<int>(sc.level_segs.size()) - 1))]; };
@@ -1004,12 +1005,12 @@ AutoLevelTally auto_level_stroke(const StrokeScene& sc, const Stroke& st, double
   return t;
 }
 
-/// A stroke with the ServoLoop alone: the handle is exactly on the stroke every tick.
-/// `control`: no ServoLoop at all, a proxy glued to the handle (free, one straight move per tick), i.e.
+/// A stroke with the SceneStep alone: the handle is exactly on the stroke every tick.
+/// `control`: no SceneStep at all, a proxy glued to the handle (free, one straight move per tick), i.e.
 /// a renderer that ignores the walls: the checker must call every such stroke a failure.
 StrokeTally kinematic_stroke(const StrokeScene& sc, const Stroke& st, double speed_m_per_s, bool control = false) {
   const ServoParams sp = stroke_servo_params();
-  ServoLoop servo(sc.scene, sp);
+  SceneStep servo(sc.scene, sp);
   servo.start(st.start_m);
   const KinematicPath path(st, speed_m_per_s, sp.period_s);
   StrokeTally t;
@@ -1054,7 +1055,7 @@ StrokeTally device_stroke(const StrokeScene& sc, const Stroke& st, double speed_
   hand.stiffness_n_per_m = kDeviceHandStiffnessNPerM;
   hand.damping_n_s_per_m = kDeviceHandDampingNSPerM;
   hand.max_force_n = kDeviceHandMaxForceN;
-  ServoLoop servo(sc.scene, sp);
+  SceneStep servo(sc.scene, sp);
   servo.start(dev.read().handle_m);
   const double len = distance(st.start_m, st.end_m);
   const Vec2 dir = (1.0 / len) * (st.end_m - st.start_m);

@@ -18,7 +18,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include "stick_service.hpp"
+#include "pictures/stick_service.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 using namespace hk::app;

@@ -18,13 +18,15 @@
 #include <string>
 #include <vector>
 
-#include "guided_tour.hpp"
+#include "runtime/guided_tour.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "image_scene.hpp"
-#include "servo_core.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/servo_step.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
 #include "tour_picture.hpp"
+#include "test_paths.hpp"
 
 using namespace hk;
 using namespace hk::app;
@@ -46,7 +48,7 @@ Row run(const std::string& name, const std::string& path, const config::Settings
   const TourParams tp = tour_params_from(s);
   SimulatedPantograph dev(sim_params_from(s), {0.0, -0.9 * s.workspace.height_m / 2});
   dev.open();
-  ServoCore core(CueTrackerParams{}, nullptr);
+  ServoStep core(CueTrackerParams{}, nullptr);
   auto bundle = std::make_unique<SceneBundle>(std::move(is.scene), sp);
   bundle->id = 1;
   const Scene& sc = *bundle->scene;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every benchmark and regenerates every chart and table of docs/PERFORMANCE.md:
 # Google Benchmark JSON and analysis JSON in docs/bench/, PNG charts beside them, tables in
-# docs/PERFORMANCE.md between its BEGIN/END markers. Takes ~15–20 minutes on 2 cores.
+# docs/PERFORMANCE.md between its BEGIN/END markers; then every fuzz harness for 2 minutes
+# (HK_BENCH_FUZZ_SECONDS; CI runs them for 10 s). Takes ~35 minutes on 2 cores.
 # Usage: scripts/bench.sh [--quick]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -67,5 +68,9 @@ PY
 /usr/bin/python3 "$root/bench/plot_levels.py" "$out/levels.json" --outdir "$out"
 if [ -f "$out/stability.json" ]; then
   /usr/bin/python3 "$root/bench/plot_stability.py" "$out/stability.json" --outdir "$out"
+fi
+# The long fuzz runs (CI runs each harness for 10 s): HK_BENCH_FUZZ_SECONDS each, 0 to leave them out.
+if [ "${HK_BENCH_FUZZ_SECONDS:-120}" != 0 ]; then
+  bash "$root/scripts/fuzz.sh" --seconds "${HK_BENCH_FUZZ_SECONDS:-120}"
 fi
 echo "bench: charts in $out, tables in docs/PERFORMANCE.md"

@@ -2,7 +2,7 @@
 # The kiosk window's frame times while pictures change: runs haptic-kiosk under Xvfb (1920 x 1080, full
 # screen) on a picture library, starting on its first picture, and presses Next (the [keys] next default,
 # RIGHT, through the same routing as a real key) many times quickly, then writes and prints the
-# --frame-stats JSON (app/kiosk/frame_stats.hpp says what "interval" and "work" are).
+# --frame-stats JSON (app/kiosk/include/kiosk/frame_stats.hpp says what "interval" and "work" are).
 # Usage: scripts/frame-stats.sh [LIBRARY] [OUT_JSON]
 #   LIBRARY   picture folder (default data/pictures)
 #   OUT_JSON  where the JSON goes (default out/frame-stats.json)

@@ -55,8 +55,10 @@ if [ -f "$build/CMakeCache.txt" ] && ! grep -q '^CMAKE_CXX_COMPILER:.*clang' "$b
   exit 2
 fi
 t0=$(date +%s)
+root="$repo"
+source "$repo/scripts/compiler-cache.sh"
 CC=clang CXX=clang++ cmake -S "$repo" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DHK_FUZZ=ON \
-  -DHK_BUILD_TESTS=OFF -DHK_BUILD_BENCH=OFF > "$build/fuzz-configure.log" 2>&1 ||
+  -DHK_BUILD_TESTS=OFF -DHK_BUILD_BENCH=OFF "${hk_cache_args[@]}" > "$build/fuzz-configure.log" 2>&1 ||
   { cat "$build/fuzz-configure.log" >&2; echo "fuzz.sh: configure failed" >&2; exit 1; }
 targets=()
 for h in "${harnesses[@]}"; do targets+=(--target "fuzz_$h"); done

@@ -5,7 +5,7 @@
 #   --demo   only what building haptic-kiosk and running `explore` needs (scripts/demo.sh)
 set -euo pipefail
 packages=(
-  g++ cmake ninja-build pkg-config
+  g++ cmake ninja-build pkg-config ccache
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-contrib-dev
   libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
   libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev
@@ -18,7 +18,7 @@ if [ "${1:-}" != "--demo" ]; then
     sox libgl1-mesa-dri xvfb xauth tesseract-ocr-deu
     poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools
     dpkg-dev file lintian systemd cage
-    clang libclang-rt-14-dev llvm-14
+    clang libclang-rt-14-dev llvm-14 clang-format-14
   )
 fi
 missing=()

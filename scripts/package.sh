@@ -23,11 +23,14 @@ deb="haptic-kiosk_${version}_$(dpkg --print-architecture).deb"
 export SOURCE_DATE_EPOCH="${SOURCE_DATE_EPOCH:-$(git -C "$root" log -1 --format=%ct 2>/dev/null || date +%s)}"
 
 # Debian's hardening flags (lintian looks for them in the binaries), without -g: they are stripped anyway.
-export DEB_BUILD_MAINT_OPTIONS="hardening=+all"
+# No -ffile-prefix-map of the checkout's path (reproducible=-fixfilepath): ccache (compiler-cache.sh) hashes
+# sources relative to the checkout, so the same sources in another clone compile from the cache.
+export DEB_BUILD_MAINT_OPTIONS="hardening=+all reproducible=-fixfilepath,-fixdebugpath"
 cxxflags="$(dpkg-buildflags --get CXXFLAGS | sed -e 's/\(^\| \)-g\( \|$\)/ /g') $(dpkg-buildflags --get CPPFLAGS)"
 ldflags="$(dpkg-buildflags --get LDFLAGS)"
 
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DHK_BUILD_TESTS=OFF -DHK_BUILD_BENCH=OFF \
+source "$root/scripts/compiler-cache.sh"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DHK_BUILD_TESTS=OFF -DHK_BUILD_BENCH=OFF "${hk_cache_args[@]}" \
   -DCMAKE_INSTALL_PREFIX=/usr -DHK_DATA_DIR=/usr/share/haptic-kiosk -DHK_LIBEXEC_DIR=/usr/libexec/haptic-kiosk \
   -DCMAKE_CXX_FLAGS="$cxxflags" -DCMAKE_EXE_LINKER_FLAGS="$ldflags" >/dev/null
 cmake --build "$build" -j "$jobs"

@@ -1,18 +1,57 @@
 #!/usr/bin/env bash
-# Fresh machine → every test: installs packages; builds with AddressSanitizer + UBSan and warnings as
-# errors and runs the GoogleTest suites through CTest, in shards of about 25 tests a process
-# (HK_TEST_SHARDS, tests/CMakeLists.txt); runs every libFuzzer harness for 30 s (scripts/fuzz.sh); builds the Debian package and checks it (lintian, file list, systemd-analyze verify).
-# The benchmarks are not built here (scripts/bench.sh builds and runs them), to keep CI under 40 minutes.
+# Fresh machine → every test, in stages (each stage's minutes printed at the end):
+#   deps      installs the Debian packages (scripts/install-deps.sh)
+#   checks    app/'s rooms depend one way (check-rooms.sh); the sources are formatted (check-format.sh)
+#   build     AddressSanitizer + UBSan, warnings as errors, through ccache when it is installed
+#             (scripts/compiler-cache.sh: its cache lives outside the checkout and survives a fresh clone)
+#   tests     the GoogleTest suites through CTest, in shards of about 25 tests a process (HK_TEST_SHARDS)
+#   fuzz      every libFuzzer harness for HK_FUZZ_SECONDS (10 s here; scripts/bench.sh runs them longer)
+#   package   the Debian package, built and checked (lintian, file list, systemd-analyze verify)
+#   limits    the PDF and OCR workers' memory limits, which ASan cannot host, on the package's Release build
+# The benchmarks are not built here (scripts/bench.sh builds and runs them).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build-asan"
-bash "$root/scripts/install-deps.sh"
-bash "$root/scripts/build.sh" "$build" -DHK_SANITIZE=ON -DHK_WERROR=ON -DHK_BUILD_BENCH=OFF -DHK_TEST_SHARDS=ON
-export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
-export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-(cd "$build" && ctest --output-on-failure -j "$(nproc)" --timeout 1200)
-unset ASAN_OPTIONS UBSAN_OPTIONS
-bash "$root/scripts/fuzz.sh" --seconds "${HK_FUZZ_SECONDS:-30}"
-bash "$root/scripts/package.sh"
-version="$(sed -n 's/^project([^)]*VERSION \([0-9][0-9.]*\).*/\1/p' "$root/CMakeLists.txt" | head -n 1)"
-bash "$root/scripts/check-package.sh" "$root/dist/haptic-kiosk_${version}_$(dpkg --print-architecture).deb"
+stages=()
+# Runs one stage and records its duration [s].
+stage() {
+  local name="$1" t0
+  shift
+  t0=$(date +%s)
+  "$@"
+  stages+=("$name $(( $(date +%s) - t0 ))")
+}
+run_tests() {
+  (cd "$build" && ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+    ctest --output-on-failure -j "$(nproc)" --timeout 1200)
+}
+package_and_check() {
+  bash "$root/scripts/package.sh"
+  local version
+  version="$(sed -n 's/^project([^)]*VERSION \([0-9][0-9.]*\).*/\1/p' "$root/CMakeLists.txt" | head -n 1)"
+  bash "$root/scripts/check-package.sh" "$root/dist/haptic-kiosk_${version}_$(dpkg --print-architecture).deb"
+}
+# The workers' memory limits, which the AddressSanitizer build cannot host: test_worker_limits built in the
+# package's Release build (its vision library already compiled there), run on the workers built beside it.
+worker_limits() {
+  local pkg="$root/build-package"
+  cmake -S "$root" -B "$pkg" -DHK_WORKER_LIMIT_TESTS=ON > /dev/null
+  cmake --build "$pkg" -j "$(nproc)" --target test_worker_limits hk-pdf-worker hk-ocr-worker
+  HK_PDF_WORKER="$pkg/vision/hk-pdf-worker" HK_OCR_WORKER="$pkg/vision/hk-ocr-worker" "$pkg/test_worker_limits" --gtest_brief=1
+}
+checks() {
+  bash "$root/scripts/check-rooms.sh"
+  bash "$root/scripts/check-format.sh"
+}
+t_all=$(date +%s)
+stage deps bash "$root/scripts/install-deps.sh"
+stage checks checks
+stage build bash "$root/scripts/build.sh" "$build" -DHK_SANITIZE=ON -DHK_WERROR=ON -DHK_BUILD_BENCH=OFF -DHK_TEST_SHARDS=ON
+stage tests run_tests
+stage fuzz bash "$root/scripts/fuzz.sh" --seconds "${HK_FUZZ_SECONDS:-10}"
+stage package package_and_check
+stage limits worker_limits
+echo "test.sh: stage minutes"
+for s in "${stages[@]}" "all $(( $(date +%s) - t_all ))"; do
+  awk -v name="${s% *}" -v s="${s#* }" 'BEGIN { printf "  %-8s %5.1f\n", name, s / 60 }'
+done

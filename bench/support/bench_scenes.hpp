@@ -9,8 +9,9 @@
 
 #include "config/settings.hpp"
 #include "haptics/hand_path.hpp"
-#include "image_scene.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 
 namespace hk::bench {
 

@@ -32,23 +32,23 @@ namespace {
 
 // The policy's ladder: the level ids it chooses from, finest first, and the scene's error bound at each
 // (the worst curve's, so the id chosen keeps every curve within tolerance). Levels: every level of the
-// scene. Tolerance steps (ServoParams::tolerance_steps) or cut steps (cut_steps): every step (LevelPolicy
+// scene. Tolerance steps or cut steps (ServoParams::steps): every step (LevelPolicy
 // keeps the bounds non-decreasing, as a curve's bound need not grow with its level); a cut step's bound is
 // its cut's (CutBounds: the largest segment bound plus the largest join shift). Also writes the scene's bound
 // at every level id to `id_bound` (kLevelIds entries), for placing an id that is not on the ladder. Returns
 // the ladder's length.
 int level_ladder(const Scene& scene, const CutBounds& cuts, const ServoParams& p, int* ids, double* err, double* id_bound) {
   for (int id = 0; id < kLevelIds; ++id) {
-    id_bound[id] = is_cut_level(id) && p.cut_steps ? cuts.error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
+    id_bound[id] = is_cut_level(id) && p.steps == LevelSteps::Cuts ? cuts.error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
   }
-  if (p.cut_steps) {
+  if (p.steps == LevelSteps::Cuts) {
     for (int t = 0; t < kToleranceSteps; ++t) {
       ids[t] = kCutLevelBase + t;
       err[t] = id_bound[ids[t]];
     }
     return kToleranceSteps;
   }
-  if (!p.tolerance_steps) {
+  if (p.steps == LevelSteps::Levels) {
     const int levels = std::min(scene.max_curve_levels(), LevelPolicy::kMaxLevels);
     for (int l = 0; l < levels; ++l) {
       ids[l] = l;
@@ -64,7 +64,7 @@ int level_ladder(const Scene& scene, const CutBounds& cuts, const ServoParams& p
   return kToleranceSteps;
 }
 
-// The solver's parameters, stepped at the loop's period. (Its cut masks come from the loop: ServoLoop::cuts_.)
+// The solver's parameters, stepped at the loop's period. (Its cut masks come from the loop: SceneStep::cuts_.)
 ContactParams contact_params(const ServoParams& p) {
   ContactParams c = p.contact;
   c.period_s = p.period_s;
@@ -117,9 +117,9 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
   p.groove.jump_step_n = g.max_force_step_n;
 }
 
-ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
+SceneStep::SceneStep(const Scene& scene, const ServoParams& params)
     : params_(params),
-      cuts_(params.cut_steps ? make_cut_walls(scene) : nullptr),  // the cut masks only where the policy can pick a cut step
+      cuts_(params.steps == LevelSteps::Cuts ? make_cut_walls(scene) : nullptr),  // the cut masks only where the policy can pick a cut step
       solver_(scene, contact_params(params), cuts_),
       groove_(scene, params.groove, cuts_),
       levels_(level_ladder(scene, solver_.section().cut_bounds(), params, ladder_id_, level_error_m_, id_bound_m_)),
@@ -127,7 +127,7 @@ ServoLoop::ServoLoop(const Scene& scene, const ServoParams& params)
       level_(params.level),
       guard_max_force_n_(params.guard.max_force_n) {}
 
-int ServoLoop::ladder_index(int id) const noexcept {
+int SceneStep::ladder_index(int id) const noexcept {
   for (int i = 0; i < levels_; ++i) {
     if (ladder_id_[i] == id) return i;
   }
@@ -140,7 +140,7 @@ int ServoLoop::ladder_index(int id) const noexcept {
   return index;
 }
 
-void ServoLoop::start(Vec2 handle_m) noexcept {
+void SceneStep::start(Vec2 handle_m) noexcept {
   level_ = params_.auto_level ? ladder_id_[policy_.level()] : params_.level;
   if (params_.render == RenderMode::Grooves) {
     groove_.reset(handle_m, level_);
@@ -156,7 +156,7 @@ void ServoLoop::start(Vec2 handle_m) noexcept {
   ticks_ = 0;
 }
 
-void ServoLoop::set_gains(const ServoGains& g) noexcept {
+void SceneStep::set_gains(const ServoGains& g) noexcept {
   if (g == gains()) return;
   apply_gains(params_, g);
   solver_.set_params(contact_params(params_));
@@ -164,11 +164,11 @@ void ServoLoop::set_gains(const ServoGains& g) noexcept {
   gains_changed_ = true;
 }
 
-bool ServoLoop::transition_active() const noexcept {
+bool SceneStep::transition_active() const noexcept {
   return force_residual_.x != 0.0 || force_residual_.y != 0.0 || guard_max_force_n_ != params_.guard.max_force_n;
 }
 
-void ServoLoop::set_auto_level(bool on) noexcept {
+void SceneStep::set_auto_level(bool on) noexcept {
   // The policy starts again from the level in use, its speed filter from rest (the ladder is kept: no
   // walk over the scene in the servo thread).
   if (on && !params_.auto_level) policy_ = LevelPolicy(policy_params(params_), level_error_m_, levels_, ladder_index(level_));
@@ -176,7 +176,7 @@ void ServoLoop::set_auto_level(bool on) noexcept {
   if (!on) params_.level = level_;
 }
 
-TickResult ServoLoop::update(const ServoInput& in, ServoOutput& out) noexcept {
+TickResult SceneStep::update(const ServoInput& in, ServoOutput& out) noexcept {
   const Vec2 h = in.sample.handle_m;
   if (!is_finite(h)) {
     out.force_n = {0.0, 0.0};

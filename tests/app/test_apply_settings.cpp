@@ -7,8 +7,9 @@
 #include <filesystem>
 #include <string>
 
-#include "kiosk_flow.hpp"
-#include "kiosk_runtime.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 
@@ -36,8 +37,8 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   flow.key(KioskKey::Other, 0.0);  // wake: the tutorial's square is shown
   const auto tick = [&] {          // the servo thread's part (no servo thread in this test)
     ServoCommand cmd;
-    rt.core().step(rt.device().read(), false, cmd);
-    rt.device().write_force(cmd.force_n);
+    rt.core().step(rt.devices().device().read(), false, cmd);
+    rt.devices().device().write_force(cmd.force_n);
     rt.core().publish_display();
   };
   tick();                          // the servo's core takes the square
@@ -100,8 +101,8 @@ TEST(ApplySettings, ToleranceModeRendersAtAStepAndTheKeysMoveAlongTheSteps) {
   flow.key(KioskKey::Other, 0.0);  // wake: the tutorial's square is shown
   const auto tick = [&] {
     ServoCommand cmd;
-    rt.core().step(rt.device().read(), false, cmd);
-    rt.device().write_force(cmd.force_n);
+    rt.core().step(rt.devices().device().read(), false, cmd);
+    rt.devices().device().write_force(cmd.force_n);
     rt.core().publish_display();
   };
   for (int i = 0; i < 5; ++i) tick();

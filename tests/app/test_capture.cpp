@@ -15,10 +15,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "capture.hpp"
+#include "pictures/capture.hpp"
 #include "kiosk_exe.hpp"
-#include "kiosk_flow.hpp"
-#include "kiosk_runtime.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "kiosk_flow.hpp"
+#include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
 namespace {

@@ -19,12 +19,13 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "capture.hpp"
+#include "pictures/capture.hpp"
 #include "kiosk_exe.hpp"
 #include "scans.hpp"
 #include "synthetic_photo.hpp"
 #include "vision/frame_source.hpp"
 #include "vision/ocr.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "coverage.hpp"
+#include "runtime/coverage.hpp"
 #include "curves.hpp"
 #include "haptics/multires.hpp"
 

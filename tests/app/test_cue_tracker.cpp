@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "cue_tracker.hpp"
+#include "runtime/cue_tracker.hpp"
 
 namespace hk::app {
 namespace {

@@ -11,11 +11,12 @@
 #include <string>
 
 #include "config/device_profile.hpp"
-#include "device_setup.hpp"
+#include "runtime/device_setup.hpp"
 #include "haptics/contact.hpp"
 #include "haptics/hand_path.hpp"
-#include "image_scene.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

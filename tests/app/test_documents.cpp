@@ -25,12 +25,14 @@
 #include <thread>
 #include <vector>
 
-#include "documents.hpp"
+#include "pictures/documents.hpp"
 #include "child_process.hpp"
-#include "image_scene.hpp"
-#include "settings_params.hpp"
-#include "stick_service.hpp"
+#include "pictures/image_scene.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "pictures/stick_service.hpp"
 #include "vision/pdf.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;

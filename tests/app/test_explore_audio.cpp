@@ -12,6 +12,7 @@
 #include "audio/source.hpp"
 #include "audio/wav.hpp"
 #include "audio_analysis.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -15,10 +15,11 @@
 
 #include "config/load.hpp"
 #include "crossing_grid.hpp"
-#include "device_setup.hpp"
+#include "runtime/device_setup.hpp"
 #include "haptics/hand_path.hpp"
-#include "image_scene.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;

@@ -16,13 +16,14 @@
 #include <thread>
 #include <vector>
 
-#include "coverage.hpp"
+#include "runtime/coverage.hpp"
 #include "curves.hpp"
 #include "kiosk_exe.hpp"
-#include "explore.hpp"
+#include "cli/explore.hpp"
 #include "haptics/explorer_hand.hpp"
 #include "haptics/multires.hpp"
-#include "simulation.hpp"
+#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;

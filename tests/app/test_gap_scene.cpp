@@ -12,7 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
 
 namespace hk::app {

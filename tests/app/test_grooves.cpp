@@ -15,11 +15,12 @@
 #include <tuple>
 #include <vector>
 
-#include "explore.hpp"
+#include "cli/explore.hpp"
 #include "haptics/hand_path.hpp"
-#include "image_scene.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "runtime/simulation.hpp"
 #include "test_pictures.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;

@@ -22,18 +22,20 @@
 #include "crossing_grid.hpp"
 #include "curves.hpp"
 #include "config/device_profile.hpp"
-#include "guided_tour.hpp"
+#include "runtime/guided_tour.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "image_scene.hpp"
-#include "kiosk_runtime.hpp"
-#include "kiosk_flow.hpp"
-#include "servo_core.hpp"
-#include "settings_params.hpp"
+#include "pictures/image_scene.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "runtime/servo_step.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
 #include "runtime_ticks.hpp"
 #include "show_now.hpp"
-#include "simulation.hpp"
+#include "runtime/simulation.hpp"
 #include "test_pictures.hpp"
 #include "tour_picture.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {
@@ -208,7 +210,7 @@ struct TourRig {
   TourParams tp;
   SimulatedPantograph device;
   audio::SpscRing<audio::CueEvent> cues{4096};
-  ServoCore core;
+  ServoStep core;
   const Scene* scene = nullptr;
   int scene_id = 7;
   bool hand_stiff = false;
@@ -664,7 +666,7 @@ TEST(GuidedTourRuntime, PracticeShapesAreNamedAndWhereExplainsFarAndNear) {
 // hooks of the rendered polyline that the planned track passes outside: the horse's ear, the gap between
 // the apple's stem and leaf (silhouette_1), a curl of the bat's wing (silhouette_3). There the spring pulls
 // into the wall, the handle stops and the tour took it for a hand holding still. Now the guide follows the
-// wall out of such a pocket (ServoCore::track_trap). With the handle relaxed, Guide pressed up to four times
+// wall out of such a pocket (ServoStep::track_trap). With the handle relaxed, Guide pressed up to four times
 // on each picture in each level mode: every tour ends Done, no move of the proxy in an outline crosses a wall
 // of the level in force (the independent crossing grid), and the forces stay within their limits. sudoku is
 // the exception: a grid line traced out and back (a doubled stroke, walls on both sides of a 0.2 mm gap) can

@@ -15,11 +15,13 @@
 #include <spdlog/spdlog.h>
 
 #include "audio/messages.hpp"
-#include "device_setup.hpp"
+#include "runtime/device_setup.hpp"
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/pty_emulator.hpp"
-#include "kiosk_runtime.hpp"
-#include "settings_params.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 
@@ -80,10 +82,10 @@ TEST(KioskDevice, ABoardOnItsTtyIsUsedAnnouncedAndItsLossSpoken) {
 
   const Library lib;
   KioskRuntime rt(options(lib), s);
-  ASSERT_NE(rt.usb_device(), nullptr) << rt.device_note();
-  EXPECT_EQ(rt.home_note(), "");
-  EXPECT_EQ(&rt.device(), rt.usb_device());
-  EXPECT_TRUE(rt.device_note().empty());
+  ASSERT_NE(rt.devices().usb(), nullptr) << rt.devices().note();
+  EXPECT_EQ(rt.devices().home_note(), "");
+  EXPECT_EQ(&rt.devices().device(), rt.devices().usb());
+  EXPECT_TRUE(rt.devices().note().empty());
   rt.start_servo();
   rt.announce_device();
   EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
@@ -96,11 +98,11 @@ TEST(KioskDevice, ABoardOnItsTtyIsUsedAnnouncedAndItsLossSpoken) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));  // a frame; the outcome is the message, not the time
   }
   EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_lost));
-  EXPECT_EQ(rt.usb_device()->status(), DeviceStatus::Lost);
+  EXPECT_EQ(rt.devices().usb()->status(), DeviceStatus::Lost);
   EXPECT_GE(board.torque_commands(), 500);
   rt.stop_servo();
   double tau1 = 1, tau2 = 1;
-  rt.usb_device()->last_torques_n_m(&tau1, &tau2);
+  rt.devices().usb()->last_torques_n_m(&tau1, &tau2);
   EXPECT_EQ(tau1, 0.0);
   EXPECT_EQ(tau2, 0.0);
 }
@@ -108,14 +110,14 @@ TEST(KioskDevice, ABoardOnItsTtyIsUsedAnnouncedAndItsLossSpoken) {
 TEST(KioskDevice, WithNoBoardTheSimulatedPantographStandsInAndSaysSo) {
   const Library lib;
   KioskRuntime rt(options(lib), no_board_settings());
-  EXPECT_EQ(rt.usb_device(), nullptr);
-  EXPECT_NE(rt.device_note().find("/dev/hk-no-such-board"), std::string::npos) << rt.device_note();
+  EXPECT_EQ(rt.devices().usb(), nullptr);
+  EXPECT_NE(rt.devices().note().find("/dev/hk-no-such-board"), std::string::npos) << rt.devices().note();
   rt.start_servo();
   rt.announce_device();
   EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_simulated));
   double o1 = 0, o2 = 0;
   std::string why;
-  EXPECT_FALSE(rt.calibrate_usb(&o1, &o2, &why));
+  EXPECT_FALSE(rt.devices().calibrate(&o1, &o2, &why));
   EXPECT_NE(why.find("no USB pantograph"), std::string::npos) << why;
   rt.stop_servo();
 }
@@ -135,7 +137,7 @@ TEST(KioskDevice, AMissingBoardIsLoggedOncePerReason) {
     KioskRuntime rt(options(lib), no_board_settings());
     EXPECT_EQ(count_warnings(), 1) << "the first probe says why";
     for (double t = 0.0; t < 120.0; t += 1.0) rt.poll_device(t);  // 12 more probes, the same reason
-    EXPECT_EQ(rt.usb_device(), nullptr);
+    EXPECT_EQ(rt.devices().usb(), nullptr);
     EXPECT_EQ(count_warnings(), 1);
   }
   spdlog::default_logger()->sinks().pop_back();
@@ -146,8 +148,8 @@ TEST(KioskDevice, ChosenSimulatedIsNotAnnounced) {
   s.device.type = "simulated";
   const Library lib;
   KioskRuntime rt(options(lib), s);
-  EXPECT_EQ(rt.usb_device(), nullptr);
-  EXPECT_TRUE(rt.device_note().empty());
+  EXPECT_EQ(rt.devices().usb(), nullptr);
+  EXPECT_TRUE(rt.devices().note().empty());
   rt.announce_device();
   EXPECT_TRUE(rt.last_said().empty()) << rt.last_said();
 }
@@ -163,8 +165,8 @@ TEST(KioskDevice, TheEmulatedBoardOptionDrivesTheDriverThroughAPty) {
   ro.device = "haply-emulator";  // ...but the emulated board asked for
   config::Settings s;
   KioskRuntime rt(ro, s);
-  ASSERT_NE(rt.usb_device(), nullptr);
-  EXPECT_NE(rt.usb_device()->name().find("tty /dev/"), std::string::npos) << rt.usb_device()->name();
+  ASSERT_NE(rt.devices().usb(), nullptr);
+  EXPECT_NE(rt.devices().usb()->name().find("tty /dev/"), std::string::npos) << rt.devices().usb()->name();
   rt.announce_device();
   EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
   rt.start_servo();
@@ -186,9 +188,17 @@ TEST(KioskDevice, TheEmulatedBoardOptionDrivesTheDriverThroughAPty) {
 namespace hk::app {
 namespace {
 
+// What run_stall saw: whether the kiosk took the emulated board, whether `done` came within the deadline, and
+// everything said, in order.
+struct StallRun {
+  bool board = false;
+  bool done = false;
+  std::vector<std::string> said;
+};
+
 // A kiosk on an emulated board that stalls at 0.3 s of its time for `stall_s`; polls the device on the
-// real clock until `done` or 20 s. Returns everything said, in order.
-std::vector<std::string> run_stall(double stall_s, const std::function<bool(KioskRuntime&)>& done) {
+// real clock until `done` (the 20 s deadline only bounds a hang).
+StallRun run_stall(double stall_s, const std::function<bool(KioskRuntime&)>& done) {
   config::Settings s;
   DeviceChoice stall;
   stall.kind = DeviceChoice::Kind::HaplyEmulator;
@@ -202,32 +212,40 @@ std::vector<std::string> run_stall(double stall_s, const std::function<bool(Kios
   s.device.serial_path = pty.device_path();
   const Library lib;
   KioskRuntime rt(options(lib), s);
-  std::vector<std::string> said_all;
-  if (!rt.usb_device()) return said_all;
+  StallRun run;
+  run.board = rt.devices().usb() != nullptr;
+  if (!run.board) return run;
   rt.start_servo();
   const auto t0 = std::chrono::steady_clock::now();
   std::string last;
-  while (!done(rt) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20)) {
+  while (!(run.done = done(rt)) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20)) {
     rt.poll_device(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    if (rt.last_said() != last) said_all.push_back(last = rt.last_said());
+    if (rt.last_said() != last) run.said.push_back(last = rt.last_said());
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   rt.stop_servo();
-  return said_all;
+  return run;
 }
 
 }  // namespace
 
 TEST(KioskDevice, ALongLossIsSpokenAndSoIsTheReturn) {
-  const std::vector<std::string> s = run_stall(1.5, [](KioskRuntime& rt) { return rt.usb_device()->counters().reconnects >= 1 && !rt.last_said().empty() && rt.last_said() == said(audio::MessageId::device_back); });
+  const StallRun run = run_stall(1.5, [](KioskRuntime& rt) {
+    return rt.devices().usb()->counters().reconnects >= 1 && rt.last_said() == said(audio::MessageId::device_back);
+  });
+  ASSERT_TRUE(run.board) << "the kiosk took the emulated board";
+  ASSERT_TRUE(run.done) << "the board was lost and came back within 20 s";
+  const std::vector<std::string>& s = run.said;
   ASSERT_EQ(s.size(), 2u);
   EXPECT_EQ(s[0], said(audio::MessageId::device_lost));
   EXPECT_EQ(s[1], said(audio::MessageId::device_back));
 }
 
 TEST(KioskDevice, AShortLossIsNotSpoken) {
-  const std::vector<std::string> s = run_stall(0.02, [](KioskRuntime& rt) { return rt.usb_device()->counters().reconnects >= 1; });
-  EXPECT_TRUE(s.empty()) << s.front();
+  const StallRun run = run_stall(0.02, [](KioskRuntime& rt) { return rt.devices().usb()->counters().reconnects >= 1; });
+  ASSERT_TRUE(run.board) << "the kiosk took the emulated board";
+  ASSERT_TRUE(run.done) << "the stall cost the driver a reconnect within 20 s";
+  EXPECT_TRUE(run.said.empty()) << run.said.front();
 }
 
 }  // namespace hk::app
@@ -245,10 +263,10 @@ TEST(KioskDevice, AHandleThatDidNotStartAtHomeIsToldToTheStaffAtStartAndNeverToA
   spdlog::set_default_logger(logger);
   KioskRuntime rt(ro, config::Settings{});
   spdlog::set_default_logger(before);
-  ASSERT_NE(rt.usb_device(), nullptr);
+  ASSERT_NE(rt.devices().usb(), nullptr);
   // The operator: one logged line, kept for the panel, naming the distance and the fix.
-  EXPECT_NE(rt.home_note().find("from its home pose at the park place"), std::string::npos) << rt.home_note();
-  EXPECT_NE(rt.home_note().find("press Calibrate in the operator's panel, or run 'haptic-kiosk calibrate'"), std::string::npos);
+  EXPECT_NE(rt.devices().home_note().find("from its home pose at the park place"), std::string::npos) << rt.devices().home_note();
+  EXPECT_NE(rt.devices().home_note().find("press Calibrate in the operator's panel, or run 'haptic-kiosk calibrate'"), std::string::npos);
   int logged = 0;
   for (const std::string& line : sink->last_formatted())
     logged += line.find("device: the handle reads") != std::string::npos && line.find("[warning]") != std::string::npos;
@@ -263,8 +281,8 @@ TEST(KioskDevice, AHandleThatDidNotStartAtHomeIsToldToTheStaffAtStartAndNeverToA
   // Calibrated where it rests: the note is gone.
   double o1 = 0, o2 = 0;
   std::string why;
-  ASSERT_TRUE(rt.calibrate_usb(&o1, &o2, &why)) << why;
-  EXPECT_EQ(rt.home_note(), "");
+  ASSERT_TRUE(rt.devices().calibrate(&o1, &o2, &why)) << why;
+  EXPECT_EQ(rt.devices().home_note(), "");
 }
 
 TEST(KioskDevice, AHandleAtHomeIsNotMentioned) {
@@ -272,8 +290,8 @@ TEST(KioskDevice, AHandleAtHomeIsNotMentioned) {
   RuntimeOptions ro = options(lib);
   ro.device = "haply-emulator:rest_at_park=1";
   KioskRuntime rt(ro, config::Settings{});
-  ASSERT_NE(rt.usb_device(), nullptr);
-  EXPECT_EQ(rt.home_note(), "");
+  ASSERT_NE(rt.devices().usb(), nullptr);
+  EXPECT_EQ(rt.devices().home_note(), "");
   rt.announce_device();
   EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
 }

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "describe.hpp"
-#include "kiosk_flow.hpp"
+#include "visit/describe.hpp"
+#include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
 namespace {

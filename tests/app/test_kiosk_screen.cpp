@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -13,6 +13,7 @@
 
 #include "audio/speech.hpp"
 #include "kiosk_exe.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -16,10 +16,12 @@
 #include "crossing_grid.hpp"
 #include "haptics/explorer_hand.hpp"
 #include "haptics/hand_path.hpp"
-#include "image_scene.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "pictures/image_scene.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
 #include "test_pictures.hpp"
+#include "test_paths.hpp"
 
 namespace hk {
 namespace {

@@ -1,6 +1,6 @@
-// Gains changed live on the kiosk's servo thread (ServoCore level): the simulated
+// Gains changed live on the kiosk's servo thread (ServoStep level): the simulated
 // pantograph held by a model hand pressing on a wall with the kiosk's defaults (800 N/m, 2 N push,
-// 0.05 N per tick, 1 kHz); ServoCore::set_gains doubles the stiffness between two ticks. The force never
+// 0.05 N per tick, 1 kHz); ServoStep::set_gains doubles the stiffness between two ticks. The force never
 // steps by more than the limit per tick (plus what the hand's own motion does to the wall), the display
 // reports the new stiffness and the end of the transition, and a picture published afterwards with the
 // old ServoParams renders with the new gains.
@@ -16,9 +16,10 @@
 
 #include "haptics/hand_path.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "servo_core.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "runtime/servo_step.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
 
 namespace hk::app {
 namespace {
@@ -36,7 +37,7 @@ struct Rig {
   ServoParams sp;
   SimulatedPantograph device;
   ModelHandParams hand;
-  ServoCore core;
+  ServoStep core;
   std::vector<Vec2> forces, handles;
   std::vector<ServoDisplayState> shown;
   Vec2 target{0.0, 0.0};  // where the hand pulls to

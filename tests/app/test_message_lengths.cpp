@@ -8,7 +8,7 @@
 
 #include "audio/messages.hpp"
 #include "audio/speech.hpp"
-#include "kiosk_flow.hpp"
+#include "visit/kiosk_flow.hpp"
 #include "message_samples.hpp"
 
 namespace hk::app {

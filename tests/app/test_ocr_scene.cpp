@@ -16,13 +16,15 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "documents.hpp"
+#include "pictures/documents.hpp"
 #include "image_pdf.hpp"
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
 #include "scans.hpp"
-#include "settings_params.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
 #include "vision/pdf.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

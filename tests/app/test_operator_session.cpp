@@ -13,7 +13,7 @@
 
 #include "config/load.hpp"
 #include "config/operator_pin.hpp"
-#include "operator_session.hpp"
+#include "visit/operator_session.hpp"
 
 namespace fs = std::filesystem;
 

@@ -13,6 +13,7 @@
 
 #include "config/load.hpp"
 #include "config/operator_pin.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -15,7 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "config/load.hpp"
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
 #include "hk/error.hpp"
 

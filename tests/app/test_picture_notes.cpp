@@ -14,9 +14,10 @@
 #include <zlib.h>
 
 #include "kiosk_exe.hpp"
-#include "picture_library.hpp"
-#include "picture_notes.hpp"
-#include "png_text.hpp"
+#include "pictures/picture_library.hpp"
+#include "formats/picture_notes.hpp"
+#include "formats/png_text.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

@@ -19,9 +19,10 @@
 
 #include "config/load.hpp"
 #include "config/operator_pin.hpp"
-#include "pin_verifier.hpp"
+#include "visit/pin_verifier.hpp"
 
 #include "letter_dir.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 using namespace hk;

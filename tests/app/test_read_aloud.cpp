@@ -11,9 +11,10 @@
 #include <vector>
 
 #include "audio/speech.hpp"
-#include "kiosk_flow.hpp"
-#include "read_aloud.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/read_aloud.hpp"
 #include "vision/ocr.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

@@ -17,10 +17,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
 #include "vision/intake.hpp"
 #include "vision/ocr.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -15,7 +15,8 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

@@ -18,11 +18,13 @@
 #include <vector>
 
 #include "hk/error.hpp"
-#include "kiosk_flow.hpp"
-#include "kiosk_runtime.hpp"
-#include "scene_builder.hpp"
-#include "scene_cache.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "pictures/scene_builder.hpp"
+#include "pictures/scene_cache.hpp"
 #include "show_now.hpp"
+#include "test_paths.hpp"
+#include "wait_until.hpp"
 
 namespace fs = std::filesystem;
 
@@ -113,11 +115,9 @@ TEST(SceneBuilder, WantsGoBeforeBuildsAheadAndAnotherGenerationIsAnotherScene) {
   hold.open.set_value();
   ASSERT_TRUE(b.wait_want(60.0));
   std::vector<int> order;
-  for (int i = 0; i < 1000 && order.size() < 4; ++i) {  // the two ahead finish after the want
-    for (const BuiltScene& d : b.poll()) order.push_back(d.scene->page);
-    if (order.size() < 4) std::this_thread::yield();
-    if (order.size() < 4 && !b.has(2, 1) && !b.has(3, 1)) break;
-  }
+  // The two ahead finish after the want: polled until all four came or nothing more is being built.
+  EXPECT_TRUE(hk::test::wait_until([&] { return order.size() >= 4 || (!b.has(2, 1) && !b.has(3, 1)); },
+                                   [&] { for (const BuiltScene& d : b.poll()) order.push_back(d.scene->page); }));
   for (const BuiltScene& d : b.poll()) order.push_back(d.scene->page);
   ASSERT_EQ(order.size(), 4u);
   EXPECT_EQ(order[0], 9);
@@ -208,23 +208,21 @@ struct LibraryRig {
   }
   /// Polls the stick service every 10 ms until scene `id` is shown (or 60 s pass), advancing `now_s`.
   bool stick_shows(int id, double& now_s) {
-    for (int i = 0; i < 6000 && rt->shown_id() != id; ++i, now_s += 0.01) {
+    return hk::test::wait_until([&] { return rt->shown_id() == id; }, [&] {
       rt->poll_sticks(*flow, now_s);
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return rt->shown_id() == id;
+      now_s += 0.01;
+    });
   }
   /// Polls until the pictures built ahead are `want` (or 60 s pass).
   bool ahead_becomes(std::vector<int> want) {
     std::sort(want.begin(), want.end());
-    for (int i = 0; i < 6000; ++i) {
-      rt->poll_pictures(flow.get(), 0.0);
-      std::vector<int> have = rt->pictures_ahead();
-      std::sort(have.begin(), have.end());
-      if (have == want) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return false;
+    return hk::test::wait_until(
+        [&] {
+          std::vector<int> have = rt->pictures_ahead();
+          std::sort(have.begin(), have.end());
+          return have == want;
+        },
+        [&] { rt->poll_pictures(flow.get(), 0.0); });
   }
 };
 
@@ -337,11 +335,11 @@ TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibr
   ASSERT_TRUE(r.stick_shows(1001, now_s)) << "the stick's first page is felt";
   r.flow->key(KioskKey::Next, now_s);  // page 2 asked for...
   r.rt->remove_stick_folder();         // ...and the stick pulled out while it is drawn
-  for (int i = 0; i < 6000 && (r.rt->stick_busy() || r.rt->picture_busy()); ++i, now_s += 0.01) {
+  ASSERT_TRUE(hk::test::wait_until([&] { return !r.rt->stick_busy() && !r.rt->picture_busy(); }, [&] {
     r.rt->poll_sticks(*r.flow, now_s);
     r.rt->poll_pictures(r.flow.get(), now_s);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+    now_s += 0.01;
+  }));
   for (int i = 0; i < 50; ++i, now_s += 0.01) r.rt->poll_sticks(*r.flow, now_s);  // page 2's drawing, if it ends now, is dropped
   EXPECT_EQ(r.rt->shown_id(), 0) << "back on the library's picture, never page 2";
   EXPECT_EQ(r.flow->failures(), 0);
@@ -361,7 +359,7 @@ TEST(KioskBuilds, FinishWhileAStickPageIsBuiltLeavesNothingBusy) {
   const int loads = r.rt->sticks().loads_started();
   const int done = r.rt->sticks().loads_done();
   r.flow->key(KioskKey::Next, now_s);  // page 2...
-  for (int i = 0; i < 6000 && r.rt->sticks().loads_started() == loads; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().loads_started() == loads); }));
   ASSERT_EQ(r.rt->sticks().loads_started(), loads + 1) << "page 2 is being drawn";
   r.rt->poll_sticks(*r.flow, now_s);
   ASSERT_TRUE(r.rt->stick_busy()) << "the kiosk waits for page 2";
@@ -370,7 +368,7 @@ TEST(KioskBuilds, FinishWhileAStickPageIsBuiltLeavesNothingBusy) {
   ASSERT_EQ(r.flow->state(), KioskState::Attract);
   EXPECT_FALSE(r.rt->stick_busy()) << "nothing of the forgotten stick is awaited";
   // Page 2's drawing ends (or has ended), and the window polls it in.
-  for (int i = 0; i < 6000 && r.rt->sticks().loads_done() == done; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().loads_done() == done); }));
   ASSERT_EQ(r.rt->sticks().loads_done(), done + 1) << "page 2's load ended within 60 s";
   r.rt->poll_sticks(*r.flow, now_s);
   EXPECT_FALSE(r.rt->stick_busy()) << "the page that arrived for the forgotten stick left nothing busy";
@@ -391,10 +389,10 @@ TEST(KioskBuilds, WhatAStickCouldNotGiveIsListedForTheOperator) {
   EXPECT_TRUE(r.rt->stick_problems().empty());
   r.rt->insert_stick_folder(stick.string());
   double now_s = 1.0;
-  for (int i = 0; i < 6000 && r.rt->stick_problems().size() < 2; ++i, now_s += 0.01) {
+  EXPECT_TRUE(hk::test::wait_until([&] { return r.rt->stick_problems().size() >= 2; }, [&] {
     r.rt->poll_sticks(*r.flow, now_s);
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+    now_s += 0.01;
+  }));
   const std::vector<std::string>& problems = r.rt->stick_problems();
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_EQ(problems[0].rfind("'bad_crc.png': ", 0), 0u) << problems[0];
@@ -414,7 +412,7 @@ TEST(KioskBuilds, StickPagesPassedByQuicklyAreNeverPutOnTheDevice) {
   const std::uint64_t published = r.rt->scenes_published();
   const int loads = r.rt->sticks().loads_started();
   r.flow->key(KioskKey::Next, now_s);  // page 2...
-  for (int i = 0; i < 6000 && r.rt->sticks().loads_started() == loads; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().loads_started() == loads); }));
   ASSERT_EQ(r.rt->sticks().loads_started(), loads + 1) << "page 2 is being drawn";
   for (int i = 0; i < 2; ++i) r.flow->key(KioskKey::Next, now_s);  // ...then pages 3 and 4 before it is done
   ASSERT_TRUE(r.stick_shows(1004, now_s));

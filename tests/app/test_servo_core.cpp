@@ -11,9 +11,10 @@
 
 #include "haptics/hand_path.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "servo_core.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "runtime/servo_step.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
 
 namespace hk::app {
 namespace {
@@ -32,7 +33,7 @@ struct Rig {
   SimulatedPantograph device;
   ModelHandParams hand;
   audio::SpscRing<audio::CueEvent> cues{1024};
-  ServoCore core;
+  ServoStep core;
   Vec2 target{0.0, 0.0};  // the hand pulls towards the square's centre: it presses on the left wall
   std::vector<Vec2> forces, handles;
 
@@ -61,7 +62,7 @@ struct Rig {
   }
 };
 
-TEST(ServoCore, SwappingPicturesUnderAPressingHandHasNoForceStep) {
+TEST(ServoStep, SwappingPicturesUnderAPressingHandHasNoForceStep) {
   Rig r;
   r.core.publish(bundle(r.sp, 1));
   r.run(1.5);  // ramp in (0.5 s), then press steadily on the left wall
@@ -82,7 +83,7 @@ TEST(ServoCore, SwappingPicturesUnderAPressingHandHasNoForceStep) {
   EXPECT_GT(length(r.forces[swap_at - 1]), 100 * ramp_step);
 }
 
-TEST(ServoCore, TheOldPictureFadesOnlyAsLongAsItsForceNeeds) {
+TEST(ServoStep, TheOldPictureFadesOnlyAsLongAsItsForceNeeds) {
   // The fade takes one ramp step of force a tick: a hand in free space (no force) gets the new picture at
   // the next tick; a hand pressing with F waits ceil(F / ramp step) ticks, never the whole ramp for less.
   Rig free_hand;
@@ -111,7 +112,7 @@ TEST(ServoCore, TheOldPictureFadesOnlyAsLongAsItsForceNeeds) {
   EXPECT_LT(ticks, static_cast<long>(pressing.sp.guard.ramp_s / pressing.sp.period_s)) << "less than the whole ramp for less than the clamp";
 }
 
-TEST(ServoCore, NewPictureStartsWithTheProxyAtTheHandle) {
+TEST(ServoStep, NewPictureStartsWithTheProxyAtTheHandle) {
   Rig r;
   r.target = {-0.05, 0.0};  // stay outside the square, no contact
   r.core.publish(bundle(r.sp, 1));
@@ -124,7 +125,7 @@ TEST(ServoCore, NewPictureStartsWithTheProxyAtTheHandle) {
   EXPECT_LT(length(d.proxy_m - d.handle_m), 1e-9);
 }
 
-TEST(ServoCore, APictureReplacedBeforeItWasTakenIsFreedAndTheLastOneWins) {
+TEST(ServoStep, APictureReplacedBeforeItWasTakenIsFreedAndTheLastOneWins) {
   Rig r;
   r.core.publish(bundle(r.sp, 1));
   r.core.publish(bundle(r.sp, 2));  // 1 never reaches the servo thread (ASan: no leak)
@@ -134,7 +135,7 @@ TEST(ServoCore, APictureReplacedBeforeItWasTakenIsFreedAndTheLastOneWins) {
   EXPECT_EQ(r.core.collect_retired(), 0);
 }
 
-TEST(ServoCore, ContactCuesReachTheRing) {
+TEST(ServoStep, ContactCuesReachTheRing) {
   Rig r;
   r.core.publish(bundle(r.sp, 1));
   r.run(1.0);
@@ -144,14 +145,14 @@ TEST(ServoCore, ContactCuesReachTheRing) {
   EXPECT_TRUE(contact);
 }
 
-TEST(ServoCore, NoPictureMeansNoForce) {
+TEST(ServoStep, NoPictureMeansNoForce) {
   Rig r;
   r.run(0.1);
   EXPECT_EQ(length(r.forces.back()), 0.0);
   EXPECT_EQ(r.core.display().scene_id, -1);
 }
 
-TEST(ServoCore, LevelRequestsFixTheLevelOrHandItBackToTheHandsSpeed) {
+TEST(ServoStep, LevelRequestsFixTheLevelOrHandItBackToTheHandsSpeed) {
   Rig r;
   ASSERT_EQ(r.s.haptics.level_mode, "auto");
   r.core.publish(bundle(r.sp, 1));
@@ -161,7 +162,7 @@ TEST(ServoCore, LevelRequestsFixTheLevelOrHandItBackToTheHandsSpeed) {
   r.run(0.5);
   EXPECT_FALSE(r.core.display().auto_level);
   EXPECT_EQ(r.core.display().level, 0);
-  r.core.request_level(ServoCore::kAutoLevel);  // a new session: back to the hand's speed
+  r.core.request_level(ServoStep::kAutoLevel);  // a new session: back to the hand's speed
   r.run(0.2);
   EXPECT_TRUE(r.core.display().auto_level);
 }

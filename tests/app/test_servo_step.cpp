@@ -1,4 +1,4 @@
-// ServoCore::step as a pure step, driven by the kiosk's ServoRunner: no device inside it, the same samples give
+// ServoStep::step as a pure step, driven by the kiosk's ServoRunner: no device inside it, the same samples give
 // the same commands bit for bit, nothing is allocated or freed in a tick (counted by a replaced global operator
 // new in this translation unit) and nothing in it waits on the device (a transport that records every wait),
 // through a whole run with a tour, picture swaps, new gains and a device that stalls and comes back; and a
@@ -17,17 +17,18 @@
 #include <vector>
 
 #include "curves.hpp"
-#include "device_setup.hpp"
-#include "guided_tour.hpp"
+#include "runtime/device_setup.hpp"
+#include "runtime/guided_tour.hpp"
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/io/haply_device.hpp"
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/pty_emulator.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "servo_core.hpp"
-#include "servo_runner.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "runtime/servo_step.hpp"
+#include "runtime/servo_runner.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
 
 // ── Counting allocation ───────────────────────────────────────────────────────────────────────────
 // Replaces the global allocation functions of the whole test_app executable (allowed, also under ASan,
@@ -105,7 +106,7 @@ struct Rig {
   SimulatedPantograph device;
   ModelHandParams hand;
   audio::SpscRing<audio::CueEvent> cues{1024};
-  ServoCore core;
+  ServoStep core;
   Vec2 target{0.0, 0.0};
   std::vector<DeviceSample> samples;   // what step() was given
   std::vector<Vec2> commands;          // what it asked for
@@ -170,7 +171,7 @@ TEST_P(ServoStepModes, NothingIsAllocatedOrFreedInTheStep) {
   r.core.request_level(fixed);
   r.run(0.3, true);
   EXPECT_EQ(r.core.display().level, fixed) << "a level change happened in the counted steps";
-  r.core.request_level(ServoCore::kAutoLevel);
+  r.core.request_level(ServoStep::kAutoLevel);
   ServoGains g = servo_gains_from(r.s);
   g.stiffness_n_per_m *= 2.0;
   g.static_friction = 0.1;
@@ -182,8 +183,8 @@ TEST_P(ServoStepModes, NothingIsAllocatedOrFreedInTheStep) {
   r.core.publish(bundle(r.sp, 2, 0.015));  // built and handed over outside the count
   r.run(1.5, true);                        // fade, swap (the old bundle goes to the retired ring), ramp in
   EXPECT_EQ(r.core.display().scene_id, 2);
-  EXPECT_EQ(g_allocations.load(), 0) << "operator new called in ServoCore::step";
-  EXPECT_EQ(g_frees.load(), 0) << "operator delete called in ServoCore::step";
+  EXPECT_EQ(g_allocations.load(), 0) << "operator new called in ServoStep::step";
+  EXPECT_EQ(g_frees.load(), 0) << "operator delete called in ServoStep::step";
   EXPECT_EQ(r.core.collect_retired(), 1);
   // The counter counts: an allocation in a counted region shows.
   {
@@ -239,8 +240,8 @@ TEST_P(ServoStepTourModes, NothingIsAllocatedOrFreedInAGuidedTour) {
   const int level = r.core.display().level;
   EXPECT_EQ(is_cut_level(level), std::string(GetParam()) == "cut") << "the walls of the mode: level id " << level;
   EXPECT_EQ(is_tolerance_level(level), std::string(GetParam()) == "tolerance") << "level id " << level;
-  EXPECT_EQ(g_allocations.load(), 0) << "operator new called in ServoCore::step during a tour";
-  EXPECT_EQ(g_frees.load(), 0) << "operator delete called in ServoCore::step during a tour";
+  EXPECT_EQ(g_allocations.load(), 0) << "operator new called in ServoStep::step during a tour";
+  EXPECT_EQ(g_frees.load(), 0) << "operator delete called in ServoStep::step during a tour";
   r.core.collect_retired();
 }
 
@@ -335,7 +336,7 @@ TEST(ServoStep, AWholeRunOnTheEmulatedBoardNeitherAllocatesNorWaitsInATick) {
   TripwireDevice device(board);
 
   audio::SpscRing<audio::CueEvent> cues(1024);
-  ServoCore core(cue_params_from(s), &cues);
+  ServoStep core(cue_params_from(s), &cues);
   core.publish(bundle(sp, 1));
   const Scene square = Scene::build({test::square(0.02)}, 3);  // bundle 1's picture
   const TourParams tp = tour_params_from(s);
@@ -417,7 +418,7 @@ TEST(ServoStep, SameSamplesGiveBitIdenticalCommands) {
   // A closed-loop run through the simulated pantograph, recorded; then a second core, given the same
   // pictures, requests and gains at the same ticks, replays the recorded samples with no device at all.
   Rig a;
-  const auto script = [](ServoCore& core, const ServoParams& sp, long k) {
+  const auto script = [](ServoStep& core, const ServoParams& sp, long k) {
     if (k == 0) core.publish(bundle(sp, 1));
     if (k == 900) core.request_level(0);
     if (k == 1400) {
@@ -433,7 +434,7 @@ TEST(ServoStep, SameSamplesGiveBitIdenticalCommands) {
     if (k == 1000) a.target = {0.0, 0.012};
     a.tick();
   }
-  ServoCore b(CueTrackerParams{}, nullptr);
+  ServoStep b(CueTrackerParams{}, nullptr);
   long contact_ticks = 0;
   for (long k = 0; k < n; ++k) {
     script(b, a.sp, k);
@@ -452,7 +453,7 @@ TEST(ServoStep, AReturningDeviceGetsItsForceBackThroughTheRamp) {
   // hand goes 5 mm deeper, then it comes back.
   const config::Settings s;
   const ServoParams sp = servo_params_from(s);
-  ServoCore core(CueTrackerParams{}, nullptr);
+  ServoStep core(CueTrackerParams{}, nullptr);
   core.publish(bundle(sp, 1));
   ServoCommand cmd;
   const auto step = [&](Vec2 h, DeviceStatus st) {

@@ -9,9 +9,10 @@
 
 #include "haptics/sim_pantograph.hpp"
 #include "hk/error.hpp"
-#include "servo_thread.hpp"
-#include "settings_params.hpp"
-#include "simulation.hpp"
+#include "runtime/servo_thread.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
+#include "runtime/simulation.hpp"
 
 namespace hk::app {
 namespace {
@@ -24,7 +25,7 @@ TEST(ServoThread, TicksCountsAMissedDeadlineAndStops) {
   SimPantographParams dp;
   SimulatedPantograph device(dp, {-0.03, 0.0});
   device.open();
-  ServoCore core(CueTrackerParams{}, nullptr);
+  ServoStep core(CueTrackerParams{}, nullptr);
   auto b = std::make_unique<SceneBundle>(std::make_unique<Scene>(Scene::build({square(0.02)}, 2)), sp);
   b->id = 7;
   core.publish(std::move(b));
@@ -57,7 +58,7 @@ TEST(ServoThread, TicksCountsAMissedDeadlineAndStops) {
 TEST(ServoThread, RefusesARateOutsideItsRange) {
   SimPantographParams dp;
   SimulatedPantograph device(dp, {0.0, 0.0});
-  ServoCore core(CueTrackerParams{}, nullptr);
+  ServoStep core(CueTrackerParams{}, nullptr);
   ServoThreadParams p;
   p.rate_hz = 50;
   EXPECT_THROW(ServoThread(core, device, p), hk::ArgumentError);

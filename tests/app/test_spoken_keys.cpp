@@ -14,7 +14,8 @@
 #include "config/keys.hpp"
 #include "config/load.hpp"
 #include "config/settings.hpp"
-#include "kiosk_flow.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

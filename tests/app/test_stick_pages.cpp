@@ -1,11 +1,11 @@
-// Where Next and Previous go on a stick (app/src/stick_pages.hpp): page by page, then to the next document's
+// Where Next and Previous go on a stick (app/pictures/include/pictures/stick_pages.hpp): page by page, then to the next document's
 // first page or the previous document's last, round the stick; the flow and the stick service's builds ahead
 // both follow it.
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "stick_pages.hpp"
+#include "pictures/stick_pages.hpp"
 
 namespace hk::app {
 namespace {

@@ -21,8 +21,9 @@
 #include <string>
 #include <thread>
 
-#include "stick_service.hpp"
+#include "pictures/stick_service.hpp"
 #include "child_process.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

@@ -19,14 +19,15 @@
 #include <thread>
 #include <vector>
 
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
-#include "kiosk_flow.hpp"
-#include "kiosk_runtime.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
 #include "scans.hpp"
 #include "show_now.hpp"
-#include "text_reader.hpp"
+#include "pictures/text_reader.hpp"
 #include "vision/ocr.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -12,9 +12,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "image_scene.hpp"
+#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
 #include "textures.hpp"
+#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {

@@ -15,13 +15,15 @@
 #include <vector>
 
 #include "audio/messages.hpp"
-#include "guided_tour.hpp"
-#include "kiosk_runtime.hpp"
+#include "runtime/guided_tour.hpp"
+#include "visit/kiosk_runtime.hpp"
 #include "runtime_ticks.hpp"
-#include "settings_params.hpp"
+#include "pictures/picture_params.hpp"
+#include "runtime/runtime_params.hpp"
 #include "show_now.hpp"
-#include "simulation.hpp"
+#include "runtime/simulation.hpp"
 #include "test_pictures.hpp"
+#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 

@@ -11,6 +11,7 @@
 #include <functional>
 
 #include "audio/messages.hpp"
+#include "test_paths.hpp"
 
 namespace hk::audio {
 namespace {

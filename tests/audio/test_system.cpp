@@ -8,6 +8,7 @@
 
 #include "audio/system.hpp"
 #include "audio_analysis.hpp"
+#include "test_paths.hpp"
 
 namespace hk::audio {
 namespace {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "config/load.hpp"
+#include "test_paths.hpp"
 
 namespace hk::config::test {
 

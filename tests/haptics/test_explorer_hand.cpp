@@ -35,7 +35,7 @@ struct LoopResult {
   std::vector<HandCommand> commands;
 };
 
-// The headless loop of app/src/simulation.cpp, reduced: read, servo, write, hand, step.
+// The headless loop of app/runtime/src/simulation.cpp, reduced: read, servo, write, hand, step.
 LoopResult run_loop(const Scene& sc, ExplorerHand& hand, double seconds, bool keep_commands = false) {
   ServoParams sp;
   sp.level = 0;
@@ -43,7 +43,7 @@ LoopResult run_loop(const Scene& sc, ExplorerHand& hand, double seconds, bool ke
   sp.contact.dynamic_friction = 0.3;
   sp.contact.max_force_n = 3.5;
   sp.guard.max_force_n = 3.5;
-  ServoLoop servo(sc, sp);
+  SceneStep servo(sc, sp);
   SimulatedPantograph dev(SimPantographParams{}, hand.start_m());
   dev.open();
   servo.start(dev.read().handle_m);

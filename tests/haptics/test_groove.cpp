@@ -103,7 +103,7 @@ struct SweepStats {
 
 // Drives the servo loop with the handle at `pts` (kinematically: the device reports exactly these).
 SweepStats sweep(const Scene& sc, const ServoParams& sp, const std::vector<Vec2>& pts, std::vector<ServoOutput>* outs = nullptr) {
-  ServoLoop loop(sc, sp);
+  SceneStep loop(sc, sp);
   loop.start(pts.front());
   SweepStats st;
   Vec2 prev_f{0, 0}, prev_h = pts.front();
@@ -326,7 +326,7 @@ DeviceRun run_device(const Scene& sc, const ServoParams& sp, Vec2 start, double 
   SimPantographParams dp;
   SimulatedPantograph dev(dp, start);
   dev.open();
-  ServoLoop loop(sc, sp);
+  SceneStep loop(sc, sp);
   loop.start(dev.read().handle_m);
   DeviceRun run;
   ServoOutput so;
@@ -430,11 +430,11 @@ TEST(GrooveOnDevice, ClosedCurveNeverBlocks) {
 
 TEST(GrooveServo, SectionFollowsTheSolverInUseAndGainsReachTheGroove) {
   const Scene sc = line_scene();
-  ServoLoop loop(sc, groove_servo_params());
+  SceneStep loop(sc, groove_servo_params());
   EXPECT_EQ(&loop.section(), &loop.groove().section());
   ServoParams walls = groove_servo_params();
   walls.render = RenderMode::Walls;
-  ServoLoop wloop(sc, walls);
+  SceneStep wloop(sc, walls);
   EXPECT_EQ(&wloop.section(), &wloop.solver().section());
 
   // A gains change reaches the groove's law, through the per-tick limit.

@@ -18,6 +18,7 @@
 
 #include "haptics/hand_path.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk {
 namespace {

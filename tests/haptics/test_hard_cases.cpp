@@ -34,7 +34,7 @@ struct RunStats {
   std::vector<ContactState> states;
 };
 
-RunStats drive(const Scene& sc, ServoLoop& loop, const std::vector<Vec2>& path, long settle_ticks = 0) {
+RunStats drive(const Scene& sc, SceneStep& loop, const std::vector<Vec2>& path, long settle_ticks = 0) {
   RunStats r;
   ServoOutput out;
   int prev_level = loop.level(), prev_transition = -1, prev_wanted = -1;
@@ -99,7 +99,7 @@ TEST(HardCases, TremorAtAWallNeitherFlapsLevelsNorChatters) {
   const Vec2 w = pts[0];
   const Vec2 n = normalized_or(w, Vec2{1, 0});
   for (const Vec2 dir : {n, left_perp(n)}) {  // tremor across the wall, and along it
-    ServoLoop loop(sc, auto_params());
+    SceneStep loop(sc, auto_params());
     std::vector<Vec2> path;
     const Vec2 rest = w - 0.0005 * n;
     for (int i = 0; i < 300; ++i) path.push_back(lerp(w + 0.01 * n, rest, i / 300.0));
@@ -121,7 +121,7 @@ TEST(HardCases, TremorAtAWallNeitherFlapsLevelsNorChatters) {
     naive.policy.speed_cutoff_hz = 200.0;
     naive.policy.hysteresis = 0.0;
     naive.policy.min_dwell_s = 0.0;
-    ServoLoop flappy(sc, naive);
+    SceneStep flappy(sc, naive);
     flappy.start(path[0]);
     EXPECT_GT(drive(sc, flappy, path, 1300).wanted_changes, 20) << "the case must be one where a naive policy flaps";
   }
@@ -156,7 +156,7 @@ TEST(HardCases, CoincidentAndTouchingCurvesDegenerateChainsRandomWalks) {
   long contacts = 0, changes = 0;
   for (int seed = 0; seed < 4; ++seed) {
     std::mt19937 walk_rng(static_cast<unsigned>(100 + seed));
-    ServoLoop loop(sc, auto_params());
+    SceneStep loop(sc, auto_params());
     const std::vector<Vec2> path = random_walk(walk_rng, {0.0, 0.04}, 20000, 0.00025, {0.06, 0.04});
     loop.start(path[0]);
     const RunStats r = drive(sc, loop, path);
@@ -175,7 +175,7 @@ TEST(HardCases, CurveThroughTheProxysStartPosition) {
   const Polyline blob = test::random_blob(rng, {0, 0}, 0.02, 128);
   const Scene sc = Scene::build({blob}, 4);
   for (const Vec2 start : {blob.points_m[7], lerp(blob.points_m[40], blob.points_m[41], 0.5)}) {
-    ServoLoop loop(sc, auto_params());
+    SceneStep loop(sc, auto_params());
     std::mt19937 walk_rng(9);
     const std::vector<Vec2> path = random_walk(walk_rng, start, 8000, 0.0002, {0.05, 0.04});
     loop.start(start);

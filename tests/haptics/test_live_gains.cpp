@@ -1,4 +1,4 @@
-// Gains changed live under a pressing hand (ServoLoop level): stiffness, damping, max
+// Gains changed live under a pressing hand (SceneStep level): stiffness, damping, max
 // force and friction take effect from the next tick, yet the force never moves by more than the configured
 // step per tick (plus what the hand's own motion does to the wall), and it ends exactly on the new force
 // law (golden values from F = k · penetration, Coulomb's μ_d · F_n, damping b · v), after the number of
@@ -44,7 +44,7 @@ Vec2 pressed(double x, double depth) { return {x, kSkin - depth}; }
 /// A servo loop over `scene`, driven by handle positions one tick at a time; every output kept.
 struct Rig {
   Scene scene;
-  ServoLoop loop;
+  SceneStep loop;
   ServoOutput out;
   std::vector<Vec2> forces, handles, proxies;
 

@@ -145,7 +145,7 @@ TEST(ServoStep, NaNSampleGivesZeroForceAndKeepsTheState) {
   ServoParams p;
   p.level = 0;
   p.guard.ramp_s = 0.0;
-  ServoLoop loop(sc, p);
+  SceneStep loop(sc, p);
   loop.start({-0.03, 0.0});
   ServoOutput out;
   for (int i = 1; i <= 22; ++i) loop.update(sample({-0.03 + 0.0005 * i, 0.0}), out);  // 1 mm into the left wall
@@ -170,7 +170,7 @@ TEST(ServoStep, DeviceNotOkAndLateTicksGiveZeroThroughTheLoop) {
   ServoParams p;
   p.level = 0;
   p.guard.ramp_s = 0.0;
-  ServoLoop loop(sc, p);
+  SceneStep loop(sc, p);
   loop.start({-0.03, 0.0});
   ServoOutput out;
   for (int i = 1; i <= 22; ++i) loop.update(sample({-0.03 + 0.0005 * i, 0.0}), out);
@@ -194,7 +194,7 @@ TEST(ServoStep, TwoLoopsFedTheSameSamplesGiveBitIdenticalOutputs) {
   const Scene sc = Scene::build(blobs(), 5);
   const std::vector<Vec2> path = wander(5, 3000);
   for (const std::int32_t budget : {0, 8, 200}) {  // the anytime path is deterministic too: no clock
-    ServoLoop a(sc, auto_params(budget)), b(sc, auto_params(budget));
+    SceneStep a(sc, auto_params(budget)), b(sc, auto_params(budget));
     a.start(path[0]);
     b.start(path[0]);
     ServoOutput oa, ob;
@@ -216,13 +216,13 @@ TEST(ServoStep, TwoLoopsFedTheSameSamplesGiveBitIdenticalOutputs) {
 TEST(ServoStep, SameInputsFromTheSameStateGiveTheSameOutput) {
   const Scene sc = Scene::build(blobs(), 5);
   const std::vector<Vec2> path = wander(9, 2000);
-  ServoLoop loop(sc, auto_params(kDefaultQueryBoxBudget));
+  SceneStep loop(sc, auto_params(kDefaultQueryBoxBudget));
   loop.start(path[0]);
   ServoOutput out, again;
   int compared = 0;
   for (std::size_t i = 1; i < path.size(); ++i) {
     if (i % 97 == 0) {  // branch off a copy and give both the same next sample
-      ServoLoop copy = loop;
+      SceneStep copy = loop;
       copy.update(sample(path[i]), again);
       loop.update(sample(path[i]), out);
       ASSERT_TRUE(same(out, again)) << "tick " << i;
@@ -240,7 +240,7 @@ TEST(ServoStep, StarvedBudgetNeverCrossesAndNeverOverspends) {
   const Scene sc = Scene::build(blobs(), 5);
   const std::vector<Vec2> path = wander(21, 6000);
   for (std::int32_t budget = 1; budget <= 12; ++budget) {
-    ServoLoop loop(sc, auto_params(budget));
+    SceneStep loop(sc, auto_params(budget));
     loop.start(path[0]);
     ServoOutput out;
     int prev_level = loop.level(), prev_transition = -1;
@@ -273,7 +273,7 @@ TEST(ServoStep, BudgetIsOneCounterForTheWholeTick) {
   const Scene sc = Scene::build(blobs(), 5);
   const std::vector<Vec2> path = wander(33, 3000);
   for (const std::int32_t budget : {0, 30, 100}) {
-    ServoLoop loop(sc, auto_params(budget));
+    SceneStep loop(sc, auto_params(budget));
     loop.start(path[0]);
     ServoOutput out;
     long binding = 0;
@@ -301,7 +301,7 @@ TEST(ServoStep, LevelChangeWaitsWhenTheBudgetCannotPayForItsCheck) {
     ServoParams p;
     p.level = 2;
     p.query_box_budget = budget;
-    ServoLoop loop(sc, p);
+    SceneStep loop(sc, p);
     const Vec2 h{-0.0185, 0.003};  // inside the square, near its left wall: the check must walk the tree
     loop.start(h);
     ServoOutput out;

@@ -257,7 +257,7 @@ TEST(ToleranceCut, CutBoundsHoldTheOriginalAndThePieces) {
   }
 }
 
-// A section built without the cut masks (what ServoLoop builds outside level_mode = "cut") renders a cut
+// A section built without the cut masks (what SceneStep builds outside level_mode = "cut") renders a cut
 // step as the tolerance step of the same tolerance, and says so: first hits and closest points equal the
 // tolerance step's, bit for bit.
 TEST(ToleranceCut, ASectionWithoutCutsRendersACutStepAsItsToleranceStep) {
@@ -303,8 +303,8 @@ TEST(ToleranceCut, TheServoLoopSharesOneCopyOfTheCutWallsBetweenItsSolvers) {
   const Scene sc = Scene::build(curves_for(rng), 6);
   ServoParams p;
   p.auto_level = true;
-  p.cut_steps = true;
-  const ServoLoop cut(sc, p);
+  p.steps = LevelSteps::Cuts;
+  const SceneStep cut(sc, p);
   const std::shared_ptr<const CutWalls>& walls = cut.solver().section().cut_walls();
   ASSERT_NE(walls, nullptr);
   EXPECT_EQ(walls.get(), cut.groove().section().cut_walls().get()) << "one copy for both solvers";
@@ -315,8 +315,8 @@ TEST(ToleranceCut, TheServoLoopSharesOneCopyOfTheCutWallsBetweenItsSolvers) {
     EXPECT_EQ(cut.solver().section().cut_bounds().half_width_m[t], cb.half_width_m[t]);
     EXPECT_GT(cb.error_bound_m[t], 0.0);
   }
-  p.cut_steps = false;
-  const ServoLoop levels(sc, p);
+  p.steps = LevelSteps::Levels;
+  const SceneStep levels(sc, p);
   EXPECT_FALSE(levels.solver().section().has_cuts());
   EXPECT_FALSE(levels.groove().section().has_cuts());
   EXPECT_EQ(levels.solver().section().cut_bounds().error_bound_m[0], 0.0);

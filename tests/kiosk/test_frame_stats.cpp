@@ -5,7 +5,7 @@
 
 #include <chrono>
 
-#include "frame_stats.hpp"
+#include "kiosk/frame_stats.hpp"
 
 namespace hk::app {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "config/keys.hpp"
 #include "config/settings.hpp"
-#include "keymap.hpp"
+#include "kiosk/keymap.hpp"
 
 namespace hk::app {
 namespace {

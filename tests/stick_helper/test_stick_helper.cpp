@@ -19,6 +19,7 @@
 
 #include "stick_helper.hpp"
 #include "vision/usb_stick.hpp"
+#include "test_paths.hpp"
 
 namespace hk::stick_helper {
 namespace {

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 #include <vector>
+#include "test_paths.hpp"
 
 namespace hk::test {
 

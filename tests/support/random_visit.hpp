@@ -1,6 +1,6 @@
 #pragma once
 /// @file random_visit.hpp
-/// A seeded random visit to the kiosk without its window: what app/kiosk/kiosk_app.cpp's frame loop does each
+/// A seeded random visit to the kiosk without its window: what app/kiosk/src/kiosk_app.cpp's frame loop does each
 /// frame (polls, the flow's tick, the handle watched for motion and sliding contact, the audio mix pulled as a
 /// sound card would), the servo core stepped on its simulated pantograph (runtime_ticks.hpp), and around it,
 /// drawn from one seed: every visitor key (the sentence and paragraph keys too), bursts of keys in one frame,
@@ -24,8 +24,8 @@
 #include <vector>
 
 #include "config/settings.hpp"
-#include "kiosk_flow.hpp"
-#include "kiosk_runtime.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
 #include "runtime_ticks.hpp"
 
 namespace hk::test {

@@ -7,7 +7,7 @@
 #include <functional>
 
 #include "haptics/sim_pantograph.hpp"
-#include "kiosk_runtime.hpp"
+#include "visit/kiosk_runtime.hpp"
 
 namespace hk::test {
 
@@ -25,7 +25,7 @@ inline app::RuntimeOptions headless_runtime_options(const std::filesystem::path&
 /// display, write the force), the handle pushed by `hand_force(sim)` [N] (the model hand), then collect().
 /// Requires the runtime's device to be the simulated pantograph.
 inline void runtime_tick(app::KioskRuntime& rt, double dt, const std::function<Vec2(const SimulatedPantograph&)>& hand_force) {
-  auto& sim = dynamic_cast<SimulatedPantograph&>(rt.device());
+  auto& sim = dynamic_cast<SimulatedPantograph&>(rt.devices().device());
   app::ServoCommand cmd;
   rt.core().step(sim.read(), false, cmd);
   rt.core().publish_display();

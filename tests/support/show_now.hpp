@@ -3,7 +3,7 @@
 /// A library picture put on the device before the test goes on: KioskRuntime::show_picture builds off the
 /// window thread, so a test that needs the picture felt waits for the build (finish_picture).
 
-#include "kiosk_runtime.hpp"
+#include "visit/kiosk_runtime.hpp"
 
 namespace hk::test {
 

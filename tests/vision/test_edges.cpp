@@ -12,6 +12,7 @@
 #include "vision/edges.hpp"
 #include "vision/intake.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

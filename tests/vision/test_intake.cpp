@@ -18,6 +18,7 @@
 #include "temp_dir.hpp"
 #include "vision/intake.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

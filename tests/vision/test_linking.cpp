@@ -16,6 +16,7 @@
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

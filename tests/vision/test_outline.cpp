@@ -13,6 +13,7 @@
 
 #include "vision/outline.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

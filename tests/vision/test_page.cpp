@@ -24,6 +24,7 @@
 #include "synthetic_photo.hpp"
 #include "vision/page.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace {
 

@@ -21,6 +21,7 @@
 
 #include "image_pdf.hpp"
 #include "vision/pdf.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {
@@ -426,21 +427,7 @@ TEST(PdfWorker, SpinningWorkerIsStoppedByItsCpuLimit) {
   expect_good_render_still_works();
 }
 
-TEST(PdfWorker, MemoryLimitEndsInADefinedErrorWithoutAddressSanitizer) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "RLIMIT_AS is not set in AddressSanitizer builds (memory is only reported there)";
-#else
-  // 2 MiB on top of what the worker inherits: poppler's Splash returns a 1 x 1 bitmap (TooLarge) or, with a
-  // little more room, crashes on a failed allocation (WorkerCrashed); either way the caller lives on.
-  const auto bytes = read_file(kSpec);
-  PdfLimits limits = generous();
-  limits.worker_max_memory_mb = 2;
-  std::string what;
-  const PdfError::Kind kind = error_kind([&] { render_pdf_page(bytes, "spec", 1, limits); }, &what);
-  EXPECT_TRUE(kind == PdfError::Kind::TooLarge || kind == PdfError::Kind::WorkerCrashed) << what;
-  expect_good_render_still_works();
-#endif
-}
+// The memory limit (RLIMIT_AS, which AddressSanitizer builds do not set): tests/worker_limits.
 
 // ---------------------------------------------------------------------------------------------------
 // group_text_blocks on synthetic words: 10 px wide characters, given line height.

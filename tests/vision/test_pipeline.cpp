@@ -15,6 +15,7 @@
 #include "chain_checks.hpp"
 #include "vision/pipeline.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

@@ -21,6 +21,7 @@
 #include "vision/edges.hpp"
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

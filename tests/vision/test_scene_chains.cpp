@@ -11,6 +11,7 @@
 
 #include "vision/scene_chains.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

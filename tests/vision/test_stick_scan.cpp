@@ -31,6 +31,7 @@
 #include "vision/intake.hpp"
 #include "vision/stick_scan.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

@@ -16,6 +16,7 @@
 #include "vision/pipeline.hpp"
 #include "vision/texture.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

@@ -21,6 +21,7 @@
 #include "vision/linking.hpp"
 #include "vision/thin_lines.hpp"
 #include "hk/error.hpp"
+#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

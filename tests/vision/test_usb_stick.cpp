@@ -31,6 +31,7 @@
 
 #include "vision/stick_scan.hpp"
 #include "vision/usb_stick.hpp"
+#include "test_paths.hpp"
 
 #ifndef ST_NOSYMFOLLOW
 #define ST_NOSYMFOLLOW 0x2000  // linux/statfs.h; glibc 2.36 does not name it

@@ -82,8 +82,8 @@ struct ContactParams {
   double pop_release_s = 0.02;  ///< the force of the tick before a pop fades to zero over this [s]
   double period_s = 0.001;      ///< the servo period the solver is stepped at [s] (counts pop_hold_s and pop_release_s in ticks)
   /// Build the cut masks for walls at cut steps (BoundarySection's `cut_walls`; read at construction);
-  /// without them a cut step renders as its tolerance step. ServoLoop does not read it: it computes the masks
-  /// once for ServoParams::cut_steps and hands them to both its solvers (the constructor that takes CutWalls).
+  /// without them a cut step renders as its tolerance step. SceneStep does not read it: it computes the masks
+  /// once for LevelSteps::Cuts and hands them to both its solvers (the constructor that takes CutWalls).
   bool cut_walls = true;
 };
 

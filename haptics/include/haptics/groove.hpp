@@ -56,7 +56,7 @@ struct GrooveParams {
 /// non-finite r), then clamped to max_force_n [N]. `r_m` in metres. Pure, real-time safe.
 double groove_profile_n(const GrooveParams& p, double r_m) noexcept;
 
-/// The groove solver for one scene: same step interface as ContactSolver, so ServoLoop can step either.
+/// The groove solver for one scene: same step interface as ContactSolver, so SceneStep can step either.
 /// One per servo thread; sized at construction.
 ///
 /// Output of update() (ContactOutput):

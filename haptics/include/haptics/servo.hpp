@@ -11,7 +11,7 @@
 /// between the force of the last tick and the new level's force fades out at max_force_step_n per tick.
 ///
 /// Live gains: stiffness, damping, maximum force and friction may change while a hand
-/// presses on a wall (ServoLoop::set_gains). The solver uses the new gains at once; the difference between
+/// presses on a wall (SceneStep::set_gains). The solver uses the new gains at once; the difference between
 /// the last tick's force and the new gains' force goes into the same fading residual as a level change, and
 /// the guard's clamp walks to the new maximum force at max_force_step_n per tick, so no change of gains
 /// (or of level, or both in one tick) moves the force by more than max_force_step_n per tick beyond what
@@ -98,21 +98,28 @@ struct ServoGains {
   bool operator==(const ServoGains&) const = default;
 };
 
-/// Parameters of the servo loop.
+/// What the level policy chooses from when the level follows the hand's speed (`[haptics] level_mode`:
+/// "auto" → Levels, "tolerance" → Tolerances, "cut" → Cuts; level ids in hk/constants.hpp).
+enum class LevelSteps : std::uint8_t {
+  /// The scene's levels: every curve at the same level.
+  Levels,
+  /// Tolerance steps: each curve renders at the coarsest of its own levels within the tolerance the hand's
+  /// speed allows, under the same crossing checks at changes.
+  Tolerances,
+  /// Cut steps (kCutLevelBase + t): the walls are the tolerance cut at that tolerance, refined per segment
+  /// rather than per curve (tolerance_cut.hpp), under the same crossing checks at changes. The step then
+  /// computes the scene's cut masks (make_cut_walls) once, for both solvers; with the others, none.
+  Cuts,
+};
+
+/// Parameters of the servo step.
 struct ServoParams {
   double period_s = 0.001;          ///< servo period = 1 / servo rate [s]
-  int level = 1;                    ///< resolution level at start, and always when !auto_level
-  bool auto_level = false;          ///< the level follows the hand's speed (LevelPolicy)
-  /// With auto_level: the policy picks a tolerance step instead of a level (level ids,
-  /// hk/constants.hpp), so each curve renders at the coarsest of its own levels within the tolerance the
-  /// hand's speed allows, under the same crossing checks at changes. `level` is then only where it starts:
+  /// Resolution level at start, and always when !auto_level. With Tolerances or Cuts only where it starts:
   /// the coarsest step whose bound is within that level's.
-  bool tolerance_steps = false;
-  /// With auto_level: the policy picks a cut step (kCutLevelBase + t): the walls are the tolerance cut at that
-  /// tolerance, refined per segment rather than per curve (tolerance_cut.hpp), under the same crossing checks
-  /// at changes. Takes precedence over tolerance_steps. `level` is where it starts, as there. The loop then
-  /// computes the scene's cut masks (make_cut_walls) once, for both solvers; without it, none.
-  bool cut_steps = false;
+  int level = 1;
+  bool auto_level = false;          ///< the level follows the hand's speed (LevelPolicy), from `steps`
+  LevelSteps steps = LevelSteps::Levels;  ///< what the policy chooses from (with auto_level)
   LevelPolicyParams policy;         ///< used when auto_level (its fixed_level is ignored: see `auto_level`)
   /// At a level change the force passes from the old level's to the new level's by at most this much per
   /// tick [N] (on top of what the hand's own motion changes), so a coarser or finer wall never kicks.
@@ -146,7 +153,7 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept;
 struct ServoInput {
   DeviceSample sample;         ///< handle position [m] and status
   bool deadline_missed = false;  ///< the caller says this tick is late: the guard sends zero force
-  /// False while the caller fades the force out (ServoCore's picture swap): a press then is not a
+  /// False while the caller fades the force out (ServoStep's picture swap): a press then is not a
   /// deliberate push-through (ContactInput::press_counts). The loop also stops counting during its own ramp.
   bool press_counts = true;
 };
@@ -162,11 +169,12 @@ struct ServoOutput {
   TickResult result = TickResult::Ok;
 };
 
-/// The haptic servo loop state for one scene. Construct at setup; call update() once per tick.
-class ServoLoop {
+/// The servo step for one scene: the guard, the level policy and the contact solver (walls or grooves) of one
+/// scene, advanced by update() once a tick (ruckig-style: state in, force out). Construct at setup.
+class SceneStep {
  public:
   /// `scene` must outlive the loop. Allocates (setup only).
-  ServoLoop(const Scene& scene, const ServoParams& params);
+  SceneStep(const Scene& scene, const ServoParams& params);
   /// Starts (or restarts) at the handle position: proxy placed there, force ramp from zero. Resets the
   /// solver in use (walls: ContactSolver, grooves: GrooveSolver), the walls' push-off charged to the tick's
   /// box-test budget (query_box_budget). Real-time safe: the servo calls it when it takes a picture and
@@ -221,7 +229,7 @@ class ServoLoop {
  private:
   ServoParams params_;
   // The cut masks and bounds (make_cut_walls), computed once and read by both solvers' sections; null unless
-  // params_.cut_steps. Declared before the solvers, which its initializer feeds.
+  // params_.steps == LevelSteps::Cuts. Declared before the solvers, which its initializer feeds.
   std::shared_ptr<const CutWalls> cuts_;
   ContactSolver solver_;
   GrooveSolver groove_;

@@ -1,0 +1,32 @@
+#include "cli/audio_settings.hpp"
+
+#include "visit/kiosk_flow.hpp"
+
+#include "audio/wav.hpp"
+#include "config/load.hpp"
+
+namespace hk::app {
+
+std::string run_speak(const SpeakOptions& o) {
+  const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
+  const audio::MessageCatalog catalog =
+      o.messages_path.empty() ? audio::MessageCatalog::english() : audio::MessageCatalog::load(o.messages_path);
+  std::string text = o.what;
+  const auto keys = key_args(s.keys);  // the keys of the settings, named as the kiosk names them
+  for (int i = 0; i < audio::kMessageCount; ++i) {
+    if (audio::kMessageKeys[static_cast<std::size_t>(i)] == o.what) {
+      // Sample values for the placeholders, so a translator hears a whole sentence.
+      text = catalog.text(static_cast<audio::MessageId>(i), {{"picture", "2"}, {"pictures", "5"}, {"shapes", "7"}, {"level", "3"},
+                                                             {"seconds", "20"}, {"description", "A large closed shape in the middle."}},
+                          keys);
+    }
+  }
+  audio::SpeechParams sp;
+  sp.voice = catalog.voice();
+  sp.rate_wpm = s.audio.speech_rate_wpm;
+  const std::vector<float> samples = audio::synthesize_speech(text, sp);
+  audio::write_wav(o.wav_path, samples, audio::kSampleRateHz);
+  return text;
+}
+
+}  // namespace hk::app

@@ -1,0 +1,387 @@
+// The kiosk: the window (window.hpp), the runtime (kiosk_runtime.hpp), the visitor's flow, the operator's
+// panel and scripted input put together. This file owns the frame loop and the routing of input.
+#include "kiosk/kiosk_app.hpp"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "config/device_profile.hpp"
+#include "config/keys.hpp"
+#include "config/load.hpp"
+#include "config/store.hpp"
+#include "kiosk/frame_stats.hpp"
+#include "kiosk/hud.hpp"
+#include "kiosk/keymap.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "kiosk/operator_panel.hpp"
+#include "visit/operator_session.hpp"
+#include "kiosk/script.hpp"
+#include "kiosk/view.hpp"
+#include "kiosk/window.hpp"
+#include "formats/app_error.hpp"
+
+#ifndef HK_DATA_DIR
+#define HK_DATA_DIR "data"
+#endif
+
+namespace hk::app {
+namespace {
+
+std::int64_t unix_now_s() { return static_cast<std::int64_t>(std::time(nullptr)); }
+
+/// The settings the kiosk starts with: the file, or (when it is corrupt) its .bak or the defaults, said in
+/// the log and kept for the operator's panel.
+struct StartSettings {
+  config::Settings settings;
+  std::string notice;
+};
+
+StartSettings start_settings(const std::string& path) {
+  if (path.empty()) return {};
+  config::LoadedSettings l = config::load_settings_with_fallback(path, unix_now_s());
+  if (!l.notice.empty()) {
+    spdlog::error("settings: {}", l.notice);
+    if (l.from == config::LoadedSettings::From::backup) {
+      // The kiosk runs on the .bak: it becomes the settings file again (the .bak stays as it is), so the PIN
+      // in it opens the panel and the next save has a file to keep as .bak.
+      try {
+        config::SaveOptions so;
+        so.keep_backup = false;
+        config::save_settings_atomic(l.settings, path, so);
+      } catch (const std::exception& e) {
+        spdlog::error("settings: the .bak could not be made the settings file again: {}", e.what());
+      }
+    }
+  }
+  return {l.settings, l.notice};
+}
+
+void check_screenshot_options(const KioskOptions& o) {
+  if (o.screenshot.empty()) return;
+  const std::filesystem::path p(o.screenshot);
+  if (p.extension() != ".png") throw AppError("--screenshot '" + o.screenshot + "': must name a .png file");
+  const auto parent = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(parent)) throw AppError("--screenshot '" + o.screenshot + "': folder '" + parent.string() + "' does not exist");
+  if (o.frames < 1 || o.frames > 100000) throw AppError("--frames " + std::to_string(o.frames) + " is outside [1, 100000]");
+}
+
+/// What --frame-stats measured, said in its file.
+constexpr const char* kScriptedFrames =
+    "scripted run (--screenshot): interval = work + buffer swap + the fixed 16.7 ms pause per frame (under Xvfb the swap is "
+    "Mesa's software GL drawing and copying the frame, tens of ms at 1920 x 1080, not a vsync wait); "
+    "work = frame start to before the swap";
+constexpr const char* kLiveFrames =
+    "live run: interval = frame start to next frame start, paced by the buffer swap (vsync on a monitor; Xvfb has no "
+    "vsync, there the swap's cost paces it); work = frame start to before the swap";
+
+/// Input routing and the frame loop's state: what a key does depends on who has the keyboard.
+class Kiosk final : public ScriptTarget {
+ public:
+  Kiosk(const KioskOptions& o, KioskRuntime& runtime, KioskFlow& flow, OperatorSession& session, OperatorPanel& panel, KioskWindow& window)
+      : o_(o), rt_(runtime), flow_(flow), session_(session), panel_(panel), window_(window) {
+    keys_changed();
+  }
+
+  /// The visitor's keys and the operator's chord, again from the settings in use.
+  void keys_changed() {
+    keys_ = visitor_key_map(rt_.settings().keys);
+    chord_ = config::parse_chord(rt_.settings().operator_.open_chord).value_or(config::KeyChord{true, true, false, false, "O"});
+  }
+
+  /// One event, real or scripted.
+  void input(const InputEvent& e) override {
+    if (session_.captures_keyboard()) {
+      session_.touch(now_s_);
+      if (e.kind == InputEvent::Kind::key && e.action == GLFW_PRESS && e.key == GLFW_KEY_ESCAPE) {
+        session_.close(unix_now_s());
+        return;
+      }
+      window_.to_imgui(e);  // the panel's: typed into its boxes, never a visitor's action
+      return;
+    }
+    const auto it = e.kind == InputEvent::Kind::key ? keys_.find(e.key) : keys_.end();
+    const bool help = it != keys_.end() && it->second == KioskKey::Help;
+    if (e.kind == InputEvent::Kind::mouse_button || (e.kind == InputEvent::Kind::key && e.action == GLFW_RELEASE)) {
+      if (help && e.action == GLFW_RELEASE) flow_.help_held(false);  // learning mode ends
+      if (e.kind == InputEvent::Kind::key && e.key == lone_modifier_) {  // a modifier pressed and let go alone
+        lone_modifier_ = 0;
+        flow_.key(KioskKey::Other, now_s_, key_name_of(e.key));
+      }
+      window_.to_imgui(e);  // buttons and releases always (ImGui must not see a key held for ever)
+      return;
+    }
+    if (e.kind != InputEvent::Kind::key || e.action != GLFW_PRESS) return;
+    if (chord_pressed(chord_, e.key, e.mods)) {
+      lone_modifier_ = 0;
+      session_.chord(now_s_, unix_now_s());
+      return;
+    }
+    // A modifier is half of a chord: answered when it is let go alone, else with its chord.
+    if (is_modifier_key(e.key)) {
+      lone_modifier_ = e.mods == 0 ? e.key : 0;
+      return;
+    }
+    lone_modifier_ = 0;
+    if (e.mods & (GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SUPER)) {  // no visitor key has modifiers: a chord
+      flow_.key(KioskKey::Other, now_s_);  // Ctrl+Q, Alt+F4: "That key does nothing here."
+      return;
+    }
+    if (e.key == GLFW_KEY_ESCAPE && o_.windowed) {
+      window_.request_close();
+      return;
+    }
+    // High contrast and the overlay are the operator's (the panel): O and C are keys like any other here.
+    const KioskKey k = it == keys_.end() ? KioskKey::Other : it->second;
+    note_picture_key(k);
+    flow_.key(k, now_s_, key_name_of(e.key));
+    if (help) flow_.help_held(true);  // held: the next keys are named, not done (learning mode)
+  }
+
+  // ---- ScriptTarget ----
+  void action_key(KioskKey k) override {
+    note_picture_key(k);
+    flow_.key(k, now_s_);
+  }
+  void cursor(Vec2 m) override { rt_.set_cursor(m); }
+  void moved() override { flow_.handle_moved(now_s_); }
+  void stick(const std::string& dir) override { rt_.insert_stick_folder(dir); }
+  void unstick() override { rt_.remove_stick_folder(); }
+  bool busy() override { return rt_.stick_busy() || rt_.text_busy() || rt_.picture_busy() || session_.state() == PanelState::checking; }
+  std::optional<WidgetRect> widget(const std::string& name) override { return panel_.widget(name); }
+
+  /// The mouse stands in for the visitor's hand, but only once it has moved: where the pointer happens to
+  /// rest when the kiosk starts must not drag the handle (and wake the kiosk). Not while the operator's
+  /// panel is open (the operator's pointer is not a visitor's hand).
+  void follow_mouse() {
+    const auto [cx, cy] = window_.cursor();
+    if (!mouse_seen_) {
+      mouse_seen_ = true;
+      mouse_rest_ = {cx, cy};
+    }
+    mouse_moved_ = mouse_moved_ || std::hypot(cx - mouse_rest_.x, cy - mouse_rest_.y) > 2.0;
+    if (!mouse_moved_ || session_.state() == PanelState::open) return;
+    const auto [ww, wh] = window_.window_size();
+    const Vec2 m = make_view(ww, wh, rt_.half()).to_m(cx, cy);
+    rt_.set_cursor({std::clamp(m.x, -rt_.half().x, rt_.half().x), std::clamp(m.y, -rt_.half().y, rt_.half().y)});
+  }
+
+  /// The handle moved noticeably (5 mm) since the last report, or slides along a shape (1 mm in contact since
+  /// the last report): the visitor is there. A handle resting against a wall, or pinned, keeps no visit alive.
+  void watch_handle() {
+    const ServoDisplayState& d = rt_.core().display();
+    if (d.state != ContactState::Free && length(d.handle_m - last_touched_at_) > 0.001) {
+      last_touched_at_ = d.handle_m;
+      flow_.touching(now_s_);
+    }
+    if (!have_baseline_ && d.tick > 0) {  // the first sample from the servo thread: where the handle rests
+      have_baseline_ = true;
+      last_moved_at_ = d.handle_m;
+    }
+    if (have_baseline_ && length(d.handle_m - last_moved_at_) > 0.005) {
+      last_moved_at_ = d.handle_m;
+      flow_.handle_moved(now_s_);
+    }
+  }
+
+  /// Whether a Next or Previous key went to the visitor's flow since the last call (--frame-stats).
+  bool take_picture_key() { return std::exchange(picture_key_, false); }
+
+  double now_s_ = 0;
+
+ private:
+  void note_picture_key(KioskKey k) { picture_key_ = picture_key_ || k == KioskKey::Next || k == KioskKey::Previous; }
+
+  const KioskOptions& o_;
+  KioskRuntime& rt_;
+  KioskFlow& flow_;
+  OperatorSession& session_;
+  OperatorPanel& panel_;
+  KioskWindow& window_;
+  std::map<int, KioskKey> keys_;
+  config::KeyChord chord_;
+  bool mouse_seen_ = false, mouse_moved_ = false;
+  Vec2 mouse_rest_;
+  bool have_baseline_ = false;
+  Vec2 last_moved_at_;
+  Vec2 last_touched_at_;
+  bool picture_key_ = false;
+  int lone_modifier_ = 0;  // a modifier key pressed with no other key down yet (GLFW key code), else 0
+};
+
+/// --show: straight to a picture, past the welcome and the tutorial.
+void show_first(const std::string& path, KioskRuntime& rt, KioskFlow& flow) {
+  int idx = rt.find_picture(path);
+  if (idx < 0) {
+    rt.add_picture_first(path);
+    idx = 0;
+  }
+  flow.key(KioskKey::Other, 0.0);                             // wake: welcome + tutorial
+  for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 0.0);  // through the tutorial to picture 1
+  for (int i = 0; i < idx; ++i) flow.key(KioskKey::Next, 0.0);
+}
+
+/// One line saying what took effect, for the operator's panel.
+std::string describe_apply(const ApplyReport& r) {
+  std::string s = "Applied";
+  if (r.gains) s += "; forces changing now";
+  if (r.scene_rebuilt) s += "; scene rebuilt";
+  if (r.keys) s += "; keys changed";
+  if (r.timing) s += "; session timing changed";
+  if (!r.next_session.empty()) s += "; " + std::to_string(r.next_session.size()) + " for the next visitor";
+  if (!r.restart.empty()) s += "; " + std::to_string(r.restart.size()) + " after a restart";
+  for (const std::string& why : r.refused) s += "; refused: " + why;
+  return s + ".";
+}
+
+/// The runtime's options from the command line and the settings in use.
+RuntimeOptions runtime_options(const KioskOptions& o, const config::Settings& settings) {
+  RuntimeOptions ro;
+  ro.library = o.library.empty() ? std::string(HK_DATA_DIR) + "/pictures" : o.library;
+  ro.hotplug = o.hotplug;
+  ro.mount_root = o.mount_root;
+  ro.high_contrast = o.high_contrast;
+  ro.overlay = o.overlay;
+  // Scripted runs (documentation, tests) never depend on hardware they were not told of: [device] type "auto"
+  // stays simulated there, a type the settings name ("haply") is looked for as at the kiosk.
+  ro.probe_usb_device = o.screenshot.empty() || config::is_usb_type(settings.device.type);
+  ro.probe_camera = o.screenshot.empty();
+  ro.device = o.device;
+  // Scripted runs (documentation, tests) build every scene afresh and leave no cache behind.
+  ro.scene_cache_dir = o.screenshot.empty() ? scene_cache_dir(settings) : std::string{};
+  return ro;
+}
+
+/// The visitor's flow's timing and keys from the settings in use; `camera`: whether a camera was found.
+KioskFlowParams flow_params(const config::Settings& settings, bool camera) {
+  KioskFlowParams fp;
+  fp.timeout_s = settings.kiosk.timeout_s;
+  fp.warning_s = settings.kiosk.warning_s;
+  fp.attract_every_s = settings.kiosk.attract_every_s;
+  fp.keys = settings.keys;
+  fp.camera = camera;
+  return fp;
+}
+
+/// Starts the servo thread, says which device and camera are in use, and takes --stick and --show.
+void start_kiosk(const KioskOptions& o, const RuntimeOptions& ro, KioskRuntime& rt, KioskFlow& flow) {
+  rt.start_servo();
+  if (ro.probe_usb_device || !ro.device.empty()) rt.announce_device();
+  rt.announce_camera();
+  if (!o.stick.empty()) rt.insert_stick_folder(o.stick);
+  if (!o.show.empty()) show_first(o.show, rt, flow);
+}
+
+/// One frame's input and time: events (real, then the script's step), sticks, capture, text, device, mouse,
+/// handle, tour, display modes, the flow and the operator's session. Returns whether the script holds this
+/// frame (waiting for the runtime).
+bool update_frame(Kiosk& kiosk, KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, KioskWindow& window,
+                  ScriptPlayer& script, bool scripted, int frame) {
+  for (const InputEvent& e : window.poll()) kiosk.input(e);
+  rt.poll_pictures(&flow, kiosk.now_s_);
+  rt.poll_sticks(flow, kiosk.now_s_);
+  rt.poll_capture(flow, kiosk.now_s_);
+  rt.poll_text(kiosk.now_s_);
+  rt.poll_device(kiosk.now_s_);
+  // A scripted run's clock is its frame count: it holds while a picture asked for is being built, so the
+  // same script shows the same frames however fast the machine builds.
+  const bool holding = scripted && (rt.picture_busy() || script.step(frame, kiosk));
+  if (!scripted) kiosk.follow_mouse();
+  kiosk.watch_handle();
+  rt.poll_tour();
+  rt.poll_display_modes();
+  flow.tick(kiosk.now_s_);
+  session.tick(kiosk.now_s_, unix_now_s());
+  rt.collect();
+  return holding;
+}
+
+/// The frame's drawing, not yet shown: the scene, the camera preview while capturing, then (ImGui) the
+/// captions, the overlay's status and the operator's panel.
+void draw_frame(KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, OperatorPanel& panel, KioskWindow& window,
+                const ScriptPlayer& script, bool scripted, double now_s, PictureTexture& texture, CapturePreviewView& preview) {
+  const auto [fw, fh] = window.framebuffer_size();
+  texture.update(rt.shown());
+  draw_scene(rt, make_view(fw, fh, rt.half()), texture);
+  if (flow.capturing()) preview.draw(rt.capture_preview(), make_view(fw, fh, rt.half()), rt.half());
+  window.begin_frame(scripted ? script.mouse() : std::nullopt);
+  draw_captions(rt, flow, fw, fh);
+  if (rt.overlay() && session.state() != PanelState::open) draw_overlay_status(rt, flow);
+  panel.draw(rt, flow, fw, fh, now_s, unix_now_s());
+  window.end_frame();
+}
+
+}  // namespace
+
+int run_kiosk(const KioskOptions& o) {
+  check_screenshot_options(o);
+  const StartSettings start = start_settings(o.config_path);
+  const std::vector<ScriptLine> script_lines = o.script.empty() ? std::vector<ScriptLine>{} : load_script(o.script);
+
+  const RuntimeOptions ro = runtime_options(o, start.settings);
+  KioskRuntime rt(ro, start.settings);
+  KioskFlow flow(rt, rt.audio().messages(), flow_params(start.settings, rt.has_camera()));
+
+  KioskWindow window(o.windowed);
+  const int picture_side = [&] {
+    const auto [fw, fh] = window.framebuffer_size();
+    return picture_side_px(make_view(fw, fh, rt.half()), rt.half());
+  }();
+  rt.set_screen_picture_side_px(picture_side);
+  Kiosk* kiosk_ptr = nullptr;
+  OperatorSession session(o.config_path, start.settings, start.notice, [&](const config::Settings& s) {
+    const ApplyReport r = rt.apply_settings(s, flow);
+    if (kiosk_ptr) kiosk_ptr->keys_changed();  // the visitor's keys, and the operator's chord
+    return describe_apply(r);
+  });
+  OperatorPanel panel(session);
+  Kiosk kiosk(o, rt, flow, session, panel, window);
+  kiosk_ptr = &kiosk;
+  ScriptPlayer script(script_lines, o.script);
+  start_kiosk(o, ro, rt, flow);
+
+  PictureTexture texture(picture_side);
+  CapturePreviewView preview;
+  const bool scripted = !o.screenshot.empty();
+  // Allocated once, here: recording a frame never allocates (frame_stats.hpp).
+  const auto stats = o.frame_stats.empty() ? nullptr : std::make_unique<FrameStats>();
+  const auto t0 = std::chrono::steady_clock::now();
+  int frame = 0;
+  while (!window.should_close()) {
+    if (stats) stats->frame_started(std::chrono::steady_clock::now());
+    const Scene* const scene_at_start = rt.shown().scene;
+    const int id_at_start = rt.shown_id();
+    kiosk.now_s_ = scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const bool holding = update_frame(kiosk, rt, flow, session, window, script, scripted, frame);
+    if (kiosk.take_picture_key() && stats) stats->picture_key(scene_at_start, id_at_start);
+    draw_frame(rt, flow, session, panel, window, script, scripted, kiosk.now_s_, texture, preview);
+    if (stats) stats->frame_drawn(std::chrono::steady_clock::now(), rt.shown().scene, rt.shown_id());
+    if (!holding) ++frame;
+    if (scripted && frame >= o.frames) {
+      if (!cv::imwrite(o.screenshot, window.read_pixels())) throw AppError("--screenshot '" + o.screenshot + "': cannot write the PNG");
+      break;
+    }
+    window.swap();
+    if (scripted) std::this_thread::sleep_for(std::chrono::microseconds(16667));  // 60 Hz of servo time per frame
+  }
+  rt.stop_servo();
+  if (stats) {
+    write_frame_stats(*stats, o.frame_stats, scripted ? kScriptedFrames : kLiveFrames);
+    spdlog::info("{} -> {}", stats->log_line(), o.frame_stats);
+  }
+  return 0;
+}
+
+}  // namespace hk::app

@@ -1,0 +1,323 @@
+#include "kiosk/operator_panel.hpp"
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "haptics/level_policy.hpp"
+
+#include "config/device_profile.hpp"
+#include "config/load.hpp"
+#include "runtime/device_setup.hpp"
+
+namespace hk::app {
+namespace {
+
+const ImVec4 kRed{1.0f, 0.45f, 0.4f, 1.0f};
+const ImVec4 kOrange{1.0f, 0.75f, 0.3f, 1.0f};
+const ImVec4 kGrey{0.7f, 0.7f, 0.72f, 1.0f};
+const ImVec4 kGreen{0.5f, 0.95f, 0.55f, 1.0f};
+
+const char* apply_text(config::ApplyWhen a) {
+  switch (a) {
+    case config::ApplyWhen::live: return "at once";
+    case config::ApplyWhen::scene: return "rebuilds the scene";
+    case config::ApplyWhen::session: return "next visitor";
+    case config::ApplyWhen::restart: return "after a restart";
+  }
+  return "";
+}
+
+
+constexpr config::FieldGroup kTabs[] = {config::FieldGroup::haptics, config::FieldGroup::levels, config::FieldGroup::scene,
+                                        config::FieldGroup::audio,   config::FieldGroup::kiosk,  config::FieldGroup::keys,
+                                        config::FieldGroup::devices};
+
+}  // namespace
+
+void OperatorPanel::record(const std::string& name) {
+  const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+  drawing_[name] = WidgetRect{a.x, a.y, b.x, b.y};
+}
+
+std::optional<WidgetRect> OperatorPanel::widget(const std::string& name) const {
+  const auto it = widgets_.find(name);
+  if (it == widgets_.end()) return std::nullopt;
+  return it->second;
+}
+
+void OperatorPanel::draw(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double now_s, std::int64_t now_unix_s) {
+  drawing_.clear();
+  sample_plot(runtime);
+  switch (s_.state()) {
+    case PanelState::closed: std::fill(pin_.begin(), pin_.end(), '\0'); pin_.clear(); break;
+    case PanelState::notice: draw_notice(fw, fh); break;
+    case PanelState::pin_entry:
+    case PanelState::checking: draw_pin_prompt(fw, fh, now_s, now_unix_s); break;
+    case PanelState::open: draw_panel(runtime, flow, fw, fh, now_s, now_unix_s); break;
+  }
+  widgets_.swap(drawing_);
+}
+
+void OperatorPanel::draw_notice(int fw, int fh) {
+  ImGui::SetNextWindowPos(ImVec2(0.5f * fw, 0.3f * fh), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowSize(ImVec2(0.6f * fw, 0));
+  ImGui::Begin("Operator", nullptr, ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
+  ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
+  ImGui::TextWrapped("%s", s_.message().c_str());
+  ImGui::PopStyleColor();
+  ImGui::End();
+}
+
+void OperatorPanel::draw_pin_prompt(int fw, int fh, double now_s, std::int64_t now_unix_s) {
+  ImGui::SetNextWindowPos(ImVec2(0.5f * fw, 0.3f * fh), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowSize(ImVec2(std::min(0.6f * fw, 560.0f), 0));
+  ImGui::Begin("Operator PIN", nullptr, ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
+  if (ImGui::IsWindowAppearing()) focus_pin_ = true;
+  ImGui::TextWrapped("%s", s_.message().c_str());
+  const bool can_type = s_.state() == PanelState::pin_entry && s_.wait_s() <= 0;
+  if (!can_type) ImGui::BeginDisabled();
+  if (focus_pin_ && can_type) {
+    ImGui::SetKeyboardFocusHere();
+    focus_pin_ = false;
+  }
+  ImGui::SetNextItemWidth(-1);
+  bool enter = ImGui::InputText("##pin", &pin_, ImGuiInputTextFlags_Password | ImGuiInputTextFlags_CharsDecimal | ImGuiInputTextFlags_EnterReturnsTrue);
+  record("pin");
+  if (pin_.size() > static_cast<std::size_t>(12)) pin_.resize(12);
+  enter = ImGui::Button("OK") || enter;
+  record("OK");
+  if (!can_type) ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (ImGui::Button("Cancel")) {
+    std::fill(pin_.begin(), pin_.end(), '\0');
+    pin_.clear();
+    s_.close(now_unix_s);
+  }
+  record("Cancel");
+  if (enter && can_type) {
+    s_.submit_pin(std::move(pin_), now_s, now_unix_s);
+    pin_.clear();
+    focus_pin_ = true;  // ready for another try
+  }
+  ImGui::End();
+}
+
+void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double, std::int64_t now_unix_s) {
+  ImGui::SetNextWindowPos(ImVec2(0.04f * fw, 0.04f * fh));
+  ImGui::SetNextWindowSize(ImVec2(0.92f * fw, 0.8f * fh));
+  ImGui::SetNextWindowBgAlpha(0.96f);  // the picture must not show through the settings
+  ImGui::Begin("Operator panel", nullptr, ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
+  if (!s_.load_notice().empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
+    ImGui::TextWrapped("Settings file: %s", s_.load_notice().c_str());
+    ImGui::PopStyleColor();
+  }
+  ImGui::TextColored(kGrey, "%s   audit: %s", s_.settings_path().c_str(), s_.audit_path().c_str());
+  const float actions_h = ImGui::GetFrameHeightWithSpacing() * 2.2f;
+  ImGui::BeginChild("tabs", ImVec2(0, -actions_h));
+  if (ImGui::BeginTabBar("groups")) {
+    if (ImGui::BeginTabItem("Status")) {
+      draw_status(runtime, flow, now_unix_s);
+      ImGui::EndTabItem();
+    }
+    record("tab:Status");
+    for (config::FieldGroup g : kTabs) {
+      const std::string name(config::group_name(g));
+      const bool open = ImGui::BeginTabItem(name.c_str());
+      record("tab:" + name);
+      if (open) {
+        draw_fields(g, runtime.profile_type(), now_unix_s);
+        ImGui::EndTabItem();
+      }
+    }
+    ImGui::EndTabBar();
+  }
+  ImGui::EndChild();
+  draw_actions(now_unix_s);
+  ImGui::End();
+}
+
+void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& profile_type, std::int64_t now_unix_s) {
+  if (!ImGui::BeginTable("fields", 4, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_SizingStretchProp)) return;
+  ImGui::TableSetupColumn("setting", ImGuiTableColumnFlags_WidthStretch, 1.3f);
+  ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch, 1.0f);
+  ImGui::TableSetupColumn("allowed", ImGuiTableColumnFlags_WidthStretch, 1.0f);
+  ImGui::TableSetupColumn("takes effect", ImGuiTableColumnFlags_WidthStretch, 0.6f);
+  ImGui::TableHeadersRow();
+  for (const config::FieldDescriptor& d : config::field_descriptors()) {
+    if (d.group != group) continue;
+    const std::string key = std::string(d.table) + "." + std::string(d.key);
+    ImGui::TableNextRow();
+    ImGui::TableNextColumn();
+    ImGui::TextUnformatted(key.c_str());
+    ImGui::PushStyleColor(ImGuiCol_Text, kGrey);
+    ImGui::TextWrapped("%.*s", static_cast<int>(d.help.size()), d.help.data());
+    ImGui::PopStyleColor();
+    ImGui::TableNextColumn();
+    ImGui::SetNextItemWidth(-1);
+    ImGui::PushID(key.c_str());
+    const bool enter = ImGui::InputText("##v", &s_.edit_text(d), ImGuiInputTextFlags_AutoSelectAll | ImGuiInputTextFlags_EnterReturnsTrue);
+    record(key);
+    if (enter || ImGui::IsItemDeactivatedAfterEdit()) s_.commit_field(d, now_unix_s);
+    if (!s_.field_error(d).empty()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, kRed);
+      ImGui::TextWrapped("%s", s_.field_error(d).c_str());
+      ImGui::PopStyleColor();
+    }
+    ImGui::PopID();
+    ImGui::TableNextColumn();
+    if (d.kind == config::FieldKind::text && !d.choices.empty() && d.choices.size() > 6) {
+      ImGui::TextWrapped("a key name (F1, A, UP, PAGE_UP, KP_5, ...)");
+    } else if (d.kind == config::FieldKind::text && d.check) {
+      ImGui::TextWrapped("text");
+    } else {
+      ImGui::TextWrapped("%s", config::field_allowed_text(d).c_str());
+      const std::string limit = config::profile_limit_text(s_.working(), profile_type, d.table, d.key);
+      if (!limit.empty()) {
+        ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
+        ImGui::TextWrapped("%s", limit.c_str());
+        ImGui::PopStyleColor();
+      }
+    }
+    ImGui::TableNextColumn();
+    ImGui::TextUnformatted(apply_text(d.apply));
+  }
+  ImGui::EndTable();
+}
+
+void OperatorPanel::draw_actions(std::int64_t now_unix_s) {
+  if (s_.dirty()) {
+    ImGui::TextColored(kOrange, "Changed in the panel, not applied yet.");
+  } else if (s_.unsaved()) {
+    ImGui::TextColored(kOrange, "Applied, not saved: the kiosk goes back to the file's settings when it restarts.");
+  } else {
+    ImGui::TextColored(kGreen, "%s", s_.status().empty() ? "In use and saved." : s_.status().c_str());
+  }
+  if (!s_.status().empty() && (s_.dirty() || s_.unsaved())) {
+    ImGui::SameLine();
+    ImGui::TextColored(kGrey, "%s", s_.status().c_str());
+  }
+  if (ImGui::Button("Apply")) s_.apply(now_unix_s);
+  record("Apply");
+  ImGui::SameLine();
+  if (ImGui::Button("Save")) s_.save(now_unix_s);
+  record("Save");
+  ImGui::SameLine();
+  if (ImGui::Button("Reset to defaults")) ImGui::OpenPopup("Reset to defaults?");
+  record("Reset to defaults");
+  ImGui::SameLine();
+  if (ImGui::Button("Close")) s_.close(now_unix_s);
+  record("Close");
+  if (ImGui::BeginPopupModal("Reset to defaults?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::TextUnformatted("Every setting in the panel goes back to its default (the PIN stays).\nNothing changes in the kiosk until Apply.");
+    if (ImGui::Button("Reset")) {
+      s_.reset_to_defaults(now_unix_s);
+      ImGui::CloseCurrentPopup();
+    }
+    record("Reset");
+    ImGui::SameLine();
+    if (ImGui::Button("Keep")) ImGui::CloseCurrentPopup();
+    record("Keep");
+    ImGui::EndPopup();
+  }
+}
+
+void OperatorPanel::sample_plot(KioskRuntime& runtime) {
+  const ServoDisplayState& d = runtime.core().display();
+  const bool touching = d.state != ContactState::Free;
+  force_n_[static_cast<std::size_t>(plot_at_)] = static_cast<float>(length(d.force_n));
+  penetration_mm_[static_cast<std::size_t>(plot_at_)] = touching ? static_cast<float>(1000.0 * length(d.handle_m - d.proxy_m)) : 0.0f;
+  plot_at_ = (plot_at_ + 1) % kPlotSamples;
+}
+
+void OperatorPanel::draw_stick_problems(const KioskRuntime& runtime) {
+  const std::vector<std::string>& problems = runtime.stick_problems();
+  if (problems.empty()) return;
+  const std::string title = "The last stick: " + std::to_string(problems.size()) + (problems.size() == 1 ? " file" : " files") +
+                            " left out (" + (problems.size() >= KioskRuntime::kStickProblems ? "the first ones; " : "") + "all in the log)";
+  if (ImGui::TreeNode("stick_problems", "%s", title.c_str())) {
+    for (const std::string& p : problems) ImGui::BulletText("%s", p.c_str());
+    ImGui::TreePop();
+  }
+  record("stick_problems");
+}
+
+void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) {
+  const ServoDisplayState& d = runtime.core().display();
+  io::HaplyDevice* usb = runtime.devices().usb();
+  if (!usb) {
+    ImGui::Text("Device: simulated pantograph%s%s", runtime.devices().note().empty() ? "" : " (no USB pantograph: ",
+                runtime.devices().note().empty() ? "" : (runtime.devices().note() + ")").c_str());
+    return;
+  }
+  const io::HaplyCounters c = usb->counters();
+  ImGui::Text("Device: %s, %s; replies missing %lld, refused %lld, reconnects %lld", usb->name().c_str(), device_status_name(d.device_status),
+              static_cast<long long>(c.replies_missing), static_cast<long long>(c.malformed), static_cast<long long>(c.reconnects));
+  if (d.device_status != DeviceStatus::Ok) {
+    ImGui::SameLine();
+    ImGui::TextColored(kOrange, "(no force while it does not answer)");
+  }
+  const double can_n = io::min_force_capability_n(usb->params());
+  ImGui::Text("%s profile: it gives at least %.2f N in every direction everywhere in its rectangle.",
+              std::string(config::device_profile(runtime.profile_type()).name).c_str(), can_n);
+  if (!runtime.devices().home_note().empty()) ImGui::TextColored(kOrange, "%s", runtime.devices().home_note().c_str());
+  if (ImGui::Button("Calibrate: the handle rests at the park place")) {
+    double o1 = 0, o2 = 0;
+    std::string why;
+    if (runtime.devices().calibrate(&o1, &o2, &why)) {
+      char text[32];
+      for (const auto& [key, value] : {std::pair{"encoder1_offset_deg", o1}, std::pair{"encoder2_offset_deg", o2}}) {
+        if (const config::FieldDescriptor* f = config::find_field("device", key)) {
+          std::snprintf(text, sizeof text, "%.3f", value);
+          s_.edit_text(*f) = text;
+          s_.commit_field(*f, now_unix_s);
+        }
+      }
+      char note[160];
+      std::snprintf(note, sizeof note, "Calibrated: encoder offsets %.3f and %.3f deg, in force now; Save keeps them.", o1, o2);
+      calibrate_note_ = note;
+    } else {
+      calibrate_note_ = "Not calibrated: " + why + ".";
+    }
+  }
+  record("button:Calibrate");
+  if (!calibrate_note_.empty()) ImGui::TextWrapped("%s", calibrate_note_.c_str());
+}
+
+void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, std::int64_t now_unix_s) {
+  const config::Settings& s = runtime.settings();
+  const ServoDisplayState& d = runtime.core().display();
+  ImGui::Text("Visitor: %s, picture %d, %s%s", state_name(flow.state()), flow.picture() + 1, level_label(d.level).c_str(), d.auto_level ? " (from hand speed)" : " (fixed)");
+  if (ServoThread* st = runtime.devices().servo()) {
+    const ServoTimingStats t = st->stats();
+    ImGui::Text("Servo: %.0f Hz, %s; lateness p50 %.0f, p99 %.0f, max %.0f us; missed deadlines %lld", s.haptics.servo_rate_hz,
+                st->realtime() ? "real-time (SCHED_FIFO)" : "normal priority", t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us,
+                static_cast<long long>(t.missed_deadlines));
+    if (t.missed_deadlines > 0) {
+      ImGui::SameLine();
+      ImGui::TextColored(kOrange, "(each one zeroed the force for a tick)");
+    }
+  }
+  draw_device(runtime, now_unix_s);
+  ImGui::Text("Walls: stiffness %.0f N/m, max force %.2f N", s.haptics.stiffness_n_per_m, s.haptics.max_force_n);
+  audio::AudioSystem& a = runtime.audio();
+  ImGui::Text("Sound: %s; speech %s; volume %d/10; cues dropped %llu", a.sound_output() ? "playing" : "no sound device",
+              a.speech_available() ? "on" : "unavailable", a.volume().step(), static_cast<unsigned long long>(a.cues_dropped()));
+  ImGui::Text("USB sticks: %s%s%s", runtime.sticks().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
+              flow.source() == KioskSource::Stick ? "; a stick is being browsed" : "", runtime.stick_busy() ? "; working" : "");
+  record(runtime.stick_busy() ? "sticks:working" : "sticks:idle");
+  draw_stick_problems(runtime);
+  ImGui::Checkbox("Show the collision tree's boxes and the boundary section on screen", &runtime.overlay());
+  ImGui::Checkbox("High contrast", &runtime.high_contrast());
+  ImGui::Separator();
+  const float w = ImGui::GetContentRegionAvail().x;
+  ImGui::Text("Force on the handle [N], last 5 s (now %.2f N)", length(d.force_n));
+  ImGui::PlotLines("##force", force_n_.data(), kPlotSamples, plot_at_, nullptr, 0.0f, static_cast<float>(std::max(0.5, s.haptics.max_force_n)), ImVec2(w, 90));
+  ImGui::Text("Penetration into the wall [mm] (now %.2f mm)", d.state != ContactState::Free ? 1000.0 * length(d.handle_m - d.proxy_m) : 0.0);
+  ImGui::PlotLines("##penetration", penetration_mm_.data(), kPlotSamples, plot_at_, nullptr, 0.0f, FLT_MAX, ImVec2(w, 90));
+}
+
+}  // namespace hk::app

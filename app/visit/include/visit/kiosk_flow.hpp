@@ -1,0 +1,400 @@
+#pragma once
+/// @file kiosk_flow.hpp
+/// What a visitor walks through, as a state machine apart from windows and devices so it can be driven by
+/// scripted input in tests:
+///   Attract   — waiting; a short spoken invitation every attract_every_s (not in quiet hours); the first key
+///               press or handle motion speaks a short welcome (≤ 8 s) and puts the tutorial's square on the
+///               device;
+///   Tutorial  — a square, a circle, a triangle (Next moves on); after the triangle, the first picture. It
+///               teaches the keys a visitor needs: the welcome names the key that moves on; touching the
+///               square, that a wall can be pushed through; the circle, Where (whose answer on a practice
+///               shape says what far and near mean); the triangle, Guide; the first picture, Describe and
+///               Repeat. Finer and Coarser on a practice shape say why they do nothing there;
+///   Picture   — Next / Previous picture, Describe, Where ("what is here"), Finer / Coarser level, Volume,
+///               Repeat, Pause, Help, Tutorial again, Guide (the guided tour), Capture, Finish.
+///
+/// The visitor is in charge (ADA §707, EN 301 549 §5, the EZ Access conventions):
+/// - every key press is answered in speech at once, cutting off what was being said, but Volume, which never
+///   cuts speech (while something is said the speech itself gets louder or quieter: that is the answer);
+/// - Repeat says the last thing said again from its start (acknowledgements such as "Louder." are passed
+///   over); Pause holds the speech where it is and, pressed again, goes on;
+/// - Help comes in two layers: one sentence for where the visitor is and the two most useful keys, then, on
+///   the same key again, every key; a key that does nothing says its own name and that it does nothing;
+///   holding Help while pressing a key names that key and what it does, without doing it (learning mode);
+/// - no time pressure: speech in progress (not paused), sliding along a shape, keys and handle motion all
+///   count as activity, so the time-out never cuts a text being read; with none of them for timeout_s the
+///   kiosk warns warning_s ahead (naming how to get more time: any key, and what will be lost), warns again
+///   kRewarn_s later, then says goodbye, restores the operator's defaults and returns to Attract; Finish does
+///   the same, once pressed twice within kFinishConfirm_s (the first press only asks: one press by accident
+///   loses nothing);
+/// - nothing a visitor does ends the kiosk: each key press, handle motion, time step, stick and capture event
+///   runs under one guard that, on an exception, restores the flow's state as it was before, logs the
+///   failure and says one short sorry line.
+///
+/// USB sticks: a stick inserted (stick_inserted) makes Next / Previous walk its documents and their pages
+/// instead of the picture library. Its first page is loaded at once and announced after a summary of the
+/// stick ("A USB stick with 3 documents: 2 pictures and a PDF of 12 pages. Press the Right arrow ...").
+/// Documents load asynchronously (KioskEffects::show_document; the window layer reports back with
+/// document_ready), so slow work never blocks; "Loading." is said when a load takes longer than
+/// loading_cue_s. A page that cannot be read is reported and the picture felt before stays. Library pictures
+/// that are not at hand are built the same way (show_picture answers kPicturePending; picture_ready follows),
+/// with the same "Loading." cue and the picture felt before kept until the new one is on the device. Removing the
+/// stick goes back to the library picture; a new session forgets the stick.
+///
+/// The camera: the Capture key starts a capture (KioskEffects::start_capture) guided by voice (capture_advice,
+/// each advice said as it comes, cutting off the one before); any key cancels it; when the picture is taken
+/// (capture_done) the Shutter earcon has sounded and the flow says "Captured. It has N shapes." and stays on it
+/// (Next and Previous go on in the library). A failure or a time-out is said. Without a camera the key says so,
+/// and the help names the key only when there is a camera (KioskFlowParams::camera).
+///
+/// Keys: what the kiosk says names the keys that work. Every message is said with its key placeholders
+/// ({help_key}, {next_key}, …) filled from the [keys] settings (KioskFlowParams::keys, changed live with
+/// set_keys()), as the catalogue's spoken form of each key ("Press the Up arrow for more detail.").
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "audio/messages.hpp"
+#include "formats/picture_notes.hpp"
+#include "pictures/picture_library.hpp"
+#include "visit/read_aloud.hpp"
+#include "config/settings.hpp"
+
+namespace hk::app {
+
+/// Keys a blind visitor can find (mapped to physical keys in the config by the window layer), in the order of
+/// config::key_actions (Help .. Finish); Other is any key that is none of them.
+enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Guide, Capture,
+                      Repeat, Pause, Where, Finish, NextSentence, PreviousSentence, NextParagraph, PreviousParagraph,
+                      Other };
+
+/// States of the flow.
+enum class KioskState { Attract, Tutorial, Picture };
+
+/// The state's name for the operator's screens: "attract", "tutorial", "picture".
+const char* state_name(KioskState s);
+
+
+/// A document of a USB stick as the flow sees it.
+struct StickEntry {
+  std::string name;   ///< file name made safe for speech
+  bool pdf = false;   ///< a PDF (pages) or a picture
+  int pages = 1;      ///< pages offered (1 for a picture)
+  std::string title;  ///< the document's own title (ListedDocument::title), spoken in place of `name`; "" when none
+  int pages_in_file = 0;  ///< pages the document has (more than `pages` when capped); 0: the same as `pages`
+};
+
+/// A document's name as it is spoken: a file name without its extension, underscores and dashes read as
+/// spaces, and at most kSpokenNameBytes bytes (cut at a word, UTF-8 whole) so that a 254-byte name is not
+/// read out in full. A title is only cut.
+std::string spoken_name(const std::string& name, bool file_name);
+inline constexpr std::size_t kSpokenNameBytes = 60;
+
+/// The text of the page shown, for reading by sentence and paragraph (read_aloud.hpp).
+struct PageText {
+  std::vector<std::string> paragraphs;  ///< its blocks of text in reading order; empty: no text
+  int at_hand = -1;                     ///< the paragraph under the hand, −1 when none is
+};
+
+/// Where Next and Previous go.
+enum class KioskSource { Library, Stick };
+
+/// The outcome of an asynchronous document load (KioskEffects::show_document), reported by the window layer.
+struct DocumentResult {
+  int document = 0;          ///< as requested
+  int page = 1;              ///< as requested (from 1)
+  bool ok = false;           ///< the scene is on the device
+  std::string description;   ///< ok: what the page holds, one sentence ("It has 3 shapes and 2 blocks of text.")
+  std::string reason;        ///< !ok: why it cannot be shown, one line for the log and the operator (the visitor hears that it cannot be read)
+};
+
+/// What the flow asks of the rest of the kiosk. The window layer implements it with the AudioSystem, the
+/// servo core and the picture library; tests record the calls.
+class KioskEffects {
+ public:
+  virtual ~KioskEffects() = default;
+  /// Speak `text` now, cutting off what is being said; Repeat says it again later.
+  virtual void say(const std::string& text) = 0;
+  /// Speak an acknowledgement ("Louder.", a key's name) now, cutting off what is being said; Repeat passes it
+  /// over and says the text before it. Default: say().
+  virtual void say_brief(const std::string& text) { say(text); }
+  /// Say the last text said with say() again, from its start. False when there is none (nothing said).
+  /// Default: nothing to repeat.
+  virtual bool repeat() { return false; }
+  /// Texts said with say() so far (a count that only grows): the flow knows whether what it said last is
+  /// still the last text kept, or something else (a tour's line, a page's text arriving) has been said since.
+  /// Default: 0.
+  virtual std::uint64_t kept_texts() const { return 0; }
+  /// Which piece (audio::speech_pieces, from 0) of the last text said with say() is being heard now; −1 when it
+  /// is over, was cut off by anything said since, or nothing was said. Default: −1.
+  virtual int heard_piece() const { return -1; }
+  /// The text of the page shown, paragraph by paragraph, and which is under the hand. Default: no text.
+  virtual PageText page_text() { return {}; }
+  /// Speech is being heard (not paused). Default: never.
+  virtual bool speaking() const { return false; }
+  /// Hold the speech where it is; false when nothing is being said. Default: nothing is.
+  virtual bool pause_speech() { return false; }
+  /// Go on from a pause; false when speech is not paused. Default: never paused.
+  virtual bool resume_speech() { return false; }
+  /// Whether now is within the operator's quiet hours ([kiosk] quiet_hours): no spoken invitation. Default: no.
+  virtual bool quiet_hours() const { return false; }
+  /// Put a tutorial shape on the device.
+  virtual void show_tutorial(TutorialShape shape) = 0;
+  /// show_picture's answer while the picture is still being built: the picture felt before stays, and
+  /// KioskFlow::picture_ready (or picture_failed) follows.
+  static constexpr int kPicturePending = -1;
+  /// Put picture `index` (0-based) on the device. Returns its number of shapes when it is on the device now
+  /// (built ahead, or quick), else kPicturePending: it is built off the window thread, and the window layer
+  /// calls KioskFlow::picture_ready or picture_failed when it is done. A newer request supersedes an older one.
+  virtual int show_picture(int index) = 0;
+  /// Pictures in the library (≥ 1).
+  virtual int picture_count() const = 0;
+  /// The title and description a person wrote for the picture shown (picture_notes.hpp); empty when none.
+  virtual PictureNotes shown_notes() const { return {}; }
+  /// A spoken description of what is shown, starting from where the hand is (describe.hpp).
+  virtual std::string describe() = 0;
+  /// "What is here": the shape or block of text under or nearest the hand and where the hand is, one or two
+  /// sentences (describe.hpp, where_message). Default: nothing to say ("").
+  virtual std::string where() { return {}; }
+  /// Level one finer (delta −1) or coarser (+1). Returns false at the limit (nothing changes). A change turns
+  /// the level from hand speed off for the picture shown (it comes back with another picture).
+  virtual bool change_level(int delta) = 0;
+  /// Whether the level is chosen from hand speed now (Finer and Coarser then say, once, that they turn it
+  /// off). Default: false.
+  virtual bool auto_level() const { return false; }
+  /// Volume one step up (+1) or down (−1). Returns false at the limit.
+  virtual bool change_volume(int delta) = 0;
+  /// A new visitor: the operator's default settings (volume, level), speech stopped and forgotten.
+  virtual void new_session() = 0;
+  /// Start loading page `page` (from 1) of stick document `document` (0-based) off the window thread; when
+  /// done, the window layer calls KioskFlow::document_ready. A newer request supersedes an older one.
+  virtual void show_document(int document, int page) = 0;
+  /// Drop the stick's listing (a new visitor must not browse the last one's stick).
+  virtual void forget_stick() = 0;
+  /// Any key that acts was pressed (before the flow acts on it): a guided tour that runs, or is about to,
+  /// stops. Not called for Volume, nor for a key named in learning mode. Default: nothing.
+  virtual void key_pressed() {}
+  /// The Capture key: start a guided camera capture off the window thread; the window layer then reports
+  /// with KioskFlow::capture_advice / capture_done / capture_failed. False when there is no camera (nothing
+  /// starts). Default: no camera.
+  virtual bool start_capture() { return false; }
+  /// Stop the capture under way (a key was pressed or the session ended); no report follows. Default: nothing.
+  virtual void cancel_capture() {}
+  /// The Guide key: say that the hand will be guided, then lead the handle to the nearest shape not yet
+  /// touched and round it, or, when the press stopped a running tour (key_pressed), say so. What is said is
+  /// up to the implementation (the tour's end is reported later). Default: nothing.
+  virtual void guide() {}
+};
+
+/// The key placeholders of the catalogue ({help_key} … {tutorial_key}, audio::kKeyPlaceholders) paired with the
+/// keys of `keys`, for audio::MessageCatalog::text(). The pairs view the strings of `keys`: keep it alive while
+/// they are used. For anything outside the flow that says a message naming keys (e.g. `haptic-kiosk speak`).
+std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings& keys);
+/// Not for a temporary: the pairs would view strings already gone.
+std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings&& keys) = delete;
+
+/// Timing of the flow. Units in names.
+struct KioskFlowParams {
+  double timeout_s = 120.0;  ///< no activity (key, motion, contact, speech heard) for this long ends the session
+  double warning_s = 20.0;   ///< the spoken warning comes this long before the end (at most timeout_s / 2)
+  double loading_cue_s = 0.5; ///< "Loading." is said when a document takes longer than this to load
+  double attract_every_s = 30.0;  ///< the spoken invitation in Attract comes this often (0: never)
+  config::KeysSettings keys{};  ///< the key of each action ([keys]), named in what is said; default: the shipped keys
+  bool camera = false;          ///< a camera is there: the help names the Capture key
+};
+
+/// The voice's rate [words per minute] (espeak-ng's default, the kiosk's [audio] default).
+inline constexpr double kWordsPerMinute = 165.0;
+/// How long `text` takes to say at kWordsPerMinute [s]: its words (runs of non-space bytes) counted, not
+/// synthesised, so a text of hours costs a pass over its bytes.
+double spoken_seconds(std::string_view text);
+
+/// The state machine. Not thread-safe: call from the window thread.
+class KioskFlow {
+ public:
+  /// Finish ends the visit only when pressed again within this long of the first press [s].
+  static constexpr double kFinishConfirm_s = 5.0;
+  /// The time-out warning is said again this long after the first, when time is left [s].
+  static constexpr double kRewarn_s = 10.0;
+  /// Every key's help is said this many sentences at a time (Next and Previous step through it).
+  static constexpr std::size_t kHelpSentencesPerGroup = 2;
+  /// Describe says how long a text is before one that takes longer than this to say [s].
+  static constexpr double kLongText_s = 30.0;
+  /// Where reading a page's text stands (the sentence heard last), and whether it is what is being read: the
+  /// last text said is the reading and no other text has been said since.
+  ReadingPlace reading_place() const { return v_.reading.place(); }
+  bool reading() const { return v_.reading_on && !v_.reading.empty() && fx_.kept_texts() == v_.reading_kept; }
+
+  KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params = {});
+
+  /// A key press at time `now_s` [s] (any monotonic clock). `key_name`: the settings' name of the key pressed
+  /// ("Q", "F5"; config/keys.hpp), spoken when `k` is Other (and when learning); empty when unknown.
+  void key(KioskKey k, double now_s, std::string_view key_name = {});
+  /// The Help key is held down (true) or let go (false). While held, a key press names the key and what it
+  /// does without doing it (learning mode).
+  void help_held(bool held) { learning_ = held; }
+  /// The handle moved noticeably (the caller decides, e.g. > 5 mm since the last call) at `now_s`.
+  void handle_moved(double now_s);
+  /// The handle slides along a shape at `now_s` (the visitor is feeling it; the caller reports contact with
+  /// motion, not a handle resting against a wall): activity, but it does not wake the kiosk from Attract.
+  void touching(double now_s);
+  /// Time passes (call every frame): the invitation, speech heard as activity, warnings, the time-out and the
+  /// loading cue.
+  void tick(double now_s);
+  /// A USB stick was inserted and scanned: its documents (may be empty), at `now_s`. Wakes the kiosk.
+  /// `unreadable`: pictures and PDFs on it that cannot be read, said in one line after what it holds ("2 files
+  /// cannot be read."; which and why are in the log and the operator's panel).
+  void stick_inserted(const std::vector<StickEntry>& documents, double now_s, int unreadable = 0);
+  /// A stick was refused (unsupported filesystem, unreadable): `reason` is spoken.
+  void stick_refused(const std::string& reason, double now_s);
+  /// The stick was taken out: back to the library.
+  void stick_removed(double now_s);
+  /// A load asked for with show_document finished (ignored unless it is the one awaited).
+  void document_ready(const DocumentResult& result, double now_s);
+  /// Library picture `index`, asked for with show_picture (which answered kPicturePending), is on the device
+  /// with `shapes` shapes: announced as show_picture's answer would have been. Ignored unless it is the one awaited.
+  void picture_ready(int index, int shapes, double now_s);
+  /// Library picture `index` could not be built (`reason`, one line, logged): that it cannot be read is said, and
+  /// the picture felt before stays.
+  /// Next and Previous go on from `index`. Ignored unless it is the one awaited.
+  void picture_failed(int index, const std::string& reason, double now_s);
+  /// A library picture is awaited (asked for, not yet on the device).
+  bool picture_pending() const { return v_.pending_picture >= 0; }
+  /// The capture under way says `advice` (one of the capture_* messages, capture.hpp advice_message). Counts as
+  /// activity (the visitor is busy placing the picture). Ignored when no capture is under way.
+  void capture_advice(audio::MessageId advice, double now_s);
+  /// The capture under way took its picture and put it on the device with `shapes` shapes: said, and the
+  /// flow is on that picture. Ignored when no capture is under way.
+  void capture_done(int shapes, double now_s);
+  /// The capture under way ended without a picture: the camera failed (timeout = false) or the picture never
+  /// lay still long enough (timeout = true). Said; the picture felt before stays.
+  void capture_failed(bool timeout, double now_s);
+  /// A capture is under way.
+  bool capturing() const { return v_.capturing; }
+  /// The operator changed the keys ([keys]): from now on every message names these (the next thing said
+  /// already does). Does not speak and does not touch the session.
+  void set_keys(const config::KeysSettings& keys) { p_.keys = keys; }
+  /// The operator changed the session's timing ([kiosk] timeout_s, warning_s, attract_every_s [s]): counted
+  /// from the last activity, as before. A warning already given stays given.
+  void set_timing(double timeout_s, double warning_s, double attract_every_s);
+  /// The keys named in what is said.
+  const config::KeysSettings& keys() const { return p_.keys; }
+  /// The text of `id` as the flow says it: `args` filled in, and every key placeholder naming the current key.
+  std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) const;
+
+  KioskSource source() const { return v_.source; }
+  int document() const { return v_.doc; }        ///< stick document shown (0-based), −1 before the first
+  /// The stick's documents as the flow lists them (empty without a stick).
+  const std::vector<StickEntry>& stick_documents() const { return v_.stick; }
+  int page() const { return v_.page; }           ///< its page (from 1)
+  bool loading() const { return v_.pending_doc >= 0; }  ///< a document load is awaited
+  /// Whether page `page` of stick document `document` is the load awaited (else a result for it is superseded).
+  bool awaits_document(int document, int page) const {
+    return v_.source == KioskSource::Stick && v_.pending_doc == document && v_.pending_page == page;
+  }
+
+  KioskState state() const { return v_.state; }
+  TutorialShape tutorial_shape() const { return v_.shape; }
+  int picture() const { return v_.picture; }
+  bool warned() const { return v_.warned; }
+  /// Visitor actions that failed and were answered with the sorry line (logged), since the start.
+  int failures() const { return failures_; }
+  /// Whether the visitor is stepping through the help's groups (Next and Previous move within it).
+  bool in_help() const { return v_.help_group >= 0; }
+
+ private:
+  /// Everything the flow knows of the visit, one value, so that a failed action can be undone whole.
+  struct Visit {
+    KioskState state = KioskState::Attract;
+    TutorialShape shape = TutorialShape::Square;
+    int picture = 0;
+    double last_activity_s = 0;
+    double next_invitation_s = 0;   // Attract: when the next spoken invitation is due
+    bool warned = false;
+    double warned_at_s = 0;         // when the first time-out warning was said
+    bool rewarned = false;          // the second warning was said
+    double finish_asked_s = -1;     // Finish pressed once at this time (asks for a second press); −1: not asked
+    int help_layer = 0;             // 1 right after the first layer of help: Help again gives every key
+    int help_group = -1;            // stepping through every key: the group said last (Next / Previous move); −1: not
+    KioskSource source = KioskSource::Library;
+    std::vector<StickEntry> stick;
+    int doc = -1, page = 1;                  // shown
+    int at_doc = -1, at_page = 1;            // where browsing stands: the last page asked for, shown or not
+    int pending_doc = -1, pending_page = 1;  // awaited
+    int pending_picture = -1;                // a library picture awaited
+    std::string pending_before;              // said before its announcement ("Tutorial done.")
+    double pending_since_s = 0;
+    bool loading_said = false;
+    std::string announce_summary;            // the stick's summary, said before the first page's announcement
+    std::string announce_unreadable;         // how many of its files cannot be read, said after the summary
+    bool capturing = false;                  // a camera capture is under way
+    bool captured = false;                   // the picture shown is the visitor's own capture
+    bool felt = false;                       // a shape, picture or page has been put under the hand in this visit
+    bool read_aloud_said = false;            // the visitor was told that their document is heard by people nearby
+    bool push_taught = false;                // the tutorial said that a wall can be pushed through
+    ReadAloud reading;                     // the page's text being read, and where the visitor is in it
+    bool reading_on = false;                 // the reading was said, as the text kept numbered reading_kept
+    std::uint64_t reading_kept = 0;
+  };
+
+  template <class Action>
+  void guarded(const char* what, Action&& action);  // runs action; on an exception: undo, log, sorry
+  void act_on_key(KioskKey k, double now_s, std::string_view key_name);
+  // The bodies of the public entry points of the same names, run under guarded().
+  void stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable);
+  std::string unreadable_line(int unreadable) const;  // "" or the line that counts them, after a space
+  void stick_removed_now(double now_s);
+  void document_ready_now(const DocumentResult& result, double now_s);
+  void capture_done_now(int shapes, double now_s);
+  bool session_key(KioskKey k, double now_s);  // keys that act the same everywhere; true when handled
+  void volume_key(int delta);
+  void finish_key(double now_s);
+  void describe_key();
+  void reading_key(KioskKey k);               // the sentence and paragraph keys
+  void repeat_key();
+  void follow_reading();                      // the place follows the sentence heard
+  /// Reads from `at` to the end of its paragraph, after `before` (said first, in the same text).
+  void read_from(ReadingPlace at, const std::string& before);
+  std::string long_text_line(const std::string& text) const;
+  std::string paragraph_line(int paragraph) const;
+  /// A load was asked for at `now_s`; `awaited`: another was awaited already (see the .cpp).
+  void start_loading_clock(double now_s, bool awaited);  // "Paragraph 2 of 5." on a page of more than one, else ""  // "" or "About 9 minutes of text. …" and a space
+  void level_key(int delta);
+  void warn(double idle_s);
+  void pause_key();
+  void help_key();
+  void learn_key(KioskKey k, std::string_view key_name);
+  void stray_key(std::string_view key_name);
+  void tutorial_key(KioskKey k);
+  void picture_key(KioskKey k);
+  void activity(double now_s);
+  void wake(double now_s);
+  void end_session(double now_s);
+  void start_tutorial();
+  void show(int index, const std::string& before = {});
+  void announce_picture(int shapes, const std::string& before);  // "Picture 2 of 5: ... It has 3 shapes."
+  void say(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
+  void say_brief(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
+  std::vector<std::string> help_groups() const;  // the help's templates, a few sentences each (every key; Capture's with a camera)
+  int help_group_count() const;
+  void say_help_group();  // group v_.help_group, where its keys lie, and how to go on
+  std::string key_place_sentence(std::string_view key_name) const;  // " The W key is ..." or "" (no place in the catalogue)
+  std::string place() const;  // where the visitor is, one sentence (a place_* message)
+  std::string spoken_key(std::string_view key_name) const;  // "The Q key", "That key"
+  void request(int document, int page, double now_s);
+  void step_document(int delta, double now_s);
+  std::string stick_summary() const;
+  std::string document_name(const StickEntry& e) const;  // the title, else the file name, as spoken
+
+  KioskEffects& fx_;
+  const audio::MessageCatalog& msg_;
+  KioskFlowParams p_;
+  Visit v_;
+  bool learning_ = false;  // Help held down
+  int failures_ = 0;
+};
+
+}  // namespace hk::app

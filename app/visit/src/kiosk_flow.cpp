@@ -1,0 +1,830 @@
+#include "visit/kiosk_flow.hpp"
+
+#include "pictures/stick_pages.hpp"
+#include "audio/speech.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <exception>
+#include <utility>
+
+namespace hk::app {
+
+const char* state_name(KioskState s) {
+  switch (s) {
+    case KioskState::Attract: return "attract";
+    case KioskState::Tutorial: return "tutorial";
+    case KioskState::Picture: return "picture";
+  }
+  return "?";
+}
+
+using audio::MessageId;
+
+namespace {
+
+/// The message naming what key `k` does (learning mode), in KioskKey order.
+constexpr std::array<MessageId, static_cast<std::size_t>(KioskKey::Other)> kKeyDoes{
+    MessageId::key_help,     MessageId::key_next,        MessageId::key_previous,      MessageId::key_describe,
+    MessageId::key_finer,    MessageId::key_coarser,     MessageId::key_volume_up,     MessageId::key_volume_down,
+    MessageId::key_tutorial, MessageId::key_guide,       MessageId::key_capture,       MessageId::key_repeat,
+    MessageId::key_pause,    MessageId::key_where,       MessageId::key_finish,        MessageId::key_next_sentence,
+    MessageId::key_previous_sentence, MessageId::key_next_paragraph, MessageId::key_previous_paragraph};
+
+}  // namespace
+
+KioskFlow::KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params)
+    : fx_(effects), msg_(messages), p_(params) {
+  p_.warning_s = std::min(p_.warning_s, 0.5 * p_.timeout_s);  // a warning must leave time to answer it
+  v_.next_invitation_s = p_.attract_every_s;
+}
+
+std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config::KeysSettings& k) {
+  static_assert(audio::kKeyPlaceholders.size() == config::kKeyActionCount, "one placeholder per [keys] action");
+  const auto actions = config::key_actions(k);
+  std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> args;
+  for (std::size_t i = 0; i < args.size(); ++i) args[i] = {audio::kKeyPlaceholders[i], actions[i].second};
+  return args;
+}
+
+std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageArg> args) const {
+  return msg_.text(id, args, key_args(p_.keys));
+}
+
+void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say(text(id, args)); }
+
+void KioskFlow::say_brief(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say_brief(text(id, args)); }
+
+void KioskFlow::set_timing(double timeout_s, double warning_s, double attract_every_s) {
+  p_.timeout_s = timeout_s;
+  p_.warning_s = std::min(warning_s, 0.5 * timeout_s);
+  p_.attract_every_s = attract_every_s;
+}
+
+// ---- the guard ---------------------------------------------------------------------------------------
+
+template <class Action>
+void KioskFlow::guarded(const char* what, Action&& action) {
+  const Visit before = v_;
+  try {
+    action();
+  } catch (const std::exception& e) {
+    // The visit as it was; what failed goes to the log, the visitor hears one short line.
+    v_ = before;
+    ++failures_;
+    spdlog::error("kiosk: {} failed: {}", what, e.what());
+    try {
+      say_brief(MessageId::sorry);
+    } catch (const std::exception& again) {
+      spdlog::error("kiosk: the sorry line failed too: {}", again.what());
+    }
+  }
+}
+
+// ---- keys --------------------------------------------------------------------------------------------
+
+void KioskFlow::key(KioskKey k, double now_s, std::string_view key_name) {
+  guarded("a key press", [&] { act_on_key(k, now_s, key_name); });
+}
+
+void KioskFlow::act_on_key(KioskKey k, double now_s, std::string_view key_name) {
+  if (v_.state == KioskState::Attract) {
+    wake(now_s);
+    return;
+  }
+  activity(now_s);
+  if (learning_ && k != KioskKey::Help) {
+    learn_key(k, key_name);
+    return;
+  }
+  if (k == KioskKey::VolumeUp || k == KioskKey::VolumeDown) {
+    volume_key(k == KioskKey::VolumeUp ? +1 : -1);
+    return;
+  }
+  if (k != KioskKey::Finish) v_.finish_asked_s = -1;  // any other key: Finish asks again
+  fx_.key_pressed();
+  if (v_.capturing) {  // any key stops a capture, and does nothing else
+    v_.capturing = false;
+    fx_.cancel_capture();
+    say(MessageId::capture_cancelled);
+    return;
+  }
+  const int help_layer = v_.help_layer;
+  v_.help_layer = 0;
+  if (k == KioskKey::Help) {
+    v_.help_layer = help_layer;
+    help_key();
+    return;
+  }
+  if (v_.help_group >= 0) {  // stepping through help: Next and Previous move within it, any other key leaves it
+    if (k == KioskKey::Previous || (k == KioskKey::Next && v_.help_group + 1 < help_group_count())) {
+      v_.help_group = std::max(0, v_.help_group + (k == KioskKey::Next ? 1 : -1));
+      say_help_group();
+      return;
+    }
+    v_.help_group = -1;
+  }
+  if (session_key(k, now_s)) return;
+  if (v_.source == KioskSource::Stick && (k == KioskKey::Next || k == KioskKey::Previous)) {
+    step_document(k == KioskKey::Next ? +1 : -1, now_s);
+    return;
+  }
+  if (k == KioskKey::Other) {
+    stray_key(key_name);
+    return;
+  }
+  if (v_.state == KioskState::Tutorial) {
+    tutorial_key(k);
+  } else {
+    picture_key(k);
+  }
+}
+
+bool KioskFlow::session_key(KioskKey k, double now_s) {
+  switch (k) {
+    case KioskKey::Capture:
+      if (fx_.start_capture()) {
+        v_.capturing = true;
+        say(MessageId::capture_start);
+      } else {
+        say(MessageId::capture_no_camera);
+      }
+      return true;
+    case KioskKey::Guide:
+      fx_.guide();
+      return true;
+    case KioskKey::Tutorial:
+      start_tutorial();
+      say(MessageId::tutorial_start);
+      return true;
+    case KioskKey::Repeat:
+      repeat_key();
+      return true;
+    case KioskKey::NextSentence:
+    case KioskKey::PreviousSentence:
+    case KioskKey::NextParagraph:
+    case KioskKey::PreviousParagraph:
+      reading_key(k);
+      return true;
+    case KioskKey::Pause:
+      pause_key();
+      return true;
+    case KioskKey::Where: {
+      const std::string here = fx_.where();
+      if (!here.empty()) fx_.say(here);
+      else fx_.say(place());
+      return true;
+    }
+    case KioskKey::Finish:
+      finish_key(now_s);
+      return true;
+    default:
+      return false;
+  }
+}
+
+void KioskFlow::volume_key(int delta) {
+  // Never cuts speech: while something is being said, it getting louder or quieter is the answer.
+  const bool changed = fx_.change_volume(delta);
+  if (fx_.speaking()) return;
+  say_brief(!changed ? MessageId::volume_limit : delta > 0 ? MessageId::volume_up : MessageId::volume_down);
+}
+
+void KioskFlow::finish_key(double now_s) {
+  if (v_.finish_asked_s >= 0 && now_s - v_.finish_asked_s <= kFinishConfirm_s) {
+    end_session(now_s);
+    return;
+  }
+  v_.finish_asked_s = now_s;
+  say_brief(MessageId::finish_ask);
+}
+
+void KioskFlow::describe_key() {
+  std::string before;
+  // A visitor's own document is about to be heard by everyone near the kiosk: said once a visit, first.
+  if (v_.source == KioskSource::Stick && v_.doc >= 0 && !v_.read_aloud_said) {
+    v_.read_aloud_said = true;
+    before = text(MessageId::read_aloud_warning) + " ";
+  }
+  // The hand on a block of text: that paragraph is read, by sentence (the reading keys move within the page).
+  PageText page = fx_.page_text();
+  v_.reading = ReadAloud(page.paragraphs);
+  v_.reading_on = false;
+  if (page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs()) {
+    const ReadingPlace at{page.at_hand, 0};
+    // The catalogue's words before the text ("Text:"), as the block's text would be said with text_block.
+    const std::string& block = msg_.raw(MessageId::text_block);
+    const std::string lead = msg_.expand(std::string_view(block).substr(0, block.find("{text}")), {}, key_args(p_.keys));
+    read_from(at, before + long_text_line(v_.reading.text_from(at)) + lead);
+    return;
+  }
+  const std::string description = fx_.describe();
+  fx_.say(before + long_text_line(description) + text(MessageId::describe, {{"description", description}}));
+}
+
+std::string KioskFlow::long_text_line(const std::string& said) const {
+  // A long text says how long it is before it starts (words at the voice's rate), and how to move through it.
+  const double seconds = spoken_seconds(said);
+  if (seconds <= kLongText_s) return {};
+  const int minutes = static_cast<int>(std::lround(seconds / 60.0));
+  return (minutes <= 1 ? text(MessageId::long_text_minute) : text(MessageId::long_text_minutes, {{"minutes", std::to_string(minutes)}})) + " ";
+}
+
+// ---- reading a page's text by sentence and paragraph ---------------------------------------------------
+
+void KioskFlow::follow_reading() {
+  if (!reading()) return;
+  const int piece = fx_.heard_piece();
+  if (piece >= 0) v_.reading.heard(piece);
+}
+
+void KioskFlow::read_from(ReadingPlace at, const std::string& before) {
+  // The lead is said in the same text, so the pieces heard count from its start; a line break ends it, so it
+  // is cut as its own pieces whatever its last character.
+  std::string said = before;
+  while (!said.empty() && said.back() == ' ') said.pop_back();
+  const int lead = static_cast<int>(audio::speech_pieces(said).size());
+  if (!said.empty()) said += '\n';
+  said += v_.reading.text_from(at);
+  fx_.say(said);
+  v_.reading.started(at, lead);
+  v_.reading_on = true;
+  v_.reading_kept = fx_.kept_texts();
+}
+
+void KioskFlow::reading_key(KioskKey k) {
+  follow_reading();
+  if (!reading()) {
+    // Nothing being read: the page's text from the paragraph under the hand (else its first), if it has any.
+    const PageText page = fx_.page_text();
+    v_.reading = ReadAloud(page.paragraphs);
+    v_.reading_on = false;
+    if (v_.reading.empty()) {
+      say_brief(MessageId::reading_none);
+      return;
+    }
+    const int p = page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs() ? page.at_hand : 0;
+    read_from({p, 0}, paragraph_line(p));
+    return;
+  }
+  const bool by_paragraph = k == KioskKey::NextParagraph || k == KioskKey::PreviousParagraph;
+  const ReadAloud::Step step = k == KioskKey::NextSentence     ? v_.reading.next_sentence()
+                                 : k == KioskKey::PreviousSentence ? v_.reading.previous_sentence()
+                                 : k == KioskKey::NextParagraph    ? v_.reading.next_paragraph()
+                                                                   : v_.reading.previous_paragraph();
+  if (step.edge == ReadAloud::Edge::End) {
+    say_brief(MessageId::reading_end);  // the reading stays where it is: Repeat and the keys go on from there
+    return;
+  }
+  std::string before = step.edge == ReadAloud::Edge::Start ? text(MessageId::reading_start) + " " : std::string();
+  if (by_paragraph || step.at.paragraph != v_.reading.place().paragraph) before += paragraph_line(step.at.paragraph);
+  read_from(step.at, before);
+}
+
+std::string KioskFlow::paragraph_line(int p) const {
+  if (v_.reading.paragraphs() < 2) return {};
+  return text(MessageId::reading_paragraph, {{"block", std::to_string(p + 1)}, {"blocks", std::to_string(v_.reading.paragraphs())}});
+}
+
+void KioskFlow::repeat_key() {
+  // Reading a text: the sentence being heard, and on from there; else the last thing said, from its start.
+  follow_reading();
+  if (reading()) {
+    read_from(v_.reading.place(), {});
+    return;
+  }
+  if (!fx_.repeat()) say_brief(MessageId::nothing_to_repeat);
+}
+
+double spoken_seconds(std::string_view text) {
+  int words = 0;
+  bool in_word = false;
+  for (const char c : text) {
+    const bool space = std::isspace(static_cast<unsigned char>(c)) != 0;
+    words += !space && !in_word;
+    in_word = !space;
+  }
+  return 60.0 * words / kWordsPerMinute;
+}
+
+void KioskFlow::level_key(int delta) {
+  const bool was_auto = fx_.auto_level();
+  const bool changed = fx_.change_level(delta);
+  std::string line = text(changed ? (delta < 0 ? MessageId::level_finer : MessageId::level_coarser)
+                                   : (delta < 0 ? MessageId::level_finest : MessageId::level_coarsest));
+  if (changed && was_auto) line += " " + text(MessageId::level_manual);
+  fx_.say_brief(line);
+}
+
+void KioskFlow::pause_key() {
+  if (fx_.resume_speech()) return;  // pressed again: goes on from where it stopped
+  if (fx_.pause_speech()) return;   // silence is the answer
+  say_brief(MessageId::nothing_to_pause);
+}
+
+void KioskFlow::help_key() {
+  // One sentence for where the visitor is and the two most useful keys; the same key again for every key, a
+  // few at a time.
+  if (v_.help_layer == 1) {
+    v_.help_layer = 0;
+    v_.help_group = 0;
+    say_help_group();
+    return;
+  }
+  v_.help_layer = 1;
+  v_.help_group = -1;
+  say(MessageId::help_brief, {{"place", place()}});
+}
+
+std::vector<std::string> KioskFlow::help_groups() const {
+  // The catalogue's help (and the camera's sentence) cut into sentences, kHelpSentencesPerGroup to a group.
+  std::string all = msg_.raw(MessageId::help);
+  if (p_.camera) all += " " + msg_.raw(MessageId::help_camera);
+  std::vector<std::string> sentences;
+  std::size_t from = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const bool end = (all[i] == '.' || all[i] == '!' || all[i] == '?') && (i + 1 == all.size() || all[i + 1] == ' ');
+    if (!end) continue;
+    sentences.push_back(all.substr(from, i + 1 - from));
+    from = i + 1;
+    while (from < all.size() && all[from] == ' ') ++from;
+  }
+  if (from < all.size()) sentences.push_back(all.substr(from));
+  std::vector<std::string> groups;
+  for (std::size_t i = 0; i < sentences.size(); ++i) {
+    if (i % kHelpSentencesPerGroup == 0) groups.emplace_back();
+    groups.back() += (groups.back().empty() ? "" : " ") + sentences[i];
+  }
+  return groups;
+}
+
+int KioskFlow::help_group_count() const { return static_cast<int>(help_groups().size()); }
+
+void KioskFlow::say_help_group() {
+  const std::vector<std::string> groups = help_groups();
+  if (groups.empty()) return;
+  const int g = std::clamp(v_.help_group, 0, static_cast<int>(groups.size()) - 1);
+  std::string line = msg_.expand(groups[static_cast<std::size_t>(g)], {}, key_args(p_.keys));
+  // Where each key of the group lies, in the order the group names them.
+  const auto actions = config::key_actions(p_.keys);
+  for (std::size_t i = 0; i < audio::kKeyPlaceholders.size(); ++i) {
+    const std::string tag = "{" + std::string(audio::kKeyPlaceholders[i]) + "}";
+    if (groups[static_cast<std::size_t>(g)].find(tag) != std::string::npos) line += key_place_sentence(actions[i].second);
+  }
+  line += " " + text(g + 1 < static_cast<int>(groups.size()) ? MessageId::help_next : MessageId::help_last);
+  fx_.say(line);
+}
+
+std::string KioskFlow::key_place_sentence(std::string_view key_name) const {
+  const std::string place = msg_.key_place(key_name);
+  if (place.empty()) return {};
+  return " " + text(MessageId::key_place, {{"key", spoken_key(key_name)}, {"place", place}});
+}
+
+void KioskFlow::learn_key(KioskKey k, std::string_view key_name) {
+  if (k == KioskKey::Other) {
+    stray_key(key_name);
+    return;
+  }
+  const std::string name(config::key_actions(p_.keys)[static_cast<std::size_t>(k)].second);
+  fx_.say_brief(text(kKeyDoes[static_cast<std::size_t>(k)]) + key_place_sentence(name));
+}
+
+void KioskFlow::stray_key(std::string_view key_name) { say_brief(MessageId::key_other, {{"key", spoken_key(key_name)}}); }
+
+std::string KioskFlow::spoken_key(std::string_view key_name) const {
+  if (key_name.empty() || !msg_.key_names().contains(key_name)) return text(MessageId::this_key);
+  std::string name = msg_.key_name(key_name);
+  if (!name.empty()) name[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(name[0])));
+  return name;
+}
+
+void KioskFlow::tutorial_key(KioskKey k) {
+  switch (k) {
+    case KioskKey::Next:
+      if (v_.shape == TutorialShape::Square) {
+        v_.shape = TutorialShape::Circle;
+        fx_.show_tutorial(v_.shape);
+        say(MessageId::tutorial_circle);
+      } else if (v_.shape == TutorialShape::Circle) {
+        v_.shape = TutorialShape::Triangle;
+        fx_.show_tutorial(v_.shape);
+        say(MessageId::tutorial_triangle);
+      } else {
+        show(0, text(MessageId::tutorial_done));
+      }
+      return;
+    case KioskKey::Previous:
+      if (v_.shape != TutorialShape::Square) v_.shape = static_cast<TutorialShape>(static_cast<int>(v_.shape) - 1);
+      fx_.show_tutorial(v_.shape);
+      say(v_.shape == TutorialShape::Square ? MessageId::tutorial_start : MessageId::tutorial_circle);
+      return;
+    case KioskKey::Describe:
+      fx_.say(fx_.describe());
+      return;
+    case KioskKey::Finer:
+    case KioskKey::Coarser:  // no levels to change on a practice shape: said why
+      say_brief(MessageId::tutorial_no_levels);
+      return;
+    default:
+      say_brief(kKeyDoes[static_cast<std::size_t>(k)]);
+      return;
+  }
+}
+
+void KioskFlow::picture_key(KioskKey k) {
+  switch (k) {
+    case KioskKey::Next:
+      show(v_.picture + 1);
+      return;
+    case KioskKey::Previous:
+      show(v_.picture - 1);
+      return;
+    case KioskKey::Describe:
+      describe_key();
+      return;
+    case KioskKey::Finer:
+      level_key(-1);
+      return;
+    case KioskKey::Coarser:
+      level_key(+1);
+      return;
+    default:
+      return;
+  }
+}
+
+
+std::string KioskFlow::place() const {
+  if (v_.state == KioskState::Tutorial) return text(MessageId::place_tutorial);
+  if (v_.source == KioskSource::Stick && v_.doc >= 0) {
+    const StickEntry& e = v_.stick[static_cast<std::size_t>(v_.doc)];
+    return text(MessageId::place_document, {{"page", std::to_string(v_.page)}, {"pages", std::to_string(std::max(e.pages, e.pages_in_file))}});
+  }
+  if (v_.captured) return text(MessageId::place_capture);
+  return text(MessageId::place_picture, {{"picture", std::to_string(v_.picture + 1)}, {"pictures", std::to_string(fx_.picture_count())}});
+}
+
+// ---- the session -------------------------------------------------------------------------------------
+
+void KioskFlow::activity(double now_s) {
+  v_.last_activity_s = now_s;
+  v_.warned = false;
+  v_.rewarned = false;
+}
+
+void KioskFlow::start_tutorial() {
+  v_.felt = true;
+  v_.state = KioskState::Tutorial;
+  v_.shape = TutorialShape::Square;
+  v_.captured = false;
+  fx_.show_tutorial(v_.shape);
+}
+
+void KioskFlow::show(int index, const std::string& before) {
+  const int n = fx_.picture_count();
+  v_.picture = ((index % n) + n) % n;  // wraps round both ways
+  v_.state = KioskState::Picture;
+  v_.felt = true;
+  v_.captured = false;
+  const int shapes = fx_.show_picture(v_.picture);
+  if (shapes == KioskEffects::kPicturePending) {  // built off the window thread: announced when it is felt
+    const bool awaited = v_.pending_picture >= 0 || v_.pending_doc >= 0;
+    v_.pending_picture = v_.picture;
+    v_.pending_before = before;
+    start_loading_clock(v_.last_activity_s, awaited);
+    return;
+  }
+  v_.pending_picture = -1;
+  announce_picture(shapes, before);
+}
+
+void KioskFlow::announce_picture(int shapes, const std::string& before) {
+  const int n = fx_.picture_count();
+  const std::string num = std::to_string(v_.picture + 1), total = std::to_string(n);
+  const std::string title = fx_.shown_notes().title;
+  std::string line;
+  if (!title.empty()) {
+    // A person's words first: "Picture 2 of 5: a horse, seen from the side. It has 2 shapes."
+    const MessageId id = shapes == 0 ? MessageId::picture_titled_empty : shapes == 1 ? MessageId::picture_titled_one : MessageId::picture_titled;
+    line = text(id, {{"picture", num}, {"pictures", total}, {"title", title}, {"shapes", std::to_string(shapes)}});
+  } else if (shapes == 0) {
+    line = text(MessageId::picture_empty, {{"picture", num}, {"pictures", total}});
+  } else if (shapes == 1) {
+    line = text(MessageId::picture_loaded_one, {{"picture", num}, {"pictures", total}});
+  } else {
+    line = text(MessageId::picture_loaded, {{"picture", num}, {"pictures", total}, {"shapes", std::to_string(shapes)}});
+  }
+  fx_.say(before.empty() ? line : before + " " + line);
+}
+
+void KioskFlow::wake(double now_s) {
+  activity(now_s);
+  v_.help_layer = 0;
+  start_tutorial();
+  say(MessageId::welcome);
+}
+
+void KioskFlow::end_session(double now_s) {
+  if (v_.capturing) fx_.cancel_capture();
+  fx_.new_session();  // first: it stops speech, and the goodbye must be heard
+  if (v_.source == KioskSource::Stick || !v_.stick.empty()) fx_.forget_stick();
+  v_ = Visit{};
+  v_.next_invitation_s = now_s + p_.attract_every_s;
+  say_brief(MessageId::goodbye);
+}
+
+void KioskFlow::handle_moved(double now_s) {
+  guarded("handle motion", [&] {
+    if (v_.state == KioskState::Attract) {
+      wake(now_s);
+      return;
+    }
+    activity(now_s);
+  });
+}
+
+void KioskFlow::touching(double now_s) {
+  guarded("touching a shape", [&] {
+    if (v_.state == KioskState::Attract) return;
+    activity(now_s);
+    // On the tutorial's square, once the welcome has been heard: the wall the hand feels can be pushed through.
+    if (v_.state == KioskState::Tutorial && v_.shape == TutorialShape::Square && !v_.push_taught && !fx_.speaking()) {
+      v_.push_taught = true;
+      say_brief(MessageId::tutorial_push);
+    }
+  });
+}
+
+void KioskFlow::tick(double now_s) {
+  guarded("the session's clock", [&] {
+    if (v_.state == KioskState::Attract) {
+      if (p_.attract_every_s > 0 && now_s >= v_.next_invitation_s) {
+        v_.next_invitation_s = now_s + p_.attract_every_s;
+        if (!fx_.quiet_hours()) say_brief(MessageId::attract);
+      }
+      return;
+    }
+    // Speech being heard is the visitor listening (a long text being read is never cut by the time-out);
+    // the warning's own speech is not.
+    if (!v_.warned && fx_.speaking()) activity(now_s);
+    follow_reading();
+    if ((v_.pending_doc >= 0 || v_.pending_picture >= 0) && !v_.loading_said && now_s - v_.pending_since_s > p_.loading_cue_s) {
+      v_.loading_said = true;
+      say_brief(MessageId::loading);
+    }
+    const double idle = now_s - v_.last_activity_s;
+    if (idle >= p_.timeout_s) {
+      end_session(now_s);
+      return;
+    }
+    if (!v_.warned && idle >= p_.timeout_s - p_.warning_s) {
+      v_.warned = true;
+      v_.warned_at_s = now_s;
+      warn(idle);
+    } else if (v_.warned && !v_.rewarned && now_s - v_.warned_at_s >= kRewarn_s && p_.timeout_s - idle >= 3.0) {
+      v_.rewarned = true;  // once more, while there is still time to answer it
+      warn(idle);
+    }
+  });
+}
+
+void KioskFlow::warn(double idle_s) {
+  const MessageId id = v_.source == KioskSource::Stick ? MessageId::timeout_warning_stick : MessageId::timeout_warning;
+  say_brief(id, {{"seconds", std::to_string(static_cast<int>(std::lround(p_.timeout_s - idle_s)))}});
+}
+
+// ---- the camera --------------------------------------------------------------------------------------
+
+void KioskFlow::capture_advice(MessageId advice, double now_s) {
+  if (!v_.capturing) return;
+  activity(now_s);
+  say(advice);
+}
+
+void KioskFlow::capture_done(int shapes, double now_s) {
+  guarded("a camera capture", [&] { capture_done_now(shapes, now_s); });
+}
+
+void KioskFlow::capture_done_now(int shapes, double now_s) {
+  if (!v_.capturing) return;
+  v_.capturing = false;
+  activity(now_s);
+  v_.state = KioskState::Picture;
+  v_.captured = true;
+  if (shapes == 0) {
+    say(MessageId::captured_empty);
+  } else if (shapes == 1) {
+    say(MessageId::captured_one);
+  } else {
+    say(MessageId::captured, {{"shapes", std::to_string(shapes)}});
+  }
+}
+
+void KioskFlow::capture_failed(bool timeout, double now_s) {
+  if (!v_.capturing) return;
+  v_.capturing = false;
+  v_.last_activity_s = now_s;
+  say(timeout ? MessageId::capture_timeout : MessageId::capture_failed);
+}
+
+// ---- USB sticks --------------------------------------------------------------------------------------
+
+std::string KioskFlow::stick_summary() const {
+  // English phrase for {summary}; the sentence around it comes from the catalogue.
+  int pictures = 0, pdfs = 0, pages = 0, capped = 0;
+  for (const StickEntry& e : v_.stick) {
+    pictures += !e.pdf;
+    pdfs += e.pdf;
+    pages += e.pdf ? std::max(e.pages, e.pages_in_file) : 0;
+    capped = std::max(capped, e.pdf && e.pages_in_file > e.pages ? e.pages : 0);
+  }
+  auto count = [](int n, const char* one, const char* many) { return n == 1 ? std::string(one) : std::to_string(n) + " " + many; };
+  const int n = static_cast<int>(v_.stick.size());
+  std::string s = count(n, "one document", "documents") + ": ";
+  std::string pdf_part;
+  if (pdfs == 1) {
+    pdf_part = "a PDF of " + count(pages, "one page", "pages");
+  } else if (pdfs > 1) {
+    pdf_part = std::to_string(pdfs) + " PDFs of " + count(pages, "one page", "pages") + " in all";
+  }
+  if (capped > 0) pdf_part += " (the first " + std::to_string(capped) + " pages of each can be read)";
+  if (pictures > 0 && pdfs > 0) return s + count(pictures, "a picture", "pictures") + " and " + pdf_part;
+  if (pictures > 0) return s + count(pictures, "a picture", "pictures");
+  return s + pdf_part;
+}
+
+std::string spoken_name(const std::string& name, bool file_name) {
+  std::string s = name;
+  if (file_name) {
+    const auto dot = s.find_last_of('.');
+    if (dot != std::string::npos && dot > 0 && s.size() - dot <= 5) s.erase(dot);
+    for (char& c : s)
+      if (c == '_' || c == '-') c = ' ';
+  }
+  if (s.size() <= kSpokenNameBytes) return s;
+  std::size_t cut = kSpokenNameBytes;
+  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;  // a whole UTF-8 character
+  const std::size_t space = s.rfind(' ', cut);
+  if (space != std::string::npos && space >= kSpokenNameBytes / 2) cut = space;  // at a word
+  s.erase(cut);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '.')) s.pop_back();
+  return s;
+}
+
+std::string KioskFlow::document_name(const StickEntry& e) const {
+  return e.title.empty() ? spoken_name(e.name, true) : spoken_name(e.title, false);
+}
+
+void KioskFlow::request(int document, int page, double now_s) {
+  const bool awaited = v_.pending_picture >= 0 || v_.pending_doc >= 0;
+  v_.pending_doc = v_.at_doc = document;
+  v_.pending_page = v_.at_page = page;
+  start_loading_clock(now_s, awaited);
+  fx_.show_document(document, page);
+}
+
+void KioskFlow::start_loading_clock(double now_s, bool awaited) {
+  // Keys pressed in a row while nothing has been said of the load awaited keep its clock, so "Loading." comes
+  // loading_cue_s after the first of them, not after the last; once said, the next key gets its own.
+  if (awaited && !v_.loading_said) return;
+  v_.pending_since_s = now_s;
+  v_.loading_said = false;
+}
+
+void KioskFlow::step_document(int delta, double now_s) {
+  // From the last page asked for: the one awaited (a key pressed while loading moves on from there), or
+  // the last one shown or found unreadable (so a visitor can step past a page that cannot be read).
+  if (v_.stick.empty()) return;
+  std::vector<int> pages;
+  pages.reserve(v_.stick.size());
+  for (const StickEntry& e : v_.stick) pages.push_back(e.pages);
+  const StickPage to = step_stick_page(pages, {v_.at_doc, v_.at_page}, delta);
+  request(to.document, to.page, now_s);
+}
+
+void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double now_s, int unreadable) {
+  guarded("a USB stick", [&] { stick_inserted_now(documents, now_s, unreadable); });
+}
+
+std::string KioskFlow::unreadable_line(int unreadable) const {
+  if (unreadable <= 0) return {};
+  return " " + (unreadable == 1 ? text(MessageId::file_unreadable) : text(MessageId::files_unreadable, {{"count", std::to_string(unreadable)}}));
+}
+
+void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable) {
+  activity(now_s);
+  v_.stick = documents;
+  v_.doc = v_.at_doc = v_.pending_doc = -1;
+  if (v_.stick.empty()) {  // nothing to show: the visitor stays where they are (the tutorial's shape, a picture)
+    v_.source = KioskSource::Library;
+    std::string line = text(MessageId::stick_empty) + unreadable_line(unreadable);
+    if (v_.state == KioskState::Attract) {  // a stick is someone at the kiosk: the tutorial starts, welcomed
+      start_tutorial();
+      line += " " + text(MessageId::welcome);
+    }
+    fx_.say(line);
+    return;
+  }
+  v_.state = KioskState::Picture;  // from Attract or the tutorial: the stick's first page comes
+  v_.source = KioskSource::Stick;
+  v_.announce_summary = stick_summary();
+  v_.announce_unreadable = unreadable_line(unreadable);
+  request(0, 1, now_s);
+}
+
+void KioskFlow::stick_refused(const std::string& reason, double now_s) {
+  guarded("a USB stick", [&] {
+    activity(now_s);
+    std::string line = text(MessageId::stick_unreadable, {{"reason", reason}});
+    if (v_.state == KioskState::Attract) {  // someone is at the kiosk: the tutorial starts, welcomed
+      start_tutorial();
+      if (!line.empty() && line.back() != '.' && line.back() != '!' && line.back() != '?') line += '.';
+      line += " " + text(MessageId::welcome);
+    }
+    fx_.say(line);
+  });
+}
+
+void KioskFlow::stick_removed(double now_s) {
+  guarded("taking out a USB stick", [&] { stick_removed_now(now_s); });
+}
+
+void KioskFlow::stick_removed_now(double now_s) {
+  const bool browsing = v_.source == KioskSource::Stick;
+  v_.stick.clear();
+  v_.source = KioskSource::Library;
+  v_.doc = v_.at_doc = v_.pending_doc = -1;
+  v_.announce_summary.clear();
+  if (!browsing || v_.state == KioskState::Attract) return;  // nothing of the stick was in use
+  activity(now_s);
+  if (v_.state == KioskState::Tutorial) {
+    say(MessageId::stick_removed);
+    return;
+  }
+  show(v_.picture, text(MessageId::stick_removed));
+}
+
+void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
+  guarded("a page of a USB stick", [&] { document_ready_now(r, now_s); });
+}
+
+void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
+  (void)now_s;
+  if (!awaits_document(r.document, r.page)) return;  // superseded
+  v_.pending_doc = -1;
+  const StickEntry& e = v_.stick[static_cast<std::size_t>(r.document)];
+  // A PDF's own title, when it has a usable one, names it: "Page 1 of 3 of Annual report 2025."
+  const std::string name = document_name(e);
+  std::string line;
+  if (r.ok) {
+    v_.felt = true;
+    v_.doc = r.document;
+    v_.page = r.page;
+    v_.state = KioskState::Picture;
+    v_.captured = false;
+    line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(std::max(e.pages, e.pages_in_file))},
+                                                          {"name", name}, {"description", r.description}})
+                 : text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
+                                                             {"documents", std::to_string(v_.stick.size())},
+                                                             {"name", name}, {"description", r.description}});
+  } else {
+    const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + name : name;
+    // "You still feel the picture before" only when there was one. Why is for the operator (the log and the
+    // panel: KioskRuntime::stick_problems), not words a visitor can act on.
+    line = text(v_.felt ? MessageId::document_unreadable : MessageId::document_unreadable_alone, {{"name", what}});
+  }
+  if (!v_.announce_summary.empty()) {  // said now, so it names the keys of now
+    line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) + std::exchange(v_.announce_unreadable, {}) + " " + line;
+    v_.announce_summary.clear();
+  }
+  fx_.say(line);
+}
+
+void KioskFlow::picture_ready(int index, int shapes, double now_s) {
+  guarded("a picture of the library", [&] {
+    (void)now_s;
+    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured || v_.source != KioskSource::Library) return;  // superseded
+    v_.pending_picture = -1;
+    announce_picture(shapes, std::exchange(v_.pending_before, {}));
+  });
+}
+
+void KioskFlow::picture_failed(int index, const std::string& reason, double now_s) {
+  guarded("a picture of the library", [&] {
+    (void)now_s;
+    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured || v_.source != KioskSource::Library) return;  // superseded
+    v_.pending_picture = -1;
+    const std::string name = "Picture " + std::to_string(index + 1) + " of " + std::to_string(fx_.picture_count());
+    spdlog::warn("kiosk: picture {} cannot be shown: {}", index + 1, reason);
+    const std::string line = text(MessageId::document_unreadable, {{"name", name}});
+    const std::string before = std::exchange(v_.pending_before, {});
+    fx_.say(before.empty() ? line : before + " " + line);
+  });
+}
+
+}  // namespace hk::app

@@ -1,0 +1,43 @@
+// What the kiosk says (voice.hpp).
+#include "visit/voice.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+namespace hk::app {
+namespace {
+
+/// `text` with its line breaks (a reading's sentences are joined by them) as spaces: one line of the log.
+std::string one_line(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  return text;
+}
+
+}  // namespace
+
+void Voice::say(const std::string& text) {
+  spdlog::info("say: {}", one_line(text));
+  last_said_ = text;
+  repeatable_ = text;
+  ++kept_texts_;
+  ++texts_said_;
+  brief_last_ = false;
+  audio_.say_text(text);
+}
+
+void Voice::say_brief(const std::string& text) {
+  spdlog::info("say: {}", one_line(text));
+  last_said_ = text;
+  ++texts_said_;
+  brief_last_ = true;
+  audio_.say_text(text, false);
+}
+
+bool Voice::repeat() {
+  if (repeatable_.empty()) return false;
+  say(std::string(repeatable_));
+  return true;
+}
+
+}  // namespace hk::app
