@@ -79,14 +79,15 @@ namespace {
 
 constexpr int kMethods = 4;
 const char* const kMethodKey[kMethods] = {"ours", "dp", "uniform", "linear22"};
-const char* const kMethodLabel[kMethods] = {"pseudocoiflet (ours)", "Douglas-Peucker", "uniform arc length", "linear (2,2) wavelet"};
+const char* const kMethodLabel[kMethods] = {"pseudocoiflet (ours)", "Douglas-Peucker", "uniform arc length",
+                                            "linear (2,2) wavelet"};
 
 struct Options {
   fs::path images_dir = fs::path(HK_TEST_DATA_DIR) / "images";
   fs::path out = "docs/bench/accuracy.json";
-  double rms_step_m = 0.01e-3;   // RMS integration piece: 10 µm, ≤ 1/17 of the finest pixel at workspace scale
-  double tol_m = 0.001e-3;       // Hausdorff underestimate bound: 1 µm, far below any reported error
-  unsigned threads = 0;          // 0: hardware concurrency
+  double rms_step_m = 0.01e-3;  // RMS integration piece: 10 µm, ≤ 1/17 of the finest pixel at workspace scale
+  double tol_m = 0.001e-3;      // Hausdorff underestimate bound: 1 µm, far below any reported error
+  unsigned threads = 0;         // 0: hardware concurrency
 };
 
 [[noreturn]] void die(const std::string& msg) {
@@ -128,7 +129,10 @@ std::vector<std::vector<Vec2>> linear22_levels(const CurveMultires& m) {
     const auto& fine = out[static_cast<std::size_t>(l - 1)];
     x.resize(fine.size());
     y.resize(fine.size());
-    for (std::size_t i = 0; i < fine.size(); ++i) { x[i] = fine[i].x; y[i] = fine[i].y; }
+    for (std::size_t i = 0; i < fine.size(); ++i) {
+      x[i] = fine[i].x;
+      y[i] = fine[i].y;
+    }
     const auto sx = linear22_forward(x, m.closed), sy = linear22_forward(y, m.closed);
     auto& coarse = out[static_cast<std::size_t>(l)];
     coarse.resize(sx.size());
@@ -158,10 +162,14 @@ DpCurve dp_prepare(const Polyline& o) {
   const Vec2 base = o.points_m[0];
   float lox = 1e30f, loy = 1e30f, hix = -1e30f, hiy = -1e30f;
   for (std::size_t i = 0; i < o.points_m.size(); ++i) {
-    const cv::Point2f q(static_cast<float>(1e3 * (o.points_m[i].x - base.x)), static_cast<float>(1e3 * (o.points_m[i].y - base.y)));
+    const cv::Point2f q(static_cast<float>(1e3 * (o.points_m[i].x - base.x)),
+                        static_cast<float>(1e3 * (o.points_m[i].y - base.y)));
     d.pts_mm.push_back(q);
     d.index_of.emplace(key_of(q), i);
-    lox = std::min(lox, q.x); loy = std::min(loy, q.y); hix = std::max(hix, q.x); hiy = std::max(hiy, q.y);
+    lox = std::min(lox, q.x);
+    loy = std::min(loy, q.y);
+    hix = std::max(hix, q.x);
+    hiy = std::max(hiy, q.y);
   }
   d.diag_mm = std::hypot(hix - lox, hiy - loy);
   return d;
@@ -192,7 +200,10 @@ std::vector<Vec2> dp_simplify(const DpCurve& d, const Polyline& o, std::size_t t
     const double mid = 0.5 * (lo + hi);
     const std::size_t n = run(mid);
     consider(mid, n);
-    if (n > target) lo = mid; else hi = mid;
+    if (n > target)
+      lo = mid;
+    else
+      hi = mid;
     if (hi - lo < 1e-9) break;
   }
   if (eps_mm_out) *eps_mm_out = best_eps;
@@ -222,7 +233,8 @@ std::vector<Vec2> probe_vertices(const std::vector<Vec2>& pts, std::size_t cap) 
   return v;
 }
 
-Errors measure(const std::vector<Vec2>& a, bool closed, const Polyline& o, const SegmentGrid& o_grid, const Options& opt, const char* what) {
+Errors measure(const std::vector<Vec2>& a, bool closed, const Polyline& o, const SegmentGrid& o_grid,
+               const Options& opt, const char* what) {
   Errors e;
   e.n = a.size();
   const SegmentGrid a_grid(a, closed);
@@ -249,7 +261,8 @@ Errors measure(const std::vector<Vec2>& a, bool closed, const Polyline& o, const
   }
   if (e.max_dev_m < one_sided_m - 1e-12) {
     char buf[256];
-    std::snprintf(buf, sizeof buf, "Hausdorff %.9g mm < brute-force one-sided %.9g mm (%s)", 1e3 * e.max_dev_m, 1e3 * one_sided_m, what);
+    std::snprintf(buf, sizeof buf, "Hausdorff %.9g mm < brute-force one-sided %.9g mm (%s)", 1e3 * e.max_dev_m,
+                  1e3 * one_sided_m, what);
     die(buf);
   }
   return e;
@@ -278,8 +291,8 @@ double polyline_length_m(const Polyline& o) {
   return len;
 }
 
-CurveResult analyse_curve(const std::string& image, const Scene& scene, std::size_t c, const Polyline& o, const Options& opt,
-                          std::atomic<std::int64_t>* method_ns) {
+CurveResult analyse_curve(const std::string& image, const Scene& scene, std::size_t c, const Polyline& o,
+                          const Options& opt, std::atomic<std::int64_t>* method_ns) {
   CurveResult r;
   r.image = image;
   r.curve = c;
@@ -288,7 +301,8 @@ CurveResult analyse_curve(const std::string& image, const Scene& scene, std::siz
   r.closed = o.closed;
   r.length_m = polyline_length_m(o);
   const CurveInfo& ci = scene.curve(c);
-  const CurveMultires m = build_multires(o, ci.levels - 1);  // the scene keeps the scaling coefficients only; the same model
+  const CurveMultires m =
+      build_multires(o, ci.levels - 1);  // the scene keeps the scaling coefficients only; the same model
   r.level0_step_m = m.arc_m.size() > 1 ? m.arc_m[1] - m.arc_m[0] : r.length_m;
 
   const SegmentGrid o_grid(o.points_m, o.closed);
@@ -296,7 +310,8 @@ CurveResult analyse_curve(const std::string& image, const Scene& scene, std::siz
   auto timed = [&](int method, auto&& fn) {
     const auto t0 = std::chrono::steady_clock::now();
     auto v = fn();
-    method_ns[method] += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
+    method_ns[method] +=
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
     return v;
   };
   const auto l22 = timed(3, [&] { return linear22_levels(m); });
@@ -305,7 +320,8 @@ CurveResult analyse_curve(const std::string& image, const Scene& scene, std::siz
     const auto& ours = m.scaling[static_cast<std::size_t>(l)];
     const std::size_t n_l = ours.size();
     // The scene's flat copy must be the model's polyline: the contact solver uses the former.
-    if (ci.point_count[l] != n_l || !(scene.points(c, l)[0] == ours[0])) die("Scene::points differs from build_multires");
+    if (ci.point_count[l] != n_l || !(scene.points(c, l)[0] == ours[0]))
+      die("Scene::points differs from build_multires");
     if (l22[static_cast<std::size_t>(l)].size() != n_l) die("linear (2,2) wavelet point count differs from ours");
     LevelResult lr;
     lr.level = l;
@@ -320,8 +336,11 @@ CurveResult analyse_curve(const std::string& image, const Scene& scene, std::siz
       e.dp_eps_mm = eps_mm;
       return e;
     });
-    lr.m[2] = timed(2, [&] { return measure(resample_arc_length(o, n_l), o.closed, o, o_grid, opt, (tag + " uniform").c_str()); });
-    lr.m[3] = timed(3, [&] { return measure(l22[static_cast<std::size_t>(l)], m.closed, o, o_grid, opt, (tag + " linear22").c_str()); });
+    lr.m[2] = timed(
+        2, [&] { return measure(resample_arc_length(o, n_l), o.closed, o, o_grid, opt, (tag + " uniform").c_str()); });
+    lr.m[3] = timed(3, [&] {
+      return measure(l22[static_cast<std::size_t>(l)], m.closed, o, o_grid, opt, (tag + " linear22").c_str());
+    });
 
     if (l == 0) {
       // Level 0 is the original resampled at step h: every original point is within h/2 of a sample
@@ -329,8 +348,8 @@ CurveResult analyse_curve(const std::string& image, const Scene& scene, std::siz
       const double bound_m = 0.5 * r.level0_step_m + opt.tol_m + 1e-12;
       if (lr.m[0].max_dev_m > bound_m) {
         char buf[256];
-        std::snprintf(buf, sizeof buf, "level 0 of ours deviates %.6g mm > half the resampling step %.6g mm (%s)", 1e3 * lr.m[0].max_dev_m,
-                      1e3 * bound_m, tag.c_str());
+        std::snprintf(buf, sizeof buf, "level 0 of ours deviates %.6g mm > half the resampling step %.6g mm (%s)",
+                      1e3 * lr.m[0].max_dev_m, 1e3 * bound_m, tag.c_str());
         die(buf);
       }
     }
@@ -368,15 +387,22 @@ Options parse(int argc, char** argv) {
       if (i + 1 >= argc) die("missing value after " + a);
       return argv[++i];
     };
-    if (a == "--images") o.images_dir = next();
-    else if (a == "--out") o.out = next();
-    else if (a == "--rms-step-mm") o.rms_step_m = std::stod(next()) * 1e-3;
-    else if (a == "--tol-mm") o.tol_m = std::stod(next()) * 1e-3;
-    else if (a == "--threads") o.threads = static_cast<unsigned>(std::stoul(next()));
+    if (a == "--images")
+      o.images_dir = next();
+    else if (a == "--out")
+      o.out = next();
+    else if (a == "--rms-step-mm")
+      o.rms_step_m = std::stod(next()) * 1e-3;
+    else if (a == "--tol-mm")
+      o.tol_m = std::stod(next()) * 1e-3;
+    else if (a == "--threads")
+      o.threads = static_cast<unsigned>(std::stoul(next()));
     else if (a == "-h" || a == "--help") {
-      std::printf("usage: bench_accuracy [--images DIR] [--out FILE.json] [--rms-step-mm S] [--tol-mm T] [--threads N]\n");
+      std::printf(
+          "usage: bench_accuracy [--images DIR] [--out FILE.json] [--rms-step-mm S] [--tol-mm T] [--threads N]\n");
       std::exit(0);
-    } else die("unknown argument " + a);
+    } else
+      die("unknown argument " + a);
   }
   if (!(o.rms_step_m > 0) || !(o.tol_m > 0)) die("--rms-step-mm and --tol-mm must be > 0");
   return o;
@@ -402,13 +428,16 @@ int main(int argc, char** argv) {
   for (const auto& p : paths) scenes.push_back(app::build_image_scene(p.string(), settings));
   const double t_scenes = now_s();
 
-  struct Job { std::size_t image, curve; };
+  struct Job {
+    std::size_t image, curve;
+  };
   std::vector<Job> jobs;
   for (std::size_t i = 0; i < scenes.size(); ++i)
     for (std::size_t c = 0; c < scenes[i].scene->curve_count(); ++c) jobs.push_back({i, c});
   // Longest curves first, so the last thread does not finish alone with a big one.
   std::sort(jobs.begin(), jobs.end(), [&](const Job& a, const Job& b) {
-    const auto na = scenes[a.image].scene->curve(a.curve).point_count[0], nb = scenes[b.image].scene->curve(b.curve).point_count[0];
+    const auto na = scenes[a.image].scene->curve(a.curve).point_count[0],
+               nb = scenes[b.image].scene->curve(b.curve).point_count[0];
     return na != nb ? na > nb : (a.image != b.image ? a.image < b.image : a.curve < b.curve);
   });
 
@@ -422,7 +451,8 @@ int main(int argc, char** argv) {
       for (std::size_t j; (j = next++) < jobs.size();) {
         const app::ImageScene& is = scenes[jobs[j].image];
         const std::size_t c = jobs[j].curve;
-        results[j] = analyse_curve(fs::path(is.image_path).stem().string(), *is.scene, c, is.polylines[is.scene->source_index(c)], opt, method_ns);
+        results[j] = analyse_curve(fs::path(is.image_path).stem().string(), *is.scene, c,
+                                   is.polylines[is.scene->source_index(c)], opt, method_ns);
       }
     });
   }
@@ -448,7 +478,8 @@ int main(int argc, char** argv) {
     level0_worst_px = std::max(level0_worst_px, 1e3 * r.levels[0].m[0].max_dev_m / mm_per_px[r.image]);
   }
 
-  std::printf("%-22s %5s %6s %9s %12s %12s %12s %12s\n", "method", "level", "curves", "vfrac", "max med mm", "max p90 mm", "rms med mm", "rms p90 mm");
+  std::printf("%-22s %5s %6s %9s %12s %12s %12s %12s\n", "method", "level", "curves", "vfrac", "max med mm",
+              "max p90 mm", "rms med mm", "rms p90 mm");
   for (int mth = 0; mth < kMethods; ++mth) {
     for (int l = 0; l <= max_level; ++l) {
       std::vector<double> frac, maxd, rms, cnt;
@@ -464,21 +495,24 @@ int main(int argc, char** argv) {
       std::size_t same_count = 0;
       for (const auto& r : results)
         if (l < static_cast<int>(r.levels.size())) same_count += r.levels[l].m[mth].n == r.levels[l].m[0].n;
-      aggregate.push_back({{"method", kMethodKey[mth]},
-                           {"curves_with_vertex_count_of_ours", same_count},
-                           {"level", l},
-                           {"curves", frac.size()},
-                           {"mean_vertex_fraction", r6(mean(frac))},
-                           {"mean_vertex_count", r6(mean(cnt))},
-                           {"max_dev_mm", {{"median", r6(percentile(maxd, 0.5))}, {"p90", r6(percentile(maxd, 0.9))}, {"mean", r6(mean(maxd))}}},
-                           {"rms_mm", {{"median", r6(percentile(rms, 0.5))}, {"p90", r6(percentile(rms, 0.9))}, {"mean", r6(mean(rms))}}}});
-      std::printf("%-22s %5d %6zu %9.4f %12.4f %12.4f %12.4f %12.4f\n", kMethodLabel[mth], l, frac.size(), mean(frac), percentile(maxd, 0.5),
-                  percentile(maxd, 0.9), percentile(rms, 0.5), percentile(rms, 0.9));
+      aggregate.push_back(
+          {{"method", kMethodKey[mth]},
+           {"curves_with_vertex_count_of_ours", same_count},
+           {"level", l},
+           {"curves", frac.size()},
+           {"mean_vertex_fraction", r6(mean(frac))},
+           {"mean_vertex_count", r6(mean(cnt))},
+           {"max_dev_mm",
+            {{"median", r6(percentile(maxd, 0.5))}, {"p90", r6(percentile(maxd, 0.9))}, {"mean", r6(mean(maxd))}}},
+           {"rms_mm",
+            {{"median", r6(percentile(rms, 0.5))}, {"p90", r6(percentile(rms, 0.9))}, {"mean", r6(mean(rms))}}}});
+      std::printf("%-22s %5d %6zu %9.4f %12.4f %12.4f %12.4f %12.4f\n", kMethodLabel[mth], l, frac.size(), mean(frac),
+                  percentile(maxd, 0.5), percentile(maxd, 0.9), percentile(rms, 0.5), percentile(rms, 0.9));
     }
   }
   std::printf("\nbox half-width / true max deviation (ours); scene max_error / true max deviation\n");
-  std::printf("%5s %6s %8s %11s %11s %9s %9s %9s %9s %8s %10s %10s\n", "level", "curves", "straight", "box med mm", "dev med mm", "ratio min",
-              "ratio med", "ratio p90", "ratio max", "ratio<1", "err/dev lo", "err/dev hi");
+  std::printf("%5s %6s %8s %11s %11s %9s %9s %9s %9s %8s %10s %10s\n", "level", "curves", "straight", "box med mm",
+              "dev med mm", "ratio min", "ratio med", "ratio p90", "ratio max", "ratio<1", "err/dev lo", "err/dev hi");
   for (int l = 0; l <= max_level; ++l) {
     std::vector<double> half, dev, ratio, scene_err, err_ratio;
     std::size_t below = 0, straight = 0;
@@ -498,20 +532,30 @@ int main(int argc, char** argv) {
       below += (q < 1.0);
     }
     if (half.empty()) continue;
-    auto lo_of = [](const std::vector<double>& v) { return v.empty() ? std::nan("") : *std::min_element(v.begin(), v.end()); };
-    auto hi_of = [](const std::vector<double>& v) { return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end()); };
-    boxes.push_back({{"level", l},
-                     {"curves", half.size()},
-                     {"straight_curves_excluded", straight},
-                     {"box_half_width_mm", {{"median", r6(percentile(half, 0.5))}, {"p90", r6(percentile(half, 0.9))}}},
-                     {"max_dev_mm", {{"median", r6(percentile(dev, 0.5))}, {"p90", r6(percentile(dev, 0.9))}}},
-                     {"scene_max_error_mm", {{"median", r6(percentile(scene_err, 0.5))}, {"p90", r6(percentile(scene_err, 0.9))}}},
-                     {"ratio", {{"min", r6(lo_of(ratio))}, {"median", r6(percentile(ratio, 0.5))}, {"p90", r6(percentile(ratio, 0.9))}, {"max", r6(hi_of(ratio))}}},
-                     {"curves_ratio_below_1", below},
-                     {"scene_error_over_dev", {{"min", r6(lo_of(err_ratio))}, {"median", r6(percentile(err_ratio, 0.5))}, {"max", r6(hi_of(err_ratio))}}}});
-    std::printf("%5d %6zu %8zu %11.4f %11.4f %9.3f %9.3f %9.3f %9.3f %8zu %10.3f %10.3f\n", l, half.size(), straight, percentile(half, 0.5),
-                percentile(dev, 0.5), lo_of(ratio), percentile(ratio, 0.5), percentile(ratio, 0.9), hi_of(ratio), below, lo_of(err_ratio),
-                hi_of(err_ratio));
+    auto lo_of = [](const std::vector<double>& v) {
+      return v.empty() ? std::nan("") : *std::min_element(v.begin(), v.end());
+    };
+    auto hi_of = [](const std::vector<double>& v) {
+      return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end());
+    };
+    boxes.push_back(
+        {{"level", l},
+         {"curves", half.size()},
+         {"straight_curves_excluded", straight},
+         {"box_half_width_mm", {{"median", r6(percentile(half, 0.5))}, {"p90", r6(percentile(half, 0.9))}}},
+         {"max_dev_mm", {{"median", r6(percentile(dev, 0.5))}, {"p90", r6(percentile(dev, 0.9))}}},
+         {"scene_max_error_mm", {{"median", r6(percentile(scene_err, 0.5))}, {"p90", r6(percentile(scene_err, 0.9))}}},
+         {"ratio",
+          {{"min", r6(lo_of(ratio))},
+           {"median", r6(percentile(ratio, 0.5))},
+           {"p90", r6(percentile(ratio, 0.9))},
+           {"max", r6(hi_of(ratio))}}},
+         {"curves_ratio_below_1", below},
+         {"scene_error_over_dev",
+          {{"min", r6(lo_of(err_ratio))}, {"median", r6(percentile(err_ratio, 0.5))}, {"max", r6(hi_of(err_ratio))}}}});
+    std::printf("%5d %6zu %8zu %11.4f %11.4f %9.3f %9.3f %9.3f %9.3f %8zu %10.3f %10.3f\n", l, half.size(), straight,
+                percentile(half, 0.5), percentile(dev, 0.5), lo_of(ratio), percentile(ratio, 0.5),
+                percentile(ratio, 0.9), hi_of(ratio), below, lo_of(err_ratio), hi_of(err_ratio));
   }
 
   nlohmann::ordered_json curves = nlohmann::ordered_json::array();
@@ -523,15 +567,18 @@ int main(int argc, char** argv) {
       for (int mth = 0; mth < kMethods; ++mth) {
         const Errors& e = lr.m[mth];
         nlohmann::ordered_json x = {{"n", e.n},
-                            {"vertex_fraction", r6(static_cast<double>(e.n) / static_cast<double>(r.n_orig))},
-                            {"max_dev_mm", mm(e.max_dev_m)},
-                            {"rms_mm", mm(e.rms_m)},
-                            {"h_orig_to_approx_mm", mm(e.h_orig_to_approx_m)},
-                            {"h_approx_to_orig_mm", mm(e.h_approx_to_orig_m)}};
+                                    {"vertex_fraction", r6(static_cast<double>(e.n) / static_cast<double>(r.n_orig))},
+                                    {"max_dev_mm", mm(e.max_dev_m)},
+                                    {"rms_mm", mm(e.rms_m)},
+                                    {"h_orig_to_approx_mm", mm(e.h_orig_to_approx_m)},
+                                    {"h_approx_to_orig_mm", mm(e.h_approx_to_orig_m)}};
         if (mth == 1) x["dp_epsilon_mm"] = r6(e.dp_eps_mm);
         ms[kMethodKey[mth]] = x;
       }
-      lv.push_back({{"level", lr.level}, {"box_half_width_mm", mm(lr.box_half_width_m)}, {"scene_max_error_mm", mm(lr.scene_max_error_m)}, {"methods", ms}});
+      lv.push_back({{"level", lr.level},
+                    {"box_half_width_mm", mm(lr.box_half_width_m)},
+                    {"scene_max_error_mm", mm(lr.scene_max_error_m)},
+                    {"methods", ms}});
     }
     curves.push_back({{"image", r.image},
                       {"curve", r.curve},
@@ -557,14 +604,16 @@ int main(int argc, char** argv) {
 
   const double t_end = now_s();
   nlohmann::ordered_json timing = {{"total_s", r6(t_end - t_start)},
-                           {"build_scenes_s", r6(t_scenes - t_start)},
-                           {"analysis_wall_s", r6(t_done - t_scenes)},
-                           {"threads", threads}};
-  for (int mth = 0; mth < kMethods; ++mth) timing["thread_s_" + std::string(kMethodKey[mth])] = r6(1e-9 * static_cast<double>(method_ns[mth].load()));
+                                   {"build_scenes_s", r6(t_scenes - t_start)},
+                                   {"analysis_wall_s", r6(t_done - t_scenes)},
+                                   {"threads", threads}};
+  for (int mth = 0; mth < kMethods; ++mth)
+    timing["thread_s_" + std::string(kMethodKey[mth])] = r6(1e-9 * static_cast<double>(method_ns[mth].load()));
 
   const nlohmann::ordered_json doc = {
-      {"what", "accuracy against size: each level of the pseudocoiflet model vs Douglas-Peucker, uniform arc-length "
-               "resampling and the linear (2,2) wavelet at equal vertex counts; errors against the original pixel chain"},
+      {"what",
+       "accuracy against size: each level of the pseudocoiflet model vs Douglas-Peucker, uniform arc-length "
+       "resampling and the linear (2,2) wavelet at equal vertex counts; errors against the original pixel chain"},
       {"settings",
        {{"max_levels", settings.haptics.max_levels},
         {"min_chain_length_m", settings.vision.min_chain_length_m},
@@ -600,10 +649,12 @@ int main(int argc, char** argv) {
   }
   f << "\n}\n";
   if (!f) die("write failed: " + opt.out.string());
-  std::printf("\n%zu curves from %zu pictures; level 0 of ours within %.4f mm (%.3f px) of the original everywhere\n", results.size(),
-              scenes.size(), level0_worst_mm, level0_worst_px);
-  std::printf("time: %.1f s total (scenes %.1f s, analysis %.1f s on %u threads; thread-seconds in ours %.1f dp %.1f uniform %.1f linear22 %.1f) -> %s\n",
-              t_end - t_start, t_scenes - t_start, t_done - t_scenes, threads, 1e-9 * method_ns[0].load(), 1e-9 * method_ns[1].load(),
-              1e-9 * method_ns[2].load(), 1e-9 * method_ns[3].load(), opt.out.string().c_str());
+  std::printf("\n%zu curves from %zu pictures; level 0 of ours within %.4f mm (%.3f px) of the original everywhere\n",
+              results.size(), scenes.size(), level0_worst_mm, level0_worst_px);
+  std::printf(
+      "time: %.1f s total (scenes %.1f s, analysis %.1f s on %u threads; thread-seconds in ours %.1f dp %.1f uniform "
+      "%.1f linear22 %.1f) -> %s\n",
+      t_end - t_start, t_scenes - t_start, t_done - t_scenes, threads, 1e-9 * method_ns[0].load(),
+      1e-9 * method_ns[1].load(), 1e-9 * method_ns[2].load(), 1e-9 * method_ns[3].load(), opt.out.string().c_str());
   return 0;
 }

@@ -23,7 +23,8 @@ using namespace hk::bench;
 namespace {
 
 std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 std::vector<Sweep> cold_sweeps(const Scene& sc, std::size_t n, std::uint32_t seed) {
@@ -83,11 +84,18 @@ nlohmann::json run(const std::string& name, const Scene& sc, const std::vector<S
     std::sort(ns.begin(), ns.end());
     const double n = static_cast<double>(sweeps.size());
     const double ns_per_box = boxes_total > 0 ? ns_total / boxes_total : 0.0;
-    rows.push_back({{"box_budget", box_budget}, {"exact_fraction", exact / n}, {"mean_level", level_sum / n},
-                    {"mean_error_mm", err_sum / n}, {"max_error_mm", err_max}, {"p50_ns", ns[ns.size() / 2]},
-                    {"p99_ns", ns[static_cast<std::size_t>(0.99 * (n - 1))]}, {"mean_box_tests", boxes_total / n},
+    rows.push_back({{"box_budget", box_budget},
+                    {"exact_fraction", exact / n},
+                    {"mean_level", level_sum / n},
+                    {"mean_error_mm", err_sum / n},
+                    {"max_error_mm", err_max},
+                    {"p50_ns", ns[ns.size() / 2]},
+                    {"p99_ns", ns[static_cast<std::size_t>(0.99 * (n - 1))]},
+                    {"mean_box_tests", boxes_total / n},
                     {"ns_per_box_test", ns_per_box}});
-    std::fprintf(stderr, "anytime %s budget %d box tests: exact %.3f, mean level %.2f, mean error %.3f mm, %.0f box tests, %.1f ns per box test\n",
+    std::fprintf(stderr,
+                 "anytime %s budget %d box tests: exact %.3f, mean level %.2f, mean error %.3f mm, %.0f box tests, "
+                 "%.1f ns per box test\n",
                  name.c_str(), box_budget, exact / n, level_sum / n, err_sum / n, boxes_total / n, ns_per_box);
   }
   return {{"scene", name}, {"segments", sc.total_segments(0)}, {"rows", rows}};

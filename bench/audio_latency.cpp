@@ -40,7 +40,9 @@ struct Tone final : hk::audio::AudioSource {
   std::uint64_t frames = 0;
   void render(float* out, std::size_t count) noexcept override {
     if (n < stamps.size()) {
-      stamps[n++] = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+      stamps[n++] =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+              .count();
     }
     const double step = 2 * std::numbers::pi * 440.0 / hk::audio::kSampleRateHz;
     for (std::size_t i = 0; i < count; ++i) {
@@ -100,11 +102,13 @@ int main(int argc, char** argv) {
     std::printf("{\"running\": false, \"why_not\": %s}\n", json_string(in.why_not).c_str());
     return 0;
   }
-  std::printf("{\"running\": true, \"device\": %s, \"host_api\": %s, \"sample_rate_hz\": %d, \"channels\": %d, "
-              "\"frames_per_buffer\": %d, \"buffer_ms\": %.3f, \"suggested_latency_ms\": %.3f, \"reported_latency_ms\": %.3f}\n",
-              json_string(in.device_name).c_str(), json_string(in.host_api).c_str(), in.sample_rate_hz, in.channels,
-              in.frames_per_buffer, 1e3 * in.frames_per_buffer / in.sample_rate_hz, p.suggested_latency_s * 1e3,
-              in.reported_latency_s * 1e3);
+  std::printf(
+      "{\"running\": true, \"device\": %s, \"host_api\": %s, \"sample_rate_hz\": %d, \"channels\": %d, "
+      "\"frames_per_buffer\": %d, \"buffer_ms\": %.3f, \"suggested_latency_ms\": %.3f, \"reported_latency_ms\": "
+      "%.3f}\n",
+      json_string(in.device_name).c_str(), json_string(in.host_api).c_str(), in.sample_rate_hz, in.channels,
+      in.frames_per_buffer, 1e3 * in.frames_per_buffer / in.sample_rate_hz, p.suggested_latency_s * 1e3,
+      in.reported_latency_s * 1e3);
   std::fflush(stdout);
   const auto t0 = std::chrono::steady_clock::now();
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
@@ -112,21 +116,26 @@ int main(int argc, char** argv) {
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   std::vector<double> dt_ms;
-  for (std::size_t i = 1; i < tone.n; ++i) dt_ms.push_back(static_cast<double>(tone.stamps[i] - tone.stamps[i - 1]) / 1e6);
+  for (std::size_t i = 1; i < tone.n; ++i)
+    dt_ms.push_back(static_cast<double>(tone.stamps[i] - tone.stamps[i - 1]) / 1e6);
   std::sort(dt_ms.begin(), dt_ms.end());
   auto pct = [&](double q) {
-    return dt_ms.empty() ? 0.0 : dt_ms[static_cast<std::size_t>(std::lround(q * static_cast<double>(dt_ms.size() - 1)))];
+    return dt_ms.empty() ? 0.0
+                         : dt_ms[static_cast<std::size_t>(std::lround(q * static_cast<double>(dt_ms.size() - 1)))];
   };
   const double span_s = tone.n >= 2 ? static_cast<double>(tone.stamps[tone.n - 1] - tone.stamps[0]) / 1e9 : 0.0;
   const double pulled_hz = span_s > 0 ? static_cast<double>(tone.n - 1) * in.frames_per_buffer / span_s : 0.0;
   // A device that is not paced by a clock (ALSA's null PCM) pulls as fast as the CPU allows: then the
   // period figures describe the CPU, not a sound card, and "paced" says so.
   const bool paced = pulled_hz > 0 && pulled_hz < 1.5 * in.sample_rate_hz;
-  std::printf("{\"seconds\": %.3f, \"callbacks\": %llu, \"underflows\": %llu, \"frames\": %llu, \"pulled_rate_hz\": %.1f, \"paced\": %s, "
-              "\"period_ms\": {\"expected\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"min\": %.3f, \"max\": %.3f}, "
-              "\"jitter_ms\": {\"p99_minus_p50\": %.3f}}\n",
-              elapsed_s, static_cast<unsigned long long>(out.callbacks()), static_cast<unsigned long long>(out.underflows()),
-              static_cast<unsigned long long>(tone.frames), pulled_hz, paced ? "true" : "false", 1e3 * in.frames_per_buffer / in.sample_rate_hz, pct(0.5),
-              pct(0.99), dt_ms.empty() ? 0.0 : dt_ms.front(), dt_ms.empty() ? 0.0 : dt_ms.back(), pct(0.99) - pct(0.5));
+  std::printf(
+      "{\"seconds\": %.3f, \"callbacks\": %llu, \"underflows\": %llu, \"frames\": %llu, \"pulled_rate_hz\": %.1f, "
+      "\"paced\": %s, "
+      "\"period_ms\": {\"expected\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"min\": %.3f, \"max\": %.3f}, "
+      "\"jitter_ms\": {\"p99_minus_p50\": %.3f}}\n",
+      elapsed_s, static_cast<unsigned long long>(out.callbacks()), static_cast<unsigned long long>(out.underflows()),
+      static_cast<unsigned long long>(tone.frames), pulled_hz, paced ? "true" : "false",
+      1e3 * in.frames_per_buffer / in.sample_rate_hz, pct(0.5), pct(0.99), dt_ms.empty() ? 0.0 : dt_ms.front(),
+      dt_ms.empty() ? 0.0 : dt_ms.back(), pct(0.99) - pct(0.5));
   return 0;
 }

@@ -48,8 +48,11 @@ int main(int argc, char** argv) {
   const config::Settings s;
   const fs::path tmp = fs::temp_directory_path() / ("hk_bench_capture_" + std::to_string(::getpid()));
   nlohmann::json rows = nlohmann::json::array();
-  std::printf("| picture | frame | found | look ms/frame | rectify ms | build ms | shapes | still page → felt s |\n|---|---|---|---|---|---|---|---|\n");
-  for (const char* name : {"horse.png", "coins.png", "page.png", "apple.jpg", "butterfly.jpg", "silhouette_3.png", "sudoku.png"}) {
+  std::printf(
+      "| picture | frame | found | look ms/frame | rectify ms | build ms | shapes | still page → felt s "
+      "|\n|---|---|---|---|---|---|---|---|\n");
+  for (const char* name :
+       {"horse.png", "coins.png", "page.png", "apple.jpg", "butterfly.jpg", "silhouette_3.png", "sudoku.png"}) {
     const cv::Mat picture = cv::imread((fs::path(HK_TEST_DATA_DIR) / "images" / name).string(), cv::IMREAD_COLOR);
     test::PhotoConditions c;
     c.rotation_deg = 12;
@@ -60,23 +63,31 @@ int main(int argc, char** argv) {
     const test::SyntheticPhoto photo = test::synthetic_photo(picture, cv::Size(1280, 960), c);
     if (!write_frame.empty()) {
       fs::create_directories(write_frame);
-      return cv::imwrite((fs::path(write_frame) / "frame.jpg").string(), photo.frame, {cv::IMWRITE_JPEG_QUALITY, 90}) ? 0 : 1;
+      return cv::imwrite((fs::path(write_frame) / "frame.jpg").string(), photo.frame, {cv::IMWRITE_JPEG_QUALITY, 90})
+                 ? 0
+                 : 1;
     }
     fs::remove_all(tmp);
     fs::create_directories(tmp);
     cv::imwrite((tmp / "frame.png").string(), photo.frame);
-    std::unique_ptr<vision::FrameSource> src = vision::open_frame_source(vision::parse_source_spec("file:" + tmp.string()),
-                                                                         frame_source_params_from(s));
+    std::unique_ptr<vision::FrameSource> src =
+        vision::open_frame_source(vision::parse_source_spec("file:" + tmp.string()), frame_source_params_from(s));
     const CaptureOutcome o = run_capture(*src, capture_params_from(s));
     const auto t0 = std::chrono::steady_clock::now();
     const ImageScene is = build_image_scene_from_picture(o.image, name, s);
     const double build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     const double look_ms = o.frames > 0 ? o.look_ms / o.frames : 0.0;
     const double felt_s = s.camera.still_s + kCameraFrameS + (look_ms + o.rectify_ms + build_ms) / 1000.0;
-    std::printf("| %s | 1280 x 960 | %s | %.1f | %.1f | %.1f | %zu | %.2f |\n", name, o.rectified ? "yes" : "no", look_ms, o.rectify_ms, build_ms,
-                is.scene->curve_count(), felt_s);
-    rows.push_back({{"picture", name}, {"found", o.rectified}, {"look_ms", look_ms}, {"rectify_ms", o.rectify_ms}, {"build_ms", build_ms},
-                    {"shapes", is.scene->curve_count()}, {"still_s", s.camera.still_s}, {"felt_s", felt_s}});
+    std::printf("| %s | 1280 x 960 | %s | %.1f | %.1f | %.1f | %zu | %.2f |\n", name, o.rectified ? "yes" : "no",
+                look_ms, o.rectify_ms, build_ms, is.scene->curve_count(), felt_s);
+    rows.push_back({{"picture", name},
+                    {"found", o.rectified},
+                    {"look_ms", look_ms},
+                    {"rectify_ms", o.rectify_ms},
+                    {"build_ms", build_ms},
+                    {"shapes", is.scene->curve_count()},
+                    {"still_s", s.camera.still_s},
+                    {"felt_s", felt_s}});
   }
   fs::remove_all(tmp);
   if (!out_json.empty()) std::ofstream(out_json) << rows.dump(2) << "\n";

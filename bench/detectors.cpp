@@ -53,7 +53,9 @@ void run(benchmark::State& state, const Picture* p, vision::Detector d) {
 }
 
 /// The generated textures of the comparison: (name, picture).
-std::vector<Picture> textures() { return {{"texture_noise", test::noise_texture(800, 520, 1)}, {"texture_wood", test::wood_texture(800, 520, 2)}}; }
+std::vector<Picture> textures() {
+  return {{"texture_noise", test::noise_texture(800, 520, 1)}, {"texture_wood", test::wood_texture(800, 520, 2)}};
+}
 
 }  // namespace
 
@@ -69,13 +71,17 @@ int main(int argc, char** argv) {
   vision::ImageLimits limits;
   for (const auto& path : bench::picture_paths()) {
     double px_scale = 1.0;
-    pictures().push_back({path.stem().string(), vision::to_grey(vision::load_image(path.string(), limits), s.vision.max_image_side_px, &px_scale)});
+    pictures().push_back({path.stem().string(), vision::to_grey(vision::load_image(path.string(), limits),
+                                                                s.vision.max_image_side_px, &px_scale)});
   }
   for (Picture& t : textures()) pictures().push_back(std::move(t));
   for (const Picture& p : pictures()) {
-    for (const vision::Detector d : {vision::Detector::Canny, vision::Detector::Surround, vision::Detector::Bilateral, vision::Detector::Edpf}) {
+    for (const vision::Detector d :
+         {vision::Detector::Canny, vision::Detector::Surround, vision::Detector::Bilateral, vision::Detector::Edpf}) {
       const std::string name = std::string("BM_Detector/") + vision::detector_name(d) + "/" + p.name;
-      benchmark::RegisterBenchmark(name.c_str(), [&p, d](benchmark::State& st) { run(st, &p, d); })->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(name.c_str(), [&p, d](benchmark::State& st) {
+        run(st, &p, d);
+      })->Unit(benchmark::kMillisecond);
     }
   }
   benchmark::RunSpecifiedBenchmarks();

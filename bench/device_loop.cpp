@@ -26,15 +26,15 @@
 #include <thread>
 #include <vector>
 
-#include "runtime/device_setup.hpp"
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/io/haply_device.hpp"
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/pty_emulator.hpp"
 #include "pictures/image_scene.hpp"
-#include "runtime/servo_thread.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/device_setup.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_thread.hpp"
 #include "runtime/simulation.hpp"
 #include "test_paths.hpp"
 
@@ -68,7 +68,9 @@ struct Board {
   explicit Board(const config::Settings& s) {
     dp = app::haply_params_from(s);
     emulator = std::make_unique<hapi::FirmwareEmulator>(app::emulator_params_from(s, {}), dp.rect_center_device_m,
-                                                        [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+                                                        [](double, Vec2, Vec2) {
+                                                          return Vec2{0.0, 0.0};
+                                                        });
     pty = std::make_unique<hapi::PtyEmulator>(*emulator);
     const std::string path = pty->device_path();
     device = std::make_unique<io::HaplyDevice>(dp, [path] { return std::make_unique<io::TtyTransport>(path); });
@@ -106,9 +108,11 @@ nlohmann::json round_trip(const config::Settings& s, double seconds) {
     }
     us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
   }
-  std::printf("| round trip tick → torque packet → reply over the pty | %ld | %.0f | %.0f | %.0f | %ld |\n", n, pct(us, 0.5), pct(us, 0.99),
-              pct(us, 1.0), missing);
-  return {{"ticks", n}, {"round_trip_us", {{"p50", pct(us, 0.5)}, {"p99", pct(us, 0.99)}, {"max", pct(us, 1.0)}}}, {"missing", missing}};
+  std::printf("| round trip tick → torque packet → reply over the pty | %ld | %.0f | %.0f | %.0f | %ld |\n", n,
+              pct(us, 0.5), pct(us, 0.99), pct(us, 1.0), missing);
+  return {{"ticks", n},
+          {"round_trip_us", {{"p50", pct(us, 0.5)}, {"p99", pct(us, 0.99)}, {"max", pct(us, 1.0)}}},
+          {"missing", missing}};
 }
 
 /// Plug-in to force: from the moment the kiosk asks a board that just arrived (its tty, through
@@ -118,20 +122,27 @@ nlohmann::json plug_in_to_force(const config::Settings& s, int runs) {
   std::vector<double> ms;
   for (int k = 0; k < runs; ++k) {
     hapi::FirmwareEmulator emulator(app::emulator_params_from(s, {}), app::haply_params_from(s).rect_center_device_m,
-                                    [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+                                    [](double, Vec2, Vec2) {
+                                      return Vec2{0.0, 0.0};
+                                    });
     hapi::PtyEmulator pty(emulator);
     const std::string path = pty.device_path();
     const auto t0 = std::chrono::steady_clock::now();
     std::unique_ptr<io::HaplyDevice> board =
-        io::open_first_board(app::haply_params_from(s), {{"tty " + path, [path] { return std::make_unique<io::TtyTransport>(path); }}}, nullptr);
+        io::open_first_board(app::haply_params_from(s),
+                             {{"tty " + path, [path] { return std::make_unique<io::TtyTransport>(path); }}}, nullptr);
     const auto t1 = std::chrono::steady_clock::now();
     if (board) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     if (board) board->close();
     pty.stop();
   }
-  std::printf("| plug-in to the board answering (open_first_board on its tty) | %d | %.1f ms | %.1f ms | %.1f ms | %d |\n", runs, pct(ms, 0.5),
-              pct(ms, 0.99), pct(ms, 1.0), runs - static_cast<int>(ms.size()));
-  return {{"runs", runs}, {"answered", ms.size()}, {"open_ms", {{"p50", pct(ms, 0.5)}, {"max", pct(ms, 1.0)}}}, {"force_ramp_s", s.haptics.force_ramp_s}};
+  std::printf(
+      "| plug-in to the board answering (open_first_board on its tty) | %d | %.1f ms | %.1f ms | %.1f ms | %d |\n",
+      runs, pct(ms, 0.5), pct(ms, 0.99), pct(ms, 1.0), runs - static_cast<int>(ms.size()));
+  return {{"runs", runs},
+          {"answered", ms.size()},
+          {"open_ms", {{"p50", pct(ms, 0.5)}, {"max", pct(ms, 1.0)}}},
+          {"force_ramp_s", s.haptics.force_ramp_s}};
 }
 
 /// The driver's calls as the servo thread makes them (read, then write_force, paced at 1 kHz, never waiting):
@@ -164,10 +175,12 @@ nlohmann::json step_calls(const config::Settings& s, double seconds) {
   }
   if (realtime) pthread_setschedparam(pthread_self(), old_policy, &old_param);
   const io::HaplyCounters c = b.device->counters();
-  std::printf("| servo step's read / write_force, never waiting (%s) | %ld | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f | %lld skipped, %lld late |\n",
-              realtime ? "SCHED_FIFO" : "normal priority", n,
-              pct(read_us, 0.5), pct(write_us, 0.5), pct(read_us, 0.99), pct(write_us, 0.99), pct(read_us, 1.0), pct(write_us, 1.0),
-              static_cast<long long>(c.writes_skipped), static_cast<long long>(c.replies_missing));
+  std::printf(
+      "| servo step's read / write_force, never waiting (%s) | %ld | %.0f / %.0f | %.0f / %.0f | %.0f / %.0f | %lld "
+      "skipped, %lld late |\n",
+      realtime ? "SCHED_FIFO" : "normal priority", n, pct(read_us, 0.5), pct(write_us, 0.5), pct(read_us, 0.99),
+      pct(write_us, 0.99), pct(read_us, 1.0), pct(write_us, 1.0), static_cast<long long>(c.writes_skipped),
+      static_cast<long long>(c.replies_missing));
   return {{"ticks", n},
           {"read_us", {{"p50", pct(read_us, 0.5)}, {"p99", pct(read_us, 0.99)}, {"max", pct(read_us, 1.0)}}},
           {"write_us", {{"p50", pct(write_us, 0.5)}, {"p99", pct(write_us, 0.99)}, {"max", pct(write_us, 1.0)}}},
@@ -209,18 +222,25 @@ nlohmann::json servo_run(const config::Settings& s, double seconds, bool usb) {
     st = thread.stats();
     realtime = thread.realtime();
   }
-  const double cpu_pct = ticks > 1 ? 100.0 * (cpu_last - cpu_first) / (static_cast<double>(ticks - 1) / s.haptics.servo_rate_hz) : 0.0;
+  const double cpu_pct =
+      ticks > 1 ? 100.0 * (cpu_last - cpu_first) / (static_cast<double>(ticks - 1) / s.haptics.servo_rate_hz) : 0.0;
   long long missing = 0;
   if (board) missing = board->device->counters().replies_missing;
   core.collect_retired();
   std::printf("| servo thread, %s | %lld | %.0f | %.0f | %.0f | %.1f | %.1f | %lld | %lld | %.1f %% | %s |\n",
-              usb ? "USB pantograph (emulated board on a pty)" : "simulated pantograph", static_cast<long long>(st.ticks), st.lateness_p50_us,
-              st.lateness_p99_us, st.lateness_max_us, st.compute_p50_us, st.compute_p99_us, static_cast<long long>(st.missed_deadlines), missing,
-              cpu_pct, realtime ? "SCHED_FIFO" : "normal");
-  return {{"device", usb ? "haply-emulator" : "simulated"}, {"ticks", st.ticks}, {"realtime", realtime},
+              usb ? "USB pantograph (emulated board on a pty)" : "simulated pantograph",
+              static_cast<long long>(st.ticks), st.lateness_p50_us, st.lateness_p99_us, st.lateness_max_us,
+              st.compute_p50_us, st.compute_p99_us, static_cast<long long>(st.missed_deadlines), missing, cpu_pct,
+              realtime ? "SCHED_FIFO" : "normal");
+  return {{"device", usb ? "haply-emulator" : "simulated"},
+          {"ticks", st.ticks},
+          {"realtime", realtime},
           {"lateness_us", {{"p50", st.lateness_p50_us}, {"p99", st.lateness_p99_us}, {"max", st.lateness_max_us}}},
-          {"compute_us", {{"p50", st.compute_p50_us}, {"p99", st.compute_p99_us}}}, {"missed_deadlines", st.missed_deadlines},
-          {"replies_missing", missing}, {"servo_thread_cpu_percent", cpu_pct}, {"seconds", seconds}};
+          {"compute_us", {{"p50", st.compute_p50_us}, {"p99", st.compute_p99_us}}},
+          {"missed_deadlines", st.missed_deadlines},
+          {"replies_missing", missing},
+          {"servo_thread_cpu_percent", cpu_pct},
+          {"seconds", seconds}};
 }
 
 }  // namespace
@@ -239,8 +259,10 @@ int main(int argc, char** argv) {
   j["round_trip"] = round_trip(s, seconds);
   j["step_calls"] = step_calls(s, seconds);
   j["plug_in"] = plug_in_to_force(s, 10);
-  std::printf("\n| run | ticks | lateness p50 µs | p99 µs | max µs | tick work p50 µs | p99 µs | missed | replies missing | servo thread CPU | priority |\n"
-              "|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "\n| run | ticks | lateness p50 µs | p99 µs | max µs | tick work p50 µs | p99 µs | missed | replies missing | "
+      "servo thread CPU | priority |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|\n");
   j["servo"] = {servo_run(s, seconds, false), servo_run(s, seconds, true)};
   if (!out_path.empty()) std::ofstream(out_path) << j.dump(2) << "\n";
   return 0;

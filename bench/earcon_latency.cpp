@@ -16,9 +16,9 @@
 
 #include "audio/mixer.hpp"
 #include "audio_analysis.hpp"
-#include "runtime/cue_tracker.hpp"
 #include "haptics/hand_path.hpp"
 #include "pictures/image_scene.hpp"
+#include "runtime/cue_tracker.hpp"
 #include "runtime/simulation.hpp"
 #include "test_paths.hpp"
 
@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
   std::map<std::string, long> missed, total;
   for (const char* name : {"horse.png", "silhouette_3.png", "coins.png", "butterfly.jpg"}) {
     app::ImageScene is = app::build_image_scene(std::string(HK_TEST_DATA_DIR) + "/images/" + name, s);
-    const HandPath hand = raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
+    const HandPath hand =
+        raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
     app::CueTrackerParams ctp;
     ctp.period_s = 1.0 / s.haptics.servo_rate_hz;
     ctp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
@@ -62,7 +63,8 @@ int main(int argc, char** argv) {
     const std::vector<std::size_t> on = test::onsets(x, 1e-3);
     long picture_cues = 0;
     for (const audio::CueEvent& e : cues) {
-      if (e.kind == audio::CueKind::Slide || e.kind == audio::CueKind::ContactEnd) continue;  // continuous / soft by design
+      if (e.kind == audio::CueKind::Slide || e.kind == audio::CueKind::ContactEnd)
+        continue;  // continuous / soft by design
       const std::string kind = audio::cue_kind_name(e.kind);
       const double t = static_cast<double>(e.tick) * ctp.period_s * audio::kSampleRateHz;
       const auto it = std::lower_bound(on.begin(), on.end(), static_cast<std::size_t>(t));
@@ -80,8 +82,10 @@ int main(int argc, char** argv) {
   for (const auto& [kind, n] : total) {
     const auto& v = lag_ms[kind];
     const double mx = v.empty() ? 0 : *std::max_element(v.begin(), v.end());
-    std::printf("| %s | %ld | %ld | %.2f | %.2f | %.2f |\n", kind.c_str(), n, missed[kind], pct(v, 0.5), pct(v, 0.99), mx);
-    j["latency"][kind] = {{"count", n}, {"missed", missed[kind]}, {"p50_ms", pct(v, 0.5)}, {"p99_ms", pct(v, 0.99)}, {"max_ms", mx}};
+    std::printf("| %s | %ld | %ld | %.2f | %.2f | %.2f |\n", kind.c_str(), n, missed[kind], pct(v, 0.5), pct(v, 0.99),
+                mx);
+    j["latency"][kind] = {
+        {"count", n}, {"missed", missed[kind]}, {"p50_ms", pct(v, 0.5)}, {"p99_ms", pct(v, 0.99)}, {"max_ms", mx}};
   }
 
   // Cost of the mix: CPU time per 256-frame buffer (5.3 ms of audio) with `voices` sounding.
@@ -100,7 +104,8 @@ int main(int argc, char** argv) {
       m.render(buf.data(), buf.size());
       us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
     }
-    std::printf("| %d | %.1f (p99 %.1f) | %.2f %% |\n", voices, pct(us, 0.5), pct(us, 0.99), 100.0 * pct(us, 0.5) / 5333.0);
+    std::printf("| %d | %.1f (p99 %.1f) | %.2f %% |\n", voices, pct(us, 0.5), pct(us, 0.99),
+                100.0 * pct(us, 0.5) / 5333.0);
     j["mixer_render_us"].push_back({{"voices", voices}, {"p50", pct(us, 0.5)}, {"p99", pct(us, 0.99)}});
   }
   if (!out_path.empty()) std::ofstream(out_path) << j.dump(2) << "\n";

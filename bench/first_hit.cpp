@@ -1,9 +1,9 @@
 // Servo query against peers: the same query streams answered by
 // our collision tree with its boundary section, by brute force, by a Boost.Geometry R-tree and by Embree
-// (bench/support/embree_peer.hpp); results checked equal before anything is timed. One benchmark iteration is one query, timed on its own (manual time), so
-// the mean and the percentiles describe the same measurements; each includes ~25–40 ns of clock reads.
-// net_mean_ns is the per-query mean less the clock's cost (clock_ns, measured in the same benchmark);
-// batch_mean_ns gives the mean again without them (blocks of queries timed as a whole).
+// (bench/support/embree_peer.hpp); results checked equal before anything is timed. One benchmark iteration is one
+// query, timed on its own (manual time), so the mean and the percentiles describe the same measurements; each includes
+// ~25–40 ns of clock reads. net_mean_ns is the per-query mean less the clock's cost (clock_ns, measured in the same
+// benchmark); batch_mean_ns gives the mean again without them (blocks of queries timed as a whole).
 //
 // Methods: ours (first_hit: boundary section, free-space ball, anytime answers at a coarser level),
 //          ours_wide (first_hit_wide: the scene's wide index alone, with a free-space ball from it; first hits
@@ -16,7 +16,8 @@
 //        BM_Level/<method>/<level>        — speed against accuracy: 4 pictures, queries at each level
 //        BM_Cut/<method>/<step>/<picture> — the same at the tolerance cut of a step (ours: first_hit_cut; the
 //                                           peers over the cut's joined pieces, bench::cut_segments)
-// Counters: p50_ns, p99_ns, max_ns per query; clock_ns, net_mean_ns; batch_mean_ns (not for brute); build_ms; bytes_per_segment; segments; max_error_mm; for
+// Counters: p50_ns, p99_ns, max_ns per query; clock_ns, net_mean_ns; batch_mean_ns (not for brute); build_ms;
+// bytes_per_segment; segments; max_error_mm; for
 //           ours and ours_wide, section_bytes_per_segment (the boundary section's own storage, BoundarySection::bytes,
 //           per level-0 segment; not in bytes_per_segment, which is the scene's), full_query_fraction (queries
 //           neither the free-space ball nor its walls answered),
@@ -26,9 +27,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <limits>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
 
 #include "bench_scenes.hpp"
@@ -40,7 +41,9 @@ using namespace hk::bench;
 
 namespace {
 
-double now_ms() { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 // One scene with its three indexes and a query stream, built once.
 struct Case {
@@ -69,14 +72,16 @@ double cut_error_mm(const Scene& sc, const std::vector<Polyline>& curves, int st
     const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
     for (const Vec2& p : curves[sc.source_index(c)].points_m) {
       double d = std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < cut.size(); ++i) d = std::min(d, distance_to_segment(p, pts[i], pts[(i + 1) % pts.size()]));
+      for (std::size_t i = 0; i < cut.size(); ++i)
+        d = std::min(d, distance_to_segment(p, pts[i], pts[(i + 1) % pts.size()]));
       worst = std::max(worst, d);
     }
   }
   return 1e3 * worst;
 }
 
-std::unique_ptr<Case> make_case(std::string name, std::vector<Polyline> curves, int level, std::vector<Sweep> stream, int cut_step = -1) {
+std::unique_ptr<Case> make_case(std::string name, std::vector<Polyline> curves, int level, std::vector<Sweep> stream,
+                                int cut_step = -1) {
   auto c = std::make_unique<Case>();
   c->name = std::move(name);
   c->level = level;
@@ -121,14 +126,17 @@ void check_equal(Case& c, std::size_t n) {
       QueryBudget unlimited;
       const SweepHit w = fresh.first_hit_wide(s.a, s.b, c.level, nullptr, 0, unlimited);
       if (w.hit != b.hit || (b.hit && w.t != b.t)) {
-        std::fprintf(stderr, "wide disagrees on %s query %zu (wide %d %.17g brute %d %.17g)\n", c.name.c_str(), i, w.hit, w.t, b.hit, b.t);
+        std::fprintf(stderr, "wide disagrees on %s query %zu (wide %d %.17g brute %d %.17g)\n", c.name.c_str(), i,
+                     w.hit, w.t, b.hit, b.t);
         std::exit(2);
       }
     }
     const PeerHit r = c.rtree->first_hit(s.a, s.b);
     const PeerHit e = c.embree->first_hit(s.a, s.b);
     if (h.hit != b.hit || r.hit != b.hit || e.hit != b.hit || (b.hit && (h.t != b.t || r.t != b.t || e.t != b.t))) {
-      std::fprintf(stderr, "first_hit: methods disagree on %s query %zu (ours %d %.17g, brute %d %.17g, rtree %d %.17g, embree %d %.17g)\n",
+      std::fprintf(stderr,
+                   "first_hit: methods disagree on %s query %zu (ours %d %.17g, brute %d %.17g, rtree %d %.17g, embree "
+                   "%d %.17g)\n",
                    c.name.c_str(), i, h.hit, h.t, b.hit, b.t, r.hit, r.t, e.hit, e.t);
       std::exit(2);
     }
@@ -140,24 +148,30 @@ void check_equal(Case& c, std::size_t n) {
       const double ours = fresh.closest_point(s.b, c.level, 1.0, &q, &seg) ? distance(s.b, q) : 1.0;
       const double rt = c.rtree->closest_distance(s.b), em = c.embree->closest_distance(s.b);
       if (std::abs(ours - want) > 1e-15 || std::abs(rt - want) > 1e-15 || std::abs(em - want) > 1e-15) {
-        std::fprintf(stderr, "closest: methods disagree on %s query %zu (ours %.17g, brute %.17g, rtree %.17g, embree %.17g)\n", c.name.c_str(), i,
-                     ours, want, rt, em);
+        std::fprintf(stderr,
+                     "closest: methods disagree on %s query %zu (ours %.17g, brute %.17g, rtree %.17g, embree %.17g)\n",
+                     c.name.c_str(), i, ours, want, rt, em);
         std::exit(2);
       }
     }
   }
-  std::fprintf(stderr, "first_hit: %s: %zu segments, %zu queries checked equal (%zu hits)\n", c.name.c_str(), c.segs.size(),
-               std::min(n, c.stream.size()), hits);
+  std::fprintf(stderr, "first_hit: %s: %zu segments, %zu queries checked equal (%zu hits)\n", c.name.c_str(),
+               c.segs.size(), std::min(n, c.stream.size()), hits);
 }
 
 enum class Method { Ours, Brute, Rtree, Embree, Wide };
 const char* method_name(Method m) {
   switch (m) {
-    case Method::Ours: return "ours";
-    case Method::Brute: return "brute";
-    case Method::Rtree: return "rtree";
-    case Method::Embree: return "embree";
-    case Method::Wide: return "ours_wide";
+    case Method::Ours:
+      return "ours";
+    case Method::Brute:
+      return "brute";
+    case Method::Rtree:
+      return "rtree";
+    case Method::Embree:
+      return "embree";
+    case Method::Wide:
+      return "ours_wide";
   }
   return "?";
 }
@@ -165,7 +179,9 @@ const char* method_name(Method m) {
 void set_percentiles(benchmark::State& state, std::vector<double>& ns) {
   if (ns.empty()) return;
   std::sort(ns.begin(), ns.end());
-  auto at = [&](double q) { return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * static_cast<double>(ns.size() - 1) + 0.5))]; };
+  auto at = [&](double q) {
+    return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * static_cast<double>(ns.size() - 1) + 0.5))];
+  };
   state.counters["p50_ns"] = at(0.5);
   state.counters["p99_ns"] = at(0.99);
   state.counters["max_ns"] = ns.back();
@@ -183,9 +199,12 @@ bool first_hit_once(Case* c, Method m, const Sweep& s, QueryStats* st) {
       QueryBudget unlimited;
       return c->ours->first_hit_wide(s.a, s.b, c->level, nullptr, 0, unlimited, st).hit;
     }
-    case Method::Brute: return c->brute->first_hit(s.a, s.b).hit;
-    case Method::Rtree: return c->rtree->first_hit(s.a, s.b).hit;
-    case Method::Embree: return c->embree->first_hit(s.a, s.b).hit;
+    case Method::Brute:
+      return c->brute->first_hit(s.a, s.b).hit;
+    case Method::Rtree:
+      return c->rtree->first_hit(s.a, s.b).hit;
+    case Method::Embree:
+      return c->embree->first_hit(s.a, s.b).hit;
   }
   return false;
 }
@@ -196,12 +215,14 @@ bool first_hit_once(Case* c, Method m, const Sweep& s, QueryStats* st) {
 // ~20 ms holds at the per-query mean, at most the whole stream and at least 1000. query(i) runs query i.
 template <class Query>
 double batch_mean_ns(std::size_t stream_size, double per_query_mean_ns, Query&& query) {
-  const auto n = static_cast<std::size_t>(std::clamp(2e7 / std::max(per_query_mean_ns, 1.0), 1000.0, static_cast<double>(stream_size)));
+  const auto n = static_cast<std::size_t>(
+      std::clamp(2e7 / std::max(per_query_mean_ns, 1.0), 1000.0, static_cast<double>(stream_size)));
   double best = std::numeric_limits<double>::infinity();
   for (int block = 0; block < 3; ++block) {
     const auto t0 = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < n; ++i) query(i);
-    best = std::min(best, std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / static_cast<double>(n));
+    best = std::min(best, std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() /
+                              static_cast<double>(n));
   }
   return best;
 }
@@ -263,13 +284,15 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     hits += hit;
     seg_tests += static_cast<std::size_t>(st.segment_tests);
     box_tests += static_cast<std::size_t>(st.box_tests);
-    full += st.section_box_tests > 0;  // a full query (not answered by the free-space ball or its walls): it scans the section
+    full += st.section_box_tests >
+            0;  // a full query (not answered by the free-space ball or its walls): it scans the section
     section += static_cast<std::size_t>(st.section_size);
     benchmark::DoNotOptimize(hit);
   }
   set_percentiles(state, ns);
   set_net_mean(state, total_s);
-  set_batch_mean(state, c, m, total_s, [&](std::size_t k) { benchmark::DoNotOptimize(first_hit_once(c, m, c->stream[k], nullptr)); });
+  set_batch_mean(state, c, m, total_s,
+                 [&](std::size_t k) { benchmark::DoNotOptimize(first_hit_once(c, m, c->stream[k], nullptr)); });
   if (m == Method::Ours || m == Method::Wide) {
     const double n = static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
     state.counters["segment_tests"] = static_cast<double>(seg_tests) / n;  // per query
@@ -279,7 +302,8 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
   }
   const double segs = static_cast<double>(c->segs.size());
   state.counters["segments"] = segs;
-  state.counters["hit_fraction"] = static_cast<double>(hits) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+  state.counters["hit_fraction"] =
+      static_cast<double>(hits) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
   state.counters["max_error_mm"] = c->max_error_mm;
   if (c->cut_step >= 0) state.counters["tolerance_mm"] = 1e3 * kToleranceLadder_m[c->cut_step];
   if (m == Method::Ours || m == Method::Wide) {
@@ -288,7 +312,8 @@ void run_first_hit(benchmark::State& state, Case* c, Method m) {
     // counts them per level-0 segment: BM_FirstHit).
     if (c->cut_step < 0) {
       state.counters["bytes_per_segment"] = static_cast<double>(c->scene->hot_bytes()) / segs;
-      state.counters["section_bytes_per_segment"] = static_cast<double>(c->ours->bytes()) / segs;  // the query's own state
+      state.counters["section_bytes_per_segment"] =
+          static_cast<double>(c->ours->bytes()) / segs;  // the query's own state
     }
   } else if (m == Method::Brute) {
     state.counters["build_ms"] = c->build_ms_brute;
@@ -368,10 +393,14 @@ double closest_once(Case* c, Method m, Vec2 p, QueryBudget* counted) {
       SegmentRef s;
       return c->ours->closest_point(p, c->level, 1.0, &q, &s, -1, counted) ? distance(p, q) : 1.0;
     }
-    case Method::Brute: return c->brute->closest_distance(p);
-    case Method::Rtree: return c->rtree->closest_distance(p);
-    case Method::Embree: return c->embree->closest_distance(p);
-    case Method::Wide: break;  // not a closest-point method
+    case Method::Brute:
+      return c->brute->closest_distance(p);
+    case Method::Rtree:
+      return c->rtree->closest_distance(p);
+    case Method::Embree:
+      return c->embree->closest_distance(p);
+    case Method::Wide:
+      break;  // not a closest-point method
   }
   return 1.0;
 }
@@ -398,11 +427,13 @@ void run_closest(benchmark::State& state, Case* c, Method m) {
   }
   set_percentiles(state, ns);
   set_net_mean(state, total_s);
-  set_batch_mean(state, c, m, total_s, [&](std::size_t k) { benchmark::DoNotOptimize(closest_once(c, m, c->stream[k].b, nullptr)); });
+  set_batch_mean(state, c, m, total_s,
+                 [&](std::size_t k) { benchmark::DoNotOptimize(closest_once(c, m, c->stream[k].b, nullptr)); });
   state.counters["segments"] = static_cast<double>(c->segs.size());
   if (m == Method::Ours) {
     // Box tests per call (every call walks; four per wide node opened).
-    state.counters["box_tests_per_walk"] = static_cast<double>(walk_box_tests) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+    state.counters["box_tests_per_walk"] =
+        static_cast<double>(walk_box_tests) / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
   }
 }
 
@@ -436,16 +467,19 @@ int main(int argc, char** argv) {
     check_equal(*c, n >= 1000000 ? 300 : 3000);
     Case* cp = c.get();
     if (n >= 100000) {  // the sizes the performance targets name
-      benchmark::RegisterBenchmark(("BM_FirstHitPaired/" + std::to_string(n)).c_str(), [cp](benchmark::State& s) { run_paired(s, cp); })
+      benchmark::RegisterBenchmark(("BM_FirstHitPaired/" + std::to_string(n)).c_str(),
+                                   [cp](benchmark::State& s) { run_paired(s, cp); })
           ->Iterations(1)
           ->Unit(benchmark::kMillisecond);
     }
     for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute, Method::Wide}) {
       benchmark::RegisterBenchmark(("BM_FirstHit/" + std::string(method_name(m)) + "/" + std::to_string(n)).c_str(),
-                                   [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+                                   [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })
+          ->UseManualTime();
       if (m == Method::Wide) continue;  // a first-hit variant only: closest_point already walks the wide index
       benchmark::RegisterBenchmark(("BM_Closest/" + std::string(method_name(m)) + "/" + std::to_string(n)).c_str(),
-                                   [cp, m](benchmark::State& s) { run_closest(s, cp, m); })->UseManualTime();
+                                   [cp, m](benchmark::State& s) { run_closest(s, cp, m); })
+          ->UseManualTime();
     }
     cases.push_back(std::move(c));
   }
@@ -454,7 +488,8 @@ int main(int argc, char** argv) {
   const auto paths = picture_paths();
   std::vector<std::vector<Sweep>> streams(paths.size());
   auto stream_of = [&](std::size_t i) -> const std::vector<Sweep>& {
-    if (streams[i].empty()) streams[i] = explore_stream(Scene::build(pictures[i], settings.haptics.max_levels), settings);
+    if (streams[i].empty())
+      streams[i] = explore_stream(Scene::build(pictures[i], settings.haptics.max_levels), settings);
     return streams[i];
   };
   for (std::size_t i = 0; i < paths.size(); ++i) {
@@ -464,7 +499,8 @@ int main(int argc, char** argv) {
     Case* cp = c.get();
     for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute, Method::Wide}) {
       benchmark::RegisterBenchmark(("BM_Picture/" + std::string(method_name(m)) + "/" + cp->name).c_str(),
-                                   [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+                                   [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })
+          ->UseManualTime();
     }
     cases.push_back(std::move(c));
   }
@@ -479,8 +515,10 @@ int main(int argc, char** argv) {
       check_equal(*c, 2000);
       Case* cp = c.get();
       for (Method m : {Method::Ours, Method::Wide, Method::Rtree, Method::Embree, Method::Brute}) {
-        benchmark::RegisterBenchmark(("BM_Level/" + std::string(method_name(m)) + "/" + std::to_string(level) + "/" + name).c_str(),
-                                     [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+        benchmark::RegisterBenchmark(
+            ("BM_Level/" + std::string(method_name(m)) + "/" + std::to_string(level) + "/" + name).c_str(),
+            [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })
+            ->UseManualTime();
       }
       cases.push_back(std::move(c));
     }
@@ -495,8 +533,10 @@ int main(int argc, char** argv) {
       check_equal(*c, 2000);
       Case* cp = c.get();
       for (Method m : {Method::Ours, Method::Rtree, Method::Embree, Method::Brute}) {
-        benchmark::RegisterBenchmark(("BM_Cut/" + std::string(method_name(m)) + "/" + std::to_string(step) + "/" + name).c_str(),
-                                     [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })->UseManualTime();
+        benchmark::RegisterBenchmark(
+            ("BM_Cut/" + std::string(method_name(m)) + "/" + std::to_string(step) + "/" + name).c_str(),
+            [cp, m](benchmark::State& s) { run_first_hit(s, cp, m); })
+            ->UseManualTime();
       }
       cases.push_back(std::move(c));
     }

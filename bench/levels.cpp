@@ -57,8 +57,11 @@ int main(int argc, char** argv) {
   raw.vision.max_segments = 1000000;
   config::Settings tight = s;
   tight.vision.max_segments = 3000;
-  std::printf("| picture | chains found | thin-line pairs merged | too short | level-0 segments, nothing simplified | after merging and dropping | after the budget (%d) | after a %d budget (chains dropped) | level changes | ticks waiting for a safe change | wait per change p50 / p90 ms | tick p50 µs | p99 µs | max µs |\n",
-              s.vision.max_segments, tight.vision.max_segments);
+  std::printf(
+      "| picture | chains found | thin-line pairs merged | too short | level-0 segments, nothing simplified | after "
+      "merging and dropping | after the budget (%d) | after a %d budget (chains dropped) | level changes | ticks "
+      "waiting for a safe change | wait per change p50 / p90 ms | tick p50 µs | p99 µs | max µs |\n",
+      s.vision.max_segments, tight.vision.max_segments);
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const fs::path& f : files) {
     const app::ImageScene is = app::build_image_scene(f.string(), s);
@@ -110,14 +113,19 @@ int main(int argc, char** argv) {
     pj["level_changes"] = changes;
     pj["ticks"] = tick_us.size();
     pj["ticks_waiting"] = waiting;
-    pj["change_wait_ms"] = {{"p50", percentile(waits_ms, 0.5)}, {"p90", percentile(waits_ms, 0.9)}, {"max", percentile(waits_ms, 1.0)}};
-    pj["tick_us"] = {{"p50", percentile(tick_us, 0.5)}, {"p99", percentile(tick_us, 0.99)}, {"max", percentile(tick_us, 1.0)}};
+    pj["change_wait_ms"] = {
+        {"p50", percentile(waits_ms, 0.5)}, {"p90", percentile(waits_ms, 0.9)}, {"max", percentile(waits_ms, 1.0)}};
+    pj["tick_us"] = {
+        {"p50", percentile(tick_us, 0.5)}, {"p99", percentile(tick_us, 0.99)}, {"max", percentile(tick_us, 1.0)}};
     pictures.push_back(pj);
-    std::printf("| %s | %zu | %zu | %zu | %zu | %zu | %zu | %zu (%zu) | %ld | %.0f %% | %.0f / %.0f | %.1f | %.1f | %.0f |\n", f.filename().c_str(), is.chains_found,
-                is.thin_line_pairs_merged, is.chains_too_short, raw_segments, is.segments_before_budget, is.segments_after_budget,
-                tight_is.segments_after_budget, tight_is.chains_over_budget, changes, 100.0 * static_cast<double>(waiting) / static_cast<double>(std::max<std::size_t>(1, tick_us.size())),
-                percentile(waits_ms, 0.5), percentile(waits_ms, 0.9),
-                percentile(tick_us, 0.5), percentile(tick_us, 0.99), percentile(tick_us, 1.0));
+    std::printf(
+        "| %s | %zu | %zu | %zu | %zu | %zu | %zu | %zu (%zu) | %ld | %.0f %% | %.0f / %.0f | %.1f | %.1f | %.0f |\n",
+        f.filename().c_str(), is.chains_found, is.thin_line_pairs_merged, is.chains_too_short, raw_segments,
+        is.segments_before_budget, is.segments_after_budget, tight_is.segments_after_budget,
+        tight_is.chains_over_budget, changes,
+        100.0 * static_cast<double>(waiting) / static_cast<double>(std::max<std::size_t>(1, tick_us.size())),
+        percentile(waits_ms, 0.5), percentile(waits_ms, 0.9), percentile(tick_us, 0.5), percentile(tick_us, 0.99),
+        percentile(tick_us, 1.0));
   }
   // Second table: share of ticks at each level per speed bin, all pictures together.
   std::printf("\n| hand speed | ticks |");
@@ -140,14 +148,17 @@ int main(int argc, char** argv) {
     } else {
       std::printf("| ≥ %.0f mm/s | %ld |", 1e3 * bin_edges[b], total);
     }
-    for (long n : sum) std::printf(" %.0f %% |", total ? 100.0 * static_cast<double>(n) / static_cast<double>(total) : 0.0);
+    for (long n : sum)
+      std::printf(" %.0f %% |", total ? 100.0 * static_cast<double>(n) / static_cast<double>(total) : 0.0);
     std::printf("\n");
   }
   nlohmann::json j;
   j["speeds_m_per_s"] = speeds;
   j["pictures"] = pictures;
-  j["policy"] = {{"error_at_rest_m", s.haptics.level_error_at_rest_m}, {"blur_time_s", s.haptics.level_blur_time_s},
-                 {"hysteresis", s.haptics.level_hysteresis}, {"min_dwell_s", s.haptics.level_min_dwell_s}};
+  j["policy"] = {{"error_at_rest_m", s.haptics.level_error_at_rest_m},
+                 {"blur_time_s", s.haptics.level_blur_time_s},
+                 {"hysteresis", s.haptics.level_hysteresis},
+                 {"min_dwell_s", s.haptics.level_min_dwell_s}};
   if (!out_path.empty()) std::ofstream(out_path) << j.dump(1) << "\n";
   return 0;
 }

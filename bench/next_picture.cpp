@@ -31,14 +31,14 @@
 #include <thread>
 #include <vector>
 
+#include <spdlog/spdlog.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
 
-#include "visit/kiosk_flow.hpp"
-#include "visit/kiosk_runtime.hpp"
 #include "pictures/view_geometry.hpp"
 #include "test_paths.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
 
 using namespace hk;
 using namespace hk::app;
@@ -49,7 +49,9 @@ namespace {
 
 constexpr double kFrame_s = 1.0 / 60.0;
 
-double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
 
 /// fruits.jpg (or another) upscaled to w x h with a little Gaussian noise, as a phone's sensor leaves it.
 cv::Mat photo(const std::string& name, int w, int h) {
@@ -66,7 +68,8 @@ cv::Mat photo(const std::string& name, int w, int h) {
 cv::Mat chessboard(int w, int h, int square_px) {
   cv::Mat m(h, w, CV_8UC3);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) m.at<cv::Vec3b>(y, x) = ((y / square_px + x / square_px) % 2) ? cv::Vec3b(255, 255, 255) : cv::Vec3b(0, 0, 0);
+    for (int x = 0; x < w; ++x)
+      m.at<cv::Vec3b>(y, x) = ((y / square_px + x / square_px) % 2) ? cv::Vec3b(255, 255, 255) : cv::Vec3b(0, 0, 0);
   return m;
 }
 
@@ -74,10 +77,13 @@ cv::Mat chessboard(int w, int h, int square_px) {
 void make_library(const fs::path& lib, bool quick) {
   fs::create_directories(lib);
   for (const auto& e : fs::directory_iterator(fs::path(HK_TEST_DATA_DIR) / "images"))
-    if (!quick || e.path().filename() == "horse.png" || e.path().filename() == "fruits.jpg") fs::copy_file(e.path(), lib / e.path().filename());
-  cv::imwrite((lib / "zz_phone24_fruits.jpg").string(), photo("fruits.jpg", 6000, 4000), {cv::IMWRITE_JPEG_QUALITY, 92});
+    if (!quick || e.path().filename() == "horse.png" || e.path().filename() == "fruits.jpg")
+      fs::copy_file(e.path(), lib / e.path().filename());
+  cv::imwrite((lib / "zz_phone24_fruits.jpg").string(), photo("fruits.jpg", 6000, 4000),
+              {cv::IMWRITE_JPEG_QUALITY, 92});
   if (quick) return;
-  cv::imwrite((lib / "zz_phone24_butterfly.jpg").string(), photo("butterfly.jpg", 6000, 4000), {cv::IMWRITE_JPEG_QUALITY, 92});
+  cv::imwrite((lib / "zz_phone24_butterfly.jpg").string(), photo("butterfly.jpg", 6000, 4000),
+              {cv::IMWRITE_JPEG_QUALITY, 92});
   cv::imwrite((lib / "zz_phone12_apple.jpg").string(), photo("apple.jpg", 4000, 3000), {cv::IMWRITE_JPEG_QUALITY, 92});
   cv::imwrite((lib / "zz_png13_photo.png").string(), photo("fruits.jpg", 3723, 3595));
   cv::imwrite((lib / "zz_png13_chessboard.png").string(), chessboard(3723, 3595, 400));
@@ -167,7 +173,7 @@ double p95(std::vector<double> v) {
 void walk(Rig& r, int pictures, int repeats, bool linger, std::vector<std::vector<double>>& out) {
   r.flow->key(KioskKey::Other, r.now_s);
   for (int i = 0; i < 2; ++i) r.flow->key(KioskKey::Next, r.now_s);  // square -> circle -> triangle
-  r.press_until_felt(KioskKey::Next, 0);                                // picture 1
+  r.press_until_felt(KioskKey::Next, 0);                             // picture 1
   for (int rep = 0; rep < repeats; ++rep) {
     for (int i = 1; i <= pictures; ++i) {
       if (linger) r.linger(30.0);
@@ -239,40 +245,55 @@ int main(int argc, char** argv) {
   }
   std::vector<std::vector<double>> cold(files.size()), ahead(files.size()), cached(files.size());
   const auto peak_kb = [] {
-    struct rusage u{};
+    struct rusage u {};
     getrusage(RUSAGE_SELF, &u);
     return u.ru_maxrss;
   };
-  { Rig r(lib, 0, ""); walk(r, n, repeats, false, cold); }
+  {
+    Rig r(lib, 0, "");
+    walk(r, n, repeats, false, cold);
+  }
   const long rss_cold_kb = peak_kb();
-  { Rig r(lib, 256, ""); walk(r, n, repeats, true, ahead); }
+  {
+    Rig r(lib, 256, "");
+    walk(r, n, repeats, true, ahead);
+  }
   const long rss_prefetch_kb = peak_kb();
-  { Rig fill(lib, 0, cache.string()); walk(fill, n, 1, false, cached); }  // fills the cache
+  {
+    Rig fill(lib, 0, cache.string());
+    walk(fill, n, 1, false, cached);
+  }  // fills the cache
   for (auto& v : cached) v.clear();
-  { Rig r(lib, 0, cache.string()); walk(r, n, repeats, false, cached); }  // a fresh start over it
+  {
+    Rig r(lib, 0, cache.string());
+    walk(r, n, repeats, false, cached);
+  }  // a fresh start over it
 
   // Stick: a 51-page PDF paged through with Next, cold and built ahead.
   std::vector<double> stick_cold, stick_ahead;
   const fs::path stick = tmp / "stick";
   fs::create_directories(stick);
   const std::string spec = std::string(HK_TEST_DATA_DIR) + "/documents/shared-mime-info-spec.pdf";
-  const std::string cmd = "pdfunite '" + spec + "' '" + spec + "' '" + spec + "' '" + (stick / "long.pdf").string() + "' 2>/dev/null";
+  const std::string cmd =
+      "pdfunite '" + spec + "' '" + spec + "' '" + spec + "' '" + (stick / "long.pdf").string() + "' 2>/dev/null";
   if (!quick && std::system(cmd.c_str()) == 0) {
     stick_cold = stick_walk(lib, stick, 0);
     stick_ahead = stick_walk(lib, stick, 256);
   }
 
   std::ostringstream md;
-  md << "Generated by `build/bench/bench_next_picture --repeats " << repeats << "` (bench/next_picture.cpp): Next pressed, key -> first servo tick on the new scene [ms], median of "
-     << repeats << " walks through the library; the window thread polls at 60 Hz.\n\n";
-  md << "| picture | bytes | pixels | cold | cold, slowest walk | prefetched | cached |\n|---|---|---|---|---|---|---|\n";
+  md << "Generated by `build/bench/bench_next_picture --repeats " << repeats
+     << "` (bench/next_picture.cpp): Next pressed, key -> first servo tick on the new scene [ms], median of " << repeats
+     << " walks through the library; the window thread polls at 60 Hz.\n\n";
+  md << "| picture | bytes | pixels | cold | cold, slowest walk | prefetched | cached "
+        "|\n|---|---|---|---|---|---|---|\n";
   std::vector<double> all_cold, all_ahead, all_cached, small_cold, big_cold;
   for (int i = 0; i < n; ++i) {
     const Row& r = rows[static_cast<std::size_t>(i)];
     const std::size_t k = static_cast<std::size_t>(i);
-    md << "| " << r.name << " | " << r.bytes << " | " << r.w << " x " << r.h << " | " << ms_text(median(cold[k])) << " | "
-       << ms_text(*std::max_element(cold[k].begin(), cold[k].end())) << " | " << ms_text(median(ahead[k])) << " | "
-       << ms_text(median(cached[k])) << " |\n";
+    md << "| " << r.name << " | " << r.bytes << " | " << r.w << " x " << r.h << " | " << ms_text(median(cold[k]))
+       << " | " << ms_text(*std::max_element(cold[k].begin(), cold[k].end())) << " | " << ms_text(median(ahead[k]))
+       << " | " << ms_text(median(cached[k])) << " |\n";
     for (double v : cold[k]) (r.name.rfind("zz_png13", 0) == 0 ? big_cold : small_cold).push_back(v);
     all_ahead.insert(all_ahead.end(), ahead[k].begin(), ahead[k].end());
     all_cached.insert(all_cached.end(), cached[k].begin(), cached[k].end());
@@ -280,7 +301,8 @@ int main(int argc, char** argv) {
   md << "\n| set | presses | p50 [ms] | p95 [ms] | max [ms] |\n|---|---|---|---|---|\n";
   const auto line = [&](const char* what, const std::vector<double>& v) {
     if (v.empty()) return;
-    md << "| " << what << " | " << v.size() << " | " << ms_text(median(v)) << " | " << ms_text(p95(v)) << " | " << ms_text(*std::max_element(v.begin(), v.end())) << " |\n";
+    md << "| " << what << " | " << v.size() << " | " << ms_text(median(v)) << " | " << ms_text(p95(v)) << " | "
+       << ms_text(*std::max_element(v.begin(), v.end())) << " |\n";
   };
   line("cold: tests/data pictures and JPEG phone photos", small_cold);
   line("cold: 13 MP PNGs", big_cold);
@@ -288,8 +310,8 @@ int main(int argc, char** argv) {
   line("prefetched", all_ahead);
   line("prefetched: pages 2-51 of a 51-page PDF on a stick", stick_ahead);
   line("cached (after a restart)", all_cached);
-  md << "\nPeak resident memory of the process: " << rss_cold_kb / 1024 << " MiB after the cold walk, " << rss_prefetch_kb / 1024
-     << " MiB after the prefetched walk ([kiosk] prefetch_mb = 256).\n";
+  md << "\nPeak resident memory of the process: " << rss_cold_kb / 1024 << " MiB after the cold walk, "
+     << rss_prefetch_kb / 1024 << " MiB after the prefetched walk ([kiosk] prefetch_mb = 256).\n";
   std::fputs(md.str().c_str(), stdout);
   if (!out_path.empty()) std::ofstream(out_path) << md.str();
   fs::remove_all(tmp);

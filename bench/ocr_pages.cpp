@@ -22,8 +22,8 @@
 #include "pictures/image_scene.hpp"
 #include "scans.hpp"
 #include "synthetic_photo.hpp"
-#include "vision/page.hpp"
 #include "test_paths.hpp"
+#include "vision/page.hpp"
 
 namespace fs = std::filesystem;
 
@@ -64,7 +64,8 @@ int curves_in(const hk::app::ImageScene& is, const std::vector<hk::app::TextBloc
 }
 
 /// One row of the "page shown" table: the page built as the kiosk builds it (text later), then its text.
-void shown_row(const std::string& name, const std::vector<std::uint8_t>& jpeg, const std::vector<std::string>& truth, const hk::config::Settings& s) {
+void shown_row(const std::string& name, const std::vector<std::uint8_t>& jpeg, const std::vector<std::string>& truth,
+               const hk::config::Settings& s) {
   hk::config::Settings off = s;
   off.vision.ocr = "off";
   const hk::app::ImageScene felt_off = hk::app::build_image_scene_from_bytes(jpeg, name, off);
@@ -78,13 +79,15 @@ void shown_row(const std::string& name, const std::vector<std::uint8_t>& jpeg, c
   const hk::app::ImageScene read = quick.with_text(nullptr);
   const double text_ms = ms_since(t0);
   std::printf("| %s | %.0f | %.0f | %d %% | %d | %d | %d |\n", name.c_str(), felt_ms, text_ms,
-              static_cast<int>(100 * hk::test::word_recall(truth, hk::test::words_of(text_of(read))) + 0.5), curves_in(felt_off, read.text_blocks),
-              curves_in(quick, read.text_blocks), curves_in(read, read.text_blocks));
+              static_cast<int>(100 * hk::test::word_recall(truth, hk::test::words_of(text_of(read))) + 0.5),
+              curves_in(felt_off, read.text_blocks), curves_in(quick, read.text_blocks),
+              curves_in(read, read.text_blocks));
 }
 
 /// The camera row: page `page` drawn at 300 dpi, photographed in a 3264 x 2448 frame (turned 3°, keystone,
 /// uneven light, noise), found and rectified at the frame's resolution, then built and read.
-void camera_row(const fs::path& pdf, int page, const fs::path& dir, const std::vector<std::string>& truth, const hk::config::Settings& s) {
+void camera_row(const fs::path& pdf, int page, const fs::path& dir, const std::vector<std::string>& truth,
+                const hk::config::Settings& s) {
   const std::vector<std::uint8_t> jpeg = hk::test::scan_jpeg(pdf, page, 300, 0.0, dir);
   const cv::Mat picture = cv::imdecode(jpeg, cv::IMREAD_COLOR);
   hk::test::PhotoConditions c;
@@ -103,8 +106,9 @@ void camera_row(const fs::path& pdf, int page, const fs::path& dir, const std::v
   const cv::Mat rectified = hk::vision::rectify_page(photo.frame, d.corners_px);
   const double rectify_ms = ms_since(t0);
   const hk::app::ImageScene is = hk::app::build_image_scene_from_picture(rectified, "camera capture", s);
-  std::printf("| camera capture of page %d | 3264x2448 → %dx%d | %.0f | %.0f | %d %% | %.0f | %.0f |\n", page, rectified.cols, rectified.rows,
-              rectify_ms, is.ocr.ms, static_cast<int>(100 * hk::test::word_recall(truth, hk::test::words_of(text_of(is))) + 0.5),
+  std::printf("| camera capture of page %d | 3264x2448 → %dx%d | %.0f | %.0f | %d %% | %.0f | %.0f |\n", page,
+              rectified.cols, rectified.rows, rectify_ms, is.ocr.ms,
+              static_cast<int>(100 * hk::test::word_recall(truth, hk::test::words_of(text_of(is))) + 0.5),
               is.ocr.worker_max_rss_kb / 1024.0, ms_since(t0));
 }
 
@@ -123,11 +127,15 @@ int main(int argc, char** argv) {
   const fs::path dir = fs::temp_directory_path() / ("hk_bench_ocr_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const hk::config::Settings s;  // shipped: [vision] ocr "auto"
-  std::printf("| picture | pixels | OCR ran | words | recall | blocks | mean confidence | OCR ms | worker peak MiB | scene ms |\n");
+  std::printf(
+      "| picture | pixels | OCR ran | words | recall | blocks | mean confidence | OCR ms | worker peak MiB | scene ms "
+      "|\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
-  auto row = [](const std::string& name, const cv::Size& size, const hk::app::ImageScene& is, double recall, double scene_ms) {
-    std::printf("| %s | %dx%d | %s | %d | %s | %zu | %.2f | %.0f | %.0f | %.0f |\n", name.c_str(), size.width, size.height,
-                is.ocr.ran ? "yes" : "no", is.ocr.words, recall < 0 ? "–" : (std::to_string(static_cast<int>(recall * 100 + 0.5)) + " %").c_str(),
+  auto row = [](const std::string& name, const cv::Size& size, const hk::app::ImageScene& is, double recall,
+                double scene_ms) {
+    std::printf("| %s | %dx%d | %s | %d | %s | %zu | %.2f | %.0f | %.0f | %.0f |\n", name.c_str(), size.width,
+                size.height, is.ocr.ran ? "yes" : "no", is.ocr.words,
+                recall < 0 ? "–" : (std::to_string(static_cast<int>(recall * 100 + 0.5)) + " %").c_str(),
                 is.text_blocks.size(), is.ocr.mean_confidence, is.ocr.ms, is.ocr.worker_max_rss_kb / 1024.0, scene_ms);
   };
   if (hk::test::have_poppler_utils()) {
@@ -154,9 +162,12 @@ int main(int argc, char** argv) {
     row(p.filename().string(), bgr.size(), is, -1, ms);
   }
   if (hk::test::have_poppler_utils()) {
-    std::printf("\nA page shown at the kiosk: felt after (the scene with its printed lines kept out), its text available after, "
-                "recall, and curves felt inside the text blocks with OCR off / before the text / after it.\n\n");
-    std::printf("| picture | felt after ms | text after ms | recall | curves in text, OCR off | before the text | after |\n");
+    std::printf(
+        "\nA page shown at the kiosk: felt after (the scene with its printed lines kept out), its text available "
+        "after, "
+        "recall, and curves felt inside the text blocks with OCR off / before the text / after it.\n\n");
+    std::printf(
+        "| picture | felt after ms | text after ms | recall | curves in text, OCR off | before the text | after |\n");
     std::printf("|---|---|---|---|---|---|---|\n");
     for (int page : pages) {
       const std::vector<std::string> truth = hk::test::words_of(hk::test::pdftotext_page(pdf, page, dir));

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "vision/pdf.hpp"
 #include "test_paths.hpp"
+#include "vision/pdf.hpp"
 
 namespace fs = std::filesystem;
 using namespace hk::vision;
@@ -40,7 +40,9 @@ int main(int argc, char** argv) {
   nlohmann::json docs = nlohmann::json::array();
   std::vector<double> all_ms;
   long max_rss = 0;
-  std::printf("| document | page | render ms | worker peak RSS KiB | pixels | dpi | words | blocks |\n|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| document | page | render ms | worker peak RSS KiB | pixels | dpi | words | blocks "
+      "|\n|---|---|---|---|---|---|---|---|\n");
   for (const fs::path& path : files) {
     std::ifstream f(path, std::ios::binary);
     const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
@@ -66,8 +68,8 @@ int main(int argc, char** argv) {
         all_ms.push_back(med);
         max_rss = std::max(max_rss, p.worker_max_rss_kb);
         const long pixels = static_cast<long>(p.grey.cols) * p.grey.rows;
-        std::printf("| %s | %d | %.1f | %ld | %ld (%d x %d) | %.1f | %zu | %zu |\n", name.c_str(), page, med, p.worker_max_rss_kb, pixels,
-                    p.grey.cols, p.grey.rows, p.dpi, p.words.size(), p.blocks.size());
+        std::printf("| %s | %d | %.1f | %ld | %ld (%d x %d) | %.1f | %zu | %zu |\n", name.c_str(), page, med,
+                    p.worker_max_rss_kb, pixels, p.grey.cols, p.grey.rows, p.dpi, p.words.size(), p.blocks.size());
         pages.push_back({{"page", page},
                          {"render_ms", med},
                          {"worker_max_rss_kb", p.worker_max_rss_kb},
@@ -89,11 +91,13 @@ int main(int argc, char** argv) {
   }
   std::sort(all_ms.begin(), all_ms.end());
   if (!all_ms.empty()) {
-    std::printf("\n%zu pages: render ms median %.1f, max %.1f; worker peak RSS max %ld KiB\n", all_ms.size(), all_ms[all_ms.size() / 2],
-                all_ms.back(), max_rss);
+    std::printf("\n%zu pages: render ms median %.1f, max %.1f; worker peak RSS max %ld KiB\n", all_ms.size(),
+                all_ms[all_ms.size() / 2], all_ms.back(), max_rss);
   }
   nlohmann::json j;
-  j["limits"] = {{"max_page_pixels", limits.max_page_pixels}, {"max_dpi", limits.max_dpi}, {"worker_wall_s", limits.worker_wall_s},
+  j["limits"] = {{"max_page_pixels", limits.max_page_pixels},
+                 {"max_dpi", limits.max_dpi},
+                 {"worker_wall_s", limits.worker_wall_s},
                  {"worker_cpu_s", limits.worker_cpu_s}};
   j["repeat"] = repeat;
 #if defined(__SANITIZE_ADDRESS__)

@@ -7,16 +7,16 @@
 //
 //   build/bench/bench_random_visits --seeds 4 --json docs/bench/random_visits.json > docs/bench/random_visits.txt
 
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
-#include <spdlog/spdlog.h>
 
+#include <unistd.h>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
-#include <unistd.h>
 
 #include "random_visit.hpp"
 #include "test_paths.hpp"
@@ -57,15 +57,26 @@ int main(int argc, char** argv) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const bool fault = !r.unanswered.empty() || !r.left_behind.empty() || r.failures != 0;
     faults = faults || fault;
-    std::cout << "seed " << p.seed << ": " << frames << " frames (" << frames / 3600.0 << " min of kiosk time) in " << wall_s << " s; " << r.keys
-              << " keys, " << r.bursts << " bursts, " << r.sticks_in << " sticks in, " << r.sticks_out << " out, " << r.panel_applies
-              << " settings applied, " << r.sessions_ended << " visits ended; " << r.unanswered.size() << " unanswered, "
-              << r.left_behind.size() << " left behind, " << r.failures << " sorry lines" << std::endl;
+    std::cout << "seed " << p.seed << ": " << frames << " frames (" << frames / 3600.0 << " min of kiosk time) in "
+              << wall_s << " s; " << r.keys << " keys, " << r.bursts << " bursts, " << r.sticks_in << " sticks in, "
+              << r.sticks_out << " out, " << r.panel_applies << " settings applied, " << r.sessions_ended
+              << " visits ended; " << r.unanswered.size() << " unanswered, " << r.left_behind.size() << " left behind, "
+              << r.failures << " sorry lines" << std::endl;
     for (const std::string& u : r.unanswered) std::cout << "  unanswered: " << u << "\n";
     for (const std::string& l : r.left_behind) std::cout << "  left behind: " << l << "\n";
-    runs.push_back({{"seed", p.seed}, {"frames", frames}, {"wall_s", wall_s}, {"keys", r.keys}, {"bursts", r.bursts}, {"sticks_in", r.sticks_in},
-                    {"sticks_out", r.sticks_out}, {"panel_applies", r.panel_applies}, {"learning", r.learning}, {"sessions_ended", r.sessions_ended},
-                    {"unanswered", r.unanswered}, {"left_behind", r.left_behind}, {"failures", r.failures}});
+    runs.push_back({{"seed", p.seed},
+                    {"frames", frames},
+                    {"wall_s", wall_s},
+                    {"keys", r.keys},
+                    {"bursts", r.bursts},
+                    {"sticks_in", r.sticks_in},
+                    {"sticks_out", r.sticks_out},
+                    {"panel_applies", r.panel_applies},
+                    {"learning", r.learning},
+                    {"sessions_ended", r.sessions_ended},
+                    {"unanswered", r.unanswered},
+                    {"left_behind", r.left_behind},
+                    {"failures", r.failures}});
   }
   if (!json_path.empty()) std::ofstream(json_path) << nlohmann::json{{"runs", runs}}.dump(2) << "\n";
   fs::remove_all(work);

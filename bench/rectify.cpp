@@ -16,8 +16,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "synthetic_photo.hpp"
-#include "vision/page.hpp"
 #include "test_paths.hpp"
+#include "vision/page.hpp"
 
 namespace {
 
@@ -34,8 +34,9 @@ const std::vector<Frame>& frames(cv::Size size) {
   std::vector<Frame> out;
   std::uint64_t seed = 1;
   for (const std::string name : {"camera.png", "silhouette_3.png", "pic1.png", "page"}) {
-    const cv::Mat picture = name == "page" ? hk::test::text_page()
-                                           : cv::imread(std::string(HK_TEST_DATA_DIR) + "/images/" + name, cv::IMREAD_COLOR);
+    const cv::Mat picture = name == "page"
+                                ? hk::test::text_page()
+                                : cv::imread(std::string(HK_TEST_DATA_DIR) + "/images/" + name, cv::IMREAD_COLOR);
     for (int condition = 0; condition < 2; ++condition) {
       hk::test::PhotoConditions c;
       c.seed = seed++;

@@ -54,8 +54,10 @@ OursRun run_ours(const Picture& p, const config::Settings& s, const vision::Edge
   const auto t1 = Clock::now();
   const auto chains = vision::link_edges(em.edges, 2.0);
   const auto t2 = Clock::now();
-  const vision::PxToM map = vision::fit_to_workspace(p.grey.cols, p.grey.rows, s.workspace.width_m, s.workspace.height_m);
-  const std::vector<Polyline> curves = app::to_polylines(vision::chains_to_curves(chains, {}, map, s.vision.min_chain_length_m));
+  const vision::PxToM map =
+      vision::fit_to_workspace(p.grey.cols, p.grey.rows, s.workspace.width_m, s.workspace.height_m);
+  const std::vector<Polyline> curves =
+      app::to_polylines(vision::chains_to_curves(chains, {}, map, s.vision.min_chain_length_m));
   const auto t3 = Clock::now();
   const Scene scene = Scene::build(curves, s.haptics.max_levels);
   benchmark::DoNotOptimize(scene.node_count());
@@ -194,15 +196,18 @@ int main(int argc, char** argv) {
     pictures().push_back(std::move(p));
   }
   for (const Picture& p : pictures()) {
-    benchmark::RegisterBenchmark(("BM_SceneBuild/ours/" + p.name).c_str(), [&p](benchmark::State& st) { build_ours(st, &p); })
-        ->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("BM_SceneBuild/opencv/" + p.name).c_str(), [&p](benchmark::State& st) { build_opencv(st, &p); })
-        ->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("BM_SceneBuild/opencv_same_edges/" + p.name).c_str(),
-                                 [&p](benchmark::State& st) { build_opencv_same_edges(st, &p); })
-        ->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("BM_SceneBuildPaired/" + p.name).c_str(), [&p](benchmark::State& st) { build_paired(st, &p); })
-        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_SceneBuild/ours/" + p.name).c_str(), [&p](benchmark::State& st) {
+      build_ours(st, &p);
+    })->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_SceneBuild/opencv/" + p.name).c_str(), [&p](benchmark::State& st) {
+      build_opencv(st, &p);
+    })->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_SceneBuild/opencv_same_edges/" + p.name).c_str(), [&p](benchmark::State& st) {
+      build_opencv_same_edges(st, &p);
+    })->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_SceneBuildPaired/" + p.name).c_str(), [&p](benchmark::State& st) {
+      build_paired(st, &p);
+    })->Unit(benchmark::kMillisecond);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

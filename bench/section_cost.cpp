@@ -24,8 +24,8 @@
 // section size, segment tests). Prints a markdown table per size, and how many full queries came right after a
 // full query (the hand near walls tick after tick: work a full query leaves for the ticks after it lands on the
 // next full query that often).
-#include <CLI/CLI.hpp>
 #include <benchmark/benchmark.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -83,8 +83,8 @@ std::vector<Sample> replay(const Scene& scene, const std::vector<Sweep>& stream,
       if (r == 0) {
         const PeerHit want = rtree.first_hit(stream[i].a, stream[i].b);
         if (h.hit != want.hit || (want.hit && h.t != want.t)) {
-          std::fprintf(stderr, "bench_section_cost: query %zu answers %s t=%.17g, the R-tree %s t=%.17g\n", i, h.hit ? "hit" : "clear", h.t,
-                       want.hit ? "hit" : "clear", want.t);
+          std::fprintf(stderr, "bench_section_cost: query %zu answers %s t=%.17g, the R-tree %s t=%.17g\n", i,
+                       h.hit ? "hit" : "clear", h.t, want.hit ? "hit" : "clear", want.t);
           std::exit(2);
         }
       }
@@ -117,8 +117,8 @@ void print_row(const char* kind, const std::vector<Sample>& all, const std::func
   double mean = 0;
   for (double x : ns) mean += x;
   std::nth_element(ns.begin(), ns.begin() + static_cast<std::ptrdiff_t>(ns.size() / 2), ns.end());
-  std::printf("| %s | %zu | %.0f | %.0f | %.1f | %.1f | %.2f | %.2f | %.1f | %.2f |\n", kind, ns.size(), mean / n, ns[ns.size() / 2], box / n,
-              scanned / n, splits / n, merges / n, size / n, seg / n);
+  std::printf("| %s | %zu | %.0f | %.0f | %.1f | %.1f | %.2f | %.2f | %.1f | %.2f |\n", kind, ns.size(), mean / n,
+              ns[ns.size() / 2], box / n, scanned / n, splits / n, merges / n, size / n, seg / n);
 }
 
 }  // namespace
@@ -129,7 +129,8 @@ int main(int argc, char** argv) {
   int replays = 5;
   std::size_t queries = 100000;
   app.add_option("--segments", sizes, "scene sizes [level-0 segments]");
-  app.add_option("--replays", replays, "replays of the stream; each query's fastest is kept")->check(CLI::Range(1, 100));
+  app.add_option("--replays", replays, "replays of the stream; each query's fastest is kept")
+      ->check(CLI::Range(1, 100));
   app.add_option("--queries", queries, "sweeps in the stream")->check(CLI::Range(1000, 10000000));
   CLI11_PARSE(app, argc, argv);
 
@@ -144,14 +145,19 @@ int main(int argc, char** argv) {
     std::vector<double> sorted;
     for (const Sample& s : all) sorted.push_back(s.ns);
     std::sort(sorted.begin(), sorted.end());
-    const auto pct = [&](double p) { return sorted[std::min(sorted.size() - 1, static_cast<std::size_t>(p * static_cast<double>(sorted.size())))]; };
+    const auto pct = [&](double p) {
+      return sorted[std::min(sorted.size() - 1, static_cast<std::size_t>(p * static_cast<double>(sorted.size())))];
+    };
     double mean = 0;
     for (double x : sorted) mean += x;
     mean /= static_cast<double>(sorted.size());
     const double p99 = pct(0.99);
-    std::printf("\n%zu segments, %zu queries, fastest of %d: mean %.0f ns, p50 %.0f, p90 %.0f, p99 %.0f, p99.9 %.0f\n\n", scene.total_segments(0),
-                all.size(), replays, mean, pct(0.5), pct(0.9), p99, pct(0.999));
-    std::printf("| kind | queries | mean ns | p50 ns | box tests | entries scanned | splits | merges | section | segment tests |\n");
+    std::printf(
+        "\n%zu segments, %zu queries, fastest of %d: mean %.0f ns, p50 %.0f, p90 %.0f, p99 %.0f, p99.9 %.0f\n\n",
+        scene.total_segments(0), all.size(), replays, mean, pct(0.5), pct(0.9), p99, pct(0.999));
+    std::printf(
+        "| kind | queries | mean ns | p50 ns | box tests | entries scanned | splits | merges | section | segment tests "
+        "|\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
     const auto full = [](const Sample& s) { return s.st.section_box_tests > 0; };
     print_row("ball", all, [&](const Sample& s) { return !full(s) && !s.st.ball_walls; });
@@ -161,9 +167,11 @@ int main(int argc, char** argv) {
     print_row("full: split", all, [](const Sample& s) { return s.st.splits > 0; });
     print_row("full: merge only", all, [&](const Sample& s) { return full(s) && s.st.splits == 0 && s.st.merges > 0; });
     print_row("top 1 %", all, [&](const Sample& s) { return s.ns >= p99; });
-    print_row("top 1 %: quiet", all, [&](const Sample& s) { return s.ns >= p99 && full(s) && s.st.splits == 0 && s.st.merges == 0; });
+    print_row("top 1 %: quiet", all,
+              [&](const Sample& s) { return s.ns >= p99 && full(s) && s.st.splits == 0 && s.st.merges == 0; });
     print_row("top 1 %: split", all, [&](const Sample& s) { return s.ns >= p99 && s.st.splits > 0; });
-    print_row("top 1 %: merge only", all, [&](const Sample& s) { return s.ns >= p99 && full(s) && s.st.splits == 0 && s.st.merges > 0; });
+    print_row("top 1 %: merge only", all,
+              [&](const Sample& s) { return s.ns >= p99 && full(s) && s.st.splits == 0 && s.st.merges > 0; });
     print_row("top 1 %: not full", all, [&](const Sample& s) { return s.ns >= p99 && !full(s); });
     std::size_t after_full = 0, full_count = 0;
     for (std::size_t i = 1; i < all.size(); ++i) {

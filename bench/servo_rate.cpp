@@ -15,9 +15,9 @@
 #include "haptics/hand_path.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "pictures/image_scene.hpp"
-#include "runtime/servo_thread.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_thread.hpp"
 #include "runtime/simulation.hpp"
 #include "test_paths.hpp"
 
@@ -32,10 +32,13 @@ int main(int argc, char** argv) {
   }
   const config::Settings s;
   nlohmann::json j = nlohmann::json::array();
-  std::printf("| load | realtime | ticks | missed | lateness p50 µs | p99 µs | max µs | tick work p50 µs | p99 µs |\n|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| load | realtime | ticks | missed | lateness p50 µs | p99 µs | max µs | tick work p50 µs | p99 µs "
+      "|\n|---|---|---|---|---|---|---|---|---|\n");
   for (const bool loaded : {false, true}) {
     app::ImageScene is = app::build_image_scene(std::string(HK_TEST_DATA_DIR) + "/images/butterfly.jpg", s);
-    const HandPath hand = raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
+    const HandPath hand =
+        raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
     SimPantographParams dp;
     dp.workspace_half_extent_m = {s.workspace.width_m / 2, s.workspace.height_m / 2};
     SimulatedPantograph device(dp, hand.at(0.0));
@@ -60,11 +63,17 @@ int main(int argc, char** argv) {
       thread.stop();
       const app::ServoTimingStats st = thread.stats();
       std::printf("| %s | %s | %lld | %lld | %.0f | %.0f | %.0f | %.0f | %.0f |\n", loaded ? "other core busy" : "idle",
-                  thread.realtime() ? "SCHED_FIFO" : "normal", static_cast<long long>(st.ticks), static_cast<long long>(st.missed_deadlines),
-                  st.lateness_p50_us, st.lateness_p99_us, st.lateness_max_us, st.compute_p50_us, st.compute_p99_us);
-      j.push_back({{"loaded", loaded}, {"realtime", thread.realtime()}, {"ticks", st.ticks}, {"missed", st.missed_deadlines},
-                   {"lateness_us", {{"p50", st.lateness_p50_us}, {"p99", st.lateness_p99_us}, {"max", st.lateness_max_us}}},
-                   {"compute_us", {{"p50", st.compute_p50_us}, {"p99", st.compute_p99_us}}}, {"seconds", seconds}});
+                  thread.realtime() ? "SCHED_FIFO" : "normal", static_cast<long long>(st.ticks),
+                  static_cast<long long>(st.missed_deadlines), st.lateness_p50_us, st.lateness_p99_us,
+                  st.lateness_max_us, st.compute_p50_us, st.compute_p99_us);
+      j.push_back(
+          {{"loaded", loaded},
+           {"realtime", thread.realtime()},
+           {"ticks", st.ticks},
+           {"missed", st.missed_deadlines},
+           {"lateness_us", {{"p50", st.lateness_p50_us}, {"p99", st.lateness_p99_us}, {"max", st.lateness_max_us}}},
+           {"compute_us", {{"p50", st.compute_p50_us}, {"p99", st.compute_p99_us}}},
+           {"seconds", seconds}});
     }
     spin = false;
     loader.join();

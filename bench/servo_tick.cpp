@@ -75,7 +75,8 @@ void fill_quantiles(std::vector<std::int64_t> ns, RunFigures& f) {
   f.p999_ns = quantile(ns, 0.999);
 }
 
-RunTrace run_once(const Scene& scene, const config::Settings& s, const std::string& hand, double seconds, std::uint64_t seed) {
+RunTrace run_once(const Scene& scene, const config::Settings& s, const std::string& hand, double seconds,
+                  std::uint64_t seed) {
   RunTrace t;
   std::vector<std::int64_t>& ns = t.ns;
   ns.reserve(static_cast<std::size_t>(seconds * 1000.0) + 1);
@@ -89,7 +90,8 @@ RunTrace run_once(const Scene& scene, const config::Settings& s, const std::stri
     level_sum += so.level;
   };
   if (hand == "raster") {
-    const HandPath path = raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
+    const HandPath path =
+        raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
     app::run_simulation(scene, s, path, std::min(seconds, path.duration_s()), observe);
   } else {
     ExplorerHand explorer(app::explorer_params_from(s, seed));
@@ -105,14 +107,17 @@ RunTrace run_once(const Scene& scene, const config::Settings& s, const std::stri
 }
 
 void print_row(std::size_t segments, const std::string& hand, const std::string& run, const RunFigures& f) {
-  std::printf("| %zu | %s | %s | %ld | %.0f %% | %.2f | %.2f | %.2f | %.2f | %.1f |\n", segments, hand.c_str(), run.c_str(), f.ticks,
-              100.0 * f.contact_fraction, f.mean_level, f.p50_ns / 1e3, f.p99_ns / 1e3, f.p999_ns / 1e3, f.max_ns / 1e3);
+  std::printf("| %zu | %s | %s | %ld | %.0f %% | %.2f | %.2f | %.2f | %.2f | %.1f |\n", segments, hand.c_str(),
+              run.c_str(), f.ticks, 100.0 * f.contact_fraction, f.mean_level, f.p50_ns / 1e3, f.p99_ns / 1e3,
+              f.p999_ns / 1e3, f.max_ns / 1e3);
   std::fflush(stdout);
 }
 
 nlohmann::json to_json(const RunFigures& f) {
-  return {{"ticks", f.ticks}, {"contact_fraction", f.contact_fraction}, {"mean_level", f.mean_level},
-          {"p50_ns", f.p50_ns}, {"p99_ns", f.p99_ns}, {"p999_ns", f.p999_ns}, {"max_ns", f.max_ns}};
+  return {{"ticks", f.ticks},           {"contact_fraction", f.contact_fraction},
+          {"mean_level", f.mean_level}, {"p50_ns", f.p50_ns},
+          {"p99_ns", f.p99_ns},         {"p999_ns", f.p999_ns},
+          {"max_ns", f.max_ns}};
 }
 
 /// Time to set up the servo loop on `scene` with the settings' servo parameters (its two solvers' boundary
@@ -140,32 +145,37 @@ int main(int argc, char** argv) {
   std::string out_path;
   std::string level_mode = "auto";
   cli.add_option("--sizes", sizes, "level-0 segments of each tiled scene")->delimiter(',')->check(CLI::PositiveNumber);
-  cli.add_option("--seconds", seconds, "simulated seconds per run (the raster stops at its path's end)")->check(CLI::Range(0.1, 3600.0));
+  cli.add_option("--seconds", seconds, "simulated seconds per run (the raster stops at its path's end)")
+      ->check(CLI::Range(0.1, 3600.0));
   cli.add_option("--repeats", repeats, "runs per size and hand")->check(CLI::Range(1, 100));
   cli.add_option("--cpu", cpu, "pin to this CPU (-1: leave it to the scheduler)");
   cli.add_option("--out", out_path, "JSON results");
-  cli.add_option("--level-mode", level_mode, "[haptics] level_mode of the runs")->check(CLI::IsMember({"auto", "tolerance", "cut", "fixed"}));
+  cli.add_option("--level-mode", level_mode, "[haptics] level_mode of the runs")
+      ->check(CLI::IsMember({"auto", "tolerance", "cut", "fixed"}));
   CLI11_PARSE(cli, argc, argv);
   if (cpu >= 0) {
     cpu_set_t set;
     CPU_ZERO(&set);
     CPU_SET(cpu, &set);
-    if (sched_setaffinity(0, sizeof set, &set) != 0) std::fprintf(stderr, "bench_servo_tick: cannot pin to CPU %d; running unpinned\n", cpu);
+    if (sched_setaffinity(0, sizeof set, &set) != 0)
+      std::fprintf(stderr, "bench_servo_tick: cannot pin to CPU %d; running unpinned\n", cpu);
   }
 
   config::Settings settings;
   settings.haptics.level_mode = level_mode;
   const auto pictures = picture_curves(settings);
   nlohmann::json out = nlohmann::json::array();
-  std::printf("| segments | hand | run | ticks | in contact | mean level | tick p50 µs | p99 µs | p99.9 µs | max µs |\n");
+  std::printf(
+      "| segments | hand | run | ticks | in contact | mean level | tick p50 µs | p99 µs | p99.9 µs | max µs |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::size_t n : sizes) {
     Vec2 plane{};
-    const Scene scene = Scene::build(tiled_scene(pictures, n, settings.haptics.max_levels, &plane), settings.haptics.max_levels);
+    const Scene scene =
+        Scene::build(tiled_scene(pictures, n, settings.haptics.max_levels, &plane), settings.haptics.max_levels);
     const std::size_t level0 = scene.total_segments(0);
     const double setup_ms = loop_setup_ms(scene, settings, repeats);
-    std::fprintf(stderr, "bench_servo_tick: %zu segments, level_mode %s: SceneStep setup %.1f ms (fastest of %d)\n", level0, level_mode.c_str(),
-                 setup_ms, repeats);
+    std::fprintf(stderr, "bench_servo_tick: %zu segments, level_mode %s: SceneStep setup %.1f ms (fastest of %d)\n",
+                 level0, level_mode.c_str(), setup_ms, repeats);
     for (const std::string hand : {"raster", "explorer"}) {
       std::vector<double> p999s;
       nlohmann::json runs = nlohmann::json::array();
@@ -182,7 +192,8 @@ int main(int argc, char** argv) {
           continue;
         }
         if (t.handle_m != first.handle_m) {
-          std::fprintf(stderr, "bench_servo_tick: run %d of %s on %zu segments did not repeat run 1's ticks\n", r + 1, hand.c_str(), level0);
+          std::fprintf(stderr, "bench_servo_tick: run %d of %s on %zu segments did not repeat run 1's ticks\n", r + 1,
+                       hand.c_str(), level0);
           return 1;
         }
         for (std::size_t k = 0; k < fastest.size(); ++k) fastest[k] = std::min(fastest[k], t.ns[k]);
@@ -191,8 +202,15 @@ int main(int argc, char** argv) {
       fill_quantiles(fastest, min_f);
       print_row(level0, hand, "min of " + std::to_string(repeats), min_f);
       std::sort(p999s.begin(), p999s.end());
-      out.push_back({{"segments", level0}, {"requested_segments", n}, {"plane_m", {plane.x, plane.y}}, {"hand", hand}, {"level_mode", level_mode},
-                     {"hot_bytes", scene.hot_bytes()}, {"loop_setup_ms", setup_ms}, {"median_p999_ns", p999s[p999s.size() / 2]}, {"runs", runs},
+      out.push_back({{"segments", level0},
+                     {"requested_segments", n},
+                     {"plane_m", {plane.x, plane.y}},
+                     {"hand", hand},
+                     {"level_mode", level_mode},
+                     {"hot_bytes", scene.hot_bytes()},
+                     {"loop_setup_ms", setup_ms},
+                     {"median_p999_ns", p999s[p999s.size() / 2]},
+                     {"runs", runs},
                      {"per_tick_min", to_json(min_f)}});
     }
   }

@@ -41,9 +41,9 @@
 
 #include "config/settings.hpp"
 #include "runtime/device_setup.hpp"
+#include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
-#include "test_paths.hpp"
 
 namespace {
 
@@ -51,20 +51,20 @@ namespace fs = std::filesystem;
 using hk::app::KioskKey;
 using Clock = std::chrono::steady_clock;
 
-constexpr double kFrameS = 1.0 / 60.0;       // window frame [s]
-constexpr std::size_t kAudioFrames = 800;    // 48 kHz / 60 Hz [frames]
-constexpr double kKeyEveryS = 3.0;           // a visitor's key presses [s]
-constexpr double kStickEveryS = 150.0;       // a stick put in [s]
-constexpr double kStickHeldS = 40.0;         // ... and taken out after [s]
-constexpr double kOperatorEveryS = 100.0;    // settings applied [s]
+constexpr double kFrameS = 1.0 / 60.0;     // window frame [s]
+constexpr std::size_t kAudioFrames = 800;  // 48 kHz / 60 Hz [frames]
+constexpr double kKeyEveryS = 3.0;         // a visitor's key presses [s]
+constexpr double kStickEveryS = 150.0;     // a stick put in [s]
+constexpr double kStickHeldS = 40.0;       // ... and taken out after [s]
+constexpr double kOperatorEveryS = 100.0;  // settings applied [s]
 constexpr double kGapBetweenVisitorsS = 10.0;
 
 /// One look at the process.
 struct ProcessSample {
-  double t_s = 0;        ///< since the start [s]
-  long rss_kib = 0;      ///< resident set [KiB]
-  int fds = 0;           ///< open file descriptors
-  int threads = 0;       ///< threads of the process
+  double t_s = 0;    ///< since the start [s]
+  long rss_kib = 0;  ///< resident set [KiB]
+  int fds = 0;       ///< open file descriptors
+  int threads = 0;   ///< threads of the process
 };
 
 /// A number from /proc/self/status ("VmRSS:", "Threads:"), −1 when absent.
@@ -148,9 +148,9 @@ class Script {
     rt_.set_cursor({0.8 * rt_.half().x * std::sin(w), 0.8 * rt_.half().y * std::sin(1.7 * w)});
     flow_.handle_moved(now_s);  // the hand moves: the visit goes on
     if (now_s >= next_key_s_) {
-      static constexpr KioskKey kKeys[] = {KioskKey::Next,    KioskKey::Previous, KioskKey::Describe,
-                                           KioskKey::Finer,   KioskKey::Coarser,  KioskKey::VolumeUp,
-                                           KioskKey::VolumeDown, KioskKey::Guide, KioskKey::Help, KioskKey::Next};
+      static constexpr KioskKey kKeys[] = {KioskKey::Next,    KioskKey::Previous, KioskKey::Describe,   KioskKey::Finer,
+                                           KioskKey::Coarser, KioskKey::VolumeUp, KioskKey::VolumeDown, KioskKey::Guide,
+                                           KioskKey::Help,    KioskKey::Next};
       press(kKeys[std::uniform_int_distribution<int>(0, 9)(rng_)], now_s);
       next_key_s_ = now_s + kKeyEveryS;
     }
@@ -223,7 +223,8 @@ int run(const SoakOptions& o) {
   std::ofstream csv;
   if (!o.csv.empty()) {
     csv.open(o.csv);
-    csv << "t_s,rss_kib,fds,threads,ticks,missed_deadlines,lateness_max_us,compute_p99_us,visitors,sticks,applies,device\n";
+    csv << "t_s,rss_kib,fds,threads,ticks,missed_deadlines,lateness_max_us,compute_p99_us,visitors,sticks,applies,"
+           "device\n";
   }
   std::vector<ProcessSample> samples;
   std::int64_t ticks = 0, missed = 0;
@@ -261,9 +262,10 @@ int run(const SoakOptions& o) {
       worst_compute_p99_us = std::max(worst_compute_p99_us, st.compute_p99_us);
       const std::string dev = hk::app::device_status_name(rt.core().display().device_status);
       char line[256];
-      std::snprintf(line, sizeof line, "%.0f,%ld,%d,%d,%lld,%lld,%.0f,%.1f,%d,%d,%d,%s", p.t_s, p.rss_kib, p.fds, p.threads,
-                    static_cast<long long>(st.ticks), static_cast<long long>(st.missed_deadlines), st.lateness_max_us,
-                    st.compute_p99_us, script.visitors(), script.sticks(), script.applies(), dev.c_str());
+      std::snprintf(line, sizeof line, "%.0f,%ld,%d,%d,%lld,%lld,%.0f,%.1f,%d,%d,%d,%s", p.t_s, p.rss_kib, p.fds,
+                    p.threads, static_cast<long long>(st.ticks), static_cast<long long>(st.missed_deadlines),
+                    st.lateness_max_us, st.compute_p99_us, script.visitors(), script.sticks(), script.applies(),
+                    dev.c_str());
       std::cout << "soak " << line << std::endl;
       if (csv) csv << line << "\n" << std::flush;
     }
@@ -295,8 +297,11 @@ int run(const SoakOptions& o) {
   j["keys"] = script.keys();
   j["sticks"] = script.sticks();
   j["operator_applies"] = script.applies();
-  j["servo"] = {{"ticks", ticks}, {"missed_deadlines", missed}, {"missed_after_warmup", missed_after_warmup},
-                {"lateness_max_us", worst_late_us}, {"compute_p99_max_us", worst_compute_p99_us}};
+  j["servo"] = {{"ticks", ticks},
+                {"missed_deadlines", missed},
+                {"missed_after_warmup", missed_after_warmup},
+                {"lateness_max_us", worst_late_us},
+                {"compute_p99_max_us", worst_compute_p99_us}};
   bool ok = first != nullptr;
   if (first) {
     const double growth_kib_per_h = slope(t_h, rss_kib);
@@ -307,7 +312,9 @@ int run(const SoakOptions& o) {
     const bool fd_ok = last->fds <= first->fds;
     const bool th_ok = last->threads <= first->threads;
     const bool dl_ok = missed_after_warmup == 0;
-    j["targets"] = {{"rss_growth_under_1_mb_per_h", rss_ok}, {"no_fd_growth", fd_ok}, {"no_thread_growth", th_ok},
+    j["targets"] = {{"rss_growth_under_1_mb_per_h", rss_ok},
+                    {"no_fd_growth", fd_ok},
+                    {"no_thread_growth", th_ok},
                     {"no_missed_deadlines_after_warmup", dl_ok}};
     ok = rss_ok && fd_ok && th_ok && dl_ok;
   }
@@ -320,17 +327,22 @@ int run(const SoakOptions& o) {
 
 int main(int argc, char** argv) {
   SoakOptions o;
-  CLI::App cli{"Runs the kiosk headless with scripted visitors, sticks, operator and device faults; watches RSS, fds, threads, deadlines"};
+  CLI::App cli{
+      "Runs the kiosk headless with scripted visitors, sticks, operator and device faults; watches RSS, fds, threads, "
+      "deadlines"};
   cli.add_option("--duration-s", o.duration_s, "Wall-clock run time [s]")->check(CLI::Range(10.0, 7.0 * 24 * 3600));
   cli.add_option("--report-every-s", o.report_every_s, "Sampling period [s]")->check(CLI::Range(1.0, 3600.0));
-  cli.add_option("--warmup-s", o.warmup_s, "Samples before this are not judged [s]")->check(CLI::Range(0.0, 7.0 * 24 * 3600));
-  cli.add_option("--device", o.device, "sim, or haply-emulator[:FAULT=V,...] (the default has dropped, garbled, misaddressed replies)");
+  cli.add_option("--warmup-s", o.warmup_s, "Samples before this are not judged [s]")
+      ->check(CLI::Range(0.0, 7.0 * 24 * 3600));
+  cli.add_option("--device", o.device,
+                 "sim, or haply-emulator[:FAULT=V,...] (the default has dropped, garbled, misaddressed replies)");
   cli.add_option("--library", o.library, "Picture folder");
   cli.add_option("--stick", o.stick, "Folder put in as a USB stick every 150 s");
   cli.add_option("--csv", o.csv, "Write the samples here");
   cli.add_option("--json", o.json, "Write the summary here");
   cli.add_option("--seed", o.seed, "The visitors' seed");
-  cli.add_option("--level-mode", o.level_mode, "[haptics] level_mode of the kiosk")->check(CLI::IsMember({"auto", "tolerance", "cut", "fixed"}));
+  cli.add_option("--level-mode", o.level_mode, "[haptics] level_mode of the kiosk")
+      ->check(CLI::IsMember({"auto", "tolerance", "cut", "fixed"}));
   cli.add_flag("--check", o.check, "Exit 1 when a target is missed");
   CLI11_PARSE(cli, argc, argv);
   if (o.warmup_s >= o.duration_s) o.warmup_s = o.duration_s / 2;

@@ -17,8 +17,8 @@
 #include "audio/messages.hpp"
 #include "audio/speech.hpp"
 #include "config/settings.hpp"
-#include "visit/kiosk_flow.hpp"
 #include "message_samples.hpp"
+#include "visit/kiosk_flow.hpp"
 
 namespace {
 
@@ -27,11 +27,11 @@ using hk::audio::MessageId;
 /// The part of a visit a message belongs to, by its key's prefix (first match wins).
 std::string part_of(std::string_view key) {
   static const std::vector<std::pair<std::string_view, std::string>> parts{
-      {"welcome", "walking up"}, {"attract", "walking up"},   {"tutorial", "tutorial"},   {"help", "help"},
-      {"place", "help"},         {"key_", "help"},            {"this_key", "help"},       {"stick", "USB stick"},
-      {"document", "USB stick"}, {"loading", "USB stick"},    {"capture", "camera"},      {"captured", "camera"},
-      {"camera", "camera"},      {"tour", "guided tour"},     {"device", "device"},       {"no_audio", "device"},
-      {"timeout", "session"},    {"goodbye", "session"},      {"sorry", "session"},       {"high_contrast", "operator"},
+      {"welcome", "walking up"}, {"attract", "walking up"}, {"tutorial", "tutorial"}, {"help", "help"},
+      {"place", "help"},         {"key_", "help"},          {"this_key", "help"},     {"stick", "USB stick"},
+      {"document", "USB stick"}, {"loading", "USB stick"},  {"capture", "camera"},    {"captured", "camera"},
+      {"camera", "camera"},      {"tour", "guided tour"},   {"device", "device"},     {"no_audio", "device"},
+      {"timeout", "session"},    {"goodbye", "session"},    {"sorry", "session"},     {"high_contrast", "operator"},
       {"overlay", "operator"}};
   for (const auto& [prefix, part] : parts)
     if (key.rfind(prefix, 0) == 0) return part;
@@ -85,30 +85,39 @@ int main(int argc, char** argv) {
     if (s > best.first) best = {s, key};
   }
 
-  std::printf("# Speech times\n\nDefault voice (espeak-ng \"en\") and rate (165 words a minute); placeholders filled with long but real values.\n\n");
+  std::printf(
+      "# Speech times\n\nDefault voice (espeak-ng \"en\") and rate (165 words a minute); placeholders filled with long "
+      "but real values.\n\n");
   std::printf("| part of the visit | longest message | seconds |\n|---|---|---|\n");
-  for (const auto& [part, best] : longest) std::printf("| %s | %s | %.1f |\n", part.c_str(), best.second.c_str(), best.first);
+  for (const auto& [part, best] : longest)
+    std::printf("| %s | %s | %.1f |\n", part.c_str(), best.second.c_str(), best.first);
   const double welcome = seconds_of(hk::test::sample_message(en, MessageId::welcome, keys));
-  std::printf("\nWalking up to the first shape felt: the welcome, %.1f s, is all that is said before the square is under the hand "
-              "(it is on the device as the welcome starts).\n",
-              welcome);
-  std::printf("Asked for, however long: help's second layer %.1f s.\n", seconds_of(hk::test::sample_message(en, MessageId::help, keys)));
+  std::printf(
+      "\nWalking up to the first shape felt: the welcome, %.1f s, is all that is said before the square is under the "
+      "hand "
+      "(it is on the device as the welcome starts).\n",
+      welcome);
+  std::printf("Asked for, however long: help's second layer %.1f s.\n",
+              seconds_of(hk::test::sample_message(en, MessageId::help, keys)));
 
   hk::audio::SpeechStream stream;
   hk::audio::Speaker speaker(stream, {});
   std::vector<double> ms;
   for (int r = 0; r < repeats; ++r) {
-    for (const MessageId id : {MessageId::volume_up, MessageId::level_finer, MessageId::help_brief, MessageId::picture_loaded,
-                               MessageId::where_on, MessageId::key_next, MessageId::tour_ask}) {
+    for (const MessageId id :
+         {MessageId::volume_up, MessageId::level_finer, MessageId::help_brief, MessageId::picture_loaded,
+          MessageId::where_on, MessageId::key_next, MessageId::tour_ask}) {
       ms.push_back(first_word_ms(speaker, stream, hk::test::sample_message(en, id, keys)));
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
   std::sort(ms.begin(), ms.end());
   const double buffer_ms = 1000.0 * 256 / hk::audio::kSampleRateHz;
-  std::printf("\nKey to first spoken word over %zu presses: median %.0f ms, worst %.0f ms (synthesis, hand-over and the voice's "
-              "own lead-in), plus the sound device's buffer (%.1f ms at 256 frames).\n",
-              ms.size(), ms[ms.size() / 2], ms.back(), buffer_ms);
+  std::printf(
+      "\nKey to first spoken word over %zu presses: median %.0f ms, worst %.0f ms (synthesis, hand-over and the "
+      "voice's "
+      "own lead-in), plus the sound device's buffer (%.1f ms at 256 frames).\n",
+      ms.size(), ms[ms.size() / 2], ms.back(), buffer_ms);
   std::printf("\n| message | seconds |\n|---|---|\n");
   for (const auto& [key, s] : all) std::printf("| %s | %.1f |\n", key.c_str(), s);
   return 0;

@@ -136,13 +136,13 @@ namespace {
 
 // ───────────────────────────── shared: driving the simulated device finely ─────────────────────────────
 
-constexpr double kMaxChunkS = 25e-6;    // hand force recomputed at least this often [s]
-constexpr double kMaxSubstepS = 1e-6;   // device integration step at most this long [s]
+constexpr double kMaxChunkS = 25e-6;   // hand force recomputed at least this often [s]
+constexpr double kMaxSubstepS = 1e-6;  // device integration step at most this long [s]
 
 /// Splits one servo period into hand chunks and device substeps no longer than the limits above.
 struct Chunking {
-  int chunks = 1;          // hand-force updates per servo period
-  int substeps = 1;        // device substeps per chunk
+  int chunks = 1;    // hand-force updates per servo period
+  int substeps = 1;  // device substeps per chunk
   double chunk_s = 0.0;
 };
 Chunking chunking_for(double period_s) {
@@ -176,17 +176,17 @@ double sig4(double v) {
 enum class HandMode { Push, LetGo };
 const char* mode_name(HandMode m) { return m == HandMode::Push ? "push" : "let_go"; }
 
-constexpr double kRunS = 2.0;            // simulated time per case [s]
-constexpr double kTransientS = 0.5;      // ignored by the push rules [s]
-constexpr double kWindowS = 0.25;        // energy windows after the transient [s]
-constexpr double kTailS = 0.5;           // oscillation window at the end [s]
-constexpr double kLetGoHeightM = 0.001;  // let-go: the hand lets go this far in front of the wall [m]
-constexpr int kLetGoPhases = 4;          // let-go: bounces per case, at different servo phases
-constexpr int kPushPhases = 4;           // push: runs per case, rest point at different encoder phases
-constexpr double kMinOscillationM = 1e-6;  // oscillation floor when the encoder is finer than this [m]
+constexpr double kRunS = 2.0;                 // simulated time per case [s]
+constexpr double kTransientS = 0.5;           // ignored by the push rules [s]
+constexpr double kWindowS = 0.25;             // energy windows after the transient [s]
+constexpr double kTailS = 0.5;                // oscillation window at the end [s]
+constexpr double kLetGoHeightM = 0.001;       // let-go: the hand lets go this far in front of the wall [m]
+constexpr int kLetGoPhases = 4;               // let-go: bounces per case, at different servo phases
+constexpr int kPushPhases = 4;                // push: runs per case, rest point at different encoder phases
+constexpr double kMinOscillationM = 1e-6;     // oscillation floor when the encoder is finer than this [m]
 constexpr int kIdealEncoderCounts = 1 << 24;  // "ideal" encoder: 0.06 µm steps, quantisation out of the way
-const Vec2 kWallStart{0.0, 0.003};       // handle starts 3 mm in front of the wall [m]
-const Vec2 kHandTarget{0.0, -0.005};     // hand target 5 mm behind the wall [m]
+const Vec2 kWallStart{0.0, 0.003};            // handle starts 3 mm in front of the wall [m]
+const Vec2 kHandTarget{0.0, -0.005};          // hand target 5 mm behind the wall [m]
 
 /// What one (rate, stiffness, mode, encoder) run measured and how it was classified.
 struct WallRun {
@@ -194,19 +194,19 @@ struct WallRun {
   HandMode mode = HandMode::Push;
   int encoder_counts = 0;
   bool stable = true;
-  std::string cls = "stable";  // push: stable / limit_cycle / unstable; let-go: stable / unstable
-  std::string reason;          // which rule fired ("" when stable)
-  double p2p_tail_m = 0;       // peak-to-peak normal displacement over the last 0.5 s [m]
-  double p2p_before_m = 0;     // the same over the 0.5 s before [m]
+  std::string cls = "stable";           // push: stable / limit_cycle / unstable; let-go: stable / unstable
+  std::string reason;                   // which rule fired ("" when stable)
+  double p2p_tail_m = 0;                // peak-to-peak normal displacement over the last 0.5 s [m]
+  double p2p_before_m = 0;              // the same over the 0.5 s before [m]
   std::vector<double> window_energy_j;  // push: peak |E − E_rest| per 0.25 s window after the transient [J]
-  double energy_in_j = 0;      // let-go: kinetic energy arriving at the wall [J]
-  double energy_out_j = 0;     // let-go: kinetic energy when the wall force ended [J]
-  int bounce_ticks = 0;        // let-go: servo ticks from the wall crossing to the end of the wall force
-  double max_depth_m = 0;      // deepest penetration behind the wall over the run [m] (let-go: the bounce)
-  double max_force_n = 0;      // largest commanded force [N]
-  double free_fraction_tail = 0;  // push: fraction of ticks in the last 0.5 s with the proxy free (bouncing)
-  double final_depth_m = 0;    // penetration at the end [m] (negative: in front of the wall)
-  std::vector<double> phase_scores;  // per phase: push p2p_tail_m [m], let-go energy out / in
+  double energy_in_j = 0;               // let-go: kinetic energy arriving at the wall [J]
+  double energy_out_j = 0;              // let-go: kinetic energy when the wall force ended [J]
+  int bounce_ticks = 0;                 // let-go: servo ticks from the wall crossing to the end of the wall force
+  double max_depth_m = 0;               // deepest penetration behind the wall over the run [m] (let-go: the bounce)
+  double max_force_n = 0;               // largest commanded force [N]
+  double free_fraction_tail = 0;        // push: fraction of ticks in the last 0.5 s with the proxy free (bouncing)
+  double final_depth_m = 0;             // penetration at the end [m] (negative: in front of the wall)
+  std::vector<double> phase_scores;     // per phase: push p2p_tail_m [m], let-go energy out / in
 };
 
 /// Encoder resolution normal to the wall at a point: the larger y-step of one count of either motor [m].
@@ -254,7 +254,8 @@ class WallBench {
   /// peak-to-peak (push).
   WallRun run(double rate_hz, double k_n_per_m, HandMode mode, const WallDevice& device) const {
     const bool push = mode == HandMode::Push;
-    const int phases = push ? (device.params.encoder_counts_per_rev >= kIdealEncoderCounts ? 1 : kPushPhases) : kLetGoPhases;
+    const int phases =
+        push ? (device.params.encoder_counts_per_rev >= kIdealEncoderCounts ? 1 : kPushPhases) : kLetGoPhases;
     auto severity = [](const WallRun& r) { return r.cls == "unstable" ? 2 : (r.cls == "limit_cycle" ? 1 : 0); };
     auto score = [push](const WallRun& r) {
       return push ? r.p2p_tail_m : (r.energy_in_j > 0.0 ? r.energy_out_j / r.energy_in_j : 0.0);
@@ -265,14 +266,16 @@ class WallBench {
       const Vec2 shift = push ? Vec2{0.00037 * i, 0.0} : Vec2{0.0, 0.00037 * i};
       const WallRun r = run_one(rate_hz, k_n_per_m, mode, device, kWallStart + shift, kHandTarget + Vec2{shift.x, 0.0});
       scores.push_back(score(r));
-      if (i == 0 || severity(r) > severity(worst) || (severity(r) == severity(worst) && score(r) > score(worst))) worst = r;
+      if (i == 0 || severity(r) > severity(worst) || (severity(r) == severity(worst) && score(r) > score(worst)))
+        worst = r;
     }
     worst.phase_scores = scores;
     return worst;
   }
 
  private:
-  WallRun run_one(double rate_hz, double k_n_per_m, HandMode mode, const WallDevice& device, Vec2 start_m, Vec2 target_m) const {
+  WallRun run_one(double rate_hz, double k_n_per_m, HandMode mode, const WallDevice& device, Vec2 start_m,
+                  Vec2 target_m) const {
     WallRun r;
     r.rate_hz = rate_hz;
     r.stiffness_n_per_m = k_n_per_m;
@@ -344,7 +347,8 @@ class WallBench {
       if (bounce_done && static_cast<double>(k - done_tick) * period_s > 0.02) break;
       for (int c = 0; c < ch.chunks; ++c) {
         if (mode == HandMode::LetGo && !let_go && dev.true_position_m().y < kLetGoHeightM) let_go = true;
-        const Vec2 f_hand = let_go ? Vec2{} : model_hand_force(hand, target_m, dev.true_position_m(), dev.velocity_m_per_s());
+        const Vec2 f_hand =
+            let_go ? Vec2{} : model_hand_force(hand, target_m, dev.true_position_m(), dev.velocity_m_per_s());
         const double ke_before = kinetic();
         const bool outside_before = dev.true_position_m().y > 0.0;
         dev.step(ch.chunk_s, f_hand);
@@ -392,7 +396,8 @@ class WallBench {
       r.window_energy_j.assign(static_cast<std::size_t>(windows), 0.0);
       for (std::size_t i = 0; i < t_s.size(); ++i) {
         if (t_s[i] < kTransientS) continue;
-        const auto w = static_cast<std::size_t>(std::min(windows - 1, static_cast<int>((t_s[i] - kTransientS) / kWindowS)));
+        const auto w =
+            static_cast<std::size_t>(std::min(windows - 1, static_cast<int>((t_s[i] - kTransientS) / kWindowS)));
         r.window_energy_j[w] = std::max(r.window_energy_j[w], std::abs(e_j[i] - mean_tail));
       }
       const double threshold_m = std::max(2.0 * step_normal_m, kMinOscillationM);
@@ -400,7 +405,8 @@ class WallBench {
       const double amp_m = 0.5 * threshold_m;
       const double threshold_j = 0.5 * (k_n_per_m + hand.stiffness_n_per_m) * amp_m * amp_m;
       const bool oscillating = r.p2p_tail_m > threshold_m && r.p2p_tail_m > 0.5 * r.p2p_before_m;
-      const bool growing = r.window_energy_j.back() > 2.0 * r.window_energy_j.front() && r.window_energy_j.back() > threshold_j;
+      const bool growing =
+          r.window_energy_j.back() > 2.0 * r.window_energy_j.front() && r.window_energy_j.back() > threshold_j;
       if (growing) {
         r.cls = "unstable";
         r.reason = "energy growth";
@@ -514,7 +520,8 @@ json wall_run_json(const WallRun& r) {
 
 /// Runs f(i) for i in [0, n) on all hardware threads. The runs are independent and deterministic.
 void parallel_for(std::size_t n, const std::function<void(std::size_t)>& f) {
-  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), static_cast<unsigned>(n)));
+  const unsigned threads =
+      std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), static_cast<unsigned>(n)));
   std::atomic<std::size_t> next{0};
   std::vector<std::thread> pool;
   for (unsigned t = 0; t < threads; ++t) {
@@ -546,14 +553,18 @@ void run_series(const WallBench& bench, const std::vector<double>& grid, int ref
     cases.push_back(wall_run_json(r));
     if (r.stable) {
       largest_stable_anywhere = k;
-      if (seen_not_stable) islands = true;
-      else stable_below = k;
+      if (seen_not_stable)
+        islands = true;
+      else
+        stable_below = k;
     } else if (!seen_not_stable) {
       seen_not_stable = true;
       first_not_stable = k;
     }
-    if (r.cls == "unstable") seen_divergent = true;
-    else if (!seen_divergent) no_divergence_below = k;
+    if (r.cls == "unstable")
+      seen_divergent = true;
+    else if (!seen_divergent)
+      no_divergence_below = k;
   }
   // Bisection (in log K) between the last value of the stable run and the first value that is not.
   double lo = stable_below, hi = first_not_stable;
@@ -572,9 +583,9 @@ void run_series(const WallBench& bench, const std::vector<double>& grid, int ref
   j["mode"] = mode_name(s.mode);
   j["encoder_counts_per_rev"] = s.device.params.encoder_counts_per_rev;
   j["delay_ticks"] = s.device.delay_ticks;
-  j["largest_stable_grid_n_per_m"] = sig4(stable_below);              // every grid value up to it stable
-  j["first_unstable_grid_n_per_m"] = sig4(first_not_stable);           // first grid value not stable
-  j["largest_stable_n_per_m"] = sig4(lo);                              // after bisection
+  j["largest_stable_grid_n_per_m"] = sig4(stable_below);      // every grid value up to it stable
+  j["first_unstable_grid_n_per_m"] = sig4(first_not_stable);  // first grid value not stable
+  j["largest_stable_n_per_m"] = sig4(lo);                     // after bisection
   j["smallest_unstable_n_per_m"] = hi > 0 ? json(sig4(hi)) : json(nullptr);
   j["largest_stable_anywhere_grid_n_per_m"] = sig4(largest_stable_anywhere);
   j["largest_without_divergence_grid_n_per_m"] = sig4(no_divergence_below);  // push: limit cycles accepted
@@ -585,7 +596,8 @@ void run_series(const WallBench& bench, const std::vector<double>& grid, int ref
 }
 
 json run_part1(bool quick) {
-  const std::vector<double> rates_hz = quick ? std::vector<double>{250, 1000, 4000} : std::vector<double>{250, 500, 1000, 2000, 4000};
+  const std::vector<double> rates_hz =
+      quick ? std::vector<double>{250, 1000, 4000} : std::vector<double>{250, 500, 1000, 2000, 4000};
   const std::vector<double> grid = log_grid(100.0, 50000.0, quick ? 10 : 25);
   const int refine_steps = quick ? 3 : 7;
   const int default_counts = SimPantographParams{}.encoder_counts_per_rev;
@@ -609,20 +621,27 @@ json run_part1(bool quick) {
                  {"start_m", {kWallStart.x, kWallStart.y}},
                  {"target_m", {kHandTarget.x, kHandTarget.y}},
                  {"let_go_height_m", kLetGoHeightM}};
-  out["servo"] = {{"contact_damping_n_s_per_m", 0.0}, {"max_force_n", 1e6}, {"force_ramp_s", 0.0}, {"query_box_budget", 0}};
+  out["servo"] = {
+      {"contact_damping_n_s_per_m", 0.0}, {"max_force_n", 1e6}, {"force_ramp_s", 0.0}, {"query_box_budget", 0}};
   out["run_s"] = kRunS;
   out["transient_s"] = kTransientS;
   out["rules"] = {
       {"push",
-       "oscillating: p2p normal displacement over the last 0.5 s > max(2 encoder steps, 1 um) and > half the p2p of the 0.5 s "
-       "before; growing: peak |E - E_rest| in the last 0.25 s window > 2x that of the first window after 0.5 s and > the "
-       "energy of the oscillation threshold; E = 0.5 m |v|^2 + 0.5 K depth^2. unstable = growing, or oscillating with the "
+       "oscillating: p2p normal displacement over the last 0.5 s > max(2 encoder steps, 1 um) and > half the p2p of "
+       "the 0.5 s "
+       "before; growing: peak |E - E_rest| in the last 0.25 s window > 2x that of the first window after 0.5 s and > "
+       "the "
+       "energy of the oscillation threshold; E = 0.5 m |v|^2 + 0.5 K depth^2. unstable = growing, or oscillating with "
+       "the "
        "proxy free at some tick of the last 0.5 s (bouncing); limit_cycle = oscillating in permanent contact; stable = "
-       "neither. Only stable counts as stable. Worst of 4 runs shifted 0.37 mm along the wall (encoder phases; 1 run with the "
+       "neither. Only stable counts as stable. Worst of 4 runs shifted 0.37 mm along the wall (encoder phases; 1 run "
+       "with the "
        "ideal encoder). Limit: first grid value not stable (all below stable), bisected against the last stable one."},
       {"let_go",
-       "the hand lets go 1 mm in front of the wall; unstable if, in any of 4 bounces started 0.37 mm apart (different servo "
-       "phases at the crossing), the kinetic energy when the wall force has ended exceeds the kinetic energy at the wall "
+       "the hand lets go 1 mm in front of the wall; unstable if, in any of 4 bounces started 0.37 mm apart (different "
+       "servo "
+       "phases at the crossing), the kinetic energy when the wall force has ended exceeds the kinetic energy at the "
+       "wall "
        "crossing (the wall created energy); the worst bounce is recorded"}};
   out["stiffness_grid_n_per_m"] = json::array();
   for (double k : grid) out["stiffness_grid_n_per_m"].push_back(sig4(k));
@@ -636,9 +655,10 @@ json run_part1(bool quick) {
     jr["passivity_bound_n_per_m"] = sig4(2.0 * dp.handle_damping_n_s_per_m / period_s);
     // Linear predictions: push = device + hand (continuous damping b + b_hand, hand spring);
     // let-go = the device alone.
-    jr["linear_limit_push_n_per_m"] =
-        sig4(linear_limit_n_per_m(dp.handle_mass_kg, dp.handle_damping_n_s_per_m + hand.damping_n_s_per_m, hand.stiffness_n_per_m, period_s));
-    jr["linear_limit_let_go_n_per_m"] = sig4(linear_limit_n_per_m(dp.handle_mass_kg, dp.handle_damping_n_s_per_m, 0.0, period_s));
+    jr["linear_limit_push_n_per_m"] = sig4(linear_limit_n_per_m(
+        dp.handle_mass_kg, dp.handle_damping_n_s_per_m + hand.damping_n_s_per_m, hand.stiffness_n_per_m, period_s));
+    jr["linear_limit_let_go_n_per_m"] =
+        sig4(linear_limit_n_per_m(dp.handle_mass_kg, dp.handle_damping_n_s_per_m, 0.0, period_s));
     rates.push_back(jr);
   }
   out["rates"] = rates;
@@ -646,14 +666,16 @@ json run_part1(bool quick) {
   std::vector<Series> series;
   for (int counts : {default_counts, kIdealEncoderCounts}) {
     for (double rate : rates_hz) {
-      for (HandMode mode : {HandMode::Push, HandMode::LetGo}) series.push_back(Series{rate, mode, WallBench::shipped_device(counts), json()});
+      for (HandMode mode : {HandMode::Push, HandMode::LetGo})
+        series.push_back(Series{rate, mode, WallBench::shipped_device(counts), json()});
     }
   }
   parallel_for(series.size(), [&](std::size_t i) { run_series(bench, grid, refine_steps, series[i]); });
   json js = json::array();
   for (const Series& s : series) {
     js.push_back(s.result);
-    std::fprintf(stderr, "  %5.0f Hz %-6s encoder %8d: largest stable %7.0f N/m (2b/T %6.0f)%s\n", s.rate_hz, mode_name(s.mode), s.device.params.encoder_counts_per_rev,
+    std::fprintf(stderr, "  %5.0f Hz %-6s encoder %8d: largest stable %7.0f N/m (2b/T %6.0f)%s\n", s.rate_hz,
+                 mode_name(s.mode), s.device.params.encoder_counts_per_rev,
                  s.result["largest_stable_n_per_m"].get<double>(), 2.0 * dp.handle_damping_n_s_per_m * s.rate_hz,
                  s.result["non_monotonic"].get<bool>() ? "  [non-monotonic]" : "");
   }
@@ -689,7 +711,8 @@ struct Segments {
     // Quick reject on the move's bounding box; the scenes are small, brute force is fine.
     const double x0 = std::min(p.x, q.x), x1 = std::max(p.x, q.x), y0 = std::min(p.y, q.y), y1 = std::max(p.y, q.y);
     for (const auto& [a, b] : segs) {
-      if (std::max(a.x, b.x) < x0 || std::min(a.x, b.x) > x1 || std::max(a.y, b.y) < y0 || std::min(a.y, b.y) > y1) continue;
+      if (std::max(a.x, b.x) < x0 || std::min(a.x, b.x) > x1 || std::max(a.y, b.y) < y0 || std::min(a.y, b.y) > y1)
+        continue;
       n += crosses(p, q, a, b);
     }
     return n;
@@ -723,10 +746,10 @@ struct Stroke {
 struct StrokeScene {
   std::string name;
   std::string description;
-  double thickness_m = 0.0;            // thin curve: its width [m]
-  double wedge_deg = 0.0;              // wedge: its opening angle [deg]
-  double apex_gap_m = -1.0;            // wedge: distance from the apex to the nearest level-0 point [m]
-  std::function<bool(Vec2)> behind;    // where a handle is unambiguously behind the shape (see make_stroke_scenes)
+  double thickness_m = 0.0;          // thin curve: its width [m]
+  double wedge_deg = 0.0;            // wedge: its opening angle [deg]
+  double apex_gap_m = -1.0;          // wedge: distance from the apex to the nearest level-0 point [m]
+  std::function<bool(Vec2)> behind;  // where a handle is unambiguously behind the shape (see make_stroke_scenes)
   Scene scene;
   Segments segs;
   std::vector<Segments> level_segs;    // every level id's segments (each curve at Scene::clamp_level), for part 2b
@@ -806,7 +829,8 @@ std::vector<StrokeScene> make_stroke_scenes() {
     StrokeScene s;
     s.name = "wedge_" + std::to_string(static_cast<int>(wedge_deg));
     s.description = std::to_string(static_cast<int>(wedge_deg)) +
-                    "-degree wedge: apex (0.01, 0) m, two 50 mm arms opening towards -x, 201 points; strokes from inside into the apex";
+                    "-degree wedge: apex (0.01, 0) m, two 50 mm arms opening towards -x, 201 points; strokes from "
+                    "inside into the apex";
     s.wedge_deg = wedge_deg;
     const Vec2 apex{0.01, 0.0};
     const double half = 0.5 * wedge_deg * deg;
@@ -842,26 +866,37 @@ std::vector<StrokeScene> make_stroke_scenes() {
 struct StrokeTally {
   int strokes = 0;
   int ticks = 0;
-  int tunnel_ticks = 0;          // ticks with a proxy sub-move crossing the polyline
-  int strokes_tunnelled = 0;     // strokes with any tunnel tick or ending on the far side
-  int strokes_far_side = 0;      // strokes whose final proxy is on the far side
-  int missed_ticks = 0;          // ticks with the handle clearly past the wall and the state Free
-  int unjudged_ticks = 0;        // ticks with the handle across the shape but outside its `behind` region
+  int tunnel_ticks = 0;       // ticks with a proxy sub-move crossing the polyline
+  int strokes_tunnelled = 0;  // strokes with any tunnel tick or ending on the far side
+  int strokes_far_side = 0;   // strokes whose final proxy is on the far side
+  int missed_ticks = 0;       // ticks with the handle clearly past the wall and the state Free
+  int unjudged_ticks = 0;     // ticks with the handle across the shape but outside its `behind` region
   int strokes_missed = 0;
-  int contact_ticks = 0;         // ticks in Edge or Vertex
+  int contact_ticks = 0;  // ticks in Edge or Vertex
   int vertex_ticks = 0;
-  int iteration_limit_ticks = 0; // ticks whose move budget ran out (the proxy stays valid, but it is a sign)
-  int query_budget_ticks = 0;    // ticks whose collision queries ran out of the box-test budget
-  double max_handle_step_m = 0;  // the largest handle jump in one tick [m]
-  double impact_speed_sum = 0;   // device: sum of handle speeds at first contact [m/s]
+  int iteration_limit_ticks = 0;  // ticks whose move budget ran out (the proxy stays valid, but it is a sign)
+  int query_budget_ticks = 0;     // ticks whose collision queries ran out of the box-test budget
+  double max_handle_step_m = 0;   // the largest handle jump in one tick [m]
+  double impact_speed_sum = 0;    // device: sum of handle speeds at first contact [m/s]
   int impacts = 0;
-  double max_depth_m = 0;        // largest handle distance past the wall while in contact [m]
+  double max_depth_m = 0;  // largest handle distance past the wall while in contact [m]
   void add(const StrokeTally& o) {
-    strokes += o.strokes; ticks += o.ticks; tunnel_ticks += o.tunnel_ticks; strokes_tunnelled += o.strokes_tunnelled;
-    strokes_far_side += o.strokes_far_side; missed_ticks += o.missed_ticks; strokes_missed += o.strokes_missed; unjudged_ticks += o.unjudged_ticks;
-    contact_ticks += o.contact_ticks; vertex_ticks += o.vertex_ticks; iteration_limit_ticks += o.iteration_limit_ticks;
-    query_budget_ticks += o.query_budget_ticks; max_handle_step_m = std::max(max_handle_step_m, o.max_handle_step_m);
-    impact_speed_sum += o.impact_speed_sum; impacts += o.impacts; max_depth_m = std::max(max_depth_m, o.max_depth_m);
+    strokes += o.strokes;
+    ticks += o.ticks;
+    tunnel_ticks += o.tunnel_ticks;
+    strokes_tunnelled += o.strokes_tunnelled;
+    strokes_far_side += o.strokes_far_side;
+    missed_ticks += o.missed_ticks;
+    strokes_missed += o.strokes_missed;
+    unjudged_ticks += o.unjudged_ticks;
+    contact_ticks += o.contact_ticks;
+    vertex_ticks += o.vertex_ticks;
+    iteration_limit_ticks += o.iteration_limit_ticks;
+    query_budget_ticks += o.query_budget_ticks;
+    max_handle_step_m = std::max(max_handle_step_m, o.max_handle_step_m);
+    impact_speed_sum += o.impact_speed_sum;
+    impacts += o.impacts;
+    max_depth_m = std::max(max_depth_m, o.max_depth_m);
   }
   bool failed() const { return strokes_tunnelled > 0 || strokes_missed > 0; }
 };
@@ -918,9 +953,9 @@ struct TickChecker {
 /// coarser level's wall lies up to its error away from the level-0 polyline, across it at a thin curve or
 /// a wedge's apex), and push-through is off (the shipped pop_force_n lets a proxy pressed that hard for
 /// pop_hold_s through a wall on purpose, kEventPopThrough: a slow stroke that ends 29 mm past a wedge's apex
-/// presses that long). Both are on by default, so part 2 sets them off itself, so it measures what it says: whether the proxy ever crosses
-/// the wall it renders.
-/// auto_levels: the shipped level_mode "auto" instead (part 2b), push-through still off.
+/// presses that long). Both are on by default, so part 2 sets them off itself, so it measures what it says: whether the
+/// proxy ever crosses the wall it renders. auto_levels: the shipped level_mode "auto" instead (part 2b), push-through
+/// still off.
 ServoParams stroke_servo_params(bool auto_levels = false) {
   config::Settings s;
   if (!auto_levels) {
@@ -936,8 +971,12 @@ ServoParams stroke_servo_params(bool auto_levels = false) {
 struct KinematicPath {
   static constexpr long kDwellTicks = 30;
   KinematicPath(const Stroke& st, double speed, double period)
-      : start(st.start_m), len(distance(st.start_m, st.end_m)), dir((1.0 / len) * (st.end_m - st.start_m)),
-        speed_m_per_s(speed), period_s(period), move_ticks(static_cast<long>(std::ceil(len / (speed * period)))) {}
+      : start(st.start_m),
+        len(distance(st.start_m, st.end_m)),
+        dir((1.0 / len) * (st.end_m - st.start_m)),
+        speed_m_per_s(speed),
+        period_s(period),
+        move_ticks(static_cast<long>(std::ceil(len / (speed * period)))) {}
   long ticks() const { return move_ticks + kDwellTicks; }
   /// The device sample of tick k, k in [1, ticks()].
   ServoInput input(long k) const {
@@ -963,10 +1002,15 @@ struct AutoLevelTally {
   int strokes_tunnelled = 0;  // strokes with a tunnel tick, or ending on the far side of the final level's polyline
   int contact_ticks = 0;
   int level_changes = 0;
-  double level_sum = 0.0;     // sum over ticks of the level in use (for the mean)
+  double level_sum = 0.0;  // sum over ticks of the level in use (for the mean)
   void add(const AutoLevelTally& o) {
-    strokes += o.strokes; ticks += o.ticks; tunnel_ticks += o.tunnel_ticks; strokes_tunnelled += o.strokes_tunnelled;
-    contact_ticks += o.contact_ticks; level_changes += o.level_changes; level_sum += o.level_sum;
+    strokes += o.strokes;
+    ticks += o.ticks;
+    tunnel_ticks += o.tunnel_ticks;
+    strokes_tunnelled += o.strokes_tunnelled;
+    contact_ticks += o.contact_ticks;
+    level_changes += o.level_changes;
+    level_sum += o.level_sum;
   }
 };
 
@@ -981,7 +1025,9 @@ AutoLevelTally auto_level_stroke(const StrokeScene& sc, const Stroke& st, double
   SceneStep servo(sc.scene, sp);
   servo.start(st.start_m);
   const KinematicPath path(st, speed_m_per_s, sp.period_s);
-  const auto segs_of = [&](int id) -> const Segments& { return sc.level_segs[static_cast<std::size_t>(std::clamp<int>(id, 0, static_cast<int>(sc.level_segs.size()) - 1))]; };
+  const auto segs_of = [&](int id) -> const Segments& {
+    return sc.level_segs[static_cast<std::size_t>(std::clamp<int>(id, 0, static_cast<int>(sc.level_segs.size()) - 1))];
+  };
   AutoLevelTally t;
   bool any_tunnel = false;
   ServoOutput so;
@@ -1132,10 +1178,13 @@ json run_part2(bool quick) {
                         {"damping_n_s_per_m_relative_to_target", kDeviceHandDampingNSPerM},
                         {"max_force_n", kDeviceHandMaxForceN}};
   out["clearly_past_m"] = kClearlyPastM;
-  out["rules"] = {{"tunnelling", "a proxy sub-move path_m[i] -> path_m[i+1] crosses a level-0 segment (p, q strictly on opposite sides of the "
-                                 "segment's line, the crossing within the closed segment), or the final proxy is on the far side"},
-                  {"missed_contact", "handle past the wall (start -> handle crosses the polyline), > clearly_past_m from it and inside the shape's "
-                                     "behind region (no way round), and contact state Free; unjudged_ticks counts handles across but outside it"}};
+  out["rules"] = {
+      {"tunnelling",
+       "a proxy sub-move path_m[i] -> path_m[i+1] crosses a level-0 segment (p, q strictly on opposite sides of the "
+       "segment's line, the crossing within the closed segment), or the final proxy is on the far side"},
+      {"missed_contact",
+       "handle past the wall (start -> handle crosses the polyline), > clearly_past_m from it and inside the shape's "
+       "behind region (no way round), and contact state Free; unjudged_ticks counts handles across but outside it"}};
   // One job per (scene, drive, speed), run in parallel; tallies land in fixed slots, so the output does
   // not depend on the scheduling.
   struct Job {
@@ -1153,7 +1202,8 @@ json run_part2(bool quick) {
     Job& job = jobs[j];
     const StrokeScene& sc = scenes[job.scene];
     for (const Stroke& st : job.device ? sc.device_strokes : sc.strokes) {
-      job.tally.add(job.device ? device_stroke(sc, st, job.speed_m_per_s) : kinematic_stroke(sc, st, job.speed_m_per_s));
+      job.tally.add(job.device ? device_stroke(sc, st, job.speed_m_per_s)
+                               : kinematic_stroke(sc, st, job.speed_m_per_s));
     }
   });
   // Control: the same kinematic strokes with a proxy that ignores the walls. Every stroke must be
@@ -1162,9 +1212,13 @@ json run_part2(bool quick) {
   for (const StrokeScene& sc : scenes) {
     StrokeTally t;
     for (const Stroke& st : sc.strokes) t.add(kinematic_stroke(sc, st, 0.5, true));
-    control.push_back({{"scene", sc.name}, {"strokes", t.strokes}, {"strokes_tunnelled", t.strokes_tunnelled}, {"strokes_missed_contact", t.strokes_missed}});
+    control.push_back({{"scene", sc.name},
+                       {"strokes", t.strokes},
+                       {"strokes_tunnelled", t.strokes_tunnelled},
+                       {"strokes_missed_contact", t.strokes_missed}});
     if (t.strokes_tunnelled != t.strokes || t.strokes_missed != t.strokes) {
-      std::fprintf(stderr, "bench_stability: the checker missed failures of the wall-blind control on %s\n", sc.name.c_str());
+      std::fprintf(stderr, "bench_stability: the checker missed failures of the wall-blind control on %s\n",
+                   sc.name.c_str());
       std::exit(3);
     }
   }
@@ -1181,7 +1235,8 @@ json run_part2(bool quick) {
   }
   parallel_for(auto_jobs.size(), [&](std::size_t j) {
     AutoJob& job = auto_jobs[j];
-    for (const Stroke& st : scenes[job.scene].strokes) job.tally.add(auto_level_stroke(scenes[job.scene], st, job.speed_m_per_s));
+    for (const Stroke& st : scenes[job.scene].strokes)
+      job.tally.add(auto_level_stroke(scenes[job.scene], st, job.speed_m_per_s));
   });
   json auto_scenes = json::array();
   for (std::size_t i = 0; i < scenes.size(); ++i) {
@@ -1191,18 +1246,25 @@ json run_part2(bool quick) {
       if (job.scene != i) continue;
       const AutoLevelTally& t = job.tally;
       failing += t.strokes_tunnelled;
-      rows.push_back({{"speed_m_per_s", sig4(job.speed_m_per_s)}, {"strokes", t.strokes}, {"ticks", t.ticks}, {"tunnel_ticks", t.tunnel_ticks},
-                      {"strokes_tunnelled", t.strokes_tunnelled}, {"contact_ticks", t.contact_ticks}, {"level_changes", t.level_changes},
+      rows.push_back({{"speed_m_per_s", sig4(job.speed_m_per_s)},
+                      {"strokes", t.strokes},
+                      {"ticks", t.ticks},
+                      {"tunnel_ticks", t.tunnel_ticks},
+                      {"strokes_tunnelled", t.strokes_tunnelled},
+                      {"contact_ticks", t.contact_ticks},
+                      {"level_changes", t.level_changes},
                       {"mean_level", sig4(t.ticks > 0 ? t.level_sum / t.ticks : 0.0)}});
     }
     std::fprintf(stderr, "  %-14s auto levels, failing strokes: kinematic %d\n", scenes[i].name.c_str(), failing);
     auto_scenes.push_back({{"name", scenes[i].name}, {"kinematic", rows}});
   }
-  out["auto_levels"] = {{"level_mode", "auto"},
-                        {"pop_force_n", 0.0},
-                        {"rule", "a proxy sub-move crosses a segment of the level id in use or of the previous one while a change is in "
-                                 "transition, or the final proxy is on the far side of the final level's polyline; no missed-contact rule"},
-                        {"scenes", auto_scenes}};
+  out["auto_levels"] = {
+      {"level_mode", "auto"},
+      {"pop_force_n", 0.0},
+      {"rule",
+       "a proxy sub-move crosses a segment of the level id in use or of the previous one while a change is in "
+       "transition, or the final proxy is on the far side of the final level's polyline; no missed-contact rule"},
+      {"scenes", auto_scenes}};
   json jscenes = json::array();
   double first_fail_kin = 0.0, first_fail_dev = 0.0;
   for (std::size_t i = 0; i < scenes.size(); ++i) {
@@ -1246,7 +1308,6 @@ json run_part2(bool quick) {
 
 }  // namespace
 
-
 // ───────────────────────────── Part 3: each device profile's model ─────────────────────────────
 
 /// The wall device of a profile's shipped settings, in the workspace frame the servo loop works in:
@@ -1262,7 +1323,8 @@ WallDevice profile_device(const config::Settings& s) {
   d.params = app::sim_params_from(s);
   d.params.max_torque_n_m = 1e4;
   if (!config::is_usb_type(s.device.type)) return d;
-  const double scale = std::min(s.workspace.width_m / s.device.rect_width_m, s.workspace.height_m / s.device.rect_height_m);
+  const double scale =
+      std::min(s.workspace.width_m / s.device.rect_width_m, s.workspace.height_m / s.device.rect_height_m);
   d.params.geometry.motor_half_spacing_m = scale * 0.5 * s.device.motor_spacing_m;
   d.params.geometry.base_m = {0.0, -scale * s.device.rect_center_y_m};
   d.params.geometry.proximal_m = scale * s.device.link_proximal_m;
@@ -1288,7 +1350,8 @@ json run_part3(bool quick) {
   for (const config::DeviceProfile& p : config::device_profiles()) {
     const config::Settings s = config::profile_defaults(p.type);
     const WallDevice d = profile_device(s);
-    for (HandMode mode : {HandMode::Push, HandMode::LetGo}) series.push_back(Series{s.haptics.servo_rate_hz, mode, d, json()});
+    for (HandMode mode : {HandMode::Push, HandMode::LetGo})
+      series.push_back(Series{s.haptics.servo_rate_hz, mode, d, json()});
     cases.push_back({s, d});
   }
   parallel_for(series.size(), [&](std::size_t i) { run_series(bench, grid, refine_steps, series[i]); });
@@ -1301,7 +1364,8 @@ json run_part3(bool quick) {
     const config::DeviceProfile& p = config::device_profile(s.device.type);
     const json& push = series[2 * i].result;
     const json& let_go = series[2 * i + 1].result;
-    const double limit = std::min(push["largest_stable_n_per_m"].get<double>(), let_go["largest_stable_n_per_m"].get<double>());
+    const double limit =
+        std::min(push["largest_stable_n_per_m"].get<double>(), let_go["largest_stable_n_per_m"].get<double>());
     json j;
     j["type"] = std::string(p.type);
     j["name"] = std::string(p.name);
@@ -1322,9 +1386,12 @@ json run_part3(bool quick) {
     j["pop_force_n"] = s.haptics.pop_force_n;
     j["push"] = push;
     j["let_go"] = let_go;
-    std::fprintf(stderr, "  %-22s push %6.0f  let-go %6.0f N/m: limit %6.0f, profile allows %6.0f, default %4.0f (margin %.1fx)\n",
-                 std::string(p.name).c_str(), push["largest_stable_n_per_m"].get<double>(), let_go["largest_stable_n_per_m"].get<double>(), limit,
-                 p.stable_stiffness_n_per_m, s.haptics.stiffness_n_per_m, limit / s.haptics.stiffness_n_per_m);
+    std::fprintf(
+        stderr,
+        "  %-22s push %6.0f  let-go %6.0f N/m: limit %6.0f, profile allows %6.0f, default %4.0f (margin %.1fx)\n",
+        std::string(p.name).c_str(), push["largest_stable_n_per_m"].get<double>(),
+        let_go["largest_stable_n_per_m"].get<double>(), limit, p.stable_stiffness_n_per_m, s.haptics.stiffness_n_per_m,
+        limit / s.haptics.stiffness_n_per_m);
     profiles.push_back(j);
   }
   out["profiles"] = profiles;

@@ -5,6 +5,7 @@
 // multiresolution + trees), which is when the kiosk says the summary and the force fades in. Mount time is
 // not included (a loop mount here takes a few ms; a real stick's is its hardware's).
 // Usage: bench_stick_first_page [--repeats N] [--out FILE.json]
+#include <unistd.h>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -13,7 +14,6 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
-#include <unistd.h>
 #include <vector>
 
 #include <spdlog/spdlog.h>
@@ -51,12 +51,14 @@ int main(int argc, char** argv) {
   }
   spdlog::set_level(spdlog::level::warn);  // the service's info lines would land in the table
   const fs::path data = HK_TEST_DATA_DIR;
-  const std::vector<fs::path> docs{data / "documents" / "horse_and_page.pdf", data / "documents" / "shared-mime-info-spec.pdf",
-                                   data / "images" / "fruits.jpg"};
+  const std::vector<fs::path> docs{data / "documents" / "horse_and_page.pdf",
+                                   data / "documents" / "shared-mime-info-spec.pdf", data / "images" / "fruits.jpg"};
   const fs::path tmp = fs::temp_directory_path() / ("hk_bench_stick_" + std::to_string(::getpid()));
   config::Settings s;
   nlohmann::json rows = nlohmann::json::array();
-  std::printf("| document | pages | inserted -> first page felt, median [ms] | min [ms] | of which scan + page count [ms] |\n|---|---|---|---|---|\n");
+  std::printf(
+      "| document | pages | inserted -> first page felt, median [ms] | min [ms] | of which scan + page count [ms] "
+      "|\n|---|---|---|---|---|\n");
   for (const fs::path& doc : docs) {
     fs::remove_all(tmp);
     fs::create_directories(tmp);
@@ -85,9 +87,14 @@ int main(int argc, char** argv) {
     std::sort(total.begin(), total.end());
     std::sort(scan.begin(), scan.end());
     const double med = total[total.size() / 2];
-    std::printf("| %s | %d | %.0f | %.0f | %.0f |\n", doc.filename().c_str(), pages, med, total.front(), scan[scan.size() / 2]);
-    rows.push_back({{"document", doc.filename().string()}, {"pages", pages}, {"first_page_ms_median", med}, {"first_page_ms_min", total.front()},
-                    {"scan_ms_median", scan[scan.size() / 2]}, {"repeats", repeats}});
+    std::printf("| %s | %d | %.0f | %.0f | %.0f |\n", doc.filename().c_str(), pages, med, total.front(),
+                scan[scan.size() / 2]);
+    rows.push_back({{"document", doc.filename().string()},
+                    {"pages", pages},
+                    {"first_page_ms_median", med},
+                    {"first_page_ms_min", total.front()},
+                    {"scan_ms_median", scan[scan.size() / 2]},
+                    {"repeats", repeats}});
   }
   fs::remove_all(tmp);
   if (!out_path.empty()) std::ofstream(out_path) << nlohmann::json{{"stick_first_page", rows}}.dump(2) << "\n";

@@ -84,7 +84,8 @@ nlohmann::json to_json(const Timing& t) {
           {"refused", t.last.refused.size()},
           {"complete", t.last.complete},
           {"stopped_by", t.last.stopped_by},
-          {"median_us_per_entry", t.last.entries_scanned ? 1e3 * t.median_ms / static_cast<double>(t.last.entries_scanned) : 0.0}};
+          {"median_us_per_entry",
+           t.last.entries_scanned ? 1e3 * t.median_ms / static_cast<double>(t.last.entries_scanned) : 0.0}};
 }
 
 }  // namespace
@@ -94,10 +95,14 @@ int main(int argc, char** argv) {
   std::string out_path;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--files" && i + 1 < argc) files = std::atoi(argv[++i]);
-    else if (a == "--folders" && i + 1 < argc) folders = std::atoi(argv[++i]);
-    else if (a == "--repeats" && i + 1 < argc) repeats = std::atoi(argv[++i]);
-    else if (a == "--out" && i + 1 < argc) out_path = argv[++i];
+    if (a == "--files" && i + 1 < argc)
+      files = std::atoi(argv[++i]);
+    else if (a == "--folders" && i + 1 < argc)
+      folders = std::atoi(argv[++i]);
+    else if (a == "--repeats" && i + 1 < argc)
+      repeats = std::atoi(argv[++i]);
+    else if (a == "--out" && i + 1 < argc)
+      out_path = argv[++i];
     else {
       std::fprintf(stderr, "usage: %s [--files N] [--folders N] [--repeats N] [--out FILE.json]\n", argv[0]);
       return 2;
@@ -134,12 +139,9 @@ int main(int argc, char** argv) {
   try {
     const Timing full = time_scans(root, whole, repeats);
     const Timing deflt = time_scans(root, ScanLimits{}, repeats);
-    j = {{"bench", "stick_scan"},
-         {"files", files},
-         {"folders", folders},
-         {"repeats", repeats},
-         {"whole_walk", to_json(full)},
-         {"default_limits", to_json(deflt)}};
+    j = {{"bench", "stick_scan"},       {"files", files},
+         {"folders", folders},          {"repeats", repeats},
+         {"whole_walk", to_json(full)}, {"default_limits", to_json(deflt)}};
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_stick_scan: %s\n", e.what());
     fs::remove_all(root);

@@ -117,18 +117,22 @@ std::vector<std::size_t> corners_of(const Polyline& src) {
   const std::size_t n = p.size();
   std::vector<double> turn(n, 0.0);
   if (n < 5) return {};
-  auto at = [&](long i) -> std::size_t { return static_cast<std::size_t>(((i % static_cast<long>(n)) + static_cast<long>(n)) % static_cast<long>(n)); };
+  auto at = [&](long i) -> std::size_t {
+    return static_cast<std::size_t>(((i % static_cast<long>(n)) + static_cast<long>(n)) % static_cast<long>(n));
+  };
   for (std::size_t i = 0; i < n; ++i) {
     long back = static_cast<long>(i), ahead = static_cast<long>(i);
     bool ok = true;
     do {
       --back;
       if (!src.closed && back < 0) ok = false;
-    } while (ok && distance(p[at(back)], p[i]) < kCornerReach_m && static_cast<long>(i) - back < static_cast<long>(n) / 2);
+    } while (ok && distance(p[at(back)], p[i]) < kCornerReach_m &&
+             static_cast<long>(i) - back < static_cast<long>(n) / 2);
     do {
       ++ahead;
       if (!src.closed && ahead >= static_cast<long>(n)) ok = false;
-    } while (ok && distance(p[at(ahead)], p[i]) < kCornerReach_m && ahead - static_cast<long>(i) < static_cast<long>(n) / 2);
+    } while (ok && distance(p[at(ahead)], p[i]) < kCornerReach_m &&
+             ahead - static_cast<long>(i) < static_cast<long>(n) / 2);
     if (!ok) continue;
     const Vec2 u = p[i] - p[at(back)], v = p[at(ahead)] - p[i];
     turn[i] = std::abs(std::atan2(u.x * v.y - u.y * v.x, u.x * v.x + u.y * v.y));
@@ -139,7 +143,8 @@ std::vector<std::size_t> corners_of(const Polyline& src) {
     bool peak = true;  // the largest turn within the reach (the first of equals)
     for (long d = 1; peak && d < static_cast<long>(n) / 2; ++d) {
       const std::size_t f = at(static_cast<long>(i) + d), b = at(static_cast<long>(i) - d);
-      const bool f_in = (src.closed || static_cast<long>(i) + d < static_cast<long>(n)) && distance(p[f], p[i]) < kCornerReach_m;
+      const bool f_in =
+          (src.closed || static_cast<long>(i) + d < static_cast<long>(n)) && distance(p[f], p[i]) < kCornerReach_m;
       const bool b_in = (src.closed || static_cast<long>(i) - d >= 0) && distance(p[b], p[i]) < kCornerReach_m;
       if (!f_in && !b_in) break;
       if ((f_in && turn[f] > turn[i]) || (b_in && turn[b] >= turn[i])) peak = false;
@@ -178,7 +183,8 @@ std::vector<Polyline> pieces_at_corners(const Polyline& src, const std::vector<s
 // (every original vertex of the piece within T), its vertices counted once where two pieces share a corner. Not
 // what the kiosk builds (a curve is one curve of the scene): an experiment that measures how much of the gap to
 // Douglas–Peucker the corners are. Returns the vertices; adds the pieces' largest measured error to *error_m.
-std::size_t cut_broken_at_corners(const Polyline& src, double tol_m, int max_levels, bool chord_roots, std::size_t* corner_count, double* error_m) {
+std::size_t cut_broken_at_corners(const Polyline& src, double tol_m, int max_levels, bool chord_roots,
+                                  std::size_t* corner_count, double* error_m) {
   const std::vector<std::size_t> corners = corners_of(src);
   *corner_count += corners.size();
   if (corners.empty()) return 0;  // the caller counts the curve's own cut
@@ -230,7 +236,9 @@ void polygon_table(nlohmann::json& out, const std::vector<double>& tolerances_mm
       {"triangle 70 mm", {{0.02, 0.02}, {0.09, 0.02}, {0.055, 0.0806}}},
       {"L 60 x 40 mm", {{0.02, 0.02}, {0.08, 0.02}, {0.08, 0.04}, {0.04, 0.04}, {0.04, 0.06}, {0.02, 0.06}}},
   };
-  std::printf("\n| polygon | corners | T mm | joined cut vertices | dp vertices | cut / dp | cut error mm | dp error mm |\n|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "\n| polygon | corners | T mm | joined cut vertices | dp vertices | cut / dp | cut error mm | dp error mm "
+      "|\n|---|---|---|---|---|---|---|---|\n");
   for (const auto& [name, corners] : shapes) {
     const std::vector<Polyline> curves = {traced_polygon(corners, kStep_m)};
     const Scene sc = Scene::build(curves, max_levels);
@@ -238,11 +246,18 @@ void polygon_table(nlohmann::json& out, const std::vector<double>& tolerances_mm
       Tally t;
       cut_curve(sc, 0, curves[0], tol_mm * 1e-3, t);
       dp_curve(curves[0], tol_mm * 1e-3, t);
-      const double ratio = static_cast<double>(t.cut_vertices) / static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
-      std::printf("| %s | %zu | %.1f | %zu | %zu | %.2f | %.3f | %.3f |\n", name, corners.size(), tol_mm, t.cut_vertices, t.dp_vertices, ratio,
-                  1e3 * t.cut_error_m, 1e3 * t.dp_error_m);
-      out.push_back({{"polygon", name}, {"corners", corners.size()}, {"tolerance_mm", tol_mm}, {"cut_vertices", t.cut_vertices},
-                     {"dp_vertices", t.dp_vertices}, {"ratio", ratio}, {"cut_error_mm", 1e3 * t.cut_error_m}, {"dp_error_mm", 1e3 * t.dp_error_m}});
+      const double ratio =
+          static_cast<double>(t.cut_vertices) / static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
+      std::printf("| %s | %zu | %.1f | %zu | %zu | %.2f | %.3f | %.3f |\n", name, corners.size(), tol_mm,
+                  t.cut_vertices, t.dp_vertices, ratio, 1e3 * t.cut_error_m, 1e3 * t.dp_error_m);
+      out.push_back({{"polygon", name},
+                     {"corners", corners.size()},
+                     {"tolerance_mm", tol_mm},
+                     {"cut_vertices", t.cut_vertices},
+                     {"dp_vertices", t.dp_vertices},
+                     {"ratio", ratio},
+                     {"cut_error_mm", 1e3 * t.cut_error_m},
+                     {"dp_error_mm", 1e3 * t.dp_error_m}});
     }
   }
 }
@@ -261,18 +276,23 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--max-levels") == 0) settings.haptics.max_levels = std::atoi(argv[i + 1]);
   }
   if (settings.haptics.max_levels < 0 || settings.haptics.max_levels >= kMaxLevels) {
-    std::fprintf(stderr, "bench_tolerance_cut: --max-levels %d is outside [0, %d]\n", settings.haptics.max_levels, kMaxLevels - 1);
+    std::fprintf(stderr, "bench_tolerance_cut: --max-levels %d is outside [0, %d]\n", settings.haptics.max_levels,
+                 kMaxLevels - 1);
     return 2;
   }
   const std::vector<double> tolerances_mm = {0.2, 0.3, 0.5, 1.0, 2.0};
   nlohmann::json rows = nlohmann::json::array();
-  std::printf("| picture | curves | T mm | joined cut vertices (breaks joined) | dp vertices | cut / dp | cut error mm | dp error mm | curves with level-0 error > T | curve levels vertices | curve levels / dp | curve levels error mm |\n");
+  std::printf(
+      "| picture | curves | T mm | joined cut vertices (breaks joined) | dp vertices | cut / dp | cut error mm | dp "
+      "error mm | curves with level-0 error > T | curve levels vertices | curve levels / dp | curve levels error mm "
+      "|\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<double> worst_ratio(tolerances_mm.size(), 0.0), worst_level_ratio(tolerances_mm.size(), 0.0);
   std::vector<double> worst_broken_ratio(tolerances_mm.size(), 0.0), worst_broken_error_mm(tolerances_mm.size(), 0.0);
   std::vector<std::string> worst_broken_picture(tolerances_mm.size());
   std::vector<double> worst_chord_ratio(tolerances_mm.size(), 0.0);
-  std::vector<int> within_cut(tolerances_mm.size(), 0), within_broken(tolerances_mm.size(), 0), within_chord(tolerances_mm.size(), 0);
+  std::vector<int> within_cut(tolerances_mm.size(), 0), within_broken(tolerances_mm.size(), 0),
+      within_chord(tolerances_mm.size(), 0);
   nlohmann::json broken_rows = nlohmann::json::array();
   for (std::size_t p = 0; p < paths.size(); ++p) {
     const Scene sc = Scene::build(pictures[p], settings.haptics.max_levels);
@@ -291,9 +311,11 @@ int main(int argc, char** argv) {
         t.curves_below_level0 += own.curves_below_level0;
         dp_curve(src, tol_m, t);
         curve_level(sc, c, src, tol_m, t);
-        const std::size_t broken = cut_broken_at_corners(src, tol_m, settings.haptics.max_levels, false, &corners, &broken_error_m);
+        const std::size_t broken =
+            cut_broken_at_corners(src, tol_m, settings.haptics.max_levels, false, &corners, &broken_error_m);
         std::size_t ignored = 0;
-        const std::size_t chorded = cut_broken_at_corners(src, tol_m, settings.haptics.max_levels, true, &ignored, &chord_error_m);
+        const std::size_t chorded =
+            cut_broken_at_corners(src, tol_m, settings.haptics.max_levels, true, &ignored, &chord_error_m);
         if (broken == 0) {
           broken_error_m = std::max(broken_error_m, own.cut_error_m);
           chord_error_m = std::max(chord_error_m, own.cut_error_m);
@@ -301,51 +323,85 @@ int main(int argc, char** argv) {
         broken_vertices += broken > 0 ? broken : own.cut_vertices;
         chord_vertices += chorded > 0 ? chorded : own.cut_vertices;
       }
-      const double broken_ratio = static_cast<double>(broken_vertices) / static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
+      const double broken_ratio =
+          static_cast<double>(broken_vertices) / static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
       if (broken_ratio > worst_broken_ratio[ti]) worst_broken_picture[ti] = paths[p].stem().string();
       worst_broken_ratio[ti] = std::max(worst_broken_ratio[ti], broken_ratio);
       worst_broken_error_mm[ti] = std::max(worst_broken_error_mm[ti], 1e3 * broken_error_m);
-      const double chord_ratio = static_cast<double>(chord_vertices) / static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
+      const double chord_ratio =
+          static_cast<double>(chord_vertices) / static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
       worst_chord_ratio[ti] = std::max(worst_chord_ratio[ti], chord_ratio);
       within_broken[ti] += broken_ratio <= 1.2;
       within_chord[ti] += chord_ratio <= 1.2;
-      broken_rows.push_back({{"picture", paths[p].stem().string()}, {"tolerance_mm", tolerances_mm[ti]}, {"corners", corners},
-                             {"vertices", broken_vertices}, {"dp_vertices", t.dp_vertices}, {"ratio", broken_ratio}, {"error_mm", 1e3 * broken_error_m},
-                             {"chord_vertices", chord_vertices}, {"chord_ratio", chord_ratio}, {"chord_error_mm", 1e3 * chord_error_m}});
+      broken_rows.push_back({{"picture", paths[p].stem().string()},
+                             {"tolerance_mm", tolerances_mm[ti]},
+                             {"corners", corners},
+                             {"vertices", broken_vertices},
+                             {"dp_vertices", t.dp_vertices},
+                             {"ratio", broken_ratio},
+                             {"error_mm", 1e3 * broken_error_m},
+                             {"chord_vertices", chord_vertices},
+                             {"chord_ratio", chord_ratio},
+                             {"chord_error_mm", 1e3 * chord_error_m}});
       const double dp = static_cast<double>(std::max<std::size_t>(1, t.dp_vertices));
-      const double ratio = static_cast<double>(t.cut_vertices) / dp, level_ratio = static_cast<double>(t.level_vertices) / dp;
+      const double ratio = static_cast<double>(t.cut_vertices) / dp,
+                   level_ratio = static_cast<double>(t.level_vertices) / dp;
       worst_ratio[ti] = std::max(worst_ratio[ti], ratio);
       worst_level_ratio[ti] = std::max(worst_level_ratio[ti], level_ratio);
       within_cut[ti] += ratio <= 1.2;
-      std::printf("| %s | %zu | %.1f | %zu (%zu) | %zu | %.2f | %.3f | %.3f | %zu | %zu | %.2f | %.3f |\n", paths[p].stem().c_str(), sc.curve_count(), tolerances_mm[ti],
-                  t.cut_vertices, t.cut_breaks, t.dp_vertices, ratio, 1e3 * t.cut_error_m, 1e3 * t.dp_error_m, t.curves_below_level0, t.level_vertices,
-                  level_ratio, 1e3 * t.level_error_m);
-      rows.push_back({{"picture", paths[p].stem().string()}, {"curves", sc.curve_count()}, {"tolerance_mm", tolerances_mm[ti]},
-                      {"cut_vertices", t.cut_vertices}, {"cut_breaks", t.cut_breaks}, {"dp_vertices", t.dp_vertices}, {"ratio", ratio},
-                      {"cut_error_mm", 1e3 * t.cut_error_m}, {"dp_error_mm", 1e3 * t.dp_error_m}, {"curves_below_level0", t.curves_below_level0},
-                      {"curve_levels_vertices", t.level_vertices}, {"curve_levels_ratio", level_ratio}, {"curve_levels_error_mm", 1e3 * t.level_error_m}});
+      std::printf("| %s | %zu | %.1f | %zu (%zu) | %zu | %.2f | %.3f | %.3f | %zu | %zu | %.2f | %.3f |\n",
+                  paths[p].stem().c_str(), sc.curve_count(), tolerances_mm[ti], t.cut_vertices, t.cut_breaks,
+                  t.dp_vertices, ratio, 1e3 * t.cut_error_m, 1e3 * t.dp_error_m, t.curves_below_level0,
+                  t.level_vertices, level_ratio, 1e3 * t.level_error_m);
+      rows.push_back({{"picture", paths[p].stem().string()},
+                      {"curves", sc.curve_count()},
+                      {"tolerance_mm", tolerances_mm[ti]},
+                      {"cut_vertices", t.cut_vertices},
+                      {"cut_breaks", t.cut_breaks},
+                      {"dp_vertices", t.dp_vertices},
+                      {"ratio", ratio},
+                      {"cut_error_mm", 1e3 * t.cut_error_m},
+                      {"dp_error_mm", 1e3 * t.dp_error_m},
+                      {"curves_below_level0", t.curves_below_level0},
+                      {"curve_levels_vertices", t.level_vertices},
+                      {"curve_levels_ratio", level_ratio},
+                      {"curve_levels_error_mm", 1e3 * t.level_error_m}});
     }
   }
   std::printf("\n| T mm | worst cut / dp over the pictures | worst curve levels / dp |\n|---|---|---|\n");
   nlohmann::json worst = nlohmann::json::array();
   for (std::size_t ti = 0; ti < tolerances_mm.size(); ++ti) {
     std::printf("| %.1f | %.2f | %.2f |\n", tolerances_mm[ti], worst_ratio[ti], worst_level_ratio[ti]);
-    worst.push_back({{"tolerance_mm", tolerances_mm[ti]}, {"worst_ratio", worst_ratio[ti]}, {"worst_curve_levels_ratio", worst_level_ratio[ti]}});
+    worst.push_back({{"tolerance_mm", tolerances_mm[ti]},
+                     {"worst_ratio", worst_ratio[ti]},
+                     {"worst_curve_levels_ratio", worst_level_ratio[ti]}});
   }
   nlohmann::json polygons = nlohmann::json::array();
   polygon_table(polygons, tolerances_mm, settings.haptics.max_levels);
-  std::printf("\n| T mm | pictures <= 1.2x dp: cut | broken at corners: worst cut / dp | its picture | pictures <= 1.2x | largest measured error mm | "
-              "and a piece within T of its chord as one segment: worst / dp | pictures <= 1.2x |\n|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "\n| T mm | pictures <= 1.2x dp: cut | broken at corners: worst cut / dp | its picture | pictures <= 1.2x | "
+      "largest measured error mm | "
+      "and a piece within T of its chord as one segment: worst / dp | pictures <= 1.2x "
+      "|\n|---|---|---|---|---|---|---|---|\n");
   nlohmann::json broken_worst = nlohmann::json::array();
   for (std::size_t ti = 0; ti < tolerances_mm.size(); ++ti) {
-    std::printf("| %.1f | %d of %zu | %.2f | %s | %d | %.3f | %.2f | %d |\n", tolerances_mm[ti], within_cut[ti], paths.size(), worst_broken_ratio[ti],
-                worst_broken_picture[ti].c_str(), within_broken[ti], worst_broken_error_mm[ti], worst_chord_ratio[ti], within_chord[ti]);
-    broken_worst.push_back({{"tolerance_mm", tolerances_mm[ti]}, {"worst_ratio", worst_broken_ratio[ti]}, {"picture", worst_broken_picture[ti]},
-                            {"largest_error_mm", worst_broken_error_mm[ti]}, {"worst_chord_ratio", worst_chord_ratio[ti]},
-                            {"pictures_within_1_2_cut", within_cut[ti]}, {"pictures_within_1_2_broken", within_broken[ti]},
+    std::printf("| %.1f | %d of %zu | %.2f | %s | %d | %.3f | %.2f | %d |\n", tolerances_mm[ti], within_cut[ti],
+                paths.size(), worst_broken_ratio[ti], worst_broken_picture[ti].c_str(), within_broken[ti],
+                worst_broken_error_mm[ti], worst_chord_ratio[ti], within_chord[ti]);
+    broken_worst.push_back({{"tolerance_mm", tolerances_mm[ti]},
+                            {"worst_ratio", worst_broken_ratio[ti]},
+                            {"picture", worst_broken_picture[ti]},
+                            {"largest_error_mm", worst_broken_error_mm[ti]},
+                            {"worst_chord_ratio", worst_chord_ratio[ti]},
+                            {"pictures_within_1_2_cut", within_cut[ti]},
+                            {"pictures_within_1_2_broken", within_broken[ti]},
                             {"pictures_within_1_2_chord", within_chord[ti]}});
   }
-  std::ofstream(out_path) << nlohmann::json{{"rows", rows}, {"worst", worst}, {"polygons", polygons},
-                                            {"broken_at_corners", {{"rows", broken_rows}, {"worst", broken_worst}}}}.dump(1) << "\n";
+  std::ofstream(out_path) << nlohmann::json{{"rows", rows},
+                                            {"worst", worst},
+                                            {"polygons", polygons},
+                                            {"broken_at_corners", {{"rows", broken_rows}, {"worst", broken_worst}}}}
+                                 .dump(1)
+                          << "\n";
   return 0;
 }

@@ -18,15 +18,15 @@
 #include <string>
 #include <vector>
 
-#include "runtime/guided_tour.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "pictures/image_scene.hpp"
-#include "runtime/servo_step.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/guided_tour.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_step.hpp"
 #include "runtime/simulation.hpp"
-#include "tour_picture.hpp"
 #include "test_paths.hpp"
+#include "tour_picture.hpp"
 
 using namespace hk;
 using namespace hk::app;
@@ -81,8 +81,12 @@ Row run(const std::string& name, const std::string& path, const config::Settings
       if (d.tour_id == id && tour_ended(d.tour_phase)) {
         row.stopped += d.tour_phase != TourPhase::Done;
         if (d.tour_phase != TourPhase::Done)
-          std::fprintf(stderr, "%s: tour %d to shape %d (%.1f mm long) %s after %.2f s: handle (%.1f, %.1f) mm, in contact with %d\n", name.c_str(), id,
-                       curve, 1000 * curve_length_m(sc, static_cast<std::size_t>(curve)), d.tour_phase == TourPhase::Stuck ? "stuck" : "stopped", ticks * sp.period_s, 1000 * d.handle_m.x, 1000 * d.handle_m.y, last_contact);
+          std::fprintf(
+              stderr,
+              "%s: tour %d to shape %d (%.1f mm long) %s after %.2f s: handle (%.1f, %.1f) mm, in contact with %d\n",
+              name.c_str(), id, curve, 1000 * curve_length_m(sc, static_cast<std::size_t>(curve)),
+              d.tour_phase == TourPhase::Stuck ? "stuck" : "stopped", ticks * sp.period_s, 1000 * d.handle_m.x,
+              1000 * d.handle_m.y, last_contact);
         break;
       }
       if (d.curve >= 0) last_contact = d.curve;
@@ -117,12 +121,14 @@ int main(int argc, char** argv) {
   }
   std::printf("tour_speed %.3f m/s, tour_max_force %.2f N, max_force %.2f N, relaxed hand, start at the park place\n",
               s.haptics.tour_speed_m_per_s, s.haptics.tour_max_force_n, s.haptics.max_force_n);
-  std::printf("| picture | shapes | tours | stopped | time to touch all [s] | per shape [s] | longest tour [s] | peak guide force [N] | peak total force [N] |\n");
+  std::printf(
+      "| picture | shapes | tours | stopped | time to touch all [s] | per shape [s] | longest tour [s] | peak guide "
+      "force [N] | peak total force [N] |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& [name, path] : pictures) {
     const Row r = run(name, path, s);
-    std::printf("| %s | %d | %d | %d | %.1f | %.1f | %.1f | %.2f | %.2f |\n", r.name.c_str(), r.shapes, r.tours, r.stopped, r.total_s,
-                r.shapes ? r.total_s / r.shapes : 0.0, r.longest_s, r.max_guide_n, r.max_total_n);
+    std::printf("| %s | %d | %d | %d | %.1f | %.1f | %.1f | %.2f | %.2f |\n", r.name.c_str(), r.shapes, r.tours,
+                r.stopped, r.total_s, r.shapes ? r.total_s / r.shapes : 0.0, r.longest_s, r.max_guide_n, r.max_total_n);
     std::fflush(stdout);
   }
   std::error_code ec;

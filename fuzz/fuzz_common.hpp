@@ -40,7 +40,8 @@ inline bool is_one_line(std::string_view s) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     const auto u = static_cast<unsigned char>(s[i]);
     if (u < 0x20 || u == 0x7F) return false;
-    if (u == 0xC2 && i + 1 < s.size() && static_cast<unsigned char>(s[i + 1]) >= 0x80 && static_cast<unsigned char>(s[i + 1]) <= 0x9F) {
+    if (u == 0xC2 && i + 1 < s.size() && static_cast<unsigned char>(s[i + 1]) >= 0x80 &&
+        static_cast<unsigned char>(s[i + 1]) <= 0x9F) {
       return false;
     }
   }
@@ -126,7 +127,7 @@ class MemFile {
 }  // namespace hk::fuzz
 
 /// Aborts with a report when `cond` is false; `detail` (a string) is printed with control characters escaped.
-#define FUZZ_CHECK(cond, detail)                                                        \
-  do {                                                                                  \
-    if (!(cond)) ::hk::fuzz::property_failed(__FILE__, __LINE__, #cond, (detail));     \
+#define FUZZ_CHECK(cond, detail)                                                   \
+  do {                                                                             \
+    if (!(cond)) ::hk::fuzz::property_failed(__FILE__, __LINE__, #cond, (detail)); \
   } while (0)

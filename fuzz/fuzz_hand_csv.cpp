@@ -29,12 +29,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const auto& s = p.samples();
     FUZZ_CHECK(!s.empty() && s.size() <= limits.max_rows, std::to_string(s.size()));
     for (std::size_t i = 0; i < s.size(); ++i) {
-      FUZZ_CHECK(std::isfinite(s[i].t_s) && std::isfinite(s[i].target_m.x) && std::isfinite(s[i].target_m.y), std::to_string(i));
+      FUZZ_CHECK(std::isfinite(s[i].t_s) && std::isfinite(s[i].target_m.x) && std::isfinite(s[i].target_m.y),
+                 std::to_string(i));
       FUZZ_CHECK(s[i].t_s >= 0.0, std::to_string(i));
       FUZZ_CHECK(i == 0 || s[i].t_s > s[i - 1].t_s, std::to_string(i));
-      FUZZ_CHECK(std::hypot(s[i].target_m.x, s[i].target_m.y) <= limits.max_distance_m * (1 + 1e-12), std::to_string(i));
+      FUZZ_CHECK(std::hypot(s[i].target_m.x, s[i].target_m.y) <= limits.max_distance_m * (1 + 1e-12),
+                 std::to_string(i));
     }
-    for (const double t : {-1.0, 0.0, p.duration_s() * 0.37, p.duration_s(), p.duration_s() + 1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    for (const double t : {-1.0, 0.0, p.duration_s() * 0.37, p.duration_s(), p.duration_s() + 1.0,
+                           std::numeric_limits<double>::quiet_NaN()}) {
       const hk::Vec2 v = p.at(t);
       FUZZ_CHECK(std::isfinite(v.x) && std::isfinite(v.y), std::to_string(t));
       FUZZ_CHECK(std::hypot(v.x, v.y) <= limits.max_distance_m * (1 + 1e-9), std::to_string(t));

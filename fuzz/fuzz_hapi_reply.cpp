@@ -66,7 +66,8 @@ void check_decode(const BoardLayout& l, const std::uint8_t* in, int n) {
         if (l.encoders[i].port != port) continue;
         float f;
         std::uint32_t bits = static_cast<std::uint32_t>(in[k]) | (static_cast<std::uint32_t>(in[k + 1]) << 8) |
-                             (static_cast<std::uint32_t>(in[k + 2]) << 16) | (static_cast<std::uint32_t>(in[k + 3]) << 24);
+                             (static_cast<std::uint32_t>(in[k + 2]) << 16) |
+                             (static_cast<std::uint32_t>(in[k + 3]) << 24);
         std::memcpy(&f, &bits, 4);
         k += 4;
         if (!std::isfinite(f)) {
@@ -95,7 +96,8 @@ void check_decode(const BoardLayout& l, const std::uint8_t* in, int n) {
 /// The board side of the serial line: one valid reply for open(), then the fuzz stream chunk by chunk.
 class FakeBoard final : public hk::io::ByteTransport {
  public:
-  FakeBoard(std::vector<std::uint8_t> hello, const std::vector<std::uint8_t>* stream) : pending_(std::move(hello)), stream_(stream) {}
+  FakeBoard(std::vector<std::uint8_t> hello, const std::vector<std::uint8_t>* stream)
+      : pending_(std::move(hello)), stream_(stream) {}
   void open() override { open_ = true; }
   void close() noexcept override { open_ = false; }
   int write(const std::uint8_t* data, int n, int) noexcept override {
@@ -141,7 +143,8 @@ class FakeBoard final : public hk::io::ByteTransport {
   bool open_ = false;
 };
 
-void check_device(const BoardLayout& board_layout, const std::vector<std::uint8_t>& stream, FuzzedDataProvider& chunks) {
+void check_device(const BoardLayout& board_layout, const std::vector<std::uint8_t>& stream,
+                  FuzzedDataProvider& chunks) {
   hk::io::HaplyDeviceParams p;
   p.layout = BoardLayout::haply_gen3();
   p.layout.device_id = board_layout.device_id;
@@ -175,14 +178,18 @@ void check_device(const BoardLayout& board_layout, const std::vector<std::uint8_
     FUZZ_CHECK(std::isfinite(s.handle_m.x) && std::isfinite(s.handle_m.y), std::to_string(tick));
     double th1 = 0, th2 = 0;
     dev.joint_angles_deg(&th1, &th2);
-    FUZZ_CHECK(std::isfinite(th1) && std::isfinite(th2) && std::fabs(th1) <= 1e5 && std::fabs(th2) <= 1e5, std::to_string(th1));
-    dev.write_force({chunks.ConsumeFloatingPointInRange<double>(-50, 50), chunks.ConsumeFloatingPointInRange<double>(-50, 50)});
+    FUZZ_CHECK(std::isfinite(th1) && std::isfinite(th2) && std::fabs(th1) <= 1e5 && std::fabs(th2) <= 1e5,
+               std::to_string(th1));
+    dev.write_force(
+        {chunks.ConsumeFloatingPointInRange<double>(-50, 50), chunks.ConsumeFloatingPointInRange<double>(-50, 50)});
     double t1 = 0, t2 = 0;
     dev.last_torques_n_m(&t1, &t2);
-    FUZZ_CHECK(std::isfinite(t1) && std::isfinite(t2) && std::fabs(t1) <= p.torque_limit_n_m && std::fabs(t2) <= p.torque_limit_n_m,
+    FUZZ_CHECK(std::isfinite(t1) && std::isfinite(t2) && std::fabs(t1) <= p.torque_limit_n_m &&
+                   std::fabs(t2) <= p.torque_limit_n_m,
                std::to_string(t1));
     const hk::io::HaplyCounters c = dev.counters();
-    FUZZ_CHECK(c.replies >= 1 && c.replies <= 1 + static_cast<std::int64_t>(stream.size()) / 9, std::to_string(c.replies));
+    FUZZ_CHECK(c.replies >= 1 && c.replies <= 1 + static_cast<std::int64_t>(stream.size()) / 9,
+               std::to_string(c.replies));
     FUZZ_CHECK(c.malformed <= static_cast<std::int64_t>(stream.size()), std::to_string(c.malformed));
     // A packet's reply is waited for at most kReplyWaitTicks reads (the writes between are skipped).
     FUZZ_CHECK(c.replies_missing <= hk::io::kReplyWaitTicks * (c.ticks + 1), std::to_string(c.replies_missing));
@@ -204,7 +211,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   // 2. The driver: the first half of the rest is the stream, the end feeds chunk sizes and forces.
   FuzzedDataProvider fdp(data + 1, size - 1);
-  const std::vector<std::uint8_t> stream = fdp.ConsumeBytes<std::uint8_t>(std::min<std::size_t>(4096, (size - 1) / 2 + 1));
+  const std::vector<std::uint8_t> stream =
+      fdp.ConsumeBytes<std::uint8_t>(std::min<std::size_t>(4096, (size - 1) / 2 + 1));
   check_device(l, stream, fdp);
   return 0;
 }

@@ -72,8 +72,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const hk::vision::DecodedImage d = hk::vision::decode_image_reduced(bytes, kName, limits, 64);
     FUZZ_CHECK(!d.bgr.empty() && d.bgr.type() == CV_8UC3, d.format);
     FUZZ_CHECK(d.scale == 1 || d.scale == 2 || d.scale == 4 || d.scale == 8, std::to_string(d.scale));
-    FUZZ_CHECK(d.bgr.cols == (d.file_width_px + d.scale - 1) / d.scale && d.bgr.rows == (d.file_height_px + d.scale - 1) / d.scale,
-               d.format + " " + std::to_string(d.bgr.cols) + "x" + std::to_string(d.bgr.rows) + " at 1/" + std::to_string(d.scale));
+    FUZZ_CHECK(d.bgr.cols == (d.file_width_px + d.scale - 1) / d.scale &&
+                   d.bgr.rows == (d.file_height_px + d.scale - 1) / d.scale,
+               d.format + " " + std::to_string(d.bgr.cols) + "x" + std::to_string(d.bgr.rows) + " at 1/" +
+                   std::to_string(d.scale));
     if (decoded) FUZZ_CHECK(d.file_width_px == cols && d.file_height_px == rows, d.format);
   } catch (const hk::vision::InputError& e) {
     const std::string what = e.what();
@@ -86,7 +88,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const hk::vision::ImageHeader h = hk::vision::read_image_header(path);
     FUZZ_CHECK(h.width_px > 0 && h.height_px > 0, h.format);
-    FUZZ_CHECK(h.format == "png" || h.format == "jpeg" || h.format == "bmp" || h.format == "tiff" || h.format == "webp", h.format);
+    FUZZ_CHECK(h.format == "png" || h.format == "jpeg" || h.format == "bmp" || h.format == "tiff" || h.format == "webp",
+               h.format);
     if (decoded) {
       FUZZ_CHECK((h.width_px == cols && h.height_px == rows) || (h.width_px == rows && h.height_px == cols),
                  h.format + " " + std::to_string(h.width_px) + "x" + std::to_string(h.height_px));

@@ -28,11 +28,13 @@ void check_result(const OcrResult& r) {
   for (const OcrBlock& b : r.blocks) {
     FUZZ_CHECK(!b.text.empty() && b.lines >= 1, b.text);
     FUZZ_CHECK(b.confidence >= 0 && b.confidence <= 1, b.text);
-    FUZZ_CHECK(std::isfinite(b.box_px.x) && std::isfinite(b.box_px.y) && b.box_px.width >= 0 && b.box_px.height >= 0, b.text);
+    FUZZ_CHECK(std::isfinite(b.box_px.x) && std::isfinite(b.box_px.y) && b.box_px.width >= 0 && b.box_px.height >= 0,
+               b.text);
   }
   for (const OcrWord& w : r.words) {
     FUZZ_CHECK(w.confidence >= 0 && w.confidence <= 1, w.text);
-    FUZZ_CHECK(std::isfinite(w.box_px.x) && std::isfinite(w.box_px.y) && w.box_px.width >= 0 && w.box_px.height >= 0, w.text);
+    FUZZ_CHECK(std::isfinite(w.box_px.x) && std::isfinite(w.box_px.y) && w.box_px.width >= 0 && w.box_px.height >= 0,
+               w.text);
     ++words;
   }
   FUZZ_CHECK(r.blocks.size() <= words, "more blocks than words");

@@ -7,7 +7,8 @@
 // kiosk side relies on:
 //  - a refusal has a kind the parent accepts and a problem of at most kMaxProblemBytes bytes (the parent
 //    turns a longer one into "no usable answer"), one line;
-//  - an answer has the exact layout the parent parses (probe: page count, title; render: page size, dpi, screen-sized flag,
+//  - an answer has the exact layout the parent parses (probe: page count, title; render: page size, dpi, screen-sized
+//  flag,
 //    w x h grey bytes within the pixel budget, words with finite boxes inside the page), and the parent's
 //    group_text_blocks (which runs in the kiosk process) digests the words.
 // The budget is lower than the kiosk's (40000 px instead of 4 MP) so that a run takes milliseconds.
@@ -30,12 +31,14 @@ void check_words_and_blocks(Reader& in, int w, int h) {
     hk::vision::PdfWord word;
     std::uint8_t space = 0;
     FUZZ_CHECK(in.str(word.text, kMaxWordBytes) && !word.text.empty(), "word text");
-    FUZZ_CHECK(in.f64(word.box_px.x) && in.f64(word.box_px.y) && in.f64(word.box_px.width) && in.f64(word.box_px.height),
-               word.text);
+    FUZZ_CHECK(
+        in.f64(word.box_px.x) && in.f64(word.box_px.y) && in.f64(word.box_px.width) && in.f64(word.box_px.height),
+        word.text);
     FUZZ_CHECK(in.u8(space) && space <= 1, word.text);
     const cv::Rect2d& b = word.box_px;
-    FUZZ_CHECK(b.width > 0 && b.height > 0 && b.x >= 0 && b.y >= 0 && b.x + b.width <= w + 1e-6 && b.y + b.height <= h + 1e-6,
-               word.text);
+    FUZZ_CHECK(
+        b.width > 0 && b.height > 0 && b.x >= 0 && b.y >= 0 && b.x + b.width <= w + 1e-6 && b.y + b.height <= h + 1e-6,
+        word.text);
     words.push_back(std::move(word));
   }
   FUZZ_CHECK(in.left() == 0, "trailing bytes in the answer");
@@ -44,7 +47,8 @@ void check_words_and_blocks(Reader& in, int w, int h) {
   std::size_t lines = 0;
   for (const hk::vision::TextBlock& b : blocks) {
     FUZZ_CHECK(b.lines >= 1 && !b.text.empty(), b.text);
-    FUZZ_CHECK(std::isfinite(b.box_px.x) && std::isfinite(b.box_px.y) && b.box_px.width > 0 && b.box_px.height > 0, b.text);
+    FUZZ_CHECK(std::isfinite(b.box_px.x) && std::isfinite(b.box_px.y) && b.box_px.width > 0 && b.box_px.height > 0,
+               b.text);
     lines += static_cast<std::size_t>(b.lines);
   }
   FUZZ_CHECK(lines <= words.size(), "more lines than words");
@@ -78,9 +82,13 @@ int run(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits) 
   std::int32_t w = 0, h = 0;
   std::uint8_t screen_sized = 0;
   FUZZ_CHECK(n >= page, "rendered a page beyond the count");
-  FUZZ_CHECK(in.f64(w_pt) && in.f64(h_pt) && in.f64(dpi) && in.u8(screen_sized) && screen_sized <= 1 && in.i32(w) && in.i32(h), "page header");
-  FUZZ_CHECK(w > 0 && h > 0 && static_cast<double>(w) * h <= limits.max_page_pixels, std::to_string(w) + "x" + std::to_string(h));
-  FUZZ_CHECK(screen_sized == 0 || std::max(w, h) <= limits.text_layer_max_side_px + 2.0, std::to_string(w) + "x" + std::to_string(h));
+  FUZZ_CHECK(
+      in.f64(w_pt) && in.f64(h_pt) && in.f64(dpi) && in.u8(screen_sized) && screen_sized <= 1 && in.i32(w) && in.i32(h),
+      "page header");
+  FUZZ_CHECK(w > 0 && h > 0 && static_cast<double>(w) * h <= limits.max_page_pixels,
+             std::to_string(w) + "x" + std::to_string(h));
+  FUZZ_CHECK(screen_sized == 0 || std::max(w, h) <= limits.text_layer_max_side_px + 2.0,
+             std::to_string(w) + "x" + std::to_string(h));
   FUZZ_CHECK(dpi > 0 && dpi <= limits.max_dpi, std::to_string(dpi));
   FUZZ_CHECK(std::abs(w - w_pt * dpi / 72.0) <= 2.0 && std::abs(h - h_pt * dpi / 72.0) <= 2.0, std::to_string(w_pt));
   std::vector<std::uint8_t> grey(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));

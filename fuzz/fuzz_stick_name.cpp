@@ -21,9 +21,9 @@
 namespace {
 
 bool dropped(char32_t cp) {
-  return cp < 0x20 || (cp >= 0x7F && cp <= 0x9F) || cp == 0x061C || cp == 0x200E || cp == 0x200F || (cp >= 0x202A && cp <= 0x202E) ||
-         (cp >= 0x2066 && cp <= 0x2069) || (cp >= 0x200B && cp <= 0x200D) || cp == 0xFEFF || cp == 0x2028 || cp == 0x2029 ||
-         cp == 0x2060;
+  return cp < 0x20 || (cp >= 0x7F && cp <= 0x9F) || cp == 0x061C || cp == 0x200E || cp == 0x200F ||
+         (cp >= 0x202A && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069) || (cp >= 0x200B && cp <= 0x200D) ||
+         cp == 0xFEFF || cp == 0x2028 || cp == 0x2029 || cp == 0x2060;
 }
 
 void put(std::string& out, char32_t cp) {
@@ -127,7 +127,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   const std::string kind = hk::vision::sniff_document_format(raw);
-  FUZZ_CHECK(kind.empty() || kind == "png" || kind == "jpeg" || kind == "bmp" || kind == "tiff" || kind == "webp" || kind == "pdf", kind);
+  FUZZ_CHECK(kind.empty() || kind == "png" || kind == "jpeg" || kind == "bmp" || kind == "tiff" || kind == "webp" ||
+                 kind == "pdf",
+             kind);
   FUZZ_CHECK(hk::vision::sniff_document_format(raw.substr(0, 16)) == kind, kind);
   return 0;
 }

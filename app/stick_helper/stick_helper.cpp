@@ -46,7 +46,8 @@ struct UsageError : HelperError {
 }  // namespace
 
 int parse_slot(const std::string& text) {
-  const std::string why = "slot '" + shown(text) + "': not a whole number from 0 to " + std::to_string(vision::kMaxStickSlot);
+  const std::string why =
+      "slot '" + shown(text) + "': not a whole number from 0 to " + std::to_string(vision::kMaxStickSlot);
   if (text.empty() || text.size() > 3 || (text.size() > 1 && text[0] == '0')) throw UsageError(why);
   int v = 0;
   for (char c : text) {
@@ -69,7 +70,9 @@ Request parse_request(const std::vector<std::string>& args, uid_t real_uid) {
   const std::string verb = args[i++];
   const std::size_t rest = args.size() - i;
   if (verb == "mount") {
-    if (rest != 2) throw UsageError("mount: expected DEVNODE SLOT, got " + std::to_string(rest) + " argument" + (rest == 1 ? "" : "s") + "; " + kUsage);
+    if (rest != 2)
+      throw UsageError("mount: expected DEVNODE SLOT, got " + std::to_string(rest) + " argument" +
+                       (rest == 1 ? "" : "s") + "; " + kUsage);
     r.verb = Request::Verb::Mount;
     r.devnode = args[i];
     r.slot = parse_slot(args[i + 1]);
@@ -97,12 +100,15 @@ void udev_probe(DeviceFacts& facts) {
 
 DeviceFacts check_devnode(const std::string& devnode, bool allow_loop, const UsbProbe& probe) {
   if (devnode.rfind("/dev/", 0) != 0) refuse_device(devnode, "not a device node under /dev/");
-  if (devnode.find('\0') != std::string::npos || devnode.size() >= PATH_MAX) refuse_device(devnode, "not a usable path");
+  if (devnode.find('\0') != std::string::npos || devnode.size() >= PATH_MAX)
+    refuse_device(devnode, "not a usable path");
   char buf[PATH_MAX];
-  if (::realpath(devnode.c_str(), buf) == nullptr) refuse_device(devnode, std::string("cannot be resolved: ") + std::strerror(errno));
+  if (::realpath(devnode.c_str(), buf) == nullptr)
+    refuse_device(devnode, std::string("cannot be resolved: ") + std::strerror(errno));
   DeviceFacts f;
   f.resolved = buf;
-  if (f.resolved.rfind("/dev/", 0) != 0) refuse_device(devnode, "leads to '" + shown(f.resolved) + "', which is not under /dev/");
+  if (f.resolved.rfind("/dev/", 0) != 0)
+    refuse_device(devnode, "leads to '" + shown(f.resolved) + "', which is not under /dev/");
   // Only nodes in folders that root alone may change (not /dev/shm or /dev/mqueue): nobody can swap the
   // node between these checks and the mount.
   const std::string folder = f.resolved.substr(0, f.resolved.rfind('/'));
@@ -111,7 +117,8 @@ DeviceFacts check_devnode(const std::string& devnode, bool allow_loop, const Usb
     refuse_device(devnode, "its folder " + shown(folder) + " is not one only root may change");
   }
   struct stat st {};
-  if (::stat(f.resolved.c_str(), &st) != 0) refuse_device(devnode, std::string("cannot examine it: ") + std::strerror(errno));
+  if (::stat(f.resolved.c_str(), &st) != 0)
+    refuse_device(devnode, std::string("cannot examine it: ") + std::strerror(errno));
   f.block = S_ISBLK(st.st_mode);
   if (!f.block) refuse_device(devnode, "not a block device");
   f.major = major(st.st_rdev);
@@ -119,11 +126,14 @@ DeviceFacts check_devnode(const std::string& devnode, bool allow_loop, const Usb
   f.loop = f.major == kLoopMajor;
   probe(f);
   if (f.loop) {
-    if (!allow_loop) refuse_device(devnode, "a loop device, not a USB stick (only the tests mount loop devices, with --allow-loop as root)");
+    if (!allow_loop)
+      refuse_device(devnode,
+                    "a loop device, not a USB stick (only the tests mount loop devices, with --allow-loop as root)");
     return f;
   }
   if (!f.on_usb) {
-    refuse_device(devnode, "not on the USB bus (block device " + std::to_string(f.major) + ":" + std::to_string(f.minor) +
+    refuse_device(devnode, "not on the USB bus (block device " + std::to_string(f.major) + ":" +
+                               std::to_string(f.minor) +
                                " has no USB device among its parents in sysfs), so it is not mounted");
   }
   return f;
@@ -138,7 +148,8 @@ std::string run_request(const Request& r, const std::string& mount_root, const U
   vision::MountedStick stick(f.resolved, mount_root, r.slot);
   // MountedStick checked that what is mounted is what it probed; this checks that it is what was validated.
   struct stat mounted {};
-  if (::stat(stick.mount_point().c_str(), &mounted) != 0 || major(mounted.st_dev) != f.major || minor(mounted.st_dev) != f.minor) {
+  if (::stat(stick.mount_point().c_str(), &mounted) != 0 || major(mounted.st_dev) != f.major ||
+      minor(mounted.st_dev) != f.minor) {
     stick.unmount();
     refuse_device(r.devnode, "changed while it was being mounted, so it was unmounted again");
   }

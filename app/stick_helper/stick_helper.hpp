@@ -46,18 +46,18 @@ class HelperError : public hk::Error {
 struct Request {
   enum class Verb { Mount, Unmount };
   Verb verb = Verb::Mount;
-  std::string devnode;     ///< Mount: as given
-  int slot = 0;            ///< 0 .. vision::kMaxStickSlot
-  bool allow_loop = false; ///< --allow-loop was given (only root may)
+  std::string devnode;      ///< Mount: as given
+  int slot = 0;             ///< 0 .. vision::kMaxStickSlot
+  bool allow_loop = false;  ///< --allow-loop was given (only root may)
 };
 
 /// The facts about a device node the helper decides on.
 struct DeviceFacts {
-  std::string resolved;   ///< the node's path with every link resolved (realpath)
-  bool block = false;     ///< a block device
+  std::string resolved;  ///< the node's path with every link resolved (realpath)
+  bool block = false;    ///< a block device
   unsigned major = 0, minor = 0;
-  bool on_usb = false;    ///< its sysfs device has a USB device (subsystem usb, devtype usb_device) among its parents
-  bool loop = false;      ///< a loop device (major 7)
+  bool on_usb = false;  ///< its sysfs device has a USB device (subsystem usb, devtype usb_device) among its parents
+  bool loop = false;    ///< a loop device (major 7)
 };
 
 /// Looks a resolved device node up in sysfs through libudev: on_usb and loop for the block device
@@ -87,7 +87,8 @@ DeviceFacts check_devnode(const std::string& devnode, bool allow_loop, const Usb
 /// Does what `r` asks under `mount_root` (kMountRoot in the helper; tests may pass another) and returns
 /// the result line (without "\n").
 /// @throws HelperError or vision::StickMountError (one line) when it is refused or fails.
-std::string run_request(const Request& r, const std::string& mount_root = kMountRoot, const UsbProbe& probe = udev_probe);
+std::string run_request(const Request& r, const std::string& mount_root = kMountRoot,
+                        const UsbProbe& probe = udev_probe);
 
 /// The whole helper: clears the environment, parses `argc`/`argv`, runs the request and prints its one
 /// line to `out` (success) or `err` ("hk-stick-mount: ..."). Returns the exit status: 0 done, 1 refused

@@ -16,18 +16,30 @@ constexpr double kC4Hz = 261.6256;
 
 const char* cue_kind_name(CueKind kind) {
   switch (kind) {
-    case CueKind::ContactBegin: return "contact_begin";
-    case CueKind::ContactEnd: return "contact_end";
-    case CueKind::Slide: return "slide";
-    case CueKind::VertexContact: return "vertex_contact";
-    case CueKind::ConvexCorner: return "convex_corner";
-    case CueKind::LevelFiner: return "level_finer";
-    case CueKind::LevelCoarser: return "level_coarser";
-    case CueKind::WorkspaceEdge: return "workspace_edge";
-    case CueKind::TextBlock: return "text_block";
-    case CueKind::PopThrough: return "pop_through";
-    case CueKind::TourStart: return "tour_start";
-    case CueKind::Shutter: return "shutter";
+    case CueKind::ContactBegin:
+      return "contact_begin";
+    case CueKind::ContactEnd:
+      return "contact_end";
+    case CueKind::Slide:
+      return "slide";
+    case CueKind::VertexContact:
+      return "vertex_contact";
+    case CueKind::ConvexCorner:
+      return "convex_corner";
+    case CueKind::LevelFiner:
+      return "level_finer";
+    case CueKind::LevelCoarser:
+      return "level_coarser";
+    case CueKind::WorkspaceEdge:
+      return "workspace_edge";
+    case CueKind::TextBlock:
+      return "text_block";
+    case CueKind::PopThrough:
+      return "pop_through";
+    case CueKind::TourStart:
+      return "tour_start";
+    case CueKind::Shutter:
+      return "shutter";
   }
   return "unknown";
 }
@@ -143,8 +155,8 @@ void EarconSynth::contact_cue(const CueEvent& e) noexcept {
       // Loudness from approach speed, with a floor so a gentle touch is still heard.
       const double v = std::clamp(static_cast<double>(e.speed_m_per_s) / params_.click_full_speed_m_per_s, 0.0, 1.0);
       const double a = g * (0.35 + 0.65 * v);
-      const double d = transient_delay_s(false);  // the strike's slot: the body starts with it
-      start({f, f, 0.15, 0.0003, 0.030, 0.010, 0.8 * a, 0.0, 0, 1, d});       // the pitched body
+      const double d = transient_delay_s(false);                         // the strike's slot: the body starts with it
+      start({f, f, 0.15, 0.0003, 0.030, 0.010, 0.8 * a, 0.0, 0, 1, d});  // the pitched body
       // The strike: a 2 ms bright noise transient, so a click that lands on the ringing body of the
       // previous one (contact chatter, 2 ms apart) is still heard as a new one.
       start({f, f, 0.002, 0.00005, 0.0004, 0.0003, 0.9 * a, 1.0, 4000, 0.7, transient_delay_s(true)});

@@ -1,10 +1,10 @@
 #include "audio/messages.hpp"
 
+#include <toml++/toml.h>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "hk/text.hpp"
 
@@ -53,7 +53,8 @@ KeyMap key_places(const toml::table& t, const std::string& where, const KeyMap& 
     const auto v = value.value<std::string>();
     if (!v) throw MessageError(where + "key_places." + shown + " is not a string");
     if (v->empty() || v->size() > MessageCatalog::kMaxKeyPlaceBytes) {
-      throw MessageError(where + "key_places." + shown + " must be 1 to " + std::to_string(MessageCatalog::kMaxKeyPlaceBytes) + " bytes");
+      throw MessageError(where + "key_places." + shown + " must be 1 to " +
+                         std::to_string(MessageCatalog::kMaxKeyPlaceBytes) + " bytes");
     }
     out.emplace(name, *v);
   }
@@ -73,7 +74,8 @@ MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& s
   }
   MessageCatalog c;
   const auto voice = t["voice"].value<std::string>();
-  if (!voice || voice->empty() || voice->size() > 64) throw MessageError(where + "voice must be an espeak-ng voice name (1 to 64 characters)");
+  if (!voice || voice->empty() || voice->size() > 64)
+    throw MessageError(where + "voice must be an espeak-ng voice name (1 to 64 characters)");
   c.voice_ = *voice;
   c.language_ = t["language"].value_or(std::string(*voice));
   const toml::table* m = t["messages"].as_table();
@@ -81,7 +83,8 @@ MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& s
   for (const auto& [key, node] : *m) {
     bool known = false;
     for (std::string_view k : kMessageKeys) known = known || k == key.str();
-    if (!known) throw MessageError(where + "messages." + hk::one_line(key.str(), 60) + " is not a message the kiosk has");
+    if (!known)
+      throw MessageError(where + "messages." + hk::one_line(key.str(), 60) + " is not a message the kiosk has");
   }
   // The English file is the reference for placeholders (it is parsed first, with itself as reference).
   const MessageCatalog* en = source == "en.toml (built in)" ? nullptr : &english();
@@ -95,7 +98,9 @@ MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& s
     if (en) {
       const auto allowed = placeholders(en->raw(static_cast<MessageId>(i)));
       for (const std::string& p : placeholders(*v)) {
-        if (!allowed.count(p)) throw MessageError(where + "messages." + key + " uses {" + hk::one_line(p, 60) + "}, which the English text does not have");
+        if (!allowed.count(p))
+          throw MessageError(where + "messages." + key + " uses {" + hk::one_line(p, 60) +
+                             "}, which the English text does not have");
       }
     }
     c.texts_[static_cast<std::size_t>(i)] = *v;
@@ -142,8 +147,8 @@ MessageCatalog MessageCatalog::load(const std::string& path) {
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) throw MessageError("messages '" + hk::one_line(path) + "': cannot read the file (" + ec.message() + ")");
   if (size > kMaxFileBytes) {
-    throw MessageError("messages '" + hk::one_line(path) + "': " + std::to_string(size) + " bytes is over the limit of " +
-                       std::to_string(kMaxFileBytes) + " bytes");
+    throw MessageError("messages '" + hk::one_line(path) + "': " + std::to_string(size) +
+                       " bytes is over the limit of " + std::to_string(kMaxFileBytes) + " bytes");
   }
   std::ifstream f(path, std::ios::binary);
   std::stringstream ss;
@@ -157,11 +162,13 @@ std::string MessageCatalog::key_name(std::string_view name) const {
   return it == key_names_.end() ? std::string(name) : it->second;
 }
 
-std::string MessageCatalog::text(MessageId id, std::initializer_list<MessageArg> args, std::span<const KeyArg> keys) const {
+std::string MessageCatalog::text(MessageId id, std::initializer_list<MessageArg> args,
+                                 std::span<const KeyArg> keys) const {
   return expand(raw(id), args, keys);
 }
 
-std::string MessageCatalog::expand(std::string_view s, std::initializer_list<MessageArg> args, std::span<const KeyArg> keys) const {
+std::string MessageCatalog::expand(std::string_view s, std::initializer_list<MessageArg> args,
+                                   std::span<const KeyArg> keys) const {
   std::string out;
   out.reserve(s.size());
   std::size_t i = 0;
@@ -186,7 +193,8 @@ std::string MessageCatalog::expand(std::string_view s, std::initializer_list<Mes
     } else if (key) {
       std::string form = key_name(key->second);
       // Forms are written as they read after "Press"; a sentence starts with a capital (ASCII letters only).
-      if (!form.empty() && starts_sentence(out) && form[0] >= 'a' && form[0] <= 'z') form[0] = static_cast<char>(form[0] - 'a' + 'A');
+      if (!form.empty() && starts_sentence(out) && form[0] >= 'a' && form[0] <= 'z')
+        form[0] = static_cast<char>(form[0] - 'a' + 'A');
       out += form;
     } else {
       out.append(s.substr(open, close - open + 1));  // unknown: left as it is

@@ -23,7 +23,12 @@ inline float soft_limit(float x) {
 
 Mixer::Mixer(const MixerParams& params, SpscRing<CueEvent>* cues, SpeechStream* speech, const Volume* volume,
              SpscRing<CueEvent>* ui_cues)
-    : params_(params), synth_(params.earcons, kSampleRateHz), cues_(cues), ui_cues_(ui_cues), speech_(speech), volume_(volume) {
+    : params_(params),
+      synth_(params.earcons, kSampleRateHz),
+      cues_(cues),
+      ui_cues_(ui_cues),
+      speech_(speech),
+      volume_(volume) {
   const double fs = kSampleRateHz;
   duck_down_ = static_cast<float>(1.0 - std::exp(-1.0 / (std::max(1e-4, params.duck_attack_s) * fs)));
   duck_up_ = static_cast<float>(1.0 - std::exp(-1.0 / (std::max(1e-4, params.duck_release_s) * fs)));

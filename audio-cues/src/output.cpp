@@ -15,7 +15,8 @@
 
 namespace hk::audio {
 
-void render_interleaved(AudioSource& source, std::span<float> scratch, float* out, std::size_t frames, int channels) noexcept {
+void render_interleaved(AudioSource& source, std::span<float> scratch, float* out, std::size_t frames,
+                        int channels) noexcept {
   const std::size_t ch = static_cast<std::size_t>(std::max(channels, 1));
   std::size_t done = 0;
   while (done < frames && !scratch.empty()) {
@@ -55,7 +56,8 @@ using AlsaHandler = void (*)(const char* file, int line, const char* function, i
 using AlsaSetHandler = int (*)(AlsaHandler);
 using JackSetFunction = void (*)(void (*)(const char*));
 
-[[gnu::format(printf, 5, 6)]] void alsa_to_debug(const char* file, int line, const char* function, int err, const char* fmt, ...) {
+[[gnu::format(printf, 5, 6)]] void alsa_to_debug(const char* file, int line, const char* function, int err,
+                                                 const char* fmt, ...) {
   char msg[512];
   va_list ap;
   va_start(ap, fmt);
@@ -142,7 +144,8 @@ void AudioOutput::on_callback(float* out, std::size_t frames, bool underflow) no
   if (underflow) underflows_.fetch_add(1, std::memory_order_relaxed);
   const std::chrono::nanoseconds wait = pacer_.after(frames, std::chrono::steady_clock::now());
   if (wait.count() > 0) {  // a device that discards (ALSA null): held to the wall clock
-    const timespec ts{static_cast<time_t>(wait.count() / 1'000'000'000), static_cast<long>(wait.count() % 1'000'000'000)};
+    const timespec ts{static_cast<time_t>(wait.count() / 1'000'000'000),
+                      static_cast<long>(wait.count() % 1'000'000'000)};
     ::nanosleep(&ts, nullptr);
   }
 }
@@ -211,8 +214,8 @@ AudioOutput::AudioOutput(AudioSource& source, const OutputParams& params) : sour
   channels_ = out.channelCount;
   PaStream* stream = nullptr;
   // paNoFlag: PortAudio clips (and dithers) when the device takes integers, so an overshoot is not a wrap.
-  e = Pa_OpenStream(&stream, nullptr, &out, kSampleRateHz, static_cast<unsigned long>(params.frames_per_buffer), paNoFlag,
-                    &OutputCallback::call, this);
+  e = Pa_OpenStream(&stream, nullptr, &out, kSampleRateHz, static_cast<unsigned long>(params.frames_per_buffer),
+                    paNoFlag, &OutputCallback::call, this);
   if (e != paNoError) {
     give_up("cannot open '" + name + "' at " + std::to_string(kSampleRateHz) + " Hz: " + Pa_GetErrorText(e));
     return;
@@ -232,9 +235,11 @@ AudioOutput::AudioOutput(AudioSource& source, const OutputParams& params) : sour
   info_.channels = channels_;
   info_.frames_per_buffer = params.frames_per_buffer;
   info_.reported_latency_s = si ? si->outputLatency : 0.0;
-  spdlog::info("audio: output '{}' via {}, {} Hz, {} channel(s), {} frames per buffer ({:.1f} ms), reported output latency {:.1f} ms",
-               info_.device_name, info_.host_api, info_.sample_rate_hz, info_.channels, info_.frames_per_buffer,
-               1e3 * info_.frames_per_buffer / std::max(info_.sample_rate_hz, 1), info_.reported_latency_s * 1e3);
+  spdlog::info(
+      "audio: output '{}' via {}, {} Hz, {} channel(s), {} frames per buffer ({:.1f} ms), reported output latency "
+      "{:.1f} ms",
+      info_.device_name, info_.host_api, info_.sample_rate_hz, info_.channels, info_.frames_per_buffer,
+      1e3 * info_.frames_per_buffer / std::max(info_.sample_rate_hz, 1), info_.reported_latency_s * 1e3);
 }
 
 bool AudioOutput::running() const { return stream_ && Pa_IsStreamActive(static_cast<PaStream*>(stream_)) == 1; }

@@ -29,9 +29,9 @@ struct Synthesis {
   double ratio = 1.0;  // kSampleRateHz / espeak-ng's rate
   Sink sink;
   std::vector<float> in, out;
-  bool stopped = false;            // the sink asked to stop, or an error: abort espeak-ng
-  std::string error;               // a resampler error
-  std::exception_ptr exception;    // thrown by the sink inside the C callback; rethrown after it
+  bool stopped = false;          // the sink asked to stop, or an error: abort espeak-ng
+  std::string error;             // a resampler error
+  std::exception_ptr exception;  // thrown by the sink inside the C callback; rethrown after it
 };
 Synthesis* g_current = nullptr;
 std::optional<SpeechParams> g_configured;  // what espeak-ng is set to now (nullopt: unknown)
@@ -108,7 +108,8 @@ std::size_t sentence_end(std::string_view text, std::size_t from) {
   for (std::size_t i = from; i < text.size(); ++i) {
     const char c = text[i];
     if (c == '\n') return i;
-    if ((c == '.' || c == '!' || c == '?' || c == ';' || c == ':') && i + 1 < text.size() && is_space(text[i + 1])) return i + 1;
+    if ((c == '.' || c == '!' || c == '?' || c == ';' || c == ':') && i + 1 < text.size() && is_space(text[i + 1]))
+      return i + 1;
   }
   return text.size();
 }
@@ -134,8 +135,10 @@ void check_params(const SpeechParams& p) {
     throw SpeechError("speech: rate_wpm " + std::to_string(p.rate_wpm) + " words/min is outside [" +
                       std::to_string(espeakRATE_MINIMUM) + ", " + std::to_string(espeakRATE_MAXIMUM) + "]");
   }
-  if (p.pitch < 0 || p.pitch > 100) throw SpeechError("speech: pitch " + std::to_string(p.pitch) + " is outside [0, 100]");
-  if (p.voice.empty() || p.voice.size() > 64 || p.voice.find_first_of(std::string_view("\0\n\r", 3)) != std::string::npos) {
+  if (p.pitch < 0 || p.pitch > 100)
+    throw SpeechError("speech: pitch " + std::to_string(p.pitch) + " is outside [0, 100]");
+  if (p.voice.empty() || p.voice.size() > 64 ||
+      p.voice.find_first_of(std::string_view("\0\n\r", 3)) != std::string::npos) {
     throw SpeechError("speech: voice name '" + p.voice.substr(0, 64) + "' must be 1 to 64 characters on one line");
   }
 }
@@ -146,7 +149,8 @@ void configure_locked(const SpeechParams& p) {
   native_rate_locked();
   if (g_configured == p) return;
   g_configured.reset();  // a refusal below leaves espeak-ng half set
-  if (espeak_SetVoiceByName(p.voice.c_str()) != EE_OK) throw SpeechError("speech: espeak-ng has no voice '" + p.voice + "'");
+  if (espeak_SetVoiceByName(p.voice.c_str()) != EE_OK)
+    throw SpeechError("speech: espeak-ng has no voice '" + p.voice + "'");
   if (espeak_SetParameter(espeakRATE, p.rate_wpm, 0) != EE_OK) {
     throw SpeechError("speech: espeak-ng refused rate_wpm " + std::to_string(p.rate_wpm));
   }
@@ -161,7 +165,8 @@ void configure_locked(const SpeechParams& p) {
 void synthesize_locked(const std::string& text, Sink sink) {
   int err = 0;
   std::unique_ptr<SRC_STATE, SRC_STATE* (*)(SRC_STATE*)> src(src_new(SRC_SINC_FASTEST, 1, &err), &src_delete);
-  if (!src) throw SpeechError(std::string("speech: resampler could not start (libsamplerate: ") + src_strerror(err) + ")");
+  if (!src)
+    throw SpeechError(std::string("speech: resampler could not start (libsamplerate: ") + src_strerror(err) + ")");
   Synthesis s;
   s.src = src.get();
   s.ratio = static_cast<double>(kSampleRateHz) / native_rate_locked();
@@ -173,14 +178,16 @@ void synthesize_locked(const std::string& text, Sink sink) {
   if (s.exception) std::rethrow_exception(s.exception);
   if (!s.error.empty()) throw SpeechError(s.error);
   if (s.stopped) return;  // cancelled
-  if (r != EE_OK) throw SpeechError("speech: espeak-ng could not synthesise the text (espeak_Synth error " + std::to_string(r) + ")");
+  if (r != EE_OK)
+    throw SpeechError("speech: espeak-ng could not synthesise the text (espeak_Synth error " + std::to_string(r) + ")");
   const short none = 0;
   feed(s, &none, 0, true);  // the resampler's tail
   if (!s.error.empty()) throw SpeechError(s.error);
 }
 
 std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 }  // namespace
@@ -254,7 +261,8 @@ void Speaker::say(std::string text, bool keep) {
   if (text.size() > kMaxSpeechTextBytes) {
     // Cut where a piece ends, so no word is cut in two; what is left out is said in the log.
     const std::size_t cut = word_cut(text, kMaxSpeechTextBytes);
-    spdlog::warn("speech: a text of {} bytes is over the limit of {} bytes; the first {} bytes are spoken", text.size(), kMaxSpeechTextBytes, cut);
+    spdlog::warn("speech: a text of {} bytes is over the limit of {} bytes; the first {} bytes are spoken", text.size(),
+                 kMaxSpeechTextBytes, cut);
     text.resize(cut);
   }
   {
@@ -317,7 +325,7 @@ int Speaker::piece_heard() const {
   if (starts_generation_ != gen || piece_starts_.empty()) return has_job_ || working_ ? 0 : -1;
   const SpeechStream::Heard heard = stream_.heard();
   if (heard.generation_low != (gen & SpeechStream::kHeardGenerationMask)) return 0;  // not reached the mixer yet
-  if (!working_ && heard.samples >= utterance_samples_) return -1;                      // played to its end
+  if (!working_ && heard.samples >= utterance_samples_) return -1;                   // played to its end
   const auto after = std::upper_bound(piece_starts_.begin(), piece_starts_.end(), heard.samples);
   return std::max(0, static_cast<int>(after - piece_starts_.begin()) - 1);
 }

@@ -5,7 +5,8 @@
 
 namespace hk::audio {
 
-bool SpeechStream::push(std::uint32_t generation, const float* samples, std::size_t count, std::size_t* written) noexcept {
+bool SpeechStream::push(std::uint32_t generation, const float* samples, std::size_t count,
+                        std::size_t* written) noexcept {
   std::size_t done = 0;
   bool ok = true;
   if (pending_.generation != generation) {  // a new utterance: forget a partial block of an old one
@@ -54,7 +55,8 @@ bool SpeechStream::finish(std::uint32_t generation) noexcept {
 std::size_t SpeechStream::read_paused(float* out, std::size_t frames) noexcept {
   const std::uint32_t gen = generation_.load(std::memory_order_acquire);
   std::size_t n = 0;
-  while (n < frames && pause_fade_left_ > 0 && have_current_ && current_.generation == gen && offset_ < current_.count) {
+  while (n < frames && pause_fade_left_ > 0 && have_current_ && current_.generation == gen &&
+         offset_ < current_.count) {
     out[n++] = current_.samples[offset_++] * static_cast<float>(pause_fade_left_) / static_cast<float>(kFadeSamples);
     --pause_fade_left_;
   }
@@ -69,7 +71,8 @@ std::size_t SpeechStream::read_paused(float* out, std::size_t frames) noexcept {
 void SpeechStream::publish_heard() noexcept {
   constexpr unsigned shift = 64 - kHeardGenerationBits;
   const std::uint64_t samples = std::min<std::uint64_t>(heard_samples_, (std::uint64_t{1} << shift) - 1);
-  heard_.store((std::uint64_t{playing_generation_ & kHeardGenerationMask} << shift) | samples, std::memory_order_release);
+  heard_.store((std::uint64_t{playing_generation_ & kHeardGenerationMask} << shift) | samples,
+               std::memory_order_release);
 }
 
 std::size_t SpeechStream::read(float* out, std::size_t frames) noexcept {

@@ -6,7 +6,9 @@ namespace hk::audio {
 
 namespace {
 
-MessageCatalog load_catalog(const std::string& file) { return file.empty() ? MessageCatalog::english() : MessageCatalog::load(file); }
+MessageCatalog load_catalog(const std::string& file) {
+  return file.empty() ? MessageCatalog::english() : MessageCatalog::load(file);
+}
 
 }  // namespace
 

@@ -20,7 +20,7 @@ struct SndCloser {
 };
 using SndPtr = std::unique_ptr<SNDFILE, SndCloser>;
 
-constexpr std::size_t kChunkFrames = 4096;                   // conversion buffer [frames]
+constexpr std::size_t kChunkFrames = 4096;                              // conversion buffer [frames]
 constexpr std::int64_t kMaxWriteFrames = (std::int64_t{1} << 31) - 64;  // 16-bit mono RIFF size limit
 
 [[noreturn]] void fail(const std::string& path, const std::string& problem) {
@@ -40,7 +40,8 @@ void write_wav(const std::string& path, std::span<const float> mono, int sample_
     fail(path, "sample rate " + std::to_string(sample_rate_hz) + " Hz is outside [8000, 192000] Hz");
   }
   if (static_cast<std::int64_t>(mono.size()) > kMaxWriteFrames) {
-    fail(path, std::to_string(mono.size()) + " samples do not fit in a WAV file (limit " + std::to_string(kMaxWriteFrames) + ")");
+    fail(path, std::to_string(mono.size()) + " samples do not fit in a WAV file (limit " +
+                   std::to_string(kMaxWriteFrames) + ")");
   }
   const std::string tmp = path + ".tmp";
   SF_INFO info{};
@@ -87,9 +88,10 @@ std::vector<float> read_wav(const std::string& path, int* sample_rate_hz) {
   if (info.frames <= 0) fail(path, "holds no samples");
   if (info.frames > kMaxWavFrames) {
     char len[64];
-    std::snprintf(len, sizeof len, "%.1f min at %d Hz", static_cast<double>(info.frames) / info.samplerate / 60.0, info.samplerate);
-    fail(path, std::to_string(info.frames) + " frames (" + len + ") is over the limit of " + std::to_string(kMaxWavFrames) +
-                   " frames (1 h at 48 kHz)");
+    std::snprintf(len, sizeof len, "%.1f min at %d Hz", static_cast<double>(info.frames) / info.samplerate / 60.0,
+                  info.samplerate);
+    fail(path, std::to_string(info.frames) + " frames (" + len + ") is over the limit of " +
+                   std::to_string(kMaxWavFrames) + " frames (1 h at 48 kHz)");
   }
   const auto ch = static_cast<std::size_t>(info.channels);
   std::vector<float> mono;

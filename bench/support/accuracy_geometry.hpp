@@ -77,7 +77,8 @@ class SegmentGrid {
     const double w_m = std::max(hi.x - lo.x, 1e-9), h_m = std::max(hi.y - lo.y, 1e-9);
     cell_m_ = std::max(n > 0 ? total_len_m / static_cast<double>(n) : 1e-6, 1e-7);
     const double max_cells = 4.0 * static_cast<double>(n) + 1024.0;
-    if ((w_m / cell_m_ + 1.0) * (h_m / cell_m_ + 1.0) > max_cells) cell_m_ = std::sqrt(w_m * h_m / max_cells) + std::max(w_m, h_m) / max_cells;
+    if ((w_m / cell_m_ + 1.0) * (h_m / cell_m_ + 1.0) > max_cells)
+      cell_m_ = std::sqrt(w_m * h_m / max_cells) + std::max(w_m, h_m) / max_cells;
     origin_ = lo;
     nx_ = static_cast<int>(w_m / cell_m_) + 1;
     ny_ = static_cast<int>(h_m / cell_m_) + 1;
@@ -93,7 +94,8 @@ class SegmentGrid {
     for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
     items_.resize(start_.back());
     std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t k = 0; k < n; ++k) for_cells(k, [&](std::size_t c) { items_[fill[c]++] = static_cast<std::uint32_t>(k); });
+    for (std::size_t k = 0; k < n; ++k)
+      for_cells(k, [&](std::size_t c) { items_[fill[c]++] = static_cast<std::uint32_t>(k); });
     stamp_.assign(n, 0);
   }
 
@@ -152,7 +154,8 @@ class SegmentGrid {
 /// polyline (every point of every segment, closing segment included), not just its vertices.
 /// Underestimates the true value by at most `tol_m` (see the file comment); `seed_m` is a known lower
 /// bound (e.g. the largest of some sampled distances), which only makes the early steps longer.
-inline double directed_hausdorff_m(const std::vector<Vec2>& a_pts, bool a_closed, const SegmentGrid& b, double tol_m, double seed_m = 0.0) {
+inline double directed_hausdorff_m(const std::vector<Vec2>& a_pts, bool a_closed, const SegmentGrid& b, double tol_m,
+                                   double seed_m = 0.0) {
   double worst_m = seed_m;
   for (const Vec2& p : a_pts) worst_m = std::max(worst_m, b.distance_m(p));
   const std::size_t ns = polyline_segments(a_pts, a_closed);
@@ -174,7 +177,8 @@ inline double directed_hausdorff_m(const std::vector<Vec2>& a_pts, bool a_closed
 /// Root mean square of d(o, B) over the polyline O by arc length [m], midpoint rule with pieces of at
 /// most `step_m`; `max_out` receives the largest sampled distance (a lower bound of the directed
 /// Hausdorff distance O → B, used to seed it).
-inline double rms_distance_m(const std::vector<Vec2>& o_pts, bool o_closed, const SegmentGrid& b, double step_m, double* max_out) {
+inline double rms_distance_m(const std::vector<Vec2>& o_pts, bool o_closed, const SegmentGrid& b, double step_m,
+                             double* max_out) {
   double sum_sq = 0.0, sum_len = 0.0, worst = 0.0;
   const std::size_t ns = polyline_segments(o_pts, o_closed);
   for (std::size_t k = 0; k < ns; ++k) {

@@ -33,7 +33,8 @@ inline std::vector<std::filesystem::path> picture_paths() {
 
 /// The handle's sweeps of a default `explore` raster run on `scene` (one per tick).
 inline std::vector<Sweep> explore_stream(const Scene& scene, const config::Settings& s) {
-  const HandPath path = raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
+  const HandPath path =
+      raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
   std::vector<Sweep> out;
   Vec2 prev{};
   bool first = true;
@@ -55,12 +56,13 @@ inline std::vector<std::vector<Polyline>> picture_curves(const config::Settings&
 /// A synthetic scene of at least `segments` level-0 segments: whole pictures (their curves at the
 /// workspace scale, so the density of real pictures is kept) tiled side by side on a plane that grows
 /// with the count. Also returns the plane's size.
-inline std::vector<Polyline> tiled_scene(const std::vector<std::vector<Polyline>>& pictures, std::size_t segments, int max_levels,
-                                         Vec2* plane_size_m, std::uint32_t seed = 7) {
+inline std::vector<Polyline> tiled_scene(const std::vector<std::vector<Polyline>>& pictures, std::size_t segments,
+                                         int max_levels, Vec2* plane_size_m, std::uint32_t seed = 7) {
   std::mt19937 rng(seed);
   std::vector<std::size_t> seg_count(pictures.size(), 0);
   for (std::size_t i = 0; i < pictures.size(); ++i) {
-    for (const Polyline& p : pictures[i]) seg_count[i] += plan_levels(p.points_m.size(), p.closed, max_levels).level0_points - (p.closed ? 0 : 1);
+    for (const Polyline& p : pictures[i])
+      seg_count[i] += plan_levels(p.points_m.size(), p.closed, max_levels).level0_points - (p.closed ? 0 : 1);
   }
   std::vector<Polyline> out;
   std::size_t total = 0;
@@ -81,7 +83,8 @@ inline std::vector<Polyline> tiled_scene(const std::vector<std::vector<Polyline>
   const std::size_t rows = (tiles + cols - 1) / cols;
   total = 0;
   for (std::size_t t = 0; t < chosen.size() && total < segments; ++t) {
-    const Vec2 off{(static_cast<double>(t % cols) + 0.5 - cols / 2.0) * tile_w, (static_cast<double>(t / cols) + 0.5 - rows / 2.0) * tile_h};
+    const Vec2 off{(static_cast<double>(t % cols) + 0.5 - cols / 2.0) * tile_w,
+                   (static_cast<double>(t / cols) + 0.5 - rows / 2.0) * tile_h};
     for (const Polyline& p : pictures[chosen[t]]) {
       if (total >= segments) break;
       Polyline q = p;
@@ -99,7 +102,8 @@ inline std::vector<Polyline> tiled_scene(const std::vector<std::vector<Polyline>
 inline std::vector<Sweep> random_walk_stream(Vec2 plane_size_m, std::size_t count, std::uint32_t seed = 11) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> turn(0.0, 0.08), dv(0.0, 0.01);
-  std::uniform_real_distribution<double> ux(-plane_size_m.x / 2, plane_size_m.x / 2), uy(-plane_size_m.y / 2, plane_size_m.y / 2);
+  std::uniform_real_distribution<double> ux(-plane_size_m.x / 2, plane_size_m.x / 2),
+      uy(-plane_size_m.y / 2, plane_size_m.y / 2);
   Vec2 p{ux(rng), uy(rng)};
   double heading = 0.3, speed = 0.1;
   std::vector<Sweep> out;
@@ -108,8 +112,14 @@ inline std::vector<Sweep> random_walk_stream(Vec2 plane_size_m, std::size_t coun
     heading += turn(rng);
     speed = std::clamp(speed + dv(rng), 0.02, 0.4);
     Vec2 q = p + (speed * 0.001) * Vec2{std::cos(heading), std::sin(heading)};
-    if (std::abs(q.x) > plane_size_m.x / 2) { heading = M_PI - heading; q.x = std::clamp(q.x, -plane_size_m.x / 2, plane_size_m.x / 2); }
-    if (std::abs(q.y) > plane_size_m.y / 2) { heading = -heading; q.y = std::clamp(q.y, -plane_size_m.y / 2, plane_size_m.y / 2); }
+    if (std::abs(q.x) > plane_size_m.x / 2) {
+      heading = M_PI - heading;
+      q.x = std::clamp(q.x, -plane_size_m.x / 2, plane_size_m.x / 2);
+    }
+    if (std::abs(q.y) > plane_size_m.y / 2) {
+      heading = -heading;
+      q.y = std::clamp(q.y, -plane_size_m.y / 2, plane_size_m.y / 2);
+    }
     out.push_back({p, q});
     p = q;
   }

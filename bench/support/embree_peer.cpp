@@ -3,8 +3,8 @@
 
 #include <embree3/rtcore.h>
 
-#include <atomic>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -82,7 +82,8 @@ bool segment_point_query(RTCPointQueryFunctionArguments* args) {
 
 [[noreturn]] void fail(RTCDevice device, const char* what) {
   const RTCError e = device ? rtcGetDeviceError(device) : RTC_ERROR_UNKNOWN;
-  throw std::runtime_error(std::string("Embree: ") + what + " failed (error " + std::to_string(static_cast<int>(e)) + ")");
+  throw std::runtime_error(std::string("Embree: ") + what + " failed (error " + std::to_string(static_cast<int>(e)) +
+                           ")");
 }
 
 bool count_bytes(void* user, ssize_t bytes, bool /*post*/) {

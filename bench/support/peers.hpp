@@ -95,9 +95,13 @@ struct CountingAllocator {
     std::allocator<T>().deallocate(p, n);
   }
   template <class U>
-  bool operator==(const CountingAllocator<U>& o) const { return bytes == o.bytes; }
+  bool operator==(const CountingAllocator<U>& o) const {
+    return bytes == o.bytes;
+  }
   template <class U>
-  bool operator!=(const CountingAllocator<U>& o) const { return bytes != o.bytes; }
+  bool operator!=(const CountingAllocator<U>& o) const {
+    return bytes != o.bytes;
+  }
 };
 
 /// Boost.Geometry R-tree over the segments (packing constructor = STR bulk load).
@@ -112,9 +116,11 @@ class RtreeIndex {
     std::vector<Value> values;
     values.reserve(segs.size());
     for (std::uint32_t i = 0; i < segs.size(); ++i) {
-      values.push_back({Segment(Point(segs[i].first.x, segs[i].first.y), Point(segs[i].second.x, segs[i].second.y)), i});
+      values.push_back(
+          {Segment(Point(segs[i].first.x, segs[i].first.y), Point(segs[i].second.x, segs[i].second.y)), i});
     }
-    tree_ = std::make_unique<Tree>(values.begin(), values.end(), bgi::rstar<16>(), bgi::indexable<Value>(), bgi::equal_to<Value>(), alloc_);
+    tree_ = std::make_unique<Tree>(values.begin(), values.end(), bgi::rstar<16>(), bgi::indexable<Value>(),
+                                   bgi::equal_to<Value>(), alloc_);
   }
   /// First hit: every segment `intersects` reports, its entry parameter from the same formula as ours.
   PeerHit first_hit(Vec2 a, Vec2 b) const {

@@ -2,12 +2,12 @@
 /// @file detail.hpp
 /// Internal helpers shared by the config sources (not installed, not part of the API).
 
-#include "hk/text.hpp"
 #include <cstddef>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include "hk/text.hpp"
 
 #include "config/load.hpp"
 
@@ -24,8 +24,8 @@ std::span<const TableInfo> tables() noexcept;
 
 /// Where a message comes from: a file (or named text) or an in-memory Settings.
 struct Source {
-  std::string name;   ///< path / source name, or "settings"
-  bool is_file;       ///< true: messages start "config '<name>': ", false: "<name>: "
+  std::string name;  ///< path / source name, or "settings"
+  bool is_file;      ///< true: messages start "config '<name>': ", false: "<name>: "
 };
 
 /// The one escaper (hk/text.hpp), for the names and values config messages echo.
@@ -66,8 +66,7 @@ std::optional<std::string> integer_problem(const FieldDescriptor& d, long long v
 std::optional<std::string> text_problem(const FieldDescriptor& d, std::string_view v);
 
 /// Throws ConfigError with message "<prefix><body>[ (line N)]", key `key`.
-[[noreturn]] void fail(const Source& src, const std::string& key, const std::string& body,
-                       std::size_t line = 0);
+[[noreturn]] void fail(const Source& src, const std::string& key, const std::string& body, std::size_t line = 0);
 
 /// validate() with messages attributed to `src`.
 void validate_as(const Settings& s, const Source& src);

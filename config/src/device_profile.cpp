@@ -88,8 +88,8 @@ double force_everywhere_n(const Settings& s, std::string_view type) {
   m.proximal_m = s.device.link_proximal_m;
   m.distal_m = s.device.link_distal_m;
   m.motor_spacing_m = s.device.motor_spacing_m;
-  return min_force_everywhere_n(hapi::geometry_of(m), {0.0, s.device.rect_center_y_m}, {s.device.rect_width_m, s.device.rect_height_m},
-                                s.device.torque_limit_n_m);
+  return min_force_everywhere_n(hapi::geometry_of(m), {0.0, s.device.rect_center_y_m},
+                                {s.device.rect_width_m, s.device.rect_height_m}, s.device.torque_limit_n_m);
 }
 
 double stiffness_limit_n_per_m(std::string_view type, double servo_rate_hz) noexcept {
@@ -102,9 +102,12 @@ bool home_park_place(const Settings& s, double* x_m, double* y_m) {
   m.distal_m = s.device.link_distal_m;
   m.motor_spacing_m = s.device.motor_spacing_m;
   Vec2 home;
-  if (!forward_kinematics(hapi::geometry_of(m), hapi::joints_from_haply_deg(s.device.encoder1_offset_deg, s.device.encoder2_offset_deg), &home))
+  if (!forward_kinematics(hapi::geometry_of(m),
+                          hapi::joints_from_haply_deg(s.device.encoder1_offset_deg, s.device.encoder2_offset_deg),
+                          &home))
     return false;
-  const double scale = std::min(s.workspace.width_m / s.device.rect_width_m, s.workspace.height_m / s.device.rect_height_m);
+  const double scale =
+      std::min(s.workspace.width_m / s.device.rect_width_m, s.workspace.height_m / s.device.rect_height_m);
   *x_m = scale * home.x;
   *y_m = scale * (home.y - s.device.rect_center_y_m);
   return true;
@@ -120,16 +123,19 @@ std::string profile_problem(const Settings& s, std::string_view type, std::strin
   const double everywhere = force_everywhere_n(s, type);
   // A rectangle the links cannot reach gives 0: the device refuses it when it is opened, with its own message.
   if (everywhere > 0.0 && h.max_force_n > everywhere + 1e-9)
-    return problem("haptics.max_force_n", h.max_force_n,
-                   "is more than the " + std::string(p.name) + " gives everywhere in its rectangle (" + newtons(everywhere) + ")");
+    return problem(
+        "haptics.max_force_n", h.max_force_n,
+        "is more than the " + std::string(p.name) + " gives everywhere in its rectangle (" + newtons(everywhere) + ")");
   const double k_max = stiffness_limit_n_per_m(type, h.servo_rate_hz);
   if (h.stiffness_n_per_m > k_max + 1e-9) {
     char b[64];
     std::snprintf(b, sizeof b, "%.0f N/m at %.0f Hz", k_max, h.servo_rate_hz);
-    return problem("haptics.stiffness_n_per_m", h.stiffness_n_per_m, "is above the stable limit of the " + std::string(p.name) + " (" + b + ")");
+    return problem("haptics.stiffness_n_per_m", h.stiffness_n_per_m,
+                   "is above the stable limit of the " + std::string(p.name) + " (" + b + ")");
   }
   const std::string within = "must be <= haptics.max_force_n = " + detail::format_real(h.max_force_n);
-  if (h.pop_force_n > h.max_force_n) return problem("haptics.pop_force_n", h.pop_force_n, within + " (no visitor could push through a wall)");
+  if (h.pop_force_n > h.max_force_n)
+    return problem("haptics.pop_force_n", h.pop_force_n, within + " (no visitor could push through a wall)");
   if (h.tour_max_force_n > h.max_force_n) return problem("haptics.tour_max_force_n", h.tour_max_force_n, within);
   if (h.groove_depth_n > h.max_force_n) return problem("haptics.groove_depth_n", h.groove_depth_n, within);
   return {};
@@ -138,14 +144,18 @@ std::string profile_problem(const Settings& s, std::string_view type, std::strin
 std::string profile_limit_text(const Settings& s, std::string_view type, std::string_view table, std::string_view key) {
   if (table != "haptics") return {};
   const DeviceProfile& p = device_profile(type);
-  if (key == "max_force_n") return "at most " + newtons(force_everywhere_n(s, type)) + " (what the " + std::string(p.name) + " gives everywhere)";
+  if (key == "max_force_n")
+    return "at most " + newtons(force_everywhere_n(s, type)) + " (what the " + std::string(p.name) +
+           " gives everywhere)";
   if (key == "stiffness_n_per_m") {
     char b[96];
-    std::snprintf(b, sizeof b, "at most %.0f N/m (stable on the %s at %.0f Hz)", stiffness_limit_n_per_m(type, s.haptics.servo_rate_hz),
-                  std::string(p.name).c_str(), s.haptics.servo_rate_hz);
+    std::snprintf(b, sizeof b, "at most %.0f N/m (stable on the %s at %.0f Hz)",
+                  stiffness_limit_n_per_m(type, s.haptics.servo_rate_hz), std::string(p.name).c_str(),
+                  s.haptics.servo_rate_hz);
     return b;
   }
-  if (key == "pop_force_n" || key == "tour_max_force_n" || key == "groove_depth_n") return "at most max_force_n (" + newtons(s.haptics.max_force_n) + ")";
+  if (key == "pop_force_n" || key == "tour_max_force_n" || key == "groove_depth_n")
+    return "at most max_force_n (" + newtons(s.haptics.max_force_n) + ")";
   return {};
 }
 
@@ -172,14 +182,20 @@ Settings fit_to_profile(const Settings& s, std::string_view type, std::vector<st
     if (why.empty()) break;
     if (notes) notes->push_back(why + "; " + std::string(to.name) + " uses its own value");
     const std::string_view k = std::string_view(key).substr(std::string_view("haptics.").size());
-    if (k == "max_force_n") h.max_force_n = to.max_force_n;
-    else if (k == "stiffness_n_per_m") h.stiffness_n_per_m = std::min(to.stiffness_n_per_m, stiffness_limit_n_per_m(type, h.servo_rate_hz));
-    else if (k == "pop_force_n") h.pop_force_n = std::min(to.pop_force_n, h.max_force_n);
-    else if (k == "tour_max_force_n") h.tour_max_force_n = std::min(to.tour_max_force_n, h.max_force_n);
-    else if (k == "groove_depth_n") h.groove_depth_n = std::min(to.groove_depth_n, h.max_force_n);
+    if (k == "max_force_n")
+      h.max_force_n = to.max_force_n;
+    else if (k == "stiffness_n_per_m")
+      h.stiffness_n_per_m = std::min(to.stiffness_n_per_m, stiffness_limit_n_per_m(type, h.servo_rate_hz));
+    else if (k == "pop_force_n")
+      h.pop_force_n = std::min(to.pop_force_n, h.max_force_n);
+    else if (k == "tour_max_force_n")
+      h.tour_max_force_n = std::min(to.tour_max_force_n, h.max_force_n);
+    else if (k == "groove_depth_n")
+      h.groove_depth_n = std::min(to.groove_depth_n, h.max_force_n);
   }
   // The tour stays below the push-through force (validate's cross-field rule).
-  if (h.pop_force_n > 0.0 && h.tour_max_force_n >= h.pop_force_n) h.tour_max_force_n = std::min(to.tour_max_force_n, 0.5 * h.pop_force_n);
+  if (h.pop_force_n > 0.0 && h.tour_max_force_n >= h.pop_force_n)
+    h.tour_max_force_n = std::min(to.tour_max_force_n, 0.5 * h.pop_force_n);
   return out;
 }
 

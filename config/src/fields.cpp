@@ -13,9 +13,9 @@
 #include <type_traits>
 #include <utility>
 
+#include "config/device_profile.hpp"
 #include "config/keys.hpp"
 #include "config/load.hpp"
-#include "config/device_profile.hpp"
 #include "detail.hpp"
 
 namespace hk::config {
@@ -43,8 +43,8 @@ constexpr FieldDescriptor make_field(std::string_view table, std::string_view ke
                                      std::span<const std::string_view> choices = {},
                                      std::string (*check)(std::string_view) = nullptr) {
   using T = std::remove_cvref_t<decltype(std::declval<Settings&>().*Sub.*Member)>;
-  static_assert(std::is_same_v<T, double> || std::is_same_v<T, int> ||
-                    std::is_same_v<T, std::int64_t> || std::is_same_v<T, std::string>,
+  static_assert(std::is_same_v<T, double> || std::is_same_v<T, int> || std::is_same_v<T, std::int64_t> ||
+                    std::is_same_v<T, std::string>,
                 "unsupported settings field type");
   FieldKind kind = FieldKind::real;
   if constexpr (std::is_same_v<T, std::string>) {
@@ -55,20 +55,30 @@ constexpr FieldDescriptor make_field(std::string_view table, std::string_view ke
     if (min != static_cast<double>(static_cast<long long>(min)) ||
         max != static_cast<double>(static_cast<long long>(max)))
       throw "integer bounds must be whole numbers";
-    if (std::is_same_v<T, int> && (min < INT_MIN || max > INT_MAX))
-      throw "bounds of an int field must fit in int";
+    if (std::is_same_v<T, int> && (min < INT_MIN || max > INT_MAX)) throw "bounds of an int field must fit in int";
   }
   if (kind != FieldKind::text && check != nullptr) throw "only a text field has a check";
   if (kind != FieldKind::text && !(min <= max)) throw "min must be <= max";
-  return FieldDescriptor{table, key, kind, min, max, unit, help, choices, check, group, apply,
-                         &ref_of<Sub, Member>, &cref_of<Sub, Member>};
+  return FieldDescriptor{table,
+                         key,
+                         kind,
+                         min,
+                         max,
+                         unit,
+                         help,
+                         choices,
+                         check,
+                         group,
+                         apply,
+                         &ref_of<Sub, Member>,
+                         &cref_of<Sub, Member>};
 }
 
 // HK_FIELD(table, field, group, apply, min, max, unit, help[, choices]): the key is the field name,
 // spelled once. HK_FIELD_IN(member, "toml table", ...) for a table whose name is a C++ keyword.
-#define HK_FIELD(table, field, ...)                                                        \
+#define HK_FIELD(table, field, ...) \
   make_field<&Settings::table, &decltype(Settings::table)::field>(#table, #field, __VA_ARGS__)
-#define HK_FIELD_IN(member, table_name, field, ...)                                         \
+#define HK_FIELD_IN(member, table_name, field, ...) \
   make_field<&Settings::member, &decltype(Settings::member)::field>(table_name, #field, __VA_ARGS__)
 
 /// The check of a path field: at most 4096 bytes, no control characters.
@@ -91,7 +101,9 @@ std::string camera_source_problem(std::string_view v) {
   if (v == "auto" || v == "none") return {};
   for (std::string_view kind : {"file:", "libcamera:", "v4l2:"})
     if (v.substr(0, kind.size()) == kind) {
-      if (v.size() == kind.size()) return "names no " + std::string(kind == "libcamera:" ? "camera number" : "path") + " after '" + std::string(kind) + "'";
+      if (v.size() == kind.size())
+        return "names no " + std::string(kind == "libcamera:" ? "camera number" : "path") + " after '" +
+               std::string(kind) + "'";
       return path_problem(v);
     }
   return "is not \"auto\", \"none\", \"file:PATH\", \"libcamera:N\" or \"v4l2:DEV\"";
@@ -104,7 +116,8 @@ std::string pin_hash_problem(std::string_view v) {
   if (v.size() > 127) return "is longer than an argon2id hash (127 bytes); set the PIN with 'haptic-kiosk pin set'";
   if (v.rfind("$argon2id$", 0) != 0) return "is not an argon2id hash; set the PIN with 'haptic-kiosk pin set'";
   for (char c : v)
-    if (c <= 0x20 || c >= 0x7f) return "holds a character no argon2id hash has; set the PIN with 'haptic-kiosk pin set'";
+    if (c <= 0x20 || c >= 0x7f)
+      return "holds a character no argon2id hash has; set the PIN with 'haptic-kiosk pin set'";
   return {};
 }
 
@@ -152,16 +165,21 @@ constexpr std::array<std::string_view, 6> kDetectors{"auto", "canny", "surround"
 constexpr std::array<std::string_view, 3> kOcrModes{"auto", "always", "off"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
-constexpr auto kKeyNames = std::to_array<std::string_view>({
-    "F1", "F2", "F3", "F4", "F5", "F6", "F7", "F8", "F9", "F10", "F11", "F12",
-    "A", "B", "D", "E", "F", "G", "H", "I", "J", "K", "L", "M", "N", "P", "Q", "R", "S", "T", "U", "V", "W", "X", "Y", "Z",
-    "0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "SPACE", "ENTER", "TAB", "BACKSPACE", "LEFT", "RIGHT", "UP", "DOWN",
-    "PAGE_UP", "PAGE_DOWN", "HOME", "END", "INSERT", "DELETE", "MINUS", "EQUAL",
-    "KP_0", "KP_1", "KP_2", "KP_3", "KP_4", "KP_5", "KP_6", "KP_7", "KP_8", "KP_9", "KP_ADD", "KP_SUBTRACT", "KP_ENTER"});
+constexpr auto kKeyNames = std::to_array<std::string_view>(
+    {"F1",    "F2",    "F3",     "F4",          "F5",      "F6",        "F7",    "F8",    "F9",     "F10",
+     "F11",   "F12",   "A",      "B",           "D",       "E",         "F",     "G",     "H",      "I",
+     "J",     "K",     "L",      "M",           "N",       "P",         "Q",     "R",     "S",      "T",
+     "U",     "V",     "W",      "X",           "Y",       "Z",         "0",     "1",     "2",      "3",
+     "4",     "5",     "6",      "7",           "8",       "9",         "SPACE", "ENTER", "TAB",    "BACKSPACE",
+     "LEFT",  "RIGHT", "UP",     "DOWN",        "PAGE_UP", "PAGE_DOWN", "HOME",  "END",   "INSERT", "DELETE",
+     "MINUS", "EQUAL", "KP_0",   "KP_1",        "KP_2",    "KP_3",      "KP_4",  "KP_5",  "KP_6",   "KP_7",
+     "KP_8",  "KP_9",  "KP_ADD", "KP_SUBTRACT", "KP_ENTER"});
 
 constexpr std::array<detail::TableInfo, 11> kTables{{
     {"haptics", "Force rendering and the servo loop."},
-    {"device", "Which device drives the handle: the simulated pantograph's physics, and the USB pantograph's board, links and calibration."},
+    {"device",
+     "Which device drives the handle: the simulated pantograph's physics, and the USB pantograph's board, links and "
+     "calibration."},
     {"hand", "The model hand that drives the simulated pantograph in headless runs."},
     {"vision", "Image intake limits, edge detection and linking."},
     {"workspace", "The device's usable rectangle, centred on the workspace origin."},
@@ -176,137 +194,248 @@ constexpr std::array<detail::TableInfo, 11> kTables{{
 constexpr auto kFields = std::to_array<FieldDescriptor>({
     // [haptics]
     HK_FIELD(haptics, stiffness_n_per_m, FieldGroup::haptics, ApplyWhen::live, 10, 5000, "N/m", "Wall stiffness."),
-    HK_FIELD(haptics, damping_n_s_per_m, FieldGroup::haptics, ApplyWhen::live, 0, 20, "N·s/m", "Damping rendered while in contact."),
-    HK_FIELD(haptics, max_force_n, FieldGroup::haptics, ApplyWhen::live, 0.1, 20, "N", "Force clamp: no force above this leaves the device."),
+    HK_FIELD(haptics, damping_n_s_per_m, FieldGroup::haptics, ApplyWhen::live, 0, 20, "N·s/m",
+             "Damping rendered while in contact."),
+    HK_FIELD(haptics, max_force_n, FieldGroup::haptics, ApplyWhen::live, 0.1, 20, "N",
+             "Force clamp: no force above this leaves the device."),
     HK_FIELD(haptics, servo_rate_hz, FieldGroup::haptics, ApplyWhen::restart, 100, 10000, "Hz", "Servo loop rate."),
-    HK_FIELD(haptics, level, FieldGroup::levels, ApplyWhen::scene, 0, 12, "",
-             "Resolution level at the start, and always when level_mode = \"fixed\"; 0 = finest; must be <= max_levels."),
-    HK_FIELD(haptics, level_mode, FieldGroup::levels, ApplyWhen::scene, 0, 0, "", "\"auto\": the level follows the hand's speed; \"tolerance\": so does the tolerance, each shape at the coarsest of its own levels within it; \"cut\": so does the tolerance, each stretch of a shape as coarse as it allows (the tolerance cut); \"fixed\": always `level`.", kLevelModes),
-    HK_FIELD(haptics, level_error_at_rest_m, FieldGroup::levels, ApplyWhen::scene, 0, 0.01, "m", "Deviation from the true curve a slowly moving fingertip cannot feel."),
-    HK_FIELD(haptics, level_blur_time_s, FieldGroup::levels, ApplyWhen::scene, 0, 0.1, "s", "The tolerable deviation grows by the hand's speed times this."),
-    HK_FIELD(haptics, level_hysteresis, FieldGroup::levels, ApplyWhen::scene, 0, 0.9, "", "Go coarser only when that level's error is this fraction below the tolerance."),
-    HK_FIELD(haptics, level_min_dwell_s, FieldGroup::levels, ApplyWhen::scene, 0, 5, "s", "Least time between two level changes."),
-    HK_FIELD(haptics, level_max_force_step_n, FieldGroup::haptics, ApplyWhen::live, 0.001, 5, "N", "Largest force change per tick that a level change or a live change of stiffness, damping, force or friction may cause."),
-    HK_FIELD(haptics, static_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "", "Coulomb static friction of the walls; >= dynamic_friction."),
-    HK_FIELD(haptics, dynamic_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "", "Coulomb dynamic friction of the walls; both 0 = frictionless."),
-    HK_FIELD(haptics, max_levels, FieldGroup::levels, ApplyWhen::scene, 1, 12, "", "Number of levels built above level 0."),
+    HK_FIELD(
+        haptics, level, FieldGroup::levels, ApplyWhen::scene, 0, 12, "",
+        "Resolution level at the start, and always when level_mode = \"fixed\"; 0 = finest; must be <= max_levels."),
+    HK_FIELD(haptics, level_mode, FieldGroup::levels, ApplyWhen::scene, 0, 0, "",
+             "\"auto\": the level follows the hand's speed; \"tolerance\": so does the tolerance, each shape at the "
+             "coarsest of its own levels within it; \"cut\": so does the tolerance, each stretch of a shape as coarse "
+             "as it allows (the tolerance cut); \"fixed\": always `level`.",
+             kLevelModes),
+    HK_FIELD(haptics, level_error_at_rest_m, FieldGroup::levels, ApplyWhen::scene, 0, 0.01, "m",
+             "Deviation from the true curve a slowly moving fingertip cannot feel."),
+    HK_FIELD(haptics, level_blur_time_s, FieldGroup::levels, ApplyWhen::scene, 0, 0.1, "s",
+             "The tolerable deviation grows by the hand's speed times this."),
+    HK_FIELD(haptics, level_hysteresis, FieldGroup::levels, ApplyWhen::scene, 0, 0.9, "",
+             "Go coarser only when that level's error is this fraction below the tolerance."),
+    HK_FIELD(haptics, level_min_dwell_s, FieldGroup::levels, ApplyWhen::scene, 0, 5, "s",
+             "Least time between two level changes."),
+    HK_FIELD(haptics, level_max_force_step_n, FieldGroup::haptics, ApplyWhen::live, 0.001, 5, "N",
+             "Largest force change per tick that a level change or a live change of stiffness, damping, force or "
+             "friction may cause."),
+    HK_FIELD(haptics, static_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "",
+             "Coulomb static friction of the walls; >= dynamic_friction."),
+    HK_FIELD(haptics, dynamic_friction, FieldGroup::haptics, ApplyWhen::live, 0, 2, "",
+             "Coulomb dynamic friction of the walls; both 0 = frictionless."),
+    HK_FIELD(haptics, max_levels, FieldGroup::levels, ApplyWhen::scene, 1, 12, "",
+             "Number of levels built above level 0."),
     HK_FIELD(haptics, query_box_budget, FieldGroup::haptics, ApplyWhen::live, 0, 10000000, "box tests",
-             "Box tests the collision queries and level-change checks of one servo tick may do; past it the proxy waits where the sweep is proven clear (anytime). 0 = no limit."),
+             "Box tests the collision queries and level-change checks of one servo tick may do; past it the proxy "
+             "waits where the sweep is proven clear (anytime). 0 = no limit."),
     HK_FIELD(haptics, force_ramp_s, FieldGroup::haptics, ApplyWhen::scene, 0, 10, "s", "Start-up force ramp duration."),
     HK_FIELD(haptics, pop_force_n, FieldGroup::haptics, ApplyWhen::live, 0, 20, "N",
              "Pressing a wall harder than this for pop_hold_s lets the hand through it; 0 = walls never give way."),
-    HK_FIELD(haptics, pop_hold_s, FieldGroup::haptics, ApplyWhen::live, 0.01, 5, "s", "How long a press must last to push through a wall."),
-    HK_FIELD(haptics, pop_release_s, FieldGroup::haptics, ApplyWhen::live, 0.001, 1, "s", "After a push-through the force falls to zero over this."),
+    HK_FIELD(haptics, pop_hold_s, FieldGroup::haptics, ApplyWhen::live, 0.01, 5, "s",
+             "How long a press must last to push through a wall."),
+    HK_FIELD(haptics, pop_release_s, FieldGroup::haptics, ApplyWhen::live, 0.001, 1, "s",
+             "After a push-through the force falls to zero over this."),
     HK_FIELD(haptics, render, FieldGroup::haptics, ApplyWhen::scene, 0, 0, "",
-             "\"walls\": curves are walls the hand slides along; \"grooves\": curves are engraved lines that pull the hand in.", kRenderModes),
-    HK_FIELD(haptics, groove_capture_radius_m, FieldGroup::haptics, ApplyWhen::scene, 0.0005, 0.02, "m", "A groove pulls the hand within this distance of its curve."),
+             "\"walls\": curves are walls the hand slides along; \"grooves\": curves are engraved lines that pull the "
+             "hand in.",
+             kRenderModes),
+    HK_FIELD(haptics, groove_capture_radius_m, FieldGroup::haptics, ApplyWhen::scene, 0.0005, 0.02, "m",
+             "A groove pulls the hand within this distance of its curve."),
     HK_FIELD(haptics, groove_depth_n, FieldGroup::haptics, ApplyWhen::scene, 0.05, 10, "N",
              "Depth of a groove as felt: its strongest pull (never more than stiffness x capture radius / 2)."),
-    HK_FIELD(haptics, tour_max_force_n, FieldGroup::haptics, ApplyWhen::live, 0.1, 5, "N", "The guided tour never pulls the handle harder than this; below pop_force_n."),
-    HK_FIELD(haptics, tour_speed_m_per_s, FieldGroup::haptics, ApplyWhen::live, 0.005, 0.2, "m/s", "Speed of the guided tour along an outline."),
+    HK_FIELD(haptics, tour_max_force_n, FieldGroup::haptics, ApplyWhen::live, 0.1, 5, "N",
+             "The guided tour never pulls the handle harder than this; below pop_force_n."),
+    HK_FIELD(haptics, tour_speed_m_per_s, FieldGroup::haptics, ApplyWhen::live, 0.005, 0.2, "m/s",
+             "Speed of the guided tour along an outline."),
     // [device]
-    HK_FIELD(device, type, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Device driving the handle, and the profile whose forces, stiffness and board it brings: \"auto\" (a USB Haply when one answers, else simulated), \"simulated\", \"haply\" (2DIY gen3) or \"haply-gen2\" (the original 2DIY).", kDeviceTypes),
-    HK_FIELD(device, handle_mass_kg, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "kg", "Effective handle mass (simulated pantograph)."),
-    HK_FIELD(device, handle_damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 100, "N·s/m", "Device viscous damping."),
-    HK_FIELD(device, encoder_counts_per_rev, FieldGroup::devices, ApplyWhen::restart, 64, 1048576, "counts/rev", "Encoder resolution."),
-    HK_FIELD(device, max_torque_n_m, FieldGroup::devices, ApplyWhen::restart, 0.02, 10, "N·m", "Per-motor torque limit (simulated pantograph)."),
-    HK_FIELD(device, transport, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "How to reach the USB pantograph: \"auto\" (libusb, then the kernel's tty), \"usb\" or \"tty\".", kTransports),
-    HK_FIELD(device, usb_ids, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "USB ids (VVVV:PPPP, comma-separated) the pantograph's board is looked for at, in order; one found is taken once it answers hAPI ('haptic-kiosk devices' says which answered).", {}, &usb_ids_problem),
-    HK_FIELD(device, serial_path, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "The board's tty for the tty transport; empty: the first /dev/serial/by-id entry.", {}, &path_problem),
-    HK_FIELD(device, device_id, FieldGroup::devices, ApplyWhen::restart, 1, 255, "", "hAPI device id the board is set up with."),
-    HK_FIELD(device, lost_after_ticks, FieldGroup::devices, ApplyWhen::restart, 1, 1000, "ticks", "Servo ticks without a valid reply before the device counts as lost (force off, spoken)."),
-    HK_FIELD(device, actuator1_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "", "Board port of actuator 1 (Haply joint 1)."),
-    HK_FIELD(device, actuator1_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Positive direction of actuator 1.", kRotations),
-    HK_FIELD(device, actuator2_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "", "Board port of actuator 2 (Haply joint 2)."),
-    HK_FIELD(device, actuator2_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Positive direction of actuator 2.", kRotations),
+    HK_FIELD(device, type, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "Device driving the handle, and the profile whose forces, stiffness and board it brings: \"auto\" (a USB "
+             "Haply when one answers, else simulated), \"simulated\", \"haply\" (2DIY gen3) or \"haply-gen2\" (the "
+             "original 2DIY).",
+             kDeviceTypes),
+    HK_FIELD(device, handle_mass_kg, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "kg",
+             "Effective handle mass (simulated pantograph)."),
+    HK_FIELD(device, handle_damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 100, "N·s/m",
+             "Device viscous damping."),
+    HK_FIELD(device, encoder_counts_per_rev, FieldGroup::devices, ApplyWhen::restart, 64, 1048576, "counts/rev",
+             "Encoder resolution."),
+    HK_FIELD(device, max_torque_n_m, FieldGroup::devices, ApplyWhen::restart, 0.02, 10, "N·m",
+             "Per-motor torque limit (simulated pantograph)."),
+    HK_FIELD(device, transport, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "How to reach the USB pantograph: \"auto\" (libusb, then the kernel's tty), \"usb\" or \"tty\".",
+             kTransports),
+    HK_FIELD(device, usb_ids, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "USB ids (VVVV:PPPP, comma-separated) the pantograph's board is looked for at, in order; one found is "
+             "taken once it answers hAPI ('haptic-kiosk devices' says which answered).",
+             {}, &usb_ids_problem),
+    HK_FIELD(device, serial_path, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "The board's tty for the tty transport; empty: the first /dev/serial/by-id entry.", {}, &path_problem),
+    HK_FIELD(device, device_id, FieldGroup::devices, ApplyWhen::restart, 1, 255, "",
+             "hAPI device id the board is set up with."),
+    HK_FIELD(device, lost_after_ticks, FieldGroup::devices, ApplyWhen::restart, 1, 1000, "ticks",
+             "Servo ticks without a valid reply before the device counts as lost (force off, spoken)."),
+    HK_FIELD(device, actuator1_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "",
+             "Board port of actuator 1 (Haply joint 1)."),
+    HK_FIELD(device, actuator1_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "Positive direction of actuator 1.", kRotations),
+    HK_FIELD(device, actuator2_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "",
+             "Board port of actuator 2 (Haply joint 2)."),
+    HK_FIELD(device, actuator2_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "Positive direction of actuator 2.", kRotations),
     HK_FIELD(device, encoder1_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "", "Board port of encoder 1."),
-    HK_FIELD(device, encoder1_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Positive direction of encoder 1.", kRotations),
-    HK_FIELD(device, encoder1_offset_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg", "Angle encoder 1 reports at the pose the board starts in ('haptic-kiosk calibrate' sets it)."),
-    HK_FIELD(device, encoder1_resolution, FieldGroup::devices, ApplyWhen::restart, 1, 1000000, "counts/rev", "Encoder 1 resolution as the board's firmware takes it."),
+    HK_FIELD(device, encoder1_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "Positive direction of encoder 1.", kRotations),
+    HK_FIELD(device, encoder1_offset_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg",
+             "Angle encoder 1 reports at the pose the board starts in ('haptic-kiosk calibrate' sets it)."),
+    HK_FIELD(device, encoder1_resolution, FieldGroup::devices, ApplyWhen::restart, 1, 1000000, "counts/rev",
+             "Encoder 1 resolution as the board's firmware takes it."),
     HK_FIELD(device, encoder2_port, FieldGroup::devices, ApplyWhen::restart, 1, 4, "", "Board port of encoder 2."),
-    HK_FIELD(device, encoder2_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "", "Positive direction of encoder 2.", kRotations),
-    HK_FIELD(device, encoder2_offset_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg", "Angle encoder 2 reports at the pose the board starts in ('haptic-kiosk calibrate' sets it)."),
-    HK_FIELD(device, encoder2_resolution, FieldGroup::devices, ApplyWhen::restart, 1, 1000000, "counts/rev", "Encoder 2 resolution as the board's firmware takes it."),
-    HK_FIELD(device, link_proximal_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 0.5, "m", "USB pantograph: motor-to-elbow link length."),
-    HK_FIELD(device, link_distal_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 0.5, "m", "USB pantograph: elbow-to-handle link length."),
-    HK_FIELD(device, motor_spacing_m, FieldGroup::devices, ApplyWhen::restart, 0, 0.5, "m", "USB pantograph: distance between the two motor axes."),
-    HK_FIELD(device, torque_limit_n_m, FieldGroup::devices, ApplyWhen::restart, 0.001, 10, "N·m", "USB pantograph: torque limit per motor (the board's own limit)."),
-    HK_FIELD(device, rect_width_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 1, "m", "USB pantograph: width of its usable rectangle, mapped onto [workspace]."),
-    HK_FIELD(device, rect_height_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 1, "m", "USB pantograph: height of its usable rectangle."),
-    HK_FIELD(device, rect_center_y_m, FieldGroup::devices, ApplyWhen::restart, -1, 1, "m", "USB pantograph: the rectangle's centre relative to the motor axes (negative: towards the visitor)."),
-    HK_FIELD(device, park_x_m, FieldGroup::devices, ApplyWhen::restart, -0.5, 0.5, "m", "Where the handle rests for 'haptic-kiosk calibrate' (workspace x)."),
-    HK_FIELD(device, park_y_m, FieldGroup::devices, ApplyWhen::restart, -0.5, 0.5, "m", "Where the handle rests for calibration (workspace y)."),
+    HK_FIELD(device, encoder2_dir, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
+             "Positive direction of encoder 2.", kRotations),
+    HK_FIELD(device, encoder2_offset_deg, FieldGroup::devices, ApplyWhen::restart, -360, 360, "deg",
+             "Angle encoder 2 reports at the pose the board starts in ('haptic-kiosk calibrate' sets it)."),
+    HK_FIELD(device, encoder2_resolution, FieldGroup::devices, ApplyWhen::restart, 1, 1000000, "counts/rev",
+             "Encoder 2 resolution as the board's firmware takes it."),
+    HK_FIELD(device, link_proximal_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 0.5, "m",
+             "USB pantograph: motor-to-elbow link length."),
+    HK_FIELD(device, link_distal_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 0.5, "m",
+             "USB pantograph: elbow-to-handle link length."),
+    HK_FIELD(device, motor_spacing_m, FieldGroup::devices, ApplyWhen::restart, 0, 0.5, "m",
+             "USB pantograph: distance between the two motor axes."),
+    HK_FIELD(device, torque_limit_n_m, FieldGroup::devices, ApplyWhen::restart, 0.001, 10, "N·m",
+             "USB pantograph: torque limit per motor (the board's own limit)."),
+    HK_FIELD(device, rect_width_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 1, "m",
+             "USB pantograph: width of its usable rectangle, mapped onto [workspace]."),
+    HK_FIELD(device, rect_height_m, FieldGroup::devices, ApplyWhen::restart, 0.01, 1, "m",
+             "USB pantograph: height of its usable rectangle."),
+    HK_FIELD(device, rect_center_y_m, FieldGroup::devices, ApplyWhen::restart, -1, 1, "m",
+             "USB pantograph: the rectangle's centre relative to the motor axes (negative: towards the visitor)."),
+    HK_FIELD(device, park_x_m, FieldGroup::devices, ApplyWhen::restart, -0.5, 0.5, "m",
+             "Where the handle rests for 'haptic-kiosk calibrate' (workspace x)."),
+    HK_FIELD(device, park_y_m, FieldGroup::devices, ApplyWhen::restart, -0.5, 0.5, "m",
+             "Where the handle rests for calibration (workspace y)."),
     // [hand]
-    HK_FIELD(hand, stiffness_n_per_m, FieldGroup::devices, ApplyWhen::restart, 1, 5000, "N/m", "Spring pulling the hand to its target."),
-    HK_FIELD(hand, damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 200, "N·s/m", "Damping of the hand spring."),
-    HK_FIELD(hand, max_force_n, FieldGroup::devices, ApplyWhen::restart, 0.01, 50, "N", "The most a visitor pushes with."),
-    HK_FIELD(hand, raster_speed_m_per_s, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "m/s", "Target speed along the raster."),
-    HK_FIELD(hand, raster_spacing_m, FieldGroup::devices, ApplyWhen::restart, 0.0005, 0.05, "m", "Line spacing of the raster."),
+    HK_FIELD(hand, stiffness_n_per_m, FieldGroup::devices, ApplyWhen::restart, 1, 5000, "N/m",
+             "Spring pulling the hand to its target."),
+    HK_FIELD(hand, damping_n_s_per_m, FieldGroup::devices, ApplyWhen::restart, 0, 200, "N·s/m",
+             "Damping of the hand spring."),
+    HK_FIELD(hand, max_force_n, FieldGroup::devices, ApplyWhen::restart, 0.01, 50, "N",
+             "The most a visitor pushes with."),
+    HK_FIELD(hand, raster_speed_m_per_s, FieldGroup::devices, ApplyWhen::restart, 0.001, 5, "m/s",
+             "Target speed along the raster."),
+    HK_FIELD(hand, raster_spacing_m, FieldGroup::devices, ApplyWhen::restart, 0.0005, 0.05, "m",
+             "Line spacing of the raster."),
     // [vision]
-    HK_FIELD(vision, max_file_bytes, FieldGroup::scene, ApplyWhen::scene, 1024, kTwoPow31, "bytes", "Largest image file accepted."),
+    HK_FIELD(vision, max_file_bytes, FieldGroup::scene, ApplyWhen::scene, 1024, kTwoPow31, "bytes",
+             "Largest image file accepted."),
     HK_FIELD(vision, max_width_px, FieldGroup::scene, ApplyWhen::scene, 16, 100000, "px", "Widest image accepted."),
     HK_FIELD(vision, max_height_px, FieldGroup::scene, ApplyWhen::scene, 16, 100000, "px", "Tallest image accepted."),
-    HK_FIELD(vision, max_pixels, FieldGroup::scene, ApplyWhen::scene, 256, kTwoPow31, "px", "Largest width x height accepted."),
+    HK_FIELD(vision, max_pixels, FieldGroup::scene, ApplyWhen::scene, 256, kTwoPow31, "px",
+             "Largest width x height accepted."),
     HK_FIELD(vision, blur_sigma_px, FieldGroup::scene, ApplyWhen::scene, 0, 20, "px", "Gaussian pre-blur sigma."),
     HK_FIELD(vision, canny_low, FieldGroup::scene, ApplyWhen::scene, 0, 2000, "",
              "Canny hysteresis low threshold; 0 = from the image; <= canny_high when both nonzero."),
-    HK_FIELD(vision, canny_high, FieldGroup::scene, ApplyWhen::scene, 0, 2000, "", "Canny hysteresis high threshold; 0 = from the image."),
-    HK_FIELD(vision, min_chain_length_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.1, "m", "Edge chains shorter than this are dropped."),
-    HK_FIELD(vision, max_image_side_px, FieldGroup::scene, ApplyWhen::scene, 64, 10000, "px", "Images are downscaled to this longest side."),
-    HK_FIELD(vision, max_segments, FieldGroup::scene, ApplyWhen::scene, 100, 1000000, "", "Scene budget: level-0 segments kept, the most salient curves first."),
-    HK_FIELD(vision, max_shapes, FieldGroup::scene, ApplyWhen::scene, 1, 1000, "", "Shape budget: curves kept, the most salient first (long, sure, closed, enclosing much); the rest are not felt."),
-    HK_FIELD(vision, thin_line_max_width_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.01, "m", "The two edges of a line thinner than this become one curve; 0 = off."),
-    HK_FIELD(vision, gap_close_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.005, "m", "Chain ends facing each other across a gap up to this are joined into one curve (closing outlines Canny broke); 0 = off."),
+    HK_FIELD(vision, canny_high, FieldGroup::scene, ApplyWhen::scene, 0, 2000, "",
+             "Canny hysteresis high threshold; 0 = from the image."),
+    HK_FIELD(vision, min_chain_length_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.1, "m",
+             "Edge chains shorter than this are dropped."),
+    HK_FIELD(vision, max_image_side_px, FieldGroup::scene, ApplyWhen::scene, 64, 10000, "px",
+             "Images are downscaled to this longest side."),
+    HK_FIELD(vision, max_segments, FieldGroup::scene, ApplyWhen::scene, 100, 1000000, "",
+             "Scene budget: level-0 segments kept, the most salient curves first."),
+    HK_FIELD(vision, max_shapes, FieldGroup::scene, ApplyWhen::scene, 1, 1000, "",
+             "Shape budget: curves kept, the most salient first (long, sure, closed, enclosing much); the rest are not "
+             "felt."),
+    HK_FIELD(vision, thin_line_max_width_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.01, "m",
+             "The two edges of a line thinner than this become one curve; 0 = off."),
+    HK_FIELD(vision, gap_close_m, FieldGroup::scene, ApplyWhen::scene, 0, 0.005, "m",
+             "Chain ends facing each other across a gap up to this are joined into one curve (closing outlines Canny "
+             "broke); 0 = off."),
     HK_FIELD(vision, surround_inhibition, FieldGroup::scene, ApplyWhen::scene, 0, 4, "",
-             "Texture test of the \"surround\" detector: how much of the surrounding edge strength is taken off each edge before asking whether it still stands out; 0 = none."),
+             "Texture test of the \"surround\" detector: how much of the surrounding edge strength is taken off each "
+             "edge before asking whether it still stands out; 0 = none."),
     HK_FIELD(vision, detector, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
-             "\"auto\": two-tone pictures (silhouettes, logos) traced from a threshold, two-tone line drawings by \"canny\", others by \"surround\"; \"canny\": Canny alone; \"surround\": Canny, edges that do not stand out from the texture around them dropped; \"bilateral\": Canny after a bilateral filter; \"edpf\": Edge Drawing (parameter-free); \"outline\": always traced from a threshold.",
+             "\"auto\": two-tone pictures (silhouettes, logos) traced from a threshold, two-tone line drawings by "
+             "\"canny\", others by \"surround\"; \"canny\": Canny alone; \"surround\": Canny, edges that do not stand "
+             "out from the texture around them dropped; \"bilateral\": Canny after a bilateral filter; \"edpf\": Edge "
+             "Drawing (parameter-free); \"outline\": always traced from a threshold.",
              kDetectors),
     HK_FIELD(vision, ocr, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
-             "\"auto\": text is read aloud (Tesseract) from pictures that look like a page of text and PDF pages without a text layer; \"always\": from every picture; \"off\": never. The picture is felt at once; its text (about 10 s a page) comes when it is read.",
+             "\"auto\": text is read aloud (Tesseract) from pictures that look like a page of text and PDF pages "
+             "without a text layer; \"always\": from every picture; \"off\": never. The picture is felt at once; its "
+             "text (about 10 s a page) comes when it is read.",
              kOcrModes),
     HK_FIELD(vision, ocr_languages, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
-             "Tesseract languages joined by '+' (\"eng\", \"eng+deu\"); empty: the message catalogue's language. A missing one turns OCR off at start, said in the log.",
+             "Tesseract languages joined by '+' (\"eng\", \"eng+deu\"); empty: the message catalogue's language. A "
+             "missing one turns OCR off at start, said in the log.",
              {}, &ocr_languages_problem),
-    HK_FIELD(vision, ocr_min_confidence, FieldGroup::scene, ApplyWhen::scene, 0, 1, "", "Words Tesseract is less sure of than this are said as \"unclear word\", never read as if certain."),
+    HK_FIELD(vision, ocr_min_confidence, FieldGroup::scene, ApplyWhen::scene, 0, 1, "",
+             "Words Tesseract is less sure of than this are said as \"unclear word\", never read as if certain."),
     // [workspace]
     HK_FIELD(workspace, width_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Width of the usable rectangle."),
-    HK_FIELD(workspace, height_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Height of the usable rectangle."),
+    HK_FIELD(workspace, height_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m",
+             "Height of the usable rectangle."),
     // [audio]
-    HK_FIELD(audio, volume_default_step, FieldGroup::audio, ApplyWhen::session, 1, 10, "", "Volume step at the start of every session (10 = loudest)."),
-    HK_FIELD(audio, volume_step_db, FieldGroup::audio, ApplyWhen::restart, 1, 6, "dB", "Loudness change per volume step."),
-    HK_FIELD(audio, earcon_gain, FieldGroup::audio, ApplyWhen::restart, 0, 1, "", "Level of the earcons before the volume."),
-    HK_FIELD(audio, duck_db, FieldGroup::audio, ApplyWhen::restart, -40, 0, "dB", "Earcons are this much quieter while speech plays."),
+    HK_FIELD(audio, volume_default_step, FieldGroup::audio, ApplyWhen::session, 1, 10, "",
+             "Volume step at the start of every session (10 = loudest)."),
+    HK_FIELD(audio, volume_step_db, FieldGroup::audio, ApplyWhen::restart, 1, 6, "dB",
+             "Loudness change per volume step."),
+    HK_FIELD(audio, earcon_gain, FieldGroup::audio, ApplyWhen::restart, 0, 1, "",
+             "Level of the earcons before the volume."),
+    HK_FIELD(audio, duck_db, FieldGroup::audio, ApplyWhen::restart, -40, 0, "dB",
+             "Earcons are this much quieter while speech plays."),
     HK_FIELD(audio, speech_rate_wpm, FieldGroup::audio, ApplyWhen::restart, 80, 450, "words/min", "Speaking rate."),
-    HK_FIELD(audio, buffer_frames, FieldGroup::audio, ApplyWhen::restart, 32, 4096, "frames", "Audio output buffer at 48 kHz (256 = 5.3 ms)."),
+    HK_FIELD(audio, buffer_frames, FieldGroup::audio, ApplyWhen::restart, 32, 4096, "frames",
+             "Audio output buffer at 48 kHz (256 = 5.3 ms)."),
     // [kiosk]
-    HK_FIELD(kiosk, timeout_s, FieldGroup::kiosk, ApplyWhen::live, 20, 3600, "s", "No key, no handle motion, no contact and no speech for this long ends the session."),
-    HK_FIELD(kiosk, warning_s, FieldGroup::kiosk, ApplyWhen::live, 10, 600, "s", "The spoken warning comes this long before the end (at most half the timeout)."),
-    HK_FIELD(kiosk, attract_every_s, FieldGroup::kiosk, ApplyWhen::live, 0, 3600, "s", "While nobody is there, a short spoken invitation comes this often (0: never)."),
+    HK_FIELD(kiosk, timeout_s, FieldGroup::kiosk, ApplyWhen::live, 20, 3600, "s",
+             "No key, no handle motion, no contact and no speech for this long ends the session."),
+    HK_FIELD(kiosk, warning_s, FieldGroup::kiosk, ApplyWhen::live, 10, 600, "s",
+             "The spoken warning comes this long before the end (at most half the timeout)."),
+    HK_FIELD(kiosk, attract_every_s, FieldGroup::kiosk, ApplyWhen::live, 0, 3600, "s",
+             "While nobody is there, a short spoken invitation comes this often (0: never)."),
     HK_FIELD(kiosk, quiet_hours, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
-             "Local times with no spoken invitation, \"HH:MM-HH:MM\" (e.g. \"22:00-07:00\"); empty: none.", {}, &quiet_hours_problem),
+             "Local times with no spoken invitation, \"HH:MM-HH:MM\" (e.g. \"22:00-07:00\"); empty: none.", {},
+             &quiet_hours_problem),
     HK_FIELD(kiosk, prefetch_mb, FieldGroup::kiosk, ApplyWhen::live, 0, 4096, "MiB",
-             "Memory for the next and previous pictures (of the library, and the pages of a USB stick), built while the visitor explores this one, so Next is at once (0: none built ahead)."),
-    HK_FIELD(kiosk, scene_cache, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
-             "Where built scenes of the library's pictures are kept, so the first picture after a restart is felt at once: \"auto\" (the service's cache folder, else ~/.cache/haptic-kiosk/scenes), \"off\", or an absolute folder.",
-             {}, &scene_cache_problem),
+             "Memory for the next and previous pictures (of the library, and the pages of a USB stick), built while "
+             "the visitor explores this one, so Next is at once (0: none built ahead)."),
+    HK_FIELD(
+        kiosk, scene_cache, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+        "Where built scenes of the library's pictures are kept, so the first picture after a restart is felt at once: "
+        "\"auto\" (the service's cache folder, else ~/.cache/haptic-kiosk/scenes), \"off\", or an absolute folder.",
+        {}, &scene_cache_problem),
     // [stick]
-    HK_FIELD(stick, max_depth, FieldGroup::devices, ApplyWhen::restart, 1, 64, "", "Deepest folder of a stick that is entered (its root is 0)."),
-    HK_FIELD(stick, max_entries, FieldGroup::devices, ApplyWhen::restart, 10, 1000000, "", "Directory entries looked at per scan of a stick."),
-    HK_FIELD(stick, max_documents, FieldGroup::devices, ApplyWhen::restart, 1, 100000, "", "Documents offered per stick."),
-    HK_FIELD(stick, max_file_bytes, FieldGroup::devices, ApplyWhen::restart, 1024, kTwoPow31, "bytes", "Largest document read from a stick."),
-    HK_FIELD(stick, scan_timeout_s, FieldGroup::devices, ApplyWhen::restart, 0.1, 60, "s", "Wall-clock limit of one scan of a stick."),
-    HK_FIELD(stick, max_pdf_pages, FieldGroup::devices, ApplyWhen::restart, 1, 100000, "", "Pages offered per PDF (the first ones)."),
-    HK_FIELD(stick, page_max_pixels, FieldGroup::devices, ApplyWhen::restart, 1e5, 4e7, "px", "A PDF page is drawn at the DPI that keeps it within this many pixels."),
-    HK_FIELD(stick, page_max_dpi, FieldGroup::devices, ApplyWhen::restart, 10, 1200, "dpi", "A PDF page is never drawn finer than this."),
-    HK_FIELD(stick, page_timeout_s, FieldGroup::devices, ApplyWhen::restart, 0.5, 120, "s", "The worker drawing a PDF page is stopped after this (wall clock and CPU)."),
+    HK_FIELD(stick, max_depth, FieldGroup::devices, ApplyWhen::restart, 1, 64, "",
+             "Deepest folder of a stick that is entered (its root is 0)."),
+    HK_FIELD(stick, max_entries, FieldGroup::devices, ApplyWhen::restart, 10, 1000000, "",
+             "Directory entries looked at per scan of a stick."),
+    HK_FIELD(stick, max_documents, FieldGroup::devices, ApplyWhen::restart, 1, 100000, "",
+             "Documents offered per stick."),
+    HK_FIELD(stick, max_file_bytes, FieldGroup::devices, ApplyWhen::restart, 1024, kTwoPow31, "bytes",
+             "Largest document read from a stick."),
+    HK_FIELD(stick, scan_timeout_s, FieldGroup::devices, ApplyWhen::restart, 0.1, 60, "s",
+             "Wall-clock limit of one scan of a stick."),
+    HK_FIELD(stick, max_pdf_pages, FieldGroup::devices, ApplyWhen::restart, 1, 100000, "",
+             "Pages offered per PDF (the first ones)."),
+    HK_FIELD(stick, page_max_pixels, FieldGroup::devices, ApplyWhen::restart, 1e5, 4e7, "px",
+             "A PDF page is drawn at the DPI that keeps it within this many pixels."),
+    HK_FIELD(stick, page_max_dpi, FieldGroup::devices, ApplyWhen::restart, 10, 1200, "dpi",
+             "A PDF page is never drawn finer than this."),
+    HK_FIELD(stick, page_timeout_s, FieldGroup::devices, ApplyWhen::restart, 0.5, 120, "s",
+             "The worker drawing a PDF page is stopped after this (wall clock and CPU)."),
     // [camera]
     HK_FIELD(camera, source, FieldGroup::devices, ApplyWhen::restart, 0, 0, "",
-             "\"auto\": the first camera found (libcamera, then V4L2); \"none\": no capture; or \"file:PATH\", \"libcamera:N\", \"v4l2:DEV\".", {}, &camera_source_problem),
-    HK_FIELD(camera, width_px, FieldGroup::devices, ApplyWhen::restart, 64, 8192, "px", "Frame width asked of the camera."),
-    HK_FIELD(camera, height_px, FieldGroup::devices, ApplyWhen::restart, 64, 8192, "px", "Frame height asked of the camera."),
-    HK_FIELD(camera, still_s, FieldGroup::devices, ApplyWhen::live, 0.2, 10, "s", "A picture is captured once it has been whole, centred and still this long."),
-    HK_FIELD(camera, timeout_s, FieldGroup::devices, ApplyWhen::live, 5, 600, "s", "A capture that has not happened after this long is given up."),
+             "\"auto\": the first camera found (libcamera, then V4L2); \"none\": no capture; or \"file:PATH\", "
+             "\"libcamera:N\", \"v4l2:DEV\".",
+             {}, &camera_source_problem),
+    HK_FIELD(camera, width_px, FieldGroup::devices, ApplyWhen::restart, 64, 8192, "px",
+             "Frame width asked of the camera."),
+    HK_FIELD(camera, height_px, FieldGroup::devices, ApplyWhen::restart, 64, 8192, "px",
+             "Frame height asked of the camera."),
+    HK_FIELD(camera, still_s, FieldGroup::devices, ApplyWhen::live, 0.2, 10, "s",
+             "A picture is captured once it has been whole, centred and still this long."),
+    HK_FIELD(camera, timeout_s, FieldGroup::devices, ApplyWhen::live, 5, 600, "s",
+             "A capture that has not happened after this long is given up."),
     // [keys]
     HK_FIELD(keys, help, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Help.", kKeyNames),
     HK_FIELD(keys, next, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Next picture (next tutorial shape).", kKeyNames),
@@ -317,27 +446,41 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(keys, volume_up, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Louder.", kKeyNames),
     HK_FIELD(keys, volume_down, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Quieter.", kKeyNames),
     HK_FIELD(keys, tutorial, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Start the tutorial again.", kKeyNames),
-    HK_FIELD(keys, guide, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Guided tour: lead the handle to the next shape not yet touched and round it.", kKeyNames),
-    HK_FIELD(keys, capture, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Capture a picture with the camera, guided by voice (any key cancels).", kKeyNames),
-    HK_FIELD(keys, repeat, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Say the last message again, from its start.", kKeyNames),
-    HK_FIELD(keys, pause, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Pause the speech; pressed again, it goes on.", kKeyNames),
-    HK_FIELD(keys, where, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "What is here: the shape under or nearest the hand, and where the hand is.", kKeyNames),
-    HK_FIELD(keys, finish, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Finish: end the visit, for the next visitor (pressed twice).", kKeyNames),
-    HK_FIELD(keys, next_sentence, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Reading a text: on from the next sentence.", kKeyNames),
-    HK_FIELD(keys, previous_sentence, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Reading a text: back to the sentence before.", kKeyNames),
-    HK_FIELD(keys, next_paragraph, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Reading a text: on from the next paragraph (block of text).", kKeyNames),
-    HK_FIELD(keys, previous_paragraph, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Reading a text: back to the paragraph before.", kKeyNames),
+    HK_FIELD(keys, guide, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "Guided tour: lead the handle to the next shape not yet touched and round it.", kKeyNames),
+    HK_FIELD(keys, capture, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "Capture a picture with the camera, guided by voice (any key cancels).", kKeyNames),
+    HK_FIELD(keys, repeat, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Say the last message again, from its start.",
+             kKeyNames),
+    HK_FIELD(keys, pause, FieldGroup::keys, ApplyWhen::live, 0, 0, "", "Pause the speech; pressed again, it goes on.",
+             kKeyNames),
+    HK_FIELD(keys, where, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "What is here: the shape under or nearest the hand, and where the hand is.", kKeyNames),
+    HK_FIELD(keys, finish, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "Finish: end the visit, for the next visitor (pressed twice).", kKeyNames),
+    HK_FIELD(keys, next_sentence, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "Reading a text: on from the next sentence.", kKeyNames),
+    HK_FIELD(keys, previous_sentence, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "Reading a text: back to the sentence before.", kKeyNames),
+    HK_FIELD(keys, next_paragraph, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "Reading a text: on from the next paragraph (block of text).", kKeyNames),
+    HK_FIELD(keys, previous_paragraph, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "Reading a text: back to the paragraph before.", kKeyNames),
     // [operator]
     HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
                 "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),
     HK_FIELD_IN(operator_, "operator", idle_close_s, FieldGroup::kiosk, ApplyWhen::live, 10, 3600, "s",
                 "The operator's panel closes itself after this long without input."),
     HK_FIELD_IN(operator_, "operator", pin_hash, FieldGroup::hidden, ApplyWhen::live, 0, 0, "",
-                "Hash of the operator's PIN (argon2id); written by 'haptic-kiosk pin set', never by hand.", {}, &pin_hash_problem),
-    HK_FIELD_IN(operator_, "operator", state_file, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
-                "Failed PIN attempts and the time of the last (the lockout); empty = beside the settings file (.state).", {}, &path_problem),
+                "Hash of the operator's PIN (argon2id); written by 'haptic-kiosk pin set', never by hand.", {},
+                &pin_hash_problem),
+    HK_FIELD_IN(
+        operator_, "operator", state_file, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+        "Failed PIN attempts and the time of the last (the lockout); empty = beside the settings file (.state).", {},
+        &path_problem),
     HK_FIELD_IN(operator_, "operator", audit_log, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
-                "One line per change made in the panel; empty = beside the settings file (.audit.log).", {}, &path_problem),
+                "One line per change made in the panel; empty = beside the settings file (.audit.log).", {},
+                &path_problem),
 });
 
 #undef HK_FIELD
@@ -364,14 +507,22 @@ std::string field_allowed_text(const FieldDescriptor& d) { return detail::allowe
 
 std::string_view group_name(FieldGroup g) noexcept {
   switch (g) {
-    case FieldGroup::haptics: return "Haptics";
-    case FieldGroup::levels: return "Levels";
-    case FieldGroup::scene: return "Scene";
-    case FieldGroup::audio: return "Audio";
-    case FieldGroup::kiosk: return "Kiosk";
-    case FieldGroup::keys: return "Keys";
-    case FieldGroup::devices: return "Devices";
-    case FieldGroup::hidden: return "";
+    case FieldGroup::haptics:
+      return "Haptics";
+    case FieldGroup::levels:
+      return "Levels";
+    case FieldGroup::scene:
+      return "Scene";
+    case FieldGroup::audio:
+      return "Audio";
+    case FieldGroup::kiosk:
+      return "Kiosk";
+    case FieldGroup::keys:
+      return "Keys";
+    case FieldGroup::devices:
+      return "Devices";
+    case FieldGroup::hidden:
+      return "";
   }
   return "";
 }
@@ -388,22 +539,30 @@ std::optional<KeyChord> parse_chord(std::string_view text, std::string* why) {
   std::size_t start = 0;
   for (;;) {
     const std::size_t plus = text.find('+', start);
-    const std::string_view part = text.substr(start, plus == std::string_view::npos ? std::string_view::npos : plus - start);
+    const std::string_view part =
+        text.substr(start, plus == std::string_view::npos ? std::string_view::npos : plus - start);
     if (part.empty()) return refuse("has an empty part between '+' signs");
     if (plus == std::string_view::npos) {  // the key
       bool known = part == "O" || part == "C" || part == "ESCAPE";
       for (auto k : kKeyNames) known = known || k == part;
-      if (!known) return refuse("ends in '" + detail::one_line(part, 40) + "', which is not a key name (e.g. O, F12, HOME)");
+      if (!known)
+        return refuse("ends in '" + detail::one_line(part, 40) + "', which is not a key name (e.g. O, F12, HOME)");
       c.key = std::string(part);
       break;
     }
-    bool* flag = part == "CTRL" ? &c.ctrl : part == "ALT" ? &c.alt : part == "SHIFT" ? &c.shift : part == "SUPER" ? &c.super : nullptr;
-    if (!flag) return refuse("has '" + detail::one_line(part, 40) + "' where a modifier (CTRL, ALT, SHIFT, SUPER) belongs");
+    bool* flag = part == "CTRL"    ? &c.ctrl
+                 : part == "ALT"   ? &c.alt
+                 : part == "SHIFT" ? &c.shift
+                 : part == "SUPER" ? &c.super
+                                   : nullptr;
+    if (!flag)
+      return refuse("has '" + detail::one_line(part, 40) + "' where a modifier (CTRL, ALT, SHIFT, SUPER) belongs");
     if (*flag) return refuse("names " + std::string(part) + " twice");
     *flag = true;
     start = plus + 1;
   }
-  if (!c.ctrl && !c.alt && !c.super) return refuse("needs CTRL, ALT or SUPER, so no visitor opens the PIN prompt with one key");
+  if (!c.ctrl && !c.alt && !c.super)
+    return refuse("needs CTRL, ALT or SUPER, so no visitor opens the PIN prompt with one key");
   return c;
 }
 
@@ -452,11 +611,21 @@ std::string toml_string(std::string_view s) {
   for (char c : s) {
     const auto u = static_cast<unsigned char>(c);
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (u < 0x20 || u == 0x7f) {
           static constexpr char kHex[] = "0123456789ABCDEF";
@@ -580,8 +749,7 @@ void validate_as(const Settings& s, const Source& src) {
           if constexpr (std::is_same_v<T, double>) {
             if (auto why = real_problem(d, *p)) fail(src, key, key + " = " + format_real(*p) + " " + *why);
           } else if constexpr (std::is_same_v<T, std::string>) {
-            if (auto why = text_problem(d, *p))
-              fail(src, key, key + " = \"" + one_line(*p, 80) + "\" " + *why);
+            if (auto why = text_problem(d, *p)) fail(src, key, key + " = \"" + one_line(*p, 80) + "\" " + *why);
           } else {
             if (auto why = integer_problem(d, static_cast<long long>(*p)))
               fail(src, key, key + " = " + std::to_string(*p) + " " + *why);
@@ -594,12 +762,10 @@ void validate_as(const Settings& s, const Source& src) {
     fail(src, "haptics.level",
          "haptics.level = " + std::to_string(s.haptics.level) + " must be <= haptics.max_levels = " +
              std::to_string(s.haptics.max_levels) + " (only levels 0..max_levels are built)");
-  if (s.vision.canny_low != 0.0 && s.vision.canny_high != 0.0 &&
-      s.vision.canny_low > s.vision.canny_high)
+  if (s.vision.canny_low != 0.0 && s.vision.canny_high != 0.0 && s.vision.canny_low > s.vision.canny_high)
     fail(src, "vision.canny_low",
          "vision.canny_low = " + format_real(s.vision.canny_low) +
-             " must be <= vision.canny_high = " + format_real(s.vision.canny_high) +
-             " when both are nonzero");
+             " must be <= vision.canny_high = " + format_real(s.vision.canny_high) + " when both are nonzero");
   if (s.haptics.dynamic_friction > s.haptics.static_friction)
     fail(src, "haptics.dynamic_friction",
          "haptics.dynamic_friction = " + format_real(s.haptics.dynamic_friction) +
@@ -613,9 +779,8 @@ void validate_as(const Settings& s, const Source& src) {
   }
   if (s.haptics.pop_force_n > 0.0 && s.haptics.tour_max_force_n >= s.haptics.pop_force_n)
     fail(src, "haptics.tour_max_force_n",
-         "haptics.tour_max_force_n = " + format_real(s.haptics.tour_max_force_n) +
-             " must be < haptics.pop_force_n = " + format_real(s.haptics.pop_force_n) +
-             " (the guided tour must not push the hand through a wall)");
+         "haptics.tour_max_force_n = " + format_real(s.haptics.tour_max_force_n) + " must be < haptics.pop_force_n = " +
+             format_real(s.haptics.pop_force_n) + " (the guided tour must not push the hand through a wall)");
   // The USB pantograph's board: two actuators on two ports, two encoders on two ports (hAPI masks one bit
   // per port), and links that can close the five-bar (2·L must span the motor spacing).
   if (s.device.actuator1_port == s.device.actuator2_port)
@@ -656,7 +821,10 @@ std::vector<UsbId> parse_usb_ids(std::string_view text, std::string* why) {
     if (h.size() != 4) return false;
     unsigned v = 0;
     for (char c : h) {
-      const int d = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+      const int d = c >= '0' && c <= '9'   ? c - '0'
+                    : c >= 'a' && c <= 'f' ? c - 'a' + 10
+                    : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                           : -1;
       if (d < 0) return false;
       v = v * 16 + static_cast<unsigned>(d);
     }
@@ -674,7 +842,8 @@ std::vector<UsbId> parse_usb_ids(std::string_view text, std::string* why) {
     while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
     UsbId id;
     if (item.size() != 9 || item[4] != ':' || !hex4(item.substr(0, 4), &id.vid) || !hex4(item.substr(5, 4), &id.pid))
-      return fail("must be USB ids \"VVVV:PPPP\" (four hex digits each), comma-separated, e.g. \"2341:804d,2341:003e\"");
+      return fail(
+          "must be USB ids \"VVVV:PPPP\" (four hex digits each), comma-separated, e.g. \"2341:804d,2341:003e\"");
     ids.push_back(id);
     if (ids.size() > kMaxIds) return fail("holds more than 16 USB ids");
     at = comma + 1;

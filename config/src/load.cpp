@@ -32,16 +32,26 @@ std::size_t line_of(const toml::source_region& r) { return static_cast<std::size
 
 const char* type_name(toml::node_type t) {
   switch (t) {
-    case toml::node_type::string: return "string";
-    case toml::node_type::integer: return "integer";
-    case toml::node_type::floating_point: return "float";
-    case toml::node_type::boolean: return "boolean";
-    case toml::node_type::table: return "table";
-    case toml::node_type::array: return "array";
-    case toml::node_type::date: return "date";
-    case toml::node_type::time: return "time";
-    case toml::node_type::date_time: return "date-time";
-    default: return "none";
+    case toml::node_type::string:
+      return "string";
+    case toml::node_type::integer:
+      return "integer";
+    case toml::node_type::floating_point:
+      return "float";
+    case toml::node_type::boolean:
+      return "boolean";
+    case toml::node_type::table:
+      return "table";
+    case toml::node_type::array:
+      return "array";
+    case toml::node_type::date:
+      return "date";
+    case toml::node_type::time:
+      return "time";
+    case toml::node_type::date_time:
+      return "date-time";
+    default:
+      return "none";
   }
 }
 
@@ -100,8 +110,7 @@ std::vector<std::string_view> table_names() {
   return v;
 }
 
-[[noreturn]] void unknown_table(const Source& src, std::string_view name, const toml::node& node,
-                                std::size_t line) {
+[[noreturn]] void unknown_table(const Source& src, std::string_view name, const toml::node& node, std::size_t line) {
   const std::string shown = one_line(name, 60);
   if (!node.is_table() && !node.is_array_of_tables()) {
     // A bare key outside any table.
@@ -111,7 +120,9 @@ std::vector<std::string_view> table_names() {
         body += " (did you mean " + detail::qualified(d) + ", i.e. under [" + std::string(d.table) + "]?)";
         fail(src, std::string(name), body, line);
       }
-    body += "; keys belong under a table: [haptics], [device], [hand], [vision], [workspace], [audio], [kiosk], [stick], [camera], [keys] or [operator]";
+    body +=
+        "; keys belong under a table: [haptics], [device], [hand], [vision], [workspace], [audio], [kiosk], [stick], "
+        "[camera], [keys] or [operator]";
     fail(src, shown, body, line);  // a quoted key may hold any character: key() is escaped as the message is
   }
   std::string body = "unknown table [" + shown + "]";
@@ -119,8 +130,7 @@ std::vector<std::string_view> table_names() {
   fail(src, "[" + shown + "]", body, line);
 }
 
-[[noreturn]] void unknown_key(const Source& src, std::string_view table, std::string_view key,
-                              std::size_t line) {
+[[noreturn]] void unknown_key(const Source& src, std::string_view table, std::string_view key, std::size_t line) {
   const std::string shown = std::string(table) + "." + one_line(key, 60);
   std::string body = "unknown key " + shown;
   std::vector<std::string_view> same_table;
@@ -142,8 +152,8 @@ std::vector<std::string_view> table_names() {
                              const char* expected) {
   const std::string key = detail::qualified(d);
   fail(src, key,
-       key + " = " + value_text(node) + " has the wrong type (" + type_name(node.type()) + "); expected " +
-           expected + " " + detail::allowed_text(d),
+       key + " = " + value_text(node) + " has the wrong type (" + type_name(node.type()) + "); expected " + expected +
+           " " + detail::allowed_text(d),
        line_of(node.source()));
 }
 
@@ -197,8 +207,8 @@ Settings parse_from(std::string_view text, const Source& src) {
   } catch (const toml::parse_error& e) {
     const auto& b = e.source().begin;
     fail(src, "",
-         "TOML syntax error at line " + std::to_string(b.line) + ", column " + std::to_string(b.column) +
-             ": " + one_line(e.description(), 160));
+         "TOML syntax error at line " + std::to_string(b.line) + ", column " + std::to_string(b.column) + ": " +
+             one_line(e.description(), 160));
   }
 
   // A [device] type that names a USB board brings its profile: the defaults every key not in the file takes.

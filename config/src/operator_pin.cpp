@@ -57,7 +57,6 @@ bool to_hash_buffer(std::string_view hash, std::array<char, crypto_pwhash_STRBYT
   throw ConfigError(path, "", msg);
 }
 
-
 /// An exclusive flock on "<state file>.lock", held for the object's life. The lock file is created
 /// (mode 0600) and never removed: removing it would let two processes lock two different files.
 class StateLock {
@@ -66,7 +65,8 @@ class StateLock {
     const std::string lock_path = state_path + ".lock";
     fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
     if (fd_ < 0)
-      state_fail(state_path, "cannot open the lock file '" + one_line(lock_path) + "': " + one_line(std::strerror(errno)));
+      state_fail(state_path,
+                 "cannot open the lock file '" + one_line(lock_path) + "': " + one_line(std::strerror(errno)));
     while (::flock(fd_, LOCK_EX) != 0) {
       if (errno == EINTR) continue;
       const int err = errno;
@@ -184,7 +184,7 @@ LockoutState read_lockout_state(const std::string& path, std::int64_t now_unix_s
     return fail_safe(path, now_unix_s, "cannot be read (" + one_line(std::strerror(errno)) + ")", note);
   }
   std::string text;
-  struct stat st{};
+  struct stat st {};
   bool too_big = false, not_file = false;
   int read_err = 0;
   if (::fstat(fd, &st) != 0) {
@@ -209,7 +209,8 @@ LockoutState read_lockout_state(const std::string& path, std::int64_t now_unix_s
     }
   }
   ::close(fd);
-  if (read_err != 0) return fail_safe(path, now_unix_s, "cannot be read (" + one_line(std::strerror(read_err)) + ")", note);
+  if (read_err != 0)
+    return fail_safe(path, now_unix_s, "cannot be read (" + one_line(std::strerror(read_err)) + ")", note);
   if (not_file) return fail_safe(path, now_unix_s, "is not a regular file", note);
   if (too_big)
     return fail_safe(path, now_unix_s, "is larger than " + std::to_string(kMaxStateFileBytes) + " bytes", note);
@@ -235,8 +236,7 @@ LockoutState read_lockout_state(const std::string& path, std::int64_t now_unix_s
       return fail_safe(path, now_unix_s, "holds '" + one_line(key.str(), 40) + "', which it should not", note);
     }
   }
-  if (!have_failures || !have_time)
-    return fail_safe(path, now_unix_s, "lacks failures or last_failure_unix_s", note);
+  if (!have_failures || !have_time) return fail_safe(path, now_unix_s, "lacks failures or last_failure_unix_s", note);
   return s;
 }
 
@@ -341,8 +341,8 @@ void set_pin(const std::string& settings_path, std::string_view pin) {
     write_lockout_state(state_path, LockoutState{});
   } catch (const ConfigError& e) {
     throw ConfigError(settings_path, "",
-                      "config '" + one_line(settings_path) + "': the PIN was set, but the failed attempts could not be reset: " +
-                          e.what());
+                      "config '" + one_line(settings_path) +
+                          "': the PIN was set, but the failed attempts could not be reset: " + e.what());
   }
 }
 

@@ -30,7 +30,6 @@ using detail::Source;
   fail(src, "", "not saved: " + what + ": " + one_line(std::strerror(err)) + " (nothing was changed)");
 }
 
-
 /// Creates `<prefix>XXXXXX` (a new, unique name) holding `text` with `mode`, fsync'ed and closed, and
 /// returns its path. On failure removes it and throws ConfigError ("not saved: ...").
 std::string write_temp(const Source& src, const std::string& prefix, const std::string& text, mode_t mode) {
@@ -69,7 +68,7 @@ std::string write_temp(const Source& src, const std::string& prefix, const std::
 int read_whole(const std::string& path, std::string& text, mode_t& mode) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return errno;
-  struct stat st{};
+  struct stat st {};
   if (::fstat(fd, &st) != 0) {
     const int err = errno;
     ::close(fd);
@@ -103,7 +102,7 @@ struct TargetMode {
 /// TargetMode of the file at `path` for `settings`.
 TargetMode target_mode(const std::string& path, const Settings& settings) {
   TargetMode t;
-  struct stat st{};
+  struct stat st {};
   t.replaces_a_file = ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
   if (t.replaces_a_file) t.mode = st.st_mode & 07777;
   if (!settings.operator_.pin_hash.empty()) t.mode = 0600;

@@ -56,7 +56,6 @@ std::string iso_utc(std::int64_t unix_s) { return format_utc(unix_s, "%Y-%m-%dT%
 /// "20261122T030405Z" (for file names).
 std::string compact_utc(std::int64_t unix_s) { return format_utc(unix_s, "%Y%m%dT%H%M%SZ"); }
 
-
 /// True when field `d` holds the same value in `a` and `b` (exact for doubles, as Settings::operator==).
 bool same_value(const FieldDescriptor& d, const Settings& a, const Settings& b) {
   const ConstFieldRef rb = d.cref(b);
@@ -70,7 +69,7 @@ bool same_value(const FieldDescriptor& d, const Settings& a, const Settings& b) 
 
 /// True when `path` is a regular file this process can open for reading.
 bool openable_regular_file(const std::string& path) {
-  struct stat st{};
+  struct stat st {};
   if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) return false;
@@ -96,7 +95,7 @@ int rename_no_replace(const std::string& from, const std::string& to) {
   const int err = errno;
   if (err != EINVAL && err != ENOSYS) return err;
   // A file system without RENAME_NOREPLACE: check, then rename (a window only a concurrent writer hits).
-  struct stat st{};
+  struct stat st {};
   if (::lstat(to.c_str(), &st) == 0) return EEXIST;
   return ::rename(from.c_str(), to.c_str()) == 0 ? 0 : errno;
 }
@@ -118,8 +117,9 @@ std::optional<std::string> keep_aside(const std::string& path, std::int64_t now_
 }
 
 [[noreturn]] void audit_fail(const std::string& log_path, const std::string& what, int err) {
-  throw ConfigError(log_path, "",
-                    "audit log '" + one_line(log_path) + "': not written: " + what + ": " + one_line(std::strerror(err)));
+  throw ConfigError(
+      log_path, "",
+      "audit log '" + one_line(log_path) + "': not written: " + what + ": " + one_line(std::strerror(err)));
 }
 
 /// Appends `lines` to the log with one O_APPEND write where possible, then fsync.
@@ -217,7 +217,8 @@ void assign_from_text(Settings& edited, const FieldDescriptor& d, std::string_vi
         const bool word = t.find_first_of("iInN") != std::string_view::npos;
         shown = std::isfinite(*v) || word ? detail::format_real(*v) : one_line(t, 80);
       }
-      if (!v) fail(src, key, key + " = " + quoted(t) + " is not a number; expected a number in " + detail::allowed_text(d));
+      if (!v)
+        fail(src, key, key + " = " + quoted(t) + " is not a number; expected a number in " + detail::allowed_text(d));
       if (auto why = detail::real_problem(d, *v)) fail(src, key, key + " = " + shown + " " + *why);
       *std::get<double*>(d.ref(edited)) = *v;
       return;
@@ -282,7 +283,7 @@ LoadedSettings load_settings_with_fallback(const std::string& path, std::int64_t
   }
 
   const std::string bak = path + ".bak";
-  struct stat st{};
+  struct stat st {};
   if (::stat(bak.c_str(), &st) != 0) {
     r.settings = Settings{};
     r.from = LoadedSettings::From::defaults;

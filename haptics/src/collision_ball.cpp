@@ -8,8 +8,9 @@ namespace hk {
 // them, excluded ones left out, the same answer a full query gives (every wall within the ball is among them;
 // ties as test_segment). False, with nothing written, for a sweep they cannot answer. Charges no box test. The
 // first sweep inside the ball copies the walls (copy_ball_walls).
-bool BoundarySection::Ops::answer_from_ball_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                                                  SweepHit* out, QueryStats* stats) noexcept {
+bool BoundarySection::Ops::answer_from_ball_walls(BoundarySection& self, Vec2 a, Vec2 b, int level,
+                                                  const SegmentRef* excluded, int excluded_count, SweepHit* out,
+                                                  QueryStats* stats) noexcept {
   BallWalls& w = self.ball_walls_;
   if (level != w.level) return false;
   const double r_sq = w.radius_sq;
@@ -22,13 +23,18 @@ bool BoundarySection::Ops::answer_from_ball_walls(BoundarySection& self, Vec2 a,
   unsigned meets = 0;
   for (int k = 0; k < w.count; k += 2) {
 #if defined(__SSE2__)
-    const __m128d lx = _mm_load_pd(w.lo_x + k), ly = _mm_load_pd(w.lo_y + k), hx = _mm_load_pd(w.hi_x + k), hy = _mm_load_pd(w.hi_y + k);
-    const __m128d m = _mm_and_pd(_mm_and_pd(_mm_cmple_pd(lx, _mm_set1_pd(sweep.hi.x)), _mm_cmple_pd(_mm_set1_pd(sweep.lo.x), hx)),
-                                 _mm_and_pd(_mm_cmple_pd(ly, _mm_set1_pd(sweep.hi.y)), _mm_cmple_pd(_mm_set1_pd(sweep.lo.y), hy)));
+    const __m128d lx = _mm_load_pd(w.lo_x + k), ly = _mm_load_pd(w.lo_y + k), hx = _mm_load_pd(w.hi_x + k),
+                  hy = _mm_load_pd(w.hi_y + k);
+    const __m128d m =
+        _mm_and_pd(_mm_and_pd(_mm_cmple_pd(lx, _mm_set1_pd(sweep.hi.x)), _mm_cmple_pd(_mm_set1_pd(sweep.lo.x), hx)),
+                   _mm_and_pd(_mm_cmple_pd(ly, _mm_set1_pd(sweep.hi.y)), _mm_cmple_pd(_mm_set1_pd(sweep.lo.y), hy)));
     meets |= static_cast<unsigned>(_mm_movemask_pd(m)) << k;
 #else
     for (int i = k; i < k + 2; ++i) {
-      meets |= (w.lo_x[i] <= sweep.hi.x && sweep.lo.x <= w.hi_x[i] && w.lo_y[i] <= sweep.hi.y && sweep.lo.y <= w.hi_y[i] ? 1u : 0u) << i;
+      meets |= (w.lo_x[i] <= sweep.hi.x && sweep.lo.x <= w.hi_x[i] && w.lo_y[i] <= sweep.hi.y && sweep.lo.y <= w.hi_y[i]
+                    ? 1u
+                    : 0u)
+               << i;
     }
 #endif
   }
@@ -73,9 +79,9 @@ bool BoundarySection::Ops::answer_from_ball_walls(BoundarySection& self, Vec2 a,
 // only walls of the level); the ball's radius is the distance to the nearest entry left out (its box's distance,
 // and no more than the next one's rectangle's, which bounds every farther box from below). Every wall of the
 // level within that radius is then among those noted, so a later sweep inside the ball is answered exactly by
-// them alone (answer_from_ball_walls): near a wall, or sliding along one in contact, where the plain ball is as small as the gap to it. Kept only
-// when it reaches farther than the plain ball. Runs before the splits and merges, which change the entries in
-// place: it reads them as phase 1 scanned them.
+// them alone (answer_from_ball_walls): near a wall, or sliding along one in contact, where the plain ball is as small
+// as the gap to it. Kept only when it reaches farther than the plain ball. Runs before the splits and merges, which
+// change the entries in place: it reads them as phase 1 scanned them.
 void BoundarySection::Ops::gather_ball_walls(BoundarySection& self, const Query& q) noexcept {
   BallWalls& w = self.ball_walls_;
   w.radius_sq = 0.0;
@@ -84,7 +90,8 @@ void BoundarySection::Ops::gather_ball_walls(BoundarySection& self, const Query&
   w.copied = false;
   const std::size_t n = q.scanned;
   std::uint32_t unused = 0;
-  if (q.nearest_rect >= n || segments_under(self, self.section_[q.nearest_rect], q.level, &unused) == 0) return;  // no walls to copy
+  if (q.nearest_rect >= n || segments_under(self, self.section_[q.nearest_rect], q.level, &unused) == 0)
+    return;  // no walls to copy
   // Note the walls of the nearest entries, in order of their rectangles' distance (each taken out of rect_d_sq_ as it
   // is reached, so the next is the nearest left), while they fit (copied when first needed: copy_ball_walls).
   float* d_sq = self.rect_d_sq_.data();
@@ -92,7 +99,8 @@ void BoundarySection::Ops::gather_ball_walls(BoundarySection& self, const Query&
   double r_sq = kAllWallsRadius_m * kAllWallsRadius_m;
   for (std::size_t e = q.nearest_rect; e < n;) {
     std::uint32_t first = 0;
-    const std::uint32_t count = w.runs == kBallWallEntries ? 0 : segments_under(self, self.section_[e], q.level, &first);
+    const std::uint32_t count =
+        w.runs == kBallWallEntries ? 0 : segments_under(self, self.section_[e], q.level, &first);
     d_sq[e] = std::numeric_limits<float>::infinity();
     if (count == 0 || w.count + static_cast<int>(count) > kMaxBallWalls) {
       // The radius: the first entry left out, by its box; every other one is no nearer than the next rectangle.

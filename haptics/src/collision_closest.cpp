@@ -17,8 +17,11 @@ struct BoundarySection::ClosestQuery {
   Vec2 best_point;
   const int* skip = nullptr;  // curves left out of the answer (skip_count of them)
   int skip_count = 0;
-  ClosestQuery(Vec2 p_in, int level_in, int curve_in, double max_distance_m, const int* skip_in = nullptr, int skip_count_in = 0)
-      : p(p_in), level(level_in), curve(curve_in), skip(skip_in), skip_count(skip_count_in) { set_best(max_distance_m); }
+  ClosestQuery(Vec2 p_in, int level_in, int curve_in, double max_distance_m, const int* skip_in = nullptr,
+               int skip_count_in = 0)
+      : p(p_in), level(level_in), curve(curve_in), skip(skip_in), skip_count(skip_count_in) {
+    set_best(max_distance_m);
+  }
   void set_best(double d_m) {
     best_m = d_m;
     bound_sq = d_m * d_m * (1.0 + 1e-12);
@@ -39,7 +42,8 @@ struct BoundarySection::ClosestQuery {
 // is within the bound (rect_within_bound), perhaps before the bound last shrank: the exact distance is
 // compared with the bound as it is now. The segment's reference is looked up only where it decides a
 // tie or wins. Inlined: it runs several times a call.
-[[gnu::always_inline]] inline void BoundarySection::Ops::closest_offer(const BoundarySection& self, ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) noexcept {
+[[gnu::always_inline]] inline void BoundarySection::Ops::closest_offer(const BoundarySection& self, ClosestQuery& q,
+                                                                       std::uint32_t node, Vec2 a, Vec2 b) noexcept {
   const Vec2 p = q.p;
   const Vec2 c = closest_point_on_segment(p, a, b);
   const double d_sq = length_sq(p - c);
@@ -74,8 +78,10 @@ inline int rects_within_bound2(const Vec2* s, Vec2 p, double bound_sq) {
   const __m128d ax = _mm_unpacklo_pd(p0, p1), ay = _mm_unpackhi_pd(p0, p1);
   const __m128d bx = _mm_unpacklo_pd(p1, p2), by = _mm_unpackhi_pd(p1, p2);
   const __m128d px = _mm_set1_pd(p.x), py = _mm_set1_pd(p.y), zero = _mm_setzero_pd();
-  const __m128d rx = _mm_max_pd(_mm_max_pd(_mm_sub_pd(_mm_min_pd(ax, bx), px), _mm_sub_pd(px, _mm_max_pd(ax, bx))), zero);
-  const __m128d ry = _mm_max_pd(_mm_max_pd(_mm_sub_pd(_mm_min_pd(ay, by), py), _mm_sub_pd(py, _mm_max_pd(ay, by))), zero);
+  const __m128d rx =
+      _mm_max_pd(_mm_max_pd(_mm_sub_pd(_mm_min_pd(ax, bx), px), _mm_sub_pd(px, _mm_max_pd(ax, bx))), zero);
+  const __m128d ry =
+      _mm_max_pd(_mm_max_pd(_mm_sub_pd(_mm_min_pd(ay, by), py), _mm_sub_pd(py, _mm_max_pd(ay, by))), zero);
   const __m128d r2 = _mm_add_pd(_mm_mul_pd(rx, rx), _mm_mul_pd(ry, ry));
   return _mm_movemask_pd(_mm_cmple_pd(r2, _mm_set1_pd(bound_sq)));
 #else
@@ -89,7 +95,9 @@ inline int rects_within_bound2(const Vec2* s, Vec2 p, double bound_sq) {
 // level and curve. A real candidate, so the walk's bound is tight from the root down; the hand moves
 // little between ticks, so it is nearly always the answer again or within a few of it.
 void BoundarySection::Ops::closest_seed(const BoundarySection& self, ClosestQuery& q) noexcept {
-  if (self.last_closest_node_ == kWideEmpty || self.last_closest_level_ != q.level || self.last_closest_curve_ != q.curve) return;
+  if (self.last_closest_node_ == kWideEmpty || self.last_closest_level_ != q.level ||
+      self.last_closest_curve_ != q.curve)
+    return;
   Vec2 a, b;
   self.scene_->segment_points(self.last_closest_node_, &a, &b);
   closest_offer(self, q, self.last_closest_node_, a, b);
@@ -111,13 +119,15 @@ void BoundarySection::Ops::closest_test_item(BoundarySection& self, ClosestQuery
     if (mask & 1) closest_offer(self, q, first + i, s[i], s[i + 1]);
     if (mask & 2) closest_offer(self, q, first + i + 1, s[i + 1], s[i + 2]);
   }
-  if (i < count && rect_within_bound(q.p, s[i], s[i + 1], q.bound_sq)) closest_offer(self, q, first + i, s[i], s[i + 1]);
+  if (i < count && rect_within_bound(q.p, s[i], s[i + 1], q.bound_sq))
+    closest_offer(self, q, first + i, s[i], s[i + 1]);
 }
 
 // Opens node n for the closest-point walk: *next is its nearest child within the bound (kWideEmpty when
 // none is), and the others within it are pushed. False, with *top as it was, when the stack is full.
-[[gnu::always_inline]] inline bool BoundarySection::Ops::closest_open_node(BoundarySection& self, const ClosestQuery& q, const WideNode& n, float px, float py, int* top,
-                                                                           std::uint32_t* next) noexcept {
+[[gnu::always_inline]] inline bool BoundarySection::Ops::closest_open_node(BoundarySection& self, const ClosestQuery& q,
+                                                                           const WideNode& n, float px, float py,
+                                                                           int* top, std::uint32_t* next) noexcept {
   float d_sq[4];
   const int mask = near_node(n, px, py, q.bound_sq_f, d_sq);
   *next = kWideEmpty;
@@ -136,7 +146,9 @@ void BoundarySection::Ops::closest_test_item(BoundarySection& self, ClosestQuery
 
 // The next entry of the closest-point walk still within the bound, taken off the stack; kWideEmpty when
 // none is left.
-[[gnu::always_inline]] inline std::uint32_t BoundarySection::Ops::closest_pop(const BoundarySection& self, const ClosestQuery& q, int* top) noexcept {
+[[gnu::always_inline]] inline std::uint32_t BoundarySection::Ops::closest_pop(const BoundarySection& self,
+                                                                              const ClosestQuery& q,
+                                                                              int* top) noexcept {
   while (*top > 0) {
     const std::size_t k = static_cast<std::size_t>(--*top);
     if (static_cast<double>(self.walk_.d_sq[k]) <= q.bound_sq) return self.walk_.code[k];
@@ -170,16 +182,18 @@ bool BoundarySection::Ops::closest_walk(BoundarySection& self, ClosestQuery& q, 
   }
 }
 
-bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
-                                    QueryBudget* budget, const int* skip_curves, int skip_count) noexcept {
+bool BoundarySection::closest_point(Vec2 p, int level, double max_distance_m, Vec2* point_out, SegmentRef* segment_out,
+                                    int curve, QueryBudget* budget, const int* skip_curves, int skip_count) noexcept {
   level = walls_of(level);
   if (is_cut_level(level)) {
-    return closest_point_cut(p, level - kCutLevelBase, max_distance_m, point_out, segment_out, curve, budget, skip_curves, skip_count);
+    return closest_point_cut(p, level - kCutLevelBase, max_distance_m, point_out, segment_out, curve, budget,
+                             skip_curves, skip_count);
   }
   if (scene_->curve_count() == 0) return false;
   ClosestQuery q(p, level, curve, max_distance_m, skip_curves, skip_count);
   Ops::closest_seed(*this, q);
-  const bool complete = Ops::wide_serves(*this, level) ? Ops::closest_walk(*this, q, budget) : Ops::closest_tree_walk(*this, q, budget);
+  const bool complete =
+      Ops::wide_serves(*this, level) ? Ops::closest_walk(*this, q, budget) : Ops::closest_tree_walk(*this, q, budget);
   last_closest_level_ = level;
   last_closest_curve_ = curve;
   last_closest_node_ = complete ? q.best_node : kWideEmpty;
@@ -213,7 +227,8 @@ bool BoundarySection::Ops::closest_tree_walk(BoundarySection& self, ClosestQuery
     return (curve >= 0 && c != static_cast<std::uint32_t>(curve)) || q.skips(c);
   };
   int top = 0;
-  self.stack_[static_cast<std::size_t>(top++)] = Candidate{0.0, sc.scene_root(), kNotAnEntry};  // t_enter: the box's squared distance [m²]
+  self.stack_[static_cast<std::size_t>(top++)] =
+      Candidate{0.0, sc.scene_root(), kNotAnEntry};  // t_enter: the box's squared distance [m²]
   while (top > 0) {
     const Candidate cur = self.stack_[static_cast<std::size_t>(--top)];
     if (cur.t_enter > q.bound_sq) continue;  // the bound shrank since it was pushed
@@ -229,24 +244,29 @@ bool BoundarySection::Ops::closest_tree_walk(BoundarySection& self, ClosestQuery
     for (std::uint32_t i = 0; i < count; ++i) {
       const std::uint32_t child = first + i;
       if (other_curve(child)) continue;
-      if (rect_distance_sq(sc.loose_aabb(child), p) > q.bound_sq) continue;  // the rectangle holds the box: a cheaper lower bound
+      if (rect_distance_sq(sc.loose_aabb(child), p) > q.bound_sq)
+        continue;  // the rectangle holds the box: a cheaper lower bound
       if (budget && !budget->spend()) return false;
       const double d_sq = box_distance_sq(sc.box(child), p);
       if (d_sq > q.bound_sq) continue;
-      if (!push(self, top, Candidate{d_sq, child, kNotAnEntry})) {  // full (never, within the tree's depth): the answer is unknown
+      if (!push(self, top,
+                Candidate{d_sq, child, kNotAnEntry})) {  // full (never, within the tree's depth): the answer is unknown
         if (budget) budget->ran_out = true;
         return false;
       }
     }
-    std::sort(self.stack_.begin() + base, self.stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
+    std::sort(self.stack_.begin() + base, self.stack_.begin() + top,
+              [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
   }
   return true;
 }
 
-bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out, SegmentRef* segment_out, int curve,
-                                        QueryBudget* budget, const int* skip_curves, int skip_count) noexcept {
+bool BoundarySection::closest_point_cut(Vec2 p, int step, double max_distance_m, Vec2* point_out,
+                                        SegmentRef* segment_out, int curve, QueryBudget* budget, const int* skip_curves,
+                                        int skip_count) noexcept {
   if (!has_cuts()) {
-    return closest_point(p, kToleranceLevelBase + step, max_distance_m, point_out, segment_out, curve, budget, skip_curves, skip_count);
+    return closest_point(p, kToleranceLevelBase + step, max_distance_m, point_out, segment_out, curve, budget,
+                         skip_curves, skip_count);
   }
   const Scene& sc = *scene_;
   if (sc.curve_count() == 0) return false;

@@ -7,7 +7,8 @@ namespace hk {
 // What a ball tick (a → b answered by the free-space ball or its walls) does to the section: the merge checks full
 // queries left owed, while some are (merge_on_ball_tick), counted in *stats (box_tests, merges) with the section's
 // size after them.
-inline void BoundarySection::Ops::pay_merge_debt(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats* stats) noexcept {
+inline void BoundarySection::Ops::pay_merge_debt(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget,
+                                                 QueryStats* stats) noexcept {
   QueryStats unused;
   if (self.merge_debt_ > 0) merge_on_ball_tick(self, a, b, budget, stats ? *stats : unused);
   if (stats) stats->section_size = static_cast<std::int32_t>(self.section_.size());
@@ -16,7 +17,8 @@ inline void BoundarySection::Ops::pay_merge_debt(BoundarySection& self, Vec2 a, 
 SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                                     QueryBudget& budget, QueryStats* stats_out) noexcept {
   level = walls_of(level);
-  if (level != last_level_ || level != other_level_) Ops::follow_level(*this, level);  // else it serves this id alone, as before
+  if (level != last_level_ || level != other_level_)
+    Ops::follow_level(*this, level);  // else it serves this id alone, as before
   if (Ops::inside_free_ball(*this, a, b)) {
     if (stats_out) *stats_out = QueryStats{};
     Ops::pay_merge_debt(*this, a, b, budget, stats_out);
@@ -29,8 +31,10 @@ SweepHit BoundarySection::first_hit(Vec2 a, Vec2 b, int level, const SegmentRef*
 
 // first_hit past its free-space ball: the ball's walls, else a full query. Out of line, so the ball's answer (most
 // ticks) does not pay this part's stack frame and saved registers.
-[[gnu::noinline]] SweepHit BoundarySection::Ops::first_hit_near_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded,
-                                                                      int excluded_count, QueryBudget& budget, QueryStats* stats_out) noexcept {
+[[gnu::noinline]] SweepHit BoundarySection::Ops::first_hit_near_walls(BoundarySection& self, Vec2 a, Vec2 b, int level,
+                                                                      const SegmentRef* excluded, int excluded_count,
+                                                                      QueryBudget& budget,
+                                                                      QueryStats* stats_out) noexcept {
   SweepHit near;
   if (answer_from_ball_walls(self, a, b, level, excluded, excluded_count, &near, stats_out)) {
     pay_merge_debt(self, a, b, budget, stats_out);  // a ball tick too

@@ -23,7 +23,8 @@ bool BoundarySection::wall_neighbour(SegmentRef s, int level, int dir, SegmentRe
   // exactly one of its ancestors-or-self is in the cut. Same-level segment k's level-0 range holds j.
   const int step = level - kCutLevelBase;
   const auto n0 = static_cast<std::int64_t>(ci.segment_count[0]);
-  const std::int64_t j = dir > 0 ? (static_cast<std::int64_t>(k) << s.level) : ((static_cast<std::int64_t>(k) + 1) << s.level) - 1;
+  const std::int64_t j =
+      dir > 0 ? (static_cast<std::int64_t>(k) << s.level) : ((static_cast<std::int64_t>(k) + 1) << s.level) - 1;
   const CurveNodes& cn = sc.curve_nodes(static_cast<std::size_t>(s.curve));
   for (int l = static_cast<int>(ci.levels) - 1; l >= 0; --l) {
     const auto i = static_cast<std::uint32_t>((j % n0) >> l);
@@ -102,7 +103,8 @@ void BoundarySection::Ops::coarsen_section(BoundarySection& self, int level) noe
 // coarsen_section).
 void BoundarySection::Ops::drop_departed_entries(BoundarySection& self) noexcept {
   std::size_t w = 0;
-  for (std::size_t i = 0; i < self.section_.size(); ++i) {  // every entry copied, kept by advancing w: no branch to mispredict
+  for (std::size_t i = 0; i < self.section_.size();
+       ++i) {  // every entry copied, kept by advancing w: no branch to mispredict
     const std::uint32_t node = self.section_[i];
     self.section_rect_.copy(w, i);
     self.section_[w] = node;

@@ -17,9 +17,9 @@ void BoundarySection::Ops::split_hit_boxes(BoundarySection& self, Query& q) noex
 
 // Phase 5: siblings whose parent is clear of the sweep by the margin merge into it (merge_children: in place, no
 // entry left to drop). Merging only shrinks the section, so it can be lazy: a full query owes one check per 8 idle
-// entries (merge_debt_), which the ticks the free-space ball or its walls answer pay, one or two each (merge_on_ball_tick); past
-// kMaxMergeDebt owed (a walk through walls, few ball ticks) the full query pays the excess itself, parents taken
-// round robin.
+// entries (merge_debt_), which the ticks the free-space ball or its walls answer pay, one or two each
+// (merge_on_ball_tick); past kMaxMergeDebt owed (a walk through walls, few ball ticks) the full query pays the excess
+// itself, parents taken round robin.
 void BoundarySection::Ops::merge_idle_siblings(BoundarySection& self, Query& q) noexcept {
   // Merges must keep up with the splits, or the section grows without bound: with 4 checks per tick and no
   // more, a long walk over a dense scene grew it to 9 000–18 000 entries (CollisionQuery.
@@ -37,7 +37,7 @@ void BoundarySection::Ops::merge_idle_siblings(BoundarySection& self, Query& q) 
   const std::size_t n = q.scanned;
   if (n == 0) return;
   self.merge_debt_ += static_cast<int>((n - q.hit) / kIdlePerMergeCheck);
-  if (self.merge_debt_ <= kMaxMergeDebt) return;  // the ball ticks after this one pay (merge_on_ball_tick)
+  if (self.merge_debt_ <= kMaxMergeDebt) return;            // the ball ticks after this one pay (merge_on_ball_tick)
   const int max_checks = self.merge_debt_ - kMaxMergeDebt;  // what is owed past the cap: at most this query's own share
   self.merge_debt_ = kMaxMergeDebt;
   int checks = 0;
@@ -49,7 +49,8 @@ void BoundarySection::Ops::merge_idle_siblings(BoundarySection& self, Query& q) 
     // Every entry is in the section and none of its ancestors is (splits and merges change it in place, a
     // frontier), so only the marks decide. One check per parent per tick: a node with many children would
     // otherwise ask again for each.
-    if ((self.node_state_[node] & kHitMark) || parent == kNoParent || (self.node_state_[parent] & kCheckedMark)) continue;
+    if ((self.node_state_[node] & kHitMark) || parent == kNoParent || (self.node_state_[parent] & kCheckedMark))
+      continue;
     mark(self, parent, kCheckedMark);
     ++checks;
     // All children in: most checks end here, a sibling split deeper (three in four), on one count rather than a loop
@@ -68,7 +69,8 @@ void BoundarySection::Ops::merge_idle_siblings(BoundarySection& self, Query& q) 
 // The merge of a check that found all `count` children of `parent` in the section (`child`, one at entry e): when the
 // parent's box is clear of the sweep a → b by the merge margin (so none of them meets it either), it takes their place
 // (merge_children). One box test, which the caller charges. True when it merged.
-bool BoundarySection::Ops::merge_if_clear(BoundarySection& self, std::size_t e, std::uint32_t parent, const std::uint32_t* child, std::uint32_t count, Vec2 a, Vec2 b) noexcept {
+bool BoundarySection::Ops::merge_if_clear(BoundarySection& self, std::size_t e, std::uint32_t parent,
+                                          const std::uint32_t* child, std::uint32_t count, Vec2 a, Vec2 b) noexcept {
   double te = 0.0, tx = 0.0;
   if (clip_segment_box_inline(entry_box(self, parent), a, b, self.merge_margin_m_, &te, &tx)) return false;
   return merge_children(self, e, parent, child, count);
@@ -78,7 +80,8 @@ bool BoundarySection::Ops::merge_if_clear(BoundarySection& self, std::size_t e, 
 // its walls answered (a → b the sweep). One check, two while more than half of kMaxMergeDebt is owed (so that runs of
 // full queries seldom leave any past the cap for a full query to pay: PERFORMANCE.md, round two). Each is
 // merge_check_on_ball_tick's: at most one optional box test, charged to `budget` and counted in st.
-[[gnu::noinline]] void BoundarySection::Ops::merge_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept {
+[[gnu::noinline]] void BoundarySection::Ops::merge_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b,
+                                                                QueryBudget& budget, QueryStats& st) noexcept {
   const int checks = self.merge_debt_ > kMaxMergeDebt / 2 ? 2 : 1;
   for (int i = 0; i < checks; ++i) merge_check_on_ball_tick(self, a, b, budget, st);
 }
@@ -86,7 +89,8 @@ bool BoundarySection::Ops::merge_if_clear(BoundarySection& self, std::size_t e, 
 // One merge check of the round robin on a ball tick: the parent of the next entry, when all its children are in the
 // section and its box is clear of the sweep by the margin (so none of them meets the sweep either), takes their place.
 // One optional box test, charged to `budget` and counted in st (box_tests; merges when it merged).
-void BoundarySection::Ops::merge_check_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept {
+void BoundarySection::Ops::merge_check_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget,
+                                                    QueryStats& st) noexcept {
   --self.merge_debt_;
   const std::size_t n = self.section_.size();
   if (n == 0) return;

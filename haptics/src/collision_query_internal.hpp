@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <limits>
 
-#include "haptics/collision_query.hpp"
 #include "collision_simd.hpp"
+#include "haptics/collision_query.hpp"
 
 namespace hk {
 namespace collision_detail {
@@ -82,7 +82,8 @@ constexpr SegmentRef kNoSegment{std::numeric_limits<std::int32_t>::max(), std::n
 
 // The bodies of clip_segment_box and intersect_sweep_segment (collision_query.hpp), inline for the query's inner
 // loops; the public functions (sweep_geometry.cpp) call these.
-inline bool clip_segment_box_inline(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter, double* t_exit) noexcept {
+inline bool clip_segment_box_inline(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, double* t_enter,
+                                    double* t_exit) noexcept {
   // Work in the box frame: u along the axis, n along the left normal.
   const Vec2 ra = a - box.origin_m;
   const Vec2 d = b - a;
@@ -141,16 +142,18 @@ struct BoundarySection::Ops {
   static std::uint32_t wall_ancestor(const BoundarySection& self, std::uint32_t node, int level) noexcept;
   static bool at_floor(const BoundarySection& self, std::uint32_t node, int level) noexcept;
   static bool inside_free_ball(const BoundarySection& self, Vec2 a, Vec2 b) noexcept;
-  static SweepHit first_hit_near_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
-                                       QueryStats* stats_out) noexcept;
-  static SweepHit first_hit_tree(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
-                                 QueryStats* stats_out) noexcept;
+  static SweepHit first_hit_near_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded,
+                                       int excluded_count, QueryBudget& budget, QueryStats* stats_out) noexcept;
+  static SweepHit first_hit_tree(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded,
+                                 int excluded_count, QueryBudget& budget, QueryStats* stats_out) noexcept;
   // Whether the wide index holds the walls of level id `level` (not a cut step): every curve is at or below its item
   // level there (wide_index.hpp). The walks of coarser ids go through the tree of error boxes.
   // A level below 0 is level 0 (Scene::clamp_level).
-  static bool wide_serves(const BoundarySection& self, int level) noexcept { return level < kCutLevelBase && self.wide_serves_[static_cast<std::size_t>(std::max(level, 0))]; }
-  static bool answer_from_ball_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, SweepHit* out,
-                                     QueryStats* stats) noexcept;
+  static bool wide_serves(const BoundarySection& self, int level) noexcept {
+    return level < kCutLevelBase && self.wide_serves_[static_cast<std::size_t>(std::max(level, 0))];
+  }
+  static bool answer_from_ball_walls(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded,
+                                     int excluded_count, SweepHit* out, QueryStats* stats) noexcept;
   static void copy_ball_walls(BoundarySection& self) noexcept;
   static void next_tick(BoundarySection& self) noexcept;
   static void clip_section(BoundarySection& self, Query& q) noexcept;
@@ -159,16 +162,19 @@ struct BoundarySection::Ops {
   static void refine_candidates(BoundarySection& self, Query& q) noexcept;
   static bool push_hit_children(BoundarySection& self, Query& q, std::uint32_t node, int& top) noexcept;
   static bool push_wide_children(BoundarySection& self, Query& q, std::uint32_t node, int& top) noexcept;
-  static std::uint32_t segments_under(const BoundarySection& self, std::uint32_t node, int level, std::uint32_t* first) noexcept;
+  static std::uint32_t segments_under(const BoundarySection& self, std::uint32_t node, int level,
+                                      std::uint32_t* first) noexcept;
   static bool test_segments_under(BoundarySection& self, Query& q, std::uint32_t node) noexcept;
   static void test_segment(BoundarySection& self, Query& q, std::uint32_t node) noexcept;
   static void test_level_run(BoundarySection& self, Query& q, std::uint32_t first, std::uint32_t count) noexcept;
   static void split_hit_boxes(BoundarySection& self, Query& q) noexcept;
   static void merge_idle_siblings(BoundarySection& self, Query& q) noexcept;
   static void merge_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
-  static void merge_check_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats& st) noexcept;
+  static void merge_check_on_ball_tick(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget,
+                                       QueryStats& st) noexcept;
   static void pay_merge_debt(BoundarySection& self, Vec2 a, Vec2 b, QueryBudget& budget, QueryStats* stats) noexcept;
-  static bool merge_if_clear(BoundarySection& self, std::size_t e, std::uint32_t parent, const std::uint32_t* child, std::uint32_t count, Vec2 a, Vec2 b) noexcept;
+  static bool merge_if_clear(BoundarySection& self, std::size_t e, std::uint32_t parent, const std::uint32_t* child,
+                             std::uint32_t count, Vec2 a, Vec2 b) noexcept;
   static void gather_ball_walls(BoundarySection& self, const Query& q) noexcept;
   static std::size_t nearest_rect_left(const BoundarySection& self, std::size_t n) noexcept;
   static void place_free_ball(BoundarySection& self, const Query& q) noexcept;
@@ -176,33 +182,49 @@ struct BoundarySection::Ops {
   static SweepHit finish(const BoundarySection& self, Query& q) noexcept;
   static void split(BoundarySection& self, std::uint32_t node, std::size_t entry) noexcept;
   static void split_wide(BoundarySection& self, std::uint32_t node, std::size_t entry) noexcept;
-  static void set_section_entry(BoundarySection& self, std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept;
+  static void set_section_entry(BoundarySection& self, std::size_t entry, std::uint32_t node,
+                                std::uint32_t parent) noexcept;
   static void place_entry(BoundarySection& self, std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept;
   static void remove_section_entry(BoundarySection& self, std::size_t entry) noexcept;
-  static bool merge_children(BoundarySection& self, std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count) noexcept;
+  static bool merge_children(BoundarySection& self, std::size_t entry, std::uint32_t parent,
+                             const std::uint32_t* children, std::uint32_t count) noexcept;
   // The wide frontier (collision_query.hpp, before wide_mode_): whether it serves `level`, and its section ids.
-  static bool wide_frontier(const BoundarySection& self, int level) noexcept { return wide_serves(self, level) && !self.scene_->wide_index().nodes.empty(); }
+  static bool wide_frontier(const BoundarySection& self, int level) noexcept {
+    return wide_serves(self, level) && !self.scene_->wide_index().nodes.empty();
+  }
   static bool is_wide_id(const BoundarySection& self, std::uint32_t id) noexcept { return id >= self.wide_base_; }
-  // The section id of a wide node's child code (WideNode::child, not kWideEmpty): an item's segment node, or a wide node.
-  static std::uint32_t wide_child_id(const BoundarySection& self, std::uint32_t code) noexcept { return (code & kWideLeaf) ? (code & ~kWideLeaf) : self.wide_base_ + code; }
+  // The section id of a wide node's child code (WideNode::child, not kWideEmpty): an item's segment node, or a wide
+  // node.
+  static std::uint32_t wide_child_id(const BoundarySection& self, std::uint32_t code) noexcept {
+    return (code & kWideLeaf) ? (code & ~kWideLeaf) : self.wide_base_ + code;
+  }
   static Aabb entry_rect(const BoundarySection& self, std::uint32_t id) noexcept;
   static ErrorBox entry_box(const BoundarySection& self, std::uint32_t id) noexcept;
   static ErrorBox entry_box_at(const BoundarySection& self, std::size_t entry) noexcept;
   static std::uint32_t entry_children(const BoundarySection& self, std::uint32_t id, std::uint32_t* out) noexcept;
   static std::uint32_t child_count(const BoundarySection& self, std::uint32_t id) noexcept;
   static void link_wide_nodes(BoundarySection& self);
-  static std::uint32_t item_segments(const BoundarySection& self, std::uint32_t item, int level, std::uint32_t* first) noexcept;
-  static bool push_walk(BoundarySection& self, float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept;
+  static std::uint32_t item_segments(const BoundarySection& self, std::uint32_t item, int level,
+                                     std::uint32_t* first) noexcept;
+  static bool push_walk(BoundarySection& self, float t_enter, float d_sq, std::uint32_t code, int base,
+                        int& top) noexcept;
   static void wide_test_item(BoundarySection& self, Query& q, std::uint32_t item) noexcept;
   static double wide_walk(BoundarySection& self, Query& q, double ball_cap_m) noexcept;
-  static float seeded_ball_sq(const BoundarySection& self, const WideIndex& wi, float bx, float by, float cap_sq) noexcept;
+  static float seeded_ball_sq(const BoundarySection& self, const WideIndex& wi, float bx, float by,
+                              float cap_sq) noexcept;
   // Appends node with its rectangle and marks it in (the caller checked the room); parent: parent_or_none(node).
   static void push_section(BoundarySection& self, std::uint32_t node, std::uint32_t parent) noexcept;
   static std::uint32_t parent_or_none(const BoundarySection& self, std::uint32_t node) noexcept;
   static void mark_out(BoundarySection& self, std::uint32_t node, std::uint32_t parent) noexcept;
-  static bool in_section(const BoundarySection& self, std::uint32_t node) noexcept { return (self.node_state_[node] & kInSection) != 0; }
-  static std::uint32_t children_in(const BoundarySection& self, std::uint32_t node) noexcept { return self.node_state_[node] / kChildInUnit; }
-  static void clear_state(BoundarySection& self, std::uint32_t node, std::uint8_t bits) noexcept { self.node_state_[node] &= static_cast<std::uint8_t>(~bits); }
+  static bool in_section(const BoundarySection& self, std::uint32_t node) noexcept {
+    return (self.node_state_[node] & kInSection) != 0;
+  }
+  static std::uint32_t children_in(const BoundarySection& self, std::uint32_t node) noexcept {
+    return self.node_state_[node] / kChildInUnit;
+  }
+  static void clear_state(BoundarySection& self, std::uint32_t node, std::uint8_t bits) noexcept {
+    self.node_state_[node] &= static_cast<std::uint8_t>(~bits);
+  }
   /// Checked push onto the DFS stack (sized by hk::tree_stack_entries): false, and nothing pushed, when it
   /// is full, which a tree within kMaxLevels + kMaxHierarchyDepth levels never fills.
   static bool push(BoundarySection& self, int& top, Candidate c) noexcept {
@@ -223,34 +245,43 @@ struct BoundarySection::Ops {
   static bool closest_walk(BoundarySection& self, ClosestQuery& q, QueryBudget* budget) noexcept;
   static bool closest_tree_walk(BoundarySection& self, ClosestQuery& q, QueryBudget* budget) noexcept;
   static void closest_test_item(BoundarySection& self, ClosestQuery& q, std::uint32_t item) noexcept;
-  static bool closest_open_node(BoundarySection& self, const ClosestQuery& q, const WideNode& n, float px, float py, int* top, std::uint32_t* next) noexcept;
+  static bool closest_open_node(BoundarySection& self, const ClosestQuery& q, const WideNode& n, float px, float py,
+                                int* top, std::uint32_t* next) noexcept;
   static std::uint32_t closest_pop(const BoundarySection& self, const ClosestQuery& q, int* top) noexcept;
   static void closest_offer(const BoundarySection& self, ClosestQuery& q, std::uint32_t node, Vec2 a, Vec2 b) noexcept;
 };
 
 // One query's inputs, answer so far and counters, passed to each phase of first_hit.
 struct BoundarySection::Query {
-  Vec2 a, b;                    // the sweep [m]
-  Aabb sweep;                   // the rectangle around it
-  int level = 0;                // target level (clamped per curve)
+  Vec2 a, b;      // the sweep [m]
+  Aabb sweep;     // the rectangle around it
+  int level = 0;  // target level (clamped per curve)
   const SegmentRef* excluded = nullptr;
   int excluded_count = 0;
   QueryBudget* budget = nullptr;
-  SweepHit best;                // nearest exact hit so far (t = +inf: none)
+  SweepHit best;                                                  // nearest exact hit so far (t = +inf: none)
   double unresolved_t = std::numeric_limits<double>::infinity();  // entry of the nearest box left unrefined
   std::uint32_t unresolved_node = 0;
   double nearest_sq = std::numeric_limits<double>::infinity();  // squared distance from b to the section's nearest box
   QueryStats st;
-  bool refused = false;  // optional work was refused for want of budget (a wide node may be refused before it is quite spent)
-  std::size_t scanned = 0;  // section entries phase 1 scanned (the first ones of section_)
-  std::size_t hit = 0;      // of which the sweep met, grown by the merge margin (kHitMark)
+  bool refused =
+      false;  // optional work was refused for want of budget (a wide node may be refused before it is quite spent)
+  std::size_t scanned = 0;       // section entries phase 1 scanned (the first ones of section_)
+  std::size_t hit = 0;           // of which the sweep met, grown by the merge margin (kHitMark)
   std::size_t nearest_rect = 0;  // of which the one whose rectangle is nearest to b (scanned when none)
 
-  float ax = 0.0f, ay = 0.0f, ix = 0.0f, iy = 0.0f;  // the sweep for sweep_node: its start, the reciprocals of its extent
+  float ax = 0.0f, ay = 0.0f, ix = 0.0f,
+        iy = 0.0f;  // the sweep for sweep_node: its start, the reciprocals of its extent
 
-  Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded, QueryBudget& shared_budget)
-      : a(a_m), b(b_m), sweep(rect_of(a_m, b_m)),
-        level(target_level), excluded(excluded_segments), excluded_count(n_excluded), budget(&shared_budget) {
+  Query(Vec2 a_m, Vec2 b_m, int target_level, const SegmentRef* excluded_segments, int n_excluded,
+        QueryBudget& shared_budget)
+      : a(a_m),
+        b(b_m),
+        sweep(rect_of(a_m, b_m)),
+        level(target_level),
+        excluded(excluded_segments),
+        excluded_count(n_excluded),
+        budget(&shared_budget) {
     best.t = std::numeric_limits<double>::infinity();  // no exact hit yet
     best.point_m = b_m;
     ax = static_cast<float>(a_m.x);
@@ -285,7 +316,8 @@ struct BoundarySection::Query {
     ++st.segment_tests;
     st.coarsest_answer_level = std::max(st.coarsest_answer_level, ref.level);
     double t = 0.0;
-    if (overlaps(rect_of(p0, p1), sweep, 0.0) && intersect_sweep_segment_inline(a, b, p0, p1, &t) && closer(t, ref, best.t, best.segment)) {
+    if (overlaps(rect_of(p0, p1), sweep, 0.0) && intersect_sweep_segment_inline(a, b, p0, p1, &t) &&
+        closer(t, ref, best.t, best.segment)) {
       best.hit = true;
       best.t = t;
       best.segment = ref;
@@ -306,7 +338,8 @@ inline bool BoundarySection::Ops::at_target(const BoundarySection& self, std::ui
 
 // The end points of wall node `node` (at_target of `level`, already walls_of): joined at a cut step, else the
 // segment's own.
-inline void BoundarySection::Ops::wall_node_points(const BoundarySection& self, std::uint32_t node, int level, Vec2* a, Vec2* b) noexcept {
+inline void BoundarySection::Ops::wall_node_points(const BoundarySection& self, std::uint32_t node, int level, Vec2* a,
+                                                   Vec2* b) noexcept {
   if (is_cut_level(level)) {
     joined_cut_segment(*self.scene_, self.cut_mask_, node, level - kCutLevelBase, a, b);
   } else {
@@ -341,8 +374,8 @@ inline ErrorBox BoundarySection::Ops::entry_box_at(const BoundarySection& self, 
 inline std::uint32_t BoundarySection::Ops::child_count(const BoundarySection& self, std::uint32_t id) noexcept {
   if (is_wide_id(self, id)) {
     const WideNode& n = self.scene_->wide_index().nodes[id - self.wide_base_];
-    return static_cast<std::uint32_t>((n.child[0] != kWideEmpty) + (n.child[1] != kWideEmpty) + (n.child[2] != kWideEmpty) +
-                                      (n.child[3] != kWideEmpty));
+    return static_cast<std::uint32_t>((n.child[0] != kWideEmpty) + (n.child[1] != kWideEmpty) +
+                                      (n.child[2] != kWideEmpty) + (n.child[3] != kWideEmpty));
   }
   std::uint32_t first = 0, count = 0;
   self.scene_->children(id, &first, &count);
@@ -352,10 +385,13 @@ inline std::uint32_t BoundarySection::Ops::child_count(const BoundarySection& se
 // Marks a node out of the section, and no longer counted among its parent's children in.
 inline void BoundarySection::Ops::mark_out(BoundarySection& self, std::uint32_t node, std::uint32_t parent) noexcept {
   clear_state(self, node, kInSection);
-  if (parent != kNoParent) self.node_state_[parent] = static_cast<std::uint8_t>(self.node_state_[parent] - kChildInUnit);  // it was counted
+  if (parent != kNoParent)
+    self.node_state_[parent] = static_cast<std::uint8_t>(self.node_state_[parent] - kChildInUnit);  // it was counted
 }
 
-inline void BoundarySection::Ops::next_tick(BoundarySection& self) noexcept { ++self.tick_; }  // wraps harmlessly: it only turns the merges' round robin
+inline void BoundarySection::Ops::next_tick(BoundarySection& self) noexcept {
+  ++self.tick_;
+}  // wraps harmlessly: it only turns the merges' round robin
 
 // The end of a full query: every mark its phases set, cleared (the next query starts with none).
 inline void BoundarySection::Ops::clear_marks(BoundarySection& self) noexcept {
@@ -377,7 +413,8 @@ inline bool BoundarySection::Ops::inside_free_ball(const BoundarySection& self, 
 // 2^kDirectLevels) and, in *first, the first one's node (they are consecutive nodes, whose points are
 // consecutive too); 0 for any other node (a chunk or above, a node farther above its walls, a cut step's
 // walls, which are of mixed levels). The node must not lie below the walls (no section entry does).
-inline std::uint32_t BoundarySection::Ops::segments_under(const BoundarySection& self, std::uint32_t node, int level, std::uint32_t* first) noexcept {
+inline std::uint32_t BoundarySection::Ops::segments_under(const BoundarySection& self, std::uint32_t node, int level,
+                                                          std::uint32_t* first) noexcept {
   const Scene& sc = *self.scene_;
   if (!sc.is_segment(node) || is_cut_level(level)) return 0;
   const std::uint32_t c = sc.tag_curve(node);
@@ -392,7 +429,8 @@ inline std::uint32_t BoundarySection::Ops::segments_under(const BoundarySection&
 // test_segment for the `count` consecutive segment nodes of one level of one curve from `first` (not a cut step's),
 // with what they share found once: their curve and level (their indices run on from the first's) and their points
 // (consecutive slots), each its own level's wall.
-inline void BoundarySection::Ops::test_level_run(BoundarySection& self, Query& q, std::uint32_t first, std::uint32_t count) noexcept {
+inline void BoundarySection::Ops::test_level_run(BoundarySection& self, Query& q, std::uint32_t first,
+                                                 std::uint32_t count) noexcept {
   const NodeInfo in = self.scene_->info(first);
   const Vec2* pts = self.scene_->slot_points(first);
   for (std::uint32_t i = 0; i < count; ++i) {
@@ -404,7 +442,8 @@ inline void BoundarySection::Ops::test_level_run(BoundarySection& self, Query& q
 // The segments a walk tests at an item (segment node `item` of the item level): the target level's segments
 // under it (the item itself at the item level). Writes the first node and returns the count. The walks of the
 // wide index take only the level ids it serves (wide_serves), whose level is at or below every curve's items.
-inline std::uint32_t BoundarySection::Ops::item_segments(const BoundarySection& self, std::uint32_t item, int level, std::uint32_t* first) noexcept {
+inline std::uint32_t BoundarySection::Ops::item_segments(const BoundarySection& self, std::uint32_t item, int level,
+                                                         std::uint32_t* first) noexcept {
   const Scene& sc = *self.scene_;
   const std::uint32_t c = sc.tag_curve(item);
   const int k_level = sc.tag_level(item);
@@ -418,7 +457,8 @@ inline std::uint32_t BoundarySection::Ops::item_segments(const BoundarySection& 
 // Checked push onto the wide walks' stack, in order: among the entries pushed since `base` (a node's
 // children, at most four) the one nearest to the walk's point ends on top. False, with nothing pushed,
 // when the stack is full.
-[[gnu::always_inline]] inline bool BoundarySection::Ops::push_walk(BoundarySection& self, float t_enter, float d_sq, std::uint32_t code, int base, int& top) noexcept {
+[[gnu::always_inline]] inline bool BoundarySection::Ops::push_walk(BoundarySection& self, float t_enter, float d_sq,
+                                                                   std::uint32_t code, int base, int& top) noexcept {
   if (static_cast<std::size_t>(top) >= self.walk_.size()) return false;
   float* t = self.walk_.t_enter.data();
   float* d = self.walk_.d_sq.data();

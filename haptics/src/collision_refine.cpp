@@ -29,13 +29,15 @@ bool BoundarySection::Ops::push_hit_children(BoundarySection& self, Query& q, st
       top = base;
       return false;
     }
-    if (overlaps(sc.loose_aabb(first + i), q.sweep, 0.0) && clip_segment_box_inline(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t &&
+    if (overlaps(sc.loose_aabb(first + i), q.sweep, 0.0) &&
+        clip_segment_box_inline(sc.box(first + i), q.a, q.b, 0.0, &te, &tx) && te <= q.best.t &&
         !push(self, top, {te, first + i, kNotAnEntry})) {
       top = base;  // the stack is full: as past the budget
       return false;
     }
   }
-  std::sort(self.stack_.begin() + base, self.stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
+  std::sort(self.stack_.begin() + base, self.stack_.begin() + top,
+            [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
   return true;
 }
 
@@ -57,7 +59,8 @@ bool BoundarySection::Ops::push_wide_children(BoundarySection& self, Query& q, s
       return false;
     }
   }
-  std::sort(self.stack_.begin() + base, self.stack_.begin() + top, [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
+  std::sort(self.stack_.begin() + base, self.stack_.begin() + top,
+            [](const Candidate& x, const Candidate& y) { return x.t_enter > y.t_enter; });
   return true;
 }
 
@@ -70,7 +73,8 @@ bool BoundarySection::Ops::push_wide_children(BoundarySection& self, Query& q, s
 bool BoundarySection::Ops::test_segments_under(BoundarySection& self, Query& q, std::uint32_t node) noexcept {
   std::uint32_t first = 0;
   const std::uint32_t count = segments_under(self, node, q.level, &first);
-  if (count == 0 || !q.budget->affords(static_cast<std::int32_t>(count))) return false;  // not refused: the descent may still go part way
+  if (count == 0 || !q.budget->affords(static_cast<std::int32_t>(count)))
+    return false;  // not refused: the descent may still go part way
   q.spend_boxes(static_cast<std::int32_t>(count));
   test_level_run(self, q, first, count);
   return true;
@@ -81,7 +85,8 @@ bool BoundarySection::Ops::test_segments_under(BoundarySection& self, Query& q, 
 // pruned past the best hit. Past the budget, boxes are not refined: the nearest
 // such box bounds what is proven clear (a box holds everything finer).
 void BoundarySection::Ops::refine_candidates(BoundarySection& self, Query& q) noexcept {
-  std::sort(self.candidates_.begin(), self.candidates_.end(), [](const Candidate& x, const Candidate& y) { return x.t_enter < y.t_enter; });
+  std::sort(self.candidates_.begin(), self.candidates_.end(),
+            [](const Candidate& x, const Candidate& y) { return x.t_enter < y.t_enter; });
   for (const Candidate& cand : self.candidates_) {
     if (cand.t_enter > q.horizon()) break;
     int top = 0;
@@ -91,7 +96,8 @@ void BoundarySection::Ops::refine_candidates(BoundarySection& self, Query& q) no
       if (cur.t_enter > q.horizon()) continue;
       if (at_target(self, cur.node, q.level)) {
         test_segment(self, q, cur.node);
-      } else if (!test_segments_under(self, q, cur.node) && !push_hit_children(self, q, cur.node, top) && cur.t_enter < q.unresolved_t) {
+      } else if (!test_segments_under(self, q, cur.node) && !push_hit_children(self, q, cur.node, top) &&
+                 cur.t_enter < q.unresolved_t) {
         q.unresolved_t = cur.t_enter;
         q.unresolved_node = cur.node;
       }
@@ -110,10 +116,12 @@ SweepHit BoundarySection::Ops::finish(const BoundarySection& self, Query& q) noe
     best.t = q.unresolved_t;
     const std::uint32_t node = q.unresolved_node;
     if (node == kWideEmpty || (!sc.is_segment(node) && !sc.is_chunk(node))) {
-      best.segment = SegmentRef{-1, Scene::kMaxLevels, -1};  // above the curves (hierarchy or wide index): no segment to name yet
+      best.segment =
+          SegmentRef{-1, Scene::kMaxLevels, -1};  // above the curves (hierarchy or wide index): no segment to name yet
     } else {
       const NodeInfo in = sc.info(node);
-      const int level = sc.is_chunk(node) ? static_cast<int>(sc.curve_nodes(in.curve).levels) - 1 : in.level;  // a chunk: its coarsest segments
+      const int level = sc.is_chunk(node) ? static_cast<int>(sc.curve_nodes(in.curve).levels) - 1
+                                          : in.level;  // a chunk: its coarsest segments
       best.segment = SegmentRef{static_cast<std::int32_t>(in.curve), level, static_cast<std::int32_t>(in.index)};
     }
     q.st.coarsest_answer_level = std::max(q.st.coarsest_answer_level, best.segment.level);

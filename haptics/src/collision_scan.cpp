@@ -33,10 +33,12 @@ void BoundarySection::Ops::clip_section(BoundarySection& self, Query& q) noexcep
       const ErrorBox box = entry_box_at(self, i);
       if (self.rect_near_bits_[w] & bit) q.nearest_sq = std::min(q.nearest_sq, box_distance_sq(box, q.b));
       double te = 0.0, tx = 0.0;
-      if ((self.rect_overlap_bits_[w] & bit) && clip_segment_box_inline(box, q.a, q.b, self.merge_margin_m_, &te, &tx)) {
+      if ((self.rect_overlap_bits_[w] & bit) &&
+          clip_segment_box_inline(box, q.a, q.b, self.merge_margin_m_, &te, &tx)) {
         mark(self, node, kHitMark);
         ++q.hit;
-        if (clip_segment_box_inline(box, q.a, q.b, 0.0, &te, &tx)) self.candidates_.push_back({te, node, static_cast<std::uint32_t>(i)});
+        if (clip_segment_box_inline(box, q.a, q.b, 0.0, &te, &tx))
+          self.candidates_.push_back({te, node, static_cast<std::uint32_t>(i)});
       }
     }
   }
@@ -75,11 +77,13 @@ std::size_t BoundarySection::Ops::scan_section_rects(BoundarySection& self, cons
   std::size_t i = 0;
 #if defined(__SSE2__)
   const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), zero = _mm_setzero_ps(), vslack = _mm_set1_ps(slack);
-  const __m128 v_slo_x = _mm_set1_ps(s_lo_x), v_slo_y = _mm_set1_ps(s_lo_y), v_shi_x = _mm_set1_ps(s_hi_x), v_shi_y = _mm_set1_ps(s_hi_y);
+  const __m128 v_slo_x = _mm_set1_ps(s_lo_x), v_slo_y = _mm_set1_ps(s_lo_y), v_shi_x = _mm_set1_ps(s_hi_x),
+               v_shi_y = _mm_set1_ps(s_hi_y);
   static_assert(kMaxSectionEntries < (1u << 24), "entries are exact as floats (NearestOfFours)");
   NearestOfFours nearest_rect(n);
   for (; i < n; i += kScanLanes) {
-    const __m128 lx = _mm_loadu_ps(lo_x + i), ly = _mm_loadu_ps(lo_y + i), hx = _mm_loadu_ps(hi_x + i), hy = _mm_loadu_ps(hi_y + i);
+    const __m128 lx = _mm_loadu_ps(lo_x + i), ly = _mm_loadu_ps(lo_y + i), hx = _mm_loadu_ps(hi_x + i),
+                 hy = _mm_loadu_ps(hi_y + i);
     const __m128 dx = _mm_max_ps(_mm_sub_ps(_mm_max_ps(_mm_sub_ps(lx, vpx), _mm_sub_ps(vpx, hx)), vslack), zero);
     const __m128 dy = _mm_max_ps(_mm_sub_ps(_mm_max_ps(_mm_sub_ps(ly, vpy), _mm_sub_ps(vpy, hy)), vslack), zero);
     const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy));

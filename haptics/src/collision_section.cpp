@@ -12,7 +12,8 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, bool
 
 BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std::shared_ptr<const CutWalls> cuts)
     : scene_(&scene), merge_margin_m_(merge_margin_m), cuts_(std::move(cuts)) {
-  if (cuts_ && cuts_->scene != &scene) throw hk::ArgumentError("BoundarySection: the cut walls were made for another scene");
+  if (cuts_ && cuts_->scene != &scene)
+    throw hk::ArgumentError("BoundarySection: the cut walls were made for another scene");
   cut_mask_ = cuts_ ? cuts_->masks.data() : nullptr;
   const std::size_t n = scene.node_count();
   std::size_t widest_root = 0;  // widest fan-out of any node (chunks and hierarchy leaves: 4)
@@ -24,7 +25,7 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   // A node's state counts its children in the frontier in three bits (node_state_); the scene has at most 4 a node.
   if (widest_root > kChildrenInMask / kChildInUnit) {
     throw hk::ArgumentError("BoundarySection: a scene node has " + std::to_string(widest_root) +
-                                " children; the section counts at most " + std::to_string(kChildrenInMask / kChildInUnit));
+                            " children; the section counts at most " + std::to_string(kChildrenInMask / kChildInUnit));
   }
   // Room for every node twice: a level change's coarsening appends ancestors before its compaction drops the
   // entries they replace (splits and merges change the section in place).
@@ -35,7 +36,8 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   const WideIndex& wi = scene.wide_index();
   wide_base_ = static_cast<std::uint32_t>(n);
   const std::size_t ids = n + wi.nodes.size();  // scene nodes, then wide nodes (the wide frontier's ids)
-  if (ids >= kNoParent) throw hk::ArgumentError("BoundarySection: the scene's nodes and wide nodes exceed 32-bit section ids");
+  if (ids >= kNoParent)
+    throw hk::ArgumentError("BoundarySection: the scene's nodes and wide nodes exceed 32-bit section ids");
   capacity_ = std::min<std::size_t>(2 * ids, kMaxSectionEntries) + widest_root + 8;
   section_.reserve(capacity_);
   section_parent_.assign(capacity_, kNoParent);
@@ -63,7 +65,8 @@ BoundarySection::BoundarySection(const Scene& scene, double merge_margin_m, std:
   // The level ids whose walls the wide index holds: those at which every curve is at or below its item level.
   for (int id = 0; id < kCutLevelBase; ++id) {
     bool served = true;
-    for (std::size_t c = 0; c < scene.curve_count() && served; ++c) served = scene.clamp_level(c, id) <= wide_item_level(scene.curve(c).levels);
+    for (std::size_t c = 0; c < scene.curve_count() && served; ++c)
+      served = scene.clamp_level(c, id) <= wide_item_level(scene.curve(c).levels);
     wide_serves_[static_cast<std::size_t>(id)] = served;
   }
   reset();
@@ -73,8 +76,8 @@ std::size_t BoundarySection::bytes() const noexcept {
   const auto of = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return of(section_) + of(section_parent_) + of(section_rect_.lo_x) + of(section_rect_.lo_y) + of(section_rect_.hi_x) +
          of(section_rect_.hi_y) + of(rect_d_sq_) + of(rect_overlap_bits_) + of(rect_near_bits_) + of(node_state_) +
-         of(marked_) + of(candidates_) + of(stack_) + of(walk_.t_enter) + of(walk_.d_sq) +
-         of(walk_.code) + of(wide_up_) + of(item_up_) + of(item_first_);
+         of(marked_) + of(candidates_) + of(stack_) + of(walk_.t_enter) + of(walk_.d_sq) + of(walk_.code) +
+         of(wide_up_) + of(item_up_) + of(item_first_);
 }
 
 void BoundarySection::reset() noexcept {
@@ -104,18 +107,21 @@ void BoundarySection::Ops::push_section(BoundarySection& self, std::uint32_t nod
 // Puts node in the section at `entry` in place of the entry's node, with its rectangle, and marks it in and
 // counted among its parent's children in (`parent`: Scene::parent(node), or kNoParent for the root). The caller
 // marks the node it replaces out (mark_out).
-void BoundarySection::Ops::set_section_entry(BoundarySection& self, std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept {
+void BoundarySection::Ops::set_section_entry(BoundarySection& self, std::size_t entry, std::uint32_t node,
+                                             std::uint32_t parent) noexcept {
   self.section_rect_.set(entry, entry_rect(self, node));
   place_entry(self, entry, node, parent);
 }
 
 // set_section_entry but for the rectangle, which the caller stores.
-void BoundarySection::Ops::place_entry(BoundarySection& self, std::size_t entry, std::uint32_t node, std::uint32_t parent) noexcept {
+void BoundarySection::Ops::place_entry(BoundarySection& self, std::size_t entry, std::uint32_t node,
+                                       std::uint32_t parent) noexcept {
   self.section_[entry] = node;
   self.section_parent_[entry] = parent;
   self.node_state_[node] |= kInSection;
   // The count stays within its bits: at most the widest fan-out, checked at construction.
-  if (parent != kNoParent) self.node_state_[parent] = static_cast<std::uint8_t>(self.node_state_[parent] + kChildInUnit);
+  if (parent != kNoParent)
+    self.node_state_[parent] = static_cast<std::uint8_t>(self.node_state_[parent] + kChildInUnit);
 }
 
 // The parent of section id `node` in the frontier's hierarchy, or kNoParent for its root. The tree's: Scene::parent
@@ -131,7 +137,8 @@ std::uint32_t BoundarySection::Ops::parent_or_none(const BoundarySection& self, 
     const std::uint32_t c = sc.tag_curve(node);
     const CurveNodes& cn = sc.curve_nodes(c);
     const int item = wide_item_level(static_cast<int>(cn.levels));
-    if (sc.tag_level(node) == item) return self.wide_base_ + (self.item_up_[self.item_first_[c] + (node - cn.box_offset[item])] >> 2);
+    if (sc.tag_level(node) == item)
+      return self.wide_base_ + (self.item_up_[self.item_first_[c] + (node - cn.box_offset[item])] >> 2);
   }
   return node == sc.scene_root() ? kNoParent : sc.parent(node);
 }
@@ -180,7 +187,8 @@ Aabb BoundarySection::Ops::entry_rect(const BoundarySection& self, std::uint32_t
 // The children of section id `id` in the frontier's hierarchy, written to out (at most kMaxEntryChildren); returns
 // their count. A wide node's: its slots' wide nodes and items, empty slots left out; a scene node's: Scene::children
 // (the wide frontier never holds a scene node above the items).
-std::uint32_t BoundarySection::Ops::entry_children(const BoundarySection& self, std::uint32_t id, std::uint32_t* out) noexcept {
+std::uint32_t BoundarySection::Ops::entry_children(const BoundarySection& self, std::uint32_t id,
+                                                   std::uint32_t* out) noexcept {
   if (is_wide_id(self, id)) {
     const WideNode& nd = self.scene_->wide_index().nodes[id - self.wide_base_];
     std::uint32_t count = 0;
@@ -245,7 +253,8 @@ void BoundarySection::Ops::split_wide(BoundarySection& self, std::uint32_t node,
 // that entry's place and the others' entries are taken out (found by a scan of the section's parents, a few dozen).
 // False, with nothing changed, when they are not all found (never, for a frontier) or there are more than
 // kMaxSiblings (never: no node has more than 4 children, scene.hpp and wide_index.hpp).
-bool BoundarySection::Ops::merge_children(BoundarySection& self, std::size_t entry, std::uint32_t parent, const std::uint32_t* children, std::uint32_t count) noexcept {
+bool BoundarySection::Ops::merge_children(BoundarySection& self, std::size_t entry, std::uint32_t parent,
+                                          const std::uint32_t* children, std::uint32_t count) noexcept {
   constexpr std::size_t kMaxSiblings = 15;
   std::size_t sibling_entry[kMaxSiblings];
   std::size_t k = 0;

@@ -93,7 +93,8 @@ class NearestOfFours {
     };
     const __m128 at_min = _mm_cmpeq_ps(d_, min4(d_));
     const __m128 none = _mm_set1_ps(static_cast<float>(n_));
-    return static_cast<std::size_t>(_mm_cvtss_f32(min4(_mm_or_ps(_mm_and_ps(at_min, entry_), _mm_andnot_ps(at_min, none)))));
+    return static_cast<std::size_t>(
+        _mm_cvtss_f32(min4(_mm_or_ps(_mm_and_ps(at_min, entry_), _mm_andnot_ps(at_min, none)))));
   }
 
  private:

@@ -61,7 +61,8 @@ double BoundarySection::Ops::wide_walk(BoundarySection& self, Query& q, double b
         self.wide_ball_seed_ = e.code << 2 | static_cast<std::uint32_t>(i);
       }
       if (leaf && !(hit_mask & bit)) continue;
-      if (!push_walk(self, (hit_mask & bit) ? t_enter[i] : std::numeric_limits<float>::infinity(), d_sq[i], n.child[i], base, top)) {  // full: as past the budget
+      if (!push_walk(self, (hit_mask & bit) ? t_enter[i] : std::numeric_limits<float>::infinity(), d_sq[i], n.child[i],
+                     base, top)) {  // full: as past the budget
         ball_known = false;
         if (e.t_enter < q.unresolved_t) {
           q.unresolved_t = e.t_enter;
@@ -82,7 +83,8 @@ double BoundarySection::Ops::wide_walk(BoundarySection& self, Query& q, double b
 // walk's end (a real rectangle, so an upper bound on the nearest one's, and pruning at it from the root
 // down opens fewer nodes; the hand moves little between ticks), computed as near_node computes it, or
 // cap_sq when there is no such rectangle or it is farther.
-float BoundarySection::Ops::seeded_ball_sq(const BoundarySection& self, const WideIndex& wi, float bx, float by, float cap_sq) noexcept {
+float BoundarySection::Ops::seeded_ball_sq(const BoundarySection& self, const WideIndex& wi, float bx, float by,
+                                           float cap_sq) noexcept {
   if (self.wide_ball_seed_ == kWideEmpty) return cap_sq;
   const WideNode& n = wi.nodes[self.wide_ball_seed_ >> 2];
   const std::uint32_t i = self.wide_ball_seed_ & 3u;
@@ -103,7 +105,8 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
     none.segment = SegmentRef{-1, Scene::kMaxLevels, -1};
     return none;
   }
-  if (!Ops::wide_serves(*this, level)) return Ops::first_hit_tree(*this, a, b, level, excluded, excluded_count, budget, stats_out);
+  if (!Ops::wide_serves(*this, level))
+    return Ops::first_hit_tree(*this, a, b, level, excluded, excluded_count, budget, stats_out);
   const double r_sq = wide_ball_radius_m_ * wide_ball_radius_m_;
   if (length_sq(a - wide_ball_center_m_) < r_sq && length_sq(b - wide_ball_center_m_) < r_sq) {
     if (stats_out) *stats_out = QueryStats{};
@@ -126,8 +129,9 @@ SweepHit BoundarySection::first_hit_wide(Vec2 a, Vec2 b, int level, const Segmen
 // scene root, with no section and no ball (refine_candidates: nearest box first, pruned past the best hit, one
 // optional box test per box). Past the budget the answer is blocked at the nearest box left unrefined, named as
 // first_hit names it (finish).
-SweepHit BoundarySection::Ops::first_hit_tree(BoundarySection& self, Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
-                                              QueryBudget& budget, QueryStats* stats_out) noexcept {
+SweepHit BoundarySection::Ops::first_hit_tree(BoundarySection& self, Vec2 a, Vec2 b, int level,
+                                              const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
+                                              QueryStats* stats_out) noexcept {
   const Scene& sc = *self.scene_;
   Query q(a, b, level, excluded, excluded_count, budget);
   self.candidates_.clear();

@@ -11,9 +11,11 @@ ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params)
 
 ContactSolver::ContactSolver(const Scene& scene, const ContactParams& params, std::shared_ptr<const CutWalls> cuts)
     : scene_(&scene), params_(params), section_(scene, 3e-4, std::move(cuts)) {
-  for (int id = 0; id < kLevelIds; ++id) {  // a cut step without the masks renders as its tolerance step, as Scene gives it
+  for (int id = 0; id < kLevelIds;
+       ++id) {  // a cut step without the masks renders as its tolerance step, as Scene gives it
     const bool cut = is_cut_level(id) && section_.has_cuts();
-    max_wall_offset_m_[id] = cut ? 2.0 * section_.cut_bounds().error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
+    max_wall_offset_m_[id] =
+        cut ? 2.0 * section_.cut_bounds().error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
   }
 }
 
@@ -61,7 +63,8 @@ long ticks_of(double duration_s, double period_s) noexcept {
 }  // namespace
 
 bool ContactSolver::pop_due() const noexcept {
-  return params_.pop_force_n > 0.0 && state_ != ContactState::Free && press_ticks_ >= ticks_of(params_.pop_hold_s, params_.period_s);
+  return params_.pop_force_n > 0.0 && state_ != ContactState::Free &&
+         press_ticks_ >= ticks_of(params_.pop_hold_s, params_.period_s);
 }
 
 void ContactSolver::pop_through(Step& s) noexcept {
@@ -80,7 +83,8 @@ void ContactSolver::pop_through(Step& s) noexcept {
 
 Vec2 ContactSolver::release_force(Vec2 f) noexcept {
   if (release_left_ > 0) {
-    const double share = static_cast<double>(release_left_) / static_cast<double>(ticks_of(params_.pop_release_s, params_.period_s));
+    const double share =
+        static_cast<double>(release_left_) / static_cast<double>(ticks_of(params_.pop_release_s, params_.period_s));
     f += std::min(share, 1.0) * release_from_n_;
     --release_left_;
     const double mag = length(f);
@@ -128,7 +132,8 @@ bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) noe
   if (transition_level_ >= 0) return false;  // one change at a time
   // A curve's polylines at two levels lie within E = (largest wall offset at one level + at the other) of
   // each other, so a point between them lies within E of both; search twice as far.
-  const double e = max_wall_offset_m_[std::clamp(level_, 0, kLevelIds - 1)] + max_wall_offset_m_[std::clamp(new_level, 0, kLevelIds - 1)];
+  const double e = max_wall_offset_m_[std::clamp(level_, 0, kLevelIds - 1)] +
+                   max_wall_offset_m_[std::clamp(new_level, 0, kLevelIds - 1)];
   const double radius = 2.0 * e + 4.0 * params_.skin_m;
   // The curves that could have the proxy between their two levels: those it touches, and every curve within
   // the radius at either level, found nearest first by closest points that skip the curves found so far.
@@ -158,25 +163,27 @@ bool ContactSolver::level_change_is_safe(int new_level, QueryBudget* budget) noe
 bool ContactSolver::excluded_at(const Constraint& c, int level) const noexcept {
   if (c.level == level) return true;
   if (!section_.is_wall(c.seg, level)) return false;
-  if (!is_cut_level(level) && !is_cut_level(c.level)) return true;  // a level's segment: the same end points under every id
+  if (!is_cut_level(level) && !is_cut_level(c.level))
+    return true;  // a level's segment: the same end points under every id
   Vec2 a0, b0, a1, b1;
   section_.wall_points(c.seg, c.level, &a0, &b0);
   section_.wall_points(c.seg, level, &a1, &b1);
   return a0 == a1 && b0 == b1;
 }
 
-ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget, ContactOutput& out,
-                                           Constraint* hit_out) noexcept {
+ContactSolver::Move ContactSolver::move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget,
+                                           ContactOutput& out, Constraint* hit_out) noexcept {
   QueryStats st;
   const bool skip_new = excluded && excluded_at(*excluded, level);
-  SweepHit hit = section_.first_hit(proxy_, target, level, skip_new ? &excluded->seg : nullptr, skip_new ? 1 : 0, budget, &st);
+  SweepHit hit =
+      section_.first_hit(proxy_, target, level, skip_new ? &excluded->seg : nullptr, skip_new ? 1 : 0, budget, &st);
   int hit_level = level;
   if (transition_level_ >= 0) {
     // Just after a level change both levels are walls (see level_change_is_safe): the nearer one stops the move.
     QueryStats st2;
     const bool skip_old = excluded && excluded_at(*excluded, transition_level_);
-    const SweepHit old_hit =
-        section_.first_hit(proxy_, target, transition_level_, skip_old ? &excluded->seg : nullptr, skip_old ? 1 : 0, budget, &st2);
+    const SweepHit old_hit = section_.first_hit(proxy_, target, transition_level_, skip_old ? &excluded->seg : nullptr,
+                                                skip_old ? 1 : 0, budget, &st2);
     st.box_tests += st2.box_tests;
     st.section_box_tests += st2.section_box_tests;
     st.segment_tests += st2.segment_tests;
@@ -236,9 +243,15 @@ void ContactSolver::update(const ContactInput& in, ContactOutput& out) noexcept 
   bool rest = false;
   for (int iter = 0; iter < params_.max_iterations && !rest; ++iter) {
     switch (state_) {
-      case ContactState::Free: rest = step_free(s); break;
-      case ContactState::Edge: rest = step_edge(s); break;
-      case ContactState::Vertex: rest = step_vertex(s); break;
+      case ContactState::Free:
+        rest = step_free(s);
+        break;
+      case ContactState::Edge:
+        rest = step_edge(s);
+        break;
+      case ContactState::Vertex:
+        rest = step_vertex(s);
+        break;
     }
   }
   if (!rest) out.events |= kEventIterationLimit;
@@ -283,13 +296,14 @@ bool ContactSolver::step_edge(Step& s) noexcept {
   // Friction cone (see contact.hpp): inside it the proxy stays; outside, it slides to trail the
   // handle's foot point by μ_d · penetration.
   const double depth = -side * dot(g.n, h - g.a);  // > 0: the handle is behind the wall's line
-  const double t_off = dot(g.u, h - proxy_);        // the handle's lead along the edge [m]
+  const double t_off = dot(g.u, h - proxy_);       // the handle's lead along the edge [m]
   const double mu = sticking_ ? params_.static_friction : params_.dynamic_friction;
   if (std::fabs(t_off) <= mu * depth) {
     // Inside the cone: the proxy stays. A sliding proxy sticks again only once the hand has all but
     // stopped along the edge (Karnopp's stick band): otherwise a press that deepens while sliding
     // would re-stick it every few ticks and each break-away would be a μ_s − μ_d force step, a buzz.
-    if (!sticking_) sticking_ = mu > 0.0 && std::fabs(dot(g.u, s.in.handle_velocity_m_per_s)) <= params_.stick_speed_m_per_s;
+    if (!sticking_)
+      sticking_ = mu > 0.0 && std::fabs(dot(g.u, s.in.handle_velocity_m_per_s)) <= params_.stick_speed_m_per_s;
     return true;
   }
   sticking_ = false;
@@ -304,7 +318,8 @@ bool ContactSolver::step_edge(Step& s) noexcept {
     c_[1] = hit;
     s.out.events |= kEventVertexBegin;
     const SegGeom gh = geom(hit);  // the angle between the two walls' lines, in [0, π/2]
-    s.out.corner_turn_rad = std::max(s.out.corner_turn_rad, std::atan2(std::fabs(cross(g.u, gh.u)), std::fabs(dot(g.u, gh.u))));
+    s.out.corner_turn_rad =
+        std::max(s.out.corner_turn_rad, std::atan2(std::fabs(cross(g.u, gh.u)), std::fabs(dot(g.u, gh.u))));
     return false;
   }
   if (clamped == 0) return true;

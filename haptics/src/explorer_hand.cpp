@@ -14,26 +14,30 @@ namespace {
 
 void require(bool ok, const char* field, const std::string& limit, double value) {
   if (!ok || !std::isfinite(value)) {
-    throw hk::ArgumentError(std::string("explorer hand: ") + field + " = " + std::to_string(value) + " is outside " + limit);
+    throw hk::ArgumentError(std::string("explorer hand: ") + field + " = " + std::to_string(value) + " is outside " +
+                            limit);
   }
 }
 
-constexpr double kMarginM = 0.003;        // the sweep keeps this far inside the workspace edge [m]
-constexpr double kWaypointReachM = 0.0015; // a plan's end is reached within this [m]
-constexpr double kPlanAheadM = 0.004;      // the next plan is made from the goal when the handle is this near it [m]
+constexpr double kMarginM = 0.003;          // the sweep keeps this far inside the workspace edge [m]
+constexpr double kWaypointReachM = 0.0015;  // a plan's end is reached within this [m]
+constexpr double kPlanAheadM = 0.004;       // the next plan is made from the goal when the handle is this near it [m]
 // Push with this times pop_force_n: over the wall's give-way force, but under the force a wall is clamped at
 // (3.5 N against the 3 N default), so the handle stops a few mm in and the press is held, not lost.
 constexpr double kPopFactor = 1.1;
-constexpr double kPopExtraS = 0.15;        // push for pop_hold_s plus this
-constexpr double kTurnRadiusM = 0.002;    // a trace that lost its wall turns towards it on this radius [m]
+constexpr double kPopExtraS = 0.15;          // push for pop_hold_s plus this
+constexpr double kTurnRadiusM = 0.002;       // a trace that lost its wall turns towards it on this radius [m]
 constexpr long kPopTriesBeforeGivingUp = 3;  // pushes that all failed before the hand stops pushing
-constexpr double kReleaseIgnoreS = 0.06;   // after a push-through, forces are not walls for this long [s]
-constexpr double kWallCostM = 0.03;               // planning: entering a remembered wall costs this much travel (~ a push) [m]
-constexpr double kCrossAheadM = 0.006;     // a remembered wall felt is pushed through if the plan crosses it this near [m]
-constexpr int kRunMaxCells = 10;           // a plan runs on along its line at most this many cells (1.5 cm at the default cell)
-constexpr double kGrooveReachM = 0.003;    // a groove is felt this far from its curve ([haptics] groove_capture_radius_m) [m]
-constexpr double kSmallLoopM2 = 1e-4;      // a loop felt round enclosing less than this (1 cm²): its inside is not planned to [m²]
-constexpr double kBlockingCos = 0.7;       // a wall whose force turns the way back by more than ~135° stands across it           // a plan runs on along its line at most this many cells
+constexpr double kReleaseIgnoreS = 0.06;     // after a push-through, forces are not walls for this long [s]
+constexpr double kWallCostM = 0.03;     // planning: entering a remembered wall costs this much travel (~ a push) [m]
+constexpr double kCrossAheadM = 0.006;  // a remembered wall felt is pushed through if the plan crosses it this near [m]
+constexpr int kRunMaxCells = 10;  // a plan runs on along its line at most this many cells (1.5 cm at the default cell)
+constexpr double kGrooveReachM =
+    0.003;  // a groove is felt this far from its curve ([haptics] groove_capture_radius_m) [m]
+constexpr double kSmallLoopM2 =
+    1e-4;  // a loop felt round enclosing less than this (1 cm²): its inside is not planned to [m²]
+constexpr double kBlockingCos = 0.7;  // a wall whose force turns the way back by more than ~135° stands across it // a
+                                      // plan runs on along its line at most this many cells
 
 }  // namespace
 
@@ -42,8 +46,10 @@ void ExplorerParams::validate() const {
   require(workspace_height_m > 0 && workspace_height_m <= 1, "workspace_height_m", "(0, 1] m", workspace_height_m);
   require(sweep_spacing_m > 0 && sweep_spacing_m <= std::min(workspace_width_m, workspace_height_m), "sweep_spacing_m",
           "(0, the smaller workspace side] m", sweep_spacing_m);
-  require(sweep_speed_m_per_s > 0 && sweep_speed_m_per_s <= 5, "sweep_speed_m_per_s", "(0, 5] m/s", sweep_speed_m_per_s);
-  require(trace_speed_m_per_s > 0 && trace_speed_m_per_s <= 5, "trace_speed_m_per_s", "(0, 5] m/s", trace_speed_m_per_s);
+  require(sweep_speed_m_per_s > 0 && sweep_speed_m_per_s <= 5, "sweep_speed_m_per_s", "(0, 5] m/s",
+          sweep_speed_m_per_s);
+  require(trace_speed_m_per_s > 0 && trace_speed_m_per_s <= 5, "trace_speed_m_per_s", "(0, 5] m/s",
+          trace_speed_m_per_s);
   require(contact_force_n > 0 && contact_force_n <= 50, "contact_force_n", "(0, 50] N", contact_force_n);
   require(max_force_n > 0 && max_force_n <= 50, "max_force_n", "(0, 50] N", max_force_n);
   require(press_force_n > 0 && press_force_n < max_force_n, "press_force_n", "(0, max_force_n) N", press_force_n);
@@ -79,7 +85,8 @@ ExplorerHand::ExplorerHand(const ExplorerParams& p) : p_(p), rng_(p.seed) {
   half_strip_ = std::max(0, static_cast<int>(std::lround(p_.sweep_spacing_m / p_.cell_m)) - 1);
   // The start: the seed's corner, kMarginM inside the workspace; the first run heads away from it.
   const bool left = corner_ == 0 || corner_ == 3, top = corner_ == 0 || corner_ == 1;
-  start_ = {(left ? -1 : 1) * (p_.workspace_width_m / 2 - kMarginM), (top ? 1 : -1) * (p_.workspace_height_m / 2 - kMarginM)};
+  start_ = {(left ? -1 : 1) * (p_.workspace_width_m / 2 - kMarginM),
+            (top ? 1 : -1) * (p_.workspace_height_m / 2 - kMarginM)};
   run_dir_ = orient0_ == 0 ? (left ? 1 : -1) : (top ? 1 : -1);
   start_pass();
   carrot_ = start_;
@@ -132,7 +139,8 @@ bool ExplorerHand::traced_near(Vec2 p) const noexcept {
 
 Vec2 ExplorerHand::cell_centre(int i) const noexcept {
   const int ix = i % nx_, iy = i / nx_;
-  return {(ix - 1 + 0.5) * p_.cell_m - p_.workspace_width_m / 2, (iy - 1 + 0.5) * p_.cell_m - p_.workspace_height_m / 2};
+  return {(ix - 1 + 0.5) * p_.cell_m - p_.workspace_width_m / 2,
+          (iy - 1 + 0.5) * p_.cell_m - p_.workspace_height_m / 2};
 }
 
 bool ExplorerHand::targetable(int i) const noexcept {
@@ -192,7 +200,8 @@ bool ExplorerHand::passable(int from, int to) const noexcept {
 
 double ExplorerHand::step_cost(int from, int to, bool diagonal) const noexcept {
   double c = (diagonal ? std::sqrt(2.0) : 1.0) * p_.cell_m;
-  if (!p_.grooves && traced_[static_cast<std::size_t>(to)] != 0 && traced_[static_cast<std::size_t>(from)] == 0) c += kWallCostM;
+  if (!p_.grooves && traced_[static_cast<std::size_t>(to)] != 0 && traced_[static_cast<std::size_t>(from)] == 0)
+    c += kWallCostM;
   return c;
 }
 
@@ -230,7 +239,9 @@ bool ExplorerHand::plan(Vec2 handle) {
         const int j = jy * nx_ + jx;
         const bool diagonal = dx != 0 && dy != 0;
         // No cutting a corner between two cells of a remembered wall.
-        if (diagonal && !p_.grooves && (traced_[static_cast<std::size_t>(iy * nx_ + jx)] != 0 || traced_[static_cast<std::size_t>(jy * nx_ + ix)] != 0))
+        if (diagonal && !p_.grooves &&
+            (traced_[static_cast<std::size_t>(iy * nx_ + jx)] != 0 ||
+             traced_[static_cast<std::size_t>(jy * nx_ + ix)] != 0))
           continue;
         if (!passable(i, j)) continue;
         const double cj = c + step_cost(i, j, diagonal);
@@ -353,13 +364,21 @@ HandCommand ExplorerHand::command(const HandFeel& feel_in) {
   const double dt = started_ ? std::clamp(f.t_s - last_t_, 0.0, 0.1) : 0.0;
   started_ = true;
   last_t_ = f.t_s;
-  (phase_ == ExplorerPhase::Move ? stats_.move_s : phase_ == ExplorerPhase::Trace ? stats_.trace_s : stats_.pop_s) += dt;
+  (phase_ == ExplorerPhase::Move    ? stats_.move_s
+   : phase_ == ExplorerPhase::Trace ? stats_.trace_s
+                                    : stats_.pop_s) += dt;
   mark_seen(f.handle_m);
   HandCommand c;
   switch (phase_) {
-    case ExplorerPhase::Move: c = step_move(f, dt); break;
-    case ExplorerPhase::Trace: c = step_trace(f, dt); break;
-    case ExplorerPhase::Pop: c = step_pop(f); break;
+    case ExplorerPhase::Move:
+      c = step_move(f, dt);
+      break;
+    case ExplorerPhase::Trace:
+      c = step_trace(f, dt);
+      break;
+    case ExplorerPhase::Pop:
+      c = step_pop(f);
+      break;
   }
   last_handle_ = f.handle_m;
   return c;
@@ -449,7 +468,8 @@ void ExplorerHand::check_goal(const HandFeel& f) {
     // Nearly there: what lies between the handle and the goal will be seen; plan on from the goal, so the hand
     // does not stop at every goal.
     const double d = distance(f.handle_m, goal);
-    for (double u = 0.0; u <= d; u += 0.5 * p_.cell_m) mark_seen(f.handle_m + (u / std::max(d, 1e-12)) * (goal - f.handle_m));
+    for (double u = 0.0; u <= d; u += 0.5 * p_.cell_m)
+      mark_seen(f.handle_m + (u / std::max(d, 1e-12)) * (goal - f.handle_m));
     mark_seen(goal);
     if (replan(goal)) {
       waypoints_.insert(waypoints_.begin(), goal);
@@ -499,7 +519,8 @@ bool ExplorerHand::feel_trace_wall(const HandFeel& f, double dt) {
     lost_since_ = -1.0;
   } else {
     if (lost_since_ < 0) lost_since_ = f.t_s;
-    const double turn = static_cast<double>(sense_) * std::max(p_.trace_speed_m_per_s, length(f.handle_velocity_m_per_s)) / kTurnRadiusM * dt;
+    const double turn = static_cast<double>(sense_) *
+                        std::max(p_.trace_speed_m_per_s, length(f.handle_velocity_m_per_s)) / kTurnRadiusM * dt;
     n_ = Vec2{n_.x * std::cos(turn) - n_.y * std::sin(turn), n_.x * std::sin(turn) + n_.y * std::cos(turn)};
   }
   return touching;
@@ -516,11 +537,13 @@ void ExplorerHand::note_trace_travel(const HandFeel& f, bool touching) {
   const int i = cell_index(f.handle_m);
   const bool own_old = i >= 0 && traced_[static_cast<std::size_t>(i)] == trace_id_ &&
                        travelled_ - traced_at_m_[static_cast<std::size_t>(i)] > p_.loop_min_m;
-  const bool other = i >= 0 && traced_[static_cast<std::size_t>(i)] != 0 && traced_[static_cast<std::size_t>(i)] != trace_id_;
+  const bool other =
+      i >= 0 && traced_[static_cast<std::size_t>(i)] != 0 && traced_[static_cast<std::size_t>(i)] != trace_id_;
   // Travel since a new wall was last felt: over old walls, or off any wall (circling at an end that keeps
   // brushing the wall it left), it grows.
   retraced_ = (touching && !own_old && !other) ? 0.0 : retraced_ + moved;
-  if (trace_path_.empty() || distance(trace_path_.back(), f.handle_m) > 0.5 * p_.cell_m) trace_path_.push_back(f.handle_m);
+  if (trace_path_.empty() || distance(trace_path_.back(), f.handle_m) > 0.5 * p_.cell_m)
+    trace_path_.push_back(f.handle_m);
   if (touching) {
     mark_traced(f.handle_m);
     if (!p_.grooves) mark_traced(f.handle_m + 0.0015 * n_);
@@ -537,7 +560,8 @@ void ExplorerHand::note_trace_travel(const HandFeel& f, bool touching) {
 // Whether the trace ends this tick, each end counted in stats_: round (back at the start going the same way, not
 // passing it on the far side of a thin stroke), timed out, lost the wall, retracing old walls, or stalled.
 bool ExplorerHand::trace_ends(const HandFeel& f) {
-  if (start_settled_ && travelled_ - travelled_at_start_ > p_.loop_min_m && distance(f.handle_m, trace_start_) < p_.loop_close_m &&
+  if (start_settled_ && travelled_ - travelled_at_start_ > p_.loop_min_m &&
+      distance(f.handle_m, trace_start_) < p_.loop_close_m &&
       dot(static_cast<double>(sense_) * left_perp(n_), start_heading_) > 0.5) {
     ++stats_.traces_closed;
     skip_small_loop();
@@ -574,7 +598,8 @@ HandCommand ExplorerHand::trace_command(const HandFeel& f, double dt, bool touch
   if (p_.grooves) {
     // The groove steers: keep going the way the handle goes, pulled lightly towards the curve.
     const Vec2 v = f.handle_velocity_m_per_s;
-    if (length(v) > 0.3 * p_.trace_speed_m_per_s) heading_ = normalized_or(0.9 * heading_ + 0.1 * normalized_or(v, heading_), heading_);
+    if (length(v) > 0.3 * p_.trace_speed_m_per_s)
+      heading_ = normalized_or(0.9 * heading_ + 0.1 * normalized_or(v, heading_), heading_);
     const Vec2 pull = touching ? (0.3 * p_.press_force_n / k) * n_ : Vec2{};
     return HandCommand{f.handle_m + lookahead_m_ * heading_ + pull, p_.max_force_n};
   }

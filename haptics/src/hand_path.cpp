@@ -35,8 +35,8 @@ Vec2 HandPath::at(double t_s) const noexcept {
   if (!(t_s > samples_.front().t_s)) return samples_.front().target_m;
   if (t_s >= samples_.back().t_s) return samples_.back().target_m;
   // First sample strictly after t; its predecessor exists because t > front.t.
-  const auto hi = std::upper_bound(samples_.begin(), samples_.end(), t_s,
-                                   [](double t, const HandSample& s) { return t < s.t_s; });
+  const auto hi =
+      std::upper_bound(samples_.begin(), samples_.end(), t_s, [](double t, const HandSample& s) { return t < s.t_s; });
   const auto lo = hi - 1;
   const double u = (t_s - lo->t_s) / (hi->t_s - lo->t_s);
   return lerp(lo->target_m, hi->target_m, u);
@@ -154,7 +154,8 @@ class Reader {
     for (auto c = sb->sbumpc(); !traits::eq_int_type(c, traits::eof()); c = sb->sbumpc()) {
       if (traits::to_char_type(c) == '\n') break;
       // One extra character is allowed through for a '\r' of a CRLF line end.
-      if (line.size() > max_chars) fail(line_no, "line longer than " + std::to_string(max_chars) + " characters (limit)");
+      if (line.size() > max_chars)
+        fail(line_no, "line longer than " + std::to_string(max_chars) + " characters (limit)");
       line += traits::to_char_type(c);
     }
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -180,7 +181,8 @@ class Reader {
         const auto [ptr, err] = std::from_chars(b, e, v[count]);
         // from_chars reports out-of-range (1e999) as result_out_of_range: that is a non-finite value.
         if (err == std::errc::result_out_of_range && ptr == e) {
-          fail(line_no, std::string("field ") + kNames[count] + " '" + hk::one_line(field, 40) + "' is out of the range of a double");
+          fail(line_no, std::string("field ") + kNames[count] + " '" + hk::one_line(field, 40) +
+                            "' is out of the range of a double");
         }
         if (field.empty() || err != std::errc() || ptr != e) {
           fail(line_no, std::string("field ") + kNames[count] + " '" + hk::one_line(field, 40) + "' is not a number");

@@ -43,9 +43,11 @@ double wrap180(double deg) {
 FirmwareEmulator::FirmwareEmulator(const EmulatorParams& params, Vec2 start_handle_device_m, HandForce hand)
     : params_(params), hand_(std::move(hand)), rng_(params.faults.seed) {
   const EmulatorParams& p = params_;
-  if (!finite_pos(p.mechanism.proximal_m) || !finite_pos(p.mechanism.distal_m) || !std::isfinite(p.mechanism.motor_spacing_m) ||
-      p.mechanism.motor_spacing_m < 0.0) {
-    bad_param("link lengths must be finite and > 0, the motor spacing finite and >= 0 (0: coaxial motors, the original 2DIY)");
+  if (!finite_pos(p.mechanism.proximal_m) || !finite_pos(p.mechanism.distal_m) ||
+      !std::isfinite(p.mechanism.motor_spacing_m) || p.mechanism.motor_spacing_m < 0.0) {
+    bad_param(
+        "link lengths must be finite and > 0, the motor spacing finite and >= 0 (0: coaxial motors, the original "
+        "2DIY)");
   }
   if (!finite_pos(p.torque_limit_n_m)) bad_param("torque_limit_n_m must be finite and > 0");
   if (!finite_pos(p.period_s)) bad_param("period_s must be finite and > 0");
@@ -148,8 +150,7 @@ int FirmwareEmulator::execute_front() {
   }
 }
 
-void FirmwareEmulator::do_setup(const std::uint8_t* b, int sensors_at, int sensor_count, int pwm_count,
-                                int float_at) {
+void FirmwareEmulator::do_setup(const std::uint8_t* b, int sensors_at, int sensor_count, int pwm_count, int float_at) {
   // reset_device first.
   for (PortState& ps : ports_) {
     ps.motor_host = 0;
@@ -169,7 +170,7 @@ void FirmwareEmulator::do_setup(const std::uint8_t* b, int sensors_at, int senso
 
   for (int i = 0; i < sensor_count; ++i) {
     const int pin = static_cast<int>(b[sensors_at + i]) - 40;  // host pin 54.. → M0 analog 14..
-    if (pin >= 14 && pin <= 18) sensor_host_[pin - 14] = id;  // 19 would overrun the board's array
+    if (pin >= 14 && pin <= 18) sensor_host_[pin - 14] = id;   // 19 would overrun the board's array
   }
   const int pwm_at = sensors_at + sensor_count + 1;
   for (int i = 0; i < pwm_count; ++i) {
@@ -264,8 +265,8 @@ std::int32_t FirmwareEmulator::encoder_count(int port) const noexcept {
   double th[2];
   true_haply_deg(&th[0], &th[1]);
   const int joint = params_.port_joint[port] - 1;
-  const double moved_deg = ps.encoder_sign * wrap180(th[joint] - params_.reference_deg[joint]) +
-                           params_.calibration_error_deg[joint];
+  const double moved_deg =
+      ps.encoder_sign * wrap180(th[joint] - params_.reference_deg[joint]) + params_.calibration_error_deg[joint];
   const double ticks = std::floor(moved_deg * static_cast<double>(ps.enc_resolution_half) / 360.0 + 1e-9);
   const double total = static_cast<double>(ps.count_at_setup) + (std::isfinite(ticks) ? ticks : 0.0);
   return static_cast<std::int32_t>(std::clamp(total, -2.0e9, 2.0e9));

@@ -51,7 +51,8 @@ std::string level_label(int id) {
   const int step = tolerance_step_of(id);
   if (step < 0) return "level " + std::to_string(id);
   char text[40];
-  std::snprintf(text, sizeof text, is_cut_level(id) ? "cut %.2f mm" : "tolerance %.2f mm", kToleranceLadder_m[step] * 1e3);
+  std::snprintf(text, sizeof text, is_cut_level(id) ? "cut %.2f mm" : "tolerance %.2f mm",
+                kToleranceLadder_m[step] * 1e3);
   return text;
 }
 

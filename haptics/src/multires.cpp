@@ -89,7 +89,8 @@ void pseudocoiflet_forward(const std::vector<double>& x, bool closed, std::vecto
   forward_step(x.data(), n, closed, e.data(), s.data(), d.data());
 }
 
-void pseudocoiflet_inverse(const std::vector<double>& s, const std::vector<double>& d, bool closed, std::vector<double>& x) {
+void pseudocoiflet_inverse(const std::vector<double>& s, const std::vector<double>& d, bool closed,
+                           std::vector<double>& x) {
   const std::size_t ne = s.size();
   const std::size_t no = d.size();
   if (closed ? (no != ne || ne < 4) : (no + 1 != ne || ne < 4)) {
@@ -103,7 +104,9 @@ void pseudocoiflet_inverse(const std::vector<double>& s, const std::vector<doubl
   for (std::size_t k = 0; k < no; ++k) x[2 * k + 1] = d[k] + predict(e.data(), ne, k, closed);
 }
 
-std::size_t arc_table_size(const Polyline& curve) { return curve.closed ? curve.points_m.size() + 1 : curve.points_m.size(); }
+std::size_t arc_table_size(const Polyline& curve) {
+  return curve.closed ? curve.points_m.size() + 1 : curve.points_m.size();
+}
 
 double arc_table(const Polyline& curve, double* cum) {
   const auto& p = curve.points_m;
@@ -129,7 +132,8 @@ void resample_arc_length(const Polyline& curve, const double* cum, std::size_t c
   const double step = resample_step_m(total, count, curve.closed);
   std::size_t seg = 0;
   for (std::size_t i = 0; i < count; ++i) {
-    const double s = level0_arc_m(total, step, count, curve.closed, i);  // an open curve lands exactly on its last point
+    const double s =
+        level0_arc_m(total, step, count, curve.closed, i);  // an open curve lands exactly on its last point
     while (seg + 1 < nseg && cum[seg + 1] < s) ++seg;
     const double len = cum[seg + 1] - cum[seg];
     const double t = len > 0.0 ? std::clamp((s - cum[seg]) / len, 0.0, 1.0) : 0.0;
@@ -153,7 +157,8 @@ std::size_t level_point_count(std::size_t level0_points, bool closed, int level)
   return closed ? level0_points >> level : ((level0_points - 1) >> level) + 1;
 }
 
-void forward_levels(Vec2* const* scaling, Vec2* const* wavelet, std::size_t level0_points, bool closed, int levels, Vec2* scratch) {
+void forward_levels(Vec2* const* scaling, Vec2* const* wavelet, std::size_t level0_points, bool closed, int levels,
+                    Vec2* scratch) {
   for (int l = 1; l < levels; ++l) {  // both coordinates in one pass (bit for bit the per-coordinate step)
     const std::size_t n = level_point_count(level0_points, closed, l - 1);
     check_forward_size(n, closed);

@@ -104,12 +104,12 @@ Vec2 handle_force(const Mat2& J, Torques tau) noexcept {
   const double scale = std::max({std::abs(J.a11), std::abs(J.a12), std::abs(J.a21), std::abs(J.a22)});
   if (!std::isfinite(d) || !std::isfinite(scale) || !(std::abs(d) > 1e-12 * scale * scale)) return {};
   // Solve Jᵀ·F = τ; (Jᵀ)⁻¹ = [[a22, −a21], [−a12, a11]] / det J.
-  const Vec2 f{(J.a22 * tau.tau1_n_m - J.a21 * tau.tau2_n_m) / d,
-               (-J.a12 * tau.tau1_n_m + J.a11 * tau.tau2_n_m) / d};
+  const Vec2 f{(J.a22 * tau.tau1_n_m - J.a21 * tau.tau2_n_m) / d, (-J.a12 * tau.tau1_n_m + J.a11 * tau.tau2_n_m) / d};
   return is_finite(f) ? f : Vec2{};
 }
 
-double min_force_everywhere_n(const PantographGeometry& g, Vec2 rect_center_m, Vec2 rect_size_m, double torque_limit_n_m) noexcept {
+double min_force_everywhere_n(const PantographGeometry& g, Vec2 rect_center_m, Vec2 rect_size_m,
+                              double torque_limit_n_m) noexcept {
   if (!is_finite(rect_center_m) || !is_finite(rect_size_m) || !(rect_size_m.x > 0.0) || !(rect_size_m.y > 0.0) ||
       !(torque_limit_n_m > 0.0) || !std::isfinite(torque_limit_n_m))
     return 0.0;
@@ -117,7 +117,8 @@ double min_force_everywhere_n(const PantographGeometry& g, Vec2 rect_center_m, V
   double least = std::numeric_limits<double>::infinity();
   for (int iy = 0; iy < kGrid; ++iy)
     for (int ix = 0; ix < kGrid; ++ix) {
-      const Vec2 at = rect_center_m + Vec2{(ix / (kGrid - 1.0) - 0.5) * rect_size_m.x, (iy / (kGrid - 1.0) - 0.5) * rect_size_m.y};
+      const Vec2 at =
+          rect_center_m + Vec2{(ix / (kGrid - 1.0) - 0.5) * rect_size_m.x, (iy / (kGrid - 1.0) - 0.5) * rect_size_m.y};
       JointAngles q;
       if (!inverse_kinematics(g, at, &q)) return 0.0;
       const Mat2 J = jacobian(g, q);

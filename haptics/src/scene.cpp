@@ -12,7 +12,8 @@ bool box_contains(const ErrorBox& box, Vec2 p, double margin_m) {
   const Vec2 r = p - box.origin_m;
   const double u = dot(r, box.axis);
   const double n = cross(box.axis, r);
-  return u >= box.u_min - margin_m && u <= box.u_max + margin_m && n >= box.n_min - margin_m && n <= box.n_max + margin_m;
+  return u >= box.u_min - margin_m && u <= box.u_max + margin_m && n >= box.n_min - margin_m &&
+         n <= box.n_max + margin_m;
 }
 
 void box_corners(const ErrorBox& box, Vec2 out[4]) {
@@ -31,8 +32,10 @@ double box_error_bound(const ErrorBox& box, double segment_length_m) {
 
 std::size_t Scene::hot_bytes() const {
   return points_m_.size() * sizeof(Vec2) + extent_.size() * sizeof(BoxExtent) + tag_.size() * sizeof(std::uint32_t) +
-         curve_nodes_.size() * sizeof(CurveNodes) + group_box_.size() * sizeof(Aabb) + group_info_.size() * sizeof(NodeInfo) +
-         (group_parent_.size() + group_child_first_.size() + group_child_count_.size() + chunk_of_curve_.size()) * sizeof(std::uint32_t) +
+         curve_nodes_.size() * sizeof(CurveNodes) + group_box_.size() * sizeof(Aabb) +
+         group_info_.size() * sizeof(NodeInfo) +
+         (group_parent_.size() + group_child_first_.size() + group_child_count_.size() + chunk_of_curve_.size()) *
+             sizeof(std::uint32_t) +
          wide_.bytes();
 }
 
@@ -59,13 +62,15 @@ std::size_t Scene::total_segments(int level) const {
 
 double Scene::max_box_half_width_m(int level) const {
   double widest = 0.0;
-  for (std::size_t c = 0; c < curves_.size(); ++c) widest = std::max(widest, curves_[c].max_box_half_width_m[clamp_level(c, level)]);
+  for (std::size_t c = 0; c < curves_.size(); ++c)
+    widest = std::max(widest, curves_[c].max_box_half_width_m[clamp_level(c, level)]);
   return widest;
 }
 
 double Scene::max_error_bound_m(int level) const {
   double bound = 0.0;
-  for (std::size_t c = 0; c < curves_.size(); ++c) bound = std::max(bound, curves_[c].max_error_bound_m[clamp_level(c, level)]);
+  for (std::size_t c = 0; c < curves_.size(); ++c)
+    bound = std::max(bound, curves_[c].max_error_bound_m[clamp_level(c, level)]);
   return bound;
 }
 

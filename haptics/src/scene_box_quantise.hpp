@@ -28,7 +28,10 @@ struct Extent {
 class BoxGrower {
  public:
   BoxGrower(Vec2 a, Vec2 axis, double length_m)
-      : origin_(load(a)), axis_x_(lanes(axis.x, axis.x)), axis_y_(lanes(axis.y, -axis.y)), clamp_hi_(lanes(length_m, 0.0)) {}
+      : origin_(load(a)),
+        axis_x_(lanes(axis.x, axis.x)),
+        axis_y_(lanes(axis.y, -axis.y)),
+        clamp_hi_(lanes(length_m, 0.0)) {}
 
   // q's frame coordinates (u, n) = (r·axis, axis×r), r = q − a: r·(ax, ax) + swap(r)·(ay, −ay), bit for bit
   // what dot() and cross() give.
@@ -125,7 +128,7 @@ class ReachGrower {
     most_ = max(most_, r);
     bound_sq_ = max(bound_sq_, r2 + swapped(r2));
   }
-  double half_width() const { return lane1(most_); }  // [quanta]
+  double half_width() const { return lane1(most_); }    // [quanta]
   double bound_sq() const { return lane0(bound_sq_); }  // [quanta²]
 
  private:
@@ -152,10 +155,12 @@ inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, dou
   };
   const Lanes2 below = e.lo;
   const Lanes2 above = swapped(e.hi), offset = lanes(0.0, length_m);
-  const auto k_over = [&](Lanes2 t) { return where_less(below, t * lq); };                     // k·q > v
-  const auto k_short = [&](Lanes2 t) { return where_less_equal((t + one) * lq, below); };       // (k + 1)·q ≤ v
-  const auto m_short = [&](Lanes2 t) { return where_less(offset + t * lq, above); };           // short of v
-  const auto m_over = [&](Lanes2 t) { return where_less_equal(above, offset + (t - one) * lq); };  // one less still reaches v
+  const auto k_over = [&](Lanes2 t) { return where_less(below, t * lq); };                 // k·q > v
+  const auto k_short = [&](Lanes2 t) { return where_less_equal((t + one) * lq, below); };  // (k + 1)·q ≤ v
+  const auto m_short = [&](Lanes2 t) { return where_less(offset + t * lq, above); };       // short of v
+  const auto m_over = [&](Lanes2 t) {
+    return where_less_equal(above, offset + (t - one) * lq);
+  };  // one less still reaches v
   Lanes2 k = truncated(below * lanes(inverse_q, inverse_q) - one);
   Lanes2 m = truncated((above - offset) * lanes(inverse_q, inverse_q) + one);
   // One test of all four conditions (the guesses are almost always right); the steps only when one holds.
@@ -170,7 +175,8 @@ inline BoxExtent quantise_extent(const Extent& e, double length_m, double q, dou
 // A segment's frame (Scene::segment_frame: its unit axis and length [m]) and its measured extents in it,
 // padded [m].
 struct SegmentExtent {
-  SegmentExtent() {}  // not zeroed: level_frames and the box pass write every field of a level's entries before they are read
+  SegmentExtent() {
+  }  // not zeroed: level_frames and the box pass write every field of a level's entries before they are read
   Extent e;
   Vec2 axis;
   double length_m;
@@ -186,7 +192,7 @@ inline void level_frames(const Vec2* points, std::size_t count, SegmentExtent* o
   for (; k + 1 < count; k += 2) {
     const Lanes2 p1 = load(points[k + 1]);
     const Lanes2 d0 = p1 - load(points[k]), d1 = load(points[k + 2]) - p1;  // (dx, dy) of each
-    const Lanes2 dx = low_lanes(d0, d1), dy = high_lanes(d0, d1);          // of both
+    const Lanes2 dx = low_lanes(d0, d1), dy = high_lanes(d0, d1);           // of both
     const Lanes2 len = sqrt(dx * dx + dy * dy);
     const Lanes2 inverse = one / len;
     const Lanes2 ax = where_greater(len, tiny, dx * inverse, one), ay = where_greater(len, tiny, dy * inverse, zero);

@@ -92,8 +92,10 @@ class SceneBuild {
         nslots += ci.segment_count[l] + 1;
       }
     }
-    if (nslots >= std::numeric_limits<std::uint32_t>::max() / 2 || scene.curves_.size() >= (std::size_t{1} << (32 - Scene::kTagLevelBits))) {
-      throw hk::ArgumentError("scene: " + std::to_string(scene.curves_.size()) + " curves and " + std::to_string(nslots) +
+    if (nslots >= std::numeric_limits<std::uint32_t>::max() / 2 ||
+        scene.curves_.size() >= (std::size_t{1} << (32 - Scene::kTagLevelBits))) {
+      throw hk::ArgumentError("scene: " + std::to_string(scene.curves_.size()) + " curves and " +
+                              std::to_string(nslots) +
                               " segment slots are over the 32-bit node ids' limit");  // far beyond any picture's budget
     }
     scene.segment_nodes_ = nslots;
@@ -173,7 +175,8 @@ class SceneBuild {
   // integer; the steps after it (rarely taken, so predicted) make it the least k for which the comparison
   // holds, as the walk evaluated it. A walk's loop exit would follow the vertices' irregular spacing and be
   // mispredicted about once a segment.
-  static void map_originals(const CurveInfo& ci, const Polyline& src, const double* cum, std::vector<std::uint32_t>& orig_first) {
+  static void map_originals(const CurveInfo& ci, const Polyline& src, const double* cum,
+                            std::vector<std::uint32_t>& orig_first) {
     const std::size_t n = src.points_m.size();
     const std::size_t s0 = ci.segment_count[0], n0 = ci.point_count[0];
     const double step = resample_step_m(ci.length_m, n0, ci.closed);  // divided once per curve
@@ -183,7 +186,7 @@ class SceneBuild {
     for (std::size_t j = 0; j < n; ++j) {
       const double x = cum[j];  // 0 ≤ x ≤ length_m
       auto key = std::min(static_cast<std::size_t>(x * inverse_step) + 1, s0);
-      while (key > 1 && x < start(key - 1)) --key;   // cum[0] = 0 < step·k for every k ≥ 1, never for k = 0
+      while (key > 1 && x < start(key - 1)) --key;  // cum[0] = 0 < step·k for every k ≥ 1, never for k = 0
       while (key < s0 && !(x < start(key))) ++key;  // keys past the last segment count only toward orig_first[s0]
       ++orig_first[key];
     }
@@ -200,7 +203,8 @@ class SceneBuild {
   // the box pad). The last piece ends at p_k1, which the segment's box holds but its error does not measure,
   // so the level-0 points on it, those after the last level-0 segment holding an original, are measured:
   // returns that segment + 1, or k0 + 1 when none holds one (then every level-0 point is measured).
-  static std::size_t first_level0_after_originals(const std::vector<std::uint32_t>& orig_first, std::size_t k0, std::size_t k1) {
+  static std::size_t first_level0_after_originals(const std::vector<std::uint32_t>& orig_first, std::size_t k0,
+                                                  std::size_t k1) {
     for (std::size_t i = k1; i > k0; --i) {
       if (orig_first[i - 1] != orig_first[i]) return i;  // level-0 segment i − 1 holds originals
     }
@@ -213,7 +217,8 @@ class SceneBuild {
   // make every segment pay for the bunch. On pictures' edge chains it is 1.1–1.7x the mean.
   static std::size_t original_slots(const std::vector<std::uint32_t>& orig_first, int l, std::size_t segments) {
     std::size_t most = 0;
-    for (std::size_t k = 0; k < segments; ++k) most = std::max<std::size_t>(most, orig_first[(k + 1) << l] - orig_first[k << l]);
+    for (std::size_t k = 0; k < segments; ++k)
+      most = std::max<std::size_t>(most, orig_first[(k + 1) << l] - orig_first[k << l]);
     const std::size_t all = orig_first[segments << l] - orig_first[0];
     return most * segments <= 2 * all + 4 * segments ? most : 0;
   }
@@ -226,14 +231,15 @@ class SceneBuild {
   // children's corners would be 1.09–1.45x the true deviation). The same pass measures the level's error
   // (grow_measuring) from the frame coordinates it computes anyway, then quantises the extents
   // (quantise_level).
-  static void build_segment_boxes(Scene& scene, std::size_t c, const Polyline& src, const std::vector<std::uint32_t>& orig_first,
-                                  std::vector<SegmentExtent>& level) {
+  static void build_segment_boxes(Scene& scene, std::size_t c, const Polyline& src,
+                                  const std::vector<std::uint32_t>& orig_first, std::vector<SegmentExtent>& level) {
     CurveInfo& ci = scene.curves_[c];
     const Vec2* orig = src.points_m.data();
     for (int l = 0; l < ci.levels; ++l) {
       level.resize(ci.segment_count[l]);
       level_frames(scene.points(c, l), ci.segment_count[l], level.data());  // the frames Scene::segment_box() rebuilds
-      double worst_sq = 0.0;  // largest squared distance of a level-0 point or original vertex from its level-l segment [m²]
+      double worst_sq =
+          0.0;  // largest squared distance of a level-0 point or original vertex from its level-l segment [m²]
       WidestExtent widest;
       const std::size_t orig_slots = original_slots(orig_first, l, ci.segment_count[l]);
       for (std::size_t k = 0; k < ci.segment_count[l]; ++k) {
@@ -274,7 +280,8 @@ class SceneBuild {
       const Lanes2 zero = lanes(0.0, 0.0);
       before_right_ = max(before_right_, zero - e.lo);
       const Lanes2 d = e.hi - lanes(length_m, 0.0);  // (u_max − length, n_max)
-      past_left_ = max(past_left_, max(d, zero - d));  // (|u_max − length|, n_max): n_max > 0, as the box holds its segment
+      past_left_ =
+          max(past_left_, max(d, zero - d));  // (|u_max − length|, n_max): n_max > 0, as the box holds its segment
     }
     double widest() const {
       const Lanes2 w = max(before_right_, past_left_);
@@ -290,19 +297,22 @@ class SceneBuild {
   // bound is within the step's tolerance, 0 when none is.
   static void assign_tolerance_levels(Scene& scene, std::size_t c) {
     CurveNodes& cn = scene.curve_nodes_[c];
-    for (int t = 0; t < kToleranceSteps; ++t) cn.tolerance_level[t] = static_cast<std::uint8_t>(scene.coarsest_level_within(c, kToleranceLadder_m[t]));
+    for (int t = 0; t < kToleranceSteps; ++t)
+      cn.tolerance_level[t] = static_cast<std::uint8_t>(scene.coarsest_level_within(c, kToleranceLadder_m[t]));
   }
 
   // Level l's quantum (its widest extent / kQuantumSteps) and every segment's extents in it, rounded
   // outward; the widest box of the level and its largest box error bound (ReachGrower).
-  static void quantise_level(Scene& scene, std::size_t c, int l, const std::vector<SegmentExtent>& level, double widest) {
+  static void quantise_level(Scene& scene, std::size_t c, int l, const std::vector<SegmentExtent>& level,
+                             double widest) {
     CurveInfo& ci = scene.curves_[c];
     const float quantum = static_cast<float>(widest / kQuantumSteps);  // > 0: every extent holds the pad
     scene.curve_nodes_[c].quantum_m[l] = quantum;
     const double q = quantum, inverse_q = 1.0 / q;
     BoxExtent* out = scene.extent_.data() + ci.box_offset[l];
     ReachGrower reach;
-    for (std::size_t k = 0; k < ci.segment_count[l]; ++k) out[k] = quantise_extent(level[k].e, level[k].length_m, q, inverse_q, reach);
+    for (std::size_t k = 0; k < ci.segment_count[l]; ++k)
+      out[k] = quantise_extent(level[k].e, level[k].length_m, q, inverse_q, reach);
     ci.max_box_half_width_m[l] = reach.half_width() * q;
     ci.max_error_bound_m[l] = std::sqrt(reach.bound_sq()) * q;
   }
@@ -310,7 +320,7 @@ class SceneBuild {
   // Every curve's error boxes (build_segment_boxes) and the scene's bounds, those of the level-0 points.
   static void build_curves(Scene& scene, const std::vector<Polyline>& input, const OriginalArcs& arcs) {
     std::vector<std::uint32_t> orig_first;
-    std::vector<SegmentExtent> level_extent;  // one level's measured extents, before quantising
+    std::vector<SegmentExtent> level_extent;                // one level's measured extents, before quantising
     BoxGrower bounds(Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, 0.0);  // the identity frame: (u, n) = (x, y)
     for (std::size_t c = 0; c < scene.curves_.size(); ++c) {
       const Polyline& src = input[scene.source_index_[c]];
@@ -328,7 +338,8 @@ class SceneBuild {
   // An axis-aligned node around the rectangles of children [first, first + count) (Scene::aabb: a segment's
   // error box as Scene::box() rebuilds it, so the rounding of the stored extents is inside, or a group's own
   // rectangle), padded; links chunk and hierarchy children to it.
-  static void make_aligned_node(Scene& scene, std::uint32_t node, std::uint32_t first, std::uint32_t count, NodeInfo info) {
+  static void make_aligned_node(Scene& scene, std::uint32_t node, std::uint32_t first, std::uint32_t count,
+                                NodeInfo info) {
     constexpr double kInf = std::numeric_limits<double>::infinity();
     Aabb r{{kInf, kInf}, {-kInf, -kInf}};
     for (std::uint32_t i = 0; i < count; ++i) {
@@ -345,7 +356,8 @@ class SceneBuild {
   }
 
   // Chunk nodes, in the hierarchy's leaf order so that every leaf's chunks have consecutive ids.
-  static void build_chunk_nodes(Scene& scene, const std::vector<Chunk>& chunks, const std::vector<std::size_t>& leaf_order) {
+  static void build_chunk_nodes(Scene& scene, const std::vector<Chunk>& chunks,
+                                const std::vector<std::size_t>& leaf_order) {
     for (std::size_t k = 0; k < chunks.size(); ++k) {
       const Chunk& ch = chunks[leaf_order[k]];
       const CurveInfo& ci = scene.curves_[ch.curve];
@@ -357,18 +369,20 @@ class SceneBuild {
   }
 
   // Hierarchy boxes bottom-up (children always have larger indices than their parent); the root is its own parent.
-  static void build_hierarchy_nodes(Scene& scene, const std::vector<HierarchyNode>& hierarchy, const std::vector<Chunk>& chunks,
-                                    const std::vector<std::size_t>& leaf_order, std::size_t hierarchy_base) {
+  static void build_hierarchy_nodes(Scene& scene, const std::vector<HierarchyNode>& hierarchy,
+                                    const std::vector<Chunk>& chunks, const std::vector<std::size_t>& leaf_order,
+                                    std::size_t hierarchy_base) {
     for (std::size_t i = hierarchy.size(); i-- > 0;) {
       const HierarchyNode& h = hierarchy[i];
-      const std::uint32_t first = h.leaf ? static_cast<std::uint32_t>(scene.segment_nodes_ + h.begin) : static_cast<std::uint32_t>(hierarchy_base + h.first_child);
+      const std::uint32_t first = h.leaf ? static_cast<std::uint32_t>(scene.segment_nodes_ + h.begin)
+                                         : static_cast<std::uint32_t>(hierarchy_base + h.first_child);
       const std::uint32_t count = h.leaf ? static_cast<std::uint32_t>(h.end - h.begin) : 2u;
-      make_aligned_node(scene, static_cast<std::uint32_t>(hierarchy_base + i), first, count, NodeInfo{chunks[leaf_order[h.begin]].curve, Scene::kHierarchyLevel, 0});
+      make_aligned_node(scene, static_cast<std::uint32_t>(hierarchy_base + i), first, count,
+                        NodeInfo{chunks[leaf_order[h.begin]].curve, Scene::kHierarchyLevel, 0});
     }
     scene.scene_root_ = static_cast<std::uint32_t>(hierarchy_base);
     scene.group_parent_[scene.scene_root_ - scene.segment_nodes_] = scene.scene_root_;
   }
-
 };
 
 Scene Scene::build(const std::vector<Polyline>& input, int max_levels) {

@@ -11,7 +11,8 @@ constexpr std::size_t kChunksPerLeaf = 4;
 
 }  // namespace
 
-void build_hierarchy(std::vector<std::size_t>& order, const std::vector<Vec2>& centre, std::vector<HierarchyNode>& nodes) {
+void build_hierarchy(std::vector<std::size_t>& order, const std::vector<Vec2>& centre,
+                     std::vector<HierarchyNode>& nodes) {
   nodes.clear();
   nodes.push_back({0, order.size(), 0, true});
   for (std::size_t i = 0; i < nodes.size(); ++i) {
@@ -25,8 +26,10 @@ void build_hierarchy(std::vector<std::size_t>& order, const std::vector<Vec2>& c
     }
     const bool split_x = hi.x - lo.x >= hi.y - lo.y;
     const std::size_t mid = begin + (end - begin) / 2;
-    std::nth_element(order.begin() + static_cast<long>(begin), order.begin() + static_cast<long>(mid), order.begin() + static_cast<long>(end),
-                     [&](std::size_t a, std::size_t b) { return split_x ? centre[a].x < centre[b].x : centre[a].y < centre[b].y; });
+    std::nth_element(order.begin() + static_cast<long>(begin), order.begin() + static_cast<long>(mid),
+                     order.begin() + static_cast<long>(end), [&](std::size_t a, std::size_t b) {
+                       return split_x ? centre[a].x < centre[b].x : centre[a].y < centre[b].y;
+                     });
     nodes[i].leaf = false;
     nodes[i].first_child = nodes.size();
     nodes.push_back({begin, mid, 0, true});

@@ -18,7 +18,8 @@ struct HierarchyNode {
 
 // Median split on the longer axis of the chunk centres. `order` is permuted in place into leaf order.
 // Children of a node are allocated as a consecutive pair, so they have consecutive ids.
-void build_hierarchy(std::vector<std::size_t>& order, const std::vector<Vec2>& centre, std::vector<HierarchyNode>& nodes);
+void build_hierarchy(std::vector<std::size_t>& order, const std::vector<Vec2>& centre,
+                     std::vector<HierarchyNode>& nodes);
 
 }  // namespace scene_detail
 }  // namespace hk

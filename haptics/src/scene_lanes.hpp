@@ -58,8 +58,9 @@ inline Lanes2 ones(Mask2 m) { return {_mm_and_pd(m.v, _mm_set1_pd(1.0))}; }
 // doubles), as its BoxExtent: two conversions to int32 pairs, one interleave and shuffle into the struct's
 // order, one pack to int16 and a single 8-byte store, instead of a conversion and store per field.
 inline BoxExtent box_extent(Lanes2 k, Lanes2 m) {
-  const __m128i mixed = _mm_unpacklo_epi32(_mm_cvttpd_epi32(k.v), _mm_cvttpd_epi32(m.v));  // u_min, n_max, n_min, u_over
-  const __m128i ordered = _mm_shuffle_epi32(mixed, _MM_SHUFFLE(1, 2, 3, 0));                // u_min, u_over, n_min, n_max
+  const __m128i mixed =
+      _mm_unpacklo_epi32(_mm_cvttpd_epi32(k.v), _mm_cvttpd_epi32(m.v));       // u_min, n_max, n_min, u_over
+  const __m128i ordered = _mm_shuffle_epi32(mixed, _MM_SHUFFLE(1, 2, 3, 0));  // u_min, u_over, n_min, n_max
   std::int64_t bits = 0;
   _mm_storel_epi64(reinterpret_cast<__m128i*>(&bits), _mm_packs_epi32(ordered, ordered));
   return std::bit_cast<BoxExtent>(bits);
@@ -85,7 +86,9 @@ inline Lanes2 where_greater(Lanes2 x, Lanes2 y, Lanes2 if_true, Lanes2 otherwise
 }
 inline double lane0(Lanes2 a) { return a.a; }
 inline double lane1(Lanes2 a) { return a.b; }
-inline Lanes2 truncated(Lanes2 a) { return {static_cast<double>(static_cast<int>(a.a)), static_cast<double>(static_cast<int>(a.b))}; }
+inline Lanes2 truncated(Lanes2 a) {
+  return {static_cast<double>(static_cast<int>(a.a)), static_cast<double>(static_cast<int>(a.b))};
+}
 struct Mask2 {
   bool a, b;
 };
@@ -95,7 +98,8 @@ inline Mask2 operator|(Mask2 a, Mask2 b) { return {a.a || b.a, a.b || b.b}; }
 inline bool any(Mask2 m) { return m.a || m.b; }
 inline Lanes2 ones(Mask2 m) { return {m.a ? 1.0 : 0.0, m.b ? 1.0 : 0.0}; }
 inline BoxExtent box_extent(Lanes2 k, Lanes2 m) {
-  return BoxExtent{static_cast<std::int16_t>(k.a), static_cast<std::int16_t>(m.b), static_cast<std::int16_t>(k.b), static_cast<std::int16_t>(m.a)};
+  return BoxExtent{static_cast<std::int16_t>(k.a), static_cast<std::int16_t>(m.b), static_cast<std::int16_t>(k.b),
+                   static_cast<std::int16_t>(m.a)};
 }
 #endif
 

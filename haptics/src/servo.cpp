@@ -6,7 +6,8 @@
 
 namespace hk {
 
-Vec2 ForceGuard::apply(Vec2 f, double since_start_s, DeviceStatus status, bool deadline_missed, TickResult* why) const noexcept {
+Vec2 ForceGuard::apply(Vec2 f, double since_start_s, DeviceStatus status, bool deadline_missed,
+                       TickResult* why) const noexcept {
   *why = TickResult::Ok;
   if (status != DeviceStatus::Ok) {
     *why = TickResult::DeviceNotOk;
@@ -37,9 +38,11 @@ namespace {
 // its cut's (CutBounds: the largest segment bound plus the largest join shift). Also writes the scene's bound
 // at every level id to `id_bound` (kLevelIds entries), for placing an id that is not on the ladder. Returns
 // the ladder's length.
-int level_ladder(const Scene& scene, const CutBounds& cuts, const ServoParams& p, int* ids, double* err, double* id_bound) {
+int level_ladder(const Scene& scene, const CutBounds& cuts, const ServoParams& p, int* ids, double* err,
+                 double* id_bound) {
   for (int id = 0; id < kLevelIds; ++id) {
-    id_bound[id] = is_cut_level(id) && p.steps == LevelSteps::Cuts ? cuts.error_bound_m[tolerance_step_of(id)] : scene.max_error_bound_m(id);
+    id_bound[id] = is_cut_level(id) && p.steps == LevelSteps::Cuts ? cuts.error_bound_m[tolerance_step_of(id)]
+                                                                   : scene.max_error_bound_m(id);
   }
   if (p.steps == LevelSteps::Cuts) {
     for (int t = 0; t < kToleranceSteps; ++t) {
@@ -119,11 +122,13 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept {
 
 SceneStep::SceneStep(const Scene& scene, const ServoParams& params)
     : params_(params),
-      cuts_(params.steps == LevelSteps::Cuts ? make_cut_walls(scene) : nullptr),  // the cut masks only where the policy can pick a cut step
+      cuts_(params.steps == LevelSteps::Cuts ? make_cut_walls(scene)
+                                             : nullptr),  // the cut masks only where the policy can pick a cut step
       solver_(scene, contact_params(params), cuts_),
       groove_(scene, params.groove, cuts_),
       levels_(level_ladder(scene, solver_.section().cut_bounds(), params, ladder_id_, level_error_m_, id_bound_m_)),
-      policy_(policy_params(params), level_error_m_, levels_, ladder_index(params.level)),  // the ladder's members are set by now
+      policy_(policy_params(params), level_error_m_, levels_,
+              ladder_index(params.level)),  // the ladder's members are set by now
       level_(params.level),
       guard_max_force_n_(params.guard.max_force_n) {}
 
@@ -171,7 +176,8 @@ bool SceneStep::transition_active() const noexcept {
 void SceneStep::set_auto_level(bool on) noexcept {
   // The policy starts again from the level in use, its speed filter from rest (the ladder is kept: no
   // walk over the scene in the servo thread).
-  if (on && !params_.auto_level) policy_ = LevelPolicy(policy_params(params_), level_error_m_, levels_, ladder_index(level_));
+  if (on && !params_.auto_level)
+    policy_ = LevelPolicy(policy_params(params_), level_error_m_, levels_, ladder_index(level_));
   params_.auto_level = on;
   if (!on) params_.level = level_;
 }
@@ -198,7 +204,8 @@ TickResult SceneStep::update(const ServoInput& in, ServoOutput& out) noexcept {
   out.level_changed = false;
   const bool grooves = params_.render == RenderMode::Grooves;
   if (wanted != level_) {
-    if (grooves || solver_.level_change_is_safe(wanted, &budget)) {  // grooves: no wall to cross; walls: else it waits (level_wanted)
+    if (grooves || solver_.level_change_is_safe(
+                       wanted, &budget)) {  // grooves: no wall to cross; walls: else it waits (level_wanted)
       out.level_changed = true;
       level_ = wanted;
     }
@@ -211,7 +218,8 @@ TickResult SceneStep::update(const ServoInput& in, ServoOutput& out) noexcept {
   ci.handle_velocity_m_per_s = velocity_;
   ci.level = level_;
   ci.budget = budget;
-  ci.press_counts = in.press_counts && static_cast<double>(ticks_) * params_.period_s >= params_.guard.ramp_s;  // not while the force ramps in
+  ci.press_counts = in.press_counts && static_cast<double>(ticks_) * params_.period_s >=
+                                           params_.guard.ramp_s;  // not while the force ramps in
   if (grooves) {
     groove_.update(ci, out.contact);
   } else {
@@ -235,7 +243,8 @@ TickResult SceneStep::update(const ServoInput& in, ServoOutput& out) noexcept {
   last_force_ = f;
   // The guard's clamp walks to a new max force at the same rate.
   const double clamp_gap = params_.guard.max_force_n - guard_max_force_n_;
-  guard_max_force_n_ = std::fabs(clamp_gap) - step > 1e-12 ? guard_max_force_n_ + std::copysign(step, clamp_gap) : params_.guard.max_force_n;
+  guard_max_force_n_ = std::fabs(clamp_gap) - step > 1e-12 ? guard_max_force_n_ + std::copysign(step, clamp_gap)
+                                                           : params_.guard.max_force_n;
   ForceGuard guard = params_.guard;
   guard.max_force_n = guard_max_force_n_;
 

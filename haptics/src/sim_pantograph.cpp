@@ -13,9 +13,7 @@ namespace hk {
 
 namespace {
 
-[[noreturn]] void bad_param(const std::string& what) {
-  throw hk::ArgumentError("simulated pantograph: " + what);
-}
+[[noreturn]] void bad_param(const std::string& what) { throw hk::ArgumentError("simulated pantograph: " + what); }
 
 bool finite_nonneg(double v) { return std::isfinite(v) && v >= 0.0; }
 
@@ -26,8 +24,7 @@ double quantise(double angle_rad, double step_rad) { return std::nearbyint(angle
 
 }  // namespace
 
-SimulatedPantograph::SimulatedPantograph(const SimPantographParams& params, Vec2 start_handle_m)
-    : params_(params) {
+SimulatedPantograph::SimulatedPantograph(const SimPantographParams& params, Vec2 start_handle_m) : params_(params) {
   const PantographGeometry& g = params.geometry;
   if (!(std::isfinite(g.proximal_m) && g.proximal_m > 0.0) || !(std::isfinite(g.distal_m) && g.distal_m > 0.0) ||
       !finite_nonneg(g.motor_half_spacing_m) || !is_finite(g.base_m)) {
@@ -90,7 +87,9 @@ DeviceSample SimulatedPantograph::read() noexcept {
   return s;
 }
 
-void SimulatedPantograph::write_force(Vec2 force_n) noexcept { commanded_force_n_ = is_finite(force_n) ? force_n : Vec2{}; }
+void SimulatedPantograph::write_force(Vec2 force_n) noexcept {
+  commanded_force_n_ = is_finite(force_n) ? force_n : Vec2{};
+}
 
 void SimulatedPantograph::close() noexcept {
   commanded_force_n_ = {};

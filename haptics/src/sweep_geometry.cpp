@@ -9,6 +9,8 @@ bool clip_segment_box(const ErrorBox& box, Vec2 a, Vec2 b, double margin_m, doub
   return clip_segment_box_inline(box, a, b, margin_m, t_enter, t_exit);
 }
 
-bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) noexcept { return intersect_sweep_segment_inline(a, b, p, q, t); }
+bool intersect_sweep_segment(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) noexcept {
+  return intersect_sweep_segment_inline(a, b, p, q, t);
+}
 
 }  // namespace hk

@@ -67,13 +67,15 @@ std::vector<std::uint8_t> tolerance_cut_masks(const Scene& scene) {
     const CurveInfo& ci = scene.curve(c);
     const int top = static_cast<int>(ci.levels) - 1;
     for (std::uint32_t k = 0; k < ci.segment_count[top]; ++k) {
-      mark_cut(scene, SegmentRef{static_cast<std::int32_t>(c), top, static_cast<std::int32_t>(k)}, kAllSteps, masks.data());
+      mark_cut(scene, SegmentRef{static_cast<std::int32_t>(c), top, static_cast<std::int32_t>(k)}, kAllSteps,
+               masks.data());
     }
   }
   return masks;
 }
 
-void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a, Vec2* b) noexcept {
+void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a,
+                        Vec2* b) noexcept {
   scene.segment_points(node, a, b);
   const std::uint32_t c = scene.tag_curve(node);
   const int l = scene.tag_level(node);
@@ -140,7 +142,8 @@ CutStats tolerance_cut(const Scene& scene, std::size_t curve, double tol_m, std:
   const CurveInfo& ci = scene.curve(curve);
   const int top = ci.levels - 1;
   const std::size_t first = out->size();
-  for (std::uint32_t k = 0; k < ci.segment_count[top]; ++k) refine(scene, SegmentRef{static_cast<std::int32_t>(curve), top, static_cast<std::int32_t>(k)}, tol_m, out, &st);
+  for (std::uint32_t k = 0; k < ci.segment_count[top]; ++k)
+    refine(scene, SegmentRef{static_cast<std::int32_t>(curve), top, static_cast<std::int32_t>(k)}, tol_m, out, &st);
   // Junctions: consecutive segments (and, closed, the last and the first); a break where their ends differ,
   // joined at the finer one's end, which moves the coarser one's end by the distance between the two.
   const std::size_t n = out->size() - first;

@@ -38,7 +38,8 @@ void TourGuide::start(const TourPath& path, Vec2 handle_m, double period_s) noex
   rendered_ticks_ = 0;
   progress_t_s_ = 0.0;
   progress_error_m_ = std::numeric_limits<double>::infinity();
-  overrun_ticks_ = std::max(stall_ticks_, static_cast<long>(path.params.overrun_factor * path.duration_s() / period_s + 0.5));
+  overrun_ticks_ =
+      std::max(stall_ticks_, static_cast<long>(path.params.overrun_factor * path.duration_s() / period_s + 0.5));
   fade_left_ = 0;
   prev_handle_ = handle_m;
   prev_target_ = path.points.front().target_m;
@@ -177,7 +178,8 @@ Vec2 TourGuide::follow_force(const TourInput& in, Vec2 press_n) noexcept {
 // is below max_force_n; `guide_len_n` the guide force's length before the fades.
 void TourGuide::advance(bool keeping_up, double guide_len_n, double period_s, TourOutput& out) noexcept {
   const TourParams& p = path_->params;
-  const bool held = (guide_len_n >= 0.95 * p.max_force_n || !keeping_up || following_) && length(hold_velocity_) < p.hold_speed_m_per_s;
+  const bool held = (guide_len_n >= 0.95 * p.max_force_n || !keeping_up || following_) &&
+                    length(hold_velocity_) < p.hold_speed_m_per_s;
   hold_ticks_ = held ? hold_ticks_ + 1 : 0;
   if (static_cast<double>(hold_ticks_) * period_s >= p.hold_s) end(TourPhase::Stopped);
   if (ending_ == TourPhase::None && keeping_up) t_s_ += period_s;
@@ -211,7 +213,8 @@ void TourGuide::update(const TourInput& in, TourOutput& out) noexcept {
   }
   double gain = std::min(1.0, static_cast<double>(ticks_ + 1) / static_cast<double>(fade_ticks_));  // fade in
   // The walls: faded out over the first fade_s of the transit, then off (walls_suspended); on from the outline.
-  if (phase_ == TourPhase::Transit) out.walls_gain = std::max(0.0, 1.0 - static_cast<double>(ticks_ + 1) / static_cast<double>(fade_ticks_));
+  if (phase_ == TourPhase::Transit)
+    out.walls_gain = std::max(0.0, 1.0 - static_cast<double>(ticks_ + 1) / static_cast<double>(fade_ticks_));
   if (ending_ == TourPhase::None && in.walls_result == TickResult::Ok) {
     advance(keeping_up, f_len, in.period_s, out);
     rendered_ticks_ += 1;

@@ -25,7 +25,8 @@ void extend(Aabb& r, Vec2 p) {
 }
 
 Aabb merged(const Aabb& a, const Aabb& b) {
-  return Aabb{{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y)}, {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y)}};
+  return Aabb{{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y)},
+              {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y)}};
 }
 
 class Builder {
@@ -128,7 +129,9 @@ class Builder {
     }
     return store;
   }
-  static double median_of_three(double x, double y, double z) { return std::max(std::min(x, y), std::min(std::max(x, y), z)); }
+  static double median_of_three(double x, double y, double z) {
+    return std::max(std::min(x, y), std::min(std::max(x, y), z));
+  }
   void set_slot(std::size_t node, int i, const Aabb& r, std::uint32_t code, double pad_m) {
     WideNode& n = out_.nodes[node];
     n.lo_x[i] = float_at_most(r.lo.x - pad_m);
@@ -162,7 +165,8 @@ void WideIndex::node_rect(std::uint32_t w, Vec2* lo, Vec2* hi) const noexcept {
 WideIndex WideIndex::build(const Scene& sc) {
   WideIndex index;
   std::size_t item_count = 0;
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) item_count += sc.curve(c).segment_count[wide_item_level(sc.curve(c).levels)];
+  for (std::size_t c = 0; c < sc.curve_count(); ++c)
+    item_count += sc.curve(c).segment_count[wide_item_level(sc.curve(c).levels)];
   std::vector<Item> items;
   std::vector<Aabb> rects;
   items.reserve(item_count);
@@ -175,7 +179,8 @@ WideIndex WideIndex::build(const Scene& sc) {
       const Aabb r = sc.aabb(ci.box_offset[item] + k);  // the item's error box's rectangle (wide_index.hpp)
       items.push_back(Item{0.5 * (r.lo + r.hi), ci.box_offset[item] + k, static_cast<std::uint32_t>(rects.size())});
       rects.push_back(r);
-      largest = std::max(std::max(largest, std::max(std::abs(r.lo.x), std::abs(r.lo.y))), std::max(std::abs(r.hi.x), std::abs(r.hi.y)));
+      largest = std::max(std::max(largest, std::max(std::abs(r.lo.x), std::abs(r.lo.y))),
+                         std::max(std::abs(r.hi.x), std::abs(r.hi.y)));
     }
   }
   if (items.empty()) return index;

@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <string>
 
+#include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
-#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 
@@ -18,7 +18,9 @@ namespace {
 
 const fs::path kData = HK_TEST_DATA_DIR;
 
-bool listed(const std::vector<std::string>& v, const std::string& key) { return std::find(v.begin(), v.end(), key) != v.end(); }
+bool listed(const std::vector<std::string>& v, const std::string& key) {
+  return std::find(v.begin(), v.end(), key) != v.end();
+}
 
 TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   const fs::path lib = fs::temp_directory_path() / ("hk_apply_" + std::to_string(::getpid()));
@@ -41,19 +43,19 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
     rt.devices().device().write_force(cmd.force_n);
     rt.core().publish_display();
   };
-  tick();                          // the servo's core takes the square
+  tick();  // the servo's core takes the square
   ASSERT_EQ(rt.core().display().scene_id, rt.shown_id());
   EXPECT_EQ(rt.core().display().stiffness_n_per_m, 800.0);
   const Scene* before = rt.shown().scene;
 
   config::Settings next = s;
-  next.haptics.stiffness_n_per_m = 1200;   // live
-  next.keys.help = "H";                    // live
-  next.kiosk.timeout_s = 300;              // live
-  next.haptics.max_levels = 4;             // scene
-  next.haptics.servo_rate_hz = 500;        // restart
-  next.device.handle_mass_kg = 0.2;        // restart
-  next.audio.volume_default_step = 5;      // next visitor
+  next.haptics.stiffness_n_per_m = 1200;  // live
+  next.keys.help = "H";                   // live
+  next.kiosk.timeout_s = 300;             // live
+  next.haptics.max_levels = 4;            // scene
+  next.haptics.servo_rate_hz = 500;       // restart
+  next.device.handle_mass_kg = 0.2;       // restart
+  next.audio.volume_default_step = 5;     // next visitor
   const ApplyReport r = rt.apply_settings(next, flow);
   EXPECT_TRUE(r.gains);
   EXPECT_TRUE(r.keys);
@@ -110,10 +112,11 @@ TEST(ApplySettings, ToleranceModeRendersAtAStepAndTheKeysMoveAlongTheSteps) {
   const int start = rt.level();
   ASSERT_TRUE(is_tolerance_level(start)) << start;
   EXPECT_TRUE(rt.core().display().auto_level);
-  const auto settle = [&](int want) {  // a change waits for a tick at which it is safe: the handle rests in the air here
-    for (int i = 0; i < 400 && rt.level() != want; ++i) tick();
-    return rt.level();
-  };
+  const auto settle =
+      [&](int want) {  // a change waits for a tick at which it is safe: the handle rests in the air here
+        for (int i = 0; i < 400 && rt.level() != want; ++i) tick();
+        return rt.level();
+      };
   if (start - kToleranceLevelBase < kToleranceSteps - 1) {
     ASSERT_TRUE(rt.change_level(+1));
     EXPECT_EQ(settle(start + 1), start + 1) << "Coarser: the next step";

@@ -15,11 +15,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "pictures/capture.hpp"
 #include "kiosk_exe.hpp"
+#include "pictures/capture.hpp"
+#include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
-#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {
@@ -84,7 +84,8 @@ std::vector<std::string> advice_of(const nlohmann::json& j) { return j.at("advic
 nlohmann::json capture(const std::string& name, const std::vector<cv::Mat>& frames) {
   const fs::path dir = fresh_dir(name);
   write_frames(dir / "frames", frames);
-  const test::ExeResult r = run_kiosk("capture --source file:" + (dir / "frames").string() + " --out " + quoted(dir / "out"), dir);
+  const test::ExeResult r =
+      run_kiosk("capture --source file:" + (dir / "frames").string() + " --out " + quoted(dir / "out"), dir);
   EXPECT_EQ(r.status, 0) << r.err;
   if (r.status != 0) return nlohmann::json::object();
   EXPECT_TRUE(fs::exists(dir / "out" / "capture.png"));
@@ -93,16 +94,19 @@ nlohmann::json capture(const std::string& name, const std::vector<cv::Mat>& fram
 
 TEST(Capture, AStillWholePageIsCapturedAfterOneSecondRectified) {
   const cv::Mat bg = table(), c = card();
-  const nlohmann::json j = capture("cap_still", {frame_with_card(bg, c, kW / 2, kH / 2)});  // one frame, served again and again
+  const nlohmann::json j =
+      capture("cap_still", {frame_with_card(bg, c, kW / 2, kH / 2)});  // one frame, served again and again
   ASSERT_FALSE(j.empty());
   EXPECT_TRUE(advice_of(j).empty()) << j.dump();
   EXPECT_EQ(j.at("captured_by"), "still");
-  EXPECT_NEAR(j.at("captured_t_s").get<double>(), 1.1, 1e-9) << "still from the second frame (0.1 s), captured 1 s later";
+  EXPECT_NEAR(j.at("captured_t_s").get<double>(), 1.1, 1e-9)
+      << "still from the second frame (0.1 s), captured 1 s later";
   ASSERT_TRUE(j.at("rectified").get<bool>());
   ASSERT_EQ(j.at("corners_px").size(), 4u);
   // The corners are the card's, within 1 % of its diagonal.
   const double diag = std::hypot(280.0, 210.0);
-  const cv::Point2d truth[4] = {{180 - 0.5, 135 - 0.5}, {460 - 0.5, 135 - 0.5}, {460 - 0.5, 345 - 0.5}, {180 - 0.5, 345 - 0.5}};
+  const cv::Point2d truth[4] = {
+      {180 - 0.5, 135 - 0.5}, {460 - 0.5, 135 - 0.5}, {460 - 0.5, 345 - 0.5}, {180 - 0.5, 345 - 0.5}};
   for (int k = 0; k < 4; ++k) {
     const cv::Point2d got(j["corners_px"][k][0].get<double>(), j["corners_px"][k][1].get<double>());
     EXPECT_LT(cv::norm(got - truth[k]), 0.01 * diag) << "corner " << k << " at " << got;
@@ -113,9 +117,9 @@ TEST(Capture, AStillWholePageIsCapturedAfterOneSecondRectified) {
 TEST(Capture, OffCentreThenCentredSaysMoveLeftThenCaptures) {
   const cv::Mat bg = table(), c = card();
   std::vector<cv::Mat> frames;
-  for (int i = 0; i < 8; ++i) frames.push_back(frame_with_card(bg, c, 470, kH / 2));      // well right of centre
+  for (int i = 0; i < 8; ++i) frames.push_back(frame_with_card(bg, c, 470, kH / 2));           // well right of centre
   for (int x = 450; x > kW / 2; x -= 30) frames.push_back(frame_with_card(bg, c, x, kH / 2));  // slid left
-  frames.push_back(frame_with_card(bg, c, kW / 2, kH / 2));                                // then left there
+  frames.push_back(frame_with_card(bg, c, kW / 2, kH / 2));                                    // then left there
   const nlohmann::json j = capture("cap_left", frames);
   ASSERT_FALSE(j.empty());
   const std::vector<std::string> said = advice_of(j);
@@ -159,7 +163,8 @@ TEST(Capture, TooDarkIsSaidUntilTheLightComesOn) {
 TEST(Capture, AShakingPageIsToldToHoldStill) {
   const cv::Mat bg = table(), c = card();
   std::vector<cv::Mat> frames;
-  for (int i = 0; i < 12; ++i) frames.push_back(frame_with_card(bg, c, kW / 2 + (i % 2 ? 12 : -12), kH / 2 + (i % 3) * 6));
+  for (int i = 0; i < 12; ++i)
+    frames.push_back(frame_with_card(bg, c, kW / 2 + (i % 2 ? 12 : -12), kH / 2 + (i % 3) * 6));
   frames.push_back(frame_with_card(bg, c, kW / 2, kH / 2));
   const nlohmann::json j = capture("cap_shake", frames);
   ASSERT_FALSE(j.empty());
@@ -172,8 +177,8 @@ TEST(Capture, AnEmptyTableIsNeverCapturedAndTheTimeOutKeepsTheLastFrame) {
   const fs::path dir = fresh_dir("cap_empty");
   write_frames(dir / "frames", {table()});
   std::ofstream(dir / "settings.toml") << "[camera]\ntimeout_s = 5\n";
-  const test::ExeResult r = run_kiosk("capture --source file:" + (dir / "frames").string() + " --out " + quoted(dir / "out") +
-                                          " --config " + quoted(dir / "settings.toml"),
+  const test::ExeResult r = run_kiosk("capture --source file:" + (dir / "frames").string() + " --out " +
+                                          quoted(dir / "out") + " --config " + quoted(dir / "settings.toml"),
                                       dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = read_json(dir / "out" / "capture.json");
@@ -185,8 +190,10 @@ TEST(Capture, AnEmptyTableIsNeverCapturedAndTheTimeOutKeepsTheLastFrame) {
 
 TEST(Capture, BadSourcesAreRefusedInOneLine) {
   const fs::path dir = fresh_dir("cap_bad");
-  for (const std::string& src : {std::string("usb:1"), std::string("file:") + (dir / "missing").string(), std::string("v4l2:/dev/null")}) {
-    const test::ExeResult r = run_kiosk("capture --source " + test::quoted(fs::path(src)) + " --out " + quoted(dir / "out"), dir);
+  for (const std::string& src :
+       {std::string("usb:1"), std::string("file:") + (dir / "missing").string(), std::string("v4l2:/dev/null")}) {
+    const test::ExeResult r =
+        run_kiosk("capture --source " + test::quoted(fs::path(src)) + " --out " + quoted(dir / "out"), dir);
     EXPECT_EQ(r.status, 1) << src;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_NE(r.err.find("camera"), std::string::npos) << r.err;
@@ -197,7 +204,8 @@ TEST(Capture, BadSourcesAreRefusedInOneLine) {
 TEST(Capture, CamerasListsNoneQuietlyOnAMachineWithout) {
   const fs::path dir = fresh_dir("cap_cameras");
   const std::string out = (dir / "out.txt").string();
-  const int raw = std::system((std::string(HK_KIOSK_EXE) + " cameras >" + out + " 2>" + (dir / "err.txt").string()).c_str());
+  const int raw =
+      std::system((std::string(HK_KIOSK_EXE) + " cameras >" + out + " 2>" + (dir / "err.txt").string()).c_str());
   ASSERT_TRUE(WIFEXITED(raw));
   EXPECT_EQ(WEXITSTATUS(raw), 0);
   std::ifstream f(out);
@@ -214,8 +222,8 @@ TEST(Capture, ExploreFromASourceBuildsTheSceneOfTheRectifiedPage) {
   const cv::Mat bg = table(), c = card();
   const fs::path dir = fresh_dir("cap_explore");
   write_frames(dir / "frames", {frame_with_card(bg, c, kW / 2, kH / 2)});
-  const test::ExeResult r =
-      run_kiosk("explore --source file:" + (dir / "frames").string() + " --out " + quoted(dir / "out") + " --duration 1", dir);
+  const test::ExeResult r = run_kiosk(
+      "explore --source file:" + (dir / "frames").string() + " --out " + quoted(dir / "out") + " --duration 1", dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json scene = read_json(dir / "out" / "scene.json");
   const nlohmann::json cap = read_json(dir / "out" / "capture.json");

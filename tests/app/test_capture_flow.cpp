@@ -79,7 +79,8 @@ TEST(CaptureFlow, OneShapeNoShapeFailureAndTimeOutAreSaid) {
   EXPECT_EQ(fx.said.back(), "The camera does not answer. Press the space bar to try again.");
   flow.key(KioskKey::Capture, 7.0);
   flow.capture_failed(true, 8.0);
-  EXPECT_EQ(fx.said.back(), "I could not take the picture: it did not lie still long enough. Press the space bar to try again.");
+  EXPECT_EQ(fx.said.back(),
+            "I could not take the picture: it did not lie still long enough. Press the space bar to try again.");
   EXPECT_EQ(fx.started, 4);
   EXPECT_EQ(fx.cancelled, 0);
 }
@@ -122,7 +123,8 @@ TEST(CaptureFlow, WithoutACameraTheKeySaysSoAndTheHelpDoesNotNameIt) {
   CameraRecorder fx2;
   KioskFlow with = on_picture(fx2, true);
   const std::string help = every_key(with, fx2);
-  EXPECT_NE(help.find("Press the space bar to feel a picture of your own under the camera."), std::string::npos) << help;
+  EXPECT_NE(help.find("Press the space bar to feel a picture of your own under the camera."), std::string::npos)
+      << help;
 }
 
 TEST(CaptureFlow, GuidanceKeepsTheSessionAliveAndTheTimeOutCancels) {

@@ -19,13 +19,13 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "pictures/capture.hpp"
 #include "kiosk_exe.hpp"
+#include "pictures/capture.hpp"
 #include "scans.hpp"
 #include "synthetic_photo.hpp"
+#include "test_paths.hpp"
 #include "vision/frame_source.hpp"
 #include "vision/ocr.hpp"
-#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {
@@ -37,7 +37,8 @@ constexpr int kPage = 3;
 const cv::Size kCamera(3264, 2448);
 
 TEST(CaptureNearTheEdge, AWholePageFillingTheFrameIsCapturedByStillnessAndItsTextRead) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (const std::string problem = vision::ocr_languages_problem({}); !problem.empty()) GTEST_SKIP() << problem;
   const fs::path dir = test::fresh_dir("capture_near_edge");
   const cv::Mat page = test::draw_page(kSpec, kPage, 300, dir);
@@ -54,10 +55,12 @@ TEST(CaptureNearTheEdge, AWholePageFillingTheFrameIsCapturedByStillnessAndItsTex
   pc.backdrop = test::Backdrop::wood;
   pc.seed = 5;
   pc.fill = 0.95;
-  const test::SyntheticPhoto photo = test::synthetic_photo(page, kCamera, test::near_edge(page.size(), kCamera, pc, 2, 40.0));
+  const test::SyntheticPhoto photo =
+      test::synthetic_photo(page, kCamera, test::near_edge(page.size(), kCamera, pc, 2, 40.0));
   double lowest = -1e300;
   for (const cv::Point2d& c : photo.corners_px) {
-    ASSERT_TRUE(c.x > -0.5 && c.y > -0.5 && c.x < kCamera.width - 0.5 && c.y < kCamera.height - 0.5) << "the page lies whole in the frame: " << c;
+    ASSERT_TRUE(c.x > -0.5 && c.y > -0.5 && c.x < kCamera.width - 0.5 && c.y < kCamera.height - 0.5)
+        << "the page lies whole in the frame: " << c;
     lowest = std::max(lowest, c.y);
   }
   ASSERT_NEAR(kCamera.height - 0.5 - lowest, 40.0, 1e-6);
@@ -100,14 +103,17 @@ TEST(CaptureNearTheEdge, AWholePageFillingTheFrameIsCapturedByStillnessAndItsTex
   std::string text;
   for (const vision::OcrBlock& b : r.blocks) text += b.text + "\n";
   const double recall = test::word_recall(truth, test::words_of(text));
-  std::printf("[capture near edge] captured by %s after %.1f s of frame time (%d frames, %zu things said), corners within %.2f px, "
-              "page %d x %d px, OCR recall %.3f of %zu words\n",
-              capture_end_name(o.end), taken_after_s, o.frames, o.advice.size(), worst_px, o.image.cols, o.image.rows, recall, truth.size());
+  std::printf(
+      "[capture near edge] captured by %s after %.1f s of frame time (%d frames, %zu things said), corners within %.2f "
+      "px, "
+      "page %d x %d px, OCR recall %.3f of %zu words\n",
+      capture_end_name(o.end), taken_after_s, o.frames, o.advice.size(), worst_px, o.image.cols, o.image.rows, recall,
+      truth.size());
   EXPECT_GE(recall, 0.9) << text.substr(0, 600);
 
   // The same frames through `explore --source`: the capture's text blocks in scene.json, read by OCR.
-  const test::ExeResult run = test::run_kiosk("explore --source " + test::quoted("file:" + frames.string()) + " --out " +
-                                                  test::quoted(dir / "out") + " --duration 0.5",
+  const test::ExeResult run = test::run_kiosk("explore --source " + test::quoted("file:" + frames.string()) +
+                                                  " --out " + test::quoted(dir / "out") + " --duration 0.5",
                                               dir);
   ASSERT_EQ(run.status, 0) << run.err;
   std::ifstream sf(dir / "out" / "summary.json"), jf(dir / "out" / "scene.json");

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "runtime/coverage.hpp"
 #include "curves.hpp"
 #include "haptics/multires.hpp"
+#include "runtime/coverage.hpp"
 
 namespace hk::app {
 namespace {

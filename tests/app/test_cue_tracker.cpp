@@ -122,7 +122,8 @@ TEST(CueTracker, WorkspaceEdgeOnceUntilTheHandComesBack) {
   p.workspace_half_extent_m = {0.07, 0.045};
   p.edge_margin_m = 0.002;
   CueRun r(p);
-  for (double x : {0.0, 0.067, 0.069, 0.0685, 0.069, 0.067, 0.0665, 0.0, 0.069}) r.step(ContactState::Free, -1, {0, 0}, 0, {x, 0});
+  for (double x : {0.0, 0.067, 0.069, 0.0685, 0.069, 0.067, 0.0665, 0.0, 0.069})
+    r.step(ContactState::Free, -1, {0, 0}, 0, {x, 0});
   EXPECT_EQ(r.count(CueKind::WorkspaceEdge), 2) << "one at the first approach, one after coming back in by 2 margins";
   r.step(ContactState::Free, -1, {0, 0}, 0, {0, -0.0449});
   EXPECT_EQ(r.count(CueKind::WorkspaceEdge), 2) << "still latched";

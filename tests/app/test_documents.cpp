@@ -17,22 +17,22 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <optional>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "pictures/documents.hpp"
 #include "child_process.hpp"
+#include "pictures/documents.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_params.hpp"
-#include "runtime/runtime_params.hpp"
 #include "pictures/stick_service.hpp"
-#include "vision/pdf.hpp"
+#include "runtime/runtime_params.hpp"
 #include "test_paths.hpp"
+#include "vision/pdf.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -73,8 +73,10 @@ double fraction_within(const ImageScene& a, const ImageScene& b, double tol_px) 
   cv::Mat canvas(a.height_px * kUp, a.width_px * kUp, CV_8UC1, cv::Scalar(255));
   auto at = [&](Vec2 m) { return cv::Point2d((a.px_to_m.u_px(m.x) + 0.5) * kUp, (a.px_to_m.v_px(m.y) + 0.5) * kUp); };
   for (const Polyline& p : a.polylines) {
-    for (std::size_t i = 0; i + 1 < p.points_m.size(); ++i) cv::line(canvas, at(p.points_m[i]), at(p.points_m[i + 1]), cv::Scalar(0), 1);
-    if (p.closed && p.points_m.size() > 1) cv::line(canvas, at(p.points_m.back()), at(p.points_m.front()), cv::Scalar(0), 1);
+    for (std::size_t i = 0; i + 1 < p.points_m.size(); ++i)
+      cv::line(canvas, at(p.points_m[i]), at(p.points_m[i + 1]), cv::Scalar(0), 1);
+    if (p.closed && p.points_m.size() > 1)
+      cv::line(canvas, at(p.points_m.back()), at(p.points_m.front()), cv::Scalar(0), 1);
   }
   cv::Mat dist;
   cv::distanceTransform(canvas, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
@@ -82,7 +84,8 @@ double fraction_within(const ImageScene& a, const ImageScene& b, double tol_px) 
   for (const Polyline& p : b.polylines) {
     for (const Vec2& m : p.points_m) {
       const cv::Point2d c = at(m);
-      const int x = std::clamp(static_cast<int>(c.x), 0, dist.cols - 1), y = std::clamp(static_cast<int>(c.y), 0, dist.rows - 1);
+      const int x = std::clamp(static_cast<int>(c.x), 0, dist.cols - 1),
+                y = std::clamp(static_cast<int>(c.y), 0, dist.rows - 1);
       ++n;
       near += dist.at<float>(y, x) / kUp <= tol_px;
     }
@@ -163,11 +166,14 @@ TEST(PdfPages, PicturePagesGiveThePngsCurvesWithinAPixel) {
     const ImageScene from_pdf = build_pdf_page_scene(pdf, "horse_and_page.pdf", page, s);
     ASSERT_GT(from_png.polylines.size(), 0u) << png;
     EXPECT_EQ(from_pdf.pages, 2);
-    EXPECT_NEAR(from_pdf.px_to_m.scale_m_per_px * from_pdf.width_px, from_png.px_to_m.scale_m_per_px * from_png.width_px, 1e-5)
+    EXPECT_NEAR(from_pdf.px_to_m.scale_m_per_px * from_pdf.width_px,
+                from_png.px_to_m.scale_m_per_px * from_png.width_px, 1e-5)
         << "same page size in the workspace";
     if (page == 1) {
-      EXPECT_GE(fraction_within(from_png, from_pdf, 1.0), 0.95) << png << ": points of the PDF page's curves within 1 px of the PNG's";
-      EXPECT_GE(fraction_within(from_pdf, from_png, 1.0), 0.95) << png << ": points of the PNG's curves within 1 px of the PDF page's";
+      EXPECT_GE(fraction_within(from_png, from_pdf, 1.0), 0.95)
+          << png << ": points of the PDF page's curves within 1 px of the PNG's";
+      EXPECT_GE(fraction_within(from_pdf, from_png, 1.0), 0.95)
+          << png << ": points of the PNG's curves within 1 px of the PDF page's";
     } else {
       // img2pdf embedded page.png with its ICC profile, which poppler applies: the page's grey levels are
       // not the PNG's, and the faint edges of this unevenly lit text photo move or come and go (measured:
@@ -185,7 +191,8 @@ TEST(PdfPages, PicturePagesGiveThePngsCurvesWithinAPixel) {
 TEST(PdfPages, TextIsSpokenNotFelt) {
   config::Settings s = test_settings();
   s.vision.ocr = "off";  // the text layer's words alone (without them the page would be read by OCR)
-  const vision::PdfPage page = vision::render_pdf_page(bytes_of(kSpecPdf), "shared-mime-info-spec.pdf", 2, pdf_limits_from(s));
+  const vision::PdfPage page =
+      vision::render_pdf_page(bytes_of(kSpecPdf), "shared-mime-info-spec.pdf", 2, pdf_limits_from(s));
   ASSERT_GT(page.words.size(), 50u) << "page 2 of the specification is a page of text";
   const ImageScene masked = build_page_scene(page, "spec.pdf", 2, s);
   vision::PdfPage bare = page;
@@ -244,7 +251,9 @@ TEST(PdfPages, TextMaskCoversEachWordGrownByAQuarterOfItsHeight) {
 TEST(ExploreDocument, PdfPageWritesTextBlocksAndRefusesBadPagesInOneLine) {
   const fs::path out = fresh_dir("explore");
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(exe + " explore " + q(kSpecPdf) + " --page 2 --out " + q(out) + generous_config(out) + " --duration 1 >/dev/null 2>" + q(out / "err.txt")), 0)
+  ASSERT_EQ(sh(exe + " explore " + q(kSpecPdf) + " --page 2 --out " + q(out) + generous_config(out) +
+               " --duration 1 >/dev/null 2>" + q(out / "err.txt")),
+            0)
       << slurp(out / "err.txt");
   const json scene = json::parse(slurp(out / "scene.json"));
   EXPECT_EQ(scene["page"], 2);
@@ -263,7 +272,10 @@ TEST(ExploreDocument, PdfPageWritesTextBlocksAndRefusesBadPagesInOneLine) {
   EXPECT_EQ(sum["document"]["text_blocks"], scene["text_blocks"].size());
   EXPECT_GT(sum["document"]["words_masked"].get<int>(), 50);
   EXPECT_TRUE(fs::exists(out / "overlay.png"));
-  EXPECT_EQ(sh(exe + " explore " + q(kHorsePdf) + " --out " + q(out / "p1") + generous_config(out) + " --duration 0.2 >/dev/null 2>&1"), 0) << "a PDF without --page: page 1";
+  EXPECT_EQ(sh(exe + " explore " + q(kHorsePdf) + " --out " + q(out / "p1") + generous_config(out) +
+               " --duration 0.2 >/dev/null 2>&1"),
+            0)
+      << "a PDF without --page: page 1";
   EXPECT_EQ(json::parse(slurp(out / "p1" / "scene.json"))["page"], 1);
 
   // Bad pages and files: a non-zero exit and one line naming the input and the limit.
@@ -272,7 +284,8 @@ TEST(ExploreDocument, PdfPageWritesTextBlocksAndRefusesBadPagesInOneLine) {
       {q(kData / "images" / "horse.png") + " --page 2", "not a PDF"},
   };
   for (const auto& [args, want] : bad) {
-    const int status = sh(exe + " explore " + args + " --out " + q(out / "bad") + " >/dev/null 2>" + q(out / "err.txt"));
+    const int status =
+        sh(exe + " explore " + args + " --out " + q(out / "bad") + " >/dev/null 2>" + q(out / "err.txt"));
     const std::string err = slurp(out / "err.txt");
     EXPECT_NE(status, 0) << args;
     EXPECT_NE(err.find(want), std::string::npos) << args << ": " << err;
@@ -292,7 +305,10 @@ TEST(StickCommand, ListsDocumentsWithPagesAndRefusalsWithReasons) {
   std::ofstream(stick / "notes.pdf") << "not a PDF at all\n";
   fs::create_symlink("/etc/passwd", stick / "passwords.png");
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(exe + " stick " + q(stick) + generous_config(dir) + " --json " + q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt")), 0) << slurp(dir / "err.txt");
+  ASSERT_EQ(sh(exe + " stick " + q(stick) + generous_config(dir) + " --json " + q(dir / "stick.json") +
+               " >/dev/null 2>" + q(dir / "err.txt")),
+            0)
+      << slurp(dir / "err.txt");
   const json j = json::parse(slurp(dir / "stick.json"));
   ASSERT_EQ(j["documents"].size(), 3u) << j.dump(2);
   EXPECT_EQ(j["documents"][0]["path"], "holiday/butterfly.jpg");
@@ -336,9 +352,12 @@ TEST(StickCommand, APdfsOwnTitleIsListedWhenItIsOneAPersonWrote) {
   for (const auto& d : j["documents"]) EXPECT_EQ(d.contains("title"), d["path"] == "ring.pdf") << d.dump();
   // Explore on the PDF itself: summary.json's document says it too.
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(exe + " explore " + q(stick / "ring.pdf") + " --out " + q(dir / "out") + " --duration 0.05 >/dev/null 2>" + q(dir / "err.txt")), 0)
+  ASSERT_EQ(sh(exe + " explore " + q(stick / "ring.pdf") + " --out " + q(dir / "out") +
+               " --duration 0.05 >/dev/null 2>" + q(dir / "err.txt")),
+            0)
       << slurp(dir / "err.txt");
-  EXPECT_EQ(json::parse(slurp(dir / "out" / "summary.json"))["document"]["title"], "A ring, drawn for the hand \u2014 caf\u00e9 edition");
+  EXPECT_EQ(json::parse(slurp(dir / "out" / "summary.json"))["document"]["title"],
+            "A ring, drawn for the hand \u2014 caf\u00e9 edition");
   fs::remove_all(dir);
 }
 
@@ -373,9 +392,11 @@ TEST(StickCommand, DeviceIsMountedReadOnlyScannedAndUnmounted) {
   const std::string& before = stick.before;
   const std::string& loop = stick.loop->dev;
   const std::string exe = HK_KIOSK_EXE;
-  const int status = sh("unshare -m --propagation private " + exe + " stick --device " + loop + generous_config(dir) + " --mount-root " + q(dir / "mnt") + " --json " +
-                        q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt"));
-  if (status != 0 && slurp(dir / "err.txt").find("unshare") != std::string::npos) GTEST_SKIP() << "no mount namespace here";
+  const int status = sh("unshare -m --propagation private " + exe + " stick --device " + loop + generous_config(dir) +
+                        " --mount-root " + q(dir / "mnt") + " --json " + q(dir / "stick.json") + " >/dev/null 2>" +
+                        q(dir / "err.txt"));
+  if (status != 0 && slurp(dir / "err.txt").find("unshare") != std::string::npos)
+    GTEST_SKIP() << "no mount namespace here";
   ASSERT_EQ(status, 0) << slurp(dir / "err.txt");
   const json j = json::parse(slurp(dir / "stick.json"));
   EXPECT_EQ(j["device"]["filesystem"], "ext4");
@@ -442,7 +463,8 @@ TEST(StickService, InsertBrowseCrashRemoveInsertAgain) {
   ASSERT_EQ(got.size(), 1u);
   EXPECT_FALSE(got[0].scene.has_value());
   EXPECT_NE(got[0].reason.find("signal"), std::string::npos) << got[0].reason;
-  EXPECT_EQ(got[0].reason.find("b_pages.pdf"), std::string::npos) << "the reason is said after the name, not with it: " << got[0].reason;
+  EXPECT_EQ(got[0].reason.find("b_pages.pdf"), std::string::npos)
+      << "the reason is said after the name, not with it: " << got[0].reason;
   svc.set_pdf_fault(vision::PdfFault::None);
 
   svc.remove_folder();
@@ -567,7 +589,8 @@ TEST(StickService, ARequestForThePageBeingBuiltAheadTakesItOverUntilAnotherIsAsk
   svc.load(stick, 0, 1);
   got = wait_for([&] { return svc.poll_loaded(); });
   ASSERT_EQ(got.size(), 1u);
-  EXPECT_EQ(got[0].document, 0) << "page " << got[0].page << " of document " << got[0].document << " was handed over after it was passed by";
+  EXPECT_EQ(got[0].document, 0) << "page " << got[0].page << " of document " << got[0].document
+                                << " was handed over after it was passed by";
   EXPECT_TRUE(got[0].scene.has_value()) << got[0].reason;
 
   svc.set_pdf_fault(vision::PdfFault::None);
@@ -589,20 +612,23 @@ TEST(StickService, ARequestForThePageBeingBuiltAheadTakesItOverUntilAnotherIsAsk
 // text is ready), Describe on a page says what it holds, taking the stick out goes back to the library (its
 // speech log, one "say:" line per message).
 TEST(KioskScreen, StickIsBrowsedPageByPageAndTakenOut) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = fresh_dir("kiosk_stick");
   fs::create_directories(dir / "library");
   fs::create_directories(dir / "stick");
   fs::copy_file(kData / "images" / "silhouette_3.png", dir / "library" / "shape.png");
   fs::copy_file(kData / "images" / "horse.png", dir / "stick" / "a horse.png");
   fs::copy_file(kHorsePdf, dir / "stick" / "b two pages.pdf");
-  std::ofstream(dir / "script.txt") << "1 stick " << (dir / "stick").string() << "\n2 wait_loaded\n3 key next\n4 wait_loaded\n"
+  std::ofstream(dir / "script.txt") << "1 stick " << (dir / "stick").string()
+                                    << "\n2 wait_loaded\n3 key next\n4 wait_loaded\n"
                                     << "5 key next\n6 wait_loaded\n7 key describe\n8 unstick\n9 wait_loaded\n";
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh("ASAN_OPTIONS=detect_leaks=0 timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug" + generous_config(dir) + " --library " +
-               q(dir / "library") + " --script " + q(dir / "script.txt") + " --screenshot " + q(dir / "end.png") + " --frames 40 >" +
-               q(dir / "log.txt") + " 2>&1"),
-            0)
+  ASSERT_EQ(
+      sh("ASAN_OPTIONS=detect_leaks=0 timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug" +
+         generous_config(dir) + " --library " + q(dir / "library") + " --script " + q(dir / "script.txt") +
+         " --screenshot " + q(dir / "end.png") + " --frames 40 >" + q(dir / "log.txt") + " 2>&1"),
+      0)
       << slurp(dir / "log.txt");
   std::vector<std::string> said;
   std::istringstream log(slurp(dir / "log.txt"));
@@ -611,8 +637,11 @@ TEST(KioskScreen, StickIsBrowsedPageByPageAndTakenOut) {
     if (at != std::string::npos) said.push_back(line.substr(at + 5));
   }
   const std::vector<std::string> want_prefix{
-      "A USB stick with 2 documents: a picture and a PDF of 2 pages. Press the Right arrow to go through them. Document 1 of 2, a horse. It has",
-      "Page 1 of 2 of b two pages. It has no text and", "Page 2 of 2 of b two pages. Reading the text.", "The text is ready. It has",
+      "A USB stick with 2 documents: a picture and a PDF of 2 pages. Press the Right arrow to go through them. "
+      "Document 1 of 2, a horse. It has",
+      "Page 1 of 2 of b two pages. It has no text and",
+      "Page 2 of 2 of b two pages. Reading the text.",
+      "The text is ready. It has",
       "People nearby can hear your document. Press the P key to pause it, or the End key to stop. It has",
       "The USB stick was taken out. Back to the picture library. Picture 1 of 1."};
   ASSERT_EQ(said.size(), want_prefix.size()) << slurp(dir / "log.txt");
@@ -626,11 +655,15 @@ TEST(StickCommand, HostilePdfsAreRefusedOrCappedWithReasons) {
   const fs::path dir = fresh_dir("hostile");
   const fs::path stick = dir / "stick";
   fs::create_directories(stick);
-  for (const char* f : {"empty.pdf", "text_named.pdf", "truncated.pdf", "locked.pdf", "pages_5000.pdf", "page_14400pt.pdf"}) {
+  for (const char* f :
+       {"empty.pdf", "text_named.pdf", "truncated.pdf", "locked.pdf", "pages_5000.pdf", "page_14400pt.pdf"}) {
     fs::copy_file(kData / "bad" / f, stick / f);
   }
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(exe + " stick " + q(stick) + generous_config(dir) + " --json " + q(dir / "stick.json") + " >/dev/null 2>" + q(dir / "err.txt")), 0) << slurp(dir / "err.txt");
+  ASSERT_EQ(sh(exe + " stick " + q(stick) + generous_config(dir) + " --json " + q(dir / "stick.json") +
+               " >/dev/null 2>" + q(dir / "err.txt")),
+            0)
+      << slurp(dir / "err.txt");
   const json j = json::parse(slurp(dir / "stick.json"));
   std::map<std::string, std::string> refused;
   for (const auto& r : j["refused"]) refused[r["path"]] = r["reason"];
@@ -681,7 +714,8 @@ std::optional<StickNews> next_news(StickService& svc) {
 // inserted again, it is a new stick. The image is unchanged.
 TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root (losetup, mount); CI runs as root";
-  if (sh("command -v mkfs.ext4 >/dev/null && command -v losetup >/dev/null") != 0) GTEST_SKIP() << "mkfs.ext4 or losetup missing";
+  if (sh("command -v mkfs.ext4 >/dev/null && command -v losetup >/dev/null") != 0)
+    GTEST_SKIP() << "mkfs.ext4 or losetup missing";
   const fs::path dir = fresh_dir("hotplug");
   fs::create_directories(dir / "src");
   fs::copy_file(kHorsePdf, dir / "src" / "pages.pdf");
@@ -702,12 +736,15 @@ TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
     if (!svc.can_mount()) return "SKIP: no CAP_SYS_ADMIN";
     fake->push({vision::BlockEvent::Action::Add, loop, ""});
     std::optional<StickNews> n = next_news(svc);
-    if (!n || n->kind != StickNews::Kind::Inserted) return "insert: no Inserted news" + (n ? " (" + n->reason + ")" : std::string());
-    if (n->documents.size() != 2 || n->documents[0].pages != 2) return "insert: expected pages.pdf (2 pages) and shape.png";
+    if (!n || n->kind != StickNews::Kind::Inserted)
+      return "insert: no Inserted news" + (n ? " (" + n->reason + ")" : std::string());
+    if (n->documents.size() != 2 || n->documents[0].pages != 2)
+      return "insert: expected pages.pdf (2 pages) and shape.png";
     const int first = n->stick;
     svc.load(first, 0, 2);
     std::vector<LoadedDocument> d = wait_for([&] { return svc.poll_loaded(); });
-    if (d.size() != 1 || !d[0].scene || d[0].scene->page != 2) return "browse: page 2 not built: " + (d.empty() ? "" : d[0].reason);
+    if (d.size() != 1 || !d[0].scene || d[0].scene->page != 2)
+      return "browse: page 2 not built: " + (d.empty() ? "" : d[0].reason);
 
     svc.set_pdf_fault(vision::PdfFault::Hang);
     svc.load(first, 0, 1);  // drawn by a worker that hangs until the 10 s page limit

@@ -4,24 +4,24 @@
 
 #include <type_traits>
 
-#include "formats/app_error.hpp"
 #include "audio/messages.hpp"
 #include "audio/speech.hpp"
 #include "audio/wav.hpp"
-#include "config/load.hpp"
-#include "runtime/device_setup.hpp"
 #include "cli/explore.hpp"
+#include "config/load.hpp"
+#include "formats/app_error.hpp"
+#include "formats/picture_notes.hpp"
 #include "haptics/device.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/multires.hpp"
 #include "hk/error.hpp"
-#include "formats/picture_notes.hpp"
+#include "runtime/device_setup.hpp"
+#include "test_paths.hpp"
 #include "vision/frame_source.hpp"
 #include "vision/intake.hpp"
 #include "vision/pdf.hpp"
 #include "vision/stick_scan.hpp"
 #include "vision/usb_stick.hpp"
-#include "test_paths.hpp"
 
 namespace hk {
 namespace {

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "crossing_grid.hpp"
-#include "kiosk_exe.hpp"
 #include "haptics/hand_path.hpp"
+#include "kiosk_exe.hpp"
 #include "pictures/image_scene.hpp"
 #include "runtime/simulation.hpp"
 #include "test_paths.hpp"
@@ -32,7 +32,6 @@ using test::quoted;
 using test::run_kiosk;
 using test::test_images;
 
-
 }  // namespace
 
 class ExploreContract : public ::testing::TestWithParam<fs::path> {};
@@ -47,7 +46,8 @@ TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
   std::ifstream sf(out / "scene.json");
   const json scene = json::parse(sf);
   ASSERT_GT(scene["image"]["width_px"].get<int>(), 0);
-  const double scale = scene["px_to_m"]["scale"], ox = scene["px_to_m"]["offset_x_m"], oy = scene["px_to_m"]["offset_y_m"];
+  const double scale = scene["px_to_m"]["scale"], ox = scene["px_to_m"]["offset_x_m"],
+               oy = scene["px_to_m"]["offset_y_m"];
   const int w = scene["image"]["width_px"], h = scene["image"]["height_px"];
   // The image fits the default usable rectangle 0.14 m x 0.09 m, centred.
   EXPECT_GE(ox, -0.07 - 1e-9);
@@ -88,8 +88,10 @@ TEST_P(ExploreContract, WritesTheFourFilesAsDesignSays) {
     int contact, curve, level;
     long long ns;
     int pop = -1;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d,%lld,%d", &t, &hx, &hy, &px, &py, &fx, &fy, &contact, &curve,
-                          &level, &ns, &pop), 12) << line;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d,%d,%d,%lld,%d", &t, &hx, &hy, &px, &py, &fx,
+                          &fy, &contact, &curve, &level, &ns, &pop),
+              12)
+        << line;
     ASSERT_TRUE(pop == 0 || pop == 1) << line;
     if (pop == 1) {
       EXPECT_EQ(contact, 0) << "a pop leaves the proxy free: " << line;
@@ -160,7 +162,8 @@ TEST_P(RasterNeverCrosses, ProxyStaysOnItsSideOfEveryWall) {
   const app::ImageScene is = app::build_image_scene(GetParam().string(), s);
   const Scene& sc = *is.scene;
   ASSERT_GT(sc.curve_count(), 0u);
-  const HandPath path = raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
+  const HandPath path =
+      raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
   test::CrossingGrid grid(sc, s.haptics.level);
   long crossings = 0, contact_ticks = 0, vertex_ticks = 0, bad_force = 0;
   app::run_simulation(sc, s, path, path.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
@@ -168,16 +171,20 @@ TEST_P(RasterNeverCrosses, ProxyStaysOnItsSideOfEveryWall) {
     for (int m = 1; m < c.path_count; ++m) {
       const int n = grid.crossings(c.path_m[m - 1], c.path_m[m]);
       if (n && getenv("HK_DEBUG")) {
-        fprintf(stderr, "tick %ld move %d/%d crossings %d state %d ev %x h(%.9g,%.9g) c0 %d/%d/%d c1 %d/%d/%d\n", r.index, m, c.path_count, n, (int)c.state, c.events, r.handle_m.x, r.handle_m.y,
-          c.constraint[0].curve, c.constraint[0].level, c.constraint[0].segment, c.constraint[1].curve, c.constraint[1].level, c.constraint[1].segment);
-        for (int q = 0; q < c.path_count; ++q) fprintf(stderr, "   p%d (%.12g, %.12g)\n", q, c.path_m[q].x, c.path_m[q].y);
+        fprintf(stderr, "tick %ld move %d/%d crossings %d state %d ev %x h(%.9g,%.9g) c0 %d/%d/%d c1 %d/%d/%d\n",
+                r.index, m, c.path_count, n, (int)c.state, c.events, r.handle_m.x, r.handle_m.y, c.constraint[0].curve,
+                c.constraint[0].level, c.constraint[0].segment, c.constraint[1].curve, c.constraint[1].level,
+                c.constraint[1].segment);
+        for (int q = 0; q < c.path_count; ++q)
+          fprintf(stderr, "   p%d (%.12g, %.12g)\n", q, c.path_m[q].x, c.path_m[q].y);
       }
       crossings += n;
     }
     contact_ticks += c.state != ContactState::Free;
     vertex_ticks += c.state == ContactState::Vertex;
     // Force = stiffness · separation, up to the clamp (and the start-up ramp).
-    const double expect = std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
+    const double expect =
+        std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
     if (r.t_s > s.haptics.force_ramp_s && std::abs(length(so.force_n) - expect) > 1e-6) ++bad_force;
   });
   EXPECT_EQ(crossings, 0);
@@ -202,7 +209,8 @@ TEST_P(RasterPushThrough, AGentleHandNeverPopsAHardOneOnlyOnPopTicks) {
     const app::ImageScene is = app::build_image_scene(GetParam().string(), s);
     const Scene& sc = *is.scene;
     ASSERT_GT(sc.curve_count(), 0u);
-    const HandPath path = raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
+    const HandPath path =
+        raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
     test::CrossingGrid grid(sc, s.haptics.level);
     const long release_ticks = std::lround(s.haptics.pop_release_s * s.haptics.servo_rate_hz);
     long pops = 0, pops_that_cross = 0, crossings_without_pop = 0, bad_force = 0, since_pop = 1L << 30;
@@ -215,8 +223,10 @@ TEST_P(RasterPushThrough, AGentleHandNeverPopsAHardOneOnlyOnPopTicks) {
       pops_that_cross += pop && n > 0;
       if (!pop) crossings_without_pop += n;
       since_pop = pop ? 0 : since_pop + 1;
-      const double expect = std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
-      if (r.t_s > s.haptics.force_ramp_s && since_pop >= release_ticks && std::abs(length(so.force_n) - expect) > 1e-6) ++bad_force;
+      const double expect =
+          std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
+      if (r.t_s > s.haptics.force_ramp_s && since_pop >= release_ticks && std::abs(length(so.force_n) - expect) > 1e-6)
+        ++bad_force;
     });
     EXPECT_EQ(crossings_without_pop, 0);
     EXPECT_EQ(pops_that_cross, pops) << "a pop that crossed nothing";
@@ -250,7 +260,8 @@ TEST_P(BadInput, OneLineErrorNonZeroExitNoCrash) {
   const fs::path out = fresh_dir("bad_" + GetParam().name);
   std::string args = GetParam().args;
   for (std::size_t at; (at = args.find("{bad}")) != std::string::npos;) args.replace(at, 5, (kData / "bad").string());
-  for (std::size_t at; (at = args.find("{img}")) != std::string::npos;) args.replace(at, 5, (kData / "images").string());
+  for (std::size_t at; (at = args.find("{img}")) != std::string::npos;)
+    args.replace(at, 5, (kData / "images").string());
   const ExeResult r = run_kiosk("explore " + args + " --out " + quoted(out / "o"), out);
   EXPECT_EQ(r.status, 1) << r.err;  // 1 = refused input; a crash or sanitizer abort would be another code
   ASSERT_FALSE(r.err.empty());
@@ -261,13 +272,15 @@ TEST_P(BadInput, OneLineErrorNonZeroExitNoCrash) {
 
 INSTANTIATE_TEST_SUITE_P(
     Files, BadInput,
-    ::testing::Values(BadCase{"missing", "{bad}/no_such_file.png", "no_such_file.png"},
-                      BadCase{"text_as_png", "{bad}/not_an_image.png", "not_an_image.png"},
-                      BadCase{"truncated_jpeg", "{bad}/truncated.jpg", "truncated.jpg"},
-                      BadCase{"empty", "{bad}/empty.png", "empty.png"},
-                      BadCase{"huge_header", "{bad}/huge_declared.png", "huge_declared.png"},
-                      BadCase{"config_out_of_range", "{img}/horse.png --config {bad}/config_out_of_range.toml", "stiffness_n_per_m"},
-                      BadCase{"config_syntax", "{img}/horse.png --config {bad}/config_syntax.toml", "config_syntax.toml"},
-                      BadCase{"hand_nan", "{img}/horse.png --hand {bad}/hand_nan.csv", "hand_nan.csv"},
-                      BadCase{"hand_decreasing", "{img}/horse.png --hand {bad}/hand_time_decreasing.csv", "hand_time_decreasing.csv"}),
+    ::testing::Values(
+        BadCase{"missing", "{bad}/no_such_file.png", "no_such_file.png"},
+        BadCase{"text_as_png", "{bad}/not_an_image.png", "not_an_image.png"},
+        BadCase{"truncated_jpeg", "{bad}/truncated.jpg", "truncated.jpg"},
+        BadCase{"empty", "{bad}/empty.png", "empty.png"},
+        BadCase{"huge_header", "{bad}/huge_declared.png", "huge_declared.png"},
+        BadCase{"config_out_of_range", "{img}/horse.png --config {bad}/config_out_of_range.toml", "stiffness_n_per_m"},
+        BadCase{"config_syntax", "{img}/horse.png --config {bad}/config_syntax.toml", "config_syntax.toml"},
+        BadCase{"hand_nan", "{img}/horse.png --hand {bad}/hand_nan.csv", "hand_nan.csv"},
+        BadCase{"hand_decreasing", "{img}/horse.png --hand {bad}/hand_time_decreasing.csv",
+                "hand_time_decreasing.csv"}),
     [](const auto& info) { return info.param.name; });

@@ -49,7 +49,9 @@ std::vector<double> contact_onsets(const fs::path& trace, long* rows) {
   while (std::getline(tf, line)) {
     double t, v[6];
     int contact = 0;
-    if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d", &t, &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &contact) != 8) continue;
+    if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d", &t, &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
+                    &contact) != 8)
+      continue;
     if (prev == 0 && contact != 0) out.push_back(t);
     prev = contact;
     ++*rows;
@@ -63,8 +65,8 @@ TEST_P(ExploreAudio, EveryContactOnsetIsHeardWithin10ms) {
   const std::string image = GetParam();
   const fs::path out = fresh_dir(fs::path(image).stem().string());
   const fs::path wav = out / "run.wav";
-  ASSERT_EQ(run("explore '" + (kData / "images" / image).string() + "' --out '" + out.string() + "' --duration 20 --audio-out '" +
-                    wav.string() + "'",
+  ASSERT_EQ(run("explore '" + (kData / "images" / image).string() + "' --out '" + out.string() +
+                    "' --duration 20 --audio-out '" + wav.string() + "'",
                 out / "err.txt"),
             0)
       << slurp(out / "err.txt");
@@ -124,7 +126,9 @@ TEST(ExploreAudioBadInput, RefusedInOneLineBeforeTheRun) {
   };
   for (const Case& c : {Case{(out / "run.mp3").string(), "must name a .wav file"},
                         Case{(out / "no_such_folder" / "run.wav").string(), "does not exist"}}) {
-    ASSERT_EQ(run("explore '" + img + "' --out '" + out.string() + "' --duration 1 --audio-out '" + c.audio_out + "'", out / "err.txt"), 1);
+    ASSERT_EQ(run("explore '" + img + "' --out '" + out.string() + "' --duration 1 --audio-out '" + c.audio_out + "'",
+                  out / "err.txt"),
+              1);
     const std::string err = slurp(out / "err.txt");
     EXPECT_NE(err.find(c.must_contain), std::string::npos) << err;
     EXPECT_NE(err.find("--audio-out"), std::string::npos) << err;
@@ -135,8 +139,10 @@ TEST(ExploreAudioBadInput, RefusedInOneLineBeforeTheRun) {
 
 TEST(Speak, RendersMessagesAndTextToWav) {
   const fs::path out = fresh_dir("speak");
-  ASSERT_EQ(run("speak picture_loaded --wav '" + (out / "a.wav").string() + "'", out / "err.txt"), 0) << slurp(out / "err.txt");
-  ASSERT_EQ(run("speak welcome --messages '" + (kData / "messages" / "de.toml").string() + "' --wav '" + (out / "b.wav").string() + "'",
+  ASSERT_EQ(run("speak picture_loaded --wav '" + (out / "a.wav").string() + "'", out / "err.txt"), 0)
+      << slurp(out / "err.txt");
+  ASSERT_EQ(run("speak welcome --messages '" + (kData / "messages" / "de.toml").string() + "' --wav '" +
+                    (out / "b.wav").string() + "'",
                 out / "err.txt"),
             0)
       << slurp(out / "err.txt");
@@ -144,7 +150,8 @@ TEST(Speak, RendersMessagesAndTextToWav) {
   const std::vector<float> a = hk::audio::read_wav((out / "a.wav").string(), &rate);
   const std::vector<float> b = hk::audio::read_wav((out / "b.wav").string(), &rate);
   EXPECT_GT(hk::test::rms(a, 0, a.size()), 0.01);
-  EXPECT_GT(b.size(), 2 * a.size()) << "the German welcome is a much longer text than 'Picture 2 of 5. It has 7 shapes.'";
+  EXPECT_GT(b.size(), 2 * a.size())
+      << "the German welcome is a much longer text than 'Picture 2 of 5. It has 7 shapes.'";
   // A broken catalogue: one line naming the file and the key, and no WAV written.
   ASSERT_EQ(run("speak help --messages '" + (kData / "messages" / "unknown_key.toml").string() + "' --wav '" +
                     (out / "c.wav").string() + "'",

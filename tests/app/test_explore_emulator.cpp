@@ -15,9 +15,9 @@
 
 #include "config/load.hpp"
 #include "crossing_grid.hpp"
-#include "runtime/device_setup.hpp"
 #include "haptics/hand_path.hpp"
 #include "pictures/image_scene.hpp"
+#include "runtime/device_setup.hpp"
 #include "runtime/simulation.hpp"
 #include "test_paths.hpp"
 
@@ -73,25 +73,30 @@ RunChecks run_checked(const std::string& image, const std::string& device, doubl
   s.haptics.level_mode = "fixed";
   const app::ImageScene is = app::build_image_scene((kData / "images" / image).string(), s);
   const Scene& sc = *is.scene;
-  const HandPath path = raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
+  const HandPath path =
+      raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
   test::CrossingGrid grid(sc, s.haptics.level);
   RunChecks rc;
   rc.torque_limit = device == "sim" ? s.device.max_torque_n_m : s.device.torque_limit_n_m;
   double ok_since_s = 0.0;
-  app::run_simulation(sc, s, path, duration_s, [&](const app::TickRecord& r, const ServoOutput& so) {
-    ++rc.ticks;
-    const ContactOutput& c = so.contact;
-    for (int m = 1; m < c.path_count; ++m) rc.crossings += grid.crossings(c.path_m[m - 1], c.path_m[m]);
-    rc.contact_ticks += c.state != ContactState::Free;
-    if (r.device_status != DeviceStatus::Ok) ok_since_s = r.t_s + s.haptics.force_ramp_s;
-    const double expect = std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
-    if (r.device_status == DeviceStatus::Ok && r.t_s > std::max(ok_since_s, s.haptics.force_ramp_s) &&
-        std::abs(length(so.force_n) - expect) > 1e-6)
-      ++rc.bad_force;
-    for (double t : r.motor_torque_n_m)
-      if (!std::isfinite(t) || std::fabs(t) > rc.torque_limit + 1e-12) ++rc.bad_torque;
-    if (extra) extra(r, so);
-  }, app::parse_device_choice(device), report);
+  app::run_simulation(
+      sc, s, path, duration_s,
+      [&](const app::TickRecord& r, const ServoOutput& so) {
+        ++rc.ticks;
+        const ContactOutput& c = so.contact;
+        for (int m = 1; m < c.path_count; ++m) rc.crossings += grid.crossings(c.path_m[m - 1], c.path_m[m]);
+        rc.contact_ticks += c.state != ContactState::Free;
+        if (r.device_status != DeviceStatus::Ok) ok_since_s = r.t_s + s.haptics.force_ramp_s;
+        const double expect =
+            std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
+        if (r.device_status == DeviceStatus::Ok && r.t_s > std::max(ok_since_s, s.haptics.force_ramp_s) &&
+            std::abs(length(so.force_n) - expect) > 1e-6)
+          ++rc.bad_force;
+        for (double t : r.motor_torque_n_m)
+          if (!std::isfinite(t) || std::fabs(t) > rc.torque_limit + 1e-12) ++rc.bad_torque;
+        if (extra) extra(r, so);
+      },
+      app::parse_device_choice(device), report);
   return rc;
 }
 
@@ -163,7 +168,8 @@ TEST(EmulatedDevice, UnpluggedMidRunGetsZeroForceAndTorqueAndEndsLost) {
 
 TEST(EmulatedDevice, GarbageAndDropsNeverGiveABadTorqueOrACrossing) {
   app::DeviceReport rep;
-  const RunChecks rc = run_checked("horse.png", "haply-emulator:garbage_every=5,drop_every=9,wrong_id_every=17,seed=3", 3.0, &rep);
+  const RunChecks rc =
+      run_checked("horse.png", "haply-emulator:garbage_every=5,drop_every=9,wrong_id_every=17,seed=3", 3.0, &rep);
   EXPECT_EQ(rc.bad_torque, 0);
   EXPECT_EQ(rc.crossings, 0);
   EXPECT_GT(rep.malformed, 50);
@@ -173,8 +179,9 @@ TEST(EmulatedDevice, GarbageAndDropsNeverGiveABadTorqueOrACrossing) {
 TEST(EmulatedDevice, AStallIsLostThenBackWithTheForceRampedIn) {
   app::DeviceReport rep;
   long lost = 0;
-  const RunChecks rc = run_checked("horse.png", "haply-emulator:stall_at_s=1,stall_s=0.05", 2.5, &rep,
-                                   [&](const app::TickRecord& r, const ServoOutput&) { lost += r.device_status == DeviceStatus::Lost; });
+  const RunChecks rc =
+      run_checked("horse.png", "haply-emulator:stall_at_s=1,stall_s=0.05", 2.5, &rep,
+                  [&](const app::TickRecord& r, const ServoOutput&) { lost += r.device_status == DeviceStatus::Lost; });
   EXPECT_GT(lost, 0);
   EXPECT_EQ(rep.status, "ok");
   EXPECT_EQ(rep.reconnects, 1);
@@ -185,11 +192,15 @@ TEST(EmulatedDevice, AStallIsLostThenBackWithTheForceRampedIn) {
 TEST(EmulatedDevice, BadDeviceValuesEndInOneLine) {
   const fs::path tmp = fresh_dir("emu_bad");
   const std::string img = (kData / "images" / "horse.png").string();
-  struct Case { const char* device; const char* must_name; };
+  struct Case {
+    const char* device;
+    const char* must_name;
+  };
   for (const Case& c : {Case{"usb", "--device 'usb'"}, Case{"haply-emulator:drop_every=-1", "drop_every=-1"},
-                        Case{"haply-emulator:fly=1", "unknown fault 'fly'"}, Case{"haply-emulator:stall_s", "KEY=VALUE"},
-                        Case{"haply-emulatorx", "must be 'sim'"}}) {
-    const ExeResult r = run_exe("explore '" + img + "' --out '" + (tmp / "o").string() + "' --duration 0.1 --device '" + c.device + "'", tmp);
+                        Case{"haply-emulator:fly=1", "unknown fault 'fly'"},
+                        Case{"haply-emulator:stall_s", "KEY=VALUE"}, Case{"haply-emulatorx", "must be 'sim'"}}) {
+    const ExeResult r = run_exe(
+        "explore '" + img + "' --out '" + (tmp / "o").string() + "' --duration 0.1 --device '" + c.device + "'", tmp);
     EXPECT_NE(r.status, 0) << c.device;
     EXPECT_NE(r.err.find(c.must_name), std::string::npos) << c.device << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -203,7 +214,8 @@ TEST(EmulatedDevice, CalibrateWritesOffsetsThatUndoAnEncoderZeroError) {
   config::Settings s;
   s.haptics.stiffness_n_per_m = 654;  // a value that must survive the rewrite
   config::save_settings_atomic(s, cfg.string());
-  const ExeResult r = run_exe("calibrate --config '" + cfg.string() + "' --device haply-emulator:calib_error1_deg=3,calib_error2_deg=-2", tmp);
+  const ExeResult r = run_exe(
+      "calibrate --config '" + cfg.string() + "' --device haply-emulator:calib_error1_deg=3,calib_error2_deg=-2", tmp);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("encoder 1 offset 180.000 ->"), std::string::npos) << r.out;
   const config::Settings back = config::load_settings(cfg.string());

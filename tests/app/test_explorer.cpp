@@ -16,12 +16,12 @@
 #include <thread>
 #include <vector>
 
-#include "runtime/coverage.hpp"
-#include "curves.hpp"
-#include "kiosk_exe.hpp"
 #include "cli/explore.hpp"
+#include "curves.hpp"
 #include "haptics/explorer_hand.hpp"
 #include "haptics/multires.hpp"
+#include "kiosk_exe.hpp"
+#include "runtime/coverage.hpp"
 #include "runtime/simulation.hpp"
 #include "test_paths.hpp"
 
@@ -36,8 +36,8 @@ using test::ExeResult;
 using test::fresh_dir;
 using test::quoted;
 using test::run_kiosk;
-using test::test_images;
 using test::sampled_square;
+using test::test_images;
 
 // trace.csv without its last column, tick_ns (the measured compute time of each tick, never the same twice).
 std::string trace_without_tick_times(const fs::path& p) {
@@ -59,10 +59,12 @@ TEST(Explorer, TheSameSeedGivesTheSameTraceAndAnotherSeedAnotherOne) {
   const fs::path img = kData / "images" / "apple.jpg";
   const fs::path tmp = fresh_dir("explorer_determinism");
   for (const char* run : {"a", "b"}) {
-    const ExeResult r = run_kiosk("explore " + quoted(img) + " --out " + quoted(tmp / run) + " --hand explorer --seed 5 --duration 4", tmp);
+    const ExeResult r = run_kiosk(
+        "explore " + quoted(img) + " --out " + quoted(tmp / run) + " --hand explorer --seed 5 --duration 4", tmp);
     ASSERT_EQ(r.status, 0) << r.err;
   }
-  const ExeResult r = run_kiosk("explore " + quoted(img) + " --out " + quoted(tmp / "c") + " --hand explorer --seed 6 --duration 4", tmp);
+  const ExeResult r = run_kiosk(
+      "explore " + quoted(img) + " --out " + quoted(tmp / "c") + " --hand explorer --seed 6 --duration 4", tmp);
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string a = trace_without_tick_times(tmp / "a" / "trace.csv");
   EXPECT_GT(std::count(a.begin(), a.end(), '\n'), 4000);
@@ -86,8 +88,8 @@ TEST(Explorer, ABadSeedIsOneLineNamingSeed) {
   const fs::path tmp = fresh_dir("explorer_badseed");
   const fs::path img = kData / "images" / "apple.jpg";
   for (const char* seed : {"-1", "1.5", "abc", "99999999999999999999"}) {
-    const ExeResult r =
-        run_kiosk("explore " + quoted(img) + " --out " + quoted(tmp / "o") + " --hand explorer --duration 1 --seed " + seed, tmp);
+    const ExeResult r = run_kiosk(
+        "explore " + quoted(img) + " --out " + quoted(tmp / "o") + " --hand explorer --duration 1 --seed " + seed, tmp);
     EXPECT_NE(r.status, 0) << seed;
     EXPECT_NE(r.err.find("--seed"), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -125,7 +127,8 @@ TEST(Explorer, TracesASquareInsideASquare) {
     outer.add(so.contact.proxy_m);
     inner.add(so.contact.proxy_m);
   });
-  const Scene only_outer = Scene::build({sampled_square(0.03, 0.001)}, 4), only_inner = Scene::build({sampled_square(0.012, 0.001)}, 4);
+  const Scene only_outer = Scene::build({sampled_square(0.03, 0.001)}, 4),
+              only_inner = Scene::build({sampled_square(0.012, 0.001)}, 4);
   const double co = outer.measure(only_outer).length_fraction, ci = inner.measure(only_inner).length_fraction;
   RecordProperty("outer_coverage", std::to_string(co));
   RecordProperty("inner_coverage", std::to_string(ci));
@@ -149,7 +152,8 @@ TEST(Explorer, CoversFourFifthsOfTheCurvesOnMostPictures) {
     for (std::size_t i = next++; i < images.size(); i = next++) {
       const fs::path out = tmp / images[i].stem();
       fs::create_directories(out);
-      const ExeResult r = run_kiosk("explore " + quoted(images[i]) + " --out " + quoted(out) + " --hand explorer --duration 120", out);
+      const ExeResult r =
+          run_kiosk("explore " + quoted(images[i]) + " --out " + quoted(out) + " --hand explorer --duration 120", out);
       if (r.status != 0) {
         errors[i] = r.err;
         continue;
@@ -170,6 +174,7 @@ TEST(Explorer, CoversFourFifthsOfTheCurvesOnMostPictures) {
     reached += coverage[i] >= 0.80;
   }
   std::printf("explorer coverage >= 0.80 on %zu of %zu pictures\n", reached, images.size());
-  EXPECT_GE(10 * reached, 9 * images.size()) << reached << " of " << images.size() << " pictures at >= 80 % (target: 90 % of them)";
+  EXPECT_GE(10 * reached, 9 * images.size())
+      << reached << " of " << images.size() << " pictures at >= 80 % (target: 90 % of them)";
   fs::remove_all(tmp);
 }

@@ -12,8 +12,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
+#include "pictures/image_scene.hpp"
 
 namespace hk::app {
 namespace {

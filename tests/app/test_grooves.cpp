@@ -19,8 +19,8 @@
 #include "haptics/hand_path.hpp"
 #include "pictures/image_scene.hpp"
 #include "runtime/simulation.hpp"
-#include "test_pictures.hpp"
 #include "test_paths.hpp"
+#include "test_pictures.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -85,7 +85,8 @@ TEST(GroovesOnPictures, ForceContinuousOnRastersFastAndSlow) {
 TEST(GroovesOnPictures, LevelsFollowHandSpeed) {
   const config::Settings s = groove_settings();
   const app::ImageScene is = app::build_image_scene(kImages + "horse.png", s);
-  const HandPath hand = raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
+  const HandPath hand =
+      raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
   const Continuity c = run_and_check(*is.scene, s, hand, std::min(40.0, hand.duration_s()));
   EXPECT_GE(c.level_changes, 2) << "auto levels change with hand speed in grooves mode";
   EXPECT_GT(c.contact_ticks, 0);
@@ -131,7 +132,9 @@ TEST(GroovesExplore, TraceHoldsTheClosestPointAndContactWithinTheRadius) {
   json scene;
   std::ifstream(dir / "out" / "scene.json") >> scene;
   // Per level: every segment of every curve at that level (clamped to the curve's coarsest), as in the solver.
-  struct Seg { double ax, ay, bx, by; };
+  struct Seg {
+    double ax, ay, bx, by;
+  };
   std::vector<std::vector<Seg>> segs(16);
   for (int l = 0; l < 16; ++l) {
     for (const json& c : scene["curves"]) {
@@ -141,7 +144,8 @@ TEST(GroovesExplore, TraceHoldsTheClosestPointAndContactWithinTheRadius) {
       for (std::size_t i = 0; i + 1 < n + (c["closed"].get<bool>() ? 1 : 0); ++i) {
         const json& a = pts[i];
         const json& b = pts[(i + 1) % n];
-        segs[static_cast<std::size_t>(l)].push_back({a[0].get<double>(), a[1].get<double>(), b[0].get<double>(), b[1].get<double>()});
+        segs[static_cast<std::size_t>(l)].push_back(
+            {a[0].get<double>(), a[1].get<double>(), b[0].get<double>(), b[1].get<double>()});
       }
     }
   }
@@ -171,7 +175,8 @@ TEST(GroovesExplore, TraceHoldsTheClosestPointAndContactWithinTheRadius) {
     }
     if (rows % 3 != 0) continue;  // the brute-force distance on every third row
     double d = 1e9;
-    for (const Seg& s : segs[static_cast<std::size_t>(level)]) d = std::min(d, seg_distance(hx, hy, s.ax, s.ay, s.bx, s.by));
+    for (const Seg& s : segs[static_cast<std::size_t>(level)])
+      d = std::min(d, seg_distance(hx, hy, s.ax, s.ay, s.bx, s.by));
     if (std::fabs(d - R) < 1e-7) continue;  // on the rim, within the trace's rounding
     ++checked;
     if ((contact == 1) != (d < R)) ++wrong_contact;
@@ -204,7 +209,8 @@ TEST_P(GroovesLevelModes, ForceContinuousWhileLevelsFollowHandSpeed) {
   s.haptics.force_ramp_s = 0.0;  // as above: the start-up ramp is not a force step
   const app::ImageScene is = app::build_image_scene(kImages + std::get<0>(GetParam()), s);
   ASSERT_GT(is.scene->curve_count(), 0u);
-  const HandPath hand = raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
+  const HandPath hand =
+      raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
   const Continuity c = run_and_check(*is.scene, s, hand, hand.duration_s());
   RecordProperty("level_changes", std::to_string(c.level_changes));
   EXPECT_GE(c.level_changes, 10) << "the fast rows coarsen and the slow rows refine";
@@ -212,8 +218,9 @@ TEST_P(GroovesLevelModes, ForceContinuousWhileLevelsFollowHandSpeed) {
   EXPECT_EQ(c.over_limit, 0) << "worst |ΔF| − k|Δh| = " << c.worst_excess_n << " N";
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    RealImages, GroovesLevelModes,
-    ::testing::Combine(::testing::ValuesIn(test::kPictures),
-                       ::testing::Values("auto", "tolerance", "cut")),
-    [](const auto& info) { return fs::path(std::get<0>(info.param)).stem().string() + "_" + std::get<1>(info.param); });
+INSTANTIATE_TEST_SUITE_P(RealImages, GroovesLevelModes,
+                         ::testing::Combine(::testing::ValuesIn(test::kPictures),
+                                            ::testing::Values("auto", "tolerance", "cut")),
+                         [](const auto& info) {
+                           return fs::path(std::get<0>(info.param)).stem().string() + "_" + std::get<1>(info.param);
+                         });

@@ -7,8 +7,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -19,23 +19,23 @@
 #include <tuple>
 #include <vector>
 
+#include "config/device_profile.hpp"
 #include "crossing_grid.hpp"
 #include "curves.hpp"
-#include "config/device_profile.hpp"
-#include "runtime/guided_tour.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "pictures/image_scene.hpp"
-#include "visit/kiosk_runtime.hpp"
-#include "visit/kiosk_flow.hpp"
-#include "runtime/servo_step.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/guided_tour.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_step.hpp"
+#include "runtime/simulation.hpp"
 #include "runtime_ticks.hpp"
 #include "show_now.hpp"
-#include "runtime/simulation.hpp"
+#include "test_paths.hpp"
 #include "test_pictures.hpp"
 #include "tour_picture.hpp"
-#include "test_paths.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
 
 namespace hk::app {
 namespace {
@@ -63,7 +63,9 @@ double dist_to_level0(const Scene& sc, std::size_t c, Vec2 p) {
 bool inside(const std::vector<Vec2>& poly, Vec2 p) {
   bool in = false;
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    if ((poly[i].y > p.y) != (poly[j].y > p.y) && p.x < (poly[j].x - poly[i].x) * (p.y - poly[i].y) / (poly[j].y - poly[i].y) + poly[i].x) in = !in;
+    if ((poly[i].y > p.y) != (poly[j].y > p.y) &&
+        p.x < (poly[j].x - poly[i].x) * (p.y - poly[i].y) / (poly[j].y - poly[i].y) + poly[i].x)
+      in = !in;
   }
   return in;
 }
@@ -106,14 +108,16 @@ TEST(TourPlanner, StartsOffTheCurveOnTheHandlesSideAndPressesPastItRoundAClosedS
         double to_corner = 1.0;
         for (const Vec2& c : sq) to_corner = std::min(to_corner, distance(c, tp.target_m));
         if (to_corner > 0.003) {  // (by a corner, pushing 3 mm along an edge's normal can miss the square)
-          EXPECT_NE(inside(sq, pushed), handle_inside) << "t " << tp.t_s << ": the press points away from the handle's side";
+          EXPECT_NE(inside(sq, pushed), handle_inside)
+              << "t " << tp.t_s << ": the press points away from the handle's side";
         }
         if (first == Vec2{}) first = tp.target_m;
         last = tp.target_m;
       }
     }
     EXPECT_GT(outline, 100);
-    EXPECT_LT(distance(first, last), 0.003) << "a closed shape is traced all the way round (the press ramps over 2 mm at each end)";
+    EXPECT_LT(distance(first, last), 0.003)
+        << "a closed shape is traced all the way round (the press ramps over 2 mm at each end)";
     // Let go off the wall on the handle's side.
     EXPECT_EQ(inside(sq, plan->points.back().target_m), handle_inside);
     EXPECT_NEAR(dist_to_level0(sc, 0, plan->points.back().target_m), p.offset_m, 1e-4);
@@ -137,7 +141,8 @@ TEST(TourPlanner, AnOpenCurveGoesFromItsNearerEndToTheFarEnd) {
   const Vec2 end = plan->points.back().target_m;
   EXPECT_NEAR(end.x, -0.02, 0.001) << "ends at the far end";
   EXPECT_GT(end.y, 0.0);
-  EXPECT_EQ(plan->direction, -1) << "from the last point to the first: decreasing segment indices (the servo follows walls that way)";
+  EXPECT_EQ(plan->direction, -1)
+      << "from the last point to the first: decreasing segment indices (the servo follows walls that way)";
   const auto from_left = plan_tour(sc, 1, {-0.03, 0.004}, none, TourParams{});
   ASSERT_TRUE(from_left.has_value());
   EXPECT_EQ(from_left->direction, 1) << "from the first point: increasing segment indices";
@@ -224,7 +229,11 @@ struct TourRig {
   std::vector<int> tour_start_curves;
 
   explicit TourRig(Vec2 start = {0.0, -0.035}, const config::Settings& settings = {})
-      : s(settings), sp(servo_params_from(s)), tp(tour_params_from(s)), device(sim_params_from(s), start), core(CueTrackerParams{}, &cues) {
+      : s(settings),
+        sp(servo_params_from(s)),
+        tp(tour_params_from(s)),
+        device(sim_params_from(s), start),
+        core(CueTrackerParams{}, &cues) {
     device.open();
   }
   void publish(std::unique_ptr<Scene> sc) {
@@ -245,7 +254,9 @@ struct TourRig {
     max_guide_step_n = std::max(max_guide_step_n, length(g - last_guide));
     last_guide = g;
     guides.push_back(g);
-    const Vec2 hand = hand_stiff ? model_hand_force(stiff_hand, hand_target, device.true_position_m(), device.velocity_m_per_s()) : Vec2{};
+    const Vec2 hand =
+        hand_stiff ? model_hand_force(stiff_hand, hand_target, device.true_position_m(), device.velocity_m_per_s())
+                   : Vec2{};
     device.step(sp.period_s, hand);
     audio::CueEvent e;
     while (cues.try_pop(e)) {
@@ -262,7 +273,8 @@ struct TourRig {
   /// Largest change of the guide force from one tick to the next over the last `n` ticks [N].
   double max_step_last(long n) const {
     double m = 0.0;
-    for (std::size_t i = guides.size() - static_cast<std::size_t>(n); i < guides.size(); ++i) m = std::max(m, length(guides[i] - guides[i - 1]));
+    for (std::size_t i = guides.size() - static_cast<std::size_t>(n); i < guides.size(); ++i)
+      m = std::max(m, length(guides[i] - guides[i - 1]));
     return m;
   }
 };
@@ -323,19 +335,23 @@ void tour_five_shapes(const config::Settings& s) {
         if (d.tour_phase == TourPhase::Outline && d.curve == curve) ++outline_contact;
       }
       if (std::getenv("HK_TOUR_DEBUG") && ticks % 50 == 0)
-        std::printf("press %d t %ld phase %d handle %.4f %.4f guide %.3f %.3f curve %d level %d state %d\n", press, ticks, static_cast<int>(d.tour_phase),
-                    d.handle_m.x, d.handle_m.y, d.guide_force_n.x, d.guide_force_n.y, d.curve, d.level, static_cast<int>(d.state));
+        std::printf("press %d t %ld phase %d handle %.4f %.4f guide %.3f %.3f curve %d level %d state %d\n", press,
+                    ticks, static_cast<int>(d.tour_phase), d.handle_m.x, d.handle_m.y, d.guide_force_n.x,
+                    d.guide_force_n.y, d.curve, d.level, static_cast<int>(d.state));
       if (d.tour_id == press && tour_ended(d.tour_phase)) break;
-      ASSERT_LT(ticks, 60000) << "press " << press << ": the tour did not end within 60 s; phase " << static_cast<int>(d.tour_phase)
-                              << " handle " << d.handle_m.x << ", " << d.handle_m.y << " guide " << d.guide_force_n.x << ", "
-                              << d.guide_force_n.y << " contact " << d.curve << " level " << d.level;
+      ASSERT_LT(ticks, 60000) << "press " << press << ": the tour did not end within 60 s; phase "
+                              << static_cast<int>(d.tour_phase) << " handle " << d.handle_m.x << ", " << d.handle_m.y
+                              << " guide " << d.guide_force_n.x << ", " << d.guide_force_n.y << " contact " << d.curve
+                              << " level " << d.level;
     }
     EXPECT_EQ(r.core.display().tour_phase, TourPhase::Done) << "press " << press;
     total_s += static_cast<double>(ticks) * r.sp.period_s;
     EXPECT_GT(outline_contact, 500) << "press " << press << ": the outline is traced against the wall";
     EXPECT_EQ(touches.count(), before + 1) << "press " << press << ": exactly one more shape touched";
-    EXPECT_TRUE(touched_now.count(curve) == 1 && touched_now.size() == 1) << "press " << press << ": only the shape toured";
-    EXPECT_LT(dist_to_level0(sc, static_cast<std::size_t>(curve), r.handle()), 0.004) << "press " << press << ": the handle ends by the shape";
+    EXPECT_TRUE(touched_now.count(curve) == 1 && touched_now.size() == 1)
+        << "press " << press << ": only the shape toured";
+    EXPECT_LT(dist_to_level0(sc, static_cast<std::size_t>(curve), r.handle()), 0.004)
+        << "press " << press << ": the handle ends by the shape";
     r.core.collect_retired();
   }
   EXPECT_EQ(visited.size(), 5u);
@@ -346,10 +362,13 @@ void tour_five_shapes(const config::Settings& s) {
   EXPECT_GT(r.max_guide_n, 0.2) << "the guide must pull for the limit to mean anything";
   EXPECT_LE(r.max_total_n, r.s.haptics.max_force_n + 1e-9);
   ::testing::Test::RecordProperty("time_to_touch_all_s", std::to_string(total_s));
-  std::printf("time to touch every shape once with the guided tour (%s profile): %.1f s\n", s.device.type.c_str(), total_s);
+  std::printf("time to touch every shape once with the guided tour (%s profile): %.1f s\n", s.device.type.c_str(),
+              total_s);
 }
 
-TEST(GuidedTour, RepeatedGuideReachesEachOfFiveShapesOnceNearestFirstWithinItsForceLimit) { tour_five_shapes(config::Settings{}); }
+TEST(GuidedTour, RepeatedGuideReachesEachOfFiveShapesOnceNearestFirstWithinItsForceLimit) {
+  tour_five_shapes(config::Settings{});
+}
 
 TEST(GuidedTour, WithTheHaplyProfilesForcesTheTourStillReachesEveryShape) {
   // The tour's pull (0.5 N), the walls (500 N/m, 1.5 N) and the fades of the gen3 board: all within what it
@@ -418,7 +437,8 @@ TEST(GuidedTour, AKeyStopsItAndTheForceFadesOut) {
   double max_drop = 0.0;
   for (std::size_t i = r.guides.size() - static_cast<std::size_t>(ticks), k = 1; i < r.guides.size(); ++i, ++k) {
     max_drop = std::max(max_drop, length(r.guides[i - 1]) - length(r.guides[i]));
-    EXPECT_LE(length(r.guides[i]), (1.0 - static_cast<double>(k) / static_cast<double>(fade)) * r.tp.max_force_n + 1e-9) << "tick " << k << " of the fade";
+    EXPECT_LE(length(r.guides[i]), (1.0 - static_cast<double>(k) / static_cast<double>(fade)) * r.tp.max_force_n + 1e-9)
+        << "tick " << k << " of the fade";
   }
   EXPECT_LE(max_drop, 0.5 * at_key) << "faded, not cut";
   EXPECT_EQ(r.tour_starts, 1);
@@ -502,7 +522,8 @@ struct RuntimeRig {
     const double dt = 1.0 / s.haptics.servo_rate_hz;
     const ModelHandParams hand = hand_params_from(s);
     const auto hand_force = [&](const SimulatedPantograph& sim) {
-      return hand_target_m ? model_hand_force(hand, *hand_target_m, sim.true_position_m(), sim.velocity_m_per_s()) : Vec2{};
+      return hand_target_m ? model_hand_force(hand, *hand_target_m, sim.true_position_m(), sim.velocity_m_per_s())
+                           : Vec2{};
     };
     for (long k = 0, n = static_cast<long>(seconds / dt + 0.5); k < n; ++k) {
       test::runtime_tick(*rt, dt, hand_force);
@@ -512,10 +533,14 @@ struct RuntimeRig {
     rt->poll_tour();
   }
   std::vector<double> guide_n;  // every tick's guide force [N], from the first run
-  std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) { return audio::MessageCatalog::english().text(id, args); }
+  std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) {
+    return audio::MessageCatalog::english().text(id, args);
+  }
 };
 
-bool ends_with(const std::string& s, const std::string& tail) { return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0; }
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
 
 TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) {
   RuntimeRig r;
@@ -529,7 +554,8 @@ TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) 
   EXPECT_FALSE(r.rt->tour_running());
   EXPECT_EQ(r.rt->touches().count(), 1);
   EXPECT_EQ(r.rt->last_said().rfind("That was shape ", 0), 0u) << "it names what it traced: " << r.rt->last_said();
-  EXPECT_TRUE(ends_with(r.rt->last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}}))) << r.rt->last_said();
+  EXPECT_TRUE(ends_with(r.rt->last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}})))
+      << r.rt->last_said();
   // A key during the next tour stops it, quietly; the Guide key stopping it says so.
   r.rt->key_pressed();
   r.rt->guide();
@@ -592,10 +618,13 @@ TEST(GuidedTourRuntime, TheTourAsksFirstAndPullsOnlyOnceThatHasBeenSaid) {
   const double ask_s = r.rt->audio().speech_duration_s(r.rt->last_said());
   ASSERT_GT(ask_s, 2.0) << "the announcement is spoken (espeak-ng present)";
   for (int i = 0; i < 60 && r.rt->tour_running(); ++i) r.run(0.5);
-  const auto first = std::find_if(r.guide_n.begin() + static_cast<std::ptrdiff_t>(asked), r.guide_n.end(), [](double f) { return f > 0.0; });
+  const auto first = std::find_if(r.guide_n.begin() + static_cast<std::ptrdiff_t>(asked), r.guide_n.end(),
+                                  [](double f) { return f > 0.0; });
   ASSERT_NE(first, r.guide_n.end()) << "the tour pulled at some point";
-  const double first_force_s = static_cast<double>(first - (r.guide_n.begin() + static_cast<std::ptrdiff_t>(asked))) / r.s.haptics.servo_rate_hz;
-  EXPECT_GE(first_force_s, ask_s) << "the first guide force came " << first_force_s << " s after the announcement of " << ask_s << " s began";
+  const double first_force_s =
+      static_cast<double>(first - (r.guide_n.begin() + static_cast<std::ptrdiff_t>(asked))) / r.s.haptics.servo_rate_hz;
+  EXPECT_GE(first_force_s, ask_s) << "the first guide force came " << first_force_s << " s after the announcement of "
+                                  << ask_s << " s began";
   EXPECT_LE(first_force_s, ask_s + KioskRuntime::kTourAskMargin_s + 0.1) << "and not much later";
   EXPECT_EQ(r.rt->touches().count(), 1);
 }
@@ -624,7 +653,8 @@ TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
   ASSERT_GE(square, 0);
   EXPECT_EQ(d.curve, square) << "it is the square the hand presses on";
   const std::string where = r.rt->where();
-  EXPECT_EQ(where, "On shape " + std::to_string(square + 1) + " of 5: a medium closed shape. Your hand is in the far middle.")
+  EXPECT_EQ(where,
+            "On shape " + std::to_string(square + 1) + " of 5: a medium closed shape. Your hand is in the far middle.")
       << "the hand's place: below the square, in the far third";
   const std::string describe = r.rt->describe();
   EXPECT_EQ(describe.rfind("5 shapes. Nearest your hand, a medium closed shape in the far middle", 0), 0u) << describe;
@@ -729,10 +759,11 @@ TEST_P(GuidedTourOnPictures, ToursEndDoneWithARelaxedHandAndTheProxyCrossesNoWal
   EXPECT_LE(r.max_total_n, r.s.haptics.max_force_n + 1e-9);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    RealImages, GuidedTourOnPictures,
-    ::testing::Combine(::testing::ValuesIn(test::kPictures),
-                       ::testing::Values("auto", "tolerance", "cut")),
-    [](const auto& info) { return fs::path(std::get<0>(info.param)).stem().string() + "_" + std::get<1>(info.param); });
+INSTANTIATE_TEST_SUITE_P(RealImages, GuidedTourOnPictures,
+                         ::testing::Combine(::testing::ValuesIn(test::kPictures),
+                                            ::testing::Values("auto", "tolerance", "cut")),
+                         [](const auto& info) {
+                           return fs::path(std::get<0>(info.param)).stem().string() + "_" + std::get<1>(info.param);
+                         });
 }  // namespace
 }  // namespace hk::app

@@ -5,23 +5,23 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <functional>
-#include <vector>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
 
 #include "audio/messages.hpp"
-#include "runtime/device_setup.hpp"
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/pty_emulator.hpp"
-#include "visit/kiosk_runtime.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/device_setup.hpp"
 #include "runtime/runtime_params.hpp"
 #include "test_paths.hpp"
+#include "visit/kiosk_runtime.hpp"
 
 namespace fs = std::filesystem;
 
@@ -74,7 +74,7 @@ TEST(KioskDevice, ABoardOnItsTtyIsUsedAnnouncedAndItsLossSpoken) {
   DeviceChoice unplug;
   unplug.kind = DeviceChoice::Kind::HaplyEmulator;
   unplug.faults.disconnect_at_s = 0.5;  // of the board's own time: 500 torque packets
-  Vec2 home;  // the board waits at its home pose, as one does for the kiosk to start
+  Vec2 home;                            // the board waits at its home pose, as one does for the kiosk to start
   const hapi::EmulatorParams at_rest = emulator_resting_at_park(s, unplug, &home);
   hapi::FirmwareEmulator board(at_rest, home, [](double, Vec2, Vec2) { return Vec2{}; });
   hapi::PtyEmulator pty(board);
@@ -161,7 +161,7 @@ namespace hk::app {
 TEST(KioskDevice, TheEmulatedBoardOptionDrivesTheDriverThroughAPty) {
   const Library lib;
   RuntimeOptions ro = options(lib);
-  ro.probe_usb_device = false;  // a scripted run: no hardware looked for...
+  ro.probe_usb_device = false;   // a scripted run: no hardware looked for...
   ro.device = "haply-emulator";  // ...but the emulated board asked for
   config::Settings s;
   KioskRuntime rt(ro, s);
@@ -265,8 +265,10 @@ TEST(KioskDevice, AHandleThatDidNotStartAtHomeIsToldToTheStaffAtStartAndNeverToA
   spdlog::set_default_logger(before);
   ASSERT_NE(rt.devices().usb(), nullptr);
   // The operator: one logged line, kept for the panel, naming the distance and the fix.
-  EXPECT_NE(rt.devices().home_note().find("from its home pose at the park place"), std::string::npos) << rt.devices().home_note();
-  EXPECT_NE(rt.devices().home_note().find("press Calibrate in the operator's panel, or run 'haptic-kiosk calibrate'"), std::string::npos);
+  EXPECT_NE(rt.devices().home_note().find("from its home pose at the park place"), std::string::npos)
+      << rt.devices().home_note();
+  EXPECT_NE(rt.devices().home_note().find("press Calibrate in the operator's panel, or run 'haptic-kiosk calibrate'"),
+            std::string::npos);
   int logged = 0;
   for (const std::string& line : sink->last_formatted())
     logged += line.find("device: the handle reads") != std::string::npos && line.find("[warning]") != std::string::npos;

@@ -71,22 +71,27 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   EXPECT_EQ(flow.state(), KioskState::Tutorial);
   ASSERT_EQ(fx.said.size(), 1u);
   EXPECT_EQ(fx.said.back().rfind("Welcome.", 0), 0u);
-  EXPECT_NE(fx.said.back().find("Feel the square with the handle. Press the Right arrow to move on."), std::string::npos)
+  EXPECT_NE(fx.said.back().find("Feel the square with the handle. Press the Right arrow to move on."),
+            std::string::npos)
       << "the welcome names the key that moves on";
   EXPECT_NE(fx.said.back().find("Press F1 for help."), std::string::npos) << "the shipped help key";
   EXPECT_EQ(fx.shown.back(), "tutorial 0");
 
   flow.key(KioskKey::Next, 20.0);
-  EXPECT_EQ(fx.said.back(), "A circle. Press the W key to hear where your hand is. Press the Right arrow for the next shape.")
+  EXPECT_EQ(fx.said.back(),
+            "A circle. Press the W key to hear where your hand is. Press the Right arrow for the next shape.")
       << "the circle practises Where";
   EXPECT_EQ(fx.said.back(), flow.text(audio::MessageId::tutorial_circle));
   EXPECT_EQ(fx.shown.back(), "tutorial 1");
   flow.key(KioskKey::Next, 30.0);
-  EXPECT_EQ(fx.said.back(), "A triangle. Press the G key to be led round it. Press the Right arrow for the first picture.");
+  EXPECT_EQ(fx.said.back(),
+            "A triangle. Press the G key to be led round it. Press the Right arrow for the first picture.");
   flow.key(KioskKey::Next, 40.0);
   EXPECT_EQ(flow.state(), KioskState::Picture);
-  EXPECT_EQ(fx.said.back(), "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. "
-                            "Picture 1 of 3. It has 4 shapes.");
+  EXPECT_EQ(
+      fx.said.back(),
+      "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. "
+      "Picture 1 of 3. It has 4 shapes.");
   EXPECT_EQ(fx.shown.back(), "picture 0");
 
   flow.key(KioskKey::Next, 50.0);
@@ -104,10 +109,12 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
     every += " " + fx.said.back();
   }
   for (const char* sentence :
-       {"Move the handle slowly to feel the outlines.", "Press the Right arrow for the next picture and the Left arrow for the one before.",
+       {"Move the handle slowly to feel the outlines.",
+        "Press the Right arrow for the next picture and the Left arrow for the one before.",
         "Press the W key to hear what is under your hand, and the D key to hear what the picture holds.",
         "Press the R key to hear the last message again, and the P key to pause the speech and go on.",
-        "Press the Up arrow for more detail and the Down arrow for less.", "Press Page Up for louder and Page Down for quieter.",
+        "Press the Up arrow for more detail and the Down arrow for less.",
+        "Press Page Up for louder and Page Down for quieter.",
         "Press the G key to be led to a shape you have not touched yet.",
         "Press the T key to practise with the shapes again, and the End key when you have finished.",
         "Hold F1 and press another key to learn what it does."}) {
@@ -155,8 +162,8 @@ TEST(KioskFlow, EveryKeyIsAnsweredInSpeech) {
       for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, t++);
     }
     ASSERT_EQ(flow.state(), want);
-    for (KioskKey k : {KioskKey::Help, KioskKey::Describe, KioskKey::Finer, KioskKey::Coarser, KioskKey::VolumeUp, KioskKey::VolumeDown,
-                       KioskKey::Other}) {
+    for (KioskKey k : {KioskKey::Help, KioskKey::Describe, KioskKey::Finer, KioskKey::Coarser, KioskKey::VolumeUp,
+                       KioskKey::VolumeDown, KioskKey::Other}) {
       const std::size_t n = fx.said.size();
       flow.key(k, t++);
       EXPECT_EQ(fx.said.size(), n + 1) << "key " << static_cast<int>(k) << " in state " << static_cast<int>(want);
@@ -170,7 +177,8 @@ TEST(KioskFlow, APdfIsNamedByItsOwnTitle) {
   KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
   flow.stick_inserted({{"ring.pdf", true, 2, "A ring, drawn for the hand"}}, 1.0);
   flow.document_ready(ready(0, 1, "It has one figure."), 1.1);
-  EXPECT_NE(fx.said.back().find("Page 1 of 2 of A ring, drawn for the hand. It has one figure."), std::string::npos) << fx.said.back();
+  EXPECT_NE(fx.said.back().find("Page 1 of 2 of A ring, drawn for the hand. It has one figure."), std::string::npos)
+      << fx.said.back();
   EXPECT_EQ(fx.said.back().find("ring.pdf"), std::string::npos) << fx.said.back();
   flow.key(KioskKey::Next, 2.0);
   DocumentResult bad;
@@ -187,7 +195,8 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   Recorder fx;
   const auto& en = audio::MessageCatalog::english();
   KioskFlow flow(fx, en, {120.0, 20.0});
-  const std::vector<StickEntry> stick{{"cat.png", false, 1, ""}, {"report.pdf", true, 3, ""}, {"dog.jpg", false, 1, ""}};
+  const std::vector<StickEntry> stick{
+      {"cat.png", false, 1, ""}, {"report.pdf", true, 3, ""}, {"dog.jpg", false, 1, ""}};
 
   flow.stick_inserted(stick, 1.0);
   EXPECT_EQ(flow.state(), KioskState::Picture) << "a stick wakes the kiosk";
@@ -244,7 +253,8 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   // Taken out mid-load: back to the library picture, and the late result is ignored.
   flow.stick_removed(7.0);
   EXPECT_EQ(flow.source(), KioskSource::Library);
-  EXPECT_EQ(fx.said.back(), "The USB stick was taken out. Back to the picture library. Picture 1 of 3. It has 4 shapes.");
+  EXPECT_EQ(fx.said.back(),
+            "The USB stick was taken out. Back to the picture library. Picture 1 of 3. It has 4 shapes.");
   EXPECT_EQ(fx.shown.back(), "picture 0");
   flow.document_ready(ready(1, 3), 7.5);
   EXPECT_EQ(fx.shown.back(), "picture 0");
@@ -256,7 +266,8 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
   flow.document_ready(ready(0, 1, "It has no text and one figure."), 9.1);
   EXPECT_EQ(fx.said.back(),
-            "A USB stick with one document: a PDF of one page. Press the Right arrow to go through them. Page 1 of 1 of only. It has no text and one figure.");
+            "A USB stick with one document: a PDF of one page. Press the Right arrow to go through them. Page 1 of 1 "
+            "of only. It has no text and one figure.");
 
   // The visitor leaves; the next one does not get the stick.
   flow.tick(9.1 + 120.0);
@@ -273,16 +284,19 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
 TEST(KioskFlow, StickNamesPageCountsAndNothingFeltBefore) {
   Recorder fx;
   KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
-  const std::string long_name = std::string("minutes_of_the_annual_general_meeting_of_the_society_") + std::string(197, 'x') + ".pdf";
+  const std::string long_name =
+      std::string("minutes_of_the_annual_general_meeting_of_the_society_") + std::string(197, 'x') + ".pdf";
   ASSERT_EQ(long_name.size(), 254u);
-  flow.stick_inserted({{"bad_crc.png", false, 1, ""}, {"atlas.pdf", true, 1000, "", 5000}, {long_name, true, 2, ""}}, 1.0);
+  flow.stick_inserted({{"bad_crc.png", false, 1, ""}, {"atlas.pdf", true, 1000, "", 5000}, {long_name, true, 2, ""}},
+                      1.0);
   DocumentResult bad;
   bad.document = 0;
   bad.page = 1;
   bad.reason = "it is damaged";
   flow.document_ready(bad, 1.1);
   EXPECT_EQ(fx.said.back(),
-            "A USB stick with 3 documents: a picture and 2 PDFs of 5002 pages in all (the first 1000 pages of each can be read). "
+            "A USB stick with 3 documents: a picture and 2 PDFs of 5002 pages in all (the first 1000 pages of each can "
+            "be read). "
             "Press the Right arrow to go through them. bad crc cannot be read.")
       << "no picture was felt before";
   flow.key(KioskKey::Next, 2.0);
@@ -293,7 +307,9 @@ TEST(KioskFlow, StickNamesPageCountsAndNothingFeltBefore) {
   flow.key(KioskKey::Previous, 3.1);
   EXPECT_EQ(fx.requested.back(), std::make_pair(2, 2)) << "the third document's last page";
   flow.document_ready(ready(2, 2), 3.2);
-  EXPECT_EQ(fx.said.back(), "Page 2 of 2 of minutes of the annual general meeting of the society. It has 2 blocks of text and one figure.");
+  EXPECT_EQ(
+      fx.said.back(),
+      "Page 2 of 2 of minutes of the annual general meeting of the society. It has 2 blocks of text and one figure.");
   flow.key(KioskKey::Next, 4.0);
   EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1));
   flow.document_ready(bad, 4.1);
@@ -306,8 +322,10 @@ TEST(KioskFlow, UnreadableFilesOfAStickAreOneCountedLine) {
   KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
   flow.stick_inserted({{"cat.png", false, 1, ""}}, 1.0, 2);
   flow.document_ready(ready(0, 1, "It has 4 shapes."), 1.1);
-  EXPECT_EQ(fx.said.back(), "A USB stick with one document: a picture. Press the Right arrow to go through them. 2 files cannot be read. "
-                            "Document 1 of 1, cat. It has 4 shapes.");
+  EXPECT_EQ(
+      fx.said.back(),
+      "A USB stick with one document: a picture. Press the Right arrow to go through them. 2 files cannot be read. "
+      "Document 1 of 1, cat. It has 4 shapes.");
   flow.stick_removed(2.0);
   flow.stick_inserted({}, 3.0, 1);
   EXPECT_EQ(fx.said.back(), "I found no pictures and no PDF documents on this USB stick. One file cannot be read.");
@@ -336,15 +354,17 @@ TEST(KioskFlow, AnEmptyStickDuringTheTutorialLeavesTheTutorialAsItWas) {
   waiting.stick_inserted({}, 1.0, 0);
   EXPECT_EQ(waiting.state(), KioskState::Tutorial);
   EXPECT_EQ(fx2.shown.back(), "tutorial 0");
-  EXPECT_EQ(fx2.said.back(), "I found no pictures and no PDF documents on this USB stick. Welcome. Feel the square with the handle. "
-                             "Press the Right arrow to move on. Press F1 for help.");
+  EXPECT_EQ(fx2.said.back(),
+            "I found no pictures and no PDF documents on this USB stick. Welcome. Feel the square with the handle. "
+            "Press the Right arrow to move on. Press F1 for help.");
   // A stick that cannot be read at all, likewise.
   Recorder fx3;
   KioskFlow refused(fx3, audio::MessageCatalog::english(), {120.0, 20.0});
   refused.stick_refused("its filesystem (btrfs) is not one the kiosk reads", 1.0);
   EXPECT_EQ(refused.state(), KioskState::Tutorial);
-  EXPECT_EQ(fx3.said.back(), "I cannot read this USB stick. its filesystem (btrfs) is not one the kiosk reads. Welcome. Feel the square "
-                             "with the handle. Press the Right arrow to move on. Press F1 for help.");
+  EXPECT_EQ(fx3.said.back(),
+            "I cannot read this USB stick. its filesystem (btrfs) is not one the kiosk reads. Welcome. Feel the square "
+            "with the handle. Press the Right arrow to move on. Press F1 for help.");
 }
 
 TEST(KioskFlow, SpokenNamesAreShortWholeWordsAndWholeCharacters) {
@@ -391,8 +411,10 @@ TEST(KioskFlow, APictureWithATitleIsAnnouncedByIt) {
   flow.handle_moved(1.0);
   for (int k = 0; k < 3; ++k) flow.key(KioskKey::Next, 2.0 + k);  // square, circle, triangle, then pictures
   EXPECT_EQ(fx.shown.back(), "picture 0");
-  EXPECT_EQ(fx.said.back(), "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. "
-                            "Picture 1 of 3: a horse, seen from the side. It has 4 shapes.");
+  EXPECT_EQ(
+      fx.said.back(),
+      "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. "
+      "Picture 1 of 3: a horse, seen from the side. It has 4 shapes.");
   flow.key(KioskKey::Next, 10.0);
   EXPECT_EQ(fx.said.back(), "Picture 2 of 3: a horse, seen from the side. It has one shape.");
   fx.notes = {};
@@ -412,7 +434,10 @@ TEST(Describe, PagesCountTextBlocksAndFigures) {
 Polyline rect(Vec2 c, Vec2 half, bool closed = true) {
   Polyline p;
   p.closed = closed;
-  p.points_m = {{c.x - half.x, c.y - half.y}, {c.x + half.x, c.y - half.y}, {c.x + half.x, c.y + half.y}, {c.x - half.x, c.y + half.y}};
+  p.points_m = {{c.x - half.x, c.y - half.y},
+                {c.x + half.x, c.y - half.y},
+                {c.x + half.x, c.y + half.y},
+                {c.x - half.x, c.y + half.y}};
   return p;
 }
 
@@ -421,12 +446,15 @@ TEST(Describe, SizesKindsAndPlaces) {
   const std::vector<Polyline> curves{rect({0.06, -0.035}, {0.004, 0.004}), rect({0, 0}, {0.05, 0.03}),
                                      rect({-0.05, 0.03}, {0.006, 0.003}, false)};
   EXPECT_EQ(describe_scene(curves, half),
-            "3 shapes. A large closed shape in the middle, a small line at the far left, and a small closed shape at the near right.");
+            "3 shapes. A large closed shape in the middle, a small line at the far left, and a small closed shape at "
+            "the near right.");
   EXPECT_EQ(describe_scene({curves[1]}, half), "One shape. A large closed shape in the middle.");
   EXPECT_EQ(describe_scene({}, half), "There are no shapes in this picture.");
   std::vector<Polyline> many(6, rect({0.05, 0.03}, {0.002, 0.002}));
   many.push_back(rect({-0.04, 0}, {0.015, 0.01}));
-  EXPECT_EQ(describe_scene(many, half, 2), "7 shapes. A medium closed shape on the left, a small closed shape at the far right, and 5 more, smaller ones.");
+  EXPECT_EQ(
+      describe_scene(many, half, 2),
+      "7 shapes. A medium closed shape on the left, a small closed shape at the far right, and 5 more, smaller ones.");
 }
 
 TEST(Describe, ShapesInsideAClosedShapeAreToldWithIt) {
@@ -438,11 +466,15 @@ TEST(Describe, ShapesInsideAClosedShapeAreToldWithIt) {
                                     rect({-0.02, 0.03}, {0.003, 0.003}, false)};
   std::vector<Polyline> scene{holes[0], plate, holes[1], rect({0.05, -0.035}, {0.003, 0.002}, false), holes[2]};
   EXPECT_EQ(describe_scene(scene, half),
-            "5 shapes. A large closed shape with 3 smaller shapes inside it, at the far left, and a small line at the near right.");
+            "5 shapes. A large closed shape with 3 smaller shapes inside it, at the far left, and a small line at the "
+            "near right.");
   // Nesting at any depth: a face, an eye in it, a pupil in the eye; the eye alone holds one.
-  const std::vector<Polyline> face{rect({0, 0}, {0.04, 0.03}), rect({-0.015, 0.01}, {0.008, 0.005}), rect({-0.015, 0.01}, {0.002, 0.002})};
-  EXPECT_EQ(describe_scene(face, half), "3 shapes. A large closed shape with 2 smaller shapes inside it, in the middle.");
-  EXPECT_EQ(describe_scene({face[1], face[2]}, half), "2 shapes. A small closed shape with a smaller shape inside it, in the middle.");
+  const std::vector<Polyline> face{rect({0, 0}, {0.04, 0.03}), rect({-0.015, 0.01}, {0.008, 0.005}),
+                                   rect({-0.015, 0.01}, {0.002, 0.002})};
+  EXPECT_EQ(describe_scene(face, half),
+            "3 shapes. A large closed shape with 2 smaller shapes inside it, in the middle.");
+  EXPECT_EQ(describe_scene({face[1], face[2]}, half),
+            "2 shapes. A small closed shape with a smaller shape inside it, in the middle.");
   // In an L's bounding box but outside the L (its notch), and overlapping a shape without being in it: not
   // inside.
   Polyline ell;
@@ -451,16 +483,22 @@ TEST(Describe, ShapesInsideAClosedShapeAreToldWithIt) {
   const Polyline in_notch = rect({0.03, 0.02}, {0.005, 0.005});
   const Polyline across = rect({-0.04, 0.0}, {0.006, 0.004});
   EXPECT_EQ(describe_scene({ell, in_notch, across}, half),
-            "3 shapes. A large closed shape in the middle, a small closed shape on the left, and a small closed shape at the far right.");
+            "3 shapes. A large closed shape in the middle, a small closed shape on the left, and a small closed shape "
+            "at the far right.");
   // Only the largest few named: the rest counted, the nested ones as told.
-  EXPECT_EQ(describe_scene(scene, half, 1), "5 shapes. A large closed shape with 3 smaller shapes inside it, at the far left, and 1 more, smaller.");
+  EXPECT_EQ(describe_scene(scene, half, 1),
+            "5 shapes. A large closed shape with 3 smaller shapes inside it, at the far left, and 1 more, smaller.");
 }
 
 TEST(Describe, FiguresAreGroupsOfTouchingCurves) {
   // A drawing of three strokes that touch (one figure), a separate box (a second), a stroke 1 mm from the
   // box (within the 2 mm margin: the same figure), a dot far away (a third).
-  const std::vector<Polyline> curves{rect({-0.03, 0}, {0.01, 0.01}), rect({-0.02, 0}, {0.01, 0.002}, false), rect({-0.01, 0.005}, {0.002, 0.01}, false),
-                                     rect({0.03, 0}, {0.005, 0.005}), rect({0.0365, 0}, {0.0005, 0.004}, false), rect({0.06, -0.04}, {0.001, 0.001})};
+  const std::vector<Polyline> curves{rect({-0.03, 0}, {0.01, 0.01}),
+                                     rect({-0.02, 0}, {0.01, 0.002}, false),
+                                     rect({-0.01, 0.005}, {0.002, 0.01}, false),
+                                     rect({0.03, 0}, {0.005, 0.005}),
+                                     rect({0.0365, 0}, {0.0005, 0.004}, false),
+                                     rect({0.06, -0.04}, {0.001, 0.001})};
   EXPECT_EQ(count_figures(curves), 3);
   EXPECT_EQ(count_figures(curves, 0.0), 4) << "without the margin the stroke beside the box stands alone";
   EXPECT_EQ(count_figures({}), 0);

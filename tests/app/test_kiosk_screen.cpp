@@ -6,9 +6,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 #include "test_paths.hpp"
@@ -42,19 +42,20 @@ bool yellow_near(const cv::Mat& img, int x, int y, int r) {
 }
 
 TEST(KioskScreen, CurvesAreDrawnWhereSceneJsonSaysFullScreenUnderXvfb) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = fs::temp_directory_path() / ("hk_screen_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "library");
   fs::copy_file(kData / "images" / "horse.png", dir / "library" / "horse.png");
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(exe + " explore '" + (dir / "library" / "horse.png").string() + "' --out '" + (dir / "explore").string() +
-               "' --duration 0.01 >/dev/null 2>&1"),
+  ASSERT_EQ(sh(exe + " explore '" + (dir / "library" / "horse.png").string() + "' --out '" +
+               (dir / "explore").string() + "' --duration 0.01 >/dev/null 2>&1"),
             0);
   const fs::path png = dir / "screen.png";
-  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 120 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --library '" + (dir / "library").string() + "' --show '" +
-               (dir / "library" / "horse.png").string() + "' --screenshot '" + png.string() + "' --frames 20 >'" +
-               (dir / "log.txt").string() + "' 2>&1"),
+  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 120 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --library '" +
+               (dir / "library").string() + "' --show '" + (dir / "library" / "horse.png").string() +
+               "' --screenshot '" + png.string() + "' --frames 20 >'" + (dir / "log.txt").string() + "' 2>&1"),
             0)
       << std::ifstream(dir / "log.txt").rdbuf();
   const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
@@ -77,8 +78,10 @@ TEST(KioskScreen, CurvesAreDrawnWhereSceneJsonSaysFullScreenUnderXvfb) {
     }
   }
   ASSERT_GT(points, 100);
-  EXPECT_GT(static_cast<double>(hits) / points, 0.95) << hits << " of " << points << " curve points have a curve pixel within 2 px";
-  EXPECT_LT(static_cast<double>(shifted_hits) / points, 0.2) << "control: 25 px off the curves there should be little yellow";
+  EXPECT_GT(static_cast<double>(hits) / points, 0.95)
+      << hits << " of " << points << " curve points have a curve pixel within 2 px";
+  EXPECT_LT(static_cast<double>(shifted_hits) / points, 0.2)
+      << "control: 25 px off the curves there should be little yellow";
   fs::remove_all(dir);
 }
 
@@ -86,7 +89,8 @@ TEST(KioskScreen, CurvesAreDrawnWhereSceneJsonSaysFullScreenUnderXvfb) {
 // such board it says so (logged, and spoken: the simulated handle stands in); with "auto" it stays simulated
 // without looking (documentation runs never depend on what is plugged in).
 TEST(KioskScreen, AScriptedRunLooksForADeviceTheSettingsName) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = fs::temp_directory_path() / ("hk_named_device_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "library");
@@ -96,8 +100,9 @@ TEST(KioskScreen, AScriptedRunLooksForADeviceTheSettingsName) {
   auto run = [&](const std::string& type) {
     // An id no board has, so that a pantograph plugged into the machine running the tests is not found either.
     std::ofstream(dir / "kiosk.toml") << "[device]\ntype = \"" << type << "\"\nusb_ids = \"ffff:ffff\"\n";
-    EXPECT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug --config '" + (dir / "kiosk.toml").string() +
-                 "' --library '" + (dir / "library").string() + "' --script '" + (dir / "script.txt").string() + "' --screenshot '" +
+    EXPECT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe +
+                 " --no-hotplug --config '" + (dir / "kiosk.toml").string() + "' --library '" +
+                 (dir / "library").string() + "' --script '" + (dir / "script.txt").string() + "' --screenshot '" +
                  (dir / "end.png").string() + "' --frames 10 >'" + (dir / "log.txt").string() + "' 2>&1"),
               0)
         << std::ifstream(dir / "log.txt").rdbuf();
@@ -107,7 +112,8 @@ TEST(KioskScreen, AScriptedRunLooksForADeviceTheSettingsName) {
   };
   const std::string named = run("haply");
   EXPECT_NE(named.find("device: no USB pantograph ("), std::string::npos) << named;
-  EXPECT_NE(named.find("say: No handle is connected. The kiosk runs on its simulated handle."), std::string::npos) << named;
+  EXPECT_NE(named.find("say: No handle is connected. The kiosk runs on its simulated handle."), std::string::npos)
+      << named;
   const std::string automatic = run("auto");
   EXPECT_EQ(automatic.find("no USB pantograph"), std::string::npos) << automatic;
   EXPECT_EQ(automatic.find("No handle is connected"), std::string::npos) << automatic;
@@ -121,7 +127,8 @@ namespace {
 // Scripted keys walk attract → tutorial → picture → next picture → time-out → attract; what the kiosk
 // said (its speech log, one "say:" line per message) must follow the flow.
 TEST(KioskScreen, ScriptedVisitWalksTheFlowAndSaysEachStep) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = fs::temp_directory_path() / ("hk_flow_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "library");
@@ -130,9 +137,10 @@ TEST(KioskScreen, ScriptedVisitWalksTheFlowAndSaysEachStep) {
   std::ofstream(dir / "kiosk.toml") << "[kiosk]\ntimeout_s = 20\nwarning_s = 10\n";
   std::ofstream(dir / "script.txt") << "# frame action\n1 move\n30 key next\n60 key next\n90 key next\n120 key next\n";
   const std::string exe = HK_KIOSK_EXE;
-  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --config '" + (dir / "kiosk.toml").string() + "' --library '" +
-               (dir / "library").string() + "' --script '" + (dir / "script.txt").string() + "' --screenshot '" + (dir / "end.png").string() +
-               "' --frames 1400 >'" + (dir / "log.txt").string() + "' 2>&1"),
+  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --config '" +
+               (dir / "kiosk.toml").string() + "' --library '" + (dir / "library").string() + "' --script '" +
+               (dir / "script.txt").string() + "' --screenshot '" + (dir / "end.png").string() + "' --frames 1400 >'" +
+               (dir / "log.txt").string() + "' 2>&1"),
             0)
       << std::ifstream(dir / "log.txt").rdbuf();
   std::ifstream log(dir / "log.txt");
@@ -141,8 +149,13 @@ TEST(KioskScreen, ScriptedVisitWalksTheFlowAndSaysEachStep) {
     const auto at = line.find("say: ");
     if (at != std::string::npos) said.push_back(line.substr(at + 5));
   }
-  const std::vector<std::string> want_prefix{"Welcome.", "A circle.", "A triangle.", "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. Picture 1 of 2.",
-                                             "Picture 2 of 2.", "Still there? Press any key for more time. In 10 seconds this visit ends",
+  const std::vector<std::string> want_prefix{"Welcome.",
+                                             "A circle.",
+                                             "A triangle.",
+                                             "Well done. Press the D key to hear about a picture, the R key to hear it "
+                                             "again. Here is the first picture. Picture 1 of 2.",
+                                             "Picture 2 of 2.",
+                                             "Still there? Press any key for more time. In 10 seconds this visit ends",
                                              "Thank you for visiting. Goodbye."};
   ASSERT_EQ(said.size(), want_prefix.size()) << std::ifstream(dir / "log.txt").rdbuf();
   for (std::size_t i = 0; i < said.size(); ++i) EXPECT_EQ(said[i].rfind(want_prefix[i], 0), 0u) << said[i];

@@ -62,7 +62,8 @@ fs::path null_sound_home(const fs::path& dir) {
 }
 
 TEST(KioskWithSound, DescribeReadsAnEightKilobyteParagraphWholeAndTheKioskRunsOn) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = hk::test::fresh_dir("kiosk_sound");
   fs::create_directories(dir / "stick");
   fs::copy_file(kData / "documents" / "long_paragraph.pdf", dir / "stick" / "manual.pdf");
@@ -74,12 +75,14 @@ TEST(KioskWithSound, DescribeReadsAnEightKilobyteParagraphWholeAndTheKioskRunsOn
   const fs::path home = null_sound_home(dir);
   const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 SPDLOG_LEVEL=debug HOME=" + hk::test::quoted(home) +
                           " timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + std::string(HK_KIOSK_EXE) +
-                          " --library " + hk::test::quoted(kData / "images") + " --stick " + hk::test::quoted(dir / "stick") +
-                          " --script " + hk::test::quoted(dir / "script.txt") + " --screenshot " + hk::test::quoted(dir / "end.png") +
-                          " --frames 720 >" + hk::test::quoted(dir / "log.txt") + " 2>&1";
+                          " --library " + hk::test::quoted(kData / "images") + " --stick " +
+                          hk::test::quoted(dir / "stick") + " --script " + hk::test::quoted(dir / "script.txt") +
+                          " --screenshot " + hk::test::quoted(dir / "end.png") + " --frames 720 >" +
+                          hk::test::quoted(dir / "log.txt") + " 2>&1";
   ASSERT_EQ(sh(cmd), 0) << "the kiosk ended: " << read(dir / "log.txt").substr(0, 4000);
   const std::string log = read(dir / "log.txt");
-  EXPECT_EQ(log.find("audio: no output device"), std::string::npos) << "the null PCM is a sound device: " << log.substr(0, 2000);
+  EXPECT_EQ(log.find("audio: no output device"), std::string::npos)
+      << "the null PCM is a sound device: " << log.substr(0, 2000);
   EXPECT_TRUE(fs::exists(dir / "end.png")) << "it ran to its last frame";
   // Describe gave the speaker the whole block, every word in order.
   const std::vector<std::string> said = lines_after(log, "say: ");
@@ -91,7 +94,10 @@ TEST(KioskWithSound, DescribeReadsAnEightKilobyteParagraphWholeAndTheKioskRunsOn
     if (l.size() >= w.size() && l.compare(l.size() - w.size(), w.size(), w) == 0) line = s;
   }
   ASSERT_FALSE(line.empty()) << "no 'say:' line holds the whole paragraph; said " << said.size() << " lines";
-  EXPECT_EQ(line.rfind("People nearby can hear your document. Press the P key to pause it, or the End key to stop. About ", 0), 0u) << line.substr(0, 200);
+  EXPECT_EQ(line.rfind(
+                "People nearby can hear your document. Press the P key to pause it, or the End key to stop. About ", 0),
+            0u)
+      << line.substr(0, 200);
   EXPECT_NE(line.find("minute"), std::string::npos) << line.substr(0, 200);
   // The pieces handed to the sound device so far follow the paragraph from its start, in order (the rest
   // would take minutes to play: the unit tests read a long text through to its end).
@@ -126,20 +132,23 @@ int reads_from(const std::vector<std::string>& sentences, const std::string& sai
 // real rate): each press reads on from the sentence being heard, never from the top; Previous goes one back,
 // Repeat says the sentence heard again, and a page of one paragraph has no next one.
 TEST(KioskWithSound, TheSentenceKeysMoveThroughALongParagraphFromTheSentenceHeard) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = hk::test::fresh_dir("kiosk_sentences");
   fs::create_directories(dir / "stick");
   fs::copy_file(kData / "documents" / "long_paragraph.pdf", dir / "stick" / "manual.pdf");
   const std::vector<std::string> sentences = hk::audio::speech_pieces(read(kData / "documents" / "long_paragraph.txt"));
   ASSERT_GT(sentences.size(), 20u);
   // Describe at 2 s; the text itself starts after the warning and the length (~10 s); then the keys.
-  std::ofstream(dir / "script.txt") << "1 wait\n2 cursor 0 0\n120 key describe\n900 key next_sentence\n1000 key next_sentence\n"
-                                       "1060 key previous_sentence\n1120 key repeat\n1180 key next_paragraph\n";
+  std::ofstream(dir / "script.txt")
+      << "1 wait\n2 cursor 0 0\n120 key describe\n900 key next_sentence\n1000 key next_sentence\n"
+         "1060 key previous_sentence\n1120 key repeat\n1180 key next_paragraph\n";
   const fs::path home = null_sound_home(dir);
-  const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 HOME=" + hk::test::quoted(home) + " timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " +
-                          std::string(HK_KIOSK_EXE) + " --library " + hk::test::quoted(kData / "images") + " --stick " +
-                          hk::test::quoted(dir / "stick") + " --script " + hk::test::quoted(dir / "script.txt") + " --screenshot " +
-                          hk::test::quoted(dir / "end.png") + " --frames 1200 >" +
+  const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 HOME=" + hk::test::quoted(home) +
+                          " timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + std::string(HK_KIOSK_EXE) +
+                          " --library " + hk::test::quoted(kData / "images") + " --stick " +
+                          hk::test::quoted(dir / "stick") + " --script " + hk::test::quoted(dir / "script.txt") +
+                          " --screenshot " + hk::test::quoted(dir / "end.png") + " --frames 1200 >" +
                           hk::test::quoted(dir / "log.txt") + " 2>&1";
   ASSERT_EQ(sh(cmd), 0) << read(dir / "log.txt").substr(0, 4000);
   const std::vector<std::string> said = lines_after(read(dir / "log.txt"), "say: ");
@@ -165,21 +174,27 @@ namespace {
 // answered like any key that does nothing; Finish pressed once only asks, pressed again too late asks again,
 // and pressed twice within 5 s ends the visit.
 TEST(KioskWithSound, ChordsAreAnsweredAndFinishAsksOnce) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = hk::test::fresh_dir("kiosk_finish");
-  std::ofstream(dir / "script.txt") << "1 wait\n10 press CTRL+Q\n40 press ALT+F4\n70 key finish\n500 key finish\n530 key finish\n";
+  std::ofstream(dir / "script.txt")
+      << "1 wait\n10 press CTRL+Q\n40 press ALT+F4\n70 key finish\n500 key finish\n530 key finish\n";
   const fs::path home = null_sound_home(dir);
-  const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 HOME=" + hk::test::quoted(home) + " timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " +
-                          std::string(HK_KIOSK_EXE) + " --library " + hk::test::quoted(kData / "images") + " --show " +
-                          hk::test::quoted(kData / "images" / "horse.png") + " --script " + hk::test::quoted(dir / "script.txt") +
-                          " --screenshot " + hk::test::quoted(dir / "end.png") + " --frames 600 >" + hk::test::quoted(dir / "log.txt") + " 2>&1";
+  const std::string cmd = "ASAN_OPTIONS=detect_leaks=0 HOME=" + hk::test::quoted(home) +
+                          " timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + std::string(HK_KIOSK_EXE) +
+                          " --library " + hk::test::quoted(kData / "images") + " --show " +
+                          hk::test::quoted(kData / "images" / "horse.png") + " --script " +
+                          hk::test::quoted(dir / "script.txt") + " --screenshot " + hk::test::quoted(dir / "end.png") +
+                          " --frames 600 >" + hk::test::quoted(dir / "log.txt") + " 2>&1";
   ASSERT_EQ(sh(cmd), 0) << read(dir / "log.txt").substr(0, 4000);
   std::vector<std::string> said = lines_after(read(dir / "log.txt"), "say: ");
-  const auto first = std::find_if(said.begin(), said.end(), [](const std::string& s) { return s.rfind("That key", 0) == 0; });
+  const auto first =
+      std::find_if(said.begin(), said.end(), [](const std::string& s) { return s.rfind("That key", 0) == 0; });
   ASSERT_NE(first, said.end()) << "Ctrl+Q was answered";
-  const std::vector<std::string> want{"That key does nothing here. Press F1 for help.", "That key does nothing here. Press F1 for help.",
-                                      "Press the End key again to finish your visit.", "Press the End key again to finish your visit.",
-                                      "Thank you for visiting. Goodbye."};
+  const std::vector<std::string> want{
+      "That key does nothing here. Press F1 for help.", "That key does nothing here. Press F1 for help.",
+      "Press the End key again to finish your visit.", "Press the End key again to finish your visit.",
+      "Thank you for visiting. Goodbye."};
   const std::vector<std::string> got(first, said.end());
   EXPECT_EQ(got, want);
   fs::remove_all(dir);

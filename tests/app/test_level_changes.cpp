@@ -20,8 +20,8 @@
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
 #include "runtime/simulation.hpp"
-#include "test_pictures.hpp"
 #include "test_paths.hpp"
+#include "test_pictures.hpp"
 
 namespace hk {
 namespace {
@@ -73,7 +73,8 @@ void level_changes_hold(const char* name, const std::string& level_mode, Hand wh
   const app::ImageScene is = app::build_image_scene(path, s);
   const Scene& sc = *is.scene;
   ASSERT_GT(sc.curve_count(), 0u);
-  const HandPath hand = raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
+  const HandPath hand =
+      raster_path_with_line_speeds(s.workspace.width_m, s.workspace.height_m, 0.008, {0.03, 0.3}, 0.03);
   ExplorerHand explorer(app::explorer_params_from(s, 7));
   const long release_ticks = std::lround(s.haptics.pop_release_s * s.haptics.servo_rate_hz);
 
@@ -89,7 +90,8 @@ void level_changes_hold(const char* name, const std::string& level_mode, Hand wh
   const double step = s.haptics.level_max_force_step_n;
 
   int prev_transition = -1;
-  long transition_ticks = 0, waiting = 0, changes = 0, finer = 0, coarser = 0, crossings = 0, wrong_side = 0, force_steps = 0, contact_changes = 0;
+  long transition_ticks = 0, waiting = 0, changes = 0, finer = 0, coarser = 0, crossings = 0, wrong_side = 0,
+       force_steps = 0, contact_changes = 0;
   int prev_level = -1;
   Vec2 prev_force, prev_handle, prev_gap;
   bool prev_unclamped = false;
@@ -116,7 +118,8 @@ void level_changes_hold(const char* name, const std::string& level_mode, Hand wh
       (so.level < prev_level ? finer : coarser) += 1;
       contact_changes += c.state != ContactState::Free;
       // Where the proxy was when the change was made: on the same side of the new polyline as of the old.
-      for (std::size_t cv = 0; cv < sc.curve_count(); ++cv) wrong_side += between_levels(sc, cv, prev_level, so.level, c.path_m[0]);
+      for (std::size_t cv = 0; cv < sc.curve_count(); ++cv)
+        wrong_side += between_levels(sc, cv, prev_level, so.level, c.path_m[0]);
     }
     // The force may jump at a change by no more than the configured step (plus what the hand's own motion
     // does: stiffness × its displacement) ...
@@ -128,8 +131,10 @@ void level_changes_hold(const char* name, const std::string& level_mode, Hand wh
     // after the start-up ramp).
     const Vec2 spring = k * (c.proxy_m - r.handle_m);
     const Vec2 gap = so.force_n - spring;
-    const bool unclamped = length(spring) < s.haptics.max_force_n - 1e-6 && length(so.force_n) < s.haptics.max_force_n - 1e-6;
-    if (!so.level_changed && unclamped && prev_unclamped && release_left == 0 && r.t_s > s.haptics.force_ramp_s && distance(gap, prev_gap) > step + 1e-9) {
+    const bool unclamped =
+        length(spring) < s.haptics.max_force_n - 1e-6 && length(so.force_n) < s.haptics.max_force_n - 1e-6;
+    if (!so.level_changed && unclamped && prev_unclamped && release_left == 0 && r.t_s > s.haptics.force_ramp_s &&
+        distance(gap, prev_gap) > step + 1e-9) {
       ++force_steps;
     }
     prev_gap = gap;
@@ -138,7 +143,8 @@ void level_changes_hold(const char* name, const std::string& level_mode, Hand wh
     prev_force = so.force_n;
     prev_handle = r.handle_m;
   };
-  const long ticks = which == Hand::Explorer ? app::run_simulation(sc, s, explorer, 60.0, observe) : app::run_simulation(sc, s, hand, hand.duration_s(), observe);
+  const long ticks = which == Hand::Explorer ? app::run_simulation(sc, s, explorer, 60.0, observe)
+                                             : app::run_simulation(sc, s, hand, hand.duration_s(), observe);
   ::testing::Test::RecordProperty("level_changes", std::to_string(changes));
   ::testing::Test::RecordProperty("ticks_waiting", std::to_string(waiting));
   ::testing::Test::RecordProperty("ticks_with_two_levels", std::to_string(transition_ticks));
@@ -177,12 +183,17 @@ TEST_P(LevelChanges, FastAndSlowRasterChangesCutStepsWithoutCrossingOrForceSteps
 
 // The visitor-like explorer in each mode: it reaches level changes the raster does not (on sudoku, one that
 // left the proxy between two levels of a curve crossing the one it slid on).
-TEST_P(LevelChanges, ExplorerChangesLevelsWithoutCrossingOrForceSteps) { level_changes_hold(GetParam(), "auto", Hand::Explorer); }
-TEST_P(LevelChanges, ExplorerChangesToleranceStepsWithoutCrossingOrForceSteps) { level_changes_hold(GetParam(), "tolerance", Hand::Explorer); }
-TEST_P(LevelChanges, ExplorerChangesCutStepsWithoutCrossingOrForceSteps) { level_changes_hold(GetParam(), "cut", Hand::Explorer); }
+TEST_P(LevelChanges, ExplorerChangesLevelsWithoutCrossingOrForceSteps) {
+  level_changes_hold(GetParam(), "auto", Hand::Explorer);
+}
+TEST_P(LevelChanges, ExplorerChangesToleranceStepsWithoutCrossingOrForceSteps) {
+  level_changes_hold(GetParam(), "tolerance", Hand::Explorer);
+}
+TEST_P(LevelChanges, ExplorerChangesCutStepsWithoutCrossingOrForceSteps) {
+  level_changes_hold(GetParam(), "cut", Hand::Explorer);
+}
 
-INSTANTIATE_TEST_SUITE_P(RealImages, LevelChanges,
-                         ::testing::ValuesIn(test::kPictures),
+INSTANTIATE_TEST_SUITE_P(RealImages, LevelChanges, ::testing::ValuesIn(test::kPictures),
                          [](const auto& info) { return fs::path(info.param).stem().string(); });
 
 }  // namespace

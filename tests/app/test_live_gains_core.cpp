@@ -16,9 +16,9 @@
 
 #include "haptics/hand_path.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "runtime/servo_step.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_step.hpp"
 #include "runtime/simulation.hpp"
 
 namespace hk::app {
@@ -42,7 +42,11 @@ struct Rig {
   std::vector<ServoDisplayState> shown;
   Vec2 target{0.0, 0.0};  // where the hand pulls to
 
-  Rig() : sp(servo_params_from(s)), device(sim_params_from(s), {-0.03, 0.0}), hand(hand_params_from(s)), core(CueTrackerParams{}, nullptr) {
+  Rig()
+      : sp(servo_params_from(s)),
+        device(sim_params_from(s), {-0.03, 0.0}),
+        hand(hand_params_from(s)),
+        core(CueTrackerParams{}, nullptr) {
     device.open();
   }
   void tick() {
@@ -106,9 +110,10 @@ TEST(LiveGainsCore, StiffnessDoublesUnderAPressingHandWithoutAForceStep) {
   }
   EXPECT_EQ(in_force, derived);
   const double ms = static_cast<double>(in_force) * r.sp.period_s * 1e3;
-  std::printf("[ live gains ] 800 -> 1600 N/m under a %.1f N press, %.2f N/tick at %.0f Hz: new stiffness fully in force "
-              "%ld ticks (%.0f ms) after set_gains; derived %ld ticks (a priori %ld)\n",
-              push, step, 1.0 / r.sp.period_s, in_force, ms, derived, derived_a_priori);
+  std::printf(
+      "[ live gains ] 800 -> 1600 N/m under a %.1f N press, %.2f N/tick at %.0f Hz: new stiffness fully in force "
+      "%ld ticks (%.0f ms) after set_gains; derived %ld ticks (a priori %ld)\n",
+      push, step, 1.0 / r.sp.period_s, in_force, ms, derived, derived_a_priori);
   RecordProperty("apply_to_full_stiffness_ticks", std::to_string(in_force));
   RecordProperty("apply_to_full_stiffness_ms", std::to_string(ms));
 

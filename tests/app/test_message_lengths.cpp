@@ -8,8 +8,8 @@
 
 #include "audio/messages.hpp"
 #include "audio/speech.hpp"
-#include "visit/kiosk_flow.hpp"
 #include "message_samples.hpp"
+#include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
 namespace {
@@ -37,7 +37,8 @@ TEST(MessageLengths, TheFirstWordsAVisitorHearsAreShort) {
   const audio::MessageCatalog& en = audio::MessageCatalog::english();
   const config::KeysSettings keys;  // key_args views its strings
   const auto key_names = key_args(keys);
-  for (const audio::MessageId id : {audio::MessageId::welcome, audio::MessageId::help_brief, audio::MessageId::attract}) {
+  for (const audio::MessageId id :
+       {audio::MessageId::welcome, audio::MessageId::help_brief, audio::MessageId::attract}) {
     const std::string text = test::sample_message(en, id, key_names);
     EXPECT_LE(static_cast<double>(audio::synthesize_speech(text, {}).size()) / audio::kSampleRateHz, 7.0) << text;
   }

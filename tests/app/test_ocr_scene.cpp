@@ -1,5 +1,5 @@
-// With [vision] ocr = "auto", pages that are pictures of text are read, never felt: a scan made here from the shipped PDF (150 dpi,
-// turned 1.5°, noise, JPEG 80) becomes text blocks read by OCR ("source": "ocr", with their confidence)
+// With [vision] ocr = "auto", pages that are pictures of text are read, never felt: a scan made here from the shipped
+// PDF (150 dpi, turned 1.5°, noise, JPEG 80) becomes text blocks read by OCR ("source": "ocr", with their confidence)
 // whose words are 90 % of pdftotext's, with at most 5 curves left inside them; the same scan wrapped in an
 // image-only PDF (no text layer, as scan-to-PDF apps write) gives the same text; every shipped photograph
 // and silhouette gives no text block; [vision] ocr = "off" feels the page's words; explore writes it all.
@@ -16,15 +16,15 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "pictures/documents.hpp"
 #include "image_pdf.hpp"
-#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
-#include "scans.hpp"
+#include "pictures/documents.hpp"
+#include "pictures/image_scene.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
-#include "vision/pdf.hpp"
+#include "scans.hpp"
 #include "test_paths.hpp"
+#include "vision/pdf.hpp"
 
 namespace fs = std::filesystem;
 
@@ -81,7 +81,8 @@ struct ScanRig {
 };
 
 TEST(OcrScene, AScannedPageIsReadAsTextBlocksNotFeltAsBumps) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   ScanRig r;
   ASSERT_FALSE(r.jpeg.empty());
   const config::Settings s = reading();
@@ -112,7 +113,8 @@ TEST(OcrScene, AScannedPageIsReadAsTextBlocksNotFeltAsBumps) {
 }
 
 TEST(OcrScene, TheSameScanInAnImageOnlyPdfGivesTheSameText) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   ScanRig r;
   const cv::Mat grey = cv::imdecode(r.jpeg, cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(grey.empty());
@@ -131,7 +133,8 @@ TEST(OcrScene, TheSameScanInAnImageOnlyPdfGivesTheSameText) {
   // Drawn again by poppler, the pixels differ a little, and Tesseract may split a paragraph differently.
   EXPECT_NEAR(static_cast<double>(from_pdf.text_blocks.size()), static_cast<double>(from_jpeg.text_blocks.size()),
               std::max(2.0, 0.2 * static_cast<double>(from_jpeg.text_blocks.size())));
-  EXPECT_GE(test::word_recall(test::words_of(all_text(from_jpeg)), test::words_of(all_text(from_pdf))), 0.93);  // measured 0.96
+  EXPECT_GE(test::word_recall(test::words_of(all_text(from_jpeg)), test::words_of(all_text(from_pdf))),
+            0.93);  // measured 0.96
   EXPECT_GE(test::word_recall(r.truth, test::words_of(all_text(from_pdf))), 0.9);
   for (const TextBlockM& b : from_pdf.text_blocks) EXPECT_EQ(b.source, "ocr");
 }
@@ -145,8 +148,10 @@ TEST(OcrScene, AStickPageIsDrawnAtTheScreenSideUnlessItsTextLayerLeavesTextForOc
     std::ifstream f(kSpec, std::ios::binary);
     return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(f), {});
   }();
-  const ImageScene small = build_pdf_page_scene(spec, "spec.pdf", kPage, s, vision::PdfFault::None, TextTiming::later, kSide);
-  const ImageScene full = build_pdf_page_scene(spec, "spec.pdf", kPage, s, vision::PdfFault::None, TextTiming::later, 0);
+  const ImageScene small =
+      build_pdf_page_scene(spec, "spec.pdf", kPage, s, vision::PdfFault::None, TextTiming::later, kSide);
+  const ImageScene full =
+      build_pdf_page_scene(spec, "spec.pdf", kPage, s, vision::PdfFault::None, TextTiming::later, 0);
   EXPECT_EQ(std::max(small.file_width_px, small.file_height_px), kSide);
   EXPECT_GT(std::max(full.file_width_px, full.file_height_px), 2000);
   EXPECT_EQ(small.ocr.why, "a text layer");
@@ -164,13 +169,15 @@ TEST(OcrScene, AStickPageIsDrawnAtTheScreenSideUnlessItsTextLayerLeavesTextForOc
 
   // A scan whose text layer is one stamped line: the layer covers little, so the page is drawn again at the
   // full budget and its text is left for OCR.
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   ScanRig r;
   const cv::Mat grey = cv::imdecode(r.jpeg, cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(grey.empty());
   const std::string pdf = test::image_only_pdf(r.jpeg, grey.cols, grey.rows, kDpi, "Scanned at the library");
   const std::vector<std::uint8_t> bytes(pdf.begin(), pdf.end());
-  const ImageScene scan = build_pdf_page_scene(bytes, "scan.pdf", 1, s, vision::PdfFault::None, TextTiming::later, kSide);
+  const ImageScene scan =
+      build_pdf_page_scene(bytes, "scan.pdf", 1, s, vision::PdfFault::None, TextTiming::later, kSide);
   EXPECT_EQ(scan.ocr.why, "text layer covers little of the text");
   EXPECT_TRUE(scan.text_pending);
   const vision::PdfPage drawn = vision::render_pdf_page(bytes, "scan.pdf", 1, pdf_limits_from(s));
@@ -206,15 +213,17 @@ TEST(OcrScene, PhotographsAndSilhouettesGiveNoTextBlock) {
 }
 
 TEST(OcrScene, ExploreWritesTheBlocksWithTheirSourceAndTheOcrSummary) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   ScanRig r;
   {
     std::ofstream f(r.dir / "scan.jpg", std::ios::binary);
     f.write(reinterpret_cast<const char*>(r.jpeg.data()), static_cast<std::streamsize>(r.jpeg.size()));
   }
   std::ofstream(r.dir / "reading.toml") << "[vision]\nocr = \"auto\"\n";
-  const test::ExeResult run = test::run_kiosk("explore " + test::quoted(r.dir / "scan.jpg") + " --config " + test::quoted(r.dir / "reading.toml") +
-                                                  " --out " + test::quoted(r.dir / "out") + " --duration 0.5",
+  const test::ExeResult run = test::run_kiosk("explore " + test::quoted(r.dir / "scan.jpg") + " --config " +
+                                                  test::quoted(r.dir / "reading.toml") + " --out " +
+                                                  test::quoted(r.dir / "out") + " --duration 0.5",
                                               r.dir);
   ASSERT_EQ(run.status, 0) << run.err;
   std::ifstream sf(r.dir / "out" / "summary.json"), jf(r.dir / "out" / "scene.json");
@@ -235,7 +244,8 @@ TEST(OcrScene, ExploreWritesTheBlocksWithTheirSourceAndTheOcrSummary) {
 // A text reader that crashes (a worker killed by SIGSEGV, as a Tesseract bug on a stranger's pixels would
 // kill it): the page is still felt, its text is reported unavailable in one line, and explore ends normally.
 TEST(OcrScene, AWorkerThatCrashesCostsTheTextNeverThePage) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   ScanRig r;
   {
     std::ofstream f(r.dir / "scan.jpg", std::ios::binary);
@@ -245,8 +255,9 @@ TEST(OcrScene, AWorkerThatCrashesCostsTheTextNeverThePage) {
   std::ofstream(crash) << "#!/bin/sh\nkill -SEGV $$\n";
   fs::permissions(crash, fs::perms::owner_all);
   ASSERT_EQ(::setenv("HK_OCR_WORKER", crash.c_str(), 1), 0);
-  const test::ExeResult run =
-      test::run_kiosk("explore " + test::quoted(r.dir / "scan.jpg") + " --out " + test::quoted(r.dir / "out") + " --duration 0.5", r.dir);
+  const test::ExeResult run = test::run_kiosk(
+      "explore " + test::quoted(r.dir / "scan.jpg") + " --out " + test::quoted(r.dir / "out") + " --duration 0.5",
+      r.dir);
   ::unsetenv("HK_OCR_WORKER");
   ASSERT_EQ(run.status, 0) << run.err;
   std::ifstream sf(r.dir / "out" / "summary.json"), jf(r.dir / "out" / "scene.json");

@@ -66,7 +66,10 @@ class OperatorSessionTest : public ::testing::Test {
 
 TEST_F(OperatorSessionTest, WrongPinIsRefusedAndCountedTheRightOneOpensThePanel) {
   int applied = 0;
-  OperatorSession s(path_, in_use_, "", [&](const config::Settings&) { ++applied; return std::string("ok"); });
+  OperatorSession s(path_, in_use_, "", [&](const config::Settings&) {
+    ++applied;
+    return std::string("ok");
+  });
   EXPECT_EQ(s.state(), PanelState::closed);
   EXPECT_FALSE(s.captures_keyboard());
   s.chord(1.0, kT0);
@@ -111,7 +114,10 @@ TEST_F(OperatorSessionTest, NoPinSetMeansANoticeNotAPrompt) {
 
 TEST_F(OperatorSessionTest, EditsAreCheckedAsTheLoaderChecksThemApplyAuditsAndSaveKeepsTheBak) {
   config::Settings handed;
-  OperatorSession s(path_, in_use_, "", [&](const config::Settings& next) { handed = next; return std::string("Applied."); });
+  OperatorSession s(path_, in_use_, "", [&](const config::Settings& next) {
+    handed = next;
+    return std::string("Applied.");
+  });
   s.chord(0.0, kT0);
   s.submit_pin("2468", 0.1, kT0);
   finish_check(s, 0.2);
@@ -137,7 +143,8 @@ TEST_F(OperatorSessionTest, EditsAreCheckedAsTheLoaderChecksThemApplyAuditsAndSa
   EXPECT_EQ(handed.haptics.stiffness_n_per_m, 1200.0);
   EXPECT_FALSE(s.dirty());
   EXPECT_TRUE(s.unsaved());
-  EXPECT_NE(read(dir_ / "kiosk.toml.audit.log").find("panel haptics.stiffness_n_per_m 800.0 -> 1200.0"), std::string::npos);
+  EXPECT_NE(read(dir_ / "kiosk.toml.audit.log").find("panel haptics.stiffness_n_per_m 800.0 -> 1200.0"),
+            std::string::npos);
   EXPECT_EQ(config::load_settings(path_).haptics.stiffness_n_per_m, 800.0) << "applied is not saved";
 
   s.save(kT0 + 2);
@@ -146,7 +153,7 @@ TEST_F(OperatorSessionTest, EditsAreCheckedAsTheLoaderChecksThemApplyAuditsAndSa
   EXPECT_EQ(saved.haptics.stiffness_n_per_m, 1200.0);
   EXPECT_EQ(saved.operator_.pin_hash, in_use_.operator_.pin_hash) << "the PIN survives a save";
   EXPECT_EQ(config::load_settings(path_ + ".bak").haptics.stiffness_n_per_m, 800.0);
-  struct stat st{};
+  struct stat st {};
   ASSERT_EQ(::stat(path_.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0600u) << "a file with the PIN's hash";
 }
@@ -172,7 +179,10 @@ TEST_F(OperatorSessionTest, ResetToDefaultsKeepsTheOperatorTableAndIsNotAppliedU
   changed.haptics.stiffness_n_per_m = 2000;
   changed.keys.next = "N";
   int applied = 0;
-  OperatorSession s(path_, changed, "", [&](const config::Settings&) { ++applied; return std::string("ok"); });
+  OperatorSession s(path_, changed, "", [&](const config::Settings&) {
+    ++applied;
+    return std::string("ok");
+  });
   s.chord(0.0, kT0);
   s.submit_pin("2468", 0.1, kT0);
   finish_check(s, 0.2);

@@ -38,11 +38,13 @@ std::string read(const fs::path& p) {
 /// operator would; true when it worked.
 bool settings_with_pin(const hk::config::Settings& s, const fs::path& settings) {
   hk::config::save_settings_atomic(s, settings.string());
-  return sh("printf '90817263\\n' | " + std::string(HK_KIOSK_EXE) + " pin set --config '" + settings.string() + "' 2>/dev/null") == 0;
+  return sh("printf '90817263\\n' | " + std::string(HK_KIOSK_EXE) + " pin set --config '" + settings.string() +
+            "' 2>/dev/null") == 0;
 }
 
 TEST(OperatorVisit, WrongPinRightPinStiffness800To1200ApplySaveUnderXvfb) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = fs::temp_directory_path() / ("hk_opvisit_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "library");
@@ -69,9 +71,10 @@ TEST(OperatorVisit, WrongPinRightPinStiffness800To1200ApplySaveUnderXvfb) {
                                       "90 click Apply\n"
                                       "100 click Save\n";
   const fs::path png = dir / "panel.png", log = dir / "log.txt";
-  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug --config '" + settings.string() +
-               "' --library '" + (dir / "library").string() + "' --show '" + (dir / "library" / "horse.png").string() + "' --script '" +
-               (dir / "visit.txt").string() + "' --screenshot '" + png.string() + "' --frames 130 >'" + log.string() + "' 2>&1"),
+  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe +
+               " --no-hotplug --config '" + settings.string() + "' --library '" + (dir / "library").string() +
+               "' --show '" + (dir / "library" / "horse.png").string() + "' --script '" + (dir / "visit.txt").string() +
+               "' --screenshot '" + png.string() + "' --frames 130 >'" + log.string() + "' 2>&1"),
             0)
       << read(log);
 
@@ -105,7 +108,8 @@ namespace {
 // wait returns: nothing of the forgotten stick is awaited), and the operator's panel, opened with the PIN,
 // says on its Status tab that the sticks are idle, not "working".
 TEST(OperatorVisit, FinishWhileAStickPageIsDrawnLeavesThePanelsStatusIdle) {
-  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+  if (sh("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
   const fs::path dir = fs::temp_directory_path() / ("hk_opfinish_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "library");
@@ -117,10 +121,11 @@ TEST(OperatorVisit, FinishWhileAStickPageIsDrawnLeavesThePanelsStatusIdle) {
   s.kiosk.prefetch_mb = 0;  // page 2 is drawn when Next asks for it, not ahead
   ASSERT_TRUE(settings_with_pin(s, settings));
   const std::string exe = HK_KIOSK_EXE;
-  std::ofstream(dir / "visit.txt") << "1 stick " << (dir / "stick").string() << "\n"
+  std::ofstream(dir / "visit.txt") << "1 stick " << (dir / "stick").string()
+                                   << "\n"
                                       "2 wait\n"
-                                      "3 key next\n"      // page 2 is drawn...
-                                      "4 key finish\n"    // ...and Finish, twice, meanwhile
+                                      "3 key next\n"    // page 2 is drawn...
+                                      "4 key finish\n"  // ...and Finish, twice, meanwhile
                                       "5 key finish\n"
                                       "6 wait\n"
                                       "10 press CTRL+ALT+O\n"
@@ -129,9 +134,10 @@ TEST(OperatorVisit, FinishWhileAStickPageIsDrawnLeavesThePanelsStatusIdle) {
                                       "22 wait\n"
                                       "40 shows sticks:idle\n";
   const fs::path png = dir / "panel.png", log = dir / "log.txt";
-  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe + " --no-hotplug --config '" + settings.string() +
-               "' --library '" + (dir / "library").string() + "' --script '" + (dir / "visit.txt").string() + "' --screenshot '" +
-               png.string() + "' --frames 50 >'" + log.string() + "' 2>&1"),
+  ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + exe +
+               " --no-hotplug --config '" + settings.string() + "' --library '" + (dir / "library").string() +
+               "' --script '" + (dir / "visit.txt").string() + "' --screenshot '" + png.string() + "' --frames 50 >'" +
+               log.string() + "' 2>&1"),
             0)
       << read(log);
   const std::string said = read(log);

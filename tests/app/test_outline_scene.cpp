@@ -15,9 +15,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "config/load.hpp"
-#include "pictures/image_scene.hpp"
-#include "kiosk_exe.hpp"
 #include "hk/error.hpp"
+#include "kiosk_exe.hpp"
+#include "pictures/image_scene.hpp"
 
 namespace hk::app {
 namespace {
@@ -32,8 +32,10 @@ std::vector<cv::Point2d> cracks(const cv::Mat& dark) {
   for (int y = 0; y < dark.rows; ++y)
     for (int x = 0; x < dark.cols; ++x) {
       const bool d = dark.at<std::uint8_t>(y, x) != 0;
-      if (x + 1 < dark.cols && d != (dark.at<std::uint8_t>(y, x + 1) != 0)) out.push_back({x + 0.5, static_cast<double>(y)});
-      if (y + 1 < dark.rows && d != (dark.at<std::uint8_t>(y + 1, x) != 0)) out.push_back({static_cast<double>(x), y + 0.5});
+      if (x + 1 < dark.cols && d != (dark.at<std::uint8_t>(y, x + 1) != 0))
+        out.push_back({x + 0.5, static_cast<double>(y)});
+      if (y + 1 < dark.rows && d != (dark.at<std::uint8_t>(y + 1, x) != 0))
+        out.push_back({static_cast<double>(x), y + 0.5});
     }
   return out;
 }
@@ -50,7 +52,8 @@ bool touches_frame(const cv::Mat& labels, int label, const cv::Mat& stats) {
 int count_outlines(const cv::Mat& dark) {
   const cv::Mat light = 255 - dark;
   auto frame = [](const cv::Mat& m) {
-    return cv::countNonZero(m.row(0)) + cv::countNonZero(m.row(m.rows - 1)) + cv::countNonZero(m.col(0)) + cv::countNonZero(m.col(m.cols - 1));
+    return cv::countNonZero(m.row(0)) + cv::countNonZero(m.row(m.rows - 1)) + cv::countNonZero(m.col(0)) +
+           cv::countNonZero(m.col(m.cols - 1));
   };
   const cv::Mat& fg = frame(light) <= frame(dark) ? light : dark;
   const cv::Mat& bg = &fg == &light ? dark : light;
@@ -94,7 +97,8 @@ Check check_picture(const fs::path& file) {
     const CurveInfo& ci = sc.curve(c);
     r.closed += ci.closed;
     std::vector<cv::Point2d> pts;
-    for (std::uint32_t i = 0; i < ci.point_count[0]; ++i) pts.push_back({is.px_to_m.u_px(sc.points(c, 0)[i].x), is.px_to_m.v_px(sc.points(c, 0)[i].y)});
+    for (std::uint32_t i = 0; i < ci.point_count[0]; ++i)
+      pts.push_back({is.px_to_m.u_px(sc.points(c, 0)[i].x), is.px_to_m.v_px(sc.points(c, 0)[i].y)});
     if (ci.closed) pts.push_back(pts.front());
     curves.push_back(std::move(pts));
   }
@@ -119,7 +123,8 @@ Check check_picture(const fs::path& file) {
     if (q.x < 1.5 || q.y < 1.5 || q.x > dark.cols - 2.5 || q.y > dark.rows - 2.5) continue;
     double best = 1e9;
     for (const auto& pts : curves)
-      for (std::size_t i = 1; i < pts.size() && best > 0.5; ++i) best = std::min(best, to_segment(q, pts[i - 1], pts[i]));
+      for (std::size_t i = 1; i < pts.size() && best > 0.5; ++i)
+        best = std::min(best, to_segment(q, pts[i - 1], pts[i]));
     r.crack_to_curve_px = std::max(r.crack_to_curve_px, best);
   }
   return r;
@@ -160,7 +165,8 @@ TEST(OutlineScene, TheSettingsOfferExactlyTheDetectorsVisionKnows) {
   const config::FieldDescriptor* d = config::find_field("vision", "detector");
   ASSERT_NE(d, nullptr);
   ASSERT_EQ(d->choices.size(), 6u);
-  for (const auto& name : d->choices) EXPECT_EQ(vision::detector_name(vision::detector_from_name(std::string(name))), name);
+  for (const auto& name : d->choices)
+    EXPECT_EQ(vision::detector_name(vision::detector_from_name(std::string(name))), name);
   EXPECT_THROW(vision::detector_from_name("sobel"), hk::ArgumentError);
 }
 

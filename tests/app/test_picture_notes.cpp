@@ -13,10 +13,10 @@
 #include <png.h>
 #include <zlib.h>
 
-#include "kiosk_exe.hpp"
-#include "pictures/picture_library.hpp"
 #include "formats/picture_notes.hpp"
 #include "formats/png_text.hpp"
+#include "kiosk_exe.hpp"
+#include "pictures/picture_library.hpp"
 #include "test_paths.hpp"
 
 namespace hk::app {
@@ -47,10 +47,13 @@ TEST(PictureNotes, ASidecarGivesTheTitleAndDescriptionTrimmed) {
   const PictureNotes none = read_picture_notes((dir / "nothing.png").string());
   EXPECT_TRUE(none.title.empty());
   EXPECT_TRUE(none.description.empty());
-  const PictureNotes n = read_picture_notes(with_sidecar(dir, "title = \"  a horse, seen from the side \"\ndescription = \"\"\"\nA horse standing.\nIts head is up.\"\"\"\n"));
+  const PictureNotes n = read_picture_notes(with_sidecar(
+      dir,
+      "title = \"  a horse, seen from the side \"\ndescription = \"\"\"\nA horse standing.\nIts head is up.\"\"\"\n"));
   EXPECT_EQ(n.title, "a horse, seen from the side");
   EXPECT_EQ(n.description, "A horse standing.\nIts head is up.");
-  const PictureNotes only = read_picture_notes(with_sidecar(dir, "title = \"Ein Pferd, von der Seite gesehen — müde\"\n"));
+  const PictureNotes only =
+      read_picture_notes(with_sidecar(dir, "title = \"Ein Pferd, von der Seite gesehen — müde\"\n"));
   EXPECT_EQ(only.title, "Ein Pferd, von der Seite gesehen — müde");
   EXPECT_TRUE(only.description.empty());
   fs::remove_all(dir);
@@ -118,14 +121,18 @@ TEST(PictureNotes, WithoutASidecarThePicturesOwnMetadataSpeaks) {
   n = embedded_notes(jpg);
   EXPECT_EQ(n.title, "a red apple on a table");
   EXPECT_EQ(n.description, "Taken in the kitchen.");
-  const std::string cam = picture_with_metadata(dir, "cam.jpg", [](Exiv2::Image& im) { im.exifData()["Exif.Image.ImageDescription"] = "OLYMPUS DIGITAL CAMERA"; });
+  const std::string cam = picture_with_metadata(dir, "cam.jpg", [](Exiv2::Image& im) {
+    im.exifData()["Exif.Image.ImageDescription"] = "OLYMPUS DIGITAL CAMERA";
+  });
   EXPECT_TRUE(embedded_notes(cam).title.empty());
   // A title of two lines or over 200 bytes is skipped, not refused.
-  const std::string two = picture_with_metadata(dir, "two.png", [](Exiv2::Image& im) { im.xmpData()["Xmp.dc.title"] = "lang=x-default one\ntwo"; });
+  const std::string two = picture_with_metadata(
+      dir, "two.png", [](Exiv2::Image& im) { im.xmpData()["Xmp.dc.title"] = "lang=x-default one\ntwo"; });
   EXPECT_TRUE(embedded_notes(two).title.empty());
   // No metadata, a damaged file, no file: nothing said, nothing thrown.
   EXPECT_TRUE(embedded_notes(picture_with_metadata(dir, "plain.png", [](Exiv2::Image&) {})).title.empty());
-  const unsigned char broken[] = {0xff, 0xd8, 0xff, 0xe1, 0x00, 0x10, 'E', 'x', 'i', 'f', 0, 0, 'g', 'a', 'r', 'b', 'a', 'g', 'e'};
+  const unsigned char broken[] = {0xff, 0xd8, 0xff, 0xe1, 0x00, 0x10, 'E', 'x', 'i', 'f',
+                                  0,    0,    'g',  'a',  'r',  'b',  'a', 'g', 'e'};
   std::ofstream(dir / "broken.jpg", std::ios::binary).write(reinterpret_cast<const char*>(broken), sizeof broken);
   EXPECT_TRUE(embedded_notes((dir / "broken.jpg").string()).title.empty());
   EXPECT_TRUE(embedded_notes((dir / "missing.png").string()).title.empty());
@@ -147,7 +154,8 @@ void write_png_with_text(const fs::path& file, const std::vector<Chunk>& before,
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png_create_info_struct(png), end = png_create_info_struct(png);
   png_init_io(png, f);
-  png_set_IHDR(png, info, 16, 8, 8, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, 16, 8, 8, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
   const auto texts = [](const std::vector<Chunk>& chunks) {
     std::vector<png_text> t(chunks.size());
     for (std::size_t i = 0; i < chunks.size(); ++i) {
@@ -174,8 +182,10 @@ void write_png_with_text(const fs::path& file, const std::vector<Chunk>& before,
 TEST(PngText, TitleAndDescriptionFromEveryKindOfTextChunkBeforeOrAfterTheImage) {
   const fs::path dir = fresh_dir("png_text");
   // tEXt before the image data; the Latin-1 "é" (0xE9) comes out as UTF-8.
-  write_png_with_text(dir / "text.png", {{"Title", "A horse at the caf\xe9", PNG_TEXT_COMPRESSION_NONE}, {"Author", "me", PNG_TEXT_COMPRESSION_NONE}},
-                      {});
+  write_png_with_text(
+      dir / "text.png",
+      {{"Title", "A horse at the caf\xe9", PNG_TEXT_COMPRESSION_NONE}, {"Author", "me", PNG_TEXT_COMPRESSION_NONE}},
+      {});
   PngText t = read_png_text((dir / "text.png").string());
   EXPECT_EQ(t.title, "A horse at the caf\u00e9");
   EXPECT_EQ(t.description, "");
@@ -220,7 +230,9 @@ TEST(PngText, TitleAndDescriptionFromEveryKindOfTextChunkBeforeOrAfterTheImage) 
 TEST(PngText, ACompressedTextBombIsNotExpanded) {
   // 4 MiB of zeros in a zTXt chunk deflate to about 4 KiB; read_png_text inflates no chunk past 1 MiB.
   const fs::path dir = fresh_dir("png_bomb");
-  write_png_with_text(dir / "bomb.png", {{"Title", "fine", PNG_TEXT_COMPRESSION_NONE}, {"Description", std::string(4u << 20, '0'), PNG_TEXT_COMPRESSION_zTXt}},
+  write_png_with_text(dir / "bomb.png",
+                      {{"Title", "fine", PNG_TEXT_COMPRESSION_NONE},
+                       {"Description", std::string(4u << 20, '0'), PNG_TEXT_COMPRESSION_zTXt}},
                       {});
   EXPECT_LT(fs::file_size(dir / "bomb.png"), 64u << 10);
   const PngText t = read_png_text((dir / "bomb.png").string());

@@ -1,7 +1,7 @@
 // `haptic-kiosk pin set|check --config FILE` run as the real executable (each run a new process, so the
 // lockout must live in the state file), and the panel's PinVerifier (check_pin on a worker thread).
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -170,7 +170,7 @@ TEST(PinCommand, SetKeepsEveryOtherValueWithMode0600) {
   ASSERT_EQ(::chmod(cfg.c_str(), 0644), 0);
   const ExeResult r = run_pin("set", "2468", cfg);
   ASSERT_EQ(r.status, 0) << r.err;
-  struct stat st{};
+  struct stat st {};
   ASSERT_EQ(::stat(cfg.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 07777, 0600u);
   config::Settings after = config::load_settings(cfg.string());

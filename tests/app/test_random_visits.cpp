@@ -5,9 +5,9 @@
 // long ones.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 
 #include "random_visit.hpp"
 #include "test_paths.hpp"
@@ -22,10 +22,12 @@ const fs::path kData = HK_TEST_DATA_DIR;
 /// A random visit of 20 000 frames with seed `seed`. The faults found
 /// fail the test; the report is returned for what the run must have held.
 RandomVisitReport visit(std::uint32_t seed) {
-  const fs::path work = fs::temp_directory_path() / ("hk_random_visit_" + std::to_string(::getpid()) + "_" + std::to_string(seed));
+  const fs::path work =
+      fs::temp_directory_path() / ("hk_random_visit_" + std::to_string(::getpid()) + "_" + std::to_string(seed));
   fs::remove_all(work);
   fs::create_directories(work / "library");
-  for (const char* name : {"horse.png", "coins.png", "silhouette_2.png"}) fs::copy_file(kData / "images" / name, work / "library" / name);
+  for (const char* name : {"horse.png", "coins.png", "silhouette_2.png"})
+    fs::copy_file(kData / "images" / name, work / "library" / name);
   RandomVisitParams p;
   p.seed = seed;
   p.frames = 20000;

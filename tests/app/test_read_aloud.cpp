@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "audio/speech.hpp"
+#include "test_paths.hpp"
+#include "vision/ocr.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/read_aloud.hpp"
-#include "vision/ocr.hpp"
-#include "test_paths.hpp"
 
 namespace hk::app {
 namespace {
@@ -25,7 +25,9 @@ const std::string kData = HK_TEST_DATA_DIR;
 
 }  // namespace
 
-void PrintTo(const ReadingPlace& p, std::ostream* os) { *os << "{paragraph " << p.paragraph << ", sentence " << p.sentence << "}"; }
+void PrintTo(const ReadingPlace& p, std::ostream* os) {
+  *os << "{paragraph " << p.paragraph << ", sentence " << p.sentence << "}";
+}
 
 namespace {
 
@@ -40,8 +42,7 @@ std::string read_file(const std::string& path) {
 /// text of long_paragraph.pdf).
 std::vector<std::string> page_paragraphs() {
   return {"Opening hours. The museum opens at nine; it closes at five.",
-          read_file(kData + "/documents/long_paragraph.txt"),
-          "Thank you for reading. Come again soon!"};
+          read_file(kData + "/documents/long_paragraph.txt"), "Thank you for reading. Come again soon!"};
 }
 
 struct Reader final : KioskEffects {
@@ -99,7 +100,9 @@ struct Page {
     fx.piece = p;
     flow.tick(now += 0.02);
   }
-  std::string text(MessageId id, std::initializer_list<audio::MessageArg> args = {}) const { return flow.text(id, args); }
+  std::string text(MessageId id, std::initializer_list<audio::MessageArg> args = {}) const {
+    return flow.text(id, args);
+  }
 };
 
 TEST(ReadAloud, SentencesAreThePiecesTheSpeakerSays) {
@@ -148,7 +151,8 @@ TEST(ReadAloud, DescribeReadsTheParagraphUnderTheHandAndTheKeysMoveFromTheSenten
   v.key(KioskKey::Describe);
   const std::string& said = v.fx.said.back();
   // A long paragraph: its length and the keys that move through it, then the catalogue's "Text:", then the text.
-  const std::string lead = "About 10 minutes of text. Press the K key to skip a sentence, the I key a paragraph. Text:\n";
+  const std::string lead =
+      "About 10 minutes of text. Press the K key to skip a sentence, the I key a paragraph. Text:\n";
   EXPECT_EQ(said.rfind(lead, 0), 0u) << said.substr(0, 200);
   EXPECT_EQ(said.substr(lead.size()), r.text_from({1, 0}));
   EXPECT_TRUE(v.flow.reading());
@@ -165,7 +169,8 @@ TEST(ReadAloud, DescribeReadsTheParagraphUnderTheHandAndTheKeysMoveFromTheSenten
   v.key(KioskKey::PreviousSentence);
   EXPECT_EQ(v.fx.said.back(), r.text_from({1, 7}));
   v.key(KioskKey::NextParagraph);
-  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_paragraph, {{"block", "3"}, {"blocks", "3"}}) + "\n" + r.text_from({2, 0}));
+  EXPECT_EQ(v.fx.said.back(),
+            v.text(MessageId::reading_paragraph, {{"block", "3"}, {"blocks", "3"}}) + "\n" + r.text_from({2, 0}));
   v.hear(2);  // the second sentence of the last paragraph
   v.key(KioskKey::NextSentence);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_end)) << "the end of the text";
@@ -175,8 +180,9 @@ TEST(ReadAloud, DescribeReadsTheParagraphUnderTheHandAndTheKeysMoveFromTheSenten
   v.key(KioskKey::PreviousParagraph);
   v.key(KioskKey::PreviousParagraph);
   v.key(KioskKey::PreviousParagraph);
-  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_start) + " " + v.text(MessageId::reading_paragraph, {{"block", "1"}, {"blocks", "3"}}) +
-                                  "\n" + r.text_from({0, 0}));
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_start) + " " +
+                                  v.text(MessageId::reading_paragraph, {{"block", "1"}, {"blocks", "3"}}) + "\n" +
+                                  r.text_from({0, 0}));
 }
 
 TEST(ReadAloud, AfterSomethingElseIsSaidTheKeysStartAgainFromTheHand) {
@@ -190,7 +196,8 @@ TEST(ReadAloud, AfterSomethingElseIsSaidTheKeysStartAgainFromTheHand) {
   EXPECT_EQ(v.fx.said.back(), v.fx.said[v.fx.said.size() - 2]) << "Repeat says what was said last, whole";
   v.fx.page.at_hand = -1;  // the hand off the text
   v.key(KioskKey::NextSentence);
-  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_paragraph, {{"block", "1"}, {"blocks", "3"}}) + "\n" + r.text_from({0, 0}))
+  EXPECT_EQ(v.fx.said.back(),
+            v.text(MessageId::reading_paragraph, {{"block", "1"}, {"blocks", "3"}}) + "\n" + r.text_from({0, 0}))
       << "the page's first paragraph";
   EXPECT_TRUE(v.flow.reading());
 }

@@ -17,11 +17,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
+#include "pictures/image_scene.hpp"
+#include "test_paths.hpp"
 #include "vision/intake.hpp"
 #include "vision/ocr.hpp"
-#include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 
@@ -35,7 +35,8 @@ std::string large_jpeg(const fs::path& picture, double k, const fs::path& dir) {
   const cv::Mat m = cv::imread(picture.string(), cv::IMREAD_COLOR);
   cv::Mat big;
   cv::resize(m, big, cv::Size(), k, k, cv::INTER_CUBIC);
-  const fs::path out = dir / (picture.stem().string() + "_x" + std::to_string(static_cast<int>(std::lround(k * 10))) + ".jpg");
+  const fs::path out =
+      dir / (picture.stem().string() + "_x" + std::to_string(static_cast<int>(std::lround(k * 10))) + ".jpg");
   EXPECT_TRUE(cv::imwrite(out.string(), big, {cv::IMWRITE_JPEG_QUALITY, 95}));
   return out.string();
 }
@@ -62,7 +63,9 @@ double directed_hausdorff(const Polyline& from, const Polyline& to) {
   return worst;
 }
 
-double hausdorff(const Polyline& a, const Polyline& b) { return std::max(directed_hausdorff(a, b), directed_hausdorff(b, a)); }
+double hausdorff(const Polyline& a, const Polyline& b) {
+  return std::max(directed_hausdorff(a, b), directed_hausdorff(b, a));
+}
 
 /// For each curve of `a`, the symmetric Hausdorff distance to its nearest curve of `b` [m]; the largest.
 double worst_partner_distance(const std::vector<Polyline>& a, const std::vector<Polyline>& b) {
@@ -96,7 +99,8 @@ config::Settings curves_only() {
 /// the 1/2 decode and the full one (its 1/4 decode agrees within 1 px): a real difference, not yet explained.
 /// For these only the curve count is compared (within 2); the printed figures show the distances.
 bool unstable(const std::string& stem) {
-  for (const char* name : {"HappyFish", "apple", "butterfly", "camera", "coins", "fruits", "page", "sudoku", "silhouette_9"}) {
+  for (const char* name :
+       {"HappyFish", "apple", "butterfly", "camera", "coins", "fruits", "page", "sudoku", "silhouette_9"}) {
     if (stem == name) return true;
   }
   return false;
@@ -132,8 +136,9 @@ TEST_P(ReducedDecodeCurves, AreTheCurvesOfTheFullDecode) {
     EXPECT_NEAR(m_per_processed_px(reduced, s) / px, 1.0, 0.01);
     const double there = worst_partner_distance(reduced.polylines, full.polylines) / px;
     const double back = worst_partner_distance(full.polylines, reduced.polylines) / px;
-    std::printf("  %-24s 1/%d  curves %3zu / %3zu  worst partner distance %.3f / %.3f processed px\n", fs::path(path).filename().string().c_str(),
-                reduced.decode_scale, reduced.polylines.size(), full.polylines.size(), there, back);
+    std::printf("  %-24s 1/%d  curves %3zu / %3zu  worst partner distance %.3f / %.3f processed px\n",
+                fs::path(path).filename().string().c_str(), reduced.decode_scale, reduced.polylines.size(),
+                full.polylines.size(), there, back);
     if (unstable(p.stem().string())) {
       EXPECT_NEAR(static_cast<double>(reduced.polylines.size()), static_cast<double>(full.polylines.size()), 2.0);
       continue;
@@ -160,7 +165,8 @@ TEST(ReducedDecodeScene, KeepsTheDecodedPicturesPixelsAndSizes) {
   ASSERT_EQ(picture_keep_side_px(reading), 1200);
   for (const bool from_bytes : {false, true}) {
     SCOPED_TRACE(from_bytes ? "from bytes" : "from the path");
-    const ImageScene is = from_bytes ? build_image_scene_from_bytes(bytes, "fruits.jpg", reading) : build_image_scene(path, reading);
+    const ImageScene is =
+        from_bytes ? build_image_scene_from_bytes(bytes, "fruits.jpg", reading) : build_image_scene(path, reading);
     EXPECT_EQ(is.decode_scale, 2);  // 2048 >= 1200 > 1024
     EXPECT_EQ(is.picture.size(), cv::Size(2048, 1920));
     EXPECT_EQ(is.picture.type(), CV_8UC3);
@@ -198,7 +204,8 @@ bool blocks_inside(const ImageScene& is) {
 
 /// The distance between the boxes of two readings' first blocks, corner to corner, the larger [m].
 double first_block_offset_m(const ImageScene& a, const ImageScene& b) {
-  return std::max(distance(a.text_blocks[0].lo_m, b.text_blocks[0].lo_m), distance(a.text_blocks[0].hi_m, b.text_blocks[0].hi_m));
+  return std::max(distance(a.text_blocks[0].lo_m, b.text_blocks[0].lo_m),
+                  distance(a.text_blocks[0].hi_m, b.text_blocks[0].hi_m));
 }
 
 TEST(ReducedDecodeScene, AReducedPageOfTextIsStillReadAtFullDetail) {

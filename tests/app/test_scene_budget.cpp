@@ -49,7 +49,8 @@ double salience(const Polyline& p, double strength, double canny_high) {
 std::vector<std::size_t> find_all(const std::vector<Polyline>& of, const std::vector<Polyline>& in) {
   std::vector<std::size_t> out;
   for (const Polyline& p : of) {
-    const auto it = std::find_if(in.begin(), in.end(), [&](const Polyline& q) { return q.points_m == p.points_m && q.closed == p.closed; });
+    const auto it = std::find_if(in.begin(), in.end(),
+                                 [&](const Polyline& q) { return q.points_m == p.points_m && q.closed == p.closed; });
     out.push_back(it == in.end() ? std::string::npos : static_cast<std::size_t>(it - in.begin()));
   }
   return out;
@@ -73,7 +74,9 @@ TEST(SceneBudget, ClutteredPhotoStaysWithinBudgetKeepingTheMostSalientCurves) {
     EXPECT_EQ(small.segments_after_budget, small.scene->total_segments(0));
     EXPECT_GT(small.chains_over_budget, 0u);
     EXPECT_EQ(small.chains_over_budget + small.polylines.size(), full.polylines.size());
-    EXPECT_EQ(small.chains_after_gaps, small.chains_too_short + small.chains_along_border + small.chains_over_max_shapes + small.chains_over_budget + small.polylines.size());
+    EXPECT_EQ(small.chains_after_gaps, small.chains_too_short + small.chains_along_border +
+                                           small.chains_over_max_shapes + small.chains_over_budget +
+                                           small.polylines.size());
     // Kept curves are full's curves, with full's strengths.
     const std::vector<std::size_t> where = find_all(small.polylines, full.polylines);
     for (std::size_t i = 0; i < where.size(); ++i) {
@@ -109,8 +112,9 @@ TEST(SceneBudget, AStrongEdgeBeatsALongerFaintOne) {
   // lower down a wavy, hence longer, step that is strong only at its left end (contrast 40, enough
   // to seed Canny's hysteresis) and faint (12) for the rest. A budget that fits only one of them
   // must keep the strong one, although "longest first" would keep the faint one.
-  const fs::path path = fs::temp_directory_path() /
-                        ("hk_budget_faint_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
+  const fs::path path =
+      fs::temp_directory_path() /
+      ("hk_budget_faint_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
   cv::Mat img(500, 1200, CV_8UC1);
   for (int v = 0; v < img.rows; ++v) {
     for (int u = 0; u < img.cols; ++u) {
@@ -126,12 +130,13 @@ TEST(SceneBudget, AStrongEdgeBeatsALongerFaintOne) {
   s.vision.canny_high = 60;  // the strong edge (~250 units) is sure, the faint one (~25) is only linked
   s.vision.canny_low = 15;
   s.vision.max_segments = 1000000;
-  s.vision.max_shapes = 1000;  // the segment budget alone
+  s.vision.max_shapes = 1000;   // the segment budget alone
   s.vision.detector = "canny";  // the faint step is under the two-tone spread: "auto" would trace only the strong one
   const ImageScene full = build_image_scene(path.string(), s);
   // Which curve is which: the strong one lies on v = 150 (y of pixel row 149.5).
   const auto is_strong = [&](const Polyline& p) {
-    return std::all_of(p.points_m.begin(), p.points_m.end(), [&](const Vec2& q) { return std::abs(full.px_to_m.v_px(q.y) - 149.5) < 2; });
+    return std::all_of(p.points_m.begin(), p.points_m.end(),
+                       [&](const Vec2& q) { return std::abs(full.px_to_m.v_px(q.y) - 149.5) < 2; });
   };
   std::size_t strong = std::string::npos, faint = std::string::npos;
   for (std::size_t i = 0; i < full.polylines.size(); ++i) {
@@ -152,9 +157,10 @@ TEST(SceneBudget, AStrongEdgeBeatsALongerFaintOne) {
     if (full.scene->source_index(c) == strong) n_strong = full.scene->curve(c).segment_count[0];
     if (full.scene->source_index(c) == faint) n_faint = full.scene->curve(c).segment_count[0];
   }
-  std::printf("  strong: %.1f mm, strength %.0f, %zu segments; faint: %.1f mm, strength %.0f, %zu segments (canny_high %.0f)\n",
-              length_m(full.polylines[strong]) * 1000, full.strength[strong], n_strong, length_m(full.polylines[faint]) * 1000,
-              full.strength[faint], n_faint, full.canny_high);
+  std::printf(
+      "  strong: %.1f mm, strength %.0f, %zu segments; faint: %.1f mm, strength %.0f, %zu segments (canny_high %.0f)\n",
+      length_m(full.polylines[strong]) * 1000, full.strength[strong], n_strong, length_m(full.polylines[faint]) * 1000,
+      full.strength[faint], n_faint, full.canny_high);
   s.vision.max_segments = static_cast<int>(std::max(n_strong, n_faint));
   s.vision.max_shapes = 1000;  // the segment budget alone
   ASSERT_LT(static_cast<std::size_t>(s.vision.max_segments), n_strong + n_faint) << "the budget must fit only one";
@@ -190,8 +196,8 @@ TEST(SceneBudget, KeptCurvesOfARealPhotoAreStrongerAndLongerThanTheDropped) {
   ASSERT_GT(kept_n, 0u);
   ASSERT_GT(dropped_n, 0u);
   EXPECT_GE(kept_sum / kept_n, dropped_sum / dropped_n) << "mean strength x length of the kept curves";
-  std::printf("  fruits.jpg, budget 1500: %zu kept, mean strength x length %.3g; %zu dropped, %.3g\n", kept_n, kept_sum / kept_n, dropped_n,
-              dropped_sum / dropped_n);
+  std::printf("  fruits.jpg, budget 1500: %zu kept, mean strength x length %.3g; %zu dropped, %.3g\n", kept_n,
+              kept_sum / kept_n, dropped_n, dropped_sum / dropped_n);
 }
 
 TEST(SceneBudget, DefaultBudgetKeepsEveryCurveOfASimplePicture) {
@@ -201,8 +207,8 @@ TEST(SceneBudget, DefaultBudgetKeepsEveryCurveOfASimplePicture) {
 }
 
 TEST(SceneBudget, SalienceRule) {
-  EXPECT_DOUBLE_EQ(curve_salience(0.05, 300, 100), 0.05);     // sure edges: length alone
-  EXPECT_DOUBLE_EQ(curve_salience(0.05, 50, 100), 0.025);     // half as strong as sure: half the weight
+  EXPECT_DOUBLE_EQ(curve_salience(0.05, 300, 100), 0.05);  // sure edges: length alone
+  EXPECT_DOUBLE_EQ(curve_salience(0.05, 50, 100), 0.025);  // half as strong as sure: half the weight
   EXPECT_DOUBLE_EQ(curve_salience(0.05, -1, 100), 0.0);
   EXPECT_DOUBLE_EQ(curve_salience(0.05, 50, 0), 0.0);
   EXPECT_DOUBLE_EQ(curve_salience(0.05, NAN, 100), 0.0);

@@ -10,20 +10,20 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <future>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "hk/error.hpp"
-#include "visit/kiosk_flow.hpp"
-#include "visit/kiosk_runtime.hpp"
 #include "pictures/scene_builder.hpp"
 #include "pictures/scene_cache.hpp"
 #include "show_now.hpp"
 #include "test_paths.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
 #include "wait_until.hpp"
 
 namespace fs = std::filesystem;
@@ -64,9 +64,9 @@ TEST(SceneBuilder, ANewerWantReplacesAWaitingOneAndTheRunningOneFinishes) {
   Gate first;
   std::atomic<int> runs{0};
   b.want(1, 1, first.job(1));
-  first.has_started.wait();           // 1 runs
-  b.want(2, 1, marked(2, &runs));     // waits...
-  b.want(3, 1, marked(3, &runs));     // ...and is replaced
+  first.has_started.wait();        // 1 runs
+  b.want(2, 1, marked(2, &runs));  // waits...
+  b.want(3, 1, marked(3, &runs));  // ...and is replaced
   first.open.set_value();
   ASSERT_TRUE(b.wait_want(60.0));
   std::vector<BuiltScene> done = b.poll();
@@ -106,8 +106,8 @@ TEST(SceneBuilder, WantsGoBeforeBuildsAheadAndAnotherGenerationIsAnotherScene) {
   hold.has_started.wait();
   b.ahead(1, 1, marked(1, &runs));
   b.ahead(2, 1, marked(2, &runs));
-  b.ahead(3, 1, marked(3, &runs));  // kMaxAhead waiting: the oldest (1) is dropped
-  b.ahead(2, 1, marked(22, &runs)); // already waiting: not queued twice
+  b.ahead(3, 1, marked(3, &runs));   // kMaxAhead waiting: the oldest (1) is dropped
+  b.ahead(2, 1, marked(22, &runs));  // already waiting: not queued twice
   EXPECT_TRUE(b.has(2, 1));
   EXPECT_FALSE(b.has(2, 2)) << "another generation (other settings) is another scene";
   EXPECT_FALSE(b.has(1, 1)) << "dropped for a newer one";
@@ -117,7 +117,9 @@ TEST(SceneBuilder, WantsGoBeforeBuildsAheadAndAnotherGenerationIsAnotherScene) {
   std::vector<int> order;
   // The two ahead finish after the want: polled until all four came or nothing more is being built.
   EXPECT_TRUE(hk::test::wait_until([&] { return order.size() >= 4 || (!b.has(2, 1) && !b.has(3, 1)); },
-                                   [&] { for (const BuiltScene& d : b.poll()) order.push_back(d.scene->page); }));
+                                   [&] {
+                                     for (const BuiltScene& d : b.poll()) order.push_back(d.scene->page);
+                                   }));
   for (const BuiltScene& d : b.poll()) order.push_back(d.scene->page);
   ASSERT_EQ(order.size(), 4u);
   EXPECT_EQ(order[0], 9);
@@ -140,7 +142,7 @@ TEST(FitPicture, AScreensWorthOfPixelsCoveringTheSameWorkspaceRectangle) {
   ImageScene is;
   is.picture = cv::Mat(2000, 4000, CV_8UC3, cv::Scalar(10, 20, 30));
   is.picture(cv::Rect(0, 0, 2000, 2000)).setTo(cv::Scalar(200, 200, 200));  // left half light
-  is.px_to_m = {0.1 / 4000, -0.05, 0.025};  // 10 cm wide, centred
+  is.px_to_m = {0.1 / 4000, -0.05, 0.025};                                  // 10 cm wide, centred
   const vision::PxToM before = is.px_to_m;
   fit_picture(is, 1920);
   EXPECT_EQ(is.picture.cols, 1920);
@@ -171,11 +173,13 @@ struct LibraryRig {
   config::Settings settings;
 
   /// A library of `files` (names in tests/data/images, copied as 0_name, 1_name, ... to keep their order).
-  LibraryRig(const std::vector<std::string>& files, int prefetch_mb, const std::string& tag, const std::string& cache_dir = "") {
+  LibraryRig(const std::vector<std::string>& files, int prefetch_mb, const std::string& tag,
+             const std::string& cache_dir = "") {
     lib = fs::temp_directory_path() / ("hk_builder_" + tag + "_" + std::to_string(::getpid()));
     fs::remove_all(lib);
     fs::create_directories(lib);
-    for (std::size_t i = 0; i < files.size(); ++i) fs::copy_file(kData / "images" / files[i], lib / (std::to_string(i) + "_" + files[i]));
+    for (std::size_t i = 0; i < files.size(); ++i)
+      fs::copy_file(kData / "images" / files[i], lib / (std::to_string(i) + "_" + files[i]));
     RuntimeOptions ro;
     ro.scene_cache_dir = cache_dir;
     ro.library = lib.string();
@@ -195,9 +199,7 @@ struct LibraryRig {
     fs::remove_all(lib);
   }
   /// Frames until nothing asked for is pending (at most 60 s of waiting in all).
-  void settle(double now_s) {
-    ASSERT_TRUE(rt->finish_picture(flow.get(), now_s));
-  }
+  void settle(double now_s) { ASSERT_TRUE(rt->finish_picture(flow.get(), now_s)); }
   /// A folder holding the shipped spec PDF (tests/data/documents), to insert as a stick; the test removes it.
   fs::path spec_stick(const std::string& tag) const {
     const fs::path stick = lib.parent_path() / ("hk_builder_" + tag + "_" + std::to_string(::getpid()));
@@ -208,10 +210,11 @@ struct LibraryRig {
   }
   /// Polls the stick service every 10 ms until scene `id` is shown (or 60 s pass), advancing `now_s`.
   bool stick_shows(int id, double& now_s) {
-    return hk::test::wait_until([&] { return rt->shown_id() == id; }, [&] {
-      rt->poll_sticks(*flow, now_s);
-      now_s += 0.01;
-    });
+    return hk::test::wait_until([&] { return rt->shown_id() == id; },
+                                [&] {
+                                  rt->poll_sticks(*flow, now_s);
+                                  now_s += 0.01;
+                                });
   }
   /// Polls until the pictures built ahead are `want` (or 60 s pass).
   bool ahead_becomes(std::vector<int> want) {
@@ -227,7 +230,8 @@ struct LibraryRig {
 };
 
 TEST(KioskBuilds, ThreeQuickNextPressesBuildAtMostTwoScenesAndLandOnTheThird) {
-  LibraryRig r({"horse.png", "coins.png", "apple.jpg", "fruits.jpg", "butterfly.jpg"}, 0, "next3");  // nothing built ahead
+  LibraryRig r({"horse.png", "coins.png", "apple.jpg", "fruits.jpg", "butterfly.jpg"}, 0,
+               "next3");              // nothing built ahead
   r.flow->key(KioskKey::Other, 0.0);  // wake: the tutorial
   for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.0);
   r.settle(0.0);  // picture 1 of the library
@@ -310,7 +314,8 @@ TEST(KioskBuilds, ACorruptCacheEntryIsRebuiltAndAnUnwritableCacheCostsOnlyTheCac
     const fs::path horse = r.lib / "0_horse.png";
     std::ifstream in(horse, std::ios::binary);
     const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    EXPECT_TRUE(SceneCache(cache.string()).load(SceneCache::key(bytes, r.settings), r.settings)) << "and kept again, whole";
+    EXPECT_TRUE(SceneCache(cache.string()).load(SceneCache::key(bytes, r.settings), r.settings))
+        << "and kept again, whole";
   }
   fs::remove_all(cache);
   {  // the cache's folder cannot be made (a file stands where it should be): the pictures are felt all the same
@@ -335,12 +340,14 @@ TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibr
   ASSERT_TRUE(r.stick_shows(1001, now_s)) << "the stick's first page is felt";
   r.flow->key(KioskKey::Next, now_s);  // page 2 asked for...
   r.rt->remove_stick_folder();         // ...and the stick pulled out while it is drawn
-  ASSERT_TRUE(hk::test::wait_until([&] { return !r.rt->stick_busy() && !r.rt->picture_busy(); }, [&] {
-    r.rt->poll_sticks(*r.flow, now_s);
-    r.rt->poll_pictures(r.flow.get(), now_s);
-    now_s += 0.01;
-  }));
-  for (int i = 0; i < 50; ++i, now_s += 0.01) r.rt->poll_sticks(*r.flow, now_s);  // page 2's drawing, if it ends now, is dropped
+  ASSERT_TRUE(hk::test::wait_until([&] { return !r.rt->stick_busy() && !r.rt->picture_busy(); },
+                                   [&] {
+                                     r.rt->poll_sticks(*r.flow, now_s);
+                                     r.rt->poll_pictures(r.flow.get(), now_s);
+                                     now_s += 0.01;
+                                   }));
+  for (int i = 0; i < 50; ++i, now_s += 0.01)
+    r.rt->poll_sticks(*r.flow, now_s);  // page 2's drawing, if it ends now, is dropped
   EXPECT_EQ(r.rt->shown_id(), 0) << "back on the library's picture, never page 2";
   EXPECT_EQ(r.flow->failures(), 0);
   fs::remove_all(stick);
@@ -389,10 +396,11 @@ TEST(KioskBuilds, WhatAStickCouldNotGiveIsListedForTheOperator) {
   EXPECT_TRUE(r.rt->stick_problems().empty());
   r.rt->insert_stick_folder(stick.string());
   double now_s = 1.0;
-  EXPECT_TRUE(hk::test::wait_until([&] { return r.rt->stick_problems().size() >= 2; }, [&] {
-    r.rt->poll_sticks(*r.flow, now_s);
-    now_s += 0.01;
-  }));
+  EXPECT_TRUE(hk::test::wait_until([&] { return r.rt->stick_problems().size() >= 2; },
+                                   [&] {
+                                     r.rt->poll_sticks(*r.flow, now_s);
+                                     now_s += 0.01;
+                                   }));
   const std::vector<std::string>& problems = r.rt->stick_problems();
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_EQ(problems[0].rfind("'bad_crc.png': ", 0), 0u) << problems[0];
@@ -417,7 +425,8 @@ TEST(KioskBuilds, StickPagesPassedByQuicklyAreNeverPutOnTheDevice) {
   for (int i = 0; i < 2; ++i) r.flow->key(KioskKey::Next, now_s);  // ...then pages 3 and 4 before it is done
   ASSERT_TRUE(r.stick_shows(1004, now_s));
   for (int i = 0; i < 50; ++i, now_s += 0.01) r.rt->poll_sticks(*r.flow, now_s);
-  EXPECT_EQ(r.rt->scenes_published() - published, 1u) << "page 2, drawn before Next was pressed again, was dropped, not shown";
+  EXPECT_EQ(r.rt->scenes_published() - published, 1u)
+      << "page 2, drawn before Next was pressed again, was dropped, not shown";
   EXPECT_EQ(r.rt->shown_id(), 1004);
   EXPECT_EQ(r.rt->last_said().rfind("Page 4 of ", 0), 0u) << r.rt->last_said();
   EXPECT_EQ(r.flow->failures(), 0);
@@ -442,7 +451,8 @@ TEST(KioskBuilds, APictureThatCannotBeReadIsSaidAndTheOldOneStays) {
   EXPECT_EQ(r.rt->shown().scene, before);
   EXPECT_EQ(r.rt->last_said().rfind("Picture 2 of 3 cannot be read. ", 0), 0u) << r.rt->last_said();
   EXPECT_EQ(r.rt->last_said().find("1_coins.png"), std::string::npos) << "the picture's number names it, not its path";
-  EXPECT_EQ(r.rt->last_said().find("PNG"), std::string::npos) << "what is wrong with it is the operator's to read (the log), not the visitor's";
+  EXPECT_EQ(r.rt->last_said().find("PNG"), std::string::npos)
+      << "what is wrong with it is the operator's to read (the log), not the visitor's";
   r.flow->key(KioskKey::Next, 2.0);  // steps past it
   r.settle(2.0);
   EXPECT_EQ(r.rt->shown_id(), 2);

@@ -1,5 +1,5 @@
-// The scene cache (app/pictures/include/pictures/scene_cache.hpp) on real scenes: a stored scene loads back equal in every kept
-// field with the same collision trees; keys follow the picture's bytes and exactly the settings that shape a
+// The scene cache (app/pictures/include/pictures/scene_cache.hpp) on real scenes: a stored scene loads back equal in
+// every kept field with the same collision trees; keys follow the picture's bytes and exactly the settings that shape a
 // scene; corrupt, stale and hostile entries are refused and removed without a crash; a folder that cannot be
 // written costs the store only; the size cap removes the least recently used entry; "off" touches nothing.
 #include <gtest/gtest.h>
@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include <csignal>
 #include <sodium.h>
 #include <sys/resource.h>
 #include <unistd.h>
+#include <csignal>
 
 #include <opencv2/core.hpp>
 
@@ -207,7 +207,8 @@ class SceneCacheTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    root_ = fs::temp_directory_path() / ("hk_scene_cache_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    root_ =
+        fs::temp_directory_path() / ("hk_scene_cache_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
     fs::remove_all(root_);
     fs::create_directories(root_);
     dir_ = (root_ / "cache" / "scenes").string();
@@ -228,7 +229,8 @@ class SceneCacheTest : public ::testing::Test {
   static std::vector<std::string> files_in(const std::string& dir) {
     std::vector<std::string> out;
     std::error_code ec;
-    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) out.push_back(it->path().filename().string());
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+      out.push_back(it->path().filename().string());
     std::sort(out.begin(), out.end());
     return out;
   }
@@ -242,7 +244,8 @@ TEST_F(SceneCacheTest, StoredSceneLoadsBackEqualInEveryKeptField) {
   const std::string key = key_of("");
   ASSERT_TRUE(cache.store(key, horse()));
   EXPECT_EQ(files_in(dir_), std::vector<std::string>{key + ".scene"});
-  EXPECT_EQ(fs::status(dir_).permissions() & fs::perms::all, fs::perms::owner_all) << "the folder is created with mode 0700";
+  EXPECT_EQ(fs::status(dir_).permissions() & fs::perms::all, fs::perms::owner_all)
+      << "the folder is created with mode 0700";
   const std::optional<ImageScene> back = cache.load(key, s_);
   ASSERT_TRUE(back);
   ASSERT_GT(horse().polylines.size(), 0u);
@@ -285,7 +288,8 @@ TEST_F(SceneCacheTest, KeyFollowsTheBytesAndTheSettingsThatShapeAScene) {
 
   const std::vector<const config::FieldDescriptor*> shaping = scene_shaping_fields();
   auto shapes = [&](std::string_view table, std::string_view key) {
-    return std::any_of(shaping.begin(), shaping.end(), [&](const auto* d) { return d->table == table && d->key == key; });
+    return std::any_of(shaping.begin(), shaping.end(),
+                       [&](const auto* d) { return d->table == table && d->key == key; });
   };
   EXPECT_TRUE(shapes("vision", "max_shapes"));
   EXPECT_TRUE(shapes("vision", "ocr"));
@@ -303,7 +307,8 @@ TEST_F(SceneCacheTest, KeyFollowsTheBytesAndTheSettingsThatShapeAScene) {
         [&d](auto* p) {
           using T = std::remove_pointer_t<decltype(p)>;
           if constexpr (std::is_same_v<T, std::string>) {
-            const auto other_choice = std::find_if(d.choices.begin(), d.choices.end(), [p](std::string_view c) { return c != *p; });
+            const auto other_choice =
+                std::find_if(d.choices.begin(), d.choices.end(), [p](std::string_view c) { return c != *p; });
             *p = other_choice != d.choices.end() ? std::string(*other_choice) : *p + "x";
           } else {
             const T lo = static_cast<T>(d.min), hi = static_cast<T>(d.max);
@@ -340,7 +345,8 @@ class Corruption : public SceneCacheTest {
   static std::vector<std::uint8_t> framed(const std::vector<std::uint8_t>& payload, std::uint32_t version) {
     std::vector<std::uint8_t> out = {'H', 'K', 'S', 'C', 'E', 'N', 'E', '\0'};
     for (int i = 0; i < 4; ++i) out.push_back(static_cast<std::uint8_t>(version >> (8 * i)));
-    for (int i = 0; i < 8; ++i) out.push_back(static_cast<std::uint8_t>(static_cast<std::uint64_t>(payload.size()) >> (8 * i)));
+    for (int i = 0; i < 8; ++i)
+      out.push_back(static_cast<std::uint8_t>(static_cast<std::uint64_t>(payload.size()) >> (8 * i)));
     crypto_generichash_state st;
     crypto_generichash_init(&st, nullptr, 0, 32);
     crypto_generichash_update(&st, out.data(), out.size());
@@ -403,7 +409,8 @@ TEST_F(SceneCacheTest, ReadOnlyFolderCostsTheStoreOnly) {
   EXPECT_FALSE(stored);
   EXPECT_FALSE(hk::test::without_file_override([&] { return cache.store(key_of("third"), horse()); }))
       << "and again (logged once)";
-  EXPECT_TRUE(hk::test::without_file_override([&] { return cache.load(key, s_); })) << "entries already there still load";
+  EXPECT_TRUE(hk::test::without_file_override([&] { return cache.load(key, s_); }))
+      << "entries already there still load";
   EXPECT_EQ(files_in(dir_), std::vector<std::string>{key + ".scene"});
 }
 

@@ -11,9 +11,9 @@
 
 #include "haptics/hand_path.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "runtime/servo_step.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_step.hpp"
 #include "runtime/simulation.hpp"
 
 namespace hk::app {
@@ -109,7 +109,8 @@ TEST(ServoStep, TheOldPictureFadesOnlyAsLongAsItsForceNeeds) {
   }
   // The force at the publish and at the swap's first tick differ by what the hand's motion does meanwhile.
   EXPECT_NEAR(static_cast<double>(ticks), static_cast<double>(expected), 0.1 * static_cast<double>(expected) + 2.0);
-  EXPECT_LT(ticks, static_cast<long>(pressing.sp.guard.ramp_s / pressing.sp.period_s)) << "less than the whole ramp for less than the clamp";
+  EXPECT_LT(ticks, static_cast<long>(pressing.sp.guard.ramp_s / pressing.sp.period_s))
+      << "less than the whole ramp for less than the clamp";
 }
 
 TEST(ServoStep, NewPictureStartsWithTheProxyAtTheHandle) {

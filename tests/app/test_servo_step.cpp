@@ -8,26 +8,26 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <thread>
 #include <cstdlib>
 #include <memory>
 #include <new>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include "curves.hpp"
-#include "runtime/device_setup.hpp"
-#include "runtime/guided_tour.hpp"
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/io/haply_device.hpp"
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/pty_emulator.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "runtime/servo_step.hpp"
-#include "runtime/servo_runner.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/device_setup.hpp"
+#include "runtime/guided_tour.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_runner.hpp"
+#include "runtime/servo_step.hpp"
 #include "runtime/simulation.hpp"
 
 // ── Counting allocation ───────────────────────────────────────────────────────────────────────────
@@ -108,11 +108,15 @@ struct Rig {
   audio::SpscRing<audio::CueEvent> cues{1024};
   ServoStep core;
   Vec2 target{0.0, 0.0};
-  std::vector<DeviceSample> samples;   // what step() was given
-  std::vector<Vec2> commands;          // what it asked for
+  std::vector<DeviceSample> samples;  // what step() was given
+  std::vector<Vec2> commands;         // what it asked for
 
   explicit Rig(config::Settings settings = {})
-      : s(std::move(settings)), sp(servo_params_from(s)), device(sim_params_from(s), {-0.03, 0.0}), hand(hand_params_from(s)), core(CueTrackerParams{}, &cues) {
+      : s(std::move(settings)),
+        sp(servo_params_from(s)),
+        device(sim_params_from(s), {-0.03, 0.0}),
+        hand(hand_params_from(s)),
+        core(CueTrackerParams{}, &cues) {
     device.open();
   }
   ServoRunner runner{core, device};
@@ -176,7 +180,7 @@ TEST_P(ServoStepModes, NothingIsAllocatedOrFreedInTheStep) {
   g.stiffness_n_per_m *= 2.0;
   g.static_friction = 0.1;
   g.dynamic_friction = 0.05;
-  r.core.set_gains(g);  // the caller's side
+  r.core.set_gains(g);                       // the caller's side
   r.target = {grooves ? -0.02 : 0.0, 0.01};  // slide along the wall
   r.run(0.5, true);
   EXPECT_EQ(r.core.display().stiffness_n_per_m, 2.0 * r.s.haptics.stiffness_n_per_m);
@@ -197,10 +201,13 @@ TEST_P(ServoStepModes, NothingIsAllocatedOrFreedInTheStep) {
 }
 
 INSTANTIATE_TEST_SUITE_P(LevelAndRenderModes, ServoStepModes,
-                         ::testing::Values(StepMode{"auto", "walls", 2}, StepMode{"tolerance", "walls", kToleranceLevelBase + 1},
+                         ::testing::Values(StepMode{"auto", "walls", 2},
+                                           StepMode{"tolerance", "walls", kToleranceLevelBase + 1},
                                            StepMode{"cut", "walls", kCutLevelBase + 1}, StepMode{"auto", "grooves", 2},
                                            StepMode{"cut", "grooves", kCutLevelBase + 1}),
-                         [](const ::testing::TestParamInfo<StepMode>& i) { return std::string(i.param.level_mode) + "_" + i.param.render; });
+                         [](const ::testing::TestParamInfo<StepMode>& i) {
+                           return std::string(i.param.level_mode) + "_" + i.param.render;
+                         });
 
 class ServoStepTourModes : public ::testing::TestWithParam<const char*> {};
 
@@ -251,8 +258,8 @@ INSTANTIATE_TEST_SUITE_P(LevelModes, ServoStepTourModes, ::testing::Values("auto
 // ── Tripwires over a whole run on the emulated board ─────────────────────────────────────────────
 /// Set on the servo's thread from the device's read to its write: inside ServoRunner::tick.
 thread_local bool g_in_tick = false;
-std::atomic<long> g_waits{0};       // transport calls inside a tick that could wait (timeout_us > 0)
-std::atomic<long> g_tick_io{0};     // transport calls inside a tick (the tripwire is on the path)
+std::atomic<long> g_waits{0};    // transport calls inside a tick that could wait (timeout_us > 0)
+std::atomic<long> g_tick_io{0};  // transport calls inside a tick (the tripwire is on the path)
 
 /// The tty transport, recording every call made inside a tick that is allowed to wait.
 class WaitRecordingTransport final : public io::ByteTransport {
@@ -315,7 +322,7 @@ TEST(ServoStep, AWholeRunOnTheEmulatedBoardNeitherAllocatesNorWaitsInATick) {
   const io::HaplyDeviceParams dp = haply_params_from(s);
   const double scale = io::workspace_scale(dp);
   const Vec2 centre = dp.rect_center_device_m;
-  std::atomic<bool> relaxed{false};  // the hand lets the tour lead
+  std::atomic<bool> relaxed{false};   // the hand lets the tour lead
   std::atomic<bool> pressing{false};  // the hand pushes into the square's middle, through its wall
   const ModelHandParams hp = hand_params_from(s);
   hapi::HandForce hand = [&](double t_s, Vec2 handle_device_m, Vec2 velocity_device_m_per_s) {
@@ -465,7 +472,7 @@ TEST(ServoStep, AReturningDeviceGetsItsForceBackThroughTheRamp) {
     return cmd.force_n;
   };
   for (int i = 0; i <= 100; ++i) step({-0.03 + 0.011 * i / 100.0, 0.0}, DeviceStatus::Ok);  // to 1 mm inside
-  for (int i = 0; i < 600; ++i) step({-0.019, 0.0}, DeviceStatus::Ok);                       // past the ramp
+  for (int i = 0; i < 600; ++i) step({-0.019, 0.0}, DeviceStatus::Ok);                      // past the ramp
   const Vec2 pressing = step({-0.019, 0.0}, DeviceStatus::Ok);
   ASSERT_GT(length(pressing), 0.7) << "800 N/m × 1 mm";
   ASSERT_EQ(core.display().device_status, DeviceStatus::Ok);

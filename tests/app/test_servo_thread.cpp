@@ -9,9 +9,9 @@
 
 #include "haptics/sim_pantograph.hpp"
 #include "hk/error.hpp"
-#include "runtime/servo_thread.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_thread.hpp"
 #include "runtime/simulation.hpp"
 
 namespace hk::app {

@@ -16,17 +16,17 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
+#include "pictures/image_scene.hpp"
 
 namespace hk::app {
 namespace {
 
 namespace fs = std::filesystem;
 using test::fresh_dir;
+using test::test_images;
 using vision::curve_salience;
 using vision::shape_salience;
-using test::test_images;
 
 /// Σ strength × length over the curves of a scene [threshold units · m].
 double strength_length(const ImageScene& is, const std::vector<std::size_t>& which) {
@@ -54,7 +54,8 @@ TEST(ShapeSalience, AClosedOutlineCountsItsAreaAndAnOpenCurveItsLength) {
   EXPECT_NEAR(shape_salience({4 * a, 100, true, a * a}, 100), 6 * a, 1e-12);
   EXPECT_NEAR(shape_salience({4 * a, 100, false, 0}, 100), 4 * a, 1e-12);
   EXPECT_NEAR(shape_salience({4 * a, 50, true, a * a}, 100), 3 * a, 1e-12);
-  EXPECT_NEAR(shape_salience({4 * a, 300, true, a * a}, 100), 18 * a, 1e-12) << "not clipped: a stronger edge counts more";
+  EXPECT_NEAR(shape_salience({4 * a, 300, true, a * a}, 100), 18 * a, 1e-12)
+      << "not clipped: a stronger edge counts more";
   EXPECT_EQ(shape_salience({4 * a, -5, true, a * a}, 100), 0.0);
   EXPECT_EQ(shape_salience({4 * a, 100, true, -1}, 100), 0.0);
   EXPECT_EQ(shape_salience({4 * a, 100, true, a * a}, 0), 0.0);
@@ -70,7 +71,7 @@ TEST(ShapeBudget, AFrameLineIsNoShapeAndTheMostSalientAreKept) {
   const fs::path dir = fresh_dir("shape_budget");
   const fs::path file = dir / "frame_and_shapes.png";
   cv::Mat img(450, 700, CV_8UC1, cv::Scalar(230));  // 0.2 mm per pixel: the border band is 5 px
-  img(cv::Rect(2, 2, 696, 446)).setTo(30);           // a frame line 3 px wide, 2 px in
+  img(cv::Rect(2, 2, 696, 446)).setTo(30);          // a frame line 3 px wide, 2 px in
   img(cv::Rect(5, 5, 690, 440)).setTo(230);
   cv::circle(img, {200, 220}, 120, cv::Scalar(40), cv::FILLED);
   cv::circle(img, {480, 150}, 40, cv::Scalar(40), cv::FILLED);
@@ -132,17 +133,19 @@ TEST(ShapeBudget, EveryPictureStaysWithinItAndKeepsAsMuchStrengthTimesLengthAsTh
     config::Settings ranked = defaults;
     const ImageScene with_defaults = build_image_scene(file.string(), defaults);
     EXPECT_LE(with_defaults.polylines.size(), max_shapes);
-    if (with_defaults.detector == vision::Detector::Surround) unlimited.vision.detector = ranked.vision.detector = "canny";
+    if (with_defaults.detector == vision::Detector::Surround)
+      unlimited.vision.detector = ranked.vision.detector = "canny";
     const ImageScene new_all = build_image_scene(file.string(), unlimited);
     const ImageScene kept = build_image_scene(file.string(), ranked);
     EXPECT_LE(kept.polylines.size(), max_shapes);
     EXPECT_EQ(kept.polylines.size(), std::min(max_shapes, new_all.polylines.size()));
     const double new_share = strength_length(kept, all_of(kept)) / strength_length(old_all, all_of(old_all));
-    std::printf("  %-18s shapes %3zu -> %3zu, share of strength x length kept: old %.3f, new %.3f\n", file.filename().string().c_str(),
-                old_all.polylines.size(), kept.polylines.size(), old_share, new_share);
-    // Photographs and line drawings (what auto sends to an edge detector): the strengths compare. A traced outline's points lie on the
-    // boundary pixels, half a pixel off the gradient's ridge, so its strength reads lower; every curve of
-    // those pictures is kept anyway (fewer than max_shapes).
+    std::printf("  %-18s shapes %3zu -> %3zu, share of strength x length kept: old %.3f, new %.3f\n",
+                file.filename().string().c_str(), old_all.polylines.size(), kept.polylines.size(), old_share,
+                new_share);
+    // Photographs and line drawings (what auto sends to an edge detector): the strengths compare. A traced outline's
+    // points lie on the boundary pixels, half a pixel off the gradient's ridge, so its strength reads lower; every
+    // curve of those pictures is kept anyway (fewer than max_shapes).
     if (kept.detector != vision::Detector::Outline) {
       EXPECT_GE(new_share, old_share - 1e-9);
     }

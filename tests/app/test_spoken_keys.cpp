@@ -14,8 +14,8 @@
 #include "config/keys.hpp"
 #include "config/load.hpp"
 #include "config/settings.hpp"
-#include "visit/kiosk_flow.hpp"
 #include "test_paths.hpp"
+#include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
 namespace {
@@ -162,8 +162,8 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
       expect_no_stale_key_words(brief);
       std::string help_form = en.key_name(s.keys.help);  // it starts a sentence
       help_form[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(help_form[0])));
-      EXPECT_NE(brief.find("Press " + en.key_name(s.keys.next) + " to go on, " + en.key_name(s.keys.where) + " for what is here. " + help_form +
-                           " again gives every key."),
+      EXPECT_NE(brief.find("Press " + en.key_name(s.keys.next) + " to go on, " + en.key_name(s.keys.where) +
+                           " for what is here. " + help_form + " again gives every key."),
                 std::string::npos)
           << brief;
       const std::string help = whole_help(flow, fx, 1.5);
@@ -172,15 +172,18 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
       const std::string phrase = std::string(action.help_before) + form + std::string(action.help_after);
       EXPECT_NE(help.find(phrase), std::string::npos) << "wanted \"" << phrase << "\" in: " << help;
       for (const Action& other : kActions) {  // and every other action with its own key
-        const std::string o = std::string(other.help_before) + en.key_name(s.keys.*other.field) + std::string(other.help_after);
+        const std::string o =
+            std::string(other.help_before) + en.key_name(s.keys.*other.field) + std::string(other.help_after);
         EXPECT_NE(help.find(o), std::string::npos) << "wanted \"" << o << "\" in: " << help;
       }
 
       // The tutorial says how to go on, with the keys that go on.
       flow.key(KioskKey::Next, 2.0);
-      EXPECT_NE(fx.caption().find("Press " + en.key_name(s.keys.next) + " for the next shape."), std::string::npos) << fx.caption();
+      EXPECT_NE(fx.caption().find("Press " + en.key_name(s.keys.next) + " for the next shape."), std::string::npos)
+          << fx.caption();
       flow.key(KioskKey::Next, 3.0);
-      EXPECT_NE(fx.caption().find("Press " + en.key_name(s.keys.next) + " for the first picture."), std::string::npos) << fx.caption();
+      EXPECT_NE(fx.caption().find("Press " + en.key_name(s.keys.next) + " for the first picture."), std::string::npos)
+          << fx.caption();
       flow.key(KioskKey::Next, 4.0);
       ASSERT_EQ(flow.state(), KioskState::Picture);
       // A USB stick: "Press <next> to go through them."
@@ -189,7 +192,8 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
       r.ok = true;
       r.description = "It has 3 shapes.";
       flow.document_ready(r, 5.1);
-      EXPECT_NE(fx.caption().find("Press " + en.key_name(s.keys.next) + " to go through them."), std::string::npos) << fx.caption();
+      EXPECT_NE(fx.caption().find("Press " + en.key_name(s.keys.next) + " to go through them."), std::string::npos)
+          << fx.caption();
       for (const std::string& t : fx.said) expect_no_stale_key_words(t);
 
       // The German kiosk names the same key in its own words.
@@ -238,7 +242,8 @@ TEST(SpokenKeys, TheOperatorsChangeIsHeardAtOnce) {
   EXPECT_EQ(flow.state(), KioskState::Picture) << "and leaves the visitor where they are";
   const std::string changed = whole_help(flow, fx, 6.0);
   EXPECT_NE(changed.find("Press keypad plus for more detail and keypad minus for less."), std::string::npos) << changed;
-  EXPECT_NE(changed.find("Hold the space bar and press another key to learn what it does."), std::string::npos) << changed;
+  EXPECT_NE(changed.find("Hold the space bar and press another key to learn what it does."), std::string::npos)
+      << changed;
   EXPECT_EQ(changed.find("Up arrow"), std::string::npos) << "the old key is not named any more: " << changed;
 
   // A stick inserted before the change and announced after it names the new next key.

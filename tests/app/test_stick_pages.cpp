@@ -1,5 +1,5 @@
-// Where Next and Previous go on a stick (app/pictures/include/pictures/stick_pages.hpp): page by page, then to the next document's
-// first page or the previous document's last, round the stick; the flow and the stick service's builds ahead
+// Where Next and Previous go on a stick (app/pictures/include/pictures/stick_pages.hpp): page by page, then to the next
+// document's first page or the previous document's last, round the stick; the flow and the stick service's builds ahead
 // both follow it.
 #include <gtest/gtest.h>
 
@@ -28,7 +28,8 @@ TEST(StickPages, NextAndPreviousWalkPagesThenDocumentsRoundTheStick) {
   std::vector<StickPage> seen;
   for (int i = 0; i < total; ++i) {
     at = step_stick_page(pages, at, +1);
-    for (const StickPage& s : seen) EXPECT_FALSE(s == at) << "page " << at.page << " of document " << at.document << " twice";
+    for (const StickPage& s : seen)
+      EXPECT_FALSE(s == at) << "page " << at.page << " of document " << at.document << " twice";
     seen.push_back(at);
   }
   for (int i = total - 1; i > 0; --i) {

@@ -21,8 +21,8 @@
 #include <string>
 #include <thread>
 
-#include "pictures/stick_service.hpp"
 #include "child_process.hpp"
+#include "pictures/stick_service.hpp"
 #include "test_paths.hpp"
 
 namespace hk::app {
@@ -83,7 +83,8 @@ TEST(StickServiceHelper, WithoutTheCapabilityTheHelperMountsAndUnmounts) {
   const fs::path helper = dir / "hk-stick-mount";
   std::ofstream(helper) << "#!/bin/sh\necho \"$*\" >> '" << log.string() << "'\n"
                         << "case \"$1\" in\n"
-                        << "  mount) if [ \"$2\" = /dev/sdz9 ]; then echo \"hk-stick-mount: stick '$2': its filesystem (swap) is not one the kiosk reads\" >&2; exit 1; fi\n"
+                        << "  mount) if [ \"$2\" = /dev/sdz9 ]; then echo \"hk-stick-mount: stick '$2': its filesystem "
+                           "(swap) is not one the kiosk reads\" >&2; exit 1; fi\n"
                         << "         echo \"mounted vfat at " << stick.string() << " from $2\" ;;\n"
                         << "  unmount) echo \"unmounted " << stick.string() << "\" ;;\n"
                         << "esac\n";
@@ -94,12 +95,15 @@ TEST(StickServiceHelper, WithoutTheCapabilityTheHelperMountsAndUnmounts) {
     auto events = std::make_unique<vision::FakeBlockEventSource>();
     vision::FakeBlockEventSource* fake = events.get();
     StickService svc(config::Settings{}, std::move(events), (dir / "mnt").string());
-    if (svc.mounter() != vision::StickMounter::Helper || !svc.can_mount()) return "the service did not choose the helper";
+    if (svc.mounter() != vision::StickMounter::Helper || !svc.can_mount())
+      return "the service did not choose the helper";
 
     fake->push({vision::BlockEvent::Action::Add, "/dev/sdz1", ""});
     std::optional<StickNews> n = next_news(svc);
-    if (!n || n->kind != StickNews::Kind::Inserted) return "insert: no Inserted news" + (n ? " (" + n->reason + ")" : std::string());
-    if (n->documents.size() != 1) return "insert: expected shape.png, got " + std::to_string(n->documents.size()) + " documents";
+    if (!n || n->kind != StickNews::Kind::Inserted)
+      return "insert: no Inserted news" + (n ? " (" + n->reason + ")" : std::string());
+    if (n->documents.size() != 1)
+      return "insert: expected shape.png, got " + std::to_string(n->documents.size()) + " documents";
     fake->push({vision::BlockEvent::Action::Remove, "/dev/sdz1", ""});
     n = next_news(svc);
     if (!n || n->kind != StickNews::Kind::Removed) return "remove: no Removed news";
@@ -108,7 +112,8 @@ TEST(StickServiceHelper, WithoutTheCapabilityTheHelperMountsAndUnmounts) {
     fake->push({vision::BlockEvent::Action::Add, "/dev/sdz9", ""});
     n = next_news(svc);
     if (!n || n->kind != StickNews::Kind::Refused) return "refused stick: no Refused news";
-    if (n->reason != "its filesystem (swap) is not one the kiosk reads") return "refused stick: reason '" + n->reason + "'";
+    if (n->reason != "its filesystem (swap) is not one the kiosk reads")
+      return "refused stick: reason '" + n->reason + "'";
     return "";
   });
   EXPECT_EQ(result, "");

@@ -19,15 +19,15 @@
 #include <thread>
 #include <vector>
 
-#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
-#include "visit/kiosk_flow.hpp"
-#include "visit/kiosk_runtime.hpp"
+#include "pictures/image_scene.hpp"
+#include "pictures/text_reader.hpp"
 #include "scans.hpp"
 #include "show_now.hpp"
-#include "pictures/text_reader.hpp"
-#include "vision/ocr.hpp"
 #include "test_paths.hpp"
+#include "vision/ocr.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
 
 namespace fs = std::filesystem;
 
@@ -72,7 +72,8 @@ struct ScanRig {
 };
 
 TEST(TextLater, AScanIsFeltAtOnceWithoutItsLettersAndItsTextComesFromWithText) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
   ScanRig r;
   ASSERT_FALSE(r.jpeg.empty());
@@ -105,7 +106,8 @@ TEST(TextLater, AScanIsFeltAtOnceWithoutItsLettersAndItsTextComesFromWithText) {
 }
 
 TEST(TextLater, ACancelledReadingGivesThePageWithoutItsText) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
   ScanRig r;
   ImageScene quick = build_image_scene_from_bytes(r.jpeg, "scan.jpg", config::Settings{}, TextTiming::later);
@@ -149,7 +151,8 @@ TEST(OcrCancel, ARaisedFlagKillsTheWorkerAndSaysCancelled) {
 
 /// A TextBuild that raises `started`, waits until it is cancelled or `release` is raised, then gives a scene
 /// named `name`.
-TextBuild waiting_build(const std::string& name, std::atomic<bool>& release, std::atomic<bool>& saw_cancel, std::atomic<bool>* started = nullptr) {
+TextBuild waiting_build(const std::string& name, std::atomic<bool>& release, std::atomic<bool>& saw_cancel,
+                        std::atomic<bool>* started = nullptr) {
   return [name, &release, &saw_cancel, started](const std::atomic<bool>* cancel) {
     if (started) started->store(true);
     while (!release.load() && !(cancel && cancel->load())) std::this_thread::yield();
@@ -219,7 +222,8 @@ struct KioskRig {
   std::unique_ptr<KioskRuntime> rt;
   KioskRig() {
     fs::create_directories(lib);
-    std::ofstream(lib / "a_scan.jpg", std::ios::binary).write(reinterpret_cast<const char*>(scan.jpeg.data()), static_cast<std::streamsize>(scan.jpeg.size()));
+    std::ofstream(lib / "a_scan.jpg", std::ios::binary)
+        .write(reinterpret_cast<const char*>(scan.jpeg.data()), static_cast<std::streamsize>(scan.jpeg.size()));
     fs::copy_file(kData / "images" / "horse.png", lib / "b_horse.png");
     RuntimeOptions ro;
     ro.library = lib.string();
@@ -244,7 +248,8 @@ struct KioskRig {
 };
 
 TEST(KioskText, APageIsFeltAtOnceThenItsTextComesWithoutLeavingThePage) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
   KioskRig k;
   const int scan = k.rt->find_picture((k.lib / "a_scan.jpg").string());
@@ -269,7 +274,8 @@ TEST(KioskText, APageIsFeltAtOnceThenItsTextComesWithoutLeavingThePage) {
 }
 
 TEST(KioskText, AnotherPictureCancelsTheReadingAndNothingIsSaidOfIt) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
   KioskRig k;
   ASSERT_GE(test::show_now(*k.rt, k.rt->find_picture((k.lib / "a_scan.jpg").string())), 0);
@@ -283,12 +289,14 @@ TEST(KioskText, AnotherPictureCancelsTheReadingAndNothingIsSaidOfIt) {
 }
 
 TEST(KioskText, AScanOnAStickIsAnnouncedAsBeingReadThenItsTextIsReady) {
-  if (!test::have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (!test::have_poppler_utils())
+    GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
   KioskRig k;
   const fs::path stick = k.scan.dir / "stick";
   fs::create_directories(stick);
-  std::ofstream(stick / "letter.jpg", std::ios::binary).write(reinterpret_cast<const char*>(k.scan.jpeg.data()), static_cast<std::streamsize>(k.scan.jpeg.size()));
+  std::ofstream(stick / "letter.jpg", std::ios::binary)
+      .write(reinterpret_cast<const char*>(k.scan.jpeg.data()), static_cast<std::streamsize>(k.scan.jpeg.size()));
   KioskFlowParams fp;
   KioskFlow flow(*k.rt, k.rt->audio().messages(), fp);
   double now_s = 0.0;
@@ -298,7 +306,8 @@ TEST(KioskText, AScanOnAStickIsAnnouncedAsBeingReadThenItsTextIsReady) {
   std::string announced;
   while (std::chrono::steady_clock::now() < deadline && announced.empty()) {
     k.rt->poll_sticks(flow, now_s);
-    if (k.rt->last_said().find("Document 1 of 1, letter") != std::string::npos && !k.rt->stick_busy()) announced = k.rt->last_said();
+    if (k.rt->last_said().find("Document 1 of 1, letter") != std::string::npos && !k.rt->stick_busy())
+      announced = k.rt->last_said();
     now_s += 0.1;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }

@@ -12,10 +12,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "pictures/image_scene.hpp"
 #include "kiosk_exe.hpp"
-#include "textures.hpp"
+#include "pictures/image_scene.hpp"
 #include "test_paths.hpp"
+#include "textures.hpp"
 
 namespace hk::app {
 namespace {
@@ -29,7 +29,8 @@ TEST(TextureScene, PureTextureGivesFewShapes) {
   const fs::path dir = fresh_dir("texture_scene");
   const config::Settings defaults;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    for (const auto& [name, img] : {std::pair{"noise", hk::test::noise_texture(800, 520, seed)}, std::pair{"wood", hk::test::wood_texture(800, 520, seed)}}) {
+    for (const auto& [name, img] : {std::pair{"noise", hk::test::noise_texture(800, 520, seed)},
+                                    std::pair{"wood", hk::test::wood_texture(800, 520, seed)}}) {
       const fs::path file = dir / (std::string(name) + std::to_string(seed) + ".png");
       ASSERT_TRUE(cv::imwrite(file.string(), img));
       SCOPED_TRACE(file.filename().string());
@@ -39,7 +40,8 @@ TEST(TextureScene, PureTextureGivesFewShapes) {
       EXPECT_GT(is.chains_texture, 100u) << "and it is the texture test that dropped the edges";
       config::Settings canny = defaults;
       canny.vision.detector = "canny";
-      EXPECT_EQ(build_image_scene(file.string(), canny).polylines.size(), static_cast<std::size_t>(defaults.vision.max_shapes))
+      EXPECT_EQ(build_image_scene(file.string(), canny).polylines.size(),
+                static_cast<std::size_t>(defaults.vision.max_shapes))
           << "Canny alone fills the shape budget with texture";
     }
   }
@@ -50,7 +52,9 @@ TEST(TextureScene, SummarySaysHowManyEdgesWereTexture) {
   const fs::path dir = fresh_dir("texture_summary");
   const fs::path file = dir / "wood.png";
   ASSERT_TRUE(cv::imwrite(file.string(), hk::test::wood_texture(640, 400, 11)));
-  const auto r = test::run_kiosk("explore " + test::quoted(file.string()) + " --out " + test::quoted((dir / "out").string()) + " --duration 0.05", dir);
+  const auto r = test::run_kiosk(
+      "explore " + test::quoted(file.string()) + " --out " + test::quoted((dir / "out").string()) + " --duration 0.05",
+      dir);
   ASSERT_EQ(r.status, 0) << r.err;
   std::ifstream in(dir / "out" / "summary.json");
   const nlohmann::json sj = nlohmann::json::parse(in);
@@ -74,7 +78,8 @@ TEST(TextureScene, EveryCoinStaysAndNothingElse) {
       hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
       sum += q;
     }
-    EXPECT_GE(std::min(hi.x - lo.x, hi.y - lo.y), 0.008) << "as large as a coin (the smallest is about 10 mm across here)";
+    EXPECT_GE(std::min(hi.x - lo.x, hi.y - lo.y), 0.008)
+        << "as large as a coin (the smallest is about 10 mm across here)";
     centres.push_back(sum * (1.0 / static_cast<double>(p.points_m.size())));
   }
   std::sort(centres.begin(), centres.end(), [](Vec2 a, Vec2 b) { return a.y > b.y; });  // top row first

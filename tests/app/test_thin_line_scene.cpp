@@ -70,7 +70,8 @@ std::vector<Doubled> parallel_stretches(const std::vector<Polyline>& curves, dou
     total[c] = s;
   }
   const auto key = [&](double x, double y) {
-    return (static_cast<long long>(std::floor(x / max_gap_m)) << 32) ^ static_cast<long long>(std::floor(y / max_gap_m) + (1LL << 31));
+    return (static_cast<long long>(std::floor(x / max_gap_m)) << 32) ^
+           static_cast<long long>(std::floor(y / max_gap_m) + (1LL << 31));
   };
   std::unordered_map<long long, std::vector<std::size_t>> grid;
   for (std::size_t i = 0; i < samples.size(); ++i) grid[key(samples[i].p.x, samples[i].p.y)].push_back(i);
@@ -137,19 +138,20 @@ TEST(ThinLineScene, SudokuLinesAreFeltOnceWithFewerSegments) {
   // ... and none are left after merging.
   const std::vector<Doubled> after = parallel_stretches(merged.polylines, w, 3 * w);
   for (const Doubled& d : after) {
-    ADD_FAILURE() << "curve " << d.curve << " runs alongside another wall for " << d.length_m * 1000 << " mm from (" << d.at.x << ", "
-                  << d.at.y << ")";
+    ADD_FAILURE() << "curve " << d.curve << " runs alongside another wall for " << d.length_m * 1000 << " mm from ("
+                  << d.at.x << ", " << d.at.y << ")";
   }
-  std::printf("  sudoku.png: level-0 segments %zu -> %zu with merging, parallel stretches %zu -> %zu\n", plain.scene->total_segments(0),
-              merged.scene->total_segments(0), before.size(), after.size());
+  std::printf("  sudoku.png: level-0 segments %zu -> %zu with merging, parallel stretches %zu -> %zu\n",
+              plain.scene->total_segments(0), merged.scene->total_segments(0), before.size(), after.size());
 }
 
 TEST(ThinLineScene, ALineDrawingIsOneCurvePerStroke) {
   // A drawing of three strokes (a line, an arc, an L) 0.5 mm wide at the kiosk's scale, end to end
   // through the file, the app's unit conversion and the scale-back from a shrunk image: one curve
   // per stroke, on the stroke's centre line.
-  const fs::path path = fs::temp_directory_path() /
-                        ("hk_thin_drawing_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
+  const fs::path path =
+      fs::temp_directory_path() /
+      ("hk_thin_drawing_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
   cv::Mat img(1000, 1600, CV_8UC3, cv::Scalar(255, 255, 255));  // shrunk to 800 x 500 for edges
   cv::line(img, {200, 150}, {1400, 250}, cv::Scalar(0, 0, 0), 6, cv::LINE_AA);
   cv::ellipse(img, {500, 600}, {250, 250}, 0, 200, 340, cv::Scalar(0, 0, 0), 6, cv::LINE_AA);
@@ -175,7 +177,8 @@ TEST(ThinLineScene, ALineDrawingIsOneCurvePerStroke) {
     return std::abs(distance(p, c) - 250 * m.scale_m_per_px);
   };
   const auto nearest = [&](Vec2 p) {
-    return std::min({seg(p, {200, 150}, {1400, 250}), on_arc(p), std::min(seg(p, {1000, 400}, {1000, 850}), seg(p, {1000, 850}, {1450, 850}))});
+    return std::min({seg(p, {200, 150}, {1400, 250}), on_arc(p),
+                     std::min(seg(p, {1000, 400}, {1000, 850}), seg(p, {1000, 850}, {1450, 850}))});
   };
   // 1 processed pixel = 2 original pixels.
   const double tol_m = 2.0 * m.scale_m_per_px;
@@ -198,7 +201,8 @@ TEST(ThinLineScene, ShippedPicturesSegmentsBeforeAndAfter) {
     const ImageScene a = build_image_scene(entry.path().string(), off);
     const ImageScene b = build_image_scene(entry.path().string(), on);
     for (const ImageScene* s : {&a, &b}) {
-      EXPECT_EQ(s->chains_after_gaps, s->chains_too_short + s->chains_along_border + s->chains_over_max_shapes + s->chains_over_budget + s->polylines.size());
+      EXPECT_EQ(s->chains_after_gaps, s->chains_too_short + s->chains_along_border + s->chains_over_max_shapes +
+                                          s->chains_over_budget + s->polylines.size());
       EXPECT_EQ(s->strength.size(), s->polylines.size());
       EXPECT_EQ(s->segments_after_budget, s->scene->total_segments(0));
       EXPECT_LE(s->segments_after_budget, static_cast<std::size_t>(on.vision.max_segments));
@@ -208,11 +212,15 @@ TEST(ThinLineScene, ShippedPicturesSegmentsBeforeAndAfter) {
     EXPECT_EQ(a.chains_after_thin_lines, a.chains_found);
     EXPECT_LE(b.segments_before_budget, a.segments_before_budget + 8);
     const double w = on.vision.thin_line_max_width_m;
-    std::printf("  %-18s chains %4zu, centre lines %3zu, level-0 segments %6zu -> %6zu, doubled stretches %3zu -> %3zu, merge %.2f ms\n",
-                name.c_str(), b.chains_found, b.thin_line_pairs_merged, a.segments_before_budget, b.segments_before_budget,
-                parallel_stretches(a.polylines, w, 3 * w).size(), parallel_stretches(b.polylines, w, 3 * w).size(), b.times.thin_lines_ms);
+    std::printf(
+        "  %-18s chains %4zu, centre lines %3zu, level-0 segments %6zu -> %6zu, doubled stretches %3zu -> %3zu, merge "
+        "%.2f ms\n",
+        name.c_str(), b.chains_found, b.thin_line_pairs_merged, a.segments_before_budget, b.segments_before_budget,
+        parallel_stretches(a.polylines, w, 3 * w).size(), parallel_stretches(b.polylines, w, 3 * w).size(),
+        b.times.thin_lines_ms);
     for (const Doubled& d : parallel_stretches(b.polylines, w, 3 * w)) {
-      std::printf("    doubled: %.1f mm from pixel (%.0f, %.0f)\n", d.length_m * 1000, b.px_to_m.u_px(d.at.x), b.px_to_m.v_px(d.at.y));
+      std::printf("    doubled: %.1f mm from pixel (%.0f, %.0f)\n", d.length_m * 1000, b.px_to_m.u_px(d.at.x),
+                  b.px_to_m.v_px(d.at.y));
     }
   }
 }

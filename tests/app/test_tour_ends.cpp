@@ -15,15 +15,15 @@
 #include <vector>
 
 #include "audio/messages.hpp"
-#include "runtime/guided_tour.hpp"
-#include "visit/kiosk_runtime.hpp"
-#include "runtime_ticks.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/guided_tour.hpp"
 #include "runtime/runtime_params.hpp"
-#include "show_now.hpp"
 #include "runtime/simulation.hpp"
-#include "test_pictures.hpp"
+#include "runtime_ticks.hpp"
+#include "show_now.hpp"
 #include "test_paths.hpp"
+#include "test_pictures.hpp"
+#include "visit/kiosk_runtime.hpp"
 
 namespace fs = std::filesystem;
 
@@ -39,7 +39,8 @@ struct OnePictureKiosk {
   long ticks = 0;
 
   explicit OnePictureKiosk(const fs::path& picture)
-      : dir(fs::temp_directory_path() / ("hk_tour_ends_" + picture.stem().string() + "_" + std::to_string(::getpid()))) {
+      : dir(fs::temp_directory_path() /
+            ("hk_tour_ends_" + picture.stem().string() + "_" + std::to_string(::getpid()))) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     fs::copy_file(picture, dir / picture.filename());
@@ -78,7 +79,8 @@ TEST_P(EveryTourEnds, OnEveryShapeWithASpokenLineWithinItsBound) {
     k.rt->guide();
     if (!k.rt->tour_running()) {  // nothing left to lead to: said so
       const std::string said = k.rt->last_said();
-      EXPECT_TRUE(said == m.text(audio::MessageId::tour_all_touched) || said == m.text(audio::MessageId::tour_nothing)) << said;
+      EXPECT_TRUE(said == m.text(audio::MessageId::tour_all_touched) || said == m.text(audio::MessageId::tour_nothing))
+          << said;
       break;
     }
     for (int i = 0; i < 200 && k.rt->tour_announced(); ++i) k.run(0.05);  // "I will guide your hand…"
@@ -93,12 +95,15 @@ TEST_P(EveryTourEnds, OnEveryShapeWithASpokenLineWithinItsBound) {
     while (k.rt->tour_running() && k.now_s() - from_s < bound_s + 5.0) k.run(0.02);
     const double took_s = k.now_s() - from_s;
     ++tours;
-    ASSERT_FALSE(k.rt->tour_running()) << "tour " << tours << " to shape " << plan->curve << " still running after " << took_s << " s";
-    EXPECT_LE(took_s, bound_s) << "tour " << tours << " to shape " << plan->curve << " (planned " << plan->duration_s() << " s)";
+    ASSERT_FALSE(k.rt->tour_running()) << "tour " << tours << " to shape " << plan->curve << " still running after "
+                                       << took_s << " s";
+    EXPECT_LE(took_s, bound_s) << "tour " << tours << " to shape " << plan->curve << " (planned " << plan->duration_s()
+                               << " s)";
     const std::string said = k.rt->last_said();
     const bool traced = starts_with(said, "That was shape ");
     done += traced;
-    EXPECT_TRUE(traced || starts_with(said, m.text(audio::MessageId::tour_stopped)) || starts_with(said, m.text(audio::MessageId::tour_stuck)))
+    EXPECT_TRUE(traced || starts_with(said, m.text(audio::MessageId::tour_stopped)) ||
+                starts_with(said, m.text(audio::MessageId::tour_stuck)))
         << "tour " << tours << " ended with: " << said;
   }
   if (shapes > 0 && tours > 0) {
@@ -116,10 +121,11 @@ std::vector<std::string> every_picture() {
   return out;
 }
 
-INSTANTIATE_TEST_SUITE_P(TestAndShippedPictures, EveryTourEnds, ::testing::ValuesIn(every_picture()), [](const auto& info) {
-  const fs::path p(info.param);
-  return (p.parent_path().filename() == "pictures" ? "shipped_" : "") + p.stem().string();
-});
+INSTANTIATE_TEST_SUITE_P(TestAndShippedPictures, EveryTourEnds, ::testing::ValuesIn(every_picture()),
+                         [](const auto& info) {
+                           const fs::path p(info.param);
+                           return (p.parent_path().filename() == "pictures" ? "shipped_" : "") + p.stem().string();
+                         });
 
 }  // namespace
 }  // namespace hk::app

@@ -17,14 +17,14 @@ namespace {
 using audio::MessageId;
 
 struct Speaker final : KioskEffects {
-  std::vector<std::string> said;       // every text, in order
-  std::vector<bool> brief;             // said[i] was an acknowledgement (Repeat passes it over)
-  std::string kept;                    // what Repeat says again
-  bool heard = false;                  // speech is being heard (the test sets it)
+  std::vector<std::string> said;  // every text, in order
+  std::vector<bool> brief;        // said[i] was an acknowledgement (Repeat passes it over)
+  std::string kept;               // what Repeat says again
+  bool heard = false;             // speech is being heard (the test sets it)
   bool paused = false;
-  bool quiet = false;                  // quiet hours
+  bool quiet = false;  // quiet hours
   int volume = 7, sessions = 0, shown_pictures = 0, keys_acting = 0;
-  bool fail_next_picture = false;      // show_picture throws once (a picture that cannot be built)
+  bool fail_next_picture = false;  // show_picture throws once (a picture that cannot be built)
   std::string here = "Your hand is on shape 2 of 4, a small closed shape, on the left. It is on the left.";
 
   void say(const std::string& t) override {
@@ -69,7 +69,7 @@ struct Speaker final : KioskEffects {
   int picture_count() const override { return 3; }
   std::string describe() override { return "4 shapes. Nearest your hand, a small closed shape on the left."; }
   std::string where() override { return here; }
-  bool automatic = false;              // the level follows hand speed (Finer and Coarser turn it off)
+  bool automatic = false;  // the level follows hand speed (Finer and Coarser turn it off)
   bool change_level(int) override {
     automatic = false;
     return true;
@@ -102,7 +102,9 @@ struct Visit {
     for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 2.0);
     fx.heard = false;
   }
-  std::string text(MessageId id, std::initializer_list<audio::MessageArg> args = {}) const { return flow.text(id, args); }
+  std::string text(MessageId id, std::initializer_list<audio::MessageArg> args = {}) const {
+    return flow.text(id, args);
+  }
 };
 
 TEST(VisitorInCharge, RepeatSaysTheLastMessageAgainAndPassesOverAcknowledgements) {
@@ -209,8 +211,9 @@ TEST(VisitorInCharge, FinerOrCoarserSaysOnceThatAutomaticDetailIsOffAndWhatBring
   Visit v;
   v.fx.automatic = true;
   v.flow.key(KioskKey::Finer, 3.0);
-  EXPECT_EQ(v.fx.said.back(), "More detail. Automatic detail is off until you press the Right arrow or the Left arrow for another "
-                            "picture.");
+  EXPECT_EQ(v.fx.said.back(),
+            "More detail. Automatic detail is off until you press the Right arrow or the Left arrow for another "
+            "picture.");
   v.flow.key(KioskKey::Coarser, 4.0);
   EXPECT_EQ(v.fx.said.back(), "Less detail.") << "said once, while it is off";
 }
@@ -219,7 +222,8 @@ TEST(VisitorInCharge, HelpComesInTwoLayers) {
   Visit v;
   v.flow.key(KioskKey::Help, 3.0);
   const std::string first = v.fx.said.back();
-  EXPECT_EQ(first, v.text(MessageId::help_brief, {{"place", v.text(MessageId::place_picture, {{"picture", "1"}, {"pictures", "3"}})}}));
+  EXPECT_EQ(first, v.text(MessageId::help_brief,
+                          {{"place", v.text(MessageId::place_picture, {{"picture", "1"}, {"pictures", "3"}})}}));
   EXPECT_EQ(first.rfind("Picture 1 of 3. ", 0), 0u) << "where the visitor is: " << first;
   EXPECT_NE(first.find("the Right arrow"), std::string::npos) << first;
   EXPECT_NE(first.find("the W key"), std::string::npos) << "the two most useful keys: " << first;
@@ -227,9 +231,12 @@ TEST(VisitorInCharge, HelpComesInTwoLayers) {
   // The same key again: every key, two sentences at a time, each key with where it lies on the keypad.
   const std::string group1 = v.fx.said.back();
   EXPECT_EQ(group1,
-            "Move the handle slowly to feel the outlines. Press the Right arrow for the next picture and the Left arrow for the one "
-            "before. The Right arrow is the right one of the four arrow keys, at the bottom right of the keyboard. The Left arrow is "
-            "the left one of the four arrow keys, at the bottom right of the keyboard. Press the Right arrow for more help, the Left "
+            "Move the handle slowly to feel the outlines. Press the Right arrow for the next picture and the Left "
+            "arrow for the one "
+            "before. The Right arrow is the right one of the four arrow keys, at the bottom right of the keyboard. The "
+            "Left arrow is "
+            "the left one of the four arrow keys, at the bottom right of the keyboard. Press the Right arrow for more "
+            "help, the Left "
             "arrow to go back.");
   EXPECT_TRUE(v.flow.in_help());
   std::string every = group1;
@@ -238,11 +245,12 @@ TEST(VisitorInCharge, HelpComesInTwoLayers) {
     every += " " + v.fx.said.back();
   }
   EXPECT_EQ(v.flow.picture(), 0) << "Next stepped through the help, not the pictures";
-  for (const char* key : {"the W key", "the D key", "the R key", "the P key", "the Up arrow", "the Down arrow", "Page Up", "Page Down",
-                          "the G key", "the T key", "the End key", "F1"}) {
+  for (const char* key : {"the W key", "the D key", "the R key", "the P key", "the Up arrow", "the Down arrow",
+                          "Page Up", "Page Down", "the G key", "the T key", "the End key", "F1"}) {
     EXPECT_NE(every.find(key), std::string::npos) << key << " in: " << every;
   }
-  EXPECT_NE(every.find("The End key is in the block of six keys above the arrow keys, the middle of its bottom row."), std::string::npos);
+  EXPECT_NE(every.find("The End key is in the block of six keys above the arrow keys, the middle of its bottom row."),
+            std::string::npos);
   v.flow.key(KioskKey::Previous, 5.5);
   EXPECT_EQ(v.flow.picture(), 0) << "Previous goes back within the help";
   EXPECT_EQ(v.fx.said.back().rfind("Press the Up arrow for more detail", 0), std::string::npos);
@@ -262,7 +270,8 @@ TEST(VisitorInCharge, HelpComesInTwoLayers) {
   EXPECT_EQ(v.fx.said.back(), first) << "and again the first layer";
   v.flow.key(KioskKey::Next, 6.3);
   v.flow.key(KioskKey::Help, 7.0);
-  EXPECT_EQ(v.fx.said.back().rfind("Picture 2 of 3.", 0), 0u) << "another key in between: the first layer, where the visitor is now";
+  EXPECT_EQ(v.fx.said.back().rfind("Picture 2 of 3.", 0), 0u)
+      << "another key in between: the first layer, where the visitor is now";
 }
 
 TEST(VisitorInCharge, AStrayKeySaysItsNameNotTheWholeHelp) {
@@ -270,7 +279,8 @@ TEST(VisitorInCharge, AStrayKeySaysItsNameNotTheWholeHelp) {
   v.flow.key(KioskKey::Other, 3.0, "Q");
   EXPECT_EQ(v.fx.said.back(), "The Q key does nothing here. Press F1 for help.");
   v.flow.key(KioskKey::Other, 4.0, "O");  // no longer the operator's: a key like any other
-  EXPECT_EQ(v.fx.said.back(), "That key does nothing here. Press F1 for help.") << "a key the catalogue has no spoken name for";
+  EXPECT_EQ(v.fx.said.back(), "That key does nothing here. Press F1 for help.")
+      << "a key the catalogue has no spoken name for";
   EXPECT_EQ(v.flow.picture(), 0);
 }
 
@@ -280,12 +290,14 @@ TEST(VisitorInCharge, HoldingHelpNamesAKeyWithoutActing) {
   v.flow.help_held(true);
   const int acting = v.fx.keys_acting;
   v.flow.key(KioskKey::Next, 3.2);
-  EXPECT_EQ(v.fx.said.back(), "The Right arrow: the next picture. The Right arrow is the right one of the four arrow keys, at the "
-                              "bottom right of the keyboard.");
+  EXPECT_EQ(v.fx.said.back(),
+            "The Right arrow: the next picture. The Right arrow is the right one of the four arrow keys, at the "
+            "bottom right of the keyboard.");
   EXPECT_EQ(v.flow.picture(), 0) << "named, not done";
   v.flow.key(KioskKey::Finish, 3.4);
-  EXPECT_EQ(v.fx.said.back(), "The End key: finish, and leave the kiosk for the next visitor. The End key is in the block of six keys "
-                              "above the arrow keys, the middle of its bottom row.")
+  EXPECT_EQ(v.fx.said.back(),
+            "The End key: finish, and leave the kiosk for the next visitor. The End key is in the block of six keys "
+            "above the arrow keys, the middle of its bottom row.")
       << "named, what it does, and where it lies";
   EXPECT_EQ(v.flow.state(), KioskState::Picture);
   v.flow.key(KioskKey::Other, 3.6, "Z");
@@ -388,9 +400,11 @@ TEST(VisitorInCharge, TheTutorialTeachesPushingThroughAndSaysWhyLevelsDoNothing)
   flow.touching(3.0);
   EXPECT_EQ(fx.said.size(), welcome + 1) << "said once";
   flow.key(KioskKey::Finer, 4.0);
-  EXPECT_EQ(fx.said.back(), "A practice shape has one level of detail. The Up arrow and the Down arrow work on the pictures.");
+  EXPECT_EQ(fx.said.back(),
+            "A practice shape has one level of detail. The Up arrow and the Down arrow work on the pictures.");
   flow.key(KioskKey::Coarser, 5.0);
-  EXPECT_EQ(fx.said.back(), "A practice shape has one level of detail. The Up arrow and the Down arrow work on the pictures.");
+  EXPECT_EQ(fx.said.back(),
+            "A practice shape has one level of detail. The Up arrow and the Down arrow work on the pictures.");
   flow.key(KioskKey::Next, 6.0);
   fx.heard = false;
   flow.touching(7.0);
@@ -402,7 +416,8 @@ TEST(VisitorInCharge, TheWelcomeIsShortAndPutsAShapeUnderTheHand) {
   KioskFlow flow(fx, en());
   flow.key(KioskKey::Describe, 1.0);
   ASSERT_EQ(fx.said.size(), 1u);
-  EXPECT_EQ(fx.said[0], "Welcome. Feel the square with the handle. Press the Right arrow to move on. Press F1 for help.");
+  EXPECT_EQ(fx.said[0],
+            "Welcome. Feel the square with the handle. Press the Right arrow to move on. Press F1 for help.");
   EXPECT_EQ(flow.state(), KioskState::Tutorial);
 }
 

@@ -34,17 +34,22 @@ TEST(Earcons, CurvePitchesArePentatonicAndNeighboursDiffer) {
   EXPECT_NEAR(curve_pitch_hz(2), 329.63, 0.01);
   EXPECT_NEAR(curve_pitch_hz(3), 392.00, 0.01);
   for (int c = 0; c < 10; ++c) {
-    for (int d = c + 1; d < 10; ++d) EXPECT_GT(std::fabs(curve_pitch_hz(c) / curve_pitch_hz(d) - 1.0), 0.1) << c << " " << d;
+    for (int d = c + 1; d < 10; ++d)
+      EXPECT_GT(std::fabs(curve_pitch_hz(c) / curve_pitch_hz(d) - 1.0), 0.1) << c << " " << d;
   }
 }
 
 // A known sequence of events: every one is heard within 10 ms after its tick, nothing is heard where no
 // event is, and all is silent before the first and after the last has died away.
 TEST(Earcons, KnownSequenceOnsetsLandWithin10msOfTheirEvents) {
-  const std::vector<CueEvent> events{
-      cue(100, CueKind::ContactBegin, 0, 0.1f), cue(300, CueKind::ConvexCorner), cue(500, CueKind::ContactEnd),
-      cue(800, CueKind::ContactBegin, 1, 0.05f), cue(1000, CueKind::VertexContact, 1), cue(1300, CueKind::LevelFiner, -1, 0, 1),
-      cue(1600, CueKind::LevelCoarser, -1, 0, 2), cue(1900, CueKind::WorkspaceEdge, -1)};
+  const std::vector<CueEvent> events{cue(100, CueKind::ContactBegin, 0, 0.1f),
+                                     cue(300, CueKind::ConvexCorner),
+                                     cue(500, CueKind::ContactEnd),
+                                     cue(800, CueKind::ContactBegin, 1, 0.05f),
+                                     cue(1000, CueKind::VertexContact, 1),
+                                     cue(1300, CueKind::LevelFiner, -1, 0, 1),
+                                     cue(1600, CueKind::LevelCoarser, -1, 0, 2),
+                                     cue(1900, CueKind::WorkspaceEdge, -1)};
   const std::vector<float> x = render_cue_timeline(events, kPeriod, 2.4);
   ASSERT_EQ(x.size(), static_cast<std::size_t>(2.4 * kRate));
   const std::vector<std::size_t> on = test::onsets(x);
@@ -74,7 +79,8 @@ TEST(Earcons, KnownSequenceOnsetsLandWithin10msOfTheirEvents) {
 
 // Corner and contact earcons differ measurably: a corner tick is brighter (spectral centroid) and shorter.
 TEST(Earcons, CornerAndContactDifferInSpectrumAndEnvelope) {
-  const std::vector<float> contact = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.1f)}, kPeriod, 0.3);
+  const std::vector<float> contact =
+      render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.1f)}, kPeriod, 0.3);
   const std::vector<float> corner = render_cue_timeline(std::vector{cue(10, CueKind::ConvexCorner, 0)}, kPeriod, 0.3);
   const std::size_t t = at(10);
   const double c_contact = test::spectral_centroid(contact, t, 2048);
@@ -103,8 +109,10 @@ TEST(Earcons, TextBlockIsTwoRisingNotesWithoutAStrike) {
   const std::size_t t = at(10);
   EXPECT_NEAR(test::dominant_frequency(x, t + 960, 2400), 784.0, 784.0 * 0.03) << "first note";
   EXPECT_NEAR(test::dominant_frequency(x, t + 4800, 2400), 1175.0, 1175.0 * 0.03) << "second note, 80 ms on";
-  const std::vector<float> click = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.1f)}, kPeriod, 0.4);
-  EXPECT_LT(test::spectral_centroid(x, t, 240), test::spectral_centroid(click, t, 240)) << "no bright strike at the start";
+  const std::vector<float> click =
+      render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.1f)}, kPeriod, 0.4);
+  EXPECT_LT(test::spectral_centroid(x, t, 240), test::spectral_centroid(click, t, 240))
+      << "no bright strike at the start";
   EXPECT_GT(test::rms(x, t, t + at(200)), 0.0);
   EXPECT_LT(test::peak(x, t + at(350), x.size()), 1e-4) << "over within 350 ms";
 }
@@ -117,7 +125,8 @@ TEST(Earcons, PopThroughIsABurstOverALowFallingPlop) {
   const double plop = test::dominant_frequency(x, t + at(55), 1440);  // 55–85 ms: the burst is over
   EXPECT_GT(plop, 100.0);
   EXPECT_LT(plop, 200.0) << "the plop has fallen below its 220 Hz start";
-  const std::vector<float> coarser = render_cue_timeline(std::vector{cue(10, CueKind::LevelCoarser, -1, 0, 2)}, kPeriod, 0.4);
+  const std::vector<float> coarser =
+      render_cue_timeline(std::vector{cue(10, CueKind::LevelCoarser, -1, 0, 2)}, kPeriod, 0.4);
   EXPECT_GT(test::spectral_centroid(x, t, 480), 1.5 * test::spectral_centroid(coarser, t, 480)) << "a noisy start";
   EXPECT_GT(test::rms(x, t, t + at(50)), 0.0);
   EXPECT_LT(test::peak(x, t + at(150), x.size()), 1e-4) << "over within 150 ms";
@@ -143,13 +152,17 @@ TEST(Earcons, ShutterIsTwoBrightClicksSixtyMillisecondsApart) {
   EXPECT_LT(second, first) << "the second click is softer";
   EXPECT_LT(test::peak(x, t + at(35), t + at(58)), 0.1 * second) << "silence between the clicks";
   EXPECT_LT(test::peak(x, t + at(120), x.size()), 1e-4) << "over within 120 ms";
-  const std::vector<float> contact = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.1f)}, kPeriod, 0.3);
-  EXPECT_GT(test::spectral_centroid(x, t, 240), test::spectral_centroid(contact, t, 240)) << "brighter than a wall's click";
+  const std::vector<float> contact =
+      render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.1f)}, kPeriod, 0.3);
+  EXPECT_GT(test::spectral_centroid(x, t, 240), test::spectral_centroid(contact, t, 240))
+      << "brighter than a wall's click";
 }
 
 TEST(Earcons, ContactLoudnessGrowsWithApproachSpeed) {
-  const std::vector<float> soft = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.01f)}, kPeriod, 0.2);
-  const std::vector<float> hard = render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.15f)}, kPeriod, 0.2);
+  const std::vector<float> soft =
+      render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.01f)}, kPeriod, 0.2);
+  const std::vector<float> hard =
+      render_cue_timeline(std::vector{cue(10, CueKind::ContactBegin, 0, 0.15f)}, kPeriod, 0.2);
   const double ps = test::rms(soft, at(10), at(60)), ph = test::rms(hard, at(10), at(60));
   EXPECT_GT(ps, 0.0) << "a gentle touch must still be heard";
   EXPECT_GT(ph, 2.0 * ps);
@@ -157,7 +170,8 @@ TEST(Earcons, ContactLoudnessGrowsWithApproachSpeed) {
 
 TEST(Earcons, LevelChirpsRiseAndFall) {
   const std::vector<float> up = render_cue_timeline(std::vector{cue(10, CueKind::LevelFiner, -1, 0, 1)}, kPeriod, 0.3);
-  const std::vector<float> down = render_cue_timeline(std::vector{cue(10, CueKind::LevelCoarser, -1, 0, 2)}, kPeriod, 0.3);
+  const std::vector<float> down =
+      render_cue_timeline(std::vector{cue(10, CueKind::LevelCoarser, -1, 0, 2)}, kPeriod, 0.3);
   const std::size_t t = at(10);
   const std::size_t n = 2400;  // 50 ms
   EXPECT_GT(test::dominant_frequency(up, t + at(105), n), 1.3 * test::dominant_frequency(up, t + at(5), n));
@@ -199,7 +213,8 @@ TEST(Earcons, TimelineRejectsBadArguments) {
   EXPECT_THROW(render_cue_timeline({}, 0.001, -1.0), hk::ArgumentError);
   EXPECT_THROW(render_cue_timeline({}, 0.001, 1e6), hk::ArgumentError);
   // Cues past the end or before the start are ignored, not a crash.
-  const std::vector<float> x = render_cue_timeline(std::vector{cue(-5, CueKind::ContactBegin), cue(999999, CueKind::ContactBegin)}, 0.001, 0.1);
+  const std::vector<float> x =
+      render_cue_timeline(std::vector{cue(-5, CueKind::ContactBegin), cue(999999, CueKind::ContactBegin)}, 0.001, 0.1);
   EXPECT_EQ(test::peak(x, 0, x.size()), 0.0);
 }
 

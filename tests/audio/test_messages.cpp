@@ -21,7 +21,8 @@ const std::string kDir = std::string(HK_TEST_DATA_DIR) + "/messages/";
 TEST(Messages, EnglishHasEveryMessageAndFillsPlaceholders) {
   const MessageCatalog& en = MessageCatalog::english();
   EXPECT_EQ(en.voice(), "en");
-  for (int i = 0; i < kMessageCount; ++i) EXPECT_FALSE(en.raw(static_cast<MessageId>(i)).empty()) << kMessageKeys[static_cast<std::size_t>(i)];
+  for (int i = 0; i < kMessageCount; ++i)
+    EXPECT_FALSE(en.raw(static_cast<MessageId>(i)).empty()) << kMessageKeys[static_cast<std::size_t>(i)];
   EXPECT_EQ(en.text(MessageId::picture_loaded, {{"picture", "2"}, {"pictures", "5"}, {"shapes", "7"}}),
             "Picture 2 of 5. It has 7 shapes.");
   // An argument the text does not use changes nothing; a placeholder without an argument stays visible.
@@ -33,7 +34,8 @@ TEST(Messages, GermanTranslationLoads) {
   const MessageCatalog de = MessageCatalog::load(kDir + "de.toml");
   EXPECT_EQ(de.voice(), "de");
   EXPECT_EQ(de.language(), "Deutsch");
-  EXPECT_EQ(de.text(MessageId::picture_loaded, {{"picture", "1"}, {"pictures", "3"}, {"shapes", "4"}}), "Bild 1 von 3. Es hat 4 Formen.");
+  EXPECT_EQ(de.text(MessageId::picture_loaded, {{"picture", "1"}, {"pictures", "3"}, {"shapes", "4"}}),
+            "Bild 1 von 3. Es hat 4 Formen.");
 }
 
 void expect_refused(const std::string& file, const std::string& must_contain) {
@@ -123,7 +125,8 @@ TEST(MessageKeys, KeyPlaceholdersAreFilledWithTheSpokenForm) {
             "A USB stick with one document: a picture. Press the space bar to go through them.");
   EXPECT_EQ(en.text(MessageId::tutorial_circle, {}, keys),
             "A circle. Press {where_key} to hear where your hand is. Press the space bar for the next shape.");
-  EXPECT_EQ(en.text(MessageId::key_previous, {}, keys), "The Backspace key: the picture before.") << "a key first in the text is capitalised";
+  EXPECT_EQ(en.text(MessageId::key_previous, {}, keys), "The Backspace key: the picture before.")
+      << "a key first in the text is capitalised";
   // Without the keys, the placeholder stays visible (a caller that forgot them is seen at once).
   EXPECT_NE(en.text(MessageId::welcome).find("{help_key}"), std::string::npos);
   // One pass: text put in is not searched for placeholders again.
@@ -137,12 +140,17 @@ TEST(MessageKeys, KeyPlaceholdersAreFilledWithTheSpokenForm) {
 TEST(MessageKeys, AKeyThatStartsASentenceStartsWithACapital) {
   // A translation that puts keys first: "{help_key} gives help." at the start and after a full stop, not mid-sentence.
   std::string de = read_text(kDir + "de.toml");
-  const std::string help_line = de.substr(de.find("\nhelp = "), de.find('\n', de.find("\nhelp = ") + 1) - de.find("\nhelp = "));
-  de = replaced(de, help_line, "\nhelp = \"{help_key} gibt Hilfe. {next_key} bringt das nächste Bild!  {finer_key} mehr, oder {coarser_key}? {describe_key}.\"");
+  const std::string help_line =
+      de.substr(de.find("\nhelp = "), de.find('\n', de.find("\nhelp = ") + 1) - de.find("\nhelp = "));
+  de = replaced(de, help_line,
+                "\nhelp = \"{help_key} gibt Hilfe. {next_key} bringt das nächste Bild!  {finer_key} mehr, oder "
+                "{coarser_key}? {describe_key}.\"");
   const MessageCatalog c = MessageCatalog::parse(de, "keys-first.toml");
-  const KeyArg keys[] = {{"help_key", "F1"}, {"next_key", "RIGHT"}, {"finer_key", "UP"}, {"coarser_key", "DOWN"}, {"describe_key", "D"}};
+  const KeyArg keys[] = {
+      {"help_key", "F1"}, {"next_key", "RIGHT"}, {"finer_key", "UP"}, {"coarser_key", "DOWN"}, {"describe_key", "D"}};
   EXPECT_EQ(c.text(MessageId::help, {}, keys),
-            "Die Taste F1 gibt Hilfe. Die Pfeiltaste nach rechts bringt das nächste Bild!  Die Pfeiltaste nach oben mehr, oder "
+            "Die Taste F1 gibt Hilfe. Die Pfeiltaste nach rechts bringt das nächste Bild!  Die Pfeiltaste nach oben "
+            "mehr, oder "
             "die Pfeiltaste nach unten? Die Taste D.");
   // English: "the Up arrow" after "Press" stays lower case; F1 has nothing to capitalise.
   const MessageCatalog& en = MessageCatalog::english();
@@ -179,7 +187,8 @@ TEST(MessageKeys, EnglishNamesKeysOnlyThroughPlaceholders) {
     EXPECT_NE(en.raw(where).find("{" + std::string(k) + "}"), std::string::npos) << k;
   }
   EXPECT_NE(en.raw(MessageId::welcome).find("{help_key}"), std::string::npos);
-  for (MessageId id : {MessageId::tutorial_start, MessageId::tutorial_circle, MessageId::tutorial_triangle, MessageId::stick_inserted}) {
+  for (MessageId id : {MessageId::tutorial_start, MessageId::tutorial_circle, MessageId::tutorial_triangle,
+                       MessageId::stick_inserted}) {
     EXPECT_NE(en.raw(id).find("{next_key}"), std::string::npos) << kMessageKeys[static_cast<std::size_t>(id)];
   }
 }
@@ -194,8 +203,10 @@ TEST(MessageKeys, GermanHasEveryKeyNameOfEnglish) {
   EXPECT_NE(de.text(MessageId::welcome, {}, keys).find("Drücken Sie die Taste F1 für Hilfe."), std::string::npos);
 }
 
-/// Loads de.toml changed by `edit` from a file named `file`; expects a one-line MessageError naming it and `must_contain`.
-void expect_translation_refused(const std::string& file, const std::function<std::string(std::string)>& edit, const std::string& must_contain) {
+/// Loads de.toml changed by `edit` from a file named `file`; expects a one-line MessageError naming it and
+/// `must_contain`.
+void expect_translation_refused(const std::string& file, const std::function<std::string(std::string)>& edit,
+                                const std::string& must_contain) {
   SCOPED_TRACE(file);
   const TempCatalog t(file, edit(read_text(kDir + "de.toml")));
   try {
@@ -210,25 +221,27 @@ void expect_translation_refused(const std::string& file, const std::function<std
 }
 
 TEST(MessageKeys, TranslationsMustNameExactlyTheEnglishKeys) {
-  expect_translation_refused("hk_keys_missing.toml",
-                             [](std::string s) { return replaced(s, "UP = \"die Pfeiltaste nach oben\"\n", ""); },
-                             "key_names.UP is missing");
-  expect_translation_refused("hk_keys_unknown.toml",
-                             [](std::string s) { return s + "ESCAPE = \"die Escape-Taste\"\n"; },
-                             "key_names.ESCAPE is not a key name the English catalogue has");
-  expect_translation_refused("hk_keys_empty.toml",
-                             [](std::string s) { return replaced(s, "F1 = \"die Taste F1\"", "F1 = \"\""); },
-                             "key_names.F1 must be 1 to 100 bytes");
-  expect_translation_refused("hk_keys_not_string.toml",
-                             [](std::string s) { return replaced(s, "KP_5 = \"die Taste 5 im Ziffernblock\"", "KP_5 = 5"); },
-                             "key_names.KP_5 is not a string");
-  expect_translation_refused("hk_keys_no_table.toml",
-                             [](std::string s) { return s.substr(0, s.find("[key_names]")); },
-                             "has no [key_names] table");
+  expect_translation_refused(
+      "hk_keys_missing.toml", [](std::string s) { return replaced(s, "UP = \"die Pfeiltaste nach oben\"\n", ""); },
+      "key_names.UP is missing");
+  expect_translation_refused(
+      "hk_keys_unknown.toml", [](std::string s) { return s + "ESCAPE = \"die Escape-Taste\"\n"; },
+      "key_names.ESCAPE is not a key name the English catalogue has");
+  expect_translation_refused(
+      "hk_keys_empty.toml", [](std::string s) { return replaced(s, "F1 = \"die Taste F1\"", "F1 = \"\""); },
+      "key_names.F1 must be 1 to 100 bytes");
+  expect_translation_refused(
+      "hk_keys_not_string.toml",
+      [](std::string s) { return replaced(s, "KP_5 = \"die Taste 5 im Ziffernblock\"", "KP_5 = 5"); },
+      "key_names.KP_5 is not a string");
+  expect_translation_refused(
+      "hk_keys_no_table.toml", [](std::string s) { return s.substr(0, s.find("[key_names]")); },
+      "has no [key_names] table");
   // A key placeholder is accepted where the English text has it, and refused where it has not.
-  expect_translation_refused("hk_keys_wrong_place.toml",
-                             [](std::string s) { return replaced(s, "volume_up = \"Lauter.\"", "volume_up = \"Lauter. {help_key}\""); },
-                             "messages.volume_up uses {help_key}");
+  expect_translation_refused(
+      "hk_keys_wrong_place.toml",
+      [](std::string s) { return replaced(s, "volume_up = \"Lauter.\"", "volume_up = \"Lauter. {help_key}\""); },
+      "messages.volume_up uses {help_key}");
 }
 
 TEST(Messages, OversizedFileIsRefusedBeforeParsing) {

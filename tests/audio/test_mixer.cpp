@@ -34,7 +34,8 @@ TEST(Volume, StepsLimitsAndReset) {
 void speak_tone(SpeechStream& s, double seconds) {
   const std::uint32_t gen = s.generation();
   std::vector<float> x(static_cast<std::size_t>(seconds * kSampleRateHz));
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = 0.2f * static_cast<float>(std::sin(2 * 3.14159265 * 200.0 * i / kSampleRateHz));
+  for (std::size_t i = 0; i < x.size(); ++i)
+    x[i] = 0.2f * static_cast<float>(std::sin(2 * 3.14159265 * 200.0 * i / kSampleRateHz));
   ASSERT_TRUE(s.push(gen, x.data(), x.size()));
   ASSERT_TRUE(s.finish(gen));
 }

@@ -31,7 +31,8 @@ bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == std::
 // Waits up to `timeout` for at least `n` callbacks.
 bool wait_for_callbacks(const AudioOutput& out, std::uint64_t n, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
-  while (out.callbacks() < n && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  while (out.callbacks() < n && std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   return out.callbacks() >= n;
 }
 
@@ -169,7 +170,7 @@ TEST(OutputPacer, ARealDeviceNeverWaitsEvenWithJitterAndDrift) {
   EXPECT_EQ(pacer.after(4096, start).count(), 0) << "the buffer primed at once";
   const double period_s = 512.0 / 48000.0 / 1.001;  // the card plays 0.1 % fast
   int waits = 0;
-  for (long i = 1; i < 24L * 3600 * 94; ++i) {  // a day of callbacks
+  for (long i = 1; i < 24L * 3600 * 94; ++i) {             // a day of callbacks
     const double jitter_s = ((i * 7919) % 11 - 5) * 1e-3;  // ±5 ms
     const auto now = start + duration_cast<nanoseconds>(duration<double>(i * period_s + jitter_s));
     waits += pacer.after(512, now).count() > 0;
@@ -188,7 +189,9 @@ TEST(Output, RenderInterleavedDuplicatesMonoAcrossChannelsInChunks) {
     EXPECT_EQ(src.calls.load(), 2u);
     EXPECT_EQ(src.frames.load(), frames);
     for (std::size_t i = 0; i < frames; ++i) {
-      for (int c = 0; c < channels; ++c) ASSERT_EQ(out[i * static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)], static_cast<float>(i)) << i;
+      for (int c = 0; c < channels; ++c)
+        ASSERT_EQ(out[i * static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)], static_cast<float>(i))
+            << i;
     }
     EXPECT_EQ(out.back(), -7.0f) << "wrote past the end";
   }

@@ -68,7 +68,8 @@ TEST(CueQueue, ProducerNeverWaitsAndEveryDropIsCounted) {
   while (ring.try_pop(e)) got.push_back(e.tick);
   EXPECT_EQ(static_cast<long>(got.size()), accepted.load());
   EXPECT_EQ(static_cast<std::uint64_t>(kTicks - accepted), ring.overflows());
-  EXPECT_GE(ring.overflows(), static_cast<std::uint64_t>(kHeadStart - 64)) << "the ring was full before the consumer started";
+  EXPECT_GE(ring.overflows(), static_cast<std::uint64_t>(kHeadStart - 64))
+      << "the ring was full before the consumer started";
   for (std::size_t i = 1; i < got.size(); ++i) ASSERT_LT(got[i - 1], got[i]);
 }
 

@@ -39,7 +39,8 @@ std::size_t nonzero(const std::vector<float>& x) {
 // `speech` (if given) gets only the samples read() reported, i.e. the utterance without those gaps.
 // Returns false on time-out.
 template <class Until>
-bool pull(SpeechStream& s, std::vector<float>& all, Until until, std::vector<float>* speech = nullptr, double timeout_s = 30) {
+bool pull(SpeechStream& s, std::vector<float>& all, Until until, std::vector<float>* speech = nullptr,
+          double timeout_s = 30) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   float buf[kChunk];
   while (!until()) {
@@ -66,7 +67,8 @@ TEST(Speech, RendersNonSilentAudioThatGrowsWithTheText) {
   SpeechParams fast;
   fast.rate_wpm = 330;
   const std::string t = "Picture two of five. It has seven shapes.";
-  EXPECT_LT(static_cast<double>(synthesize_speech(t, fast).size()), 0.75 * static_cast<double>(synthesize_speech(t, {}).size()));
+  EXPECT_LT(static_cast<double>(synthesize_speech(t, fast).size()),
+            0.75 * static_cast<double>(synthesize_speech(t, {}).size()));
   // Another voice works too (and the default one again afterwards).
   SpeechParams de;
   de.voice = "de";
@@ -139,7 +141,8 @@ TEST(Speech, ConcurrentCallersAreSerialised) {
   // espeak-ng carries a little state from the text it said last: "Hello there." comes out 7 % longer right
   // after "... because a key is pressed." (the first of kLong's two pieces, which the worker says between
   // these calls) than fresh. A call run inside another synthesis would give a mix of both, far longer.
-  for (std::size_t n : sizes) EXPECT_NEAR(static_cast<double>(n), static_cast<double>(ref), 0.10 * static_cast<double>(ref));
+  for (std::size_t n : sizes)
+    EXPECT_NEAR(static_cast<double>(n), static_cast<double>(ref), 0.10 * static_cast<double>(ref));
 }
 
 TEST(Speech, StreamsBeforeTheSentenceIsDone) {
@@ -148,10 +151,13 @@ TEST(Speech, StreamsBeforeTheSentenceIsDone) {
   Speaker speaker(stream, {});
   speaker.say(kLong);
   std::vector<float> all, speech;
-  ASSERT_TRUE(pull(stream, all, [&] { return !speech.empty(); }, &speech)) << "speech never started";
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speech.empty(); }, &speech))
+      << "speech never started";
   EXPECT_FALSE(speaker.wait_idle(0)) << "the first samples arrived only after the whole sentence was synthesised";
   EXPECT_TRUE(speaker.busy());
-  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy(); }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speaker.busy(); }, &speech));
   EXPECT_GT(stream.full_waits(), 0u);
   // Nothing lost or doubled on the way through the full ring (espeak-ng's length of a text varies by ~0.3 %).
   const double expected = static_cast<double>(synthesize_speech(kLong, {}).size());
@@ -190,9 +196,10 @@ TEST(Speech, SayingANewTextReplacesTheOneBeingHeard) {
   speaker.say(kLong);
   std::vector<float> all;
   ASSERT_TRUE(pull(stream, all, [&] { return nonzero(all) > static_cast<std::size_t>(0.3 * kSampleRateHz); }));
-  speaker.say(kShort);  // between two reads, as a key press would
+  speaker.say(kShort);        // between two reads, as a key press would
   std::vector<float> speech;  // what is heard after the cut, without the test's read-ahead gaps
-  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy(); }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speaker.busy(); }, &speech));
   // After the cut: the old text fades out within SpeechStream::kFadeSamples, then the new one only.
   const double expected = static_cast<double>(synthesize_speech(kShort, {}).size());
   EXPECT_NEAR(static_cast<double>(speech.size()), expected, 0.05 * expected + SpeechStream::kFadeSamples);
@@ -204,7 +211,8 @@ TEST(Speech, NewTextReplacesTheQueuedOne) {
   speaker.say(kLong);
   speaker.say(kShort);
   std::vector<float> all, speech;
-  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy() && !speech.empty(); }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speaker.busy() && !speech.empty(); }, &speech));
   // Only the second text plays: its length, not the ~12 times longer first one's (nor both).
   const double expected = static_cast<double>(synthesize_speech(kShort, {}).size());
   EXPECT_NEAR(static_cast<double>(speech.size()), expected, 0.05 * expected);
@@ -224,9 +232,11 @@ TEST(Speech, RepeatSaysTheLastTextAgainAndTheLogHasIt) {
   EXPECT_EQ(speaker.last_text(), "");
   speaker.say(kShort);
   std::vector<float> all, first, second;
-  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy() && !first.empty(); }, &first));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speaker.busy() && !first.empty(); }, &first));
   speaker.repeat();
-  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy() && !second.empty(); }, &second));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speaker.busy() && !second.empty(); }, &second));
   const double once = static_cast<double>(first.size());
   EXPECT_GT(once, 0.3 * kSampleRateHz);
   EXPECT_NEAR(static_cast<double>(second.size()), once, 0.05 * once);
@@ -264,7 +274,8 @@ TEST(Speech, DestroyedWhileSpeakingDoesNotHang) {
   Speaker speaker(stream, {});
   speaker.say(kShort);
   std::vector<float> all, speech;
-  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy() && !speech.empty(); }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speaker.busy() && !speech.empty(); }, &speech));
   const double expected = static_cast<double>(synthesize_speech(kShort, {}).size());
   EXPECT_NEAR(static_cast<double>(speech.size()), expected, 0.05 * expected);
 }
@@ -326,10 +337,12 @@ TEST(SpeechPieces, SentenceSizedPiecesThatAddUpToTheWholeText) {
     EXPECT_FALSE(p.empty());
     EXPECT_LE(p.size(), kSpeechPieceBytes) << p.substr(0, 60);
     EXPECT_TRUE(valid_utf8(p)) << "a piece cut inside a UTF-8 sequence: " << p.substr(0, 60);
-    EXPECT_FALSE(std::isspace(static_cast<unsigned char>(p.front())) || std::isspace(static_cast<unsigned char>(p.back())));
+    EXPECT_FALSE(std::isspace(static_cast<unsigned char>(p.front())) ||
+                 std::isspace(static_cast<unsigned char>(p.back())));
   }
   EXPECT_EQ(letters_of(joined(pieces)), letters_of(text)) << "every word, in order, none doubled";
-  EXPECT_EQ(pieces[0], "Sentence 0 of the manual tells how the part number 1000 fits, and why;") << "a sentence ends at ';' too";
+  EXPECT_EQ(pieces[0], "Sentence 0 of the manual tells how the part number 1000 fits, and why;")
+      << "a sentence ends at ';' too";
   EXPECT_EQ(pieces[1], "then Sentence 1 of the manual tells how the part number 1007 fits.");
   EXPECT_EQ(pieces.back(), "The end.");
   // A short text is one piece, as it was.
@@ -372,11 +385,14 @@ TEST(SpeechPieces, ThePieceHeardFollowsTheMixer) {
   EXPECT_EQ(speaker.piece_heard(), 0) << "asked for, not heard yet: its first piece is next";
   std::vector<float> all, speech;
   std::vector<std::pair<std::size_t, int>> changes;  // (samples of speech read, piece heard after them)
-  ASSERT_TRUE(pull(stream, all, [&] {
-    const int p = speaker.piece_heard();
-    if (changes.empty() || changes.back().second != p) changes.emplace_back(speech.size(), p);
-    return p < 0;
-  }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all,
+      [&] {
+        const int p = speaker.piece_heard();
+        if (changes.empty() || changes.back().second != p) changes.emplace_back(speech.size(), p);
+        return p < 0;
+      },
+      &speech));
   ASSERT_EQ(changes.size(), 4u) << "0, 1, 2, then over";
   EXPECT_EQ(changes[0].second, 0);
   EXPECT_EQ(changes[1].second, 1);
@@ -429,7 +445,8 @@ TEST(SpeechPause, PauseHoldsTheSpeechWhereItIsAndResumeGoesOn) {
   EXPECT_FALSE(speaker.pause()) << "nothing is being said";
   speaker.say(kLong);
   std::vector<float> all, speech;
-  ASSERT_TRUE(pull(stream, all, [&] { return speech.size() > static_cast<std::size_t>(1.0 * kSampleRateHz); }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return speech.size() > static_cast<std::size_t>(1.0 * kSampleRateHz); }, &speech));
   ASSERT_TRUE(speaker.pause());
   EXPECT_TRUE(speaker.paused());
   EXPECT_FALSE(speaker.busy()) << "paused speech is not being heard";
@@ -443,7 +460,8 @@ TEST(SpeechPause, PauseHoldsTheSpeechWhereItIsAndResumeGoesOn) {
   EXPECT_FALSE(speaker.pause()) << "already paused";
   ASSERT_TRUE(speaker.resume());
   EXPECT_FALSE(speaker.resume());
-  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy(); }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speaker.busy(); }, &speech));
   // Nothing was dropped: the whole text was heard, in two parts.
   const double expected = static_cast<double>(synthesize_speech(kLong, {}).size());
   EXPECT_NEAR(static_cast<double>(speech.size()), expected, 0.05 * expected);
@@ -454,12 +472,14 @@ TEST(SpeechPause, ANewTextEndsThePause) {
   Speaker speaker(stream, {});
   speaker.say(kLong);
   std::vector<float> all, speech;
-  ASSERT_TRUE(pull(stream, all, [&] { return !speech.empty(); }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speech.empty(); }, &speech));
   ASSERT_TRUE(speaker.pause());
   speaker.say(kShort);
   EXPECT_FALSE(speaker.paused());
   speech.clear();
-  ASSERT_TRUE(pull(stream, all, [&] { return !speaker.busy() && !speech.empty(); }, &speech));
+  ASSERT_TRUE(pull(
+      stream, all, [&] { return !speaker.busy() && !speech.empty(); }, &speech));
   const double expected = static_cast<double>(synthesize_speech(kShort, {}).size());
   EXPECT_NEAR(static_cast<double>(speech.size()), expected, 0.05 * expected + SpeechStream::kFadeSamples);
 }

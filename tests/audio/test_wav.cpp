@@ -19,7 +19,9 @@ namespace fs = std::filesystem;
 namespace hk::audio {
 namespace {
 
-fs::path tmp(const std::string& name) { return fs::temp_directory_path() / ("hk_wav_" + std::to_string(::getpid()) + "_" + name); }
+fs::path tmp(const std::string& name) {
+  return fs::temp_directory_path() / ("hk_wav_" + std::to_string(::getpid()) + "_" + name);
+}
 
 std::string slurp(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
@@ -30,8 +32,12 @@ std::string slurp(const fs::path& p) {
 
 // A canonical 44-byte PCM16 WAV header, written by hand (independently of libsndfile).
 void put_header(std::ofstream& f, int channels, int rate, std::uint32_t data_bytes) {
-  auto u32 = [&](std::uint32_t v) { for (int i = 0; i < 4; ++i) f.put(static_cast<char>((v >> (8 * i)) & 0xFF)); };
-  auto u16 = [&](std::uint16_t v) { for (int i = 0; i < 2; ++i) f.put(static_cast<char>((v >> (8 * i)) & 0xFF)); };
+  auto u32 = [&](std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) f.put(static_cast<char>((v >> (8 * i)) & 0xFF));
+  };
+  auto u16 = [&](std::uint16_t v) {
+    for (int i = 0; i < 2; ++i) f.put(static_cast<char>((v >> (8 * i)) & 0xFF));
+  };
   f.write("RIFF", 4);
   u32(36 + data_bytes);
   f.write("WAVEfmt ", 8);
@@ -75,7 +81,8 @@ TEST(Wav, RoundTripSineAndSilenceWithin16BitQuantisation) {
     // 50 ms of a 440 Hz sine at 0.9, then 50 ms of silence.
     const std::size_t half = static_cast<std::size_t>(rate / 20);
     std::vector<float> x(2 * half, 0.0f);
-    for (std::size_t i = 0; i < half; ++i) x[i] = 0.9f * static_cast<float>(std::sin(2 * std::numbers::pi * 440.0 * static_cast<double>(i) / rate));
+    for (std::size_t i = 0; i < half; ++i)
+      x[i] = 0.9f * static_cast<float>(std::sin(2 * std::numbers::pi * 440.0 * static_cast<double>(i) / rate));
     const fs::path p = tmp("rt.wav");
     write_wav(p.string(), x, rate);
     EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
@@ -93,8 +100,14 @@ TEST(Wav, RoundTripSineAndSilenceWithin16BitQuantisation) {
 }
 
 TEST(Wav, ClipsOutOfRangeAndWritesNaNAsZero) {
-  const std::vector<float> x = {1.5f, -3.0f, 1.0f, -1.0f, std::numeric_limits<float>::quiet_NaN(),
-                                std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(), 0.25f};
+  const std::vector<float> x = {1.5f,
+                                -3.0f,
+                                1.0f,
+                                -1.0f,
+                                std::numeric_limits<float>::quiet_NaN(),
+                                std::numeric_limits<float>::infinity(),
+                                -std::numeric_limits<float>::infinity(),
+                                0.25f};
   const fs::path p = tmp("clip.wav");
   write_wav(p.string(), x, 48000);
   const std::vector<float> y = read_wav(p.string(), nullptr);
@@ -120,7 +133,8 @@ TEST(Wav, StereoFileIsMixedDownToMono) {
   const std::vector<float> y = read_wav(p.string(), &rate);
   EXPECT_EQ(rate, 44100);
   ASSERT_EQ(y.size(), 1000u);
-  for (int i = 0; i < 1000; ++i) ASSERT_NEAR(y[static_cast<std::size_t>(i)], (i * 16 - i * 8) / 2.0 / 32768.0, 1e-6) << i;
+  for (int i = 0; i < 1000; ++i)
+    ASSERT_NEAR(y[static_cast<std::size_t>(i)], (i * 16 - i * 8) / 2.0 / 32768.0, 1e-6) << i;
   fs::remove(p);
 }
 

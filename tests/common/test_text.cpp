@@ -21,14 +21,20 @@ TEST(OneLine, ControlBytesBecomeHexEscapes) {
 }
 
 TEST(OneLine, WellFormedUtf8IsKeptAndJunkEscaped) {
-  EXPECT_EQ(one_line("Stra\xc3\x9f" "e/\xe6\x97\xa5\xe6\x9c\xac.pdf"), "Stra\xc3\x9f" "e/\xe6\x97\xa5\xe6\x9c\xac.pdf");  // ß, 日本
-  EXPECT_EQ(one_line("\xf0\x9f\x90\x8e"), "\xf0\x9f\x90\x8e");                                    // U+1F40E, 4 bytes
-  EXPECT_EQ(one_line("\xff\xfe"), "\\xFF\\xFE");                                                  // never UTF-8
-  EXPECT_EQ(one_line("\xc0\xaf"), "\\xC0\\xAF");                                                  // overlong '/'
-  EXPECT_EQ(one_line("\xed\xa0\x80"), "\\xED\\xA0\\x80");                                         // surrogate U+D800
-  EXPECT_EQ(one_line("\xf4\x90\x80\x80"), "\\xF4\\x90\\x80\\x80");                                // above U+10FFFF
-  EXPECT_EQ(one_line("ab\xe6\x97"), "ab\\xE6\\x97");                                              // cut short
-  EXPECT_EQ(one_line("\xc2\x9b" "31m"), "\\xC2\\x9B" "31m");                                      // C1 CSI
+  EXPECT_EQ(one_line("Stra\xc3\x9f"
+                     "e/\xe6\x97\xa5\xe6\x9c\xac.pdf"),
+            "Stra\xc3\x9f"
+            "e/\xe6\x97\xa5\xe6\x9c\xac.pdf");                      // ß, 日本
+  EXPECT_EQ(one_line("\xf0\x9f\x90\x8e"), "\xf0\x9f\x90\x8e");      // U+1F40E, 4 bytes
+  EXPECT_EQ(one_line("\xff\xfe"), "\\xFF\\xFE");                    // never UTF-8
+  EXPECT_EQ(one_line("\xc0\xaf"), "\\xC0\\xAF");                    // overlong '/'
+  EXPECT_EQ(one_line("\xed\xa0\x80"), "\\xED\\xA0\\x80");           // surrogate U+D800
+  EXPECT_EQ(one_line("\xf4\x90\x80\x80"), "\\xF4\\x90\\x80\\x80");  // above U+10FFFF
+  EXPECT_EQ(one_line("ab\xe6\x97"), "ab\\xE6\\x97");                // cut short
+  EXPECT_EQ(one_line("\xc2\x9b"
+                     "31m"),
+            "\\xC2\\x9B"
+            "31m");  // C1 CSI
 }
 
 TEST(DecodeUtf8, WellFormedSequencesAndMaximalSubparts) {
@@ -44,8 +50,8 @@ TEST(DecodeUtf8, WellFormedSequencesAndMaximalSubparts) {
     EXPECT_EQ(step(ill).length, 1u) << ill;  // starts no sequence
   }
   EXPECT_FALSE(step("\xe6\x97X").well_formed);
-  EXPECT_EQ(step("\xe6\x97X").length, 2u);      // E6 97 is the longest well-formed prefix
-  EXPECT_EQ(step("\xed\xa0\x80").length, 1u);  // a surrogate: ED A0 is no prefix
+  EXPECT_EQ(step("\xe6\x97X").length, 2u);         // E6 97 is the longest well-formed prefix
+  EXPECT_EQ(step("\xed\xa0\x80").length, 1u);      // a surrogate: ED A0 is no prefix
   EXPECT_EQ(step("\xf4\x90\x80\x80").length, 1u);  // above U+10FFFF
 }
 

@@ -25,7 +25,7 @@ TEST(DeviceProfile, EveryProfilesDefaultsAreValidAndWithinWhatItsDeviceGives) {
     EXPECT_EQ(profile_problem(s, p.type), "");
     const double everywhere = force_everywhere_n(s, p.type);
     EXPECT_LE(s.haptics.max_force_n, everywhere);
-    EXPECT_GE(s.haptics.max_force_n, 0.85 * everywhere);  // the budget uses what the device has
+    EXPECT_GE(s.haptics.max_force_n, 0.85 * everywhere);      // the budget uses what the device has
     EXPECT_LT(s.haptics.pop_force_n, s.haptics.max_force_n);  // a visitor can press harder than the push-through force
     EXPECT_LT(s.haptics.tour_max_force_n, s.haptics.pop_force_n);
     EXPECT_LE(s.haptics.groove_depth_n, s.haptics.max_force_n);
@@ -86,7 +86,8 @@ TEST(DeviceProfile, AFileThatNamesAHaplyGetsItsBudget) {
   EXPECT_EQ(s.haptics.pop_force_n, 1.2);
   EXPECT_EQ(s.haptics.stiffness_n_per_m, 500.0);
   // What the file says within the profile stays; the rest is the profile's.
-  const Settings t = parse_settings("[haptics]\nstiffness_n_per_m = 700.0\n[device]\ntype = \"haply-gen2\"\n", "gen2.toml");
+  const Settings t =
+      parse_settings("[haptics]\nstiffness_n_per_m = 700.0\n[device]\ntype = \"haply-gen2\"\n", "gen2.toml");
   EXPECT_EQ(t.haptics.stiffness_n_per_m, 700.0);
   EXPECT_EQ(t.haptics.max_force_n, 1.45);
   EXPECT_EQ(t.device.encoder1_offset_deg, 241.0);
@@ -95,18 +96,28 @@ TEST(DeviceProfile, AFileThatNamesAHaplyGetsItsBudget) {
 }
 
 TEST(DeviceProfile, SettingsBeyondTheProfileAreRefusedWithTheLimitNamed) {
-  auto e = capture_error([] { (void)parse_settings("[haptics]\nmax_force_n = 3.5\n[device]\ntype = \"haply\"\n", "f.toml"); });
+  auto e = capture_error(
+      [] { (void)parse_settings("[haptics]\nmax_force_n = 3.5\n[device]\ntype = \"haply\"\n", "f.toml"); });
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "haptics.max_force_n");
-  EXPECT_EQ(std::string(e->what()), "config 'f.toml': haptics.max_force_n = 3.5 is more than the Haply 2DIY gen3 gives everywhere in its rectangle (1.65 N)");
-  e = capture_error([] { (void)parse_settings("[haptics]\nstiffness_n_per_m = 2000.0\n[device]\ntype = \"haply\"\n", "k.toml"); });
+  EXPECT_EQ(std::string(e->what()),
+            "config 'f.toml': haptics.max_force_n = 3.5 is more than the Haply 2DIY gen3 gives everywhere in its "
+            "rectangle (1.65 N)");
+  e = capture_error(
+      [] { (void)parse_settings("[haptics]\nstiffness_n_per_m = 2000.0\n[device]\ntype = \"haply\"\n", "k.toml"); });
   ASSERT_TRUE(e);
-  EXPECT_EQ(std::string(e->what()), "config 'k.toml': haptics.stiffness_n_per_m = 2000 is above the stable limit of the Haply 2DIY gen3 (850 N/m at 1000 Hz)");
-  e = capture_error([] { (void)parse_settings("[haptics]\npop_force_n = 1.6\n[device]\ntype = \"haply\"\n", "p.toml"); });
+  EXPECT_EQ(std::string(e->what()),
+            "config 'k.toml': haptics.stiffness_n_per_m = 2000 is above the stable limit of the Haply 2DIY gen3 (850 "
+            "N/m at 1000 Hz)");
+  e = capture_error(
+      [] { (void)parse_settings("[haptics]\npop_force_n = 1.6\n[device]\ntype = \"haply\"\n", "p.toml"); });
   ASSERT_TRUE(e);
-  EXPECT_EQ(std::string(e->what()), "config 'p.toml': haptics.pop_force_n = 1.6 must be <= haptics.max_force_n = 1.5 (no visitor could push through a wall)");
+  EXPECT_EQ(std::string(e->what()),
+            "config 'p.toml': haptics.pop_force_n = 1.6 must be <= haptics.max_force_n = 1.5 (no visitor could push "
+            "through a wall)");
   // A slower servo loop holds a proportionally softer wall.
-  e = capture_error([] { (void)parse_settings("[haptics]\nservo_rate_hz = 500.0\n[device]\ntype = \"haply\"\n", "r.toml"); });
+  e = capture_error(
+      [] { (void)parse_settings("[haptics]\nservo_rate_hz = 500.0\n[device]\ntype = \"haply\"\n", "r.toml"); });
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "haptics.stiffness_n_per_m");
   EXPECT_NE(std::string(e->what()).find("(425 N/m at 500 Hz)"), std::string::npos) << e->what();
@@ -114,8 +125,10 @@ TEST(DeviceProfile, SettingsBeyondTheProfileAreRefusedWithTheLimitNamed) {
 
 TEST(DeviceProfile, TheOperatorsPanelShowsEachLimit) {
   const Settings s = profile_defaults("haply");
-  EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "max_force_n"), "at most 1.65 N (what the Haply 2DIY gen3 gives everywhere)");
-  EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "stiffness_n_per_m"), "at most 850 N/m (stable on the Haply 2DIY gen3 at 1000 Hz)");
+  EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "max_force_n"),
+            "at most 1.65 N (what the Haply 2DIY gen3 gives everywhere)");
+  EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "stiffness_n_per_m"),
+            "at most 850 N/m (stable on the Haply 2DIY gen3 at 1000 Hz)");
   EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "pop_force_n"), "at most max_force_n (1.50 N)");
   EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "pop_hold_s"), "");
 }
@@ -141,7 +154,9 @@ TEST(DeviceProfile, AnAutoKioskThatTakesABoardMovesIntoItsProfile) {
   EXPECT_EQ(fit2.haptics.stiffness_n_per_m, 700.0);
   EXPECT_EQ(fit2.haptics.max_force_n, 1.5);
   ASSERT_EQ(notes.size(), 1u);
-  EXPECT_EQ(notes[0], "haptics.max_force_n = 3 is more than the Haply 2DIY gen3 gives everywhere in its rectangle (1.65 N); Haply 2DIY gen3 uses its own value");
+  EXPECT_EQ(notes[0],
+            "haptics.max_force_n = 3 is more than the Haply 2DIY gen3 gives everywhere in its rectangle (1.65 N); "
+            "Haply 2DIY gen3 uses its own value");
   EXPECT_EQ(profile_problem(fit2, "haply"), "");
 }
 
@@ -153,7 +168,8 @@ namespace {
 
 TEST(UsbIds, TheDefaultListHoldsEveryIdHaplysBoardsEnumerateWith) {
   const std::vector<UsbId> ids = parse_usb_ids(Settings{}.device.usb_ids);
-  const std::vector<UsbId> expected = {{0x2341, 0x003e}, {0x2341, 0x804d}, {0x2341, 0x004d}, {0x2341, 0x824d}, {0x2341, 0x024d}};
+  const std::vector<UsbId> expected = {
+      {0x2341, 0x003e}, {0x2341, 0x804d}, {0x2341, 0x004d}, {0x2341, 0x824d}, {0x2341, 0x024d}};
   EXPECT_EQ(ids, expected);
   EXPECT_EQ(parse_usb_ids(" 239A:8013 , 2341:804D"), (std::vector<UsbId>{{0x239a, 0x8013}, {0x2341, 0x804d}}));
 }
@@ -173,7 +189,8 @@ TEST(UsbIds, AMalformedListIsRefusedWithItsKeyAndTheForm) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "device.usb_ids");
   EXPECT_EQ(std::string(e->what()),
-            "config 'ids.toml': device.usb_ids = \"2341:80\" must be USB ids \"VVVV:PPPP\" (four hex digits each), comma-separated, e.g. "
+            "config 'ids.toml': device.usb_ids = \"2341:80\" must be USB ids \"VVVV:PPPP\" (four hex digits each), "
+            "comma-separated, e.g. "
             "\"2341:804d,2341:003e\" (line 2)");
 }
 

@@ -19,11 +19,18 @@ using test::capture_error;
 using test::is_one_line;
 
 /// The [keys] actions in table order, with their fields.
-constexpr std::array<std::pair<std::string_view, std::string KeysSettings::*>, 11> kActions{{
-    {"help", &KeysSettings::help}, {"next", &KeysSettings::next}, {"previous", &KeysSettings::previous},
-    {"describe", &KeysSettings::describe}, {"finer", &KeysSettings::finer}, {"coarser", &KeysSettings::coarser},
-    {"volume_up", &KeysSettings::volume_up}, {"volume_down", &KeysSettings::volume_down}, {"tutorial", &KeysSettings::tutorial},
-    {"guide", &KeysSettings::guide}, {"capture", &KeysSettings::capture}}};
+constexpr std::array<std::pair<std::string_view, std::string KeysSettings::*>, 11> kActions{
+    {{"help", &KeysSettings::help},
+     {"next", &KeysSettings::next},
+     {"previous", &KeysSettings::previous},
+     {"describe", &KeysSettings::describe},
+     {"finer", &KeysSettings::finer},
+     {"coarser", &KeysSettings::coarser},
+     {"volume_up", &KeysSettings::volume_up},
+     {"volume_down", &KeysSettings::volume_down},
+     {"tutorial", &KeysSettings::tutorial},
+     {"guide", &KeysSettings::guide},
+     {"capture", &KeysSettings::capture}}};
 
 TEST(KeysRule, ShippedKeysAreAllDifferentAndValid) { EXPECT_NO_THROW(validate(Settings{})); }
 
@@ -49,8 +56,8 @@ TEST(KeysRule, EveryPairOfActionsOnOneKeyIsRefusedNamingBoth) {
       ASSERT_TRUE(e);
       const std::string earlier = "keys." + std::string(kActions[i].first);
       EXPECT_EQ(e->key(), earlier);
-      EXPECT_EQ(std::string(e->what()), "settings: " + earlier + " = \"X\" is also keys." + std::string(kActions[j].first) +
-                                            "; each action needs its own key");
+      EXPECT_EQ(std::string(e->what()), "settings: " + earlier + " = \"X\" is also keys." +
+                                            std::string(kActions[j].first) + "; each action needs its own key");
       EXPECT_TRUE(is_one_line(e->what()));
       ++pairs;
     }
@@ -75,7 +82,8 @@ TEST(KeysRule, SwappingTwoKeysIsFine) {
   EXPECT_NO_THROW(validate(s));
   // Every action moved to another key name, all different: fine.
   const auto names = visitor_key_names();
-  for (std::size_t i = 0; i < kActions.size(); ++i) s.keys.*kActions[i].second = std::string(names[names.size() - 1 - i]);
+  for (std::size_t i = 0; i < kActions.size(); ++i)
+    s.keys.*kActions[i].second = std::string(names[names.size() - 1 - i]);
   EXPECT_NO_THROW(validate(s));
 }
 
@@ -84,7 +92,8 @@ TEST(KeysRule, ASettingsFileWithTwoActionsOnOneKeyIsRefused) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "keys.help");
   EXPECT_NE(std::string(e->what()).find("kiosk.toml"), std::string::npos) << e->what();
-  EXPECT_NE(std::string(e->what()).find("keys.help = \"D\" is also keys.describe; each action needs its own key"), std::string::npos)
+  EXPECT_NE(std::string(e->what()).find("keys.help = \"D\" is also keys.describe; each action needs its own key"),
+            std::string::npos)
       << e->what();
 }
 

@@ -25,8 +25,8 @@ bool contains(const std::string& s, const std::string& part) { return s.find(par
 TEST(ConfigLoad, EmptyTextGivesDefaults) { EXPECT_EQ(parse_settings("", "empty"), Settings{}); }
 
 TEST(ConfigLoad, PresentKeysOverrideAndOthersKeepDefaults) {
-  const Settings s = parse_settings(
-      "[haptics]\nstiffness_n_per_m = 1200.5\nlevel = 3\n[vision]\nmax_file_bytes = 2048\n", "t");
+  const Settings s =
+      parse_settings("[haptics]\nstiffness_n_per_m = 1200.5\nlevel = 3\n[vision]\nmax_file_bytes = 2048\n", "t");
   Settings expected;
   expected.haptics.stiffness_n_per_m = 1200.5;
   expected.haptics.level = 3;
@@ -65,7 +65,7 @@ TEST(ConfigLoad, ShippedDefaultFileIsUpToDate) {
 
 struct BadFile {
   const char* file;
-  const char* key;          // expected ConfigError::key(); "" when not about one key
+  const char* key;           // expected ConfigError::key(); "" when not about one key
   const char* must_contain;  // another part the message must contain
 };
 
@@ -93,17 +93,17 @@ TEST_P(ConfigBadFile, IsRefusedWithOneLineNamingFileAndKey) {
 
 INSTANTIATE_TEST_SUITE_P(
     Committed, ConfigBadFile,
-    ::testing::Values(
-        BadFile{"config_syntax.toml", "", "TOML syntax error at line 5"},
-        BadFile{"config_unknown_key.toml", "haptics.stifness_n_per_m",
-                "unknown key haptics.stifness_n_per_m (did you mean haptics.stiffness_n_per_m?) (line 3)"},
-        BadFile{"config_wrong_type.toml", "haptics.stiffness_n_per_m",
-                "haptics.stiffness_n_per_m = \"stiff\" has the wrong type (string); expected a number in "
-                "[10, 5000] N/m (line 3)"},
-        BadFile{"config_out_of_range.toml", "haptics.stiffness_n_per_m",
-                "haptics.stiffness_n_per_m = -5 is out of range [10, 5000] N/m (line 3)"},
-        BadFile{"config_nan.toml", "haptics.max_force_n",
-                "haptics.max_force_n = nan is not a finite number; allowed range [0.1, 20] N"}),
+    ::testing::Values(BadFile{"config_syntax.toml", "", "TOML syntax error at line 5"},
+                      BadFile{
+                          "config_unknown_key.toml", "haptics.stifness_n_per_m",
+                          "unknown key haptics.stifness_n_per_m (did you mean haptics.stiffness_n_per_m?) (line 3)"},
+                      BadFile{"config_wrong_type.toml", "haptics.stiffness_n_per_m",
+                              "haptics.stiffness_n_per_m = \"stiff\" has the wrong type (string); expected a number in "
+                              "[10, 5000] N/m (line 3)"},
+                      BadFile{"config_out_of_range.toml", "haptics.stiffness_n_per_m",
+                              "haptics.stiffness_n_per_m = -5 is out of range [10, 5000] N/m (line 3)"},
+                      BadFile{"config_nan.toml", "haptics.max_force_n",
+                              "haptics.max_force_n = nan is not a finite number; allowed range [0.1, 20] N"}),
     [](const auto& info) {
       std::string n = info.param.file;
       return n.substr(0, n.find('.'));
@@ -154,8 +154,7 @@ TEST(ConfigLoad, InvalidUtf8IsASyntaxError) {
 }
 
 TEST(ConfigLoad, DuplicateKeyIsASyntaxError) {
-  auto e = capture_error(
-      [&] { (void)parse_settings("[haptics]\nlevel = 1\nlevel = 2\n", "dup.toml"); });
+  auto e = capture_error([&] { (void)parse_settings("[haptics]\nlevel = 1\nlevel = 2\n", "dup.toml"); });
   ASSERT_TRUE(e);
   EXPECT_TRUE(contains(e->what(), "config 'dup.toml': TOML syntax error at line 3")) << e->what();
 }
@@ -239,7 +238,8 @@ TEST(ConfigLoad, EveryKeyBelowMinOrAboveMaxIsRefusedNamingIt) {
       ASSERT_TRUE(e) << text;
       const std::string msg = e->what();
       EXPECT_EQ(e->key(), spec.name()) << msg;
-      EXPECT_TRUE(contains(msg, "config 'range.toml': " + spec.name() + " = " + shown(spec, bad) + " is out of range ["))
+      EXPECT_TRUE(
+          contains(msg, "config 'range.toml': " + spec.name() + " = " + shown(spec, bad) + " is out of range ["))
           << msg;
       EXPECT_TRUE(contains(msg, "(line 2)")) << msg;
       EXPECT_TRUE(is_one_line(msg)) << msg;
@@ -258,12 +258,15 @@ TEST(ConfigLoad, EveryKeyAtItsBoundsIsAccepted) {
       // enough for the largest forces, its servo rate fast enough for the largest stiffness.
       const std::string strong = "max_force_n = 20.0\n[device]\nmax_torque_n_m = 10.0\n";
       const std::string weak = "pop_force_n = 0.0\ntour_max_force_n = 0.1\ngroove_depth_n = 0.05\nmax_force_n = 0.1\n";
-      if (spec.name() == "haptics.tour_max_force_n") text += "pop_force_n = 20.0\n";  // the tour stays below the push-through force
+      if (spec.name() == "haptics.tour_max_force_n")
+        text += "pop_force_n = 20.0\n";  // the tour stays below the push-through force
       if (spec.name() == "haptics.pop_force_n") text += "tour_max_force_n = 0.1\n";
-      if (spec.name() == "haptics.tour_max_force_n" || (ok == spec.max && (spec.name() == "haptics.pop_force_n" || spec.name() == "haptics.groove_depth_n")))
+      if (spec.name() == "haptics.tour_max_force_n" ||
+          (ok == spec.max && (spec.name() == "haptics.pop_force_n" || spec.name() == "haptics.groove_depth_n")))
         text += strong;
       if (ok == spec.max && spec.name() == "haptics.max_force_n") text += "[device]\nmax_torque_n_m = 10.0\n";
-      if (ok == spec.min && spec.name() == "haptics.max_force_n") text += "pop_force_n = 0.0\ntour_max_force_n = 0.1\ngroove_depth_n = 0.05\n";
+      if (ok == spec.min && spec.name() == "haptics.max_force_n")
+        text += "pop_force_n = 0.0\ntour_max_force_n = 0.1\ngroove_depth_n = 0.05\n";
       if (ok == spec.min && spec.name() == "device.max_torque_n_m") text += "[haptics]\n" + weak;
       if (ok == spec.max && spec.name() == "haptics.stiffness_n_per_m") text += "servo_rate_hz = 2000\n";
       if (ok == spec.min && spec.name() == "haptics.servo_rate_hz") text += "stiffness_n_per_m = 100.0\n";
@@ -328,15 +331,15 @@ TEST(ConfigLoad, DeviceTypeMustBeAKnownStringValue) {
   auto e = capture_error([&] { (void)parse_settings("[device]\ntype = \"usb\"\n", "t.toml"); });
   ASSERT_TRUE(e);
   EXPECT_EQ(std::string(e->what()),
-            "config 't.toml': device.type = \"usb\" is not a known value; allowed: one of \"auto\", \"simulated\", \"haply\", \"haply-gen2\" (line 2)");
+            "config 't.toml': device.type = \"usb\" is not a known value; allowed: one of \"auto\", \"simulated\", "
+            "\"haply\", \"haply-gen2\" (line 2)");
   e = capture_error([&] { (void)parse_settings("[device]\ntype = 3\n", "t.toml"); });
   ASSERT_TRUE(e);
   EXPECT_TRUE(contains(e->what(), "device.type = 3 has the wrong type (integer)")) << e->what();
 }
 
 TEST(ConfigLoad, CrossFieldRulesApplyToFiles) {
-  auto e = capture_error(
-      [&] { (void)parse_settings("[vision]\ncanny_low = 100\ncanny_high = 50\n", "x.toml"); });
+  auto e = capture_error([&] { (void)parse_settings("[vision]\ncanny_low = 100\ncanny_high = 50\n", "x.toml"); });
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "vision.canny_low");
   EXPECT_EQ(std::string(e->what()).rfind("config 'x.toml': ", 0), 0u) << e->what();

@@ -56,7 +56,7 @@ Settings non_default_settings() {
 constexpr std::int64_t kT0 = 1'700'000'000;
 
 mode_t file_mode(const fs::path& p) {
-  struct stat st{};
+  struct stat st {};
   EXPECT_EQ(::stat(p.c_str(), &st), 0) << p;
   return st.st_mode & 07777;
 }
@@ -133,8 +133,8 @@ TEST(OperatorPinHash, BadPinIsRefusedWithoutNamingIt) {
 TEST(OperatorPinHash, OutdatedParametersNeedARehash) {
   ASSERT_GE(sodium_init(), 0);
   char weak[crypto_pwhash_STRBYTES];
-  ASSERT_EQ(crypto_pwhash_str_alg(weak, "2468", 4, crypto_pwhash_argon2id_OPSLIMIT_MIN, crypto_pwhash_argon2id_MEMLIMIT_MIN,
-                                  crypto_pwhash_ALG_ARGON2ID13),
+  ASSERT_EQ(crypto_pwhash_str_alg(weak, "2468", 4, crypto_pwhash_argon2id_OPSLIMIT_MIN,
+                                  crypto_pwhash_argon2id_MEMLIMIT_MIN, crypto_pwhash_ALG_ARGON2ID13),
             0);
   EXPECT_TRUE(verify_pin(weak, "2468"));
   EXPECT_TRUE(pin_hash_needs_rehash(weak));
@@ -210,7 +210,8 @@ TEST(OperatorPinState, RoundTripsWithMode0600) {
 TEST(OperatorPinState, CorruptFileCountsAsThreeFailuresNow) {
   LetterDir dir;
   const fs::path path = dir.path() / "k.toml.state";
-  const std::string garbage("\xff\xfe\x00\x01\x9c\x80 failures = \x07\xc3\x28\x00\xa0\xa1\x8f\x0d\x0a\xf0\x28\x8c\xbc", 24);
+  const std::string garbage("\xff\xfe\x00\x01\x9c\x80 failures = \x07\xc3\x28\x00\xa0\xa1\x8f\x0d\x0a\xf0\x28\x8c\xbc",
+                            24);
   write_file(path, garbage);
   std::string note;
   EXPECT_EQ(read_lockout_state(path.string(), kT0 + 5, &note), (LockoutState{3, kT0 + 5}));
@@ -220,10 +221,10 @@ TEST(OperatorPinState, CorruptFileCountsAsThreeFailuresNow) {
   EXPECT_EQ(lockout_wait_s(read_lockout_state(path.string(), kT0 + 5), kT0 + 5), 30.0);
 
   // Nonsense that parses is as untrusted as garbage.
-  for (const std::string text : {"failures = -1\nlast_failure_unix_s = 0\n", "failures = 2\n",
-                                 "failures = \"2\"\nlast_failure_unix_s = 0\n",
-                                 "failures = 2\nlast_failure_unix_s = 0\nextra = 1\n", "",
-                                 "failures = 99999999999\nlast_failure_unix_s = 0\n"}) {
+  for (const std::string text :
+       {"failures = -1\nlast_failure_unix_s = 0\n", "failures = 2\n", "failures = \"2\"\nlast_failure_unix_s = 0\n",
+        "failures = 2\nlast_failure_unix_s = 0\nextra = 1\n", "",
+        "failures = 99999999999\nlast_failure_unix_s = 0\n"}) {
     write_file(path, text);
     EXPECT_EQ(read_lockout_state(path.string(), kT0, &note), (LockoutState{3, kT0})) << text;
     EXPECT_FALSE(note.empty()) << text;
@@ -328,8 +329,8 @@ TEST(OperatorPinCheck, RightPinRehashesAnOutdatedHashKeepingEverythingElse) {
   const std::string cfg = (dir.path() / "k.toml").string();
   ASSERT_GE(sodium_init(), 0);
   char weak[crypto_pwhash_STRBYTES];
-  ASSERT_EQ(crypto_pwhash_str_alg(weak, "2468", 4, crypto_pwhash_argon2id_OPSLIMIT_MIN, crypto_pwhash_argon2id_MEMLIMIT_MIN,
-                                  crypto_pwhash_ALG_ARGON2ID13),
+  ASSERT_EQ(crypto_pwhash_str_alg(weak, "2468", 4, crypto_pwhash_argon2id_OPSLIMIT_MIN,
+                                  crypto_pwhash_argon2id_MEMLIMIT_MIN, crypto_pwhash_ALG_ARGON2ID13),
             0);
   Settings s = non_default_settings();
   s.operator_.pin_hash = weak;

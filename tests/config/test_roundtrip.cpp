@@ -1,7 +1,7 @@
 // to_toml -> parse_settings gives back exactly the same Settings, and the text is operator-readable.
 
-#include <algorithm>
 #include <gtest/gtest.h>
+#include <algorithm>
 
 #include <random>
 #include <sstream>
@@ -201,8 +201,8 @@ Settings random_settings(std::mt19937_64& rng) {
     } else if (r < 0.10) {
       v = spec.max;
     } else if (spec.integer) {
-      v = static_cast<double>(std::uniform_int_distribution<long long>(
-          static_cast<long long>(spec.min), static_cast<long long>(spec.max))(rng));
+      v = static_cast<double>(std::uniform_int_distribution<long long>(static_cast<long long>(spec.min),
+                                                                       static_cast<long long>(spec.max))(rng));
     } else {
       v = std::uniform_real_distribution<double>(spec.min, spec.max)(rng);
     }
@@ -219,19 +219,26 @@ Settings random_settings(std::mt19937_64& rng) {
   if (s.haptics.max_levels < 1) s.haptics.max_levels = 1;
   if (s.haptics.level > s.haptics.max_levels) s.haptics.level = s.haptics.max_levels;
   if (s.vision.canny_low > s.vision.canny_high) std::swap(s.vision.canny_low, s.vision.canny_high);
-  if (s.haptics.dynamic_friction > s.haptics.static_friction) std::swap(s.haptics.dynamic_friction, s.haptics.static_friction);
+  if (s.haptics.dynamic_friction > s.haptics.static_friction)
+    std::swap(s.haptics.dynamic_friction, s.haptics.static_friction);
   // Within the simulated pantograph's profile (device_profile.hpp): forces it gives, stiffness it holds.
-  s.haptics.stiffness_n_per_m = std::min(s.haptics.stiffness_n_per_m, stiffness_limit_n_per_m(s.device.type, s.haptics.servo_rate_hz));
-  if (const double f = force_everywhere_n(s, s.device.type); f > 0.0) s.haptics.max_force_n = std::max(0.1, std::min(s.haptics.max_force_n, f));
+  s.haptics.stiffness_n_per_m =
+      std::min(s.haptics.stiffness_n_per_m, stiffness_limit_n_per_m(s.device.type, s.haptics.servo_rate_hz));
+  if (const double f = force_everywhere_n(s, s.device.type); f > 0.0)
+    s.haptics.max_force_n = std::max(0.1, std::min(s.haptics.max_force_n, f));
   s.haptics.pop_force_n = std::min(s.haptics.pop_force_n, s.haptics.max_force_n);
   s.haptics.tour_max_force_n = std::min(s.haptics.tour_max_force_n, s.haptics.max_force_n);
   s.haptics.groove_depth_n = std::min(s.haptics.groove_depth_n, s.haptics.max_force_n);
   if (s.haptics.pop_force_n > 0.0 && s.haptics.tour_max_force_n >= s.haptics.pop_force_n) {
-    if (s.haptics.pop_force_n > 0.2) s.haptics.tour_max_force_n = s.haptics.pop_force_n / 2; else s.haptics.pop_force_n = 0.0;
+    if (s.haptics.pop_force_n > 0.2)
+      s.haptics.tour_max_force_n = s.haptics.pop_force_n / 2;
+    else
+      s.haptics.pop_force_n = 0.0;
   }
   if (s.device.actuator1_port == s.device.actuator2_port) s.device.actuator2_port = s.device.actuator1_port % 4 + 1;
   if (s.device.encoder1_port == s.device.encoder2_port) s.device.encoder2_port = s.device.encoder1_port % 4 + 1;
-  s.device.motor_spacing_m = std::min(s.device.motor_spacing_m, 1.9 * (s.device.link_proximal_m + s.device.link_distal_m));
+  s.device.motor_spacing_m =
+      std::min(s.device.motor_spacing_m, 1.9 * (s.device.link_proximal_m + s.device.link_distal_m));
   return s;
 }
 

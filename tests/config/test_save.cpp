@@ -78,8 +78,7 @@ TEST(ConfigSave, InvalidSettingsAreNotSavedAndTheFileIsUntouched) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "haptics.max_force_n");
   EXPECT_EQ(std::string(e->what()),
-            "config '" + path.string() +
-                "': haptics.max_force_n = -1 is out of range [0.1, 20] N; not saved");
+            "config '" + path.string() + "': haptics.max_force_n = -1 is out of range [0.1, 20] N; not saved");
   EXPECT_EQ(read_file(path), "# operator's file\n[haptics]\nlevel = 2\n");
   EXPECT_EQ(list_dir(dir.path()), std::vector<std::string>{"settings.toml"});
 }

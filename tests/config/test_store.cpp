@@ -158,8 +158,9 @@ TEST(StoreBackup, WhereNoHardLinkIsAllowedTheOldFileIsCopiedToBak) {
   EXPECT_EQ(load_settings(path.string()), settings_b());
   const fs::path bak = dir.path() / "settings.toml.bak";
   EXPECT_EQ(read_file(bak), to_toml(settings_a()));
-  EXPECT_EQ(mode_of(bak), fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read | fs::perms::others_read);
-  struct stat st{};
+  EXPECT_EQ(mode_of(bak),
+            fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read | fs::perms::others_read);
+  struct stat st {};
   ASSERT_EQ(::stat(bak.c_str(), &st), 0);
   EXPECT_EQ(st.st_uid, kNobody) << "a copy, not a link to root's file";
   EXPECT_EQ(list_dir(dir.path()), (std::vector<std::string>{"settings.toml", "settings.toml.bak"}));
@@ -172,7 +173,8 @@ TEST(StoreBackup, InvalidSettingsAreRefusedBeforeAnyHook) {
   Settings bad;
   bad.haptics.level = 9;  // > max_levels
   int calls = 0;
-  auto e = capture_error([&] { save_settings_atomic(bad, path.string(), {.keep_backup = true, .hook = [&](SaveStage) { ++calls; }}); });
+  auto e = capture_error(
+      [&] { save_settings_atomic(bad, path.string(), {.keep_backup = true, .hook = [&](SaveStage) { ++calls; }}); });
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "haptics.level");
   EXPECT_EQ(calls, 0);
@@ -236,9 +238,12 @@ TEST_P(StoreCrash, ACrashLeavesTheOldOrTheNewFileAndALoadableBak) {
   UnsetEnvAtExit unset{kCrashDirEnv};
   const std::string path = (dir / "settings.toml").string();
 
-  EXPECT_EXIT(save_settings_atomic(fresh, path, {.keep_backup = true, .hook = [stage](SaveStage s) {
-                                                   if (s == stage) ::_exit(42);
-                                                 }}),
+  EXPECT_EXIT(save_settings_atomic(fresh, path,
+                                   {.keep_backup = true,
+                                    .hook =
+                                        [stage](SaveStage s) {
+                                          if (s == stage) ::_exit(42);
+                                        }}),
               ::testing::ExitedWithCode(42), "");
 
   const Settings now = load_settings(path);
@@ -273,9 +278,12 @@ TEST_P(StoreCrash, AThrowingHookLeavesNoTemporaryFiles) {
   struct Injected : std::runtime_error {
     Injected() : std::runtime_error("injected") {}
   };
-  EXPECT_THROW(save_settings_atomic(settings_c(), path, {.keep_backup = true, .hook = [stage](SaveStage s) {
-                                                           if (s == stage) throw Injected();
-                                                         }}),
+  EXPECT_THROW(save_settings_atomic(settings_c(), path,
+                                    {.keep_backup = true,
+                                     .hook =
+                                         [stage](SaveStage s) {
+                                           if (s == stage) throw Injected();
+                                         }}),
                Injected);
   EXPECT_EQ(load_settings(path), stage == SaveStage::renamed ? settings_c() : settings_b());
   EXPECT_EQ(load_settings(path + ".bak"), stage == SaveStage::temp_written ? settings_a() : settings_b());
@@ -287,9 +295,12 @@ INSTANTIATE_TEST_SUITE_P(EveryStage, StoreCrash,
                          ::testing::Values(SaveStage::temp_written, SaveStage::backup_kept, SaveStage::renamed),
                          [](const ::testing::TestParamInfo<SaveStage>& info) {
                            switch (info.param) {
-                             case SaveStage::temp_written: return std::string("temp_written");
-                             case SaveStage::backup_kept: return std::string("backup_kept");
-                             case SaveStage::renamed: return std::string("renamed");
+                             case SaveStage::temp_written:
+                               return std::string("temp_written");
+                             case SaveStage::backup_kept:
+                               return std::string("backup_kept");
+                             case SaveStage::renamed:
+                               return std::string("renamed");
                            }
                            return std::string("unknown");
                          });
@@ -340,8 +351,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(CorruptCase{"png", read_file(data_dir() / "images" / "coins.png")},
                       CorruptCase{"out_of_range", read_file(data_dir() / "bad" / "config_out_of_range.toml")},
                       CorruptCase{"syntax", read_file(data_dir() / "bad" / "config_syntax.toml")},
-                      CorruptCase{"cross_field", "[haptics]\nlevel = 9\n"},
-                      CorruptCase{"empty_table_name", "[]\n"},
+                      CorruptCase{"cross_field", "[haptics]\nlevel = 9\n"}, CorruptCase{"empty_table_name", "[]\n"},
                       CorruptCase{"too_large", std::string(kMaxConfigFileBytes + 1, '#')}),
     [](const ::testing::TestParamInfo<CorruptCase>& info) { return std::string(info.param.name); });
 
@@ -467,8 +477,8 @@ TEST(StoreAudit, DiffGivesEachChangedFieldAsTomlText) {
   Settings after;
   after.haptics.stiffness_n_per_m = 1200;
   after.keys.next = "N";
-  EXPECT_EQ(diff_settings(before, after),
-            (std::vector<SettingChange>{{"haptics.stiffness_n_per_m", "800.0", "1200.0"}, {"keys.next", "\"RIGHT\"", "\"N\""}}));
+  EXPECT_EQ(diff_settings(before, after), (std::vector<SettingChange>{{"haptics.stiffness_n_per_m", "800.0", "1200.0"},
+                                                                      {"keys.next", "\"RIGHT\"", "\"N\""}}));
   EXPECT_TRUE(diff_settings(after, after).empty());
   after.haptics.max_levels = 8;
   after.vision.max_file_bytes = 2048;
@@ -582,7 +592,8 @@ std::string loader_message_as_panel(const std::string& toml) {
   m = "operator panel: " + m.substr(file_prefix.size());
   // Drop a trailing " (line N)" (std::regex is avoided: GCC 12 warns about it under the sanitizers).
   if (const std::size_t at = m.rfind(" (line "); at != std::string::npos && m.back() == ')' &&
-      m.find_first_not_of("0123456789", at + 7) == m.size() - 1 && m.size() > at + 8)
+                                                 m.find_first_not_of("0123456789", at + 7) == m.size() - 1 &&
+                                                 m.size() > at + 8)
     m.erase(at);
   return m;
 }
@@ -635,11 +646,10 @@ INSTANTIATE_TEST_SUITE_P(
                       LoaderCase{"haptics", "stiffness_n_per_m", "inf", "inf"},
                       LoaderCase{"haptics", "stiffness_n_per_m", "nan", "nan"},
                       LoaderCase{"haptics", "max_levels", "13", "13"},
-                      LoaderCase{"haptics", "level", "7", "7"},  // cross-field: level <= max_levels (6)
+                      LoaderCase{"haptics", "level", "7", "7"},                // cross-field: level <= max_levels (6)
                       LoaderCase{"haptics", "static_friction", "0.1", "0.1"},  // cross-field: dynamic (0.3) <= static
                       LoaderCase{"vision", "max_file_bytes", "2147483649", "2147483649"},
-                      LoaderCase{"keys", "next", "FOO", "\"FOO\""},
-                      LoaderCase{"keys", "next", "right", "\"right\""},
+                      LoaderCase{"keys", "next", "FOO", "\"FOO\""}, LoaderCase{"keys", "next", "right", "\"right\""},
                       LoaderCase{"haptics", "level_mode", "sometimes", "\"sometimes\""},
                       LoaderCase{"device", "type", "phantom", "\"phantom\""},
                       LoaderCase{"operator", "open_chord", "O", "\"O\""},
@@ -662,10 +672,12 @@ TEST(StorePanelEdit, ANonNumberIsRefusedWithOneLine) {
             "operator panel: haptics.stiffness_n_per_m = \"abc\" is not a number; expected a number in [10, 5000] N/m");
   EXPECT_EQ(set_field_from_text(s, field("haptics", "stiffness_n_per_m"), ""),
             "operator panel: haptics.stiffness_n_per_m = \"\" is not a number; expected a number in [10, 5000] N/m");
-  EXPECT_EQ(set_field_from_text(s, field("haptics", "stiffness_n_per_m"), "1_000"),
-            "operator panel: haptics.stiffness_n_per_m = \"1_000\" is not a number; expected a number in [10, 5000] N/m");
-  EXPECT_EQ(set_field_from_text(s, field("haptics", "stiffness_n_per_m"), "12\n00"),
-            "operator panel: haptics.stiffness_n_per_m = \"12\\x0A00\" is not a number; expected a number in [10, 5000] N/m");
+  EXPECT_EQ(
+      set_field_from_text(s, field("haptics", "stiffness_n_per_m"), "1_000"),
+      "operator panel: haptics.stiffness_n_per_m = \"1_000\" is not a number; expected a number in [10, 5000] N/m");
+  EXPECT_EQ(
+      set_field_from_text(s, field("haptics", "stiffness_n_per_m"), "12\n00"),
+      "operator panel: haptics.stiffness_n_per_m = \"12\\x0A00\" is not a number; expected a number in [10, 5000] N/m");
   EXPECT_EQ(set_field_from_text(s, field("haptics", "level"), "two"),
             "operator panel: haptics.level = \"two\" is not a number; expected an integer in [0, 12]");
   EXPECT_EQ(s, before);
@@ -689,10 +701,12 @@ TEST(StorePanelEdit, CrossFieldRulesUseTheOtherValuesOfTheSettings) {
   s.haptics.max_levels = 3;
   EXPECT_EQ(set_field_from_text(s, field("haptics", "level"), "3"), "");
   const Settings before = s;
-  EXPECT_EQ(set_field_from_text(s, field("haptics", "level"), "4"),
-            "operator panel: haptics.level = 4 must be <= haptics.max_levels = 3 (only levels 0..max_levels are built)");
-  EXPECT_EQ(set_field_from_text(s, field("haptics", "max_levels"), "2"),
-            "operator panel: haptics.level = 3 must be <= haptics.max_levels = 2 (only levels 0..max_levels are built)");
+  EXPECT_EQ(
+      set_field_from_text(s, field("haptics", "level"), "4"),
+      "operator panel: haptics.level = 4 must be <= haptics.max_levels = 3 (only levels 0..max_levels are built)");
+  EXPECT_EQ(
+      set_field_from_text(s, field("haptics", "max_levels"), "2"),
+      "operator panel: haptics.level = 3 must be <= haptics.max_levels = 2 (only levels 0..max_levels are built)");
   EXPECT_EQ(s, before);
 }
 

@@ -114,7 +114,10 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
       ++texts;
       continue;
     }
-    if (name == "operator.open_chord" || name == "device.serial_path" || name == "device.usb_ids" || name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" || name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "kiosk.scene_cache" || name == "vision.ocr_languages") {
+    if (name == "operator.open_chord" || name == "device.serial_path" || name == "device.usb_ids" ||
+        name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" ||
+        name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "kiosk.scene_cache" ||
+        name == "vision.ocr_languages") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -170,11 +173,11 @@ TEST(ConfigValidate, BoundsThemselvesAreAccepted) {
   for (const auto& spec : numeric_specs()) {
     for (double ok : {spec.min, spec.max}) {
       Settings s;
-      s.haptics.max_levels = 12;  // so that haptics.level = 12 passes the cross-field rule
+      s.haptics.max_levels = 12;        // so that haptics.level = 12 passes the cross-field rule
       s.haptics.static_friction = 2.0;  // and any dynamic friction passes dynamic <= static...
       if (spec.name() == "haptics.static_friction") s.haptics.dynamic_friction = 0.0;  // ...and any static
-      s.device.link_distal_m = 0.5;  // so that any motor spacing lets the links meet
-      s.haptics.pop_force_n = 20.0;  // so that any tour force stays below the push-through force...
+      s.device.link_distal_m = 0.5;      // so that any motor spacing lets the links meet
+      s.haptics.pop_force_n = 20.0;      // so that any tour force stays below the push-through force...
       s.haptics.tour_max_force_n = 0.1;  // ...and any push-through force above the tour's
       // Within the simulated pantograph's profile (device_profile.hpp): motors strong enough for the largest
       // forces and a servo rate fast enough for the largest stiffness; the weakest motors and the slowest
@@ -182,7 +185,8 @@ TEST(ConfigValidate, BoundsThemselvesAreAccepted) {
       s.haptics.max_force_n = 20.0;
       s.device.max_torque_n_m = 10.0;
       s.haptics.servo_rate_hz = 2000.0;
-      const bool weak = (spec.name() == "haptics.max_force_n" || spec.name() == "device.max_torque_n_m") && ok == spec.min;
+      const bool weak =
+          (spec.name() == "haptics.max_force_n" || spec.name() == "device.max_torque_n_m") && ok == spec.min;
       if (weak) {
         s.haptics.max_force_n = 0.1;
         s.haptics.pop_force_n = 0.0;
@@ -266,7 +270,9 @@ TEST(ConfigValidate, TheTourMustPullLessThanAPushThrough) {
   auto e = capture_error([&] { validate(s); });
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "haptics.tour_max_force_n");
-  EXPECT_EQ(std::string(e->what()), "settings: haptics.tour_max_force_n = 2 must be < haptics.pop_force_n = 2 (the guided tour must not push the hand through a wall)");
+  EXPECT_EQ(std::string(e->what()),
+            "settings: haptics.tour_max_force_n = 2 must be < haptics.pop_force_n = 2 (the guided tour must not push "
+            "the hand through a wall)");
   s.haptics.pop_force_n = 0.0;  // walls never give way: any tour force is fine
   EXPECT_NO_THROW(validate(s));
 }
@@ -323,7 +329,8 @@ TEST(ConfigValidate, UnknownDeviceTypeIsRefused) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->key(), "device.type");
   EXPECT_EQ(std::string(e->what()),
-            "settings: device.type = \"mouse\" is not a known value; allowed: one of \"auto\", \"simulated\", \"haply\", \"haply-gen2\"");
+            "settings: device.type = \"mouse\" is not a known value; allowed: one of \"auto\", \"simulated\", "
+            "\"haply\", \"haply-gen2\"");
 }
 
 TEST(ConfigValidate, ControlCharactersInValuesDoNotBreakTheLine) {
@@ -335,7 +342,6 @@ TEST(ConfigValidate, ControlCharactersInValuesDoNotBreakTheLine) {
   EXPECT_NE(std::string(e->what()).find("sim\\x0Aulated\\x0D\\x01"), std::string::npos) << e->what();
 }
 
-
 // [operator] open_chord: what parse_chord reads, and what it refuses with a phrase saying why.
 TEST(OperatorChord, ParsesModifiersInAnyOrderAndRefusesWhatAVisitorCouldPressAlone) {
   std::string why;
@@ -346,7 +352,8 @@ TEST(OperatorChord, ParsesModifiersInAnyOrderAndRefusesWhatAVisitorCouldPressAlo
   EXPECT_EQ(chord_text(*c), "CTRL+ALT+O");
   EXPECT_EQ(parse_chord(chord_text(*c)), c);
   EXPECT_TRUE(parse_chord("SUPER+F12"));
-  for (const char* bad : {"", "O", "SHIFT+O", "CTRL+", "+O", "CTRL+CTRL+O", "CTRL+ALT+Ö", "ctrl+alt+o", "CTRL+META+O"}) {
+  for (const char* bad :
+       {"", "O", "SHIFT+O", "CTRL+", "+O", "CTRL+CTRL+O", "CTRL+ALT+Ö", "ctrl+alt+o", "CTRL+META+O"}) {
     why.clear();
     EXPECT_FALSE(parse_chord(bad, &why)) << bad;
     EXPECT_FALSE(why.empty()) << bad;
@@ -404,7 +411,8 @@ TEST(QuietHours, ReadsTwoTimesAndKnowsWhetherAMinuteIsInThem) {
   EXPECT_FALSE(in_quiet_hours(*lunch, 11 * 60 + 59));
   EXPECT_FALSE(parse_quiet_hours(""));  // none
   std::string why;
-  for (const char* bad : {"24:00-07:00", "7:00-8:00", "22:00-22:00", "22:00 07:00", "22:60-07:00", "22:00-07:00x", "ab:cd-ef:gh"}) {
+  for (const char* bad :
+       {"24:00-07:00", "7:00-8:00", "22:00-22:00", "22:00 07:00", "22:60-07:00", "22:00-07:00x", "ab:cd-ef:gh"}) {
     why.clear();
     EXPECT_FALSE(parse_quiet_hours(bad, &why)) << bad;
     EXPECT_FALSE(why.empty()) << bad;

@@ -3,11 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <unordered_set>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
+#include <unordered_set>
 
 #include "crossing_grid.hpp"
 #include "curves.hpp"
@@ -46,7 +46,8 @@ void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
       while (k + 1 < s0 && m.arc_m[k + 1] <= arc) ++k;
       for (int l = 0; l < ci.levels; ++l) {
         const std::uint32_t node = ci.box_offset[l] + static_cast<std::uint32_t>(k >> l);
-        ASSERT_TRUE(box_contains(sc.box(node), src.points_m[j], tol)) << "curve " << c << " vertex " << j << " level " << l;
+        ASSERT_TRUE(box_contains(sc.box(node), src.points_m[j], tol))
+            << "curve " << c << " vertex " << j << " level " << l;
         // The level's measured error covers the vertex's distance from the segment standing for it.
         Vec2 a, b;
         sc.segment_points(node, &a, &b);
@@ -69,7 +70,8 @@ void check_containment(const Scene& sc, const std::vector<Polyline>& input) {
             Vec2 fa, fb;
             sc.segment({static_cast<int>(c), j, static_cast<int>(f)}, &fa, &fb);
             ASSERT_TRUE(box_contains(sc.box(node), fa, tol) && box_contains(sc.box(node), fb, tol))
-                << "curve " << c << " level " << l << " segment " << s << ": level-" << j << " segment " << f << " outside";
+                << "curve " << c << " level " << l << " segment " << s << ": level-" << j << " segment " << f
+                << " outside";
           }
         }
         // The links agree: a level-l segment's children are segments 2s and 2s+1 of level l−1.
@@ -206,7 +208,8 @@ TEST(CollisionTree, BoxesAreTightAroundTheOriginalUnderThem) {
   std::sort(ratio.begin(), ratio.end());
   const double median = ratio[ratio.size() / 2];
   EXPECT_LE(median, 1.05) << "median box half-width / true deviation over " << ratio.size() << " boxes";
-  std::printf("box half-width / true deviation: median %.4f, p90 %.4f over %zu boxes\n", median, ratio[ratio.size() * 9 / 10], ratio.size());
+  std::printf("box half-width / true deviation: median %.4f, p90 %.4f over %zu boxes\n", median,
+              ratio[ratio.size() * 9 / 10], ratio.size());
 }
 
 // Compact storage: a level is a run of slots, one per point, a closed curve's first point
@@ -230,7 +233,8 @@ TEST(CollisionTree, SegmentsRunBetweenTheLevelsPointsAndClosedLevelsCloseTheLoop
     closed += ci.closed ? 1 : 0;
     const CurveMultires m = build_multires(curves[sc.source_index(c)], ci.levels - 1);
     ASSERT_EQ(m.levels, ci.levels);
-    for (std::size_t i = 0; i < m.arc_m.size(); ++i) ASSERT_EQ(sc.level0_arc_m(c, i), m.arc_m[i]) << "curve " << c << " point " << i;
+    for (std::size_t i = 0; i < m.arc_m.size(); ++i)
+      ASSERT_EQ(sc.level0_arc_m(c, i), m.arc_m[i]) << "curve " << c << " point " << i;
     for (int l = 0; l < ci.levels; ++l) {
       const auto& pts = m.scaling[static_cast<std::size_t>(l)];
       ASSERT_EQ(ci.segment_count[l], ci.closed ? pts.size() : pts.size() - 1);
@@ -267,7 +271,8 @@ TEST(CollisionTree, SceneHierarchyHoldsEveryCoarsestSegmentOnce) {
   // Walk down from the scene root to the coarsest segments: each is reached exactly once, every
   // child box lies inside its parent's box, and no node fans out to more than a handful of children.
   std::vector<std::vector<int>> reached(sc.curve_count());
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) reached[c].assign(sc.curve(c).segment_count[sc.curve(c).levels - 1], 0);
+  for (std::size_t c = 0; c < sc.curve_count(); ++c)
+    reached[c].assign(sc.curve(c).segment_count[sc.curve(c).levels - 1], 0);
   std::vector<std::uint32_t> stack{sc.scene_root()};
   while (!stack.empty()) {
     const std::uint32_t node = stack.back();
@@ -377,7 +382,8 @@ TEST(CollisionTree, SceneErrorBoundIsTheWidestBoxOfAnyCurveAtThatLevel) {
   // A short curve (few levels) and a long one: past the short curve's coarsest level, its coarsest boxes
   // still count.
   std::mt19937 rng(12);
-  std::vector<Polyline> curves{test::random_blob(rng, {-0.03, 0}, 0.01, 16), test::random_blob(rng, {0.03, 0}, 0.02, 400)};
+  std::vector<Polyline> curves{test::random_blob(rng, {-0.03, 0}, 0.01, 16),
+                               test::random_blob(rng, {0.03, 0}, 0.02, 400)};
   const Scene sc = Scene::build(curves, 6);
   ASSERT_LT(sc.curve(0).levels, sc.curve(1).levels);
   EXPECT_EQ(sc.max_curve_levels(), std::max(sc.curve(0).levels, sc.curve(1).levels));
@@ -394,9 +400,9 @@ TEST(CollisionTree, SceneErrorBoundIsTheWidestBoxOfAnyCurveAtThatLevel) {
 
 TEST(CollisionTree, SkipsDegenerateCurves) {
   std::vector<Polyline> curves(3);
-  curves[0].points_m = {{0.01, 0.01}};                  // one point
-  curves[1].points_m = {{0.02, 0.02}, {0.02, 0.02}};    // zero length
-  curves[2].points_m = {{0.0, 0.0}, {0.01, 0.0}};       // two points: a single short wall
+  curves[0].points_m = {{0.01, 0.01}};                // one point
+  curves[1].points_m = {{0.02, 0.02}, {0.02, 0.02}};  // zero length
+  curves[2].points_m = {{0.0, 0.0}, {0.01, 0.0}};     // two points: a single short wall
   const Scene sc = Scene::build(curves, 6);
   EXPECT_EQ(sc.curve_count(), 1u);
   EXPECT_EQ(sc.skipped_curves(), 2u);
@@ -475,7 +481,8 @@ TEST(CollisionQuery, ToleranceStepsEqualBruteForceInEveryWalk) {
         ++hits;
         ASSERT_NEAR(h.t, t_ref, 1e-9);
         ASSERT_EQ(hw.t, h.t);
-        ASSERT_EQ(h.segment.level, sc.clamp_level(static_cast<std::size_t>(h.segment.curve), id)) << "a wall of the curve's own level";
+        ASSERT_EQ(h.segment.level, sc.clamp_level(static_cast<std::size_t>(h.segment.curve), id))
+            << "a wall of the curve's own level";
       }
     };
     Vec2 p{0.0, 0.0};
@@ -529,7 +536,8 @@ TEST(CollisionQuery, SkippingTheCurvesFoundListsEveryCurveWithinTheRadiusNearest
       Vec2 q;
       SegmentRef s;
       while (n < 32 && section.closest_point(p, id, kRadius_m, &q, &s, -1, nullptr, found, n)) {
-        ASSERT_LT(static_cast<std::size_t>(n), want.size()) << "id " << id << ": a curve beyond the radius, or one already skipped";
+        ASSERT_LT(static_cast<std::size_t>(n), want.size())
+            << "id " << id << ": a curve beyond the radius, or one already skipped";
         ASSERT_EQ(s.curve, want[static_cast<std::size_t>(n)].second) << "id " << id << ", the " << n << "th nearest";
         ASSERT_NEAR(distance(p, q), want[static_cast<std::size_t>(n)].first, 1e-12);
         found[n++] = s.curve;
@@ -575,7 +583,8 @@ bool below_walls(const Scene& sc, const BoundarySection& section, std::uint32_t 
 
 // A frontier: each node once, none below another, and no segment entry below the walls of any id in `ids`
 // (its box then holds those walls).
-void expect_frontier_serving(const Scene& sc, const BoundarySection& section, std::initializer_list<int> ids, const char* where) {
+void expect_frontier_serving(const Scene& sc, const BoundarySection& section, std::initializer_list<int> ids,
+                             const char* where) {
   std::unordered_set<std::uint32_t> in(section.section().begin(), section.section().end());
   ASSERT_EQ(in.size(), section.section().size()) << "a node twice in the section " << where;
   for (std::uint32_t node : section.section()) {
@@ -583,7 +592,8 @@ void expect_frontier_serving(const Scene& sc, const BoundarySection& section, st
       ASSERT_EQ(in.count(up), 0u) << "node " << node << " and its ancestor " << up << " both in the section " << where;
     }
     if (!sc.is_segment(node)) continue;
-    for (int id : ids) ASSERT_FALSE(below_walls(sc, section, node, id)) << "an entry below the walls of id " << id << " " << where;
+    for (int id : ids)
+      ASSERT_FALSE(below_walls(sc, section, node, id)) << "an entry below the walls of id " << id << " " << where;
   }
 }
 
@@ -647,7 +657,8 @@ TEST(CollisionQuery, LevelChangesKeepTheSectionAndEqualBruteForce) {
   ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {4}, "on the tree's frontier"));
   ASSERT_GT(entries_at_level(sc, section, 4), 1);
   section.first_hit(a, b, 5, nullptr, 0, QueryBudget{});
-  ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {4, 5}, "after a change to a coarser level past the items"));
+  ASSERT_NO_FATAL_FAILURE(
+      expect_frontier_serving(sc, section, {4, 5}, "after a change to a coarser level past the items"));
   EXPECT_GT(entries_at_level(sc, section, 5), 1) << "the refinement near the hit kept at the new level";
   EXPECT_EQ(entries_at_level(sc, section, 4), 0);
   // To a cut step: entries under the cut give way to the cut's segments over them.
@@ -668,10 +679,12 @@ TEST(CollisionQuery, LevelChangesKeepTheSectionAndEqualBruteForce) {
   std::mt19937 rng(41);
   const Scene big = Scene::build(random_scene(rng, 8, 8), 6);
   BoundarySection walk(big);
-  const int ids[9] = {0, 1, 2, 3, 4, kToleranceLevelBase + 1, kToleranceLevelBase + 5, kCutLevelBase + 1, kCutLevelBase + 4};
+  const int ids[9] = {
+      0, 1, 2, 3, 4, kToleranceLevelBase + 1, kToleranceLevelBase + 5, kCutLevelBase + 1, kCutLevelBase + 4};
   std::vector<std::vector<std::vector<Vec2>>> walls(9);
   for (int j = 0; j < 9; ++j) {
-    for (std::size_t c = 0; c < big.curve_count(); ++c) walls[static_cast<std::size_t>(j)].push_back(test::polyline_at(big, c, ids[j]));
+    for (std::size_t c = 0; c < big.curve_count(); ++c)
+      walls[static_cast<std::size_t>(j)].push_back(test::polyline_at(big, c, ids[j]));
   }
   std::uniform_real_distribution<double> step(-0.0004, 0.0004);
   std::uniform_int_distribution<int> pick(0, 8), run(20, 400);
@@ -735,7 +748,8 @@ TEST(CollisionQuery, BoundarySectionStaysSmallOnALongWalk) {
       ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {1}, ("at tick " + std::to_string(i)).c_str()));
     }
   }
-  std::printf("[ info ] section over %d ticks: mean %.1f, largest %zu entries\n", kTicks, static_cast<double>(total) / kTicks, largest);
+  std::printf("[ info ] section over %d ticks: mean %.1f, largest %zu entries\n", kTicks,
+              static_cast<double>(total) / kTicks, largest);
   // This scene is dense (300 overlapping curves): ~120 entries near the hand on average are real work.
   // Merges that could not keep up let the section reach 9 000–18 000 entries on this walk.
   EXPECT_LE(static_cast<double>(total) / kTicks, 250.0);
@@ -765,7 +779,8 @@ TEST(CollisionQuery, AFullSectionRefusesSplitsAndStillAnswersAsBruteForce) {
     walls0.push_back(test::polyline_at(sc, c, 0));
     walls3.push_back(test::polyline_at(sc, c, 3));
   }
-  const auto expect_brute = [&](Vec2 a, Vec2 b, int level, const std::vector<std::vector<Vec2>>& walls, const char* where) {
+  const auto expect_brute = [&](Vec2 a, Vec2 b, int level, const std::vector<std::vector<Vec2>>& walls,
+                                const char* where) {
     const SweepHit h = section.first_hit(a, b, level, nullptr, 0, QueryBudget{});
     double t_ref = 0.0;
     const bool hit_ref = brute_first_hit_of(sc, walls, a, b, &t_ref);
@@ -777,7 +792,8 @@ TEST(CollisionQuery, AFullSectionRefusesSplitsAndStillAnswersAsBruteForce) {
   const Vec2 left{-0.061, 0.0}, right{0.061, 0.0};
   const std::size_t full = BoundarySection::kMaxSectionEntries - 16;  // within a node's children of the bound
   const auto fill = [&](const char* where) {
-    for (int i = 0; i < 40; ++i) ASSERT_NO_FATAL_FAILURE(expect_brute(i % 2 ? right : left, i % 2 ? left : right, 0, walls0, where));
+    for (int i = 0; i < 40; ++i)
+      ASSERT_NO_FATAL_FAILURE(expect_brute(i % 2 ? right : left, i % 2 ? left : right, 0, walls0, where));
     ASSERT_GE(section.section().size(), full) << where;
     ASSERT_LE(section.section().size(), BoundarySection::kMaxSectionEntries + 16) << where;
     ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {0}, where));
@@ -788,7 +804,8 @@ TEST(CollisionQuery, AFullSectionRefusesSplitsAndStillAnswersAsBruteForce) {
   std::uniform_real_distribution<double> x(-0.06, 0.06), y(-0.004, 0.004);
   int while_full = 0;
   for (int i = 0; i < 300; ++i) {
-    ASSERT_NO_FATAL_FAILURE(expect_brute(i % 2 ? right : left, i % 2 ? left : right, 0, walls0, "the line, at the bound"));
+    ASSERT_NO_FATAL_FAILURE(
+        expect_brute(i % 2 ? right : left, i % 2 ? left : right, 0, walls0, "the line, at the bound"));
     while_full += section.section().size() >= full;
     const Vec2 a{x(rng), y(rng)}, b{x(rng), y(rng)};
     ASSERT_NO_FATAL_FAILURE(expect_brute(a, b, 0, walls0, "a sweep at the bound"));
@@ -802,13 +819,15 @@ TEST(CollisionQuery, AFullSectionRefusesSplitsAndStillAnswersAsBruteForce) {
   ASSERT_NO_FATAL_FAILURE(expect_brute(left, right, 3, walls3, "at the change to level 3"));
   EXPECT_LT(section.section().size(), 100u);
   for (int i = 0; i < 20; ++i) {
-    ASSERT_NO_FATAL_FAILURE(expect_brute(i % 2 ? left : right, i % 2 ? right : left, 3, walls3, "after a change to level 3"));
+    ASSERT_NO_FATAL_FAILURE(
+        expect_brute(i % 2 ? left : right, i % 2 ? right : left, 3, walls3, "after a change to level 3"));
   }
   ASSERT_NO_FATAL_FAILURE(expect_frontier_serving(sc, section, {0, 3}, "after the change"));
   // One byte a node, the wide frontier's parent links (4 B a wide node, with its byte, and 4 B an item) and the
   // bounded entries (~53 B each, 0.43 MB here; with 3 bytes a node this scene's 261 023 nodes made 1.2 MB).
   std::size_t items = 0;
-  for (std::size_t c = 0; c < sc.curve_count(); ++c) items += sc.curve(c).segment_count[wide_item_level(static_cast<int>(sc.curve(c).levels))];
+  for (std::size_t c = 0; c < sc.curve_count(); ++c)
+    items += sc.curve(c).segment_count[wide_item_level(static_cast<int>(sc.curve(c).levels))];
   EXPECT_LT(section.bytes(), sc.node_count() + 5 * sc.wide_index().nodes.size() + 4 * items + (std::size_t{1} << 19));
 }
 
@@ -851,7 +870,8 @@ void slide_along_walls(Vec2 offset, SlideCounts* out) {
       const Vec2 along = (w1 - w0) * (1.0 / std::max(distance(w0, w1), 1e-12));
       move = along * (dot(heading, along) >= 0 ? 0.0002 : -0.0002) + Vec2{jitter(rng), jitter(rng)};
     }
-    const Vec2 q{std::clamp(p.x + move.x, offset.x - 0.07, offset.x + 0.07), std::clamp(p.y + move.y, offset.y - 0.045, offset.y + 0.045)};
+    const Vec2 q{std::clamp(p.x + move.x, offset.x - 0.07, offset.x + 0.07),
+                 std::clamp(p.y + move.y, offset.y - 0.045, offset.y + 0.045)};
     const int n_excl = sliding > 0 ? 1 : 0;
     QueryStats st;
     const SweepHit h = section.first_hit(p, q, id, &resting, n_excl, QueryBudget{}, &st);
@@ -860,12 +880,14 @@ void slide_along_walls(Vec2 offset, SlideCounts* out) {
     ASSERT_EQ(h.hit, hit_ref) << "tick " << i << ", id " << id;
     if (hit_ref) {
       ASSERT_NEAR(h.t, t_ref, 1e-9) << "tick " << i << ", id " << id;
-      ASSERT_NE(std::find(near_refs.begin(), near_refs.end(), h.segment), near_refs.end()) << "tick " << i << ": the segment hit";
+      ASSERT_NE(std::find(near_refs.begin(), near_refs.end(), h.segment), near_refs.end())
+          << "tick " << i << ": the segment hit";
     }
     if (st.ball_walls) {
       ++walls_answers;
       ASSERT_EQ(st.section_box_tests, 0) << "tick " << i << ": the walls answer without a section scan";
-      ASSERT_LE(st.box_tests, 2) << "tick " << i << ": the walls answer without a box test but the merge checks it pays";
+      ASSERT_LE(st.box_tests, 2) << "tick " << i
+                                 << ": the walls answer without a box test but the merge checks it pays";
       walls_merges += st.merges;
     }
     if (test::brute_closest_distance(sc, q, id) < 0.001) {
@@ -883,9 +905,10 @@ void slide_along_walls(Vec2 offset, SlideCounts* out) {
       p = q;
     }
   }
-  std::printf("[ info ] sliding hand: %d hits, %d ticks within 1 mm of a wall, %.0f %% of them answered without a full query; "
-              "%d answers by the ball's walls, which made %d merges\n", hits, near_walls, 100.0 * near_walls_answered / std::max(near_walls, 1),
-              walls_answers, walls_merges);
+  std::printf(
+      "[ info ] sliding hand: %d hits, %d ticks within 1 mm of a wall, %.0f %% of them answered without a full query; "
+      "%d answers by the ball's walls, which made %d merges\n",
+      hits, near_walls, 100.0 * near_walls_answered / std::max(near_walls, 1), walls_answers, walls_merges);
   *out = SlideCounts{hits, near_walls, near_walls_answered, walls_answers, walls_merges};
 }
 
@@ -1017,7 +1040,10 @@ TEST(CollisionQuery, ExcludedSegmentIsIgnored) {
 TEST(CollisionQuery, AnytimeAnswerIsConservativeAndFromACoarserLevel) {
   int blocked = 0, exact = 0;
   starved_queries(
-      6, [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) { return section.first_hit(a, b, level, nullptr, 0, budget, &st); },
+      6,
+      [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) {
+        return section.first_hit(a, b, level, nullptr, 0, budget, &st);
+      },
       [](int) { return 0; },
       [](const SweepHit& h, const QueryBudget&, const QueryStats& st, bool, double, const Scene&) {
         if (!h.blocked) return;
@@ -1060,7 +1086,8 @@ std::vector<WideLeaf> wide_leaves(const Scene& sc) {
   std::vector<WideLeaf> out;
   for (const WideNode& n : sc.wide_index().nodes) {
     for (int i = 0; i < 4; ++i) {
-      if (n.child[i] != kWideEmpty && (n.child[i] & kWideLeaf)) out.push_back({n.child[i] & ~kWideLeaf, n.lo_x[i], n.lo_y[i], n.hi_x[i], n.hi_y[i]});
+      if (n.child[i] != kWideEmpty && (n.child[i] & kWideLeaf))
+        out.push_back({n.child[i] & ~kWideLeaf, n.lo_x[i], n.lo_y[i], n.hi_x[i], n.hi_y[i]});
     }
   }
   return out;
@@ -1125,7 +1152,8 @@ TEST(WideIndex, ItemsAppearOnceAndNodesHoldTheirChildren) {
       const WideNode& below = nodes[n.child[i]];
       for (int j = 0; j < 4; ++j) {
         if (below.child[j] == kWideEmpty) continue;
-        ASSERT_TRUE(n.lo_x[i] <= below.lo_x[j] && n.lo_y[i] <= below.lo_y[j] && below.hi_x[j] <= n.hi_x[i] && below.hi_y[j] <= n.hi_y[i]);
+        ASSERT_TRUE(n.lo_x[i] <= below.lo_x[j] && n.lo_y[i] <= below.lo_y[j] && below.hi_x[j] <= n.hi_x[i] &&
+                    below.hi_y[j] <= n.hi_y[i]);
       }
     }
   }
@@ -1168,7 +1196,8 @@ TEST(WideIndex, SplitsByRankAlongTheLongerAxis) {
       ++item_nodes;
     }
     for (std::size_t j = 1; j < order.size(); ++j) {
-      EXPECT_LE(n.hi_x[order[j - 1]], n.lo_x[order[j]] + 1e-5f) << "slots " << order[j - 1] << " and " << order[j] << " overlap along x";
+      EXPECT_LE(n.hi_x[order[j - 1]], n.lo_x[order[j]] + 1e-5f)
+          << "slots " << order[j - 1] << " and " << order[j] << " overlap along x";
       ++pairs;
     }
   }
@@ -1181,7 +1210,10 @@ TEST(WideIndex, SplitsByRankAlongTheLongerAxis) {
 TEST(WideIndex, AnytimeAnswerIsConservative) {
   int blocked = 0, exact = 0;
   starved_queries(
-      33, [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) { return section.first_hit_wide(a, b, level, nullptr, 0, budget, &st); },
+      33,
+      [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) {
+        return section.first_hit_wide(a, b, level, nullptr, 0, budget, &st);
+      },
       [](int i) { return i % 4 == 0 ? 2 : 0; },
       [](const SweepHit& h, const QueryBudget& budget, const QueryStats& st, bool hit_ref, double t_ref, const Scene&) {
         ASSERT_LE(budget.box_tests_used, budget.max_box_tests);  // no overrun: the wide walk has no section to scan
@@ -1225,9 +1257,13 @@ TEST(WideIndex, AnytimeAnswerAboveTheItemsIsConservativeAndNamesABoxAtOrAboveThe
   int blocked = 0, exact = 0, named = 0;
   static constexpr int kLevel = kWideItemLevel + 1;
   starved_queries(
-      34, [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) { return section.first_hit_wide(a, b, level, nullptr, 0, budget, &st); },
+      34,
+      [](BoundarySection& section, Vec2 a, Vec2 b, int level, QueryBudget& budget, QueryStats& st) {
+        return section.first_hit_wide(a, b, level, nullptr, 0, budget, &st);
+      },
       [](int) { return kLevel; },
-      [&named](const SweepHit& h, const QueryBudget& budget, const QueryStats& st, bool hit_ref, double t_ref, const Scene& sc) {
+      [&named](const SweepHit& h, const QueryBudget& budget, const QueryStats& st, bool hit_ref, double t_ref,
+               const Scene& sc) {
         ASSERT_LE(budget.box_tests_used, budget.max_box_tests);  // the descent's box tests are all optional
         if (!h.blocked) return;
         if (hit_ref) {
@@ -1243,6 +1279,6 @@ TEST(WideIndex, AnytimeAnswerAboveTheItemsIsConservativeAndNamesABoxAtOrAboveThe
       },
       &blocked, &exact);
   EXPECT_GT(blocked, 500);
-  EXPECT_GT(exact, 50);  // 98 here: a descent from the root needs more of the 1–12 box tests than a wide walk
+  EXPECT_GT(exact, 50);   // 98 here: a descent from the root needs more of the 1–12 box tests than a wide walk
   EXPECT_GT(named, 100);  // the descent got below the hierarchy before the budget ran out, often
 }

@@ -52,7 +52,7 @@ TEST(Contact, PushIntoWallStopsProxyOnItsSide) {
   const Trajectory r = drive(solver, line_path({0.0, 0.03}, {0.0, 0.017}, 100), 0);
   EXPECT_EQ(r.states.back(), ContactState::Edge);
   EXPECT_GT(r.proxies.back().y, 0.02);          // outside
-  EXPECT_NEAR(r.proxies.back().y, 0.02, 1e-5);   // on the wall
+  EXPECT_NEAR(r.proxies.back().y, 0.02, 1e-5);  // on the wall
   EXPECT_NEAR(r.proxies.back().x, 0.0, 1e-9);
   // Force pushes the handle back out: stiffness · penetration.
   EXPECT_NEAR(r.forces.back().y, cp.stiffness_n_per_m * (r.proxies.back().y - 0.017), 1e-9);
@@ -146,10 +146,14 @@ TEST(Contact, ForceIsStiffnessTimesSeparationUpToClamp) {
 TEST(Contact, ProxyNeverCrossesOnRandomWalks) {
   std::mt19937 rng(31);
   std::vector<Polyline> curves;
-  for (int i = 0; i < 6; ++i) curves.push_back(test::random_blob(rng, {-0.04 + 0.016 * i, 0.005 * (i % 3)}, 0.012, 120));
+  for (int i = 0; i < 6; ++i)
+    curves.push_back(test::random_blob(rng, {-0.04 + 0.016 * i, 0.005 * (i % 3)}, 0.012, 120));
   for (int i = 0; i < 4; ++i) curves.push_back(test::random_stroke(rng, {-0.05 + 0.03 * i, -0.03}, 0.0004, 150));
   curves.push_back(test::staircase_circle({0, 0}, 0.03, 0.00025));
-  struct Case { int level; int max_box_tests; };
+  struct Case {
+    int level;
+    int max_box_tests;
+  };
   for (const Case cs : {Case{0, 0}, Case{1, 0}, Case{3, 0}, Case{1, 3}, Case{0, 12}}) {
     const int level = cs.level;
     const Scene sc = Scene::build(curves, 5);
@@ -169,7 +173,8 @@ TEST(Contact, ProxyNeverCrossesOnRandomWalks) {
       solver.update(in, out);
       // Every move of the tick, checked with the independent predicate.
       ASSERT_EQ(out.path_m[0], prev);
-      for (int m = 1; m < out.path_count; ++m) crossings += test::count_crossings(sc, out.path_m[m - 1], out.path_m[m], level);
+      for (int m = 1; m < out.path_count; ++m)
+        crossings += test::count_crossings(sc, out.path_m[m - 1], out.path_m[m], level);
       ASSERT_EQ(out.path_m[out.path_count - 1], out.proxy_m);
       contacts += out.state != ContactState::Free;
       vertices += out.state == ContactState::Vertex;

@@ -57,8 +57,8 @@ LoopResult run_loop(const Scene& sc, ExplorerHand& hand, double seconds, bool ke
     servo.update(in, so);
     dev.write_force(so.force_n);
     const bool heard_pop = (so.contact.events & kEventPopThrough) != 0;
-    const HandCommand c =
-        hand.command(HandFeel{k * sp.period_s, dev.true_position_m(), dev.velocity_m_per_s(), dev.commanded_force_n(), heard_pop});
+    const HandCommand c = hand.command(
+        HandFeel{k * sp.period_s, dev.true_position_m(), dev.velocity_m_per_s(), dev.commanded_force_n(), heard_pop});
     r.handle_m.push_back(dev.true_position_m());
     r.max_command_force_n = std::max(r.max_command_force_n, c.max_force_n);
     if (keep_commands) r.commands.push_back(c);
@@ -150,7 +150,8 @@ TEST(ExplorerHand, SameFeelsGiveTheSameCommands) {
   for (int k = 0; k < 3000; ++k) {
     // A made-up feel: a wall pushing back along +x for a while, then nothing.
     const double t = k * 0.001;
-    const HandFeel f{t, {0.01 * std::sin(t), 0.005 * std::cos(2 * t)}, {0.01, 0.0}, k > 500 && k < 1500 ? Vec2{1.2, 0.1} : Vec2{}};
+    const HandFeel f{
+        t, {0.01 * std::sin(t), 0.005 * std::cos(2 * t)}, {0.01, 0.0}, k > 500 && k < 1500 ? Vec2{1.2, 0.1} : Vec2{}};
     const HandCommand ca = a.command(f), cb = b.command(f);
     ASSERT_EQ(ca.target_m, cb.target_m) << "tick " << k;
     ASSERT_EQ(ca.max_force_n, cb.max_force_n) << "tick " << k;
@@ -187,20 +188,21 @@ TEST(ExplorerHand, TracesASquareRoundThenPushesIntoItWithMoreThanThePopForce) {
       const double o = 0.0155;
       const Vec2 q = side == 0 ? Vec2{u, -o} : side == 1 ? Vec2{o, u} : side == 2 ? Vec2{u, o} : Vec2{-o, u};
       ++points;
-      traced += h.traced_at(q) || h.traced_at(q + Vec2{0.002, 0}) || h.traced_at(q - Vec2{0.002, 0}) || h.traced_at(q + Vec2{0, 0.002}) ||
-                h.traced_at(q - Vec2{0, 0.002});
+      traced += h.traced_at(q) || h.traced_at(q + Vec2{0.002, 0}) || h.traced_at(q - Vec2{0.002, 0}) ||
+                h.traced_at(q + Vec2{0, 0.002}) || h.traced_at(q - Vec2{0, 0.002});
     }
   EXPECT_GE(traced, points * 9 / 10) << traced << " of " << points;
   EXPECT_GE(h.stats().pops, 1) << "the sweep met the traced square again and pushed at it";
-  EXPECT_NEAR(r.max_command_force_n, 1.1 * p.pop_force_n, 1e-9) << "over the give-way force, under the wall's 3.5 N clamp";
+  EXPECT_NEAR(r.max_command_force_n, 1.1 * p.pop_force_n, 1e-9)
+      << "over the give-way force, under the wall's 3.5 N clamp";
 }
 
 TEST(ExplorerHand, OnAnEmptyWorkspaceItsPlansSweepEveryPlaceAboutASpacingApart) {
   // Nothing to feel: the plans alone must reach every cell of the memory grid, so no place of the workspace (less
   // the 3 mm margin) lies farther from the path than the footprint reaches (sweep_spacing_m across from the far side
-  // of the handle's cell, half a cell along), and the first pass must end. The lines lie about a spacing apart: on average a place is within a third of a
-  // spacing of the path (a perfect raster: a quarter), and the first pass takes no longer than 1.5 x its lines'
-  // length at the sweep speed.
+  // of the handle's cell, half a cell along), and the first pass must end. The lines lie about a spacing apart: on
+  // average a place is within a third of a spacing of the path (a perfect raster: a quarter), and the first pass takes
+  // no longer than 1.5 x its lines' length at the sweep speed.
   ExplorerParams p;
   for (std::uint64_t seed : {1u, 2u}) {
     p.seed = seed;

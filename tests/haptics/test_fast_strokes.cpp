@@ -43,7 +43,8 @@ int stroke_crossings(const Scene& sc, int level, const std::vector<std::pair<Vec
       in.level = level;
       solver.update(in, out);
       EXPECT_EQ(out.path_m[0], prev);
-      for (int m = 1; m < out.path_count; ++m) crossings += test::count_crossings(sc, out.path_m[m - 1], out.path_m[m], level);
+      for (int m = 1; m < out.path_count; ++m)
+        crossings += test::count_crossings(sc, out.path_m[m - 1], out.path_m[m], level);
       *contact_ticks += out.state != ContactState::Free;
       prev = out.proxy_m;
     }
@@ -97,16 +98,20 @@ TEST(FastStrokes, AcuteCornersAt2MetresPerSecond) {
     const double half = deg / 2 * M_PI / 180;
     // An open V with its apex at the origin, and a closed sliver triangle with the same apex angle.
     Polyline v, sliver;
-    v.points_m = {{-0.03 * std::cos(half), 0.03 * std::sin(half)}, {0.0, 0.0}, {-0.03 * std::cos(half), -0.03 * std::sin(half)}};
+    v.points_m = {
+        {-0.03 * std::cos(half), 0.03 * std::sin(half)}, {0.0, 0.0}, {-0.03 * std::cos(half), -0.03 * std::sin(half)}};
     sliver.closed = true;
-    sliver.points_m = {{0.0, 0.0}, {-0.03 * std::cos(half), 0.03 * std::sin(half)}, {-0.03 * std::cos(half), -0.03 * std::sin(half)}};
+    sliver.points_m = {
+        {0.0, 0.0}, {-0.03 * std::cos(half), 0.03 * std::sin(half)}, {-0.03 * std::cos(half), -0.03 * std::sin(half)}};
     for (const Polyline& p : {v, sliver}) {
       const Scene sc = Scene::build({p}, 0);
       for (const ContactParams& cp : contact_variants()) {
         int contacts = 0;
         // Through the apex, and through a point 5 mm inside the wedge where the walls are 0.9–2.6 mm apart.
-        EXPECT_EQ(stroke_crossings(sc, 0, strokes_through({0.0, 0.0}, 11), &contacts, cp), 0) << deg << "° apex, μ_s " << cp.static_friction;
-        EXPECT_EQ(stroke_crossings(sc, 0, strokes_through({-0.005, 0.0}, 13), &contacts, cp), 0) << deg << "° inside, μ_s " << cp.static_friction;
+        EXPECT_EQ(stroke_crossings(sc, 0, strokes_through({0.0, 0.0}, 11), &contacts, cp), 0)
+            << deg << "° apex, μ_s " << cp.static_friction;
+        EXPECT_EQ(stroke_crossings(sc, 0, strokes_through({-0.005, 0.0}, 13), &contacts, cp), 0)
+            << deg << "° inside, μ_s " << cp.static_friction;
         EXPECT_GT(contacts, 200) << "the strokes must actually hit the walls";
       }
     }

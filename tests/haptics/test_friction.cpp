@@ -116,7 +116,7 @@ TEST(Friction, HandStillMovingDoesNotStickSlip) {
   double prev_fx = 0.0;
   double max_jump = 0.0;
   for (int i = 1; i <= 2000; ++i) {
-    const double hx = 2e-5 * i;                                    // 20 mm/s
+    const double hx = 2e-5 * i;                                      // 20 mm/s
     const double depth = kDepth * (1.0 + 0.3 * std::sin(i * 0.05));  // pressing harder and softer
     const ContactOutput out = tick(w.solver, {hx, -depth}, {0.02, 0.0});
     if (i > 200) max_jump = std::max(max_jump, std::fabs(out.force_n.x - prev_fx));
@@ -148,7 +148,8 @@ double loop_work(const ContactParams& p, double depth, double* proxy_path_out) {
   const double R = 0.02;
   Polyline circle;
   circle.closed = true;
-  for (int k = 0; k < 400; ++k) circle.points_m.push_back({R * std::cos(2 * M_PI * k / 400), R * std::sin(2 * M_PI * k / 400)});
+  for (int k = 0; k < 400; ++k)
+    circle.points_m.push_back({R * std::cos(2 * M_PI * k / 400), R * std::sin(2 * M_PI * k / 400)});
   const Scene sc = Scene::build({circle}, 3);
   ContactSolver s(sc, p);
   std::vector<Vec2> path;
@@ -201,7 +202,8 @@ TEST(Friction, DefaultsKeepAHandPushingSlightlyAskewOnTheCurve) {
   Polyline circle;
   circle.closed = true;
   const double R = 0.02;
-  for (int k = 0; k < 256; ++k) circle.points_m.push_back({R * std::cos(2 * M_PI * k / 256), R * std::sin(2 * M_PI * k / 256)});
+  for (int k = 0; k < 256; ++k)
+    circle.points_m.push_back({R * std::cos(2 * M_PI * k / 256), R * std::sin(2 * M_PI * k / 256)});
   const Scene sc = Scene::build({circle}, 3);
   const double tilt = 15.0 * M_PI / 180.0;
   double slide[2] = {0.0, 0.0};

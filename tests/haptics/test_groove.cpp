@@ -79,7 +79,8 @@ std::vector<Vec2> raster(Vec2 lo, Vec2 hi, double spacing, double speed_m_per_s)
   for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
     const double len = distance(corners[i], corners[i + 1]);
     const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
-    for (int j = 0; j < n; ++j) pts.push_back(corners[i] + (static_cast<double>(j) / n) * (corners[i + 1] - corners[i]));
+    for (int j = 0; j < n; ++j)
+      pts.push_back(corners[i] + (static_cast<double>(j) / n) * (corners[i + 1] - corners[i]));
   }
   pts.push_back(corners.back());
   return pts;
@@ -102,7 +103,8 @@ struct SweepStats {
 };
 
 // Drives the servo loop with the handle at `pts` (kinematically: the device reports exactly these).
-SweepStats sweep(const Scene& sc, const ServoParams& sp, const std::vector<Vec2>& pts, std::vector<ServoOutput>* outs = nullptr) {
+SweepStats sweep(const Scene& sc, const ServoParams& sp, const std::vector<Vec2>& pts,
+                 std::vector<ServoOutput>* outs = nullptr) {
   SceneStep loop(sc, sp);
   loop.start(pts.front());
   SweepStats st;
@@ -314,15 +316,16 @@ TEST(GrooveContinuity, RandomBlobsAndStrokesWithLevelsFromSpeed) {
 namespace {
 
 struct DeviceRun {
-  std::vector<Vec2> handle;   // what the servo saw [m]
-  std::vector<Vec2> force;    // what it sent [N]
+  std::vector<Vec2> handle;  // what the servo saw [m]
+  std::vector<Vec2> force;   // what it sent [N]
   std::vector<ServoOutput> out;
   Vec2 final_true;
 };
 
 // Runs the servo loop on the simulated pantograph with a model hand pulled along target(t).
 template <class Target>
-DeviceRun run_device(const Scene& sc, const ServoParams& sp, Vec2 start, double seconds, const ModelHandParams* hand, Target target) {
+DeviceRun run_device(const Scene& sc, const ServoParams& sp, Vec2 start, double seconds, const ModelHandParams* hand,
+                     Target target) {
   SimPantographParams dp;
   SimulatedPantograph dev(dp, start);
   dev.open();
@@ -336,7 +339,8 @@ DeviceRun run_device(const Scene& sc, const ServoParams& sp, Vec2 start, double 
     in.sample = dev.read();
     loop.update(in, so);
     dev.write_force(so.force_n);
-    const Vec2 fh = hand ? model_hand_force(*hand, target(static_cast<double>(k) * sp.period_s), dev.true_position_m(), dev.velocity_m_per_s())
+    const Vec2 fh = hand ? model_hand_force(*hand, target(static_cast<double>(k) * sp.period_s), dev.true_position_m(),
+                                            dev.velocity_m_per_s())
                          : Vec2{0.0, 0.0};
     dev.step(sp.period_s, fh);
     run.handle.push_back(in.sample.handle_m);
@@ -361,7 +365,8 @@ TEST(GrooveOnDevice, ReleasedHandRestsInTheCentre) {
   const ModelHandParams* hands[] = {nullptr, &relaxed};
   for (const ModelHandParams* hand : hands) {
     const DeviceRun run = run_device(sc, sp, start, 3.0, hand, [&](double) { return start; });
-    EXPECT_LT(std::fabs(run.final_true.y), 0.0002) << (hand ? "relaxed hand" : "no hand") << ": rests at y = " << run.final_true.y;
+    EXPECT_LT(std::fabs(run.final_true.y), 0.0002)
+        << (hand ? "relaxed hand" : "no hand") << ": rests at y = " << run.final_true.y;
     // Settled: the last 0.2 s all within 0.2 mm of the line, in contact.
     for (std::size_t i = run.handle.size() - 200; i < run.handle.size(); ++i) {
       EXPECT_LT(std::fabs(run.handle[i].y), 0.0002);

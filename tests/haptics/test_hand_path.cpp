@@ -164,9 +164,9 @@ TEST_P(Raster, ConstantSpeedAndDurationIsLengthOverSpeed) {
 }
 
 INSTANTIATE_TEST_SUITE_P(HandPath, Raster,
-                         ::testing::Values(RasterCase{0.14, 0.09, 0.006, 0.08},     // kiosk defaults
-                                           RasterCase{0.10, 0.05, 0.007, 0.05},     // spacing not a divisor
-                                           RasterCase{0.14, 0.09, 0.2, 0.1},        // spacing > height
+                         ::testing::Values(RasterCase{0.14, 0.09, 0.006, 0.08},  // kiosk defaults
+                                           RasterCase{0.10, 0.05, 0.007, 0.05},  // spacing not a divisor
+                                           RasterCase{0.14, 0.09, 0.2, 0.1},     // spacing > height
                                            RasterCase{0.03, 0.02, 0.0011, 0.3}));
 
 TEST(HandPath, RasterRejectsBadArguments) {
@@ -182,7 +182,8 @@ TEST(HandPath, RasterWithLineSpeedsTimesEachLineAtItsSpeed) {
   const HandPath p = raster_path_with_line_speeds(0.14, 0.09, 0.03, {0.02, 0.2}, 0.05);
   const HandPath same_path = raster_path(0.14, 0.09, 0.03, 1.0);
   ASSERT_EQ(p.samples().size(), same_path.samples().size());
-  for (std::size_t i = 0; i < p.samples().size(); ++i) EXPECT_EQ(p.samples()[i].target_m, same_path.samples()[i].target_m);
+  for (std::size_t i = 0; i < p.samples().size(); ++i)
+    EXPECT_EQ(p.samples()[i].target_m, same_path.samples()[i].target_m);
   // Lines alternate 7 s and 0.7 s, steps take 0.6 s: 2·7 + 2·0.7 + 3·0.6 = 17.2 s.
   EXPECT_NEAR(p.duration_s(), 17.2, 1e-9);
   EXPECT_NEAR(p.samples()[1].t_s, 7.0, 1e-9);
@@ -255,7 +256,8 @@ const std::map<std::string, std::string>& bad_files() {
       {"hand_too_far_diagonal.csv", "line 3: point (0.8, -0.8) is"},
       {"hand_blank_line_in_middle.csv", "line 3: blank line"},
       {"hand_long_line.csv", "line 3: line longer than 1024 characters (limit)"},
-      // NUL, control bytes and bytes that are not UTF-8 come out as \\xNN (hk::one_line; a raw NUL would even cut what() short).
+      // NUL, control bytes and bytes that are not UTF-8 come out as \\xNN (hk::one_line; a raw NUL would even cut
+      // what() short).
       {"hand_binary.csv", "line 2: field t_s '\\x00\\x01\\x02\\xFF\\xFE\\x7F\\x1B[2J\\x00\\x00' is not a number"},
   };
   return files;
@@ -272,10 +274,12 @@ TEST(HandFile, EveryBadFileThrowsOneLineNamingIt) {
     EXPECT_NE(msg.find(name), std::string::npos) << name << ": " << msg;
     EXPECT_EQ(msg.find_first_of("\n\r"), std::string::npos) << name << ": not one line: " << msg;
     // Printable ASCII only (the test data paths are ASCII): binary junk is not echoed raw.
-    EXPECT_TRUE(std::all_of(msg.begin(), msg.end(), [](char ch) {
-      const auto u = static_cast<unsigned char>(ch);
-      return u >= 0x20 && u < 0x7f;
-    })) << name << ": unprintable byte in: " << msg;
+    EXPECT_TRUE(std::all_of(msg.begin(), msg.end(),
+                            [](char ch) {
+                              const auto u = static_cast<unsigned char>(ch);
+                              return u >= 0x20 && u < 0x7f;
+                            }))
+        << name << ": unprintable byte in: " << msg;
     const auto it = bad_files().find(name);
     if (it == bad_files().end()) {
       ADD_FAILURE() << name << " has no expected message in this test; add it to bad_files()";

@@ -274,7 +274,7 @@ TEST(HapiEmulator, FirmwareClampsAndQuantisesTorque) {
   send(e, torque_pkt(0.5, -0.06));
   double h1 = 0, h2 = 0;
   e.applied_haply_torques_n_m(&h1, &h2);
-  EXPECT_DOUBLE_EQ(h1, 0.123);                                       // duty 1023
+  EXPECT_DOUBLE_EQ(h1, 0.123);                                             // duty 1023
   EXPECT_DOUBLE_EQ(h2, -std::floor(1023 * 0.06f / 0.123) * 0.123 / 1023);  // duty ⌊1023·0.06/0.123⌋
 }
 
@@ -331,7 +331,7 @@ TEST(HapiEmulatorFaults, Disconnect) {
   for (int i = 0; i < 6; ++i) send(e, torque_pkt(0, 0));
   EXPECT_EQ(drain(e).size(), 2u * 9);  // replies at t = 1 ms and 2 ms only
   EXPECT_TRUE(e.disconnected());
-  EXPECT_EQ(e.torque_commands(), 3);   // input ignored from then on
+  EXPECT_EQ(e.torque_commands(), 3);  // input ignored from then on
   send(e, setup_pkt());
   send(e, torque_pkt(0, 0));
   EXPECT_EQ(e.output_pending(), 0);
@@ -422,7 +422,8 @@ Bytes read_some(int fd, std::size_t want, std::chrono::milliseconds timeout) {
   Bytes got;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (got.size() < want) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) break;
     pollfd pfd{fd, POLLIN, 0};
     if (::poll(&pfd, 1, static_cast<int>(left.count())) <= 0) break;

@@ -55,15 +55,15 @@ TEST(HapiProtocol, Gen3SetupGoldenBytes) {
   //   port 2 = actuator 1 (CW = 0), encoder 1 (CCW = 1, offset 180°, 4880).
   // Then sensor count 0 and pwm count 0 (none declared). Board.transmit puts [type = 1, id = 5] first.
   const Bytes expected = {
-      0x01, 0x05,                          // setup, device 5
-      0x03, 0x00, 0x00,                    // motor mask, dir port 1 (act 2 CW), dir port 2 (act 1 CW)
-      0x03, 0x01, 0x01,                    // encoder mask, dir port 1 (enc 2 CCW), dir port 2 (enc 1 CCW)
-      0x00,                                // sensors
-      0x00,                                // pwms
-      0x00, 0x00, 0x00, 0x00,              // port 1 (encoder 2) offset 0.0f
-      0x00, 0x80, 0x98, 0x45,              // port 1 resolution 4880.0f
-      0x00, 0x00, 0x34, 0x43,              // port 2 (encoder 1) offset 180.0f
-      0x00, 0x80, 0x98, 0x45,              // port 2 resolution 4880.0f
+      0x01, 0x05,              // setup, device 5
+      0x03, 0x00, 0x00,        // motor mask, dir port 1 (act 2 CW), dir port 2 (act 1 CW)
+      0x03, 0x01, 0x01,        // encoder mask, dir port 1 (enc 2 CCW), dir port 2 (enc 1 CCW)
+      0x00,                    // sensors
+      0x00,                    // pwms
+      0x00, 0x00, 0x00, 0x00,  // port 1 (encoder 2) offset 0.0f
+      0x00, 0x80, 0x98, 0x45,  // port 1 resolution 4880.0f
+      0x00, 0x00, 0x34, 0x43,  // port 2 (encoder 1) offset 180.0f
+      0x00, 0x80, 0x98, 0x45,  // port 2 resolution 4880.0f
   };
   EXPECT_EQ(setup_bytes(BoardLayout::haply_gen3()), expected);
   std::uint8_t small[25];
@@ -91,10 +91,10 @@ TEST(HapiProtocol, SetupMaskForSparsePorts) {
   EXPECT_EQ(b[2], 0x04);
   EXPECT_EQ(b[3], 0x01);  // CCW
   EXPECT_EQ(b[4], 0x09);
-  EXPECT_EQ(b[5], 0x01);  // port 1: encoder 2 CCW
-  EXPECT_EQ(b[6], 0x00);  // port 4: encoder 1 CW
+  EXPECT_EQ(b[5], 0x01);                   // port 1: encoder 2 CCW
+  EXPECT_EQ(b[6], 0x00);                   // port 4: encoder 1 CW
   EXPECT_EQ(get_f32_le(&b[9]), 0.0f);      // port 1 offset (after 7 sensor, 8 pwm counts)
-  EXPECT_EQ(get_f32_le(&b[17]), 180.0f);  // port 4 offset
+  EXPECT_EQ(get_f32_le(&b[17]), 180.0f);   // port 4 offset
   EXPECT_EQ(get_f32_le(&b[21]), 4880.0f);  // port 4 resolution
 }
 
@@ -115,8 +115,8 @@ TEST(HapiProtocol, TorquesClampedAndNonFiniteZeroed) {
   const double tau[4] = {1.0, std::numeric_limits<double>::quiet_NaN(), 0, 0};
   std::uint8_t b[kMaxPacketBytes];
   ASSERT_EQ(encode_torques(l, tau, 0.123, b, kMaxPacketBytes), 10);
-  EXPECT_EQ(get_f32_le(b + 2), 0.0f);     // actuator 2 (NaN) on port 1
-  EXPECT_EQ(get_f32_le(b + 6), 0.123f);   // actuator 1 clamped
+  EXPECT_EQ(get_f32_le(b + 2), 0.0f);    // actuator 2 (NaN) on port 1
+  EXPECT_EQ(get_f32_le(b + 6), 0.123f);  // actuator 1 clamped
   const double neg[4] = {-5.0, std::numeric_limits<double>::infinity(), 0, 0};
   ASSERT_EQ(encode_torques(l, neg, 0.1, b, kMaxPacketBytes), 10);
   EXPECT_EQ(get_f32_le(b + 2), 0.0f);
@@ -237,8 +237,8 @@ TEST(HaplyMechanism, OurForwardKinematicsEqualsHaplysRotated) {
 
 TEST(HaplyMechanism, AngleMapsRoundTripAndWrap) {
   const JointAngles q = joints_from_haply_deg(180.0, 0.0);
-  EXPECT_NEAR(q.theta2_rad, 0.0, 1e-12);   // Haply motor 1 at 180° points to our +x: right motor
-  EXPECT_NEAR(q.theta1_rad, kPi, 1e-12);   // Haply motor 2 at 0° points to our −x: left motor
+  EXPECT_NEAR(q.theta2_rad, 0.0, 1e-12);  // Haply motor 1 at 180° points to our +x: right motor
+  EXPECT_NEAR(q.theta1_rad, kPi, 1e-12);  // Haply motor 2 at 0° points to our −x: left motor
   const JointAngles q2 = joints_from_haply_deg(150.0, 30.0);
   EXPECT_GE(q2.theta1_rad, 0.0);
   EXPECT_LT(q2.theta1_rad, 2 * kPi);

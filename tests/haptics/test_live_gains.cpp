@@ -170,7 +170,7 @@ TEST(LiveGains, DampingChangeUnderAHandMovingIntoTheWallDoesNotStep) {
 
 TEST(LiveGains, LoweringFrictionUnderAStickingOrSlidingHandDoesNotStep) {
   const double k = 800.0, d = 0.002;  // the solver's depth below the wall's line (handle y = −d)
-  const double depth_line = d;         // friction cone: |tangential offset| ≤ μ · (depth below the line)
+  const double depth_line = d;        // friction cone: |tangential offset| ≤ μ · (depth below the line)
   ServoParams p = params(k);
   p.contact.static_friction = 0.8;
   p.contact.dynamic_friction = 0.8;

@@ -65,10 +65,17 @@ TEST(Pseudocoiflet, MultiLevelCurveReconstruction) {
     ASSERT_GE(m.levels, 4);
     // Rebuild level 0 from the coarsest scaling coefficients and all wavelet coefficients.
     std::vector<double> x, y, sx, sy, dx, dy;
-    for (const Vec2& q : m.scaling.back()) { sx.push_back(q.x); sy.push_back(q.y); }
+    for (const Vec2& q : m.scaling.back()) {
+      sx.push_back(q.x);
+      sy.push_back(q.y);
+    }
     for (int l = m.levels - 1; l >= 1; --l) {
-      dx.clear(); dy.clear();
-      for (const Vec2& w : m.wavelet[l]) { dx.push_back(w.x); dy.push_back(w.y); }
+      dx.clear();
+      dy.clear();
+      for (const Vec2& w : m.wavelet[l]) {
+        dx.push_back(w.x);
+        dy.push_back(w.y);
+      }
       pseudocoiflet_inverse(sx, dx, closed, x);
       pseudocoiflet_inverse(sy, dy, closed, y);
       sx = x;
@@ -89,21 +96,27 @@ TEST(Pseudocoiflet, BothCoordinatesAtOnceAreBitForBitTheOneCoordinateStep) {
   std::mt19937 rng(11);
   for (bool closed : {true, false}) {
     for (int points : {8, 9, 17, 33, 300}) {
-      const Polyline p = closed ? test::random_blob(rng, {0, 0}, 0.03, points) : test::random_stroke(rng, {0, 0}, 0.0005, points);
+      const Polyline p =
+          closed ? test::random_blob(rng, {0, 0}, 0.03, points) : test::random_stroke(rng, {0, 0}, 0.0005, points);
       const CurveMultires m = build_multires(p, 6);
       ASSERT_GE(m.levels, 2) << points;
       for (int l = 1; l < m.levels; ++l) {
         std::vector<double> x, y, sx, sy, dx, dy;
-        for (const Vec2& q : m.scaling[l - 1]) { x.push_back(q.x); y.push_back(q.y); }
+        for (const Vec2& q : m.scaling[l - 1]) {
+          x.push_back(q.x);
+          y.push_back(q.y);
+        }
         pseudocoiflet_forward(x, closed, sx, dx);
         pseudocoiflet_forward(y, closed, sy, dy);
         ASSERT_EQ(m.scaling[l].size(), sx.size());
         ASSERT_EQ(m.wavelet[l].size(), dx.size());
         for (std::size_t i = 0; i < sx.size(); ++i) {
-          EXPECT_EQ(m.scaling[l][i], (Vec2{sx[i], sy[i]})) << (closed ? "closed " : "open ") << points << " level " << l << " i " << i;
+          EXPECT_EQ(m.scaling[l][i], (Vec2{sx[i], sy[i]}))
+              << (closed ? "closed " : "open ") << points << " level " << l << " i " << i;
         }
         for (std::size_t i = 0; i < dx.size(); ++i) {
-          EXPECT_EQ(m.wavelet[l][i], (Vec2{dx[i], dy[i]})) << (closed ? "closed " : "open ") << points << " level " << l << " i " << i;
+          EXPECT_EQ(m.wavelet[l][i], (Vec2{dx[i], dy[i]}))
+              << (closed ? "closed " : "open ") << points << " level " << l << " i " << i;
         }
       }
     }

@@ -54,9 +54,7 @@ JointAngles ik_or_die(const PantographGeometry& g, Vec2 p) {
   return q;
 }
 
-double max_abs(const Mat2& m) {
-  return std::max({std::abs(m.a11), std::abs(m.a12), std::abs(m.a21), std::abs(m.a22)});
-}
+double max_abs(const Mat2& m) { return std::max({std::abs(m.a11), std::abs(m.a12), std::abs(m.a21), std::abs(m.a22)}); }
 
 /// Singular values of a 2×2 matrix (largest first).
 std::pair<double, double> singular_values(const Mat2& m) {
@@ -130,10 +128,10 @@ TEST(Pantograph, JacobianMatchesCentralDifferences) {
   for (const Vec2 p : jittered_grid(kHalfW + kStop, kHalfH + kStop, 15, 10, 4242u)) {
     const JointAngles q = ik_or_die(g, p);
     const Mat2 J = jacobian(g, q);
-    const Vec2 d1 = (1.0 / (2.0 * h)) * (fk_or_die(g, {q.theta1_rad + h, q.theta2_rad}) -
-                                         fk_or_die(g, {q.theta1_rad - h, q.theta2_rad}));
-    const Vec2 d2 = (1.0 / (2.0 * h)) * (fk_or_die(g, {q.theta1_rad, q.theta2_rad + h}) -
-                                         fk_or_die(g, {q.theta1_rad, q.theta2_rad - h}));
+    const Vec2 d1 = (1.0 / (2.0 * h)) *
+                    (fk_or_die(g, {q.theta1_rad + h, q.theta2_rad}) - fk_or_die(g, {q.theta1_rad - h, q.theta2_rad}));
+    const Vec2 d2 = (1.0 / (2.0 * h)) *
+                    (fk_or_die(g, {q.theta1_rad, q.theta2_rad + h}) - fk_or_die(g, {q.theta1_rad, q.theta2_rad - h}));
     const Mat2 fd{d1.x, d2.x, d1.y, d2.y};
     const double tol = 1e-6 * max_abs(fd);
     EXPECT_NEAR(J.a11, fd.a11, tol);
@@ -192,8 +190,8 @@ TEST(Pantograph, ReachableRectangleAwayFromSingularities) {
   //  - serial singularity (a chain stretched or folded, det J → 0): |det J| ≥ kMinDetJ;
   //  - parallel singularity (distal links collinear, ‖J‖ → ∞): largest singular value ≤ kMaxSigma and
   //    an angle between the distal links inside [kMinAngle, 180° − kMinAngle].
-  constexpr double kMinDetJ = 0.005;   // m²/rad²
-  constexpr double kMaxSigma = 0.25;   // m/rad: 1 count of a 16384-count encoder ≤ 0.1 mm
+  constexpr double kMinDetJ = 0.005;  // m²/rad²
+  constexpr double kMaxSigma = 0.25;  // m/rad: 1 count of a 16384-count encoder ≤ 0.1 mm
   constexpr double kMinAngle = 30.0 * kPi / 180.0;
   const PantographGeometry g;
   for (const double margin : {0.0, kStop}) {
@@ -219,9 +217,10 @@ TEST(Pantograph, ReachableRectangleAwayFromSingularities) {
     EXPECT_LE(s_hi, kMaxSigma) << "margin " << margin;
     EXPECT_GE(ang_lo, kMinAngle) << "margin " << margin;
     EXPECT_LE(ang_hi, kPi - kMinAngle) << "margin " << margin;
-    std::printf("[ info ] margin %.3f m: |det J| in [%.4g, %.4g] m^2/rad^2, sigma(J) in [%.4g, %.4g] m/rad, "
-                "distal angle in [%.1f, %.1f] deg\n",
-                margin, det_lo, det_hi, s_lo, s_hi, ang_lo * 180 / kPi, ang_hi * 180 / kPi);
+    std::printf(
+        "[ info ] margin %.3f m: |det J| in [%.4g, %.4g] m^2/rad^2, sigma(J) in [%.4g, %.4g] m/rad, "
+        "distal angle in [%.1f, %.1f] deg\n",
+        margin, det_lo, det_hi, s_lo, s_hi, ang_lo * 180 / kPi, ang_hi * 180 / kPi);
   }
 }
 
@@ -360,8 +359,8 @@ TEST(SimPantograph, EncoderQuantisationWithinHandleResolution) {
     }
     // Quantisation is really applied: some sample lands well away from the true position.
     EXPECT_GT(worst_ratio, 0.3) << counts << " counts";
-    std::printf("[ info ] %d counts/rev: worst handle error %.3g um, bound up to %.3g um\n", counts,
-                worst_err * 1e6, worst_bound * 1e6);
+    std::printf("[ info ] %d counts/rev: worst handle error %.3g um, bound up to %.3g um\n", counts, worst_err * 1e6,
+                worst_bound * 1e6);
   }
 }
 

@@ -31,8 +31,10 @@ std::vector<Polyline> scene_curves(std::mt19937& rng, std::size_t segments, Vec2
   std::uniform_real_distribution<double> jitter(-0.2 * kCell, 0.2 * kCell);
   std::vector<Polyline> curves;
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 c{-half + kCell * (static_cast<double>(i % side) + 0.5) + jitter(rng), -half + kCell * (static_cast<double>(i / side) + 0.5) + jitter(rng)};
-    curves.push_back(i % 2 == 0 ? test::random_blob(rng, c, 0.01, kPerCurve) : test::random_stroke(rng, c, 0.0003, kPerCurve));
+    const Vec2 c{-half + kCell * (static_cast<double>(i % side) + 0.5) + jitter(rng),
+                 -half + kCell * (static_cast<double>(i / side) + 0.5) + jitter(rng)};
+    curves.push_back(i % 2 == 0 ? test::random_blob(rng, c, 0.01, kPerCurve)
+                                : test::random_stroke(rng, c, 0.0003, kPerCurve));
   }
   *half_extent = {half, half};
   return curves;
@@ -117,10 +119,10 @@ TEST(Peers, FirstHitAndClosestPointAgreeAcrossMethods) {
 // joined_cut_points: bench::cut_segments) and handed to brute force, the R-tree and Embree; first_hit_cut
 // walks the boundary section with the cut masks instead. 15 000 queries a step, 120 000 in all, every one
 // against the three peers: the same hits and t bit for bit; every 5th also a closest point on the whole cut
-// (against brute force) and on one curve's (against its joined polyline, within 20 mm). Every 7th query is repeated on a second section
-// with a budget of 6 optional box tests (a new one each step): an exact answer there must be the same, a blocked one must not claim
-// the sweep clear past the true hit. The scene mixes smooth blobs and strokes with a staircase circle and
-// squares, so that the cuts change level along curves (counted: the check must cover joins).
+// (against brute force) and on one curve's (against its joined polyline, within 20 mm). Every 7th query is repeated on
+// a second section with a budget of 6 optional box tests (a new one each step): an exact answer there must be the same,
+// a blocked one must not claim the sweep clear past the true hit. The scene mixes smooth blobs and strokes with a
+// staircase circle and squares, so that the cuts change level along curves (counted: the check must cover joins).
 TEST(Peers, FirstHitAndClosestPointAtTheToleranceCutAgreeAcrossMethods) {
   std::mt19937 rng(44);
   Vec2 half;
@@ -139,7 +141,8 @@ TEST(Peers, FirstHitAndClosestPointAtTheToleranceCutAgreeAcrossMethods) {
     const bench::BruteForce brute(segs);
     const bench::RtreeIndex rtree(segs);
     const bench::EmbreeIndex embree(segs);
-    std::vector<std::vector<Vec2>> joined(sc.curve_count());  // each curve's joined polyline, for closest points on one curve
+    std::vector<std::vector<Vec2>> joined(
+        sc.curve_count());  // each curve's joined polyline, for closest points on one curve
     for (std::size_t c = 0; c < sc.curve_count(); ++c) {
       std::vector<SegmentRef> cut;
       tolerance_cut(sc, c, kToleranceLadder_m[step], &cut);
@@ -272,7 +275,8 @@ TEST_P(PeersAtSize, HundredThousandQueriesAgree) {
   EXPECT_EQ(closest_checked, 10000);
 }
 
-INSTANTIATE_TEST_SUITE_P(Sizes, PeersAtSize, ::testing::Values(std::size_t{1000}, std::size_t{10000}, std::size_t{100000}));
+INSTANTIATE_TEST_SUITE_P(Sizes, PeersAtSize,
+                         ::testing::Values(std::size_t{1000}, std::size_t{10000}, std::size_t{100000}));
 
 // ── Closest points seeded by the previous answer (closest points from coherence) ───────────
 
@@ -284,7 +288,8 @@ struct Closest {
   Vec2 point;
   SegmentRef segment;
 };
-Closest closest(BoundarySection& section, Vec2 p, int level, double max_distance_m, int curve = -1, QueryBudget* budget = nullptr) {
+Closest closest(BoundarySection& section, Vec2 p, int level, double max_distance_m, int curve = -1,
+                QueryBudget* budget = nullptr) {
   Closest c;
   c.found = section.closest_point(p, level, max_distance_m, &c.point, &c.segment, curve, budget);
   return c;
@@ -294,7 +299,8 @@ void expect_same(const Closest& a, const Closest& b, int query) {
   if (!a.found) return;
   ASSERT_EQ(a.point.x, b.point.x) << "query " << query;
   ASSERT_EQ(a.point.y, b.point.y) << "query " << query;
-  ASSERT_TRUE(a.segment == b.segment) << "query " << query << ": segment " << a.segment.segment << " against " << b.segment.segment;
+  ASSERT_TRUE(a.segment == b.segment) << "query " << query << ": segment " << a.segment.segment << " against "
+                                      << b.segment.segment;
 }
 
 }  // namespace

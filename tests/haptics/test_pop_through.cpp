@@ -13,8 +13,8 @@ using namespace hk;
 
 namespace {
 
-constexpr double kStiffness = 800.0;   // [N/m]
-constexpr double kPeriod = 0.001;      // [s]
+constexpr double kStiffness = 800.0;  // [N/m]
+constexpr double kPeriod = 0.001;     // [s]
 
 ContactParams pop_params(double pop_force_n = 3.0) {
   ContactParams p;

@@ -10,9 +10,9 @@
 
 #include "curves.hpp"
 #include "haptics/collision_query.hpp"
+#include "haptics/level_policy.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
-#include "haptics/level_policy.hpp"
 #include "haptics/tolerance_cut.hpp"
 #include "hk/error.hpp"
 
@@ -63,7 +63,8 @@ TEST(ToleranceCut, CoversTheCurveOnceAndKeepsEveryVertexWithinTheTolerance) {
       for (std::size_t i = 0; i < cut.size(); ++i) {
         const SegmentRef s = cut[i];
         ASSERT_EQ(s.curve, static_cast<int>(c));
-        const std::size_t k0 = static_cast<std::size_t>(s.segment) << s.level, k1 = (static_cast<std::size_t>(s.segment) + 1) << s.level;
+        const std::size_t k0 = static_cast<std::size_t>(s.segment) << s.level,
+                          k1 = (static_cast<std::size_t>(s.segment) + 1) << s.level;
         ASSERT_EQ(k0, next) << "curve " << c << " tol " << tol_mm;
         for (std::size_t k = k0; k < k1; ++k) owner[k] = i;
         next = k1;
@@ -118,7 +119,8 @@ TEST(ToleranceCut, JoinedPiecesLieInTheirBoxesAndKeepVerticesWithinBoundPlusShif
       for (std::size_t i = 0; i < cut.size(); ++i) {
         const Vec2 p0 = pts[i], p1 = pts[(i + 1) % pts.size()];
         const ErrorBox box = sc.box(sc.node_of(cut[i]));
-        EXPECT_TRUE(box_contains(box, p0, 1e-9) && box_contains(box, p1, 1e-9)) << "curve " << c << " piece " << i << " tol " << tol_mm;
+        EXPECT_TRUE(box_contains(box, p0, 1e-9) && box_contains(box, p1, 1e-9))
+            << "curve " << c << " piece " << i << " tol " << tol_mm;
         Vec2 a, b;
         sc.segment(cut[i], &a, &b);
         shift[i] = std::max(distance(p0, a), distance(p1, b));
@@ -131,7 +133,9 @@ TEST(ToleranceCut, JoinedPiecesLieInTheirBoxesAndKeepVerticesWithinBoundPlusShif
       // Original vertices, each against the piece of the cut segment over its level-0 segment.
       std::vector<std::size_t> owner(ci.segment_count[0]);
       for (std::size_t i = 0; i < cut.size(); ++i) {
-        for (std::size_t k = std::size_t(cut[i].segment) << cut[i].level; k < (std::size_t(cut[i].segment) + 1) << cut[i].level; ++k) owner[k] = i;
+        for (std::size_t k = std::size_t(cut[i].segment) << cut[i].level;
+             k < (std::size_t(cut[i].segment) + 1) << cut[i].level; ++k)
+          owner[k] = i;
       }
       const auto vseg = level0_of_vertices(sc, c, curves[sc.source_index(c)]);
       const auto& orig = curves[sc.source_index(c)].points_m;
@@ -206,7 +210,8 @@ TEST(ToleranceCut, TheSectionGivesEachCutSegmentItsJoinedEndsAndItsNeighboursAlo
         ASSERT_TRUE(section.is_wall(cut[i], id));
         Vec2 a, b;
         section.wall_points(cut[i], id, &a, &b);
-        ASSERT_TRUE(a == pts[i] && b == pts[(i + 1) % pts.size()]) << "step " << step << " curve " << c << " piece " << i;
+        ASSERT_TRUE(a == pts[i] && b == pts[(i + 1) % pts.size()])
+            << "step " << step << " curve " << c << " piece " << i;
         SegmentRef next, prev;
         const bool has_next = section.wall_neighbour(cut[i], id, +1, &next);
         const bool has_prev = section.wall_neighbour(cut[i], id, -1, &prev);
@@ -243,12 +248,14 @@ TEST(ToleranceCut, CutBoundsHoldTheOriginalAndThePieces) {
       const std::vector<Vec2> pts = joined_cut_points(sc, c, cut.data(), cut.size());
       for (const Vec2& p : curves[sc.source_index(c)].points_m) {
         double d = 1e9;
-        for (std::size_t i = 0; i < cut.size(); ++i) d = std::min(d, distance_to_segment(p, pts[i], pts[(i + 1) % pts.size()]));
+        for (std::size_t i = 0; i < cut.size(); ++i)
+          d = std::min(d, distance_to_segment(p, pts[i], pts[(i + 1) % pts.size()]));
         worst_vertex = std::max(worst_vertex, d);
       }
       for (std::size_t i = 0; i < cut.size(); ++i) {
         const ErrorBox box = sc.box(sc.node_of(cut[i]));
-        for (const Vec2& e : {pts[i], pts[(i + 1) % pts.size()]}) worst_side = std::max(worst_side, std::abs(cross(box.axis, e - box.origin_m)));
+        for (const Vec2& e : {pts[i], pts[(i + 1) % pts.size()]})
+          worst_side = std::max(worst_side, std::abs(cross(box.axis, e - box.origin_m)));
       }
     }
     EXPECT_LE(worst_vertex, cb.error_bound_m[step]) << "step " << step;
@@ -335,7 +342,7 @@ TEST(ToleranceCut, EndsAreTheCoarsestLevelAndLevelZero) {
     std::vector<SegmentRef> coarse, fine;
     const CutStats loose = tolerance_cut(sc, c, 1.0, &coarse);  // a metre: nothing is refined
     EXPECT_EQ(loose.segments, ci.segment_count[ci.levels - 1]);
-    EXPECT_EQ(loose.breaks, 0u);  // one level: the polyline is unbroken
+    EXPECT_EQ(loose.breaks, 0u);                              // one level: the polyline is unbroken
     const CutStats tight = tolerance_cut(sc, c, 0.0, &fine);  // zero: everything down to level 0
     EXPECT_EQ(tight.segments, ci.segment_count[0]);
     EXPECT_EQ(tight.breaks, 0u);
@@ -411,7 +418,8 @@ TEST(ToleranceSteps, EachCurveTakesTheCoarsestOfItsLevelsWithinTheStep) {
         EXPECT_LE(bound[static_cast<std::size_t>(l)], tol) << "curve " << c << " step " << t;
       }
       for (int coarser = l + 1; coarser < ci.levels; ++coarser) {
-        EXPECT_GT(bound[static_cast<std::size_t>(coarser)], tol) << "curve " << c << " step " << t << ": level " << coarser << " is within it too";
+        EXPECT_GT(bound[static_cast<std::size_t>(coarser)], tol)
+            << "curve " << c << " step " << t << ": level " << coarser << " is within it too";
       }
       // What the bound promises, measured: every original vertex within the step's tolerance (or, at level
       // 0, that level's own error) of the level-l segment standing for it.
@@ -425,7 +433,8 @@ TEST(ToleranceSteps, EachCurveTakesTheCoarsestOfItsLevelsWithinTheStep) {
   }
   // The straight line is exact at every level: its coarsest at every step.
   const std::size_t line = sc.curve_count() - 1;
-  for (int t = 0; t < kToleranceSteps; ++t) EXPECT_EQ(sc.clamp_level(line, kToleranceLevelBase + t), sc.curve(line).levels - 1);
+  for (int t = 0; t < kToleranceSteps; ++t)
+    EXPECT_EQ(sc.clamp_level(line, kToleranceLevelBase + t), sc.curve(line).levels - 1);
 }
 
 TEST(ToleranceSteps, NeverMoreSegmentsThanTheOneLevelWithinTheSameToleranceAndFewerOnAMixedScene) {

@@ -42,7 +42,10 @@ class LoopbackTransport final : public io::ByteTransport {
 struct Rig {
   explicit Rig(hapi::EmulatorParams ep = {}, Vec2 start_ws = {0.01, -0.005}, io::HaplyDeviceParams p = {})
       : dp(p),
-        emu(fill(ep, dp), device_of(dp, start_ws), [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; }),
+        emu(fill(ep, dp), device_of(dp, start_ws),
+            [](double, Vec2, Vec2) {
+              return Vec2{0.0, 0.0};
+            }),
         dev(dp, [this] { return std::make_unique<LoopbackTransport>(emu); }) {}
   static hapi::EmulatorParams fill(hapi::EmulatorParams ep, const io::HaplyDeviceParams& dp) {
     ep.mechanism = dp.mechanism;
@@ -51,7 +54,9 @@ struct Rig {
     ep.workspace_center_m = dp.rect_center_device_m;
     return ep;
   }
-  static Vec2 device_of(const io::HaplyDeviceParams& dp, Vec2 ws) { return (1.0 / io::workspace_scale(dp)) * ws + dp.rect_center_device_m; }
+  static Vec2 device_of(const io::HaplyDeviceParams& dp, Vec2 ws) {
+    return (1.0 / io::workspace_scale(dp)) * ws + dp.rect_center_device_m;
+  }
   io::HaplyDeviceParams dp;
   hapi::FirmwareEmulator emu;
   io::HaplyDevice dev;
@@ -293,7 +298,8 @@ class LateLoopback final : public io::ByteTransport {
     std::copy(held_bytes_, held_bytes_ + n, buf);
     std::copy(held_bytes_ + n, held_bytes_ + held_, held_bytes_);
     held_ -= n;
-    held_ += emu_.take_output(held_bytes_ + held_, static_cast<int>(sizeof held_bytes_) - held_);  // heard now, delivered next read
+    held_ += emu_.take_output(held_bytes_ + held_,
+                              static_cast<int>(sizeof held_bytes_) - held_);  // heard now, delivered next read
     return n;
   }
   void flush_input() noexcept override {}
@@ -335,7 +341,9 @@ class NarrowLoopback final : public io::ByteTransport {
 
 TEST(HaplyDeviceNeverWaits, AReplyOneTickLateIsTakenOnTheNextTickAndTheWriteBetweenIsSkipped) {
   const io::HaplyDeviceParams dp;
-  hapi::FirmwareEmulator emu(Rig::fill({}, dp), Rig::device_of(dp, {0.01, -0.005}), [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+  hapi::FirmwareEmulator emu(Rig::fill({}, dp), Rig::device_of(dp, {0.01, -0.005}), [](double, Vec2, Vec2) {
+    return Vec2{0.0, 0.0};
+  });
   io::HaplyDevice dev(dp, [&emu] { return std::make_unique<LateLoopback>(emu); });
   dev.open();  // its zero-torque packets until the first (late) reply
   // Settle: whatever open() left outstanding is answered or given up.
@@ -361,7 +369,9 @@ TEST(HaplyDeviceNeverWaits, AReplyOneTickLateIsTakenOnTheNextTickAndTheWriteBetw
 
 TEST(HaplyDeviceNeverWaits, AFullTransportSkipsTheWriteAndNeverCutsAPacket) {
   const io::HaplyDeviceParams dp;
-  hapi::FirmwareEmulator emu(Rig::fill({}, dp), Rig::device_of(dp, {0.0, 0.0}), [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+  hapi::FirmwareEmulator emu(Rig::fill({}, dp), Rig::device_of(dp, {0.0, 0.0}), [](double, Vec2, Vec2) {
+    return Vec2{0.0, 0.0};
+  });
   NarrowLoopback* narrow = nullptr;
   io::HaplyDevice dev(dp, [&emu, &narrow] {
     auto t = std::make_unique<NarrowLoopback>(emu, 4);  // a 10-byte torque packet takes three ticks to go out
@@ -378,10 +388,11 @@ TEST(HaplyDeviceNeverWaits, AFullTransportSkipsTheWriteAndNeverCutsAPacket) {
     dev.write_force({0.0, 0.2});
   }
   const io::HaplyCounters after = dev.counters();
-  EXPECT_EQ(narrow->max_timeout_us, 0);                // no call in the step waited for room
+  EXPECT_EQ(narrow->max_timeout_us, 0);                          // no call in the step waited for room
   EXPECT_GT(after.writes_skipped - before.writes_skipped, 100);  // most ticks found the last packet still going out
   EXPECT_GT(after.ticks - before.ticks, 50);
-  EXPECT_EQ(after.malformed, 0);                       // the board never saw a packet cut by another:
-  EXPECT_GE(emu.torque_commands() - commands_before, after.ticks - before.ticks - 1);  // every packet but one on its way, whole
-  EXPECT_GT(after.replies - before.replies, 50);       // and answered
+  EXPECT_EQ(after.malformed, 0);  // the board never saw a packet cut by another:
+  EXPECT_GE(emu.torque_commands() - commands_before,
+            after.ticks - before.ticks - 1);      // every packet but one on its way, whole
+  EXPECT_GT(after.replies - before.replies, 50);  // and answered
 }

@@ -1,7 +1,7 @@
 // TtyTransport against a pseudo-terminal (openpty): bytes both ways, timeouts, hang-up, exclusivity,
 // errors naming the path, and the refused 1200 baud.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <poll.h>
 #include <pty.h>
 #include <sys/stat.h>
@@ -224,7 +224,8 @@ TEST(TtyTransport, SecondOpenByAnotherProcessFails) {
 }
 
 TEST(TtyTransport, SecondTransportInThisProcessFailsUnlessRoot) {
-  if (geteuid() == 0) GTEST_SKIP() << "root (CAP_SYS_ADMIN) bypasses TIOCEXCL; covered by SecondOpenByAnotherProcessFails";
+  if (geteuid() == 0)
+    GTEST_SKIP() << "root (CAP_SYS_ADMIN) bypasses TIOCEXCL; covered by SecondOpenByAnotherProcessFails";
   Pty pty;
   ASSERT_TRUE(pty.ok());
   TtyTransport a(pty.slave_path), b(pty.slave_path);

@@ -36,11 +36,11 @@ struct State {
   std::set<int> claimed;
   bool auto_detach = false, unplugged = false;
   int transfers = 0, contexts = 0, handles = 0;
-  std::deque<libusb_transfer*> pending;   // submitted, not completed
-  std::set<libusb_transfer*> cancelled;   // cancel requested
-  std::deque<std::uint8_t> to_host;       // device → host bytes not yet delivered
-  std::vector<std::uint8_t> from_host;    // host → device bytes
-  int event_fd = -1;                      // readable when there is something to complete
+  std::deque<libusb_transfer*> pending;  // submitted, not completed
+  std::set<libusb_transfer*> cancelled;  // cancel requested
+  std::deque<std::uint8_t> to_host;      // device → host bytes not yet delivered
+  std::vector<std::uint8_t> from_host;   // host → device bytes
+  int event_fd = -1;                     // readable when there is something to complete
   libusb_pollfd pollfd{};
 };
 
@@ -139,9 +139,12 @@ void LIBUSB_CALL libusb_exit(libusb_context* ctx) {
 }
 const char* LIBUSB_CALL libusb_error_name(int code) {
   switch (code) {
-    case LIBUSB_ERROR_ACCESS: return "LIBUSB_ERROR_ACCESS";
-    case LIBUSB_ERROR_NO_DEVICE: return "LIBUSB_ERROR_NO_DEVICE";
-    default: return "LIBUSB_ERROR_OTHER";
+    case LIBUSB_ERROR_ACCESS:
+      return "LIBUSB_ERROR_ACCESS";
+    case LIBUSB_ERROR_NO_DEVICE:
+      return "LIBUSB_ERROR_NO_DEVICE";
+    default:
+      return "LIBUSB_ERROR_OTHER";
   }
 }
 const char* LIBUSB_CALL libusb_strerror(int) { return "fake"; }
@@ -220,8 +223,8 @@ int LIBUSB_CALL libusb_control_transfer(libusb_device_handle*, uint8_t request_t
     std::memcpy(data, c.data(), static_cast<std::size_t>(n));
     return n;
   }
-  st().requests.push_back({request_type, request, value, index,
-                           std::vector<std::uint8_t>(data, data + (data ? length : 0))});
+  st().requests.push_back(
+      {request_type, request, value, index, std::vector<std::uint8_t>(data, data + (data ? length : 0))});
   return length;
 }
 
@@ -272,8 +275,8 @@ const libusb_pollfd** LIBUSB_CALL libusb_get_pollfds(libusb_context*) {
   return l;
 }
 void LIBUSB_CALL libusb_free_pollfds(const libusb_pollfd** l) { std::free(l); }
-void LIBUSB_CALL libusb_set_pollfd_notifiers(libusb_context*, libusb_pollfd_added_cb, libusb_pollfd_removed_cb,
-                                             void*) {}
+void LIBUSB_CALL libusb_set_pollfd_notifiers(libusb_context*, libusb_pollfd_added_cb, libusb_pollfd_removed_cb, void*) {
+}
 int LIBUSB_CALL libusb_get_next_timeout(libusb_context*, timeval*) { return 0; }
 
 // Completes what can be completed: cancelled → CANCELLED, unplugged → NO_DEVICE, OUT → COMPLETED (bytes

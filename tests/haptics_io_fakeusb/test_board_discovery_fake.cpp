@@ -28,7 +28,11 @@ enum class Board { Haply, Garbage, Silent, Late };
 class Bridge {
  public:
   explicit Bridge(Board kind)
-      : kind_(kind), emu_(hapi::EmulatorParams{}, {0.0, -0.088}, [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; }),
+      : kind_(kind),
+        emu_(hapi::EmulatorParams{}, {0.0, -0.088},
+             [](double, Vec2, Vec2) {
+               return Vec2{0.0, 0.0};
+             }),
         thread_([this] { run(); }) {}
   ~Bridge() {
     stop_ = true;
@@ -108,7 +112,9 @@ TEST(BoardDiscoveryFake, ADeviceAnsweringGarbageIsRefusedWithTheReason) {
   EXPECT_EQ(open_first_board(quick_params(), {usb(0x2341, 0x804d)}, &probes), nullptr);
   ASSERT_EQ(probes.size(), 1u);
   EXPECT_FALSE(probes[0].answered);
-  EXPECT_NE(probes[0].how.find("answered, but with no well-formed hAPI reply from device id 5 within 300 ms"), std::string::npos) << probes[0].how;
+  EXPECT_NE(probes[0].how.find("answered, but with no well-formed hAPI reply from device id 5 within 300 ms"),
+            std::string::npos)
+      << probes[0].how;
   EXPECT_NE(probes[0].how.find("another device, or another firmware"), std::string::npos) << probes[0].how;
 }
 

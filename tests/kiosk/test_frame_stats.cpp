@@ -30,9 +30,9 @@ TEST(FrameTimeHistogram, OneSlowFrameInAHundredIsTheP99OnlyWhenItIsMoreThanOnePe
   FrameTimeHistogram h;
   for (int i = 0; i < 99; ++i) h.add_ms(16.75);
   h.add_ms(250.0);
-  EXPECT_NEAR(h.percentile_ms(99), 16.8, 1e-9);   // rank 99 of 100: still a 16.75 ms frame
+  EXPECT_NEAR(h.percentile_ms(99), 16.8, 1e-9);  // rank 99 of 100: still a 16.75 ms frame
   EXPECT_DOUBLE_EQ(h.percentile_ms(100), 250.0);
-  h.add_ms(250.0);                                 // 2 of 101: rank ⌈99.99⌉ = 100 is a slow one
+  h.add_ms(250.0);  // 2 of 101: rank ⌈99.99⌉ = 100 is a slow one
   EXPECT_DOUBLE_EQ(h.percentile_ms(99), 250.0);
   EXPECT_EQ(h.summary().over_20_ms, 2);
 }
@@ -75,12 +75,12 @@ TEST(FrameStats, FramesFromTheKeyToTheNewSceneDrawnAreTheChangingOnes) {
     st.frame_drawn(t + microseconds(work_us), drawn, 0);
     t += microseconds(work_us + gap_us);
   };
-  frame(2000, 14000, &a, false, &a);    // 16 ms
-  frame(2000, 14000, &a, false, &a);    // 16 ms
-  frame(90000, 10000, &a, true, &a);    // key: 100 ms, the new scene not drawn yet
-  frame(30000, 10000, &b, false, &a);   // 40 ms: the new scene drawn
-  frame(2000, 14000, &b, false, &b);    // 16 ms
-  st.frame_started(t);                  // closes the last interval
+  frame(2000, 14000, &a, false, &a);   // 16 ms
+  frame(2000, 14000, &a, false, &a);   // 16 ms
+  frame(90000, 10000, &a, true, &a);   // key: 100 ms, the new scene not drawn yet
+  frame(30000, 10000, &b, false, &a);  // 40 ms: the new scene drawn
+  frame(2000, 14000, &b, false, &b);   // 16 ms
+  st.frame_started(t);                 // closes the last interval
 
   EXPECT_EQ(st.interval_all().frames(), 5);
   EXPECT_EQ(st.interval_changing().frames(), 2);

@@ -35,20 +35,48 @@ TEST(Keymap, EveryAllowedKeyNameIsAKeyAndNoTwoNamesShareOne) {
 
 TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
   // Every name on every action (the other actions moved off it), as the operator could set them.
-  const KioskKey actions[] = {KioskKey::Help,     KioskKey::Next,        KioskKey::Previous,
-                              KioskKey::Describe, KioskKey::Finer,       KioskKey::Coarser,
-                              KioskKey::VolumeUp, KioskKey::VolumeDown,  KioskKey::Tutorial,
-                              KioskKey::Guide,    KioskKey::Capture,     KioskKey::Repeat,
-                              KioskKey::Pause,    KioskKey::Where,       KioskKey::Finish,
-                              KioskKey::NextSentence, KioskKey::PreviousSentence, KioskKey::NextParagraph,
+  const KioskKey actions[] = {KioskKey::Help,
+                              KioskKey::Next,
+                              KioskKey::Previous,
+                              KioskKey::Describe,
+                              KioskKey::Finer,
+                              KioskKey::Coarser,
+                              KioskKey::VolumeUp,
+                              KioskKey::VolumeDown,
+                              KioskKey::Tutorial,
+                              KioskKey::Guide,
+                              KioskKey::Capture,
+                              KioskKey::Repeat,
+                              KioskKey::Pause,
+                              KioskKey::Where,
+                              KioskKey::Finish,
+                              KioskKey::NextSentence,
+                              KioskKey::PreviousSentence,
+                              KioskKey::NextParagraph,
                               KioskKey::PreviousParagraph};
   static_assert(std::size(actions) == config::kKeyActionCount);
   for (int a = 0; a < static_cast<int>(config::kKeyActionCount); ++a) {
     for (std::string_view name : config::visitor_key_names()) {
       config::KeysSettings k;
-      std::string* slot[] = {&k.help, &k.next, &k.previous, &k.describe, &k.finer, &k.coarser, &k.volume_up, &k.volume_down, &k.tutorial, &k.guide,
-                             &k.capture, &k.repeat, &k.pause, &k.where, &k.finish, &k.next_sentence, &k.previous_sentence,
-                             &k.next_paragraph, &k.previous_paragraph};
+      std::string* slot[] = {&k.help,
+                             &k.next,
+                             &k.previous,
+                             &k.describe,
+                             &k.finer,
+                             &k.coarser,
+                             &k.volume_up,
+                             &k.volume_down,
+                             &k.tutorial,
+                             &k.guide,
+                             &k.capture,
+                             &k.repeat,
+                             &k.pause,
+                             &k.where,
+                             &k.finish,
+                             &k.next_sentence,
+                             &k.previous_sentence,
+                             &k.next_paragraph,
+                             &k.previous_paragraph};
       for (int b = 0; b < static_cast<int>(config::kKeyActionCount); ++b)
         if (b != a && *slot[b] == name) *slot[b] = *slot[a];  // swap: the set stays one key per action
       *slot[a] = std::string(name);
@@ -64,7 +92,8 @@ TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
 TEST(Keymap, TheChordNeedsExactlyItsModifiers) {
   const config::KeyChord c = *config::parse_chord("CTRL+ALT+O");
   EXPECT_TRUE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT));
-  EXPECT_TRUE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_NUM_LOCK)) << "Num Lock is not a modifier";
+  EXPECT_TRUE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_NUM_LOCK))
+      << "Num Lock is not a modifier";
   EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, 0)) << "O alone is a key like any other";
   EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL));
   EXPECT_FALSE(chord_pressed(c, GLFW_KEY_O, GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SHIFT));

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "stick_helper.hpp"
-#include "vision/usb_stick.hpp"
 #include "test_paths.hpp"
+#include "vision/usb_stick.hpp"
 
 namespace hk::stick_helper {
 namespace {
@@ -28,7 +28,9 @@ namespace fs = std::filesystem;
 
 const std::string kHelper = HK_STICK_HELPER_EXE;
 
-bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == std::string::npos && s.find('\r') == std::string::npos; }
+bool one_line(const std::string& s) {
+  return !s.empty() && s.find('\n') == std::string::npos && s.find('\r') == std::string::npos;
+}
 
 /// The HelperError text of `f()`, or "" when it did not throw one.
 template <class F>
@@ -128,7 +130,8 @@ TEST(StickHelperArgs, SlotsAreSmallWholeNumbersOnly) {
   EXPECT_EQ(parse_slot("0"), 0);
   EXPECT_EQ(parse_slot("7"), 7);
   EXPECT_EQ(parse_slot("999"), vision::kMaxStickSlot);
-  for (const std::string bad : {"", "-1", "+1", "01", "000", "1000", "12a", " 1", "1 ", "0x1", "1e2", "99999999999999999999", "\xd9\xa3"}) {
+  for (const std::string bad :
+       {"", "-1", "+1", "01", "000", "1000", "12a", " 1", "1 ", "0x1", "1e2", "99999999999999999999", "\xd9\xa3"}) {
     const std::string what = refusal([&] { (void)parse_slot(bad); });
     EXPECT_TRUE(one_line(what)) << "'" << bad << "' -> " << what;
     EXPECT_EQ(what.rfind("slot '", 0), 0U) << what;
@@ -148,7 +151,8 @@ UsbProbe fake_probe(bool on_usb, int* calls = nullptr) {
 }
 
 TEST(StickHelperDevice, PathsOutsideDevAreRefused) {
-  for (const std::string bad : {"sdb1", "dev/sdb1", "./dev/sdb1", "/etc/passwd", "/tmp/stick.img", "/devx/sdb1", "/proc/self/fd/0", ""}) {
+  for (const std::string bad :
+       {"sdb1", "dev/sdb1", "./dev/sdb1", "/etc/passwd", "/tmp/stick.img", "/devx/sdb1", "/proc/self/fd/0", ""}) {
     int calls = 0;
     const std::string what = refusal([&] { (void)check_devnode(bad, true, fake_probe(true, &calls)); });
     EXPECT_TRUE(one_line(what)) << bad << " -> " << what;
@@ -223,7 +227,9 @@ TEST(StickHelperDevice, BlockDeviceOffTheUsbBusIsRefused) {
   if (f.on_usb) GTEST_SKIP() << disk << " is on the USB bus here";
   const std::string what = refusal([&] { (void)check_devnode(disk, false); });
   EXPECT_TRUE(one_line(what)) << what;
-  EXPECT_EQ(what.rfind("device '" + disk + "': not on the USB bus (block device " + std::to_string(f.major) + ":", 0), 0U) << what;
+  EXPECT_EQ(what.rfind("device '" + disk + "': not on the USB bus (block device " + std::to_string(f.major) + ":", 0),
+            0U)
+      << what;
   // The same node, were it on USB, passes (nothing is opened or mounted by check_devnode).
   const DeviceFacts ok = check_devnode(disk, false, fake_probe(true));
   EXPECT_EQ(ok.resolved, fs::canonical(disk).string());
@@ -273,12 +279,12 @@ TEST(StickHelperExe, RefusalsAreOneLineOnStandardErrorWithTheirExitStatus) {
 }
 
 /// Skips unless this test can make loop devices and private mount namespaces.
-#define SKIP_UNLESS_ROOT_TOOLS()                                                                  \
-  do {                                                                                            \
-    if (::geteuid() != 0) GTEST_SKIP() << "needs root (loop devices, mount namespaces)";         \
-    for (const char* tool : {"unshare", "losetup", "mkfs.ext4"}) {                                \
-      if (!have_tool(tool)) GTEST_SKIP() << tool << " is not installed";                         \
-    }                                                                                             \
+#define SKIP_UNLESS_ROOT_TOOLS()                                                                             \
+  do {                                                                                                       \
+    if (::geteuid() != 0) GTEST_SKIP() << "needs root (loop devices, mount namespaces)";                     \
+    for (const char* tool : {"unshare", "losetup", "mkfs.ext4"}) {                                           \
+      if (!have_tool(tool)) GTEST_SKIP() << tool << " is not installed";                                     \
+    }                                                                                                        \
     if (run("unshare -m --propagation private true").status != 0) GTEST_SKIP() << "unshare -m refused here"; \
   } while (0)
 
@@ -292,7 +298,8 @@ class LoopStick {
     std::ofstream(dir_ / "hello.txt") << "hello from the stick\n";
     fs::create_directories(dir_ / "src");
     fs::rename(dir_ / "hello.txt", dir_ / "src" / "hello.txt");
-    const Shell mk = run("mkfs.ext4 -q -d " + quote((dir_ / "src").string()) + " " + quote((dir_ / "stick.img").string()) + " 4M");
+    const Shell mk =
+        run("mkfs.ext4 -q -d " + quote((dir_ / "src").string()) + " " + quote((dir_ / "stick.img").string()) + " 4M");
     if (mk.status != 0) {
       error_ = "mkfs.ext4 failed: " + mk.err;
       return;
@@ -321,21 +328,22 @@ class LoopStick {
 
 /// Runs `script` (sh) in a private mount namespace whose /run is a fresh tmpfs; $H is the helper.
 Shell in_private_run(const std::string& script) {
-  return run("unshare -m --propagation private sh -c " + quote("mount -t tmpfs tmpfs /run && H=" + kHelper + " && " + script));
+  return run("unshare -m --propagation private sh -c " +
+             quote("mount -t tmpfs tmpfs /run && H=" + kHelper + " && " + script));
 }
 
 TEST(StickHelperExe, MountsALoopStickReadOnlyAndUnmountsIt) {
   SKIP_UNLESS_ROOT_TOOLS();
   LoopStick stick;
   if (stick.dev().empty()) GTEST_SKIP() << stick.error();
-  const Shell r = in_private_run(
-      "\"$H\" --allow-loop mount " + stick.dev() + " 3 && "
-      "cat /run/haptic-kiosk/usb/3/hello.txt && "
-      "grep ' /run/haptic-kiosk/usb/3 ' /proc/self/mountinfo | cut -d' ' -f6 && "
-      "stat -c '%a %U' /run/haptic-kiosk/usb /run/haptic-kiosk && "
-      "\"$H\" unmount 3 && "
-      "(test -e /run/haptic-kiosk/usb/3 && echo still there || echo gone) && "
-      "\"$H\" unmount 3");
+  const Shell r = in_private_run("\"$H\" --allow-loop mount " + stick.dev() +
+                                 " 3 && "
+                                 "cat /run/haptic-kiosk/usb/3/hello.txt && "
+                                 "grep ' /run/haptic-kiosk/usb/3 ' /proc/self/mountinfo | cut -d' ' -f6 && "
+                                 "stat -c '%a %U' /run/haptic-kiosk/usb /run/haptic-kiosk && "
+                                 "\"$H\" unmount 3 && "
+                                 "(test -e /run/haptic-kiosk/usb/3 && echo still there || echo gone) && "
+                                 "\"$H\" unmount 3");
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   EXPECT_EQ(r.err, "");
   std::istringstream lines(r.out);
@@ -359,25 +367,33 @@ TEST(StickHelperExe, ALinkInTheMountRootIsNotFollowed) {
   LoopStick stick;
   if (stick.dev().empty()) GTEST_SKIP() << stick.error();
   // /run/haptic-kiosk/usb pointing elsewhere (the kiosk's user owns /run/haptic-kiosk and could plant it).
-  const Shell r = in_private_run("mkdir -p /run/haptic-kiosk /run/elsewhere && ln -s /run/elsewhere /run/haptic-kiosk/usb && "
-                               "\"$H\" --allow-loop mount " + stick.dev() + " 1; echo \"status $?\"; ls -A /run/elsewhere; "
-                               "\"$H\" unmount 1; echo \"status $?\"");
+  const Shell r = in_private_run(
+      "mkdir -p /run/haptic-kiosk /run/elsewhere && ln -s /run/elsewhere /run/haptic-kiosk/usb && "
+      "\"$H\" --allow-loop mount " +
+      stick.dev() +
+      " 1; echo \"status $?\"; ls -A /run/elsewhere; "
+      "\"$H\" unmount 1; echo \"status $?\"");
   EXPECT_EQ(r.out, "status 1\nstatus 1\n");
-  EXPECT_EQ(r.err,
-            "hk-stick-mount: stick '" + stick.dev() + "': the mount root's part /run/haptic-kiosk/usb is a symbolic link or not a folder\n"
-            "hk-stick-mount: stick slot 1: the mount root's part /run/haptic-kiosk/usb is a symbolic link or not a folder\n");
+  EXPECT_EQ(r.err, "hk-stick-mount: stick '" + stick.dev() +
+                       "': the mount root's part /run/haptic-kiosk/usb is a symbolic link or not a folder\n"
+                       "hk-stick-mount: stick slot 1: the mount root's part /run/haptic-kiosk/usb is a symbolic link "
+                       "or not a folder\n");
 }
 
 TEST(StickHelperExe, ADeviceInUseIsRefusedAndNoMountPointIsLeft) {
   SKIP_UNLESS_ROOT_TOOLS();
   LoopStick stick;
   if (stick.dev().empty()) GTEST_SKIP() << stick.error();
-  const Shell r = in_private_run("mkdir /run/other && mount -o ro " + stick.dev() + " /run/other && "
-                               "\"$H\" --allow-loop mount " + stick.dev() + " 2; echo \"status $?\"; "
-                               "test -e /run/haptic-kiosk/usb/2 && echo left || echo clean");
+  const Shell r = in_private_run("mkdir /run/other && mount -o ro " + stick.dev() +
+                                 " /run/other && "
+                                 "\"$H\" --allow-loop mount " +
+                                 stick.dev() +
+                                 " 2; echo \"status $?\"; "
+                                 "test -e /run/haptic-kiosk/usb/2 && echo left || echo clean");
   EXPECT_EQ(r.out, "status 1\nclean\n") << r.err;
-  EXPECT_EQ(r.err, "hk-stick-mount: stick '" + stick.dev() +
-                       "': it is in use (mounted elsewhere, or a disk with a partition in use), so it is not mounted\n");
+  EXPECT_EQ(r.err,
+            "hk-stick-mount: stick '" + stick.dev() +
+                "': it is in use (mounted elsewhere, or a disk with a partition in use), so it is not mounted\n");
 }
 
 }  // namespace

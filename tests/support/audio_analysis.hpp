@@ -27,7 +27,8 @@ inline std::vector<double> hf_energy(const std::vector<float>& x, std::size_t ho
 /// and `rise` times the largest of the windows 0.75–1.5 ms before it. The time reported is the END of the
 /// window, so an onset is never reported before the sound that caused it. After an onset, 1 ms is skipped.
 /// The short windows resolve clicks 2 ms apart (contact chatter), about the ear's own limit.
-inline std::vector<std::size_t> onsets(const std::vector<float>& x, double floor = 1e-4, double rise = 4.0, int rate = 48000) {
+inline std::vector<std::size_t> onsets(const std::vector<float>& x, double floor = 1e-4, double rise = 4.0,
+                                       int rate = 48000) {
   const std::size_t hop = static_cast<std::size_t>(rate / 4000), win = 2 * hop;
   const std::vector<double> e = hf_energy(x, hop, win);
   const std::size_t back_lo = 3, back_hi = 6, skip = 4;  // in hops: 0.75 ms, 1.5 ms, 1 ms

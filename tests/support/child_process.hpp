@@ -41,7 +41,8 @@ inline std::string run_in_child(const std::function<std::string()>& work, const 
   ::close(fds[0]);
   int status = 0;
   ::waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) out += " (child ended with status " + std::to_string(status) + ")";
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    out += " (child ended with status " + std::to_string(status) + ")";
   return out;
 }
 

@@ -53,7 +53,9 @@ class CrossingGrid {
       for (int id : cells_[static_cast<std::size_t>(cell)]) {
         if (stamp_[static_cast<std::size_t>(id)] == tick_) continue;
         stamp_[static_cast<std::size_t>(id)] = tick_;
-        if (crosses_strictly(p, q, segs_[static_cast<std::size_t>(id)].first, segs_[static_cast<std::size_t>(id)].second)) ++n;
+        if (crosses_strictly(p, q, segs_[static_cast<std::size_t>(id)].first,
+                             segs_[static_cast<std::size_t>(id)].second))
+          ++n;
       }
     });
     return n;

@@ -38,7 +38,10 @@ inline Polyline sampled_square(double half, double step) {
 inline Polyline random_blob(std::mt19937& rng, Vec2 c, double r0, int n) {
   std::uniform_real_distribution<double> amp(-0.12, 0.12), ph(0.0, 2 * M_PI);
   double a[6], phi[6];
-  for (int i = 0; i < 6; ++i) { a[i] = amp(rng) / (1 + i); phi[i] = ph(rng); }
+  for (int i = 0; i < 6; ++i) {
+    a[i] = amp(rng) / (1 + i);
+    phi[i] = ph(rng);
+  }
   Polyline p;
   p.closed = true;
   for (int k = 0; k < n; ++k) {
@@ -72,7 +75,8 @@ inline Polyline staircase_circle(Vec2 c, double r, double cell_m) {
   const int n = static_cast<int>(2 * M_PI * r / cell_m);
   for (int k = 0; k < n; ++k) {
     const double th = 2 * M_PI * k / n;
-    Vec2 q{std::round((c.x + r * std::cos(th)) / cell_m) * cell_m, std::round((c.y + r * std::sin(th)) / cell_m) * cell_m};
+    Vec2 q{std::round((c.x + r * std::cos(th)) / cell_m) * cell_m,
+           std::round((c.y + r * std::sin(th)) / cell_m) * cell_m};
     if (p.points_m.empty() || !(p.points_m.back() == q)) p.points_m.push_back(q);
   }
   if (p.points_m.size() > 1 && p.points_m.back() == p.points_m.front()) p.points_m.pop_back();
@@ -107,7 +111,8 @@ inline bool cramer_sweep_hit(Vec2 a, Vec2 b, Vec2 p, Vec2 q, double* t) {
 /// *t_out, in *seg_out the first segment hit at it in (curve, level, segment) order, and in *near_out (when
 /// given) every segment hit within 1e-9 of it (a shared vertex is met by two). Any output may be null.
 inline bool brute_first_hit(const Scene& sc, Vec2 a, Vec2 b, int level, double* t_out, SegmentRef* seg_out,
-                            const SegmentRef* excluded = nullptr, int n_excluded = 0, std::vector<SegmentRef>* near_out = nullptr) {
+                            const SegmentRef* excluded = nullptr, int n_excluded = 0,
+                            std::vector<SegmentRef>* near_out = nullptr) {
   std::vector<std::pair<double, SegmentRef>> hits;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const int l = sc.clamp_level(c, level);

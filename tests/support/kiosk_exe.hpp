@@ -28,7 +28,8 @@ inline std::vector<std::filesystem::path> test_images() {
 
 /// An empty folder in the temporary directory named after `name` and this process (removed first if there).
 inline std::filesystem::path fresh_dir(const std::string& name) {
-  const std::filesystem::path d = std::filesystem::temp_directory_path() / ("hk_test_" + name + "_" + std::to_string(::getpid()));
+  const std::filesystem::path d =
+      std::filesystem::temp_directory_path() / ("hk_test_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;

@@ -17,7 +17,8 @@ class LetterDir {
   explicit LetterDir(const std::string& prefix) {
     static int counter = 0;
     std::string tag;
-    for (unsigned long v = static_cast<unsigned long>(::getpid()) * 1000 + static_cast<unsigned long>(counter++); v > 0; v /= 10)
+    for (unsigned long v = static_cast<unsigned long>(::getpid()) * 1000 + static_cast<unsigned long>(counter++); v > 0;
+         v /= 10)
       tag += static_cast<char>('a' + v % 10);
     path_ = std::filesystem::temp_directory_path() / (prefix + tag);
     std::filesystem::remove_all(path_);

@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "config/settings.hpp"
+#include "runtime_ticks.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
-#include "runtime_ticks.hpp"
 
 namespace hk::test {
 
@@ -53,7 +53,7 @@ struct RandomVisitParams {
 /// What happened, and what was wrong.
 struct RandomVisitReport {
   int keys = 0, bursts = 0, sticks_in = 0, sticks_out = 0, panel_applies = 0, learning = 0;
-  int sessions_ended = 0;  ///< visits ended by Finish (in the run) or by the time-out (a walk away)
+  int sessions_ended = 0;                ///< visits ended by Finish (in the run) or by the time-out (a walk away)
   std::vector<std::string> unanswered;   ///< "frame F: key K said nothing"
   std::vector<std::string> left_behind;  ///< what the kiosk kept that a new visitor must not find
   int failures = 0;                      ///< actions answered with the sorry line (KioskFlow::failures)
@@ -72,7 +72,8 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   const fs::path sticks[] = {p.work / "damaged", p.work / "pdf", p.work / "empty"};
   for (const fs::path& s : sticks) fs::create_directories(s);
   fs::copy_file(p.data / "bad" / "bad_crc.png", sticks[0] / "bad_crc.png", fs::copy_options::overwrite_existing);
-  fs::copy_file(p.data / "bad" / "damaged_idat.png", sticks[0] / "damaged_idat.png", fs::copy_options::overwrite_existing);
+  fs::copy_file(p.data / "bad" / "damaged_idat.png", sticks[0] / "damaged_idat.png",
+                fs::copy_options::overwrite_existing);
   fs::copy_file(p.data / "bad" / "empty.pdf", sticks[0] / "empty.pdf", fs::copy_options::overwrite_existing);
   fs::copy_file(p.data / "bad" / "truncated.pdf", sticks[0] / "truncated.pdf", fs::copy_options::overwrite_existing);
   fs::copy_file(p.data / "bad" / "pages_5000.pdf", sticks[1] / "pages_5000.pdf", fs::copy_options::overwrite_existing);
@@ -118,9 +119,11 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
     ++report.keys;
     const bool volume = k == KioskKey::VolumeUp || k == KioskKey::VolumeDown;
     const bool silent_answer = (volume && heard) || k == KioskKey::Pause;
-    const std::string what = "seed " + std::to_string(p.seed) + ", frame " + std::to_string(frame) + ": key " + std::to_string(static_cast<int>(k)) +
-                             " (" + app::state_name(flow.state()) + (flow.source() == app::KioskSource::Stick ? ", on a stick" : "") +
-                             (flow.loading() ? ", a page awaited" : "") + (flow.picture_pending() ? ", a picture awaited" : "") + ") said nothing";
+    const std::string what = "seed " + std::to_string(p.seed) + ", frame " + std::to_string(frame) + ": key " +
+                             std::to_string(static_cast<int>(k)) + " (" + app::state_name(flow.state()) +
+                             (flow.source() == app::KioskSource::Stick ? ", on a stick" : "") +
+                             (flow.loading() ? ", a page awaited" : "") +
+                             (flow.picture_pending() ? ", a picture awaited" : "") + ") said nothing";
     if (rt->texts_said() != said || silent_answer) return;
     if (flow.loading() || flow.picture_pending()) {
       awaited.push_back({frame + answer_frames, said, what + " within " + std::to_string(answer_frames) + " frames"});
@@ -133,8 +136,9 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
       if (rt->texts_said() > it->said) {
         it = awaited.erase(it);
       } else if (frame >= it->due_frame) {
-        report.unanswered.push_back(it->what + "; then: " + app::state_name(flow.state()) + (flow.loading() ? ", a page awaited" : "") +
-                                    (flow.picture_pending() ? ", a picture awaited" : "") + "; last said: " + rt->last_said());
+        report.unanswered.push_back(
+            it->what + "; then: " + app::state_name(flow.state()) + (flow.loading() ? ", a page awaited" : "") +
+            (flow.picture_pending() ? ", a picture awaited" : "") + "; last said: " + rt->last_said());
         it = awaited.erase(it);
       } else {
         ++it;
@@ -180,8 +184,9 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
       away_until = frame + 150 * 60;
       continue;
     }
-    if (frame % 120 == 0 && chance(0.5)) target = {std::uniform_real_distribution<double>(-half_w, half_w)(rng),
-                                                  std::uniform_real_distribution<double>(-half_h, half_h)(rng)};
+    if (frame % 120 == 0 && chance(0.5))
+      target = {std::uniform_real_distribution<double>(-half_w, half_w)(rng),
+                std::uniform_real_distribution<double>(-half_h, half_h)(rng)};
     if (chance(p.key_per_frame)) {
       const bool learn = chance(0.05);
       if (learn) {
@@ -235,19 +240,22 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   settle(end_s);
   check_awaited(p.frames + answer_frames);
   if (flow.state() != app::KioskState::Attract) {  // in Attract the first key would only wake the kiosk
-    flow.key(KioskKey::Finish, end_s);  // asks, or ends a visit whose Finish was asked a moment ago
+    flow.key(KioskKey::Finish, end_s);             // asks, or ends a visit whose Finish was asked a moment ago
     if (flow.state() != app::KioskState::Attract) flow.key(KioskKey::Finish, end_s + 0.5);
   }
   settle(end_s + 0.5);
   auto expect = [&](bool ok, const std::string& what) {
-    if (!ok) report.left_behind.push_back("seed " + std::to_string(p.seed) + ": " + what + " (" + app::state_name(flow.state()) + "; last said: " + rt->last_said() + ")");
+    if (!ok)
+      report.left_behind.push_back("seed " + std::to_string(p.seed) + ": " + what + " (" +
+                                   app::state_name(flow.state()) + "; last said: " + rt->last_said() + ")");
   };
   expect(flow.state() == app::KioskState::Attract, "the kiosk is not waiting for a visitor");
   expect(flow.source() == app::KioskSource::Library, "Next and Previous would still walk the stick");
   expect(!rt->stick_busy(), "the stick is still 'working'");
   expect(!rt->picture_busy(), "a picture is still awaited");
   expect(!rt->tour_running(), "a guided tour still runs");
-  expect(!flow.reading() && !flow.in_help() && !flow.capturing() && !flow.warned(), "reading, help, capture or a warning is still on");
+  expect(!flow.reading() && !flow.in_help() && !flow.capturing() && !flow.warned(),
+         "reading, help, capture or a warning is still on");
   expect(rt->audio().volume().step() == settings.audio.volume_default_step, "the volume is not the operator's default");
   expect(rt->auto_level(), "the level does not follow the hand again");
   report.failures = flow.failures();

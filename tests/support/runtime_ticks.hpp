@@ -24,7 +24,8 @@ inline app::RuntimeOptions headless_runtime_options(const std::filesystem::path&
 /// One servo tick of `dt` [s] as the servo thread does it (read the simulated pantograph, step, publish the
 /// display, write the force), the handle pushed by `hand_force(sim)` [N] (the model hand), then collect().
 /// Requires the runtime's device to be the simulated pantograph.
-inline void runtime_tick(app::KioskRuntime& rt, double dt, const std::function<Vec2(const SimulatedPantograph&)>& hand_force) {
+inline void runtime_tick(app::KioskRuntime& rt, double dt,
+                         const std::function<Vec2(const SimulatedPantograph&)>& hand_force) {
   auto& sim = dynamic_cast<SimulatedPantograph&>(rt.devices().device());
   app::ServoCommand cmd;
   rt.core().step(sim.read(), false, cmd);

@@ -26,7 +26,9 @@ inline int shell(const std::string& cmd) {
 }
 
 /// Whether pdftoppm and pdftotext (poppler-utils) are there.
-inline bool have_poppler_utils() { return shell("command -v pdftoppm >/dev/null 2>&1 && command -v pdftotext >/dev/null 2>&1") == 0; }
+inline bool have_poppler_utils() {
+  return shell("command -v pdftoppm >/dev/null 2>&1 && command -v pdftotext >/dev/null 2>&1") == 0;
+}
 
 /// The words of `text`: lower case, letters and digits only, empty ones left out.
 inline std::vector<std::string> words_of(const std::string& text) {
@@ -59,10 +61,11 @@ inline double word_recall(const std::vector<std::string>& truth, const std::vect
 /// A scan of `page` of `pdf` as a scanner or a phone gives it: drawn at `dpi`, turned by `degrees`, with
 /// Gaussian sensor noise (sigma 6 grey levels, the same for the same page and dpi), as JPEG bytes at quality
 /// 80 (grey).
-inline std::vector<std::uint8_t> scan_jpeg(const std::filesystem::path& pdf, int page, int dpi, double degrees, const std::filesystem::path& dir) {
+inline std::vector<std::uint8_t> scan_jpeg(const std::filesystem::path& pdf, int page, int dpi, double degrees,
+                                           const std::filesystem::path& dir) {
   const std::filesystem::path stem = dir / ("p" + std::to_string(page) + "_" + std::to_string(dpi));
-  if (shell("pdftoppm -gray -r " + std::to_string(dpi) + " -f " + std::to_string(page) + " -l " + std::to_string(page) + " -singlefile -png '" +
-            pdf.string() + "' '" + stem.string() + "'") != 0)
+  if (shell("pdftoppm -gray -r " + std::to_string(dpi) + " -f " + std::to_string(page) + " -l " + std::to_string(page) +
+            " -singlefile -png '" + pdf.string() + "' '" + stem.string() + "'") != 0)
     return {};
   cv::Mat grey = cv::imread(stem.string() + ".png", cv::IMREAD_GRAYSCALE);
   if (grey.empty()) return {};
@@ -83,8 +86,8 @@ inline std::vector<std::uint8_t> scan_jpeg(const std::filesystem::path& pdf, int
 /// fails. The PNG is left in `dir`.
 inline cv::Mat draw_page(const std::filesystem::path& pdf, int page, int dpi, const std::filesystem::path& dir) {
   const std::filesystem::path stem = dir / ("page" + std::to_string(page) + "_" + std::to_string(dpi));
-  if (shell("pdftoppm -gray -r " + std::to_string(dpi) + " -f " + std::to_string(page) + " -l " + std::to_string(page) + " -singlefile -png '" +
-            pdf.string() + "' '" + stem.string() + "'") != 0)
+  if (shell("pdftoppm -gray -r " + std::to_string(dpi) + " -f " + std::to_string(page) + " -l " + std::to_string(page) +
+            " -singlefile -png '" + pdf.string() + "' '" + stem.string() + "'") != 0)
     return {};
   return cv::imread(stem.string() + ".png", cv::IMREAD_GRAYSCALE);
 }
@@ -92,7 +95,9 @@ inline cv::Mat draw_page(const std::filesystem::path& pdf, int page, int dpi, co
 /// The text layer of `page` of `pdf`, as pdftotext gives it.
 inline std::string pdftotext_page(const std::filesystem::path& pdf, int page, const std::filesystem::path& dir) {
   const std::filesystem::path out = dir / "truth.txt";
-  if (shell("pdftotext -f " + std::to_string(page) + " -l " + std::to_string(page) + " '" + pdf.string() + "' '" + out.string() + "'") != 0) return {};
+  if (shell("pdftotext -f " + std::to_string(page) + " -l " + std::to_string(page) + " '" + pdf.string() + "' '" +
+            out.string() + "'") != 0)
+    return {};
   std::ifstream f(out);
   std::stringstream ss;
   ss << f.rdbuf();

@@ -33,16 +33,17 @@ enum class Backdrop {
 
 /// How the picture is held and photographed. Ranges are those the tests cover.
 struct PhotoConditions {
-  double rotation_deg = 0.0;      ///< the picture turned in the frame, counter-clockwise on screen, [-30, 30] degrees
-  double perspective = 0.0;       ///< keystone: the two corners of one (seeded) side moved inward along that side by
-                                  ///< this share of its length, the other two by up to a third of it, [0, 0.15]
-  double blur_sigma_px = 0.0;     ///< Gaussian blur of the whole frame (focus), [0, 1.5] px
-  double noise_sigma = 0.0;       ///< Gaussian sensor noise per channel, [0, 6] grey levels
-  bool uneven_light = false;      ///< a multiplicative light gradient from 0.6 to 1.1 across the frame (seeded direction)
+  double rotation_deg = 0.0;   ///< the picture turned in the frame, counter-clockwise on screen, [-30, 30] degrees
+  double perspective = 0.0;    ///< keystone: the two corners of one (seeded) side moved inward along that side by
+                               ///< this share of its length, the other two by up to a third of it, [0, 0.15]
+  double blur_sigma_px = 0.0;  ///< Gaussian blur of the whole frame (focus), [0, 1.5] px
+  double noise_sigma = 0.0;    ///< Gaussian sensor noise per channel, [0, 6] grey levels
+  bool uneven_light = false;   ///< a multiplicative light gradient from 0.6 to 1.1 across the frame (seeded direction)
   Backdrop backdrop = Backdrop::wood;
-  double fill = 0.72;             ///< the picture's bounding box spans at most this share of the frame's width and height
-  cv::Point2d offset_px{0, 0};    ///< the picture's centre relative to the frame's centre [px]; may move it out of the frame
-  std::uint64_t seed = 1;         ///< seeds the backdrop, the keystone side, the light's direction and the noise
+  double fill = 0.72;  ///< the picture's bounding box spans at most this share of the frame's width and height
+  cv::Point2d offset_px{0,
+                        0};  ///< the picture's centre relative to the frame's centre [px]; may move it out of the frame
+  std::uint64_t seed = 1;    ///< seeds the backdrop, the keystone side, the light's direction and the noise
 };
 
 /// A synthetic photo and its truth.
@@ -95,7 +96,8 @@ inline cv::Mat text_page(int w = 420, int h = 594, std::uint64_t seed = 7) {
   const double s = w / 420.0;
   const cv::Scalar ink(30, 30, 30);
   const int thick = std::max(1, static_cast<int>(std::lround(5 * s)));
-  cv::putText(page, "Shapes", {margin, margin + static_cast<int>(48 * s)}, cv::FONT_HERSHEY_DUPLEX, 2.0 * s, ink, thick + 1, cv::LINE_AA);
+  cv::putText(page, "Shapes", {margin, margin + static_cast<int>(48 * s)}, cv::FONT_HERSHEY_DUPLEX, 2.0 * s, ink,
+              thick + 1, cv::LINE_AA);
   int y = margin + static_cast<int>(115 * s);
   const int line_step = static_cast<int>(50 * s);
   for (int line = 0; line < 4; ++line, y += line_step) {
@@ -112,8 +114,10 @@ inline cv::Mat text_page(int w = 420, int h = 594, std::uint64_t seed = 7) {
   if (fh > 20) {
     const int r = std::min(fh, w / 4) / 2;
     cv::circle(page, {margin + r + 4, fy + fh / 2}, r, ink, cv::FILLED, cv::LINE_AA);
-    cv::rectangle(page, cv::Rect(w / 2 - r, fy + fh / 2 - r, 2 * r, 2 * r), ink, std::max(2, static_cast<int>(6 * s)), cv::LINE_AA);
-    const std::vector<cv::Point> tri{{w - margin - 2 * r, fy + fh / 2 + r}, {w - margin, fy + fh / 2 + r}, {w - margin - r, fy + fh / 2 - r}};
+    cv::rectangle(page, cv::Rect(w / 2 - r, fy + fh / 2 - r, 2 * r, 2 * r), ink, std::max(2, static_cast<int>(6 * s)),
+                  cv::LINE_AA);
+    const std::vector<cv::Point> tri{
+        {w - margin - 2 * r, fy + fh / 2 + r}, {w - margin, fy + fh / 2 + r}, {w - margin - r, fy + fh / 2 - r}};
     cv::fillConvexPoly(page, tri, ink, cv::LINE_AA);
   }
   return page;
@@ -124,7 +128,8 @@ inline cv::Mat text_page(int w = 420, int h = 594, std::uint64_t seed = 7) {
 inline std::array<cv::Point2d, 4> photo_corners(cv::Size picture, cv::Size frame, const PhotoConditions& c) {
   cv::RNG rng(c.seed * 7919 + 17);
   const double w = picture.width, h = picture.height;
-  std::array<cv::Point2d, 4> q{cv::Point2d(-w / 2, -h / 2), cv::Point2d(w / 2, -h / 2), cv::Point2d(w / 2, h / 2), cv::Point2d(-w / 2, h / 2)};
+  std::array<cv::Point2d, 4> q{cv::Point2d(-w / 2, -h / 2), cv::Point2d(w / 2, -h / 2), cv::Point2d(w / 2, h / 2),
+                               cv::Point2d(-w / 2, h / 2)};
   // Keystone: side k (k -> k+1) is the far one; its corners move inward along it by `perspective` of its length.
   const int far = rng.uniform(0, 4);
   std::array<cv::Point2d, 4> moved = q;
@@ -157,12 +162,21 @@ inline PhotoConditions near_edge(cv::Size picture, cv::Size frame, PhotoConditio
   for (const cv::Point2d& p : photo_corners(picture, frame, c)) {
     x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
   }
-  const double left = -0.5 + gap_px, right = frame.width - 0.5 - gap_px, top = -0.5 + gap_px, bottom = frame.height - 0.5 - gap_px;
+  const double left = -0.5 + gap_px, right = frame.width - 0.5 - gap_px, top = -0.5 + gap_px,
+               bottom = frame.height - 0.5 - gap_px;
   switch (edge) {
-    case 0: c.offset_px = {0, top - y0}; break;
-    case 1: c.offset_px = {right - x1, 0}; break;
-    case 2: c.offset_px = {0, bottom - y1}; break;
-    default: c.offset_px = {left - x0, 0}; break;
+    case 0:
+      c.offset_px = {0, top - y0};
+      break;
+    case 1:
+      c.offset_px = {right - x1, 0};
+      break;
+    case 2:
+      c.offset_px = {0, bottom - y1};
+      break;
+    default:
+      c.offset_px = {left - x0, 0};
+      break;
   }
   return c;
 }
@@ -172,20 +186,26 @@ inline PhotoConditions near_edge(cv::Size picture, cv::Size frame, PhotoConditio
 /// frame is then backdrop·(1 − coverage) + picture·coverage (cv::blendLinear), times the light, blurred, plus
 /// noise. `backdrop`, when given (frame-sized CV_8UC3, e.g. a cached backdrop_texture), is used instead of
 /// generating one from c.backdrop and c.seed.
-inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, const PhotoConditions& c, const cv::Mat* backdrop = nullptr) {
+inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, const PhotoConditions& c,
+                                      const cv::Mat* backdrop = nullptr) {
   CV_Assert(!picture.empty() && (picture.type() == CV_8UC1 || picture.type() == CV_8UC3));
   CV_Assert(backdrop == nullptr || (backdrop->size() == frame && backdrop->type() == CV_8UC3));
   cv::Mat pic;
-  if (picture.channels() == 1) cv::cvtColor(picture, pic, cv::COLOR_GRAY2BGR);
-  else pic = picture;
+  if (picture.channels() == 1)
+    cv::cvtColor(picture, pic, cv::COLOR_GRAY2BGR);
+  else
+    pic = picture;
   SyntheticPhoto out;
   out.corners_px = photo_corners(pic.size(), frame, c);
   const double W = pic.cols, H = pic.rows;
-  const cv::Point2f src[4] = {{-0.5f, -0.5f}, {static_cast<float>(W - 0.5), -0.5f}, {static_cast<float>(W - 0.5), static_cast<float>(H - 0.5)},
+  const cv::Point2f src[4] = {{-0.5f, -0.5f},
+                              {static_cast<float>(W - 0.5), -0.5f},
+                              {static_cast<float>(W - 0.5), static_cast<float>(H - 0.5)},
                               {-0.5f, static_cast<float>(H - 0.5)}};
   cv::Point2f dst[4];
-  for (int k = 0; k < 4; ++k) dst[k] = cv::Point2f(static_cast<float>(out.corners_px[static_cast<std::size_t>(k)].x),
-                                                   static_cast<float>(out.corners_px[static_cast<std::size_t>(k)].y));
+  for (int k = 0; k < 4; ++k)
+    dst[k] = cv::Point2f(static_cast<float>(out.corners_px[static_cast<std::size_t>(k)].x),
+                         static_cast<float>(out.corners_px[static_cast<std::size_t>(k)].y));
   out.homography = cv::Matx33d(cv::getPerspectiveTransform(src, dst));
 
   // Shrink first when the picture is smaller in the frame than in its file.
@@ -194,7 +214,8 @@ inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, co
   cv::Mat render = pic;
   cv::Matx33d render_h = out.homography;
   if (lin < 0.9) {
-    const cv::Size rs(std::max(2, static_cast<int>(std::lround(W * lin))), std::max(2, static_cast<int>(std::lround(H * lin))));
+    const cv::Size rs(std::max(2, static_cast<int>(std::lround(W * lin))),
+                      std::max(2, static_cast<int>(std::lround(H * lin))));
     cv::resize(pic, render, rs, 0, 0, cv::INTER_AREA);
     const double sx = W / rs.width, sy = H / rs.height;  // resized px -> picture px: x = (x' + 0.5) sx - 0.5
     const cv::Matx33d to_pic(sx, 0, 0.5 * sx - 0.5, 0, sy, 0.5 * sy - 0.5, 0, 0, 1);
@@ -203,10 +224,11 @@ inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, co
   cv::Mat colour, coverage, uncovered, img;
   cv::warpPerspective(render, colour, cv::Mat(render_h), frame, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   // Bilinear coverage of a ones image with a zero border: 0.5 exactly on the picture's outline (x = -0.5).
-  cv::warpPerspective(cv::Mat(render.size(), CV_32F, cv::Scalar(1.0)), coverage, cv::Mat(render_h), frame, cv::INTER_LINEAR,
-                      cv::BORDER_CONSTANT, cv::Scalar(0.0));
+  cv::warpPerspective(cv::Mat(render.size(), CV_32F, cv::Scalar(1.0)), coverage, cv::Mat(render_h), frame,
+                      cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0.0));
   cv::subtract(cv::Scalar(1.0), coverage, uncovered);
-  cv::blendLinear(colour, backdrop ? *backdrop : backdrop_texture(c.backdrop, frame.width, frame.height, c.seed), coverage, uncovered, img);
+  cv::blendLinear(colour, backdrop ? *backdrop : backdrop_texture(c.backdrop, frame.width, frame.height, c.seed),
+                  coverage, uncovered, img);
 
   cv::RNG rng(c.seed * 104729 + 3);
   cv::Mat f;
@@ -218,7 +240,8 @@ inline SyntheticPhoto synthetic_photo(const cv::Mat& picture, cv::Size frame, co
     const double hi = std::max(0.0, dx * frame.width) + std::max(0.0, dy * frame.height);
     for (int y = 0; y < frame.height; ++y) {
       cv::Vec3f* row = f.ptr<cv::Vec3f>(y);
-      for (int x = 0; x < frame.width; ++x) row[x] *= static_cast<float>(0.6 + 0.5 * ((dx * x + dy * y) - lo) / (hi - lo));
+      for (int x = 0; x < frame.width; ++x)
+        row[x] *= static_cast<float>(0.6 + 0.5 * ((dx * x + dy * y) - lo) / (hi - lo));
     }
   }
   if (c.blur_sigma_px > 0) cv::GaussianBlur(f, f, cv::Size(0, 0), c.blur_sigma_px);

@@ -33,7 +33,8 @@ class TempDir {
   /// Writes `bytes` to the file `name` in the folder; its path.
   std::string write(const std::string& name, const std::vector<std::uint8_t>& bytes) const {
     const std::filesystem::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    std::ofstream(p, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     return p.string();
   }
   /// The folder's path.

@@ -6,10 +6,10 @@
 
 namespace hk::test {
 
-extern const char* const kTestDataDir;          ///< tests/data of this tree
-extern const char* const kShippedPicturesDir;   ///< data/pictures of this tree
-extern const char* const kKioskExe;             ///< the haptic-kiosk executable of this build
-extern const char* const kStickHelperExe;       ///< the hk-stick-mount executable of this build
+extern const char* const kTestDataDir;         ///< tests/data of this tree
+extern const char* const kShippedPicturesDir;  ///< data/pictures of this tree
+extern const char* const kKioskExe;            ///< the haptic-kiosk executable of this build
+extern const char* const kStickHelperExe;      ///< the hk-stick-mount executable of this build
 
 }  // namespace hk::test
 

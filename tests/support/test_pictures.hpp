@@ -6,10 +6,11 @@
 namespace hk::test {
 
 inline constexpr const char* kPictures[] = {
-    "HappyFish.jpg",     "LinuxLogo.jpg",    "apple.jpg",        "butterfly.jpg",    "camera.png",       "coins.png",
-    "fruits.jpg",        "horse.png",        "page.png",         "pic1.png",         "pic3.png",         "silhouette_1.png",
-    "silhouette_10.png", "silhouette_2.png", "silhouette_3.png", "silhouette_4.png", "silhouette_5.png", "silhouette_6.png",
-    "silhouette_7.png",  "silhouette_8.png", "silhouette_9.png", "sudoku.png",
+    "HappyFish.jpg",    "LinuxLogo.jpg",    "apple.jpg",         "butterfly.jpg",    "camera.png",
+    "coins.png",        "fruits.jpg",       "horse.png",         "page.png",         "pic1.png",
+    "pic3.png",         "silhouette_1.png", "silhouette_10.png", "silhouette_2.png", "silhouette_3.png",
+    "silhouette_4.png", "silhouette_5.png", "silhouette_6.png",  "silhouette_7.png", "silhouette_8.png",
+    "silhouette_9.png", "sudoku.png",
 };
 
 }  // namespace hk::test

@@ -21,7 +21,8 @@ inline cv::Mat smooth_field(int w, int h, double cell_px, cv::RNG& rng) {
   cv::Mat grid(gh, gw, CV_32F);
   rng.fill(grid, cv::RNG::UNIFORM, -1.0, 1.0);
   cv::Mat big;
-  cv::resize(grid, big, cv::Size(static_cast<int>(gw * cell_px), static_cast<int>(gh * cell_px)), 0, 0, cv::INTER_CUBIC);
+  cv::resize(grid, big, cv::Size(static_cast<int>(gw * cell_px), static_cast<int>(gh * cell_px)), 0, 0,
+             cv::INTER_CUBIC);
   return big(cv::Rect(0, 0, w, h)).clone();
 }
 

@@ -13,9 +13,9 @@ namespace hk::test {
 template <class Done, class Step>
 bool wait_until(Done&& done, Step&& step, double timeout_s = 60.0,
                 std::chrono::milliseconds pause = std::chrono::milliseconds(10)) {
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(timeout_s));
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(timeout_s));
   for (;;) {
     step();
     if (done()) return true;
@@ -27,7 +27,8 @@ bool wait_until(Done&& done, Step&& step, double timeout_s = 60.0,
 /// wait_until without a step: `done()` alone is polled.
 template <class Done>
 bool wait_until(Done&& done, double timeout_s = 60.0) {
-  return wait_until(done, [] {}, timeout_s);
+  return wait_until(
+      done, [] {}, timeout_s);
 }
 
 }  // namespace hk::test

@@ -27,14 +27,16 @@ constexpr int opposite(int d) { return (d + 4) & 7; }
 
 // Segments shorter than these are Canny artefacts at corners, not shape (a few pixels are a
 // fraction of a millimetre on the device); they must not cut a boundary into pieces.
-constexpr double kSpurPx = 3.0;       // a branch from a junction to a free end
-constexpr double kShortPx = 3.0;      // one of several branches joining the same two junctions
-constexpr double kTinyLoopPx = 5.0;   // a loop from a junction back to itself (a 2x2 block)
+constexpr double kSpurPx = 3.0;      // a branch from a junction to a free end
+constexpr double kShortPx = 3.0;     // one of several branches joining the same two junctions
+constexpr double kTinyLoopPx = 5.0;  // a loop from a junction back to itself (a 2x2 block)
 
 class Linker {
  public:
   explicit Linker(const cv::Mat& edges)
-      : w_(edges.cols), h_(edges.rows), stride_(edges.cols + 2),
+      : w_(edges.cols),
+        h_(edges.rows),
+        stride_(edges.cols + 2),
         set_(static_cast<std::size_t>(stride_) * (h_ + 2), 0),
         adj_(set_.size(), 0),
         used_(set_.size(), 0) {
@@ -52,8 +54,7 @@ class Linker {
     mark_minor_segments();
     link_segments_at_junctions();
     std::vector<Found> found = assemble();
-    std::stable_sort(found.begin(), found.end(),
-                     [](const Found& a, const Found& b) { return a.first < b.first; });
+    std::stable_sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.first < b.first; });
     std::vector<Chain> chains;
     chains.reserve(found.size());
     for (Found& f : found) {
@@ -103,7 +104,7 @@ class Linker {
         if (set_[step(p, 0)] + set_[step(p, 2)] + set_[step(p, 4)] + set_[step(p, 6)] != 2) continue;
         for (int d = 0; d < 8; d += 2) {  // u = direction d, v = direction d + 2 (perpendicular)
           if (!set_[step(p, d)] || !set_[step(p, (d + 2) & 7)]) continue;
-          const bool inner_empty = !set_[step(p, (d + 5) & 7)];                        // p - u - v
+          const bool inner_empty = !set_[step(p, (d + 5) & 7)];                            // p - u - v
           const bool side_set = set_[step(p, (d + 7) & 7)] || set_[step(p, (d + 3) & 7)];  // p + u - v, p - u + v
           if (inner_empty && side_set) set_[p] = 0;
           break;
@@ -241,7 +242,7 @@ class Linker {
   void link_segments_at_junctions() {
     link_.assign(2 * segs_.size(), -1);
     std::vector<std::int32_t> slot(set_.size(), -1);  // junction pixel -> index into ends
-    std::vector<std::array<std::int64_t, 3>> ends;     // {count, first end, second end}
+    std::vector<std::array<std::int64_t, 3>> ends;    // {count, first end, second end}
     for (std::size_t i = 0; i < segs_.size(); ++i) {
       const Segment& s = segs_[i];
       if (s.cycle || s.minor || s.pix.size() < 2) continue;

@@ -9,10 +9,10 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "vision/edges.hpp"
-#include "vision/intake.hpp"
 #include "hk/error.hpp"
 #include "test_paths.hpp"
+#include "vision/edges.hpp"
+#include "vision/intake.hpp"
 
 namespace hk::vision {
 namespace {

@@ -19,11 +19,11 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "vision/frame_source.hpp"
-#include "temp_dir.hpp"
-#include "vision/intake.hpp"
 #include "hk/error.hpp"
+#include "temp_dir.hpp"
 #include "test_paths.hpp"
+#include "vision/frame_source.hpp"
+#include "vision/intake.hpp"
 
 namespace hk::vision {
 namespace {
@@ -102,7 +102,8 @@ TEST(FrameSourceSpec, ParsesEveryKind) {
 }
 
 TEST(FrameSourceSpec, RefusesBadSpecsInOneLineNamingThem) {
-  camera_refusal([] { parse_source_spec("usb:1"); }, {"'usb:1'", "unknown kind", "file:PATH", "libcamera:N", "v4l2:DEV"});
+  camera_refusal([] { parse_source_spec("usb:1"); },
+                 {"'usb:1'", "unknown kind", "file:PATH", "libcamera:N", "v4l2:DEV"});
   camera_refusal([] { parse_source_spec(""); }, {"''", "unknown kind"});
   camera_refusal([] { parse_source_spec("frames"); }, {"'frames'", "unknown kind"});
   camera_refusal([] { parse_source_spec("FILE:x.png"); }, {"'FILE:x.png'", "unknown kind"});

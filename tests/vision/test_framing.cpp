@@ -11,9 +11,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include "hk/error.hpp"
 #include "synthetic_photo.hpp"
 #include "vision/framing.hpp"
-#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -21,7 +21,8 @@ namespace {
 constexpr int kW = 640, kH = 480;
 
 /// A look at a 640 x 480 frame: a page of w x h px centred at (cx, cy) (no page when w = 0), lit, with detail.
-FrameLook look(double t_s, double cx, double cy, double w = 300, double h = 220, double motion = 1.0, double corner_motion = 0.001) {
+FrameLook look(double t_s, double cx, double cy, double w = 300, double h = 220, double motion = 1.0,
+               double corner_motion = 0.001) {
   FrameLook l;
   l.t_s = t_s;
   l.width_px = kW;
@@ -31,8 +32,8 @@ FrameLook look(double t_s, double cx, double cy, double w = 300, double h = 220,
   l.motion = motion;
   if (w > 0) {
     l.page.found = true;
-    l.page.corners_px = {cv::Point2d(cx - w / 2, cy - h / 2), cv::Point2d(cx + w / 2, cy - h / 2), cv::Point2d(cx + w / 2, cy + h / 2),
-                         cv::Point2d(cx - w / 2, cy + h / 2)};
+    l.page.corners_px = {cv::Point2d(cx - w / 2, cy - h / 2), cv::Point2d(cx + w / 2, cy - h / 2),
+                         cv::Point2d(cx + w / 2, cy + h / 2), cv::Point2d(cx - w / 2, cy + h / 2)};
     l.corner_motion = corner_motion;
   }
   return l;
@@ -60,7 +61,8 @@ Heard run(FramingGuide& g, const std::vector<FrameLook>& looks) {
 TEST(FramingGuide, AStillCentredPageIsCapturedAfterOneSecondAndNothingIsSaid) {
   FramingGuide g;
   std::vector<FrameLook> looks;
-  for (int i = 0; i < 30; ++i) looks.push_back(look(i * 0.1, kW / 2.0, kH / 2.0, 300, 220, i == 0 ? -1.0 : 1.0, i == 0 ? -1.0 : 0.001));
+  for (int i = 0; i < 30; ++i)
+    looks.push_back(look(i * 0.1, kW / 2.0, kH / 2.0, 300, 220, i == 0 ? -1.0 : 1.0, i == 0 ? -1.0 : 0.001));
   const Heard h = run(g, looks);
   EXPECT_TRUE(h.said.empty());
   ASSERT_TRUE(h.captured_at_s.has_value());
@@ -108,13 +110,15 @@ TEST(FramingGuide, APageBroughtInFromTheRightIsGuidedThenCaptured) {
   cut.page.touches_frame[1] = true;
   looks.push_back(cut);
   t += 0.1;
-  for (double x = kW * 0.78; x > kW * 0.5; x -= 20, t += 0.1) looks.push_back(look(t, x, kH / 2.0, 300, 220, 8.0, 0.03));  // sliding left
-  for (int i = 0; i < 3; ++i, t += 0.1) looks.push_back(look(t, kW * 0.5, kH / 2.0, 300, 220, 8.0, 0.02));  // still settling
+  for (double x = kW * 0.78; x > kW * 0.5; x -= 20, t += 0.1)
+    looks.push_back(look(t, x, kH / 2.0, 300, 220, 8.0, 0.03));  // sliding left
+  for (int i = 0; i < 3; ++i, t += 0.1)
+    looks.push_back(look(t, kW * 0.5, kH / 2.0, 300, 220, 8.0, 0.02));  // still settling
   const double settled_s = t;
   for (int i = 0; i < 15; ++i, t += 0.1) looks.push_back(look(t, kW * 0.5, kH / 2.0));
   const Heard h = run(g, looks);
-  const std::vector<FramingAdvice> expected = {FramingAdvice::PlacePicture, FramingAdvice::CutOffRight, FramingAdvice::MoveLeft,
-                                               FramingAdvice::HoldStill};
+  const std::vector<FramingAdvice> expected = {FramingAdvice::PlacePicture, FramingAdvice::CutOffRight,
+                                               FramingAdvice::MoveLeft, FramingAdvice::HoldStill};
   EXPECT_EQ(h.said, expected);
   ASSERT_TRUE(h.captured_at_s.has_value());
   EXPECT_NEAR(*h.captured_at_s, settled_s + 1.0, 1e-9);
@@ -136,8 +140,8 @@ TEST(FramingGuide, AMovingPageIsNeverCapturedAndAPauseShorterThanStillSIsNotEnou
   std::vector<FrameLook> looks;
   double t = 0;
   for (int round = 0; round < 5; ++round) {
-    for (int i = 0; i < 9; ++i, t += 0.1) looks.push_back(look(t, kW / 2.0, kH / 2.0));             // 0.9 s still
-    looks.push_back(look(t, kW / 2.0, kH / 2.0, 300, 220, 12.0, 0.02));                               // a jolt
+    for (int i = 0; i < 9; ++i, t += 0.1) looks.push_back(look(t, kW / 2.0, kH / 2.0));  // 0.9 s still
+    looks.push_back(look(t, kW / 2.0, kH / 2.0, 300, 220, 12.0, 0.02));                  // a jolt
     t += 0.1;
   }
   const Heard h = run(g, looks);
@@ -151,7 +155,8 @@ TEST(FramingGuide, APictureFillingTheFrameIsCapturedWholeAfterWholeFrameAfterS) 
   std::vector<FrameLook> looks;
   for (int i = 0; i < 50; ++i) looks.push_back(look(i * 0.1, 0, 0, 0, 0, i == 0 ? -1.0 : 1.0));
   const Heard h = run(g, looks);
-  EXPECT_EQ(h.said, std::vector<FramingAdvice>{FramingAdvice::PlacePicture}) << "said once, not repeated while it waits";
+  EXPECT_EQ(h.said, std::vector<FramingAdvice>{FramingAdvice::PlacePicture})
+      << "said once, not repeated while it waits";
   ASSERT_TRUE(h.captured_at_s.has_value());
   EXPECT_NEAR(*h.captured_at_s, 0.1 + 3.0, 1e-9);
   // An empty, even table is never captured: no detail.
@@ -208,7 +213,8 @@ TEST(FrameLook, APageWholeNearTheBottomIsReadyAndOneJustBeyondItIsCutOff) {
     pc.backdrop = hk::test::Backdrop::blobs;
     pc.seed = 43;
     pc.fill = 0.85;
-    const cv::Mat frame = hk::test::synthetic_photo(page, size, hk::test::near_edge(page.size(), size, pc, 2, gap_px)).frame;
+    const cv::Mat frame =
+        hk::test::synthetic_photo(page, size, hk::test::near_edge(page.size(), size, pc, 2, gap_px)).frame;
     cv::Mat small;
     const FrameLook first = look_at_frame(frame, 0.0, nullptr, small);
     const FrameLook still = look_at_frame(frame, 0.1, &first, small);

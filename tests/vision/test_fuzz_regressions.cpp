@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_inputs.hpp"
 #include "vision/intake.hpp"
 #include "vision/pdf.hpp"
-#include "fuzz_inputs.hpp"
 
 namespace hk::vision {
 namespace {
@@ -49,7 +49,8 @@ TEST(ImageFuzzRegressions, PngChunkTypeOfControlBytesIsEscaped) {
   // IHDR, then a chunk header whose length runs past the end and whose type is "@\x0F\x84\x18": the message
   // quoted the 4 type bytes raw (a control character and a stray UTF-8 byte in the kiosk's log line).
   const std::string what = image_refusal(test::fuzz_dir("image") / "png_chunk_type_control_bytes.png");
-  EXPECT_NE(what.find("truncated PNG: chunk '@\\x0F\\x84\\x18' at byte 33 runs past the end of the file"), std::string::npos)
+  EXPECT_NE(what.find("truncated PNG: chunk '@\\x0F\\x84\\x18' at byte 33 runs past the end of the file"),
+            std::string::npos)
       << what;
 }
 

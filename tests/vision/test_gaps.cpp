@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "vision/gaps.hpp"
 #include "hk/error.hpp"
+#include "vision/gaps.hpp"
 
 namespace hk::vision {
 namespace {
@@ -91,7 +91,7 @@ TEST(CloseGaps, EndsSideBySideOrTurnedTooFarAreNotJoined) {
   EXPECT_EQ(st.joins, 1u);
   // Two strokes on one line with their first points facing each other across 4 px: joined, one reversed.
   Chain c, d;
-  for (int x = 50; x >= 0; --x) c.points_px.emplace_back(x, 30);   // first point (50, 30), leaving it +x
+  for (int x = 50; x >= 0; --x) c.points_px.emplace_back(x, 30);    // first point (50, 30), leaving it +x
   for (int x = 54; x <= 100; ++x) d.points_px.emplace_back(x, 30);  // first point (54, 30), leaving it -x
   const auto cd = close_gaps({c, d}, at_one_mm(), &st);
   ASSERT_EQ(cd.size(), 1u);

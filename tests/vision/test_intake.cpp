@@ -15,10 +15,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "temp_dir.hpp"
-#include "vision/intake.hpp"
 #include "hk/error.hpp"
+#include "temp_dir.hpp"
 #include "test_paths.hpp"
+#include "vision/intake.hpp"
 
 namespace hk::vision {
 namespace {
@@ -140,9 +140,9 @@ TEST(ReadImageHeader, ParsesHeaderLayoutsOpenCvDoesNotWrite) {
   // Big-endian TIFF, width as SHORT and height as LONG; BigTIFF with LONG8; BMP core header;
   // JPEG whose frame header comes after a large APP segment and fill bytes.
   TempDir tmp;
-  const auto mm_tiff = cat({str("MM\0*", 4), be32(8), be16(2),                  //
-                            be16(256), be16(3), be32(1), be16(300), be16(0),     // ImageWidth SHORT
-                            be16(257), be16(4), be32(1), be32(70000),            // ImageLength LONG
+  const auto mm_tiff = cat({str("MM\0*", 4), be32(8), be16(2),                //
+                            be16(256), be16(3), be32(1), be16(300), be16(0),  // ImageWidth SHORT
+                            be16(257), be16(4), be32(1), be32(70000),         // ImageLength LONG
                             be32(0)});
   const ImageHeader t = read_image_header(tmp.write("mm.tif", mm_tiff));
   EXPECT_EQ(t.width_px, 300);
@@ -157,16 +157,24 @@ TEST(ReadImageHeader, ParsesHeaderLayoutsOpenCvDoesNotWrite) {
   EXPECT_EQ(bt.width_px, 123456);
   EXPECT_EQ(bt.height_px, 77);
 
-  const auto core_bmp = cat({str("BM", 2), le32(26), le32(0), le32(26), le32(12), le16(640), le16(480),
-                             le16(1), le16(24)});
+  const auto core_bmp =
+      cat({str("BM", 2), le32(26), le32(0), le32(26), le32(12), le16(640), le16(480), le16(1), le16(24)});
   const ImageHeader b = read_image_header(tmp.write("core.bmp", core_bmp));
   EXPECT_EQ(b.width_px, 640);
   EXPECT_EQ(b.height_px, 480);
   EXPECT_EQ(b.format, "bmp");
 
   std::vector<std::uint8_t> app(3000, 0xAB);
-  const auto jpeg = cat({{0xFF, 0xD8}, {0xFF, 0xE1}, be16(2 + 3000), app,  // APP1
-                         {0xFF, 0xFF, 0xFF, 0xC2}, be16(11), {8}, be16(1234), be16(4321), {1, 1, 0x11, 0},
+  const auto jpeg = cat({{0xFF, 0xD8},
+                         {0xFF, 0xE1},
+                         be16(2 + 3000),
+                         app,  // APP1
+                         {0xFF, 0xFF, 0xFF, 0xC2},
+                         be16(11),
+                         {8},
+                         be16(1234),
+                         be16(4321),
+                         {1, 1, 0x11, 0},
                          {0xFF, 0xD9}});
   const ImageHeader j = read_image_header(tmp.write("p.jpg", jpeg));
   EXPECT_EQ(j.width_px, 4321);
@@ -179,8 +187,7 @@ TEST(ReadImageHeader, RefusesWhatItCannotParse) {
   EXPECT_TRUE(contains(refusal([&] { read_image_header(bad + "not_an_image.png"); }, "not_an_image.png"),
                        "unknown image format"));
   EXPECT_TRUE(contains(refusal([&] { read_image_header(bad + "empty.png"); }, "empty.png"), "empty"));
-  EXPECT_TRUE(contains(refusal([&] { read_image_header(bad + "no_such_file.png"); }, "no_such_file.png"),
-                       "not found"));
+  EXPECT_TRUE(contains(refusal([&] { read_image_header(bad + "no_such_file.png"); }, "no_such_file.png"), "not found"));
   EXPECT_TRUE(contains(refusal([&] { read_image_header(bad + "bad_crc.png"); }, "bad_crc.png"), "CRC"));
   refusal([&] { read_image_header(kData + "/bad"); }, "bad");  // a directory
 
@@ -299,8 +306,7 @@ TEST(LoadImage, ChecksPngChunks) {
   const auto idat = std::search(damaged.begin(), damaged.end(), std::begin("IDAT"), std::begin("IDAT") + 4);
   ASSERT_NE(idat, damaged.end());
   idat[6] ^= 0x55;
-  EXPECT_TRUE(contains(refusal([&] { load_image(tmp.write("damaged.png", damaged), {}); }, "damaged.png"),
-                       "CRC"));
+  EXPECT_TRUE(contains(refusal([&] { load_image(tmp.write("damaged.png", damaged), {}); }, "damaged.png"), "CRC"));
 
   // No IEND: the file was cut after the image data.
   std::vector<std::uint8_t> cut(png.begin(), png.end() - 12);
@@ -328,9 +334,9 @@ TEST(LoadImage, CompositesTransparencyOverWhite) {
   // Transparent pixels often hold black colour values; shown as black they would hide a dark
   // drawing's outline. A viewer shows them as background.
   TempDir tmp;
-  cv::Mat bgra(20, 30, CV_8UC4, cv::Scalar(0, 0, 0, 0));                   // transparent black
-  bgra(cv::Rect(10, 5, 10, 10)).setTo(cv::Scalar(0, 0, 0, 255));           // opaque black square
-  bgra(cv::Rect(0, 0, 4, 4)).setTo(cv::Scalar(0, 0, 255, 128));            // half-transparent red
+  cv::Mat bgra(20, 30, CV_8UC4, cv::Scalar(0, 0, 0, 0));          // transparent black
+  bgra(cv::Rect(10, 5, 10, 10)).setTo(cv::Scalar(0, 0, 0, 255));  // opaque black square
+  bgra(cv::Rect(0, 0, 4, 4)).setTo(cv::Scalar(0, 0, 255, 128));   // half-transparent red
   std::vector<std::uint8_t> bytes;
   ASSERT_TRUE(cv::imencode(".png", bgra, bytes));
   const cv::Mat m = load_image(tmp.write("alpha.png", bytes), {});

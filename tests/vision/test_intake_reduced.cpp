@@ -11,19 +11,19 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <png.h>
 #include <zlib.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
-#include "temp_dir.hpp"
-#include "vision/intake.hpp"
 #include "hk/error.hpp"
+#include "temp_dir.hpp"
 #include "test_paths.hpp"
+#include "vision/intake.hpp"
 
 namespace hk::vision {
 namespace {
@@ -50,11 +50,32 @@ std::vector<std::uint8_t> encode(const std::string& ext, const cv::Mat& m, std::
 /// `jpeg` with an EXIF APP1 segment (little-endian TIFF, one IFD entry: Orientation = `orientation`) right
 /// after its SOI marker.
 std::vector<std::uint8_t> with_exif_orientation(const std::vector<std::uint8_t>& jpeg, std::uint16_t orientation) {
-  const std::vector<std::uint8_t> tiff = {'I', 'I', 42, 0, 8, 0, 0, 0,  // header, IFD at offset 8
-                                          1, 0,                         // one entry
-                                          0x12, 0x01, 3, 0, 1, 0, 0, 0,  // tag 0x0112 Orientation, SHORT, count 1
-                                          static_cast<std::uint8_t>(orientation), 0, 0, 0,
-                                          0, 0, 0, 0};  // no next IFD
+  const std::vector<std::uint8_t> tiff = {'I',
+                                          'I',
+                                          42,
+                                          0,
+                                          8,
+                                          0,
+                                          0,
+                                          0,  // header, IFD at offset 8
+                                          1,
+                                          0,  // one entry
+                                          0x12,
+                                          0x01,
+                                          3,
+                                          0,
+                                          1,
+                                          0,
+                                          0,
+                                          0,  // tag 0x0112 Orientation, SHORT, count 1
+                                          static_cast<std::uint8_t>(orientation),
+                                          0,
+                                          0,
+                                          0,
+                                          0,
+                                          0,
+                                          0,
+                                          0};  // no next IFD
   std::vector<std::uint8_t> app1 = {'E', 'x', 'i', 'f', 0, 0};
   app1.insert(app1.end(), tiff.begin(), tiff.end());
   const std::size_t len = app1.size() + 2;
@@ -89,7 +110,7 @@ TEST(DecodeReductionFor, ChoosesTheLargestReductionThatKeepsTheSide) {
   EXPECT_EQ(decode_reduction_for(6000, 4000, 750), 8);   // never beyond 1/8
   EXPECT_EQ(decode_reduction_for(6001, 10, 751), 8);     // libjpeg rounds up: ceil(6001 / 8) = 751
   EXPECT_EQ(decode_reduction_for(6000, 10, 751), 4);
-  EXPECT_EQ(decode_reduction_for(799, 600, 800), 1);     // already smaller than asked
+  EXPECT_EQ(decode_reduction_for(799, 600, 800), 1);  // already smaller than asked
 }
 
 TEST(LoadImageReduced, DecodesA24MegapixelJpegAtTheChosenReduction) {
@@ -100,7 +121,8 @@ TEST(LoadImageReduced, DecodesA24MegapixelJpegAtTheChosenReduction) {
   struct Case {
     int keep, scale, w, h;
   };
-  for (const Case c : {Case{800, 4, 1500, 1000}, Case{1200, 4, 1500, 1000}, Case{1600, 2, 3000, 2000}, Case{0, 1, 6000, 4000}}) {
+  for (const Case c :
+       {Case{800, 4, 1500, 1000}, Case{1200, 4, 1500, 1000}, Case{1600, 2, 3000, 2000}, Case{0, 1, 6000, 4000}}) {
     SCOPED_TRACE("keep " + std::to_string(c.keep));
     const DecodedImage d = load_image_reduced(path, {}, c.keep);
     EXPECT_EQ(d.scale, c.scale);
@@ -129,7 +151,7 @@ struct PngSpec {
   int interlace = PNG_INTERLACE_NONE;
   std::vector<std::vector<png_byte>> rows;
   std::vector<png_color> palette;
-  std::vector<png_byte> trns_alpha;    ///< palette entries' alpha
+  std::vector<png_byte> trns_alpha;         ///< palette entries' alpha
   std::optional<png_color_16> trns_colour;  ///< the one transparent grey or RGB value
 };
 
@@ -155,10 +177,11 @@ std::vector<std::uint8_t> write_png(const PngSpec& spec) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png_create_info_struct(png);
   png_set_write_fn(png, &out, append_bytes, nullptr);
-  png_set_IHDR(png, info, spec.width, spec.height, spec.bit_depth, spec.colour_type, spec.interlace, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, spec.width, spec.height, spec.bit_depth, spec.colour_type, spec.interlace,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   if (!spec.palette.empty()) png_set_PLTE(png, info, spec.palette.data(), static_cast<int>(spec.palette.size()));
-  if (!spec.trns_alpha.empty()) png_set_tRNS(png, info, spec.trns_alpha.data(), static_cast<int>(spec.trns_alpha.size()), nullptr);
+  if (!spec.trns_alpha.empty())
+    png_set_tRNS(png, info, spec.trns_alpha.data(), static_cast<int>(spec.trns_alpha.size()), nullptr);
   if (spec.trns_colour) png_set_tRNS(png, info, nullptr, 0, &*spec.trns_colour);
   png_write_info(png, info);
   std::vector<png_bytep> rows;
@@ -183,7 +206,9 @@ std::vector<std::pair<std::string, PngSpec>> libpng_variants(cv::Size size) {
   const cv::Mat c = photo(size);
   std::vector<std::pair<std::string, PngSpec>> out;
   PngSpec pal = png_spec(size, PNG_COLOR_TYPE_PALETTE, 8);
-  for (int i = 0; i < 16; ++i) pal.palette.push_back({static_cast<png_byte>(i * 17), static_cast<png_byte>(255 - i * 17), static_cast<png_byte>(i * 5)});
+  for (int i = 0; i < 16; ++i)
+    pal.palette.push_back(
+        {static_cast<png_byte>(i * 17), static_cast<png_byte>(255 - i * 17), static_cast<png_byte>(i * 5)});
   for (int i = 0; i < 16; ++i) pal.trns_alpha.push_back(static_cast<png_byte>(i * 16));
   PngSpec two_bit = png_spec(size, PNG_COLOR_TYPE_GRAY, 2);
   PngSpec grey_trns = png_spec(size, PNG_COLOR_TYPE_GRAY, 8);
@@ -226,7 +251,8 @@ cv::Mat reference_decode(const std::vector<std::uint8_t>& png) {
   for (int y = 0; y < f.rows; ++y) {
     for (int x = 0; x < f.cols; ++x) {
       const cv::Vec4f p = f.at<cv::Vec4f>(y, x);
-      for (int k = 0; k < 3; ++k) out.at<cv::Vec3b>(y, x)[k] = cv::saturate_cast<std::uint8_t>(255.0f * (p[3] * p[k] + 1.0f - p[3]));
+      for (int k = 0; k < 3; ++k)
+        out.at<cv::Vec3b>(y, x)[k] = cv::saturate_cast<std::uint8_t>(255.0f * (p[3] * p[k] + 1.0f - p[3]));
     }
   }
   return out;
@@ -247,7 +273,8 @@ TEST(LoadImageReduced, DecodesAPngToTheBlockMeansOfItsFullDecode) {
   const cv::Mat c = photo(size);
   cv::Mat alpha(size, CV_8UC1);
   for (int y = 0; y < size.height; ++y)
-    for (int x = 0; x < size.width; ++x) alpha.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>((x * 255) / (size.width - 1));
+    for (int x = 0; x < size.width; ++x)
+      alpha.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>((x * 255) / (size.width - 1));
   cv::Mat bgra, c16, bgra16, g16;
   cv::merge(std::vector<cv::Mat>{c, alpha}, bgra);  // alpha from 0 at the left to 1 at the right
   c.convertTo(c16, CV_16UC3, 257.0);
@@ -255,8 +282,12 @@ TEST(LoadImageReduced, DecodesAPngToTheBlockMeansOfItsFullDecode) {
   bgra.convertTo(bgra16, CV_16UC4, 257.0);
   grey_photo(size).convertTo(g16, CV_16UC1, 257.0);
   std::vector<std::pair<std::string, std::vector<std::uint8_t>>> pngs = {
-      {"RGB 8-bit", encode(".png", c)},         {"RGBA 8-bit", encode(".png", bgra)},      {"RGB 16-bit", encode(".png", c16)},
-      {"RGBA 16-bit", encode(".png", bgra16)}, {"grey 8-bit", encode(".png", grey_photo(size))}, {"grey 16-bit", encode(".png", g16)}};
+      {"RGB 8-bit", encode(".png", c)},
+      {"RGBA 8-bit", encode(".png", bgra)},
+      {"RGB 16-bit", encode(".png", c16)},
+      {"RGBA 16-bit", encode(".png", bgra16)},
+      {"grey 8-bit", encode(".png", grey_photo(size))},
+      {"grey 16-bit", encode(".png", g16)}};
   for (const auto& [name, spec] : libpng_variants(size)) pngs.emplace_back(name, write_png(spec));
   for (const auto& [name, png] : pngs) {
     SCOPED_TRACE(name);
@@ -279,11 +310,13 @@ TEST(LoadImageReduced, DecodesAnInterlacedPngOrOneWithAnExifChunkInFull) {
   const cv::Size size(1203, 803);
   PngSpec spec = png_spec(size, PNG_COLOR_TYPE_GRAY, 8, PNG_INTERLACE_ADAM7);
   const cv::Mat g = grey_photo(size);
-  for (int y = 0; y < size.height; ++y) spec.rows.emplace_back(g.ptr<std::uint8_t>(y), g.ptr<std::uint8_t>(y) + size.width);
+  for (int y = 0; y < size.height; ++y)
+    spec.rows.emplace_back(g.ptr<std::uint8_t>(y), g.ptr<std::uint8_t>(y) + size.width);
   const std::vector<std::uint8_t> interlaced = write_png(spec);
   // An eXIf chunk (orientation 1: as stored) after the IHDR: 8 + 25 bytes in.
   std::vector<std::uint8_t> exif = encode(".png", photo(size));
-  const std::vector<std::uint8_t> body = {'e', 'X', 'I', 'f', 'I', 'I', 42, 0, 8, 0, 0, 0, 1, 0, 0x12, 0x01, 3, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0};
+  const std::vector<std::uint8_t> body = {'e',  'X', 'I', 'f', 'I', 'I', 42, 0, 8, 0, 0, 0, 1, 0, 0x12,
+                                          0x01, 3,   0,   1,   0,   0,   0,  1, 0, 0, 0, 0, 0, 0, 0};
   std::vector<std::uint8_t> chunk = {0, 0, 0, static_cast<std::uint8_t>(body.size() - 4)};
   chunk.insert(chunk.end(), body.begin(), body.end());
   const auto crc = static_cast<std::uint32_t>(crc32(0, body.data(), static_cast<uInt>(body.size())));
@@ -302,10 +335,12 @@ TEST(LoadImageReduced, RefusesAPngWhoseImageDataIsDamagedWithLibpngsReason) {
   // Both files' chunks are whole and their CRCs right (tests/data/bad/IMAGES.md): only inflating and
   // unfiltering the image data finds what is wrong.
   const std::string bad = kData + "/bad/";
-  for (const auto& [name, reason] : {std::pair{"damaged_idat.png", "bad adaptive filter value"}, std::pair{"short_idat.png", "Not enough image data"}}) {
+  for (const auto& [name, reason] : {std::pair{"damaged_idat.png", "bad adaptive filter value"},
+                                     std::pair{"short_idat.png", "Not enough image data"}}) {
     SCOPED_TRACE(name);
     const std::string full = refusal([&] { load_image(bad + name, {}); });
-    EXPECT_EQ(full, "image '" + bad + name + "': the png data could not be decoded (corrupt or unsupported): " + reason);
+    EXPECT_EQ(full,
+              "image '" + bad + name + "': the png data could not be decoded (corrupt or unsupported): " + reason);
     for (const int keep : {50, 100, 200}) EXPECT_EQ(refusal([&] { load_image_reduced(bad + name, {}, keep); }), full);
   }
 }
@@ -313,7 +348,8 @@ TEST(LoadImageReduced, RefusesAPngWhoseImageDataIsDamagedWithLibpngsReason) {
 TEST(LoadImageReduced, AppliesTheExifOrientationToAReducedDecode) {
   const TempDir dir;
   cv::Mat landscape = photo({1600, 800});
-  cv::rectangle(landscape, cv::Rect(0, 0, 200, 200), cv::Scalar(0, 0, 255), cv::FILLED);  // red corner: top left as stored
+  cv::rectangle(landscape, cv::Rect(0, 0, 200, 200), cv::Scalar(0, 0, 255),
+                cv::FILLED);  // red corner: top left as stored
   const std::vector<std::uint8_t> plain = encode(".jpg", landscape, {cv::IMWRITE_JPEG_QUALITY, 95});
   const std::string path = dir.write("rotated.jpg", with_exif_orientation(plain, 6));  // 6: turn 90° clockwise to show
   const cv::Mat full = load_image(path, {});
@@ -334,8 +370,8 @@ TEST(LoadImageReduced, AppliesTheExifOrientationToAReducedDecode) {
 
 TEST(LoadImageReduced, RefusesEveryBadFileAsLoadImageDoes) {
   const std::string bad = kData + "/bad/";
-  for (const std::string name : {"not_an_image.png", "empty.png", "no_such_file.png", "truncated.jpg", "truncated.png", "bad_crc.png",
-                                  "huge_declared.png"}) {
+  for (const std::string name : {"not_an_image.png", "empty.png", "no_such_file.png", "truncated.jpg", "truncated.png",
+                                 "bad_crc.png", "huge_declared.png"}) {
     SCOPED_TRACE(name);
     const std::string full = refusal([&] { load_image(bad + name, {}); });
     for (const int keep : {1, 100, 800, 100000}) {

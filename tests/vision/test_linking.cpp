@@ -12,11 +12,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include "chain_checks.hpp"
+#include "hk/error.hpp"
+#include "test_paths.hpp"
 #include "vision/edges.hpp"
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
-#include "hk/error.hpp"
-#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "vision/mapping.hpp"
 #include "hk/error.hpp"
+#include "vision/mapping.hpp"
 
 namespace hk::vision {
 namespace {
@@ -15,7 +15,8 @@ constexpr double kW = 0.14;  // default usable rectangle (DESIGN.md) [m]
 constexpr double kH = 0.09;
 
 TEST(FitToWorkspace, ImageCornersLandInsideTheUsableRectangle) {
-  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{400, 328}, {1, 1}, {10000, 3}, {3, 10000}, {512, 512}, {800, 600}}) {
+  for (const auto& [w, h] :
+       std::vector<std::pair<int, int>>{{400, 328}, {1, 1}, {10000, 3}, {3, 10000}, {512, 512}, {800, 600}}) {
     SCOPED_TRACE(std::to_string(w) + " x " + std::to_string(h));
     const PxToM m = fit_to_workspace(w, h, kW, kH);
     const double eps = 1e-12;

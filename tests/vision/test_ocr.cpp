@@ -20,10 +20,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "scans.hpp"
-#include "vision/ocr.hpp"
 #include "hk/error.hpp"
+#include "scans.hpp"
 #include "test_paths.hpp"
+#include "vision/ocr.hpp"
 
 namespace fs = std::filesystem;
 
@@ -68,7 +68,8 @@ TEST_P(OcrScans, ReadsAScannedPageAsItsTextLayerSaysWithRecallOver90Percent) {
   const std::vector<std::string> truth = words_of(test::pdftotext_page(pdf, c.page, dir));
   ASSERT_GT(truth.size(), 100u);
   const double got = test::word_recall(truth, words_of(all_text(r)));
-  EXPECT_GE(got, 0.9) << r.words.size() << " words kept of " << r.words_seen << "; text: " << all_text(r).substr(0, 600);
+  EXPECT_GE(got, 0.9) << r.words.size() << " words kept of " << r.words_seen
+                      << "; text: " << all_text(r).substr(0, 600);
   EXPECT_GE(r.mean_confidence, 0.8);
   EXPECT_GE(r.blocks.size(), 3u) << "paragraphs, headings: more than one block";
   for (const OcrBlock& b : r.blocks) {
@@ -79,7 +80,8 @@ TEST_P(OcrScans, ReadsAScannedPageAsItsTextLayerSaysWithRecallOver90Percent) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Pages, OcrScans,
-                         ::testing::Values(ScanCase{3, 150, 1.5}, ScanCase{3, 300, -1.5}, ScanCase{5, 150, -1.5}, ScanCase{5, 300, 1.5}),
+                         ::testing::Values(ScanCase{3, 150, 1.5}, ScanCase{3, 300, -1.5}, ScanCase{5, 150, -1.5},
+                                           ScanCase{5, 300, 1.5}),
                          [](const ::testing::TestParamInfo<ScanCase>& i) {
                            return "page" + std::to_string(i.param.page) + "_" + std::to_string(i.param.dpi) + "dpi_" +
                                   (i.param.degrees < 0 ? "ccw" : "cw");
@@ -114,8 +116,10 @@ TEST(Ocr, TheWordsOfAStreetSignInAPhotographAreRead) {
   ASSERT_FALSE(photo.empty());
   cv::resize(photo, photo, cv::Size(1200, 800));
   cv::rectangle(photo, cv::Rect(150, 200, 900, 400), cv::Scalar(30, 90, 20), cv::FILLED);
-  cv::putText(photo, "MAIN STREET", {200, 350}, cv::FONT_HERSHEY_DUPLEX, 3.2, cv::Scalar(255, 255, 255), 8, cv::LINE_AA);
-  cv::putText(photo, "CITY MUSEUM", {200, 520}, cv::FONT_HERSHEY_DUPLEX, 3.2, cv::Scalar(255, 255, 255), 8, cv::LINE_AA);
+  cv::putText(photo, "MAIN STREET", {200, 350}, cv::FONT_HERSHEY_DUPLEX, 3.2, cv::Scalar(255, 255, 255), 8,
+              cv::LINE_AA);
+  cv::putText(photo, "CITY MUSEUM", {200, 520}, cv::FONT_HERSHEY_DUPLEX, 3.2, cv::Scalar(255, 255, 255), 8,
+              cv::LINE_AA);
   cv::Mat grey;
   cv::cvtColor(photo, grey, cv::COLOR_BGR2GRAY);
   EXPECT_TRUE(looks_like_text_page(grey)) << "a sign's line of large letters is text worth reading";
@@ -138,7 +142,8 @@ TEST(Ocr, ThePageOfTextAmongTheTestPicturesIsRead) {
 TEST(Ocr, AMissingLanguageIsNamed) {
   OcrParams p;
   p.languages = "eng+xyz";
-  EXPECT_NE(ocr_languages_problem(p).find("no 'xyz' (no xyz.traineddata in /usr/share/tesseract-ocr/5/tessdata)"), std::string::npos)
+  EXPECT_NE(ocr_languages_problem(p).find("no 'xyz' (no xyz.traineddata in /usr/share/tesseract-ocr/5/tessdata)"),
+            std::string::npos)
       << ocr_languages_problem(p);
   p.languages = "eng;rm -rf";
   EXPECT_NE(ocr_languages_problem(p).find("is not a '+'-joined list"), std::string::npos) << ocr_languages_problem(p);

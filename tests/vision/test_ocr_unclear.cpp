@@ -19,8 +19,8 @@ worker::WorkerRun answer(const std::vector<std::pair<std::string, double>>& word
   out.u32(kOcrMagic);
   out.u8(0);
   out.u32(static_cast<std::uint32_t>(words.size()));  // words seen
-  out.u32(1);                                          // blocks
-  out.u32(1);                                          // lines
+  out.u32(1);                                         // blocks
+  out.u32(1);                                         // lines
   out.u32(static_cast<std::uint32_t>(words.size()));
   double x = 10;
   for (const auto& [text, confidence] : words) {
@@ -40,7 +40,9 @@ worker::WorkerRun answer(const std::vector<std::pair<std::string, double>>& word
 TEST(OcrUnclear, AWordUnderTheThresholdIsMarkedNotReadAsIfCertain) {
   OcrParams p;
   p.min_word_confidence = 0.6;
-  const OcrResult r = read_ocr_answer(answer({{"The", 0.95}, {"museurn", 0.41}, {"opens", 0.9}, {"at", 0.88}, {"rn1ne", 0.35}, {"0c1ock", 0.32}}), "page", p);
+  const OcrResult r = read_ocr_answer(
+      answer({{"The", 0.95}, {"museurn", 0.41}, {"opens", 0.9}, {"at", 0.88}, {"rn1ne", 0.35}, {"0c1ock", 0.32}}),
+      "page", p);
   ASSERT_EQ(r.blocks.size(), 1u);
   const std::string u(kUnclearWord);
   EXPECT_EQ(r.blocks[0].text, "The " + u + " opens at " + u + " " + u);

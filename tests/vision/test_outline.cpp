@@ -11,9 +11,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "vision/outline.hpp"
 #include "hk/error.hpp"
 #include "test_paths.hpp"
+#include "vision/outline.hpp"
 
 namespace hk::vision {
 namespace {
@@ -29,8 +29,10 @@ double to_crack(const cv::Mat& g, cv::Point2d p) {
   for (int y = 0; y < g.rows; ++y)
     for (int x = 0; x < g.cols; ++x) {
       const bool d = g.at<std::uint8_t>(y, x) < 128;
-      if (x + 1 < g.cols && d != (g.at<std::uint8_t>(y, x + 1) < 128)) best = std::min(best, cv::norm(p - cv::Point2d(x + 0.5, y)));
-      if (y + 1 < g.rows && d != (g.at<std::uint8_t>(y + 1, x) < 128)) best = std::min(best, cv::norm(p - cv::Point2d(x, y + 0.5)));
+      if (x + 1 < g.cols && d != (g.at<std::uint8_t>(y, x + 1) < 128))
+        best = std::min(best, cv::norm(p - cv::Point2d(x + 0.5, y)));
+      if (y + 1 < g.rows && d != (g.at<std::uint8_t>(y + 1, x) < 128))
+        best = std::min(best, cv::norm(p - cv::Point2d(x, y + 0.5)));
     }
   return best;
 }
@@ -73,7 +75,8 @@ TEST(TwoTone, TheShippedSilhouettesAreTwoToneAndThePhotographsAreNot) {
     ASSERT_FALSE(g.empty()) << name;
     EXPECT_TRUE(classify_two_tone(g).two_tone) << name;
   }
-  for (const char* name : {"apple.jpg", "butterfly.jpg", "fruits.jpg", "camera.png", "coins.png", "sudoku.png", "HappyFish.jpg"}) {
+  for (const char* name :
+       {"apple.jpg", "butterfly.jpg", "fruits.jpg", "camera.png", "coins.png", "sudoku.png", "HappyFish.jpg"}) {
     const cv::Mat g = cv::imread((kImages / name).string(), cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(g.empty()) << name;
     EXPECT_FALSE(classify_two_tone(g).two_tone) << name;
@@ -111,7 +114,8 @@ TEST(TraceOutlines, ARingGivesTwoClosedChainsOnTheCrackAndTwoBlobsTwoMore) {
     for (std::size_t i = 0; i < c.points_px.size(); ++i) {
       const cv::Point2d a = c.points_px[i], b = c.points_px[(i + 1) % c.points_px.size()];
       ASSERT_LE(std::max(std::abs(a.x - b.x), std::abs(a.y - b.y)), 1.0) << "8-adjacent, closing point included";
-      ASSERT_LE(to_crack(g, a), std::sqrt(0.5) + 1e-9) << "a boundary pixel's centre is at most a half diagonal off the crack";
+      ASSERT_LE(to_crack(g, a), std::sqrt(0.5) + 1e-9)
+          << "a boundary pixel's centre is at most a half diagonal off the crack";
     }
   }
 }

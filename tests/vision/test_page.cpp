@@ -21,10 +21,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "synthetic_photo.hpp"
-#include "vision/page.hpp"
 #include "hk/error.hpp"
+#include "synthetic_photo.hpp"
 #include "test_paths.hpp"
+#include "vision/page.hpp"
 
 namespace {
 
@@ -51,9 +51,9 @@ struct Picture {
 };
 
 const Picture kPictures[] = {
-    {"camera.png"},       {"fruits.jpg"},       {"coins.png"},         {"HappyFish.jpg"},   {"apple.jpg"},
-    {"LinuxLogo.jpg"},    {"horse.png"},        {"pic1.png"},          {"silhouette_3.png"}, {"silhouette_5.png"},
-    {"silhouette_7.png"}, {"silhouette_10.png"}, {"butterfly.jpg", 1.0}, {"sudoku.png", 1.0}, {"page", 1.0},
+    {"camera.png"},       {"fruits.jpg"},        {"coins.png"},          {"HappyFish.jpg"},    {"apple.jpg"},
+    {"LinuxLogo.jpg"},    {"horse.png"},         {"pic1.png"},           {"silhouette_3.png"}, {"silhouette_5.png"},
+    {"silhouette_7.png"}, {"silhouette_10.png"}, {"butterfly.jpg", 1.0}, {"sudoku.png", 1.0},  {"page", 1.0},
 };
 
 /// How the picture is held and photographed: every condition turns and tilts it; together they cover blur,
@@ -67,12 +67,9 @@ struct Condition {
 };
 
 const Condition kConditions[] = {
-    {"clean", 12, 0.06, 0.0, 0, false, Backdrop::wood},
-    {"tilted", -30, 0.15, 0.8, 3, true, Backdrop::blobs},
-    {"blurred", 20, 0.10, 1.5, 6, true, Backdrop::wood},
-    {"noisy", -8, 0.12, 0.5, 6, false, Backdrop::blobs},
-    {"worst", 30, 0.15, 1.5, 6, true, Backdrop::blobs},
-    {"soft", -20, 0.08, 1.0, 4, true, Backdrop::wood},
+    {"clean", 12, 0.06, 0.0, 0, false, Backdrop::wood},  {"tilted", -30, 0.15, 0.8, 3, true, Backdrop::blobs},
+    {"blurred", 20, 0.10, 1.5, 6, true, Backdrop::wood}, {"noisy", -8, 0.12, 0.5, 6, false, Backdrop::blobs},
+    {"worst", 30, 0.15, 1.5, 6, true, Backdrop::blobs},  {"soft", -20, 0.08, 1.0, 4, true, Backdrop::wood},
 };
 
 /// A backdrop, made once per (kind, seed): the pictures take turns on three of each kind.
@@ -87,7 +84,9 @@ const cv::Mat& backdrop(Backdrop kind, std::uint64_t seed) {
 /// full of long straight leaf stripes, on the busiest cloth at the worst condition (30°, 15 % keystone, blur,
 /// noise, uneven light): its top edge breaks into pieces among the blobs and the stripes outnumber it among the
 /// straight lines, so no candidate has all four of its sides. Found with other seeds of the same condition.
-bool known_miss(const std::string& picture, const std::string& condition) { return picture == "butterfly.jpg" && condition == "worst"; }
+bool known_miss(const std::string& picture, const std::string& condition) {
+  return picture == "butterfly.jpg" && condition == "worst";
+}
 
 cv::Mat load_picture(const std::string& name) {
   if (name == "page") return hk::test::text_page();
@@ -152,14 +151,16 @@ TEST_P(PageRectification, FindsTheCornersAndFlattensThePicture) {
   pc.uneven_light = cond.uneven_light;
   pc.backdrop = cond.backdrop;
   pc.seed = 1000 + 10 * static_cast<std::uint64_t>(pi) + static_cast<std::uint64_t>(ci);  // keystone side, light, noise
-  const SyntheticPhoto photo = hk::test::synthetic_photo(original, kFrame, pc, &backdrop(cond.backdrop, 1 + static_cast<std::uint64_t>(pi) % 3));
+  const SyntheticPhoto photo =
+      hk::test::synthetic_photo(original, kFrame, pc, &backdrop(cond.backdrop, 1 + static_cast<std::uint64_t>(pi) % 3));
 
   const PageDetection d = find_page(photo.frame);
   if (known_miss(pic.name, cond.name) && !d.found) GTEST_SKIP() << "known miss: " << pic.name << " under " << cond.name;
   ASSERT_TRUE(d.found) << pic.name << " under " << cond.name;
   const double err = worst_corner_px(d.corners_px, photo.corners_px) / diagonal(photo.corners_px);
   const double score = ncc(rectified_at_original_size(photo.frame, d.corners_px, original.size()), original);
-  std::printf("[page] %-18s %-8s corner error %.3f %% of the diagonal, NCC %.3f\n", pic.name, cond.name, 100 * err, score);
+  std::printf("[page] %-18s %-8s corner error %.3f %% of the diagonal, NCC %.3f\n", pic.name, cond.name, 100 * err,
+              score);
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_LE(cv::norm(d.corners_px[i] - photo.corners_px[i]), 0.01 * diagonal(photo.corners_px))
         << "corner " << i << " found at " << d.corners_px[i] << ", truth " << photo.corners_px[i];
@@ -174,7 +175,8 @@ INSTANTIATE_TEST_SUITE_P(Pictures, PageRectification,
                          ::testing::Combine(::testing::Range(0, static_cast<int>(std::size(kPictures))),
                                             ::testing::Range(0, static_cast<int>(std::size(kConditions)))),
                          [](const ::testing::TestParamInfo<std::tuple<int, int>>& info) {
-                           return test_name(kPictures[std::get<0>(info.param)].name, kConditions[std::get<1>(info.param)].name);
+                           return test_name(kPictures[std::get<0>(info.param)].name,
+                                            kConditions[std::get<1>(info.param)].name);
                          });
 
 // A grey camera gives the same page as a colour one.
@@ -243,7 +245,9 @@ TEST(PageCutOff, TopEdgeOutsideTheFrame) {
     const double tol = 0.01 * diagonal(photo.corners_px);
     EXPECT_LE(cv::norm(d.corners_px[2] - photo.corners_px[2]), tol) << name;
     EXPECT_LE(cv::norm(d.corners_px[3] - photo.corners_px[3]), tol) << name;
-    const auto at_top = [](cv::Point2d below, cv::Point2d above) { return below + (-0.5 - below.y) / (above.y - below.y) * (above - below); };
+    const auto at_top = [](cv::Point2d below, cv::Point2d above) {
+      return below + (-0.5 - below.y) / (above.y - below.y) * (above - below);
+    };
     EXPECT_LE(cv::norm(d.corners_px[0] - at_top(photo.corners_px[3], photo.corners_px[0])), tol) << name;
     EXPECT_LE(cv::norm(d.corners_px[1] - at_top(photo.corners_px[2], photo.corners_px[1])), tol) << name;
   }
@@ -281,17 +285,21 @@ SyntheticPhoto photo_near_edge(const cv::Mat& picture, cv::Size frame, const Nea
 /// How far `p` lies inside the frame's edge `edge` (from its outer boundary); negative outside.
 double inside_edge(cv::Point2d p, cv::Size frame, int edge) {
   switch (edge) {
-    case 0: return p.y + 0.5;
-    case 1: return frame.width - 0.5 - p.x;
-    case 2: return frame.height - 0.5 - p.y;
-    default: return p.x + 0.5;
+    case 0:
+      return p.y + 0.5;
+    case 1:
+      return frame.width - 0.5 - p.x;
+    case 2:
+      return frame.height - 0.5 - p.y;
+    default:
+      return p.x + 0.5;
   }
 }
 
 /// Finds the page of a photo made whole near the edge and checks it: every corner within max_error_px of the truth,
 /// touching no edge of the frame.
-void expect_whole_near_edge(const char* picture_name, const cv::Mat& picture, cv::Size frame, const NearEdge& k, double fill,
-                            double max_error_px) {
+void expect_whole_near_edge(const char* picture_name, const cv::Mat& picture, cv::Size frame, const NearEdge& k,
+                            double fill, double max_error_px) {
   SCOPED_TRACE(std::string(picture_name) + " " + k.name);
   const SyntheticPhoto photo = photo_near_edge(picture, frame, k, fill);
   // The set-up itself: the page inside the frame, its nearest corner gap_px from the edge.
@@ -305,9 +313,11 @@ void expect_whole_near_edge(const char* picture_name, const cv::Mat& picture, cv
   ASSERT_TRUE(d.found);
   const double err = worst_corner_px(d.corners_px, photo.corners_px);
   const double share = 100.0 * k.gap_px / (k.edge % 2 == 0 ? frame.height : frame.width);
-  std::printf("[page near edge] %-10s %-11s %4d x %4d, %3.0f px (%.1f %%) from the edge: worst corner error %.2f px, touches %d%d%d%d\n",
-              picture_name, k.name, frame.width, frame.height, k.gap_px, share, err, d.touches_frame[0], d.touches_frame[1], d.touches_frame[2],
-              d.touches_frame[3]);
+  std::printf(
+      "[page near edge] %-10s %-11s %4d x %4d, %3.0f px (%.1f %%) from the edge: worst corner error %.2f px, touches "
+      "%d%d%d%d\n",
+      picture_name, k.name, frame.width, frame.height, k.gap_px, share, err, d.touches_frame[0], d.touches_frame[1],
+      d.touches_frame[2], d.touches_frame[3]);
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_LE(cv::norm(d.corners_px[i] - photo.corners_px[i]), max_error_px)
         << "corner " << i << " found at " << d.corners_px[i] << ", truth " << photo.corners_px[i];
@@ -328,8 +338,10 @@ TEST(PageNearTheEdge, AWholePageInACameraFrameIsFoundWithItsOwnCornersAndNotCutO
 TEST(PageNearTheEdge, AWholePageNearEachEdgeIsFoundWithItsOwnCornersAndNotCutOff) {
   const cv::Mat page = load_picture("page"), camera = load_picture("camera.png");
   const NearEdge cases[] = {
-      {"top_8px", 0, 8, 4, 0.08, Backdrop::wood, 41},     {"right_8px", 1, 8, -5, 0.10, Backdrop::blobs, 42},
-      {"bottom_8px", 2, 8, 3, 0.12, Backdrop::blobs, 43}, {"left_8px", 3, 8, -3, 0.06, Backdrop::wood, 44},
+      {"top_8px", 0, 8, 4, 0.08, Backdrop::wood, 41},
+      {"right_8px", 1, 8, -5, 0.10, Backdrop::blobs, 42},
+      {"bottom_8px", 2, 8, 3, 0.12, Backdrop::blobs, 43},
+      {"left_8px", 3, 8, -3, 0.06, Backdrop::wood, 44},
   };
   for (const NearEdge& k : cases) {
     expect_whole_near_edge("page", page, kFrame, k, 0.85, 1.0);
@@ -343,8 +355,10 @@ TEST(PageNearTheEdge, AWholePageNearEachEdgeIsFoundWithItsOwnCornersAndNotCutOff
 TEST(PageCutOff, ACornerJustOutsideTheFrameIsCutOffAtThatEdge) {
   const cv::Mat page = load_picture("page");
   const NearEdge cases[] = {
-      {"top", 0, -6, 4, 0.08, Backdrop::wood, 51},     {"right", 1, -6, -5, 0.10, Backdrop::blobs, 52},
-      {"bottom", 2, -6, 3, 0.12, Backdrop::blobs, 53}, {"left", 3, -6, -3, 0.06, Backdrop::wood, 54},
+      {"top", 0, -6, 4, 0.08, Backdrop::wood, 51},
+      {"right", 1, -6, -5, 0.10, Backdrop::blobs, 52},
+      {"bottom", 2, -6, 3, 0.12, Backdrop::blobs, 53},
+      {"left", 3, -6, -3, 0.06, Backdrop::wood, 54},
   };
   for (const NearEdge& k : cases) {
     SCOPED_TRACE(k.name);
@@ -372,7 +386,8 @@ Corners project_rectangle(double w, double h, double f, cv::Point2d c, double ax
   const cv::Matx33d rx(1, 0, 0, 0, std::cos(ax), -std::sin(ax), 0, std::sin(ax), std::cos(ax));
   const cv::Matx33d ry(std::cos(ay), 0, std::sin(ay), 0, 1, 0, -std::sin(ay), 0, std::cos(ay));
   const cv::Vec3d centre(0.02, -0.01, 1.0);
-  const std::array<cv::Vec3d, 4> rect{cv::Vec3d(-w / 2, -h / 2, 0), cv::Vec3d(w / 2, -h / 2, 0), cv::Vec3d(w / 2, h / 2, 0), cv::Vec3d(-w / 2, h / 2, 0)};
+  const std::array<cv::Vec3d, 4> rect{cv::Vec3d(-w / 2, -h / 2, 0), cv::Vec3d(w / 2, -h / 2, 0),
+                                      cv::Vec3d(w / 2, h / 2, 0), cv::Vec3d(-w / 2, h / 2, 0)};
   Corners out;
   for (std::size_t i = 0; i < 4; ++i) {
     const cv::Vec3d p = centre + ry * (rx * rect[i]);
@@ -386,11 +401,13 @@ TEST(PageAspectRatio, MatchesAProjectedRectangle) {
   struct Case {
     double w, h, f, ax, ay;
   };
-  for (const Case& k : {Case{0.297, 0.210, 900, 25, -20}, Case{0.210, 0.297, 1200, -30, 15}, Case{0.148, 0.105, 700, 10, 35},
-                        Case{0.20, 0.20, 1000, -20, -25}, Case{0.30, 0.10, 800, 40, 5}}) {
+  for (const Case& k :
+       {Case{0.297, 0.210, 900, 25, -20}, Case{0.210, 0.297, 1200, -30, 15}, Case{0.148, 0.105, 700, 10, 35},
+        Case{0.20, 0.20, 1000, -20, -25}, Case{0.30, 0.10, 800, 40, 5}}) {
     const Corners q = project_rectangle(k.w, k.h, k.f, centre, k.ax, k.ay);
     const double r = page_aspect_ratio(q, centre);
-    EXPECT_NEAR(r, k.w / k.h, 0.01 * k.w / k.h) << "w " << k.w << " h " << k.h << " f " << k.f << " ax " << k.ax << " ay " << k.ay;
+    EXPECT_NEAR(r, k.w / k.h, 0.01 * k.w / k.h)
+        << "w " << k.w << " h " << k.h << " f " << k.f << " ax " << k.ax << " ay " << k.ay;
     // The mean of opposite sides, the fallback, would be off by more here: the views are not fronto-parallel.
   }
 }

@@ -20,8 +20,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "image_pdf.hpp"
-#include "vision/pdf.hpp"
 #include "test_paths.hpp"
+#include "vision/pdf.hpp"
 
 namespace hk::vision {
 namespace {
@@ -58,7 +58,9 @@ std::string run(const std::string& cmd) {
   return out;
 }
 
-bool have_tool(const std::string& tool) { return std::system(("command -v " + tool + " >/dev/null 2>&1").c_str()) == 0; }
+bool have_tool(const std::string& tool) {
+  return std::system(("command -v " + tool + " >/dev/null 2>&1").c_str()) == 0;
+}
 
 std::vector<std::string> split_words(const std::string& s) {
   std::istringstream in(s);
@@ -91,7 +93,8 @@ void expect_good_render_still_works() {
 /// Fraction of pixels darker than 128 in `box` (clipped to the image).
 double ink(const cv::Mat& grey, const cv::Rect2d& box) {
   const cv::Rect r = cv::Rect(cv::Point(static_cast<int>(std::floor(box.x)), static_cast<int>(std::floor(box.y))),
-                              cv::Point(static_cast<int>(std::ceil(box.x + box.width)), static_cast<int>(std::ceil(box.y + box.height)))) &
+                              cv::Point(static_cast<int>(std::ceil(box.x + box.width)),
+                                        static_cast<int>(std::ceil(box.y + box.height)))) &
                      cv::Rect(0, 0, grey.cols, grey.rows);
   if (r.area() == 0) return 0.0;
   return static_cast<double>(cv::countNonZero(grey(r) < 128)) / r.area();
@@ -144,7 +147,8 @@ TEST(PdfDocuments, TheTitleComesFromTheInfoDictionaryAsUtf8) {
   }
   EXPECT_EQ(probe_pdf(read_file(kHorse), "horse_and_page.pdf", generous()).title, "") << "no /Title";
   // A /Title of 2000 bytes is dropped, the document is not.
-  const PdfInfo long_title = probe_pdf(read_file(kData + "/bad/title_2000_bytes.pdf"), "title_2000_bytes.pdf", generous());
+  const PdfInfo long_title =
+      probe_pdf(read_file(kData + "/bad/title_2000_bytes.pdf"), "title_2000_bytes.pdf", generous());
   EXPECT_EQ(long_title.title, "");
   EXPECT_EQ(long_title.pages, 1);
 }
@@ -219,11 +223,13 @@ TEST(PdfDocuments, APageWithoutATextLayerIsDrawnAtTheFullBudgetForOcr) {
   EXPECT_FALSE(p.screen_sized);
   EXPECT_EQ(p.dpi, full.dpi);
   EXPECT_EQ(p.grey.size(), full.grey.size());
-  EXPECT_GT(std::max(p.grey.cols, p.grey.rows), 1000) << "the full budget, not the side asked for pages with a text layer";
+  EXPECT_GT(std::max(p.grey.cols, p.grey.rows), 1000)
+      << "the full budget, not the side asked for pages with a text layer";
 
   // The same scan with a one-line text layer is drawn at the side: the layer is what decides.
   const std::string captioned = test::image_only_pdf(jpeg, horse.cols, horse.rows, 72.0, "Scanned at the library");
-  const PdfPage c = render_pdf_page(std::vector<std::uint8_t>(captioned.begin(), captioned.end()), "captioned.pdf", 1, screen);
+  const PdfPage c =
+      render_pdf_page(std::vector<std::uint8_t>(captioned.begin(), captioned.end()), "captioned.pdf", 1, screen);
   EXPECT_EQ(c.words.size(), 4u);
   EXPECT_TRUE(c.screen_sized);
   EXPECT_LE(std::max(c.grey.cols, c.grey.rows), 100);
@@ -241,8 +247,8 @@ TEST(PdfText, ParagraphPageBlocksGiveThePdftotextWords) {
     for (const TextBlock& b : p.blocks) {
       for (const std::string& w : split_words(b.text)) ours.push_back(w);
     }
-    const std::vector<std::string> theirs =
-        split_words(run("pdftotext -f " + std::to_string(page) + " -l " + std::to_string(page) + " '" + kSpec + "' - 2>/dev/null"));
+    const std::vector<std::string> theirs = split_words(
+        run("pdftotext -f " + std::to_string(page) + " -l " + std::to_string(page) + " '" + kSpec + "' - 2>/dev/null"));
     EXPECT_EQ(ours, theirs);
     // Every word's box holds ink, and the ink of the page is on words (this page has no pictures or rules).
     cv::Mat covered(p.grey.size(), CV_8UC1, cv::Scalar(0));
@@ -328,7 +334,8 @@ TEST(PdfBadFiles, FiveThousandPagesAreCappedNotRefused) {
   ASSERT_EQ(last.words.size(), 1u);
   EXPECT_EQ(last.words[0].text, "Page");
   std::string what;
-  EXPECT_EQ(error_kind([&] { render_pdf_page(bytes, "pages_5000.pdf", 1001, limits); }, &what), PdfError::Kind::NoSuchPage);
+  EXPECT_EQ(error_kind([&] { render_pdf_page(bytes, "pages_5000.pdf", 1001, limits); }, &what),
+            PdfError::Kind::NoSuchPage);
   EXPECT_NE(what.find("first 1000 pages"), std::string::npos) << what;
   expect_good_render_still_works();
 }
@@ -419,8 +426,8 @@ TEST(PdfWorker, SpinningWorkerIsStoppedByItsCpuLimit) {
   const auto bytes = read_file(kHorse);
   PdfLimits limits = generous();
   limits.fault = PdfFault::Hang;
-  limits.worker_cpu_s = 0.2;   // rounded up to 1 s
-  limits.worker_wall_s = 60;   // not reached
+  limits.worker_cpu_s = 0.2;  // rounded up to 1 s
+  limits.worker_wall_s = 60;  // not reached
   std::string what;
   EXPECT_EQ(error_kind([&] { render_pdf_page(bytes, "x.pdf", 1, limits); }, &what), PdfError::Kind::Timeout);
   EXPECT_EQ(what, "pdf 'x.pdf': page 1 used more than 1 s of processor time");
@@ -443,7 +450,9 @@ std::vector<PdfWord> line_of(const std::string& text, double x, double y, double
   return out;
 }
 
-void append(std::vector<PdfWord>& to, const std::vector<PdfWord>& from) { to.insert(to.end(), from.begin(), from.end()); }
+void append(std::vector<PdfWord>& to, const std::vector<PdfWord>& from) {
+  to.insert(to.end(), from.begin(), from.end());
+}
 
 TEST(PdfTextBlocks, ParagraphsSeparatedByAGapAreTwoBlocks) {
   std::vector<PdfWord> words;

@@ -13,9 +13,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "chain_checks.hpp"
-#include "vision/pipeline.hpp"
 #include "hk/error.hpp"
 #include "test_paths.hpp"
+#include "vision/pipeline.hpp"
 
 namespace hk::vision {
 namespace {
@@ -84,8 +84,9 @@ TEST(ExtractChains, SilhouetteOutlinesHaveNoDanglingEnds) {
 TEST(ExtractChains, ChainsOfAShrunkImageAreInOriginalPixels) {
   // A 1600 x 1200 picture of a disc, processed at 800 x 600: the loop must come back around the
   // disc's true outline in original pixels.
-  const fs::path path = fs::temp_directory_path() /
-                        ("hk_vision_disc_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
+  const fs::path path =
+      fs::temp_directory_path() /
+      ("hk_vision_disc_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
   const cv::Point2d centre(830.0, 570.0);
   const double r = 400.0;
   cv::Mat img(1200, 1600, CV_8UC3, cv::Scalar(255, 255, 255));
@@ -110,14 +111,16 @@ TEST(ExtractChains, PointStrengthIsTheGradientMagnitudeCannyThresholded) {
   // Recomputed independently with OpenCV's own blur and Sobel on the processed grey image, at each
   // chain point mapped back to processed pixels; every edge pixel passed Canny's low threshold.
   // And a picture bigger than max_image_side_px, so the chains are scaled back from a shrunk image.
-  const fs::path shrunk = fs::temp_directory_path() /
-                          ("hk_vision_strength_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
+  const fs::path shrunk =
+      fs::temp_directory_path() /
+      ("hk_vision_strength_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".png");
   cv::Mat big(1000, 1700, CV_8UC3, cv::Scalar(230, 230, 230));
   cv::circle(big, cv::Point(600, 500), 300, cv::Scalar(20, 20, 20), cv::FILLED, cv::LINE_AA);
   cv::rectangle(big, cv::Rect(1100, 200, 400, 500), cv::Scalar(150, 150, 150), cv::FILLED);
   ASSERT_TRUE(cv::imwrite(shrunk.string(), big));
   const std::string images = std::string(HK_TEST_DATA_DIR) + "/images/";
-  for (const std::string& path : {images + "fruits.jpg", images + "horse.png", images + "sudoku.png", images + "butterfly.jpg", shrunk.string()}) {
+  for (const std::string& path : {images + "fruits.jpg", images + "horse.png", images + "sudoku.png",
+                                  images + "butterfly.jpg", shrunk.string()}) {
     SCOPED_TRACE(path);
     const ExtractParams p;
     const Extraction ex = extract_chains(path, p);

@@ -18,10 +18,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "reference_linker.hpp"
+#include "test_paths.hpp"
 #include "vision/edges.hpp"
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
-#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {
@@ -119,7 +119,8 @@ void expect_same_chains(const cv::Mat& edges, double min_length_px, const std::s
 
 std::vector<fs::path> test_images() {
   std::vector<fs::path> paths;
-  for (const auto& entry : fs::directory_iterator(std::string(HK_TEST_DATA_DIR) + "/images")) paths.push_back(entry.path());
+  for (const auto& entry : fs::directory_iterator(std::string(HK_TEST_DATA_DIR) + "/images"))
+    paths.push_back(entry.path());
   std::sort(paths.begin(), paths.end());
   return paths;
 }
@@ -166,10 +167,18 @@ TEST(Reference, DetectEdgesMatchesOpenCVOnRandomImages) {
       for (int x = 0; x < w; ++x) {
         int v = 0;
         switch (rep % 4) {
-          case 0: v = static_cast<int>(rng() % 256); break;                        // noise
-          case 1: v = 128 + static_cast<int>(rng() % 7) - 3; break;               // faint noise
-          case 2: v = (x / 7 + y / 5) % 2 != 0 ? 200 : 40; break;                  // blocks
-          default: v = (3 * x + 2 * y + static_cast<int>(rng() % 20)) % 256; break;  // ramps
+          case 0:
+            v = static_cast<int>(rng() % 256);
+            break;  // noise
+          case 1:
+            v = 128 + static_cast<int>(rng() % 7) - 3;
+            break;  // faint noise
+          case 2:
+            v = (x / 7 + y / 5) % 2 != 0 ? 200 : 40;
+            break;  // blocks
+          default:
+            v = (3 * x + 2 * y + static_cast<int>(rng() % 20)) % 256;
+            break;  // ramps
         }
         g.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(v);
       }

@@ -9,9 +9,9 @@
 #include <filesystem>
 #include <string>
 
-#include "vision/scene_chains.hpp"
 #include "hk/error.hpp"
 #include "test_paths.hpp"
+#include "vision/scene_chains.hpp"
 
 namespace hk::vision {
 namespace {
@@ -44,7 +44,8 @@ TEST(SceneChains, TheReportAccountsForEveryChainAndTheBudgetsHold) {
     p.max_segments = 2000;
     const SceneChains sc = scene_chains(file.string(), ExtractParams{}, p, points_cost);
     const SimplifyReport& r = sc.report;
-    EXPECT_EQ(r.chains_after_gaps, r.chains_too_short + r.chains_along_border + r.chains_over_max_shapes + r.chains_over_budget + sc.curves.size());
+    EXPECT_EQ(r.chains_after_gaps, r.chains_too_short + r.chains_along_border + r.chains_over_max_shapes +
+                                       r.chains_over_budget + sc.curves.size());
     EXPECT_LE(sc.curves.size(), p.max_shapes);
     std::size_t segments = 0;
     for (const SceneCurve& c : sc.curves) {
@@ -79,8 +80,9 @@ TEST(SceneChains, TheShapesKeptAreTheMostSalient) {
     ASSERT_GT(every.curves.size(), 5u);
     std::vector<double> salience;
     for (const SceneCurve& c : every.curves)
-      salience.push_back(shape_salience({curve_length_m(c), c.strength, c.closed, c.closed ? enclosed_area_m2(c.points_m) : 0.0},
-                                        every.extraction.edge_map.high));
+      salience.push_back(
+          shape_salience({curve_length_m(c), c.strength, c.closed, c.closed ? enclosed_area_m2(c.points_m) : 0.0},
+                         every.extraction.edge_map.high));
     std::vector<double> sorted = salience;
     std::sort(sorted.rbegin(), sorted.rend());
     SimplifyParams five = all;
@@ -89,9 +91,11 @@ TEST(SceneChains, TheShapesKeptAreTheMostSalient) {
     ASSERT_EQ(kept.curves.size(), 5u);
     EXPECT_EQ(kept.report.chains_over_max_shapes, every.curves.size() - 5);
     for (const SceneCurve& c : kept.curves) {
-      const auto it = std::find_if(every.curves.begin(), every.curves.end(), [&](const SceneCurve& e) { return e.points_m == c.points_m; });
+      const auto it = std::find_if(every.curves.begin(), every.curves.end(),
+                                   [&](const SceneCurve& e) { return e.points_m == c.points_m; });
       ASSERT_NE(it, every.curves.end()) << "a kept curve is one of all";
-      EXPECT_GE(salience[static_cast<std::size_t>(it - every.curves.begin())], sorted[4]) << "among the five most salient";
+      EXPECT_GE(salience[static_cast<std::size_t>(it - every.curves.begin())], sorted[4])
+          << "among the five most salient";
     }
   }
 }

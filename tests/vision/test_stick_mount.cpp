@@ -61,7 +61,9 @@ std::string refusal(F f) {
   return "";
 }
 
-bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == std::string::npos && s.find('\r') == std::string::npos; }
+bool one_line(const std::string& s) {
+  return !s.empty() && s.find('\n') == std::string::npos && s.find('\r') == std::string::npos;
+}
 
 const char* kAnswers =
     "case \"$1\" in\n"
@@ -80,7 +82,8 @@ TEST_F(FakeHelpers, TheCapabilityComesFirstThenAnExecutableHelper) {
   const fs::path plain = dir_ / "not-executable";
   std::ofstream(plain) << "#!/bin/sh\n";
   fs::permissions(plain, fs::perms(0644));
-  EXPECT_EQ(choose_stick_mounter(false, plain.string()), StickMounter::None);  // access(X_OK) wants an x bit, even for root
+  EXPECT_EQ(choose_stick_mounter(false, plain.string()),
+            StickMounter::None);  // access(X_OK) wants an x bit, even for root
   EXPECT_STREQ(stick_mounter_name(StickMounter::Direct), "direct");
   EXPECT_STREQ(stick_mounter_name(StickMounter::Helper), "helper");
   EXPECT_STREQ(stick_mounter_name(StickMounter::None), "none");
@@ -112,7 +115,9 @@ TEST_F(FakeHelpers, MountedThroughTheHelperAndUnmountedWhenDestroyed) {
 }
 
 TEST_F(FakeHelpers, UnmountIsIdempotentAndReportsFailure) {
-  const std::string exe = helper("hk-stick-mount", "case \"$1\" in mount) echo \"mounted ext4 at /run/haptic-kiosk/usb/$3 from $2\" ;; *) exit 1 ;; esac");
+  const std::string exe =
+      helper("hk-stick-mount",
+             "case \"$1\" in mount) echo \"mounted ext4 at /run/haptic-kiosk/usb/$3 from $2\" ;; *) exit 1 ;; esac");
   auto m = mount_stick(StickMounter::Helper, "/dev/sdz1", "", 0, exe);
   EXPECT_FALSE(m->unmount());  // the helper said no
   EXPECT_TRUE(m->unmount());   // nothing left to do
@@ -121,16 +126,19 @@ TEST_F(FakeHelpers, UnmountIsIdempotentAndReportsFailure) {
 }
 
 TEST_F(FakeHelpers, TheHelpersRefusalIsPassedOnInOneLine) {
-  const std::string exe = helper("hk-stick-mount",
-                                 "echo \"hk-stick-mount: stick '$2': its filesystem (swap) is not one the kiosk reads (FAT, exFAT, NTFS, "
-                                 "ext4, ISO 9660)\" >&2; exit 1");
+  const std::string exe =
+      helper("hk-stick-mount",
+             "echo \"hk-stick-mount: stick '$2': its filesystem (swap) is not one the kiosk reads (FAT, exFAT, NTFS, "
+             "ext4, ISO 9660)\" >&2; exit 1");
   const std::string what = refusal([&] { (void)mount_stick(StickMounter::Helper, "/dev/sdz1", "", 1, exe); });
-  EXPECT_EQ(what, "stick '/dev/sdz1': its filesystem (swap) is not one the kiosk reads (FAT, exFAT, NTFS, ext4, ISO 9660)");
+  EXPECT_EQ(what,
+            "stick '/dev/sdz1': its filesystem (swap) is not one the kiosk reads (FAT, exFAT, NTFS, ext4, ISO 9660)");
   EXPECT_EQ(calls(), "mount /dev/sdz1 1\n");  // nothing to unmount after a refusal
 }
 
 TEST_F(FakeHelpers, ARefusalAboutTheArgumentsNamesTheDevice) {
-  const std::string exe = helper("hk-stick-mount", "echo \"hk-stick-mount: device '$2': not on the USB bus\" >&2; exit 1");
+  const std::string exe =
+      helper("hk-stick-mount", "echo \"hk-stick-mount: device '$2': not on the USB bus\" >&2; exit 1");
   const std::string what = refusal([&] { (void)mount_stick(StickMounter::Helper, "/dev/vda", "", 1, exe); });
   EXPECT_TRUE(one_line(what)) << what;
   EXPECT_EQ(what, "stick '/dev/vda': the mount helper refused: device '/dev/vda': not on the USB bus");

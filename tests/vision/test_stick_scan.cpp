@@ -28,10 +28,10 @@
 #include <tuple>
 #include <vector>
 
-#include "vision/intake.hpp"
-#include "vision/stick_scan.hpp"
 #include "hk/error.hpp"
 #include "test_paths.hpp"
+#include "vision/intake.hpp"
+#include "vision/stick_scan.hpp"
 
 namespace hk::vision {
 namespace {
@@ -127,8 +127,8 @@ bool safe_one_line(const std::string& s) {
   for (unsigned char c : s) {
     if (c < 0x20 || c == 0x7F) return false;
   }
-  for (const char* bad : {"\xC2\x80", "\xC2\x85", "\xC2\x9F", "\xE2\x80\xAE", "\xE2\x80\xAD", "\xE2\x81\xA6", "\xE2\x80\x8B", "\xEF\xBB\xBF",
-                          "\xE2\x80\x8E", "\xD8\x9C", "\xE2\x80\xA8"}) {
+  for (const char* bad : {"\xC2\x80", "\xC2\x85", "\xC2\x9F", "\xE2\x80\xAE", "\xE2\x80\xAD", "\xE2\x81\xA6",
+                          "\xE2\x80\x8B", "\xEF\xBB\xBF", "\xE2\x80\x8E", "\xD8\x9C", "\xE2\x80\xA8"}) {
     if (s.find(bad) != std::string::npos) return false;
   }
   return true;
@@ -171,7 +171,8 @@ std::map<std::string, std::tuple<unsigned, long long, long long, long long>> lis
   for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
     struct stat st;
     if (::lstat(it->path().c_str(), &st) != 0) continue;
-    out[it->path().string()] = {st.st_mode, static_cast<long long>(st.st_size), st.st_mtim.tv_sec * 1000000000LL + st.st_mtim.tv_nsec,
+    out[it->path().string()] = {st.st_mode, static_cast<long long>(st.st_size),
+                                st.st_mtim.tv_sec * 1000000000LL + st.st_mtim.tv_nsec,
                                 st.st_ctim.tv_sec * 1000000000LL + st.st_ctim.tv_nsec};
   }
   return out;
@@ -181,7 +182,8 @@ std::map<std::string, std::tuple<unsigned, long long, long long, long long>> lis
 void expect_well_formed(const StickScan& s, const ScanLimits& limits) {
   EXPECT_LE(s.entries_scanned, limits.max_entries);
   EXPECT_LE(static_cast<long>(s.documents.size()), limits.max_documents);
-  EXPECT_TRUE(std::is_sorted(s.documents.begin(), s.documents.end(), [](const auto& a, const auto& b) { return a.path < b.path; }));
+  EXPECT_TRUE(std::is_sorted(s.documents.begin(), s.documents.end(),
+                             [](const auto& a, const auto& b) { return a.path < b.path; }));
   for (const auto& r : s.refused) {
     EXPECT_TRUE(safe_one_line(r.path)) << r.path;
     EXPECT_TRUE(safe_one_line(r.reason)) << r.reason;
@@ -216,19 +218,33 @@ TEST(StickSafeName, GoldenValues) {
   // RIGHT-TO-LEFT OVERRIDE (U+202E) would show "photoexe.png"; removed, the real order shows.
   EXPECT_EQ(safe_display_name("photo\xE2\x80\xAEgnp.exe"), "photognp.exe");
   // Every bidi control, zero-width and BOM character is removed.
-  EXPECT_EQ(safe_display_name("a\xE2\x80\x8E" "b\xE2\x80\x8F" "c\xE2\x80\xAA" "d\xE2\x81\xA6" "e\xE2\x81\xA9" "f\xD8\x9C" "g\xE2\x80\x8B" "h\xE2\x80\x8D" "i\xEF\xBB\xBF" "j"),
+  EXPECT_EQ(safe_display_name("a\xE2\x80\x8E"
+                              "b\xE2\x80\x8F"
+                              "c\xE2\x80\xAA"
+                              "d\xE2\x81\xA6"
+                              "e\xE2\x81\xA9"
+                              "f\xD8\x9C"
+                              "g\xE2\x80\x8B"
+                              "h\xE2\x80\x8D"
+                              "i\xEF\xBB\xBF"
+                              "j"),
             "abcdefghij");
   // C0 controls (newline, tab, ESC), DEL and C1 (NEL U+0085) go; the text stays on one line.
   EXPECT_EQ(safe_display_name("line\nbreak\r\t\x1b[31mred\x7f.png"), "linebreak[31mred.png");
   EXPECT_EQ(safe_display_name("x\xC2\x85y\xC2\x9Fz"), "xyz");
   // Line and paragraph separators go too.
-  EXPECT_EQ(safe_display_name("a\xE2\x80\xA8" "b\xE2\x80\xA9" "c"), "abc");
+  EXPECT_EQ(safe_display_name("a\xE2\x80\xA8"
+                              "b\xE2\x80\xA9"
+                              "c"),
+            "abc");
   // Ill-formed UTF-8: one U+FFFD per maximal subpart.
-  EXPECT_EQ(safe_display_name("\xC0\xAF"), fffd + fffd);                      // overlong '/': C0 and AF start nothing
-  EXPECT_EQ(safe_display_name("\xED\xA0\x80"), fffd + fffd + fffd);           // surrogate U+D800
+  EXPECT_EQ(safe_display_name("\xC0\xAF"), fffd + fffd);                        // overlong '/': C0 and AF start nothing
+  EXPECT_EQ(safe_display_name("\xED\xA0\x80"), fffd + fffd + fffd);             // surrogate U+D800
   EXPECT_EQ(safe_display_name("\xF4\x90\x80\x80"), fffd + fffd + fffd + fffd);  // above U+10FFFF
-  EXPECT_EQ(safe_display_name("ab\xE2\x82"), "ab" + fffd);                     // truncated €: one subpart
-  EXPECT_EQ(safe_display_name("\xE2\x82" "x"), fffd + "x");
+  EXPECT_EQ(safe_display_name("ab\xE2\x82"), "ab" + fffd);                      // truncated €: one subpart
+  EXPECT_EQ(safe_display_name("\xE2\x82"
+                              "x"),
+            fffd + "x");
   EXPECT_EQ(safe_display_name("\xFF\xFE"), fffd + fffd);
   // Valid 2-, 3- and 4-byte characters stay.
   EXPECT_EQ(safe_display_name("\xC3\xA9\xE2\x82\xAC\xF0\x9F\x90\xB4"), "\xC3\xA9\xE2\x82\xAC\xF0\x9F\x90\xB4");
@@ -253,7 +269,10 @@ TEST(StickSafeName, GoldenValues) {
   EXPECT_EQ(safe_display_name("a" + horse64), "a" + std::string(horse63.substr(0, 248)) + ell);  // 1 + 62*4 = 249 ≤ 252
   // Controls removed before measuring: 300 bytes of which 100 are controls → 200, unchanged.
   std::string mixed;
-  for (int i = 0; i < 100; ++i) mixed += "a\x01" "b";
+  for (int i = 0; i < 100; ++i)
+    mixed +=
+        "a\x01"
+        "b";
   EXPECT_EQ(safe_display_name(mixed).size(), 200u);
 }
 
@@ -286,15 +305,15 @@ TEST(StickScan, GoodStickListsPicturesAndPdfByMagicBytesNotNames) {
   t.copy("images/butterfly.jpg", "Fotos/butterfly.jpg");
   t.copy("images/apple.jpg", "Fotos/2023/Sommer/apple.jpg");
   t.copy("documents/horse_and_page.pdf", "Dokumente/horse_and_page.pdf");
-  t.copy("images/camera.png", "Fotos/notes.txt");  // a PNG with a wrong name: found as png
+  t.copy("images/camera.png", "Fotos/notes.txt");               // a PNG with a wrong name: found as png
   t.write("Dokumente/fake.pdf", "hello, this is not a PDF\n");  // a text with a PDF's name: refused
   t.write("README.txt", "just text\n");
   const ScanLimits limits;
   const StickScan s = scan_stick(t.root(), limits);
   expect_well_formed(s, limits);
   EXPECT_TRUE(s.complete);
-  EXPECT_EQ(doc_paths(s), (std::vector<std::string>{"Dokumente/horse_and_page.pdf", "Fotos/2023/Sommer/apple.jpg", "Fotos/butterfly.jpg",
-                                                    "Fotos/notes.txt", "horse.png"}));
+  EXPECT_EQ(doc_paths(s), (std::vector<std::string>{"Dokumente/horse_and_page.pdf", "Fotos/2023/Sommer/apple.jpg",
+                                                    "Fotos/butterfly.jpg", "Fotos/notes.txt", "horse.png"}));
   // Entries: 7 files and 4 folders (Fotos, Fotos/2023, Fotos/2023/Sommer, Dokumente; the root is not one).
   EXPECT_EQ(s.entries_scanned, 7 + 4);
   const StickDocument* pdf = find_doc(s, "Dokumente/horse_and_page.pdf");
@@ -351,21 +370,22 @@ TEST(StickScan, SymbolicLinksAreRefusedAndNeverFollowed) {
   outside.copy("images/butterfly.jpg", "Ordner/inside.jpg");
   t.copy("images/apple.jpg", "apple.jpg");
   t.mkdir("sub");
-  t.symlink(outside / "secret.png", "outside.png");            // a file outside the tree
-  t.symlink("/etc/shadow", "shadow.png");                      // a system file
-  t.symlink(outside / "Ordner", "Ordner");                     // a folder outside
-  t.symlink("../apple.jpg", "sub/up.jpg");                     // inside, but still a link
-  t.symlink("loop", "loop");                                   // a loop on itself
-  t.symlink("b", "a");                                         // and a loop of two
+  t.symlink(outside / "secret.png", "outside.png");  // a file outside the tree
+  t.symlink("/etc/shadow", "shadow.png");            // a system file
+  t.symlink(outside / "Ordner", "Ordner");           // a folder outside
+  t.symlink("../apple.jpg", "sub/up.jpg");           // inside, but still a link
+  t.symlink("loop", "loop");                         // a loop on itself
+  t.symlink("b", "a");                               // and a loop of two
   t.symlink("a", "b");
-  t.symlink("../../../../../../../../../../..", "sub/root");   // towards /
-  t.symlink("/proc/self/root", "magic");                       // a magic link
+  t.symlink("../../../../../../../../../../..", "sub/root");  // towards /
+  t.symlink("/proc/self/root", "magic");                      // a magic link
   const ScanLimits limits;
   const StickScan s = scan_stick(t.root(), limits);
   expect_well_formed(s, limits);
   EXPECT_TRUE(s.complete);
   EXPECT_EQ(doc_paths(s), std::vector<std::string>{"apple.jpg"});
-  for (const char* link : {"outside.png", "shadow.png", "Ordner", "sub/up.jpg", "loop", "a", "b", "sub/root", "magic"}) {
+  for (const char* link :
+       {"outside.png", "shadow.png", "Ordner", "sub/up.jpg", "loop", "a", "b", "sub/root", "magic"}) {
     EXPECT_EQ(refusal(s, link), "a symbolic link (links are not followed)") << link;
   }
   EXPECT_EQ(s.entries_scanned, 11);  // apple.jpg, sub, 7 links at the root level and 2 in sub
@@ -472,7 +492,7 @@ TEST(StickScan, EntryLimitStopsAFloodOfFiles) {
     ::close(fd);
   }
   t.write("zz/late.png", tiny_png());  // after "flood" in name order: never reached
-  const ScanLimits limits;  // max_entries 10 000
+  const ScanLimits limits;             // max_entries 10 000
   const StickScan s = scan_stick(t.root(), limits);
   expect_well_formed(s, limits);
   EXPECT_FALSE(s.complete);
@@ -538,15 +558,17 @@ TEST(StickScan, EmptyMislabelledAndOversizedFilesAreRefused) {
   EXPECT_EQ(doc_paths(s2), std::vector<std::string>{"ok.png"});
   EXPECT_EQ(refusal(s2, "medium.pdf"), "file size 5009 bytes exceeds the limit of 1000 bytes");
   // read_stick_file applies its own limit.
-  EXPECT_EQ(read_error(t.root(), "big.png", 209715200), "stick file 'big.png': file size 262144000 bytes exceeds the limit of 209715200 bytes");
-  EXPECT_EQ(read_error(t.root(), "medium.pdf", 1000), "stick file 'medium.pdf': file size 5009 bytes exceeds the limit of 1000 bytes");
+  EXPECT_EQ(read_error(t.root(), "big.png", 209715200),
+            "stick file 'big.png': file size 262144000 bytes exceeds the limit of 209715200 bytes");
+  EXPECT_EQ(read_error(t.root(), "medium.pdf", 1000),
+            "stick file 'medium.pdf': file size 5009 bytes exceeds the limit of 1000 bytes");
   EXPECT_EQ(read_error(t.root(), "medium.pdf", 5009), "");
   EXPECT_NE(read_error(t.root(), "ok.png", 0).find("not positive"), std::string::npos);
 }
 
-// With picture_check = image_header_problem (as at the kiosk), a picture whose header cannot be read (real bad files from tests/data/bad: a
-// PNG whose IHDR checksum is wrong, an empty PNG, a PNG whose image data is damaged but header whole) is
-// refused at the scan, as a document, with the header parser's one line; a whole picture is listed. Without
+// With picture_check = image_header_problem (as at the kiosk), a picture whose header cannot be read (real bad files
+// from tests/data/bad: a PNG whose IHDR checksum is wrong, an empty PNG, a PNG whose image data is damaged but header
+// whole) is refused at the scan, as a document, with the header parser's one line; a whole picture is listed. Without
 // it, the magic bytes alone decide.
 TEST(StickScan, PicturesWhoseHeaderCannotBeReadAreRefusedAsDocuments) {
   TempTree t;
@@ -562,7 +584,8 @@ TEST(StickScan, PicturesWhoseHeaderCannotBeReadAreRefusedAsDocuments) {
   limits.picture_check = image_header_problem;
   const StickScan s = scan_stick(t.root(), limits);
   expect_well_formed(s, limits);
-  EXPECT_EQ(doc_paths(s), (std::vector<std::string>{"damaged_idat.png", "horse.png"})) << "a whole header is listed; its pixels are read when shown";
+  EXPECT_EQ(doc_paths(s), (std::vector<std::string>{"damaged_idat.png", "horse.png"}))
+      << "a whole header is listed; its pixels are read when shown";
   EXPECT_NE(refusal(s, "bad_crc.png").find("CRC"), std::string::npos) << refusal(s, "bad_crc.png");
   ASSERT_EQ(s.refused.size(), 1u);
   EXPECT_TRUE(s.refused[0].document);
@@ -573,12 +596,14 @@ TEST(StickScan, PicturesWhoseHeaderCannotBeReadAreRefusedAsDocuments) {
 
 TEST(StickScan, HostileNamesAreShownSafelyAndStillOpen) {
   TempTree t;
-  const std::string cafe = "caf\xe9.png";                          // Latin-1, not UTF-8
-  const std::string rlo = "photo\xE2\x80\xAEgnp.exe";              // shows as "photoexe.png" with the override
-  const std::string lines = "line\nbreak\r\x1b[2J.png";            // newline, CR, terminal escape
-  const std::string folder = "\xff\xfe\xE2\x80\x8B" "Ordner";      // invalid bytes and a zero-width space
+  const std::string cafe = "caf\xe9.png";                // Latin-1, not UTF-8
+  const std::string rlo = "photo\xE2\x80\xAEgnp.exe";    // shows as "photoexe.png" with the override
+  const std::string lines = "line\nbreak\r\x1b[2J.png";  // newline, CR, terminal escape
+  const std::string folder =
+      "\xff\xfe\xE2\x80\x8B"
+      "Ordner";  // invalid bytes and a zero-width space
   std::string long_name;
-  for (int i = 0; i < 85; ++i) long_name += "\xE6\x97\xA5";          // 255 bytes, the longest name
+  for (int i = 0; i < 85; ++i) long_name += "\xE6\x97\xA5";  // 255 bytes, the longest name
   t.write(cafe, tiny_png());
   t.write(rlo, tiny_png());
   t.write(lines, tiny_png());
@@ -601,7 +626,8 @@ TEST(StickScan, HostileNamesAreShownSafelyAndStillOpen) {
   EXPECT_EQ(lng->display_name.substr(lng->display_name.size() - 3), "\xE2\x80\xA6");
   EXPECT_EQ(refusal(s, "badname.txt"), "not a picture or PDF (unknown format)");
   // The raw path still opens the file.
-  for (const auto& d : s.documents) EXPECT_EQ(read_stick_file(t.root(), d.path, limits.max_file_bytes).size(), tiny_png().size()) << d.display_name;
+  for (const auto& d : s.documents)
+    EXPECT_EQ(read_stick_file(t.root(), d.path, limits.max_file_bytes).size(), tiny_png().size()) << d.display_name;
   // A refused read names the file safely too, on one line.
   const std::string e = read_error(t.root(), lines + ".missing");
   EXPECT_EQ(e, "stick file 'linebreak[2J.png.missing': no such file");
@@ -711,7 +737,8 @@ TEST(StickScan, BadRootOrLimitsAreTypedOneLineErrors) {
   EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_documents = 0; })), hk::ArgumentError);
   EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_file_bytes = 0; })), hk::ArgumentError);
   EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = 0.0; })), hk::ArgumentError);
-  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = std::nan(""); })), hk::ArgumentError);
+  EXPECT_THROW((void)scan_stick(t.root(), with([](ScanLimits& l) { l.max_seconds = std::nan(""); })),
+               hk::ArgumentError);
   EXPECT_NE(read_error(t / "missing", "file.png").find("stick file 'file.png'"), std::string::npos);
 }
 

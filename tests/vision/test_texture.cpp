@@ -11,12 +11,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "chain_checks.hpp"
+#include "hk/error.hpp"
+#include "test_paths.hpp"
 #include "textures.hpp"
 #include "vision/intake.hpp"
 #include "vision/pipeline.hpp"
 #include "vision/texture.hpp"
-#include "hk/error.hpp"
-#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {
@@ -104,8 +104,10 @@ TEST(Detectors, SurroundKeepsExactlyTheCannyChainsThatStandOut) {
   // our own Sobel of the blurred picture, chain_surround on the picture as it came, stands_out with the
   // pipeline's thresholds. (Regression: the strength pass once blurred the grey image in place, so the
   // surround was taken on a picture blurred twice.) Pictures below max_image_side_px: no shrinking.
-  for (const auto& [name, img] : {std::pair{"noise", hk::test::noise_texture(400, 300, 4)}, std::pair{"wood", hk::test::wood_texture(400, 300, 4)},
-                                  std::pair{"coins", load_image(std::string(HK_TEST_DATA_DIR) + "/images/coins.png", {})}}) {
+  for (const auto& [name, img] :
+       {std::pair{"noise", hk::test::noise_texture(400, 300, 4)},
+        std::pair{"wood", hk::test::wood_texture(400, 300, 4)},
+        std::pair{"coins", load_image(std::string(HK_TEST_DATA_DIR) + "/images/coins.png", {})}}) {
     SCOPED_TRACE(name);
     cv::Mat grey;
     if (img.channels() == 3) {
@@ -128,7 +130,8 @@ TEST(Detectors, SurroundKeepsExactlyTheCannyChainsThatStandOut) {
     for (std::size_t k = 0; k < canny.chains.size(); ++k) {
       std::vector<double> strength;
       for (const cv::Point2d& q : canny.chains[k].points_px)
-        strength.push_back(std::hypot(gx.at<double>(static_cast<int>(q.y), static_cast<int>(q.x)), gy.at<double>(static_cast<int>(q.y), static_cast<int>(q.x))));
+        strength.push_back(std::hypot(gx.at<double>(static_cast<int>(q.y), static_cast<int>(q.x)),
+                                      gy.at<double>(static_cast<int>(q.y), static_cast<int>(q.x))));
       standing += stands_out(strength, around[k], p.surround_inhibition, canny.edge_map.low);
     }
     EXPECT_EQ(surround.chains.size(), standing);
@@ -161,7 +164,8 @@ TEST(Detectors, SurroundDropsGeneratedTextureAndKeepsTheCoins) {
   // background: the texture test keeps nearly all of their outlines' length.
   ExtractParams p;  // the defaults: α = 1.5
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    for (const auto& [name, img] : {std::pair{"noise", hk::test::noise_texture(800, 520, seed)}, std::pair{"wood", hk::test::wood_texture(800, 520, seed)}}) {
+    for (const auto& [name, img] : {std::pair{"noise", hk::test::noise_texture(800, 520, seed)},
+                                    std::pair{"wood", hk::test::wood_texture(800, 520, seed)}}) {
       SCOPED_TRACE(std::string(name) + " seed " + std::to_string(seed));
       p.detector = Detector::Canny;
       const Extraction canny = extract_chains_from_image(img, p);

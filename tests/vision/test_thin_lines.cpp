@@ -16,12 +16,12 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hk/error.hpp"
+#include "test_paths.hpp"
 #include "vision/edges.hpp"
 #include "vision/intake.hpp"
 #include "vision/linking.hpp"
 #include "vision/thin_lines.hpp"
-#include "hk/error.hpp"
-#include "test_paths.hpp"
 
 namespace hk::vision {
 namespace {
@@ -90,7 +90,8 @@ CentreLine arc_centre(cv::Point2d centre, double r, double a0, double a1) {
 }
 
 /// The real pipeline on a grey image: default Canny, linking, thin-line merging.
-std::vector<Chain> pipeline(const cv::Mat& grey, double width_px, ThinLineStats* st, std::vector<Chain>* linked = nullptr) {
+std::vector<Chain> pipeline(const cv::Mat& grey, double width_px, ThinLineStats* st,
+                            std::vector<Chain>* linked = nullptr) {
   const EdgeMap em = detect_edges(grey, EdgeParams{});
   const std::vector<Chain> chains = link_edges(em.edges, 2.0);
   if (linked != nullptr) *linked = chains;
@@ -105,7 +106,8 @@ void expect_on_centre_line(const Chain& c, const CentreLine& line) {
   EXPECT_LE(worst, 1.0) << "an output point is off the stroke's centre line";
   std::size_t covered = 0;
   for (const cv::Point2d& s : line.samples) covered += to_chain(s, c) <= 1.5;
-  EXPECT_GE(static_cast<double>(covered) / static_cast<double>(line.samples.size()), 0.9) << "the centre line is not covered";
+  EXPECT_GE(static_cast<double>(covered) / static_cast<double>(line.samples.size()), 0.9)
+      << "the centre line is not covered";
 }
 
 cv::Mat white(int w, int h) { return cv::Mat(h, w, CV_8UC1, cv::Scalar(255)); }
@@ -306,8 +308,8 @@ TEST(MergeThinLines, RealImagesStayInsideTheImageAndShrink) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<Chain> out = merge_thin_lines(chains, width_px, &st);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("  %-20s width %5.2f px: chains %4zu -> %4zu, points %6zu -> %6zu, centre lines %3zu, %.2f ms\n", name.c_str(),
-                width_px, chains.size(), out.size(), st.points_in, st.points_out, st.pairs_merged, ms);
+    std::printf("  %-20s width %5.2f px: chains %4zu -> %4zu, points %6zu -> %6zu, centre lines %3zu, %.2f ms\n",
+                name.c_str(), width_px, chains.size(), out.size(), st.points_in, st.points_out, st.pairs_merged, ms);
     EXPECT_LE(st.points_out, st.points_in);
     for (const Chain& c : out) {
       ASSERT_FALSE(c.points_px.empty());

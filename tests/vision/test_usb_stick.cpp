@@ -29,9 +29,9 @@
 #include <thread>
 #include <vector>
 
+#include "test_paths.hpp"
 #include "vision/stick_scan.hpp"
 #include "vision/usb_stick.hpp"
-#include "test_paths.hpp"
 
 #ifndef ST_NOSYMFOLLOW
 #define ST_NOSYMFOLLOW 0x2000  // linux/statfs.h; glibc 2.36 does not name it
@@ -80,7 +80,9 @@ bool kernel_has_filesystem(const std::string& type) {
   return false;
 }
 
-bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == std::string::npos && s.find('\r') == std::string::npos; }
+bool one_line(const std::string& s) {
+  return !s.empty() && s.find('\n') == std::string::npos && s.find('\r') == std::string::npos;
+}
 
 /// A scratch folder, removed with its contents at the end of the test.
 class TempDir {
@@ -255,21 +257,21 @@ ChildReport in_private_namespace(const std::function<void(Checks&)>& body) {
 }
 
 /// Reports the child's failures to gtest, then its skip reason if it had one.
-#define REPORT_CHILD(report)                                          \
-  do {                                                                \
-    const ChildReport& r_ = (report);                                 \
-    for (const auto& f_ : r_.failures) ADD_FAILURE() << f_;           \
-    if (!r_.skip.empty()) GTEST_SKIP() << r_.skip;                    \
+#define REPORT_CHILD(report)                                \
+  do {                                                      \
+    const ChildReport& r_ = (report);                       \
+    for (const auto& f_ : r_.failures) ADD_FAILURE() << f_; \
+    if (!r_.skip.empty()) GTEST_SKIP() << r_.skip;          \
   } while (0)
 
-#define SKIP_UNLESS_ROOT()                                                              \
-  do {                                                                                  \
+#define SKIP_UNLESS_ROOT()                                                               \
+  do {                                                                                   \
     if (::geteuid() != 0) GTEST_SKIP() << "needs root (loop devices, mount namespaces)"; \
-    if (!have_mount_capability()) GTEST_SKIP() << "needs CAP_SYS_ADMIN";                \
+    if (!have_mount_capability()) GTEST_SKIP() << "needs CAP_SYS_ADMIN";                 \
   } while (0)
 
-#define SKIP_UNLESS_TOOL(name) \
-  do {                         \
+#define SKIP_UNLESS_TOOL(name)                                         \
+  do {                                                                 \
     if (!have_tool(name)) GTEST_SKIP() << name << " is not installed"; \
   } while (0)
 
@@ -321,7 +323,8 @@ void check_same_tree(Checks& c, const fs::path& src, const fs::path& mounted) {
   for (const auto& p : got) listed += p + " ";
   CHILD_CHECK(c, want == got, "listed under the mount point: " + listed);
   for (const auto& rel : want) {
-    struct stat s {}, m {};
+    struct stat s {
+    }, m{};
     if (::lstat((src / rel).c_str(), &s) != 0 || ::lstat((mounted / rel).c_str(), &m) != 0) {
       c.expect(false, "cannot lstat " + rel + " on the stick");
       continue;
@@ -362,9 +365,9 @@ void check_locked_down(Checks& c, const MountedStick& stick, const std::string& 
   struct statvfs sv {};
   CHILD_CHECK(c, ::statvfs(mp.c_str(), &sv) == 0, std::strerror(errno));
   using Flag = std::pair<unsigned long, const char*>;
-  for (const auto& [flag, name] : {Flag{ST_RDONLY, "ST_RDONLY"}, Flag{ST_NOSUID, "ST_NOSUID"}, Flag{ST_NODEV, "ST_NODEV"},
-                                   Flag{ST_NOEXEC, "ST_NOEXEC"}, Flag{ST_NOATIME, "ST_NOATIME"},
-                                   Flag{ST_NOSYMFOLLOW, "ST_NOSYMFOLLOW"}}) {
+  for (const auto& [flag, name] :
+       {Flag{ST_RDONLY, "ST_RDONLY"}, Flag{ST_NOSUID, "ST_NOSUID"}, Flag{ST_NODEV, "ST_NODEV"},
+        Flag{ST_NOEXEC, "ST_NOEXEC"}, Flag{ST_NOATIME, "ST_NOATIME"}, Flag{ST_NOSYMFOLLOW, "ST_NOSYMFOLLOW"}}) {
     CHILD_CHECK(c, (sv.f_flag & flag) != 0, name);
   }
   CHILD_CHECK(c, block_read_only(stick.devnode()) == 1, "BLKROGET");
@@ -378,9 +381,11 @@ void check_locked_down(Checks& c, const MountedStick& stick, const std::string& 
   CHILD_CHECK(c, fd < 0 && errno == EROFS, std::string("open for writing: ") + std::strerror(errno));
   if (fd >= 0) ::close(fd);
   errno = 0;
-  CHILD_CHECK(c, ::mkdir((mp + "/newdir").c_str(), 0700) != 0 && errno == EROFS, std::string("mkdir: ") + std::strerror(errno));
+  CHILD_CHECK(c, ::mkdir((mp + "/newdir").c_str(), 0700) != 0 && errno == EROFS,
+              std::string("mkdir: ") + std::strerror(errno));
   errno = 0;
-  CHILD_CHECK(c, ::unlink((mp + "/horse.png").c_str()) != 0 && errno == EROFS, std::string("unlink: ") + std::strerror(errno));
+  CHILD_CHECK(c, ::unlink((mp + "/horse.png").c_str()) != 0 && errno == EROFS,
+              std::string("unlink: ") + std::strerror(errno));
 }
 
 /// unmount() detaches the stick and removes its mount point; a second call is harmless.
@@ -410,7 +415,8 @@ void check_nothing_mounted(Checks& c, const fs::path& root, int slot) {
 
 TEST(UsbStickBasics, SupportedFilesystems) {
   for (const char* t : {"vfat", "exfat", "ntfs", "ext4", "iso9660"}) EXPECT_TRUE(filesystem_supported(t)) << t;
-  for (const char* t : {"", "ntfs3", "ext2", "ext3", "btrfs", "xfs", "swap", "squashfs", "udf", "hfsplus", "crypto_LUKS", "VFAT"}) {
+  for (const char* t :
+       {"", "ntfs3", "ext2", "ext3", "btrfs", "xfs", "swap", "squashfs", "udf", "hfsplus", "crypto_LUKS", "VFAT"}) {
     EXPECT_FALSE(filesystem_supported(t)) << t;
   }
 }
@@ -607,7 +613,9 @@ TEST_F(UsbStickImage, Ext4MountedReadOnlyAndReadBack) {
       const StickScan scan = scan_stick(mp.string(), ScanLimits{});
       std::set<std::string> docs;
       for (const auto& d : scan.documents) docs.insert(d.path + ":" + d.format);
-      CHILD_CHECK(c, (docs == std::set<std::string>{"docs/deeper/butterfly.jpg:jpeg", "docs/horse_and_page.pdf:pdf", "horse.png:png"}),
+      CHILD_CHECK(c,
+                  (docs == std::set<std::string>{"docs/deeper/butterfly.jpg:jpeg", "docs/horse_and_page.pdf:pdf",
+                                                 "horse.png:png"}),
                   std::to_string(docs.size()) + " documents");
       const bool link_refused = std::any_of(scan.refused.begin(), scan.refused.end(),
                                             [](const RefusedEntry& r) { return r.path == "passwd_link"; });
@@ -666,8 +674,8 @@ TEST_F(UsbStickImage, VfatIdentifiedAndMountedOrRefusedByThisKernel) {
   SKIP_UNLESS_TOOL("losetup");
   copy_documents(src_);
   ASSERT_TRUE(make("mkfs.vfat -C -n KIOSKTEST '" + image_.string() + "' 8192 >/dev/null"));
-  ASSERT_TRUE(make("MTOOLS_SKIP_CHECK=1 mcopy -s -i '" + image_.string() + "' '" + (src_ / "horse.png").string() + "' '" +
-                   (src_ / "docs").string() + "' ::/"));
+  ASSERT_TRUE(make("MTOOLS_SKIP_CHECK=1 mcopy -s -i '" + image_.string() + "' '" + (src_ / "horse.png").string() +
+                   "' '" + (src_ / "docs").string() + "' ::/"));
   remember_image();
   const bool kernel_vfat = kernel_has_filesystem("vfat");
   {
@@ -698,7 +706,8 @@ TEST_F(UsbStickImage, VfatIdentifiedAndMountedOrRefusedByThisKernel) {
     REPORT_CHILD(report);
   }
   expect_image_unchanged();
-  if (!kernel_vfat) GTEST_SKIP() << "this kernel has no vfat driver (CONFIG_VFAT_FS); checked identification and the refusal only";
+  if (!kernel_vfat)
+    GTEST_SKIP() << "this kernel has no vfat driver (CONFIG_VFAT_FS); checked identification and the refusal only";
 }
 
 /// The image, attached read-only, is identified as `type` and refused by MountedStick with the one-line
@@ -712,7 +721,8 @@ void expect_refused_filesystem(const fs::path& image, const fs::path& mount_root
       MountedStick stick(loop.dev(), mount_root.string(), 2);
       c.expect(false, "mounted a " + type + " stick");
     } catch (const StickMountError& e) {
-      const std::string want = "stick '" + loop.dev() + "': its filesystem (" + type + ") is not one the kiosk reads " + kSupportedList;
+      const std::string want =
+          "stick '" + loop.dev() + "': its filesystem (" + type + ") is not one the kiosk reads " + kSupportedList;
       CHILD_CHECK(c, std::string(e.what()) == want, e.what());
     }
     check_nothing_mounted(c, mount_root, 2);

@@ -51,8 +51,8 @@ TEST(PdfWorkerLimits, MemoryLimitEndsInADefinedErrorAndTheNextPageRenders) {
     EXPECT_TRUE(e.kind() == PdfError::Kind::TooLarge || e.kind() == PdfError::Kind::WorkerCrashed) << e.what();
     EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
   }
-  const PdfPage page = render_pdf_page(read_file(kData + "/documents/horse_and_page.pdf"), "horse_and_page.pdf", 2,
-                                       generous());
+  const PdfPage page =
+      render_pdf_page(read_file(kData + "/documents/horse_and_page.pdf"), "horse_and_page.pdf", 2, generous());
   EXPECT_EQ(page.pages, 2);
   EXPECT_GT(page.grey.cols, 100);
 }

@@ -65,9 +65,8 @@ class MagnitudeHistogram {
       // below the next integer (> 1 / (2 * 1443)) exceeds half a float ulp there (2^-14), so
       // truncating the correctly rounded float square root gives floor(sqrt(m2)), as the
       // double one does. Bins < 1448 fit in 16 bits.
-      const cv::v_uint16x8 bins = cv::v_min(cv::v_pack_u(cv::v_trunc(cv::v_sqrt(cv::v_cvt_f32(a))),
-                                                         cv::v_trunc(cv::v_sqrt(cv::v_cvt_f32(b)))),
-                                            last);
+      const cv::v_uint16x8 bins = cv::v_min(
+          cv::v_pack_u(cv::v_trunc(cv::v_sqrt(cv::v_cvt_f32(a))), cv::v_trunc(cv::v_sqrt(cv::v_cvt_f32(b)))), last);
       ++part_[0][cv::v_extract_n<0>(bins)];
       ++part_[1][cv::v_extract_n<1>(bins)];
       ++part_[2][cv::v_extract_n<2>(bins)];
@@ -159,8 +158,8 @@ constexpr std::int64_t kMinStripePixels = std::int64_t{1} << 17;
 constexpr int kMinStripeRows = 16;
 
 int stripe_count(int rows, int cols) {
-  const std::int64_t by_size = std::min<std::int64_t>(static_cast<std::int64_t>(rows) * cols / kMinStripePixels,
-                                                      rows / kMinStripeRows);
+  const std::int64_t by_size =
+      std::min<std::int64_t>(static_cast<std::int64_t>(rows) * cols / kMinStripePixels, rows / kMinStripeRows);
   return static_cast<int>(std::max<std::int64_t>(1, std::min<std::int64_t>(cv::getNumThreads(), by_size)));
 }
 
@@ -468,9 +467,10 @@ struct SimdRowSuppressor {
 
 /// The scalar suppression of pixels x0 .. n-1 of a row (the ones the vectorised blocks leave, or all of
 /// them without SIMD), with the same inputs and result as suppress_row.
-[[gnu::always_inline]] inline void suppress_row_scalar(const std::int32_t* mp, const std::int32_t* mc, const std::int32_t* mn,
-                                                       const std::int16_t* gx, const std::int16_t* gy, int x0, int n, int low,
-                                                       int high, std::uint8_t* map, std::vector<std::uint8_t*>& stack) {
+[[gnu::always_inline]] inline void suppress_row_scalar(const std::int32_t* mp, const std::int32_t* mc,
+                                                       const std::int32_t* mn, const std::int16_t* gx,
+                                                       const std::int16_t* gy, int x0, int n, int low, int high,
+                                                       std::uint8_t* map, std::vector<std::uint8_t*>& stack) {
   for (int x = x0; x < n; ++x) {
     const int m = mc[x];
     bool cand = false;

@@ -70,7 +70,7 @@ class FileFrameSource final : public FrameSource {
   ImageLimits limits_;
   std::vector<std::string> files_;  ///< the frames, in the order served; never empty
   bool folder_;
-  cv::Mat current_;                 ///< the decoded frame of files_[current_file_]
+  cv::Mat current_;  ///< the decoded frame of files_[current_file_]
   std::size_t current_file_ = kNone;
   std::uint64_t next_index_ = 0;
 };

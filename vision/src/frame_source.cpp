@@ -12,8 +12,8 @@
 #include <system_error>
 
 #include "frame_sources.hpp"
-#include "input_error.hpp"
 #include "hk/error.hpp"
+#include "input_error.hpp"
 
 namespace hk::vision {
 
@@ -52,7 +52,8 @@ void check_params(const SourceSpec& spec, const FrameSourceParams& p) {
     throw hk::ArgumentError("camera '" + hk::one_line(spec.str()) + "': " + what);
   };
   if (p.width_px < 64 || p.width_px > 8192) bad("width_px " + std::to_string(p.width_px) + " is outside [64, 8192]");
-  if (p.height_px < 64 || p.height_px > 8192) bad("height_px " + std::to_string(p.height_px) + " is outside [64, 8192]");
+  if (p.height_px < 64 || p.height_px > 8192)
+    bad("height_px " + std::to_string(p.height_px) + " is outside [64, 8192]");
   if (!(std::isfinite(p.file_fps) && p.file_fps > 0.0 && p.file_fps <= 1000.0)) {
     bad("file_fps " + std::to_string(p.file_fps) + " is outside (0, 1000]");
   }
@@ -102,7 +103,8 @@ SourceSpec parse_source_spec(const std::string& spec) {
       out.path = rest;
     } else {
       const int n = parse_decimal(rest);
-      if (n < 0) throw_spec_error(spec, "bad device (expected a path starting with '/' or a number: v4l2:/dev/video0, v4l2:0)");
+      if (n < 0)
+        throw_spec_error(spec, "bad device (expected a path starting with '/' or a number: v4l2:/dev/video0, v4l2:0)");
       out.path = "/dev/video" + std::to_string(n);
     }
   }

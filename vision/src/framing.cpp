@@ -14,7 +14,7 @@
 namespace hk::vision {
 namespace {
 
-constexpr int kSmallWidthPx = 160;  // motion and detail are measured on a copy this wide
+constexpr int kSmallWidthPx = 160;    // motion and detail are measured on a copy this wide
 constexpr double kTimeSlackS = 1e-6;  // frame times are sums of floating-point steps: 10 x 0.1 s counts as 1 s
 
 cv::Mat grey_of(const cv::Mat& frame) {
@@ -45,7 +45,8 @@ void check(bool ok, const char* what) {
 
 }  // namespace
 
-FrameLook look_at_frame(const cv::Mat& frame, double t_s, const FrameLook* previous, cv::Mat& small, const PageParams& page) {
+FrameLook look_at_frame(const cv::Mat& frame, double t_s, const FrameLook* previous, cv::Mat& small,
+                        const PageParams& page) {
   if (frame.empty() || (frame.type() != CV_8UC3 && frame.type() != CV_8UC1)) {
     throw hk::ArgumentError("look_at_frame: the frame must be a non-empty CV_8UC3 or CV_8UC1 image");
   }
@@ -74,17 +75,28 @@ FrameLook look_at_frame(const cv::Mat& frame, double t_s, const FrameLook* previ
 
 const char* advice_name(FramingAdvice a) {
   switch (a) {
-    case FramingAdvice::PlacePicture: return "place";
-    case FramingAdvice::TooDark: return "too_dark";
-    case FramingAdvice::CutOffTop: return "cut_off_top";
-    case FramingAdvice::CutOffBottom: return "cut_off_bottom";
-    case FramingAdvice::CutOffLeft: return "cut_off_left";
-    case FramingAdvice::CutOffRight: return "cut_off_right";
-    case FramingAdvice::MoveLeft: return "move_left";
-    case FramingAdvice::MoveRight: return "move_right";
-    case FramingAdvice::MoveUp: return "move_up";
-    case FramingAdvice::MoveDown: return "move_down";
-    case FramingAdvice::HoldStill: return "hold_still";
+    case FramingAdvice::PlacePicture:
+      return "place";
+    case FramingAdvice::TooDark:
+      return "too_dark";
+    case FramingAdvice::CutOffTop:
+      return "cut_off_top";
+    case FramingAdvice::CutOffBottom:
+      return "cut_off_bottom";
+    case FramingAdvice::CutOffLeft:
+      return "cut_off_left";
+    case FramingAdvice::CutOffRight:
+      return "cut_off_right";
+    case FramingAdvice::MoveLeft:
+      return "move_left";
+    case FramingAdvice::MoveRight:
+      return "move_right";
+    case FramingAdvice::MoveUp:
+      return "move_up";
+    case FramingAdvice::MoveDown:
+      return "move_down";
+    case FramingAdvice::HoldStill:
+      return "hold_still";
   }
   return "?";
 }
@@ -92,8 +104,10 @@ const char* advice_name(FramingAdvice a) {
 FramingGuide::FramingGuide(const FramingParams& p) : p_(p) {
   check(std::isfinite(p.still_s) && p.still_s > 0.0 && p.still_s <= 60.0, "still_s must be in (0, 60] s");
   check(std::isfinite(p.repeat_s) && p.repeat_s >= 0.0, "repeat_s must be >= 0 s");
-  check(std::isfinite(p.centre_tolerance) && p.centre_tolerance > 0.0 && p.centre_tolerance <= 0.5, "centre_tolerance must be in (0, 0.5]");
-  check(std::isfinite(p.min_mean_grey) && p.min_mean_grey >= 0.0 && p.min_mean_grey <= 255.0, "min_mean_grey must be in [0, 255]");
+  check(std::isfinite(p.centre_tolerance) && p.centre_tolerance > 0.0 && p.centre_tolerance <= 0.5,
+        "centre_tolerance must be in (0, 0.5]");
+  check(std::isfinite(p.min_mean_grey) && p.min_mean_grey >= 0.0 && p.min_mean_grey <= 255.0,
+        "min_mean_grey must be in [0, 255]");
   check(std::isfinite(p.max_motion) && p.max_motion > 0.0, "max_motion must be > 0");
   check(std::isfinite(p.max_corner_motion) && p.max_corner_motion > 0.0, "max_corner_motion must be > 0");
   check(std::isfinite(p.whole_frame_after_s) && p.whole_frame_after_s > 0.0, "whole_frame_after_s must be > 0 s");

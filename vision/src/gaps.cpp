@@ -42,7 +42,8 @@ void check_input(const std::vector<Chain>& chains, const GapParams& p, const Poi
   if (values.empty()) return;
   if (values.size() != chains.size()) throw hk::ArgumentError("close_gaps: values must have one entry per chain");
   for (std::size_t k = 0; k < chains.size(); ++k)
-    if (values[k].size() != chains[k].points_px.size()) throw hk::ArgumentError("close_gaps: values must have one value per chain point");
+    if (values[k].size() != chains[k].points_px.size())
+      throw hk::ArgumentError("close_gaps: values must have one value per chain point");
 }
 
 /// A possible join: its gap [px], how far it turns from the ends' directions (the larger of the two) and
@@ -87,7 +88,7 @@ std::vector<Candidate> find_candidates(const std::vector<Chain>& chains, const G
         ca = dirs[i].dot(u);
         cb = -dirs[j].dot(u);
       }
-      const double need = gap < 1.5 ? 1e-9 : min_cos;  // adjacent pixels: only not turning back
+      const double need = gap < 1.5 ? 1e-9 : min_cos;        // adjacent pixels: only not turning back
       if (ca < need - 1e-12 || cb < need - 1e-12) continue;  // "at most max_turn_deg", rounding aside
       out.push_back({gap, 1.0 - std::min(ca, cb), a, b});
     }
@@ -123,7 +124,8 @@ void append_chain(const std::vector<Chain>& chains, const PointValues& values, s
 }
 
 /// Appends the points strictly between ends `from` and `to` on the straight join, about 1 px apart.
-void fill_gap(const std::vector<Chain>& chains, const PointValues& values, int from, int to, Chain& out, std::vector<double>* vout) {
+void fill_gap(const std::vector<Chain>& chains, const PointValues& values, int from, int to, Chain& out,
+              std::vector<double>* vout) {
   const cv::Point2d a = end_point(chains, from), b = end_point(chains, to);
   const int steps = static_cast<int>(std::ceil(cv::norm(b - a) - 1e-9));
   for (int k = 1; k < steps; ++k) {
@@ -135,8 +137,8 @@ void fill_gap(const std::vector<Chain>& chains, const PointValues& values, int f
 
 /// Phase 3: walks each group of joined chains from its head (an end with no partner, or chain k itself when
 /// the group is a ring) into one chain.
-void walk_group(const std::vector<Chain>& chains, const PointValues& values, const std::vector<int>& partner, std::size_t k,
-                std::vector<char>& used, Chain& out, std::vector<double>* vout, GapStats& stats) {
+void walk_group(const std::vector<Chain>& chains, const PointValues& values, const std::vector<int>& partner,
+                std::size_t k, std::vector<char>& used, Chain& out, std::vector<double>* vout, GapStats& stats) {
   // The head: back from chain k's first end until an end with no partner, or round to chain k (a ring).
   int head = 2 * static_cast<int>(k);
   bool ring = false;
@@ -187,8 +189,8 @@ cv::Point2d end_direction(const Chain& c, bool at_start, double span_px) {
   return len > 0.0 ? d / len : cv::Point2d(0.0, 0.0);
 }
 
-std::vector<Chain> close_gaps(const std::vector<Chain>& chains, const GapParams& p, GapStats* stats, const PointValues& values,
-                              PointValues* values_out) {
+std::vector<Chain> close_gaps(const std::vector<Chain>& chains, const GapParams& p, GapStats* stats,
+                              const PointValues& values, PointValues* values_out) {
   check_input(chains, p, values);
   GapStats st;
   const std::vector<int> partner = choose_joins(find_candidates(chains, p), chains.size(), st);

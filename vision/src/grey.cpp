@@ -9,8 +9,8 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "vision/intake.hpp"
 #include "hk/error.hpp"
+#include "vision/intake.hpp"
 
 namespace hk::vision {
 
@@ -19,10 +19,17 @@ cv::Mat to_grey(const cv::Mat& bgr, int max_side_px, double* px_scale_out) {
   if (max_side_px < 1) throw hk::ArgumentError("to_grey: max_side_px must be >= 1");
   cv::Mat grey;
   switch (bgr.type()) {
-    case CV_8UC3: cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY); break;
-    case CV_8UC4: cv::cvtColor(bgr, grey, cv::COLOR_BGRA2GRAY); break;
-    case CV_8UC1: grey = bgr.clone(); break;
-    default: throw hk::ArgumentError("to_grey: expected CV_8UC3, CV_8UC4 or CV_8UC1");
+    case CV_8UC3:
+      cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+      break;
+    case CV_8UC4:
+      cv::cvtColor(bgr, grey, cv::COLOR_BGRA2GRAY);
+      break;
+    case CV_8UC1:
+      grey = bgr.clone();
+      break;
+    default:
+      throw hk::ArgumentError("to_grey: expected CV_8UC3, CV_8UC4 or CV_8UC1");
   }
   const int long_side = std::max(grey.cols, grey.rows);
   if (long_side <= max_side_px) {
@@ -30,11 +37,9 @@ cv::Mat to_grey(const cv::Mat& bgr, int max_side_px, double* px_scale_out) {
     return grey;
   }
   const double scale = static_cast<double>(long_side) / max_side_px;
-  const auto shrink = [&](int n) {
-    return std::clamp(static_cast<int>(std::lround(n / scale)), 1, max_side_px);
-  };
-  const cv::Size size = grey.cols >= grey.rows ? cv::Size(max_side_px, shrink(grey.rows))
-                                               : cv::Size(shrink(grey.cols), max_side_px);
+  const auto shrink = [&](int n) { return std::clamp(static_cast<int>(std::lround(n / scale)), 1, max_side_px); };
+  const cv::Size size =
+      grey.cols >= grey.rows ? cv::Size(max_side_px, shrink(grey.rows)) : cv::Size(shrink(grey.cols), max_side_px);
   cv::Mat small;
   cv::resize(grey, small, size, 0, 0, cv::INTER_AREA);
   if (px_scale_out != nullptr) *px_scale_out = scale;

@@ -42,8 +42,7 @@ namespace {
 /// offsets, and fill-byte runs are read byte by byte.
 class FileSource final : public ByteSource {
  public:
-  FileSource(const std::string& path, std::uint64_t size)
-      : file_(path, std::ios::binary), size_(size) {}
+  FileSource(const std::string& path, std::uint64_t size) : file_(path, std::ios::binary), size_(size) {}
   bool is_open() const { return file_.is_open(); }
   std::uint64_t size() const override { return size_; }
 
@@ -54,8 +53,7 @@ class FileSource final : public ByteSource {
       if (block_start != cached_start_ && !load(block_start)) return false;
       const std::uint64_t in_block = offset - block_start;
       if (in_block >= cached_len_) return false;
-      const std::size_t take =
-          static_cast<std::size_t>(std::min<std::uint64_t>(n, cached_len_ - in_block));
+      const std::size_t take = static_cast<std::size_t>(std::min<std::uint64_t>(n, cached_len_ - in_block));
       std::memcpy(out, block_.data() + in_block, take);
       out += take;
       offset += take;
@@ -108,8 +106,7 @@ class Reader {
   std::uint16_t u16(std::uint64_t off, bool little) {
     std::uint8_t b[2];
     bytes(off, 2, b);
-    return little ? static_cast<std::uint16_t>(b[0] | (b[1] << 8))
-                  : static_cast<std::uint16_t>((b[0] << 8) | b[1]);
+    return little ? static_cast<std::uint16_t>(b[0] | (b[1] << 8)) : static_cast<std::uint16_t>((b[0] << 8) | b[1]);
   }
   std::uint32_t u32(std::uint64_t off, bool little) {
     std::uint8_t b[4];
@@ -141,8 +138,8 @@ ImageHeader make_header(Reader& r, std::uint64_t w, std::uint64_t h, const char*
     r.corrupt("declares an empty image (" + std::to_string(w) + " x " + std::to_string(h) + " px)");
   }
   if (w > static_cast<std::uint64_t>(INT_MAX) || h > static_cast<std::uint64_t>(INT_MAX)) {
-    throw_input_error(r.path(), "declared size " + std::to_string(w) + " x " + std::to_string(h) +
-                                    " px is out of range");
+    throw_input_error(r.path(),
+                      "declared size " + std::to_string(w) + " x " + std::to_string(h) + " px is out of range");
   }
   return ImageHeader{static_cast<int>(w), static_cast<int>(h), format};
 }
@@ -235,8 +232,7 @@ HeaderDetails parse_bmp(ByteSource& src, const std::string& path) {
   }
   if (w < 0) r.corrupt("negative width " + std::to_string(w));
   if (h < 0) h = -h;  // negative height = rows stored top-down
-  return HeaderDetails{make_header(r, static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), "bmp"),
-                       false};
+  return HeaderDetails{make_header(r, static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h), "bmp"), false};
 }
 
 // ---- TIFF 6.0 (Adobe, 1992: §2 header and IFD; tags 256 ImageWidth, 257 ImageLength,
@@ -335,9 +331,7 @@ HeaderDetails parse_image_header(ByteSource& src, const std::string& path) {
   std::uint8_t m[12] = {};
   const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(src.size(), sizeof m));
   if (!src.read(0, n, m)) throw_input_error(path, "cannot read the file");
-  const auto starts = [&](const char* sig, std::size_t len) {
-    return n >= len && std::memcmp(m, sig, len) == 0;
-  };
+  const auto starts = [&](const char* sig, std::size_t len) { return n >= len && std::memcmp(m, sig, len) == 0; };
   if (starts("\x89PNG\r\n\x1A\n", 8)) return parse_png(src, path);
   if (starts("\xFF\xD8\xFF", 3)) return parse_jpeg(src, path);
   if (starts("BM", 2)) return parse_bmp(src, path);

@@ -15,9 +15,9 @@
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "hk/error.hpp"
 #include "image_header_detail.hpp"
 #include "input_error.hpp"
-#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -97,16 +97,14 @@ int decode_reduction_for(int width_px, int height_px, int keep_side_px) {
 }
 
 cv::Mat load_image(const std::string& path, const ImageLimits& limits) {
-  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
-      limits.max_pixels <= 0) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 || limits.max_pixels <= 0) {
     throw hk::ArgumentError("load_image: every ImageLimits field must be positive");
   }
   return decode_image(read_input_file(path, limits.max_file_bytes), path, limits);
 }
 
 DecodedImage load_image_reduced(const std::string& path, const ImageLimits& limits, int keep_side_px) {
-  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
-      limits.max_pixels <= 0) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 || limits.max_pixels <= 0) {
     throw hk::ArgumentError("load_image_reduced: every ImageLimits field must be positive");
   }
   return decode_image_reduced(read_input_file(path, limits.max_file_bytes), path, limits, keep_side_px);
@@ -116,14 +114,14 @@ std::vector<std::uint8_t> read_input_file(const std::string& path, std::int64_t 
   if (max_bytes <= 0) throw hk::ArgumentError("read_input_file: max_bytes must be positive");
   const std::uint64_t size = detail::checked_file_size(path);
   if (size > static_cast<std::uint64_t>(max_bytes)) {
-    detail::throw_input_error(path, "file size " + std::to_string(size) + " bytes exceeds the limit of " + std::to_string(max_bytes) + " bytes");
+    detail::throw_input_error(path, "file size " + std::to_string(size) + " bytes exceeds the limit of " +
+                                        std::to_string(max_bytes) + " bytes");
   }
   return read_all(path, size);
 }
 
 cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits) {
-  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
-      limits.max_pixels <= 0) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 || limits.max_pixels <= 0) {
     throw hk::ArgumentError("decode_image: every ImageLimits field must be positive");
   }
   return decode_image_reduced(bytes, path, limits, 0).bgr;
@@ -133,14 +131,16 @@ namespace {
 
 /// The header of `bytes`, checked before any pixel is decoded: declared width, height and pixel count
 /// within `limits`, and a JPEG's stream reaching its end-of-image marker. Throws InputError naming `path`.
-detail::HeaderDetails checked_header(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits) {
+detail::HeaderDetails checked_header(std::span<const std::uint8_t> bytes, const std::string& path,
+                                     const ImageLimits& limits) {
   detail::MemorySource src(bytes);
   detail::HeaderDetails hd = detail::parse_image_header(src, path);
   const ImageHeader& h = hd.header;
-  const std::string declared = "declared size " + std::to_string(h.width_px) + " x " + std::to_string(h.height_px) + " px";
+  const std::string declared =
+      "declared size " + std::to_string(h.width_px) + " x " + std::to_string(h.height_px) + " px";
   if (h.width_px > limits.max_width_px || h.height_px > limits.max_height_px) {
-    detail::throw_input_error(path, declared + " exceeds the limit of " + std::to_string(limits.max_width_px) +
-                                        " x " + std::to_string(limits.max_height_px) + " px");
+    detail::throw_input_error(path, declared + " exceeds the limit of " + std::to_string(limits.max_width_px) + " x " +
+                                        std::to_string(limits.max_height_px) + " px");
   }
   const std::int64_t pixels = std::int64_t{h.width_px} * h.height_px;
   if (pixels > limits.max_pixels) {
@@ -148,7 +148,8 @@ detail::HeaderDetails checked_header(std::span<const std::uint8_t> bytes, const 
                                         std::to_string(limits.max_pixels) + " pixels");
   }
   if (h.format == "jpeg" && !detail::jpeg_is_complete(bytes)) {
-    detail::throw_input_error(path, "truncated or corrupt JPEG: the stream does not reach its end-of-image marker (0xFFD9)");
+    detail::throw_input_error(path,
+                              "truncated or corrupt JPEG: the stream does not reach its end-of-image marker (0xFFD9)");
   }
   return hd;
 }
@@ -187,10 +188,9 @@ cv::Mat decoded_by_opencv(std::span<const std::uint8_t> bytes, const detail::Hea
 
 }  // namespace
 
-DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& path, const ImageLimits& limits,
-                                  int keep_side_px) {
-  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 ||
-      limits.max_pixels <= 0) {
+DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& path,
+                                  const ImageLimits& limits, int keep_side_px) {
+  if (limits.max_file_bytes <= 0 || limits.max_width_px <= 0 || limits.max_height_px <= 0 || limits.max_pixels <= 0) {
     throw hk::ArgumentError("decode_image_reduced: every ImageLimits field must be positive");
   }
   if (bytes.empty()) detail::throw_input_error(path, "empty file (0 bytes)");
@@ -200,7 +200,8 @@ DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std
   }
   const detail::HeaderDetails hd = checked_header(bytes, path, limits);
   const ImageHeader& h = hd.header;
-  const std::string declared = "declared size " + std::to_string(h.width_px) + " x " + std::to_string(h.height_px) + " px";
+  const std::string declared =
+      "declared size " + std::to_string(h.width_px) + " x " + std::to_string(h.height_px) + " px";
 
   std::vector<std::uint8_t> png_storage;
   std::span<const std::uint8_t> to_decode = bytes;
@@ -213,7 +214,8 @@ DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std
   // stderr. Other decoders would decode in full and resize.
   const bool png_by_rows = h.format == "png" && detail::png_decodes_by_rows(to_decode);
   const int scale = h.format == "jpeg" || png_by_rows ? decode_reduction_for(h.width_px, h.height_px, keep_side_px) : 1;
-  const cv::Mat bgr = png_by_rows ? detail::decode_png_by_rows(to_decode, path, scale) : decoded_by_opencv(to_decode, hd, scale);
+  const cv::Mat bgr =
+      png_by_rows ? detail::decode_png_by_rows(to_decode, path, scale) : decoded_by_opencv(to_decode, hd, scale);
   if (bgr.empty()) {
     detail::throw_input_error(path, "the " + h.format + " data could not be decoded (corrupt or unsupported)");
   }
@@ -221,8 +223,9 @@ DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std
   const bool as_declared = bgr.cols == want_w && bgr.rows == want_h;
   const bool transposed = bgr.cols == want_h && bgr.rows == want_w;  // EXIF rotation
   if (!as_declared && !transposed) {
-    detail::throw_input_error(path, "decoded size " + std::to_string(bgr.cols) + " x " + std::to_string(bgr.rows) + " px differs from the " +
-                                        declared + (scale > 1 ? " reduced to 1/" + std::to_string(scale) : std::string()));
+    detail::throw_input_error(path, "decoded size " + std::to_string(bgr.cols) + " x " + std::to_string(bgr.rows) +
+                                        " px differs from the " + declared +
+                                        (scale > 1 ? " reduced to 1/" + std::to_string(scale) : std::string()));
   }
   if (bgr.type() != CV_8UC3) {
     detail::throw_input_error(path, "decoder returned an unexpected pixel type");

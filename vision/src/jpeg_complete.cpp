@@ -23,8 +23,8 @@ bool jpeg_is_complete(std::span<const std::uint8_t> d) {
     while (pos < n && d[pos] == 0xFF) ++pos;
     if (pos >= n) return false;
     const std::uint8_t marker = d[pos++];
-    if (marker == 0xD9) return true;                                      // EOI
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;   // no length field
+    if (marker == 0xD9) return true;                                     // EOI
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;  // no length field
     if (marker == 0x00 || marker == 0xD8) return false;
     if (n - pos < 2) return false;
     const std::size_t len = (std::size_t{d[pos]} << 8) | d[pos + 1];

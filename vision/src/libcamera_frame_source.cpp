@@ -147,9 +147,9 @@ struct FormatChoice {
 // R, G, B, XRGB8888 is B, G, R, X (libcamera formats.yaml / include/uapi/drm/drm_fourcc.h).
 const std::vector<FormatChoice>& format_choices() {
   static const std::vector<FormatChoice> choices = {
-      {lc::formats::RGB888, Conversion::Copy},         {lc::formats::BGR888, Conversion::SwapRB},
-      {lc::formats::XRGB8888, Conversion::DropX},      {lc::formats::XBGR8888, Conversion::DropXSwapRB},
-      {lc::formats::YUYV, Conversion::Yuyv},           {lc::formats::NV12, Conversion::Nv12},
+      {lc::formats::RGB888, Conversion::Copy},    {lc::formats::BGR888, Conversion::SwapRB},
+      {lc::formats::XRGB8888, Conversion::DropX}, {lc::formats::XBGR8888, Conversion::DropXSwapRB},
+      {lc::formats::YUYV, Conversion::Yuyv},      {lc::formats::NV12, Conversion::Nv12},
       {lc::formats::MJPEG, Conversion::Jpeg},
   };
   return choices;
@@ -230,9 +230,7 @@ class LibcameraFrameSource final : public FrameSource {
     }
   }
 
-  std::string name() const override {
-    return "libcamera camera " + std::to_string(spec_.index) + " (" + model_ + ")";
-  }
+  std::string name() const override { return "libcamera camera " + std::to_string(spec_.index) + " (" + model_ + ")"; }
 
   bool next(Frame& out, double timeout_s) override {
     using Clock = std::chrono::steady_clock;
@@ -458,8 +456,8 @@ class LibcameraFrameSource final : public FrameSource {
     const auto h = static_cast<std::size_t>(height_);
     cv::Mat bgr;
     const auto short_frame = [&](std::size_t need) {
-      fail("frame " + std::to_string(next_index_) + " is " + std::to_string(total) + " bytes, " +
-           std::to_string(need) + " expected");
+      fail("frame " + std::to_string(next_index_) + " is " + std::to_string(total) + " bytes, " + std::to_string(need) +
+           " expected");
     };
     switch (conversion_) {
       case Conversion::Copy:
@@ -472,11 +470,21 @@ class LibcameraFrameSource final : public FrameSource {
         const int type = conversion_ == Conversion::Yuyv ? CV_8UC2 : (bytes_per_pixel() == 4 ? CV_8UC4 : CV_8UC3);
         const cv::Mat src(height_, width_, type, data, stride_);
         switch (conversion_) {
-          case Conversion::Copy: bgr = src.clone(); break;
-          case Conversion::SwapRB: cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR); break;
-          case Conversion::DropX: cv::cvtColor(src, bgr, cv::COLOR_BGRA2BGR); break;
-          case Conversion::DropXSwapRB: cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGR); break;
-          default: cv::cvtColor(src, bgr, cv::COLOR_YUV2BGR_YUYV); break;
+          case Conversion::Copy:
+            bgr = src.clone();
+            break;
+          case Conversion::SwapRB:
+            cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR);
+            break;
+          case Conversion::DropX:
+            cv::cvtColor(src, bgr, cv::COLOR_BGRA2BGR);
+            break;
+          case Conversion::DropXSwapRB:
+            cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGR);
+            break;
+          default:
+            cv::cvtColor(src, bgr, cv::COLOR_YUV2BGR_YUYV);
+            break;
         }
         return bgr;
       }
@@ -496,10 +504,12 @@ class LibcameraFrameSource final : public FrameSource {
         }
         cv::Mat packed(height_ + height_ / 2, width_, CV_8UC1);
         for (int y = 0; y < height_; ++y) {
-          std::memcpy(packed.ptr(y), work_.data() + stride_ * static_cast<std::size_t>(y), static_cast<std::size_t>(width_));
+          std::memcpy(packed.ptr(y), work_.data() + stride_ * static_cast<std::size_t>(y),
+                      static_cast<std::size_t>(width_));
         }
         for (int y = 0; y < height_ / 2; ++y) {
-          std::memcpy(packed.ptr(height_ + y), uv + stride_ * static_cast<std::size_t>(y), static_cast<std::size_t>(width_));
+          std::memcpy(packed.ptr(height_ + y), uv + stride_ * static_cast<std::size_t>(y),
+                      static_cast<std::size_t>(width_));
         }
         cv::cvtColor(packed, bgr, cv::COLOR_YUV2BGR_NV12);
         return bgr;
@@ -548,12 +558,12 @@ class LibcameraFrameSource final : public FrameSource {
 
   std::mutex mutex_;
   std::condition_variable ready_;
-  std::vector<std::uint8_t> slot_;          ///< the latest frame's planes, back to back (guarded by mutex_)
-  std::vector<std::size_t> slot_planes_;    ///< their sizes [bytes] (guarded by mutex_)
-  double slot_t_s_ = 0.0;                   ///< its capture time [s] (guarded by mutex_)
-  bool slot_full_ = false;                  ///< a frame waits in the slot (guarded by mutex_)
-  std::string failure_;                     ///< why the camera stopped, once it has (guarded by mutex_)
-  std::vector<std::uint8_t> work_;          ///< the frame being converted (caller's thread)
+  std::vector<std::uint8_t> slot_;        ///< the latest frame's planes, back to back (guarded by mutex_)
+  std::vector<std::size_t> slot_planes_;  ///< their sizes [bytes] (guarded by mutex_)
+  double slot_t_s_ = 0.0;                 ///< its capture time [s] (guarded by mutex_)
+  bool slot_full_ = false;                ///< a frame waits in the slot (guarded by mutex_)
+  std::string failure_;                   ///< why the camera stopped, once it has (guarded by mutex_)
+  std::vector<std::uint8_t> work_;        ///< the frame being converted (caller's thread)
   std::vector<std::size_t> work_planes_;
   std::uint64_t next_index_ = 0;
 };

@@ -50,9 +50,9 @@ constexpr bool has(unsigned mask, int d) { return ((mask >> (d & 7)) & 1U) != 0;
 
 // Segments shorter than these are Canny artefacts at corners, not shape (a few pixels are a
 // fraction of a millimetre on the device); they must not cut a boundary into pieces.
-constexpr double kSpurPx = 3.0;       // a branch from a junction to a free end
-constexpr double kShortPx = 3.0;      // one of several branches joining the same two junctions
-constexpr double kTinyLoopPx = 5.0;   // a loop from a junction back to itself (a 2x2 block)
+constexpr double kSpurPx = 3.0;      // a branch from a junction to a free end
+constexpr double kShortPx = 3.0;     // one of several branches joining the same two junctions
+constexpr double kTinyLoopPx = 5.0;  // a loop from a junction back to itself (a 2x2 block)
 
 // Everything the linker decides about a pixel depends only on which of its 8 neighbours are
 // edge pixels: an 8-bit mask, bit d = direction d. The rules are tabulated once.
@@ -64,8 +64,8 @@ constexpr bool is_staircase_corner(unsigned n) {
   if (has(n, 0) + has(n, 2) + has(n, 4) + has(n, 6) != 2) return false;
   for (int d = 0; d < 8; d += 2) {  // u = direction d, v = direction d + 2 (perpendicular)
     if (!has(n, d) || !has(n, d + 2)) continue;
-    const bool inner_empty = !has(n, d + 5);                  // p - u - v
-    const bool side_set = has(n, d + 7) || has(n, d + 3);     // p + u - v, p - u + v
+    const bool inner_empty = !has(n, d + 5);               // p - u - v
+    const bool side_set = has(n, d + 7) || has(n, d + 3);  // p + u - v, p - u + v
     return inner_empty && side_set;
   }
   return false;
@@ -151,8 +151,7 @@ class Linker {
     link_segments_at_junctions();
     assemble();
     // Output order: raster index of the first point, ties in discovery order.
-    std::stable_sort(found_.begin(), found_.end(),
-                     [](const Found& a, const Found& b) { return a.first < b.first; });
+    std::stable_sort(found_.begin(), found_.end(), [](const Found& a, const Found& b) { return a.first < b.first; });
     std::vector<Chain> chains;
     chains.reserve(found_.size());
     for (const Found& f : found_) {
@@ -179,9 +178,9 @@ class Linker {
     std::size_t begin = 0;
     std::size_t end = 0;
     std::size_t front_end = 0;  // index in ends_ of the first pixel (segments from pass 1)
-    bool cycle = false;   // a cycle without junctions
-    bool minor = false;   // a corner artefact, kept as its own chain (see kSpurPx)
-    double length = 0.0;  // polyline length [px] (of an open walk; cycles: unused)
+    bool cycle = false;         // a cycle without junctions
+    bool minor = false;         // a corner artefact, kept as its own chain (see kSpurPx)
+    double length = 0.0;        // polyline length [px] (of an open walk; cycles: unused)
     std::size_t size() const { return end - begin; }
   };
   /// One output chain: out_pix_[begin, begin + count), raster index of its first point.
@@ -404,7 +403,7 @@ class Linker {
   void link_segments_at_junctions() {
     link_.assign(2 * segs_.size(), -1);
     struct Junction {
-      int count = 0;                    // segment ends here
+      int count = 0;                      // segment ends here
       std::array<std::int64_t, 2> end{};  // the first two of them
     };
     std::vector<Junction> at(ends_.size());  // by index in ends_ (junctions are among them)
@@ -560,8 +559,11 @@ class Linker {
 double chain_length_px(const Chain& chain) {
   const auto& p = chain.points_px;
   double len = 0.0;
-  // sqrt of the squared length, not std::hypot: pixel steps are far from overflow, and hypot costs several times as much.
-  const auto step = [](cv::Point2d a, cv::Point2d b) { return std::sqrt((b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y)); };
+  // sqrt of the squared length, not std::hypot: pixel steps are far from overflow, and hypot costs several times as
+  // much.
+  const auto step = [](cv::Point2d a, cv::Point2d b) {
+    return std::sqrt((b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y));
+  };
   for (std::size_t i = 1; i < p.size(); ++i) len += step(p[i - 1], p[i]);
   if (chain.closed && p.size() > 1) len += step(p.back(), p.front());
   return len;

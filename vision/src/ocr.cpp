@@ -12,10 +12,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hk/error.hpp"
 #include "hk/text.hpp"
 #include "ocr_wire.hpp"
 #include "worker_process.hpp"
-#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -33,25 +33,30 @@ constexpr std::size_t kMaxAnswerBytes = 64u << 20;
 [[noreturn]] void fail_run(const worker::WorkerRun& run, const std::string& name, const OcrParams& p) {
   const double cpu_limit = std::ceil(std::max(p.worker_cpu_s, 0.001));
   if (run.cancelled) fail(OcrError::Kind::Cancelled, name, "reading the text was cancelled");
-  if (run.timed_out) fail(OcrError::Kind::Timeout, name, "reading the text took longer than " + worker::arg(p.worker_wall_s) + " s");
+  if (run.timed_out)
+    fail(OcrError::Kind::Timeout, name, "reading the text took longer than " + worker::arg(p.worker_wall_s) + " s");
   if (run.overflow) fail(OcrError::Kind::WorkerCrashed, name, "the text reader sent an oversized answer");
   if (WIFSIGNALED(run.status)) {
     const int sig = WTERMSIG(run.status);
     if (sig == SIGXCPU || (sig == SIGKILL && run.cpu_s >= cpu_limit)) {
-      fail(OcrError::Kind::Timeout, name, "reading the text used more than " + worker::arg(cpu_limit) + " s of processor time");
+      fail(OcrError::Kind::Timeout, name,
+           "reading the text used more than " + worker::arg(cpu_limit) + " s of processor time");
     }
     fail(OcrError::Kind::WorkerCrashed, name, "the text reader stopped (signal " + std::to_string(sig) + ")");
   }
   if (WIFEXITED(run.status) && WEXITSTATUS(run.status) != 0) {
-    fail(OcrError::Kind::WorkerCrashed, name, "the text reader stopped (exit status " + std::to_string(WEXITSTATUS(run.status)) + ")");
+    fail(OcrError::Kind::WorkerCrashed, name,
+         "the text reader stopped (exit status " + std::to_string(WEXITSTATUS(run.status)) + ")");
   }
   fail(OcrError::Kind::WorkerCrashed, name, "the text reader gave no usable answer");
 }
 
 void check_params(const cv::Mat& grey, const OcrParams& p) {
-  if (grey.empty() || grey.type() != CV_8UC1) throw hk::ArgumentError("recognise_text: the picture must be a non-empty CV_8UC1 image");
-  if (!(p.max_pixels > 0 && p.worker_cpu_s > 0 && p.worker_wall_s > 0 && p.worker_max_memory_mb >= 0 && p.min_word_confidence >= 0 &&
-        p.min_word_confidence <= 1 && p.min_letter_share >= 0 && p.min_letter_share <= 1)) {
+  if (grey.empty() || grey.type() != CV_8UC1)
+    throw hk::ArgumentError("recognise_text: the picture must be a non-empty CV_8UC1 image");
+  if (!(p.max_pixels > 0 && p.worker_cpu_s > 0 && p.worker_wall_s > 0 && p.worker_max_memory_mb >= 0 &&
+        p.min_word_confidence >= 0 && p.min_word_confidence <= 1 && p.min_letter_share >= 0 &&
+        p.min_letter_share <= 1)) {
     throw hk::ArgumentError("OcrParams: limits must be positive and shares within [0, 1]");
   }
 }
@@ -59,7 +64,8 @@ void check_params(const cv::Mat& grey, const OcrParams& p) {
 /// The picture's rows, packed (the worker reads width x height bytes).
 std::vector<std::uint8_t> packed(const cv::Mat& grey) {
   std::vector<std::uint8_t> px(static_cast<std::size_t>(grey.cols) * static_cast<std::size_t>(grey.rows));
-  for (int y = 0; y < grey.rows; ++y) std::copy_n(grey.ptr<std::uint8_t>(y), grey.cols, px.data() + static_cast<std::size_t>(y) * grey.cols);
+  for (int y = 0; y < grey.rows; ++y)
+    std::copy_n(grey.ptr<std::uint8_t>(y), grey.cols, px.data() + static_cast<std::size_t>(y) * grey.cols);
   return px;
 }
 
@@ -67,7 +73,8 @@ std::vector<std::uint8_t> packed(const cv::Mat& grey) {
 /// below p.min_word_confidence stands in the block's text as kUnclearWord.
 bool read_block(worker::WireReader& in, const OcrParams& p, OcrResult& out, double& confidence_sum) {
   std::uint32_t lines = 0, words = 0;
-  if (!in.u32(lines) || !in.u32(words) || words == 0 || words > kMaxWords || out.words.size() + words > kMaxWords || lines == 0 || lines > words) {
+  if (!in.u32(lines) || !in.u32(words) || words == 0 || words > kMaxWords || out.words.size() + words > kMaxWords ||
+      lines == 0 || lines > words) {
     return false;
   }
   OcrBlock b;
@@ -75,8 +82,9 @@ bool read_block(worker::WireReader& in, const OcrParams& p, OcrResult& out, doub
   double block_sum = 0;
   for (std::uint32_t i = 0; i < words; ++i) {
     OcrWord w;
-    if (!in.str(w.text, kMaxWordBytes) || w.text.empty() || !in.f64(w.box_px.x) || !in.f64(w.box_px.y) || !in.f64(w.box_px.width) || !in.f64(w.box_px.height) ||
-        !in.f64(w.confidence) || w.confidence < 0 || w.confidence > 1 || w.box_px.width < 0 || w.box_px.height < 0) {
+    if (!in.str(w.text, kMaxWordBytes) || w.text.empty() || !in.f64(w.box_px.x) || !in.f64(w.box_px.y) ||
+        !in.f64(w.box_px.width) || !in.f64(w.box_px.height) || !in.f64(w.confidence) || w.confidence < 0 ||
+        w.confidence > 1 || w.box_px.width < 0 || w.box_px.height < 0) {
       return false;
     }
     b.box_px = i == 0 ? w.box_px : (b.box_px | w.box_px);
@@ -93,7 +101,8 @@ bool read_block(worker::WireReader& in, const OcrParams& p, OcrResult& out, doub
 }  // namespace
 
 std::string ocr_languages_problem(const OcrParams& p) {
-  if (p.languages.empty() || p.languages.size() > 200) return "the OCR languages must be 1 to 200 characters, e.g. \"eng\" or \"eng+deu\"";
+  if (p.languages.empty() || p.languages.size() > 200)
+    return "the OCR languages must be 1 to 200 characters, e.g. \"eng\" or \"eng+deu\"";
   const std::string dir = p.tessdata_dir.empty() ? std::string("/usr/share/tesseract-ocr/5/tessdata") : p.tessdata_dir;
   std::size_t from = 0;
   while (from <= p.languages.size()) {
@@ -102,9 +111,12 @@ std::string ocr_languages_problem(const OcrParams& p) {
     const bool name_ok = !lang.empty() && lang.size() <= 32 && std::all_of(lang.begin(), lang.end(), [](char c) {
       return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
     });
-    if (!name_ok) return "'" + hk::one_line(p.languages, 80) + "' is not a '+'-joined list of Tesseract languages, e.g. \"eng+deu\"";
+    if (!name_ok)
+      return "'" + hk::one_line(p.languages, 80) +
+             "' is not a '+'-joined list of Tesseract languages, e.g. \"eng+deu\"";
     const std::string file = dir + "/" + lang + ".traineddata";
-    if (::access(file.c_str(), R_OK) != 0) return "Tesseract has no '" + lang + "' (no " + lang + ".traineddata in " + hk::one_line(dir, 200) + ")";
+    if (::access(file.c_str(), R_OK) != 0)
+      return "Tesseract has no '" + lang + "' (no " + lang + ".traineddata in " + hk::one_line(dir, 200) + ")";
     from = plus + 1;
   }
   return {};
@@ -119,7 +131,9 @@ OcrResult read_ocr_answer(const worker::WorkerRun& run, const std::string& name,
   if (status == 1) {
     std::uint8_t kind = 0;
     std::string problem;
-    if (!in.u8(kind) || kind > static_cast<std::uint8_t>(OcrError::Kind::WorkerCrashed) || !in.str(problem, kMaxProblemBytes)) fail_run(run, name, p);
+    if (!in.u8(kind) || kind > static_cast<std::uint8_t>(OcrError::Kind::WorkerCrashed) ||
+        !in.str(problem, kMaxProblemBytes))
+      fail_run(run, name, p);
     fail(static_cast<OcrError::Kind>(kind), name, hk::one_line(problem, kMaxProblemBytes));
   }
   OcrResult out;
@@ -140,8 +154,9 @@ OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const Ocr
   check_params(grey, p);
   const double pixels = static_cast<double>(grey.cols) * grey.rows;
   if (pixels > p.max_pixels) {
-    fail(OcrError::Kind::TooLarge, name, std::to_string(grey.cols) + " x " + std::to_string(grey.rows) + " pixels is over the limit of " +
-                                             worker::arg(p.max_pixels));
+    fail(OcrError::Kind::TooLarge, name,
+         std::to_string(grey.cols) + " x " + std::to_string(grey.rows) + " pixels is over the limit of " +
+             worker::arg(p.max_pixels));
   }
   if (const std::string why = ocr_languages_problem(p); !why.empty()) fail(OcrError::Kind::Unavailable, name, why);
 #ifdef HK_OCR_WORKER_PATH
@@ -151,7 +166,8 @@ OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const Ocr
 #endif
   worker::WorkerRun run;
   try {
-    run = worker::run_worker(path, ocr_request_args(grey.cols, grey.rows, p), packed(grey), p.worker_wall_s, kMaxAnswerBytes, p.cancel);
+    run = worker::run_worker(path, ocr_request_args(grey.cols, grey.rows, p), packed(grey), p.worker_wall_s,
+                             kMaxAnswerBytes, p.cancel);
   } catch (const worker::WorkerStartFailure& f) {
     fail(OcrError::Kind::WorkerCrashed, name, "cannot start the text reader (" + f.why + ")");
   }
@@ -173,8 +189,8 @@ std::vector<std::pair<cv::Rect, int>> components(const cv::Mat& binary, cv::Mat&
   std::vector<std::pair<cv::Rect, int>> out;
   out.reserve(static_cast<std::size_t>(std::max(0, n - 1)));
   for (int i = 1; i < n; ++i) {
-    out.push_back({cv::Rect(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP), stats.at<int>(i, cv::CC_STAT_WIDTH),
-                            stats.at<int>(i, cv::CC_STAT_HEIGHT)),
+    out.push_back({cv::Rect(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP),
+                            stats.at<int>(i, cv::CC_STAT_WIDTH), stats.at<int>(i, cv::CC_STAT_HEIGHT)),
                    stats.at<int>(i, cv::CC_STAT_AREA)});
   }
   return out;
@@ -192,7 +208,8 @@ PrintedLetters printed_letters(const cv::Mat& ink, double side, cv::Mat& labels)
   const auto all = components(ink, labels);
   std::vector<Blob> letters;  // by bottom
   for (const auto& [r, area] : all)
-    if (r.height >= 0.006 * side && r.height <= 0.06 * side && r.width <= 3 * r.height) letters.push_back({r.y + r.height, r.x, r.x + r.width, r.height});
+    if (r.height >= 0.006 * side && r.height <= 0.06 * side && r.width <= 3 * r.height)
+      letters.push_back({r.y + r.height, r.x, r.x + r.width, r.height});
   if (letters.size() < 60 || static_cast<double>(letters.size()) < 0.4 * static_cast<double>(all.size())) return out;
   std::vector<int> heights;
   for (const Blob& l : letters) heights.push_back(l.height);
@@ -204,7 +221,8 @@ PrintedLetters printed_letters(const cv::Mat& ink, double side, cv::Mat& labels)
   for (std::size_t i = 0, from = 0; i < letters.size(); ++i) {
     while (letters[i].bottom - letters[from].bottom > tolerance) ++from;
     int beside = 0;
-    for (std::size_t j = from; j < letters.size() && letters[j].bottom - letters[i].bottom <= tolerance && beside < 2; ++j) {
+    for (std::size_t j = from; j < letters.size() && letters[j].bottom - letters[i].bottom <= tolerance && beside < 2;
+         ++j) {
       if (j == i) continue;
       const int gap = std::max(letters[j].left - letters[i].right, letters[i].left - letters[j].right);
       beside += gap <= 2 * median;
@@ -225,7 +243,8 @@ bool a_line_of_large_letters(const cv::Mat& side_up, double side, cv::Mat& label
   std::vector<Blob> letters;
   for (const auto& [r, area] : components(side_up, labels)) {
     const double fill = static_cast<double>(area) / (static_cast<double>(r.width) * r.height);
-    if (r.height >= 0.03 * side && r.height <= 0.3 * side && r.width >= 0.15 * r.height && r.width <= 1.2 * r.height && fill >= 0.15 && fill <= 0.7)
+    if (r.height >= 0.03 * side && r.height <= 0.3 * side && r.width >= 0.15 * r.height && r.width <= 1.2 * r.height &&
+        fill >= 0.15 && fill <= 0.7)
       letters.push_back({r.y + r.height, r.x, r.x + r.width, r.height});
   }
   std::sort(letters.begin(), letters.end(), [](const Blob& a, const Blob& b) { return a.left < b.left; });
@@ -272,7 +291,8 @@ cv::Mat printed_letters_mask(const cv::Mat& grey) {
   cv::Mat mask(grey.size(), CV_8UC1, cv::Scalar(0));
   const int grow = static_cast<int>(std::ceil(0.5 * letters.median_height));
   for (const Blob& b : letters.on_lines) {
-    cv::rectangle(mask, cv::Point(b.left - grow, b.bottom - b.height - grow), cv::Point(b.right - 1 + grow, b.bottom - 1 + grow), cv::Scalar(255), cv::FILLED);
+    cv::rectangle(mask, cv::Point(b.left - grow, b.bottom - b.height - grow),
+                  cv::Point(b.right - 1 + grow, b.bottom - 1 + grow), cv::Scalar(255), cv::FILLED);
   }
   return mask;
 }

@@ -13,7 +13,8 @@ namespace hk::vision {
 namespace {
 
 void check_grey(const cv::Mat& grey, const char* who) {
-  if (grey.empty() || grey.type() != CV_8UC1) throw hk::ArgumentError(std::string(who) + ": the image must be CV_8UC1 and not empty");
+  if (grey.empty() || grey.type() != CV_8UC1)
+    throw hk::ArgumentError(std::string(who) + ": the image must be CV_8UC1 and not empty");
 }
 
 bool on_frame(const cv::Point& p, int w, int h) { return p.x == 0 || p.y == 0 || p.x == w - 1 || p.y == h - 1; }
@@ -23,7 +24,8 @@ long frame_count(const cv::Mat& mask) {
   long n = 0;
   const int w = mask.cols, h = mask.rows;
   for (int x = 0; x < w; ++x) n += (mask.at<std::uint8_t>(0, x) != 0) + (h > 1 && mask.at<std::uint8_t>(h - 1, x) != 0);
-  for (int y = 1; y + 1 < h; ++y) n += (mask.at<std::uint8_t>(y, 0) != 0) + (w > 1 && mask.at<std::uint8_t>(y, w - 1) != 0);
+  for (int y = 1; y + 1 < h; ++y)
+    n += (mask.at<std::uint8_t>(y, 0) != 0) + (w > 1 && mask.at<std::uint8_t>(y, w - 1) != 0);
   return n;
 }
 

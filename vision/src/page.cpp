@@ -68,15 +68,18 @@ Quad order_corners(Quad q) {
 std::optional<std::pair<double, double>> clip_segment(cv::Point2d a, cv::Point2d b, cv::Size size, double m) {
   double t0 = 0.0, t1 = 1.0;
   const cv::Point2d d = b - a;
-  const std::array<std::pair<double, double>, 4> pq{{{-d.x, a.x - m}, {d.x, size.width - 1 - m - a.x}, {-d.y, a.y - m}, {d.y, size.height - 1 - m - a.y}}};
+  const std::array<std::pair<double, double>, 4> pq{
+      {{-d.x, a.x - m}, {d.x, size.width - 1 - m - a.x}, {-d.y, a.y - m}, {d.y, size.height - 1 - m - a.y}}};
   for (const auto& [p, q] : pq) {
     if (p == 0.0) {
       if (q < 0.0) return std::nullopt;
       continue;
     }
     const double r = q / p;
-    if (p < 0.0) t0 = std::max(t0, r);
-    else t1 = std::min(t1, r);
+    if (p < 0.0)
+      t0 = std::max(t0, r);
+    else
+      t1 = std::min(t1, r);
   }
   if (t1 - t0 <= 0.0) return std::nullopt;
   return std::make_pair(t0, t1);
@@ -84,7 +87,10 @@ std::optional<std::pair<double, double>> clip_segment(cv::Point2d a, cv::Point2d
 
 /// Area of the part of `q` (convex) inside the frame [px²].
 double visible_area(const Quad& q, cv::Size size) {
-  std::vector<cv::Point2f> quad, rect{{-0.5f, -0.5f}, {size.width - 0.5f, -0.5f}, {size.width - 0.5f, size.height - 0.5f}, {-0.5f, size.height - 0.5f}};
+  std::vector<cv::Point2f> quad, rect{{-0.5f, -0.5f},
+                                      {size.width - 0.5f, -0.5f},
+                                      {size.width - 0.5f, size.height - 0.5f},
+                                      {-0.5f, size.height - 0.5f}};
   for (const cv::Point2d& p : q) quad.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
   if (signed_area(q) < 0) std::reverse(quad.begin(), quad.end());
   std::vector<cv::Point2f> both;
@@ -95,14 +101,16 @@ double visible_area(const Quad& q, cv::Size size) {
 /// i, tangential offset j and normal offset k: n_pos rows of (n_tan · n_off) pixels, j-major, same type as `image`
 /// (bilinear, border replicated). The result is a view of a buffer kept per thread and reused by the next call
 /// (this runs a few hundred times per frame; reusing the buffers keeps it from allocating each time).
-cv::Mat sample_across(const cv::Mat& image, const std::vector<cv::Point2d>& base, cv::Point2d tangent, cv::Point2d normal,
-                      const std::vector<double>& tan_offsets, const std::vector<double>& normal_offsets) {
+cv::Mat sample_across(const cv::Mat& image, const std::vector<cv::Point2d>& base, cv::Point2d tangent,
+                      cv::Point2d normal, const std::vector<double>& tan_offsets,
+                      const std::vector<double>& normal_offsets) {
   const int n_pos = static_cast<int>(base.size());
   const int n_tan = static_cast<int>(tan_offsets.size()), n_off = static_cast<int>(normal_offsets.size());
   thread_local cv::Mat map_buffer, out_buffers[2];  // out: grey, colour
   const auto view = [](cv::Mat& buffer, int rows, int cols, int type) {
     if (buffer.type() != type || buffer.rows < rows || buffer.cols < cols)
-      buffer.create(std::max(rows, buffer.type() == type ? buffer.rows : 0), std::max(cols, buffer.type() == type ? buffer.cols : 0), type);
+      buffer.create(std::max(rows, buffer.type() == type ? buffer.rows : 0),
+                    std::max(cols, buffer.type() == type ? buffer.cols : 0), type);
     return buffer(cv::Rect(0, 0, cols, rows));
   };
   cv::Mat map = view(map_buffer, n_pos, n_tan * n_off, CV_32FC2);
@@ -122,13 +130,15 @@ cv::Mat sample_across(const cv::Mat& image, const std::vector<cv::Point2d>& base
 }
 
 /// Positions spread along a → b over [t0, t1], those at least `margin` inside the frame.
-std::vector<cv::Point2d> positions_along(cv::Point2d a, cv::Point2d b, int n, double t0, double t1, cv::Size frame, double margin) {
+std::vector<cv::Point2d> positions_along(cv::Point2d a, cv::Point2d b, int n, double t0, double t1, cv::Size frame,
+                                         double margin) {
   std::vector<cv::Point2d> out;
   out.reserve(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     const double t = t0 + (t1 - t0) * (n == 1 ? 0.5 : static_cast<double>(i) / (n - 1));
     const cv::Point2d p = a + t * (b - a);
-    if (p.x >= margin && p.y >= margin && p.x <= frame.width - 1 - margin && p.y <= frame.height - 1 - margin) out.push_back(p);
+    if (p.x >= margin && p.y >= margin && p.x <= frame.width - 1 - margin && p.y <= frame.height - 1 - margin)
+      out.push_back(p);
   }
   return out;
 }
@@ -147,8 +157,8 @@ struct EdgePoints {
 /// sub-pixel precision (parabola through the peak). The profiles across the side are sampled every 0.5 px
 /// (cv::remap, bilinear), averaged over 5 samples along the side (less noise, no blur across it), smoothed across
 /// it (Gaussian, σ = smooth_px x unit) and differentiated ([-1 0 1]). `unit`: frame px per downscaled px.
-EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double window, double unit, double t0 = 0.05, double t1 = 0.95,
-                       bool nearest = false, double smooth_px = 0.75) {
+EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double window, double unit, double t0 = 0.05,
+                       double t1 = 0.95, bool nearest = false, double smooth_px = 0.75) {
   const cv::Point2d d = b - a;
   const double len = std::hypot(d.x, d.y);
   const cv::Point2d t = d / len, n(t.y, -t.x);
@@ -184,7 +194,8 @@ EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, doubl
   mag2 = mag2.reshape(1, rows);
   cv::Mat der;
   cv::sqrt(mag2, der);
-  const int lo = half - static_cast<int>(std::floor(window / kStep)), hi = half + static_cast<int>(std::floor(window / kStep));
+  const int lo = half - static_cast<int>(std::floor(window / kStep)),
+            hi = half + static_cast<int>(std::floor(window / kStep));
   for (int i = 0; i < der.rows; ++i) {
     const float* g = der.ptr<float>(i);
     int best = -1;
@@ -197,11 +208,13 @@ EdgePoints edge_points(const cv::Mat& image, cv::Point2d a, cv::Point2d b, doubl
     }
     if (nearest && best >= 0) {  // the peak nearest the side among those at least 0.4 x the strongest
       for (int k = std::max(lo, 1) + 1; k < std::min(hi, n_off - 2); ++k) {
-        if (g[k] >= 0.4f * best_v && g[k] >= g[k - 1] && g[k] > g[k + 1] && std::abs(k - half) < std::abs(best - half)) best = k;
+        if (g[k] >= 0.4f * best_v && g[k] >= g[k - 1] && g[k] > g[k + 1] && std::abs(k - half) < std::abs(best - half))
+          best = k;
       }
       best_v = g[best];
     }
-    if (best <= std::max(lo, 1) || best >= std::min(hi, n_off - 2) || best_v < 2.0f) continue;  // no peak inside the window
+    if (best <= std::max(lo, 1) || best >= std::min(hi, n_off - 2) || best_v < 2.0f)
+      continue;  // no peak inside the window
     const double y0 = g[best - 1], y1 = g[best], y2 = g[best + 1];
     const double den = y0 - 2 * y1 + y2;
     const double delta = den < 0 ? std::clamp(0.5 * (y0 - y2) / den, -0.5, 0.5) : 0.0;
@@ -250,7 +263,8 @@ std::optional<Line> refine_side(const cv::Mat& image, cv::Point2d a, cv::Point2d
 /// positions along it where the change across it nearest the side (edge_points with `nearest`, within ±4 px)
 /// lies within 1.25 px of it and is at least 0.3 x `typical`. `typical`: when zero, set to the median strength of
 /// the changes found (so a weak page edge counts where it is as strong as elsewhere along the side).
-double side_support(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double unit, double t0, double t1, float* typical) {
+double side_support(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double unit, double t0, double t1,
+                    float* typical) {
   const EdgePoints e = edge_points(image, a, b, 4.0 * std::max(1.0, unit), unit, t0, t1, true, 1.0);
   if (e.tried.size() < 4 || e.pts.empty()) return 0.0;
   float least = 0.0f;
@@ -292,7 +306,8 @@ struct SideContrast {
 
 using Segments = std::array<std::pair<cv::Point2d, cv::Point2d>, 4>;
 
-SideContrast border_contrast(const cv::Mat& image, const Segments& sides, const std::array<bool, 4>& on_frame, double gap, double depth) {
+SideContrast border_contrast(const cv::Mat& image, const Segments& sides, const std::array<bool, 4>& on_frame,
+                             double gap, double depth) {
   constexpr int kStretches = 8, kPerStretch = 5, kDepths = 4;
   std::vector<double> offs;
   for (int k = 0; k < kDepths; ++k) offs.push_back(gap + depth * k / (kDepths - 1));     // outward (positive) ...
@@ -307,7 +322,9 @@ SideContrast border_contrast(const cv::Mat& image, const Segments& sides, const 
     const double len = std::hypot(d.x, d.y);
     if (len < 1.0) continue;
     const cv::Point2d t = d / len, n(t.y, -t.x);  // n: outward for corners clockwise on screen
-    const auto in_frame = [&](cv::Point2d x) { return x.x >= 0 && x.y >= 0 && x.x <= image.cols - 1 && x.y <= image.rows - 1; };
+    const auto in_frame = [&](cv::Point2d x) {
+      return x.x >= 0 && x.y >= 0 && x.x <= image.cols - 1 && x.y <= image.rows - 1;
+    };
     for (int st = 0; st < kStretches; ++st) {
       std::vector<cv::Point2d> base;
       for (int i = 0; i < kPerStretch; ++i) {
@@ -325,7 +342,8 @@ SideContrast border_contrast(const cv::Mat& image, const Segments& sides, const 
           const uchar* r = v.ptr<uchar>(i);
           for (int k = 0; k < kDepths; ++k) {
             in_sum += r[(kDepths + k) * cn + c];
-            if (!in_frame(base[static_cast<std::size_t>(i)] + offs[static_cast<std::size_t>(k)] * n)) continue;  // beyond the frame's edge
+            if (!in_frame(base[static_cast<std::size_t>(i)] + offs[static_cast<std::size_t>(k)] * n))
+              continue;  // beyond the frame's edge
             out_sum += r[k * cn + c];
             ++out_count;
           }
@@ -377,18 +395,21 @@ void add_quad(const Quad& quad, double min_area, cv::Size size, std::vector<Cand
 /// Quadrilaterals from a convex polygon of 4 to 6 corners: itself when it has 4; else its sides' lines with the
 /// shortest dropped until 4 remain, intersected in turn (a corner the outline missed, cut off by a shadow or a
 /// dark stretch of the page's edge, is restored by extending its neighbouring sides).
-void quads_from_polygon(const std::vector<cv::Point>& poly, double min_area, cv::Size size, std::vector<Candidate>& out) {
+void quads_from_polygon(const std::vector<cv::Point>& poly, double min_area, cv::Size size,
+                        std::vector<Candidate>& out) {
   const std::size_t n = poly.size();
   if (n < 4 || n > 6) return;
   if (n == 4) {
-    add_quad({cv::Point2d(poly[0]), cv::Point2d(poly[1]), cv::Point2d(poly[2]), cv::Point2d(poly[3])}, min_area, size, out);
+    add_quad({cv::Point2d(poly[0]), cv::Point2d(poly[1]), cv::Point2d(poly[2]), cv::Point2d(poly[3])}, min_area, size,
+             out);
     return;
   }
   std::vector<std::size_t> keep(n);
   for (std::size_t i = 0; i < n; ++i) keep[i] = i;
   const auto side_len = [&](std::size_t i) { return cv::norm(cv::Point2d(poly[(i + 1) % n]) - cv::Point2d(poly[i])); };
   while (keep.size() > 4) {
-    const auto shortest = std::min_element(keep.begin(), keep.end(), [&](std::size_t a, std::size_t b) { return side_len(a) < side_len(b); });
+    const auto shortest = std::min_element(keep.begin(), keep.end(),
+                                           [&](std::size_t a, std::size_t b) { return side_len(a) < side_len(b); });
     keep.erase(shortest);
   }
   std::array<Line, 4> lines;
@@ -456,7 +477,8 @@ double covered_length(std::vector<std::pair<double, double>> spans, double t0, d
 /// Groups segments (longest first) into lines: a segment joins a line when it is within 5° of it and both its ends
 /// are within `tol` px of it; the line is then fitted again (least squares) to points along all its segments.
 std::vector<SegmentLine> group_segments(std::vector<std::pair<cv::Point2d, cv::Point2d>> segs, double tol) {
-  std::sort(segs.begin(), segs.end(), [](const auto& x, const auto& y) { return cv::norm(x.second - x.first) > cv::norm(y.second - y.first); });
+  std::sort(segs.begin(), segs.end(),
+            [](const auto& x, const auto& y) { return cv::norm(x.second - x.first) > cv::norm(y.second - y.first); });
   const double cos_tol = std::cos(5.0 * CV_PI / 180.0);
   std::vector<SegmentLine> lines;
   std::vector<std::vector<cv::Point2f>> members;  // per line, points along its segments
@@ -465,7 +487,8 @@ std::vector<SegmentLine> group_segments(std::vector<std::pair<cv::Point2d, cv::P
     if (len < 1.0) continue;
     const cv::Point2d d = (b - a) / len;
     const auto joined = std::find_if(lines.begin(), lines.end(), [&](const SegmentLine& l) {
-      return std::abs(l.n.dot(cv::Point2d(-d.y, d.x))) >= cos_tol && std::abs(l.n.dot(a) - l.rho) <= tol && std::abs(l.n.dot(b) - l.rho) <= tol;
+      return std::abs(l.n.dot(cv::Point2d(-d.y, d.x))) >= cos_tol && std::abs(l.n.dot(a) - l.rho) <= tol &&
+             std::abs(l.n.dot(b) - l.rho) <= tol;
     });
     const auto k = static_cast<std::size_t>(joined - lines.begin());
     if (joined == lines.end()) {
@@ -494,7 +517,8 @@ std::vector<SegmentLine> group_segments(std::vector<std::pair<cv::Point2d, cv::P
     std::size_t start = 0;
     for (std::size_t i = 1; i <= proj.size(); ++i) {
       if (i == proj.size() || cv::norm(cv::Point2d(members[k][i]) - cv::Point2d(members[k][i - 1])) > 2.5) {
-        const auto [lo, hi] = std::minmax_element(proj.begin() + static_cast<std::ptrdiff_t>(start), proj.begin() + static_cast<std::ptrdiff_t>(i));
+        const auto [lo, hi] = std::minmax_element(proj.begin() + static_cast<std::ptrdiff_t>(start),
+                                                  proj.begin() + static_cast<std::ptrdiff_t>(i));
         l.spans.emplace_back(*lo, *hi);
         start = i;
       }
@@ -509,11 +533,15 @@ std::vector<SegmentLine> group_segments(std::vector<std::pair<cv::Point2d, cv::P
 /// frame's edge covered at least 20 % by edge segments, corners at most a quarter of the frame's size outside it (a
 /// page cut off at a corner). This finds a page whose outline no single edge map closes: broken by weak stretches,
 /// or tied to a textured background.
-void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& segs, cv::Size size, double min_area, std::vector<Candidate>& out) {
+void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& segs, cv::Size size, double min_area,
+                      std::vector<Candidate>& out) {
   const double shorter = std::min(size.width, size.height);
   std::vector<SegmentLine> lines = group_segments(segs, std::max(2.5, 0.006 * shorter));
-  std::sort(lines.begin(), lines.end(), [](const SegmentLine& a, const SegmentLine& b) { return a.covered > b.covered; });
-  lines.erase(std::remove_if(lines.begin(), lines.end(), [&](const SegmentLine& l) { return l.covered < 0.1 * shorter; }), lines.end());
+  std::sort(lines.begin(), lines.end(),
+            [](const SegmentLine& a, const SegmentLine& b) { return a.covered > b.covered; });
+  lines.erase(
+      std::remove_if(lines.begin(), lines.end(), [&](const SegmentLine& l) { return l.covered < 0.1 * shorter; }),
+      lines.end());
   if (lines.size() > 24) lines.resize(24);
   const double w = size.width - 1.0, h = size.height - 1.0;
   const std::array<std::pair<cv::Point2d, double>, 4> frame{{{{0, 1}, 0.0}, {{1, 0}, w}, {{0, 1}, h}, {{1, 0}, 0.0}}};
@@ -538,7 +566,8 @@ void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& se
       const auto [k, l] = pairs[r];
       if (i == k || i == l || j == k || j == l) continue;
       if (std::abs(lines[i].n.dot(lines[k].n)) > cos_cross) continue;
-      const int on_frame = (lines[i].frame_edge >= 0) + (lines[j].frame_edge >= 0) + (lines[k].frame_edge >= 0) + (lines[l].frame_edge >= 0);
+      const int on_frame = (lines[i].frame_edge >= 0) + (lines[j].frame_edge >= 0) + (lines[k].frame_edge >= 0) +
+                           (lines[l].frame_edge >= 0);
       if (on_frame > 2) continue;
       const std::array<std::size_t, 4> side{i, k, j, l};  // around the quad: i, k, j, l; corner s joins side s-1 and s
       Quad q;
@@ -553,7 +582,8 @@ void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& se
         const SegmentLine& sl = lines[side[s]];
         if (sl.frame_edge >= 0) continue;
         const cv::Point2d t(-sl.n.y, sl.n.x);
-        const double t0 = std::min(t.dot(q[s]), t.dot(q[(s + 1) % 4])), t1 = std::max(t.dot(q[s]), t.dot(q[(s + 1) % 4]));
+        const double t0 = std::min(t.dot(q[s]), t.dot(q[(s + 1) % 4])),
+                     t1 = std::max(t.dot(q[s]), t.dot(q[(s + 1) % 4]));
         ok = t1 - t0 > 1.0 && covered_length(sl.spans, t0, t1) >= 0.2 * (t1 - t0);
       }
       if (ok) add_quad(q, min_area, size, out);
@@ -570,7 +600,8 @@ void quads_from_lines(const std::vector<std::pair<cv::Point2d, cv::Point2d>>& se
 std::vector<Candidate> candidates(const cv::Mat& small, const cv::Mat& half, double min_area) {
   std::vector<Candidate> out;
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
-  const double to_small_x = static_cast<double>(small.cols) / half.cols, to_small_y = static_cast<double>(small.rows) / half.rows;
+  const double to_small_x = static_cast<double>(small.cols) / half.cols,
+               to_small_y = static_cast<double>(small.rows) / half.rows;
   const double half_area = min_area / (to_small_x * to_small_y);
   std::vector<std::pair<cv::Point2d, cv::Point2d>> segments;  // in downscaled-frame px
   for (double sigma : {1.5, 2.5}) {
@@ -591,7 +622,8 @@ std::vector<Candidate> candidates(const cv::Mat& small, const cv::Mat& half, dou
       for (Candidate& c : found) {
         for (cv::Point2d& p : c.q) p = {(p.x + 0.5) * to_small_x - 0.5, (p.y + 0.5) * to_small_y - 0.5};
         c.area *= to_small_x * to_small_y;
-        for (std::size_t i = 0; i < 4; ++i) c.frame_edge[i] = frame_edge_of(c.q[i], c.q[(i + 1) % 4], small.size(), 4.0);
+        for (std::size_t i = 0; i < 4; ++i)
+          c.frame_edge[i] = frame_edge_of(c.q[i], c.q[(i + 1) % 4], small.size(), 4.0);
         out.push_back(c);
       }
     }
@@ -616,10 +648,14 @@ std::vector<Candidate> candidates(const cv::Mat& small, const cv::Mat& half, dou
 Line frame_line(int e, cv::Size size) {
   const double r = size.width - 0.5, b = size.height - 0.5;
   switch (e) {
-    case 0: return {{-0.5, -0.5}, {1, 0}};
-    case 1: return {{r, -0.5}, {0, 1}};
-    case 2: return {{r, b}, {-1, 0}};
-    default: return {{-0.5, b}, {0, -1}};
+    case 0:
+      return {{-0.5, -0.5}, {1, 0}};
+    case 1:
+      return {{r, -0.5}, {0, 1}};
+    case 2:
+      return {{r, b}, {-1, 0}};
+    default:
+      return {{-0.5, b}, {0, -1}};
   }
 }
 
@@ -691,7 +727,8 @@ double quick_support(const Gradient& grad, const Candidate& c, double min_grad) 
 void check_params(const PageParams& p) {
   if (!(p.min_area_fraction > 0.0 && p.min_area_fraction < 1.0))
     throw hk::ArgumentError("find_page: min_area_fraction must be in (0, 1)");
-  if (!(p.min_contrast >= 0.0 && p.min_contrast <= 255.0)) throw hk::ArgumentError("find_page: min_contrast must be in [0, 255]");
+  if (!(p.min_contrast >= 0.0 && p.min_contrast <= 255.0))
+    throw hk::ArgumentError("find_page: min_contrast must be in [0, 255]");
   if (p.max_side_px < 64) throw hk::ArgumentError("find_page: max_side_px must be at least 64");
 }
 
@@ -741,7 +778,8 @@ std::optional<std::array<Line, 4>> refined_lines(const Frame& f, const Candidate
     const cv::Point2d a = full[s], b = full[(s + 1) % 4];
     const double same = 2.0 * unit;
     auto known = std::find_if(memo.sides.begin(), memo.sides.end(), [&](const RefinedSide& r) {
-      return (cv::norm(r.a - a) <= same && cv::norm(r.b - b) <= same) || (cv::norm(r.a - b) <= same && cv::norm(r.b - a) <= same);
+      return (cv::norm(r.a - a) <= same && cv::norm(r.b - b) <= same) ||
+             (cv::norm(r.a - b) <= same && cv::norm(r.b - a) <= same);
     });
     if (known == memo.sides.end()) {
       const double window = std::max(4.0 * unit + 2.0, 0.04 * cv::norm(b - a));
@@ -782,7 +820,8 @@ bool snap_to_frame(const Frame& f, const Quad& corners, std::array<Line, 4>& lin
   for (std::size_t s = 0; s < 4; ++s) {
     if (on_frame[s]) continue;
     const cv::Point2d half(0.5, 0.5);
-    const int e = frame_edge_of(corners[s] + half, corners[(s + 1) % 4] + half, f.image.size() + cv::Size(1, 1), f.band_start);
+    const int e =
+        frame_edge_of(corners[s] + half, corners[(s + 1) % 4] + half, f.image.size() + cv::Size(1, 1), f.band_start);
     if (e < 0) continue;
     lines[s] = frame_line(e, f.image.size());
     on_frame[s] = snapped = true;
@@ -835,7 +874,8 @@ std::optional<VisibleSides> visible_sides(const cv::Size& frame, const Quad& q, 
     v.segments[s] = {a, b};
     if (on_frame[s]) continue;
     const auto t = clip_segment(a, b, frame, 0.0);
-    if (!t || (t->second - t->first) * cv::norm(b - a) < 0.03 * std::hypot(frame.width, frame.height)) return std::nullopt;
+    if (!t || (t->second - t->first) * cv::norm(b - a) < 0.03 * std::hypot(frame.width, frame.height))
+      return std::nullopt;
     v.segments[s] = {a + t->first * (b - a), a + t->second * (b - a)};
     v.ends_at_frame[s] = {on_frame[(s + 3) % 4] || t->first > 0.0, on_frame[(s + 1) % 4] || t->second < 1.0};
   }
@@ -861,7 +901,8 @@ bool backed_by_edges(const Frame& f, const VisibleSides& v, const std::array<boo
     const cv::Point2d ia = a + inner->first * (b - a), ib = a + inner->second * (b - a);
     const double len = cv::norm(ib - ia), stretch = std::max(0.1, 15.0 * unit / len), tip = std::min(0.02, 3.0 / len);
     if (v.ends_at_frame[s].first && side_support(frame, ia, ib, unit, tip, stretch, &typical) < 0.5) return false;
-    if (v.ends_at_frame[s].second && side_support(frame, ia, ib, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5) return false;
+    if (v.ends_at_frame[s].second && side_support(frame, ia, ib, unit, 1.0 - stretch, 1.0 - tip, &typical) < 0.5)
+      return false;
   }
   return true;
 }
@@ -870,7 +911,8 @@ bool backed_by_edges(const Frame& f, const VisibleSides& v, const std::array<boo
 /// colour contrast at least 1.5 x min_contrast: a grain line of a table or a fold of a cloth has the same stuff on
 /// both sides), and at its end on the frame's edge as elsewhere (at least 0.35 x its median there: where a side
 /// runs on past the page's corner along a grain of the background, the stretch at the frame has no step across it).
-bool set_off(const SideContrast& colour, const VisibleSides& v, const std::array<bool, 4>& on_frame, const PageParams& params) {
+bool set_off(const SideContrast& colour, const VisibleSides& v, const std::array<bool, 4>& on_frame,
+             const PageParams& params) {
   for (std::size_t s = 0; s < 4; ++s) {
     const std::vector<double>& c = colour.stretches[s];
     if (on_frame[s]) continue;
@@ -947,7 +989,8 @@ bool shares_side(const Quad& a, const Quad& b, std::size_t s, double tol) {
   const cv::Point2d bd = (b1 - b0) / cv::norm(b1 - b0);
   for (std::size_t i = 0; i < 4; ++i) {
     const Line l{a[i], (a[(i + 1) % 4] - a[i]) / cv::norm(a[(i + 1) % 4] - a[i])};
-    if (std::abs(l.d.dot(bd)) >= std::cos(3.0 * CV_PI / 180.0) && distance(l, b0) <= tol && distance(l, b1) <= tol) return true;
+    if (std::abs(l.d.dot(bd)) >= std::cos(3.0 * CV_PI / 180.0) && distance(l, b0) <= tol && distance(l, b1) <= tol)
+      return true;
   }
   return false;
 }
@@ -961,8 +1004,8 @@ cv::Scalar band_mean(const cv::Mat& image, cv::Point2d a, cv::Point2d b, double 
   for (int i = 0; i < 16; ++i) {
     const cv::Point2d p = a + (0.1 + 0.8 * i / 15.0) * (b - a);
     const cv::Point2d far = p + (gap + depth) * n;
-    if (p.x >= 0 && p.y >= 0 && p.x <= image.cols - 1 && p.y <= image.rows - 1 && far.x >= 0 && far.y >= 0 && far.x <= image.cols - 1 &&
-        far.y <= image.rows - 1)
+    if (p.x >= 0 && p.y >= 0 && p.x <= image.cols - 1 && p.y <= image.rows - 1 && far.x >= 0 && far.y >= 0 &&
+        far.x <= image.cols - 1 && far.y <= image.rows - 1)
       base.push_back(p);
   }
   if (base.empty()) return cv::Scalar::all(-1);
@@ -1002,12 +1045,14 @@ bool runs_past_over_background(const Found& x, const Found& y, const cv::Mat& im
       if (side_support(image, a, b, unit, 0.05, 0.95, &typical) <= 0.0) break;
       const double u0 = std::min((a - A).dot(l.d), (b - A).dot(l.d)), u1 = std::max((a - A).dot(l.d), (b - A).dot(l.d));
       // Beyond y's side towards x's corner where x meets the frame's edge: before s (at A), after s (at B).
-      const std::array<std::pair<bool, std::pair<double, double>>, 2> beyond{{{x.side_contrast[(s + 3) % 4].empty(), {0.0, u0 - margin}},
-                                                                             {x.side_contrast[(s + 1) % 4].empty(), {u1 + margin, len}}}};
+      const std::array<std::pair<bool, std::pair<double, double>>, 2> beyond{
+          {{x.side_contrast[(s + 3) % 4].empty(), {0.0, u0 - margin}},
+           {x.side_contrast[(s + 1) % 4].empty(), {u1 + margin, len}}}};
       for (const auto& [to_frame, span] : beyond) {
         if (!to_frame || span.second - span.first < least) continue;
         float strength = typical;
-        if (side_support(image, A + span.first * l.d, A + span.second * l.d, unit, 0.0, 1.0, &strength) >= 0.5) return false;
+        if (side_support(image, A + span.first * l.d, A + span.second * l.d, unit, 0.0, 1.0, &strength) >= 0.5)
+          return false;
       }
       break;
     }
@@ -1025,8 +1070,10 @@ bool runs_past_over_background(const Found& x, const Found& y, const cv::Mat& im
 /// on from the smaller's corners to the frame's edge over the background (runs_past_over_background): the page's
 /// own side, seen near the frame's edge; the page lies whole in the frame. Bands for the colours: `gap` to `gap` +
 /// `depth` px off a side; `tol`: sides this close are the same side; `unit`: frame px per downscaled px.
-PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap, double depth, double tol, double unit) {
-  std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.det.area_fraction > b.det.area_fraction; });
+PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap, double depth, double tol,
+                     double unit) {
+  std::sort(found.begin(), found.end(),
+            [](const Found& a, const Found& b) { return a.det.area_fraction > b.det.area_fraction; });
   // Lower quartile of the stretch contrasts of x's sides that are (shared = true) or are not sides of y.
   const auto lower_quartile = [&](const Found& x, const Found& y, bool shared) {
     std::vector<double> v;
@@ -1057,7 +1104,8 @@ PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap,
       }
     }
     if (n_strip == 0 || n_background == 0) return false;
-    return colour_distance(strip / n_strip, background / n_background) < colour_distance(strip / n_strip, inside / n_strip);
+    return colour_distance(strip / n_strip, background / n_background) <
+           colour_distance(strip / n_strip, inside / n_strip);
   };
   for (std::size_t i = 0; i < found.size(); ++i) {
     bool beaten = false;
@@ -1071,15 +1119,18 @@ PageDetection choose(std::vector<Found> found, const cv::Mat& image, double gap,
       bool rest_shared = true;
       for (std::size_t s = 0; s < 4; ++s) {
         on_edge_j += found[j].side_contrast[s].empty();
-        if (found[i].side_contrast[s].empty()) ++on_edge_i;
-        else rest_shared = rest_shared && shares_side(found[j].det.corners_px, found[i].det.corners_px, s, tol);
+        if (found[i].side_contrast[s].empty())
+          ++on_edge_i;
+        else
+          rest_shared = rest_shared && shares_side(found[j].det.corners_px, found[i].det.corners_px, s, tol);
       }
       if (on_edge_i > on_edge_j && rest_shared) {
         beaten = runs_past_over_background(found[i], found[j], image, unit, tol);
         continue;
       }
       int shared = 0;
-      for (std::size_t s = 0; s < 4; ++s) shared += shares_side(found[i].det.corners_px, found[j].det.corners_px, s, tol);
+      for (std::size_t s = 0; s < 4; ++s)
+        shared += shares_side(found[i].det.corners_px, found[j].det.corners_px, s, tol);
       if (shared == 0 || shared == 4) continue;
       const double own = lower_quartile(found[i], found[j], false), common = lower_quartile(found[i], found[j], true);
       const double other = lower_quartile(found[j], found[i], false);
@@ -1097,14 +1148,20 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
   if (frame.type() != CV_8UC3 && frame.type() != CV_8UC1)
     throw hk::ArgumentError("find_page: the frame must be CV_8UC3 (BGR) or CV_8UC1 (grey)");
   check_params(params);
-  Frame f{frame, {}, 1.0, 1.0, 1.0, 0.01 * std::hypot(frame.cols, frame.rows), 3.0, static_cast<double>(frame.cols) * frame.rows};
-  if (frame.channels() == 3) cv::cvtColor(frame, f.grey, cv::COLOR_BGR2GRAY);
-  else f.grey = frame;
+  Frame f{frame, {},
+          1.0,   1.0,
+          1.0,   0.01 * std::hypot(frame.cols, frame.rows),
+          3.0,   static_cast<double>(frame.cols) * frame.rows};
+  if (frame.channels() == 3)
+    cv::cvtColor(frame, f.grey, cv::COLOR_BGR2GRAY);
+  else
+    f.grey = frame;
 
   const double scale = std::min(1.0, static_cast<double>(params.max_side_px) / std::max(frame.cols, frame.rows));
   cv::Mat small = frame;
   if (scale < 1.0) {
-    const cv::Size ss(std::max(1, static_cast<int>(std::lround(frame.cols * scale))), std::max(1, static_cast<int>(std::lround(frame.rows * scale))));
+    const cv::Size ss(std::max(1, static_cast<int>(std::lround(frame.cols * scale))),
+                      std::max(1, static_cast<int>(std::lround(frame.rows * scale))));
     cv::resize(frame, small, ss, 0, 0, cv::INTER_AREA);
   }
   f.sx = static_cast<double>(frame.cols) / small.cols;
@@ -1113,7 +1170,8 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
   f.band_start = 1.5 + 1.5 * f.unit;
   cv::Mat half;
   cv::pyrDown(small, half);
-  const std::vector<Candidate> cands = candidates(small, half, 0.8 * params.min_area_fraction * small.cols * small.rows);
+  const std::vector<Candidate> cands =
+      candidates(small, half, 0.8 * params.min_area_fraction * small.cols * small.rows);
 
   // Score each candidate by how well its sides are backed by edges; merge those that differ by less than 1 % of
   // the frame's diagonal.
@@ -1132,8 +1190,10 @@ PageDetection find_page(const cv::Mat& frame, const PageParams& params) {
         if (cv::norm(r.second.q[i] - c.q[i]) > same) return false;
       return true;
     });
-    if (twin == ranked.end()) ranked.emplace_back(score, c);
-    else if (score > twin->first) *twin = {score, c};
+    if (twin == ranked.end())
+      ranked.emplace_back(score, c);
+    else if (score > twin->first)
+      *twin = {score, c};
   }
   // Verified: the best-backed candidates, then the largest of the well-backed (score >= 0.75) ones not yet looked at
   // (the page is the largest quadrilateral; the lines of a printed grid or a window in a photograph make many
@@ -1172,7 +1232,8 @@ double page_aspect_ratio(const std::array<cv::Point2d, 4>& corners_px, cv::Point
   const cv::Vec3d n2 = k2 * m2 - m1, n3 = k3 * m3 - m1;
   // n2[2] = k2 − 1 and n3[2] = k3 − 1 vanish when a pair of opposite sides is parallel: f is then undetermined.
   constexpr double kParallel = 1e-6;
-  if (!std::isfinite(k2) || !std::isfinite(k3) || std::abs(n2[2]) < kParallel || std::abs(n3[2]) < kParallel) return mean_sides;
+  if (!std::isfinite(k2) || !std::isfinite(k3) || std::abs(n2[2]) < kParallel || std::abs(n3[2]) < kParallel)
+    return mean_sides;
   const double f2 = -(n2[0] * n3[0] + n2[1] * n3[1]) / (n2[2] * n3[2]);
   if (!std::isfinite(f2) || !(f2 > 0.0)) return mean_sides;
   // (w/h)² = n2ᵀ A⁻ᵀA⁻¹ n2 / n3ᵀ A⁻ᵀA⁻¹ n3 with A = [f 0 0; 0 f 0; 0 0 1]; both sides times f².
@@ -1186,7 +1247,8 @@ cv::Mat rectify_page(const cv::Mat& frame, const std::array<cv::Point2d, 4>& cor
   if (frame.empty()) throw hk::ArgumentError("rectify_page: empty frame");
   for (const cv::Point2d& p : corners_px)
     if (!finite(p)) throw hk::ArgumentError("rectify_page: corners must be finite");
-  if (std::abs(signed_area(corners_px)) < 1.0) throw hk::ArgumentError("rectify_page: degenerate quadrilateral (area < 1 px²)");
+  if (std::abs(signed_area(corners_px)) < 1.0)
+    throw hk::ArgumentError("rectify_page: degenerate quadrilateral (area < 1 px²)");
   double longest = 0.0;
   for (std::size_t i = 0; i < 4; ++i) longest = std::max(longest, cv::norm(corners_px[(i + 1) % 4] - corners_px[i]));
   const double diag = std::hypot(frame.cols, frame.rows);
@@ -1195,7 +1257,8 @@ cv::Mat rectify_page(const cv::Mat& frame, const std::array<cv::Point2d, 4>& cor
   const double w = ratio >= 1.0 ? longest : longest * ratio, h = ratio >= 1.0 ? longest / ratio : longest;
   const int W = std::max(1, static_cast<int>(std::lround(w))), H = std::max(1, static_cast<int>(std::lround(h)));
   cv::Point2f src[4], dst[4];
-  for (std::size_t i = 0; i < 4; ++i) src[i] = cv::Point2f(static_cast<float>(corners_px[i].x), static_cast<float>(corners_px[i].y));
+  for (std::size_t i = 0; i < 4; ++i)
+    src[i] = cv::Point2f(static_cast<float>(corners_px[i].x), static_cast<float>(corners_px[i].y));
   // The page's corners are the outer corners of the output's corner pixels.
   dst[0] = {-0.5f, -0.5f};
   dst[1] = {static_cast<float>(W) - 0.5f, -0.5f};

@@ -30,9 +30,9 @@
 #include <signal.h>
 #include <spawn.h>
 #include <sys/mman.h>
-#include <sys/stat.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -49,16 +49,16 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgproc.hpp>
 #include <poppler/cpp/poppler-document.h>
 #include <poppler/cpp/poppler-global.h>
 #include <poppler/cpp/poppler-image.h>
 #include <poppler/cpp/poppler-page-renderer.h>
 #include <poppler/cpp/poppler-page.h>
+#include <opencv2/imgproc.hpp>
 
+#include "hk/error.hpp"
 #include "input_error.hpp"
 #include "worker_process.hpp"
-#include "hk/error.hpp"
 
 namespace hk::vision {
 namespace {
@@ -67,11 +67,11 @@ using Writer = worker::WireWriter;
 using Reader = worker::WireReader;
 using worker::WorkerRun;
 
-constexpr std::uint32_t kMagic = 0x44504B48;    // "HKPD"
-constexpr std::uint32_t kMaxWords = 200000;      // words accepted per page
-constexpr std::uint32_t kMaxWordBytes = 4096;    // UTF-8 bytes accepted per word
-constexpr std::uint32_t kMaxProblemBytes = 512;  // bytes accepted in a worker's refusal
-constexpr std::size_t kMaxTextBytes = 64u << 20; // bound on the words' share of an answer
+constexpr std::uint32_t kMagic = 0x44504B48;      // "HKPD"
+constexpr std::uint32_t kMaxWords = 200000;       // words accepted per page
+constexpr std::uint32_t kMaxWordBytes = 4096;     // UTF-8 bytes accepted per word
+constexpr std::uint32_t kMaxProblemBytes = 512;   // bytes accepted in a worker's refusal
+constexpr std::size_t kMaxTextBytes = 64u << 20;  // bound on the words' share of an answer
 
 std::string fmt_num(double v) {
   char buf[32];
@@ -119,7 +119,8 @@ cv::Mat render_grey(const poppler::page& pg, double dpi) {
     const char* data = img.const_data();
     if (img.format() == poppler::image::format_gray8 && stride >= w) {
       cv::Mat grey(h, w, CV_8UC1);
-      for (int y = 0; y < h; ++y) std::memcpy(grey.ptr(y), data + static_cast<std::ptrdiff_t>(y) * stride, static_cast<std::size_t>(w));
+      for (int y = 0; y < h; ++y)
+        std::memcpy(grey.ptr(y), data + static_cast<std::ptrdiff_t>(y) * stride, static_cast<std::size_t>(w));
       return grey;
     }
     if (img.format() == poppler::image::format_argb32 && stride >= 4 * w) {
@@ -146,11 +147,12 @@ std::string pdf_title(const poppler::document& doc) {
 void check_page_number(int page, int n, int offered) {
   if (page <= offered) return;
   if (offered < n) {
-    throw Refusal{PdfError::Kind::NoSuchPage, "page " + std::to_string(page) + " is beyond the first " + std::to_string(offered) +
-                                                  " pages offered (the document has " + std::to_string(n) + ")"};
+    throw Refusal{PdfError::Kind::NoSuchPage, "page " + std::to_string(page) + " is beyond the first " +
+                                                  std::to_string(offered) + " pages offered (the document has " +
+                                                  std::to_string(n) + ")"};
   }
-  throw Refusal{PdfError::Kind::NoSuchPage, "page " + std::to_string(page) + " does not exist (the document has " + std::to_string(n) +
-                                                (n == 1 ? " page)" : " pages)")};
+  throw Refusal{PdfError::Kind::NoSuchPage, "page " + std::to_string(page) + " does not exist (the document has " +
+                                                std::to_string(n) + (n == 1 ? " page)" : " pages)")};
 }
 
 /// A page's size as it is shown [pt]: its crop box, turned for landscape and seascape pages.
@@ -165,7 +167,8 @@ PageSize page_size(const poppler::page& pg, const std::string& pname) {
   const auto orient = pg.orientation();
   if (orient == poppler::page::landscape || orient == poppler::page::seascape) std::swap(w_pt, h_pt);
   if (!(w_pt >= 1e-3 && h_pt >= 1e-3 && std::isfinite(w_pt * h_pt))) {
-    throw Refusal{PdfError::Kind::Damaged, pname + " has no usable size (" + fmt_num(w_pt) + " x " + fmt_num(h_pt) + " pt)"};
+    throw Refusal{PdfError::Kind::Damaged,
+                  pname + " has no usable size (" + fmt_num(w_pt) + " x " + fmt_num(h_pt) + " pt)"};
   }
   return {w_pt, h_pt};
 }
@@ -176,8 +179,8 @@ double page_dpi(PageSize size, const PdfLimits& limits, const std::string& pname
   const double dpi = dpi_for(size.w_pt, size.h_pt, limits);
   if (!(dpi >= 1.0)) {
     char buf[200];
-    std::snprintf(buf, sizeof buf, "%s: page size %g x %g pt would need %.2g dpi to stay within %.0f pixels", pname.c_str(), size.w_pt,
-                  size.h_pt, dpi, limits.max_page_pixels);
+    std::snprintf(buf, sizeof buf, "%s: page size %g x %g pt would need %.2g dpi to stay within %.0f pixels",
+                  pname.c_str(), size.w_pt, size.h_pt, dpi, limits.max_page_pixels);
     throw Refusal{PdfError::Kind::TooLarge, buf};
   }
   return dpi;
@@ -195,26 +198,28 @@ double text_layer_dpi(PageSize size, double full, const PdfLimits& limits) {
 /// The page drawn in grey at `dpi`, checked: refused as Damaged when not drawn, as TooLarge when poppler
 /// returned another size than asked (Splash answers a failed bitmap allocation under RLIMIT_AS with a
 /// 1 x 1 picture) or more pixels than the budget.
-cv::Mat render_checked(const poppler::page& pg, PageSize size, double dpi, const PdfLimits& limits, const std::string& pname) {
+cv::Mat render_checked(const poppler::page& pg, PageSize size, double dpi, const PdfLimits& limits,
+                       const std::string& pname) {
   const cv::Mat grey = render_grey(pg, dpi);
   if (grey.empty()) throw Refusal{PdfError::Kind::Damaged, pname + " could not be drawn"};
   const double want_w = size.w_pt * dpi / 72.0, want_h = size.h_pt * dpi / 72.0;
   if (std::abs(grey.cols - want_w) > 2.0 || std::abs(grey.rows - want_h) > 2.0) {
     char buf[200];
-    std::snprintf(buf, sizeof buf, "%s could not be drawn at %.0f x %.0f px (poppler returned %d x %d; out of memory?)", pname.c_str(), want_w,
-                  want_h, grey.cols, grey.rows);
+    std::snprintf(buf, sizeof buf, "%s could not be drawn at %.0f x %.0f px (poppler returned %d x %d; out of memory?)",
+                  pname.c_str(), want_w, want_h, grey.cols, grey.rows);
     throw Refusal{PdfError::Kind::TooLarge, buf};
   }
   if (static_cast<double>(grey.cols) * grey.rows > limits.max_page_pixels) {
-    throw Refusal{PdfError::Kind::TooLarge, pname + " came out " + std::to_string(grey.cols) + " x " + std::to_string(grey.rows) +
-                                                " px, over the budget of " + fmt_num(limits.max_page_pixels) + " pixels"};
+    throw Refusal{PdfError::Kind::TooLarge, pname + " came out " + std::to_string(grey.cols) + " x " +
+                                                std::to_string(grey.rows) + " px, over the budget of " +
+                                                fmt_num(limits.max_page_pixels) + " pixels"};
   }
   return grey;
 }
 
-/// Writes the page's words (`text`, its page::text_list) to `out`: their count, then each word's text (at most kMaxWordBytes), box in
-/// the drawn page's pixels (pt × k, clipped to `frame`; words with nothing visible dropped) and whether a
-/// space follows it; at most kMaxWords words and about kMaxTextBytes bytes.
+/// Writes the page's words (`text`, its page::text_list) to `out`: their count, then each word's text (at most
+/// kMaxWordBytes), box in the drawn page's pixels (pt × k, clipped to `frame`; words with nothing visible dropped) and
+/// whether a space follows it; at most kMaxWords words and about kMaxTextBytes bytes.
 void write_words(const std::vector<poppler::text_box>& text, double k, const cv::Rect2d& frame, Writer& out) {
   Writer words;
   std::uint32_t count = 0;
@@ -226,7 +231,8 @@ void write_words(const std::vector<poppler::text_box>& text, double k, const cv:
     if (text.empty()) continue;
     if (text.size() > kMaxWordBytes) text.resize(kMaxWordBytes);
     const poppler::rectf b = tb.bbox();
-    const cv::Rect2d box = cv::Rect2d(b.x() * k, b.y() * k, b.width() * k, b.height() * k) & frame;  // invisible parts dropped
+    const cv::Rect2d box =
+        cv::Rect2d(b.x() * k, b.y() * k, b.width() * k, b.height() * k) & frame;  // invisible parts dropped
     if (!(box.width > 0 && box.height > 0)) continue;
     words.str(text);
     words.f64(box.x);
@@ -243,8 +249,8 @@ void write_words(const std::vector<poppler::text_box>& text, double k, const cv:
 /// The worker's work: an answer in `out` (page 0: the page count and title; else those, the page's size
 /// [pt], dpi, whether it was drawn screen-sized, grey picture and words), or a Refusal thrown.
 void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits, Writer& out) {
-  std::unique_ptr<poppler::document> doc(
-      poppler::document::load_from_raw_data(reinterpret_cast<const char*>(bytes.data()), static_cast<int>(bytes.size())));
+  std::unique_ptr<poppler::document> doc(poppler::document::load_from_raw_data(
+      reinterpret_cast<const char*>(bytes.data()), static_cast<int>(bytes.size())));
   if (!doc) throw Refusal{PdfError::Kind::Damaged, "poppler cannot read it (damaged or not a PDF)"};
   if (doc->is_locked()) throw Refusal{PdfError::Kind::Locked, "protected by a password"};
   const int n = doc->pages();
@@ -286,7 +292,8 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   poppler::set_debug_error_function(no_poppler_output, nullptr);
   const Writer out = worker::worker_answer<Refusal>(
       kMagic, [&](Writer& answer) { work(bytes, page, limits, answer); },
-      std::pair{PdfError::Kind::TooLarge, "the reader ran out of memory (limit " + fmt_num(limits.worker_max_memory_mb) + " MiB)"},
+      std::pair{PdfError::Kind::TooLarge,
+                "the reader ran out of memory (limit " + fmt_num(limits.worker_max_memory_mb) + " MiB)"},
       std::pair{PdfError::Kind::Damaged, std::string("poppler failed on it")});
   worker::write_all(worker::kAnswerFd, out.bytes());
   ::_exit(0);
@@ -296,7 +303,8 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
 // Parent side.
 
 /// Runs the worker on `bytes` for `page` (0: open and count only); a worker that cannot start is a PdfError.
-WorkerRun run_pdf_worker(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits, const std::string& name, std::size_t max_answer) {
+WorkerRun run_pdf_worker(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits,
+                         const std::string& name, std::size_t max_answer) {
 #ifdef HK_PDF_WORKER_PATH
   static const std::string path = worker::find_worker("HK_PDF_WORKER", "hk-pdf-worker", HK_PDF_WORKER_PATH);
 #else
@@ -326,36 +334,40 @@ std::string doing(int page) { return page == 0 ? "opening the document" : "page 
   const double cpu_limit = std::ceil(std::max(limits.worker_cpu_s, 0.001));
   if (run.timed_out) {
     fail(PdfError::Kind::Timeout, name,
-         (page == 0 ? std::string("opening it") : "page " + std::to_string(page)) + " took longer than " + fmt_num(limits.worker_wall_s) +
-             " s" + (page == 0 ? "" : " to draw"));
+         (page == 0 ? std::string("opening it") : "page " + std::to_string(page)) + " took longer than " +
+             fmt_num(limits.worker_wall_s) + " s" + (page == 0 ? "" : " to draw"));
   }
   if (run.overflow) fail(PdfError::Kind::WorkerCrashed, name, "the reader sent an oversized answer for " + doing(page));
   if (WIFSIGNALED(run.status)) {
     const int sig = WTERMSIG(run.status);
     if (sig == SIGXCPU || (sig == SIGKILL && run.cpu_s >= cpu_limit)) {
-      fail(PdfError::Kind::Timeout, name, doing(page) + " used more than " + fmt_num(cpu_limit) + " s of processor time");
+      fail(PdfError::Kind::Timeout, name,
+           doing(page) + " used more than " + fmt_num(cpu_limit) + " s of processor time");
     }
     const std::string where = page == 0 ? "while opening the document" : "on page " + std::to_string(page);
     fail(PdfError::Kind::WorkerCrashed, name, "the reader stopped " + where + " (signal " + std::to_string(sig) + ")");
   }
   const std::string where = page == 0 ? "while opening the document" : "on page " + std::to_string(page);
   if (WIFEXITED(run.status) && WEXITSTATUS(run.status) != 0) {
-    fail(PdfError::Kind::WorkerCrashed, name, "the reader stopped " + where + " (exit status " + std::to_string(WEXITSTATUS(run.status)) + ")");
+    fail(PdfError::Kind::WorkerCrashed, name,
+         "the reader stopped " + where + " (exit status " + std::to_string(WEXITSTATUS(run.status)) + ")");
   }
   fail(PdfError::Kind::WorkerCrashed, name, "the reader gave no usable answer " + where);
 }
 
 /// Checks what every caller checks before starting a worker.
 void check_input(std::span<const std::uint8_t> bytes, const std::string& name, const PdfLimits& limits) {
-  if (!(limits.max_file_bytes > 0 && limits.max_pages > 0 && limits.max_page_pixels > 0 && limits.max_dpi > 0 && limits.worker_cpu_s > 0 &&
-        limits.worker_wall_s > 0 && limits.worker_max_memory_mb >= 0 && limits.text_layer_max_side_px >= 0)) {
+  if (!(limits.max_file_bytes > 0 && limits.max_pages > 0 && limits.max_page_pixels > 0 && limits.max_dpi > 0 &&
+        limits.worker_cpu_s > 0 && limits.worker_wall_s > 0 && limits.worker_max_memory_mb >= 0 &&
+        limits.text_layer_max_side_px >= 0)) {
     throw hk::ArgumentError("PdfLimits: every limit must be positive");
   }
   if (bytes.empty()) fail(PdfError::Kind::NotPdf, name, "the file is empty");
   if (!looks_like_pdf(bytes)) fail(PdfError::Kind::NotPdf, name, "not a PDF (no %PDF- header)");
   const auto cap = std::min<std::int64_t>(limits.max_file_bytes, INT_MAX);
   if (static_cast<std::int64_t>(bytes.size()) > cap) {
-    fail(PdfError::Kind::TooLarge, name, "file of " + std::to_string(bytes.size()) + " bytes is over the limit of " + std::to_string(cap) + " bytes");
+    fail(PdfError::Kind::TooLarge, name,
+         "file of " + std::to_string(bytes.size()) + " bytes is over the limit of " + std::to_string(cap) + " bytes");
   }
 }
 
@@ -367,7 +379,8 @@ void read_head(Reader& in, const WorkerRun& run, const std::string& name, int pa
   if (status == 1) {
     std::uint8_t kind = 0;
     std::string problem;
-    if (!in.u8(kind) || kind > static_cast<std::uint8_t>(PdfError::Kind::WorkerCrashed) || !in.str(problem, kMaxProblemBytes)) {
+    if (!in.u8(kind) || kind > static_cast<std::uint8_t>(PdfError::Kind::WorkerCrashed) ||
+        !in.str(problem, kMaxProblemBytes)) {
       fail_run(run, name, page, limits);
     }
     for (char& c : problem) {
@@ -424,19 +437,23 @@ PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, 
   return info;
 }
 
-PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& name, int page, const PdfLimits& limits) {
+PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& name, int page,
+                        const PdfLimits& limits) {
   check_input(bytes, name, limits);
-  if (page < 1) fail(PdfError::Kind::NoSuchPage, name, "page " + std::to_string(page) + " does not exist (pages count from 1)");
-  const std::size_t max_answer = 1024 + static_cast<std::size_t>(std::min(limits.max_page_pixels, 1e10)) + kMaxTextBytes + 2 * (kMaxWordBytes + 40);
+  if (page < 1)
+    fail(PdfError::Kind::NoSuchPage, name, "page " + std::to_string(page) + " does not exist (pages count from 1)");
+  const std::size_t max_answer = 1024 + static_cast<std::size_t>(std::min(limits.max_page_pixels, 1e10)) +
+                                 kMaxTextBytes + 2 * (kMaxWordBytes + 40);
   const WorkerRun run = run_pdf_worker(bytes, page, limits, name, max_answer);
   Reader in(run.answer);
   read_head(in, run, name, page, limits);
   std::int32_t n = 0, w = 0, h = 0;
   std::uint8_t screen_sized = 0;
   PdfPage out;
-  if (!in.i32(n) || n < page || !in.str(out.title, kMaxPdfTitleBytes) || !in.f64(out.width_pt) || !in.f64(out.height_pt) || !in.f64(out.dpi) ||
-      !in.u8(screen_sized) || screen_sized > 1 || (screen_sized == 1 && !(limits.text_layer_max_side_px > 0)) || !in.i32(w) || !in.i32(h) || w <= 0 ||
-      h <= 0 || static_cast<double>(w) * h > limits.max_page_pixels || !(out.dpi > 0 && out.dpi <= limits.max_dpi) ||
+  if (!in.i32(n) || n < page || !in.str(out.title, kMaxPdfTitleBytes) || !in.f64(out.width_pt) ||
+      !in.f64(out.height_pt) || !in.f64(out.dpi) || !in.u8(screen_sized) || screen_sized > 1 ||
+      (screen_sized == 1 && !(limits.text_layer_max_side_px > 0)) || !in.i32(w) || !in.i32(h) || w <= 0 || h <= 0 ||
+      static_cast<double>(w) * h > limits.max_page_pixels || !(out.dpi > 0 && out.dpi <= limits.max_dpi) ||
       std::abs(w - out.width_pt * out.dpi / 72.0) > 2.0 || std::abs(h - out.height_pt * out.dpi / 72.0) > 2.0) {
     fail_run(run, name, page, limits);
   }
@@ -451,8 +468,8 @@ PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& 
   for (std::uint32_t i = 0; i < count; ++i) {
     PdfWord word;
     std::uint8_t space = 0;
-    if (!in.str(word.text, kMaxWordBytes) || !in.f64(word.box_px.x) || !in.f64(word.box_px.y) || !in.f64(word.box_px.width) ||
-        !in.f64(word.box_px.height) || !in.u8(space) || space > 1) {
+    if (!in.str(word.text, kMaxWordBytes) || !in.f64(word.box_px.x) || !in.f64(word.box_px.y) ||
+        !in.f64(word.box_px.width) || !in.f64(word.box_px.height) || !in.u8(space) || space > 1) {
       fail_run(run, name, page, limits);
     }
     word.space_after = space == 1;
@@ -486,7 +503,8 @@ double overlap(double a0, double a1, double b0, double b1) { return std::min(a1,
 std::vector<Line> words_to_lines(const std::vector<PdfWord>& words) {
   std::vector<std::size_t> order(words.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return words[a].box_px.x < words[b].box_px.x; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return words[a].box_px.x < words[b].box_px.x; });
   std::vector<Line> lines;
   for (const std::size_t i : order) {
     const cv::Rect2d& b = words[i].box_px;
@@ -524,7 +542,8 @@ struct Block {
 /// Lines -> blocks: sorts the lines top to bottom; each joins the block whose last line is closest above it
 /// when the gap is under one line height, the heights differ by less than 1.5x and they overlap horizontally.
 std::vector<Block> lines_to_blocks(std::vector<Line>& lines) {
-  std::stable_sort(lines.begin(), lines.end(), [](const Line& a, const Line& b) { return a.top != b.top ? a.top < b.top : a.left < b.left; });
+  std::stable_sort(lines.begin(), lines.end(),
+                   [](const Line& a, const Line& b) { return a.top != b.top ? a.top < b.top : a.left < b.left; });
   std::vector<Block> blocks;
   for (std::size_t li = 0; li < lines.size(); ++li) {
     const Line& l = lines[li];
@@ -553,7 +572,8 @@ std::vector<Block> lines_to_blocks(std::vector<Line>& lines) {
 
 /// Each block's text (its words joined by spaces, except where poppler glued two words that touch), box
 /// (the union of its words' boxes, px) and line count.
-std::vector<TextBlock> block_texts(const std::vector<PdfWord>& words, const std::vector<Line>& lines, const std::vector<Block>& blocks) {
+std::vector<TextBlock> block_texts(const std::vector<PdfWord>& words, const std::vector<Line>& lines,
+                                   const std::vector<Block>& blocks) {
   std::vector<TextBlock> out;
   out.reserve(blocks.size());
   for (const Block& blk : blocks) {
@@ -565,7 +585,8 @@ std::vector<TextBlock> block_texts(const std::vector<PdfWord>& words, const std:
         const PdfWord& w = words[lw[k]];
         // No space after poppler's "no space after" word only if the next one really touches it: a bullet
         // flagged so but set off by an indent still reads as its own word (as pdftotext prints it).
-        const bool glued = k > 0 && !words[lw[k - 1]].space_after && w.box_px.x - words[lw[k - 1]].box_px.br().x < 0.3 * lines[li].height();
+        const bool glued = k > 0 && !words[lw[k - 1]].space_after &&
+                           w.box_px.x - words[lw[k - 1]].box_px.br().x < 0.3 * lines[li].height();
         if (!first && !glued) tb.text += ' ';
         tb.text += w.text;
         tb.box_px = first ? w.box_px : (tb.box_px | w.box_px);
@@ -581,7 +602,8 @@ std::vector<TextBlock> block_texts(const std::vector<PdfWord>& words, const std:
 /// Sorts blocks into reading order: top to bottom; blocks whose tops lie within half a line of the row's
 /// first block form a row, read left to right.
 void sort_reading_order(std::vector<TextBlock>& out) {
-  std::stable_sort(out.begin(), out.end(), [](const TextBlock& a, const TextBlock& b) { return a.box_px.y < b.box_px.y; });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const TextBlock& a, const TextBlock& b) { return a.box_px.y < b.box_px.y; });
   for (std::size_t row = 0; row < out.size();) {
     const double tol = 0.5 * out[row].box_px.height / std::max(out[row].lines, 1);
     std::size_t end = row + 1;

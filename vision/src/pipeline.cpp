@@ -3,9 +3,9 @@
 
 #include "vision/pipeline.hpp"
 
+#include "hk/error.hpp"
 #include "vision/mapping.hpp"
 #include "vision/texture.hpp"
-#include "hk/error.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -62,18 +62,25 @@ PointValues chain_strength(const cv::Mat& grey, double blur_sigma_px, const std:
 
 const char* detector_name(Detector d) {
   switch (d) {
-    case Detector::Auto: return "auto";
-    case Detector::Canny: return "canny";
-    case Detector::Surround: return "surround";
-    case Detector::Bilateral: return "bilateral";
-    case Detector::Edpf: return "edpf";
-    case Detector::Outline: return "outline";
+    case Detector::Auto:
+      return "auto";
+    case Detector::Canny:
+      return "canny";
+    case Detector::Surround:
+      return "surround";
+    case Detector::Bilateral:
+      return "bilateral";
+    case Detector::Edpf:
+      return "edpf";
+    case Detector::Outline:
+      return "outline";
   }
   return "auto";
 }
 
 Detector detector_from_name(const std::string& name) {
-  for (Detector d : {Detector::Auto, Detector::Canny, Detector::Surround, Detector::Bilateral, Detector::Edpf, Detector::Outline})
+  for (Detector d :
+       {Detector::Auto, Detector::Canny, Detector::Surround, Detector::Bilateral, Detector::Edpf, Detector::Outline})
     if (name == detector_name(d)) return d;
   throw hk::ArgumentError("detector '" + name + "' is not one of auto, canny, surround, bilateral, edpf, outline");
 }
@@ -89,7 +96,8 @@ void check_params(const ExtractParams& p) {
     throw hk::ArgumentError("extract_chains: surround_inhibition must be finite and >= 0");
   if (!std::isfinite(p.line_drawing_max_ink_m) || p.line_drawing_max_ink_m < 0.0)
     throw hk::ArgumentError("extract_chains: line_drawing_max_ink_m must be finite and >= 0");
-  if (!(p.workspace_width_m > 0.0) || !(p.workspace_height_m > 0.0) || !std::isfinite(p.workspace_width_m) || !std::isfinite(p.workspace_height_m))
+  if (!(p.workspace_width_m > 0.0) || !(p.workspace_height_m > 0.0) || !std::isfinite(p.workspace_width_m) ||
+      !std::isfinite(p.workspace_height_m))
     throw hk::ArgumentError("extract_chains: the workspace must be finite and > 0");
 }
 
@@ -103,11 +111,13 @@ cv::Mat processed_mask(const cv::Mat& ignore_mask, cv::Size size) {
 
 /// Canny, Surround or Bilateral: (bilateral filter,) edges, ignored regions cleared, linking. Surround's
 /// texture test comes after the strengths (drop_texture).
-void canny_chains(const cv::Mat& grey, Detector detector, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
+void canny_chains(const cv::Mat& grey, Detector detector, const ExtractParams& p, const cv::Mat& ignore_mask,
+                  Extraction& out) {
   auto t0 = std::chrono::steady_clock::now();
   if (detector == Detector::Bilateral) {
     cv::Mat smooth;
-    cv::bilateralFilter(grey, smooth, kBilateralDiameterPx, kBilateralSigmaGrey, kBilateralSigmaSpacePx, cv::BORDER_REPLICATE);
+    cv::bilateralFilter(grey, smooth, kBilateralDiameterPx, kBilateralSigmaGrey, kBilateralSigmaSpacePx,
+                        cv::BORDER_REPLICATE);
     out.edge_map = detect_edges(smooth, p.edges);
   } else {
     out.edge_map = detect_edges(grey, p.edges);
@@ -177,7 +187,8 @@ void drop_texture(const cv::Mat& grey, const ExtractParams& p, Extraction& out) 
       kept_strength.push_back(std::move(out.point_strength[k]));
     } else {
       ++out.texture_chains;
-      for (const cv::Point2d& q : out.chains[k].points_px) out.edge_map.edges.at<std::uint8_t>(static_cast<int>(q.y), static_cast<int>(q.x)) = 0;
+      for (const cv::Point2d& q : out.chains[k].points_px)
+        out.edge_map.edges.at<std::uint8_t>(static_cast<int>(q.y), static_cast<int>(q.x)) = 0;
     }
   }
   out.chains = std::move(kept);
@@ -229,10 +240,12 @@ void outline_chains(const cv::Mat& grey, const ExtractParams& p, const cv::Mat& 
 
 /// The stages after the grey image is ready: boundaries (Canny or outline), strength, scale back to the
 /// `full` size.
-void extract_from_grey(const cv::Mat& grey, cv::Size full, const ExtractParams& p, const cv::Mat& ignore_mask, Extraction& out) {
+void extract_from_grey(const cv::Mat& grey, cv::Size full, const ExtractParams& p, const cv::Mat& ignore_mask,
+                       Extraction& out) {
   if (p.detector == Detector::Auto || p.detector == Detector::Outline) out.tones = classify_two_tone(grey);
   if (out.tones.two_tone && p.line_drawing_max_ink_m > 0.0) {
-    const double m_per_px = fit_to_workspace(full.width, full.height, p.workspace_width_m, p.workspace_height_m).scale_m_per_px;
+    const double m_per_px =
+        fit_to_workspace(full.width, full.height, p.workspace_width_m, p.workspace_height_m).scale_m_per_px;
     const double px_scale = static_cast<double>(full.width) / grey.cols;
     out.line_drawing = out.tones.ink_width_px * px_scale * m_per_px <= p.line_drawing_max_ink_m;
   }

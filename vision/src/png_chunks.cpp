@@ -55,8 +55,8 @@ std::span<const std::uint8_t> png_decodable(std::span<const std::uint8_t> bytes,
     if (kept_chunk(type) || is_critical(type)) {
       // Unknown critical chunks are passed on: libpng refuses them, as the standard requires.
       if (crc32_png(type, 4 + std::size_t{len}) != be32(type + 4 + len)) {
-        throw_input_error(path, "corrupt PNG: checksum (CRC) mismatch in chunk '" + name + "' at byte " +
-                                    std::to_string(pos));
+        throw_input_error(
+            path, "corrupt PNG: checksum (CRC) mismatch in chunk '" + name + "' at byte " + std::to_string(pos));
       }
       if (copying) storage.insert(storage.end(), chunk, chunk + chunk_bytes);
       idat = idat || std::memcmp(type, "IDAT", 4) == 0;

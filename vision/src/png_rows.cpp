@@ -20,9 +20,9 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "image_header_detail.hpp"
 #include "hk/error.hpp"
 #include "hk/text.hpp"
+#include "image_header_detail.hpp"
 #include "input_error.hpp"
 
 namespace hk::vision::detail {
@@ -73,7 +73,8 @@ int set_transformations(png_structp png, png_infop info) {
   const int colour = png_get_color_type(png, info);
   const int depth = png_get_bit_depth(png, info);
   const bool trns = png_get_valid(png, info, PNG_INFO_tRNS) != 0;
-  const bool alpha = (colour & PNG_COLOR_MASK_ALPHA) != 0 || (trns && (colour == PNG_COLOR_TYPE_RGB || colour == PNG_COLOR_TYPE_PALETTE));
+  const bool alpha = (colour & PNG_COLOR_MASK_ALPHA) != 0 ||
+                     (trns && (colour == PNG_COLOR_TYPE_RGB || colour == PNG_COLOR_TYPE_PALETTE));
   if (depth == 16 && !alpha) png_set_strip_16(png);
   if (depth == 16 && alpha) png_set_swap(png);  // PNG's samples are big-endian; cv::Mat's are native
   if (alpha) png_set_tRNS_to_alpha(png);
@@ -165,7 +166,8 @@ cv::Mat decode_png_by_rows(std::span<const std::uint8_t> png, const std::string&
   PngInput in;
   in.bytes = png;
   PngReader reader(in);
-  if (reader.png == nullptr || reader.info == nullptr) throw_input_error(path, "libpng could not start (out of memory)");
+  if (reader.png == nullptr || reader.info == nullptr)
+    throw_input_error(path, "libpng could not start (out of memory)");
   Strips strips;
   cv::Mat out;
   if (!read_reduced(reader, scale, strips, out)) {

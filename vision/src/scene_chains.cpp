@@ -10,9 +10,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include "hk/error.hpp"
 #include "vision/gaps.hpp"
 #include "vision/thin_lines.hpp"
-#include "hk/error.hpp"
 
 namespace hk::vision {
 
@@ -58,13 +58,15 @@ double enclosed_area_m2(const std::vector<cv::Point2d>& points_m) {
 }
 
 double curve_salience(double length_m, double strength, double canny_high) {
-  if (!std::isfinite(length_m) || !std::isfinite(strength) || !std::isfinite(canny_high) || canny_high <= 0.0) return 0.0;
+  if (!std::isfinite(length_m) || !std::isfinite(strength) || !std::isfinite(canny_high) || canny_high <= 0.0)
+    return 0.0;
   return length_m * std::clamp(strength / canny_high, 0.0, 1.0);
 }
 
 double shape_salience(const ShapeFeatures& f, double canny_high) {
   if (!std::isfinite(f.area_m2) || f.area_m2 < 0.0) return 0.0;
-  if (!std::isfinite(f.length_m) || !std::isfinite(f.strength) || !std::isfinite(canny_high) || canny_high <= 0.0) return 0.0;
+  if (!std::isfinite(f.length_m) || !std::isfinite(f.strength) || !std::isfinite(canny_high) || canny_high <= 0.0)
+    return 0.0;
   const double outline_m = f.length_m + (f.closed ? 2.0 * std::sqrt(f.area_m2) : 0.0);
   return outline_m * std::max(0.0, f.strength) / canny_high;
 }
@@ -82,8 +84,8 @@ double border_share(const SceneCurve& c, const PxToM& map, int width_px, int hei
   return static_cast<double>(near) / static_cast<double>(c.points_m.size());
 }
 
-std::vector<SceneCurve> chains_to_curves(const std::vector<Chain>& chains, const PointValues& strengths, const PxToM& map, double min_length_m,
-                                         std::size_t* too_short) {
+std::vector<SceneCurve> chains_to_curves(const std::vector<Chain>& chains, const PointValues& strengths,
+                                         const PxToM& map, double min_length_m, std::size_t* too_short) {
   std::vector<SceneCurve> out;
   out.reserve(chains.size());
   std::size_t dropped = 0;
@@ -97,7 +99,8 @@ std::vector<SceneCurve> chains_to_curves(const std::vector<Chain>& chains, const
       continue;
     }
     if (k < strengths.size() && !strengths[k].empty()) {
-      c.strength = std::accumulate(strengths[k].begin(), strengths[k].end(), 0.0) / static_cast<double>(strengths[k].size());
+      c.strength =
+          std::accumulate(strengths[k].begin(), strengths[k].end(), 0.0) / static_cast<double>(strengths[k].size());
     }
     out.push_back(std::move(c));
   }
@@ -116,7 +119,8 @@ void check(const SimplifyParams& p) {
     if (!std::isfinite(v) || v <= 0.0) throw hk::ArgumentError("simplify_chains: the workspace must be finite and > 0");
   for (const double v : {p.thin_line_max_width_m, p.gap_close_m, p.min_chain_length_m})
     if (!std::isfinite(v) || v < 0.0) throw hk::ArgumentError("simplify_chains: lengths must be finite and >= 0");
-  if (p.max_shapes < 1 || p.max_segments < 1) throw hk::ArgumentError("simplify_chains: max_shapes and max_segments must be >= 1");
+  if (p.max_shapes < 1 || p.max_segments < 1)
+    throw hk::ArgumentError("simplify_chains: max_shapes and max_segments must be >= 1");
 }
 
 /// The chains and their strengths between the stages.
@@ -171,8 +175,8 @@ void join_gaps(Work& w, const Extraction& ex, const PxToM& map, const SimplifyPa
 /// decreasing shape_salience (ties: picture order), each kept while fewer than max_shapes are and its
 /// segments still fit max_segments (a less salient one further down may still fit). The kept curves stay in
 /// picture order, so curve ids follow the picture, not the ranking.
-std::vector<SceneCurve> apply_budgets(std::vector<SceneCurve> curves, const Extraction& ex, const PxToM& map, const SimplifyParams& p,
-                                      const SegmentCost& cost, SimplifyReport& r) {
+std::vector<SceneCurve> apply_budgets(std::vector<SceneCurve> curves, const Extraction& ex, const PxToM& map,
+                                      const SimplifyParams& p, const SegmentCost& cost, SimplifyReport& r) {
   std::vector<std::size_t> order;
   std::vector<double> salience(curves.size(), 0.0);
   std::vector<std::size_t> segments(curves.size(), 0);
@@ -185,7 +189,8 @@ std::vector<SceneCurve> apply_budgets(std::vector<SceneCurve> curves, const Extr
     }
     order.push_back(i);
     const SceneCurve& c = curves[i];
-    salience[i] = shape_salience({curve_length_m(c), c.strength, c.closed, c.closed ? enclosed_area_m2(c.points_m) : 0.0}, ex.edge_map.high);
+    salience[i] = shape_salience(
+        {curve_length_m(c), c.strength, c.closed, c.closed ? enclosed_area_m2(c.points_m) : 0.0}, ex.edge_map.high);
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return salience[a] > salience[b]; });
   std::vector<char> keep(curves.size(), 0);
@@ -225,19 +230,21 @@ SceneChains simplify_chains(Extraction ex, const SimplifyParams& p, const Segmen
   out.report.chains_after_thin_lines = w.chains.size();
   if (edges && p.gap_close_m > 0.0) join_gaps(w, ex, out.px_to_m, p, out.report);
   out.report.chains_after_gaps = w.chains.size();
-  std::vector<SceneCurve> curves = chains_to_curves(w.chains, w.strength, out.px_to_m, p.min_chain_length_m, &out.report.chains_too_short);
+  std::vector<SceneCurve> curves =
+      chains_to_curves(w.chains, w.strength, out.px_to_m, p.min_chain_length_m, &out.report.chains_too_short);
   out.curves = apply_budgets(std::move(curves), ex, out.px_to_m, p, cost, out.report);
   out.extraction = std::move(ex);
   return out;
 }
 
-SceneChains scene_chains(const std::string& path, const ExtractParams& ep, const SimplifyParams& p, const SegmentCost& cost) {
+SceneChains scene_chains(const std::string& path, const ExtractParams& ep, const SimplifyParams& p,
+                         const SegmentCost& cost) {
   check(p);
   return simplify_chains(extract_chains(path, ep), p, cost);
 }
 
-SceneChains scene_chains_from_image(const cv::Mat& image, const ExtractParams& ep, const SimplifyParams& p, const SegmentCost& cost,
-                                    const cv::Mat& ignore_mask) {
+SceneChains scene_chains_from_image(const cv::Mat& image, const ExtractParams& ep, const SimplifyParams& p,
+                                    const SegmentCost& cost, const cv::Mat& ignore_mask) {
   check(p);
   return simplify_chains(extract_chains_from_image(image, ep, ignore_mask), p, cost);
 }

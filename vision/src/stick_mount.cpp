@@ -44,9 +44,12 @@ struct HelperRun {
 /// Runs `helper args...` with standard output and error into one pipe and standard input from /dev/null,
 /// waits at most `timeout_s` (then SIGKILL), and returns its first line and exit status.
 /// Throws StickMountError (naming `devnode`) when it cannot be started.
-HelperRun run_helper(const std::string& helper, std::vector<std::string> args, double timeout_s, const std::string& devnode) {
+HelperRun run_helper(const std::string& helper, std::vector<std::string> args, double timeout_s,
+                     const std::string& devnode) {
   int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) throw StickMountError(stick_line(devnode, std::string("cannot start the mount helper (pipe: ") + std::strerror(errno) + ")"));
+  if (::pipe2(fds, O_CLOEXEC) != 0)
+    throw StickMountError(
+        stick_line(devnode, std::string("cannot start the mount helper (pipe: ") + std::strerror(errno) + ")"));
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
@@ -67,10 +70,13 @@ HelperRun run_helper(const std::string& helper, std::vector<std::string> args, d
 
   HelperRun run;
   std::string text;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(timeout_s));
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(timeout_s));
   char buf[4096];
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
     if (left <= 0) {
       run.timed_out = true;
       ::kill(pid, SIGKILL);
@@ -100,7 +106,8 @@ std::string helper_refusal(const std::string& devnode, const HelperRun& run) {
   const std::string prefix = "hk-stick-mount: ";
   if (line.rfind(prefix, 0) == 0) line = line.substr(prefix.size());
   if (line.empty()) {
-    if (WIFSIGNALED(run.status)) return stick_line(devnode, "the mount helper died of signal " + std::to_string(WTERMSIG(run.status)));
+    if (WIFSIGNALED(run.status))
+      return stick_line(devnode, "the mount helper died of signal " + std::to_string(WTERMSIG(run.status)));
     return stick_line(devnode, "the mount helper failed without saying why (exit status " +
                                    std::to_string(WIFEXITED(run.status) ? WEXITSTATUS(run.status) : -1) + ")");
   }
@@ -116,7 +123,8 @@ std::string helper_refusal(const std::string& devnode, const HelperRun& run) {
 /// A stick the kiosk mounted itself.
 class DirectStickMount final : public StickMount {
  public:
-  DirectStickMount(const std::string& devnode, const std::string& mount_root, int slot) : stick_(devnode, mount_root, slot) {}
+  DirectStickMount(const std::string& devnode, const std::string& mount_root, int slot)
+      : stick_(devnode, mount_root, slot) {}
   const std::string& devnode() const override { return stick_.devnode(); }
   const std::string& mount_point() const override { return stick_.mount_point(); }
   const std::string& filesystem() const override { return stick_.filesystem(); }
@@ -129,8 +137,13 @@ class DirectStickMount final : public StickMount {
 /// A stick the helper mounted; the helper's "unmount" verb undoes it.
 class HelperStickMount final : public StickMount {
  public:
-  HelperStickMount(std::string helper, std::string devnode, int slot, std::string mount_point, std::string fs, double timeout_s)
-      : helper_(std::move(helper)), devnode_(std::move(devnode)), mount_point_(std::move(mount_point)), fs_(std::move(fs)), slot_(slot),
+  HelperStickMount(std::string helper, std::string devnode, int slot, std::string mount_point, std::string fs,
+                   double timeout_s)
+      : helper_(std::move(helper)),
+        devnode_(std::move(devnode)),
+        mount_point_(std::move(mount_point)),
+        fs_(std::move(fs)),
+        slot_(slot),
         timeout_s_(timeout_s) {}
   ~HelperStickMount() override { (void)unmount(); }
   HelperStickMount(const HelperStickMount&) = delete;
@@ -156,7 +169,8 @@ class HelperStickMount final : public StickMount {
   bool mounted_ = true;
 };
 
-std::unique_ptr<StickMount> mount_through_helper(const std::string& helper, const std::string& devnode, int slot, double timeout_s) {
+std::unique_ptr<StickMount> mount_through_helper(const std::string& helper, const std::string& devnode, int slot,
+                                                 double timeout_s) {
   const HelperRun run = run_helper(helper, {"mount", devnode, std::to_string(slot)}, timeout_s, devnode);
   if (run.timed_out) {
     // It may have mounted meanwhile: undo whatever it did at this slot.
@@ -172,7 +186,8 @@ std::unique_ptr<StickMount> mount_through_helper(const std::string& helper, cons
   in >> word >> fs >> at >> mount_point;
   if (word != "mounted" || fs.empty() || at != "at" || mount_point.empty()) {
     (void)run_helper(helper, {"unmount", std::to_string(slot)}, timeout_s, devnode);
-    throw StickMountError(stick_line(devnode, "the mount helper answered '" + run.first_line + "', not 'mounted FSTYPE at MOUNT_POINT'"));
+    throw StickMountError(
+        stick_line(devnode, "the mount helper answered '" + run.first_line + "', not 'mounted FSTYPE at MOUNT_POINT'"));
   }
   return std::make_unique<HelperStickMount>(helper, devnode, slot, mount_point, fs, timeout_s);
 }
@@ -181,9 +196,12 @@ std::unique_ptr<StickMount> mount_through_helper(const std::string& helper, cons
 
 const char* stick_mounter_name(StickMounter m) {
   switch (m) {
-    case StickMounter::Direct: return "direct";
-    case StickMounter::Helper: return "helper";
-    case StickMounter::None: return "none";
+    case StickMounter::Direct:
+      return "direct";
+    case StickMounter::Helper:
+      return "helper";
+    case StickMounter::None:
+      return "none";
   }
   return "none";
 }
@@ -196,20 +214,25 @@ std::string stick_helper_path() {
 StickMounter choose_stick_mounter(bool have_capability, const std::string& helper_path) {
   if (have_capability) return StickMounter::Direct;
   struct stat st {};
-  if (!helper_path.empty() && ::stat(helper_path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(helper_path.c_str(), X_OK) == 0) {
+  if (!helper_path.empty() && ::stat(helper_path.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+      ::access(helper_path.c_str(), X_OK) == 0) {
     return StickMounter::Helper;
   }
   return StickMounter::None;
 }
 
-std::unique_ptr<StickMount> mount_stick(StickMounter how, const std::string& devnode, const std::string& mount_root, int slot,
-                                        const std::string& helper_path, double timeout_s) {
+std::unique_ptr<StickMount> mount_stick(StickMounter how, const std::string& devnode, const std::string& mount_root,
+                                        int slot, const std::string& helper_path, double timeout_s) {
   switch (how) {
-    case StickMounter::Direct: return std::make_unique<DirectStickMount>(devnode, mount_root, slot);
-    case StickMounter::Helper: return mount_through_helper(helper_path, devnode, slot, timeout_s);
-    case StickMounter::None: break;
+    case StickMounter::Direct:
+      return std::make_unique<DirectStickMount>(devnode, mount_root, slot);
+    case StickMounter::Helper:
+      return mount_through_helper(helper_path, devnode, slot, timeout_s);
+    case StickMounter::None:
+      break;
   }
-  throw StickMountError(stick_line(devnode, "cannot mount it: " + mount_capability_hint() + ", or install the mount helper " + kDefaultStickHelperPath));
+  throw StickMountError(stick_line(devnode, "cannot mount it: " + mount_capability_hint() +
+                                                ", or install the mount helper " + kDefaultStickHelperPath));
 }
 
 }  // namespace hk::vision

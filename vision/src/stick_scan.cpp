@@ -18,8 +18,8 @@
 #include "vision/stick_scan.hpp"
 #include "hk/text.hpp"
 
-#include "unique_fd.hpp"
 #include "hk/error.hpp"
+#include "unique_fd.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -104,7 +104,9 @@ bool ascii_iequal(std::string_view a, std::string_view b) {
 /// Reason to leave out a hidden or system entry without opening it, or "".
 std::string reason_for_hidden(std::string_view name, bool folder) {
   if (name.starts_with("._")) return "a macOS metadata file (name starts with \"._\"), not a document";
-  if (name.starts_with(".")) return folder ? "a hidden folder (name starts with '.'), not entered" : "a hidden file (name starts with '.'), not listed";
+  if (name.starts_with("."))
+    return folder ? "a hidden folder (name starts with '.'), not entered"
+                  : "a hidden file (name starts with '.'), not listed";
   if (ascii_iequal(name, "System Volume Information") || ascii_iequal(name, "$RECYCLE.BIN")) {
     return folder ? "a Windows system folder, not entered" : "a Windows system file, not listed";
   }
@@ -147,7 +149,9 @@ class Walker {
   bool out_of_time() {
     if (seconds() <= limits_.max_seconds) return false;
     char buf[128];
-    std::snprintf(buf, sizeof buf, "time limit: the walk took longer than %g s; the rest of the stick was not looked at", limits_.max_seconds);
+    std::snprintf(buf, sizeof buf,
+                  "time limit: the walk took longer than %g s; the rest of the stick was not looked at",
+                  limits_.max_seconds);
     stop(buf);
     stopped_ = true;
     return true;
@@ -196,9 +200,14 @@ class Walker {
         refuse(path, "cannot be examined: " + errno_text(errno));
         return;
       }
-      type = S_ISDIR(st.st_mode) ? DT_DIR : S_ISREG(st.st_mode) ? DT_REG : S_ISLNK(st.st_mode) ? DT_LNK
-           : S_ISFIFO(st.st_mode) ? DT_FIFO : S_ISSOCK(st.st_mode) ? DT_SOCK : S_ISCHR(st.st_mode) ? DT_CHR
-           : S_ISBLK(st.st_mode) ? DT_BLK : DT_WHT;
+      type = S_ISDIR(st.st_mode)    ? DT_DIR
+             : S_ISREG(st.st_mode)  ? DT_REG
+             : S_ISLNK(st.st_mode)  ? DT_LNK
+             : S_ISFIFO(st.st_mode) ? DT_FIFO
+             : S_ISSOCK(st.st_mode) ? DT_SOCK
+             : S_ISCHR(st.st_mode)  ? DT_CHR
+             : S_ISBLK(st.st_mode)  ? DT_BLK
+                                    : DT_WHT;
     }
     switch (type) {
       case DT_DIR:
@@ -225,7 +234,8 @@ class Walker {
       return refuse(path, "folder deeper than " + std::to_string(limits_.max_depth) + " levels is not entered");
     }
     if (entries_exhausted_) {
-      return refuse(path, "folder not entered: the limit of " + std::to_string(limits_.max_entries) + " entries was reached");
+      return refuse(path,
+                    "folder not entered: the limit of " + std::to_string(limits_.max_entries) + " entries was reached");
     }
     const Fd fd(open_beneath(dirfd, name.c_str(), O_RDONLY | O_DIRECTORY));
     if (!fd.ok()) return refuse(path, reason_for_open_error(-fd.get(), true));
@@ -256,15 +266,19 @@ class Walker {
     const std::string format = sniff_document_format(std::string_view(head, static_cast<std::size_t>(got)));
     if (format.empty()) return refuse(path, "not a picture or PDF (unknown format)");
     if (st.st_size > limits_.max_file_bytes) {
-      return refuse(path, "file size " + std::to_string(st.st_size) + " bytes exceeds the limit of " +
-                              std::to_string(limits_.max_file_bytes) + " bytes", true);
+      return refuse(path,
+                    "file size " + std::to_string(st.st_size) + " bytes exceeds the limit of " +
+                        std::to_string(limits_.max_file_bytes) + " bytes",
+                    true);
     }
     if (limits_.picture_check && format != "pdf") {  // refused here, with the others, not when visited
-      std::string why = limits_.picture_check(fd.get(), static_cast<std::uint64_t>(st.st_size), safe_display_name(path));
+      std::string why =
+          limits_.picture_check(fd.get(), static_cast<std::uint64_t>(st.st_size), safe_display_name(path));
       if (!why.empty()) return refuse(path, std::move(why), true);
     }
     if (static_cast<long>(out_.documents.size()) >= limits_.max_documents) {
-      const std::string why = "document limit: more than " + std::to_string(limits_.max_documents) + " documents; the rest were not listed";
+      const std::string why =
+          "document limit: more than " + std::to_string(limits_.max_documents) + " documents; the rest were not listed";
       refuse(path, "over the limit of " + std::to_string(limits_.max_documents) + " documents");
       stop(why);
       stopped_ = true;
@@ -295,7 +309,8 @@ void check_limits(const ScanLimits& l) {
   if (l.max_entries <= 0) bad("max_entries", std::to_string(l.max_entries));
   if (l.max_documents <= 0) bad("max_documents", std::to_string(l.max_documents));
   if (l.max_file_bytes <= 0) bad("max_file_bytes", std::to_string(l.max_file_bytes));
-  if (!(l.max_seconds > 0.0) || !std::isfinite(l.max_seconds)) bad("max_seconds (finite)", std::to_string(l.max_seconds));
+  if (!(l.max_seconds > 0.0) || !std::isfinite(l.max_seconds))
+    bad("max_seconds (finite)", std::to_string(l.max_seconds));
 }
 
 /// The root folder, opened as a folder and checked to accept openat2 (Linux 5.6 or later).
@@ -337,22 +352,24 @@ void put_utf8(std::string& out, char32_t cp) {
 
 /// True for the characters safe_display_name drops.
 bool dropped(char32_t cp) {
-  return cp < 0x20 || (cp >= 0x7F && cp <= 0x9F)       // C0, DEL, C1
-         || cp == 0x061C || cp == 0x200E || cp == 0x200F  // bidi marks
-         || (cp >= 0x202A && cp <= 0x202E)                // bidi embeddings and overrides
-         || (cp >= 0x2066 && cp <= 0x2069)                // bidi isolates
+  return cp < 0x20 || (cp >= 0x7F && cp <= 0x9F)            // C0, DEL, C1
+         || cp == 0x061C || cp == 0x200E || cp == 0x200F    // bidi marks
+         || (cp >= 0x202A && cp <= 0x202E)                  // bidi embeddings and overrides
+         || (cp >= 0x2066 && cp <= 0x2069)                  // bidi isolates
          || (cp >= 0x200B && cp <= 0x200D) || cp == 0xFEFF  // zero-width space, joiners, BOM
-         || cp == 0x2028 || cp == 0x2029 || cp == 0x2060;  // line and paragraph separators, word joiner
+         || cp == 0x2028 || cp == 0x2029 || cp == 0x2060;   // line and paragraph separators, word joiner
 }
 
 }  // namespace
 
 std::string sniff_document_format(std::string_view h) {
-  auto at = [&](std::size_t off, std::string_view magic) { return h.size() >= off + magic.size() && h.substr(off, magic.size()) == magic; };
+  auto at = [&](std::size_t off, std::string_view magic) {
+    return h.size() >= off + magic.size() && h.substr(off, magic.size()) == magic;
+  };
   if (at(0, std::string_view("\x89PNG\r\n\x1a\n", 8))) return "png";
   if (at(0, "\xFF\xD8\xFF")) return "jpeg";
-  if (at(0, std::string_view("II*\0", 4)) || at(0, std::string_view("MM\0*", 4)) || at(0, std::string_view("II+\0", 4)) ||
-      at(0, std::string_view("MM\0+", 4))) {
+  if (at(0, std::string_view("II*\0", 4)) || at(0, std::string_view("MM\0*", 4)) ||
+      at(0, std::string_view("II+\0", 4)) || at(0, std::string_view("MM\0+", 4))) {
     return "tiff";
   }
   if (at(0, "RIFF") && at(8, "WEBP")) return "webp";
@@ -361,7 +378,8 @@ std::string sniff_document_format(std::string_view h) {
     // "BM" alone is weak (a text file may start so); when the first 16 bytes are there, the low half of
     // the DIB header size at offset 14 must be one of the known sizes.
     if (h.size() < 16) return "bmp";
-    const unsigned dib = static_cast<unsigned char>(h[14]) | (static_cast<unsigned>(static_cast<unsigned char>(h[15])) << 8);
+    const unsigned dib =
+        static_cast<unsigned char>(h[14]) | (static_cast<unsigned>(static_cast<unsigned char>(h[15])) << 8);
     for (unsigned known : {12u, 16u, 40u, 52u, 56u, 64u, 108u, 124u}) {
       if (dib == known) return "bmp";
     }
@@ -401,13 +419,15 @@ StickScan scan_stick(const std::string& root, const ScanLimits& limits) {
   StickScan out;
   Walker walker(limits, out);
   walker.walk(root_fd.get(), "", 0);
-  std::sort(out.documents.begin(), out.documents.end(), [](const StickDocument& a, const StickDocument& b) { return a.path < b.path; });
+  std::sort(out.documents.begin(), out.documents.end(),
+            [](const StickDocument& a, const StickDocument& b) { return a.path < b.path; });
   if (!out.complete) out.refused.push_back({"", out.stopped_by});
   out.seconds = walker.seconds();
   return out;
 }
 
-std::vector<std::uint8_t> read_stick_file(const std::string& root, const std::string& relative_path, std::int64_t max_bytes) {
+std::vector<std::uint8_t> read_stick_file(const std::string& root, const std::string& relative_path,
+                                          std::int64_t max_bytes) {
   auto fail = [&](const std::string& problem) -> StickError {
     return StickError("stick file '" + safe_display_name(relative_path) + "': " + problem);
   };
@@ -456,7 +476,8 @@ std::vector<std::uint8_t> read_stick_file(const std::string& root, const std::st
   check_type(st);
   if (st.st_dev != seen.st_dev || st.st_ino != seen.st_ino) throw fail("changed while being opened");
   if (st.st_size > max_bytes) {
-    throw fail("file size " + std::to_string(st.st_size) + " bytes exceeds the limit of " + std::to_string(max_bytes) + " bytes");
+    throw fail("file size " + std::to_string(st.st_size) + " bytes exceeds the limit of " + std::to_string(max_bytes) +
+               " bytes");
   }
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(st.st_size));
   std::size_t done = 0;
@@ -466,7 +487,8 @@ std::vector<std::uint8_t> read_stick_file(const std::string& root, const std::st
       if (errno == EINTR) continue;
       throw fail("cannot be read: " + errno_text(errno));
     }
-    if (got == 0) throw fail("changed while being read (shorter than its size of " + std::to_string(st.st_size) + " bytes)");
+    if (got == 0)
+      throw fail("changed while being read (shorter than its size of " + std::to_string(st.st_size) + " bytes)");
     done += static_cast<std::size_t>(got);
   }
   std::uint8_t extra;
@@ -474,7 +496,8 @@ std::vector<std::uint8_t> read_stick_file(const std::string& root, const std::st
   do {
     more = ::read(fd.get(), &extra, 1);
   } while (more < 0 && errno == EINTR);
-  if (more > 0) throw fail("changed while being read (longer than its size of " + std::to_string(st.st_size) + " bytes)");
+  if (more > 0)
+    throw fail("changed while being read (longer than its size of " + std::to_string(st.st_size) + " bytes)");
   return bytes;
 }
 

@@ -14,7 +14,8 @@
 namespace hk::vision {
 
 cv::Mat surround_mean(const cv::Mat& src, double sigma) {
-  if (src.empty() || src.type() != CV_32FC1) throw hk::ArgumentError("surround_mean: expected a non-empty CV_32FC1 image");
+  if (src.empty() || src.type() != CV_32FC1)
+    throw hk::ArgumentError("surround_mean: expected a non-empty CV_32FC1 image");
   if (!(sigma > 0.0) || !std::isfinite(sigma)) throw hk::ArgumentError("surround_mean: sigma must be finite and > 0");
   const double so = kSurroundRatio * sigma;
   const double c = (sigma / so) * (sigma / so);
@@ -45,8 +46,10 @@ cv::Mat gradient_magnitude(const cv::Mat& grey, double blur_sigma_px) {
 }  // namespace
 
 PointValues chain_surround(const cv::Mat& grey, double blur_sigma_px, const std::vector<Chain>& chains) {
-  if (grey.empty() || grey.type() != CV_8UC1) throw hk::ArgumentError("chain_surround: expected a non-empty CV_8UC1 image");
-  if (!std::isfinite(blur_sigma_px) || blur_sigma_px < 0.0) throw hk::ArgumentError("chain_surround: blur_sigma_px must be finite and >= 0");
+  if (grey.empty() || grey.type() != CV_8UC1)
+    throw hk::ArgumentError("chain_surround: expected a non-empty CV_8UC1 image");
+  if (!std::isfinite(blur_sigma_px) || blur_sigma_px < 0.0)
+    throw hk::ArgumentError("chain_surround: blur_sigma_px must be finite and >= 0");
   const cv::Mat m = gradient_magnitude(grey, blur_sigma_px);
   // The annulus is smooth (σo = 4σ): averaged at half resolution (area-averaged, σ halved), enlarged back
   // bilinearly — a quarter of the pixels to blur.
@@ -58,7 +61,8 @@ PointValues chain_surround(const cv::Mat& grey, double blur_sigma_px, const std:
   for (std::size_t k = 0; k < chains.size(); ++k) {
     out[k].reserve(chains[k].points_px.size());
     for (const cv::Point2d& p : chains[k].points_px) {
-      const int x = std::clamp(static_cast<int>(p.x), 0, grey.cols - 1), y = std::clamp(static_cast<int>(p.y), 0, grey.rows - 1);
+      const int x = std::clamp(static_cast<int>(p.x), 0, grey.cols - 1),
+                y = std::clamp(static_cast<int>(p.y), 0, grey.rows - 1);
       out[k].push_back(surround.at<float>(y, x));
     }
   }

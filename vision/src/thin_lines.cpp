@@ -20,17 +20,17 @@ namespace hk::vision {
 namespace {
 
 constexpr double kCosParallel = 0.8660254037844386;  // tangents within 30 deg of (anti-)parallel
-constexpr double kSinNormal = 0.5;                    // the gap within 30 deg of both normals
-constexpr double kMinGapPx = 1.0;       // closer points are the same edge (junction pixels repeat)
-constexpr double kMinRunWidths = 2.0;   // a run of pairs must be this many widths long to be a line
-constexpr double kMinPiecePx = 2.0;     // left-over pieces up to this long are Canny crumbs
-constexpr double kMinStepPx = 0.2;      // centre-line points closer than this to the last are dropped
-constexpr double kCosJoin = -0.2;       // a join turns by at most ~100 deg (an L's 90 deg passes)
+constexpr double kSinNormal = 0.5;                   // the gap within 30 deg of both normals
+constexpr double kMinGapPx = 1.0;                    // closer points are the same edge (junction pixels repeat)
+constexpr double kMinRunWidths = 2.0;                // a run of pairs must be this many widths long to be a line
+constexpr double kMinPiecePx = 2.0;                  // left-over pieces up to this long are Canny crumbs
+constexpr double kMinStepPx = 0.2;                   // centre-line points closer than this to the last are dropped
+constexpr double kCosJoin = -0.2;                    // a join turns by at most ~100 deg (an L's 90 deg passes)
 // A join must stay clear of every edge point by this much: a segment crossing an 8-connected
 // pixel chain passes within sqrt(2) / 2 px of one of its pixel centres (+ the 0.25 px sampling),
 // while the centre of a stroke lies half the stroke width (>= ~1.5 px after the blur) from them.
 constexpr double kJoinClearPx = 0.9;
-constexpr double kCosCorner = 0.94;     // a join turning by more than ~20 deg goes through its corner
+constexpr double kCosCorner = 0.94;  // a join turning by more than ~20 deg goes through its corner
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 
 /// Uniform grid over a fixed point set for radius queries: counting sort of the points by cell,
@@ -110,9 +110,9 @@ class PointGrid {
 
   double x0_ = 0, y0_ = 0, cell_ = 1;
   std::size_t nx_ = 0, ny_ = 0;
-  std::vector<std::size_t> start_;  // points of cell c: order_[start_[c] .. start_[c + 1])
-  std::vector<std::size_t> order_;     // point indices by cell
-  std::vector<cv::Point2d> sorted_;    // the points in that order (the query loop reads them in sequence)
+  std::vector<std::size_t> start_;   // points of cell c: order_[start_[c] .. start_[c + 1])
+  std::vector<std::size_t> order_;   // point indices by cell
+  std::vector<cv::Point2d> sorted_;  // the points in that order (the query loop reads them in sequence)
 };
 
 /// A centre line under construction.
@@ -292,7 +292,8 @@ long index_step(const Flat& f, std::size_t k, std::size_t i, std::size_t j) {
 
 /// Whether the partners of consecutive run points g0 and g1 (walk `steps` apart) follow each other: on one
 /// chain and moving on slowly; a leap is another stroke.
-bool partners_follow(const Flat& f, const std::vector<std::size_t>& partner, std::size_t g0, std::size_t g1, std::size_t steps) {
+bool partners_follow(const Flat& f, const std::vector<std::size_t>& partner, std::size_t g0, std::size_t g1,
+                     std::size_t steps) {
   const std::size_t q0 = partner[g0];
   const std::size_t q1 = partner[g1];
   if (f.chain_of[q0] != f.chain_of[q1]) return false;
@@ -330,8 +331,8 @@ void walk_chain(const Flat& f, const std::vector<std::size_t>& partner, std::siz
       const std::size_t steps = t - r.walk_pos.back();
       // The fold test: g's partner already in this run, or g the partner of one of its points,
       // means the walk went round a stroke's end and came back along its other side.
-      extend = steps - 1 <= max_skip && partners_follow(f, partner, r.members.back(), g, steps) && rw.run_of[partner[g]] != cur &&
-               rw.partner_of_run[g] != cur;
+      extend = steps - 1 <= max_skip && partners_follow(f, partner, r.members.back(), g, steps) &&
+               rw.run_of[partner[g]] != cur && rw.partner_of_run[g] != cur;
     }
     if (!extend) {
       cur = runs.size();
@@ -409,7 +410,9 @@ std::vector<Run> find_runs(const Flat& f, const std::vector<std::size_t>& partne
 }
 
 /// The value of chain k's point i, 0 without values.
-double value_at(const PointValues* values_in, std::size_t k, std::size_t i) { return values_in != nullptr ? (*values_in)[k][i] : 0.0; }
+double value_at(const PointValues* values_in, std::size_t k, std::size_t i) {
+  return values_in != nullptr ? (*values_in)[k][i] : 0.0;
+}
 
 /// Marks what run r stands for as covered: its points, their partners, the unpaired points skipped between
 /// run points and the partner-side points between consecutive partners.
@@ -439,8 +442,9 @@ void cover_run(const Flat& f, const std::vector<std::size_t>& partner, const Run
 
 /// Step 4: centre lines from the kept runs' fresh points (midpoints of each point and its partner, values
 /// averaged), smoothed; what each run stands for is marked in `covered`.
-std::vector<Piece> build_centre_lines(const Flat& f, const std::vector<std::size_t>& partner, const std::vector<Run>& runs,
-                                      const PointValues* values_in, std::vector<char>& covered) {
+std::vector<Piece> build_centre_lines(const Flat& f, const std::vector<std::size_t>& partner,
+                                      const std::vector<Run>& runs, const PointValues* values_in,
+                                      std::vector<char>& covered) {
   std::vector<Piece> centre;
   for (const Run& r : runs) {
     if (!r.kept) continue;
@@ -455,7 +459,8 @@ std::vector<Piece> build_centre_lines(const Flat& f, const std::vector<std::size
       const std::size_t g = r.members[j];
       const std::size_t q = partner[g];
       c.pts.push_back(0.5 * (f.pos[g] + f.pos[q]));
-      c.vals.push_back(0.5 * (value_at(values_in, f.chain_of[g], f.idx[g]) + value_at(values_in, f.chain_of[q], f.idx[q])));
+      c.vals.push_back(0.5 *
+                       (value_at(values_in, f.chain_of[g], f.idx[g]) + value_at(values_in, f.chain_of[q], f.idx[q])));
     };
     if (r.closed && all_fresh) {
       Piece c;
@@ -537,7 +542,8 @@ std::vector<cv::Point2d> join_path(const End& ea, const End& eb, const PointGrid
     for (std::size_t k = 1; clear && k < path.size(); ++k) {
       const int parts = static_cast<int>(std::ceil(cv::norm(path[k] - path[k - 1]) / 0.25));
       for (int i = 0; clear && i <= parts; ++i) {
-        const cv::Point2d p = path[k - 1] + (path[k] - path[k - 1]) * (parts > 0 ? static_cast<double>(i) / parts : 0.0);
+        const cv::Point2d p =
+            path[k - 1] + (path[k] - path[k - 1]) * (parts > 0 ? static_cast<double>(i) / parts : 0.0);
         clear = !grid.any_within(p, kJoinClearPx);
       }
     }
@@ -548,7 +554,8 @@ std::vector<cv::Point2d> join_path(const End& ea, const End& eb, const PointGrid
 
 /// Each end's best partner end for a join (kNone: none): within join_r, the smallest turn, the joining
 /// segment not doubling back and its path clear of the edges.
-std::vector<std::size_t> best_joins(const std::vector<End>& ends, const std::vector<Piece>& centre, const PointGrid& grid, double join_r) {
+std::vector<std::size_t> best_joins(const std::vector<End>& ends, const std::vector<Piece>& centre,
+                                    const PointGrid& grid, double join_r) {
   std::vector<cv::Point2d> end_pts;
   for (const End& e : ends) end_pts.push_back(e.at);
   const PointGrid end_grid(end_pts, join_r);
@@ -639,8 +646,9 @@ std::vector<Piece> join_centre_lines(std::vector<Piece> centre, const PointGrid&
 
 /// Step 6: the chains' points no run covered (untouched chains whole, the rest cut into pieces trimmed where
 /// they run into a centre line, crumbs dropped), then the centre lines; values alongside.
-std::vector<Chain> assemble(const std::vector<Chain>& chains, const Flat& f, const std::vector<char>& covered, std::vector<Piece> lines,
-                            double w, const PointValues* values_in, PointValues& vals_out, ThinLineStats& st) {
+std::vector<Chain> assemble(const std::vector<Chain>& chains, const Flat& f, const std::vector<char>& covered,
+                            std::vector<Piece> lines, double w, const PointValues* values_in, PointValues& vals_out,
+                            ThinLineStats& st) {
   std::vector<cv::Point2d> samples;  // centre lines sampled at <= 0.5 px
   for (const Piece& c : lines) {
     const std::size_t n = c.pts.size();

@@ -180,7 +180,8 @@ int open_root(const std::string& who, const std::string& root, bool create) {
       fd = ::openat(dir.get(), part.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
     }
     if (fd < 0) {
-      if (errno == ENOTDIR || errno == ELOOP) fail("the mount root's part " + walked + " is a symbolic link or not a folder");
+      if (errno == ENOTDIR || errno == ELOOP)
+        fail("the mount root's part " + walked + " is a symbolic link or not a folder");
       fail("cannot open the mount root's part " + walked + ": " + errno_text(errno));
     }
     dir.reset(fd);
@@ -213,7 +214,8 @@ int fresh_mount_point(const std::string& devnode, int root_fd, const std::string
   } else if (errno != ENOENT) {
     refuse(devnode, "cannot examine the mount point " + shown + ": " + errno_text(errno));
   }
-  if (::mkdirat(root_fd, name.c_str(), 0700) != 0) refuse(devnode, "cannot create the mount point " + shown + ": " + errno_text(errno));
+  if (::mkdirat(root_fd, name.c_str(), 0700) != 0)
+    refuse(devnode, "cannot create the mount point " + shown + ": " + errno_text(errno));
   const int fd = ::openat(root_fd, name.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
   if (fd < 0) {
     const int err = errno;
@@ -236,7 +238,8 @@ void check_not_in_use(const std::string& devnode) {
     ::close(fd);
     return;
   }
-  if (errno == EBUSY) refuse(devnode, "it is in use (mounted elsewhere, or a disk with a partition in use), so it is not mounted");
+  if (errno == EBUSY)
+    refuse(devnode, "it is in use (mounted elsewhere, or a disk with a partition in use), so it is not mounted");
   refuse(devnode, "cannot open the device exclusively: " + errno_text(errno));
 }
 
@@ -483,7 +486,8 @@ UdevBlockEventSource::UdevBlockEventSource() : impl_(std::make_unique<Impl>()) {
   impl_->ctx = udev_new();
   if (impl_->ctx == nullptr) throw StickMountError(who + ": cannot start libudev: " + errno_text(errno));
   impl_->monitor = udev_monitor_new_from_netlink(impl_->ctx, "udev");
-  if (impl_->monitor == nullptr) throw StickMountError(who + ": cannot open the udev netlink socket: " + errno_text(errno));
+  if (impl_->monitor == nullptr)
+    throw StickMountError(who + ": cannot open the udev netlink socket: " + errno_text(errno));
   if (udev_monitor_filter_add_match_subsystem_devtype(impl_->monitor, "block", nullptr) < 0 ||
       udev_monitor_enable_receiving(impl_->monitor) < 0) {
     throw StickMountError(who + ": cannot listen to udev block events: " + errno_text(errno));

@@ -166,8 +166,10 @@ class V4l2FrameSource final : public FrameSource {
   bool next(Frame& out, double timeout_s) override {
     if (requeue_failed_) fail("VIDIOC_QBUF: " + errno_text(requeue_errno_));
     using Clock = std::chrono::steady_clock;
-    const double wait_s = std::isfinite(timeout_s) ? std::clamp(timeout_s, 0.0, 86400.0) : (timeout_s > 0 ? 86400.0 : 0.0);
-    const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wait_s));
+    const double wait_s =
+        std::isfinite(timeout_s) ? std::clamp(timeout_s, 0.0, 86400.0) : (timeout_s > 0 ? 86400.0 : 0.0);
+    const auto deadline =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wait_s));
     for (;;) {
       const double left_s = std::chrono::duration<double>(deadline - Clock::now()).count();
       const int left_ms = left_s <= 0.0 ? 0 : static_cast<int>(std::ceil(left_s * 1000.0));
@@ -192,8 +194,8 @@ class V4l2FrameSource final : public FrameSource {
         }
         fail("VIDIOC_DQBUF: " + errno_text(errno));
       }
-      if (b.index >= buffers_.size()) fail("VIDIOC_DQBUF returned buffer " + std::to_string(b.index) + " of " +
-                                           std::to_string(buffers_.size()));
+      if (b.index >= buffers_.size())
+        fail("VIDIOC_DQBUF returned buffer " + std::to_string(b.index) + " of " + std::to_string(buffers_.size()));
       const Requeue requeue(*this, b.index);
       if ((b.flags & V4L2_BUF_FLAG_ERROR) != 0) continue;  // a corrupted frame: wait for the next one
       cv::Mat bgr;
@@ -282,8 +284,9 @@ class V4l2FrameSource final : public FrameSource {
     if (pixel_format_ == V4L2_PIX_FMT_YUYV) {
       if (w % 2 != 0) fail("the driver gave an odd YUYV width of " + std::to_string(w) + " px");
       if (bytes_per_line_ == 0) bytes_per_line_ = 2 * w;
-      if (bytes_per_line_ < 2 * w) fail("the driver gave a YUYV line of " + std::to_string(bytes_per_line_) +
-                                        " bytes for " + std::to_string(w) + " px");
+      if (bytes_per_line_ < 2 * w)
+        fail("the driver gave a YUYV line of " + std::to_string(bytes_per_line_) + " bytes for " + std::to_string(w) +
+             " px");
     }
   }
 
@@ -309,8 +312,8 @@ class V4l2FrameSource final : public FrameSource {
       if (xioctl(fd_, VIDIOC_QUERYBUF, &b) != 0) fail("VIDIOC_QUERYBUF: " + errno_text(errno));
       if (b.length == 0) fail("the driver gave an empty frame buffer");
       if (b.length > max_bytes) {
-        fail("frame buffer of " + std::to_string(b.length) + " bytes exceeds the limit of " + std::to_string(max_bytes) +
-             " bytes");
+        fail("frame buffer of " + std::to_string(b.length) + " bytes exceeds the limit of " +
+             std::to_string(max_bytes) + " bytes");
       }
       if (pixel_format_ == V4L2_PIX_FMT_YUYV && b.length < yuyv_bytes) {
         fail("frame buffer of " + std::to_string(b.length) + " bytes is smaller than a YUYV frame (" +

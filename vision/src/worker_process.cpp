@@ -131,7 +131,9 @@ int high_fd(int fd) {
   return h;
 }
 
-[[noreturn]] void cannot_start(const char* what, int e) { throw WorkerStartFailure{std::string(what) + ": " + std::strerror(e)}; }
+[[noreturn]] void cannot_start(const char* what, int e) {
+  throw WorkerStartFailure{std::string(what) + ": " + std::strerror(e)};
+}
 
 /// The input in memory the worker maps read-only (sealed: it cannot be changed after it is written).
 int sealed_input(std::span<const std::uint8_t> input) {
@@ -153,14 +155,16 @@ int sealed_input(std::span<const std::uint8_t> input) {
 }
 
 /// Reads `fd` into run.answer until EOF, the deadline, max_answer bytes or the cancel flag.
-void read_answer(int fd, std::chrono::steady_clock::time_point deadline, std::size_t max_answer, const std::atomic<bool>* cancel, WorkerRun& run) {
+void read_answer(int fd, std::chrono::steady_clock::time_point deadline, std::size_t max_answer,
+                 const std::atomic<bool>* cancel, WorkerRun& run) {
   char buf[1 << 16];
   for (;;) {
     if (cancel && cancel->load(std::memory_order_relaxed)) {
       run.cancelled = true;
       return;
     }
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
     if (left <= 0) {
       run.timed_out = true;
       return;
@@ -184,8 +188,8 @@ void read_answer(int fd, std::chrono::steady_clock::time_point deadline, std::si
 
 }  // namespace
 
-WorkerRun run_worker(const std::string& path, const std::vector<std::string>& args, std::span<const std::uint8_t> input, double wall_s,
-                     std::size_t max_answer, const std::atomic<bool>* cancel) {
+WorkerRun run_worker(const std::string& path, const std::vector<std::string>& args, std::span<const std::uint8_t> input,
+                     double wall_s, std::size_t max_answer, const std::atomic<bool>* cancel) {
   const int in = sealed_input(input);
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) {
@@ -215,7 +219,10 @@ WorkerRun run_worker(const std::string& path, const std::vector<std::string>& ar
     cannot_start(path.c_str(), rc);
   }
   WorkerRun run;
-  read_answer(fds[0], t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall_s)), max_answer, cancel, run);
+  read_answer(
+      fds[0],
+      t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall_s)),
+      max_answer, cancel, run);
   ::kill(pid, SIGKILL);  // in every case: a worker that closed its pipe but lives on is not left behind
   ::close(fds[0]);
   rusage ru{};
@@ -223,7 +230,8 @@ WorkerRun run_worker(const std::string& path, const std::vector<std::string>& ar
   }
   run.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   run.max_rss_kb = ru.ru_maxrss;
-  run.cpu_s = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  run.cpu_s = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+              1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   return run;
 }
 

@@ -75,7 +75,8 @@ class WireReader {
 /// u8 1, u8 kind and the problem (str) when it fails: a thrown `Refusal` (a type with `kind`, an enum, and
 /// `problem`, a string) as it says, std::bad_alloc as `out_of_memory`, anything else as `failed`.
 template <class Refusal, class Kind, class Work>
-WireWriter worker_answer(std::uint32_t magic, Work&& work, std::pair<Kind, std::string> out_of_memory, std::pair<Kind, std::string> failed) {
+WireWriter worker_answer(std::uint32_t magic, Work&& work, std::pair<Kind, std::string> out_of_memory,
+                         std::pair<Kind, std::string> failed) {
   WireWriter out;
   out.u32(magic);
   auto refuse = [&out](Kind kind, const std::string& problem) {
@@ -121,14 +122,14 @@ std::span<const std::uint8_t> map_input(std::size_t size);
 
 /// What a run of a worker gave.
 struct WorkerRun {
-  std::string answer;          ///< bytes read from the pipe
-  bool timed_out = false;      ///< the wall-clock deadline passed
-  bool overflow = false;       ///< the worker sent more than max_answer
-  bool cancelled = false;      ///< the caller's cancel flag was raised (checked every kCancelPoll_ms)
-  int status = 0;              ///< from wait4
-  double cpu_s = 0.0;          ///< user + system time of the worker [s]
-  double ms = 0.0;             ///< wall time [ms]
-  long max_rss_kb = 0;         ///< peak resident memory [KiB]
+  std::string answer;      ///< bytes read from the pipe
+  bool timed_out = false;  ///< the wall-clock deadline passed
+  bool overflow = false;   ///< the worker sent more than max_answer
+  bool cancelled = false;  ///< the caller's cancel flag was raised (checked every kCancelPoll_ms)
+  int status = 0;          ///< from wait4
+  double cpu_s = 0.0;      ///< user + system time of the worker [s]
+  double ms = 0.0;         ///< wall time [ms]
+  long max_rss_kb = 0;     ///< peak resident memory [KiB]
 };
 
 /// The worker could not be started (memfd, pipe or posix_spawn failed): `why` says which and errno's words.
@@ -144,8 +145,8 @@ inline constexpr int kCancelPoll_ms = 50;
 /// The kiosk's environment is passed on (sanitizer options). Blocks the calling thread for at most about
 /// wall_s (kCancelPoll_ms after a cancel).
 /// @throws WorkerStartFailure when it cannot be started.
-WorkerRun run_worker(const std::string& path, const std::vector<std::string>& args, std::span<const std::uint8_t> input, double wall_s,
-                     std::size_t max_answer, const std::atomic<bool>* cancel = nullptr);
+WorkerRun run_worker(const std::string& path, const std::vector<std::string>& args, std::span<const std::uint8_t> input,
+                     double wall_s, std::size_t max_answer, const std::atomic<bool>* cancel = nullptr);
 
 /// The worker executable: $`env_var` if set; else `file_name` beside this executable (an installed kiosk);
 /// else `built_path` (tests and bench binaries live elsewhere in the build tree).

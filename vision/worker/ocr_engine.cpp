@@ -84,7 +84,9 @@ std::vector<Block> read_blocks(tesseract::TessBaseAPI& api, const OcrParams& p, 
     Word w;
     w.text = text.get();
     w.confidence = it->Confidence(kWord) / 100.0;
-    if (w.confidence < std::min(p.min_word_confidence, kNoiseWordConfidence) || !it->BoundingBox(kWord, &w.l, &w.t, &w.r, &w.b)) continue;
+    if (w.confidence < std::min(p.min_word_confidence, kNoiseWordConfidence) ||
+        !it->BoundingBox(kWord, &w.l, &w.t, &w.r, &w.b))
+      continue;
     if (!line_has_word) ++current.lines;
     line_has_word = true;
     current.words.push_back(std::move(w));
@@ -108,7 +110,8 @@ constexpr std::size_t kEnoughForALayout = 3;
 /// when it cannot.
 void start_engine(tesseract::TessBaseAPI& api, const OcrParams& p) {
   ::setenv("OMP_THREAD_LIMIT", "1", 1);  // one core: the servo thread and the window keep theirs
-  if (api.Init(p.tessdata_dir.empty() ? nullptr : p.tessdata_dir.c_str(), p.languages.c_str(), tesseract::OEM_LSTM_ONLY) != 0) {
+  if (api.Init(p.tessdata_dir.empty() ? nullptr : p.tessdata_dir.c_str(), p.languages.c_str(),
+               tesseract::OEM_LSTM_ONLY) != 0) {
     throw Refusal{OcrError::Kind::Unavailable, "Tesseract cannot start with the languages '" + p.languages + "'"};
   }
   api.SetVariable("debug_file", "/dev/null");
@@ -116,7 +119,8 @@ void start_engine(tesseract::TessBaseAPI& api, const OcrParams& p) {
 
 /// Reads the `width` x `height` grey `pixels` with a started engine: the answer (after the status byte) in
 /// `out`, or a Refusal thrown.
-void read_page(tesseract::TessBaseAPI& api, const std::uint8_t* pixels, int width, int height, const OcrParams& p, worker::WireWriter& out) {
+void read_page(tesseract::TessBaseAPI& api, const std::uint8_t* pixels, int width, int height, const OcrParams& p,
+               worker::WireWriter& out) {
   api.SetImage(pixels, width, height, 1, width);
   api.SetSourceResolution(300);
   // Pages: Tesseract's layout analysis. A sign or a poster in a photograph is no page layout: where that
@@ -125,7 +129,8 @@ void read_page(tesseract::TessBaseAPI& api, const std::uint8_t* pixels, int widt
   std::vector<Block> blocks;
   for (const tesseract::PageSegMode mode : {tesseract::PSM_AUTO, tesseract::PSM_SPARSE_TEXT}) {
     api.SetPageSegMode(mode);
-    if (api.Recognize(nullptr) != 0) throw Refusal{OcrError::Kind::WorkerCrashed, "Tesseract could not read the picture"};
+    if (api.Recognize(nullptr) != 0)
+      throw Refusal{OcrError::Kind::WorkerCrashed, "Tesseract could not read the picture"};
     std::uint32_t mode_seen = 0;
     std::vector<Block> found = read_blocks(api, p, mode_seen);
     if (kept_words(found, p) > kept_words(blocks, p)) {
@@ -174,7 +179,8 @@ void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p,
 int ocr_worker_entry(int argc, char** argv) {
   OcrRequest rq;
   if (!parse_ocr_request(argc, argv, rq)) return 64;
-  const std::span<const std::uint8_t> pixels = worker::map_input(static_cast<std::size_t>(rq.width) * static_cast<std::size_t>(rq.height));
+  const std::span<const std::uint8_t> pixels =
+      worker::map_input(static_cast<std::size_t>(rq.width) * static_cast<std::size_t>(rq.height));
   if (pixels.empty()) return 65;
   worker::confine_worker(rq.params.worker_cpu_s, rq.params.worker_max_memory_mb);
   const worker::WireWriter out = worker::worker_answer<Refusal>(
@@ -183,7 +189,8 @@ int ocr_worker_entry(int argc, char** argv) {
         if (rq.params.fault != OcrFault::None) fail_on_purpose(rq.params.fault);
         work(pixels.data(), rq.width, rq.height, rq.params, answer);
       },
-      std::pair{OcrError::Kind::TooLarge, "the text reader ran out of memory (limit " + worker::arg(rq.params.worker_max_memory_mb) + " MiB)"},
+      std::pair{OcrError::Kind::TooLarge,
+                "the text reader ran out of memory (limit " + worker::arg(rq.params.worker_max_memory_mb) + " MiB)"},
       std::pair{OcrError::Kind::WorkerCrashed, std::string("Tesseract failed on it")});
   worker::write_all(worker::kAnswerFd, out.bytes());
   ::_exit(0);

@@ -16,8 +16,13 @@ std::string run_speak(const SpeakOptions& o) {
   for (int i = 0; i < audio::kMessageCount; ++i) {
     if (audio::kMessageKeys[static_cast<std::size_t>(i)] == o.what) {
       // Sample values for the placeholders, so a translator hears a whole sentence.
-      text = catalog.text(static_cast<audio::MessageId>(i), {{"picture", "2"}, {"pictures", "5"}, {"shapes", "7"}, {"level", "3"},
-                                                             {"seconds", "20"}, {"description", "A large closed shape in the middle."}},
+      text = catalog.text(static_cast<audio::MessageId>(i),
+                          {{"picture", "2"},
+                           {"pictures", "5"},
+                           {"shapes", "7"},
+                           {"level", "3"},
+                           {"seconds", "20"},
+                           {"description", "A large closed shape in the middle."}},
                           keys);
     }
   }

@@ -9,14 +9,14 @@
 #include <vector>
 
 #include "config/load.hpp"
-#include "runtime/device_setup.hpp"
+#include "formats/app_error.hpp"
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/io/haply_device.hpp"
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/io/usb_devices.hpp"
 #include "haptics/pty_emulator.hpp"
-#include "formats/app_error.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/device_setup.hpp"
 #include "runtime/runtime_params.hpp"
 
 namespace hk::app {
@@ -29,7 +29,8 @@ int run_devices(const DevicesOptions& o) {
   std::printf("USB devices:\n");
   if (usb.empty()) std::printf("  no USB device found%s%s\n", reason.empty() ? "" : ": ", reason.c_str());
   for (const io::UsbDeviceInfo& d : usb) {
-    const bool listed = std::any_of(ids.begin(), ids.end(), [&](const config::UsbId& id) { return id.vid == d.vid && id.pid == d.pid; });
+    const bool listed = std::any_of(ids.begin(), ids.end(),
+                                    [&](const config::UsbId& id) { return id.vid == d.vid && id.pid == d.pid; });
     std::string label = d.manufacturer;
     if (!d.product.empty()) label += (label.empty() ? "" : " ") + d.product;
     if (label.empty()) label = "(no name readable)";
@@ -46,8 +47,10 @@ int run_devices(const DevicesOptions& o) {
   if (candidates.empty()) std::printf("  none to ask\n");
   for (const io::BoardCandidate& c : candidates) {
     std::vector<io::BoardProbe> probe;
-    if (std::unique_ptr<io::HaplyDevice> board = io::open_first_board(haply_params_from(s), {c}, &probe)) board->close();
-    for (const io::BoardProbe& p : probe) std::printf("  %s  %s: %s\n", p.name.c_str(), p.answered ? "answered" : "refused", p.how.c_str());
+    if (std::unique_ptr<io::HaplyDevice> board = io::open_first_board(haply_params_from(s), {c}, &probe))
+      board->close();
+    for (const io::BoardProbe& p : probe)
+      std::printf("  %s  %s: %s\n", p.name.c_str(), p.answered ? "answered" : "refused", p.how.c_str());
   }
   return 0;
 }
@@ -69,7 +72,9 @@ int run_calibrate(const CalibrateOptions& o) {
     // The emulated handle rests at the park place, untouched.
     Vec2 park_device;
     const hapi::EmulatorParams ep = emulator_resting_at_park(s, choice, &park_device);
-    emulator = std::make_unique<hapi::FirmwareEmulator>(ep, park_device, [](double, Vec2, Vec2) { return Vec2{0.0, 0.0}; });
+    emulator = std::make_unique<hapi::FirmwareEmulator>(ep, park_device, [](double, Vec2, Vec2) {
+      return Vec2{0.0, 0.0};
+    });
     pty = std::make_unique<hapi::PtyEmulator>(*emulator);
     const std::string path = pty->device_path();
     factory = [path] { return std::make_unique<io::TtyTransport>(path); };
@@ -96,7 +101,7 @@ int run_calibrate(const CalibrateOptions& o) {
   double o1 = 0, o2 = 0;
   if (!io::calibrated_offsets(dp, park, sum1 / kTicks, sum2 / kTicks, &o1, &o2))
     throw AppError("calibrate: the park place (" + std::to_string(park.x) + ", " + std::to_string(park.y) +
-                             ") m is out of the links' reach; check [device] park_x_m, park_y_m and the rectangle");
+                   ") m is out of the links' reach; check [device] park_x_m, park_y_m and the rectangle");
   const double old1 = s.device.encoder1_offset_deg, old2 = s.device.encoder2_offset_deg;
   s.device.encoder1_offset_deg = std::round(o1 * 1000.0) / 1000.0;
   s.device.encoder2_offset_deg = std::round(o2 * 1000.0) / 1000.0;

@@ -1,11 +1,12 @@
 // Headless explore run: image → scene → simulated pantograph + model hand → servo ticks → files.
 #include "cli/explore.hpp"
 
-#include <array>
+#include <spdlog/spdlog.h>
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -13,21 +14,20 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
 
 #include "audio/mixer.hpp"
 #include "audio/wav.hpp"
-#include "pictures/capture.hpp"
 #include "config/load.hpp"
-#include "runtime/coverage.hpp"
-#include "runtime/cue_tracker.hpp"
-#include "pictures/documents.hpp"
-#include "haptics/tolerance_cut.hpp"
 #include "haptics/explorer_hand.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
+#include "haptics/tolerance_cut.hpp"
+#include "pictures/capture.hpp"
+#include "pictures/documents.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/coverage.hpp"
+#include "runtime/cue_tracker.hpp"
 #include "runtime/runtime_params.hpp"
 #include "runtime/simulation.hpp"
 
@@ -46,7 +46,9 @@ void write_text(const std::filesystem::path& p, const std::string& text) {
 json scene_json(const ImageScene& is, const config::Settings& s) {
   json j;
   j["image"] = {{"path", is.image_path}, {"width_px", is.width_px}, {"height_px", is.height_px}};
-  j["px_to_m"] = {{"scale", is.px_to_m.scale_m_per_px}, {"offset_x_m", is.px_to_m.offset_x_m}, {"offset_y_m", is.px_to_m.offset_y_m}};
+  j["px_to_m"] = {{"scale", is.px_to_m.scale_m_per_px},
+                  {"offset_x_m", is.px_to_m.offset_x_m},
+                  {"offset_y_m", is.px_to_m.offset_y_m}};
   j["stiffness_n_per_m"] = s.haptics.stiffness_n_per_m;
   j["max_force_n"] = s.haptics.max_force_n;
   j["level_in_use"] = s.haptics.level;
@@ -59,8 +61,11 @@ json scene_json(const ImageScene& is, const config::Settings& s) {
       json pts = json::array();
       const Vec2* p = sc.points(c, l);
       for (std::uint32_t i = 0; i < ci.point_count[l]; ++i) pts.push_back({p[i].x, p[i].y});
-      levels.push_back({{"level", l}, {"points_m", std::move(pts)}, {"max_error_m", ci.max_error_m[l]},
-                        {"max_box_half_width_m", ci.max_box_half_width_m[l]}, {"max_error_bound_m", ci.max_error_bound_m[l]}});
+      levels.push_back({{"level", l},
+                        {"points_m", std::move(pts)},
+                        {"max_error_m", ci.max_error_m[l]},
+                        {"max_box_half_width_m", ci.max_box_half_width_m[l]},
+                        {"max_error_bound_m", ci.max_error_bound_m[l]}});
     }
     curves.push_back({{"id", c}, {"closed", ci.closed}, {"levels", std::move(levels)}});
   }
@@ -72,7 +77,10 @@ json scene_json(const ImageScene& is, const config::Settings& s) {
   if (is.page > 0 || !is.text_blocks.empty()) {  // a page with text: its text is spoken, not felt
     json blocks = json::array();
     for (const TextBlockM& b : is.text_blocks) {
-      blocks.push_back({{"id", b.id}, {"bbox_m", {b.lo_m.x, b.lo_m.y, b.hi_m.x, b.hi_m.y}}, {"text", b.text}, {"source", b.source},
+      blocks.push_back({{"id", b.id},
+                        {"bbox_m", {b.lo_m.x, b.lo_m.y, b.hi_m.x, b.hi_m.y}},
+                        {"text", b.text},
+                        {"source", b.source},
                         {"confidence", b.confidence}});
     }
     j["text_blocks"] = std::move(blocks);
@@ -82,14 +90,18 @@ json scene_json(const ImageScene& is, const config::Settings& s) {
 
 cv::Point2d to_px(const vision::PxToM& m, Vec2 q) { return {m.u_px(q.x), m.v_px(q.y)}; }
 
-void write_overlay(const std::filesystem::path& out, const ImageScene& is, int level, const std::vector<Vec2>& proxy_path) {
-  if (is.picture.empty()) throw ExploreError("image '" + is.image_path + "': the scene holds no picture for the overlay");
+void write_overlay(const std::filesystem::path& out, const ImageScene& is, int level,
+                   const std::vector<Vec2>& proxy_path) {
+  if (is.picture.empty())
+    throw ExploreError("image '" + is.image_path + "': the scene holds no picture for the overlay");
   cv::Mat img = is.picture.clone();
   // Dim the picture so the drawn curves stand out; draw at 4x sub-pixel precision.
   img = img * 0.55;
   const int thick = std::max(1, static_cast<int>(std::lround(std::max(img.cols, img.rows) / 400.0)));
   constexpr int kShift = 2;
-  auto fixed = [&](cv::Point2d p) { return cv::Point(static_cast<int>(std::lround(p.x * 4)), static_cast<int>(std::lround(p.y * 4))); };
+  auto fixed = [&](cv::Point2d p) {
+    return cv::Point(static_cast<int>(std::lround(p.x * 4)), static_cast<int>(std::lround(p.y * 4)));
+  };
   const Scene& sc = *is.scene;
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const int l = sc.clamp_level(c, level);
@@ -107,7 +119,8 @@ void write_overlay(const std::filesystem::path& out, const ImageScene& is, int l
   std::vector<cv::Point> path;
   const std::size_t stride = std::max<std::size_t>(1, proxy_path.size() / 20000);
   for (std::size_t i = 0; i < proxy_path.size(); i += stride) path.push_back(fixed(to_px(is.px_to_m, proxy_path[i])));
-  if (path.size() > 1) cv::polylines(img, path, false, cv::Scalar(255, 120, 40), std::max(1, thick / 2), cv::LINE_AA, kShift);
+  if (path.size() > 1)
+    cv::polylines(img, path, false, cv::Scalar(255, 120, 40), std::max(1, thick / 2), cv::LINE_AA, kShift);
   if (!cv::imwrite(out.string(), img)) throw ExploreError("output '" + out.string() + "': cannot write the PNG");
 }
 
@@ -120,7 +133,8 @@ double percentile(std::vector<std::int64_t>& v, double q) {
 
 // --source: one capture (capture.hpp; a time-out keeps the last frame), written beside the outputs as capture.png
 // and capture.json, and the scene of what it captured.
-ImageScene build_capture_scene(const std::string& spec_text, int page, const config::Settings& s, const std::filesystem::path& out) {
+ImageScene build_capture_scene(const std::string& spec_text, int page, const config::Settings& s,
+                               const std::filesystem::path& out) {
   if (page > 0) throw ExploreError("--page " + std::to_string(page) + ": a camera capture has no pages");
   const vision::SourceSpec spec = vision::parse_source_spec(spec_text);
   std::unique_ptr<vision::FrameSource> source = vision::open_frame_source(spec, frame_source_params_from(s));
@@ -146,7 +160,9 @@ std::uint64_t parse_seed(const std::string& text) {
 ImageScene build_input_scene(const std::string& path, int page, const config::Settings& s) {
   if (page < 0) throw ExploreError("--page " + std::to_string(page) + " is outside [1, pages of the document]");
   if (!is_pdf_file(path)) {
-    if (page > 0) throw ExploreError("--page " + std::to_string(page) + ": '" + path + "' is not a PDF (pages are for PDF documents)");
+    if (page > 0)
+      throw ExploreError("--page " + std::to_string(page) + ": '" + path +
+                         "' is not a PDF (pages are for PDF documents)");
     return build_image_scene(path, s);
   }
   return build_pdf_page_scene(vision::read_input_file(path, s.stick.max_file_bytes), path, page > 0 ? page : 1, s);
@@ -171,7 +187,8 @@ config::Settings explore_settings(const ExploreOptions& o, const DeviceChoice& d
 HandPath hand_path_of(const ExploreOptions& o, const config::Settings& s, const DeviceChoice& device) {
   const bool explorer = o.hand == "explorer";
   if (explorer && device.kind == DeviceChoice::Kind::HaplyEmulator) {
-    throw ExploreError("--hand explorer: the explorer needs the device's force each tick, which only --device sim gives");
+    throw ExploreError(
+        "--hand explorer: the explorer needs the device's force each tick, which only --device sim gives");
   }
   if (o.hand == "raster" || explorer) {
     return raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
@@ -188,7 +205,8 @@ std::unique_ptr<HandController> make_hand(const ExploreOptions& o, const config:
 std::filesystem::path make_out_dir(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir)) throw ExploreError("output folder '" + dir + "': cannot create it (" + ec.message() + ")");
+  if (ec || !std::filesystem::is_directory(dir))
+    throw ExploreError("output folder '" + dir + "': cannot create it (" + ec.message() + ")");
   return std::filesystem::path(dir);
 }
 
@@ -200,9 +218,11 @@ void check_audio_out(const std::string& audio_out, double duration_s) {
   for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   if (ext != ".wav") throw ExploreError("--audio-out '" + audio_out + "': must name a .wav file");
   const std::filesystem::path parent = a.has_parent_path() ? a.parent_path() : std::filesystem::path(".");
-  if (!std::filesystem::is_directory(parent)) throw ExploreError("--audio-out '" + audio_out + "': folder '" + parent.string() + "' does not exist");
+  if (!std::filesystem::is_directory(parent))
+    throw ExploreError("--audio-out '" + audio_out + "': folder '" + parent.string() + "' does not exist");
   if (duration_s > 3600.0) {
-    throw ExploreError("--audio-out '" + audio_out + "': a run of " + std::to_string(duration_s) + " s is over the audio limit of 3600 s");
+    throw ExploreError("--audio-out '" + audio_out + "': a run of " + std::to_string(duration_s) +
+                       " s is over the audio limit of 3600 s");
   }
 }
 
@@ -259,8 +279,8 @@ struct RunRecord {
 };
 
 // The servo run itself: the kiosk's runner over the chosen device, the earcons drained after every tick.
-void run_servo(const Scene& scene, const ImageScene& is, const config::Settings& s, HandController& hand, double duration_s,
-               const DeviceChoice& device, RunRecord& rec) {
+void run_servo(const Scene& scene, const ImageScene& is, const config::Settings& s, HandController& hand,
+               double duration_s, const DeviceChoice& device, RunRecord& rec) {
   rec.rows.reserve(static_cast<std::size_t>(std::ceil(duration_s * s.haptics.servo_rate_hz)) + 1);
   audio::SpscRing<audio::CueEvent> cue_ring(64);
   RunOptions run;
@@ -268,10 +288,13 @@ void run_servo(const Scene& scene, const ImageScene& is, const config::Settings&
   run.report = &rec.sum.device;
   run.cues = &cue_ring;
   run.text_blocks_m = text_block_regions(is.text_blocks);
-  run_simulation(scene, s, hand, duration_s, [&](const TickRecord& r, const ServoOutput& so) {
-    for (audio::CueEvent e; cue_ring.try_pop(e);) rec.cues.push_back(e);
-    rec.add(r, so);
-  }, run);
+  run_simulation(
+      scene, s, hand, duration_s,
+      [&](const TickRecord& r, const ServoOutput& so) {
+        for (audio::CueEvent e; cue_ring.try_pop(e);) rec.cues.push_back(e);
+        rec.add(r, so);
+      },
+      run);
   rec.sum.curves = scene.curve_count();
   rec.sum.cues = rec.cues.size();
 }
@@ -281,12 +304,15 @@ void write_trace(const std::filesystem::path& trace_path, const std::vector<Trac
   if (!trace) throw ExploreError("output '" + trace_path.string() + "': cannot open for writing");
   static char buffer[1 << 16];
   std::setvbuf(trace.get(), buffer, _IOFBF, sizeof buffer);
-  std::fputs("t_s,handle_x_m,handle_y_m,proxy_x_m,proxy_y_m,force_x_n,force_y_n,contact,curve,level,tick_ns,pop\n", trace.get());
+  std::fputs("t_s,handle_x_m,handle_y_m,proxy_x_m,proxy_y_m,force_x_n,force_y_n,contact,curve,level,tick_ns,pop\n",
+             trace.get());
   for (const TraceRow& w : rows) {
-    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld,%d\n", w.t_s, w.handle_m.x, w.handle_m.y, w.proxy_m.x,
-                 w.proxy_m.y, w.force_n.x, w.force_n.y, w.contact, w.curve, w.level, static_cast<long long>(w.tick_ns), w.pop);
+    std::fprintf(trace.get(), "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%lld,%d\n", w.t_s, w.handle_m.x,
+                 w.handle_m.y, w.proxy_m.x, w.proxy_m.y, w.force_n.x, w.force_n.y, w.contact, w.curve, w.level,
+                 static_cast<long long>(w.tick_ns), w.pop);
   }
-  if (std::fflush(trace.get()) != 0 || std::ferror(trace.get())) throw ExploreError("output '" + trace_path.string() + "': write failed");
+  if (std::fflush(trace.get()) != 0 || std::ferror(trace.get()))
+    throw ExploreError("output '" + trace_path.string() + "': write failed");
 }
 
 // summary.json's servo part: tick times, contact states, the collision queries' work.
@@ -294,30 +320,49 @@ void add_servo_summary(json& sj, RunRecord& rec, const config::Settings& s) {
   const ExploreSummary& sum = rec.sum;
   sj["ticks"] = sum.ticks;
   sj["servo_rate_hz"] = s.haptics.servo_rate_hz;
-  sj["tick_ns"] = {{"p50", percentile(rec.tick_ns, 0.5)}, {"p99", percentile(rec.tick_ns, 0.99)}, {"p999", percentile(rec.tick_ns, 0.999)},
-                   {"max", rec.tick_ns.empty() ? 0.0 : static_cast<double>(*std::max_element(rec.tick_ns.begin(), rec.tick_ns.end()))}};
+  sj["tick_ns"] = {
+      {"p50", percentile(rec.tick_ns, 0.5)},
+      {"p99", percentile(rec.tick_ns, 0.99)},
+      {"p999", percentile(rec.tick_ns, 0.999)},
+      {"max",
+       rec.tick_ns.empty() ? 0.0 : static_cast<double>(*std::max_element(rec.tick_ns.begin(), rec.tick_ns.end()))}};
   sj["contact_ticks"] = {{"free", sum.free_ticks}, {"edge", sum.edge_ticks}, {"vertex", sum.vertex_ticks}};
   sj["max_force_n"] = sum.max_force_n;
   sj["query_budget_exhausted_ticks"] = rec.budget_exhausted;
   const double n = std::max<long>(1, sum.ticks);
-  sj["per_tick"] = {{"queries_mean", rec.queries / n}, {"box_tests_mean", rec.box_tests / n}, {"boundary_section_mean", rec.section_sum / n},
-                    {"boundary_section_max", rec.section_max}, {"iteration_limited_ticks", rec.iteration_limited}};
+  sj["per_tick"] = {{"queries_mean", rec.queries / n},
+                    {"box_tests_mean", rec.box_tests / n},
+                    {"boundary_section_mean", rec.section_sum / n},
+                    {"boundary_section_max", rec.section_max},
+                    {"iteration_limited_ticks", rec.iteration_limited}};
   sj["sticking_ticks"] = rec.sticking;
   sj["push_throughs"] = rec.pops;
-  sj["device"] = {{"name", sum.device.name}, {"status", sum.device.status}, {"replies_missing", sum.device.replies_missing},
-                  {"reconnects", sum.device.reconnects}, {"malformed_replies", sum.device.malformed}};
+  sj["device"] = {{"name", sum.device.name},
+                  {"status", sum.device.status},
+                  {"replies_missing", sum.device.replies_missing},
+                  {"reconnects", sum.device.reconnects},
+                  {"malformed_replies", sum.device.malformed}};
 }
 
 // summary.json's scene part: what the scene left out and why, in pipeline order, and its budgets and levels.
 void add_scene_summary(json& sj, const ImageScene& is, const Scene& scene, const config::Settings& s) {
   sj["curves"] = scene.curve_count();
-  sj["chains"] = {{"texture", is.chains_texture}, {"found", is.chains_found}, {"thin_line_pairs_merged", is.thin_line_pairs_merged},
-                  {"after_thin_lines", is.chains_after_thin_lines}, {"gaps_closed", is.gaps_closed},
-                  {"closed_by_gaps", is.chains_closed_by_gaps}, {"after_gaps", is.chains_after_gaps}, {"too_short", is.chains_too_short},
-                  {"along_border", is.chains_along_border}, {"over_max_shapes", is.chains_over_max_shapes},
-                  {"over_budget", is.chains_over_budget}, {"unbuildable", scene.skipped_curves()}};
+  sj["chains"] = {{"texture", is.chains_texture},
+                  {"found", is.chains_found},
+                  {"thin_line_pairs_merged", is.thin_line_pairs_merged},
+                  {"after_thin_lines", is.chains_after_thin_lines},
+                  {"gaps_closed", is.gaps_closed},
+                  {"closed_by_gaps", is.chains_closed_by_gaps},
+                  {"after_gaps", is.chains_after_gaps},
+                  {"too_short", is.chains_too_short},
+                  {"along_border", is.chains_along_border},
+                  {"over_max_shapes", is.chains_over_max_shapes},
+                  {"over_budget", is.chains_over_budget},
+                  {"unbuildable", scene.skipped_curves()}};
   sj["shapes_budget"] = {{"max_shapes", s.vision.max_shapes}, {"kept", is.polylines.size()}};
-  sj["segments_budget"] = {{"max_segments", s.vision.max_segments}, {"before", is.segments_before_budget}, {"after", is.segments_after_budget}};
+  sj["segments_budget"] = {{"max_segments", s.vision.max_segments},
+                           {"before", is.segments_before_budget},
+                           {"after", is.segments_after_budget}};
   json segs = json::array();
   for (int l = 0; l < Scene::kMaxLevels; ++l) {
     bool any = false;
@@ -335,65 +380,99 @@ void add_level_summary(json& sj, const RunRecord& rec, const config::Settings& s
   for (int l = 0; l < kLevelIds; ++l) {
     if (rec.level_ticks[static_cast<std::size_t>(l)] == 0) continue;
     json e = {{"level", l}, {"ticks", rec.level_ticks[static_cast<std::size_t>(l)]}};
-    if (tolerance_step_of(l) >= 0) e["tolerance_m"] = kToleranceLadder_m[tolerance_step_of(l)];  // a tolerance or cut step's id
+    if (tolerance_step_of(l) >= 0)
+      e["tolerance_m"] = kToleranceLadder_m[tolerance_step_of(l)];  // a tolerance or cut step's id
     if (is_cut_level(l)) e["cut"] = true;
     lt.push_back(std::move(e));
   }
-  sj["levels"] = {{"mode", s.haptics.level_mode}, {"changes", rec.level_changes}, {"ticks_waiting_for_a_safe_change", rec.level_waiting},
+  sj["levels"] = {{"mode", s.haptics.level_mode},
+                  {"changes", rec.level_changes},
+                  {"ticks_waiting_for_a_safe_change", rec.level_waiting},
                   {"ticks_per_level", std::move(lt)}};
 }
 
 // summary.json's hand part: which hand, and the explorer's own counts; and the coverage it reached.
-void add_hand_summary(json& sj, const ExploreOptions& o, const HandController& hand, RunRecord& rec, const Scene& scene) {
+void add_hand_summary(json& sj, const ExploreOptions& o, const HandController& hand, RunRecord& rec,
+                      const Scene& scene) {
   const bool known = o.hand == "raster" || o.hand == "explorer";
   sj["hand"] = {{"kind", known ? o.hand : std::string("file")}, {"seed", o.seed}};
   if (const auto* ex = dynamic_cast<const ExplorerHand*>(&hand)) {
     const ExplorerStats& st = ex->stats();
-    sj["hand"]["explorer"] = {{"traces", st.traces}, {"traces_closed", st.traces_closed}, {"traces_lost", st.traces_lost},
-                              {"traces_stalled", st.traces_stalled}, {"traces_timed_out", st.traces_timed_out},
-                              {"traces_retraced", st.traces_retraced}, {"pops", st.pops}, {"pops_through", st.pops_through},
-                              {"passes", st.passes}, {"plans", st.plans}, {"traced_m", st.traced_m},
-                              {"move_s", st.move_s}, {"trace_s", st.trace_s}, {"pop_s", st.pop_s}};
+    sj["hand"]["explorer"] = {{"traces", st.traces},
+                              {"traces_closed", st.traces_closed},
+                              {"traces_lost", st.traces_lost},
+                              {"traces_stalled", st.traces_stalled},
+                              {"traces_timed_out", st.traces_timed_out},
+                              {"traces_retraced", st.traces_retraced},
+                              {"pops", st.pops},
+                              {"pops_through", st.pops_through},
+                              {"passes", st.passes},
+                              {"plans", st.plans},
+                              {"traced_m", st.traced_m},
+                              {"move_s", st.move_s},
+                              {"trace_s", st.trace_s},
+                              {"pop_s", st.pop_s}};
   }
   const Coverage cov = rec.coverage.measure(scene);
-  sj["coverage"] = {{"length_fraction", cov.length_fraction}, {"curves_touched", cov.curves_touched}, {"curves", cov.curves}};
+  sj["coverage"] = {
+      {"length_fraction", cov.length_fraction}, {"curves_touched", cov.curves_touched}, {"curves", cov.curves}};
 }
 
 // summary.json's picture part: the document's page, OCR, the detector, two tones and the build's times.
 void add_picture_summary(json& sj, const ImageScene& is) {
   if (is.page > 0) {
-    sj["document"] = {{"page", is.page}, {"pages", is.pages}, {"text_blocks", is.text_blocks.size()}, {"words_masked", is.text_words_masked},
-                      {"dpi", is.render_dpi}, {"worker_ms", is.worker_ms}, {"worker_max_rss_kb", is.worker_max_rss_kb},
+    sj["document"] = {{"page", is.page},
+                      {"pages", is.pages},
+                      {"text_blocks", is.text_blocks.size()},
+                      {"words_masked", is.text_words_masked},
+                      {"dpi", is.render_dpi},
+                      {"worker_ms", is.worker_ms},
+                      {"worker_max_rss_kb", is.worker_max_rss_kb},
                       {"title", is.document_title}};
   }
-  sj["ocr"] = {{"ran", is.ocr.ran}, {"why", is.ocr.why}, {"words", is.ocr.words}, {"mean_confidence", is.ocr.mean_confidence},
-               {"ms", is.ocr.ms}, {"worker_max_rss_kb", is.ocr.worker_max_rss_kb}};
+  sj["ocr"] = {{"ran", is.ocr.ran},     {"why", is.ocr.why},
+               {"words", is.ocr.words}, {"mean_confidence", is.ocr.mean_confidence},
+               {"ms", is.ocr.ms},       {"worker_max_rss_kb", is.ocr.worker_max_rss_kb}};
   sj["canny_thresholds"] = {{"low", is.canny_low}, {"high", is.canny_high}};
   sj["detector"] = vision::detector_name(is.detector);
-  sj["two_tone"] = {{"two_tone", is.tones.two_tone}, {"threshold", is.tones.threshold}, {"near_share", is.tones.near_share},
-                    {"ink_width_px", is.tones.ink_width_px}, {"line_drawing", is.line_drawing}};
-  sj["picture"] = {{"file_width_px", is.file_width_px}, {"file_height_px", is.file_height_px}, {"decode_scale", is.decode_scale},
-                   {"width_px", is.width_px}, {"height_px", is.height_px}};
-  sj["build_ms"] = {{"load", is.times.load_ms}, {"decode", is.times.decode_ms}, {"edges", is.times.edges_ms}, {"linking", is.times.linking_ms},
-                    {"thin_lines", is.times.thin_lines_ms}, {"gaps", is.times.gaps_ms}, {"multires", is.times.multires_ms},
+  sj["two_tone"] = {{"two_tone", is.tones.two_tone},
+                    {"threshold", is.tones.threshold},
+                    {"near_share", is.tones.near_share},
+                    {"ink_width_px", is.tones.ink_width_px},
+                    {"line_drawing", is.line_drawing}};
+  sj["picture"] = {{"file_width_px", is.file_width_px},
+                   {"file_height_px", is.file_height_px},
+                   {"decode_scale", is.decode_scale},
+                   {"width_px", is.width_px},
+                   {"height_px", is.height_px}};
+  sj["build_ms"] = {{"load", is.times.load_ms},
+                    {"decode", is.times.decode_ms},
+                    {"edges", is.times.edges_ms},
+                    {"linking", is.times.linking_ms},
+                    {"thin_lines", is.times.thin_lines_ms},
+                    {"gaps", is.times.gaps_ms},
+                    {"multires", is.times.multires_ms},
                     {"tree", is.times.tree_ms}};
 }
 
 // cues.csv and the WAV: the earcons on the trace's timeline (tick k sounds at t = k · period).
-void write_earcons(const std::filesystem::path& out, const std::string& audio_out, const RunRecord& rec, const config::Settings& s) {
+void write_earcons(const std::filesystem::path& out, const std::string& audio_out, const RunRecord& rec,
+                   const config::Settings& s) {
   const double period_s = 1.0 / s.haptics.servo_rate_hz;
   std::string csv = "tick,t_s,kind,curve,speed_m_per_s,level\n";
   char line[160];
   for (const audio::CueEvent& e : rec.cues) {
-    std::snprintf(line, sizeof line, "%lld,%.6f,%s,%d,%.6g,%d\n", static_cast<long long>(e.tick), static_cast<double>(e.tick) * period_s,
-                  audio::cue_kind_name(e.kind), e.curve, static_cast<double>(e.speed_m_per_s), e.level);
+    std::snprintf(line, sizeof line, "%lld,%.6f,%s,%d,%.6g,%d\n", static_cast<long long>(e.tick),
+                  static_cast<double>(e.tick) * period_s, audio::cue_kind_name(e.kind), e.curve,
+                  static_cast<double>(e.speed_m_per_s), e.level);
     csv += line;
   }
   write_text(out / "cues.csv", csv);
   audio::MixerParams mp;
   mp.earcons.gain = s.audio.earcon_gain;
   mp.duck_db = s.audio.duck_db;
-  const std::vector<float> wav = audio::render_cue_timeline(rec.cues, period_s, static_cast<double>(rec.sum.ticks) * period_s, mp);
+  const std::vector<float> wav =
+      audio::render_cue_timeline(rec.cues, period_s, static_cast<double>(rec.sum.ticks) * period_s, mp);
   audio::write_wav(audio_out, wav, audio::kSampleRateHz);
 }
 
@@ -408,9 +487,12 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   const HandPath path = hand_path_of(o, s, device);
   const std::unique_ptr<HandController> hand = make_hand(o, s, path);
   const std::filesystem::path out = make_out_dir(o.out_dir);
-  const ImageScene is = o.source.empty() ? build_input_scene(o.image_path, o.page, s) : build_capture_scene(o.source, o.page, s, out);
+  const ImageScene is =
+      o.source.empty() ? build_input_scene(o.image_path, o.page, s) : build_capture_scene(o.source, o.page, s, out);
   const Scene& scene = *is.scene;
-  const double duration = o.duration_s > 0.0 ? o.duration_s : o.hand == "explorer" ? hand->natural_duration_s() : path.duration_s() + 0.5;
+  const double duration = o.duration_s > 0.0     ? o.duration_s
+                          : o.hand == "explorer" ? hand->natural_duration_s()
+                                                 : path.duration_s() + 0.5;
   check_audio_out(o.audio_out, duration);
 
   RunRecord rec;

@@ -50,7 +50,7 @@ class EchoOff {
  public:
   EchoOff() {
     if (::tcgetattr(STDIN_FILENO, &g_saved_termios) != 0) return;
-    struct sigaction sa{};
+    struct sigaction sa {};
     sa.sa_handler = &restore_echo_and_reraise;
     sigemptyset(&sa.sa_mask);
     for (std::size_t i = 0; i < kSignals.size(); ++i) {
@@ -81,8 +81,8 @@ class EchoOff {
 
 /// A PIN read from standard input; its bytes are wiped when it goes.
 struct SecretLine {
-  std::string text;      ///< at most kMaxLineBytes (capacity reserved once: no copies left behind)
-  bool too_long = false; ///< the line had more than kMaxLineBytes bytes
+  std::string text;       ///< at most kMaxLineBytes (capacity reserved once: no copies left behind)
+  bool too_long = false;  ///< the line had more than kMaxLineBytes bytes
   SecretLine() { text.reserve(kMaxLineBytes); }
   ~SecretLine() { config::wipe_pin(text); }
   SecretLine(const SecretLine&) = delete;

@@ -7,9 +7,9 @@
 #include <stdexcept>
 
 #include "config/load.hpp"
+#include "formats/app_error.hpp"
 #include "pictures/documents.hpp"
 #include "vision/usb_stick.hpp"
-#include "formats/app_error.hpp"
 
 namespace hk::app {
 namespace {
@@ -41,7 +41,8 @@ int run_stick(const StickOptions& o) {
   if (!o.json_path.empty()) {  // refuse a bad output before mounting anything
     const std::filesystem::path p(o.json_path);
     const auto parent = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
-    if (!std::filesystem::is_directory(parent)) throw AppError("--json '" + o.json_path + "': folder '" + parent.string() + "' does not exist");
+    if (!std::filesystem::is_directory(parent))
+      throw AppError("--json '" + o.json_path + "': folder '" + parent.string() + "' does not exist");
   }
   std::optional<vision::MountedStick> mounted;
   std::string root = o.folder;
@@ -60,8 +61,9 @@ int run_stick(const StickOptions& o) {
     std::fputs(text.c_str(), stdout);
   } else {
     write_atomically(o.json_path, text);
-    std::printf("stick: %zu documents (%d pictures, %d PDFs), %zu refused%s -> %s\n", listing.documents.size(), listing.pictures(),
-                listing.pdfs(), listing.refused.size(), listing.scan.complete ? "" : " (stopped by a limit)", o.json_path.c_str());
+    std::printf("stick: %zu documents (%d pictures, %d PDFs), %zu refused%s -> %s\n", listing.documents.size(),
+                listing.pictures(), listing.pdfs(), listing.refused.size(),
+                listing.scan.complete ? "" : " (stopped by a limit)", o.json_path.c_str());
   }
   return 0;
 }

@@ -9,8 +9,8 @@
 
 #include <exiv2/exiv2.hpp>
 
-#include "formats/png_text.hpp"
 #include <toml++/toml.h>
+#include "formats/png_text.hpp"
 
 namespace hk::app {
 namespace {
@@ -27,7 +27,8 @@ bool valid_utf8(std::string_view s) {
   while (i < s.size()) {
     const auto c = static_cast<unsigned char>(s[i]);
     int extra = c < 0x80 ? 0 : (c >> 5) == 0x6 ? 1 : (c >> 4) == 0xE ? 2 : (c >> 3) == 0x1E ? 3 : -1;
-    if (extra < 0 || i + static_cast<std::size_t>(extra) >= s.size()) return false;  // a lead byte, and all its bytes there
+    if (extra < 0 || i + static_cast<std::size_t>(extra) >= s.size())
+      return false;  // a lead byte, and all its bytes there
     unsigned cp = extra == 0 ? c : extra == 1 ? (c & 0x1Fu) : extra == 2 ? (c & 0x0Fu) : (c & 0x07u);
     for (int k = 1; k <= extra; ++k) {
       const auto d = static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]);
@@ -55,7 +56,8 @@ std::string text_problem(const std::string& key, const std::string& raw, std::si
   if (!valid_utf8(raw)) return key + " is not valid UTF-8";
   const std::string text = trimmed(raw);
   if (text.empty()) return key + " is blank";
-  if (text.size() > max_bytes) return key + " is " + std::to_string(text.size()) + " bytes, at most " + std::to_string(max_bytes);
+  if (text.size() > max_bytes)
+    return key + " is " + std::to_string(text.size()) + " bytes, at most " + std::to_string(max_bytes);
   for (const char ch : text) {
     const auto u = static_cast<unsigned char>(ch);
     if ((u < 0x20 && !(lines && (ch == '\n' || ch == '\r'))) || u == 0x7F)
@@ -65,7 +67,8 @@ std::string text_problem(const std::string& key, const std::string& raw, std::si
 }
 
 /// The text of a sidecar's key `key`, checked (text_problem); refused with fail().
-std::string checked_text(const std::string& file, const std::string& key, const toml::node& node, std::size_t max_bytes, bool lines) {
+std::string checked_text(const std::string& file, const std::string& key, const toml::node& node, std::size_t max_bytes,
+                         bool lines) {
   const auto* str = node.as_string();
   if (!str) fail(file, key + " must be a string");
   if (const std::string why = text_problem(key, str->get(), max_bytes, lines); !why.empty()) fail(file, why);
@@ -75,8 +78,9 @@ std::string checked_text(const std::string& file, const std::string& key, const 
 }  // namespace
 
 std::string usable_note(const std::string& raw, std::size_t max_bytes, bool lines) {
-  static const char* const kPlaceholders[] = {"OLYMPUS DIGITAL CAMERA", "SONY DSC", "DCIM", "Digital Camera", "DIGITAL CAMERA",
-                                              "KODAK Digital Still Camera", "Default", "Untitled", "default"};
+  static const char* const kPlaceholders[] = {
+      "OLYMPUS DIGITAL CAMERA",     "SONY DSC", "DCIM",     "Digital Camera", "DIGITAL CAMERA",
+      "KODAK Digital Still Camera", "Default",  "Untitled", "default"};
   if (!text_problem("", raw, max_bytes, lines).empty()) return "";
   std::string text = trimmed(raw);
   for (const char* p : kPlaceholders)
@@ -127,7 +131,9 @@ PictureNotes embedded_notes(const std::string& image_path) {
   return notes;
 }
 
-std::string notes_path(const std::string& image_path) { return fs::path(image_path).replace_extension(".toml").string(); }
+std::string notes_path(const std::string& image_path) {
+  return fs::path(image_path).replace_extension(".toml").string();
+}
 
 PictureNotes read_picture_notes(const std::string& image_path, const PictureNotes* file_notes) {
   const std::string file = notes_path(image_path);
@@ -136,7 +142,8 @@ PictureNotes read_picture_notes(const std::string& image_path, const PictureNote
   if (!fs::is_regular_file(file, ec)) fail(file, "is not a regular file");
   const auto size = fs::file_size(file, ec);
   if (ec) fail(file, "cannot be read: " + ec.message());
-  if (size > kMaxNotesFileBytes) fail(file, "is " + std::to_string(size) + " bytes, at most " + std::to_string(kMaxNotesFileBytes));
+  if (size > kMaxNotesFileBytes)
+    fail(file, "is " + std::to_string(size) + " bytes, at most " + std::to_string(kMaxNotesFileBytes));
   std::ifstream in(file, std::ios::binary);
   if (!in) fail(file, "cannot be opened");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -20,7 +20,7 @@ namespace hk::app {
 namespace {
 
 constexpr std::size_t kMaxChunkBytes = 1u << 20;  // a text chunk, stored or inflated, larger than this is skipped
-constexpr int kMaxChunks = 1 << 20;                // chunks looked at before giving up on a file
+constexpr int kMaxChunks = 1 << 20;               // chunks looked at before giving up on a file
 constexpr std::array<std::uint8_t, 8> kSignature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
 
 /// Latin-1 (tEXt, zTXt) to UTF-8.
@@ -113,7 +113,9 @@ PngText read_png_text(const std::string& path) {
     }
     data.resize(length);
     std::array<std::uint8_t, 4> crc{};
-    if ((length > 0 && std::fread(data.data(), 1, length, f.get()) != length) || std::fread(crc.data(), 1, 4, f.get()) != 4) break;
+    if ((length > 0 && std::fread(data.data(), 1, length, f.get()) != length) ||
+        std::fread(crc.data(), 1, 4, f.get()) != 4)
+      break;
     uLong sum = crc32(0L, head.data() + 4, 4);
     sum = crc32(sum, reinterpret_cast<const Bytef*>(data.data()), static_cast<uInt>(length));
     if (sum != big_endian(crc.data())) continue;  // a damaged chunk says nothing

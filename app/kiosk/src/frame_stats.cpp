@@ -19,8 +19,9 @@ double ms_between(FrameStats::Clock::time_point a, FrameStats::Clock::time_point
 double to_us(double ms) { return std::round(ms * 1000.0) / 1000.0; }
 
 nlohmann::json summary_json(const FrameTimeSummary& s) {
-  return {{"frames", s.frames}, {"p50_ms", to_us(s.p50_ms)}, {"p95_ms", to_us(s.p95_ms)}, {"p99_ms", to_us(s.p99_ms)},
-          {"max_ms", to_us(s.max_ms)}, {"mean_ms", to_us(s.mean_ms)}, {"over_20_ms", s.over_20_ms}};
+  return {{"frames", s.frames},        {"p50_ms", to_us(s.p50_ms)}, {"p95_ms", to_us(s.p95_ms)},
+          {"p99_ms", to_us(s.p99_ms)}, {"max_ms", to_us(s.max_ms)}, {"mean_ms", to_us(s.mean_ms)},
+          {"over_20_ms", s.over_20_ms}};
 }
 
 }  // namespace
@@ -38,7 +39,8 @@ void FrameTimeHistogram::add_ms(double ms) {
 double FrameTimeHistogram::percentile_ms(double p) const {
   if (n_ == 0) return 0;
   p = std::clamp(p, 0.0, 100.0);
-  const auto rank = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(p / 100.0 * static_cast<double>(n_) - 1e-9)));
+  const auto rank =
+      std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(p / 100.0 * static_cast<double>(n_) - 1e-9)));
   std::int64_t seen = 0;
   for (int b = 0; b < kBins; ++b) {
     seen += bins_[static_cast<std::size_t>(b)];
@@ -98,7 +100,8 @@ nlohmann::json FrameStats::to_json(const std::string& measured) const {
   return {{"measured", measured},
           {"slow_frame_ms", kSlowFrameMs},
           {"bin_ms", FrameTimeHistogram::kBinMs},
-          {"interval", {{"all", summary_json(interval_all_.summary())}, {"changing", summary_json(interval_changing_.summary())}}},
+          {"interval",
+           {{"all", summary_json(interval_all_.summary())}, {"changing", summary_json(interval_changing_.summary())}}},
           {"work", {{"all", summary_json(work_all_.summary())}, {"changing", summary_json(work_changing_.summary())}}},
           {"changes", changes_},
           {"max_change_ms", to_us(max_change_ms_)}};
@@ -111,8 +114,8 @@ std::string FrameStats::log_line() const {
       "frame stats: {} frames, interval p50 {:.1f} p95 {:.1f} p99 {:.1f} max {:.1f} ms, {} over {:.0f} ms; "
       "while pictures changed ({} changes): {} frames, interval p99 {:.1f} max {:.1f} ms, {} over; "
       "work p99 {:.1f} ms (changing {:.1f} ms)",
-      a.frames, a.p50_ms, a.p95_ms, a.p99_ms, a.max_ms, a.over_20_ms, kSlowFrameMs, changes_, c.frames, c.p99_ms, c.max_ms,
-      c.over_20_ms, w.p99_ms, wc.p99_ms);
+      a.frames, a.p50_ms, a.p95_ms, a.p99_ms, a.max_ms, a.over_20_ms, kSlowFrameMs, changes_, c.frames, c.p99_ms,
+      c.max_ms, c.over_20_ms, w.p99_ms, wc.p99_ms);
 }
 
 void write_frame_stats(const FrameStats& stats, const std::string& path, const std::string& measured) {

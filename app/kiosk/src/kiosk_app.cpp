@@ -21,17 +21,17 @@
 #include "config/keys.hpp"
 #include "config/load.hpp"
 #include "config/store.hpp"
+#include "formats/app_error.hpp"
 #include "kiosk/frame_stats.hpp"
 #include "kiosk/hud.hpp"
 #include "kiosk/keymap.hpp"
-#include "visit/kiosk_flow.hpp"
-#include "visit/kiosk_runtime.hpp"
 #include "kiosk/operator_panel.hpp"
-#include "visit/operator_session.hpp"
 #include "kiosk/script.hpp"
 #include "kiosk/view.hpp"
 #include "kiosk/window.hpp"
-#include "formats/app_error.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/kiosk_runtime.hpp"
+#include "visit/operator_session.hpp"
 
 #ifndef HK_DATA_DIR
 #define HK_DATA_DIR "data"
@@ -74,13 +74,16 @@ void check_screenshot_options(const KioskOptions& o) {
   const std::filesystem::path p(o.screenshot);
   if (p.extension() != ".png") throw AppError("--screenshot '" + o.screenshot + "': must name a .png file");
   const auto parent = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
-  if (!std::filesystem::is_directory(parent)) throw AppError("--screenshot '" + o.screenshot + "': folder '" + parent.string() + "' does not exist");
-  if (o.frames < 1 || o.frames > 100000) throw AppError("--frames " + std::to_string(o.frames) + " is outside [1, 100000]");
+  if (!std::filesystem::is_directory(parent))
+    throw AppError("--screenshot '" + o.screenshot + "': folder '" + parent.string() + "' does not exist");
+  if (o.frames < 1 || o.frames > 100000)
+    throw AppError("--frames " + std::to_string(o.frames) + " is outside [1, 100000]");
 }
 
 /// What --frame-stats measured, said in its file.
 constexpr const char* kScriptedFrames =
-    "scripted run (--screenshot): interval = work + buffer swap + the fixed 16.7 ms pause per frame (under Xvfb the swap is "
+    "scripted run (--screenshot): interval = work + buffer swap + the fixed 16.7 ms pause per frame (under Xvfb the "
+    "swap is "
     "Mesa's software GL drawing and copying the frame, tens of ms at 1920 x 1080, not a vsync wait); "
     "work = frame start to before the swap";
 constexpr const char* kLiveFrames =
@@ -90,7 +93,8 @@ constexpr const char* kLiveFrames =
 /// Input routing and the frame loop's state: what a key does depends on who has the keyboard.
 class Kiosk final : public ScriptTarget {
  public:
-  Kiosk(const KioskOptions& o, KioskRuntime& runtime, KioskFlow& flow, OperatorSession& session, OperatorPanel& panel, KioskWindow& window)
+  Kiosk(const KioskOptions& o, KioskRuntime& runtime, KioskFlow& flow, OperatorSession& session, OperatorPanel& panel,
+        KioskWindow& window)
       : o_(o), rt_(runtime), flow_(flow), session_(session), panel_(panel), window_(window) {
     keys_changed();
   }
@@ -98,7 +102,8 @@ class Kiosk final : public ScriptTarget {
   /// The visitor's keys and the operator's chord, again from the settings in use.
   void keys_changed() {
     keys_ = visitor_key_map(rt_.settings().keys);
-    chord_ = config::parse_chord(rt_.settings().operator_.open_chord).value_or(config::KeyChord{true, true, false, false, "O"});
+    chord_ = config::parse_chord(rt_.settings().operator_.open_chord)
+                 .value_or(config::KeyChord{true, true, false, false, "O"});
   }
 
   /// One event, real or scripted.
@@ -115,7 +120,7 @@ class Kiosk final : public ScriptTarget {
     const auto it = e.kind == InputEvent::Kind::key ? keys_.find(e.key) : keys_.end();
     const bool help = it != keys_.end() && it->second == KioskKey::Help;
     if (e.kind == InputEvent::Kind::mouse_button || (e.kind == InputEvent::Kind::key && e.action == GLFW_RELEASE)) {
-      if (help && e.action == GLFW_RELEASE) flow_.help_held(false);  // learning mode ends
+      if (help && e.action == GLFW_RELEASE) flow_.help_held(false);      // learning mode ends
       if (e.kind == InputEvent::Kind::key && e.key == lone_modifier_) {  // a modifier pressed and let go alone
         lone_modifier_ = 0;
         flow_.key(KioskKey::Other, now_s_, key_name_of(e.key));
@@ -136,7 +141,7 @@ class Kiosk final : public ScriptTarget {
     }
     lone_modifier_ = 0;
     if (e.mods & (GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SUPER)) {  // no visitor key has modifiers: a chord
-      flow_.key(KioskKey::Other, now_s_);  // Ctrl+Q, Alt+F4: "That key does nothing here."
+      flow_.key(KioskKey::Other, now_s_);                               // Ctrl+Q, Alt+F4: "That key does nothing here."
       return;
     }
     if (e.key == GLFW_KEY_ESCAPE && o_.windowed) {
@@ -159,7 +164,9 @@ class Kiosk final : public ScriptTarget {
   void moved() override { flow_.handle_moved(now_s_); }
   void stick(const std::string& dir) override { rt_.insert_stick_folder(dir); }
   void unstick() override { rt_.remove_stick_folder(); }
-  bool busy() override { return rt_.stick_busy() || rt_.text_busy() || rt_.picture_busy() || session_.state() == PanelState::checking; }
+  bool busy() override {
+    return rt_.stick_busy() || rt_.text_busy() || rt_.picture_busy() || session_.state() == PanelState::checking;
+  }
   std::optional<WidgetRect> widget(const std::string& name) override { return panel_.widget(name); }
 
   /// The mouse stands in for the visitor's hand, but only once it has moved: where the pointer happens to
@@ -311,7 +318,8 @@ bool update_frame(Kiosk& kiosk, KioskRuntime& rt, KioskFlow& flow, OperatorSessi
 /// The frame's drawing, not yet shown: the scene, the camera preview while capturing, then (ImGui) the
 /// captions, the overlay's status and the operator's panel.
 void draw_frame(KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, OperatorPanel& panel, KioskWindow& window,
-                const ScriptPlayer& script, bool scripted, double now_s, PictureTexture& texture, CapturePreviewView& preview) {
+                const ScriptPlayer& script, bool scripted, double now_s, PictureTexture& texture,
+                CapturePreviewView& preview) {
   const auto [fw, fh] = window.framebuffer_size();
   texture.update(rt.shown());
   draw_scene(rt, make_view(fw, fh, rt.half()), texture);
@@ -363,14 +371,16 @@ int run_kiosk(const KioskOptions& o) {
     if (stats) stats->frame_started(std::chrono::steady_clock::now());
     const Scene* const scene_at_start = rt.shown().scene;
     const int id_at_start = rt.shown_id();
-    kiosk.now_s_ = scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    kiosk.now_s_ =
+        scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const bool holding = update_frame(kiosk, rt, flow, session, window, script, scripted, frame);
     if (kiosk.take_picture_key() && stats) stats->picture_key(scene_at_start, id_at_start);
     draw_frame(rt, flow, session, panel, window, script, scripted, kiosk.now_s_, texture, preview);
     if (stats) stats->frame_drawn(std::chrono::steady_clock::now(), rt.shown().scene, rt.shown_id());
     if (!holding) ++frame;
     if (scripted && frame >= o.frames) {
-      if (!cv::imwrite(o.screenshot, window.read_pixels())) throw AppError("--screenshot '" + o.screenshot + "': cannot write the PNG");
+      if (!cv::imwrite(o.screenshot, window.read_pixels()))
+        throw AppError("--screenshot '" + o.screenshot + "': cannot write the PNG");
       break;
     }
     window.swap();

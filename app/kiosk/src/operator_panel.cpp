@@ -22,18 +22,21 @@ const ImVec4 kGreen{0.5f, 0.95f, 0.55f, 1.0f};
 
 const char* apply_text(config::ApplyWhen a) {
   switch (a) {
-    case config::ApplyWhen::live: return "at once";
-    case config::ApplyWhen::scene: return "rebuilds the scene";
-    case config::ApplyWhen::session: return "next visitor";
-    case config::ApplyWhen::restart: return "after a restart";
+    case config::ApplyWhen::live:
+      return "at once";
+    case config::ApplyWhen::scene:
+      return "rebuilds the scene";
+    case config::ApplyWhen::session:
+      return "next visitor";
+    case config::ApplyWhen::restart:
+      return "after a restart";
   }
   return "";
 }
 
-
-constexpr config::FieldGroup kTabs[] = {config::FieldGroup::haptics, config::FieldGroup::levels, config::FieldGroup::scene,
-                                        config::FieldGroup::audio,   config::FieldGroup::kiosk,  config::FieldGroup::keys,
-                                        config::FieldGroup::devices};
+constexpr config::FieldGroup kTabs[] = {
+    config::FieldGroup::haptics, config::FieldGroup::levels, config::FieldGroup::scene,  config::FieldGroup::audio,
+    config::FieldGroup::kiosk,   config::FieldGroup::keys,   config::FieldGroup::devices};
 
 }  // namespace
 
@@ -48,15 +51,25 @@ std::optional<WidgetRect> OperatorPanel::widget(const std::string& name) const {
   return it->second;
 }
 
-void OperatorPanel::draw(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double now_s, std::int64_t now_unix_s) {
+void OperatorPanel::draw(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double now_s,
+                         std::int64_t now_unix_s) {
   drawing_.clear();
   sample_plot(runtime);
   switch (s_.state()) {
-    case PanelState::closed: std::fill(pin_.begin(), pin_.end(), '\0'); pin_.clear(); break;
-    case PanelState::notice: draw_notice(fw, fh); break;
+    case PanelState::closed:
+      std::fill(pin_.begin(), pin_.end(), '\0');
+      pin_.clear();
+      break;
+    case PanelState::notice:
+      draw_notice(fw, fh);
+      break;
     case PanelState::pin_entry:
-    case PanelState::checking: draw_pin_prompt(fw, fh, now_s, now_unix_s); break;
-    case PanelState::open: draw_panel(runtime, flow, fw, fh, now_s, now_unix_s); break;
+    case PanelState::checking:
+      draw_pin_prompt(fw, fh, now_s, now_unix_s);
+      break;
+    case PanelState::open:
+      draw_panel(runtime, flow, fw, fh, now_s, now_unix_s);
+      break;
   }
   widgets_.swap(drawing_);
 }
@@ -64,7 +77,9 @@ void OperatorPanel::draw(KioskRuntime& runtime, const KioskFlow& flow, int fw, i
 void OperatorPanel::draw_notice(int fw, int fh) {
   ImGui::SetNextWindowPos(ImVec2(0.5f * fw, 0.3f * fh), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSize(ImVec2(0.6f * fw, 0));
-  ImGui::Begin("Operator", nullptr, ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
+  ImGui::Begin("Operator", nullptr,
+               ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoResize);
   ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
   ImGui::TextWrapped("%s", s_.message().c_str());
   ImGui::PopStyleColor();
@@ -74,7 +89,9 @@ void OperatorPanel::draw_notice(int fw, int fh) {
 void OperatorPanel::draw_pin_prompt(int fw, int fh, double now_s, std::int64_t now_unix_s) {
   ImGui::SetNextWindowPos(ImVec2(0.5f * fw, 0.3f * fh), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSize(ImVec2(std::min(0.6f * fw, 560.0f), 0));
-  ImGui::Begin("Operator PIN", nullptr, ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
+  ImGui::Begin("Operator PIN", nullptr,
+               ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoResize);
   if (ImGui::IsWindowAppearing()) focus_pin_ = true;
   ImGui::TextWrapped("%s", s_.message().c_str());
   const bool can_type = s_.state() == PanelState::pin_entry && s_.wait_s() <= 0;
@@ -84,7 +101,9 @@ void OperatorPanel::draw_pin_prompt(int fw, int fh, double now_s, std::int64_t n
     focus_pin_ = false;
   }
   ImGui::SetNextItemWidth(-1);
-  bool enter = ImGui::InputText("##pin", &pin_, ImGuiInputTextFlags_Password | ImGuiInputTextFlags_CharsDecimal | ImGuiInputTextFlags_EnterReturnsTrue);
+  bool enter = ImGui::InputText(
+      "##pin", &pin_,
+      ImGuiInputTextFlags_Password | ImGuiInputTextFlags_CharsDecimal | ImGuiInputTextFlags_EnterReturnsTrue);
   record("pin");
   if (pin_.size() > static_cast<std::size_t>(12)) pin_.resize(12);
   enter = ImGui::Button("OK") || enter;
@@ -105,11 +124,14 @@ void OperatorPanel::draw_pin_prompt(int fw, int fh, double now_s, std::int64_t n
   ImGui::End();
 }
 
-void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double, std::int64_t now_unix_s) {
+void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double,
+                               std::int64_t now_unix_s) {
   ImGui::SetNextWindowPos(ImVec2(0.04f * fw, 0.04f * fh));
   ImGui::SetNextWindowSize(ImVec2(0.92f * fw, 0.8f * fh));
   ImGui::SetNextWindowBgAlpha(0.96f);  // the picture must not show through the settings
-  ImGui::Begin("Operator panel", nullptr, ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
+  ImGui::Begin("Operator panel", nullptr,
+               ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoResize);
   if (!s_.load_notice().empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
     ImGui::TextWrapped("Settings file: %s", s_.load_notice().c_str());
@@ -141,7 +163,9 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
 }
 
 void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& profile_type, std::int64_t now_unix_s) {
-  if (!ImGui::BeginTable("fields", 4, ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_SizingStretchProp)) return;
+  if (!ImGui::BeginTable("fields", 4,
+                         ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_SizingStretchProp))
+    return;
   ImGui::TableSetupColumn("setting", ImGuiTableColumnFlags_WidthStretch, 1.3f);
   ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch, 1.0f);
   ImGui::TableSetupColumn("allowed", ImGuiTableColumnFlags_WidthStretch, 1.0f);
@@ -159,7 +183,8 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
     ImGui::TableNextColumn();
     ImGui::SetNextItemWidth(-1);
     ImGui::PushID(key.c_str());
-    const bool enter = ImGui::InputText("##v", &s_.edit_text(d), ImGuiInputTextFlags_AutoSelectAll | ImGuiInputTextFlags_EnterReturnsTrue);
+    const bool enter = ImGui::InputText("##v", &s_.edit_text(d),
+                                        ImGuiInputTextFlags_AutoSelectAll | ImGuiInputTextFlags_EnterReturnsTrue);
     record(key);
     if (enter || ImGui::IsItemDeactivatedAfterEdit()) s_.commit_field(d, now_unix_s);
     if (!s_.field_error(d).empty()) {
@@ -212,7 +237,9 @@ void OperatorPanel::draw_actions(std::int64_t now_unix_s) {
   if (ImGui::Button("Close")) s_.close(now_unix_s);
   record("Close");
   if (ImGui::BeginPopupModal("Reset to defaults?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
-    ImGui::TextUnformatted("Every setting in the panel goes back to its default (the PIN stays).\nNothing changes in the kiosk until Apply.");
+    ImGui::TextUnformatted(
+        "Every setting in the panel goes back to its default (the PIN stays).\nNothing changes in the kiosk until "
+        "Apply.");
     if (ImGui::Button("Reset")) {
       s_.reset_to_defaults(now_unix_s);
       ImGui::CloseCurrentPopup();
@@ -229,15 +256,17 @@ void OperatorPanel::sample_plot(KioskRuntime& runtime) {
   const ServoDisplayState& d = runtime.core().display();
   const bool touching = d.state != ContactState::Free;
   force_n_[static_cast<std::size_t>(plot_at_)] = static_cast<float>(length(d.force_n));
-  penetration_mm_[static_cast<std::size_t>(plot_at_)] = touching ? static_cast<float>(1000.0 * length(d.handle_m - d.proxy_m)) : 0.0f;
+  penetration_mm_[static_cast<std::size_t>(plot_at_)] =
+      touching ? static_cast<float>(1000.0 * length(d.handle_m - d.proxy_m)) : 0.0f;
   plot_at_ = (plot_at_ + 1) % kPlotSamples;
 }
 
 void OperatorPanel::draw_stick_problems(const KioskRuntime& runtime) {
   const std::vector<std::string>& problems = runtime.stick_problems();
   if (problems.empty()) return;
-  const std::string title = "The last stick: " + std::to_string(problems.size()) + (problems.size() == 1 ? " file" : " files") +
-                            " left out (" + (problems.size() >= KioskRuntime::kStickProblems ? "the first ones; " : "") + "all in the log)";
+  const std::string title =
+      "The last stick: " + std::to_string(problems.size()) + (problems.size() == 1 ? " file" : " files") +
+      " left out (" + (problems.size() >= KioskRuntime::kStickProblems ? "the first ones; " : "") + "all in the log)";
   if (ImGui::TreeNode("stick_problems", "%s", title.c_str())) {
     for (const std::string& p : problems) ImGui::BulletText("%s", p.c_str());
     ImGui::TreePop();
@@ -254,8 +283,9 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
     return;
   }
   const io::HaplyCounters c = usb->counters();
-  ImGui::Text("Device: %s, %s; replies missing %lld, refused %lld, reconnects %lld", usb->name().c_str(), device_status_name(d.device_status),
-              static_cast<long long>(c.replies_missing), static_cast<long long>(c.malformed), static_cast<long long>(c.reconnects));
+  ImGui::Text("Device: %s, %s; replies missing %lld, refused %lld, reconnects %lld", usb->name().c_str(),
+              device_status_name(d.device_status), static_cast<long long>(c.replies_missing),
+              static_cast<long long>(c.malformed), static_cast<long long>(c.reconnects));
   if (d.device_status != DeviceStatus::Ok) {
     ImGui::SameLine();
     ImGui::TextColored(kOrange, "(no force while it does not answer)");
@@ -277,7 +307,8 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
         }
       }
       char note[160];
-      std::snprintf(note, sizeof note, "Calibrated: encoder offsets %.3f and %.3f deg, in force now; Save keeps them.", o1, o2);
+      std::snprintf(note, sizeof note, "Calibrated: encoder offsets %.3f and %.3f deg, in force now; Save keeps them.",
+                    o1, o2);
       calibrate_note_ = note;
     } else {
       calibrate_note_ = "Not calibrated: " + why + ".";
@@ -290,12 +321,13 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
 void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, std::int64_t now_unix_s) {
   const config::Settings& s = runtime.settings();
   const ServoDisplayState& d = runtime.core().display();
-  ImGui::Text("Visitor: %s, picture %d, %s%s", state_name(flow.state()), flow.picture() + 1, level_label(d.level).c_str(), d.auto_level ? " (from hand speed)" : " (fixed)");
+  ImGui::Text("Visitor: %s, picture %d, %s%s", state_name(flow.state()), flow.picture() + 1,
+              level_label(d.level).c_str(), d.auto_level ? " (from hand speed)" : " (fixed)");
   if (ServoThread* st = runtime.devices().servo()) {
     const ServoTimingStats t = st->stats();
-    ImGui::Text("Servo: %.0f Hz, %s; lateness p50 %.0f, p99 %.0f, max %.0f us; missed deadlines %lld", s.haptics.servo_rate_hz,
-                st->realtime() ? "real-time (SCHED_FIFO)" : "normal priority", t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us,
-                static_cast<long long>(t.missed_deadlines));
+    ImGui::Text("Servo: %.0f Hz, %s; lateness p50 %.0f, p99 %.0f, max %.0f us; missed deadlines %lld",
+                s.haptics.servo_rate_hz, st->realtime() ? "real-time (SCHED_FIFO)" : "normal priority",
+                t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us, static_cast<long long>(t.missed_deadlines));
     if (t.missed_deadlines > 0) {
       ImGui::SameLine();
       ImGui::TextColored(kOrange, "(each one zeroed the force for a tick)");
@@ -305,9 +337,12 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, st
   ImGui::Text("Walls: stiffness %.0f N/m, max force %.2f N", s.haptics.stiffness_n_per_m, s.haptics.max_force_n);
   audio::AudioSystem& a = runtime.audio();
   ImGui::Text("Sound: %s; speech %s; volume %d/10; cues dropped %llu", a.sound_output() ? "playing" : "no sound device",
-              a.speech_available() ? "on" : "unavailable", a.volume().step(), static_cast<unsigned long long>(a.cues_dropped()));
-  ImGui::Text("USB sticks: %s%s%s", runtime.sticks().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
-              flow.source() == KioskSource::Stick ? "; a stick is being browsed" : "", runtime.stick_busy() ? "; working" : "");
+              a.speech_available() ? "on" : "unavailable", a.volume().step(),
+              static_cast<unsigned long long>(a.cues_dropped()));
+  ImGui::Text("USB sticks: %s%s%s",
+              runtime.sticks().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
+              flow.source() == KioskSource::Stick ? "; a stick is being browsed" : "",
+              runtime.stick_busy() ? "; working" : "");
   record(runtime.stick_busy() ? "sticks:working" : "sticks:idle");
   draw_stick_problems(runtime);
   ImGui::Checkbox("Show the collision tree's boxes and the boundary section on screen", &runtime.overlay());
@@ -315,9 +350,12 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, st
   ImGui::Separator();
   const float w = ImGui::GetContentRegionAvail().x;
   ImGui::Text("Force on the handle [N], last 5 s (now %.2f N)", length(d.force_n));
-  ImGui::PlotLines("##force", force_n_.data(), kPlotSamples, plot_at_, nullptr, 0.0f, static_cast<float>(std::max(0.5, s.haptics.max_force_n)), ImVec2(w, 90));
-  ImGui::Text("Penetration into the wall [mm] (now %.2f mm)", d.state != ContactState::Free ? 1000.0 * length(d.handle_m - d.proxy_m) : 0.0);
-  ImGui::PlotLines("##penetration", penetration_mm_.data(), kPlotSamples, plot_at_, nullptr, 0.0f, FLT_MAX, ImVec2(w, 90));
+  ImGui::PlotLines("##force", force_n_.data(), kPlotSamples, plot_at_, nullptr, 0.0f,
+                   static_cast<float>(std::max(0.5, s.haptics.max_force_n)), ImVec2(w, 90));
+  ImGui::Text("Penetration into the wall [mm] (now %.2f mm)",
+              d.state != ContactState::Free ? 1000.0 * length(d.handle_m - d.proxy_m) : 0.0);
+  ImGui::PlotLines("##penetration", penetration_mm_.data(), kPlotSamples, plot_at_, nullptr, 0.0f, FLT_MAX,
+                   ImVec2(w, 90));
 }
 
 }  // namespace hk::app

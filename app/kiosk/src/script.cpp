@@ -8,29 +8,39 @@
 #include <stdexcept>
 
 #include "config/keys.hpp"
-#include "kiosk/keymap.hpp"
 #include "formats/app_error.hpp"
+#include "kiosk/keymap.hpp"
 
 namespace hk::app {
 namespace {
 
 const std::map<std::string, KioskKey>& action_names() {
-  static const std::map<std::string, KioskKey> m{{"help", KioskKey::Help},         {"next", KioskKey::Next},
-                                                 {"previous", KioskKey::Previous}, {"describe", KioskKey::Describe},
-                                                 {"finer", KioskKey::Finer},       {"coarser", KioskKey::Coarser},
-                                                 {"volume_up", KioskKey::VolumeUp}, {"volume_down", KioskKey::VolumeDown},
-                                                 {"tutorial", KioskKey::Tutorial}, {"guide", KioskKey::Guide},
-                                                 {"capture", KioskKey::Capture}, {"repeat", KioskKey::Repeat},
-                                                 {"pause", KioskKey::Pause},       {"where", KioskKey::Where},
-                                                 {"finish", KioskKey::Finish},     {"next_sentence", KioskKey::NextSentence},
+  static const std::map<std::string, KioskKey> m{{"help", KioskKey::Help},
+                                                 {"next", KioskKey::Next},
+                                                 {"previous", KioskKey::Previous},
+                                                 {"describe", KioskKey::Describe},
+                                                 {"finer", KioskKey::Finer},
+                                                 {"coarser", KioskKey::Coarser},
+                                                 {"volume_up", KioskKey::VolumeUp},
+                                                 {"volume_down", KioskKey::VolumeDown},
+                                                 {"tutorial", KioskKey::Tutorial},
+                                                 {"guide", KioskKey::Guide},
+                                                 {"capture", KioskKey::Capture},
+                                                 {"repeat", KioskKey::Repeat},
+                                                 {"pause", KioskKey::Pause},
+                                                 {"where", KioskKey::Where},
+                                                 {"finish", KioskKey::Finish},
+                                                 {"next_sentence", KioskKey::NextSentence},
                                                  {"previous_sentence", KioskKey::PreviousSentence},
                                                  {"next_paragraph", KioskKey::NextParagraph},
-                                                 {"previous_paragraph", KioskKey::PreviousParagraph}, {"other", KioskKey::Other}};
+                                                 {"previous_paragraph", KioskKey::PreviousParagraph},
+                                                 {"other", KioskKey::Other}};
   return m;
 }
 
 constexpr const char* kAllowed =
-    "'FRAME key ACTION', 'FRAME press KEYS', 'FRAME type TEXT', 'FRAME click NAME', 'FRAME shows NAME', 'FRAME cursor X_M Y_M', 'FRAME move', "
+    "'FRAME key ACTION', 'FRAME press KEYS', 'FRAME type TEXT', 'FRAME click NAME', 'FRAME shows NAME', 'FRAME cursor "
+    "X_M Y_M', 'FRAME move', "
     "'FRAME stick DIR', 'FRAME unstick' or 'FRAME wait'";
 
 /// KEYS of a press line: a key name, or modifiers and a key joined by '+'. False when it is neither.
@@ -47,11 +57,16 @@ bool parse_keys(const std::string& text, int* key, int* mods) {
     const std::size_t plus = rest.find('+');
     if (plus == std::string::npos) break;
     const std::string part = rest.substr(0, plus);
-    if (part == "CTRL") m |= GLFW_MOD_CONTROL;
-    else if (part == "ALT") m |= GLFW_MOD_ALT;
-    else if (part == "SHIFT") m |= GLFW_MOD_SHIFT;
-    else if (part == "SUPER") m |= GLFW_MOD_SUPER;
-    else return false;
+    if (part == "CTRL")
+      m |= GLFW_MOD_CONTROL;
+    else if (part == "ALT")
+      m |= GLFW_MOD_ALT;
+    else if (part == "SHIFT")
+      m |= GLFW_MOD_SHIFT;
+    else if (part == "SUPER")
+      m |= GLFW_MOD_SUPER;
+    else
+      return false;
     rest = rest.substr(plus + 1);
   }
   *key = glfw_key(rest);
@@ -117,7 +132,9 @@ bool ScriptPlayer::step(int frame, ScriptTarget& t) {
   while (next_ < lines_.size() && lines_[next_].frame <= frame) {
     const ScriptLine& l = lines_[next_];
     if (l.what == "wait" && t.busy()) {
-      if (++held_ > kMaxHeldFrames) throw AppError("script '" + path_ + "': line " + std::to_string(l.number) + ": the kiosk was still busy after 60 s");
+      if (++held_ > kMaxHeldFrames)
+        throw AppError("script '" + path_ + "': line " + std::to_string(l.number) +
+                       ": the kiosk was still busy after 60 s");
       return true;
     }
     if (l.what == "click" && !clicks_.empty()) return false;  // one click at a time: this one waits a frame
@@ -135,15 +152,18 @@ bool ScriptPlayer::step(int frame, ScriptTarget& t) {
       for (unsigned char c : l.arg) t.input({InputEvent::Kind::character, 0, 0, 0, 0, c, 0});
     }
     if (l.what == "shows" && !t.widget(l.arg)) {
-      throw AppError("script '" + path_ + "': line " + std::to_string(l.number) + ": '" + l.arg + "' is not on screen at frame " + std::to_string(frame));
+      throw AppError("script '" + path_ + "': line " + std::to_string(l.number) + ": '" + l.arg +
+                     "' is not on screen at frame " + std::to_string(frame));
     }
     if (l.what == "click") {
       const std::optional<WidgetRect> r = t.widget(l.arg);
-      if (!r) throw AppError("script '" + path_ + "': line " + std::to_string(l.number) + ": no widget '" + l.arg + "' on screen at frame " + std::to_string(frame));
+      if (!r)
+        throw AppError("script '" + path_ + "': line " + std::to_string(l.number) + ": no widget '" + l.arg +
+                       "' on screen at frame " + std::to_string(frame));
       const ScriptedMouse at{0.5f * (r->x0 + r->x1), 0.5f * (r->y0 + r->y1), false};
-      mouse_ = at;                               // this frame: the pointer arrives (hover)
-      clicks_.push_back({at.x, at.y, true});     // next: button down
-      clicks_.push_back(at);                     // then: up (the click)
+      mouse_ = at;                            // this frame: the pointer arrives (hover)
+      clicks_.push_back({at.x, at.y, true});  // next: button down
+      clicks_.push_back(at);                  // then: up (the click)
     }
   }
   return false;

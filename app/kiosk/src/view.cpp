@@ -6,7 +6,6 @@
 
 namespace hk::app {
 
-
 PictureTexture::PictureTexture(int side_px) {
   glGenTextures(2, tex_);
   for (int i = 0; i < 2; ++i) allocate(i, std::max(side_px, 1));
@@ -41,7 +40,8 @@ void PictureTexture::update(const Shown& shown) {
   if (pending_.empty()) return;
   // OpenCV's BGR rows go up as they are (GL_BGR, OpenGL 1.2): no converted copy on the window thread.
   const std::size_t row_bytes = pending_.step[0];
-  const int rows = std::clamp(static_cast<int>(kUploadBytesPerFrame / std::max<std::size_t>(row_bytes, 1)), 1, h_ - rows_up_);
+  const int rows =
+      std::clamp(static_cast<int>(kUploadBytesPerFrame / std::max<std::size_t>(row_bytes, 1)), 1, h_ - rows_up_);
   glBindTexture(GL_TEXTURE_2D, tex_[drawn_]);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   glPixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(row_bytes / 3));
@@ -138,12 +138,17 @@ void draw_picture(const View& v, const PictureTexture& tex, const Shown& sh, boo
   // The picture's corner of the texture, its far edges at the last texels' centres (half a texel in), so
   // linear filtering never blends in the texels past the picture, left there by a larger one.
   const float side = static_cast<float>(tex.side());
-  const float u1 = (static_cast<float>(tex.width()) - 0.5f) / side, v1 = (static_cast<float>(tex.height()) - 0.5f) / side;
+  const float u1 = (static_cast<float>(tex.width()) - 0.5f) / side,
+              v1 = (static_cast<float>(tex.height()) - 0.5f) / side;
   glBegin(GL_QUADS);
-  glTexCoord2f(0, 0); glVertex2d(v.px(x0), v.py(y0));
-  glTexCoord2f(u1, 0); glVertex2d(v.px(x1), v.py(y0));
-  glTexCoord2f(u1, v1); glVertex2d(v.px(x1), v.py(y1));
-  glTexCoord2f(0, v1); glVertex2d(v.px(x0), v.py(y1));
+  glTexCoord2f(0, 0);
+  glVertex2d(v.px(x0), v.py(y0));
+  glTexCoord2f(u1, 0);
+  glVertex2d(v.px(x1), v.py(y0));
+  glTexCoord2f(u1, v1);
+  glVertex2d(v.px(x1), v.py(y1));
+  glTexCoord2f(0, v1);
+  glVertex2d(v.px(x0), v.py(y1));
   glEnd();
   glDisable(GL_TEXTURE_2D);
 }
@@ -181,8 +186,10 @@ void draw_curves(KioskRuntime& app, const View& v, const Shown& sh, bool hc, int
   glLineWidth(hc ? 6.0f : 3.0f);
   for (std::size_t c = 0; c < sh.levels.size(); ++c) {
     const int top = static_cast<int>(sh.levels[c].size()) - 1;
-    const int l = sh.scene ? sh.scene->clamp_level(c, app.level()) : std::min(app.level(), top);  // a tolerance step: the curve's own level
-    const std::vector<Vec2>& pts = cut_step >= 0 ? sh.cuts[c][static_cast<std::size_t>(cut_step)] : sh.levels[c][static_cast<std::size_t>(l)];
+    const int l = sh.scene ? sh.scene->clamp_level(c, app.level())
+                           : std::min(app.level(), top);  // a tolerance step: the curve's own level
+    const std::vector<Vec2>& pts =
+        cut_step >= 0 ? sh.cuts[c][static_cast<std::size_t>(cut_step)] : sh.levels[c][static_cast<std::size_t>(l)];
     glBegin(sh.closed[c] ? GL_LINE_LOOP : GL_LINE_STRIP);
     for (const Vec2& p : pts) glVertex2d(v.px(p.x), v.py(p.y));
     glEnd();
@@ -215,7 +222,8 @@ void draw_error_boxes(KioskRuntime& app, const View& v, const Shown& sh, int cut
     }
     const int l = sc.clamp_level(c, app.level());
     const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
-    for (std::uint32_t k = 0; k < segs; ++k) segment_box({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)});
+    for (std::uint32_t k = 0; k < segs; ++k)
+      segment_box({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)});
   }
 }
 

@@ -14,7 +14,9 @@
 namespace hk::app {
 namespace {
 
-std::vector<InputEvent>& queue_of(GLFWwindow* w) { return *static_cast<std::vector<InputEvent>*>(glfwGetWindowUserPointer(w)); }
+std::vector<InputEvent>& queue_of(GLFWwindow* w) {
+  return *static_cast<std::vector<InputEvent>*>(glfwGetWindowUserPointer(w));
+}
 
 }  // namespace
 
@@ -45,7 +47,9 @@ KioskWindow::KioskWindow(bool windowed) {
   glfwSetKeyCallback(win_, [](GLFWwindow* w, int key, int scancode, int action, int mods) {
     queue_of(w).push_back({InputEvent::Kind::key, key, scancode, action, mods, 0, 0});
   });
-  glfwSetCharCallback(win_, [](GLFWwindow* w, unsigned c) { queue_of(w).push_back({InputEvent::Kind::character, 0, 0, 0, 0, c, 0}); });
+  glfwSetCharCallback(win_, [](GLFWwindow* w, unsigned c) {
+    queue_of(w).push_back({InputEvent::Kind::character, 0, 0, 0, 0, c, 0});
+  });
   glfwSetMouseButtonCallback(win_, [](GLFWwindow* w, int button, int action, int mods) {
     queue_of(w).push_back({InputEvent::Kind::mouse_button, 0, 0, action, mods, 0, button});
   });
@@ -72,9 +76,15 @@ std::vector<InputEvent> KioskWindow::poll() {
 
 void KioskWindow::to_imgui(const InputEvent& e) {
   switch (e.kind) {
-    case InputEvent::Kind::key: ImGui_ImplGlfw_KeyCallback(win_, e.key, e.scancode, e.action, e.mods); break;
-    case InputEvent::Kind::character: ImGui_ImplGlfw_CharCallback(win_, e.codepoint); break;
-    case InputEvent::Kind::mouse_button: ImGui_ImplGlfw_MouseButtonCallback(win_, e.button, e.action, e.mods); break;
+    case InputEvent::Kind::key:
+      ImGui_ImplGlfw_KeyCallback(win_, e.key, e.scancode, e.action, e.mods);
+      break;
+    case InputEvent::Kind::character:
+      ImGui_ImplGlfw_CharCallback(win_, e.codepoint);
+      break;
+    case InputEvent::Kind::mouse_button:
+      ImGui_ImplGlfw_MouseButtonCallback(win_, e.button, e.action, e.mods);
+      break;
   }
 }
 

@@ -44,10 +44,14 @@ void take(CaptureOutcome& o, const cv::Mat& frame, const vision::FrameLook& look
 
 const char* capture_end_name(CaptureEnd e) {
   switch (e) {
-    case CaptureEnd::Still: return "still";
-    case CaptureEnd::WholeFrame: return "whole_frame";
-    case CaptureEnd::Timeout: return "timeout";
-    case CaptureEnd::Cancelled: return "cancelled";
+    case CaptureEnd::Still:
+      return "still";
+    case CaptureEnd::WholeFrame:
+      return "whole_frame";
+    case CaptureEnd::Timeout:
+      return "timeout";
+    case CaptureEnd::Cancelled:
+      return "cancelled";
   }
   return "?";
 }
@@ -55,17 +59,28 @@ const char* capture_end_name(CaptureEnd e) {
 audio::MessageId advice_message(vision::FramingAdvice a) {
   using audio::MessageId;
   switch (a) {
-    case vision::FramingAdvice::PlacePicture: return MessageId::capture_place;
-    case vision::FramingAdvice::TooDark: return MessageId::capture_too_dark;
-    case vision::FramingAdvice::CutOffTop: return MessageId::capture_cut_off_top;
-    case vision::FramingAdvice::CutOffBottom: return MessageId::capture_cut_off_bottom;
-    case vision::FramingAdvice::CutOffLeft: return MessageId::capture_cut_off_left;
-    case vision::FramingAdvice::CutOffRight: return MessageId::capture_cut_off_right;
-    case vision::FramingAdvice::MoveLeft: return MessageId::capture_move_left;
-    case vision::FramingAdvice::MoveRight: return MessageId::capture_move_right;
-    case vision::FramingAdvice::MoveUp: return MessageId::capture_move_up;
-    case vision::FramingAdvice::MoveDown: return MessageId::capture_move_down;
-    case vision::FramingAdvice::HoldStill: return MessageId::capture_hold_still;
+    case vision::FramingAdvice::PlacePicture:
+      return MessageId::capture_place;
+    case vision::FramingAdvice::TooDark:
+      return MessageId::capture_too_dark;
+    case vision::FramingAdvice::CutOffTop:
+      return MessageId::capture_cut_off_top;
+    case vision::FramingAdvice::CutOffBottom:
+      return MessageId::capture_cut_off_bottom;
+    case vision::FramingAdvice::CutOffLeft:
+      return MessageId::capture_cut_off_left;
+    case vision::FramingAdvice::CutOffRight:
+      return MessageId::capture_cut_off_right;
+    case vision::FramingAdvice::MoveLeft:
+      return MessageId::capture_move_left;
+    case vision::FramingAdvice::MoveRight:
+      return MessageId::capture_move_right;
+    case vision::FramingAdvice::MoveUp:
+      return MessageId::capture_move_up;
+    case vision::FramingAdvice::MoveDown:
+      return MessageId::capture_move_down;
+    case vision::FramingAdvice::HoldStill:
+      return MessageId::capture_hold_still;
   }
   return MessageId::capture_place;
 }
@@ -86,7 +101,8 @@ CaptureOutcome run_capture(vision::FrameSource& source, const CaptureParams& par
       return o;
     }
     if (!source.next(frame, params.frame_wait_s)) {
-      throw vision::CameraError("camera '" + source.name() + "': no frame came for " + std::to_string(params.frame_wait_s) + " s");
+      throw vision::CameraError("camera '" + source.name() + "': no frame came for " +
+                                std::to_string(params.frame_wait_s) + " s");
     }
     const auto t0 = Clock::now();
     look = vision::look_at_frame(frame.bgr, frame.t_s, o.frames > 0 ? &previous : nullptr, small, params.page);
@@ -170,7 +186,8 @@ int run_capture_command(const CaptureOptions& opt) {
   const CaptureOutcome o = run_capture(*source, capture_params_from(s));
   write_capture(o, source->name(), opt.out_dir);
   std::printf("capture: %s after %d frames (%.1f s), %s, %zu things said -> %s\n", capture_end_name(o.end), o.frames,
-              o.captured_t_s - o.first_frame_t_s, o.rectified ? "page rectified" : "whole frame", o.advice.size(), opt.out_dir.c_str());
+              o.captured_t_s - o.first_frame_t_s, o.rectified ? "page rectified" : "whole frame", o.advice.size(),
+              opt.out_dir.c_str());
   return 0;
 }
 
@@ -180,7 +197,8 @@ int run_cameras_command() {
     std::printf("no camera found\n");
     return 0;
   }
-  for (const vision::CameraInfo& c : cameras) std::printf("%s  %s  (%s)\n", c.spec.c_str(), c.name.c_str(), c.backend.c_str());
+  for (const vision::CameraInfo& c : cameras)
+    std::printf("%s  %s  (%s)\n", c.spec.c_str(), c.name.c_str(), c.backend.c_str());
   return 0;
 }
 

@@ -6,8 +6,8 @@
 #include <exception>
 #include <utility>
 
-#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
+#include <opencv2/imgproc.hpp>
 
 namespace hk::app {
 namespace {
@@ -128,9 +128,11 @@ void CaptureService::run(config::Settings s) {
       end.kind = CaptureNews::Kind::TimedOut;
     } else {
       end.kind = CaptureNews::Kind::Captured;
-      end.scene = std::make_shared<ImageScene>(build_image_scene_from_picture(o.image, "camera capture", s, TextTiming::later));
-      spdlog::info("capture: {} after {:.1f} s, {}, {} shapes", capture_end_name(o.end), o.captured_t_s - o.first_frame_t_s,
-                   o.rectified ? "page rectified" : "whole frame", end.scene->scene->curve_count());
+      end.scene =
+          std::make_shared<ImageScene>(build_image_scene_from_picture(o.image, "camera capture", s, TextTiming::later));
+      spdlog::info("capture: {} after {:.1f} s, {}, {} shapes", capture_end_name(o.end),
+                   o.captured_t_s - o.first_frame_t_s, o.rectified ? "page rectified" : "whole frame",
+                   end.scene->scene->curve_count());
     }
   } catch (const std::exception& e) {
     end.kind = CaptureNews::Kind::Failed;

@@ -2,14 +2,14 @@
 
 #include "formats/picture_notes.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "pictures/picture_params.hpp"
 #include "vision/intake.hpp"
@@ -90,16 +90,14 @@ nlohmann::json stick_listing_json(const StickListing& l) {
   }
   nlohmann::json refused = nlohmann::json::array();
   for (const vision::RefusedEntry& r : l.refused) refused.push_back({{"path", r.path}, {"reason", r.reason}});
-  return {{"documents", std::move(docs)},
-          {"refused", std::move(refused)},
-          {"complete", l.scan.complete},
-          {"entries_scanned", l.scan.entries_scanned},
-          {"scan_ms", 1000.0 * l.scan.seconds},
-          {"probe_ms", l.probe_ms}};
+  return {{"documents", std::move(docs)},       {"refused", std::move(refused)},
+          {"complete", l.scan.complete},        {"entries_scanned", l.scan.entries_scanned},
+          {"scan_ms", 1000.0 * l.scan.seconds}, {"probe_ms", l.probe_ms}};
 }
 
-ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
-                                vision::PdfFault fault, TextTiming timing, int text_layer_side_px) {
+ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page,
+                                const config::Settings& s, vision::PdfFault fault, TextTiming timing,
+                                int text_layer_side_px) {
   vision::PdfLimits limits = pdf_limits_from(s);
   limits.fault = fault;
   limits.text_layer_max_side_px = std::max(text_layer_side_px, 0);

@@ -6,13 +6,13 @@
 #include <functional>
 #include <memory>
 
-#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
+#include <opencv2/imgproc.hpp>
 
 #include "haptics/multires.hpp"
+#include "hk/error.hpp"
 #include "pictures/picture_params.hpp"
 #include "vision/intake.hpp"
-#include "hk/error.hpp"
 
 namespace hk::app {
 
@@ -164,8 +164,9 @@ void scale_boxes(vision::OcrResult& r, double k) {
 /// The text of the scene's picture (`grey`, at 1/decode_scale of the file), read at full detail: from `source`
 /// when given (its boxes scaled into grey's frame), else from `grey`. A refused second decode costs the text
 /// only, as an OCR failure does.
-vision::OcrResult read_picture_text(const cv::Mat& grey, int decode_scale, const OcrSource& source, const std::string& name,
-                                    const config::Settings& s, OcrReport& report, const std::atomic<bool>* cancel) {
+vision::OcrResult read_picture_text(const cv::Mat& grey, int decode_scale, const OcrSource& source,
+                                    const std::string& name, const config::Settings& s, OcrReport& report,
+                                    const std::atomic<bool>* cancel) {
   if (!source) return read_text(grey, name, s, report, cancel);
   cv::Mat detail_grey;
   int detail_scale = 1;
@@ -189,8 +190,8 @@ vision::OcrResult read_picture_text(const cv::Mat& grey, int decode_scale, const
 /// The scene of a picture (BGR) whose text is read when [vision] ocr asks (now, or later by with_text): the
 /// words masked from the edges, the blocks kept in metres.
 /// `source` (may be empty): the picture in more detail for OCR, see OcrSource; out.decode_scale is bgr's.
-void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel,
-                   const OcrSource& source = {}) {
+void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& s, TextTiming timing,
+                   const std::atomic<bool>* cancel, const OcrSource& source = {}) {
   out.width_px = bgr.cols;
   out.height_px = bgr.rows;
   cv::Mat grey;
@@ -224,14 +225,16 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
     }
   }
   out.text_words_masked = text.words.size();
-  build_from_chains(out, vision::scene_chains_from_image(bgr, extract_params_from(s), simplify_params_from(s), segment_cost(s), mask), s);
+  build_from_chains(
+      out, vision::scene_chains_from_image(bgr, extract_params_from(s), simplify_params_from(s), segment_cost(s), mask),
+      s);
   add_ocr_blocks(out, text);
 }
 
 /// The scene of a rendered document page (see build_page_scene).
 /// `choice`: wants_page_text's answer when the caller has it, else null (judged here).
-void build_page(ImageScene& out, const vision::PdfPage& page, const config::Settings& s, TextTiming timing, const std::atomic<bool>* cancel,
-                const PageTextChoice* choice) {
+void build_page(ImageScene& out, const vision::PdfPage& page, const config::Settings& s, TextTiming timing,
+                const std::atomic<bool>* cancel, const PageTextChoice* choice) {
   cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
   out.file_width_px = page.grey.cols;
   out.file_height_px = page.grey.rows;
@@ -251,7 +254,8 @@ void build_page(ImageScene& out, const vision::PdfPage& page, const config::Sett
     } else {
       out.text_pending = true;
       out.text_likely = !letters.empty() || !page.words.empty();
-      out.with_text = [kept = std::make_shared<const vision::PdfPage>(page), name = out.image_path, number = out.page, s](const std::atomic<bool>* stop) {
+      out.with_text = [kept = std::make_shared<const vision::PdfPage>(page), name = out.image_path, number = out.page,
+                       s](const std::atomic<bool>* stop) {
         ImageScene again;
         again.image_path = name;
         again.page = number;
@@ -266,7 +270,10 @@ void build_page(ImageScene& out, const vision::PdfPage& page, const config::Sett
   out.text_words_masked = words.size();
   cv::Mat mask = words.empty() ? cv::Mat() : text_mask(page.grey.size(), words);
   if (!letters.empty()) mask = mask.empty() ? letters : (mask | letters);
-  build_from_chains(out, vision::scene_chains_from_image(page.grey, extract_params_from(s), simplify_params_from(s), segment_cost(s), mask), s);
+  build_from_chains(out,
+                    vision::scene_chains_from_image(page.grey, extract_params_from(s), simplify_params_from(s),
+                                                    segment_cost(s), mask),
+                    s);
   if (read) {
     add_ocr_blocks(out, text);
     return;
@@ -330,8 +337,10 @@ vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const 
     return {};
   }
   if (scale < 1.0) {  // back to the picture's pixels
-    for (vision::OcrWord& w : r.words) w.box_px = cv::Rect2d(w.box_px.x / scale, w.box_px.y / scale, w.box_px.width / scale, w.box_px.height / scale);
-    for (vision::OcrBlock& b : r.blocks) b.box_px = cv::Rect2d(b.box_px.x / scale, b.box_px.y / scale, b.box_px.width / scale, b.box_px.height / scale);
+    for (vision::OcrWord& w : r.words)
+      w.box_px = cv::Rect2d(w.box_px.x / scale, w.box_px.y / scale, w.box_px.width / scale, w.box_px.height / scale);
+    for (vision::OcrBlock& b : r.blocks)
+      b.box_px = cv::Rect2d(b.box_px.x / scale, b.box_px.y / scale, b.box_px.width / scale, b.box_px.height / scale);
   }
   report.ran = true;
   report.words = static_cast<int>(r.words.size());
@@ -342,7 +351,8 @@ vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const 
 }
 
 int picture_keep_side_px(const config::Settings& s) {
-  return s.vision.ocr == "off" ? s.vision.max_image_side_px : std::max(s.vision.max_image_side_px, kPictureTextJudgedMinSidePx);
+  return s.vision.ocr == "off" ? s.vision.max_image_side_px
+                               : std::max(s.vision.max_image_side_px, kPictureTextJudgedMinSidePx);
 }
 
 namespace {
@@ -374,8 +384,8 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s,
   return out;
 }
 
-ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& s,
-                                        TextTiming timing) {
+ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name,
+                                        const config::Settings& s, TextTiming timing) {
   ImageScene out;
   out.image_path = name;
   const vision::ImageLimits limits = extract_params_from(s).limits;
@@ -393,8 +403,10 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
   return out;
 }
 
-ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& s, TextTiming timing) {
-  if (bgr.empty() || bgr.type() != CV_8UC3) throw hk::ArgumentError("picture '" + name + "': must be a non-empty 8-bit BGR image");
+ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string& name, const config::Settings& s,
+                                          TextTiming timing) {
+  if (bgr.empty() || bgr.type() != CV_8UC3)
+    throw hk::ArgumentError("picture '" + name + "': must be a non-empty 8-bit BGR image");
   ImageScene out;
   out.image_path = name;
   out.picture = bgr.clone();
@@ -431,7 +443,8 @@ cv::Mat text_mask(cv::Size size, const std::vector<vision::PdfWord>& words, doub
   const cv::Rect2d frame(0, 0, size.width, size.height);
   for (const vision::PdfWord& w : words) {
     const double g = grow * w.box_px.height;
-    const cv::Rect2d r = cv::Rect2d(w.box_px.x - g, w.box_px.y - g, w.box_px.width + 2 * g, w.box_px.height + 2 * g) & frame;
+    const cv::Rect2d r =
+        cv::Rect2d(w.box_px.x - g, w.box_px.y - g, w.box_px.width + 2 * g, w.box_px.height + 2 * g) & frame;
     if (r.width <= 0 || r.height <= 0) continue;
     const cv::Point p0(static_cast<int>(std::floor(r.x)), static_cast<int>(std::floor(r.y)));
     const cv::Point p1(static_cast<int>(std::ceil(r.x + r.width)) - 1, static_cast<int>(std::ceil(r.y + r.height)) - 1);
@@ -456,8 +469,8 @@ bool wants_page_text(const vision::PdfPage& page, const config::Settings& s, std
   return little;
 }
 
-ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& s, TextTiming timing,
-                            const PageTextChoice* choice) {
+ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number,
+                            const config::Settings& s, TextTiming timing, const PageTextChoice* choice) {
   ImageScene out;
   out.image_path = name;
   out.page = page_number;

@@ -39,7 +39,8 @@ std::vector<std::string> list_pictures(const std::string& folder) {
   for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
     std::string ext = e.path().extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".tiff" || ext == ".webp") {
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".tiff" ||
+        ext == ".webp") {
       out.push_back(e.path().string());
     }
   }

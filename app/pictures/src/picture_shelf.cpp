@@ -19,7 +19,8 @@ namespace {
 /// when it holds one for this file and these settings (found by the file's stamp without reading it, else
 /// by its bytes' key), else built from the bytes read once and stored; a scene whose text is still to be
 /// read is stored once it has been read (its with_text stores what it builds). Runs on the builder's worker.
-ImageScene cached_or_built(const std::string& path, const config::Settings& s, const std::shared_ptr<SceneCache>& cache, int side_px) {
+ImageScene cached_or_built(const std::string& path, const config::Settings& s, const std::shared_ptr<SceneCache>& cache,
+                           int side_px) {
   // What the file says of itself is read beside the build: exiv2 reads a PNG's chunks through its image
   // data (tens of milliseconds for a 20 MB photo PNG), which need not delay the scene.
   const auto notes_beside = [&path] { return std::async(std::launch::async, [path] { return embedded_notes(path); }); };
@@ -59,7 +60,8 @@ ImageScene cached_or_built(const std::string& path, const config::Settings& s, c
     keep(is);
     return is;
   }
-  is.with_text = [read = std::move(is.with_text), keep, file_notes = is.file_notes, side_px](const std::atomic<bool>* cancel) {
+  is.with_text = [read = std::move(is.with_text), keep, file_notes = is.file_notes,
+                  side_px](const std::atomic<bool>* cancel) {
     ImageScene with_text = read(cancel);
     fit_picture(with_text, side_px);
     with_text.file_notes = file_notes;
@@ -83,7 +85,8 @@ PictureNotes notes_of(const std::string& path, const PictureNotes& file_notes) {
 
 }  // namespace
 
-PictureShelf::PictureShelf(std::vector<std::string> pictures, std::shared_ptr<SceneCache> cache, const config::Settings& s)
+PictureShelf::PictureShelf(std::vector<std::string> pictures, std::shared_ptr<SceneCache> cache,
+                           const config::Settings& s)
     : pictures_(std::move(pictures)), cache_(std::move(cache)), s_(s) {}
 
 int PictureShelf::find(const std::string& path) const {

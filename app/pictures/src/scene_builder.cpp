@@ -98,7 +98,8 @@ bool SceneBuilder::want_pending() const {
 
 bool SceneBuilder::wait_want(double timeout_s) {
   std::unique_lock<std::mutex> lock(m_);
-  return done_cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [this] { return !want_ && !(running_ && running_wanted_); });
+  return done_cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                           [this] { return !want_ && !(running_ && running_wanted_); });
 }
 
 std::uint64_t SceneBuilder::builds_started() const {

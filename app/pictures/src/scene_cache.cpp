@@ -18,9 +18,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <spdlog/spdlog.h>
 
 #ifndef HK_PROGRAM_VERSION
 #error "HK_PROGRAM_VERSION (the project's version) must be defined by the build"
@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 constexpr std::array<std::uint8_t, 8> kMagic = {'H', 'K', 'S', 'C', 'E', 'N', 'E', '\0'};
-constexpr std::size_t kHeaderBytes = 8 + 4 + 8;                  // magic, format, payload size
+constexpr std::size_t kHeaderBytes = 8 + 4 + 8;                   // magic, format, payload size
 constexpr std::size_t kChecksumBytes = crypto_generichash_BYTES;  // 32
 constexpr std::size_t kPrefixBytes = kHeaderBytes + kChecksumBytes;
 constexpr std::string_view kSuffix = ".scene";
@@ -157,7 +157,8 @@ json to_payload(const std::string& key, const ImageScene& is) {
   j["document_title"] = is.document_title;
   if (!is.picture.empty()) {
     std::vector<std::uint8_t> jpeg;
-    if (!cv::imencode(".jpg", is.picture, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90})) throw BadEntry{"the picture could not be encoded"};
+    if (!cv::imencode(".jpg", is.picture, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90}))
+      throw BadEntry{"the picture could not be encoded"};
     j["picture"] = {{"cols", is.picture.cols}, {"rows", is.picture.rows}, {"jpeg", json::binary_t(std::move(jpeg))}};
   }
   json blocks = json::array();
@@ -169,12 +170,9 @@ json to_payload(const std::string& key, const ImageScene& is) {
                       {"confidence", b.confidence}});
   }
   j["text_blocks"] = std::move(blocks);
-  j["ocr"] = {{"ran", is.ocr.ran},
-              {"why", is.ocr.why},
-              {"words", is.ocr.words},
-              {"mean_confidence", is.ocr.mean_confidence},
-              {"ms", is.ocr.ms},
-              {"worker_max_rss_kb", is.ocr.worker_max_rss_kb}};
+  j["ocr"] = {{"ran", is.ocr.ran},     {"why", is.ocr.why},
+              {"words", is.ocr.words}, {"mean_confidence", is.ocr.mean_confidence},
+              {"ms", is.ocr.ms},       {"worker_max_rss_kb", is.ocr.worker_max_rss_kb}};
   j["text_likely"] = is.text_likely;
   j["text_words_masked"] = is.text_words_masked;
   j["file_notes"] = {{"title", is.file_notes.title}, {"description", is.file_notes.description}};
@@ -200,12 +198,9 @@ json to_payload(const std::string& key, const ImageScene& is) {
                  {"segments_after_budget", is.segments_after_budget}};
   j["canny"] = {is.canny_low, is.canny_high};
   j["detector"] = vision::detector_name(is.detector);
-  j["tones"] = {{"two_tone", is.tones.two_tone},
-                {"threshold", is.tones.threshold},
-                {"dark_mean", is.tones.dark_mean},
-                {"light_mean", is.tones.light_mean},
-                {"near_share", is.tones.near_share},
-                {"ink_width_px", is.tones.ink_width_px}};
+  j["tones"] = {{"two_tone", is.tones.two_tone},     {"threshold", is.tones.threshold},
+                {"dark_mean", is.tones.dark_mean},   {"light_mean", is.tones.light_mean},
+                {"near_share", is.tones.near_share}, {"ink_width_px", is.tones.ink_width_px}};
   j["line_drawing"] = is.line_drawing;
   json curves = json::array();
   for (const Polyline& p : is.polylines) {
@@ -361,7 +356,8 @@ ImageScene from_payload(const json& j, const std::string& key) {
 }
 
 /// The checksum of an entry's header (bytes 0..19) and payload.
-std::array<std::uint8_t, kChecksumBytes> checksum(const std::uint8_t* header, const std::uint8_t* payload, std::size_t payload_size) {
+std::array<std::uint8_t, kChecksumBytes> checksum(const std::uint8_t* header, const std::uint8_t* payload,
+                                                  std::size_t payload_size) {
   crypto_generichash_state st;
   crypto_generichash_init(&st, nullptr, 0, kChecksumBytes);
   crypto_generichash_update(&st, header, kHeaderBytes);
@@ -512,13 +508,15 @@ std::string scene_cache_dir(const config::Settings& s) {
 std::vector<const config::FieldDescriptor*> scene_shaping_fields() {
   std::vector<const config::FieldDescriptor*> out;
   for (const config::FieldDescriptor& d : config::field_descriptors()) {
-    if (d.apply == config::ApplyWhen::scene || d.table == "workspace" || (d.table == "haptics" && d.key == "max_levels"))
+    if (d.apply == config::ApplyWhen::scene || d.table == "workspace" ||
+        (d.table == "haptics" && d.key == "max_levels"))
       out.push_back(&d);
   }
   return out;
 }
 
-SceneCache::SceneCache(std::string dir, std::int64_t max_bytes) : dir_(std::move(dir)), max_bytes_(std::max<std::int64_t>(max_bytes, 1)) {
+SceneCache::SceneCache(std::string dir, std::int64_t max_bytes)
+    : dir_(std::move(dir)), max_bytes_(std::max<std::int64_t>(max_bytes, 1)) {
   while (dir_.size() > 1 && dir_.back() == '/') dir_.pop_back();
 }
 
@@ -556,7 +554,8 @@ std::string ref_name(const FileStamp& f, const config::Settings& s) {
   crypto_generichash_state st;
   begin_settings_hash(st, "haptic-kiosk file stamp", s);
   hash_text(st, f.path);
-  for (const std::uint64_t v : {f.device, f.inode, f.size_bytes, static_cast<std::uint64_t>(f.mtime_ns), static_cast<std::uint64_t>(f.ctime_ns)})
+  for (const std::uint64_t v : {f.device, f.inode, f.size_bytes, static_cast<std::uint64_t>(f.mtime_ns),
+                                static_cast<std::uint64_t>(f.ctime_ns)})
     hash_u64(st, v);
   return final_hex(st) + std::string(kRefSuffix);
 }
@@ -572,7 +571,8 @@ std::optional<std::string> SceneCache::known_key(const FileStamp& stamp, const c
   const ssize_t n = ::read(fd, buf.data(), buf.size());
   ::close(fd);
   const std::string key(buf.data(), n > 0 ? static_cast<std::size_t>(n) : 0);
-  if (key.size() == kRefBytes && key.back() == '\n' && is_key(key.substr(0, kRefBytes - 1))) return key.substr(0, kRefBytes - 1);
+  if (key.size() == kRefBytes && key.back() == '\n' && is_key(key.substr(0, kRefBytes - 1)))
+    return key.substr(0, kRefBytes - 1);
   ::unlink(path.c_str());
   spdlog::warn("scene cache: ref '{}' does not hold a key; removed", path);
   return std::nullopt;
@@ -582,7 +582,8 @@ void SceneCache::remember_key(const FileStamp& stamp, const config::Settings& s,
   if (dir_.empty() || !is_key(key)) return;
   const std::string text = key + "\n";
   const std::string failed = write_atomically(ref_name(stamp, s), std::vector<std::uint8_t>(text.begin(), text.end()));
-  if (!failed.empty()) warn_once(failed, "in '" + dir_ + "': cannot " + failed + "; pictures are read again to find their scenes");
+  if (!failed.empty())
+    warn_once(failed, "in '" + dir_ + "': cannot " + failed + "; pictures are read again to find their scenes");
 }
 
 std::string SceneCache::write_atomically(const std::string& name, const std::vector<std::uint8_t>& bytes) const {
@@ -617,7 +618,8 @@ std::optional<ImageScene> SceneCache::load(const std::string& key, const config:
   const std::string path = entry_path(key);
   auto bad = [&path](const std::string& why) -> std::optional<ImageScene> {
     const bool removed = ::unlink(path.c_str()) == 0;
-    spdlog::warn("scene cache: entry '{}' {}; {}", path, why, removed ? "removed" : "could not be removed: " + errno_text(errno));
+    spdlog::warn("scene cache: entry '{}' {}; {}", path, why,
+                 removed ? "removed" : "could not be removed: " + errno_text(errno));
     return std::nullopt;
   };
   try {
@@ -635,8 +637,10 @@ std::optional<ImageScene> SceneCache::load(const std::string& key, const config:
     struct stat st {};
     if (::fstat(fd, &st) != 0) return std::nullopt;
     if (!S_ISREG(st.st_mode)) return bad("is not a regular file");
-    if (st.st_size < static_cast<off_t>(kPrefixBytes)) return bad("is too short to be an entry (" + std::to_string(st.st_size) + " bytes)");
-    if (st.st_size > kSceneCacheMaxEntryBytes) return bad("is larger than an entry may be (" + std::to_string(st.st_size) + " bytes)");
+    if (st.st_size < static_cast<off_t>(kPrefixBytes))
+      return bad("is too short to be an entry (" + std::to_string(st.st_size) + " bytes)");
+    if (st.st_size > kSceneCacheMaxEntryBytes)
+      return bad("is larger than an entry may be (" + std::to_string(st.st_size) + " bytes)");
     std::vector<std::uint8_t> bytes(static_cast<std::size_t>(st.st_size));
     if (!read_all(fd, bytes.data(), bytes.size())) return bad("could not be read whole");
     if (!std::equal(kMagic.begin(), kMagic.end(), bytes.begin())) return bad("is not a scene entry (wrong magic)");
@@ -645,14 +649,16 @@ std::optional<ImageScene> SceneCache::load(const std::string& key, const config:
       return bad("is of format " + std::to_string(format) + ", not " + std::to_string(kSceneCacheFormat) + " (stale)");
     const std::uint64_t payload_size = get_le(bytes.data() + 12, 8);
     if (payload_size != bytes.size() - kPrefixBytes)
-      return bad("is truncated or padded (payload " + std::to_string(bytes.size() - kPrefixBytes) + " bytes, header says " +
-                 std::to_string(payload_size) + ")");
+      return bad("is truncated or padded (payload " + std::to_string(bytes.size() - kPrefixBytes) +
+                 " bytes, header says " + std::to_string(payload_size) + ")");
     const std::uint8_t* payload = bytes.data() + kPrefixBytes;
     const auto sum = checksum(bytes.data(), payload, payload_size);
-    if (sodium_memcmp(sum.data(), bytes.data() + kHeaderBytes, kChecksumBytes) != 0) return bad("fails its checksum (corrupt)");
+    if (sodium_memcmp(sum.data(), bytes.data() + kHeaderBytes, kChecksumBytes) != 0)
+      return bad("fails its checksum (corrupt)");
     CborBudget budget;
     if (!json::sax_parse(payload, payload + payload_size, &budget, json::input_format_t::cbor, true))
-      return bad("holds no well-formed CBOR within " + std::to_string(kMaxCborValues) + " values and depth " + std::to_string(kMaxCborDepth));
+      return bad("holds no well-formed CBOR within " + std::to_string(kMaxCborValues) + " values and depth " +
+                 std::to_string(kMaxCborDepth));
     const json j = json::from_cbor(payload, payload + payload_size, true, true, json::cbor_tag_handler_t::error);
     ImageScene is = from_payload(j, key);
     bytes = {};
@@ -661,7 +667,8 @@ std::optional<ImageScene> SceneCache::load(const std::string& key, const config:
     } catch (const hk::Error& e) {
       return bad(std::string("holds curves the trees cannot be built from: ") + e.what());
     }
-    if (is.scene->total_segments(0) != is.segments_after_budget) return bad("rebuilds to another number of level-0 segments");
+    if (is.scene->total_segments(0) != is.segments_after_budget)
+      return bad("rebuilds to another number of level-0 segments");
     is.times.multires_ms = is.scene->build_times().multires_ms;
     is.times.tree_ms = is.scene->build_times().tree_ms;
     ::futimens(fd, nullptr);  // most recently used; a read-only folder keeps the old time
@@ -704,8 +711,9 @@ bool SceneCache::store(const std::string& key, const ImageScene& is) {
   }
   const auto size = static_cast<std::int64_t>(bytes.size());
   if (size > kSceneCacheMaxEntryBytes || size > max_bytes_) {
-    warn_once("size", "a scene of " + std::to_string(size) + " bytes is larger than the cache of '" + dir_ + "' keeps (" +
-                          std::to_string(std::min(max_bytes_, kSceneCacheMaxEntryBytes)) + " bytes); not stored");
+    warn_once("size", "a scene of " + std::to_string(size) + " bytes is larger than the cache of '" + dir_ +
+                          "' keeps (" + std::to_string(std::min(max_bytes_, kSceneCacheMaxEntryBytes)) +
+                          " bytes); not stored");
     return false;
   }
   const std::string failed = write_atomically(key + std::string(kSuffix), bytes);
@@ -740,8 +748,9 @@ void SceneCache::evict(const std::string& keep) {
     if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
     const std::int64_t mtime_ns = static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec;
     if (name.starts_with(kTempPrefix)) {  // a crashed writer's, or one being written now (recent)
-      const auto age = now - std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
-                                 std::chrono::nanoseconds(mtime_ns)));
+      const auto age =
+          now - std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                    std::chrono::nanoseconds(mtime_ns)));
       if (age > kStaleTemp) ::unlink(path.c_str());
       continue;
     }

@@ -17,15 +17,17 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-StickService::StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events, std::string mount_root)
+StickService::StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events,
+                           std::string mount_root)
     : s_(settings), events_(std::move(events)), mount_root_(std::move(mount_root)) {
   helper_path_ = vision::stick_helper_path();
   mounter_ = vision::choose_stick_mounter(vision::have_mount_capability(), helper_path_);
   if (events_ && mounter_ == vision::StickMounter::None) {
-    spdlog::warn("usb sticks: not mounted: this process lacks CAP_SYS_ADMIN and there is no mount helper at {}. {}", helper_path_,
-                 vision::mount_capability_hint());
+    spdlog::warn("usb sticks: not mounted: this process lacks CAP_SYS_ADMIN and there is no mount helper at {}. {}",
+                 helper_path_, vision::mount_capability_hint());
   } else if (events_ && mounter_ == vision::StickMounter::Helper) {
-    spdlog::info("usb sticks: mounted read-only by the helper {} under {}", helper_path_, vision::kDefaultStickMountRoot);
+    spdlog::info("usb sticks: mounted read-only by the helper {} under {}", helper_path_,
+                 vision::kDefaultStickMountRoot);
   }
   watcher_ = std::thread([this] { watch(); });
   loader_ = std::thread([this] { serve(); });
@@ -74,7 +76,8 @@ void StickService::load(int stick, int document, int page) {
       if (a.at == r) {
         served = true;
         a.loaded.load_ms = 0;
-        spdlog::info("stick {}: page {} of document {} built ahead, on the device at once", r.stick, r.page, r.document + 1);
+        spdlog::info("stick {}: page {} of document {} built ahead, on the device at once", r.stick, r.page,
+                     r.document + 1);
         loaded_.push_back(std::move(a.loaded));
       } else if (std::find(near.begin(), near.end(), a.at) != near.end()) {
         kept.push_back(std::move(a));
@@ -159,8 +162,8 @@ void StickService::keep_ahead(const Request& r, LoadedDocument d, std::uint64_t 
   }
   const std::size_t bytes = approx_scene_bytes(*d.scene);
   if (ahead_bytes() + bytes > ahead_budget_bytes()) {
-    spdlog::info("stick {}: page {} of document {} ({} MiB) is over [kiosk] prefetch_mb; built when asked for", r.stick, r.page, r.document + 1,
-                 bytes >> 20);
+    spdlog::info("stick {}: page {} of document {} ({} MiB) is over [kiosk] prefetch_mb; built when asked for", r.stick,
+                 r.page, r.document + 1, bytes >> 20);
     ahead_refused_.push_back(r);
     return;
   }
@@ -206,11 +209,12 @@ void StickService::scan_root(const std::string& root, double started_ms) {
     n.stick = id;
     n.documents = l.documents;
     n.refused_entries = l.refused.size();
-    n.unreadable_documents = static_cast<int>(std::count_if(l.refused.begin(), l.refused.end(), [](const vision::RefusedEntry& r) { return r.document; }));
+    n.unreadable_documents = static_cast<int>(
+        std::count_if(l.refused.begin(), l.refused.end(), [](const vision::RefusedEntry& r) { return r.document; }));
     n.refused = l.refused;
     n.scan_ms = started_ms + ms_since(t0);
-    spdlog::info("stick {}: {} documents ({} pictures, {} PDFs), {} entries left out, {} ms", id, l.documents.size(), l.pictures(), l.pdfs(),
-                 l.refused.size(), n.scan_ms);
+    spdlog::info("stick {}: {} documents ({} pictures, {} PDFs), {} entries left out, {} ms", id, l.documents.size(),
+                 l.pictures(), l.pdfs(), l.refused.size(), n.scan_ms);
     {
       const std::lock_guard<std::mutex> lock(m_);
       stick_id_ = id;
@@ -309,8 +313,10 @@ void StickService::watch() {
       continue;
     }
     if (!e) continue;
-    if (e->action == vision::BlockEvent::Action::Add) handle_add(e->devnode);
-    else handle_remove(e->devnode);
+    if (e->action == vision::BlockEvent::Action::Add)
+      handle_add(e->devnode);
+    else
+      handle_remove(e->devnode);
   }
 }
 
@@ -338,15 +344,18 @@ LoadedDocument StickService::build(const Request& r, bool ahead) {
     (ahead ? ahead_started_ : loads_started_).fetch_add(1);
     const int side_px = screen_side_px_.load();
     out.scene = doc.doc.kind == vision::DocumentKind::Pdf
-                    ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s, pdf_fault_.load(), TextTiming::later, side_px)
+                    ? build_pdf_page_scene(bytes, doc.doc.display_name, r.page, s, pdf_fault_.load(), TextTiming::later,
+                                           side_px)
                     : build_image_scene_from_bytes(bytes, doc.doc.display_name, s, TextTiming::later);
     if (out.scene) fit_picture(*out.scene, side_px);  // the screen's copy, made here rather than on the window thread
-  } catch (const std::exception& e) {  // InputError, PdfError, StickError: this page only
+  } catch (const std::exception& e) {                 // InputError, PdfError, StickError: this page only
     spdlog::warn("stick {}: {}", r.stick, e.what());
     out.reason = problem_of(e.what());
   }
   out.load_ms = ms_since(t0);
-  if (out.scene) spdlog::info("stick {}: '{}' page {} built{} in {:.0f} ms", r.stick, doc.doc.display_name, r.page, ahead ? " ahead" : "", out.load_ms);
+  if (out.scene)
+    spdlog::info("stick {}: '{}' page {} built{} in {:.0f} ms", r.stick, doc.doc.display_name, r.page,
+                 ahead ? " ahead" : "", out.load_ms);
   return out;
 }
 

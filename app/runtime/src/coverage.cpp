@@ -9,7 +9,8 @@ long long cell_key(long long ix, long long iy) { return (ix << 32) ^ (iy & 0xfff
 
 }  // namespace
 
-CoverageMeter::CoverageMeter(double radius_m) : radius_m_(radius_m > 0.0 && std::isfinite(radius_m) ? radius_m : 0.001) {}
+CoverageMeter::CoverageMeter(double radius_m)
+    : radius_m_(radius_m > 0.0 && std::isfinite(radius_m) ? radius_m : 0.001) {}
 
 void CoverageMeter::add(Vec2 proxy_m, int curve_a, int curve_b) {
   for (int c : {curve_a, curve_b}) {

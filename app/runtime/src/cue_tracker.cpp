@@ -25,7 +25,8 @@ bool in_box(const Aabb& b, Vec2 p, double margin_m) {
 
 }  // namespace
 
-int CueTracker::update(std::int64_t tick, const ServoOutput& out, Vec2 handle_m, int level_in_use, CueEvent* cues) noexcept {
+int CueTracker::update(std::int64_t tick, const ServoOutput& out, Vec2 handle_m, int level_in_use,
+                       CueEvent* cues) noexcept {
   int n = 0;
   auto emit = [&](CueKind kind, int curve, double speed, int level) {
     if (n >= kMaxCuesPerTick) return;
@@ -58,7 +59,8 @@ int CueTracker::update(std::int64_t tick, const ServoOutput& out, Vec2 handle_m,
   }
   const bool sharp = c.corner_turn_rad >= p_.corner_min_turn_rad;
   if ((c.events & kEventVertexBegin) && sharp) emit(CueKind::VertexContact, curve, 0.0, level_in_use);
-  if ((c.events & kEventConvexCorner) && sharp && !(c.events & kEventVertexBegin)) emit(CueKind::ConvexCorner, curve, 0.0, level_in_use);
+  if ((c.events & kEventConvexCorner) && sharp && !(c.events & kEventVertexBegin))
+    emit(CueKind::ConvexCorner, curve, 0.0, level_in_use);
 
   if (c.state == ContactState::Edge && have_prev_) {
     slide_path_m_ += length(c.proxy_m - prev_proxy_);
@@ -82,7 +84,8 @@ int CueTracker::update(std::int64_t tick, const ServoOutput& out, Vec2 handle_m,
     at_edge_ = false;
   }
 
-  if (in_text_block_ >= 0 && !in_box(text_blocks_[in_text_block_], c.proxy_m, p_.text_block_margin_m)) in_text_block_ = -1;
+  if (in_text_block_ >= 0 && !in_box(text_blocks_[in_text_block_], c.proxy_m, p_.text_block_margin_m))
+    in_text_block_ = -1;
   for (int b = 0; b < text_block_count_; ++b) {
     if (b != in_text_block_ && in_box(text_blocks_[b], c.proxy_m, 0.0)) {
       in_text_block_ = b;

@@ -37,7 +37,8 @@ void DeviceHost::set_settings(const config::Settings& s) {
 void DeviceHost::open_emulated_board(const std::string& text) {
   const DeviceChoice choice = parse_device_choice(text);
   if (choice.kind != DeviceChoice::Kind::HaplyEmulator)
-    throw DeviceChoiceError("--device '" + text + "': the kiosk takes 'haply-emulator[:FAULT=VALUE,...]' (or nothing: [device])");
+    throw DeviceChoiceError("--device '" + text +
+                            "': the kiosk takes 'haply-emulator[:FAULT=VALUE,...]' (or nothing: [device])");
   const io::HaplyDeviceParams dp = haply_params_from(s_);
   const double scale = io::workspace_scale(dp);
   const Vec2 centre = dp.rect_center_device_m;

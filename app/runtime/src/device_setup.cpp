@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <vector>
 
@@ -21,7 +21,8 @@ double number_of(const std::string& key, const std::string& value, double lo, do
   const char* first = value.data();
   const char* last = value.data() + value.size();
   auto [p, ec] = std::from_chars(first, last, v);
-  const bool ok = ec == std::errc{} && p == last && std::isfinite(v) && v >= lo && v <= hi && (!integer || v == std::floor(v));
+  const bool ok =
+      ec == std::errc{} && p == last && std::isfinite(v) && v >= lo && v <= hi && (!integer || v == std::floor(v));
   if (!ok) {
     char range[96];
     std::snprintf(range, sizeof range, "%s in [%g, %g]", integer ? "an integer" : "a number", lo, hi);
@@ -51,28 +52,41 @@ DeviceChoice parse_device_choice(const std::string& text) {
       throw DeviceChoiceError("--device haply-emulator: '" + item + "' must be KEY=VALUE");
     const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
     constexpr double kDay = 86400.0, kMaxEvery = 1e6;
-    if (key == "disconnect_at_s") c.faults.disconnect_at_s = number_of(key, value, 0, kDay, false);
-    else if (key == "stall_at_s") c.faults.stall_at_s = number_of(key, value, 0, kDay, false);
-    else if (key == "stall_s") c.faults.stall_s = number_of(key, value, 0, 60, false);
-    else if (key == "drop_every") c.faults.drop_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
-    else if (key == "garbage_every") c.faults.garbage_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
-    else if (key == "wrong_id_every") c.faults.wrong_id_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
-    else if (key == "seed") c.faults.seed = static_cast<std::uint64_t>(number_of(key, value, 0, 9007199254740992.0, true));
-    else if (key == "calib_error1_deg") c.calibration_error_deg[0] = number_of(key, value, -90, 90, false);
-    else if (key == "calib_error2_deg") c.calibration_error_deg[1] = number_of(key, value, -90, 90, false);
-    else if (key == "rest_at_park") c.rest_at_park = number_of(key, value, 0, 1, true) == 1.0;
+    if (key == "disconnect_at_s")
+      c.faults.disconnect_at_s = number_of(key, value, 0, kDay, false);
+    else if (key == "stall_at_s")
+      c.faults.stall_at_s = number_of(key, value, 0, kDay, false);
+    else if (key == "stall_s")
+      c.faults.stall_s = number_of(key, value, 0, 60, false);
+    else if (key == "drop_every")
+      c.faults.drop_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
+    else if (key == "garbage_every")
+      c.faults.garbage_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
+    else if (key == "wrong_id_every")
+      c.faults.wrong_id_every = static_cast<int>(number_of(key, value, 0, kMaxEvery, true));
+    else if (key == "seed")
+      c.faults.seed = static_cast<std::uint64_t>(number_of(key, value, 0, 9007199254740992.0, true));
+    else if (key == "calib_error1_deg")
+      c.calibration_error_deg[0] = number_of(key, value, -90, 90, false);
+    else if (key == "calib_error2_deg")
+      c.calibration_error_deg[1] = number_of(key, value, -90, 90, false);
+    else if (key == "rest_at_park")
+      c.rest_at_park = number_of(key, value, 0, 1, true) == 1.0;
     else
-      throw DeviceChoiceError("--device haply-emulator: unknown fault '" + key +
-                              "'; known: disconnect_at_s, drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed, "
-                              "calib_error1_deg, calib_error2_deg, rest_at_park");
+      throw DeviceChoiceError(
+          "--device haply-emulator: unknown fault '" + key +
+          "'; known: disconnect_at_s, drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed, "
+          "calib_error1_deg, calib_error2_deg, rest_at_park");
   }
   return c;
 }
 
-hapi::EmulatorParams emulator_resting_at_park(const config::Settings& s, const DeviceChoice& choice, Vec2* start_device_m) {
+hapi::EmulatorParams emulator_resting_at_park(const config::Settings& s, const DeviceChoice& choice,
+                                              Vec2* start_device_m) {
   const io::HaplyDeviceParams dp = haply_params_from(s);
   hapi::EmulatorParams ep = emulator_params_from(s, choice);
-  *start_device_m = (1.0 / io::workspace_scale(dp)) * Vec2{s.device.park_x_m, s.device.park_y_m} + dp.rect_center_device_m;
+  *start_device_m =
+      (1.0 / io::workspace_scale(dp)) * Vec2{s.device.park_x_m, s.device.park_y_m} + dp.rect_center_device_m;
   ep.workspace_center_m = *start_device_m;
   ep.workspace_half_extent_m = {0.0005, 0.0005};
   ep.stop_margin_m = 0.0;
@@ -96,8 +110,10 @@ HomeCheck check_home_pose(const io::HaplyDevice& device, const config::Settings&
 std::string home_check_line(const HomeCheck& c) {
   char b[320];
   std::snprintf(b, sizeof b,
-                "the handle reads (%.1f, %.1f) mm at start, %.1f mm from its home pose at the park place (%.1f, %.1f) mm: positions read wrong "
-                "until it is calibrated; rest the handle at home (both arms stretched out sideways) and press Calibrate in the operator's "
+                "the handle reads (%.1f, %.1f) mm at start, %.1f mm from its home pose at the park place (%.1f, %.1f) "
+                "mm: positions read wrong "
+                "until it is calibrated; rest the handle at home (both arms stretched out sideways) and press "
+                "Calibrate in the operator's "
                 "panel, or run 'haptic-kiosk calibrate'",
                 1000 * c.read_m.x, 1000 * c.read_m.y, 1000 * c.off_m, 1000 * c.park_m.x, 1000 * c.park_m.y);
   return b;
@@ -111,7 +127,8 @@ std::vector<io::BoardCandidate> board_candidates(const config::Settings& s) {
     const std::vector<io::UsbDeviceInfo> bus = io::list_usb_devices(&reason);
     const bool listed = reason.empty();
     for (const config::UsbId& id : config::parse_usb_ids(d.usb_ids)) {
-      const bool present = std::any_of(bus.begin(), bus.end(), [&](const io::UsbDeviceInfo& u) { return u.vid == id.vid && u.pid == id.pid; });
+      const bool present = std::any_of(bus.begin(), bus.end(),
+                                       [&](const io::UsbDeviceInfo& u) { return u.vid == id.vid && u.pid == id.pid; });
       if (listed && !present) continue;
       char name[32];
       std::snprintf(name, sizeof name, "usb %04x:%04x", id.vid, id.pid);
@@ -119,8 +136,10 @@ std::vector<io::BoardCandidate> board_candidates(const config::Settings& s) {
     }
   }
   if (d.transport != "usb") {
-    const std::vector<std::string> ttys = d.serial_path.empty() ? io::list_serial_by_id() : std::vector<std::string>{d.serial_path};
-    for (const std::string& path : ttys) out.push_back({"tty " + path, [path] { return std::make_unique<io::TtyTransport>(path); }});
+    const std::vector<std::string> ttys =
+        d.serial_path.empty() ? io::list_serial_by_id() : std::vector<std::string>{d.serial_path};
+    for (const std::string& path : ttys)
+      out.push_back({"tty " + path, [path] { return std::make_unique<io::TtyTransport>(path); }});
   }
   return out;
 }
@@ -128,9 +147,10 @@ std::vector<io::BoardCandidate> board_candidates(const config::Settings& s) {
 std::unique_ptr<io::HaplyDevice> open_board(const config::Settings& s, std::vector<io::BoardProbe>* probes) {
   const std::vector<io::BoardCandidate> candidates = board_candidates(s);
   if (candidates.empty())
-    throw DeviceError(s.device.transport == "tty" ? std::string("no serial device in /dev/serial/by-id (set [device] serial_path)")
-                                                  : "no USB device with an id of [device] usb_ids" +
-                                                        std::string(s.device.transport == "auto" ? " and no serial device" : ""));
+    throw DeviceError(s.device.transport == "tty"
+                          ? std::string("no serial device in /dev/serial/by-id (set [device] serial_path)")
+                          : "no USB device with an id of [device] usb_ids" +
+                                std::string(s.device.transport == "auto" ? " and no serial device" : ""));
   std::vector<io::BoardProbe> tried;
   std::unique_ptr<io::HaplyDevice> device = io::open_first_board(haply_params_from(s), candidates, &tried);
   if (probes) probes->insert(probes->end(), tried.begin(), tried.end());
@@ -140,7 +160,9 @@ std::unique_ptr<io::HaplyDevice> open_board(const config::Settings& s, std::vect
   throw DeviceError(why);
 }
 
-std::string board_profile_type(const config::Settings& s) { return config::is_usb_type(s.device.type) ? s.device.type : std::string("haply"); }
+std::string board_profile_type(const config::Settings& s) {
+  return config::is_usb_type(s.device.type) ? s.device.type : std::string("haply");
+}
 
 config::Settings settings_for_board(const config::Settings& s, std::vector<std::string>* notes) {
   if (config::is_usb_type(s.device.type)) return s;
@@ -149,10 +171,14 @@ config::Settings settings_for_board(const config::Settings& s, std::vector<std::
 
 const char* device_status_name(DeviceStatus status) noexcept {
   switch (status) {
-    case DeviceStatus::Closed: return "closed";
-    case DeviceStatus::Ok: return "ok";
-    case DeviceStatus::Lost: return "lost";
-    case DeviceStatus::Fault: return "fault";
+    case DeviceStatus::Closed:
+      return "closed";
+    case DeviceStatus::Ok:
+      return "ok";
+    case DeviceStatus::Lost:
+      return "lost";
+    case DeviceStatus::Fault:
+      return "fault";
   }
   return "unknown";
 }

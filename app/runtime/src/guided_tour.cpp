@@ -35,11 +35,14 @@ double curve_length_m(const Scene& scene, std::size_t c) {
   return len;
 }
 
-bool is_tour_shape(const Scene& scene, std::size_t c, const TourParams& p) { return curve_length_m(scene, c) >= p.min_shape_length_m; }
+bool is_tour_shape(const Scene& scene, std::size_t c, const TourParams& p) {
+  return curve_length_m(scene, c) >= p.min_shape_length_m;
+}
 
 int shapes_remaining(const Scene& scene, const VisitTouches& touched, const TourParams& p) {
   int n = 0;
-  for (std::size_t c = 0; c < scene.curve_count(); ++c) n += is_tour_shape(scene, c, p) && !touched.touched(static_cast<int>(c));
+  for (std::size_t c = 0; c < scene.curve_count(); ++c)
+    n += is_tour_shape(scene, c, p) && !touched.touched(static_cast<int>(c));
   return n;
 }
 
@@ -100,7 +103,8 @@ Vec2 vertex_normal(Vec2 n0, Vec2 n1) {
 /// Appends the polyline `pts` (with its press force at each point) to `out` at `speed` [m/s]: its vertices
 /// and points in between no more than `step` [m] apart, each timed by its arc length from the last point
 /// of `out`, the press interpolated along each piece.
-void append_polyline(std::vector<TourPoint>& out, const std::vector<Vec2>& pts, const std::vector<Vec2>& press, double speed, double step) {
+void append_polyline(std::vector<TourPoint>& out, const std::vector<Vec2>& pts, const std::vector<Vec2>& press,
+                     double speed, double step) {
   for (std::size_t k = 0; k < pts.size(); ++k) {
     const TourPoint last = out.back();
     const Vec2 b = pts[k];
@@ -226,7 +230,8 @@ Track outline_track(const Outline& o, double side, const TourParams& p) {
   const double total = arc.back();
   press.reserve(rest.size() + 1);
   for (std::size_t i = 0; i < rest.size(); ++i) {
-    const double ramp = p.press_ramp_m > 0.0 ? std::clamp(std::min(arc[i], total - arc[i]) / p.press_ramp_m, 0.0, 1.0) : 1.0;
+    const double ramp =
+        p.press_ramp_m > 0.0 ? std::clamp(std::min(arc[i], total - arc[i]) / p.press_ramp_m, 0.0, 1.0) : 1.0;
     press.push_back((-side * p.press_force_n * ramp) * press_dir[i]);
   }
   rest.push_back(base.back() + (side * p.offset_m) * normalized_or(normal.back(), {0.0, 1.0}));
@@ -243,7 +248,8 @@ double distance_to_curve_m(const Scene& scene, std::size_t c, int level, Vec2 p)
 namespace {
 
 /// The tour shape (is_tour_shape) not yet touched that is nearest the handle (m), if any is left.
-std::optional<ChosenShape> nearest_untouched_shape(const Scene& scene, Vec2 handle_m, const VisitTouches& touched, const TourParams& p) {
+std::optional<ChosenShape> nearest_untouched_shape(const Scene& scene, Vec2 handle_m, const VisitTouches& touched,
+                                                   const TourParams& p) {
   std::optional<ChosenShape> chosen;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t c = 0; c < scene.curve_count(); ++c) {
@@ -260,7 +266,8 @@ std::optional<ChosenShape> nearest_untouched_shape(const Scene& scene, Vec2 hand
 
 }  // namespace
 
-std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_m, const VisitTouches& touched, const TourParams& p) {
+std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_m, const VisitTouches& touched,
+                                  const TourParams& p) {
   const std::optional<ChosenShape> chosen = nearest_untouched_shape(scene, handle_m, touched, p);
   if (!chosen) return std::nullopt;
   const std::size_t c = chosen->curve;
@@ -268,7 +275,8 @@ std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_
   // The base sequence (on the curve) and its unit normals, from the start of the outline to its end; the
   // direction is along increasing segment indices (a closed curve's outline, an open one from its first point)
   // unless an open curve is taken from its last point.
-  const Outline outline = scene.curve(c).closed ? closed_outline(pts, handle_m) : open_outline(std::move(pts), handle_m);
+  const Outline outline =
+      scene.curve(c).closed ? closed_outline(pts, handle_m) : open_outline(std::move(pts), handle_m);
   // The handle's side of the curve at the start (+1: along the normal); on the curve, +1.
   const double along = dot(handle_m - outline.base.front(), outline.normal.front());
   const double side = along < 0.0 ? -1.0 : 1.0;

@@ -1,8 +1,8 @@
 #include "runtime/servo_step.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <cmath>
+#include <limits>
 
 namespace hk::app {
 
@@ -71,7 +71,8 @@ void ServoStep::tour_before_update(const DeviceSample& sample) noexcept {
   const bool picture_changing = fading_ || !current_ || (tour_ && current_->id != tour_->scene_id);
   if (tour_ && (cancel || picture_changing)) guide_.stop();
   take_tour(sample);
-  if (tour_ && guide_.walls_suspended(out_.contact) && is_finite(sample.handle_m)) current_->loop.relocate(sample.handle_m);
+  if (tour_ && guide_.walls_suspended(out_.contact) && is_finite(sample.handle_m))
+    current_->loop.relocate(sample.handle_m);
 }
 
 // After the walls' step: the guide force of the tick (TourGuide::update), the walls faded in the transit,

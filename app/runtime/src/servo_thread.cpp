@@ -66,8 +66,9 @@ void ServoThread::ask_for_fifo() {
     realtime_.store(true);
     spdlog::info("servo: SCHED_FIFO priority {} at {} Hz", params_.fifo_priority, params_.rate_hz);
   } else {
-    spdlog::warn("servo: SCHED_FIFO refused ({}); running at normal priority at {} Hz (grant CAP_SYS_NICE or an rtprio limit)",
-                 std::strerror(err), params_.rate_hz);
+    spdlog::warn(
+        "servo: SCHED_FIFO refused ({}); running at normal priority at {} Hz (grant CAP_SYS_NICE or an rtprio limit)",
+        std::strerror(err), params_.rate_hz);
   }
 }
 
@@ -78,10 +79,14 @@ void ServoThread::record(const ServoTick& t, std::int64_t work_ns) noexcept {
   d.missed_deadlines = missed_.load(std::memory_order_relaxed) + (t.deadline_missed ? 1 : 0);
   core_.publish_display();
 
-  late_[static_cast<std::size_t>(std::clamp<std::int64_t>(t.late_ns / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
-  compute_[static_cast<std::size_t>(std::clamp<std::int64_t>(work_ns / 1000, 0, kBins - 1))].fetch_add(1, std::memory_order_relaxed);
-  if (t.late_ns > max_late_ns_.load(std::memory_order_relaxed)) max_late_ns_.store(t.late_ns, std::memory_order_relaxed);
-  if (t.late_ns > total_max_late_ns_.load(std::memory_order_relaxed)) total_max_late_ns_.store(t.late_ns, std::memory_order_relaxed);
+  late_[static_cast<std::size_t>(std::clamp<std::int64_t>(t.late_ns / 1000, 0, kBins - 1))].fetch_add(
+      1, std::memory_order_relaxed);
+  compute_[static_cast<std::size_t>(std::clamp<std::int64_t>(work_ns / 1000, 0, kBins - 1))].fetch_add(
+      1, std::memory_order_relaxed);
+  if (t.late_ns > max_late_ns_.load(std::memory_order_relaxed))
+    max_late_ns_.store(t.late_ns, std::memory_order_relaxed);
+  if (t.late_ns > total_max_late_ns_.load(std::memory_order_relaxed))
+    total_max_late_ns_.store(t.late_ns, std::memory_order_relaxed);
   ticks_.fetch_add(1, std::memory_order_relaxed);
   total_ticks_.fetch_add(1, std::memory_order_relaxed);
   if (t.deadline_missed) {

@@ -10,8 +10,8 @@
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/pty_emulator.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "runtime/servo_runner.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_runner.hpp"
 
 namespace hk::app {
 
@@ -22,8 +22,8 @@ namespace {
 // physics and torques, or the driver's torques), the observer, the script, and the owner's collection of
 // what the servo let go of.
 template <class AfterWrite>
-long run_ticks(const Scene& scene, const config::Settings& s, Device& device, double duration_s, const TickObserver& observe,
-               const RunOptions& o, AfterWrite after_write) {
+long run_ticks(const Scene& scene, const config::Settings& s, Device& device, double duration_s,
+               const TickObserver& observe, const RunOptions& o, AfterWrite after_write) {
   const ServoParams sp = servo_params_from(s);
   ServoStep core(cue_params_from(s), o.cues);
   auto bundle = std::make_unique<SceneBundle>(std::shared_ptr<const Scene>(std::shared_ptr<const Scene>(), &scene), sp);
@@ -60,11 +60,13 @@ long run_simulated(const Scene& scene, const config::Settings& s, HandController
     // What the hand feels: where the handle is and the force the device was told to put on it (last write);
     // what it hears: the push-through earcon of this tick.
     const bool heard_pop = (so.contact.events & kEventPopThrough) != 0;
-    const HandFeel feel{rec.t_s, device.true_position_m(), device.velocity_m_per_s(), device.commanded_force_n(), heard_pop};
+    const HandFeel feel{rec.t_s, device.true_position_m(), device.velocity_m_per_s(), device.commanded_force_n(),
+                        heard_pop};
     const HandCommand cmd = hand.command(feel);
     ModelHandParams tick_hp = hp;
     tick_hp.max_force_n = cmd.max_force_n;
-    device.step(sp.period_s, model_hand_force(tick_hp, cmd.target_m, device.true_position_m(), device.velocity_m_per_s()));
+    device.step(sp.period_s,
+                model_hand_force(tick_hp, cmd.target_m, device.true_position_m(), device.velocity_m_per_s()));
     const Torques tau = device.applied_torques_n_m();
     rec.motor_torque_n_m[0] = tau.tau1_n_m;
     rec.motor_torque_n_m[1] = tau.tau2_n_m;
@@ -87,14 +89,16 @@ long run_emulated(const Scene& scene, const config::Settings& s, HandController&
   // The model hand lives in the workspace frame; the emulator's handle in the device frame.
   // Called on the emulator's thread only (the controller is not touched by this thread during the run); no
   // device force is fed back (see run_simulation).
-  hapi::HandForce hand_force = [&hand, hp, scale, centre](double t_s, Vec2 handle_device_m, Vec2 velocity_device_m_per_s) {
+  hapi::HandForce hand_force = [&hand, hp, scale, centre](double t_s, Vec2 handle_device_m,
+                                                          Vec2 velocity_device_m_per_s) {
     const Vec2 handle = scale * (handle_device_m - centre), velocity = scale * velocity_device_m_per_s;
     const HandCommand cmd = hand.command(HandFeel{t_s, handle, velocity, Vec2{}});
     ModelHandParams tick_hp = hp;
     tick_hp.max_force_n = cmd.max_force_n;
     return model_hand_force(tick_hp, cmd.target_m, handle, velocity);
   };
-  hapi::FirmwareEmulator emulator(emulator_params_from(s, o.device), (1.0 / scale) * hand.start_m() + centre, hand_force);
+  hapi::FirmwareEmulator emulator(emulator_params_from(s, o.device), (1.0 / scale) * hand.start_m() + centre,
+                                  hand_force);
   hapi::PtyEmulator pty(emulator);
   const std::string tty_path = pty.device_path();
   io::HaplyDevice device(dp, [tty_path] { return std::make_unique<io::TtyTransport>(tty_path); });

@@ -15,10 +15,10 @@ struct Shape {
   double diag_m;
   Vec2 centre_m;
   bool closed;
-  std::size_t curve;   // index in the curves described
-  int inside = 0;      // shapes nested in it, at any depth
-  bool top = true;     // inside no other shape
-  int parent = -1;     // the smallest shape it lies inside (index into the shapes), −1 for none
+  std::size_t curve;  // index in the curves described
+  int inside = 0;     // shapes nested in it, at any depth
+  bool top = true;    // inside no other shape
+  int parent = -1;    // the smallest shape it lies inside (index into the shapes), −1 for none
 };
 
 /// Distance from `p` to the polyline of `c` (with its closing segment when closed) [m].
@@ -58,11 +58,12 @@ bool inside_polygon(Vec2 p, const std::vector<Vec2>& poly) {
 
 /// Whether curve `inner` lies inside the closed curve `outer`: its bounding box within outer's, and up to
 /// kNestSamples of its points, spread along it, all inside outer's polygon.
-bool nested_in(const Polyline& inner, const Polyline& outer, const std::pair<Vec2, Vec2>& inner_box, const std::pair<Vec2, Vec2>& outer_box) {
+bool nested_in(const Polyline& inner, const Polyline& outer, const std::pair<Vec2, Vec2>& inner_box,
+               const std::pair<Vec2, Vec2>& outer_box) {
   constexpr std::size_t kNestSamples = 16;
   if (!outer.closed || outer.points_m.size() < 3) return false;
-  if (inner_box.first.x < outer_box.first.x || inner_box.first.y < outer_box.first.y || inner_box.second.x > outer_box.second.x ||
-      inner_box.second.y > outer_box.second.y)
+  if (inner_box.first.x < outer_box.first.x || inner_box.first.y < outer_box.first.y ||
+      inner_box.second.x > outer_box.second.x || inner_box.second.y > outer_box.second.y)
     return false;
   const std::size_t n = inner.points_m.size();
   const std::size_t step = std::max<std::size_t>(1, n / kNestSamples);
@@ -80,7 +81,8 @@ std::vector<Shape> shapes_of(const std::vector<Polyline>& curves) {
     const Polyline& p = curves[k];
     if (p.points_m.empty()) continue;
     boxes.push_back(bounds_of(p));
-    shapes.push_back({length(boxes.back().second - boxes.back().first), 0.5 * (boxes.back().first + boxes.back().second), p.closed, k});
+    shapes.push_back({length(boxes.back().second - boxes.back().first),
+                      0.5 * (boxes.back().first + boxes.back().second), p.closed, k});
   }
   for (std::size_t i = 0; i < shapes.size(); ++i)
     for (std::size_t j = 0; j < shapes.size(); ++j) {
@@ -88,7 +90,8 @@ std::vector<Shape> shapes_of(const std::vector<Polyline>& curves) {
       if (nested_in(curves[shapes[i].curve], curves[shapes[j].curve], boxes[i], boxes[j])) {
         ++shapes[j].inside;
         shapes[i].top = false;
-        if (shapes[i].parent < 0 || shapes[j].diag_m < shapes[static_cast<std::size_t>(shapes[i].parent)].diag_m) shapes[i].parent = static_cast<int>(j);
+        if (shapes[i].parent < 0 || shapes[j].diag_m < shapes[static_cast<std::size_t>(shapes[i].parent)].diag_m)
+          shapes[i].parent = static_cast<int>(j);
       }
     }
   return shapes;
@@ -165,8 +168,11 @@ std::string describe_scene(const std::vector<Polyline>& curves, Vec2 half, int m
   std::size_t told = 0;  // shapes spoken of so far, the nested ones included
   for (std::size_t i = 0; i < named; ++i) {
     const Shape& s = top[i];
-    std::string part = std::string(i == 0 ? (hand_m ? "Nearest your hand, a " : "A ") : "a ") + size(s) + (s.closed ? " closed shape" : " line");
-    if (s.inside > 0) part += s.inside == 1 ? " with a smaller shape inside it," : " with " + std::to_string(s.inside) + " smaller shapes inside it,";
+    std::string part = std::string(i == 0 ? (hand_m ? "Nearest your hand, a " : "A ") : "a ") + size(s) +
+                       (s.closed ? " closed shape" : " line");
+    if (s.inside > 0)
+      part += s.inside == 1 ? " with a smaller shape inside it,"
+                            : " with " + std::to_string(s.inside) + " smaller shapes inside it,";
     part += std::string(" ") + place_words(s.centre_m, half);
     told += 1 + static_cast<std::size_t>(s.inside);
     if (i > 0) out += (i + 1 == named && told == all.size()) ? ", and " : ", ";
@@ -197,7 +203,8 @@ int count_figures(const std::vector<Polyline>& curves, double margin_m) {
     for (std::size_t j = i + 1; j < boxes.size(); ++j) {
       const auto& [a0, a1] = boxes[i];
       const auto& [b0, b1] = boxes[j];
-      const bool touch = a0.x - margin_m <= b1.x && b0.x <= a1.x + margin_m && a0.y - margin_m <= b1.y && b0.y <= a1.y + margin_m;
+      const bool touch =
+          a0.x - margin_m <= b1.x && b0.x <= a1.x + margin_m && a0.y - margin_m <= b1.y && b0.y <= a1.y + margin_m;
       if (!touch) continue;
       const std::size_t ri = find(i), rj = find(j);
       if (ri != rj) {

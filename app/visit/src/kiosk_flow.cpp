@@ -1,7 +1,7 @@
 #include "visit/kiosk_flow.hpp"
 
-#include "pictures/stick_pages.hpp"
 #include "audio/speech.hpp"
+#include "pictures/stick_pages.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -16,9 +16,12 @@ namespace hk::app {
 
 const char* state_name(KioskState s) {
   switch (s) {
-    case KioskState::Attract: return "attract";
-    case KioskState::Tutorial: return "tutorial";
-    case KioskState::Picture: return "picture";
+    case KioskState::Attract:
+      return "attract";
+    case KioskState::Tutorial:
+      return "tutorial";
+    case KioskState::Picture:
+      return "picture";
   }
   return "?";
 }
@@ -28,12 +31,25 @@ using audio::MessageId;
 namespace {
 
 /// The message naming what key `k` does (learning mode), in KioskKey order.
-constexpr std::array<MessageId, static_cast<std::size_t>(KioskKey::Other)> kKeyDoes{
-    MessageId::key_help,     MessageId::key_next,        MessageId::key_previous,      MessageId::key_describe,
-    MessageId::key_finer,    MessageId::key_coarser,     MessageId::key_volume_up,     MessageId::key_volume_down,
-    MessageId::key_tutorial, MessageId::key_guide,       MessageId::key_capture,       MessageId::key_repeat,
-    MessageId::key_pause,    MessageId::key_where,       MessageId::key_finish,        MessageId::key_next_sentence,
-    MessageId::key_previous_sentence, MessageId::key_next_paragraph, MessageId::key_previous_paragraph};
+constexpr std::array<MessageId, static_cast<std::size_t>(KioskKey::Other)> kKeyDoes{MessageId::key_help,
+                                                                                    MessageId::key_next,
+                                                                                    MessageId::key_previous,
+                                                                                    MessageId::key_describe,
+                                                                                    MessageId::key_finer,
+                                                                                    MessageId::key_coarser,
+                                                                                    MessageId::key_volume_up,
+                                                                                    MessageId::key_volume_down,
+                                                                                    MessageId::key_tutorial,
+                                                                                    MessageId::key_guide,
+                                                                                    MessageId::key_capture,
+                                                                                    MessageId::key_repeat,
+                                                                                    MessageId::key_pause,
+                                                                                    MessageId::key_where,
+                                                                                    MessageId::key_finish,
+                                                                                    MessageId::key_next_sentence,
+                                                                                    MessageId::key_previous_sentence,
+                                                                                    MessageId::key_next_paragraph,
+                                                                                    MessageId::key_previous_paragraph};
 
 }  // namespace
 
@@ -57,7 +73,9 @@ std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageAr
 
 void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say(text(id, args)); }
 
-void KioskFlow::say_brief(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say_brief(text(id, args)); }
+void KioskFlow::say_brief(MessageId id, std::initializer_list<audio::MessageArg> args) {
+  fx_.say_brief(text(id, args));
+}
 
 void KioskFlow::set_timing(double timeout_s, double warning_s, double attract_every_s) {
   p_.timeout_s = timeout_s;
@@ -175,8 +193,10 @@ bool KioskFlow::session_key(KioskKey k, double now_s) {
       return true;
     case KioskKey::Where: {
       const std::string here = fx_.where();
-      if (!here.empty()) fx_.say(here);
-      else fx_.say(place());
+      if (!here.empty())
+        fx_.say(here);
+      else
+        fx_.say(place());
       return true;
     }
     case KioskKey::Finish:
@@ -218,7 +238,8 @@ void KioskFlow::describe_key() {
     const ReadingPlace at{page.at_hand, 0};
     // The catalogue's words before the text ("Text:"), as the block's text would be said with text_block.
     const std::string& block = msg_.raw(MessageId::text_block);
-    const std::string lead = msg_.expand(std::string_view(block).substr(0, block.find("{text}")), {}, key_args(p_.keys));
+    const std::string lead =
+        msg_.expand(std::string_view(block).substr(0, block.find("{text}")), {}, key_args(p_.keys));
     read_from(at, before + long_text_line(v_.reading.text_from(at)) + lead);
     return;
   }
@@ -231,7 +252,9 @@ std::string KioskFlow::long_text_line(const std::string& said) const {
   const double seconds = spoken_seconds(said);
   if (seconds <= kLongText_s) return {};
   const int minutes = static_cast<int>(std::lround(seconds / 60.0));
-  return (minutes <= 1 ? text(MessageId::long_text_minute) : text(MessageId::long_text_minutes, {{"minutes", std::to_string(minutes)}})) + " ";
+  return (minutes <= 1 ? text(MessageId::long_text_minute)
+                       : text(MessageId::long_text_minutes, {{"minutes", std::to_string(minutes)}})) +
+         " ";
 }
 
 // ---- reading a page's text by sentence and paragraph ---------------------------------------------------
@@ -272,10 +295,10 @@ void KioskFlow::reading_key(KioskKey k) {
     return;
   }
   const bool by_paragraph = k == KioskKey::NextParagraph || k == KioskKey::PreviousParagraph;
-  const ReadAloud::Step step = k == KioskKey::NextSentence     ? v_.reading.next_sentence()
-                                 : k == KioskKey::PreviousSentence ? v_.reading.previous_sentence()
-                                 : k == KioskKey::NextParagraph    ? v_.reading.next_paragraph()
-                                                                   : v_.reading.previous_paragraph();
+  const ReadAloud::Step step = k == KioskKey::NextSentence       ? v_.reading.next_sentence()
+                               : k == KioskKey::PreviousSentence ? v_.reading.previous_sentence()
+                               : k == KioskKey::NextParagraph    ? v_.reading.next_paragraph()
+                                                                 : v_.reading.previous_paragraph();
   if (step.edge == ReadAloud::Edge::End) {
     say_brief(MessageId::reading_end);  // the reading stays where it is: Repeat and the keys go on from there
     return;
@@ -287,7 +310,8 @@ void KioskFlow::reading_key(KioskKey k) {
 
 std::string KioskFlow::paragraph_line(int p) const {
   if (v_.reading.paragraphs() < 2) return {};
-  return text(MessageId::reading_paragraph, {{"block", std::to_string(p + 1)}, {"blocks", std::to_string(v_.reading.paragraphs())}});
+  return text(MessageId::reading_paragraph,
+              {{"block", std::to_string(p + 1)}, {"blocks", std::to_string(v_.reading.paragraphs())}});
 }
 
 void KioskFlow::repeat_key() {
@@ -315,7 +339,7 @@ void KioskFlow::level_key(int delta) {
   const bool was_auto = fx_.auto_level();
   const bool changed = fx_.change_level(delta);
   std::string line = text(changed ? (delta < 0 ? MessageId::level_finer : MessageId::level_coarser)
-                                   : (delta < 0 ? MessageId::level_finest : MessageId::level_coarsest));
+                                  : (delta < 0 ? MessageId::level_finest : MessageId::level_coarsest));
   if (changed && was_auto) line += " " + text(MessageId::level_manual);
   fx_.say_brief(line);
 }
@@ -373,7 +397,8 @@ void KioskFlow::say_help_group() {
   const auto actions = config::key_actions(p_.keys);
   for (std::size_t i = 0; i < audio::kKeyPlaceholders.size(); ++i) {
     const std::string tag = "{" + std::string(audio::kKeyPlaceholders[i]) + "}";
-    if (groups[static_cast<std::size_t>(g)].find(tag) != std::string::npos) line += key_place_sentence(actions[i].second);
+    if (groups[static_cast<std::size_t>(g)].find(tag) != std::string::npos)
+      line += key_place_sentence(actions[i].second);
   }
   line += " " + text(g + 1 < static_cast<int>(groups.size()) ? MessageId::help_next : MessageId::help_last);
   fx_.say(line);
@@ -394,7 +419,9 @@ void KioskFlow::learn_key(KioskKey k, std::string_view key_name) {
   fx_.say_brief(text(kKeyDoes[static_cast<std::size_t>(k)]) + key_place_sentence(name));
 }
 
-void KioskFlow::stray_key(std::string_view key_name) { say_brief(MessageId::key_other, {{"key", spoken_key(key_name)}}); }
+void KioskFlow::stray_key(std::string_view key_name) {
+  say_brief(MessageId::key_other, {{"key", spoken_key(key_name)}});
+}
 
 std::string KioskFlow::spoken_key(std::string_view key_name) const {
   if (key_name.empty() || !msg_.key_names().contains(key_name)) return text(MessageId::this_key);
@@ -458,15 +485,16 @@ void KioskFlow::picture_key(KioskKey k) {
   }
 }
 
-
 std::string KioskFlow::place() const {
   if (v_.state == KioskState::Tutorial) return text(MessageId::place_tutorial);
   if (v_.source == KioskSource::Stick && v_.doc >= 0) {
     const StickEntry& e = v_.stick[static_cast<std::size_t>(v_.doc)];
-    return text(MessageId::place_document, {{"page", std::to_string(v_.page)}, {"pages", std::to_string(std::max(e.pages, e.pages_in_file))}});
+    return text(MessageId::place_document,
+                {{"page", std::to_string(v_.page)}, {"pages", std::to_string(std::max(e.pages, e.pages_in_file))}});
   }
   if (v_.captured) return text(MessageId::place_capture);
-  return text(MessageId::place_picture, {{"picture", std::to_string(v_.picture + 1)}, {"pictures", std::to_string(fx_.picture_count())}});
+  return text(MessageId::place_picture,
+              {{"picture", std::to_string(v_.picture + 1)}, {"pictures", std::to_string(fx_.picture_count())}});
 }
 
 // ---- the session -------------------------------------------------------------------------------------
@@ -510,7 +538,9 @@ void KioskFlow::announce_picture(int shapes, const std::string& before) {
   std::string line;
   if (!title.empty()) {
     // A person's words first: "Picture 2 of 5: a horse, seen from the side. It has 2 shapes."
-    const MessageId id = shapes == 0 ? MessageId::picture_titled_empty : shapes == 1 ? MessageId::picture_titled_one : MessageId::picture_titled;
+    const MessageId id = shapes == 0   ? MessageId::picture_titled_empty
+                         : shapes == 1 ? MessageId::picture_titled_one
+                                       : MessageId::picture_titled;
     line = text(id, {{"picture", num}, {"pictures", total}, {"title", title}, {"shapes", std::to_string(shapes)}});
   } else if (shapes == 0) {
     line = text(MessageId::picture_empty, {{"picture", num}, {"pictures", total}});
@@ -573,7 +603,8 @@ void KioskFlow::tick(double now_s) {
     // the warning's own speech is not.
     if (!v_.warned && fx_.speaking()) activity(now_s);
     follow_reading();
-    if ((v_.pending_doc >= 0 || v_.pending_picture >= 0) && !v_.loading_said && now_s - v_.pending_since_s > p_.loading_cue_s) {
+    if ((v_.pending_doc >= 0 || v_.pending_picture >= 0) && !v_.loading_said &&
+        now_s - v_.pending_since_s > p_.loading_cue_s) {
       v_.loading_said = true;
       say_brief(MessageId::loading);
     }
@@ -643,7 +674,9 @@ std::string KioskFlow::stick_summary() const {
     pages += e.pdf ? std::max(e.pages, e.pages_in_file) : 0;
     capped = std::max(capped, e.pdf && e.pages_in_file > e.pages ? e.pages : 0);
   }
-  auto count = [](int n, const char* one, const char* many) { return n == 1 ? std::string(one) : std::to_string(n) + " " + many; };
+  auto count = [](int n, const char* one, const char* many) {
+    return n == 1 ? std::string(one) : std::to_string(n) + " " + many;
+  };
   const int n = static_cast<int>(v_.stick.size());
   std::string s = count(n, "one document", "documents") + ": ";
   std::string pdf_part;
@@ -713,7 +746,8 @@ void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double 
 
 std::string KioskFlow::unreadable_line(int unreadable) const {
   if (unreadable <= 0) return {};
-  return " " + (unreadable == 1 ? text(MessageId::file_unreadable) : text(MessageId::files_unreadable, {{"count", std::to_string(unreadable)}}));
+  return " " + (unreadable == 1 ? text(MessageId::file_unreadable)
+                                : text(MessageId::files_unreadable, {{"count", std::to_string(unreadable)}}));
 }
 
 void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable) {
@@ -787,11 +821,14 @@ void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
     v_.page = r.page;
     v_.state = KioskState::Picture;
     v_.captured = false;
-    line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)}, {"pages", std::to_string(std::max(e.pages, e.pages_in_file))},
-                                                          {"name", name}, {"description", r.description}})
+    line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)},
+                                                   {"pages", std::to_string(std::max(e.pages, e.pages_in_file))},
+                                                   {"name", name},
+                                                   {"description", r.description}})
                  : text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
-                                                             {"documents", std::to_string(v_.stick.size())},
-                                                             {"name", name}, {"description", r.description}});
+                                                      {"documents", std::to_string(v_.stick.size())},
+                                                      {"name", name},
+                                                      {"description", r.description}});
   } else {
     const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + name : name;
     // "You still feel the picture before" only when there was one. Why is for the operator (the log and the
@@ -799,7 +836,8 @@ void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
     line = text(v_.felt ? MessageId::document_unreadable : MessageId::document_unreadable_alone, {{"name", what}});
   }
   if (!v_.announce_summary.empty()) {  // said now, so it names the keys of now
-    line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) + std::exchange(v_.announce_unreadable, {}) + " " + line;
+    line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) +
+           std::exchange(v_.announce_unreadable, {}) + " " + line;
     v_.announce_summary.clear();
   }
   fx_.say(line);
@@ -808,7 +846,9 @@ void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
 void KioskFlow::picture_ready(int index, int shapes, double now_s) {
   guarded("a picture of the library", [&] {
     (void)now_s;
-    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured || v_.source != KioskSource::Library) return;  // superseded
+    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured ||
+        v_.source != KioskSource::Library)
+      return;  // superseded
     v_.pending_picture = -1;
     announce_picture(shapes, std::exchange(v_.pending_before, {}));
   });
@@ -817,7 +857,9 @@ void KioskFlow::picture_ready(int index, int shapes, double now_s) {
 void KioskFlow::picture_failed(int index, const std::string& reason, double now_s) {
   guarded("a picture of the library", [&] {
     (void)now_s;
-    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured || v_.source != KioskSource::Library) return;  // superseded
+    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured ||
+        v_.source != KioskSource::Library)
+      return;  // superseded
     v_.pending_picture = -1;
     const std::string name = "Picture " + std::to_string(index + 1) + " of " + std::to_string(fx_.picture_count());
     spdlog::warn("kiosk: picture {} cannot be shown: {}", index + 1, reason);

@@ -13,17 +13,17 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
-#include "formats/app_error.hpp"
 #include "config/load.hpp"
-#include "visit/describe.hpp"
-#include "runtime/device_setup.hpp"
+#include "formats/app_error.hpp"
 #include "haptics/io/tty_transport.hpp"
 #include "haptics/tolerance_cut.hpp"
 #include "pictures/picture_library.hpp"
 #include "pictures/picture_params.hpp"
+#include "runtime/device_setup.hpp"
 #include "runtime/runtime_params.hpp"
 #include "runtime/simulation.hpp"
 #include "vision/intake.hpp"
+#include "visit/describe.hpp"
 
 namespace hk::app {
 namespace {
@@ -73,10 +73,20 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& give
     : KioskRuntime(o, with_usable_ocr(given), 0) {}
 
 KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, int /*checked*/)
-    : opt_(o), s_(s), audio_(audio_params(s, o.open_audio_output)), voice_(audio_),
-      half_{s.workspace.width_m / 2, s.workspace.height_m / 2}, sp_(servo_params_from(s)), core_(cue_params(), &audio_.cues()), devices_(s), shelf_(library_shelf(o, s)),
-      capture_(s, o.probe_camera || s.camera.source != "auto" ? choose_camera(s.camera) : CameraChoice{{}, {}, "not looked for (a scripted run)"}),
-      sticks_(s, block_events(o.hotplug), o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
+    : opt_(o),
+      s_(s),
+      audio_(audio_params(s, o.open_audio_output)),
+      voice_(audio_),
+      half_{s.workspace.width_m / 2, s.workspace.height_m / 2},
+      sp_(servo_params_from(s)),
+      core_(cue_params(), &audio_.cues()),
+      devices_(s),
+      shelf_(library_shelf(o, s)),
+      capture_(s, o.probe_camera || s.camera.source != "auto"
+                      ? choose_camera(s.camera)
+                      : CameraChoice{{}, {}, "not looked for (a scripted run)"}),
+      sticks_(s, block_events(o.hotplug),
+              o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root) {
   if (!o.device.empty()) {
     devices_.open_emulated_board(o.device);
     adopt_board_profile();
@@ -214,8 +224,11 @@ std::string KioskRuntime::where() {
   const audio::MessageCatalog& m = audio_.messages();
   if (const TextBlockM* b = text_block_at(shown_.text_blocks, d.handle_m)) {
     const auto index = b - shown_.text_blocks.data();
-    return m.text(audio::MessageId::where_text, {{"block", std::to_string(index + 1)}, {"blocks", std::to_string(shown_.text_blocks.size())},
-                                                  {"where", place}, {"text", first_words(name_unclear_words(b->text, m), kWhereTextWords)}});
+    return m.text(audio::MessageId::where_text,
+                  {{"block", std::to_string(index + 1)},
+                   {"blocks", std::to_string(shown_.text_blocks.size())},
+                   {"where", place},
+                   {"text", first_words(name_unclear_words(b->text, m), kWhereTextWords)}});
   }
   const ShapeAtHand at = shape_at_hand(shown_.polylines, d.handle_m, d.scene_id == shown_id_ ? d.curve : -1);
   // A practice shape: far and near explained with the first answer of the visit, not again.
@@ -224,8 +237,11 @@ std::string KioskRuntime::where() {
   const std::string far_near = explain ? " " + m.text(audio::MessageId::far_near) : std::string();
   if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}}) + far_near;
   return m.text(at.on ? audio::MessageId::where_on : audio::MessageId::where_near,
-                {{"shape", std::to_string(at.curve + 1)}, {"shapes", std::to_string(shown_.polylines.size())},
-                 {"description", shape_words(static_cast<std::size_t>(at.curve))}, {"where", place}}) + far_near;
+                {{"shape", std::to_string(at.curve + 1)},
+                 {"shapes", std::to_string(shown_.polylines.size())},
+                 {"description", shape_words(static_cast<std::size_t>(at.curve))},
+                 {"where", place}}) +
+         far_near;
 }
 
 bool KioskRuntime::showing_tutorial() const { return shown_id_ <= -1 && shown_id_ >= -3; }
@@ -238,7 +254,8 @@ std::string KioskRuntime::shape_words(std::size_t curve) const {
 void KioskRuntime::poll_display_modes() {
   if (high_contrast_ != said_contrast_) {
     said_contrast_ = high_contrast_;
-    say_brief(audio_.messages().text(high_contrast_ ? audio::MessageId::high_contrast_on : audio::MessageId::high_contrast_off));
+    say_brief(audio_.messages().text(high_contrast_ ? audio::MessageId::high_contrast_on
+                                                    : audio::MessageId::high_contrast_off));
   }
   if (overlay_ != said_overlay_) {
     said_overlay_ = overlay_;
@@ -250,9 +267,11 @@ void KioskRuntime::show_tutorial(TutorialShape shape) {
   shelf_.drop_want();  // a picture still being built is not wanted any more
   Shown sh;
   sh.polylines = {tutorial_polyline(shape, half_)};
-  static constexpr audio::MessageId kNames[] = {audio::MessageId::shape_square, audio::MessageId::shape_circle, audio::MessageId::shape_triangle};
+  static constexpr audio::MessageId kNames[] = {audio::MessageId::shape_square, audio::MessageId::shape_circle,
+                                                audio::MessageId::shape_triangle};
   sh.notes.title = audio_.messages().text(kNames[static_cast<int>(shape)]);  // Where, Describe and the tour name it
-  publish(std::move(sh), std::make_unique<Scene>(Scene::build({tutorial_polyline(shape, half_)}, s_.haptics.max_levels)),
+  publish(std::move(sh),
+          std::make_unique<Scene>(Scene::build({tutorial_polyline(shape, half_)}, s_.haptics.max_levels)),
           -1 - static_cast<int>(shape));
   text_.cancel();
   text_news_.clear();
@@ -285,7 +304,8 @@ void KioskRuntime::poll_pictures(KioskFlow* flow, double now_s) {
     spdlog::info("scene {}: built in {:.0f} ms (waited {:.0f} ms to start)", b.id, b.build_ms, b.queued_ms);
     if (!b.scene) {
       spdlog::warn("scene {}: {}; the picture felt before stays", b.id, b.error);
-      if (d->kind == ShelfDelivery::Kind::Picture && flow) flow->picture_failed(b.id, problem_of(b.error), now_s);  // "Picture N of M" names it
+      if (d->kind == ShelfDelivery::Kind::Picture && flow)
+        flow->picture_failed(b.id, problem_of(b.error), now_s);  // "Picture N of M" names it
     } else if (d->kind == ShelfDelivery::Kind::Rebuild) {
       PictureNotes notes = std::move(shown_.notes);
       show_built(*b.scene, b.id);  // the same picture with the new settings: no new announcement
@@ -350,7 +370,8 @@ void KioskRuntime::poll_text(double now_s) {
 
 void KioskRuntime::text_arrived(TextRead& read) {
   ImageScene& is = read.scene;
-  spdlog::info("text of scene {}: {}, {} words in {} blocks, read in {:.0f} ms", read.id, is.ocr.why, is.ocr.words, is.text_blocks.size(), read.wall_ms);
+  spdlog::info("text of scene {}: {}, {} words in {} blocks, read in {:.0f} ms", read.id, is.ocr.why, is.ocr.words,
+               is.text_blocks.size(), read.wall_ms);
   const audio::MessageCatalog& m = audio_.messages();
   text_news_id_ = read.id;
   const bool built = is.scene != nullptr;
@@ -360,7 +381,9 @@ void KioskRuntime::text_arrived(TextRead& read) {
     shown_.notes = std::move(notes);
   }
   if (built && !is.text_blocks.empty()) {
-    text_news_ = m.text(audio::MessageId::text_ready, {{"description", describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))}});
+    text_news_ =
+        m.text(audio::MessageId::text_ready,
+               {{"description", describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))}});
   } else if (is.ocr.why.rfind("failed", 0) == 0 || !built) {
     text_news_ = m.text(audio::MessageId::text_unavailable);
   } else if (text_said_) {
@@ -370,14 +393,17 @@ void KioskRuntime::text_arrived(TextRead& read) {
 
 std::string KioskRuntime::describe() {
   // Its text still being read: said first, so the visitor knows more is coming.
-  const std::string reading = text_.pending() ? audio_.messages().text(audio::MessageId::text_reading) + " " : std::string();
+  const std::string reading =
+      text_.pending() ? audio_.messages().text(audio::MessageId::text_reading) + " " : std::string();
   return reading + describe_shown();
 }
 
 PageText KioskRuntime::page_text() {
   PageText page;
-  for (const TextBlockM& b : shown_.text_blocks) page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
-  if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m)) page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
+  for (const TextBlockM& b : shown_.text_blocks)
+    page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
+  if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m))
+    page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
   return page;
 }
 
@@ -385,10 +411,13 @@ std::string KioskRuntime::describe_shown() {
   if (shown_page_ > 0 || !shown_.text_blocks.empty()) {
     // A page (or a picture of one): the block of text under the hand is read; elsewhere, what the page holds.
     if (const TextBlockM* b = text_block_at(shown_.text_blocks, core_.display().proxy_m)) {
-      return audio_.messages().text(audio::MessageId::text_block, {{"text", name_unclear_words(b->text, audio_.messages())}});
+      return audio_.messages().text(audio::MessageId::text_block,
+                                    {{"text", name_unclear_words(b->text, audio_.messages())}});
     }
-    const std::string page = describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
-    return shown_.polylines.empty() ? page : page + " " + describe_scene(shown_.polylines, half_, 3, core_.display().handle_m);
+    const std::string page =
+        describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
+    return shown_.polylines.empty() ? page
+                                    : page + " " + describe_scene(shown_.polylines, half_, 3, core_.display().handle_m);
   }
   if (showing_tutorial() && !shown_.notes.title.empty()) {  // a practice shape: "A square, in the middle."
     std::string words = shown_.notes.title + ", " + place_words({0.0, 0.0}, half_) + ".";
@@ -415,7 +444,7 @@ void KioskRuntime::set_screen_picture_side_px(int px) {
 }
 
 void KioskRuntime::show_document(int document, int page) {
-  reset_level();  // a level the visitor chose holds for one page
+  reset_level();       // a level the visitor chose holds for one page
   shelf_.drop_want();  // the stick's page, not a library picture still being built
   sticks_.load(stick_id_, document, page);
 }
@@ -434,7 +463,8 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
       stick_id_ = n.stick;
       std::vector<StickEntry> entries;
       for (const ListedDocument& d : n.documents)
-        entries.push_back({d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages, d.title, d.pages_in_file});
+        entries.push_back(
+            {d.doc.display_name, d.doc.kind == vision::DocumentKind::Pdf, d.pages, d.title, d.pages_in_file});
       stick_busy_ = !entries.empty();
       stick_problems_.clear();
       // Pictures and PDFs first: what the visitor was told of; then the rest left out.
@@ -462,7 +492,8 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
       stick_busy_ = false;
       continue;
     }
-    if (!flow.awaits_document(d.document, d.page)) continue;  // superseded by a later Next or Previous: never on the device
+    if (!flow.awaits_document(d.document, d.page))
+      continue;  // superseded by a later Next or Previous: never on the device
     DocumentResult r;
     r.document = d.document;
     r.page = d.page;
@@ -472,8 +503,9 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
       // A page, or a picture of one (its text read): blocks of text and figures; its text still being read:
       // said so at once; else shapes.
       r.description = is.text_pending && is.text_likely ? audio_.messages().text(audio::MessageId::text_reading)
-                      : is.page > 0 || !is.text_blocks.empty() ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
-                                                               : describe_shapes(static_cast<int>(is.scene->curve_count()));
+                      : is.page > 0 || !is.text_blocks.empty()
+                          ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
+                          : describe_shapes(static_cast<int>(is.scene->curve_count()));
       const bool said_reading = is.text_pending && is.text_likely;
       show_built(is, id);
       text_said_ = said_reading;
@@ -483,7 +515,9 @@ void KioskRuntime::poll_sticks(KioskFlow& flow, double now_s) {
     } else {
       r.reason = d.reason;
       const std::vector<StickEntry>& docs = flow.stick_documents();
-      const std::string name = d.document >= 0 && d.document < static_cast<int>(docs.size()) ? docs[static_cast<std::size_t>(d.document)].name : "?";
+      const std::string name = d.document >= 0 && d.document < static_cast<int>(docs.size())
+                                   ? docs[static_cast<std::size_t>(d.document)].name
+                                   : "?";
       note_stick_problem("'" + name + "' page " + std::to_string(d.page) + ": " + d.reason);
     }
     stick_busy_ = false;
@@ -510,8 +544,9 @@ void KioskRuntime::remove_stick_folder() {
 
 bool KioskRuntime::change_level(int delta) {
   // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until
-  // another picture or page is asked for (reset_level) or the session ends. With a tolerance or cut step in use (level_mode = "tolerance" or "cut") the keys move along
-  // the steps, so finer and coarser keep their order (and their earcons) without comparing a step with a level.
+  // another picture or page is asked for (reset_level) or the session ends. With a tolerance or cut step in use
+  // (level_mode = "tolerance" or "cut") the keys move along the steps, so finer and coarser keep their order (and their
+  // earcons) without comparing a step with a level.
   const int now = level();
   const int next = now + delta;
   const bool in_range = is_tolerance_level(now) ? is_tolerance_level(next)
@@ -536,8 +571,10 @@ void KioskRuntime::new_session() {
   far_near_said_ = false;
   if (ServoThread* servo = devices_.servo()) {  // the servo thread's timing, once per visitor's session
     const ServoTimingStats t = servo->take_stats();
-    spdlog::info("session: servo {} ticks, {} missed deadlines, lateness p50 {:.0f} p99 {:.0f} max {:.0f} us, tick work p99 {:.0f} us",
-                 t.ticks, t.missed_deadlines, t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us, t.compute_p99_us);
+    spdlog::info(
+        "session: servo {} ticks, {} missed deadlines, lateness p50 {:.0f} p99 {:.0f} max {:.0f} us, tick work p99 "
+        "{:.0f} us",
+        t.ticks, t.missed_deadlines, t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us, t.compute_p99_us);
   }
   capture_.cancel();
   shelf_.drop_want();
@@ -585,7 +622,8 @@ void KioskRuntime::guide() {
   const TourParams tp = tour_params_from(s_);
   if (!plan_tour(*shown_.scene, shown_id_, core_.display().handle_m, touches_, tp)) {
     bool any_shape = false;
-    for (std::size_t c = 0; c < shown_.scene->curve_count(); ++c) any_shape = any_shape || is_tour_shape(*shown_.scene, c, tp);
+    for (std::size_t c = 0; c < shown_.scene->curve_count(); ++c)
+      any_shape = any_shape || is_tour_shape(*shown_.scene, c, tp);
     say(audio_.messages().text(any_shape ? audio::MessageId::tour_all_touched : audio::MessageId::tour_nothing));
     return;
   }
@@ -596,7 +634,8 @@ void KioskRuntime::guide() {
   tour_asked_ = true;
   tour_scene_ = shown_id_;
   tour_due_tick_ = core_.display().tick +
-                   static_cast<std::int64_t>(std::ceil((audio_.speech_duration_s(ask) + kTourAskMargin_s) * s_.haptics.servo_rate_hz));
+                   static_cast<std::int64_t>(
+                       std::ceil((audio_.speech_duration_s(ask) + kTourAskMargin_s) * s_.haptics.servo_rate_hz));
 }
 
 void KioskRuntime::hand_over_tour() {
@@ -640,13 +679,18 @@ void KioskRuntime::report_tour_end(const ServoDisplayState& d) {
     spdlog::warn("tour {}: stuck on shape {} (no progress), let go", d.tour_id, d.tour_curve);
     text = m.text(audio::MessageId::tour_stuck) + " ";
   } else if (d.tour_curve >= 0 && static_cast<std::size_t>(d.tour_curve) < shown_.polylines.size()) {
-    text = m.text(audio::MessageId::tour_traced, {{"shape", std::to_string(d.tour_curve + 1)},
-                                                   {"description", shape_words(static_cast<std::size_t>(d.tour_curve))}}) + " ";
+    text =
+        m.text(audio::MessageId::tour_traced, {{"shape", std::to_string(d.tour_curve + 1)},
+                                               {"description", shape_words(static_cast<std::size_t>(d.tour_curve))}}) +
+        " ";
   }
   const int left = shapes_remaining(*shown_.scene, touches_, tour_params_from(s_));
-  if (left == 0) text += m.text(audio::MessageId::tour_all_touched);
-  else if (left == 1) text += m.text(audio::MessageId::tour_one_remaining);
-  else text += m.text(audio::MessageId::tour_remaining, {{"count", std::to_string(left)}});
+  if (left == 0)
+    text += m.text(audio::MessageId::tour_all_touched);
+  else if (left == 1)
+    text += m.text(audio::MessageId::tour_one_remaining);
+  else
+    text += m.text(audio::MessageId::tour_remaining, {{"count", std::to_string(left)}});
   say(text);
 }
 
@@ -721,10 +765,12 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
   const config::Settings before = s_;
   bool rebuild = false;
   for (const config::FieldDescriptor& d : config::field_descriptors()) {
-    const bool same = std::visit([&](const auto* a) {
-      using P = decltype(a);
-      return *a == *std::get<P>(d.cref(next));
-    }, d.cref(before));
+    const bool same = std::visit(
+        [&](const auto* a) {
+          using P = decltype(a);
+          return *a == *std::get<P>(d.cref(next));
+        },
+        d.cref(before));
     if (same) continue;
     const std::string key = std::string(d.table) + "." + std::string(d.key);
     switch (d.apply) {
@@ -733,9 +779,15 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
         if (d.table == "keys") r.keys = true;
         if (d.table == "kiosk") r.timing = true;
         break;
-      case config::ApplyWhen::scene: rebuild = true; break;
-      case config::ApplyWhen::session: r.next_session.push_back(key); break;
-      case config::ApplyWhen::restart: r.restart.push_back(key); break;
+      case config::ApplyWhen::scene:
+        rebuild = true;
+        break;
+      case config::ApplyWhen::session:
+        r.next_session.push_back(key);
+        break;
+      case config::ApplyWhen::restart:
+        r.restart.push_back(key);
+        break;
     }
   }
   // What the next start needs stays as it was in the running kiosk (its threads, device and view were made
@@ -743,10 +795,12 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
   config::Settings in_use = next;
   for (const config::FieldDescriptor& d : config::field_descriptors()) {
     if (d.apply != config::ApplyWhen::restart) continue;
-    std::visit([&](auto* dst) {
-      using P = decltype(dst);
-      *dst = *std::get<std::add_pointer_t<std::add_const_t<std::remove_pointer_t<P>>>>(d.cref(before));
-    }, d.ref(in_use));
+    std::visit(
+        [&](auto* dst) {
+          using P = decltype(dst);
+          *dst = *std::get<std::add_pointer_t<std::add_const_t<std::remove_pointer_t<P>>>>(d.cref(before));
+        },
+        d.ref(in_use));
   }
   // A board's profile bounds what the panel may ask of it (device_profile.hpp): refused values take the profile's.
   if (devices_.usb()) {

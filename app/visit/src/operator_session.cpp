@@ -15,15 +15,21 @@ namespace {
 constexpr double kNoticeS = 8.0;  // a notice stays this long [s]
 
 std::string wait_text(double wait_s) {
-  if (std::isinf(wait_s)) return "The PIN is locked after too many failed attempts: set it again with 'haptic-kiosk pin set'.";
+  if (std::isinf(wait_s))
+    return "The PIN is locked after too many failed attempts: set it again with 'haptic-kiosk pin set'.";
   return "Try again in " + std::to_string(static_cast<long long>(std::ceil(wait_s))) + " s.";
 }
 
 }  // namespace
 
-OperatorSession::OperatorSession(std::string settings_path, const config::Settings& in_use, std::string load_notice, ApplyFn apply)
-    : settings_path_(std::move(settings_path)), load_notice_(std::move(load_notice)), apply_fn_(std::move(apply)),
-      in_use_(in_use), saved_(in_use), working_(in_use) {
+OperatorSession::OperatorSession(std::string settings_path, const config::Settings& in_use, std::string load_notice,
+                                 ApplyFn apply)
+    : settings_path_(std::move(settings_path)),
+      load_notice_(std::move(load_notice)),
+      apply_fn_(std::move(apply)),
+      in_use_(in_use),
+      saved_(in_use),
+      working_(in_use) {
   if (!settings_path_.empty()) {
     audit_path_ = config::audit_log_path(in_use, settings_path_);
     verifier_ = std::make_unique<PinVerifier>(settings_path_);
@@ -54,7 +60,9 @@ void OperatorSession::chord(double now_s, std::int64_t now_unix_s) {
   if (settings_path_.empty()) {
     state_ = PanelState::notice;
     notice_until_s_ = now_s + kNoticeS;
-    message_ = "The kiosk runs on its built-in settings: start it with --config FILE, and set a PIN with 'haptic-kiosk pin set --config FILE'.";
+    message_ =
+        "The kiosk runs on its built-in settings: start it with --config FILE, and set a PIN with 'haptic-kiosk pin "
+        "set --config FILE'.";
     spdlog::warn("operator panel: {}", message_);
     return;
   }
@@ -108,7 +116,9 @@ void OperatorSession::tick(double now_s, std::int64_t now_unix_s) {
         spdlog::error("operator panel: {}", o->error);
       } else {
         switch (o->attempt.verdict) {
-          case config::PinVerdict::right: open_panel(now_s, now_unix_s); return;
+          case config::PinVerdict::right:
+            open_panel(now_s, now_unix_s);
+            return;
           case config::PinVerdict::wrong:
             message_ = "Wrong PIN (" + std::to_string(o->attempt.failures) + " failed attempts).";
             if (o->attempt.wait_s > 0) message_ += " " + wait_text(o->attempt.wait_s);
@@ -162,7 +172,9 @@ void OperatorSession::close(std::int64_t now_unix_s) {
 
 std::string& OperatorSession::edit_text(const config::FieldDescriptor& d) { return edit_texts_[index_of(d)]; }
 
-const std::string& OperatorSession::field_error(const config::FieldDescriptor& d) const { return field_errors_[index_of(d)]; }
+const std::string& OperatorSession::field_error(const config::FieldDescriptor& d) const {
+  return field_errors_[index_of(d)];
+}
 
 std::string OperatorSession::commit_field(const config::FieldDescriptor& d, std::int64_t) {
   const std::size_t i = index_of(d);

@@ -29,10 +29,10 @@ inline constexpr int kCueKindCount = 12;
 
 /// One cue. 24 bytes (checked below): small enough that a 4096-entry queue is 96 KiB.
 struct CueEvent {
-  std::int64_t tick = 0;         ///< servo tick index k; the cue belongs at t = k · period
-  float speed_m_per_s = 0.0f;    ///< approach (ContactBegin) or sliding (Slide) speed [m/s]; 0 otherwise
-  std::int32_t curve = -1;       ///< curve touched (its pitch); −1 when none
-  std::int16_t level = 0;        ///< level in use (LevelFiner/LevelCoarser: the new one)
+  std::int64_t tick = 0;       ///< servo tick index k; the cue belongs at t = k · period
+  float speed_m_per_s = 0.0f;  ///< approach (ContactBegin) or sliding (Slide) speed [m/s]; 0 otherwise
+  std::int32_t curve = -1;     ///< curve touched (its pitch); −1 when none
+  std::int16_t level = 0;      ///< level in use (LevelFiner/LevelCoarser: the new one)
   CueKind kind = CueKind::ContactBegin;
 };
 static_assert(sizeof(CueEvent) == 24, "CueEvent is a hot queue entry: keep it 24 bytes");

@@ -33,11 +33,11 @@ namespace hk::audio {
 
 /// Earcon tuning. Units in names.
 struct EarconParams {
-  double gain = 0.5;                        ///< overall earcon gain, linear [0, 1]
-  double click_full_speed_m_per_s = 0.15;   ///< approach speed at which a contact click is loudest [m/s]
-  double slide_grain_spacing_m = 0.002;     ///< sliding distance per texture grain [m]
-  double slide_max_grain_rate_hz = 80.0;    ///< texture grain rate limit [Hz]
-  double slide_timeout_s = 0.03;            ///< texture stops when no Slide cue came for this long [s]
+  double gain = 0.5;                       ///< overall earcon gain, linear [0, 1]
+  double click_full_speed_m_per_s = 0.15;  ///< approach speed at which a contact click is loudest [m/s]
+  double slide_grain_spacing_m = 0.002;    ///< sliding distance per texture grain [m]
+  double slide_max_grain_rate_hz = 80.0;   ///< texture grain rate limit [Hz]
+  double slide_timeout_s = 0.03;           ///< texture stops when no Slide cue came for this long [s]
 };
 
 /// The pitch of curve `curve` [Hz]: a major-pentatonic scale over two octaves from C4 (261.6 Hz), so
@@ -65,25 +65,25 @@ class EarconSynth {
   const EarconParams& params() const noexcept { return params_; }
 
  private:
-  struct Voice {                // 96 bytes; the pool is flat and fixed
+  struct Voice {  // 96 bytes; the pool is flat and fixed
     bool active = false;
-    int delay = 0;              ///< samples to wait before starting [samples]
-    int left = 0;               ///< samples still to play [samples]
-    int attack = 1;             ///< attack length [samples]
-    int age = 0;                ///< samples played
-    int release = 1;            ///< linear fade over the last `release` samples
-    float amp = 0;              ///< peak amplitude
-    float env = 1;              ///< exponential decay envelope
-    float decay = 1;            ///< per-sample decay factor
-    float noise_mix = 0;        ///< 0 = pure tone, 1 = pure band-passed noise
-    double phase = 0;           ///< [rad]
-    double omega = 0;           ///< tone phase step [rad/sample]
-    double glide = 1;           ///< per-sample multiplier of omega (chirps)
+    int delay = 0;                 ///< samples to wait before starting [samples]
+    int left = 0;                  ///< samples still to play [samples]
+    int attack = 1;                ///< attack length [samples]
+    int age = 0;                   ///< samples played
+    int release = 1;               ///< linear fade over the last `release` samples
+    float amp = 0;                 ///< peak amplitude
+    float env = 1;                 ///< exponential decay envelope
+    float decay = 1;               ///< per-sample decay factor
+    float noise_mix = 0;           ///< 0 = pure tone, 1 = pure band-passed noise
+    double phase = 0;              ///< [rad]
+    double omega = 0;              ///< tone phase step [rad/sample]
+    double glide = 1;              ///< per-sample multiplier of omega (chirps)
     float b0 = 0, a1 = 0, a2 = 0;  ///< band-pass biquad (RBJ, constant 0 dB peak; b1 = 0, b2 = −b0)
     float x1 = 0, x2 = 0, y1 = 0, y2 = 0;
   };
   static_assert(sizeof(Voice) <= 96, "voices are walked every sample: keep them small");
-  struct Shape {                // what a voice plays, in physical units
+  struct Shape {  // what a voice plays, in physical units
     double freq_hz, glide_to_hz, duration_s, attack_s, tau_s, release_s, amp, noise_mix, noise_hz, noise_q, delay_s;
   };
   void start(const Shape& s) noexcept;
@@ -94,8 +94,8 @@ class EarconSynth {
   void knock_cue(CueKind kind) noexcept;
   /// The signals (LevelFiner, LevelCoarser, TextBlock, TourStart, Shutter): chirps, notes and the shutter.
   void signal_cue(CueKind kind) noexcept;
-  static constexpr double kMinTransientGapS = 0.003;   ///< clicks start at least this far apart [s]
-  static constexpr double kMaxTransientDelayS = 0.006; ///< and are never pushed back further [s]
+  static constexpr double kMinTransientGapS = 0.003;    ///< clicks start at least this far apart [s]
+  static constexpr double kMaxTransientDelayS = 0.006;  ///< and are never pushed back further [s]
   float next_noise() noexcept;
 
   EarconParams params_;
@@ -104,12 +104,12 @@ class EarconSynth {
   std::uint32_t noise_state_ = 0x9E3779B9u;
   // slide texture
   bool slide_active_ = false;
-  double slide_speed_ = 0;      ///< [m/s]
+  double slide_speed_ = 0;  ///< [m/s]
   int slide_curve_ = -1;
-  long slide_since_update_ = 0; ///< samples since the last Slide cue
-  double grain_phase_ = 0;      ///< fractional grains accumulated
-  long now_ = 0;                ///< samples rendered so far
-  long next_transient_at_ = 0;  ///< earliest sample the next click may start at
+  long slide_since_update_ = 0;  ///< samples since the last Slide cue
+  double grain_phase_ = 0;       ///< fractional grains accumulated
+  long now_ = 0;                 ///< samples rendered so far
+  long next_transient_at_ = 0;   ///< earliest sample the next click may start at
 };
 
 }  // namespace hk::audio

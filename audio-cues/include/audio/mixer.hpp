@@ -21,10 +21,10 @@ namespace hk::audio {
 /// Mixer tuning. Units in names.
 struct MixerParams {
   EarconParams earcons;
-  double duck_db = -14.0;        ///< earcon level change while speech plays [dB] (≤ 0)
-  double duck_attack_s = 0.010;  ///< time constant of ducking down [s]
-  double duck_release_s = 0.150; ///< time constant of coming back up [s]
-  double speech_gain = 0.9;      ///< speech level, linear
+  double duck_db = -14.0;         ///< earcon level change while speech plays [dB] (≤ 0)
+  double duck_attack_s = 0.010;   ///< time constant of ducking down [s]
+  double duck_release_s = 0.150;  ///< time constant of coming back up [s]
+  double speech_gain = 0.9;       ///< speech level, linear
 };
 
 /// The mix. One consumer thread (the audio callback) calls render(); other threads only push cues into
@@ -57,8 +57,8 @@ class Mixer final : public AudioSource {
   SpscRing<CueEvent>* ui_cues_;
   SpeechStream* speech_;
   const Volume* volume_;
-  float duck_ = 1.0f;           ///< current earcon gain from ducking
-  float duck_down_, duck_up_;   ///< one-pole coefficients per sample
+  float duck_ = 1.0f;          ///< current earcon gain from ducking
+  float duck_down_, duck_up_;  ///< one-pole coefficients per sample
   float duck_floor_;
   std::uint64_t cues_played_ = 0;
   float earcon_buf_[kChunk];

@@ -10,8 +10,8 @@
 /// follows DESIGN.md "Real-time rules": it only calls AudioSource::render() and copies samples.
 
 #include <array>
-#include <chrono>
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -36,14 +36,14 @@ struct OutputParams {
 
 /// What was opened, for the log and the operator overlay. A snapshot taken when the stream started.
 struct OutputInfo {
-  bool running = false;                ///< the stream started and stop() was not called since
-  std::string device_name;             ///< PortAudio's device name
-  std::string host_api;                ///< e.g. "ALSA", "JACK Audio Connection Kit"
-  int sample_rate_hz = 0;              ///< the stream's actual rate [Hz] (kSampleRateHz when running)
-  int channels = 0;                    ///< 1 (mono) or 2 (the mono mix on both channels)
-  int frames_per_buffer = 0;           ///< frames per callback
-  double reported_latency_s = 0.0;     ///< Pa_GetStreamInfo()->outputLatency [s]
-  std::string why_not;                 ///< one line, when not running; empty otherwise
+  bool running = false;             ///< the stream started and stop() was not called since
+  std::string device_name;          ///< PortAudio's device name
+  std::string host_api;             ///< e.g. "ALSA", "JACK Audio Connection Kit"
+  int sample_rate_hz = 0;           ///< the stream's actual rate [Hz] (kSampleRateHz when running)
+  int channels = 0;                 ///< 1 (mono) or 2 (the mono mix on both channels)
+  int frames_per_buffer = 0;        ///< frames per callback
+  double reported_latency_s = 0.0;  ///< Pa_GetStreamInfo()->outputLatency [s]
+  std::string why_not;              ///< one line, when not running; empty otherwise
 };
 
 /// Real-time helper used by AudioOutput's callback, public so it can be tested without a device.
@@ -119,9 +119,9 @@ class AudioOutput {
   static constexpr std::size_t kMaxFrames = 4096;  // largest frames_per_buffer [frames]
   AudioSource& source_;
   OutputInfo info_;
-  void* stream_ = nullptr;   // PaStream*
-  bool initialised_ = false; // this object holds one Pa_Initialize
-  int channels_ = 1;         // fixed before the stream starts; read by the callback
+  void* stream_ = nullptr;    // PaStream*
+  bool initialised_ = false;  // this object holds one Pa_Initialize
+  int channels_ = 1;          // fixed before the stream starts; read by the callback
   std::atomic<std::uint64_t> callbacks_{0}, underflows_{0};
   std::array<float, kMaxFrames> mono_{};  // the callback's scratch buffer
   OutputPacer pacer_{kSampleRateHz};      // the callback's; a device faster than real time waits here

@@ -10,7 +10,6 @@
 /// serialised by one process-wide mutex, and it is initialised once per process (on first use). Nothing
 /// else in the process should call espeak-ng directly.
 
-#include "hk/error.hpp"
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -22,6 +21,7 @@
 #include <thread>
 #include <utility>
 #include <vector>
+#include "hk/error.hpp"
 
 #include "audio/source.hpp"
 #include "audio/speech_stream.hpp"
@@ -136,26 +136,27 @@ class Speaker {
   /// was spoken whole and in order. Each piece is also logged at spdlog's debug level.
   std::vector<std::string> pieces_spoken() const;
 
-  static constexpr std::size_t kLogEntries = 256;       ///< entries kept in log() and pieces_spoken()
-  static constexpr double kHandOverGrace = 0.25;        ///< see busy() [s]
-  static constexpr double kFullRingRetry = 0.005;       ///< worker's wait when the stream is full [s]
+  static constexpr std::size_t kLogEntries = 256;  ///< entries kept in log() and pieces_spoken()
+  static constexpr double kHandOverGrace = 0.25;   ///< see busy() [s]
+  static constexpr double kFullRingRetry = 0.005;  ///< worker's wait when the stream is full [s]
 
  private:
   void run();
   void submit(std::string text, bool keep);  // cancels and queues; caller holds m_
-  bool speak_piece(const std::string& piece, std::uint32_t gen, std::uint64_t* pushed);  // false: cancelled; *pushed += samples handed over
+  bool speak_piece(const std::string& piece, std::uint32_t gen,
+                   std::uint64_t* pushed);  // false: cancelled; *pushed += samples handed over
 
   SpeechStream& stream_;
   SpeechParams params_;
   mutable std::mutex m_;
   std::condition_variable cv_;
-  bool has_job_ = false;         // a text waits for the worker
+  bool has_job_ = false;  // a text waits for the worker
   std::uint32_t job_generation_ = 0;
   std::string job_text_;
   std::deque<std::pair<std::int64_t, std::string>> log_;
   std::deque<std::string> pieces_;
   std::string last_;
-  bool working_ = false;         // the worker is synthesising
+  bool working_ = false;                 // the worker is synthesising
   std::uint32_t handed_generation_ = 0;  // the last utterance the worker finished, and when [steady ns]
   std::int64_t handed_at_ns_ = 0;
   bool handed_ = false;

@@ -26,8 +26,8 @@ class SpeechStream {
   /// One block: 1 KiB of samples plus its tag.
   struct Block {
     std::uint32_t generation = 0;
-    std::uint32_t count = 0;            ///< valid samples in `samples` [0, kBlockSamples]
-    bool last = false;                  ///< the utterance ends with this block
+    std::uint32_t count = 0;  ///< valid samples in `samples` [0, kBlockSamples]
+    bool last = false;        ///< the utterance ends with this block
     float samples[kBlockSamples] = {};
   };
 
@@ -71,7 +71,8 @@ class SpeechStream {
   static constexpr std::uint32_t kHeardGenerationMask = (1u << kHeardGenerationBits) - 1;
   Heard heard() const noexcept {
     const std::uint64_t v = heard_.load(std::memory_order_acquire);
-    return {static_cast<std::uint32_t>(v >> (64 - kHeardGenerationBits)), v & ((std::uint64_t{1} << (64 - kHeardGenerationBits)) - 1)};
+    return {static_cast<std::uint32_t>(v >> (64 - kHeardGenerationBits)),
+            v & ((std::uint64_t{1} << (64 - kHeardGenerationBits)) - 1)};
   }
 
   /// Blocks dropped because the ring was full (the producer retries; this counts the waits).
@@ -94,7 +95,7 @@ class SpeechStream {
   bool have_current_ = false;
   float last_sample_ = 0.0f;
   std::size_t fade_left_ = 0;
-  std::uint64_t heard_samples_ = 0;  // samples of playing_generation_ read
+  std::uint64_t heard_samples_ = 0;             // samples of playing_generation_ read
   std::size_t pause_fade_left_ = kFadeSamples;  // fade-out samples left on entering a pause
   std::uint32_t playing_generation_ = 0;
 };

@@ -82,10 +82,10 @@ class SpscRing {
   std::unique_ptr<T[]> items_;
   std::size_t mask_ = 0;
   alignas(kLine) std::atomic<std::uint64_t> head_{0};  // written by the producer
-  std::uint64_t tail_cache_ = 0;                         // producer's last view of tail_
+  std::uint64_t tail_cache_ = 0;                       // producer's last view of tail_
   std::atomic<std::uint64_t> overflows_{0};
   alignas(kLine) std::atomic<std::uint64_t> tail_{0};  // written by the consumer
-  std::uint64_t head_cache_ = 0;                        // consumer's last view of head_
+  std::uint64_t head_cache_ = 0;                       // consumer's last view of head_
 };
 
 }  // namespace hk::audio

@@ -26,7 +26,7 @@ namespace hk::audio {
 /// Everything the audio side is configured with. Units in names.
 struct AudioSystemParams {
   MixerParams mixer;
-  SpeechParams speech;              ///< voice: empty = the catalogue's voice
+  SpeechParams speech;  ///< voice: empty = the catalogue's voice
   OutputParams output;
   int volume_default_step = 7;      ///< [1, 10]
   double volume_step_db = 3.0;      ///< [dB]
@@ -106,7 +106,7 @@ class AudioSystem {
   std::unique_ptr<Speaker> speaker_;
   std::unique_ptr<AudioOutput> output_;
   SpeechParams speech_params_;  // the speaker's
-  bool pulled_ = false;  // open_output was false: the caller pulls render()
+  bool pulled_ = false;         // open_output was false: the caller pulls render()
 };
 
 }  // namespace hk::audio

@@ -5,12 +5,12 @@
 /// file I/O, so never call them from the audio callback or the servo thread. Any thread may call them
 /// concurrently on different paths.
 
-#include "hk/error.hpp"
 #include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "hk/error.hpp"
 
 namespace hk::audio {
 

@@ -33,7 +33,8 @@ inline constexpr int kCutLevelBase = kToleranceLevelBase + kToleranceSteps;
 inline constexpr int kLevelIds = kMaxLevels + 2 * kToleranceSteps;
 /// The tolerance of each step [m], increasing by ~1.6x (the R10 series): from the fingertip's 0.1 mm at
 /// rest to 2.5 mm, the tolerable error of a hand at ~0.24 m/s (haptics/level_policy.hpp).
-inline constexpr double kToleranceLadder_m[kToleranceSteps] = {1.0e-4, 1.6e-4, 2.5e-4, 4.0e-4, 6.3e-4, 1.0e-3, 1.6e-3, 2.5e-3};
+inline constexpr double kToleranceLadder_m[kToleranceSteps] = {1.0e-4, 1.6e-4, 2.5e-4, 4.0e-4,
+                                                               6.3e-4, 1.0e-3, 1.6e-3, 2.5e-3};
 /// True for a tolerance-step id.
 constexpr bool is_tolerance_level(int id) { return id >= kToleranceLevelBase && id < kCutLevelBase; }
 /// True for a cut-step id.

@@ -10,9 +10,9 @@ namespace hk {
 
 /// One step of UTF-8 decoding (see decode_utf8).
 struct Utf8Step {
-  char32_t code_point = 0;  ///< the scalar value decoded; 0 when ill-formed
-  std::size_t length = 1;   ///< bytes consumed [1, 4]
-  bool well_formed = false; ///< a well-formed sequence (Unicode 15 table 3-7)
+  char32_t code_point = 0;   ///< the scalar value decoded; 0 when ill-formed
+  std::size_t length = 1;    ///< bytes consumed [1, 4]
+  bool well_formed = false;  ///< a well-formed sequence (Unicode 15 table 3-7)
 };
 
 /// Decodes the UTF-8 sequence starting at s[i] (i < s.size()). Well-formed (Unicode table 3-7: no overlong

@@ -3,11 +3,13 @@
 /// Device profiles: what each kind of handle can give, and the settings it brings ([device] type picks
 /// one; DESIGN.md "Devices").
 ///
-/// | [device] type | device | force everywhere | max_force_n | pop_force_n | tour_max_force_n | groove_depth_n | stiffness_n_per_m (stable limit) |
+/// | [device] type | device | force everywhere | max_force_n | pop_force_n | tour_max_force_n | groove_depth_n |
+/// stiffness_n_per_m (stable limit) |
 /// |---|---|---|---|---|---|---|---|
-/// | "simulated", "auto" | simulated pantograph | 3.78 N | 3.5 N | 3.0 N | 1.2 N | 1.0 N | 800 (limit 3000; stable to 3784) N/m |
-/// | "haply" | Haply 2DIY gen3 | 1.65 N | 1.5 N | 1.2 N | 0.5 N | 0.45 N | 500 (limit 850; stable to 1103) N/m |
-/// | "haply-gen2" | the original Haply 2DIY | 1.60 N | 1.45 N | 1.15 N | 0.5 N | 0.45 N | 500 (limit 850; stable to 1129) N/m |
+/// | "simulated", "auto" | simulated pantograph | 3.78 N | 3.5 N | 3.0 N | 1.2 N | 1.0 N | 800 (limit 3000; stable to
+/// 3784) N/m | | "haply" | Haply 2DIY gen3 | 1.65 N | 1.5 N | 1.2 N | 0.5 N | 0.45 N | 500 (limit 850; stable to 1103)
+/// N/m | | "haply-gen2" | the original Haply 2DIY | 1.60 N | 1.45 N | 1.15 N | 0.5 N | 0.45 N | 500 (limit 850; stable
+/// to 1129) N/m |
 ///
 /// Force everywhere: the least force the handle gives in every direction at every point of its usable
 /// rectangle with its torque limit (pantograph.hpp `min_force_everywhere_n`; computed from the settings
@@ -37,15 +39,15 @@ namespace hk::config {
 
 /// One device profile. Values are the shipped ones; see the table in the file comment.
 struct DeviceProfile {
-  std::string_view type;               ///< the [device] type that picks it: "simulated", "haply", "haply-gen2"
-  std::string_view name;               ///< for people: "Haply 2DIY gen3"
-  double stable_stiffness_n_per_m;     ///< largest stiffness allowed at a 1000 Hz servo rate [N/m]
-  double max_force_n;                  ///< the force budget it brings: [haptics] max_force_n [N]
-  double pop_force_n;                  ///< [haptics] pop_force_n [N]
-  double tour_max_force_n;             ///< [haptics] tour_max_force_n [N]
-  double groove_depth_n;               ///< [haptics] groove_depth_n [N]
-  double level_max_force_step_n;       ///< [haptics] level_max_force_step_n [N per tick]
-  double stiffness_n_per_m;            ///< [haptics] stiffness_n_per_m [N/m]
+  std::string_view type;            ///< the [device] type that picks it: "simulated", "haply", "haply-gen2"
+  std::string_view name;            ///< for people: "Haply 2DIY gen3"
+  double stable_stiffness_n_per_m;  ///< largest stiffness allowed at a 1000 Hz servo rate [N/m]
+  double max_force_n;               ///< the force budget it brings: [haptics] max_force_n [N]
+  double pop_force_n;               ///< [haptics] pop_force_n [N]
+  double tour_max_force_n;          ///< [haptics] tour_max_force_n [N]
+  double groove_depth_n;            ///< [haptics] groove_depth_n [N]
+  double level_max_force_step_n;    ///< [haptics] level_max_force_step_n [N per tick]
+  double stiffness_n_per_m;         ///< [haptics] stiffness_n_per_m [N/m]
 };
 
 /// Every profile, simulated first.

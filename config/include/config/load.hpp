@@ -3,15 +3,14 @@
 /// Reading, checking and writing the kiosk settings (`settings.hpp`) as TOML.
 ///
 /// The file layout is one TOML table per settings struct ([haptics], [device], [hand], [vision],
-/// [workspace], [audio], [kiosk], [stick], [camera], [keys], [operator]) with one key per field, named exactly as the field. Every key is optional: a key
-/// that is absent keeps its default. Everything else is refused with a ConfigError whose message is
-/// one line naming the file, the key (as `table.key`), the bad value and what is allowed, e.g.
+/// [workspace], [audio], [kiosk], [stick], [camera], [keys], [operator]) with one key per field, named exactly as the
+/// field. Every key is optional: a key that is absent keeps its default. Everything else is refused with a ConfigError
+/// whose message is one line naming the file, the key (as `table.key`), the bad value and what is allowed, e.g.
 ///   config 'k.toml': haptics.stiffness_n_per_m = -5 is out of range [10, 5000] N/m (line 3)
 ///
 /// All field knowledge (table, key, range, unit, help) lives in one descriptor table,
 /// field_descriptors(), which load, validate and to_toml share.
 
-#include "hk/error.hpp"
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -19,6 +18,7 @@
 #include <string>
 #include <string_view>
 #include <variant>
+#include "hk/error.hpp"
 
 #include "config/settings.hpp"
 
@@ -70,27 +70,26 @@ enum class ApplyWhen {
 /// Mutable view of one field inside a Settings.
 using FieldRef = std::variant<double*, int*, std::int64_t*, std::string*>;
 /// Read-only view of one field inside a Settings.
-using ConstFieldRef =
-    std::variant<const double*, const int*, const std::int64_t*, const std::string*>;
+using ConstFieldRef = std::variant<const double*, const int*, const std::int64_t*, const std::string*>;
 
 /// Describes one settings field: where it lives in TOML, its allowed values and its unit.
 /// Bounds are inclusive; for integer fields they are whole numbers (exact in a double).
 struct FieldDescriptor {
-  std::string_view table;  ///< TOML table, e.g. "haptics"
-  std::string_view key;    ///< key in that table, e.g. "stiffness_n_per_m" (= the field name)
-  FieldKind kind;          ///< storage kind
-  double min;              ///< inclusive lower bound (real, integer); unused for text
-  double max;              ///< inclusive upper bound (real, integer); unused for text
-  std::string_view unit;   ///< unit shown to the operator, e.g. "N/m"; empty when dimensionless
-  std::string_view help;   ///< one-line description for the operator
+  std::string_view table;                     ///< TOML table, e.g. "haptics"
+  std::string_view key;                       ///< key in that table, e.g. "stiffness_n_per_m" (= the field name)
+  FieldKind kind;                             ///< storage kind
+  double min;                                 ///< inclusive lower bound (real, integer); unused for text
+  double max;                                 ///< inclusive upper bound (real, integer); unused for text
+  std::string_view unit;                      ///< unit shown to the operator, e.g. "N/m"; empty when dimensionless
+  std::string_view help;                      ///< one-line description for the operator
   std::span<const std::string_view> choices;  ///< allowed values of a text field (empty: `check` decides)
   /// For a text field without choices: why `value` is not allowed (one phrase, e.g. "is longer than 4096
   /// bytes"), or empty when it is. Null for every other field.
   std::string (*check)(std::string_view value);
-  FieldGroup group;                           ///< where the operator's panel shows it
-  ApplyWhen apply;                            ///< when a change in the running kiosk takes effect
-  FieldRef (*ref)(Settings&);                 ///< the field inside a Settings
-  ConstFieldRef (*cref)(const Settings&);     ///< the field inside a const Settings
+  FieldGroup group;                        ///< where the operator's panel shows it
+  ApplyWhen apply;                         ///< when a change in the running kiosk takes effect
+  FieldRef (*ref)(Settings&);              ///< the field inside a Settings
+  ConstFieldRef (*cref)(const Settings&);  ///< the field inside a const Settings
 };
 
 /// Every settings field, grouped by table in file order (haptics, device, hand, vision,

@@ -57,8 +57,8 @@ struct LockoutPolicy {
 /// What the state file holds: failed attempts since the last right one (or `pin set`), and when the
 /// last of them was.
 struct LockoutState {
-  int failures = 0;                       ///< failed attempts in a row, >= 0
-  std::int64_t last_failure_unix_s = 0;   ///< time of the last failure, s since the epoch; 0 = none
+  int failures = 0;                      ///< failed attempts in a row, >= 0
+  std::int64_t last_failure_unix_s = 0;  ///< time of the last failure, s since the epoch; 0 = none
   /// Field-by-field equality.
   bool operator==(const LockoutState&) const = default;
 };
@@ -104,7 +104,7 @@ enum class PinVerdict {
 struct PinAttempt {
   PinVerdict verdict = PinVerdict::no_pin;  ///< see PinVerdict
   int failures = 0;                         ///< failed attempts counted after this one
-  double wait_s = 0;                        ///< s until the next attempt is heard (kLockedUntilPinSet when locked for good)
+  double wait_s = 0;  ///< s until the next attempt is heard (kLockedUntilPinSet when locked for good)
 };
 
 /// The whole check, shared by the CLI and the panel:

@@ -82,8 +82,7 @@ void append_audit(const std::string& log_path, std::int64_t unix_s, std::string_
 /// "2026-11-22T03:04:05Z panel PIN refused, 2 failed attempts". Events used by the panel: "panel
 /// opened", "PIN refused, N failed attempts", "reset to defaults (not saved yet)", "saved".
 /// Same guarantees and errors as append_audit().
-void append_audit_event(const std::string& log_path, std::int64_t unix_s, std::string_view who,
-                        std::string_view event);
+void append_audit_event(const std::string& log_path, std::int64_t unix_s, std::string_view who, std::string_view event);
 
 /// The operator panel's edit of one field of `s`.
 /// @param text  as typed: for a text field the value itself (no quotes, nothing trimmed); for a real or

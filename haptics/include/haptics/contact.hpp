@@ -53,13 +53,16 @@ enum class ContactState : std::uint8_t { Free = 0, Edge = 1, Vertex = 2 };
 /// Haptic events of one tick, for sound and display (bit flags).
 enum HapticEvent : std::uint32_t {
   kEventNone = 0,
-  kEventContactBegin = 1u << 0,   ///< free → contact
-  kEventContactEnd = 1u << 1,     ///< contact → free
-  kEventVertexBegin = 1u << 2,    ///< entered vertex contact (concave corner)
-  kEventConvexCorner = 1u << 3,   ///< slid over a convex corner onto the next edge
-  kEventIterationLimit = 1u << 4, ///< the tick's move budget ran out before the proxy came to rest
-  kEventQueryBudget = 1u << 5,    ///< a collision query ran out of its box-test budget: the proxy stopped where the sweep was proven clear
-  kEventPopThrough = 1u << 6,     ///< the proxy passed through a wall on purpose this tick (pressed ≥ pop_force_n for pop_hold_s)
+  kEventContactBegin = 1u << 0,    ///< free → contact
+  kEventContactEnd = 1u << 1,      ///< contact → free
+  kEventVertexBegin = 1u << 2,     ///< entered vertex contact (concave corner)
+  kEventConvexCorner = 1u << 3,    ///< slid over a convex corner onto the next edge
+  kEventIterationLimit = 1u << 4,  ///< the tick's move budget ran out before the proxy came to rest
+  kEventQueryBudget =
+      1u
+      << 5,  ///< a collision query ran out of its box-test budget: the proxy stopped where the sweep was proven clear
+  kEventPopThrough =
+      1u << 6,  ///< the proxy passed through a wall on purpose this tick (pressed ≥ pop_force_n for pop_hold_s)
 };
 
 /// Solver parameters. Units in names.
@@ -67,8 +70,8 @@ struct ContactParams {
   double stiffness_n_per_m = 800.0;
   double damping_n_s_per_m = 0.0;
   double max_force_n = 4.0;
-  double skin_m = 1e-6;       ///< the proxy rests this far on its side of a wall, so rounding never puts it across
-  int max_iterations = 8;     ///< proxy moves per tick before giving up for this tick (it stays valid)
+  double skin_m = 1e-6;           ///< the proxy rests this far on its side of a wall, so rounding never puts it across
+  int max_iterations = 8;         ///< proxy moves per tick before giving up for this tick (it stays valid)
   double static_friction = 0.0;   ///< μ_s: the proxy sticks while |tangential offset| ≤ μ_s · penetration
   double dynamic_friction = 0.0;  ///< μ_d ≤ μ_s: a sliding proxy trails the handle by μ_d · penetration
   /// A sliding proxy sticks again only when the handle moves along the edge slower than this [m/s]
@@ -80,7 +83,8 @@ struct ContactParams {
   double pop_force_n = 0.0;
   double pop_hold_s = 0.3;      ///< how long the press must last [s]
   double pop_release_s = 0.02;  ///< the force of the tick before a pop fades to zero over this [s]
-  double period_s = 0.001;      ///< the servo period the solver is stepped at [s] (counts pop_hold_s and pop_release_s in ticks)
+  double period_s =
+      0.001;  ///< the servo period the solver is stepped at [s] (counts pop_hold_s and pop_release_s in ticks)
   /// Build the cut masks for walls at cut steps (BoundarySection's `cut_walls`; read at construction);
   /// without them a cut step renders as its tolerance step. SceneStep does not read it: it computes the masks
   /// once for LevelSteps::Cuts and hands them to both its solvers (the constructor that takes CutWalls).
@@ -89,9 +93,9 @@ struct ContactParams {
 
 /// Input of one solver step.
 struct ContactInput {
-  Vec2 handle_m;                     ///< handle position [m]
-  Vec2 handle_velocity_m_per_s;      ///< for rendered damping [m/s]
-  int level = 0;                     ///< level id whose polylines are walls (a level, a tolerance step or a cut step: hk/constants.hpp)
+  Vec2 handle_m;                 ///< handle position [m]
+  Vec2 handle_velocity_m_per_s;  ///< for rendered damping [m/s]
+  int level = 0;  ///< level id whose polylines are walls (a level, a tolerance step or a cut step: hk/constants.hpp)
   /// The tick's box-test budget (QueryBudget): its limit, and what was already spent this tick before the
   /// step (e.g. by level_change_is_safe). Every query of the step draws on it.
   QueryBudget budget;
@@ -102,22 +106,23 @@ struct ContactInput {
 
 /// Output of one solver step.
 struct ContactOutput {
-  Vec2 proxy_m;                      ///< proxy (god-object) position after the step [m]
-  Vec2 force_n;                      ///< force on the handle, clamped [N]
+  Vec2 proxy_m;  ///< proxy (god-object) position after the step [m]
+  Vec2 force_n;  ///< force on the handle, clamped [N]
   ContactState state = ContactState::Free;
-  SegmentRef constraint[2];          ///< active constraints (edge: [0]; vertex: [0] and [1])
-  std::int32_t level = -1;           ///< level of the polyline that constrained the proxy (its curve's level, −1 when free)
-  std::uint32_t events = kEventNone; ///< HapticEvent flags
+  SegmentRef constraint[2];  ///< active constraints (edge: [0]; vertex: [0] and [1])
+  std::int32_t level = -1;   ///< level of the polyline that constrained the proxy (its curve's level, −1 when free)
+  std::uint32_t events = kEventNone;  ///< HapticEvent flags
   /// Sharpest turn of the corners met this tick (convex corners passed, the corner of a vertex contact
   /// entered) [rad], 0 when none: the direction change of the polyline there, in [0, π]. Lets sound and
   /// display mark only the corners a hand would call corners, not every vertex of a smooth curve.
   double corner_turn_rad = 0.0;
-  bool sticking = false;             ///< edge contact held by static friction this tick
-  std::int32_t transition_level = -1; ///< ≥ 0: the previous level id, still a wall after a level change (see level_change_is_safe)
+  bool sticking = false;  ///< edge contact held by static friction this tick
+  std::int32_t transition_level =
+      -1;  ///< ≥ 0: the previous level id, still a wall after a level change (see level_change_is_safe)
   /// How long the hand has pressed with ≥ pop_force_n without a break, by the end of this tick [s]; 0 when
   /// push-through is off, the proxy is free or the press is lighter. The wall gives way once it reaches pop_hold_s.
   double press_s = 0.0;
-  QueryStats query;                  ///< summed over this step's queries
+  QueryStats query;  ///< summed over this step's queries
   std::int32_t queries = 0;
   /// Box tests charged to the tick's budget by the end of the step: ContactInput::budget.box_tests_used
   /// plus this step's (query.box_tests). At most budget.max_box_tests + query.section_box_tests.
@@ -161,18 +166,17 @@ class ContactSolver {
   /// is the larger at a sharp corner, where a coarse level's apex lies inside the original's. So only curves
   /// within 2E are searched, and every one of them, not only the nearest at each level: a second curve as
   /// near, where two edges cross, could have the proxy between its levels; and E takes the reach as well as the
-  /// half-width, since with the half-width alone a coarse apex could lie behind the proxy unseen. When the change is made (the next update() with the new level),
-  /// the old level stays a wall, with the proxy's constraints on it, until the proxy rests on none of its
-  /// segments: the proxy, on the same side of both polylines, then reaches the new one without crossing
-  /// either. No second change is made while the old level is still a wall. Allocates nothing (at most six
-  /// closest-point walks). With a `budget`, the walks' box tests are charged to it and never take it past
-  /// its limit: when it runs out before the answer is known, the answer is false (the change waits).
-  /// Levels, tolerance steps and cut steps mix freely (level ids, hk/constants.hpp): each curve is compared
-  /// at its own polyline for each id (a cut step's: its joined cut, where E takes twice the cut's error bound,
-  /// as a joined piece may lie anywhere in its box), and a curve with the same polyline under both has nothing
-  /// between them. At a cut step a segment's ends depend on its neighbours in the cut, so a constraint keeps
-  /// the level id it was met at (its geometry), and the wall the proxy slides on is left out only of the
-  /// queries where it has that same geometry.
+  /// half-width, since with the half-width alone a coarse apex could lie behind the proxy unseen. When the change is
+  /// made (the next update() with the new level), the old level stays a wall, with the proxy's constraints on it, until
+  /// the proxy rests on none of its segments: the proxy, on the same side of both polylines, then reaches the new one
+  /// without crossing either. No second change is made while the old level is still a wall. Allocates nothing (at most
+  /// six closest-point walks). With a `budget`, the walks' box tests are charged to it and never take it past its
+  /// limit: when it runs out before the answer is known, the answer is false (the change waits). Levels, tolerance
+  /// steps and cut steps mix freely (level ids, hk/constants.hpp): each curve is compared at its own polyline for each
+  /// id (a cut step's: its joined cut, where E takes twice the cut's error bound, as a joined piece may lie anywhere in
+  /// its box), and a curve with the same polyline under both has nothing between them. At a cut step a segment's ends
+  /// depend on its neighbours in the cut, so a constraint keeps the level id it was met at (its geometry), and the wall
+  /// the proxy slides on is left out only of the queries where it has that same geometry.
   bool level_change_is_safe(int new_level, QueryBudget* budget = nullptr) noexcept;
   /// The most curves level_change_is_safe compares sides on in one check (where more lie within its radius,
   /// as at a knot of many edges, the change waits).
@@ -188,14 +192,15 @@ class ContactSolver {
   struct Constraint {
     SegmentRef seg;
     double side = 1.0;  // +1: proxy on the segment's left, −1: right
-    int level = 0;      // the level id it is a wall of (a cut step's segments are drawn joined: their ends depend on it)
+    int level = 0;  // the level id it is a wall of (a cut step's segments are drawn joined: their ends depend on it)
   };
   enum class Move : std::uint8_t { Clear, Hit, Blocked };
   // Moves the proxy towards `target`, stopping a skin short of the first wall (Hit, wall in hit_out),
   // or short of the first box the query could not resolve in its budget (Blocked). The `excluded`
   // constraint (the wall the proxy slides on, or null) is left out of each query whose walls include it
   // with the same geometry (excluded_at).
-  Move move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget, ContactOutput& out, Constraint* hit_out) noexcept;
+  Move move_to(Vec2 target, int level, const Constraint* excluded, QueryBudget& budget, ContactOutput& out,
+               Constraint* hit_out) noexcept;
   // Whether constraint c is a wall of level id `level` with the same end points as its own (its own level;
   // at a cut step the same segment may be joined to other neighbours, so it is another wall there).
   bool excluded_at(const Constraint& c, int level) const noexcept;
@@ -239,7 +244,7 @@ class ContactSolver {
   ContactState state_ = ContactState::Free;
   Constraint c_[2];
   int level_ = 0;
-  bool sticking_ = false;   // edge contact inside the static friction cone
+  bool sticking_ = false;      // edge contact inside the static friction cone
   int transition_level_ = -1;  // the previous level, still a wall just after a change; −1 = none
   long press_ticks_ = 0;       // consecutive ticks in contact pressed with ≥ pop_force_n
   Vec2 release_from_n_;        // the force of the tick before the last pop [N]

@@ -8,10 +8,10 @@
 /// must not allocate, lock, throw or block. `open` and `close` are called outside the servo loop and may
 /// throw `DeviceError`.
 
-#include "hk/error.hpp"
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include "hk/error.hpp"
 
 #include "haptics/vec2.hpp"
 
@@ -27,8 +27,8 @@ enum class DeviceStatus : std::uint8_t {
 
 /// One sample from the device: the handle position in the workspace frame [m] and when it was taken.
 struct DeviceSample {
-  Vec2 handle_m;              ///< handle position, workspace frame [m]
-  std::int64_t time_ns = 0;   ///< device time of the sample [ns]
+  Vec2 handle_m;             ///< handle position, workspace frame [m]
+  std::int64_t time_ns = 0;  ///< device time of the sample [ns]
   DeviceStatus status = DeviceStatus::Closed;
 };
 

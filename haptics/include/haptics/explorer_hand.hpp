@@ -48,10 +48,11 @@ namespace hk {
 /// Parameters of the explorer hand. Units in names; the defaults are the kiosk's (config [hand],
 /// [haptics], [workspace]).
 struct ExplorerParams {
-  double workspace_width_m = 0.14;      ///< usable rectangle, centred on the origin [m], > 0
-  double workspace_height_m = 0.09;     ///< [m], > 0
-  double sweep_spacing_m = 0.006;       ///< distance between sweep lines [m], > 0 and ≤ the smaller side
-  double sweep_speed_m_per_s = 0.12;    ///< carrot speed along the sweep [m/s], > 0 (the kiosk's: 1.5 x [hand] raster_speed_m_per_s)
+  double workspace_width_m = 0.14;   ///< usable rectangle, centred on the origin [m], > 0
+  double workspace_height_m = 0.09;  ///< [m], > 0
+  double sweep_spacing_m = 0.006;    ///< distance between sweep lines [m], > 0 and ≤ the smaller side
+  double sweep_speed_m_per_s =
+      0.12;  ///< carrot speed along the sweep [m/s], > 0 (the kiosk's: 1.5 x [hand] raster_speed_m_per_s)
   double trace_speed_m_per_s = 0.045;   ///< speed along an outline [m/s], > 0
   double contact_force_n = 0.5;         ///< a felt force above this is a wall (or a groove) [N], > 0
   double press_force_n = 1.0;           ///< how hard a trace presses against the wall [N], > 0, < pop_force_n
@@ -70,7 +71,8 @@ struct ExplorerParams {
   double lost_s = 0.4;                  ///< a trace that feels no wall this long ends [s], > 0
   double stall_s = 1.0;                 ///< a trace or move making less than 1 mm of progress in this ends [s], > 0
   double retrace_max_m = 0.02;          ///< a trace running this far over walls traced before ends [m], > 0
-  double pop_travel_max_m = 0.008;      ///< a push that carried the handle this far without the wall giving way failed [m], > 0
+  double pop_travel_max_m =
+      0.008;  ///< a push that carried the handle this far without the wall giving way failed [m], > 0
 
   /// Throws hk::ArgumentError (one line naming the field and its limit) when a value is out of range.
   void validate() const;
@@ -81,20 +83,20 @@ enum class ExplorerPhase : std::uint8_t { Move, Trace, Pop };
 
 /// Counters of an explorer run, for tests and summaries.
 struct ExplorerStats {
-  long traces = 0;          ///< traces begun
-  long traces_closed = 0;   ///< traces that came round to their start
-  long traces_lost = 0;     ///< traces ended because no wall was felt for lost_s
-  long traces_stalled = 0;  ///< traces ended for lack of progress (stall_s)
-  long traces_timed_out = 0;///< traces ended after trace_max_s
-  long traces_retraced = 0; ///< traces ended running over walls traced before (retrace_max_m)
-  long pops = 0;            ///< push-throughs tried
-  long pops_through = 0;    ///< push-throughs in which the wall gave way
-  long passes = 0;          ///< coverage passes begun (each ends when every reachable cell is seen)
-  long plans = 0;           ///< plans made (Dijkstra runs that found an unseen cell)
-  double traced_m = 0.0;    ///< handle travel while tracing [m]
-  double move_s = 0.0;      ///< time spent sweeping (Move) [s]
-  double trace_s = 0.0;     ///< time spent tracing, bypasses included (Trace) [s]
-  double pop_s = 0.0;       ///< time spent pushing through (Pop) [s]
+  long traces = 0;            ///< traces begun
+  long traces_closed = 0;     ///< traces that came round to their start
+  long traces_lost = 0;       ///< traces ended because no wall was felt for lost_s
+  long traces_stalled = 0;    ///< traces ended for lack of progress (stall_s)
+  long traces_timed_out = 0;  ///< traces ended after trace_max_s
+  long traces_retraced = 0;   ///< traces ended running over walls traced before (retrace_max_m)
+  long pops = 0;              ///< push-throughs tried
+  long pops_through = 0;      ///< push-throughs in which the wall gave way
+  long passes = 0;            ///< coverage passes begun (each ends when every reachable cell is seen)
+  long plans = 0;             ///< plans made (Dijkstra runs that found an unseen cell)
+  double traced_m = 0.0;      ///< handle travel while tracing [m]
+  double move_s = 0.0;        ///< time spent sweeping (Move) [s]
+  double trace_s = 0.0;       ///< time spent tracing, bypasses included (Trace) [s]
+  double pop_s = 0.0;         ///< time spent pushing through (Pop) [s]
 };
 
 /// The visitor-like model hand (`--hand explorer`). Not thread-safe; one per run.
@@ -162,8 +164,8 @@ class ExplorerHand final : public HandController {
 
   ExplorerParams p_;
   std::mt19937_64 rng_;
-  int corner_ = 0;        // 0 top-left, 1 top-right, 2 bottom-right, 3 bottom-left
-  int orient0_ = 0;       // first pass: 0 horizontal lines, 1 vertical
+  int corner_ = 0;   // 0 top-left, 1 top-right, 2 bottom-right, 3 bottom-left
+  int orient0_ = 0;  // first pass: 0 horizontal lines, 1 vertical
   int sense_ = 1;
   Vec2 start_;
   ExplorerPhase phase_ = ExplorerPhase::Move;
@@ -173,18 +175,18 @@ class ExplorerHand final : public HandController {
   Vec2 last_handle_;
 
   // Move.
-  int orient_ = 0;                // this pass: 0 horizontal lines, 1 vertical
-  int half_strip_ = 2;            // the footprint reaches this many cells either side of the handle, across the lines
-  int run_dir_ = 1;               // the way the last run along a line went (+1 / −1 along the axis)
-  std::vector<Vec2> waypoints_;   // the plan: cell centres to the goal (the last) [m]
-  std::size_t wi_ = 0;            // the waypoint the carrot runs to
+  int orient_ = 0;               // this pass: 0 horizontal lines, 1 vertical
+  int half_strip_ = 2;           // the footprint reaches this many cells either side of the handle, across the lines
+  int run_dir_ = 1;              // the way the last run along a line went (+1 / −1 along the axis)
+  std::vector<Vec2> waypoints_;  // the plan: cell centres to the goal (the last) [m]
+  std::size_t wi_ = 0;           // the waypoint the carrot runs to
   Vec2 carrot_;
   double move_check_t_ = 0.0;
   double move_check_dist_ = 0.0;
-  double ignore_until_t_ = 0.0;   // after a push-through, the release is not a new wall
-  bool patched_ = false;          // this plan met a wall the memory had missed, and the memory was patched
-  double idle_until_t_ = 0.0;     // nothing reachable was left: plan again after this
-  std::vector<double> cost_;      // Dijkstra scratch, per cell [m]
+  double ignore_until_t_ = 0.0;  // after a push-through, the release is not a new wall
+  bool patched_ = false;         // this plan met a wall the memory had missed, and the memory was patched
+  double idle_until_t_ = 0.0;    // nothing reachable was left: plan again after this
+  std::vector<double> cost_;     // Dijkstra scratch, per cell [m]
   std::vector<int> prev_;
 
   // Trace.
@@ -195,11 +197,11 @@ class ExplorerHand final : public HandController {
   double retraced_ = 0.0;
   bool start_settled_ = false;
   double travelled_at_start_ = 0.0;
-  Vec2 start_heading_;      // t̂ where the trace settled
-  Vec2 n_;                  // felt force direction (unit)
+  Vec2 start_heading_;  // t̂ where the trace settled
+  Vec2 n_;              // felt force direction (unit)
   double lost_since_ = -1.0;
   double lookahead_m_ = 0.001;
-  Vec2 heading_;            // grooves: direction of travel
+  Vec2 heading_;  // grooves: direction of travel
   double stall_t_ = 0.0;
   Vec2 stall_pos_;
 
@@ -213,8 +215,8 @@ class ExplorerHand final : public HandController {
   std::vector<int> traced_;
   std::vector<double> traced_at_m_;  // the trace's travel when the cell was first marked by it [m]
   std::vector<std::uint8_t> seen_;
-  std::vector<std::uint8_t> skip_;   // inside a small loop felt round: never planned to
-  std::vector<Vec2> trace_path_;     // the handle's path along the current trace, every half cell [m]
+  std::vector<std::uint8_t> skip_;  // inside a small loop felt round: never planned to
+  std::vector<Vec2> trace_path_;    // the handle's path along the current trace, every half cell [m]
 };
 
 }  // namespace hk

@@ -44,12 +44,13 @@ namespace hk {
 /// Parameters of the groove field. Units in names. Values are assumed checked (config ranges): finite,
 /// capture_radius_m > 0, the rest ≥ 0.
 struct GrooveParams {
-  double capture_radius_m = 0.003;     ///< R: the pull acts within this distance of the curve [m]
-  double depth_n = 1.0;                ///< the strongest pull (the trapezoid's flat top), at most k·R/2 is reached [N]
-  double stiffness_n_per_m = 800;      ///< k: slope of the profile at the centre and at the rim [N/m]
-  double max_force_n = 4;              ///< clamp on the groove force [N]
-  double jump_step_n = 0.05;           ///< force change per tick allowed beyond k·|Δhandle| where the closest point jumps [N]
-  bool cut_walls = true;               ///< build the cut masks (grooves along cut steps; read by the constructor without CutWalls); see ContactParams::cut_walls
+  double capture_radius_m = 0.003;  ///< R: the pull acts within this distance of the curve [m]
+  double depth_n = 1.0;             ///< the strongest pull (the trapezoid's flat top), at most k·R/2 is reached [N]
+  double stiffness_n_per_m = 800;   ///< k: slope of the profile at the centre and at the rim [N/m]
+  double max_force_n = 4;           ///< clamp on the groove force [N]
+  double jump_step_n = 0.05;  ///< force change per tick allowed beyond k·|Δhandle| where the closest point jumps [N]
+  bool cut_walls = true;  ///< build the cut masks (grooves along cut steps; read by the constructor without CutWalls);
+                          ///< see ContactParams::cut_walls
 };
 
 /// The groove profile: F(r) = min(k·r, depth_n, k·(R − r)) for 0 ≤ r < R, 0 for r ≥ R (and for r < 0 or
@@ -110,12 +111,12 @@ class GrooveSolver {
   const Scene* scene_;
   GrooveParams params_;
   BoundarySection section_;
-  Vec2 proxy_;                       // closest point (Edge) or handle (Free) [m]
+  Vec2 proxy_;  // closest point (Edge) or handle (Free) [m]
   ContactState state_ = ContactState::Free;
-  SegmentRef seg_;                   // segment holding proxy_ while Edge
+  SegmentRef seg_;  // segment holding proxy_ while Edge
   int level_ = 0;
-  Vec2 last_force_;                  // groove force of the last tick [N]
-  Vec2 last_handle_;                 // handle at the last tick [m]
+  Vec2 last_force_;   // groove force of the last tick [N]
+  Vec2 last_handle_;  // handle at the last tick [m]
 };
 
 }  // namespace hk

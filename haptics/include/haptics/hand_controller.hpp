@@ -16,18 +16,18 @@ namespace hk {
 
 /// What the model hand feels at one tick (all in the workspace frame).
 struct HandFeel {
-  double t_s = 0.0;                  ///< time since the run started [s]
-  Vec2 handle_m;                     ///< where the handle is [m] (the device's true position)
-  Vec2 handle_velocity_m_per_s;      ///< its velocity [m/s]
-  Vec2 device_force_n;               ///< the force the device put on the handle at the last tick [N] (what a fingertip feels)
-  bool heard_pop = false;            ///< the push-through earcon sounded at the last tick (what an ear hears); false where no
-                                     ///< servo output reaches the hand (the emulated device's thread)
+  double t_s = 0.0;              ///< time since the run started [s]
+  Vec2 handle_m;                 ///< where the handle is [m] (the device's true position)
+  Vec2 handle_velocity_m_per_s;  ///< its velocity [m/s]
+  Vec2 device_force_n;     ///< the force the device put on the handle at the last tick [N] (what a fingertip feels)
+  bool heard_pop = false;  ///< the push-through earcon sounded at the last tick (what an ear hears); false where no
+                           ///< servo output reaches the hand (the emulated device's thread)
 };
 
 /// What the model hand does at one tick.
 struct HandCommand {
-  Vec2 target_m;            ///< where the hand pulls the handle to [m] (a spring-damper, model_hand_force)
-  double max_force_n = 2.0; ///< the most the hand pushes with this tick [N], > 0
+  Vec2 target_m;             ///< where the hand pulls the handle to [m] (a spring-damper, model_hand_force)
+  double max_force_n = 2.0;  ///< the most the hand pushes with this tick [N], > 0
 };
 
 /// A model hand that reacts to what it feels. Deterministic: the same feels give the same commands.

@@ -4,11 +4,11 @@
 /// frame, linearly interpolated. Built in code (`raster_path`) or read from a hand file
 /// (`load_hand_csv`, header `t_s,x_m,y_m`).
 
-#include "hk/error.hpp"
 #include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "hk/error.hpp"
 
 #include "haptics/vec2.hpp"
 

@@ -45,30 +45,31 @@ namespace hk::hapi {
 /// Faults the emulator can inject into its replies. Reply numbers count the replies the firmware
 /// produces (1-based), whether or not a fault then hides them.
 struct EmulatorFaults {
-  double disconnect_at_s = -1;   ///< from this emulated time on [s], no reply ever again, input ignored (< 0: never)
-  int drop_every = 0;            ///< every Nth reply is not sent (0: never)
-  int garbage_every = 0;         ///< before every Nth reply, 1..8 pseudo-random bytes are sent (0: never)
-  int wrong_id_every = 0;        ///< every Nth reply carries id + 1 (0: never)
-  double stall_at_s = -1;        ///< replies of commands ending in [stall_at_s, stall_at_s + stall_s) are withheld (< 0: never)
-  double stall_s = 0.1;          ///< length of the stall [s]; the withheld replies go out with the first reply after it
-  std::uint64_t seed = 1;        ///< seed of the garbage bytes (deterministic)
+  double disconnect_at_s = -1;  ///< from this emulated time on [s], no reply ever again, input ignored (< 0: never)
+  int drop_every = 0;           ///< every Nth reply is not sent (0: never)
+  int garbage_every = 0;        ///< before every Nth reply, 1..8 pseudo-random bytes are sent (0: never)
+  int wrong_id_every = 0;       ///< every Nth reply carries id + 1 (0: never)
+  double stall_at_s =
+      -1;                ///< replies of commands ending in [stall_at_s, stall_at_s + stall_s) are withheld (< 0: never)
+  double stall_s = 0.1;  ///< length of the stall [s]; the withheld replies go out with the first reply after it
+  std::uint64_t seed = 1;  ///< seed of the garbage bytes (deterministic)
 };
 
 /// The emulated board, its wiring and the mechanism behind it. Defaults: a Haply 2DIY gen3.
 struct EmulatorParams {
-  HaplyMechanism mechanism;                   ///< link lengths [m]
-  double handle_mass_kg = 0.08;               ///< effective handle mass [kg], > 0
-  double handle_damping_n_s_per_m = 2.0;      ///< viscous damping [N·s/m], ≥ 0
-  double torque_limit_n_m = 0.123;            ///< firmware MAX_TORQUE [N·m], > 0
-  double period_s = 0.001;                    ///< physics time per torque command [s], > 0
+  HaplyMechanism mechanism;               ///< link lengths [m]
+  double handle_mass_kg = 0.08;           ///< effective handle mass [kg], > 0
+  double handle_damping_n_s_per_m = 2.0;  ///< viscous damping [N·s/m], ≥ 0
+  double torque_limit_n_m = 0.123;        ///< firmware MAX_TORQUE [N·m], > 0
+  double period_s = 0.001;                ///< physics time per torque command [s], > 0
   /// True wiring per PORT (element 0 = port 1): a host direction byte equal to it gives sign +1, else −1.
   Rotation wired_motor_dir[2] = {Rotation::CW, Rotation::CW};
   Rotation wired_encoder_dir[2] = {Rotation::CCW, Rotation::CCW};
-  int port_joint[2] = {2, 1};                 ///< Haply joint (1 = θ_h1, 2 = θ_h2) wired to port 1, port 2
+  int port_joint[2] = {2, 1};  ///< Haply joint (1 = θ_h1, 2 = θ_h2) wired to port 1, port 2
   /// Haply angles of joint 1, 2 [deg] at the pose where the counters were zeroed:
   /// reported = offset_sent + sign·(θ_true − reference) + calibration_error (then quantised).
   double reference_deg[2] = {180, 0};
-  double calibration_error_deg[2] = {0, 0};   ///< per Haply joint [deg]
+  double calibration_error_deg[2] = {0, 0};  ///< per Haply joint [deg]
   /// Usable rectangle of the device frame [m] (largest 14:9 rectangle with good conditioning, see
   /// hapi_emulator.cpp): 0.112 m × 0.072 m centred at (0, −0.088) m; stops 5 mm outside it.
   Vec2 workspace_half_extent_m{0.056, 0.036};
@@ -132,13 +133,13 @@ class FirmwareEmulator {
 
  private:
   struct PortState {
-    std::uint8_t motor_host = 0;    ///< hostAddress of the actuator on this port (0: unassigned)
-    std::uint8_t motor_dir = 0;     ///< direction byte stored for actuators[port]
+    std::uint8_t motor_host = 0;  ///< hostAddress of the actuator on this port (0: unassigned)
+    std::uint8_t motor_dir = 0;   ///< direction byte stored for actuators[port]
     std::uint8_t encoder_host = 0;
     std::uint8_t encoder_dir = 0;
     float enc_resolution_half = 1;  ///< EncResolution = resolution / 2
     std::int32_t count_at_setup = 0;
-    int encoder_sign = 1;           ///< counting direction fixed at setup (pins swapped or not)
+    int encoder_sign = 1;  ///< counting direction fixed at setup (pins swapped or not)
   };
 
   /// Tries to execute one command at the front of in_; returns the bytes consumed, 0 when incomplete.

@@ -32,27 +32,27 @@ enum class Rotation : std::uint8_t { CW = 0, CCW = 1 };
 
 /// One actuator as the host declares it (Haply `add_actuator(index, direction, port)`).
 struct ActuatorSpec {
-  int index = 1;                       ///< host index, 1..4
-  Rotation direction = Rotation::CW;   ///< direction byte sent at setup
-  int port = 1;                        ///< board port, 1..4
+  int index = 1;                      ///< host index, 1..4
+  Rotation direction = Rotation::CW;  ///< direction byte sent at setup
+  int port = 1;                       ///< board port, 1..4
 };
 
 /// One encoder as the host declares it (Haply `add_encoder(index, direction, offset, resolution, port)`).
 struct EncoderSpec {
-  int index = 1;                        ///< host index, 1..4
-  Rotation direction = Rotation::CCW;   ///< direction byte sent at setup
-  double offset_deg = 0;                ///< angle the firmware loads into the counter at setup [deg]
-  double resolution = 4880;             ///< counts per revolution as the host states it (> 0, finite)
-  int port = 1;                         ///< board port, 1..4
+  int index = 1;                       ///< host index, 1..4
+  Rotation direction = Rotation::CCW;  ///< direction byte sent at setup
+  double offset_deg = 0;               ///< angle the firmware loads into the counter at setup [deg]
+  double resolution = 4880;            ///< counts per revolution as the host states it (> 0, finite)
+  int port = 1;                        ///< board port, 1..4
 };
 
 /// The whole device declaration sent at setup.
 struct BoardLayout {
-  std::uint8_t device_id = 5;   ///< 1..255 (0 is the firmware's "unassigned" value, see validate)
-  int actuator_count = 2;       ///< 0..4
-  ActuatorSpec actuators[4];    ///< actuators[0..actuator_count) in any order
-  int encoder_count = 2;        ///< 0..4
-  EncoderSpec encoders[4];      ///< encoders[0..encoder_count) in any order
+  std::uint8_t device_id = 5;  ///< 1..255 (0 is the firmware's "unassigned" value, see validate)
+  int actuator_count = 2;      ///< 0..4
+  ActuatorSpec actuators[4];   ///< actuators[0..actuator_count) in any order
+  int encoder_count = 2;       ///< 0..4
+  EncoderSpec encoders[4];     ///< encoders[0..encoder_count) in any order
   /// The Haply 2DIY gen3 declaration of Haply's own examples (hardwareVersion 3 in Haply-API-Java
   /// examples): device id 5; actuator 1 CW port 2, actuator 2 CW port 1; encoder 1 CCW offset 180°
   /// resolution 4880 port 2, encoder 2 CCW offset 0° resolution 4880 port 1 (ports cross-wired).
@@ -83,8 +83,8 @@ int torque_packet_length(const BoardLayout& layout) noexcept;
 /// a non-finite torque is sent as 0; each is clamped to ±limit_n_m (a non-finite or negative limit
 /// counts as 0). Floats go out in port order. Returns the length, or −1 (nothing written) when
 /// capacity is too small.
-int encode_torques(const BoardLayout& layout, const double torque_by_index[4], double limit_n_m,
-                   std::uint8_t* out, int capacity) noexcept;
+int encode_torques(const BoardLayout& layout, const double torque_by_index[4], double limit_n_m, std::uint8_t* out,
+                   int capacity) noexcept;
 
 /// Length of the reply to a torque command for `layout` [bytes]: 1 + 4·encoder_count (no sensors).
 int reply_length(const BoardLayout& layout) noexcept;

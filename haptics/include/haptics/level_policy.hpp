@@ -27,12 +27,12 @@ namespace hk {
 
 /// Policy parameters. Units in names.
 struct LevelPolicyParams {
-  double error_at_rest_m = 1e-4;     ///< e_rest: tolerable deviation at rest [m]
-  double blur_time_s = 0.010;        ///< t_blur: tolerable deviation grows by speed × this [s]
-  double speed_cutoff_hz = 2.0;      ///< low-pass on the hand speed [Hz]: slower than tremor (8–12 Hz)
-  double hysteresis = 0.3;           ///< go coarser only when that level's bound ≤ (1 − hysteresis) · e(v)
-  double min_dwell_s = 0.15;         ///< at least this long between two changes [s]
-  int fixed_level = -1;              ///< ≥ 0: the operator fixed the level; the policy always returns it
+  double error_at_rest_m = 1e-4;  ///< e_rest: tolerable deviation at rest [m]
+  double blur_time_s = 0.010;     ///< t_blur: tolerable deviation grows by speed × this [s]
+  double speed_cutoff_hz = 2.0;   ///< low-pass on the hand speed [Hz]: slower than tremor (8–12 Hz)
+  double hysteresis = 0.3;        ///< go coarser only when that level's bound ≤ (1 − hysteresis) · e(v)
+  double min_dwell_s = 0.15;      ///< at least this long between two changes [s]
+  int fixed_level = -1;           ///< ≥ 0: the operator fixed the level; the policy always returns it
 };
 
 /// Picks the level each tick. Level 0 is the finest.
@@ -63,8 +63,8 @@ class LevelPolicy {
   std::array<double, kMaxLevels> error_{};
   int levels_ = 1;
   int level_ = 0;
-  double speed_ = 0.0;            ///< filtered speed [m/s]
-  double since_change_s_ = 1e9;   ///< time since the last change [s]
+  double speed_ = 0.0;           ///< filtered speed [m/s]
+  double since_change_s_ = 1e9;  ///< time since the last change [s]
   std::int64_t changes_ = 0;
 };
 

@@ -11,10 +11,10 @@
 /// coefficients outside the curve as zero and leaves the two end samples alone, so an open curve keeps
 /// its end points at every level.
 
-#include "hk/error.hpp"
 #include <cstddef>
 #include <stdexcept>
 #include <vector>
+#include "hk/error.hpp"
 
 #include "haptics/vec2.hpp"
 
@@ -70,22 +70,23 @@ inline double level0_arc_m(double total_m, std::size_t count, bool closed, std::
 }
 
 /// One forward lifting step on one coordinate. `x` has n samples: closed n even (≥ 8), open n odd (≥ 7):
-/// four even samples for the cubic predictor. Throws CurveError for any other n. Writes s (scaling coefficients, n/2 closed,
-/// (n+1)/2 open) and d (wavelet coefficients, n/2 closed, (n−1)/2 open). Source: DESIGN.md "Wavelets".
+/// four even samples for the cubic predictor. Throws CurveError for any other n. Writes s (scaling coefficients, n/2
+/// closed, (n+1)/2 open) and d (wavelet coefficients, n/2 closed, (n−1)/2 open). Source: DESIGN.md "Wavelets".
 void pseudocoiflet_forward(const std::vector<double>& x, bool closed, std::vector<double>& s, std::vector<double>& d);
 
 /// Exact inverse of pseudocoiflet_forward: rebuilds x from s and d (sizes as above).
-void pseudocoiflet_inverse(const std::vector<double>& s, const std::vector<double>& d, bool closed, std::vector<double>& x);
+void pseudocoiflet_inverse(const std::vector<double>& s, const std::vector<double>& d, bool closed,
+                           std::vector<double>& x);
 
 /// The multiresolution model of one curve: scaling coefficients of every level and the wavelet
 /// coefficients between them. Level 0 is the arc-length resampled curve; level l has
 /// K·2^(L−l) points (closed) or K·2^(L−l)+1 points (open), L = finest_to_coarsest_levels.
 struct CurveMultires {
   bool closed = false;
-  int levels = 0;                                ///< number of levels, L + 1 (level 0 .. L)
-  std::vector<std::vector<Vec2>> scaling;        ///< scaling[l]: scaling coefficients = level-l polyline [m]
-  std::vector<std::vector<Vec2>> wavelet;        ///< wavelet[l] (l ≥ 1): coefficients lost going l−1 → l [m]
-  std::vector<double> arc_m;                     ///< arc length along the original of each level-0 point [m]
+  int levels = 0;                          ///< number of levels, L + 1 (level 0 .. L)
+  std::vector<std::vector<Vec2>> scaling;  ///< scaling[l]: scaling coefficients = level-l polyline [m]
+  std::vector<std::vector<Vec2>> wavelet;  ///< wavelet[l] (l ≥ 1): coefficients lost going l−1 → l [m]
+  std::vector<double> arc_m;               ///< arc length along the original of each level-0 point [m]
 
   /// Number of segments of level l's polyline (closed: points; open: points − 1).
   std::size_t segment_count(int level) const {
@@ -97,7 +98,11 @@ struct CurveMultires {
 /// Chooses the level-0 sample count for a curve of `point_count` input points: K·2^L (closed) or
 /// K·2^L + 1 (open), at least the input count, with L ≤ max_levels and the coarsest level still at
 /// least 4 segments (closed) or 3 segments (open). Returns {K, L}.
-struct LevelPlan { std::size_t k = 0; int levels_above_0 = 0; std::size_t level0_points = 0; };
+struct LevelPlan {
+  std::size_t k = 0;
+  int levels_above_0 = 0;
+  std::size_t level0_points = 0;
+};
 LevelPlan plan_levels(std::size_t point_count, bool closed, int max_levels);
 
 /// Points of level `level` of a curve with level0_points points at level 0 (plan_levels' counts):
@@ -113,7 +118,8 @@ inline std::size_t forward_scratch_size(std::size_t level0_points) { return leve
 /// (level0_points / 2^l of them), or only into `scratch` when wavelet[l] is null, for l = 1 .. levels − 1.
 /// `scratch` holds forward_scratch_size(level0_points) points. Bit for bit build_multires' levels.
 /// Allocates nothing; throws CurveError for a level size the lifting step does not take.
-void forward_levels(Vec2* const* scaling, Vec2* const* wavelet, std::size_t level0_points, bool closed, int levels, Vec2* scratch);
+void forward_levels(Vec2* const* scaling, Vec2* const* wavelet, std::size_t level0_points, bool closed, int levels,
+                    Vec2* scratch);
 
 /// Builds the multiresolution of a curve: resample to plan_levels' count, then apply the forward
 /// transform L times. Throws CurveError for a curve too short to resample (< 2 points or zero length).

@@ -124,6 +124,7 @@ Vec2 handle_force(const Mat2& J, Torques tau) noexcept;
 /// 72 directions u, the largest f with |(Jᵀ·f·u)_i| ≤ `torque_limit_n_m` for both motors; the minimum over
 /// all. Above it a wall saturates somewhere: a force clamp beyond it cannot be felt everywhere.
 /// 0 when some grid point is out of reach or an input is not finite or not positive.
-double min_force_everywhere_n(const PantographGeometry& g, Vec2 rect_center_m, Vec2 rect_size_m, double torque_limit_n_m) noexcept;
+double min_force_everywhere_n(const PantographGeometry& g, Vec2 rect_center_m, Vec2 rect_size_m,
+                              double torque_limit_n_m) noexcept;
 
 }  // namespace hk

@@ -42,11 +42,11 @@ namespace hk {
 /// stores it compactly (BoxExtent) and Scene::box() rebuilds it.
 /// Points q inside satisfy u_min ≤ dot(q − origin, axis) ≤ u_max and n_min ≤ cross(axis, q − origin) ≤ n_max.
 struct ErrorBox {
-  Vec2 origin_m;        ///< frame origin: the segment's first point [m]
-  Vec2 axis;            ///< unit vector along the segment (x axis for a zero-length segment)
-  double u_min = 0.0;   ///< extent along axis [m]
+  Vec2 origin_m;       ///< frame origin: the segment's first point [m]
+  Vec2 axis;           ///< unit vector along the segment (x axis for a zero-length segment)
+  double u_min = 0.0;  ///< extent along axis [m]
   double u_max = 0.0;
-  double n_min = 0.0;   ///< extent along the left normal [m]
+  double n_min = 0.0;  ///< extent along the left normal [m]
   double n_max = 0.0;
 };
 static_assert(sizeof(ErrorBox) == 64, "ErrorBox: one cache line per box");
@@ -59,16 +59,20 @@ static_assert(sizeof(Aabb) == 32, "Aabb: two per cache line");
 
 /// An axis-aligned rectangle as an ErrorBox [m]: origin (0, 0), axis (1, 0), its extents the rectangle's (how a
 /// chunk's, a hierarchy node's or a wide index node's box is tested like a segment's).
-inline ErrorBox rect_box(const Aabb& r) { return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo.x, r.hi.x, r.lo.y, r.hi.y}; }
+inline ErrorBox rect_box(const Aabb& r) {
+  return ErrorBox{Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, r.lo.x, r.hi.x, r.lo.y, r.hi.y};
+}
 
 /// The rectangle of two points [m] (a segment's, or a sweep's from a to b), grown by grow_m ≥ 0 on every side.
 inline Aabb rect_of(Vec2 a, Vec2 b, double grow_m = 0.0) {
-  return Aabb{{std::min(a.x, b.x) - grow_m, std::min(a.y, b.y) - grow_m}, {std::max(a.x, b.x) + grow_m, std::max(a.y, b.y) + grow_m}};
+  return Aabb{{std::min(a.x, b.x) - grow_m, std::min(a.y, b.y) - grow_m},
+              {std::max(a.x, b.x) + grow_m, std::max(a.y, b.y) + grow_m}};
 }
 
 /// True when two rectangles overlap after growing `a` by margin_m on every side.
 inline bool overlaps(const Aabb& a, const Aabb& b, double margin_m) {
-  return a.lo.x - margin_m <= b.hi.x && b.lo.x <= a.hi.x + margin_m && a.lo.y - margin_m <= b.hi.y && b.lo.y <= a.hi.y + margin_m;
+  return a.lo.x - margin_m <= b.hi.x && b.lo.x <= a.hi.x + margin_m && a.lo.y - margin_m <= b.hi.y &&
+         b.lo.y <= a.hi.y + margin_m;
 }
 
 /// True when p lies in the box, grown by `margin_m` on every side.
@@ -87,14 +91,18 @@ double box_error_bound(const ErrorBox& box, double segment_length_m);
 struct CurveInfo {
   bool closed = false;
   int levels = 0;
-  double length_m = 0.0;                         ///< arc length of the original curve (closed: the whole loop) [m]
-  std::uint32_t point_offset[kMaxLevels] = {};   ///< index of level l's first point in the scene's point array (= box_offset[l])
-  std::uint32_t point_count[kMaxLevels] = {};    ///< distinct points of level l (a closed curve's repeated first point not counted)
+  double length_m = 0.0;  ///< arc length of the original curve (closed: the whole loop) [m]
+  std::uint32_t point_offset[kMaxLevels] =
+      {};  ///< index of level l's first point in the scene's point array (= box_offset[l])
+  std::uint32_t point_count[kMaxLevels] =
+      {};  ///< distinct points of level l (a closed curve's repeated first point not counted)
   std::uint32_t box_offset[kMaxLevels] = {};     ///< node id of level l's first segment
   std::uint32_t segment_count[kMaxLevels] = {};  ///< segments of level l (closed: points; open: points − 1)
-  double max_error_m[kMaxLevels] = {};           ///< largest distance of an original point from the level-l segment standing for it [m]
+  double max_error_m[kMaxLevels] =
+      {};  ///< largest distance of an original point from the level-l segment standing for it [m]
   double max_box_half_width_m[kMaxLevels] = {};  ///< largest error box half-width at level l [m]
-  double max_error_bound_m[kMaxLevels] = {};     ///< largest box_error_bound of level l (to a few ulps): bounds max_error_m[l] [m]
+  double max_error_bound_m[kMaxLevels] =
+      {};  ///< largest box_error_bound of level l (to a few ulps): bounds max_error_m[l] [m]
 };
 
 /// What the tree walks need of a curve: its levels' first node ids, the quantum of their box extents,
@@ -129,14 +137,16 @@ struct SegmentRef {
   std::int32_t segment = -1;
 };
 static_assert(sizeof(SegmentRef) == 12, "SegmentRef: passed by value in the servo path");
-constexpr bool operator==(SegmentRef a, SegmentRef b) { return a.curve == b.curve && a.level == b.level && a.segment == b.segment; }
+constexpr bool operator==(SegmentRef a, SegmentRef b) {
+  return a.curve == b.curve && a.level == b.level && a.segment == b.segment;
+}
 
 /// What a node is: its curve, level and index. 12 bytes. Stored for chunk and hierarchy nodes; computed
 /// from a segment node's tag (Scene::info).
 struct NodeInfo {
-  std::uint32_t curve = 0;    ///< curve of a segment or chunk; curve of the first chunk under a hierarchy node
-  std::int32_t level = 0;     ///< segment level; `levels` of its curve for a chunk; kHierarchyLevel above
-  std::uint32_t index = 0;    ///< segment index within its level; a chunk's first coarsest segment; 0 above
+  std::uint32_t curve = 0;  ///< curve of a segment or chunk; curve of the first chunk under a hierarchy node
+  std::int32_t level = 0;   ///< segment level; `levels` of its curve for a chunk; kHierarchyLevel above
+  std::uint32_t index = 0;  ///< segment index within its level; a chunk's first coarsest segment; 0 above
 };
 static_assert(sizeof(NodeInfo) == 12, "NodeInfo: 12 bytes per node");
 
@@ -149,7 +159,7 @@ struct SceneBuildTimes {
 /// All curves of a picture, ready for the servo loop. Immutable once built; shared read-only.
 class Scene {
  public:
-  static constexpr int kMaxLevels = hk::kMaxLevels;  ///< see hk/constants.hpp
+  static constexpr int kMaxLevels = hk::kMaxLevels;      ///< see hk/constants.hpp
   static constexpr std::int32_t kHierarchyLevel = 1000;  ///< NodeInfo::level of the nodes above the chunks
 
   /// Builds multiresolution models and collision trees for `curves` (workspace metres), with at most
@@ -181,7 +191,9 @@ class Scene {
   /// false for chunks and the hierarchy.
   bool is_segment(std::uint32_t node) const noexcept { return node < segment_nodes_; }
   /// True for a chunk (a run of coarsest segments of one curve).
-  bool is_chunk(std::uint32_t node) const noexcept { return node >= segment_nodes_ && node < segment_nodes_ + chunk_count_; }
+  bool is_chunk(std::uint32_t node) const noexcept {
+    return node >= segment_nodes_ && node < segment_nodes_ + chunk_count_;
+  }
   /// Coarsest segments per chunk, at most.
   static constexpr std::uint32_t kSegmentsPerChunk = 4;
 
@@ -189,7 +201,9 @@ class Scene {
   static constexpr std::uint32_t kTagLevelBits = 4;
   static_assert(kMaxLevels <= (1 << kTagLevelBits), "a level fits the tag's level bits");
   std::uint32_t tag_curve(std::uint32_t node) const noexcept { return tag_[node] >> kTagLevelBits; }
-  int tag_level(std::uint32_t node) const noexcept { return static_cast<int>(tag_[node] & ((1u << kTagLevelBits) - 1)); }
+  int tag_level(std::uint32_t node) const noexcept {
+    return static_cast<int>(tag_[node] & ((1u << kTagLevelBits) - 1));
+  }
 
   /// The error box of a node: a segment's, rebuilt from its end points and stored extents; a chunk's or
   /// hierarchy node's axis-aligned box as an ErrorBox with origin (0, 0) and axis (1, 0). O(1), one root.
@@ -226,7 +240,8 @@ class Scene {
     if (node >= segment_nodes_) return group_box_[node - segment_nodes_];
     const Vec2 a = points_m_[node], b = points_m_[node + 1];
     const BoxExtent& e = extent_[node];
-    const int reach = std::max<int>(std::max<int>(-e.u_min, e.u_over), 0) + std::max<int>(std::max<int>(-e.n_min, e.n_max), 0);
+    const int reach =
+        std::max<int>(std::max<int>(-e.u_min, e.u_over), 0) + std::max<int>(std::max<int>(-e.n_min, e.n_max), 0);
     const double r = reach * static_cast<double>(curve_nodes_[tag_curve(node)].quantum_m[tag_level(node)]);
     return rect_of(a, b, r);
   }
@@ -240,7 +255,9 @@ class Scene {
     const int l = tag_level(node);
     return NodeInfo{c, l, node - curve_nodes_[c].box_offset[l]};
   }
-  std::uint32_t node_of(SegmentRef s) const noexcept { return curve_nodes_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment); }
+  std::uint32_t node_of(SegmentRef s) const noexcept {
+    return curve_nodes_[static_cast<std::size_t>(s.curve)].box_offset[s.level] + static_cast<std::uint32_t>(s.segment);
+  }
   /// Parent of a node (the scene root's parent is itself). Inline: the section's merge checks ask it per entry.
   std::uint32_t parent(std::uint32_t node) const noexcept {
     if (node >= segment_nodes_) return group_parent_[node - segment_nodes_];
@@ -274,7 +291,9 @@ class Scene {
 
   /// Level-l points of curve c (the scaling coefficients) [m]: point_count[l] of them, then, for a closed
   /// curve, the first again.
-  const Vec2* points(std::size_t c, int level) const noexcept { return points_m_.data() + curves_[c].point_offset[level]; }
+  const Vec2* points(std::size_t c, int level) const noexcept {
+    return points_m_.data() + curves_[c].point_offset[level];
+  }
   /// End points of a segment [m].
   void segment(SegmentRef s, Vec2* a, Vec2* b) const noexcept { segment_points(node_of(s), a, b); }
   /// The point of slot `node` [m]: segment node k runs from slot_points(k)[0] to slot_points(k)[1], and

@@ -60,7 +60,8 @@ struct ForceGuard {
   /// Zero force when `status` is not Ok (why = DeviceNotOk), when `deadline_missed` (DeadlineMissed) or
   /// when `force_n` is NaN/inf (NonFinite), checked in that order; otherwise the force clamped in length
   /// to max_force_n · min(1, since_start_s / ramp_s), direction kept (why = Ok). `why` must not be null.
-  Vec2 apply(Vec2 force_n, double since_start_s, DeviceStatus status, bool deadline_missed, TickResult* why) const noexcept;
+  Vec2 apply(Vec2 force_n, double since_start_s, DeviceStatus status, bool deadline_missed,
+             TickResult* why) const noexcept;
 };
 
 /// Default box-test budget of a servo tick (ServoParams::query_box_budget; config key
@@ -85,16 +86,18 @@ enum class RenderMode : std::uint8_t {
 /// The servo settings an operator may change while a visitor touches a wall. Units in
 /// names. Values are assumed checked (config ranges): finite, max_force_step_n > 0, the rest ≥ 0.
 struct ServoGains {
-  double stiffness_n_per_m = 800.0;   ///< wall stiffness [N/m] (ContactParams::stiffness_n_per_m)
-  double damping_n_s_per_m = 0.0;     ///< damping along the contact normal [N·s/m]
-  double max_force_n = 4.0;           ///< force clamp of the solver and of the guard [N]
-  double static_friction = 0.0;       ///< μ_s (ContactParams::static_friction)
-  double dynamic_friction = 0.0;      ///< μ_d ≤ μ_s
-  double max_force_step_n = 0.05;     ///< the limit on force change per tick a gains change (or level change) may cause [N]
-  std::int32_t query_box_budget = kDefaultQueryBoxBudget;  ///< box tests per tick (ServoParams::query_box_budget); 0 = no limit
-  double pop_force_n = 0.0;           ///< push-through press [N], 0 = off (ContactParams::pop_force_n)
-  double pop_hold_s = 0.3;            ///< how long the press must last [s]
-  double pop_release_s = 0.02;        ///< the force fades over this after a push-through [s]
+  double stiffness_n_per_m = 800.0;  ///< wall stiffness [N/m] (ContactParams::stiffness_n_per_m)
+  double damping_n_s_per_m = 0.0;    ///< damping along the contact normal [N·s/m]
+  double max_force_n = 4.0;          ///< force clamp of the solver and of the guard [N]
+  double static_friction = 0.0;      ///< μ_s (ContactParams::static_friction)
+  double dynamic_friction = 0.0;     ///< μ_d ≤ μ_s
+  double max_force_step_n =
+      0.05;  ///< the limit on force change per tick a gains change (or level change) may cause [N]
+  std::int32_t query_box_budget =
+      kDefaultQueryBoxBudget;   ///< box tests per tick (ServoParams::query_box_budget); 0 = no limit
+  double pop_force_n = 0.0;     ///< push-through press [N], 0 = off (ContactParams::pop_force_n)
+  double pop_hold_s = 0.3;      ///< how long the press must last [s]
+  double pop_release_s = 0.02;  ///< the force fades over this after a push-through [s]
   bool operator==(const ServoGains&) const = default;
 };
 
@@ -114,13 +117,13 @@ enum class LevelSteps : std::uint8_t {
 
 /// Parameters of the servo step.
 struct ServoParams {
-  double period_s = 0.001;          ///< servo period = 1 / servo rate [s]
+  double period_s = 0.001;  ///< servo period = 1 / servo rate [s]
   /// Resolution level at start, and always when !auto_level. With Tolerances or Cuts only where it starts:
   /// the coarsest step whose bound is within that level's.
   int level = 1;
-  bool auto_level = false;          ///< the level follows the hand's speed (LevelPolicy), from `steps`
+  bool auto_level = false;                ///< the level follows the hand's speed (LevelPolicy), from `steps`
   LevelSteps steps = LevelSteps::Levels;  ///< what the policy chooses from (with auto_level)
-  LevelPolicyParams policy;         ///< used when auto_level (its fixed_level is ignored: see `auto_level`)
+  LevelPolicyParams policy;               ///< used when auto_level (its fixed_level is ignored: see `auto_level`)
   /// At a level change the force passes from the old level's to the new level's by at most this much per
   /// tick [N] (on top of what the hand's own motion changes), so a coarser or finer wall never kicks.
   double max_force_step_n = 0.05;
@@ -151,7 +154,7 @@ void apply_gains(ServoParams& p, const ServoGains& g) noexcept;
 
 /// Input of one tick.
 struct ServoInput {
-  DeviceSample sample;         ///< handle position [m] and status
+  DeviceSample sample;           ///< handle position [m] and status
   bool deadline_missed = false;  ///< the caller says this tick is late: the guard sends zero force
   /// False while the caller fades the force out (ServoStep's picture swap): a press then is not a
   /// deliberate push-through (ContactInput::press_counts). The loop also stops counting during its own ramp.
@@ -160,12 +163,13 @@ struct ServoInput {
 
 /// Output of one tick.
 struct ServoOutput {
-  Vec2 force_n;                ///< force to write to the device [N] (after the guard)
+  Vec2 force_n;  ///< force to write to the device [N] (after the guard)
   Vec2 handle_velocity_m_per_s;
-  ContactOutput contact;       ///< proxy, state, constraints, events, query stats (budget_used: the whole tick's box tests)
-  std::int32_t level = 0;      ///< level id in use this tick (walls the proxy met): a level or a tolerance step (hk/constants.hpp)
+  ContactOutput contact;  ///< proxy, state, constraints, events, query stats (budget_used: the whole tick's box tests)
+  std::int32_t level =
+      0;  ///< level id in use this tick (walls the proxy met): a level or a tolerance step (hk/constants.hpp)
   std::int32_t level_wanted = 0;  ///< level id asked for (policy or fixed); differs from `level` while a change waits
-  bool level_changed = false;  ///< the level in use changed at the start of this tick
+  bool level_changed = false;     ///< the level in use changed at the start of this tick
   TickResult result = TickResult::Ok;
 };
 
@@ -238,16 +242,18 @@ class SceneStep {
   // levels_'s initializer fills them, policy_'s reads them.
   int ladder_id_[LevelPolicy::kMaxLevels] = {};
   double level_error_m_[LevelPolicy::kMaxLevels] = {};
-  double id_bound_m_[kLevelIds] = {};  // the scene's error bound at every level id [m] (to place an id not on the ladder)
+  double id_bound_m_[kLevelIds] =
+      {};  // the scene's error bound at every level id [m] (to place an id not on the ladder)
   int levels_ = 1;
   // The rung for level id `id`: its own, or the coarsest whose bound is within the id's.
   int ladder_index(int id) const noexcept;
   LevelPolicy policy_;
-  int level_ = 0;              // level in use
-  Vec2 force_residual_;        // old level's (or gains') force minus the new one's, fading out at max_force_step_n per tick [N]
+  int level_ = 0;        // level in use
+  Vec2 force_residual_;  // old level's (or gains') force minus the new one's, fading out at max_force_step_n per tick
+                         // [N]
   double guard_max_force_n_ = 0.0;  // the guard's clamp in use, walking to params_.guard.max_force_n [N]
-  bool gains_changed_ = false; // set_gains since the last update: this tick's force difference goes to the residual
-  Vec2 last_force_;            // force of the previous tick before the guard [N]
+  bool gains_changed_ = false;  // set_gains since the last update: this tick's force difference goes to the residual
+  Vec2 last_force_;             // force of the previous tick before the guard [N]
   Vec2 last_handle_;
   Vec2 velocity_;
   std::int64_t ticks_ = 0;

@@ -27,12 +27,12 @@ namespace hk {
 
 /// Physical parameters of the simulated pantograph. Defaults = config::DeviceSettings defaults.
 struct SimPantographParams {
-  PantographGeometry geometry;             ///< link lengths and motor placement [m]
-  double handle_mass_kg = 0.08;            ///< effective handle mass, link inertia folded in [kg], > 0
-  double handle_damping_n_s_per_m = 2.0;   ///< viscous damping of the mechanism [N·s/m], ≥ 0
-  int encoder_counts_per_rev = 16384;      ///< encoder resolution per motor [counts/rev], ≥ 1
-  double max_torque_n_m = 0.5;             ///< per-motor torque limit [N·m], ≥ 0
-  int substeps = 8;                        ///< integration substeps per `step`, in [1, 100000]
+  PantographGeometry geometry;            ///< link lengths and motor placement [m]
+  double handle_mass_kg = 0.08;           ///< effective handle mass, link inertia folded in [kg], > 0
+  double handle_damping_n_s_per_m = 2.0;  ///< viscous damping of the mechanism [N·s/m], ≥ 0
+  int encoder_counts_per_rev = 16384;     ///< encoder resolution per motor [counts/rev], ≥ 1
+  double max_torque_n_m = 0.5;            ///< per-motor torque limit [N·m], ≥ 0
+  int substeps = 8;                       ///< integration substeps per `step`, in [1, 100000]
   /// Half the usable rectangle [m] (config::WorkspaceSettings width/2, height/2).
   Vec2 workspace_half_extent_m{0.07, 0.045};
   /// The mechanical stops sit this far outside the usable rectangle [m], ≥ 0.
@@ -126,7 +126,6 @@ struct ModelHandParams {
 /// max_force_n (direction kept). The clamp is what lets a wall stop the hand: at the 800 N/m default
 /// wall stiffness, 2 N of push is balanced after 2.5 mm of penetration, however far the target has
 /// run ahead. Returns zero when any input is not finite. Real-time safe.
-Vec2 model_hand_force(const ModelHandParams& p, Vec2 target_m, Vec2 handle_m,
-                      Vec2 handle_velocity_m_per_s) noexcept;
+Vec2 model_hand_force(const ModelHandParams& p, Vec2 target_m, Vec2 handle_m, Vec2 handle_velocity_m_per_s) noexcept;
 
 }  // namespace hk

@@ -35,11 +35,12 @@ namespace hk {
 
 /// Size and error of a tolerance cut of one curve.
 struct CutStats {
-  std::size_t segments = 0;      ///< segments in the cut
-  std::size_t breaks = 0;        ///< junctions where consecutive cut segments do not share an end point (joined)
-  std::size_t vertices = 0;      ///< vertices of the joined polyline: segments, + 1 when the curve is open
-  double max_bound_m = 0.0;      ///< largest box_error_bound of a cut segment [m]
-  double max_join_shift_m = 0.0; ///< largest distance a segment's end moved to join a finer neighbour [m]; 0 without breaks
+  std::size_t segments = 0;  ///< segments in the cut
+  std::size_t breaks = 0;    ///< junctions where consecutive cut segments do not share an end point (joined)
+  std::size_t vertices = 0;  ///< vertices of the joined polyline: segments, + 1 when the curve is open
+  double max_bound_m = 0.0;  ///< largest box_error_bound of a cut segment [m]
+  double max_join_shift_m =
+      0.0;  ///< largest distance a segment's end moved to join a finer neighbour [m]; 0 without breaks
 };
 
 /// The tolerance cut of curve `curve` of `scene`, in curve order (segment refs of mixed levels covering
@@ -71,8 +72,10 @@ inline bool in_cut(const std::uint8_t* masks, std::uint32_t node, int step) noex
 /// What each tolerance step's cut keeps, over the whole scene, for the contact solver's level-change checks and
 /// the level policy (the cut's counterparts of Scene::max_box_half_width_m and Scene::max_error_bound_m).
 struct CutBounds {
-  double error_bound_m[kToleranceSteps] = {};  ///< largest box_error_bound of a cut segment + largest join shift: no original vertex is farther from its joined piece [m]
-  double half_width_m[kToleranceSteps] = {};   ///< largest error-box half-width of a cut segment [m]; a joined piece lies anywhere in its box
+  double error_bound_m[kToleranceSteps] = {};  ///< largest box_error_bound of a cut segment + largest join shift: no
+                                               ///< original vertex is farther from its joined piece [m]
+  double half_width_m[kToleranceSteps] =
+      {};  ///< largest error-box half-width of a cut segment [m]; a joined piece lies anywhere in its box
 };
 
 /// The CutBounds of every step of `scene`'s cuts; `masks` is tolerance_cut_masks(scene). O(nodes · steps);
@@ -97,6 +100,7 @@ std::shared_ptr<const CutWalls> make_cut_walls(const Scene& scene);
 /// end there is that finer segment's end point; otherwise its own. `masks` is tolerance_cut_masks(scene),
 /// and `node` must have bit `step` set in it (a segment of that cut). O(level of the node) mask reads per
 /// end; allocates nothing, real-time safe.
-void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a, Vec2* b) noexcept;
+void joined_cut_segment(const Scene& scene, const std::uint8_t* masks, std::uint32_t node, int step, Vec2* a,
+                        Vec2* b) noexcept;
 
 }  // namespace hk

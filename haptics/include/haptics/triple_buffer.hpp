@@ -37,9 +37,9 @@ class TripleBuffer {
  private:
   static constexpr std::uint8_t kIndex = 0x3, kNew = 0x4;
   T slots_[3]{};
-  std::uint8_t back_ = 0;                 // writer's
-  std::atomic<std::uint8_t> middle_{1};   // shared: index | kNew
-  std::uint8_t front_ = 2;                // reader's
+  std::uint8_t back_ = 0;                // writer's
+  std::atomic<std::uint8_t> middle_{1};  // shared: index | kNew
+  std::uint8_t front_ = 2;               // reader's
 };
 
 }  // namespace hk

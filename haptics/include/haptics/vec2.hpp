@@ -18,8 +18,16 @@ constexpr Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
 constexpr Vec2 operator-(Vec2 a) { return {-a.x, -a.y}; }
 constexpr Vec2 operator*(double s, Vec2 a) { return {s * a.x, s * a.y}; }
 constexpr Vec2 operator*(Vec2 a, double s) { return {s * a.x, s * a.y}; }
-constexpr Vec2& operator+=(Vec2& a, Vec2 b) { a.x += b.x; a.y += b.y; return a; }
-constexpr Vec2& operator-=(Vec2& a, Vec2 b) { a.x -= b.x; a.y -= b.y; return a; }
+constexpr Vec2& operator+=(Vec2& a, Vec2 b) {
+  a.x += b.x;
+  a.y += b.y;
+  return a;
+}
+constexpr Vec2& operator-=(Vec2& a, Vec2 b) {
+  a.x -= b.x;
+  a.y -= b.y;
+  return a;
+}
 constexpr bool operator==(Vec2 a, Vec2 b) { return a.x == b.x && a.y == b.y; }
 
 /// Dot product.
@@ -58,6 +66,8 @@ inline Vec2 closest_point_on_segment(Vec2 p, Vec2 a, Vec2 b, double* t_out = nul
 /// Distance from p to segment [a, b] [m].
 inline double distance_to_segment(Vec2 p, Vec2 a, Vec2 b) { return distance(p, closest_point_on_segment(p, a, b)); }
 /// Squared distance from p to segment [a, b] [m²] (no square root: for comparisons).
-inline double distance_sq_to_segment(Vec2 p, Vec2 a, Vec2 b) { return length_sq(p - closest_point_on_segment(p, a, b)); }
+inline double distance_sq_to_segment(Vec2 p, Vec2 a, Vec2 b) {
+  return length_sq(p - closest_point_on_segment(p, a, b));
+}
 
 }  // namespace hk

@@ -39,7 +39,9 @@ class Scene;
 inline constexpr int kWideItemLevel = 3;
 /// The item level of a curve with `curve_levels` levels (levels 0 … curve_levels − 1): kWideItemLevel, or its
 /// coarsest when it has fewer.
-constexpr int wide_item_level(int curve_levels) { return curve_levels - 1 < kWideItemLevel ? curve_levels - 1 : kWideItemLevel; }
+constexpr int wide_item_level(int curve_levels) {
+  return curve_levels - 1 < kWideItemLevel ? curve_levels - 1 : kWideItemLevel;
+}
 /// Box tests a walk charges to its QueryBudget per wide node it opens: one per child rectangle.
 inline constexpr std::int32_t kWideBoxTestsPerNode = 4;
 
@@ -51,7 +53,7 @@ struct alignas(16) WideNode {
 };
 static_assert(sizeof(WideNode) == 80, "WideNode: 80 bytes");
 
-inline constexpr std::uint32_t kWideLeaf = 1u << 31;    ///< child code flag: the slot is an item
+inline constexpr std::uint32_t kWideLeaf = 1u << 31;      ///< child code flag: the slot is an item
 inline constexpr std::uint32_t kWideEmpty = 0xffffffffu;  ///< child code of an empty slot (never entered)
 
 /// The index of one scene. Built once with the scene, read-only after.

@@ -9,7 +9,8 @@ namespace hk::io {
 namespace {
 
 std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 /// Setup-time write of a whole packet: as many calls as the transport needs, within `timeout_us` [µs] in all.
@@ -35,9 +36,10 @@ double workspace_scale(const HaplyDeviceParams& p) noexcept {
   return std::min(p.workspace_size_m.x / p.rect_size_device_m.x, p.workspace_size_m.y / p.rect_size_device_m.y);
 }
 
-bool calibrated_offsets(const HaplyDeviceParams& p, Vec2 park_workspace_m, double reported_th1_deg, double reported_th2_deg,
-                        double* offset1_deg, double* offset2_deg) noexcept {
-  if (!is_finite(park_workspace_m) || !std::isfinite(reported_th1_deg) || !std::isfinite(reported_th2_deg)) return false;
+bool calibrated_offsets(const HaplyDeviceParams& p, Vec2 park_workspace_m, double reported_th1_deg,
+                        double reported_th2_deg, double* offset1_deg, double* offset2_deg) noexcept {
+  if (!is_finite(park_workspace_m) || !std::isfinite(reported_th1_deg) || !std::isfinite(reported_th2_deg))
+    return false;
   const Vec2 park_device = (1.0 / workspace_scale(p)) * park_workspace_m + p.rect_center_device_m;
   JointAngles q;
   if (!inverse_kinematics(hapi::geometry_of(p.mechanism), park_device, &q)) return false;
@@ -55,10 +57,12 @@ bool calibrated_offsets(const HaplyDeviceParams& p, Vec2 park_workspace_m, doubl
 }
 
 double min_force_capability_n(const HaplyDeviceParams& p) noexcept {
-  return min_force_everywhere_n(hapi::geometry_of(p.mechanism), p.rect_center_device_m, p.rect_size_device_m, p.torque_limit_n_m);
+  return min_force_everywhere_n(hapi::geometry_of(p.mechanism), p.rect_center_device_m, p.rect_size_device_m,
+                                p.torque_limit_n_m);
 }
 
-std::unique_ptr<HaplyDevice> open_first_board(const HaplyDeviceParams& params, const std::vector<BoardCandidate>& candidates,
+std::unique_ptr<HaplyDevice> open_first_board(const HaplyDeviceParams& params,
+                                              const std::vector<BoardCandidate>& candidates,
                                               std::vector<BoardProbe>* probes) {
   for (const BoardCandidate& c : candidates) {
     BoardProbe probe{c.name, false, {}};
@@ -89,9 +93,11 @@ HaplyDevice::HaplyDevice(const HaplyDeviceParams& params, TransportFactory facto
   };
   for (int index : {1, 2}) {
     if (!has_index(params_.layout.actuators, params_.layout.actuator_count, index))
-      throw DeviceError("USB pantograph: the board layout has no actuator " + std::to_string(index) + " (a pantograph needs actuators 1 and 2)");
+      throw DeviceError("USB pantograph: the board layout has no actuator " + std::to_string(index) +
+                        " (a pantograph needs actuators 1 and 2)");
     if (!has_index(params_.layout.encoders, params_.layout.encoder_count, index))
-      throw DeviceError("USB pantograph: the board layout has no encoder " + std::to_string(index) + " (a pantograph needs encoders 1 and 2)");
+      throw DeviceError("USB pantograph: the board layout has no encoder " + std::to_string(index) +
+                        " (a pantograph needs encoders 1 and 2)");
   }
   if (!finite_positive(params_.rect_size_device_m) || !finite_positive(params_.workspace_size_m) ||
       !is_finite(params_.rect_center_device_m))
@@ -109,8 +115,12 @@ std::string HaplyDevice::name() const {
   return "Haply pantograph" + (transport_ ? " (" + transport_->name() + ")" : std::string{});
 }
 
-Vec2 HaplyDevice::to_workspace(Vec2 device_m) const noexcept { return scale_ * (device_m - params_.rect_center_device_m); }
-Vec2 HaplyDevice::to_device(Vec2 workspace_m) const noexcept { return (1.0 / scale_) * workspace_m + params_.rect_center_device_m; }
+Vec2 HaplyDevice::to_workspace(Vec2 device_m) const noexcept {
+  return scale_ * (device_m - params_.rect_center_device_m);
+}
+Vec2 HaplyDevice::to_device(Vec2 workspace_m) const noexcept {
+  return (1.0 / scale_) * workspace_m + params_.rect_center_device_m;
+}
 
 bool HaplyDevice::device_position(double th1_deg, double th2_deg, Vec2* device_m) const noexcept {
   return forward_kinematics(geometry_, hapi::joints_from_haply_deg(th1_deg, th2_deg), device_m);
@@ -121,7 +131,8 @@ void HaplyDevice::send_setup(ByteTransport& t) {
   int n = hapi::encode_reset(params_.layout.device_id, buf);
   if (write_whole(t, buf, n, 100000) != n) throw DeviceError(t.name() + ": the reset packet could not be written");
   n = hapi::encode_setup(params_.layout, buf, static_cast<int>(sizeof buf));
-  if (n < 0 || write_whole(t, buf, n, 100000) != n) throw DeviceError(t.name() + ": the setup packet could not be written");
+  if (n < 0 || write_whole(t, buf, n, 100000) != n)
+    throw DeviceError(t.name() + ": the setup packet could not be written");
 }
 
 void HaplyDevice::open() {
@@ -153,11 +164,14 @@ void HaplyDevice::open() {
     const std::int64_t refused = malformed_.exchange(0);
     transport_->close();
     transport_.reset();
-    const std::string id = std::to_string(params_.layout.device_id), within = std::to_string(params_.open_timeout_ms) + " ms";
+    const std::string id = std::to_string(params_.layout.device_id),
+                      within = std::to_string(params_.open_timeout_ms) + " ms";
     if (refused > 0)
-      throw DeviceError(what + ": answered, but with no well-formed hAPI reply from device id " + id + " within " + within + " (" +
-                        std::to_string(refused) + " replies refused: another device, or another firmware)");
-    throw DeviceError(what + ": no reply from device id " + id + " within " + within + " (is the board a Haply running hAPI firmware?)");
+      throw DeviceError(what + ": answered, but with no well-formed hAPI reply from device id " + id + " within " +
+                        within + " (" + std::to_string(refused) +
+                        " replies refused: another device, or another firmware)");
+    throw DeviceError(what + ": no reply from device id " + id + " within " + within +
+                      " (is the board a Haply running hAPI firmware?)");
   }
   t0_ns_ = steady_ns();
   gone_.store(false);
@@ -224,7 +238,8 @@ bool HaplyDevice::take_replies(int wait_us) noexcept {
 }
 
 void HaplyDevice::adopt_pending() noexcept {
-  if (pending_.load(std::memory_order_acquire) == nullptr || retired_.load(std::memory_order_acquire) != nullptr) return;
+  if (pending_.load(std::memory_order_acquire) == nullptr || retired_.load(std::memory_order_acquire) != nullptr)
+    return;
   ByteTransport* fresh = pending_.exchange(nullptr, std::memory_order_acq_rel);
   retired_.store(transport_.release(), std::memory_order_release);  // closed and freed by the re-open thread
   transport_.reset(fresh);
@@ -256,7 +271,8 @@ DeviceSample HaplyDevice::read() noexcept {
     ++missing_in_row_;
     missing_.fetch_add(1, std::memory_order_relaxed);
     if (missing_in_row_ >= params_.lost_after_ticks) status_.store(DeviceStatus::Lost, std::memory_order_release);
-    if (outstanding_ && ++outstanding_age_ >= kReplyWaitTicks) outstanding_ = false;  // given up: the next packet goes out
+    if (outstanding_ && ++outstanding_age_ >= kReplyWaitTicks)
+      outstanding_ = false;  // given up: the next packet goes out
   }
   s.handle_m = handle_ws_m_;
   s.time_ns = steady_ns() - t0_ns_;
@@ -297,7 +313,8 @@ void HaplyDevice::write_force(Vec2 force_n) noexcept {
     const Torques ours = joint_torques(jacobian(geometry_, q_), force_n);
     hapi::haply_torques_from(ours, &tau_by_index[0], &tau_by_index[1]);
   }
-  const int n = hapi::encode_torques(params_.layout, tau_by_index, params_.torque_limit_n_m, tx_, static_cast<int>(sizeof tx_));
+  const int n =
+      hapi::encode_torques(params_.layout, tau_by_index, params_.torque_limit_n_m, tx_, static_cast<int>(sizeof tx_));
   const double lim = params_.torque_limit_n_m;
   tau1_.store(std::isfinite(tau_by_index[0]) ? std::clamp(tau_by_index[0], -lim, lim) : 0.0, std::memory_order_relaxed);
   tau2_.store(std::isfinite(tau_by_index[1]) ? std::clamp(tau_by_index[1], -lim, lim) : 0.0, std::memory_order_relaxed);
@@ -345,7 +362,8 @@ void HaplyDevice::close() noexcept {
   if (transport_ && !gone_.load()) {
     std::uint8_t pkt[hapi::kMaxPacketBytes];
     const double zero[4] = {0, 0, 0, 0};
-    const int n = hapi::encode_torques(params_.layout, zero, params_.torque_limit_n_m, pkt, static_cast<int>(sizeof pkt));
+    const int n =
+        hapi::encode_torques(params_.layout, zero, params_.torque_limit_n_m, pkt, static_cast<int>(sizeof pkt));
     if (tx_at_ >= tx_len_) (void)write_whole(*transport_, pkt, n, 100000);  // not into the middle of a packet
   }
   if (transport_) transport_->close();

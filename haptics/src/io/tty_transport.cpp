@@ -22,11 +22,10 @@ struct BaudEntry {
   speed_t speed;
 };
 constexpr BaudEntry kBauds[] = {
-    {9600, B9600},       {19200, B19200},     {38400, B38400},     {57600, B57600},
-    {115200, B115200},   {230400, B230400},   {460800, B460800},   {500000, B500000},
-    {576000, B576000},   {921600, B921600},   {1000000, B1000000}, {1152000, B1152000},
-    {1500000, B1500000}, {2000000, B2000000}, {2500000, B2500000}, {3000000, B3000000},
-    {3500000, B3500000}, {4000000, B4000000},
+    {9600, B9600},       {19200, B19200},     {38400, B38400},     {57600, B57600},     {115200, B115200},
+    {230400, B230400},   {460800, B460800},   {500000, B500000},   {576000, B576000},   {921600, B921600},
+    {1000000, B1000000}, {1152000, B1152000}, {1500000, B1500000}, {2000000, B2000000}, {2500000, B2500000},
+    {3000000, B3000000}, {3500000, B3500000}, {4000000, B4000000},
 };
 
 speed_t speed_of(int baud) {
@@ -37,8 +36,7 @@ speed_t speed_of(int baud) {
 }
 
 std::int64_t now_us() noexcept {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -63,7 +61,8 @@ bool gone_errno(int e) noexcept { return e == EIO || e == ENXIO || e == ENODEV |
 
 TtyTransport::TtyTransport(std::string path, int baud) : path_(std::move(path)), baud_(baud) {
   if (baud == 1200) {
-    throw DeviceError("tty " + path_ + ": baud 1200 refused (the 1200 baud touch resets SAMD boards into the bootloader)");
+    throw DeviceError("tty " + path_ +
+                      ": baud 1200 refused (the 1200 baud touch resets SAMD boards into the bootloader)");
   }
   if (speed_of(baud) == B0) {
     throw DeviceError("tty " + path_ + ": baud " + std::to_string(baud) +

@@ -7,8 +7,8 @@
 namespace hk::io {
 namespace {
 
-constexpr std::uint8_t kDtConfig = 0x02, kDtInterface = 0x04, kDtEndpoint = 0x05, kDtIad = 0x0B,
-                       kDtCsInterface = 0x24, kCdcUnion = 0x06;
+constexpr std::uint8_t kDtConfig = 0x02, kDtInterface = 0x04, kDtEndpoint = 0x05, kDtIad = 0x0B, kDtCsInterface = 0x24,
+                       kCdcUnion = 0x06;
 
 struct Iface {
   int number = -1;
@@ -31,13 +31,13 @@ int checked_total_length(const std::uint8_t* d, int length) {
                       " bytes, need at least 9");
   }
   if (d[0] < 9 || d[1] != kDtConfig) {
-    throw DeviceError("USB configuration descriptor: not a configuration descriptor (bLength " +
-                      std::to_string(d[0]) + ", bDescriptorType " + std::to_string(d[1]) + ")");
+    throw DeviceError("USB configuration descriptor: not a configuration descriptor (bLength " + std::to_string(d[0]) +
+                      ", bDescriptorType " + std::to_string(d[1]) + ")");
   }
   const int total = d[2] | (d[3] << 8);
   if (total > length || total < d[0]) {
-    throw DeviceError("USB configuration descriptor: wTotalLength " + std::to_string(total) +
-                      " outside [" + std::to_string(d[0]) + ", " + std::to_string(length) + "] bytes given");
+    throw DeviceError("USB configuration descriptor: wTotalLength " + std::to_string(total) + " outside [" +
+                      std::to_string(d[0]) + ", " + std::to_string(length) + "] bytes given");
   }
   return total;
 }
@@ -57,8 +57,8 @@ std::vector<Iface> list_interfaces(const std::uint8_t* d, int total) {
     const int len = d[off];
     const std::uint8_t type = d[off + 1];
     if (len < 2 || len > total - off) {
-      throw DeviceError("USB configuration descriptor: bLength " + std::to_string(len) + at(off) +
-                        " outside [2, " + std::to_string(total - off) + "]");
+      throw DeviceError("USB configuration descriptor: bLength " + std::to_string(len) + at(off) + " outside [2, " +
+                        std::to_string(total - off) + "]");
     }
     const std::uint8_t* p = d + off;
     if (type == kDtIad && len >= 8) {
@@ -133,9 +133,10 @@ CdcEndpoints find_cdc_endpoints(const std::uint8_t* d, int length) {
     e.max_packet_out = data->max_out;
     return e;
   }
-  throw DeviceError("USB configuration descriptor: no CDC-ACM function (interface class 0x02/0x02 with a class "
-                    "0x0A data interface holding bulk IN and OUT endpoints) among " +
-                    std::to_string(ifaces.size()) + " interfaces");
+  throw DeviceError(
+      "USB configuration descriptor: no CDC-ACM function (interface class 0x02/0x02 with a class "
+      "0x0A data interface holding bulk IN and OUT endpoints) among " +
+      std::to_string(ifaces.size()) + " interfaces");
 }
 
 std::array<std::uint8_t, 7> line_coding_bytes(int baud, int data_bits) {
@@ -147,8 +148,10 @@ std::array<std::uint8_t, 7> line_coding_bytes(int baud, int data_bits) {
     throw DeviceError("line coding: data bits " + std::to_string(data_bits) + " not one of 5, 6, 7, 8, 16");
   }
   const auto b = static_cast<std::uint32_t>(baud);
-  return {static_cast<std::uint8_t>(b & 0xFF),         static_cast<std::uint8_t>((b >> 8) & 0xFF),
-          static_cast<std::uint8_t>((b >> 16) & 0xFF), static_cast<std::uint8_t>((b >> 24) & 0xFF),
+  return {static_cast<std::uint8_t>(b & 0xFF),
+          static_cast<std::uint8_t>((b >> 8) & 0xFF),
+          static_cast<std::uint8_t>((b >> 16) & 0xFF),
+          static_cast<std::uint8_t>((b >> 24) & 0xFF),
           0,  // bCharFormat: 1 stop bit
           0,  // bParityType: none
           static_cast<std::uint8_t>(data_bits)};

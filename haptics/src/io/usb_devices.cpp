@@ -79,7 +79,8 @@ UsbHotplugMonitor::UsbHotplugMonitor(std::uint16_t vid, int pid, std::function<v
   libusb_hotplug_callback_handle handle = 0;
   const int r = libusb_hotplug_register_callback(
       ctx, static_cast<libusb_hotplug_event>(LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED | LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT),
-      LIBUSB_HOTPLUG_ENUMERATE, vid, pid < 0 ? LIBUSB_HOTPLUG_MATCH_ANY : pid, LIBUSB_HOTPLUG_MATCH_ANY, &on_hotplug, &on_change_, &handle);
+      LIBUSB_HOTPLUG_ENUMERATE, vid, pid < 0 ? LIBUSB_HOTPLUG_MATCH_ANY : pid, LIBUSB_HOTPLUG_MATCH_ANY, &on_hotplug,
+      &on_change_, &handle);
   if (r != LIBUSB_SUCCESS) {
     reason_ = usb_error("libusb_hotplug_register_callback", r);
     return;

@@ -256,7 +256,8 @@ void UsbCdcTransport::Impl::start_libusb(std::uint16_t vid, std::uint16_t pid) {
 
 // Opens the first device with this vendor and product id (and this serial string, when one is asked for), so
 // that two boards of one kind can be told apart; notes its bus and address for the messages that follow.
-void UsbCdcTransport::Impl::open_device(std::uint16_t vid, std::uint16_t pid, const std::string& serial, const std::string& who) {
+void UsbCdcTransport::Impl::open_device(std::uint16_t vid, std::uint16_t pid, const std::string& serial,
+                                        const std::string& who) {
   libusb_device** list = nullptr;
   const ssize_t count = libusb_get_device_list(ctx, &list);
   if (count < 0) throw DeviceError(who + ": " + usb_error("libusb_get_device_list", static_cast<int>(count)));
@@ -271,7 +272,8 @@ void UsbCdcTransport::Impl::open_device(std::uint16_t vid, std::uint16_t pid, co
     }
     if (!serial.empty()) {
       unsigned char s[256];
-      const int n = desc.iSerialNumber ? libusb_get_string_descriptor_ascii(opened, desc.iSerialNumber, s, sizeof s) : 0;
+      const int n =
+          desc.iSerialNumber ? libusb_get_string_descriptor_ascii(opened, desc.iSerialNumber, s, sizeof s) : 0;
       if (n <= 0 || std::string(reinterpret_cast<char*>(s), static_cast<std::size_t>(n)) != serial) {
         libusb_close(opened);
         continue;
@@ -347,8 +349,8 @@ void UsbCdcTransport::Impl::set_up_line(int baud, const std::string& here) {
       r < 0) {
     throw DeviceError(here + ": " + usb_error("SET_LINE_CODING", r));
   }
-  if (const int r = libusb_control_transfer(h, kCdcRequestTypeOut, kCdcSetControlLineState, kCdcDtr | kCdcRts,
-                                            ctl_if, nullptr, 0, kControlTimeoutMs);
+  if (const int r = libusb_control_transfer(h, kCdcRequestTypeOut, kCdcSetControlLineState, kCdcDtr | kCdcRts, ctl_if,
+                                            nullptr, 0, kControlTimeoutMs);
       r < 0) {
     throw DeviceError(here + ": " + usb_error("SET_CONTROL_LINE_STATE", r));
   }
@@ -368,7 +370,8 @@ void UsbCdcTransport::Impl::allocate_transfers(const std::string& here) {
     s.impl = this;
     s.t = libusb_alloc_transfer(0);
     if (s.t == nullptr) throw DeviceError(here + ": libusb_alloc_transfer failed");
-    libusb_fill_bulk_transfer(s.t, h, ep.bulk_in, in_bufs.get() + i * in_transfer_bytes, in_transfer_bytes, &Impl::on_in, &s, 0);
+    libusb_fill_bulk_transfer(s.t, h, ep.bulk_in, in_bufs.get() + i * in_transfer_bytes, in_transfer_bytes,
+                              &Impl::on_in, &s, 0);
   }
   out_slot.impl = this;
   out_slot.t = libusb_alloc_transfer(0);

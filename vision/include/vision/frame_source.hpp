@@ -10,12 +10,12 @@
 /// decided from frames over time (framing guidance: "hold still", "whole and still for 1 s") is the same
 /// for a camera in real time and for a folder of frames read as fast as the disk allows.
 
-#include "hk/error.hpp"
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "hk/error.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -47,17 +47,17 @@ SourceSpec parse_source_spec(const std::string& spec);
 
 /// Settings of a source.
 struct FrameSourceParams {
-  int width_px = 1280;          ///< requested frame width [px], [64, 8192]; a camera may give the nearest it has
-  int height_px = 960;          ///< requested frame height [px], [64, 8192]
-  double file_fps = 10.0;       ///< file source: frame i is stamped i / file_fps [s], (0, 1000]
+  int width_px = 1280;     ///< requested frame width [px], [64, 8192]; a camera may give the nearest it has
+  int height_px = 960;     ///< requested frame height [px], [64, 8192]
+  double file_fps = 10.0;  ///< file source: frame i is stamped i / file_fps [s], (0, 1000]
   std::int64_t max_frame_bytes = 64LL << 20;  ///< largest frame buffer or file accepted [bytes]
 };
 
 /// One frame.
 struct Frame {
-  cv::Mat bgr;             ///< CV_8UC3, the whole sensor image as delivered (not rectified)
-  double t_s = 0.0;        ///< capture time [s] on the source's monotonic clock (file: index / file_fps)
-  std::uint64_t index = 0; ///< 0, 1, 2, ... in delivery order
+  cv::Mat bgr;              ///< CV_8UC3, the whole sensor image as delivered (not rectified)
+  double t_s = 0.0;         ///< capture time [s] on the source's monotonic clock (file: index / file_fps)
+  std::uint64_t index = 0;  ///< 0, 1, 2, ... in delivery order
 };
 
 /// A source of frames. Not thread-safe: one thread calls next(). Destroying it stops the camera and frees

@@ -28,39 +28,41 @@ namespace hk::vision {
 
 /// What a frame showed (look_at_frame).
 struct FrameLook {
-  PageDetection page;         ///< the page found (page.found false: none)
-  double mean_grey = 0.0;     ///< mean grey level of the frame [0, 255]
-  double detail = 0.0;        ///< standard deviation of the grey levels of the small frame [grey levels]: ~0 for an empty, even table
+  PageDetection page;      ///< the page found (page.found false: none)
+  double mean_grey = 0.0;  ///< mean grey level of the frame [0, 255]
+  double detail =
+      0.0;  ///< standard deviation of the grey levels of the small frame [grey levels]: ~0 for an empty, even table
   /// Mean absolute grey-level change from the frame before, on small blurred copies [grey levels]; negative
   /// for the first frame (nothing to compare with).
   double motion = -1.0;
   /// Largest move of a page corner since the frame before, as a share of the frame's diagonal; negative when
   /// either frame had no page.
   double corner_motion = -1.0;
-  double t_s = 0.0;           ///< the frame's time [s] (Frame::t_s)
-  int width_px = 0;           ///< the frame's width [px]
-  int height_px = 0;          ///< the frame's height [px]
+  double t_s = 0.0;   ///< the frame's time [s] (Frame::t_s)
+  int width_px = 0;   ///< the frame's width [px]
+  int height_px = 0;  ///< the frame's height [px]
 };
 
 /// Looks at one frame (CV_8UC3 BGR or CV_8UC1): find_page at `page`'s settings, brightness, detail, and motion
 /// against `previous`. `previous` is the look at the frame before (nullptr for the first) and `small` carries a
 /// small blurred grey copy from one call to the next (empty at the first call; replaced by this frame's).
 /// @throws hk::ArgumentError as find_page.
-FrameLook look_at_frame(const cv::Mat& frame, double t_s, const FrameLook* previous, cv::Mat& small, const PageParams& page = {});
+FrameLook look_at_frame(const cv::Mat& frame, double t_s, const FrameLook* previous, cv::Mat& small,
+                        const PageParams& page = {});
 
 /// What the guide says (one message of the catalogue each).
 enum class FramingAdvice : std::uint8_t {
-  PlacePicture,   ///< "Place the picture under the camera."
-  TooDark,        ///< "It is too dark."
-  CutOffTop,      ///< "It is cut off at the top."
-  CutOffBottom,   ///< "It is cut off at the bottom."
-  CutOffLeft,     ///< "It is cut off on the left."
-  CutOffRight,    ///< "It is cut off on the right."
-  MoveLeft,       ///< "Move it left."
-  MoveRight,      ///< "Move it right."
-  MoveUp,         ///< "Move it up." (away from you)
-  MoveDown,       ///< "Move it down." (towards you)
-  HoldStill,      ///< "Hold still."
+  PlacePicture,  ///< "Place the picture under the camera."
+  TooDark,       ///< "It is too dark."
+  CutOffTop,     ///< "It is cut off at the top."
+  CutOffBottom,  ///< "It is cut off at the bottom."
+  CutOffLeft,    ///< "It is cut off on the left."
+  CutOffRight,   ///< "It is cut off on the right."
+  MoveLeft,      ///< "Move it left."
+  MoveRight,     ///< "Move it right."
+  MoveUp,        ///< "Move it up." (away from you)
+  MoveDown,      ///< "Move it down." (towards you)
+  HoldStill,     ///< "Hold still."
 };
 
 /// The advice's short name, as written in capture.json's guidance: "place", "too_dark", "cut_off_top",
@@ -70,14 +72,17 @@ const char* advice_name(FramingAdvice a);
 
 /// Thresholds of the guide. Defaults measured on synthetic camera sequences (tests/vision/test_framing.cpp).
 struct FramingParams {
-  double still_s = 1.0;               ///< whole, centred and still this long → capture [s], (0, 60]
-  double repeat_s = 3.0;              ///< the same advice is said again after this long at the earliest [s], >= 0
-  double centre_tolerance = 0.15;     ///< the page's centre may lie this share of the frame's width (height) off the frame's centre, (0, 0.5]
-  double min_mean_grey = 45.0;        ///< a darker frame is "too dark" [grey levels], [0, 255]
-  double max_motion = 4.0;            ///< FrameLook::motion above this is moving [grey levels], > 0
-  double max_corner_motion = 0.006;   ///< FrameLook::corner_motion above this is moving [share of the diagonal], > 0
-  double whole_frame_after_s = 3.0;   ///< no page but lit, still and with detail this long → capture the whole frame [s], > 0
-  double min_detail = 30.0;           ///< FrameLook::detail below this is an empty table or a plain texture, not a picture [grey levels], >= 0
+  double still_s = 1.0;   ///< whole, centred and still this long → capture [s], (0, 60]
+  double repeat_s = 3.0;  ///< the same advice is said again after this long at the earliest [s], >= 0
+  double centre_tolerance =
+      0.15;  ///< the page's centre may lie this share of the frame's width (height) off the frame's centre, (0, 0.5]
+  double min_mean_grey = 45.0;       ///< a darker frame is "too dark" [grey levels], [0, 255]
+  double max_motion = 4.0;           ///< FrameLook::motion above this is moving [grey levels], > 0
+  double max_corner_motion = 0.006;  ///< FrameLook::corner_motion above this is moving [share of the diagonal], > 0
+  double whole_frame_after_s =
+      3.0;  ///< no page but lit, still and with detail this long → capture the whole frame [s], > 0
+  double min_detail =
+      30.0;  ///< FrameLook::detail below this is an empty table or a plain texture, not a picture [grey levels], >= 0
 };
 
 /// One step of the guide.
@@ -102,9 +107,9 @@ class FramingGuide {
   FramingParams p_;
   std::optional<FramingAdvice> last_said_;
   double last_said_t_s_ = 0.0;
-  bool ready_ = false;           // the looks since ready_since_s_ all called for nothing
+  bool ready_ = false;  // the looks since ready_since_s_ all called for nothing
   double ready_since_s_ = 0.0;
-  bool whole_ = false;           // no page, but lit, still and with detail since whole_since_s_
+  bool whole_ = false;  // no page, but lit, still and with detail since whole_since_s_
   double whole_since_s_ = 0.0;
 };
 

@@ -14,16 +14,19 @@ namespace hk::vision {
 
 /// How close_gaps decides.
 struct GapParams {
-  double max_gap_px = 0.0;       ///< the widest gap joined [px]; 0 = join nothing. Must be finite and >= 0
-  double max_turn_deg = 45.0;    ///< the join may turn from each end's direction by at most this, (0, 90] [deg]
-  double direction_span_px = 6.0;  ///< an end's direction: from the point this far back along the chain to the end [px], > 0
-  double min_piece_px = 0.0;     ///< chains shorter than this are never joined (crumbs of texture are not outlines) [px], >= 0
+  double max_gap_px = 0.0;     ///< the widest gap joined [px]; 0 = join nothing. Must be finite and >= 0
+  double max_turn_deg = 45.0;  ///< the join may turn from each end's direction by at most this, (0, 90] [deg]
+  double direction_span_px =
+      6.0;  ///< an end's direction: from the point this far back along the chain to the end [px], > 0
+  double min_piece_px =
+      0.0;  ///< chains shorter than this are never joined (crumbs of texture are not outlines) [px], >= 0
 };
 
 /// What close_gaps did.
 struct GapStats {
-  std::size_t joins = 0;          ///< gaps bridged
-  std::size_t chains_closed = 0;  ///< chains that came out closed from joining (one chain's two ends, or a ring of several)
+  std::size_t joins = 0;  ///< gaps bridged
+  std::size_t chains_closed =
+      0;  ///< chains that came out closed from joining (one chain's two ends, or a ring of several)
 };
 
 /// The direction a chain leaves by at one end: the unit vector from the point `span_px` back along the chain
@@ -32,7 +35,8 @@ struct GapStats {
 cv::Point2d end_direction(const Chain& c, bool at_start, double span_px);
 
 /// Joins the open chains' ends that face each other across a gap:
-/// 1. Candidates: every pair of ends of open chains at least min_piece_px long (two ends of one chain too, if the chain is longer than
+/// 1. Candidates: every pair of ends of open chains at least min_piece_px long (two ends of one chain too, if the chain
+/// is longer than
 ///    3 × the gap, so a short stroke is never bent into a loop) at most max_gap_px apart, where the join runs
 ///    on within max_turn_deg of both ends' directions (end_direction): end a's direction and the join from a
 ///    to b, and end b's direction and the join from b to a. Ends closer than 1.5 px (adjacent pixels)

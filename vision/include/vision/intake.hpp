@@ -9,12 +9,12 @@
 /// bytes already checked (not by reopening the path, which could have changed in between).
 /// Every refusal is an InputError whose message is one line naming the file and the problem.
 
-#include "hk/error.hpp"
 #include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "hk/error.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -146,8 +146,8 @@ cv::Mat decode_image(std::span<const std::uint8_t> bytes, const std::string& nam
 
 /// decode_image at reduced detail: load_image_reduced on bytes already read. `name` names the input in errors.
 /// @throws InputError as decode_image; hk::ArgumentError if a limit is not positive.
-DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& name, const ImageLimits& limits,
-                                  int keep_side_px);
+DecodedImage decode_image_reduced(std::span<const std::uint8_t> bytes, const std::string& name,
+                                  const ImageLimits& limits, int keep_side_px);
 
 /// Converts to one grey channel and shrinks so that max(width, height) <= max_side_px.
 ///

@@ -48,23 +48,25 @@ struct OcrParams {
   std::string languages = "eng";
   /// Tesseract's data folder; empty: Tesseract's own default (Debian: /usr/share/tesseract-ocr/5/tessdata).
   std::string tessdata_dir;
-  double min_word_confidence = 0.6;   ///< a word below this (Tesseract's confidence / 100, [0, 1]) is unclear (kUnclearWord)
-  double min_letter_share = 0.5;      ///< a block whose characters are less than this share letters or digits is dropped
-  double max_pixels = 4e7;            ///< a larger picture is refused before the worker starts [px]
-  double worker_cpu_s = 30.0;         ///< RLIMIT_CPU of the worker [s]
-  double worker_wall_s = 30.0;        ///< the worker is killed after this wall-clock time [s]
-  double worker_max_memory_mb = 1536.0;  ///< address space the worker may add at start [MiB] (not under ASan); 0 = no limit
+  double min_word_confidence =
+      0.6;  ///< a word below this (Tesseract's confidence / 100, [0, 1]) is unclear (kUnclearWord)
+  double min_letter_share = 0.5;  ///< a block whose characters are less than this share letters or digits is dropped
+  double max_pixels = 4e7;        ///< a larger picture is refused before the worker starts [px]
+  double worker_cpu_s = 30.0;     ///< RLIMIT_CPU of the worker [s]
+  double worker_wall_s = 30.0;    ///< the worker is killed after this wall-clock time [s]
+  double worker_max_memory_mb =
+      1536.0;  ///< address space the worker may add at start [MiB] (not under ASan); 0 = no limit
   /// When given and it becomes true, the worker is killed within worker::kCancelPoll_ms (50 ms) and
   /// recognise_text throws OcrError Cancelled (a newer page no longer needs this one's text).
   const std::atomic<bool>* cancel = nullptr;
-  OcrFault fault = OcrFault::None;    ///< test hook only
+  OcrFault fault = OcrFault::None;  ///< test hook only
 };
 
 /// One word Tesseract read, in the picture's pixels (u right, v down, origin at the top-left pixel's corner).
 struct OcrWord {
-  std::string text;      ///< UTF-8
-  cv::Rect2d box_px;     ///< bounding box [px]
-  double confidence = 0; ///< [0, 1]
+  std::string text;       ///< UTF-8
+  cv::Rect2d box_px;      ///< bounding box [px]
+  double confidence = 0;  ///< [0, 1]
 };
 
 /// A block of text (one of Tesseract's paragraphs), in reading order.
@@ -77,7 +79,7 @@ struct OcrBlock {
 
 /// What OCR found in one picture.
 struct OcrResult {
-  std::vector<OcrWord> words;    ///< every kept word (in the blocks; unclear ones with their own text), in reading order
+  std::vector<OcrWord> words;  ///< every kept word (in the blocks; unclear ones with their own text), in reading order
   std::vector<OcrBlock> blocks;  ///< the text blocks
   int words_seen = 0;            ///< words Tesseract read, kept or not
   double mean_confidence = 0;    ///< over the kept words, [0, 1]; 0 when none

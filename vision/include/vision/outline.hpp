@@ -16,11 +16,11 @@ namespace hk::vision {
 
 /// What classify_two_tone found.
 struct TwoTone {
-  bool two_tone = false;      ///< the picture is two-tone (see classify_two_tone)
-  double threshold = 0.0;     ///< Otsu's threshold [grey level]: the dark tone is <= threshold
-  double dark_mean = 0.0;     ///< mean grey of the dark class [grey level]
-  double light_mean = 0.0;    ///< mean grey of the light class [grey level]
-  double near_share = 0.0;    ///< share of the pixels within kToneSpreadLevels of their class's mean, [0, 1]
+  bool two_tone = false;    ///< the picture is two-tone (see classify_two_tone)
+  double threshold = 0.0;   ///< Otsu's threshold [grey level]: the dark tone is <= threshold
+  double dark_mean = 0.0;   ///< mean grey of the dark class [grey level]
+  double light_mean = 0.0;  ///< mean grey of the light class [grey level]
+  double near_share = 0.0;  ///< share of the pixels within kToneSpreadLevels of their class's mean, [0, 1]
   /// Mean width of the foreground (the tone covering less of the frame, as in trace_outlines): 2 · its area /
   /// the length of its boundary (4-neighbour pairs of unlike tone) [px]; a stroke of width w gives about w,
   /// a disc of radius r gives r. 0 when the picture has one tone. Tells a line drawing (strokes to be felt

@@ -13,7 +13,8 @@ namespace hk::vision {
 
 /// Settings of find_page.
 struct PageParams {
-  double min_area_fraction = 0.08;  ///< a page covers at least this share of the frame (its part inside the frame), (0, 1)
+  double min_area_fraction =
+      0.08;  ///< a page covers at least this share of the frame (its part inside the frame), (0, 1)
   /// Contrast of the page against its background, [0, 255] grey levels: the mean, over the sides not on the frame's
   /// edge in stretches of an eighth of a side, of |mean grey of a thin band just inside the border − mean grey of
   /// one just outside it| (bands 3 to 6 px off the side for frames up to max_side_px, in proportion for larger
@@ -22,7 +23,8 @@ struct PageParams {
   /// the grain of a table or the weave of a cloth) at least 1.5 x this. For a side nearer the frame's edge than
   /// that, the outer bands are cut short at the frame's edge (they must start inside it).
   double min_contrast = 12.0;
-  int max_side_px = 800;  ///< the frame is searched at most this large (longer side) [px], >= 64; corners are refined at full size
+  int max_side_px =
+      800;  ///< the frame is searched at most this large (longer side) [px], >= 64; corners are refined at full size
 };
 
 /// A page found in a frame.

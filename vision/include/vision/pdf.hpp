@@ -6,9 +6,9 @@
 /// worker process, the executable hk-pdf-worker started with posix_spawn (not a fork of the kiosk, whose
 /// other threads may hold locks a forked child would wait on forever), with RLIMIT_CPU and a wall-clock
 /// kill, so a PDF that crashes or hangs poppler takes down only its worker. The worker is found as
-/// $HK_PDF_WORKER, else beside the running executable, else where the build put it. The kiosk process itself never calls poppler. The worker
-/// sends its answer back through a pipe; the parent reads it with poll(2) against the deadline, then
-/// SIGKILLs and reaps the worker in every case (wait4, for the worker's peak memory).
+/// $HK_PDF_WORKER, else beside the running executable, else where the build put it. The kiosk process itself never
+/// calls poppler. The worker sends its answer back through a pipe; the parent reads it with poll(2) against the
+/// deadline, then SIGKILLs and reaps the worker in every case (wait4, for the worker's peak memory).
 ///
 /// Order inside the worker: poppler::document::load_from_raw_data, then is_locked() before anything
 /// else (a locked document crashes pages() in Debian 12's poppler 22.12), then the page count (capped),
@@ -16,12 +16,12 @@
 /// antialiasing on) at the DPI that keeps it within the pixel budget (or, with words and
 /// text_layer_max_side_px set, within that side), the words put in the same pixel frame.
 
-#include "hk/error.hpp"
 #include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "hk/error.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -35,8 +35,8 @@ enum class PdfFault {
   Hang,   ///< the worker spins on the CPU forever (until RLIMIT_CPU or the wall-clock kill)
 };
 
-/// Limits of PDF work. Defaults are the config's (`[stick]`). All must be positive (worker_max_memory_mb and text_layer_max_side_px
-/// may be 0).
+/// Limits of PDF work. Defaults are the config's (`[stick]`). All must be positive (worker_max_memory_mb and
+/// text_layer_max_side_px may be 0).
 struct PdfLimits {
   std::int64_t max_file_bytes = 200LL << 20;  ///< largest PDF [bytes]
   int max_pages = 1000;                       ///< pages offered; a longer document offers its first max_pages
@@ -47,13 +47,13 @@ struct PdfLimits {
   /// and not from OCR, which wants every pixel. A page without words is drawn at the full budget. 0 = always
   /// the full budget.
   double text_layer_max_side_px = 0.0;
-  double worker_cpu_s = 5.0;                  ///< RLIMIT_CPU of the worker [s]
-  double worker_wall_s = 5.0;                 ///< the worker is killed after this wall-clock time [s]
+  double worker_cpu_s = 5.0;   ///< RLIMIT_CPU of the worker [s]
+  double worker_wall_s = 5.0;  ///< the worker is killed after this wall-clock time [s]
   /// Address space the worker may add to its size at start [MiB] (RLIMIT_AS, set in the worker to its size
   /// with the document mapped, plus this). Applied only in builds without AddressSanitizer (ASan reserves terabytes
   /// of shadow memory); there memory is only reported (worker_max_rss_kb). 0 = no limit.
   double worker_max_memory_mb = 2048.0;
-  PdfFault fault = PdfFault::None;            ///< test hook only (PdfFault); None in the kiosk
+  PdfFault fault = PdfFault::None;  ///< test hook only (PdfFault); None in the kiosk
 };
 
 /// What a PDF is, without rendering any page.
@@ -61,7 +61,7 @@ struct PdfLimits {
 inline constexpr std::size_t kMaxPdfTitleBytes = 1024;
 
 struct PdfInfo {
-  int pages = 0;               ///< pages offered (min(real pages, max_pages)), >= 1
+  int pages = 0;  ///< pages offered (min(real pages, max_pages)), >= 1
   /// The document's title as its Info dictionary gives it (poppler's document::get_title, UTF-8), as written:
   /// unchecked text from a stranger's file — check it before speaking it (app::usable_note). Empty when it has
   /// none or it is longer than kMaxPdfTitleBytes.
@@ -76,8 +76,8 @@ struct PdfInfo {
 /// the top-left pixel's corner). Boxes are clipped to the page; words wholly outside it are dropped. The boxes
 /// come from the font's metrics: with a substituted (not embedded) font, glyphs may spill a little over them.
 struct PdfWord {
-  std::string text;           ///< UTF-8
-  cv::Rect2d box_px;          ///< bounding box [px]
+  std::string text;   ///< UTF-8
+  cv::Rect2d box_px;  ///< bounding box [px]
   /// poppler's has_space_after(): false when the next word follows with no space on the same line (as
   /// "globs2" then "," in "globs2,"); group_text_blocks then joins the two without a space, as pdftotext
   /// does, when their boxes are less than 0.3 line heights apart.
@@ -95,18 +95,18 @@ struct TextBlock {
 
 /// A rendered page.
 struct PdfPage {
-  cv::Mat grey;                   ///< CV_8UC1, the page on white
-  double dpi = 0.0;               ///< the DPI it was rendered at
+  cv::Mat grey;      ///< CV_8UC1, the page on white
+  double dpi = 0.0;  ///< the DPI it was rendered at
   /// Drawn smaller than the budget allows, for its text layer (PdfLimits::text_layer_max_side_px). Reading
   /// text the layer leaves out needs the page drawn again at the full budget.
   bool screen_sized = false;
   double width_pt = 0, height_pt = 0;  ///< page size [pt] (1/72 inch), after its rotation
-  std::vector<PdfWord> words;     ///< every word on the page, in poppler's reading order
-  std::vector<TextBlock> blocks;  ///< words grouped (group_text_blocks)
-  int pages = 0;                  ///< pages offered by the document (as PdfInfo::pages)
-  std::string title;              ///< the document's title, unchecked (as PdfInfo::title)
-  double worker_ms = 0.0;         ///< wall time of the worker [ms]
-  long worker_max_rss_kb = 0;     ///< the worker's peak resident memory [KiB] (as PdfInfo's)
+  std::vector<PdfWord> words;          ///< every word on the page, in poppler's reading order
+  std::vector<TextBlock> blocks;       ///< words grouped (group_text_blocks)
+  int pages = 0;                       ///< pages offered by the document (as PdfInfo::pages)
+  std::string title;                   ///< the document's title, unchecked (as PdfInfo::title)
+  double worker_ms = 0.0;              ///< wall time of the worker [ms]
+  long worker_max_rss_kb = 0;          ///< the worker's peak resident memory [KiB] (as PdfInfo's)
 };
 
 /// A refused or unreadable PDF or page. what() is one line: "pdf '<name>': <problem>", e.g.
@@ -137,7 +137,8 @@ PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, 
 /// @throws PdfError as probe_pdf, plus NoSuchPage (page outside [1, pages offered]) and TooLarge (a page so
 ///         large that even 1 DPI would exceed the budget). Timeout: the worker outlived worker_wall_s or
 ///         used up worker_cpu_s; WorkerCrashed: it died (a signal, or an exit without an answer).
-PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& name, int page, const PdfLimits& limits);
+PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& name, int page,
+                        const PdfLimits& limits);
 
 /// Groups words into lines and lines into blocks, the way a reader sees paragraphs:
 /// - a word joins a line when its vertical extent overlaps the line's by at least half of the smaller
@@ -152,8 +153,8 @@ bool looks_like_pdf(std::span<const std::uint8_t> bytes);
 
 /// Entry point of the worker executable (vision/worker/pdf_worker_main.cpp), not for other callers: maps the
 /// document from descriptor 3, limits itself, runs poppler for the request in argv (page, max_pages,
-/// max_page_pixels, max_dpi, text_layer_max_side_px, worker_cpu_s, worker_max_memory_mb, fault, document size), writes the answer
-/// to descriptor 4 and exits. Returns 64-66 (never reaching poppler) for a malformed request.
+/// max_page_pixels, max_dpi, text_layer_max_side_px, worker_cpu_s, worker_max_memory_mb, fault, document size), writes
+/// the answer to descriptor 4 and exits. Returns 64-66 (never reaching poppler) for a malformed request.
 int pdf_worker_entry(int argc, char** argv);
 
 }  // namespace hk::vision

@@ -21,8 +21,9 @@ namespace hk::vision {
 /// The edge detectors (Canny, Surround, Bilateral, Edpf) were compared on every test picture and on generated
 /// texture (docs/PERFORMANCE.md, "Texture out before edges"; bench/scene_detectors.sh); Auto uses the best.
 enum class Detector : std::uint8_t {
-  Auto,       ///< Outline for a two-tone picture (classify_two_tone), Canny for a line drawing, kAutoEdgeDetector for any other
-  Canny,      ///< detect_edges + link_edges (Gaussian blur, Canny, pixel-graph linking), no texture suppression
+  Auto,   ///< Outline for a two-tone picture (classify_two_tone), Canny for a line drawing, kAutoEdgeDetector for any
+          ///< other
+  Canny,  ///< detect_edges + link_edges (Gaussian blur, Canny, pixel-graph linking), no texture suppression
   Surround,   ///< Canny, then chains that do not stand out from their surround dropped as texture (texture.hpp)
   Bilateral,  ///< Canny after an edge-preserving bilateral filter (cv::bilateralFilter, kBilateral* below)
   Edpf,       ///< Edge Drawing, parameter-free (cv::ximgproc::EdgeDrawing, PFmode: a-contrario validated segments)
@@ -47,10 +48,10 @@ inline constexpr double kBilateralSigmaSpacePx = 4.0;
 /// Parameters of extract_chains.
 struct ExtractParams {
   Detector detector = Detector::Auto;  ///< how boundaries are found
-  ImageLimits limits;                ///< refusal limits for the file (see load_image)
-  EdgeParams edges;                  ///< edge detection, at the processed resolution
-  int max_image_side_px = 800;       ///< longest side the image is shrunk to before edges [px], >= 1
-  double min_chain_length_px = 20;   ///< shortest chain kept [processed px], >= 0 (see link_edges)
+  ImageLimits limits;                  ///< refusal limits for the file (see load_image)
+  EdgeParams edges;                    ///< edge detection, at the processed resolution
+  int max_image_side_px = 800;         ///< longest side the image is shrunk to before edges [px], >= 1
+  double min_chain_length_px = 20;     ///< shortest chain kept [processed px], >= 0 (see link_edges)
   /// Surround inhibition α of Detector::Surround's texture test (stands_out), >= 0; 0 keeps every chain.
   double surround_inhibition = 1.5;
   /// Auto: a two-tone picture whose ink (TwoTone::ink_width_px) is at most this wide at the workspace scale is
@@ -90,11 +91,11 @@ struct Extraction {
   /// one over Canny's high threshold), so curve strengths compare with `high` alike.
   EdgeMap edge_map;
   Detector detector_used = Detector::Canny;  ///< the detector that ran (never Auto: what Auto chose)
-  std::size_t texture_chains = 0;            ///< Surround: chains dropped as texture (not standing out from their surround)
-  bool line_drawing = false;                 ///< two-tone, but ink no wider than ExtractParams::line_drawing_max_ink_m
-  TwoTone tones;                             ///< classify_two_tone of the processed grey image (Auto and Outline)
-  double px_scale;   ///< original px per processed px (>= 1; 1 = not shrunk), see to_grey
-  StageTimes times;  ///< per-stage wall time
+  std::size_t texture_chains = 0;  ///< Surround: chains dropped as texture (not standing out from their surround)
+  bool line_drawing = false;       ///< two-tone, but ink no wider than ExtractParams::line_drawing_max_ink_m
+  TwoTone tones;                   ///< classify_two_tone of the processed grey image (Auto and Outline)
+  double px_scale;                 ///< original px per processed px (>= 1; 1 = not shrunk), see to_grey
+  StageTimes times;                ///< per-stage wall time
 };
 
 /// load_image -> to_grey (shrink to max_image_side_px) -> boundaries: detect_edges -> link_edges

@@ -89,8 +89,8 @@ inline constexpr double kBorderShare = 0.5;
 /// Chains (pixels) → curves in workspace metres, dropping chains shorter than min_length_m (a fingertip cannot
 /// resolve them); strengths[k] (optional: empty = strength 0) are chains[k]'s per-point strengths, averaged.
 /// `too_short` (optional) receives the number dropped.
-std::vector<SceneCurve> chains_to_curves(const std::vector<Chain>& chains, const PointValues& strengths, const PxToM& map, double min_length_m,
-                                         std::size_t* too_short = nullptr);
+std::vector<SceneCurve> chains_to_curves(const std::vector<Chain>& chains, const PointValues& strengths,
+                                         const PxToM& map, double min_length_m, std::size_t* too_short = nullptr);
 
 /// Level-0 segments the haptic model of a curve costs (the caller's multiresolution model decides: the app
 /// passes haptics' plan_levels). Must not throw.
@@ -98,13 +98,13 @@ using SegmentCost = std::function<std::size_t(const SceneCurve&)>;
 
 /// The settings of simplify_chains, at the workspace scale ([vision] and [workspace] of the settings).
 struct SimplifyParams {
-  double workspace_width_m = 0.14;      ///< the workspace the picture is fitted to [m], > 0
-  double workspace_height_m = 0.09;     ///< [m], > 0
-  double thin_line_max_width_m = 0.0;   ///< strokes thinner than this are felt as their centre line [m]; 0 = off
-  double gap_close_m = 0.0;             ///< widest gap between chain ends joined [m]; 0 = off
-  double min_chain_length_m = 0.0;      ///< shorter curves are dropped [m], >= 0
-  std::size_t max_shapes = 30;          ///< curves kept at most, >= 1
-  std::size_t max_segments = 30000;     ///< level-0 segments kept at most (SegmentCost), >= 1
+  double workspace_width_m = 0.14;     ///< the workspace the picture is fitted to [m], > 0
+  double workspace_height_m = 0.09;    ///< [m], > 0
+  double thin_line_max_width_m = 0.0;  ///< strokes thinner than this are felt as their centre line [m]; 0 = off
+  double gap_close_m = 0.0;            ///< widest gap between chain ends joined [m]; 0 = off
+  double min_chain_length_m = 0.0;     ///< shorter curves are dropped [m], >= 0
+  std::size_t max_shapes = 30;         ///< curves kept at most, >= 1
+  std::size_t max_segments = 30000;    ///< level-0 segments kept at most (SegmentCost), >= 1
 };
 
 /// What simplify_chains left out and why, in pipeline order (each count is of the stage before it):
@@ -130,9 +130,9 @@ struct SimplifyReport {
 /// A picture's scene: the extraction (its chains moved into `curves`) and the curves kept, in the picture's
 /// order (not the ranking's), with the report.
 struct SceneChains {
-  Extraction extraction;            ///< extract_chains' result; its chains and point strengths are moved out (empty)
-  PxToM px_to_m{};                  ///< original pixels → workspace metres (fit_to_workspace)
-  std::vector<SceneCurve> curves;   ///< the curves kept
+  Extraction extraction;           ///< extract_chains' result; its chains and point strengths are moved out (empty)
+  PxToM px_to_m{};                 ///< original pixels → workspace metres (fit_to_workspace)
+  std::vector<SceneCurve> curves;  ///< the curves kept
   SimplifyReport report;
 };
 
@@ -143,11 +143,12 @@ SceneChains simplify_chains(Extraction ex, const SimplifyParams& p, const Segmen
 
 /// extract_chains(path, ep) then simplify_chains.
 /// @throws InputError when the file is refused (see load_image); hk::ArgumentError as above.
-SceneChains scene_chains(const std::string& path, const ExtractParams& ep, const SimplifyParams& p, const SegmentCost& cost);
+SceneChains scene_chains(const std::string& path, const ExtractParams& ep, const SimplifyParams& p,
+                         const SegmentCost& cost);
 
 /// extract_chains_from_image(image, ep, ignore_mask) then simplify_chains.
 /// @throws hk::ArgumentError as extract_chains_from_image and simplify_chains.
-SceneChains scene_chains_from_image(const cv::Mat& image, const ExtractParams& ep, const SimplifyParams& p, const SegmentCost& cost,
-                                    const cv::Mat& ignore_mask = {});
+SceneChains scene_chains_from_image(const cv::Mat& image, const ExtractParams& ep, const SimplifyParams& p,
+                                    const SegmentCost& cost, const cv::Mat& ignore_mask = {});
 
 }  // namespace hk::vision

@@ -59,7 +59,7 @@ StickMounter choose_stick_mounter(bool have_capability, const std::string& helpe
 /// @throws StickMountError, one line naming devnode: None; the helper's own refusal (its line, without the
 /// "hk-stick-mount: " prefix); a helper that cannot be started, does not answer in time, dies, or answers
 /// something else than the result line.
-std::unique_ptr<StickMount> mount_stick(StickMounter how, const std::string& devnode, const std::string& mount_root, int slot,
-                                        const std::string& helper_path, double timeout_s = 30.0);
+std::unique_ptr<StickMount> mount_stick(StickMounter how, const std::string& devnode, const std::string& mount_root,
+                                        int slot, const std::string& helper_path, double timeout_s = 30.0);
 
 }  // namespace hk::vision

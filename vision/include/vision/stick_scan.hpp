@@ -11,23 +11,23 @@
 /// File names are bytes: they are kept as found for opening, and made safe for speech and display with
 /// safe_display_name.
 
-#include "hk/error.hpp"
 #include <cstdint>
-#include <stdexcept>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
+#include "hk/error.hpp"
 
 namespace hk::vision {
 
 /// Limits of one scan. Defaults are the config's (`[stick]`). All must be positive.
 struct ScanLimits {
-  int max_depth = 8;                         ///< deepest folder entered; the root is depth 0
-  long max_entries = 10000;                  ///< directory entries looked at, over the whole walk
-  int max_documents = 500;                   ///< documents listed; later ones are refused
-  std::int64_t max_file_bytes = 200LL << 20; ///< largest document [bytes] (200 MB)
-  double max_seconds = 2.0;                  ///< wall-clock time of the walk [s]
+  int max_depth = 8;                          ///< deepest folder entered; the root is depth 0
+  long max_entries = 10000;                   ///< directory entries looked at, over the whole walk
+  int max_documents = 500;                    ///< documents listed; later ones are refused
+  std::int64_t max_file_bytes = 200LL << 20;  ///< largest document [bytes] (200 MB)
+  double max_seconds = 2.0;                   ///< wall-clock time of the walk [s]
   /// When set, called for each picture (not a PDF) with its open file descriptor, its size [bytes] and its
   /// safe name; a non-empty answer (one line) refuses it as a document that cannot be read, so that what a
   /// stick offers is what can be shown. The kiosk passes vision::image_header_problem (intake.hpp); empty: the
@@ -43,8 +43,8 @@ struct StickDocument {
   std::string path;          ///< relative to the stick's root, '/'-separated, raw bytes as on the stick (for opening)
   std::string display_name;  ///< the path made safe for speech and display (safe_display_name)
   DocumentKind kind = DocumentKind::Image;
-  std::string format;        ///< "png", "jpeg", "bmp", "tiff", "webp" or "pdf" (from the magic bytes)
-  std::int64_t bytes = 0;    ///< file size [bytes]
+  std::string format;      ///< "png", "jpeg", "bmp", "tiff", "webp" or "pdf" (from the magic bytes)
+  std::int64_t bytes = 0;  ///< file size [bytes]
 };
 
 /// An entry left out, and why.
@@ -126,6 +126,7 @@ std::string safe_display_name(std::string_view raw);
 /// @returns the file's bytes (its whole size, at most max_bytes).
 /// @throws StickError (one line "stick file '<safe path>': <problem>"), also when max_bytes is not positive
 ///         or the root cannot be opened.
-std::vector<std::uint8_t> read_stick_file(const std::string& root, const std::string& relative_path, std::int64_t max_bytes);
+std::vector<std::uint8_t> read_stick_file(const std::string& root, const std::string& relative_path,
+                                          std::int64_t max_bytes);
 
 }  // namespace hk::vision

@@ -83,7 +83,8 @@ struct ThinLineStats {
 /// @return the chains with each thin stroke's pair of sides replaced by one centre line.
 /// @throws hk::ArgumentError if max_width_px is negative, NaN or infinite, or a point is not
 ///         finite (one line naming the parameter).
-std::vector<Chain> merge_thin_lines(const std::vector<Chain>& chains, double max_width_px, ThinLineStats* stats = nullptr);
+std::vector<Chain> merge_thin_lines(const std::vector<Chain>& chains, double max_width_px,
+                                    ThinLineStats* stats = nullptr);
 
 /// merge_thin_lines that also carries one value per point (e.g. edge strength) to the output:
 /// a centre-line point gets the mean of the values of its two side points (a corner point added

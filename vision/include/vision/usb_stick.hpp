@@ -24,11 +24,11 @@
 /// looked up again: the helper runs with CAP_SYS_ADMIN for a user who owns /run/haptic-kiosk, and a link
 /// or a folder swapped in there must not move a mount anywhere else.
 
-#include "hk/error.hpp"
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include "hk/error.hpp"
 
 namespace hk::vision {
 

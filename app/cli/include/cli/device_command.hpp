@@ -20,8 +20,9 @@ int run_devices(const DevicesOptions& options);
 
 /// What `haptic-kiosk calibrate` was asked to do.
 struct CalibrateOptions {
-  std::string config_path;     ///< settings file to read and to write the new offsets into (required)
-  std::string device = "haply";///< "haply" (the board per [device]) or "haply-emulator[:...]" (tests, demos: the handle rests at the park place)
+  std::string config_path;       ///< settings file to read and to write the new offsets into (required)
+  std::string device = "haply";  ///< "haply" (the board per [device]) or "haply-emulator[:...]" (tests, demos: the
+                                 ///< handle rests at the park place)
 };
 
 /// Opens the device, takes the angles of 50 zero-torque ticks (their mean), computes the offsets

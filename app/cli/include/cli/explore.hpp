@@ -4,24 +4,26 @@
 /// pantograph driven by a model hand, tick by tick as fast as it can, writing scene.json, trace.csv,
 /// summary.json and overlay.png into the output folder.
 
-#include "hk/error.hpp"
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include "hk/error.hpp"
 
 #include "config/settings.hpp"
-#include "runtime/device_setup.hpp"
 #include "pictures/image_scene.hpp"
+#include "runtime/device_setup.hpp"
 
 namespace hk::app {
 
 /// What `haptic-kiosk explore` was asked to do.
 struct ExploreOptions {
-  std::string image_path;      ///< picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore; empty when `source` is given
-  std::string source;          ///< a camera capture instead (capture.hpp): "file:PATH" | "libcamera:N" | "v4l2:DEV"; empty: none
-  int page = 0;                ///< PDF page (from 1); 0 = not given (a PDF's first page; refused for a picture)
-  std::string out_dir;         ///< folder for the four output files (created if missing)
-  std::string hand = "raster"; ///< "raster", "explorer" (the visitor-like closed-loop hand) or a CSV file with header t_s,x_m,y_m
+  std::string image_path;  ///< picture (PNG, JPEG, BMP, TIFF, WebP) or PDF to explore; empty when `source` is given
+  std::string
+      source;    ///< a camera capture instead (capture.hpp): "file:PATH" | "libcamera:N" | "v4l2:DEV"; empty: none
+  int page = 0;  ///< PDF page (from 1); 0 = not given (a PDF's first page; refused for a picture)
+  std::string out_dir;  ///< folder for the four output files (created if missing)
+  std::string hand =
+      "raster";  ///< "raster", "explorer" (the visitor-like closed-loop hand) or a CSV file with header t_s,x_m,y_m
   std::uint64_t seed = 1;      ///< the explorer's seed (start corner, pass orientation, turning sense); see parse_seed
   double duration_s = 0.0;     ///< run length [s]; ≤ 0: the hand path's duration + 0.5 s, or 120 s for the explorer
   std::string config_path;     ///< TOML settings; empty: defaults
@@ -46,8 +48,8 @@ struct ExploreSummary {
   long free_ticks = 0, edge_ticks = 0, vertex_ticks = 0;
   double max_force_n = 0.0;
   std::size_t curves = 0;
-  std::size_t cues = 0;        ///< audio cues emitted (counted with or without --audio-out)
-  DeviceReport device;         ///< the device's name, final status and counters (summary.json "device")
+  std::size_t cues = 0;  ///< audio cues emitted (counted with or without --audio-out)
+  DeviceReport device;   ///< the device's name, final status and counters (summary.json "device")
 };
 
 /// The scene of the run's input: a picture file, or page `page` of a PDF (drawn in the worker, text

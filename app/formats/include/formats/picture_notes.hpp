@@ -10,10 +10,10 @@
 /// both first when the visitor asks for a description. Written by people, so read with care: a sidecar that
 /// cannot be used is refused with one line, and the picture is shown without it.
 
-#include "hk/error.hpp"
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include "hk/error.hpp"
 
 namespace hk::app {
 
@@ -36,11 +36,11 @@ class PictureNotesError : public hk::Error {
 
 /// What the picture file itself says of it (exiv2, and libpng for a PNG's text chunks, png_text.hpp): the
 /// title from XMP dc:title, else a PNG's `Title` text, else EXIF ImageDescription; the description from XMP
-/// dc:description, else a PNG's `Description` text, else the image comment (a JPEG's COM). Values are checked as a sidecar's are (trimmed, valid UTF-8, not blank, within the byte limits, one
-/// line for the title); a value that fails, and the placeholders cameras write ("OLYMPUS DIGITAL CAMERA",
-/// "SONY DSC", ...), are skipped rather than refused: the file's author did not write them for the kiosk.
-/// Never throws; a file exiv2 cannot read gives empty notes. Safe to call from any thread: calls take turns
-/// (exiv2's XMP toolkit is not thread-safe).
+/// dc:description, else a PNG's `Description` text, else the image comment (a JPEG's COM). Values are checked as a
+/// sidecar's are (trimmed, valid UTF-8, not blank, within the byte limits, one line for the title); a value that fails,
+/// and the placeholders cameras write ("OLYMPUS DIGITAL CAMERA", "SONY DSC", ...), are skipped rather than refused: the
+/// file's author did not write them for the kiosk. Never throws; a file exiv2 cannot read gives empty notes. Safe to
+/// call from any thread: calls take turns (exiv2's XMP toolkit is not thread-safe).
 PictureNotes embedded_notes(const std::string& image_path);
 
 /// A title or description found in a file (a picture's metadata, a PDF's Info /Title): trimmed, when it is

@@ -43,8 +43,8 @@ struct FrameTimeSummary {
 /// Frame times in fixed bins: add() never allocates.
 class FrameTimeHistogram {
  public:
-  static constexpr double kBinMs = 0.1;      ///< bin width [ms]
-  static constexpr double kRangeMs = 1000.0; ///< times from here up share the last bin (max_ms stays exact)
+  static constexpr double kBinMs = 0.1;       ///< bin width [ms]
+  static constexpr double kRangeMs = 1000.0;  ///< times from here up share the last bin (max_ms stays exact)
   static constexpr int kBins = static_cast<int>(kRangeMs / kBinMs) + 1;
 
   /// Records one frame time [ms]; negative times count as 0.

@@ -10,7 +10,8 @@
 /// The pieces, each in a file of its own: window.hpp (GLFW, GL context, Dear ImGui, the
 /// input queue), view.hpp (the scene drawn), hud.hpp (captions, overlay status), operator_panel.hpp and
 /// app/visit/include/visit/operator_session.hpp (the panel and its logic), script.hpp (scripted input), keymap.hpp (key
-/// names), app/visit/include/visit/kiosk_runtime.hpp (everything but the window); this file's run_kiosk puts them together.
+/// names), app/visit/include/visit/kiosk_runtime.hpp (everything but the window); this file's run_kiosk puts them
+/// together.
 ///
 /// View mapping (tests rely on it): workspace metres → window pixels with one uniform scale
 /// s = 0.9 · min(W / width_m, 0.8 · H / height_m) [px/m], y up, the bottom 14 % left to the captions:
@@ -22,20 +23,20 @@ namespace hk::app {
 
 /// What `haptic-kiosk` (no subcommand) was asked to do.
 struct KioskOptions {
-  bool windowed = false;        ///< a 1280 x 720 window instead of full screen
-  std::string config_path;      ///< TOML settings; empty: defaults
-  std::string library;          ///< picture folder; empty: the shipped data/pictures
-  std::string show;             ///< start on this picture (skips attract and tutorial): for documentation and tests
-  bool high_contrast = false;   ///< start in high contrast (dimmed picture, thick bright curves)
-  bool overlay = false;         ///< start with the operator overlay
-  std::string screenshot;       ///< write the last frame here as PNG and quit
-  int frames = 0;               ///< frames to run before the screenshot (at 60 Hz)
+  bool windowed = false;       ///< a 1280 x 720 window instead of full screen
+  std::string config_path;     ///< TOML settings; empty: defaults
+  std::string library;         ///< picture folder; empty: the shipped data/pictures
+  std::string show;            ///< start on this picture (skips attract and tutorial): for documentation and tests
+  bool high_contrast = false;  ///< start in high contrast (dimmed picture, thick bright curves)
+  bool overlay = false;        ///< start with the operator overlay
+  std::string screenshot;      ///< write the last frame here as PNG and quit
+  int frames = 0;              ///< frames to run before the screenshot (at 60 Hz)
   /// Write the window's frame times here as JSON at exit (frame_stats.hpp); empty: not measured.
   std::string frame_stats;
-  std::string script;           ///< scripted input (script.hpp): key, press, type, click, cursor, move, stick, unstick, wait
-  std::string stick;            ///< a folder treated as a USB stick inserted at start (documentation, tests)
-  bool hotplug = true;          ///< watch for USB sticks (libudev); off: only --stick and scripted sticks
-  std::string mount_root;       ///< where sticks are mounted; empty: /run/haptic-kiosk/usb
+  std::string script;      ///< scripted input (script.hpp): key, press, type, click, cursor, move, stick, unstick, wait
+  std::string stick;       ///< a folder treated as a USB stick inserted at start (documentation, tests)
+  bool hotplug = true;     ///< watch for USB sticks (libudev); off: only --stick and scripted sticks
+  std::string mount_root;  ///< where sticks are mounted; empty: /run/haptic-kiosk/usb
   /// Empty: the device [device] names. "haply-emulator[:FAULT=V,...]": the USB pantograph's driver on the
   /// firmware emulator behind a pty, its handle pulled by the mouse (demonstrations, documentation).
   std::string device;

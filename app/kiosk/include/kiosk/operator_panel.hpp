@@ -58,8 +58,8 @@ class OperatorPanel {
   void record(const std::string& name);
 
   OperatorSession& s_;
-  std::string pin_;                       // the PIN being typed (wiped at submit and close)
-  std::string calibrate_note_;            // what the last Calibrate did
+  std::string pin_;             // the PIN being typed (wiped at submit and close)
+  std::string calibrate_note_;  // what the last Calibrate did
   bool focus_pin_ = false;
   std::map<std::string, WidgetRect> widgets_, drawing_;
   static constexpr int kPlotSamples = 300;  // 5 s of frames at 60 Hz

@@ -27,21 +27,21 @@
 #include <vector>
 
 #include "haptics/vec2.hpp"
-#include "visit/kiosk_flow.hpp"
 #include "kiosk/operator_panel.hpp"
 #include "kiosk/window.hpp"
+#include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
 
 /// One line of a script.
 struct ScriptLine {
   int frame = 0;
-  std::string what;     ///< the command
-  std::string arg;      ///< ACTION, KEYS, TEXT, NAME or DIR
-  Vec2 cursor_m;        ///< cursor
+  std::string what;                   ///< the command
+  std::string arg;                    ///< ACTION, KEYS, TEXT, NAME or DIR
+  Vec2 cursor_m;                      ///< cursor
   KioskKey action = KioskKey::Other;  ///< key
   int glfw_key = 0, glfw_mods = 0;    ///< press
-  int number = 0;       ///< line number in the file
+  int number = 0;                     ///< line number in the file
 };
 
 /// Reads a script. @throws AppError (one line: the file, the line number, what is allowed).
@@ -51,13 +51,13 @@ std::vector<ScriptLine> load_script(const std::string& path);
 class ScriptTarget {
  public:
   virtual ~ScriptTarget() = default;
-  virtual void action_key(KioskKey k) = 0;                 ///< key ACTION
-  virtual void input(const InputEvent& e) = 0;              ///< press, type: routed like a real event
-  virtual void cursor(Vec2 m) = 0;                          ///< cursor
-  virtual void moved() = 0;                                 ///< move
-  virtual void stick(const std::string& dir) = 0;           ///< stick
-  virtual void unstick() = 0;                               ///< unstick
-  virtual bool busy() = 0;                                  ///< wait holds while true
+  virtual void action_key(KioskKey k) = 0;                                ///< key ACTION
+  virtual void input(const InputEvent& e) = 0;                            ///< press, type: routed like a real event
+  virtual void cursor(Vec2 m) = 0;                                        ///< cursor
+  virtual void moved() = 0;                                               ///< move
+  virtual void stick(const std::string& dir) = 0;                         ///< stick
+  virtual void unstick() = 0;                                             ///< unstick
+  virtual bool busy() = 0;                                                ///< wait holds while true
   virtual std::optional<WidgetRect> widget(const std::string& name) = 0;  ///< click
 };
 
@@ -77,8 +77,8 @@ class ScriptPlayer {
   std::string path_;
   std::size_t next_ = 0;
   int held_ = 0;
-  std::vector<InputEvent> releases_;               // keys pressed last frame
-  std::deque<ScriptedMouse> clicks_;               // pointer states of the next frames
+  std::vector<InputEvent> releases_;  // keys pressed last frame
+  std::deque<ScriptedMouse> clicks_;  // pointer states of the next frames
   std::optional<ScriptedMouse> mouse_;
 };
 

@@ -8,8 +8,8 @@
 
 #include <GL/gl.h>
 
-#include "visit/kiosk_runtime.hpp"
 #include "pictures/view_geometry.hpp"
+#include "visit/kiosk_runtime.hpp"
 
 namespace hk::app {
 
@@ -46,12 +46,12 @@ class PictureTexture {
   void allocate(int i, int side_px);  // texture i's storage, side_px square (glTexImage2D, no pixels)
   GLuint tex_[2] = {0, 0};
   int side_[2] = {0, 0};  // each texture's allocated side [texels] (0: not yet allocated)
-  int drawn_ = 0;     // the texture drawn when valid_, else the one being filled (never the one drawn last)
+  int drawn_ = 0;         // the texture drawn when valid_, else the one being filled (never the one drawn last)
   const Scene* for_ = nullptr;
   bool valid_ = false;
   int w_ = 0, h_ = 0;
-  cv::Mat pending_;   // the picture being uploaded (shares the shown picture's pixels), empty when up
-  int rows_up_ = 0;   // rows of pending_ uploaded so far
+  cv::Mat pending_;  // the picture being uploaded (shares the shown picture's pixels), empty when up
+  int rows_up_ = 0;  // rows of pending_ uploaded so far
 };
 
 /// The camera's preview while a capture is under way (for sighted companions): the latest frame

@@ -21,12 +21,12 @@ namespace hk::app {
 struct InputEvent {
   enum class Kind { key, character, mouse_button };
   Kind kind = Kind::key;
-  int key = 0;            ///< GLFW key code (key)
-  int scancode = 0;       ///< (key)
-  int action = 0;         ///< GLFW_PRESS, GLFW_RELEASE or GLFW_REPEAT (key, mouse_button)
-  int mods = 0;           ///< GLFW_MOD_* bits (key, mouse_button)
-  unsigned codepoint = 0; ///< Unicode code point (character)
-  int button = 0;         ///< mouse button (mouse_button)
+  int key = 0;             ///< GLFW key code (key)
+  int scancode = 0;        ///< (key)
+  int action = 0;          ///< GLFW_PRESS, GLFW_RELEASE or GLFW_REPEAT (key, mouse_button)
+  int mods = 0;            ///< GLFW_MOD_* bits (key, mouse_button)
+  unsigned codepoint = 0;  ///< Unicode code point (character)
+  int button = 0;          ///< mouse button (mouse_button)
 };
 
 /// The pointer as a script sets it for one frame [window px], overriding the real one for ImGui.

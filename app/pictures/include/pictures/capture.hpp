@@ -30,7 +30,7 @@ struct CaptureParams {
   /// Frame time after which the capture gives up [s] (> 0): the kiosk says so; the `capture` command keeps
   /// the last frame instead (rectified when a page was in it).
   double timeout_s = 60.0;
-  double frame_wait_s = 2.0;      ///< a source silent this long (wall clock) ends the capture with CameraError [s]
+  double frame_wait_s = 2.0;  ///< a source silent this long (wall clock) ends the capture with CameraError [s]
 };
 
 /// How a capture ended.
@@ -47,19 +47,20 @@ const char* capture_end_name(CaptureEnd e);
 /// What a capture gave.
 struct CaptureOutcome {
   CaptureEnd end = CaptureEnd::Cancelled;
-  cv::Mat frame;   ///< the frame captured (Still, WholeFrame) or the last one (Timeout), as delivered (CV_8UC3); empty for Cancelled
+  cv::Mat frame;  ///< the frame captured (Still, WholeFrame) or the last one (Timeout), as delivered (CV_8UC3); empty
+                  ///< for Cancelled
   /// What the scene is built from (CV_8UC3): the page rectified, or the whole frame when no page was found.
   /// For Timeout the last frame's (the kiosk does not use it); empty for Cancelled or no frame.
   cv::Mat image;
   std::optional<std::array<cv::Point2d, 4>> corners_px;  ///< the page's corners in `frame` (TL, TR, BR, BL), when found
-  bool rectified = false;                                 ///< `image` is the rectified page
-  std::vector<vision::FramingAdvice> advice;              ///< what the guide said, in order
-  std::vector<double> advice_t_s;                         ///< the frame time of each [s]
-  int frames = 0;                                         ///< frames looked at
-  double first_frame_t_s = 0.0;                           ///< the first frame's time [s]
-  double captured_t_s = 0.0;                              ///< the last frame's time [s]
-  double look_ms = 0.0;                                   ///< wall time of look_at_frame over all frames [ms]
-  double rectify_ms = 0.0;                                ///< wall time of the rectification [ms]
+  bool rectified = false;                                ///< `image` is the rectified page
+  std::vector<vision::FramingAdvice> advice;             ///< what the guide said, in order
+  std::vector<double> advice_t_s;                        ///< the frame time of each [s]
+  int frames = 0;                                        ///< frames looked at
+  double first_frame_t_s = 0.0;                          ///< the first frame's time [s]
+  double captured_t_s = 0.0;                             ///< the last frame's time [s]
+  double look_ms = 0.0;                                  ///< wall time of look_at_frame over all frames [ms]
+  double rectify_ms = 0.0;                               ///< wall time of the rectification [ms]
 };
 
 /// Callbacks of a running capture (all optional), called on the capturing thread.

@@ -2,8 +2,8 @@
 /// @file capture_service.hpp
 /// The kiosk's camera: which camera it has ([camera] source), and captures run off the window
 /// thread. A capture opens the source, runs run_capture (capture.hpp) on a worker thread, and builds the scene
-/// of what it took (build_image_scene_from_picture, its text left for the kiosk's TextReader); the window thread polls the news (advice to speak, the
-/// scene, a failure) and the latest preview frame for sighted companions.
+/// of what it took (build_image_scene_from_picture, its text left for the kiosk's TextReader); the window thread polls
+/// the news (advice to speak, the scene, a failure) and the latest preview frame for sighted companions.
 ///
 /// Threads: construct, call and destroy on one thread (the window thread); the worker is owned here and joined
 /// by cancel(), the next start() or the destructor.
@@ -18,8 +18,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "pictures/capture.hpp"
 #include "config/settings.hpp"
+#include "pictures/capture.hpp"
 #include "pictures/image_scene.hpp"
 #include "vision/frame_source.hpp"
 
@@ -39,14 +39,14 @@ CameraChoice choose_camera(const config::CameraSettings& camera);
 struct CaptureNews {
   enum class Kind { Advice, Captured, Failed, TimedOut };
   Kind kind = Kind::Advice;
-  vision::FramingAdvice advice{};        ///< Advice: what the guide says
-  std::shared_ptr<ImageScene> scene;     ///< Captured: the scene of the picture taken (its picture in ImageScene::picture)
-  std::string reason;                    ///< Failed: why, one line (for the log)
+  vision::FramingAdvice advice{};     ///< Advice: what the guide says
+  std::shared_ptr<ImageScene> scene;  ///< Captured: the scene of the picture taken (its picture in ImageScene::picture)
+  std::string reason;                 ///< Failed: why, one line (for the log)
 };
 
 /// The latest frame with what the guide saw in it, for the preview.
 struct CapturePreview {
-  cv::Mat frame;                     ///< BGR, at most 640 px wide (scaled down); empty before the first frame
+  cv::Mat frame;  ///< BGR, at most 640 px wide (scaled down); empty before the first frame
   std::optional<std::array<cv::Point2d, 4>> corners_px;  ///< the page's corners in `frame`'s pixels, when found
 };
 

@@ -23,9 +23,9 @@ bool is_pdf_file(const std::string& path);
 /// One document of a stick, with its page count (1 for a picture).
 struct ListedDocument {
   vision::StickDocument doc;
-  int pages = 1;             ///< pages offered (a PDF's are capped at [stick] max_pdf_pages)
-  int pages_in_file = 1;     ///< pages the document has
-  std::string title;         ///< a PDF's title (pdf_title of its Info /Title), spoken in place of its file name; "" when none
+  int pages = 1;          ///< pages offered (a PDF's are capped at [stick] max_pdf_pages)
+  int pages_in_file = 1;  ///< pages the document has
+  std::string title;  ///< a PDF's title (pdf_title of its Info /Title), spoken in place of its file name; "" when none
 };
 
 /// The title of a PDF to speak, from vision::PdfInfo::title as the file gives it: usable_note (one line, at
@@ -38,10 +38,10 @@ std::string pdf_title(const std::string& raw);
 struct StickListing {
   std::vector<ListedDocument> documents;
   std::vector<vision::RefusedEntry> refused;
-  vision::StickScan scan;    ///< the walk's own figures (entries, complete, seconds); its lists are moved out
-  double probe_ms = 0.0;     ///< time spent counting PDF pages [ms]
-  int pictures() const;      ///< documents that are pictures
-  int pdfs() const;          ///< documents that are PDFs
+  vision::StickScan scan;  ///< the walk's own figures (entries, complete, seconds); its lists are moved out
+  double probe_ms = 0.0;   ///< time spent counting PDF pages [ms]
+  int pictures() const;    ///< documents that are pictures
+  int pdfs() const;        ///< documents that are PDFs
 };
 
 /// Scans the folder `root` (a mounted stick, or any folder) and probes its PDFs, with the [stick] limits.
@@ -61,8 +61,8 @@ nlohmann::json stick_listing_json(const StickListing& listing);
 /// full budget, for OCR. 0: every page at the full budget (explore, whose outputs keep the page's detail).
 /// @throws vision::PdfError (one line: not a PDF, locked, damaged, no such page, worker stopped).
 /// `fault` is the worker's test hook (vision::PdfFault): None outside tests.
-ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page, const config::Settings& s,
-                                vision::PdfFault fault = vision::PdfFault::None, TextTiming timing = TextTiming::now,
-                                int text_layer_side_px = 0);
+ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const std::string& name, int page,
+                                const config::Settings& s, vision::PdfFault fault = vision::PdfFault::None,
+                                TextTiming timing = TextTiming::now, int text_layer_side_px = 0);
 
 }  // namespace hk::app

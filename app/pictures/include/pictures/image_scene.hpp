@@ -33,9 +33,9 @@ struct BuildTimes {
 
 /// A block of text of a page in workspace metres: spoken, not felt.
 struct TextBlockM {
-  int id = 0;             ///< index in ImageScene::text_blocks
-  Vec2 lo_m, hi_m;        ///< bounding box [m]: lo = (x0, y0) lower left, hi = (x1, y1) upper right
-  std::string text;       ///< its words in reading order (UTF-8)
+  int id = 0;                  ///< index in ImageScene::text_blocks
+  Vec2 lo_m, hi_m;             ///< bounding box [m]: lo = (x0, y0) lower left, hi = (x1, y1) upper right
+  std::string text;            ///< its words in reading order (UTF-8)
   std::string source = "pdf";  ///< where the text came from: "pdf" (a PDF's text layer) or "ocr" (read from the pixels)
   double confidence = 1.0;     ///< how sure the reading is, [0, 1] (1 for a text layer; OCR: its words' mean)
   /// Whether the point p [m] lies in the box (edges included).
@@ -61,7 +61,7 @@ const TextBlockM* text_block_at(const std::vector<TextBlockM>& blocks, Vec2 p);
 
 /// What text reading (OCR) did for a scene: summary.json's "ocr".
 struct OcrReport {
-  bool ran = false;            ///< Tesseract read the picture
+  bool ran = false;  ///< Tesseract read the picture
   /// Why it ran or not, one phrase: "off", "not a page of text", "a page of text", "always", "no text layer",
   /// "text layer covers little of the text", "a text layer", or what stopped it ("failed: ocr '...': ...").
   std::string why;
@@ -91,10 +91,10 @@ using TextBuild = std::function<ImageScene(const std::atomic<bool>* cancel)>;
 ///   chains_found --thin-line merging--> chains_after_thin_lines --gap closing--> chains_after_gaps
 ///   = chains_too_short + chains_along_border + chains_over_max_shapes + chains_over_budget + polylines.size().
 struct ImageScene {
-  std::string image_path;                   ///< the file (for a document page: the PDF)
-  int page = 0;                             ///< document page shown (from 1); 0 for a picture file
-  int pages = 0;                            ///< pages the document offers; 0 for a picture file
-  std::string document_title;               ///< a PDF's own title (documents.hpp pdf_title), "" when none or a picture file
+  std::string image_path;      ///< the file (for a document page: the PDF)
+  int page = 0;                ///< document page shown (from 1); 0 for a picture file
+  int pages = 0;               ///< pages the document offers; 0 for a picture file
+  std::string document_title;  ///< a PDF's own title (documents.hpp pdf_title), "" when none or a picture file
   /// A library picture's title and description (picture_notes.hpp), read where the scene was built (reading
   /// them parses the whole file, too slow for the window thread); empty for everything else.
   PictureNotes notes;
@@ -111,8 +111,8 @@ struct ImageScene {
   /// Full-detail pixels per `picture` pixel along each side: 1, 2, 4 or 8 (a JPEG decoded reduced, "decoded at
   /// 1/4"); 1 for everything else.
   int decode_scale = 1;
-  std::vector<TextBlockM> text_blocks;      ///< a page's text blocks (masked from the edges), in reading order
-  OcrReport ocr;                            ///< whether the text was read from the pixels, and how it went
+  std::vector<TextBlockM> text_blocks;  ///< a page's text blocks (masked from the edges), in reading order
+  OcrReport ocr;                        ///< whether the text was read from the pixels, and how it went
   /// The text is still to be read (built with TextTiming::later and OCR wanted): the curves are the
   /// picture's with the letters of printed lines kept out (vision::printed_letters_mask), there are no OCR
   /// text blocks yet, and `with_text` reads them.
@@ -121,38 +121,45 @@ struct ImageScene {
   /// "Reading the text." with it at once; false for a picture page of a PDF without a text layer, which is
   /// read all the same but may well hold no text.
   bool text_likely = false;
-  TextBuild with_text;                      ///< set with text_pending; slow (seconds): call it off the window thread
-  std::size_t text_words_masked = 0;        ///< words whose outlines were kept out of the edges
-  double render_dpi = 0;                    ///< a PDF page: the DPI it was drawn at
-  double worker_ms = 0;                     ///< a PDF page: wall time of the drawing worker [ms]
-  long worker_max_rss_kb = 0;               ///< a PDF page: the worker's peak memory [KiB]
-  int width_px = 0, height_px = 0;          ///< size of `picture` [px] (what px_to_m maps)
+  TextBuild with_text;                ///< set with text_pending; slow (seconds): call it off the window thread
+  std::size_t text_words_masked = 0;  ///< words whose outlines were kept out of the edges
+  double render_dpi = 0;              ///< a PDF page: the DPI it was drawn at
+  double worker_ms = 0;               ///< a PDF page: wall time of the drawing worker [ms]
+  long worker_max_rss_kb = 0;         ///< a PDF page: the worker's peak memory [KiB]
+  int width_px = 0, height_px = 0;    ///< size of `picture` [px] (what px_to_m maps)
   vision::PxToM px_to_m{};
-  std::size_t chains_texture = 0;           ///< dropped before chains_found: edges that do not stand out from their surround (detector "surround", vision::stands_out)
-  std::size_t chains_found = 0;             ///< chains out of edge linking (after the texture test)
-  std::size_t thin_line_pairs_merged = 0;   ///< pairs of facing edges (two sides of a stroke thinner than vision.thin_line_max_width_m) felt as one centre line
-  std::size_t chains_after_thin_lines = 0;  ///< chains after thin-line merging (centre lines, left-over pieces, untouched chains)
-  std::size_t gaps_closed = 0;              ///< chain ends joined across a gap of at most vision.gap_close_m (vision::close_gaps)
-  std::size_t chains_closed_by_gaps = 0;    ///< chains that came out closed from those joins
-  std::size_t chains_after_gaps = 0;        ///< chains after gap closing
-  std::size_t chains_too_short = 0;         ///< dropped: shorter than vision.min_chain_length_m
-  std::size_t chains_along_border = 0;      ///< dropped: running along the picture's frame (border_share >= kBorderShare), not shapes
-  std::size_t chains_over_max_shapes = 0;   ///< dropped: vision.max_shapes more salient curves were kept
-  std::size_t chains_over_budget = 0;       ///< dropped: the scene would hold more than vision.max_segments level-0 segments (least salient dropped first)
-  std::size_t segments_before_budget = 0;   ///< level-0 segments of the scene of every curve long enough to feel
-  std::size_t segments_after_budget = 0;    ///< level-0 segments of the scene built (<= vision.max_segments)
-  double canny_low = 0, canny_high = 0;     ///< Canny's thresholds; for traced outlines low = 0, high = the sure strength (vision::Extraction::edge_map)
-  vision::Detector detector = vision::Detector::Canny;  ///< how the boundaries were found (what [vision] detector "auto" chose)
-  vision::TwoTone tones;                    ///< the picture's two tones, when it was classified
+  std::size_t chains_texture = 0;  ///< dropped before chains_found: edges that do not stand out from their surround
+                                   ///< (detector "surround", vision::stands_out)
+  std::size_t chains_found = 0;    ///< chains out of edge linking (after the texture test)
+  std::size_t thin_line_pairs_merged = 0;  ///< pairs of facing edges (two sides of a stroke thinner than
+                                           ///< vision.thin_line_max_width_m) felt as one centre line
+  std::size_t chains_after_thin_lines =
+      0;                        ///< chains after thin-line merging (centre lines, left-over pieces, untouched chains)
+  std::size_t gaps_closed = 0;  ///< chain ends joined across a gap of at most vision.gap_close_m (vision::close_gaps)
+  std::size_t chains_closed_by_gaps = 0;  ///< chains that came out closed from those joins
+  std::size_t chains_after_gaps = 0;      ///< chains after gap closing
+  std::size_t chains_too_short = 0;       ///< dropped: shorter than vision.min_chain_length_m
+  std::size_t chains_along_border =
+      0;  ///< dropped: running along the picture's frame (border_share >= kBorderShare), not shapes
+  std::size_t chains_over_max_shapes = 0;  ///< dropped: vision.max_shapes more salient curves were kept
+  std::size_t chains_over_budget = 0;  ///< dropped: the scene would hold more than vision.max_segments level-0 segments
+                                       ///< (least salient dropped first)
+  std::size_t segments_before_budget = 0;  ///< level-0 segments of the scene of every curve long enough to feel
+  std::size_t segments_after_budget = 0;   ///< level-0 segments of the scene built (<= vision.max_segments)
+  double canny_low = 0, canny_high = 0;  ///< Canny's thresholds; for traced outlines low = 0, high = the sure strength
+                                         ///< (vision::Extraction::edge_map)
+  vision::Detector detector =
+      vision::Detector::Canny;  ///< how the boundaries were found (what [vision] detector "auto" chose)
+  vision::TwoTone tones;        ///< the picture's two tones, when it was classified
   /// A two-tone picture whose ink (tones.ink_width_px, in metres at the workspace scale) is at most
   /// vision.thin_line_max_width_m: a line drawing, found by Canny and its strokes merged to centre lines.
   bool line_drawing = false;
-  std::vector<Polyline> polylines;          ///< kept chains in workspace metres
+  std::vector<Polyline> polylines;  ///< kept chains in workspace metres
   /// strength[i]: mean edge strength along polylines[i], in Canny threshold units (the Sobel-3x3 L2
   /// gradient magnitude Canny thresholded, vision::Extraction::point_strength; a centre line takes
   /// the mean of its two sides).
   std::vector<double> strength;
-  std::unique_ptr<Scene> scene;             ///< collision trees (heap: the servo loop holds a pointer)
+  std::unique_ptr<Scene> scene;  ///< collision trees (heap: the servo loop holds a pointer)
   BuildTimes times;
 };
 
@@ -188,17 +195,17 @@ inline constexpr int kPictureTextJudgedMinSidePx = 1200;
 
 /// Loads the image at `path` and builds its scene with `settings`: text read from it when [vision] ocr asks
 /// (wants_picture_text, read_text), then vision::scene_chains_from_image with the words and the letters of
-/// printed lines (printed_letters_mask_of: words too uncertain to speak are no shapes either) masked (extraction, thin lines,
-/// gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the
-/// level-0 segments plan_levels gives it), then Scene::build (haptics.max_levels) of the curves kept.
-/// `timing` later: the text is not read here (ImageScene::text_pending, with_text).
-/// The file is decoded by vision::load_image_reduced at picture_keep_side_px (a large JPEG or PNG at 1/2, 1/4 or 1/8:
-/// ImageScene::picture, decode_scale, file_width_px, file_height_px). When its text is read and the decode was
-/// reduced, the file is decoded again for OCR at up to kOcrMaxSidePx (all intake checks again) and the words'
-/// boxes are scaled into `picture`'s pixels; if that second decode is refused, the picture is felt without its
-/// text (OcrReport::why "failed: ...").
-/// Throws vision::InputError for bad image files (one line naming the file and the limit).
-ImageScene build_image_scene(const std::string& path, const config::Settings& settings, TextTiming timing = TextTiming::now);
+/// printed lines (printed_letters_mask_of: words too uncertain to speak are no shapes either) masked (extraction, thin
+/// lines, gaps, pixels → metres, the budgets; the [vision] and [workspace] settings, each curve priced at the level-0
+/// segments plan_levels gives it), then Scene::build (haptics.max_levels) of the curves kept. `timing` later: the text
+/// is not read here (ImageScene::text_pending, with_text). The file is decoded by vision::load_image_reduced at
+/// picture_keep_side_px (a large JPEG or PNG at 1/2, 1/4 or 1/8: ImageScene::picture, decode_scale, file_width_px,
+/// file_height_px). When its text is read and the decode was reduced, the file is decoded again for OCR at up to
+/// kOcrMaxSidePx (all intake checks again) and the words' boxes are scaled into `picture`'s pixels; if that second
+/// decode is refused, the picture is felt without its text (OcrReport::why "failed: ..."). Throws vision::InputError
+/// for bad image files (one line naming the file and the limit).
+ImageScene build_image_scene(const std::string& path, const config::Settings& settings,
+                             TextTiming timing = TextTiming::now);
 
 /// build_image_scene on a picture's bytes already read (a document from a USB stick, read once through
 /// vision::read_stick_file): vision::decode_image_reduced with the [vision] limits at picture_keep_side_px, then
@@ -206,8 +213,8 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& se
 /// When OCR needs more detail than the reduced decode kept, a copy of `bytes` is kept (shared by
 /// ImageScene::with_text) and decoded again for it.
 /// @throws vision::InputError (one line naming `name` and the limit).
-ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name, const config::Settings& settings,
-                                        TextTiming timing = TextTiming::now);
+ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, const std::string& name,
+                                        const config::Settings& settings, TextTiming timing = TextTiming::now);
 
 /// build_image_scene on pixels already in memory (a camera capture): the same steps from
 /// vision::scene_chains_from_image. `name` names it in errors and scene.json; ImageScene::picture holds a copy.
@@ -232,8 +239,9 @@ struct PageTextChoice {
 /// @param name  the document's name for scene.json and messages (image_path).
 /// @param choice  wants_page_text's answer for this page when the caller has it, so the page is not judged
 ///        twice; null: judged here.
-ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number, const config::Settings& settings,
-                            TextTiming timing = TextTiming::now, const PageTextChoice* choice = nullptr);
+ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name, int page_number,
+                            const config::Settings& settings, TextTiming timing = TextTiming::now,
+                            const PageTextChoice* choice = nullptr);
 
 /// The mask of a page's text for vision::extract_chains_from_image: CV_8UC1 of `size`, 255 inside each
 /// word box grown by `grow` x its height on every side, 0 elsewhere.
@@ -257,8 +265,8 @@ bool wants_page_text(const vision::PdfPage& page, const config::Settings& settin
 /// in `grey`'s pixel frame. Fills `report` (ran, words, confidence, time, memory). A failure (OcrError) is
 /// logged in one line and costs the text only: report.why says what happened ("cancelled" when `cancel` was
 /// raised), the result is empty.
-vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& settings, OcrReport& report,
-                            const std::atomic<bool>* cancel = nullptr);
+vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& settings,
+                            OcrReport& report, const std::atomic<bool>* cancel = nullptr);
 
 /// Where the letters of printed lines lie in `grey` (vision::printed_letters_mask judged at up to 1600 px,
 /// scaled back to grey's size); empty when it is not a page of text. What a page's curves leave out until

@@ -99,7 +99,7 @@ class PictureShelf {
   ShelfDelivery::Kind wanted_kind_ = ShelfDelivery::Kind::Picture;
   std::optional<BuiltScene> wanted_done_;  // the wanted scene's build, once ended
   std::vector<Ahead> ahead_;               // library pictures built ahead
-  std::vector<int> ahead_refused_;         // built ahead in this generation but failed or over the budget: not asked again
+  std::vector<int> ahead_refused_;  // built ahead in this generation but failed or over the budget: not asked again
 };
 
 }  // namespace hk::app

@@ -92,16 +92,16 @@ class SceneBuilder {
   mutable std::mutex m_;
   std::condition_variable cv_;
   std::condition_variable done_cv_;
-  std::optional<Job> want_;          // guarded by m_: the visitor's, waiting
-  std::deque<Job> ahead_;            // guarded by m_: built ahead, waiting
-  bool running_ = false;             // guarded by m_
-  int running_id_ = 0;               // guarded by m_
-  std::uint64_t running_gen_ = 0;    // guarded by m_
-  bool running_wanted_ = false;      // guarded by m_: the running build is (or became) the want
-  std::vector<BuiltScene> done_;     // guarded by m_
-  std::uint64_t started_ = 0;        // guarded by m_
-  bool stop_ = false;                // guarded by m_
-  std::thread worker_;               // last: started when the rest is ready
+  std::optional<Job> want_;        // guarded by m_: the visitor's, waiting
+  std::deque<Job> ahead_;          // guarded by m_: built ahead, waiting
+  bool running_ = false;           // guarded by m_
+  int running_id_ = 0;             // guarded by m_
+  std::uint64_t running_gen_ = 0;  // guarded by m_
+  bool running_wanted_ = false;    // guarded by m_: the running build is (or became) the want
+  std::vector<BuiltScene> done_;   // guarded by m_
+  std::uint64_t started_ = 0;      // guarded by m_
+  bool stop_ = false;              // guarded by m_
+  std::thread worker_;             // last: started when the rest is ready
 };
 
 }  // namespace hk::app

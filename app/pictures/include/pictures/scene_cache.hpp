@@ -137,8 +137,8 @@ class SceneCache {
 
   std::string dir_;
   std::int64_t max_bytes_;
-  std::mutex mutex_;               ///< guards warned_ and serialises eviction
-  std::set<std::string> warned_;   ///< reasons already logged
+  std::mutex mutex_;              ///< guards warned_ and serialises eviction
+  std::set<std::string> warned_;  ///< reasons already logged
 };
 
 }  // namespace hk::app

@@ -22,7 +22,9 @@ struct StickPage {
 /// page and Previous to the last document's last page. `pages` must not be empty. Never throws.
 inline StickPage step_stick_page(std::span<const int> pages, StickPage at, int delta) {
   const int n = static_cast<int>(pages.size());
-  auto pages_of = [&](int d) { return pages[static_cast<std::size_t>(d)] < 1 ? 1 : pages[static_cast<std::size_t>(d)]; };
+  auto pages_of = [&](int d) {
+    return pages[static_cast<std::size_t>(d)] < 1 ? 1 : pages[static_cast<std::size_t>(d)];
+  };
   if (at.document < 0 || at.document >= n) {
     const int d = delta > 0 ? 0 : n - 1;
     return {d, delta > 0 ? 1 : pages_of(d)};

@@ -18,8 +18,8 @@
 
 #include <atomic>
 #include <chrono>
-#include <cstdint>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -30,8 +30,8 @@
 
 #include "config/settings.hpp"
 #include "pictures/documents.hpp"
-#include "pictures/stick_pages.hpp"
 #include "pictures/image_scene.hpp"
+#include "pictures/stick_pages.hpp"
 #include "vision/stick_mount.hpp"
 #include "vision/usb_stick.hpp"
 
@@ -41,21 +41,21 @@ namespace hk::app {
 struct StickNews {
   enum class Kind { Inserted, Refused, Removed };
   Kind kind = Kind::Inserted;
-  int stick = 0;                        ///< the stick's number (every insertion gets a new one)
-  std::vector<ListedDocument> documents;///< Inserted: what it offers
-  std::size_t refused_entries = 0;      ///< Inserted: entries left out (reasons in the log and in `refused`)
+  int stick = 0;                              ///< the stick's number (every insertion gets a new one)
+  std::vector<ListedDocument> documents;      ///< Inserted: what it offers
+  std::size_t refused_entries = 0;            ///< Inserted: entries left out (reasons in the log and in `refused`)
   std::vector<vision::RefusedEntry> refused;  ///< Inserted: those entries and why (for the operator's panel)
-  int unreadable_documents = 0;         ///< Inserted: of those, pictures and PDFs that cannot be read (RefusedEntry::document)
-  std::string reason;                   ///< Refused: why, one line for speech
-  double scan_ms = 0;                   ///< Inserted: mount + scan + page counting [ms]
+  int unreadable_documents = 0;  ///< Inserted: of those, pictures and PDFs that cannot be read (RefusedEntry::document)
+  std::string reason;            ///< Refused: why, one line for speech
+  double scan_ms = 0;            ///< Inserted: mount + scan + page counting [ms]
 };
 
 /// A finished load.
 struct LoadedDocument {
   int stick = 0, document = 0, page = 1;
-  std::optional<ImageScene> scene;      ///< set when it could be built
-  std::string reason;                   ///< why not, one line for speech (the problem without the file name)
-  double load_ms = 0;                   ///< request to result [ms]
+  std::optional<ImageScene> scene;  ///< set when it could be built
+  std::string reason;               ///< why not, one line for speech (the problem without the file name)
+  double load_ms = 0;               ///< request to result [ms]
 };
 
 /// Watcher and loader threads. Construct and use from the window thread.
@@ -64,7 +64,8 @@ class StickService {
   /// `events` may be null (no hot-plug: only insert_folder). `mount_root` is where sticks are mounted (the
   /// helper always mounts under vision::kDefaultStickMountRoot). Who mounts is chosen once here:
   /// vision::choose_stick_mounter(have_mount_capability(), stick_helper_path()).
-  StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events, std::string mount_root);
+  StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events,
+               std::string mount_root);
   /// Stops both threads (a load in progress finishes first: at most the page time limit) and unmounts.
   ~StickService();
   StickService(const StickService&) = delete;
@@ -154,7 +155,8 @@ class StickService {
   mutable std::mutex m_;
   std::condition_variable cv_;
   bool stop_ = false;
-  std::deque<std::optional<std::string>> folder_ops_;  // guarded by m_: folders put in (a path) and taken out (nullopt), in order
+  std::deque<std::optional<std::string>>
+      folder_ops_;                          // guarded by m_: folders put in (a path) and taken out (nullopt), in order
   std::vector<StickNews> news_;             // guarded by m_
   std::optional<Request> request_;          // guarded by m_
   std::vector<LoadedDocument> loaded_;      // guarded by m_
@@ -166,7 +168,7 @@ class StickService {
   std::vector<Request> ahead_refused_;      // guarded by m_: neighbours that failed or did not fit (not tried again)
   std::optional<Request> building_;         // guarded by m_: the page being built ahead now
   std::optional<std::chrono::steady_clock::time_point> building_wanted_;  // guarded by m_: asked for meanwhile, when
-  std::uint64_t ahead_generation_ = 0;      // guarded by m_: bumped when pages built so far must not be used
+  std::uint64_t ahead_generation_ = 0;  // guarded by m_: bumped when pages built so far must not be used
 
   // watcher thread only
   std::unique_ptr<vision::StickMount> mounted_;

@@ -24,11 +24,11 @@ namespace hk::app {
 
 /// A reading that has ended.
 struct TextRead {
-  int id = 0;               ///< the scene id it was started for (KioskRuntime::shown_id)
+  int id = 0;  ///< the scene id it was started for (KioskRuntime::shown_id)
   /// The scene with its text (OcrReport says how the reading went); without a built scene (scene.scene null,
   /// ocr.why "failed: ...") when building it failed: the page stays as it is felt.
   ImageScene scene;
-  double wall_ms = 0;       ///< from start() to the end [ms]
+  double wall_ms = 0;  ///< from start() to the end [ms]
 };
 
 /// One worker thread reading the text of the page shown.
@@ -61,13 +61,13 @@ class TextReader {
 
   std::mutex m_;
   std::condition_variable cv_;
-  std::optional<Job> waiting_;                    // guarded by m_
-  std::shared_ptr<std::atomic<bool>> running_;    // guarded by m_: the running job's cancel flag
-  std::optional<TextRead> done_;                  // guarded by m_
-  bool stop_ = false;                             // guarded by m_
-  bool pending_ = false;                          // window thread only
-  int pending_id_ = 0;                            // window thread only
-  std::thread worker_;                            // last: started when the rest is ready
+  std::optional<Job> waiting_;                  // guarded by m_
+  std::shared_ptr<std::atomic<bool>> running_;  // guarded by m_: the running job's cancel flag
+  std::optional<TextRead> done_;                // guarded by m_
+  bool stop_ = false;                           // guarded by m_
+  bool pending_ = false;                        // window thread only
+  int pending_id_ = 0;                          // window thread only
+  std::thread worker_;                          // last: started when the rest is ready
 };
 
 }  // namespace hk::app

@@ -25,7 +25,9 @@ struct View {
 };
 
 /// The view of a `w` x `h` pixel window onto a workspace of half extent `half` [m].
-inline View make_view(int w, int h, Vec2 half) { return {w, h, 0.9 * std::min(w / (2 * half.x), 0.8 * h / (2 * half.y))}; }
+inline View make_view(int w, int h, Vec2 half) {
+  return {w, h, 0.9 * std::min(w / (2 * half.x), 0.8 * h / (2 * half.y))};
+}
 
 /// The longest side a picture needs on this view [px]: the workspace rectangle's longer side on the screen
 /// (a picture spans at most the workspace), within [256, kScreenPictureMaxSidePx]. Pictures are shrunk to

@@ -15,9 +15,10 @@ namespace hk::app {
 
 /// What coverage() found.
 struct Coverage {
-  double length_fraction = 0.0;  ///< level-0 curve length within `radius_m` of a proxy position / all of it, in [0, 1]; 0 for an empty scene
-  std::size_t curves_touched = 0;///< curves the proxy was in contact with (edge or vertex) at least once
-  std::size_t curves = 0;        ///< curves in the scene
+  double length_fraction =
+      0.0;  ///< level-0 curve length within `radius_m` of a proxy position / all of it, in [0, 1]; 0 for an empty scene
+  std::size_t curves_touched = 0;  ///< curves the proxy was in contact with (edge or vertex) at least once
+  std::size_t curves = 0;          ///< curves in the scene
 };
 
 /// Collects a run's proxy positions and touched curves tick by tick, then measures the coverage.

@@ -14,10 +14,10 @@ namespace hk::app {
 
 /// Tuning of the tracker. Units in names.
 struct CueTrackerParams {
-  double period_s = 0.001;              ///< servo period [s]
-  int slide_every_ticks = 5;            ///< a Slide cue every this many ticks of edge contact (200 Hz at 1 kHz)
+  double period_s = 0.001;                    ///< servo period [s]
+  int slide_every_ticks = 5;                  ///< a Slide cue every this many ticks of edge contact (200 Hz at 1 kHz)
   Vec2 workspace_half_extent_m{0.07, 0.045};  ///< half width and height of the usable rectangle [m]
-  double edge_margin_m = 0.002;         ///< WorkspaceEdge when the handle comes this close to the border [m]
+  double edge_margin_m = 0.002;               ///< WorkspaceEdge when the handle comes this close to the border [m]
   /// ConvexCorner / VertexContact only at corners that turn at least this much [rad] (30°): a smooth curve
   /// is a chain of slightly convex vertices, and ticking at each would drown the corners that matter.
   double corner_min_turn_rad = 0.5235987755982988;
@@ -37,12 +37,13 @@ class CueTracker {
   /// Rules: ContactBegin / ContactEnd from the solver's events (approach speed = handle speed), PopThrough in
   /// place of ContactEnd when the contact ended by a push-through (kEventPopThrough); a new
   /// ContactBegin when contact moves to another curve (its pitch changes); VertexContact on entering a
-  /// concave corner; ConvexCorner when one is passed (both only at corners of corner_min_turn_rad or more); Slide with the proxy's mean speed over the last
-  /// slide_every_ticks ticks of edge contact; LevelFiner / LevelCoarser when level_in_use changes;
-  /// WorkspaceEdge when the handle reaches the margin (re-armed once it is 2 margins inside); TextBlock
-  /// (curve = block id) when the proxy enters a text block set with set_text_blocks, from outside every
-  /// block or from another (it has left one when it is text_block_margin_m outside its box).
-  int update(std::int64_t tick, const ServoOutput& out, Vec2 handle_m, int level_in_use, audio::CueEvent* cues) noexcept;
+  /// concave corner; ConvexCorner when one is passed (both only at corners of corner_min_turn_rad or more); Slide with
+  /// the proxy's mean speed over the last slide_every_ticks ticks of edge contact; LevelFiner / LevelCoarser when
+  /// level_in_use changes; WorkspaceEdge when the handle reaches the margin (re-armed once it is 2 margins inside);
+  /// TextBlock (curve = block id) when the proxy enters a text block set with set_text_blocks, from outside every block
+  /// or from another (it has left one when it is text_block_margin_m outside its box).
+  int update(std::int64_t tick, const ServoOutput& out, Vec2 handle_m, int level_in_use,
+             audio::CueEvent* cues) noexcept;
   /// Forgets the state (a new scene or session).
   void reset() noexcept;
   /// The text blocks of the page in use [m] (flat array owned by the caller, alive while in use; null / 0:

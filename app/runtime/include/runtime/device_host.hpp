@@ -111,22 +111,22 @@ class DeviceHost {
  private:
   config::Settings s_;
   ModelHandParams hand_;
-  SimulatedPantograph sim_;                         // stands in when there is no USB pantograph
-  std::unique_ptr<hapi::FirmwareEmulator> board_;   // the emulated board...
-  std::unique_ptr<hapi::PtyEmulator> board_pty_;    // ...behind its pty
-  std::unique_ptr<io::HaplyDevice> usb_;            // the USB pantograph, when one answered
+  SimulatedPantograph sim_;                        // stands in when there is no USB pantograph
+  std::unique_ptr<hapi::FirmwareEmulator> board_;  // the emulated board...
+  std::unique_ptr<hapi::PtyEmulator> board_pty_;   // ...behind its pty
+  std::unique_ptr<io::HaplyDevice> usb_;           // the USB pantograph, when one answered
   std::unique_ptr<io::UsbHotplugMonitor> usb_watch_;
   std::atomic<bool> usb_arrived_{false};
-  double next_probe_s_ = 10.0;                      // poll's clock [s]
+  double next_probe_s_ = 10.0;  // poll's clock [s]
   std::string note_;
   std::string home_note_;
   bool home_unspoken_ = false;
   DeviceStatus last_status_ = DeviceStatus::Ok;
-  double lost_since_s_ = 0.0;                       // when the device stopped answering [s, poll's clock]
-  bool lost_spoken_ = false;                        // the loss was told (the return will be)
-  TripleBuffer<Vec2> target_;                       // the model hand's target, read on the servo thread
+  double lost_since_s_ = 0.0;  // when the device stopped answering [s, poll's clock]
+  bool lost_spoken_ = false;   // the loss was told (the return will be)
+  TripleBuffer<Vec2> target_;  // the model hand's target, read on the servo thread
   std::atomic<bool> hand_limp_{false};
-  std::unique_ptr<ServoThread> servo_;              // last: stops first
+  std::unique_ptr<ServoThread> servo_;  // last: stops first
 };
 
 }  // namespace hk::app

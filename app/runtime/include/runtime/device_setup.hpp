@@ -6,10 +6,10 @@
 /// driver parameters from [device] and [workspace], and the transport to a real board ([device] transport:
 /// libusb CDC-ACM by VID:PID, or the kernel's tty).
 
-#include "hk/error.hpp"
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "hk/error.hpp"
 
 #include "config/settings.hpp"
 #include "haptics/device.hpp"
@@ -29,28 +29,32 @@ class DeviceChoiceError : public hk::Error {
 struct DeviceChoice {
   enum class Kind { Simulated, HaplyEmulator };
   Kind kind = Kind::Simulated;
-  hapi::EmulatorFaults faults;             ///< haply-emulator faults (disconnect_at_s, drop_every, garbage_every, wrong_id_every, stall_at_s, stall_s, seed)
-  double calibration_error_deg[2] = {0, 0};///< haply-emulator: encoder zero errors of joints 1 and 2 (calib_error1_deg, calib_error2_deg) [deg]
-  bool rest_at_park = false;                ///< haply-emulator: the handle rests at the park place, its stops hugging it (rest_at_park=1), as a board waits at its home pose for a kiosk to start
+  hapi::EmulatorFaults faults;  ///< haply-emulator faults (disconnect_at_s, drop_every, garbage_every, wrong_id_every,
+                                ///< stall_at_s, stall_s, seed)
+  double calibration_error_deg[2] = {
+      0, 0};  ///< haply-emulator: encoder zero errors of joints 1 and 2 (calib_error1_deg, calib_error2_deg) [deg]
+  bool rest_at_park = false;  ///< haply-emulator: the handle rests at the park place, its stops hugging it
+                              ///< (rest_at_park=1), as a board waits at its home pose for a kiosk to start
 };
 
 /// Parses `sim` (or `simulated`) and `haply-emulator[:KEY=VALUE,...]` with keys disconnect_at_s, stall_at_s,
 /// stall_s (seconds ≥ 0), drop_every, garbage_every, wrong_id_every (integers in [0, 1000000]; 0 = never),
-/// seed (integer ≥ 0), calib_error1_deg, calib_error2_deg ([-90, 90]), rest_at_park (0 or 1). Throws DeviceChoiceError naming the
-/// key or value and its limit.
+/// seed (integer ≥ 0), calib_error1_deg, calib_error2_deg ([-90, 90]), rest_at_park (0 or 1). Throws DeviceChoiceError
+/// naming the key or value and its limit.
 DeviceChoice parse_device_choice(const std::string& text);
 
 /// The firmware emulator with its handle resting at the park place ([device] park_x_m, park_y_m: by default
 /// the board's home pose, beyond the usable rectangle at the edge of the links' reach): emulator_params_from
 /// with stops hugging the park place (0.5 mm each way). `*start_device_m` is the place, device frame [m].
-hapi::EmulatorParams emulator_resting_at_park(const config::Settings& s, const DeviceChoice& choice, Vec2* start_device_m);
+hapi::EmulatorParams emulator_resting_at_park(const config::Settings& s, const DeviceChoice& choice,
+                                              Vec2* start_device_m);
 
 /// Where the handle read at start against where it should rest (the park place), workspace frame.
 struct HomeCheck {
-  bool at_home = true;   ///< within kHomeTolerance_m of the park place (or nothing read yet)
-  Vec2 read_m;           ///< where the first reply puts the handle [m]
-  Vec2 park_m;           ///< [device] park_x_m, park_y_m [m]
-  double off_m = 0.0;    ///< the distance between them [m]
+  bool at_home = true;  ///< within kHomeTolerance_m of the park place (or nothing read yet)
+  Vec2 read_m;          ///< where the first reply puts the handle [m]
+  Vec2 park_m;          ///< [device] park_x_m, park_y_m [m]
+  double off_m = 0.0;   ///< the distance between them [m]
 };
 
 /// How far from the park place a handle may read at start and still count as resting there [m]: a few
@@ -92,10 +96,10 @@ const char* device_status_name(DeviceStatus status) noexcept;
 /// The device part of summary.json: {name, status, replies_missing, reconnects}.
 struct DeviceReport {
   std::string name = "simulated pantograph";
-  std::string status = "ok";        ///< status at the end of the run (before closing)
-  long long replies_missing = 0;    ///< ticks whose reply did not come or came malformed (0 for the simulation)
-  long long reconnects = 0;         ///< times the device came back after being lost
-  long long malformed = 0;          ///< replies refused (wrong id, bad angles, bytes out of step)
+  std::string status = "ok";      ///< status at the end of the run (before closing)
+  long long replies_missing = 0;  ///< ticks whose reply did not come or came malformed (0 for the simulation)
+  long long reconnects = 0;       ///< times the device came back after being lost
+  long long malformed = 0;        ///< replies refused (wrong id, bad angles, bytes out of step)
 };
 
 }  // namespace hk::app

@@ -30,10 +30,10 @@
 /// TourParams::trap_s): the handle is led out of the pocket along it, and the spring takes over again near the
 /// waiting target; without it, tours on 9 of the 22 test pictures stop as if held.
 /// (An outline 1.5 mm off the wall on the handle's side with no press would lead the handle round in the
-/// air, never touching the shape. A target 1.5 mm past the wall fails: with the walls' friction (μ_s 0.4) the handle sticks on the wall wherever the pull
-/// points mostly into it — round every convex corner — while the target runs on. A target outside pulls
-/// the handle round convex corners; the press, a force along the wall's normal where the handle is,
-/// keeps it on the wall without pulling it into a corner.)
+/// air, never touching the shape. A target 1.5 mm past the wall fails: with the walls' friction (μ_s 0.4) the handle
+/// sticks on the wall wherever the pull points mostly into it — round every convex corner — while the target runs on. A
+/// target outside pulls the handle round convex corners; the press, a force along the wall's normal where the handle
+/// is, keeps it on the wall without pulling it into a corner.)
 ///
 /// "Sensible order": always the nearest untouched shape from where the handle is (distance to its
 /// polyline), so repeated Guide presses walk the picture without long jumps. Specks are not toured: a
@@ -51,8 +51,8 @@
 
 namespace hk::app {
 
-/// The shapes touched in this visit of this picture (the kiosk keeps what was touched per visit). Fed with the servo display state's contact curve and with completed tours. Forgotten with a
-/// new picture (reset) and a new visitor.
+/// The shapes touched in this visit of this picture (the kiosk keeps what was touched per visit). Fed with the servo
+/// display state's contact curve and with completed tours. Forgotten with a new picture (reset) and a new visitor.
 class VisitTouches {
  public:
   /// Forgets everything; from now on touches of picture `scene_id` with `curve_count` curves are kept.
@@ -87,6 +87,7 @@ int tour_plan_level(const Scene& scene, std::size_t c, const TourParams& p);
 /// tour_plan_level), as described in the file comment. `scene_id` is stored in the path (the servo drops a
 /// path for another picture). Returns nullopt when every shape is touched (or there is none). Allocates:
 /// not for the servo thread. Never throws for a valid scene (std::bad_alloc aside).
-std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_m, const VisitTouches& touched, const TourParams& p);
+std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_m, const VisitTouches& touched,
+                                  const TourParams& p);
 
 }  // namespace hk::app

@@ -30,15 +30,15 @@ std::int64_t monotonic_ns() noexcept;
 
 /// One tick as the runner ran it (the clock fills the timing, ServoRunner::tick the rest).
 struct ServoTick {
-  std::int64_t index = 0;          ///< ticks since the run began
-  double t_s = 0.0;                ///< the tick's scheduled time since the run began: index · period [s]
-  std::int64_t woke_ns = 0;        ///< monotonic_ns() when the tick started [ns]
-  std::int64_t late_ns = 0;        ///< start minus the tick's deadline [ns] (0 on a HeadlessClock)
-  std::int64_t step_ns = 0;        ///< time of ServoStep::step alone [ns]
-  DeviceSample sample;             ///< what the device read
-  ServoCommand command;            ///< the force written to the device [N]
+  std::int64_t index = 0;    ///< ticks since the run began
+  double t_s = 0.0;          ///< the tick's scheduled time since the run began: index · period [s]
+  std::int64_t woke_ns = 0;  ///< monotonic_ns() when the tick started [ns]
+  std::int64_t late_ns = 0;  ///< start minus the tick's deadline [ns] (0 on a HeadlessClock)
+  std::int64_t step_ns = 0;  ///< time of ServoStep::step alone [ns]
+  DeviceSample sample;       ///< what the device read
+  ServoCommand command;      ///< the force written to the device [N]
   TickResult result = TickResult::Ok;
-  bool deadline_missed = false;    ///< started a whole period late: the step sent zero force
+  bool deadline_missed = false;  ///< started a whole period late: the step sent zero force
 };
 
 /// When ticks start. next() waits for the next one (or returns false: the run is over); done() is told

@@ -41,13 +41,13 @@
 
 #include "audio/cue_event.hpp"
 #include "audio/spsc_ring.hpp"
-#include "runtime/cue_tracker.hpp"
-#include "runtime/guided_tour.hpp"
 #include "haptics/device.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
 #include "haptics/tour_guide.hpp"
 #include "haptics/triple_buffer.hpp"
+#include "runtime/cue_tracker.hpp"
+#include "runtime/guided_tour.hpp"
 
 namespace hk::app {
 
@@ -73,13 +73,13 @@ struct ServoDisplayState {
   Vec2 handle_m, proxy_m, force_n;
   ContactState state = ContactState::Free;
   int curve = -1;
-  int level = 0;                   ///< level in use
-  bool auto_level = false;         ///< the level follows the hand's speed
-  int scene_id = -1;               ///< SceneBundle::id in use, −1 before the first
+  int level = 0;            ///< level in use
+  bool auto_level = false;  ///< the level follows the hand's speed
+  int scene_id = -1;        ///< SceneBundle::id in use, −1 before the first
   /// The device sample's status of this tick, so the display thread can announce a lost or returned device.
   DeviceStatus device_status = DeviceStatus::Closed;
-  std::int64_t tick_compute_ns = 0;///< time of this tick's work [ns] (set by ServoThread)
-  std::int64_t period_error_ns = 0;///< wake-up minus deadline of this tick [ns] (set by ServoThread)
+  std::int64_t tick_compute_ns = 0;  ///< time of this tick's work [ns] (set by ServoThread)
+  std::int64_t period_error_ns = 0;  ///< wake-up minus deadline of this tick [ns] (set by ServoThread)
   std::int64_t missed_deadlines = 0;
   /// |handle − proxy| while in contact, else 0 [m] (the operator panel's live plot: force against it).
   double penetration_m = 0.0;
@@ -163,23 +163,23 @@ class ServoStep {
   CueTracker tracker_;
   audio::SpscRing<audio::CueEvent>* cues_;
   std::atomic<SceneBundle*> pending_{nullptr};
-  audio::SpscRing<SceneBundle*> retired_{16};          // servo → owner
-  SceneBundle* current_ = nullptr;                     // owned by the servo thread while running
-  SceneBundle* to_retire_ = nullptr;                   // waiting for room in retired_
+  audio::SpscRing<SceneBundle*> retired_{16};  // servo → owner
+  SceneBundle* current_ = nullptr;             // owned by the servo thread while running
+  SceneBundle* to_retire_ = nullptr;           // waiting for room in retired_
   std::atomic<int> requested_level_{-1};
   struct GainsSlot {
     ServoGains gains;
     std::uint64_t seq = 0;  // 0: set_gains never called (pictures keep their own ServoParams)
   };
-  TripleBuffer<GainsSlot> gains_in_;                   // set_gains' thread → servo
-  std::uint64_t gains_written_ = 0;                    // writer's count of set_gains
-  GainsSlot gains_;                                    // servo thread: the gains last taken
-  bool fading_ = false;                                // the old picture's force fades before a swap
-  long fade_total_ = 0, fade_left_ = 0;                // [ticks]
-  double fade_step_n_ = 0.0;                           // the force may fall this much a tick while fading [N]
+  TripleBuffer<GainsSlot> gains_in_;     // set_gains' thread → servo
+  std::uint64_t gains_written_ = 0;      // writer's count of set_gains
+  GainsSlot gains_;                      // servo thread: the gains last taken
+  bool fading_ = false;                  // the old picture's force fades before a swap
+  long fade_total_ = 0, fade_left_ = 0;  // [ticks]
+  double fade_step_n_ = 0.0;             // the force may fall this much a tick while fading [N]
   TripleBuffer<ServoDisplayState> display_;
   ServoOutput out_;
-  DeviceStatus last_status_ = DeviceStatus::Ok;        // the previous tick's sample status (a return restarts the picture)
+  DeviceStatus last_status_ = DeviceStatus::Ok;  // the previous tick's sample status (a return restarts the picture)
   // The phases of step, in order (each documented where it is defined; tour_* below).
   void take_gains() noexcept;
   void swap_scene(Vec2 handle_m) noexcept;
@@ -195,13 +195,13 @@ class ServoStep {
   void end_tour(TourPhase how) noexcept;
   std::atomic<TourPath*> tour_pending_{nullptr};
   std::atomic<bool> tour_cancel_{false};
-  audio::SpscRing<TourPath*> tour_retired_{8};         // servo → owner
-  TourPath* tour_ = nullptr;                           // running (or fading out)
-  TourPath* tour_to_retire_ = nullptr;                 // waiting for room in tour_retired_
-  TourGuide guide_;                                    // the force law following tour_
-  TourPhase tour_phase_ = TourPhase::None;             // reported
+  audio::SpscRing<TourPath*> tour_retired_{8};  // servo → owner
+  TourPath* tour_ = nullptr;                    // running (or fading out)
+  TourPath* tour_to_retire_ = nullptr;          // waiting for room in tour_retired_
+  TourGuide guide_;                             // the force law following tour_
+  TourPhase tour_phase_ = TourPhase::None;      // reported
   int tour_id_ = 0, tour_curve_ = -1;
-  Vec2 guide_force_;                                   // this tick's guide force [N]
+  Vec2 guide_force_;  // this tick's guide force [N]
   std::int64_t tick_ = 0;
 };
 

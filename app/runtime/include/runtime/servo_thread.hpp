@@ -12,16 +12,16 @@
 #include <functional>
 #include <thread>
 
-#include "runtime/servo_step.hpp"
 #include "runtime/servo_runner.hpp"
+#include "runtime/servo_step.hpp"
 
 namespace hk::app {
 
 /// Servo thread settings. Units in names.
 struct ServoThreadParams {
-  double rate_hz = 1000.0;     ///< servo rate [Hz], [100, 10000]
-  bool realtime = true;        ///< ask for SCHED_FIFO
-  int fifo_priority = 80;      ///< SCHED_FIFO priority [1, 99]
+  double rate_hz = 1000.0;  ///< servo rate [Hz], [100, 10000]
+  bool realtime = true;     ///< ask for SCHED_FIFO
+  int fifo_priority = 80;   ///< SCHED_FIFO priority [1, 99]
 };
 
 /// Wake-up lateness and deadlines so far.

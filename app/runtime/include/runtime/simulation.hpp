@@ -12,13 +12,13 @@
 #include "audio/cue_event.hpp"
 #include "audio/spsc_ring.hpp"
 #include "config/settings.hpp"
-#include "runtime/device_setup.hpp"
 #include "haptics/explorer_hand.hpp"
 #include "haptics/hand_controller.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
 #include "haptics/sim_pantograph.hpp"
+#include "runtime/device_setup.hpp"
 #include "runtime/servo_step.hpp"
 
 namespace hk::app {
@@ -26,9 +26,9 @@ namespace hk::app {
 /// One tick as the trace records it.
 struct TickRecord {
   long index = 0;
-  double t_s = 0.0;             ///< tick k at t = k · period [s]
-  Vec2 handle_m;                ///< handle position the servo saw (encoder-quantised) [m]
-  std::int64_t tick_ns = 0;     ///< measured time of ServoStep::step (collision, contact, force, cues) [ns]
+  double t_s = 0.0;          ///< tick k at t = k · period [s]
+  Vec2 handle_m;             ///< handle position the servo saw (encoder-quantised) [m]
+  std::int64_t tick_ns = 0;  ///< measured time of ServoStep::step (collision, contact, force, cues) [ns]
   /// Motor torques the device was commanded this tick [N·m]: the simulated pantograph's (left, right motor),
   /// or the USB pantograph's (actuator 1, actuator 2) as sent in the torque packet.
   double motor_torque_n_m[2] = {0.0, 0.0};
@@ -46,12 +46,12 @@ using RunScript = std::function<void(std::int64_t index, ServoStep& core)>;
 
 /// What a headless run may add to the scene and the hand.
 struct RunOptions {
-  DeviceChoice device;                                 ///< the simulated pantograph or the emulated board
-  DeviceReport* report = nullptr;                      ///< receives the device's name, status, counters
-  RunScript script;                                    ///< the owner's calls between ticks (may be empty)
-  audio::SpscRing<audio::CueEvent>* cues = nullptr;    ///< the step's earcons (drain it each tick), or none
-  std::vector<Aabb> text_blocks_m;                     ///< the scene's text blocks [m] (TextBlock cues)
-  int scene_id = 0;                                    ///< SceneBundle::id of the scene (a tour names it)
+  DeviceChoice device;                               ///< the simulated pantograph or the emulated board
+  DeviceReport* report = nullptr;                    ///< receives the device's name, status, counters
+  RunScript script;                                  ///< the owner's calls between ticks (may be empty)
+  audio::SpscRing<audio::CueEvent>* cues = nullptr;  ///< the step's earcons (drain it each tick), or none
+  std::vector<Aabb> text_blocks_m;                   ///< the scene's text blocks [m] (TextBlock cues)
+  int scene_id = 0;                                  ///< SceneBundle::id of the scene (a tour names it)
 };
 
 /// Runs the device `o.device` chose (the simulated pantograph, or the Haply firmware emulator behind a pty

@@ -23,20 +23,22 @@ std::string place_words(Vec2 p_m, Vec2 half_extent_m);
 
 /// The shape under or nearest a hand.
 struct ShapeAtHand {
-  int curve = -1;   ///< index into the curves, −1 when there are none
-  bool on = false;  ///< in contact with it, or within on_within_m of it
+  int curve = -1;                                               ///< index into the curves, −1 when there are none
+  bool on = false;                                              ///< in contact with it, or within on_within_m of it
   double distance_m = std::numeric_limits<double>::infinity();  ///< from the hand to its polyline [m]
 };
 
 /// The shape the hand at `hand_m` [m] is on or nearest: `contact_curve` (the curve the proxy rests on, −1 for
 /// none) when there is one, else the curve whose polyline (closing segment included) is nearest; `on` when in
 /// contact or within `on_within_m` [m]. Cost: O(points).
-ShapeAtHand shape_at_hand(const std::vector<Polyline>& curves, Vec2 hand_m, int contact_curve, double on_within_m = 0.003);
+ShapeAtHand shape_at_hand(const std::vector<Polyline>& curves, Vec2 hand_m, int contact_curve,
+                          double on_within_m = 0.003);
 
 /// One shape, `curves[index]`, for speech: size (as describe_scene), kind, how many shapes lie inside it and
 /// the smallest closed shape it lies in: "a small closed shape with 2 inside it, in a large closed shape"; `with_place`
 /// adds its place (place_words of its bounding-box centre): "..., on the left".
-std::string describe_one_shape(const std::vector<Polyline>& curves, std::size_t index, Vec2 half_extent_m, bool with_place = true);
+std::string describe_one_shape(const std::vector<Polyline>& curves, std::size_t index, Vec2 half_extent_m,
+                               bool with_place = true);
 
 /// Describes `curves` (workspace metres) in a workspace of half extents `half_extent_m` [m]: how many shapes,
 /// then `max_named` of those inside no other shape (the largest first or, given `hand_m`, the nearest to the

@@ -58,18 +58,37 @@
 #include <vector>
 
 #include "audio/messages.hpp"
+#include "config/settings.hpp"
 #include "formats/picture_notes.hpp"
 #include "pictures/picture_library.hpp"
 #include "visit/read_aloud.hpp"
-#include "config/settings.hpp"
 
 namespace hk::app {
 
 /// Keys a blind visitor can find (mapped to physical keys in the config by the window layer), in the order of
 /// config::key_actions (Help .. Finish); Other is any key that is none of them.
-enum class KioskKey { Help, Next, Previous, Describe, Finer, Coarser, VolumeUp, VolumeDown, Tutorial, Guide, Capture,
-                      Repeat, Pause, Where, Finish, NextSentence, PreviousSentence, NextParagraph, PreviousParagraph,
-                      Other };
+enum class KioskKey {
+  Help,
+  Next,
+  Previous,
+  Describe,
+  Finer,
+  Coarser,
+  VolumeUp,
+  VolumeDown,
+  Tutorial,
+  Guide,
+  Capture,
+  Repeat,
+  Pause,
+  Where,
+  Finish,
+  NextSentence,
+  PreviousSentence,
+  NextParagraph,
+  PreviousParagraph,
+  Other
+};
 
 /// States of the flow.
 enum class KioskState { Attract, Tutorial, Picture };
@@ -77,13 +96,12 @@ enum class KioskState { Attract, Tutorial, Picture };
 /// The state's name for the operator's screens: "attract", "tutorial", "picture".
 const char* state_name(KioskState s);
 
-
 /// A document of a USB stick as the flow sees it.
 struct StickEntry {
-  std::string name;   ///< file name made safe for speech
-  bool pdf = false;   ///< a PDF (pages) or a picture
-  int pages = 1;      ///< pages offered (1 for a picture)
-  std::string title;  ///< the document's own title (ListedDocument::title), spoken in place of `name`; "" when none
+  std::string name;       ///< file name made safe for speech
+  bool pdf = false;       ///< a PDF (pages) or a picture
+  int pages = 1;          ///< pages offered (1 for a picture)
+  std::string title;      ///< the document's own title (ListedDocument::title), spoken in place of `name`; "" when none
   int pages_in_file = 0;  ///< pages the document has (more than `pages` when capped); 0: the same as `pages`
 };
 
@@ -104,11 +122,12 @@ enum class KioskSource { Library, Stick };
 
 /// The outcome of an asynchronous document load (KioskEffects::show_document), reported by the window layer.
 struct DocumentResult {
-  int document = 0;          ///< as requested
-  int page = 1;              ///< as requested (from 1)
-  bool ok = false;           ///< the scene is on the device
-  std::string description;   ///< ok: what the page holds, one sentence ("It has 3 shapes and 2 blocks of text.")
-  std::string reason;        ///< !ok: why it cannot be shown, one line for the log and the operator (the visitor hears that it cannot be read)
+  int document = 0;         ///< as requested
+  int page = 1;             ///< as requested (from 1)
+  bool ok = false;          ///< the scene is on the device
+  std::string description;  ///< ok: what the page holds, one sentence ("It has 3 shapes and 2 blocks of text.")
+  std::string reason;  ///< !ok: why it cannot be shown, one line for the log and the operator (the visitor hears that
+                       ///< it cannot be read)
 };
 
 /// What the flow asks of the rest of the kiosk. The window layer implements it with the AudioSystem, the
@@ -198,12 +217,12 @@ std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config:
 
 /// Timing of the flow. Units in names.
 struct KioskFlowParams {
-  double timeout_s = 120.0;  ///< no activity (key, motion, contact, speech heard) for this long ends the session
-  double warning_s = 20.0;   ///< the spoken warning comes this long before the end (at most timeout_s / 2)
-  double loading_cue_s = 0.5; ///< "Loading." is said when a document takes longer than this to load
+  double timeout_s = 120.0;       ///< no activity (key, motion, contact, speech heard) for this long ends the session
+  double warning_s = 20.0;        ///< the spoken warning comes this long before the end (at most timeout_s / 2)
+  double loading_cue_s = 0.5;     ///< "Loading." is said when a document takes longer than this to load
   double attract_every_s = 30.0;  ///< the spoken invitation in Attract comes this often (0: never)
-  config::KeysSettings keys{};  ///< the key of each action ([keys]), named in what is said; default: the shipped keys
-  bool camera = false;          ///< a camera is there: the help names the Capture key
+  config::KeysSettings keys{};    ///< the key of each action ([keys]), named in what is said; default: the shipped keys
+  bool camera = false;            ///< a camera is there: the help names the Capture key
 };
 
 /// The voice's rate [words per minute] (espeak-ng's default, the kiosk's [audio] default).
@@ -286,10 +305,10 @@ class KioskFlow {
   std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) const;
 
   KioskSource source() const { return v_.source; }
-  int document() const { return v_.doc; }        ///< stick document shown (0-based), −1 before the first
+  int document() const { return v_.doc; }  ///< stick document shown (0-based), −1 before the first
   /// The stick's documents as the flow lists them (empty without a stick).
   const std::vector<StickEntry>& stick_documents() const { return v_.stick; }
-  int page() const { return v_.page; }           ///< its page (from 1)
+  int page() const { return v_.page; }                  ///< its page (from 1)
   bool loading() const { return v_.pending_doc >= 0; }  ///< a document load is awaited
   /// Whether page `page` of stick document `document` is the load awaited (else a result for it is superseded).
   bool awaits_document(int document, int page) const {
@@ -312,13 +331,13 @@ class KioskFlow {
     TutorialShape shape = TutorialShape::Square;
     int picture = 0;
     double last_activity_s = 0;
-    double next_invitation_s = 0;   // Attract: when the next spoken invitation is due
+    double next_invitation_s = 0;  // Attract: when the next spoken invitation is due
     bool warned = false;
-    double warned_at_s = 0;         // when the first time-out warning was said
-    bool rewarned = false;          // the second warning was said
-    double finish_asked_s = -1;     // Finish pressed once at this time (asks for a second press); −1: not asked
-    int help_layer = 0;             // 1 right after the first layer of help: Help again gives every key
-    int help_group = -1;            // stepping through every key: the group said last (Next / Previous move); −1: not
+    double warned_at_s = 0;      // when the first time-out warning was said
+    bool rewarned = false;       // the second warning was said
+    double finish_asked_s = -1;  // Finish pressed once at this time (asks for a second press); −1: not asked
+    int help_layer = 0;          // 1 right after the first layer of help: Help again gives every key
+    int help_group = -1;         // stepping through every key: the group said last (Next / Previous move); −1: not
     KioskSource source = KioskSource::Library;
     std::vector<StickEntry> stick;
     int doc = -1, page = 1;                  // shown
@@ -328,15 +347,15 @@ class KioskFlow {
     std::string pending_before;              // said before its announcement ("Tutorial done.")
     double pending_since_s = 0;
     bool loading_said = false;
-    std::string announce_summary;            // the stick's summary, said before the first page's announcement
-    std::string announce_unreadable;         // how many of its files cannot be read, said after the summary
-    bool capturing = false;                  // a camera capture is under way
-    bool captured = false;                   // the picture shown is the visitor's own capture
-    bool felt = false;                       // a shape, picture or page has been put under the hand in this visit
-    bool read_aloud_said = false;            // the visitor was told that their document is heard by people nearby
-    bool push_taught = false;                // the tutorial said that a wall can be pushed through
-    ReadAloud reading;                     // the page's text being read, and where the visitor is in it
-    bool reading_on = false;                 // the reading was said, as the text kept numbered reading_kept
+    std::string announce_summary;     // the stick's summary, said before the first page's announcement
+    std::string announce_unreadable;  // how many of its files cannot be read, said after the summary
+    bool capturing = false;           // a camera capture is under way
+    bool captured = false;            // the picture shown is the visitor's own capture
+    bool felt = false;                // a shape, picture or page has been put under the hand in this visit
+    bool read_aloud_said = false;     // the visitor was told that their document is heard by people nearby
+    bool push_taught = false;         // the tutorial said that a wall can be pushed through
+    ReadAloud reading;                // the page's text being read, and where the visitor is in it
+    bool reading_on = false;          // the reading was said, as the text kept numbered reading_kept
     std::uint64_t reading_kept = 0;
   };
 
@@ -353,15 +372,16 @@ class KioskFlow {
   void volume_key(int delta);
   void finish_key(double now_s);
   void describe_key();
-  void reading_key(KioskKey k);               // the sentence and paragraph keys
+  void reading_key(KioskKey k);  // the sentence and paragraph keys
   void repeat_key();
-  void follow_reading();                      // the place follows the sentence heard
+  void follow_reading();  // the place follows the sentence heard
   /// Reads from `at` to the end of its paragraph, after `before` (said first, in the same text).
   void read_from(ReadingPlace at, const std::string& before);
   std::string long_text_line(const std::string& text) const;
   std::string paragraph_line(int paragraph) const;
   /// A load was asked for at `now_s`; `awaited`: another was awaited already (see the .cpp).
-  void start_loading_clock(double now_s, bool awaited);  // "Paragraph 2 of 5." on a page of more than one, else ""  // "" or "About 9 minutes of text. …" and a space
+  void start_loading_clock(double now_s, bool awaited);  // "Paragraph 2 of 5." on a page of more than one, else ""  //
+                                                         // "" or "About 9 minutes of text. …" and a space
   void level_key(int delta);
   void warn(double idle_s);
   void pause_key();
@@ -378,11 +398,13 @@ class KioskFlow {
   void announce_picture(int shapes, const std::string& before);  // "Picture 2 of 5: ... It has 3 shapes."
   void say(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
   void say_brief(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
-  std::vector<std::string> help_groups() const;  // the help's templates, a few sentences each (every key; Capture's with a camera)
+  std::vector<std::string> help_groups()
+      const;  // the help's templates, a few sentences each (every key; Capture's with a camera)
   int help_group_count() const;
   void say_help_group();  // group v_.help_group, where its keys lie, and how to go on
-  std::string key_place_sentence(std::string_view key_name) const;  // " The W key is ..." or "" (no place in the catalogue)
-  std::string place() const;  // where the visitor is, one sentence (a place_* message)
+  std::string key_place_sentence(
+      std::string_view key_name) const;                     // " The W key is ..." or "" (no place in the catalogue)
+  std::string place() const;                                // where the visitor is, one sentence (a place_* message)
   std::string spoken_key(std::string_view key_name) const;  // "The Q key", "That key"
   void request(int document, int page, double now_s);
   void step_document(int delta, double now_s);

@@ -14,45 +14,45 @@
 
 #include <atomic>
 #include <memory>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "audio/system.hpp"
 #include "config/settings.hpp"
+#include "formats/picture_notes.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/hapi_emulator.hpp"
-#include "haptics/pty_emulator.hpp"
 #include "haptics/io/haply_device.hpp"
 #include "haptics/io/usb_devices.hpp"
+#include "haptics/pty_emulator.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "haptics/triple_buffer.hpp"
 #include "pictures/capture_service.hpp"
-#include "runtime/guided_tour.hpp"
 #include "pictures/image_scene.hpp"
-#include "visit/kiosk_flow.hpp"
-#include "visit/voice.hpp"
-#include "formats/picture_notes.hpp"
-#include "pictures/scene_builder.hpp"
 #include "pictures/picture_shelf.hpp"
+#include "pictures/scene_builder.hpp"
 #include "pictures/scene_cache.hpp"
-#include "runtime/servo_step.hpp"
-#include "runtime/servo_thread.hpp"
-#include "runtime/device_host.hpp"
 #include "pictures/stick_service.hpp"
 #include "pictures/text_reader.hpp"
+#include "runtime/device_host.hpp"
+#include "runtime/guided_tour.hpp"
+#include "runtime/servo_step.hpp"
+#include "runtime/servo_thread.hpp"
+#include "visit/kiosk_flow.hpp"
+#include "visit/voice.hpp"
 
 namespace hk::app {
 
 /// What the runtime is started with besides the settings.
 struct RuntimeOptions {
-  std::string library;           ///< picture folder (already resolved; must hold at least one picture)
-  bool hotplug = true;           ///< watch for USB sticks (libudev)
-  std::string mount_root;        ///< where sticks are mounted; empty: vision::kDefaultStickMountRoot
-  bool high_contrast = false;    ///< start (and every session) in high contrast
-  bool overlay = false;          ///< start with the operator overlay
-  bool open_audio_output = true; ///< false: no PortAudio (tests)
+  std::string library;            ///< picture folder (already resolved; must hold at least one picture)
+  bool hotplug = true;            ///< watch for USB sticks (libudev)
+  std::string mount_root;         ///< where sticks are mounted; empty: vision::kDefaultStickMountRoot
+  bool high_contrast = false;     ///< start (and every session) in high contrast
+  bool overlay = false;           ///< start with the operator overlay
+  bool open_audio_output = true;  ///< false: no PortAudio (tests)
   /// Look for the USB pantograph ([device] type "auto" or "haply"); false: always the simulated one (tests,
   /// documentation runs).
   bool probe_usb_device = true;
@@ -76,23 +76,24 @@ struct Shown {
   /// polyline (joined_cut_points) [m], what the walls are at that cut step; empty otherwise.
   std::vector<std::vector<std::vector<SegmentRef>>> cut_segments;
   std::vector<std::vector<std::vector<Vec2>>> cuts;
-  std::vector<bool> closed;                            ///< [curve]
-  cv::Mat picture;                                     ///< BGR, empty for tutorial shapes
-  vision::PxToM px_to_m{1, 0, 0};                      ///< picture pixels → workspace metres
-  const Scene* scene = nullptr;                        ///< the published scene (read-only here; for the overlay)
-  std::vector<TextBlockM> text_blocks;                 ///< a document page's text (Describe reads the one under the hand)
-  PictureNotes notes;                                  ///< a library picture's title and description (its sidecar)
+  std::vector<bool> closed;             ///< [curve]
+  cv::Mat picture;                      ///< BGR, empty for tutorial shapes
+  vision::PxToM px_to_m{1, 0, 0};       ///< picture pixels → workspace metres
+  const Scene* scene = nullptr;         ///< the published scene (read-only here; for the overlay)
+  std::vector<TextBlockM> text_blocks;  ///< a document page's text (Describe reads the one under the hand)
+  PictureNotes notes;                   ///< a library picture's title and description (its sidecar)
 };
 
 /// What apply_settings did with a change, for the operator panel and the audit.
 struct ApplyReport {
-  bool gains = false;          ///< stiffness, damping, force, friction or deadline went to the servo thread
-  bool scene_rebuilt = false;  ///< the scene was rebuilt and swapped in with the fade
-  bool keys = false;           ///< the visitor's keys (and what the kiosk says of them) changed
-  bool timing = false;         ///< the session's time-out changed
+  bool gains = false;                     ///< stiffness, damping, force, friction or deadline went to the servo thread
+  bool scene_rebuilt = false;             ///< the scene was rebuilt and swapped in with the fade
+  bool keys = false;                      ///< the visitor's keys (and what the kiosk says of them) changed
+  bool timing = false;                    ///< the session's time-out changed
   std::vector<std::string> next_session;  ///< keys (table.key) that take effect with the next visitor
   std::vector<std::string> restart;       ///< keys that take effect at the next start
-  std::vector<std::string> refused;       ///< values the device's profile refused, each "<table.key> = <value> <why>; ..." (the profile's value is used)
+  std::vector<std::string> refused;  ///< values the device's profile refused, each "<table.key> = <value> <why>; ..."
+                                     ///< (the profile's value is used)
 };
 
 /// The kiosk without its window. Not thread-safe: one thread.
@@ -302,19 +303,21 @@ class KioskRuntime final : public KioskEffects {
   const StickService& sticks() const { return sticks_; }
 
  private:
-  KioskRuntime(const RuntimeOptions& options, const config::Settings& checked_settings, int);  // settings already checked
+  KioskRuntime(const RuntimeOptions& options, const config::Settings& checked_settings,
+               int);  // settings already checked
   CueTrackerParams cue_params() const;
-  void show_built(ImageScene& is, int id);  // publishes it; starts reading its text when pending
+  void show_built(ImageScene& is, int id);     // publishes it; starts reading its text when pending
   int put_picture(int index, ImageScene& is);  // library picture `index` on the device, with its notes; its shapes
-  void reset_level();                         // the operator's level and mode again (a new picture or visitor)
-  bool showing_tutorial() const;              // a practice shape is shown (ids -1 .. -3)
+  void reset_level();                          // the operator's level and mode again (a new picture or visitor)
+  bool showing_tutorial() const;               // a practice shape is shown (ids -1 .. -3)
   std::string shape_words(std::size_t curve) const;  // what curve `curve` of what is shown is, for Where and the tour
-  void text_arrived(TextRead& read);        // swaps in the page with its text and words what came
-  std::string describe_shown();             // describe() of what is shown, without the reading's news
+  void text_arrived(TextRead& read);                 // swaps in the page with its text and words what came
+  std::string describe_shown();                      // describe() of what is shown, without the reading's news
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
   void rebuild_shown();
-  void adopt_board_profile();  // the board's profile in force: settings_for_board, then servo params, hand and gains from them
-  void hand_over_tour();   // plans the announced tour from the handle and publishes it
+  void adopt_board_profile();  // the board's profile in force: settings_for_board, then servo params, hand and gains
+                               // from them
+  void hand_over_tour();       // plans the announced tour from the handle and publishes it
   void report_tour_end(const ServoDisplayState& d);  // what it traced and what remains
 
   RuntimeOptions opt_;
@@ -333,39 +336,39 @@ class KioskRuntime final : public KioskEffects {
   bool said_contrast_ = false, said_overlay_ = false;  // the switches as last announced
   int shown_id_ = -100;
   std::uint64_t scenes_published_ = 0;
-  int shown_picture_ = -1;  // library index shown, −1 for none
-  int shown_page_ = 0;      // a document page shown (from 1), 0 for a picture
+  int shown_picture_ = -1;                        // library index shown, −1 for none
+  int shown_page_ = 0;                            // a document page shown (from 1), 0 for a picture
   int screen_side_px_ = kScreenPictureMaxSidePx;  // set_screen_picture_side_px
-  int shown_document_ = -1; // stick document shown, −1 for none
-  int rebuild_page_id_ = 0; // a stick page re-requested by apply_settings (shown without a new announcement)
+  int shown_document_ = -1;                       // stick document shown, −1 for none
+  int rebuild_page_id_ = 0;  // a stick page re-requested by apply_settings (shown without a new announcement)
   static constexpr int kFirstCaptureId = -100;  // shown_id_ of the first camera capture; later ones count down
-  int captures_ = 0;        // camera captures shown so far
-  int stick_id_ = 0;        // the stick the flow browses (StickNews::stick), 0 for none
+  int captures_ = 0;                            // camera captures shown so far
+  int stick_id_ = 0;                            // the stick the flow browses (StickNews::stick), 0 for none
   bool stick_busy_ = false;
-  int stick_folder_ops_ = 0;  // folders put in or taken out whose news has not come yet (one news each)
+  int stick_folder_ops_ = 0;                 // folders put in or taken out whose news has not come yet (one news each)
   std::vector<std::string> stick_problems_;  // stick_problems()
   void note_stick_problem(std::string line);
   // The guided tour (window thread).
   VisitTouches touches_;
-  int tour_seq_ = 0;           // TourPath::id of the last tour handed over
-  int tour_running_ = 0;       // its id until poll_tour sees it ended, else 0
-  int tour_scene_ = 0;         // the picture it was planned for
-  bool far_near_said_ = false;  // Where on a practice shape has said what far and near mean in this visit
-  bool tour_quiet_ = false;    // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
-  bool guide_stops_ = false;   // this key press stopped a running or announced tour
-  bool tour_asked_ = false;    // announced, not yet handed to the servo thread
+  int tour_seq_ = 0;                // TourPath::id of the last tour handed over
+  int tour_running_ = 0;            // its id until poll_tour sees it ended, else 0
+  int tour_scene_ = 0;              // the picture it was planned for
+  bool far_near_said_ = false;      // Where on a practice shape has said what far and near mean in this visit
+  bool tour_quiet_ = false;         // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
+  bool guide_stops_ = false;        // this key press stopped a running or announced tour
+  bool tour_asked_ = false;         // announced, not yet handed to the servo thread
   std::int64_t tour_due_tick_ = 0;  // the servo tick from which the announced tour may start
-  Vec2 cursor_in_;             // the last cursor given to set_cursor [m]
-  Vec2 cursor_offset_;         // added to it: where tours left the hand [m]
-  Vec2 tour_cursor_ref_;       // cursor_in_ when the tour was handed over [m]
+  Vec2 cursor_in_;                  // the last cursor given to set_cursor [m]
+  Vec2 cursor_offset_;              // added to it: where tours left the hand [m]
+  Vec2 tour_cursor_ref_;            // cursor_in_ when the tour was handed over [m]
   // The text of the page shown (window thread).
   TextReader text_;
   double text_since_s_ = -1.0;  // poll_text's clock when the reading was first seen, −1 before
   bool text_said_ = false;      // "Reading the text." was said for it
   std::string text_news_;       // what came of it, said once nothing else is being said
   int text_news_id_ = 0;        // the scene it is about
-  CaptureService capture_;  // the camera; its worker stops before the rest goes
-  StickService sticks_;     // last: its threads stop first
+  CaptureService capture_;      // the camera; its worker stops before the rest goes
+  StickService sticks_;         // last: its threads stop first
 };
 
 }  // namespace hk::app

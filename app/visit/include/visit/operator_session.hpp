@@ -27,11 +27,11 @@ class PinVerifier;
 
 /// Where the panel stands.
 enum class PanelState {
-  closed,      ///< the visitor's kiosk; the chord opens the PIN prompt
-  notice,      ///< a message instead of the PIN prompt (no PIN set, no settings file); closes after a while
-  pin_entry,   ///< asking for the PIN (a wait is shown while the lockout holds)
-  checking,    ///< the PIN is being verified on the worker thread
-  open,        ///< the settings and the live status
+  closed,     ///< the visitor's kiosk; the chord opens the PIN prompt
+  notice,     ///< a message instead of the PIN prompt (no PIN set, no settings file); closes after a while
+  pin_entry,  ///< asking for the PIN (a wait is shown while the lockout holds)
+  checking,   ///< the PIN is being verified on the worker thread
+  open,       ///< the settings and the live status
 };
 
 /// The operator's panel's state and actions.
@@ -63,7 +63,9 @@ class OperatorSession {
 
   PanelState state() const { return state_; }
   /// True while the keyboard belongs to the panel (prompt or panel): visitor keys are not acted on.
-  bool captures_keyboard() const { return state_ == PanelState::pin_entry || state_ == PanelState::checking || state_ == PanelState::open; }
+  bool captures_keyboard() const {
+    return state_ == PanelState::pin_entry || state_ == PanelState::checking || state_ == PanelState::open;
+  }
   /// The line shown under the PIN prompt or as the notice ("Wrong PIN. 2 failed attempts.", "Try again in 27 s.").
   const std::string& message() const { return message_; }
   /// Seconds until a PIN is heard (0 = now); infinity when locked until `pin set`.

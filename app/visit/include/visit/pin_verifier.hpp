@@ -52,14 +52,14 @@ class PinVerifier {
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   bool stop_ = false;
-  bool pending_ = false;   ///< an attempt submitted, not started
-  bool busy_ = false;      ///< submitted and not finished
+  bool pending_ = false;  ///< an attempt submitted, not started
+  bool busy_ = false;     ///< submitted and not finished
   /// The PIN of the pending attempt; never longer than kPinMaxDigits + 1 (a longer string is cut there
   /// and stays no PIN), so the string's storage never moves.
   std::string pin_;
   std::int64_t now_unix_s_ = 0;
   std::optional<PinOutcome> outcome_;
-  std::thread worker_;     ///< last: started after everything above exists
+  std::thread worker_;  ///< last: started after everything above exists
 };
 
 }  // namespace hk::app

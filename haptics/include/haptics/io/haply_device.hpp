@@ -57,7 +57,7 @@ namespace hk::io {
 /// Settings of the USB pantograph. Units in names. Defaults: the gen3 2DIY (config [device] defaults).
 struct HaplyDeviceParams {
   hapi::BoardLayout layout = hapi::BoardLayout::haply_gen3();  ///< ports, directions, offsets, device id
-  hapi::HaplyMechanism mechanism;          ///< link lengths and motor spacing [m]
+  hapi::HaplyMechanism mechanism;                              ///< link lengths and motor spacing [m]
   double torque_limit_n_m = 0.123;         ///< |τ| clamp per motor [N·m] (the firmware's MAX_TORQUE)
   Vec2 rect_center_device_m{0.0, -0.088};  ///< centre of the device's usable rectangle, device frame [m]
   Vec2 rect_size_device_m{0.112, 0.072};   ///< its width and height [m]
@@ -65,7 +65,7 @@ struct HaplyDeviceParams {
   int lost_after_ticks = 3;                ///< ticks without a valid reply before Lost, ≥ 1
   int open_timeout_ms = 1000;              ///< open() waits this long for the first reply [ms]
   double reopen_interval_s = 0.5;          ///< a gone transport is re-opened this often [s]
-  double max_step_deg = 20.0;              ///< a reply whose angle moved more than this since the last good one is refused [deg]
+  double max_step_deg = 20.0;  ///< a reply whose angle moved more than this since the last good one is refused [deg]
 };
 
 /// Makes a new, not yet opened transport to the board (called at open and by the re-open thread).
@@ -79,7 +79,8 @@ struct HaplyCounters {
   std::int64_t malformed = 0;        ///< replies refused (wrong id, bad angle, out of step): bytes dropped
   std::int64_t reconnects = 0;       ///< times the status went from Lost back to Ok
   std::int64_t reopens = 0;          ///< transports re-opened in the background
-  std::int64_t writes_skipped = 0;   ///< ticks whose packet was not sent: the last one's reply not yet in, or the transport full
+  std::int64_t writes_skipped =
+      0;  ///< ticks whose packet was not sent: the last one's reply not yet in, or the transport full
 };
 
 /// Ticks a packet's reply is waited for before the next packet goes out anyway (the reply is then missing).
@@ -94,8 +95,8 @@ double workspace_scale(const HaplyDeviceParams& p) noexcept;
 /// (the joint angle the park place has, by inverse kinematics, − the angle reported), the difference
 /// wrapped into (−180°, 180°]. Returns false (outputs untouched) when the park place is out of the links'
 /// reach or an input is not finite.
-bool calibrated_offsets(const HaplyDeviceParams& p, Vec2 park_workspace_m, double reported_th1_deg, double reported_th2_deg,
-                        double* offset1_deg, double* offset2_deg) noexcept;
+bool calibrated_offsets(const HaplyDeviceParams& p, Vec2 park_workspace_m, double reported_th1_deg,
+                        double reported_th2_deg, double* offset1_deg, double* offset2_deg) noexcept;
 
 /// The force the pantograph can give in every direction everywhere in its usable rectangle [N]: at each
 /// point of a 21 × 21 grid over the rectangle and each of 72 directions u, the largest f with
@@ -113,16 +114,17 @@ struct BoardCandidate {
 
 /// What trying one candidate found.
 struct BoardProbe {
-  std::string name;        ///< the candidate's name
-  bool answered = false;   ///< its board answered the protocol and was taken
-  std::string how;         ///< answered: "hAPI reply from device id 5 after 12 ms"; else why not (one line)
+  std::string name;       ///< the candidate's name
+  bool answered = false;  ///< its board answered the protocol and was taken
+  std::string how;        ///< answered: "hAPI reply from device id 5 after 12 ms"; else why not (one line)
 };
 
 /// Opens the first candidate whose board answers the protocol — reset, setup, zero-torque packets until a
 /// well-formed reply (HaplyDevice::open, within open_timeout_ms) — and returns it open; a later reply, a
 /// tick or more behind, is taken as it comes. One BoardProbe per candidate tried is appended to `probes`
 /// (may be null). Null when none answered; the probes say why (missing, busy, no permission, garbage, silence).
-std::unique_ptr<HaplyDevice> open_first_board(const HaplyDeviceParams& params, const std::vector<BoardCandidate>& candidates,
+std::unique_ptr<HaplyDevice> open_first_board(const HaplyDeviceParams& params,
+                                              const std::vector<BoardCandidate>& candidates,
                                               std::vector<BoardProbe>* probes);
 
 /// The hAPI pantograph as a `Device`.
@@ -191,28 +193,29 @@ class HaplyDevice final : public Device {
   HaplyDeviceParams params_;
   TransportFactory factory_;
   PantographGeometry geometry_;
-  double scale_ = 1.0;                        // device → workspace [m/m]
-  std::unique_ptr<ByteTransport> transport_;  // servo thread's (after open)
+  double scale_ = 1.0;                            // device → workspace [m/m]
+  std::unique_ptr<ByteTransport> transport_;      // servo thread's (after open)
   std::atomic<ByteTransport*> pending_{nullptr};  // re-open thread → servo thread
   std::atomic<ByteTransport*> retired_{nullptr};  // servo thread → re-open thread (to close and free)
-  std::atomic<bool> gone_{false};             // the transport in use reported kGone
+  std::atomic<bool> gone_{false};                 // the transport in use reported kGone
   std::atomic<DeviceStatus> status_{DeviceStatus::Closed};
   std::uint8_t rx_[256] = {};
   int rx_len_ = 0;
-  bool outstanding_ = false;                  // a torque packet waits for its reply
-  int outstanding_age_ = 0;                   // reads since it was sent without its reply
-  bool fresh_ = false;                        // a valid reply was taken since the last read()
+  bool outstanding_ = false;                     // a torque packet waits for its reply
+  int outstanding_age_ = 0;                      // reads since it was sent without its reply
+  bool fresh_ = false;                           // a valid reply was taken since the last read()
   std::uint8_t tx_[hapi::kMaxPacketBytes] = {};  // the last packet
-  int tx_len_ = 0, tx_at_ = 0;                // its length and how much of it the transport took
+  int tx_len_ = 0, tx_at_ = 0;                   // its length and how much of it the transport took
   int missing_in_row_ = 0;
   bool have_angles_ = false;
   std::atomic<double> th1_deg_{0.0}, th2_deg_{0.0};
   std::atomic<double> tau1_{0.0}, tau2_{0.0};
   std::atomic<double> correction1_deg_{0.0}, correction2_deg_{0.0};  // apply_offsets − the layout's offsets
-  JointAngles q_;                             // our joint angles of the newest valid reply
-  Vec2 handle_ws_m_;                          // its handle, workspace frame
+  JointAngles q_;                                                    // our joint angles of the newest valid reply
+  Vec2 handle_ws_m_;                                                 // its handle, workspace frame
   std::int64_t t0_ns_ = 0;
-  std::atomic<std::int64_t> ticks_{0}, replies_{0}, missing_{0}, malformed_{0}, reconnects_{0}, reopens_{0}, skipped_{0};
+  std::atomic<std::int64_t> ticks_{0}, replies_{0}, missing_{0}, malformed_{0}, reconnects_{0}, reopens_{0},
+      skipped_{0};
   std::mutex reopen_mutex_;
   std::condition_variable reopen_cv_;
   bool stop_reopen_ = false;

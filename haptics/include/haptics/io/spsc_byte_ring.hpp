@@ -20,8 +20,7 @@ namespace hk::io {
 class SpscByteRing {
  public:
   /// `capacity_bytes` must be a power of two in [2, 2^30]; else throws hk::DeviceError naming it.
-  explicit SpscByteRing(std::size_t capacity_bytes)
-      : capacity_(capacity_bytes), mask_(capacity_bytes - 1) {
+  explicit SpscByteRing(std::size_t capacity_bytes) : capacity_(capacity_bytes), mask_(capacity_bytes - 1) {
     if (capacity_bytes < 2 || capacity_bytes > (std::size_t{1} << 30) || (capacity_bytes & mask_) != 0) {
       throw DeviceError("byte ring capacity " + std::to_string(capacity_bytes) +
                         " must be a power of two in [2, 2^30]");

@@ -39,9 +39,10 @@ std::vector<UsbDeviceInfo> list_usb_devices(std::string* reason = nullptr);
 /// constructor on the constructing thread; the libusb docs warn that with ENUMERATE one arrival may be
 /// reported twice and a departure may come without its arrival, so treat calls as "state may have
 /// changed" and re-check with list_usb_devices() if exact counts matter. Runs its own libusb context and
-/// event thread; later calls come on that thread and must not block long or call back into the monitor. When libusb cannot start or lacks hotplug support
-/// (libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG) == 0), supported() is false, nothing is ever called,
-/// and callers poll list_usb_devices() instead. Never throws from the constructor for lack of USB.
+/// event thread; later calls come on that thread and must not block long or call back into the monitor. When libusb
+/// cannot start or lacks hotplug support (libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG) == 0), supported() is false,
+/// nothing is ever called, and callers poll list_usb_devices() instead. Never throws from the constructor for lack of
+/// USB.
 class UsbHotplugMonitor {
  public:
   UsbHotplugMonitor(std::uint16_t vid, int pid, std::function<void(bool arrived)> on_change);
