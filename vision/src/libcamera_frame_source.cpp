@@ -451,87 +451,104 @@ class LibcameraFrameSource final : public FrameSource {
   /// work_ (the planes of one frame, back to back) as BGR.
   cv::Mat convert() const {
     const std::size_t plane0 = work_planes_.empty() ? 0 : work_planes_[0];
-    const std::size_t total = work_.size();
-    auto* data = const_cast<std::uint8_t*>(work_.data());  // cv::Mat header over bytes it does not change
-    const auto h = static_cast<std::size_t>(height_);
-    cv::Mat bgr;
-    const auto short_frame = [&](std::size_t need) {
-      fail("frame " + std::to_string(next_index_) + " is " + std::to_string(total) + " bytes, " + std::to_string(need) +
-           " expected");
-    };
     switch (conversion_) {
       case Conversion::Copy:
       case Conversion::SwapRB:
       case Conversion::DropX:
       case Conversion::DropXSwapRB:
-      case Conversion::Yuyv: {
-        const std::size_t need = stride_ * (h - 1) + static_cast<std::size_t>(width_) * bytes_per_pixel();
-        if (plane0 < need) short_frame(need);
-        const int type = conversion_ == Conversion::Yuyv ? CV_8UC2 : (bytes_per_pixel() == 4 ? CV_8UC4 : CV_8UC3);
-        const cv::Mat src(height_, width_, type, data, stride_);
-        switch (conversion_) {
-          case Conversion::Copy:
-            bgr = src.clone();
-            break;
-          case Conversion::SwapRB:
-            cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR);
-            break;
-          case Conversion::DropX:
-            cv::cvtColor(src, bgr, cv::COLOR_BGRA2BGR);
-            break;
-          case Conversion::DropXSwapRB:
-            cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGR);
-            break;
-          default:
-            cv::cvtColor(src, bgr, cv::COLOR_YUV2BGR_YUYV);
-            break;
-        }
-        return bgr;
-      }
-      case Conversion::Nv12: {
-        // Y: height lines, then interleaved UV: height / 2 lines, each stride bytes (in one plane or two).
-        const std::size_t luma = stride_ * h;
-        const std::size_t chroma_lines = h / 2;
-        const std::size_t need_uv = stride_ * (chroma_lines - 1) + static_cast<std::size_t>(width_);
-        const std::uint8_t* uv = nullptr;
-        if (work_planes_.size() >= 2) {
-          if (plane0 < stride_ * (h - 1) + static_cast<std::size_t>(width_)) short_frame(luma + need_uv);
-          if (work_planes_[1] < need_uv) short_frame(luma + need_uv);
-          uv = work_.data() + plane0;
-        } else {
-          if (plane0 < luma + need_uv) short_frame(luma + need_uv);
-          uv = work_.data() + luma;
-        }
-        cv::Mat packed(height_ + height_ / 2, width_, CV_8UC1);
-        for (int y = 0; y < height_; ++y) {
-          std::memcpy(packed.ptr(y), work_.data() + stride_ * static_cast<std::size_t>(y),
-                      static_cast<std::size_t>(width_));
-        }
-        for (int y = 0; y < height_ / 2; ++y) {
-          std::memcpy(packed.ptr(height_ + y), uv + stride_ * static_cast<std::size_t>(y),
-                      static_cast<std::size_t>(width_));
-        }
-        cv::cvtColor(packed, bgr, cv::COLOR_YUV2BGR_NV12);
-        return bgr;
-      }
-      case Conversion::Jpeg: {
-        if (plane0 == 0) short_frame(1);
-        if (static_cast<std::int64_t>(plane0) > params_.max_frame_bytes) {
-          fail("frame of " + std::to_string(plane0) + " bytes exceeds the limit of " +
-               std::to_string(params_.max_frame_bytes) + " bytes");
-        }
-        const cv::Mat jpeg(1, static_cast<int>(plane0), CV_8UC1, data);
-        try {
-          bgr = cv::imdecode(jpeg, cv::IMREAD_COLOR);
-        } catch (const cv::Exception&) {
-          bgr.release();
-        }
-        if (bgr.empty() || bgr.type() != CV_8UC3) {
-          fail("frame " + std::to_string(next_index_) + " (" + std::to_string(plane0) +
-               " bytes of MJPEG) cannot be decoded");
-        }
-        return bgr;
-      }
+      case Conversion::Yuyv:
+        return convert_packed(plane0);
+      case Conversion::Nv12:
+        return convert_nv12(plane0);
+      case Conversion::Jpeg:
+        return convert_jpeg(plane0);
+    }
+    return {};
+  }
+
+  /// Fails with the frame's size against the `need` bytes its format takes.
+  [[noreturn]] void short_frame(std::size_t need) const {
+    fail("frame " + std::to_string(next_index_) + " is " + std::to_string(work_.size()) + " bytes, " +
+         std::to_string(need) + " expected");
+  }
+
+  /// Packed pixels in the first plane (`plane0` bytes): RGB, BGR, XRGB-style or YUYV, as BGR.
+  cv::Mat convert_packed(std::size_t plane0) const {
+    const auto h = static_cast<std::size_t>(height_);
+    const std::size_t need = stride_ * (h - 1) + static_cast<std::size_t>(width_) * bytes_per_pixel();
+    if (plane0 < need) short_frame(need);
+    const int type = conversion_ == Conversion::Yuyv ? CV_8UC2 : (bytes_per_pixel() == 4 ? CV_8UC4 : CV_8UC3);
+    auto* data = const_cast<std::uint8_t*>(work_.data());  // cv::Mat header over bytes it does not change
+    const cv::Mat src(height_, width_, type, data, stride_);
+    cv::Mat bgr;
+    switch (conversion_) {
+      case Conversion::Copy:
+        bgr = src.clone();
+        break;
+      case Conversion::SwapRB:
+        cv::cvtColor(src, bgr, cv::COLOR_RGB2BGR);
+        break;
+      case Conversion::DropX:
+        cv::cvtColor(src, bgr, cv::COLOR_BGRA2BGR);
+        break;
+      case Conversion::DropXSwapRB:
+        cv::cvtColor(src, bgr, cv::COLOR_RGBA2BGR);
+        break;
+      default:
+        cv::cvtColor(src, bgr, cv::COLOR_YUV2BGR_YUYV);
+        break;
+    }
+    return bgr;
+  }
+
+  /// NV12 as BGR: Y, height lines, then interleaved UV, height / 2 lines, each stride bytes (in one plane or
+  /// two; the first `plane0` bytes long).
+  cv::Mat convert_nv12(std::size_t plane0) const {
+    const auto h = static_cast<std::size_t>(height_);
+    const std::size_t luma = stride_ * h;
+    const std::size_t chroma_lines = h / 2;
+    const std::size_t need_uv = stride_ * (chroma_lines - 1) + static_cast<std::size_t>(width_);
+    const std::uint8_t* uv = nullptr;
+    if (work_planes_.size() >= 2) {
+      if (plane0 < stride_ * (h - 1) + static_cast<std::size_t>(width_)) short_frame(luma + need_uv);
+      if (work_planes_[1] < need_uv) short_frame(luma + need_uv);
+      uv = work_.data() + plane0;
+    } else {
+      if (plane0 < luma + need_uv) short_frame(luma + need_uv);
+      uv = work_.data() + luma;
+    }
+    cv::Mat packed(height_ + height_ / 2, width_, CV_8UC1);
+    for (int y = 0; y < height_; ++y) {
+      std::memcpy(packed.ptr(y), work_.data() + stride_ * static_cast<std::size_t>(y),
+                  static_cast<std::size_t>(width_));
+    }
+    for (int y = 0; y < height_ / 2; ++y) {
+      std::memcpy(packed.ptr(height_ + y), uv + stride_ * static_cast<std::size_t>(y),
+                  static_cast<std::size_t>(width_));
+    }
+    cv::Mat bgr;
+    cv::cvtColor(packed, bgr, cv::COLOR_YUV2BGR_NV12);
+    return bgr;
+  }
+
+  /// One MJPEG frame of `plane0` bytes, decoded to BGR under [camera]'s frame size limit.
+  cv::Mat convert_jpeg(std::size_t plane0) const {
+    if (plane0 == 0) short_frame(1);
+    if (static_cast<std::int64_t>(plane0) > params_.max_frame_bytes) {
+      fail("frame of " + std::to_string(plane0) + " bytes exceeds the limit of " +
+           std::to_string(params_.max_frame_bytes) + " bytes");
+    }
+    auto* data = const_cast<std::uint8_t*>(work_.data());  // cv::Mat header over bytes it does not change
+    const cv::Mat jpeg(1, static_cast<int>(plane0), CV_8UC1, data);
+    cv::Mat bgr;
+    try {
+      bgr = cv::imdecode(jpeg, cv::IMREAD_COLOR);
+    } catch (const cv::Exception&) {
+      bgr.release();
+    }
+    if (bgr.empty() || bgr.type() != CV_8UC3) {
+      fail("frame " + std::to_string(next_index_) + " (" + std::to_string(plane0) +
+           " bytes of MJPEG) cannot be decoded");
     }
     return bgr;
   }

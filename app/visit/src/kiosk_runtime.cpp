@@ -81,6 +81,7 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
       sp_(servo_params_from(s)),
       core_(cue_params(), &audio_.cues()),
       devices_(s),
+      tour_(core_, devices_, voice_, audio_, s_, half_, devices_.simulated_handle_m()),
       shelf_(library_shelf(o, s)),
       capture_(s, o.probe_camera || s.camera.source != "auto"
                       ? choose_camera(s.camera)
@@ -97,7 +98,6 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
     }
     devices_.watch_hotplug();
   }
-  cursor_in_ = devices_.simulated_handle_m();
   level_ = s.haptics.level;
   auto_level_ = s.haptics.level_mode != "fixed";
   high_contrast_ = said_contrast_ = o.high_contrast;
@@ -580,118 +580,26 @@ void KioskRuntime::new_session() {
   shelf_.drop_want();
   audio_.new_session();
   voice_.forget();
-  tour_asked_ = false;
   reset_level();
   high_contrast_ = said_contrast_ = opt_.high_contrast;
-  if (tour_running_) {
-    core_.cancel_tour();
-    tour_quiet_ = true;
-  }
-  touches_.reset(shown_id_, shown_.scene ? static_cast<int>(shown_.scene->curve_count()) : 0);
-  cursor_offset_ = {};
+  tour_.new_visitor(shown_id_, shown_.scene ? static_cast<int>(shown_.scene->curve_count()) : 0);
 }
 
-void KioskRuntime::set_cursor(Vec2 m) {
-  cursor_in_ = m;
-  if (tour_running_ && !tour_quiet_ && length(m - tour_cursor_ref_) > 0.003) {
-    core_.cancel_tour();  // the visitor's hand takes over
-    tour_quiet_ = true;
-    spdlog::info("tour: stopped by the hand");
-  }
-  const Vec2 c = m + cursor_offset_;
-  const bool offset = cursor_offset_.x != 0.0 || cursor_offset_.y != 0.0;
-  devices_.set_target(offset ? Vec2{std::clamp(c.x, -half_.x, half_.x), std::clamp(c.y, -half_.y, half_.y)} : m);
-}
+void KioskRuntime::set_cursor(Vec2 m) { tour_.set_cursor(m); }
 
-void KioskRuntime::key_pressed() {
-  guide_stops_ = tour_running_ != 0 || tour_asked_;
-  tour_asked_ = false;  // an announced tour does not start
-  if (tour_running_) {
-    core_.cancel_tour();
-    tour_quiet_ = true;
-  }
-}
+void KioskRuntime::key_pressed() { tour_.key_pressed(); }
 
-void KioskRuntime::guide() {
-  if (guide_stops_) {
-    guide_stops_ = false;
-    say(audio_.messages().text(audio::MessageId::tour_stopped));
-    return;
-  }
-  if (!shown_.scene) return;
-  const TourParams tp = tour_params_from(s_);
-  if (!plan_tour(*shown_.scene, shown_id_, core_.display().handle_m, touches_, tp)) {
-    bool any_shape = false;
-    for (std::size_t c = 0; c < shown_.scene->curve_count(); ++c)
-      any_shape = any_shape || is_tour_shape(*shown_.scene, c, tp);
-    say(audio_.messages().text(any_shape ? audio::MessageId::tour_all_touched : audio::MessageId::tour_nothing));
-    return;
-  }
-  // Ask first: the pull starts once the visitor has heard what is coming (counted in servo ticks, so the
-  // same in a headless run as at the kiosk).
-  const std::string ask = audio_.messages().text(audio::MessageId::tour_ask);
-  say_brief(ask);
-  tour_asked_ = true;
-  tour_scene_ = shown_id_;
-  tour_due_tick_ = core_.display().tick +
-                   static_cast<std::int64_t>(
-                       std::ceil((audio_.speech_duration_s(ask) + kTourAskMargin_s) * s_.haptics.servo_rate_hz));
-}
+void KioskRuntime::guide() { tour_.guide(tour_picture()); }
 
-void KioskRuntime::hand_over_tour() {
-  tour_asked_ = false;
-  if (!shown_.scene || tour_scene_ != shown_id_) return;  // another picture came meanwhile
-  const TourParams tp = tour_params_from(s_);
-  std::optional<TourPath> plan = plan_tour(*shown_.scene, shown_id_, core_.display().handle_m, touches_, tp);
-  if (!plan) return;  // touched meanwhile: nothing left to lead to
-  plan->id = ++tour_seq_;
-  tour_running_ = plan->id;
-  tour_quiet_ = false;
-  tour_cursor_ref_ = cursor_in_;
-  spdlog::info("tour {}: to shape {} ({:.1f} s)", plan->id, plan->curve, plan->duration_s());
-  devices_.set_limp(true);
-  core_.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
-}
+void KioskRuntime::poll_tour() { tour_.poll(tour_picture()); }
 
-void KioskRuntime::poll_tour() {
-  const ServoDisplayState& d = core_.display();
-  if (d.scene_id == touches_.scene_id() && d.curve >= 0) touches_.touch(d.scene_id, d.curve);
-  if (tour_asked_ && d.tick >= tour_due_tick_) hand_over_tour();
-  if (!tour_running_ || d.tour_id != tour_running_ || !tour_ended(d.tour_phase)) return;
-  if (d.tour_phase == TourPhase::Done) touches_.touch(tour_scene_, d.tour_curve);
-  tour_running_ = 0;
-  // The hand lets go where the tour left the handle (unless the visitor's own hand took over).
-  if (devices_.limp()) {
-    if (!tour_quiet_ || length(cursor_in_ - tour_cursor_ref_) <= 0.003) cursor_offset_ = d.handle_m - cursor_in_;
-    set_cursor(cursor_in_);
-    devices_.set_limp(false);
-  }
-  if (tour_quiet_ || !shown_.scene || tour_scene_ != shown_id_) return;
-  report_tour_end(d);
-}
-
-void KioskRuntime::report_tour_end(const ServoDisplayState& d) {
-  const audio::MessageCatalog& m = audio_.messages();
-  std::string text;
-  if (d.tour_phase == TourPhase::Stopped) {
-    text = m.text(audio::MessageId::tour_stopped) + " ";
-  } else if (d.tour_phase == TourPhase::Stuck) {
-    spdlog::warn("tour {}: stuck on shape {} (no progress), let go", d.tour_id, d.tour_curve);
-    text = m.text(audio::MessageId::tour_stuck) + " ";
-  } else if (d.tour_curve >= 0 && static_cast<std::size_t>(d.tour_curve) < shown_.polylines.size()) {
-    text =
-        m.text(audio::MessageId::tour_traced, {{"shape", std::to_string(d.tour_curve + 1)},
-                                               {"description", shape_words(static_cast<std::size_t>(d.tour_curve))}}) +
-        " ";
-  }
-  const int left = shapes_remaining(*shown_.scene, touches_, tour_params_from(s_));
-  if (left == 0)
-    text += m.text(audio::MessageId::tour_all_touched);
-  else if (left == 1)
-    text += m.text(audio::MessageId::tour_one_remaining);
-  else
-    text += m.text(audio::MessageId::tour_remaining, {{"count", std::to_string(left)}});
-  say(text);
+TourPicture KioskRuntime::tour_picture() const {
+  TourPicture p;
+  p.scene = shown_.scene;
+  p.id = shown_id_;
+  p.described = shown_.polylines.size();
+  p.words = [this](std::size_t curve) { return shape_words(curve); };
+  return p;
 }
 
 int KioskRuntime::find_picture(const std::string& path) const { return shelf_.find(path); }
@@ -732,12 +640,7 @@ void KioskRuntime::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::
   sh.scene = bundle->scene.get();
   shown_ = std::move(sh);
   shown_id_ = id;
-  touches_.reset(id, static_cast<int>(sc.curve_count()));  // touches are kept per picture
-  tour_asked_ = false;
-  if (tour_running_) {
-    core_.cancel_tour();  // the servo stops it at the swap anyway; nothing to say of it
-    tour_quiet_ = true;
-  }
+  tour_.picture_changed(id, static_cast<int>(sc.curve_count()));
   core_.publish(std::move(bundle));
 }
 

@@ -12,7 +12,6 @@
 /// builder's worker (every library picture and every rebuild after Apply is built there, never on the window
 /// thread: scene_builder.hpp), the text reader's and the stick service's threads are owned here.
 
-#include <atomic>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -22,18 +21,9 @@
 #include "audio/system.hpp"
 #include "config/settings.hpp"
 #include "formats/picture_notes.hpp"
-#include "haptics/hand_path.hpp"
-#include "haptics/hapi_emulator.hpp"
-#include "haptics/io/haply_device.hpp"
-#include "haptics/io/usb_devices.hpp"
-#include "haptics/pty_emulator.hpp"
-#include "haptics/sim_pantograph.hpp"
-#include "haptics/triple_buffer.hpp"
 #include "pictures/capture_service.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_shelf.hpp"
-#include "pictures/scene_builder.hpp"
-#include "pictures/scene_cache.hpp"
 #include "pictures/stick_service.hpp"
 #include "pictures/text_reader.hpp"
 #include "runtime/device_host.hpp"
@@ -41,6 +31,7 @@
 #include "runtime/servo_step.hpp"
 #include "runtime/servo_thread.hpp"
 #include "visit/kiosk_flow.hpp"
+#include "visit/tour_desk.hpp"
 #include "visit/voice.hpp"
 
 namespace hk::app {
@@ -205,13 +196,13 @@ class KioskRuntime final : public KioskEffects {
   /// the handle back to the cursor where it is.
   void poll_tour();
   /// Whether a tour announced or handed to the servo thread has not yet been reported ended (poll_tour).
-  bool tour_running() const { return tour_running_ != 0 || tour_asked_; }
+  bool tour_running() const { return tour_.running(); }
   /// A tour is announced and not yet handed to the servo thread.
-  bool tour_announced() const { return tour_asked_; }
+  bool tour_announced() const { return tour_.announced(); }
   /// Extra time after the tour's announcement before its force may start [s] (the sound device's latency).
-  static constexpr double kTourAskMargin_s = 0.3;
+  static constexpr double kTourAskMargin_s = TourDesk::kAskMargin_s;
   /// The shapes touched in this visit of the picture shown.
-  const VisitTouches& touches() const { return touches_; }
+  const VisitTouches& touches() const { return tour_.touches(); }
 
   /// Window thread, every frame (`now_s` the frame clock [s]): scenes the builder has finished. The one asked
   /// for is put on the device with the fade and handed to `flow` (picture_ready or picture_failed; null: a
@@ -311,14 +302,13 @@ class KioskRuntime final : public KioskEffects {
   void reset_level();                          // the operator's level and mode again (a new picture or visitor)
   bool showing_tutorial() const;               // a practice shape is shown (ids -1 .. -3)
   std::string shape_words(std::size_t curve) const;  // what curve `curve` of what is shown is, for Where and the tour
+  TourPicture tour_picture() const;                  // what is shown, as the tour sees it
   void text_arrived(TextRead& read);                 // swaps in the page with its text and words what came
   std::string describe_shown();                      // describe() of what is shown, without the reading's news
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
   void rebuild_shown();
   void adopt_board_profile();  // the board's profile in force: settings_for_board, then servo params, hand and gains
                                // from them
-  void hand_over_tour();       // plans the announced tour from the handle and publishes it
-  void report_tour_end(const ServoDisplayState& d);  // what it traced and what remains
 
   RuntimeOptions opt_;
   config::Settings s_;
@@ -328,6 +318,7 @@ class KioskRuntime final : public KioskEffects {
   ServoParams sp_;
   ServoStep core_;
   DeviceHost devices_;  // after core_: its servo thread steps core_, and stops before core_ goes
+  TourDesk tour_;       // the guided tour's window-thread half
   PictureShelf shelf_;  // the library's scenes, asked for and built ahead
   Shown shown_;
   int level_ = 1;           // the fixed level (auto_level_ false)
@@ -348,19 +339,7 @@ class KioskRuntime final : public KioskEffects {
   int stick_folder_ops_ = 0;                 // folders put in or taken out whose news has not come yet (one news each)
   std::vector<std::string> stick_problems_;  // stick_problems()
   void note_stick_problem(std::string line);
-  // The guided tour (window thread).
-  VisitTouches touches_;
-  int tour_seq_ = 0;                // TourPath::id of the last tour handed over
-  int tour_running_ = 0;            // its id until poll_tour sees it ended, else 0
-  int tour_scene_ = 0;              // the picture it was planned for
-  bool far_near_said_ = false;      // Where on a practice shape has said what far and near mean in this visit
-  bool tour_quiet_ = false;         // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
-  bool guide_stops_ = false;        // this key press stopped a running or announced tour
-  bool tour_asked_ = false;         // announced, not yet handed to the servo thread
-  std::int64_t tour_due_tick_ = 0;  // the servo tick from which the announced tour may start
-  Vec2 cursor_in_;                  // the last cursor given to set_cursor [m]
-  Vec2 cursor_offset_;              // added to it: where tours left the hand [m]
-  Vec2 tour_cursor_ref_;            // cursor_in_ when the tour was handed over [m]
+  bool far_near_said_ = false;  // Where on a practice shape has said what far and near mean in this visit
   // The text of the page shown (window thread).
   TextReader text_;
   double text_since_s_ = -1.0;  // poll_text's clock when the reading was first seen, −1 before

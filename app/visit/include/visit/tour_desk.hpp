@@ -1,0 +1,102 @@
+#pragma once
+/// @file tour_desk.hpp
+/// The guided tour's window-thread half (runtime/guided_tour.hpp plans it, the servo step follows it): the
+/// Guide key's question ("I will guide your hand to a shape. Hold the handle lightly."), the tour planned
+/// from where the handle is once that has been heard and handed to the servo thread, the cursor while it
+/// runs (a cursor that moves more than 3 mm takes over; the model hand goes limp, so the tour leads the
+/// handle), and what is said when it ends: the shape it traced and what remains. It also keeps which shapes
+/// the handle touched in this visit of the picture shown (VisitTouches), from which the next tour is chosen.
+///
+/// Window thread only: it reads the servo's display state and hands tours over through ServoStep's
+/// publish_tour and cancel_tour, nothing else.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "audio/system.hpp"
+#include "config/settings.hpp"
+#include "haptics/scene.hpp"
+#include "runtime/device_host.hpp"
+#include "runtime/guided_tour.hpp"
+#include "runtime/servo_step.hpp"
+#include "visit/voice.hpp"
+
+namespace hk::app {
+
+/// The picture shown, as the tour sees it.
+struct TourPicture {
+  const Scene* scene = nullptr;  ///< null: nothing shown
+  int id = 0;                    ///< its SceneBundle id
+  std::size_t described = 0;     ///< shapes `words` can name (the level-0 curves shown)
+  /// What shape `curve` is, in words ("a small closed shape, on the left"), for the line said at a tour's end.
+  std::function<std::string(std::size_t curve)> words;
+};
+
+/// The guided tour between the Guide key and the line said at its end. Not thread-safe: the window thread.
+class TourDesk {
+ public:
+  /// Extra time after the tour's question before its force may start [s] (the sound device's latency).
+  static constexpr double kAskMargin_s = 0.3;
+
+  /// Everything given outlives the desk. `settings`: the settings in use (tour_params_from; the servo rate
+  /// that times the question); `half_m`: half the workspace's extent [m]; `cursor_m`: where the model hand
+  /// starts [m].
+  TourDesk(ServoStep& step, DeviceHost& devices, Voice& voice, const audio::AudioSystem& audio,
+           const config::Settings& settings, Vec2 half_m, Vec2 cursor_m);
+
+  /// The model hand's target [m] (the mouse or a script stands in for the visitor's hand). After a tour the
+  /// hand keeps the place the tour led the handle to: later cursors are offset by it (until new_visitor).
+  /// While a tour runs, a cursor more than 3 mm from where it was at the hand-over stops it.
+  void set_cursor(Vec2 m);
+  /// Any key: stops a tour under way or announced, quietly (the Guide key that did so then says so).
+  void key_pressed();
+  /// The Guide key on `picture`: when it has a shape not yet touched (plan_tour), asks first; the tour is
+  /// planned and handed to the servo thread by poll() once the question has been heard (its length in servo
+  /// ticks, kAskMargin_s more). Nothing left: says so (tour_all_touched, or tour_nothing without shapes).
+  /// A press that stopped a tour says tour_stopped instead.
+  void guide(const TourPicture& picture);
+  /// Window thread, every frame: keeps what the handle touches in this visit's touches; hands an announced
+  /// tour over when it is due; and when the tour handed over has ended, says what it traced and what remains
+  /// ("Tour stopped. …" when the hand held it back or the device was lost; nothing when a key, the mouse, a
+  /// new picture or visitor stopped it) and gives the handle back to the cursor where it is.
+  void poll(const TourPicture& picture);
+  /// A new picture (`id`, `curves` shapes) is published: touches start again; a tour under way stops
+  /// without a word, an announced one does not start.
+  void picture_changed(int id, int curves);
+  /// A new visitor, on the picture `id` with `curves` shapes: as picture_changed, and the hand's offset from
+  /// earlier tours is forgotten.
+  void new_visitor(int id, int curves);
+
+  /// Whether a tour announced or handed to the servo thread has not yet been reported ended.
+  bool running() const { return running_ != 0 || asked_; }
+  /// A tour is announced and not yet handed to the servo thread.
+  bool announced() const { return asked_; }
+  /// The shapes touched in this visit of the picture shown.
+  const VisitTouches& touches() const { return touches_; }
+
+ private:
+  void hand_over(const TourPicture& picture);  // plans the announced tour from the handle and publishes it
+  void report_end(const TourPicture& picture, const ServoDisplayState& d);  // what it traced and what remains
+  void stop_quietly();                                                      // ends what runs or is announced
+
+  ServoStep& step_;
+  DeviceHost& devices_;
+  Voice& voice_;
+  const audio::AudioSystem& audio_;
+  const config::Settings& s_;
+  Vec2 half_;
+  VisitTouches touches_;
+  int seq_ = 0;                // TourPath::id of the last tour handed over
+  int running_ = 0;            // its id until poll sees it ended, else 0
+  int scene_ = 0;              // the picture it was planned for
+  bool quiet_ = false;         // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
+  bool guide_stops_ = false;   // this key press stopped a running or announced tour
+  bool asked_ = false;         // announced, not yet handed to the servo thread
+  std::int64_t due_tick_ = 0;  // the servo tick from which the announced tour may start
+  Vec2 cursor_in_;             // the last cursor given to set_cursor [m]
+  Vec2 cursor_offset_;         // added to it: where tours left the hand [m]
+  Vec2 cursor_ref_;            // cursor_in_ when the tour was handed over [m]
+};
+
+}  // namespace hk::app

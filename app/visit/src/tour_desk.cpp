@@ -1,0 +1,136 @@
+// The guided tour's window-thread half (tour_desk.hpp).
+#include "visit/tour_desk.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include "runtime/runtime_params.hpp"
+
+namespace hk::app {
+
+TourDesk::TourDesk(ServoStep& step, DeviceHost& devices, Voice& voice, const audio::AudioSystem& audio,
+                   const config::Settings& settings, Vec2 half_m, Vec2 cursor_m)
+    : step_(step), devices_(devices), voice_(voice), audio_(audio), s_(settings), half_(half_m), cursor_in_(cursor_m) {}
+
+void TourDesk::set_cursor(Vec2 m) {
+  cursor_in_ = m;
+  if (running_ && !quiet_ && length(m - cursor_ref_) > 0.003) {
+    step_.cancel_tour();  // the visitor's hand takes over
+    quiet_ = true;
+    spdlog::info("tour: stopped by the hand");
+  }
+  const Vec2 c = m + cursor_offset_;
+  const bool offset = cursor_offset_.x != 0.0 || cursor_offset_.y != 0.0;
+  devices_.set_target(offset ? Vec2{std::clamp(c.x, -half_.x, half_.x), std::clamp(c.y, -half_.y, half_.y)} : m);
+}
+
+void TourDesk::stop_quietly() {
+  asked_ = false;  // an announced tour does not start
+  if (running_) {
+    step_.cancel_tour();
+    quiet_ = true;
+  }
+}
+
+void TourDesk::key_pressed() {
+  guide_stops_ = running();
+  stop_quietly();
+}
+
+void TourDesk::guide(const TourPicture& picture) {
+  if (guide_stops_) {
+    guide_stops_ = false;
+    voice_.say(audio_.messages().text(audio::MessageId::tour_stopped));
+    return;
+  }
+  if (!picture.scene) return;
+  const TourParams tp = tour_params_from(s_);
+  if (!plan_tour(*picture.scene, picture.id, step_.display().handle_m, touches_, tp)) {
+    bool any_shape = false;
+    for (std::size_t c = 0; c < picture.scene->curve_count(); ++c)
+      any_shape = any_shape || is_tour_shape(*picture.scene, c, tp);
+    voice_.say(audio_.messages().text(any_shape ? audio::MessageId::tour_all_touched : audio::MessageId::tour_nothing));
+    return;
+  }
+  // Ask first: the pull starts once the visitor has heard what is coming (counted in servo ticks, so the
+  // same in a headless run as at the kiosk).
+  const std::string ask = audio_.messages().text(audio::MessageId::tour_ask);
+  voice_.say_brief(ask);
+  asked_ = true;
+  scene_ = picture.id;
+  due_tick_ =
+      step_.display().tick +
+      static_cast<std::int64_t>(std::ceil((audio_.speech_duration_s(ask) + kAskMargin_s) * s_.haptics.servo_rate_hz));
+}
+
+void TourDesk::hand_over(const TourPicture& picture) {
+  asked_ = false;
+  if (!picture.scene || scene_ != picture.id) return;  // another picture came meanwhile
+  std::optional<TourPath> plan =
+      plan_tour(*picture.scene, picture.id, step_.display().handle_m, touches_, tour_params_from(s_));
+  if (!plan) return;  // touched meanwhile: nothing left to lead to
+  plan->id = ++seq_;
+  running_ = plan->id;
+  quiet_ = false;
+  cursor_ref_ = cursor_in_;
+  spdlog::info("tour {}: to shape {} ({:.1f} s)", plan->id, plan->curve, plan->duration_s());
+  devices_.set_limp(true);
+  step_.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
+}
+
+void TourDesk::poll(const TourPicture& picture) {
+  const ServoDisplayState& d = step_.display();
+  if (d.scene_id == touches_.scene_id() && d.curve >= 0) touches_.touch(d.scene_id, d.curve);
+  if (asked_ && d.tick >= due_tick_) hand_over(picture);
+  if (!running_ || d.tour_id != running_ || !tour_ended(d.tour_phase)) return;
+  if (d.tour_phase == TourPhase::Done) touches_.touch(scene_, d.tour_curve);
+  running_ = 0;
+  // The hand lets go where the tour left the handle (unless the visitor's own hand took over).
+  if (devices_.limp()) {
+    if (!quiet_ || length(cursor_in_ - cursor_ref_) <= 0.003) cursor_offset_ = d.handle_m - cursor_in_;
+    set_cursor(cursor_in_);
+    devices_.set_limp(false);
+  }
+  if (quiet_ || !picture.scene || scene_ != picture.id) return;
+  report_end(picture, d);
+}
+
+void TourDesk::report_end(const TourPicture& picture, const ServoDisplayState& d) {
+  const audio::MessageCatalog& m = audio_.messages();
+  std::string text;
+  if (d.tour_phase == TourPhase::Stopped) {
+    text = m.text(audio::MessageId::tour_stopped) + " ";
+  } else if (d.tour_phase == TourPhase::Stuck) {
+    spdlog::warn("tour {}: stuck on shape {} (no progress), let go", d.tour_id, d.tour_curve);
+    text = m.text(audio::MessageId::tour_stuck) + " ";
+  } else if (d.tour_curve >= 0 && static_cast<std::size_t>(d.tour_curve) < picture.described) {
+    text = m.text(audio::MessageId::tour_traced,
+                  {{"shape", std::to_string(d.tour_curve + 1)},
+                   {"description", picture.words(static_cast<std::size_t>(d.tour_curve))}}) +
+           " ";
+  }
+  const int left = shapes_remaining(*picture.scene, touches_, tour_params_from(s_));
+  if (left == 0)
+    text += m.text(audio::MessageId::tour_all_touched);
+  else if (left == 1)
+    text += m.text(audio::MessageId::tour_one_remaining);
+  else
+    text += m.text(audio::MessageId::tour_remaining, {{"count", std::to_string(left)}});
+  voice_.say(text);
+}
+
+void TourDesk::picture_changed(int id, int curves) {
+  touches_.reset(id, curves);  // touches are kept per picture
+  stop_quietly();              // the servo stops a running tour at the swap anyway; nothing to say of it
+}
+
+void TourDesk::new_visitor(int id, int curves) {
+  picture_changed(id, curves);
+  cursor_offset_ = {};
+}
+
+}  // namespace hk::app
