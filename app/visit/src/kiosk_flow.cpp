@@ -843,12 +843,15 @@ void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
   fx_.say(line);
 }
 
+bool KioskFlow::awaits_library_picture(int index) const {
+  return index == v_.pending_picture && v_.state == KioskState::Picture && !v_.captured &&
+         v_.source == KioskSource::Library;
+}
+
 void KioskFlow::picture_ready(int index, int shapes, double now_s) {
   guarded("a picture of the library", [&] {
     (void)now_s;
-    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured ||
-        v_.source != KioskSource::Library)
-      return;  // superseded
+    if (!awaits_library_picture(index)) return;  // superseded
     v_.pending_picture = -1;
     announce_picture(shapes, std::exchange(v_.pending_before, {}));
   });
@@ -857,9 +860,7 @@ void KioskFlow::picture_ready(int index, int shapes, double now_s) {
 void KioskFlow::picture_failed(int index, const std::string& reason, double now_s) {
   guarded("a picture of the library", [&] {
     (void)now_s;
-    if (index != v_.pending_picture || v_.state != KioskState::Picture || v_.captured ||
-        v_.source != KioskSource::Library)
-      return;  // superseded
+    if (!awaits_library_picture(index)) return;  // superseded
     v_.pending_picture = -1;
     const std::string name = "Picture " + std::to_string(index + 1) + " of " + std::to_string(fx_.picture_count());
     spdlog::warn("kiosk: picture {} cannot be shown: {}", index + 1, reason);

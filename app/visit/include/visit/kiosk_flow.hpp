@@ -396,6 +396,7 @@ class KioskFlow {
   void start_tutorial();
   void show(int index, const std::string& before = {});
   void announce_picture(int shapes, const std::string& before);  // "Picture 2 of 5: ... It has 3 shapes."
+  bool awaits_library_picture(int index) const;  // picture `index` of the library is the one asked for, still wanted
   void say(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
   void say_brief(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {});
   std::vector<std::string> help_groups()
