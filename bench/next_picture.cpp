@@ -1,7 +1,7 @@
 // Picture chosen -> felt: the kiosk's own runtime, headless, with its servo thread at 1 kHz on the simulated
 // pantograph (the handle at rest in free space), driven by the visitor's flow. Each Next press is timed from
 // the key to the first servo tick on the new scene (ServoDisplayState::scene_id). The window thread is
-// played as the kiosk plays it: the flow's key, then poll_pictures / poll_sticks once a frame (60 Hz), so a
+// played as the kiosk plays it: the flow's key, then the library's and the sticks' poll once a frame (60 Hz), so a
 // scene built off the window thread waits up to one frame to be put on the device, as at the kiosk. The
 // screen is a 1920 x 1080 one: pictures are shrunk to the size it draws them (picture_side_px), as there.
 //
@@ -106,21 +106,21 @@ struct Rig {
     rt = std::make_unique<KioskRuntime>(ro, s);
     // Pictures shrunk to what a full-HD kiosk screen draws, as the kiosk's window sets it.
     rt->set_screen_picture_side_px(picture_side_px(make_view(1920, 1080, rt->half()), rt->half()));
-    flow = std::make_unique<KioskFlow>(*rt, rt->audio().messages(), KioskFlowParams{});
+    flow = std::make_unique<KioskFlow>(rt->effects(), rt->audio().messages(), KioskFlowParams{});
     rt->start_servo();
   }
   ~Rig() {
-    rt->stop_servo();
+    rt->devices().stop_servo();
     flow.reset();
     rt.reset();
   }
   /// One frame of the window thread's polling.
   void frame() {
     now_s += kFrame_s;
-    rt->poll_pictures(flow.get(), now_s);
-    rt->poll_sticks(*flow, now_s);
-    rt->poll_text(now_s);
-    rt->collect();
+    rt->library().poll(flow.get(), now_s);
+    rt->sticks().poll(*flow, now_s);
+    rt->stage().poll_text(now_s);
+    rt->core().collect_retired();
   }
   /// Presses `key` and returns the ms until the first servo tick on scene `id` (frames played meanwhile).
   double press_until_felt(KioskKey key, int id) {
@@ -144,7 +144,7 @@ struct Rig {
     while (ms_between(t0, Clock::now()) < max_s * 1000) {
       frame();
       std::this_thread::sleep_for(std::chrono::microseconds(16667));
-      if (!rt->picture_busy() && rt->pictures_ahead().size() >= 2) return;
+      if (!rt->library().busy() && rt->library().ahead().size() >= 2) return;
     }
   }
 };
@@ -190,7 +190,7 @@ std::vector<double> stick_walk(const fs::path& lib, const fs::path& stick, int p
   std::vector<double> out;
   Rig r(lib, prefetch_mb, "");
   r.flow->key(KioskKey::Other, r.now_s);
-  r.rt->insert_stick_folder(stick.string());
+  r.rt->sticks().insert_folder(stick.string());
   const Clock::time_point t0 = Clock::now();
   while (r.rt->core().display().scene_id != 1000 + 1 && ms_between(t0, Clock::now()) < 60000) {
     r.frame();
@@ -198,7 +198,7 @@ std::vector<double> stick_walk(const fs::path& lib, const fs::path& stick, int p
   }
   for (int page = 2; page <= 51; ++page) {
     const Clock::time_point l0 = Clock::now();
-    while (prefetch_mb > 0 && r.rt->sticks().pages_ahead() < 2 && ms_between(l0, Clock::now()) < 30000) {
+    while (prefetch_mb > 0 && r.rt->sticks().service().pages_ahead() < 2 && ms_between(l0, Clock::now()) < 30000) {
       r.frame();
       std::this_thread::sleep_for(std::chrono::microseconds(16667));
     }

@@ -145,7 +145,7 @@ class Script {
       return;
     }
     const double w = 2 * 3.14159265358979 * 0.25 * now_s;  // a slow figure over the workspace
-    rt_.set_cursor({0.8 * rt_.half().x * std::sin(w), 0.8 * rt_.half().y * std::sin(1.7 * w)});
+    rt_.tour().set_cursor({0.8 * rt_.half().x * std::sin(w), 0.8 * rt_.half().y * std::sin(1.7 * w)});
     flow_.handle_moved(now_s);  // the hand moves: the visit goes on
     if (now_s >= next_key_s_) {
       static constexpr KioskKey kKeys[] = {KioskKey::Next,    KioskKey::Previous, KioskKey::Describe,   KioskKey::Finer,
@@ -159,11 +159,11 @@ class Script {
   void stick(double now_s) {
     const double phase = std::fmod(now_s, kStickEveryS);
     if (!stick_in_ && phase >= kStickEveryS / 2 && phase < kStickEveryS / 2 + kStickHeldS && now_s > kStickEveryS / 2) {
-      rt_.insert_stick_folder(stick_dir_);
+      rt_.sticks().insert_folder(stick_dir_);
       stick_in_ = true;
       ++sticks_;
     } else if (stick_in_ && phase >= kStickEveryS / 2 + kStickHeldS) {
-      rt_.remove_stick_folder();
+      rt_.sticks().remove_folder();
       stick_in_ = false;
     }
   }
@@ -214,7 +214,7 @@ int run(const SoakOptions& o) {
   fp.timeout_s = s.kiosk.timeout_s;
   fp.warning_s = s.kiosk.warning_s;
   fp.keys = s.keys;
-  hk::app::KioskFlow flow(rt, rt.audio().messages(), fp);
+  hk::app::KioskFlow flow(rt.effects(), rt.audio().messages(), fp);
   Script script(rt, flow, s, o.seed);
   script.stick_dir_ = o.stick;
   rt.start_servo();
@@ -238,12 +238,9 @@ int run(const SoakOptions& o) {
     const double now_s = std::chrono::duration<double>(Clock::now() - t0).count();
     if (now_s >= o.duration_s) break;
     script.frame(now_s);
-    rt.poll_sticks(flow, now_s);
-    rt.poll_text(now_s);
-    rt.poll_device(now_s);
-    rt.poll_tour();
+    rt.poll(&flow, now_s);
+    rt.poll_after_input();
     flow.tick(now_s);
-    rt.collect();
     rt.audio().render(audio.data(), audio.size());
     if (now_s >= next_report_s) {
       next_report_s += o.report_every_s;
@@ -272,7 +269,7 @@ int run(const SoakOptions& o) {
     next_frame += std::chrono::microseconds(16667);
     std::this_thread::sleep_until(next_frame);
   }
-  rt.stop_servo();
+  rt.devices().stop_servo();
 
   // After warm-up: growth and ranges.
   std::vector<double> t_h, rss_kib;

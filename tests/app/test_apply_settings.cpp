@@ -35,7 +35,7 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   config::Settings s;
   KioskRuntime rt(ro, s);
   KioskFlowParams fp;
-  KioskFlow flow(rt, rt.audio().messages(), fp);
+  KioskFlow flow(rt.effects(), rt.audio().messages(), fp);
   flow.key(KioskKey::Other, 0.0);  // wake: the tutorial's square is shown
   const auto tick = [&] {          // the servo thread's part (no servo thread in this test)
     ServoCommand cmd;
@@ -44,9 +44,9 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
     rt.core().publish_display();
   };
   tick();  // the servo's core takes the square
-  ASSERT_EQ(rt.core().display().scene_id, rt.shown_id());
+  ASSERT_EQ(rt.core().display().scene_id, rt.stage().shown_id());
   EXPECT_EQ(rt.core().display().stiffness_n_per_m, 800.0);
-  const Scene* before = rt.shown().scene;
+  const Scene* before = rt.stage().shown().scene;
 
   config::Settings next = s;
   next.haptics.stiffness_n_per_m = 1200;  // live
@@ -72,18 +72,18 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   EXPECT_EQ(rt.settings().haptics.servo_rate_hz, 1000.0) << "the servo thread runs at the rate it started with";
   EXPECT_EQ(rt.settings().device.handle_mass_kg, s.device.handle_mass_kg);
   // The scene was rebuilt (a new one published) and the servo's core renders it with the new stiffness.
-  EXPECT_NE(rt.shown().scene, before);
+  EXPECT_NE(rt.stage().shown().scene, before);
   tick();
   EXPECT_EQ(rt.core().display().stiffness_n_per_m, 1200.0) << "the gains reach the scene in use at the next tick";
   const int fade_ticks = static_cast<int>(s.haptics.force_ramp_s * s.haptics.servo_rate_hz);
   for (int i = 0; i < fade_ticks + 10; ++i) tick();  // the old scene's force fades, then the rebuilt one is taken
-  EXPECT_EQ(rt.core().display().scene_id, rt.shown_id());
+  EXPECT_EQ(rt.core().display().scene_id, rt.stage().shown_id());
   EXPECT_EQ(rt.core().display().stiffness_n_per_m, 1200.0);
-  EXPECT_LE(rt.shown().scene->max_curve_levels(), 5) << "levels 0..max_levels";
+  EXPECT_LE(rt.stage().shown().scene->max_curve_levels(), 5) << "levels 0..max_levels";
   // The keys changed: the help names the new key.
   flow.key(KioskKey::Help, 1.0);
-  EXPECT_NE(rt.last_said().find("H key again gives every key"), std::string::npos) << rt.last_said();
-  EXPECT_EQ(rt.last_said().find("F1"), std::string::npos) << rt.last_said();
+  EXPECT_NE(rt.voice().last_said().find("H key again gives every key"), std::string::npos) << rt.voice().last_said();
+  EXPECT_EQ(rt.voice().last_said().find("F1"), std::string::npos) << rt.voice().last_said();
   fs::remove_all(lib);
 }
 
@@ -99,7 +99,7 @@ TEST(ApplySettings, ToleranceModeRendersAtAStepAndTheKeysMoveAlongTheSteps) {
   s.haptics.level_mode = "tolerance";
   KioskRuntime rt(ro, s);
   KioskFlowParams fp;
-  KioskFlow flow(rt, rt.audio().messages(), fp);
+  KioskFlow flow(rt.effects(), rt.audio().messages(), fp);
   flow.key(KioskKey::Other, 0.0);  // wake: the tutorial's square is shown
   const auto tick = [&] {
     ServoCommand cmd;
@@ -108,35 +108,35 @@ TEST(ApplySettings, ToleranceModeRendersAtAStepAndTheKeysMoveAlongTheSteps) {
     rt.core().publish_display();
   };
   for (int i = 0; i < 5; ++i) tick();
-  ASSERT_EQ(rt.core().display().scene_id, rt.shown_id());
-  const int start = rt.level();
+  ASSERT_EQ(rt.core().display().scene_id, rt.stage().shown_id());
+  const int start = rt.stage().level();
   ASSERT_TRUE(is_tolerance_level(start)) << start;
   EXPECT_TRUE(rt.core().display().auto_level);
   const auto settle =
       [&](int want) {  // a change waits for a tick at which it is safe: the handle rests in the air here
-        for (int i = 0; i < 400 && rt.level() != want; ++i) tick();
-        return rt.level();
+        for (int i = 0; i < 400 && rt.stage().level() != want; ++i) tick();
+        return rt.stage().level();
       };
   if (start - kToleranceLevelBase < kToleranceSteps - 1) {
-    ASSERT_TRUE(rt.change_level(+1));
+    ASSERT_TRUE(rt.stage().change_level(+1));
     EXPECT_EQ(settle(start + 1), start + 1) << "Coarser: the next step";
     EXPECT_FALSE(rt.core().display().auto_level) << "the visitor's choice holds";
-    ASSERT_TRUE(rt.change_level(-1));
+    ASSERT_TRUE(rt.stage().change_level(-1));
     EXPECT_EQ(settle(start), start) << "Finer: back";
   }
   // To the finest step, then no further; to the loosest, then no further.
-  while (rt.level() > kToleranceLevelBase) {
-    const int now = rt.level();
-    ASSERT_TRUE(rt.change_level(-1));
+  while (rt.stage().level() > kToleranceLevelBase) {
+    const int now = rt.stage().level();
+    ASSERT_TRUE(rt.stage().change_level(-1));
     ASSERT_EQ(settle(now - 1), now - 1);
   }
-  EXPECT_FALSE(rt.change_level(-1)) << "no step is finer than the first";
-  while (rt.level() < kToleranceLevelBase + kToleranceSteps - 1) {
-    const int now = rt.level();
-    ASSERT_TRUE(rt.change_level(+1));
+  EXPECT_FALSE(rt.stage().change_level(-1)) << "no step is finer than the first";
+  while (rt.stage().level() < kToleranceLevelBase + kToleranceSteps - 1) {
+    const int now = rt.stage().level();
+    ASSERT_TRUE(rt.stage().change_level(+1));
     ASSERT_EQ(settle(now + 1), now + 1);
   }
-  EXPECT_FALSE(rt.change_level(+1)) << "no step is looser than the last";
+  EXPECT_FALSE(rt.stage().change_level(+1)) << "no step is looser than the last";
 }
 
 }  // namespace

@@ -250,7 +250,7 @@ void poll_until_done(KioskRuntime& rt, KioskFlow& flow) {
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   double t = 1.0;
   while (flow.capturing() && std::chrono::steady_clock::now() < give_up) {
-    rt.poll_capture(flow, t += 0.01);
+    rt.camera().poll(flow, t += 0.01);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
@@ -262,34 +262,34 @@ TEST(CaptureRuntime, TheKioskCapturesFromItsCameraAndPutsThePictureOnTheDevice) 
   config::Settings s;
   s.camera.source = "file:" + (dir / "frames").string();
   KioskRuntime rt(headless_options(), s);
-  ASSERT_TRUE(rt.has_camera());
+  ASSERT_TRUE(rt.camera().available());
   KioskFlowParams fp;
-  fp.camera = rt.has_camera();
-  KioskFlow flow(rt, rt.audio().messages(), fp);
+  fp.camera = rt.camera().available();
+  KioskFlow flow(rt.effects(), rt.audio().messages(), fp);
   flow.key(KioskKey::Other, 0.0);
   flow.key(KioskKey::Capture, 0.5);
   ASSERT_TRUE(flow.capturing());
   poll_until_done(rt, flow);
   ASSERT_FALSE(flow.capturing());
-  EXPECT_EQ(rt.last_said().rfind("Captured.", 0), 0u) << rt.last_said();
-  EXPECT_LE(rt.shown_id(), -100) << "the capture is what is shown";
-  EXPECT_FALSE(rt.shown().picture.empty());
-  EXPECT_GE(rt.shown().polylines.size(), 1u);
+  EXPECT_EQ(rt.voice().last_said().rfind("Captured.", 0), 0u) << rt.voice().last_said();
+  EXPECT_LE(rt.stage().shown_id(), -100) << "the capture is what is shown";
+  EXPECT_FALSE(rt.stage().shown().picture.empty());
+  EXPECT_GE(rt.stage().shown().polylines.size(), 1u);
   // A second capture, cancelled by a key at once: nothing more is said of it but "Capture stopped.".
   flow.key(KioskKey::Capture, 50.0);
   flow.key(KioskKey::Next, 50.1);
-  EXPECT_EQ(rt.last_said(), "Capture stopped.");
-  rt.poll_capture(flow, 50.2);
-  EXPECT_EQ(rt.last_said(), "Capture stopped.");
+  EXPECT_EQ(rt.voice().last_said(), "Capture stopped.");
+  rt.camera().poll(flow, 50.2);
+  EXPECT_EQ(rt.voice().last_said(), "Capture stopped.");
 }
 
 TEST(CaptureRuntime, ScriptedRunsLookForNoCameraAndSayNothingOfIt) {
   config::Settings s;  // [camera] source = "auto"
   KioskRuntime rt(headless_options(), s);
-  EXPECT_FALSE(rt.has_camera());
-  rt.announce_camera();
-  EXPECT_EQ(rt.last_said(), "");
-  EXPECT_FALSE(rt.start_capture());
+  EXPECT_FALSE(rt.camera().available());
+  rt.camera().announce(rt.settings().keys);
+  EXPECT_EQ(rt.voice().last_said(), "");
+  EXPECT_FALSE(rt.camera().start_capture());
 }
 
 }  // namespace

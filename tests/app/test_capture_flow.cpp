@@ -5,12 +5,13 @@
 #include <string>
 #include <vector>
 
+#include "every_effect.hpp"
 #include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
 namespace {
 
-struct CameraRecorder final : KioskEffects {
+struct CameraRecorder final : hk::test::EveryEffect {
   bool camera = true;
   int started = 0, cancelled = 0;
   std::vector<std::string> said;

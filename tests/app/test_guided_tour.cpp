@@ -22,6 +22,7 @@
 #include "config/device_profile.hpp"
 #include "crossing_grid.hpp"
 #include "curves.hpp"
+#include "every_effect.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_params.hpp"
@@ -462,7 +463,7 @@ TEST(GuidedTour, ATourForAnotherPictureIsDropped) {
 }
 
 // ── The flow: the Guide key, and any key stops a tour ─────────────────────────────────────────────────
-struct GuideRecorder final : KioskEffects {
+struct GuideRecorder final : hk::test::EveryEffect {
   int guides = 0, keys = 0;
   std::vector<std::string> said;
   void say(const std::string& t) override { said.push_back(t); }
@@ -528,9 +529,9 @@ struct RuntimeRig {
     for (long k = 0, n = static_cast<long>(seconds / dt + 0.5); k < n; ++k) {
       test::runtime_tick(*rt, dt, hand_force);
       guide_n.push_back(length(rt->core().display().guide_force_n));
-      if (k % 16 == 0) rt->poll_tour();  // a frame
+      if (k % 16 == 0) rt->tour().poll();  // a frame
     }
-    rt->poll_tour();
+    rt->tour().poll();
   }
   std::vector<double> guide_n;  // every tick's guide force [N], from the first run
   std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) {
@@ -546,61 +547,63 @@ TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) 
   RuntimeRig r;
   ASSERT_EQ(test::show_now(*r.rt, 0), 5);
   r.run(0.6);
-  r.rt->key_pressed();
-  r.rt->guide();
-  ASSERT_TRUE(r.rt->tour_running()) << r.rt->last_said();
-  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_ask));
-  for (int i = 0; i < 60 && r.rt->tour_running(); ++i) r.run(0.5);
-  EXPECT_FALSE(r.rt->tour_running());
-  EXPECT_EQ(r.rt->touches().count(), 1);
-  EXPECT_EQ(r.rt->last_said().rfind("That was shape ", 0), 0u) << "it names what it traced: " << r.rt->last_said();
-  EXPECT_TRUE(ends_with(r.rt->last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}})))
-      << r.rt->last_said();
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
+  ASSERT_TRUE(r.rt->tour().running()) << r.rt->voice().last_said();
+  EXPECT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::tour_ask));
+  for (int i = 0; i < 60 && r.rt->tour().running(); ++i) r.run(0.5);
+  EXPECT_FALSE(r.rt->tour().running());
+  EXPECT_EQ(r.rt->tour().touches().count(), 1);
+  EXPECT_EQ(r.rt->voice().last_said().rfind("That was shape ", 0), 0u)
+      << "it names what it traced: " << r.rt->voice().last_said();
+  EXPECT_TRUE(ends_with(r.rt->voice().last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}})))
+      << r.rt->voice().last_said();
   // A key during the next tour stops it, quietly; the Guide key stopping it says so.
-  r.rt->key_pressed();
-  r.rt->guide();
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
   r.run(5.0);  // past the announcement: the tour runs
-  ASSERT_TRUE(r.rt->tour_running());
-  ASSERT_FALSE(r.rt->tour_announced());
-  r.rt->key_pressed();  // e.g. Describe: its own answer is what the visitor hears
+  ASSERT_TRUE(r.rt->tour().running());
+  ASSERT_FALSE(r.rt->tour().announced());
+  r.rt->tour().key_pressed();  // e.g. Describe: its own answer is what the visitor hears
   r.run(0.2);
-  EXPECT_FALSE(r.rt->tour_running());
-  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_ask)) << "nothing said of a tour a key stopped";
-  r.rt->key_pressed();
-  r.rt->guide();
+  EXPECT_FALSE(r.rt->tour().running());
+  EXPECT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::tour_ask)) << "nothing said of a tour a key stopped";
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
   r.run(5.0);
-  r.rt->key_pressed();
-  r.rt->guide();  // the Guide key again: stops it
-  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_stopped));
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();  // the Guide key again: stops it
+  EXPECT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::tour_stopped));
   r.run(0.2);
-  EXPECT_FALSE(r.rt->tour_running());
+  EXPECT_FALSE(r.rt->tour().running());
   // A key while the tour is being announced: it never starts.
-  r.rt->key_pressed();
-  r.rt->guide();
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
   r.run(0.5);
-  r.rt->key_pressed();
+  r.rt->tour().key_pressed();
   const std::size_t from = r.guide_n.size();
   r.run(8.0);
-  EXPECT_FALSE(r.rt->tour_running());
+  EXPECT_FALSE(r.rt->tour().running());
   EXPECT_EQ(*std::max_element(r.guide_n.begin() + static_cast<std::ptrdiff_t>(from), r.guide_n.end()), 0.0);
   // The rest, one Guide after another.
   // (A shape may be touched on the way to another: then fewer tours are needed.)
-  for (int tours = 0; tours < 4 && r.rt->touches().count() < 5; ++tours) {
-    r.rt->key_pressed();
-    r.rt->guide();
-    ASSERT_TRUE(r.rt->tour_running()) << tours;
-    for (int i = 0; i < 60 && r.rt->tour_running(); ++i) r.run(0.5);
-    EXPECT_FALSE(r.rt->tour_running());
+  for (int tours = 0; tours < 4 && r.rt->tour().touches().count() < 5; ++tours) {
+    r.rt->tour().key_pressed();
+    r.rt->tour().guide();
+    ASSERT_TRUE(r.rt->tour().running()) << tours;
+    for (int i = 0; i < 60 && r.rt->tour().running(); ++i) r.run(0.5);
+    EXPECT_FALSE(r.rt->tour().running());
   }
-  EXPECT_EQ(r.rt->touches().count(), 5);
-  EXPECT_TRUE(ends_with(r.rt->last_said(), r.text(audio::MessageId::tour_all_touched))) << r.rt->last_said();
-  r.rt->key_pressed();
-  r.rt->guide();
-  EXPECT_FALSE(r.rt->tour_running());
-  EXPECT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_all_touched));
+  EXPECT_EQ(r.rt->tour().touches().count(), 5);
+  EXPECT_TRUE(ends_with(r.rt->voice().last_said(), r.text(audio::MessageId::tour_all_touched)))
+      << r.rt->voice().last_said();
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
+  EXPECT_FALSE(r.rt->tour().running());
+  EXPECT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::tour_all_touched));
   // A new visitor: nothing touched.
-  r.rt->new_session();
-  EXPECT_EQ(r.rt->touches().count(), 0);
+  r.rt->effects().session.new_session();
+  EXPECT_EQ(r.rt->tour().touches().count(), 0);
 }
 
 // The tour asks first: "I will guide your hand to a shape. Hold the handle lightly." is said, and the trace
@@ -611,13 +614,13 @@ TEST(GuidedTourRuntime, TheTourAsksFirstAndPullsOnlyOnceThatHasBeenSaid) {
   ASSERT_EQ(test::show_now(*r.rt, 0), 5);
   r.run(0.6);
   const std::size_t asked = r.guide_n.size();
-  r.rt->key_pressed();
-  r.rt->guide();
-  ASSERT_EQ(r.rt->last_said(), r.text(audio::MessageId::tour_ask));
-  ASSERT_TRUE(r.rt->tour_announced());
-  const double ask_s = r.rt->audio().speech_duration_s(r.rt->last_said());
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
+  ASSERT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::tour_ask));
+  ASSERT_TRUE(r.rt->tour().announced());
+  const double ask_s = r.rt->audio().speech_duration_s(r.rt->voice().last_said());
   ASSERT_GT(ask_s, 2.0) << "the announcement is spoken (espeak-ng present)";
-  for (int i = 0; i < 60 && r.rt->tour_running(); ++i) r.run(0.5);
+  for (int i = 0; i < 60 && r.rt->tour().running(); ++i) r.run(0.5);
   const auto first = std::find_if(r.guide_n.begin() + static_cast<std::ptrdiff_t>(asked), r.guide_n.end(),
                                   [](double f) { return f > 0.0; });
   ASSERT_NE(first, r.guide_n.end()) << "the tour pulled at some point";
@@ -625,8 +628,8 @@ TEST(GuidedTourRuntime, TheTourAsksFirstAndPullsOnlyOnceThatHasBeenSaid) {
       static_cast<double>(first - (r.guide_n.begin() + static_cast<std::ptrdiff_t>(asked))) / r.s.haptics.servo_rate_hz;
   EXPECT_GE(first_force_s, ask_s) << "the first guide force came " << first_force_s << " s after the announcement of "
                                   << ask_s << " s began";
-  EXPECT_LE(first_force_s, ask_s + KioskRuntime::kTourAskMargin_s + 0.1) << "and not much later";
-  EXPECT_EQ(r.rt->touches().count(), 1);
+  EXPECT_LE(first_force_s, ask_s + TourDesk::kAskMargin_s + 0.1) << "and not much later";
+  EXPECT_EQ(r.rt->tour().touches().count(), 1);
 }
 
 // "What is here": the handle pressed against the square from below. Where names it by its number, size and
@@ -634,7 +637,7 @@ TEST(GuidedTourRuntime, TheTourAsksFirstAndPullsOnlyOnceThatHasBeenSaid) {
 TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
   RuntimeRig r;
   ASSERT_EQ(test::show_now(*r.rt, 0), 5);
-  const vision::PxToM& px = r.rt->shown().px_to_m;
+  const vision::PxToM& px = r.rt->stage().shown().px_to_m;
   auto at = [&](double u, double v) { return Vec2{px.x_m(u), px.y_m(v)}; };
   // Up the free corridor between the ellipse and the rotated rectangle, then into the square's bottom side.
   r.run(2.0, at(360, 230));
@@ -642,9 +645,9 @@ TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
   const ServoDisplayState& d = r.rt->core().display();
   ASSERT_GE(d.curve, 0) << "the handle rests against a shape";
   int square = -1;
-  for (std::size_t c = 0; c < r.rt->shown().polylines.size(); ++c) {
+  for (std::size_t c = 0; c < r.rt->stage().shown().polylines.size(); ++c) {
     Vec2 lo{1e9, 1e9}, hi{-1e9, -1e9};
-    for (Vec2 p : r.rt->shown().polylines[c].points_m) {
+    for (Vec2 p : r.rt->stage().shown().polylines[c].points_m) {
       lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
       hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
     }
@@ -652,15 +655,15 @@ TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
   }
   ASSERT_GE(square, 0);
   EXPECT_EQ(d.curve, square) << "it is the square the hand presses on";
-  const std::string where = r.rt->where();
+  const std::string where = r.rt->stage().where();
   EXPECT_EQ(where,
             "On shape " + std::to_string(square + 1) + " of 5: a medium closed shape. Your hand is in the far middle.")
       << "the hand's place: below the square, in the far third";
-  const std::string describe = r.rt->describe();
+  const std::string describe = r.rt->stage().describe();
   EXPECT_EQ(describe.rfind("5 shapes. Nearest your hand, a medium closed shape in the far middle", 0), 0u) << describe;
   // The hand away from every shape, near the visitor: the nearest shape, and where the hand is.
   r.run(2.0, at(360, 230));
-  const std::string near = r.rt->where();
+  const std::string near = r.rt->stage().where();
   EXPECT_EQ(near.rfind("Near shape ", 0), 0u) << near;
   EXPECT_TRUE(ends_with(near, "Your hand is in the middle.")) << near;
 }
@@ -669,26 +672,26 @@ TEST(GuidedTourRuntime, WhereNamesTheShapeUnderTheHandAndDescribeStartsThere) {
 // too, and a tour round it says what it traced by that name.
 TEST(GuidedTourRuntime, PracticeShapesAreNamedAndWhereExplainsFarAndNear) {
   RuntimeRig r;
-  r.rt->show_tutorial(TutorialShape::Circle);
+  r.rt->stage().show_tutorial(TutorialShape::Circle);
   r.run(0.6);  // the handle at rest, off the circle
-  r.rt->key_pressed();
-  r.rt->guide();
-  ASSERT_TRUE(r.rt->tour_running()) << r.rt->last_said();
-  for (int i = 0; i < 80 && r.rt->tour_running(); ++i) r.run(0.5);
-  EXPECT_FALSE(r.rt->tour_running());
-  EXPECT_EQ(r.rt->last_said().rfind("That was shape 1: a circle.", 0), 0u) << r.rt->last_said();
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
+  ASSERT_TRUE(r.rt->tour().running()) << r.rt->voice().last_said();
+  for (int i = 0; i < 80 && r.rt->tour().running(); ++i) r.run(0.5);
+  EXPECT_FALSE(r.rt->tour().running());
+  EXPECT_EQ(r.rt->voice().last_said().rfind("That was shape 1: a circle.", 0), 0u) << r.rt->voice().last_said();
   r.run(1.5, Vec2{0.0, 0.0});  // the hand pulled towards the middle, against the circle's wall
-  const std::string where = r.rt->where();
+  const std::string where = r.rt->stage().where();
   EXPECT_EQ(where.rfind("On shape 1 of 1: a circle. Your hand is ", 0), 0u) << where;
   EXPECT_TRUE(ends_with(where, ". Far means away from you, near means towards you.")) << where;
-  EXPECT_EQ(r.rt->where().find("Far means"), std::string::npos) << "said once a visit";
-  r.rt->new_session();
-  EXPECT_NE(r.rt->where().find("Far means"), std::string::npos) << "and again for the next visitor";
-  EXPECT_EQ(r.rt->describe(), "A circle, in the middle.");
+  EXPECT_EQ(r.rt->stage().where().find("Far means"), std::string::npos) << "said once a visit";
+  r.rt->effects().session.new_session();
+  EXPECT_NE(r.rt->stage().where().find("Far means"), std::string::npos) << "and again for the next visitor";
+  EXPECT_EQ(r.rt->stage().describe(), "A circle, in the middle.");
   // A picture is described by its shapes again.
   ASSERT_EQ(test::show_now(*r.rt, 0), 5);
   r.run(0.5, Vec2{0.0, 0.0});
-  EXPECT_EQ(r.rt->where().find("Far means"), std::string::npos) << r.rt->where();
+  EXPECT_EQ(r.rt->stage().where().find("Far means"), std::string::npos) << r.rt->stage().where();
 }
 
 // Tours on real pictures: a tour must not stop while the hand is relaxed (13 tours on 9 of the 22 pictures

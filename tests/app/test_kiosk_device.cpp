@@ -88,19 +88,19 @@ TEST(KioskDevice, ABoardOnItsTtyIsUsedAnnouncedAndItsLossSpoken) {
   EXPECT_TRUE(rt.devices().note().empty());
   rt.start_servo();
   rt.announce_device();
-  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
+  EXPECT_EQ(rt.voice().last_said(), said(audio::MessageId::device_ready));
 
   // The servo thread sends a packet every millisecond; the board stops answering after 500 of them.
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   double t = 0.0;
-  while (rt.last_said() != said(audio::MessageId::device_lost) && std::chrono::steady_clock::now() < give_up) {
-    rt.poll_device(t += 0.01);
+  while (rt.voice().last_said() != said(audio::MessageId::device_lost) && std::chrono::steady_clock::now() < give_up) {
+    rt.poll(nullptr, t += 0.01);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));  // a frame; the outcome is the message, not the time
   }
-  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_lost));
+  EXPECT_EQ(rt.voice().last_said(), said(audio::MessageId::device_lost));
   EXPECT_EQ(rt.devices().usb()->status(), DeviceStatus::Lost);
   EXPECT_GE(board.torque_commands(), 500);
-  rt.stop_servo();
+  rt.devices().stop_servo();
   double tau1 = 1, tau2 = 1;
   rt.devices().usb()->last_torques_n_m(&tau1, &tau2);
   EXPECT_EQ(tau1, 0.0);
@@ -114,12 +114,12 @@ TEST(KioskDevice, WithNoBoardTheSimulatedPantographStandsInAndSaysSo) {
   EXPECT_NE(rt.devices().note().find("/dev/hk-no-such-board"), std::string::npos) << rt.devices().note();
   rt.start_servo();
   rt.announce_device();
-  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_simulated));
+  EXPECT_EQ(rt.voice().last_said(), said(audio::MessageId::device_simulated));
   double o1 = 0, o2 = 0;
   std::string why;
   EXPECT_FALSE(rt.devices().calibrate(&o1, &o2, &why));
   EXPECT_NE(why.find("no USB pantograph"), std::string::npos) << why;
-  rt.stop_servo();
+  rt.devices().stop_servo();
 }
 
 // Probed every 10 s for months without a board: the warning is logged once per reason, not each time.
@@ -136,7 +136,7 @@ TEST(KioskDevice, AMissingBoardIsLoggedOncePerReason) {
     const Library lib;
     KioskRuntime rt(options(lib), no_board_settings());
     EXPECT_EQ(count_warnings(), 1) << "the first probe says why";
-    for (double t = 0.0; t < 120.0; t += 1.0) rt.poll_device(t);  // 12 more probes, the same reason
+    for (double t = 0.0; t < 120.0; t += 1.0) rt.poll(nullptr, t);  // 12 more probes, the same reason
     EXPECT_EQ(rt.devices().usb(), nullptr);
     EXPECT_EQ(count_warnings(), 1);
   }
@@ -151,7 +151,7 @@ TEST(KioskDevice, ChosenSimulatedIsNotAnnounced) {
   EXPECT_EQ(rt.devices().usb(), nullptr);
   EXPECT_TRUE(rt.devices().note().empty());
   rt.announce_device();
-  EXPECT_TRUE(rt.last_said().empty()) << rt.last_said();
+  EXPECT_TRUE(rt.voice().last_said().empty()) << rt.voice().last_said();
 }
 
 }  // namespace hk::app
@@ -168,15 +168,15 @@ TEST(KioskDevice, TheEmulatedBoardOptionDrivesTheDriverThroughAPty) {
   ASSERT_NE(rt.devices().usb(), nullptr);
   EXPECT_NE(rt.devices().usb()->name().find("tty /dev/"), std::string::npos) << rt.devices().usb()->name();
   rt.announce_device();
-  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
+  EXPECT_EQ(rt.voice().last_said(), said(audio::MessageId::device_ready));
   rt.start_servo();
   // The handle follows the cursor through the board's model hand: the servo sees it arrive.
-  rt.set_cursor({0.03, 0.01});
+  rt.tour().set_cursor({0.03, 0.01});
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while (distance(rt.core().display().handle_m, Vec2{0.03, 0.01}) > 0.004 && std::chrono::steady_clock::now() < give_up)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   EXPECT_LT(distance(rt.core().display().handle_m, Vec2{0.03, 0.01}), 0.004);
-  rt.stop_servo();
+  rt.devices().stop_servo();
 
   RuntimeOptions bad = options(lib);
   bad.device = "sim";
@@ -219,11 +219,11 @@ StallRun run_stall(double stall_s, const std::function<bool(KioskRuntime&)>& don
   const auto t0 = std::chrono::steady_clock::now();
   std::string last;
   while (!(run.done = done(rt)) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20)) {
-    rt.poll_device(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    if (rt.last_said() != last) run.said.push_back(last = rt.last_said());
+    rt.poll(nullptr, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    if (rt.voice().last_said() != last) run.said.push_back(last = rt.voice().last_said());
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  rt.stop_servo();
+  rt.devices().stop_servo();
   return run;
 }
 
@@ -231,7 +231,8 @@ StallRun run_stall(double stall_s, const std::function<bool(KioskRuntime&)>& don
 
 TEST(KioskDevice, ALongLossIsSpokenAndSoIsTheReturn) {
   const StallRun run = run_stall(1.5, [](KioskRuntime& rt) {
-    return rt.devices().usb()->counters().reconnects >= 1 && rt.last_said() == said(audio::MessageId::device_back);
+    return rt.devices().usb()->counters().reconnects >= 1 &&
+           rt.voice().last_said() == said(audio::MessageId::device_back);
   });
   ASSERT_TRUE(run.board) << "the kiosk took the emulated board";
   ASSERT_TRUE(run.done) << "the board was lost and came back within 20 s";
@@ -275,11 +276,12 @@ TEST(KioskDevice, AHandleThatDidNotStartAtHomeIsToldToTheStaffAtStartAndNeverToA
   EXPECT_EQ(logged, 1);
   // Spoken once, with the start's announcement, before any visitor.
   rt.announce_device();
-  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready) + " " + said(audio::MessageId::device_not_home));
+  EXPECT_EQ(rt.voice().last_said(),
+            said(audio::MessageId::device_ready) + " " + said(audio::MessageId::device_not_home));
   // A visitor who comes later does not hear it: not again with the device, not in the picture's description.
   rt.announce_device();
-  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
-  EXPECT_EQ(rt.describe().find(said(audio::MessageId::device_not_home)), std::string::npos);
+  EXPECT_EQ(rt.voice().last_said(), said(audio::MessageId::device_ready));
+  EXPECT_EQ(rt.stage().describe().find(said(audio::MessageId::device_not_home)), std::string::npos);
   // Calibrated where it rests: the note is gone.
   double o1 = 0, o2 = 0;
   std::string why;
@@ -295,7 +297,7 @@ TEST(KioskDevice, AHandleAtHomeIsNotMentioned) {
   ASSERT_NE(rt.devices().usb(), nullptr);
   EXPECT_EQ(rt.devices().home_note(), "");
   rt.announce_device();
-  EXPECT_EQ(rt.last_said(), said(audio::MessageId::device_ready));
+  EXPECT_EQ(rt.voice().last_said(), said(audio::MessageId::device_ready));
 }
 
 }  // namespace hk::app

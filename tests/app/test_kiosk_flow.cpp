@@ -6,13 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "every_effect.hpp"
 #include "visit/describe.hpp"
 #include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
 namespace {
 
-struct Recorder final : KioskEffects {
+struct Recorder final : hk::test::EveryEffect {
   std::vector<std::string> said;
   std::vector<std::string> shown;
   int level = 1, volume = 7, sessions = 0;

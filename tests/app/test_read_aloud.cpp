@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "audio/speech.hpp"
+#include "every_effect.hpp"
 #include "test_paths.hpp"
 #include "vision/ocr.hpp"
 #include "visit/kiosk_flow.hpp"
@@ -45,7 +46,7 @@ std::vector<std::string> page_paragraphs() {
           read_file(kData + "/documents/long_paragraph.txt"), "Thank you for reading. Come again soon!"};
 }
 
-struct Reader final : KioskEffects {
+struct Reader final : hk::test::EveryEffect {
   std::vector<std::string> said;
   std::vector<bool> brief;
   std::string kept;

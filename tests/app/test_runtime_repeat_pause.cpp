@@ -38,7 +38,7 @@ struct SpeakingKiosk {
     config::Settings s;
     s.vision.ocr = "off";
     rt = std::make_unique<KioskRuntime>(test::headless_runtime_options(lib), s);
-    flow = std::make_unique<KioskFlow>(*rt, rt->audio().messages(), KioskFlowParams{});
+    flow = std::make_unique<KioskFlow>(rt->effects(), rt->audio().messages(), KioskFlowParams{});
   }
   ~SpeakingKiosk() {
     flow.reset();
@@ -66,7 +66,7 @@ struct SpeakingKiosk {
   }
   /// Pulls the mix until nothing is being said.
   bool listen_to_the_end() {
-    return test::wait_until([&] { return !rt->speaking(); }, [&] { listen(0.1); });
+    return test::wait_until([&] { return !rt->voice().speaking(); }, [&] { listen(0.1); });
   }
   void key(KioskKey k) {
     flow->key(k, now_s);
@@ -78,7 +78,7 @@ struct SpeakingKiosk {
     ASSERT_TRUE(listen_to_the_end());
     for (int i = 0; i < 8 && flow->state() != KioskState::Picture; ++i) {
       key(KioskKey::Next);
-      ASSERT_TRUE(rt->finish_picture(flow.get(), now_s));
+      ASSERT_TRUE(rt->library().finish(flow.get(), now_s));
       ASSERT_TRUE(listen_to_the_end());
     }
     ASSERT_EQ(flow->state(), KioskState::Picture);
@@ -89,56 +89,56 @@ TEST(RuntimeRepeat, SaysTheDescriptionAgainAndPassesOverTheAcknowledgementAfterI
   SpeakingKiosk k;
   k.walk_to_the_picture();
   k.key(KioskKey::Describe);
-  const std::string description = k.rt->last_said();
+  const std::string description = k.rt->voice().last_said();
   ASSERT_FALSE(description.empty());
   EXPECT_TRUE(k.hears_speech()) << "the description is heard";
   ASSERT_TRUE(k.listen_to_the_end());
-  const std::uint64_t kept = k.rt->kept_texts();
+  const std::uint64_t kept = k.rt->voice().kept_texts();
   k.key(KioskKey::Finer);  // "More detail." (or that it is the finest): an acknowledgement
-  EXPECT_NE(k.rt->last_said(), description);
-  EXPECT_EQ(k.rt->kept_texts(), kept) << "an acknowledgement is not kept for Repeat";
+  EXPECT_NE(k.rt->voice().last_said(), description);
+  EXPECT_EQ(k.rt->voice().kept_texts(), kept) << "an acknowledgement is not kept for Repeat";
   ASSERT_TRUE(k.listen_to_the_end());
 
   k.key(KioskKey::Repeat);
-  EXPECT_EQ(k.rt->last_said(), description) << "Repeat says the description again, not the acknowledgement";
-  EXPECT_EQ(k.rt->kept_texts(), kept + 1);
-  EXPECT_TRUE(k.rt->speaking());
+  EXPECT_EQ(k.rt->voice().last_said(), description) << "Repeat says the description again, not the acknowledgement";
+  EXPECT_EQ(k.rt->voice().kept_texts(), kept + 1);
+  EXPECT_TRUE(k.rt->voice().speaking());
   EXPECT_TRUE(k.hears_speech()) << "and it is heard";
 }
 
 TEST(RuntimeRepeat, BeforeAnythingWasSaidInThisVisitSaysSo) {
   SpeakingKiosk k;
-  k.flow->handle_moved(k.now_s);  // the welcome...
-  k.rt->new_session();            // ...forgotten, as at a new visitor: nothing of the last one is repeated
+  k.flow->handle_moved(k.now_s);          // the welcome...
+  k.rt->effects().session.new_session();  // ...forgotten, as at a new visitor: nothing of the last one is repeated
   k.key(KioskKey::Repeat);
-  EXPECT_EQ(k.rt->last_said(), k.flow->text(MessageId::nothing_to_repeat));
+  EXPECT_EQ(k.rt->voice().last_said(), k.flow->text(MessageId::nothing_to_repeat));
 }
 
 TEST(RuntimePause, HoldsTheSpeechInSilenceAndPauseAgainGoesOn) {
   SpeakingKiosk k;
   k.walk_to_the_picture();
   k.key(KioskKey::Describe);
-  const std::string description = k.rt->last_said();
+  const std::string description = k.rt->voice().last_said();
   ASSERT_TRUE(k.hears_speech()) << "the description is heard";
-  ASSERT_TRUE(k.rt->speaking());
-  const std::uint64_t said = k.rt->texts_said();
+  ASSERT_TRUE(k.rt->voice().speaking());
+  const std::uint64_t said = k.rt->voice().texts_said();
 
   k.key(KioskKey::Pause);
-  EXPECT_FALSE(k.rt->speaking()) << "held";
-  EXPECT_EQ(k.rt->texts_said(), said) << "silence is the answer to Pause";
+  EXPECT_FALSE(k.rt->voice().speaking()) << "held";
+  EXPECT_EQ(k.rt->voice().texts_said(), said) << "silence is the answer to Pause";
   k.listen(0.05);  // the speech fades out into the pause (SpeechStream::kFadeSamples, 2 ms)
   EXPECT_LT(k.listen(1.0), 1e-6) << "nothing is heard while it is held";
-  EXPECT_FALSE(k.rt->speaking()) << "still held a second later";
+  EXPECT_FALSE(k.rt->voice().speaking()) << "still held a second later";
 
   k.key(KioskKey::Pause);
-  EXPECT_TRUE(k.rt->speaking()) << "pressed again, it goes on";
-  EXPECT_EQ(k.rt->texts_said(), said) << "going on is not a new line";
-  EXPECT_EQ(k.rt->last_said(), description);
+  EXPECT_TRUE(k.rt->voice().speaking()) << "pressed again, it goes on";
+  EXPECT_EQ(k.rt->voice().texts_said(), said) << "going on is not a new line";
+  EXPECT_EQ(k.rt->voice().last_said(), description);
   EXPECT_TRUE(k.hears_speech()) << "and is heard again";
 
   ASSERT_TRUE(k.listen_to_the_end());
   k.key(KioskKey::Pause);
-  EXPECT_EQ(k.rt->last_said(), k.flow->text(MessageId::nothing_to_pause));
+  EXPECT_EQ(k.rt->voice().last_said(), k.flow->text(MessageId::nothing_to_pause));
 }
 
 }  // namespace

@@ -191,7 +191,7 @@ struct LibraryRig {
     s.vision.ocr = "off";
     settings = s;
     rt = std::make_unique<KioskRuntime>(ro, s);
-    flow = std::make_unique<KioskFlow>(*rt, rt->audio().messages(), KioskFlowParams{});
+    flow = std::make_unique<KioskFlow>(rt->effects(), rt->audio().messages(), KioskFlowParams{});
   }
   ~LibraryRig() {
     flow.reset();
@@ -199,7 +199,7 @@ struct LibraryRig {
     fs::remove_all(lib);
   }
   /// Frames until nothing asked for is pending (at most 60 s of waiting in all).
-  void settle(double now_s) { ASSERT_TRUE(rt->finish_picture(flow.get(), now_s)); }
+  void settle(double now_s) { ASSERT_TRUE(rt->library().finish(flow.get(), now_s)); }
   /// A folder holding the shipped spec PDF (tests/data/documents), to insert as a stick; the test removes it.
   fs::path spec_stick(const std::string& tag) const {
     const fs::path stick = lib.parent_path() / ("hk_builder_" + tag + "_" + std::to_string(::getpid()));
@@ -210,9 +210,9 @@ struct LibraryRig {
   }
   /// Polls the stick service every 10 ms until scene `id` is shown (or 60 s pass), advancing `now_s`.
   bool stick_shows(int id, double& now_s) {
-    return hk::test::wait_until([&] { return rt->shown_id() == id; },
+    return hk::test::wait_until([&] { return rt->stage().shown_id() == id; },
                                 [&] {
-                                  rt->poll_sticks(*flow, now_s);
+                                  rt->sticks().poll(*flow, now_s);
                                   now_s += 0.01;
                                 });
   }
@@ -221,11 +221,11 @@ struct LibraryRig {
     std::sort(want.begin(), want.end());
     return hk::test::wait_until(
         [&] {
-          std::vector<int> have = rt->pictures_ahead();
+          std::vector<int> have = rt->library().ahead();
           std::sort(have.begin(), have.end());
           return have == want;
         },
-        [&] { rt->poll_pictures(flow.get(), 0.0); });
+        [&] { rt->library().poll(flow.get(), 0.0); });
   }
 };
 
@@ -235,26 +235,27 @@ TEST(KioskBuilds, ThreeQuickNextPressesBuildAtMostTwoScenesAndLandOnTheThird) {
   r.flow->key(KioskKey::Other, 0.0);  // wake: the tutorial
   for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.0);
   r.settle(0.0);  // picture 1 of the library
-  ASSERT_EQ(r.rt->shown_id(), 0);
-  const std::uint64_t before = r.rt->scene_builds();
+  ASSERT_EQ(r.rt->stage().shown_id(), 0);
+  const std::uint64_t before = r.rt->library().builds_started();
   for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.1);
-  EXPECT_EQ(r.rt->shown_id(), 0) << "the picture felt before stays while the new one is built";
+  EXPECT_EQ(r.rt->stage().shown_id(), 0) << "the picture felt before stays while the new one is built";
   r.settle(0.2);
-  EXPECT_LE(r.rt->scene_builds() - before, 2u) << "the second picture is not built";
-  EXPECT_EQ(r.rt->shown_id(), 3);
-  EXPECT_EQ(r.rt->last_said().rfind("Picture 4 of 5", 0), 0u) << r.rt->last_said();
+  EXPECT_LE(r.rt->library().builds_started() - before, 2u) << "the second picture is not built";
+  EXPECT_EQ(r.rt->stage().shown_id(), 3);
+  EXPECT_EQ(r.rt->voice().last_said().rfind("Picture 4 of 5", 0), 0u) << r.rt->voice().last_said();
 }
 
 TEST(KioskBuilds, TheNextPictureBuiltAheadIsASwapAndThePreviousIsKept) {
   LibraryRig r({"horse.png", "coins.png", "apple.jpg", "fruits.jpg"}, 256, "ahead");
   ASSERT_GE(test::show_now(*r.rt, 1), 0);
   ASSERT_TRUE(r.ahead_becomes({0, 2})) << "the neighbours of picture 2 are built ahead";
-  const std::uint64_t before = r.rt->scene_builds();
-  const int shapes = r.rt->show_picture(2);
+  const std::uint64_t before = r.rt->library().builds_started();
+  const int shapes = r.rt->library().show_picture(2);
   EXPECT_NE(shapes, KioskEffects::kPicturePending) << "on the device at once";
-  EXPECT_EQ(r.rt->shown_id(), 2);
-  EXPECT_EQ(shapes, static_cast<int>(r.rt->shown().scene->curve_count()));
-  EXPECT_LE(r.rt->scene_builds() - before, 1u) << "picture 3 is being built ahead; picture 2 was not built again";
+  EXPECT_EQ(r.rt->stage().shown_id(), 2);
+  EXPECT_EQ(shapes, static_cast<int>(r.rt->stage().shown().scene->curve_count()));
+  EXPECT_LE(r.rt->library().builds_started() - before, 1u)
+      << "picture 3 is being built ahead; picture 2 was not built again";
   ASSERT_TRUE(r.ahead_becomes({1, 3})) << "picture 2's neighbours: 1 (built before) and 3";
 }
 
@@ -264,24 +265,24 @@ TEST(KioskBuilds, TheFirstPictureIsBuiltDuringTheTutorialSoItsEndIsASwap) {
   ASSERT_TRUE(r.ahead_becomes({0})) << "picture 1 is built while the visitor learns the shapes";
   for (int i = 0; i < 2; ++i) r.flow->key(KioskKey::Next, 1.0);  // circle, triangle
   r.flow->key(KioskKey::Next, 2.0);                              // the first picture
-  EXPECT_EQ(r.rt->shown_id(), 0) << "on the device at the key, not after a build";
-  EXPECT_FALSE(r.rt->picture_busy());
-  EXPECT_NE(r.rt->last_said().find("Picture 1 of 3"), std::string::npos) << r.rt->last_said();
+  EXPECT_EQ(r.rt->stage().shown_id(), 0) << "on the device at the key, not after a build";
+  EXPECT_FALSE(r.rt->library().busy());
+  EXPECT_NE(r.rt->voice().last_said().find("Picture 1 of 3"), std::string::npos) << r.rt->voice().last_said();
 }
 
 TEST(KioskBuilds, NothingIsBuiltAheadOverTheBudgetAndNothingIsBuiltTwice) {
   LibraryRig r({"horse.png", "fruits.jpg", "apple.jpg"}, 0, "budget0");
   ASSERT_GE(test::show_now(*r.rt, 0), 0);
-  const std::uint64_t after_first = r.rt->scene_builds();
-  for (int i = 0; i < 50; ++i) r.rt->poll_pictures(r.flow.get(), 0.0);
-  EXPECT_EQ(r.rt->scene_builds(), after_first) << "prefetch_mb = 0: nothing built ahead";
-  EXPECT_TRUE(r.rt->pictures_ahead().empty());
+  const std::uint64_t after_first = r.rt->library().builds_started();
+  for (int i = 0; i < 50; ++i) r.rt->library().poll(r.flow.get(), 0.0);
+  EXPECT_EQ(r.rt->library().builds_started(), after_first) << "prefetch_mb = 0: nothing built ahead";
+  EXPECT_TRUE(r.rt->library().ahead().empty());
 }
 
 /// The level-0 points of every curve of the scene shown.
 std::vector<std::vector<Vec2>> shown_points(KioskRuntime& rt) {
   std::vector<std::vector<Vec2>> out;
-  for (const Polyline& p : rt.shown().polylines) out.push_back(p.points_m);
+  for (const Polyline& p : rt.stage().shown().polylines) out.push_back(p.points_m);
   return out;
 }
 
@@ -334,21 +335,21 @@ TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibr
   r.flow->key(KioskKey::Other, 0.0);
   for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.0);
   r.settle(0.0);
-  ASSERT_EQ(r.rt->shown_id(), 0);
-  r.rt->insert_stick_folder(stick.string());
+  ASSERT_EQ(r.rt->stage().shown_id(), 0);
+  r.rt->sticks().insert_folder(stick.string());
   double now_s = 1.0;
   ASSERT_TRUE(r.stick_shows(1001, now_s)) << "the stick's first page is felt";
   r.flow->key(KioskKey::Next, now_s);  // page 2 asked for...
-  r.rt->remove_stick_folder();         // ...and the stick pulled out while it is drawn
-  ASSERT_TRUE(hk::test::wait_until([&] { return !r.rt->stick_busy() && !r.rt->picture_busy(); },
+  r.rt->sticks().remove_folder();      // ...and the stick pulled out while it is drawn
+  ASSERT_TRUE(hk::test::wait_until([&] { return !r.rt->sticks().busy() && !r.rt->library().busy(); },
                                    [&] {
-                                     r.rt->poll_sticks(*r.flow, now_s);
-                                     r.rt->poll_pictures(r.flow.get(), now_s);
+                                     r.rt->sticks().poll(*r.flow, now_s);
+                                     r.rt->library().poll(r.flow.get(), now_s);
                                      now_s += 0.01;
                                    }));
   for (int i = 0; i < 50; ++i, now_s += 0.01)
-    r.rt->poll_sticks(*r.flow, now_s);  // page 2's drawing, if it ends now, is dropped
-  EXPECT_EQ(r.rt->shown_id(), 0) << "back on the library's picture, never page 2";
+    r.rt->sticks().poll(*r.flow, now_s);  // page 2's drawing, if it ends now, is dropped
+  EXPECT_EQ(r.rt->stage().shown_id(), 0) << "back on the library's picture, never page 2";
   EXPECT_EQ(r.flow->failures(), 0);
   fs::remove_all(stick);
 }
@@ -360,25 +361,25 @@ TEST(KioskBuilds, FinishWhileAStickPageIsBuiltLeavesNothingBusy) {
   LibraryRig r({"horse.png"}, 0, "stickfinish");
   const fs::path stick = r.spec_stick("stickfinish");
   r.flow->key(KioskKey::Other, 0.0);
-  r.rt->insert_stick_folder(stick.string());
+  r.rt->sticks().insert_folder(stick.string());
   double now_s = 1.0;
   ASSERT_TRUE(r.stick_shows(1001, now_s)) << "the stick's first page is felt";
-  const int loads = r.rt->sticks().loads_started();
-  const int done = r.rt->sticks().loads_done();
+  const int loads = r.rt->sticks().service().loads_started();
+  const int done = r.rt->sticks().service().loads_done();
   r.flow->key(KioskKey::Next, now_s);  // page 2...
-  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().loads_started() == loads); }));
-  ASSERT_EQ(r.rt->sticks().loads_started(), loads + 1) << "page 2 is being drawn";
-  r.rt->poll_sticks(*r.flow, now_s);
-  ASSERT_TRUE(r.rt->stick_busy()) << "the kiosk waits for page 2";
+  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().service().loads_started() == loads); }));
+  ASSERT_EQ(r.rt->sticks().service().loads_started(), loads + 1) << "page 2 is being drawn";
+  r.rt->sticks().poll(*r.flow, now_s);
+  ASSERT_TRUE(r.rt->sticks().busy()) << "the kiosk waits for page 2";
   r.flow->key(KioskKey::Finish, now_s);  // ...and Finish, twice, before it is done
   r.flow->key(KioskKey::Finish, now_s + 0.5);
   ASSERT_EQ(r.flow->state(), KioskState::Attract);
-  EXPECT_FALSE(r.rt->stick_busy()) << "nothing of the forgotten stick is awaited";
+  EXPECT_FALSE(r.rt->sticks().busy()) << "nothing of the forgotten stick is awaited";
   // Page 2's drawing ends (or has ended), and the window polls it in.
-  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().loads_done() == done); }));
-  ASSERT_EQ(r.rt->sticks().loads_done(), done + 1) << "page 2's load ended within 60 s";
-  r.rt->poll_sticks(*r.flow, now_s);
-  EXPECT_FALSE(r.rt->stick_busy()) << "the page that arrived for the forgotten stick left nothing busy";
+  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().service().loads_done() == done); }));
+  ASSERT_EQ(r.rt->sticks().service().loads_done(), done + 1) << "page 2's load ended within 60 s";
+  r.rt->sticks().poll(*r.flow, now_s);
+  EXPECT_FALSE(r.rt->sticks().busy()) << "the page that arrived for the forgotten stick left nothing busy";
   EXPECT_EQ(r.flow->state(), KioskState::Attract) << "and did not wake the kiosk";
   EXPECT_EQ(r.flow->failures(), 0);
   fs::remove_all(stick);
@@ -393,15 +394,15 @@ TEST(KioskBuilds, WhatAStickCouldNotGiveIsListedForTheOperator) {
   fs::copy_file(kData / "bad" / "bad_crc.png", stick / "bad_crc.png");
   fs::copy_file(kData / "bad" / "damaged_idat.png", stick / "a_damaged.png");  // sorted first: the first page asked for
   r.flow->key(KioskKey::Other, 0.0);
-  EXPECT_TRUE(r.rt->stick_problems().empty());
-  r.rt->insert_stick_folder(stick.string());
+  EXPECT_TRUE(r.rt->sticks().problems().empty());
+  r.rt->sticks().insert_folder(stick.string());
   double now_s = 1.0;
-  EXPECT_TRUE(hk::test::wait_until([&] { return r.rt->stick_problems().size() >= 2; },
+  EXPECT_TRUE(hk::test::wait_until([&] { return r.rt->sticks().problems().size() >= 2; },
                                    [&] {
-                                     r.rt->poll_sticks(*r.flow, now_s);
+                                     r.rt->sticks().poll(*r.flow, now_s);
                                      now_s += 0.01;
                                    }));
-  const std::vector<std::string>& problems = r.rt->stick_problems();
+  const std::vector<std::string>& problems = r.rt->sticks().problems();
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_EQ(problems[0].rfind("'bad_crc.png': ", 0), 0u) << problems[0];
   EXPECT_NE(problems[0].find("CRC"), std::string::npos) << "why, as the log says it: " << problems[0];
@@ -414,21 +415,21 @@ TEST(KioskBuilds, StickPagesPassedByQuicklyAreNeverPutOnTheDevice) {
   LibraryRig r({"horse.png"}, 0, "stickquick");  // prefetch_mb 0: each page is built when asked for
   const fs::path stick = r.spec_stick("stickquick");
   r.flow->key(KioskKey::Other, 0.0);
-  r.rt->insert_stick_folder(stick.string());
+  r.rt->sticks().insert_folder(stick.string());
   double now_s = 1.0;
   ASSERT_TRUE(r.stick_shows(1001, now_s)) << "the stick's first page is felt";
-  const std::uint64_t published = r.rt->scenes_published();
-  const int loads = r.rt->sticks().loads_started();
+  const std::uint64_t published = r.rt->stage().scenes_published();
+  const int loads = r.rt->sticks().service().loads_started();
   r.flow->key(KioskKey::Next, now_s);  // page 2...
-  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().loads_started() == loads); }));
-  ASSERT_EQ(r.rt->sticks().loads_started(), loads + 1) << "page 2 is being drawn";
+  ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().service().loads_started() == loads); }));
+  ASSERT_EQ(r.rt->sticks().service().loads_started(), loads + 1) << "page 2 is being drawn";
   for (int i = 0; i < 2; ++i) r.flow->key(KioskKey::Next, now_s);  // ...then pages 3 and 4 before it is done
   ASSERT_TRUE(r.stick_shows(1004, now_s));
-  for (int i = 0; i < 50; ++i, now_s += 0.01) r.rt->poll_sticks(*r.flow, now_s);
-  EXPECT_EQ(r.rt->scenes_published() - published, 1u)
+  for (int i = 0; i < 50; ++i, now_s += 0.01) r.rt->sticks().poll(*r.flow, now_s);
+  EXPECT_EQ(r.rt->stage().scenes_published() - published, 1u)
       << "page 2, drawn before Next was pressed again, was dropped, not shown";
-  EXPECT_EQ(r.rt->shown_id(), 1004);
-  EXPECT_EQ(r.rt->last_said().rfind("Page 4 of ", 0), 0u) << r.rt->last_said();
+  EXPECT_EQ(r.rt->stage().shown_id(), 1004);
+  EXPECT_EQ(r.rt->voice().last_said().rfind("Page 4 of ", 0), 0u) << r.rt->voice().last_said();
   EXPECT_EQ(r.flow->failures(), 0);
   fs::remove_all(stick);
 }
@@ -443,19 +444,20 @@ TEST(KioskBuilds, APictureThatCannotBeReadIsSaidAndTheOldOneStays) {
   r.flow->key(KioskKey::Other, 0.0);
   for (int i = 0; i < 3; ++i) r.flow->key(KioskKey::Next, 0.0);
   r.settle(0.0);
-  ASSERT_EQ(r.rt->shown_id(), 0);
-  const Scene* before = r.rt->shown().scene;
+  ASSERT_EQ(r.rt->stage().shown_id(), 0);
+  const Scene* before = r.rt->stage().shown().scene;
   r.flow->key(KioskKey::Next, 1.0);
   r.settle(1.0);
-  EXPECT_EQ(r.rt->shown_id(), 0) << "the horse is still felt";
-  EXPECT_EQ(r.rt->shown().scene, before);
-  EXPECT_EQ(r.rt->last_said().rfind("Picture 2 of 3 cannot be read. ", 0), 0u) << r.rt->last_said();
-  EXPECT_EQ(r.rt->last_said().find("1_coins.png"), std::string::npos) << "the picture's number names it, not its path";
-  EXPECT_EQ(r.rt->last_said().find("PNG"), std::string::npos)
+  EXPECT_EQ(r.rt->stage().shown_id(), 0) << "the horse is still felt";
+  EXPECT_EQ(r.rt->stage().shown().scene, before);
+  EXPECT_EQ(r.rt->voice().last_said().rfind("Picture 2 of 3 cannot be read. ", 0), 0u) << r.rt->voice().last_said();
+  EXPECT_EQ(r.rt->voice().last_said().find("1_coins.png"), std::string::npos)
+      << "the picture's number names it, not its path";
+  EXPECT_EQ(r.rt->voice().last_said().find("PNG"), std::string::npos)
       << "what is wrong with it is the operator's to read (the log), not the visitor's";
   r.flow->key(KioskKey::Next, 2.0);  // steps past it
   r.settle(2.0);
-  EXPECT_EQ(r.rt->shown_id(), 2);
+  EXPECT_EQ(r.rt->stage().shown_id(), 2);
   EXPECT_EQ(r.flow->failures(), 0);
 }
 

@@ -14,6 +14,7 @@
 #include "config/keys.hpp"
 #include "config/load.hpp"
 #include "config/settings.hpp"
+#include "every_effect.hpp"
 #include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
 
@@ -23,7 +24,7 @@ namespace {
 const std::string kMessagesDir = std::string(HK_TEST_DATA_DIR) + "/messages/";
 
 /// Records what is said (the captions show the last of it); the device and library are trivial.
-struct Speech final : KioskEffects {
+struct Speech final : hk::test::EveryEffect {
   std::vector<std::string> said;
   void say(const std::string& t) override { said.push_back(t); }
   void show_tutorial(TutorialShape) override {}

@@ -236,10 +236,10 @@ struct KioskRig {
   std::vector<std::string> frames_until_read(double& now_s) {
     std::vector<std::string> said;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (rt->text_busy() && std::chrono::steady_clock::now() < deadline) {
-      const std::string before = rt->last_said();
-      rt->poll_text(now_s);
-      if (rt->last_said() != before) said.push_back(rt->last_said());
+    while (rt->stage().text_busy() && std::chrono::steady_clock::now() < deadline) {
+      const std::string before = rt->voice().last_said();
+      rt->stage().poll_text(now_s);
+      if (rt->voice().last_said() != before) said.push_back(rt->voice().last_said());
       now_s += 0.1;
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
@@ -252,24 +252,25 @@ TEST(KioskText, APageIsFeltAtOnceThenItsTextComesWithoutLeavingThePage) {
     GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
   KioskRig k;
-  const int scan = k.rt->find_picture((k.lib / "a_scan.jpg").string());
+  const int scan = k.rt->library().find((k.lib / "a_scan.jpg").string());
   ASSERT_GE(scan, 0);
   ASSERT_GE(test::show_now(*k.rt, scan), 0);
-  const int id = k.rt->shown_id();
-  EXPECT_TRUE(k.rt->text_busy());
-  EXPECT_TRUE(k.rt->shown().text_blocks.empty()) << "not read yet";
-  ASSERT_NE(k.rt->shown().scene, nullptr) << "felt at once";
-  EXPECT_EQ(k.rt->describe().rfind("Reading the text. ", 0), 0u) << k.rt->describe();
+  const int id = k.rt->stage().shown_id();
+  EXPECT_TRUE(k.rt->stage().text_busy());
+  EXPECT_TRUE(k.rt->stage().shown().text_blocks.empty()) << "not read yet";
+  ASSERT_NE(k.rt->stage().shown().scene, nullptr) << "felt at once";
+  EXPECT_EQ(k.rt->stage().describe().rfind("Reading the text. ", 0), 0u) << k.rt->stage().describe();
   double now_s = 0.0;
   const std::vector<std::string> said = k.frames_until_read(now_s);
-  ASSERT_FALSE(k.rt->text_busy()) << "no text within 60 s";
+  ASSERT_FALSE(k.rt->stage().text_busy()) << "no text within 60 s";
   ASSERT_EQ(said.size(), 2u) << (said.empty() ? "" : said.front());
   EXPECT_EQ(said[0], "Reading the text.");
   EXPECT_EQ(said[1].rfind("The text is ready. It has ", 0), 0u) << said[1];
-  EXPECT_EQ(k.rt->shown_id(), id) << "the same page";
-  EXPECT_GE(k.rt->shown().text_blocks.size(), 3u);
-  for (const TextBlockM& b : k.rt->shown().text_blocks) EXPECT_EQ(b.source, "ocr");
-  const std::string d = k.rt->describe();  // a block's text where the proxy rests on one, else the page's blocks
+  EXPECT_EQ(k.rt->stage().shown_id(), id) << "the same page";
+  EXPECT_GE(k.rt->stage().shown().text_blocks.size(), 3u);
+  for (const TextBlockM& b : k.rt->stage().shown().text_blocks) EXPECT_EQ(b.source, "ocr");
+  const std::string d =
+      k.rt->stage().describe();  // a block's text where the proxy rests on one, else the page's blocks
   EXPECT_TRUE(d.rfind("Text: ", 0) == 0 || d.find("blocks of text") != std::string::npos) << d;
 }
 
@@ -278,14 +279,14 @@ TEST(KioskText, AnotherPictureCancelsTheReadingAndNothingIsSaidOfIt) {
     GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
   if (!have_ocr()) GTEST_SKIP() << "Tesseract's eng traineddata is not installed (scripts/install-deps.sh installs it)";
   KioskRig k;
-  ASSERT_GE(test::show_now(*k.rt, k.rt->find_picture((k.lib / "a_scan.jpg").string())), 0);
-  ASSERT_TRUE(k.rt->text_busy());
-  ASSERT_GE(test::show_now(*k.rt, k.rt->find_picture((k.lib / "b_horse.png").string())), 0);
-  EXPECT_FALSE(k.rt->text_busy()) << "the horse has no text to read";
+  ASSERT_GE(test::show_now(*k.rt, k.rt->library().find((k.lib / "a_scan.jpg").string())), 0);
+  ASSERT_TRUE(k.rt->stage().text_busy());
+  ASSERT_GE(test::show_now(*k.rt, k.rt->library().find((k.lib / "b_horse.png").string())), 0);
+  EXPECT_FALSE(k.rt->stage().text_busy()) << "the horse has no text to read";
   double now_s = 0.0;
-  for (int frame = 0; frame < 30; ++frame, now_s += 0.1) k.rt->poll_text(now_s);
-  EXPECT_EQ(k.rt->last_said(), "") << "nothing said of the page left";
-  EXPECT_TRUE(k.rt->shown().text_blocks.empty());
+  for (int frame = 0; frame < 30; ++frame, now_s += 0.1) k.rt->stage().poll_text(now_s);
+  EXPECT_EQ(k.rt->voice().last_said(), "") << "nothing said of the page left";
+  EXPECT_TRUE(k.rt->stage().shown().text_blocks.empty());
 }
 
 TEST(KioskText, AScanOnAStickIsAnnouncedAsBeingReadThenItsTextIsReady) {
@@ -298,26 +299,27 @@ TEST(KioskText, AScanOnAStickIsAnnouncedAsBeingReadThenItsTextIsReady) {
   std::ofstream(stick / "letter.jpg", std::ios::binary)
       .write(reinterpret_cast<const char*>(k.scan.jpeg.data()), static_cast<std::streamsize>(k.scan.jpeg.size()));
   KioskFlowParams fp;
-  KioskFlow flow(*k.rt, k.rt->audio().messages(), fp);
+  KioskFlow flow(k.rt->effects(), k.rt->audio().messages(), fp);
   double now_s = 0.0;
   flow.key(KioskKey::Other, now_s);  // a visitor is there
-  k.rt->insert_stick_folder(stick.string());
+  k.rt->sticks().insert_folder(stick.string());
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   std::string announced;
   while (std::chrono::steady_clock::now() < deadline && announced.empty()) {
-    k.rt->poll_sticks(flow, now_s);
-    if (k.rt->last_said().find("Document 1 of 1, letter") != std::string::npos && !k.rt->stick_busy())
-      announced = k.rt->last_said();
+    k.rt->sticks().poll(flow, now_s);
+    if (k.rt->voice().last_said().find("Document 1 of 1, letter") != std::string::npos && !k.rt->sticks().busy())
+      announced = k.rt->voice().last_said();
     now_s += 0.1;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  ASSERT_FALSE(announced.empty()) << "the stick's picture was not shown within 60 s; last said: " << k.rt->last_said();
+  ASSERT_FALSE(announced.empty()) << "the stick's picture was not shown within 60 s; last said: "
+                                  << k.rt->voice().last_said();
   EXPECT_NE(announced.find("letter. Reading the text."), std::string::npos) << announced;
-  EXPECT_TRUE(k.rt->text_busy());
+  EXPECT_TRUE(k.rt->stage().text_busy());
   const std::vector<std::string> said = k.frames_until_read(now_s);
   ASSERT_EQ(said.size(), 1u) << "'Reading the text.' is not said twice";
   EXPECT_EQ(said[0].rfind("The text is ready. It has ", 0), 0u) << said[0];
-  EXPECT_GE(k.rt->shown().text_blocks.size(), 3u);
+  EXPECT_GE(k.rt->stage().shown().text_blocks.size(), 3u);
 }
 
 }  // namespace

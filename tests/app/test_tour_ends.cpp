@@ -55,9 +55,9 @@ struct OnePictureKiosk {
     const double dt = 1.0 / s.haptics.servo_rate_hz;
     for (long k = 0, n = static_cast<long>(seconds / dt + 0.5); k < n; ++k, ++ticks) {
       test::runtime_tick(*rt, dt, nullptr);
-      if (ticks % 16 == 0) rt->poll_tour();
+      if (ticks % 16 == 0) rt->tour().poll();
     }
-    rt->poll_tour();
+    rt->tour().poll();
   }
   double now_s() const { return static_cast<double>(ticks) / s.haptics.servo_rate_hz; }
 };
@@ -75,31 +75,31 @@ TEST_P(EveryTourEnds, OnEveryShapeWithASpokenLineWithinItsBound) {
   const TourParams tp = tour_params_from(k.s);
   int tours = 0, done = 0;
   for (int press = 0; press <= shapes + 1; ++press) {
-    k.rt->key_pressed();
-    k.rt->guide();
-    if (!k.rt->tour_running()) {  // nothing left to lead to: said so
-      const std::string said = k.rt->last_said();
+    k.rt->tour().key_pressed();
+    k.rt->tour().guide();
+    if (!k.rt->tour().running()) {  // nothing left to lead to: said so
+      const std::string said = k.rt->voice().last_said();
       EXPECT_TRUE(said == m.text(audio::MessageId::tour_all_touched) || said == m.text(audio::MessageId::tour_nothing))
           << said;
       break;
     }
-    for (int i = 0; i < 200 && k.rt->tour_announced(); ++i) k.run(0.05);  // "I will guide your hand…"
-    ASSERT_FALSE(k.rt->tour_announced());
-    if (!k.rt->tour_running()) continue;  // touched meanwhile: nothing to lead to
+    for (int i = 0; i < 200 && k.rt->tour().announced(); ++i) k.run(0.05);  // "I will guide your hand…"
+    ASSERT_FALSE(k.rt->tour().announced());
+    if (!k.rt->tour().running()) continue;  // touched meanwhile: nothing to lead to
     // What the runtime planned as it handed the tour over, planned again from (almost) the same place.
-    const std::optional<TourPath> plan =
-        plan_tour(*k.rt->shown().scene, k.rt->shown_id(), k.rt->core().display().handle_m, k.rt->touches(), tp);
+    const std::optional<TourPath> plan = plan_tour(*k.rt->stage().shown().scene, k.rt->stage().shown_id(),
+                                                   k.rt->core().display().handle_m, k.rt->tour().touches(), tp);
     ASSERT_TRUE(plan.has_value());
     const double bound_s = std::max(tp.stall_s, tp.overrun_factor * plan->duration_s()) + tp.fade_s + 0.1;
     const double from_s = k.now_s();
-    while (k.rt->tour_running() && k.now_s() - from_s < bound_s + 5.0) k.run(0.02);
+    while (k.rt->tour().running() && k.now_s() - from_s < bound_s + 5.0) k.run(0.02);
     const double took_s = k.now_s() - from_s;
     ++tours;
-    ASSERT_FALSE(k.rt->tour_running()) << "tour " << tours << " to shape " << plan->curve << " still running after "
-                                       << took_s << " s";
+    ASSERT_FALSE(k.rt->tour().running()) << "tour " << tours << " to shape " << plan->curve << " still running after "
+                                         << took_s << " s";
     EXPECT_LE(took_s, bound_s) << "tour " << tours << " to shape " << plan->curve << " (planned " << plan->duration_s()
                                << " s)";
-    const std::string said = k.rt->last_said();
+    const std::string said = k.rt->voice().last_said();
     const bool traced = starts_with(said, "That was shape ");
     done += traced;
     EXPECT_TRUE(traced || starts_with(said, m.text(audio::MessageId::tour_stopped)) ||

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "every_effect.hpp"
 #include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
@@ -16,7 +17,7 @@ namespace {
 
 using audio::MessageId;
 
-struct Speaker final : KioskEffects {
+struct Speaker final : hk::test::EveryEffect {
   std::vector<std::string> said;  // every text, in order
   std::vector<bool> brief;        // said[i] was an acknowledgement (Repeat passes it over)
   std::string kept;               // what Repeat says again

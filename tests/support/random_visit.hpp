@@ -86,7 +86,7 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   settings.vision.ocr = "off";  // OCR's worker takes seconds a page: not what is visited here
   app::RuntimeOptions ro = headless_runtime_options(p.library);
   auto rt = std::make_unique<app::KioskRuntime>(ro, settings);
-  app::KioskFlow flow(*rt, rt->audio().messages(), app::KioskFlowParams{});
+  app::KioskFlow flow(rt->effects(), rt->audio().messages(), app::KioskFlowParams{});
 
   const double dt_s = 1.0 / settings.haptics.servo_rate_hz;
   const int ticks_per_frame = static_cast<int>(std::lround(settings.haptics.servo_rate_hz / 60.0));
@@ -112,8 +112,8 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   std::vector<Awaited> awaited;
 
   auto press = [&](KioskKey k, double now_s, int frame) {
-    const std::uint64_t said = rt->texts_said();
-    const bool heard = rt->speaking();
+    const std::uint64_t said = rt->voice().texts_said();
+    const bool heard = rt->voice().speaking();
     const std::string name = k == KioskKey::Other ? kStrayNames[pick(6)] : "";
     flow.key(k, now_s, name);
     ++report.keys;
@@ -124,7 +124,7 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
                              (flow.source() == app::KioskSource::Stick ? ", on a stick" : "") +
                              (flow.loading() ? ", a page awaited" : "") +
                              (flow.picture_pending() ? ", a picture awaited" : "") + ") said nothing";
-    if (rt->texts_said() != said || silent_answer) return;
+    if (rt->voice().texts_said() != said || silent_answer) return;
     if (flow.loading() || flow.picture_pending()) {
       awaited.push_back({frame + answer_frames, said, what + " within " + std::to_string(answer_frames) + " frames"});
     } else {
@@ -133,12 +133,12 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   };
   auto check_awaited = [&](int frame) {
     for (auto it = awaited.begin(); it != awaited.end();) {
-      if (rt->texts_said() > it->said) {
+      if (rt->voice().texts_said() > it->said) {
         it = awaited.erase(it);
       } else if (frame >= it->due_frame) {
         report.unanswered.push_back(
             it->what + "; then: " + app::state_name(flow.state()) + (flow.loading() ? ", a page awaited" : "") +
-            (flow.picture_pending() ? ", a picture awaited" : "") + "; last said: " + rt->last_said());
+            (flow.picture_pending() ? ", a picture awaited" : "") + "; last said: " + rt->voice().last_said());
         it = awaited.erase(it);
       } else {
         ++it;
@@ -147,11 +147,7 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   };
   auto frame_step = [&](double now_s) {
     for (int t = 0; t < ticks_per_frame; ++t) runtime_tick(*rt, dt_s, hand);
-    rt->poll_pictures(&flow, now_s);
-    rt->poll_sticks(flow, now_s);
-    rt->poll_capture(flow, now_s);
-    rt->poll_text(now_s);
-    rt->poll_device(now_s);
+    rt->poll(&flow, now_s);  // as the kiosk's frame: pictures, sticks, capture, text, device
     // The handle watched as the window does: motion wakes and keeps the visit, sliding contact keeps it.
     const app::ServoDisplayState& d = rt->core().display();
     if (length(d.handle_m - watched) > 0.005) {
@@ -162,10 +158,8 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
       slid = d.handle_m;
       flow.touching(now_s);
     }
-    rt->poll_tour();
-    rt->poll_display_modes();
+    rt->poll_after_input();
     flow.tick(now_s);
-    rt->collect();
     rt->audio().render(audio.data(), audio.size());
   };
 
@@ -202,10 +196,10 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
     }
     if (chance(p.stick_per_frame)) {
       if (stick_in) {
-        rt->remove_stick_folder();
+        rt->sticks().remove_folder();
         ++report.sticks_out;
       } else {
-        rt->insert_stick_folder(sticks[pick(3)].string());
+        rt->sticks().insert_folder(sticks[pick(3)].string());
         ++report.sticks_in;
       }
       stick_in = !stick_in;
@@ -232,7 +226,8 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   // As a scripted `wait` does: the kiosk's clock holds while the work ends (at most 60 s of the machine's).
   auto settle = [&](double now_s) {
     const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while ((rt->stick_busy() || rt->picture_busy() || rt->text_busy()) && std::chrono::steady_clock::now() < give_up) {
+    while ((rt->sticks().busy() || rt->library().busy() || rt->stage().text_busy()) &&
+           std::chrono::steady_clock::now() < give_up) {
       frame_step(now_s);
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
@@ -247,17 +242,17 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   auto expect = [&](bool ok, const std::string& what) {
     if (!ok)
       report.left_behind.push_back("seed " + std::to_string(p.seed) + ": " + what + " (" +
-                                   app::state_name(flow.state()) + "; last said: " + rt->last_said() + ")");
+                                   app::state_name(flow.state()) + "; last said: " + rt->voice().last_said() + ")");
   };
   expect(flow.state() == app::KioskState::Attract, "the kiosk is not waiting for a visitor");
   expect(flow.source() == app::KioskSource::Library, "Next and Previous would still walk the stick");
-  expect(!rt->stick_busy(), "the stick is still 'working'");
-  expect(!rt->picture_busy(), "a picture is still awaited");
-  expect(!rt->tour_running(), "a guided tour still runs");
+  expect(!rt->sticks().busy(), "the stick is still 'working'");
+  expect(!rt->library().busy(), "a picture is still awaited");
+  expect(!rt->tour().running(), "a guided tour still runs");
   expect(!flow.reading() && !flow.in_help() && !flow.capturing() && !flow.warned(),
          "reading, help, capture or a warning is still on");
   expect(rt->audio().volume().step() == settings.audio.volume_default_step, "the volume is not the operator's default");
-  expect(rt->auto_level(), "the level does not follow the hand again");
+  expect(rt->stage().auto_level(), "the level does not follow the hand again");
   report.failures = flow.failures();
   return report;
 }

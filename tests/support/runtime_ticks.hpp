@@ -32,7 +32,7 @@ inline void runtime_tick(app::KioskRuntime& rt, double dt,
   rt.core().publish_display();
   sim.write_force(cmd.force_n);
   sim.step(dt, hand_force ? hand_force(sim) : Vec2{});
-  rt.collect();
+  rt.core().collect_retired();
 }
 
 }  // namespace hk::test

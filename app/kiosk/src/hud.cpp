@@ -8,8 +8,9 @@
 
 namespace hk::app {
 void draw_captions(KioskRuntime& app, const KioskFlow& flow, int fw, int fh) {
-  const std::string caption =
-      flow.state() == KioskState::Attract ? app.audio().messages().raw(audio::MessageId::attract) : app.last_said();
+  const std::string caption = flow.state() == KioskState::Attract
+                                  ? app.audio().messages().raw(audio::MessageId::attract)
+                                  : app.voice().last_said();
   ImGui::SetNextWindowPos(ImVec2(0.05f * fw, 0.86f * fh));
   ImGui::SetNextWindowSize(ImVec2(0.9f * fw, 0.13f * fh));
   ImGui::SetNextWindowBgAlpha(0.75f);

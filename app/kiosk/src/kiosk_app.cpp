@@ -160,12 +160,13 @@ class Kiosk final : public ScriptTarget {
     note_picture_key(k);
     flow_.key(k, now_s_);
   }
-  void cursor(Vec2 m) override { rt_.set_cursor(m); }
+  void cursor(Vec2 m) override { rt_.tour().set_cursor(m); }
   void moved() override { flow_.handle_moved(now_s_); }
-  void stick(const std::string& dir) override { rt_.insert_stick_folder(dir); }
-  void unstick() override { rt_.remove_stick_folder(); }
+  void stick(const std::string& dir) override { rt_.sticks().insert_folder(dir); }
+  void unstick() override { rt_.sticks().remove_folder(); }
   bool busy() override {
-    return rt_.stick_busy() || rt_.text_busy() || rt_.picture_busy() || session_.state() == PanelState::checking;
+    return rt_.sticks().busy() || rt_.stage().text_busy() || rt_.library().busy() ||
+           session_.state() == PanelState::checking;
   }
   std::optional<WidgetRect> widget(const std::string& name) override { return panel_.widget(name); }
 
@@ -182,7 +183,7 @@ class Kiosk final : public ScriptTarget {
     if (!mouse_moved_ || session_.state() == PanelState::open) return;
     const auto [ww, wh] = window_.window_size();
     const Vec2 m = make_view(ww, wh, rt_.half()).to_m(cx, cy);
-    rt_.set_cursor({std::clamp(m.x, -rt_.half().x, rt_.half().x), std::clamp(m.y, -rt_.half().y, rt_.half().y)});
+    rt_.tour().set_cursor({std::clamp(m.x, -rt_.half().x, rt_.half().x), std::clamp(m.y, -rt_.half().y, rt_.half().y)});
   }
 
   /// The handle moved noticeably (5 mm) since the last report, or slides along a shape (1 mm in contact since
@@ -230,9 +231,9 @@ class Kiosk final : public ScriptTarget {
 
 /// --show: straight to a picture, past the welcome and the tutorial.
 void show_first(const std::string& path, KioskRuntime& rt, KioskFlow& flow) {
-  int idx = rt.find_picture(path);
+  int idx = rt.library().find(path);
   if (idx < 0) {
-    rt.add_picture_first(path);
+    rt.library().add_first(path);
     idx = 0;
   }
   flow.key(KioskKey::Other, 0.0);                             // wake: welcome + tutorial
@@ -286,8 +287,8 @@ KioskFlowParams flow_params(const config::Settings& settings, bool camera) {
 void start_kiosk(const KioskOptions& o, const RuntimeOptions& ro, KioskRuntime& rt, KioskFlow& flow) {
   rt.start_servo();
   if (ro.probe_usb_device || !ro.device.empty()) rt.announce_device();
-  rt.announce_camera();
-  if (!o.stick.empty()) rt.insert_stick_folder(o.stick);
+  rt.camera().announce(rt.settings().keys);
+  if (!o.stick.empty()) rt.sticks().insert_folder(o.stick);
   if (!o.show.empty()) show_first(o.show, rt, flow);
 }
 
@@ -297,21 +298,15 @@ void start_kiosk(const KioskOptions& o, const RuntimeOptions& ro, KioskRuntime& 
 bool update_frame(Kiosk& kiosk, KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, KioskWindow& window,
                   ScriptPlayer& script, bool scripted, int frame) {
   for (const InputEvent& e : window.poll()) kiosk.input(e);
-  rt.poll_pictures(&flow, kiosk.now_s_);
-  rt.poll_sticks(flow, kiosk.now_s_);
-  rt.poll_capture(flow, kiosk.now_s_);
-  rt.poll_text(kiosk.now_s_);
-  rt.poll_device(kiosk.now_s_);
+  rt.poll(&flow, kiosk.now_s_);  // pictures, sticks, capture, text, device
   // A scripted run's clock is its frame count: it holds while a picture asked for is being built, so the
   // same script shows the same frames however fast the machine builds.
-  const bool holding = scripted && (rt.picture_busy() || script.step(frame, kiosk));
+  const bool holding = scripted && (rt.library().busy() || script.step(frame, kiosk));
   if (!scripted) kiosk.follow_mouse();
   kiosk.watch_handle();
-  rt.poll_tour();
-  rt.poll_display_modes();
+  rt.poll_after_input();  // tour, display switches, retired scenes
   flow.tick(kiosk.now_s_);
   session.tick(kiosk.now_s_, unix_now_s());
-  rt.collect();
   return holding;
 }
 
@@ -321,12 +316,12 @@ void draw_frame(KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, Ope
                 const ScriptPlayer& script, bool scripted, double now_s, PictureTexture& texture,
                 CapturePreviewView& preview) {
   const auto [fw, fh] = window.framebuffer_size();
-  texture.update(rt.shown());
+  texture.update(rt.stage().shown());
   draw_scene(rt, make_view(fw, fh, rt.half()), texture);
-  if (flow.capturing()) preview.draw(rt.capture_preview(), make_view(fw, fh, rt.half()), rt.half());
+  if (flow.capturing()) preview.draw(rt.camera().preview(), make_view(fw, fh, rt.half()), rt.half());
   window.begin_frame(scripted ? script.mouse() : std::nullopt);
   draw_captions(rt, flow, fw, fh);
-  if (rt.overlay() && session.state() != PanelState::open) draw_overlay_status(rt, flow);
+  if (rt.switches().overlay() && session.state() != PanelState::open) draw_overlay_status(rt, flow);
   panel.draw(rt, flow, fw, fh, now_s, unix_now_s());
   window.end_frame();
 }
@@ -340,7 +335,7 @@ int run_kiosk(const KioskOptions& o) {
 
   const RuntimeOptions ro = runtime_options(o, start.settings);
   KioskRuntime rt(ro, start.settings);
-  KioskFlow flow(rt, rt.audio().messages(), flow_params(start.settings, rt.has_camera()));
+  KioskFlow flow(rt.effects(), rt.audio().messages(), flow_params(start.settings, rt.camera().available()));
 
   KioskWindow window(o.windowed);
   const int picture_side = [&] {
@@ -369,14 +364,14 @@ int run_kiosk(const KioskOptions& o) {
   int frame = 0;
   while (!window.should_close()) {
     if (stats) stats->frame_started(std::chrono::steady_clock::now());
-    const Scene* const scene_at_start = rt.shown().scene;
-    const int id_at_start = rt.shown_id();
+    const Scene* const scene_at_start = rt.stage().shown().scene;
+    const int id_at_start = rt.stage().shown_id();
     kiosk.now_s_ =
         scripted ? frame / 60.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const bool holding = update_frame(kiosk, rt, flow, session, window, script, scripted, frame);
     if (kiosk.take_picture_key() && stats) stats->picture_key(scene_at_start, id_at_start);
     draw_frame(rt, flow, session, panel, window, script, scripted, kiosk.now_s_, texture, preview);
-    if (stats) stats->frame_drawn(std::chrono::steady_clock::now(), rt.shown().scene, rt.shown_id());
+    if (stats) stats->frame_drawn(std::chrono::steady_clock::now(), rt.stage().shown().scene, rt.stage().shown_id());
     if (!holding) ++frame;
     if (scripted && frame >= o.frames) {
       if (!cv::imwrite(o.screenshot, window.read_pixels()))
@@ -386,7 +381,7 @@ int run_kiosk(const KioskOptions& o) {
     window.swap();
     if (scripted) std::this_thread::sleep_for(std::chrono::microseconds(16667));  // 60 Hz of servo time per frame
   }
-  rt.stop_servo();
+  rt.devices().stop_servo();
   if (stats) {
     write_frame_stats(*stats, o.frame_stats, scripted ? kScriptedFrames : kLiveFrames);
     spdlog::info("{} -> {}", stats->log_line(), o.frame_stats);

@@ -151,7 +151,7 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
       const bool open = ImGui::BeginTabItem(name.c_str());
       record("tab:" + name);
       if (open) {
-        draw_fields(g, runtime.profile_type(), now_unix_s);
+        draw_fields(g, profile_type(runtime), now_unix_s);
         ImGui::EndTabItem();
       }
     }
@@ -261,12 +261,12 @@ void OperatorPanel::sample_plot(KioskRuntime& runtime) {
   plot_at_ = (plot_at_ + 1) % kPlotSamples;
 }
 
-void OperatorPanel::draw_stick_problems(const KioskRuntime& runtime) {
-  const std::vector<std::string>& problems = runtime.stick_problems();
+void OperatorPanel::draw_stick_problems(KioskRuntime& runtime) {
+  const std::vector<std::string>& problems = runtime.sticks().problems();
   if (problems.empty()) return;
-  const std::string title =
-      "The last stick: " + std::to_string(problems.size()) + (problems.size() == 1 ? " file" : " files") +
-      " left out (" + (problems.size() >= KioskRuntime::kStickProblems ? "the first ones; " : "") + "all in the log)";
+  const std::string title = "The last stick: " + std::to_string(problems.size()) +
+                            (problems.size() == 1 ? " file" : " files") + " left out (" +
+                            (problems.size() >= StickDesk::kProblems ? "the first ones; " : "") + "all in the log)";
   if (ImGui::TreeNode("stick_problems", "%s", title.c_str())) {
     for (const std::string& p : problems) ImGui::BulletText("%s", p.c_str());
     ImGui::TreePop();
@@ -292,7 +292,7 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
   }
   const double can_n = io::min_force_capability_n(usb->params());
   ImGui::Text("%s profile: it gives at least %.2f N in every direction everywhere in its rectangle.",
-              std::string(config::device_profile(runtime.profile_type()).name).c_str(), can_n);
+              std::string(config::device_profile(profile_type(runtime)).name).c_str(), can_n);
   if (!runtime.devices().home_note().empty()) ImGui::TextColored(kOrange, "%s", runtime.devices().home_note().c_str());
   if (ImGui::Button("Calibrate: the handle rests at the park place")) {
     double o1 = 0, o2 = 0;
@@ -339,14 +339,15 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, st
   ImGui::Text("Sound: %s; speech %s; volume %d/10; cues dropped %llu", a.sound_output() ? "playing" : "no sound device",
               a.speech_available() ? "on" : "unavailable", a.volume().step(),
               static_cast<unsigned long long>(a.cues_dropped()));
-  ImGui::Text("USB sticks: %s%s%s",
-              runtime.sticks().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
-              flow.source() == KioskSource::Stick ? "; a stick is being browsed" : "",
-              runtime.stick_busy() ? "; working" : "");
-  record(runtime.stick_busy() ? "sticks:working" : "sticks:idle");
+  ImGui::Text(
+      "USB sticks: %s%s%s",
+      runtime.sticks().service().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
+      flow.source() == KioskSource::Stick ? "; a stick is being browsed" : "",
+      runtime.sticks().busy() ? "; working" : "");
+  record(runtime.sticks().busy() ? "sticks:working" : "sticks:idle");
   draw_stick_problems(runtime);
-  ImGui::Checkbox("Show the collision tree's boxes and the boundary section on screen", &runtime.overlay());
-  ImGui::Checkbox("High contrast", &runtime.high_contrast());
+  ImGui::Checkbox("Show the collision tree's boxes and the boundary section on screen", &runtime.switches().overlay());
+  ImGui::Checkbox("High contrast", &runtime.switches().high_contrast());
   ImGui::Separator();
   const float w = ImGui::GetContentRegionAvail().x;
   ImGui::Text("Force on the handle [N], last 5 s (now %.2f N)", length(d.force_n));

@@ -186,8 +186,8 @@ void draw_curves(KioskRuntime& app, const View& v, const Shown& sh, bool hc, int
   glLineWidth(hc ? 6.0f : 3.0f);
   for (std::size_t c = 0; c < sh.levels.size(); ++c) {
     const int top = static_cast<int>(sh.levels[c].size()) - 1;
-    const int l = sh.scene ? sh.scene->clamp_level(c, app.level())
-                           : std::min(app.level(), top);  // a tolerance step: the curve's own level
+    const int l = sh.scene ? sh.scene->clamp_level(c, app.stage().level())
+                           : std::min(app.stage().level(), top);  // a tolerance step: the curve's own level
     const std::vector<Vec2>& pts =
         cut_step >= 0 ? sh.cuts[c][static_cast<std::size_t>(cut_step)] : sh.levels[c][static_cast<std::size_t>(l)];
     glBegin(sh.closed[c] ? GL_LINE_LOOP : GL_LINE_STRIP);
@@ -220,7 +220,7 @@ void draw_error_boxes(KioskRuntime& app, const View& v, const Shown& sh, int cut
       for (const SegmentRef& ref : sh.cut_segments[c][static_cast<std::size_t>(cut_step)]) segment_box(ref);
       continue;
     }
-    const int l = sc.clamp_level(c, app.level());
+    const int l = sc.clamp_level(c, app.stage().level());
     const std::uint32_t segs = sc.curve(c).point_count[l] - (sc.curve(c).closed ? 0 : 1);
     for (std::uint32_t k = 0; k < segs; ++k)
       segment_box({static_cast<std::int32_t>(c), l, static_cast<std::int32_t>(k)});
@@ -271,16 +271,17 @@ void draw_handle(const View& v, const ServoDisplayState& d) {
 
 void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
   begin_frame(v);
-  const Shown& sh = app.shown();
-  const bool hc = app.high_contrast();
+  const Shown& sh = app.stage().shown();
+  const bool hc = app.switches().high_contrast();
   draw_picture(v, tex, sh, hc);
   draw_workspace_frame(v, app.half());
   draw_text_blocks(v, sh, hc);
-  const int cut_step = is_cut_level(app.level()) && !sh.cuts.empty() ? tolerance_step_of(app.level()) : -1;
+  const int cut_step =
+      is_cut_level(app.stage().level()) && !sh.cuts.empty() ? tolerance_step_of(app.stage().level()) : -1;
   draw_curves(app, v, sh, hc, cut_step);
-  if (app.overlay() && sh.scene) draw_error_boxes(app, v, sh, cut_step);
+  if (app.switches().overlay() && sh.scene) draw_error_boxes(app, v, sh, cut_step);
   const ServoDisplayState& d = app.core().display();
-  if (app.overlay() && sh.scene && d.scene_id == app.shown_id()) draw_section(v, *sh.scene, d);
+  if (app.switches().overlay() && sh.scene && d.scene_id == app.stage().shown_id()) draw_section(v, *sh.scene, d);
   draw_handle(v, d);
 }
 

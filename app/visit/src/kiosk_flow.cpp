@@ -53,7 +53,7 @@ constexpr std::array<MessageId, static_cast<std::size_t>(KioskKey::Other)> kKeyD
 
 }  // namespace
 
-KioskFlow::KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params)
+KioskFlow::KioskFlow(KioskEffects effects, const audio::MessageCatalog& messages, const KioskFlowParams& params)
     : fx_(effects), msg_(messages), p_(params) {
   p_.warning_s = std::min(p_.warning_s, 0.5 * p_.timeout_s);  // a warning must leave time to answer it
   v_.next_invitation_s = p_.attract_every_s;
@@ -71,10 +71,10 @@ std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageAr
   return msg_.text(id, args, key_args(p_.keys));
 }
 
-void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.say(text(id, args)); }
+void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.speech.say(text(id, args)); }
 
 void KioskFlow::say_brief(MessageId id, std::initializer_list<audio::MessageArg> args) {
-  fx_.say_brief(text(id, args));
+  fx_.speech.say_brief(text(id, args));
 }
 
 void KioskFlow::set_timing(double timeout_s, double warning_s, double attract_every_s) {
@@ -85,8 +85,7 @@ void KioskFlow::set_timing(double timeout_s, double warning_s, double attract_ev
 
 // ---- the guard ---------------------------------------------------------------------------------------
 
-template <class Action>
-void KioskFlow::guarded(const char* what, Action&& action) {
+void KioskFlow::guarded(const char* what, const std::function<void()>& action) {
   const Visit before = v_;
   try {
     action();
@@ -124,10 +123,10 @@ void KioskFlow::act_on_key(KioskKey k, double now_s, std::string_view key_name) 
     return;
   }
   if (k != KioskKey::Finish) v_.finish_asked_s = -1;  // any other key: Finish asks again
-  fx_.key_pressed();
+  fx_.tour.key_pressed();
   if (v_.capturing) {  // any key stops a capture, and does nothing else
     v_.capturing = false;
-    fx_.cancel_capture();
+    fx_.camera.cancel_capture();
     say(MessageId::capture_cancelled);
     return;
   }
@@ -165,7 +164,7 @@ void KioskFlow::act_on_key(KioskKey k, double now_s, std::string_view key_name) 
 bool KioskFlow::session_key(KioskKey k, double now_s) {
   switch (k) {
     case KioskKey::Capture:
-      if (fx_.start_capture()) {
+      if (fx_.camera.start_capture()) {
         v_.capturing = true;
         say(MessageId::capture_start);
       } else {
@@ -173,7 +172,7 @@ bool KioskFlow::session_key(KioskKey k, double now_s) {
       }
       return true;
     case KioskKey::Guide:
-      fx_.guide();
+      fx_.tour.guide();
       return true;
     case KioskKey::Tutorial:
       start_tutorial();
@@ -192,11 +191,11 @@ bool KioskFlow::session_key(KioskKey k, double now_s) {
       pause_key();
       return true;
     case KioskKey::Where: {
-      const std::string here = fx_.where();
+      const std::string here = fx_.stage.where();
       if (!here.empty())
-        fx_.say(here);
+        fx_.speech.say(here);
       else
-        fx_.say(place());
+        fx_.speech.say(place());
       return true;
     }
     case KioskKey::Finish:
@@ -209,8 +208,8 @@ bool KioskFlow::session_key(KioskKey k, double now_s) {
 
 void KioskFlow::volume_key(int delta) {
   // Never cuts speech: while something is being said, it getting louder or quieter is the answer.
-  const bool changed = fx_.change_volume(delta);
-  if (fx_.speaking()) return;
+  const bool changed = fx_.session.change_volume(delta);
+  if (fx_.speech.speaking()) return;
   say_brief(!changed ? MessageId::volume_limit : delta > 0 ? MessageId::volume_up : MessageId::volume_down);
 }
 
@@ -231,7 +230,7 @@ void KioskFlow::describe_key() {
     before = text(MessageId::read_aloud_warning) + " ";
   }
   // The hand on a block of text: that paragraph is read, by sentence (the reading keys move within the page).
-  PageText page = fx_.page_text();
+  PageText page = fx_.stage.page_text();
   v_.reading = ReadAloud(page.paragraphs);
   v_.reading_on = false;
   if (page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs()) {
@@ -243,8 +242,8 @@ void KioskFlow::describe_key() {
     read_from(at, before + long_text_line(v_.reading.text_from(at)) + lead);
     return;
   }
-  const std::string description = fx_.describe();
-  fx_.say(before + long_text_line(description) + text(MessageId::describe, {{"description", description}}));
+  const std::string description = fx_.stage.describe();
+  fx_.speech.say(before + long_text_line(description) + text(MessageId::describe, {{"description", description}}));
 }
 
 std::string KioskFlow::long_text_line(const std::string& said) const {
@@ -255,73 +254,6 @@ std::string KioskFlow::long_text_line(const std::string& said) const {
   return (minutes <= 1 ? text(MessageId::long_text_minute)
                        : text(MessageId::long_text_minutes, {{"minutes", std::to_string(minutes)}})) +
          " ";
-}
-
-// ---- reading a page's text by sentence and paragraph ---------------------------------------------------
-
-void KioskFlow::follow_reading() {
-  if (!reading()) return;
-  const int piece = fx_.heard_piece();
-  if (piece >= 0) v_.reading.heard(piece);
-}
-
-void KioskFlow::read_from(ReadingPlace at, const std::string& before) {
-  // The lead is said in the same text, so the pieces heard count from its start; a line break ends it, so it
-  // is cut as its own pieces whatever its last character.
-  std::string said = before;
-  while (!said.empty() && said.back() == ' ') said.pop_back();
-  const int lead = static_cast<int>(audio::speech_pieces(said).size());
-  if (!said.empty()) said += '\n';
-  said += v_.reading.text_from(at);
-  fx_.say(said);
-  v_.reading.started(at, lead);
-  v_.reading_on = true;
-  v_.reading_kept = fx_.kept_texts();
-}
-
-void KioskFlow::reading_key(KioskKey k) {
-  follow_reading();
-  if (!reading()) {
-    // Nothing being read: the page's text from the paragraph under the hand (else its first), if it has any.
-    const PageText page = fx_.page_text();
-    v_.reading = ReadAloud(page.paragraphs);
-    v_.reading_on = false;
-    if (v_.reading.empty()) {
-      say_brief(MessageId::reading_none);
-      return;
-    }
-    const int p = page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs() ? page.at_hand : 0;
-    read_from({p, 0}, paragraph_line(p));
-    return;
-  }
-  const bool by_paragraph = k == KioskKey::NextParagraph || k == KioskKey::PreviousParagraph;
-  const ReadAloud::Step step = k == KioskKey::NextSentence       ? v_.reading.next_sentence()
-                               : k == KioskKey::PreviousSentence ? v_.reading.previous_sentence()
-                               : k == KioskKey::NextParagraph    ? v_.reading.next_paragraph()
-                                                                 : v_.reading.previous_paragraph();
-  if (step.edge == ReadAloud::Edge::End) {
-    say_brief(MessageId::reading_end);  // the reading stays where it is: Repeat and the keys go on from there
-    return;
-  }
-  std::string before = step.edge == ReadAloud::Edge::Start ? text(MessageId::reading_start) + " " : std::string();
-  if (by_paragraph || step.at.paragraph != v_.reading.place().paragraph) before += paragraph_line(step.at.paragraph);
-  read_from(step.at, before);
-}
-
-std::string KioskFlow::paragraph_line(int p) const {
-  if (v_.reading.paragraphs() < 2) return {};
-  return text(MessageId::reading_paragraph,
-              {{"block", std::to_string(p + 1)}, {"blocks", std::to_string(v_.reading.paragraphs())}});
-}
-
-void KioskFlow::repeat_key() {
-  // Reading a text: the sentence being heard, and on from there; else the last thing said, from its start.
-  follow_reading();
-  if (reading()) {
-    read_from(v_.reading.place(), {});
-    return;
-  }
-  if (!fx_.repeat()) say_brief(MessageId::nothing_to_repeat);
 }
 
 double spoken_seconds(std::string_view text) {
@@ -336,17 +268,17 @@ double spoken_seconds(std::string_view text) {
 }
 
 void KioskFlow::level_key(int delta) {
-  const bool was_auto = fx_.auto_level();
-  const bool changed = fx_.change_level(delta);
+  const bool was_auto = fx_.stage.auto_level();
+  const bool changed = fx_.stage.change_level(delta);
   std::string line = text(changed ? (delta < 0 ? MessageId::level_finer : MessageId::level_coarser)
                                   : (delta < 0 ? MessageId::level_finest : MessageId::level_coarsest));
   if (changed && was_auto) line += " " + text(MessageId::level_manual);
-  fx_.say_brief(line);
+  fx_.speech.say_brief(line);
 }
 
 void KioskFlow::pause_key() {
-  if (fx_.resume_speech()) return;  // pressed again: goes on from where it stopped
-  if (fx_.pause_speech()) return;   // silence is the answer
+  if (fx_.speech.resume_speech()) return;  // pressed again: goes on from where it stopped
+  if (fx_.speech.pause_speech()) return;   // silence is the answer
   say_brief(MessageId::nothing_to_pause);
 }
 
@@ -401,7 +333,7 @@ void KioskFlow::say_help_group() {
       line += key_place_sentence(actions[i].second);
   }
   line += " " + text(g + 1 < static_cast<int>(groups.size()) ? MessageId::help_next : MessageId::help_last);
-  fx_.say(line);
+  fx_.speech.say(line);
 }
 
 std::string KioskFlow::key_place_sentence(std::string_view key_name) const {
@@ -416,7 +348,7 @@ void KioskFlow::learn_key(KioskKey k, std::string_view key_name) {
     return;
   }
   const std::string name(config::key_actions(p_.keys)[static_cast<std::size_t>(k)].second);
-  fx_.say_brief(text(kKeyDoes[static_cast<std::size_t>(k)]) + key_place_sentence(name));
+  fx_.speech.say_brief(text(kKeyDoes[static_cast<std::size_t>(k)]) + key_place_sentence(name));
 }
 
 void KioskFlow::stray_key(std::string_view key_name) {
@@ -435,11 +367,11 @@ void KioskFlow::tutorial_key(KioskKey k) {
     case KioskKey::Next:
       if (v_.shape == TutorialShape::Square) {
         v_.shape = TutorialShape::Circle;
-        fx_.show_tutorial(v_.shape);
+        fx_.stage.show_tutorial(v_.shape);
         say(MessageId::tutorial_circle);
       } else if (v_.shape == TutorialShape::Circle) {
         v_.shape = TutorialShape::Triangle;
-        fx_.show_tutorial(v_.shape);
+        fx_.stage.show_tutorial(v_.shape);
         say(MessageId::tutorial_triangle);
       } else {
         show(0, text(MessageId::tutorial_done));
@@ -447,11 +379,11 @@ void KioskFlow::tutorial_key(KioskKey k) {
       return;
     case KioskKey::Previous:
       if (v_.shape != TutorialShape::Square) v_.shape = static_cast<TutorialShape>(static_cast<int>(v_.shape) - 1);
-      fx_.show_tutorial(v_.shape);
+      fx_.stage.show_tutorial(v_.shape);
       say(v_.shape == TutorialShape::Square ? MessageId::tutorial_start : MessageId::tutorial_circle);
       return;
     case KioskKey::Describe:
-      fx_.say(fx_.describe());
+      fx_.speech.say(fx_.stage.describe());
       return;
     case KioskKey::Finer:
     case KioskKey::Coarser:  // no levels to change on a practice shape: said why
@@ -494,7 +426,7 @@ std::string KioskFlow::place() const {
   }
   if (v_.captured) return text(MessageId::place_capture);
   return text(MessageId::place_picture,
-              {{"picture", std::to_string(v_.picture + 1)}, {"pictures", std::to_string(fx_.picture_count())}});
+              {{"picture", std::to_string(v_.picture + 1)}, {"pictures", std::to_string(fx_.library.picture_count())}});
 }
 
 // ---- the session -------------------------------------------------------------------------------------
@@ -510,16 +442,16 @@ void KioskFlow::start_tutorial() {
   v_.state = KioskState::Tutorial;
   v_.shape = TutorialShape::Square;
   v_.captured = false;
-  fx_.show_tutorial(v_.shape);
+  fx_.stage.show_tutorial(v_.shape);
 }
 
 void KioskFlow::show(int index, const std::string& before) {
-  const int n = fx_.picture_count();
+  const int n = fx_.library.picture_count();
   v_.picture = ((index % n) + n) % n;  // wraps round both ways
   v_.state = KioskState::Picture;
   v_.felt = true;
   v_.captured = false;
-  const int shapes = fx_.show_picture(v_.picture);
+  const int shapes = fx_.library.show_picture(v_.picture);
   if (shapes == KioskEffects::kPicturePending) {  // built off the window thread: announced when it is felt
     const bool awaited = v_.pending_picture >= 0 || v_.pending_doc >= 0;
     v_.pending_picture = v_.picture;
@@ -532,9 +464,9 @@ void KioskFlow::show(int index, const std::string& before) {
 }
 
 void KioskFlow::announce_picture(int shapes, const std::string& before) {
-  const int n = fx_.picture_count();
+  const int n = fx_.library.picture_count();
   const std::string num = std::to_string(v_.picture + 1), total = std::to_string(n);
-  const std::string title = fx_.shown_notes().title;
+  const std::string title = fx_.stage.shown_notes().title;
   std::string line;
   if (!title.empty()) {
     // A person's words first: "Picture 2 of 5: a horse, seen from the side. It has 2 shapes."
@@ -549,7 +481,7 @@ void KioskFlow::announce_picture(int shapes, const std::string& before) {
   } else {
     line = text(MessageId::picture_loaded, {{"picture", num}, {"pictures", total}, {"shapes", std::to_string(shapes)}});
   }
-  fx_.say(before.empty() ? line : before + " " + line);
+  fx_.speech.say(before.empty() ? line : before + " " + line);
 }
 
 void KioskFlow::wake(double now_s) {
@@ -560,9 +492,9 @@ void KioskFlow::wake(double now_s) {
 }
 
 void KioskFlow::end_session(double now_s) {
-  if (v_.capturing) fx_.cancel_capture();
-  fx_.new_session();  // first: it stops speech, and the goodbye must be heard
-  if (v_.source == KioskSource::Stick || !v_.stick.empty()) fx_.forget_stick();
+  if (v_.capturing) fx_.camera.cancel_capture();
+  fx_.session.new_session();  // first: it stops speech, and the goodbye must be heard
+  if (v_.source == KioskSource::Stick || !v_.stick.empty()) fx_.sticks.forget_stick();
   v_ = Visit{};
   v_.next_invitation_s = now_s + p_.attract_every_s;
   say_brief(MessageId::goodbye);
@@ -583,7 +515,8 @@ void KioskFlow::touching(double now_s) {
     if (v_.state == KioskState::Attract) return;
     activity(now_s);
     // On the tutorial's square, once the welcome has been heard: the wall the hand feels can be pushed through.
-    if (v_.state == KioskState::Tutorial && v_.shape == TutorialShape::Square && !v_.push_taught && !fx_.speaking()) {
+    if (v_.state == KioskState::Tutorial && v_.shape == TutorialShape::Square && !v_.push_taught &&
+        !fx_.speech.speaking()) {
       v_.push_taught = true;
       say_brief(MessageId::tutorial_push);
     }
@@ -595,13 +528,13 @@ void KioskFlow::tick(double now_s) {
     if (v_.state == KioskState::Attract) {
       if (p_.attract_every_s > 0 && now_s >= v_.next_invitation_s) {
         v_.next_invitation_s = now_s + p_.attract_every_s;
-        if (!fx_.quiet_hours()) say_brief(MessageId::attract);
+        if (!fx_.speech.quiet_hours()) say_brief(MessageId::attract);
       }
       return;
     }
     // Speech being heard is the visitor listening (a long text being read is never cut by the time-out);
     // the warning's own speech is not.
-    if (!v_.warned && fx_.speaking()) activity(now_s);
+    if (!v_.warned && fx_.speech.speaking()) activity(now_s);
     follow_reading();
     if ((v_.pending_doc >= 0 || v_.pending_picture >= 0) && !v_.loading_said &&
         now_s - v_.pending_since_s > p_.loading_cue_s) {
@@ -627,247 +560,6 @@ void KioskFlow::tick(double now_s) {
 void KioskFlow::warn(double idle_s) {
   const MessageId id = v_.source == KioskSource::Stick ? MessageId::timeout_warning_stick : MessageId::timeout_warning;
   say_brief(id, {{"seconds", std::to_string(static_cast<int>(std::lround(p_.timeout_s - idle_s)))}});
-}
-
-// ---- the camera --------------------------------------------------------------------------------------
-
-void KioskFlow::capture_advice(MessageId advice, double now_s) {
-  if (!v_.capturing) return;
-  activity(now_s);
-  say(advice);
-}
-
-void KioskFlow::capture_done(int shapes, double now_s) {
-  guarded("a camera capture", [&] { capture_done_now(shapes, now_s); });
-}
-
-void KioskFlow::capture_done_now(int shapes, double now_s) {
-  if (!v_.capturing) return;
-  v_.capturing = false;
-  activity(now_s);
-  v_.state = KioskState::Picture;
-  v_.captured = true;
-  if (shapes == 0) {
-    say(MessageId::captured_empty);
-  } else if (shapes == 1) {
-    say(MessageId::captured_one);
-  } else {
-    say(MessageId::captured, {{"shapes", std::to_string(shapes)}});
-  }
-}
-
-void KioskFlow::capture_failed(bool timeout, double now_s) {
-  if (!v_.capturing) return;
-  v_.capturing = false;
-  v_.last_activity_s = now_s;
-  say(timeout ? MessageId::capture_timeout : MessageId::capture_failed);
-}
-
-// ---- USB sticks --------------------------------------------------------------------------------------
-
-std::string KioskFlow::stick_summary() const {
-  // English phrase for {summary}; the sentence around it comes from the catalogue.
-  int pictures = 0, pdfs = 0, pages = 0, capped = 0;
-  for (const StickEntry& e : v_.stick) {
-    pictures += !e.pdf;
-    pdfs += e.pdf;
-    pages += e.pdf ? std::max(e.pages, e.pages_in_file) : 0;
-    capped = std::max(capped, e.pdf && e.pages_in_file > e.pages ? e.pages : 0);
-  }
-  auto count = [](int n, const char* one, const char* many) {
-    return n == 1 ? std::string(one) : std::to_string(n) + " " + many;
-  };
-  const int n = static_cast<int>(v_.stick.size());
-  std::string s = count(n, "one document", "documents") + ": ";
-  std::string pdf_part;
-  if (pdfs == 1) {
-    pdf_part = "a PDF of " + count(pages, "one page", "pages");
-  } else if (pdfs > 1) {
-    pdf_part = std::to_string(pdfs) + " PDFs of " + count(pages, "one page", "pages") + " in all";
-  }
-  if (capped > 0) pdf_part += " (the first " + std::to_string(capped) + " pages of each can be read)";
-  if (pictures > 0 && pdfs > 0) return s + count(pictures, "a picture", "pictures") + " and " + pdf_part;
-  if (pictures > 0) return s + count(pictures, "a picture", "pictures");
-  return s + pdf_part;
-}
-
-std::string spoken_name(const std::string& name, bool file_name) {
-  std::string s = name;
-  if (file_name) {
-    const auto dot = s.find_last_of('.');
-    if (dot != std::string::npos && dot > 0 && s.size() - dot <= 5) s.erase(dot);
-    for (char& c : s)
-      if (c == '_' || c == '-') c = ' ';
-  }
-  if (s.size() <= kSpokenNameBytes) return s;
-  std::size_t cut = kSpokenNameBytes;
-  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;  // a whole UTF-8 character
-  const std::size_t space = s.rfind(' ', cut);
-  if (space != std::string::npos && space >= kSpokenNameBytes / 2) cut = space;  // at a word
-  s.erase(cut);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '.')) s.pop_back();
-  return s;
-}
-
-std::string KioskFlow::document_name(const StickEntry& e) const {
-  return e.title.empty() ? spoken_name(e.name, true) : spoken_name(e.title, false);
-}
-
-void KioskFlow::request(int document, int page, double now_s) {
-  const bool awaited = v_.pending_picture >= 0 || v_.pending_doc >= 0;
-  v_.pending_doc = v_.at_doc = document;
-  v_.pending_page = v_.at_page = page;
-  start_loading_clock(now_s, awaited);
-  fx_.show_document(document, page);
-}
-
-void KioskFlow::start_loading_clock(double now_s, bool awaited) {
-  // Keys pressed in a row while nothing has been said of the load awaited keep its clock, so "Loading." comes
-  // loading_cue_s after the first of them, not after the last; once said, the next key gets its own.
-  if (awaited && !v_.loading_said) return;
-  v_.pending_since_s = now_s;
-  v_.loading_said = false;
-}
-
-void KioskFlow::step_document(int delta, double now_s) {
-  // From the last page asked for: the one awaited (a key pressed while loading moves on from there), or
-  // the last one shown or found unreadable (so a visitor can step past a page that cannot be read).
-  if (v_.stick.empty()) return;
-  std::vector<int> pages;
-  pages.reserve(v_.stick.size());
-  for (const StickEntry& e : v_.stick) pages.push_back(e.pages);
-  const StickPage to = step_stick_page(pages, {v_.at_doc, v_.at_page}, delta);
-  request(to.document, to.page, now_s);
-}
-
-void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double now_s, int unreadable) {
-  guarded("a USB stick", [&] { stick_inserted_now(documents, now_s, unreadable); });
-}
-
-std::string KioskFlow::unreadable_line(int unreadable) const {
-  if (unreadable <= 0) return {};
-  return " " + (unreadable == 1 ? text(MessageId::file_unreadable)
-                                : text(MessageId::files_unreadable, {{"count", std::to_string(unreadable)}}));
-}
-
-void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable) {
-  activity(now_s);
-  v_.stick = documents;
-  v_.doc = v_.at_doc = v_.pending_doc = -1;
-  if (v_.stick.empty()) {  // nothing to show: the visitor stays where they are (the tutorial's shape, a picture)
-    v_.source = KioskSource::Library;
-    std::string line = text(MessageId::stick_empty) + unreadable_line(unreadable);
-    if (v_.state == KioskState::Attract) {  // a stick is someone at the kiosk: the tutorial starts, welcomed
-      start_tutorial();
-      line += " " + text(MessageId::welcome);
-    }
-    fx_.say(line);
-    return;
-  }
-  v_.state = KioskState::Picture;  // from Attract or the tutorial: the stick's first page comes
-  v_.source = KioskSource::Stick;
-  v_.announce_summary = stick_summary();
-  v_.announce_unreadable = unreadable_line(unreadable);
-  request(0, 1, now_s);
-}
-
-void KioskFlow::stick_refused(const std::string& reason, double now_s) {
-  guarded("a USB stick", [&] {
-    activity(now_s);
-    std::string line = text(MessageId::stick_unreadable, {{"reason", reason}});
-    if (v_.state == KioskState::Attract) {  // someone is at the kiosk: the tutorial starts, welcomed
-      start_tutorial();
-      if (!line.empty() && line.back() != '.' && line.back() != '!' && line.back() != '?') line += '.';
-      line += " " + text(MessageId::welcome);
-    }
-    fx_.say(line);
-  });
-}
-
-void KioskFlow::stick_removed(double now_s) {
-  guarded("taking out a USB stick", [&] { stick_removed_now(now_s); });
-}
-
-void KioskFlow::stick_removed_now(double now_s) {
-  const bool browsing = v_.source == KioskSource::Stick;
-  v_.stick.clear();
-  v_.source = KioskSource::Library;
-  v_.doc = v_.at_doc = v_.pending_doc = -1;
-  v_.announce_summary.clear();
-  if (!browsing || v_.state == KioskState::Attract) return;  // nothing of the stick was in use
-  activity(now_s);
-  if (v_.state == KioskState::Tutorial) {
-    say(MessageId::stick_removed);
-    return;
-  }
-  show(v_.picture, text(MessageId::stick_removed));
-}
-
-void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
-  guarded("a page of a USB stick", [&] { document_ready_now(r, now_s); });
-}
-
-void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
-  (void)now_s;
-  if (!awaits_document(r.document, r.page)) return;  // superseded
-  v_.pending_doc = -1;
-  const StickEntry& e = v_.stick[static_cast<std::size_t>(r.document)];
-  // A PDF's own title, when it has a usable one, names it: "Page 1 of 3 of Annual report 2025."
-  const std::string name = document_name(e);
-  std::string line;
-  if (r.ok) {
-    v_.felt = true;
-    v_.doc = r.document;
-    v_.page = r.page;
-    v_.state = KioskState::Picture;
-    v_.captured = false;
-    line = e.pdf ? text(MessageId::document_page, {{"page", std::to_string(r.page)},
-                                                   {"pages", std::to_string(std::max(e.pages, e.pages_in_file))},
-                                                   {"name", name},
-                                                   {"description", r.description}})
-                 : text(MessageId::document_picture, {{"document", std::to_string(r.document + 1)},
-                                                      {"documents", std::to_string(v_.stick.size())},
-                                                      {"name", name},
-                                                      {"description", r.description}});
-  } else {
-    const std::string what = e.pdf ? "Page " + std::to_string(r.page) + " of " + name : name;
-    // "You still feel the picture before" only when there was one. Why is for the operator (the log and the
-    // panel: KioskRuntime::stick_problems), not words a visitor can act on.
-    line = text(v_.felt ? MessageId::document_unreadable : MessageId::document_unreadable_alone, {{"name", what}});
-  }
-  if (!v_.announce_summary.empty()) {  // said now, so it names the keys of now
-    line = text(MessageId::stick_inserted, {{"summary", v_.announce_summary}}) +
-           std::exchange(v_.announce_unreadable, {}) + " " + line;
-    v_.announce_summary.clear();
-  }
-  fx_.say(line);
-}
-
-bool KioskFlow::awaits_library_picture(int index) const {
-  return index == v_.pending_picture && v_.state == KioskState::Picture && !v_.captured &&
-         v_.source == KioskSource::Library;
-}
-
-void KioskFlow::picture_ready(int index, int shapes, double now_s) {
-  guarded("a picture of the library", [&] {
-    (void)now_s;
-    if (!awaits_library_picture(index)) return;  // superseded
-    v_.pending_picture = -1;
-    announce_picture(shapes, std::exchange(v_.pending_before, {}));
-  });
-}
-
-void KioskFlow::picture_failed(int index, const std::string& reason, double now_s) {
-  guarded("a picture of the library", [&] {
-    (void)now_s;
-    if (!awaits_library_picture(index)) return;  // superseded
-    v_.pending_picture = -1;
-    const std::string name = "Picture " + std::to_string(index + 1) + " of " + std::to_string(fx_.picture_count());
-    spdlog::warn("kiosk: picture {} cannot be shown: {}", index + 1, reason);
-    const std::string line = text(MessageId::document_unreadable, {{"name", name}});
-    const std::string before = std::exchange(v_.pending_before, {});
-    fx_.say(before.empty() ? line : before + " " + line);
-  });
 }
 
 }  // namespace hk::app

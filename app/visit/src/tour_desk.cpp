@@ -41,7 +41,8 @@ void TourDesk::key_pressed() {
   stop_quietly();
 }
 
-void TourDesk::guide(const TourPicture& picture) {
+void TourDesk::guide() {
+  const TourPicture picture = this->picture();
   if (guide_stops_) {
     guide_stops_ = false;
     voice_.say(audio_.messages().text(audio::MessageId::tour_stopped));
@@ -82,7 +83,8 @@ void TourDesk::hand_over(const TourPicture& picture) {
   step_.publish_tour(std::make_unique<TourPath>(std::move(*plan)));
 }
 
-void TourDesk::poll(const TourPicture& picture) {
+void TourDesk::poll() {
+  const TourPicture picture = this->picture();
   const ServoDisplayState& d = step_.display();
   if (d.scene_id == touches_.scene_id() && d.curve >= 0) touches_.touch(d.scene_id, d.curve);
   if (asked_ && d.tick >= due_tick_) hand_over(picture);

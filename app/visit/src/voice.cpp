@@ -4,6 +4,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <ctime>
+#include <optional>
 
 namespace hk::app {
 namespace {
@@ -38,6 +40,15 @@ bool Voice::repeat() {
   if (repeatable_.empty()) return false;
   say(std::string(repeatable_));
   return true;
+}
+
+bool Voice::quiet_hours() const {
+  const std::optional<config::QuietHours> hours = config::parse_quiet_hours(s_.kiosk.quiet_hours);
+  if (!hours) return false;
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  if (localtime_r(&now, &local) == nullptr) return false;
+  return config::in_quiet_hours(*hours, local.tm_hour * 60 + local.tm_min);
 }
 
 }  // namespace hk::app

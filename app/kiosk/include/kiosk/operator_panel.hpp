@@ -49,7 +49,7 @@ class OperatorPanel {
   void draw_status(KioskRuntime& runtime, const KioskFlow& flow, std::int64_t now_unix_s);
   void draw_device(KioskRuntime& runtime, std::int64_t now_unix_s);
   /// What the last stick could not give, file by file (the visitor hears only how many), folded.
-  void draw_stick_problems(const KioskRuntime& runtime);
+  void draw_stick_problems(KioskRuntime& runtime);
   /// The settings of `group`, each with its range and, for the force budget, the limit of the device
   /// profile in force (`profile_type`, KioskRuntime::profile_type) beside it.
   void draw_fields(config::FieldGroup group, const std::string& profile_type, std::int64_t now_unix_s);

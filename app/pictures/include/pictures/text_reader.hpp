@@ -24,7 +24,7 @@ namespace hk::app {
 
 /// A reading that has ended.
 struct TextRead {
-  int id = 0;  ///< the scene id it was started for (KioskRuntime::shown_id)
+  int id = 0;  ///< the scene id it was started for (Stage::shown_id)
   /// The scene with its text (OcrReport says how the reading went); without a built scene (scene.scene null,
   /// ocr.why "failed: ...") when building it failed: the page stays as it is felt.
   ImageScene scene;

@@ -34,14 +34,14 @@
 /// USB sticks: a stick inserted (stick_inserted) makes Next / Previous walk its documents and their pages
 /// instead of the picture library. Its first page is loaded at once and announced after a summary of the
 /// stick ("A USB stick with 3 documents: 2 pictures and a PDF of 12 pages. Press the Right arrow ...").
-/// Documents load asynchronously (KioskEffects::show_document; the window layer reports back with
+/// Documents load asynchronously (StickEffects::show_document; the window layer reports back with
 /// document_ready), so slow work never blocks; "Loading." is said when a load takes longer than
 /// loading_cue_s. A page that cannot be read is reported and the picture felt before stays. Library pictures
 /// that are not at hand are built the same way (show_picture answers kPicturePending; picture_ready follows),
 /// with the same "Loading." cue and the picture felt before kept until the new one is on the device. Removing the
 /// stick goes back to the library picture; a new session forgets the stick.
 ///
-/// The camera: the Capture key starts a capture (KioskEffects::start_capture) guided by voice (capture_advice,
+/// The camera: the Capture key starts a capture (CameraEffects::start_capture) guided by voice (capture_advice,
 /// each advice said as it comes, cutting off the one before); any key cancels it; when the picture is taken
 /// (capture_done) the Shutter earcon has sounded and the flow says "Captured. It has N shapes." and stays on it
 /// (Next and Previous go on in the library). A failure or a time-out is said. Without a camera the key says so,
@@ -53,6 +53,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -61,6 +62,7 @@
 #include "config/settings.hpp"
 #include "formats/picture_notes.hpp"
 #include "pictures/picture_library.hpp"
+#include "visit/kiosk_effects.hpp"
 #include "visit/read_aloud.hpp"
 
 namespace hk::app {
@@ -111,16 +113,10 @@ struct StickEntry {
 std::string spoken_name(const std::string& name, bool file_name);
 inline constexpr std::size_t kSpokenNameBytes = 60;
 
-/// The text of the page shown, for reading by sentence and paragraph (read_aloud.hpp).
-struct PageText {
-  std::vector<std::string> paragraphs;  ///< its blocks of text in reading order; empty: no text
-  int at_hand = -1;                     ///< the paragraph under the hand, −1 when none is
-};
-
 /// Where Next and Previous go.
 enum class KioskSource { Library, Stick };
 
-/// The outcome of an asynchronous document load (KioskEffects::show_document), reported by the window layer.
+/// The outcome of an asynchronous document load (StickEffects::show_document), reported by the window layer.
 struct DocumentResult {
   int document = 0;         ///< as requested
   int page = 1;             ///< as requested (from 1)
@@ -128,84 +124,6 @@ struct DocumentResult {
   std::string description;  ///< ok: what the page holds, one sentence ("It has 3 shapes and 2 blocks of text.")
   std::string reason;  ///< !ok: why it cannot be shown, one line for the log and the operator (the visitor hears that
                        ///< it cannot be read)
-};
-
-/// What the flow asks of the rest of the kiosk. The window layer implements it with the AudioSystem, the
-/// servo core and the picture library; tests record the calls.
-class KioskEffects {
- public:
-  virtual ~KioskEffects() = default;
-  /// Speak `text` now, cutting off what is being said; Repeat says it again later.
-  virtual void say(const std::string& text) = 0;
-  /// Speak an acknowledgement ("Louder.", a key's name) now, cutting off what is being said; Repeat passes it
-  /// over and says the text before it. Default: say().
-  virtual void say_brief(const std::string& text) { say(text); }
-  /// Say the last text said with say() again, from its start. False when there is none (nothing said).
-  /// Default: nothing to repeat.
-  virtual bool repeat() { return false; }
-  /// Texts said with say() so far (a count that only grows): the flow knows whether what it said last is
-  /// still the last text kept, or something else (a tour's line, a page's text arriving) has been said since.
-  /// Default: 0.
-  virtual std::uint64_t kept_texts() const { return 0; }
-  /// Which piece (audio::speech_pieces, from 0) of the last text said with say() is being heard now; −1 when it
-  /// is over, was cut off by anything said since, or nothing was said. Default: −1.
-  virtual int heard_piece() const { return -1; }
-  /// The text of the page shown, paragraph by paragraph, and which is under the hand. Default: no text.
-  virtual PageText page_text() { return {}; }
-  /// Speech is being heard (not paused). Default: never.
-  virtual bool speaking() const { return false; }
-  /// Hold the speech where it is; false when nothing is being said. Default: nothing is.
-  virtual bool pause_speech() { return false; }
-  /// Go on from a pause; false when speech is not paused. Default: never paused.
-  virtual bool resume_speech() { return false; }
-  /// Whether now is within the operator's quiet hours ([kiosk] quiet_hours): no spoken invitation. Default: no.
-  virtual bool quiet_hours() const { return false; }
-  /// Put a tutorial shape on the device.
-  virtual void show_tutorial(TutorialShape shape) = 0;
-  /// show_picture's answer while the picture is still being built: the picture felt before stays, and
-  /// KioskFlow::picture_ready (or picture_failed) follows.
-  static constexpr int kPicturePending = -1;
-  /// Put picture `index` (0-based) on the device. Returns its number of shapes when it is on the device now
-  /// (built ahead, or quick), else kPicturePending: it is built off the window thread, and the window layer
-  /// calls KioskFlow::picture_ready or picture_failed when it is done. A newer request supersedes an older one.
-  virtual int show_picture(int index) = 0;
-  /// Pictures in the library (≥ 1).
-  virtual int picture_count() const = 0;
-  /// The title and description a person wrote for the picture shown (picture_notes.hpp); empty when none.
-  virtual PictureNotes shown_notes() const { return {}; }
-  /// A spoken description of what is shown, starting from where the hand is (describe.hpp).
-  virtual std::string describe() = 0;
-  /// "What is here": the shape or block of text under or nearest the hand and where the hand is, one or two
-  /// sentences (describe.hpp, where_message). Default: nothing to say ("").
-  virtual std::string where() { return {}; }
-  /// Level one finer (delta −1) or coarser (+1). Returns false at the limit (nothing changes). A change turns
-  /// the level from hand speed off for the picture shown (it comes back with another picture).
-  virtual bool change_level(int delta) = 0;
-  /// Whether the level is chosen from hand speed now (Finer and Coarser then say, once, that they turn it
-  /// off). Default: false.
-  virtual bool auto_level() const { return false; }
-  /// Volume one step up (+1) or down (−1). Returns false at the limit.
-  virtual bool change_volume(int delta) = 0;
-  /// A new visitor: the operator's default settings (volume, level), speech stopped and forgotten.
-  virtual void new_session() = 0;
-  /// Start loading page `page` (from 1) of stick document `document` (0-based) off the window thread; when
-  /// done, the window layer calls KioskFlow::document_ready. A newer request supersedes an older one.
-  virtual void show_document(int document, int page) = 0;
-  /// Drop the stick's listing (a new visitor must not browse the last one's stick).
-  virtual void forget_stick() = 0;
-  /// Any key that acts was pressed (before the flow acts on it): a guided tour that runs, or is about to,
-  /// stops. Not called for Volume, nor for a key named in learning mode. Default: nothing.
-  virtual void key_pressed() {}
-  /// The Capture key: start a guided camera capture off the window thread; the window layer then reports
-  /// with KioskFlow::capture_advice / capture_done / capture_failed. False when there is no camera (nothing
-  /// starts). Default: no camera.
-  virtual bool start_capture() { return false; }
-  /// Stop the capture under way (a key was pressed or the session ended); no report follows. Default: nothing.
-  virtual void cancel_capture() {}
-  /// The Guide key: say that the hand will be guided, then lead the handle to the nearest shape not yet
-  /// touched and round it, or, when the press stopped a running tour (key_pressed), say so. What is said is
-  /// up to the implementation (the tour's end is reported later). Default: nothing.
-  virtual void guide() {}
 };
 
 /// The key placeholders of the catalogue ({help_key} … {tutorial_key}, audio::kKeyPlaceholders) paired with the
@@ -245,9 +163,9 @@ class KioskFlow {
   /// Where reading a page's text stands (the sentence heard last), and whether it is what is being read: the
   /// last text said is the reading and no other text has been said since.
   ReadingPlace reading_place() const { return v_.reading.place(); }
-  bool reading() const { return v_.reading_on && !v_.reading.empty() && fx_.kept_texts() == v_.reading_kept; }
+  bool reading() const { return v_.reading_on && !v_.reading.empty() && fx_.speech.kept_texts() == v_.reading_kept; }
 
-  KioskFlow(KioskEffects& effects, const audio::MessageCatalog& messages, const KioskFlowParams& params = {});
+  KioskFlow(KioskEffects effects, const audio::MessageCatalog& messages, const KioskFlowParams& params = {});
 
   /// A key press at time `now_s` [s] (any monotonic clock). `key_name`: the settings' name of the key pressed
   /// ("Q", "F5"; config/keys.hpp), spoken when `k` is Other (and when learning); empty when unknown.
@@ -359,8 +277,8 @@ class KioskFlow {
     std::uint64_t reading_kept = 0;
   };
 
-  template <class Action>
-  void guarded(const char* what, Action&& action);  // runs action; on an exception: undo, log, sorry
+  void guarded(const char* what,
+               const std::function<void()>& action);  // runs action; on an exception: undo, log, sorry
   void act_on_key(KioskKey k, double now_s, std::string_view key_name);
   // The bodies of the public entry points of the same names, run under guarded().
   void stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable);
@@ -412,7 +330,7 @@ class KioskFlow {
   std::string stick_summary() const;
   std::string document_name(const StickEntry& e) const;  // the title, else the file name, as spoken
 
-  KioskEffects& fx_;
+  KioskEffects fx_;
   const audio::MessageCatalog& msg_;
   KioskFlowParams p_;
   Visit v_;

@@ -20,6 +20,7 @@
 #include "runtime/device_host.hpp"
 #include "runtime/guided_tour.hpp"
 #include "runtime/servo_step.hpp"
+#include "visit/kiosk_effects.hpp"
 #include "visit/voice.hpp"
 
 namespace hk::app {
@@ -33,8 +34,9 @@ struct TourPicture {
   std::function<std::string(std::size_t curve)> words;
 };
 
-/// The guided tour between the Guide key and the line said at its end. Not thread-safe: the window thread.
-class TourDesk {
+/// The guided tour between the Guide key and the line said at its end; it answers the visitor's flow's
+/// TourEffects (kiosk_effects.hpp). Not thread-safe: the window thread.
+class TourDesk final : public TourEffects {
  public:
   /// Extra time after the tour's question before its force may start [s] (the sound device's latency).
   static constexpr double kAskMargin_s = 0.3;
@@ -44,23 +46,26 @@ class TourDesk {
   /// starts [m].
   TourDesk(ServoStep& step, DeviceHost& devices, Voice& voice, const audio::AudioSystem& audio,
            const config::Settings& settings, Vec2 half_m, Vec2 cursor_m);
+  /// Where the desk learns what is shown (Stage::tour_picture), asked at each Guide key and poll. Until it is
+  /// set, nothing is shown.
+  void set_picture(std::function<TourPicture()> picture) { picture_ = std::move(picture); }
 
   /// The model hand's target [m] (the mouse or a script stands in for the visitor's hand). After a tour the
   /// hand keeps the place the tour led the handle to: later cursors are offset by it (until new_visitor).
   /// While a tour runs, a cursor more than 3 mm from where it was at the hand-over stops it.
   void set_cursor(Vec2 m);
   /// Any key: stops a tour under way or announced, quietly (the Guide key that did so then says so).
-  void key_pressed();
-  /// The Guide key on `picture`: when it has a shape not yet touched (plan_tour), asks first; the tour is
+  void key_pressed() override;
+  /// The Guide key on the picture shown: when it has a shape not yet touched (plan_tour), asks first; the tour is
   /// planned and handed to the servo thread by poll() once the question has been heard (its length in servo
   /// ticks, kAskMargin_s more). Nothing left: says so (tour_all_touched, or tour_nothing without shapes).
   /// A press that stopped a tour says tour_stopped instead.
-  void guide(const TourPicture& picture);
+  void guide() override;
   /// Window thread, every frame: keeps what the handle touches in this visit's touches; hands an announced
   /// tour over when it is due; and when the tour handed over has ended, says what it traced and what remains
   /// ("Tour stopped. …" when the hand held it back or the device was lost; nothing when a key, the mouse, a
   /// new picture or visitor stopped it) and gives the handle back to the cursor where it is.
-  void poll(const TourPicture& picture);
+  void poll();
   /// A new picture (`id`, `curves` shapes) is published: touches start again; a tour under way stops
   /// without a word, an announced one does not start.
   void picture_changed(int id, int curves);
@@ -76,10 +81,12 @@ class TourDesk {
   const VisitTouches& touches() const { return touches_; }
 
  private:
+  TourPicture picture() const { return picture_ ? picture_() : TourPicture{}; }
   void hand_over(const TourPicture& picture);  // plans the announced tour from the handle and publishes it
   void report_end(const TourPicture& picture, const ServoDisplayState& d);  // what it traced and what remains
   void stop_quietly();                                                      // ends what runs or is announced
 
+  std::function<TourPicture()> picture_;  // set_picture
   ServoStep& step_;
   DeviceHost& devices_;
   Voice& voice_;

@@ -1,0 +1,268 @@
+// What the device and the screen show (stage.hpp).
+#include "visit/stage.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cctype>
+
+#include "haptics/tolerance_cut.hpp"
+#include "pictures/picture_library.hpp"
+#include "runtime/runtime_params.hpp"
+#include "visit/describe.hpp"
+#include "visit/read_aloud.hpp"
+
+namespace hk::app {
+namespace {
+
+/// `words` with its first letter a capital.
+std::string capitalised(std::string words) {
+  if (!words.empty()) words[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(words[0])));
+  return words;
+}
+
+/// With level_mode = "cut", each curve's cut at each tolerance step (Shown::cut_segments and Shown::cuts).
+void add_cuts(const Scene& sc, Shown& sh) {
+  sh.cut_segments.assign(sc.curve_count(), std::vector<std::vector<SegmentRef>>(kToleranceSteps));
+  sh.cuts.assign(sc.curve_count(), std::vector<std::vector<Vec2>>(kToleranceSteps));
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    for (int t = 0; t < kToleranceSteps; ++t) {
+      std::vector<SegmentRef>& cut = sh.cut_segments[c][static_cast<std::size_t>(t)];
+      tolerance_cut(sc, c, kToleranceLadder_m[t], &cut);
+      sh.cuts[c][static_cast<std::size_t>(t)] = joined_cut_points(sc, c, cut.data(), cut.size());
+    }
+  }
+}
+
+}  // namespace
+
+Stage::Stage(ServoStep& step, Voice& voice, const audio::AudioSystem& audio, TourDesk& tour, PictureShelf& shelf,
+             const config::Settings& settings, Vec2 half_m)
+    : step_(step),
+      voice_(voice),
+      audio_(audio),
+      tour_(tour),
+      shelf_(shelf),
+      s_(settings),
+      half_(half_m),
+      level_(settings.haptics.level),
+      auto_level_(settings.haptics.level_mode != "fixed") {}
+
+void Stage::show_tutorial(TutorialShape shape) {
+  shelf_.drop_want();  // a picture still being built is not wanted any more
+  Shown sh;
+  sh.polylines = {tutorial_polyline(shape, half_)};
+  static constexpr audio::MessageId kNames[] = {audio::MessageId::shape_square, audio::MessageId::shape_circle,
+                                                audio::MessageId::shape_triangle};
+  sh.notes.title = audio_.messages().text(kNames[static_cast<int>(shape)]);  // Where, Describe and the tour name it
+  publish(std::move(sh),
+          std::make_unique<Scene>(Scene::build({tutorial_polyline(shape, half_)}, s_.haptics.max_levels)),
+          -1 - static_cast<int>(shape));
+  text_.cancel();
+  text_news_.clear();
+  source_ = {};
+}
+
+void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes, bool reading_said) {
+  Shown sh;
+  sh.polylines = is.polylines;
+  sh.picture = is.picture;  // the pixels the scene was built from (a picture file decoded once, reduced)
+  sh.px_to_m = is.px_to_m;
+  sh.text_blocks = is.text_blocks;
+  sh.notes = std::move(notes);
+  publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
+  source_ = source;
+  text_news_.clear();
+  if (is.text_pending && is.with_text) {
+    text_.start(id, [read = std::move(is.with_text), side_px = screen_side_px_](const std::atomic<bool>* cancel) {
+      ImageScene with_text = read(cancel);
+      fit_picture(with_text, side_px);  // on the reader's worker, not the window thread
+      return with_text;
+    });
+    text_since_s_ = -1.0;
+    text_said_ = reading_said;
+  } else {
+    text_.cancel();
+  }
+}
+
+void Stage::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes) {
+  ++scenes_published_;
+  const Scene& sc = *scene;
+  sh.levels.resize(sc.curve_count());
+  sh.closed.resize(sc.curve_count());
+  for (std::size_t c = 0; c < sc.curve_count(); ++c) {
+    sh.closed[c] = sc.curve(c).closed;
+    for (int l = 0; l < sc.curve(c).levels; ++l) {
+      const Vec2* p = sc.points(c, l);
+      sh.levels[c].emplace_back(p, p + sc.curve(c).point_count[l]);
+    }
+  }
+  sh.cut_segments.clear();
+  sh.cuts.clear();
+  if (s_.haptics.level_mode == "cut") add_cuts(sc, sh);
+  ServoParams sp = servo_params_from(s_);
+  sp.level = auto_level_ ? s_.haptics.level : level_;  // auto: where the policy starts
+  sp.auto_level = auto_level_;
+  auto bundle = std::make_unique<SceneBundle>(std::move(scene), sp);
+  bundle->id = id;
+  bundle->text_blocks_m = std::move(text_boxes);
+  sh.scene = bundle->scene.get();
+  shown_ = std::move(sh);
+  shown_id_ = id;
+  tour_.picture_changed(id, static_cast<int>(sc.curve_count()));
+  step_.publish(std::move(bundle));
+}
+
+void Stage::poll_text(double now_s) {
+  if (!text_news_.empty() && (text_news_id_ != shown_id_ || !audio_.speaking())) {
+    if (text_news_id_ == shown_id_) voice_.say(text_news_);
+    text_news_.clear();
+  }
+  if (!text_.pending()) return;
+  if (text_.pending_id() != shown_id_) {  // another picture came meanwhile
+    text_.cancel();
+    return;
+  }
+  if (text_since_s_ < 0) text_since_s_ = now_s;
+  if (std::optional<TextRead> read = text_.poll()) {
+    text_arrived(*read);
+    return;
+  }
+  if (!text_said_ && now_s - text_since_s_ > kTextWait_s && !audio_.speaking()) {
+    text_said_ = true;
+    voice_.say_brief(audio_.messages().text(audio::MessageId::text_reading));
+  }
+}
+
+void Stage::text_arrived(TextRead& read) {
+  ImageScene& is = read.scene;
+  spdlog::info("text of scene {}: {}, {} words in {} blocks, read in {:.0f} ms", read.id, is.ocr.why, is.ocr.words,
+               is.text_blocks.size(), read.wall_ms);
+  const audio::MessageCatalog& m = audio_.messages();
+  text_news_id_ = read.id;
+  const bool built = is.scene != nullptr;
+  const bool said_reading = text_said_;
+  if (built) show(is, read.id, source_, shown_.notes);  // the fade: no force step as the letters' curves go
+  if (built && !is.text_blocks.empty()) {
+    text_news_ =
+        m.text(audio::MessageId::text_ready,
+               {{"description", describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))}});
+  } else if (is.ocr.why.rfind("failed", 0) == 0 || !built) {
+    text_news_ = m.text(audio::MessageId::text_unavailable);
+  } else if (said_reading) {
+    text_news_ = m.text(audio::MessageId::text_none);
+  }
+}
+
+std::string Stage::where() {
+  const ServoDisplayState& d = step_.display();
+  const std::string place = place_words(d.handle_m, half_);
+  const audio::MessageCatalog& m = audio_.messages();
+  if (const TextBlockM* b = text_block_at(shown_.text_blocks, d.handle_m)) {
+    const auto index = b - shown_.text_blocks.data();
+    return m.text(audio::MessageId::where_text,
+                  {{"block", std::to_string(index + 1)},
+                   {"blocks", std::to_string(shown_.text_blocks.size())},
+                   {"where", place},
+                   {"text", first_words(name_unclear_words(b->text, m), kWhereTextWords)}});
+  }
+  const ShapeAtHand at = shape_at_hand(shown_.polylines, d.handle_m, d.scene_id == shown_id_ ? d.curve : -1);
+  // A practice shape: far and near explained with the first answer of the visit, not again.
+  const bool explain = showing_tutorial() && !far_near_said_;
+  far_near_said_ = far_near_said_ || explain;
+  const std::string far_near = explain ? " " + m.text(audio::MessageId::far_near) : std::string();
+  if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}}) + far_near;
+  return m.text(at.on ? audio::MessageId::where_on : audio::MessageId::where_near,
+                {{"shape", std::to_string(at.curve + 1)},
+                 {"shapes", std::to_string(shown_.polylines.size())},
+                 {"description", shape_words(static_cast<std::size_t>(at.curve))},
+                 {"where", place}}) +
+         far_near;
+}
+
+std::string Stage::shape_words(std::size_t curve) const {
+  if (showing_tutorial() && !shown_.notes.title.empty()) return shown_.notes.title;  // "a square"
+  return describe_one_shape(shown_.polylines, curve, half_, false);
+}
+
+std::string Stage::describe() {
+  // Its text still being read: said first, so the visitor knows more is coming.
+  const std::string reading =
+      text_.pending() ? audio_.messages().text(audio::MessageId::text_reading) + " " : std::string();
+  return reading + describe_shown();
+}
+
+PageText Stage::page_text() {
+  PageText page;
+  for (const TextBlockM& b : shown_.text_blocks)
+    page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
+  if (const TextBlockM* b = text_block_at(shown_.text_blocks, step_.display().proxy_m))
+    page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
+  return page;
+}
+
+std::string Stage::describe_shown() {
+  if (source_.page > 0 || !shown_.text_blocks.empty()) {
+    // A page (or a picture of one): the block of text under the hand is read; elsewhere, what the page holds.
+    if (const TextBlockM* b = text_block_at(shown_.text_blocks, step_.display().proxy_m)) {
+      return audio_.messages().text(audio::MessageId::text_block,
+                                    {{"text", name_unclear_words(b->text, audio_.messages())}});
+    }
+    const std::string page =
+        describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
+    return shown_.polylines.empty() ? page
+                                    : page + " " + describe_scene(shown_.polylines, half_, 3, step_.display().handle_m);
+  }
+  if (showing_tutorial() && !shown_.notes.title.empty())  // a practice shape: "A square, in the middle."
+    return capitalised(shown_.notes.title + ", " + place_words({0.0, 0.0}, half_) + ".");
+  // A picture: what a person wrote of it first ("A horse, seen from the side. A horse standing, ..."), then
+  // its shapes.
+  std::string words;
+  if (!shown_.notes.title.empty()) {
+    words = capitalised(shown_.notes.title);
+    if (words.back() != '.' && words.back() != '!' && words.back() != '?') words += '.';
+    words += ' ';
+  }
+  if (!shown_.notes.description.empty()) words += shown_.notes.description + ' ';
+  return words + describe_scene(shown_.polylines, half_, 3, step_.display().handle_m);
+}
+
+bool Stage::change_level(int delta) {
+  // From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until
+  // another picture or page is asked for (reset_level) or the session ends. With a tolerance or cut step in use
+  // (level_mode = "tolerance" or "cut") the keys move along the steps, so finer and coarser keep their order (and
+  // their earcons) without comparing a step with a level.
+  const int now = level();
+  const int next = now + delta;
+  const bool in_range = is_tolerance_level(now) ? is_tolerance_level(next)
+                        : is_cut_level(now)     ? is_cut_level(next)
+                                                : (next >= 0 && next <= s_.haptics.max_levels);
+  if (!in_range) return false;
+  level_ = next;
+  auto_level_ = false;
+  step_.request_level(level_);
+  return true;
+}
+
+void Stage::reset_level(bool at_once) {
+  level_ = s_.haptics.level;
+  auto_level_ = s_.haptics.level_mode != "fixed";
+  if (at_once) step_.request_level(auto_level_ ? ServoStep::kAutoLevel : level_);
+}
+
+void Stage::new_visitor() {
+  far_near_said_ = false;
+  reset_level();
+  tour_.new_visitor(shown_id_, shown_.scene ? static_cast<int>(shown_.scene->curve_count()) : 0);
+}
+
+TourPicture Stage::tour_picture() const {
+  TourPicture p;
+  p.scene = shown_.scene;
+  p.id = shown_id_;
+  p.described = shown_.polylines.size();
+  p.words = [this](std::size_t curve) { return shape_words(curve); };
+  return p;
+}
+
+}  // namespace hk::app
