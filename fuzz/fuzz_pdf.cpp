@@ -7,10 +7,9 @@
 // kiosk side relies on:
 //  - a refusal has a kind the parent accepts and a problem of at most kMaxProblemBytes bytes (the parent
 //    turns a longer one into "no usable answer"), one line;
-//  - an answer has the exact layout the parent parses (probe: page count, title; render: page size, dpi, screen-sized
-//  flag,
-//    w x h grey bytes within the pixel budget, words with finite boxes inside the page), and the parent's
-//    group_text_blocks (which runs in the kiosk process) digests the words.
+//  - an answer has the exact layout the parent parses (probe: page count, title; render: page size, dpi,
+//    screen-sized flag, w x h grey bytes within the pixel budget, words with finite boxes inside the page), and the
+//    parent's group_text_blocks (which runs in the kiosk process) digests the words.
 // The budget is lower than the kiosk's (40000 px instead of 4 MP) so that a run takes milliseconds.
 
 #include "pdf.cpp"  // vision/src/pdf.cpp, for its internal worker function work()

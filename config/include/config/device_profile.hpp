@@ -3,23 +3,21 @@
 /// Device profiles: what each kind of handle can give, and the settings it brings ([device] type picks
 /// one; DESIGN.md "Devices").
 ///
-/// | [device] type | device | force everywhere | max_force_n | pop_force_n | tour_max_force_n | groove_depth_n |
-/// stiffness_n_per_m (stable limit) |
+/// | [device] type | device | everywhere | max_force_n | pop_force_n | tour_max_force_n | groove_depth_n | stiffness |
 /// |---|---|---|---|---|---|---|---|
-/// | "simulated", "auto" | simulated pantograph | 3.78 N | 3.5 N | 3.0 N | 1.2 N | 1.0 N | 800 (limit 3000; stable to
-/// 3784) N/m | | "haply" | Haply 2DIY gen3 | 1.65 N | 1.5 N | 1.2 N | 0.5 N | 0.45 N | 500 (limit 850; stable to 1103)
-/// N/m | | "haply-gen2" | the original Haply 2DIY | 1.60 N | 1.45 N | 1.15 N | 0.5 N | 0.45 N | 500 (limit 850; stable
-/// to 1129) N/m |
+/// | "simulated", "auto" | simulated pantograph | 3.78 N | 3.5 N | 3.0 N | 1.2 N | 1.0 N | 800 (3000; 3784) N/m |
+/// | "haply" | Haply 2DIY gen3 | 1.65 N | 1.5 N | 1.2 N | 0.5 N | 0.45 N | 500 (850; 1103) N/m |
+/// | "haply-gen2" | the original Haply 2DIY | 1.60 N | 1.45 N | 1.15 N | 0.5 N | 0.45 N | 500 (850; 1129) N/m |
 ///
-/// Force everywhere: the least force the handle gives in every direction at every point of its usable
-/// rectangle with its torque limit (pantograph.hpp `min_force_everywhere_n`; computed from the settings
-/// by `force_everywhere_n`, the table shows the shipped values). max_force_n is about 0.9 of it, the
-/// push-through force 0.8 of max_force_n, the tour's pull and the groove's depth about a third; the
-/// force step of a level change or a live change scales with max_force_n. The stiffness limit is the largest wall
-/// stiffness the servo loop renders stably on the device's model (mass, damping, encoder quantisation,
-/// and for a USB board one tick of delay; `bench_stability --profiles`, docs/PERFORMANCE.md "Device
-/// profiles") with a margin, at 1000 Hz; at other servo rates it scales with the rate (the sampled-data
-/// bound 2b/T is proportional to it).
+/// Stiffness: stiffness_n_per_m's default (its limit; stable to). Force everywhere: the least force the handle gives in
+/// every direction at every point of its usable rectangle with its torque limit (pantograph.hpp
+/// `min_force_everywhere_n`; computed from the settings by `force_everywhere_n`, the table shows the shipped values).
+/// max_force_n is about 0.9 of it, the push-through force 0.8 of max_force_n, the tour's pull and the groove's depth
+/// about a third; the force step of a level change or a live change scales with max_force_n. The stiffness limit is the
+/// largest wall stiffness the servo loop renders stably on the device's model (mass, damping, encoder quantisation, and
+/// for a USB board one tick of delay; `bench_stability --profiles`, docs/PERFORMANCE.md "Device profiles") with a
+/// margin, at 1000 Hz; at other servo rates it scales with the rate (the sampled-data bound 2b/T is proportional to
+/// it).
 ///
 /// Sources of the Haply boards: HaplyHaptics' hAPI examples (`add_actuator`, `add_encoder` for
 /// hardwareVersion 2 and 3: ports, directions, home offsets, encoder resolutions) and Pantograph.java
