@@ -130,7 +130,7 @@ class Script {
 
  private:
   void visitor(double now_s) {
-    if (!present_ && flow_.state() == hk::app::KioskState::Attract && now_s >= next_visit_s_) {
+    if (!present_ && flow_.view().state == hk::app::KioskState::Attract && now_s >= next_visit_s_) {
       present_ = true;
       ++visitors_;
       leave_s_ = now_s + std::uniform_real_distribution<double>(45, 90)(rng_);

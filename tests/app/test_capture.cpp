@@ -249,7 +249,7 @@ RuntimeOptions headless_options() {
 void poll_until_done(KioskRuntime& rt, KioskFlow& flow) {
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   double t = 1.0;
-  while (flow.capturing() && std::chrono::steady_clock::now() < give_up) {
+  while (flow.view().capturing && std::chrono::steady_clock::now() < give_up) {
     rt.camera().poll(flow, t += 0.01);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
@@ -268,9 +268,9 @@ TEST(CaptureRuntime, TheKioskCapturesFromItsCameraAndPutsThePictureOnTheDevice) 
   KioskFlow flow(rt.effects(), rt.audio().messages(), fp);
   flow.key(KioskKey::Other, 0.0);
   flow.key(KioskKey::Capture, 0.5);
-  ASSERT_TRUE(flow.capturing());
+  ASSERT_TRUE(flow.view().capturing);
   poll_until_done(rt, flow);
-  ASSERT_FALSE(flow.capturing());
+  ASSERT_FALSE(flow.view().capturing);
   EXPECT_EQ(rt.voice().last_said().rfind("Captured.", 0), 0u) << rt.voice().last_said();
   EXPECT_LE(rt.stage().shown_id(), -100) << "the capture is what is shown";
   EXPECT_FALSE(rt.stage().shown().picture.empty());

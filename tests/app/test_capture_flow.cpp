@@ -48,7 +48,7 @@ TEST(CaptureFlow, GuidedThenCapturedAndSaid) {
   KioskFlow flow = on_picture(fx, true);
   flow.key(KioskKey::Capture, 1.0);
   EXPECT_EQ(fx.started, 1);
-  EXPECT_TRUE(flow.capturing());
+  EXPECT_TRUE(flow.view().capturing);
   EXPECT_EQ(fx.said.back().rfind("Place the picture under the camera, face up.", 0), 0u) << fx.said.back();
   flow.capture_advice(audio::MessageId::capture_move_left, 2.0);
   EXPECT_EQ(fx.said.back(), "Move it left.");
@@ -56,8 +56,8 @@ TEST(CaptureFlow, GuidedThenCapturedAndSaid) {
   EXPECT_EQ(fx.said.back(), "Hold still.");
   flow.capture_done(5, 4.5);
   EXPECT_EQ(fx.said.back(), "Captured. It has 5 shapes.");
-  EXPECT_FALSE(flow.capturing());
-  EXPECT_EQ(flow.state(), KioskState::Picture);
+  EXPECT_FALSE(flow.view().capturing);
+  EXPECT_EQ(flow.view().state, KioskState::Picture);
   // A late advice after the end is not said.
   const std::size_t n = fx.said.size();
   flow.capture_advice(audio::MessageId::capture_move_left, 4.6);
@@ -90,13 +90,13 @@ TEST(CaptureFlow, AnyKeyCancelsAndDoesNothingElse) {
   for (KioskKey k : {KioskKey::Next, KioskKey::Capture, KioskKey::Describe, KioskKey::Other}) {
     CameraRecorder fx;
     KioskFlow flow = on_picture(fx, true);
-    const int picture = flow.picture();
+    const int picture = flow.view().picture;
     flow.key(KioskKey::Capture, 1.0);
     flow.key(k, 2.0);
     EXPECT_EQ(fx.cancelled, 1);
-    EXPECT_FALSE(flow.capturing());
+    EXPECT_FALSE(flow.view().capturing);
     EXPECT_EQ(fx.said.back(), "Capture stopped.");
-    EXPECT_EQ(flow.picture(), picture) << "the key did not also move on";
+    EXPECT_EQ(flow.view().picture, picture) << "the key did not also move on";
     EXPECT_EQ(fx.started, 1);
   }
 }
@@ -119,7 +119,7 @@ TEST(CaptureFlow, WithoutACameraTheKeySaysSoAndTheHelpDoesNotNameIt) {
   KioskFlow flow = on_picture(fx, false);
   flow.key(KioskKey::Capture, 1.0);
   EXPECT_EQ(fx.said.back(), "There is no camera on this kiosk.");
-  EXPECT_FALSE(flow.capturing());
+  EXPECT_FALSE(flow.view().capturing);
   EXPECT_EQ(every_key(flow, fx).find("camera"), std::string::npos);
   CameraRecorder fx2;
   KioskFlow with = on_picture(fx2, true);
@@ -141,12 +141,12 @@ TEST(CaptureFlow, GuidanceKeepsTheSessionAliveAndTheTimeOutCancels) {
     flow.capture_advice(audio::MessageId::capture_move_up, t);
     flow.tick(t + 1);
   }
-  EXPECT_TRUE(flow.capturing()) << "advice is activity: no time-out while the visitor places the picture";
+  EXPECT_TRUE(flow.view().capturing) << "advice is activity: no time-out while the visitor places the picture";
   EXPECT_EQ(fx.cancelled, 0);
   flow.tick(200);
-  EXPECT_FALSE(flow.capturing());
+  EXPECT_FALSE(flow.view().capturing);
   EXPECT_EQ(fx.cancelled, 1);
-  EXPECT_EQ(flow.state(), KioskState::Attract);
+  EXPECT_EQ(flow.view().state, KioskState::Attract);
 }
 
 }  // namespace

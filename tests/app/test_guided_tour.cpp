@@ -488,7 +488,7 @@ TEST(GuidedTour, TheFlowSendsGuideAndTellsOfEveryKey) {
   flow.key(KioskKey::Guide, 1.0);  // on a tutorial shape
   EXPECT_EQ(fx.guides, 1);
   for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 2.0);
-  ASSERT_EQ(flow.state(), KioskState::Picture);
+  ASSERT_EQ(flow.view().state, KioskState::Picture);
   flow.key(KioskKey::Guide, 3.0);
   flow.key(KioskKey::Describe, 4.0);
   EXPECT_EQ(fx.guides, 2);

@@ -65,11 +65,11 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   const auto& en = audio::MessageCatalog::english();
   KioskFlow flow(fx, en, {120.0, 20.0});
   flow.tick(10.0);
-  EXPECT_EQ(flow.state(), KioskState::Attract);
+  EXPECT_EQ(flow.view().state, KioskState::Attract);
   EXPECT_TRUE(fx.said.empty()) << "attract is silent until someone comes";
 
   flow.handle_moved(11.0);
-  EXPECT_EQ(flow.state(), KioskState::Tutorial);
+  EXPECT_EQ(flow.view().state, KioskState::Tutorial);
   ASSERT_EQ(fx.said.size(), 1u);
   EXPECT_EQ(fx.said.back().rfind("Welcome.", 0), 0u);
   EXPECT_NE(fx.said.back().find("Feel the square with the handle. Press the Right arrow to move on."),
@@ -88,7 +88,7 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   EXPECT_EQ(fx.said.back(),
             "A triangle. Press the G key to be led round it. Press the Right arrow for the first picture.");
   flow.key(KioskKey::Next, 40.0);
-  EXPECT_EQ(flow.state(), KioskState::Picture);
+  EXPECT_EQ(flow.view().state, KioskState::Picture);
   EXPECT_EQ(
       fx.said.back(),
       "Well done. Press the D key to hear about a picture, the R key to hear it again. Here is the first picture. "
@@ -105,7 +105,7 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   flow.key(KioskKey::Help, 53.5);
   flow.key(KioskKey::Help, 53.6);  // the second layer: every key, two sentences at a time, Next for more
   std::string every = fx.said.back();
-  for (int g = 0; g < 6 && flow.in_help() && fx.said.back().find("That is every key.") == std::string::npos; ++g) {
+  for (int g = 0; g < 6 && flow.view().in_help && fx.said.back().find("That is every key.") == std::string::npos; ++g) {
     flow.key(KioskKey::Next, 53.7 + 0.01 * g);
     every += " " + fx.said.back();
   }
@@ -141,16 +141,16 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
   EXPECT_EQ(fx.said.size(), before + 1) << "warned once";
   flow.handle_moved(160.0);
   flow.tick(200.0);
-  EXPECT_EQ(flow.state(), KioskState::Picture) << "the motion extended the session";
+  EXPECT_EQ(flow.view().state, KioskState::Picture) << "the motion extended the session";
   flow.tick(280.0);
-  EXPECT_EQ(flow.state(), KioskState::Attract);
+  EXPECT_EQ(flow.view().state, KioskState::Attract);
   EXPECT_EQ(fx.said.back(), en.raw(audio::MessageId::goodbye));
   EXPECT_EQ(fx.sessions, 1);
   EXPECT_EQ(fx.volume, 7) << "the operator's default again";
 
   // The next visitor starts with the tutorial again.
   flow.key(KioskKey::Other, 300.0);
-  EXPECT_EQ(flow.state(), KioskState::Tutorial);
+  EXPECT_EQ(flow.view().state, KioskState::Tutorial);
 }
 
 TEST(KioskFlow, EveryKeyIsAnsweredInSpeech) {
@@ -162,7 +162,7 @@ TEST(KioskFlow, EveryKeyIsAnsweredInSpeech) {
     if (want == KioskState::Picture) {
       for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, t++);
     }
-    ASSERT_EQ(flow.state(), want);
+    ASSERT_EQ(flow.view().state, want);
     for (KioskKey k : {KioskKey::Help, KioskKey::Describe, KioskKey::Finer, KioskKey::Coarser, KioskKey::VolumeUp,
                        KioskKey::VolumeDown, KioskKey::Other}) {
       const std::size_t n = fx.said.size();
@@ -200,8 +200,8 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
       {"cat.png", false, 1, ""}, {"report.pdf", true, 3, ""}, {"dog.jpg", false, 1, ""}};
 
   flow.stick_inserted(stick, 1.0);
-  EXPECT_EQ(flow.state(), KioskState::Picture) << "a stick wakes the kiosk";
-  EXPECT_EQ(flow.source(), KioskSource::Stick);
+  EXPECT_EQ(flow.view().state, KioskState::Picture) << "a stick wakes the kiosk";
+  EXPECT_EQ(flow.view().source, KioskSource::Stick);
   ASSERT_EQ(fx.requested.size(), 1u);
   EXPECT_EQ(fx.requested.back(), std::make_pair(0, 1)) << "the first page is loaded at once";
   EXPECT_TRUE(fx.said.empty()) << "the summary waits for the first page, so one announcement says both";
@@ -216,7 +216,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   EXPECT_EQ(fx.said.back(),
             "A USB stick with 3 documents: 2 pictures and a PDF of 3 pages. Press the Right arrow to go through them. "
             "Document 1 of 3, cat. It has 4 shapes.");
-  EXPECT_EQ(flow.document(), 0);
+  EXPECT_EQ(flow.view().document, 0);
 
   flow.key(KioskKey::Next, 3.0);
   EXPECT_EQ(fx.requested.back(), std::make_pair(1, 1));
@@ -231,8 +231,8 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
   bad.reason = "the reader stopped on page 2 (signal 11)";
   flow.document_ready(bad, 4.2);
   EXPECT_EQ(fx.said.back(), "Page 2 of report cannot be read. You still feel the picture before.");
-  EXPECT_EQ(flow.document(), 1);
-  EXPECT_EQ(flow.page(), 1) << "the page shown is still page 1";
+  EXPECT_EQ(flow.view().document, 1);
+  EXPECT_EQ(flow.view().page, 1) << "the page shown is still page 1";
   // Next moves on from the unreadable page; a second press while loading moves on from the first; the
   // first's late result is ignored.
   flow.key(KioskKey::Next, 5.0);
@@ -253,7 +253,7 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
 
   // Taken out mid-load: back to the library picture, and the late result is ignored.
   flow.stick_removed(7.0);
-  EXPECT_EQ(flow.source(), KioskSource::Library);
+  EXPECT_EQ(flow.view().source, KioskSource::Library);
   EXPECT_EQ(fx.said.back(),
             "The USB stick was taken out. Back to the picture library. Picture 1 of 3. It has 4 shapes.");
   EXPECT_EQ(fx.shown.back(), "picture 0");
@@ -272,11 +272,11 @@ TEST(KioskFlow, UsbStickInsertBrowseRemoveInsertAgain) {
 
   // The visitor leaves; the next one does not get the stick.
   flow.tick(9.1 + 120.0);
-  EXPECT_EQ(flow.state(), KioskState::Attract);
+  EXPECT_EQ(flow.view().state, KioskState::Attract);
   EXPECT_EQ(fx.forgotten, 1);
-  EXPECT_EQ(flow.source(), KioskSource::Library);
+  EXPECT_EQ(flow.view().source, KioskSource::Library);
   flow.key(KioskKey::Other, 300.0);
-  EXPECT_EQ(flow.state(), KioskState::Tutorial);
+  EXPECT_EQ(flow.view().state, KioskState::Tutorial);
 }
 
 // A stick put in while the kiosk waits, its first file unreadable: nothing was felt before, so nothing
@@ -341,10 +341,10 @@ TEST(KioskFlow, AnEmptyStickDuringTheTutorialLeavesTheTutorialAsItWas) {
   Recorder fx;
   KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
   flow.key(KioskKey::Other, 0.0);
-  ASSERT_EQ(flow.state(), KioskState::Tutorial);
+  ASSERT_EQ(flow.view().state, KioskState::Tutorial);
   flow.stick_inserted({}, 1.0, 0);
   EXPECT_EQ(fx.said.back(), "I found no pictures and no PDF documents on this USB stick.");
-  EXPECT_EQ(flow.state(), KioskState::Tutorial);
+  EXPECT_EQ(flow.view().state, KioskState::Tutorial);
   flow.key(KioskKey::Help, 2.0);
   EXPECT_EQ(fx.said.back().rfind("Practising with a shape.", 0), 0u) << fx.said.back();
   flow.key(KioskKey::Next, 3.0);
@@ -353,7 +353,7 @@ TEST(KioskFlow, AnEmptyStickDuringTheTutorialLeavesTheTutorialAsItWas) {
   Recorder fx2;
   KioskFlow waiting(fx2, audio::MessageCatalog::english(), {120.0, 20.0});
   waiting.stick_inserted({}, 1.0, 0);
-  EXPECT_EQ(waiting.state(), KioskState::Tutorial);
+  EXPECT_EQ(waiting.view().state, KioskState::Tutorial);
   EXPECT_EQ(fx2.shown.back(), "tutorial 0");
   EXPECT_EQ(fx2.said.back(),
             "I found no pictures and no PDF documents on this USB stick. Welcome. Feel the square with the handle. "
@@ -362,7 +362,7 @@ TEST(KioskFlow, AnEmptyStickDuringTheTutorialLeavesTheTutorialAsItWas) {
   Recorder fx3;
   KioskFlow refused(fx3, audio::MessageCatalog::english(), {120.0, 20.0});
   refused.stick_refused("its filesystem (btrfs) is not one the kiosk reads", 1.0);
-  EXPECT_EQ(refused.state(), KioskState::Tutorial);
+  EXPECT_EQ(refused.view().state, KioskState::Tutorial);
   EXPECT_EQ(fx3.said.back(),
             "I cannot read this USB stick. its filesystem (btrfs) is not one the kiosk reads. Welcome. Feel the square "
             "with the handle. Press the Right arrow to move on. Press F1 for help.");
@@ -394,10 +394,10 @@ TEST(KioskFlow, EmptyAndRefusedSticksAreSaidAndChangeNothing) {
   KioskFlow flow(fx, audio::MessageCatalog::english(), {120.0, 20.0});
   flow.key(KioskKey::Other, 0.0);
   for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 1.0);
-  ASSERT_EQ(flow.state(), KioskState::Picture);
+  ASSERT_EQ(flow.view().state, KioskState::Picture);
   flow.stick_inserted({}, 2.0);
   EXPECT_EQ(fx.said.back(), "I found no pictures and no PDF documents on this USB stick.");
-  EXPECT_EQ(flow.source(), KioskSource::Library);
+  EXPECT_EQ(flow.view().source, KioskSource::Library);
   EXPECT_TRUE(fx.requested.empty());
   flow.stick_refused("its filesystem (btrfs) is not one the kiosk reads", 3.0);
   EXPECT_EQ(fx.said.back(), "I cannot read this USB stick. its filesystem (btrfs) is not one the kiosk reads");

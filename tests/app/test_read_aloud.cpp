@@ -156,15 +156,15 @@ TEST(ReadAloud, DescribeReadsTheParagraphUnderTheHandAndTheKeysMoveFromTheSenten
       "About 10 minutes of text. Press the K key to skip a sentence, the I key a paragraph. Text:\n";
   EXPECT_EQ(said.rfind(lead, 0), 0u) << said.substr(0, 200);
   EXPECT_EQ(said.substr(lead.size()), r.text_from({1, 0}));
-  EXPECT_TRUE(v.flow.reading());
+  EXPECT_TRUE(v.flow.view().reading);
   const int lead_pieces = static_cast<int>(audio::speech_pieces(lead).size());
   ASSERT_EQ(lead_pieces, 3);
   v.hear(lead_pieces + 5);  // the visitor hears sentence 5
-  EXPECT_EQ(v.flow.reading_place(), (ReadingPlace{1, 5}));
+  EXPECT_EQ(v.flow.view().reading_place, (ReadingPlace{1, 5}));
   v.key(KioskKey::NextSentence);
   EXPECT_EQ(v.fx.said.back(), r.text_from({1, 6})) << "on from the next sentence, nothing before it";
   v.hear(2);
-  EXPECT_EQ(v.flow.reading_place(), (ReadingPlace{1, 8}));
+  EXPECT_EQ(v.flow.view().reading_place, (ReadingPlace{1, 8}));
   v.key(KioskKey::Repeat);
   EXPECT_EQ(v.fx.said.back(), r.text_from({1, 8})) << "Repeat: the sentence heard, again";
   v.key(KioskKey::PreviousSentence);
@@ -192,7 +192,7 @@ TEST(ReadAloud, AfterSomethingElseIsSaidTheKeysStartAgainFromTheHand) {
   v.key(KioskKey::Describe);
   EXPECT_EQ(v.fx.said.back(), "Text:\n" + r.text_from({2, 0})) << "a short paragraph: no length said";
   v.key(KioskKey::Where);  // something else is said: the reading is over
-  EXPECT_FALSE(v.flow.reading());
+  EXPECT_FALSE(v.flow.view().reading);
   v.key(KioskKey::Repeat);
   EXPECT_EQ(v.fx.said.back(), v.fx.said[v.fx.said.size() - 2]) << "Repeat says what was said last, whole";
   v.fx.page.at_hand = -1;  // the hand off the text
@@ -200,7 +200,7 @@ TEST(ReadAloud, AfterSomethingElseIsSaidTheKeysStartAgainFromTheHand) {
   EXPECT_EQ(v.fx.said.back(),
             v.text(MessageId::reading_paragraph, {{"block", "1"}, {"blocks", "3"}}) + "\n" + r.text_from({0, 0}))
       << "the page's first paragraph";
-  EXPECT_TRUE(v.flow.reading());
+  EXPECT_TRUE(v.flow.view().reading);
 }
 
 TEST(ReadAloud, UnclearWordsAreNamedNotReadAsIfCertain) {
@@ -221,7 +221,7 @@ TEST(ReadAloud, APictureWithoutTextSaysSo) {
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_none));
   v.key(KioskKey::Describe);
   EXPECT_EQ(v.fx.said.back(), v.fx.describe()) << "Describe as ever: what the picture holds";
-  EXPECT_FALSE(v.flow.reading());
+  EXPECT_FALSE(v.flow.view().reading);
 }
 
 }  // namespace

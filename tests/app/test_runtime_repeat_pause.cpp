@@ -76,12 +76,12 @@ struct SpeakingKiosk {
   void walk_to_the_picture() {
     flow->handle_moved(now_s);
     ASSERT_TRUE(listen_to_the_end());
-    for (int i = 0; i < 8 && flow->state() != KioskState::Picture; ++i) {
+    for (int i = 0; i < 8 && flow->view().state != KioskState::Picture; ++i) {
       key(KioskKey::Next);
       ASSERT_TRUE(rt->library().finish(flow.get(), now_s));
       ASSERT_TRUE(listen_to_the_end());
     }
-    ASSERT_EQ(flow->state(), KioskState::Picture);
+    ASSERT_EQ(flow->view().state, KioskState::Picture);
   }
 };
 

@@ -350,7 +350,7 @@ TEST(KioskBuilds, AStickTakenOutWhileItsPageIsBuiltLeavesTheStickAndFeelsTheLibr
   for (int i = 0; i < 50; ++i, now_s += 0.01)
     r.rt->sticks().poll(*r.flow, now_s);  // page 2's drawing, if it ends now, is dropped
   EXPECT_EQ(r.rt->stage().shown_id(), 0) << "back on the library's picture, never page 2";
-  EXPECT_EQ(r.flow->failures(), 0);
+  EXPECT_EQ(r.flow->view().failures, 0);
   fs::remove_all(stick);
 }
 
@@ -373,15 +373,15 @@ TEST(KioskBuilds, FinishWhileAStickPageIsBuiltLeavesNothingBusy) {
   ASSERT_TRUE(r.rt->sticks().busy()) << "the kiosk waits for page 2";
   r.flow->key(KioskKey::Finish, now_s);  // ...and Finish, twice, before it is done
   r.flow->key(KioskKey::Finish, now_s + 0.5);
-  ASSERT_EQ(r.flow->state(), KioskState::Attract);
+  ASSERT_EQ(r.flow->view().state, KioskState::Attract);
   EXPECT_FALSE(r.rt->sticks().busy()) << "nothing of the forgotten stick is awaited";
   // Page 2's drawing ends (or has ended), and the window polls it in.
   ASSERT_TRUE(hk::test::wait_until([&] { return !(r.rt->sticks().service().loads_done() == done); }));
   ASSERT_EQ(r.rt->sticks().service().loads_done(), done + 1) << "page 2's load ended within 60 s";
   r.rt->sticks().poll(*r.flow, now_s);
   EXPECT_FALSE(r.rt->sticks().busy()) << "the page that arrived for the forgotten stick left nothing busy";
-  EXPECT_EQ(r.flow->state(), KioskState::Attract) << "and did not wake the kiosk";
-  EXPECT_EQ(r.flow->failures(), 0);
+  EXPECT_EQ(r.flow->view().state, KioskState::Attract) << "and did not wake the kiosk";
+  EXPECT_EQ(r.flow->view().failures, 0);
   fs::remove_all(stick);
 }
 
@@ -407,7 +407,7 @@ TEST(KioskBuilds, WhatAStickCouldNotGiveIsListedForTheOperator) {
   EXPECT_EQ(problems[0].rfind("'bad_crc.png': ", 0), 0u) << problems[0];
   EXPECT_NE(problems[0].find("CRC"), std::string::npos) << "why, as the log says it: " << problems[0];
   EXPECT_EQ(problems[1].rfind("'a_damaged.png' page 1: ", 0), 0u) << problems[1];
-  EXPECT_EQ(r.flow->failures(), 0);
+  EXPECT_EQ(r.flow->view().failures, 0);
   fs::remove_all(stick);
 }
 
@@ -430,7 +430,7 @@ TEST(KioskBuilds, StickPagesPassedByQuicklyAreNeverPutOnTheDevice) {
       << "page 2, drawn before Next was pressed again, was dropped, not shown";
   EXPECT_EQ(r.rt->stage().shown_id(), 1004);
   EXPECT_EQ(r.rt->voice().last_said().rfind("Page 4 of ", 0), 0u) << r.rt->voice().last_said();
-  EXPECT_EQ(r.flow->failures(), 0);
+  EXPECT_EQ(r.flow->view().failures, 0);
   fs::remove_all(stick);
 }
 
@@ -458,7 +458,7 @@ TEST(KioskBuilds, APictureThatCannotBeReadIsSaidAndTheOldOneStays) {
   r.flow->key(KioskKey::Next, 2.0);  // steps past it
   r.settle(2.0);
   EXPECT_EQ(r.rt->stage().shown_id(), 2);
-  EXPECT_EQ(r.flow->failures(), 0);
+  EXPECT_EQ(r.flow->view().failures, 0);
 }
 
 }  // namespace

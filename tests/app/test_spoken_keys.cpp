@@ -78,7 +78,7 @@ std::string whole_help(KioskFlow& flow, Speech& fx, double now_s, std::string_vi
   std::string all;
   for (int g = 0; g < 12; ++g) {
     all += fx.caption() + " ";
-    if (fx.caption().find(last) != std::string::npos || !flow.in_help()) break;
+    if (fx.caption().find(last) != std::string::npos || !flow.view().in_help) break;
     flow.key(KioskKey::Next, now_s + 0.2 + 0.1 * g);
   }
   return all;
@@ -168,7 +168,7 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
                 std::string::npos)
           << brief;
       const std::string help = whole_help(flow, fx, 1.5);
-      ASSERT_TRUE(flow.in_help()) << "on the last group: Next goes on from here";
+      ASSERT_TRUE(flow.view().in_help) << "on the last group: Next goes on from here";
       expect_no_stale_key_words(help);
       const std::string phrase = std::string(action.help_before) + form + std::string(action.help_after);
       EXPECT_NE(help.find(phrase), std::string::npos) << "wanted \"" << phrase << "\" in: " << help;
@@ -186,7 +186,7 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
       EXPECT_NE(fx.caption().find("Press " + en.key_name(s.keys.next) + " for the first picture."), std::string::npos)
           << fx.caption();
       flow.key(KioskKey::Next, 4.0);
-      ASSERT_EQ(flow.state(), KioskState::Picture);
+      ASSERT_EQ(flow.view().state, KioskState::Picture);
       // A USB stick: "Press <next> to go through them."
       flow.stick_inserted({{"cat.png", false, 1, ""}}, 5.0);
       DocumentResult r;
@@ -228,7 +228,7 @@ TEST(SpokenKeys, TheOperatorsChangeIsHeardAtOnce) {
   KioskFlow flow(fx, en);  // the shipped keys
   flow.key(KioskKey::Other, 0.0);
   for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 1.0 + i);
-  ASSERT_EQ(flow.state(), KioskState::Picture);
+  ASSERT_EQ(flow.view().state, KioskState::Picture);
   const std::string help = whole_help(flow, fx, 5.0);  // the second layer: every key
   EXPECT_NE(help.find("Press the Up arrow for more detail and the Down arrow for less."), std::string::npos) << help;
 
@@ -240,7 +240,7 @@ TEST(SpokenKeys, TheOperatorsChangeIsHeardAtOnce) {
   flow.set_keys(k);
   EXPECT_EQ(fx.said.size(), before) << "changing the keys says nothing by itself";
   EXPECT_EQ(flow.keys(), k);
-  EXPECT_EQ(flow.state(), KioskState::Picture) << "and leaves the visitor where they are";
+  EXPECT_EQ(flow.view().state, KioskState::Picture) << "and leaves the visitor where they are";
   const std::string changed = whole_help(flow, fx, 6.0);
   EXPECT_NE(changed.find("Press keypad plus for more detail and keypad minus for less."), std::string::npos) << changed;
   EXPECT_NE(changed.find("Hold the space bar and press another key to learn what it does."), std::string::npos)
@@ -259,7 +259,7 @@ TEST(SpokenKeys, TheOperatorsChangeIsHeardAtOnce) {
 
   // The next visitor hears the new help key in the welcome.
   flow.tick(7.2 + 1000.0);
-  ASSERT_EQ(flow.state(), KioskState::Attract);
+  ASSERT_EQ(flow.view().state, KioskState::Attract);
   flow.handle_moved(2000.0);
   EXPECT_NE(fx.caption().find("Press the space bar for help."), std::string::npos) << fx.caption();
   flow.key(KioskKey::Help, 2001.0);

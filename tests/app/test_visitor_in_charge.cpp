@@ -110,7 +110,7 @@ struct Visit {
 
 TEST(VisitorInCharge, RepeatSaysTheLastMessageAgainAndPassesOverAcknowledgements) {
   Visit v;
-  ASSERT_EQ(v.flow.state(), KioskState::Picture);
+  ASSERT_EQ(v.flow.view().state, KioskState::Picture);
   v.flow.key(KioskKey::Describe, 3.0);
   const std::string description = v.fx.said.back();
   v.flow.key(KioskKey::Finer, 4.0);  // "More detail." is an acknowledgement
@@ -171,18 +171,18 @@ TEST(VisitorInCharge, WhereSaysWhatIsUnderTheHand) {
 TEST(VisitorInCharge, FinishPressedTwiceEndsTheVisit) {
   Visit v;
   v.flow.key(KioskKey::Next, 3.0);
-  ASSERT_EQ(v.flow.picture(), 1);
+  ASSERT_EQ(v.flow.view().picture, 1);
   v.flow.key(KioskKey::Finish, 4.0);
-  EXPECT_EQ(v.flow.state(), KioskState::Picture) << "one press only asks";
+  EXPECT_EQ(v.flow.view().state, KioskState::Picture) << "one press only asks";
   EXPECT_EQ(v.fx.said.back(), "Press the End key again to finish your visit.");
   EXPECT_EQ(v.fx.sessions, 0);
   v.flow.key(KioskKey::Finish, 4.0 + KioskFlow::kFinishConfirm_s - 0.1);
-  EXPECT_EQ(v.flow.state(), KioskState::Attract);
+  EXPECT_EQ(v.flow.view().state, KioskState::Attract);
   EXPECT_EQ(v.fx.sessions, 1) << "the operator's defaults again";
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::goodbye));
   // The next visitor starts from the beginning.
   v.flow.key(KioskKey::Next, 10.0);
-  EXPECT_EQ(v.flow.state(), KioskState::Tutorial);
+  EXPECT_EQ(v.flow.view().state, KioskState::Tutorial);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::welcome));
   v.flow.key(KioskKey::Repeat, 11.0);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::welcome)) << "Repeat never reaches the last visitor's words";
@@ -194,18 +194,18 @@ TEST(VisitorInCharge, OneFinishByAccidentLosesNothing) {
   // Too late for a second press: it asks again.
   v.flow.key(KioskKey::Finish, 4.0);
   v.flow.key(KioskKey::Finish, 4.0 + KioskFlow::kFinishConfirm_s + 0.5);
-  EXPECT_EQ(v.flow.state(), KioskState::Picture);
+  EXPECT_EQ(v.flow.view().state, KioskState::Picture);
   EXPECT_EQ(v.fx.said.back(), "Press the End key again to finish your visit.");
   // Another key in between: the next Finish asks again.
   v.flow.key(KioskKey::Where, 10.5);
   v.flow.key(KioskKey::Finish, 11.0);
-  EXPECT_EQ(v.flow.state(), KioskState::Picture);
-  EXPECT_EQ(v.flow.picture(), 1) << "the picture is still the one felt";
+  EXPECT_EQ(v.flow.view().state, KioskState::Picture);
+  EXPECT_EQ(v.flow.view().picture, 1) << "the picture is still the one felt";
   EXPECT_EQ(v.fx.sessions, 0);
   // Volume (next to it on the keypad) neither finishes nor cancels the question.
   v.flow.key(KioskKey::VolumeDown, 11.5);
   v.flow.key(KioskKey::Finish, 12.0);
-  EXPECT_EQ(v.flow.state(), KioskState::Attract);
+  EXPECT_EQ(v.flow.view().state, KioskState::Attract);
 }
 
 TEST(VisitorInCharge, FinerOrCoarserSaysOnceThatAutomaticDetailIsOffAndWhatBringsItBack) {
@@ -239,13 +239,13 @@ TEST(VisitorInCharge, HelpComesInTwoLayers) {
             "the left one of the four arrow keys, at the bottom right of the keyboard. Press the Right arrow for more "
             "help, the Left "
             "arrow to go back.");
-  EXPECT_TRUE(v.flow.in_help());
+  EXPECT_TRUE(v.flow.view().in_help);
   std::string every = group1;
   for (int g = 0; g < 10 && v.fx.said.back().find("That is every key.") == std::string::npos; ++g) {
     v.flow.key(KioskKey::Next, 4.1 + 0.1 * g);
     every += " " + v.fx.said.back();
   }
-  EXPECT_EQ(v.flow.picture(), 0) << "Next stepped through the help, not the pictures";
+  EXPECT_EQ(v.flow.view().picture, 0) << "Next stepped through the help, not the pictures";
   for (const char* key : {"the W key", "the D key", "the R key", "the P key", "the Up arrow", "the Down arrow",
                           "Page Up", "Page Down", "the G key", "the T key", "the End key", "F1"}) {
     EXPECT_NE(every.find(key), std::string::npos) << key << " in: " << every;
@@ -253,18 +253,18 @@ TEST(VisitorInCharge, HelpComesInTwoLayers) {
   EXPECT_NE(every.find("The End key is in the block of six keys above the arrow keys, the middle of its bottom row."),
             std::string::npos);
   v.flow.key(KioskKey::Previous, 5.5);
-  EXPECT_EQ(v.flow.picture(), 0) << "Previous goes back within the help";
+  EXPECT_EQ(v.flow.view().picture, 0) << "Previous goes back within the help";
   EXPECT_EQ(v.fx.said.back().rfind("Press the Up arrow for more detail", 0), std::string::npos);
   v.flow.key(KioskKey::Next, 5.6);  // back on the last group
   v.flow.key(KioskKey::Next, 5.7);  // past it: Next moves on again
-  EXPECT_FALSE(v.flow.in_help());
-  EXPECT_EQ(v.flow.picture(), 1);
+  EXPECT_FALSE(v.flow.view().in_help);
+  EXPECT_EQ(v.flow.view().picture, 1);
   v.flow.key(KioskKey::Previous, 5.8);
-  EXPECT_EQ(v.flow.picture(), 0);
+  EXPECT_EQ(v.flow.view().picture, 0);
   v.flow.key(KioskKey::Help, 5.9);
   v.flow.key(KioskKey::Help, 5.95);
   v.flow.key(KioskKey::Where, 5.97);  // any other key leaves the help
-  EXPECT_FALSE(v.flow.in_help());
+  EXPECT_FALSE(v.flow.view().in_help);
   v.flow.key(KioskKey::Help, 6.0);
   v.flow.key(KioskKey::Help, 6.05);
   v.flow.key(KioskKey::Help, 6.1);
@@ -282,7 +282,7 @@ TEST(VisitorInCharge, AStrayKeySaysItsNameNotTheWholeHelp) {
   v.flow.key(KioskKey::Other, 4.0, "O");  // no longer the operator's: a key like any other
   EXPECT_EQ(v.fx.said.back(), "That key does nothing here. Press F1 for help.")
       << "a key the catalogue has no spoken name for";
-  EXPECT_EQ(v.flow.picture(), 0);
+  EXPECT_EQ(v.flow.view().picture, 0);
 }
 
 TEST(VisitorInCharge, HoldingHelpNamesAKeyWithoutActing) {
@@ -294,32 +294,32 @@ TEST(VisitorInCharge, HoldingHelpNamesAKeyWithoutActing) {
   EXPECT_EQ(v.fx.said.back(),
             "The Right arrow: the next picture. The Right arrow is the right one of the four arrow keys, at the "
             "bottom right of the keyboard.");
-  EXPECT_EQ(v.flow.picture(), 0) << "named, not done";
+  EXPECT_EQ(v.flow.view().picture, 0) << "named, not done";
   v.flow.key(KioskKey::Finish, 3.4);
   EXPECT_EQ(v.fx.said.back(),
             "The End key: finish, and leave the kiosk for the next visitor. The End key is in the block of six keys "
             "above the arrow keys, the middle of its bottom row.")
       << "named, what it does, and where it lies";
-  EXPECT_EQ(v.flow.state(), KioskState::Picture);
+  EXPECT_EQ(v.flow.view().state, KioskState::Picture);
   v.flow.key(KioskKey::Other, 3.6, "Z");
   EXPECT_EQ(v.fx.said.back(), "The Z key does nothing here. Press F1 for help.");
   EXPECT_EQ(v.fx.keys_acting, acting) << "no key acted while Help was held";
   v.flow.help_held(false);
   v.flow.key(KioskKey::Next, 4.0);
-  EXPECT_EQ(v.flow.picture(), 1) << "let go: keys act again";
+  EXPECT_EQ(v.flow.view().picture, 1) << "let go: keys act again";
 }
 
 TEST(VisitorInCharge, TheTimeOutNeverCutsATextBeingRead) {
   Visit v;
   v.flow.key(KioskKey::Describe, 3.0);  // a long text: heard for 300 s
   for (double t = 3.0; t <= 303.0; t += 0.5) v.flow.tick(t);
-  EXPECT_EQ(v.flow.state(), KioskState::Picture) << "speech heard is activity";
-  EXPECT_FALSE(v.flow.warned());
+  EXPECT_EQ(v.flow.view().state, KioskState::Picture) << "speech heard is activity";
+  EXPECT_FALSE(v.flow.view().warned);
   v.fx.heard = false;  // the text ends at 303 s
   for (double t = 303.5; t < 303.0 + 100.0; t += 0.5) v.flow.tick(t);
-  EXPECT_FALSE(v.flow.warned()) << "the 120 s start when the reading ends";
+  EXPECT_FALSE(v.flow.view().warned) << "the 120 s start when the reading ends";
   v.flow.tick(303.0 + 101.0);
-  EXPECT_TRUE(v.flow.warned());
+  EXPECT_TRUE(v.flow.view().warned);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::timeout_warning, {{"seconds", "19"}}));
   EXPECT_NE(v.fx.said.back().find("Press any key for more time."), std::string::npos);
   EXPECT_NE(v.fx.said.back().find("this visit ends"), std::string::npos) << "what is at stake";
@@ -331,7 +331,7 @@ TEST(VisitorInCharge, TheTimeOutNeverCutsATextBeingRead) {
   v.flow.tick(414.0);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::timeout_warning, {{"seconds", "9"}}));
   for (double t = 414.5; t <= 424.0; t += 0.5) v.flow.tick(t);
-  EXPECT_EQ(v.flow.state(), KioskState::Attract);
+  EXPECT_EQ(v.flow.view().state, KioskState::Attract);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::goodbye));
 }
 
@@ -340,28 +340,28 @@ TEST(VisitorInCharge, PausedSpeechAndTouchingAShape) {
   v.flow.key(KioskKey::Describe, 3.0);
   v.flow.key(KioskKey::Pause, 4.0);  // paused: nobody is listening to it
   for (double t = 4.0; t < 104.0; t += 0.5) v.flow.tick(t);
-  EXPECT_FALSE(v.flow.warned());
+  EXPECT_FALSE(v.flow.view().warned);
   v.flow.tick(104.5);
-  EXPECT_TRUE(v.flow.warned()) << "a paused text holds no one's session";
+  EXPECT_TRUE(v.flow.view().warned) << "a paused text holds no one's session";
   // Sliding along a shape is activity (the window layer reports contact with motion): a hand feeling an
   // outline without moving 5 mm is there.
   for (double t = 105.0; t < 400.0; t += 0.5) {
     v.flow.touching(t);
     v.flow.tick(t);
   }
-  EXPECT_EQ(v.flow.state(), KioskState::Picture);
-  EXPECT_FALSE(v.flow.warned());
+  EXPECT_EQ(v.flow.view().state, KioskState::Picture);
+  EXPECT_FALSE(v.flow.view().warned);
 }
 
 TEST(VisitorInCharge, AnyKeyAfterTheWarningGivesMoreTime) {
   Visit v;
   v.flow.tick(103.0);  // 100 s idle since the walk: warned
-  ASSERT_TRUE(v.flow.warned());
+  ASSERT_TRUE(v.flow.view().warned);
   v.flow.key(KioskKey::Repeat, 105.0);
-  EXPECT_FALSE(v.flow.warned());
+  EXPECT_FALSE(v.flow.view().warned);
   v.fx.heard = false;  // what Repeat said is over at once
   for (double t = 105.0; t < 205.0; t += 1.0) v.flow.tick(t);
-  EXPECT_EQ(v.flow.state(), KioskState::Picture);
+  EXPECT_EQ(v.flow.view().state, KioskState::Picture);
 }
 
 TEST(VisitorInCharge, AttractInvitesEveryIntervalButNotInQuietHours) {
@@ -377,7 +377,7 @@ TEST(VisitorInCharge, AttractInvitesEveryIntervalButNotInQuietHours) {
   fx.quiet = true;
   for (double t = 90.5; t < 200.0; t += 0.5) flow.tick(t);
   EXPECT_EQ(fx.said.size(), 3u) << "none in quiet hours";
-  EXPECT_EQ(flow.state(), KioskState::Attract) << "an invitation is not a visitor";
+  EXPECT_EQ(flow.view().state, KioskState::Attract) << "an invitation is not a visitor";
   KioskFlow off(fx, en(), KioskFlowParams{120.0, 20.0, 0.5, 0.0});
   fx.quiet = false;
   for (double t = 0.0; t < 200.0; t += 0.5) off.tick(t);
@@ -390,7 +390,7 @@ TEST(VisitorInCharge, TheTutorialTeachesPushingThroughAndSaysWhyLevelsDoNothing)
   Speaker fx;
   KioskFlow flow(fx, en(), KioskFlowParams{120.0, 20.0, 0.5, 30.0});
   flow.handle_moved(1.0);
-  ASSERT_EQ(flow.state(), KioskState::Tutorial);
+  ASSERT_EQ(flow.view().state, KioskState::Tutorial);
   const std::size_t welcome = fx.said.size();
   flow.touching(1.5);
   EXPECT_EQ(fx.said.size(), welcome) << "never over the welcome";
@@ -419,21 +419,21 @@ TEST(VisitorInCharge, TheWelcomeIsShortAndPutsAShapeUnderTheHand) {
   ASSERT_EQ(fx.said.size(), 1u);
   EXPECT_EQ(fx.said[0],
             "Welcome. Feel the square with the handle. Press the Right arrow to move on. Press F1 for help.");
-  EXPECT_EQ(flow.state(), KioskState::Tutorial);
+  EXPECT_EQ(flow.view().state, KioskState::Tutorial);
 }
 
 TEST(VisitorInCharge, AFailedActionLeavesTheKioskAsItWasWithOneSorryLine) {
   Visit v;
   v.flow.key(KioskKey::Next, 3.0);
-  ASSERT_EQ(v.flow.picture(), 1);
+  ASSERT_EQ(v.flow.view().picture, 1);
   v.fx.fail_next_picture = true;
   v.flow.key(KioskKey::Next, 4.0);
-  EXPECT_EQ(v.flow.picture(), 1) << "the picture felt before stays, and the flow knows it";
-  EXPECT_EQ(v.flow.state(), KioskState::Picture);
+  EXPECT_EQ(v.flow.view().picture, 1) << "the picture felt before stays, and the flow knows it";
+  EXPECT_EQ(v.flow.view().state, KioskState::Picture);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::sorry));
-  EXPECT_EQ(v.flow.failures(), 1);
+  EXPECT_EQ(v.flow.view().failures, 1);
   v.flow.key(KioskKey::Next, 5.0);
-  EXPECT_EQ(v.flow.picture(), 2) << "and goes on from there";
+  EXPECT_EQ(v.flow.view().picture, 2) << "and goes on from there";
 }
 
 }  // namespace

@@ -120,12 +120,12 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
     const bool volume = k == KioskKey::VolumeUp || k == KioskKey::VolumeDown;
     const bool silent_answer = (volume && heard) || k == KioskKey::Pause;
     const std::string what = "seed " + std::to_string(p.seed) + ", frame " + std::to_string(frame) + ": key " +
-                             std::to_string(static_cast<int>(k)) + " (" + app::state_name(flow.state()) +
-                             (flow.source() == app::KioskSource::Stick ? ", on a stick" : "") +
-                             (flow.loading() ? ", a page awaited" : "") +
-                             (flow.picture_pending() ? ", a picture awaited" : "") + ") said nothing";
+                             std::to_string(static_cast<int>(k)) + " (" + app::state_name(flow.view().state) +
+                             (flow.view().source == app::KioskSource::Stick ? ", on a stick" : "") +
+                             (flow.view().loading ? ", a page awaited" : "") +
+                             (flow.view().picture_pending ? ", a picture awaited" : "") + ") said nothing";
     if (rt->voice().texts_said() != said || silent_answer) return;
-    if (flow.loading() || flow.picture_pending()) {
+    if (flow.view().loading || flow.view().picture_pending) {
       awaited.push_back({frame + answer_frames, said, what + " within " + std::to_string(answer_frames) + " frames"});
     } else {
       report.unanswered.push_back(what);
@@ -136,9 +136,10 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
       if (rt->voice().texts_said() > it->said) {
         it = awaited.erase(it);
       } else if (frame >= it->due_frame) {
-        report.unanswered.push_back(
-            it->what + "; then: " + app::state_name(flow.state()) + (flow.loading() ? ", a page awaited" : "") +
-            (flow.picture_pending() ? ", a picture awaited" : "") + "; last said: " + rt->voice().last_said());
+        report.unanswered.push_back(it->what + "; then: " + app::state_name(flow.view().state) +
+                                    (flow.view().loading ? ", a page awaited" : "") +
+                                    (flow.view().picture_pending ? ", a picture awaited" : "") +
+                                    "; last said: " + rt->voice().last_said());
         it = awaited.erase(it);
       } else {
         ++it;
@@ -168,10 +169,10 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   for (int frame = 0; frame < p.frames; ++frame) {
     const double now_s = frame / 60.0;
     if (frame < away_until) {
-      const bool was_attract = flow.state() == app::KioskState::Attract;
+      const bool was_attract = flow.view().state == app::KioskState::Attract;
       frame_step(now_s);
       check_awaited(frame);
-      if (!was_attract && flow.state() == app::KioskState::Attract) ++report.sessions_ended;
+      if (!was_attract && flow.view().state == app::KioskState::Attract) ++report.sessions_ended;
       continue;
     }
     if (chance(p.leave_per_frame)) {
@@ -211,10 +212,10 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
       rt->apply_settings(s, flow);
       ++report.panel_applies;
     }
-    const bool was_attract = flow.state() == app::KioskState::Attract;
+    const bool was_attract = flow.view().state == app::KioskState::Attract;
     frame_step(now_s);
     check_awaited(frame);
-    if (!was_attract && flow.state() == app::KioskState::Attract) ++report.sessions_ended;
+    if (!was_attract && flow.view().state == app::KioskState::Attract) ++report.sessions_ended;
   }
 
   // The visitor leaves: what was under way settles (a stick put in at the last moment is announced: it wakes
@@ -234,26 +235,27 @@ inline RandomVisitReport run_random_visit(const RandomVisitParams& p) {
   };
   settle(end_s);
   check_awaited(p.frames + answer_frames);
-  if (flow.state() != app::KioskState::Attract) {  // in Attract the first key would only wake the kiosk
-    flow.key(KioskKey::Finish, end_s);             // asks, or ends a visit whose Finish was asked a moment ago
-    if (flow.state() != app::KioskState::Attract) flow.key(KioskKey::Finish, end_s + 0.5);
+  if (flow.view().state != app::KioskState::Attract) {  // in Attract the first key would only wake the kiosk
+    flow.key(KioskKey::Finish, end_s);                  // asks, or ends a visit whose Finish was asked a moment ago
+    if (flow.view().state != app::KioskState::Attract) flow.key(KioskKey::Finish, end_s + 0.5);
   }
   settle(end_s + 0.5);
   auto expect = [&](bool ok, const std::string& what) {
     if (!ok)
       report.left_behind.push_back("seed " + std::to_string(p.seed) + ": " + what + " (" +
-                                   app::state_name(flow.state()) + "; last said: " + rt->voice().last_said() + ")");
+                                   app::state_name(flow.view().state) + "; last said: " + rt->voice().last_said() +
+                                   ")");
   };
-  expect(flow.state() == app::KioskState::Attract, "the kiosk is not waiting for a visitor");
-  expect(flow.source() == app::KioskSource::Library, "Next and Previous would still walk the stick");
+  expect(flow.view().state == app::KioskState::Attract, "the kiosk is not waiting for a visitor");
+  expect(flow.view().source == app::KioskSource::Library, "Next and Previous would still walk the stick");
   expect(!rt->sticks().busy(), "the stick is still 'working'");
   expect(!rt->library().busy(), "a picture is still awaited");
   expect(!rt->tour().running(), "a guided tour still runs");
-  expect(!flow.reading() && !flow.in_help() && !flow.capturing() && !flow.warned(),
+  expect(!flow.view().reading && !flow.view().in_help && !flow.view().capturing && !flow.view().warned,
          "reading, help, capture or a warning is still on");
   expect(rt->audio().volume().step() == settings.audio.volume_default_step, "the volume is not the operator's default");
   expect(rt->stage().auto_level(), "the level does not follow the hand again");
-  report.failures = flow.failures();
+  report.failures = flow.view().failures;
   return report;
 }
 

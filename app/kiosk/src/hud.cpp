@@ -8,7 +8,7 @@
 
 namespace hk::app {
 void draw_captions(KioskRuntime& app, const KioskFlow& flow, int fw, int fh) {
-  const std::string caption = flow.state() == KioskState::Attract
+  const std::string caption = flow.view().state == KioskState::Attract
                                   ? app.audio().messages().raw(audio::MessageId::attract)
                                   : app.voice().last_said();
   ImGui::SetNextWindowPos(ImVec2(0.05f * fw, 0.86f * fh));
@@ -27,7 +27,7 @@ void draw_overlay_status(KioskRuntime& app, const KioskFlow& flow) {
   ImGui::Begin("overlay", nullptr,
                ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoInputs |
                    ImGuiWindowFlags_NoSavedSettings);
-  ImGui::Text("state %s   picture %d   %s%s", state_name(flow.state()), flow.picture() + 1,
+  ImGui::Text("state %s   picture %d   %s%s", state_name(flow.view().state), flow.view().picture + 1,
               level_label(d.level).c_str(), d.auto_level ? " (auto)" : "");
   ImGui::Text("contact %d   curve %d   force %.2f N", static_cast<int>(d.state), d.curve, length(d.force_n));
   if (ServoThread* st = app.devices().servo()) {

@@ -318,7 +318,7 @@ void draw_frame(KioskRuntime& rt, KioskFlow& flow, OperatorSession& session, Ope
   const auto [fw, fh] = window.framebuffer_size();
   texture.update(rt.stage().shown());
   draw_scene(rt, make_view(fw, fh, rt.half()), texture);
-  if (flow.capturing()) preview.draw(rt.camera().preview(), make_view(fw, fh, rt.half()), rt.half());
+  if (flow.view().capturing) preview.draw(rt.camera().preview(), make_view(fw, fh, rt.half()), rt.half());
   window.begin_frame(scripted ? script.mouse() : std::nullopt);
   draw_captions(rt, flow, fw, fh);
   if (rt.switches().overlay() && session.state() != PanelState::open) draw_overlay_status(rt, flow);

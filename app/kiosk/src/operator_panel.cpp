@@ -321,7 +321,7 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
 void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, std::int64_t now_unix_s) {
   const config::Settings& s = runtime.settings();
   const ServoDisplayState& d = runtime.core().display();
-  ImGui::Text("Visitor: %s, picture %d, %s%s", state_name(flow.state()), flow.picture() + 1,
+  ImGui::Text("Visitor: %s, picture %d, %s%s", state_name(flow.view().state), flow.view().picture + 1,
               level_label(d.level).c_str(), d.auto_level ? " (from hand speed)" : " (fixed)");
   if (ServoThread* st = runtime.devices().servo()) {
     const ServoTimingStats t = st->stats();
@@ -342,7 +342,7 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, st
   ImGui::Text(
       "USB sticks: %s%s%s",
       runtime.sticks().service().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
-      flow.source() == KioskSource::Stick ? "; a stick is being browsed" : "",
+      flow.view().source == KioskSource::Stick ? "; a stick is being browsed" : "",
       runtime.sticks().busy() ? "; working" : "");
   record(runtime.sticks().busy() ? "sticks:working" : "sticks:idle");
   draw_stick_problems(runtime);

@@ -67,6 +67,28 @@ std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config:
   return args;
 }
 
+FlowView KioskFlow::view() const {
+  FlowView f;
+  f.state = v_.state;
+  f.tutorial_shape = v_.shape;
+  f.picture = v_.picture;
+  f.source = v_.source;
+  f.document = v_.doc;
+  f.page = v_.page;
+  f.stick_documents = v_.stick;
+  f.loading = v_.pending_doc >= 0;
+  f.picture_pending = v_.pending_picture >= 0;
+  f.capturing = v_.capturing;
+  f.warned = v_.warned;
+  f.in_help = v_.help_group >= 0;
+  f.reading = reading();
+  f.reading_place = v_.reading.place();
+  f.failures = failures_;
+  f.pending_document = v_.pending_doc;
+  f.pending_page = v_.pending_page;
+  return f;
+}
+
 std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageArg> args) const {
   return msg_.text(id, args, key_args(p_.keys));
 }

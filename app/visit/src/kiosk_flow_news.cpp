@@ -192,7 +192,7 @@ void KioskFlow::document_ready(const DocumentResult& r, double now_s) {
 
 void KioskFlow::document_ready_now(const DocumentResult& r, double now_s) {
   (void)now_s;
-  if (!awaits_document(r.document, r.page)) return;  // superseded
+  if (!view().awaits_document(r.document, r.page)) return;  // superseded
   v_.pending_doc = -1;
   const StickEntry& e = v_.stick[static_cast<std::size_t>(r.document)];
   // A PDF's own title, when it has a usable one, names it: "Page 1 of 3 of Annual report 2025."

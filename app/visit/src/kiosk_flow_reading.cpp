@@ -11,6 +11,10 @@ using audio::MessageId;
 
 // ---- reading a page's text by sentence and paragraph ---------------------------------------------------
 
+bool KioskFlow::reading() const {
+  return v_.reading_on && !v_.reading.empty() && fx_.speech.kept_texts() == v_.reading_kept;
+}
+
 void KioskFlow::follow_reading() {
   if (!reading()) return;
   const int piece = fx_.speech.heard_piece();

@@ -44,7 +44,7 @@ void StickDesk::poll(KioskFlow& flow, double now_s) {
     if (d.stick != stick_) continue;  // a stick taken out or forgotten meanwhile
     loaded(d, flow, now_s);
   }
-  if (flow.loading()) busy_ = true;
+  if (flow.view().loading) busy_ = true;
 }
 
 void StickDesk::inserted(StickNews& n, KioskFlow& flow, double now_s) {
@@ -63,14 +63,14 @@ void StickDesk::inserted(StickNews& n, KioskFlow& flow, double now_s) {
 
 void StickDesk::loaded(LoadedDocument& d, KioskFlow& flow, double now_s) {
   const int id = page_id(d.document, d.page);
-  if (rebuild_id_ == id && !flow.loading()) {
+  if (rebuild_id_ == id && !flow.view().loading) {
     // The page shown, rebuilt with new settings (rebuild_page): swapped in without a new announcement.
     rebuild_id_ = 0;
     if (d.scene) stage_.show(*d.scene, id, stage_.source(), {});
     busy_ = false;
     return;
   }
-  if (!flow.awaits_document(d.document, d.page)) return;  // superseded by a later Next or Previous: never felt
+  if (!flow.view().awaits_document(d.document, d.page)) return;  // superseded by a later Next or Previous: never felt
   DocumentResult r;
   r.document = d.document;
   r.page = d.page;
@@ -87,7 +87,7 @@ void StickDesk::loaded(LoadedDocument& d, KioskFlow& flow, double now_s) {
     stage_.show(is, id, ShownSource{-1, d.document, is.page}, {}, said_reading);
   } else {
     r.reason = d.reason;
-    const std::vector<StickEntry>& docs = flow.stick_documents();
+    const std::span<const StickEntry> docs = flow.view().stick_documents;
     const std::string name = d.document >= 0 && d.document < static_cast<int>(docs.size())
                                  ? docs[static_cast<std::size_t>(d.document)].name
                                  : "?";

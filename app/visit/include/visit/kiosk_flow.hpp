@@ -54,6 +54,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -149,6 +150,34 @@ inline constexpr double kWordsPerMinute = 165.0;
 /// synthesised, so a text of hours costs a pass over its bytes.
 double spoken_seconds(std::string_view text);
 
+/// Where the visit stands (KioskFlow::view), for the window, the operator's panel, the runtime and tests. A
+/// snapshot: `stick_documents` views the flow's list and holds until the flow is next called.
+struct FlowView {
+  KioskState state = KioskState::Attract;
+  TutorialShape tutorial_shape = TutorialShape::Square;  ///< the practice shape shown (Tutorial)
+  int picture = 0;                                       ///< the library picture shown or last shown (0-based)
+  KioskSource source = KioskSource::Library;             ///< where Next and Previous go
+  int document = -1;                                     ///< stick document shown (0-based), −1 before the first
+  int page = 1;                                          ///< its page (from 1)
+  std::span<const StickEntry> stick_documents;  ///< the stick's documents as the flow lists them (none without one)
+  bool loading = false;                         ///< a stick page is awaited
+  bool picture_pending = false;                 ///< a library picture is awaited (asked for, not yet on the device)
+  bool capturing = false;                       ///< a capture is under way
+  bool warned = false;                          ///< the time-out warning was said
+  bool in_help = false;  ///< the visitor is stepping through the help's groups (Next and Previous move in it)
+  /// Whether reading a page's text is what is being heard: the last text said is the reading and no other
+  /// text has been said since; `reading_place` is where it stands (the sentence heard last).
+  bool reading = false;
+  ReadingPlace reading_place;
+  int failures = 0;  ///< visitor actions that failed and were answered with the sorry line (logged), since the start
+  int pending_document = -1, pending_page = 1;  ///< the stick page awaited (loading)
+
+  /// Whether page `page` of stick document `document` is the load awaited (else a result for it is superseded).
+  bool awaits_document(int document_index, int page_number) const {
+    return source == KioskSource::Stick && pending_document == document_index && pending_page == page_number;
+  }
+};
+
 /// The state machine. Not thread-safe: call from the window thread.
 class KioskFlow {
  public:
@@ -160,10 +189,6 @@ class KioskFlow {
   static constexpr std::size_t kHelpSentencesPerGroup = 2;
   /// Describe says how long a text is before one that takes longer than this to say [s].
   static constexpr double kLongText_s = 30.0;
-  /// Where reading a page's text stands (the sentence heard last), and whether it is what is being read: the
-  /// last text said is the reading and no other text has been said since.
-  ReadingPlace reading_place() const { return v_.reading.place(); }
-  bool reading() const { return v_.reading_on && !v_.reading.empty() && fx_.speech.kept_texts() == v_.reading_kept; }
 
   KioskFlow(KioskEffects effects, const audio::MessageCatalog& messages, const KioskFlowParams& params = {});
 
@@ -198,8 +223,6 @@ class KioskFlow {
   /// the picture felt before stays.
   /// Next and Previous go on from `index`. Ignored unless it is the one awaited.
   void picture_failed(int index, const std::string& reason, double now_s);
-  /// A library picture is awaited (asked for, not yet on the device).
-  bool picture_pending() const { return v_.pending_picture >= 0; }
   /// The capture under way says `advice` (one of the capture_* messages, capture.hpp advice_message). Counts as
   /// activity (the visitor is busy placing the picture). Ignored when no capture is under way.
   void capture_advice(audio::MessageId advice, double now_s);
@@ -209,8 +232,6 @@ class KioskFlow {
   /// The capture under way ended without a picture: the camera failed (timeout = false) or the picture never
   /// lay still long enough (timeout = true). Said; the picture felt before stays.
   void capture_failed(bool timeout, double now_s);
-  /// A capture is under way.
-  bool capturing() const { return v_.capturing; }
   /// The operator changed the keys ([keys]): from now on every message names these (the next thing said
   /// already does). Does not speak and does not touch the session.
   void set_keys(const config::KeysSettings& keys) { p_.keys = keys; }
@@ -222,25 +243,8 @@ class KioskFlow {
   /// The text of `id` as the flow says it: `args` filled in, and every key placeholder naming the current key.
   std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) const;
 
-  KioskSource source() const { return v_.source; }
-  int document() const { return v_.doc; }  ///< stick document shown (0-based), −1 before the first
-  /// The stick's documents as the flow lists them (empty without a stick).
-  const std::vector<StickEntry>& stick_documents() const { return v_.stick; }
-  int page() const { return v_.page; }                  ///< its page (from 1)
-  bool loading() const { return v_.pending_doc >= 0; }  ///< a document load is awaited
-  /// Whether page `page` of stick document `document` is the load awaited (else a result for it is superseded).
-  bool awaits_document(int document, int page) const {
-    return v_.source == KioskSource::Stick && v_.pending_doc == document && v_.pending_page == page;
-  }
-
-  KioskState state() const { return v_.state; }
-  TutorialShape tutorial_shape() const { return v_.shape; }
-  int picture() const { return v_.picture; }
-  bool warned() const { return v_.warned; }
-  /// Visitor actions that failed and were answered with the sorry line (logged), since the start.
-  int failures() const { return failures_; }
-  /// Whether the visitor is stepping through the help's groups (Next and Previous move within it).
-  bool in_help() const { return v_.help_group >= 0; }
+  /// Where the visit stands.
+  FlowView view() const;
 
  private:
   /// Everything the flow knows of the visit, one value, so that a failed action can be undone whole.
@@ -292,6 +296,7 @@ class KioskFlow {
   void describe_key();
   void reading_key(KioskKey k);  // the sentence and paragraph keys
   void repeat_key();
+  bool reading() const;   // FlowView::reading
   void follow_reading();  // the place follows the sentence heard
   /// Reads from `at` to the end of its paragraph, after `before` (said first, in the same text).
   void read_from(ReadingPlace at, const std::string& before);
