@@ -108,7 +108,7 @@ class Kiosk final : public ScriptTarget {
 
   /// One event, real or scripted.
   void input(const InputEvent& e) override {
-    if (session_.captures_keyboard()) {
+    if (captures_keyboard(session_.state())) {
       session_.touch(now_s_);
       if (e.kind == InputEvent::Kind::key && e.action == GLFW_PRESS && e.key == GLFW_KEY_ESCAPE) {
         session_.close(unix_now_s());

@@ -132,12 +132,12 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
   ImGui::Begin("Operator panel", nullptr,
                ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoResize);
-  if (!s_.load_notice().empty()) {
+  if (!s_.files().load_notice.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
-    ImGui::TextWrapped("Settings file: %s", s_.load_notice().c_str());
+    ImGui::TextWrapped("Settings file: %s", s_.files().load_notice.c_str());
     ImGui::PopStyleColor();
   }
-  ImGui::TextColored(kGrey, "%s   audit: %s", s_.settings_path().c_str(), s_.audit_path().c_str());
+  ImGui::TextColored(kGrey, "%s   audit: %s", s_.files().settings_path.c_str(), s_.files().audit_path.c_str());
   const float actions_h = ImGui::GetFrameHeightWithSpacing() * 2.2f;
   ImGui::BeginChild("tabs", ImVec2(0, -actions_h));
   if (ImGui::BeginTabBar("groups")) {

@@ -24,15 +24,14 @@ std::string wait_text(double wait_s) {
 
 OperatorSession::OperatorSession(std::string settings_path, const config::Settings& in_use, std::string load_notice,
                                  ApplyFn apply)
-    : settings_path_(std::move(settings_path)),
-      load_notice_(std::move(load_notice)),
+    : files_{std::move(settings_path), {}, std::move(load_notice)},
       apply_fn_(std::move(apply)),
       in_use_(in_use),
       saved_(in_use),
       working_(in_use) {
-  if (!settings_path_.empty()) {
-    audit_path_ = config::audit_log_path(in_use, settings_path_);
-    verifier_ = std::make_unique<PinVerifier>(settings_path_);
+  if (!files_.settings_path.empty()) {
+    files_.audit_path = config::audit_log_path(in_use, files_.settings_path);
+    verifier_ = std::make_unique<PinVerifier>(files_.settings_path);
   }
   const std::size_t n = config::field_descriptors().size();
   edit_texts_.resize(n);
@@ -46,9 +45,9 @@ std::size_t OperatorSession::index_of(const config::FieldDescriptor& d) const {
 }
 
 void OperatorSession::audit_event(std::int64_t now_unix_s, const std::string& event) {
-  if (audit_path_.empty()) return;
+  if (files_.audit_path.empty()) return;
   try {
-    config::append_audit_event(audit_path_, now_unix_s, "panel", event);
+    config::append_audit_event(files_.audit_path, now_unix_s, "panel", event);
   } catch (const std::exception& e) {
     spdlog::error("operator panel: {}", e.what());
   }
@@ -57,7 +56,7 @@ void OperatorSession::audit_event(std::int64_t now_unix_s, const std::string& ev
 void OperatorSession::chord(double now_s, std::int64_t now_unix_s) {
   if (state_ != PanelState::closed && state_ != PanelState::notice) return;
   last_input_s_ = now_s;
-  if (settings_path_.empty()) {
+  if (files_.settings_path.empty()) {
     state_ = PanelState::notice;
     notice_until_s_ = now_s + kNoticeS;
     message_ =
@@ -68,7 +67,7 @@ void OperatorSession::chord(double now_s, std::int64_t now_unix_s) {
   }
   config::PinAttempt st;
   try {
-    st = config::pin_status(settings_path_, now_unix_s);
+    st = config::pin_status(files_.settings_path, now_unix_s);
   } catch (const std::exception& e) {
     state_ = PanelState::notice;
     notice_until_s_ = now_s + kNoticeS;
@@ -79,7 +78,7 @@ void OperatorSession::chord(double now_s, std::int64_t now_unix_s) {
   if (st.verdict == config::PinVerdict::no_pin) {
     state_ = PanelState::notice;
     notice_until_s_ = now_s + kNoticeS;
-    message_ = "No operator PIN is set. Set one with: haptic-kiosk pin set --config " + settings_path_;
+    message_ = "No operator PIN is set. Set one with: haptic-kiosk pin set --config " + files_.settings_path;
     spdlog::warn("operator panel: {}", message_);
     return;
   }
@@ -131,7 +130,7 @@ void OperatorSession::tick(double now_s, std::int64_t now_unix_s) {
           case config::PinVerdict::no_pin:
             state_ = PanelState::notice;
             notice_until_s_ = now_s + kNoticeS;
-            message_ = "No operator PIN is set. Set one with: haptic-kiosk pin set --config " + settings_path_;
+            message_ = "No operator PIN is set. Set one with: haptic-kiosk pin set --config " + files_.settings_path;
             return;
         }
         wait_s_ = o->attempt.wait_s;
@@ -189,9 +188,9 @@ std::string OperatorSession::apply(std::int64_t now_unix_s) {
   if (changes.empty()) return status_ = "Nothing to apply.";
   status_ = apply_fn_ ? apply_fn_(working_) : std::string("Applied.");
   in_use_ = working_;
-  if (!audit_path_.empty()) {
+  if (!files_.audit_path.empty()) {
     try {
-      config::append_audit(audit_path_, now_unix_s, "panel", changes);
+      config::append_audit(files_.audit_path, now_unix_s, "panel", changes);
     } catch (const std::exception& e) {
       spdlog::error("operator panel: {}", e.what());
       status_ += " (" + std::string(e.what()) + ")";
@@ -207,11 +206,11 @@ std::string OperatorSession::save(std::int64_t now_unix_s) {
   try {
     // A `pin set` made while the panel was open must not be undone: the hash on disk wins.
     try {
-      to_save.operator_.pin_hash = config::load_settings(settings_path_).operator_.pin_hash;
+      to_save.operator_.pin_hash = config::load_settings(files_.settings_path).operator_.pin_hash;
     } catch (const config::ConfigError&) {
       // The file on disk is unreadable: ours is the one to write.
     }
-    config::save_settings_atomic(to_save, settings_path_);
+    config::save_settings_atomic(to_save, files_.settings_path);
   } catch (const std::exception& e) {
     status_ = std::string("Not saved: ") + e.what();
     spdlog::error("operator panel: {}", e.what());
@@ -220,9 +219,9 @@ std::string OperatorSession::save(std::int64_t now_unix_s) {
   in_use_.operator_.pin_hash = to_save.operator_.pin_hash;
   working_.operator_.pin_hash = to_save.operator_.pin_hash;
   saved_ = in_use_;
-  status_ = "Saved to " + settings_path_ + " (the previous file kept as .bak).";
-  spdlog::info("operator panel: saved {}", settings_path_);
-  audit_event(now_unix_s, "saved " + settings_path_);
+  status_ = "Saved to " + files_.settings_path + " (the previous file kept as .bak).";
+  spdlog::info("operator panel: saved {}", files_.settings_path);
+  audit_event(now_unix_s, "saved " + files_.settings_path);
   return status_;
 }
 

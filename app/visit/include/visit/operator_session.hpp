@@ -34,6 +34,18 @@ enum class PanelState {
   open,       ///< the settings and the live status
 };
 
+/// True while the keyboard belongs to the panel in state `s` (prompt or panel): visitor keys are not acted on.
+inline bool captures_keyboard(PanelState s) {
+  return s == PanelState::pin_entry || s == PanelState::checking || s == PanelState::open;
+}
+
+/// The files an operator session works on, and what start-up found wrong with the settings file.
+struct SessionFiles {
+  std::string settings_path;  ///< the settings file (empty: the kiosk runs on defaults)
+  std::string audit_path;     ///< the audit log beside it
+  std::string load_notice;    ///< what start-up found wrong with the settings file; empty when it loaded
+};
+
 /// The operator's panel's state and actions.
 class OperatorSession {
  public:
@@ -62,10 +74,6 @@ class OperatorSession {
   void close(std::int64_t now_unix_s);
 
   PanelState state() const { return state_; }
-  /// True while the keyboard belongs to the panel (prompt or panel): visitor keys are not acted on.
-  bool captures_keyboard() const {
-    return state_ == PanelState::pin_entry || state_ == PanelState::checking || state_ == PanelState::open;
-  }
   /// The line shown under the PIN prompt or as the notice ("Wrong PIN. 2 failed attempts.", "Try again in 27 s.").
   const std::string& message() const { return message_; }
   /// Seconds until a PIN is heard (0 = now); infinity when locked until `pin set`.
@@ -96,18 +104,15 @@ class OperatorSession {
   void reset_to_defaults(std::int64_t now_unix_s);
   /// The last status line (apply, save, reset).
   const std::string& status() const { return status_; }
-  /// What start-up found wrong with the settings file; empty when it loaded.
-  const std::string& load_notice() const { return load_notice_; }
-  /// The settings file and the audit log in use.
-  const std::string& settings_path() const { return settings_path_; }
-  const std::string& audit_path() const { return audit_path_; }
+  /// The settings file and the audit log in use, and what start-up found wrong with the file.
+  const SessionFiles& files() const { return files_; }
 
  private:
   void open_panel(double now_s, std::int64_t now_unix_s);
   void audit_event(std::int64_t now_unix_s, const std::string& event);
   std::size_t index_of(const config::FieldDescriptor& d) const;
 
-  std::string settings_path_, audit_path_, load_notice_;
+  SessionFiles files_;
   ApplyFn apply_fn_;
   std::unique_ptr<PinVerifier> verifier_;
   PanelState state_ = PanelState::closed;
