@@ -210,10 +210,7 @@ int run(const SoakOptions& o) {
   ro.probe_usb_device = false;
   ro.device = o.device == "sim" ? std::string() : o.device;
   hk::app::KioskRuntime rt(ro, s);
-  hk::app::KioskFlowParams fp;
-  fp.timeout_s = s.kiosk.timeout_s;
-  fp.warning_s = s.kiosk.warning_s;
-  fp.keys = s.keys;
+  const hk::app::KioskFlowParams fp = hk::app::flow_params_from(s, false);
   hk::app::KioskFlow flow(rt.effects(), rt.audio().messages(), fp);
   Script script(rt, flow, s, o.seed);
   script.stick_dir_ = o.stick;

@@ -4,6 +4,7 @@
 
 #include "audio/wav.hpp"
 #include "config/load.hpp"
+#include "runtime/runtime_params.hpp"
 
 namespace hk::app {
 
@@ -26,9 +27,8 @@ std::string run_speak(const SpeakOptions& o) {
                           keys);
     }
   }
-  audio::SpeechParams sp;
+  audio::SpeechParams sp = audio_params_from(s).speech;
   sp.voice = catalog.voice();
-  sp.rate_wpm = s.audio.speech_rate_wpm;
   const std::vector<float> samples = audio::synthesize_speech(text, sp);
   audio::write_wav(o.wav_path, samples, audio::kSampleRateHz);
   return text;

@@ -468,9 +468,7 @@ void write_earcons(const std::filesystem::path& out, const std::string& audio_ou
     csv += line;
   }
   write_text(out / "cues.csv", csv);
-  audio::MixerParams mp;
-  mp.earcons.gain = s.audio.earcon_gain;
-  mp.duck_db = s.audio.duck_db;
+  const audio::MixerParams mp = audio_params_from(s).mixer;
   const std::vector<float> wav =
       audio::render_cue_timeline(rec.cues, period_s, static_cast<double>(rec.sum.ticks) * period_s, mp);
   audio::write_wav(audio_out, wav, audio::kSampleRateHz);

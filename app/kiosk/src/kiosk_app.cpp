@@ -272,17 +272,6 @@ RuntimeOptions runtime_options(const KioskOptions& o, const config::Settings& se
   return ro;
 }
 
-/// The visitor's flow's timing and keys from the settings in use; `camera`: whether a camera was found.
-KioskFlowParams flow_params(const config::Settings& settings, bool camera) {
-  KioskFlowParams fp;
-  fp.timeout_s = settings.kiosk.timeout_s;
-  fp.warning_s = settings.kiosk.warning_s;
-  fp.attract_every_s = settings.kiosk.attract_every_s;
-  fp.keys = settings.keys;
-  fp.camera = camera;
-  return fp;
-}
-
 /// Starts the servo thread, says which device and camera are in use, and takes --stick and --show.
 void start_kiosk(const KioskOptions& o, const RuntimeOptions& ro, KioskRuntime& rt, KioskFlow& flow) {
   rt.start_servo();
@@ -335,7 +324,7 @@ int run_kiosk(const KioskOptions& o) {
 
   const RuntimeOptions ro = runtime_options(o, start.settings);
   KioskRuntime rt(ro, start.settings);
-  KioskFlow flow(rt.effects(), rt.audio().messages(), flow_params(start.settings, rt.camera().available()));
+  KioskFlow flow(rt.effects(), rt.audio().messages(), flow_params_from(start.settings, rt.camera().available()));
 
   KioskWindow window(o.windowed);
   const int picture_side = [&] {

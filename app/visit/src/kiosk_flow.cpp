@@ -67,6 +67,16 @@ std::array<audio::KeyArg, audio::kKeyPlaceholders.size()> key_args(const config:
   return args;
 }
 
+KioskFlowParams flow_params_from(const config::Settings& s, bool camera) {
+  KioskFlowParams fp;
+  fp.timeout_s = s.kiosk.timeout_s;
+  fp.warning_s = s.kiosk.warning_s;
+  fp.attract_every_s = s.kiosk.attract_every_s;
+  fp.keys = s.keys;
+  fp.camera = camera;
+  return fp;
+}
+
 FlowView KioskFlow::view() const {
   FlowView f;
   f.state = v_.state;

@@ -150,6 +150,10 @@ inline constexpr double kWordsPerMinute = 165.0;
 /// synthesised, so a text of hours costs a pass over its bytes.
 double spoken_seconds(std::string_view text);
 
+/// The flow's parameters from the settings ([kiosk] timeout_s, warning_s, attract_every_s; [keys]); `camera`:
+/// whether there is a camera to capture from.
+KioskFlowParams flow_params_from(const config::Settings& s, bool camera);
+
 /// Where the visit stands (KioskFlow::view), for the window, the operator's panel, the runtime and tests. A
 /// snapshot: `stick_documents` views the flow's list and holds until the flow is next called.
 struct FlowView {
