@@ -54,9 +54,9 @@ int main(int argc, char** argv) {
     app::CueTracker tracker(ctp);
     std::vector<audio::CueEvent> cues;
     const double duration = 20.0;
-    app::run_simulation(*is.scene, s, hand, duration, [&](const app::TickRecord& r, const ServoOutput& so) {
+    app::run_simulation(*is.scene, s, hand, duration, [&](const app::ServoTick& r, const ServoOutput& so) {
       audio::CueEvent c[app::CueTracker::kMaxCuesPerTick];
-      const int n = tracker.update(r.index, so, r.handle_m, s.haptics.level, c);
+      const int n = tracker.update(r.index, so, r.sample.handle_m, s.haptics.level, c);
       cues.insert(cues.end(), c, c + n);
     });
     const std::vector<float> x = audio::render_cue_timeline(cues, ctp.period_s, duration);

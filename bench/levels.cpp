@@ -75,14 +75,14 @@ int main(int argc, char** argv) {
     long changes = 0, waiting = 0, episode = 0;
     std::vector<double> waits_ms;  // how long each wanted change waited for a safe moment [ms]
     std::vector<long> level_ticks(static_cast<std::size_t>(levels), 0);
-    app::run_simulation(sc, s, hand, hand.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
+    app::run_simulation(sc, s, hand, hand.duration_s(), [&](const app::ServoTick& r, const ServoOutput& so) {
       const double v = length(so.handle_velocity_m_per_s);
       std::size_t b = 0;
       while (b + 2 < bin_edges.size() && v >= bin_edges[b + 1]) ++b;
       const auto l = static_cast<std::size_t>(std::clamp(so.level, 0, levels - 1));
       ++hist[b][l];
       ++level_ticks[l];
-      tick_us.push_back(1e-3 * static_cast<double>(r.tick_ns));
+      tick_us.push_back(1e-3 * static_cast<double>(r.step_ns));
       changes += so.level_changed;
       waiting += so.level != so.level_wanted;
       if (so.level != so.level_wanted) {

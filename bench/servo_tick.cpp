@@ -83,9 +83,9 @@ RunTrace run_once(const Scene& scene, const config::Settings& s, const std::stri
   t.handle_m.reserve(ns.capacity());
   long contact = 0;
   double level_sum = 0;
-  const app::TickObserver observe = [&](const app::TickRecord& r, const ServoOutput& so) {
-    ns.push_back(r.tick_ns);
-    t.handle_m.push_back(r.handle_m);
+  const app::TickObserver observe = [&](const app::ServoTick& r, const ServoOutput& so) {
+    ns.push_back(r.step_ns);
+    t.handle_m.push_back(r.sample.handle_m);
     contact += so.contact.state != ContactState::Free ? 1 : 0;
     level_sum += so.level;
   };

@@ -38,9 +38,9 @@ inline std::vector<Sweep> explore_stream(const Scene& scene, const config::Setti
   std::vector<Sweep> out;
   Vec2 prev{};
   bool first = true;
-  app::run_simulation(scene, s, path, path.duration_s(), [&](const app::TickRecord& r, const ServoOutput&) {
-    if (!first) out.push_back({prev, r.handle_m});
-    prev = r.handle_m;
+  app::run_simulation(scene, s, path, path.duration_s(), [&](const app::ServoTick& r, const ServoOutput&) {
+    if (!first) out.push_back({prev, r.sample.handle_m});
+    prev = r.sample.handle_m;
     first = false;
   });
   return out;

@@ -44,7 +44,7 @@ BoardRun raster_on_board(config::Settings s, double hand_force_n, double seconds
   const double limit = s.device.torque_limit_n_m;
   run_simulation(
       *is.scene, s, path, seconds,
-      [&](const TickRecord& rec, const ServoOutput& so) {
+      [&](const ServoTick& rec, const ServoOutput& so) {
         const double f = length(so.force_n);
         r.max_force_n = std::max(r.max_force_n, f);
         if (f > 0.05) {

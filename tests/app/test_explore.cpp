@@ -166,15 +166,15 @@ TEST_P(RasterNeverCrosses, ProxyStaysOnItsSideOfEveryWall) {
       raster_path(s.workspace.width_m, s.workspace.height_m, s.hand.raster_spacing_m, s.hand.raster_speed_m_per_s);
   test::CrossingGrid grid(sc, s.haptics.level);
   long crossings = 0, contact_ticks = 0, vertex_ticks = 0, bad_force = 0;
-  app::run_simulation(sc, s, path, path.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
+  app::run_simulation(sc, s, path, path.duration_s(), [&](const app::ServoTick& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     for (int m = 1; m < c.path_count; ++m) {
       const int n = grid.crossings(c.path_m[m - 1], c.path_m[m]);
       if (n && getenv("HK_DEBUG")) {
         fprintf(stderr, "tick %ld move %d/%d crossings %d state %d ev %x h(%.9g,%.9g) c0 %d/%d/%d c1 %d/%d/%d\n",
-                r.index, m, c.path_count, n, (int)c.state, c.events, r.handle_m.x, r.handle_m.y, c.constraint[0].curve,
-                c.constraint[0].level, c.constraint[0].segment, c.constraint[1].curve, c.constraint[1].level,
-                c.constraint[1].segment);
+                r.index, m, c.path_count, n, (int)c.state, c.events, r.sample.handle_m.x, r.sample.handle_m.y,
+                c.constraint[0].curve, c.constraint[0].level, c.constraint[0].segment, c.constraint[1].curve,
+                c.constraint[1].level, c.constraint[1].segment);
         for (int q = 0; q < c.path_count; ++q)
           fprintf(stderr, "   p%d (%.12g, %.12g)\n", q, c.path_m[q].x, c.path_m[q].y);
       }
@@ -184,7 +184,7 @@ TEST_P(RasterNeverCrosses, ProxyStaysOnItsSideOfEveryWall) {
     vertex_ticks += c.state == ContactState::Vertex;
     // Force = stiffness · separation, up to the clamp (and the start-up ramp).
     const double expect =
-        std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
+        std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.sample.handle_m), s.haptics.max_force_n);
     if (r.t_s > s.haptics.force_ramp_s && std::abs(length(so.force_n) - expect) > 1e-6) ++bad_force;
   });
   EXPECT_EQ(crossings, 0);
@@ -214,7 +214,7 @@ TEST_P(RasterPushThrough, AGentleHandNeverPopsAHardOneOnlyOnPopTicks) {
     test::CrossingGrid grid(sc, s.haptics.level);
     const long release_ticks = std::lround(s.haptics.pop_release_s * s.haptics.servo_rate_hz);
     long pops = 0, pops_that_cross = 0, crossings_without_pop = 0, bad_force = 0, since_pop = 1L << 30;
-    app::run_simulation(sc, s, path, path.duration_s(), [&](const app::TickRecord& r, const ServoOutput& so) {
+    app::run_simulation(sc, s, path, path.duration_s(), [&](const app::ServoTick& r, const ServoOutput& so) {
       const ContactOutput& c = so.contact;
       int n = 0;
       for (int m = 1; m < c.path_count; ++m) n += grid.crossings(c.path_m[m - 1], c.path_m[m]);
@@ -224,7 +224,7 @@ TEST_P(RasterPushThrough, AGentleHandNeverPopsAHardOneOnlyOnPopTicks) {
       if (!pop) crossings_without_pop += n;
       since_pop = pop ? 0 : since_pop + 1;
       const double expect =
-          std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
+          std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.sample.handle_m), s.haptics.max_force_n);
       if (r.t_s > s.haptics.force_ramp_s && since_pop >= release_ticks && std::abs(length(so.force_n) - expect) > 1e-6)
         ++bad_force;
     });

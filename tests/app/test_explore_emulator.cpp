@@ -66,7 +66,7 @@ struct RunChecks {
 // Runs `choice` on `image` with a pushing raster hand for `duration_s`; counts crossings (independent grid),
 // force-law violations (Ok ticks after the ramp) and torques that are non-finite or over the limit.
 RunChecks run_checked(const std::string& image, const std::string& device, double duration_s, app::DeviceReport* report,
-                      const std::function<void(const app::TickRecord&, const ServoOutput&)>& extra = {}) {
+                      const std::function<void(const app::ServoTick&, const ServoOutput&)>& extra = {}) {
   config::Settings s;
   s.hand.raster_spacing_m = 0.008;
   s.hand.raster_speed_m_per_s = 0.12;
@@ -81,15 +81,15 @@ RunChecks run_checked(const std::string& image, const std::string& device, doubl
   double ok_since_s = 0.0;
   app::run_simulation(
       sc, s, path, duration_s,
-      [&](const app::TickRecord& r, const ServoOutput& so) {
+      [&](const app::ServoTick& r, const ServoOutput& so) {
         ++rc.ticks;
         const ContactOutput& c = so.contact;
         for (int m = 1; m < c.path_count; ++m) rc.crossings += grid.crossings(c.path_m[m - 1], c.path_m[m]);
         rc.contact_ticks += c.state != ContactState::Free;
-        if (r.device_status != DeviceStatus::Ok) ok_since_s = r.t_s + s.haptics.force_ramp_s;
+        if (r.sample.status != DeviceStatus::Ok) ok_since_s = r.t_s + s.haptics.force_ramp_s;
         const double expect =
-            std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.handle_m), s.haptics.max_force_n);
-        if (r.device_status == DeviceStatus::Ok && r.t_s > std::max(ok_since_s, s.haptics.force_ramp_s) &&
+            std::min(s.haptics.stiffness_n_per_m * distance(c.proxy_m, r.sample.handle_m), s.haptics.max_force_n);
+        if (r.sample.status == DeviceStatus::Ok && r.t_s > std::max(ok_since_s, s.haptics.force_ramp_s) &&
             std::abs(length(so.force_n) - expect) > 1e-6)
           ++rc.bad_force;
         for (double t : r.motor_torque_n_m)
@@ -128,7 +128,7 @@ TEST(EmulatedDevice, UnpluggedMidRunGetsZeroForceAndTorqueAndEndsLost) {
   long late_force = 0, late_torque = 0, late_ticks = 0;
   app::DeviceReport rep;
   const RunChecks rc = run_checked("horse.png", "haply-emulator:disconnect_at_s=1", 2.0, &rep,
-                                   [&](const app::TickRecord& r, const ServoOutput& so) {
+                                   [&](const app::ServoTick& r, const ServoOutput& so) {
                                      if (r.t_s <= quiet_after) return;
                                      ++late_ticks;
                                      late_force += so.force_n.x != 0.0 || so.force_n.y != 0.0;
@@ -181,7 +181,7 @@ TEST(EmulatedDevice, AStallIsLostThenBackWithTheForceRampedIn) {
   long lost = 0;
   const RunChecks rc =
       run_checked("horse.png", "haply-emulator:stall_at_s=1,stall_s=0.05", 2.5, &rep,
-                  [&](const app::TickRecord& r, const ServoOutput&) { lost += r.device_status == DeviceStatus::Lost; });
+                  [&](const app::ServoTick& r, const ServoOutput&) { lost += r.sample.status == DeviceStatus::Lost; });
   EXPECT_GT(lost, 0);
   EXPECT_EQ(rep.status, "ok");
   EXPECT_EQ(rep.reconnects, 1);

@@ -123,7 +123,7 @@ TEST(Explorer, TracesASquareInsideASquare) {
   ep.pop_hold_s = s.haptics.pop_hold_s;
   ExplorerHand hand(ep);
   app::CoverageMeter outer(0.001), inner(0.001);
-  app::run_simulation(sc, s, hand, 60.0, [&](const app::TickRecord&, const ServoOutput& so) {
+  app::run_simulation(sc, s, hand, 60.0, [&](const app::ServoTick&, const ServoOutput& so) {
     outer.add(so.contact.proxy_m);
     inner.add(so.contact.proxy_m);
   });

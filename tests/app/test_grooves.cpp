@@ -47,17 +47,17 @@ Continuity run_and_check(const Scene& sc, const config::Settings& s, const HandP
   Continuity c;
   Vec2 prev_f{0, 0}, prev_h;
   bool first = true;
-  app::run_simulation(sc, s, hand, seconds, [&](const app::TickRecord& r, const ServoOutput& so) {
-    if (first) prev_h = r.handle_m;
+  app::run_simulation(sc, s, hand, seconds, [&](const app::ServoTick& r, const ServoOutput& so) {
+    if (first) prev_h = r.sample.handle_m;
     first = false;
-    const double df = distance(so.force_n, prev_f), lip = k * distance(r.handle_m, prev_h);
+    const double df = distance(so.force_n, prev_f), lip = k * distance(r.sample.handle_m, prev_h);
     c.over_limit += df > lip + jump + 1e-9;
     c.worst_excess_n = std::max(c.worst_excess_n, df - lip);
     c.contact_ticks += so.contact.state != ContactState::Free;
     c.level_changes += so.level_changed;
     ++c.ticks;
     prev_f = so.force_n;
-    prev_h = r.handle_m;
+    prev_h = r.sample.handle_m;
   });
   return c;
 }

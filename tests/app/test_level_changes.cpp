@@ -96,7 +96,7 @@ void level_changes_hold(const char* name, const std::string& level_mode, Hand wh
   Vec2 prev_force, prev_handle, prev_gap;
   bool prev_unclamped = false;
   long pops = 0, release_left = 0;
-  const app::TickObserver observe = [&](const app::TickRecord& r, const ServoOutput& so) {
+  const app::TickObserver observe = [&](const app::ServoTick& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     const bool pop = (c.events & kEventPopThrough) != 0;
     pops += pop;
@@ -124,12 +124,12 @@ void level_changes_hold(const char* name, const std::string& level_mode, Hand wh
     // The force may jump at a change by no more than the configured step (plus what the hand's own motion
     // does: stiffness × its displacement) ...
     if (so.level_changed && r.index > 0 && release_left == 0) {
-      if (distance(so.force_n, prev_force) > step + k * distance(r.handle_m, prev_handle) + 1e-9) ++force_steps;
+      if (distance(so.force_n, prev_force) > step + k * distance(r.sample.handle_m, prev_handle) + 1e-9) ++force_steps;
     }
     // ... and the force leaves the spring law of the new level (stiffness × (proxy − handle)) only by a
     // difference made at the change tick that then shrinks by at most the step per tick (unclamped ticks
     // after the start-up ramp).
-    const Vec2 spring = k * (c.proxy_m - r.handle_m);
+    const Vec2 spring = k * (c.proxy_m - r.sample.handle_m);
     const Vec2 gap = so.force_n - spring;
     const bool unclamped =
         length(spring) < s.haptics.max_force_n - 1e-6 && length(so.force_n) < s.haptics.max_force_n - 1e-6;
@@ -141,7 +141,7 @@ void level_changes_hold(const char* name, const std::string& level_mode, Hand wh
     prev_unclamped = unclamped;
     prev_level = so.level;
     prev_force = so.force_n;
-    prev_handle = r.handle_m;
+    prev_handle = r.sample.handle_m;
   };
   const long ticks = which == Hand::Explorer ? app::run_simulation(sc, s, explorer, 60.0, observe)
                                              : app::run_simulation(sc, s, hand, hand.duration_s(), observe);

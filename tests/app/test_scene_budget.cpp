@@ -1,5 +1,5 @@
 // The scene budget: a cluttered photo stays within the segment budget, and the kept
-// curves are the most salient ones (long and strong, image_scene.hpp curve_salience) — checked against
+// curves are the most salient ones (long and strong, tests/support/curve_salience.hpp) — checked against
 // the unbudgeted scene with an independent greedy replay of the documented rule, on a synthetic
 // picture where strength must beat length, and on a real photo.
 #include <gtest/gtest.h>
@@ -15,13 +15,14 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "curve_salience.hpp"
 #include "pictures/image_scene.hpp"
 #include "test_paths.hpp"
 
 namespace hk::app {
 namespace {
 
-using vision::curve_salience;
+using hk::test::curve_salience;
 
 namespace fs = std::filesystem;
 

@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "curve_salience.hpp"
 #include "kiosk_exe.hpp"
 #include "pictures/image_scene.hpp"
 
@@ -23,9 +24,9 @@ namespace hk::app {
 namespace {
 
 namespace fs = std::filesystem;
+using hk::test::curve_salience;
 using test::fresh_dir;
 using test::test_images;
-using vision::curve_salience;
 using vision::shape_salience;
 
 /// Σ strength × length over the curves of a scene [threshold units · m].

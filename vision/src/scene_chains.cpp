@@ -57,12 +57,6 @@ double enclosed_area_m2(const std::vector<cv::Point2d>& points_m) {
   return 0.5 * std::abs(twice);
 }
 
-double curve_salience(double length_m, double strength, double canny_high) {
-  if (!std::isfinite(length_m) || !std::isfinite(strength) || !std::isfinite(canny_high) || canny_high <= 0.0)
-    return 0.0;
-  return length_m * std::clamp(strength / canny_high, 0.0, 1.0);
-}
-
 double shape_salience(const ShapeFeatures& f, double canny_high) {
   if (!std::isfinite(f.area_m2) || f.area_m2 < 0.0) return 0.0;
   if (!std::isfinite(f.length_m) || !std::isfinite(f.strength) || !std::isfinite(canny_high) || canny_high <= 0.0)

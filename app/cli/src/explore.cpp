@@ -250,14 +250,14 @@ struct RunRecord {
   std::array<long, kLevelIds> level_ticks{};  // per level id (levels and tolerance steps)
   CoverageMeter coverage{0.001};
 
-  void add(const TickRecord& r, const ServoOutput& so) {
+  void add(const ServoTick& r, const ServoOutput& so) {
     const ContactOutput& c = so.contact;
     const int state = static_cast<int>(c.state);
     const int curve = c.state == ContactState::Free ? -1 : c.constraint[0].curve;
     const int pop = (c.events & kEventPopThrough) != 0;
-    rows.push_back({r.t_s, r.handle_m, c.proxy_m, so.force_n, state, curve, c.level, r.tick_ns, pop});
+    rows.push_back({r.t_s, r.sample.handle_m, c.proxy_m, so.force_n, state, curve, c.level, r.step_ns, pop});
     pops += pop;
-    tick_ns.push_back(r.tick_ns);
+    tick_ns.push_back(r.step_ns);
     proxy_path.push_back(c.proxy_m);
     coverage.add(c.proxy_m, curve, c.state == ContactState::Vertex ? c.constraint[1].curve : -1);
     ++sum.ticks;
@@ -290,7 +290,7 @@ void run_servo(const Scene& scene, const ImageScene& is, const config::Settings&
   run.text_blocks_m = text_block_regions(is.text_blocks);
   run_simulation(
       scene, s, hand, duration_s,
-      [&](const TickRecord& r, const ServoOutput& so) {
+      [&](const ServoTick& r, const ServoOutput& so) {
         for (audio::CueEvent e; cue_ring.try_pop(e);) rec.cues.push_back(e);
         rec.add(r, so);
       },

@@ -31,8 +31,8 @@ double percentile_us(const std::array<std::atomic<std::uint32_t>, 2048>& h, doub
 
 }  // namespace
 
-ServoThread::ServoThread(ServoStep& core, Device& device, const ServoThreadParams& params, AfterTick after_tick)
-    : core_(core), device_(device), params_(params), after_tick_(std::move(after_tick)) {
+ServoThread::ServoThread(ServoStep& core, Device& device, const ServoThreadParams& params, PlantStep plant_step)
+    : core_(core), device_(device), params_(params), plant_step_(std::move(plant_step)) {
   if (!(params.rate_hz >= 100 && params.rate_hz <= 10000)) {
     throw hk::ArgumentError("servo rate " + std::to_string(params.rate_hz) + " Hz is outside [100, 10000] Hz");
   }
@@ -53,7 +53,7 @@ void ServoThread::run() {
   DeadlineClock clock(period_ns, stop_);
   ServoRunner runner(core_, device_);
   runner.run(clock, [this, period_s](ServoTick& t) {
-    if (after_tick_) after_tick_(period_s);
+    if (plant_step_) plant_step_(period_s);
     record(t, monotonic_ns() - t.woke_ns);
   });
 }

@@ -18,7 +18,7 @@ namespace hk::app {
 namespace {
 
 // The headless servo loop over any device: the kiosk's ServoRunner on a HeadlessClock, `scene` the first
-// picture of a ServoStep. After each tick's write: `after_write(rec, servo output)` (the simulated pantograph's
+// picture of a ServoStep. After each tick's write: `after_write(tick, servo output)` (the simulated pantograph's
 // physics and torques, or the driver's torques), the observer, the script, and the owner's collection of
 // what the servo let go of.
 template <class AfterWrite>
@@ -33,17 +33,11 @@ long run_ticks(const Scene& scene, const config::Settings& s, Device& device, do
   const auto n_ticks = static_cast<std::int64_t>(std::ceil(duration_s / sp.period_s - 1e-9));
   HeadlessClock clock(n_ticks, sp.period_s);
   ServoRunner runner(core, device);
-  TickRecord rec;
   runner.run(clock, [&](ServoTick& t) {
     core.publish_display();
-    rec.index = static_cast<long>(t.index);
-    rec.t_s = t.t_s;
-    rec.tick_ns = t.step_ns;
-    rec.handle_m = t.sample.handle_m;
-    rec.device_status = t.sample.status;
     const ServoOutput& so = core.last_output();
-    after_write(rec, so);
-    if (observe) observe(rec, so);
+    after_write(t, so);
+    if (observe) observe(t, so);
     if (o.script) o.script(t.index, core);
     core.collect_retired();
   });
@@ -56,7 +50,7 @@ long run_simulated(const Scene& scene, const config::Settings& s, HandController
   device.open();
   const ModelHandParams hp = hand_params_from(s);
   const ServoParams sp = servo_params_from(s);
-  const long n_ticks = run_ticks(scene, s, device, duration_s, observe, o, [&](TickRecord& rec, const ServoOutput& so) {
+  const long n_ticks = run_ticks(scene, s, device, duration_s, observe, o, [&](ServoTick& rec, const ServoOutput& so) {
     // What the hand feels: where the handle is and the force the device was told to put on it (last write);
     // what it hears: the push-through earcon of this tick.
     const bool heard_pop = (so.contact.events & kEventPopThrough) != 0;
@@ -103,7 +97,7 @@ long run_emulated(const Scene& scene, const config::Settings& s, HandController&
   const std::string tty_path = pty.device_path();
   io::HaplyDevice device(dp, [tty_path] { return std::make_unique<io::TtyTransport>(tty_path); });
   device.open();
-  const long n_ticks = run_ticks(scene, s, device, duration_s, observe, o, [&](TickRecord& rec, const ServoOutput&) {
+  const long n_ticks = run_ticks(scene, s, device, duration_s, observe, o, [&](ServoTick& rec, const ServoOutput&) {
     device.last_torques_n_m(&rec.motor_torque_n_m[0], &rec.motor_torque_n_m[1]);
     // Keep the emulated board in step with the run, Lost or not: wait (up to 20 ms) until it has executed
     // every torque packet sent, so the emulated time, and what a fault does, never depends on how busy the

@@ -41,20 +41,6 @@ double curve_length_m(const SceneCurve& c);
 /// than 3 points.
 double enclosed_area_m2(const std::vector<cv::Point2d>& points_m);
 
-/// Salience of a curve as the segment budget used to rank curves, before shape_salience replaced it; kept
-/// as the baseline the shape budget's test compares with.
-///
-///   salience = length_m · clamp(strength / canny_high, 0, 1)
-///
-/// Long boundaries are the shapes a visitor explores (a fingertip finds a long wall and can follow
-/// it; a short one is a bump), so length counts linearly. Strength says how sure the boundary is:
-/// Canny accepts an edge pixel above canny_high outright and one between canny_low and canny_high
-/// only when it is linked to a sure one, so a curve whose mean magnitude is below canny_high is
-/// mostly hysteresis-linked shading or texture and is discounted in proportion; above canny_high
-/// every curve is equally sure (a wall is felt the same whatever its grey-level contrast), hence the
-/// clip at 1. Returns 0 for a non-positive canny_high or a non-finite input.
-double curve_salience(double length_m, double strength, double canny_high);
-
 /// What a curve offers a hand, for ranking it against the others.
 struct ShapeFeatures {
   double length_m = 0.0;  ///< curve length [m]
@@ -71,10 +57,10 @@ struct ShapeFeatures {
 /// A closed outline is an object a visitor can recognise by going round it, and a large one more than a
 /// small one: a square of side a counts 4a + 2a, a circle of radius r 2πr + 3.5 r; a thin closed loop (a
 /// hair, a crack in the texture, w × L) gains only 2·√(w/L) of its length. Strength counts in proportion,
-/// not clipped at canny_high as in curve_salience: with at most max_shapes curves kept, the strongest
-/// boundaries of a photograph are its objects' outlines, and so the kept curves carry more of the picture's
-/// edge strength × length than the old ranking's (tests/app/test_shape_budget.cpp). 0 for a non-finite
-/// input or a non-positive canny_high; area_m2 must be >= 0 (0 for an open curve).
+/// not clipped at canny_high as the old ranking (curve_salience, tests/support/curve_salience.hpp) was: with at most
+/// max_shapes curves kept, the strongest boundaries of a photograph are its objects' outlines, and so the kept curves
+/// carry more of the picture's edge strength × length than the old ranking's (tests/app/test_shape_budget.cpp). 0 for a
+/// non-finite input or a non-positive canny_high; area_m2 must be >= 0 (0 for an open curve).
 double shape_salience(const ShapeFeatures& f, double canny_high);
 
 /// Share of a curve's points (in metres, mapped back to pixels through `map`) within band_m of the picture's

@@ -39,6 +39,10 @@ struct ServoTick {
   ServoCommand command;      ///< the force written to the device [N]
   TickResult result = TickResult::Ok;
   bool deadline_missed = false;  ///< started a whole period late: the step sent zero force
+  /// Motor torques the device was commanded this tick [N·m]: the simulated pantograph's (left, right motor),
+  /// or the USB pantograph's (actuator 1, actuator 2) as sent in the torque packet. Filled by a headless run
+  /// after the write (simulation.hpp); 0 where nothing fills them (the kiosk's servo thread).
+  double motor_torque_n_m[2] = {0.0, 0.0};
 };
 
 /// When ticks start. next() waits for the next one (or returns false: the run is over); done() is told

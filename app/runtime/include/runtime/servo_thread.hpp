@@ -35,13 +35,13 @@ struct ServoTimingStats {
 /// Runs a ServoStep on its own thread. Start and stop from one (non-real-time) thread.
 class ServoThread {
  public:
-  /// Called in the servo thread after each tick with the period [s]: e.g. the simulated pantograph's
-  /// physics step. Must be real-time safe.
-  using AfterTick = std::function<void(double period_s)>;
+  /// The plant's step, called in the servo thread after each tick with the period [s] (e.g. the simulated pantograph's
+  /// physics). Must be real-time safe.
+  using PlantStep = std::function<void(double period_s)>;
 
   /// Starts the thread, which reads `device` and writes its force each tick. `core` and `device` (open)
   /// must outlive the thread. @throws hk::ArgumentError for a rate outside [100, 10000] Hz.
-  ServoThread(ServoStep& core, Device& device, const ServoThreadParams& params, AfterTick after_tick = {});
+  ServoThread(ServoStep& core, Device& device, const ServoThreadParams& params, PlantStep plant_step = {});
   /// Stops and joins.
   ~ServoThread();
   ServoThread(const ServoThread&) = delete;
@@ -73,7 +73,7 @@ class ServoThread {
   ServoStep& core_;
   Device& device_;
   ServoThreadParams params_;
-  AfterTick after_tick_;
+  PlantStep plant_step_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> realtime_{false};
   std::atomic<std::int64_t> ticks_{0}, missed_{0}, max_late_ns_{0};

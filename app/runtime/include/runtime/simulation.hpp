@@ -19,24 +19,14 @@
 #include "haptics/servo.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "runtime/device_setup.hpp"
+#include "runtime/servo_runner.hpp"
 #include "runtime/servo_step.hpp"
 
 namespace hk::app {
 
-/// One tick as the trace records it.
-struct TickRecord {
-  long index = 0;
-  double t_s = 0.0;          ///< tick k at t = k · period [s]
-  Vec2 handle_m;             ///< handle position the servo saw (encoder-quantised) [m]
-  std::int64_t tick_ns = 0;  ///< measured time of ServoStep::step (collision, contact, force, cues) [ns]
-  /// Motor torques the device was commanded this tick [N·m]: the simulated pantograph's (left, right motor),
-  /// or the USB pantograph's (actuator 1, actuator 2) as sent in the torque packet.
-  double motor_torque_n_m[2] = {0.0, 0.0};
-  DeviceStatus device_status = DeviceStatus::Ok;  ///< the sample's status this tick
-};
-
-/// Called after every tick with its record and the servo's full output (proxy path, events, stats).
-using TickObserver = std::function<void(const TickRecord&, const ServoOutput&)>;
+/// Called after every tick with the tick (servo_runner.hpp ServoTick: its time, the device's sample, the step's
+/// time and the motor torques) and the servo's full output (proxy path, events, stats).
+using TickObserver = std::function<void(const ServoTick&, const ServoOutput&)>;
 
 /// The owner's side of a headless run, called after tick `index` (after the observer): what the kiosk's
 /// other threads do while a visitor explores, e.g. core.publish(bundle) (a new picture, faded in as in the
