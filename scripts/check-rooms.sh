@@ -7,13 +7,14 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 # room: the rooms it may include (besides itself)
 declare -A allowed=(
   [formats]=""
-  [pictures]="formats"
+  [sticks]=""
+  [pictures]="formats sticks"
   [runtime]="formats"
-  [visit]="formats pictures runtime"
-  [cli]="formats pictures runtime visit"
-  [kiosk]="formats pictures runtime visit cli"
+  [visit]="formats sticks pictures runtime"
+  [cli]="formats sticks pictures runtime visit"
+  [kiosk]="formats sticks pictures runtime visit cli"
 )
-rooms="formats pictures runtime visit cli kiosk"
+rooms="formats sticks pictures runtime visit cli kiosk"
 bad=0
 for room in $rooms; do
   while IFS= read -r -d '' file; do

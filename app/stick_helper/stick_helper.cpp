@@ -1,5 +1,5 @@
 // hk-stick-mount: argument checks and the two verbs (see stick_helper.hpp). The mounting itself is
-// vision::MountedStick's and vision::unmount_stick_slot's code, compiled into this executable.
+// sticks::MountedStick's and sticks::unmount_stick_slot's code, compiled into this executable.
 
 #include "stick_helper.hpp"
 
@@ -15,11 +15,11 @@
 #include <exception>
 #include <memory>
 
-#include "vision/usb_stick.hpp"
+#include "sticks/usb_stick.hpp"
 
 namespace hk::stick_helper {
 
-const char* const kMountRoot = vision::kDefaultStickMountRoot;
+const char* const kMountRoot = sticks::kDefaultStickMountRoot;
 
 namespace {
 
@@ -47,14 +47,14 @@ struct UsageError : HelperError {
 
 int parse_slot(const std::string& text) {
   const std::string why =
-      "slot '" + shown(text) + "': not a whole number from 0 to " + std::to_string(vision::kMaxStickSlot);
+      "slot '" + shown(text) + "': not a whole number from 0 to " + std::to_string(sticks::kMaxStickSlot);
   if (text.empty() || text.size() > 3 || (text.size() > 1 && text[0] == '0')) throw UsageError(why);
   int v = 0;
   for (char c : text) {
     if (c < '0' || c > '9') throw UsageError(why);
     v = v * 10 + (c - '0');
   }
-  if (v > vision::kMaxStickSlot) throw UsageError(why);
+  if (v > sticks::kMaxStickSlot) throw UsageError(why);
   return v;
 }
 
@@ -142,10 +142,10 @@ DeviceFacts check_devnode(const std::string& devnode, bool allow_loop, const Usb
 std::string run_request(const Request& r, const std::string& mount_root, const UsbProbe& probe) {
   const std::string point = mount_root + "/" + std::to_string(r.slot);
   if (r.verb == Request::Verb::Unmount) {
-    return vision::unmount_stick_slot(mount_root, r.slot) ? "unmounted " + point : "nothing mounted at " + point;
+    return sticks::unmount_stick_slot(mount_root, r.slot) ? "unmounted " + point : "nothing mounted at " + point;
   }
   const DeviceFacts f = check_devnode(r.devnode, r.allow_loop, probe);
-  vision::MountedStick stick(f.resolved, mount_root, r.slot);
+  sticks::MountedStick stick(f.resolved, mount_root, r.slot);
   // MountedStick checked that what is mounted is what it probed; this checks that it is what was validated.
   struct stat mounted {};
   if (::stat(stick.mount_point().c_str(), &mounted) != 0 || major(mounted.st_dev) != f.major ||

@@ -5,7 +5,7 @@
 /// The kiosk runs as the unprivileged user haptic-kiosk; mounting a USB stick needs CAP_SYS_ADMIN (and
 /// opening the stick's block device, owned root:disk, needs CAP_DAC_READ_SEARCH). Instead of giving the
 /// kiosk those, the package installs this helper root:haptic-kiosk mode 0750 with the file capabilities
-/// cap_dac_read_search,cap_sys_admin+ep. It does two things, with vision::MountedStick's code:
+/// cap_dac_read_search,cap_sys_admin+ep. It does two things, with sticks::MountedStick's code:
 ///
 ///   hk-stick-mount mount DEVNODE SLOT   mounts DEVNODE read-only at /run/haptic-kiosk/usb/SLOT
 ///   hk-stick-mount unmount SLOT         detaches /run/haptic-kiosk/usb/SLOT and removes the folder
@@ -17,7 +17,7 @@
 /// It accepts only: DEVNODE an absolute path under /dev/ (a link there, such as /dev/disk/by-id/usb-...,
 /// is resolved and must lead to a node under /dev/ too) of a block device that sits on the USB bus (its
 /// sysfs device has a USB device among its parents, as libudev reports it); SLOT a whole number from 0
-/// to vision::kMaxStickSlot written without sign or leading zeros. The mount root is fixed. Loop devices
+/// to sticks::kMaxStickSlot written without sign or leading zeros. The mount root is fixed. Loop devices
 /// are accepted only with the first argument --allow-loop, and only when the real user is root (the
 /// tests, which have no USB stick). The environment is cleared before anything else runs.
 
@@ -32,7 +32,7 @@
 
 namespace hk::stick_helper {
 
-/// The fixed mount root, vision::kDefaultStickMountRoot.
+/// The fixed mount root, sticks::kDefaultStickMountRoot.
 extern const char* const kMountRoot;
 
 /// A refused command line or device. what() is one line naming the argument: "slot '12a': ...",
@@ -47,7 +47,7 @@ struct Request {
   enum class Verb { Mount, Unmount };
   Verb verb = Verb::Mount;
   std::string devnode;      ///< Mount: as given
-  int slot = 0;             ///< 0 .. vision::kMaxStickSlot
+  int slot = 0;             ///< 0 .. sticks::kMaxStickSlot
   bool allow_loop = false;  ///< --allow-loop was given (only root may)
 };
 
@@ -73,7 +73,7 @@ void udev_probe(DeviceFacts& facts);
 /// a bad slot, --allow-loop without root).
 Request parse_request(const std::vector<std::string>& args, uid_t real_uid);
 
-/// SLOT text -> number: digits only, no sign, no leading zero (but "0"), at most vision::kMaxStickSlot.
+/// SLOT text -> number: digits only, no sign, no leading zero (but "0"), at most sticks::kMaxStickSlot.
 /// @throws HelperError "slot '<text>': not a whole number from 0 to 999".
 int parse_slot(const std::string& text);
 
@@ -86,7 +86,7 @@ DeviceFacts check_devnode(const std::string& devnode, bool allow_loop, const Usb
 
 /// Does what `r` asks under `mount_root` (kMountRoot in the helper; tests may pass another) and returns
 /// the result line (without "\n").
-/// @throws HelperError or vision::StickMountError (one line) when it is refused or fails.
+/// @throws HelperError or sticks::StickMountError (one line) when it is refused or fails.
 std::string run_request(const Request& r, const std::string& mount_root = kMountRoot,
                         const UsbProbe& probe = udev_probe);
 

@@ -728,13 +728,13 @@ TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
   const std::string& loop = stick.loop->dev;
 
   const std::string result = in_mount_namespace([&]() -> std::string {
-    auto events = std::make_unique<vision::FakeBlockEventSource>();
-    vision::FakeBlockEventSource* fake = events.get();
+    auto events = std::make_unique<sticks::FakeBlockEventSource>();
+    sticks::FakeBlockEventSource* fake = events.get();
     config::Settings s = test_settings();
     s.stick.page_timeout_s = 10.0;  // the page drawn first must be done within it, and the hanging worker lasts it
     StickService svc(s, std::move(events), (dir / "mnt").string());
     if (!svc.can_mount()) return "SKIP: no CAP_SYS_ADMIN";
-    fake->push({vision::BlockEvent::Action::Add, loop, ""});
+    fake->push({sticks::BlockEvent::Action::Add, loop, ""});
     std::optional<StickNews> n = next_news(svc);
     if (!n || n->kind != StickNews::Kind::Inserted)
       return "insert: no Inserted news" + (n ? " (" + n->reason + ")" : std::string());
@@ -751,7 +751,7 @@ TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
     const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     while (svc.loads_started() < 2 && std::chrono::steady_clock::now() < until) std::this_thread::yield();
     if (svc.loads_started() < 2) return "remove: the second load never started";
-    fake->push({vision::BlockEvent::Action::Remove, loop, ""});
+    fake->push({sticks::BlockEvent::Action::Remove, loop, ""});
     n = next_news(svc);
     if (!n || n->kind != StickNews::Kind::Removed) return "remove: no Removed news";
     if (!svc.poll_loaded().empty()) return "remove: the hanging page finished before the removal was reported";
@@ -760,7 +760,7 @@ TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
     svc.set_pdf_fault(vision::PdfFault::None);
     if (fs::exists(dir / "mnt" / "0")) return "remove: mount point left behind";
 
-    fake->push({vision::BlockEvent::Action::Add, loop, ""});
+    fake->push({sticks::BlockEvent::Action::Add, loop, ""});
     n = next_news(svc);
     if (!n || n->kind != StickNews::Kind::Inserted || n->stick == first) return "insert again: expected a new stick";
     svc.load(n->stick, 1, 1);

@@ -16,12 +16,12 @@
 #include "haptics/multires.hpp"
 #include "hk/error.hpp"
 #include "runtime/device_setup.hpp"
+#include "sticks/usb_stick.hpp"
 #include "test_paths.hpp"
 #include "vision/frame_source.hpp"
 #include "vision/intake.hpp"
 #include "vision/pdf.hpp"
 #include "vision/stick_scan.hpp"
-#include "vision/usb_stick.hpp"
 
 namespace hk {
 namespace {
@@ -31,7 +31,7 @@ constexpr bool all_hk_errors = (std::is_base_of_v<Error, E> && ...);
 
 static_assert(all_hk_errors<CurveError, DeviceError, HandFileError>);
 static_assert(all_hk_errors<vision::InputError, vision::PdfError, vision::CameraError, vision::StickError,
-                            vision::StickMountError>);
+                            sticks::StickMountError>);
 static_assert(all_hk_errors<config::ConfigError>);
 static_assert(all_hk_errors<audio::SpeechError, audio::MessageError, audio::WavError>);
 static_assert(all_hk_errors<app::ExploreError, app::DeviceChoiceError, app::PictureNotesError, app::AppError>);

@@ -55,7 +55,7 @@ bool drop_sys_admin() {
 std::string in_child_without_sys_admin(const std::function<std::string()>& body) {
   return test::run_in_child(
       [&]() -> std::string {
-        if (!drop_sys_admin() || vision::have_mount_capability()) return "cannot drop CAP_SYS_ADMIN";
+        if (!drop_sys_admin() || sticks::have_mount_capability()) return "cannot drop CAP_SYS_ADMIN";
         return body();
       },
       "pipe or fork failed");
@@ -92,24 +92,24 @@ TEST(StickServiceHelper, WithoutTheCapabilityTheHelperMountsAndUnmounts) {
 
   const std::string result = in_child_without_sys_admin([&]() -> std::string {
     ::setenv("HK_STICK_HELPER", helper.c_str(), 1);
-    auto events = std::make_unique<vision::FakeBlockEventSource>();
-    vision::FakeBlockEventSource* fake = events.get();
+    auto events = std::make_unique<sticks::FakeBlockEventSource>();
+    sticks::FakeBlockEventSource* fake = events.get();
     StickService svc(config::Settings{}, std::move(events), (dir / "mnt").string());
-    if (svc.mounter() != vision::StickMounter::Helper || !svc.can_mount())
+    if (svc.mounter() != sticks::StickMounter::Helper || !svc.can_mount())
       return "the service did not choose the helper";
 
-    fake->push({vision::BlockEvent::Action::Add, "/dev/sdz1", ""});
+    fake->push({sticks::BlockEvent::Action::Add, "/dev/sdz1", ""});
     std::optional<StickNews> n = next_news(svc);
     if (!n || n->kind != StickNews::Kind::Inserted)
       return "insert: no Inserted news" + (n ? " (" + n->reason + ")" : std::string());
     if (n->documents.size() != 1)
       return "insert: expected shape.png, got " + std::to_string(n->documents.size()) + " documents";
-    fake->push({vision::BlockEvent::Action::Remove, "/dev/sdz1", ""});
+    fake->push({sticks::BlockEvent::Action::Remove, "/dev/sdz1", ""});
     n = next_news(svc);
     if (!n || n->kind != StickNews::Kind::Removed) return "remove: no Removed news";
 
     // The helper's refusal reaches the visitor as the reason, without the device's name.
-    fake->push({vision::BlockEvent::Action::Add, "/dev/sdz9", ""});
+    fake->push({sticks::BlockEvent::Action::Add, "/dev/sdz9", ""});
     n = next_news(svc);
     if (!n || n->kind != StickNews::Kind::Refused) return "refused stick: no Refused news";
     if (n->reason != "its filesystem (swap) is not one the kiosk reads")

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "stick_helper.hpp"
+#include "sticks/usb_stick.hpp"
 #include "test_paths.hpp"
-#include "vision/usb_stick.hpp"
 
 namespace hk::stick_helper {
 namespace {
@@ -129,7 +129,7 @@ TEST(StickHelperArgs, BadCommandLinesAreRefusedInOneLineNamingTheArgument) {
 TEST(StickHelperArgs, SlotsAreSmallWholeNumbersOnly) {
   EXPECT_EQ(parse_slot("0"), 0);
   EXPECT_EQ(parse_slot("7"), 7);
-  EXPECT_EQ(parse_slot("999"), vision::kMaxStickSlot);
+  EXPECT_EQ(parse_slot("999"), sticks::kMaxStickSlot);
   for (const std::string bad :
        {"", "-1", "+1", "01", "000", "1000", "12a", " 1", "1 ", "0x1", "1e2", "99999999999999999999", "\xd9\xa3"}) {
     const std::string what = refusal([&] { (void)parse_slot(bad); });

@@ -19,7 +19,7 @@
 #include "hk/text.hpp"
 
 #include "hk/error.hpp"
-#include "unique_fd.hpp"
+#include "hk/unique_fd.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -43,7 +43,7 @@ namespace {
 constexpr std::uint64_t kResolve = RESOLVE_BENEATH | RESOLVE_NO_SYMLINKS | RESOLVE_NO_XDEV | RESOLVE_NO_MAGICLINKS;
 constexpr std::size_t kMagicBytes = 16;
 
-using Fd = detail::UniqueFd;
+using Fd = hk::UniqueFd;
 
 std::string errno_text(int e) { return std::generic_category().message(e); }
 

@@ -9,7 +9,7 @@
 #include "config/load.hpp"
 #include "formats/app_error.hpp"
 #include "pictures/documents.hpp"
-#include "vision/usb_stick.hpp"
+#include "sticks/usb_stick.hpp"
 
 namespace hk::app {
 namespace {
@@ -44,10 +44,10 @@ int run_stick(const StickOptions& o) {
     if (!std::filesystem::is_directory(parent))
       throw AppError("--json '" + o.json_path + "': folder '" + parent.string() + "' does not exist");
   }
-  std::optional<vision::MountedStick> mounted;
+  std::optional<sticks::MountedStick> mounted;
   std::string root = o.folder;
   if (!o.device.empty()) {
-    mounted.emplace(o.device, o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root, 0);
+    mounted.emplace(o.device, o.mount_root.empty() ? std::string(sticks::kDefaultStickMountRoot) : o.mount_root, 0);
     root = mounted->mount_point();
   }
   const StickListing listing = list_stick(root, s);

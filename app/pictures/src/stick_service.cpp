@@ -17,17 +17,17 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-StickService::StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events,
+StickService::StickService(const config::Settings& settings, std::unique_ptr<sticks::BlockEventSource> events,
                            std::string mount_root)
     : s_(settings), events_(std::move(events)), mount_root_(std::move(mount_root)) {
-  helper_path_ = vision::stick_helper_path();
-  mounter_ = vision::choose_stick_mounter(vision::have_mount_capability(), helper_path_);
-  if (events_ && mounter_ == vision::StickMounter::None) {
+  helper_path_ = sticks::stick_helper_path();
+  mounter_ = sticks::choose_stick_mounter(sticks::have_mount_capability(), helper_path_);
+  if (events_ && mounter_ == sticks::StickMounter::None) {
     spdlog::warn("usb sticks: not mounted: this process lacks CAP_SYS_ADMIN and there is no mount helper at {}. {}",
-                 helper_path_, vision::mount_capability_hint());
-  } else if (events_ && mounter_ == vision::StickMounter::Helper) {
+                 helper_path_, sticks::mount_capability_hint());
+  } else if (events_ && mounter_ == sticks::StickMounter::Helper) {
     spdlog::info("usb sticks: mounted read-only by the helper {} under {}", helper_path_,
-                 vision::kDefaultStickMountRoot);
+                 sticks::kDefaultStickMountRoot);
   }
   watcher_ = std::thread([this] { watch(); });
   loader_ = std::thread([this] { serve(); });
@@ -244,8 +244,8 @@ void StickService::handle_add(const std::string& devnode) {
   const auto t0 = std::chrono::steady_clock::now();
   try {
     const int slot = next_slot_;
-    next_slot_ = (next_slot_ + 1) % (vision::kMaxStickSlot + 1);  // one stick at a time: slots are reused after 1000
-    mounted_ = vision::mount_stick(mounter_, devnode, mount_root_, slot, helper_path_);
+    next_slot_ = (next_slot_ + 1) % (sticks::kMaxStickSlot + 1);  // one stick at a time: slots are reused after 1000
+    mounted_ = sticks::mount_stick(mounter_, devnode, mount_root_, slot, helper_path_);
   } catch (const std::exception& e) {
     spdlog::warn("{}", e.what());
     StickNews n;
@@ -304,7 +304,7 @@ void StickService::watch() {
       cv_.wait_for(lock, std::chrono::milliseconds(50), [this] { return stop_ || !folder_ops_.empty(); });
       continue;
     }
-    std::optional<vision::BlockEvent> e;
+    std::optional<sticks::BlockEvent> e;
     try {
       e = events_->next(50);
     } catch (const std::exception& ex) {
@@ -313,7 +313,7 @@ void StickService::watch() {
       continue;
     }
     if (!e) continue;
-    if (e->action == vision::BlockEvent::Action::Add)
+    if (e->action == sticks::BlockEvent::Action::Add)
       handle_add(e->devnode);
     else
       handle_remove(e->devnode);

@@ -22,10 +22,10 @@
 namespace hk::app {
 namespace {
 
-std::unique_ptr<vision::BlockEventSource> block_events(bool hotplug) {
+std::unique_ptr<sticks::BlockEventSource> block_events(bool hotplug) {
   if (!hotplug) return nullptr;
   try {
-    return std::make_unique<vision::UdevBlockEventSource>();
+    return std::make_unique<sticks::UdevBlockEventSource>();
   } catch (const std::exception& e) {
     spdlog::warn("usb sticks: no hot-plug ({}); the kiosk runs on without sticks", e.what());
     return nullptr;
@@ -92,7 +92,7 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
       switches_(o.high_contrast, o.overlay),
       camera_(s, camera_of(s, o.probe_camera), camera_looked_for(s, o.probe_camera), stage_, shelf_, voice_, audio_),
       sticks_(s, block_events(o.hotplug),
-              o.mount_root.empty() ? std::string(vision::kDefaultStickMountRoot) : o.mount_root, stage_, shelf_,
+              o.mount_root.empty() ? std::string(sticks::kDefaultStickMountRoot) : o.mount_root, stage_, shelf_,
               audio_) {
   tour_.set_picture([this] { return stage_.tour_picture(); });
   if (!o.device.empty()) {

@@ -8,7 +8,7 @@
 
 namespace hk::app {
 
-StickDesk::StickDesk(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events,
+StickDesk::StickDesk(const config::Settings& settings, std::unique_ptr<sticks::BlockEventSource> events,
                      const std::string& mount_root, Stage& stage, PictureShelf& shelf, const audio::AudioSystem& audio)
     : stage_(stage), shelf_(shelf), audio_(audio), service_(settings, std::move(events), mount_root) {}
 

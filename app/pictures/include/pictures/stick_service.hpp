@@ -3,8 +3,8 @@
 /// The kiosk's USB-stick work off the window and servo threads.
 ///
 /// Two worker threads:
-/// - the watcher takes block events (vision::BlockEventSource), mounts an inserted stick read-only
-///   (vision::mount_stick: itself with CAP_SYS_ADMIN, else through the mount helper hk-stick-mount when it
+/// - the watcher takes block events (sticks::BlockEventSource), mounts an inserted stick read-only
+///   (sticks::mount_stick: itself with CAP_SYS_ADMIN, else through the mount helper hk-stick-mount when it
 ///   is installed), scans it and counts its PDFs' pages (list_stick), and unmounts it when it is taken out;
 ///   with neither it says once in the log how to grant the capability and ignores sticks;
 /// - the loader builds the scene of a document page on request (the PDF drawn in its worker process,
@@ -32,8 +32,8 @@
 #include "pictures/documents.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/stick_pages.hpp"
-#include "vision/stick_mount.hpp"
-#include "vision/usb_stick.hpp"
+#include "sticks/stick_mount.hpp"
+#include "sticks/usb_stick.hpp"
 
 namespace hk::app {
 
@@ -62,9 +62,9 @@ struct LoadedDocument {
 class StickService {
  public:
   /// `events` may be null (no hot-plug: only insert_folder). `mount_root` is where sticks are mounted (the
-  /// helper always mounts under vision::kDefaultStickMountRoot). Who mounts is chosen once here:
-  /// vision::choose_stick_mounter(have_mount_capability(), stick_helper_path()).
-  StickService(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events,
+  /// helper always mounts under sticks::kDefaultStickMountRoot). Who mounts is chosen once here:
+  /// sticks::choose_stick_mounter(have_mount_capability(), stick_helper_path()).
+  StickService(const config::Settings& settings, std::unique_ptr<sticks::BlockEventSource> events,
                std::string mount_root);
   /// Stops both threads (a load in progress finishes first: at most the page time limit) and unmounts.
   ~StickService();
@@ -89,9 +89,9 @@ class StickService {
   /// Forget the stick's listing (a new session): later loads of it are refused. The mount stays until removal.
   void forget();
   /// Whether sticks can be mounted (CAP_SYS_ADMIN, or the mount helper); folders work regardless.
-  bool can_mount() const { return mounter_ != vision::StickMounter::None; }
+  bool can_mount() const { return mounter_ != sticks::StickMounter::None; }
   /// Who mounts sticks: this process, the helper, or nobody.
-  vision::StickMounter mounter() const { return mounter_; }
+  sticks::StickMounter mounter() const { return mounter_; }
   /// Loads that have read their document and begun drawing and building it (for the operator's status and
   /// for tests that need a load to be under way).
   /// Pages built ahead are not counted.
@@ -142,9 +142,9 @@ class StickService {
   LoadedDocument build(const Request& r, bool ahead);
 
   config::Settings s_;  // guarded by m_ (set_settings); each job works on a copy
-  std::unique_ptr<vision::BlockEventSource> events_;
+  std::unique_ptr<sticks::BlockEventSource> events_;
   std::string mount_root_;
-  vision::StickMounter mounter_ = vision::StickMounter::None;
+  sticks::StickMounter mounter_ = sticks::StickMounter::None;
   std::string helper_path_;
   std::atomic<vision::PdfFault> pdf_fault_{vision::PdfFault::None};
   std::atomic<int> loads_started_{0};
@@ -171,7 +171,7 @@ class StickService {
   std::uint64_t ahead_generation_ = 0;  // guarded by m_: bumped when pages built so far must not be used
 
   // watcher thread only
-  std::unique_ptr<vision::StickMount> mounted_;
+  std::unique_ptr<sticks::StickMount> mounted_;
   int next_stick_ = 1;
   int next_slot_ = 0;
 

@@ -45,7 +45,7 @@ namespace hk::app {
 struct RuntimeOptions {
   std::string library;            ///< picture folder (already resolved; must hold at least one picture)
   bool hotplug = true;            ///< watch for USB sticks (libudev)
-  std::string mount_root;         ///< where sticks are mounted; empty: vision::kDefaultStickMountRoot
+  std::string mount_root;         ///< where sticks are mounted; empty: sticks::kDefaultStickMountRoot
   bool high_contrast = false;     ///< start (and every session) in high contrast
   bool overlay = false;           ///< start with the operator overlay
   bool open_audio_output = true;  ///< false: no PortAudio (tests)

@@ -30,7 +30,7 @@ class StickDesk final : public StickEffects {
 
   /// Starts the stick service (stick_service.hpp: `events` null for no hot-plug; sticks mounted under
   /// `mount_root`). `stage`, `shelf` and `audio` outlive the desk.
-  StickDesk(const config::Settings& settings, std::unique_ptr<vision::BlockEventSource> events,
+  StickDesk(const config::Settings& settings, std::unique_ptr<sticks::BlockEventSource> events,
             const std::string& mount_root, Stage& stage, PictureShelf& shelf, const audio::AudioSystem& audio);
 
   /// Loads page `page` of document `document` of the stick the flow browses (the operator's level comes

@@ -1,9 +1,9 @@
 // USB sticks coming and going: libudev block events, libblkid identification, and a read-only mount
 // (see usb_stick.hpp for the order of the steps and why each one is there).
 
-#include "vision/usb_stick.hpp"
+#include "sticks/usb_stick.hpp"
 
-#include "unique_fd.hpp"
+#include "hk/unique_fd.hpp"
 
 #include <blkid/blkid.h>
 #include <fcntl.h>
@@ -29,7 +29,7 @@
 #define MS_NOSYMFOLLOW 256  // Linux 5.10
 #endif
 
-namespace hk::vision {
+namespace hk::sticks {
 namespace {
 
 /// "stick '<devnode>': <what>", kept on one line (a device name from udev cannot hold a newline, but a
@@ -48,7 +48,7 @@ std::string stick_message(const std::string& devnode, const std::string& what) {
 
 std::string errno_text(int err) { return std::strerror(err); }
 
-using Fd = detail::UniqueFd;
+using Fd = hk::UniqueFd;
 
 /// Opens `devnode` read-only for probing; refuses anything that is neither a block device nor a regular
 /// file (an image). Never creates, never writes.
@@ -531,4 +531,4 @@ std::optional<BlockEvent> UdevBlockEventSource::next(int timeout_ms) {
   }
 }
 
-}  // namespace hk::vision
+}  // namespace hk::sticks

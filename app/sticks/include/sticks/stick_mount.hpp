@@ -14,9 +14,9 @@
 #include <memory>
 #include <string>
 
-#include "vision/usb_stick.hpp"
+#include "sticks/usb_stick.hpp"
 
-namespace hk::vision {
+namespace hk::sticks {
 
 /// Where the package installs the helper.
 inline constexpr const char* kDefaultStickHelperPath = "/usr/libexec/haptic-kiosk/hk-stick-mount";
@@ -62,4 +62,4 @@ StickMounter choose_stick_mounter(bool have_capability, const std::string& helpe
 std::unique_ptr<StickMount> mount_stick(StickMounter how, const std::string& devnode, const std::string& mount_root,
                                         int slot, const std::string& helper_path, double timeout_s = 30.0);
 
-}  // namespace hk::vision
+}  // namespace hk::sticks

@@ -1,7 +1,7 @@
 // How the kiosk mounts a USB stick: itself (MountedStick) or through the mount helper hk-stick-mount
 // (see stick_mount.hpp for the helper's command line and answers).
 
-#include "vision/stick_mount.hpp"
+#include "sticks/stick_mount.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -22,7 +22,7 @@
 
 extern char** environ;
 
-namespace hk::vision {
+namespace hk::sticks {
 namespace {
 
 /// "stick '<devnode>': <what>" on one line.
@@ -235,4 +235,4 @@ std::unique_ptr<StickMount> mount_stick(StickMounter how, const std::string& dev
                                                 ", or install the mount helper " + kDefaultStickHelperPath));
 }
 
-}  // namespace hk::vision
+}  // namespace hk::sticks

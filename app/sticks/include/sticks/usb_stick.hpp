@@ -30,7 +30,7 @@
 #include <string>
 #include "hk/error.hpp"
 
-namespace hk::vision {
+namespace hk::sticks {
 
 /// A block device appearing or disappearing.
 struct BlockEvent {
@@ -160,4 +160,4 @@ bool unmount_stick_slot(const std::string& mount_root, int slot);
 /// The default mount root, "/run/haptic-kiosk/usb".
 inline constexpr const char* kDefaultStickMountRoot = "/run/haptic-kiosk/usb";
 
-}  // namespace hk::vision
+}  // namespace hk::sticks

@@ -29,15 +29,16 @@
 #include <thread>
 #include <vector>
 
+#include "sticks/usb_stick.hpp"
 #include "test_paths.hpp"
 #include "vision/stick_scan.hpp"
-#include "vision/usb_stick.hpp"
 
 #ifndef ST_NOSYMFOLLOW
 #define ST_NOSYMFOLLOW 0x2000  // linux/statfs.h; glibc 2.36 does not name it
 #endif
 
-namespace hk::vision {
+namespace hk::sticks {
+using namespace hk::vision;  // the stick's scan (stick_scan.hpp)
 namespace {
 
 namespace fs = std::filesystem;
@@ -834,4 +835,4 @@ TEST_F(UsbStickImage, WithoutCapabilityNothingIsMounted) {
 }
 
 }  // namespace
-}  // namespace hk::vision
+}  // namespace hk::sticks

@@ -1,10 +1,10 @@
 #pragma once
-// Private to the vision library: a file descriptor closed at the end of its scope (stick scan, block
-// devices).
+/// @file unique_fd.hpp
+/// A file descriptor closed at the end of its scope (a stick's scan, its block device).
 
 #include <unistd.h>
 
-namespace hk::vision::detail {
+namespace hk {
 
 /// Owns one file descriptor (−1: none) and closes it when destroyed. Not copyable.
 class UniqueFd {
@@ -22,4 +22,4 @@ class UniqueFd {
   int fd_;
 };
 
-}  // namespace hk::vision::detail
+}  // namespace hk

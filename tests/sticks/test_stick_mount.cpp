@@ -14,9 +14,9 @@
 #include <sstream>
 #include <string>
 
-#include "vision/stick_mount.hpp"
+#include "sticks/stick_mount.hpp"
 
-namespace hk::vision {
+namespace hk::sticks {
 namespace {
 
 namespace fs = std::filesystem;
@@ -188,4 +188,4 @@ TEST_F(FakeHelpers, MissingHelperIsAnErrorNamingIt) {
 }
 
 }  // namespace
-}  // namespace hk::vision
+}  // namespace hk::sticks
