@@ -15,12 +15,12 @@
 #include <vector>
 
 #include <unistd.h>
-#include <zlib.h>
 
 #include <cerrno>
 
 #include "image_header_detail.hpp"
 #include "input_error.hpp"
+#include "vision/png_chunks.hpp"
 
 namespace hk::vision {
 namespace detail {
@@ -29,11 +29,6 @@ bool MemorySource::read(std::uint64_t offset, std::size_t n, std::uint8_t* out) 
   if (offset > bytes_.size() || n > bytes_.size() - offset) return false;
   if (n > 0) std::memcpy(out, bytes_.data() + offset, n);
   return true;
-}
-
-std::uint32_t crc32_png(const std::uint8_t* data, std::size_t n) {
-  // PNG Annex D's CRC-32 is zlib's (ISO 3309 polynomial, init and final xor 0xFFFFFFFF).
-  return static_cast<std::uint32_t>(::crc32_z(0UL, data, n));
 }
 
 namespace {
@@ -153,7 +148,7 @@ HeaderDetails parse_png(ByteSource& src, const std::string& path) {
   if (r.u32(8, false) != 13 || std::memcmp(ihdr, "IHDR", 4) != 0) {
     r.corrupt("the first chunk is not a 13-byte IHDR");
   }
-  if (crc32_png(ihdr, sizeof ihdr) != r.u32(29, false)) r.corrupt("IHDR checksum (CRC) mismatch");
+  if (png_crc(ihdr, sizeof ihdr) != r.u32(29, false)) r.corrupt("IHDR checksum (CRC) mismatch");
   const std::uint32_t w = r.u32(16, false);
   const std::uint32_t h = r.u32(20, false);
   if (w > 0x7FFFFFFFU || h > 0x7FFFFFFFU) r.corrupt("IHDR size exceeds 2^31 - 1");
@@ -162,14 +157,12 @@ HeaderDetails parse_png(ByteSource& src, const std::string& path) {
   d.may_have_alpha = colour_type == 4 || colour_type == 6;
   // A tRNS chunk (transparency for grey, RGB or palette images) must come before IDAT; a few
   // chunk headers are cheap to walk. Stop at the first problem: this is only a hint.
-  std::uint64_t off = 33;
+  PngChunkWalker walker(
+      [&src](std::uint64_t offset, std::size_t n, std::uint8_t* out) { return src.read(offset, n, out); }, 33);
   for (int i = 0; i < 256 && !d.may_have_alpha; ++i) {
-    std::uint8_t hdr[8];
-    if (!src.read(off, 8, hdr)) break;
-    const std::uint64_t len = (std::uint64_t{hdr[0]} << 24) | (hdr[1] << 16) | (hdr[2] << 8) | hdr[3];
-    if (std::memcmp(hdr + 4, "IDAT", 4) == 0 || std::memcmp(hdr + 4, "IEND", 4) == 0) break;
-    if (std::memcmp(hdr + 4, "tRNS", 4) == 0) d.may_have_alpha = true;
-    off += 12 + len;
+    const std::optional<PngChunk> c = walker.next();
+    if (!c || c->is("IDAT") || c->is("IEND")) break;
+    if (c->is("tRNS")) d.may_have_alpha = true;
   }
   return d;
 }

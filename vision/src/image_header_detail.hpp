@@ -51,9 +51,6 @@ HeaderDetails parse_image_header(ByteSource& src, const std::string& path);
 /// not a regular file, or is empty.
 std::uint64_t checked_file_size(const std::string& path);
 
-/// CRC-32 as used by PNG chunks (W3C PNG 2nd ed. Annex D; the zlib/ISO 3309 polynomial).
-std::uint32_t crc32_png(const std::uint8_t* data, std::size_t n);
-
 /// The PNG file's bytes that libpng is given: only the chunks which change the pixels OpenCV decodes
 /// (IHDR, PLTE, tRNS, IDAT, IEND, eXIf for orientation, and any unknown critical chunk, which libpng then
 /// refuses), after checking the chunk structure: every kept chunk's CRC, an IDAT, and an IEND before the end

@@ -24,6 +24,7 @@
 #include "hk/text.hpp"
 #include "image_header_detail.hpp"
 #include "input_error.hpp"
+#include "vision/png_chunks.hpp"
 
 namespace hk::vision::detail {
 namespace {
@@ -150,13 +151,10 @@ bool png_decodes_by_rows(std::span<const std::uint8_t> png) {
   // Signature (8), IHDR length and type (8), width, height (8), bit depth, colour type, compression,
   // filter, interlace method (byte 28).
   if (png.size() < 33 || png[28] != 0) return false;
-  std::size_t pos = 8;
-  while (pos + 8 <= png.size()) {
-    const std::uint32_t len = (std::uint32_t{png[pos]} << 24) | (std::uint32_t{png[pos + 1]} << 16) |
-                              (std::uint32_t{png[pos + 2]} << 8) | png[pos + 3];
-    if (std::memcmp(png.data() + pos + 4, "eXIf", 4) == 0) return false;
-    if (len > png.size() - pos - 8 || png.size() - pos - 8 - len < 4) break;
-    pos += 12 + std::size_t{len};
+  PngChunkWalker walker(png_read_of(png));
+  while (const std::optional<PngChunk> c = walker.next()) {
+    if (c->is("eXIf")) return false;
+    if (c->end() > png.size()) break;
   }
   return true;
 }

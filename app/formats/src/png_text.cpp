@@ -1,13 +1,16 @@
-// PNG text chunks (see png_text.hpp): the file is walked chunk by chunk (PNG 2nd ed. §5.3: length, type,
-// data, CRC-32) and only the text chunks are read; the image data is skipped, not decoded, so a 20 MB photo
-// costs a few hundred small reads and seeks rather than a second full decode. zlib checks each text chunk's
-// CRC and inflates the compressed ones.
+// PNG text chunks (see png_text.hpp): the file is walked chunk by chunk (vision/png_chunks.hpp
+// PngChunkWalker) and only the text chunks are read; the image data is skipped, not decoded, so a 20 MB photo
+// costs a few hundred small reads and seeks rather than a second full decode. Each text chunk's CRC is
+// checked (png_crc) and zlib inflates the compressed ones.
 
 #include "formats/png_text.hpp"
+
+#include "vision/png_chunks.hpp"
 
 #include <zlib.h>
 
 #include <array>
+#include <climits>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -21,7 +24,6 @@ namespace {
 
 constexpr std::size_t kMaxChunkBytes = 1u << 20;  // a text chunk, stored or inflated, larger than this is skipped
 constexpr int kMaxChunks = 1 << 20;               // chunks looked at before giving up on a file
-constexpr std::array<std::uint8_t, 8> kSignature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
 
 /// Latin-1 (tEXt, zTXt) to UTF-8.
 std::string latin1_to_utf8(std::string_view s) {
@@ -82,10 +84,6 @@ std::optional<std::string> chunk_text(std::string_view type, std::string_view da
   return compressed ? inflated(rest) : std::optional<std::string>(std::string(rest));
 }
 
-std::uint32_t big_endian(const std::uint8_t* p) {
-  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) | p[3];
-}
-
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
 };
@@ -96,30 +94,28 @@ PngText read_png_text(const std::string& path) {
   PngText out;
   const std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "rb"));
   if (!f) return out;
+  const auto read = [file = f.get()](std::uint64_t offset, std::size_t n, std::uint8_t* to) {
+    return offset <= static_cast<std::uint64_t>(LONG_MAX) &&
+           std::fseek(file, static_cast<long>(offset), SEEK_SET) == 0 && std::fread(to, 1, n, file) == n;
+  };
   std::array<std::uint8_t, 8> sig{};
-  if (std::fread(sig.data(), 1, sig.size(), f.get()) != sig.size() || sig != kSignature) return out;
+  if (!read(0, sig.size(), sig.data()) || sig != vision::kPngSignature) return out;
   bool have_title = false, have_description = false;
   std::string data, keyword;
+  vision::PngChunkWalker walker(read);
   for (int chunk = 0; chunk < kMaxChunks && !(have_title && have_description); ++chunk) {
-    std::array<std::uint8_t, 8> head{};
-    if (std::fread(head.data(), 1, head.size(), f.get()) != head.size()) break;
-    const std::uint32_t length = big_endian(head.data());
-    const std::string_view type(reinterpret_cast<const char*>(head.data() + 4), 4);
-    if (length > 0x7fffffffu || type == "IEND") break;
-    const bool text = type == "tEXt" || type == "zTXt" || type == "iTXt";
-    if (!text || length > kMaxChunkBytes) {  // the image data and everything else: skipped, with its CRC
-      if (std::fseek(f.get(), static_cast<long>(length) + 4, SEEK_CUR) != 0) break;
-      continue;
-    }
-    data.resize(length);
-    std::array<std::uint8_t, 4> crc{};
-    if ((length > 0 && std::fread(data.data(), 1, length, f.get()) != length) ||
-        std::fread(crc.data(), 1, 4, f.get()) != 4)
-      break;
-    uLong sum = crc32(0L, head.data() + 4, 4);
-    sum = crc32(sum, reinterpret_cast<const Bytef*>(data.data()), static_cast<uInt>(length));
-    if (sum != big_endian(crc.data())) continue;  // a damaged chunk says nothing
-    const std::optional<std::string> value = chunk_text(type, data, keyword);
+    const std::optional<vision::PngChunk> c = walker.next();
+    if (!c || c->length > vision::kPngMaxChunkLength || c->is("IEND")) break;
+    const bool text = c->is("tEXt") || c->is("zTXt") || c->is("iTXt");
+    if (!text || c->length > kMaxChunkBytes) continue;  // the image data and everything else: skipped
+    // Its type, data and CRC, in one read.
+    data.resize(4 + std::size_t{c->length} + 4);
+    if (!read(c->offset + 4, data.size(), reinterpret_cast<std::uint8_t*>(data.data()))) break;
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(data.data());
+    if (vision::png_crc(bytes, 4 + c->length) != vision::png_u32(bytes + 4 + c->length))
+      continue;  // a damaged chunk says nothing
+    const std::optional<std::string> value =
+        chunk_text(c->name(), std::string_view(data).substr(4, c->length), keyword);
     if (!value) continue;
     if (keyword == "Title" && !have_title) {
       out.title = *value;
