@@ -23,6 +23,7 @@
 #include "pictures/picture_params.hpp"
 #include "runtime/guided_tour.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_runner.hpp"
 #include "runtime/servo_step.hpp"
 #include "runtime/simulation.hpp"
 #include "test_paths.hpp"
@@ -53,13 +54,13 @@ Row run(const std::string& name, const std::string& path, const config::Settings
   bundle->id = 1;
   const Scene& sc = *bundle->scene;
   core.publish(std::move(bundle));
+  ServoRunner runner(core, dev);
   const auto tick = [&] {
-    ServoCommand cmd;
-    core.step(dev.read(), false, cmd);
+    ServoTick t;
+    runner.tick(t);
     core.publish_display();
-    dev.write_force(cmd.force_n);
     row.max_guide_n = std::max(row.max_guide_n, length(core.last_guide_force()));
-    row.max_total_n = std::max(row.max_total_n, length(cmd.force_n));
+    row.max_total_n = std::max(row.max_total_n, length(t.command.force_n));
     dev.step(sp.period_s, {});
   };
   for (int k = 0; k < 600; ++k) tick();  // taken, force ramped in

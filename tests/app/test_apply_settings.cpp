@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "runtime/servo_runner.hpp"
 #include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
@@ -37,10 +38,10 @@ TEST(ApplySettings, EachChangeTakesEffectWhereItsFieldSays) {
   KioskFlowParams fp;
   KioskFlow flow(rt.effects(), rt.audio().messages(), fp);
   flow.key(KioskKey::Other, 0.0);  // wake: the tutorial's square is shown
-  const auto tick = [&] {          // the servo thread's part (no servo thread in this test)
-    ServoCommand cmd;
-    rt.core().step(rt.devices().device().read(), false, cmd);
-    rt.devices().device().write_force(cmd.force_n);
+  ServoRunner runner(rt.core(), rt.devices().device());
+  const auto tick = [&] {  // the servo thread's part (no servo thread in this test)
+    ServoTick t;
+    runner.tick(t);
     rt.core().publish_display();
   };
   tick();  // the servo's core takes the square
@@ -101,10 +102,10 @@ TEST(ApplySettings, ToleranceModeRendersAtAStepAndTheKeysMoveAlongTheSteps) {
   KioskFlowParams fp;
   KioskFlow flow(rt.effects(), rt.audio().messages(), fp);
   flow.key(KioskKey::Other, 0.0);  // wake: the tutorial's square is shown
+  ServoRunner runner(rt.core(), rt.devices().device());
   const auto tick = [&] {
-    ServoCommand cmd;
-    rt.core().step(rt.devices().device().read(), false, cmd);
-    rt.devices().device().write_force(cmd.force_n);
+    ServoTick t;
+    runner.tick(t);
     rt.core().publish_display();
   };
   for (int i = 0; i < 5; ++i) tick();

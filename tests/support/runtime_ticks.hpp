@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "haptics/sim_pantograph.hpp"
+#include "runtime/servo_runner.hpp"
 #include "visit/kiosk_runtime.hpp"
 
 namespace hk::test {
@@ -21,16 +22,17 @@ inline app::RuntimeOptions headless_runtime_options(const std::filesystem::path&
   return ro;
 }
 
-/// One servo tick of `dt` [s] as the servo thread does it (read the simulated pantograph, step, publish the
-/// display, write the force), the handle pushed by `hand_force(sim)` [N] (the model hand), then collect().
+/// One servo tick of `dt` [s] as the servo thread does it (ServoRunner::tick: read the simulated pantograph,
+/// step, write the force; then publish the display), the handle pushed by `hand_force(sim)` [N] (the model
+/// hand), then the window thread's collect.
 /// Requires the runtime's device to be the simulated pantograph.
 inline void runtime_tick(app::KioskRuntime& rt, double dt,
                          const std::function<Vec2(const SimulatedPantograph&)>& hand_force) {
   auto& sim = dynamic_cast<SimulatedPantograph&>(rt.devices().device());
-  app::ServoCommand cmd;
-  rt.core().step(sim.read(), false, cmd);
+  app::ServoRunner runner(rt.core(), sim);
+  app::ServoTick t;
+  runner.tick(t);
   rt.core().publish_display();
-  sim.write_force(cmd.force_n);
   sim.step(dt, hand_force ? hand_force(sim) : Vec2{});
   rt.core().collect_retired();
 }
