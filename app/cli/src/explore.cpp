@@ -22,6 +22,7 @@
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
 #include "haptics/tolerance_cut.hpp"
+#include "hk/level_choice.hpp"
 #include "pictures/capture.hpp"
 #include "pictures/documents.hpp"
 #include "pictures/image_scene.hpp"
@@ -103,12 +104,13 @@ void write_overlay(const std::filesystem::path& out, const ImageScene& is, int l
     return cv::Point(static_cast<int>(std::lround(p.x * 4)), static_cast<int>(std::lround(p.y * 4)));
   };
   const Scene& sc = *is.scene;
+  const LevelChoice choice = LevelChoice::of_id(level);
   for (std::size_t c = 0; c < sc.curve_count(); ++c) {
     const int l = sc.clamp_level(c, level);
     std::vector<cv::Point> pts;
-    if (is_cut_level(level)) {  // a cut step: the cut's joined polyline, what the walls were
+    if (choice.kind == LevelChoice::Kind::Cut) {  // a cut step: the cut's joined polyline, what the walls were
       std::vector<SegmentRef> cut;
-      tolerance_cut(sc, c, kToleranceLadder_m[tolerance_step_of(level)], &cut);
+      tolerance_cut(sc, c, kToleranceLadder_m[choice.index], &cut);
       for (const Vec2& p : joined_cut_points(sc, c, cut.data(), cut.size())) pts.push_back(fixed(to_px(is.px_to_m, p)));
     } else {
       const Vec2* p = sc.points(c, l);
@@ -380,9 +382,9 @@ void add_level_summary(json& sj, const RunRecord& rec, const config::Settings& s
   for (int l = 0; l < kLevelIds; ++l) {
     if (rec.level_ticks[static_cast<std::size_t>(l)] == 0) continue;
     json e = {{"level", l}, {"ticks", rec.level_ticks[static_cast<std::size_t>(l)]}};
-    if (tolerance_step_of(l) >= 0)
-      e["tolerance_m"] = kToleranceLadder_m[tolerance_step_of(l)];  // a tolerance or cut step's id
-    if (is_cut_level(l)) e["cut"] = true;
+    const LevelChoice choice = LevelChoice::of_id(l);
+    if (choice.kind != LevelChoice::Kind::Level) e["tolerance_m"] = kToleranceLadder_m[choice.index];
+    if (choice.kind == LevelChoice::Kind::Cut) e["cut"] = true;
     lt.push_back(std::move(e));
   }
   sj["levels"] = {{"mode", s.haptics.level_mode},

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "hk/level_choice.hpp"
+
 namespace hk::app {
 
 PictureTexture::PictureTexture(int side_px) {
@@ -276,8 +278,8 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
   draw_picture(v, tex, sh, hc);
   draw_workspace_frame(v, app.half());
   draw_text_blocks(v, sh, hc);
-  const int cut_step =
-      is_cut_level(app.stage().level()) && !sh.cuts.empty() ? tolerance_step_of(app.stage().level()) : -1;
+  const LevelChoice choice = LevelChoice::of_id(app.stage().level());
+  const int cut_step = choice.kind == LevelChoice::Kind::Cut && !sh.cuts.empty() ? choice.index : -1;
   draw_curves(app, v, sh, hc, cut_step);
   if (app.switches().overlay() && sh.scene) draw_error_boxes(app, v, sh, cut_step);
   const ServoDisplayState& d = app.core().display();

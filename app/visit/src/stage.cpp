@@ -44,7 +44,7 @@ Stage::Stage(ServoStep& step, Voice& voice, const audio::AudioSystem& audio, Tou
       shelf_(shelf),
       s_(settings),
       half_(half_m),
-      level_(settings.haptics.level),
+      level_(LevelChoice::of_id(settings.haptics.level)),
       auto_level_(settings.haptics.level_mode != "fixed") {}
 
 void Stage::show_tutorial(TutorialShape shape) {
@@ -101,7 +101,7 @@ void Stage::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<
   sh.cuts.clear();
   if (s_.haptics.level_mode == "cut") add_cuts(sc, sh);
   ServoParams sp = servo_params_from(s_);
-  sp.level = auto_level_ ? s_.haptics.level : level_;  // auto: where the policy starts
+  sp.level = auto_level_ ? s_.haptics.level : level_.id();  // auto: where the policy starts
   sp.auto_level = auto_level_;
   auto bundle = std::make_unique<SceneBundle>(std::move(scene), sp);
   bundle->id = id;
@@ -232,22 +232,18 @@ bool Stage::change_level(int delta) {
   // another picture or page is asked for (reset_level) or the session ends. With a tolerance or cut step in use
   // (level_mode = "tolerance" or "cut") the keys move along the steps, so finer and coarser keep their order (and
   // their earcons) without comparing a step with a level.
-  const int now = level();
-  const int next = now + delta;
-  const bool in_range = is_tolerance_level(now) ? is_tolerance_level(next)
-                        : is_cut_level(now)     ? is_cut_level(next)
-                                                : (next >= 0 && next <= s_.haptics.max_levels);
-  if (!in_range) return false;
-  level_ = next;
+  const std::optional<LevelChoice> next = LevelChoice::of_id(level()).stepped(delta, s_.haptics.max_levels);
+  if (!next) return false;
+  level_ = *next;
   auto_level_ = false;
-  step_.request_level(level_);
+  step_.request_level(level_.id());
   return true;
 }
 
 void Stage::reset_level(bool at_once) {
-  level_ = s_.haptics.level;
+  level_ = LevelChoice::of_id(s_.haptics.level);
   auto_level_ = s_.haptics.level_mode != "fixed";
-  if (at_once) step_.request_level(auto_level_ ? ServoStep::kAutoLevel : level_);
+  if (at_once) step_.request_level(auto_level_ ? ServoStep::kAutoLevel : level_.id());
 }
 
 void Stage::new_visitor() {

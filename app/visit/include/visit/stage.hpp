@@ -19,6 +19,7 @@
 #include "audio/system.hpp"
 #include "config/settings.hpp"
 #include "formats/picture_notes.hpp"
+#include "hk/level_choice.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_shelf.hpp"
 #include "pictures/text_reader.hpp"
@@ -86,8 +87,8 @@ class Stage final : public StageEffects {
   std::string where() override;
   /// The blocks of text of the page shown, and the one under the proxy (as Describe reads it).
   PageText page_text() override;
-  /// From the level in use (chosen by hand speed in auto mode): the visitor's choice then holds until
-  /// reset_level. With a tolerance or cut step in use the keys move along the steps.
+  /// From the level in use (chosen by hand speed in auto mode), one step of the same kind (LevelChoice::stepped:
+  /// a level, or along the tolerance or cut steps): the visitor's choice then holds until reset_level.
   bool change_level(int delta) override;
   bool auto_level() const override { return auto_level_; }
 
@@ -143,7 +144,7 @@ class Stage final : public StageEffects {
   int shown_id_ = -100;
   ShownSource source_;
   std::uint64_t scenes_published_ = 0;
-  int level_ = 1;                                 // the fixed level (auto_level_ false)
+  LevelChoice level_;                             // the visitor's or the operator's fixed choice (auto_level_ false)
   bool auto_level_ = true;                        // levels from hand speed
   bool far_near_said_ = false;                    // Where on a practice shape has said what far and near mean
   int screen_side_px_ = kScreenPictureMaxSidePx;  // set_screen_picture_side_px
