@@ -1,4 +1,4 @@
-// Who mounts a stick (vision/stick_mount.hpp): the choice between the kiosk itself and the mount helper,
+// Who mounts a stick (sticks/stick_mount.hpp): the choice between the kiosk itself and the mount helper,
 // and the kiosk's side of the helper's protocol, against fake helpers (shell scripts) that answer as
 // hk-stick-mount does, refuse, hang, die or talk nonsense. No root needed: nothing is mounted.
 

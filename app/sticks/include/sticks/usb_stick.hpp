@@ -17,7 +17,7 @@
 /// 4. on removal or destruction, umount2(MNT_DETACH) and remove the mount point.
 /// The kiosk needs CAP_SYS_ADMIN for steps 2 and 3; have_mount_capability() tells beforehand. Without it,
 /// the installed kiosk mounts through the narrow helper hk-stick-mount (app/stick_helper, reached through
-/// vision/stick_mount.hpp), which runs this same code with the capability.
+/// sticks/stick_mount.hpp), which runs this same code with the capability.
 ///
 /// The mount root and the mount point are reached from "/" one folder at a time without following any
 /// symbolic link, and mount(2) and umount2(2) are given the opened folder (/proc/self/fd/N), never a path
