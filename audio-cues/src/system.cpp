@@ -41,18 +41,8 @@ AudioSystem::~AudioSystem() {
   speaker_.reset();
 }
 
-void AudioSystem::say(MessageId id, std::initializer_list<MessageArg> args) { say_text(catalog_.text(id, args)); }
-
 void AudioSystem::say_text(std::string text, bool keep) {
   if (speaker_) speaker_->say(std::move(text), keep);
-}
-
-void AudioSystem::repeat() {
-  if (speaker_) speaker_->repeat();
-}
-
-void AudioSystem::stop_speech() {
-  if (speaker_) speaker_->cancel();
 }
 
 bool AudioSystem::pause_speech() { return speaker_ && speaker_->pause(); }

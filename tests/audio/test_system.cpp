@@ -46,7 +46,7 @@ bool until_heard(AudioSystem& a) {
 TEST(AudioSystem, SpeaksCatalogueMessagesThroughTheMix) {
   AudioSystem a(headless());
   ASSERT_TRUE(a.speech_available());
-  a.say(MessageId::picture_loaded, {{"picture", "1"}, {"pictures", "4"}, {"shapes", "3"}});
+  a.say_text(a.messages().text(MessageId::picture_loaded, {{"picture", "1"}, {"pictures", "4"}, {"shapes", "3"}}));
   ASSERT_TRUE(until_heard(a));
   const std::vector<float> x = pull(a, 1.0);
   EXPECT_GT(test::rms(x, 0, x.size()), 0.01) << "the message is heard";
@@ -74,7 +74,7 @@ TEST(AudioSystem, NewSessionResetsTheVolumeAndStopsSpeech) {
   EXPECT_TRUE(a.volume_up());
   EXPECT_TRUE(a.volume_up());
   EXPECT_EQ(a.volume().step(), 7);
-  a.say(MessageId::help);
+  a.say_text(a.messages().text(MessageId::help));
   ASSERT_TRUE(until_heard(a));
   const std::vector<float> before = pull(a, 0.5);
   ASSERT_GT(test::rms(before, 0, before.size()), 0.01) << "help was being spoken";
@@ -91,7 +91,7 @@ TEST(AudioSystem, RunsWithoutASoundCard) {
   if (!a.sound_output()) {
     EXPECT_FALSE(a.output_info()->why_not.empty());
   }
-  a.say(MessageId::welcome);
+  a.say_text(a.messages().text(MessageId::welcome));
   EXPECT_EQ(a.speech_log().size(), 1u);
 }
 
@@ -100,7 +100,7 @@ TEST(AudioSystem, TranslationChoosesItsVoiceAndBadOnesAreRefused) {
   p.messages_file = std::string(HK_TEST_DATA_DIR) + "/messages/de.toml";
   AudioSystem de(p);
   EXPECT_EQ(de.messages().voice(), "de");
-  de.say(MessageId::volume_up);
+  de.say_text(de.messages().text(MessageId::volume_up));
   EXPECT_EQ(de.speech_log().back().second, "Lauter.");
   p.messages_file = std::string(HK_TEST_DATA_DIR) + "/messages/missing_key.toml";
   EXPECT_THROW(AudioSystem bad(p), MessageError);

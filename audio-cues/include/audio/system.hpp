@@ -52,15 +52,9 @@ class AudioSystem {
   /// cues()): the camera's Shutter. Returns at once; false when the queue is full (dropped).
   bool play(CueKind kind) noexcept;
 
-  /// Speaks message `id` (placeholders filled from `args`), cutting off whatever is being said. Returns at once.
-  void say(MessageId id, std::initializer_list<MessageArg> args = {});
   /// Speaks free text (e.g. a picture description), cutting off whatever is being said. `keep` as
-  /// Speaker::say: false for an acknowledgement that repeat() should pass over. Any length (Speaker::say).
+  /// Speaker::say: false for an acknowledgement, which Speaker::repeat passes over. Any length (Speaker::say).
   void say_text(std::string text, bool keep = true);
-  /// Says the last text kept again, from its start.
-  void repeat();
-  /// Stops speech now.
-  void stop_speech();
   /// Holds speech where it is (Speaker::pause); false when nothing is being said.
   bool pause_speech();
   /// Goes on from the pause (Speaker::resume); false when not paused.
