@@ -18,6 +18,7 @@
 #include "haptics/sim_pantograph.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_runner.hpp"
 #include "runtime/servo_step.hpp"
 #include "runtime/simulation.hpp"
 
@@ -49,10 +50,10 @@ struct Rig {
         core(CueTrackerParams{}, nullptr) {
     device.open();
   }
+  ServoRunner runner{core, device};
   void tick() {
-    ServoCommand cmd;
-    core.step(device.read(), false, cmd);
-    device.write_force(cmd.force_n);
+    ServoTick t;
+    runner.tick(t);  // read, step, write, as the servo thread
     core.publish_display();
     forces.push_back(core.last_output().force_n);
     const ServoDisplayState& d = core.display();

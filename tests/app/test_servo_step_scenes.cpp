@@ -13,6 +13,7 @@
 #include "haptics/sim_pantograph.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
+#include "runtime/servo_runner.hpp"
 #include "runtime/servo_step.hpp"
 #include "runtime/simulation.hpp"
 
@@ -36,6 +37,7 @@ struct Rig {
   ServoStep core;
   Vec2 target{0.0, 0.0};  // the hand pulls towards the square's centre: it presses on the left wall
   std::vector<Vec2> forces, handles;
+  ServoRunner runner{core, device};
 
   Rig() : sp(servo_params_from(s)), device(sim_params(s), {-0.03, 0.0}), core(CueTrackerParams{}, &cues) {
     device.open();
@@ -51,9 +53,8 @@ struct Rig {
   void run(double seconds) {
     const long n = static_cast<long>(seconds / sp.period_s + 0.5);
     for (long k = 0; k < n; ++k) {
-      ServoCommand cmd;
-      core.step(device.read(), false, cmd);
-      device.write_force(cmd.force_n);
+      ServoTick t;
+      runner.tick(t);  // read, step, write, as the servo thread
       core.publish_display();
       forces.push_back(core.last_output().force_n);
       handles.push_back(core.display().handle_m);
