@@ -14,7 +14,8 @@
 //        BM_Closest/<method>/<segments>   — closest point on the same scenes
 //        BM_Picture/<method>/<picture>    — the handle sweeps of an explore raster run on that picture
 //        BM_Level/<method>/<level>        — speed against accuracy: 4 pictures, queries at each level
-//        BM_Cut/<method>/<step>/<picture> — the same at the tolerance cut of a step (ours: first_hit_cut; the
+//        BM_Cut/<method>/<step>/<picture> — the same at the tolerance cut of a step (ours: first_hit at level id
+//        kCutLevelBase + step; the
 //                                           peers over the cut's joined pieces, bench::cut_segments)
 // Counters: p50_ns, p99_ns, max_ns per query; clock_ns, net_mean_ns; batch_mean_ns (not for brute); build_ms;
 // bytes_per_segment; segments; max_error_mm; for
@@ -58,7 +59,8 @@ struct Case {
   std::vector<Sweep> stream;
   double build_ms_ours = 0, build_ms_rtree = 0, build_ms_brute = 0, build_ms_embree = 0;
   double max_error_mm = 0;
-  int cut_step = -1;  // ≥ 0: queries at the tolerance cut of that step (first_hit_cut), not at `level`
+  int cut_step =
+      -1;  // ≥ 0: queries at the tolerance cut of that step (first_hit at kCutLevelBase + step), not at `level`
 };
 
 // Largest distance of an original vertex of each curve from the nearest joined piece of that curve's cut at
@@ -119,8 +121,9 @@ void check_equal(Case& c, std::size_t n) {
   for (std::size_t i = 0; i < std::min(n, c.stream.size()); ++i) {
     const Sweep& s = c.stream[i];
     QueryBudget unlimited_cut;
-    const SweepHit h = c.cut_step >= 0 ? fresh.first_hit_cut(s.a, s.b, c.cut_step, nullptr, 0, unlimited_cut)
-                                       : fresh.first_hit(s.a, s.b, c.level, nullptr, 0, QueryBudget{});
+    const SweepHit h = c.cut_step >= 0
+                           ? fresh.first_hit(s.a, s.b, kCutLevelBase + c.cut_step, nullptr, 0, unlimited_cut)
+                           : fresh.first_hit(s.a, s.b, c.level, nullptr, 0, QueryBudget{});
     const PeerHit b = c.brute->first_hit(s.a, s.b);
     if (c.cut_step < 0) {  // first_hit_wide and closest_point take levels only
       QueryBudget unlimited;
@@ -193,7 +196,7 @@ bool first_hit_once(Case* c, Method m, const Sweep& s, QueryStats* st) {
     case Method::Ours: {
       if (c->cut_step < 0) return c->ours->first_hit(s.a, s.b, c->level, nullptr, 0, QueryBudget{}, st).hit;
       QueryBudget unlimited;
-      return c->ours->first_hit_cut(s.a, s.b, c->cut_step, nullptr, 0, unlimited, st).hit;
+      return c->ours->first_hit(s.a, s.b, kCutLevelBase + c->cut_step, nullptr, 0, unlimited, st).hit;
     }
     case Method::Wide: {
       QueryBudget unlimited;

@@ -195,7 +195,7 @@ if lvl:
         ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=COLORS[method], label=method)
         for p in pts:
             ax.annotate("L%d" % p[2], (p[0], p[1]), textcoords="offset points", xytext=(4, 3), fontsize=7, color=COLORS[method])
-    # Queries at the tolerance cut (ours: first_hit_cut; the peers over the cut's joined pieces): a point per
+    # Queries at the tolerance cut (ours: first_hit at the cut's level id; the peers over the cut's joined pieces): a point per
     # step, its measured error on the y axis as for the levels.
     for method in [m for m in METHODS if cuts[m]]:
         pts = []

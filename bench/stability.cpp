@@ -121,10 +121,10 @@
 
 #include "config/device_profile.hpp"
 #include "config/settings.hpp"
-#include "haptics/pantograph.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
 #include "haptics/sim_pantograph.hpp"
+#include "kinematics/pantograph.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/runtime_params.hpp"
 #include "runtime/simulation.hpp"

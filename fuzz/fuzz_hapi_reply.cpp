@@ -24,10 +24,10 @@
 
 #include "fuzz_common.hpp"
 #include "haptics/hapi_protocol.hpp"
-#include "haptics/haply_mechanism.hpp"
 #include "haptics/io/byte_transport.hpp"
 #include "haptics/io/haply_device.hpp"
-#include "haptics/pantograph.hpp"
+#include "kinematics/haply_mechanism.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace {
 

@@ -16,7 +16,7 @@
 #include <limits>
 #include <vector>
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk::bench {
 

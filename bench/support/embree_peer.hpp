@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 #include "peer_hit.hpp"
 
 namespace hk::bench {

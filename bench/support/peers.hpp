@@ -40,7 +40,7 @@ inline std::vector<std::pair<Vec2, Vec2>> flat_segments(const Scene& sc, int lev
 /// Every piece of the joined tolerance cut at step `step` (kToleranceLadder_m[step]) of every curve, as a flat
 /// array of end-point pairs: hk::tolerance_cut, then hk::joined_cut_points, curve by curve (a closed curve's
 /// last piece runs back to its first vertex). Built from the cut's own functions, not from the masks that
-/// BoundarySection::first_hit_cut walks with, so a peer over these checks that walk.
+/// BoundarySection::first_hit walks with at a cut step, so a peer over these checks that walk.
 inline std::vector<std::pair<Vec2, Vec2>> cut_segments(const Scene& sc, int step) {
   std::vector<std::pair<Vec2, Vec2>> v;
   std::vector<SegmentRef> cut;

@@ -8,8 +8,8 @@
 #include <cstdio>
 
 #include "detail.hpp"
-#include "haptics/haply_mechanism.hpp"
-#include "haptics/pantograph.hpp"
+#include "kinematics/haply_mechanism.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace hk::config {
 namespace {

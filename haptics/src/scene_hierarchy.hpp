@@ -3,7 +3,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 namespace scene_detail {

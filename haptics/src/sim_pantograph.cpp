@@ -13,6 +13,18 @@ namespace hk {
 
 namespace {
 
+/// One axis of a rigid, perfectly inelastic stop: the position clamped to [lo, hi] [m] and the velocity into
+/// the stop killed [m/s].
+void stop_axis(double lo, double hi, double& position, double& velocity) noexcept {
+  if (position < lo) {
+    position = lo;
+    velocity = std::max(velocity, 0.0);
+  } else if (position > hi) {
+    position = hi;
+    velocity = std::min(velocity, 0.0);
+  }
+}
+
 [[noreturn]] void bad_param(const std::string& what) { throw hk::ArgumentError("simulated pantograph: " + what); }
 
 bool finite_nonneg(double v) { return std::isfinite(v) && v >= 0.0; }
@@ -136,21 +148,8 @@ void SimulatedPantograph::step(double dt_s, Vec2 hand_force_n) noexcept {
 }
 
 void SimulatedPantograph::apply_stops() noexcept {
-  // A rigid, perfectly inelastic stop: clamp the position and kill the velocity into the stop.
-  if (position_m_.x < stop_min_m_.x) {
-    position_m_.x = stop_min_m_.x;
-    velocity_m_per_s_.x = std::max(velocity_m_per_s_.x, 0.0);
-  } else if (position_m_.x > stop_max_m_.x) {
-    position_m_.x = stop_max_m_.x;
-    velocity_m_per_s_.x = std::min(velocity_m_per_s_.x, 0.0);
-  }
-  if (position_m_.y < stop_min_m_.y) {
-    position_m_.y = stop_min_m_.y;
-    velocity_m_per_s_.y = std::max(velocity_m_per_s_.y, 0.0);
-  } else if (position_m_.y > stop_max_m_.y) {
-    position_m_.y = stop_max_m_.y;
-    velocity_m_per_s_.y = std::min(velocity_m_per_s_.y, 0.0);
-  }
+  stop_axis(stop_min_m_.x, stop_max_m_.x, position_m_.x, velocity_m_per_s_.x);
+  stop_axis(stop_min_m_.y, stop_max_m_.y, position_m_.y, velocity_m_per_s_.y);
 }
 
 Vec2 model_hand_force(const ModelHandParams& p, Vec2 target_m, Vec2 handle_m, Vec2 handle_velocity_m_per_s) noexcept {

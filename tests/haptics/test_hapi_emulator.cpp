@@ -18,10 +18,10 @@
 
 #include "haptics/hapi_emulator.hpp"
 #include "haptics/hapi_protocol.hpp"
-#include "haptics/haply_mechanism.hpp"
-#include "haptics/pantograph.hpp"
 #include "haptics/pty_emulator.hpp"
 #include "hk/error.hpp"
+#include "kinematics/haply_mechanism.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace hk::hapi {
 namespace {

@@ -13,8 +13,8 @@
 
 #include "haptics/device.hpp"
 #include "haptics/hapi_protocol.hpp"
-#include "haptics/haply_mechanism.hpp"
-#include "haptics/pantograph.hpp"
+#include "kinematics/haply_mechanism.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace hk::hapi {
 namespace {

@@ -12,9 +12,9 @@
 #include <random>
 #include <vector>
 
-#include "haptics/pantograph.hpp"
 #include "haptics/sim_pantograph.hpp"
 #include "hk/error.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace hk {
 namespace {

@@ -116,13 +116,14 @@ TEST(Peers, FirstHitAndClosestPointAgreeAcrossMethods) {
 
 // First hits and closest points at the tolerance cut instead of a level. Each of the eight steps' cuts (segments
 // of mixed levels, joined where the level changes) is taken apart by the cut's own functions (tolerance_cut,
-// joined_cut_points: bench::cut_segments) and handed to brute force, the R-tree and Embree; first_hit_cut
-// walks the boundary section with the cut masks instead. 15 000 queries a step, 120 000 in all, every one
-// against the three peers: the same hits and t bit for bit; every 5th also a closest point on the whole cut
-// (against brute force) and on one curve's (against its joined polyline, within 20 mm). Every 7th query is repeated on
-// a second section with a budget of 6 optional box tests (a new one each step): an exact answer there must be the same,
-// a blocked one must not claim the sweep clear past the true hit. The scene mixes smooth blobs and strokes with a
-// staircase circle and squares, so that the cuts change level along curves (counted: the check must cover joins).
+// joined_cut_points: bench::cut_segments) and handed to brute force, the R-tree and Embree; first_hit at
+// level id kCutLevelBase + step walks the boundary section with the cut masks instead. 15 000 queries a step, 120 000
+// in all, every one against the three peers: the same hits and t bit for bit; every 5th also a closest point on the
+// whole cut (against brute force) and on one curve's (against its joined polyline, within 20 mm). Every 7th query is
+// repeated on a second section with a budget of 6 optional box tests (a new one each step): an exact answer there must
+// be the same, a blocked one must not claim the sweep clear past the true hit. The scene mixes smooth blobs and strokes
+// with a staircase circle and squares, so that the cuts change level along curves (counted: the check must cover
+// joins).
 TEST(Peers, FirstHitAndClosestPointAtTheToleranceCutAgreeAcrossMethods) {
   std::mt19937 rng(44);
   Vec2 half;
@@ -161,7 +162,7 @@ TEST(Peers, FirstHitAndClosestPointAtTheToleranceCutAgreeAcrossMethods) {
     for (int i = 0; i < 15000; ++i) {
       const Vec2 p = walk.p, q = walk.next();
       QueryBudget unlimited;
-      const SweepHit h = ours.first_hit_cut(p, q, step, nullptr, 0, unlimited);
+      const SweepHit h = ours.first_hit(p, q, kCutLevelBase + step, nullptr, 0, unlimited);
       const bench::PeerHit hb = brute.first_hit(p, q);
       const bench::PeerHit hr = rtree.first_hit(p, q);
       const bench::PeerHit he = embree.first_hit(p, q);
@@ -195,7 +196,7 @@ TEST(Peers, FirstHitAndClosestPointAtTheToleranceCutAgreeAcrossMethods) {
       if (i % 7 == 0) {
         QueryBudget small;
         small.max_box_tests = 6;
-        const SweepHit hs = budgeted.first_hit_cut(p, q, step, nullptr, 0, small);
+        const SweepHit hs = budgeted.first_hit(p, q, kCutLevelBase + step, nullptr, 0, small);
         if (hs.hit) {
           ASSERT_TRUE(hb.hit) << "step " << step << " query " << i;
           ASSERT_EQ(hs.t, hb.t) << "step " << step << " query " << i;

@@ -152,7 +152,7 @@ TEST(ToleranceCut, JoinedPiecesLieInTheirBoxesAndKeepVerticesWithinBoundPlusShif
   EXPECT_GT(breaks, 20u);  // the scene mixes levels, so the joins were exercised
 }
 
-// The masks first_hit_cut walks with mark exactly the segments of each step's cut, and joined_cut_segment
+// The masks first_hit walks with at a cut step mark exactly the segments of each step's cut, and joined_cut_segment
 // gives each cut segment the two vertices joined_cut_points gives its piece (bit for bit), on curves whose
 // cuts change level (counted).
 TEST(ToleranceCut, MasksMarkTheCutAndJoinedSegmentsAreThePiecesOfTheJoinedPolyline) {

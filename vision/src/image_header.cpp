@@ -98,30 +98,25 @@ class Reader {
     bytes(off, 1, &b);
     return b;
   }
-  std::uint16_t u16(std::uint64_t off, bool little) {
-    std::uint8_t b[2];
-    bytes(off, 2, b);
-    return little ? static_cast<std::uint16_t>(b[0] | (b[1] << 8)) : static_cast<std::uint16_t>((b[0] << 8) | b[1]);
-  }
-  std::uint32_t u32(std::uint64_t off, bool little) {
-    std::uint8_t b[4];
-    bytes(off, 4, b);
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(b[little ? i : 3 - i]) << (8 * i);
-    return v;
-  }
-  std::uint64_t u64(std::uint64_t off, bool little) {
-    std::uint8_t b[8];
-    bytes(off, 8, b);
-    std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(b[little ? i : 7 - i]) << (8 * i);
-    return v;
-  }
+  std::uint16_t u16(std::uint64_t off, bool little) { return uint_at<std::uint16_t>(off, little); }
+  std::uint32_t u32(std::uint64_t off, bool little) { return uint_at<std::uint32_t>(off, little); }
+  std::uint64_t u64(std::uint64_t off, bool little) { return uint_at<std::uint64_t>(off, little); }
   [[noreturn]] void corrupt(const std::string& what) {
     throw_input_error(path_, std::string("corrupt ") + format_ + " header: " + what);
   }
 
  private:
+  /// The unsigned integer of sizeof(T) bytes at `off`, little- or big-endian.
+  template <typename T>
+  T uint_at(std::uint64_t off, bool little) {
+    std::uint8_t b[sizeof(T)];
+    bytes(off, sizeof(T), b);
+    T v = 0;
+    for (std::size_t i = 0; i < sizeof(T); ++i)
+      v |= static_cast<T>(static_cast<T>(b[little ? i : sizeof(T) - 1 - i]) << (8 * i));
+    return v;
+  }
+
   ByteSource& src_;
   const std::string& path_;
   const char* format_;

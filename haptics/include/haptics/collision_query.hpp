@@ -144,7 +144,7 @@ class BoundarySection {
   void reset() noexcept;
 
   /// First hit of the sweep a→b against the polylines at level id `level` (clamped per curve to its coarsest;
-  /// a cut step: its cut's joined segments, see first_hit_cut),
+  /// at a cut step, level id kCutLevelBase + step, its tolerance cut's joined segments: see below),
   /// ignoring up to kMaxExcluded segments (the contact solver's active constraints). Updates the
   /// boundary section, which serves this id and the previous query's (splits stop at the coarser of the
   /// two; a new id coarsens the entries below its walls, O(section entries), O(levels) each at a cut step).
@@ -152,6 +152,15 @@ class BoundarySection {
   /// ball, or inside the ball of its walls (at most 16 segment tests), is answered without a box test of its own, and
   /// pays one merge check full queries left owed, two while more than 8 are (one optional box test each).
   /// Charges its box tests to `budget` (see QueryBudget). Real-time safe.
+  /// At level id kCutLevelBase + step (0 ≤ step < kToleranceSteps, tolerance kToleranceLadder_m[step]) the walls are
+  /// the tolerance cut's instead of a level's: each curve's segments of mixed levels that tolerance_cut chooses
+  /// (refined while a box's error bound exceeds the tolerance; seed §3, "contact computations at a desired tolerance
+  /// level"), drawn joined (joined_cut_segment: where the cut changes level, both pieces meet at the finer segment's
+  /// end). The walk is the same, stopping at the cut's segments: each joined piece lies inside its own segment's error
+  /// box (tolerance_cut.hpp), so the boxes prune it exactly as they prune a level; a box above the cut holds every
+  /// joined piece under it. A change of step, or between a step and a level, keeps the section. The answer's segment
+  /// is the cut segment hit (its own level and index). Answers equal a brute-force test of the joined polylines (t bit
+  /// for bit; tests).
   SweepHit first_hit(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
                      QueryStats* stats = nullptr) noexcept;
   /// The same first hit through the scene's wide index alone (wide_index.hpp), for comparison with
@@ -173,26 +182,10 @@ class BoundarySection {
   /// the boundary section. Real-time safe.
   SweepHit first_hit_wide(Vec2 a, Vec2 b, int level, const SegmentRef* excluded, int excluded_count,
                           QueryBudget& budget, QueryStats* stats = nullptr) noexcept;
-  /// First hit against the tolerance cut at step `step` (0 ≤ step < kToleranceSteps, tolerance
-  /// kToleranceLadder_m[step]) instead of a level; the same as first_hit at level id kCutLevelBase + step: each curve's
-  /// segments of mixed levels that tolerance_cut chooses (refined while a box's error bound exceeds the tolerance; seed
-  /// §3, "contact computations at a desired tolerance level"), drawn joined (joined_cut_segment: where the cut changes
-  /// level, both pieces meet at the finer segment's end). The walk is first_hit's, through the same boundary section,
-  /// stopping at the cut's segments instead of a level's: each joined piece lies inside its own segment's error box
-  /// (tolerance_cut.hpp), so the boxes prune it exactly as they prune a level; a box above the cut holds every
-  /// joined piece under it (both its ends are points under the box). A change of step, or between a step and a
-  /// level, keeps the section (first_hit). The answer's segment is the cut segment hit
-  /// (its own level and index); anytime and budget as first_hit. Answers equal a brute-force test of the
-  /// joined polylines (t bit for bit; tests). first_hit_wide does not walk a cut: the wide index's rectangles
-  /// hold each level's own pieces, not the joined ones (closest points at a cut: closest_point_cut). Real-time safe.
-  SweepHit first_hit_cut(Vec2 a, Vec2 b, int step, const SegmentRef* excluded, int excluded_count, QueryBudget& budget,
-                         QueryStats* stats = nullptr) noexcept {
-    return first_hit(a, b, kCutLevelBase + step, excluded, excluded_count, budget, stats);
-  }
-  /// Closest point on the tolerance cut at step `step` (its joined pieces, as first_hit_cut meets them) to p
-  /// within max_distance_m; false when nothing is that close. `curve` ≥ 0 restricts it to that curve. Ties as
-  /// closest_point (the smallest (curve, level, segment)). A distance-pruned depth-first walk of the tree of
-  /// error boxes from the scene root, nearest box first (branch and bound, as closest_point): each joined
+  /// Closest point on the tolerance cut at step `step` (its joined pieces, as first_hit meets them at level id
+  /// kCutLevelBase + step) to p within max_distance_m; false when nothing is that close. `curve` ≥ 0 restricts it to
+  /// that curve. Ties as closest_point (the smallest (curve, level, segment)). A distance-pruned depth-first walk of
+  /// the tree of error boxes from the scene root, nearest box first (branch and bound, as closest_point): each joined
   /// piece lies inside its own segment's box, so a box's distance bounds every piece under it from below. Not
   /// the wide index, whose rectangles hold each level's own pieces, and not seeded between calls. With a
   /// `budget`, each box measured is one optional box test; when it runs out the walk stops and returns false

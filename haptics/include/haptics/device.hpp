@@ -13,7 +13,7 @@
 #include <string>
 #include "hk/error.hpp"
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

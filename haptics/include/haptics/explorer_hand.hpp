@@ -41,7 +41,7 @@
 #include <vector>
 
 #include "haptics/hand_controller.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

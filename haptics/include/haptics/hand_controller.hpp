@@ -10,7 +10,7 @@
 /// hand can press harder than its usual max_force_n when it means to push through a wall (pop_force_n).
 
 #include "haptics/hand_path.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

@@ -10,7 +10,7 @@
 #include <vector>
 #include "hk/error.hpp"
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

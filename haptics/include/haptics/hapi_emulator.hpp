@@ -35,10 +35,10 @@
 #include <vector>
 
 #include "haptics/hapi_protocol.hpp"
-#include "haptics/haply_mechanism.hpp"
-#include "haptics/pantograph.hpp"
 #include "haptics/sim_pantograph.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
+#include "kinematics/haply_mechanism.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace hk::hapi {
 

@@ -20,8 +20,8 @@
 #include <cstdint>
 #include <string>
 
-#include "haptics/vec2.hpp"
 #include "hk/constants.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

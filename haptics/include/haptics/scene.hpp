@@ -32,9 +32,9 @@
 #include <vector>
 
 #include "haptics/multires.hpp"
-#include "haptics/vec2.hpp"
 #include "haptics/wide_index.hpp"
 #include "hk/constants.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

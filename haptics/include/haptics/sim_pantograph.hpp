@@ -20,8 +20,8 @@
 #include <string>
 
 #include "haptics/device.hpp"
-#include "haptics/pantograph.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace hk {
 

@@ -56,11 +56,11 @@ CutStats tolerance_cut(const Scene& scene, std::size_t curve, double tol_m, std:
 std::vector<Vec2> joined_cut_points(const Scene& scene, std::size_t curve, const SegmentRef* cut, std::size_t count);
 
 /// Cut membership of every segment node of `scene` at every tolerance step (hk/constants.hpp), for walks that
-/// stop at the cut instead of a level (BoundarySection::first_hit_cut): scene.node_count() entries; entry n
-/// has bit t set when segment node n is a segment of tolerance_cut(scene, its curve, kToleranceLadder_m[t]).
-/// The bounds are the ones tolerance_cut computes, compared the same way, so the cuts are the same; one pass
-/// down each curve's tree computes each segment's bound once for all steps. Group nodes (chunks, hierarchy)
-/// and segments below every step's cut are 0. Allocates (setup, not the servo path).
+/// stop at the cut instead of a level (BoundarySection::first_hit at level id kCutLevelBase + step): scene.node_count()
+/// entries; entry n has bit t set when segment node n is a segment of tolerance_cut(scene, its curve,
+/// kToleranceLadder_m[t]). The bounds are the ones tolerance_cut computes, compared the same way, so the cuts are the
+/// same; one pass down each curve's tree computes each segment's bound once for all steps. Group nodes (chunks,
+/// hierarchy) and segments below every step's cut are 0. Allocates (setup, not the servo path).
 std::vector<std::uint8_t> tolerance_cut_masks(const Scene& scene);
 
 /// Whether segment node `node` is a segment of tolerance step `step`'s cut: bit `step` of masks[node], where

@@ -34,7 +34,7 @@
 #include "haptics/contact.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/servo.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

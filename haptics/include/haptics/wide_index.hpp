@@ -29,7 +29,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 #include "kiosk/operator_panel.hpp"
 #include "kiosk/window.hpp"
 #include "visit/kiosk_flow.hpp"

@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 #include "pictures/image_scene.hpp"
 
 namespace hk::app {

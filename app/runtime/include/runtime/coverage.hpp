@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "haptics/scene.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk::app {
 

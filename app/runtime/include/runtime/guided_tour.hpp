@@ -47,7 +47,7 @@
 #include "config/settings.hpp"
 #include "haptics/scene.hpp"
 #include "haptics/tour_guide.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk::app {
 

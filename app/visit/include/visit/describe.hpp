@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "haptics/multires.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk::app {
 

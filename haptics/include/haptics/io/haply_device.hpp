@@ -48,9 +48,9 @@
 
 #include "haptics/device.hpp"
 #include "haptics/hapi_protocol.hpp"
-#include "haptics/haply_mechanism.hpp"
 #include "haptics/io/byte_transport.hpp"
-#include "haptics/pantograph.hpp"
+#include "kinematics/haply_mechanism.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace hk::io {
 

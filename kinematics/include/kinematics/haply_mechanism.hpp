@@ -15,8 +15,8 @@
 /// motor (theta1_rad), with θ_ours = θ_h + π (a rotation keeps the sense of rotation); a positive Haply
 /// torque is a positive torque of ours on the same motor (τ = Jᵀ·F holds in both frames).
 
-#include "haptics/pantograph.hpp"
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
+#include "kinematics/pantograph.hpp"
 
 namespace hk::hapi {
 

@@ -36,7 +36,7 @@
 ///
 /// All functions are real-time safe: no allocation, no locks, no exceptions.
 
-#include "haptics/vec2.hpp"
+#include "hk/vec2.hpp"
 
 namespace hk {
 

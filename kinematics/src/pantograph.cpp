@@ -1,7 +1,7 @@
 /// @file pantograph.cpp
 /// Five-bar kinematics and statics. See pantograph.hpp for the frame, the branch and the sources.
 
-#include "haptics/pantograph.hpp"
+#include "kinematics/pantograph.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file vec2.hpp
-/// Small value types of the haptic core: a 2-D vector and free functions on it.
+/// The 2-D vector every module that works in the workspace shares, and free functions on it.
 /// All coordinates are workspace metres unless a name says otherwise (DESIGN.md "Frames and units").
 
 #include <cmath>

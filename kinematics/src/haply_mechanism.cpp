@@ -1,7 +1,7 @@
 /// @file haply_mechanism.cpp
 /// Haply five-bar in our frames. See haply_mechanism.hpp.
 
-#include "haptics/haply_mechanism.hpp"
+#include "kinematics/haply_mechanism.hpp"
 
 #include <cmath>
 #include <numbers>
