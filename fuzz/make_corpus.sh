@@ -9,7 +9,7 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 [ $# -ge 1 ] || { echo "usage: $0 DEST [harness ...]" >&2; exit 2; }
 dest=$1
 shift
-all=(image pdf config messages hand_csv hapi_reply stick_name ocr)
+all=(image pdf config messages hand_csv hapi_reply stick_name ocr annotations)
 [ $# -gt 0 ] && harnesses=("$@") || harnesses=("${all[@]}")
 data=$repo/tests/data
 seeds=$repo/fuzz/seeds
@@ -66,6 +66,9 @@ for h in "${harnesses[@]}"; do
     ocr)
       copy_seeds ocr 16384 "$seeds"/ocr/*
       cp "$dicts/ocr.dict" "$dest/dicts/ocr.dict" ;;
+    annotations)
+      copy_seeds annotations 16384 "$data"/annotations/*.json "$data"/bad/annotations_*.json
+      cp "$dicts/annotations.dict" "$dest/dicts/annotations.dict" ;;
     *)
       echo "make_corpus: unknown harness '$h' (known: ${all[*]})" >&2
       exit 2 ;;

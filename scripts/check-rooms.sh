@@ -8,13 +8,14 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 declare -A allowed=(
   [formats]=""
   [sticks]=""
-  [pictures]="formats sticks"
+  [meaning]="formats"
+  [pictures]="formats sticks meaning"
   [runtime]="formats"
-  [visit]="formats sticks pictures runtime"
-  [cli]="formats sticks pictures runtime visit"
-  [kiosk]="formats sticks pictures runtime visit cli"
+  [visit]="formats sticks meaning pictures runtime"
+  [cli]="formats sticks meaning pictures runtime visit"
+  [kiosk]="formats sticks meaning pictures runtime visit cli"
 )
-rooms="formats sticks pictures runtime visit cli kiosk"
+rooms="formats sticks meaning pictures runtime visit cli kiosk"
 bad=0
 for room in $rooms; do
   while IFS= read -r -d '' file; do

@@ -7,7 +7,7 @@
 #     --seconds N   fuzzing time per harness (default 30)
 #     --jobs J      harnesses run at once, and build jobs (default: nproc)
 #     --build DIR   build folder (default: build-fuzz in the repository root)
-#     harness       image pdf config messages hand_csv hapi_reply stick_name ocr (default: all)
+#     harness       image pdf config messages hand_csv hapi_reply stick_name ocr annotations (default: all)
 #
 # Each harness runs with -max_total_time=N -timeout=10 (pdf: 30, see timeout_s) -rss_limit_mb=2048, a
 # -max_len suited to its input and its dictionary (fuzz/dicts).
@@ -20,7 +20,7 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 seconds=30
 jobs=$(nproc)
 build=$repo/build-fuzz
-all=(image pdf config messages hand_csv hapi_reply stick_name ocr)
+all=(image pdf config messages hand_csv hapi_reply stick_name ocr annotations)
 harnesses=()
 usage() { sed -n '6,11p' "$0" | sed -e 's/^# \{0,1\}//' >&2; exit 2; }
 while [ $# -gt 0 ]; do
@@ -43,7 +43,7 @@ build=$(mkdir -p "$build" && cd "$build" && pwd)
 
 # Largest input per harness [bytes].
 declare -A max_len=([image]=65536 [pdf]=65536 [config]=32768 [messages]=16384 [hand_csv]=8192 [hapi_reply]=1024
-                    [stick_name]=1024 [ocr]=16384)
+                    [stick_name]=1024 [ocr]=16384 [annotations]=16384)
 # Slowest run that is not a "timeout" finding [s]. pdf: poppler is not our code and the kiosk runs it only in
 # the worker process, which is killed after 5 s of CPU; a run within that (slower here, in-process under ASan)
 # is no bug, so only a pathological one (over 30 s) is reported.

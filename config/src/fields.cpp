@@ -121,7 +121,7 @@ std::string pin_hash_problem(std::string_view v) {
   return {};
 }
 
-/// The check of [kiosk] scene_cache: "auto", "off" or an absolute folder.
+/// The check of [kiosk] scene_cache and names_dir: "auto", "off" or an absolute folder.
 std::string scene_cache_problem(std::string_view v) {
   if (v == "auto" || v == "off" || (!v.empty() && v.front() == '/')) return {};
   return "must be \"auto\", \"off\" or an absolute folder";
@@ -404,6 +404,11 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
         "Where built scenes of the library's pictures are kept, so the first picture after a restart is felt at once: "
         "\"auto\" (the service's cache folder, else ~/.cache/haptic-kiosk/scenes), \"off\", or an absolute folder.",
         {}, &scene_cache_problem),
+    HK_FIELD(kiosk, names_dir, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+             "Where names staff give shapes at the kiosk are kept (they win over the file beside the picture): "
+             "\"auto\" (the service's state folder, else ~/.local/share/haptic-kiosk/names), \"off\" (only the "
+             "files beside the pictures), or an absolute folder.",
+             {}, &scene_cache_problem),
     // [stick]
     HK_FIELD(stick, max_depth, FieldGroup::devices, ApplyWhen::restart, 1, 64, "",
              "Deepest folder of a stick that is entered (its root is 0)."),

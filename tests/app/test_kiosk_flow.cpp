@@ -442,55 +442,6 @@ Polyline rect(Vec2 c, Vec2 half, bool closed = true) {
   return p;
 }
 
-TEST(Describe, SizesKindsAndPlaces) {
-  const Vec2 half{0.07, 0.045};
-  const std::vector<Polyline> curves{rect({0.06, -0.035}, {0.004, 0.004}), rect({0, 0}, {0.05, 0.03}),
-                                     rect({-0.05, 0.03}, {0.006, 0.003}, false)};
-  EXPECT_EQ(describe_scene(curves, half),
-            "3 shapes. A large closed shape in the middle, a small line at the far left, and a small closed shape at "
-            "the near right.");
-  EXPECT_EQ(describe_scene({curves[1]}, half), "One shape. A large closed shape in the middle.");
-  EXPECT_EQ(describe_scene({}, half), "There are no shapes in this picture.");
-  std::vector<Polyline> many(6, rect({0.05, 0.03}, {0.002, 0.002}));
-  many.push_back(rect({-0.04, 0}, {0.015, 0.01}));
-  EXPECT_EQ(
-      describe_scene(many, half, 2),
-      "7 shapes. A medium closed shape on the left, a small closed shape at the far right, and 5 more, smaller ones.");
-}
-
-TEST(Describe, ShapesInsideAClosedShapeAreToldWithIt) {
-  const Vec2 half{0.07, 0.045};
-  // A plate at the far left with three holes, and a small line at the near right: the holes are told with
-  // the plate.
-  const Polyline plate = rect({-0.035, 0.02}, {0.03, 0.02});
-  const std::vector<Polyline> holes{rect({-0.05, 0.025}, {0.004, 0.004}), rect({-0.035, 0.015}, {0.005, 0.003}),
-                                    rect({-0.02, 0.03}, {0.003, 0.003}, false)};
-  std::vector<Polyline> scene{holes[0], plate, holes[1], rect({0.05, -0.035}, {0.003, 0.002}, false), holes[2]};
-  EXPECT_EQ(describe_scene(scene, half),
-            "5 shapes. A large closed shape with 3 smaller shapes inside it, at the far left, and a small line at the "
-            "near right.");
-  // Nesting at any depth: a face, an eye in it, a pupil in the eye; the eye alone holds one.
-  const std::vector<Polyline> face{rect({0, 0}, {0.04, 0.03}), rect({-0.015, 0.01}, {0.008, 0.005}),
-                                   rect({-0.015, 0.01}, {0.002, 0.002})};
-  EXPECT_EQ(describe_scene(face, half),
-            "3 shapes. A large closed shape with 2 smaller shapes inside it, in the middle.");
-  EXPECT_EQ(describe_scene({face[1], face[2]}, half),
-            "2 shapes. A small closed shape with a smaller shape inside it, in the middle.");
-  // In an L's bounding box but outside the L (its notch), and overlapping a shape without being in it: not
-  // inside.
-  Polyline ell;
-  ell.closed = true;
-  ell.points_m = {{-0.04, -0.03}, {0.04, -0.03}, {0.04, -0.01}, {-0.02, -0.01}, {-0.02, 0.03}, {-0.04, 0.03}};
-  const Polyline in_notch = rect({0.03, 0.02}, {0.005, 0.005});
-  const Polyline across = rect({-0.04, 0.0}, {0.006, 0.004});
-  EXPECT_EQ(describe_scene({ell, in_notch, across}, half),
-            "3 shapes. A large closed shape in the middle, a small closed shape on the left, and a small closed shape "
-            "at the far right.");
-  // Only the largest few named: the rest counted, the nested ones as told.
-  EXPECT_EQ(describe_scene(scene, half, 1),
-            "5 shapes. A large closed shape with 3 smaller shapes inside it, at the far left, and 1 more, smaller.");
-}
-
 TEST(Describe, FiguresAreGroupsOfTouchingCurves) {
   // A drawing of three strokes that touch (one figure), a separate box (a second), a stroke 1 mm from the
   // box (within the 2 mm margin: the same figure), a dot far away (a third).

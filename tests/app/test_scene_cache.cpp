@@ -91,6 +91,7 @@ ImageScene copy_of(const ImageScene& is, const config::Settings& s) {
   c.line_drawing = is.line_drawing;
   c.polylines = is.polylines;
   c.strength = is.strength;
+  c.descriptors = is.descriptors;
   c.scene = std::make_unique<Scene>(Scene::build(c.polylines, s.haptics.max_levels));
   c.times = is.times;
   return c;
@@ -138,6 +139,18 @@ void expect_same(const ImageScene& a, const ImageScene& b) {
   EXPECT_EQ(a.px_to_m.scale_m_per_px, b.px_to_m.scale_m_per_px);
   EXPECT_EQ(a.px_to_m.offset_x_m, b.px_to_m.offset_x_m);
   EXPECT_EQ(a.px_to_m.offset_y_m, b.px_to_m.offset_y_m);
+  ASSERT_EQ(a.descriptors.size(), b.descriptors.size());
+  for (std::size_t i = 0; i < a.descriptors.size(); ++i) {
+    const meaning::ShapeDescriptor &x = a.descriptors[i], &y = b.descriptors[i];
+    EXPECT_EQ(x.form.form, y.form.form);
+    EXPECT_EQ(x.form.corners, y.form.corners);
+    EXPECT_EQ(x.has_colour, y.has_colour);
+    EXPECT_EQ(x.colour.colour, y.colour.colour);
+    EXPECT_EQ(x.colour.shade, y.colour.shade);
+    EXPECT_EQ(x.size_cm, y.size_cm);
+    EXPECT_EQ(x.length_m, y.length_m);
+    EXPECT_EQ(x.speck, y.speck);
+  }
   EXPECT_EQ(a.chains_texture, b.chains_texture);
   EXPECT_EQ(a.chains_found, b.chains_found);
   EXPECT_EQ(a.thin_line_pairs_merged, b.thin_line_pairs_merged);

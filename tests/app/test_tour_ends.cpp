@@ -2,7 +2,7 @@
 // (data/pictures), the kiosk's own runtime is asked for a tour again and again until every shape has been
 // led to, with the model hand limp as the kiosk makes it during a tour (nobody holds the handle): each tour
 // must end within its bound — one and a half times its planned duration, or the 3 s without progress, plus
-// the fade — with one of the lines that say how it ended ("That was shape …", "Tour stopped.", or that the
+// the fade — with one of the lines that say how it ended ("That was …", "Tour stopped.", or that the
 // guide could not go on and let go), followed by what remains. The shipped horse's tour once held the
 // handle pinned in the tip of the tail for good, saying nothing more.
 #include <gtest/gtest.h>
@@ -100,7 +100,7 @@ TEST_P(EveryTourEnds, OnEveryShapeWithASpokenLineWithinItsBound) {
     EXPECT_LE(took_s, bound_s) << "tour " << tours << " to shape " << plan->curve << " (planned " << plan->duration_s()
                                << " s)";
     const std::string said = k.rt->voice().last_said();
-    const bool traced = starts_with(said, "That was shape ");
+    const bool traced = starts_with(said, "That was ");
     done += traced;
     EXPECT_TRUE(traced || starts_with(said, m.text(audio::MessageId::tour_stopped)) ||
                 starts_with(said, m.text(audio::MessageId::tour_stuck)))

@@ -117,7 +117,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     if (name == "operator.open_chord" || name == "device.serial_path" || name == "device.usb_ids" ||
         name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" ||
         name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "kiosk.scene_cache" ||
-        name == "vision.ocr_languages") {
+        name == "kiosk.names_dir" || name == "vision.ocr_languages") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -127,7 +127,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 39u);
+  EXPECT_EQ(texts, 40u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -431,15 +431,17 @@ TEST(QuietHours, ReadsTwoTimesAndKnowsWhetherAMinuteIsInThem) {
 // [kiosk] scene_cache: "auto", "off" or an absolute folder; a relative one (which would land wherever the
 // service happens to start) is refused naming the key.
 TEST(SceneCacheSetting, TakesAutoOffOrAnAbsoluteFolderOnly) {
-  for (const char* good : {"auto", "off", "/var/cache/haptic-kiosk/scenes"})
-    EXPECT_NO_THROW((void)parse_settings(std::string("[kiosk]\nscene_cache = \"") + good + "\"\n", "k.toml")) << good;
-  for (const char* bad : {"", "scenes", "./cache", "Off"}) {
-    try {
-      (void)parse_settings(std::string("[kiosk]\nscene_cache = \"") + bad + "\"\n", "k.toml");
-      ADD_FAILURE() << "'" << bad << "' was accepted";
-    } catch (const ConfigError& e) {
-      EXPECT_EQ(e.key(), "kiosk.scene_cache") << bad;
-      EXPECT_NE(std::string(e.what()).find("absolute folder"), std::string::npos) << e.what();
+  for (const std::string key : {"scene_cache", "names_dir"}) {
+    for (const char* good : {"auto", "off", "/var/cache/haptic-kiosk/scenes"})
+      EXPECT_NO_THROW((void)parse_settings("[kiosk]\n" + key + " = \"" + good + "\"\n", "k.toml")) << good;
+    for (const char* bad : {"", "scenes", "./cache", "Off"}) {
+      try {
+        (void)parse_settings("[kiosk]\n" + key + " = \"" + bad + "\"\n", "k.toml");
+        ADD_FAILURE() << key << " '" << bad << "' was accepted";
+      } catch (const ConfigError& e) {
+        EXPECT_EQ(e.key(), "kiosk." + key) << bad;
+        EXPECT_NE(std::string(e.what()).find("absolute folder"), std::string::npos) << e.what();
+      }
     }
   }
 }

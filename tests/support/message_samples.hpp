@@ -23,32 +23,36 @@ inline std::string sample_message(const audio::MessageCatalog& m, audio::Message
                                   std::span<const audio::KeyArg> keys) {
   using audio::MessageId;
   const std::string place = m.text(MessageId::place_document, {{"page", "12"}, {"pages", "40"}});
-  return m.text(id,
-                {{"picture", "12"},
-                 {"pictures", "12"},
-                 {"shapes", "30"},
-                 {"title", "a horse, seen from the side"},
-                 {"level", "3"},
-                 {"seconds", "20"},
-                 {"count", "12"},
-                 {"description", id == MessageId::document_page || id == MessageId::document_picture
-                                     ? "It has 2 blocks of text and 3 figures."
-                                     : "a small closed shape with 2 inside it, in a large closed shape"},
-                 {"summary", "3 documents: 2 pictures and a PDF of 12 pages"},
-                 {"reason", "the file is damaged"},
-                 {"name", "Annual report 2025"},
-                 {"page", "12"},
-                 {"pages", "40"},
-                 {"document", "2"},
-                 {"documents", "3"},
-                 {"text", "The quick brown fox jumps over the lazy dog"},
-                 {"place", place},
-                 {"shape", "12"},
-                 {"where", "in the far middle"},
-                 {"key", "The Q key"},
-                 {"block", "2"},
-                 {"blocks", "5"}},
-                keys);
+  return m.text(
+      id,
+      {{"picture", "12"},
+       {"pictures", "12"},
+       {"shapes", "30"},
+       {"title", "a horse, seen from the side"},
+       {"level", "3"},
+       {"seconds", "20"},
+       {"count", "12"},
+       {"description", id == MessageId::document_page || id == MessageId::document_picture
+                           ? "It has 2 blocks of text and 3 figures."
+                       : id == MessageId::where_near || id == MessageId::where_inside || id == MessageId::where_on_part
+                           ? "a small light grey round shape"
+                           : "a small white round shape with 2 small black round shapes inside it"},
+       {"direction", "3 cm farther away, to your right"},
+       {"summary", "3 documents: 2 pictures and a PDF of 12 pages"},
+       {"reason", "the file is damaged"},
+       {"name", "Annual report 2025"},
+       {"page", "12"},
+       {"pages", "40"},
+       {"document", "2"},
+       {"documents", "3"},
+       {"text", "The quick brown fox jumps over the lazy dog"},
+       {"place", place},
+       {"shape", "12"},
+       {"where", "in the far middle"},
+       {"key", "The Q key"},
+       {"block", "2"},
+       {"blocks", "5"}},
+      keys);
 }
 
 }  // namespace hk::test

@@ -23,14 +23,17 @@
 #include "haptics/servo.hpp"
 #include "haptics/tolerance_cut.hpp"
 #include "hk/level_choice.hpp"
+#include "meaning/shape_descriptors.hpp"
 #include "pictures/capture.hpp"
 #include "pictures/documents.hpp"
 #include "pictures/image_scene.hpp"
+#include "pictures/picture_names.hpp"
 #include "pictures/picture_params.hpp"
 #include "runtime/coverage.hpp"
 #include "runtime/cue_tracker.hpp"
 #include "runtime/runtime_params.hpp"
 #include "runtime/simulation.hpp"
+#include "visit/describe.hpp"
 
 namespace hk::app {
 namespace {
@@ -42,6 +45,39 @@ void write_text(const std::filesystem::path& p, const std::string& text) {
   f << text;
   f.close();
   if (!f) throw ExploreError("output '" + p.string() + "': cannot write the file");
+}
+
+/// A curve's `name` and `name_source` in scene.json: staff's ("staff"), else its form's look ("form": "small red
+/// round shape", sizes against the workspace of half extents `half_m` [m]) when it has a form; neither for an
+/// irregular shape without a name.
+void add_curve_name(json& curve, const ImageScene& is, std::size_t source, Vec2 half_m) {
+  if (source < is.shape_region.size() && is.shape_region[source] >= 0) {
+    curve["name"] = is.regions[static_cast<std::size_t>(is.shape_region[source])].name;
+    curve["name_source"] = "staff";
+    return;
+  }
+  if (source >= is.descriptors.size() || is.descriptors[source].form.form == meaning::Form::irregular) return;
+  std::string look = describe_one_look(is.polylines, is.descriptors, source, half_m);
+  curve["name"] = look.substr(look.find(' ') + 1);  // without its article
+  curve["name_source"] = "form";
+}
+
+/// The named regions of `is` that name no curve: scene.json's `regions` [{name, description, bbox_m}].
+json unnamed_regions_json(const ImageScene& is) {
+  json out = json::array();
+  for (std::size_t r = 0; r < is.regions.size(); ++r) {
+    if (std::find(is.shape_region.begin(), is.shape_region.end(), static_cast<int>(r)) != is.shape_region.end())
+      continue;
+    const meaning::NamedRegion& nr = is.regions[r];
+    const cv::Rect& b = nr.box_px;
+    json e = {{"name", nr.name},
+              {"bbox_m",
+               {is.px_to_m.x_m(b.x - 0.5), is.px_to_m.y_m(b.y + b.height - 0.5), is.px_to_m.x_m(b.x + b.width - 0.5),
+                is.px_to_m.y_m(b.y - 0.5)}}};
+    if (!nr.description.empty()) e["description"] = nr.description;
+    out.push_back(std::move(e));
+  }
+  return out;
 }
 
 json scene_json(const ImageScene& is, const config::Settings& s) {
@@ -68,9 +104,21 @@ json scene_json(const ImageScene& is, const config::Settings& s) {
                         {"max_box_half_width_m", ci.max_box_half_width_m[l]},
                         {"max_error_bound_m", ci.max_error_bound_m[l]}});
     }
-    curves.push_back({{"id", c}, {"closed", ci.closed}, {"levels", std::move(levels)}});
+    json curve = {{"id", c}, {"closed", ci.closed}, {"levels", std::move(levels)}};
+    const std::size_t source = sc.source_index(c);
+    add_curve_name(curve, is, source, {s.workspace.width_m / 2, s.workspace.height_m / 2});
+    if (source < is.descriptors.size()) {
+      const meaning::ShapeDescriptor& d = is.descriptors[source];
+      json desc = {{"form", meaning::form_key(d.form.form)}, {"size_cm", d.size_cm}};
+      if (d.has_colour) desc["colour"] = meaning::colour_words(d.colour);
+      if (d.form.form == meaning::Form::polygon || d.form.form == meaning::Form::star) desc["corners"] = d.form.corners;
+      curve["descriptors"] = std::move(desc);
+      curve["speck"] = d.speck;
+    }
+    curves.push_back(std::move(curve));
   }
   j["curves"] = std::move(curves);
+  j["regions"] = unnamed_regions_json(is);
   if (is.page > 0) {
     j["page"] = is.page;
     j["pages"] = is.pages;
@@ -454,7 +502,8 @@ void add_picture_summary(json& sj, const ImageScene& is) {
                     {"thin_lines", is.times.thin_lines_ms},
                     {"gaps", is.times.gaps_ms},
                     {"multires", is.times.multires_ms},
-                    {"tree", is.times.tree_ms}};
+                    {"tree", is.times.tree_ms},
+                    {"descriptors", is.times.descriptors_ms}};
 }
 
 // cues.csv and the WAV: the earcons on the trace's timeline (tick k sounds at t = k · period).
@@ -487,8 +536,11 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   const HandPath path = hand_path_of(o, s, device);
   const std::unique_ptr<HandController> hand = make_hand(o, s, path);
   const std::filesystem::path out = make_out_dir(o.out_dir);
-  const ImageScene is =
+  ImageScene is =
       o.source.empty() ? build_input_scene(o.image_path, o.page, s) : build_capture_scene(o.source, o.page, s, out);
+  if (o.source.empty() && is.page == 0)  // a picture file's staff names, as the library takes them
+    apply_names(is, names_file_for(o.image_path, names_dir(s)),
+                std::filesystem::path(o.image_path).filename().string());
   const Scene& scene = *is.scene;
   const double duration = o.duration_s > 0.0     ? o.duration_s
                           : o.hand == "explorer" ? hand->natural_duration_s()

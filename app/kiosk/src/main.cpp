@@ -96,8 +96,14 @@ void add_explore_command(CLI::App& cli, Commands& c) {
   input->excludes(source);
   source->excludes(input);
   c.explore->add_option("--page", c.eo.page, "Page of a PDF, from 1 (default 1)")->check(CLI::PositiveNumber);
-  c.explore->add_option("--out", c.eo.out_dir, "Folder for scene.json, trace.csv, summary.json, overlay.png")
-      ->required();
+  CLI::Option* out =
+      c.explore->add_option("--out", c.eo.out_dir, "Folder for scene.json, trace.csv, summary.json, overlay.png");
+  CLI::Option* where = c.explore->add_option(
+      "--where", c.eo.where, "X_M,Y_M: print what Where would say with the hand there [m], and run nothing else");
+  CLI::Option* describe =
+      c.explore->add_flag("--describe", c.eo.describe, "Print what Describe would say, and run nothing else");
+  where->excludes(out)->excludes(describe);
+  describe->excludes(out);
   c.explore
       ->add_option(
           "--hand", c.eo.hand,
@@ -174,6 +180,11 @@ int run_command(Commands& c) {
   if (*c.explore) {
     if (c.eo.image_path.empty() && c.eo.source.empty())
       throw hk::app::AppError("explore: give a picture or PDF to explore, or --source");
+    if (!c.eo.where.empty() || c.eo.describe) {
+      std::printf("%s\n", hk::app::explore_answer(c.eo).c_str());
+      return 0;
+    }
+    if (c.eo.out_dir.empty()) throw hk::app::AppError("explore: --out is required (or --where X_M,Y_M, or --describe)");
     c.eo.seed = hk::app::parse_seed(c.seed_text);
     const auto sum = hk::app::run_explore(c.eo);
     std::printf("explore: %ld ticks, %zu curves, contact %ld edge + %ld vertex ticks, max force %.3f N -> %s\n",

@@ -30,6 +30,14 @@ std::size_t approx_scene_bytes(const ImageScene& is) {
   return b + sizeof(ImageScene);
 }
 
+void describe_scene_shapes(ImageScene& is) {
+  const auto start = std::chrono::steady_clock::now();
+  const meaning::PictureColours colours{is.picture, is.px_to_m, is.line_drawing};
+  is.descriptors = is.scene ? meaning::describe_shapes(is.polylines, *is.scene, colours)
+                            : meaning::describe_shapes(is.polylines, colours);
+  is.times.descriptors_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
 void fit_picture(ImageScene& is, int max_side_px) {
   if (max_side_px < 1) throw hk::ArgumentError("fit_picture: max_side_px must be >= 1");
   const int side = std::max(is.picture.cols, is.picture.rows);
@@ -105,6 +113,7 @@ void build_from_chains(ImageScene& out, vision::SceneChains sc, const config::Se
   out.segments_after_budget = out.scene->total_segments(0);
   out.times.multires_ms = out.scene->build_times().multires_ms;
   out.times.tree_ms = out.scene->build_times().tree_ms;
+  describe_scene_shapes(out);
 }
 
 /// OCR's words as a text layer's, for the text mask.

@@ -1,5 +1,6 @@
 // The library's scenes, asked for and built ahead (picture_shelf.hpp).
 #include "pictures/picture_shelf.hpp"
+#include "pictures/picture_names.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -113,6 +114,15 @@ SceneJob PictureShelf::picture_job(int index) const {
   return [path = pictures_[static_cast<std::size_t>(index)], s = s_, cache = cache_, side_px = side_px_] {
     ImageScene is = cached_or_built(path, s, cache, side_px);
     is.notes = notes_of(path, is.file_notes);
+    const std::string names = names_file_for(path, names_dir(s)),
+                      file = std::filesystem::path(path).filename().string();
+    apply_names(is, names, file);
+    if (is.with_text)  // the scene read again with its text keeps the names
+      is.with_text = [read = std::move(is.with_text), names, file](const std::atomic<bool>* cancel) {
+        ImageScene with_text = read(cancel);
+        apply_names(with_text, names, file);
+        return with_text;
+      };
     return is;
   };
 }

@@ -314,6 +314,7 @@ std::optional<ImageScene> SceneCache::load(const std::string& key, const config:
       return bad("rebuilds to another number of level-0 segments");
     is.times.multires_ms = is.scene->build_times().multires_ms;
     is.times.tree_ms = is.scene->build_times().tree_ms;
+    if (is.descriptors.size() != is.polylines.size()) describe_scene_shapes(is);  // an entry written without them
     ::futimens(fd, nullptr);  // most recently used; a read-only folder keeps the old time
     return is;
   } catch (const BadEntry& e) {

@@ -112,6 +112,39 @@ bool jpeg_size(const std::vector<std::uint8_t>& b, int& width, int& height) {
   return false;
 }
 
+/// The shapes' descriptors as a payload array: {form, corners, colour (absent when unknown), size_cm, length_m,
+/// speck} each.
+json descriptors_json(const std::vector<meaning::ShapeDescriptor>& ds) {
+  json out = json::array();
+  for (const meaning::ShapeDescriptor& d : ds) {
+    json e = {{"form", meaning::form_key(d.form.form)},
+              {"corners", d.form.corners},
+              {"size_cm", d.size_cm},
+              {"length_m", d.length_m},
+              {"speck", d.speck}};
+    if (d.has_colour) e["colour"] = meaning::colour_words(d.colour);
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+/// A payload's descriptors, one per polyline. Throws BadEntry on a form or colour it does not know.
+void descriptors_from(const json& a, ImageScene& is) {
+  for (const json& e : a) {
+    meaning::ShapeDescriptor d;
+    if (!meaning::form_from_key(e.at("form").get<std::string>(), &d.form.form)) throw BadEntry{"an unknown form"};
+    d.form.corners = e.at("corners").get<int>();
+    d.size_cm = e.at("size_cm").get<double>();
+    d.length_m = e.at("length_m").get<double>();
+    d.speck = e.at("speck").get<bool>();
+    d.has_colour = e.contains("colour");
+    if (d.has_colour && !meaning::colour_from_words(e.at("colour").get<std::string>(), &d.colour))
+      throw BadEntry{"an unknown colour"};
+    is.descriptors.push_back(d);
+  }
+  if (is.descriptors.size() != is.polylines.size()) throw BadEntry{"descriptors and polylines differ in count"};
+}
+
 /// The payload of an entry: every kept field of `is`. What is not kept: `scene` (rebuilt from the
 /// polylines on load, about 1 ms, and not a stable format), `with_text` (a function; only complete
 /// scenes are stored, so text_pending is always false) and the picture's exact pixels (JPEG quality 90:
@@ -182,6 +215,7 @@ json to_payload(const std::string& key, const ImageScene& is) {
     curves.push_back({{"closed", p.closed}, {"points_m", to_binary(xy.data(), xy.size())}});
   }
   j["polylines"] = std::move(curves);
+  if (is.descriptors.size() == is.polylines.size()) j["descriptors"] = descriptors_json(is.descriptors);
   j["strength"] = to_binary(is.strength.data(), is.strength.size());
   const BuildTimes& t = is.times;
   j["times_ms"] = {t.load_ms, t.edges_ms, t.linking_ms, t.thin_lines_ms, t.gaps_ms, t.multires_ms, t.tree_ms};
@@ -316,6 +350,7 @@ ImageScene from_payload(const json& j, const std::string& key) {
   counts_from(j.at("counts"), is);
   detection_from(j, is);
   curves_from(j, is);
+  if (j.contains("descriptors")) descriptors_from(j.at("descriptors"), is);
   const json& t = j.at("times_ms");
   if (!t.is_array() || t.size() != 7) throw BadEntry{"times_ms is not 7 numbers"};
   is.times = {t[0].get<double>(), t[1].get<double>(), t[2].get<double>(), t[3].get<double>(),

@@ -14,12 +14,6 @@
 namespace hk::app {
 namespace {
 
-/// `words` with its first letter a capital.
-std::string capitalised(std::string words) {
-  if (!words.empty()) words[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(words[0])));
-  return words;
-}
-
 /// With level_mode = "cut", each curve's cut at each tolerance step (Shown::cut_segments and Shown::cuts).
 void add_cuts(const Scene& sc, Shown& sh) {
   sh.cut_segments.assign(sc.curve_count(), std::vector<std::vector<SegmentRef>>(kToleranceSteps));
@@ -51,6 +45,7 @@ void Stage::show_tutorial(TutorialShape shape) {
   shelf_.drop_want();  // a picture still being built is not wanted any more
   Shown sh;
   sh.polylines = {tutorial_polyline(shape, half_)};
+  sh.descriptors = meaning::describe_shapes(sh.polylines, meaning::PictureColours{});
   static constexpr audio::MessageId kNames[] = {audio::MessageId::shape_square, audio::MessageId::shape_circle,
                                                 audio::MessageId::shape_triangle};
   sh.notes.title = audio_.messages().text(kNames[static_cast<int>(shape)]);  // Where, Describe and the tour name it
@@ -65,6 +60,10 @@ void Stage::show_tutorial(TutorialShape shape) {
 void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes, bool reading_said) {
   Shown sh;
   sh.polylines = is.polylines;
+  sh.descriptors = is.descriptors;
+  sh.regions = is.regions;
+  sh.shape_region = is.shape_region;
+  sh.names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m);
   sh.picture = is.picture;  // the pixels the scene was built from (a picture file decoded once, reduced)
   sh.px_to_m = is.px_to_m;
   sh.text_blocks = is.text_blocks;
@@ -154,36 +153,21 @@ void Stage::text_arrived(TextRead& read) {
   }
 }
 
+ShownView Stage::view() const {
+  return {shown_.polylines,   shown_.descriptors, shown_.text_blocks, shown_.notes,    half_,
+          showing_tutorial(), source_.page > 0,   &shown_.names,      &shown_.regions, shown_.px_to_m};
+}
+
 std::string Stage::where() {
   const ServoDisplayState& d = step_.display();
-  const std::string place = place_words(d.handle_m, half_);
-  const audio::MessageCatalog& m = audio_.messages();
-  if (const TextBlockM* b = text_block_at(shown_.text_blocks, d.handle_m)) {
-    const auto index = b - shown_.text_blocks.data();
-    return m.text(audio::MessageId::where_text,
-                  {{"block", std::to_string(index + 1)},
-                   {"blocks", std::to_string(shown_.text_blocks.size())},
-                   {"where", place},
-                   {"text", first_words(name_unclear_words(b->text, m), kWhereTextWords)}});
-  }
-  const ShapeAtHand at = shape_at_hand(shown_.polylines, d.handle_m, d.scene_id == shown_id_ ? d.curve : -1);
   // A practice shape: far and near explained with the first answer of the visit, not again.
   const bool explain = showing_tutorial() && !far_near_said_;
   far_near_said_ = far_near_said_ || explain;
-  const std::string far_near = explain ? " " + m.text(audio::MessageId::far_near) : std::string();
-  if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}}) + far_near;
-  return m.text(at.on ? audio::MessageId::where_on : audio::MessageId::where_near,
-                {{"shape", std::to_string(at.curve + 1)},
-                 {"shapes", std::to_string(shown_.polylines.size())},
-                 {"description", shape_words(static_cast<std::size_t>(at.curve))},
-                 {"where", place}}) +
-         far_near;
+  const std::string far_near = explain ? " " + audio_.messages().text(audio::MessageId::far_near) : std::string();
+  return where_answer(view(), audio_.messages(), d.handle_m, d.scene_id == shown_id_ ? d.curve : -1) + far_near;
 }
 
-std::string Stage::shape_words(std::size_t curve) const {
-  if (showing_tutorial() && !shown_.notes.title.empty()) return shown_.notes.title;  // "a square"
-  return describe_one_shape(shown_.polylines, curve, half_, false);
-}
+std::string Stage::shape_words(std::size_t curve) const { return app::shape_words(view(), curve); }
 
 std::string Stage::describe() {
   // Its text still being read: said first, so the visitor knows more is coming.
@@ -202,29 +186,8 @@ PageText Stage::page_text() {
 }
 
 std::string Stage::describe_shown() {
-  if (source_.page > 0 || !shown_.text_blocks.empty()) {
-    // A page (or a picture of one): the block of text under the hand is read; elsewhere, what the page holds.
-    if (const TextBlockM* b = text_block_at(shown_.text_blocks, step_.display().proxy_m)) {
-      return audio_.messages().text(audio::MessageId::text_block,
-                                    {{"text", name_unclear_words(b->text, audio_.messages())}});
-    }
-    const std::string page =
-        describe_page(static_cast<int>(shown_.text_blocks.size()), count_figures(shown_.polylines));
-    return shown_.polylines.empty() ? page
-                                    : page + " " + describe_scene(shown_.polylines, half_, 3, step_.display().handle_m);
-  }
-  if (showing_tutorial() && !shown_.notes.title.empty())  // a practice shape: "A square, in the middle."
-    return capitalised(shown_.notes.title + ", " + place_words({0.0, 0.0}, half_) + ".");
-  // A picture: what a person wrote of it first ("A horse, seen from the side. A horse standing, ..."), then
-  // its shapes.
-  std::string words;
-  if (!shown_.notes.title.empty()) {
-    words = capitalised(shown_.notes.title);
-    if (words.back() != '.' && words.back() != '!' && words.back() != '?') words += '.';
-    words += ' ';
-  }
-  if (!shown_.notes.description.empty()) words += shown_.notes.description + ' ';
-  return words + describe_scene(shown_.polylines, half_, 3, step_.display().handle_m);
+  const ServoDisplayState& d = step_.display();
+  return describe_answer(view(), audio_.messages(), d.handle_m, d.proxy_m);
 }
 
 bool Stage::change_level(int delta) {

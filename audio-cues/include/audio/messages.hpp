@@ -113,7 +113,10 @@ enum class MessageId : int {
   nothing_to_pause,
   nothing_to_repeat,
   where_on,
+  where_on_part,
   where_near,
+  where_inside,
+  where_region,
   where_none,
   where_text,
   sorry,
@@ -158,7 +161,7 @@ enum class MessageId : int {
   unclear_word,
   unclear_words,
 };
-inline constexpr int kMessageCount = 133;
+inline constexpr int kMessageCount = 136;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{"welcome",
@@ -250,7 +253,10 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{"welco
                                                                           "nothing_to_pause",
                                                                           "nothing_to_repeat",
                                                                           "where_on",
+                                                                          "where_on_part",
                                                                           "where_near",
+                                                                          "where_inside",
+                                                                          "where_region",
                                                                           "where_none",
                                                                           "where_text",
                                                                           "sorry",

@@ -211,6 +211,11 @@ struct KioskSettings {
       "auto";  ///< key scene_cache, where built scenes of library pictures are kept on disk: "auto"
                ///< ($CACHE_DIRECTORY/scenes under the service, else $XDG_CACHE_HOME/haptic-kiosk/scenes, else
                ///< ~/.cache/haptic-kiosk/scenes), "off", or an absolute folder
+  std::string names_dir =
+      "auto";  ///< key names_dir, where names staff give shapes at the kiosk are kept (NAME.annotations.json; they
+               ///< win over the file beside the picture): "auto" ($STATE_DIRECTORY/names under the service, else
+               ///< $XDG_DATA_HOME/haptic-kiosk/names, else ~/.local/share/haptic-kiosk/names), "off" (only the files
+               ///< beside the pictures), or an absolute folder
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const KioskSettings&) const = default;

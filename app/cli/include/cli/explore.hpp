@@ -29,6 +29,10 @@ struct ExploreOptions {
   std::string config_path;     ///< TOML settings; empty: defaults
   std::string audio_out;       ///< WAV file for the run's earcons (and cues.csv beside the outputs); empty: none
   std::string device = "sim";  ///< "sim" or "haply-emulator[:FAULT=VALUE,...]" (parse_device_choice)
+  /// "X_M,Y_M": print the one line Where would say with the hand there [m, workspace frame], run nothing else
+  /// (explore_answer); empty: not asked.
+  std::string where;
+  bool describe = false;  ///< print what Describe would say (the hand at the centre), run nothing else
 };
 
 /// A problem with the run's own arguments or output folder (bad inputs raise their own typed errors:
@@ -41,6 +45,16 @@ class ExploreError : public hk::Error {
 /// The `--seed` argument: a whole number in [0, 2^63 − 1], decimal digits only. Throws ExploreError
 /// ("--seed 'TEXT': ...", one line naming the limit) for anything else (empty, a sign, a fraction, too big).
 std::uint64_t parse_seed(const std::string& text);
+
+/// The hand's place of `--where X_M,Y_M` [m]: two finite numbers, comma-separated, within the workspace of `s`
+/// (|x| ≤ width_m / 2, |y| ≤ height_m / 2). Throws ExploreError ("--where 'TEXT': ...", one line naming the limit).
+Vec2 parse_where(const std::string& text, const config::Settings& s);
+
+/// What the kiosk would say of the input of `o` (its scene built as run_explore builds it, the picture's notes
+/// read as the library reads them, English): the Where answer at o.where, or the Describe answer with the hand
+/// at the centre when o.describe. No simulation, no output files. Throws as run_explore does for a bad input,
+/// and ExploreError for a bad --where.
+std::string explore_answer(const ExploreOptions& o);
 
 /// Numbers of a finished run (also written to summary.json).
 struct ExploreSummary {

@@ -15,6 +15,8 @@
 #include "config/settings.hpp"
 #include "formats/picture_notes.hpp"
 #include "haptics/scene.hpp"
+#include "meaning/names.hpp"
+#include "meaning/shape_descriptors.hpp"
 #include "vision/mapping.hpp"
 #include "vision/ocr.hpp"
 #include "vision/pdf.hpp"
@@ -29,6 +31,8 @@ struct BuildTimes {
   /// Of load_ms, a picture file's checks and decoding (vision::load_image_reduced / decode_image_reduced);
   /// 0 for pixels already in memory (a camera capture, a rendered page).
   double decode_ms = 0;
+  /// What the kiosk sees of the shapes (describe_scene_shapes): forms, colours, sizes; 0 when read from the cache.
+  double descriptors_ms = 0;
 };
 
 /// A block of text of a page in workspace metres: spoken, not felt.
@@ -159,12 +163,24 @@ struct ImageScene {
   /// gradient magnitude Canny thresholded, vision::Extraction::point_strength; a centre line takes
   /// the mean of its two sides).
   std::vector<double> strength;
+  /// descriptors[i]: what polylines[i] looks like (meaning/shape_descriptors.hpp), one per polyline.
+  std::vector<meaning::ShapeDescriptor> descriptors;
+  /// Regions staff named on `picture` (picture_names.hpp apply_names; not kept in the scene cache).
+  std::vector<meaning::NamedRegion> regions;
+  /// shape_region[i]: the region polylines[i] takes its name from, −1 for none; empty before apply_names.
+  std::vector<int> shape_region;
   std::unique_ptr<Scene> scene;  ///< collision trees (heap: the servo loop holds a pointer)
   BuildTimes times;
 };
 
 /// Longest side of the picture a screen shows [px]: a full-HD screen's width (the workspace never fills more).
 inline constexpr int kScreenPictureMaxSidePx = 1920;
+
+/// Sets `is.descriptors` (one per polyline: form, colour, size, speck) from its polylines, its scene (the form's
+/// coarse level; without a scene, each polyline's own points) and its picture (the colours; none when empty),
+/// and times it in is.times.descriptors_ms. Call after the scene is built and before fit_picture shrinks the
+/// picture. Never throws but std::bad_alloc.
+void describe_scene_shapes(ImageScene& is);
 
 /// Shrinks `is.picture` (INTER_AREA) so that its long side is at most `max_side_px`, and moves `is.px_to_m`
 /// with it (pixel centres kept: the same workspace rectangle), so the picture shown is no larger than a screen

@@ -24,6 +24,7 @@
 #include "pictures/picture_shelf.hpp"
 #include "pictures/text_reader.hpp"
 #include "runtime/servo_step.hpp"
+#include "visit/answers.hpp"
 #include "visit/kiosk_effects.hpp"
 #include "visit/tour_desk.hpp"
 #include "visit/voice.hpp"
@@ -44,6 +45,11 @@ struct Shown {
   const Scene* scene = nullptr;         ///< the published scene (read-only here; for the overlay)
   std::vector<TextBlockM> text_blocks;  ///< a document page's text (Describe reads the one under the hand)
   PictureNotes notes;                   ///< a library picture's title and description (its sidecar)
+  /// What each of `polylines` looks like (form, colour, size, speck), one per polyline.
+  std::vector<meaning::ShapeDescriptor> descriptors;
+  std::vector<meaning::NamedRegion> regions;  ///< regions staff named on `picture`
+  std::vector<int> shape_region;              ///< per polyline: the region naming it, −1 none
+  PictureNames names;                         ///< the same as Describe and Where say them
 };
 
 /// Where what is shown came from (what a rebuild with new settings asks for again).
@@ -66,8 +72,6 @@ inline int page_id(int document, int page) { return kFirstPageId + document * kP
 /// What is shown. Not thread-safe: the window thread.
 class Stage final : public StageEffects {
  public:
-  /// Words of a block of text that Where reads (Describe reads it whole).
-  static constexpr int kWhereTextWords = 8;
   /// How long a reading may take before "Reading the text." is said [s].
   static constexpr double kTextWait_s = 1.0;
 
@@ -128,6 +132,7 @@ class Stage final : public StageEffects {
 
  private:
   bool showing_tutorial() const { return shown_id_ <= -1 && shown_id_ >= -3; }
+  ShownView view() const;                            // what the answers read of what is shown
   std::string shape_words(std::size_t curve) const;  // what curve `curve` is, for Where and the tour
   std::string describe_shown();                      // describe() without the reading's news
   void text_arrived(TextRead& read);                 // swaps in the page with its text and words what came

@@ -1,0 +1,51 @@
+#pragma once
+/// @file names.hpp
+/// Staff names on a picture's shapes: the regions of an annotation file (formats/annotations.hpp) drawn onto
+/// the picture's pixels, and each shape named by the smallest region holding at least half of its outline.
+///
+/// A FragmentSelector's box is filled; an SvgSelector is drawn by librsvg as its SVG says (fill and stroke),
+/// so any path SVG allows (relative commands, arcs, transforms, groups) takes the shape it shows. An SVG that
+/// draws only thin strokes (less than a fifth of its box covered: an open path, a polyline) is widened by
+/// kLineReachPx on each side, so the shapes along it fall inside. Coordinates are the canvas's, scaled to the
+/// picture's pixels when the canvas's size differs (a museum's master image is larger than the kiosk's copy).
+
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+#include "formats/annotations.hpp"
+#include "haptics/multires.hpp"
+#include "vision/mapping.hpp"
+
+namespace hk::meaning {
+
+/// How far an SVG line's region reaches on each side of its stroke [px of the picture].
+inline constexpr int kLineReachPx = 6;
+
+/// One named region on the picture's pixels.
+struct NamedRegion {
+  std::string name;         ///< what staff called it; may be empty when they only described it
+  std::string description;  ///< their longer text; may be empty
+  cv::Rect box_px;          ///< its bounding box on the picture [px], within the picture
+  cv::Mat mask;             ///< CV_8U over box_px, non-zero inside
+  double area_px = 0;       ///< pixels inside
+};
+
+/// The regions of `set` on a picture of `width_px` x `height_px` [px] whose full-detail size (the file's, upright)
+/// is `full_width_px` x `full_height_px`: without a canvas in `set`, coordinates are those full-detail pixels. A
+/// region outside the picture, an SVG that cannot be read or draws nothing, is left out with one line in
+/// `problems` (naming `source` and the rule). Cost: one picture-sized 8-bit surface per SVG region.
+std::vector<NamedRegion> draw_regions(const app::AnnotationSet& set, int width_px, int height_px, int full_width_px,
+                                      int full_height_px, const std::string& source,
+                                      std::vector<std::string>* problems);
+
+/// The region each polyline takes its name from: the smallest (fewest pixels) region with a name that holds at
+/// least half of the polyline's points (`px_to_m` maps picture pixels to metres); −1 for none. One per polyline.
+std::vector<int> name_shapes(const std::vector<NamedRegion>& regions, const std::vector<Polyline>& polylines,
+                             const vision::PxToM& px_to_m);
+
+/// The regions with a name holding the picture pixel (u, v) [px], the smallest first.
+std::vector<int> regions_at(const std::vector<NamedRegion>& regions, double u_px, double v_px);
+
+}  // namespace hk::meaning

@@ -1,0 +1,29 @@
+#pragma once
+/// @file picture_names.hpp
+/// Staff names put on a built scene: the annotation file of its picture (formats/annotations.hpp) read, its
+/// regions drawn on the picture and the shapes named (meaning/names.hpp). Applied after a scene is built or
+/// taken from the scene cache: names change while the picture does not. Off the window thread (librsvg).
+
+#include <string>
+
+#include "config/settings.hpp"
+#include "pictures/image_scene.hpp"
+
+namespace hk::app {
+
+/// The writable names folder of [kiosk] names_dir: "off" → "" (none); "auto" → $STATE_DIRECTORY/names (the
+/// service's), else $XDG_DATA_HOME/haptic-kiosk/names, else $HOME/.local/share/haptic-kiosk/names ("" when none of
+/// these is an absolute path); else the folder given.
+std::string names_dir(const config::Settings& s);
+
+/// The annotation file that names `picture_path`'s shapes: the one in `names_folder` when it exists (names saved at
+/// the kiosk win), else the one beside the picture when it exists, else "".
+std::string names_file_for(const std::string& picture_path, const std::string& names_folder);
+
+/// Puts the names of `names_file` (annotations_path's form; "" = none) on `is`: ImageScene::regions and
+/// shape_region. A file refused whole, and each annotation left out, is one warning in the log naming the file
+/// and the rule; the scene keeps the names that were valid (none when the file is refused). Never throws but
+/// std::bad_alloc.
+void apply_names(ImageScene& is, const std::string& names_file, const std::string& picture_file_name);
+
+}  // namespace hk::app
