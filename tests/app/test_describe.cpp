@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "test_polylines.hpp"
 #include "visit/describe.hpp"
 
 namespace hk::app {
@@ -19,15 +20,7 @@ namespace {
 
 const Vec2 kHalf{0.07, 0.045};
 
-Polyline rect(Vec2 c, Vec2 half, bool closed = true) {
-  Polyline p;
-  p.closed = closed;
-  p.points_m = {{c.x - half.x, c.y - half.y},
-                {c.x + half.x, c.y - half.y},
-                {c.x + half.x, c.y + half.y},
-                {c.x - half.x, c.y + half.y}};
-  return p;
-}
+using test::rect;
 
 Polyline circle(Vec2 c, double r, int n = 48) {
   Polyline p;

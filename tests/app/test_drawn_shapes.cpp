@@ -66,22 +66,29 @@ cv::Mat as_jpeg(const cv::Mat& bgr, int quality) {
   return cv::imdecode(bytes, cv::IMREAD_COLOR);
 }
 
+/// The closed shape of `is` (not a speck) whose points' mean lies within 4 mm of picture pixel `centre_px`; −1
+/// for none.
+int outline_around(const ImageScene& is, cv::Point2d centre_px) {
+  const Vec2 c{is.px_to_m.x_m(centre_px.x), is.px_to_m.y_m(centre_px.y)};
+  int found = -1;
+  for (std::size_t i = 0; i < is.polylines.size(); ++i) {
+    const Polyline& p = is.polylines[i];
+    if (!p.closed || is.descriptors[i].speck) continue;
+    Vec2 mean;
+    for (const Vec2& q : p.points_m) mean += q;
+    mean = (1.0 / static_cast<double>(p.points_m.size())) * mean;
+    if (length(mean - c) < 0.004) found = static_cast<int>(i);
+  }
+  return found;
+}
+
 /// Checks that each drawn shape has a curve around it whose descriptor names its form and colour.
 void expect_named(const cv::Mat& bgr, const std::vector<Drawn>& drawn, const std::string& what) {
   const config::Settings s;
   const ImageScene is = build_image_scene_from_picture(bgr, what, s);
   ASSERT_EQ(is.descriptors.size(), is.polylines.size()) << what;
   for (const Drawn& d : drawn) {
-    const Vec2 c{is.px_to_m.x_m(d.centre_px.x), is.px_to_m.y_m(d.centre_px.y)};
-    int found = -1;
-    for (std::size_t i = 0; i < is.polylines.size(); ++i) {
-      const Polyline& p = is.polylines[i];
-      if (!p.closed || is.descriptors[i].speck) continue;
-      Vec2 mean;
-      for (const Vec2& q : p.points_m) mean += q;
-      mean = (1.0 / static_cast<double>(p.points_m.size())) * mean;
-      if (length(mean - c) < 0.004) found = static_cast<int>(i);
-    }
+    const int found = outline_around(is, d.centre_px);
     ASSERT_GE(found, 0) << what << ": no closed outline around the " << d.colour << " shape";
     const meaning::ShapeDescriptor& desc = is.descriptors[static_cast<std::size_t>(found)];
     EXPECT_EQ(meaning::form_key(desc.form.form), meaning::form_key(d.form)) << what << ", the " << d.colour << " shape";
@@ -120,17 +127,8 @@ struct Named {
   }
   /// The name of the closed shape drawn at drawn[k] ("" none).
   std::string name_of(std::size_t k) const {
-    const Vec2 c{is.px_to_m.x_m(drawn[k].centre_px.x), is.px_to_m.y_m(drawn[k].centre_px.y)};
-    std::string name;
-    for (std::size_t i = 0; i < is.polylines.size(); ++i) {
-      const Polyline& p = is.polylines[i];
-      if (!p.closed || is.descriptors[i].speck) continue;
-      Vec2 mean;
-      for (const Vec2& q : p.points_m) mean += q;
-      mean = (1.0 / static_cast<double>(p.points_m.size())) * mean;
-      if (length(mean - c) < 0.004) name = names.shape_name.empty() ? "" : names.shape_name[i];
-    }
-    return name;
+    const int i = outline_around(is, drawn[k].centre_px);
+    return i < 0 || names.shape_name.empty() ? "" : names.shape_name[static_cast<std::size_t>(i)];
   }
   ShownView view() const {
     static const std::vector<TextBlockM> none;

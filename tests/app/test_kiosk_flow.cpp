@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "every_effect.hpp"
+#include "test_polylines.hpp"
 #include "visit/describe.hpp"
 #include "visit/kiosk_flow.hpp"
 
@@ -432,15 +433,7 @@ TEST(Describe, PagesCountTextBlocksAndFigures) {
   EXPECT_EQ(describe_shapes(5), "It has 5 shapes.");
 }
 
-Polyline rect(Vec2 c, Vec2 half, bool closed = true) {
-  Polyline p;
-  p.closed = closed;
-  p.points_m = {{c.x - half.x, c.y - half.y},
-                {c.x + half.x, c.y - half.y},
-                {c.x + half.x, c.y + half.y},
-                {c.x - half.x, c.y + half.y}};
-  return p;
-}
+using test::rect;
 
 TEST(Describe, FiguresAreGroupsOfTouchingCurves) {
   // A drawing of three strokes that touch (one figure), a separate box (a second), a stroke 1 mm from the

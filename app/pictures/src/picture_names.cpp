@@ -3,30 +3,16 @@
 
 #include <spdlog/spdlog.h>
 
-#include <cstdlib>
 #include <filesystem>
 
 #include "formats/annotations.hpp"
 #include "meaning/names.hpp"
+#include "pictures/kiosk_folders.hpp"
 
 namespace hk::app {
 
 std::string names_dir(const config::Settings& s) {
-  const std::string& v = s.kiosk.names_dir;
-  if (v == "off") return "";
-  if (v != "auto") return v;
-  auto absolute = [](const char* name) -> std::string {
-    const char* e = std::getenv(name);
-    if (e == nullptr || e[0] != '/') return "";
-    return e;
-  };
-  std::string state = absolute("STATE_DIRECTORY");
-  if (!state.empty()) return state.substr(0, state.find(':')) + "/names";
-  const std::string xdg = absolute("XDG_DATA_HOME");
-  if (!xdg.empty()) return xdg + "/haptic-kiosk/names";
-  const std::string home = absolute("HOME");
-  if (!home.empty()) return home + "/.local/share/haptic-kiosk/names";
-  return "";
+  return kiosk_folder(s.kiosk.names_dir, "STATE_DIRECTORY", "XDG_DATA_HOME", ".local/share", "names");
 }
 
 std::string names_file_for(const std::string& picture_path, const std::string& names_folder) {

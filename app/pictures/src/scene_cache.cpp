@@ -1,6 +1,8 @@
 // Built scenes on disk (scene_cache.hpp).
 #include "pictures/scene_cache.hpp"
 
+#include "pictures/kiosk_folders.hpp"
+
 #include "pictures/scene_entry.hpp"
 
 #include <algorithm>
@@ -145,24 +147,7 @@ std::string final_hex(crypto_generichash_state& st) {
 }  // namespace
 
 std::string scene_cache_dir(const config::Settings& s) {
-  const std::string& v = s.kiosk.scene_cache;
-  if (v == "off") return "";
-  if (v != "auto") return v;
-  auto absolute = [](const char* name) -> std::string {
-    const char* e = std::getenv(name);
-    if (e == nullptr || e[0] != '/') return "";
-    return e;
-  };
-  std::string cache = absolute("CACHE_DIRECTORY");
-  if (!cache.empty()) {
-    cache = cache.substr(0, cache.find(':'));
-    return cache + "/scenes";
-  }
-  const std::string xdg = absolute("XDG_CACHE_HOME");
-  if (!xdg.empty()) return xdg + "/haptic-kiosk/scenes";
-  const std::string home = absolute("HOME");
-  if (!home.empty()) return home + "/.cache/haptic-kiosk/scenes";
-  return "";
+  return kiosk_folder(s.kiosk.scene_cache, "CACHE_DIRECTORY", "XDG_CACHE_HOME", ".cache", "scenes");
 }
 
 std::vector<const config::FieldDescriptor*> scene_shaping_fields() {
