@@ -1,12 +1,12 @@
 /// @file test_colour_name.cpp
 /// Basic colour terms named in CIELAB (meaning/colour_name.hpp). The Lab values are those of named sRGB colours
 /// (CSS Color 4's keywords) converted with the sRGB transfer function and D65 white, as colour references
-/// publish them, rounded to one decimal: independent of OpenCV's conversion, which median_lab is checked
-/// against here.
+/// publish them, rounded to one decimal; lab_of_srgb is checked against them and against OpenCV's conversion.
 
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <string>
 
@@ -56,6 +56,28 @@ TEST(ColourName, WordsParseBack) {
   ColourName n;
   EXPECT_FALSE(colour_from_words("mauve", &n));
   EXPECT_FALSE(colour_from_words("light", &n));
+}
+
+TEST(ColourName, LabOfSrgbAgreesWithPublishedValuesAndOpenCv) {
+  const Lab red = lab_of_srgb(1, 0, 0), blue = lab_of_srgb(0, 0, 1), white = lab_of_srgb(1, 1, 1);
+  EXPECT_NEAR(red.l, 53.24, 0.05);
+  EXPECT_NEAR(red.a, 80.09, 0.05);
+  EXPECT_NEAR(red.b, 67.20, 0.05);
+  EXPECT_NEAR(blue.b, -107.86, 0.05);
+  EXPECT_NEAR(white.l, 100.0, 0.01);
+  EXPECT_NEAR(white.a, 0.0, 0.01);
+  // Every 51st level of each channel against OpenCV's float conversion (same D65 white, same formulae).
+  for (int r = 0; r < 256; r += 51)
+    for (int g = 0; g < 256; g += 51)
+      for (int b = 0; b < 256; b += 51) {
+        cv::Mat px(1, 1, CV_32FC3, cv::Scalar(b / 255.0, g / 255.0, r / 255.0)), lab;
+        cv::cvtColor(px, lab, cv::COLOR_BGR2Lab);
+        const cv::Vec3f want = lab.at<cv::Vec3f>(0, 0);
+        const Lab got = lab_of_srgb(r / 255.0, g / 255.0, b / 255.0);
+        EXPECT_NEAR(got.l, want[0], 0.2) << r << "," << g << "," << b;
+        EXPECT_NEAR(got.a, want[1], 0.3) << r << "," << g << "," << b;
+        EXPECT_NEAR(got.b, want[2], 0.3) << r << "," << g << "," << b;
+      }
 }
 
 TEST(ColourName, MedianLabOfAPatchIsItsColourAndIgnoresWhatIsNotMasked) {

@@ -1,8 +1,6 @@
 // Basic colour terms named in CIELAB (colour_name.hpp).
 #include "meaning/colour_name.hpp"
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -74,29 +72,41 @@ bool colour_from_words(std::string_view words, ColourName* name) {
   return false;
 }
 
+Lab lab_of_srgb(double r, double g, double b) {
+  // IEC 61966-2-1 sRGB: companding undone, then linear RGB to XYZ (D65), then CIE 1976 L*a*b* against D65 white.
+  const auto linear = [](double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };
+  const double rl = linear(r), gl = linear(g), bl = linear(b);
+  const double x = (0.4124564 * rl + 0.3575761 * gl + 0.1804375 * bl) / 0.95047;
+  const double y = 0.2126729 * rl + 0.7151522 * gl + 0.0721750 * bl;
+  const double z = (0.0193339 * rl + 0.1191920 * gl + 0.9503041 * bl) / 1.08883;
+  const auto f = [](double t) { return t > 216.0 / 24389.0 ? std::cbrt(t) : (24389.0 / 27.0 * t + 16.0) / 116.0; };
+  const double fx = f(x), fy = f(y), fz = f(z);
+  return {116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)};
+}
+
 bool median_lab(const cv::Mat& bgr, const cv::Mat& mask, Lab* out) {
   if (bgr.empty() || mask.empty() || bgr.size() != mask.size() || bgr.type() != CV_8UC3) return false;
-  const cv::Rect box = cv::boundingRect(mask);
-  if (box.area() == 0) return false;
-  cv::Mat lab;
-  bgr(box).convertTo(lab, CV_32FC3, 1.0 / 255.0);
-  cv::cvtColor(lab, lab, cv::COLOR_BGR2Lab);
-  std::array<std::vector<float>, 3> ch;
-  const cv::Mat m = mask(box);
-  for (int y = 0; y < m.rows; ++y)
-    for (int x = 0; x < m.cols; ++x)
-      if (m.at<std::uint8_t>(y, x)) {
-        const cv::Vec3f v = lab.at<cv::Vec3f>(y, x);
-        for (int k = 0; k < 3; ++k) ch[static_cast<std::size_t>(k)].push_back(v[k]);
-      }
-  if (ch[0].empty()) return false;
-  double med[3];
-  for (std::size_t k = 0; k < 3; ++k) {
-    auto mid = ch[k].begin() + static_cast<std::ptrdiff_t>(ch[k].size() / 2);
-    std::nth_element(ch[k].begin(), mid, ch[k].end());
-    med[k] = *mid;
+  // Per-channel histograms of the masked pixels, their medians, then one conversion (not the whole patch:
+  // OpenCV's BGR→Lab builds its tables on first use, about 0.1 s a process).
+  std::array<std::array<std::size_t, 256>, 3> hist{};
+  std::size_t n = 0;
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
+    const std::uint8_t* m = mask.ptr<std::uint8_t>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      if (!m[x]) continue;
+      for (std::size_t k = 0; k < 3; ++k) ++hist[k][row[x][static_cast<int>(k)]];
+      ++n;
+    }
   }
-  *out = {med[0], med[1], med[2]};
+  if (n == 0) return false;
+  double median[3];
+  for (std::size_t k = 0; k < 3; ++k) {
+    std::size_t seen = 0, v = 0;
+    while (seen + hist[k][v] <= n / 2) seen += hist[k][v++];
+    median[k] = static_cast<double>(v) / 255.0;
+  }
+  *out = lab_of_srgb(median[2], median[1], median[0]);  // B, G, R order in the Mat
   return true;
 }
 

@@ -2,7 +2,7 @@
 /// @file colour_name.hpp
 /// The name of a colour among the eleven basic colour terms (Berlin & Kay, "Basic Color Terms", 1969):
 /// black, white, grey, red, orange, yellow, green, blue, purple, pink, brown, with "light" or "dark" where
-/// it is far from the term's own lightness. Named in CIELAB (D65, OpenCV's sRGB → Lab) by lightness L*,
+/// it is far from the term's own lightness. Named in CIELAB (D65, from sRGB: lab_of_srgb) by lightness L*,
 /// chroma C* = √(a*² + b*²) and hue angle h = atan2(b*, a*):
 ///
 /// | term | when |
@@ -55,8 +55,11 @@ std::string_view colour_key(BasicColour colour);
 /// The term and shade parsed from colour_words' output; false for anything else.
 bool colour_from_words(std::string_view words, ColourName* name);
 
-/// The median colour (per channel, in CIELAB) of the BGR pixels of `bgr` (8-bit, 3 channels) where `mask`
-/// (8-bit, same size) is non-zero. False when no pixel is masked.
+/// The CIELAB colour (D65) of the sRGB colour (r, g, b), each in [0, 1] (IEC 61966-2-1; CIE 1976 L*a*b*).
+Lab lab_of_srgb(double r, double g, double b);
+
+/// The colour, in CIELAB, of the median (per sRGB channel) of the BGR pixels of `bgr` (8-bit, 3 channels) where
+/// `mask` (8-bit, same size) is non-zero. False when no pixel is masked, or the images do not match.
 bool median_lab(const cv::Mat& bgr, const cv::Mat& mask, Lab* out);
 
 }  // namespace hk::meaning
