@@ -102,8 +102,9 @@ TEST(Describe, SpecksAreNotShapes) {
   EXPECT_FALSE(ds[2].speck);
   EXPECT_EQ(describe_scene(curves, ds, kHalf),
             "2 shapes. A medium rectangle in the middle, and a small square at the far left.");
-  EXPECT_EQ(shape_number(ds, 2), std::make_pair(2, 2));
-  EXPECT_EQ(shape_number(ds, 1).first, 0);
+  EXPECT_EQ(shape_number(ds, 3, 2), std::make_pair(2, 2));
+  EXPECT_EQ(shape_number(ds, 3, 1).first, 0);
+  EXPECT_EQ(shape_number({}, 3, 2), std::make_pair(3, 3)) << "no descriptors: every curve is a shape";
   // The hand on the speck hears the nearest shape instead.
   const ShapeAtHand at = shape_at_hand(curves, ds, {0.05, 0.03}, 1);
   EXPECT_NE(at.curve, 1);

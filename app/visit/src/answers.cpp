@@ -134,11 +134,8 @@ std::string where_answer(const ShownView& shown, const audio::MessageCatalog& m,
   }
   if (!at.on && !part.empty()) return m.text(audio::MessageId::where_region, {{"name", part}, {"where", place}});
   if (at.curve < 0) return m.text(audio::MessageId::where_none, {{"where", place}});
-  const std::vector<meaning::ShapeDescriptor> ds =
-      shown.descriptors.size() == shown.polylines.size()
-          ? shown.descriptors
-          : meaning::describe_shapes(shown.polylines, meaning::PictureColours{});
-  const auto [number, count] = shape_number(ds, static_cast<std::size_t>(at.curve));
+  const auto [number, count] =
+      shape_number(shown.descriptors, shown.polylines.size(), static_cast<std::size_t>(at.curve));
   const auto curve = static_cast<std::size_t>(at.curve);
   const bool own_part = at.on && !part.empty() && shape_look(shown, curve).find(part) == std::string::npos;
   // On a shape: what it is, whole; with a part under the hand, or off it, its look only (said short).

@@ -295,10 +295,12 @@ std::string direction_words(Vec2 from, Vec2 to) {
   return how_far + " " + ways[sector];
 }
 
-std::pair<int, int> shape_number(const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t curve) {
+std::pair<int, int> shape_number(const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t curves,
+                                 std::size_t curve) {
+  const bool known = descriptors.size() == curves;
   int number = 0, count = 0;
-  for (std::size_t k = 0; k < descriptors.size(); ++k) {
-    if (descriptors[k].speck) continue;
+  for (std::size_t k = 0; k < curves; ++k) {
+    if (known && descriptors[k].speck) continue;
     ++count;
     if (k == curve) number = count;
   }

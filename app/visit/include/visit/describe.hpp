@@ -47,9 +47,11 @@ bool shape_holds(const Polyline& c, Vec2 p_m);
 /// centimetre farther away", "5 cm nearer to you, to your left" (8 directions; far is +y).
 std::string direction_words(Vec2 from_m, Vec2 to_m);
 
-/// The number a visitor hears for curve `curve` (from 1), counting only the shapes that are not specks, and
-/// how many there are: {number, count}. A speck's number is 0.
-std::pair<int, int> shape_number(const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t curve);
+/// The number a visitor hears for curve `curve` of `curves` curves (from 1), counting only the shapes that are not
+/// specks, and how many there are: {number, count}. A speck's number is 0. `descriptors` not one per curve (none
+/// known): every curve counts, as shape_at_hand counts them.
+std::pair<int, int> shape_number(const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t curves,
+                                 std::size_t curve);
 
 /// One shape, `curves[index]`, for speech, from its descriptor (size against the workspace, colour, form):
 /// "a small white round shape", "a large black shape with 26 small white round shapes inside it"; `with_place`
