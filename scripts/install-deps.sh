@@ -6,7 +6,7 @@
 set -euo pipefail
 packages=(
   g++ cmake ninja-build pkg-config ccache
-  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-contrib-dev
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-objdetect-dev libopencv-contrib-dev opencv-data
   libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
   libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev
   libglfw3-dev libimgui-dev libgl-dev

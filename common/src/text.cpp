@@ -1,6 +1,8 @@
 // hk::decode_utf8 and hk::one_line, the one escaper for text echoed in messages (see text.hpp).
 #include "hk/text.hpp"
 
+#include <cctype>
+
 #include <algorithm>
 
 namespace hk {
@@ -70,6 +72,22 @@ std::string quoted(std::string_view s, std::size_t max_bytes, char quote) {
   std::string out(1, quote);
   out += one_line(s, max_bytes);
   out += quote;
+  return out;
+}
+
+std::string first_words(const std::string& text, int n) {
+  std::string out;
+  int words = 0;
+  std::size_t i = 0;
+  while (i < text.size() && words < n) {
+    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    const std::size_t start = i;
+    while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    if (i == start) break;
+    if (!out.empty()) out += ' ';
+    out.append(text, start, i - start);
+    ++words;
+  }
   return out;
 }
 

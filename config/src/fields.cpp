@@ -163,6 +163,7 @@ constexpr std::array<std::string_view, 4> kLevelModes{"auto", "tolerance", "cut"
 constexpr std::array<std::string_view, 2> kRenderModes{"walls", "grooves"};
 constexpr std::array<std::string_view, 6> kDetectors{"auto", "canny", "surround", "bilateral", "edpf", "outline"};
 constexpr std::array<std::string_view, 3> kOcrModes{"auto", "always", "off"};
+constexpr std::array<std::string_view, 2> kOnOff{"on", "off"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>(
@@ -409,6 +410,10 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
              "\"auto\" (the service's state folder, else ~/.local/share/haptic-kiosk/names), \"off\" (only the "
              "files beside the pictures), or an absolute folder.",
              {}, &scene_cache_problem),
+    HK_FIELD(kiosk, say_names_on_touch, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
+             "\"on\": the first time a visitor touches a named shape of a picture, its name is said, once; \"off\": "
+             "names only when asked (Where, Describe).",
+             kOnOff),
     // [stick]
     HK_FIELD(stick, max_depth, FieldGroup::devices, ApplyWhen::restart, 1, 64, "",
              "Deepest folder of a stick that is entered (its root is 0)."),

@@ -18,6 +18,7 @@
 #include "audio/mixer.hpp"
 #include "audio/wav.hpp"
 #include "config/load.hpp"
+#include "formats/picture_notes.hpp"
 #include "haptics/explorer_hand.hpp"
 #include "haptics/hand_path.hpp"
 #include "haptics/servo.hpp"
@@ -47,13 +48,24 @@ void write_text(const std::filesystem::path& p, const std::string& text) {
   if (!f) throw ExploreError("output '" + p.string() + "': cannot write the file");
 }
 
-/// A curve's `name` and `name_source` in scene.json: staff's ("staff"), else its form's look ("form": "small red
-/// round shape", sizes against the workspace of half extents `half_m` [m]) when it has a form; neither for an
-/// irregular shape without a name.
+/// Whether the sidecar of picture file `path` lets the kiosk's guesses name its parts (`guesses`); a sidecar that
+/// cannot be used is read as none (the kiosk shows the picture without its notes).
+bool guesses_wanted(const std::string& path) {
+  try {
+    return read_picture_notes(path).guesses;
+  } catch (const PictureNotesError&) {
+    return true;
+  }
+}
+
+/// A curve's `name` and `name_source` in scene.json: its region's ("staff", or a guess: "face", "text"), else its
+/// form's look ("form": "small red round shape", sizes against the workspace of half extents `half_m` [m]) when it
+/// has a form; neither for an irregular shape without a name.
 void add_curve_name(json& curve, const ImageScene& is, std::size_t source, Vec2 half_m) {
   if (source < is.shape_region.size() && is.shape_region[source] >= 0) {
-    curve["name"] = is.regions[static_cast<std::size_t>(is.shape_region[source])].name;
-    curve["name_source"] = "staff";
+    const meaning::NamedRegion& r = is.regions[static_cast<std::size_t>(is.shape_region[source])];
+    curve["name"] = r.name;
+    curve["name_source"] = meaning::region_source_key(r.source);
     return;
   }
   if (source >= is.descriptors.size() || is.descriptors[source].form.form == meaning::Form::irregular) return;
@@ -71,6 +83,7 @@ json unnamed_regions_json(const ImageScene& is) {
     const meaning::NamedRegion& nr = is.regions[r];
     const cv::Rect& b = nr.box_px;
     json e = {{"name", nr.name},
+              {"name_source", meaning::region_source_key(nr.source)},
               {"bbox_m",
                {is.px_to_m.x_m(b.x - 0.5), is.px_to_m.y_m(b.y + b.height - 0.5), is.px_to_m.x_m(b.x + b.width - 0.5),
                 is.px_to_m.y_m(b.y - 0.5)}}};
@@ -503,7 +516,8 @@ void add_picture_summary(json& sj, const ImageScene& is) {
                     {"gaps", is.times.gaps_ms},
                     {"multires", is.times.multires_ms},
                     {"tree", is.times.tree_ms},
-                    {"descriptors", is.times.descriptors_ms}};
+                    {"descriptors", is.times.descriptors_ms},
+                    {"faces", is.times.faces_ms}};
 }
 
 // cues.csv and the WAV: the earcons on the trace's timeline (tick k sounds at t = k · period).
@@ -538,9 +552,11 @@ ExploreSummary run_explore(const ExploreOptions& o) {
   const std::filesystem::path out = make_out_dir(o.out_dir);
   ImageScene is =
       o.source.empty() ? build_input_scene(o.image_path, o.page, s) : build_capture_scene(o.source, o.page, s, out);
-  if (o.source.empty() && is.page == 0)  // a picture file's staff names, as the library takes them
-    apply_names(is, names_file_for(o.image_path, names_dir(s)),
-                std::filesystem::path(o.image_path).filename().string());
+  if (o.source.empty() && is.page == 0)  // a picture file's names, as the library takes them
+    apply_names(is, names_file_for(o.image_path, names_dir(s)), std::filesystem::path(o.image_path).filename().string(),
+                guesses_wanted(o.image_path));
+  else
+    add_guessed_regions(is);
   const Scene& scene = *is.scene;
   const double duration = o.duration_s > 0.0     ? o.duration_s
                           : o.hand == "explorer" ? hand->natural_duration_s()

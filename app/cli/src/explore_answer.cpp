@@ -45,9 +45,11 @@ std::string explore_answer(const ExploreOptions& o) {
   ImageScene is = build_input_scene(o.image_path, o.page, s);
   const PictureNotes notes = is.page > 0 ? PictureNotes{} : read_picture_notes(o.image_path);
   if (is.page == 0)
-    apply_names(is, names_file_for(o.image_path, names_dir(s)),
-                std::filesystem::path(o.image_path).filename().string());
-  const PictureNames names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m);
+    apply_names(is, names_file_for(o.image_path, names_dir(s)), std::filesystem::path(o.image_path).filename().string(),
+                notes.guesses);
+  else
+    add_guessed_regions(is);
+  const PictureNames names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m, &is.polylines);
   const ShownView view{
       is.polylines, is.descriptors, is.text_blocks, notes,       {s.workspace.width_m / 2, s.workspace.height_m / 2},
       false,        is.page > 0,    &names,         &is.regions, is.px_to_m};

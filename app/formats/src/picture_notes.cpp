@@ -161,8 +161,12 @@ PictureNotes read_picture_notes(const std::string& image_path, const PictureNote
       notes.title = checked_text(file, name, node, kMaxTitleBytes, false);
     } else if (name == "description") {
       notes.description = checked_text(file, name, node, kMaxDescriptionBytes, true);
+    } else if (name == "guesses") {
+      const toml::value<bool>* flag = node.as_boolean();
+      if (!flag) fail(file, "guesses must be true or false");
+      notes.guesses = flag->get();
     } else {
-      fail(file, "unknown key '" + name + "' (title and description are known)");
+      fail(file, "unknown key '" + name + "' (title, description and guesses are known)");
     }
   }
   return notes;

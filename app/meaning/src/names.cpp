@@ -164,4 +164,51 @@ std::vector<int> regions_at(const std::vector<NamedRegion>& regions, double u_px
   return out;
 }
 
+const char* region_source_key(RegionSource s) {
+  switch (s) {
+    case RegionSource::face:
+      return "face";
+    case RegionSource::text:
+      return "text";
+    case RegionSource::staff:
+      break;
+  }
+  return "staff";
+}
+
+std::optional<NamedRegion> guessed_region(RegionSource source, std::string name, cv::Rect box_px, int width_px,
+                                          int height_px) {
+  const cv::Rect box = box_px & cv::Rect(0, 0, width_px, height_px);
+  if (box.empty()) return std::nullopt;
+  NamedRegion r;
+  r.source = source;
+  r.name = std::move(name);
+  r.box_px = box;
+  r.mask = cv::Mat::zeros(box.size(), CV_8U);
+  if (source == RegionSource::face) {
+    // The face's own box, drawn as the ellipse it holds, then clipped with the box to the picture.
+    cv::Mat whole = cv::Mat::zeros(box_px.size(), CV_8U);
+    cv::ellipse(whole, {box_px.width / 2, box_px.height / 2}, {box_px.width / 2, box_px.height / 2}, 0, 0, 360,
+                cv::Scalar(255), cv::FILLED);
+    whole(cv::Rect(box.x - box_px.x, box.y - box_px.y, box.width, box.height)).copyTo(r.mask);
+  } else {
+    r.mask.setTo(255);
+  }
+  r.area_px = cv::countNonZero(r.mask);
+  if (r.area_px <= 0) return std::nullopt;
+  return r;
+}
+
+bool covered_by_staff(const NamedRegion& guess, const std::vector<NamedRegion>& staff) {
+  for (const NamedRegion& s : staff) {
+    if (s.source != RegionSource::staff) continue;
+    const cv::Rect both = guess.box_px & s.box_px;
+    if (both.empty()) continue;
+    cv::Mat in_both;
+    cv::bitwise_and(guess.mask(both - guess.box_px.tl()), s.mask(both - s.box_px.tl()), in_both);
+    if (cv::countNonZero(in_both) * 2 >= guess.area_px) return true;
+  }
+  return false;
+}
+
 }  // namespace hk::meaning

@@ -11,6 +11,7 @@
 
 #include "haptics/multires.hpp"
 #include "hk/error.hpp"
+#include "meaning/faces.hpp"
 #include "pictures/picture_params.hpp"
 #include "vision/intake.hpp"
 
@@ -35,7 +36,16 @@ void describe_scene_shapes(ImageScene& is) {
   const meaning::PictureColours colours{is.picture, is.px_to_m, is.line_drawing};
   is.descriptors = is.scene ? meaning::describe_shapes(is.polylines, *is.scene, colours)
                             : meaning::describe_shapes(is.polylines, colours);
-  is.times.descriptors_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const auto described = std::chrono::steady_clock::now();
+  is.times.descriptors_ms = std::chrono::duration<double, std::milli>(described - start).count();
+  is.faces_m.clear();
+  if (is.pages > 0 || is.picture.empty()) return;  // a document page: text and figures, not faces
+  for (const cv::Rect& f : meaning::find_faces(is.picture)) {
+    const Vec2 a{is.px_to_m.x_m(f.x), is.px_to_m.y_m(f.y)};
+    const Vec2 b{is.px_to_m.x_m(f.x + f.width), is.px_to_m.y_m(f.y + f.height)};
+    is.faces_m.push_back({{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}});
+  }
+  is.times.faces_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - described).count();
 }
 
 void fit_picture(ImageScene& is, int max_side_px) {

@@ -116,11 +116,12 @@ SceneJob PictureShelf::picture_job(int index) const {
     is.notes = notes_of(path, is.file_notes);
     const std::string names = names_file_for(path, names_dir(s)),
                       file = std::filesystem::path(path).filename().string();
-    apply_names(is, names, file);
+    const bool guesses = is.notes.guesses;
+    apply_names(is, names, file, guesses);
     if (is.with_text)  // the scene read again with its text keeps the names
-      is.with_text = [read = std::move(is.with_text), names, file](const std::atomic<bool>* cancel) {
+      is.with_text = [read = std::move(is.with_text), names, file, guesses](const std::atomic<bool>* cancel) {
         ImageScene with_text = read(cancel);
-        apply_names(with_text, names, file);
+        apply_names(with_text, names, file, guesses);
         return with_text;
       };
     return is;

@@ -145,6 +145,23 @@ void descriptors_from(const json& a, ImageScene& is) {
   if (is.descriptors.size() != is.polylines.size()) throw BadEntry{"descriptors and polylines differ in count"};
 }
 
+/// The faces guessed as a payload array of [lo.x, lo.y, hi.x, hi.y] boxes [m].
+json faces_json(const std::vector<Aabb>& faces) {
+  json out = json::array();
+  for (const Aabb& f : faces) out.push_back({f.lo.x, f.lo.y, f.hi.x, f.hi.y});
+  return out;
+}
+
+/// A payload's faces. Throws BadEntry on a box that is not 4 numbers with lo below hi.
+void faces_from(const json& a, ImageScene& is) {
+  for (const json& e : a) {
+    if (!e.is_array() || e.size() != 4) throw BadEntry{"a face is not 4 numbers"};
+    const Aabb f{{e[0].get<double>(), e[1].get<double>()}, {e[2].get<double>(), e[3].get<double>()}};
+    if (!(f.lo.x <= f.hi.x && f.lo.y <= f.hi.y)) throw BadEntry{"a face's box is upside down"};
+    is.faces_m.push_back(f);
+  }
+}
+
 /// The payload of an entry: every kept field of `is`. What is not kept: `scene` (rebuilt from the
 /// polylines on load, about 1 ms, and not a stable format), `with_text` (a function; only complete
 /// scenes are stored, so text_pending is always false) and the picture's exact pixels (JPEG quality 90:
@@ -216,6 +233,7 @@ json to_payload(const std::string& key, const ImageScene& is) {
   }
   j["polylines"] = std::move(curves);
   if (is.descriptors.size() == is.polylines.size()) j["descriptors"] = descriptors_json(is.descriptors);
+  j["faces_m"] = faces_json(is.faces_m);
   j["strength"] = to_binary(is.strength.data(), is.strength.size());
   const BuildTimes& t = is.times;
   j["times_ms"] = {t.load_ms, t.edges_ms, t.linking_ms, t.thin_lines_ms, t.gaps_ms, t.multires_ms, t.tree_ms};
@@ -351,6 +369,7 @@ ImageScene from_payload(const json& j, const std::string& key) {
   detection_from(j, is);
   curves_from(j, is);
   if (j.contains("descriptors")) descriptors_from(j.at("descriptors"), is);
+  if (j.contains("faces_m")) faces_from(j.at("faces_m"), is);
   const json& t = j.at("times_ms");
   if (!t.is_array() || t.size() != 7) throw BadEntry{"times_ms is not 7 numbers"};
   is.times = {t[0].get<double>(), t[1].get<double>(), t[2].get<double>(), t[3].get<double>(),

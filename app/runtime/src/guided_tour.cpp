@@ -270,8 +270,14 @@ std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_
                                   const TourParams& p) {
   const std::optional<ChosenShape> chosen = nearest_untouched_shape(scene, handle_m, touched, p);
   if (!chosen) return std::nullopt;
-  const std::size_t c = chosen->curve;
-  std::vector<Vec2> pts = curve_points(scene, c, chosen->level);
+  return plan_tour_to(scene, scene_id, handle_m, chosen->curve, p);
+}
+
+std::optional<TourPath> plan_tour_to(const Scene& scene, int scene_id, Vec2 handle_m, std::size_t c,
+                                     const TourParams& p) {
+  if (c >= scene.curve_count()) return std::nullopt;
+  std::vector<Vec2> pts = curve_points(scene, c, tour_plan_level(scene, c, p));
+  if (pts.size() < 2) return std::nullopt;
   // The base sequence (on the curve) and its unit normals, from the start of the outline to its end; the
   // direction is along increasing segment indices (a closed curve's outline, an open one from its first point)
   // unless an open curve is taken from its last point.

@@ -6,16 +6,12 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hk/text.hpp"
 #include "visit/describe.hpp"
 #include "visit/read_aloud.hpp"
 
 namespace hk::app {
 namespace {
-
-std::string capitalised(std::string words) {
-  if (!words.empty()) words[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(words[0])));
-  return words;
-}
 
 /// Whether `text` opens with `title` (letters compared without case, a trailing full stop of the title
 /// ignored): a description that repeats its picture's title ("A horse, seen from the side." after "A horse").
@@ -33,7 +29,7 @@ bool opens_with(const std::string& text, std::string title) {
 std::string notes_words(const PictureNotes& notes) {
   std::string words;
   if (!notes.title.empty() && !opens_with(notes.description, notes.title)) {
-    words = capitalised(notes.title);
+    words = sentence_case(notes.title);
     if (words.back() != '.' && words.back() != '!' && words.back() != '?') words += '.';
     words += ' ';
   }
@@ -43,8 +39,32 @@ std::string notes_words(const PictureNotes& notes) {
 
 }  // namespace
 
+std::string region_said_name(const meaning::NamedRegion& region) {
+  return region.source == meaning::RegionSource::staff ? said_name(region.name) : region.name;
+}
+
+namespace {
+
+/// Sets each part's curve: the longest of `polylines` whose region's name is said as the part's.
+void longest_curve_of_each_part(const std::vector<meaning::NamedRegion>& regions, const std::vector<int>& shape_region,
+                                const std::vector<Polyline>& polylines, PictureNames& names) {
+  std::vector<double> best(names.parts.size(), 0.0);
+  for (std::size_t i = 0; i < polylines.size() && i < shape_region.size(); ++i) {
+    if (shape_region[i] < 0) continue;
+    const std::string name = region_said_name(regions[static_cast<std::size_t>(shape_region[i])]);
+    const double len = polyline_length_m(polylines[i]);
+    for (std::size_t p = 0; p < names.parts.size(); ++p)
+      if (names.parts[p].name == name && len > best[p]) {
+        best[p] = len;
+        names.parts[p].curve = static_cast<int>(i);
+      }
+  }
+}
+
+}  // namespace
+
 PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, const std::vector<int>& shape_region,
-                           std::size_t curves, const vision::PxToM& px_to_m) {
+                           std::size_t curves, const vision::PxToM& px_to_m, const std::vector<Polyline>* polylines) {
   PictureNames out;
   if (regions.empty()) return out;
   out.shape_name.assign(curves, std::string());
@@ -57,7 +77,7 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
     if (shape_region[i] < 0) continue;
     const auto r = static_cast<std::size_t>(shape_region[i]);
     // Several shapes of one name: "one of the white spots" (a plural name), "part of the left wing".
-    const std::string name = said_name(regions[r].name);
+    const std::string name = region_said_name(regions[r]);
     const std::string head = name.substr(0, name.find(" of "));  // "the coins of the top row": "the coins"
     const bool plural = head.ends_with("s") || head.ends_with("ae");
     out.shape_name[i] = sharing[r] > 1 && name.rfind("the ", 0) == 0 ? (plural ? "one of " : "part of ") + name : name;
@@ -69,14 +89,15 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
   const double m_per_px = px_to_m.scale_m_per_px;
   for (const std::size_t r : order) {
     const meaning::NamedRegion& nr = regions[r];
-    const std::string name = said_name(nr.name);
+    const std::string name = region_said_name(nr);
     if (name.empty() || std::any_of(out.parts.begin(), out.parts.end(), [&](const auto& p) { return p.name == name; }))
       continue;
     const cv::Moments mo = cv::moments(nr.mask, true);
     const double u = nr.box_px.x + (mo.m00 > 0 ? mo.m10 / mo.m00 : nr.box_px.width / 2.0);
     const double v = nr.box_px.y + (mo.m00 > 0 ? mo.m01 / mo.m00 : nr.box_px.height / 2.0);
-    out.parts.push_back({name, {px_to_m.x_m(u), px_to_m.y_m(v)}, nr.area_px * m_per_px * m_per_px});
+    out.parts.push_back({name, {px_to_m.x_m(u), px_to_m.y_m(v)}, nr.area_px * m_per_px * m_per_px, -1});
   }
+  if (polylines && polylines->size() == curves) longest_curve_of_each_part(regions, shape_region, *polylines, out);
   return out;
 }
 
@@ -128,7 +149,7 @@ std::string where_answer(const ShownView& shown, const audio::MessageCatalog& m,
     const Vec2 px{shown.px_to_m.u_px(hand_m.x), shown.px_to_m.v_px(hand_m.y)};
     for (const int r : meaning::regions_at(*shown.regions, px.x, px.y))
       if (region_holds(shown, r, hand_m)) {
-        part = said_name((*shown.regions)[static_cast<std::size_t>(r)].name);
+        part = region_said_name((*shown.regions)[static_cast<std::size_t>(r)]);
         break;
       }
   }
@@ -163,7 +184,7 @@ std::string describe_answer(const ShownView& shown, const audio::MessageCatalog&
                : page + " " + describe_scene(shown.polylines, shown.descriptors, shown.half_m, 3, hand_m, shown.names);
   }
   if (shown.tutorial && !shown.notes.title.empty())  // a practice shape: "A square, in the middle."
-    return capitalised(shown.notes.title + ", " + place_words({0.0, 0.0}, shown.half_m) + ".");
+    return sentence_case(shown.notes.title + ", " + place_words({0.0, 0.0}, shown.half_m) + ".");
   return notes_words(shown.notes) +
          describe_scene(shown.polylines, shown.descriptors, shown.half_m, 3, hand_m, shown.names);
 }

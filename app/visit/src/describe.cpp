@@ -370,8 +370,7 @@ std::string list_groups(const std::vector<Group>& groups, const std::vector<Shap
     const Group& g = groups[i];
     std::string part = group_words(g);
     if (i == 0) {
-      part = lead + part;
-      part[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(part[0])));
+      part = sentence_case(lead + part);
     }
     const std::size_t m0 = g.members[0];
     told += g.members.size();
@@ -397,7 +396,7 @@ std::string named_parts_words(const PictureNames& names, Vec2 half) {
   std::string out;
   for (std::size_t i = 0; i < names.parts.size(); ++i) {
     std::string part = names.parts[i].name + " " + place_words(names.parts[i].centre_m, half);
-    if (i == 0) part[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(part[0])));
+    if (i == 0) part = sentence_case(part);
     if (i > 0) out += i + 1 == names.parts.size() ? ", and " : ", ";
     out += part;
   }
@@ -459,20 +458,9 @@ int count_figures(const std::vector<Polyline>& curves, double margin_m) {
   return groups;
 }
 
-std::string first_words(const std::string& text, int n) {
-  std::string out;
-  int words = 0;
-  std::size_t i = 0;
-  while (i < text.size() && words < n) {
-    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
-    const std::size_t start = i;
-    while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
-    if (i == start) break;
-    if (!out.empty()) out += ' ';
-    out.append(text, start, i - start);
-    ++words;
-  }
-  return out;
+std::string sentence_case(std::string text) {
+  if (!text.empty() && text[0] >= 'a' && text[0] <= 'z') text[0] = static_cast<char>(text[0] - 'a' + 'A');
+  return text;
 }
 
 std::string describe_shapes(int shapes) {

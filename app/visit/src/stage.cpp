@@ -1,6 +1,8 @@
 // What the device and the screen show (stage.hpp).
 #include "visit/stage.hpp"
 
+#include "pictures/picture_names.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <cctype>
@@ -58,12 +60,14 @@ void Stage::show_tutorial(TutorialShape shape) {
 }
 
 void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes, bool reading_said) {
+  // A capture or a stick's page has no names file: the kiosk's own guesses name its parts.
+  if (is.shape_region.size() != is.polylines.size() && notes.guesses) add_guessed_regions(is);
   Shown sh;
   sh.polylines = is.polylines;
   sh.descriptors = is.descriptors;
   sh.regions = is.regions;
   sh.shape_region = is.shape_region;
-  sh.names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m);
+  sh.names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m, &is.polylines);
   sh.picture = is.picture;  // the pixels the scene was built from (a picture file decoded once, reduced)
   sh.px_to_m = is.px_to_m;
   sh.text_blocks = is.text_blocks;
@@ -221,6 +225,17 @@ TourPicture Stage::tour_picture() const {
   p.id = shown_id_;
   p.described = shown_.polylines.size();
   p.words = [this](std::size_t curve) { return shape_words(curve); };
+  const PictureNames& names = shown_.names;
+  if (names.shape_name.empty() || showing_tutorial()) return p;
+  p.name = [this](std::size_t curve) {
+    // "part of the left wing" is the shape's; touched, the part is named: "the left wing".
+    const std::vector<std::string>& said = shown_.names.shape_name;
+    if (curve >= said.size()) return std::string();
+    const std::string& name = said[curve];
+    return name.rfind("part of ", 0) == 0 ? name.substr(8) : name;
+  };
+  for (const PictureNames::Part& part : names.parts)
+    if (part.curve >= 0) p.parts.push_back({part.name, static_cast<std::size_t>(part.curve)});
   return p;
 }
 

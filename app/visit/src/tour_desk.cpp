@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "runtime/runtime_params.hpp"
+#include "visit/describe.hpp"
 
 namespace hk::app {
 
@@ -43,6 +44,14 @@ void TourDesk::key_pressed() {
 
 void TourDesk::guide() {
   const TourPicture picture = this->picture();
+  if (picture.scene && !picture.parts.empty()) {
+    guide_stops_ = false;  // a press during a tour offers the next part
+    const TourPicture::Part& part = picture.parts[next_part_ % picture.parts.size()];
+    next_part_ = (next_part_ + 1) % picture.parts.size();
+    ask(audio_.messages().text(audio::MessageId::tour_ask_part, {{"name", part.name}}), picture.id,
+        static_cast<int>(part.curve));
+    return;
+  }
   if (guide_stops_) {
     guide_stops_ = false;
     voice_.say(audio_.messages().text(audio::MessageId::tour_stopped));
@@ -57,22 +66,29 @@ void TourDesk::guide() {
     voice_.say(audio_.messages().text(any_shape ? audio::MessageId::tour_all_touched : audio::MessageId::tour_nothing));
     return;
   }
+  ask(audio_.messages().text(audio::MessageId::tour_ask), picture.id, -1);
+}
+
+void TourDesk::ask(const std::string& question, int scene_id, int part_curve) {
   // Ask first: the pull starts once the visitor has heard what is coming (counted in servo ticks, so the
   // same in a headless run as at the kiosk).
-  const std::string ask = audio_.messages().text(audio::MessageId::tour_ask);
-  voice_.say_brief(ask);
+  voice_.say_brief(question);
   asked_ = true;
-  scene_ = picture.id;
-  due_tick_ =
-      step_.display().tick +
-      static_cast<std::int64_t>(std::ceil((audio_.speech_duration_s(ask) + kAskMargin_s) * s_.haptics.servo_rate_hz));
+  scene_ = scene_id;
+  part_curve_ = part_curve;
+  due_tick_ = step_.display().tick +
+              static_cast<std::int64_t>(
+                  std::ceil((audio_.speech_duration_s(question) + kAskMargin_s) * s_.haptics.servo_rate_hz));
 }
 
 void TourDesk::hand_over(const TourPicture& picture) {
   asked_ = false;
   if (!picture.scene || scene_ != picture.id) return;  // another picture came meanwhile
+  const Vec2 handle_m = step_.display().handle_m;
+  const TourParams tp = tour_params_from(s_);
   std::optional<TourPath> plan =
-      plan_tour(*picture.scene, picture.id, step_.display().handle_m, touches_, tour_params_from(s_));
+      part_curve_ >= 0 ? plan_tour_to(*picture.scene, picture.id, handle_m, static_cast<std::size_t>(part_curve_), tp)
+                       : plan_tour(*picture.scene, picture.id, handle_m, touches_, tp);
   if (!plan) return;  // touched meanwhile: nothing left to lead to
   plan->id = ++seq_;
   running_ = plan->id;
@@ -86,7 +102,10 @@ void TourDesk::hand_over(const TourPicture& picture) {
 void TourDesk::poll() {
   const TourPicture picture = this->picture();
   const ServoDisplayState& d = step_.display();
-  if (d.scene_id == touches_.scene_id() && d.curve >= 0) touches_.touch(d.scene_id, d.curve);
+  if (d.scene_id == touches_.scene_id() && d.curve >= 0) {
+    touches_.touch(d.scene_id, d.curve);
+    if (picture.scene && picture.id == d.scene_id) say_touched_name(picture, d.curve);
+  }
   if (asked_ && d.tick >= due_tick_) hand_over(picture);
   if (!running_ || d.tour_id != running_ || !tour_ended(d.tour_phase)) return;
   if (d.tour_phase == TourPhase::Done) touches_.touch(scene_, d.tour_curve);
@@ -125,9 +144,20 @@ void TourDesk::report_end(const TourPicture& picture, const ServoDisplayState& d
   voice_.say(text);
 }
 
+void TourDesk::say_touched_name(const TourPicture& picture, int curve) {
+  if (s_.kiosk.say_names_on_touch != "on" || !picture.name || running() || voice_.speaking()) return;
+  if (static_cast<std::size_t>(curve) >= picture.described) return;
+  std::string name = picture.name(static_cast<std::size_t>(curve));
+  if (name.empty() || std::find(names_said_.begin(), names_said_.end(), name) != names_said_.end()) return;
+  names_said_.push_back(name);
+  voice_.say_brief(audio_.messages().text(audio::MessageId::touch_name, {{"name", sentence_case(name)}}));
+}
+
 void TourDesk::picture_changed(int id, int curves) {
   touches_.reset(id, curves);  // touches are kept per picture
-  stop_quietly();              // the servo stops a running tour at the swap anyway; nothing to say of it
+  names_said_.clear();
+  next_part_ = 0;
+  stop_quietly();  // the servo stops a running tour at the swap anyway; nothing to say of it
 }
 
 void TourDesk::new_visitor(int id, int curves) {

@@ -122,6 +122,8 @@ enum class MessageId : int {
   sorry,
   tour_ask,
   tour_traced,
+  tour_ask_part,
+  touch_name,
   high_contrast_on,
   high_contrast_off,
   overlay_on,
@@ -161,7 +163,7 @@ enum class MessageId : int {
   unclear_word,
   unclear_words,
 };
-inline constexpr int kMessageCount = 136;
+inline constexpr int kMessageCount = 138;
 
 /// TOML key of every MessageId, in enum order.
 inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{"welcome",
@@ -262,6 +264,8 @@ inline constexpr std::array<std::string_view, kMessageCount> kMessageKeys{"welco
                                                                           "sorry",
                                                                           "tour_ask",
                                                                           "tour_traced",
+                                                                          "tour_ask_part",
+                                                                          "touch_name",
                                                                           "high_contrast_on",
                                                                           "high_contrast_off",
                                                                           "overlay_on",

@@ -36,4 +36,8 @@ inline constexpr std::size_t kOneLineMaxBytes = 512;
 /// ..." (single quotes, the default), or a settings value as the file spells it ('"', config).
 [[nodiscard]] std::string quoted(std::string_view s, std::size_t max_bytes = kOneLineMaxBytes, char quote = '\'');
 
+/// The first `n` words of `text` (split at ASCII white space, joined by one space), for speech and names: what
+/// a block of text begins with. The whole text when it has no more. Never throws but std::bad_alloc.
+std::string first_words(const std::string& text, int n);
+
 }  // namespace hk

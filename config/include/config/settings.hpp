@@ -216,6 +216,8 @@ struct KioskSettings {
                ///< win over the file beside the picture): "auto" ($STATE_DIRECTORY/names under the service, else
                ///< $XDG_DATA_HOME/haptic-kiosk/names, else ~/.local/share/haptic-kiosk/names), "off" (only the files
                ///< beside the pictures), or an absolute folder
+  std::string say_names_on_touch = "on";  ///< key say_names_on_touch, "on": the first touch of a named shape in a visit
+                                          ///< of a picture says its name, once; "off": names only when asked
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const KioskSettings&) const = default;

@@ -5,6 +5,7 @@
 ///
 ///     title = "a horse, seen from the side"
 ///     description = "A horse standing, its head to the left."
+///     guesses = false   # optional: no faces or text guessed on it
 ///
 /// The kiosk speaks the title when the picture is shown ("Picture 2 of 5: a horse, seen from the side.") and
 /// both first when the visitor asks for a description. Written by people, so read with care: a sidecar that
@@ -21,6 +22,9 @@ namespace hk::app {
 struct PictureNotes {
   std::string title;        ///< one line, 1 to kMaxTitleBytes bytes of UTF-8; empty when none
   std::string description;  ///< 1 to kMaxDescriptionBytes bytes of UTF-8, spoken as it is; empty when none
+  /// Whether the kiosk's own guesses name parts of the picture (faces, text blocks: picture_names.hpp); a
+  /// sidecar's `guesses = false` turns them off (a false face on an artwork).
+  bool guesses = true;
 };
 
 inline constexpr std::size_t kMaxNotesFileBytes = 16 * 1024;
@@ -57,7 +61,8 @@ std::string notes_path(const std::string& image_path);
 /// over the file: it is the operator's). The sidecar must be at most
 /// kMaxNotesFileBytes, valid TOML, with only the string keys `title` (one line, no control characters, at
 /// most kMaxTitleBytes) and `description` (no control characters but line breaks, at most
-/// kMaxDescriptionBytes), both valid UTF-8 and not blank; surrounding white space is trimmed.
+/// kMaxDescriptionBytes), both valid UTF-8 and not blank, and the boolean `guesses`; surrounding white space is
+/// trimmed.
 /// @throws PictureNotesError (one line) for a sidecar that breaks any of these, or cannot be read.
 PictureNotes read_picture_notes(const std::string& image_path, const PictureNotes* file_notes = nullptr);
 

@@ -11,6 +11,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,9 +24,25 @@ namespace hk::meaning {
 /// How far an SVG line's region reaches on each side of its stroke [px of the picture].
 inline constexpr int kLineReachPx = 6;
 
+/// Who named a region: staff (an annotation file, the authority), or a guess of the kiosk's own.
+enum class RegionSource {
+  staff,  ///< an annotation: said with its article ("the left wing")
+  face,   ///< a face guessed (faces.hpp): said as a guess, kFaceName
+  text,   ///< a block of text read from the page or picture: "text: " and its first words
+};
+
+/// The name of a face guessed, as said: a guess, never a certainty.
+inline constexpr const char* kFaceName = "something that could be a face";
+/// Words of a text block a text region's name keeps ("text: Emergency exit").
+inline constexpr int kTextNameWords = 4;
+
+/// The key scene.json gives each source: "staff", "face", "text".
+const char* region_source_key(RegionSource s);
+
 /// One named region on the picture's pixels.
 struct NamedRegion {
-  std::string name;         ///< what staff called it; may be empty when they only described it
+  RegionSource source = RegionSource::staff;
+  std::string name;         ///< what staff called it (may be empty when they only described it), or the guess's name
   std::string description;  ///< their longer text; may be empty
   cv::Rect box_px;          ///< its bounding box on the picture [px], within the picture
   cv::Mat mask;             ///< CV_8U over box_px, non-zero inside
@@ -39,6 +56,16 @@ struct NamedRegion {
 std::vector<NamedRegion> draw_regions(const app::AnnotationSet& set, int width_px, int height_px, int full_width_px,
                                       int full_height_px, const std::string& source,
                                       std::vector<std::string>* problems);
+
+/// A guessed region (`source` face or text) named `name` filling the box `box_px` [px] of a `width_px` x
+/// `height_px` picture (clipped to it): an ellipse for a face, the whole box for text. nullopt when nothing of
+/// the box lies on the picture.
+std::optional<NamedRegion> guessed_region(RegionSource source, std::string name, cv::Rect box_px, int width_px,
+                                          int height_px);
+
+/// Whether at least half of `guess`'s pixels lie in one of `staff` (staff named that part already: their name is
+/// the one said, the guess is dropped).
+bool covered_by_staff(const NamedRegion& guess, const std::vector<NamedRegion>& staff);
 
 /// The region each polyline takes its name from: the smallest (fewest pixels) region with a name that holds at
 /// least half of the polyline's points (`px_to_m` maps picture pixels to metres); −1 for none. One per polyline.

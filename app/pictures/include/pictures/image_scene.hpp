@@ -33,6 +33,8 @@ struct BuildTimes {
   double decode_ms = 0;
   /// What the kiosk sees of the shapes (describe_scene_shapes): forms, colours, sizes; 0 when read from the cache.
   double descriptors_ms = 0;
+  /// Faces guessed (describe_scene_shapes, meaning/faces.hpp); 0 when read from the cache or not looked for.
+  double faces_ms = 0;
 };
 
 /// A block of text of a page in workspace metres: spoken, not felt.
@@ -165,7 +167,11 @@ struct ImageScene {
   std::vector<double> strength;
   /// descriptors[i]: what polylines[i] looks like (meaning/shape_descriptors.hpp), one per polyline.
   std::vector<meaning::ShapeDescriptor> descriptors;
-  /// Regions staff named on `picture` (picture_names.hpp apply_names; not kept in the scene cache).
+  /// Faces guessed in the picture (meaning/faces.hpp), boxes in workspace metres (lo = lower left); kept in the
+  /// scene cache. Not looked for on document pages.
+  std::vector<Aabb> faces_m;
+  /// Regions named on `picture`: staff's, then the guesses (faces, text blocks) that staff's do not cover
+  /// (picture_names.hpp apply_names; not kept in the scene cache).
   std::vector<meaning::NamedRegion> regions;
   /// shape_region[i]: the region polylines[i] takes its name from, −1 for none; empty before apply_names.
   std::vector<int> shape_region;
@@ -178,8 +184,9 @@ inline constexpr int kScreenPictureMaxSidePx = 1920;
 
 /// Sets `is.descriptors` (one per polyline: form, colour, size, speck) from its polylines, its scene (the form's
 /// coarse level; without a scene, each polyline's own points) and its picture (the colours; none when empty),
-/// and times it in is.times.descriptors_ms. Call after the scene is built and before fit_picture shrinks the
-/// picture. Never throws but std::bad_alloc.
+/// timed in is.times.descriptors_ms; and `is.faces_m` (meaning/find_faces on the picture; none for a document
+/// page or an empty picture), timed in is.times.faces_ms. Call after the scene is built and before fit_picture
+/// shrinks the picture. Never throws but std::bad_alloc.
 void describe_scene_shapes(ImageScene& is);
 
 /// Shrinks `is.picture` (INTER_AREA) so that its long side is at most `max_side_px`, and moves `is.px_to_m`

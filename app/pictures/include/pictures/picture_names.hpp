@@ -21,9 +21,18 @@ std::string names_dir(const config::Settings& s);
 std::string names_file_for(const std::string& picture_path, const std::string& names_folder);
 
 /// Puts the names of `names_file` (annotations_path's form; "" = none) on `is`: ImageScene::regions and
-/// shape_region. A file refused whole, and each annotation left out, is one warning in the log naming the file
-/// and the rule; the scene keeps the names that were valid (none when the file is refused). Never throws but
+/// shape_region; then, with `guesses` (a sidecar's `guesses = false` turns them off), the kiosk's own
+/// (add_guessed_regions). A file refused whole, and each annotation left out, is one warning in the log naming
+/// the file and the rule; the scene keeps the names that were valid (none when the file is refused). Never
+/// throws but std::bad_alloc.
+void apply_names(ImageScene& is, const std::string& names_file, const std::string& picture_file_name,
+                 bool guesses = true);
+
+/// Adds the kiosk's own guesses to `is.regions` and names the shapes again (shape_region): each face of
+/// is.faces_m (meaning::kFaceName) and each text block (its first meaning::kTextNameWords words after "text: ")
+/// as a region of the picture, unless half of it lies in a region staff named. Cheap (a few small masks): the
+/// window thread may call it for a capture or a stick's page, which have no names file. Never throws but
 /// std::bad_alloc.
-void apply_names(ImageScene& is, const std::string& names_file, const std::string& picture_file_name);
+void add_guessed_regions(ImageScene& is);
 
 }  // namespace hk::app

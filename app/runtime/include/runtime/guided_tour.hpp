@@ -90,4 +90,10 @@ int tour_plan_level(const Scene& scene, std::size_t c, const TourParams& p);
 std::optional<TourPath> plan_tour(const Scene& scene, int scene_id, Vec2 handle_m, const VisitTouches& touched,
                                   const TourParams& p);
 
+/// Plans the tour to curve `curve` (a named part the visitor picked) from `handle_m` [m], as plan_tour does for
+/// the shape it chooses, touched or not. Returns nullopt for a curve out of range or with fewer than 2 points at
+/// tour_plan_level. Allocates: not for the servo thread.
+std::optional<TourPath> plan_tour_to(const Scene& scene, int scene_id, Vec2 handle_m, std::size_t curve,
+                                     const TourParams& p);
+
 }  // namespace hk::app

@@ -31,12 +31,18 @@ struct ShownView {
   vision::PxToM px_to_m{1, 0, 0};                              ///< the picture's pixels → metres (for `regions`)
 };
 
+/// A region's name as said: staff's with its article (said_name: "the left wing"), a guess's as it is
+/// ("something that could be a face", "text: Emergency exit").
+std::string region_said_name(const meaning::NamedRegion& region);
+
 /// The names of a picture in the terms Describe and Where use: each curve's name (said_name of the region it
 /// takes it from, `shape_region[i]`, −1 none; when several shapes take one region's: "one of the white spots" for a
 /// plural name, "part of the left wing" for another) and each named region once (the largest region of a name), largest
-/// first, with its centre and area in metres (`px_to_m`). `curves`: how many curves there are.
+/// first, with its centre and area in metres (`px_to_m`). `curves`: how many curves there are. Given `polylines`
+/// (the `curves` curves [m]), each part's curve is the longest curve taking its name.
 PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, const std::vector<int>& shape_region,
-                           std::size_t curves, const vision::PxToM& px_to_m);
+                           std::size_t curves, const vision::PxToM& px_to_m,
+                           const std::vector<Polyline>* polylines = nullptr);
 
 /// Words of a block of text that Where reads (Describe reads it whole).
 inline constexpr int kWhereTextWords = 8;

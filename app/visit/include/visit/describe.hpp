@@ -72,6 +72,7 @@ struct PictureNames {
     std::string name;  ///< as said ("the left wing")
     Vec2 centre_m;
     double area_m2 = 0;
+    int curve = -1;  ///< the longest curve taking this name (what a tour to it traces), −1 for none or not known
   };
   std::vector<Part> parts;  ///< largest first
 };
@@ -109,9 +110,9 @@ std::string describe_scene(const std::vector<Polyline>& curves,
 /// apart count twice. Returns 0 for no curves.
 int count_figures(const std::vector<Polyline>& curves, double margin_m = 0.002);
 
-/// The first `n` words of `text` (split at white space, joined by one space), for speech: what a block of
-/// text begins with. The whole text when it has no more.
-std::string first_words(const std::string& text, int n);
+/// `text` with its first letter upper case (ASCII letters only; any other first byte, as it is): a phrase that
+/// begins a sentence ("the left wing" → "The left wing").
+std::string sentence_case(std::string text);
 
 /// How many shapes a picture has, for speech: "It has 4 shapes.", "It has one shape.", "I found no shapes in it."
 std::string describe_shapes(int shapes);

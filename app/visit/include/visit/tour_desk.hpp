@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "audio/system.hpp"
 #include "config/settings.hpp"
@@ -32,6 +33,16 @@ struct TourPicture {
   std::size_t described = 0;     ///< shapes `words` can name (the level-0 curves shown)
   /// What shape `curve` is, in words ("a small closed shape, on the left"), for the line said at a tour's end.
   std::function<std::string(std::size_t curve)> words;
+  /// The name curve `curve` takes, as said ("the left wing"), "" for none; null: the picture has no names.
+  std::function<std::string(std::size_t curve)> name;
+  /// A named part the Guide key leads to: its name as said and the curve a tour traces for it.
+  struct Part {
+    std::string name;
+    std::size_t curve = 0;
+  };
+  /// The named parts in the order Guide offers them (the largest first), each name once; empty: Guide leads to
+  /// the nearest shape not yet touched.
+  std::vector<Part> parts;
 };
 
 /// The guided tour between the Guide key and the line said at its end; it answers the visitor's flow's
@@ -56,15 +67,21 @@ class TourDesk final : public TourEffects {
   void set_cursor(Vec2 m);
   /// Any key: stops a tour under way or announced, quietly (the Guide key that did so then says so).
   void key_pressed() override;
-  /// The Guide key on the picture shown: when it has a shape not yet touched (plan_tour), asks first; the tour is
-  /// planned and handed to the servo thread by poll() once the question has been heard (its length in servo
-  /// ticks, kAskMargin_s more). Nothing left: says so (tour_all_touched, or tour_nothing without shapes).
-  /// A press that stopped a tour says tour_stopped instead.
+  /// The Guide key on the picture shown. A picture with named parts (TourPicture::parts): names the next part
+  /// in turn ("I will guide your hand to the left wing. …", tour_ask_part), so each press, one that stops a
+  /// tour too, offers the next, round and round; the tour to it (plan_tour_to) starts once the question has
+  /// been heard. Otherwise, when it has a shape not yet touched (plan_tour), asks first; the tour is planned
+  /// and handed to the servo thread by poll() once the question has been heard (its length in servo ticks,
+  /// kAskMargin_s more). Nothing left: says so (tour_all_touched, or tour_nothing without shapes). A press
+  /// that stopped a tour says tour_stopped instead.
   void guide() override;
-  /// Window thread, every frame: keeps what the handle touches in this visit's touches; hands an announced
-  /// tour over when it is due; and when the tour handed over has ended, says what it traced and what remains
-  /// ("Tour stopped. …" when the hand held it back or the device was lost; nothing when a key, the mouse, a
-  /// new picture or visitor stopped it) and gives the handle back to the cursor where it is.
+  /// Window thread, every frame: keeps what the handle touches in this visit's touches, and with [kiosk]
+  /// say_names_on_touch "on" says the name of a named shape the handle touches, once in the visit of the
+  /// picture (touch_name: "The left wing."; not while a tour runs or anything else is being said: then at a
+  /// later touch); hands an announced tour over when it is due; and when the tour handed over has ended, says
+  /// what it traced and what remains ("Tour stopped. …" when the hand held it back or the device was lost;
+  /// nothing when a key, the mouse, a new picture or visitor stopped it) and gives the handle back to the
+  /// cursor where it is.
   void poll();
   /// A new picture (`id`, `curves` shapes) is published: touches start again; a tour under way stops
   /// without a word, an announced one does not start.
@@ -85,6 +102,8 @@ class TourDesk final : public TourEffects {
   void hand_over(const TourPicture& picture);  // plans the announced tour from the handle and publishes it
   void report_end(const TourPicture& picture, const ServoDisplayState& d);  // what it traced and what remains
   void stop_quietly();                                                      // ends what runs or is announced
+  void ask(const std::string& question, int scene_id, int part_curve);      // announces a tour, due once heard
+  void say_touched_name(const TourPicture& picture, int curve);             // the first touch of a named shape
 
   std::function<TourPicture()> picture_;  // set_picture
   ServoStep& step_;
@@ -101,9 +120,12 @@ class TourDesk final : public TourEffects {
   bool guide_stops_ = false;   // this key press stopped a running or announced tour
   bool asked_ = false;         // announced, not yet handed to the servo thread
   std::int64_t due_tick_ = 0;  // the servo tick from which the announced tour may start
-  Vec2 cursor_in_;             // the last cursor given to set_cursor [m]
-  Vec2 cursor_offset_;         // added to it: where tours left the hand [m]
-  Vec2 cursor_ref_;            // cursor_in_ when the tour was handed over [m]
+  int part_curve_ = -1;        // the announced tour's named part (its curve), −1 for the nearest untouched shape
+  std::size_t next_part_ = 0;  // the named part the next Guide press offers (TourPicture::parts)
+  std::vector<std::string> names_said_;  // names said at a touch in this visit of the picture
+  Vec2 cursor_in_;                       // the last cursor given to set_cursor [m]
+  Vec2 cursor_offset_;                   // added to it: where tours left the hand [m]
+  Vec2 cursor_ref_;                      // cursor_in_ when the tour was handed over [m]
 };
 
 }  // namespace hk::app
