@@ -25,14 +25,14 @@ using detail::fail;
 using detail::one_line;
 using detail::Source;
 
-/// Throws ConfigError for `src`: "not saved: <what>: <strerror(err)> (nothing was changed)".
-[[noreturn]] void io_fail(const Source& src, const std::string& what, int err) {
-  fail(src, "", "not saved: " + what + ": " + one_line(std::strerror(err)) + " (nothing was changed)");
+/// Throws FileWriteError for the file `path`: "<what>: <strerror(err)>".
+[[noreturn]] void io_fail(const std::string& path, const std::string& what, int err) {
+  throw FileWriteError(path, err, what + ": " + one_line(std::strerror(err)));
 }
 
 /// Creates `<prefix>XXXXXX` (a new, unique name) holding `text` with `mode`, fsync'ed and closed, and
-/// returns its path. On failure removes it and throws ConfigError ("not saved: ...").
-std::string write_temp(const Source& src, const std::string& prefix, const std::string& text, mode_t mode) {
+/// returns its path. On failure removes it and throws FileWriteError naming `src` (the file being written).
+std::string write_temp(const std::string& src, const std::string& prefix, const std::string& text, mode_t mode) {
   std::vector<char> tmpl(prefix.begin(), prefix.end());
   for (char c : std::string_view("XXXXXX")) tmpl.push_back(c);
   tmpl.push_back('\0');
@@ -99,20 +99,21 @@ struct TargetMode {
   bool replaces_a_file = false;
 };
 
-/// TargetMode of the file at `path` for `settings`.
-TargetMode target_mode(const std::string& path, const Settings& settings) {
+/// TargetMode of the file at `path`: `new_mode` for a new file, or always when `force`.
+TargetMode target_mode(const std::string& path, mode_t new_mode, bool force) {
   TargetMode t;
+  t.mode = new_mode;
   struct stat st {};
   t.replaces_a_file = ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-  if (t.replaces_a_file) t.mode = st.st_mode & 07777;
-  if (!settings.operator_.pin_hash.empty()) t.mode = 0600;
+  if (t.replaces_a_file && !force) t.mode = st.st_mode & 07777;
   return t;
 }
 
 /// Keeps the file at `path` as `path`.bak before it is replaced: a second name for the old file (a copy
 /// where hard links are not possible), renamed over .bak, so .bak is always a complete file. On failure
-/// removes `tmp` (the new file not yet renamed) and throws ConfigError ("not saved: ...").
-void keep_backup(const Source& src, const std::string& path, const std::string& tmp, const std::string& temp_prefix) {
+/// removes `tmp` (the new file not yet renamed) and throws FileWriteError.
+void keep_backup(const std::string& src, const std::string& path, const std::string& tmp,
+                 const std::string& temp_prefix) {
   const std::string bak = path + ".bak";
   const std::string what = "cannot keep the old file as '" + one_line(bak) + "'";
   std::string bak_tmp = tmp + ".bak";
@@ -201,18 +202,30 @@ void save_settings_atomic(const Settings& settings, const std::string& path, con
   } catch (const ConfigError& e) {
     throw ConfigError(e.source(), e.key(), std::string(e.what()) + "; not saved");
   }
-  const std::string text = to_toml(settings);
+  // A file with the PIN's hash is only ever the owner's.
+  const bool pin = !settings.operator_.pin_hash.empty();
+  try {
+    write_file_atomic(to_toml(settings), path, pin ? 0600 : 0644, pin, options);
+  } catch (const FileWriteError& e) {
+    fail(src, "", std::string("not saved: ") + e.what() + (e.error_number() != 0 ? " (nothing was changed)" : ""));
+  }
+}
 
+FileWriteError::FileWriteError(std::string path, int error_number, const std::string& message)
+    : hk::Error(message), path_(std::move(path)), error_number_(error_number) {}
+
+void write_file_atomic(const std::string& text, const std::string& path, unsigned new_file_mode, bool force_mode,
+                       const SaveOptions& options) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  if (target.filename().empty()) fail(src, "", "not saved: the path names no file");
+  if (target.filename().empty()) throw FileWriteError(path, 0, "the path names no file");
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
-  const TargetMode mode = target_mode(path, settings);
+  const TargetMode mode = target_mode(path, static_cast<mode_t>(new_file_mode & 07777), force_mode);
 
   // Every temporary name is ".<name>.tmp.*" beside the target, so one pattern finds what a crash left.
   const std::string temp_prefix = detail::temp_prefix(dir.string(), target.filename().string());
-  const std::string tmp = write_temp(src, temp_prefix, text, mode.mode);
+  const std::string tmp = write_temp(path, temp_prefix, text, mode.mode);
   bool tmp_renamed = false;  // after the commit point `tmp` no longer names our file
   const auto reached = [&](SaveStage stage) {
     if (!options.hook) return;
@@ -224,13 +237,13 @@ void save_settings_atomic(const Settings& settings, const std::string& path, con
     }
   };
   reached(SaveStage::temp_written);
-  if (mode.replaces_a_file && options.keep_backup) keep_backup(src, path, tmp, temp_prefix);
+  if (mode.replaces_a_file && options.keep_backup) keep_backup(path, path, tmp, temp_prefix);
   reached(SaveStage::backup_kept);
 
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
     const int err = errno;
     ::unlink(tmp.c_str());
-    io_fail(src, "cannot rename the temporary file over it", err);
+    io_fail(path, "cannot rename the temporary file over it", err);
   }
   tmp_renamed = true;
   reached(SaveStage::renamed);

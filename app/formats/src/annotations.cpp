@@ -308,6 +308,7 @@ class Reader {
     const auto target = a.find(a.contains("target") ? "target" : "on");
     if (target == a.end() || !parse_target(*target, &out.selector))
       return problem(which + "its target has no FragmentSelector (xywh=) or SvgSelector");
+    if (set_.canvas_width_px <= 0) canvas_of_source(*target);
     const AnnotationSelector& s = out.selector;
     if (s.kind == AnnotationSelector::Kind::svg && s.svg.size() > kMaxSvgBytes)
       return problem(which + "its SVG selector is larger than " + std::to_string(kMaxSvgBytes / 1024) + " kB");
@@ -316,12 +317,30 @@ class Reader {
     set_.annotations.push_back(std::move(out));
   }
 
+  /// A target whose source is a Canvas with its size (as write_annotation_page writes one): the canvas the
+  /// coordinates are in, when no Manifest said it.
+  void canvas_of_source(const json& target) {
+    if (!target.is_object()) return;
+    const auto src = target.find("source");
+    if (src == target.end() || !src->is_object() || type_of(*src) != "Canvas") return;
+    const auto w = src->find("width"), h = src->find("height");
+    if (w == src->end() || h == src->end() || !w->is_number() || !h->is_number()) return;
+    if (!(w->get<double>() > 0) || !(h->get<double>() > 0)) return;
+    set_.canvas_width_px = w->get<double>();
+    set_.canvas_height_px = h->get<double>();
+  }
+
   std::string source_, picture_;
   AnnotationSet set_;
   std::size_t seen_ = 0;
 };
 
 }  // namespace
+
+std::string annotation_text_problem(const std::string& text, bool description) {
+  return description ? text_problem(text, kMaxRegionDescriptionBytes, true, "description")
+                     : text_problem(text, kMaxNameBytes, false, "name");
+}
 
 std::string annotations_path(const std::string& picture_path) {
   std::filesystem::path p(picture_path);
@@ -376,12 +395,17 @@ std::string write_annotation_page(const AnnotationSet& set, const std::string& s
                     a.selector.y, a.selector.w, a.selector.h);
       selector = {{"type", "FragmentSelector"}, {"conformsTo", "http://www.w3.org/TR/media-frags/"}, {"value", v}};
     }
+    json target_source = source;
+    if (set.canvas_width_px > 0 && set.canvas_height_px > 0)  // coordinates on a canvas of its own size
+      target_source = {
+          {"id", source}, {"type", "Canvas"}, {"width", set.canvas_width_px}, {"height", set.canvas_height_px}};
     items.push_back(
         {{"id", "#name-" + std::to_string(++n)},
          {"type", "Annotation"},
          {"motivation", "identifying"},
          {"body", std::move(body)},
-         {"target", {{"type", "SpecificResource"}, {"source", source}, {"selector", std::move(selector)}}}});
+         {"target",
+          {{"type", "SpecificResource"}, {"source", std::move(target_source)}, {"selector", std::move(selector)}}}});
   }
   const json page = {
       {"@context", "http://www.w3.org/ns/anno.jsonld"}, {"type", "AnnotationPage"}, {"items", std::move(items)}};

@@ -10,6 +10,7 @@
 
 #include "config/device_profile.hpp"
 #include "config/load.hpp"
+#include "pictures/picture_names.hpp"
 #include "runtime/device_setup.hpp"
 
 namespace hk::app {
@@ -154,6 +155,12 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
         draw_fields(g, profile_type(runtime), now_unix_s);
         ImGui::EndTabItem();
       }
+    }
+    const bool names_open = ImGui::BeginTabItem("Names");
+    record("tab:Names");
+    if (names_open) {
+      draw_names(runtime);
+      ImGui::EndTabItem();
     }
     ImGui::EndTabBar();
   }
@@ -357,6 +364,83 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, st
               d.state != ContactState::Free ? 1000.0 * length(d.handle_m - d.proxy_m) : 0.0);
   ImGui::PlotLines("##penetration", penetration_mm_.data(), kPlotSamples, plot_at_, nullptr, 0.0f, FLT_MAX,
                    ImVec2(w, 90));
+}
+
+void OperatorPanel::draw_name_list() {
+  const std::vector<NamesEntry>& entries = names_->entries();
+  if (entries.empty()) ImGui::TextColored(kGrey, "No shape of this picture has a name yet.");
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const NamesEntry& e = entries[i];
+    std::string label = (e.name.empty() ? std::string("(no name)") : e.name) + "  -  ";
+    if (e.curves.empty()) label += "no shape";
+    for (std::size_t k = 0; k < e.curves.size() && k < 8; ++k)
+      label += (k == 0 ? (e.curves.size() == 1 ? "shape " : "shapes ") : ", ") + std::to_string(e.curves[k] + 1);
+    if (e.curves.size() > 8) label += ", ...";
+    if (!e.description.empty()) label += "  (described)";
+    ImGui::PushID(static_cast<int>(i));
+    if (ImGui::Selectable(label.c_str(), names_->selected() == static_cast<int>(i)))
+      names_->select_entry(static_cast<int>(i));
+    ImGui::PopID();
+    record("name:" + std::to_string(i));
+  }
+}
+
+void OperatorPanel::draw_names(KioskRuntime& runtime) {
+  Stage& stage = runtime.stage();
+  const std::string folder = names_dir(runtime.settings());
+  if (!names_ || names_->folder() != folder) {
+    names_ = std::make_unique<NamesEditor>(folder);
+    names_scene_ = 0;
+  }
+  if (names_scene_ != stage.scenes_published()) {  // another picture, or the same one built again
+    names_scene_ = stage.scenes_published();
+    const Shown& sh = stage.shown();
+    const bool library = stage.source().picture >= 0 && stage.source().document < 0;
+    names_->open({library ? sh.image_path : std::string(), sh.picture, sh.file_width_px, sh.file_height_px, sh.px_to_m,
+                  sh.polylines, sh.descriptors});
+  }
+  if (!names_->is_open()) {
+    ImGui::TextWrapped("Names are given to the library's pictures; what is on show is not one of them.");
+    return;
+  }
+  ImGui::TextColored(kGrey, "%s   names: %s", names_->picture_path().c_str(),
+                     folder.empty() ? "no names folder ([kiosk] names_dir is off)" : names_->target_file().c_str());
+  ImGui::BeginChild("names_list", ImVec2(0, ImGui::GetContentRegionAvail().y * 0.45f), true);
+  draw_name_list();
+  ImGui::EndChild();
+  if (ImGui::Button("Pick the shape at the handle")) {
+    const ServoDisplayState& d = runtime.core().display();
+    names_->pick_at_hand(d.handle_m, d.scene_id == stage.shown_id() ? d.curve : -1);
+  }
+  record("Pick the shape at the handle");
+  ImGui::SameLine();
+  if (names_->picked_curve() >= 0)
+    ImGui::Text("Shape %d picked%s", names_->picked_curve() + 1, names_->selected() >= 0 ? " (named)" : " (no name)");
+  else
+    ImGui::TextColored(kGrey, "No shape picked: move the handle onto one, or click a name above.");
+  ImGui::TextUnformatted("Name");
+  ImGui::SetNextItemWidth(-1);
+  ImGui::InputText("##names.name", &names_->name_text());
+  record("names.name");
+  ImGui::TextUnformatted("Description (optional)");
+  ImGui::SetNextItemWidth(-1);
+  ImGui::InputText("##names.description", &names_->description_text());
+  record("names.description");
+  bool saved = false;
+  if (ImGui::Button("Save names")) saved = names_->save_typed();
+  record("Save names");
+  ImGui::SameLine();
+  if (ImGui::Button("Delete name")) saved = names_->delete_and_save();
+  record("Delete name");
+  if (saved) stage.set_names(names_->regions(), names_->shape_region());  // Where and Describe say them at once
+  const NamesSaved last = names_->last_save();
+  if (!names_->status().empty())
+    ImGui::TextColored(last == NamesSaved::failed ? kRed : (last == NamesSaved::saved ? kGreen : kGrey), "%s",
+                       names_->status().c_str());
+  else
+    ImGui::TextColored(kGrey, "%s", names_->dirty() ? "Not saved yet." : "");
+  record("names:status");
+  if (last != NamesSaved::none) record(last == NamesSaved::saved ? "names:saved" : "names:failed");
 }
 
 }  // namespace hk::app

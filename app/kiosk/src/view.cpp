@@ -198,6 +198,19 @@ void draw_curves(KioskRuntime& app, const View& v, const Shown& sh, bool hc, int
   }
 }
 
+/// The shapes staff named (operator overlay): their level-0 curves in pale green over the walls, so the
+/// operator sees which shapes have a name (the Names tab).
+void draw_named_shapes(const View& v, const Shown& sh) {
+  glColor4f(0.55f, 1.0f, 0.6f, 0.85f);
+  glLineWidth(5.0f);
+  for (std::size_t c = 0; c < sh.polylines.size() && c < sh.shape_region.size(); ++c) {
+    if (sh.shape_region[c] < 0) continue;
+    glBegin(sh.polylines[c].closed ? GL_LINE_LOOP : GL_LINE_STRIP);
+    for (const Vec2& p : sh.polylines[c].points_m) glVertex2d(v.px(p.x), v.py(p.y));
+    glEnd();
+  }
+}
+
 /// One error box (a rotated rectangle: origin, axis, [u_min, u_max] × [n_min, n_max] in m) as a line loop,
 /// in the colour and width already set.
 void draw_box(const View& v, const ErrorBox& b) {
@@ -280,6 +293,7 @@ void draw_scene(KioskRuntime& app, const View& v, const PictureTexture& tex) {
   draw_text_blocks(v, sh, hc);
   const LevelChoice choice = LevelChoice::of_id(app.stage().level());
   const int cut_step = choice.kind == LevelChoice::Kind::Cut && !sh.cuts.empty() ? choice.index : -1;
+  if (app.switches().overlay()) draw_named_shapes(v, sh);
   draw_curves(app, v, sh, hc, cut_step);
   if (app.switches().overlay() && sh.scene) draw_error_boxes(app, v, sh, cut_step);
   const ServoDisplayState& d = app.core().display();

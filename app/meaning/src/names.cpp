@@ -118,6 +118,7 @@ std::vector<NamedRegion> draw_regions(const app::AnnotationSet& set, int width_p
     r.box_px = box;
     r.mask = mask(box).clone();
     r.area_px = cv::countNonZero(r.mask);
+    r.annotation = static_cast<int>(i);
     out.push_back(std::move(r));
   }
   return out;

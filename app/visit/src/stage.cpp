@@ -69,6 +69,9 @@ void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes,
   sh.shape_region = is.shape_region;
   sh.names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m, &is.polylines);
   sh.picture = is.picture;  // the pixels the scene was built from (a picture file decoded once, reduced)
+  sh.image_path = is.image_path;
+  sh.file_width_px = is.file_width_px > 0 ? is.file_width_px : is.picture.cols;
+  sh.file_height_px = is.file_height_px > 0 ? is.file_height_px : is.picture.rows;
   sh.px_to_m = is.px_to_m;
   sh.text_blocks = is.text_blocks;
   sh.notes = std::move(notes);
@@ -155,6 +158,13 @@ void Stage::text_arrived(TextRead& read) {
   } else if (said_reading) {
     text_news_ = m.text(audio::MessageId::text_none);
   }
+}
+
+void Stage::set_names(std::vector<meaning::NamedRegion> regions, std::vector<int> shape_region) {
+  if (shape_region.size() != shown_.polylines.size()) return;
+  shown_.names = picture_names(regions, shape_region, shown_.polylines.size(), shown_.px_to_m);
+  shown_.regions = std::move(regions);
+  shown_.shape_region = std::move(shape_region);
 }
 
 ShownView Stage::view() const {

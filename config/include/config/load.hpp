@@ -171,4 +171,32 @@ struct SaveOptions {
 /// propagates unchanged.
 void save_settings_atomic(const Settings& settings, const std::string& path, const SaveOptions& options = {});
 
+/// A file write_file_atomic() could not write. what() is one line, "<what could not be done>: <the system's
+/// reason>" ("cannot create a temporary file in '/srv/names': Permission denied"); `path` is the file being written
+/// and error_number() the errno value (0 when the failure had none, e.g. a path naming no file).
+class FileWriteError : public hk::Error {
+ public:
+  /// @param path  the file being written; @param error_number  errno (0: none); @param message  what() (one line)
+  FileWriteError(std::string path, int error_number, const std::string& message);
+  /// The file being written, as given.
+  [[nodiscard]] const std::string& path() const noexcept { return path_; }
+  /// The errno value of the failing call (EACCES, ENOSPC, ...), 0 when there was none.
+  [[nodiscard]] int error_number() const noexcept { return error_number_; }
+
+ private:
+  std::string path_;
+  int error_number_ = 0;
+};
+
+/// Writes `text` to `path` the way save_settings_atomic() writes settings (the steps and the crash guarantee
+/// above: a temporary file in the same folder, fsync'ed, the old file kept as `<path>.bak` when
+/// options.keep_backup, renamed over `path`, the folder fsync'ed), for any file the kiosk keeps (settings, staff
+/// names). A new file gets `new_file_mode` (permission bits, e.g. 0644); an existing one keeps its own unless
+/// `force_mode`, which gives it `new_file_mode` too. The folder must exist. Not safe against concurrent writers.
+/// @throws FileWriteError (one line, the errno kept) if any step before the rename over `path` fails; `path` is
+///   then untouched (`.bak` may already hold the old file) and the temporary files are removed. A throwing
+///   hook's exception propagates unchanged, as in save_settings_atomic().
+void write_file_atomic(const std::string& text, const std::string& path, unsigned new_file_mode = 0644,
+                       bool force_mode = false, const SaveOptions& options = {});
+
 }  // namespace hk::config

@@ -12,7 +12,9 @@
 /// (`resources`) | its `oa:Annotation`s: `resource` (`chars`; `oa:Tag` a name), `on` (a `#xywh=` string or an
 /// `oa:SpecificResource` with a selector, `oa:Choice` of two) |
 ///
-/// An annotation page referenced only by URL is not fetched (the kiosk is offline): noted in `problems`.
+/// An annotation page referenced only by URL is not fetched (the kiosk is offline): noted in `problems`. A target
+/// whose `source` is a `Canvas` with `width` and `height` (as write_annotation_page writes one) gives the canvas
+/// when no Manifest does.
 ///
 /// | part | read |
 /// |---|---|
@@ -77,6 +79,11 @@ struct AnnotationSet {
   std::vector<std::string> problems;
 };
 
+/// Why `text` cannot be an annotation's name (`description` false) or its description (true), as the reader leaves
+/// such an annotation out: "the name is longer than 200 bytes", "the name is not valid UTF-8", "the name has a
+/// control character" (a description may break lines); "" when it can.
+std::string annotation_text_problem(const std::string& text, bool description);
+
 /// The file of names for `picture_path` ("…/horse.png" → "…/horse.annotations.json").
 std::string annotations_path(const std::string& picture_path);
 
@@ -93,7 +100,9 @@ AnnotationSet read_annotations(const std::string& path, const std::string& pictu
 
 /// The annotations as an AnnotationPage (W3C model: TextualBody with purpose "identifying" for the name and
 /// "describing" for the description; a SpecificResource target with its selector; canvas coordinates as
-/// given), for a file written by the kiosk. `source` is the target's source (the picture's file name).
+/// given), for a file written by the kiosk. `source` is the target's source (the picture's file name); with a
+/// canvas in `set` (AnnotationSet::canvas_width_px > 0) the source is a Canvas of that width and height, which
+/// parse_annotations reads back as the canvas, so the coordinates keep their meaning.
 std::string write_annotation_page(const AnnotationSet& set, const std::string& source);
 
 }  // namespace hk::app

@@ -4,8 +4,8 @@
 /// with every setting of the field table grouped in tabs (Haptics, Levels, Scene, Audio, Kiosk, Keys,
 /// Devices), each with its unit, range, help text and when a change takes effect, plus a Status tab with
 /// the servo's lateness and missed deadlines, the device, sound, the stick, the level in use and a live
-/// plot of force and penetration. Its logic lives in OperatorSession (GL-free); this file only draws and
-/// turns clicks and keys into the session's actions.
+/// plot of force and penetration, and a Names tab where staff name the shapes of the picture on show. Its logic lives
+/// in OperatorSession (GL-free); this file only draws and turns clicks and keys into the session's actions.
 ///
 /// Scripted runs click widgets by name (script lines "FRAME click NAME"): every clickable widget drawn in a
 /// frame is recorded with its screen rectangle — a setting's edit box by its `table.key`, buttons by their
@@ -13,14 +13,23 @@
 /// the PIN box as "pin". Some lines of the Status tab are recorded by what they say, for "FRAME shows NAME":
 /// the USB stick line as "sticks:idle" or "sticks:working", the last stick's list of files left out as
 /// "stick_problems".
+///
+/// The Names tab ("tab:Names") names the shapes of the library picture on show (NamesEditor, GL-free): the list of
+/// names (each "name:<index>", click to select), "Pick the shape at the handle", the name box "names.name" and the
+/// description box "names.description" (click, then type), "Save names" and "Delete name", and a status line
+/// recorded as "names:saved" or "names:failed" after a save (with "names:status" always). A save puts the names on
+/// what is shown at once (Stage::set_names).
 
 #include <array>
+#include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
+#include "visit/names_editor.hpp"
 #include "visit/operator_session.hpp"
 
 namespace hk::app {
@@ -54,6 +63,10 @@ class OperatorPanel {
   /// profile in force (`profile_type`, KioskRuntime::profile_type) beside it.
   void draw_fields(config::FieldGroup group, const std::string& profile_type, std::int64_t now_unix_s);
   void draw_actions(std::int64_t now_unix_s);
+  /// The Names tab: the editor opened again on the picture on show whenever another scene is shown.
+  void draw_names(KioskRuntime& runtime);
+  /// The Names tab's list of names, each selectable ("name:<index>").
+  void draw_name_list();
   void sample_plot(KioskRuntime& runtime);
   void record(const std::string& name);
 
@@ -65,6 +78,8 @@ class OperatorPanel {
   static constexpr int kPlotSamples = 300;  // 5 s of frames at 60 Hz
   std::array<float, kPlotSamples> force_n_{}, penetration_mm_{};
   int plot_at_ = 0;
+  std::unique_ptr<NamesEditor> names_;  // the Names tab's editor, made when the tab is first drawn
+  std::uint64_t names_scene_ = 0;       // Stage::scenes_published() when it was last opened
 };
 
 }  // namespace hk::app

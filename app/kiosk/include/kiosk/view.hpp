@@ -3,7 +3,8 @@
 /// What the screen shows of the scene (OpenGL 2, legacy pipeline: one draw per frame of a few thousand
 /// vertices): the picture where its pixels map in the workspace, the usable rectangle, a document page's
 /// text blocks, the curves at the level in use, the handle, the proxy and the force; with the operator
-/// overlay also the error boxes of the level in use and the boundary section the servo thread keeps.
+/// overlay also the error boxes of the level in use, the boundary section the servo thread keeps and the shapes
+/// staff named (pale green, under the walls).
 /// Where the workspace lands on the screen (View, make_view): view_geometry.hpp.
 
 #include <GL/gl.h>

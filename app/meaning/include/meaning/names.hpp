@@ -47,6 +47,7 @@ struct NamedRegion {
   cv::Rect box_px;          ///< its bounding box on the picture [px], within the picture
   cv::Mat mask;             ///< CV_8U over box_px, non-zero inside
   double area_px = 0;       ///< pixels inside
+  int annotation = -1;      ///< the index in AnnotationSet::annotations it was drawn from; −1 when not from a set
 };
 
 /// The regions of `set` on a picture of `width_px` x `height_px` [px] whose full-detail size (the file's, upright)

@@ -39,8 +39,12 @@ struct Shown {
   /// polyline (joined_cut_points) [m], what the walls are at that cut step; empty otherwise.
   std::vector<std::vector<std::vector<SegmentRef>>> cut_segments;
   std::vector<std::vector<std::vector<Vec2>>> cuts;
-  std::vector<bool> closed;             ///< [curve]
-  cv::Mat picture;                      ///< BGR, empty for tutorial shapes
+  std::vector<bool> closed;  ///< [curve]
+  cv::Mat picture;           ///< BGR, empty for tutorial shapes
+  std::string image_path;    ///< the picture's file (a page: its document), "" for tutorial shapes
+  /// The picture's own size at full detail [px] (ImageScene::file_width_px), what staff names' coordinates are
+  /// in; 0 for tutorial shapes.
+  int file_width_px = 0, file_height_px = 0;
   vision::PxToM px_to_m{1, 0, 0};       ///< picture pixels → workspace metres
   const Scene* scene = nullptr;         ///< the published scene (read-only here; for the overlay)
   std::vector<TextBlockM> text_blocks;  ///< a document page's text (Describe reads the one under the hand)
@@ -103,6 +107,11 @@ class Stage final : public StageEffects {
   /// The operator's level and mode again (a new picture, page or visitor), asked of the servo step at once;
   /// `at_once` false: from the next scene published (settings applied, the scene rebuilt).
   void reset_level(bool at_once = true);
+  /// Staff names put on what is shown, at once (the operator's Names tab saved them): `regions` drawn on
+  /// Shown::picture and `shape_region` one per curve (−1 none), as apply_names makes them. Where, Describe and the
+  /// tour say them from now on; the scene on the device is not touched (names never reach the servo thread).
+  /// Ignored when `shape_region` is not one per curve shown.
+  void set_names(std::vector<meaning::NamedRegion> regions, std::vector<int> shape_region);
   /// A new visitor: far and near explained again, the operator's level, the tour's touches forgotten.
   void new_visitor();
   /// Window thread, every frame (`now_s` the frame clock [s]): the text of the page shown, read since it was
