@@ -15,13 +15,16 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 #include <string>
 #include <vector>
 
 #include "audio/messages.hpp"
 #include "config/settings.hpp"
+#include "meaning/faces.hpp"
 #include "meaning/shape_descriptors.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_names.hpp"
@@ -174,6 +177,39 @@ TEST(StaffNames, APresentationTwoListNamesByItsTagAndAChoiceTakesTheSvg) {
   ASSERT_EQ(n.is.regions.size(), 2u);
   EXPECT_EQ(n.is.regions[0].description, "A red disc, the first shape drawn.");
   EXPECT_TRUE(n.is.regions[1].name.empty()) << "a comment alone names nothing";
+}
+
+}  // namespace
+}  // namespace hk::app
+
+namespace hk::app {
+namespace {
+
+// The cameraman: the face the kiosk guesses names the shapes in it, said as a guess; a sidecar's
+// `guesses = false` (apply_names' guesses) leaves the picture without it.
+TEST(GuessedNames, TheCameramansFaceIsSaidAsAGuessUnlessGuessesAreOff) {
+  if (!std::filesystem::exists(std::string(meaning::kOpenCvCascadeDir) + "/haarcascade_profileface.xml"))
+    GTEST_SKIP() << "Debian's opencv-data is not installed (scripts/install-deps.sh installs it)";
+  const cv::Mat camera = cv::imread(std::string(HK_TEST_DATA_DIR) + "/images/camera.png");
+  ImageScene is = build_image_scene_from_picture(camera, "camera.png", config::Settings{});
+  ASSERT_EQ(is.faces_m.size(), 1u);
+  apply_names(is, "", "camera.png", true);
+  ASSERT_EQ(is.regions.size(), 1u);
+  EXPECT_EQ(is.regions[0].source, meaning::RegionSource::face);
+  const std::size_t named = static_cast<std::size_t>(std::count(is.shape_region.begin(), is.shape_region.end(), 0));
+  EXPECT_GE(named, 1u) << "the outlines of his face take its name";
+  const PictureNames names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m, &is.polylines);
+  static const std::vector<TextBlockM> none;
+  static const PictureNotes no_notes;
+  const ShownView view{is.polylines, is.descriptors, none,   no_notes,    {0.07, 0.045},
+                       false,        false,          &names, &is.regions, is.px_to_m};
+  const std::string said = describe_answer(view, audio::MessageCatalog::english(), {0.07, -0.045}, {0.07, -0.045});
+  EXPECT_NE(said.find("omething that could be a face"), std::string::npos) << said;
+  EXPECT_EQ(said.find("the something"), std::string::npos) << "a guess takes no article: " << said;
+  apply_names(is, "", "camera.png", false);
+  EXPECT_TRUE(is.regions.empty());
+  EXPECT_EQ(std::count(is.shape_region.begin(), is.shape_region.end(), -1),
+            static_cast<std::ptrdiff_t>(is.polylines.size()));
 }
 
 }  // namespace

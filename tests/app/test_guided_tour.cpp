@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -37,6 +38,7 @@
 #include "tour_picture.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
+#include "wait_until.hpp"
 
 namespace hk::app {
 namespace {
@@ -529,11 +531,20 @@ struct RuntimeRig {
     for (long k = 0, n = static_cast<long>(seconds / dt + 0.5); k < n; ++k) {
       test::runtime_tick(*rt, dt, hand_force);
       guide_n.push_back(length(rt->core().display().guide_force_n));
-      if (k % 16 == 0) rt->tour().poll();  // a frame
+      if (k % 16 == 0) {  // a frame: the window thread's poll, and 16 ms of sound heard (48 kHz, mono)
+        rt->tour().poll();
+        rt->audio().render(heard.data(), heard.size());
+      }
     }
     rt->tour().poll();
   }
-  std::vector<double> guide_n;  // every tick's guide force [N], from the first run
+  /// Pulls the mix until nothing is being said (the speech worker synthesises in its own time).
+  bool listen_to_the_end() {
+    return test::wait_until([&] { return !rt->voice().speaking(); },
+                            [&] { rt->audio().render(heard.data(), heard.size()); });
+  }
+  std::vector<double> guide_n;                         // every tick's guide force [N], from the first run
+  std::vector<float> heard = std::vector<float>(768);  // one frame's sound
   std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) {
     return audio::MessageCatalog::english().text(id, args);
   }
@@ -604,6 +615,76 @@ TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) 
   // A new visitor: nothing touched.
   r.rt->effects().session.new_session();
   EXPECT_EQ(r.rt->tour().touches().count(), 0);
+}
+
+/// Staff names for the five shapes: the circle "sun" and the triangle "roof" (boxes around them, in pixels).
+void name_sun_and_roof(const fs::path& dir) {
+  std::ofstream(dir / "five.annotations.json") << R"({"type": "AnnotationPage", "items": [
+    {"type": "Annotation", "motivation": "identifying", "body": {"type": "TextualBody", "value": "sun"},
+     "target": {"source": "five.png", "selector": {"type": "FragmentSelector", "value": "xywh=50,40,140,140"}}},
+    {"type": "Annotation", "motivation": "identifying", "body": {"type": "TextualBody", "value": "roof"},
+     "target": {"source": "five.png", "selector": {"type": "FragmentSelector", "value": "xywh=510,40,160,160"}}}]})";
+}
+
+// On a picture with named parts, Guide offers them in turn, the largest first ("I will guide your hand to the
+// roof."), a press during the announcement offers the next, the tour ends saying what it traced by its name; then
+// the first touch of the other named shape says its name, once; once every part has been offered, Guide leads to
+// the nearest shape not yet touched, as on any picture.
+TEST(GuidedTourRuntime, GuideOffersEachNamedPartInTurnAndTheFirstTouchOfANamedShapeSaysItsNameOnce) {
+  RuntimeRig r;
+  name_sun_and_roof(r.dir);
+  ASSERT_EQ(test::show_now(*r.rt, 0), 5);
+  r.run(0.6);
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
+  EXPECT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::tour_ask_part, {{"name", "the roof"}}));
+  r.run(0.3);
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();  // while it is announced: the next part
+  EXPECT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::tour_ask_part, {{"name", "the sun"}}));
+  for (int i = 0; i < 60 && r.rt->tour().running(); ++i) r.run(0.5);
+  ASSERT_FALSE(r.rt->tour().running());
+  EXPECT_EQ(r.rt->voice().last_said().rfind("That was the sun.", 0), 0u) << r.rt->voice().last_said();
+  ASSERT_TRUE(r.listen_to_the_end());
+  // The hand over the top of the picture, clear of the square, then down into the triangle: it meets the
+  // roof's edge.
+  const vision::PxToM& px = r.rt->stage().shown().px_to_m;
+  const Vec2 roof{px.x_m(590), px.y_m(150)};
+  r.run(2.0, Vec2{px.x_m(230), px.y_m(22)});
+  r.run(2.0, Vec2{px.x_m(590), px.y_m(22)});
+  r.run(3.0, roof);
+  EXPECT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::touch_name, {{"name", "The roof"}}));
+  ASSERT_TRUE(r.listen_to_the_end());
+  const std::uint64_t said = r.rt->voice().texts_said();
+  r.run(2.0, Vec2{px.x_m(590), px.y_m(22)});  // off it
+  r.run(3.0, roof);                           // and back on
+  EXPECT_EQ(r.rt->voice().texts_said(), said) << "a name is said once a visit: " << r.rt->voice().last_said();
+  // Every part offered: the nearest shape not yet touched.
+  r.rt->tour().key_pressed();
+  r.rt->tour().guide();
+  EXPECT_EQ(r.rt->voice().last_said(), r.text(audio::MessageId::tour_ask));
+}
+
+// With [kiosk] say_names_on_touch "off", touching a named shape says nothing.
+TEST(GuidedTourRuntime, WithSayNamesOnTouchOffATouchSaysNothing) {
+  RuntimeRig r;
+  r.s.kiosk.say_names_on_touch = "off";
+  r.rt.reset();
+  r.rt = std::make_unique<KioskRuntime>(test::headless_runtime_options(r.dir), r.s);
+  name_sun_and_roof(r.dir);
+  ASSERT_EQ(test::show_now(*r.rt, 0), 5);
+  ASSERT_TRUE(r.listen_to_the_end());  // the picture's announcement
+  const std::uint64_t said = r.rt->voice().texts_said();
+  const vision::PxToM& px = r.rt->stage().shown().px_to_m;
+  r.run(2.0, Vec2{px.x_m(590), px.y_m(22)});
+  r.run(3.0, Vec2{px.x_m(590), px.y_m(150)});
+  ASSERT_EQ(r.rt->stage().shown().names.shape_name.size(), 5u);
+  int roof = -1;
+  for (int c = 0; c < 5; ++c)
+    if (r.rt->stage().shown().names.shape_name[static_cast<std::size_t>(c)] == "the roof") roof = c;
+  ASSERT_GE(roof, 0);
+  EXPECT_TRUE(r.rt->tour().touches().touched(roof)) << "the roof was touched";
+  EXPECT_EQ(r.rt->voice().texts_said(), said) << r.rt->voice().last_said();
 }
 
 // The tour asks first: "I will guide your hand to a shape. Hold the handle lightly." is said, and the trace

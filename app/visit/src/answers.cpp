@@ -95,7 +95,11 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
     const cv::Moments mo = cv::moments(nr.mask, true);
     const double u = nr.box_px.x + (mo.m00 > 0 ? mo.m10 / mo.m00 : nr.box_px.width / 2.0);
     const double v = nr.box_px.y + (mo.m00 > 0 ? mo.m01 / mo.m00 : nr.box_px.height / 2.0);
-    out.parts.push_back({name, {px_to_m.x_m(u), px_to_m.y_m(v)}, nr.area_px * m_per_px * m_per_px, -1});
+    out.parts.push_back({name,
+                         {px_to_m.x_m(u), px_to_m.y_m(v)},
+                         nr.area_px * m_per_px * m_per_px,
+                         -1,
+                         nr.source != meaning::RegionSource::staff});
   }
   if (polylines && polylines->size() == curves) longest_curve_of_each_part(regions, shape_region, *polylines, out);
   return out;

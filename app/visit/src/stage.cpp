@@ -244,8 +244,8 @@ TourPicture Stage::tour_picture() const {
     const std::string& name = said[curve];
     return name.rfind("part of ", 0) == 0 ? name.substr(8) : name;
   };
-  for (const PictureNames::Part& part : names.parts)
-    if (part.curve >= 0) p.parts.push_back({part.name, static_cast<std::size_t>(part.curve)});
+  for (const PictureNames::Part& part : names.parts)  // Guide leads to what staff named, not to guesses
+    if (part.curve >= 0 && !part.guess) p.parts.push_back({part.name, static_cast<std::size_t>(part.curve)});
   return p;
 }
 

@@ -44,22 +44,17 @@ void TourDesk::key_pressed() {
 
 void TourDesk::guide() {
   const TourPicture picture = this->picture();
-  if (picture.scene && !picture.parts.empty()) {
-    guide_stops_ = false;  // a press during a tour offers the next part
-    const TourPicture::Part& part = picture.parts[next_part_ % picture.parts.size()];
-    next_part_ = (next_part_ + 1) % picture.parts.size();
-    ask(audio_.messages().text(audio::MessageId::tour_ask_part, {{"name", part.name}}), picture.id,
-        static_cast<int>(part.curve));
-    return;
-  }
-  if (guide_stops_) {
-    guide_stops_ = false;
+  const bool stops = guide_stops_;
+  guide_stops_ = false;
+  if (picture.scene && parts_offered_ < picture.parts.size()) return offer_part(picture);
+  if (stops) {
     voice_.say(audio_.messages().text(audio::MessageId::tour_stopped));
     return;
   }
   if (!picture.scene) return;
   const TourParams tp = tour_params_from(s_);
   if (!plan_tour(*picture.scene, picture.id, step_.display().handle_m, touches_, tp)) {
+    if (!picture.parts.empty()) return offer_part(picture);  // every shape touched: the named parts again
     bool any_shape = false;
     for (std::size_t c = 0; c < picture.scene->curve_count(); ++c)
       any_shape = any_shape || is_tour_shape(*picture.scene, c, tp);
@@ -67,6 +62,12 @@ void TourDesk::guide() {
     return;
   }
   ask(audio_.messages().text(audio::MessageId::tour_ask), picture.id, -1);
+}
+
+void TourDesk::offer_part(const TourPicture& picture) {
+  const TourPicture::Part& part = picture.parts[parts_offered_++ % picture.parts.size()];
+  ask(audio_.messages().text(audio::MessageId::tour_ask_part, {{"name", part.name}}), picture.id,
+      static_cast<int>(part.curve));
 }
 
 void TourDesk::ask(const std::string& question, int scene_id, int part_curve) {
@@ -156,7 +157,7 @@ void TourDesk::say_touched_name(const TourPicture& picture, int curve) {
 void TourDesk::picture_changed(int id, int curves) {
   touches_.reset(id, curves);  // touches are kept per picture
   names_said_.clear();
-  next_part_ = 0;
+  parts_offered_ = 0;
   stop_quietly();  // the servo stops a running tour at the swap anyway; nothing to say of it
 }
 

@@ -72,7 +72,8 @@ struct PictureNames {
     std::string name;  ///< as said ("the left wing")
     Vec2 centre_m;
     double area_m2 = 0;
-    int curve = -1;  ///< the longest curve taking this name (what a tour to it traces), −1 for none or not known
+    int curve = -1;      ///< the longest curve taking this name (what a tour to it traces), −1 for none or not known
+    bool guess = false;  ///< named by the kiosk's own guess (a face, a text block), not by staff
   };
   std::vector<Part> parts;  ///< largest first
 };

@@ -40,8 +40,8 @@ struct TourPicture {
     std::string name;
     std::size_t curve = 0;
   };
-  /// The named parts in the order Guide offers them (the largest first), each name once; empty: Guide leads to
-  /// the nearest shape not yet touched.
+  /// The parts staff named, in the order Guide offers them (the largest first), each name once; empty: Guide
+  /// leads to the nearest shape not yet touched.
   std::vector<Part> parts;
 };
 
@@ -67,13 +67,14 @@ class TourDesk final : public TourEffects {
   void set_cursor(Vec2 m);
   /// Any key: stops a tour under way or announced, quietly (the Guide key that did so then says so).
   void key_pressed() override;
-  /// The Guide key on the picture shown. A picture with named parts (TourPicture::parts): names the next part
-  /// in turn ("I will guide your hand to the left wing. …", tour_ask_part), so each press, one that stops a
-  /// tour too, offers the next, round and round; the tour to it (plan_tour_to) starts once the question has
-  /// been heard. Otherwise, when it has a shape not yet touched (plan_tour), asks first; the tour is planned
-  /// and handed to the servo thread by poll() once the question has been heard (its length in servo ticks,
-  /// kAskMargin_s more). Nothing left: says so (tour_all_touched, or tour_nothing without shapes). A press
-  /// that stopped a tour says tour_stopped instead.
+  /// The Guide key on the picture shown. A picture with parts staff named (TourPicture::parts): until each has
+  /// been offered in this visit of the picture, names the next ("I will guide your hand to the left wing. …",
+  /// tour_ask_part), so each press, one that stops a tour too, offers the next; the tour to it (plan_tour_to)
+  /// starts once the question has been heard. Then, as on any picture: when it has a shape not yet touched
+  /// (plan_tour), asks first; the tour is planned and handed to the servo thread by poll() once the question
+  /// has been heard (its length in servo ticks, kAskMargin_s more). Nothing left: the named parts again, in
+  /// turn, else says so (tour_all_touched, or tour_nothing without shapes). A press that stopped a tour to an
+  /// untouched shape says tour_stopped instead.
   void guide() override;
   /// Window thread, every frame: keeps what the handle touches in this visit's touches, and with [kiosk]
   /// say_names_on_touch "on" says the name of a named shape the handle touches, once in the visit of the
@@ -103,6 +104,7 @@ class TourDesk final : public TourEffects {
   void report_end(const TourPicture& picture, const ServoDisplayState& d);  // what it traced and what remains
   void stop_quietly();                                                      // ends what runs or is announced
   void ask(const std::string& question, int scene_id, int part_curve);      // announces a tour, due once heard
+  void offer_part(const TourPicture& picture);                              // the next named part, in turn
   void say_touched_name(const TourPicture& picture, int curve);             // the first touch of a named shape
 
   std::function<TourPicture()> picture_;  // set_picture
@@ -113,15 +115,15 @@ class TourDesk final : public TourEffects {
   const config::Settings& s_;
   Vec2 half_;
   VisitTouches touches_;
-  int seq_ = 0;                // TourPath::id of the last tour handed over
-  int running_ = 0;            // its id until poll sees it ended, else 0
-  int scene_ = 0;              // the picture it was planned for
-  bool quiet_ = false;         // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
-  bool guide_stops_ = false;   // this key press stopped a running or announced tour
-  bool asked_ = false;         // announced, not yet handed to the servo thread
-  std::int64_t due_tick_ = 0;  // the servo tick from which the announced tour may start
-  int part_curve_ = -1;        // the announced tour's named part (its curve), −1 for the nearest untouched shape
-  std::size_t next_part_ = 0;  // the named part the next Guide press offers (TourPicture::parts)
+  int seq_ = 0;                    // TourPath::id of the last tour handed over
+  int running_ = 0;                // its id until poll sees it ended, else 0
+  int scene_ = 0;                  // the picture it was planned for
+  bool quiet_ = false;             // ended by a key, the mouse, a new picture or visitor: nothing to say at its end
+  bool guide_stops_ = false;       // this key press stopped a running or announced tour
+  bool asked_ = false;             // announced, not yet handed to the servo thread
+  std::int64_t due_tick_ = 0;      // the servo tick from which the announced tour may start
+  int part_curve_ = -1;            // the announced tour's named part (its curve), −1 for the nearest untouched shape
+  std::size_t parts_offered_ = 0;  // named parts offered in this visit of the picture (TourPicture::parts)
   std::vector<std::string> names_said_;  // names said at a touch in this visit of the picture
   Vec2 cursor_in_;                       // the last cursor given to set_cursor [m]
   Vec2 cursor_offset_;                   // added to it: where tours left the hand [m]
