@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -331,6 +332,48 @@ TEST(NamesEditor, WhatIsNotALibraryPictureHasNothingToName) {
   EXPECT_EQ(ed.set_name("x", ""), "There is no library picture on show to name.");
   EXPECT_FALSE(ed.save());
   EXPECT_EQ(ed.last_save(), NamesSaved::failed);
+}
+
+}  // namespace
+}  // namespace hk::app
+
+namespace hk::app {
+namespace {
+
+// The Names tab's switch of the kiosk's guesses: with a face guessed over the round shape, the shape takes the
+// guess's name; switched off, the names folder's sidecar says `guesses = false`, the kiosk reads it so
+// (guesses_for), and the shape has no name; switched on again, it has.
+TEST(NamesEditor, TheGuessesSwitchIsKeptInTheNamesFolderAndTheFaceGuessComesAndGoes) {
+  TempDir dir("hk_names_guesses");
+  NamesPicture p = picture_in(dir.path);
+  // A face guessed around the circle (px 60..140 x 80..160).
+  const Vec2 a = at(p.px_to_m, 55, 165), b = at(p.px_to_m, 145, 75);
+  p.faces_m = {Aabb{{std::min(a.x, b.x), std::min(a.y, b.y)}, {std::max(a.x, b.x), std::max(a.y, b.y)}}};
+  const fs::path folder = dir.path / "names";
+  NamesEditor ed(folder.string());
+  ed.open(p);
+  ASSERT_TRUE(ed.guesses());
+  ASSERT_EQ(ed.shape_region().size(), 3u);
+  ASSERT_GE(ed.shape_region()[0], 0);
+  EXPECT_EQ(ed.regions()[static_cast<std::size_t>(ed.shape_region()[0])].source, meaning::RegionSource::face);
+
+  ASSERT_TRUE(ed.set_guesses(false)) << ed.status();
+  const std::string sidecar = guesses_sidecar_in(folder.string(), p.picture_path);
+  EXPECT_EQ(sidecar, (folder / "birds.toml").string());
+  EXPECT_NE(read_file(sidecar).find("guesses = false"), std::string::npos);
+  EXPECT_FALSE(guesses_for(p.picture_path, folder.string(), true)) << "the kiosk reads the switch";
+  EXPECT_TRUE(ed.regions().empty());
+  EXPECT_EQ(ed.shape_region()[0], -1);
+
+  ASSERT_TRUE(ed.set_guesses(true)) << ed.status();
+  EXPECT_TRUE(guesses_for(p.picture_path, folder.string(), false)) << "the names folder's switch wins";
+  ASSERT_GE(ed.shape_region()[0], 0);
+  // A names folder that is a file: the switch is not written and nothing changes.
+  NamesEditor blocked((dir.path / "birds.png").string());
+  blocked.open(p);
+  EXPECT_FALSE(blocked.set_guesses(false));
+  EXPECT_NE(blocked.status().find("Could not save the switch"), std::string::npos) << blocked.status();
+  EXPECT_TRUE(blocked.guesses());
 }
 
 }  // namespace

@@ -68,7 +68,9 @@ TEST(PictureNotes, BadSidecarsAreRefusedWithOneLineNamingTheFileAndTheLimit) {
   } cases[] = {
       {"title = \"a horse\n", "picture notes 'pic.toml': TOML syntax error at line 1"},
       {"title = 3\n", "picture notes 'pic.toml': title must be a string"},
-      {"titel = \"a horse\"\n", "picture notes 'pic.toml': unknown key 'titel' (title and description are known)"},
+      {"titel = \"a horse\"\n",
+       "picture notes 'pic.toml': unknown key 'titel' (title, description and guesses are known)"},
+      {"guesses = \"no\"\n", "picture notes 'pic.toml': guesses must be true or false"},
       {long_title, "picture notes 'pic.toml': title is 201 bytes, at most 200"},
       {"title = \"   \"\n", "picture notes 'pic.toml': title is blank"},
       {"title = \"two\\nlines\"\n", "picture notes 'pic.toml': title holds a control character (one line, please)"},

@@ -554,7 +554,7 @@ ExploreSummary run_explore(const ExploreOptions& o) {
       o.source.empty() ? build_input_scene(o.image_path, o.page, s) : build_capture_scene(o.source, o.page, s, out);
   if (o.source.empty() && is.page == 0)  // a picture file's names, as the library takes them
     apply_names(is, names_file_for(o.image_path, names_dir(s)), std::filesystem::path(o.image_path).filename().string(),
-                guesses_wanted(o.image_path));
+                guesses_for(o.image_path, names_dir(s), guesses_wanted(o.image_path)));
   else
     add_guessed_regions(is);
   const Scene& scene = *is.scene;

@@ -46,7 +46,7 @@ std::string explore_answer(const ExploreOptions& o) {
   const PictureNotes notes = is.page > 0 ? PictureNotes{} : read_picture_notes(o.image_path);
   if (is.page == 0)
     apply_names(is, names_file_for(o.image_path, names_dir(s)), std::filesystem::path(o.image_path).filename().string(),
-                notes.guesses);
+                guesses_for(o.image_path, names_dir(s), notes.guesses));
   else
     add_guessed_regions(is);
   const PictureNames names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m, &is.polylines);

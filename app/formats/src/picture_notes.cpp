@@ -139,6 +139,11 @@ PictureNotes read_picture_notes(const std::string& image_path, const PictureNote
   const std::string file = notes_path(image_path);
   std::error_code ec;
   if (!fs::exists(file, ec)) return file_notes != nullptr ? *file_notes : embedded_notes(image_path);
+  return read_sidecar(file);
+}
+
+PictureNotes read_sidecar(const std::string& file) {
+  std::error_code ec;
   if (!fs::is_regular_file(file, ec)) fail(file, "is not a regular file");
   const auto size = fs::file_size(file, ec);
   if (ec) fail(file, "cannot be read: " + ec.message());

@@ -396,8 +396,9 @@ void OperatorPanel::draw_names(KioskRuntime& runtime) {
     names_scene_ = stage.scenes_published();
     const Shown& sh = stage.shown();
     const bool library = stage.source().picture >= 0 && stage.source().document < 0;
-    names_->open({library ? sh.image_path : std::string(), sh.picture, sh.file_width_px, sh.file_height_px, sh.px_to_m,
-                  sh.polylines, sh.descriptors});
+    const std::string path = library ? sh.image_path : std::string();
+    names_->open({path, sh.picture, sh.file_width_px, sh.file_height_px, sh.px_to_m, sh.polylines, sh.descriptors,
+                  sh.faces_m, sh.text_blocks, path.empty() || guesses_for(path, folder, sh.notes.guesses)});
   }
   if (!names_->is_open()) {
     ImGui::TextWrapped("Names are given to the library's pictures; what is on show is not one of them.");
@@ -427,6 +428,10 @@ void OperatorPanel::draw_names(KioskRuntime& runtime) {
   ImGui::InputText("##names.description", &names_->description_text());
   record("names.description");
   bool saved = false;
+  bool guesses = names_->guesses();
+  if (ImGui::Checkbox("The kiosk's own guesses (faces, text) name parts of this picture", &guesses))
+    saved = names_->set_guesses(guesses);
+  record("names.guesses");
   if (ImGui::Button("Save names")) saved = names_->save_typed();
   record("Save names");
   ImGui::SameLine();

@@ -40,21 +40,33 @@ double iou(const cv::Rect& a, const cv::Rect& b) {
   return inter <= 0 ? 0.0 : inter / (a.area() + b.area() - inter);
 }
 
-/// Boxes `cascade` finds in `grey` and, mirrored back, in its mirror `mirrored`, kept when both agree.
-std::vector<cv::Rect> found_both_ways(cv::CascadeClassifier& cascade, const cv::Mat& grey, const cv::Mat& mirrored) {
-  std::vector<cv::Rect> direct, flipped;
-  const cv::Size min_size(kMinFacePx, kMinFacePx);
-  cascade.detectMultiScale(grey, direct, 1.05, 3, 0, min_size);
-  cascade.detectMultiScale(mirrored, flipped, 1.05, 3, 0, min_size);
-  std::vector<cv::Rect> agreed;
-  for (cv::Rect f : flipped) {
-    f.x = grey.cols - f.x - f.width;  // back to the picture's side
-    for (const cv::Rect& d : direct)
-      if (iou(d, f) >= kMirrorAgreement) {
-        agreed.push_back(d | f);
-        break;
-      }
+/// Whether `cascade` finds, in the mirror image of `grey`'s neighbourhood of `box` (the box grown by half its width on
+/// every side), a face of about its size (0.7 to 1.4 times) agreeing with it (kMirrorAgreement once mirrored back).
+bool found_in_mirror(cv::CascadeClassifier& cascade, const cv::Mat& grey, const cv::Rect& box) {
+  const int grow = box.width / 2;
+  const cv::Rect around = cv::Rect(box.x - grow, box.y - grow, box.width + 2 * grow, box.height + 2 * grow) &
+                          cv::Rect(0, 0, grey.cols, grey.rows);
+  cv::Mat mirrored;
+  cv::flip(grey(around), mirrored, 1);
+  std::vector<cv::Rect> found;
+  const int lo = std::max(kMinFacePx * 3 / 4, box.width * 7 / 10), hi = box.width * 14 / 10;
+  // Two neighbours, not three: the neighbourhood's smaller pyramid samples fewer windows over the face.
+  cascade.detectMultiScale(mirrored, found, 1.05, 2, 0, cv::Size(lo, lo), cv::Size(hi, hi));
+  for (cv::Rect f : found) {
+    f.x = around.x + around.width - f.x - f.width;  // back to the picture's side
+    f.y += around.y;
+    if (iou(f, box) >= kMirrorAgreement) return true;
   }
+  return false;
+}
+
+/// Boxes `cascade` finds in `grey` that it finds again in the mirror image.
+std::vector<cv::Rect> found_both_ways(cv::CascadeClassifier& cascade, const cv::Mat& grey) {
+  std::vector<cv::Rect> direct;
+  cascade.detectMultiScale(grey, direct, 1.05, 3, 0, cv::Size(kMinFacePx, kMinFacePx));
+  std::vector<cv::Rect> agreed;
+  for (const cv::Rect& d : direct)
+    if (found_in_mirror(cascade, grey, d)) agreed.push_back(d);
   return agreed;
 }
 
@@ -73,10 +85,8 @@ std::vector<cv::Rect> find_faces(const cv::Mat& picture, const std::string& casc
   cv::Mat small;
   cv::resize(grey, small, {}, scale, scale, scale < 1.0 ? cv::INTER_AREA : cv::INTER_LINEAR);
   cv::equalizeHist(small, small);
-  cv::Mat mirrored;
-  cv::flip(small, mirrored, 1);
-  std::vector<cv::Rect> faces = found_both_ways(c.frontal, small, mirrored);
-  for (const cv::Rect& p : found_both_ways(c.profile, small, mirrored))
+  std::vector<cv::Rect> faces = found_both_ways(c.frontal, small);
+  for (const cv::Rect& p : found_both_ways(c.profile, small))
     if (std::none_of(faces.begin(), faces.end(), [&](const cv::Rect& f) { return iou(f, p) >= kMirrorAgreement; }))
       faces.push_back(p);
   std::sort(faces.begin(), faces.end(), [](const cv::Rect& a, const cv::Rect& b) { return a.area() > b.area(); });

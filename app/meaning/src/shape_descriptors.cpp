@@ -46,21 +46,62 @@ std::vector<Vec2> form_level_points(const Scene& scene, std::size_t c, double di
   return std::vector<Vec2>(p, p + ci.point_count[level]);
 }
 
-/// The colour inside the closed outline (2 px in from it) or along the line, in the picture's pixels.
-bool colour_of(const Polyline& line, bool inside, const PictureColours& pc, ColourName* out) {
-  if (pc.picture.empty() || line.points_m.empty()) return false;
+/// A polyline's points on the picture's pixels [px].
+std::vector<cv::Point> pixels_of(const Polyline& line, const PictureColours& pc) {
   std::vector<cv::Point> px;
+  px.reserve(line.points_m.size());
   for (const Vec2& p : line.points_m)
     px.emplace_back(static_cast<int>(std::lround(pc.px_to_m.u_px(p.x))),
                     static_cast<int>(std::lround(pc.px_to_m.v_px(p.y))));
+  return px;
+}
+
+/// For each closed polyline, the closed polylines directly or deeper inside it (bounding box within its own and
+/// first point inside its polygon); empty for an open one. What its colour leaves out: a thick stroke drawn as a
+/// square is the ring between its two outlines, a wing is black around its white spots.
+std::vector<std::vector<std::size_t>> shapes_inside(const std::vector<Polyline>& polylines) {
+  std::vector<Box> boxes(polylines.size());
+  for (std::size_t i = 0; i < polylines.size(); ++i)
+    for (const Vec2& p : polylines[i].points_m) boxes[i].add(p);
+  std::vector<std::vector<std::size_t>> inside(polylines.size());
+  for (std::size_t i = 0; i < polylines.size(); ++i) {
+    if (!polylines[i].closed || polylines[i].points_m.size() < 3) continue;
+    std::vector<cv::Point2f> poly;
+    for (const Vec2& p : polylines[i].points_m) poly.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+    for (std::size_t j = 0; j < polylines.size(); ++j) {
+      const Box& a = boxes[i];
+      const Box& b = boxes[j];
+      if (j == i || !polylines[j].closed || polylines[j].points_m.empty()) continue;
+      if (b.lo.x < a.lo.x || b.lo.y < a.lo.y || b.hi.x > a.hi.x || b.hi.y > a.hi.y) continue;
+      const Vec2 q = polylines[j].points_m.front();
+      if (cv::pointPolygonTest(poly, cv::Point2f(static_cast<float>(q.x), static_cast<float>(q.y)), false) > 0)
+        inside[i].push_back(j);
+    }
+  }
+  return inside;
+}
+
+/// The colour inside the closed outline (2 px in from it, and from the closed shapes `holes` inside it) or
+/// along the line, in the picture's pixels.
+bool colour_of(const Polyline& line, bool inside, const std::vector<const Polyline*>& holes, const PictureColours& pc,
+               ColourName* out) {
+  if (pc.picture.empty() || line.points_m.empty()) return false;
+  std::vector<cv::Point> px = pixels_of(line, pc);
   const cv::Rect box = cv::boundingRect(px) & cv::Rect(0, 0, pc.picture.cols, pc.picture.rows);
   if (box.area() == 0) return false;
   for (cv::Point& q : px) q -= box.tl();
   cv::Mat mask = cv::Mat::zeros(box.size(), CV_8U);
   if (inside) {
     cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{px}, 255);
+    cv::Mat own = mask.clone();
+    for (const Polyline* h : holes) {
+      std::vector<cv::Point> hp = pixels_of(*h, pc);
+      for (cv::Point& q : hp) q -= box.tl();
+      cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{hp}, 0);
+    }
     cv::Mat eroded;
     cv::erode(mask, eroded, cv::Mat(), cv::Point(-1, -1), 2);
+    if (cv::countNonZero(eroded) < 16) cv::erode(own, eroded, cv::Mat(), cv::Point(-1, -1), 2);  // holes fill it
     if (cv::countNonZero(eroded) >= 16) mask = eroded;  // else the outline's own pixels: a speck of a shape
   } else {
     cv::polylines(mask, std::vector<std::vector<cv::Point>>{px}, line.closed, 255);
@@ -72,7 +113,7 @@ bool colour_of(const Polyline& line, bool inside, const PictureColours& pc, Colo
 }
 
 ShapeDescriptor describe_one(const Polyline& line, const std::vector<Vec2>& form_points, double length_m,
-                             const PictureColours& pc) {
+                             const std::vector<const Polyline*>& holes, const PictureColours& pc) {
   ShapeDescriptor d;
   Box box;
   for (const Vec2& p : line.points_m) box.add(p);
@@ -82,14 +123,24 @@ ShapeDescriptor describe_one(const Polyline& line, const std::vector<Vec2>& form
   d.speck = length_m < TourParams{}.min_shape_length_m;
   // Inside a closed shape; along a line only when it is ink (a line drawing): a photograph's open edge lies
   // between two colours, and its own pixels are a blend of both.
-  if (line.closed || pc.line_drawing) d.has_colour = colour_of(line, line.closed && !pc.line_drawing, pc, &d.colour);
+  if (line.closed || pc.line_drawing)
+    d.has_colour = colour_of(line, line.closed && !pc.line_drawing, holes, pc, &d.colour);
   return d;
+}
+
+/// The closed polylines inside polylines[i] (shapes_inside), as pointers.
+std::vector<const Polyline*> holes_of(const std::vector<Polyline>& polylines,
+                                      const std::vector<std::vector<std::size_t>>& inside, std::size_t i) {
+  std::vector<const Polyline*> out;
+  for (const std::size_t j : inside[i]) out.push_back(&polylines[j]);
+  return out;
 }
 
 }  // namespace
 
 std::vector<ShapeDescriptor> describe_shapes(const std::vector<Polyline>& polylines, const Scene& scene,
                                              const PictureColours& colours) {
+  const std::vector<std::vector<std::size_t>> inside = shapes_inside(polylines);
   std::vector<int> curve_of(polylines.size(), -1);
   for (std::size_t c = 0; c < scene.curve_count(); ++c)
     if (scene.source_index(c) < polylines.size()) curve_of[scene.source_index(c)] = static_cast<int>(c);
@@ -98,7 +149,8 @@ std::vector<ShapeDescriptor> describe_shapes(const std::vector<Polyline>& polyli
   for (std::size_t i = 0; i < polylines.size(); ++i) {
     const Polyline& line = polylines[i];
     if (curve_of[i] < 0) {
-      out.push_back(describe_one(line, line.points_m, length_of(line.points_m, line.closed), colours));
+      out.push_back(describe_one(line, line.points_m, length_of(line.points_m, line.closed),
+                                 holes_of(polylines, inside, i), colours));
       continue;
     }
     const auto c = static_cast<std::size_t>(curve_of[i]);
@@ -107,16 +159,20 @@ std::vector<ShapeDescriptor> describe_shapes(const std::vector<Polyline>& polyli
     const CurveInfo& ci = scene.curve(c);
     const Vec2* p0 = scene.points(c, 0);
     const double len0 = length_of(std::vector<Vec2>(p0, p0 + ci.point_count[0]), ci.closed);
-    out.push_back(describe_one(line, form_level_points(scene, c, length(box.hi - box.lo)), len0, colours));
+    out.push_back(describe_one(line, form_level_points(scene, c, length(box.hi - box.lo)), len0,
+                               holes_of(polylines, inside, i), colours));
   }
   return out;
 }
 
 std::vector<ShapeDescriptor> describe_shapes(const std::vector<Polyline>& polylines, const PictureColours& colours) {
+  const std::vector<std::vector<std::size_t>> inside = shapes_inside(polylines);
   std::vector<ShapeDescriptor> out;
   out.reserve(polylines.size());
-  for (const Polyline& line : polylines)
-    out.push_back(describe_one(line, line.points_m, length_of(line.points_m, line.closed), colours));
+  for (std::size_t i = 0; i < polylines.size(); ++i)
+    out.push_back(describe_one(polylines[i], polylines[i].points_m,
+                               length_of(polylines[i].points_m, polylines[i].closed), holes_of(polylines, inside, i),
+                               colours));
   return out;
 }
 

@@ -39,7 +39,9 @@ void describe_scene_shapes(ImageScene& is) {
   const auto described = std::chrono::steady_clock::now();
   is.times.descriptors_ms = std::chrono::duration<double, std::milli>(described - start).count();
   is.faces_m.clear();
-  if (is.pages > 0 || is.picture.empty()) return;  // a document page: text and figures, not faces
+  // A document page holds text and figures, a two-tone picture (a silhouette, a line drawing) outlines: no faces
+  // to see, and the cascades' search is the dearest part of a build.
+  if (is.pages > 0 || is.picture.empty() || is.tones.two_tone || is.line_drawing) return;
   for (const cv::Rect& f : meaning::find_faces(is.picture)) {
     const Vec2 a{is.px_to_m.x_m(f.x), is.px_to_m.y_m(f.y)};
     const Vec2 b{is.px_to_m.x_m(f.x + f.width), is.px_to_m.y_m(f.y + f.height)};

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "formats/annotations.hpp"
+#include "formats/picture_notes.hpp"
 #include "hk/text.hpp"
 #include "meaning/names.hpp"
 #include "pictures/kiosk_folders.hpp"
@@ -26,6 +27,25 @@ std::string names_file_for(const std::string& picture_path, const std::string& n
   }
   const std::string beside = annotations_path(picture_path);
   return std::filesystem::is_regular_file(beside, ec) ? beside : std::string();
+}
+
+std::string guesses_sidecar_in(const std::string& names_folder, const std::string& picture_path) {
+  if (names_folder.empty()) return {};
+  return (std::filesystem::path(names_folder) / std::filesystem::path(picture_path).filename())
+      .replace_extension(".toml")
+      .string();
+}
+
+bool guesses_for(const std::string& picture_path, const std::string& names_folder, bool sidecar_guesses) {
+  const std::string file = guesses_sidecar_in(names_folder, picture_path);
+  std::error_code ec;
+  if (file.empty() || !std::filesystem::exists(file, ec)) return sidecar_guesses;
+  try {
+    return read_sidecar(file).guesses;
+  } catch (const PictureNotesError& e) {
+    spdlog::warn("names: {}; the sidecar beside the picture decides", e.what());
+    return sidecar_guesses;
+  }
 }
 
 namespace {

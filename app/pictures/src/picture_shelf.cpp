@@ -116,7 +116,7 @@ SceneJob PictureShelf::picture_job(int index) const {
     is.notes = notes_of(path, is.file_notes);
     const std::string names = names_file_for(path, names_dir(s)),
                       file = std::filesystem::path(path).filename().string();
-    const bool guesses = is.notes.guesses;
+    const bool guesses = guesses_for(path, names_dir(s), is.notes.guesses);
     apply_names(is, names, file, guesses);
     if (is.with_text)  // the scene read again with its text keeps the names
       is.with_text = [read = std::move(is.with_text), names, file, guesses](const std::atomic<bool>* cancel) {

@@ -70,6 +70,8 @@ void NamesEditor::open(NamesPicture picture) {
   }
   scene_.picture = picture_.picture;
   scene_.polylines = picture_.polylines;
+  scene_.faces_m = picture_.faces_m;
+  scene_.text_blocks = picture_.text_blocks;
   scene_.px_to_m = picture_.px_to_m;
   scene_.width_px = picture_.picture.cols;
   scene_.height_px = picture_.picture.rows;
@@ -87,7 +89,7 @@ void NamesEditor::open(NamesPicture picture) {
       status_ = std::string(e.what()) + "; saving starts a new file.";
     }
   }
-  apply_names(scene_, file, file_name);
+  apply_names(scene_, file, file_name, picture_.guesses);
   refresh();
 }
 
@@ -271,6 +273,38 @@ std::string NamesEditor::target_file() const {
   return annotations_path_in(folder_, picture_.picture_path);
 }
 
+bool NamesEditor::set_guesses(bool on) {
+  if (!is_open()) {
+    status_ = "There is no library picture on show.";
+    return false;
+  }
+  const std::string sidecar = guesses_sidecar_in(folder_, picture_.picture_path);
+  if (sidecar.empty()) {
+    status_ = "Could not save the switch: there is no names folder ([kiosk] names_dir is off).";
+    return false;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(folder_, ec);
+  try {
+    if (ec) throw config::FileWriteError(folder_, ec.value(), ec.message());
+    config::write_file_atomic(
+        std::string("# Written by the operator panel's Names tab: whether the kiosk's own guesses "
+                    "(faces, text) name parts of this picture.\nguesses = ") +
+            (on ? "true" : "false") + "\n",
+        sidecar, 0644);
+  } catch (const config::FileWriteError& e) {
+    status_ = "Could not save the switch to " + hk::one_line(sidecar) + ": " +
+              hk::one_line(e.error_number() != 0 ? std::strerror(e.error_number()) : e.what());
+    return false;
+  }
+  picture_.guesses = on;
+  const std::string file = names_file_for(picture_.picture_path, folder_);
+  apply_names(scene_, file, std::filesystem::path(picture_.picture_path).filename().string(), on);
+  status_ = on ? "The kiosk's guesses name parts of this picture." : "The kiosk's guesses are off for this picture.";
+  spdlog::info("names: guesses {} for {}", on ? "on" : "off", picture_.picture_path);
+  return true;
+}
+
 bool NamesEditor::save() {
   last_save_ = NamesSaved::failed;
   if (!is_open()) {
@@ -297,7 +331,7 @@ bool NamesEditor::save() {
     spdlog::warn("names: not saved: {}", e.what());
     return false;
   }
-  apply_names(scene_, file, file_name);  // what the kiosk reads from now on
+  apply_names(scene_, file, file_name, picture_.guesses);  // what the kiosk reads from now on
   try {
     set_ = read_annotations(file, file_name);  // as the kiosk reads it (the same annotations, in the same order)
   } catch (const AnnotationError& e) {

@@ -74,6 +74,7 @@ void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes,
   sh.file_height_px = is.file_height_px > 0 ? is.file_height_px : is.picture.rows;
   sh.px_to_m = is.px_to_m;
   sh.text_blocks = is.text_blocks;
+  sh.faces_m = is.faces_m;
   sh.notes = std::move(notes);
   publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
   source_ = source;
@@ -162,7 +163,7 @@ void Stage::text_arrived(TextRead& read) {
 
 void Stage::set_names(std::vector<meaning::NamedRegion> regions, std::vector<int> shape_region) {
   if (shape_region.size() != shown_.polylines.size()) return;
-  shown_.names = picture_names(regions, shape_region, shown_.polylines.size(), shown_.px_to_m);
+  shown_.names = picture_names(regions, shape_region, shown_.polylines.size(), shown_.px_to_m, &shown_.polylines);
   shown_.regions = std::move(regions);
   shown_.shape_region = std::move(shape_region);
 }

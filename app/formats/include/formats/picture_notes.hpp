@@ -66,4 +66,8 @@ std::string notes_path(const std::string& image_path);
 /// @throws PictureNotesError (one line) for a sidecar that breaks any of these, or cannot be read.
 PictureNotes read_picture_notes(const std::string& image_path, const PictureNotes* file_notes = nullptr);
 
+/// Reads the sidecar file `sidecar_path` itself (read_picture_notes' rules; a missing file is refused too).
+/// @throws PictureNotesError (one line) for a file that breaks them or cannot be read.
+PictureNotes read_sidecar(const std::string& sidecar_path);
+
 }  // namespace hk::app

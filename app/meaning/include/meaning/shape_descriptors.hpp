@@ -40,9 +40,11 @@ struct PictureColours {
 /// One descriptor per polyline: `polylines[i]` [m] built into `scene` as the curve whose source_index is i
 /// (a polyline the scene skipped: its form from its own points). The form is read at the coarsest level of
 /// the curve with at least 32 points whose largest deviation (CurveInfo::max_error_m) is at most 3 % of the curve's
-/// bounding-box diagonal, the colour as the median in CIELAB inside a closed shape (its outline filled, 2 px in from
-/// it) or along a line drawing's line; an open edge of a photograph has none (its pixels blend two colours). Cost:
-/// O(points) a shape plus O(pixels) of each closed shape's box.
+/// bounding-box diagonal, the colour as the median in CIELAB inside a closed shape (its outline filled, less the
+/// closed shapes inside it, 2 px in from both: a thick stroke drawn as a square is the colour of its stroke, a wing
+/// the colour around its spots) or along a line drawing's line; an open edge of a photograph has none (its pixels
+/// blend two colours). Cost: O(points) a shape, O(shapes²) to find the shapes inside, plus O(pixels) of each closed
+/// shape's box.
 std::vector<ShapeDescriptor> describe_shapes(const std::vector<Polyline>& polylines, const Scene& scene,
                                              const PictureColours& colours);
 

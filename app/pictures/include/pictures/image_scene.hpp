@@ -168,7 +168,7 @@ struct ImageScene {
   /// descriptors[i]: what polylines[i] looks like (meaning/shape_descriptors.hpp), one per polyline.
   std::vector<meaning::ShapeDescriptor> descriptors;
   /// Faces guessed in the picture (meaning/faces.hpp), boxes in workspace metres (lo = lower left); kept in the
-  /// scene cache. Not looked for on document pages.
+  /// scene cache. Not looked for on document pages and two-tone pictures (silhouettes, line drawings).
   std::vector<Aabb> faces_m;
   /// Regions named on `picture`: staff's, then the guesses (faces, text blocks) that staff's do not cover
   /// (picture_names.hpp apply_names; not kept in the scene cache).
@@ -184,9 +184,9 @@ inline constexpr int kScreenPictureMaxSidePx = 1920;
 
 /// Sets `is.descriptors` (one per polyline: form, colour, size, speck) from its polylines, its scene (the form's
 /// coarse level; without a scene, each polyline's own points) and its picture (the colours; none when empty),
-/// timed in is.times.descriptors_ms; and `is.faces_m` (meaning/find_faces on the picture; none for a document
-/// page or an empty picture), timed in is.times.faces_ms. Call after the scene is built and before fit_picture
-/// shrinks the picture. Never throws but std::bad_alloc.
+/// timed in is.times.descriptors_ms; and `is.faces_m` (meaning/find_faces on the picture; not looked for on a
+/// document page, a two-tone picture or an empty one), timed in is.times.faces_ms. Call after the scene is built and
+/// before fit_picture shrinks the picture. Never throws but std::bad_alloc.
 void describe_scene_shapes(ImageScene& is);
 
 /// Shrinks `is.picture` (INTER_AREA) so that its long side is at most `max_side_px`, and moves `is.px_to_m`

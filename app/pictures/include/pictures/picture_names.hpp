@@ -20,6 +20,16 @@ std::string names_dir(const config::Settings& s);
 /// the kiosk win), else the one beside the picture when it exists, else "".
 std::string names_file_for(const std::string& picture_path, const std::string& names_folder);
 
+/// The sidecar in the names folder `names_folder` for `picture_path` (NAME.toml there): where the operator panel's
+/// Names tab keeps its switch of the kiosk's guesses (`guesses = false`), since the picture's own folder is
+/// read-only under the service. "" when there is no names folder.
+std::string guesses_sidecar_in(const std::string& names_folder, const std::string& picture_path);
+
+/// Whether the kiosk's own guesses name parts of `picture_path`: the names folder's sidecar (guesses_sidecar_in)
+/// when it exists, else `sidecar_guesses` (the sidecar beside the picture, PictureNotes::guesses). A names-folder
+/// sidecar that cannot be used is one log line and passed over.
+bool guesses_for(const std::string& picture_path, const std::string& names_folder, bool sidecar_guesses);
+
 /// Puts the names of `names_file` (annotations_path's form; "" = none) on `is`: ImageScene::regions and
 /// shape_region; then, with `guesses` (a sidecar's `guesses = false` turns them off), the kiosk's own
 /// (add_guessed_regions). A file refused whole, and each annotation left out, is one warning in the log naming

@@ -40,6 +40,9 @@ struct NamesPicture {
   vision::PxToM px_to_m{1, 0, 0};                     ///< picture pixels → workspace metres
   std::vector<Polyline> polylines;                    ///< the curves shown [m]
   std::vector<meaning::ShapeDescriptor> descriptors;  ///< one per polyline, or empty (no specks known)
+  std::vector<Aabb> faces_m;                          ///< faces guessed [m] (ImageScene::faces_m)
+  std::vector<TextBlockM> text_blocks;                ///< its text blocks [m]
+  bool guesses = true;  ///< the kiosk's guesses name its parts (picture_names.hpp guesses_for)
 };
 
 /// One annotation of the file: a name and the curves it gives it to.
@@ -130,6 +133,13 @@ class NamesEditor {
   std::string target_file() const;
   /// One line: what the last action did, or why it did not.
   const std::string& status() const { return status_; }
+
+  /// Whether the kiosk's own guesses (faces, text blocks) name parts of the picture open.
+  bool guesses() const { return picture_.guesses; }
+  /// Turns the kiosk's guesses on this picture on or off: the names folder's sidecar for it (guesses_sidecar_in:
+  /// `guesses = true|false`) written with config::write_file_atomic, then the names read again (regions()).
+  /// True when written; else false, nothing changed, and status() says why in one line.
+  bool set_guesses(bool on);
 
   /// The names as the kiosk reads them now (after open, or save's read-back): regions on the picture's pixels and
   /// one region index per curve (−1 none), for Stage::set_names.
