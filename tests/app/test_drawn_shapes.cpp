@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "audio/messages.hpp"
@@ -29,6 +30,7 @@
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_names.hpp"
 #include "test_paths.hpp"
+#include "vision/ocr.hpp"
 #include "visit/answers.hpp"
 
 namespace hk::app {
@@ -210,6 +212,33 @@ TEST(GuessedNames, TheCameramansFaceIsSaidAsAGuessUnlessGuessesAreOff) {
   EXPECT_TRUE(is.regions.empty());
   EXPECT_EQ(std::count(is.shape_region.begin(), is.shape_region.end(), -1),
             static_cast<std::ptrdiff_t>(is.polylines.size()));
+}
+
+// A block of text read from a picture names the shapes in it by its first sure words; on a document page, whose
+// text is read as text, it names nothing.
+TEST(GuessedNames, ATextBlockOfAPictureNamesTheShapesInItByItsFirstSureWords) {
+  ImageScene is;
+  is.picture = cv::Mat(100, 200, CV_8UC3, cv::Scalar(255, 255, 255));
+  is.px_to_m = vision::fit_to_workspace(200, 100, 0.14, 0.09);
+  Polyline letter{{}, true};
+  for (const auto& [u, v] : {std::pair{40.0, 40.0}, {60.0, 40.0}, {60.0, 60.0}, {40.0, 60.0}})
+    letter.points_m.push_back({is.px_to_m.x_m(u), is.px_to_m.y_m(v)});
+  is.polylines = {letter};
+  TextBlockM block;
+  block.lo_m = {is.px_to_m.x_m(20), is.px_to_m.y_m(80)};
+  block.hi_m = {is.px_to_m.x_m(180), is.px_to_m.y_m(20)};
+  block.text = std::string("Emergency ") + std::string(vision::kUnclearWord) + "xit this way out now";
+  is.text_blocks = {block};
+  add_guessed_regions(is);
+  ASSERT_EQ(is.regions.size(), 1u);
+  EXPECT_EQ(is.regions[0].name, "text: Emergency this way out");
+  EXPECT_EQ(is.regions[0].source, meaning::RegionSource::text);
+  EXPECT_EQ(is.shape_region, std::vector<int>{0});
+  is.regions.clear();
+  is.pages = 1;
+  add_guessed_regions(is);
+  EXPECT_TRUE(is.regions.empty());
+  EXPECT_EQ(is.shape_region, std::vector<int>{-1});
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "hk/text.hpp"
 #include "meaning/names.hpp"
 #include "pictures/kiosk_folders.hpp"
+#include "vision/ocr.hpp"
 
 namespace hk::app {
 
@@ -79,6 +80,23 @@ cv::Rect box_px_of(const ImageScene& is, Vec2 lo_m, Vec2 hi_m) {
   return {a, b};
 }
 
+/// `text` without the words OCR was not sure of (those holding vision::kUnclearWord).
+std::string sure_words(const std::string& text) {
+  std::string out, word;
+  const auto flush = [&] {
+    if (!word.empty() && word.find(vision::kUnclearWord) == std::string::npos) out += (out.empty() ? "" : " ") + word;
+    word.clear();
+  };
+  for (const char c : text) {
+    if (c == ' ' || c == '\n' || c == '\t' || c == '\r')
+      flush();
+    else
+      word += c;
+  }
+  flush();
+  return out;
+}
+
 /// Adds `guess` to the scene's regions unless staff named that part already.
 void add_guess(ImageScene& is, std::optional<meaning::NamedRegion> guess) {
   if (guess && !meaning::covered_by_staff(*guess, is.regions)) is.regions.push_back(std::move(*guess));
@@ -92,8 +110,12 @@ void add_guessed_regions(ImageScene& is) {
   for (const Aabb& f : is.faces_m)
     add_guess(
         is, meaning::guessed_region(meaning::RegionSource::face, meaning::kFaceName, box_px_of(is, f.lo, f.hi), w, h));
+  if (is.pages > 0) {  // a document page: its text is read as text (Where, Describe), not named as parts
+    is.shape_region = meaning::name_shapes(is.regions, is.polylines, is.px_to_m);
+    return;
+  }
   for (const TextBlockM& b : is.text_blocks) {
-    const std::string words = hk::first_words(b.text, meaning::kTextNameWords);
+    const std::string words = hk::first_words(sure_words(b.text), meaning::kTextNameWords);
     if (!words.empty())
       add_guess(is, meaning::guessed_region(meaning::RegionSource::text, "text: " + words,
                                             box_px_of(is, b.lo_m, b.hi_m), w, h));

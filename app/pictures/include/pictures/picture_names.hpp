@@ -39,8 +39,9 @@ void apply_names(ImageScene& is, const std::string& names_file, const std::strin
                  bool guesses = true);
 
 /// Adds the kiosk's own guesses to `is.regions` and names the shapes again (shape_region): each face of
-/// is.faces_m (meaning::kFaceName) and each text block (its first meaning::kTextNameWords words after "text: ")
-/// as a region of the picture, unless half of it lies in a region staff named. Cheap (a few small masks): the
+/// is.faces_m (meaning::kFaceName) and each text block of a picture (its first meaning::kTextNameWords words OCR
+/// was sure of, after "text: "; not on a document page, whose text is read as text) as a region of the picture,
+/// unless half of it lies in a region staff named. Cheap (a few small masks): the
 /// window thread may call it for a capture or a stick's page, which have no names file. Never throws but
 /// std::bad_alloc.
 void add_guessed_regions(ImageScene& is);
