@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "child_process.hpp"
+#include "kiosk_exe.hpp"
 #include "pictures/documents.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_params.hpp"
@@ -41,14 +42,11 @@ using namespace hk::app;
 
 namespace {
 
+using hk::test::sh;
+
 const fs::path kData = HK_TEST_DATA_DIR;
 const fs::path kHorsePdf = kData / "documents" / "horse_and_page.pdf";
 const fs::path kSpecPdf = kData / "documents" / "shared-mime-info-spec.pdf";
-
-int sh(const std::string& cmd) {
-  const int raw = std::system(cmd.c_str());
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-}
 
 std::string slurp(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);

@@ -11,11 +11,14 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "kiosk_exe.hpp"
 #include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
+
+using hk::test::sh;
 
 const fs::path kData = HK_TEST_DATA_DIR;
 
@@ -23,11 +26,6 @@ const fs::path kData = HK_TEST_DATA_DIR;
 // then reports an "<unknown module>"). Leak checking stays on for everything else in the suite; only the
 // GL process runs without it.
 const std::string kNoGlLeakCheck = "ASAN_OPTIONS=detect_leaks=0 ";
-
-int sh(const std::string& cmd) {
-  const int raw = std::system(cmd.c_str());
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-}
 
 bool yellow_near(const cv::Mat& img, int x, int y, int r) {
   for (int dy = -r; dy <= r; ++dy) {

@@ -19,19 +19,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using hk::test::read_text;
+using hk::test::sh;
+
 const fs::path kData = HK_TEST_DATA_DIR;
-
-int sh(const std::string& cmd) {
-  const int raw = std::system(cmd.c_str());
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// The bytes of `text` but its white space.
 std::string letters_of(const std::string& text) {
@@ -67,7 +58,7 @@ TEST(KioskWithSound, DescribeReadsAnEightKilobyteParagraphWholeAndTheKioskRunsOn
   const fs::path dir = hk::test::fresh_dir("kiosk_sound");
   fs::create_directories(dir / "stick");
   fs::copy_file(kData / "documents" / "long_paragraph.pdf", dir / "stick" / "manual.pdf");
-  const std::string paragraph = read(kData / "documents" / "long_paragraph.txt");
+  const std::string paragraph = read_text(kData / "documents" / "long_paragraph.txt");
   ASSERT_GT(paragraph.size(), 8000u);
   // The stick's page comes up by itself; the hand goes to the middle of the page (on the paragraph), then
   // Describe. 12 s of kiosk time in all.
@@ -79,8 +70,8 @@ TEST(KioskWithSound, DescribeReadsAnEightKilobyteParagraphWholeAndTheKioskRunsOn
                           hk::test::quoted(dir / "stick") + " --script " + hk::test::quoted(dir / "script.txt") +
                           " --screenshot " + hk::test::quoted(dir / "end.png") + " --frames 720 >" +
                           hk::test::quoted(dir / "log.txt") + " 2>&1";
-  ASSERT_EQ(sh(cmd), 0) << "the kiosk ended: " << read(dir / "log.txt").substr(0, 4000);
-  const std::string log = read(dir / "log.txt");
+  ASSERT_EQ(sh(cmd), 0) << "the kiosk ended: " << read_text(dir / "log.txt").substr(0, 4000);
+  const std::string log = read_text(dir / "log.txt");
   EXPECT_EQ(log.find("audio: no output device"), std::string::npos)
       << "the null PCM is a sound device: " << log.substr(0, 2000);
   EXPECT_TRUE(fs::exists(dir / "end.png")) << "it ran to its last frame";
@@ -137,7 +128,8 @@ TEST(KioskWithSound, TheSentenceKeysMoveThroughALongParagraphFromTheSentenceHear
   const fs::path dir = hk::test::fresh_dir("kiosk_sentences");
   fs::create_directories(dir / "stick");
   fs::copy_file(kData / "documents" / "long_paragraph.pdf", dir / "stick" / "manual.pdf");
-  const std::vector<std::string> sentences = hk::audio::speech_pieces(read(kData / "documents" / "long_paragraph.txt"));
+  const std::vector<std::string> sentences =
+      hk::audio::speech_pieces(read_text(kData / "documents" / "long_paragraph.txt"));
   ASSERT_GT(sentences.size(), 20u);
   // Describe at 2 s; the text itself starts after the warning and the length (~10 s); then the keys.
   std::ofstream(dir / "script.txt")
@@ -150,8 +142,8 @@ TEST(KioskWithSound, TheSentenceKeysMoveThroughALongParagraphFromTheSentenceHear
                           hk::test::quoted(dir / "stick") + " --script " + hk::test::quoted(dir / "script.txt") +
                           " --screenshot " + hk::test::quoted(dir / "end.png") + " --frames 1200 >" +
                           hk::test::quoted(dir / "log.txt") + " 2>&1";
-  ASSERT_EQ(sh(cmd), 0) << read(dir / "log.txt").substr(0, 4000);
-  const std::vector<std::string> said = lines_after(read(dir / "log.txt"), "say: ");
+  ASSERT_EQ(sh(cmd), 0) << read_text(dir / "log.txt").substr(0, 4000);
+  const std::vector<std::string> said = lines_after(read_text(dir / "log.txt"), "say: ");
   ASSERT_GE(said.size(), 5u);
   const std::vector<std::string> last(said.end() - 5, said.end());
   const int a = reads_from(sentences, last[0]), b = reads_from(sentences, last[1]), c = reads_from(sentences, last[2]),
@@ -186,8 +178,8 @@ TEST(KioskWithSound, ChordsAreAnsweredAndFinishAsksOnce) {
                           hk::test::quoted(kData / "images" / "horse.png") + " --script " +
                           hk::test::quoted(dir / "script.txt") + " --screenshot " + hk::test::quoted(dir / "end.png") +
                           " --frames 600 >" + hk::test::quoted(dir / "log.txt") + " 2>&1";
-  ASSERT_EQ(sh(cmd), 0) << read(dir / "log.txt").substr(0, 4000);
-  std::vector<std::string> said = lines_after(read(dir / "log.txt"), "say: ");
+  ASSERT_EQ(sh(cmd), 0) << read_text(dir / "log.txt").substr(0, 4000);
+  std::vector<std::string> said = lines_after(read_text(dir / "log.txt"), "say: ");
   const auto first =
       std::find_if(said.begin(), said.end(), [](const std::string& s) { return s.rfind("That key", 0) == 0; });
   ASSERT_NE(first, said.end()) << "Ctrl+Q was answered";

@@ -16,6 +16,7 @@
 
 #include "config/load.hpp"
 #include "formats/annotations.hpp"
+#include "kiosk_exe.hpp"
 #include "pictures/image_scene.hpp"
 #include "pictures/picture_names.hpp"
 #include "test_paths.hpp"
@@ -24,20 +25,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using hk::test::read_text;
+using hk::test::sh;
+
 const fs::path kData = HK_TEST_DATA_DIR;
 const std::string kNoGlLeakCheck = "ASAN_OPTIONS=detect_leaks=0 ";  // Mesa's DRI driver (see test_kiosk_screen.cpp)
-
-int sh(const std::string& cmd) {
-  const int raw = std::system(cmd.c_str());
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// The curve with the most points among the closed ones of `is` (the horse's outline), and its point farthest from
 /// every other curve: where the hand goes, so the shape at the handle cannot be another one.
@@ -104,12 +96,12 @@ TEST(OperatorNames, TheShapeAtTheHandleNamedLeftWingInTheNamesTabIsSavedAndReadB
                "' --show '" + horse.string() + "' --script '" + (dir / "visit.txt").string() + "' --screenshot '" +
                png.string() + "' --frames 120 >'" + log.string() + "' 2>&1"),
             0)
-      << read(log);
+      << read_text(log);
 
   const fs::path file = names / "horse.annotations.json";
-  ASSERT_TRUE(fs::is_regular_file(file)) << read(log);
+  ASSERT_TRUE(fs::is_regular_file(file)) << read_text(log);
   const hk::app::AnnotationSet set = hk::app::read_annotations(file.string(), "horse.png");
-  ASSERT_EQ(set.annotations.size(), 1u) << read(file);
+  ASSERT_EQ(set.annotations.size(), 1u) << read_text(file);
   EXPECT_TRUE(set.problems.empty());
   EXPECT_EQ(set.annotations[0].name, "left wing");
   EXPECT_EQ(set.annotations[0].selector.kind, hk::app::AnnotationSelector::Kind::svg);
@@ -118,7 +110,7 @@ TEST(OperatorNames, TheShapeAtTheHandleNamedLeftWingInTheNamesTabIsSavedAndReadB
   const int region = is.shape_region[static_cast<std::size_t>(outline)];
   ASSERT_GE(region, 0) << "the outline at the hand has a name";
   EXPECT_EQ(is.regions[static_cast<std::size_t>(region)].name, "left wing");
-  EXPECT_NE(read(log).find("names: saved 1 annotations to " + file.string()), std::string::npos) << read(log);
+  EXPECT_NE(read_text(log).find("names: saved 1 annotations to " + file.string()), std::string::npos) << read_text(log);
   fs::remove_all(dir);
 }
 

@@ -13,26 +13,18 @@
 
 #include "config/load.hpp"
 #include "config/operator_pin.hpp"
+#include "kiosk_exe.hpp"
 #include "test_paths.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
+using hk::test::read_text;
+using hk::test::sh;
+
 const fs::path kData = HK_TEST_DATA_DIR;
 const std::string kNoGlLeakCheck = "ASAN_OPTIONS=detect_leaks=0 ";  // Mesa's DRI driver (see test_kiosk_screen.cpp)
-
-int sh(const std::string& cmd) {
-  const int raw = std::system(cmd.c_str());
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-}
-
-std::string read(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// Saves `s` as `settings` and sets the operator's PIN 90817263 in it with `haptic-kiosk pin set`, as an
 /// operator would; true when it worked.
@@ -76,13 +68,13 @@ TEST(OperatorVisit, WrongPinRightPinStiffness800To1200ApplySaveUnderXvfb) {
                "' --show '" + (dir / "library" / "horse.png").string() + "' --script '" + (dir / "visit.txt").string() +
                "' --screenshot '" + png.string() + "' --frames 130 >'" + log.string() + "' 2>&1"),
             0)
-      << read(log);
+      << read_text(log);
 
   const hk::config::Settings saved = hk::config::load_settings(settings.string());
-  EXPECT_EQ(saved.haptics.stiffness_n_per_m, 1200.0) << read(log);
+  EXPECT_EQ(saved.haptics.stiffness_n_per_m, 1200.0) << read_text(log);
   EXPECT_EQ(saved.operator_.pin_hash, hash) << "the PIN survives the panel's save";
   EXPECT_EQ(hk::config::load_settings(settings.string() + ".bak").haptics.stiffness_n_per_m, 800.0);
-  const std::string audit = read(dir / "kiosk.toml.audit.log");
+  const std::string audit = read_text(dir / "kiosk.toml.audit.log");
   EXPECT_NE(audit.find("PIN refused, 1 failed attempts"), std::string::npos) << audit;
   EXPECT_NE(audit.find("panel opened"), std::string::npos) << audit;
   EXPECT_NE(audit.find("panel haptics.stiffness_n_per_m 800.0 -> 1200.0"), std::string::npos) << audit;
@@ -90,7 +82,7 @@ TEST(OperatorVisit, WrongPinRightPinStiffness800To1200ApplySaveUnderXvfb) {
   // The lockout counted the wrong PIN and the right one reset it.
   EXPECT_EQ(hk::config::read_lockout_state(settings.string() + ".state", 0).failures, 0);
   // No PIN in the log, the audit or the settings.
-  for (const std::string& text : {read(log), audit, read(settings)}) {
+  for (const std::string& text : {read_text(log), audit, read_text(settings)}) {
     EXPECT_EQ(text.find("90817263"), std::string::npos);
     EXPECT_EQ(text.find("55443322"), std::string::npos);
   }
@@ -139,8 +131,8 @@ TEST(OperatorVisit, FinishWhileAStickPageIsDrawnLeavesThePanelsStatusIdle) {
                "' --script '" + (dir / "visit.txt").string() + "' --screenshot '" + png.string() + "' --frames 50 >'" +
                log.string() + "' 2>&1"),
             0)
-      << read(log);
-  const std::string said = read(log);
+      << read_text(log);
+  const std::string said = read_text(log);
   EXPECT_NE(said.find("say: Thank you for visiting. Goodbye."), std::string::npos) << said;
   fs::remove_all(dir);
 }

@@ -38,6 +38,20 @@ inline std::filesystem::path fresh_dir(const std::string& name) {
 /// `p` in single quotes, for a shell command line.
 inline std::string quoted(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
 
+/// Runs `cmd` through the shell: its exit status, 128 when it did not exit.
+inline int sh(const std::string& cmd) {
+  const int raw = std::system(cmd.c_str());
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+}
+
+/// The whole of file `p` ("" when it cannot be read).
+inline std::string read_text(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
 /// What a run of the executable gave: its exit status (128 when it did not exit) and its stderr.
 struct ExeResult {
   int status = -1;
