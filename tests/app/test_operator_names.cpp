@@ -2,7 +2,8 @@
 // cursor) is put on the horse's outline, the panel opened with the PIN, the Names tab clicked, the shape at the
 // handle picked, "left wing" typed into the name box and saved. The script itself fails unless the panel then shows
 // "names:saved"; afterwards the names folder holds horse.annotations.json, it parses, and read by the kiosk's own
-// apply_names it gives that outline the name "left wing".
+// apply_names it gives that outline the name "left wing". Then its check box turns the kiosk's guesses off for the
+// picture: the names folder's horse.toml says `guesses = false`, and the kiosk reads it so.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -89,12 +90,13 @@ TEST(OperatorNames, TheShapeAtTheHandleNamedLeftWingInTheNamesTabIsSavedAndReadB
                                       "80 click names.name\n"
                                       "90 type left wing\n"
                                       "100 click Save names\n"
-                                      "110 shows names:saved\n";
+                                      "110 shows names:saved\n"
+                                      "112 click names.guesses\n";  // the kiosk's guesses off for this picture
   const fs::path png = dir / "names.png", log = dir / "log.txt";
   ASSERT_EQ(sh(kNoGlLeakCheck + "timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' " + HK_KIOSK_EXE +
                " --no-hotplug --config '" + settings.string() + "' --library '" + (dir / "library").string() +
                "' --show '" + horse.string() + "' --script '" + (dir / "visit.txt").string() + "' --screenshot '" +
-               png.string() + "' --frames 120 >'" + log.string() + "' 2>&1"),
+               png.string() + "' --frames 130 >'" + log.string() + "' 2>&1"),
             0)
       << read_text(log);
 
@@ -111,6 +113,8 @@ TEST(OperatorNames, TheShapeAtTheHandleNamedLeftWingInTheNamesTabIsSavedAndReadB
   ASSERT_GE(region, 0) << "the outline at the hand has a name";
   EXPECT_EQ(is.regions[static_cast<std::size_t>(region)].name, "left wing");
   EXPECT_NE(read_text(log).find("names: saved 1 annotations to " + file.string()), std::string::npos) << read_text(log);
+  EXPECT_NE(read_text(names / "horse.toml").find("guesses = false"), std::string::npos) << read_text(log);
+  EXPECT_FALSE(hk::app::guesses_for(horse.string(), names.string(), true));
   fs::remove_all(dir);
 }
 
