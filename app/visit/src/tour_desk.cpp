@@ -61,22 +61,23 @@ void TourDesk::guide() {
     voice_.say(audio_.messages().text(any_shape ? audio::MessageId::tour_all_touched : audio::MessageId::tour_nothing));
     return;
   }
-  ask(audio_.messages().text(audio::MessageId::tour_ask), picture.id, -1);
+  ask(audio_.messages().text(audio::MessageId::tour_ask), picture.id, -1, {});
 }
 
 void TourDesk::offer_part(const TourPicture& picture) {
   const TourPicture::Part& part = picture.parts[parts_offered_++ % picture.parts.size()];
   ask(audio_.messages().text(audio::MessageId::tour_ask_part, {{"name", part.name}}), picture.id,
-      static_cast<int>(part.curve));
+      static_cast<int>(part.curve), part.name);
 }
 
-void TourDesk::ask(const std::string& question, int scene_id, int part_curve) {
+void TourDesk::ask(const std::string& question, int scene_id, int part_curve, std::string part_name) {
   // Ask first: the pull starts once the visitor has heard what is coming (counted in servo ticks, so the
   // same in a headless run as at the kiosk).
   voice_.say_brief(question);
   asked_ = true;
   scene_ = scene_id;
   part_curve_ = part_curve;
+  part_name_ = std::move(part_name);
   due_tick_ = step_.display().tick +
               static_cast<std::int64_t>(
                   std::ceil((audio_.speech_duration_s(question) + kAskMargin_s) * s_.haptics.servo_rate_hz));
@@ -130,9 +131,11 @@ void TourDesk::report_end(const TourPicture& picture, const ServoDisplayState& d
     spdlog::warn("tour {}: stuck on shape {} (no progress), let go", d.tour_id, d.tour_curve);
     text = m.text(audio::MessageId::tour_stuck) + " ";
   } else if (d.tour_curve >= 0 && static_cast<std::size_t>(d.tour_curve) < picture.described) {
+    // A named part is said as it was offered ("the right wing"), not as one of its shapes ("part of ...").
+    const bool part = !part_name_.empty() && d.tour_curve == part_curve_;
     text = m.text(audio::MessageId::tour_traced,
                   {{"shape", std::to_string(d.tour_curve + 1)},
-                   {"description", picture.words(static_cast<std::size_t>(d.tour_curve))}}) +
+                   {"description", part ? part_name_ : picture.words(static_cast<std::size_t>(d.tour_curve))}}) +
            " ";
   }
   const int left = shapes_remaining(*picture.scene, touches_, tour_params_from(s_));

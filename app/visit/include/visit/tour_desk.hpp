@@ -70,7 +70,8 @@ class TourDesk final : public TourEffects {
   /// The Guide key on the picture shown. A picture with parts staff named (TourPicture::parts): until each has
   /// been offered in this visit of the picture, names the next ("I will guide your hand to the left wing. …",
   /// tour_ask_part), so each press, one that stops a tour too, offers the next; the tour to it (plan_tour_to)
-  /// starts once the question has been heard. Then, as on any picture: when it has a shape not yet touched
+  /// starts once the question has been heard, and its end says the part as offered ("That was the left wing.").
+  /// Then, as on any picture: when it has a shape not yet touched
   /// (plan_tour), asks first; the tour is planned and handed to the servo thread by poll() once the question
   /// has been heard (its length in servo ticks, kAskMargin_s more). Nothing left: the named parts again, in
   /// turn, else says so (tour_all_touched, or tour_nothing without shapes). A press that stopped a tour to an
@@ -103,9 +104,11 @@ class TourDesk final : public TourEffects {
   void hand_over(const TourPicture& picture);  // plans the announced tour from the handle and publishes it
   void report_end(const TourPicture& picture, const ServoDisplayState& d);  // what it traced and what remains
   void stop_quietly();                                                      // ends what runs or is announced
-  void ask(const std::string& question, int scene_id, int part_curve);      // announces a tour, due once heard
-  void offer_part(const TourPicture& picture);                              // the next named part, in turn
-  void say_touched_name(const TourPicture& picture, int curve);             // the first touch of a named shape
+  // Announces a tour, due once heard: to named part `part_name` (its curve `part_curve`) or, −1 and "", to the
+  // nearest shape not yet touched.
+  void ask(const std::string& question, int scene_id, int part_curve, std::string part_name);
+  void offer_part(const TourPicture& picture);                   // the next named part, in turn
+  void say_touched_name(const TourPicture& picture, int curve);  // the first touch of a named shape
 
   std::function<TourPicture()> picture_;  // set_picture
   ServoStep& step_;
@@ -123,6 +126,7 @@ class TourDesk final : public TourEffects {
   bool asked_ = false;             // announced, not yet handed to the servo thread
   std::int64_t due_tick_ = 0;      // the servo tick from which the announced tour may start
   int part_curve_ = -1;            // the announced tour's named part (its curve), −1 for the nearest untouched shape
+  std::string part_name_;          // that part's name as offered, "" for none
   std::size_t parts_offered_ = 0;  // named parts offered in this visit of the picture (TourPicture::parts)
   std::vector<std::string> names_said_;  // names said at a touch in this visit of the picture
   Vec2 cursor_in_;                       // the last cursor given to set_cursor [m]
