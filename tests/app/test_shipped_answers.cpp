@@ -81,6 +81,12 @@ TEST(ShippedAnswers, DescribeOpensWithTheNamedPartsAndNeverSaysAPhraseTwiceInARo
     SCOPED_TRACE(p.filename().string());
     const Shipped s(p);
     ASSERT_FALSE(s.names.parts.empty()) << "the curators named its parts";
+    // A touched shape is said as its part: "part of the left wing" is touched as "the left wing".
+    ASSERT_EQ(s.names.part_name.size(), s.names.shape_name.size());
+    for (std::size_t c = 0; c < s.names.shape_name.size(); ++c) {
+      const std::string& shape = s.names.shape_name[c];
+      EXPECT_EQ(s.names.part_name[c], shape.rfind("part of ", 0) == 0 ? shape.substr(8) : shape) << c;
+    }
     for (const Vec2 hand : {Vec2{0, 0}, Vec2{-0.06, 0.04}, Vec2{0.06, -0.04}}) {
       const std::string said = describe_answer(s.view(), m, hand, hand);
       const std::vector<std::string> ph = phrases(said);

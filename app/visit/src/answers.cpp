@@ -68,6 +68,7 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
   PictureNames out;
   if (regions.empty()) return out;
   out.shape_name.assign(curves, std::string());
+  out.part_name.assign(curves, std::string());
   out.shape_region.assign(curves, -1);
   for (std::size_t i = 0; i < curves && i < shape_region.size(); ++i) out.shape_region[i] = shape_region[i];
   std::vector<int> sharing(regions.size(), 0);  // shapes that take each region's name
@@ -80,7 +81,9 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
     const std::string name = region_said_name(regions[r]);
     const std::string head = name.substr(0, name.find(" of "));  // "the coins of the top row": "the coins"
     const bool plural = head.ends_with("s") || head.ends_with("ae");
-    out.shape_name[i] = sharing[r] > 1 && name.rfind("the ", 0) == 0 ? (plural ? "one of " : "part of ") + name : name;
+    const bool shared = sharing[r] > 1 && name.rfind("the ", 0) == 0;
+    out.shape_name[i] = shared ? (plural ? "one of " : "part of ") + name : name;
+    out.part_name[i] = shared && plural ? "one of " + name : name;
   }
   std::vector<std::size_t> order(regions.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;

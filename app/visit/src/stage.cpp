@@ -239,11 +239,8 @@ TourPicture Stage::tour_picture() const {
   const PictureNames& names = shown_.names;
   if (names.shape_name.empty() || showing_tutorial()) return p;
   p.name = [this](std::size_t curve) {
-    // "part of the left wing" is the shape's; touched, the part is named: "the left wing".
-    const std::vector<std::string>& said = shown_.names.shape_name;
-    if (curve >= said.size()) return std::string();
-    const std::string& name = said[curve];
-    return name.rfind("part of ", 0) == 0 ? name.substr(8) : name;
+    const std::vector<std::string>& part = shown_.names.part_name;
+    return curve < part.size() ? part[curve] : std::string();
   };
   for (const PictureNames::Part& part : names.parts)  // Guide leads to what staff named, not to guesses
     if (part.curve >= 0 && !part.guess) p.parts.push_back({part.name, static_cast<std::size_t>(part.curve)});

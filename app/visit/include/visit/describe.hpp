@@ -65,6 +65,9 @@ std::string describe_one_shape(const std::vector<Polyline>& curves,
 struct PictureNames {
   /// One per curve: its name as said ("the left wing"), "" for none; empty: no names.
   std::vector<std::string> shape_name;
+  /// One per curve: the name of the part it belongs to, as said when it is touched ("the left wing"; "one of the
+  /// white spots" for a plural name several shapes share), "" for none; empty: no names.
+  std::vector<std::string> part_name;
   /// One per curve: the region it takes its name from, −1 for none; empty: no names.
   std::vector<int> shape_region;
   /// A named part of the picture: each name once, with the centre of its region [m] and its area [m²].
