@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
   std::vector<std::pair<std::string, double>> all;
   for (int i = 0; i < hk::audio::kMessageCount; ++i) {
     const auto id = static_cast<MessageId>(i);
-    const std::string key(hk::audio::kMessageKeys[static_cast<std::size_t>(i)]);
+    const std::string key(hk::audio::message_key(id));
     const double s = seconds_of(hk::test::sample_message(en, id, keys));
     all.emplace_back(key, s);
     if (hk::test::asked_to_be_long(id)) continue;

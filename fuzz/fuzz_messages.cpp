@@ -1,17 +1,18 @@
-// Fuzz harness: a message catalogue (translation) file (audio-cues/include/audio/messages.hpp).
+// Fuzz harness: a compiled message catalogue (an MO file, audio-cues/include/audio/messages.hpp).
 //
-// Entry point: hk::audio::MessageCatalog::parse (the in-memory half of load). toml++ is compiled into this
-// harness (header-only), so the fuzzer sees the parser's coverage too. Properties:
-//  - a refusal is a MessageError whose what() is one line "messages '<source>': ...", of bounded length;
-//  - an accepted catalogue keeps the documented limits (voice 1..64 bytes, every text 1..1000 bytes and
-//    using only the English text's placeholders, [key_names] exactly English's, each 1..100 bytes), and
-//    text() expands every message, with and without arguments, without growing beyond what was put in.
+// Entry point: hk::audio::MessageCatalog::from_mo (the in-memory half of load), which hands the bytes to
+// Boost.Locale's gettext reader and checks every entry against the English source. Properties:
+//  - a refusal is a MessageError whose what() is one line "catalogue 'fr' (stick/fr.mo): ...", of bounded length;
+//  - an accepted catalogue keeps the documented limits (every message, word, key name and key place at most 2000
+//    bytes, using only its English text's placeholders), and text() expands every message, plain and counted
+//    for 0, 1, 2 and 5, without growing beyond what was put in.
 
 #include <cstddef>
 #include <cstdint>
 #include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "audio/messages.hpp"
 #include "fuzz_common.hpp"
@@ -38,36 +39,32 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using hk::audio::MessageCatalog;
   using hk::audio::MessageId;
-  const std::string_view text(reinterpret_cast<const char*>(data), size);
-  const std::string source = "stick/de.toml";
+  const std::string source = "stick/fr.mo";
   try {
-    const MessageCatalog c = MessageCatalog::parse(text, source);
-    const MessageCatalog& en = MessageCatalog::english();
-    FUZZ_CHECK(!c.voice().empty() && c.voice().size() <= 64, c.voice());
-    FUZZ_CHECK(c.key_names().size() == en.key_names().size(), c.voice());
-    for (const auto& [name, form] : c.key_names()) {
-      FUZZ_CHECK(en.key_names().count(name) == 1, name);
-      FUZZ_CHECK(!form.empty() && form.size() <= 100, form);
-    }
+    const MessageCatalog c = MessageCatalog::from_mo("fr", std::vector<char>(data, data + size), source);
     const std::string arg(20, 'x');
+    const hk::audio::KeyArg keys[] = {{"help_key", "F1"}, {"next_key", "UP"}};
+    std::size_t longest_key = 0;
+    for (const auto& [name, form] : c.key_names()) longest_key = std::max(longest_key, form.size());
     for (int i = 0; i < hk::audio::kMessageCount; ++i) {
       const auto id = static_cast<MessageId>(i);
-      const std::string& raw = c.raw(id);
-      FUZZ_CHECK(!raw.empty() && raw.size() <= 1000, raw);
-      const std::set<std::string> allowed = placeholders(en.raw(id));
-      for (const std::string& p : placeholders(raw)) FUZZ_CHECK(allowed.count(p) == 1, p);
-      FUZZ_CHECK(c.text(id) == raw, raw);  // nothing to put in: unchanged
-      const hk::audio::KeyArg keys[] = {{"help_key", "F1"}, {"next_key", "UP"}};
-      const std::string filled = c.text(id, {{"picture", arg}, {"title", arg}, {"seconds", arg}}, keys);
-      std::size_t longest_key = 0;
-      for (const auto& [name, form] : c.key_names()) longest_key = std::max(longest_key, form.size());
-      // Each placeholder (at least 2 bytes of braces) is replaced by at most max(arg, key name) bytes.
-      FUZZ_CHECK(filled.size() <= raw.size() * (1 + std::max(arg.size(), longest_key)), filled);
+      const auto& source_text = hk::audio::kMessageSources[static_cast<std::size_t>(i)];
+      std::set<std::string> allowed = placeholders(source_text.one);
+      for (const std::string& p : placeholders(source_text.many)) allowed.insert(p);
+      for (const long n : {0L, 1L, 2L, 5L}) {
+        const std::string raw = c.raw(id, n);
+        FUZZ_CHECK(raw.size() <= 2000, raw);
+        for (const std::string& p : placeholders(raw)) FUZZ_CHECK(allowed.count(p) == 1, p);
+        const std::string filled = c.text(id, n, {{"picture", arg}, {"title", arg}}, keys);
+        // Each placeholder (at least 2 bytes of braces) is replaced by at most max(arg, key name, count) bytes.
+        FUZZ_CHECK(filled.size() <= raw.size() * (1 + std::max(arg.size(), longest_key)), filled);
+      }
     }
+    for (const auto& w : hk::audio::kWordSources) FUZZ_CHECK(c.word(w.key, 2).size() <= 2000 * 3, w.key);
   } catch (const hk::audio::MessageError& e) {
     const std::string what = e.what();
     FUZZ_CHECK(hk::fuzz::is_one_line(what), what);
-    FUZZ_CHECK(what.starts_with("messages '" + source + "': "), what);
+    FUZZ_CHECK(what.starts_with("catalogue 'fr' (" + source + "): "), what);
     FUZZ_CHECK(what.size() <= 1024, what);
   }
   return 0;

@@ -46,9 +46,13 @@ for h in "${harnesses[@]}"; do
       copy_seeds config 65536 "$seeds"/config/* "$data"/config/*.toml "$data"/bad/config_*.toml
       { cat "$dicts/toml.dict"; toml_keys "$data"/config/*.toml; } > "$dest/dicts/config.dict" ;;
     messages)
-      copy_seeds messages 65536 "$seeds"/messages/* "$data"/messages/*.toml "$repo"/audio-cues/messages/*.toml
-      { cat "$dicts/toml.dict"; toml_keys "$repo"/audio-cues/messages/en.toml
-        grep -hoE '\{[a-z_]+\}' "$repo"/audio-cues/messages/en.toml | sort -u | sed -e 's/.*/"&"/'; } > "$dest/dicts/messages.dict" ;;
+      # The catalogues compiled from audio-cues/po (msgfmt: gettext is a build dependency) and the hand-made seed.
+      mkdir -p "$dest/mo"
+      for po in "$repo"/audio-cues/po/*.po; do msgfmt -o "$dest/mo/$(basename "$po" .po).mo" "$po"; done
+      copy_seeds messages 131072 "$seeds"/messages/* "$dest"/mo/*.mo
+      { printf '%s\n' '"\x95\x04\x12\xde"' '"\xde\x12\x04\x95"' '"Plural-Forms: nplurals=2; plural=(n > 1);"'
+        grep -hoE 'NP?C_\("[a-z_.A-Z0-9]+"' "$repo"/audio-cues/src/messages_en.cpp | sed -e 's/^NP*C_(//'
+        grep -hoE '\{[a-z_]+\}' "$repo"/audio-cues/src/messages_en.cpp | sort -u | sed -e 's/.*/"&"/'; } > "$dest/dicts/messages.dict" ;;
     hand_csv)
       copy_seeds hand_csv 65536 "$seeds"/hand_csv/* "$data"/bad/hand_*.csv
       cp "$dicts/csv.dict" "$dest/dicts/hand_csv.dict" ;;

@@ -42,7 +42,7 @@ done
 build=$(mkdir -p "$build" && cd "$build" && pwd)
 
 # Largest input per harness [bytes].
-declare -A max_len=([image]=65536 [pdf]=65536 [config]=32768 [messages]=16384 [hand_csv]=8192 [hapi_reply]=1024
+declare -A max_len=([image]=65536 [pdf]=65536 [config]=32768 [messages]=131072 [hand_csv]=8192 [hapi_reply]=1024
                     [stick_name]=1024 [ocr]=16384 [annotations]=16384)
 # Slowest run that is not a "timeout" finding [s]. pdf: poppler is not our code and the kiosk runs it only in
 # the worker process, which is killed after 5 s of CPU; a run within that (slower here, in-process under ASan)

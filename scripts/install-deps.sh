@@ -8,14 +8,14 @@ packages=(
   g++ cmake ninja-build pkg-config ccache
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-objdetect-dev libopencv-contrib-dev opencv-data
   libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
-  libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev
+  libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev gettext libboost-locale-dev
   libglfw3-dev libimgui-dev libgl-dev
   libpoppler-cpp-dev libtesseract-dev tesseract-ocr-eng libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev zlib1g-dev librsvg2-dev
 )
 if [ "${1:-}" != "--demo" ]; then
   packages+=(
     libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libembree-dev
-    sox libgl1-mesa-dri xvfb xauth tesseract-ocr-deu
+    sox libgl1-mesa-dri xvfb xauth tesseract-ocr-deu tesseract-ocr-fra tesseract-ocr-spa
     poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools
     dpkg-dev file lintian systemd cage
     clang libclang-rt-14-dev llvm-14 clang-format-14

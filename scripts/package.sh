@@ -31,7 +31,7 @@ ldflags="$(dpkg-buildflags --get LDFLAGS)"
 
 source "$root/scripts/compiler-cache.sh"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DHK_BUILD_TESTS=OFF -DHK_BUILD_BENCH=OFF "${hk_cache_args[@]}" \
-  -DCMAKE_INSTALL_PREFIX=/usr -DHK_DATA_DIR=/usr/share/haptic-kiosk -DHK_LIBEXEC_DIR=/usr/libexec/haptic-kiosk \
+  -DCMAKE_INSTALL_PREFIX=/usr -DHK_DATA_DIR=/usr/share/haptic-kiosk -DHK_LOCALE_DIR=/usr/share/haptic-kiosk/locale -DHK_LIBEXEC_DIR=/usr/libexec/haptic-kiosk \
   -DCMAKE_CXX_FLAGS="$cxxflags" -DCMAKE_EXE_LINKER_FLAGS="$ldflags" >/dev/null
 cmake --build "$build" -j "$jobs"
 

@@ -1,24 +1,26 @@
 #include "audio/messages.hpp"
 
-#include <toml++/toml.h>
-#include <filesystem>
-#include <fstream>
-#include <set>
-#include <sstream>
+#include <boost/locale/gnu_gettext.hpp>
+#include <boost/locale/message.hpp>
 
+#include <fstream>
+#include <iterator>
+#include <set>
+
+#include "hk/language.hpp"
 #include "hk/text.hpp"
+
+#ifndef HK_LOCALE_DIR
+#define HK_LOCALE_DIR "locale"
+#endif
 
 namespace hk::audio {
 namespace {
 
-#include "messages_en.inc"
+constexpr std::size_t kMaxTextBytes = 2000;
 
-constexpr std::size_t kMaxTextBytes = 1000;
-constexpr std::size_t kMaxKeyNameBytes = 100;
-constexpr std::uintmax_t kMaxFileBytes = 256 * 1024;
-
-std::set<std::string> placeholders(std::string_view s) {
-  std::set<std::string> out;
+std::set<std::string, std::less<>> placeholders(std::string_view s) {
+  std::set<std::string, std::less<>> out;
   for (std::size_t i = s.find('{'); i != std::string_view::npos; i = s.find('{', i + 1)) {
     const std::size_t j = s.find('}', i);
     if (j == std::string_view::npos) break;
@@ -37,124 +39,152 @@ bool starts_sentence(const std::string& out) {
   return c == '.' || c == '!' || c == '?';
 }
 
-using KeyMap = std::map<std::string, std::string, std::less<>>;
+/// The name of a key entry without its family ("key_name.UP" → "UP").
+std::string_view entry_name(std::string_view key) { return key.substr(key.find('.') + 1); }
 
-/// [key_places] (optional, any of the key names): where each key lies on the keypad, as a blind visitor finds it.
-KeyMap key_places(const toml::table& t, const std::string& where, const KeyMap& key_names) {
-  KeyMap out;
-  const toml::node* node = t.get("key_places");
-  if (!node) return out;
-  const toml::table* kp = node->as_table();
-  if (!kp) throw MessageError(where + "key_places must be a table");
-  for (const auto& [key, value] : *kp) {
-    const std::string name(key.str());
-    const std::string shown = hk::one_line(name, 60);
-    if (!key_names.count(name)) throw MessageError(where + "key_places." + shown + " is not a key name of [key_names]");
-    const auto v = value.value<std::string>();
-    if (!v) throw MessageError(where + "key_places." + shown + " is not a string");
-    if (v->empty() || v->size() > MessageCatalog::kMaxKeyPlaceBytes) {
-      throw MessageError(where + "key_places." + shown + " must be 1 to " +
-                         std::to_string(MessageCatalog::kMaxKeyPlaceBytes) + " bytes");
-    }
-    out.emplace(name, *v);
+/// `text` with runs of spaces made one and spaces before a comma or full stop dropped: a template whose
+/// optional placeholder ({colour} unknown) was left empty.
+std::string tidy_spaces(std::string text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    if (c == ' ' && (out.empty() || out.back() == ' ')) continue;
+    if ((c == ',' || c == '.') && !out.empty() && out.back() == ' ') out.pop_back();
+    out += c;
   }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
   return out;
 }
 
 }  // namespace
 
-MessageCatalog MessageCatalog::parse(std::string_view text, const std::string& source) {
-  const std::string where = "messages '" + hk::one_line(source) + "': ";
-  toml::table t;
-  try {
-    t = toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    const std::string d = hk::one_line(e.description(), 160);  // toml++ quotes the offending character as it is
-    throw MessageError(where + "not valid TOML: " + d + " (line " + std::to_string(e.source().begin.line) + ")");
+struct MessageCatalog::Compiled {
+  std::locale locale;
+  const boost::locale::message_format<char>* facet = nullptr;
+  int domain = 0;
+};
+
+std::filesystem::path default_locale_dir() { return HK_LOCALE_DIR; }
+
+std::string MessageCatalog::voice() const { return language_.substr(0, language_.find('-')); }
+
+std::string MessageCatalog::translate(const MessageSource& s, long count) const {
+  const std::string ctx(s.key), one(s.one);
+  if (compiled_) {
+    const int n = static_cast<int>(std::clamp<long>(count, 0, 1'000'000'000));
+    const char* t = s.many.empty() ? compiled_->facet->get(compiled_->domain, ctx.c_str(), one.c_str())
+                                   : compiled_->facet->get(compiled_->domain, ctx.c_str(), one.c_str(), n);
+    if (t && *t) return t;
   }
+  return std::string(s.many.empty() || count == 1 ? s.one : s.many);
+}
+
+MessageCatalog MessageCatalog::build(std::string_view language, std::shared_ptr<const Compiled> compiled,
+                                     const std::string& source) {
   MessageCatalog c;
-  const auto voice = t["voice"].value<std::string>();
-  if (!voice || voice->empty() || voice->size() > 64)
-    throw MessageError(where + "voice must be an espeak-ng voice name (1 to 64 characters)");
-  c.voice_ = *voice;
-  c.language_ = t["language"].value_or(std::string(*voice));
-  const toml::table* m = t["messages"].as_table();
-  if (!m) throw MessageError(where + "has no [messages] table");
-  for (const auto& [key, node] : *m) {
-    bool known = false;
-    for (std::string_view k : kMessageKeys) known = known || k == key.str();
-    if (!known)
-      throw MessageError(where + "messages." + hk::one_line(key.str(), 60) + " is not a message the kiosk has");
-  }
-  // The English file is the reference for placeholders (it is parsed first, with itself as reference).
-  const MessageCatalog* en = source == "en.toml (built in)" ? nullptr : &english();
-  for (int i = 0; i < kMessageCount; ++i) {
-    const std::string key(kMessageKeys[static_cast<std::size_t>(i)]);
-    const auto v = (*m)[key].value<std::string>();
-    if (!v) throw MessageError(where + "messages." + key + " is missing (or not a string)");
-    if (v->empty() || v->size() > kMaxTextBytes) {
-      throw MessageError(where + "messages." + key + " must be 1 to " + std::to_string(kMaxTextBytes) + " bytes");
-    }
-    if (en) {
-      const auto allowed = placeholders(en->raw(static_cast<MessageId>(i)));
-      for (const std::string& p : placeholders(*v)) {
-        if (!allowed.count(p))
-          throw MessageError(where + "messages." + key + " uses {" + hk::one_line(p, 60) +
-                             "}, which the English text does not have");
+  c.language_ = language;
+  c.compiled_ = std::move(compiled);
+  const std::string where = "catalogue '" + hk::one_line(std::string(language)) + "' (" + hk::one_line(source) + "): ";
+  // Each entry is there, not empty, not too long, and uses only the placeholders of its English text.
+  const auto check = [&](const MessageSource& s) {
+    for (const long n : {1L, 2L, 5L}) {
+      if (s.many.empty() && n > 1) break;
+      const std::string t = c.translate(s, n);
+      if (c.compiled_ && t == (n == 1 || s.many.empty() ? s.one : s.many)) {
+        const char* found =
+            c.compiled_->facet->get(c.compiled_->domain, std::string(s.key).c_str(), std::string(s.one).c_str());
+        if (!found) throw MessageError(where + std::string(s.key) + " is missing");
       }
+      if (t.size() > kMaxTextBytes)
+        throw MessageError(where + std::string(s.key) + " is " + std::to_string(t.size()) +
+                           " bytes, over the limit of " + std::to_string(kMaxTextBytes));
+      const auto allowed = placeholders(s.one), allowed_many = placeholders(s.many);
+      for (const std::string& p : placeholders(t))
+        if (!allowed.count(p) && !allowed_many.count(p))
+          throw MessageError(where + std::string(s.key) + " uses {" + hk::one_line(p, 60) +
+                             "}, which the English text does not have");
     }
-    c.texts_[static_cast<std::size_t>(i)] = *v;
-  }
-  // [key_names]: English names every key a visitor may be given; a translation names exactly the same ones.
-  const toml::table* kn = t["key_names"].as_table();
-  if (!kn) throw MessageError(where + "has no [key_names] table");
-  for (const auto& [key, node] : *kn) {
-    const std::string name(key.str());
-    const std::string shown = hk::one_line(name, 60);  // a quoted TOML key may hold any character
-    if (en && !en->key_names_.count(name)) {
-      throw MessageError(where + "key_names." + shown + " is not a key name the English catalogue has");
-    }
-    const auto v = node.value<std::string>();
-    if (!v) throw MessageError(where + "key_names." + shown + " is not a string");
-    if (v->empty() || v->size() > kMaxKeyNameBytes) {
-      throw MessageError(where + "key_names." + shown + " must be 1 to " + std::to_string(kMaxKeyNameBytes) + " bytes");
-    }
-    c.key_names_.emplace(name, *v);
-  }
-  if (en) {
-    for (const auto& [name, form] : en->key_names_) {
-      if (!c.key_names_.count(name)) throw MessageError(where + "key_names." + name + " is missing (or not a string)");
-    }
-  } else if (c.key_names_.empty()) {
-    throw MessageError(where + "[key_names] is empty");
-  }
-  c.key_places_ = key_places(t, where, c.key_names_);
+  };
+  for (const MessageSource& s : kMessageSources) check(s);
+  for (const MessageSource& s : kWordSources) check(s);
+  for (const MessageSource& s : kKeyNameSources) check(s);
+  for (const MessageSource& s : kKeyPlaceSources) check(s);
+  for (std::size_t i = 0; i < kMessageSources.size(); ++i) c.texts_[i] = c.translate(kMessageSources[i], 1);
+  for (std::size_t i = 0; i < kWordSources.size(); ++i) c.words_[i] = c.translate(kWordSources[i], 1);
+  for (const MessageSource& s : kKeyNameSources) c.key_names_.emplace(entry_name(s.key), c.translate(s, 1));
+  for (const MessageSource& s : kKeyPlaceSources) c.key_places_.emplace(entry_name(s.key), c.translate(s, 1));
   return c;
 }
 
-std::string MessageCatalog::key_place(std::string_view name) const {
-  const auto it = key_places_.find(name);
-  return it == key_places_.end() ? std::string() : it->second;
-}
-
 const MessageCatalog& MessageCatalog::english() {
-  static const MessageCatalog en = parse(kMessagesEnToml, "en.toml (built in)");
+  static const MessageCatalog en = build("en", nullptr, "built in");
   return en;
 }
 
-MessageCatalog MessageCatalog::load(const std::string& path) {
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw MessageError("messages '" + hk::one_line(path) + "': cannot read the file (" + ec.message() + ")");
-  if (size > kMaxFileBytes) {
-    throw MessageError("messages '" + hk::one_line(path) + "': " + std::to_string(size) +
-                       " bytes is over the limit of " + std::to_string(kMaxFileBytes) + " bytes");
+MessageCatalog MessageCatalog::from_mo(std::string_view language, std::vector<char> mo_bytes,
+                                       const std::string& source) {
+  const std::string where = "catalogue '" + hk::one_line(std::string(language)) + "' (" + hk::one_line(source) + "): ";
+  if (!is_language_tag(language)) throw MessageError(where + "not a BCP 47 language tag such as \"fr\" or \"pt-BR\"");
+  namespace gg = boost::locale::gnu_gettext;
+  gg::messages_info info;
+  info.language = std::string(language.substr(0, language.find('-')));
+  info.encoding = "UTF-8";
+  info.domains.emplace_back(std::string(kMessageDomain));
+  info.paths.emplace_back("memory");
+  bool handed = false;
+  info.callback = [&](const std::string&, const std::string&) {
+    if (handed) return std::vector<char>();
+    handed = true;
+    return mo_bytes;
+  };
+  auto compiled = std::make_shared<Compiled>();
+  try {
+    boost::locale::message_format<char>* facet = gg::create_messages_facet<char>(info);
+    if (!facet) throw MessageError(where + "Boost.Locale made no catalogue of it");
+    compiled->locale = std::locale(std::locale::classic(), facet);
+    compiled->facet = facet;
+    compiled->domain = facet->domain(std::string(kMessageDomain));
+  } catch (const MessageError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw MessageError(where + "not a gettext MO file (" + hk::one_line(e.what(), 120) + ")");
   }
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  if (!f) throw MessageError("messages '" + hk::one_line(path) + "': cannot read the file");
-  return parse(ss.str(), path);
+  if (!handed) throw MessageError(where + "not read");
+  return build(language, std::move(compiled), source);
+}
+
+MessageCatalog MessageCatalog::load(std::string_view language, const std::filesystem::path& locale_dir) {
+  if (language == "en") return english();
+  const std::string shown = hk::one_line(std::string(language));
+  if (!is_language_tag(language))
+    throw MessageError("catalogue '" + shown + "': not a BCP 47 language tag such as \"fr\" or \"pt-BR\"");
+  std::filesystem::path file;
+  for (const std::string_view tag : {language, language.substr(0, language.find('-'))}) {
+    const auto f = locale_dir / std::string(tag) / "LC_MESSAGES" / (std::string(kMessageDomain) + ".mo");
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(f, ec)) {
+      file = f;
+      break;
+    }
+  }
+  if (file.empty()) {
+    throw MessageError(
+        "catalogue '" + shown + "': no file " +
+        hk::one_line(
+            (locale_dir / std::string(language) / "LC_MESSAGES" / (std::string(kMessageDomain) + ".mo")).string()));
+  }
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  if (ec) throw MessageError("catalogue '" + shown + "' (" + hk::one_line(file.string()) + "): cannot read it");
+  if (size > kMaxCatalogueBytes) {
+    throw MessageError("catalogue '" + shown + "' (" + hk::one_line(file.string()) + "): " + std::to_string(size) +
+                       " bytes is over the limit of " + std::to_string(kMaxCatalogueBytes) + " bytes");
+  }
+  std::ifstream in(file, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof())
+    throw MessageError("catalogue '" + shown + "' (" + hk::one_line(file.string()) + "): cannot read it");
+  return from_mo(language, std::move(bytes), file.string());
 }
 
 std::string MessageCatalog::key_name(std::string_view name) const {
@@ -162,13 +192,46 @@ std::string MessageCatalog::key_name(std::string_view name) const {
   return it == key_names_.end() ? std::string(name) : it->second;
 }
 
+std::string MessageCatalog::key_place(std::string_view name) const {
+  const auto it = key_places_.find(name);
+  return it == key_places_.end() ? std::string() : it->second;
+}
+
+std::string MessageCatalog::raw(MessageId id, long count) const {
+  const MessageSource& s = kMessageSources[static_cast<std::size_t>(id)];
+  return s.many.empty() ? raw(id) : translate(s, count);
+}
+
 std::string MessageCatalog::text(MessageId id, std::initializer_list<MessageArg> args,
                                  std::span<const KeyArg> keys) const {
   return expand(raw(id), args, keys);
 }
 
+std::string MessageCatalog::text(MessageId id, long count, std::initializer_list<MessageArg> args,
+                                 std::span<const KeyArg> keys) const {
+  std::vector<MessageArg> all(args);
+  all.emplace_back("count", std::to_string(count));  // after the caller's: a caller's own {count} wins
+  return expand_all(raw(id, count), all, keys);
+}
+
+std::string MessageCatalog::word(std::string_view key, long count, std::initializer_list<MessageArg> args) const {
+  for (std::size_t i = 0; i < kWordSources.size(); ++i) {
+    const MessageSource& s = kWordSources[i];
+    if (s.key != key) continue;
+    std::vector<MessageArg> all(args);
+    all.emplace_back("count", std::to_string(count));
+    return tidy_spaces(expand_all(s.many.empty() || count == 1 ? words_[i] : translate(s, count), all, {}));
+  }
+  return {};
+}
+
 std::string MessageCatalog::expand(std::string_view s, std::initializer_list<MessageArg> args,
                                    std::span<const KeyArg> keys) const {
+  return expand_all(s, std::span<const MessageArg>(args.begin(), args.size()), keys);
+}
+
+std::string MessageCatalog::expand_all(std::string_view s, std::span<const MessageArg> args,
+                                       std::span<const KeyArg> keys) const {
   std::string out;
   out.reserve(s.size());
   std::size_t i = 0;
@@ -192,9 +255,8 @@ std::string MessageCatalog::expand(std::string_view s, std::initializer_list<Mes
       out += arg->second;
     } else if (key) {
       std::string form = key_name(key->second);
-      // Forms are written as they read after "Press"; a sentence starts with a capital (ASCII letters only).
-      if (!form.empty() && starts_sentence(out) && form[0] >= 'a' && form[0] <= 'z')
-        form[0] = static_cast<char>(form[0] - 'a' + 'A');
+      // Forms are written as they read after "Press"; a sentence starts with a capital.
+      if (starts_sentence(out)) form = hk::capitalised(form);
       out += form;
     } else {
       out.append(s.substr(open, close - open + 1));  // unknown: left as it is

@@ -244,7 +244,7 @@ Speaker::~Speaker() {
   worker_.join();
 }
 
-void Speaker::submit(std::string text, bool keep) {
+void Speaker::submit(std::string text, bool keep, bool again) {
   // Under m_, so two concurrent say() calls queue in the order of their generations.
   job_generation_ = stream_.cancel();
   stream_.set_paused(false);
@@ -252,7 +252,11 @@ void Speaker::submit(std::string text, bool keep) {
   log_.emplace_back(steady_ns(), text);
   while (log_.size() > kLogEntries) log_.pop_front();
   if (!text.empty()) {
-    if (keep) last_ = text;
+    job_params_ = again ? last_params_ : params_;
+    if (keep) {
+      last_ = text;
+      last_params_ = job_params_;
+    }
     job_text_ = std::move(text);
   }
 }
@@ -267,7 +271,7 @@ void Speaker::say(std::string text, bool keep) {
   }
   {
     std::lock_guard<std::mutex> lock(m_);
-    submit(std::move(text), keep);
+    submit(std::move(text), keep, false);
   }
   cv_.notify_all();
 }
@@ -276,7 +280,7 @@ void Speaker::repeat() {
   {
     std::lock_guard<std::mutex> lock(m_);
     if (last_.empty()) return;
-    submit(last_, true);
+    submit(last_, true, true);
   }
   cv_.notify_all();
 }
@@ -351,7 +355,28 @@ std::vector<std::string> Speaker::pieces_spoken() const {
   return {pieces_.begin(), pieces_.end()};
 }
 
-bool Speaker::speak_piece(const std::string& piece, std::uint32_t gen, std::uint64_t* pushed) {
+void Speaker::set_voice(const std::string& voice) {
+  SpeechParams p;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    p = params_;
+  }
+  p.voice = voice;
+  {
+    std::lock_guard<std::mutex> lock(espeak_mutex());
+    configure_locked(p);  // refuses a voice espeak-ng does not have
+  }
+  std::lock_guard<std::mutex> lock(m_);
+  params_ = p;
+}
+
+std::string Speaker::voice() const {
+  std::lock_guard<std::mutex> lock(m_);
+  return params_.voice;
+}
+
+bool Speaker::speak_piece(const std::string& piece, const SpeechParams& params, std::uint32_t gen,
+                          std::uint64_t* pushed) {
   const auto retry = std::chrono::duration<double>(kFullRingRetry);
   // Synthesised whole under the synthesiser's lock (a piece is a sentence: tens of milliseconds), then handed
   // to the mixer outside it. Waiting for room in the mixer's ring takes as long as the piece plays; holding
@@ -360,7 +385,7 @@ bool Speaker::speak_piece(const std::string& piece, std::uint32_t gen, std::uint
   std::vector<float> samples;
   {
     std::lock_guard<std::mutex> lock(espeak_mutex());
-    configure_locked(params_);
+    configure_locked(params);
     synthesize_locked(piece, [&](const float* x, std::size_t n) {
       samples.insert(samples.end(), x, x + n);
       return stream_.generation() == gen;  // cancelled: abort espeak-ng now
@@ -390,12 +415,14 @@ void Speaker::run() {
   const auto retry = std::chrono::duration<double>(kFullRingRetry);
   for (;;) {
     std::string text;
+    SpeechParams params;
     std::uint32_t gen = 0;
     {
       std::unique_lock<std::mutex> lock(m_);
       cv_.wait(lock, [this] { return stop_ || has_job_; });
       if (stop_) return;
       text = std::move(job_text_);
+      params = job_params_;
       gen = job_generation_;
       has_job_ = false;
       working_ = true;
@@ -415,7 +442,7 @@ void Speaker::run() {
             }
             piece_starts_.push_back(pushed);
           }
-          if (!speak_piece(piece, gen, &pushed)) {
+          if (!speak_piece(piece, params, gen, &pushed)) {
             whole = false;
             break;
           }

@@ -2,32 +2,84 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 namespace hk::audio {
 
-namespace {
-
-MessageCatalog load_catalog(const std::string& file) {
-  return file.empty() ? MessageCatalog::english() : MessageCatalog::load(file);
+void AudioSystem::load_languages(const AudioSystemParams& p) {
+  for (const std::string& code : p.languages) {
+    if (std::find(language_codes_.begin(), language_codes_.end(), code) != language_codes_.end()) continue;
+    try {
+      catalogues_.push_back(MessageCatalog::load(code, p.locale_dir));
+      language_codes_.push_back(code);
+    } catch (const MessageError& e) {
+      spdlog::error("audio: {}; the language is not offered", e.what());
+    }
+  }
+  if (catalogues_.empty()) {
+    spdlog::error("audio: no offered language could be loaded; the kiosk speaks English");
+    catalogues_.push_back(MessageCatalog::english());
+    language_codes_.emplace_back("en");
+  }
+  const auto it = std::find(language_codes_.begin(), language_codes_.end(), p.language);
+  if (it == language_codes_.end())
+    spdlog::error("audio: the default language '{}' is not among those loaded; visits start in '{}'", p.language,
+                  language_codes_[0]);
+  default_language_ = language_ = it == language_codes_.end() ? 0 : static_cast<int>(it - language_codes_.begin());
+  catalog_ = catalogues_[static_cast<std::size_t>(language_)];
 }
 
-}  // namespace
-
 AudioSystem::AudioSystem(const AudioSystemParams& p)
-    : catalog_(load_catalog(p.messages_file)),
-      cues_(p.cue_capacity),
+    : cues_(p.cue_capacity),
       ui_cues_(64),
       volume_(p.volume_default_step, 10, p.volume_step_db),
       mixer_(p.mixer, &cues_, &speech_stream_, &volume_, &ui_cues_) {
+  load_languages(p);
   SpeechParams sp = p.speech;
   if (sp.voice.empty()) sp.voice = catalog_.voice();
   speech_params_ = sp;
   try {
     speaker_ = std::make_unique<Speaker>(speech_stream_, sp);
   } catch (const SpeechError& e) {
-    spdlog::warn("audio: no speech ({}); the kiosk continues with earcons only", e.what());
+    if (sp.voice != "en") {  // the language's voice is missing: the English voice, never silence
+      spdlog::error("audio: {}; speaking with the voice 'en'", e.what());
+      sp.voice = "en";
+      try {
+        speaker_ = std::make_unique<Speaker>(speech_stream_, sp);
+      } catch (const SpeechError&) {
+      }
+    }
+    if (!speaker_) spdlog::warn("audio: no speech ({}); the kiosk continues with earcons only", e.what());
   }
   pulled_ = !p.open_output;
   if (p.open_output) output_ = std::make_unique<AudioOutput>(mixer_, p.output);  // logs its own state
+}
+
+bool AudioSystem::set_language(int index) {
+  if (index < 0 || index >= static_cast<int>(catalogues_.size())) return false;
+  if (index == language_) return true;
+  language_ = index;
+  catalog_ = catalogues_[static_cast<std::size_t>(index)];
+  if (speaker_) {
+    try {
+      speaker_->set_voice(catalog_.voice());
+    } catch (const SpeechError& e) {
+      if (missing_voices_.insert(catalog_.voice()).second)  // once per voice
+        spdlog::error("audio: {}; speaking {} with the voice 'en'", e.what(),
+                      language_codes_[static_cast<std::size_t>(index)]);
+      try {
+        speaker_->set_voice("en");
+      } catch (const SpeechError&) {  // "en" started the speaker: not refused now
+      }
+    }
+  }
+  speech_params_.voice = speaker_ ? speaker_->voice() : catalog_.voice();
+  return true;
+}
+
+const MessageCatalog& AudioSystem::catalogue(int index) const {
+  return index >= 0 && index < static_cast<int>(catalogues_.size()) ? catalogues_[static_cast<std::size_t>(index)]
+                                                                    : catalog_;
 }
 
 bool AudioSystem::play(CueKind kind) noexcept {

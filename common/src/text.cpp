@@ -91,4 +91,16 @@ std::string first_words(const std::string& text, int n) {
   return out;
 }
 
+std::string capitalised(std::string text) {
+  if (text.empty()) return text;
+  const auto c0 = static_cast<unsigned char>(text[0]);
+  if (c0 >= 'a' && c0 <= 'z') {
+    text[0] = static_cast<char>(c0 - 'a' + 'A');
+  } else if (c0 == 0xC3 && text.size() > 1) {  // U+00C0..U+00FF: second byte 0x80..0xBF
+    const auto c1 = static_cast<unsigned char>(text[1]);
+    if (c1 >= 0xA0 && c1 <= 0xBE && c1 != 0xB7) text[1] = static_cast<char>(c1 - 0x20);  // à..þ but ÷
+  }
+  return text;
+}
+
 }  // namespace hk

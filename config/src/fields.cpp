@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <charconv>
@@ -17,6 +18,7 @@
 #include "config/keys.hpp"
 #include "config/load.hpp"
 #include "detail.hpp"
+#include "hk/language.hpp"
 
 namespace hk::config {
 
@@ -131,6 +133,17 @@ std::string scene_cache_problem(std::string_view v) {
 std::string quiet_hours_problem(std::string_view v) {
   std::string why;
   return v.empty() || parse_quiet_hours(v, &why) ? std::string{} : why;
+}
+
+/// The check of [kiosk] languages: BCP 47 tags separated by commas.
+std::string languages_problem(std::string_view v) {
+  std::string why;
+  return language_list(v, &why).empty() ? why : std::string{};
+}
+
+/// The check of [kiosk] language: one BCP 47 tag.
+std::string language_problem(std::string_view v) {
+  return is_language_tag(v) ? std::string{} : "is not a language tag such as \"fr\" or \"pt-BR\"";
 }
 
 /// The check of [vision] ocr_languages: empty, or Tesseract language codes joined by '+'.
@@ -414,6 +427,14 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
              "\"on\": the first time a visitor touches a named shape of a picture, its name is said, once; \"off\": "
              "names only when asked (Where, Describe).",
              kOnOff),
+    HK_FIELD(kiosk, languages, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+             "The languages offered to visitors, as BCP 47 tags separated by commas (\"en, fr, de, es\"); the "
+             "Language key steps through them in this order. Each needs its catalogue; one without is left out "
+             "(logged).",
+             {}, &languages_problem),
+    HK_FIELD(kiosk, language, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+             "The language each visit starts in, and comes back to at Finish or time-out: one of the languages.", {},
+             &language_problem),
     // [stick]
     HK_FIELD(stick, max_depth, FieldGroup::devices, ApplyWhen::restart, 1, 64, "",
              "Deepest folder of a stick that is entered (its root is 0)."),
@@ -476,6 +497,10 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
              "Reading a text: on from the next paragraph (block of text).", kKeyNames),
     HK_FIELD(keys, previous_paragraph, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
              "Reading a text: back to the paragraph before.", kKeyNames),
+    HK_FIELD(keys, language, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "The next of the offered languages, said in itself; while the kiosk waits, the language of the "
+             "invitation just heard.",
+             kKeyNames),
     // [operator]
     HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
                 "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),
@@ -805,6 +830,13 @@ void validate_as(const Settings& s, const Source& src) {
     fail(src, "device.motor_spacing_m",
          "device.motor_spacing_m = " + format_real(s.device.motor_spacing_m) +
              " must be < 2 * (device.link_proximal_m + device.link_distal_m) or the links cannot meet");
+  {
+    const std::vector<std::string> offered = language_list(s.kiosk.languages);
+    if (!offered.empty() && std::find(offered.begin(), offered.end(), s.kiosk.language) == offered.end())
+      fail(src, "kiosk.language",
+           "kiosk.language = \"" + one_line(s.kiosk.language, 40) + "\" must be one of kiosk.languages = \"" +
+               one_line(s.kiosk.languages, 80) + "\"");
+  }
   // Each visitor action on its own key: one key cannot do two things, and the help names each action's key.
   // The first pair in table order is reported, attributed to the earlier key and naming the later.
   {

@@ -57,7 +57,7 @@ TEST(Describe, AlikeShapesAreSaidTogetherAndTheRestCountedTruly) {
   // hand first).
   const std::vector<Polyline> two{rect({0.05, 0.03}, {0.003, 0.003}), rect({-0.03, 0}, {0.03, 0.02})};
   EXPECT_EQ(describe_scene(two, {}, kHalf, 1, Vec2{0.05, 0.03}),
-            "2 shapes. Nearest your hand, a small square at the far right, and 1 more.");
+            "2 shapes. Nearest your hand, a small square at the far right, and one more.");
 }
 
 TEST(Describe, ShapesInsideAClosedShapeAreToldWithItAsGroups) {
@@ -71,7 +71,7 @@ TEST(Describe, ShapesInsideAClosedShapeAreToldWithItAsGroups) {
       "5 shapes. A large rectangle with 3 smaller shapes inside it, at the far left, and a small bent line at the "
       "near right.");
   EXPECT_EQ(describe_scene(scene, {}, kHalf, 1),
-            "5 shapes. A large rectangle with 3 smaller shapes inside it, at the far left, and 1 more, smaller.");
+            "5 shapes. A large rectangle with 3 smaller shapes inside it, at the far left, and one more, smaller.");
   // A board with 26 round spots of one size: one group inside it.
   std::vector<Polyline> spots{rect({0, 0}, {0.05, 0.03})};
   for (int i = 0; i < 26; ++i) spots.push_back(circle({-0.04 + 0.003 * i, 0.0}, 0.001));
@@ -119,7 +119,7 @@ TEST(Describe, ColoursAndFormsFromDescriptorsAreSaid) {
   ds[1].colour = {meaning::BasicColour::blue, meaning::Shade::light};
   EXPECT_EQ(describe_scene(curves, ds, kHalf),
             "2 shapes. A small red round shape on the left, and a small light blue square on the right.");
-  EXPECT_EQ(describe_one_shape(curves, ds, 1, kHalf), "a small light blue square, on the right");
+  EXPECT_EQ(describe_one_shape(curves, ds, 1, kHalf), "a small light blue square on the right");
   ds[1].has_colour = false;
   EXPECT_EQ(describe_one_shape(curves, ds, 1, kHalf, false), "a small square");
 }

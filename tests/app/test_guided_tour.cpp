@@ -567,7 +567,8 @@ TEST(GuidedTourRuntime, GuideLeadsToEachShapeThenSaysWhatRemainsAndAKeyStopsIt) 
   EXPECT_EQ(r.rt->tour().touches().count(), 1);
   EXPECT_EQ(r.rt->voice().last_said().rfind("That was ", 0), 0u)
       << "it names what it traced: " << r.rt->voice().last_said();
-  EXPECT_TRUE(ends_with(r.rt->voice().last_said(), r.text(audio::MessageId::tour_remaining, {{"count", "4"}})))
+  EXPECT_TRUE(
+      ends_with(r.rt->voice().last_said(), audio::MessageCatalog::english().text(audio::MessageId::tour_remaining, 4)))
       << r.rt->voice().last_said();
   // A key during the next tour stops it, quietly; the Guide key stopping it says so.
   r.rt->tour().key_pressed();

@@ -118,7 +118,8 @@ TEST(KioskFlow, AttractTutorialPicturesTimeoutAndBack) {
         "Press the Up arrow for more detail and the Down arrow for less.",
         "Press Page Up for louder and Page Down for quieter.",
         "Press the G key to be led to a shape you have not touched yet.",
-        "Press the T key to practise with the shapes again, and the End key when you have finished.",
+        "Press the T key to practise with the shapes again, the L key for another language, and the End key when you "
+        "have finished.",
         "Hold F1 and press another key to learn what it does."}) {
     EXPECT_NE(every.find(sentence), std::string::npos) << "the help names the shipped keys: " << sentence;
   }
@@ -447,6 +448,87 @@ TEST(Describe, FiguresAreGroupsOfTouchingCurves) {
   EXPECT_EQ(count_figures(curves), 3);
   EXPECT_EQ(count_figures(curves, 0.0), 4) << "without the margin the stroke beside the box stands alone";
   EXPECT_EQ(count_figures({}), 0);
+}
+
+}  // namespace
+}  // namespace hk::app
+
+namespace hk::app {
+namespace {
+using audio::MessageId;
+
+/// A visit as heard in one language: the flow's catalogue is `current`, which set_language swaps, as the audio
+/// system does; each picture has the shapes of kShapes, and Describe says a drawn scene in the visit's language.
+struct LanguageRecorder final : hk::test::EveryEffect {
+  std::vector<audio::MessageCatalog> catalogues;
+  audio::MessageCatalog current = audio::MessageCatalog::english();
+  int in_use = 0;
+  std::vector<std::string> said;
+  static constexpr int kShapes[] = {0, 1, 2, 5};
+  void say(const std::string& t) override { said.push_back(t); }
+  void show_tutorial(TutorialShape) override {}
+  int show_picture(int i) override { return kShapes[i]; }
+  int picture_count() const override { return 4; }
+  std::string describe() override {
+    Polyline square{{{-0.02, -0.02}, {0.02, -0.02}, {0.02, 0.02}, {-0.02, 0.02}}, true};
+    Polyline dot{{{0.05, 0.03}, {0.056, 0.03}, {0.056, 0.036}, {0.05, 0.036}}, true};
+    return describe_scene({square, dot}, {}, {0.08, 0.06}, 3, std::nullopt, nullptr, current);
+  }
+  bool change_level(int) override { return true; }
+  bool change_volume(int) override { return true; }
+  void new_session() override {}
+  void show_document(int, int) override {}
+  void forget_stick() override {}
+  int language_count() const override { return static_cast<int>(catalogues.size()); }
+  int language() const override { return in_use; }
+  int default_language() const override { return 0; }
+  void set_language(int i) override {
+    in_use = i;
+    current = catalogues[static_cast<std::size_t>(i)];
+  }
+};
+
+TEST(KioskFlow, AVisitInEachLanguageIsSaidWhollyInIt) {
+  const std::vector<std::string> codes{"en", "fr", "de", "es"};
+  for (std::size_t lang = 1; lang < codes.size(); ++lang) {
+    SCOPED_TRACE(codes[lang]);
+    LanguageRecorder fx;
+    for (const std::string& c : codes)
+      fx.catalogues.push_back(audio::MessageCatalog::load(c, audio::default_locale_dir()));
+    const audio::MessageCatalog& m = fx.catalogues[lang];
+    KioskFlowParams p;
+    p.attract_every_s = 10.0;
+    KioskFlow flow(fx, fx.current, p);
+    // The invitation comes in each language in turn, from the default; each offers its own.
+    for (std::size_t i = 0; i <= lang; ++i) flow.tick(10.0 * static_cast<double>(i + 1));
+    ASSERT_EQ(fx.said.size(), lang + 1);
+    EXPECT_NE(fx.said.back().find(m.text(MessageId::language_offer, {}, key_args(p.keys))), std::string::npos)
+        << fx.said.back();
+    // The Language key answers it: the visit is in that language, from the welcome to the goodbye.
+    fx.said.clear();
+    flow.key(KioskKey::Language, 100.0);
+    EXPECT_EQ(fx.said.back(), m.text(MessageId::welcome, {}, key_args(p.keys)));
+    flow.key(KioskKey::Help, 101.0);
+    for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 102.0 + i);  // the tutorial, then picture 1: no shapes
+    EXPECT_NE(fx.said.back().find(m.text(MessageId::picture_empty, {{"picture", "1"}, {"pictures", "4"}})),
+              std::string::npos);
+    for (int n = 1; n < 4; ++n) {  // 1, 2 and 5 shapes, each in its plural form
+      flow.key(KioskKey::Next, 110.0 + n);
+      EXPECT_EQ(fx.said.back(), m.text(MessageId::picture_loaded, LanguageRecorder::kShapes[n],
+                                       {{"picture", std::to_string(n + 1)}, {"pictures", "4"}}));
+    }
+    flow.key(KioskKey::Describe, 120.0);
+    EXPECT_NE(fx.said.back().find(m.word("scene_count", 2)), std::string::npos) << fx.said.back();
+    flow.key(KioskKey::Finish, 130.0);
+    flow.key(KioskKey::Finish, 130.5);
+    EXPECT_EQ(fx.said.back(), m.text(MessageId::goodbye));
+    EXPECT_EQ(fx.in_use, 0) << "the next visit starts in the default language";
+    // Not one English line or phrase: the English texts of the words said are nowhere in it.
+    for (const std::string& line : fx.said) {
+      for (const char* english : {"Press", " the ", "shape", "Picture", "Welcome", "Goodbye", "picture"})
+        EXPECT_EQ(line.find(english), std::string::npos) << english << " in: " << line;
+    }
+  }
 }
 
 }  // namespace

@@ -1,70 +1,29 @@
-// The message catalogue: English compiled in, translations loaded and checked, bad files refused in one
-// line naming the file and the key.
+// The message catalogues: English is the source, the shipped translations load from the build's MO files with
+// every message, the build's check refuses a broken catalogue, and a bad file is refused in one line.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <functional>
-
 #include "audio/messages.hpp"
+#include "hk/text.hpp"
 #include "test_paths.hpp"
 
 namespace hk::audio {
 namespace {
 
-const std::string kDir = std::string(HK_TEST_DATA_DIR) + "/messages/";
+namespace fs = std::filesystem;
 
-TEST(Messages, EnglishHasEveryMessageAndFillsPlaceholders) {
-  const MessageCatalog& en = MessageCatalog::english();
-  EXPECT_EQ(en.voice(), "en");
-  for (int i = 0; i < kMessageCount; ++i)
-    EXPECT_FALSE(en.raw(static_cast<MessageId>(i)).empty()) << kMessageKeys[static_cast<std::size_t>(i)];
-  EXPECT_EQ(en.text(MessageId::picture_loaded, {{"picture", "2"}, {"pictures", "5"}, {"shapes", "7"}}),
-            "Picture 2 of 5. It has 7 shapes.");
-  // An argument the text does not use changes nothing; a placeholder without an argument stays visible.
-  EXPECT_EQ(en.text(MessageId::volume_up, {{"shapes", "3"}}), "Louder.");
-  EXPECT_NE(en.text(MessageId::timeout_warning).find("{seconds}"), std::string::npos);
-}
+const fs::path kPoDir = fs::path(HK_TEST_DATA_DIR) / ".." / ".." / "audio-cues" / "po";
+const fs::path kEnglishSource = fs::path(HK_TEST_DATA_DIR) / ".." / ".." / "audio-cues" / "src" / "messages_en.cpp";
+const std::vector<std::string> kShipped{"fr", "de", "es"};
 
-TEST(Messages, GermanTranslationLoads) {
-  const MessageCatalog de = MessageCatalog::load(kDir + "de.toml");
-  EXPECT_EQ(de.voice(), "de");
-  EXPECT_EQ(de.language(), "Deutsch");
-  EXPECT_EQ(de.text(MessageId::picture_loaded, {{"picture", "1"}, {"pictures", "3"}, {"shapes", "4"}}),
-            "Bild 1 von 3. Es hat 4 Formen.");
-}
-
-void expect_refused(const std::string& file, const std::string& must_contain) {
-  SCOPED_TRACE(file);
-  try {
-    MessageCatalog::load(kDir + file);
-    ADD_FAILURE() << "loaded";
-  } catch (const MessageError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(file), std::string::npos) << what;
-    EXPECT_NE(what.find(must_contain), std::string::npos) << what;
-    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
-  }
-}
-
-TEST(Messages, BadTranslationsAreRefusedInOneLine) {
-  expect_refused("missing_key.toml", "messages.help is missing");
-  expect_refused("unknown_key.toml", "messages.colour is not a message");
-  expect_refused("bad_placeholder.toml", "messages.picture_loaded uses {colour}");
-  expect_refused("empty_text.toml", "messages.volume_up must be 1 to 1000 bytes");
-  expect_refused("not_toml.toml", "not valid TOML");
-  expect_refused("no_voice.toml", "voice");
-  expect_refused("binary.toml", "not valid TOML");
-  expect_refused("does_not_exist.toml", "cannot read");
-}
-
-// --- Keys: messages name keys with placeholders filled from [key_names]. ---
-
-std::string read_text(const std::string& path) {
+std::string read_text(const fs::path& path) {
   std::ifstream f(path, std::ios::binary);
   std::stringstream ss;
   ss << f.rdbuf();
@@ -79,15 +38,6 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
-/// Writes `text` to a file named `name` in the temp directory, removed at scope exit.
-struct TempCatalog {
-  std::filesystem::path path;
-  TempCatalog(const std::string& name, const std::string& text) : path(std::filesystem::temp_directory_path() / name) {
-    std::ofstream(path, std::ios::binary) << text;
-  }
-  ~TempCatalog() { std::filesystem::remove(path); }
-};
-
 /// Placeholders used in `s`.
 std::vector<std::string> placeholders_in(const std::string& s) {
   std::vector<std::string> out;
@@ -98,6 +48,161 @@ std::vector<std::string> placeholders_in(const std::string& s) {
   }
   return out;
 }
+
+/// A fresh folder under the temp directory, removed at scope exit.
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name) : path(fs::temp_directory_path() / ("hk_messages_" + name)) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+/// Runs `command` with sh; its exit status, its standard error in *err.
+int run(const std::string& command, const fs::path& err_file, std::string* err) {
+  const int rc = std::system((command + " 2> '" + err_file.string() + "'").c_str());
+  *err = read_text(err_file);
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+TEST(Messages, EnglishHasEveryMessageAndFillsPlaceholders) {
+  const MessageCatalog& en = MessageCatalog::english();
+  EXPECT_EQ(en.voice(), "en");
+  EXPECT_EQ(en.language_name(), "English");
+  for (int i = 0; i < kMessageCount; ++i) EXPECT_FALSE(en.raw(static_cast<MessageId>(i)).empty()) << i;
+  EXPECT_EQ(message_key(MessageId::welcome), "welcome");
+  EXPECT_EQ(message_key(MessageId::other_language), "other_language");
+  EXPECT_EQ(en.text(MessageId::picture_loaded, 7, {{"picture", "2"}, {"pictures", "5"}}),
+            "Picture 2 of 5. It has 7 shapes.");
+  EXPECT_EQ(en.text(MessageId::picture_loaded, 1, {{"picture", "2"}, {"pictures", "5"}}),
+            "Picture 2 of 5. It has one shape.");
+  // An argument the text does not use changes nothing; a placeholder without an argument stays visible.
+  EXPECT_EQ(en.text(MessageId::volume_up, {{"shapes", "3"}}), "Louder.");
+  EXPECT_NE(en.text(MessageId::timeout_warning).find("{seconds}"), std::string::npos);
+  // Words: a form's look with its size and colour; an unknown colour leaves no double space.
+  EXPECT_EQ(en.word("look_round", 1, {{"size", "small"}, {"colour", "white"}}), "a small white round shape");
+  EXPECT_EQ(en.word("look_square", 3, {{"size", "large"}, {"colour", ""}}), "3 large squares");
+  EXPECT_EQ(en.word("no_such_word"), "");
+}
+
+TEST(Messages, EveryShippedLanguageLoadsWholeAndTranslated) {
+  const MessageCatalog& en = MessageCatalog::english();
+  const std::map<std::string, std::string> names{{"fr", "Français"}, {"de", "Deutsch"}, {"es", "Español"}};
+  for (const std::string& lang : kShipped) {
+    SCOPED_TRACE(lang);
+    const MessageCatalog c = MessageCatalog::load(lang, default_locale_dir());
+    EXPECT_EQ(c.language(), lang);
+    EXPECT_EQ(c.voice(), lang);
+    EXPECT_EQ(c.language_name(), names.at(lang));
+    int same = 0;
+    for (int i = 0; i < kMessageCount; ++i) {
+      const auto id = static_cast<MessageId>(i);
+      same += c.raw(id) == en.raw(id);
+      EXPECT_EQ(c.text(id).find('\n'), std::string::npos) << message_key(id);
+    }
+    EXPECT_LE(same, 3) << "messages left in English (describe, a bare {name}., Text: are the same in some)";
+    for (const auto& [name, form] : en.key_names()) EXPECT_EQ(c.key_names().count(name), 1u) << name;
+  }
+}
+
+TEST(Messages, PluralFormsFollowEachCatalogue) {
+  const MessageCatalog fr = MessageCatalog::load("fr", default_locale_dir());
+  const MessageCatalog de = MessageCatalog::load("de", default_locale_dir());
+  const MessageCatalog& en = MessageCatalog::english();
+  // French counts 0 and 1 as one (Plural-Forms: n > 1); German and English only 1.
+  EXPECT_EQ(fr.raw(MessageId::tour_remaining, 0), fr.raw(MessageId::tour_remaining, 1));
+  EXPECT_NE(fr.raw(MessageId::tour_remaining, 2), fr.raw(MessageId::tour_remaining, 1));
+  EXPECT_EQ(fr.raw(MessageId::tour_remaining, 2), fr.raw(MessageId::tour_remaining, 5));
+  EXPECT_NE(de.raw(MessageId::tour_remaining, 0), de.raw(MessageId::tour_remaining, 1));
+  EXPECT_EQ(de.raw(MessageId::tour_remaining, 0), de.raw(MessageId::tour_remaining, 5));
+  EXPECT_EQ(en.text(MessageId::tour_remaining, 5), "5 shapes not yet touched.");
+  EXPECT_EQ(en.text(MessageId::tour_remaining, 1), "One shape not yet touched.");
+  EXPECT_NE(fr.text(MessageId::tour_remaining, 5).find('5'), std::string::npos);
+}
+
+/// The catalogue of `lang` from `po_text`, compiled by msgfmt (without --check, so a broken entry gets through
+/// to the loader) into `dir`/LANG/LC_MESSAGES/haptic-kiosk.mo.
+void compile(const std::string& po_text, const fs::path& dir, const std::string& lang) {
+  const fs::path out = dir / lang / "LC_MESSAGES";
+  fs::create_directories(out);
+  std::ofstream(dir / (lang + ".po"), std::ios::binary) << po_text;
+  std::string err;
+  ASSERT_EQ(run("msgfmt -o '" + (out / "haptic-kiosk.mo").string() + "' '" + (dir / (lang + ".po")).string() + "'",
+                dir / "err.txt", &err),
+            0)
+      << err;
+}
+
+void expect_refused(const std::string& lang, const fs::path& dir, const std::string& must_contain) {
+  SCOPED_TRACE(lang);
+  try {
+    (void)MessageCatalog::load(lang, dir);
+    ADD_FAILURE() << "loaded";
+  } catch (const MessageError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("catalogue '" + lang + "'"), std::string::npos) << what;
+    EXPECT_NE(what.find(must_contain), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+  }
+}
+
+TEST(Messages, BadCataloguesAreRefusedInOneLine) {
+  const TempDir dir("bad");
+  const std::string fr = read_text(kPoDir / "fr.po");
+  // A translation with a placeholder its English text lacks (msgfmt without --check lets it through).
+  compile(replaced(fr, "msgstr \"Plus fort.\"", "msgstr \"Plus fort {colour}.\""), dir.path, "fr");
+  expect_refused("fr", dir.path, "volume_up uses {colour}");
+  // A message left out.
+  std::string missing = fr;
+  const std::size_t at = missing.find("msgctxt \"volume_up\"");
+  ASSERT_NE(at, std::string::npos);
+  missing.erase(at, missing.find("\n\n", at) - at);
+  compile(missing, dir.path, "de");
+  expect_refused("de", dir.path, "volume_up is missing");
+  // No catalogue, not an MO file, too big, not a language tag.
+  expect_refused("it", dir.path, "no file");
+  fs::create_directories(dir.path / "es" / "LC_MESSAGES");
+  std::ofstream(dir.path / "es" / "LC_MESSAGES" / "haptic-kiosk.mo", std::ios::binary) << "msgid \"x\"\n";
+  expect_refused("es", dir.path, "not a gettext MO file");
+  fs::create_directories(dir.path / "pt" / "LC_MESSAGES");
+  std::ofstream(dir.path / "pt" / "LC_MESSAGES" / "haptic-kiosk.mo", std::ios::binary)
+      << std::string(kMaxCatalogueBytes + 1, '\0');
+  expect_refused("pt", dir.path, "over the limit of 1048576 bytes");
+  expect_refused("EN_us", dir.path, "not a BCP 47 language tag");
+  // A regional tag falls back to its language's catalogue.
+  EXPECT_EQ(MessageCatalog::load("fr-CA", default_locale_dir()).language_name(), "Français");
+}
+
+TEST(Messages, TheBuildCheckFailsOnABrokenCatalogue) {
+  // The build's own step (audio-cues/po/catalogues.sh build) on a copy of the catalogues, each broken in turn.
+  const TempDir dir("check");
+  const std::string script = (kPoDir / "catalogues.sh").string();
+  const auto check = [&](const std::string& fr_text, std::string* err) {
+    fs::remove_all(dir.path / "po");
+    fs::create_directories(dir.path / "po");
+    fs::copy_file(kPoDir / "haptic-kiosk.pot", dir.path / "po" / "haptic-kiosk.pot");
+    std::ofstream(dir.path / "po" / "fr.po", std::ios::binary) << fr_text;
+    return run("bash '" + script + "' build '" + kEnglishSource.string() + "' '" + (dir.path / "po").string() + "' '" +
+                   (dir.path / "out").string() + "'",
+               dir.path / "err.txt", err);
+  };
+  const std::string fr = read_text(kPoDir / "fr.po");
+  std::string err;
+  ASSERT_EQ(check(fr, &err), 0) << err;
+  EXPECT_TRUE(fs::exists(dir.path / "out" / "fr" / "LC_MESSAGES" / "haptic-kiosk.mo"));
+  // A placeholder that differs from the English text's.
+  std::string bad = fr;
+  const std::size_t entry = bad.find("msgstr", bad.find("msgctxt \"picture_empty\""));
+  bad.replace(bad.find("{picture}", entry), 9, "{image}");
+  EXPECT_EQ(check(bad, &err), 1);
+  EXPECT_NE(err.find("fr.po does not compile"), std::string::npos) << err;
+  // A message left untranslated.
+  EXPECT_EQ(check(replaced(fr, "msgstr \"Plus fort.\"", "msgstr \"\""), &err), 1);
+  EXPECT_NE(err.find("fr.po lacks messages"), std::string::npos) << err;
+}
+
+// --- Keys: messages name keys with placeholders filled with their spoken forms. ---
 
 TEST(MessageKeys, EnglishSpokenFormsReadAfterPress) {
   const MessageCatalog& en = MessageCatalog::english();
@@ -138,31 +243,24 @@ TEST(MessageKeys, KeyPlaceholdersAreFilledWithTheSpokenForm) {
 }
 
 TEST(MessageKeys, AKeyThatStartsASentenceStartsWithACapital) {
-  // A translation that puts keys first: "{help_key} gives help." at the start and after a full stop, not mid-sentence.
-  std::string de = read_text(kDir + "de.toml");
-  const std::string help_line =
-      de.substr(de.find("\nhelp = "), de.find('\n', de.find("\nhelp = ") + 1) - de.find("\nhelp = "));
-  de = replaced(de, help_line,
-                "\nhelp = \"{help_key} gibt Hilfe. {next_key} bringt das nächste Bild!  {finer_key} mehr, oder "
-                "{coarser_key}? {describe_key}.\"");
-  const MessageCatalog c = MessageCatalog::parse(de, "keys-first.toml");
-  const KeyArg keys[] = {
-      {"help_key", "F1"}, {"next_key", "RIGHT"}, {"finer_key", "UP"}, {"coarser_key", "DOWN"}, {"describe_key", "D"}};
-  EXPECT_EQ(c.text(MessageId::help, {}, keys),
-            "Die Taste F1 gibt Hilfe. Die Pfeiltaste nach rechts bringt das nächste Bild!  Die Pfeiltaste nach oben "
-            "mehr, oder "
-            "die Pfeiltaste nach unten? Die Taste D.");
+  const MessageCatalog fr = MessageCatalog::load("fr", default_locale_dir());
+  const KeyArg keys[] = {{"previous_key", "LEFT"}};
+  const std::string t = fr.text(MessageId::key_previous, {}, keys);
+  ASSERT_FALSE(t.empty());
+  EXPECT_EQ(t.rfind(hk::capitalised(fr.key_name("LEFT")), 0), 0u) << t;
   // English: "the Up arrow" after "Press" stays lower case; F1 has nothing to capitalise.
   const MessageCatalog& en = MessageCatalog::english();
   const KeyArg up[] = {{"help_key", "UP"}};
   EXPECT_NE(en.text(MessageId::welcome, {}, up).find("Press the Up arrow for help."), std::string::npos);
+  EXPECT_EQ(hk::capitalised("écoutez"), "Écoutez");
+  EXPECT_EQ(hk::capitalised("÷x"), "÷x");
 }
 
 TEST(MessageKeys, EnglishNamesKeysOnlyThroughPlaceholders) {
   const MessageCatalog& en = MessageCatalog::english();
   for (int i = 0; i < kMessageCount; ++i) {
     const std::string& t = en.raw(static_cast<MessageId>(i));
-    SCOPED_TRACE(std::string(kMessageKeys[static_cast<std::size_t>(i)]) + ": " + t);
+    SCOPED_TRACE(std::string(message_key(static_cast<MessageId>(i))) + ": " + t);
     for (const std::string& p : placeholders_in(t)) {
       if (p.size() > 4 && p.ends_with("_key")) {
         bool known = false;
@@ -189,74 +287,8 @@ TEST(MessageKeys, EnglishNamesKeysOnlyThroughPlaceholders) {
   EXPECT_NE(en.raw(MessageId::welcome).find("{help_key}"), std::string::npos);
   for (MessageId id : {MessageId::tutorial_start, MessageId::tutorial_circle, MessageId::tutorial_triangle,
                        MessageId::stick_inserted}) {
-    EXPECT_NE(en.raw(id).find("{next_key}"), std::string::npos) << kMessageKeys[static_cast<std::size_t>(id)];
+    EXPECT_NE(en.raw(id).find("{next_key}"), std::string::npos) << message_key(id);
   }
-}
-
-TEST(MessageKeys, GermanHasEveryKeyNameOfEnglish) {
-  const MessageCatalog de = MessageCatalog::load(kDir + "de.toml");
-  const MessageCatalog& en = MessageCatalog::english();
-  ASSERT_EQ(de.key_names().size(), en.key_names().size());
-  for (const auto& [name, form] : en.key_names()) EXPECT_EQ(de.key_names().count(name), 1u) << name;
-  EXPECT_EQ(de.key_name("SPACE"), "die Leertaste");
-  const KeyArg keys[] = {{"help_key", "F1"}};
-  EXPECT_NE(de.text(MessageId::welcome, {}, keys).find("Drücken Sie die Taste F1 für Hilfe."), std::string::npos);
-}
-
-/// Loads de.toml changed by `edit` from a file named `file`; expects a one-line MessageError naming it and
-/// `must_contain`.
-void expect_translation_refused(const std::string& file, const std::function<std::string(std::string)>& edit,
-                                const std::string& must_contain) {
-  SCOPED_TRACE(file);
-  const TempCatalog t(file, edit(read_text(kDir + "de.toml")));
-  try {
-    MessageCatalog::load(t.path.string());
-    ADD_FAILURE() << "loaded";
-  } catch (const MessageError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(file), std::string::npos) << what;
-    EXPECT_NE(what.find(must_contain), std::string::npos) << what;
-    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
-  }
-}
-
-TEST(MessageKeys, TranslationsMustNameExactlyTheEnglishKeys) {
-  expect_translation_refused(
-      "hk_keys_missing.toml", [](std::string s) { return replaced(s, "UP = \"die Pfeiltaste nach oben\"\n", ""); },
-      "key_names.UP is missing");
-  expect_translation_refused(
-      "hk_keys_unknown.toml", [](std::string s) { return s + "ESCAPE = \"die Escape-Taste\"\n"; },
-      "key_names.ESCAPE is not a key name the English catalogue has");
-  expect_translation_refused(
-      "hk_keys_empty.toml", [](std::string s) { return replaced(s, "F1 = \"die Taste F1\"", "F1 = \"\""); },
-      "key_names.F1 must be 1 to 100 bytes");
-  expect_translation_refused(
-      "hk_keys_not_string.toml",
-      [](std::string s) { return replaced(s, "KP_5 = \"die Taste 5 im Ziffernblock\"", "KP_5 = 5"); },
-      "key_names.KP_5 is not a string");
-  expect_translation_refused(
-      "hk_keys_no_table.toml", [](std::string s) { return s.substr(0, s.find("[key_names]")); },
-      "has no [key_names] table");
-  // A key placeholder is accepted where the English text has it, and refused where it has not.
-  expect_translation_refused(
-      "hk_keys_wrong_place.toml",
-      [](std::string s) { return replaced(s, "volume_up = \"Lauter.\"", "volume_up = \"Lauter. {help_key}\""); },
-      "messages.volume_up uses {help_key}");
-}
-
-TEST(Messages, OversizedFileIsRefusedBeforeParsing) {
-  const auto path = std::filesystem::temp_directory_path() / "hk_messages_huge.toml";
-  {
-    std::ofstream f(path);
-    f << "voice = \"en\"\n# " << std::string(300 * 1024, 'x') << "\n";
-  }
-  try {
-    MessageCatalog::load(path.string());
-    ADD_FAILURE() << "loaded";
-  } catch (const MessageError& e) {
-    EXPECT_NE(std::string(e.what()).find("over the limit of 262144 bytes"), std::string::npos) << e.what();
-  }
-  std::filesystem::remove(path);
 }
 
 }  // namespace

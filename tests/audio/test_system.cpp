@@ -46,7 +46,7 @@ bool until_heard(AudioSystem& a) {
 TEST(AudioSystem, SpeaksCatalogueMessagesThroughTheMix) {
   AudioSystem a(headless());
   ASSERT_TRUE(a.speech_available());
-  a.say_text(a.messages().text(MessageId::picture_loaded, {{"picture", "1"}, {"pictures", "4"}, {"shapes", "3"}}));
+  a.say_text(a.messages().text(MessageId::picture_loaded, 3, {{"picture", "1"}, {"pictures", "4"}}));
   ASSERT_TRUE(until_heard(a));
   const std::vector<float> x = pull(a, 1.0);
   EXPECT_GT(test::rms(x, 0, x.size()), 0.01) << "the message is heard";
@@ -95,15 +95,35 @@ TEST(AudioSystem, RunsWithoutASoundCard) {
   EXPECT_EQ(a.speech_log().size(), 1u);
 }
 
-TEST(AudioSystem, TranslationChoosesItsVoiceAndBadOnesAreRefused) {
+TEST(AudioSystem, OffersItsLanguagesEachWithItsVoice) {
   AudioSystemParams p = headless();
-  p.messages_file = std::string(HK_TEST_DATA_DIR) + "/messages/de.toml";
-  AudioSystem de(p);
-  EXPECT_EQ(de.messages().voice(), "de");
-  de.say_text(de.messages().text(MessageId::volume_up));
-  EXPECT_EQ(de.speech_log().back().second, "Lauter.");
-  p.messages_file = std::string(HK_TEST_DATA_DIR) + "/messages/missing_key.toml";
-  EXPECT_THROW(AudioSystem bad(p), MessageError);
+  p.languages = {"en", "fr", "de", "es"};
+  p.language = "de";
+  AudioSystem a(p);
+  ASSERT_EQ(a.languages(), (std::vector<std::string>{"en", "fr", "de", "es"}));
+  EXPECT_EQ(a.language(), 2);
+  EXPECT_EQ(a.messages().language_name(), "Deutsch");
+  const MessageCatalog& current = a.messages();  // the reference the visitor flow keeps
+  ASSERT_TRUE(a.set_language(1));
+  EXPECT_EQ(current.language_name(), "Français");
+  EXPECT_EQ(current.voice(), "fr");
+  a.say_text(current.text(MessageId::volume_up));
+  EXPECT_EQ(a.speech_log().back().second, "Plus fort.");
+  EXPECT_FALSE(a.set_language(4));
+  EXPECT_EQ(a.language(), 1);
+}
+
+TEST(AudioSystem, ALanguageThatCannotLoadIsLeftOutAndTheDefaultFallsBack) {
+  AudioSystemParams p = headless();
+  p.languages = {"it", "fr", "EN_us"};  // no Italian catalogue; not a BCP 47 tag
+  p.language = "it";
+  AudioSystem a(p);
+  EXPECT_EQ(a.languages(), std::vector<std::string>{"fr"});
+  EXPECT_EQ(a.messages().language(), "fr");
+  p.languages = {"it"};
+  AudioSystem none(p);
+  EXPECT_EQ(none.languages(), std::vector<std::string>{"en"});
+  EXPECT_EQ(none.messages().text(MessageId::volume_up), "Louder.");
 }
 
 }  // namespace

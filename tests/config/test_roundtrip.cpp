@@ -25,7 +25,7 @@ TEST(ConfigRoundTrip, Defaults) {
 /// default, so a field missing from the table (or written or read under the wrong key) comes back as
 /// its default and fails the comparison. kFieldsSetByHand counts the assignments below; the test checks
 /// it against the table, so a field added to Settings and the table but not here fails too.
-constexpr std::size_t kFieldsSetByHand = 132;
+constexpr std::size_t kFieldsSetByHand = 135;
 
 Settings every_field_changed() {
   Settings s;
@@ -128,6 +128,8 @@ Settings every_field_changed() {
   s.kiosk.scene_cache = "/var/cache/x";
   s.kiosk.names_dir = "/var/lib/names";
   s.kiosk.say_names_on_touch = "off";
+  s.kiosk.languages = "de, en";
+  s.kiosk.language = "de";
   auto& st = s.stick;
   st.max_depth = 4;
   st.max_entries = 2000;
@@ -164,6 +166,7 @@ Settings every_field_changed() {
   k.previous_sentence = "KP_4";
   k.next_paragraph = "KP_2";
   k.previous_paragraph = "KP_8";
+  k.language = "KP_5";
   auto& o = s.operator_;
   o.open_chord = "CTRL+SHIFT+P";
   o.idle_close_s = 120;

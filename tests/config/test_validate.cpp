@@ -117,7 +117,8 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     if (name == "operator.open_chord" || name == "device.serial_path" || name == "device.usb_ids" ||
         name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" ||
         name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "kiosk.scene_cache" ||
-        name == "kiosk.names_dir" || name == "vision.ocr_languages") {
+        name == "kiosk.names_dir" || name == "vision.ocr_languages" || name == "kiosk.languages" ||
+        name == "kiosk.language") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -127,7 +128,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 41u);
+  EXPECT_EQ(texts, 44u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 

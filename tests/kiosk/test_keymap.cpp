@@ -53,7 +53,8 @@ TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
                               KioskKey::NextSentence,
                               KioskKey::PreviousSentence,
                               KioskKey::NextParagraph,
-                              KioskKey::PreviousParagraph};
+                              KioskKey::PreviousParagraph,
+                              KioskKey::Language};
   static_assert(std::size(actions) == config::kKeyActionCount);
   for (int a = 0; a < static_cast<int>(config::kKeyActionCount); ++a) {
     for (std::string_view name : config::visitor_key_names()) {
@@ -76,7 +77,8 @@ TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
                              &k.next_sentence,
                              &k.previous_sentence,
                              &k.next_paragraph,
-                             &k.previous_paragraph};
+                             &k.previous_paragraph,
+                             &k.language};
       for (int b = 0; b < static_cast<int>(config::kKeyActionCount); ++b)
         if (b != a && *slot[b] == name) *slot[b] = *slot[a];  // swap: the set stays one key per action
       *slot[a] = std::string(name);

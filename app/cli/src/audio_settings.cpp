@@ -10,14 +10,13 @@ namespace hk::app {
 
 std::string run_speak(const SpeakOptions& o) {
   const config::Settings s = o.config_path.empty() ? config::Settings{} : config::load_settings(o.config_path);
-  const audio::MessageCatalog catalog =
-      o.messages_path.empty() ? audio::MessageCatalog::english() : audio::MessageCatalog::load(o.messages_path);
+  const audio::MessageCatalog catalog = audio::MessageCatalog::load(o.language, audio::default_locale_dir());
   std::string text = o.what;
   const auto keys = key_args(s.keys);  // the keys of the settings, named as the kiosk names them
   for (int i = 0; i < audio::kMessageCount; ++i) {
-    if (audio::kMessageKeys[static_cast<std::size_t>(i)] == o.what) {
+    if (audio::message_key(static_cast<audio::MessageId>(i)) == o.what) {
       // Sample values for the placeholders, so a translator hears a whole sentence.
-      text = catalog.text(static_cast<audio::MessageId>(i),
+      text = catalog.text(static_cast<audio::MessageId>(i), 7,
                           {{"picture", "2"},
                            {"pictures", "5"},
                            {"shapes", "7"},

@@ -154,8 +154,8 @@ void add_speak_stick_pin_commands(CLI::App& cli, Commands& c) {
       ->required();
   c.speak->add_option("--wav", c.so.wav_path, "WAV file to write")->required();
   c.speak->add_option("--config", c.so.config_path, "Settings file (TOML): [audio] speech_rate_wpm");
-  c.speak->add_option("--messages", c.so.messages_path,
-                      "A translated message catalogue (see audio-cues/messages/en.toml)");
+  c.speak->add_option("--language", c.so.language,
+                      "The catalogue's language (a BCP 47 tag: en, fr, de, es; default en), its voice too");
   c.stick = cli.add_subcommand(
       "stick", "What a USB stick (a folder, or a device mounted read-only) offers, and what was refused and why");
   c.stick->add_option("folder", c.sto.folder, "A mounted stick or any folder");

@@ -34,6 +34,7 @@ const std::map<std::string, KioskKey>& action_names() {
                                                  {"previous_sentence", KioskKey::PreviousSentence},
                                                  {"next_paragraph", KioskKey::NextParagraph},
                                                  {"previous_paragraph", KioskKey::PreviousParagraph},
+                                                 {"language", KioskKey::Language},
                                                  {"other", KioskKey::Other}};
   return m;
 }

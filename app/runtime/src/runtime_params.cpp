@@ -1,6 +1,8 @@
 // The settings mapped to the servo side's parameters (runtime_params.hpp).
 #include "runtime/runtime_params.hpp"
 
+#include "hk/language.hpp"
+
 #include <algorithm>
 #include <string>
 
@@ -16,6 +18,9 @@ audio::AudioSystemParams audio_params_from(const config::Settings& s) {
   p.mixer.earcons.gain = s.audio.earcon_gain;
   p.mixer.duck_db = s.audio.duck_db;
   p.speech.voice.clear();  // the catalogue's voice
+  p.languages = language_list(s.kiosk.languages);
+  if (p.languages.empty()) p.languages = {"en"};
+  p.language = s.kiosk.language;
   p.speech.rate_wpm = s.audio.speech_rate_wpm;
   p.output.frames_per_buffer = s.audio.buffer_frames;
   p.volume_default_step = s.audio.volume_default_step;

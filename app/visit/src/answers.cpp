@@ -39,19 +39,31 @@ std::string notes_words(const PictureNotes& notes) {
 
 }  // namespace
 
-std::string region_said_name(const meaning::NamedRegion& region) {
-  return region.source == meaning::RegionSource::staff ? said_name(region.name) : region.name;
+std::string region_said_name(const meaning::NamedRegion& region, const audio::MessageCatalog& m) {
+  switch (region.source) {
+    case meaning::RegionSource::staff:
+      return said_name(region.name, m);
+    case meaning::RegionSource::face:
+      return m.word("guess_face");
+    case meaning::RegionSource::text: {
+      constexpr std::string_view kLead = "text: ";  // as meaning::guessed_region names it
+      const std::string words = region.name.rfind(kLead, 0) == 0 ? region.name.substr(kLead.size()) : region.name;
+      return m.word("guess_text", 1, {{"text", words}});
+    }
+  }
+  return region.name;
 }
 
 namespace {
 
 /// Sets each part's curve: the longest of `polylines` whose region's name is said as the part's.
 void longest_curve_of_each_part(const std::vector<meaning::NamedRegion>& regions, const std::vector<int>& shape_region,
-                                const std::vector<Polyline>& polylines, PictureNames& names) {
+                                const std::vector<Polyline>& polylines, PictureNames& names,
+                                const audio::MessageCatalog& m) {
   std::vector<double> best(names.parts.size(), 0.0);
   for (std::size_t i = 0; i < polylines.size() && i < shape_region.size(); ++i) {
     if (shape_region[i] < 0) continue;
-    const std::string name = region_said_name(regions[static_cast<std::size_t>(shape_region[i])]);
+    const std::string name = region_said_name(regions[static_cast<std::size_t>(shape_region[i])], m);
     const double len = polyline_length_m(polylines[i]);
     for (std::size_t p = 0; p < names.parts.size(); ++p)
       if (names.parts[p].name == name && len > best[p]) {
@@ -64,7 +76,8 @@ void longest_curve_of_each_part(const std::vector<meaning::NamedRegion>& regions
 }  // namespace
 
 PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, const std::vector<int>& shape_region,
-                           std::size_t curves, const vision::PxToM& px_to_m, const std::vector<Polyline>* polylines) {
+                           std::size_t curves, const vision::PxToM& px_to_m, const std::vector<Polyline>* polylines,
+                           const audio::MessageCatalog& m) {
   PictureNames out;
   if (regions.empty()) return out;
   out.shape_name.assign(curves, std::string());
@@ -78,12 +91,13 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
     if (shape_region[i] < 0) continue;
     const auto r = static_cast<std::size_t>(shape_region[i]);
     // Several shapes of one name: "one of the white spots" (a plural name), "part of the left wing".
-    const std::string name = region_said_name(regions[r]);
+    const std::string name = region_said_name(regions[r], m);
     const std::string head = name.substr(0, name.find(" of "));  // "the coins of the top row": "the coins"
     const bool plural = head.ends_with("s") || head.ends_with("ae");
     const bool shared = sharing[r] > 1 && name.rfind("the ", 0) == 0;
-    out.shape_name[i] = shared ? (plural ? "one of " : "part of ") + name : name;
-    out.part_name[i] = shared && plural ? "one of " + name : name;
+    const std::string one_of = m.word("name_one_of", 1, {{"name", name}});
+    out.shape_name[i] = shared ? (plural ? one_of : m.word("name_part_of", 1, {{"name", name}})) : name;
+    out.part_name[i] = shared && plural ? one_of : name;
   }
   std::vector<std::size_t> order(regions.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -92,7 +106,7 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
   const double m_per_px = px_to_m.scale_m_per_px;
   for (const std::size_t r : order) {
     const meaning::NamedRegion& nr = regions[r];
-    const std::string name = region_said_name(nr);
+    const std::string name = region_said_name(nr, m);
     if (name.empty() || std::any_of(out.parts.begin(), out.parts.end(), [&](const auto& p) { return p.name == name; }))
       continue;
     const cv::Moments mo = cv::moments(nr.mask, true);
@@ -104,15 +118,15 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
                          -1,
                          nr.source != meaning::RegionSource::staff});
   }
-  if (polylines && polylines->size() == curves) longest_curve_of_each_part(regions, shape_region, *polylines, out);
+  if (polylines && polylines->size() == curves) longest_curve_of_each_part(regions, shape_region, *polylines, out, m);
   return out;
 }
 
-std::string shape_words(const ShownView& shown, std::size_t curve) {
+std::string shape_words(const ShownView& shown, std::size_t curve, const audio::MessageCatalog& m) {
   if (shown.tutorial && !shown.notes.title.empty()) return shown.notes.title;  // "a square"
   if (shown.names && curve < shown.names->shape_name.size() && !shown.names->shape_name[curve].empty())
     return shown.names->shape_name[curve];
-  return describe_one_shape(shown.polylines, shown.descriptors, curve, shown.half_m, false);
+  return describe_one_shape(shown.polylines, shown.descriptors, curve, shown.half_m, false, m);
 }
 
 namespace {
@@ -132,15 +146,15 @@ bool region_holds(const ShownView& shown, int r, Vec2 hand_m) {
 
 }  // namespace
 
-std::string shape_look(const ShownView& shown, std::size_t curve) {
+std::string shape_look(const ShownView& shown, std::size_t curve, const audio::MessageCatalog& m) {
   if (shown.tutorial && !shown.notes.title.empty()) return shown.notes.title;
   if (shown.names && curve < shown.names->shape_name.size() && !shown.names->shape_name[curve].empty())
     return shown.names->shape_name[curve];
-  return describe_one_look(shown.polylines, shown.descriptors, curve, shown.half_m);
+  return describe_one_look(shown.polylines, shown.descriptors, curve, shown.half_m, m);
 }
 
 std::string where_answer(const ShownView& shown, const audio::MessageCatalog& m, Vec2 hand_m, int contact_curve) {
-  const std::string place = place_words(hand_m, shown.half_m);
+  const std::string place = place_words(hand_m, shown.half_m, m);
   if (const TextBlockM* b = text_block_at(shown.text_blocks, hand_m)) {
     const auto index = b - shown.text_blocks.data();
     return m.text(audio::MessageId::where_text,
@@ -156,7 +170,7 @@ std::string where_answer(const ShownView& shown, const audio::MessageCatalog& m,
     const Vec2 px{shown.px_to_m.u_px(hand_m.x), shown.px_to_m.v_px(hand_m.y)};
     for (const int r : meaning::regions_at(*shown.regions, px.x, px.y))
       if (region_holds(shown, r, hand_m)) {
-        part = region_said_name((*shown.regions)[static_cast<std::size_t>(r)]);
+        part = region_said_name((*shown.regions)[static_cast<std::size_t>(r)], m);
         break;
       }
   }
@@ -165,9 +179,9 @@ std::string where_answer(const ShownView& shown, const audio::MessageCatalog& m,
   const auto [number, count] =
       shape_number(shown.descriptors, shown.polylines.size(), static_cast<std::size_t>(at.curve));
   const auto curve = static_cast<std::size_t>(at.curve);
-  const bool own_part = at.on && !part.empty() && shape_look(shown, curve).find(part) == std::string::npos;
+  const bool own_part = at.on && !part.empty() && shape_look(shown, curve, m).find(part) == std::string::npos;
   // On a shape: what it is, whole; with a part under the hand, or off it, its look only (said short).
-  const std::string words = at.on && !own_part ? shape_words(shown, curve) : shape_look(shown, curve);
+  const std::string words = at.on && !own_part ? shape_words(shown, curve, m) : shape_look(shown, curve, m);
   const audio::MessageId id = own_part    ? audio::MessageId::where_on_part
                               : at.on     ? audio::MessageId::where_on
                               : at.inside ? audio::MessageId::where_inside
@@ -177,7 +191,7 @@ std::string where_answer(const ShownView& shown, const audio::MessageCatalog& m,
                      {"shapes", std::to_string(count)},
                      {"description", words},
                      {"where", place},
-                     {"direction", direction_words(hand_m, at.nearest_m)}});
+                     {"direction", direction_words(hand_m, at.nearest_m, m)}});
 }
 
 std::string describe_answer(const ShownView& shown, const audio::MessageCatalog& m, Vec2 hand_m, Vec2 proxy_m) {
@@ -185,15 +199,18 @@ std::string describe_answer(const ShownView& shown, const audio::MessageCatalog&
     // A page (or a picture of one): the block of text under the hand is read; elsewhere, what the page holds.
     if (const TextBlockM* b = text_block_at(shown.text_blocks, proxy_m))
       return m.text(audio::MessageId::text_block, {{"text", name_unclear_words(b->text, m)}});
-    const std::string page = describe_page(static_cast<int>(shown.text_blocks.size()), count_figures(shown.polylines));
+    const std::string page =
+        describe_page(static_cast<int>(shown.text_blocks.size()), count_figures(shown.polylines), m);
     return shown.polylines.empty()
                ? page
-               : page + " " + describe_scene(shown.polylines, shown.descriptors, shown.half_m, 3, hand_m, shown.names);
+               : page + " " +
+                     describe_scene(shown.polylines, shown.descriptors, shown.half_m, 3, hand_m, shown.names, m);
   }
   if (shown.tutorial && !shown.notes.title.empty())  // a practice shape: "A square, in the middle."
-    return sentence_case(shown.notes.title + ", " + place_words({0.0, 0.0}, shown.half_m) + ".");
+    return sentence_case(
+        m.word("shape_at", 1, {{"shape", shown.notes.title}, {"place", place_words({0.0, 0.0}, shown.half_m, m)}}));
   return notes_words(shown.notes) +
-         describe_scene(shown.polylines, shown.descriptors, shown.half_m, 3, hand_m, shown.names);
+         describe_scene(shown.polylines, shown.descriptors, shown.half_m, 3, hand_m, shown.names, m);
 }
 
 }  // namespace hk::app

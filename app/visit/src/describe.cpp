@@ -9,6 +9,8 @@
 #include <string>
 #include <utility>
 
+#include "hk/text.hpp"
+
 namespace hk::app {
 namespace {
 
@@ -113,67 +115,90 @@ std::vector<Shape> shapes_of(const std::vector<Polyline>& curves, const std::vec
   return shapes;
 }
 
-const char* size_word(double diag_m, Vec2 half) {
+const char* size_key(double diag_m, Vec2 half) {
   const double ws = 2.0 * length(half);
   return diag_m > 0.4 * ws ? "large" : (diag_m > 0.15 * ws ? "medium" : "small");
 }
 
-const char* kCornerWords[] = {"", "", "", "three", "four", "five", "six", "seven", "eight"};
-
-/// The form as words before a noun, and the noun: {"round", "shape"}, {"", "square"}, {"straight", "line"}.
-std::pair<std::string, std::string> form_words(const meaning::ShapeDescriptor& d) {
+/// The look_* / gender_* ending of a form ("round", "square", "polygon", "straight", "shape", …).
+std::string form_ending(const meaning::ShapeDescriptor& d) {
   using meaning::Form;
   switch (d.form.form) {
     case Form::round:
-      return {"round", "shape"};
+      return "round";
     case Form::oval:
-      return {"oval", "shape"};
+      return "oval";
     case Form::square:
-      return {"", "square"};
+      return "square";
     case Form::rectangle:
-      return {"", "rectangle"};
+      return "rectangle";
     case Form::triangle:
-      return {"", "triangle"};
+      return "triangle";
     case Form::star:
-      return {"", "star"};
+      return "star";
     case Form::polygon:
-      return {d.form.corners >= 3 && d.form.corners <= 8 ? std::string(kCornerWords[d.form.corners]) + "-cornered" : "",
-              "shape"};
+      return d.form.corners >= 4 && d.form.corners <= 8 ? "polygon" : "shape";
     case Form::straight_line:
-      return {"straight", "line"};
+      return "straight";
     case Form::curve:
-      return {d.form.corners > 0 ? "bent" : "curved", "line"};
+      return d.form.corners > 0 ? "bent" : "curved";
     case Form::irregular:
       break;
   }
-  return {"", "shape"};
+  return "shape";
 }
 
-/// What a shape looks like without an article: "small white round shape" (`count` > 1: "small white round
-/// shapes"); `shade` false leaves out light and dark ("small blue square" for a light blue one).
-std::string look_words(const Shape& s, const meaning::ShapeDescriptor& d, Vec2 half, int count = 1, bool shade = true) {
-  std::string out = size_word(s.diag_m, half);
-  if (d.has_colour)
-    out += " " + meaning::colour_words(shade ? d.colour : meaning::ColourName{d.colour.colour, meaning::Shade::plain});
-  const auto [adjective, noun] = form_words(d);
-  if (!adjective.empty()) out += " " + adjective;
-  return out + " " + noun + (count > 1 ? "s" : "");
+/// What makes shapes alike: the same size word, colour term and form.
+struct LookKey {
+  std::string size, form;
+  int corners = 0;
+  bool has_colour = false;
+  meaning::BasicColour colour = meaning::BasicColour::grey;
+  bool operator==(const LookKey&) const = default;
+};
+
+LookKey look_key(const Shape& s, const meaning::ShapeDescriptor& d, Vec2 half) {
+  return {size_key(s.diag_m, half), form_ending(d), d.form.form == meaning::Form::polygon ? d.form.corners : 0,
+          d.has_colour, d.colour.colour};
 }
 
-/// "a" or "an" before `words`.
-std::string with_article(const std::string& words) {
-  const bool vowel = !words.empty() && std::string("aeiou").find(words[0]) != std::string::npos;
-  return (vowel ? "an " : "a ") + words;
+/// A shape's look as the catalogue says it: "a small white round shape" (`count` > 1: "26 small white round
+/// shapes"); `shade` false leaves out light and dark ("small blue square" for a light blue one). The size and
+/// colour words take the gender of the form's noun (gender_*) and the number of `count`.
+std::string look_words(const audio::MessageCatalog& m, const LookKey& k, meaning::Shade shade, int count = 1) {
+  const std::string gender = m.word("gender_" + k.form);
+  const std::string g = gender == "m" || gender == "f" ? gender : "n";
+  std::string colour;
+  if (k.has_colour) {
+    colour = m.word("colour_" + std::string(meaning::colour_key(k.colour)) + "_" + g, count);
+    if (shade != meaning::Shade::plain)
+      colour = m.word(shade == meaning::Shade::light ? "shade_light" : "shade_dark", count, {{"colour", colour}});
+  }
+  return m.word("look_" + k.form, count,
+                {{"size", m.word("size_" + k.size + "_" + g, count)},
+                 {"colour", colour},
+                 {"corners", std::to_string(k.corners)}});
 }
 
 /// Shapes said together: alike in size word, colour term and form (their shade said only when they share it).
 struct Group {
-  std::string key;                   // look_words without the shade: what makes shapes alike
-  std::string look, looks;           // as said, singular and plural
-  std::vector<std::size_t> members;  // indices into the shapes
+  LookKey key;
+  meaning::Shade shade = meaning::Shade::plain;  // the members' shade, plain when they differ
+  std::vector<std::size_t> members;              // indices into the shapes
   double max_diag_m = 0;
-  std::string place;  // the members' place (place_words), or "across the picture" when they differ
+  std::string place;  // the members' place key (place_key), or "across" when they differ
 };
+
+/// The place_* key of point `c` in the 3 x 3 grid of the workspace ("far_left", …, "near_right").
+std::string place_key(Vec2 c, Vec2 half) {
+  // Thirds of the workspace; +y is away from the visitor: far. (Up on the screen, but a visitor who
+  // cannot see it knows only near and far.)
+  const int col = c.x < -half.x / 3 ? 0 : (c.x > half.x / 3 ? 2 : 1);
+  const int row = c.y > half.y / 3 ? 0 : (c.y < -half.y / 3 ? 2 : 1);
+  static const char* const keys[3][3] = {
+      {"far_left", "far_middle", "far_right"}, {"left", "middle", "right"}, {"near_left", "near_middle", "near_right"}};
+  return keys[row][col];
+}
 
 /// The shapes `members` (indices into `all`) in groups of alike ones, in the order of their first member.
 std::vector<Group> group_alike(const std::vector<Shape>& all, const std::vector<std::size_t>& members,
@@ -182,18 +207,15 @@ std::vector<Group> group_alike(const std::vector<Shape>& all, const std::vector<
   for (const std::size_t i : members) {
     const Shape& s = all[i];
     const meaning::ShapeDescriptor& d = ds[s.curve];
-    const std::string key = look_words(s, d, half, 1, false);
-    const std::string place = place_words(s.centre_m, half);
+    const LookKey key = look_key(s, d, half);
+    const std::string place = place_key(s.centre_m, half);
     auto g = std::find_if(groups.begin(), groups.end(), [&](const Group& x) { return x.key == key; });
     if (g == groups.end()) {
-      groups.push_back({key, look_words(s, d, half), look_words(s, d, half, 2), {}, 0.0, place});
+      groups.push_back({key, d.has_colour ? d.colour.shade : meaning::Shade::plain, {}, 0.0, place});
       g = groups.end() - 1;
     } else {
-      if (g->look != look_words(s, d, half)) {  // shades differ: the colour term alone
-        g->look = key;
-        g->looks = look_words(s, d, half, 2, false);
-      }
-      if (g->place != place) g->place = "across the picture";
+      if (g->shade != d.colour.shade) g->shade = meaning::Shade::plain;  // shades differ: the colour term alone
+      if (g->place != place) g->place = "across";
     }
     g->members.push_back(i);
     g->max_diag_m = std::max(g->max_diag_m, s.diag_m);
@@ -202,14 +224,14 @@ std::vector<Group> group_alike(const std::vector<Shape>& all, const std::vector<
 }
 
 /// A group as said: "a small white round shape" or "26 small white round shapes".
-std::string group_words(const Group& g) {
-  return g.members.size() == 1 ? with_article(g.look) : std::to_string(g.members.size()) + " " + g.looks;
+std::string group_words(const audio::MessageCatalog& m, const Group& g) {
+  return look_words(m, g.key, g.shade, static_cast<int>(g.members.size()));
 }
 
-/// What lies inside shape `index` (at any depth), as groups: " with 26 small white round shapes inside it",
-/// " with a small red square and 2 small blue triangles inside it", " with 9 smaller shapes inside it" when they
-/// are of more than two kinds; "" when nothing is.
-std::string inside_words(const std::vector<Shape>& all, std::size_t index,
+/// What lies inside shape `index` (at any depth), as groups: "26 small white round shapes", "a small red
+/// square and 2 small blue triangles", "9 smaller shapes" when they are of more than two kinds; "" when
+/// nothing is.
+std::string inside_words(const audio::MessageCatalog& m, const std::vector<Shape>& all, std::size_t index,
                          const std::vector<meaning::ShapeDescriptor>& ds, Vec2 half) {
   std::vector<std::size_t> within;
   for (std::size_t i = 0; i < all.size(); ++i)
@@ -220,22 +242,16 @@ std::string inside_words(const std::vector<Shape>& all, std::size_t index,
       }
   if (within.empty()) return "";
   const std::vector<Group> groups = group_alike(all, within, ds, half);
-  if (groups.size() == 1) return " with " + group_words(groups[0]) + " inside it";
-  if (groups.size() == 2) return " with " + group_words(groups[0]) + " and " + group_words(groups[1]) + " inside it";
-  return " with " + std::to_string(within.size()) + " smaller shapes inside it";
+  if (groups.size() == 1) return group_words(m, groups[0]);
+  if (groups.size() == 2)
+    return m.word("list_two", 1, {{"first", group_words(m, groups[0])}, {"second", group_words(m, groups[1])}});
+  return m.word("inside_many", static_cast<long>(within.size()));
 }
 
 }  // namespace
 
-std::string place_words(Vec2 c, Vec2 half) {
-  // Thirds of the workspace; +y is away from the visitor: far. (Up on the screen, but a visitor who
-  // cannot see it knows only near and far.)
-  const int col = c.x < -half.x / 3 ? 0 : (c.x > half.x / 3 ? 2 : 1);
-  const int row = c.y > half.y / 3 ? 0 : (c.y < -half.y / 3 ? 2 : 1);
-  static const char* const names[3][3] = {{"at the far left", "in the far middle", "at the far right"},
-                                          {"on the left", "in the middle", "on the right"},
-                                          {"at the near left", "in the near middle", "at the near right"}};
-  return names[row][col];
+std::string place_words(Vec2 c, Vec2 half, const audio::MessageCatalog& m) {
+  return m.word("place_" + place_key(c, half));
 }
 
 ShapeAtHand shape_at_hand(const std::vector<Polyline>& curves, const std::vector<meaning::ShapeDescriptor>& descriptors,
@@ -281,18 +297,17 @@ ShapeAtHand shape_at_hand(const std::vector<Polyline>& curves, const std::vector
 
 bool shape_holds(const Polyline& c, Vec2 p_m) { return holds(c, p_m); }
 
-std::string direction_words(Vec2 from, Vec2 to) {
+std::string direction_words(Vec2 from, Vec2 to, const audio::MessageCatalog& m) {
   const Vec2 v = to - from;
   const double d = length(v);
   const std::string how_far =
-      d < 0.01 ? "less than a centimetre" : std::to_string(static_cast<int>(std::lround(d * 100.0))) + " cm";
+      d < 0.01 ? m.word("distance_under_cm") : m.word("distance_cm", static_cast<long>(std::lround(d * 100.0)));
   // Eight sectors of 45°, +x (right) at 0°, +y (far) at 90°.
   const double deg = std::atan2(v.y, v.x) * 180.0 / std::numbers::pi;
   const int sector = static_cast<int>(std::lround(deg / 45.0)) & 7;
-  static const char* const ways[8] = {
-      "to your right", "farther away, to your right", "farther away",  "farther away, to your left",
-      "to your left",  "nearer to you, to your left", "nearer to you", "nearer to you, to your right"};
-  return how_far + " " + ways[sector];
+  static const char* const ways[8] = {"way_right", "way_far_right", "way_far",  "way_far_left",
+                                      "way_left",  "way_near_left", "way_near", "way_near_right"};
+  return m.word("direction", 1, {{"distance", how_far}, {"way", m.word(ways[sector])}});
 }
 
 std::pair<int, int> shape_number(const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t curves,
@@ -309,32 +324,38 @@ std::pair<int, int> shape_number(const std::vector<meaning::ShapeDescriptor>& de
 
 std::string describe_one_shape(const std::vector<Polyline>& curves,
                                const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t index, Vec2 half,
-                               bool with_place) {
+                               bool with_place, const audio::MessageCatalog& m) {
   const std::vector<meaning::ShapeDescriptor> ds = descriptors_for(curves, descriptors);
   const std::vector<Shape> all = shapes_of(curves, ds);
   const auto it = std::find_if(all.begin(), all.end(), [&](const Shape& s) { return s.curve == index; });
-  if (it == all.end()) return "a speck";
+  if (it == all.end()) return m.word("look_speck");
   const Shape& s = *it;
-  const std::string out = with_article(look_words(s, ds[s.curve], half)) +
-                          inside_words(all, static_cast<std::size_t>(it - all.begin()), ds, half);
-  return with_place ? out + ", " + place_words(s.centre_m, half) : out;
+  const meaning::ShapeDescriptor& d = ds[s.curve];
+  const std::string look = look_words(m, look_key(s, d, half), d.has_colour ? d.colour.shade : meaning::Shade::plain);
+  const std::string inside = inside_words(m, all, static_cast<std::size_t>(it - all.begin()), ds, half);
+  const std::string place = place_words(s.centre_m, half, m);
+  if (inside.empty()) return with_place ? m.word("shape_place", 1, {{"shape", look}, {"place", place}}) : look;
+  return with_place ? m.word("shape_inside_place", 1, {{"shape", look}, {"inside", inside}, {"place", place}})
+                    : m.word("shape_inside", 1, {{"shape", look}, {"inside", inside}});
 }
 
 std::string describe_one_look(const std::vector<Polyline>& curves,
-                              const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t index, Vec2 half) {
+                              const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t index, Vec2 half,
+                              const audio::MessageCatalog& m) {
   const std::vector<meaning::ShapeDescriptor> ds = descriptors_for(curves, descriptors);
-  if (index >= curves.size() || curves[index].points_m.empty() || ds[index].speck) return "a speck";
+  if (index >= curves.size() || curves[index].points_m.empty() || ds[index].speck) return m.word("look_speck");
   const auto [lo, hi] = bounds_of(curves[index]);
   const Shape s{length(hi - lo), 0.5 * (lo + hi), lo, hi, curves[index].closed, index};
-  return with_article(look_words(s, ds[index], half));
+  const meaning::ShapeDescriptor& d = ds[index];
+  return look_words(m, look_key(s, d, half), d.has_colour ? d.colour.shade : meaning::Shade::plain);
 }
 
-std::string said_name(const std::string& name) {
+std::string said_name(const std::string& name, const audio::MessageCatalog& m) {
   if (name.empty()) return name;
   const unsigned char c = static_cast<unsigned char>(name[0]);
   for (const char* article : {"the ", "a ", "an "})
     if (name.rfind(article, 0) == 0) return name;
-  return c < 0x80 && std::islower(c) ? "the " + name : name;
+  return c < 0x80 && std::islower(c) ? m.word("name_the", 1, {{"name", name}}) : name;
 }
 
 namespace {
@@ -357,68 +378,77 @@ std::vector<std::size_t> ordered_top(const std::vector<Shape>& all, const std::v
   return top;
 }
 
-/// Up to `max_named` of `groups` said, the rest counted ("and 4 more, smaller ones."): the list after "N shapes. ".
-/// `told` counts the shapes already spoken of (the nested ones of a single shape said with it); `lead` opens
-/// the list ("Nearest your hand, "), its first letter made a capital.
-std::string list_groups(const std::vector<Group>& groups, const std::vector<Shape>& all, std::size_t count,
-                        std::size_t told, const std::vector<meaning::ShapeDescriptor>& ds, Vec2 half, int max_named,
-                        const std::string& lead, bool with_inside) {
+/// Items joined as the catalogue joins a list: "A", "A, and B", "A, B, and C" (list_next, list_last).
+std::string join_list(const audio::MessageCatalog& m, const std::vector<std::string>& items, bool last_is_end) {
   std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i == 0)
+      out = items[0];
+    else
+      out = m.word(i + 1 == items.size() && last_is_end ? "list_last" : "list_next", 1,
+                   {{"list", out}, {"item", items[i]}});
+  }
+  return out;
+}
+
+/// Up to `max_named` of `groups` said, the rest counted ("and 4 more, smaller ones."): the list after "N shapes. ".
+/// `told` counts the shapes already spoken of (the nested ones of a single shape said with it); `lead` (a
+/// scene_* key, or "") opens the list ("Nearest your hand, "), its first letter made a capital.
+std::string list_groups(const audio::MessageCatalog& m, const std::vector<Group>& groups, const std::vector<Shape>& all,
+                        std::size_t count, std::size_t told, const std::vector<meaning::ShapeDescriptor>& ds, Vec2 half,
+                        int max_named, const char* lead, bool with_inside) {
   const std::size_t named = std::min<std::size_t>(groups.size(), static_cast<std::size_t>(std::max(1, max_named)));
   double smallest_named = std::numeric_limits<double>::infinity();
+  std::vector<std::string> items;
   for (std::size_t i = 0; i < named; ++i) {
     const Group& g = groups[i];
-    std::string part = group_words(g);
-    if (i == 0) {
-      part = sentence_case(lead + part);
-    }
+    const std::string look = group_words(m, g);
+    const std::string place = m.word("place_" + g.place);
     const std::size_t m0 = g.members[0];
     told += g.members.size();
+    std::string inside;
     if (with_inside) {
-      for (const std::size_t m : g.members) told += static_cast<std::size_t>(all[m].inside);
-      if (g.members.size() == 1) part += inside_words(all, m0, ds, half) + (all[m0].inside ? "," : "");
+      for (const std::size_t k : g.members) told += static_cast<std::size_t>(all[k].inside);
+      if (g.members.size() == 1) inside = inside_words(m, all, m0, ds, half);
     }
-    part += " " + g.place;
+    items.push_back(inside.empty()
+                        ? m.word("shape_place", 1, {{"shape", look}, {"place", place}})
+                        : m.word("shape_inside_place", 1, {{"shape", look}, {"inside", inside}, {"place", place}}));
     smallest_named = std::min(smallest_named, g.max_diag_m);
-    if (i > 0) out += (i + 1 == named && told >= count) ? ", and " : ", ";
-    out += part;
   }
-  if (told >= count) return out + ".";
+  std::string list = join_list(m, items, told >= count);
+  if (*lead) list = m.word(lead, 1, {{"list", list}});
+  list = sentence_case(list);
+  if (told >= count) return m.word("list_end", 1, {{"list", list}});
   const std::size_t rest = count - told;
   bool smaller = true;
   for (std::size_t i = named; i < groups.size(); ++i) smaller = smaller && groups[i].max_diag_m < smallest_named;
-  return out + ", and " + std::to_string(rest) + " more" +
-         (smaller ? (rest == 1 ? ", smaller." : ", smaller ones.") : ".");
+  return m.word(smaller ? "list_rest_smaller" : "list_rest", static_cast<long>(rest), {{"list", list}});
 }
 
 /// The named parts, largest first, each with its place: "The left wing on the left, and the body in the middle."
-std::string named_parts_words(const PictureNames& names, Vec2 half) {
-  std::string out;
-  for (std::size_t i = 0; i < names.parts.size(); ++i) {
-    std::string part = names.parts[i].name + " " + place_words(names.parts[i].centre_m, half);
-    if (i == 0) part = sentence_case(part);
-    if (i > 0) out += i + 1 == names.parts.size() ? ", and " : ", ";
-    out += part;
-  }
-  return out + ".";
+std::string named_parts_words(const audio::MessageCatalog& m, const PictureNames& names, Vec2 half) {
+  std::vector<std::string> items;
+  for (const PictureNames::Part& part : names.parts)
+    items.push_back(m.word("shape_place", 1, {{"shape", part.name}, {"place", place_words(part.centre_m, half, m)}}));
+  return m.word("list_end", 1, {{"list", sentence_case(join_list(m, items, true))}});
 }
 
 }  // namespace
 
 std::string describe_scene(const std::vector<Polyline>& curves,
                            const std::vector<meaning::ShapeDescriptor>& descriptors, Vec2 half, int max_named,
-                           std::optional<Vec2> hand_m, const PictureNames* names) {
+                           std::optional<Vec2> hand_m, const PictureNames* names, const audio::MessageCatalog& m) {
   const std::vector<meaning::ShapeDescriptor> ds = descriptors_for(curves, descriptors);
   const std::vector<Shape> all = shapes_of(curves, ds);
   const bool named = names && !names->parts.empty();
-  if (all.empty() && !named) return "There are no shapes in this picture.";
-  std::string out = all.size() == 1 ? "One shape. " : std::to_string(all.size()) + " shapes. ";
-  if (all.empty()) out.clear();
+  if (all.empty() && !named) return m.word("scene_none");
+  std::string out = all.empty() ? std::string() : m.word("scene_count", static_cast<long>(all.size())) + " ";
   if (!named)  // shapes alike said together
-    return out + list_groups(group_alike(all, ordered_top(all, curves, hand_m), ds, half), all, all.size(), 0, ds, half,
-                             max_named, hand_m ? "Nearest your hand, " : "", true);
+    return out + list_groups(m, group_alike(all, ordered_top(all, curves, hand_m), ds, half), all, all.size(), 0, ds,
+                             half, max_named, hand_m ? "scene_nearest" : "", true);
   // Named parts first; then the shapes without a name, in groups, wherever they lie.
-  out += named_parts_words(*names, half);
+  out += named_parts_words(m, *names, half);
   std::vector<std::size_t> unnamed;
   for (std::size_t i = 0; i < all.size(); ++i)
     if (names->shape_name.size() != curves.size() || names->shape_name[all[i].curve].empty()) unnamed.push_back(i);
@@ -426,7 +456,8 @@ std::string describe_scene(const std::vector<Polyline>& curves,
                    [&](std::size_t a, std::size_t b) { return all[a].diag_m > all[b].diag_m; });
   if (unnamed.empty()) return out;
   return out + " " +
-         list_groups(group_alike(all, unnamed, ds, half), all, unnamed.size(), 0, ds, half, max_named, "Also ", false);
+         list_groups(m, group_alike(all, unnamed, ds, half), all, unnamed.size(), 0, ds, half, max_named, "scene_also",
+                     false);
 }
 
 int count_figures(const std::vector<Polyline>& curves, double margin_m) {
@@ -458,22 +489,16 @@ int count_figures(const std::vector<Polyline>& curves, double margin_m) {
   return groups;
 }
 
-std::string sentence_case(std::string text) {
-  if (!text.empty() && text[0] >= 'a' && text[0] <= 'z') text[0] = static_cast<char>(text[0] - 'a' + 'A');
-  return text;
+std::string sentence_case(std::string text) { return hk::capitalised(std::move(text)); }
+
+std::string describe_shapes(int shapes, const audio::MessageCatalog& m) {
+  return shapes == 0 ? m.word("shapes_none") : m.word("shapes", shapes);
 }
 
-std::string describe_shapes(int shapes) {
-  if (shapes == 0) return "I found no shapes in it.";
-  return shapes == 1 ? "It has one shape." : "It has " + std::to_string(shapes) + " shapes.";
-}
-
-std::string describe_page(int text_blocks, int figures) {
-  auto count = [](int n, const char* one, const char* many, const char* none) {
-    return n == 0 ? std::string(none) : n == 1 ? std::string(one) : std::to_string(n) + " " + many;
-  };
-  return "It has " + count(text_blocks, "one block of text", "blocks of text", "no text") + " and " +
-         count(figures, "one figure", "figures", "no figures") + ".";
+std::string describe_page(int text_blocks, int figures, const audio::MessageCatalog& m) {
+  return m.word("page_holds", 1,
+                {{"blocks", text_blocks == 0 ? m.word("page_no_text") : m.word("page_blocks", text_blocks)},
+                 {"figures", figures == 0 ? m.word("page_no_figures") : m.word("page_figures", figures)}});
 }
 
 }  // namespace hk::app

@@ -49,7 +49,8 @@ constexpr std::array<MessageId, static_cast<std::size_t>(KioskKey::Other)> kKeyD
                                                                                     MessageId::key_next_sentence,
                                                                                     MessageId::key_previous_sentence,
                                                                                     MessageId::key_next_paragraph,
-                                                                                    MessageId::key_previous_paragraph};
+                                                                                    MessageId::key_previous_paragraph,
+                                                                                    MessageId::key_language};
 
 }  // namespace
 
@@ -103,6 +104,10 @@ std::string KioskFlow::text(MessageId id, std::initializer_list<audio::MessageAr
   return msg_.text(id, args, key_args(p_.keys));
 }
 
+std::string KioskFlow::counted(MessageId id, long count, std::initializer_list<audio::MessageArg> args) const {
+  return msg_.text(id, count, args, key_args(p_.keys));
+}
+
 void KioskFlow::say(MessageId id, std::initializer_list<audio::MessageArg> args) { fx_.speech.say(text(id, args)); }
 
 void KioskFlow::say_brief(MessageId id, std::initializer_list<audio::MessageArg> args) {
@@ -142,7 +147,8 @@ void KioskFlow::key(KioskKey k, double now_s, std::string_view key_name) {
 
 void KioskFlow::act_on_key(KioskKey k, double now_s, std::string_view key_name) {
   if (v_.state == KioskState::Attract) {
-    wake(now_s);
+    // The Language key answers the invitation just heard: the visit starts in its language.
+    wake(now_s, k == KioskKey::Language);
     return;
   }
   activity(now_s);
@@ -233,6 +239,9 @@ bool KioskFlow::session_key(KioskKey k, double now_s) {
     case KioskKey::Finish:
       finish_key(now_s);
       return true;
+    case KioskKey::Language:
+      language_key();
+      return true;
     default:
       return false;
   }
@@ -243,6 +252,12 @@ void KioskFlow::volume_key(int delta) {
   const bool changed = fx_.session.change_volume(delta);
   if (fx_.speech.speaking()) return;
   say_brief(!changed ? MessageId::volume_limit : delta > 0 ? MessageId::volume_up : MessageId::volume_down);
+}
+
+void KioskFlow::language_key() {
+  const int n = fx_.speech.language_count();
+  if (n > 1) fx_.speech.set_language((fx_.speech.language() + 1) % n);
+  say(MessageId::language_name);  // in itself: "Français"
 }
 
 void KioskFlow::finish_key(double now_s) {
@@ -283,9 +298,7 @@ std::string KioskFlow::long_text_line(const std::string& said) const {
   const double seconds = spoken_seconds(said);
   if (seconds <= kLongText_s) return {};
   const int minutes = static_cast<int>(std::lround(seconds / 60.0));
-  return (minutes <= 1 ? text(MessageId::long_text_minute)
-                       : text(MessageId::long_text_minutes, {{"minutes", std::to_string(minutes)}})) +
-         " ";
+  return counted(MessageId::long_text_minutes, std::max(1, minutes)) + " ";
 }
 
 double spoken_seconds(std::string_view text) {
@@ -502,25 +515,36 @@ void KioskFlow::announce_picture(int shapes, const std::string& before) {
   std::string line;
   if (!title.empty()) {
     // A person's words first: "Picture 2 of 5: a horse, seen from the side. It has 2 shapes."
-    const MessageId id = shapes == 0   ? MessageId::picture_titled_empty
-                         : shapes == 1 ? MessageId::picture_titled_one
-                                       : MessageId::picture_titled;
-    line = text(id, {{"picture", num}, {"pictures", total}, {"title", title}, {"shapes", std::to_string(shapes)}});
+    line = shapes == 0
+               ? text(MessageId::picture_titled_empty, {{"picture", num}, {"pictures", total}, {"title", title}})
+               : counted(MessageId::picture_titled, shapes, {{"picture", num}, {"pictures", total}, {"title", title}});
   } else if (shapes == 0) {
     line = text(MessageId::picture_empty, {{"picture", num}, {"pictures", total}});
-  } else if (shapes == 1) {
-    line = text(MessageId::picture_loaded_one, {{"picture", num}, {"pictures", total}});
   } else {
-    line = text(MessageId::picture_loaded, {{"picture", num}, {"pictures", total}, {"shapes", std::to_string(shapes)}});
+    line = counted(MessageId::picture_loaded, shapes, {{"picture", num}, {"pictures", total}});
   }
   fx_.speech.say(before.empty() ? line : before + " " + line);
 }
 
-void KioskFlow::wake(double now_s) {
+void KioskFlow::wake(double now_s, bool keep_language) {
+  if (!keep_language) fx_.speech.set_language(fx_.speech.default_language());
   activity(now_s);
   v_.help_layer = 0;
   start_tutorial();
   say(MessageId::welcome);
+}
+
+void KioskFlow::invite() {
+  // One language an invitation, in turn, from the default: each offers its own language's key.
+  const int n = fx_.speech.language_count();
+  if (n <= 1) {
+    say_brief(MessageId::attract);
+    return;
+  }
+  v_.invitation_language =
+      v_.invitation_language < 0 ? fx_.speech.default_language() : (v_.invitation_language + 1) % n;
+  fx_.speech.set_language(v_.invitation_language);
+  fx_.speech.say_brief(text(MessageId::attract) + " " + text(MessageId::language_offer));
 }
 
 void KioskFlow::end_session(double now_s) {
@@ -529,13 +553,14 @@ void KioskFlow::end_session(double now_s) {
   if (v_.source == KioskSource::Stick || !v_.stick.empty()) fx_.sticks.forget_stick();
   v_ = Visit{};
   v_.next_invitation_s = now_s + p_.attract_every_s;
-  say_brief(MessageId::goodbye);
+  say_brief(MessageId::goodbye);  // in the visitor's language; the next visit starts in the default
+  fx_.speech.set_language(fx_.speech.default_language());
 }
 
 void KioskFlow::handle_moved(double now_s) {
   guarded("handle motion", [&] {
     if (v_.state == KioskState::Attract) {
-      wake(now_s);
+      wake(now_s, false);
       return;
     }
     activity(now_s);
@@ -560,7 +585,7 @@ void KioskFlow::tick(double now_s) {
     if (v_.state == KioskState::Attract) {
       if (p_.attract_every_s > 0 && now_s >= v_.next_invitation_s) {
         v_.next_invitation_s = now_s + p_.attract_every_s;
-        if (!fx_.speech.quiet_hours()) say_brief(MessageId::attract);
+        if (!fx_.speech.quiet_hours()) invite();
       }
       return;
     }

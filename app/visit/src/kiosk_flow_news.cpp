@@ -32,10 +32,8 @@ void KioskFlow::capture_done_now(int shapes, double now_s) {
   v_.captured = true;
   if (shapes == 0) {
     say(MessageId::captured_empty);
-  } else if (shapes == 1) {
-    say(MessageId::captured_one);
   } else {
-    say(MessageId::captured, {{"shapes", std::to_string(shapes)}});
+    fx_.speech.say(counted(MessageId::captured, shapes));
   }
 }
 
@@ -129,8 +127,7 @@ void KioskFlow::stick_inserted(const std::vector<StickEntry>& documents, double 
 
 std::string KioskFlow::unreadable_line(int unreadable) const {
   if (unreadable <= 0) return {};
-  return " " + (unreadable == 1 ? text(MessageId::file_unreadable)
-                                : text(MessageId::files_unreadable, {{"count", std::to_string(unreadable)}}));
+  return " " + counted(MessageId::files_unreadable, unreadable);
 }
 
 void KioskFlow::stick_inserted_now(const std::vector<StickEntry>& documents, double now_s, int unreadable) {

@@ -28,8 +28,7 @@ std::string name_unclear_words(std::string_view text, const audio::MessageCatalo
       if (text.compare(k, mark.size(), mark) != 0) break;
       j = k;
     }
-    out += run == 1 ? messages.text(audio::MessageId::unclear_word)
-                    : messages.text(audio::MessageId::unclear_words, {{"count", std::to_string(run)}});
+    out += messages.text(audio::MessageId::unclear_words, run);
     i = j;
   }
   return out;

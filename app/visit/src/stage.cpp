@@ -67,7 +67,8 @@ void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes,
   sh.descriptors = is.descriptors;
   sh.regions = is.regions;
   sh.shape_region = is.shape_region;
-  sh.names = picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m, &is.polylines);
+  sh.names =
+      picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m, &is.polylines, audio_.messages());
   sh.picture = is.picture;  // the pixels the scene was built from (a picture file decoded once, reduced)
   sh.image_path = is.image_path;
   sh.file_width_px = is.file_width_px > 0 ? is.file_width_px : is.picture.cols;
@@ -151,9 +152,9 @@ void Stage::text_arrived(TextRead& read) {
   const bool said_reading = text_said_;
   if (built) show(is, read.id, source_, shown_.notes);  // the fade: no force step as the letters' curves go
   if (built && !is.text_blocks.empty()) {
-    text_news_ =
-        m.text(audio::MessageId::text_ready,
-               {{"description", describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))}});
+    text_news_ = m.text(audio::MessageId::text_ready,
+                        {{"description", describe_page(static_cast<int>(is.text_blocks.size()),
+                                                       count_figures(is.polylines), audio_.messages())}});
   } else if (is.ocr.why.rfind("failed", 0) == 0 || !built) {
     text_news_ = m.text(audio::MessageId::text_unavailable);
   } else if (said_reading) {
@@ -163,7 +164,8 @@ void Stage::text_arrived(TextRead& read) {
 
 void Stage::set_names(std::vector<meaning::NamedRegion> regions, std::vector<int> shape_region) {
   if (shape_region.size() != shown_.polylines.size()) return;
-  shown_.names = picture_names(regions, shape_region, shown_.polylines.size(), shown_.px_to_m, &shown_.polylines);
+  shown_.names = picture_names(regions, shape_region, shown_.polylines.size(), shown_.px_to_m, &shown_.polylines,
+                               audio_.messages());
   shown_.regions = std::move(regions);
   shown_.shape_region = std::move(shape_region);
 }
@@ -182,7 +184,7 @@ std::string Stage::where() {
   return where_answer(view(), audio_.messages(), d.handle_m, d.scene_id == shown_id_ ? d.curve : -1) + far_near;
 }
 
-std::string Stage::shape_words(std::size_t curve) const { return app::shape_words(view(), curve); }
+std::string Stage::shape_words(std::size_t curve) const { return app::shape_words(view(), curve, audio_.messages()); }
 
 std::string Stage::describe() {
   // Its text still being read: said first, so the visitor knows more is coming.

@@ -80,10 +80,11 @@ void StickDesk::loaded(LoadedDocument& d, KioskFlow& flow, double now_s) {
     // A page, or a picture of one (its text read): blocks of text and figures; its text still being read:
     // said so at once; else shapes.
     const bool said_reading = is.text_pending && is.text_likely;
-    r.description = said_reading ? audio_.messages().text(audio::MessageId::text_reading)
-                    : is.page > 0 || !is.text_blocks.empty()
-                        ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines))
-                        : describe_shapes(static_cast<int>(is.scene->curve_count()));
+    r.description =
+        said_reading ? audio_.messages().text(audio::MessageId::text_reading)
+        : is.page > 0 || !is.text_blocks.empty()
+            ? describe_page(static_cast<int>(is.text_blocks.size()), count_figures(is.polylines), audio_.messages())
+            : describe_shapes(static_cast<int>(is.scene->curve_count()), audio_.messages());
     stage_.show(is, id, ShownSource{-1, d.document, is.page}, {}, said_reading);
   } else {
     r.reason = d.reason;

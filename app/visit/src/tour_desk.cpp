@@ -141,10 +141,8 @@ void TourDesk::report_end(const TourPicture& picture, const ServoDisplayState& d
   const int left = shapes_remaining(*picture.scene, touches_, tour_params_from(s_));
   if (left == 0)
     text += m.text(audio::MessageId::tour_all_touched);
-  else if (left == 1)
-    text += m.text(audio::MessageId::tour_one_remaining);
   else
-    text += m.text(audio::MessageId::tour_remaining, {{"count", std::to_string(left)}});
+    text += m.text(audio::MessageId::tour_remaining, left);
   voice_.say(text);
 }
 

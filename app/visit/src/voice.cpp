@@ -42,6 +42,11 @@ bool Voice::repeat() {
   return true;
 }
 
+void Voice::set_language(int index) {
+  if (index == audio_.language() || !audio_.set_language(index)) return;
+  spdlog::info("kiosk: language {}", audio_.languages()[static_cast<std::size_t>(index)]);
+}
+
 bool Voice::quiet_hours() const {
   const std::optional<config::QuietHours> hours = config::parse_quiet_hours(s_.kiosk.quiet_hours);
   if (!hours) return false;

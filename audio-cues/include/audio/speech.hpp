@@ -97,8 +97,14 @@ class Speaker {
   /// text only cancels (it is logged, and last_text() keeps the previous text). Never throws for a text's
   /// length: over kMaxSpeechTextBytes it is cut at the last piece that fits (logged as a warning).
   void say(std::string text, bool keep = true);
-  /// Says last_text() again, from its start (nothing if there was none). Logged like say().
+  /// Says last_text() again, from its start, in the voice it was said in (nothing if there was none). Logged
+  /// like say().
   void repeat();
+  /// The voice of the texts said from now on (espeak-ng voice name); what is being said goes on in its own.
+  /// @throws SpeechError when espeak-ng has no such voice (the voice stays as it was).
+  void set_voice(const std::string& voice);
+  /// The voice of the texts said from now on.
+  std::string voice() const;
   /// Silence now: cancels what is playing and drops what waits, and ends a pause. Not logged.
   void cancel();
   /// cancel(), and last_text() forgotten: a new visitor must not hear the last one's texts again.
@@ -142,13 +148,15 @@ class Speaker {
 
  private:
   void run();
-  void submit(std::string text, bool keep);  // cancels and queues; caller holds m_
-  bool speak_piece(const std::string& piece, std::uint32_t gen,
+  void submit(std::string text, bool keep, bool again);  // cancels and queues; caller holds m_
+  bool speak_piece(const std::string& piece, const SpeechParams& params, std::uint32_t gen,
                    std::uint64_t* pushed);  // false: cancelled; *pushed += samples handed over
 
   SpeechStream& stream_;
-  SpeechParams params_;
   mutable std::mutex m_;
+  SpeechParams params_;       // the voice of the next say()
+  SpeechParams job_params_;   // the waiting text's
+  SpeechParams last_params_;  // last_'s
   std::condition_variable cv_;
   bool has_job_ = false;  // a text waits for the worker
   std::uint32_t job_generation_ = 0;

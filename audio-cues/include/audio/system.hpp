@@ -6,8 +6,10 @@
 /// on: a kiosk without a speaker still renders forces, and tests run it headless and pull render().
 
 #include <cstdint>
+#include <filesystem>
 #include <initializer_list>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -32,14 +34,21 @@ struct AudioSystemParams {
   double volume_step_db = 3.0;      ///< [dB]
   std::size_t cue_capacity = 4096;  ///< cue ring entries (4 s of cues at 1 kHz)
   bool open_output = true;          ///< false: no PortAudio; the caller pulls render() (headless runs, tests)
-  std::string messages_file;        ///< a translated catalogue; empty: English, built in
+  /// The languages offered to visitors (BCP 47 tags, in the order the Language key steps through them).
+  std::vector<std::string> languages{"en"};
+  /// The language each visit starts in; one of `languages` (else the first of them that loads).
+  std::string language = "en";
+  /// Where the compiled catalogues are (audio::default_locale_dir(): this build's or the package's).
+  std::filesystem::path locale_dir = default_locale_dir();
 };
 
 /// The audio side. Construct and destroy on the kiosk's main thread.
 class AudioSystem {
  public:
-  /// @throws MessageError if `messages_file` is given and cannot be used (the operator's mistake: say so).
-  ///         Never throws for a missing sound card or speech engine (logged; running without).
+  /// Loads the catalogue of every offered language; one that cannot be loaded (no catalogue file, a broken
+  /// one, not a BCP 47 tag) is logged in one line naming it and left out, and English stands in when none
+  /// is left. Never throws for a missing sound card, speech engine or voice (logged; running without, or
+  /// with the espeak-ng voice "en").
   explicit AudioSystem(const AudioSystemParams& params);
   ~AudioSystem();
   AudioSystem(const AudioSystem&) = delete;
@@ -71,14 +80,27 @@ class AudioSystem {
   /// Volume one step up / down; false at the limit (the kiosk then says volume_limit).
   bool volume_up() noexcept { return volume_.up(); }
   bool volume_down() noexcept { return volume_.down(); }
-  /// A new visitor: volume back to the operator's default, speech stopped and the last text forgotten.
+  /// A new visitor: volume back to the operator's default, speech stopped and the last text forgotten (the
+  /// language is the visitor flow's to set back).
   void new_session();
 
   /// Headless: pulls `frames` samples of the mix (only when open_output was false; otherwise PortAudio pulls).
   void render(float* out, std::size_t frames) noexcept { mixer_.render(out, frames); }
 
   const Volume& volume() const noexcept { return volume_; }
+  /// The catalogue of the language in use. The reference stays valid for the system's life; its texts
+  /// change with set_language().
   const MessageCatalog& messages() const noexcept { return catalog_; }
+  /// The offered languages that loaded, in order (BCP 47 tags); never empty.
+  const std::vector<std::string>& languages() const noexcept { return language_codes_; }
+  /// Index into languages() of the language in use, and of the default.
+  int language() const noexcept { return language_; }
+  int default_language() const noexcept { return default_language_; }
+  /// Speaks and answers in languages()[index] from now on: messages() becomes its catalogue, the speaker
+  /// its voice (what is being said goes on in its own). Out of range: nothing changes (false).
+  bool set_language(int index);
+  /// The catalogue of languages()[index] (the one in use when out of range).
+  const MessageCatalog& catalogue(int index) const;
   /// True if sound reaches a device.
   bool sound_output() const { return output_ && output_->running(); }
   /// The output's state (why_not when there is none); null if open_output was false.
@@ -91,7 +113,13 @@ class AudioSystem {
   std::uint64_t cues_dropped() const noexcept { return cues_.overflows(); }
 
  private:
-  MessageCatalog catalog_;
+  void load_languages(const AudioSystemParams& p);
+
+  std::vector<MessageCatalog> catalogues_;   // one per offered language that loaded
+  std::vector<std::string> language_codes_;  // their tags
+  int language_ = 0, default_language_ = 0;
+  std::set<std::string> missing_voices_;  // voices espeak-ng refused, each logged once
+  MessageCatalog catalog_;                // a copy of catalogues_[language_]: what messages() hands out
   SpscRing<CueEvent> cues_;
   SpscRing<CueEvent> ui_cues_;  // the window thread's earcons (play)
   SpeechStream speech_stream_;

@@ -40,4 +40,9 @@ inline constexpr std::size_t kOneLineMaxBytes = 512;
 /// a block of text begins with. The whole text when it has no more. Never throws but std::bad_alloc.
 std::string first_words(const std::string& text, int n);
 
+/// `text` with its first letter upper case, for a phrase that begins a sentence ("la flèche droite" → "La flèche
+/// droite", "écoutez" → "Écoutez"): ASCII letters and the lower-case letters of Latin-1 (U+00E0 to U+00FE but
+/// U+00F7, as UTF-8) are made upper case; any other first character is kept as it is.
+std::string capitalised(std::string text);
+
 }  // namespace hk

@@ -218,6 +218,9 @@ struct KioskSettings {
                ///< beside the pictures), or an absolute folder
   std::string say_names_on_touch = "on";  ///< key say_names_on_touch, "on": the first touch of a named shape in a visit
                                           ///< of a picture says its name, once; "off": names only when asked
+  std::string languages = "en, fr, de, es";  ///< key languages, the languages offered to visitors, BCP 47 tags
+                                             ///< separated by commas, in the order the Language key steps through
+  std::string language = "en";               ///< key language, the language each visit starts in, one of languages
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const KioskSettings&) const = default;
@@ -284,17 +287,18 @@ struct KeysSettings {
   std::string previous_sentence = "J";  ///< key previous_sentence, reading a text: back to the sentence before
   std::string next_paragraph = "I";  ///< key next_paragraph, reading a text: on from the next paragraph (block of text)
   std::string previous_paragraph = "U";  ///< key previous_paragraph, reading a text: back to the paragraph before
+  std::string language = "L";            ///< key language, the next of the offered languages ([kiosk] languages)
 
   /// Field-by-field equality; used by round-trip checks.
   bool operator==(const KeysSettings&) const = default;
 };
 
 /// Visitor actions in [keys].
-inline constexpr std::size_t kKeyActionCount = 19;
+inline constexpr std::size_t kKeyActionCount = 20;
 
 /// Each [keys] action's name and its key, in table order: help, next, previous, describe, finer, coarser,
 /// volume_up, volume_down, tutorial, guide, capture, repeat, pause, where, finish, next_sentence,
-/// previous_sentence, next_paragraph, previous_paragraph. The one list that the
+/// previous_sentence, next_paragraph, previous_paragraph, language. The one list that the
 /// validation, the spoken key placeholders (audio::kKeyPlaceholders, the same order) and the window's key map
 /// follow. The views point into `keys`: keep it alive while they are used.
 inline std::array<std::pair<std::string_view, std::string_view>, kKeyActionCount> key_actions(const KeysSettings& k) {
@@ -316,7 +320,8 @@ inline std::array<std::pair<std::string_view, std::string_view>, kKeyActionCount
            {"next_sentence", k.next_sentence},
            {"previous_sentence", k.previous_sentence},
            {"next_paragraph", k.next_paragraph},
-           {"previous_paragraph", k.previous_paragraph}}};
+           {"previous_paragraph", k.previous_paragraph},
+           {"language", k.language}}};
 }
 
 /// One USB id of [device] usb_ids.

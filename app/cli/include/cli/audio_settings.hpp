@@ -13,10 +13,10 @@ namespace hk::app {
 
 /// What `haptic-kiosk speak` was asked to do.
 struct SpeakOptions {
-  std::string what;           ///< a message key of the catalogue (e.g. "welcome") or free text
-  std::string wav_path;       ///< output WAV
-  std::string config_path;    ///< TOML settings; empty: defaults
-  std::string messages_path;  ///< a translated catalogue; empty: English
+  std::string what;             ///< a message key of the catalogue (e.g. "welcome") or free text
+  std::string wav_path;         ///< output WAV
+  std::string config_path;      ///< TOML settings; empty: defaults
+  std::string language = "en";  ///< the catalogue and voice (BCP 47 tag, audio::MessageCatalog::load)
 };
 
 /// Renders the speech of `options.what` to `options.wav_path` (a message's placeholders get sample values:

@@ -33,7 +33,8 @@ struct ShownView {
 
 /// A region's name as said: staff's with its article (said_name: "the left wing"), a guess's as it is
 /// ("something that could be a face", "text: Emergency exit").
-std::string region_said_name(const meaning::NamedRegion& region);
+std::string region_said_name(const meaning::NamedRegion& region,
+                             const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// The names of a picture in the terms Describe and Where use: each curve's name (said_name of the region it
 /// takes it from, `shape_region[i]`, −1 none; when several shapes take one region's: "one of the white spots" for a
@@ -42,18 +43,21 @@ std::string region_said_name(const meaning::NamedRegion& region);
 /// (the `curves` curves [m]), each part's curve is the longest curve taking its name.
 PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, const std::vector<int>& shape_region,
                            std::size_t curves, const vision::PxToM& px_to_m,
-                           const std::vector<Polyline>* polylines = nullptr);
+                           const std::vector<Polyline>* polylines = nullptr,
+                           const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// Words of a block of text that Where reads (Describe reads it whole).
 inline constexpr int kWhereTextWords = 8;
 
 /// What shape `curve` is, for speech: a practice shape's title, else its staff name ("the left wing"), else
 /// describe_one_shape without its place.
-std::string shape_words(const ShownView& shown, std::size_t curve);
+std::string shape_words(const ShownView& shown, std::size_t curve,
+                        const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// What shape `curve` looks like, short: a practice shape's title, its staff name, else describe_one_look ("a small
 /// white round shape"): what Where says of a shape the hand is inside or near.
-std::string shape_look(const ShownView& shown, std::size_t curve);
+std::string shape_look(const ShownView& shown, std::size_t curve,
+                       const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// The Where answer for the hand at `hand_m` [m] with the proxy on curve `contact_curve` (−1 for none): the text
 /// block under it (where_text), else the shape it is on (where_on; where_on_part with the smallest named region

@@ -3,8 +3,9 @@
 /// The Describe and Where keys: a spoken summary of a picture's shapes and where they are, e.g.
 /// "3 shapes. A large black shape with a small white round shape inside it, in the middle, a straight line at
 /// the far left, and a small red square at the near right.", and one shape under, around or near the hand. Places are
-/// in the visitor's terms: far is away from them (+y), near towards them. English only for now (the catalogue's
-/// messages carry these phrases whole).
+/// in the visitor's terms: far is away from them (+y), near towards them. Every phrase is built from the words of
+/// the catalogue `m` (audio/messages.hpp kWordSources: look_*, size_*, colour_*, place_*, list_*, …), so it
+/// comes out in the visitor's language with its genders and word order; the examples are English.
 
 #include <limits>
 #include <optional>
@@ -12,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "audio/messages.hpp"
 #include "haptics/multires.hpp"
 #include "hk/vec2.hpp"
 #include "meaning/shape_descriptors.hpp"
@@ -21,7 +23,8 @@ namespace hk::app {
 /// Where point `p_m` lies in a workspace of half extents `half_extent_m` [m], in the visitor's terms: the cell
 /// of a 3 x 3 grid, "at the far left", "in the far middle", "at the far right", "on the left", "in the
 /// middle", "on the right", "at the near left", "in the near middle", "at the near right".
-std::string place_words(Vec2 p_m, Vec2 half_extent_m);
+std::string place_words(Vec2 p_m, Vec2 half_extent_m,
+                        const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// The shape under or nearest a hand.
 struct ShapeAtHand {
@@ -45,7 +48,7 @@ bool shape_holds(const Polyline& c, Vec2 p_m);
 
 /// Which way and how far `to_m` lies from `from_m`, in the visitor's terms: "3 cm to your right", "less than a
 /// centimetre farther away", "5 cm nearer to you, to your left" (8 directions; far is +y).
-std::string direction_words(Vec2 from_m, Vec2 to_m);
+std::string direction_words(Vec2 from_m, Vec2 to_m, const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// The number a visitor hears for curve `curve` of `curves` curves (from 1), counting only the shapes that are not
 /// specks, and how many there are: {number, count}. A speck's number is 0. `descriptors` not one per curve (none
@@ -59,7 +62,8 @@ std::pair<int, int> shape_number(const std::vector<meaning::ShapeDescriptor>& de
 /// `descriptors`: parallel to `curves`; empty: forms from the curves' own points, no colours.
 std::string describe_one_shape(const std::vector<Polyline>& curves,
                                const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t index,
-                               Vec2 half_extent_m, bool with_place = true);
+                               Vec2 half_extent_m, bool with_place = true,
+                               const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// Names staff gave the picture (meaning/names.hpp), in the terms Describe and Where use.
 struct PictureNames {
@@ -83,12 +87,12 @@ struct PictureNames {
 
 /// A staff name as said: "the " before a name that starts with a small letter and no article ("left wing" →
 /// "the left wing"); a proper name ("Gänseliesel fountain") and one with its own article as written.
-std::string said_name(const std::string& name);
+std::string said_name(const std::string& name, const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// One shape's look only (size, colour, form): "a small white round shape"; "a speck" for a speck.
 std::string describe_one_look(const std::vector<Polyline>& curves,
                               const std::vector<meaning::ShapeDescriptor>& descriptors, std::size_t index,
-                              Vec2 half_extent_m);
+                              Vec2 half_extent_m, const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// Describes `curves` (workspace metres) in a workspace of half extents `half_extent_m` [m]: how many shapes
 /// (specks not counted), then up to `max_named` groups of those inside no other shape, the largest first or,
@@ -107,22 +111,24 @@ std::string describe_one_look(const std::vector<Polyline>& curves,
 std::string describe_scene(const std::vector<Polyline>& curves,
                            const std::vector<meaning::ShapeDescriptor>& descriptors, Vec2 half_extent_m,
                            int max_named = 3, std::optional<Vec2> hand_m = std::nullopt,
-                           const PictureNames* names = nullptr);
+                           const PictureNames* names = nullptr,
+                           const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// Figures on a document page: groups of curves whose bounding boxes, grown by margin_m on every side,
 /// overlap (transitively: union-find over the pairs). A drawing of many strokes counts once; two drawings
 /// apart count twice. Returns 0 for no curves.
 int count_figures(const std::vector<Polyline>& curves, double margin_m = 0.002);
 
-/// `text` with its first letter upper case (ASCII letters only; any other first byte, as it is): a phrase that
-/// begins a sentence ("the left wing" → "The left wing").
+/// `text` with its first letter upper case (hk::capitalised): a phrase that begins a sentence ("the left wing" →
+/// "The left wing").
 std::string sentence_case(std::string text);
 
 /// How many shapes a picture has, for speech: "It has 4 shapes.", "It has one shape.", "I found no shapes in it."
-std::string describe_shapes(int shapes);
+std::string describe_shapes(int shapes, const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 /// What a document page holds, for speech: "It has 2 blocks of text and one figure.",
 /// "It has one block of text and no figures.", "It has no text and no figures."
-std::string describe_page(int text_blocks, int figures);
+std::string describe_page(int text_blocks, int figures,
+                          const audio::MessageCatalog& m = audio::MessageCatalog::english());
 
 }  // namespace hk::app

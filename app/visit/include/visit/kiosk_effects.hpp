@@ -59,6 +59,12 @@ class SpeechEffects {
   virtual bool resume_speech() { return false; }
   /// Whether now is within the operator's quiet hours ([kiosk] quiet_hours): no spoken invitation. Default: no.
   virtual bool quiet_hours() const { return false; }
+  /// How many languages are offered, the one in use (index, from 0) and the default each visit starts in.
+  virtual int language_count() const { return 1; }
+  virtual int language() const { return 0; }
+  virtual int default_language() const { return 0; }
+  /// Speaks and answers in language `index` from now on (the catalogue and the voice); out of range: nothing.
+  virtual void set_language(int index) { (void)index; }
 };
 
 /// What is on the device and the screen, and what is said of it.

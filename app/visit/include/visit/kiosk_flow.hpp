@@ -90,6 +90,7 @@ enum class KioskKey {
   PreviousSentence,
   NextParagraph,
   PreviousParagraph,
+  Language,
   Other
 };
 
@@ -246,6 +247,8 @@ class KioskFlow {
   const config::KeysSettings& keys() const { return p_.keys; }
   /// The text of `id` as the flow says it: `args` filled in, and every key placeholder naming the current key.
   std::string text(audio::MessageId id, std::initializer_list<audio::MessageArg> args = {}) const;
+  /// A counted message in the plural form for `count` (audio::MessageCatalog::text with a count).
+  std::string counted(audio::MessageId id, long count, std::initializer_list<audio::MessageArg> args = {}) const;
 
   /// Where the visit stands.
   FlowView view() const;
@@ -258,6 +261,7 @@ class KioskFlow {
     int picture = 0;
     double last_activity_s = 0;
     double next_invitation_s = 0;  // Attract: when the next spoken invitation is due
+    int invitation_language = -1;  // Attract: the language of the last invitation, −1 before the first
     bool warned = false;
     double warned_at_s = 0;      // when the first time-out warning was said
     bool rewarned = false;       // the second warning was said
@@ -297,6 +301,7 @@ class KioskFlow {
   bool session_key(KioskKey k, double now_s);  // keys that act the same everywhere; true when handled
   void volume_key(int delta);
   void finish_key(double now_s);
+  void language_key();
   void describe_key();
   void reading_key(KioskKey k);  // the sentence and paragraph keys
   void repeat_key();
@@ -318,7 +323,11 @@ class KioskFlow {
   void tutorial_key(KioskKey k);
   void picture_key(KioskKey k);
   void activity(double now_s);
-  void wake(double now_s);
+  /// Starts a visit: the welcome and the tutorial, in the default language unless `keep_language` (the
+  /// Language key answering an invitation: the invitation's language).
+  void wake(double now_s, bool keep_language);
+  /// The attract invitation, in the next offered language in turn (language_offer after it).
+  void invite();
   void end_session(double now_s);
   void start_tutorial();
   void show(int index, const std::string& before = {});

@@ -46,6 +46,12 @@ class Voice final : public SpeechEffects {
   bool resume_speech() override { return audio_.resume_speech(); }
   /// Whether the local time of day lies in [kiosk] quiet_hours.
   bool quiet_hours() const override;
+  /// The audio system's languages (audio::AudioSystem::languages).
+  int language_count() const override { return static_cast<int>(audio_.languages().size()); }
+  int language() const override { return audio_.language(); }
+  int default_language() const override { return audio_.default_language(); }
+  /// audio::AudioSystem::set_language; logged when it changes.
+  void set_language(int index) override;
 
  private:
   audio::AudioSystem& audio_;
