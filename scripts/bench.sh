@@ -44,6 +44,7 @@ taskset -c 1 "$b/bench_scene_build" --benchmark_min_time=$(awk "BEGIN { print $m
 "$b/bench_tour_time" > "$out/tour_time.md"
 "$b/bench_random_visits" --seeds 4 --json "$out/random_visits.json" > "$out/random_visits.txt"  # long seeded random visits: every key answered, the kiosk new after Finish
 "$b/bench_speech_times" > "$out/speech_times.md"  # how long the kiosk talks, and how soon a key is answered
+"$b/bench_voices" > "$out/voices.md"  # each voice's first audio and speed, a change of language, the catalogues
 "$b/bench_ocr_pages" > "$out/ocr_pages.md"  # text read from scans and pictures: time, memory, recall, false blocks
 "$b/bench_decode" > "$out/decode.md"  # a picture file's decode, full and as the scene build does it (reduced JPEG), and the scene after it
 "$b/bench_next_picture" --out "$out/next_picture.md" > /dev/null  # Next pressed -> first servo tick on the new scene: cold, prefetched, cached; tests/data pictures, 24/12 MP JPEGs, 13 MP PNGs, a 51-page PDF

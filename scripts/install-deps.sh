@@ -15,7 +15,7 @@ packages=(
 if [ "${1:-}" != "--demo" ]; then
   packages+=(
     libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libembree-dev
-    sox libgl1-mesa-dri xvfb xauth tesseract-ocr-deu tesseract-ocr-fra tesseract-ocr-spa
+    sox libgl1-mesa-dri xvfb xauth tesseract-ocr tesseract-ocr-deu tesseract-ocr-fra tesseract-ocr-spa
     poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools
     dpkg-dev file lintian systemd cage
     clang libclang-rt-14-dev llvm-14 clang-format-14

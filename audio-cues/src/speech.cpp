@@ -2,6 +2,14 @@
 
 #include <espeak-ng/speak_lib.h>
 #include <samplerate.h>
+extern "C" {
+#include <flite/flite.h>
+// The CMU Flite English voices this build links (Debian flite1-dev): their registration functions.
+cst_voice* register_cmu_us_slt(const char* voxdir);
+cst_voice* register_cmu_us_kal(const char* voxdir);
+cst_voice* register_cmu_us_awb(const char* voxdir);
+cst_voice* register_cmu_us_rms(const char* voxdir);
+}
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -17,7 +25,7 @@ namespace {
 /// Receives resampled speech; returns false to stop the synthesis (the utterance was cancelled).
 using Sink = std::function<bool(const float*, std::size_t)>;
 
-/// The one lock around every espeak-ng call (and the globals below).
+/// The one lock around every espeak-ng and Flite call (and the globals below).
 std::mutex& espeak_mutex() {
   static std::mutex m;
   return m;
@@ -79,6 +87,33 @@ int on_samples(short* pcm, int n, espeak_EVENT* /*events*/) {
   }
   return s->stopped ? 1 : 0;
 }
+
+/// The Flite voice `name` names ("flite:slt" → CMU's slt voice), registered once per process; null for a name
+/// that is not a Flite voice of this build. Caller holds espeak_mutex().
+cst_voice* flite_voice_locked(std::string_view name) {
+  struct Known {
+    std::string_view name;
+    cst_voice* (*reg)(const char*);
+    cst_voice* voice;
+  };
+  static Known known[] = {{"flite:slt", &register_cmu_us_slt, nullptr},
+                          {"flite:kal", &register_cmu_us_kal, nullptr},
+                          {"flite:awb", &register_cmu_us_awb, nullptr},
+                          {"flite:rms", &register_cmu_us_rms, nullptr}};
+  static const bool started = [] {
+    flite_init();
+    return true;
+  }();
+  (void)started;
+  for (Known& k : known) {
+    if (k.name != name) continue;
+    if (!k.voice) k.voice = k.reg(nullptr);
+    return k.voice;
+  }
+  return nullptr;
+}
+
+bool is_flite(std::string_view voice) { return voice.rfind("flite:", 0) == 0; }
 
 /// Initialises espeak-ng once per process; returns its sample rate [Hz]. Caller holds espeak_mutex().
 int native_rate_locked() {
@@ -146,6 +181,11 @@ void check_params(const SpeechParams& p) {
 /// Sets voice, rate and pitch (skipped when espeak-ng is already set so). Caller holds espeak_mutex().
 void configure_locked(const SpeechParams& p) {
   check_params(p);
+  if (is_flite(p.voice)) {  // Flite's rate is set on each utterance
+    if (!flite_voice_locked(p.voice)) throw SpeechError("speech: Flite has no voice '" + p.voice + "'");
+    g_configured = p;
+    return;
+  }
   native_rate_locked();
   if (g_configured == p) return;
   g_configured.reset();  // a refusal below leaves espeak-ng half set
@@ -160,6 +200,25 @@ void configure_locked(const SpeechParams& p) {
   g_configured = p;
 }
 
+/// Synthesises `text` with the Flite voice of `p` into `s` (a whole piece at once: a sentence, tens of
+/// milliseconds), its speaking rate set by Flite's duration_stretch (its voices speak about 165 words/min at 1).
+/// Caller holds espeak_mutex() and has configured.
+void synthesize_flite_locked(const std::string& text, const SpeechParams& p, Synthesis& s) {
+  cst_voice* v = flite_voice_locked(p.voice);
+  if (!v) throw SpeechError("speech: Flite has no voice '" + p.voice + "'");
+  flite_feat_set_float(v->features, "duration_stretch", 165.0f / static_cast<float>(p.rate_wpm));
+  std::unique_ptr<cst_wave, void (*)(cst_wave*)> w(flite_text_to_wave(text.c_str(), v), &delete_wave);
+  if (!w || w->sample_rate <= 0) throw SpeechError("speech: Flite could not synthesise the text");
+  s.ratio = static_cast<double>(kSampleRateHz) / w->sample_rate;
+  if (w->num_samples > 0 && !feed(s, w->samples, static_cast<std::size_t>(w->num_samples), false)) {
+    if (!s.error.empty()) throw SpeechError(s.error);
+    return;  // cancelled
+  }
+  const short none = 0;
+  feed(s, &none, 0, true);  // the resampler's tail
+  if (!s.error.empty()) throw SpeechError(s.error);
+}
+
 /// Synthesises `text` (non-empty) into `sink` at kSampleRateHz. Caller holds espeak_mutex() and has
 /// configured. Returns normally also when the sink stopped it.
 void synthesize_locked(const std::string& text, Sink sink) {
@@ -169,8 +228,12 @@ void synthesize_locked(const std::string& text, Sink sink) {
     throw SpeechError(std::string("speech: resampler could not start (libsamplerate: ") + src_strerror(err) + ")");
   Synthesis s;
   s.src = src.get();
-  s.ratio = static_cast<double>(kSampleRateHz) / native_rate_locked();
   s.sink = std::move(sink);
+  if (g_configured && is_flite(g_configured->voice)) {
+    synthesize_flite_locked(text, *g_configured, s);
+    return;
+  }
+  s.ratio = static_cast<double>(kSampleRateHz) / native_rate_locked();
   g_current = &s;
   const espeak_ERROR r =
       espeak_Synth(text.c_str(), text.size() + 1, 0, POS_CHARACTER, 0, espeakCHARS_UTF8, nullptr, nullptr);
@@ -244,7 +307,7 @@ Speaker::~Speaker() {
   worker_.join();
 }
 
-void Speaker::submit(std::string text, bool keep, bool again) {
+void Speaker::submit(std::string text, bool keep, bool again, std::size_t switch_from, const SpeechParams* switch_to) {
   // Under m_, so two concurrent say() calls queue in the order of their generations.
   job_generation_ = stream_.cancel();
   stream_.set_paused(false);
@@ -253,9 +316,13 @@ void Speaker::submit(std::string text, bool keep, bool again) {
   while (log_.size() > kLogEntries) log_.pop_front();
   if (!text.empty()) {
     job_params_ = again ? last_params_ : params_;
+    job_switch_from_ = again ? last_switch_from_ : switch_to ? switch_from : SIZE_MAX;
+    job_switch_params_ = again ? last_switch_params_ : switch_to ? *switch_to : params_;
     if (keep) {
       last_ = text;
       last_params_ = job_params_;
+      last_switch_from_ = job_switch_from_;
+      last_switch_params_ = job_switch_params_;
     }
     job_text_ = std::move(text);
   }
@@ -272,6 +339,25 @@ void Speaker::say(std::string text, bool keep) {
   {
     std::lock_guard<std::mutex> lock(m_);
     submit(std::move(text), keep, false);
+  }
+  cv_.notify_all();
+}
+
+void Speaker::say_switching(std::string text, bool keep, std::size_t from_piece, const std::string& voice) {
+  SpeechParams other;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    other = params_;
+  }
+  other.voice = voice;
+  {
+    std::lock_guard<std::mutex> lock(espeak_mutex());
+    configure_locked(other);  // refuses a voice the synthesisers do not have, before anything is cut off
+  }
+  if (text.size() > kMaxSpeechTextBytes) text.resize(word_cut(text, kMaxSpeechTextBytes));
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    submit(std::move(text), keep, false, from_piece, &other);
   }
   cv_.notify_all();
 }
@@ -415,7 +501,8 @@ void Speaker::run() {
   const auto retry = std::chrono::duration<double>(kFullRingRetry);
   for (;;) {
     std::string text;
-    SpeechParams params;
+    SpeechParams params, switch_params;
+    std::size_t switch_from = SIZE_MAX;
     std::uint32_t gen = 0;
     {
       std::unique_lock<std::mutex> lock(m_);
@@ -423,6 +510,8 @@ void Speaker::run() {
       if (stop_) return;
       text = std::move(job_text_);
       params = job_params_;
+      switch_from = job_switch_from_;
+      switch_params = job_switch_params_;
       gen = job_generation_;
       has_job_ = false;
       working_ = true;
@@ -432,7 +521,9 @@ void Speaker::run() {
       try {
         bool whole = true;
         std::uint64_t pushed = 0;  // samples of this utterance handed to the stream
-        for (const std::string& piece : speech_pieces(text)) {
+        const std::vector<std::string> pieces = speech_pieces(text);
+        for (std::size_t k = 0; k < pieces.size(); ++k) {
+          const std::string& piece = pieces[k];
           {
             std::lock_guard<std::mutex> lock(m_);
             if (starts_generation_ != gen) {
@@ -442,7 +533,7 @@ void Speaker::run() {
             }
             piece_starts_.push_back(pushed);
           }
-          if (!speak_piece(piece, params, gen, &pushed)) {
+          if (!speak_piece(piece, k >= switch_from ? switch_params : params, gen, &pushed)) {
             whole = false;
             break;
           }

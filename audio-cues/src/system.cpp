@@ -35,13 +35,14 @@ AudioSystem::AudioSystem(const AudioSystemParams& p)
       volume_(p.volume_default_step, 10, p.volume_step_db),
       mixer_(p.mixer, &cues_, &speech_stream_, &volume_, &ui_cues_) {
   load_languages(p);
+  english_voice_ = p.english_voice;
   SpeechParams sp = p.speech;
-  if (sp.voice.empty()) sp.voice = catalog_.voice();
+  if (sp.voice.empty()) sp.voice = voice_of(language_);
   speech_params_ = sp;
   try {
     speaker_ = std::make_unique<Speaker>(speech_stream_, sp);
   } catch (const SpeechError& e) {
-    if (sp.voice != "en") {  // the language's voice is missing: the English voice, never silence
+    if (sp.voice != "en") {  // the language's voice is missing: espeak-ng's English, never silence
       spdlog::error("audio: {}; speaking with the voice 'en'", e.what());
       sp.voice = "en";
       try {
@@ -62,9 +63,9 @@ bool AudioSystem::set_language(int index) {
   catalog_ = catalogues_[static_cast<std::size_t>(index)];
   if (speaker_) {
     try {
-      speaker_->set_voice(catalog_.voice());
+      speaker_->set_voice(voice_of(index));
     } catch (const SpeechError& e) {
-      if (missing_voices_.insert(catalog_.voice()).second)  // once per voice
+      if (missing_voices_.insert(voice_of(index)).second)  // once per voice
         spdlog::error("audio: {}; speaking {} with the voice 'en'", e.what(),
                       language_codes_[static_cast<std::size_t>(index)]);
       try {
@@ -75,6 +76,11 @@ bool AudioSystem::set_language(int index) {
   }
   speech_params_.voice = speaker_ ? speaker_->voice() : catalog_.voice();
   return true;
+}
+
+std::string AudioSystem::voice_of(int index) const {
+  const MessageCatalog& c = catalogue(index);
+  return c.voice() == "en" && !english_voice_.empty() ? english_voice_ : c.voice();
 }
 
 const MessageCatalog& AudioSystem::catalogue(int index) const {
@@ -95,6 +101,19 @@ AudioSystem::~AudioSystem() {
 
 void AudioSystem::say_text(std::string text, bool keep) {
   if (speaker_) speaker_->say(std::move(text), keep);
+}
+
+void AudioSystem::say_text_in(std::string text, bool keep, std::size_t from_piece, const std::string& language) {
+  if (!speaker_) return;
+  const std::string primary = language.substr(0, language.find('-'));
+  const std::string voice = primary == "en" && !english_voice_.empty() ? english_voice_ : primary;
+  try {
+    speaker_->say_switching(text, keep, from_piece, voice);
+  } catch (const SpeechError& e) {
+    if (missing_voices_.insert(voice).second)
+      spdlog::error("audio: {}; its text is said in the voice in use", e.what());
+    speaker_->say(std::move(text), keep);
+  }
 }
 
 bool AudioSystem::pause_speech() { return speaker_ && speaker_->pause(); }

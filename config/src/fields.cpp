@@ -177,6 +177,7 @@ constexpr std::array<std::string_view, 2> kRenderModes{"walls", "grooves"};
 constexpr std::array<std::string_view, 6> kDetectors{"auto", "canny", "surround", "bilateral", "edpf", "outline"};
 constexpr std::array<std::string_view, 3> kOcrModes{"auto", "always", "off"};
 constexpr std::array<std::string_view, 2> kOnOff{"on", "off"};
+constexpr std::array<std::string_view, 5> kVoices{"flite-slt", "flite-kal", "flite-awb", "flite-rms", "espeak"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>(
@@ -379,11 +380,13 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
              "text (about 10 s a page) comes when it is read.",
              kOcrModes),
     HK_FIELD(vision, ocr_languages, FieldGroup::scene, ApplyWhen::scene, 0, 0, "",
-             "Tesseract languages joined by '+' (\"eng\", \"eng+deu\"); empty: the message catalogue's language. A "
+             "Tesseract languages joined by '+' (\"eng\", \"eng+deu\"); empty: the kiosk's language and English "
+             "(\"fra+eng\" for [kiosk] language = \"fr\"). A "
              "missing one turns OCR off at start, said in the log.",
              {}, &ocr_languages_problem),
     HK_FIELD(vision, ocr_min_confidence, FieldGroup::scene, ApplyWhen::scene, 0, 1, "",
-             "Words Tesseract is less sure of than this are said as \"unclear word\", never read as if certain."),
+             "Marks with no letter or digit that Tesseract is less sure of than this are said as \"unclear word\"; "
+             "words are said as read, however unsure, and a paragraph with no word this sure is left out."),
     // [workspace]
     HK_FIELD(workspace, width_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m", "Width of the usable rectangle."),
     HK_FIELD(workspace, height_m, FieldGroup::scene, ApplyWhen::restart, 0.01, 1, "m",
@@ -398,6 +401,11 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(audio, duck_db, FieldGroup::audio, ApplyWhen::restart, -40, 0, "dB",
              "Earcons are this much quieter while speech plays."),
     HK_FIELD(audio, speech_rate_wpm, FieldGroup::audio, ApplyWhen::restart, 80, 450, "words/min", "Speaking rate."),
+    HK_FIELD(audio, voice, FieldGroup::audio, ApplyWhen::restart, 0, 0, "",
+             "The voice English is spoken with: a CMU Flite voice (\"flite-slt\", a woman's, the most natural; "
+             "\"flite-kal\", \"flite-awb\", \"flite-rms\", men's) or \"espeak\" (espeak-ng, clipped but fastest). "
+             "Other languages speak with espeak-ng.",
+             kVoices),
     HK_FIELD(audio, buffer_frames, FieldGroup::audio, ApplyWhen::restart, 32, 4096, "frames",
              "Audio output buffer at 48 kHz (256 = 5.3 ms)."),
     // [kiosk]

@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "audio/speech.hpp"
 #include "every_effect.hpp"
 #include "test_polylines.hpp"
 #include "visit/describe.hpp"
@@ -486,6 +488,18 @@ struct LanguageRecorder final : hk::test::EveryEffect {
     in_use = i;
     current = catalogues[static_cast<std::size_t>(i)];
   }
+  PageText page;  // what page_text() gives
+  PageText page_text() override { return page; }
+  std::vector<std::tuple<std::string, int, std::string>> said_in;  // say_in calls: text, from piece, language
+  void say_in(const std::string& text, int from_piece, const std::string& language) override {
+    said.push_back(text);
+    said_in.emplace_back(text, from_piece, language);
+  }
+  std::string language_name_of(const std::string& tag) const override {
+    for (const auto& c : catalogues)
+      if (c.language() == tag.substr(0, tag.find('-'))) return c.language_name();
+    return {};
+  }
 };
 
 TEST(KioskFlow, AVisitInEachLanguageIsSaidWhollyInIt) {
@@ -529,6 +543,32 @@ TEST(KioskFlow, AVisitInEachLanguageIsSaidWhollyInIt) {
         EXPECT_EQ(line.find(english), std::string::npos) << english << " in: " << line;
     }
   }
+}
+
+TEST(KioskFlow, ADocumentsTextInAnotherLanguageIsSaidInItsVoiceAfterANotice) {
+  LanguageRecorder fx;
+  for (const char* c : {"en", "de"})
+    fx.catalogues.push_back(audio::MessageCatalog::load(c, audio::default_locale_dir()));
+  fx.page = {{"Der Brunnen steht auf dem Markt. Er ist alt."}, 0, "de-DE"};
+  KioskFlowParams p;
+  KioskFlow flow(fx, fx.current, p);
+  flow.key(KioskKey::Other, 0.0);
+  for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 1.0 + i);  // to the first picture
+  flow.key(KioskKey::Describe, 5.0);                              // the hand on the block of text: it is read
+  ASSERT_EQ(fx.said_in.size(), 1u);
+  const auto& [text, from_piece, language] = fx.said_in[0];
+  EXPECT_EQ(language, "de-DE");
+  const std::vector<std::string> pieces = audio::speech_pieces(text);
+  ASSERT_LT(static_cast<std::size_t>(from_piece), pieces.size());
+  EXPECT_EQ(pieces[static_cast<std::size_t>(from_piece)], "Der Brunnen steht auf dem Markt.")
+      << "the visitor's words before it, the document's from here";
+  EXPECT_NE(text.find("In Deutsch:"), std::string::npos) << text;
+  // A page in the visitor's own language is said as ever.
+  fx.page.language = "en-GB";
+  flow.key(KioskKey::Where, 7.0);
+  flow.key(KioskKey::Describe, 8.0);
+  EXPECT_EQ(fx.said_in.size(), 1u);
+  EXPECT_NE(fx.said.back().find("Der Brunnen"), std::string::npos) << fx.said.back();
 }
 
 }  // namespace

@@ -93,7 +93,7 @@ struct Page {
   explicit Page(int at_hand) {
     flow.handle_moved(now);
     for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, now += 0.1);
-    fx.page = {page_paragraphs(), at_hand};
+    fx.page = {page_paragraphs(), at_hand, ""};
   }
   void key(KioskKey k) { flow.key(k, now += 0.1); }
   /// The mixer reaches piece `p` of the last text said; the flow follows at its next tick.

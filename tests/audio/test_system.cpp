@@ -126,5 +126,34 @@ TEST(AudioSystem, ALanguageThatCannotLoadIsLeftOutAndTheDefaultFallsBack) {
   EXPECT_EQ(none.messages().text(MessageId::volume_up), "Louder.");
 }
 
+TEST(AudioSystem, EnglishSpeaksWithFliteAndADocumentsTextWithItsOwnVoice) {
+  AudioSystemParams p = headless();
+  p.languages = {"en", "de"};
+  p.english_voice = "flite:slt";
+  AudioSystem a(p);
+  ASSERT_TRUE(a.speech_available());
+  // Flite's slt and espeak-ng's en are different voices: the same words make different sound.
+  SpeechParams slt, en;
+  slt.voice = "flite:slt";
+  const std::vector<float> by_flite = synthesize_speech("The handle is ready.", slt);
+  const std::vector<float> by_espeak = synthesize_speech("The handle is ready.", en);
+  ASSERT_GT(by_flite.size(), static_cast<std::size_t>(kSampleRateHz / 2));
+  EXPECT_GT(test::rms(by_flite, 0, by_flite.size()), 0.01);
+  EXPECT_NE(by_flite.size(), by_espeak.size());
+  a.say_text(a.messages().text(MessageId::device_ready));
+  ASSERT_TRUE(until_heard(a));
+  const std::vector<float> x = pull(a, 1.0);
+  EXPECT_GT(test::rms(x, 0, x.size()), 0.01) << "English is heard in Flite's voice";
+  // A German text after English words: said, the German from its piece on; a language without a voice
+  // falls back to the voice in use (and is still said).
+  a.say_text_in("Text: Der Brunnen steht auf dem Markt.", true, 1, "de");
+  EXPECT_EQ(a.speech_log().back().second, "Text: Der Brunnen steht auf dem Markt.");
+  a.say_text_in("Text: something.", true, 1, "xx");
+  EXPECT_EQ(a.speech_log().back().second, "Text: something.");
+  SpeechParams none;
+  none.voice = "flite:nobody";
+  EXPECT_THROW(synthesize_speech("x", none), SpeechError);
+}
+
 }  // namespace
 }  // namespace hk::audio

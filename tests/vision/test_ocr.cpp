@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <random>
 #include <sstream>
@@ -76,6 +77,39 @@ TEST_P(OcrScans, ReadsAScannedPageAsItsTextLayerSaysWithRecallOver90Percent) {
     EXPECT_GE(b.confidence, 0.6) << b.text;
     EXPECT_TRUE((cv::Rect2d(0, 0, grey.cols, grey.rows) & b.box_px) == b.box_px) << "inside the picture: " << b.text;
   }
+  fs::remove_all(dir);
+}
+
+/// The words of 3 or more letters or digits among `words`: what recall is counted on against the tesseract command.
+std::vector<std::string> long_words(const std::vector<std::string>& words) {
+  std::vector<std::string> out;
+  for (const std::string& w : words)
+    if (w.size() >= 3) out.push_back(w);
+  return out;
+}
+
+TEST_P(OcrScans, EveryWordTesseractReadsReachesTheVisitor) {
+  // The kiosk's blocks (what is said) against the `tesseract` command on the same JPEG: no filter of the kiosk's
+  // may cut real text (a word read with low confidence is said; an unclear-word mark counts as no word).
+  if (!have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  if (test::shell("command -v tesseract >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "the tesseract command is not installed (scripts/install-deps.sh installs tesseract-ocr)";
+  const ScanCase c = GetParam();
+  const fs::path dir = scratch("cli");
+  const fs::path pdf = kData / "documents" / "shared-mime-info-spec.pdf";
+  const std::vector<std::uint8_t> jpeg = test::scan_jpeg(pdf, c.page, c.dpi, c.degrees, dir);
+  std::ofstream(dir / "scan.jpg", std::ios::binary)
+      .write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
+  ASSERT_EQ(
+      test::shell("tesseract '" + (dir / "scan.jpg").string() + "' '" + (dir / "cli").string() + "' >/dev/null 2>&1"),
+      0);
+  std::ifstream cli_file(dir / "cli.txt");
+  const std::string cli_text((std::istreambuf_iterator<char>(cli_file)), std::istreambuf_iterator<char>());
+  const std::vector<std::string> truth = long_words(words_of(test::pdftotext_page(pdf, c.page, dir)));
+  const OcrResult r = recognise_text(cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE), "scan.jpg", {});
+  const double kiosk = test::word_recall(truth, long_words(words_of(all_text(r))));
+  const double command = test::word_recall(truth, long_words(words_of(cli_text)));
+  EXPECT_GE(kiosk, command - 0.02) << "kiosk " << kiosk << ", tesseract " << command;
   fs::remove_all(dir);
 }
 

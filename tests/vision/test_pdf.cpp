@@ -18,9 +18,14 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+// qpdf 11: the std::shared_ptr API only, without its transition warning.
+#define POINTERHOLDER_TRANSITION 4
+#include <qpdf/QPDF.hh>
+#include <qpdf/QPDFWriter.hh>
 
 #include "image_pdf.hpp"
 #include "test_paths.hpp"
+
 #include "vision/pdf.hpp"
 
 namespace hk::vision {
@@ -151,6 +156,33 @@ TEST(PdfDocuments, TheTitleComesFromTheInfoDictionaryAsUtf8) {
       probe_pdf(read_file(kData + "/bad/title_2000_bytes.pdf"), "title_2000_bytes.pdf", generous());
   EXPECT_EQ(long_title.title, "");
   EXPECT_EQ(long_title.pages, 1);
+}
+
+/// `pdf` with its catalog's /Lang set to `lang` (a string), or to the name /fr when `as_name`, written by qpdf.
+std::vector<std::uint8_t> with_lang(const std::vector<std::uint8_t>& pdf, const std::string& lang,
+                                    bool as_name = false) {
+  QPDF q;
+  q.processMemoryFile("in", reinterpret_cast<const char*>(pdf.data()), pdf.size());
+  q.getRoot().replaceKey("/Lang",
+                         as_name ? QPDFObjectHandle::newName("/fr") : QPDFObjectHandle::newUnicodeString(lang));
+  QPDFWriter w(q);
+  w.setOutputMemory();
+  w.write();
+  std::shared_ptr<Buffer> b = w.getBufferSharedPointer();
+  return {b->getBuffer(), b->getBuffer() + b->getSize()};
+}
+
+TEST(PdfDocuments, TheLanguageComesFromTheCatalogsLang) {
+  const auto bytes = read_file(kTitled);
+  EXPECT_EQ(probe_pdf(bytes, "titled.pdf", generous()).language, "") << "no /Lang";
+  const auto fr = with_lang(bytes, "fr-FR");
+  EXPECT_EQ(probe_pdf(fr, "fr.pdf", generous()).language, "fr-FR");
+  EXPECT_EQ(render_pdf_page(fr, "fr.pdf", 1, generous()).language, "fr-FR");
+  EXPECT_EQ(probe_pdf(with_lang(bytes, "DE_ch"), "de.pdf", generous()).language, "de-ch") << "made a tag";
+  EXPECT_EQ(probe_pdf(with_lang(bytes, "not a language"), "x.pdf", generous()).language, "");
+  EXPECT_EQ(probe_pdf(with_lang(bytes, "", true), "name.pdf", generous()).language, "") << "a name, not a string";
+  EXPECT_EQ(pdf_language_tag("es"), "es");
+  EXPECT_EQ(pdf_language_tag(std::string(40, 'a')), "");
 }
 
 TEST(PdfDocuments, HorsePageAtThePngResolutionMatchesThePng) {

@@ -69,8 +69,17 @@ std::vector<std::uint8_t> packed(const cv::Mat& grey) {
   return px;
 }
 
-/// Reads one block of the answer into `out` (its words appended to out.words, the block to out.blocks); a word
-/// below p.min_word_confidence stands in the block's text as kUnclearWord.
+/// Whether `text` has an ASCII letter or digit, or a non-ASCII character (a letter of another script).
+bool has_letter_or_digit(const std::string& text) {
+  return std::any_of(text.begin(), text.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u >= 0x80 || std::isalnum(u) != 0;
+  });
+}
+
+/// Reads one block of the answer into `out` (its words appended to out.words, the block to out.blocks); a mark
+/// below p.min_word_confidence with no letter or digit stands in the block's text as kUnclearWord, every word as
+/// read.
 bool read_block(worker::WireReader& in, const OcrParams& p, OcrResult& out, double& confidence_sum) {
   std::uint32_t lines = 0, words = 0;
   if (!in.u32(lines) || !in.u32(words) || words == 0 || words > kMaxWords || out.words.size() + words > kMaxWords ||
@@ -88,7 +97,8 @@ bool read_block(worker::WireReader& in, const OcrParams& p, OcrResult& out, doub
       return false;
     }
     b.box_px = i == 0 ? w.box_px : (b.box_px | w.box_px);
-    b.text += (i == 0 ? "" : " ") + (w.confidence < p.min_word_confidence ? std::string(kUnclearWord) : w.text);
+    const bool unclear = w.confidence < p.min_word_confidence && !has_letter_or_digit(w.text);
+    b.text += (i == 0 ? "" : " ") + (unclear ? std::string(kUnclearWord) : w.text);
     block_sum += w.confidence;
     out.words.push_back(std::move(w));
   }

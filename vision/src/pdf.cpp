@@ -16,6 +16,7 @@
 //   u32 magic 'HKPD', u8 status (0 = answer, 1 = refusal)
 //   refusal: u8 PdfError::Kind, str problem
 //   answer:  i32 pages_in_file, str title (the Info dictionary's, UTF-8, at most kMaxPdfTitleBytes, else
+//            empty), str language (the catalog's /Lang, read with qpdf, as pdf_language_tag gives it, else
 //            empty); for a render also f64 width_pt, height_pt, dpi, i32 width, height,
 //            width*height grey bytes, u32 word count, per word: str text, f64 x, y, w, h [px], u8 space_after
 //   str = u32 length + bytes; numbers in the machine's byte order (the worker runs on the same machine).
@@ -24,6 +25,13 @@
 // check this on a rotated page with an offset crop box (tests/data/documents/rotated_text.pdf).
 
 #include "vision/pdf.hpp"
+
+// qpdf 11: the std::shared_ptr API only, without its transition warning.
+#define POINTERHOLDER_TRANSITION 4
+#include <qpdf/QPDF.hh>
+#include <qpdf/QPDFObjectHandle.hh>
+
+#include "hk/language.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -143,6 +151,20 @@ std::string pdf_title(const poppler::document& doc) {
   return t.size() <= kMaxPdfTitleBytes ? t : std::string();
 }
 
+/// The document's language: its catalog's /Lang (PDF 32000-1 §14.9.2), read with qpdf since poppler-cpp does not
+/// expose it, as pdf_language_tag makes it; "" when it has none or qpdf cannot read the file.
+std::string pdf_language(std::span<const std::uint8_t> bytes) {
+  try {
+    QPDF q;
+    q.setSuppressWarnings(true);
+    q.processMemoryFile("document", reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    QPDFObjectHandle lang = q.getRoot().getKey("/Lang");
+    return lang.isString() ? pdf_language_tag(lang.getUTF8Value()) : std::string();
+  } catch (const std::exception&) {  // a damaged catalog: no language, the page is still read by poppler
+    return {};
+  }
+}
+
 /// Refuses (NoSuchPage) a page number past the `offered` first of the document's n pages, saying which.
 void check_page_number(int page, int n, int offered) {
   if (page <= offered) return;
@@ -258,6 +280,7 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
   if (page == 0) {  // probe
     out.i32(n);
     out.str(pdf_title(*doc));
+    out.str(pdf_language(bytes));
     return;
   }
   check_page_number(page, n, std::min(n, limits.max_pages));
@@ -273,6 +296,7 @@ void work(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits
 
   out.i32(n);
   out.str(pdf_title(*doc));
+  out.str(pdf_language(bytes));
   out.f64(size.w_pt);
   out.f64(size.h_pt);
   out.f64(dpi);
@@ -428,7 +452,9 @@ PdfInfo probe_pdf(std::span<const std::uint8_t> bytes, const std::string& name, 
   read_head(in, run, name, 0, limits);
   std::int32_t n = 0;
   PdfInfo info;
-  if (!in.i32(n) || n <= 0 || !in.str(info.title, kMaxPdfTitleBytes) || in.left() != 0) fail_run(run, name, 0, limits);
+  if (!in.i32(n) || n <= 0 || !in.str(info.title, kMaxPdfTitleBytes) || !in.str(info.language, kMaxLanguageTagBytes) ||
+      in.left() != 0)
+    fail_run(run, name, 0, limits);
   info.pages_in_file = n;
   info.pages = std::min(n, limits.max_pages);
   info.capped = n > limits.max_pages;
@@ -450,8 +476,8 @@ PdfPage render_pdf_page(std::span<const std::uint8_t> bytes, const std::string& 
   std::int32_t n = 0, w = 0, h = 0;
   std::uint8_t screen_sized = 0;
   PdfPage out;
-  if (!in.i32(n) || n < page || !in.str(out.title, kMaxPdfTitleBytes) || !in.f64(out.width_pt) ||
-      !in.f64(out.height_pt) || !in.f64(out.dpi) || !in.u8(screen_sized) || screen_sized > 1 ||
+  if (!in.i32(n) || n < page || !in.str(out.title, kMaxPdfTitleBytes) || !in.str(out.language, kMaxLanguageTagBytes) ||
+      !in.f64(out.width_pt) || !in.f64(out.height_pt) || !in.f64(out.dpi) || !in.u8(screen_sized) || screen_sized > 1 ||
       (screen_sized == 1 && !(limits.text_layer_max_side_px > 0)) || !in.i32(w) || !in.i32(h) || w <= 0 || h <= 0 ||
       static_cast<double>(w) * h > limits.max_page_pixels || !(out.dpi > 0 && out.dpi <= limits.max_dpi) ||
       std::abs(w - out.width_pt * out.dpi / 72.0) > 2.0 || std::abs(h - out.height_pt * out.dpi / 72.0) > 2.0) {
@@ -622,6 +648,15 @@ std::vector<TextBlock> group_text_blocks(const std::vector<PdfWord>& words) {
   std::vector<TextBlock> out = block_texts(words, lines, blocks);
   sort_reading_order(out);
   return out;
+}
+
+std::string pdf_language_tag(std::string_view lang) {
+  std::string tag(lang.substr(0, std::min(lang.size(), kMaxLanguageTagBytes + 1)));
+  for (char& c : tag) c = c == '_' ? '-' : c;
+  const std::size_t dash = tag.find('-');
+  for (std::size_t i = 0; i < std::min(dash, tag.size()); ++i)
+    tag[i] = static_cast<char>(std::tolower(static_cast<unsigned char>(tag[i])));
+  return hk::is_language_tag(tag) ? tag : std::string();
 }
 
 }  // namespace hk::vision

@@ -122,6 +122,7 @@ ImageScene build_pdf_page_scene(const std::vector<std::uint8_t>& bytes, const st
   is.worker_ms = pg.worker_ms;
   is.worker_max_rss_kb = pg.worker_max_rss_kb;
   is.document_title = pdf_title(pg.title);
+  is.document_language = pg.language;
   return is;
 }
 

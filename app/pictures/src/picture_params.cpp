@@ -45,9 +45,18 @@ vision::PdfLimits pdf_limits_from(const config::Settings& s) {
   return l;
 }
 
+std::string tesseract_languages_for(std::string_view tag) {
+  static constexpr std::pair<std::string_view, std::string_view> kCodes[] = {
+      {"en", "eng"}, {"fr", "fra"}, {"de", "deu"}, {"es", "spa"}, {"it", "ita"}, {"pt", "por"}, {"nl", "nld"}};
+  const std::string_view primary = tag.substr(0, tag.find('-'));
+  for (const auto& [bcp47, tess] : kCodes)
+    if (bcp47 == primary) return tess == "eng" ? std::string("eng") : std::string(tess) + "+eng";
+  return "eng";
+}
+
 vision::OcrParams ocr_params_from(const config::Settings& s) {
   vision::OcrParams p;
-  p.languages = s.vision.ocr_languages.empty() ? std::string("eng") : s.vision.ocr_languages;
+  p.languages = s.vision.ocr_languages.empty() ? tesseract_languages_for(s.kiosk.language) : s.vision.ocr_languages;
   p.min_word_confidence = s.vision.ocr_min_confidence;
   return p;
 }

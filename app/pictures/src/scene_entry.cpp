@@ -173,6 +173,7 @@ json to_payload(const std::string& key, const ImageScene& is) {
   j["page"] = is.page;
   j["pages"] = is.pages;
   j["document_title"] = is.document_title;
+  j["document_language"] = is.document_language;
   if (!is.picture.empty()) {
     std::vector<std::uint8_t> jpeg;
     if (!cv::imencode(".jpg", is.picture, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90}))
@@ -362,6 +363,7 @@ ImageScene from_payload(const json& j, const std::string& key) {
   is.page = j.at("page").get<int>();
   is.pages = j.at("pages").get<int>();
   is.document_title = j.at("document_title").get<std::string>();
+  is.document_language = j.value("document_language", std::string());  // entries written before it was kept
   if (j.contains("picture")) is.picture = picture_from(j.at("picture"));
   text_from(j, is);
   geometry_from(j, is);

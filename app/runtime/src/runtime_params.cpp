@@ -21,6 +21,7 @@ audio::AudioSystemParams audio_params_from(const config::Settings& s) {
   p.languages = language_list(s.kiosk.languages);
   if (p.languages.empty()) p.languages = {"en"};
   p.language = s.kiosk.language;
+  p.english_voice = s.audio.voice == "espeak" ? std::string() : "flite:" + s.audio.voice.substr(6);
   p.speech.rate_wpm = s.audio.speech_rate_wpm;
   p.output.frames_per_buffer = s.audio.buffer_frames;
   p.volume_default_step = s.audio.volume_default_step;

@@ -279,6 +279,7 @@ void KioskFlow::describe_key() {
   // The hand on a block of text: that paragraph is read, by sentence (the reading keys move within the page).
   PageText page = fx_.stage.page_text();
   v_.reading = ReadAloud(page.paragraphs);
+  v_.reading_language = other_language(page.language);
   v_.reading_on = false;
   if (page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs()) {
     const ReadingPlace at{page.at_hand, 0};
@@ -286,7 +287,7 @@ void KioskFlow::describe_key() {
     const std::string& block = msg_.raw(MessageId::text_block);
     const std::string lead =
         msg_.expand(std::string_view(block).substr(0, block.find("{text}")), {}, key_args(p_.keys));
-    read_from(at, before + long_text_line(v_.reading.text_from(at)) + lead);
+    read_from(at, before + long_text_line(v_.reading.text_from(at)) + language_notice() + lead);
     return;
   }
   const std::string description = fx_.stage.describe();

@@ -21,6 +21,18 @@ void KioskFlow::follow_reading() {
   if (piece >= 0) v_.reading.heard(piece);
 }
 
+std::string KioskFlow::other_language(const std::string& tag) const {
+  const auto primary = [](const std::string& t) { return t.substr(0, t.find('-')); };
+  return !tag.empty() && primary(tag) != primary(msg_.language()) ? tag : std::string();
+}
+
+std::string KioskFlow::language_notice() const {
+  if (v_.reading_language.empty()) return {};
+  std::string name = fx_.speech.language_name_of(v_.reading_language);
+  if (name.empty()) name = v_.reading_language;
+  return text(MessageId::other_language, {{"name", name}}) + " ";
+}
+
 void KioskFlow::read_from(ReadingPlace at, const std::string& before) {
   // The lead is said in the same text, so the pieces heard count from its start; a line break ends it, so it
   // is cut as its own pieces whatever its last character.
@@ -29,7 +41,10 @@ void KioskFlow::read_from(ReadingPlace at, const std::string& before) {
   const int lead = static_cast<int>(audio::speech_pieces(said).size());
   if (!said.empty()) said += '\n';
   said += v_.reading.text_from(at);
-  fx_.speech.say(said);
+  if (v_.reading_language.empty())
+    fx_.speech.say(said);
+  else
+    fx_.speech.say_in(said, lead, v_.reading_language);
   v_.reading.started(at, lead);
   v_.reading_on = true;
   v_.reading_kept = fx_.speech.kept_texts();
@@ -41,13 +56,14 @@ void KioskFlow::reading_key(KioskKey k) {
     // Nothing being read: the page's text from the paragraph under the hand (else its first), if it has any.
     const PageText page = fx_.stage.page_text();
     v_.reading = ReadAloud(page.paragraphs);
+    v_.reading_language = other_language(page.language);
     v_.reading_on = false;
     if (v_.reading.empty()) {
       say_brief(MessageId::reading_none);
       return;
     }
     const int p = page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs() ? page.at_hand : 0;
-    read_from({p, 0}, paragraph_line(p));
+    read_from({p, 0}, language_notice() + paragraph_line(p));
     return;
   }
   const bool by_paragraph = k == KioskKey::NextParagraph || k == KioskKey::PreviousParagraph;

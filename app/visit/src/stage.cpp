@@ -75,6 +75,7 @@ void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes,
   sh.file_height_px = is.file_height_px > 0 ? is.file_height_px : is.picture.rows;
   sh.px_to_m = is.px_to_m;
   sh.text_blocks = is.text_blocks;
+  sh.text_language = is.document_language;
   sh.faces_m = is.faces_m;
   sh.notes = std::move(notes);
   publish(std::move(sh), std::move(is.scene), id, text_block_regions(is.text_blocks));
@@ -199,6 +200,7 @@ PageText Stage::page_text() {
     page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
   if (const TextBlockM* b = text_block_at(shown_.text_blocks, step_.display().proxy_m))
     page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
+  page.language = shown_.text_language;
   return page;
 }
 

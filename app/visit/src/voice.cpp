@@ -42,6 +42,24 @@ bool Voice::repeat() {
   return true;
 }
 
+void Voice::say_in(const std::string& text, int from_piece, const std::string& language) {
+  spdlog::info("say: {} (from piece {} in {})", one_line(text), from_piece, language);
+  last_said_ = text;
+  repeatable_ = text;
+  ++kept_texts_;
+  ++texts_said_;
+  brief_last_ = false;
+  audio_.say_text_in(text, true, static_cast<std::size_t>(std::max(0, from_piece)), language);
+}
+
+std::string Voice::language_name_of(const std::string& tag) const {
+  const std::string primary = tag.substr(0, tag.find('-'));
+  const auto& codes = audio_.languages();
+  for (std::size_t i = 0; i < codes.size(); ++i)
+    if (codes[i].substr(0, codes[i].find('-')) == primary) return audio_.catalogue(static_cast<int>(i)).language_name();
+  return {};
+}
+
 void Voice::set_language(int index) {
   if (index == audio_.language() || !audio_.set_language(index)) return;
   spdlog::info("kiosk: language {}", audio_.languages()[static_cast<std::size_t>(index)]);

@@ -1,6 +1,7 @@
 #pragma once
 /// @file speech.hpp
-/// Speech with espeak-ng, synthesised into our own mixer: espeak-ng only makes
+/// Speech with espeak-ng (every language) or CMU Flite (its English voices), synthesised into our own mixer:
+/// the synthesisers only make
 /// samples (AUDIO_OUTPUT_SYNCHRONOUS + espeak_SetSynthCallback, never its own playback); they are
 /// resampled from espeak-ng's rate (22050 Hz) to kSampleRateHz with libsamplerate and handed to the audio
 /// callback through a SpeechStream, so speech can be cut at once, repeated, and mixed with the earcons
@@ -30,8 +31,9 @@ namespace hk::audio {
 
 /// Voice settings. Units in names.
 struct SpeechParams {
-  /// espeak-ng voice name as espeak_SetVoiceByName takes it ("en", "en-us", "de", "en+f3" for a variant).
-  /// espeak-ng accepts an unknown variant after '+' silently (the base voice is used).
+  /// espeak-ng voice name as espeak_SetVoiceByName takes it ("en", "en-us", "de", "en+f3" for a variant;
+  /// espeak-ng accepts an unknown variant after '+' silently), or a CMU Flite English voice: "flite:slt",
+  /// "flite:kal", "flite:awb", "flite:rms" (pitch is the voice's own there).
   std::string voice = "en";
   int rate_wpm = 165;  ///< speaking rate [words/min], [80, 450] (espeakRATE_MINIMUM .. espeakRATE_MAXIMUM)
   int pitch = 50;      ///< base pitch, [0, 100] (espeakPITCH); 50 is the voice's normal pitch
@@ -97,6 +99,10 @@ class Speaker {
   /// text only cancels (it is logged, and last_text() keeps the previous text). Never throws for a text's
   /// length: over kMaxSpeechTextBytes it is cut at the last piece that fits (logged as a warning).
   void say(std::string text, bool keep = true);
+  /// As say(), but its pieces from `from_piece` on (speech_pieces, from 0) in `voice` (a document's text in its
+  /// own language after words in the visitor's). @throws SpeechError when the synthesisers have no such voice
+  /// (nothing is said then).
+  void say_switching(std::string text, bool keep, std::size_t from_piece, const std::string& voice);
   /// Says last_text() again, from its start, in the voice it was said in (nothing if there was none). Logged
   /// like say().
   void repeat();
@@ -148,15 +154,18 @@ class Speaker {
 
  private:
   void run();
-  void submit(std::string text, bool keep, bool again);  // cancels and queues; caller holds m_
+  void submit(std::string text, bool keep, bool again, std::size_t switch_from = SIZE_MAX,
+              const SpeechParams* switch_to = nullptr);  // cancels and queues; caller holds m_
   bool speak_piece(const std::string& piece, const SpeechParams& params, std::uint32_t gen,
                    std::uint64_t* pushed);  // false: cancelled; *pushed += samples handed over
 
   SpeechStream& stream_;
   mutable std::mutex m_;
-  SpeechParams params_;       // the voice of the next say()
-  SpeechParams job_params_;   // the waiting text's
-  SpeechParams last_params_;  // last_'s
+  SpeechParams params_;                                                   // the voice of the next say()
+  SpeechParams job_params_;                                               // the waiting text's
+  SpeechParams last_params_;                                              // last_'s
+  std::size_t job_switch_from_ = SIZE_MAX, last_switch_from_ = SIZE_MAX;  // pieces from here in *_switch_params_
+  SpeechParams job_switch_params_, last_switch_params_;
   std::condition_variable cv_;
   bool has_job_ = false;  // a text waits for the worker
   std::uint32_t job_generation_ = 0;

@@ -38,6 +38,9 @@ struct AudioSystemParams {
   std::vector<std::string> languages{"en"};
   /// The language each visit starts in; one of `languages` (else the first of them that loads).
   std::string language = "en";
+  /// The voice English is spoken with (SpeechParams::voice: "flite:slt"); empty: espeak-ng's "en". Every other
+  /// language speaks with its espeak-ng voice.
+  std::string english_voice;
   /// Where the compiled catalogues are (audio::default_locale_dir(): this build's or the package's).
   std::filesystem::path locale_dir = default_locale_dir();
 };
@@ -64,6 +67,10 @@ class AudioSystem {
   /// Speaks free text (e.g. a picture description), cutting off whatever is being said. `keep` as
   /// Speaker::say: false for an acknowledgement, which Speaker::repeat passes over. Any length (Speaker::say).
   void say_text(std::string text, bool keep = true);
+  /// As say_text(), but its pieces from `from_piece` on in the voice of `language` (a BCP 47 tag: English's
+  /// voice for "en", else espeak-ng's voice of its language subtag). A language without a voice is said in the
+  /// voice in use (logged once per language).
+  void say_text_in(std::string text, bool keep, std::size_t from_piece, const std::string& language);
   /// Holds speech where it is (Speaker::pause); false when nothing is being said.
   bool pause_speech();
   /// Goes on from the pause (Speaker::resume); false when not paused.
@@ -114,12 +121,15 @@ class AudioSystem {
 
  private:
   void load_languages(const AudioSystemParams& p);
+  /// The voice of languages()[index]: english_voice_ for English, else its espeak-ng voice.
+  std::string voice_of(int index) const;
 
   std::vector<MessageCatalog> catalogues_;   // one per offered language that loaded
   std::vector<std::string> language_codes_;  // their tags
   int language_ = 0, default_language_ = 0;
-  std::set<std::string> missing_voices_;  // voices espeak-ng refused, each logged once
-  MessageCatalog catalog_;                // a copy of catalogues_[language_]: what messages() hands out
+  std::set<std::string> missing_voices_;  // voices the synthesisers refused, each logged once
+  std::string english_voice_;
+  MessageCatalog catalog_;  // a copy of catalogues_[language_]: what messages() hands out
   SpscRing<CueEvent> cues_;
   SpscRing<CueEvent> ui_cues_;  // the window thread's earcons (play)
   SpeechStream speech_stream_;

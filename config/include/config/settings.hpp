@@ -164,9 +164,10 @@ struct VisionSettings {
                               ///< page of text, PDF pages without a text layer), "always" (every picture), "off"; the
                               ///< kiosk feels the picture at once and reads its text meanwhile (about 10 s a page)
   std::string ocr_languages;  ///< key ocr_languages, Tesseract languages '+'-joined ("eng", "eng+deu"); empty = the
-                              ///< message catalogue's language
+                              ///< kiosk's language ([kiosk] language) and English ("fra+eng")
   double ocr_min_confidence =
-      0.6;  ///< key ocr_min_confidence, words Tesseract is less sure of are said as "unclear word", [0, 1]
+      0.6;  ///< key ocr_min_confidence, marks with no letter or digit Tesseract is less sure of are said as "unclear
+            ///< word" (words are said as read), a paragraph with no word this sure is left out, [0, 1]
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const VisionSettings&) const = default;
@@ -185,11 +186,13 @@ struct WorkspaceSettings {
 struct AudioSettings {
   int volume_default_step =
       7;  ///< key volume_default_step, volume at the start of every session, [1, 10] (10 = loudest)
-  double volume_step_db = 3.0;  ///< key volume_step_db, loudness change per volume step, [1, 6] dB
-  double earcon_gain = 0.5;     ///< key earcon_gain, level of the earcons before the volume, [0, 1]
-  double duck_db = -14.0;       ///< key duck_db, earcons are this much quieter while speech plays, [-40, 0] dB
-  int speech_rate_wpm = 165;    ///< key speech_rate_wpm, speaking rate, [80, 450] words/min
-  int buffer_frames = 256;      ///< key buffer_frames, audio output buffer, [32, 4096] frames (at 48 kHz: 256 = 5.3 ms)
+  double volume_step_db = 3.0;      ///< key volume_step_db, loudness change per volume step, [1, 6] dB
+  double earcon_gain = 0.5;         ///< key earcon_gain, level of the earcons before the volume, [0, 1]
+  double duck_db = -14.0;           ///< key duck_db, earcons are this much quieter while speech plays, [-40, 0] dB
+  int speech_rate_wpm = 165;        ///< key speech_rate_wpm, speaking rate, [80, 450] words/min
+  std::string voice = "flite-slt";  ///< key voice, English's voice: "flite-slt", "flite-kal", "flite-awb", "flite-rms"
+                                    ///< (CMU Flite) or "espeak" (espeak-ng); other languages speak with espeak-ng
+  int buffer_frames = 256;  ///< key buffer_frames, audio output buffer, [32, 4096] frames (at 48 kHz: 256 = 5.3 ms)
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.
   bool operator==(const AudioSettings&) const = default;

@@ -10,11 +10,12 @@
 ///
 /// In the worker: tesseract::TessBaseAPI with the LSTM engine and automatic page segmentation on the grey
 /// pixels; the layout read back with its ResultIterator at block, paragraph, line and word level (boxes and
-/// confidences). A word below the confidence threshold is unclear: it is kept in its place in the block's text
-/// as kUnclearWord, never read as if certain (the kiosk says "unclear word" there); a word below
-/// kNoiseWordConfidence as well is dropped as noise. A paragraph with no word at or above the threshold, or
-/// whose clear words are mostly not letters or digits, is dropped; the rest are the text blocks, in Tesseract's
-/// reading order.
+/// confidences). Every word is said as Tesseract read it, however unsure (a code word such as "mime.cache" is
+/// often read right with a low confidence, and cutting it loses real text); only a mark below the confidence
+/// threshold with no letter or digit in it is unclear: kept in its place in the block's text as kUnclearWord (the
+/// kiosk says "unclear word" there). A word below kNoiseWordConfidence as well is dropped as noise. A paragraph with no
+/// word at or above the threshold, or whose clear words are mostly not letters or digits, is dropped; the rest are the
+/// text blocks, in Tesseract's reading order.
 
 #include <atomic>
 #include <cstdint>
@@ -28,11 +29,11 @@
 
 namespace hk::vision {
 
-/// What stands in an OcrBlock's text for one unclear word (a word Tesseract is less sure of than
-/// OcrParams::min_word_confidence): U+FFFD, the replacement character, as a word of its own.
+/// What stands in an OcrBlock's text for one unclear word (a mark with no letter or digit that Tesseract is less
+/// sure of than OcrParams::min_word_confidence): U+FFFD, the replacement character, as a word of its own.
 inline constexpr std::string_view kUnclearWord = "\xEF\xBF\xBD";
 /// A word below this confidence, and below OcrParams::min_word_confidence, is noise: left out altogether [0, 1].
-inline constexpr double kNoiseWordConfidence = 0.3;
+inline constexpr double kNoiseWordConfidence = 0.1;
 
 /// Test hook: the worker fails on purpose as soon as it has started. Never set outside tests.
 enum class OcrFault {
@@ -49,7 +50,8 @@ struct OcrParams {
   /// Tesseract's data folder; empty: Tesseract's own default (Debian: /usr/share/tesseract-ocr/5/tessdata).
   std::string tessdata_dir;
   double min_word_confidence =
-      0.6;  ///< a word below this (Tesseract's confidence / 100, [0, 1]) is unclear (kUnclearWord)
+      0.6;  ///< below this (Tesseract's confidence / 100, [0, 1]) a mark with no letter or digit is unclear
+            ///< (kUnclearWord) and a word does not count towards keeping its block; a word is still said
   double min_letter_share = 0.5;  ///< a block whose characters are less than this share letters or digits is dropped
   double max_pixels = 4e7;        ///< a larger picture is refused before the worker starts [px]
   double worker_cpu_s = 30.0;     ///< RLIMIT_CPU of the worker [s]

@@ -60,12 +60,21 @@ struct PdfLimits {
 /// Longest document title passed on [bytes]: a longer Info /Title is no title a person would hear, and is dropped.
 inline constexpr std::size_t kMaxPdfTitleBytes = 1024;
 
+/// Longest language tag passed on [bytes] (BCP 47 tags the kiosk takes: hk::is_language_tag).
+inline constexpr std::size_t kMaxLanguageTagBytes = 35;
+
+/// A PDF's /Lang as a language tag the kiosk takes ("fr", "de-CH"): '_' made '-', the language subtag lower case;
+/// "" when it is not a tag (hk::is_language_tag) or longer than kMaxLanguageTagBytes.
+std::string pdf_language_tag(std::string_view lang);
+
 struct PdfInfo {
   int pages = 0;  ///< pages offered (min(real pages, max_pages)), >= 1
   /// The document's title as its Info dictionary gives it (poppler's document::get_title, UTF-8), as written:
   /// unchecked text from a stranger's file — check it before speaking it (app::usable_note). Empty when it has
   /// none or it is longer than kMaxPdfTitleBytes.
   std::string title;
+  /// The document's language, its catalog's /Lang as pdf_language_tag makes it ("fr"); "" when it does not say.
+  std::string language;
   int pages_in_file = 0;       ///< pages the document has
   bool capped = false;         ///< pages_in_file > max_pages
   double worker_ms = 0.0;      ///< wall time of the worker [ms]
@@ -105,6 +114,7 @@ struct PdfPage {
   std::vector<TextBlock> blocks;       ///< words grouped (group_text_blocks)
   int pages = 0;                       ///< pages offered by the document (as PdfInfo::pages)
   std::string title;                   ///< the document's title, unchecked (as PdfInfo::title)
+  std::string language;                ///< the document's language (as PdfInfo::language)
   double worker_ms = 0.0;              ///< wall time of the worker [ms]
   long worker_max_rss_kb = 0;          ///< the worker's peak resident memory [KiB] (as PdfInfo's)
 };

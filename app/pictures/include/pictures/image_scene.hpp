@@ -97,10 +97,11 @@ using TextBuild = std::function<ImageScene(const std::atomic<bool>* cancel)>;
 ///   chains_found --thin-line merging--> chains_after_thin_lines --gap closing--> chains_after_gaps
 ///   = chains_too_short + chains_along_border + chains_over_max_shapes + chains_over_budget + polylines.size().
 struct ImageScene {
-  std::string image_path;      ///< the file (for a document page: the PDF)
-  int page = 0;                ///< document page shown (from 1); 0 for a picture file
-  int pages = 0;               ///< pages the document offers; 0 for a picture file
-  std::string document_title;  ///< a PDF's own title (documents.hpp pdf_title), "" when none or a picture file
+  std::string image_path;         ///< the file (for a document page: the PDF)
+  int page = 0;                   ///< document page shown (from 1); 0 for a picture file
+  int pages = 0;                  ///< pages the document offers; 0 for a picture file
+  std::string document_title;     ///< a PDF's own title (documents.hpp pdf_title), "" when none or a picture file
+  std::string document_language;  ///< a PDF's language (its /Lang, vision::PdfPage::language), "" when it does not say
   /// A library picture's title and description (picture_notes.hpp), read where the scene was built (reading
   /// them parses the whole file, too slow for the window thread); empty for everything else.
   PictureNotes notes;

@@ -5,6 +5,8 @@
 /// runtime/runtime_params.hpp the one place where a setting becomes a parameter: every part's own
 /// parameter struct keeps its defaults and units; these functions copy the settings' values into it.
 
+#include <string>
+#include <string_view>
 #include "config/settings.hpp"
 #include "pictures/capture.hpp"
 #include "vision/frame_source.hpp"
@@ -28,9 +30,14 @@ vision::ScanLimits scan_limits_from(const config::Settings& s);
 /// [stick] settings as the PDF worker's limits (page_timeout_s is both the wall-clock and the CPU limit).
 vision::PdfLimits pdf_limits_from(const config::Settings& s);
 
-/// vision::OcrParams from the [vision] settings: the languages (empty: "eng", the language of the kiosk's
-/// message catalogue) and the confidence threshold.
+/// vision::OcrParams from the [vision] settings: the languages (empty: tesseract_languages_for the kiosk's
+/// [kiosk] language) and the confidence threshold.
 vision::OcrParams ocr_params_from(const config::Settings& settings);
+
+/// The Tesseract languages that read text in the language `tag` (BCP 47): its own data and English ("fr" →
+/// "fra+eng"), "eng" for English and for a language the kiosk has no Tesseract code for (en, fr, de, es, it,
+/// pt, nl are known).
+std::string tesseract_languages_for(std::string_view tag);
 
 /// The edge pipeline's parameters from [vision] and [workspace]: input limits, edge detector and its
 /// thresholds, the working size, the workspace (chains are kept down to 2 px here; length is judged in

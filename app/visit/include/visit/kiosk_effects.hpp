@@ -30,6 +30,7 @@ namespace hk::app {
 struct PageText {
   std::vector<std::string> paragraphs;  ///< its blocks of text in reading order; empty: no text
   int at_hand = -1;                     ///< the paragraph under the hand, −1 when none is
+  std::string language;                 ///< the text's language (BCP 47) as its document says it, "" unknown
 };
 
 /// What is said, and what is heard of it.
@@ -65,6 +66,18 @@ class SpeechEffects {
   virtual int default_language() const { return 0; }
   /// Speaks and answers in language `index` from now on (the catalogue and the voice); out of range: nothing.
   virtual void set_language(int index) { (void)index; }
+  /// As say(), but from its piece `from_piece` on (audio::speech_pieces) in the voice of `language` (a BCP 47
+  /// tag): a document's text in its own language after the visitor's words before it.
+  virtual void say_in(const std::string& text, int from_piece, const std::string& language) {
+    (void)from_piece;
+    (void)language;
+    say(text);
+  }
+  /// The name of language `tag` in itself ("Français") where the kiosk offers it; "" otherwise.
+  virtual std::string language_name_of(const std::string& tag) const {
+    (void)tag;
+    return {};
+  }
 };
 
 /// What is on the device and the screen, and what is said of it.

@@ -262,6 +262,7 @@ class KioskFlow {
     double last_activity_s = 0;
     double next_invitation_s = 0;  // Attract: when the next spoken invitation is due
     int invitation_language = -1;  // Attract: the language of the last invitation, −1 before the first
+    std::string reading_language;  // the text being read is in this language, not the visitor's ("" theirs)
     bool warned = false;
     double warned_at_s = 0;      // when the first time-out warning was said
     bool rewarned = false;       // the second warning was said
@@ -302,6 +303,10 @@ class KioskFlow {
   void volume_key(int delta);
   void finish_key(double now_s);
   void language_key();
+  /// `tag` when it names another language than the visitor's (by language subtag), else "".
+  std::string other_language(const std::string& tag) const;
+  /// "In Français: " before a text in v_.reading_language, "" when it is the visitor's.
+  std::string language_notice() const;
   void describe_key();
   void reading_key(KioskKey k);  // the sentence and paragraph keys
   void repeat_key();

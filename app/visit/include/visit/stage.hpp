@@ -48,6 +48,7 @@ struct Shown {
   vision::PxToM px_to_m{1, 0, 0};       ///< picture pixels → workspace metres
   const Scene* scene = nullptr;         ///< the published scene (read-only here; for the overlay)
   std::vector<TextBlockM> text_blocks;  ///< a document page's text (Describe reads the one under the hand)
+  std::string text_language;            ///< the language of `text_blocks` as the document says it, "" unknown
   std::vector<Aabb> faces_m;            ///< faces guessed in the picture [m] (ImageScene::faces_m)
   PictureNotes notes;                   ///< a library picture's title and description (its sidecar)
   /// What each of `polylines` looks like (form, colour, size, speck), one per polyline.
