@@ -570,6 +570,26 @@ std::string_view group_name(FieldGroup g) noexcept {
   return "";
 }
 
+std::string field_label(const FieldDescriptor& d) {
+  std::string_view h = d.help;
+  const std::size_t end = std::min({h.find(". "), h.find(':'), h.find(';'), h.find(", "), h.find(" ("), h.size()});
+  std::string label(h.substr(0, end));
+  // Another setting's key is no staff word: the label stops before it ("... for pop_hold_s" → "... for ...").
+  bool cut = false;
+  if (const std::size_t u = label.find('_'); u != std::string::npos) {
+    const std::size_t word = label.rfind(' ', u);
+    label = label.substr(0, word == std::string::npos ? 0 : word);
+    cut = true;
+  }
+  while (!label.empty() && (label.back() == '.' || label.back() == ' ')) label.pop_back();
+  if (cut && !label.empty()) label += " ...";
+  if (label.size() > kMaxFieldLabelBytes) {
+    const std::size_t cut = label.rfind(' ', kMaxFieldLabelBytes);
+    label = label.substr(0, cut == std::string::npos ? kMaxFieldLabelBytes : cut) + " ...";
+  }
+  return label.empty() ? std::string(d.table) + "." + std::string(d.key) : label;
+}
+
 std::span<const std::string_view> visitor_key_names() noexcept { return kKeyNames; }
 
 std::optional<KeyChord> parse_chord(std::string_view text, std::string* why) {

@@ -59,6 +59,21 @@ TEST(PictureNotes, ASidecarGivesTheTitleAndDescriptionTrimmed) {
   fs::remove_all(dir);
 }
 
+TEST(PictureNotes, EachLanguageHasItsOwnTitleAndDescription) {
+  const fs::path dir = fresh_dir("notes_languages");
+  const PictureNotes n = read_picture_notes(
+      with_sidecar(dir,
+                   "title = \"a horse\"\ndescription = \"A horse standing.\"\n[fr]\ntitle = \"un cheval\"\n"
+                   "description = \"Un cheval debout.\"\n[de]\ntitle = \"ein Pferd\"\n"));
+  EXPECT_EQ(notes_in(n, "en").title, "a horse");
+  EXPECT_EQ(notes_in(n, "fr").title, "un cheval");
+  EXPECT_EQ(notes_in(n, "fr-CA").description, "Un cheval debout.") << "the language subtag's table";
+  EXPECT_EQ(notes_in(n, "de").title, "ein Pferd");
+  EXPECT_EQ(notes_in(n, "de").description, "A horse standing.") << "no German description: the top-level one";
+  EXPECT_EQ(notes_in(n, "es").title, "a horse");
+  fs::remove_all(dir);
+}
+
 TEST(PictureNotes, BadSidecarsAreRefusedWithOneLineNamingTheFileAndTheLimit) {
   const fs::path dir = fresh_dir("notes_bad");
   const std::string long_title = "title = \"" + std::string(201, 'a') + "\"\n";
@@ -69,7 +84,12 @@ TEST(PictureNotes, BadSidecarsAreRefusedWithOneLineNamingTheFileAndTheLimit) {
       {"title = \"a horse\n", "picture notes 'pic.toml': TOML syntax error at line 1"},
       {"title = 3\n", "picture notes 'pic.toml': title must be a string"},
       {"titel = \"a horse\"\n",
-       "picture notes 'pic.toml': unknown key 'titel' (title, description and guesses are known)"},
+       "picture notes 'pic.toml': unknown key 'titel' (title, description, guesses and a table per language such as "
+       "[fr] are known)"},
+      {"[fr]\ntitre = \"un cheval\"\n",
+       "picture notes 'pic.toml': unknown key 'fr.titre' (title and description are known)"},
+      {"[FR]\ntitle = \"un cheval\"\n", "picture notes 'pic.toml': unknown key 'FR'"},
+      {"[de]\ntitle = \"   \"\n", "picture notes 'pic.toml': de.title is blank"},
       {"guesses = \"no\"\n", "picture notes 'pic.toml': guesses must be true or false"},
       {long_title, "picture notes 'pic.toml': title is 201 bytes, at most 200"},
       {"title = \"   \"\n", "picture notes 'pic.toml': title is blank"},
@@ -250,6 +270,11 @@ TEST(PictureNotes, EveryShippedPictureHasATitle) {
     const PictureNotes n = read_picture_notes(p);
     EXPECT_FALSE(n.title.empty()) << p;
     EXPECT_FALSE(n.description.empty()) << p;
+    for (const char* lang : {"fr", "de", "es"}) {  // each offered language has its own words
+      ASSERT_EQ(n.translations.count(lang), 1u) << p << " has no [" << lang << "]";
+      EXPECT_FALSE(n.translations.at(lang).title.empty()) << p << " " << lang;
+      EXPECT_FALSE(n.translations.at(lang).description.empty()) << p << " " << lang;
+    }
   }
 }
 

@@ -503,7 +503,8 @@ TEST_F(SceneCacheTest, AFileSeenBeforeIsFoundByItsStampWithTheFilesOwnNotes) {
   EXPECT_FALSE(SceneCache::stamp((root_ / "missing.png").string()));
 
   ImageScene is = copy_of(horse(), s_);
-  is.file_notes = {"A horse", "Drawn from the side."};
+  is.file_notes.title = "A horse";
+  is.file_notes.description = "Drawn from the side.";
   const std::string key = SceneCache::key(read_bytes(pic), s_);
   ASSERT_TRUE(cache.store(key, is));
   cache.remember_key(*stamp, s_, key);

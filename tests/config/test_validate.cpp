@@ -450,3 +450,21 @@ TEST(SceneCacheSetting, TakesAutoOffOrAnAbsoluteFolderOnly) {
 
 }  // namespace
 }  // namespace hk::config
+
+namespace hk::config {
+namespace {
+
+TEST(ConfigFields, EachFieldHasAShortNameInStaffWords) {
+  EXPECT_EQ(field_label(*find_field("haptics", "stiffness_n_per_m")), "Wall stiffness");
+  EXPECT_EQ(field_label(*find_field("audio", "speech_rate_wpm")), "Speaking rate");
+  EXPECT_EQ(field_label(*find_field("kiosk", "languages")), "The languages offered to visitors");
+  for (const FieldDescriptor& d : field_descriptors()) {
+    const std::string label = field_label(d);
+    EXPECT_FALSE(label.empty()) << d.table << "." << d.key;
+    EXPECT_LE(label.size(), kMaxFieldLabelBytes + 4) << label;
+    EXPECT_EQ(label.find('_'), std::string::npos) << d.table << "." << d.key << ": a key, not words: " << label;
+  }
+}
+
+}  // namespace
+}  // namespace hk::config

@@ -1,6 +1,9 @@
 // A picture's title and description from its sidecar file: read_picture_notes.
 #include "formats/picture_notes.hpp"
 
+#include "hk/language.hpp"
+#include "hk/text.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -170,11 +173,34 @@ PictureNotes read_sidecar(const std::string& file) {
       const toml::value<bool>* flag = node.as_boolean();
       if (!flag) fail(file, "guesses must be true or false");
       notes.guesses = flag->get();
+    } else if (node.is_table() && hk::is_language_tag(name)) {
+      PictureNotes::Translation& t = notes.translations[name];
+      for (auto&& [inner_key, inner] : *node.as_table()) {
+        const std::string inner_name(inner_key.str());
+        if (inner_name == "title")
+          t.title = checked_text(file, name + ".title", inner, kMaxTitleBytes, false);
+        else if (inner_name == "description")
+          t.description = checked_text(file, name + ".description", inner, kMaxDescriptionBytes, true);
+        else
+          fail(file,
+               "unknown key '" + name + "." + hk::one_line(inner_name, 60) + "' (title and description are known)");
+      }
     } else {
-      fail(file, "unknown key '" + name + "' (title, description and guesses are known)");
+      fail(file, "unknown key '" + hk::one_line(name, 60) +
+                     "' (title, description, guesses and a table per language such as [fr] are known)");
     }
   }
   return notes;
+}
+
+PictureNotes notes_in(const PictureNotes& notes, std::string_view language) {
+  PictureNotes out = notes;
+  auto it = notes.translations.find(std::string(language));
+  if (it == notes.translations.end()) it = notes.translations.find(std::string(language.substr(0, language.find('-'))));
+  if (it == notes.translations.end()) return out;
+  if (!it->second.title.empty()) out.title = it->second.title;
+  if (!it->second.description.empty()) out.description = it->second.description;
+  return out;
 }
 
 }  // namespace hk::app

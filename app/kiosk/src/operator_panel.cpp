@@ -183,7 +183,12 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
     const std::string key = std::string(d.table) + "." + std::string(d.key);
     ImGui::TableNextRow();
     ImGui::TableNextColumn();
-    ImGui::TextUnformatted(key.c_str());
+    // The setting in staff words, its key small and grey beside it for those who edit the file, then its help.
+    ImGui::TextUnformatted(config::field_label(d).c_str());
+    ImGui::SameLine();
+    ImGui::SetWindowFontScale(0.8f);
+    ImGui::TextColored(kGrey, "%s", key.c_str());
+    ImGui::SetWindowFontScale(1.0f);
     ImGui::PushStyleColor(ImGuiCol_Text, kGrey);
     ImGui::TextWrapped("%.*s", static_cast<int>(d.help.size()), d.help.data());
     ImGui::PopStyleColor();

@@ -172,7 +172,8 @@ void Stage::set_names(std::vector<meaning::NamedRegion> regions, std::vector<int
 }
 
 ShownView Stage::view() const {
-  return {shown_.polylines,   shown_.descriptors, shown_.text_blocks, shown_.notes,    half_,
+  said_notes_ = notes_in(shown_.notes, audio_.messages().language());
+  return {shown_.polylines,   shown_.descriptors, shown_.text_blocks, said_notes_,     half_,
           showing_tutorial(), source_.page > 0,   &shown_.names,      &shown_.regions, shown_.px_to_m};
 }
 

@@ -102,6 +102,12 @@ struct FieldDescriptor {
 /// What `d` allows, as the loader's messages say it: "[10, 5000] N/m", "one of \"auto\", \"fixed\"", "text".
 [[nodiscard]] std::string field_allowed_text(const FieldDescriptor& d);
 
+/// The field's name in staff words, for the operator's panel: its help's first phrase (up to the first full stop,
+/// colon, semicolon, comma or opening parenthesis, and before another setting's key), at most kMaxFieldLabelBytes
+/// (cut at a word), e.g. "Speaking rate" for [audio] speech_rate_wpm; the key when the help is empty.
+[[nodiscard]] std::string field_label(const FieldDescriptor& d);
+inline constexpr std::size_t kMaxFieldLabelBytes = 48;
+
 /// Largest settings file load_settings() reads, in bytes (1 MiB).
 inline constexpr std::uintmax_t kMaxConfigFileBytes = 1u << 20;
 

@@ -7,13 +7,19 @@
 ///     description = "A horse standing, its head to the left."
 ///     guesses = false   # optional: no faces or text guessed on it
 ///
+///     [fr]              # optional, one table per language (a BCP 47 tag): said to a visitor in that language
+///     title = "un cheval, vu de côté"
+///     description = "Un cheval debout, la tête à gauche."
+///
 /// The kiosk speaks the title when the picture is shown ("Picture 2 of 5: a horse, seen from the side.") and
 /// both first when the visitor asks for a description. Written by people, so read with care: a sidecar that
 /// cannot be used is refused with one line, and the picture is shown without it.
 
 #include <cstddef>
+#include <map>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include "hk/error.hpp"
 
 namespace hk::app {
@@ -25,7 +31,17 @@ struct PictureNotes {
   /// Whether the kiosk's own guesses name parts of the picture (faces, text blocks: picture_names.hpp); a
   /// sidecar's `guesses = false` turns them off (a false face on an artwork).
   bool guesses = true;
+  /// The title and description in other languages, by BCP 47 tag ("fr"): the sidecar's [fr] table; either may
+  /// be empty (the top-level one is said then).
+  struct Translation {
+    std::string title, description;
+  };
+  std::map<std::string, Translation> translations;
 };
+
+/// `notes` as said to a visitor in `language` (a BCP 47 tag): its translation's title and description where
+/// the sidecar has them (the tag, else its language subtag: "fr-CA" takes [fr]), else the top-level ones.
+PictureNotes notes_in(const PictureNotes& notes, std::string_view language);
 
 inline constexpr std::size_t kMaxNotesFileBytes = 16 * 1024;
 inline constexpr std::size_t kMaxTitleBytes = 200;

@@ -88,7 +88,8 @@ class Stage final : public StageEffects {
 
   /// Puts practice shape `shape` on the device (a library picture still being built is not wanted any more).
   void show_tutorial(TutorialShape shape) override;
-  PictureNotes shown_notes() const override { return shown_.notes; }
+  /// The shown picture's notes in the language in use (notes_in).
+  PictureNotes shown_notes() const override { return notes_in(shown_.notes, audio_.messages().language()); }
   /// What the picture or page holds (describe.hpp), led by "Reading the text." while its text is read.
   std::string describe() override;
   /// "What is here": on a document page, the block of text under the hand (its number and first words);
@@ -157,6 +158,7 @@ class Stage final : public StageEffects {
   const config::Settings& s_;
   Vec2 half_;
   Shown shown_;
+  mutable PictureNotes said_notes_;  // shown_.notes in the language in use, what view() hands out
   int shown_id_ = -100;
   ShownSource source_;
   std::uint64_t scenes_published_ = 0;
