@@ -47,7 +47,7 @@ void KioskFlow::capture_failed(bool timeout, double now_s) {
 // ---- USB sticks --------------------------------------------------------------------------------------
 
 std::string KioskFlow::stick_summary() const {
-  // English phrase for {summary}; the sentence around it comes from the catalogue.
+  // The {summary} of stick_inserted, from the catalogue's summary_* words.
   int pictures = 0, pdfs = 0, pages = 0, capped = 0;
   for (const StickEntry& e : v_.stick) {
     pictures += !e.pdf;
@@ -55,21 +55,20 @@ std::string KioskFlow::stick_summary() const {
     pages += e.pdf ? std::max(e.pages, e.pages_in_file) : 0;
     capped = std::max(capped, e.pdf && e.pages_in_file > e.pages ? e.pages : 0);
   }
-  auto count = [](int n, const char* one, const char* many) {
-    return n == 1 ? std::string(one) : std::to_string(n) + " " + many;
-  };
-  const int n = static_cast<int>(v_.stick.size());
-  std::string s = count(n, "one document", "documents") + ": ";
+  const std::string page_words = msg_.word("summary_pages", pages);
   std::string pdf_part;
-  if (pdfs == 1) {
-    pdf_part = "a PDF of " + count(pages, "one page", "pages");
-  } else if (pdfs > 1) {
-    pdf_part = std::to_string(pdfs) + " PDFs of " + count(pages, "one page", "pages") + " in all";
-  }
-  if (capped > 0) pdf_part += " (the first " + std::to_string(capped) + " pages of each can be read)";
-  if (pictures > 0 && pdfs > 0) return s + count(pictures, "a picture", "pictures") + " and " + pdf_part;
-  if (pictures > 0) return s + count(pictures, "a picture", "pictures");
-  return s + pdf_part;
+  if (pdfs == 1)
+    pdf_part = msg_.word("summary_one_pdf", 1, {{"pages", page_words}});
+  else if (pdfs > 1)
+    pdf_part = msg_.word("summary_pdfs", pdfs, {{"pages", page_words}});
+  if (capped > 0) pdf_part = msg_.word("summary_capped", capped, {{"pdfs", pdf_part}});
+  const std::string picture_part = pictures > 0 ? msg_.word("summary_pictures", pictures) : std::string();
+  const std::string what = pictures > 0 && pdfs > 0 ? msg_.word("summary_pictures_and_pdfs", 1,
+                                                                {{"pictures", picture_part}, {"pdfs", pdf_part}})
+                           : pictures > 0           ? picture_part
+                                                    : pdf_part;
+  return msg_.word("summary_all", 1,
+                   {{"documents", msg_.word("summary_documents", static_cast<long>(v_.stick.size()))}, {"what", what}});
 }
 
 std::string spoken_name(const std::string& name, bool file_name) {
