@@ -18,6 +18,7 @@
 #include <cstdint>
 
 #include "fuzz_common.hpp"
+#include "hk/language.hpp"
 
 namespace hk::vision {  // pdf.cpp's internals (Writer, Reader, Refusal, work) live in its anonymous namespace here
 namespace {
@@ -73,6 +74,9 @@ int run(std::span<const std::uint8_t> bytes, int page, const PdfLimits& limits) 
   std::string title;
   FUZZ_CHECK(in.i32(n) && n > 0, "page count");
   FUZZ_CHECK(in.str(title, hk::vision::kMaxPdfTitleBytes), "title");
+  std::string language;  // the catalog's /Lang, as pdf_language_tag makes it: a tag the kiosk takes, or ""
+  FUZZ_CHECK(in.str(language, hk::vision::kMaxLanguageTagBytes), "language");
+  FUZZ_CHECK(language.empty() || hk::is_language_tag(language), language);
   if (page == 0) {
     FUZZ_CHECK(in.left() == 0, "trailing bytes after a probe");
     return n;

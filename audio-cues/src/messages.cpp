@@ -56,6 +56,44 @@ std::string tidy_spaces(std::string text) {
   return out;
 }
 
+/// What is wrong with `mo` as a GNU MO file (the gettext manual, "The Format of GNU MO Files"), "" when nothing:
+/// the magic number in either byte order, and every string table entry and the hash table inside the file, each
+/// string NUL-terminated, each hash slot 0 or an entry's number + 1. Boost.Locale 1.74 reads the offsets as they
+/// are, so a file is checked before it is handed over.
+std::string mo_problem(const std::vector<char>& mo) {
+  const std::size_t size = mo.size();
+  if (size < 28) return "shorter than an MO header";
+  const auto u32 = [&](std::size_t at, bool swap) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) {
+      const auto byte = static_cast<std::uint32_t>(static_cast<unsigned char>(mo[at + static_cast<std::size_t>(i)]));
+      v |= swap ? byte << (8 * (3 - i)) : byte << (8 * i);
+    }
+    return v;
+  };
+  bool swap = false;
+  if (u32(0, false) != 0x950412deu) {
+    if (u32(0, true) != 0x950412deu) return "no MO magic number";
+    swap = true;
+  }
+  const std::uint64_t n = u32(8, swap), originals = u32(12, swap), translations = u32(16, swap);
+  const std::uint64_t hash_size = u32(20, swap), hash_at = u32(24, swap);
+  for (const std::uint64_t table : {originals, translations}) {
+    if (table + 8 * n > size) return "a string table runs past the end";
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const std::uint64_t len = u32(static_cast<std::size_t>(table + 8 * i), swap);
+      const std::uint64_t at = u32(static_cast<std::size_t>(table + 8 * i + 4), swap);
+      if (at + len >= size || mo[static_cast<std::size_t>(at + len)] != '\0') return "a string runs past the end";
+    }
+  }
+  if (hash_size > 0) {
+    if (hash_at + 4 * hash_size > size) return "the hash table runs past the end";
+    for (std::uint64_t i = 0; i < hash_size; ++i)
+      if (u32(static_cast<std::size_t>(hash_at + 4 * i), swap) > n) return "a hash slot names no string";
+  }
+  return {};
+}
+
 }  // namespace
 
 struct MessageCatalog::Compiled {
@@ -75,7 +113,7 @@ std::string MessageCatalog::translate(const MessageSource& s, long count) const 
     const char* t = s.many.empty() ? compiled_->facet->get(compiled_->domain, ctx.c_str(), one.c_str())
                                    : compiled_->facet->get(compiled_->domain, ctx.c_str(), one.c_str(), n);
     if (t && *t) return t;
-  }
+  }  // build() looked every entry up once: a file Boost.Locale cannot read was refused there
   return std::string(s.many.empty() || count == 1 ? s.one : s.many);
 }
 
@@ -125,6 +163,8 @@ MessageCatalog MessageCatalog::from_mo(std::string_view language, std::vector<ch
                                        const std::string& source) {
   const std::string where = "catalogue '" + hk::one_line(std::string(language)) + "' (" + hk::one_line(source) + "): ";
   if (!is_language_tag(language)) throw MessageError(where + "not a BCP 47 language tag such as \"fr\" or \"pt-BR\"");
+  if (const std::string why = mo_problem(mo_bytes); !why.empty())
+    throw MessageError(where + "not a gettext MO file (" + why + ")");
   namespace gg = boost::locale::gnu_gettext;
   gg::messages_info info;
   info.language = std::string(language.substr(0, language.find('-')));
@@ -150,7 +190,13 @@ MessageCatalog MessageCatalog::from_mo(std::string_view language, std::vector<ch
     throw MessageError(where + "not a gettext MO file (" + hk::one_line(e.what(), 120) + ")");
   }
   if (!handed) throw MessageError(where + "not read");
-  return build(language, std::move(compiled), source);
+  try {  // Boost.Locale reads parts of the file on the first lookups, which build() makes
+    return build(language, std::move(compiled), source);
+  } catch (const MessageError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw MessageError(where + "not a gettext MO file (" + hk::one_line(e.what(), 120) + ")");
+  }
 }
 
 MessageCatalog MessageCatalog::load(std::string_view language, const std::filesystem::path& locale_dir) {

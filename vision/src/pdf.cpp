@@ -26,10 +26,7 @@
 
 #include "vision/pdf.hpp"
 
-// qpdf 11: the std::shared_ptr API only, without its transition warning.
-#define POINTERHOLDER_TRANSITION 4
-#include <qpdf/QPDF.hh>
-#include <qpdf/QPDFObjectHandle.hh>
+#include "pdf_language.hpp"
 
 #include "hk/language.hpp"
 
@@ -151,18 +148,9 @@ std::string pdf_title(const poppler::document& doc) {
   return t.size() <= kMaxPdfTitleBytes ? t : std::string();
 }
 
-/// The document's language: its catalog's /Lang (PDF 32000-1 §14.9.2), read with qpdf since poppler-cpp does not
-/// expose it, as pdf_language_tag makes it; "" when it has none or qpdf cannot read the file.
+/// The document's language (pdf_language.hpp), as pdf_language_tag makes it.
 std::string pdf_language(std::span<const std::uint8_t> bytes) {
-  try {
-    QPDF q;
-    q.setSuppressWarnings(true);
-    q.processMemoryFile("document", reinterpret_cast<const char*>(bytes.data()), bytes.size());
-    QPDFObjectHandle lang = q.getRoot().getKey("/Lang");
-    return lang.isString() ? pdf_language_tag(lang.getUTF8Value()) : std::string();
-  } catch (const std::exception&) {  // a damaged catalog: no language, the page is still read by poppler
-    return {};
-  }
+  return pdf_language_tag(pdf_catalog_language(bytes.data(), bytes.size()));
 }
 
 /// Refuses (NoSuchPage) a page number past the `offered` first of the document's n pages, saying which.
