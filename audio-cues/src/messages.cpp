@@ -104,7 +104,7 @@ struct MessageCatalog::Compiled {
 
 std::filesystem::path default_locale_dir() { return HK_LOCALE_DIR; }
 
-std::string MessageCatalog::voice() const { return language_.substr(0, language_.find('-')); }
+std::string MessageCatalog::voice() const { return std::string(hk::language_subtag(language_)); }
 
 std::string MessageCatalog::translate(const MessageSource& s, long count) const {
   const std::string ctx(s.key), one(s.one);
@@ -167,7 +167,7 @@ MessageCatalog MessageCatalog::from_mo(std::string_view language, std::vector<ch
     throw MessageError(where + "not a gettext MO file (" + why + ")");
   namespace gg = boost::locale::gnu_gettext;
   gg::messages_info info;
-  info.language = std::string(language.substr(0, language.find('-')));
+  info.language = std::string(hk::language_subtag(language));
   info.encoding = "UTF-8";
   info.domains.emplace_back(std::string(kMessageDomain));
   info.paths.emplace_back("memory");
@@ -205,7 +205,7 @@ MessageCatalog MessageCatalog::load(std::string_view language, const std::filesy
   if (!is_language_tag(language))
     throw MessageError("catalogue '" + shown + "': not a BCP 47 language tag such as \"fr\" or \"pt-BR\"");
   std::filesystem::path file;
-  for (const std::string_view tag : {language, language.substr(0, language.find('-'))}) {
+  for (const std::string_view tag : {language, hk::language_subtag(language)}) {
     const auto f = locale_dir / std::string(tag) / "LC_MESSAGES" / (std::string(kMessageDomain) + ".mo");
     std::error_code ec;
     if (std::filesystem::is_regular_file(f, ec)) {

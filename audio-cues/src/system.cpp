@@ -1,4 +1,5 @@
 #include "audio/system.hpp"
+#include "hk/language.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -37,7 +38,7 @@ AudioSystem::AudioSystem(const AudioSystemParams& p)
   load_languages(p);
   english_voice_ = p.english_voice;
   SpeechParams sp = p.speech;
-  if (sp.voice.empty()) sp.voice = voice_of(language_);
+  if (sp.voice.empty()) sp.voice = voice_for(language_codes_[static_cast<std::size_t>(language_)]);
   speech_params_ = sp;
   try {
     speaker_ = std::make_unique<Speaker>(speech_stream_, sp);
@@ -61,11 +62,12 @@ bool AudioSystem::set_language(int index) {
   if (index == language_) return true;
   language_ = index;
   catalog_ = catalogues_[static_cast<std::size_t>(index)];
+  const std::string voice = voice_for(language_codes_[static_cast<std::size_t>(index)]);
   if (speaker_) {
     try {
-      speaker_->set_voice(voice_of(index));
+      speaker_->set_voice(voice);
     } catch (const SpeechError& e) {
-      if (missing_voices_.insert(voice_of(index)).second)  // once per voice
+      if (missing_voices_.insert(voice).second)  // once per voice
         spdlog::error("audio: {}; speaking {} with the voice 'en'", e.what(),
                       language_codes_[static_cast<std::size_t>(index)]);
       try {
@@ -78,9 +80,9 @@ bool AudioSystem::set_language(int index) {
   return true;
 }
 
-std::string AudioSystem::voice_of(int index) const {
-  const MessageCatalog& c = catalogue(index);
-  return c.voice() == "en" && !english_voice_.empty() ? english_voice_ : c.voice();
+std::string AudioSystem::voice_for(std::string_view language) const {
+  const std::string_view subtag = hk::language_subtag(language);
+  return subtag == "en" && !english_voice_.empty() ? english_voice_ : std::string(subtag);
 }
 
 const MessageCatalog& AudioSystem::catalogue(int index) const {
@@ -105,8 +107,7 @@ void AudioSystem::say_text(std::string text, bool keep) {
 
 void AudioSystem::say_text_in(std::string text, bool keep, std::size_t from_piece, const std::string& language) {
   if (!speaker_) return;
-  const std::string primary = language.substr(0, language.find('-'));
-  const std::string voice = primary == "en" && !english_voice_.empty() ? english_voice_ : primary;
+  const std::string voice = voice_for(language);
   try {
     speaker_->say_switching(text, keep, from_piece, voice);
   } catch (const SpeechError& e) {

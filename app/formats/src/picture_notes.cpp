@@ -196,7 +196,7 @@ PictureNotes read_sidecar(const std::string& file) {
 PictureNotes notes_in(const PictureNotes& notes, std::string_view language) {
   PictureNotes out = notes;
   auto it = notes.translations.find(std::string(language));
-  if (it == notes.translations.end()) it = notes.translations.find(std::string(language.substr(0, language.find('-'))));
+  if (it == notes.translations.end()) it = notes.translations.find(std::string(hk::language_subtag(language)));
   if (it == notes.translations.end()) return out;
   if (!it->second.title.empty()) out.title = it->second.title;
   if (!it->second.description.empty()) out.description = it->second.description;

@@ -1,5 +1,6 @@
 // The settings mapped to the picture side's parameters (picture_params.hpp).
 #include "pictures/picture_params.hpp"
+#include "hk/language.hpp"
 
 #include "vision/intake.hpp"
 
@@ -48,7 +49,7 @@ vision::PdfLimits pdf_limits_from(const config::Settings& s) {
 std::string tesseract_languages_for(std::string_view tag) {
   static constexpr std::pair<std::string_view, std::string_view> kCodes[] = {
       {"en", "eng"}, {"fr", "fra"}, {"de", "deu"}, {"es", "spa"}, {"it", "ita"}, {"pt", "por"}, {"nl", "nld"}};
-  const std::string_view primary = tag.substr(0, tag.find('-'));
+  const std::string_view primary = hk::language_subtag(tag);
   for (const auto& [bcp47, tess] : kCodes)
     if (bcp47 == primary) return tess == "eng" ? std::string("eng") : std::string(tess) + "+eng";
   return "eng";

@@ -254,12 +254,6 @@ void KioskFlow::volume_key(int delta) {
   say_brief(!changed ? MessageId::volume_limit : delta > 0 ? MessageId::volume_up : MessageId::volume_down);
 }
 
-void KioskFlow::language_key() {
-  const int n = fx_.speech.language_count();
-  if (n > 1) fx_.speech.set_language((fx_.speech.language() + 1) % n);
-  say(MessageId::language_name);  // in itself: "Français"
-}
-
 void KioskFlow::finish_key(double now_s) {
   if (v_.finish_asked_s >= 0 && now_s - v_.finish_asked_s <= kFinishConfirm_s) {
     end_session(now_s);
@@ -267,50 +261,6 @@ void KioskFlow::finish_key(double now_s) {
   }
   v_.finish_asked_s = now_s;
   say_brief(MessageId::finish_ask);
-}
-
-void KioskFlow::describe_key() {
-  std::string before;
-  // A visitor's own document is about to be heard by everyone near the kiosk: said once a visit, first.
-  if (v_.source == KioskSource::Stick && v_.doc >= 0 && !v_.read_aloud_said) {
-    v_.read_aloud_said = true;
-    before = text(MessageId::read_aloud_warning) + " ";
-  }
-  // The hand on a block of text: that paragraph is read, by sentence (the reading keys move within the page).
-  PageText page = fx_.stage.page_text();
-  v_.reading = ReadAloud(page.paragraphs);
-  v_.reading_language = other_language(page.language);
-  v_.reading_on = false;
-  if (page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs()) {
-    const ReadingPlace at{page.at_hand, 0};
-    // The catalogue's words before the text ("Text:"), as the block's text would be said with text_block.
-    const std::string& block = msg_.raw(MessageId::text_block);
-    const std::string lead =
-        msg_.expand(std::string_view(block).substr(0, block.find("{text}")), {}, key_args(p_.keys));
-    read_from(at, before + long_text_line(v_.reading.text_from(at)) + language_notice() + lead);
-    return;
-  }
-  const std::string description = fx_.stage.describe();
-  fx_.speech.say(before + long_text_line(description) + text(MessageId::describe, {{"description", description}}));
-}
-
-std::string KioskFlow::long_text_line(const std::string& said) const {
-  // A long text says how long it is before it starts (words at the voice's rate), and how to move through it.
-  const double seconds = spoken_seconds(said);
-  if (seconds <= kLongText_s) return {};
-  const int minutes = static_cast<int>(std::lround(seconds / 60.0));
-  return counted(MessageId::long_text_minutes, std::max(1, minutes)) + " ";
-}
-
-double spoken_seconds(std::string_view text) {
-  int words = 0;
-  bool in_word = false;
-  for (const char c : text) {
-    const bool space = std::isspace(static_cast<unsigned char>(c)) != 0;
-    words += !space && !in_word;
-    in_word = !space;
-  }
-  return 60.0 * words / kWordsPerMinute;
 }
 
 void KioskFlow::level_key(int delta) {
@@ -533,19 +483,6 @@ void KioskFlow::wake(double now_s, bool keep_language) {
   v_.help_layer = 0;
   start_tutorial();
   say(MessageId::welcome);
-}
-
-void KioskFlow::invite() {
-  // One language an invitation, in turn, from the default: each offers its own language's key.
-  const int n = fx_.speech.language_count();
-  if (n <= 1) {
-    say_brief(MessageId::attract);
-    return;
-  }
-  v_.invitation_language =
-      v_.invitation_language < 0 ? fx_.speech.default_language() : (v_.invitation_language + 1) % n;
-  fx_.speech.set_language(v_.invitation_language);
-  fx_.speech.say_brief(text(MessageId::attract) + " " + text(MessageId::language_offer));
 }
 
 void KioskFlow::end_session(double now_s) {

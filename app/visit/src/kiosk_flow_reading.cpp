@@ -1,5 +1,7 @@
-// The visitor's flow: reading a page's text aloud by sentence and paragraph, and Repeat (kiosk_flow.hpp,
+// The visitor's flow: Describe, reading a page's text aloud by sentence and paragraph, and Repeat (kiosk_flow.hpp,
 // read_aloud.hpp).
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "audio/speech.hpp"
@@ -8,6 +10,52 @@
 namespace hk::app {
 
 using audio::MessageId;
+
+// ---- Describe: the block of text under the hand read, else what the picture holds ------------------------
+
+void KioskFlow::describe_key() {
+  std::string before;
+  // A visitor's own document is about to be heard by everyone near the kiosk: said once a visit, first.
+  if (v_.source == KioskSource::Stick && v_.doc >= 0 && !v_.read_aloud_said) {
+    v_.read_aloud_said = true;
+    before = text(MessageId::read_aloud_warning) + " ";
+  }
+  // The hand on a block of text: that paragraph is read, by sentence (the reading keys move within the page).
+  PageText page = fx_.stage.page_text();
+  v_.reading = ReadAloud(page.paragraphs);
+  v_.reading_language = other_language(page.language);
+  v_.reading_on = false;
+  if (page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs()) {
+    const ReadingPlace at{page.at_hand, 0};
+    // The catalogue's words before the text ("Text:"), as the block's text would be said with text_block.
+    const std::string& block = msg_.raw(MessageId::text_block);
+    const std::string lead =
+        msg_.expand(std::string_view(block).substr(0, block.find("{text}")), {}, key_args(p_.keys));
+    read_from(at, before + long_text_line(v_.reading.text_from(at)) + language_notice() + lead);
+    return;
+  }
+  const std::string description = fx_.stage.describe();
+  fx_.speech.say(before + long_text_line(description) + text(MessageId::describe, {{"description", description}}));
+}
+
+std::string KioskFlow::long_text_line(const std::string& said) const {
+  // A long text says how long it is before it starts (words at the voice's rate), and how to move through it.
+  const double seconds = spoken_seconds(said);
+  if (seconds <= kLongText_s) return {};
+  const int minutes = static_cast<int>(std::lround(seconds / 60.0));
+  return counted(MessageId::long_text_minutes, std::max(1, minutes)) + " ";
+}
+
+double spoken_seconds(std::string_view text) {
+  int words = 0;
+  bool in_word = false;
+  for (const char c : text) {
+    const bool space = std::isspace(static_cast<unsigned char>(c)) != 0;
+    words += !space && !in_word;
+    in_word = !space;
+  }
+  return 60.0 * words / kWordsPerMinute;
+}
 
 // ---- reading a page's text by sentence and paragraph ---------------------------------------------------
 
@@ -19,18 +67,6 @@ void KioskFlow::follow_reading() {
   if (!reading()) return;
   const int piece = fx_.speech.heard_piece();
   if (piece >= 0) v_.reading.heard(piece);
-}
-
-std::string KioskFlow::other_language(const std::string& tag) const {
-  const auto primary = [](const std::string& t) { return t.substr(0, t.find('-')); };
-  return !tag.empty() && primary(tag) != primary(msg_.language()) ? tag : std::string();
-}
-
-std::string KioskFlow::language_notice() const {
-  if (v_.reading_language.empty()) return {};
-  std::string name = fx_.speech.language_name_of(v_.reading_language);
-  if (name.empty()) name = v_.reading_language;
-  return text(MessageId::other_language, {{"name", name}}) + " ";
 }
 
 void KioskFlow::read_from(ReadingPlace at, const std::string& before) {

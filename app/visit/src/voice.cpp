@@ -1,5 +1,6 @@
 // What the kiosk says (voice.hpp).
 #include "visit/voice.hpp"
+#include "hk/language.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -53,10 +54,10 @@ void Voice::say_in(const std::string& text, int from_piece, const std::string& l
 }
 
 std::string Voice::language_name_of(const std::string& tag) const {
-  const std::string primary = tag.substr(0, tag.find('-'));
   const auto& codes = audio_.languages();
   for (std::size_t i = 0; i < codes.size(); ++i)
-    if (codes[i].substr(0, codes[i].find('-')) == primary) return audio_.catalogue(static_cast<int>(i)).language_name();
+    if (hk::language_subtag(codes[i]) == hk::language_subtag(tag))
+      return audio_.catalogue(static_cast<int>(i)).language_name();
   return {};
 }
 

@@ -121,8 +121,9 @@ class AudioSystem {
 
  private:
   void load_languages(const AudioSystemParams& p);
-  /// The voice of languages()[index]: english_voice_ for English, else its espeak-ng voice.
-  std::string voice_of(int index) const;
+  /// The voice of `language` (a BCP 47 tag): english_voice_ for English when set, else the espeak-ng voice of
+  /// its language subtag.
+  std::string voice_for(std::string_view language) const;
 
   std::vector<MessageCatalog> catalogues_;   // one per offered language that loaded
   std::vector<std::string> language_codes_;  // their tags

@@ -13,6 +13,9 @@ namespace hk {
 /// optional subtags of 1 to 8 ASCII letters or digits after '-'; 35 bytes at most.
 bool is_language_tag(std::string_view tag);
 
+/// The language subtag of `tag`: "fr" of "fr-CA", `tag` itself when it has no other subtag.
+inline std::string_view language_subtag(std::string_view tag) { return tag.substr(0, tag.find('-')); }
+
 /// The tags of a list the settings give as "en, fr, de" (comma-separated, spaces ignored), in order.
 /// Returns an empty list, with `*problem` set to one line naming the entry at fault, when an entry is not a
 /// language tag, one is given twice, or there are none or more than kMaxLanguages.
