@@ -110,5 +110,61 @@ TEST(Annotations, WhatTheKioskWritesTheW3cModelReadsTheSame) {
             "/var/lib/haptic-kiosk/names/horse.annotations.json");
 }
 
+TEST(Annotations, EachLanguagesNameIsReadWrittenBackAndChosenForTheVisitor) {
+  // The shipped butterfly names each part in English, French, German and Spanish, a TextualBody a language.
+  const AnnotationSet set =
+      read_annotations(std::string(HK_SHIPPED_PICTURES_DIR) + "/butterfly.annotations.json", "butterfly.jpg");
+  ASSERT_FALSE(set.annotations.empty());
+  EXPECT_TRUE(set.problems.empty());
+  const Annotation& wing = set.annotations[0];
+  EXPECT_EQ(wing.name, "left wing");
+  EXPECT_EQ(wing.language, "en");
+  ASSERT_EQ(wing.translations.size(), 3u);
+  EXPECT_EQ(wing.translations.at("fr").name, "l'aile gauche");
+  std::string language;
+  EXPECT_EQ(annotation_text_in(wing, "fr-CA", &language).name, "l'aile gauche");  // the subtag's
+  EXPECT_EQ(language, "fr");
+  EXPECT_EQ(annotation_text_in(wing, "de").description,
+            "Das linke Flügelpaar, schwarz mit Reihen cremeweißer Flecken.");
+  EXPECT_EQ(annotation_text_in(wing, "it", &language).name, "left wing");  // none in Italian: its own
+  EXPECT_EQ(language, "en");
+  // Written back, every language's bodies come back as they were.
+  const AnnotationSet back = parse_annotations(write_annotation_page(set, "butterfly.jpg"), "w.json", "butterfly.jpg");
+  ASSERT_EQ(back.annotations.size(), set.annotations.size());
+  for (std::size_t i = 0; i < set.annotations.size(); ++i) {
+    ASSERT_EQ(back.annotations[i].translations.size(), set.annotations[i].translations.size()) << i;
+    for (const auto& [tag, tr] : set.annotations[i].translations) {
+      EXPECT_EQ(back.annotations[i].translations.at(tag).name, tr.name);
+      EXPECT_EQ(back.annotations[i].translations.at(tag).description, tr.description);
+    }
+  }
+  // The names drawn on the picture keep every language's.
+  std::vector<std::string> problems;
+  const std::vector<meaning::NamedRegion> regions = meaning::draw_regions(set, 493, 356, 493, 356, "b", &problems);
+  ASSERT_FALSE(regions.empty());
+  EXPECT_EQ(meaning::region_name_in(regions[0], "es"), "el ala izquierda");
+  EXPECT_EQ(meaning::region_name_in(regions[0], "en-GB"), "left wing");
+}
+
+TEST(Annotations, ATextInALanguageThatIsNoTagIsLeftOutWithOneLineAndTheRestKept) {
+  const std::string page = R"({"type": "AnnotationPage", "items": [{"type": "Annotation", "motivation": "identifying",
+    "body": [{"type": "TextualBody", "value": "tail", "language": "en"},
+             {"type": "TextualBody", "value": "la queue", "language": "fr"},
+             {"type": "TextualBody", "value": "??", "language": "not a language!"},
+             {"type": "TextualBody", "value": "Schweif\u0007", "language": "de"}],
+    "target": "horse.png#xywh=1,2,30,40"},
+   {"type": "Annotation", "body": {"type": "TextualBody", "value": "head", "language": "en"},
+    "target": "horse.png#xywh=5,5,10,10"}]})";
+  const AnnotationSet set = parse_annotations(page, "langs.json", "horse.png");
+  // The control character in the German name leaves its annotation out; the bad tag only that text.
+  ASSERT_EQ(set.annotations.size(), 1u);
+  EXPECT_EQ(set.annotations[0].name, "head");
+  ASSERT_EQ(set.problems.size(), 2u);
+  EXPECT_NE(set.problems[0].find("'not a language!' is not a BCP 47 tag"), std::string::npos) << set.problems[0];
+  EXPECT_NE(set.problems[1].find("annotation 1: the name in de has a control character"), std::string::npos)
+      << set.problems[1];
+  for (const std::string& p : set.problems) EXPECT_TRUE(one_line(p)) << p;
+}
+
 }  // namespace
 }  // namespace hk::app

@@ -125,5 +125,38 @@ TEST(ShippedAnswers, WhereOverTheWholeWorkspaceNeverSaysASentenceTwice) {
   }
 }
 
+TEST(ShippedAnswers, EveryPartIsNamedInTheVisitorsLanguage) {
+  for (const char* language : {"fr", "de", "es"}) {
+    const audio::MessageCatalog m = audio::MessageCatalog::load(language, audio::default_locale_dir());
+    ASSERT_EQ(m.language(), language);
+    for (const fs::path& p : shipped_pictures()) {
+      SCOPED_TRACE(std::string(language) + " " + p.filename().string());
+      const Shipped s(p);
+      const PictureNames english = s.names;
+      const PictureNames names =
+          picture_names(s.is.regions, s.is.shape_region, s.is.polylines.size(), s.is.px_to_m, &s.is.polylines, m);
+      ASSERT_EQ(names.parts.size(), english.parts.size());
+      for (std::size_t i = 0; i < names.parts.size(); ++i) {
+        // Each part's name is the curators' in this language, none left in English.
+        EXPECT_NE(names.parts[i].name, english.parts[i].name);
+        if (names.parts[i].guess) continue;
+        bool theirs = false;
+        for (const meaning::NamedRegion& r : s.is.regions)
+          theirs = theirs || (r.names_in.count(language) && r.names_in.at(language) == names.parts[i].name);
+        EXPECT_TRUE(theirs) << names.parts[i].name;
+      }
+      // Several shapes of one part are said as one of them in this language, as in English.
+      for (std::size_t c = 0; c < names.shape_name.size(); ++c) {
+        const bool shared_en =
+            english.shape_name[c] != english.part_name[c] || english.shape_name[c].rfind("one of ", 0) == 0;
+        const std::string one_of = m.word("name_one_of", 1, {{"name", ""}});
+        const std::string part_of = m.word("name_part_of", 1, {{"name", ""}});
+        const bool shared = names.shape_name[c].rfind(one_of, 0) == 0 || names.shape_name[c].rfind(part_of, 0) == 0;
+        EXPECT_EQ(shared, shared_en) << names.shape_name[c] << " / " << english.shape_name[c];
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hk::app

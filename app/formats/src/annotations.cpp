@@ -9,8 +9,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 
+#include "hk/language.hpp"
 #include "hk/text.hpp"
 
 namespace hk::app {
@@ -55,14 +57,14 @@ std::string type_of(const json& j) {
 std::string bare(std::string v) { return v.rfind("oa:", 0) == 0 ? v.substr(3) : v; }
 
 /// Why `text` is no good as a name (lines false) or description (lines true) of at most `max` bytes; "" when fine.
-std::string text_problem(const std::string& text, std::size_t max, bool lines, const char* what) {
-  if (text.size() > max) return std::string("the ") + what + " is longer than " + std::to_string(max) + " bytes";
+std::string text_problem(const std::string& text, std::size_t max, bool lines, const std::string& what) {
+  if (text.size() > max) return "the " + what + " is longer than " + std::to_string(max) + " bytes";
   for (std::size_t i = 0; i < text.size();) {
     const Utf8Step st = decode_utf8(text, i);
-    if (!st.well_formed) return std::string("the ") + what + " is not valid UTF-8";
+    if (!st.well_formed) return "the " + what + " is not valid UTF-8";
     const char32_t c = st.code_point;
     if ((c < 0x20 && !(lines && (c == '\n' || c == '\t'))) || (c >= 0x7F && c <= 0x9F))
-      return std::string("the ") + what + " has a control character";
+      return "the " + what + " has a control character";
     i += st.length;
   }
   return {};
@@ -173,13 +175,16 @@ bool parse_target(const json& target, AnnotationSelector* out) {
   return false;
 }
 
-/// The name and description of an annotation's bodies.
+/// The name and description of an annotation's bodies: the first name's language is the annotation's, a body
+/// tagged with another language a translation (the first of each kind a language kept).
 struct Texts {
   std::string name, description, language;
+  std::map<std::string, Annotation::Translation> translations;
 };
 
 Texts bodies_of(const json& a, const std::string& motivation) {
   Texts t;
+  bool named = false;
   for (const json* b : a.contains("body") ? items_at(a, "body") : items_at(a, "resource")) {
     std::string value = b->is_string() ? b->get<std::string>() : str(*b, "value");
     if (value.empty()) value = plain_text(str(*b, "chars"));
@@ -188,13 +193,18 @@ Texts bodies_of(const json& a, const std::string& motivation) {
     if (type_of(*b) == "Tag") purpose = "tagging";
     if (purpose.empty()) purpose = motivation;
     const bool describes = purpose == "describing" || purpose == "commenting";
-    if (describes) {
-      if (t.description.empty()) t.description = value;
-    } else if (t.name.empty()) {
+    const std::string language = b->is_object() ? str(*b, "language") : std::string();
+    if (!describes && !named) {
+      named = true;
       t.name = value;
-      t.language = str(*b, "language");
+      t.language = language;
     }
+    const bool own = language.empty() || language == t.language || (!named && describes);
+    std::string& field = own ? (describes ? t.description : t.name)
+                             : (describes ? t.translations[language].description : t.translations[language].name);
+    if (field.empty()) field = value;
   }
+  t.translations.erase(t.language);  // a description in the name's language, read before the name
   return t;
 }
 
@@ -301,10 +311,24 @@ class Reader {
     out.name = t.name;
     out.description = t.description;
     out.language = t.language;
+    out.translations = t.translations;
     if (out.name.empty() && out.description.empty()) return problem(which + "it has no text body");
     for (const std::string& why : {text_problem(out.name, kMaxNameBytes, false, "name"),
                                    text_problem(out.description, kMaxRegionDescriptionBytes, true, "description")})
       if (!why.empty()) return problem(which + why);
+    for (auto it = out.translations.begin(); it != out.translations.end();) {
+      if (hk::is_language_tag(it->first)) {
+        ++it;
+        continue;
+      }
+      problem(which + "its language " + hk::quoted(it->first, 40) + " is not a BCP 47 tag; that text is left out");
+      it = out.translations.erase(it);
+    }
+    for (const auto& [tag, tr] : out.translations)
+      for (const std::string& why :
+           {text_problem(tr.name, kMaxNameBytes, false, "name in " + tag),
+            text_problem(tr.description, kMaxRegionDescriptionBytes, true, "description in " + tag)})
+        if (!why.empty()) return problem(which + why);
     const auto target = a.find(a.contains("target") ? "target" : "on");
     if (target == a.end() || !parse_target(*target, &out.selector))
       return problem(which + "its target has no FragmentSelector (xywh=) or SvgSelector");
@@ -336,6 +360,20 @@ class Reader {
 };
 
 }  // namespace
+
+Annotation::Translation annotation_text_in(const Annotation& a, std::string_view language, std::string* language_out) {
+  Annotation::Translation out{a.name, a.description};
+  if (language_out) *language_out = a.language;
+  auto it = a.translations.find(std::string(language));
+  if (it == a.translations.end()) it = a.translations.find(std::string(hk::language_subtag(language)));
+  if (it == a.translations.end()) return out;
+  if (!it->second.name.empty()) {
+    out.name = it->second.name;
+    if (language_out) *language_out = it->first;
+  }
+  if (!it->second.description.empty()) out.description = it->second.description;
+  return out;
+}
 
 std::string annotation_text_problem(const std::string& text, bool description) {
   return description ? text_problem(text, kMaxRegionDescriptionBytes, true, "description")
@@ -386,6 +424,13 @@ std::string write_annotation_page(const AnnotationSet& set, const std::string& s
     }
     if (!a.description.empty())
       body.push_back({{"type", "TextualBody"}, {"value", a.description}, {"purpose", "describing"}});
+    for (const auto& [tag, tr] : a.translations) {  // one body a language and kind, tagged
+      if (!tr.name.empty())
+        body.push_back({{"type", "TextualBody"}, {"value", tr.name}, {"purpose", "identifying"}, {"language", tag}});
+      if (!tr.description.empty())
+        body.push_back(
+            {{"type", "TextualBody"}, {"value", tr.description}, {"purpose", "describing"}, {"language", tag}});
+    }
     json selector;
     if (a.selector.kind == AnnotationSelector::Kind::svg) {
       selector = {{"type", "SvgSelector"}, {"value", a.selector.svg}};

@@ -1,6 +1,8 @@
 // Staff names drawn onto the picture and given to its shapes (names.hpp).
 #include "meaning/names.hpp"
 
+#include "hk/language.hpp"
+
 #include <cairo.h>
 #include <librsvg/rsvg.h>
 
@@ -10,6 +12,7 @@
 #include <cmath>
 #include <memory>
 
+#include "hk/language.hpp"
 #include "hk/text.hpp"
 
 namespace hk::meaning {
@@ -115,6 +118,9 @@ std::vector<NamedRegion> draw_regions(const app::AnnotationSet& set, int width_p
     NamedRegion r;
     r.name = a.name;
     r.description = a.description;
+    r.language = a.language;
+    for (const auto& [tag, tr] : a.translations)
+      if (!tr.name.empty()) r.names_in[tag] = tr.name;
     r.box_px = box;
     r.mask = mask(box).clone();
     r.area_px = cv::countNonZero(r.mask);
@@ -210,6 +216,14 @@ bool covered_by_staff(const NamedRegion& guess, const std::vector<NamedRegion>& 
     if (cv::countNonZero(in_both) * 2 >= guess.area_px) return true;
   }
   return false;
+}
+
+std::string region_name_in(const NamedRegion& region, std::string_view language, std::string* language_out) {
+  auto it = region.names_in.find(std::string(language));
+  if (it == region.names_in.end()) it = region.names_in.find(std::string(hk::language_subtag(language)));
+  const bool found = it != region.names_in.end();
+  if (language_out) *language_out = found ? it->first : region.language;
+  return found ? it->second : region.name;
 }
 
 }  // namespace hk::meaning

@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hk/language.hpp"
 #include "hk/text.hpp"
 #include "visit/describe.hpp"
 #include "visit/read_aloud.hpp"
@@ -42,7 +43,7 @@ std::string notes_words(const PictureNotes& notes) {
 std::string region_said_name(const meaning::NamedRegion& region, const audio::MessageCatalog& m) {
   switch (region.source) {
     case meaning::RegionSource::staff:
-      return said_name(region.name, m);
+      return said_name(meaning::region_name_in(region, m.language()), m);
     case meaning::RegionSource::face:
       return m.word("guess_face");
     case meaning::RegionSource::text: {
@@ -55,6 +56,29 @@ std::string region_said_name(const meaning::NamedRegion& region, const audio::Me
 }
 
 namespace {
+
+/// What kind of name a region has, which decides how one of several shapes taking it is said.
+enum class NameKind {
+  proper,    ///< a proper name or a guess ("Pegasus", "text: Exit"): said as it is
+  singular,  ///< "left wing": "part of the left wing"
+  plural,    ///< "white spots": "one of the white spots"
+};
+
+/// The kind of `region`'s name, judged on its English name where it has one (the one language whose plurals
+/// these rules know), else its own: every language's said form then takes the same one. A name in small letters
+/// is a common noun; its head (before " of ") ending in "s" or "ae" a plural.
+NameKind name_kind(const meaning::NamedRegion& region) {
+  if (region.source != meaning::RegionSource::staff) return NameKind::proper;
+  std::string language;
+  std::string name = meaning::region_name_in(region, "en", &language);
+  if (hk::language_subtag(language) != "en" && !language.empty()) name = region.name;
+  for (const char* article : {"the ", "a ", "an "})
+    if (name.rfind(article, 0) == 0) name = name.substr(std::string_view(article).size());
+  const unsigned char c = name.empty() ? 'A' : static_cast<unsigned char>(name[0]);
+  if (c < 0x80 && !std::islower(c)) return NameKind::proper;
+  const std::string head = name.substr(0, name.find(" of "));  // "coins of the top row": "coins"
+  return head.ends_with("s") || head.ends_with("ae") ? NameKind::plural : NameKind::singular;
+}
 
 /// Sets each part's curve: the longest of `polylines` whose region's name is said as the part's.
 void longest_curve_of_each_part(const std::vector<meaning::NamedRegion>& regions, const std::vector<int>& shape_region,
@@ -92,9 +116,9 @@ PictureNames picture_names(const std::vector<meaning::NamedRegion>& regions, con
     const auto r = static_cast<std::size_t>(shape_region[i]);
     // Several shapes of one name: "one of the white spots" (a plural name), "part of the left wing".
     const std::string name = region_said_name(regions[r], m);
-    const std::string head = name.substr(0, name.find(" of "));  // "the coins of the top row": "the coins"
-    const bool plural = head.ends_with("s") || head.ends_with("ae");
-    const bool shared = sharing[r] > 1 && name.rfind("the ", 0) == 0;
+    const NameKind kind = name_kind(regions[r]);
+    const bool plural = kind == NameKind::plural;
+    const bool shared = sharing[r] > 1 && kind != NameKind::proper;
     const std::string one_of = m.word("name_one_of", 1, {{"name", name}});
     out.shape_name[i] = shared ? (plural ? one_of : m.word("name_part_of", 1, {{"name", name}})) : name;
     out.part_name[i] = shared && plural ? one_of : name;

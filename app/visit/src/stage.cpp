@@ -67,8 +67,6 @@ void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes,
   sh.descriptors = is.descriptors;
   sh.regions = is.regions;
   sh.shape_region = is.shape_region;
-  sh.names =
-      picture_names(is.regions, is.shape_region, is.polylines.size(), is.px_to_m, &is.polylines, audio_.messages());
   sh.picture = is.picture;  // the pixels the scene was built from (a picture file decoded once, reduced)
   sh.image_path = is.image_path;
   sh.file_width_px = is.file_width_px > 0 ? is.file_width_px : is.picture.cols;
@@ -165,16 +163,25 @@ void Stage::text_arrived(TextRead& read) {
 
 void Stage::set_names(std::vector<meaning::NamedRegion> regions, std::vector<int> shape_region) {
   if (shape_region.size() != shown_.polylines.size()) return;
-  shown_.names = picture_names(regions, shape_region, shown_.polylines.size(), shown_.px_to_m, &shown_.polylines,
-                               audio_.messages());
   shown_.regions = std::move(regions);
   shown_.shape_region = std::move(shape_region);
+  shown_.names_language.clear();  // made anew when next said
+}
+
+const PictureNames& Stage::names() const {
+  const std::string& language = audio_.messages().language();
+  if (shown_.names_language != language || shown_.names_language.empty()) {
+    shown_.names = picture_names(shown_.regions, shown_.shape_region, shown_.polylines.size(), shown_.px_to_m,
+                                 &shown_.polylines, audio_.messages());
+    shown_.names_language = language;
+  }
+  return shown_.names;
 }
 
 ShownView Stage::view() const {
   said_notes_ = notes_in(shown_.notes, audio_.messages().language());
   return {shown_.polylines,   shown_.descriptors, shown_.text_blocks, said_notes_,     half_,
-          showing_tutorial(), source_.page > 0,   &shown_.names,      &shown_.regions, shown_.px_to_m};
+          showing_tutorial(), source_.page > 0,   &names(),           &shown_.regions, shown_.px_to_m};
 }
 
 std::string Stage::where() {
@@ -241,10 +248,10 @@ TourPicture Stage::tour_picture() const {
   p.id = shown_id_;
   p.described = shown_.polylines.size();
   p.words = [this](std::size_t curve) { return shape_words(curve); };
-  const PictureNames& names = shown_.names;
+  const PictureNames& names = this->names();
   if (names.shape_name.empty() || showing_tutorial()) return p;
   p.name = [this](std::size_t curve) {
-    const std::vector<std::string>& part = shown_.names.part_name;
+    const std::vector<std::string>& part = this->names().part_name;
     return curve < part.size() ? part[curve] : std::string();
   };
   for (const PictureNames::Part& part : names.parts)  // Guide leads to what staff named, not to guesses

@@ -7,23 +7,25 @@
 /// |---|---|
 /// | an `AnnotationPage` (`items`) | its annotations |
 /// | a JSON array, or one `Annotation` | those annotations |
-/// | a IIIF Presentation 3 `Manifest` | the `annotations` pages of the canvas whose painted image's file name is the
-/// picture's (else the first canvas); canvas width and height kept | | a IIIF Presentation 2 `sc:AnnotationList`
-/// (`resources`) | its `oa:Annotation`s: `resource` (`chars`; `oa:Tag` a name), `on` (a `#xywh=` string or an
-/// `oa:SpecificResource` with a selector, `oa:Choice` of two) |
+/// | a IIIF Presentation 3 `Manifest` | the `annotations` pages of the picture's canvas (below) |
+/// | a IIIF Presentation 2 `sc:AnnotationList` (`resources`) | its `oa:Annotation`s (below) |
 ///
-/// An annotation page referenced only by URL is not fetched (the kiosk is offline): noted in `problems`. A target
-/// whose `source` is a `Canvas` with `width` and `height` (as write_annotation_page writes one) gives the canvas
-/// when no Manifest does.
+/// A Manifest's canvas is the one whose painted image's file name is the picture's (else the first), its width
+/// and height kept. An `oa:Annotation` has a `resource` (`chars`; an `oa:Tag` is a name) and an `on` (a `#xywh=`
+/// string, or an `oa:SpecificResource` with a selector, or an `oa:Choice` of two). An annotation page referenced
+/// only by URL is not fetched (the kiosk is offline): noted in `problems`. A target whose `source` is a `Canvas`
+/// with `width` and `height` (as write_annotation_page writes one) gives the canvas when no Manifest does.
 ///
 /// | part | read |
 /// |---|---|
-/// | `body` | a `TextualBody` or an array of them (`value`, `language`, `purpose`); a name when its purpose, else the
-/// annotation's motivation, is `identifying` or `tagging`; a description when `describing` or `commenting` (neither
-/// said: a name) | | `target` | a `source#xywh=…` string, or a `SpecificResource` with a `selector` (one, or an array:
-/// the first understood) | | `FragmentSelector` | `xywh=x,y,w,h` (pixels, also `xywh=pixel:…`) or
-/// `xywh=percent:x,y,w,h` | | `SvgSelector` | its `value`, an SVG document (drawn later by librsvg: meaning/names.hpp)
-/// |
+/// | `body` | a `TextualBody` or an array of them (`value`, `language`, `purpose`) |
+/// | `target` | a `source#xywh=…` string, or a `SpecificResource` with a `selector` (the first understood) |
+/// | `FragmentSelector` | `xywh=x,y,w,h` (pixels, also `xywh=pixel:…`) or `xywh=percent:x,y,w,h` |
+/// | `SvgSelector` | its `value`, an SVG document (drawn later by librsvg: meaning/names.hpp) |
+///
+/// A body is a name when its purpose, else the annotation's motivation, is `identifying` or `tagging`, a
+/// description when `describing` or `commenting` (neither said: a name). The first name's `language` is the
+/// annotation's; bodies in other languages are its translations (a name and a description a language).
 ///
 /// Rules (an annotation that breaks one is left out, with one line in `problems` naming the file and the rule;
 /// the rest are kept): a name of at most kMaxNameBytes and a description of at most kMaxRegionDescriptionBytes, both
@@ -32,6 +34,7 @@
 /// JSON that is none of the forms above, or larger than kMaxAnnotationFileBytes, is refused whole
 /// (AnnotationError).
 
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -68,7 +71,19 @@ struct Annotation {
   std::string description;  ///< a longer text; may be empty
   std::string language;     ///< the name's BCP 47 language tag, "" when not said
   AnnotationSelector selector;
+  /// The name and description in other languages, by BCP 47 tag: the bodies whose `language` differs from the
+  /// first name's (one TextualBody a language, as the W3C model gives translations). Either may be empty.
+  struct Translation {
+    std::string name, description;
+  };
+  std::map<std::string, Translation> translations;
 };
+
+/// The name and description of `a` said to a visitor in `language` (a BCP 47 tag): its translation's where it
+/// has one (the tag, else its language subtag: "fr-CA" takes "fr"), else the annotation's own (first) ones.
+/// `*language_out`, when given, is the language of the name chosen ("" when not said).
+Annotation::Translation annotation_text_in(const Annotation& a, std::string_view language,
+                                           std::string* language_out = nullptr);
 
 /// What one file says.
 struct AnnotationSet {

@@ -7,11 +7,14 @@
 ///
 /// | term | when |
 /// |---|---|
-/// | black / grey / white | C* < 15 (achromatic): L* < 20 black, L* > 88 white, else grey (light above 70, dark below
-/// 40) | | pink | h in [345°, 55°) with L* ≥ 60 and C* < 75; h in [315°, 345°) with L* ≥ 70 | | red | h in [345°, 55°),
-/// the rest (brown when L* < 45 and C* < 50) | | orange | h in [55°, 85°) (brown when L* < 55 or C* < 35) | | yellow |
-/// h in [85°, 115°) (brown when L* < 45) | | green | h in [115°, 190°) | | blue | h in [190°, 315°) (sRGB's pure blue
-/// lies at 306°) | | purple | h in [315°, 345°) |
+/// | black / grey / white | C* < 15 (achromatic): L* < 20 black, L* > 88 white, else grey (light > 70, dark < 40) |
+/// | pink | h in [345°, 55°) with L* ≥ 60 and C* < 75; h in [315°, 345°) with L* ≥ 70 |
+/// | red | h in [345°, 55°), the rest (brown when L* < 45 and C* < 50) |
+/// | orange | h in [55°, 85°) (brown when L* < 55 or C* < 35) |
+/// | yellow | h in [85°, 115°) (brown when L* < 45) |
+/// | green | h in [115°, 190°) |
+/// | blue | h in [190°, 315°) (sRGB's pure blue lies at 306°) |
+/// | purple | h in [315°, 345°) |
 ///
 /// A chromatic term is "light" when L* is 20 or more above its own lightness (kTermLightness) and "dark" when
 /// 20 or more below; yellow, pink and white are never light, black never dark.

@@ -11,8 +11,10 @@
 
 #include <opencv2/core.hpp>
 
+#include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "formats/annotations.hpp"
@@ -48,7 +50,15 @@ struct NamedRegion {
   cv::Mat mask;             ///< CV_8U over box_px, non-zero inside
   double area_px = 0;       ///< pixels inside
   int annotation = -1;      ///< the index in AnnotationSet::annotations it was drawn from; −1 when not from a set
+  std::string language;     ///< the name's BCP 47 tag, "" when not said
+  /// The name in other languages, by BCP 47 tag (Annotation::translations' names).
+  std::map<std::string, std::string> names_in;
 };
+
+/// The name of `region` said to a visitor in `language` (a BCP 47 tag): its name in that language (the tag, else
+/// its language subtag) where it has one, else its own name. `*language_out`, when given, is the language of the
+/// name returned ("" when not said).
+std::string region_name_in(const NamedRegion& region, std::string_view language, std::string* language_out = nullptr);
 
 /// The regions of `set` on a picture of `width_px` x `height_px` [px] whose full-detail size (the file's, upright)
 /// is `full_width_px` x `full_height_px`: without a canvas in `set`, coordinates are those full-detail pixels. A

@@ -11,9 +11,12 @@
 /// | rectangle | as square, the axes further apart |
 /// | triangle | 3 corners, convex, straight sides (no point farther from a side's chord than 8 % of it) |
 /// | polygon | 4–8 corners, convex, straight sides (4 only when not a square or rectangle) |
-/// | star | 8 corners or more, at least 2 in 5 of them notches (turning against the way round), solidity (area over its
-/// convex hull's) < 0.75 | | straight line | open, chord at least 0.95 of its length | | curve | open, the rest | |
-/// irregular | closed, the rest (no form is said) |
+/// | star | 8 corners or more, at least 2 in 5 of them notches (turning against the way round), solidity < 0.75 |
+/// | straight line | open, chord at least 0.95 of its length |
+/// | curve | open, the rest |
+/// | irregular | closed, the rest (no form is said) |
+///
+/// Solidity is a shape's area over its convex hull's.
 ///
 /// Corners are found on the curve's coarse wavelet level (the coarsest whose largest deviation from the
 /// curve is at most 3 % of its size, with at least 32 points: seed §2, the scaling coefficients as a smoothed curve, so

@@ -31,8 +31,9 @@ struct ShownView {
   vision::PxToM px_to_m{1, 0, 0};                              ///< the picture's pixels → metres (for `regions`)
 };
 
-/// A region's name as said: staff's with its article (said_name: "the left wing"), a guess's as it is
-/// ("something that could be a face", "text: Emergency exit").
+/// A region's name as said in `m`'s language: staff's in that language where they gave one (region_name_in), with
+/// its article (said_name: "the left wing"), a guess's from the catalogue ("something that could be a face",
+/// "text: Emergency exit").
 std::string region_said_name(const meaning::NamedRegion& region,
                              const audio::MessageCatalog& m = audio::MessageCatalog::english());
 

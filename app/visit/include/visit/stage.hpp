@@ -55,7 +55,10 @@ struct Shown {
   std::vector<meaning::ShapeDescriptor> descriptors;
   std::vector<meaning::NamedRegion> regions;  ///< regions staff named on `picture`
   std::vector<int> shape_region;              ///< per polyline: the region naming it, −1 none
-  PictureNames names;                         ///< the same as Describe and Where say them
+  /// The same as Describe and Where say them, in the language `names_language` (Stage::names() makes them
+  /// anew in the language in use, so a visitor who changes language hears staff names in theirs).
+  mutable PictureNames names;
+  mutable std::string names_language;
 };
 
 /// Where what is shown came from (what a rebuild with new settings asks for again).
@@ -149,6 +152,7 @@ class Stage final : public StageEffects {
   std::string describe_shown();                      // describe() without the reading's news
   void text_arrived(TextRead& read);                 // swaps in the page with its text and words what came
   void publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<Aabb> text_boxes = {});
+  const PictureNames& names() const;  // shown_.names in the language in use
 
   ServoStep& step_;
   Voice& voice_;
