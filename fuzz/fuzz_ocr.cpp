@@ -5,10 +5,11 @@
 //  - even: the worker. Bytes 1 and 2 give a picture of 1–96 x 1–96 pixels, the rest are its grey values
 //    (repeated to fill it). The worker's own read_page (vision/worker/ocr_engine.cpp, compiled into this
 //    file: its functions are internal to it, nothing in it is changed) reads it with one Tesseract engine
-//    started once; then the kiosk's read_ocr_answer must accept that answer: every word of a block with
-//    text, a finite box and a confidence in [0, 1], the mean confidence in [0, 1]; a refusal must be of a
-//    kind the kiosk accepts, with a one-line problem.
-//  - odd: the kiosk. The rest is a worker's answer as it comes down the pipe: read_ocr_answer either reads it
+//    started once, its records gathered as the pipe would carry them; then the kiosk's read_ocr_answer must accept that
+//    answer: every word of a block with text, a finite box and a confidence in [0, 1], the mean confidence in [0, 1]; a
+//    refusal must be of a kind the kiosk accepts, with a one-line problem.
+//  - odd: the kiosk. The rest is a worker's answer (magic, then records) as it comes down the pipe: read_ocr_answer
+//    either reads it
 //    into a result with the same properties or refuses it with an OcrError whose what() is one line; it
 //    never reads past the end or allocates what the sizes claim before checking them.
 #include "ocr_engine.cpp"  // vision/worker/ocr_engine.cpp, for its internal start_engine() and read_page()
@@ -73,20 +74,17 @@ void read_as_worker(const std::uint8_t* data, std::size_t size) {
   std::vector<std::uint8_t> px(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 255);
   if (size > 2)
     for (std::size_t i = 0; i < px.size(); ++i) px[i] = data[2 + i % (size - 2)];
-  worker::WireWriter out;
-  out.u32(kOcrMagic);
+  worker::WireWriter magic;
+  magic.u32(kOcrMagic);
+  std::string answer = magic.bytes();
+  const Emit emit = [&answer](const std::string& record) { answer += record; };
   try {
-    worker::WireWriter answer;
-    read_page(engine(), px.data(), w, h, OcrParams{}, answer);
-    out.u8(0);
-    out.raw(answer.bytes().data(), answer.bytes().size());
+    read_page(engine(), px.data(), w, h, OcrParams{}, emit);
   } catch (const Refusal& r) {
     FUZZ_CHECK(r.kind <= OcrError::Kind::WorkerCrashed, r.problem);
-    out.u8(1);
-    out.u8(static_cast<std::uint8_t>(r.kind));
-    out.str(r.problem);
+    emit(refusal(r.kind, r.problem));
   }
-  read_as_kiosk(out.bytes(), true);
+  read_as_kiosk(answer, true);
 }
 
 }  // namespace

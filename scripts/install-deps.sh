@@ -10,7 +10,7 @@ packages=(
   libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
   libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev gettext libboost-locale-dev
   libglfw3-dev libimgui-dev libgl-dev
-  libpoppler-cpp-dev libtesseract-dev tesseract-ocr-eng libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev zlib1g-dev librsvg2-dev
+  libpoppler-cpp-dev libtesseract-dev libleptonica-dev tesseract-ocr-eng libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev zlib1g-dev librsvg2-dev
 )
 if [ "${1:-}" != "--demo" ]; then
   packages+=(

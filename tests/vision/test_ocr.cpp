@@ -65,7 +65,13 @@ TEST_P(OcrScans, ReadsAScannedPageAsItsTextLayerSaysWithRecallOver90Percent) {
   const cv::Mat grey = cv::imdecode(test::scan_jpeg(pdf, c.page, c.dpi, c.degrees, dir), cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(grey.empty());
   EXPECT_TRUE(looks_like_text_page(grey)) << "a page of text is seen as one from its pixels";
-  const OcrResult r = recognise_text(grey, "scan.jpg", {});
+  OcrParams p;
+  std::vector<std::string> handed;  // each block as the worker sent it, before the page was done
+  p.on_block = [&handed](const OcrBlock& b) { handed.push_back(b.text); };
+  const OcrResult r = recognise_text(grey, "scan.jpg", p);
+  std::vector<std::string> blocks;
+  for (const OcrBlock& b : r.blocks) blocks.push_back(b.text);
+  EXPECT_EQ(handed, blocks) << "every block handed on as read, in reading order, and only those";
   const std::vector<std::string> truth = words_of(test::pdftotext_page(pdf, c.page, dir));
   ASSERT_GT(truth.size(), 100u);
   const double got = test::word_recall(truth, words_of(all_text(r)));

@@ -4,6 +4,7 @@
 // every box still counts as text (masked out of the curves).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,23 +17,25 @@ namespace {
 
 /// A worker's answer of one block of one line: `words` as (text, confidence).
 worker::WorkerRun answer(const std::vector<std::pair<std::string, double>>& words) {
-  worker::WireWriter out;
-  out.u32(kOcrMagic);
-  out.u8(0);
-  out.u32(static_cast<std::uint32_t>(words.size()));  // words seen
-  out.u32(1);                                         // blocks
-  out.u32(1);                                         // lines
-  out.u32(static_cast<std::uint32_t>(words.size()));
+  worker::WireWriter block;
+  block.u32(1);  // lines
+  block.u32(static_cast<std::uint32_t>(words.size()));
   double x = 10;
   for (const auto& [text, confidence] : words) {
-    out.str(text);
-    out.f64(x);
-    out.f64(20);
-    out.f64(30);
-    out.f64(12);
-    out.f64(confidence);
+    block.str(text);
+    block.f64(x);
+    block.f64(20);
+    block.f64(30);
+    block.f64(12);
+    block.f64(confidence);
     x += 40;
   }
+  worker::WireWriter end;
+  end.u32(static_cast<std::uint32_t>(words.size()));  // words seen
+  worker::WireWriter out;
+  out.u32(kOcrMagic);
+  const std::string records = ocr_record(OcrRecord::block, block) + ocr_record(OcrRecord::end, end);
+  out.raw(records.data(), records.size());
   worker::WorkerRun run;
   run.answer = out.bytes();
   return run;
@@ -52,6 +55,45 @@ TEST(OcrUnclear, AWordUnderTheThresholdIsSaidAndAMarkIsUnclear) {
   // A sure mark is said as read; with the threshold at 0.3 every mark here is.
   p.min_word_confidence = 0.3;
   EXPECT_EQ(read_ocr_answer(answer({{"The", 0.95}, {"|~", 0.41}}), "page", p).blocks[0].text, "The |~");
+}
+
+TEST(OcrAnswer, EachBlockIsHandedOnAsSoonAsItsRecordHasComeWhateverTheReadsCut) {
+  // Two blocks and the end, as the pipe may cut them: byte by byte.
+  const std::string one = answer({{"First", 0.9}, {"words", 0.9}}).answer;
+  const std::string two = answer({{"Second", 0.9}}).answer;
+  const std::size_t head = sizeof(std::uint32_t);  // the magic
+  worker::WireWriter end;
+  end.u32(3);
+  // The first answer's block record, then the second's, then an end: records are [tag u8][size u32][payload].
+  const auto record_at = [](const std::string& a, std::size_t at) {
+    std::uint32_t size = 0;
+    std::memcpy(&size, a.data() + at + 1, sizeof size);
+    return a.substr(at, 5 + size);
+  };
+  const std::string whole =
+      one.substr(0, head) + record_at(one, head) + record_at(two, head) + ocr_record(OcrRecord::end, end);
+  std::vector<std::string> handed;
+  std::vector<std::size_t> handed_at;  // bytes fed when each block was handed on
+  OcrParams p;
+  p.on_block = [&](const OcrBlock& b) { handed.push_back(b.text); };
+  OcrAnswerReader reader(p);
+  for (std::size_t n = 1; n <= whole.size(); ++n) {
+    const std::size_t before = handed.size();
+    ASSERT_TRUE(reader.feed(whole.substr(0, n))) << n;
+    if (handed.size() > before) handed_at.push_back(n);
+  }
+  ASSERT_EQ(handed, (std::vector<std::string>{"First words", "Second"}));
+  // Each at the very byte that completed its record, the end still to come.
+  EXPECT_EQ(handed_at[0], head + record_at(one, head).size());
+  EXPECT_EQ(handed_at[1], head + record_at(one, head).size() + record_at(two, head).size());
+  EXPECT_TRUE(reader.ended());
+  EXPECT_EQ(reader.result().blocks.size(), 2u);
+  EXPECT_EQ(reader.result().words_seen, 3);
+  // A record after the end, or a tag no worker writes, is a malformed answer.
+  EXPECT_FALSE(OcrAnswerReader(p).feed(whole + ocr_record(OcrRecord::end, end)));
+  std::string bad_tag = whole;
+  bad_tag[head] = 7;
+  EXPECT_FALSE(OcrAnswerReader(OcrParams{}).feed(bad_tag));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -132,32 +133,79 @@ std::string ocr_languages_problem(const OcrParams& p) {
   return {};
 }
 
-OcrResult read_ocr_answer(const worker::WorkerRun& run, const std::string& name, const OcrParams& p) {
-  if (run.cancelled) fail_run(run, name, p);
-  worker::WireReader in(run.answer);
-  std::uint32_t magic = 0;
-  std::uint8_t status = 0;
-  if (!in.u32(magic) || magic != kOcrMagic || !in.u8(status) || status > 1) fail_run(run, name, p);
-  if (status == 1) {
-    std::uint8_t kind = 0;
-    std::string problem;
-    if (!in.u8(kind) || kind > static_cast<std::uint8_t>(OcrError::Kind::WorkerCrashed) ||
-        !in.str(problem, kMaxProblemBytes))
-      fail_run(run, name, p);
-    fail(static_cast<OcrError::Kind>(kind), name, hk::one_line(problem, kMaxProblemBytes));
+bool OcrAnswerReader::feed(const std::string& answer) {
+  if (bad_) return false;
+  if (at_ == 0) {
+    if (answer.size() < sizeof(std::uint32_t)) return true;
+    worker::WireReader head(answer);
+    std::uint32_t magic = 0;
+    if (!head.u32(magic) || magic != kOcrMagic) return !(bad_ = true);
+    at_ = sizeof magic;
   }
-  OcrResult out;
-  std::uint32_t seen = 0, blocks = 0;
-  if (!in.u32(seen) || !in.u32(blocks) || seen > kMaxWords || blocks > seen) fail_run(run, name, p);
-  out.words_seen = static_cast<int>(seen);
-  double confidence_sum = 0;
-  for (std::uint32_t i = 0; i < blocks; ++i)
-    if (!read_block(in, p, out, confidence_sum)) fail_run(run, name, p);
-  if (in.left() != 0) fail_run(run, name, p);
-  out.mean_confidence = out.words.empty() ? 0.0 : confidence_sum / static_cast<double>(out.words.size());
+  constexpr std::size_t kHead = 1 + sizeof(std::uint32_t);  // tag, size
+  while (answer.size() - at_ >= kHead) {
+    if (ended_ || refused_) return !(bad_ = true);  // nothing may follow the last record
+    const auto tag = static_cast<std::uint8_t>(answer[at_]);
+    std::uint32_t size = 0;
+    std::memcpy(&size, answer.data() + at_ + 1, sizeof size);
+    if (tag > static_cast<std::uint8_t>(OcrRecord::block) || size > kMaxAnswerBytes) return !(bad_ = true);
+    if (answer.size() - at_ - kHead < size) return true;  // the rest of it is still to come
+    if (!read_record(static_cast<OcrRecord>(tag), answer.substr(at_ + kHead, size))) return !(bad_ = true);
+    at_ += kHead + size;
+  }
+  return true;
+}
+
+bool OcrAnswerReader::read_record(OcrRecord tag, const std::string& payload) {
+  worker::WireReader in(payload);
+  switch (tag) {
+    case OcrRecord::block: {
+      if (!read_block(in, p_, out_, confidence_sum_) || in.left() != 0) return false;
+      if (p_.on_block) p_.on_block(out_.blocks.back());
+      return true;
+    }
+    case OcrRecord::end: {
+      std::uint32_t seen = 0;
+      if (!in.u32(seen) || seen > kMaxWords || out_.blocks.size() > seen || in.left() != 0) return false;
+      out_.words_seen = static_cast<int>(seen);
+      out_.mean_confidence = out_.words.empty() ? 0.0 : confidence_sum_ / static_cast<double>(out_.words.size());
+      ended_ = true;
+      return true;
+    }
+    case OcrRecord::refusal: {
+      std::uint8_t kind = 0;
+      if (!in.u8(kind) || kind > static_cast<std::uint8_t>(OcrError::Kind::WorkerCrashed) ||
+          !in.str(refusal_problem_, kMaxProblemBytes) || in.left() != 0)
+        return false;
+      refusal_kind_ = static_cast<OcrError::Kind>(kind);
+      refused_ = true;
+      return true;
+    }
+  }
+  return false;
+}
+
+namespace {
+
+/// The result of a run whose answer `reader` has read (fed the whole answer here): the worker's refusal, or
+/// what went wrong with the run, thrown as an OcrError.
+OcrResult finish(OcrAnswerReader& reader, const worker::WorkerRun& run, const std::string& name, const OcrParams& p) {
+  if (run.cancelled) fail_run(run, name, p);
+  const bool parsed = reader.feed(run.answer);
+  if (parsed && reader.refused())
+    fail(reader.refusal_kind(), name, hk::one_line(reader.refusal_problem(), kMaxProblemBytes));
+  if (!parsed || !reader.ended()) fail_run(run, name, p);
+  OcrResult out = std::move(reader.result());
   out.ms = run.ms;
   out.worker_max_rss_kb = run.max_rss_kb;
   return out;
+}
+
+}  // namespace
+
+OcrResult read_ocr_answer(const worker::WorkerRun& run, const std::string& name, const OcrParams& p) {
+  OcrAnswerReader reader(p);
+  return finish(reader, run, name, p);
 }
 
 OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const OcrParams& p) {
@@ -174,14 +222,17 @@ OcrResult recognise_text(const cv::Mat& grey, const std::string& name, const Ocr
 #else
   static const std::string path = worker::find_worker("HK_OCR_WORKER", "hk-ocr-worker", "hk-ocr-worker");
 #endif
+  OcrAnswerReader reader(p);
+  worker::AnswerSoFar on_data;
+  if (p.on_block) on_data = [&reader](const std::string& answer) { reader.feed(answer); };  // blocks as they come
   worker::WorkerRun run;
   try {
     run = worker::run_worker(path, ocr_request_args(grey.cols, grey.rows, p), packed(grey), p.worker_wall_s,
-                             kMaxAnswerBytes, p.cancel);
+                             kMaxAnswerBytes, p.cancel, on_data);
   } catch (const worker::WorkerStartFailure& f) {
     fail(OcrError::Kind::WorkerCrashed, name, "cannot start the text reader (" + f.why + ")");
   }
-  return read_ocr_answer(run, name, p);
+  return finish(reader, run, name, p);
 }
 
 namespace {

@@ -4,6 +4,7 @@
 /// for the contract; the pixels come on worker::kInputFd, width x height bytes, row after row). Private to
 /// vision.
 
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -52,8 +53,49 @@ inline bool parse_ocr_request(int argc, char** argv, OcrRequest& rq) {
   return rq.width > 0 && rq.height > 0 && !rq.params.languages.empty();
 }
 
-/// The kiosk's side of the answer: what the worker of `run` sent, read with every size and value checked
-/// (the worker reads a stranger's pixels, so its answer is not trusted either).
+/// What a record of the answer holds. The answer is u32 kOcrMagic, then records as the worker works, each u8
+/// OcrRecord, u32 size [bytes], then that many bytes:
+///   block:   u32 lines, u32 words; per word: str text, f64 x, y, w, h [px], f64 confidence [0, 1]
+///   end:     u32 words seen (the last record of an answer that worked)
+///   refusal: u8 OcrError::Kind, str problem (the last record of one that did not)
+enum class OcrRecord : std::uint8_t { end = 0, refusal = 1, block = 2 };
+
+/// One record: its tag, the size of `payload` and the payload.
+inline std::string ocr_record(OcrRecord tag, const worker::WireWriter& payload) {
+  worker::WireWriter out;
+  out.u8(static_cast<std::uint8_t>(tag));
+  out.u32(static_cast<std::uint32_t>(payload.bytes().size()));
+  out.raw(payload.bytes().data(), payload.bytes().size());
+  return out.bytes();
+}
+
+/// The kiosk's side of the answer, read record by record as it comes down the pipe, every size and value
+/// checked (the worker reads a stranger's pixels, so its answer is not trusted either).
+class OcrAnswerReader {
+ public:
+  explicit OcrAnswerReader(const OcrParams& params) : p_(params) {}
+  /// Reads the records of `answer` (every byte so far: each call a longer prefix of the same answer) not read
+  /// yet; calls OcrParams::on_block with each block. False once the answer is malformed (nothing more is read).
+  bool feed(const std::string& answer);
+  bool ended() const { return ended_; }      ///< the end record was read
+  bool refused() const { return refused_; }  ///< a refusal record was read: refusal_kind and refusal_problem say it
+  OcrError::Kind refusal_kind() const { return refusal_kind_; }
+  const std::string& refusal_problem() const { return refusal_problem_; }
+  /// What was read so far (OcrResult::ms and the worker's memory are the caller's to set).
+  OcrResult& result() { return out_; }
+
+ private:
+  bool read_record(OcrRecord tag, const std::string& payload);
+  const OcrParams& p_;
+  std::size_t at_ = 0;  // bytes of the answer read
+  bool bad_ = false, ended_ = false, refused_ = false;
+  OcrError::Kind refusal_kind_ = OcrError::Kind::WorkerCrashed;
+  std::string refusal_problem_;
+  double confidence_sum_ = 0;
+  OcrResult out_;
+};
+
+/// The kiosk's side of the whole answer of `run` (OcrAnswerReader over it).
 /// @throws OcrError: the worker's own refusal, or what went wrong with the run (cancelled, timed out, crashed,
 ///         or an answer that does not parse: "the text reader gave no usable answer").
 OcrResult read_ocr_answer(const worker::WorkerRun& run, const std::string& name, const OcrParams& params);

@@ -156,7 +156,7 @@ int sealed_input(std::span<const std::uint8_t> input) {
 
 /// Reads `fd` into run.answer until EOF, the deadline, max_answer bytes or the cancel flag.
 void read_answer(int fd, std::chrono::steady_clock::time_point deadline, std::size_t max_answer,
-                 const std::atomic<bool>* cancel, WorkerRun& run) {
+                 const std::atomic<bool>* cancel, const AnswerSoFar& on_data, WorkerRun& run) {
   char buf[1 << 16];
   for (;;) {
     if (cancel && cancel->load(std::memory_order_relaxed)) {
@@ -183,13 +183,15 @@ void read_answer(int fd, std::chrono::steady_clock::time_point deadline, std::si
       return;
     }
     run.answer.append(buf, static_cast<std::size_t>(n));
+    if (on_data) on_data(run.answer);
   }
 }
 
 }  // namespace
 
 WorkerRun run_worker(const std::string& path, const std::vector<std::string>& args, std::span<const std::uint8_t> input,
-                     double wall_s, std::size_t max_answer, const std::atomic<bool>* cancel) {
+                     double wall_s, std::size_t max_answer, const std::atomic<bool>* cancel,
+                     const AnswerSoFar& on_data) {
   const int in = sealed_input(input);
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) {
@@ -222,7 +224,7 @@ WorkerRun run_worker(const std::string& path, const std::vector<std::string>& ar
   read_answer(
       fds[0],
       t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wall_s)),
-      max_answer, cancel, run);
+      max_answer, cancel, on_data, run);
   ::kill(pid, SIGKILL);  // in every case: a worker that closed its pipe but lives on is not left behind
   ::close(fds[0]);
   rusage ru{};

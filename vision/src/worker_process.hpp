@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <new>
 #include <span>
 #include <string>
@@ -140,13 +141,19 @@ struct WorkerStartFailure {
 /// How often run_worker looks at its cancel flag while it waits for the answer [ms].
 inline constexpr int kCancelPoll_ms = 50;
 
+/// Called on run_worker's thread each time more of the answer has come: the answer so far (a worker that sends
+/// its answer in records as it works lets the caller use each before the last).
+using AnswerSoFar = std::function<void(const std::string& answer)>;
+
 /// Parent side: runs the worker executable `path` with `args` (argv[1..]) on `input`, reads its answer until
 /// EOF, `wall_s` [s], `max_answer` bytes or `*cancel` (when given) becoming true, then kills and reaps it.
-/// The kiosk's environment is passed on (sanitizer options). Blocks the calling thread for at most about
-/// wall_s (kCancelPoll_ms after a cancel).
+/// `on_data`, when given, sees the answer after each read. The kiosk's environment is passed on (sanitizer
+/// options). Blocks the calling thread for at most about wall_s (kCancelPoll_ms after a cancel), plus what
+/// on_data takes.
 /// @throws WorkerStartFailure when it cannot be started.
 WorkerRun run_worker(const std::string& path, const std::vector<std::string>& args, std::span<const std::uint8_t> input,
-                     double wall_s, std::size_t max_answer, const std::atomic<bool>* cancel = nullptr);
+                     double wall_s, std::size_t max_answer, const std::atomic<bool>* cancel = nullptr,
+                     const AnswerSoFar& on_data = {});
 
 /// The worker executable: $`env_var` if set; else `file_name` beside this executable (an installed kiosk);
 /// else `built_path` (tests and bench binaries live elsewhere in the build tree).

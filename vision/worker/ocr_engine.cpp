@@ -1,23 +1,24 @@
 // The worker side of OCR (vision/ocr.hpp): Tesseract on the pixels of descriptor 3, the answer on
 // descriptor 4. Built only into hk-ocr-worker; the kiosk process never links Tesseract.
 //
-// Answer: u32 magic 'HKOC', u8 status (0 = answer, 1 = refusal)
-//   refusal: u8 OcrError::Kind, str problem
-//   answer:  u32 words seen, u32 blocks; per block: u32 lines, u32 words; per word: str text, f64 x, y, w, h
-//            [px], f64 confidence [0, 1]
+// Answer: u32 magic 'HKOC', then records as they are read (ocr_wire.hpp): a block record for each text block
+// (sent the moment it is read), then an end record, or a refusal record when the work fails.
 #include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <new>
 #include <span>
 #include <string>
 #include <vector>
 
+#include <leptonica/allheaders.h>
 #include <tesseract/baseapi.h>
 #include <tesseract/resultiterator.h>
 
@@ -117,50 +118,178 @@ void start_engine(tesseract::TessBaseAPI& api, const OcrParams& p) {
   api.SetVariable("debug_file", "/dev/null");
 }
 
-/// Reads the `width` x `height` grey `pixels` with a started engine: the answer (after the status byte) in
-/// `out`, or a Refusal thrown.
-void read_page(tesseract::TessBaseAPI& api, const std::uint8_t* pixels, int width, int height, const OcrParams& p,
-               worker::WireWriter& out) {
-  api.SetImage(pixels, width, height, 1, width);
-  api.SetSourceResolution(300);
-  // Pages: Tesseract's layout analysis. A sign or a poster in a photograph is no page layout: where that
-  // finds (almost) nothing, sparse text (words wherever they stand) is tried too, and the better taken.
-  std::uint32_t seen = 0;
-  std::vector<Block> blocks;
-  for (const tesseract::PageSegMode mode : {tesseract::PSM_AUTO, tesseract::PSM_SPARSE_TEXT}) {
-    api.SetPageSegMode(mode);
-    if (api.Recognize(nullptr) != 0)
-      throw Refusal{OcrError::Kind::WorkerCrashed, "Tesseract could not read the picture"};
-    std::uint32_t mode_seen = 0;
-    std::vector<Block> found = read_blocks(api, p, mode_seen);
-    if (kept_words(found, p) > kept_words(blocks, p)) {
-      blocks = std::move(found);
-      seen = mode_seen;
-    }
-    if (kept_words(blocks, p) >= kEnoughForALayout) break;
+/// Sends one record of the answer at once (the kiosk reads each as it comes).
+using Emit = std::function<void(const std::string& record)>;
+
+void send_block(const Block& b, const Emit& emit) {
+  worker::WireWriter out;
+  out.u32(static_cast<std::uint32_t>(b.lines));
+  out.u32(static_cast<std::uint32_t>(b.words.size()));
+  for (const Word& w : b.words) {
+    out.str(w.text);
+    out.f64(w.l);
+    out.f64(w.t);
+    out.f64(w.r - w.l);
+    out.f64(w.b - w.t);
+    out.f64(w.confidence);
   }
-  out.u32(seen);
-  out.u32(static_cast<std::uint32_t>(blocks.size()));
-  for (const Block& b : blocks) {
-    out.u32(static_cast<std::uint32_t>(b.lines));
-    out.u32(static_cast<std::uint32_t>(b.words.size()));
-    for (const Word& w : b.words) {
-      out.str(w.text);
-      out.f64(w.l);
-      out.f64(w.t);
-      out.f64(w.r - w.l);
-      out.f64(w.b - w.t);
-      out.f64(w.confidence);
-    }
-  }
+  emit(ocr_record(OcrRecord::block, out));
 }
 
-/// The worker's work: an answer in `out`, or a Refusal thrown.
-void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p, worker::WireWriter& out) {
+/// One text block of the layout: the picture's pixels over its box, white outside its polygon grown by the
+/// margins (so no piece of a neighbouring block, tilted into the box on a turned page, is read with it).
+struct BlockImage {
+  int l = 0, t = 0, w = 0, h = 0;  ///< its box in the picture [px]
+  std::vector<std::uint8_t> grey;  ///< w x h, row after row
+};
+
+/// Pixel columns of row `y` + 0.5 inside `polygon` (even-odd rule), as [from, to) spans.
+std::vector<std::pair<int, int>> row_spans(const std::vector<std::pair<int, int>>& polygon, int y) {
+  std::vector<double> xs;
+  const double yc = y + 0.5;
+  for (std::size_t i = 0; i < polygon.size(); ++i) {
+    const auto [x0, y0] = polygon[i];
+    const auto [x1, y1] = polygon[(i + 1) % polygon.size()];
+    if ((y0 <= yc) == (y1 <= yc)) continue;
+    xs.push_back(x0 + (yc - y0) * (x1 - x0) / static_cast<double>(y1 - y0));
+  }
+  std::sort(xs.begin(), xs.end());
+  std::vector<std::pair<int, int>> spans;
+  for (std::size_t i = 0; i + 1 < xs.size(); i += 2)
+    spans.push_back({static_cast<int>(std::floor(xs[i])), static_cast<int>(std::ceil(xs[i + 1]))});
+  return spans;
+}
+
+/// The block the iterator is at, cut out of the `width` x `height` `pixels`: its polygon (its box when it has
+/// none) grown by `mx` columns and `my` rows.
+BlockImage cut_block(const tesseract::PageIterator& it, const std::uint8_t* pixels, int width, int height, int mx,
+                     int my) {
+  std::vector<std::pair<int, int>> polygon;
+  if (Pta* pta = it.BlockPolygon()) {
+    for (int i = 0; i < ptaGetCount(pta); ++i) {
+      int x = 0, y = 0;
+      if (ptaGetIPt(pta, i, &x, &y) == 0) polygon.push_back({x, y});
+    }
+    ptaDestroy(&pta);
+  }
+  int l = 0, t = 0, r = 0, b = 0;
+  it.BoundingBox(tesseract::RIL_BLOCK, &l, &t, &r, &b);
+  if (polygon.size() < 3) polygon = {{l, t}, {r, t}, {r, b}, {l, b}};
+  BlockImage out;
+  out.l = std::max(0, l - mx);
+  out.t = std::max(0, t - my);
+  out.w = std::min(width, r + mx) - out.l;
+  out.h = std::min(height, b + my) - out.t;
+  if (out.w <= 0 || out.h <= 0) return {};
+  out.grey.assign(static_cast<std::size_t>(out.w) * static_cast<std::size_t>(out.h), 255);
+  std::vector<std::vector<std::pair<int, int>>> spans(static_cast<std::size_t>(out.h));
+  for (int y = out.t; y < out.t + out.h; ++y) spans[static_cast<std::size_t>(y - out.t)] = row_spans(polygon, y);
+  for (int y = out.t; y < out.t + out.h; ++y) {
+    std::uint8_t* row = out.grey.data() + static_cast<std::size_t>(y - out.t) * static_cast<std::size_t>(out.w);
+    const std::uint8_t* src = pixels + static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
+    for (int yy = std::max(out.t, y - my); yy <= std::min(out.t + out.h - 1, y + my); ++yy)
+      for (const auto& [from, to] : spans[static_cast<std::size_t>(yy - out.t)]) {
+        const int x0 = std::max(out.l, from - mx), x1 = std::min(out.l + out.w, to + mx);
+        for (int x = x0; x < x1; ++x) row[x - out.l] = src[x];
+      }
+  }
+  return out;
+}
+
+/// The text blocks of Tesseract's layout analysis of the `width` x `height` `pixels` (set as the image), in its
+/// reading order.
+std::vector<BlockImage> text_blocks(tesseract::TessBaseAPI& api, const std::uint8_t* pixels, int width, int height) {
+  std::vector<BlockImage> blocks;
+  std::unique_ptr<tesseract::PageIterator> it(api.AnalyseLayout());
+  if (!it) return blocks;
+  const int side = std::max(width, height);
+  const int mx = std::max(kBlockMarginMinPx, static_cast<int>(kBlockMargin * side));
+  const int my = std::max(kBlockMarginMinPx / 2, static_cast<int>(kBlockMargin / 4 * side));
+  do {
+    if (!PTIsTextType(it->BlockType())) continue;
+    BlockImage b = cut_block(*it, pixels, width, height, mx, my);
+    if (!b.grey.empty()) blocks.push_back(std::move(b));
+  } while (it->Next(tesseract::RIL_BLOCK));
+  return blocks;
+}
+
+/// Moves the words of `blocks` by (dx, dy) [px]: from a block's own image into the picture's.
+void shift(std::vector<Block>& blocks, int dx, int dy) {
+  for (Block& b : blocks)
+    for (Word& w : b.words) {
+      w.l += dx;
+      w.r += dx;
+      w.t += dy;
+      w.b += dy;
+    }
+}
+
+/// Reads the `width` x `height` grey `pixels` with a started engine, sending each block as it is read and then
+/// the end record; a Refusal thrown when Tesseract fails.
+void read_page(tesseract::TessBaseAPI& api, const std::uint8_t* pixels, int width, int height, const OcrParams& p,
+               const Emit& emit) {
+  api.SetImage(pixels, width, height, 1, width);
+  api.SetSourceResolution(300);
+  api.SetPageSegMode(tesseract::PSM_AUTO);
+  const std::vector<BlockImage> cut = text_blocks(api, pixels, width, height);
+  // Each block of the layout on its own, sent as soon as the page has shown it is a page (kEnoughForALayout
+  // clear words): until then held, since a sign or a poster in a photograph is no page layout.
+  std::uint32_t seen = 0;
+  std::vector<Block> held;
+  std::size_t kept = 0;
+  bool sending = false;
+  for (const BlockImage& c : cut) {
+    api.SetImage(c.grey.data(), c.w, c.h, 1, c.w);
+    api.SetSourceResolution(300);
+    api.SetPageSegMode(tesseract::PSM_SINGLE_BLOCK);
+    if (api.Recognize(nullptr) != 0)
+      throw Refusal{OcrError::Kind::WorkerCrashed, "Tesseract could not read the picture"};
+    std::vector<Block> read = read_blocks(api, p, seen);
+    shift(read, c.l, c.t);
+    for (Block& b : read) {
+      for (const Word& w : b.words) kept += w.confidence >= p.min_word_confidence;
+      held.push_back(std::move(b));
+    }
+    sending = sending || kept >= kEnoughForALayout;
+    if (sending) {
+      for (const Block& b : held) send_block(b, emit);
+      held.clear();
+    }
+  }
+  if (!sending) {
+    // (Almost) nothing as a page: sparse text (words wherever they stand) on the whole picture, the better taken.
+    api.SetImage(pixels, width, height, 1, width);
+    api.SetSourceResolution(300);
+    api.SetPageSegMode(tesseract::PSM_SPARSE_TEXT);
+    if (api.Recognize(nullptr) != 0)
+      throw Refusal{OcrError::Kind::WorkerCrashed, "Tesseract could not read the picture"};
+    std::uint32_t sparse_seen = 0;
+    std::vector<Block> sparse = read_blocks(api, p, sparse_seen);
+    if (kept_words(sparse, p) > kept) {
+      held = std::move(sparse);
+      seen = sparse_seen;
+    }
+    for (const Block& b : held) send_block(b, emit);
+  }
+  worker::WireWriter end;
+  end.u32(seen);
+  emit(ocr_record(OcrRecord::end, end));
+}
+
+/// The worker's work: its records sent with `emit`, or a Refusal thrown.
+void work(const std::uint8_t* pixels, int width, int height, const OcrParams& p, const Emit& emit) {
   tesseract::TessBaseAPI api;
   start_engine(api, p);
-  read_page(api, pixels, width, height, p, out);
+  read_page(api, pixels, width, height, p, emit);
   api.End();
+}
+
+/// The refusal record of `kind` and `problem`.
+std::string refusal(OcrError::Kind kind, const std::string& problem) {
+  worker::WireWriter out;
+  out.u8(static_cast<std::uint8_t>(kind));
+  out.str(problem);
+  return ocr_record(OcrRecord::refusal, out);
 }
 
 [[noreturn]] void fail_on_purpose(OcrFault fault) {
@@ -183,16 +312,21 @@ int ocr_worker_entry(int argc, char** argv) {
       worker::map_input(static_cast<std::size_t>(rq.width) * static_cast<std::size_t>(rq.height));
   if (pixels.empty()) return 65;
   worker::confine_worker(rq.params.worker_cpu_s, rq.params.worker_max_memory_mb);
-  const worker::WireWriter out = worker::worker_answer<Refusal>(
-      kOcrMagic,
-      [&](worker::WireWriter& answer) {
-        if (rq.params.fault != OcrFault::None) fail_on_purpose(rq.params.fault);
-        work(pixels.data(), rq.width, rq.height, rq.params, answer);
-      },
-      std::pair{OcrError::Kind::TooLarge,
-                "the text reader ran out of memory (limit " + worker::arg(rq.params.worker_max_memory_mb) + " MiB)"},
-      std::pair{OcrError::Kind::WorkerCrashed, std::string("Tesseract failed on it")});
-  worker::write_all(worker::kAnswerFd, out.bytes());
+  worker::WireWriter magic;
+  magic.u32(kOcrMagic);
+  worker::write_all(worker::kAnswerFd, magic.bytes());
+  const Emit emit = [](const std::string& record) { worker::write_all(worker::kAnswerFd, record); };
+  try {
+    if (rq.params.fault != OcrFault::None) fail_on_purpose(rq.params.fault);
+    work(pixels.data(), rq.width, rq.height, rq.params, emit);
+  } catch (const Refusal& r) {
+    emit(refusal(r.kind, r.problem));
+  } catch (const std::bad_alloc&) {
+    emit(refusal(OcrError::Kind::TooLarge,
+                 "the text reader ran out of memory (limit " + worker::arg(rq.params.worker_max_memory_mb) + " MiB)"));
+  } catch (...) {
+    emit(refusal(OcrError::Kind::WorkerCrashed, "Tesseract failed on it"));
+  }
   ::_exit(0);
 }
 

@@ -8,17 +8,21 @@
 /// a wall-clock kill), so a page that crashes, hangs or exhausts it costs the text, never the kiosk. The
 /// worker is found as $HK_OCR_WORKER, else beside the running executable, else where the build put it.
 ///
-/// In the worker: tesseract::TessBaseAPI with the LSTM engine and automatic page segmentation on the grey
-/// pixels; the layout read back with its ResultIterator at block, paragraph, line and word level (boxes and
-/// confidences). Every word is said as Tesseract read it, however unsure (a code word such as "mime.cache" is
-/// often read right with a low confidence, and cutting it loses real text); only a mark below the confidence
-/// threshold with no letter or digit in it is unclear: kept in its place in the block's text as kUnclearWord (the
-/// kiosk says "unclear word" there). A word below kNoiseWordConfidence as well is dropped as noise. A paragraph with no
-/// word at or above the threshold, or whose clear words are mostly not letters or digits, is dropped; the rest are the
-/// text blocks, in Tesseract's reading order.
+/// In the worker: tesseract::TessBaseAPI with the LSTM engine on the grey pixels. Tesseract's layout analysis
+/// finds the page's text blocks in reading order; each is recognised on its own (its polygon grown by kBlockMargin,
+/// the rest of the picture white) and sent to the kiosk at once, so the first words come
+/// in a fraction of a second while the rest are read; each block read back with its ResultIterator at paragraph,
+/// line and word level (boxes and confidences). Where the layout finds (almost) nothing, as for a sign in a
+/// photograph, the whole picture is read as sparse text instead. Every word is said as Tesseract read it, however
+/// unsure (a code word such as "mime.cache" is often read right with a low confidence, and cutting it loses real text);
+/// only a mark below the confidence threshold with no letter or digit in it is unclear: kept in its place in the
+/// block's text as kUnclearWord (the kiosk says "unclear word" there). A word below kNoiseWordConfidence as well is
+/// dropped as noise. A paragraph with no word at or above the threshold, or whose clear words are mostly not letters or
+/// digits, is dropped; the rest are the text blocks, in Tesseract's reading order.
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +38,13 @@ namespace hk::vision {
 inline constexpr std::string_view kUnclearWord = "\xEF\xBF\xBD";
 /// A word below this confidence, and below OcrParams::min_word_confidence, is noise: left out altogether [0, 1].
 inline constexpr double kNoiseWordConfidence = 0.1;
+/// How far each text block's polygon is grown to the left and right before it is recognised, as a share of the
+/// picture's longer side (at least kBlockMarginMinPx), and a quarter of that up and down (at least half): a tight
+/// polygon cuts the letters at its edge, a wide one takes in pieces of the lines of the next block.
+inline constexpr double kBlockMargin = 0.01;
+inline constexpr int kBlockMarginMinPx = 8;
+
+struct OcrBlock;
 
 /// Test hook: the worker fails on purpose as soon as it has started. Never set outside tests.
 enum class OcrFault {
@@ -61,6 +72,10 @@ struct OcrParams {
   /// When given and it becomes true, the worker is killed within worker::kCancelPoll_ms (50 ms) and
   /// recognise_text throws OcrError Cancelled (a newer page no longer needs this one's text).
   const std::atomic<bool>* cancel = nullptr;
+  /// When given, called on recognise_text's thread with each block as soon as the worker has read it, in reading
+  /// order, before recognise_text returns (the page's first words can be said while the rest is read). The
+  /// blocks are those the result will hold; a reading that fails later has still called it for those before.
+  std::function<void(const OcrBlock& block)> on_block;
   OcrFault fault = OcrFault::None;  ///< test hook only
 };
 
