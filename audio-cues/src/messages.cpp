@@ -56,51 +56,7 @@ std::string tidy_spaces(std::string text) {
   return out;
 }
 
-/// What is wrong with `mo` as a GNU MO file (the gettext manual, "The Format of GNU MO Files"), "" when nothing:
-/// the magic number in either byte order, and every string table entry and the hash table inside the file, each
-/// string NUL-terminated, each hash slot 0 or an entry's number + 1. Boost.Locale 1.74 reads the offsets as they
-/// are, so a file is checked before it is handed over.
-std::string mo_problem(const std::vector<char>& mo) {
-  const std::size_t size = mo.size();
-  if (size < 28) return "shorter than an MO header";
-  const auto u32 = [&](std::size_t at, bool swap) {
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) {
-      const auto byte = static_cast<std::uint32_t>(static_cast<unsigned char>(mo[at + static_cast<std::size_t>(i)]));
-      v |= swap ? byte << (8 * (3 - i)) : byte << (8 * i);
-    }
-    return v;
-  };
-  bool swap = false;
-  if (u32(0, false) != 0x950412deu) {
-    if (u32(0, true) != 0x950412deu) return "no MO magic number";
-    swap = true;
-  }
-  const std::uint64_t n = u32(8, swap), originals = u32(12, swap), translations = u32(16, swap);
-  const std::uint64_t hash_size = u32(20, swap), hash_at = u32(24, swap);
-  for (const std::uint64_t table : {originals, translations}) {
-    if (table + 8 * n > size) return "a string table runs past the end";
-    for (std::uint64_t i = 0; i < n; ++i) {
-      const std::uint64_t len = u32(static_cast<std::size_t>(table + 8 * i), swap);
-      const std::uint64_t at = u32(static_cast<std::size_t>(table + 8 * i + 4), swap);
-      if (at + len >= size || mo[static_cast<std::size_t>(at + len)] != '\0') return "a string runs past the end";
-    }
-  }
-  if (hash_size > 0) {
-    if (hash_at + 4 * hash_size > size) return "the hash table runs past the end";
-    for (std::uint64_t i = 0; i < hash_size; ++i)
-      if (u32(static_cast<std::size_t>(hash_at + 4 * i), swap) > n) return "a hash slot names no string";
-  }
-  return {};
-}
-
 }  // namespace
-
-struct MessageCatalog::Compiled {
-  std::locale locale;
-  const boost::locale::message_format<char>* facet = nullptr;
-  int domain = 0;
-};
 
 std::filesystem::path default_locale_dir() { return HK_LOCALE_DIR; }
 
@@ -108,29 +64,27 @@ std::string MessageCatalog::voice() const { return std::string(hk::language_subt
 
 std::string MessageCatalog::translate(const MessageSource& s, long count) const {
   const std::string ctx(s.key), one(s.one);
-  if (compiled_) {
+  if (mo_) {
     const int n = static_cast<int>(std::clamp<long>(count, 0, 1'000'000'000));
-    const char* t = s.many.empty() ? compiled_->facet->get(compiled_->domain, ctx.c_str(), one.c_str())
-                                   : compiled_->facet->get(compiled_->domain, ctx.c_str(), one.c_str(), n);
+    const char* t = s.many.empty() ? mo_->get(ctx.c_str(), one.c_str()) : mo_->get(ctx.c_str(), one.c_str(), n);
     if (t && *t) return t;
   }  // build() looked every entry up once: a file Boost.Locale cannot read was refused there
   return std::string(s.many.empty() || count == 1 ? s.one : s.many);
 }
 
-MessageCatalog MessageCatalog::build(std::string_view language, std::shared_ptr<const Compiled> compiled,
+MessageCatalog MessageCatalog::build(std::string_view language, std::optional<MoCatalogue> mo,
                                      const std::string& source) {
   MessageCatalog c;
   c.language_ = language;
-  c.compiled_ = std::move(compiled);
+  c.mo_ = std::move(mo);
   const std::string where = "catalogue '" + hk::one_line(std::string(language)) + "' (" + hk::one_line(source) + "): ";
   // Each entry is there, not empty, not too long, and uses only the placeholders of its English text.
   const auto check = [&](const MessageSource& s) {
     for (const long n : {1L, 2L, 5L}) {
       if (s.many.empty() && n > 1) break;
       const std::string t = c.translate(s, n);
-      if (c.compiled_ && t == (n == 1 || s.many.empty() ? s.one : s.many)) {
-        const char* found =
-            c.compiled_->facet->get(c.compiled_->domain, std::string(s.key).c_str(), std::string(s.one).c_str());
+      if (c.mo_ && t == (n == 1 || s.many.empty() ? s.one : s.many)) {
+        const char* found = c.mo_->get(std::string(s.key).c_str(), std::string(s.one).c_str());
         if (!found) throw MessageError(where + std::string(s.key) + " is missing");
       }
       if (t.size() > kMaxTextBytes)
@@ -155,82 +109,30 @@ MessageCatalog MessageCatalog::build(std::string_view language, std::shared_ptr<
 }
 
 const MessageCatalog& MessageCatalog::english() {
-  static const MessageCatalog en = build("en", nullptr, "built in");
+  static const MessageCatalog en = build("en", std::nullopt, "built in");
   return en;
 }
 
 MessageCatalog MessageCatalog::from_mo(std::string_view language, std::vector<char> mo_bytes,
                                        const std::string& source) {
-  const std::string where = "catalogue '" + hk::one_line(std::string(language)) + "' (" + hk::one_line(source) + "): ";
-  if (!is_language_tag(language)) throw MessageError(where + "not a BCP 47 language tag such as \"fr\" or \"pt-BR\"");
-  if (const std::string why = mo_problem(mo_bytes); !why.empty())
-    throw MessageError(where + "not a gettext MO file (" + why + ")");
-  namespace gg = boost::locale::gnu_gettext;
-  gg::messages_info info;
-  info.language = std::string(hk::language_subtag(language));
-  info.encoding = "UTF-8";
-  info.domains.emplace_back(std::string(kMessageDomain));
-  info.paths.emplace_back("memory");
-  bool handed = false;
-  info.callback = [&](const std::string&, const std::string&) {
-    if (handed) return std::vector<char>();
-    handed = true;
-    return mo_bytes;
-  };
-  auto compiled = std::make_shared<Compiled>();
-  try {
-    boost::locale::message_format<char>* facet = gg::create_messages_facet<char>(info);
-    if (!facet) throw MessageError(where + "Boost.Locale made no catalogue of it");
-    compiled->locale = std::locale(std::locale::classic(), facet);
-    compiled->facet = facet;
-    compiled->domain = facet->domain(std::string(kMessageDomain));
-  } catch (const MessageError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw MessageError(where + "not a gettext MO file (" + hk::one_line(e.what(), 120) + ")");
-  }
-  if (!handed) throw MessageError(where + "not read");
-  try {  // Boost.Locale reads parts of the file on the first lookups, which build() makes
-    return build(language, std::move(compiled), source);
-  } catch (const MessageError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw MessageError(where + "not a gettext MO file (" + hk::one_line(e.what(), 120) + ")");
-  }
+  return checked(MoCatalogue::from_bytes(kMessageDomain, language, std::move(mo_bytes), source));
 }
 
 MessageCatalog MessageCatalog::load(std::string_view language, const std::filesystem::path& locale_dir) {
   if (language == "en") return english();
-  const std::string shown = hk::one_line(std::string(language));
-  if (!is_language_tag(language))
-    throw MessageError("catalogue '" + shown + "': not a BCP 47 language tag such as \"fr\" or \"pt-BR\"");
-  std::filesystem::path file;
-  for (const std::string_view tag : {language, hk::language_subtag(language)}) {
-    const auto f = locale_dir / std::string(tag) / "LC_MESSAGES" / (std::string(kMessageDomain) + ".mo");
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(f, ec)) {
-      file = f;
-      break;
-    }
+  return checked(MoCatalogue::load(kMessageDomain, language, locale_dir));
+}
+
+MessageCatalog MessageCatalog::checked(MoCatalogue mo) {
+  const std::string where = mo.where();
+  const std::string language = mo.language(), source = mo.source();
+  try {  // Boost.Locale reads parts of the file on the first lookups, which build() makes
+    return build(language, std::move(mo), source);
+  } catch (const MessageError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw MessageError(where + "not a gettext MO file (" + hk::one_line(e.what(), 120) + ")");
   }
-  if (file.empty()) {
-    throw MessageError(
-        "catalogue '" + shown + "': no file " +
-        hk::one_line(
-            (locale_dir / std::string(language) / "LC_MESSAGES" / (std::string(kMessageDomain) + ".mo")).string()));
-  }
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(file, ec);
-  if (ec) throw MessageError("catalogue '" + shown + "' (" + hk::one_line(file.string()) + "): cannot read it");
-  if (size > kMaxCatalogueBytes) {
-    throw MessageError("catalogue '" + shown + "' (" + hk::one_line(file.string()) + "): " + std::to_string(size) +
-                       " bytes is over the limit of " + std::to_string(kMaxCatalogueBytes) + " bytes");
-  }
-  std::ifstream in(file, std::ios::binary);
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof())
-    throw MessageError("catalogue '" + shown + "' (" + hk::one_line(file.string()) + "): cannot read it");
-  return from_mo(language, std::move(bytes), file.string());
 }
 
 std::string MessageCatalog::key_name(std::string_view name) const {

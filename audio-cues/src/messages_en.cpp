@@ -186,6 +186,9 @@ const std::array<MessageSource, kMessageCount> kMessageSources{
     NC_("key_next_paragraph", "{next_paragraph_key}: while a text is read, the next paragraph."),
     NC_("key_previous_paragraph", "{previous_paragraph_key}: while a text is read, the paragraph before."),
     NC_("reading_none", "There is no text here to read. Press {describe_key} to hear what the picture holds."),
+    // TRANSLATORS: a reading key was pressed on a page whose text is still being recognised (OCR); the reading
+    // starts by itself with the first words recognised.
+    NC_("reading_soon", "The text is still being recognised. I will read it as soon as its first words are ready."),
     NC_("reading_start", "The start of the text."),
     NC_("reading_end", "That is the end of the text. Press {previous_sentence_key} to go back."),
     NC_("reading_paragraph", "Paragraph {block} of {blocks}."),

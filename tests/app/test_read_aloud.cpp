@@ -226,5 +226,48 @@ TEST(ReadAloud, APictureWithoutTextSaysSo) {
   EXPECT_FALSE(v.flow.view().reading);
 }
 
+TEST(ReadAloud, AReadingAskedForWhileTheTextIsReadStartsWithItsFirstBlockAndGoesOnAsBlocksCome) {
+  Page v(-1);
+  const std::vector<std::string> all = page_paragraphs();
+  v.fx.page = {{}, -1, "", false};  // no block read yet
+  v.key(KioskKey::NextSentence);
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_soon));
+  const std::size_t asked = v.fx.said.size();
+  v.hear(-1);  // heard; still nothing read
+  EXPECT_EQ(v.fx.said.size(), asked) << "nothing to say until a block comes";
+  v.fx.page = {{all[0]}, -1, "", false};  // the first block is read
+  v.hear(-1);
+  const std::string first = ReadAloud({all[0]}).text_from({0, 0});
+  EXPECT_EQ(v.fx.said.back(), first) << "said at once, without a count of paragraphs not yet known";
+  EXPECT_TRUE(v.flow.view().reading);
+  v.hear(0);
+  v.fx.page = {{all[0], all[1]}, -1, "", false};
+  v.hear(0);
+  EXPECT_EQ(v.fx.said.back(), first) << "the block being heard is not cut by the next one coming";
+  v.fx.page = {all, -1, "", true};  // the whole text has been read
+  v.hear(-1);                       // and the first block has been heard to its end
+  EXPECT_EQ(v.fx.said.back(), ReadAloud(all).text_from({1, 0})) << "on with the blocks that came, from the next";
+  EXPECT_TRUE(v.flow.view().reading);
+  const std::size_t read = v.fx.said.size();
+  v.hear(-1);
+  EXPECT_EQ(v.fx.said.size(), read) << "the whole text read: nothing more to add";
+}
+
+TEST(ReadAloud, AWaitingReadingIsDroppedWhenTheVisitorMovesOnAndSaysSoWhenThePageHasNoText) {
+  Page v(-1);
+  v.fx.page = {{}, -1, "", false};
+  v.key(KioskKey::NextParagraph);
+  v.key(KioskKey::Where);  // something else asked for
+  const std::size_t n = v.fx.said.size();
+  v.fx.page = {{"Opening hours."}, -1, "", false};
+  v.hear(-1);
+  EXPECT_EQ(v.fx.said.size(), n) << "not read over what the visitor asked for since";
+  v.fx.page = {{}, -1, "", false};
+  v.key(KioskKey::NextParagraph);
+  v.fx.page = {{}, -1, "", true};  // read whole: no text on it
+  v.hear(-1);
+  EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_none));
+}
+
 }  // namespace
 }  // namespace hk::app

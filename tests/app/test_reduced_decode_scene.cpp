@@ -235,7 +235,7 @@ TEST(ReducedDecodeScene, AReducedPageOfTextIsStillReadAtFullDetail) {
   const ImageScene pending = build_image_scene_from_bytes(bytes, "page.jpg", reading, TextTiming::later);
   ASSERT_TRUE(pending.text_pending);
   ASSERT_TRUE(pending.with_text);
-  const ImageScene read = pending.with_text(nullptr);
+  const ImageScene read = pending.with_text(TextRun{});
   EXPECT_EQ(read.decode_scale, 2);
   EXPECT_EQ(read.picture.size(), pending.picture.size());
   ASSERT_EQ(read.text_blocks.size(), is.text_blocks.size());

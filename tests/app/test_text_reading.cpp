@@ -87,7 +87,7 @@ TEST(TextLater, AScanIsFeltAtOnceWithoutItsLettersAndItsTextComesFromWithText) {
   EXPECT_TRUE(quick.text_blocks.empty());
   ASSERT_TRUE(quick.scene);
 
-  const ImageScene read = quick.with_text(nullptr);
+  const ImageScene read = quick.with_text(TextRun{});
   EXPECT_FALSE(read.text_pending);
   EXPECT_TRUE(read.ocr.ran) << read.ocr.why;
   ASSERT_GE(read.text_blocks.size(), 3u);
@@ -113,7 +113,7 @@ TEST(TextLater, ACancelledReadingGivesThePageWithoutItsText) {
   ImageScene quick = build_image_scene_from_bytes(r.jpeg, "scan.jpg", config::Settings{}, TextTiming::later);
   ASSERT_TRUE(static_cast<bool>(quick.with_text));
   const std::atomic<bool> cancelled{true};
-  const ImageScene read = quick.with_text(&cancelled);
+  const ImageScene read = quick.with_text(TextRun{&cancelled, {}});
   EXPECT_FALSE(read.ocr.ran);
   EXPECT_EQ(read.ocr.why, "cancelled");
   EXPECT_TRUE(read.text_blocks.empty());
@@ -153,7 +153,8 @@ TEST(OcrCancel, ARaisedFlagKillsTheWorkerAndSaysCancelled) {
 /// named `name`.
 TextBuild waiting_build(const std::string& name, std::atomic<bool>& release, std::atomic<bool>& saw_cancel,
                         std::atomic<bool>* started = nullptr) {
-  return [name, &release, &saw_cancel, started](const std::atomic<bool>* cancel) {
+  return [name, &release, &saw_cancel, started](const TextRun& run) {
+    const std::atomic<bool>* cancel = run.cancel;
     if (started) started->store(true);
     while (!release.load() && !(cancel && cancel->load())) std::this_thread::yield();
     if (cancel && cancel->load()) saw_cancel.store(true);
@@ -205,9 +206,35 @@ TEST(TextReader, CancelStopsTheRunningReadingAndNothingComes) {
   EXPECT_TRUE(saw_cancel.load());
 }
 
+TEST(TextReader, EachBlockReadIsThereToSayWhileTheRestIsRead) {
+  TextReader reader;
+  std::atomic<bool> release{false}, told{false};
+  reader.start(4, [&](const TextRun& run) {
+    run.on_block("Opening hours.");
+    run.on_block("Nine to five.");
+    told.store(true);
+    while (!release.load() && !run.cancel->load()) std::this_thread::yield();
+    return ImageScene{};
+  });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!told.load() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+  ASSERT_TRUE(told.load());
+  EXPECT_EQ(reader.blocks_so_far(), (std::vector<std::string>{"Opening hours.", "Nine to five."}))
+      << "both blocks, in reading order, before the reading has ended";
+  EXPECT_FALSE(reader.poll());
+  release.store(true);
+  ASSERT_TRUE(wait_for(reader));
+  EXPECT_TRUE(reader.blocks_so_far().empty()) << "the whole text has come: no blocks of it any more";
+  // A newer page's reading starts with none of the older one's blocks.
+  std::atomic<bool> release2{false}, saw_cancel{false};
+  reader.start(5, waiting_build("next", release2, saw_cancel));
+  EXPECT_TRUE(reader.blocks_so_far().empty());
+  reader.cancel();
+}
+
 TEST(TextReader, AFailingBuildIsReportedAsAFailureNotLost) {
   TextReader reader;
-  reader.start(3, [](const std::atomic<bool>*) -> ImageScene { throw std::runtime_error("picture 'x': broken"); });
+  reader.start(3, [](const TextRun&) -> ImageScene { throw std::runtime_error("picture 'x': broken"); });
   const std::optional<TextRead> r = wait_for(reader);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->id, 3);

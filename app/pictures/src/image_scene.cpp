@@ -187,8 +187,8 @@ void scale_boxes(vision::OcrResult& r, double k) {
 /// only, as an OCR failure does.
 vision::OcrResult read_picture_text(const cv::Mat& grey, int decode_scale, const OcrSource& source,
                                     const std::string& name, const config::Settings& s, OcrReport& report,
-                                    const std::atomic<bool>* cancel) {
-  if (!source) return read_text(grey, name, s, report, cancel);
+                                    const TextRun& run) {
+  if (!source) return read_text(grey, name, s, report, run);
   cv::Mat detail_grey;
   int detail_scale = 1;
   try {
@@ -201,7 +201,7 @@ vision::OcrResult read_picture_text(const cv::Mat& grey, int decode_scale, const
     report.why = std::string("failed: ") + e.what();
     return {};
   }
-  vision::OcrResult r = read_text(detail_grey, name, s, report, cancel);
+  vision::OcrResult r = read_text(detail_grey, name, s, report, run);
   // A position x in the detail decode's pixels is x * detail_scale at full detail, x * detail_scale /
   // decode_scale in the scene's picture.
   scale_boxes(r, static_cast<double>(detail_scale) / decode_scale);
@@ -212,7 +212,7 @@ vision::OcrResult read_picture_text(const cv::Mat& grey, int decode_scale, const
 /// words masked from the edges, the blocks kept in metres.
 /// `source` (may be empty): the picture in more detail for OCR, see OcrSource; out.decode_scale is bgr's.
 void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& s, TextTiming timing,
-                   const std::atomic<bool>* cancel, const OcrSource& source = {}) {
+                   const TextRun& run, const OcrSource& source = {}) {
   out.width_px = bgr.cols;
   out.height_px = bgr.rows;
   cv::Mat grey;
@@ -224,7 +224,7 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
     // uncertain to speak is still no shape to feel).
     mask = printed_letters_mask_of(grey);
     if (timing == TextTiming::now) {
-      text = read_picture_text(grey, out.decode_scale, source, out.image_path, s, out.ocr, cancel);
+      text = read_picture_text(grey, out.decode_scale, source, out.image_path, s, out.ocr, run);
       if (!text.words.empty()) {
         const cv::Mat words = text_mask(grey.size(), as_page_words(text.words));
         mask = mask.empty() ? words : (mask | words);
@@ -233,14 +233,14 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
       out.text_pending = true;
       out.text_likely = true;  // it looks like a page of text, or [vision] ocr "always" asks for it
       out.with_text = [bgr, name = out.image_path, s, source, fw = out.file_width_px, fh = out.file_height_px,
-                       scale = out.decode_scale](const std::atomic<bool>* stop) {
+                       scale = out.decode_scale](const TextRun& run) {
         ImageScene again;
         again.image_path = name;
         again.picture = bgr;
         again.file_width_px = fw;
         again.file_height_px = fh;
         again.decode_scale = scale;
-        build_picture(again, bgr, s, TextTiming::now, stop, source);
+        build_picture(again, bgr, s, TextTiming::now, run, source);
         return again;
       };
     }
@@ -255,7 +255,7 @@ void build_picture(ImageScene& out, const cv::Mat& bgr, const config::Settings& 
 /// The scene of a rendered document page (see build_page_scene).
 /// `choice`: wants_page_text's answer when the caller has it, else null (judged here).
 void build_page(ImageScene& out, const vision::PdfPage& page, const config::Settings& s, TextTiming timing,
-                const std::atomic<bool>* cancel, const PageTextChoice* choice) {
+                const TextRun& run, const PageTextChoice* choice) {
   cv::cvtColor(page.grey, out.picture, cv::COLOR_GRAY2BGR);
   out.file_width_px = page.grey.cols;
   out.file_height_px = page.grey.rows;
@@ -271,17 +271,17 @@ void build_page(ImageScene& out, const vision::PdfPage& page, const config::Sett
   if (wanted) {
     letters = printed_letters_mask_of(page.grey);
     if (timing == TextTiming::now) {
-      text = read_text(page.grey, out.image_path, s, out.ocr, cancel);
+      text = read_text(page.grey, out.image_path, s, out.ocr, run);
     } else {
       out.text_pending = true;
       out.text_likely = !letters.empty() || !page.words.empty();
       out.with_text = [kept = std::make_shared<const vision::PdfPage>(page), name = out.image_path, number = out.page,
-                       s](const std::atomic<bool>* stop) {
+                       s](const TextRun& run) {
         ImageScene again;
         again.image_path = name;
         again.page = number;
         again.pages = kept->pages;
-        build_page(again, *kept, s, TextTiming::now, stop, nullptr);
+        build_page(again, *kept, s, TextTiming::now, run, nullptr);
         return again;
       };
     }
@@ -338,11 +338,12 @@ cv::Mat printed_letters_mask_of(const cv::Mat& grey) {
 }
 
 vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& s, OcrReport& report,
-                            const std::atomic<bool>* cancel) {
+                            const TextRun& run) {
   double scale = 1.0;
   const cv::Mat read = at_most(grey, kOcrMaxSidePx, scale);
   vision::OcrParams params = ocr_params_from(s);
-  params.cancel = cancel;
+  params.cancel = run.cancel;
+  if (run.on_block) params.on_block = [&run](const vision::OcrBlock& b) { run.on_block(b.text); };
   vision::OcrResult r;
   try {
     r = vision::recognise_text(read, name, params);
@@ -400,7 +401,7 @@ ImageScene build_image_scene(const std::string& path, const config::Settings& s,
   if (out.decode_scale > 1 && s.vision.ocr != "off") {
     source = [path, limits] { return vision::load_image_reduced(path, limits, kOcrMaxSidePx); };
   }
-  build_picture(out, out.picture, s, timing, nullptr, source);
+  build_picture(out, out.picture, s, timing, TextRun{}, source);
   out.times.load_ms += out.times.decode_ms;
   return out;
 }
@@ -419,7 +420,7 @@ ImageScene build_image_scene_from_bytes(const std::vector<std::uint8_t>& bytes, 
       return vision::decode_image_reduced(*kept, name, limits, kOcrMaxSidePx);
     };
   }
-  build_picture(out, out.picture, s, timing, nullptr, source);
+  build_picture(out, out.picture, s, timing, TextRun{}, source);
   out.times.load_ms += out.times.decode_ms;
   return out;
 }
@@ -433,7 +434,7 @@ ImageScene build_image_scene_from_picture(const cv::Mat& bgr, const std::string&
   out.picture = bgr.clone();
   out.file_width_px = bgr.cols;
   out.file_height_px = bgr.rows;
-  build_picture(out, out.picture, s, timing, nullptr);
+  build_picture(out, out.picture, s, timing, TextRun{});
   return out;
 }
 
@@ -496,7 +497,7 @@ ImageScene build_page_scene(const vision::PdfPage& page, const std::string& name
   out.image_path = name;
   out.page = page_number;
   out.pages = page.pages;
-  build_page(out, page, s, timing, nullptr, choice);
+  build_page(out, page, s, timing, TextRun{}, choice);
   return out;
 }
 

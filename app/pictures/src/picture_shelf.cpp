@@ -61,9 +61,8 @@ ImageScene cached_or_built(const std::string& path, const config::Settings& s, c
     keep(is);
     return is;
   }
-  is.with_text = [read = std::move(is.with_text), keep, file_notes = is.file_notes,
-                  side_px](const std::atomic<bool>* cancel) {
-    ImageScene with_text = read(cancel);
+  is.with_text = [read = std::move(is.with_text), keep, file_notes = is.file_notes, side_px](const TextRun& run) {
+    ImageScene with_text = read(run);
     fit_picture(with_text, side_px);
     with_text.file_notes = file_notes;
     const bool whole = with_text.scene && with_text.ocr.why != "cancelled" && with_text.ocr.why.rfind("failed", 0) != 0;
@@ -119,8 +118,8 @@ SceneJob PictureShelf::picture_job(int index) const {
     const bool guesses = guesses_for(path, names_dir(s), is.notes.guesses);
     apply_names(is, names, file, guesses);
     if (is.with_text)  // the scene read again with its text keeps the names
-      is.with_text = [read = std::move(is.with_text), names, file, guesses](const std::atomic<bool>* cancel) {
-        ImageScene with_text = read(cancel);
+      is.with_text = [read = std::move(is.with_text), names, file, guesses](const TextRun& run) {
+        ImageScene with_text = read(run);
         apply_names(with_text, names, file, guesses);
         return with_text;
       };

@@ -29,6 +29,8 @@ void TextReader::start(int id, TextBuild build) {
     std::lock_guard<std::mutex> lock(m_);
     if (running_) running_->store(true);
     done_.reset();
+    blocks_.clear();
+    blocks_id_ = id;
     waiting_ = Job{id, std::move(build), std::make_shared<std::atomic<bool>>(false)};
   }
   pending_ = true;
@@ -42,8 +44,15 @@ void TextReader::cancel() {
     waiting_.reset();
     if (running_) running_->store(true);
     done_.reset();
+    blocks_.clear();
   }
   pending_ = false;
+}
+
+std::vector<std::string> TextReader::blocks_so_far() const {
+  if (!pending_) return {};
+  std::lock_guard<std::mutex> lock(m_);
+  return blocks_id_ == pending_id_ ? blocks_ : std::vector<std::string>{};
 }
 
 std::optional<TextRead> TextReader::poll() {
@@ -52,6 +61,7 @@ std::optional<TextRead> TextReader::poll() {
   if (!done_ || done_->id != pending_id_) return std::nullopt;
   std::optional<TextRead> out = std::move(done_);
   done_.reset();
+  blocks_.clear();
   pending_ = false;
   return out;
 }
@@ -69,8 +79,14 @@ void TextReader::run() {
     }
     const auto t0 = std::chrono::steady_clock::now();
     TextRead read{job.id, {}, 0.0};
+    TextRun run;
+    run.cancel = job.cancel.get();
+    run.on_block = [this, &job](const std::string& text) {
+      std::lock_guard<std::mutex> lock(m_);
+      if (!job.cancel->load() && blocks_id_ == job.id) blocks_.push_back(text);
+    };
     try {
-      read.scene = job.build(job.cancel.get());
+      read.scene = job.build(run);
     } catch (const std::exception& e) {  // the page stays as it is felt; only its text is lost
       spdlog::warn("reading the text of scene {}: {}", job.id, e.what());
       read.scene = ImageScene{};

@@ -531,6 +531,7 @@ void KioskFlow::tick(double now_s) {
     // the warning's own speech is not.
     if (!v_.warned && fx_.speech.speaking()) activity(now_s);
     follow_reading();
+    read_more();
     if ((v_.pending_doc >= 0 || v_.pending_picture >= 0) && !v_.loading_said &&
         now_s - v_.pending_since_s > p_.loading_cue_s) {
       v_.loading_said = true;

@@ -24,6 +24,7 @@ void KioskFlow::describe_key() {
   PageText page = fx_.stage.page_text();
   v_.reading = ReadAloud(page.paragraphs);
   v_.reading_language = other_language(page.language);
+  v_.reading_complete = page.complete;
   v_.reading_on = false;
   if (page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs()) {
     const ReadingPlace at{page.at_hand, 0};
@@ -93,7 +94,14 @@ void KioskFlow::reading_key(KioskKey k) {
     const PageText page = fx_.stage.page_text();
     v_.reading = ReadAloud(page.paragraphs);
     v_.reading_language = other_language(page.language);
+    v_.reading_complete = page.complete;
     v_.reading_on = false;
+    if (v_.reading.empty() && !page.complete) {  // its first words are still being read: said when they are
+      say(MessageId::reading_soon);
+      v_.reading_waits = true;
+      v_.reading_waits_kept = fx_.speech.kept_texts();
+      return;
+    }
     if (v_.reading.empty()) {
       say_brief(MessageId::reading_none);
       return;
@@ -116,8 +124,29 @@ void KioskFlow::reading_key(KioskKey k) {
   read_from(step.at, before);
 }
 
+void KioskFlow::read_more() {
+  if (v_.reading_waits && fx_.speech.kept_texts() != v_.reading_waits_kept) v_.reading_waits = false;  // moved on
+  const bool heard_all = reading() && !v_.reading_complete && fx_.speech.heard_piece() < 0;
+  if (!v_.reading_waits && !heard_all) return;
+  const PageText page = fx_.stage.page_text();
+  const int had = v_.reading_waits ? 0 : v_.reading.paragraphs();
+  if (static_cast<int>(page.paragraphs.size()) <= had) {
+    if (!page.complete) return;  // more is still being read
+    v_.reading_complete = true;
+    if (v_.reading_waits) say_brief(MessageId::reading_none);  // read whole, and no text on it
+    v_.reading_waits = false;
+    return;
+  }
+  const bool first = v_.reading_waits;
+  v_.reading_waits = false;
+  v_.reading = ReadAloud(page.paragraphs);
+  v_.reading_language = other_language(page.language);
+  v_.reading_complete = page.complete;
+  read_from({had, 0}, first ? language_notice() : std::string());
+}
+
 std::string KioskFlow::paragraph_line(int p) const {
-  if (v_.reading.paragraphs() < 2) return {};
+  if (v_.reading.paragraphs() < 2 || !v_.reading_complete) return {};
   return text(MessageId::reading_paragraph,
               {{"block", std::to_string(p + 1)}, {"blocks", std::to_string(v_.reading.paragraphs())}});
 }

@@ -80,13 +80,14 @@ void Stage::show(ImageScene& is, int id, ShownSource source, PictureNotes notes,
   source_ = source;
   text_news_.clear();
   if (is.text_pending && is.with_text) {
-    text_.start(id, [read = std::move(is.with_text), side_px = screen_side_px_](const std::atomic<bool>* cancel) {
-      ImageScene with_text = read(cancel);
+    text_.start(id, [read = std::move(is.with_text), side_px = screen_side_px_](const TextRun& run) {
+      ImageScene with_text = read(run);
       fit_picture(with_text, side_px);  // on the reader's worker, not the window thread
       return with_text;
     });
     text_since_s_ = -1.0;
     text_said_ = reading_said;
+    text_heard_early_ = false;
   } else {
     text_.cancel();
   }
@@ -150,7 +151,9 @@ void Stage::text_arrived(TextRead& read) {
   const bool built = is.scene != nullptr;
   const bool said_reading = text_said_;
   if (built) show(is, read.id, source_, shown_.notes);  // the fade: no force step as the letters' curves go
-  if (built && !is.text_blocks.empty()) {
+  if (built && !is.text_blocks.empty() && text_heard_early_) {
+    // Being read to the visitor as it came: nothing to announce.
+  } else if (built && !is.text_blocks.empty()) {
     text_news_ = m.text(audio::MessageId::text_ready,
                         {{"description", describe_page(static_cast<int>(is.text_blocks.size()),
                                                        count_figures(is.polylines), audio_.messages())}});
@@ -204,11 +207,20 @@ std::string Stage::describe() {
 
 PageText Stage::page_text() {
   PageText page;
+  page.language = shown_.text_language;
+  if (shown_.text_blocks.empty() && text_.pending() && text_.pending_id() == shown_id_) {
+    // Its text still being read: the blocks read so far, more to come; the visitor hears them as they come,
+    // so "The text is ready" is not said over them.
+    for (const std::string& b : text_.blocks_so_far())
+      page.paragraphs.push_back(name_unclear_words(b, audio_.messages()));
+    page.complete = false;
+    text_heard_early_ = true;
+    return page;
+  }
   for (const TextBlockM& b : shown_.text_blocks)
     page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
   if (const TextBlockM* b = text_block_at(shown_.text_blocks, step_.display().proxy_m))
     page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
-  page.language = shown_.text_language;
   return page;
 }
 

@@ -24,12 +24,15 @@
 #include <locale>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "audio/mo_catalogue.hpp"
 #include "hk/error.hpp"
 
 namespace hk::audio {
@@ -163,6 +166,7 @@ enum class MessageId : int {
   key_next_paragraph,
   key_previous_paragraph,
   reading_none,
+  reading_soon,
   reading_start,
   reading_end,
   reading_paragraph,
@@ -172,7 +176,7 @@ enum class MessageId : int {
   key_language,
   other_language,
 };
-inline constexpr int kMessageCount = 135;
+inline constexpr int kMessageCount = 136;
 
 /// One entry of the English source: its key (the msgctxt), its English text (the msgid) and, for a counted
 /// entry, its English text for more than one (the msgid_plural; empty for an entry that is not counted).
@@ -200,19 +204,9 @@ inline std::string_view message_key(MessageId id) { return kMessageSources[stati
 
 /// The gettext domain: the catalogues' file name, haptic-kiosk.mo.
 inline constexpr std::string_view kMessageDomain = "haptic-kiosk";
-/// The largest catalogue file read [bytes].
-inline constexpr std::uintmax_t kMaxCatalogueBytes = 1024 * 1024;
 
 /// The folder of the compiled catalogues this build or package ships (LANG/LC_MESSAGES/haptic-kiosk.mo below it).
 std::filesystem::path default_locale_dir();
-
-/// A catalogue file that cannot be used. what() is one line naming the file and, when one entry is at
-/// fault, its key, e.g. "catalogue 'de' (/usr/share/haptic-kiosk/locale/de/LC_MESSAGES/haptic-kiosk.mo): help uses
-/// {colour}, which the English text does not have".
-class MessageError : public hk::Error {
- public:
-  using hk::Error::Error;
-};
 
 /// A named value for a {placeholder}.
 using MessageArg = std::pair<std::string_view, std::string>;
@@ -297,9 +291,9 @@ class MessageCatalog {
   std::string voice() const;
 
  private:
-  struct Compiled;  // the MO's std::locale with its Boost.Locale message facet
-  static MessageCatalog build(std::string_view language, std::shared_ptr<const Compiled> compiled,
-                              const std::string& source);
+  static MessageCatalog build(std::string_view language, std::optional<MoCatalogue> mo, const std::string& source);
+  /// build() from `mo`, a lookup Boost.Locale throws on made a MessageError.
+  static MessageCatalog checked(MoCatalogue mo);
   std::string translate(const MessageSource& s, long count) const;
   std::string expand_all(std::string_view text_template, std::span<const MessageArg> args,
                          std::span<const KeyArg> keys) const;
@@ -309,7 +303,7 @@ class MessageCatalog {
   std::map<std::string, std::string, std::less<>> key_names_;
   std::map<std::string, std::string, std::less<>> key_places_;
   std::string language_;
-  std::shared_ptr<const Compiled> compiled_;  // null for English
+  std::optional<MoCatalogue> mo_;  // none for English
 };
 
 }  // namespace hk::audio

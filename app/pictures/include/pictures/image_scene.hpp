@@ -85,10 +85,20 @@ enum class TextTiming {
 
 struct ImageScene;
 
+/// What a reading of a scene's text is given while it runs.
+struct TextRun {
+  /// Raised (may be null): the OCR worker is killed within 50 ms and the scene comes back without its text
+  /// (OcrReport::why "cancelled").
+  const std::atomic<bool>* cancel = nullptr;
+  /// When given, called on the reading's thread with each text block's text as OCR reads it, in reading order
+  /// (vision::OcrParams::on_block): the blocks the finished scene's text_blocks hold, the first of them seconds
+  /// before the rest.
+  std::function<void(const std::string& text)> on_block;
+};
+
 /// Builds a scene again with its text read (OCR in its worker process, the words masked from the edges, the
-/// blocks kept). A raised `cancel` (may be null) kills the worker within 50 ms; the scene then comes back
-/// without its text (OcrReport::why "cancelled").
-using TextBuild = std::function<ImageScene(const std::atomic<bool>* cancel)>;
+/// blocks kept), as `run` says.
+using TextBuild = std::function<ImageScene(const TextRun& run)>;
 
 /// A picture turned into a scene. `polylines[i]` is the curve built into `scene` as the curve whose
 /// `source_index` is i.
@@ -287,10 +297,10 @@ bool wants_page_text(const vision::PdfPage& page, const config::Settings& settin
 
 /// Reads the text of `grey` (CV_8UC1) with vision::recognise_text at up to kOcrMaxSidePx; the words come back
 /// in `grey`'s pixel frame. Fills `report` (ran, words, confidence, time, memory). A failure (OcrError) is
-/// logged in one line and costs the text only: report.why says what happened ("cancelled" when `cancel` was
-/// raised), the result is empty.
+/// logged in one line and costs the text only: report.why says what happened ("cancelled" when run.cancel was
+/// raised), the result is empty. run.on_block hears each block as it is read.
 vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const config::Settings& settings,
-                            OcrReport& report, const std::atomic<bool>* cancel = nullptr);
+                            OcrReport& report, const TextRun& run = {});
 
 /// Where the letters of printed lines lie in `grey` (vision::printed_letters_mask judged at up to 1600 px,
 /// scaled back to grey's size); empty when it is not a page of text. What a page's curves leave out until

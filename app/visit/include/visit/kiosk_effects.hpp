@@ -31,6 +31,9 @@ struct PageText {
   std::vector<std::string> paragraphs;  ///< its blocks of text in reading order; empty: no text
   int at_hand = -1;                     ///< the paragraph under the hand, −1 when none is
   std::string language;                 ///< the text's language (BCP 47) as its document says it, "" unknown
+  /// False while the page's text is still being read (OCR): `paragraphs` are the blocks read so far, in reading
+  /// order, and more may follow (at_hand is then −1).
+  bool complete = true;
 };
 
 /// What is said, and what is heard of it.
@@ -93,7 +96,8 @@ class StageEffects {
   /// "What is here": the shape or block of text under or nearest the hand and where the hand is, one or two
   /// sentences (describe.hpp, where_message). Default: nothing to say ("").
   virtual std::string where() { return {}; }
-  /// The text of the page shown, paragraph by paragraph, and which is under the hand. Default: no text.
+  /// The text of the page shown, paragraph by paragraph, and which is under the hand; while it is still being
+  /// read, the blocks read so far (PageText::complete false). Default: no text.
   virtual PageText page_text() { return {}; }
   /// Level one finer (delta −1) or coarser (+1). Returns false at the limit (nothing changes). A change turns
   /// the level from hand speed off for the picture shown (it comes back with another picture).

@@ -288,6 +288,9 @@ class KioskFlow {
     ReadAloud reading;                // the page's text being read, and where the visitor is in it
     bool reading_on = false;          // the reading was said, as the text kept numbered reading_kept
     std::uint64_t reading_kept = 0;
+    bool reading_complete = true;          // the text being read is the page's whole text (else more blocks may come)
+    bool reading_waits = false;            // the visitor asked to hear a text of which no block has been read yet,
+    std::uint64_t reading_waits_kept = 0;  // when the text kept numbered this was said (anything said since: not)
   };
 
   void guarded(const char* what,
@@ -314,11 +317,15 @@ class KioskFlow {
   void follow_reading();  // the place follows the sentence heard
   /// Reads from `at` to the end of its paragraph, after `before` (said first, in the same text).
   void read_from(ReadingPlace at, const std::string& before);
+  /// A page's text still being read: the reading asked for starts with its first block, and goes on with each
+  /// block that came once what came before has been heard (called by tick).
+  void read_more();
+  /// "" or "About 9 minutes of text. …" and a space, for a text that long.
   std::string long_text_line(const std::string& text) const;
+  /// "Paragraph 2 of 5." on a page of more than one whose whole text is known, else "".
   std::string paragraph_line(int paragraph) const;
   /// A load was asked for at `now_s`; `awaited`: another was awaited already (see the .cpp).
-  void start_loading_clock(double now_s, bool awaited);  // "Paragraph 2 of 5." on a page of more than one, else ""  //
-                                                         // "" or "About 9 minutes of text. …" and a space
+  void start_loading_clock(double now_s, bool awaited);
   void level_key(int delta);
   void warn(double idle_s);
   void pause_key();

@@ -172,10 +172,11 @@ class Stage final : public StageEffects {
   int screen_side_px_ = kScreenPictureMaxSidePx;  // set_screen_picture_side_px
   // The text of the page shown.
   TextReader text_;
-  double text_since_s_ = -1.0;  // poll_text's clock when the reading was first seen, −1 before
-  bool text_said_ = false;      // "Reading the text." was said for it
-  std::string text_news_;       // what came of it, said once nothing else is being said
-  int text_news_id_ = 0;        // the scene it is about
+  double text_since_s_ = -1.0;     // poll_text's clock when the reading was first seen, −1 before
+  bool text_said_ = false;         // "Reading the text." was said for it
+  bool text_heard_early_ = false;  // page_text handed out its blocks before it was whole: no "text ready" news
+  std::string text_news_;          // what came of it, said once nothing else is being said
+  int text_news_id_ = 0;           // the scene it is about
 };
 
 }  // namespace hk::app
