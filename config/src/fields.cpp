@@ -524,6 +524,9 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD_IN(operator_, "operator", audit_log, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
                 "One line per change made in the panel; empty = beside the settings file (.audit.log).", {},
                 &path_problem),
+    HK_FIELD_IN(operator_, "operator", language, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
+                "Language of the operator's panel (a tag: \"en\", \"fr\"); English where it has no translation.", {},
+                &language_problem),
 });
 
 #undef HK_FIELD
@@ -548,22 +551,26 @@ std::span<const FieldDescriptor> field_descriptors() noexcept { return kFields; 
 
 std::string field_allowed_text(const FieldDescriptor& d) { return detail::allowed_text(d); }
 
+// N_ marks a word of the operator's panel for the translators' template (the panel catalogue, xgettext --keyword=N_);
+// the panel looks it up in the staff's language.
+#define N_(text) text
+
 std::string_view group_name(FieldGroup g) noexcept {
   switch (g) {
     case FieldGroup::haptics:
-      return "Haptics";
+      return N_("Haptics");
     case FieldGroup::levels:
-      return "Levels";
+      return N_("Levels");
     case FieldGroup::scene:
-      return "Scene";
+      return N_("Scene");
     case FieldGroup::audio:
-      return "Audio";
+      return N_("Audio");
     case FieldGroup::kiosk:
-      return "Kiosk";
+      return N_("Kiosk");
     case FieldGroup::keys:
-      return "Keys";
+      return N_("Keys");
     case FieldGroup::devices:
-      return "Devices";
+      return N_("Devices");
     case FieldGroup::hidden:
       return "";
   }
@@ -571,7 +578,11 @@ std::string_view group_name(FieldGroup g) noexcept {
 }
 
 std::string field_label(const FieldDescriptor& d) {
-  std::string_view h = d.help;
+  return field_label(d.help, std::string(d.table) + "." + std::string(d.key));
+}
+
+std::string field_label(std::string_view help, std::string_view key) {
+  std::string_view h = help;
   const std::size_t end = std::min({h.find(". "), h.find(':'), h.find(';'), h.find(", "), h.find(" ("), h.size()});
   std::string label(h.substr(0, end));
   // Another setting's key is no staff word: the label stops before it ("... for pop_hold_s" → "... for ...").
@@ -587,7 +598,7 @@ std::string field_label(const FieldDescriptor& d) {
     const std::size_t cut = label.rfind(' ', kMaxFieldLabelBytes);
     label = label.substr(0, cut == std::string::npos ? kMaxFieldLabelBytes : cut) + " ...";
   }
-  return label.empty() ? std::string(d.table) + "." + std::string(d.key) : label;
+  return label.empty() ? std::string(key) : label;
 }
 
 std::span<const std::string_view> visitor_key_names() noexcept { return kKeyNames; }

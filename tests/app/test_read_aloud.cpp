@@ -248,9 +248,12 @@ TEST(ReadAloud, AReadingAskedForWhileTheTextIsReadStartsWithItsFirstBlockAndGoes
   v.hear(-1);                       // and the first block has been heard to its end
   EXPECT_EQ(v.fx.said.back(), ReadAloud(all).text_from({1, 0})) << "on with the blocks that came, from the next";
   EXPECT_TRUE(v.flow.view().reading);
+  v.hear(3);
+  v.hear(-1);  // the second paragraph heard to its end: the third follows, to the end of the page
+  EXPECT_EQ(v.fx.said.back(), ReadAloud(all).text_from({2, 0}));
   const std::size_t read = v.fx.said.size();
   v.hear(-1);
-  EXPECT_EQ(v.fx.said.size(), read) << "the whole text read: nothing more to add";
+  EXPECT_EQ(v.fx.said.size(), read) << "the end of the page: nothing more to add";
 }
 
 TEST(ReadAloud, AWaitingReadingIsDroppedWhenTheVisitorMovesOnAndSaysSoWhenThePageHasNoText) {

@@ -183,8 +183,8 @@ TEST(Messages, TheBuildCheckFailsOnABrokenCatalogue) {
     fs::create_directories(dir.path / "po");
     fs::copy_file(kPoDir / "haptic-kiosk.pot", dir.path / "po" / "haptic-kiosk.pot");
     std::ofstream(dir.path / "po" / "fr.po", std::ios::binary) << fr_text;
-    return run("bash '" + script + "' build '" + kEnglishSource.string() + "' '" + (dir.path / "po").string() + "' '" +
-                   (dir.path / "out").string() + "'",
+    return run("bash '" + script + "' build haptic-kiosk '" + (dir.path / "po").string() + "' '" +
+                   (dir.path / "out").string() + "' '" + kEnglishSource.string() + "'",
                dir.path / "err.txt", err);
   };
   const std::string fr = read_text(kPoDir / "fr.po");

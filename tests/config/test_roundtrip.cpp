@@ -25,7 +25,7 @@ TEST(ConfigRoundTrip, Defaults) {
 /// default, so a field missing from the table (or written or read under the wrong key) comes back as
 /// its default and fails the comparison. kFieldsSetByHand counts the assignments below; the test checks
 /// it against the table, so a field added to Settings and the table but not here fails too.
-constexpr std::size_t kFieldsSetByHand = 136;
+constexpr std::size_t kFieldsSetByHand = 137;
 
 Settings every_field_changed() {
   Settings s;
@@ -174,6 +174,7 @@ Settings every_field_changed() {
   o.pin_hash = "$argon2id$v=19$m=65536,t=2,p=1$c29tZXNhbHQ$aGFzaA";
   o.state_file = "/var/lib/haptic-kiosk/pin.state";
   o.audit_log = "/var/log/haptic-kiosk/audit.log";
+  o.language = "fr";
   return s;
 }
 

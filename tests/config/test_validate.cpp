@@ -119,7 +119,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
         name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" ||
         name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "kiosk.scene_cache" ||
         name == "kiosk.names_dir" || name == "vision.ocr_languages" || name == "kiosk.languages" ||
-        name == "kiosk.language") {
+        name == "kiosk.language" || name == "operator.language") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -129,7 +129,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 45u);
+  EXPECT_EQ(texts, 46u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 

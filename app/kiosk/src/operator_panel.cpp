@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "haptics/level_policy.hpp"
 
@@ -12,6 +13,9 @@
 #include "config/load.hpp"
 #include "pictures/picture_names.hpp"
 #include "runtime/device_setup.hpp"
+
+// N_ marks a word for the panel's catalogue (xgettext --keyword=N_) where it is looked up later with tr().
+#define N_(text) text
 
 namespace hk::app {
 namespace {
@@ -24,13 +28,13 @@ const ImVec4 kGreen{0.5f, 0.95f, 0.55f, 1.0f};
 const char* apply_text(config::ApplyWhen a) {
   switch (a) {
     case config::ApplyWhen::live:
-      return "at once";
+      return N_("at once");
     case config::ApplyWhen::scene:
-      return "rebuilds the scene";
+      return N_("rebuilds the scene");
     case config::ApplyWhen::session:
-      return "next visitor";
+      return N_("next visitor");
     case config::ApplyWhen::restart:
-      return "after a restart";
+      return N_("after a restart");
   }
   return "";
 }
@@ -55,6 +59,8 @@ std::optional<WidgetRect> OperatorPanel::widget(const std::string& name) const {
 void OperatorPanel::draw(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double now_s,
                          std::int64_t now_unix_s) {
   drawing_.clear();
+  if (runtime.settings().operator_.language != text_.asked())
+    text_ = PanelText::load(runtime.settings().operator_.language, audio::default_locale_dir());
   sample_plot(runtime);
   switch (s_.state()) {
     case PanelState::closed:
@@ -78,7 +84,7 @@ void OperatorPanel::draw(KioskRuntime& runtime, const KioskFlow& flow, int fw, i
 void OperatorPanel::draw_notice(int fw, int fh) {
   ImGui::SetNextWindowPos(ImVec2(0.5f * fw, 0.3f * fh), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSize(ImVec2(0.6f * fw, 0));
-  ImGui::Begin("Operator", nullptr,
+  ImGui::Begin((std::string(tr("Operator")) + "###operator_notice").c_str(), nullptr,
                ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoResize);
   ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
@@ -90,7 +96,7 @@ void OperatorPanel::draw_notice(int fw, int fh) {
 void OperatorPanel::draw_pin_prompt(int fw, int fh, double now_s, std::int64_t now_unix_s) {
   ImGui::SetNextWindowPos(ImVec2(0.5f * fw, 0.3f * fh), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSize(ImVec2(std::min(0.6f * fw, 560.0f), 0));
-  ImGui::Begin("Operator PIN", nullptr,
+  ImGui::Begin((std::string(tr("Operator PIN")) + "###operator_pin").c_str(), nullptr,
                ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoResize);
   if (ImGui::IsWindowAppearing()) focus_pin_ = true;
@@ -107,11 +113,11 @@ void OperatorPanel::draw_pin_prompt(int fw, int fh, double now_s, std::int64_t n
       ImGuiInputTextFlags_Password | ImGuiInputTextFlags_CharsDecimal | ImGuiInputTextFlags_EnterReturnsTrue);
   record("pin");
   if (pin_.size() > static_cast<std::size_t>(12)) pin_.resize(12);
-  enter = ImGui::Button("OK") || enter;
+  enter = ImGui::Button((std::string(tr("OK")) + "###OK").c_str()) || enter;
   record("OK");
   if (!can_type) ImGui::EndDisabled();
   ImGui::SameLine();
-  if (ImGui::Button("Cancel")) {
+  if (ImGui::Button((std::string(tr("Cancel")) + "###Cancel").c_str())) {
     std::fill(pin_.begin(), pin_.end(), '\0');
     pin_.clear();
     s_.close(now_unix_s);
@@ -130,33 +136,33 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
   ImGui::SetNextWindowPos(ImVec2(0.04f * fw, 0.04f * fh));
   ImGui::SetNextWindowSize(ImVec2(0.92f * fw, 0.8f * fh));
   ImGui::SetNextWindowBgAlpha(0.96f);  // the picture must not show through the settings
-  ImGui::Begin("Operator panel", nullptr,
+  ImGui::Begin((std::string(tr("Operator panel")) + "###operator_panel").c_str(), nullptr,
                ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoResize);
   if (!s_.files().load_notice.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
-    ImGui::TextWrapped("Settings file: %s", s_.files().load_notice.c_str());
+    ImGui::TextWrapped(tr("Settings file: %s"), s_.files().load_notice.c_str());
     ImGui::PopStyleColor();
   }
-  ImGui::TextColored(kGrey, "%s   audit: %s", s_.files().settings_path.c_str(), s_.files().audit_path.c_str());
+  ImGui::TextColored(kGrey, tr("%s   audit: %s"), s_.files().settings_path.c_str(), s_.files().audit_path.c_str());
   const float actions_h = ImGui::GetFrameHeightWithSpacing() * 2.2f;
   ImGui::BeginChild("tabs", ImVec2(0, -actions_h));
   if (ImGui::BeginTabBar("groups")) {
-    if (ImGui::BeginTabItem("Status")) {
+    if (ImGui::BeginTabItem((std::string(tr("Status")) + "###Status").c_str())) {
       draw_status(runtime, flow, now_unix_s);
       ImGui::EndTabItem();
     }
     record("tab:Status");
     for (config::FieldGroup g : kTabs) {
       const std::string name(config::group_name(g));
-      const bool open = ImGui::BeginTabItem(name.c_str());
+      const bool open = ImGui::BeginTabItem((std::string(tr(name.c_str())) + "###" + name).c_str());
       record("tab:" + name);
       if (open) {
         draw_fields(g, profile_type(runtime), now_unix_s);
         ImGui::EndTabItem();
       }
     }
-    const bool names_open = ImGui::BeginTabItem("Names");
+    const bool names_open = ImGui::BeginTabItem((std::string(tr("Names")) + "###Names").c_str());
     record("tab:Names");
     if (names_open) {
       draw_names(runtime);
@@ -173,10 +179,10 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
   if (!ImGui::BeginTable("fields", 4,
                          ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_SizingStretchProp))
     return;
-  ImGui::TableSetupColumn("setting", ImGuiTableColumnFlags_WidthStretch, 1.3f);
-  ImGui::TableSetupColumn("value", ImGuiTableColumnFlags_WidthStretch, 1.0f);
-  ImGui::TableSetupColumn("allowed", ImGuiTableColumnFlags_WidthStretch, 1.0f);
-  ImGui::TableSetupColumn("takes effect", ImGuiTableColumnFlags_WidthStretch, 0.6f);
+  ImGui::TableSetupColumn(tr("setting"), ImGuiTableColumnFlags_WidthStretch, 1.3f);
+  ImGui::TableSetupColumn(tr("value"), ImGuiTableColumnFlags_WidthStretch, 1.0f);
+  ImGui::TableSetupColumn(tr("allowed"), ImGuiTableColumnFlags_WidthStretch, 1.0f);
+  ImGui::TableSetupColumn(tr("takes effect"), ImGuiTableColumnFlags_WidthStretch, 0.6f);
   ImGui::TableHeadersRow();
   for (const config::FieldDescriptor& d : config::field_descriptors()) {
     if (d.group != group) continue;
@@ -184,13 +190,14 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
     ImGui::TableNextRow();
     ImGui::TableNextColumn();
     // The setting in staff words, its key small and grey beside it for those who edit the file, then its help.
-    ImGui::TextUnformatted(config::field_label(d).c_str());
+    const std::string help = text_(d.help);  // in the staff's language
+    ImGui::TextUnformatted(config::field_label(help, key).c_str());
     ImGui::SameLine();
     ImGui::SetWindowFontScale(0.8f);
     ImGui::TextColored(kGrey, "%s", key.c_str());
     ImGui::SetWindowFontScale(1.0f);
     ImGui::PushStyleColor(ImGuiCol_Text, kGrey);
-    ImGui::TextWrapped("%.*s", static_cast<int>(d.help.size()), d.help.data());
+    ImGui::TextWrapped("%s", help.c_str());
     ImGui::PopStyleColor();
     ImGui::TableNextColumn();
     ImGui::SetNextItemWidth(-1);
@@ -207,9 +214,9 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
     ImGui::PopID();
     ImGui::TableNextColumn();
     if (d.kind == config::FieldKind::text && !d.choices.empty() && d.choices.size() > 6) {
-      ImGui::TextWrapped("a key name (F1, A, UP, PAGE_UP, KP_5, ...)");
+      ImGui::TextWrapped("%s", tr("a key name (F1, A, UP, PAGE_UP, KP_5, ...)"));
     } else if (d.kind == config::FieldKind::text && d.check) {
-      ImGui::TextWrapped("text");
+      ImGui::TextWrapped("%s", tr("text"));
     } else {
       ImGui::TextWrapped("%s", config::field_allowed_text(d).c_str());
       const std::string limit = config::profile_limit_text(s_.working(), profile_type, d.table, d.key);
@@ -220,45 +227,48 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
       }
     }
     ImGui::TableNextColumn();
-    ImGui::TextUnformatted(apply_text(d.apply));
+    ImGui::TextUnformatted(tr(apply_text(d.apply)));
   }
   ImGui::EndTable();
 }
 
 void OperatorPanel::draw_actions(std::int64_t now_unix_s) {
   if (s_.dirty()) {
-    ImGui::TextColored(kOrange, "Changed in the panel, not applied yet.");
+    ImGui::TextColored(kOrange, "%s", tr("Changed in the panel, not applied yet."));
   } else if (s_.unsaved()) {
-    ImGui::TextColored(kOrange, "Applied, not saved: the kiosk goes back to the file's settings when it restarts.");
+    ImGui::TextColored(kOrange, "%s",
+                       tr("Applied, not saved: the kiosk goes back to the file's settings when it restarts."));
   } else {
-    ImGui::TextColored(kGreen, "%s", s_.status().empty() ? "In use and saved." : s_.status().c_str());
+    ImGui::TextColored(kGreen, "%s", s_.status().empty() ? tr("In use and saved.") : s_.status().c_str());
   }
   if (!s_.status().empty() && (s_.dirty() || s_.unsaved())) {
     ImGui::SameLine();
     ImGui::TextColored(kGrey, "%s", s_.status().c_str());
   }
-  if (ImGui::Button("Apply")) s_.apply(now_unix_s);
+  if (ImGui::Button((std::string(tr("Apply")) + "###Apply").c_str())) s_.apply(now_unix_s);
   record("Apply");
   ImGui::SameLine();
-  if (ImGui::Button("Save")) s_.save(now_unix_s);
+  if (ImGui::Button((std::string(tr("Save")) + "###Save").c_str())) s_.save(now_unix_s);
   record("Save");
   ImGui::SameLine();
-  if (ImGui::Button("Reset to defaults")) ImGui::OpenPopup("Reset to defaults?");
+  if (ImGui::Button((std::string(tr("Reset to defaults")) + "###Reset to defaults").c_str()))
+    ImGui::OpenPopup("###reset_popup");
   record("Reset to defaults");
   ImGui::SameLine();
-  if (ImGui::Button("Close")) s_.close(now_unix_s);
+  if (ImGui::Button((std::string(tr("Close")) + "###Close").c_str())) s_.close(now_unix_s);
   record("Close");
-  if (ImGui::BeginPopupModal("Reset to defaults?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+  if (ImGui::BeginPopupModal((std::string(tr("Reset to defaults?")) + "###reset_popup").c_str(), nullptr,
+                             ImGuiWindowFlags_AlwaysAutoResize)) {
     ImGui::TextUnformatted(
-        "Every setting in the panel goes back to its default (the PIN stays).\nNothing changes in the kiosk until "
-        "Apply.");
-    if (ImGui::Button("Reset")) {
+        tr("Every setting in the panel goes back to its default (the PIN stays).\nNothing changes in the kiosk until "
+           "Apply."));
+    if (ImGui::Button((std::string(tr("Reset")) + "###Reset").c_str())) {
       s_.reset_to_defaults(now_unix_s);
       ImGui::CloseCurrentPopup();
     }
     record("Reset");
     ImGui::SameLine();
-    if (ImGui::Button("Keep")) ImGui::CloseCurrentPopup();
+    if (ImGui::Button((std::string(tr("Keep")) + "###Keep").c_str())) ImGui::CloseCurrentPopup();
     record("Keep");
     ImGui::EndPopup();
   }
@@ -276,10 +286,13 @@ void OperatorPanel::sample_plot(KioskRuntime& runtime) {
 void OperatorPanel::draw_stick_problems(KioskRuntime& runtime) {
   const std::vector<std::string>& problems = runtime.sticks().problems();
   if (problems.empty()) return;
-  const std::string title = "The last stick: " + std::to_string(problems.size()) +
-                            (problems.size() == 1 ? " file" : " files") + " left out (" +
-                            (problems.size() >= StickDesk::kProblems ? "the first ones; " : "") + "all in the log)";
-  if (ImGui::TreeNode("stick_problems", "%s", title.c_str())) {
+  char title[160];
+  std::snprintf(title, sizeof title,
+                problems.size() >= StickDesk::kProblems
+                    ? tr("The last stick: %zu files left out (the first ones; all in the log)")
+                    : tr("The last stick: %zu file(s) left out (all in the log)"),
+                problems.size());
+  if (ImGui::TreeNode("stick_problems", "%s", title)) {
     for (const std::string& p : problems) ImGui::BulletText("%s", p.c_str());
     ImGui::TreePop();
   }
@@ -290,23 +303,24 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
   const ServoDisplayState& d = runtime.core().display();
   io::HaplyDevice* usb = runtime.devices().usb();
   if (!usb) {
-    ImGui::Text("Device: simulated pantograph%s%s", runtime.devices().note().empty() ? "" : " (no USB pantograph: ",
+    ImGui::Text(tr("Device: simulated pantograph%s%s"),
+                runtime.devices().note().empty() ? "" : tr(" (no USB pantograph: "),
                 runtime.devices().note().empty() ? "" : (runtime.devices().note() + ")").c_str());
     return;
   }
   const io::HaplyCounters c = usb->counters();
-  ImGui::Text("Device: %s, %s; replies missing %lld, refused %lld, reconnects %lld", usb->name().c_str(),
+  ImGui::Text(tr("Device: %s, %s; replies missing %lld, refused %lld, reconnects %lld"), usb->name().c_str(),
               device_status_name(d.device_status), static_cast<long long>(c.replies_missing),
               static_cast<long long>(c.malformed), static_cast<long long>(c.reconnects));
   if (d.device_status != DeviceStatus::Ok) {
     ImGui::SameLine();
-    ImGui::TextColored(kOrange, "(no force while it does not answer)");
+    ImGui::TextColored(kOrange, "%s", tr("(no force while it does not answer)"));
   }
   const double can_n = io::min_force_capability_n(usb->params());
-  ImGui::Text("%s profile: it gives at least %.2f N in every direction everywhere in its rectangle.",
+  ImGui::Text(tr("%s profile: it gives at least %.2f N in every direction everywhere in its rectangle."),
               std::string(config::device_profile(profile_type(runtime)).name).c_str(), can_n);
   if (!runtime.devices().home_note().empty()) ImGui::TextColored(kOrange, "%s", runtime.devices().home_note().c_str());
-  if (ImGui::Button("Calibrate: the handle rests at the park place")) {
+  if (ImGui::Button((std::string(tr("Calibrate: the handle rests at the park place")) + "###calibrate").c_str())) {
     double o1 = 0, o2 = 0;
     std::string why;
     if (runtime.devices().calibrate(&o1, &o2, &why)) {
@@ -319,11 +333,11 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
         }
       }
       char note[160];
-      std::snprintf(note, sizeof note, "Calibrated: encoder offsets %.3f and %.3f deg, in force now; Save keeps them.",
-                    o1, o2);
+      std::snprintf(note, sizeof note,
+                    tr("Calibrated: encoder offsets %.3f and %.3f deg, in force now; Save keeps them."), o1, o2);
       calibrate_note_ = note;
     } else {
-      calibrate_note_ = "Not calibrated: " + why + ".";
+      calibrate_note_ = std::string(tr("Not calibrated:")) + " " + why + ".";
     }
   }
   record("button:Calibrate");
@@ -333,39 +347,41 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
 void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, std::int64_t now_unix_s) {
   const config::Settings& s = runtime.settings();
   const ServoDisplayState& d = runtime.core().display();
-  ImGui::Text("Visitor: %s, picture %d, %s%s", state_name(flow.view().state), flow.view().picture + 1,
-              level_label(d.level).c_str(), d.auto_level ? " (from hand speed)" : " (fixed)");
+  ImGui::Text(tr("Visitor: %s, picture %d, %s%s"), state_name(flow.view().state), flow.view().picture + 1,
+              level_label(d.level).c_str(), d.auto_level ? tr(" (from hand speed)") : tr(" (fixed)"));
   if (ServoThread* st = runtime.devices().servo()) {
     const ServoTimingStats t = st->stats();
-    ImGui::Text("Servo: %.0f Hz, %s; lateness p50 %.0f, p99 %.0f, max %.0f us; missed deadlines %lld",
-                s.haptics.servo_rate_hz, st->realtime() ? "real-time (SCHED_FIFO)" : "normal priority",
+    ImGui::Text(tr("Servo: %.0f Hz, %s; lateness p50 %.0f, p99 %.0f, max %.0f us; missed deadlines %lld"),
+                s.haptics.servo_rate_hz, st->realtime() ? tr("real-time (SCHED_FIFO)") : tr("normal priority"),
                 t.lateness_p50_us, t.lateness_p99_us, t.lateness_max_us, static_cast<long long>(t.missed_deadlines));
     if (t.missed_deadlines > 0) {
       ImGui::SameLine();
-      ImGui::TextColored(kOrange, "(each one zeroed the force for a tick)");
+      ImGui::TextColored(kOrange, "%s", tr("(each one zeroed the force for a tick)"));
     }
   }
   draw_device(runtime, now_unix_s);
-  ImGui::Text("Walls: stiffness %.0f N/m, max force %.2f N", s.haptics.stiffness_n_per_m, s.haptics.max_force_n);
+  ImGui::Text(tr("Walls: stiffness %.0f N/m, max force %.2f N"), s.haptics.stiffness_n_per_m, s.haptics.max_force_n);
   audio::AudioSystem& a = runtime.audio();
-  ImGui::Text("Sound: %s; speech %s; volume %d/10; cues dropped %llu", a.sound_output() ? "playing" : "no sound device",
-              a.speech_available() ? "on" : "unavailable", a.volume().step(),
+  ImGui::Text(tr("Sound: %s; speech %s; volume %d/10; cues dropped %llu"),
+              a.sound_output() ? tr("playing") : tr("no sound device"),
+              a.speech_available() ? tr("on") : tr("unavailable"), a.volume().step(),
               static_cast<unsigned long long>(a.cues_dropped()));
-  ImGui::Text(
-      "USB sticks: %s%s%s",
-      runtime.sticks().service().can_mount() ? "mounted read-only when inserted" : "cannot mount (no CAP_SYS_ADMIN)",
-      flow.view().source == KioskSource::Stick ? "; a stick is being browsed" : "",
-      runtime.sticks().busy() ? "; working" : "");
+  ImGui::Text(tr("USB sticks: %s%s%s"),
+              runtime.sticks().service().can_mount() ? tr("mounted read-only when inserted")
+                                                     : tr("cannot mount (no CAP_SYS_ADMIN)"),
+              flow.view().source == KioskSource::Stick ? tr("; a stick is being browsed") : "",
+              runtime.sticks().busy() ? tr("; working") : "");
   record(runtime.sticks().busy() ? "sticks:working" : "sticks:idle");
   draw_stick_problems(runtime);
-  ImGui::Checkbox("Show the collision tree's boxes and the boundary section on screen", &runtime.switches().overlay());
-  ImGui::Checkbox("High contrast", &runtime.switches().high_contrast());
+  ImGui::Checkbox(tr("Show the collision tree's boxes and the boundary section on screen"),
+                  &runtime.switches().overlay());
+  ImGui::Checkbox(tr("High contrast"), &runtime.switches().high_contrast());
   ImGui::Separator();
   const float w = ImGui::GetContentRegionAvail().x;
-  ImGui::Text("Force on the handle [N], last 5 s (now %.2f N)", length(d.force_n));
+  ImGui::Text(tr("Force on the handle [N], last 5 s (now %.2f N)"), length(d.force_n));
   ImGui::PlotLines("##force", force_n_.data(), kPlotSamples, plot_at_, nullptr, 0.0f,
                    static_cast<float>(std::max(0.5, s.haptics.max_force_n)), ImVec2(w, 90));
-  ImGui::Text("Penetration into the wall [mm] (now %.2f mm)",
+  ImGui::Text(tr("Penetration into the wall [mm] (now %.2f mm)"),
               d.state != ContactState::Free ? 1000.0 * length(d.handle_m - d.proxy_m) : 0.0);
   ImGui::PlotLines("##penetration", penetration_mm_.data(), kPlotSamples, plot_at_, nullptr, 0.0f, FLT_MAX,
                    ImVec2(w, 90));
@@ -373,15 +389,16 @@ void OperatorPanel::draw_status(KioskRuntime& runtime, const KioskFlow& flow, st
 
 void OperatorPanel::draw_name_list() {
   const std::vector<NamesEntry>& entries = names_->entries();
-  if (entries.empty()) ImGui::TextColored(kGrey, "No shape of this picture has a name yet.");
+  if (entries.empty()) ImGui::TextColored(kGrey, "%s", tr("No shape of this picture has a name yet."));
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const NamesEntry& e = entries[i];
-    std::string label = (e.name.empty() ? std::string("(no name)") : e.name) + "  -  ";
-    if (e.curves.empty()) label += "no shape";
+    std::string label = (e.name.empty() ? std::string(tr("(no name)")) : e.name) + "  -  ";
+    if (e.curves.empty()) label += tr("no shape");
     for (std::size_t k = 0; k < e.curves.size() && k < 8; ++k)
-      label += (k == 0 ? (e.curves.size() == 1 ? "shape " : "shapes ") : ", ") + std::to_string(e.curves[k] + 1);
+      label += (k == 0 ? std::string(e.curves.size() == 1 ? tr("shape") : tr("shapes")) + " " : std::string(", ")) +
+               std::to_string(e.curves[k] + 1);
     if (e.curves.size() > 8) label += ", ...";
-    if (!e.description.empty()) label += "  (described)";
+    if (!e.description.empty()) label += std::string("  ") + tr("(described)");
     ImGui::PushID(static_cast<int>(i));
     if (ImGui::Selectable(label.c_str(), names_->selected() == static_cast<int>(i)))
       names_->select_entry(static_cast<int>(i));
@@ -406,41 +423,42 @@ void OperatorPanel::draw_names(KioskRuntime& runtime) {
                   sh.faces_m, sh.text_blocks, path.empty() || guesses_for(path, folder, sh.notes.guesses)});
   }
   if (!names_->is_open()) {
-    ImGui::TextWrapped("Names are given to the library's pictures; what is on show is not one of them.");
+    ImGui::TextWrapped("%s", tr("Names are given to the library's pictures; what is on show is not one of them."));
     return;
   }
-  ImGui::TextColored(kGrey, "%s   names: %s", names_->picture_path().c_str(),
-                     folder.empty() ? "no names folder ([kiosk] names_dir is off)" : names_->target_file().c_str());
+  ImGui::TextColored(kGrey, tr("%s   names: %s"), names_->picture_path().c_str(),
+                     folder.empty() ? tr("no names folder ([kiosk] names_dir is off)") : names_->target_file().c_str());
   ImGui::BeginChild("names_list", ImVec2(0, ImGui::GetContentRegionAvail().y * 0.45f), true);
   draw_name_list();
   ImGui::EndChild();
-  if (ImGui::Button("Pick the shape at the handle")) {
+  if (ImGui::Button((std::string(tr("Pick the shape at the handle")) + "###pick").c_str())) {
     const ServoDisplayState& d = runtime.core().display();
     names_->pick_at_hand(d.handle_m, d.scene_id == stage.shown_id() ? d.curve : -1);
   }
   record("Pick the shape at the handle");
   ImGui::SameLine();
   if (names_->picked_curve() >= 0)
-    ImGui::Text("Shape %d picked%s", names_->picked_curve() + 1, names_->selected() >= 0 ? " (named)" : " (no name)");
+    ImGui::Text(tr("Shape %d picked%s"), names_->picked_curve() + 1,
+                names_->selected() >= 0 ? tr(" (named)") : tr(" (no name)"));
   else
-    ImGui::TextColored(kGrey, "No shape picked: move the handle onto one, or click a name above.");
-  ImGui::TextUnformatted("Name");
+    ImGui::TextColored(kGrey, "%s", tr("No shape picked: move the handle onto one, or click a name above."));
+  ImGui::TextUnformatted(tr("Name"));
   ImGui::SetNextItemWidth(-1);
   ImGui::InputText("##names.name", &names_->name_text());
   record("names.name");
-  ImGui::TextUnformatted("Description (optional)");
+  ImGui::TextUnformatted(tr("Description (optional)"));
   ImGui::SetNextItemWidth(-1);
   ImGui::InputText("##names.description", &names_->description_text());
   record("names.description");
   bool saved = false;
   bool guesses = names_->guesses();
-  if (ImGui::Checkbox("The kiosk's own guesses (faces, text) name parts of this picture", &guesses))
+  if (ImGui::Checkbox(tr("The kiosk's own guesses (faces, text) name parts of this picture"), &guesses))
     saved = names_->set_guesses(guesses);
   record("names.guesses");
-  if (ImGui::Button("Save names")) saved = names_->save_typed();
+  if (ImGui::Button((std::string(tr("Save names")) + "###Save names").c_str())) saved = names_->save_typed();
   record("Save names");
   ImGui::SameLine();
-  if (ImGui::Button("Delete name")) saved = names_->delete_and_save();
+  if (ImGui::Button((std::string(tr("Delete name")) + "###Delete name").c_str())) saved = names_->delete_and_save();
   record("Delete name");
   if (saved) stage.set_names(names_->regions(), names_->shape_region());  // Where and Describe say them at once
   const NamesSaved last = names_->last_save();
@@ -448,7 +466,7 @@ void OperatorPanel::draw_names(KioskRuntime& runtime) {
     ImGui::TextColored(last == NamesSaved::failed ? kRed : (last == NamesSaved::saved ? kGreen : kGrey), "%s",
                        names_->status().c_str());
   else
-    ImGui::TextColored(kGrey, "%s", names_->dirty() ? "Not saved yet." : "");
+    ImGui::TextColored(kGrey, "%s", names_->dirty() ? tr("Not saved yet.") : "");
   record("names:status");
   if (last != NamesSaved::none) record(last == NamesSaved::saved ? "names:saved" : "names:failed");
 }

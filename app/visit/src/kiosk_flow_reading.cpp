@@ -25,6 +25,7 @@ void KioskFlow::describe_key() {
   v_.reading = ReadAloud(page.paragraphs);
   v_.reading_language = other_language(page.language);
   v_.reading_complete = page.complete;
+  v_.reading_reads_on = false;
   v_.reading_on = false;
   if (page.at_hand >= 0 && page.at_hand < v_.reading.paragraphs()) {
     const ReadingPlace at{page.at_hand, 0};
@@ -96,7 +97,9 @@ void KioskFlow::reading_key(KioskKey k) {
     v_.reading_language = other_language(page.language);
     v_.reading_complete = page.complete;
     v_.reading_on = false;
-    if (v_.reading.empty() && !page.complete) {  // its first words are still being read: said when they are
+    // A page still being read is read on to its end, each block as it comes; its first words said when they are.
+    v_.reading_reads_on = !page.complete;
+    if (v_.reading.empty() && !page.complete) {
       say(MessageId::reading_soon);
       v_.reading_waits = true;
       v_.reading_waits_kept = fx_.speech.kept_texts();
@@ -126,15 +129,15 @@ void KioskFlow::reading_key(KioskKey k) {
 
 void KioskFlow::read_more() {
   if (v_.reading_waits && fx_.speech.kept_texts() != v_.reading_waits_kept) v_.reading_waits = false;  // moved on
-  const bool heard_all = reading() && !v_.reading_complete && fx_.speech.heard_piece() < 0;
-  if (!v_.reading_waits && !heard_all) return;
+  const bool heard = reading() && v_.reading_reads_on && fx_.speech.heard_piece() < 0;
+  if (!v_.reading_waits && !heard) return;
   const PageText page = fx_.stage.page_text();
-  const int had = v_.reading_waits ? 0 : v_.reading.paragraphs();
-  if (static_cast<int>(page.paragraphs.size()) <= had) {
-    if (!page.complete) return;  // more is still being read
-    v_.reading_complete = true;
+  const int next = v_.reading_waits ? 0 : v_.reading.place().paragraph + 1;  // after the paragraph heard to its end
+  if (next >= static_cast<int>(page.paragraphs.size())) {
+    if (!page.complete) return;                                // more is still being read
     if (v_.reading_waits) say_brief(MessageId::reading_none);  // read whole, and no text on it
     v_.reading_waits = false;
+    v_.reading_reads_on = false;  // the end of the page
     return;
   }
   const bool first = v_.reading_waits;
@@ -142,7 +145,7 @@ void KioskFlow::read_more() {
   v_.reading = ReadAloud(page.paragraphs);
   v_.reading_language = other_language(page.language);
   v_.reading_complete = page.complete;
-  read_from({had, 0}, first ? language_notice() : std::string());
+  read_from({next, 0}, first ? language_notice() : std::string());
 }
 
 std::string KioskFlow::paragraph_line(int p) const {

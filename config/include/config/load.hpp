@@ -106,6 +106,9 @@ struct FieldDescriptor {
 /// colon, semicolon, comma or opening parenthesis, and before another setting's key), at most kMaxFieldLabelBytes
 /// (cut at a word), e.g. "Speaking rate" for [audio] speech_rate_wpm; the key when the help is empty.
 [[nodiscard]] std::string field_label(const FieldDescriptor& d);
+/// The same label made from a help text in any language (the panel's translation of FieldDescriptor::help), `key`
+/// when it gives none.
+[[nodiscard]] std::string field_label(std::string_view help, std::string_view key);
 inline constexpr std::size_t kMaxFieldLabelBytes = 48;
 
 /// Largest settings file load_settings() reads, in bytes (1 MiB).

@@ -367,6 +367,7 @@ struct OperatorSettings {
   std::string state_file;  ///< key state_file, failed PIN attempts and the time of the last (the lockout), survives
                            ///< restarts; empty = `<settings>.state`
   std::string audit_log;   ///< key audit_log, one line per change made in the panel; empty = `<settings>.audit.log`
+  std::string language = "en";  ///< key language, the panel's language (BCP 47); English where it has no catalogue
 
   /// Field-by-field equality; used by round-trip checks.
   bool operator==(const OperatorSettings&) const = default;

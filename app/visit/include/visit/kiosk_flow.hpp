@@ -289,6 +289,7 @@ class KioskFlow {
     bool reading_on = false;          // the reading was said, as the text kept numbered reading_kept
     std::uint64_t reading_kept = 0;
     bool reading_complete = true;          // the text being read is the page's whole text (else more blocks may come)
+    bool reading_reads_on = false;         // started on a page still being read: each paragraph heard, the next follows
     bool reading_waits = false;            // the visitor asked to hear a text of which no block has been read yet,
     std::uint64_t reading_waits_kept = 0;  // when the text kept numbered this was said (anything said since: not)
   };
@@ -317,8 +318,8 @@ class KioskFlow {
   void follow_reading();  // the place follows the sentence heard
   /// Reads from `at` to the end of its paragraph, after `before` (said first, in the same text).
   void read_from(ReadingPlace at, const std::string& before);
-  /// A page's text still being read: the reading asked for starts with its first block, and goes on with each
-  /// block that came once what came before has been heard (called by tick).
+  /// A page's text still being read: the reading asked for starts with its first block, and goes on paragraph
+  /// by paragraph to the end of the page, each once the one before has been heard and it has been read (tick).
   void read_more();
   /// "" or "About 9 minutes of text. …" and a space, for a text that long.
   std::string long_text_line(const std::string& text) const;
