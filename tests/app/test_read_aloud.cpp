@@ -51,7 +51,8 @@ struct Reader final : hk::test::EveryEffect {
   std::vector<bool> brief;
   std::string kept;
   std::uint64_t kept_count = 0;
-  int piece = -1;  // the piece of the last kept text being heard (the test moves it)
+  int piece = -1;            // the piece of the last kept text being heard (the test moves it)
+  bool brief_since = false;  // an acknowledgement was said after the last kept text (it cut that text off)
   PageText page;
 
   void say(const std::string& t) override {
@@ -60,11 +61,13 @@ struct Reader final : hk::test::EveryEffect {
     kept = t;
     ++kept_count;
     piece = 0;
+    brief_since = false;
   }
   void say_brief(const std::string& t) override {
     said.push_back(t);
     brief.push_back(true);
     piece = -1;
+    brief_since = true;
   }
   bool repeat() override {
     if (kept.empty()) return false;
@@ -73,6 +76,7 @@ struct Reader final : hk::test::EveryEffect {
   }
   std::uint64_t kept_texts() const override { return kept_count; }
   int heard_piece() const override { return piece; }
+  bool heard_to_end() const override { return piece < 0 && !brief_since; }
   PageText page_text() override { return page; }
   void show_tutorial(TutorialShape) override {}
   int show_picture(int) override { return 2; }
@@ -256,6 +260,20 @@ TEST(ReadAloud, AReadingAskedForWhileTheTextIsReadStartsWithItsFirstBlockAndGoes
   EXPECT_EQ(v.fx.said.size(), read) << "the end of the page: nothing more to add";
 }
 
+TEST(ReadAloud, AnAcknowledgementThatCutsAReadingOnEndsIt) {
+  Page v(-1);
+  const std::vector<std::string> all = page_paragraphs();
+  v.fx.page = {{all[0]}, -1, "", false};
+  v.key(KioskKey::NextSentence);  // the first block has been read: said at once
+  v.fx.page = {all, -1, "", true};
+  v.key(KioskKey::Finish);  // "Press the End key again ..." cuts it off
+  ASSERT_TRUE(v.fx.brief.back());
+  const std::size_t n = v.fx.said.size();
+  v.hear(-1);
+  v.hear(-1);
+  EXPECT_EQ(v.fx.said.size(), n) << "the reading does not come back over what the visitor did";
+}
+
 TEST(ReadAloud, AWaitingReadingIsDroppedWhenTheVisitorMovesOnAndSaysSoWhenThePageHasNoText) {
   Page v(-1);
   v.fx.page = {{}, -1, "", false};
@@ -265,6 +283,14 @@ TEST(ReadAloud, AWaitingReadingIsDroppedWhenTheVisitorMovesOnAndSaysSoWhenThePag
   v.fx.page = {{"Opening hours."}, -1, "", false};
   v.hear(-1);
   EXPECT_EQ(v.fx.said.size(), n) << "not read over what the visitor asked for since";
+  v.fx.page = {{}, -1, "", false};
+  v.key(KioskKey::NextParagraph);
+  v.key(KioskKey::Finish);  // an acknowledgement ("Press the End key again ...") cuts the wait off too
+  const std::size_t acknowledged = v.fx.said.size();
+  v.fx.page = {{"Opening hours."}, -1, "", false};
+  v.hear(-1);
+  EXPECT_EQ(v.fx.said.size(), acknowledged) << "the first block is not read over the acknowledgement";
+  EXPECT_TRUE(v.fx.brief.back());
   v.fx.page = {{}, -1, "", false};
   v.key(KioskKey::NextParagraph);
   v.fx.page = {{}, -1, "", true};  // read whole: no text on it

@@ -128,8 +128,12 @@ void KioskFlow::reading_key(KioskKey k) {
 }
 
 void KioskFlow::read_more() {
-  if (v_.reading_waits && fx_.speech.kept_texts() != v_.reading_waits_kept) v_.reading_waits = false;  // moved on
-  const bool heard = reading() && v_.reading_reads_on && fx_.speech.heard_piece() < 0;
+  // Anything said since "I will read it as soon as ..." (a kept text, or an acknowledgement that cut it off): the
+  // visitor has moved on, and the reading asked for is not said over it.
+  if (v_.reading_waits && (fx_.speech.kept_texts() != v_.reading_waits_kept ||
+                           (fx_.speech.heard_piece() < 0 && !fx_.speech.heard_to_end())))
+    v_.reading_waits = false;
+  const bool heard = reading() && v_.reading_reads_on && fx_.speech.heard_to_end();
   if (!v_.reading_waits && !heard) return;
   const PageText page = fx_.stage.page_text();
   const int next = v_.reading_waits ? 0 : v_.reading.place().paragraph + 1;  // after the paragraph heard to its end

@@ -55,6 +55,9 @@ class SpeechEffects {
   /// Which piece (audio::speech_pieces, from 0) of the last text said with say() is being heard now; −1 when it
   /// is over, was cut off by anything said since, or nothing was said. Default: −1.
   virtual int heard_piece() const { return -1; }
+  /// The last text said with say() was heard to its end: not cut off by anything said since, brief or not.
+  /// Default: heard_piece() < 0.
+  virtual bool heard_to_end() const { return heard_piece() < 0; }
   /// Speech is being heard (not paused). Default: never.
   virtual bool speaking() const { return false; }
   /// Hold the speech where it is; false when nothing is being said. Default: nothing is.

@@ -38,6 +38,7 @@ class Voice final : public SpeechEffects {
   /// The piece of the last text given to say() being heard (audio::AudioSystem::piece_heard); −1 once an
   /// acknowledgement has cut it off.
   int heard_piece() const override { return brief_last_ ? -1 : audio_.piece_heard(); }
+  bool heard_to_end() const override { return !brief_last_ && audio_.piece_heard() < 0; }
   /// Speech is being heard (audio::AudioSystem::speaking).
   bool speaking() const override { return audio_.speaking(); }
   /// Holds the speech where it is (audio::AudioSystem::pause_speech); false when nothing is being said.
