@@ -114,6 +114,59 @@ TEST(Capture, AStillWholePageIsCapturedAfterOneSecondRectified) {
   EXPECT_NEAR(j.at("width_px").get<double>() / j.at("height_px").get<double>(), 280.0 / 210.0, 0.02);
 }
 
+/// A camera whose preview is `preview` (10 frames a second) and whose still is `full`, the same scene at a larger
+/// size, as a libcamera or V4L2 camera gives them; counts the stills asked for.
+struct TwoSizeCamera final : vision::FrameSource {
+  cv::Mat preview, full;
+  bool still_fails = false;
+  int stills = 0;
+  std::uint64_t n = 0;
+  std::string name() const override { return "two-size camera"; }
+  bool next(vision::Frame& out, double) override {
+    out.bgr = preview.clone();
+    out.t_s = 0.1 * static_cast<double>(n);
+    out.index = n++;
+    return true;
+  }
+  bool still(vision::Frame& out, double) override {
+    ++stills;
+    if (still_fails) throw vision::CameraError("camera 'two-size': cannot set the still's size");
+    out.bgr = full.clone();
+    out.t_s = 0.1 * static_cast<double>(n);
+    out.index = n++;
+    return true;
+  }
+};
+
+TEST(Capture, ThePageIsRectifiedFromTheCamerasFullSizeStillNotThePreview) {
+  const cv::Mat bg = table(), c = card();
+  TwoSizeCamera cam;
+  cam.preview = frame_with_card(bg, c, kW / 2, kH / 2);
+  cv::resize(cam.preview, cam.full, cv::Size(2 * kW, 2 * kH), 0, 0, cv::INTER_CUBIC);
+  CaptureParams params;
+  const CaptureOutcome o = run_capture(cam, params);
+  ASSERT_EQ(o.end, CaptureEnd::Still);
+  EXPECT_EQ(cam.stills, 1) << "one still, when the guide captures";
+  EXPECT_TRUE(o.from_still);
+  EXPECT_EQ(o.frame.size(), cam.full.size());
+  ASSERT_TRUE(o.rectified && o.corners_px);
+  // The card's corners in the still's pixels (twice the preview's), and the page at the still's detail.
+  const cv::Point2d truth[4] = {{359, 269}, {919, 269}, {919, 689}, {359, 689}};
+  for (int k = 0; k < 4; ++k) EXPECT_LT(cv::norm((*o.corners_px)[k] - truth[k]), 0.01 * 2 * std::hypot(280.0, 210.0));
+  EXPECT_NEAR(o.image.cols, 2 * 280, 0.05 * 2 * 280) << "rectified at the still's resolution";
+  // A camera whose still fails keeps the preview frame: the capture is not lost.
+  TwoSizeCamera broken = cam;
+  broken.still_fails = true;
+  broken.stills = 0;
+  broken.n = 0;
+  const CaptureOutcome kept = run_capture(broken, params);
+  EXPECT_EQ(kept.end, CaptureEnd::Still);
+  EXPECT_EQ(broken.stills, 1);
+  EXPECT_FALSE(kept.from_still);
+  EXPECT_EQ(kept.frame.size(), cam.preview.size());
+  EXPECT_TRUE(kept.rectified);
+}
+
 TEST(Capture, OffCentreThenCentredSaysMoveLeftThenCaptures) {
   const cv::Mat bg = table(), c = card();
   std::vector<cv::Mat> frames;

@@ -7,6 +7,9 @@
 // each dmabuf once, and keeps one request per buffer queued: libcamera completes requests on its own thread,
 // where on_request_completed copies the frame into a mutex-protected slot (the latest frame wins) and queues
 // the request again. next() waits on the slot and converts the copied bytes to BGR on the caller's thread.
+// still() stops the camera, configures the stream at the size libcamera proposes for a still (the sensor's
+// full resolution), takes one frame after the exposure has settled, and configures the preview again.
+// Written from libcamera's documentation; no camera was at hand to try still() on.
 
 #include <linux/dma-buf.h>
 #include <sys/ioctl.h>
@@ -21,6 +24,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -172,6 +176,9 @@ double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+/// Frames dropped after the size changes for a still, while the camera's exposure settles.
+constexpr int kStillSettleFrames = 2;
+
 class LibcameraFrameSource final : public FrameSource {
  public:
   LibcameraFrameSource(SourceSpec spec, const FrameSourceParams& params) : spec_(std::move(spec)), params_(params) {}
@@ -215,19 +222,35 @@ class LibcameraFrameSource final : public FrameSource {
     if (acquired != 0) fail("cannot acquire: " + errno_text(-acquired));
     acquired_ = true;
 
-    configure();
+    configure(false);
     allocate_and_map();
 
     camera_->requestCompleted.connect(this, &LibcameraFrameSource::on_request_completed);
     camera_->disconnected.connect(this, &LibcameraFrameSource::on_disconnected);
     connected_ = true;
-    const int started = camera_->start();
-    if (started != 0) fail("cannot start: " + errno_text(-started));
-    started_ = true;
-    for (const std::unique_ptr<lc::Request>& r : requests_) {
-      const int queued = camera_->queueRequest(r.get());
-      if (queued != 0) fail("cannot queue a capture request: " + errno_text(-queued));
+    start_and_queue();
+  }
+
+  bool still(Frame& out, double timeout_s) override {
+    // The size libcamera proposes for a still: the sensor's full resolution.
+    const std::unique_ptr<lc::CameraConfiguration> probe =
+        camera_->generateConfiguration({lc::StreamRole::StillCapture});
+    const lc::Size full = probe && !probe->empty() ? probe->at(0).size : lc::Size();
+    if (static_cast<std::uint64_t>(full.width) * full.height <=
+        static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_))
+      return next(out, timeout_s);  // the preview is the largest it gives
+    restart(true);
+    bool got = false;
+    std::exception_ptr failed;
+    try {
+      for (int dropped = 0; (got = next(out, timeout_s)) && dropped < kStillSettleFrames; ++dropped) {
+      }
+    } catch (const CameraError&) {
+      failed = std::current_exception();
     }
+    restart(false);  // back to the preview whatever happened
+    if (failed) std::rethrow_exception(failed);
+    return got;
   }
 
   std::string name() const override { return "libcamera camera " + std::to_string(spec_.index) + " (" + model_ + ")"; }
@@ -265,7 +288,44 @@ class LibcameraFrameSource final : public FrameSource {
 
   [[noreturn]] void fail(const std::string& problem) const { throw_camera_error(spec_, problem); }
 
-  void configure() {
+  /// Starts the camera and queues every request.
+  void start_and_queue() {
+    const int started = camera_->start();
+    if (started != 0) fail("cannot start: " + errno_text(-started));
+    started_ = true;
+    for (const std::unique_ptr<lc::Request>& r : requests_) {
+      const int queued = camera_->queueRequest(r.get());
+      if (queued != 0) fail("cannot queue a capture request: " + errno_text(-queued));
+    }
+  }
+
+  /// Stops the camera, gives its buffers back and starts it again configured for a still at its full size
+  /// (`full`) or for the preview at the requested size.
+  void restart(bool full) {
+    stopping_.store(true);
+    if (started_) camera_->stop();  // completes every pending request as cancelled
+    started_ = false;
+    stopping_.store(false);
+    requests_.clear();
+    planes_.clear();
+    for (const auto& [fd, m] : maps_) ::munmap(m.first, m.second);
+    maps_.clear();
+    if (allocator_ != nullptr && stream_ != nullptr) allocator_->free(stream_);
+    allocator_.reset();
+    stream_ = nullptr;
+    config_.reset();
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      slot_full_ = false;
+    }
+    configure(full);
+    allocate_and_map();
+    start_and_queue();
+  }
+
+  /// The StillCapture stream in a format OpenCV converts, at its proposed size (`full`: the sensor's) or the
+  /// requested preview size.
+  void configure(bool full) {
     config_ = camera_->generateConfiguration({lc::StreamRole::StillCapture});
     if (config_ == nullptr || config_->empty()) config_ = camera_->generateConfiguration({lc::StreamRole::Viewfinder});
     if (config_ == nullptr || config_->empty()) fail("no still-capture configuration");
@@ -287,7 +347,7 @@ class LibcameraFrameSource final : public FrameSource {
            "; RGB888, BGR888, XRGB8888, XBGR8888, YUYV, NV12 or MJPEG needed)");
     }
     cfg.pixelFormat = *chosen;
-    cfg.size = lc::Size(static_cast<unsigned>(params_.width_px), static_cast<unsigned>(params_.height_px));
+    if (!full) cfg.size = lc::Size(static_cast<unsigned>(params_.width_px), static_cast<unsigned>(params_.height_px));
     if (config_->validate() == lc::CameraConfiguration::Invalid) fail("the stream configuration was refused");
     const std::optional<Conversion> conversion = conversion_of(cfg.pixelFormat);
     if (!conversion) fail("the camera changed the pixel format to " + hk::one_line(cfg.pixelFormat.toString()));

@@ -1,7 +1,9 @@
 // The V4L2 frame source ("v4l2:DEV", vision/frame_source.hpp): raw ioctls on a video-capture node, MMAP
 // streaming with four buffers, YUYV converted or MJPEG decoded with OpenCV. References: the Linux kernel's
 // "Video for Linux API" (uAPI) documentation, sections "Querying Capabilities", "Image Format Negotiation",
-// "Streaming I/O (Memory Mapping)" and "Buffers" (timestamp flags).
+// "Streaming I/O (Memory Mapping)" and "Buffers" (timestamp flags). still() stops streaming, sets the largest
+// frame size the device lists (VIDIOC_ENUM_FRAMESIZES), takes one frame after the exposure has settled, and sets
+// the preview size again. No camera was at hand to try still() on.
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -18,6 +20,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <memory>
 #include <string>
 #include <utility>
@@ -97,6 +100,29 @@ bool has_frame_size(int fd, std::uint32_t fourcc, std::uint32_t width, std::uint
   return false;
 }
 
+/// The largest frame size (by area) the node lists for pixel format `fourcc`; {0, 0} when it lists none.
+std::pair<std::uint32_t, std::uint32_t> largest_frame_size(int fd, std::uint32_t fourcc) {
+  std::pair<std::uint32_t, std::uint32_t> best{0, 0};
+  const auto area = [](std::pair<std::uint32_t, std::uint32_t> s) {
+    return static_cast<std::uint64_t>(s.first) * s.second;
+  };
+  for (std::uint32_t i = 0; i < 256; ++i) {
+    v4l2_frmsizeenum fs{};
+    fs.index = i;
+    fs.pixel_format = fourcc;
+    if (xioctl(fd, VIDIOC_ENUM_FRAMESIZES, &fs) != 0) break;
+    const std::pair<std::uint32_t, std::uint32_t> size = fs.type == V4L2_FRMSIZE_TYPE_DISCRETE
+                                                             ? std::pair{fs.discrete.width, fs.discrete.height}
+                                                             : std::pair{fs.stepwise.max_width, fs.stepwise.max_height};
+    if (area(size) > area(best)) best = size;
+    if (fs.type != V4L2_FRMSIZE_TYPE_DISCRETE) break;  // stepwise or continuous: one range (index 0 only)
+  }
+  return best;
+}
+
+/// Frames dropped after the size changes for a still, while the camera's exposure settles.
+constexpr int kStillSettleFrames = 2;
+
 /// One mmap'ed driver buffer.
 struct Mapping {
   void* start = MAP_FAILED;
@@ -147,18 +173,27 @@ class V4l2FrameSource final : public FrameSource {
     if ((caps & V4L2_CAP_STREAMING) == 0) fail("does not support streaming I/O");
 
     choose_format();
-    set_format();
-    map_buffers();
-    for (std::uint32_t i = 0; i < buffers_.size(); ++i) {
-      v4l2_buffer b{};
-      b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-      b.memory = V4L2_MEMORY_MMAP;
-      b.index = i;
-      if (xioctl(fd_, VIDIOC_QBUF, &b) != 0) fail("VIDIOC_QBUF: " + errno_text(errno));
+    start_streaming(static_cast<std::uint32_t>(params_.width_px), static_cast<std::uint32_t>(params_.height_px));
+  }
+
+  bool still(Frame& out, double timeout_s) override {
+    const auto [w, h] = largest_frame_size(fd_, pixel_format_);
+    if (static_cast<std::uint64_t>(w) * h <= static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_))
+      return next(out, timeout_s);  // the preview is the largest it gives
+    stop_streaming();
+    start_streaming(w, h);
+    bool got = false;
+    std::exception_ptr failed;
+    try {
+      for (int dropped = 0; (got = next(out, timeout_s)) && dropped < kStillSettleFrames; ++dropped) {
+      }
+    } catch (const CameraError&) {
+      failed = std::current_exception();
     }
-    int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    if (xioctl(fd_, VIDIOC_STREAMON, &type) != 0) fail("VIDIOC_STREAMON: " + errno_text(errno));
-    streaming_ = true;
+    stop_streaming();  // back to the preview whatever happened
+    start_streaming(static_cast<std::uint32_t>(params_.width_px), static_cast<std::uint32_t>(params_.height_px));
+    if (failed) std::rethrow_exception(failed);
+    return got;
   }
 
   std::string name() const override { return "V4L2 camera " + hk::one_line(spec_.path) + " (" + card_ + ")"; }
@@ -258,11 +293,49 @@ class V4l2FrameSource final : public FrameSource {
     }
   }
 
-  void set_format() {
+  /// Sets the format at `width` x `height` (the driver may give the nearest it has), maps the buffers, queues
+  /// them and starts streaming.
+  void start_streaming(std::uint32_t width, std::uint32_t height) {
+    set_format(width, height);
+    map_buffers();
+    for (std::uint32_t i = 0; i < buffers_.size(); ++i) {
+      v4l2_buffer b{};
+      b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+      b.memory = V4L2_MEMORY_MMAP;
+      b.index = i;
+      if (xioctl(fd_, VIDIOC_QBUF, &b) != 0) fail("VIDIOC_QBUF: " + errno_text(errno));
+    }
+    int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    if (xioctl(fd_, VIDIOC_STREAMON, &type) != 0) fail("VIDIOC_STREAMON: " + errno_text(errno));
+    streaming_ = true;
+  }
+
+  /// Stops streaming and gives the buffers back (a format can be set again after).
+  void stop_streaming() {
+    if (streaming_) {
+      int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+      (void)xioctl(fd_, VIDIOC_STREAMOFF, &type);
+      streaming_ = false;
+    }
+    for (const Mapping& m : buffers_)
+      if (m.start != MAP_FAILED) ::munmap(m.start, m.length);
+    buffers_.clear();
+    if (buffers_requested_) {
+      v4l2_requestbuffers req{};
+      req.count = 0;
+      req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+      req.memory = V4L2_MEMORY_MMAP;
+      (void)xioctl(fd_, VIDIOC_REQBUFS, &req);
+      buffers_requested_ = false;
+    }
+    requeue_failed_ = false;
+  }
+
+  void set_format(std::uint32_t width, std::uint32_t height) {
     v4l2_format f{};
     f.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    f.fmt.pix.width = static_cast<std::uint32_t>(params_.width_px);
-    f.fmt.pix.height = static_cast<std::uint32_t>(params_.height_px);
+    f.fmt.pix.width = width;
+    f.fmt.pix.height = height;
     f.fmt.pix.pixelformat = pixel_format_;
     f.fmt.pix.field = V4L2_FIELD_ANY;
     if (xioctl(fd_, VIDIOC_S_FMT, &f) != 0) {

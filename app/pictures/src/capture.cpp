@@ -8,6 +8,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -38,6 +39,37 @@ void take(CaptureOutcome& o, const cv::Mat& frame, const vision::FrameLook& look
     o.corners_px.reset();
     o.rectified = false;
   }
+}
+
+/// Takes the capture from a still at the camera's largest size when it gives one larger than `preview`: the page
+/// found again in the still (else the preview's corners scaled to it) and rectified from it, so that OCR reads
+/// the sensor's pixels. A camera that gives none larger, or fails to (one warning), leaves the preview frame.
+void take_still(CaptureOutcome& o, vision::FrameSource& source, const cv::Mat& preview, const vision::FrameLook& look,
+                const CaptureParams& params) {
+  vision::Frame still;
+  bool got = false;
+  try {
+    got = source.still(still, params.frame_wait_s);
+  } catch (const vision::CameraError& e) {
+    spdlog::warn("{}; the capture keeps the preview frame", e.what());
+  }
+  if (!got || still.bgr.empty() || still.bgr.cols <= preview.cols || still.bgr.rows <= preview.rows) {
+    take(o, preview, look);
+    return;
+  }
+  vision::FrameLook at_still = look;
+  if (look.page.found) {
+    const vision::PageDetection again = vision::find_page(still.bgr, params.page);
+    if (again.found) {
+      at_still.page = again;
+    } else {  // the page lay still: where the preview saw it, at the still's scale
+      const double kx = static_cast<double>(still.bgr.cols) / preview.cols;
+      const double ky = static_cast<double>(still.bgr.rows) / preview.rows;
+      for (cv::Point2d& c : at_still.page.corners_px) c = {c.x * kx, c.y * ky};
+    }
+  }
+  take(o, still.bgr, at_still);
+  o.from_still = true;
 }
 
 }  // namespace
@@ -119,7 +151,7 @@ CaptureOutcome run_capture(vision::FrameSource& source, const CaptureParams& par
     }
     if (step.capture) {
       o.end = look.page.found ? CaptureEnd::Still : CaptureEnd::WholeFrame;
-      take(o, frame.bgr, look);
+      take_still(o, source, frame.bgr, look, params);
       return o;
     }
     if (frame.t_s - o.first_frame_t_s >= params.timeout_s) {
@@ -150,6 +182,7 @@ std::string capture_json(const CaptureOutcome& o, const std::string& source_name
   j["advice"] = std::move(advice);
   j["advice_t_s"] = o.advice_t_s;
   j["rectified"] = o.rectified;
+  j["from_still"] = o.from_still;
   j["captured_by"] = capture_end_name(o.end);
   j["source"] = source_name;
   j["frames"] = o.frames;

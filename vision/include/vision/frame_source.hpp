@@ -73,6 +73,14 @@ class FrameSource {
   /// seeing the scene), with times going on at file_fps.
   /// @throws CameraError when the source failed (unplugged, a frame that cannot be decoded or is too large).
   virtual bool next(Frame& out, double timeout_s) = 0;
+  /// A still for reading a page: one frame at the largest size the camera gives (libcamera: its StillCapture
+  /// configuration at the size the camera proposes for it, the sensor's full resolution; V4L2: the largest frame
+  /// size the device lists for the pixel format in use), after which the source streams at its preview size
+  /// again. Waits at most timeout_s for the still's frame; false on time-out (the preview streams again all the
+  /// same). The file source, which has no larger frame, gives its next frame.
+  /// @throws CameraError when the camera cannot be set to the still's size or back (the source may then be
+  ///         unusable: its next() throws too).
+  virtual bool still(Frame& out, double timeout_s) { return next(out, timeout_s); }
 };
 
 /// Opens the source a spec names.

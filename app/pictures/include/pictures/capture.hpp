@@ -1,10 +1,11 @@
 #pragma once
 /// @file capture.hpp
 /// One camera capture: frames from a vision::FrameSource are looked at (vision::look_at_frame), the
-/// framing guide (vision::FramingGuide) says what to do and decides when to take the picture, and the page is
-/// rectified (vision::rectify_page) or, when none was found, the whole frame kept. The same loop serves the
-/// headless `capture` command, `explore --source` and the kiosk's Capture key (on a worker thread, with a
-/// cancel flag and a preview).
+/// framing guide (vision::FramingGuide) says what to do and decides when to take the picture, a still is taken at
+/// the camera's largest size (FrameSource::still: the page's text is read from the sensor's pixels, not the
+/// preview's), and the page is rectified (vision::rectify_page) or, when none was found, the whole frame kept. The same
+/// loop serves the headless `capture` command, `explore --source` and the kiosk's Capture key (on a worker thread, with
+/// a cancel flag and a preview).
 
 #include <array>
 #include <atomic>
@@ -54,13 +55,16 @@ struct CaptureOutcome {
   cv::Mat image;
   std::optional<std::array<cv::Point2d, 4>> corners_px;  ///< the page's corners in `frame` (TL, TR, BR, BL), when found
   bool rectified = false;                                ///< `image` is the rectified page
-  std::vector<vision::FramingAdvice> advice;             ///< what the guide said, in order
-  std::vector<double> advice_t_s;                        ///< the frame time of each [s]
-  int frames = 0;                                        ///< frames looked at
-  double first_frame_t_s = 0.0;                          ///< the first frame's time [s]
-  double captured_t_s = 0.0;                             ///< the last frame's time [s]
-  double look_ms = 0.0;                                  ///< wall time of look_at_frame over all frames [ms]
-  double rectify_ms = 0.0;                               ///< wall time of the rectification [ms]
+  /// `frame` is the camera's still at its largest size (FrameSource::still), larger than the preview frames the
+  /// guide looked at; false when the camera gave none larger (the preview frame is kept).
+  bool from_still = false;
+  std::vector<vision::FramingAdvice> advice;  ///< what the guide said, in order
+  std::vector<double> advice_t_s;             ///< the frame time of each [s]
+  int frames = 0;                             ///< frames looked at
+  double first_frame_t_s = 0.0;               ///< the first frame's time [s]
+  double captured_t_s = 0.0;                  ///< the last frame's time [s]
+  double look_ms = 0.0;                       ///< wall time of look_at_frame over all frames [ms]
+  double rectify_ms = 0.0;                    ///< wall time of the rectification [ms]
 };
 
 /// Callbacks of a running capture (all optional), called on the capturing thread.
@@ -86,7 +90,8 @@ struct CaptureOptions {
 };
 
 /// capture.json of an outcome: {"corners_px": [[x, y] × 4] or null, "guidance": [the spoken texts, in
-/// English], "advice": [advice_name ...], "advice_t_s": [...], "rectified", "captured_by", "source", "frames",
+/// English], "advice": [advice_name ...], "advice_t_s": [...], "rectified", "from_still", "captured_by", "source",
+/// "frames",
 /// "first_frame_t_s", "captured_t_s", "rectify_ms", "width_px", "height_px" (of capture.png)}.
 std::string capture_json(const CaptureOutcome& o, const std::string& source_name);
 
