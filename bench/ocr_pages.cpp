@@ -79,7 +79,7 @@ void shown_row(const std::string& name, const std::vector<std::uint8_t>& jpeg, c
   }
   double first_ms = -1;  // the first block read, as the TextReader hands it to the reading
   hk::app::TextRun run;
-  run.on_block = [&](const std::string&) {
+  run.on_block = [&](const std::string&, const std::string&) {
     if (first_ms < 0) first_ms = ms_since(t0);
   };
   const hk::app::ImageScene read = quick.with_text(run);

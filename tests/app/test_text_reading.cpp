@@ -210,8 +210,8 @@ TEST(TextReader, EachBlockReadIsThereToSayWhileTheRestIsRead) {
   TextReader reader;
   std::atomic<bool> release{false}, told{false};
   reader.start(4, [&](const TextRun& run) {
-    run.on_block("Opening hours.");
-    run.on_block("Nine to five.");
+    run.on_block("Opening hours.", "en");
+    run.on_block("Nine to five.", "en");
     told.store(true);
     while (!release.load() && !run.cancel->load()) std::this_thread::yield();
     return ImageScene{};
@@ -219,7 +219,7 @@ TEST(TextReader, EachBlockReadIsThereToSayWhileTheRestIsRead) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (!told.load() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
   ASSERT_TRUE(told.load());
-  EXPECT_EQ(reader.blocks_so_far(), (std::vector<std::string>{"Opening hours.", "Nine to five."}))
+  EXPECT_EQ(reader.blocks_so_far(), (std::vector<TextReader::Block>{{"Opening hours.", "en"}, {"Nine to five.", "en"}}))
       << "both blocks, in reading order, before the reading has ended";
   EXPECT_FALSE(reader.poll());
   release.store(true);

@@ -241,5 +241,83 @@ TEST(Ocr, BadArgumentsAreRefusedBeforeAnyWorkerStarts) {
   }
 }
 
+/// A one-page PDF (A4) of `lines` in Helvetica 13 pt, each a line of UTF-8 text within Latin-1 (written in the PDF's
+/// WinAnsi encoding), its cross-reference table computed: a printed page in another language, made in the test.
+std::string pdf_of_lines(const std::vector<std::string>& lines) {
+  std::string content = "BT /F1 13 Tf 16 TL 60 780 Td\n";
+  for (const std::string& line : lines) {
+    content += "(";
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      const auto c = static_cast<unsigned char>(line[i]);
+      if (c == 0xC3 && i + 1 < line.size()) {  // a two-byte UTF-8 letter of Latin-1: é, à, ç, ...
+        char octal[8];
+        std::snprintf(octal, sizeof octal, "\\%03o", 0x40 + static_cast<unsigned char>(line[++i]));
+        content += octal;
+      } else if (c == '(' || c == ')' || c == '\\') {
+        content += '\\';
+        content += static_cast<char>(c);
+      } else {
+        content += static_cast<char>(c);
+      }
+    }
+    content += ") Tj T*\n";
+  }
+  content += "ET\n";
+  const std::vector<std::string> objects = {
+      "<< /Type /Catalog /Pages 2 0 R >>", "<< /Type /Pages /Kids [3 0 R] /Count 1 >>",
+      "<< /Type /Page /Parent 2 0 R /MediaBox [0 0 595 842] /Resources << /Font << /F1 4 0 R >> >> /Contents 5 0 R >>",
+      "<< /Type /Font /Subtype /Type1 /BaseFont /Helvetica /Encoding /WinAnsiEncoding >>",
+      "<< /Length " + std::to_string(content.size()) + " >>\nstream\n" + content + "endstream"};
+  std::string pdf = "%PDF-1.4\n";
+  std::vector<std::size_t> at;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    at.push_back(pdf.size());
+    pdf += std::to_string(i + 1) + " 0 obj\n" + objects[i] + "\nendobj\n";
+  }
+  const std::size_t xref = pdf.size();
+  pdf += "xref\n0 " + std::to_string(objects.size() + 1) + "\n0000000000 65535 f \n";
+  for (const std::size_t a : at) {
+    char entry[24];
+    std::snprintf(entry, sizeof entry, "%010zu 00000 n \n", a);
+    pdf += entry;
+  }
+  pdf += "trailer\n<< /Size " + std::to_string(objects.size() + 1) + " /Root 1 0 R >>\nstartxref\n" +
+         std::to_string(xref) + "\n%%EOF\n";
+  return pdf;
+}
+
+TEST(Ocr, AFrenchScanIsReadWithTheFrenchDataAndSaysItIsFrench) {
+  if (!have_poppler_utils()) GTEST_SKIP() << "poppler-utils is not installed (scripts/install-deps.sh installs it)";
+  OcrParams p;
+  p.languages = "fra+eng";  // what a French visitor's kiosk reads with
+  if (!ocr_languages_problem(p).empty()) GTEST_SKIP() << ocr_languages_problem(p);
+  const std::vector<std::string> lines = {
+      "Le musée est ouvert tous les jours de neuf heures à dix-sept heures.",
+      "Les visiteurs aveugles ou malvoyants peuvent toucher les sculptures de la salle trois.",
+      "Une borne tactile leur permet de sentir les contours de chaque tableau.",
+      "Les enfants sont les bienvenus ; les chiens guides aussi.",
+      "Pour toute question, adressez-vous à l'accueil, près de l'entrée principale.",
+      "Nous vous souhaitons une très agréable visite dans nos galeries.",
+  };
+  const fs::path dir = scratch("french");
+  std::ofstream(dir / "page.pdf", std::ios::binary) << pdf_of_lines(lines);
+  const std::vector<std::uint8_t> jpeg = test::scan_jpeg(dir / "page.pdf", 1, 150, 1.0, dir);
+  const cv::Mat grey = cv::imdecode(jpeg, cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(grey.empty());
+  const OcrResult r = recognise_text(grey, "french.jpg", p);
+  std::string truth;
+  for (const std::string& l : lines) truth += l + "\n";
+  const double got = test::word_recall(words_of(truth), words_of(all_text(r)));
+  EXPECT_GE(got, 0.9) << all_text(r);
+  EXPECT_NE(all_text(r).find("musée"), std::string::npos) << "its accents read: " << all_text(r);
+  ASSERT_FALSE(r.blocks.empty());
+  // Most of the page is read by the French model (a plain word such as "sont" may be read by the English one, so
+  // a short block may say "eng"; the kiosk takes the page's language from its letters, most first).
+  std::map<std::string, std::size_t> letters;
+  for (const OcrBlock& b : r.blocks) letters[b.language] += b.text.size();
+  EXPECT_GT(letters["fra"], letters["eng"]) << all_text(r);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace hk::vision

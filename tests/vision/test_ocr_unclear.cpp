@@ -30,6 +30,7 @@ worker::WorkerRun answer(const std::vector<std::pair<std::string, double>>& word
     block.f64(confidence);
     x += 40;
   }
+  block.str("eng");  // the language most of its words were read in
   worker::WireWriter end;
   end.u32(static_cast<std::uint32_t>(words.size()));  // words seen
   worker::WireWriter out;

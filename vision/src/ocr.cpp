@@ -24,6 +24,7 @@ namespace {
 constexpr std::uint32_t kMaxWords = 200000;      // words accepted per picture
 constexpr std::uint32_t kMaxWordBytes = 1024;    // UTF-8 bytes accepted per word
 constexpr std::uint32_t kMaxProblemBytes = 512;  // bytes accepted in a worker's refusal
+constexpr std::uint32_t kMaxLanguageBytes = 32;  // bytes accepted in a block's language
 constexpr std::size_t kMaxAnswerBytes = 64u << 20;
 
 [[noreturn]] void fail(OcrError::Kind kind, const std::string& name, const std::string& problem) {
@@ -104,6 +105,10 @@ bool read_block(worker::WireReader& in, const OcrParams& p, OcrResult& out, doub
     out.words.push_back(std::move(w));
   }
   b.confidence = block_sum / words;
+  if (!in.str(b.language, kMaxLanguageBytes) || !std::all_of(b.language.begin(), b.language.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+      }))
+    return false;
   confidence_sum += block_sum;
   out.blocks.push_back(std::move(b));
   return true;

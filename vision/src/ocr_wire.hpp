@@ -55,7 +55,8 @@ inline bool parse_ocr_request(int argc, char** argv, OcrRequest& rq) {
 
 /// What a record of the answer holds. The answer is u32 kOcrMagic, then records as the worker works, each u8
 /// OcrRecord, u32 size [bytes], then that many bytes:
-///   block:   u32 lines, u32 words; per word: str text, f64 x, y, w, h [px], f64 confidence [0, 1]
+///   block:   u32 lines, u32 words; per word: str text, f64 x, y, w, h [px], f64 confidence [0, 1]; then str
+///            the Tesseract language most of its words were read in ("fra"; "" when none says)
 ///   end:     u32 words seen (the last record of an answer that worked)
 ///   refusal: u8 OcrError::Kind, str problem (the last record of one that did not)
 enum class OcrRecord : std::uint8_t { end = 0, refusal = 1, block = 2 };

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <map>
 #include <memory>
 #include <new>
 #include <span>
@@ -38,6 +39,7 @@ struct Word {
   std::string text;
   int l = 0, t = 0, r = 0, b = 0;
   double confidence = 0;
+  std::string language;  // the Tesseract language whose model read it ("fra"), "" when not said
 };
 
 struct Block {
@@ -85,6 +87,7 @@ std::vector<Block> read_blocks(tesseract::TessBaseAPI& api, const OcrParams& p, 
     Word w;
     w.text = text.get();
     w.confidence = it->Confidence(kWord) / 100.0;
+    if (const char* language = it->WordRecognitionLanguage()) w.language = language;
     if (w.confidence < std::min(p.min_word_confidence, kNoiseWordConfidence) ||
         !it->BoundingBox(kWord, &w.l, &w.t, &w.r, &w.b))
       continue;
@@ -121,6 +124,21 @@ void start_engine(tesseract::TessBaseAPI& api, const OcrParams& p) {
 /// Sends one record of the answer at once (the kiosk reads each as it comes).
 using Emit = std::function<void(const std::string& record)>;
 
+/// The language most of `b`'s words were read in ("" when none says).
+std::string block_language(const Block& b) {
+  std::map<std::string, int> votes;
+  for (const Word& w : b.words)
+    if (!w.language.empty()) ++votes[w.language];
+  std::string best;
+  int most = 0;
+  for (const auto& [language, n] : votes)
+    if (n > most) {
+      most = n;
+      best = language;
+    }
+  return best;
+}
+
 void send_block(const Block& b, const Emit& emit) {
   worker::WireWriter out;
   out.u32(static_cast<std::uint32_t>(b.lines));
@@ -133,6 +151,7 @@ void send_block(const Block& b, const Emit& emit) {
     out.f64(w.b - w.t);
     out.f64(w.confidence);
   }
+  out.str(block_language(b));
   emit(ocr_record(OcrRecord::block, out));
 }
 

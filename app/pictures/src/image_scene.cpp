@@ -153,6 +153,7 @@ void add_ocr_blocks(ImageScene& out, const vision::OcrResult& text) {
     t.text = b.text;
     t.source = "ocr";
     t.confidence = b.confidence;
+    t.language = language_of_tesseract(b.language);
     out.text_blocks.push_back(std::move(t));
   }
 }
@@ -343,7 +344,8 @@ vision::OcrResult read_text(const cv::Mat& grey, const std::string& name, const 
   const cv::Mat read = at_most(grey, kOcrMaxSidePx, scale);
   vision::OcrParams params = ocr_params_from(s);
   params.cancel = run.cancel;
-  if (run.on_block) params.on_block = [&run](const vision::OcrBlock& b) { run.on_block(b.text); };
+  if (run.on_block)
+    params.on_block = [&run](const vision::OcrBlock& b) { run.on_block(b.text, language_of_tesseract(b.language)); };
   vision::OcrResult r;
   try {
     r = vision::recognise_text(read, name, params);

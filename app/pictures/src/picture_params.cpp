@@ -46,9 +46,22 @@ vision::PdfLimits pdf_limits_from(const config::Settings& s) {
   return l;
 }
 
+namespace {
+
+/// BCP 47 language subtags and the Tesseract languages that read them.
+constexpr std::pair<std::string_view, std::string_view> kTesseractCodes[] = {
+    {"en", "eng"}, {"fr", "fra"}, {"de", "deu"}, {"es", "spa"}, {"it", "ita"}, {"pt", "por"}, {"nl", "nld"}};
+
+}  // namespace
+
+std::string language_of_tesseract(std::string_view code) {
+  for (const auto& [bcp47, tess] : kTesseractCodes)
+    if (tess == code) return std::string(bcp47);
+  return {};
+}
+
 std::string tesseract_languages_for(std::string_view tag) {
-  static constexpr std::pair<std::string_view, std::string_view> kCodes[] = {
-      {"en", "eng"}, {"fr", "fra"}, {"de", "deu"}, {"es", "spa"}, {"it", "ita"}, {"pt", "por"}, {"nl", "nld"}};
+  const auto& kCodes = kTesseractCodes;
   const std::string_view primary = hk::language_subtag(tag);
   for (const auto& [bcp47, tess] : kCodes)
     if (bcp47 == primary) return tess == "eng" ? std::string("eng") : std::string(tess) + "+eng";

@@ -49,10 +49,10 @@ void TextReader::cancel() {
   pending_ = false;
 }
 
-std::vector<std::string> TextReader::blocks_so_far() const {
+std::vector<TextReader::Block> TextReader::blocks_so_far() const {
   if (!pending_) return {};
   std::lock_guard<std::mutex> lock(m_);
-  return blocks_id_ == pending_id_ ? blocks_ : std::vector<std::string>{};
+  return blocks_id_ == pending_id_ ? blocks_ : std::vector<Block>{};
 }
 
 std::optional<TextRead> TextReader::poll() {
@@ -81,9 +81,9 @@ void TextReader::run() {
     TextRead read{job.id, {}, 0.0};
     TextRun run;
     run.cancel = job.cancel.get();
-    run.on_block = [this, &job](const std::string& text) {
+    run.on_block = [this, &job](const std::string& text, const std::string& language) {
       std::lock_guard<std::mutex> lock(m_);
-      if (!job.cancel->load() && blocks_id_ == job.id) blocks_.push_back(text);
+      if (!job.cancel->load() && blocks_id_ == job.id) blocks_.push_back({text, language});
     };
     try {
       read.scene = job.build(run);

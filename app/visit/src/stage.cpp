@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cctype>
+#include <map>
 
 #include "haptics/tolerance_cut.hpp"
 #include "pictures/picture_library.hpp"
@@ -15,6 +16,18 @@
 
 namespace hk::app {
 namespace {
+
+/// The language with the most letters in `letters` (by language, "" unknown); "" when unknown has the most.
+std::string most_of(const std::map<std::string, std::size_t>& letters) {
+  std::string best;
+  std::size_t most = 0;
+  for (const auto& [language, n] : letters)
+    if (n > most) {
+      most = n;
+      best = language;
+    }
+  return best;
+}
 
 /// With level_mode = "cut", each curve's cut at each tolerance step (Shown::cut_segments and Shown::cuts).
 void add_cuts(const Scene& sc, Shown& sh) {
@@ -211,14 +224,22 @@ PageText Stage::page_text() {
   if (shown_.text_blocks.empty() && text_.pending() && text_.pending_id() == shown_id_) {
     // Its text still being read: the blocks read so far, more to come; the visitor hears them as they come,
     // so "The text is ready" is not said over them.
-    for (const std::string& b : text_.blocks_so_far())
-      page.paragraphs.push_back(name_unclear_words(b, audio_.messages()));
+    std::map<std::string, std::size_t> said_in;  // letters a language
+    for (const TextReader::Block& b : text_.blocks_so_far()) {
+      page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
+      said_in[b.language] += b.text.size();
+    }
+    if (page.language.empty()) page.language = most_of(said_in);
     page.complete = false;
     text_heard_early_ = true;
     return page;
   }
-  for (const TextBlockM& b : shown_.text_blocks)
+  std::map<std::string, std::size_t> said_in;
+  for (const TextBlockM& b : shown_.text_blocks) {
     page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
+    said_in[b.language] += b.text.size();
+  }
+  if (page.language.empty()) page.language = most_of(said_in);  // the document does not say: what OCR read
   if (const TextBlockM* b = text_block_at(shown_.text_blocks, step_.display().proxy_m))
     page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
   return page;

@@ -92,6 +92,9 @@ struct OcrBlock {
   std::string text;       ///< its kept words, line by line, joined by single spaces; each unclear word as kUnclearWord
   double confidence = 0;  ///< mean confidence of its kept words (unclear ones too), [0, 1]
   int lines = 0;          ///< lines with a kept word
+  /// The Tesseract language whose model read most of its words ("fra", "eng"; "" when Tesseract does not say):
+  /// with OcrParams::languages "fra+eng", which of the two the block is in.
+  std::string language;
 };
 
 /// What OCR found in one picture.

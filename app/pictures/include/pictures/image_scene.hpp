@@ -44,6 +44,7 @@ struct TextBlockM {
   std::string text;            ///< its words in reading order (UTF-8)
   std::string source = "pdf";  ///< where the text came from: "pdf" (a PDF's text layer) or "ocr" (read from the pixels)
   double confidence = 1.0;     ///< how sure the reading is, [0, 1] (1 for a text layer; OCR: its words' mean)
+  std::string language{};      ///< OCR: the language (BCP 47) most of its words were read in; "" unknown
   /// Whether the point p [m] lies in the box (edges included).
   bool contains(Vec2 p) const { return p.x >= lo_m.x && p.x <= hi_m.x && p.y >= lo_m.y && p.y <= hi_m.y; }
   /// Distance from p to the box [m] (0 inside).
@@ -90,10 +91,10 @@ struct TextRun {
   /// Raised (may be null): the OCR worker is killed within 50 ms and the scene comes back without its text
   /// (OcrReport::why "cancelled").
   const std::atomic<bool>* cancel = nullptr;
-  /// When given, called on the reading's thread with each text block's text as OCR reads it, in reading order
-  /// (vision::OcrParams::on_block): the blocks the finished scene's text_blocks hold, the first of them seconds
-  /// before the rest.
-  std::function<void(const std::string& text)> on_block;
+  /// When given, called on the reading's thread with each text block's text and language (TextBlockM::language)
+  /// as OCR reads it, in reading order (vision::OcrParams::on_block): the blocks the finished scene's text_blocks
+  /// hold, the first of them seconds before the rest.
+  std::function<void(const std::string& text, const std::string& language)> on_block;
 };
 
 /// Builds a scene again with its text read (OCR in its worker process, the words masked from the edges, the

@@ -39,6 +39,10 @@ vision::OcrParams ocr_params_from(const config::Settings& settings);
 /// pt, nl are known).
 std::string tesseract_languages_for(std::string_view tag);
 
+/// The BCP 47 language subtag of a Tesseract language ("fra" → "fr"), of those tesseract_languages_for knows; ""
+/// for another.
+std::string language_of_tesseract(std::string_view code);
+
 /// The edge pipeline's parameters from [vision] and [workspace]: input limits, edge detector and its
 /// thresholds, the working size, the workspace (chains are kept down to 2 px here; length is judged in
 /// metres by simplify_params_from's limits).

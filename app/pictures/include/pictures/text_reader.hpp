@@ -48,9 +48,14 @@ class TextReader {
   void cancel();
   /// The reading of the latest start() once it has ended; nothing while it runs, after cancel(), or twice.
   std::optional<TextRead> poll();
-  /// The texts of the blocks the running reading of the latest start() has read so far (TextRun::on_block), in
-  /// reading order: a page's first words to say while the rest is read. Empty once it is polled or cancelled.
-  std::vector<std::string> blocks_so_far() const;
+  /// A block of text read so far: its text and language (BCP 47, "" unknown).
+  struct Block {
+    std::string text, language;
+    bool operator==(const Block&) const = default;
+  };
+  /// The blocks the running reading of the latest start() has read so far (TextRun::on_block), in reading order:
+  /// a page's first words to say while the rest is read. Empty once it is polled or cancelled.
+  std::vector<Block> blocks_so_far() const;
   /// Whether a reading was started and not yet polled or cancelled.
   bool pending() const { return pending_; }
   /// Its scene id (meaningful while pending()).
@@ -69,7 +74,7 @@ class TextReader {
   std::optional<Job> waiting_;                  // guarded by m_
   std::shared_ptr<std::atomic<bool>> running_;  // guarded by m_: the running job's cancel flag
   std::optional<TextRead> done_;                // guarded by m_
-  std::vector<std::string> blocks_;             // guarded by m_: blocks_so_far of the latest job
+  std::vector<Block> blocks_;                   // guarded by m_: blocks_so_far of the latest job
   int blocks_id_ = 0;                           // guarded by m_: the job they are of
   bool stop_ = false;                           // guarded by m_
   bool pending_ = false;                        // window thread only
