@@ -307,7 +307,8 @@ Speaker::~Speaker() {
   worker_.join();
 }
 
-void Speaker::submit(std::string text, bool keep, bool again, std::size_t switch_from, const SpeechParams* switch_to) {
+void Speaker::submit(std::string text, bool keep, bool again, std::size_t switch_from, const SpeechParams* switch_to,
+                     std::size_t switch_until) {
   // Under m_, so two concurrent say() calls queue in the order of their generations.
   job_generation_ = stream_.cancel();
   stream_.set_paused(false);
@@ -317,11 +318,13 @@ void Speaker::submit(std::string text, bool keep, bool again, std::size_t switch
   if (!text.empty()) {
     job_params_ = again ? last_params_ : params_;
     job_switch_from_ = again ? last_switch_from_ : switch_to ? switch_from : SIZE_MAX;
+    job_switch_until_ = again ? last_switch_until_ : switch_to ? switch_until : SIZE_MAX;
     job_switch_params_ = again ? last_switch_params_ : switch_to ? *switch_to : params_;
     if (keep) {
       last_ = text;
       last_params_ = job_params_;
       last_switch_from_ = job_switch_from_;
+      last_switch_until_ = job_switch_until_;
       last_switch_params_ = job_switch_params_;
     }
     job_text_ = std::move(text);
@@ -343,7 +346,8 @@ void Speaker::say(std::string text, bool keep) {
   cv_.notify_all();
 }
 
-void Speaker::say_switching(std::string text, bool keep, std::size_t from_piece, const std::string& voice) {
+void Speaker::say_switching(std::string text, bool keep, std::size_t from_piece, const std::string& voice,
+                            std::size_t until_piece) {
   SpeechParams other;
   {
     std::lock_guard<std::mutex> lock(m_);
@@ -357,7 +361,7 @@ void Speaker::say_switching(std::string text, bool keep, std::size_t from_piece,
   if (text.size() > kMaxSpeechTextBytes) text.resize(word_cut(text, kMaxSpeechTextBytes));
   {
     std::lock_guard<std::mutex> lock(m_);
-    submit(std::move(text), keep, false, from_piece, &other);
+    submit(std::move(text), keep, false, from_piece, &other, until_piece);
   }
   cv_.notify_all();
 }
@@ -502,7 +506,7 @@ void Speaker::run() {
   for (;;) {
     std::string text;
     SpeechParams params, switch_params;
-    std::size_t switch_from = SIZE_MAX;
+    std::size_t switch_from = SIZE_MAX, switch_until = SIZE_MAX;
     std::uint32_t gen = 0;
     {
       std::unique_lock<std::mutex> lock(m_);
@@ -511,6 +515,7 @@ void Speaker::run() {
       text = std::move(job_text_);
       params = job_params_;
       switch_from = job_switch_from_;
+      switch_until = job_switch_until_;
       switch_params = job_switch_params_;
       gen = job_generation_;
       has_job_ = false;
@@ -533,7 +538,7 @@ void Speaker::run() {
             }
             piece_starts_.push_back(pushed);
           }
-          if (!speak_piece(piece, k >= switch_from ? switch_params : params, gen, &pushed)) {
+          if (!speak_piece(piece, k >= switch_from && k < switch_until ? switch_params : params, gen, &pushed)) {
             whole = false;
             break;
           }

@@ -105,11 +105,12 @@ void AudioSystem::say_text(std::string text, bool keep) {
   if (speaker_) speaker_->say(std::move(text), keep);
 }
 
-void AudioSystem::say_text_in(std::string text, bool keep, std::size_t from_piece, const std::string& language) {
+void AudioSystem::say_text_in(std::string text, bool keep, std::size_t from_piece, const std::string& language,
+                              std::size_t until_piece) {
   if (!speaker_) return;
   const std::string voice = voice_for(language);
   try {
-    speaker_->say_switching(text, keep, from_piece, voice);
+    speaker_->say_switching(text, keep, from_piece, voice, until_piece);
   } catch (const SpeechError& e) {
     if (missing_voices_.insert(voice).second)
       spdlog::error("audio: {}; its text is said in the voice in use", e.what());

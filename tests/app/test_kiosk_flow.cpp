@@ -10,6 +10,7 @@
 #include "audio/speech.hpp"
 #include "every_effect.hpp"
 #include "test_polylines.hpp"
+#include "visit/answers.hpp"
 #include "visit/describe.hpp"
 #include "visit/kiosk_flow.hpp"
 
@@ -474,8 +475,10 @@ struct LanguageRecorder final : hk::test::EveryEffect {
   std::string describe() override {
     Polyline square{{{-0.02, -0.02}, {0.02, -0.02}, {0.02, 0.02}, {-0.02, 0.02}}, true};
     Polyline dot{{{0.05, 0.03}, {0.056, 0.03}, {0.056, 0.036}, {0.05, 0.036}}, true};
-    return describe_scene({square, dot}, {}, {0.08, 0.06}, 3, std::nullopt, nullptr, current);
+    return notes_words(notes) + describe_scene({square, dot}, {}, {0.08, 0.06}, 3, std::nullopt, nullptr, current);
   }
+  PictureNotes notes;  // what staff wrote of the picture shown, in notes.language
+  PictureNotes shown_notes() const override { return notes; }
   bool change_level(int) override { return true; }
   bool change_volume(int) override { return true; }
   void new_session() override {}
@@ -490,10 +493,11 @@ struct LanguageRecorder final : hk::test::EveryEffect {
   }
   PageText page;  // what page_text() gives
   PageText page_text() override { return page; }
-  std::vector<std::tuple<std::string, int, std::string>> said_in;  // say_in calls: text, from piece, language
-  void say_in(const std::string& text, int from_piece, const std::string& language) override {
+  /// say_in calls: text, from piece, language, until piece.
+  std::vector<std::tuple<std::string, int, std::string, int>> said_in;
+  void say_in(const std::string& text, int from_piece, const std::string& language, int until_piece) override {
     said.push_back(text);
-    said_in.emplace_back(text, from_piece, language);
+    said_in.emplace_back(text, from_piece, language, until_piece);
   }
   std::string language_name_of(const std::string& tag) const override {
     for (const auto& c : catalogues)
@@ -556,8 +560,9 @@ TEST(KioskFlow, ADocumentsTextInAnotherLanguageIsSaidInItsVoiceAfterANotice) {
   for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 1.0 + i);  // to the first picture
   flow.key(KioskKey::Describe, 5.0);                              // the hand on the block of text: it is read
   ASSERT_EQ(fx.said_in.size(), 1u);
-  const auto& [text, from_piece, language] = fx.said_in[0];
+  const auto& [text, from_piece, language, until_piece] = fx.said_in[0];
   EXPECT_EQ(language, "de-DE");
+  EXPECT_EQ(until_piece, -1) << "to the end";
   const std::vector<std::string> pieces = audio::speech_pieces(text);
   ASSERT_LT(static_cast<std::size_t>(from_piece), pieces.size());
   EXPECT_EQ(pieces[static_cast<std::size_t>(from_piece)], "Der Brunnen steht auf dem Markt.")
@@ -569,6 +574,39 @@ TEST(KioskFlow, ADocumentsTextInAnotherLanguageIsSaidInItsVoiceAfterANotice) {
   flow.key(KioskKey::Describe, 8.0);
   EXPECT_EQ(fx.said_in.size(), 1u);
   EXPECT_NE(fx.said.back().find("Der Brunnen"), std::string::npos) << fx.said.back();
+}
+
+TEST(KioskFlow, WhatStaffWroteOnlyInAnotherLanguageIsSaidInItsVoiceBetweenTheVisitorsWords) {
+  LanguageRecorder fx;
+  for (const char* c : {"en", "fr"})
+    fx.catalogues.push_back(audio::MessageCatalog::load(c, audio::default_locale_dir()));
+  fx.notes.title = "A horse";
+  fx.notes.description = "A horse standing, its head to the left.";
+  fx.notes.language = "en";  // the sidecar has no [fr] table
+  KioskFlowParams p;
+  KioskFlow flow(fx, fx.current, p);
+  flow.key(KioskKey::Other, 0.0);
+  flow.key(KioskKey::Language, 0.5);  // Français
+  ASSERT_EQ(fx.current.language(), "fr");
+  for (int i = 0; i < 3; ++i) flow.key(KioskKey::Next, 1.0 + i);
+  flow.key(KioskKey::Describe, 5.0);
+  ASSERT_EQ(fx.said_in.size(), 1u) << fx.said.back();
+  const auto& [text, from_piece, language, until_piece] = fx.said_in[0];
+  EXPECT_EQ(language, "en");
+  const std::vector<std::string> pieces = audio::speech_pieces(text);
+  ASSERT_LT(static_cast<std::size_t>(until_piece), pieces.size());
+  ASSERT_EQ(until_piece - from_piece, 1) << text;  // the description, which opens with the title
+  EXPECT_EQ(pieces[static_cast<std::size_t>(from_piece)], "A horse standing, its head to the left.");
+  EXPECT_EQ(pieces[static_cast<std::size_t>(from_piece) - 1],
+            fx.current.text(MessageId::other_language, {{"name", "English"}}))
+      << "the notice, in the visitor's language, just before";
+  EXPECT_NE(pieces[static_cast<std::size_t>(until_piece)].find("forme"), std::string::npos)
+      << "the rest in French, in the French voice: " << text;
+  // Notes in the visitor's own language are said as ever.
+  fx.notes.language = "fr";
+  flow.key(KioskKey::Where, 7.0);
+  flow.key(KioskKey::Describe, 8.0);
+  EXPECT_EQ(fx.said_in.size(), 1u);
 }
 
 }  // namespace

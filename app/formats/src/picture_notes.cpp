@@ -163,6 +163,7 @@ PictureNotes read_sidecar(const std::string& file) {
     fail(file, "TOML syntax error at line " + std::to_string(b.line) + ", column " + std::to_string(b.column));
   }
   PictureNotes notes;
+  notes.from_sidecar = true;
   for (auto&& [key, node] : root) {
     const std::string name(key.str());
     if (name == "title") {
@@ -200,6 +201,11 @@ PictureNotes notes_in(const PictureNotes& notes, std::string_view language) {
   if (it == notes.translations.end()) return out;
   if (!it->second.title.empty()) out.title = it->second.title;
   if (!it->second.description.empty()) out.description = it->second.description;
+  // The language of what is said at length: the translated description, or the translated title of notes that
+  // have no description; a translated title over the top-level description leaves it the top level's.
+  const bool translated_description = !it->second.description.empty();
+  const bool only_a_title = notes.description.empty() && !it->second.title.empty();
+  if (translated_description || only_a_title) out.language = it->first;
   return out;
 }
 

@@ -25,8 +25,8 @@ bool opens_with(const std::string& text, std::string title) {
   return true;
 }
 
-/// What a person wrote of a picture, for the start of Describe: "A horse. A horse standing, ..." (the title
-/// left out when the description opens with it); "" when nothing was written.
+}  // namespace
+
 std::string notes_words(const PictureNotes& notes) {
   std::string words;
   if (!notes.title.empty() && !opens_with(notes.description, notes.title)) {
@@ -37,8 +37,6 @@ std::string notes_words(const PictureNotes& notes) {
   if (!notes.description.empty()) words += notes.description + ' ';
   return words;
 }
-
-}  // namespace
 
 std::string region_said_name(const meaning::NamedRegion& region, const audio::MessageCatalog& m) {
   switch (region.source) {

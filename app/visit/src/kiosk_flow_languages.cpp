@@ -32,10 +32,12 @@ std::string KioskFlow::other_language(const std::string& tag) const {
   return !tag.empty() && hk::language_subtag(tag) != hk::language_subtag(msg_.language()) ? tag : std::string();
 }
 
-std::string KioskFlow::language_notice() const {
-  if (v_.reading_language.empty()) return {};
-  std::string name = fx_.speech.language_name_of(v_.reading_language);
-  if (name.empty()) name = v_.reading_language;
+std::string KioskFlow::language_notice() const { return language_notice(v_.reading_language); }
+
+std::string KioskFlow::language_notice(const std::string& tag) const {
+  if (tag.empty()) return {};
+  std::string name = fx_.speech.language_name_of(tag);
+  if (name.empty()) name = tag;
   return text(MessageId::other_language, {{"name", name}}) + " ";
 }
 

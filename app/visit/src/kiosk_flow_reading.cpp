@@ -5,6 +5,7 @@
 #include <string>
 
 #include "audio/speech.hpp"
+#include "visit/answers.hpp"
 #include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
@@ -37,7 +38,23 @@ void KioskFlow::describe_key() {
     return;
   }
   const std::string description = fx_.stage.describe();
-  fx_.speech.say(before + long_text_line(description) + text(MessageId::describe, {{"description", description}}));
+  const std::string said = text(MessageId::describe, {{"description", description}});
+  // What staff wrote only in another language: said in that language's voice after a notice in the visitor's.
+  const PictureNotes notes = fx_.stage.shown_notes();
+  const std::string foreign = other_language(notes.language);
+  std::string written = notes_words(notes);
+  if (!foreign.empty() && !written.empty() && said.rfind(written, 0) == 0) {
+    std::string lead = before + long_text_line(description) + language_notice(foreign);
+    while (!lead.empty() && lead.back() == ' ') lead.pop_back();
+    const std::string rest = said.substr(written.size());
+    while (!written.empty() && written.back() == ' ') written.pop_back();
+    // Line breaks end pieces: the notes are pieces of their own, whatever their last character.
+    const int from = static_cast<int>(audio::speech_pieces(lead).size());
+    const int until = from + static_cast<int>(audio::speech_pieces(written).size());
+    fx_.speech.say_in(lead + "\n" + written + "\n" + rest, from, foreign, until);
+    return;
+  }
+  fx_.speech.say(before + long_text_line(description) + said);
 }
 
 std::string KioskFlow::long_text_line(const std::string& said) const {

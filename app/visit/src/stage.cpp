@@ -64,6 +64,7 @@ void Stage::show_tutorial(TutorialShape shape) {
   static constexpr audio::MessageId kNames[] = {audio::MessageId::shape_square, audio::MessageId::shape_circle,
                                                 audio::MessageId::shape_triangle};
   sh.notes.title = audio_.messages().text(kNames[static_cast<int>(shape)]);  // Where, Describe and the tour name it
+  sh.notes.language = audio_.messages().language();
   publish(std::move(sh),
           std::make_unique<Scene>(Scene::build({tutorial_polyline(shape, half_)}, s_.haptics.max_levels)),
           -1 - static_cast<int>(shape));
@@ -216,6 +217,12 @@ std::string Stage::describe() {
   const std::string reading =
       text_.pending() ? audio_.messages().text(audio::MessageId::text_reading) + " " : std::string();
   return reading + describe_shown();
+}
+
+PictureNotes Stage::shown_notes() const {
+  PictureNotes n = notes_in(shown_.notes, audio_.messages().language());
+  if (n.language.empty() && n.from_sidecar) n.language = s_.kiosk.language;  // its top level: the default's
+  return n;
 }
 
 PageText Stage::page_text() {

@@ -43,14 +43,18 @@ bool Voice::repeat() {
   return true;
 }
 
-void Voice::say_in(const std::string& text, int from_piece, const std::string& language) {
-  spdlog::info("say: {} (from piece {} in {})", one_line(text), from_piece, language);
+void Voice::say_in(const std::string& text, int from_piece, const std::string& language, int until_piece) {
+  if (until_piece < 0)
+    spdlog::info("say: {} (from piece {} in {})", one_line(text), from_piece, language);
+  else
+    spdlog::info("say: {} (pieces {} to {} in {})", one_line(text), from_piece, until_piece - 1, language);
   last_said_ = text;
   repeatable_ = text;
   ++kept_texts_;
   ++texts_said_;
   brief_last_ = false;
-  audio_.say_text_in(text, true, static_cast<std::size_t>(std::max(0, from_piece)), language);
+  audio_.say_text_in(text, true, static_cast<std::size_t>(std::max(0, from_piece)), language,
+                     until_piece < 0 ? SIZE_MAX : static_cast<std::size_t>(until_piece));
 }
 
 std::string Voice::language_name_of(const std::string& tag) const {

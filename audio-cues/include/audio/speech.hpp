@@ -99,10 +99,12 @@ class Speaker {
   /// text only cancels (it is logged, and last_text() keeps the previous text). Never throws for a text's
   /// length: over kMaxSpeechTextBytes it is cut at the last piece that fits (logged as a warning).
   void say(std::string text, bool keep = true);
-  /// As say(), but its pieces from `from_piece` on (speech_pieces, from 0) in `voice` (a document's text in its
-  /// own language after words in the visitor's). @throws SpeechError when the synthesisers have no such voice
-  /// (nothing is said then).
-  void say_switching(std::string text, bool keep, std::size_t from_piece, const std::string& voice);
+  /// As say(), but its pieces from `from_piece` up to (not including) `until_piece` (speech_pieces, from 0;
+  /// SIZE_MAX: to the end) in `voice`: a document's text in its own language after words in the visitor's, or a
+  /// description staff wrote in another language between them. @throws SpeechError when the synthesisers have no
+  /// such voice (nothing is said then).
+  void say_switching(std::string text, bool keep, std::size_t from_piece, const std::string& voice,
+                     std::size_t until_piece = SIZE_MAX);
   /// Says last_text() again, from its start, in the voice it was said in (nothing if there was none). Logged
   /// like say().
   void repeat();
@@ -155,16 +157,18 @@ class Speaker {
  private:
   void run();
   void submit(std::string text, bool keep, bool again, std::size_t switch_from = SIZE_MAX,
-              const SpeechParams* switch_to = nullptr);  // cancels and queues; caller holds m_
+              const SpeechParams* switch_to = nullptr,
+              std::size_t switch_until = SIZE_MAX);  // cancels and queues; caller holds m_
   bool speak_piece(const std::string& piece, const SpeechParams& params, std::uint32_t gen,
                    std::uint64_t* pushed);  // false: cancelled; *pushed += samples handed over
 
   SpeechStream& stream_;
   mutable std::mutex m_;
-  SpeechParams params_;                                                   // the voice of the next say()
-  SpeechParams job_params_;                                               // the waiting text's
-  SpeechParams last_params_;                                              // last_'s
-  std::size_t job_switch_from_ = SIZE_MAX, last_switch_from_ = SIZE_MAX;  // pieces from here in *_switch_params_
+  SpeechParams params_;                                                     // the voice of the next say()
+  SpeechParams job_params_;                                                 // the waiting text's
+  SpeechParams last_params_;                                                // last_'s
+  std::size_t job_switch_from_ = SIZE_MAX, last_switch_from_ = SIZE_MAX;    // pieces from here in *_switch_params_
+  std::size_t job_switch_until_ = SIZE_MAX, last_switch_until_ = SIZE_MAX;  // ... up to (not including) here
   SpeechParams job_switch_params_, last_switch_params_;
   std::condition_variable cv_;
   bool has_job_ = false;  // a text waits for the worker

@@ -67,10 +67,11 @@ class AudioSystem {
   /// Speaks free text (e.g. a picture description), cutting off whatever is being said. `keep` as
   /// Speaker::say: false for an acknowledgement, which Speaker::repeat passes over. Any length (Speaker::say).
   void say_text(std::string text, bool keep = true);
-  /// As say_text(), but its pieces from `from_piece` on in the voice of `language` (a BCP 47 tag: English's
-  /// voice for "en", else espeak-ng's voice of its language subtag). A language without a voice is said in the
-  /// voice in use (logged once per language).
-  void say_text_in(std::string text, bool keep, std::size_t from_piece, const std::string& language);
+  /// As say_text(), but its pieces from `from_piece` up to (not including) `until_piece` (SIZE_MAX: to the end)
+  /// in the voice of `language` (a BCP 47 tag: English's voice for "en", else espeak-ng's voice of its language
+  /// subtag). A language without a voice is said in the voice in use (logged once per language).
+  void say_text_in(std::string text, bool keep, std::size_t from_piece, const std::string& language,
+                   std::size_t until_piece = SIZE_MAX);
   /// Holds speech where it is (Speaker::pause); false when nothing is being said.
   bool pause_speech();
   /// Goes on from the pause (Speaker::resume); false when not paused.

@@ -37,6 +37,12 @@ struct PictureNotes {
     std::string title, description;
   };
   std::map<std::string, Translation> translations;
+  /// The language the title and description are in (BCP 47): notes_in's translation's tag; "" when not known
+  /// (the sidecar's top-level keys, in the kiosk's default language; a file's own metadata).
+  std::string language;
+  /// The title and description are a sidecar's (a person wrote them for the kiosk, in its default language),
+  /// not the picture file's own metadata.
+  bool from_sidecar = false;
 };
 
 /// `notes` as said to a visitor in `language` (a BCP 47 tag): its translation's title and description where

@@ -31,6 +31,10 @@ struct ShownView {
   vision::PxToM px_to_m{1, 0, 0};                              ///< the picture's pixels → metres (for `regions`)
 };
 
+/// What a person wrote of a picture, as Describe opens with it: "A horse. A horse standing, ... " (the title
+/// left out when the description opens with it; a space after); "" when nothing was written.
+std::string notes_words(const PictureNotes& notes);
+
 /// A region's name as said in `m`'s language: staff's in that language where they gave one (region_name_in), with
 /// its article (said_name: "the left wing"), a guess's from the catalogue ("something that could be a face",
 /// "text: Emergency exit").

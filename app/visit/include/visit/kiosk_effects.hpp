@@ -72,11 +72,13 @@ class SpeechEffects {
   virtual int default_language() const { return 0; }
   /// Speaks and answers in language `index` from now on (the catalogue and the voice); out of range: nothing.
   virtual void set_language(int index) { (void)index; }
-  /// As say(), but from its piece `from_piece` on (audio::speech_pieces) in the voice of `language` (a BCP 47
-  /// tag): a document's text in its own language after the visitor's words before it.
-  virtual void say_in(const std::string& text, int from_piece, const std::string& language) {
+  /// As say(), but its pieces from `from_piece` up to (not including) `until_piece` (audio::speech_pieces; −1:
+  /// to the end) in the voice of `language` (a BCP 47 tag): a document's text in its own language after the
+  /// visitor's words before it, or what staff wrote in another language between the visitor's words.
+  virtual void say_in(const std::string& text, int from_piece, const std::string& language, int until_piece = -1) {
     (void)from_piece;
     (void)language;
+    (void)until_piece;
     say(text);
   }
   /// The name of language `tag` in itself ("Français") where the kiosk offers it; "" otherwise.

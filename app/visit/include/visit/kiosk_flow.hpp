@@ -311,6 +311,8 @@ class KioskFlow {
   std::string other_language(const std::string& tag) const;
   /// "In Français: " before a text in v_.reading_language, "" when it is the visitor's.
   std::string language_notice() const;
+  /// "In English: " before a text in language `tag` (other_language's), "" for "".
+  std::string language_notice(const std::string& tag) const;
   void describe_key();
   void reading_key(KioskKey k);  // the sentence and paragraph keys
   void repeat_key();

@@ -92,7 +92,7 @@ class Stage final : public StageEffects {
   /// Puts practice shape `shape` on the device (a library picture still being built is not wanted any more).
   void show_tutorial(TutorialShape shape) override;
   /// The shown picture's notes in the language in use (notes_in).
-  PictureNotes shown_notes() const override { return notes_in(shown_.notes, audio_.messages().language()); }
+  PictureNotes shown_notes() const override;
   /// What the picture or page holds (describe.hpp), led by "Reading the text." while its text is read.
   std::string describe() override;
   /// "What is here": on a document page, the block of text under the hand (its number and first words);

@@ -54,7 +54,7 @@ class Voice final : public SpeechEffects {
   /// audio::AudioSystem::set_language; logged when it changes.
   void set_language(int index) override;
   /// As say(), its pieces from `from_piece` on in the voice of `language` (audio::AudioSystem::say_text_in).
-  void say_in(const std::string& text, int from_piece, const std::string& language) override;
+  void say_in(const std::string& text, int from_piece, const std::string& language, int until_piece = -1) override;
   /// The offered language `tag` names (by language subtag), in itself; "" when it is not offered.
   std::string language_name_of(const std::string& tag) const override;
 
