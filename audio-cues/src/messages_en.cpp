@@ -351,6 +351,12 @@ const std::array<MessageSource, kWordCount> kWordSources{
     NC_("guess_face", "something that could be a face"),
     // TRANSLATORS: a part named by the first words of the text written on it.
     NC_("guess_text", "text: {text}"),
+    // TRANSLATORS: the names of the languages the kiosk speaks, as said in other_language's {name} ("In French:"),
+    // in this language and as they read there.
+    NC_("language_en", "English"),
+    NC_("language_fr", "French"),
+    NC_("language_de", "German"),
+    NC_("language_es", "Spanish"),
     // TRANSLATORS: what a USB stick holds, in stick_inserted's {summary}: summary_all is "{documents}:
     // {what}", {what} one of summary_pictures_and_pdfs, the summary_pictures phrase, or a summary_pdf phrase.
     NC_("summary_all", "{documents}: {what}"),

@@ -567,7 +567,7 @@ TEST(KioskFlow, ADocumentsTextInAnotherLanguageIsSaidInItsVoiceAfterANotice) {
   ASSERT_LT(static_cast<std::size_t>(from_piece), pieces.size());
   EXPECT_EQ(pieces[static_cast<std::size_t>(from_piece)], "Der Brunnen steht auf dem Markt.")
       << "the visitor's words before it, the document's from here";
-  EXPECT_NE(text.find("In Deutsch:"), std::string::npos) << text;
+  EXPECT_NE(text.find("In German:"), std::string::npos) << text;  // its name in the visitor's language
   // A page in the visitor's own language is said as ever.
   fx.page.language = "en-GB";
   flow.key(KioskKey::Where, 7.0);
@@ -598,7 +598,7 @@ TEST(KioskFlow, WhatStaffWroteOnlyInAnotherLanguageIsSaidInItsVoiceBetweenTheVis
   ASSERT_EQ(until_piece - from_piece, 1) << text;  // the description, which opens with the title
   EXPECT_EQ(pieces[static_cast<std::size_t>(from_piece)], "A horse standing, its head to the left.");
   EXPECT_EQ(pieces[static_cast<std::size_t>(from_piece) - 1],
-            fx.current.text(MessageId::other_language, {{"name", "English"}}))
+            fx.current.text(MessageId::other_language, {{"name", fx.current.word("language_en")}}))
       << "the notice, in the visitor's language, just before";
   EXPECT_NE(pieces[static_cast<std::size_t>(until_piece)].find("forme"), std::string::npos)
       << "the rest in French, in the French voice: " << text;

@@ -36,7 +36,9 @@ std::string KioskFlow::language_notice() const { return language_notice(v_.readi
 
 std::string KioskFlow::language_notice(const std::string& tag) const {
   if (tag.empty()) return {};
-  std::string name = fx_.speech.language_name_of(tag);
+  // The language's name in the visitor's ("In French:"), else in itself ("Français"), else its tag.
+  std::string name = msg_.word("language_" + std::string(hk::language_subtag(tag)));
+  if (name.empty()) name = fx_.speech.language_name_of(tag);
   if (name.empty()) name = tag;
   return text(MessageId::other_language, {{"name", name}}) + " ";
 }

@@ -186,7 +186,7 @@ struct MessageSource {
   std::string_view many;
 };
 
-inline constexpr int kWordCount = 123;     ///< entries of kWordSources
+inline constexpr int kWordCount = 127;     ///< entries of kWordSources
 inline constexpr int kKeyNameCount = 75;   ///< entries of kKeyNameSources
 inline constexpr int kKeyPlaceCount = 21;  ///< entries of kKeyPlaceSources
 
