@@ -80,7 +80,7 @@ MessageCatalog MessageCatalog::build(std::string_view language, std::optional<Mo
   const std::string where = "catalogue '" + hk::one_line(std::string(language)) + "' (" + hk::one_line(source) + "): ";
   // Each entry is there, not empty, not too long, and uses only the placeholders of its English text.
   const auto check = [&](const MessageSource& s) {
-    for (const long n : {1L, 2L, 5L}) {
+    for (const long n : {1L, 0L, 2L, 5L}) {  // each plural form a visit can say, 0 shapes too
       if (s.many.empty() && n > 1) break;
       const std::string t = c.translate(s, n);
       if (c.mo_ && t == (n == 1 || s.many.empty() ? s.one : s.many)) {

@@ -24,14 +24,16 @@ std::string mo_problem(const std::vector<char>& mo) {
     }
     return v;
   };
-  const bool swap = false;
+  bool swap = false;
   if (u32(0, false) != 0x950412deu) {
-    // Boost.Locale 1.74 reads a file of the other byte order with this machine's (its offsets then point anywhere);
-    // msgfmt writes this machine's.
-    return u32(0, true) == 0x950412deu ? "written in the other byte order" : "no MO magic number";
+    if (u32(0, true) != 0x950412deu) return "no MO magic number";
+    swap = true;
   }
   const std::uint64_t n = u32(8, swap), originals = u32(12, swap), translations = u32(16, swap);
   const std::uint64_t hash_size = u32(20, swap), hash_at = u32(24, swap);
+  if ((u32(4, swap) >> 16) > 1) return "an MO revision this reader does not know";
+  // Boost.Locale reads entry 0, the header (its Plural-Forms), whatever the count says: it must be there.
+  if (n == 0) return "no header entry";
   for (const std::uint64_t table : {originals, translations}) {
     if (table + 8 * n > size) return "a string table runs past the end";
     for (std::uint64_t i = 0; i < n; ++i) {

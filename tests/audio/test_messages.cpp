@@ -174,19 +174,19 @@ TEST(Messages, BadCataloguesAreRefusedInOneLine) {
   EXPECT_EQ(MessageCatalog::load("fr-CA", default_locale_dir()).language_name(), "Français");
 }
 
-TEST(Messages, AnMoFileInTheOtherByteOrderIsRefusedInOneLine) {
-  // Boost.Locale 1.74 reads such a file's offsets in this machine's order (a fuzz find: it read past the end).
+TEST(Messages, AnMoFileWithoutItsHeaderEntryIsRefusedInOneLine) {
+  // Boost.Locale 1.74 reads entry 0 (the header) whatever the file's count says, and read past the end of one that
+  // said 0 (a fuzz find, kept as fuzz/seeds/messages/no_header_entry.mo).
   std::ifstream in(default_locale_dir() / "fr" / "LC_MESSAGES" / "haptic-kiosk.mo", std::ios::binary);
   std::vector<char> mo((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(mo.size(), 28u);
-  std::swap(mo[0], mo[3]);
-  std::swap(mo[1], mo[2]);
+  std::fill(mo.begin() + 8, mo.begin() + 12, '\0');  // no strings
   try {
-    (void)MessageCatalog::from_mo("fr", mo, "swapped.mo");
-    ADD_FAILURE() << "a file in the other byte order was read";
+    (void)MessageCatalog::from_mo("fr", mo, "headless.mo");
+    ADD_FAILURE() << "a file without its header entry was read";
   } catch (const MessageError& e) {
-    EXPECT_NE(std::string(e.what()).find("swapped.mo"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("other byte order"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("headless.mo"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no header entry"), std::string::npos) << e.what();
   }
 }
 

@@ -27,7 +27,8 @@ class MessageError : public hk::Error {
 };
 
 /// What is wrong with `mo` as a GNU MO file (the gettext manual, "The Format of GNU MO Files"), "" when nothing:
-/// the magic number in this machine's byte order (Boost.Locale 1.74 misreads the other), and every string table entry
+/// the magic number in either byte order, a revision of 0 or 1, a header entry (Boost.Locale reads entry 0 whatever
+/// the count says), and every string table entry
 /// and the hash table inside the file, each string NUL-terminated, each hash slot 0 or an entry's number + 1.
 /// Boost.Locale 1.74 reads the offsets as they are, so a file is checked before it is handed over.
 std::string mo_problem(const std::vector<char>& mo);
