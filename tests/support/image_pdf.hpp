@@ -11,6 +11,26 @@
 
 namespace hk::test {
 
+/// A PDF file of `objects` (object i + 1 is objects[i]; the first the catalog), with its cross-reference table.
+inline std::string pdf_of_objects(const std::vector<std::string>& objects) {
+  std::string out = "%PDF-1.4\n%\xe2\xe3\xcf\xd3\n";
+  std::vector<std::size_t> offsets;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    offsets.push_back(out.size());
+    out += std::to_string(i + 1) + " 0 obj\n" + objects[i] + "\nendobj\n";
+  }
+  const std::size_t xref = out.size();
+  out += "xref\n0 " + std::to_string(objects.size() + 1) + "\n0000000000 65535 f \n";
+  for (std::size_t off : offsets) {
+    char line[24];
+    std::snprintf(line, sizeof line, "%010zu 00000 n \n", off);
+    out += line;
+  }
+  out += "trailer\n<< /Size " + std::to_string(objects.size() + 1) + " /Root 1 0 R >>\nstartxref\n" +
+         std::to_string(xref) + "\n%%EOF\n";
+  return out;
+}
+
 /// The bytes of a one-page PDF showing `jpeg` (a grey JPEG of width x height pixels) at `dpi`. A non-empty
 /// `caption` (ASCII letters, digits and spaces) is added as invisible text (render mode 3, as OCR layers are
 /// written) in 10 pt Helvetica near the bottom-left corner: a text layer of one short line.
@@ -39,22 +59,7 @@ inline std::string image_only_pdf(const std::vector<std::uint8_t>& jpeg, int wid
       image_head + std::string(jpeg.begin(), jpeg.end()) + "\nendstream",
       "<< /Type /Font /Subtype /Type1 /BaseFont /Helvetica >>",
   };
-  std::string out = "%PDF-1.4\n%\xe2\xe3\xcf\xd3\n";
-  std::vector<std::size_t> offsets;
-  for (std::size_t i = 0; i < objects.size(); ++i) {
-    offsets.push_back(out.size());
-    out += std::to_string(i + 1) + " 0 obj\n" + objects[i] + "\nendobj\n";
-  }
-  const std::size_t xref = out.size();
-  out += "xref\n0 " + std::to_string(objects.size() + 1) + "\n0000000000 65535 f \n";
-  for (std::size_t off : offsets) {
-    char line[24];
-    std::snprintf(line, sizeof line, "%010zu 00000 n \n", off);
-    out += line;
-  }
-  out += "trailer\n<< /Size " + std::to_string(objects.size() + 1) + " /Root 1 0 R >>\nstartxref\n" +
-         std::to_string(xref) + "\n%%EOF\n";
-  return out;
+  return pdf_of_objects(objects);
 }
 
 }  // namespace hk::test

@@ -22,6 +22,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hk/error.hpp"
+#include "image_pdf.hpp"
 #include "scans.hpp"
 #include "test_paths.hpp"
 #include "vision/ocr.hpp"
@@ -268,22 +269,7 @@ std::string pdf_of_lines(const std::vector<std::string>& lines) {
       "<< /Type /Page /Parent 2 0 R /MediaBox [0 0 595 842] /Resources << /Font << /F1 4 0 R >> >> /Contents 5 0 R >>",
       "<< /Type /Font /Subtype /Type1 /BaseFont /Helvetica /Encoding /WinAnsiEncoding >>",
       "<< /Length " + std::to_string(content.size()) + " >>\nstream\n" + content + "endstream"};
-  std::string pdf = "%PDF-1.4\n";
-  std::vector<std::size_t> at;
-  for (std::size_t i = 0; i < objects.size(); ++i) {
-    at.push_back(pdf.size());
-    pdf += std::to_string(i + 1) + " 0 obj\n" + objects[i] + "\nendobj\n";
-  }
-  const std::size_t xref = pdf.size();
-  pdf += "xref\n0 " + std::to_string(objects.size() + 1) + "\n0000000000 65535 f \n";
-  for (const std::size_t a : at) {
-    char entry[24];
-    std::snprintf(entry, sizeof entry, "%010zu 00000 n \n", a);
-    pdf += entry;
-  }
-  pdf += "trailer\n<< /Size " + std::to_string(objects.size() + 1) + " /Root 1 0 R >>\nstartxref\n" +
-         std::to_string(xref) + "\n%%EOF\n";
-  return pdf;
+  return test::pdf_of_objects(objects);
 }
 
 TEST(Ocr, AFrenchScanIsReadWithTheFrenchDataAndSaysItIsFrench) {

@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -140,6 +141,22 @@ std::vector<CameraInfo> list_cameras() {
   } catch (...) {
   }
   return out;
+}
+
+bool detail::still_between(FrameSource& source, Frame& out, double timeout_s, const std::function<void()>& to_still,
+                           const std::function<void()>& back) {
+  to_still();
+  bool got = false;
+  std::exception_ptr failed;
+  try {
+    for (int dropped = 0; (got = source.next(out, timeout_s)) && dropped < kStillSettleFrames; ++dropped) {
+    }
+  } catch (const CameraError&) {
+    failed = std::current_exception();
+  }
+  back();
+  if (failed) std::rethrow_exception(failed);
+  return got;
 }
 
 }  // namespace hk::vision

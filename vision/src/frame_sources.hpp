@@ -3,6 +3,7 @@
 // V4L2), opened by open_frame_source and listed by list_cameras, and the one-line CameraError messages they
 // share.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +14,16 @@ namespace hk::vision::detail {
 
 /// "camera '<spec, control characters escaped>': <problem>" as a CameraError. problem must be one line.
 [[noreturn]] void throw_camera_error(const SourceSpec& spec, const std::string& problem);
+
+/// A camera's still (FrameSource::still) between `to_still` and `back`, which set its size for the still and back
+/// to the preview (both may throw CameraError): kStillSettleFrames frames dropped while the exposure settles, the
+/// next kept in `out`, and `back` called whatever happened, a CameraError from the frames thrown after it. False
+/// when no frame came within `timeout_s` [s].
+bool still_between(FrameSource& source, Frame& out, double timeout_s, const std::function<void()>& to_still,
+                   const std::function<void()>& back);
+
+/// Frames dropped after a camera's size changes for a still, while its exposure settles.
+inline constexpr int kStillSettleFrames = 2;
 
 /// strerror(err) as a std::string (thread-safe).
 std::string errno_text(int err);

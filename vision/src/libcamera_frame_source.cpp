@@ -24,7 +24,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -176,9 +175,6 @@ double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-/// Frames dropped after the size changes for a still, while the camera's exposure settles.
-constexpr int kStillSettleFrames = 2;
-
 class LibcameraFrameSource final : public FrameSource {
  public:
   LibcameraFrameSource(SourceSpec spec, const FrameSourceParams& params) : spec_(std::move(spec)), params_(params) {}
@@ -239,18 +235,8 @@ class LibcameraFrameSource final : public FrameSource {
     if (static_cast<std::uint64_t>(full.width) * full.height <=
         static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_))
       return next(out, timeout_s);  // the preview is the largest it gives
-    restart(true);
-    bool got = false;
-    std::exception_ptr failed;
-    try {
-      for (int dropped = 0; (got = next(out, timeout_s)) && dropped < kStillSettleFrames; ++dropped) {
-      }
-    } catch (const CameraError&) {
-      failed = std::current_exception();
-    }
-    restart(false);  // back to the preview whatever happened
-    if (failed) std::rethrow_exception(failed);
-    return got;
+    return still_between(
+        *this, out, timeout_s, [this] { restart(true); }, [this] { restart(false); });
   }
 
   std::string name() const override { return "libcamera camera " + std::to_string(spec_.index) + " (" + model_ + ")"; }

@@ -20,7 +20,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <exception>
 #include <memory>
 #include <string>
 #include <utility>
@@ -120,9 +119,6 @@ std::pair<std::uint32_t, std::uint32_t> largest_frame_size(int fd, std::uint32_t
   return best;
 }
 
-/// Frames dropped after the size changes for a still, while the camera's exposure settles.
-constexpr int kStillSettleFrames = 2;
-
 /// One mmap'ed driver buffer.
 struct Mapping {
   void* start = MAP_FAILED;
@@ -134,20 +130,7 @@ class V4l2FrameSource final : public FrameSource {
   V4l2FrameSource(SourceSpec spec, const FrameSourceParams& params) : spec_(std::move(spec)), params_(params) {}
 
   ~V4l2FrameSource() override {
-    if (streaming_) {
-      int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-      (void)xioctl(fd_, VIDIOC_STREAMOFF, &type);
-    }
-    for (const Mapping& m : buffers_) {
-      if (m.start != MAP_FAILED) ::munmap(m.start, m.length);
-    }
-    if (buffers_requested_) {
-      v4l2_requestbuffers req{};
-      req.count = 0;
-      req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-      req.memory = V4L2_MEMORY_MMAP;
-      (void)xioctl(fd_, VIDIOC_REQBUFS, &req);
-    }
+    stop_streaming();
     if (fd_ >= 0) ::close(fd_);
   }
 
@@ -180,20 +163,15 @@ class V4l2FrameSource final : public FrameSource {
     const auto [w, h] = largest_frame_size(fd_, pixel_format_);
     if (static_cast<std::uint64_t>(w) * h <= static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_))
       return next(out, timeout_s);  // the preview is the largest it gives
-    stop_streaming();
-    start_streaming(w, h);
-    bool got = false;
-    std::exception_ptr failed;
-    try {
-      for (int dropped = 0; (got = next(out, timeout_s)) && dropped < kStillSettleFrames; ++dropped) {
-      }
-    } catch (const CameraError&) {
-      failed = std::current_exception();
-    }
-    stop_streaming();  // back to the preview whatever happened
-    start_streaming(static_cast<std::uint32_t>(params_.width_px), static_cast<std::uint32_t>(params_.height_px));
-    if (failed) std::rethrow_exception(failed);
-    return got;
+    const auto size_for = [this](std::uint32_t width, std::uint32_t height) {
+      return [this, width, height] {
+        stop_streaming();
+        start_streaming(width, height);
+      };
+    };
+    return still_between(
+        *this, out, timeout_s, size_for(w, h),
+        size_for(static_cast<std::uint32_t>(params_.width_px), static_cast<std::uint32_t>(params_.height_px)));
   }
 
   std::string name() const override { return "V4L2 camera " + hk::one_line(spec_.path) + " (" + card_ + ")"; }
