@@ -196,7 +196,7 @@ const PictureNames& Stage::names() const {
 }
 
 ShownView Stage::view() const {
-  said_notes_ = notes_in(shown_.notes, audio_.messages().language());
+  said_notes_ = shown_notes();
   return {shown_.polylines,   shown_.descriptors, shown_.text_blocks, said_notes_,     half_,
           showing_tutorial(), source_.page > 0,   &names(),           &shown_.regions, shown_.px_to_m};
 }
@@ -227,28 +227,23 @@ PictureNotes Stage::shown_notes() const {
 
 PageText Stage::page_text() {
   PageText page;
-  page.language = shown_.text_language;
+  std::map<std::string, std::size_t> said_in;  // letters a language (OCR's), for a document that does not say
+  const auto add = [&](const std::string& text, const std::string& language) {
+    page.paragraphs.push_back(name_unclear_words(text, audio_.messages()));
+    said_in[language] += text.size();
+  };
   if (shown_.text_blocks.empty() && text_.pending() && text_.pending_id() == shown_id_) {
     // Its text still being read: the blocks read so far, more to come; the visitor hears them as they come,
     // so "The text is ready" is not said over them.
-    std::map<std::string, std::size_t> said_in;  // letters a language
-    for (const TextReader::Block& b : text_.blocks_so_far()) {
-      page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
-      said_in[b.language] += b.text.size();
-    }
-    if (page.language.empty()) page.language = most_of(said_in);
+    for (const TextReader::Block& b : text_.blocks_so_far()) add(b.text, b.language);
     page.complete = false;
     text_heard_early_ = true;
-    return page;
+  } else {
+    for (const TextBlockM& b : shown_.text_blocks) add(b.text, b.language);
+    if (const TextBlockM* b = text_block_at(shown_.text_blocks, step_.display().proxy_m))
+      page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
   }
-  std::map<std::string, std::size_t> said_in;
-  for (const TextBlockM& b : shown_.text_blocks) {
-    page.paragraphs.push_back(name_unclear_words(b.text, audio_.messages()));
-    said_in[b.language] += b.text.size();
-  }
-  if (page.language.empty()) page.language = most_of(said_in);  // the document does not say: what OCR read
-  if (const TextBlockM* b = text_block_at(shown_.text_blocks, step_.display().proxy_m))
-    page.at_hand = static_cast<int>(b - shown_.text_blocks.data());
+  page.language = shown_.text_language.empty() ? most_of(said_in) : shown_.text_language;
   return page;
 }
 
