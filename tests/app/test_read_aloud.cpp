@@ -62,6 +62,7 @@ struct Reader final : hk::test::EveryEffect {
     ++kept_count;
     piece = 0;
     brief_since = false;
+    voices.push_back("");
   }
   void say_brief(const std::string& t) override {
     said.push_back(t);
@@ -75,6 +76,11 @@ struct Reader final : hk::test::EveryEffect {
     return true;
   }
   std::uint64_t kept_texts() const override { return kept_count; }
+  std::vector<std::string> voices;  // the language of each text said with say_in, "" for say
+  void say_in(const std::string& t, int, const std::string& language, int) override {
+    say(t);
+    voices.back() = language;
+  }
   int heard_piece() const override { return piece; }
   bool heard_to_end() const override { return piece < 0 && !brief_since; }
   PageText page_text() override { return page; }
@@ -296,6 +302,18 @@ TEST(ReadAloud, AWaitingReadingIsDroppedWhenTheVisitorMovesOnAndSaysSoWhenThePag
   v.fx.page = {{}, -1, "", true};  // read whole: no text on it
   v.hear(-1);
   EXPECT_EQ(v.fx.said.back(), v.text(MessageId::reading_none));
+}
+
+TEST(ReadAloud, AReadingOnKeepsTheVoiceItBeganInWhateverLaterBlocksSeemToBe) {
+  Page v(-1);
+  const std::vector<std::string> all = page_paragraphs();
+  v.fx.page = {{all[0]}, -1, "de", false};  // OCR's guess from the first block: German
+  v.key(KioskKey::NextSentence);
+  ASSERT_EQ(v.fx.voices.back(), "de");
+  v.fx.page = {all, -1, "en", true};  // from the whole page, another guess
+  v.hear(-1);
+  EXPECT_EQ(v.fx.said.back(), ReadAloud(all).text_from({1, 0}));
+  EXPECT_EQ(v.fx.voices.back(), "de") << "one voice for the whole reading";
 }
 
 }  // namespace

@@ -164,7 +164,9 @@ void KioskFlow::read_more() {
   const bool first = v_.reading_waits;
   v_.reading_waits = false;
   v_.reading = ReadAloud(page.paragraphs);
-  v_.reading_language = other_language(page.language);
+  // One voice for the whole reading: the language the page had when the reading began (OCR's guess from more
+  // blocks may differ, and a page read half in one voice and half in another is worse than either).
+  if (first) v_.reading_language = other_language(page.language);
   v_.reading_complete = page.complete;
   read_from({next, 0}, first ? language_notice() : std::string());
 }
