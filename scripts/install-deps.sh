@@ -8,9 +8,9 @@ packages=(
   g++ cmake ninja-build pkg-config ccache
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-objdetect-dev libopencv-contrib-dev opencv-data
   libtomlplusplus-dev libcli11-dev libspdlog-dev nlohmann-json3-dev
-  libespeak-ng-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev gettext libboost-locale-dev
+  libespeak-ng-dev flite1-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev gettext libboost-locale-dev
   libglfw3-dev libimgui-dev libgl-dev
-  libpoppler-cpp-dev libtesseract-dev libleptonica-dev tesseract-ocr-eng libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev zlib1g-dev librsvg2-dev
+  libpoppler-cpp-dev libqpdf-dev libtesseract-dev libleptonica-dev tesseract-ocr-eng libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev zlib1g-dev librsvg2-dev
 )
 if [ "${1:-}" != "--demo" ]; then
   packages+=(

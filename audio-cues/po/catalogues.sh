@@ -6,8 +6,10 @@
 # The domains:
 #   haptic-kiosk        what visitors hear: NC_(key, text) and NPC_(key, one, many) in audio-cues/src/messages_en.cpp,
 #                       every entry a {placeholder} template (python-brace-format)
-#   haptic-kiosk-panel  the operator's panel: tr("…") in app/kiosk/src/operator_panel.cpp, N_("…") and each settings
-#                       field's help (HK_FIELD's 8th argument, HK_FIELD_IN's 9th) in config/src/fields.cpp
+#   haptic-kiosk-panel  the operator's panel: tr("…") in app/kiosk/src/operator_panel.cpp, tr("…") and
+#                       trn("one", "many", n) in app/visit/src/operator_session.cpp, N_("…") and each settings
+#                       field's help (HK_FIELD's 8th argument, HK_FIELD_IN's 9th) in config/src/fields.cpp, N_("…")
+#                       (device names) in config/src/device_profile.cpp
 # build fails, naming the file, when the committed PO_DIR/DOMAIN.pot is not what the English sources make, when a
 # catalogue lacks a message of the template or leaves one untranslated or fuzzy (msgcmp), or when a translation's
 # placeholders ({name}, or printf's %s) differ from the English text's (msgfmt --check).
@@ -19,7 +21,7 @@ make_pot() {  # DOMAIN OUT SOURCE...
   local keywords
   case "$domain" in
     haptic-kiosk) keywords=(--keyword=NC_:1c,2 --keyword=NPC_:1c,2,3) ;;
-    haptic-kiosk-panel) keywords=(--keyword=tr --keyword=N_ --keyword=HK_FIELD:8 --keyword=HK_FIELD_IN:9) ;;
+    haptic-kiosk-panel) keywords=(--keyword=tr --keyword=trn:1,2 --keyword=N_ --keyword=HK_FIELD:8 --keyword=HK_FIELD_IN:9) ;;
     *)
       echo "catalogues: unknown domain '$domain'" >&2
       exit 2

@@ -16,11 +16,14 @@ namespace {
 
 constexpr double kProfileRateHz = 1000.0;  // the rate the stiffness limits were measured at [Hz]
 
+// N_ marks a device's name for the operator panel's catalogue (xgettext --keyword=N_), where it is looked up.
+#define N_(text) text
+
 const std::vector<DeviceProfile> kProfiles = {
     //  type          name                          stable K  max F  pop   tour  groove step  K
-    {"simulated", "simulated pantograph", 3000.0, 3.5, 3.0, 1.2, 1.0, 0.05, 800.0},
+    {"simulated", N_("simulated pantograph"), 3000.0, 3.5, 3.0, 1.2, 1.0, 0.05, 800.0},
     {"haply", "Haply 2DIY gen3", 850.0, 1.5, 1.2, 0.5, 0.45, 0.02, 500.0},
-    {"haply-gen2", "original Haply 2DIY", 850.0, 1.45, 1.15, 0.5, 0.45, 0.02, 500.0},
+    {"haply-gen2", N_("original Haply 2DIY"), 850.0, 1.45, 1.15, 0.5, 0.45, 0.02, 500.0},
 };
 
 /// The original 2DIY's board in [device] (hAPI examples, hardwareVersion 2; Pantograph.java: coaxial
@@ -141,22 +144,18 @@ std::string profile_problem(const Settings& s, std::string_view type, std::strin
   return {};
 }
 
-std::string profile_limit_text(const Settings& s, std::string_view type, std::string_view table, std::string_view key) {
-  if (table != "haptics") return {};
-  const DeviceProfile& p = device_profile(type);
+std::optional<ProfileLimit> profile_limit(const Settings& s, std::string_view type, std::string_view table,
+                                          std::string_view key) {
+  if (table != "haptics") return std::nullopt;
+  const std::string device(device_profile(type).name);
+  const double rate_hz = s.haptics.servo_rate_hz;
   if (key == "max_force_n")
-    return "at most " + newtons(force_everywhere_n(s, type)) + " (what the " + std::string(p.name) +
-           " gives everywhere)";
-  if (key == "stiffness_n_per_m") {
-    char b[96];
-    std::snprintf(b, sizeof b, "at most %.0f N/m (stable on the %s at %.0f Hz)",
-                  stiffness_limit_n_per_m(type, s.haptics.servo_rate_hz), std::string(p.name).c_str(),
-                  s.haptics.servo_rate_hz);
-    return b;
-  }
+    return ProfileLimit{ProfileLimit::Kind::force_everywhere, force_everywhere_n(s, type), device, rate_hz};
+  if (key == "stiffness_n_per_m")
+    return ProfileLimit{ProfileLimit::Kind::stable_stiffness, stiffness_limit_n_per_m(type, rate_hz), device, rate_hz};
   if (key == "pop_force_n" || key == "tour_max_force_n" || key == "groove_depth_n")
-    return "at most max_force_n (" + newtons(s.haptics.max_force_n) + ")";
-  return {};
+    return ProfileLimit{ProfileLimit::Kind::within_max_force, s.haptics.max_force_n, device, rate_hz};
+  return std::nullopt;
 }
 
 Settings fit_to_profile(const Settings& s, std::string_view type, std::vector<std::string>* notes) {

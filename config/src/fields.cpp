@@ -551,6 +551,15 @@ std::span<const FieldDescriptor> field_descriptors() noexcept { return kFields; 
 
 std::string field_allowed_text(const FieldDescriptor& d) { return detail::allowed_text(d); }
 
+std::string field_choices_text(const FieldDescriptor& d) {
+  std::string s;
+  for (std::size_t i = 0; i < d.choices.size(); ++i) {
+    if (i) s += ", ";
+    s += detail::toml_string(d.choices[i]);
+  }
+  return s;
+}
+
 // N_ marks a word of the operator's panel for the translators' template (the panel catalogue, xgettext --keyword=N_);
 // the panel looks it up in the staff's language.
 #define N_(text) text
@@ -764,14 +773,7 @@ std::string qualified(const FieldDescriptor& d) {
 
 std::string allowed_text(const FieldDescriptor& d) {
   if (d.kind == FieldKind::text && d.check) return "text";
-  if (d.kind == FieldKind::text) {
-    std::string s = "one of ";
-    for (std::size_t i = 0; i < d.choices.size(); ++i) {
-      if (i) s += ", ";
-      s += toml_string(d.choices[i]);
-    }
-    return s;
-  }
+  if (d.kind == FieldKind::text) return "one of " + field_choices_text(d);
   std::string range = "[";  // appended piece by piece: "literal" + a temporary trips GCC 12's -Wrestrict (bug 105329)
   range += format_bound(d, d.min);
   range += ", ";

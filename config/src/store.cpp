@@ -354,6 +354,34 @@ std::string set_field_from_text(Settings& s, const FieldDescriptor& d, std::stri
   return {};
 }
 
+FieldRefusal field_refusal(const FieldDescriptor& d, std::string_view text) {
+  switch (d.kind) {
+    case FieldKind::real: {
+      const std::string_view t = trim(text);
+      bool overflow = false;
+      std::optional<double> v;
+      if (auto i = parse_integer(t, overflow)) v = static_cast<double>(*i);
+      if (!v) v = parse_real(t);
+      if (!v) return FieldRefusal::not_a_number;
+      return detail::real_problem(d, *v) ? FieldRefusal::out_of_range : FieldRefusal::none;
+    }
+    case FieldKind::integer: {
+      const std::string_view t = trim(text);
+      bool overflow = false;
+      const std::optional<long long> v = parse_integer(t, overflow);
+      if (!v)
+        return overflow        ? FieldRefusal::out_of_range
+               : parse_real(t) ? FieldRefusal::not_an_integer
+                               : FieldRefusal::not_a_number;
+      return detail::integer_problem(d, *v) ? FieldRefusal::out_of_range : FieldRefusal::none;
+    }
+    case FieldKind::text:
+      if (!detail::text_problem(d, text)) return FieldRefusal::none;
+      return d.check ? FieldRefusal::other : FieldRefusal::not_a_choice;
+  }
+  return FieldRefusal::other;
+}
+
 std::string field_text(const Settings& s, const FieldDescriptor& d) {
   return std::visit(
       [](auto* p) -> std::string {

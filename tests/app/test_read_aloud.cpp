@@ -307,8 +307,10 @@ TEST(ReadAloud, AWaitingReadingIsDroppedWhenTheVisitorMovesOnAndSaysSoWhenThePag
 TEST(ReadAloud, AReadingOnKeepsTheVoiceItBeganInWhateverLaterBlocksSeemToBe) {
   Page v(-1);
   const std::vector<std::string> all = page_paragraphs();
-  v.fx.page = {{all[0]}, -1, "de", false};  // OCR's guess from the first block: German
+  v.fx.page = {{}, -1, "", false};  // asked for before any block is read
   v.key(KioskKey::NextSentence);
+  v.fx.page = {{all[0]}, -1, "de", false};  // OCR's guess from the first block: German
+  v.hear(-1);
   ASSERT_EQ(v.fx.voices.back(), "de");
   v.fx.page = {all, -1, "en", true};  // from the whole page, another guess
   v.hear(-1);

@@ -125,12 +125,22 @@ TEST(DeviceProfile, SettingsBeyondTheProfileAreRefusedWithTheLimitNamed) {
 
 TEST(DeviceProfile, TheOperatorsPanelShowsEachLimit) {
   const Settings s = profile_defaults("haply");
-  EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "max_force_n"),
-            "at most 1.65 N (what the Haply 2DIY gen3 gives everywhere)");
-  EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "stiffness_n_per_m"),
-            "at most 850 N/m (stable on the Haply 2DIY gen3 at 1000 Hz)");
-  EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "pop_force_n"), "at most max_force_n (1.50 N)");
-  EXPECT_EQ(profile_limit_text(s, "haply", "haptics", "pop_hold_s"), "");
+  const std::optional<ProfileLimit> force = profile_limit(s, "haply", "haptics", "max_force_n");
+  ASSERT_TRUE(force);
+  EXPECT_EQ(force->kind, ProfileLimit::Kind::force_everywhere);
+  EXPECT_NEAR(force->value, force_everywhere_n(s, "haply"), 1e-12);
+  EXPECT_NEAR(force->value, 1.65, 0.005);
+  EXPECT_EQ(force->device, "Haply 2DIY gen3");
+  const std::optional<ProfileLimit> k = profile_limit(s, "haply", "haptics", "stiffness_n_per_m");
+  ASSERT_TRUE(k);
+  EXPECT_EQ(k->kind, ProfileLimit::Kind::stable_stiffness);
+  EXPECT_DOUBLE_EQ(k->value, 850.0);
+  EXPECT_DOUBLE_EQ(k->servo_rate_hz, 1000.0);
+  const std::optional<ProfileLimit> pop = profile_limit(s, "haply", "haptics", "pop_force_n");
+  ASSERT_TRUE(pop);
+  EXPECT_EQ(pop->kind, ProfileLimit::Kind::within_max_force);
+  EXPECT_DOUBLE_EQ(pop->value, s.haptics.max_force_n);
+  EXPECT_FALSE(profile_limit(s, "haply", "haptics", "pop_hold_s"));
 }
 
 TEST(DeviceProfile, AnAutoKioskThatTakesABoardMovesIntoItsProfile) {

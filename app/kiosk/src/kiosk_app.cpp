@@ -241,19 +241,6 @@ void show_first(const std::string& path, KioskRuntime& rt, KioskFlow& flow) {
   for (int i = 0; i < idx; ++i) flow.key(KioskKey::Next, 0.0);
 }
 
-/// One line saying what took effect, for the operator's panel.
-std::string describe_apply(const ApplyReport& r) {
-  std::string s = "Applied";
-  if (r.gains) s += "; forces changing now";
-  if (r.scene_rebuilt) s += "; scene rebuilt";
-  if (r.keys) s += "; keys changed";
-  if (r.timing) s += "; session timing changed";
-  if (!r.next_session.empty()) s += "; " + std::to_string(r.next_session.size()) + " for the next visitor";
-  if (!r.restart.empty()) s += "; " + std::to_string(r.restart.size()) + " after a restart";
-  for (const std::string& why : r.refused) s += "; refused: " + why;
-  return s + ".";
-}
-
 /// The runtime's options from the command line and the settings in use.
 RuntimeOptions runtime_options(const KioskOptions& o, const config::Settings& settings) {
   RuntimeOptions ro;
@@ -336,7 +323,7 @@ int run_kiosk(const KioskOptions& o) {
   OperatorSession session(o.config_path, start.settings, start.notice, [&](const config::Settings& s) {
     const ApplyReport r = rt.apply_settings(s, flow);
     if (kiosk_ptr) kiosk_ptr->keys_changed();  // the visitor's keys, and the operator's chord
-    return describe_apply(r);
+    return r;
   });
   OperatorPanel panel(session);
   Kiosk kiosk(o, rt, flow, session, panel, window);

@@ -45,6 +45,19 @@ constexpr config::FieldGroup kTabs[] = {
 
 }  // namespace
 
+std::string OperatorPanel::profile_limit_line(const config::ProfileLimit& limit) const {
+  switch (limit.kind) {
+    case config::ProfileLimit::Kind::force_everywhere:
+      return format(tr("at most %.2f N (what the %s gives everywhere)"), limit.value, tr(limit.device.c_str()));
+    case config::ProfileLimit::Kind::stable_stiffness:
+      return format(tr("at most %.0f N/m (stable on the %s at %.0f Hz)"), limit.value, tr(limit.device.c_str()),
+                    limit.servo_rate_hz);
+    case config::ProfileLimit::Kind::within_max_force:
+      return format(tr("at most max_force_n (%.2f N)"), limit.value);
+  }
+  return {};
+}
+
 void OperatorPanel::record(const std::string& name) {
   const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
   drawing_[name] = WidgetRect{a.x, a.y, b.x, b.y};
@@ -59,8 +72,7 @@ std::optional<WidgetRect> OperatorPanel::widget(const std::string& name) const {
 void OperatorPanel::draw(KioskRuntime& runtime, const KioskFlow& flow, int fw, int fh, double now_s,
                          std::int64_t now_unix_s) {
   drawing_.clear();
-  if (runtime.settings().operator_.language != text_.asked())
-    text_ = PanelText::load(runtime.settings().operator_.language, audio::default_locale_dir());
+  s_.set_language(runtime.settings().operator_.language, audio::default_locale_dir());
   sample_plot(runtime);
   switch (s_.state()) {
     case PanelState::closed:
@@ -190,7 +202,7 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
     ImGui::TableNextRow();
     ImGui::TableNextColumn();
     // The setting in staff words, its key small and grey beside it for those who edit the file, then its help.
-    const std::string help = text_(d.help);  // in the staff's language
+    const std::string help = s_.words()(d.help);  // in the staff's language
     ImGui::TextUnformatted(config::field_label(help, key).c_str());
     ImGui::SameLine();
     ImGui::SetWindowFontScale(0.8f);
@@ -218,11 +230,14 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
     } else if (d.kind == config::FieldKind::text && d.check) {
       ImGui::TextWrapped("%s", tr("text"));
     } else {
-      ImGui::TextWrapped("%s", config::field_allowed_text(d).c_str());
-      const std::string limit = config::profile_limit_text(s_.working(), profile_type, d.table, d.key);
-      if (!limit.empty()) {
+      if (d.kind == config::FieldKind::text)
+        ImGui::TextWrapped(tr("one of %s"), config::field_choices_text(d).c_str());
+      else
+        ImGui::TextWrapped("%s", config::field_allowed_text(d).c_str());
+      if (const std::optional<config::ProfileLimit> limit =
+              config::profile_limit(s_.working(), profile_type, d.table, d.key)) {
         ImGui::PushStyleColor(ImGuiCol_Text, kOrange);
-        ImGui::TextWrapped("%s", limit.c_str());
+        ImGui::TextWrapped("%s", profile_limit_line(*limit).c_str());
         ImGui::PopStyleColor();
       }
     }
@@ -318,7 +333,7 @@ void OperatorPanel::draw_device(KioskRuntime& runtime, std::int64_t now_unix_s) 
   }
   const double can_n = io::min_force_capability_n(usb->params());
   ImGui::Text(tr("%s profile: it gives at least %.2f N in every direction everywhere in its rectangle."),
-              std::string(config::device_profile(profile_type(runtime)).name).c_str(), can_n);
+              tr(std::string(config::device_profile(profile_type(runtime)).name).c_str()), can_n);
   if (!runtime.devices().home_note().empty()) ImGui::TextColored(kOrange, "%s", runtime.devices().home_note().c_str());
   if (ImGui::Button((std::string(tr("Calibrate: the handle rests at the park place")) + "###calibrate").c_str())) {
     double o1 = 0, o2 = 0;

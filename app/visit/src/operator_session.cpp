@@ -1,3 +1,5 @@
+// The operator's panel's logic (operator_session.hpp). Every line it shows is a tr("…") / trn("…") template in the
+// panel's catalogue (app/kiosk/po); the audit log and the journal stay English.
 #include "visit/operator_session.hpp"
 
 #include <spdlog/spdlog.h>
@@ -13,12 +15,6 @@ namespace hk::app {
 namespace {
 
 constexpr double kNoticeS = 8.0;  // a notice stays this long [s]
-
-std::string wait_text(double wait_s) {
-  if (std::isinf(wait_s))
-    return "The PIN is locked after too many failed attempts: set it again with 'haptic-kiosk pin set'.";
-  return "Try again in " + std::to_string(static_cast<long long>(std::ceil(wait_s))) + " s.";
-}
 
 }  // namespace
 
@@ -40,6 +36,52 @@ OperatorSession::OperatorSession(std::string settings_path, const config::Settin
 
 OperatorSession::~OperatorSession() = default;
 
+void OperatorSession::set_language(const std::string& language, const std::filesystem::path& locale_dir) {
+  if (language != words_.asked()) words_ = PanelText::load(language, locale_dir);
+}
+
+std::string OperatorSession::prompt_line(double wait_s) const {
+  if (std::isinf(wait_s))
+    return tr("The PIN is locked after too many failed attempts: set it again with 'haptic-kiosk pin set'.");
+  if (wait_s <= 0) return tr("Enter the operator's PIN, then Enter.");
+  const long long s = static_cast<long long>(std::ceil(wait_s));
+  return format(trn("Try again in %lld second.", "Try again in %lld seconds.", s), s);
+}
+
+std::string OperatorSession::refusal_line(const config::FieldDescriptor& d, const std::string& typed,
+                                          const std::string& loader_line) const {
+  const std::string allowed = config::field_allowed_text(d);
+  const std::string t = typed.size() > 80 ? typed.substr(0, 80) + "..." : typed;
+  switch (config::field_refusal(d, typed)) {
+    case config::FieldRefusal::not_a_number:
+      return format(tr("\"%s\" is not a number; allowed: %s"), t.c_str(), allowed.c_str());
+    case config::FieldRefusal::not_an_integer:
+      return format(tr("%s is not a whole number; allowed: %s"), t.c_str(), allowed.c_str());
+    case config::FieldRefusal::out_of_range:
+      return format(tr("%s is out of range %s"), t.c_str(), allowed.c_str());
+    case config::FieldRefusal::not_a_choice:
+      return format(tr("\"%s\" is not one of the choices: %s"), t.c_str(), config::field_choices_text(d).c_str());
+    case config::FieldRefusal::none:   // a rule across fields
+    case config::FieldRefusal::other:  // the field's own check, which says why in English
+      break;
+  }
+  return loader_line;
+}
+
+std::string OperatorSession::applied_line(const ApplyReport& r) const {
+  std::string s = tr("Applied");
+  const auto part = [&s](const std::string& p) { s += "; " + p; };
+  if (r.gains) part(tr("forces changing now"));
+  if (r.scene_rebuilt) part(tr("scene rebuilt"));
+  if (r.keys) part(tr("keys changed"));
+  if (r.timing) part(tr("session timing changed"));
+  const long next = static_cast<long>(r.next_session.size()), restart = static_cast<long>(r.restart.size());
+  if (next > 0) part(format(trn("%ld setting for the next visitor", "%ld settings for the next visitor", next), next));
+  if (restart > 0) part(format(trn("%ld setting after a restart", "%ld settings after a restart", restart), restart));
+  for (const std::string& why : r.refused) part(format(tr("refused: %s"), why.c_str()));
+  return s + ".";
+}
+
 std::size_t OperatorSession::index_of(const config::FieldDescriptor& d) const {
   return static_cast<std::size_t>(&d - config::field_descriptors().data());
 }
@@ -60,8 +102,8 @@ void OperatorSession::chord(double now_s, std::int64_t now_unix_s) {
     state_ = PanelState::notice;
     notice_until_s_ = now_s + kNoticeS;
     message_ =
-        "The kiosk runs on its built-in settings: start it with --config FILE, and set a PIN with 'haptic-kiosk pin "
-        "set --config FILE'.";
+        tr("The kiosk runs on its built-in settings: start it with --config FILE, and set a PIN with 'haptic-kiosk "
+           "pin set --config FILE'.");
     spdlog::warn("operator panel: {}", message_);
     return;
   }
@@ -78,14 +120,15 @@ void OperatorSession::chord(double now_s, std::int64_t now_unix_s) {
   if (st.verdict == config::PinVerdict::no_pin) {
     state_ = PanelState::notice;
     notice_until_s_ = now_s + kNoticeS;
-    message_ = "No operator PIN is set. Set one with: haptic-kiosk pin set --config " + files_.settings_path;
+    message_ = format(tr("No operator PIN is set. Set one with: haptic-kiosk pin set --config %s"),
+                      files_.settings_path.c_str());
     spdlog::warn("operator panel: {}", message_);
     return;
   }
   state_ = PanelState::pin_entry;
   wait_s_ = st.verdict == config::PinVerdict::locked ? st.wait_s : 0.0;
   notice_until_s_ = now_s + wait_s_;  // when the wait ends (frame clock)
-  message_ = wait_s_ > 0 ? wait_text(wait_s_) : "Enter the operator's PIN, then Enter.";
+  message_ = prompt_line(wait_s_);
 }
 
 void OperatorSession::submit_pin(std::string pin, double now_s, std::int64_t now_unix_s) {
@@ -96,7 +139,7 @@ void OperatorSession::submit_pin(std::string pin, double now_s, std::int64_t now
   }
   if (verifier_->submit(std::move(pin), now_unix_s)) {
     state_ = PanelState::checking;
-    message_ = "Checking...";
+    message_ = tr("Checking...");
   }
 }
 
@@ -104,7 +147,7 @@ void OperatorSession::tick(double now_s, std::int64_t now_unix_s) {
   if (state_ == PanelState::notice && now_s >= notice_until_s_) state_ = PanelState::closed;
   if (state_ == PanelState::pin_entry && wait_s_ > 0) {
     wait_s_ = std::isinf(wait_s_) ? wait_s_ : std::max(0.0, notice_until_s_ - now_s);
-    message_ = wait_s_ > 0 ? wait_text(wait_s_) : "Enter the operator's PIN, then Enter.";
+    message_ = prompt_line(wait_s_);
   }
   if (state_ == PanelState::checking && verifier_) {
     if (std::optional<PinOutcome> o = verifier_->poll()) {
@@ -119,18 +162,21 @@ void OperatorSession::tick(double now_s, std::int64_t now_unix_s) {
             open_panel(now_s, now_unix_s);
             return;
           case config::PinVerdict::wrong:
-            message_ = "Wrong PIN (" + std::to_string(o->attempt.failures) + " failed attempts).";
-            if (o->attempt.wait_s > 0) message_ += " " + wait_text(o->attempt.wait_s);
+            message_ =
+                format(trn("Wrong PIN (%d failed attempt).", "Wrong PIN (%d failed attempts).", o->attempt.failures),
+                       o->attempt.failures);
+            if (o->attempt.wait_s > 0) message_ += " " + prompt_line(o->attempt.wait_s);
             spdlog::warn("operator panel: a wrong PIN ({} failed attempts)", o->attempt.failures);
             audit_event(now_unix_s, "PIN refused, " + std::to_string(o->attempt.failures) + " failed attempts");
             break;
           case config::PinVerdict::locked:
-            message_ = wait_text(o->attempt.wait_s);
+            message_ = prompt_line(o->attempt.wait_s);
             break;
           case config::PinVerdict::no_pin:
             state_ = PanelState::notice;
             notice_until_s_ = now_s + kNoticeS;
-            message_ = "No operator PIN is set. Set one with: haptic-kiosk pin set --config " + files_.settings_path;
+            message_ = format(tr("No operator PIN is set. Set one with: haptic-kiosk pin set --config %s"),
+                              files_.settings_path.c_str());
             return;
         }
         wait_s_ = o->attempt.wait_s;
@@ -177,16 +223,19 @@ const std::string& OperatorSession::field_error(const config::FieldDescriptor& d
 
 std::string OperatorSession::commit_field(const config::FieldDescriptor& d, std::int64_t) {
   const std::size_t i = index_of(d);
-  std::string why = config::set_field_from_text(working_, d, edit_texts_[i]);
-  field_errors_[i] = why;
-  if (why.empty()) edit_texts_[i] = config::field_text(working_, d);
-  return why;
+  const std::string loader_line = config::set_field_from_text(working_, d, edit_texts_[i]);
+  if (loader_line.empty()) {
+    field_errors_[i].clear();
+    edit_texts_[i] = config::field_text(working_, d);
+    return {};
+  }
+  return field_errors_[i] = refusal_line(d, edit_texts_[i], loader_line);
 }
 
 std::string OperatorSession::apply(std::int64_t now_unix_s) {
   const std::vector<config::SettingChange> changes = config::diff_settings(in_use_, working_);
-  if (changes.empty()) return status_ = "Nothing to apply.";
-  status_ = apply_fn_ ? apply_fn_(working_) : std::string("Applied.");
+  if (changes.empty()) return status_ = tr("Nothing to apply.");
+  status_ = applied_line(apply_fn_ ? apply_fn_(working_) : ApplyReport{});
   in_use_ = working_;
   if (!files_.audit_path.empty()) {
     try {
@@ -212,14 +261,14 @@ std::string OperatorSession::save(std::int64_t now_unix_s) {
     }
     config::save_settings_atomic(to_save, files_.settings_path);
   } catch (const std::exception& e) {
-    status_ = std::string("Not saved: ") + e.what();
+    status_ = format(tr("Not saved: %s"), e.what());
     spdlog::error("operator panel: {}", e.what());
     return status_;
   }
   in_use_.operator_.pin_hash = to_save.operator_.pin_hash;
   working_.operator_.pin_hash = to_save.operator_.pin_hash;
   saved_ = in_use_;
-  status_ = "Saved to " + files_.settings_path + " (the previous file kept as .bak).";
+  status_ = format(tr("Saved to %s (the previous file kept as .bak)."), files_.settings_path.c_str());
   spdlog::info("operator panel: saved {}", files_.settings_path);
   audit_event(now_unix_s, "saved " + files_.settings_path);
   return status_;
@@ -234,7 +283,7 @@ void OperatorSession::reset_to_defaults(std::int64_t now_unix_s) {
     edit_texts_[i] = config::field_text(working_, fields[i]);
     field_errors_[i].clear();
   }
-  status_ = "Defaults restored in the panel: Apply to use them, Save to keep them.";
+  status_ = tr("Defaults restored in the panel: Apply to use them, Save to keep them.");
   audit_event(now_unix_s, "reset to defaults (not applied yet)");
 }
 

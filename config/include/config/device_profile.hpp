@@ -27,6 +27,7 @@
 /// "auto" loads with the simulated profile; when the kiosk takes a USB board, `fit_to_profile` moves
 /// the settings into the board's profile.
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -86,10 +87,24 @@ bool home_park_place(const Settings& s, double* x_m, double* y_m);
 /// `*key` when not null.
 std::string profile_problem(const Settings& s, std::string_view type, std::string* key = nullptr);
 
-/// What the profile in force allows for the field `table.key` as the operator's panel shows it beside
-/// the field ("at most 1.65 N (what the Haply 2DIY gen3 gives everywhere)"); empty for fields the profile
-/// does not bound.
-std::string profile_limit_text(const Settings& s, std::string_view type, std::string_view table, std::string_view key);
+/// What the profile in force allows for one field, as the operator's panel shows it beside the field (in the
+/// staff's words: "at most 1.65 N (what the Haply 2DIY gen3 gives everywhere)").
+struct ProfileLimit {
+  enum class Kind {
+    force_everywhere,  ///< haptics.max_force_n: at most `value` [N], what `device` gives everywhere in its rectangle
+    stable_stiffness,  ///< haptics.stiffness_n_per_m: at most `value` [N/m], stable on `device` at `servo_rate_hz`
+    within_max_force,  ///< pop_force_n, tour_max_force_n, groove_depth_n: at most haptics.max_force_n = `value` [N]
+  };
+  Kind kind = Kind::force_everywhere;
+  double value = 0;          ///< the limit [N] or [N/m]
+  std::string device;        ///< the profile's device name ("Haply 2DIY gen3")
+  double servo_rate_hz = 0;  ///< the servo rate the stiffness limit holds at [Hz]
+};
+
+/// The limit the profile of `type`'s device sets on field `table.key` with settings `s`; none for fields the
+/// profile does not bound.
+std::optional<ProfileLimit> profile_limit(const Settings& s, std::string_view type, std::string_view table,
+                                          std::string_view key);
 
 /// The settings a kiosk in "auto" runs with once it has taken a board of `type`: every force-budget field
 /// still at the simulated profile's value takes `type`'s (the operator never chose it), and a field the

@@ -101,6 +101,8 @@ struct FieldDescriptor {
 
 /// What `d` allows, as the loader's messages say it: "[10, 5000] N/m", "one of \"auto\", \"fixed\"", "text".
 [[nodiscard]] std::string field_allowed_text(const FieldDescriptor& d);
+/// A text field's choices as TOML strings joined by ", " ("\"auto\", \"fixed\""); empty for a field without.
+[[nodiscard]] std::string field_choices_text(const FieldDescriptor& d);
 
 /// The field's name in staff words, for the operator's panel: its help's first phrase (up to the first full stop,
 /// colon, semicolon, comma or opening parenthesis, and before another setting's key), at most kMaxFieldLabelBytes

@@ -97,6 +97,21 @@ void append_audit_event(const std::string& log_path, std::int64_t unix_s, std::s
 ///   in [10, 5000] N/m"; `s` is then unchanged.
 [[nodiscard]] std::string set_field_from_text(Settings& s, const FieldDescriptor& d, std::string_view text);
 
+/// Why a text typed for one field is refused on its own, before the rules across fields: what the panel says
+/// in the staff's words (the loader's message stays English).
+enum class FieldRefusal {
+  none,            ///< the text is a value `d` allows (a rule across fields may still refuse it)
+  not_a_number,    ///< a real or integer field given no number
+  not_an_integer,  ///< an integer field given a fraction or exponent
+  out_of_range,    ///< a number outside [min, max] (inf and nan included)
+  not_a_choice,    ///< a text field with choices given none of them
+  other,           ///< a text field's own check refused it (its message says why)
+};
+
+/// How `text` (spaces and tabs around it ignored, as set_field_from_text reads it) is refused as field `d`'s
+/// value on its own; FieldRefusal::none when set_field_from_text would take it but for the cross-field rules.
+[[nodiscard]] FieldRefusal field_refusal(const FieldDescriptor& d, std::string_view text);
+
 /// The value of field `d` in `s` as the panel shows it for editing: reals in the shortest text that
 /// reads back exactly, plain decimal where that is short ("800", "0.0005", "5e-324"), integers in
 /// decimal, text as is (no quotes). set_field_from_text() of this text gives back the same value.

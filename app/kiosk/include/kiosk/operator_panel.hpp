@@ -27,7 +27,7 @@
 #include <optional>
 #include <string>
 
-#include "kiosk/panel_text.hpp"
+#include "config/device_profile.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
 #include "visit/names_editor.hpp"
@@ -70,11 +70,12 @@ class OperatorPanel {
   void draw_name_list();
   void sample_plot(KioskRuntime& runtime);
   void record(const std::string& name);
-  /// `english` in the staff's language (PanelText; the panel catalogue's template takes every tr("…")).
-  const char* tr(const char* english) const { return text_(english); }
+  /// `english` in the staff's language (the session's PanelText; the panel catalogue's template takes every tr("…")).
+  const char* tr(const char* english) const { return s_.words()(english); }
+  /// What the device profile allows for a field, in the staff's words.
+  std::string profile_limit_line(const config::ProfileLimit& limit) const;
 
   OperatorSession& s_;
-  PanelText text_;              // the words in [operator] language, loaded again when it changes
   std::string pin_;             // the PIN being typed (wiped at submit and close)
   std::string calibrate_note_;  // what the last Calibrate did
   bool focus_pin_ = false;

@@ -34,6 +34,7 @@
 #include "visit/display_switches.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/library_desk.hpp"
+#include "visit/operator_session.hpp"
 #include "visit/stage.hpp"
 #include "visit/stick_desk.hpp"
 #include "visit/tour_desk.hpp"
@@ -62,18 +63,6 @@ struct RuntimeOptions {
   /// Look for a camera when [camera] source is "auto" (list_cameras); false: "auto" means no camera (scripted
   /// runs, tests). A source named in the settings ("file:...", "libcamera:N", "v4l2:DEV") is used either way.
   bool probe_camera = false;
-};
-
-/// What apply_settings did with a change, for the operator panel and the audit.
-struct ApplyReport {
-  bool gains = false;                     ///< stiffness, damping, force, friction or deadline went to the servo thread
-  bool scene_rebuilt = false;             ///< the scene was rebuilt and swapped in with the fade
-  bool keys = false;                      ///< the visitor's keys (and what the kiosk says of them) changed
-  bool timing = false;                    ///< the session's time-out changed
-  std::vector<std::string> next_session;  ///< keys (table.key) that take effect with the next visitor
-  std::vector<std::string> restart;       ///< keys that take effect at the next start
-  std::vector<std::string> refused;  ///< values the device's profile refused, each "<table.key> = <value> <why>; ..."
-                                     ///< (the profile's value is used)
 };
 
 /// The kiosk without its window. Not thread-safe: one thread.

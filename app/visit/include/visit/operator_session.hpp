@@ -12,6 +12,7 @@
 /// the lockout and the audit, which outlive the process. Not thread-safe: the window thread.
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -20,6 +21,7 @@
 
 #include "config/load.hpp"
 #include "config/settings.hpp"
+#include "visit/panel_text.hpp"
 
 namespace hk::app {
 
@@ -46,11 +48,23 @@ struct SessionFiles {
   std::string load_notice;    ///< what start-up found wrong with the settings file; empty when it loaded
 };
 
+/// What apply_settings did with a change, for the operator panel and the audit.
+struct ApplyReport {
+  bool gains = false;                     ///< stiffness, damping, force, friction or deadline went to the servo thread
+  bool scene_rebuilt = false;             ///< the scene was rebuilt and swapped in with the fade
+  bool keys = false;                      ///< the visitor's keys (and what the kiosk says of them) changed
+  bool timing = false;                    ///< the session's time-out changed
+  std::vector<std::string> next_session;  ///< keys (table.key) that take effect with the next visitor
+  std::vector<std::string> restart;       ///< keys that take effect at the next start
+  std::vector<std::string> refused;  ///< values the device's profile refused, each "<table.key> = <value> <why>; ..."
+                                     ///< (the profile's value is used)
+};
+
 /// The operator's panel's state and actions.
 class OperatorSession {
  public:
-  /// Called by apply() with the working copy; returns one line saying what took effect (for the panel).
-  using ApplyFn = std::function<std::string(const config::Settings&)>;
+  /// Called by apply() with the working copy; says what took effect (the session makes the panel's line of it).
+  using ApplyFn = std::function<ApplyReport(const config::Settings&)>;
 
   /// `settings_path`: the settings file (empty: the kiosk runs on defaults and the panel cannot open).
   /// `in_use`: the settings the kiosk runs with. `load_notice`: what start-up found wrong with the file
@@ -73,6 +87,13 @@ class OperatorSession {
   /// applied stays applied.
   void close(std::int64_t now_unix_s);
 
+  /// The panel's words in `language` ([operator] language, a BCP 47 tag) from `locale_dir` (PanelText::load),
+  /// read again only when the language changes. Every line composed after this is in that language; the audit
+  /// log and the journal stay English.
+  void set_language(const std::string& language, const std::filesystem::path& locale_dir);
+  /// The panel's words in the staff's language.
+  const PanelText& words() const { return words_; }
+
   PanelState state() const { return state_; }
   /// The line shown under the PIN prompt or as the notice ("Wrong PIN. 2 failed attempts.", "Try again in 27 s.").
   const std::string& message() const { return message_; }
@@ -84,8 +105,9 @@ class OperatorSession {
   const config::Settings& working() const { return working_; }
   /// The text in a field's edit box (what the operator typed, refused or not).
   std::string& edit_text(const config::FieldDescriptor& d);
-  /// Commits a field's edit box to the working copy: empty on success, else the loader's one-line message
-  /// (also kept as field_error(d) and shown beside the field).
+  /// Commits a field's edit box to the working copy: empty on success, else one line saying why not (also kept
+  /// as field_error(d) and shown beside the field): in the staff's words for a value that is no number, no whole
+  /// number, out of range or no allowed choice (config::field_refusal), else the loader's own message.
   std::string commit_field(const config::FieldDescriptor& d, std::int64_t now_unix_s);
   /// The refusal of a field's last edit, empty when none.
   const std::string& field_error(const config::FieldDescriptor& d) const;
@@ -111,9 +133,19 @@ class OperatorSession {
   void open_panel(double now_s, std::int64_t now_unix_s);
   void audit_event(std::int64_t now_unix_s, const std::string& event);
   std::size_t index_of(const config::FieldDescriptor& d) const;
+  /// The PIN prompt's line while a wait of `wait_s` [s] holds (infinite: locked until `pin set`), else the prompt.
+  std::string prompt_line(double wait_s) const;
+  /// What a refused edit `typed` of `d` says; `loader_line` when it is none of the refusals put in staff words.
+  std::string refusal_line(const config::FieldDescriptor& d, const std::string& typed,
+                           const std::string& loader_line) const;
+  /// One line of what `r` took effect as.
+  std::string applied_line(const ApplyReport& r) const;
+  const char* tr(const char* english) const { return words_(english); }
+  const char* trn(const char* one, const char* many, long n) const { return words_(one, many, n); }
 
   SessionFiles files_;
   ApplyFn apply_fn_;
+  PanelText words_;
   std::unique_ptr<PinVerifier> verifier_;
   PanelState state_ = PanelState::closed;
   double last_input_s_ = 0, notice_until_s_ = 0;

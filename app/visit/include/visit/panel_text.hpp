@@ -5,7 +5,12 @@
 /// the gettext domain haptic-kiosk-panel, compiled from app/kiosk/po/LANG.po into LOCALE/LANG/LC_MESSAGES/
 /// haptic-kiosk-panel.mo (audio::MoCatalogue: Boost.Locale, no system locale). English needs no file: a language
 /// without a panel catalogue, or one that cannot be read, is English with one log line.
+///
+/// The lines the operator session composes (the PIN prompt, the lockout, Apply's and Save's status, a refused
+/// value) are printf templates marked tr("…") or trn("…", "…", n) in operator_session.cpp: msgfmt --check holds
+/// each translation to the English template's conversions, so format() can hand them the same arguments.
 
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -32,6 +37,8 @@ class PanelText {
   const char* operator()(const char* english) const;
   /// The same for a text that is not NUL-terminated where it ends (a field's help).
   std::string operator()(std::string_view english) const;
+  /// The plural entry `one` / `many` in the form for `n` (the catalogue's Plural-Forms; English: `one` for 1).
+  const char* operator()(const char* one, const char* many, long n) const;
   /// The language asked for, as given to load() ("en" for the default).
   const std::string& asked() const { return asked_; }
   /// The language the words are in: the catalogue's, or "en".
@@ -41,5 +48,17 @@ class PanelText {
   std::string asked_ = "en";
   std::optional<audio::MoCatalogue> mo_;
 };
+
+/// `tmpl` (a printf template: a translated tr("…") whose conversions msgfmt --check matched to the English one's)
+/// filled in with `args`.
+template <typename... Args>
+std::string format(const char* tmpl, Args... args) {
+  const int n = std::snprintf(nullptr, 0, tmpl, args...);
+  if (n <= 0) return {};
+  std::string out(static_cast<std::size_t>(n) + 1, '\0');
+  std::snprintf(out.data(), out.size(), tmpl, args...);
+  out.pop_back();
+  return out;
+}
 
 }  // namespace hk::app

@@ -1,7 +1,9 @@
 // The operator panel's words in the staff's language (panel_text.hpp).
-#include "kiosk/panel_text.hpp"
+#include "visit/panel_text.hpp"
 
 #include <spdlog/spdlog.h>
+
+#include <algorithm>
 
 namespace hk::app {
 
@@ -25,6 +27,17 @@ const char* PanelText::operator()(const char* english) const {
     const char* t = mo_->get(nullptr, english);
     return t && *t ? t : english;
   } catch (const std::exception&) {  // a damaged file: its words stay English
+    return english;
+  }
+}
+
+const char* PanelText::operator()(const char* one, const char* many, long n) const {
+  const char* english = n == 1 ? one : many;
+  if (!mo_) return english;
+  try {
+    const char* t = mo_->get(nullptr, one, static_cast<int>(std::clamp(n, -1000000L, 1000000L)));
+    return t && *t ? t : english;
+  } catch (const std::exception&) {
     return english;
   }
 }

@@ -1,4 +1,4 @@
-// The operator panel in the staff's language (kiosk/panel_text.hpp): the French catalogue built from
+// The operator panel in the staff's language (visit/panel_text.hpp): the French catalogue built from
 // app/kiosk/po/fr.po gives every word of the panel's template, each setting's help included, so that its label
 // (config::field_label, the help's first phrase) is French too; a language without a panel catalogue, and a
 // damaged catalogue file, leave the panel in English.
@@ -13,7 +13,7 @@
 
 #include "audio/messages.hpp"
 #include "config/load.hpp"
-#include "kiosk/panel_text.hpp"
+#include "visit/panel_text.hpp"
 
 namespace fs = std::filesystem;
 
