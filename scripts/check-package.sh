@@ -44,6 +44,14 @@ else
   failed+=("the file list differs from packaging/expected-files.txt (diff above)")
 fi
 
+# 2b. The data and voices of every language offered: Tesseract's per language, CMU Flite's English voices.
+depends="$(dpkg-deb -f "$deb" Depends)"
+for p in tesseract-ocr-eng tesseract-ocr-fra tesseract-ocr-deu tesseract-ocr-spa libflite1; do
+  if ! grep -qE "(^|, )$p( |,|$)" <<<"$depends"; then
+    failed+=("Depends lacks $p (Depends: $depends)")
+  fi
+done
+
 # 3. The unit, as extracted from the package. systemd-analyze verify needs no running systemd (it loads
 # the unit offline) but wants ExecStart's program, /usr/bin/cage, to exist on this machine (install-deps
 # installs it); man pages are not looked up (the package's own is not installed here).
