@@ -49,6 +49,7 @@ taskset -c 1 "$b/bench_scene_build" --benchmark_min_time=$(awk "BEGIN { print $m
 "$b/bench_decode" > "$out/decode.md"  # a picture file's decode, full and as the scene build does it (reduced JPEG), and the scene after it
 "$b/bench_next_picture" --out "$out/next_picture.md" > /dev/null  # Next pressed -> first servo tick on the new scene: cold, prefetched, cached; tests/data pictures, 24/12 MP JPEGs, 13 MP PNGs, a 51-page PDF
 "$b/bench_meaning_cost" > "$out/meaning_cost.md"  # descriptors, faces and describe_scene against the rest of a cold scene build, per picture
+"$b/bench_tactile_copies" > "$out/tactile_copies.md"  # take-home copies: lay out, PDF and SVG times, the guidelines' distances per picture
 taskset -c 1 "$b/bench_section_cost" --segments 100000 1000000 > "$out/section_cost.md"  # first_hit by kind of query (PERFORMANCE "The boundary section's full queries")
 "$b/bench_capture_latency" --out "$out/capture_latency.json" > "$out/capture_latency.md"
 [ -x "$b/bench_rectify" ] && "$b/bench_rectify" --benchmark_min_time=$min_time --benchmark_out="$out/rectify.json" --benchmark_out_format=json >/dev/null

@@ -10,12 +10,13 @@ declare -A allowed=(
   [sticks]=""
   [meaning]="formats"
   [pictures]="formats sticks meaning"
+  [copies]="formats sticks meaning pictures"
   [runtime]="formats"
-  [visit]="formats sticks meaning pictures runtime"
-  [cli]="formats sticks meaning pictures runtime visit"
-  [kiosk]="formats sticks meaning pictures runtime visit cli"
+  [visit]="formats sticks meaning pictures copies runtime"
+  [cli]="formats sticks meaning pictures copies runtime visit"
+  [kiosk]="formats sticks meaning pictures copies runtime visit cli"
 )
-rooms="formats sticks meaning pictures runtime visit cli kiosk"
+rooms="formats sticks meaning pictures copies runtime visit cli kiosk"
 bad=0
 for room in $rooms; do
   while IFS= read -r -d '' file; do

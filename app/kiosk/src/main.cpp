@@ -1,7 +1,7 @@
 // haptic-kiosk: command line entry. Subcommands: explore (headless run, DESIGN.md contract), capture (one camera
 // capture), cameras (the cameras found), stick (what a USB stick offers), pin (set or check the operator's PIN), speak
 // (a message or text rendered to WAV), devices (USB and serial devices found) and calibrate (the USB pantograph's
-// encoder offsets).
+// encoder offsets) and tactile (a take-home copy of a picture).
 #include <spdlog/cfg/env.h>
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -13,6 +13,7 @@
 #include "cli/explore.hpp"
 #include "cli/pin_command.hpp"
 #include "cli/stick_command.hpp"
+#include "cli/tactile_command.hpp"
 #include "formats/app_error.hpp"
 #include "kiosk/kiosk_app.hpp"
 #include "pictures/capture.hpp"
@@ -40,6 +41,7 @@ struct Commands {
   hk::app::SpeakOptions so;
   hk::app::StickOptions sto;
   hk::app::PinOptions po;
+  hk::app::TactileOptions to;
   CLI::App* explore = nullptr;
   CLI::App* capture = nullptr;
   CLI::App* cameras = nullptr;
@@ -48,6 +50,7 @@ struct Commands {
   CLI::App* speak = nullptr;
   CLI::App* stick = nullptr;
   CLI::App* pin = nullptr;
+  CLI::App* tactile = nullptr;
 };
 
 /// The kiosk's own options (no subcommand: the window with the picture library).
@@ -174,6 +177,22 @@ void add_speak_stick_pin_commands(CLI::App& cli, Commands& c) {
   c.pin->add_option("--config", c.po.config_path, "Settings file (TOML) holding [operator] pin_hash")->required();
 }
 
+/// The take-home copy: `tactile`.
+void add_tactile_command(CLI::App& cli, Commands& c) {
+  c.tactile = cli.add_subcommand(
+      "tactile", "A take-home copy of a picture as a tactile graphic with braille labels: PDF, SVG or BRF");
+  c.tactile->add_option("picture", c.to.picture, "A picture file or a PDF")->required();
+  c.tactile->add_option("--out", c.to.out, "Files to write: FILE.pdf (swell paper, embossers), FILE.svg, FILE.brf")
+      ->required();
+  c.tactile->add_option("--page", c.to.page, "A PDF's page (from 1)");
+  c.tactile->add_option("--level", c.to.level, "Resolution level, 0 = finest (default: [haptics] level)");
+  c.tactile->add_option("--paper", c.to.paper, "a4 (default), letter or 11x11.5in");
+  c.tactile->add_option("--language", c.to.language, "Names and braille in this language (default: [kiosk] language)");
+  c.tactile->add_option("--grade", c.to.grade, "Braille grade: 2 contracted (default) or 1 uncontracted");
+  c.tactile->add_option("--title", c.to.title, "The copy's title (default: the picture's own, else its file name)");
+  c.tactile->add_option("--config", c.to.config_path, "Settings file (TOML)");
+}
+
 /// Runs the subcommand given (the kiosk when none) and returns the process's exit status.
 /// @throws whatever the command throws (hk::Error and the like); main prints it as one line.
 int run_command(Commands& c) {
@@ -201,6 +220,8 @@ int run_command(Commands& c) {
     return hk::app::run_stick(c.sto);
   } else if (*c.pin) {
     return hk::app::run_pin(c.po);
+  } else if (*c.tactile) {
+    return hk::app::run_tactile(c.to);
   } else if (!*c.speak) {
     return hk::app::run_kiosk(c.ko);
   } else if (*c.speak) {
@@ -221,6 +242,7 @@ int main(int argc, char** argv) {
   add_explore_command(cli, c);
   add_camera_and_device_commands(cli, c);
   add_speak_stick_pin_commands(cli, c);
+  add_tactile_command(cli, c);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
