@@ -11,13 +11,13 @@ packages=(
   libespeak-ng-dev flite1-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev gettext libboost-locale-dev
   libglfw3-dev libimgui-dev libgl-dev
   libpoppler-cpp-dev libqpdf-dev libtesseract-dev libleptonica-dev tesseract-ocr-eng libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev zlib1g-dev librsvg2-dev
-  liblouis-dev liblouis-data libcairo2-dev
+  liblouis-dev liblouis-data libcairo2-dev libcups2-dev
 )
 if [ "${1:-}" != "--demo" ]; then
   packages+=(
     libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libembree-dev
     sox libgl1-mesa-dri xvfb xauth tesseract-ocr tesseract-ocr-deu tesseract-ocr-fra tesseract-ocr-spa
-    poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools
+    poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools cups-daemon cups-client
     dpkg-dev file lintian systemd cage
     clang libclang-rt-14-dev llvm-14 clang-format-14
   )
