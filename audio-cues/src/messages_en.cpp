@@ -201,6 +201,25 @@ const std::array<MessageSource, kMessageCount> kMessageSources{
     // TRANSLATORS: said before a text that is in another language than the visitor's: {name} is that
     // language's own name.
     NC_("other_language", "In {name}:"),
+    NC_("key_copy", "{copy_key}: a copy of this picture to take home, pressed twice."),
+    NC_("copy_confirm", "Press {copy_key} again within 10 seconds for a copy of this picture to take home."),
+    NC_("copy_making", "Making your copy."),
+    // TRANSLATORS: said when the copy has gone to the printer, unless staff wrote their own line.
+    NC_("copy_printed", "Your copy is being printed. Ask for it at the front desk."),
+    NC_("copy_not_set_up", "Copies to take home are not offered at this kiosk."),
+    NC_("copy_nothing", "There is no picture to copy yet."),
+    NPC_("copy_visit_limit", "You have had your copy for this visit.",
+         "You have had the {count} copies of this visit."),
+    NC_("copy_day_limit", "No more copies can be made today. Please ask a member of staff."),
+    NC_("copy_failed", "Sorry, your copy could not be made. Please ask a member of staff."),
+    // TRANSLATORS: the following four are printed and brailled on a take-home copy (a tactile graphic), not
+    // spoken: the title of its key page, a shape without a name, the count of shapes left out, one not labelled.
+    NC_("copy_key_title", "Key"),
+    NC_("copy_shape", "shape {number}"),
+    NC_("copy_left_out", "Shapes left out, too small or too close to another: {count}"),
+    NC_("copy_not_labelled", "Not labelled on the picture: {name}"),
+    // TRANSLATORS: the help's sentence for the Copy key, said when the kiosk offers copies.
+    NC_("help_copy", "Press {copy_key} twice for a copy of the picture to take home."),
 };
 
 const std::array<MessageSource, kWordCount> kWordSources{

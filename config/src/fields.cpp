@@ -91,6 +91,24 @@ std::string path_problem(std::string_view v) {
   return {};
 }
 
+/// The check of [copy] printer: a CUPS queue name (at most 127 printable characters, none of space, '/', '#'),
+/// or empty.
+std::string printer_problem(std::string_view v) {
+  if (v.size() > 127) return "is longer than a CUPS queue name (127 bytes)";
+  for (char c : v)
+    if (static_cast<unsigned char>(c) <= 0x20 || c == 0x7f || c == '/' || c == '#')
+      return "is not a CUPS queue name (no spaces, '/', '#' or control characters)";
+  return {};
+}
+
+/// The check of a line staff write for visitors to hear: at most 200 bytes, no control characters.
+std::string spoken_line_problem(std::string_view v) {
+  if (v.size() > 200) return "is longer than 200 bytes";
+  for (char c : v)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "holds a control character";
+  return {};
+}
+
 /// The check of [device] usb_ids (parse_usb_ids).
 std::string usb_ids_problem(std::string_view v) {
   std::string why;
@@ -179,6 +197,9 @@ constexpr std::array<std::string_view, 3> kOcrModes{"auto", "always", "off"};
 constexpr std::array<std::string_view, 2> kOnOff{"on", "off"};
 constexpr std::array<std::string_view, 5> kVoices{"flite-slt", "flite-kal", "flite-awb", "flite-rms", "espeak"};
 constexpr double kTwoPow31 = 2147483648.0;
+// Where [copy] sends copies, and the papers a copy is laid out for (copies/tactile_graphic.hpp parse_paper).
+constexpr auto kCopyTo = std::to_array<std::string_view>({"off", "printer"});
+constexpr auto kPapers = std::to_array<std::string_view>({"a4", "letter", "11x11.5in"});
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>(
     {"F1",    "F2",    "F3",     "F4",          "F5",      "F6",        "F7",    "F8",    "F9",     "F10",
@@ -190,7 +211,7 @@ constexpr auto kKeyNames = std::to_array<std::string_view>(
      "MINUS", "EQUAL", "KP_0",   "KP_1",        "KP_2",    "KP_3",      "KP_4",  "KP_5",  "KP_6",   "KP_7",
      "KP_8",  "KP_9",  "KP_ADD", "KP_SUBTRACT", "KP_ENTER"});
 
-constexpr std::array<detail::TableInfo, 11> kTables{{
+constexpr std::array<detail::TableInfo, 12> kTables{{
     {"haptics", "Force rendering and the servo loop."},
     {"device",
      "Which device drives the handle: the simulated pantograph's physics, and the USB pantograph's board, links and "
@@ -203,6 +224,9 @@ constexpr std::array<detail::TableInfo, 11> kTables{{
     {"stick", "Documents from USB sticks: how far a scan goes and how PDF pages are drawn."},
     {"camera", "The camera a visitor puts a picture under: the source, the frame size and when a capture happens."},
     {"keys", "The key for each of the visitor's actions (O, C and ESCAPE are never a visitor's)."},
+    {"copy",
+     "Take-home copies: a tactile graphic of the picture with braille, made when a visitor presses the Copy "
+     "key twice."},
     {"operator", "The operator's panel: how it opens, its PIN (set with 'haptic-kiosk pin set') and its records."},
 }};
 
@@ -509,6 +533,24 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
              "The next of the offered languages, said in itself; while the kiosk waits, the language of the "
              "invitation just heard.",
              kKeyNames),
+    HK_FIELD(keys, copy, FieldGroup::keys, ApplyWhen::live, 0, 0, "",
+             "Copy to take home: pressed twice within 10 s, a copy of the picture as a tactile graphic ([copy]).",
+             kKeyNames),
+    // [copy]
+    HK_FIELD(copy, to, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
+             "Where take-home copies go: \"off\" (none offered) or \"printer\" (the CUPS queue [copy] printer).",
+             kCopyTo),
+    HK_FIELD(copy, printer, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
+             "Printer for copies: the CUPS queue's name (swell paper or an embosser behind it).", {}, &printer_problem),
+    HK_FIELD(copy, printed_line, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
+             "Said when a copy has gone to the printer, e.g. where to collect it; empty = the kiosk's own line.", {},
+             &spoken_line_problem),
+    HK_FIELD(copy, per_visit, FieldGroup::kiosk, ApplyWhen::live, 0, 20, "", "Copies a visitor may have."),
+    HK_FIELD(copy, per_day, FieldGroup::kiosk, ApplyWhen::live, 0, 10000, "",
+             "Copies a day: the kiosk makes no more until midnight."),
+    HK_FIELD(copy, paper, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "", "Paper of the copies.", kPapers),
+    HK_FIELD(copy, braille_grade, FieldGroup::kiosk, ApplyWhen::live, 1, 2, "",
+             "Braille of the copies' labels: 1 uncontracted, 2 contracted."),
     // [operator]
     HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
                 "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),

@@ -67,6 +67,7 @@ constexpr std::array<Action, config::kKeyActionCount> kActions{{
     {"next_paragraph", &config::KeysSettings::next_paragraph, "and ", " or "},
     {"previous_paragraph", &config::KeysSettings::previous_paragraph, "or ", " by paragraph."},
     {"language", &config::KeysSettings::language, ", ", " for another language,"},
+    {"copy", &config::KeysSettings::copy, "Press ", " twice for a copy of the picture"},
 }};
 
 /// Every key's help as a visitor hears it: Help pressed (twice when `fresh`: the first layer, then every key),
@@ -146,6 +147,7 @@ TEST(SpokenKeys, EveryActionOnEveryKeyIsNamedInTheWelcomeHelpAndTutorial) {
       KioskFlowParams p;
       p.keys = s.keys;
       p.camera = true;  // the help names the Capture key too
+      p.copies = true;  // and the Copy key
       KioskFlow flow(fx, en, p);
       flow.key(KioskKey::Other, 0.0);  // wakes: the welcome and the first tutorial shape
       ASSERT_EQ(fx.said.size(), 1u);

@@ -294,10 +294,12 @@ TEST(MessageKeys, EnglishNamesKeysOnlyThroughPlaceholders) {
       EXPECT_EQ(t.find(wrong), std::string::npos) << wrong;
     }
   }
-  // The help names every action's key (the camera's in the sentence added when there is a camera); the welcome
-  // the help key; the tutorial how to go on.
+  // The help names every action's key (the camera's in the sentence added when there is a camera, the Copy key's
+  // in the one added where copies are offered); the welcome the help key; the tutorial how to go on.
   for (std::string_view k : kKeyPlaceholders) {
-    const MessageId where = k == "capture_key" ? MessageId::help_camera : MessageId::help;
+    const MessageId where = k == "capture_key" ? MessageId::help_camera
+                            : k == "copy_key"  ? MessageId::help_copy
+                                               : MessageId::help;
     EXPECT_NE(en.raw(where).find("{" + std::string(k) + "}"), std::string::npos) << k;
   }
   EXPECT_NE(en.raw(MessageId::welcome).find("{help_key}"), std::string::npos);

@@ -54,7 +54,8 @@ TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
                               KioskKey::PreviousSentence,
                               KioskKey::NextParagraph,
                               KioskKey::PreviousParagraph,
-                              KioskKey::Language};
+                              KioskKey::Language,
+                              KioskKey::Copy};
   static_assert(std::size(actions) == config::kKeyActionCount);
   for (int a = 0; a < static_cast<int>(config::kKeyActionCount); ++a) {
     for (std::string_view name : config::visitor_key_names()) {
@@ -78,7 +79,8 @@ TEST(Keymap, EachActionIsOnItsConfiguredKeyForEveryKeyName) {
                              &k.previous_sentence,
                              &k.next_paragraph,
                              &k.previous_paragraph,
-                             &k.language};
+                             &k.language,
+                             &k.copy};
       for (int b = 0; b < static_cast<int>(config::kKeyActionCount); ++b)
         if (b != a && *slot[b] == name) *slot[b] = *slot[a];  // swap: the set stays one key per action
       *slot[a] = std::string(name);

@@ -413,7 +413,7 @@ TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const T
     page.strokes.push_back({p.points_mm, p.closed, styles[i], static_cast<int>(i)});
     TactileShape ts;
     ts.number = p.number;
-    ts.name = p.name.empty() ? with_arg(words.shape, "{n}", std::to_string(p.number)) : p.name;
+    ts.name = p.name.empty() ? with_arg(words.shape, "{number}", std::to_string(p.number)) : p.name;
     ts.style = styles[i];
     page.shapes.push_back(ts);
     for_segments(p.points_mm, p.closed,
@@ -466,7 +466,7 @@ TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const T
     if (!ts.key.empty()) lines.push_back(ts.key + " " + ts.name);
   for (const TactileShape& ts : g.pages[0].shapes)
     if (!ts.labelled) lines.push_back(with_arg(words.not_labelled, "{name}", ts.name));
-  if (g.left_out > 0) lines.push_back(with_arg(words.left_out, "{n}", std::to_string(g.left_out)));
+  if (g.left_out > 0) lines.push_back(with_arg(words.left_out, "{count}", std::to_string(g.left_out)));
   std::vector<std::pair<LineStyle, std::string>> legend;
   for (const TactileShape& ts : g.pages[0].shapes)
     if (ts.style != LineStyle::solid &&

@@ -10,6 +10,13 @@ namespace hk::app {
 
 TactileInput tactile_input_of(const ImageScene& is, int level, Paper paper, const std::string& language,
                               const std::string& title, BrailleGrade grade) {
+  return tactile_input_of(
+      SceneToCopy{is.scene.get(), &is.regions, &is.shape_region, is.px_to_m, is.width_px, is.height_px}, level, paper,
+      language, title, grade);
+}
+
+TactileInput tactile_input_of(const SceneToCopy& is, int level, Paper paper, const std::string& language,
+                              const std::string& title, BrailleGrade grade) {
   if (!is.scene) throw hk::ArgumentError("tactile copy: the picture has no scene");
   TactileInput in;
   in.title = title;
@@ -25,6 +32,8 @@ TactileInput tactile_input_of(const ImageScene& is, int level, Paper paper, cons
   const double tolerance_m = kTactileToleranceMm / mm_per_m;
 
   const Scene& scene = *is.scene;
+  static const std::vector<int> kNoRegions;
+  const std::vector<int>& shape_region = is.shape_region ? *is.shape_region : kNoRegions;
   for (std::size_t c = 0; c < scene.curve_count(); ++c) {
     const CurveInfo& ci = scene.curve(c);
     const int l = std::max(scene.clamp_level(c, level), scene.coarsest_level_within(c, tolerance_m));
@@ -35,9 +44,9 @@ TactileInput tactile_input_of(const ImageScene& is, int level, Paper paper, cons
     const std::size_t source = scene.source_index(c);
     tc.number = static_cast<int>(source) + 1;
     tc.salience = ci.length_m;
-    if (source < is.shape_region.size() && is.shape_region[source] >= 0 &&
-        static_cast<std::size_t>(is.shape_region[source]) < is.regions.size())
-      tc.name = meaning::region_name_in(is.regions[static_cast<std::size_t>(is.shape_region[source])], language);
+    if (is.regions && source < shape_region.size() && shape_region[source] >= 0 &&
+        static_cast<std::size_t>(shape_region[source]) < is.regions->size())
+      tc.name = meaning::region_name_in((*is.regions)[static_cast<std::size_t>(shape_region[source])], language);
     in.curves.push_back(std::move(tc));
   }
   return in;

@@ -35,6 +35,7 @@ const std::map<std::string, KioskKey>& action_names() {
                                                  {"next_paragraph", KioskKey::NextParagraph},
                                                  {"previous_paragraph", KioskKey::PreviousParagraph},
                                                  {"language", KioskKey::Language},
+                                                 {"copy", KioskKey::Copy},
                                                  {"other", KioskKey::Other}};
   return m;
 }

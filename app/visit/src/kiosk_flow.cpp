@@ -50,7 +50,8 @@ constexpr std::array<MessageId, static_cast<std::size_t>(KioskKey::Other)> kKeyD
                                                                                     MessageId::key_previous_sentence,
                                                                                     MessageId::key_next_paragraph,
                                                                                     MessageId::key_previous_paragraph,
-                                                                                    MessageId::key_language};
+                                                                                    MessageId::key_language,
+                                                                                    MessageId::key_copy};
 
 }  // namespace
 
@@ -75,6 +76,8 @@ KioskFlowParams flow_params_from(const config::Settings& s, bool camera) {
   fp.attract_every_s = s.kiosk.attract_every_s;
   fp.keys = s.keys;
   fp.camera = camera;
+  fp.copies = s.copy.to != "off";
+  fp.copy_per_visit = s.copy.per_visit;
   return fp;
 }
 
@@ -161,6 +164,7 @@ void KioskFlow::act_on_key(KioskKey k, double now_s, std::string_view key_name) 
     return;
   }
   if (k != KioskKey::Finish) v_.finish_asked_s = -1;  // any other key: Finish asks again
+  if (k != KioskKey::Copy) v_.copy_asked_s = -1;      // and Copy
   fx_.tour.key_pressed();
   if (v_.capturing) {  // any key stops a capture, and does nothing else
     v_.capturing = false;
@@ -242,6 +246,9 @@ bool KioskFlow::session_key(KioskKey k, double now_s) {
     case KioskKey::Language:
       language_key();
       return true;
+    case KioskKey::Copy:
+      copy_key(now_s);
+      return true;
     default:
       return false;
   }
@@ -252,6 +259,39 @@ void KioskFlow::volume_key(int delta) {
   const bool changed = fx_.session.change_volume(delta);
   if (fx_.speech.speaking()) return;
   say_brief(!changed ? MessageId::volume_limit : delta > 0 ? MessageId::volume_up : MessageId::volume_down);
+}
+
+void KioskFlow::copy_key(double now_s) {
+  CopyEffects* copies = fx_.copies;
+  if (copies == nullptr || !copies->copies_offered()) {
+    say(MessageId::copy_not_set_up);
+    return;
+  }
+  if (v_.state != KioskState::Picture) {
+    say(MessageId::copy_nothing);
+    return;
+  }
+  if (v_.copies_made >= p_.copy_per_visit) {
+    fx_.speech.say(counted(MessageId::copy_visit_limit, p_.copy_per_visit));
+    return;
+  }
+  if (copies->day_limit_reached()) {
+    say(MessageId::copy_day_limit);
+    return;
+  }
+  // The first press only asks: a copy is paper and a printer's time, not made by a key pressed by accident.
+  if (v_.copy_asked_s < 0 || now_s - v_.copy_asked_s > kCopyConfirm_s) {
+    v_.copy_asked_s = now_s;
+    say(MessageId::copy_confirm);
+    return;
+  }
+  v_.copy_asked_s = -1;
+  if (!copies->start_copy()) {
+    say(MessageId::copy_nothing);
+    return;
+  }
+  ++v_.copies_made;
+  say(MessageId::copy_making);
 }
 
 void KioskFlow::finish_key(double now_s) {
@@ -296,6 +336,7 @@ std::vector<std::string> KioskFlow::help_groups() const {
   // The catalogue's help (and the camera's sentence) cut into sentences, kHelpSentencesPerGroup to a group.
   std::string all = msg_.raw(MessageId::help);
   if (p_.camera) all += " " + msg_.raw(MessageId::help_camera);
+  if (p_.copies) all += " " + msg_.raw(MessageId::help_copy);
   std::vector<std::string> sentences;
   std::size_t from = 0;
   for (std::size_t i = 0; i < all.size(); ++i) {

@@ -91,6 +91,7 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
       library_(shelf_, stage_),
       switches_(o.high_contrast, o.overlay),
       camera_(s, camera_of(s, o.probe_camera), camera_looked_for(s, o.probe_camera), stage_, shelf_, voice_, audio_),
+      copies_(s_, stage_, [this] { return copy_language(); }),
       sticks_(s, block_events(o.hotplug),
               o.mount_root.empty() ? std::string(sticks::kDefaultStickMountRoot) : o.mount_root, stage_, shelf_,
               audio_) {
@@ -110,7 +111,20 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
 KioskRuntime::~KioskRuntime() { devices_.stop_servo(); }
 
 KioskEffects KioskRuntime::effects() {
-  return KioskEffects(voice_, stage_, library_, sticks_, camera_, tour_, static_cast<SessionEffects&>(*this));
+  KioskEffects e(voice_, stage_, library_, sticks_, camera_, tour_, static_cast<SessionEffects&>(*this));
+  e.copies = &copies_;
+  return e;
+}
+
+CopyDesk::Language KioskRuntime::copy_language() const {
+  const audio::MessageCatalog& m = audio_.messages();
+  CopyDesk::Language l;
+  l.tag = m.language();
+  l.words.key = m.raw(audio::MessageId::copy_key_title);
+  l.words.shape = m.raw(audio::MessageId::copy_shape);
+  l.words.left_out = m.raw(audio::MessageId::copy_left_out);
+  l.words.not_labelled = m.raw(audio::MessageId::copy_not_labelled);
+  return l;
 }
 
 void KioskRuntime::adopt_board_profile() {
@@ -142,6 +156,7 @@ void KioskRuntime::poll(KioskFlow* flow, double now_s) {
   if (flow) {
     sticks_.poll(*flow, now_s);
     camera_.poll(*flow, now_s);
+    copies_.poll(*flow, now_s);
   }
   stage_.poll_text(now_s);
   poll_device(now_s);
@@ -272,6 +287,7 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
   if (r.gains) core_.set_gains(servo_gains_from(s_));
   if (r.keys) flow.set_keys(s_.keys);
   if (r.timing) flow.set_timing(s_.kiosk.timeout_s, s_.kiosk.warning_s, s_.kiosk.attract_every_s);
+  flow.set_copies(s_.copy.to != "off", s_.copy.per_visit);  // the desk reads the rest of [copy] at each copy
   if (rebuild) {
     stage_.reset_level(false);  // the rebuilt scene starts there
     rebuild_shown();

@@ -175,8 +175,22 @@ enum class MessageId : int {
   language_offer,
   key_language,
   other_language,
+  key_copy,
+  copy_confirm,
+  copy_making,
+  copy_printed,
+  copy_not_set_up,
+  copy_nothing,
+  copy_visit_limit,
+  copy_day_limit,
+  copy_failed,
+  copy_key_title,
+  copy_shape,
+  copy_left_out,
+  copy_not_labelled,
+  help_copy,
 };
-inline constexpr int kMessageCount = 136;
+inline constexpr int kMessageCount = 150;
 
 /// One entry of the English source: its key (the msgctxt), its English text (the msgid) and, for a counted
 /// entry, its English text for more than one (the msgid_plural; empty for an entry that is not counted).
@@ -213,8 +227,8 @@ using MessageArg = std::pair<std::string_view, std::string>;
 
 /// The placeholders that name one of the visitor's keys, one per action of the [keys] settings (help, next,
 /// previous, describe, finer, coarser, volume_up, volume_down, tutorial, guide, capture, repeat, pause, where,
-/// finish, next_sentence, previous_sentence, next_paragraph, previous_paragraph, language), in that order.
-inline constexpr std::array<std::string_view, 20> kKeyPlaceholders{"help_key",
+/// finish, next_sentence, previous_sentence, next_paragraph, previous_paragraph, language, copy), in that order.
+inline constexpr std::array<std::string_view, 21> kKeyPlaceholders{"help_key",
                                                                    "next_key",
                                                                    "previous_key",
                                                                    "describe_key",
@@ -233,7 +247,8 @@ inline constexpr std::array<std::string_view, 20> kKeyPlaceholders{"help_key",
                                                                    "previous_sentence_key",
                                                                    "next_paragraph_key",
                                                                    "previous_paragraph_key",
-                                                                   "language_key"};
+                                                                   "language_key",
+                                                                   "copy_key"};
 
 /// A key placeholder and the key it stands for, by its settings name: {"help_key", "F1"}. MessageCatalog::text()
 /// puts the spoken form of the key (MessageCatalog::key_name()) in its place.

@@ -291,17 +291,18 @@ struct KeysSettings {
   std::string next_paragraph = "I";  ///< key next_paragraph, reading a text: on from the next paragraph (block of text)
   std::string previous_paragraph = "U";  ///< key previous_paragraph, reading a text: back to the paragraph before
   std::string language = "L";            ///< key language, the next of the offered languages ([kiosk] languages)
+  std::string copy = "H";                ///< key copy, pressed twice: a copy of the picture to take home ([copy])
 
   /// Field-by-field equality; used by round-trip checks.
   bool operator==(const KeysSettings&) const = default;
 };
 
 /// Visitor actions in [keys].
-inline constexpr std::size_t kKeyActionCount = 20;
+inline constexpr std::size_t kKeyActionCount = 21;
 
 /// Each [keys] action's name and its key, in table order: help, next, previous, describe, finer, coarser,
 /// volume_up, volume_down, tutorial, guide, capture, repeat, pause, where, finish, next_sentence,
-/// previous_sentence, next_paragraph, previous_paragraph, language. The one list that the
+/// previous_sentence, next_paragraph, previous_paragraph, language, copy. The one list that the
 /// validation, the spoken key placeholders (audio::kKeyPlaceholders, the same order) and the window's key map
 /// follow. The views point into `keys`: keep it alive while they are used.
 inline std::array<std::pair<std::string_view, std::string_view>, kKeyActionCount> key_actions(const KeysSettings& k) {
@@ -324,7 +325,8 @@ inline std::array<std::pair<std::string_view, std::string_view>, kKeyActionCount
            {"previous_sentence", k.previous_sentence},
            {"next_paragraph", k.next_paragraph},
            {"previous_paragraph", k.previous_paragraph},
-           {"language", k.language}}};
+           {"language", k.language},
+           {"copy", k.copy}}};
 }
 
 /// One USB id of [device] usb_ids.
@@ -353,6 +355,21 @@ inline bool in_quiet_hours(const QuietHours& hours, int minute_of_day) {
   return hours.first <= hours.second ? minute_of_day >= hours.first && minute_of_day < hours.second
                                      : minute_of_day >= hours.first || minute_of_day < hours.second;
 }
+
+/// [copy] — take-home copies of a picture (a tactile graphic with braille), made when a visitor presses the Copy
+/// key twice.
+struct CopySettings {
+  std::string to = "off";    ///< key to, where copies go: "off" (none offered) or "printer" (a CUPS queue)
+  std::string printer;       ///< key printer, the CUPS queue copies are printed on ("" = none)
+  std::string printed_line;  ///< key printed_line, said when a copy went to the printer, staff's words ("" = the
+                             ///< catalogue's "Your copy is being printed. Ask for it at the front desk.")
+  int per_visit = 1;         ///< key per_visit, copies a visitor may have, [0, 20]
+  int per_day = 50;          ///< key per_day, copies the kiosk makes a day (counted since midnight), [0, 10000]
+  std::string paper = "a4";  ///< key paper, "a4", "letter" or "11x11.5in" (swell paper, embossers)
+  int braille_grade = 2;     ///< key braille_grade, 1 uncontracted or 2 contracted braille, [1, 2]
+
+  bool operator==(const CopySettings&) const = default;
+};
 
 /// [operator] — the operator's panel: how it is opened, its PIN and where its records go.
 /// Paths left empty are beside the settings file: `<settings>.state` and `<settings>.audit.log`.
@@ -385,6 +402,7 @@ struct Settings {
   StickSettings stick;
   CameraSettings camera;
   KeysSettings keys;
+  CopySettings copy;
   OperatorSettings operator_;  ///< TOML table [operator] (`operator` is a C++ keyword)
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.

@@ -77,11 +77,12 @@ struct TactileInput {
   std::vector<TactileCurve> curves;
 };
 
-/// The words of a copy's key in its language ({n} is a number, {name} a name).
+/// The words of a copy's key in its language: the catalogue's copy_key_title, copy_shape ({number}: the shape's
+/// number), copy_left_out ({count}) and copy_not_labelled ({name}) templates.
 struct TactileWords {
   std::string key = "Key";
-  std::string shape = "shape {n}";
-  std::string left_out = "Left out, too small or too close to another: {n}";
+  std::string shape = "shape {number}";
+  std::string left_out = "Shapes left out, too small or too close to another: {count}";
   std::string not_labelled = "Not labelled on the picture: {name}";
 };
 

@@ -5,7 +5,8 @@
 /// kiosk time); lines run in file order once their frame is reached.
 ///   key ACTION      a visitor's action straight to the flow (help, next, previous, describe, finer, coarser,
 ///                   volume_up, volume_down, tutorial, guide, capture, repeat, pause, where, finish,
-///                   next_sentence, previous_sentence, next_paragraph, previous_paragraph, other)
+///                   next_sentence, previous_sentence, next_paragraph, previous_paragraph, language, copy,
+///                   other)
 ///   press KEYS      a key as the keyboard sends it, through the same routing as a real key: a key name of
 ///                   the settings (F1, A, UP, ENTER, ESCAPE, BACKSPACE, TAB, O, ...) or a chord (CTRL+ALT+O);
 ///                   pressed in this frame, released in the next

@@ -12,6 +12,7 @@
 /// | CameraEffects  | a capture                                             | CameraDesk (camera_desk.hpp) |
 /// | TourEffects    | Guide, and keys that stop a tour                      | TourDesk (tour_desk.hpp) |
 /// | SessionEffects | volume, a new visitor                                 | KioskRuntime (kiosk_runtime.hpp) |
+/// | CopyEffects    | a take-home copy of the picture (optional)            | CopyDesk (copy_desk.hpp) |
 ///
 /// KioskEffects gathers one of each for the flow. Tests record the calls with one object that implements
 /// them all (tests/support/every_effect.hpp), which converts to a KioskEffects by itself.
@@ -173,6 +174,19 @@ class SessionEffects {
   virtual void new_session() = 0;
 };
 
+/// Take-home copies of the picture shown (a tactile graphic with braille).
+class CopyEffects {
+ public:
+  virtual ~CopyEffects() = default;
+  /// Copies are offered here ([copy] to is not "off" and names where they go).
+  virtual bool copies_offered() const = 0;
+  /// The day's copies ([copy] per_day) have all been made.
+  virtual bool day_limit_reached() const = 0;
+  /// Starts a copy of what is shown, in the visitor's language, off the window thread; the window layer then
+  /// reports with KioskFlow::copy_done or copy_failed. False when what is shown cannot be copied (nothing starts).
+  virtual bool start_copy() = 0;
+};
+
 /// One of each effect, as the flow uses them. Each object outlives the flow.
 struct KioskEffects {
   SpeechEffects& speech;
@@ -182,6 +196,8 @@ struct KioskEffects {
   CameraEffects& camera;
   TourEffects& tour;
   SessionEffects& session;
+  /// Take-home copies; none (null) where the kiosk offers none. Set after construction.
+  CopyEffects* copies = nullptr;
 
   /// show_picture's answer while the picture is still being built (LibraryEffects::kPicturePending).
   static constexpr int kPicturePending = LibraryEffects::kPicturePending;

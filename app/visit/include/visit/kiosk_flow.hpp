@@ -91,6 +91,7 @@ enum class KioskKey {
   NextParagraph,
   PreviousParagraph,
   Language,
+  Copy,
   Other
 };
 
@@ -143,6 +144,8 @@ struct KioskFlowParams {
   double attract_every_s = 30.0;  ///< the spoken invitation in Attract comes this often (0: never)
   config::KeysSettings keys{};    ///< the key of each action ([keys]), named in what is said; default: the shipped keys
   bool camera = false;            ///< a camera is there: the help names the Capture key
+  bool copies = false;            ///< copies are offered: the help names the Copy key
+  int copy_per_visit = 1;         ///< copies a visitor may have ([copy] per_visit)
 };
 
 /// The voice's rate [words per minute] (espeak-ng's default, the kiosk's [audio] default).
@@ -188,6 +191,8 @@ class KioskFlow {
  public:
   /// Finish ends the visit only when pressed again within this long of the first press [s].
   static constexpr double kFinishConfirm_s = 5.0;
+  /// The Copy key's second press must come within this long of the first [s].
+  static constexpr double kCopyConfirm_s = 10.0;
   /// The time-out warning is said again this long after the first, when time is left [s].
   static constexpr double kRewarn_s = 10.0;
   /// Every key's help is said this many sentences at a time (Next and Previous step through it).
@@ -237,9 +242,20 @@ class KioskFlow {
   /// The capture under way ended without a picture: the camera failed (timeout = false) or the picture never
   /// lay still long enough (timeout = true). Said; the picture felt before stays.
   void capture_failed(bool timeout, double now_s);
+  /// The copy asked for was made and sent: `line` is said (staff's words, [copy] printed_line), or the
+  /// catalogue's when it is empty.
+  void copy_done(const std::string& line, double now_s);
+  /// The copy asked for could not be made or sent (why is in the log): the visitor is told to ask staff.
+  void copy_failed(double now_s);
   /// The operator changed the keys ([keys]): from now on every message names these (the next thing said
   /// already does). Does not speak and does not touch the session.
   void set_keys(const config::KeysSettings& keys) { p_.keys = keys; }
+  /// The operator changed [copy]: whether copies are offered (the help names the Copy key) and how many a visitor
+  /// may have, from the next press.
+  void set_copies(bool offered, int per_visit) {
+    p_.copies = offered;
+    p_.copy_per_visit = per_visit;
+  }
   /// The operator changed the session's timing ([kiosk] timeout_s, warning_s, attract_every_s [s]): counted
   /// from the last activity, as before. A warning already given stays given.
   void set_timing(double timeout_s, double warning_s, double attract_every_s);
@@ -267,6 +283,8 @@ class KioskFlow {
     double warned_at_s = 0;      // when the first time-out warning was said
     bool rewarned = false;       // the second warning was said
     double finish_asked_s = -1;  // Finish pressed once at this time (asks for a second press); −1: not asked
+    double copy_asked_s = -1;    // Copy pressed once at this time (asks for a second press); −1: not asked
+    int copies_made = 0;         // copies started in this visit
     int help_layer = 0;          // 1 right after the first layer of help: Help again gives every key
     int help_group = -1;         // stepping through every key: the group said last (Next / Previous move); −1: not
     KioskSource source = KioskSource::Library;
@@ -307,6 +325,7 @@ class KioskFlow {
   void volume_key(int delta);
   void finish_key(double now_s);
   void language_key();
+  void copy_key(double now_s);
   /// `tag` when it names another language than the visitor's (by language subtag), else "".
   std::string other_language(const std::string& tag) const;
   /// "In Français: " before a text in v_.reading_language, "" when it is the visitor's.

@@ -31,6 +31,7 @@
 #include "runtime/servo_step.hpp"
 #include "runtime/servo_thread.hpp"
 #include "visit/camera_desk.hpp"
+#include "visit/copy_desk.hpp"
 #include "visit/display_switches.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/library_desk.hpp"
@@ -133,6 +134,7 @@ class KioskRuntime final : private SessionEffects {
   StickDesk& sticks() { return sticks_; }
   /// The camera.
   CameraDesk& camera() { return camera_; }
+  CopyDesk& copies() { return copies_; }
   /// The guided tour, and the model hand's target (TourDesk::set_cursor: the mouse or a script stands in
   /// for the visitor's hand).
   TourDesk& tour() { return tour_; }
@@ -149,6 +151,9 @@ class KioskRuntime final : private SessionEffects {
   void adopt_board_profile();  // the board's profile in force: settings_for_board, then servo params, hand and gains
                                // from them
 
+  /// The visitor's language and the key page's words in it, for a copy.
+  CopyDesk::Language copy_language() const;
+
   RuntimeOptions opt_;
   config::Settings s_;  // the settings in use: every part below reads them by reference
   audio::AudioSystem audio_;
@@ -162,6 +167,7 @@ class KioskRuntime final : private SessionEffects {
   LibraryDesk library_;
   DisplaySwitches switches_;
   CameraDesk camera_;  // its worker stops before the rest goes
+  CopyDesk copies_;    // its worker too
   StickDesk sticks_;   // last: its threads stop first
 };
 
