@@ -23,7 +23,7 @@ stage() {
 }
 run_tests() {
   (cd "$build" && ASAN_OPTIONS="detect_leaks=1:abort_on_error=1" UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
-    ctest --output-on-failure -j "$(nproc)" --timeout 1200)
+    LSAN_OPTIONS="suppressions=$root/tests/lsan.supp" ctest --output-on-failure -j "$(nproc)" --timeout 1200)
 }
 package_and_check() {
   bash "$root/scripts/package.sh"
