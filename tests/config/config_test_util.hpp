@@ -128,6 +128,9 @@ inline const std::vector<NumericSpec>& numeric_specs() {
       {"camera", "height_px", 64, 8192, true},
       {"camera", "still_s", 0.2, 10, false},
       {"camera", "timeout_s", 5, 600, false},
+      {"copy", "per_visit", 0, 20, true},
+      {"copy", "per_day", 0, 10000, true},
+      {"copy", "braille_grade", 1, 2, true},
       {"operator", "idle_close_s", 10, 3600, false},
   };
   return specs;

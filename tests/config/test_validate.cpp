@@ -109,7 +109,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     }
     if (name == "device.transport" || name == "device.actuator1_dir" || name == "device.actuator2_dir" ||
         name == "device.encoder1_dir" || name == "device.encoder2_dir" || name == "kiosk.say_names_on_touch" ||
-        name == "audio.voice") {
+        name == "audio.voice" || name == "copy.to" || name == "copy.paper") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_GE(d.choices.size(), 2u) << name;
       ++texts;
@@ -119,7 +119,8 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
         name == "camera.source" || name == "operator.pin_hash" || name == "operator.state_file" ||
         name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "kiosk.scene_cache" ||
         name == "kiosk.names_dir" || name == "vision.ocr_languages" || name == "kiosk.languages" ||
-        name == "kiosk.language" || name == "operator.language") {
+        name == "kiosk.language" || name == "operator.language" || name == "copy.printer" ||
+        name == "copy.printed_line") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -129,7 +130,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 46u);
+  EXPECT_EQ(texts, 51u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
