@@ -387,27 +387,11 @@ double tactile_scale_mm_per_m(PaperSize paper, Vec2 lo, Vec2 hi) {
   return std::min((b.x1 - b.x0) / w, (b.y1 - b.y0) / h);
 }
 
-TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const TactileWords& words) {
-  TactileGraphic g;
-  g.paper = paper_size(paper_kind);
-  g.title = in.title;
-  g.language = in.language;
-  const Box frame = frame_box(g.paper), pic = picture_box(g.paper);
-  g.mm_per_m = tactile_scale_mm_per_m(g.paper, in.picture_lo_m, in.picture_hi_m);
-  // The picture centred in its box.
-  const double w = g.mm_per_m * (in.picture_hi_m.x - in.picture_lo_m.x);
-  const double h = g.mm_per_m * (in.picture_hi_m.y - in.picture_lo_m.y);
-  g.origin_mm = {pic.x0 + (pic.x1 - pic.x0 - w) / 2, pic.y0 + (pic.y1 - pic.y0 - h) / 2};
+namespace {
 
-  std::vector<Placed> shapes = to_page(in, g.mm_per_m, g.origin_mm);
-  g.left_out = keep_apart(shapes);
+/// The picture page's shapes: their outlines in their styles, the textured fills, each taken in `occ`.
+void draw_shapes(TactilePage& page, const std::vector<Placed>& shapes, const TactileWords& words, Occupancy& occ) {
   const std::vector<LineStyle> styles = choose_styles(shapes);
-
-  TactilePage page;
-  page.frame_mm = std::array<Vec2, 2>{Vec2{frame.x0, frame.y0}, Vec2{frame.x1, frame.y1}};
-  add_title(page, in, g.paper);
-  Occupancy occ(g.paper);
-  occ.mark_outside({frame.x0 + kClearMm, frame.y0 + kClearMm, frame.x1 - kClearMm, frame.y1 - kClearMm});
   for (std::size_t i = 0; i < shapes.size(); ++i) {
     const Placed& p = shapes[i];
     page.strokes.push_back({p.points_mm, p.closed, styles[i], static_cast<int>(i)});
@@ -418,15 +402,16 @@ TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const T
     page.shapes.push_back(ts);
     for_segments(p.points_mm, p.closed,
                  [&](Vec2 a, Vec2 b) { occ.mark_segment(a, b, kClearMm + kCellReachMm, static_cast<int>(i)); });
-    if (styles[i] == LineStyle::textured) {
-      for (const Vec2& d : fill_dots(p, shapes)) {
-        page.fill_dots_mm.push_back(d);
-        occ.mark_segment(d, d, kTactileGapMm + kBrailleDotDiameterMm / 2 + kCellReachMm, static_cast<int>(i));
-      }
+    if (styles[i] != LineStyle::textured) continue;
+    for (const Vec2& d : fill_dots(p, shapes)) {
+      page.fill_dots_mm.push_back(d);
+      occ.mark_segment(d, d, kTactileGapMm + kBrailleDotDiameterMm / 2 + kCellReachMm, static_cast<int>(i));
     }
   }
+}
 
-  // Labels, most salient shape first: its name where it fits, else a key letter.
+/// Labels, most salient shape first: its name where it fits, else the next key letter; each taken in `occ`.
+void place_labels(TactilePage& page, const std::vector<Placed>& shapes, const TactileInput& in, Occupancy& occ) {
   int keys = 0;
   for (std::size_t i = 0; i < shapes.size(); ++i) {
     TactileShape& ts = page.shapes[i];
@@ -458,9 +443,11 @@ TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const T
       break;
     }
   }
-  g.pages.push_back(std::move(page));
+}
 
-  // The key: key letters, styles, what was left out or not labelled.
+/// The key's pages after the picture page: key letters, what was left out or not labelled, a sample of each line
+/// style with the name it stands for; g.key_lines the same in print. None when nothing needs a key.
+void add_key_pages(TactileGraphic& g, const TactileInput& in, const TactileWords& words) {
   std::vector<std::string> lines;
   for (const TactileShape& ts : g.pages[0].shapes)
     if (!ts.key.empty()) lines.push_back(ts.key + " " + ts.name);
@@ -474,21 +461,22 @@ TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const T
       legend.emplace_back(ts.style, ts.name);
   g.key_lines = lines;
   for (const auto& [style, name] : legend) g.key_lines.push_back(name);
-  if (lines.empty() && legend.empty()) return g;
+  if (lines.empty() && legend.empty()) return;
 
   const int max_cells = static_cast<int>((g.paper.width_mm - 2 * kTactileMarginMm) / kBrailleCellPitchMm);
   const double bottom = g.paper.height_mm - kTactileMarginMm;
   TactilePage key_page;
   double y = kTactileMarginMm;
+  const auto new_page_unless = [&](double need) {
+    if (y + need <= bottom) return;
+    g.pages.push_back(std::move(key_page));
+    key_page = TactilePage{};
+    y = kTactileMarginMm;
+  };
   const auto add_line = [&](const std::string& text, double indent_mm) {
     const int cells_here = max_cells - static_cast<int>(indent_mm / kBrailleCellPitchMm);
     const std::vector<std::string> wrapped = wrap_cells(to_braille(text, in.language, in.grade), cells_here);
-    const double need = static_cast<double>(wrapped.size()) * kBrailleLinePitchMm + kPrintTextMm + 2.0;
-    if (y + need > bottom) {
-      g.pages.push_back(std::move(key_page));
-      key_page = TactilePage{};
-      y = kTactileMarginMm;
-    }
+    new_page_unless(static_cast<double>(wrapped.size()) * kBrailleLinePitchMm + kPrintTextMm + 2.0);
     for (std::size_t k = 0; k < wrapped.size(); ++k, y += kBrailleLinePitchMm)
       key_page.labels.push_back(
           {wrapped[k], k == 0 ? text : std::string(), {kTactileMarginMm + indent_mm, y}, false, -1});
@@ -499,12 +487,7 @@ TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const T
   for (const std::string& l : lines) add_line(l, 0.0);
   for (const auto& [style, name] : legend) {
     // A sample of the style, 30 mm long, then the name it stands for beside it.
-    const double sample_y = y + kBrailleLinePitchMm / 2;
-    if (sample_y + kBrailleLinePitchMm > bottom) {
-      g.pages.push_back(std::move(key_page));
-      key_page = TactilePage{};
-      y = kTactileMarginMm;
-    }
+    new_page_unless(kBrailleLinePitchMm / 2 + kBrailleLinePitchMm);
     const double sy = y + kBrailleLinePitchMm / 2 - 1.0;
     key_page.strokes.push_back({{{kTactileMarginMm, sy}, {kTactileMarginMm + 30.0, sy}},
                                 false,
@@ -513,6 +496,33 @@ TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const T
     add_line(name, 30.0 + kTactileGapMm + 1.0);
   }
   g.pages.push_back(std::move(key_page));
+}
+
+}  // namespace
+
+TactileGraphic lay_out_tactile(const TactileInput& in, Paper paper_kind, const TactileWords& words) {
+  TactileGraphic g;
+  g.paper = paper_size(paper_kind);
+  g.title = in.title;
+  g.language = in.language;
+  const Box frame = frame_box(g.paper), pic = picture_box(g.paper);
+  g.mm_per_m = tactile_scale_mm_per_m(g.paper, in.picture_lo_m, in.picture_hi_m);
+  // The picture centred in its box.
+  const double w = g.mm_per_m * (in.picture_hi_m.x - in.picture_lo_m.x);
+  const double h = g.mm_per_m * (in.picture_hi_m.y - in.picture_lo_m.y);
+  g.origin_mm = {pic.x0 + (pic.x1 - pic.x0 - w) / 2, pic.y0 + (pic.y1 - pic.y0 - h) / 2};
+
+  std::vector<Placed> shapes = to_page(in, g.mm_per_m, g.origin_mm);
+  g.left_out = keep_apart(shapes);
+  TactilePage page;
+  page.frame_mm = std::array<Vec2, 2>{Vec2{frame.x0, frame.y0}, Vec2{frame.x1, frame.y1}};
+  add_title(page, in, g.paper);
+  Occupancy occ(g.paper);
+  occ.mark_outside({frame.x0 + kClearMm, frame.y0 + kClearMm, frame.x1 - kClearMm, frame.y1 - kClearMm});
+  draw_shapes(page, shapes, words, occ);
+  place_labels(page, shapes, in, occ);
+  g.pages.push_back(std::move(page));
+  add_key_pages(g, in, words);
   return g;
 }
 

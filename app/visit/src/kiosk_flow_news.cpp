@@ -20,23 +20,6 @@ void KioskFlow::capture_advice(MessageId advice, double now_s) {
   say(advice);
 }
 
-void KioskFlow::copy_done(const std::string& line, double now_s) {
-  guarded("a copy made", [&] {
-    activity(now_s);
-    if (line.empty())
-      say(MessageId::copy_printed);
-    else
-      fx_.speech.say(line);
-  });
-}
-
-void KioskFlow::copy_failed(double now_s) {
-  guarded("a copy that failed", [&] {
-    activity(now_s);
-    say(MessageId::copy_failed);
-  });
-}
-
 void KioskFlow::capture_done(int shapes, double now_s) {
   guarded("a camera capture", [&] { capture_done_now(shapes, now_s); });
 }
