@@ -20,10 +20,13 @@
 namespace hk::stick_helper {
 
 const char* const kMountRoot = sticks::kDefaultStickMountRoot;
+const char* const kWriteRoot = sticks::kDefaultStickWriteRoot;
 
 namespace {
 
-constexpr const char* kUsage = "usage: hk-stick-mount mount DEVNODE SLOT | hk-stick-mount unmount SLOT";
+constexpr const char* kUsage =
+    "usage: hk-stick-mount mount DEVNODE SLOT | hk-stick-mount unmount SLOT | hk-stick-mount mount-rw DEVNODE SLOT | "
+    "hk-stick-mount unmount-rw DEVNODE SLOT";
 constexpr unsigned kLoopMajor = 7;
 
 /// `s` on one line, control characters shown as '?', cut at 200 bytes: what a message echoes of an argument.
@@ -69,11 +72,13 @@ Request parse_request(const std::vector<std::string>& args, uid_t real_uid) {
   if (i >= args.size()) throw UsageError(std::string("no verb given; ") + kUsage);
   const std::string verb = args[i++];
   const std::size_t rest = args.size() - i;
-  if (verb == "mount") {
+  if (verb == "mount" || verb == "mount-rw" || verb == "unmount-rw") {
     if (rest != 2)
-      throw UsageError("mount: expected DEVNODE SLOT, got " + std::to_string(rest) + " argument" +
+      throw UsageError(verb + ": expected DEVNODE SLOT, got " + std::to_string(rest) + " argument" +
                        (rest == 1 ? "" : "s") + "; " + kUsage);
-    r.verb = Request::Verb::Mount;
+    r.verb = verb == "mount"      ? Request::Verb::Mount
+             : verb == "mount-rw" ? Request::Verb::MountRw
+                                  : Request::Verb::UnmountRw;
     r.devnode = args[i];
     r.slot = parse_slot(args[i + 1]);
   } else if (verb == "unmount") {
@@ -81,7 +86,7 @@ Request parse_request(const std::vector<std::string>& args, uid_t real_uid) {
     r.verb = Request::Verb::Unmount;
     r.slot = parse_slot(args[i]);
   } else {
-    throw UsageError("verb '" + shown(verb) + "': not mount or unmount; " + kUsage);
+    throw UsageError("verb '" + shown(verb) + "': not mount, unmount, mount-rw or unmount-rw; " + kUsage);
   }
   return r;
 }
@@ -145,6 +150,17 @@ std::string run_request(const Request& r, const std::string& mount_root, const U
     return sticks::unmount_stick_slot(mount_root, r.slot) ? "unmounted " + point : "nothing mounted at " + point;
   }
   const DeviceFacts f = check_devnode(r.devnode, r.allow_loop, probe);
+  const std::string write_root = sticks::write_root_of(mount_root);
+  if (r.verb == Request::Verb::UnmountRw) {
+    const std::string folder = write_root + "/" + std::to_string(r.slot);
+    return sticks::close_writable_slot(f.resolved, write_root, r.slot) ? "unmounted-rw " + folder
+                                                                       : "nothing mounted at " + folder;
+  }
+  if (r.verb == Request::Verb::MountRw) {
+    sticks::WritableStick stick(f.resolved, mount_root, r.slot, write_root);
+    stick.release();  // stays writable for the kiosk until unmount-rw
+    return "mounted-rw " + stick.filesystem() + " at " + stick.folder() + " from " + shown(r.devnode);
+  }
   sticks::MountedStick stick(f.resolved, mount_root, r.slot);
   // MountedStick checked that what is mounted is what it probed; this checks that it is what was validated.
   struct stat mounted {};

@@ -5,13 +5,21 @@
 /// The kiosk runs as the unprivileged user haptic-kiosk; mounting a USB stick needs CAP_SYS_ADMIN (and
 /// opening the stick's block device, owned root:disk, needs CAP_DAC_READ_SEARCH). Instead of giving the
 /// kiosk those, the package installs this helper root:haptic-kiosk mode 0750 with the file capabilities
-/// cap_dac_read_search,cap_sys_admin+ep. It does two things, with sticks::MountedStick's code:
+/// cap_dac_read_search,cap_sys_admin+ep. It does four things, with sticks::MountedStick's and sticks::WritableStick's
+/// code:
 ///
 ///   hk-stick-mount mount DEVNODE SLOT   mounts DEVNODE read-only at /run/haptic-kiosk/usb/SLOT
 ///   hk-stick-mount unmount SLOT         detaches /run/haptic-kiosk/usb/SLOT and removes the folder
+///   hk-stick-mount mount-rw DEVNODE SLOT
+///                                       mounts the FAT or exFAT stick DEVNODE, already mounted read-only at
+///                                       /run/haptic-kiosk/usb/SLOT, a second time read-write at
+///                                       /run/haptic-kiosk/usb-rw/SLOT (sticks::WritableStick), for a copy
+///   hk-stick-mount unmount-rw DEVNODE SLOT
+///                                       syncs, detaches /run/haptic-kiosk/usb-rw/SLOT and sets DEVNODE read-only
 ///
 /// and prints one line: on standard output "mounted FSTYPE at MOUNT_POINT from DEVNODE", "unmounted
-/// MOUNT_POINT" or "nothing mounted at MOUNT_POINT" (exit 0); on standard error "hk-stick-mount: ..."
+/// MOUNT_POINT", "mounted-rw FSTYPE at FOLDER from DEVNODE", "unmounted-rw FOLDER" or "nothing mounted at
+/// MOUNT_POINT" (exit 0); on standard error "hk-stick-mount: ..."
 /// (exit 1 refused or failed, 2 bad command line).
 ///
 /// It accepts only: DEVNODE an absolute path under /dev/ (a link there, such as /dev/disk/by-id/usb-...,
@@ -34,6 +42,8 @@ namespace hk::stick_helper {
 
 /// The fixed mount root, sticks::kDefaultStickMountRoot.
 extern const char* const kMountRoot;
+/// The fixed root of the read-write mounts, sticks::kDefaultStickWriteRoot.
+extern const char* const kWriteRoot;
 
 /// A refused command line or device. what() is one line naming the argument: "slot '12a': ...",
 /// "device '/etc/passwd': ...".
@@ -44,9 +54,9 @@ class HelperError : public hk::Error {
 
 /// What the helper was asked to do.
 struct Request {
-  enum class Verb { Mount, Unmount };
+  enum class Verb { Mount, Unmount, MountRw, UnmountRw };
   Verb verb = Verb::Mount;
-  std::string devnode;      ///< Mount: as given
+  std::string devnode;      ///< Mount, MountRw, UnmountRw: as given
   int slot = 0;             ///< 0 .. sticks::kMaxStickSlot
   bool allow_loop = false;  ///< --allow-loop was given (only root may)
 };
@@ -68,7 +78,8 @@ using UsbProbe = std::function<void(DeviceFacts&)>;
 void udev_probe(DeviceFacts& facts);
 
 /// Parses the arguments after the program name: [--allow-loop] mount DEVNODE SLOT | [--allow-loop]
-/// unmount SLOT. `real_uid` is getuid() (--allow-loop is refused unless it is 0).
+/// unmount SLOT | [--allow-loop] mount-rw DEVNODE SLOT | [--allow-loop] unmount-rw DEVNODE SLOT. `real_uid` is getuid()
+/// (--allow-loop is refused unless it is 0).
 /// @throws HelperError, one line naming the bad argument (an unknown verb, a missing or extra argument,
 /// a bad slot, --allow-loop without root).
 Request parse_request(const std::vector<std::string>& args, uid_t real_uid);
@@ -84,8 +95,8 @@ int parse_slot(const std::string& text);
 /// `allow_loop`.
 DeviceFacts check_devnode(const std::string& devnode, bool allow_loop, const UsbProbe& probe = udev_probe);
 
-/// Does what `r` asks under `mount_root` (kMountRoot in the helper; tests may pass another) and returns
-/// the result line (without "\n").
+/// Does what `r` asks under `mount_root` (kMountRoot in the helper; tests may pass another; the read-write
+/// mounts go to sticks::write_root_of(mount_root)) and returns the result line (without "\n").
 /// @throws HelperError or sticks::StickMountError (one line) when it is refused or fails.
 std::string run_request(const Request& r, const std::string& mount_root = kMountRoot,
                         const UsbProbe& probe = udev_probe);

@@ -220,6 +220,19 @@ const std::array<MessageSource, kMessageCount> kMessageSources{
     NC_("copy_not_labelled", "Not labelled on the picture: {name}"),
     // TRANSLATORS: the help's sentence for the Copy key, said when the kiosk offers copies.
     NC_("help_copy", "Press {copy_key} twice for a copy of the picture to take home."),
+    // TRANSLATORS: said when the copy is on the visitor's USB stick: {folder} is the new folder's name
+    // (copy_folder with the picture's title).
+    NC_("copy_saved", "Your copy is on your stick, in the folder {folder}. You can take your stick now."),
+    NC_("copy_no_stick", "Put your USB stick in first: the copy is saved on it."),
+    NC_("copy_stick_full", "Your stick is full, so the copy could not be saved on it."),
+    NC_("copy_stick_locked",
+        "Your stick is write-protected, so the copy could not be saved on it. If it has a lock switch, slide it "
+        "and try again."),
+    NC_("copy_stick_format", "Your stick cannot be written here: only FAT and exFAT sticks can take a copy."),
+    NC_("copy_stick_failed", "Sorry, the copy could not be saved on your stick. Please ask a member of staff."),
+    // TRANSLATORS: the name of the folder a copy is saved in on the visitor's stick; {title} is the picture's
+    // title. Not spoken by itself (copy_saved says it). Avoid the characters " * / : < > ? \ |.
+    NC_("copy_folder", "{title} (tactile copy)"),
 };
 
 const std::array<MessageSource, kWordCount> kWordSources{

@@ -198,7 +198,7 @@ constexpr std::array<std::string_view, 2> kOnOff{"on", "off"};
 constexpr std::array<std::string_view, 5> kVoices{"flite-slt", "flite-kal", "flite-awb", "flite-rms", "espeak"};
 constexpr double kTwoPow31 = 2147483648.0;
 // Where [copy] sends copies, and the papers a copy is laid out for (copies/tactile_graphic.hpp parse_paper).
-constexpr auto kCopyTo = std::to_array<std::string_view>({"off", "printer"});
+constexpr auto kCopyTo = std::to_array<std::string_view>({"off", "printer", "stick", "both"});
 constexpr auto kPapers = std::to_array<std::string_view>({"a4", "letter", "11x11.5in"});
 // Key names of [keys] (GLFW's names without the GLFW_KEY_ prefix; app/kiosk maps them).
 constexpr auto kKeyNames = std::to_array<std::string_view>(
@@ -538,7 +538,8 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
              kKeyNames),
     // [copy]
     HK_FIELD(copy, to, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
-             "Where take-home copies go: \"off\" (none offered) or \"printer\" (the CUPS queue [copy] printer).",
+             "Where take-home copies go: \"off\" (none offered), \"printer\" (the CUPS queue [copy] printer), "
+             "\"stick\" (a new folder on the visitor's USB stick, FAT or exFAT) or \"both\".",
              kCopyTo),
     HK_FIELD(copy, printer, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
              "Printer for copies: the CUPS queue's name (swell paper or an embosser behind it).", {}, &printer_problem),

@@ -37,9 +37,10 @@ struct Recorder final : hk::test::EveryEffect, CopyEffects {
   void show_document(int, int) override {}
   void forget_stick() override {}
   // CopyEffects
-  bool offered = true, day_full = false, can_start = true;
+  bool offered = true, day_full = false, can_start = true, no_stick = false;
   int started = 0;
   bool copies_offered() const override { return offered; }
+  bool stick_missing() const override { return no_stick; }
   bool day_limit_reached() const override { return day_full; }
   bool start_copy() override {
     if (!can_start) return false;
@@ -85,12 +86,64 @@ TEST(CopyKey, TheFirstPressAsksTheSecondWithin10sMakesTheCopy) {
   EXPECT_EQ(v.fx.started, 1);
   EXPECT_EQ(v.fx.said.back(), line(MessageId::copy_making));
   // The desk reports: the staff's line, else the catalogue's.
-  v.flow.copy_done("Your copy will be at the front desk.", 25.0);
+  using Route = CopyReport::Route;
+  v.flow.copy_finished({Route::Done, Route::NotAsked, "Your copy will be at the front desk.", ""}, 25.0);
   EXPECT_EQ(v.fx.said.back(), "Your copy will be at the front desk.");
-  v.flow.copy_done("", 26.0);
+  v.flow.copy_finished({Route::Done, Route::NotAsked, "", ""}, 26.0);
   EXPECT_EQ(v.fx.said.back(), line(MessageId::copy_printed));
-  v.flow.copy_failed(27.0);
+  v.flow.copy_finished({Route::Failed, Route::NotAsked, "", ""}, 27.0);
   EXPECT_EQ(v.fx.said.back(), line(MessageId::copy_failed));
+}
+
+TEST(CopyKey, EachRouteIsOneSentencePrintedFirstAndTheStickSaysWhereTheCopyIs) {
+  using Route = CopyReport::Route;
+  Visit v;
+  v.flow.copy_finished({Route::NotAsked, Route::Done, "", "Butterfly (tactile copy)"}, 25.0);
+  EXPECT_EQ(v.fx.said.back(),
+            "Your copy is on your stick, in the folder Butterfly (tactile copy). You can take your stick now.");
+  v.flow.copy_finished({Route::Done, Route::Done, "At the desk.", "Butterfly (tactile copy) 2"}, 26.0);
+  EXPECT_EQ(
+      v.fx.said.back(),
+      "At the desk. Your copy is on your stick, in the folder Butterfly (tactile copy) 2. You can take your stick "
+      "now.");
+  v.flow.copy_finished({Route::Done, Route::Full, "At the desk.", ""}, 27.0);
+  EXPECT_EQ(v.fx.said.back(), "At the desk. " + line(MessageId::copy_stick_full));
+  const std::pair<Route, MessageId> refusals[] = {{Route::WriteProtected, MessageId::copy_stick_locked},
+                                                  {Route::Format, MessageId::copy_stick_format},
+                                                  {Route::NoStick, MessageId::copy_no_stick},
+                                                  {Route::Failed, MessageId::copy_stick_failed}};
+  for (const auto& [route, id] : refusals) {
+    v.flow.copy_finished({Route::NotAsked, route, "", ""}, 28.0);
+    EXPECT_EQ(v.fx.said.back(), line(id));
+  }
+}
+
+TEST(CopyKey, ACopyThatReachedNeitherRouteDoesNotCountAgainstTheVisit) {
+  using Route = CopyReport::Route;
+  Visit v;  // one copy a visit
+  v.flow.key(KioskKey::Copy, 10.0);
+  v.flow.key(KioskKey::Copy, 11.0);
+  EXPECT_EQ(v.fx.started, 1);
+  v.flow.copy_finished({Route::NotAsked, Route::Full, "", ""}, 12.0);  // a full stick: try another
+  v.flow.key(KioskKey::Copy, 13.0);
+  v.flow.key(KioskKey::Copy, 14.0);
+  EXPECT_EQ(v.fx.started, 2);
+  v.flow.copy_finished({Route::NotAsked, Route::Done, "", "x"}, 15.0);
+  v.flow.key(KioskKey::Copy, 16.0);
+  EXPECT_EQ(v.fx.said.back(), "You have had your copy for this visit.");
+  EXPECT_EQ(v.fx.started, 2);
+}
+
+TEST(CopyKey, CopiesForSticksOnlyAskForTheStickFirst) {
+  Visit v;
+  v.fx.no_stick = true;
+  v.flow.key(KioskKey::Copy, 10.0);
+  EXPECT_EQ(v.fx.said.back(), line(MessageId::copy_no_stick));
+  v.flow.key(KioskKey::Copy, 11.0);
+  EXPECT_EQ(v.fx.started, 0) << "no confirmation was asked, so no copy is started";
+  v.fx.no_stick = false;
+  v.flow.key(KioskKey::Copy, 12.0);
+  EXPECT_EQ(v.fx.said.back(), line(MessageId::copy_confirm));
 }
 
 TEST(CopyKey, ALateSecondPressAsksAgainAndAnyOtherKeyInBetweenCancels) {
@@ -173,7 +226,8 @@ struct KioskWithCopies {
   config::Settings s;
   std::unique_ptr<KioskRuntime> rt;
   std::unique_ptr<KioskFlow> flow;
-  KioskWithCopies(const std::string& queue, const std::string& line, int per_day = 50) {
+  KioskWithCopies(const std::string& queue, const std::string& line, int per_day = 50,
+                  const std::string& to = "printer") {
     namespace fs = std::filesystem;
     lib = fs::temp_directory_path() / ("hk_copy_lib_" + std::to_string(::getpid()));
     fs::remove_all(lib);
@@ -186,7 +240,7 @@ struct KioskWithCopies {
     ro.open_audio_output = false;
     ro.probe_usb_device = false;
     ro.probe_camera = false;
-    s.copy.to = "printer";
+    s.copy.to = to;
     s.copy.printer = queue;
     s.copy.printed_line = line;
     s.copy.per_day = per_day;
@@ -247,6 +301,32 @@ TEST(CopyDesk, APrinterThatRefusesGivesTheSorryLineAndDoesNotCountAgainstTheDay)
   EXPECT_EQ(k.rt->voice().last_said(), line(MessageId::copy_failed));
   EXPECT_FALSE(k.rt->copies().day_limit_reached()) << "a copy not made does not count";
   EXPECT_TRUE(std::filesystem::is_empty(cups.out()));
+}
+
+TEST(CopyDesk, ACopyForTheStickIsANewFolderOnItAndTheVisitorHearsWhere) {
+  KioskWithCopies k("", "", 50, "stick");
+  double now = 5.0;
+  ASSERT_TRUE(k.run_until([&] { return !k.rt->stage().shown().image_path.empty(); }, now));
+  k.flow->key(KioskKey::Copy, now);
+  EXPECT_EQ(k.rt->voice().last_said(), line(MessageId::copy_no_stick));
+  // A folder stands in for the visitor's stick (the loop-device tests write real images).
+  const std::filesystem::path stick = k.lib.string() + "_stick";
+  std::filesystem::create_directories(stick);
+  k.rt->sticks().insert_folder(stick.string());
+  ASSERT_TRUE(k.run_until([&] { return k.rt->sticks().service().stick_in() && !k.rt->sticks().busy(); }, now));
+  k.flow->key(KioskKey::Copy, now);
+  k.flow->key(KioskKey::Copy, now + 1.0);
+  EXPECT_EQ(k.rt->voice().last_said(), line(MessageId::copy_making));
+  ASSERT_TRUE(k.run_until([&] { return k.rt->voice().last_said() != line(MessageId::copy_making); }, now));
+  std::vector<std::filesystem::path> folders;
+  for (const auto& e : std::filesystem::directory_iterator(stick)) folders.push_back(e.path());
+  ASSERT_EQ(folders.size(), 1u) << k.rt->voice().last_said();
+  const std::string folder = folders[0].filename().string();
+  EXPECT_NE(folder.find("(tactile copy)"), std::string::npos) << folder;
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(folders[0]), std::filesystem::directory_iterator()), 3);
+  EXPECT_EQ(k.rt->voice().last_said(),
+            "Your copy is on your stick, in the folder " + folder + ". You can take your stick now.");
+  std::filesystem::remove_all(stick);
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "copies/tactile_graphic.hpp"
 #include "copies/tactile_output.hpp"
 #include "copies/tactile_scene.hpp"
+#include "curves.hpp"
 #include "pictures/picture_names.hpp"
 #include "test_paths.hpp"
 
@@ -118,12 +119,7 @@ TEST(Braille, BrfIsTheNorthAmericanBrailleAsciiLiblouisWritesItself) {
 
 TEST(TactileLayout, ShapesTooSmallOrTooCloseAreLeftOutAndTheRestStayApart) {
   // A workspace of 0.14 m x 0.09 m on A4: about 1.3 mm a millimetre of workspace.
-  const auto circle = [](Vec2 c, double r_m) {
-    std::vector<Vec2> p;
-    for (int i = 0; i < 48; ++i)
-      p.push_back({c.x + r_m * std::cos(i * M_PI / 24), c.y + r_m * std::sin(i * M_PI / 24)});
-    return p;
-  };
+  const auto circle = [](Vec2 c, double r_m) { return hk::test::circle_points(c, r_m); };
   TactileInput in;
   in.title = "circles";
   in.grade = BrailleGrade::one;

@@ -97,6 +97,13 @@ TEST(StickHelperArgs, MountAndUnmountAreParsed) {
   EXPECT_EQ(u.verb, Request::Verb::Unmount);
   EXPECT_EQ(u.slot, 999);
   EXPECT_TRUE(parse_request({"--allow-loop", "mount", "/dev/loop0", "0"}, 0).allow_loop);
+  const Request rw = parse_request({"mount-rw", "/dev/sdb1", "7"}, 1000);
+  EXPECT_EQ(rw.verb, Request::Verb::MountRw);
+  EXPECT_EQ(rw.devnode, "/dev/sdb1");
+  EXPECT_EQ(rw.slot, 7);
+  const Request done = parse_request({"unmount-rw", "/dev/sdb1", "7"}, 1000);
+  EXPECT_EQ(done.verb, Request::Verb::UnmountRw);
+  EXPECT_EQ(done.devnode, "/dev/sdb1");
 }
 
 TEST(StickHelperArgs, BadCommandLinesAreRefusedInOneLineNamingTheArgument) {
@@ -116,6 +123,9 @@ TEST(StickHelperArgs, BadCommandLinesAreRefusedInOneLineNamingTheArgument) {
       {{"--allow-loop", "mount", "/dev/loop0", "0"}, 1000, "--allow-loop: only root"},
       {{"mount", "--allow-loop", "/dev/loop0", "0"}, 0, "got 3 arguments"},  // the flag comes first or not at all
       {{"verb\nwith a newline"}, 1000, "verb 'verb?with a newline'"},
+      {{"mount-rw", "/dev/sdb1"}, 1000, "mount-rw: expected DEVNODE SLOT, got 1 argument"},
+      {{"unmount-rw", "3"}, 1000, "unmount-rw: expected DEVNODE SLOT, got 1 argument"},
+      {{"mount-rw", "/dev/sdb1", "1000"}, 1000, "slot '1000'"},
   };
   for (const Case& c : cases) {
     std::string joined;
@@ -259,7 +269,9 @@ TEST(StickHelperExe, RefusalsAreOneLineOnStandardErrorWithTheirExitStatus) {
     std::string err;
   };
   const std::vector<Case> cases{
-      {"", 2, "hk-stick-mount: no verb given; usage: hk-stick-mount mount DEVNODE SLOT | hk-stick-mount unmount SLOT"},
+      {"", 2,
+       "hk-stick-mount: no verb given; usage: hk-stick-mount mount DEVNODE SLOT | hk-stick-mount unmount SLOT | "
+       "hk-stick-mount mount-rw DEVNODE SLOT | hk-stick-mount unmount-rw DEVNODE SLOT"},
       {"mount /dev/sdb1 1000", 2, "hk-stick-mount: slot '1000': not a whole number from 0 to 999"},
       {"unmount -1", 2, "hk-stick-mount: slot '-1': not a whole number from 0 to 999"},
       {"mount /etc/passwd 1", 1, "hk-stick-mount: device '/etc/passwd': not a device node under /dev/"},
@@ -360,6 +372,33 @@ TEST(StickHelperExe, MountsALoopStickReadOnlyAndUnmountsIt) {
   EXPECT_EQ(l[5], "unmounted /run/haptic-kiosk/usb/3");
   EXPECT_EQ(l[6], "gone");
   EXPECT_EQ(l[7], "nothing mounted at /run/haptic-kiosk/usb/3");
+}
+
+TEST(StickHelperExe, OnlyAFatOrExfatStickIsMountedForWriting) {
+  SKIP_UNLESS_ROOT_TOOLS();
+  LoopStick stick;  // ext4
+  if (stick.dev().empty()) GTEST_SKIP() << stick.error();
+  const Shell r = in_private_run("\"$H\" --allow-loop mount " + stick.dev() + " 3 >/dev/null && " +
+                                 "{ \"$H\" --allow-loop mount-rw " + stick.dev() + " 3; echo \"status $?\"; } && " +
+                                 "(test -e /run/haptic-kiosk/usb-rw/3 && echo left || echo none) && " +
+                                 "grep -c ' /run/haptic-kiosk/usb/3 ' /proc/self/mountinfo && " +
+                                 "\"$H\" --allow-loop unmount-rw " + stick.dev() + " 3 && \"$H\" unmount 3");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  std::istringstream lines(r.out);
+  std::vector<std::string> l;
+  for (std::string line; std::getline(lines, line);) l.push_back(line);
+  ASSERT_EQ(l.size(), 5U) << r.out << r.err;
+  EXPECT_EQ(l[0], "status 1");
+  EXPECT_EQ(l[1], "none") << "no read-write mount point is left";
+  EXPECT_EQ(l[2], "1") << "the visit's read-only mount stays";
+  EXPECT_EQ(l[3], "nothing mounted at /run/haptic-kiosk/usb-rw/3");
+  EXPECT_EQ(l[4], "unmounted /run/haptic-kiosk/usb/3");
+  EXPECT_TRUE(one_line(r.err.substr(0, r.err.size() - 1))) << r.err;
+  EXPECT_NE(r.err.find("hk-stick-mount: stick '" + stick.dev() +
+                       "': its filesystem (ext4) is not one the kiosk "
+                       "writes (FAT, exFAT)"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST(StickHelperExe, ALinkInTheMountRootIsNotFollowed) {

@@ -68,6 +68,14 @@ inline Polyline random_stroke(std::mt19937& rng, Vec2 s, double step_m, int n) {
   return p;
 }
 
+/// `n` points on the circle of centre `c` and radius `r_m` [m], counter-clockwise from angle 0.
+inline std::vector<Vec2> circle_points(Vec2 c, double r_m, int n = 48) {
+  std::vector<Vec2> p;
+  for (int i = 0; i < n; ++i)
+    p.push_back({c.x + r_m * std::cos(2 * M_PI * i / n), c.y + r_m * std::sin(2 * M_PI * i / n)});
+  return p;
+}
+
 /// A pixel-like staircase curve: a circle rounded to a grid of `cell_m` (as edge chains are).
 inline Polyline staircase_circle(Vec2 c, double r, double cell_m) {
   Polyline p;

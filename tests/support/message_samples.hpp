@@ -51,7 +51,8 @@ inline std::string sample_message(const audio::MessageCatalog& m, audio::Message
        {"where", "in the far middle"},
        {"key", "The Q key"},
        {"block", "2"},
-       {"blocks", "5"}},
+       {"blocks", "5"},
+       {"folder", "A horse, seen from the side (tactile copy) 2"}},
       keys);
 }
 

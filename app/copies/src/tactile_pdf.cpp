@@ -113,22 +113,47 @@ double print_width_mm(const std::string& text) {
   return std::max(e.x_advance, e.x_bearing + e.width);
 }
 
-void write_tactile_pdf(const TactileGraphic& g, const std::string& path) {
-  std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface(
-      cairo_pdf_surface_create(path.c_str(), g.paper.width_mm * kPtPerMm, g.paper.height_mm * kPtPerMm),
-      cairo_surface_destroy);
-  std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr(cairo_create(surface.get()), cairo_destroy);
-  cairo_pdf_surface_set_metadata(surface.get(), CAIRO_PDF_METADATA_TITLE, g.title.c_str());
+namespace {
+
+/// Draws `g` on the PDF surface `surface` and finishes it; cairo's status afterwards.
+cairo_status_t draw_pdf(cairo_surface_t* surface, const TactileGraphic& g) {
+  std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr(cairo_create(surface), cairo_destroy);
+  cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_TITLE, g.title.c_str());
   cairo_scale(cr.get(), kPtPerMm, kPtPerMm);
   for (const TactilePage& page : g.pages) {
     draw_page(cr.get(), page);
     cairo_show_page(cr.get());
   }
   cr.reset();
-  cairo_surface_finish(surface.get());
-  const cairo_status_t st = cairo_surface_status(surface.get());
+  cairo_surface_finish(surface);
+  return cairo_surface_status(surface);
+}
+
+using SurfacePtr = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
+
+}  // namespace
+
+void write_tactile_pdf(const TactileGraphic& g, const std::string& path) {
+  SurfacePtr surface(cairo_pdf_surface_create(path.c_str(), g.paper.width_mm * kPtPerMm, g.paper.height_mm * kPtPerMm),
+                     cairo_surface_destroy);
+  const cairo_status_t st = draw_pdf(surface.get(), g);
   if (st != CAIRO_STATUS_SUCCESS)
     throw CopyError("copy " + hk::quoted(path) + ": cannot write the PDF (" + cairo_status_to_string(st) + ")");
+}
+
+std::string tactile_pdf(const TactileGraphic& g) {
+  std::string bytes;
+  const cairo_write_func_t append = [](void* closure, const unsigned char* data, unsigned int length) {
+    static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
+    return CAIRO_STATUS_SUCCESS;
+  };
+  SurfacePtr surface(
+      cairo_pdf_surface_create_for_stream(append, &bytes, g.paper.width_mm * kPtPerMm, g.paper.height_mm * kPtPerMm),
+      cairo_surface_destroy);
+  const cairo_status_t st = draw_pdf(surface.get(), g);
+  if (st != CAIRO_STATUS_SUCCESS)
+    throw CopyError("copy '" + g.title + "': cannot draw the PDF (" + cairo_status_to_string(st) + ")");
+  return bytes;
 }
 
 }  // namespace hk::app

@@ -49,6 +49,73 @@ void StickService::insert_folder(const std::string& folder) {
   folder_ops_.emplace_back(folder);
 }
 
+std::future<StickWriteOutcome> StickService::write_to_stick(std::function<void(const std::string& top)> write) {
+  WriteJob job;
+  job.write = std::move(write);
+  std::future<StickWriteOutcome> f = job.done.get_future();
+  {
+    const std::lock_guard<std::mutex> lock(m_);
+    writes_.push_back(std::move(job));
+  }
+  cv_.notify_all();
+  return f;
+}
+
+void StickService::run_write(WriteJob& job) {
+  StickWriteOutcome out;
+  if (folder_stick_) {
+    try {
+      job.write(*folder_stick_);
+      out.kind = StickWriteOutcome::Kind::Written;
+      job.done.set_value(out);
+    } catch (...) {
+      job.done.set_exception(std::current_exception());
+    }
+    return;
+  }
+  if (!mounted_) {
+    out.kind = StickWriteOutcome::Kind::NoStick;
+    job.done.set_value(out);
+    return;
+  }
+  std::unique_ptr<sticks::StickWriteMount> rw;
+  try {
+    rw = mounted_->mount_writable();
+  } catch (const std::exception& e) {
+    switch (sticks::stick_write_refusal(e.what())) {
+      case sticks::StickWriteRefusal::WriteProtected:
+        out.kind = StickWriteOutcome::Kind::WriteProtected;
+        break;
+      case sticks::StickWriteRefusal::Format:
+        out.kind = StickWriteOutcome::Kind::Format;
+        break;
+      case sticks::StickWriteRefusal::Other:
+        out.kind = StickWriteOutcome::Kind::Failed;
+        break;
+    }
+    out.error = e.what();
+    job.done.set_value(out);
+    return;
+  }
+  std::exception_ptr failed;
+  try {
+    job.write(rw->folder());
+  } catch (...) {
+    failed = std::current_exception();
+  }
+  try {
+    rw->close();  // synced, read-only again, the second mount gone
+    out.kind = StickWriteOutcome::Kind::Written;
+  } catch (const std::exception& e) {
+    out.kind = StickWriteOutcome::Kind::Failed;
+    out.error = e.what();
+  }
+  if (failed)
+    job.done.set_exception(failed);
+  else
+    job.done.set_value(out);
+}
+
 void StickService::remove_folder() {
   const std::lock_guard<std::mutex> lock(m_);
   folder_ops_.emplace_back(std::nullopt);
@@ -254,6 +321,7 @@ void StickService::handle_add(const std::string& devnode) {
     post(std::move(n));
     return;
   }
+  stick_in_ = true;
   spdlog::info("stick '{}': {} mounted read-only at {}", devnode, mounted_->filesystem(), mounted_->mount_point());
   scan_root(mounted_->mount_point(), ms_since(t0));
 }
@@ -261,6 +329,7 @@ void StickService::handle_add(const std::string& devnode) {
 void StickService::handle_remove(const std::string& devnode) {
   if (!mounted_ || mounted_->devnode() != devnode) return;
   mounted_.reset();  // MNT_DETACH: a read in progress on the loader finishes or fails, nothing hangs
+  stick_in_ = folder_stick_.has_value();
   {
     const std::lock_guard<std::mutex> lock(m_);
     stick_id_ = 0;
@@ -277,13 +346,17 @@ void StickService::handle_remove(const std::string& devnode) {
 void StickService::watch() {
   for (;;) {
     std::deque<std::optional<std::string>> ops;
+    std::deque<WriteJob> writes;
     {
       const std::lock_guard<std::mutex> lock(m_);
       if (stop_) return;
       ops.swap(folder_ops_);
+      writes.swap(writes_);
     }
     // In the order asked: a folder put in and taken out at once ends taken out.
     for (const std::optional<std::string>& op : ops) {
+      folder_stick_ = op;
+      stick_in_ = folder_stick_.has_value() || mounted_ != nullptr;
       if (op) {
         scan_root(*op, 0.0);
         continue;
@@ -299,9 +372,11 @@ void StickService::watch() {
       n.kind = StickNews::Kind::Removed;
       post(std::move(n));
     }
+    for (WriteJob& job : writes) run_write(job);
     if (!events_) {
       std::unique_lock<std::mutex> lock(m_);
-      cv_.wait_for(lock, std::chrono::milliseconds(50), [this] { return stop_ || !folder_ops_.empty(); });
+      cv_.wait_for(lock, std::chrono::milliseconds(50),
+                   [this] { return stop_ || !folder_ops_.empty() || !writes_.empty(); });
       continue;
     }
     std::optional<sticks::BlockEvent> e;

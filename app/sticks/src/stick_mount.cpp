@@ -120,18 +120,69 @@ std::string helper_refusal(const std::string& devnode, const HelperRun& run) {
   return stick_line(devnode, "the mount helper refused: " + line);
 }
 
+/// A stick the kiosk opened for writing itself.
+class DirectWriteMount final : public StickWriteMount {
+ public:
+  DirectWriteMount(const std::string& devnode, const std::string& mount_root, int slot)
+      : stick_(devnode, mount_root, slot, write_root_of(mount_root)) {}
+  const std::string& folder() const override { return stick_.folder(); }
+  void close() override { stick_.close(); }
+
+ private:
+  WritableStick stick_;
+};
+
 /// A stick the kiosk mounted itself.
 class DirectStickMount final : public StickMount {
  public:
   DirectStickMount(const std::string& devnode, const std::string& mount_root, int slot)
-      : stick_(devnode, mount_root, slot) {}
+      : stick_(devnode, mount_root, slot), root_(mount_root), slot_(slot) {}
   const std::string& devnode() const override { return stick_.devnode(); }
   const std::string& mount_point() const override { return stick_.mount_point(); }
   const std::string& filesystem() const override { return stick_.filesystem(); }
   bool unmount() override { return stick_.unmount(); }
+  std::unique_ptr<StickWriteMount> mount_writable() override {
+    return std::make_unique<DirectWriteMount>(stick_.devnode(), root_, slot_);
+  }
 
  private:
   MountedStick stick_;
+  std::string root_;
+  int slot_ = 0;
+};
+
+/// A stick the helper opened for writing (mount-rw); its unmount-rw verb undoes it.
+class HelperWriteMount final : public StickWriteMount {
+ public:
+  HelperWriteMount(std::string helper, std::string devnode, int slot, std::string folder, double timeout_s)
+      : helper_(std::move(helper)),
+        devnode_(std::move(devnode)),
+        folder_(std::move(folder)),
+        slot_(slot),
+        timeout_s_(timeout_s) {}
+  ~HelperWriteMount() override {
+    try {
+      close();
+    } catch (const StickMountError&) {
+      // the caller who wanted to know called close() itself
+    }
+  }
+  HelperWriteMount(const HelperWriteMount&) = delete;
+  HelperWriteMount& operator=(const HelperWriteMount&) = delete;
+  const std::string& folder() const override { return folder_; }
+  void close() override {
+    if (!open_) return;
+    open_ = false;
+    const HelperRun run = run_helper(helper_, {"unmount-rw", devnode_, std::to_string(slot_)}, timeout_s_, devnode_);
+    if (run.timed_out) throw StickMountError(stick_line(devnode_, "the mount helper did not finish the write in time"));
+    if (!WIFEXITED(run.status) || WEXITSTATUS(run.status) != 0) throw StickMountError(helper_refusal(devnode_, run));
+  }
+
+ private:
+  std::string helper_, devnode_, folder_;
+  int slot_ = 0;
+  double timeout_s_ = 30.0;
+  bool open_ = true;
 };
 
 /// A stick the helper mounted; the helper's "unmount" verb undoes it.
@@ -151,6 +202,24 @@ class HelperStickMount final : public StickMount {
   const std::string& devnode() const override { return devnode_; }
   const std::string& mount_point() const override { return mount_point_; }
   const std::string& filesystem() const override { return fs_; }
+  std::unique_ptr<StickWriteMount> mount_writable() override {
+    const HelperRun run = run_helper(helper_, {"mount-rw", devnode_, std::to_string(slot_)}, timeout_s_, devnode_);
+    if (run.timed_out) {
+      (void)run_helper(helper_, {"unmount-rw", devnode_, std::to_string(slot_)}, timeout_s_, devnode_);
+      throw StickMountError(stick_line(devnode_, "the mount helper did not open it for writing in time"));
+    }
+    if (!WIFEXITED(run.status) || WEXITSTATUS(run.status) != 0) throw StickMountError(helper_refusal(devnode_, run));
+    // "mounted-rw FSTYPE at FOLDER from DEVNODE"
+    std::istringstream in(run.first_line);
+    std::string word, fs, at, folder;
+    in >> word >> fs >> at >> folder;
+    if (word != "mounted-rw" || fs.empty() || at != "at" || folder.empty()) {
+      (void)run_helper(helper_, {"unmount-rw", devnode_, std::to_string(slot_)}, timeout_s_, devnode_);
+      throw StickMountError(stick_line(
+          devnode_, "the mount helper answered '" + run.first_line + "', not 'mounted-rw FSTYPE at FOLDER'"));
+    }
+    return std::make_unique<HelperWriteMount>(helper_, devnode_, slot_, folder, timeout_s_);
+  }
   bool unmount() override {
     if (!mounted_) return true;
     mounted_ = false;

@@ -16,6 +16,7 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <condition_variable>
@@ -120,23 +121,6 @@ std::string mount_failure(int err, const std::string& type) {
   }
 }
 
-/// A descriptor owned by a scope, that can be handed on (release) or replaced (reset).
-class OwnedFd {
- public:
-  explicit OwnedFd(int fd = -1) : fd_(fd) {}
-  ~OwnedFd() { reset(); }
-  OwnedFd(const OwnedFd&) = delete;
-  OwnedFd& operator=(const OwnedFd&) = delete;
-  int get() const { return fd_; }
-  void reset(int fd = -1) {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = fd;
-  }
-
- private:
-  int fd_;
-};
-
 /// "/proc/self/fd/N": the path that reaches exactly what descriptor N holds open, whatever happens to
 /// the names on the way to it meanwhile.
 std::string fd_path(int fd) { return "/proc/self/fd/" + std::to_string(fd); }
@@ -160,7 +144,7 @@ int open_root(const std::string& who, const std::string& root, bool create) {
     throw StickMountError(line);
   };
   if (root.empty() || root.front() != '/') fail("the mount root '" + root + "' is not an absolute path");
-  OwnedFd dir(::open("/", O_PATH | O_DIRECTORY | O_CLOEXEC));
+  Fd dir(::open("/", O_PATH | O_DIRECTORY | O_CLOEXEC));
   if (dir.get() < 0) fail("cannot open / (" + errno_text(errno) + ")");
   std::string walked;
   std::size_t pos = 0;
@@ -194,7 +178,7 @@ int open_root(const std::string& who, const std::string& root, bool create) {
 /// umount2(MNT_DETACH) of the filesystem mounted on the folder `name` in `root_fd`, reached without
 /// following a link. 0, or the errno (EINVAL: nothing is mounted there; ENOENT: no such folder).
 int detach_at(int root_fd, const std::string& name) {
-  OwnedFd fd(::openat(root_fd, name.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  Fd fd(::openat(root_fd, name.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
   if (fd.get() < 0) return errno;
   return ::umount2(fd_path(fd.get()).c_str(), MNT_DETACH) == 0 ? 0 : errno;
 }
@@ -295,8 +279,8 @@ MountedStick::MountedStick(const std::string& devnode, const std::string& mount_
   root_ = trimmed_root(mount_root);
   const std::string name = std::to_string(slot);
   mount_point_ = (root_ == "/" ? "" : root_) + "/" + name;
-  OwnedFd root_fd(open_root("stick '" + devnode + "'", root_, true));
-  OwnedFd point(fresh_mount_point(devnode, root_fd.get(), name, mount_point_));
+  Fd root_fd(open_root("stick '" + devnode + "'", root_, true));
+  Fd point(fresh_mount_point(devnode, root_fd.get(), name, mount_point_));
   const auto drop_point = [&] {
     point.reset();
     (void)::unlinkat(root_fd.get(), name.c_str(), AT_REMOVEDIR);
@@ -351,7 +335,7 @@ bool MountedStick::unmount() {
   mounted_ = false;
   const std::string name = mount_point_.substr(mount_point_.rfind('/') + 1);
   try {
-    OwnedFd root_fd(open_root("stick '" + devnode_ + "'", root_, false));
+    Fd root_fd(open_root("stick '" + devnode_ + "'", root_, false));
     if (root_fd.get() < 0) return false;
     bool ok = detach_at(root_fd.get(), name) == 0;
     ok = ::unlinkat(root_fd.get(), name.c_str(), AT_REMOVEDIR) == 0 && ok;
@@ -369,7 +353,7 @@ bool unmount_stick_slot(const std::string& mount_root, int slot) {
   const std::string root = trimmed_root(mount_root);
   const std::string name = std::to_string(slot);
   const std::string shown = (root == "/" ? "" : root) + "/" + name;
-  OwnedFd root_fd(open_root(who, root, false));
+  Fd root_fd(open_root(who, root, false));
   if (root_fd.get() < 0) return false;  // no mount root: nothing was ever mounted there
   struct stat st {};
   if (::fstatat(root_fd.get(), name.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) {
@@ -383,6 +367,187 @@ bool unmount_stick_slot(const std::string& mount_root, int slot) {
     throw StickMountError(who + ": cannot remove " + shown + ": " + errno_text(errno));
   }
   return err == 0;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// WritableStick
+
+std::string write_root_of(const std::string& mount_root) { return trimmed_root(mount_root) + "-rw"; }
+
+bool filesystem_writable(const std::string& type) { return type == "vfat" || type == "exfat"; }
+
+StickWriteRefusal stick_write_refusal(const std::string& line) {
+  if (line.find("write-protected") != std::string::npos) return StickWriteRefusal::WriteProtected;
+  if (line.find("not one the kiosk writes") != std::string::npos) return StickWriteRefusal::Format;
+  return StickWriteRefusal::Other;
+}
+
+namespace {
+
+/// The flags of the read-write mount: as the read-only one's, but writable.
+constexpr unsigned long kWriteMountFlags = MS_NOSUID | MS_NODEV | MS_NOEXEC | MS_NOSYMFOLLOW | MS_NOATIME;
+
+/// BLKROSET on `devnode` (opened read-only: the ioctl needs no write access). 0, or the errno.
+int set_device_read_only(const std::string& devnode, bool read_only) {
+  Fd fd(::open(devnode.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK));
+  if (fd.get() < 0) return errno;
+  const int v = read_only ? 1 : 0;
+  return ::ioctl(fd.get(), BLKROSET, &v) == 0 ? 0 : errno;
+}
+
+/// The slot's folder name and the path shown in messages.
+std::string slot_path(const std::string& root, const std::string& name) {
+  return (root == "/" ? "" : root) + "/" + name;
+}
+
+}  // namespace
+
+WritableStick::WritableStick(const std::string& devnode, const std::string& mount_root, int slot,
+                             const std::string& write_root, const std::vector<std::string>& writable_types)
+    : devnode_(devnode), root_(trimmed_root(write_root)), slot_(slot) {
+  if (slot < 0 || slot > kMaxStickSlot) {
+    refuse(devnode, "invalid mount slot " + std::to_string(slot) + " (0 to " + std::to_string(kMaxStickSlot) + ")");
+  }
+  struct stat dev {};
+  Fd fd(open_for_probe(devnode, &dev));
+  if (!S_ISBLK(dev.st_mode)) refuse(devnode, "not a block device");
+
+  // 1. Only filesystems a home computer writes back without a journal.
+  fs_ = probe_type(devnode, fd.get());
+  if (std::find(writable_types.begin(), writable_types.end(), fs_) == writable_types.end()) {
+    refuse(devnode, "its filesystem (" + fs_ + ") is not one the kiosk writes (FAT, exFAT)");
+  }
+  if (!have_mount_capability()) refuse(devnode, "cannot write to it: " + mount_capability_hint());
+
+  // 2. The visit's read-only mount of this very device.
+  const std::string name = std::to_string(slot);
+  const std::string ro_point = slot_path(trimmed_root(mount_root), name);
+  Fd ro_root(open_root("stick '" + devnode + "'", trimmed_root(mount_root), false));
+  if (ro_root.get() < 0) refuse(devnode, "it is not mounted at " + ro_point);
+  Fd ro(::openat(ro_root.get(), name.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  struct stat ro_st {};
+  if (ro.get() < 0 || ::fstat(ro.get(), &ro_st) != 0 || ro_st.st_dev != dev.st_rdev) {
+    refuse(devnode, "it is not mounted at " + ro_point);
+  }
+
+  // 3. The device writable, unless it is write-protected.
+  const int zero = 0;
+  if (::ioctl(fd.get(), BLKROSET, &zero) != 0) {
+    refuse(devnode, "cannot make the device writable (BLKROSET: " + errno_text(errno) + ")");
+  }
+  int ro_now = 1;
+  if (::ioctl(fd.get(), BLKROGET, &ro_now) != 0 || ro_now != 0) {
+    (void)set_device_read_only(devnode, true);
+    refuse(devnode, "it is write-protected, so nothing was written");
+  }
+  const auto undo_device = [&] { (void)set_device_read_only(devnode, true); };
+
+  // 4. A second mount, then the filesystem read-write through it.
+  folder_ = slot_path(root_, name);
+  Fd rw_root;
+  Fd point;
+  try {
+    rw_root.reset(open_root("stick '" + devnode + "'", root_, true));
+    point.reset(fresh_mount_point(devnode, rw_root.get(), name, folder_));
+  } catch (...) {
+    undo_device();
+    throw;
+  }
+  const auto undo_point = [&] {
+    point.reset();
+    (void)::unlinkat(rw_root.get(), name.c_str(), AT_REMOVEDIR);
+    undo_device();
+  };
+  if (::mount(fd_path(ro.get()).c_str(), fd_path(point.get()).c_str(), nullptr, MS_BIND, nullptr) != 0) {
+    const int err = errno;
+    undo_point();
+    refuse(devnode, "cannot mount it a second time for writing: " + errno_text(err));
+  }
+  point.reset();
+  Fd top(::openat(rw_root.get(), name.c_str(), O_PATH | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  struct stat top_st {};
+  const bool same = top.get() >= 0 && ::fstat(top.get(), &top_st) == 0 && top_st.st_dev == dev.st_rdev;
+  const int rc =
+      same ? ::mount(nullptr, fd_path(top.get()).c_str(), nullptr, MS_REMOUNT | kWriteMountFlags, nullptr) : -1;
+  const int err = same ? errno : EXDEV;
+  if (rc != 0) {
+    (void)detach_at(rw_root.get(), name);
+    top.reset();
+    undo_point();
+    if (err == EACCES || err == EROFS) refuse(devnode, "it is write-protected, so nothing was written");
+    if (err == EXDEV) refuse(devnode, "the device changed while it was being mounted for writing");
+    refuse(devnode, "the kernel refused to make its " + fs_ + " filesystem writable: " + errno_text(err));
+  }
+  open_ = true;
+}
+
+WritableStick::~WritableStick() {
+  try {
+    close();
+  } catch (const StickMountError&) {
+    // the caller who wanted to know called close() itself
+  }
+}
+
+void WritableStick::close() {
+  if (!open_) return;
+  open_ = false;
+  (void)close_writable_slot(devnode_, root_, slot_);
+}
+
+bool close_writable_slot(const std::string& devnode, const std::string& write_root, int slot) {
+  if (slot < 0 || slot > kMaxStickSlot) {
+    refuse(devnode, "invalid mount slot " + std::to_string(slot) + " (0 to " + std::to_string(kMaxStickSlot) + ")");
+  }
+  struct stat dev {};
+  {
+    Fd fd(open_for_probe(devnode, &dev));
+    if (!S_ISBLK(dev.st_mode)) refuse(devnode, "not a block device");
+  }
+  const std::string root = trimmed_root(write_root);
+  const std::string name = std::to_string(slot);
+  const std::string shown = slot_path(root, name);
+  Fd root_fd(open_root("stick '" + devnode + "'", root, false));
+  if (root_fd.get() < 0) {
+    (void)set_device_read_only(devnode, true);
+    return false;
+  }
+  Fd top(::openat(root_fd.get(), name.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  if (top.get() < 0) {
+    if (errno != ENOENT) refuse(devnode, "cannot open " + shown + ": " + errno_text(errno));
+    (void)set_device_read_only(devnode, true);
+    return false;
+  }
+  struct stat st {
+  }, parent{};
+  if (::fstat(top.get(), &st) != 0 || ::fstat(root_fd.get(), &parent) != 0) {
+    refuse(devnode, "cannot examine " + shown + ": " + errno_text(errno));
+  }
+  if (st.st_dev == parent.st_dev) {  // an empty folder: nothing mounted
+    top.reset();
+    (void)::unlinkat(root_fd.get(), name.c_str(), AT_REMOVEDIR);
+    (void)set_device_read_only(devnode, true);
+    return false;
+  }
+  if (st.st_dev != dev.st_rdev) refuse(devnode, shown + " holds another device's filesystem, so it was left alone");
+
+  // Written through, then read-only again; each step is tried whatever the one before gave.
+  std::string problem;
+  if (::syncfs(top.get()) != 0) problem = "what was written may not be on it (sync: " + errno_text(errno) + ")";
+  if (::mount(nullptr, fd_path(top.get()).c_str(), nullptr, MS_REMOUNT | MS_RDONLY | kWriteMountFlags, nullptr) != 0 &&
+      problem.empty()) {
+    problem = "cannot make its filesystem read-only again: " + errno_text(errno);
+  }
+  top.reset();
+  const int detach = detach_at(root_fd.get(), name);
+  if (detach != 0 && problem.empty()) problem = "cannot unmount " + shown + ": " + errno_text(detach);
+  if (::unlinkat(root_fd.get(), name.c_str(), AT_REMOVEDIR) != 0 && problem.empty()) {
+    problem = "cannot remove " + shown + ": " + errno_text(errno);
+  }
+  const int ro = set_device_read_only(devnode, true);
+  if (ro != 0 && problem.empty()) problem = "cannot make the device read-only again (BLKROSET: " + errno_text(ro) + ")";
+  if (!problem.empty()) refuse(devnode, problem);
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------------------

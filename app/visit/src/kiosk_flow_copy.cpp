@@ -1,4 +1,6 @@
 // The visitor's flow: the Copy key and what became of the copy (kiosk_flow.hpp, kiosk_effects.hpp CopyEffects).
+#include <optional>
+
 #include "visit/kiosk_flow.hpp"
 
 namespace hk::app {
@@ -13,6 +15,10 @@ void KioskFlow::copy_key(double now_s) {
   }
   if (v_.state != KioskState::Picture) {
     say(MessageId::copy_nothing);
+    return;
+  }
+  if (copies->stick_missing()) {
+    say(MessageId::copy_no_stick);
     return;
   }
   if (v_.copies_made >= p_.copy_per_visit) {
@@ -38,20 +44,47 @@ void KioskFlow::copy_key(double now_s) {
   say(MessageId::copy_making);
 }
 
-void KioskFlow::copy_done(const std::string& line, double now_s) {
-  guarded("a copy made", [&] {
-    activity(now_s);
-    if (line.empty())
-      say(MessageId::copy_printed);
-    else
-      fx_.speech.say(line);
-  });
+namespace {
+
+/// The sentence for the stick's route (none when it was not asked).
+std::optional<MessageId> saved_message(CopyReport::Route r) {
+  using Route = CopyReport::Route;
+  switch (r) {
+    case Route::NotAsked:
+      return std::nullopt;
+    case Route::Done:
+      return MessageId::copy_saved;
+    case Route::NoStick:
+      return MessageId::copy_no_stick;
+    case Route::Full:
+      return MessageId::copy_stick_full;
+    case Route::WriteProtected:
+      return MessageId::copy_stick_locked;
+    case Route::Format:
+      return MessageId::copy_stick_format;
+    case Route::Failed:
+      return MessageId::copy_stick_failed;
+  }
+  return MessageId::copy_stick_failed;
 }
 
-void KioskFlow::copy_failed(double now_s) {
-  guarded("a copy that failed", [&] {
+}  // namespace
+
+void KioskFlow::copy_finished(const CopyReport& report, double now_s) {
+  guarded("a copy finished", [&] {
     activity(now_s);
-    say(MessageId::copy_failed);
+    std::string line;
+    if (report.printed == CopyReport::Route::Done)
+      line = report.printed_line.empty() ? text(MessageId::copy_printed) : report.printed_line;
+    else if (report.printed != CopyReport::Route::NotAsked)
+      line = text(MessageId::copy_failed);
+    if (const std::optional<MessageId> saved = saved_message(report.saved)) {
+      if (!line.empty()) line += " ";
+      line += text(*saved, {{"folder", report.folder}});
+    }
+    if (report.nothing_made() && v_.copies_made > 0) --v_.copies_made;  // nothing to take home: not the visit's copy
+    if (line.empty()) line = text(MessageId::copy_failed);
+    fx_.speech.say(line);
   });
 }
 

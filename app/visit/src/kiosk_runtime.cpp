@@ -91,10 +91,11 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
       library_(shelf_, stage_),
       switches_(o.high_contrast, o.overlay),
       camera_(s, camera_of(s, o.probe_camera), camera_looked_for(s, o.probe_camera), stage_, shelf_, voice_, audio_),
-      copies_(s_, stage_, [this] { return copy_language(); }),
       sticks_(s, block_events(o.hotplug),
               o.mount_root.empty() ? std::string(sticks::kDefaultStickMountRoot) : o.mount_root, stage_, shelf_,
-              audio_) {
+              audio_),
+      copies_(
+          s_, stage_, [this] { return copy_language(); }, &sticks_.service()) {
   tour_.set_picture([this] { return stage_.tour_picture(); });
   if (!o.device.empty()) {
     devices_.open_emulated_board(o.device);
@@ -124,6 +125,7 @@ CopyDesk::Language KioskRuntime::copy_language() const {
   l.words.shape = m.raw(audio::MessageId::copy_shape);
   l.words.left_out = m.raw(audio::MessageId::copy_left_out);
   l.words.not_labelled = m.raw(audio::MessageId::copy_not_labelled);
+  l.folder = m.raw(audio::MessageId::copy_folder);
   return l;
 }
 

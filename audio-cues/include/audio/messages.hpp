@@ -189,8 +189,15 @@ enum class MessageId : int {
   copy_left_out,
   copy_not_labelled,
   help_copy,
+  copy_saved,
+  copy_no_stick,
+  copy_stick_full,
+  copy_stick_locked,
+  copy_stick_format,
+  copy_stick_failed,
+  copy_folder,
 };
-inline constexpr int kMessageCount = 150;
+inline constexpr int kMessageCount = 157;
 
 /// One entry of the English source: its key (the msgctxt), its English text (the msgid) and, for a counted
 /// entry, its English text for more than one (the msgid_plural; empty for an entry that is not counted).

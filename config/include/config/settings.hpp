@@ -359,7 +359,8 @@ inline bool in_quiet_hours(const QuietHours& hours, int minute_of_day) {
 /// [copy] — take-home copies of a picture (a tactile graphic with braille), made when a visitor presses the Copy
 /// key twice.
 struct CopySettings {
-  std::string to = "off";    ///< key to, where copies go: "off" (none offered) or "printer" (a CUPS queue)
+  std::string to = "off";    ///< key to, where copies go: "off" (none offered), "printer" (a CUPS queue), "stick"
+                             ///< (a new folder on the visitor's FAT or exFAT stick) or "both"
   std::string printer;       ///< key printer, the CUPS queue copies are printed on ("" = none)
   std::string printed_line;  ///< key printed_line, said when a copy went to the printer, staff's words ("" = the
                              ///< catalogue's "Your copy is being printed. Ask for it at the front desk.")

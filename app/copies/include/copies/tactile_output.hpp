@@ -27,6 +27,9 @@ inline constexpr int kBrfLinesPerPage = 25;
 
 /// Writes `g` as a PDF file at `path`. @throws CopyError (one line naming the file) when cairo cannot write it.
 void write_tactile_pdf(const TactileGraphic& g, const std::string& path);
+/// `g` as a PDF file's bytes (as write_tactile_pdf writes them). @throws CopyError when cairo cannot draw it.
+std::string tactile_pdf(const TactileGraphic& g);
+
 /// `g` as an SVG document (UTF-8).
 std::string tactile_svg(const TactileGraphic& g);
 /// `g` as BRF text (North American Braille ASCII), in `language`'s braille at `grade`.

@@ -21,6 +21,8 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -58,6 +60,19 @@ struct LoadedDocument {
   double load_ms = 0;               ///< request to result [ms]
 };
 
+/// What became of a write onto the stick (StickService::write_to_stick).
+struct StickWriteOutcome {
+  enum class Kind {
+    Written,         ///< the writer ran and what it wrote is on the stick (synced)
+    NoStick,         ///< no stick is in the kiosk
+    WriteProtected,  ///< its lock switch is on (or the device is read-only)
+    Format,          ///< not FAT or exFAT: the kiosk does not write to it
+    Failed,          ///< anything else; `error` says what (one line, for the log)
+  };
+  Kind kind = Kind::Failed;
+  std::string error;
+};
+
 /// Watcher and loader threads. Construct and use from the window thread.
 class StickService {
  public:
@@ -88,6 +103,13 @@ class StickService {
   std::vector<LoadedDocument> poll_loaded();
   /// Forget the stick's listing (a new session): later loads of it are refused. The mount stays until removal.
   void forget();
+  /// Writes onto the stick in the kiosk, on the watcher thread (so it never races the stick's removal): a mounted
+  /// stick is opened for writing for the time of `write` (StickMount::mount_writable: FAT and exFAT only, synced
+  /// and read-only again after); a folder stick is written directly. `write` gets the stick's top folder. An
+  /// exception from `write` reaches the future (after the stick is read-only again). Any thread.
+  std::future<StickWriteOutcome> write_to_stick(std::function<void(const std::string& top)> write);
+  /// A stick (or a folder standing in for one) is in the kiosk now, as the watcher last saw it. Any thread.
+  bool stick_in() const { return stick_in_.load(); }
   /// Whether sticks can be mounted (CAP_SYS_ADMIN, or the mount helper); folders work regardless.
   bool can_mount() const { return mounter_ != sticks::StickMounter::None; }
   /// Who mounts sticks: this process, the helper, or nobody.
@@ -134,6 +156,13 @@ class StickService {
   void drop_ahead();
   /// Keeps or drops a page just built ahead (m_ held; `generation` the ahead_generation_ it began under).
   void keep_ahead(const Request& r, LoadedDocument d, std::uint64_t generation);
+  /// A write onto the stick, waiting for the watcher.
+  struct WriteJob {
+    std::function<void(const std::string&)> write;
+    std::promise<StickWriteOutcome> done;
+  };
+  /// Runs `job` on the watcher thread.
+  void run_write(WriteJob& job);
   void handle_add(const std::string& devnode);
   void handle_remove(const std::string& devnode);
   void scan_root(const std::string& root, double started_ms_offset);
@@ -157,6 +186,7 @@ class StickService {
   bool stop_ = false;
   std::deque<std::optional<std::string>>
       folder_ops_;                          // guarded by m_: folders put in (a path) and taken out (nullopt), in order
+  std::deque<WriteJob> writes_;             // guarded by m_: writes onto the stick asked for
   std::vector<StickNews> news_;             // guarded by m_
   std::optional<Request> request_;          // guarded by m_
   std::vector<LoadedDocument> loaded_;      // guarded by m_
@@ -170,8 +200,11 @@ class StickService {
   std::optional<std::chrono::steady_clock::time_point> building_wanted_;  // guarded by m_: asked for meanwhile, when
   std::uint64_t ahead_generation_ = 0;  // guarded by m_: bumped when pages built so far must not be used
 
+  std::atomic<bool> stick_in_{false};  // the watcher's: a stick mounted or a folder stick in
+
   // watcher thread only
   std::unique_ptr<sticks::StickMount> mounted_;
+  std::optional<std::string> folder_stick_;  // the folder standing in for a stick
   int next_stick_ = 1;
   int next_slot_ = 0;
 

@@ -8,6 +8,8 @@
 /// cap_sys_admin and cap_dac_read_search, executable by the group haptic-kiosk only) to do the same steps:
 ///   hk-stick-mount mount DEVNODE SLOT   ->  "mounted FSTYPE at MOUNT_POINT from DEVNODE"
 ///   hk-stick-mount unmount SLOT         ->  "unmounted MOUNT_POINT" or "nothing mounted at MOUNT_POINT"
+///   hk-stick-mount mount-rw DEVNODE SLOT   ->  "mounted-rw FSTYPE at FOLDER from DEVNODE"
+///   hk-stick-mount unmount-rw DEVNODE SLOT ->  "unmounted-rw FOLDER" or "nothing mounted at FOLDER"
 /// Refusals are one line on standard error, "hk-stick-mount: stick 'DEVNODE': why", exit status 1.
 /// The helper accepts only USB block devices and mounts only under /run/haptic-kiosk/usb.
 
@@ -21,6 +23,18 @@ namespace hk::sticks {
 /// Where the package installs the helper.
 inline constexpr const char* kDefaultStickHelperPath = "/usr/libexec/haptic-kiosk/hk-stick-mount";
 
+/// A stick opened for writing for a moment (WritableStick, itself or through the helper's mount-rw verb).
+/// Undone when destroyed (errors swallowed); close() to know that what was written is on the stick.
+class StickWriteMount {
+ public:
+  virtual ~StickWriteMount() = default;
+  /// The stick's top folder, writable.
+  virtual const std::string& folder() const = 0;
+  /// Syncs and undoes the read-write mount; idempotent.
+  /// @throws StickMountError (one line naming the stick) when what was written may not be on it.
+  virtual void close() = 0;
+};
+
 /// A stick mounted read-only, however it was mounted. Unmounts when destroyed.
 class StickMount {
  public:
@@ -33,6 +47,11 @@ class StickMount {
   virtual const std::string& filesystem() const = 0;
   /// Unmounts now (lazy detach, mount point removed); idempotent, never throws. False when that failed.
   virtual bool unmount() = 0;
+  /// Opens it for writing: a second, read-write mount (WritableStick; FAT and exFAT only) while this read-only
+  /// one stays. One at a time.
+  /// @throws StickMountError, one line naming the stick (stick_write_refusal tells write-protected and a format
+  /// not written from the rest).
+  virtual std::unique_ptr<StickWriteMount> mount_writable() = 0;
 };
 
 /// Who mounts sticks.

@@ -28,6 +28,8 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
 #include "hk/error.hpp"
 
 namespace hk::sticks {
@@ -159,5 +161,78 @@ bool unmount_stick_slot(const std::string& mount_root, int slot);
 
 /// The default mount root, "/run/haptic-kiosk/usb".
 inline constexpr const char* kDefaultStickMountRoot = "/run/haptic-kiosk/usb";
+
+/// The default root of the read-write mounts, "/run/haptic-kiosk/usb-rw" (write_root_of the default mount root).
+inline constexpr const char* kDefaultStickWriteRoot = "/run/haptic-kiosk/usb-rw";
+
+/// Where the read-write mounts of sticks mounted under `mount_root` go: `<mount_root>-rw` (a sibling, so a
+/// slot's read-only and read-write mounts never share a folder).
+std::string write_root_of(const std::string& mount_root);
+
+/// Whether a copy may be written to a filesystem of this type: FAT ("vfat") and exFAT, which every computer at
+/// home reads and writes and whose writes leave no journal to replay. NTFS, ext4 and ISO 9660 are read only.
+bool filesystem_writable(const std::string& type);
+
+/// Why a stick could not be opened for writing, for the visitor's sentence.
+enum class StickWriteRefusal {
+  WriteProtected,  ///< its lock switch is on, or the device is read-only at the block layer
+  Format,          ///< its filesystem is not FAT or exFAT
+  Other,           ///< anything else (named in the log line)
+};
+
+/// The refusal a StickMountError line from WritableStick (directly or through the mount helper, which runs the
+/// same code and passes its line on) stands for: it carries "write-protected" or "not one the kiosk writes".
+StickWriteRefusal stick_write_refusal(const std::string& line);
+
+/// A stick mounted read-only by MountedStick, opened for writing for a moment: a second mount of the same
+/// filesystem, read-write, at `<write_root>/<slot>`, while the read-only mount at `<mount_root>/<slot>` stays
+/// as it is (a mount of its own flagged read-only: nothing reads or writes through it differently). Steps:
+/// 1. the device's filesystem must be one of `writable_types` (FAT, exFAT: filesystem_writable);
+/// 2. the read-only mount must be there and be of this device;
+/// 3. the block device is made writable (ioctl BLKROSET 0); a device that stays read-only (a stick's lock
+///    switch, a read-only loop device) is refused as write-protected and set read-only again;
+/// 4. the read-only mount is bind-mounted at `<write_root>/<slot>` (a fresh folder, mode 0700) and the
+///    filesystem remounted read-write there (MS_REMOUNT; nosuid, nodev, noexec, nosymfollow, noatime), which the
+///    kernel refuses for a write-protected device.
+/// close() undoes them: syncfs, the filesystem read-only again, the second mount detached and its folder removed,
+/// the device read-only again (BLKROSET 1). Needs CAP_SYS_ADMIN, as MountedStick; the installed kiosk has the mount
+/// helper do it (its mount-rw and unmount-rw verbs).
+class WritableStick {
+ public:
+  /// @throws StickMountError, one line naming devnode, with nothing left changed: not a block device, a slot
+  /// outside [0, kMaxStickSlot], a filesystem not in `writable_types` ("its filesystem (ext4) is not one the kiosk
+  /// writes (FAT, exFAT)"), no capability, no read-only mount of it at the slot, "it is write-protected", a mount
+  /// the kernel refuses. `writable_types` is for the tests, whose kernels may have no FAT driver.
+  WritableStick(const std::string& devnode, const std::string& mount_root, int slot, const std::string& write_root,
+                const std::vector<std::string>& writable_types = {"vfat", "exfat"});
+  /// close(), its error swallowed (unless released).
+  ~WritableStick();
+  WritableStick(const WritableStick&) = delete;
+  WritableStick& operator=(const WritableStick&) = delete;
+
+  /// The read-write mount point: the stick's top folder, writable.
+  const std::string& folder() const { return folder_; }
+  /// The filesystem type (identify_filesystem's name).
+  const std::string& filesystem() const { return fs_; }
+  /// Syncs and undoes the read-write mount (close_writable_slot); idempotent.
+  /// @throws StickMountError when what was written may not be on the stick (the sync reported an error) or the
+  /// read-write mount could not be undone.
+  void close();
+  /// Forgets the mount without closing it (the mount helper's process ends while the kiosk writes).
+  void release() { open_ = false; }
+
+ private:
+  std::string devnode_, root_, folder_, fs_;
+  int slot_ = 0;
+  bool open_ = false;
+};
+
+/// Undoes the read-write mount at `<write_root>/<slot>` of `devnode`: syncfs, remount read-only, detach, remove
+/// the folder, BLKROSET 1 on the device (which is set read-only even when nothing was mounted there). The mount
+/// helper's unmount-rw verb. Returns false when nothing was mounted there.
+/// @throws StickMountError, one line naming devnode: a slot outside [0, kMaxStickSlot], a link or non-folder on
+/// the way, a mount there of another device, a sync that reported an error (what was written may not be on the
+/// stick: everything else is still undone), a remount or detach the kernel refused.
+bool close_writable_slot(const std::string& devnode, const std::string& write_root, int slot);
 
 }  // namespace hk::sticks

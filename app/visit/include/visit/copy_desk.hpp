@@ -1,9 +1,11 @@
 #pragma once
 /// @file copy_desk.hpp
 /// Take-home copies as the visitor asks for them (the Copy key, pressed twice): the picture shown, at the level in
-/// use, in the visitor's language, laid out as a tactile graphic (copies/tactile_graphic.hpp) and printed on the
-/// CUPS queue staff named ([copy] printer), off the window thread; the outcome handed to the flow
-/// (KioskFlow::copy_done, copy_failed) and written in the log. At most [copy] per_day copies a day (counted from
+/// use, in the visitor's language, laid out as a tactile graphic (copies/tactile_graphic.hpp), off the window
+/// thread, and sent where staff chose ([copy] to): printed on the CUPS queue staff named ([copy] printer), saved in
+/// a new folder on the visitor's USB stick (copies/stick_copy.hpp, through StickService::write_to_stick: FAT and
+/// exFAT sticks only, mounted read-write for that write alone), or both; the outcome handed to the flow
+/// (KioskFlow::copy_finished) and written in the log. At most [copy] per_day copies a day (counted from
 /// local midnight, in memory: a restart counts afresh). Answers the flow's CopyEffects (kiosk_effects.hpp).
 /// Window thread only, but for the worker it starts.
 
@@ -18,6 +20,7 @@
 #include "config/settings.hpp"
 #include "copies/print_queue.hpp"
 #include "copies/tactile_graphic.hpp"
+#include "pictures/stick_service.hpp"
 #include "visit/kiosk_effects.hpp"
 
 namespace hk::app {
@@ -34,42 +37,49 @@ class CopyDesk final : public CopyEffects {
   struct Language {
     std::string tag = "en";
     TactileWords words;
+    std::string folder = "{title} (tactile copy)";  ///< the stick folder's name (catalogue: copy_folder)
   };
   using LanguageNow = std::function<Language()>;
 
-  /// `settings` (the settings in use; read at each copy), `stage` and `language` outlive the desk. `printer`:
-  /// how copies reach paper; default print_pdf on [copy] printer.
-  CopyDesk(const config::Settings& settings, const Stage& stage, LanguageNow language, Printer printer = {});
+  /// `settings` (the settings in use; read at each copy), `stage`, `language` and `stick` outlive the desk.
+  /// `stick`: the kiosk's sticks (null: copies are never saved on one). `printer`: how copies reach paper; default
+  /// print_pdf on [copy] printer.
+  CopyDesk(const config::Settings& settings, const Stage& stage, LanguageNow language, StickService* stick = nullptr,
+           Printer printer = {});
   ~CopyDesk() override;
   CopyDesk(const CopyDesk&) = delete;
   CopyDesk& operator=(const CopyDesk&) = delete;
 
-  /// [copy] to is "printer" and a queue is named.
+  /// Copies are printed ([copy] to "printer" or "both", a queue named) or saved on sticks ("stick" or "both").
   bool copies_offered() const override;
+  /// Copies go to sticks only and no stick is in.
+  bool stick_missing() const override;
   /// [copy] per_day copies were started today (failed ones not counted).
   bool day_limit_reached() const override;
   /// Takes what is shown (a copy of its curves and names, on this thread) and lays it out, writes its PDF and
   /// prints it on a worker; false when nothing is shown that has curves, or a copy is still being made.
   bool start_copy() override;
-  /// Every frame: a finished copy's outcome handed to `flow` (copy_done with [copy] printed_line, or copy_failed).
+  /// Every frame: a finished copy's outcome handed to `flow` (copy_finished).
   void poll(KioskFlow& flow, double now_s);
   /// A copy is being made.
   bool busy() const { return worker_.joinable(); }
 
  private:
-  struct Outcome {
-    bool ok = false;
-    std::string error;
-  };
-  int today() const;  // local days since the epoch
+  int today() const;    // local days since the epoch
+  bool prints() const;  // [copy] to sends copies to a named printer
+  bool saves() const;   // [copy] to sends copies to sticks, and there are sticks
+  /// The worker's two routes, each filling its part of `r` (printed_line set by the caller).
+  void print_copy(const TactileGraphic& g, BrailleGrade grade, const std::string& pdf, CopyReport& r);
+  void save_copy(const TactileGraphic& g, BrailleGrade grade, const std::string& folder, CopyReport& r);
 
   const config::Settings& s_;
   const Stage& stage_;
   LanguageNow language_;
+  StickService* stick_;
   Printer printer_;
   int day_ = -1, made_today_ = 0;
   std::mutex mutex_;
-  std::optional<Outcome> outcome_;  // under mutex_: what the worker made of the copy
+  std::optional<CopyReport> outcome_;  // under mutex_: what the worker made of the copy
   std::thread worker_;
 };
 

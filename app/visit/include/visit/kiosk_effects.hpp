@@ -175,15 +175,37 @@ class SessionEffects {
 };
 
 /// Take-home copies of the picture shown (a tactile graphic with braille).
+/// What became of a copy, route by route ([copy] to: the printer, the visitor's stick, or both).
+struct CopyReport {
+  /// A route's outcome.
+  enum class Route {
+    NotAsked,        ///< [copy] to does not send copies this way
+    Done,            ///< printed (queued) / saved on the stick
+    Failed,          ///< the printer refused or is gone / the stick could not be written (a log line says why)
+    NoStick,         ///< stick: none is in the kiosk
+    Full,            ///< stick: no room on it
+    WriteProtected,  ///< stick: its lock switch is on
+    Format,          ///< stick: not FAT or exFAT
+  };
+  Route printed = Route::NotAsked;
+  Route saved = Route::NotAsked;
+  std::string printed_line;  ///< printed: [copy] printed_line (empty: the catalogue's)
+  std::string folder;        ///< saved: the new folder's name on the stick
+  /// Neither route gave the visitor a copy.
+  bool nothing_made() const { return printed != Route::Done && saved != Route::Done; }
+};
+
 class CopyEffects {
  public:
   virtual ~CopyEffects() = default;
   /// Copies are offered here ([copy] to is not "off" and names where they go).
   virtual bool copies_offered() const = 0;
+  /// Copies go to the visitor's stick only ([copy] to = "stick") and no stick is in the kiosk.
+  virtual bool stick_missing() const = 0;
   /// The day's copies ([copy] per_day) have all been made.
   virtual bool day_limit_reached() const = 0;
   /// Starts a copy of what is shown, in the visitor's language, off the window thread; the window layer then
-  /// reports with KioskFlow::copy_done or copy_failed. False when what is shown cannot be copied (nothing starts).
+  /// reports with KioskFlow::copy_finished. False when what is shown cannot be copied (nothing starts).
   virtual bool start_copy() = 0;
 };
 

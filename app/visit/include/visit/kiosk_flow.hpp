@@ -242,11 +242,11 @@ class KioskFlow {
   /// The capture under way ended without a picture: the camera failed (timeout = false) or the picture never
   /// lay still long enough (timeout = true). Said; the picture felt before stays.
   void capture_failed(bool timeout, double now_s);
-  /// The copy asked for was made and sent: `line` is said (staff's words, [copy] printed_line), or the
-  /// catalogue's when it is empty.
-  void copy_done(const std::string& line, double now_s);
-  /// The copy asked for could not be made or sent (why is in the log): the visitor is told to ask staff.
-  void copy_failed(double now_s);
+  /// The copy asked for is finished: one sentence a route, printed first: printed, staff's line ([copy]
+  /// printed_line, else the catalogue's) or the sorry line; saved, the folder it is in and "You can take your stick
+  /// now", or why not (full, write-protected, not FAT or exFAT, no stick, the sorry line). A copy that reached
+  /// neither does not count against the visit.
+  void copy_finished(const CopyReport& report, double now_s);
   /// The operator changed the keys ([keys]): from now on every message names these (the next thing said
   /// already does). Does not speak and does not touch the session.
   void set_keys(const config::KeysSettings& keys) { p_.keys = keys; }

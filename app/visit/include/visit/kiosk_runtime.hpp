@@ -167,8 +167,8 @@ class KioskRuntime final : private SessionEffects {
   LibraryDesk library_;
   DisplaySwitches switches_;
   CameraDesk camera_;  // its worker stops before the rest goes
-  CopyDesk copies_;    // its worker too
-  StickDesk sticks_;   // last: its threads stop first
+  StickDesk sticks_;   // its threads stop before the parts above go
+  CopyDesk copies_;    // last: its worker, which may wait on sticks_, stops first
 };
 
 /// The device profile in force (config/device_profile.hpp): the board's ("haply", "haply-gen2") while a USB

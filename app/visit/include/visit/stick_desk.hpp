@@ -59,6 +59,8 @@ class StickDesk final : public StickEffects {
   void set_screen_picture_side_px(int px) { service_.set_screen_picture_side_px(px); }
   /// The stick service, for the operator's status and tests.
   const StickService& service() const { return service_; }
+  /// The stick service, for writing copies onto the stick (CopyDesk).
+  StickService& service() { return service_; }
 
  private:
   void inserted(StickNews& n, KioskFlow& flow, double now_s);
