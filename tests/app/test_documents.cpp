@@ -710,6 +710,64 @@ std::optional<StickNews> next_news(StickService& svc) {
 // device "inserted" is mounted by the kiosk's own code and listed; a page is browsed; the stick is taken
 // out while a page is still being drawn (the worker made to hang), and the removal is not held up by it;
 // inserted again, it is a new stick. The image is unchanged.
+// A write onto the stick in the kiosk (a take-home copy): none without a stick; a folder stick is written in
+// place; a real ext4 stick, mounted by the kiosk's own code, is refused as not FAT or exFAT before anything is
+// touched (the image is unchanged) and the writer never runs; taken out, there is no stick again.
+TEST(StickService, WritesGoOnlyToAStickInTheKioskAndOnlyIfFatOrExfat) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root (losetup, mount); CI runs as root";
+  if (sh("command -v mkfs.ext4 >/dev/null && command -v losetup >/dev/null") != 0)
+    GTEST_SKIP() << "mkfs.ext4 or losetup missing";
+  const fs::path dir = fresh_dir("stick_write");
+  fs::create_directories(dir / "src");
+  fs::copy_file(kData / "images" / "silhouette_3.png", dir / "src" / "shape.png");
+  const Ext4Stick stick(dir / "src", dir / "stick.img");
+  ASSERT_TRUE(stick.made) << "mkfs.ext4 -d failed";
+  if (stick.loop->dev.empty()) GTEST_SKIP() << "the kernel refused a loop device";
+  const std::string& loop = stick.loop->dev;
+  const fs::path folder_stick = dir / "folder";
+  fs::create_directories(folder_stick);
+
+  const std::string result = in_mount_namespace([&]() -> std::string {
+    auto events = std::make_unique<sticks::FakeBlockEventSource>();
+    sticks::FakeBlockEventSource* fake = events.get();
+    StickService svc(test_settings(), std::move(events), (dir / "mnt").string());
+    if (!svc.can_mount()) return "SKIP: no CAP_SYS_ADMIN";
+    int written = 0;
+    const auto writer = [&](const std::string& top) {
+      ++written;
+      std::ofstream(fs::path(top) / "copy.txt") << "a copy";
+    };
+    if (svc.stick_in()) return "a stick is in before any was inserted";
+    if (svc.write_to_stick(writer).get().kind != StickWriteOutcome::Kind::NoStick) return "no stick: not NoStick";
+
+    svc.insert_folder(folder_stick.string());
+    std::optional<StickNews> n = next_news(svc);
+    if (!n || !svc.stick_in()) return "folder: not in";
+    if (svc.write_to_stick(writer).get().kind != StickWriteOutcome::Kind::Written || written != 1)
+      return "folder: not written";
+    if (slurp(folder_stick / "copy.txt") != "a copy") return "folder: the file is not there";
+    svc.remove_folder();
+    n = next_news(svc);
+    if (!n || n->kind != StickNews::Kind::Removed || svc.stick_in()) return "folder: still in after removal";
+
+    fake->push({sticks::BlockEvent::Action::Add, loop, ""});
+    n = next_news(svc);
+    if (!n || n->kind != StickNews::Kind::Inserted || !svc.stick_in()) return "ext4: not inserted";
+    const StickWriteOutcome o = svc.write_to_stick(writer).get();
+    if (o.kind != StickWriteOutcome::Kind::Format) return "ext4: expected Format, got: " + o.error;
+    if (o.error.find("(ext4) is not one the kiosk writes") == std::string::npos) return "ext4: " + o.error;
+    if (written != 1) return "ext4: the writer ran";
+    fake->push({sticks::BlockEvent::Action::Remove, loop, ""});
+    n = next_news(svc);
+    if (!n || n->kind != StickNews::Kind::Removed || svc.stick_in()) return "ext4: still in after removal";
+    return "";
+  });
+  if (result.rfind("SKIP: ", 0) == 0) GTEST_SKIP() << result.substr(6);
+  EXPECT_EQ(result, "");
+  EXPECT_EQ(slurp(stick.img), stick.before) << "nothing was written to the ext4 stick";
+  fs::remove_all(dir);
+}
+
 TEST(StickService, HotPlugInsertBrowseRemoveMidRenderInsertAgain) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root (losetup, mount); CI runs as root";
   if (sh("command -v mkfs.ext4 >/dev/null && command -v losetup >/dev/null") != 0)

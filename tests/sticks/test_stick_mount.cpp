@@ -114,6 +114,50 @@ TEST_F(FakeHelpers, MountedThroughTheHelperAndUnmountedWhenDestroyed) {
   EXPECT_EQ(calls(), "mount /dev/sdz1 4\nunmount 4\n");
 }
 
+TEST_F(FakeHelpers, WrittenThroughTheHelpersReadWriteMountAndClosedOnce) {
+  const std::string exe = helper("hk-stick-mount",
+                                 "case \"$1\" in\n"
+                                 "  mount) echo \"mounted vfat at /run/haptic-kiosk/usb/$3 from $2\" ;;\n"
+                                 "  mount-rw) echo \"mounted-rw vfat at /run/haptic-kiosk/usb-rw/$3 from $2\" ;;\n"
+                                 "  unmount-rw) echo \"unmounted-rw /run/haptic-kiosk/usb-rw/$3\" ;;\n"
+                                 "  unmount) echo \"unmounted /run/haptic-kiosk/usb/$2\" ;;\n"
+                                 "esac");
+  auto m = mount_stick(StickMounter::Helper, "/dev/sdz1", "", 6, exe);
+  {
+    auto rw = m->mount_writable();
+    EXPECT_EQ(rw->folder(), "/run/haptic-kiosk/usb-rw/6");
+    rw->close();
+    rw->close();  // once is enough
+  }
+  { auto forgotten = m->mount_writable(); }  // closed when it goes, too
+  m.reset();
+  EXPECT_EQ(calls(),
+            "mount /dev/sdz1 6\nmount-rw /dev/sdz1 6\nunmount-rw /dev/sdz1 6\nmount-rw /dev/sdz1 6\n"
+            "unmount-rw /dev/sdz1 6\nunmount 6\n");
+}
+
+TEST_F(FakeHelpers, TheHelpersWriteRefusalsKeepTheirKind) {
+  const std::string exe = helper(
+      "hk-stick-mount",
+      "case \"$1\" in\n"
+      "  mount) echo \"mounted vfat at /run/haptic-kiosk/usb/$3 from $2\" ;;\n"
+      "  mount-rw) echo \"hk-stick-mount: stick '$2': it is write-protected, so nothing was written\" >&2; exit 1 ;;\n"
+      "esac");
+  auto m = mount_stick(StickMounter::Helper, "/dev/sdz1", "", 0, exe);
+  const std::string why = refusal([&] { (void)m->mount_writable(); });
+  EXPECT_EQ(why, "stick '/dev/sdz1': it is write-protected, so nothing was written");
+  EXPECT_EQ(stick_write_refusal(why), StickWriteRefusal::WriteProtected);
+  EXPECT_EQ(stick_write_refusal("stick '/dev/sdz1': its filesystem (ntfs) is not one the kiosk writes (FAT, exFAT)"),
+            StickWriteRefusal::Format);
+  EXPECT_EQ(stick_write_refusal("stick '/dev/sdz1': the kernel refused"), StickWriteRefusal::Other);
+  // An answer that is not the result line: refused, and whatever it did is undone.
+  const std::string odd = helper("hk-stick-mount2",
+                                 "case \"$1\" in mount) echo \"mounted vfat at /run/haptic-kiosk/usb/$3 from $2\" ;;"
+                                 " mount-rw) echo \"all good\" ;; esac");
+  auto m2 = mount_stick(StickMounter::Helper, "/dev/sdz2", "", 1, odd);
+  EXPECT_NE(refusal([&] { (void)m2->mount_writable(); }).find("not 'mounted-rw FSTYPE at FOLDER'"), std::string::npos);
+}
+
 TEST_F(FakeHelpers, UnmountIsIdempotentAndReportsFailure) {
   const std::string exe =
       helper("hk-stick-mount",
