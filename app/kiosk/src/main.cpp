@@ -1,7 +1,8 @@
 // haptic-kiosk: command line entry. Subcommands: explore (headless run, DESIGN.md contract), capture (one camera
 // capture), cameras (the cameras found), stick (what a USB stick offers), pin (set or check the operator's PIN), speak
 // (a message or text rendered to WAV), devices (USB and serial devices found) and calibrate (the USB pantograph's
-// encoder offsets) and tactile (a take-home copy of a picture).
+// encoder offsets), tactile (a take-home copy of a picture) and library check (a picture library checked before
+// roll-out).
 #include <spdlog/cfg/env.h>
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -11,6 +12,7 @@
 #include "cli/audio_settings.hpp"
 #include "cli/device_command.hpp"
 #include "cli/explore.hpp"
+#include "cli/library_command.hpp"
 #include "cli/pin_command.hpp"
 #include "cli/stick_command.hpp"
 #include "cli/tactile_command.hpp"
@@ -42,6 +44,7 @@ struct Commands {
   hk::app::StickOptions sto;
   hk::app::PinOptions po;
   hk::app::TactileOptions to;
+  hk::app::LibraryOptions lo;
   CLI::App* explore = nullptr;
   CLI::App* capture = nullptr;
   CLI::App* cameras = nullptr;
@@ -51,6 +54,8 @@ struct Commands {
   CLI::App* stick = nullptr;
   CLI::App* pin = nullptr;
   CLI::App* tactile = nullptr;
+  CLI::App* library = nullptr;
+  CLI::App* library_check = nullptr;
 };
 
 /// The kiosk's own options (no subcommand: the window with the picture library).
@@ -193,6 +198,18 @@ void add_tactile_command(CLI::App& cli, Commands& c) {
   c.tactile->add_option("--config", c.to.config_path, "Settings file (TOML)");
 }
 
+/// The library's own: `library check`.
+void add_library_command(CLI::App& cli, Commands& c) {
+  c.library = cli.add_subcommand("library", "The picture library: check one before it is rolled out");
+  c.library->require_subcommand(1);
+  c.library_check = c.library->add_subcommand(
+      "check",
+      "Check a library folder: every picture decodes within the limits, every sidecar and annotation file loads; "
+      "one line per problem (FILE: reason); exit 0 all well, 1 problems, 2 the folder cannot be read");
+  c.library_check->add_option("folder", c.lo.folder, "The library folder")->required();
+  c.library_check->add_option("--config", c.lo.config_path, "Settings file (TOML) whose [vision] limits apply");
+}
+
 /// Runs the subcommand given (the kiosk when none) and returns the process's exit status.
 /// @throws whatever the command throws (hk::Error and the like); main prints it as one line.
 int run_command(Commands& c) {
@@ -222,6 +239,8 @@ int run_command(Commands& c) {
     return hk::app::run_pin(c.po);
   } else if (*c.tactile) {
     return hk::app::run_tactile(c.to);
+  } else if (*c.library) {
+    return hk::app::run_library_check(c.lo);
   } else if (!*c.speak) {
     return hk::app::run_kiosk(c.ko);
   } else if (*c.speak) {
@@ -243,6 +262,7 @@ int main(int argc, char** argv) {
   add_camera_and_device_commands(cli, c);
   add_speak_stick_pin_commands(cli, c);
   add_tactile_command(cli, c);
+  add_library_command(cli, c);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
