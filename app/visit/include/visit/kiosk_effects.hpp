@@ -174,7 +174,6 @@ class SessionEffects {
   virtual void new_session() = 0;
 };
 
-/// Take-home copies of the picture shown (a tactile graphic with braille).
 /// What became of a copy, route by route ([copy] to: the printer, the visitor's stick, or both).
 struct CopyReport {
   /// A route's outcome.
@@ -195,6 +194,7 @@ struct CopyReport {
   bool nothing_made() const { return printed != Route::Done && saved != Route::Done; }
 };
 
+/// Take-home copies of the picture shown (a tactile graphic with braille).
 class CopyEffects {
  public:
   virtual ~CopyEffects() = default;
