@@ -11,7 +11,7 @@ packages=(
   libespeak-ng-dev flite1-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev gettext libboost-locale-dev
   libglfw3-dev libimgui-dev libgl-dev
   libpoppler-cpp-dev libqpdf-dev libtesseract-dev libleptonica-dev tesseract-ocr-eng libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev zlib1g-dev librsvg2-dev
-  liblouis-dev liblouis-data libcairo2-dev libcups2-dev
+  liblouis-dev liblouis-data libcairo2-dev libcups2-dev libsystemd-dev
 )
 if [ "${1:-}" != "--demo" ]; then
   packages+=(

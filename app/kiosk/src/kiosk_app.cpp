@@ -29,6 +29,7 @@
 #include "kiosk/script.hpp"
 #include "kiosk/view.hpp"
 #include "kiosk/window.hpp"
+#include "runtime/event_log.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
 #include "visit/operator_session.hpp"
@@ -53,7 +54,7 @@ StartSettings start_settings(const std::string& path) {
   if (path.empty()) return {};
   config::LoadedSettings l = config::load_settings_with_fallback(path, unix_now_s());
   if (!l.notice.empty()) {
-    spdlog::error("settings: {}", l.notice);
+    log_event(KioskEvent::settings_refused, spdlog::level::err, "settings: " + l.notice);
     if (l.from == config::LoadedSettings::From::backup) {
       // The kiosk runs on the .bak: it becomes the settings file again (the .bak stays as it is), so the PIN
       // in it opens the panel and the next save has a file to keep as .bak.
@@ -330,6 +331,9 @@ int run_kiosk(const KioskOptions& o) {
   kiosk_ptr = &kiosk;
   ScriptPlayer script(script_lines, o.script);
   start_kiosk(o, ro, rt, flow);
+  log_event(KioskEvent::kiosk_started, spdlog::level::info,
+            fmt::format("kiosk: started, {} library pictures, device {}", rt.library().picture_count(),
+                        rt.devices().usb() ? "USB pantograph" : "simulated"));
 
   PictureTexture texture(picture_side);
   CapturePreviewView preview;

@@ -19,6 +19,7 @@
 #include "formats/app_error.hpp"
 #include "kiosk/kiosk_app.hpp"
 #include "pictures/capture.hpp"
+#include "runtime/event_log.hpp"
 
 namespace {
 
@@ -253,6 +254,7 @@ int run_command(Commands& c) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  hk::app::use_kiosk_logger();     // the journal under the service (HK_EVENT fields), else standard error
   spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows e.g. each piece of speech as it is handed on
   CLI::App cli{"haptic-kiosk: feel the shapes in a picture through a force-feedback pantograph"};
   cli.require_subcommand(0, 1);

@@ -1,6 +1,8 @@
 // The kiosk's device and servo thread (device_host.hpp).
 #include "runtime/device_host.hpp"
 
+#include "runtime/event_log.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -63,8 +65,10 @@ void DeviceHost::open_emulated_board(const std::string& text) {
 bool DeviceHost::try_open_usb() {
   try {
     std::unique_ptr<io::HaplyDevice> dev = open_board(s_, nullptr);
-    spdlog::info("device: {} ({} profile: {:.2f} N everywhere)", dev->name(),
-                 config::device_profile(board_profile_type(s_)).name, io::min_force_capability_n(dev->params()));
+    log_event(
+        KioskEvent::device_connected, spdlog::level::info,
+        fmt::format("device: {} ({} profile: {:.2f} N everywhere)", dev->name(),
+                    config::device_profile(board_profile_type(s_)).name, io::min_force_capability_n(dev->params())));
     usb_ = std::move(dev);
     note_.clear();
     return true;
@@ -136,11 +140,11 @@ DeviceNews DeviceHost::poll(double now_s, DeviceStatus st, bool allowed) {
   if (usb_) {
     if (st != DeviceStatus::Ok && last_status_ == DeviceStatus::Ok) lost_since_s_ = now_s;
     if (st != DeviceStatus::Ok && !lost_spoken_ && now_s - lost_since_s_ >= kLostSpeech_s) {
-      spdlog::warn("device: {} lost", usb_->name());
+      log_event(KioskEvent::device_lost, spdlog::level::warn, "device: " + usb_->name() + " lost");
       lost_spoken_ = true;
       news = DeviceNews::Lost;
     } else if (st == DeviceStatus::Ok && lost_spoken_) {
-      spdlog::info("device: {} back", usb_->name());
+      log_event(KioskEvent::device_connected, spdlog::level::info, "device: " + usb_->name() + " back");
       lost_spoken_ = false;
       news = DeviceNews::Back;
     }

@@ -10,6 +10,7 @@
 #include "copies/stick_copy.hpp"
 #include "copies/tactile_output.hpp"
 #include "copies/tactile_scene.hpp"
+#include "runtime/event_log.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/stage.hpp"
 
@@ -161,6 +162,14 @@ void CopyDesk::poll(KioskFlow& flow, double now_s) {
   if (!r) return;
   worker_.join();
   if (r->nothing_made()) --made_today_;  // not made: it does not count against the day
+  const bool printed = r->printed == CopyReport::Route::Done, saved = r->saved == CopyReport::Route::Done;
+  if (r->nothing_made())
+    log_event(KioskEvent::copy_failed, spdlog::level::warn, "copy: neither printed nor saved (why is logged above)");
+  else
+    log_event(KioskEvent::copy_made, spdlog::level::info,
+              std::string("copy: ") + (printed && saved ? "printed and saved on a stick"
+                                       : printed        ? "printed"
+                                                        : "saved on a stick"));
   flow.copy_finished(*r, now_s);
 }
 

@@ -1,5 +1,7 @@
 #include "visit/kiosk_flow.hpp"
 
+#include "runtime/event_log.hpp"
+
 #include "audio/speech.hpp"
 #include "pictures/stick_pages.hpp"
 
@@ -489,6 +491,8 @@ void KioskFlow::wake(double now_s, bool keep_language) {
   if (!keep_language) fx_.speech.set_language(fx_.speech.default_language());
   activity(now_s);
   v_.help_layer = 0;
+  v_.started_s = now_s;
+  log_event(KioskEvent::visit_started, spdlog::level::info, "visit: started");
   start_tutorial();
   say(MessageId::welcome);
 }
@@ -497,6 +501,10 @@ void KioskFlow::end_session(double now_s) {
   if (v_.capturing) fx_.camera.cancel_capture();
   fx_.session.new_session();  // first: it stops speech, and the goodbye must be heard
   if (v_.source == KioskSource::Stick || !v_.stick.empty()) fx_.sticks.forget_stick();
+  if (v_.started_s >= 0)
+    log_event(KioskEvent::visit_finished, spdlog::level::info,
+              fmt::format("visit: finished after {:.0f} s, {} cop{} made", now_s - v_.started_s, v_.copies_made,
+                          v_.copies_made == 1 ? "y" : "ies"));
   v_ = Visit{};
   v_.next_invitation_s = now_s + p_.attract_every_s;
   say_brief(MessageId::goodbye);  // in the visitor's language; the next visit starts in the default

@@ -1,5 +1,7 @@
 #include "visit/kiosk_runtime.hpp"
 
+#include "runtime/event_log.hpp"
+
 #include "config/device_profile.hpp"
 
 #include <spdlog/spdlog.h>
@@ -295,6 +297,10 @@ ApplyReport KioskRuntime::apply_settings(const config::Settings& next, KioskFlow
     rebuild_shown();
     r.scene_rebuilt = true;
   }
+  log_event(r.refused.empty() ? KioskEvent::settings_applied : KioskEvent::settings_refused,
+            r.refused.empty() ? spdlog::level::info : spdlog::level::warn,
+            fmt::format("settings: applied at the panel{}{}", r.scene_rebuilt ? ", scene rebuilt" : "",
+                        r.refused.empty() ? "" : fmt::format(", {} refused for the board", r.refused.size())));
   return r;
 }
 

@@ -1,6 +1,8 @@
 // A USB stick as the visitor walks it (stick_desk.hpp).
 #include "visit/stick_desk.hpp"
 
+#include "runtime/event_log.hpp"
+
 #include <algorithm>
 
 #include "visit/describe.hpp"
@@ -31,6 +33,7 @@ void StickDesk::poll(KioskFlow& flow, double now_s) {
     if (n.kind == StickNews::Kind::Inserted) {
       inserted(n, flow, now_s);
     } else if (n.kind == StickNews::Kind::Refused) {
+      log_event(KioskEvent::stick_refused, spdlog::level::warn, "stick: refused: " + n.reason);
       busy_ = false;
       flow.stick_refused(n.reason, now_s);
     } else {
@@ -58,6 +61,9 @@ void StickDesk::inserted(StickNews& n, KioskFlow& flow, double now_s) {
   for (const bool documents : {true, false})
     for (const vision::RefusedEntry& r : n.refused)
       if (r.document == documents) note_problem("'" + r.path + "': " + r.reason);
+  log_event(
+      KioskEvent::stick_inserted, spdlog::level::info,
+      fmt::format("stick: {} documents, {} left out, read in {:.0f} ms", entries.size(), n.refused_entries, n.scan_ms));
   flow.stick_inserted(entries, now_s, n.unreadable_documents);
 }
 

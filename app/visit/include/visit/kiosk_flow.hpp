@@ -276,6 +276,7 @@ class KioskFlow {
     TutorialShape shape = TutorialShape::Square;
     int picture = 0;
     double last_activity_s = 0;
+    double started_s = -1;         // when the visitor woke the kiosk; −1 in attract before any visit
     double next_invitation_s = 0;  // Attract: when the next spoken invitation is due
     int invitation_language = -1;  // Attract: the language of the last invitation, −1 before the first
     std::string reading_language;  // the text being read is in this language, not the visitor's ("" theirs)
