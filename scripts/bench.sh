@@ -52,6 +52,8 @@ taskset -c 1 "$b/bench_scene_build" --benchmark_min_time=$(awk "BEGIN { print $m
 "$b/bench_tactile_copies" > "$out/tactile_copies.md"  # take-home copies: lay out, PDF and SVG times, the guidelines' distances per picture
 taskset -c 1 "$b/bench_section_cost" --segments 100000 1000000 > "$out/section_cost.md"  # first_hit by kind of query (PERFORMANCE "The boundary section's full queries")
 "$b/bench_capture_latency" --out "$out/capture_latency.json" > "$out/capture_latency.md"
+"$b/bench_library_reload" --out "$out/library_reload.md" > /dev/null  # 100 pictures copied into the watched library: live after, frames meanwhile
+"$b/bench_metrics_endpoint" --out "$out/metrics_endpoint.md" > /dev/null  # GET /metrics at 100/s: latency, and the servo's missed deadlines with and without
 [ -x "$b/bench_rectify" ] && "$b/bench_rectify" --benchmark_min_time=$min_time --benchmark_out="$out/rectify.json" --benchmark_out_format=json >/dev/null
 bash "$root/bench/coverage.sh" "$root/build" "$out" >/dev/null  # coverage per picture: CSV, chart and its table
 bash "$root/bench/scene_detectors.sh" "$root/build" "$out" > "$out/scene_detectors.md"  # each picture's scene, canny → auto, and per detector

@@ -11,7 +11,7 @@ packages=(
   libespeak-ng-dev flite1-dev portaudio19-dev libsndfile1-dev libsamplerate0-dev gettext libboost-locale-dev
   libglfw3-dev libimgui-dev libgl-dev
   libpoppler-cpp-dev libqpdf-dev libtesseract-dev libleptonica-dev tesseract-ocr-eng libudev-dev libblkid-dev libcamera-dev libsodium-dev libusb-1.0-0-dev libexiv2-dev libpng-dev zlib1g-dev librsvg2-dev
-  liblouis-dev liblouis-data libcairo2-dev libcups2-dev libsystemd-dev
+  liblouis-dev liblouis-data libcairo2-dev libcups2-dev libsystemd-dev libmicrohttpd-dev
 )
 if [ "${1:-}" != "--demo" ]; then
   packages+=(
@@ -20,6 +20,7 @@ if [ "${1:-}" != "--demo" ]; then
     poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools cups-daemon cups-client
     dpkg-dev file lintian systemd cage
     clang libclang-rt-14-dev llvm-14 clang-format-14
+    prometheus ansible ansible-lint rsync
   )
 fi
 missing=()

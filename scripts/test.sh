@@ -8,6 +8,8 @@
 #   fuzz      every libFuzzer harness for HK_FUZZ_SECONDS (10 s here; scripts/bench.sh runs them longer)
 #   package   the Debian package, built and checked (lintian, file list, systemd-analyze verify)
 #   limits    the PDF and OCR workers' memory limits, which ASan cannot host, on the package's Release build
+#   fleet     the Ansible playbook (syntax, ansible-lint, the role in check mode against this machine, a broken
+#             library refused first) and the Prometheus files (promtool): tests/fleet/check.sh
 # The benchmarks are not built here (scripts/bench.sh builds and runs them).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -43,6 +45,13 @@ worker_limits() {
   cmake --build "$pkg" -j "$(nproc)" --target test_worker_limits hk-pdf-worker hk-ocr-worker
   HK_PDF_WORKER="$pkg/vision/hk-pdf-worker" HK_OCR_WORKER="$pkg/vision/hk-ocr-worker" "$pkg/test_worker_limits" --gtest_brief=1
 }
+# The fleet's files against the package just built and the kiosk of the sanitizer build.
+fleet_check() {
+  local version
+  version="$(sed -n 's/^project([^)]*VERSION \([0-9][0-9.]*\).*/\1/p' "$root/CMakeLists.txt" | head -n 1)"
+  bash "$root/tests/fleet/check.sh" "$root/dist/haptic-kiosk_${version}_$(dpkg --print-architecture).deb" \
+    "$build/app/haptic-kiosk"
+}
 checks() {
   bash "$root/scripts/check-rooms.sh"
   bash "$root/scripts/check-format.sh"
@@ -55,6 +64,7 @@ stage tests run_tests
 stage fuzz bash "$root/scripts/fuzz.sh" --seconds "${HK_FUZZ_SECONDS:-10}"
 stage package package_and_check
 stage limits worker_limits
+stage fleet fleet_check
 echo "test.sh: stage minutes"
 for s in "${stages[@]}" "all $(( $(date +%s) - t_all ))"; do
   awk -v name="${s% *}" -v s="${s#* }" 'BEGIN { printf "  %-8s %5.1f\n", name, s / 60 }'

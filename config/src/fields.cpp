@@ -2,6 +2,7 @@
 /// The one table of settings fields (table, key, range, unit, help, accessors) and the checks
 /// built on it: range checks, cross-field checks, message formatting.
 
+#include <arpa/inet.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -147,6 +148,36 @@ std::string scene_cache_problem(std::string_view v) {
   return "must be \"auto\", \"off\" or an absolute folder";
 }
 
+/// The check of [kiosk] library: "auto" or an absolute folder.
+std::string library_problem(std::string_view v) {
+  if (v == "auto" || (!v.empty() && v.front() == '/')) return path_problem(v);
+  return "must be \"auto\" or an absolute folder";
+}
+
+/// The check of [metrics] listen: empty, or ADDRESS:PORT with a numeric IPv4 address or a bracketed IPv6 one and a
+/// port in [1, 65535].
+std::string listen_problem(std::string_view v) {
+  if (v.empty()) return {};
+  const std::string_view::size_type colon = v.rfind(':');
+  if (colon == std::string_view::npos || colon == 0) return "must be ADDRESS:PORT (\"127.0.0.1:9471\") or empty";
+  const std::string_view host = v.substr(0, colon), port = v.substr(colon + 1);
+  int p = 0;
+  if (port.empty() || port.size() > 5) return "has no port in [1, 65535] after the last ':'";
+  for (char c : port) {
+    if (c < '0' || c > '9') return "has no port in [1, 65535] after the last ':'";
+    p = p * 10 + (c - '0');
+  }
+  if (p < 1 || p > 65535) return "has no port in [1, 65535] after the last ':'";
+  std::array<unsigned char, 16> addr{};
+  if (host.size() > 2 && host.front() == '[' && host.back() == ']') {
+    const std::string h(host.substr(1, host.size() - 2));
+    if (inet_pton(AF_INET6, h.c_str(), addr.data()) == 1) return {};
+    return "has an IPv6 address in brackets that does not parse";
+  }
+  if (inet_pton(AF_INET, std::string(host).c_str(), addr.data()) == 1) return {};
+  return "must name a numeric IPv4 address or a bracketed IPv6 one before the port";
+}
+
 /// The check of [kiosk] quiet_hours (parse_quiet_hours).
 std::string quiet_hours_problem(std::string_view v) {
   std::string why;
@@ -211,7 +242,7 @@ constexpr auto kKeyNames = std::to_array<std::string_view>(
      "MINUS", "EQUAL", "KP_0",   "KP_1",        "KP_2",    "KP_3",      "KP_4",  "KP_5",  "KP_6",   "KP_7",
      "KP_8",  "KP_9",  "KP_ADD", "KP_SUBTRACT", "KP_ENTER"});
 
-constexpr std::array<detail::TableInfo, 12> kTables{{
+constexpr std::array<detail::TableInfo, 13> kTables{{
     {"haptics", "Force rendering and the servo loop."},
     {"device",
      "Which device drives the handle: the simulated pantograph's physics, and the USB pantograph's board, links and "
@@ -227,6 +258,7 @@ constexpr std::array<detail::TableInfo, 12> kTables{{
     {"copy",
      "Take-home copies: a tactile graphic of the picture with braille, made when a visitor presses the Copy "
      "key twice."},
+    {"metrics", "The Prometheus metrics endpoint a museum's monitoring scrapes: counts only, no visitor data."},
     {"operator", "The operator's panel: how it opens, its PIN (set with 'haptic-kiosk pin set') and its records."},
 }};
 
@@ -455,6 +487,11 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
              "\"auto\" (the service's state folder, else ~/.local/share/haptic-kiosk/names), \"off\" (only the "
              "files beside the pictures), or an absolute folder.",
              {}, &scene_cache_problem),
+    HK_FIELD(kiosk, library, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+             "The picture library folder, watched: pictures added, changed or removed there are taken without a "
+             "restart once unchanged for 2 s. \"auto\" (the service's state folder's library, else the shipped "
+             "pictures) or an absolute folder; the shipped pictures while it holds none.",
+             {}, &library_problem),
     HK_FIELD(kiosk, say_names_on_touch, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
              "\"on\": the first time a visitor touches a named shape of a picture, its name is said, once; \"off\": "
              "names only when asked (Where, Describe).",
@@ -552,6 +589,11 @@ constexpr auto kFields = std::to_array<FieldDescriptor>({
     HK_FIELD(copy, paper, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "", "Paper of the copies.", kPapers),
     HK_FIELD(copy, braille_grade, FieldGroup::kiosk, ApplyWhen::live, 1, 2, "",
              "Braille of the copies' labels: 1 uncontracted, 2 contracted."),
+    // [metrics]
+    HK_FIELD(metrics, listen, FieldGroup::kiosk, ApplyWhen::restart, 0, 0, "",
+             "Where the Prometheus metrics endpoint listens, \"ADDRESS:PORT\" (\"127.0.0.1:9471\"; a LAN address "
+             "for a central Prometheus); empty: off.",
+             {}, &listen_problem),
     // [operator]
     HK_FIELD_IN(operator_, "operator", open_chord, FieldGroup::kiosk, ApplyWhen::live, 0, 0, "",
                 "Key chord that opens the operator's panel (then the PIN), e.g. \"CTRL+ALT+O\".", {}, &chord_problem),

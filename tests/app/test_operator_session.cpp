@@ -14,6 +14,7 @@
 #include "audio/messages.hpp"
 #include "config/load.hpp"
 #include "config/operator_pin.hpp"
+#include "visit/fleet_settings.hpp"
 #include "visit/operator_session.hpp"
 
 namespace fs = std::filesystem;
@@ -294,6 +295,52 @@ TEST_F(OperatorSessionTest, TheLockoutIsToldInTheStaffsLanguageToo) {
   EXPECT_EQ(s.message(), "Code PIN erroné (3 essais manqués). Réessayez dans 30 secondes.");
   s.tick(29.5, kT0 + 29);
   EXPECT_EQ(s.message(), "Réessayez dans 1 seconde.");
+}
+
+}  // namespace
+}  // namespace hk::app
+
+namespace hk::app {
+namespace {
+
+TEST_F(OperatorSessionTest, TheMuseumsFieldsAreLockedKeptAtResetAndNeverWrittenIntoTheStaffsFile) {
+  // The staff's file says English and a 300 s timeout; the museum's fleet file says French.
+  config::Settings own = in_use_;
+  own.kiosk.timeout_s = 300;
+  config::save_settings_atomic(own, path_);
+  std::ofstream(dir_ / "fleet.toml") << "[kiosk]\nlanguage = \"fr\"\n\n[metrics]\nlisten = \"127.0.0.1:9471\"\n";
+  const std::optional<FleetSettings> fleet = load_fleet(fleet_path_for(path_));
+  ASSERT_TRUE(fleet);
+  const config::Settings merged = with_fleet(config::load_settings(path_), *fleet);
+  ASSERT_EQ(merged.kiosk.language, "fr");
+  OperatorSession s(path_, merged, "", [](const config::Settings&) { return ApplyReport{}; });
+  s.set_fleet(fleet->path, fleet->keys);
+  s.chord(0.0, kT0);
+  s.submit_pin("2468", 0.1, kT0);
+  finish_check(s, 0.2);
+  ASSERT_EQ(s.state(), PanelState::open);
+  EXPECT_TRUE(s.managed(field("kiosk", "language")));
+  EXPECT_FALSE(s.managed(field("kiosk", "timeout_s")));
+  // A locked field cannot be changed: refused, its box back to the museum's value.
+  s.edit_text(field("kiosk", "language")) = "de";
+  const std::string why = s.commit_field(field("kiosk", "language"), kT0);
+  EXPECT_NE(why.find("Set by the museum in " + fleet->path), std::string::npos) << why;
+  EXPECT_EQ(s.working().kiosk.language, "fr");
+  EXPECT_EQ(s.edit_text(field("kiosk", "language")), "fr");
+  // Reset keeps the museum's values; a staff field goes back to its default.
+  s.reset_to_defaults(kT0);
+  EXPECT_EQ(s.working().kiosk.language, "fr");
+  EXPECT_EQ(s.working().metrics.listen, "127.0.0.1:9471");
+  EXPECT_EQ(s.working().kiosk.timeout_s, 120.0);
+  // Save: the staff's file gets the staff's change and keeps its own values of the museum's fields.
+  s.edit_text(field("kiosk", "timeout_s")) = "600";
+  ASSERT_EQ(s.commit_field(field("kiosk", "timeout_s"), kT0), "");
+  s.save(kT0);
+  const config::Settings saved = config::load_settings(path_);
+  EXPECT_EQ(saved.kiosk.timeout_s, 600.0);
+  EXPECT_EQ(saved.kiosk.language, "en");
+  EXPECT_EQ(saved.metrics.listen, "");
+  EXPECT_EQ(s.working().kiosk.language, "fr");  // still in force
 }
 
 }  // namespace

@@ -296,3 +296,72 @@ TEST(PinVerifier, DestructorFinishesTheAttemptUnderWay) {
   // The attempt was heard and counted before the worker stopped.
   EXPECT_EQ(config::read_lockout_state(cfg + ".state", 1'700'000'000), (config::LockoutState{1, 1'700'000'000}));
 }
+
+namespace {
+
+/// `printf '%s\n' TEXT | haptic-kiosk pin ACTION [--config CFG]`: exit status, stdout and stderr.
+struct ExeOutput {
+  int status = -1;
+  std::string out, err;
+};
+ExeOutput run_pin_out(const std::string& action, const std::string& stdin_text, const fs::path& dir,
+                      const std::string& cfg) {
+  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = "printf '%s\\n' '" + stdin_text + "' | " + std::string(HK_KIOSK_EXE) + " pin " + action +
+                          (cfg.empty() ? std::string() : " --config '" + cfg + "'") + " >'" + out.string() + "' 2>'" +
+                          err.string() + "'";
+  ExeOutput r;
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+  r.out = read_text(out);
+  r.err = read_text(err);
+  return r;
+}
+
+TEST(PinCommand, HashPrintsAHashThatSetHashPutsIntoTheFileOnceAndThePinThenOpens) {
+  LetterDir dir;
+  const fs::path cfg = dir.path() / "kiosk.toml";
+  config::Settings s = non_default_settings();
+  config::save_settings_atomic(s, cfg.string());
+  const ExeOutput h = run_pin_out("hash", "8642", dir.path(), "");
+  ASSERT_EQ(h.status, 0) << h.err;
+  const std::string hash = h.out.substr(0, h.out.find('\n'));
+  EXPECT_EQ(hash.rfind("$argon2id$", 0), 0u) << h.out;
+  EXPECT_TRUE(config::verify_pin(hash, "8642"));
+  EXPECT_EQ(h.out.find("8642"), std::string::npos);
+  // set-hash: written once, "unchanged" the second time (a roll-out run twice changes nothing).
+  const ExeOutput first = run_pin_out("set-hash", hash, dir.path(), cfg.string());
+  ASSERT_EQ(first.status, 0) << first.err;
+  EXPECT_EQ(first.out, "set\n");
+  const auto mtime = fs::last_write_time(cfg);
+  const ExeOutput second = run_pin_out("set-hash", hash, dir.path(), cfg.string());
+  ASSERT_EQ(second.status, 0) << second.err;
+  EXPECT_EQ(second.out, "unchanged\n");
+  EXPECT_EQ(fs::last_write_time(cfg), mtime);
+  config::Settings after = config::load_settings(cfg.string());
+  EXPECT_EQ(after.operator_.pin_hash, hash);
+  after.operator_.pin_hash = s.operator_.pin_hash;
+  EXPECT_EQ(after, s);  // every other value kept
+  EXPECT_EQ(run_pin("check", "8642", cfg).status, 0);
+}
+
+TEST(PinCommand, SetHashRefusesWhatIsNoHashAndHashRefusesWhatIsNoPin) {
+  LetterDir dir;
+  const fs::path cfg = dir.path() / "kiosk.toml";
+  config::save_settings_atomic(config::Settings{}, cfg.string());
+  const std::string before = read_text(cfg);
+  const ExeOutput bad = run_pin_out("set-hash", "1234", dir.path(), cfg.string());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_TRUE(one_line(bad.err)) << bad.err;
+  EXPECT_NE(bad.err.find("not an argon2id hash"), std::string::npos) << bad.err;
+  EXPECT_EQ(read_text(cfg), before);
+  const ExeOutput short_pin = run_pin_out("hash", "12", dir.path(), "");
+  EXPECT_EQ(short_pin.status, 1);
+  EXPECT_TRUE(short_pin.out.empty());
+  EXPECT_TRUE(one_line(short_pin.err)) << short_pin.err;
+  const ExeOutput no_config = run_pin_out("set", "1234", dir.path(), "");
+  EXPECT_EQ(no_config.status, 1);
+  EXPECT_NE(no_config.err.find("--config FILE is needed"), std::string::npos) << no_config.err;
+}
+
+}  // namespace

@@ -128,6 +128,8 @@ Settings every_field_changed() {
   s.kiosk.scene_cache = "/var/cache/x";
   s.kiosk.names_dir = "/var/lib/names";
   s.kiosk.say_names_on_touch = "off";
+  s.kiosk.library = "/srv/kiosk library";
+  s.metrics.listen = "[::1]:9471";
   s.kiosk.languages = "de, en";
   s.audio.voice = "espeak";
   s.kiosk.language = "de";

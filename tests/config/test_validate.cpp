@@ -120,7 +120,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
         name == "operator.audit_log" || name == "kiosk.quiet_hours" || name == "kiosk.scene_cache" ||
         name == "kiosk.names_dir" || name == "vision.ocr_languages" || name == "kiosk.languages" ||
         name == "kiosk.language" || name == "operator.language" || name == "copy.printer" ||
-        name == "copy.printed_line") {
+        name == "copy.printed_line" || name == "kiosk.library" || name == "metrics.listen") {
       EXPECT_EQ(d.kind, FieldKind::text) << name;
       EXPECT_TRUE(d.choices.empty()) << name;
       EXPECT_NE(d.check, nullptr) << name;  // free text, checked
@@ -130,7 +130,7 @@ TEST(ConfigValidate, DescriptorTableMatchesDocumentedRanges) {
     EXPECT_TRUE(seen.count(name)) << name << " is in the table but not documented in the test";
     EXPECT_FALSE(d.help.empty()) << name;
   }
-  EXPECT_EQ(texts, 51u);
+  EXPECT_EQ(texts, 53u);
   EXPECT_EQ(field_descriptors().size(), numeric_specs().size() + texts);
 }
 
@@ -315,6 +315,36 @@ TEST(ConfigValidate, CameraSourceIsAutoNoneOrASourceSpec) {
   auto e = capture_error([&] { validate(s); });
   ASSERT_TRUE(e);
   EXPECT_NE(std::string(e->what()).find("control character"), std::string::npos) << e->what();
+}
+
+TEST(ConfigValidate, MetricsListenIsEmptyOrANumericAddressAndAPort) {
+  Settings s;
+  for (const char* good : {"", "127.0.0.1:9471", "0.0.0.0:1", "192.168.4.20:65535", "[::1]:9471", "[::]:80"}) {
+    s.metrics.listen = good;
+    EXPECT_NO_THROW(validate(s)) << good;
+  }
+  for (const char* bad : {"9471", ":9471", "127.0.0.1", "127.0.0.1:0", "127.0.0.1:65536", "127.0.0.1:94x1",
+                          "localhost:9471", "::1:9471", "[::1]", "[fe80::zz]:9471", "300.1.1.1:9471"}) {
+    s.metrics.listen = bad;
+    auto e = capture_error([&] { validate(s); });
+    ASSERT_TRUE(e) << bad;
+    EXPECT_EQ(e->key(), "metrics.listen") << bad;
+    EXPECT_TRUE(is_one_line(e->what())) << e->what();
+  }
+}
+
+TEST(ConfigValidate, LibraryIsAutoOrAnAbsoluteFolder) {
+  Settings s;
+  for (const char* good : {"auto", "/var/lib/haptic-kiosk/library", "/srv/gallery 2"}) {
+    s.kiosk.library = good;
+    EXPECT_NO_THROW(validate(s)) << good;
+  }
+  for (const char* bad : {"", "off", "pictures", "./library"}) {
+    s.kiosk.library = bad;
+    auto e = capture_error([&] { validate(s); });
+    ASSERT_TRUE(e) << bad;
+    EXPECT_EQ(e->key(), "kiosk.library") << bad;
+  }
 }
 
 TEST(ConfigValidate, UnknownLevelModeIsRefused) {

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <string>
 
 #include "config/load.hpp"
@@ -187,13 +188,58 @@ int run_check(const std::string& config_path) {
   return 3;
 }
 
+/// `hash`: the argon2id hash of the PIN read, on standard output (for a museum's inventory; the PIN never leaves).
+int run_hash() {
+  SecretLine pin;
+  read_line("PIN to hash (4 to 12 digits, not shown): ", pin);
+  if (pin.too_long || !config::pin_problem(pin.text).empty()) {
+    say("no hash: a PIN is " + std::to_string(config::kPinMinDigits) + " to " + std::to_string(config::kPinMaxDigits) +
+        " digits (0-9)");
+    return 1;
+  }
+  std::printf("%s\n", config::hash_pin(pin.text).c_str());
+  return 0;
+}
+
+/// `set-hash`: the hash read (one line, as `hash` prints it) becomes [operator] pin_hash of the settings file; the
+/// file is left as it is when it already holds it ("unchanged" on standard output, for a roll-out's idempotence).
+int run_set_hash(const std::string& config_path) {
+  SecretLine line;
+  read_line("PIN hash: ", line);
+  const config::FieldDescriptor* d = config::find_field("operator", "pin_hash");
+  const std::string why = line.too_long ? std::string("is longer than an argon2id hash") : d->check(line.text);
+  if (line.text.empty() || !why.empty()) {
+    say("PIN hash not set: the line read " + (line.text.empty() ? std::string("is empty") : why) +
+        "; nothing was changed");
+    return 1;
+  }
+  config::Settings s;
+  std::error_code ec;
+  if (std::filesystem::exists(config_path, ec)) s = config::load_settings(config_path);
+  if (s.operator_.pin_hash == line.text) {
+    std::printf("unchanged\n");
+    return 0;
+  }
+  s.operator_.pin_hash = line.text;
+  config::save_settings_atomic(s, config_path);
+  std::printf("set\n");
+  say("PIN hash set in '" + config_path + "'");
+  return 0;
+}
+
 }  // namespace
 
 int run_pin(const PinOptions& options) {
   try {
+    if (options.action == "hash") return run_hash();
+    if (options.config_path.empty()) {
+      say("--config FILE is needed to " + options.action + " the PIN");
+      return options.action == "check" ? 3 : 1;
+    }
     if (options.action == "set") return run_set(options.config_path);
     if (options.action == "check") return run_check(options.config_path);
-    say("unknown action '" + options.action + "'; expected set or check");
+    if (options.action == "set-hash") return run_set_hash(options.config_path);
+    say("unknown action '" + options.action + "'; expected set, check, hash or set-hash");
   } catch (const std::exception& e) {
     say(e.what());
   }

@@ -29,7 +29,9 @@
 #include "kiosk/script.hpp"
 #include "kiosk/view.hpp"
 #include "kiosk/window.hpp"
+#include "pictures/picture_library.hpp"
 #include "runtime/event_log.hpp"
+#include "visit/fleet_settings.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
 #include "visit/operator_session.hpp"
@@ -44,11 +46,32 @@ namespace {
 std::int64_t unix_now_s() { return static_cast<std::int64_t>(std::time(nullptr)); }
 
 /// The settings the kiosk starts with: the file, or (when it is corrupt) its .bak or the defaults, said in
-/// the log and kept for the operator's panel.
+/// the log and kept for the operator's panel; then the museum's fleet file beside it over them
+/// (fleet_settings.hpp), or, when that is refused, the file alone (said the same way).
 struct StartSettings {
   config::Settings settings;
   std::string notice;
+  std::string fleet_path;            ///< the fleet file in force ("" none)
+  std::vector<std::string> managed;  ///< the keys it sets
 };
+
+/// `start` with the fleet file beside `path` over it, when there is one and it holds.
+void add_fleet(StartSettings& start, const std::string& path) {
+  const std::string fleet_path = fleet_path_for(path);
+  try {
+    if (std::optional<FleetSettings> f = load_fleet(fleet_path)) {
+      start.settings = with_fleet(start.settings, *f);
+      start.fleet_path = f->path;
+      start.managed = f->keys;
+      spdlog::info("settings: {} sets {} of them (the museum's; locked in the panel)", f->path, f->keys.size());
+    }
+  } catch (const config::ConfigError& e) {
+    log_event(KioskEvent::settings_refused, spdlog::level::err,
+              fmt::format("settings: {}; the museum's settings are not used, the kiosk runs on {}", e.what(), path));
+    if (!start.notice.empty()) start.notice += " ";
+    start.notice += e.what();
+  }
+}
 
 StartSettings start_settings(const std::string& path) {
   if (path.empty()) return {};
@@ -67,7 +90,9 @@ StartSettings start_settings(const std::string& path) {
       }
     }
   }
-  return {l.settings, l.notice};
+  StartSettings start{l.settings, l.notice, {}, {}};
+  add_fleet(start, path);
+  return start;
 }
 
 void check_screenshot_options(const KioskOptions& o) {
@@ -245,7 +270,11 @@ void show_first(const std::string& path, KioskRuntime& rt, KioskFlow& flow) {
 /// The runtime's options from the command line and the settings in use.
 RuntimeOptions runtime_options(const KioskOptions& o, const config::Settings& settings) {
   RuntimeOptions ro;
-  ro.library = o.library.empty() ? std::string(HK_DATA_DIR) + "/pictures" : o.library;
+  ro.shipped_library = std::string(HK_DATA_DIR) + "/pictures";
+  ro.library = !o.library.empty() ? o.library : library_dir(settings);
+  if (ro.library.empty()) ro.library = ro.shipped_library;
+  // Watched unless it is the shipped folder, or --show puts a picture from elsewhere first.
+  ro.library_settle_s = ro.library != ro.shipped_library && o.show.empty() ? kLibrarySettle_s : 0.0;
   ro.hotplug = o.hotplug;
   ro.mount_root = o.mount_root;
   ro.high_contrast = o.high_contrast;
@@ -326,6 +355,7 @@ int run_kiosk(const KioskOptions& o) {
     if (kiosk_ptr) kiosk_ptr->keys_changed();  // the visitor's keys, and the operator's chord
     return r;
   });
+  session.set_fleet(start.fleet_path, start.managed);
   OperatorPanel panel(session);
   Kiosk kiosk(o, rt, flow, session, panel, window);
   kiosk_ptr = &kiosk;

@@ -177,10 +177,13 @@ void add_speak_stick_pin_commands(CLI::App& cli, Commands& c) {
   c.pin
       ->add_option(
           "action", c.po.action,
-          "set: a new PIN (4 to 12 digits); check: exit 0 right, 1 wrong, 2 locked, 3 no PIN or unusable settings")
+          "set: a new PIN (4 to 12 digits); check: exit 0 right, 1 wrong, 2 locked, 3 no PIN or unusable settings; "
+          "hash: print the PIN's hash (for a museum's roll-out); set-hash: a hash read (as hash prints it) becomes "
+          "the settings file's (\"unchanged\" when it already is)")
       ->required()
-      ->check(CLI::IsMember({"set", "check"}));
-  c.pin->add_option("--config", c.po.config_path, "Settings file (TOML) holding [operator] pin_hash")->required();
+      ->check(CLI::IsMember({"set", "check", "hash", "set-hash"}));
+  c.pin->add_option("--config", c.po.config_path,
+                    "Settings file (TOML) holding [operator] pin_hash (every action but hash)");
 }
 
 /// The take-home copy: `tactile`.

@@ -157,6 +157,8 @@ void OperatorPanel::draw_panel(KioskRuntime& runtime, const KioskFlow& flow, int
     ImGui::PopStyleColor();
   }
   ImGui::TextColored(kGrey, tr("%s   audit: %s"), s_.files().settings_path.c_str(), s_.files().audit_path.c_str());
+  if (!s_.files().fleet_path.empty())
+    ImGui::TextColored(kGrey, tr("Locked fields are set by the museum in %s."), s_.files().fleet_path.c_str());
   const float actions_h = ImGui::GetFrameHeightWithSpacing() * 2.2f;
   ImGui::BeginChild("tabs", ImVec2(0, -actions_h));
   if (ImGui::BeginTabBar("groups")) {
@@ -214,10 +216,16 @@ void OperatorPanel::draw_fields(config::FieldGroup group, const std::string& pro
     ImGui::TableNextColumn();
     ImGui::SetNextItemWidth(-1);
     ImGui::PushID(key.c_str());
+    const bool locked = s_.managed(d);
+    if (locked) ImGui::BeginDisabled();
     const bool enter = ImGui::InputText("##v", &s_.edit_text(d),
                                         ImGuiInputTextFlags_AutoSelectAll | ImGuiInputTextFlags_EnterReturnsTrue);
+    if (locked) {
+      ImGui::EndDisabled();
+      ImGui::TextColored(kGrey, "%s", tr("locked: set by the museum"));
+    }
     record(key);
-    if (enter || ImGui::IsItemDeactivatedAfterEdit()) s_.commit_field(d, now_unix_s);
+    if (!locked && (enter || ImGui::IsItemDeactivatedAfterEdit())) s_.commit_field(d, now_unix_s);
     if (!s_.field_error(d).empty()) {
       ImGui::PushStyleColor(ImGuiCol_Text, kRed);
       ImGui::TextWrapped("%s", s_.field_error(d).c_str());

@@ -2,13 +2,13 @@
 #include "pictures/library_check.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <set>
 
 #include "formats/annotations.hpp"
 #include "formats/app_error.hpp"
 #include "formats/picture_notes.hpp"
+#include "pictures/picture_library.hpp"
 #include "pictures/picture_params.hpp"
 #include "vision/intake.hpp"
 
@@ -19,11 +19,6 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSidecarSuffix = ".toml";
 constexpr const char* kAnnotationsSuffix = ".annotations.json";
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
@@ -82,13 +77,11 @@ LibraryReport check_library(const std::string& folder, const config::Settings& s
   std::sort(names.begin(), names.end());
 
   const vision::ImageLimits limits = extract_params_from(s).limits;
-  static const std::set<std::string> kPictureKinds{".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp"};
   LibraryReport r;
   std::set<std::string> stems;  // of the pictures, for the companions' check
   for (const std::string& name : names) {
-    if (name.empty() || name[0] == '.') continue;
+    if (!is_picture_name(name)) continue;
     const fs::path path = fs::path(folder) / name;
-    if (kPictureKinds.count(lower(path.extension().string())) == 0) continue;
     ++r.pictures;
     stems.insert(path.stem().string());
     check_picture(path.string(), name, limits, r.problems);

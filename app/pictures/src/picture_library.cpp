@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
@@ -33,17 +35,27 @@ Polyline tutorial_polyline(TutorialShape shape, Vec2 half) {
   return p;
 }
 
+std::string library_dir(const config::Settings& s) {
+  if (s.kiosk.library != "auto") return s.kiosk.library;
+  const char* env = std::getenv("STATE_DIRECTORY");
+  if (!env || env[0] != '/') return {};
+  const std::string first(env, std::strcspn(env, ":"));
+  return first + "/library";
+}
+
+bool is_picture_name(const std::string& name) {
+  if (name.empty() || name[0] == '.') return false;
+  std::string ext = std::filesystem::path(name).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".tiff" ||
+         ext == ".webp";
+}
+
 std::vector<std::string> list_pictures(const std::string& folder) {
   std::error_code ec;
   std::vector<std::string> out;
-  for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
-    std::string ext = e.path().extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".tiff" ||
-        ext == ".webp") {
-      out.push_back(e.path().string());
-    }
-  }
+  for (const auto& e : std::filesystem::directory_iterator(folder, ec))
+    if (is_picture_name(e.path().filename().string())) out.push_back(e.path().string());
   if (ec) throw AppError("picture library '" + folder + "': cannot read the folder (" + ec.message() + ")");
   if (out.empty()) throw AppError("picture library '" + folder + "': holds no picture (png, jpg, bmp, tif, webp)");
   std::sort(out.begin(), out.end());

@@ -97,6 +97,25 @@ int PictureShelf::find(const std::string& path) const {
   return -1;
 }
 
+void PictureShelf::replace_pictures(std::vector<std::string> pictures, const std::vector<std::string>& changed) {
+  absorb_built();  // what the old numbering built, first
+  std::vector<Ahead> kept;
+  for (Ahead& a : ahead_) {
+    const std::string& old_path = pictures_[static_cast<std::size_t>(a.index)];
+    if (std::find(changed.begin(), changed.end(), old_path) != changed.end()) continue;
+    const auto at = std::find(pictures.begin(), pictures.end(), old_path);
+    if (at == pictures.end()) continue;
+    a.index = static_cast<int>(at - pictures.begin());
+    kept.push_back(std::move(a));
+  }
+  ahead_ = std::move(kept);
+  ahead_refused_.clear();
+  ++generation_;
+  builder_.drop_ahead();
+  drop_want();
+  pictures_ = std::move(pictures);
+}
+
 void PictureShelf::set_settings(const config::Settings& s, bool shape_changed) {
   s_ = s;
   if (!shape_changed) return;

@@ -1,5 +1,6 @@
 // Log lines with an event word, to the journal or standard error (event_log.hpp).
 #include "runtime/event_log.hpp"
+#include "runtime/metrics.hpp"
 
 #include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/base_sink.h>
@@ -75,7 +76,41 @@ const char* kiosk_event_name(KioskEvent e) {
   return i < kNames.size() ? kNames[i] : "";
 }
 
+namespace {
+
+/// The metrics an event counts (metrics.hpp).
+void count_event(KioskEvent e) {
+  KioskMetrics& m = kiosk_metrics();
+  switch (e) {
+    case KioskEvent::visit_started:
+      return m.add(KioskCount::visits_started);
+    case KioskEvent::visit_finished:
+      return m.add(KioskCount::visits_finished);
+    case KioskEvent::stick_inserted:
+      return m.add(KioskCount::sticks_read);
+    case KioskEvent::stick_refused:
+      return m.error(KioskError::stick_refused);
+    case KioskEvent::copy_made:
+      return m.add(KioskCount::copies_made);
+    case KioskEvent::copy_failed:
+      return m.error(KioskError::copy_failed);
+    case KioskEvent::device_lost:
+      return m.error(KioskError::device_lost);
+    case KioskEvent::settings_applied:
+      return m.add(KioskCount::settings_applied);
+    case KioskEvent::settings_refused:
+      return m.error(KioskError::settings_refused);
+    case KioskEvent::none:
+    case KioskEvent::kiosk_started:
+    case KioskEvent::device_connected:
+      return;
+  }
+}
+
+}  // namespace
+
 void log_event(KioskEvent e, spdlog::level::level_enum level, std::string_view message) {
+  count_event(e);
   const KioskEvent before = t_event;
   t_event = e;
   spdlog::log(level, "{}", message);

@@ -1,6 +1,7 @@
 #include "visit/kiosk_flow.hpp"
 
 #include "runtime/event_log.hpp"
+#include "runtime/metrics.hpp"
 
 #include "audio/speech.hpp"
 #include "pictures/stick_pages.hpp"
@@ -135,6 +136,7 @@ void KioskFlow::guarded(const char* what, const std::function<void()>& action) {
     // The visit as it was; what failed goes to the log, the visitor hears one short line.
     v_ = before;
     ++failures_;
+    kiosk_metrics().error(KioskError::visitor_action);
     spdlog::error("kiosk: {} failed: {}", what, e.what());
     try {
       say_brief(MessageId::sorry);
@@ -453,7 +455,8 @@ void KioskFlow::start_tutorial() {
 
 void KioskFlow::show(int index, const std::string& before) {
   const int n = fx_.library.picture_count();
-  v_.picture = ((index % n) + n) % n;  // wraps round both ways
+  const int from = v_.state == KioskState::Picture && !v_.captured ? v_.picture : -1;
+  v_.picture = fx_.library.moving_to(((index % n) + n) % n, from);  // wraps round both ways; a new listing taken
   v_.state = KioskState::Picture;
   v_.felt = true;
   v_.captured = false;

@@ -1,6 +1,7 @@
 #include "visit/kiosk_runtime.hpp"
 
 #include "runtime/event_log.hpp"
+#include "runtime/metrics.hpp"
 
 #include "config/device_profile.hpp"
 
@@ -52,15 +53,68 @@ config::Settings with_usable_ocr(const config::Settings& s) {
   return off;
 }
 
-/// The library's pictures (list_pictures: throws AppError for an empty or unreadable folder) on a shelf, with
-/// the scene cache of `o` (none when its folder is empty).
-PictureShelf library_shelf(const RuntimeOptions& o, const config::Settings& s) {
+/// The library folder of `o` watched, when it asks for that (null otherwise, or when inotify cannot start: logged,
+/// the folder is then read once).
+std::unique_ptr<LibraryWatch> library_watch(const RuntimeOptions& o, const config::Settings& s) {
+  if (!(o.library_settle_s > 0.0)) return nullptr;
+  try {
+    auto w = std::make_unique<LibraryWatch>(o.library, o.library_settle_s, extract_params_from(s).limits);
+    spdlog::info("library: watching {} ({} pictures now)", o.library, w->first_listing().size());
+    return w;
+  } catch (const AppError& e) {
+    spdlog::error("{}; its pictures are read once", e.what());
+    return nullptr;
+  }
+}
+
+/// The shipped pictures when the library folder is watched (empty otherwise, or when they cannot be read: logged).
+std::vector<std::string> shipped_pictures(const RuntimeOptions& o) {
+  if (!(o.library_settle_s > 0.0) || o.shipped_library.empty()) return {};
+  try {
+    return list_pictures(o.shipped_library);
+  } catch (const AppError& e) {
+    spdlog::warn("{}", e.what());
+    return {};
+  }
+}
+
+/// The library's pictures on a shelf, with the scene cache of `o` (none when its folder is empty): the folder
+/// watched's live pictures, else the shipped ones; a folder not watched is read once (list_pictures).
+/// @throws AppError (one line) when there is no picture to show.
+PictureShelf library_shelf(const RuntimeOptions& o, const config::Settings& s, const LibraryWatch* watch,
+                           const std::vector<std::string>& shipped) {
   std::shared_ptr<SceneCache> cache;
   if (!o.scene_cache_dir.empty()) {
     cache = std::make_shared<SceneCache>(o.scene_cache_dir);
     spdlog::info("scenes: kept in {}", o.scene_cache_dir);
   }
-  return PictureShelf(list_pictures(o.library), std::move(cache), s);
+  std::vector<std::string> pictures;
+  if (watch) {
+    pictures = watch->first_listing();
+    if (pictures.empty()) {
+      if (shipped.empty())
+        throw AppError("picture library '" + o.library + "': holds no picture, nor do the shipped ones");
+      spdlog::info("library: {} holds no picture yet; the {} shipped pictures meanwhile", o.library, shipped.size());
+      pictures = shipped;
+    }
+  } else {
+    pictures = list_pictures(o.library);
+  }
+  return PictureShelf(std::move(pictures), std::move(cache), s);
+}
+
+/// The metrics endpoint of [metrics] listen (null when off, or when it cannot listen: logged, the kiosk runs on).
+std::unique_ptr<MetricsServer> metrics_server(const config::Settings& s) {
+  if (s.metrics.listen.empty()) return nullptr;
+  try {
+    auto m = std::make_unique<MetricsServer>(s.metrics.listen,
+                                             [] { return kiosk_metrics().exposition(HK_PROGRAM_VERSION); });
+    spdlog::info("metrics: serving http://{}/metrics", s.metrics.listen);
+    return m;
+  } catch (const AppError& e) {
+    spdlog::error("{}; the kiosk runs on without its metrics", e.what());
+    return nullptr;
+  }
 }
 
 /// The camera of [camera] source: looked for when the source is named, or "auto" and `probe` (else none).
@@ -88,7 +142,9 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
       core_(cue_params_from(s), &audio_.cues()),
       devices_(s),
       tour_(core_, devices_, voice_, audio_, s_, half_, devices_.simulated_handle_m()),
-      shelf_(library_shelf(o, s)),
+      watch_(library_watch(o, s)),
+      shipped_(shipped_pictures(o)),
+      shelf_(library_shelf(o, s, watch_.get(), shipped_)),
       stage_(core_, voice_, audio_, tour_, shelf_, s_, half_),
       library_(shelf_, stage_),
       switches_(o.high_contrast, o.overlay),
@@ -97,7 +153,8 @@ KioskRuntime::KioskRuntime(const RuntimeOptions& o, const config::Settings& s, i
               o.mount_root.empty() ? std::string(sticks::kDefaultStickMountRoot) : o.mount_root, stage_, shelf_,
               audio_),
       copies_(
-          s_, stage_, [this] { return copy_language(); }, &sticks_.service()) {
+          s_, stage_, [this] { return copy_language(); }, &sticks_.service()),
+      metrics_(metrics_server(s)) {
   tour_.set_picture([this] { return stage_.tour_picture(); });
   if (!o.device.empty()) {
     devices_.open_emulated_board(o.device);
@@ -156,6 +213,9 @@ void KioskRuntime::announce_device() {
 }
 
 void KioskRuntime::poll(KioskFlow* flow, double now_s) {
+  if (watch_)
+    if (std::optional<LibraryListing> l = watch_->take())
+      library_.offer_listing(l->pictures.empty() ? shipped_ : std::move(l->pictures), std::move(l->changed));
   library_.poll(flow, now_s);
   if (flow) {
     sticks_.poll(*flow, now_s);
@@ -164,6 +224,25 @@ void KioskRuntime::poll(KioskFlow* flow, double now_s) {
   }
   stage_.poll_text(now_s);
   poll_device(now_s);
+  poll_metrics(now_s);
+  if (flow) kiosk_metrics().set_visit_active(flow->view().state != KioskState::Attract);
+}
+
+void KioskRuntime::poll_metrics(double now_s) {
+  KioskMetrics& m = kiosk_metrics();
+  const ServoDisplayState& d = core_.display();
+  if (contact_clock_s_ >= 0.0 && d.state != ContactState::Free) m.add_contact(now_s - contact_clock_s_);
+  contact_clock_s_ = now_s;
+  if (ServoThread* servo = devices_.servo()) {
+    const ServoThread::Totals t = servo->totals();
+    m.set_servo(t.ticks, t.missed_deadlines, s_.haptics.servo_rate_hz);
+  }
+  const std::string device = !opt_.device.empty() ? "emulator" : devices_.usb() ? board_profile_type(s_) : "simulated";
+  m.set_device(device, d.device_status == DeviceStatus::Ok);
+  m.set_library_pictures(library_.picture_count());
+  if (watch_)
+    for (const std::uint64_t refused = watch_->refused(); library_refused_ < refused; ++library_refused_)
+      m.error(KioskError::library_refused);
 }
 
 void KioskRuntime::poll_after_input() {

@@ -4,11 +4,13 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "config/operator_pin.hpp"
 #include "config/store.hpp"
+#include "visit/fleet_settings.hpp"
 #include "visit/pin_verifier.hpp"
 
 namespace hk::app {
@@ -20,7 +22,7 @@ constexpr double kNoticeS = 8.0;  // a notice stays this long [s]
 
 OperatorSession::OperatorSession(std::string settings_path, const config::Settings& in_use, std::string load_notice,
                                  ApplyFn apply)
-    : files_{std::move(settings_path), {}, std::move(load_notice)},
+    : files_{std::move(settings_path), {}, std::move(load_notice), {}},
       apply_fn_(std::move(apply)),
       in_use_(in_use),
       saved_(in_use),
@@ -221,8 +223,23 @@ const std::string& OperatorSession::field_error(const config::FieldDescriptor& d
   return field_errors_[index_of(d)];
 }
 
+void OperatorSession::set_fleet(std::string path, std::vector<std::string> managed) {
+  files_.fleet_path = std::move(path);
+  managed_ = std::move(managed);
+}
+
+bool OperatorSession::managed(const config::FieldDescriptor& d) const {
+  const std::string key = std::string(d.table) + "." + std::string(d.key);
+  return std::find(managed_.begin(), managed_.end(), key) != managed_.end();
+}
+
 std::string OperatorSession::commit_field(const config::FieldDescriptor& d, std::int64_t) {
   const std::size_t i = index_of(d);
+  if (managed(d)) {
+    edit_texts_[i] = config::field_text(working_, d);
+    return field_errors_[i] =
+               format(tr("Set by the museum in %s: change it there, for every kiosk."), files_.fleet_path.c_str());
+  }
   const std::string loader_line = config::set_field_from_text(working_, d, edit_texts_[i]);
   if (loader_line.empty()) {
     field_errors_[i].clear();
@@ -255,7 +272,9 @@ std::string OperatorSession::save(std::int64_t now_unix_s) {
   try {
     // A `pin set` made while the panel was open must not be undone: the hash on disk wins.
     try {
-      to_save.operator_.pin_hash = config::load_settings(files_.settings_path).operator_.pin_hash;
+      const config::Settings on_disk = config::load_settings(files_.settings_path);
+      to_save.operator_.pin_hash = on_disk.operator_.pin_hash;
+      to_save = keep_own(to_save, on_disk, managed_);  // the museum's values stay in fleet.toml
     } catch (const config::ConfigError&) {
       // The file on disk is unreadable: ours is the one to write.
     }
@@ -277,7 +296,7 @@ std::string OperatorSession::save(std::int64_t now_unix_s) {
 void OperatorSession::reset_to_defaults(std::int64_t now_unix_s) {
   config::Settings d;
   d.operator_ = working_.operator_;
-  working_ = d;
+  working_ = keep_own(d, working_, managed_);
   const auto fields = config::field_descriptors();
   for (std::size_t i = 0; i < fields.size(); ++i) {
     edit_texts_[i] = config::field_text(working_, fields[i]);

@@ -10,6 +10,7 @@
 
 #include "haptics/tolerance_cut.hpp"
 #include "pictures/picture_library.hpp"
+#include "runtime/metrics.hpp"
 #include "runtime/runtime_params.hpp"
 #include "visit/describe.hpp"
 #include "visit/read_aloud.hpp"
@@ -130,6 +131,8 @@ void Stage::publish(Shown sh, std::unique_ptr<Scene> scene, int id, std::vector<
   bundle->text_blocks_m = std::move(text_boxes);
   sh.scene = bundle->scene.get();
   shown_ = std::move(sh);
+  const bool practice = id <= -1 && id >= -3;
+  if (id != shown_id_ && !practice) kiosk_metrics().add(KioskCount::pictures_explored);  // not a rebuild of it
   shown_id_ = id;
   tour_.picture_changed(id, static_cast<int>(sc.curve_count()));
   step_.publish(std::move(bundle));
@@ -160,6 +163,7 @@ void Stage::text_arrived(TextRead& read) {
   ImageScene& is = read.scene;
   spdlog::info("text of scene {}: {}, {} words in {} blocks, read in {:.0f} ms", read.id, is.ocr.why, is.ocr.words,
                is.text_blocks.size(), read.wall_ms);
+  kiosk_metrics().observe(KioskTiming::ocr, read.wall_ms / 1000.0);
   const audio::MessageCatalog& m = audio_.messages();
   text_news_id_ = read.id;
   const bool built = is.scene != nullptr;

@@ -219,6 +219,11 @@ struct KioskSettings {
                ///< win over the file beside the picture): "auto" ($STATE_DIRECTORY/names under the service, else
                ///< $XDG_DATA_HOME/haptic-kiosk/names, else ~/.local/share/haptic-kiosk/names), "off" (only the files
                ///< beside the pictures), or an absolute folder
+  std::string library =
+      "auto";  ///< key library, the picture library folder, watched: a picture added, changed or removed there is
+               ///< taken without a restart once its files have been unchanged for 2 s and it decodes. "auto"
+               ///< ($STATE_DIRECTORY/library under the service, else the shipped pictures) or an absolute folder;
+               ///< the shipped pictures while it holds none. The command line's --library wins
   std::string say_names_on_touch = "on";  ///< key say_names_on_touch, "on": the first touch of a named shape in a visit
                                           ///< of a picture says its name, once; "off": names only when asked
   std::string languages = "en, fr, de, es";  ///< key languages, the languages offered to visitors, BCP 47 tags
@@ -372,6 +377,14 @@ struct CopySettings {
   bool operator==(const CopySettings&) const = default;
 };
 
+/// [metrics] — the Prometheus metrics endpoint that a museum's monitoring scrapes (counts only, no visitor data).
+struct MetricsSettings {
+  std::string listen;  ///< key listen, "ADDRESS:PORT" the endpoint listens on for GET /metrics (an IPv4 address, or
+                       ///< an IPv6 one in brackets: "127.0.0.1:9471", "[::1]:9471"); "" = off
+
+  bool operator==(const MetricsSettings&) const = default;
+};
+
 /// [operator] — the operator's panel: how it is opened, its PIN and where its records go.
 /// Paths left empty are beside the settings file: `<settings>.state` and `<settings>.audit.log`.
 struct OperatorSettings {
@@ -404,6 +417,7 @@ struct Settings {
   CameraSettings camera;
   KeysSettings keys;
   CopySettings copy;
+  MetricsSettings metrics;
   OperatorSettings operator_;  ///< TOML table [operator] (`operator` is a C++ keyword)
 
   /// Field-by-field equality (exact for doubles); used by round-trip checks.

@@ -41,6 +41,14 @@ class PictureShelf {
 
   /// Library pictures.
   int count() const { return static_cast<int>(pictures_.size()); }
+  /// Library picture `index`'s path (0 <= index < count()).
+  const std::string& path(int index) const { return pictures_.at(static_cast<std::size_t>(index)); }
+  /// The library's files, in order.
+  const std::vector<std::string>& pictures() const { return pictures_; }
+  /// The library's files become `pictures` (a listing of the folder watched): what was built ahead of a picture
+  /// still there is kept under its new index unless its path is in `changed` (its files changed); builds under
+  /// way and the ask waiting are dropped (they carry the old numbering).
+  void replace_pictures(std::vector<std::string> pictures, const std::vector<std::string>& changed);
   /// Index of `path` in the library (the same file, by std::filesystem::equivalent), −1 when it is not there.
   int find(const std::string& path) const;
   /// Puts `path` first in the library (documentation runs: --show of a picture from elsewhere).

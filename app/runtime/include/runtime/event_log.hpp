@@ -54,8 +54,9 @@ inline constexpr int kKioskEventCount = 12;  ///< none included
 /// The event's word ("visit_started"; "" for none).
 const char* kiosk_event_name(KioskEvent e);
 
-/// Logs `message` (one line) at `level` with `e` attached (the journal's HK_EVENT; "[word] " on standard error). Not
-/// for the servo thread (spdlog allocates and locks).
+/// Logs `message` (one line) at `level` with `e` attached (the journal's HK_EVENT; "[word] " on standard error), and
+/// counts it in kiosk_metrics() (metrics.hpp: visits, sticks, copies, settings applied; refusals, failures and lost
+/// devices as errors). Not for the servo thread (spdlog allocates and locks).
 void log_event(KioskEvent e, spdlog::level::level_enum level, std::string_view message);
 
 /// The event of the line being logged on this thread: `e` inside log_event, `none` otherwise (the sinks read it).

@@ -126,6 +126,14 @@ class LibraryEffects {
   virtual int show_picture(int index) = 0;
   /// Pictures in the library (≥ 1).
   virtual int picture_count() const = 0;
+  /// The visitor moves to library picture `index` from picture `from` (0-based, of the library as it is; `from` −1
+  /// when they were on none): a new listing of the library folder that waited while a picture was felt is taken
+  /// now. Returns the index, in the library from now on, of that same picture; when it is gone, of the one after
+  /// `from` by file name (before it, for a step back), round the ends.
+  virtual int moving_to(int index, int from) {
+    (void)from;
+    return index;
+  }
 };
 
 /// A USB stick's documents.

@@ -23,11 +23,13 @@
 #include "formats/picture_notes.hpp"
 #include "pictures/capture_service.hpp"
 #include "pictures/image_scene.hpp"
+#include "pictures/library_watch.hpp"
 #include "pictures/picture_shelf.hpp"
 #include "pictures/stick_service.hpp"
 #include "pictures/text_reader.hpp"
 #include "runtime/device_host.hpp"
 #include "runtime/guided_tour.hpp"
+#include "runtime/metrics_server.hpp"
 #include "runtime/servo_step.hpp"
 #include "runtime/servo_thread.hpp"
 #include "visit/camera_desk.hpp"
@@ -45,7 +47,11 @@ namespace hk::app {
 
 /// What the runtime is started with besides the settings.
 struct RuntimeOptions {
-  std::string library;            ///< picture folder (already resolved; must hold at least one picture)
+  std::string library;  ///< picture folder (already resolved); without library_settle_s it must hold a picture
+  /// > 0: `library` is watched (library_watch.hpp) with this quiet time [s], and the pictures there are live as
+  /// they settle; while it holds none, the pictures of `shipped_library` are the library. 0: read once at start.
+  double library_settle_s = 0.0;
+  std::string shipped_library;    ///< the shipped pictures' folder (with library_settle_s)
   bool hotplug = true;            ///< watch for USB sticks (libudev)
   std::string mount_root;         ///< where sticks are mounted; empty: sticks::kDefaultStickMountRoot
   bool high_contrast = false;     ///< start (and every session) in high contrast
@@ -89,14 +95,17 @@ class KioskRuntime final : private SessionEffects {
   /// What the visitor's flow asks of the kiosk, each answered by the part that does it (kiosk_effects.hpp).
   KioskEffects effects();
 
-  /// Window thread, every frame (`now_s` the frame clock [s]), before the frame's input: the news of the
-  /// library's scenes (LibraryDesk::poll), of sticks (StickDesk::poll) and of the camera (CameraDesk::poll)
-  /// handed to `flow` (null: a headless caller; the library's pictures are still felt, stick and camera news
-  /// wait), the text of the page shown (Stage::poll_text), and the device: says when the handle has been lost
-  /// for 0.5 s and, after that, when it works again (shorter losses are not spoken), and, while the simulated
-  /// pantograph stands in for a USB pantograph that was not found, switches to one that arrives (USB
-  /// hot-plug, or a probe every 10 s).
+  /// Window thread, every frame (`now_s` the frame clock [s]), before the frame's input: a new listing of the
+  /// library folder watched (LibraryDesk::offer_listing), the news of the library's scenes (LibraryDesk::poll), of
+  /// sticks (StickDesk::poll) and of the camera (CameraDesk::poll) handed to `flow` (null: a headless caller; the
+  /// library's pictures are still felt, stick and camera news wait), the text of the page shown (Stage::poll_text), and
+  /// the device: says when the handle has been lost for 0.5 s and, after that, when it works again (shorter losses are
+  /// not spoken), and, while the simulated pantograph stands in for a USB pantograph that was not found, switches to
+  /// one that arrives (USB hot-plug, or a probe every 10 s); then the metrics of the frame (servo totals, device, time
+  /// in contact, library size; metrics.hpp).
   void poll(KioskFlow* flow, double now_s);
+  /// The metrics endpoint's port (0: [metrics] listen is off, or it could not listen: logged).
+  int metrics_port() const { return metrics_ ? metrics_->port() : 0; }
   /// Window thread, every frame, after the frame's input: the guided tour (TourDesk::poll), the display
   /// switches said (DisplaySwitches::poll), and scene bundles the servo thread has let go of freed.
   void poll_after_input();
@@ -148,6 +157,7 @@ class KioskRuntime final : private SessionEffects {
   void new_session() override;
   void poll_device(double now_s);
   void rebuild_shown();
+  void poll_metrics(double now_s);  // the frame's servo totals, device, time in contact and library size
   void adopt_board_profile();  // the board's profile in force: settings_for_board, then servo params, hand and gains
                                // from them
 
@@ -162,13 +172,18 @@ class KioskRuntime final : private SessionEffects {
   ServoStep core_;
   DeviceHost devices_;  // after core_: its servo thread steps core_, and stops before core_ goes
   TourDesk tour_;
-  PictureShelf shelf_;  // the library's scenes, asked for and built ahead
+  std::unique_ptr<LibraryWatch> watch_;  // the library folder watched (null: read once)
+  std::vector<std::string> shipped_;     // the shipped pictures, the library while the folder watched holds none
+  PictureShelf shelf_;                   // the library's scenes, asked for and built ahead
   Stage stage_;
   LibraryDesk library_;
   DisplaySwitches switches_;
-  CameraDesk camera_;  // its worker stops before the rest goes
-  StickDesk sticks_;   // its threads stop before the parts above go
-  CopyDesk copies_;    // last: its worker, which may wait on sticks_, stops first
+  CameraDesk camera_;                       // its worker stops before the rest goes
+  StickDesk sticks_;                        // its threads stop before the parts above go
+  CopyDesk copies_;                         // its worker, which may wait on sticks_, stops before sticks_ goes
+  std::unique_ptr<MetricsServer> metrics_;  // last, so it stops first: [metrics] listen (null: off)
+  double contact_clock_s_ = -1.0;           // poll's clock at its last call, for the time in contact
+  std::uint64_t library_refused_ = 0;       // the watch's refusals already counted
 };
 
 /// The device profile in force (config/device_profile.hpp): the board's ("haply", "haply-gen2") while a USB

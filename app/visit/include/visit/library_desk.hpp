@@ -4,11 +4,18 @@
 /// was built ahead, else asked of the scene builder (PictureShelf) and put on the device when it comes, the
 /// picture felt before staying until then; the next and previous pictures are built ahead. It answers the
 /// visitor's flow's LibraryEffects (kiosk_effects.hpp). Window thread only.
+///
+/// A new listing of the library (its folder watched, library_watch.hpp) is taken while nobody is on a visit; during
+/// a visit it waits until the visitor moves to a picture (moving_to), so the picture explored stays, under the
+/// same number, until they move on; Next from a picture that has gone is the one after it by file name, Previous the
+/// one before it.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "pictures/library_watch.hpp"
 #include "pictures/picture_shelf.hpp"
 #include "visit/kiosk_effects.hpp"
 #include "visit/stage.hpp"
@@ -28,6 +35,14 @@ class LibraryDesk final : public LibraryEffects {
   /// The picture felt before stays until then. The operator's level comes back (reset_level).
   int show_picture(int index) override;
   int picture_count() const override { return shelf_.count(); }
+  int moving_to(int index, int from) override;
+
+  /// A new listing of the library: `pictures` (paths, sorted by file name; an empty one is ignored), `changed`
+  /// those whose files changed since they were last listed. Taken by poll while the kiosk waits in attract (or
+  /// without a flow), else by moving_to; a newer listing replaces one still waiting.
+  void offer_listing(std::vector<std::string> pictures, std::vector<std::string> changed);
+  /// The listing offered and not yet taken, if any.
+  const std::optional<LibraryListing>& waiting() const { return waiting_; }
 
   /// Window thread, every frame (`now_s` the frame clock [s]): scenes the builder has finished. The one asked
   /// for is put on the device with the fade and handed to `flow` (picture_ready or picture_failed; null: a
@@ -52,9 +67,11 @@ class LibraryDesk final : public LibraryEffects {
 
  private:
   int put_picture(int index, ImageScene& is);  // library picture `index` on the device, with its notes; its shapes
+  void take_listing();                         // the listing waiting becomes the library's
 
   PictureShelf& shelf_;
   Stage& stage_;
+  std::optional<LibraryListing> waiting_;  // offered, not yet taken
 };
 
 }  // namespace hk::app

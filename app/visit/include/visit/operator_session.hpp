@@ -46,6 +46,7 @@ struct SessionFiles {
   std::string settings_path;  ///< the settings file (empty: the kiosk runs on defaults)
   std::string audit_path;     ///< the audit log beside it
   std::string load_notice;    ///< what start-up found wrong with the settings file; empty when it loaded
+  std::string fleet_path;     ///< the museum's fleet file in force (fleet_settings.hpp); empty: none
 };
 
 /// What apply_settings did with a change, for the operator panel and the audit.
@@ -93,6 +94,11 @@ class OperatorSession {
   void set_language(const std::string& language, const std::filesystem::path& locale_dir);
   /// The panel's words in the staff's language.
   const PanelText& words() const { return words_; }
+  /// The museum's fleet file in force (`path`) and the settings it manages ("table.key"): shown locked, refused
+  /// by commit_field, kept by reset_to_defaults, and saved with settings.toml's own values (fleet_settings.hpp).
+  void set_fleet(std::string path, std::vector<std::string> managed);
+  /// Whether the museum manages `d` (set_fleet).
+  bool managed(const config::FieldDescriptor& d) const;
 
   PanelState state() const { return state_; }
   /// The line shown under the PIN prompt or as the notice ("Wrong PIN. 2 failed attempts.", "Try again in 27 s.").
@@ -107,7 +113,8 @@ class OperatorSession {
   std::string& edit_text(const config::FieldDescriptor& d);
   /// Commits a field's edit box to the working copy: empty on success, else one line saying why not (also kept
   /// as field_error(d) and shown beside the field): in the staff's words for a value that is no number, no whole
-  /// number, out of range or no allowed choice (config::field_refusal), else the loader's own message.
+  /// number, out of range or no allowed choice (config::field_refusal), else the loader's own message; a field the
+  /// museum manages is refused as such and its box shows its value again.
   std::string commit_field(const config::FieldDescriptor& d, std::int64_t now_unix_s);
   /// The refusal of a field's last edit, empty when none.
   const std::string& field_error(const config::FieldDescriptor& d) const;
@@ -118,10 +125,11 @@ class OperatorSession {
   /// Hands the working copy to the kiosk; audit lines for every change. Returns the status line.
   std::string apply(std::int64_t now_unix_s);
   /// Applies, then saves the settings in use (atomic, .bak kept); the PIN hash on disk is kept (a
-  /// `pin set` made meanwhile is not undone). Returns the status line (the error, one line, on failure:
-  /// nothing in use is lost).
+  /// `pin set` made meanwhile is not undone), and so are the file's own values of the fields the museum manages.
+  /// Returns the status line (the error, one line, on failure: nothing in use is lost).
   std::string save(std::int64_t now_unix_s);
-  /// The working copy back to the defaults (the [operator] table kept: the PIN and where the records go).
+  /// The working copy back to the defaults (the [operator] table kept: the PIN and where the records go; the fields
+  /// the museum manages keep their values).
   /// Not applied or saved yet: the panel asks for confirmation before calling this.
   void reset_to_defaults(std::int64_t now_unix_s);
   /// The last status line (apply, save, reset).
@@ -153,6 +161,7 @@ class OperatorSession {
   std::string message_, status_;
   config::Settings in_use_, saved_, working_;
   std::vector<std::string> edit_texts_, field_errors_;
+  std::vector<std::string> managed_;  // "table.key" the museum's fleet file sets
 };
 
 }  // namespace hk::app

@@ -138,6 +138,9 @@ class Stage final : public StageEffects {
   int shown_id() const { return shown_id_; }
   /// Where what is shown came from.
   const ShownSource& source() const { return source_; }
+  /// The library picture shown is now number `index` of a new listing (−1: no longer in it). Its scene, and the
+  /// SceneBundle id the device holds it under, stay as they are.
+  void renumber_picture(int index) { source_.picture = index; }
   /// Scenes put on the device so far: what tests count to see that a superseded page never was.
   std::uint64_t scenes_published() const { return scenes_published_; }
   /// Level in use (the servo thread's, which follows the hand's speed in auto mode).
