@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "pictures/picture_library.hpp"
 #include "test_paths.hpp"
@@ -121,17 +122,10 @@ Run one_run(const fs::path& work) {
 int main(int argc, char** argv) {
   std::string out;
   int repeats = 3;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
-      out = argv[++i];
-    else if (a == "--repeats" && i + 1 < argc)
-      repeats = std::max(1, std::atoi(argv[++i]));
-    else {
-      std::fprintf(stderr, "usage: bench_library_reload [--out FILE.md] [--repeats N]\n");
-      return 2;
-    }
-  }
+  CLI::App cli("100 pictures copied into the watched library of a running kiosk");
+  cli.add_option("--out", out, "Write the table (Markdown) to this file too");
+  cli.add_option("--repeats", repeats, "Runs (each a fresh kiosk and folder)")->check(CLI::PositiveNumber);
+  CLI11_PARSE(cli, argc, argv);
   spdlog::set_level(spdlog::level::warn);
   const fs::path work = fs::temp_directory_path() / ("hk_bench_reload_" + std::to_string(::getpid()));
   std::vector<Run> runs;

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
@@ -83,17 +84,10 @@ Window play(KioskRuntime& rt, KioskFlow& flow, double seconds, double& now_s) {
 int main(int argc, char** argv) {
   std::string out;
   double seconds = 10.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
-      out = argv[++i];
-    else if (a == "--seconds" && i + 1 < argc)
-      seconds = std::max(1.0, std::atof(argv[++i]));
-    else {
-      std::fprintf(stderr, "usage: bench_metrics_endpoint [--out FILE.md] [--seconds S]\n");
-      return 2;
-    }
-  }
+  CLI::App cli("GET /metrics at 100 requests/s while the kiosk runs");
+  cli.add_option("--out", out, "Write the table (Markdown) to this file too");
+  cli.add_option("--seconds", seconds, "Seconds of each window, without and with the load")->check(CLI::PositiveNumber);
+  CLI11_PARSE(cli, argc, argv);
   spdlog::set_level(spdlog::level::warn);
   config::Settings s;
   s.kiosk.names_dir = "off";
