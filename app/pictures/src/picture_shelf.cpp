@@ -177,6 +177,7 @@ void PictureShelf::drop_want() {
 
 void PictureShelf::absorb_built() {
   for (BuiltScene& b : builder_.poll()) {
+    build_times_ms_.push_back(b.build_ms);
     if (b.generation != generation_) continue;  // built with settings no longer in use
     if (b.id == wanted_id_) {
       wanted_done_ = std::move(b);

@@ -27,7 +27,7 @@ constexpr std::array<const char*, kKioskErrorCount> kErrorKinds{
 };
 constexpr std::array<const char*, kKioskTimingCount> kTimingNames{"scene_build_seconds", "ocr_seconds"};
 constexpr std::array<const char*, kKioskTimingCount> kTimingHelp{
-    "Scene builds of library pictures, in seconds.",
+    "Scene builds of the library's pictures (asked for or built ahead, and rebuilt after Apply), in seconds.",
     "Readings of a picture's or page's text, in seconds.",
 };
 

@@ -90,7 +90,6 @@ void LibraryDesk::poll(KioskFlow* flow, double now_s) {
   if (std::optional<ShelfDelivery> d = shelf_.poll()) {
     BuiltScene& b = d->built;
     spdlog::info("scene {}: built in {:.0f} ms (waited {:.0f} ms to start)", b.id, b.build_ms, b.queued_ms);
-    kiosk_metrics().observe(KioskTiming::scene_build, b.build_ms / 1000.0);
     if (!b.scene) {
       kiosk_metrics().error(KioskError::picture_unreadable);
       spdlog::warn("scene {}: {}; the picture felt before stays", b.id, b.error);
@@ -106,6 +105,7 @@ void LibraryDesk::poll(KioskFlow* flow, double now_s) {
     }
   }
   shelf_.build_ahead(stage_.source().picture);
+  for (const double ms : shelf_.take_build_times_ms()) kiosk_metrics().observe(KioskTiming::scene_build, ms / 1000.0);
 }
 
 bool LibraryDesk::finish(KioskFlow* flow, double now_s, double timeout_s) {

@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "config/settings.hpp"
@@ -86,6 +87,9 @@ class PictureShelf {
   std::vector<int> ahead() const;
   /// Scene builds started since the start (asked for and built ahead).
   std::uint64_t builds_started() const { return builder_.builds_started(); }
+  /// How long each scene build that ended since the last call took [ms] (asked for, built ahead, rebuilt; those
+  /// dropped for old settings too), oldest first; the list is then emptied.
+  std::vector<double> take_build_times_ms() { return std::exchange(build_times_ms_, {}); }
 
  private:
   static constexpr int kNoWant = -1000000;
@@ -107,7 +111,8 @@ class PictureShelf {
   ShelfDelivery::Kind wanted_kind_ = ShelfDelivery::Kind::Picture;
   std::optional<BuiltScene> wanted_done_;  // the wanted scene's build, once ended
   std::vector<Ahead> ahead_;               // library pictures built ahead
-  std::vector<int> ahead_refused_;  // built ahead in this generation but failed or over the budget: not asked again
+  std::vector<int> ahead_refused_;      // built ahead in this generation but failed or over the budget: not asked again
+  std::vector<double> build_times_ms_;  // builds ended, not yet taken (take_build_times_ms)
 };
 
 }  // namespace hk::app
