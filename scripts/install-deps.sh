@@ -20,7 +20,7 @@ if [ "${1:-}" != "--demo" ]; then
     poppler-utils e2fsprogs util-linux mount qpdf dosfstools mtools cups-daemon cups-client
     dpkg-dev file lintian systemd cage
     clang libclang-rt-14-dev llvm-14 clang-format-14
-    prometheus ansible ansible-lint rsync
+    prometheus ansible ansible-lint
   )
 fi
 missing=()
