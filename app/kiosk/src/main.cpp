@@ -63,7 +63,8 @@ struct Commands {
 void add_kiosk_options(CLI::App& cli, hk::app::KioskOptions& ko) {
   cli.add_flag("--windowed", ko.windowed, "A 1280 x 720 window instead of full screen (development)");
   cli.add_option("--config", ko.config_path, "Settings file (TOML)");
-  cli.add_option("--library", ko.library, "Picture folder (default: the shipped data/pictures)");
+  cli.add_option("--library", ko.library,
+                 "Picture folder, watched for pictures added, changed or removed (default: [kiosk] library)");
   cli.add_option("--show", ko.show, "Start on this picture, past the welcome and tutorial (documentation, tests)");
   cli.add_flag("--high-contrast", ko.high_contrast,
                "Start in high contrast: dimmed picture, thick bright curves (also in the operator's panel)");
