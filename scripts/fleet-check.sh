@@ -115,7 +115,13 @@ for h in "${hosts[@]}"; do
   chroot "$work/$h" dpkg-query -W -f='${Package} ${Version}\n' haptic-kiosk
   cat "$work/$h/etc/haptic-kiosk/fleet.toml"
   grep -c '^pin_hash = "\$argon2id' "$work/$h/etc/haptic-kiosk/settings.toml" | sed 's/^/pin_hash lines in settings.toml: /'
-  ls "$work/$h/var/lib/haptic-kiosk/library"
+  ls "$work/$h/var/lib/haptic-kiosk/library" | tr '\n' ' '
+  echo
+  # The installed kiosk reads what it was given: the PIN rolled out opens, the library checks clean.
+  chroot "$work/$h" sh -c "printf '2468\n' | haptic-kiosk pin check --config /etc/haptic-kiosk/settings.toml" ||
+    { echo "fleet-check: $h: the PIN rolled out does not open the panel" >&2; exit 1; }
+  echo "pin check: the PIN rolled out opens the panel"
+  chroot "$work/$h" haptic-kiosk library check /var/lib/haptic-kiosk/library --config /etc/haptic-kiosk/settings.toml
 done
 echo "fleet-check: a broken library (half a PNG)"
 library_sums > "$work/before.sums"
