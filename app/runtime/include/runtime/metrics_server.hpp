@@ -10,8 +10,8 @@
 /// | another method on /metrics | 405, `Allow: GET, HEAD` |
 /// | another path | 404 |
 /// | a request line and headers over 8 KiB | refused by the library (4xx) or the connection closed |
-/// | connections over 16 open at once | closed as soon as they are accepted; those the kernel has not handed over yet wait in its listen backlog (16), never in the kiosk's files |
-/// | a connection idle for 10 s | closed (so held-open connections free their places) |
+/// | connections over 16 open at once | closed as soon as accepted (the rest wait in the kernel's backlog of 16) |
+/// | a connection idle for 10 s | closed, so held-open connections free their places |
 ///
 /// libmicrohttpd rather than cpp-httplib: cpp-httplib 0.11 (Debian 12) queues every accepted connection for its
 /// worker pool and has no way to close the ones over a limit, which is what a flood of held-open connections must
