@@ -22,6 +22,7 @@
 #include <CLI/CLI.hpp>
 
 #include "pictures/picture_library.hpp"
+#include "runtime_ticks.hpp"
 #include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
@@ -61,13 +62,9 @@ Run one_run(const fs::path& work) {
 
   config::Settings s;
   s.kiosk.names_dir = "off";
-  RuntimeOptions ro;
-  ro.library = lib.string();
+  RuntimeOptions ro = hk::test::headless_runtime_options(lib);
   ro.library_settle_s = kLibrarySettle_s;
   ro.shipped_library = std::string(HK_DATA_DIR) + "/pictures";
-  ro.hotplug = false;
-  ro.open_audio_output = false;
-  ro.probe_usb_device = false;
   KioskRuntime rt(ro, s);
   rt.start_servo();
   KioskFlow flow(rt.effects(), rt.audio().messages(), flow_params_from(s, false));

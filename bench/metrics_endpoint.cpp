@@ -23,6 +23,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "runtime_ticks.hpp"
 #include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
 #include "visit/kiosk_runtime.hpp"
@@ -92,12 +93,7 @@ int main(int argc, char** argv) {
   config::Settings s;
   s.kiosk.names_dir = "off";
   s.metrics.listen = "127.0.0.1:0";
-  RuntimeOptions ro;
-  ro.library = HK_SHIPPED_PICTURES_DIR;
-  ro.hotplug = false;
-  ro.open_audio_output = false;
-  ro.probe_usb_device = false;
-  KioskRuntime rt(ro, s);
+  KioskRuntime rt(hk::test::headless_runtime_options(HK_SHIPPED_PICTURES_DIR), s);
   rt.start_servo();
   KioskFlow flow(rt.effects(), rt.audio().messages(), flow_params_from(s, false));
   double now_s = 0.0;

@@ -10,6 +10,7 @@
 
 #include "audio/messages.hpp"
 #include "pictures/library_watch.hpp"
+#include "runtime_ticks.hpp"
 #include "temp_dir.hpp"
 #include "test_paths.hpp"
 #include "visit/kiosk_flow.hpp"
@@ -208,14 +209,9 @@ struct WatchedKiosk {
   double now_s = 0.0;
 
   void start() {
-    hk::app::RuntimeOptions ro;
-    ro.library = lib.string();
+    hk::app::RuntimeOptions ro = hk::test::headless_runtime_options(lib);
     ro.library_settle_s = 0.3;
     ro.shipped_library = HK_SHIPPED_PICTURES_DIR;
-    ro.hotplug = false;
-    ro.open_audio_output = false;
-    ro.probe_usb_device = false;
-    ro.probe_camera = false;
     s.kiosk.names_dir = "off";
     s.kiosk.say_names_on_touch = "off";
     rt = std::make_unique<hk::app::KioskRuntime>(ro, s);

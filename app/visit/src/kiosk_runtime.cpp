@@ -237,8 +237,14 @@ void KioskRuntime::poll_metrics(double now_s) {
     const ServoThread::Totals t = servo->totals();
     m.set_servo(t.ticks, t.missed_deadlines, s_.haptics.servo_rate_hz);
   }
-  const std::string device = !opt_.device.empty() ? "emulator" : devices_.usb() ? board_profile_type(s_) : "simulated";
-  m.set_device(device, d.device_status == DeviceStatus::Ok);
+  const char* device = !opt_.device.empty() ? "emulator" : devices_.usb() ? nullptr : "simulated";
+  const std::string name = device ? device : board_profile_type(s_);
+  const bool connected = d.device_status == DeviceStatus::Ok;
+  if (name != metrics_device_ || connected != metrics_connected_) {  // the registry's lock only on a change
+    metrics_device_ = name;
+    metrics_connected_ = connected;
+    m.set_device(name, connected);
+  }
   m.set_library_pictures(library_.picture_count());
   if (watch_)
     for (const std::uint64_t refused = watch_->refused(); library_refused_ < refused; ++library_refused_)

@@ -184,6 +184,8 @@ class KioskRuntime final : private SessionEffects {
   std::unique_ptr<MetricsServer> metrics_;  // last, so it stops first: [metrics] listen (null: off)
   double contact_clock_s_ = -1.0;           // poll's clock at its last call, for the time in contact
   std::uint64_t library_refused_ = 0;       // the watch's refusals already counted
+  std::string metrics_device_;              // the device as the metrics last had it
+  bool metrics_connected_ = false;
 };
 
 /// The device profile in force (config/device_profile.hpp): the board's ("haply", "haply-gen2") while a USB
